@@ -1,0 +1,20 @@
+"""allanite — static and dynamic Allan variance for gyroscopes, IMUs and clocks, with a Rust core.
+
+Main entry points: :func:`avar` (static overlapping/classic Allan variance), :func:`davar` (dynamic
+Allan variance on a sliding window, naive or fast), :func:`tau_grid` (τ grids). Errors are
+:class:`AllaniteError` subclasses of ``ValueError``.
+"""
+
+from ._core import __version__
+from .allan import avar, davar
+from .datasets import default_record
+from .errors import AllaniteError, InputError, MemoryBudgetError, ParameterError
+from .grid import tau_grid
+from .results import AllanResult, DynamicAllanResult
+
+__all__ = [
+    "avar", "davar", "tau_grid", "default_record",
+    "AllanResult", "DynamicAllanResult",
+    "AllaniteError", "InputError", "ParameterError", "MemoryBudgetError",
+    "__version__",
+]

@@ -1,0 +1,107 @@
+"""Turning what users pass into what the core needs: contiguous float64 rate columns.
+
+Kept apart from the estimators so that readers, the CLI and later estimators share one set of
+checks and one set of messages.
+"""
+
+from __future__ import annotations
+
+import numbers
+import os
+
+import numpy as np
+
+from .errors import InputError, ParameterError
+from .grid import _check_count, _check_fs
+
+INPUTS = ("rate", "increment", "angle")
+DEFAULT_MAX_MEMORY = 2 * 1024**3
+
+
+def check_choice(value, name: str, allowed) -> str:
+    if not isinstance(value, str) or value not in allowed:
+        raise ParameterError(f"unknown {name} {value!r}; allowed: {', '.join(map(repr, allowed))}")
+    return value
+
+
+def as_rate_columns(x, fs, input: str):
+    """Validate samples and convert them to rate columns.
+
+    Returns ``(columns, fs, is_multi)``: a list of C-contiguous float64 arrays (one per axis) of rate
+    samples, the sampling rate, and whether the input had an axes dimension. ``input="increment"``
+    (angle per sample) is divided by τ0; ``input="angle"`` (cumulative angle, M + 1 points) is
+    differenced first. All three describe the same record and give the same Allan variance.
+    """
+    fs = _check_fs(fs)
+    check_choice(input, "input", INPUTS)
+    try:
+        arr = np.asarray(x)
+    except Exception as exc:  # ragged lists and the like
+        raise InputError(f"samples could not be read as a numeric array: {exc}") from None
+    if arr.dtype.kind not in "iuf":
+        raise InputError(
+            f"samples must be real numbers (integer or float dtype), got dtype {arr.dtype} "
+            f"({'bool' if arr.dtype.kind == 'b' else arr.dtype.kind!r} kind)"
+        )
+    if arr.ndim not in (1, 2):
+        raise InputError(
+            f"samples must be 1-D (samples,) or 2-D (samples, axes), got {arr.ndim}-D with shape {arr.shape}"
+        )
+    is_multi = arr.ndim == 2
+    cols = [arr] if not is_multi else [arr[:, a] for a in range(arr.shape[1])]
+    if is_multi and arr.shape[1] == 0:
+        raise InputError(f"samples have shape {arr.shape}: at least one axis is needed")
+    n_points = arr.shape[0]
+    need = 3 if input == "angle" else 2
+    if n_points < need:
+        what = "angle points" if input == "angle" else "samples"
+        raise InputError(f"record has {n_points} {what}; at least {need} are needed for any Allan variance")
+    out = []
+    for a, c in enumerate(cols):
+        c = np.asarray(c, dtype=np.float64)
+        finite = np.isfinite(c)
+        if not finite.all():
+            i = int(np.argmin(finite))
+            where = f"sample {i}" + (f" of axis {a}" if is_multi else "")
+            raise InputError(f"samples contain a non-finite value ({c[i]}) at {where}; only finite numbers are allowed")
+        if input == "rate":
+            y = np.ascontiguousarray(c)
+        elif input == "increment":
+            y = c * fs
+        else:
+            y = np.diff(c) * fs
+        out.append(y)
+    return out, fs, is_multi
+
+
+def resolve_workers(workers) -> int:
+    """Threads for the core: ``workers`` if given, else ``ALLANITE_NUM_THREADS``, else 0 (rayon's
+    default: ``RAYON_NUM_THREADS`` or the number of cores)."""
+    if workers is None:
+        env = os.environ.get("ALLANITE_NUM_THREADS", "").strip()
+        if not env:
+            return 0
+        try:
+            workers = int(env)
+        except ValueError:
+            raise ParameterError(f"ALLANITE_NUM_THREADS={env!r} must be a positive integer") from None
+        if workers < 1:
+            raise ParameterError(f"ALLANITE_NUM_THREADS={env!r} must be a positive integer")
+        return workers
+    return _check_count(workers, "workers", 1)
+
+
+def resolve_max_memory(max_memory) -> int:
+    """Byte budget for a result: ``max_memory`` if given, else ``ALLANITE_MAX_MEMORY``, else 2 GiB."""
+    if max_memory is None:
+        env = os.environ.get("ALLANITE_MAX_MEMORY", "").strip()
+        if not env:
+            return DEFAULT_MAX_MEMORY
+        try:
+            max_memory = float(env)
+        except ValueError:
+            raise ParameterError(f"ALLANITE_MAX_MEMORY={env!r} must be a number of bytes") from None
+    if isinstance(max_memory, bool) or not isinstance(max_memory, (numbers.Real, np.integer, np.floating)) \
+            or not np.isfinite(max_memory) or max_memory <= 0:
+        raise ParameterError(f"max_memory must be a positive number of bytes, got {max_memory!r}")
+    return int(max_memory)

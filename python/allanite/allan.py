@@ -1,0 +1,156 @@
+"""Static and dynamic Allan variance — the public entry points over the Rust core."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _core
+from ._input import as_rate_columns, check_choice, resolve_max_memory, resolve_workers
+from .errors import MemoryBudgetError, ParameterError
+from .grid import _check_count, resolve_taus
+from .results import AllanResult, DynamicAllanResult
+
+__all__ = ["avar", "davar", "ESTIMATORS", "METHODS"]
+
+ESTIMATORS = ("oavar", "avar")
+METHODS = ("fast", "naive")
+
+
+def _n_terms(estimator: str, window: int, ms: np.ndarray) -> np.ndarray:
+    if estimator == "oavar":
+        return (window + 1 - 2 * ms).astype(np.int64)
+    return (window // ms - 1).astype(np.int64)
+
+
+def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar", workers=None) -> AllanResult:
+    """Allan variance of a whole record.
+
+    Parameters
+    ----------
+    x : array_like, shape (samples,) or (samples, axes)
+        Samples: rate (e.g. °/s), increments (angle per sample) or cumulative angle, per ``input``.
+        Any real dtype, any strides or byte order; computed in float64.
+    fs : float
+        Sampling rate, Hz (τ0 = 1/fs).
+    input : {"rate", "increment", "angle"}
+        What the samples are. Equivalent inputs give the same numbers: rate y, increments y/fs and
+        angle ``[0, cumsum(y/fs)]`` (M + 1 points). Results are always in rate units.
+    taus : str or array_like
+        A grid name (``"octave"``, default; ``"decade"``, ``"all"``, ``"exp"`` — see
+        :func:`allanite.tau_grid`) or τ in seconds, each rounded to m = round(τ·fs) and required to be
+        valid; ``result.tau`` holds the τ actually used.
+    estimator : {"oavar", "avar"}
+        Overlapping (default; NIST SP 1065 eq. 11) or classic non-overlapping Allan variance.
+    workers : int, optional
+        Threads (default: ``ALLANITE_NUM_THREADS``, else all cores). Results do not depend on it.
+
+    Returns
+    -------
+    AllanResult
+        ``tau``, ``avar``, ``adev``, ``n`` (terms per τ), ``m``; for 2-D input ``avar`` is
+        (axes, tau).
+
+    Examples
+    --------
+    >>> import numpy as np, allanite
+    >>> y = np.random.default_rng(1).normal(size=100_000)      # white rate noise, σ = 1
+    >>> r = allanite.avar(y, fs=100.0, taus=[0.01, 0.1, 1.0])
+    >>> r.tau
+    array([0.01, 0.1 , 1.  ])
+    >>> np.round(r.adev * np.sqrt(r.m), 2)                      # ARW: adev·√m ≈ σ
+    array([1.  , 1.  , 0.99])
+    """
+    check_choice(estimator, "estimator", ESTIMATORS)
+    cols, fs, is_multi = as_rate_columns(x, fs, input)
+    n = cols[0].size
+    ms = resolve_taus(taus, n, fs)
+    out = _core.davar(cols, n, 1, [int(m) for m in ms], estimator, "fast", resolve_workers(workers))
+    values = out[:, :, 0] if is_multi else out[0, :, 0]
+    return AllanResult(
+        tau=ms / fs, avar=values, n=_n_terms(estimator, n, ms), m=ms,
+        estimator=estimator, fs=fs, n_samples=n, input=input,
+    )
+
+
+def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: str = "oavar",
+          input: str = "rate", workers=None, max_memory=None) -> DynamicAllanResult:
+    """Dynamic Allan variance: the Allan variance of every sliding window (DAVAR).
+
+    Column j of the result is exactly the static Allan variance (:func:`avar`) of the ``window``
+    samples starting at sample ``j·hop``, for every window that fits in the record, at the same τ.
+
+    Parameters
+    ----------
+    x : array_like, shape (samples,) or (samples, axes)
+        Samples, as for :func:`avar`.
+    fs : float
+        Sampling rate, Hz.
+    window : int
+        Window length in samples (rate or increment samples; for ``input="angle"`` in angle
+        intervals). 2 ≤ window ≤ record length.
+    hop : int
+        Distance between window starts, samples (≥ 1).
+    taus : str or array_like
+        Grid name or τ in seconds, for the *window*: ``"exp"`` (default) is paper 000's exponential
+        grid up to window/9 — with ``method="fast"`` this is the "improved fast DAVAR".
+    method : {"fast", "naive"}
+        ``"fast"``: sliding block sums, O(record) work per τ whatever the window and hop, exact to
+        rounding (no drift, see the core's notes). ``"naive"``: recompute every window from
+        scratch — paper 000's DAVAR, O(window) per τ per window; kept as a reference and baseline.
+    estimator : {"oavar", "avar"}
+        Overlapping (default) or classic Allan variance inside each window.
+    input : {"rate", "increment", "angle"}
+    workers : int, optional
+        Threads (default ``ALLANITE_NUM_THREADS``, else all cores); results are bit-identical for
+        any value. The GIL is released while the core computes.
+    max_memory : int, optional
+        Byte budget for the output (default ``ALLANITE_MAX_MEMORY`` or 2 GiB). A larger request
+        raises :class:`~allanite.errors.MemoryBudgetError` at once, with a hop that fits.
+
+    Returns
+    -------
+    DynamicAllanResult
+        ``tau``, ``t`` (window centres, s), ``avar`` of shape (tau, t) — or (axes, tau, t) for 2-D
+        input —, ``adev``, ``n`` (terms per window at each τ).
+
+    Examples
+    --------
+    >>> import numpy as np, allanite
+    >>> y = np.random.default_rng(2).normal(size=20_000)
+    >>> y[10_000:] *= 10                                        # the noise grows tenfold
+    >>> d = allanite.davar(y, 100.0, window=2_000, hop=500, taus=[0.01, 0.1])
+    >>> d.avar.shape                                            # (tau, t)
+    (2, 37)
+    >>> np.round(d.adev[0, [0, -1]], 1)                         # before and after, at τ = 0.01 s
+    array([ 1., 10.])
+    """
+    check_choice(estimator, "estimator", ESTIMATORS)
+    check_choice(method, "method", METHODS)
+    cols, fs, is_multi = as_rate_columns(x, fs, input)
+    n = cols[0].size
+    window = _check_count(window, "window", 2)
+    hop = _check_count(hop, "hop", 1)
+    if window > n:
+        raise ParameterError(f"window ({window} samples) is longer than the record ({n} samples)")
+    ms = resolve_taus(taus, window, fs)
+    n_win = (n - window) // hop + 1
+    n_axes = len(cols)
+    nbytes = n_axes * ms.size * n_win * 8
+    budget = resolve_max_memory(max_memory)
+    if nbytes > budget:
+        # windows scale as 1/hop: the smallest hop whose output fits.
+        per_window = n_axes * ms.size * 8
+        max_windows = max(1, budget // per_window)
+        suggest = max(hop + 1, -(-(n - window) // max(1, max_windows - 1)) if max_windows > 1 else n)
+        raise MemoryBudgetError(
+            f"the output would take {nbytes / 2**30:.2f} GiB ({n_axes} axes × {ms.size} τ × {n_win} windows "
+            f"× 8 bytes), over the memory budget of {budget / 2**30:.2f} GiB; use hop ≥ {suggest}, fewer τ, "
+            f"or raise max_memory / ALLANITE_MAX_MEMORY"
+        )
+    out = _core.davar(cols, window, hop, [int(m) for m in ms], estimator, method, resolve_workers(workers))
+    values = out if is_multi else out[0]
+    t = (np.arange(n_win) * hop + window / 2) / fs
+    return DynamicAllanResult(
+        tau=ms / fs, t=t, avar=values, n=_n_terms(estimator, window, ms), m=ms, window=window, hop=hop,
+        method=method, estimator=estimator, fs=fs, n_samples=n, input=input,
+    )

@@ -1,0 +1,13 @@
+//! allanite-core: the pure-Rust estimators behind the `allanite` Python package.
+//!
+//! Nothing here knows about Python. Inputs are rate samples (`&[f64]`), outputs plain vectors; every
+//! entry point validates its arguments and returns [`CoreError`] instead of panicking.
+
+pub mod allan;
+pub mod error;
+
+pub use allan::{
+    compensated_mean, dynamic_avar, max_m, n_terms, n_windows, run_in_pool, static_avar, Estimator,
+    Method, Request,
+};
+pub use error::{CoreError, Result};

@@ -1,0 +1,94 @@
+//! The `allanite._core` extension module: numpy in, numpy out, GIL released around the work.
+//! Nothing else lives here — validation with friendly messages happens in Python, the arithmetic in
+//! allanite-core, and core errors come back as `allanite.errors.AllaniteError` (a ValueError).
+
+use allanite_core::{dynamic_avar, run_in_pool, CoreError, Estimator, Method, Request};
+use numpy::ndarray::Array3;
+use numpy::{IntoPyArray, PyArray3, PyReadonlyArray1};
+use pyo3::prelude::*;
+
+/// Raises `allanite.errors.AllaniteError(msg)`; falls back to ValueError if the package is absent.
+fn allanite_error(py: Python<'_>, msg: String) -> PyErr {
+    let made = py
+        .import("allanite.errors")
+        .and_then(|m| m.getattr("AllaniteError"))
+        .and_then(|cls| cls.call1((msg.clone(),)));
+    match made {
+        Ok(instance) => PyErr::from_value(instance),
+        Err(_) => pyo3::exceptions::PyValueError::new_err(msg),
+    }
+}
+
+fn core_error(py: Python<'_>, e: CoreError) -> PyErr {
+    allanite_error(py, e.to_string())
+}
+
+fn parse_estimator(py: Python<'_>, s: &str) -> PyResult<Estimator> {
+    match s {
+        "oavar" => Ok(Estimator::Overlapping),
+        "avar" => Ok(Estimator::Classic),
+        other => Err(allanite_error(
+            py,
+            format!("unknown estimator {other:?}; allowed: 'oavar', 'avar'"),
+        )),
+    }
+}
+
+fn parse_method(py: Python<'_>, s: &str) -> PyResult<Method> {
+    match s {
+        "fast" => Ok(Method::Fast),
+        "naive" => Ok(Method::Naive),
+        other => Err(allanite_error(
+            py,
+            format!("unknown method {other:?}; allowed: 'fast', 'naive'"),
+        )),
+    }
+}
+
+/// Allan variance of every window at every averaging factor, for every axis.
+///
+/// `columns`: one contiguous float64 rate record per axis (equal lengths). Returns an array of shape
+/// (axes, len(ms), windows). `window == len(record)` gives the static estimator.
+#[pyfunction]
+#[pyo3(signature = (columns, window, hop, ms, estimator, method, workers))]
+#[allow(clippy::too_many_arguments)]
+fn davar<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    window: usize,
+    hop: usize,
+    ms: Vec<usize>,
+    estimator: &str,
+    method: &str,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let estimator = parse_estimator(py, estimator)?;
+    let method = parse_method(py, method)?;
+    let mut slices: Vec<&[f64]> = Vec::with_capacity(columns.len());
+    for (a, c) in columns.iter().enumerate() {
+        let s = c.as_slice().map_err(|_| {
+            allanite_error(py, format!("axis {a} is not a contiguous float64 array"))
+        })?;
+        slices.push(s);
+    }
+    let req = Request {
+        columns: &slices,
+        window,
+        hop,
+        ms: &ms,
+        estimator,
+        method,
+    };
+    let result = py.detach(|| run_in_pool(workers, || dynamic_avar(&req)));
+    let (values, n_win) = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(davar, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
