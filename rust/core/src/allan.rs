@@ -53,6 +53,13 @@ pub enum Method {
 /// Longest run of terms added into one partial sum before it is folded into its block total.
 const RUN: usize = 1024;
 
+/// Averaging factors up to this use direct block sums, in chunks of `DIRECT_CHUNK` terms.
+const DIRECT_M: usize = 8;
+const DIRECT_CHUNK: usize = 2048;
+
+/// Hops up to this many terms are cut into blocks after the terms are stored.
+const SMALL_HOP: usize = 64;
+
 /// Number of windows of `window` samples, starting every `hop` samples, that fit in `n` samples.
 pub fn n_windows(n: usize, window: usize, hop: usize) -> usize {
     if window > n || hop == 0 || window == 0 {
@@ -112,34 +119,205 @@ fn sum4(v: &[f64]) -> f64 {
     (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
-/// B(k) = Σ_{i=k}^{k+m−1} (y_i − μ) for k in [start, start + out.len()), `start` a multiple of m.
-/// Van Herk / Gil-Werman: suffix sum of the segment [start, start+m) plus prefix sum of the next one.
-/// Requires start + out.len() − 1 + m ≤ y.len().
-fn block_sums_segment(
-    y: &[f64],
-    mu: f64,
-    m: usize,
-    start: usize,
-    suf: &mut [f64],
-    out: &mut [f64],
-) {
-    let len = out.len();
-    debug_assert!(len >= 1 && len <= m && start + len - 1 + m <= y.len());
-    let seg = &y[start..start + m];
-    let mut s = 0.0;
-    for &v in seg[len..].iter().rev() {
-        s += v - mu;
+/// Interleaved chains for the running sums below: a running sum is a chain of dependent additions,
+/// latency-bound; independent chains over separate parts of the range overlap their latencies.
+const CHAINS: usize = 4; // the hot loops below are unrolled for exactly four
+
+/// Scratch and state for the terms of one m, reused across segments.
+struct TermScratch {
+    suf: Vec<f64>,
+    pre: Vec<f64>,
+    bprev: Vec<f64>,
+}
+
+/// Part boundaries for `CHAINS` chains over `len` items: parts of q items, the last takes the rest.
+#[inline]
+fn parts(len: usize) -> (usize, [usize; CHAINS + 1]) {
+    let q = len / CHAINS;
+    let mut b = [0usize; CHAINS + 1];
+    for (p, v) in b.iter_mut().enumerate() {
+        *v = (p * q).min(len);
     }
-    for i in (0..len).rev() {
-        s += seg[i] - mu;
-        suf[i] = s;
+    b[CHAINS] = len;
+    (q, b)
+}
+
+impl TermScratch {
+    fn new(m: usize) -> Self {
+        TermScratch {
+            suf: vec![0.0; m],
+            pre: vec![0.0; m],
+            bprev: vec![0.0; m],
+        }
     }
-    out[0] = suf[0];
-    let next = &y[start + m..start + m + len - 1];
-    let mut p = 0.0;
-    for r in 1..len {
-        p += next[r - 1] - mu;
-        out[r] = suf[r] + p;
+
+    /// Block sums B(k) = Σ_{i=k}^{k+m−1} (y_i − μ) for k = start + r, r < len, `start` a multiple of
+    /// m (Van Herk / Gil-Werman: suffix sum of the segment [start, start+m) from k, plus prefix sum
+    /// of the next segment up to k+m−1). With `terms`, writes a(k−m) = (B(k) − B(k−m))² into `terms`
+    /// and keeps B in `bprev`; without, only fills `bprev`.
+    ///
+    /// Both running sums are split into `CHAINS` parts whose local sums run interleaved; the parts
+    /// are joined in the same pass that forms B, by adding per-part constants (the suffix totals of
+    /// the parts above and the prefix totals of the parts below). Every term of every sum lies inside
+    /// B(k)'s own range [k, k+m): the rounding error is local, whatever the rest of the record holds.
+    /// Requires start + len − 1 + m ≤ y.len().
+    fn segment(
+        &mut self,
+        y: &[f64],
+        mu: f64,
+        m: usize,
+        start: usize,
+        len: usize,
+        terms: Option<&mut [f64]>,
+    ) {
+        debug_assert!(len >= 1 && len <= m && start + len - 1 + m <= y.len());
+        let seg = &y[start..start + m];
+        let next = &y[start + m..start + m + len - 1];
+        let (q, bd) = parts(len);
+        let chained = q >= 4;
+        let suf = &mut self.suf[..len];
+        let pre = &mut self.pre[..len];
+        // Tail of the segment beyond len: belongs to every B(k) of this call.
+        let mut tail = 0.0;
+        for &v in seg[len..].iter().rev() {
+            tail += v - mu;
+        }
+        let mut soff = [0.0f64; CHAINS];
+        let mut poff = [0.0f64; CHAINS];
+        if chained {
+            // Local suffix sums per part, interleaved; the longest (last) part's extra items first.
+            let mut s = [0.0f64; CHAINS];
+            for i in (CHAINS * q..len).rev() {
+                s[CHAINS - 1] += seg[i] - mu;
+                suf[i] = s[CHAINS - 1];
+            }
+            // Hot loop: indices are in range by construction (p·q + i < CHAINS·q ≤ len ≤ m).
+            assert!(CHAINS * q <= len && len <= seg.len());
+            {
+                let (mut s0, mut s1, mut s2, mut s3) = (s[0], s[1], s[2], s[3]);
+                for i in (0..q).rev() {
+                    // SAFETY: i + 3q < CHAINS·q ≤ len = suf.len() ≤ seg.len() (asserted above).
+                    unsafe {
+                        s0 += *seg.get_unchecked(i) - mu;
+                        s1 += *seg.get_unchecked(i + q) - mu;
+                        s2 += *seg.get_unchecked(i + 2 * q) - mu;
+                        s3 += *seg.get_unchecked(i + 3 * q) - mu;
+                        *suf.get_unchecked_mut(i) = s0;
+                        *suf.get_unchecked_mut(i + q) = s1;
+                        *suf.get_unchecked_mut(i + 2 * q) = s2;
+                        *suf.get_unchecked_mut(i + 3 * q) = s3;
+                    }
+                }
+                s = [s0, s1, s2, s3];
+            }
+            // Local prefix sums: pre[r] = Σ next[bd[p]..r] for r in part p; the running value after
+            // the part's last item is the part's total.
+            // next has len − 1 items: every part but the last is full; the last part's final item
+            // (index len − 1) has no next sample, which the tail loop below handles.
+            let mut t = [0.0f64; CHAINS];
+            assert!(CHAINS * q <= len && next.len() + 1 == len && pre.len() == len);
+            let full_q = if CHAINS * q == len { q - 1 } else { q };
+            {
+                let (mut t0, mut t1, mut t2, mut t3) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+                for i in 0..full_q {
+                    // SAFETY: i + 3q < CHAINS·q − 1 ≤ len − 1 = next.len() when CHAINS·q == len,
+                    // else i + 3q < CHAINS·q ≤ len − 1; pre.len() == len (asserted above).
+                    unsafe {
+                        *pre.get_unchecked_mut(i) = t0;
+                        *pre.get_unchecked_mut(i + q) = t1;
+                        *pre.get_unchecked_mut(i + 2 * q) = t2;
+                        *pre.get_unchecked_mut(i + 3 * q) = t3;
+                        t0 += *next.get_unchecked(i) - mu;
+                        t1 += *next.get_unchecked(i + q) - mu;
+                        t2 += *next.get_unchecked(i + 2 * q) - mu;
+                        t3 += *next.get_unchecked(i + 3 * q) - mu;
+                    }
+                }
+                t = [t0, t1, t2, t3];
+            }
+            for i in full_q..q {
+                for (p, tp) in t.iter_mut().enumerate() {
+                    let idx = p * q + i;
+                    pre[idx] = *tp;
+                    if idx < next.len() {
+                        *tp += next[idx] - mu;
+                    }
+                }
+            }
+            for idx in CHAINS * q..len {
+                pre[idx] = t[CHAINS - 1];
+                if idx < next.len() {
+                    t[CHAINS - 1] += next[idx] - mu;
+                }
+            }
+            let mut above = tail;
+            for p in (0..CHAINS).rev() {
+                soff[p] = above;
+                above += s[p];
+            }
+            let mut below = 0.0;
+            for p in 0..CHAINS {
+                poff[p] = below;
+                below += t[p];
+            }
+        } else {
+            let mut sacc = tail;
+            for i in (0..len).rev() {
+                sacc += seg[i] - mu;
+                suf[i] = sacc;
+            }
+            let mut pacc = 0.0;
+            for r in 0..len {
+                pre[r] = pacc;
+                if r < next.len() {
+                    pacc += next[r] - mu;
+                }
+            }
+        }
+        let bprev = &mut self.bprev[..len];
+        match terms {
+            Some(a) => {
+                for p in 0..CHAINS {
+                    let (lo, hi) = if chained {
+                        (bd[p], bd[p + 1])
+                    } else if p == 0 {
+                        (0, len)
+                    } else {
+                        break;
+                    };
+                    let c = soff[p] + poff[p];
+                    let it = suf[lo..hi]
+                        .iter()
+                        .zip(&pre[lo..hi])
+                        .zip(bprev[lo..hi].iter_mut());
+                    for (((s, pr), bp), ak) in it.zip(a[lo..hi].iter_mut()) {
+                        let b = (s + pr) + c;
+                        let d = b - *bp;
+                        *bp = b;
+                        *ak = d * d;
+                    }
+                }
+            }
+            None => {
+                for p in 0..CHAINS {
+                    let (lo, hi) = if chained {
+                        (bd[p], bd[p + 1])
+                    } else if p == 0 {
+                        (0, len)
+                    } else {
+                        break;
+                    };
+                    let c = soff[p] + poff[p];
+                    for ((s, pr), bp) in suf[lo..hi]
+                        .iter()
+                        .zip(&pre[lo..hi])
+                        .zip(bprev[lo..hi].iter_mut())
+                    {
+                        *bp = (s + pr) + c;
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -147,23 +325,40 @@ fn block_sums_segment(
 /// Requires 1 ≤ k_end ≤ y.len() + 1 − 2m.
 fn for_each_term_chunk(y: &[f64], mu: f64, m: usize, k_end: usize, mut f: impl FnMut(&[f64])) {
     debug_assert!(k_end >= 1 && k_end + 2 * m <= y.len() + 1);
-    let mut suf = vec![0.0; m];
-    let mut bprev = vec![0.0; m];
-    let mut bcur = vec![0.0; m];
+    if m <= DIRECT_M {
+        // Short blocks: sum each B(k) directly over its own m samples (exactly local too), in
+        // chunks of k so the per-call bookkeeping of the segment scheme is not paid per sample.
+        let mut bbuf = vec![0.0; DIRECT_CHUNK + m];
+        let mut a = vec![0.0; DIRECT_CHUNK];
+        let mut k0 = 0;
+        while k0 < k_end {
+            let c = DIRECT_CHUNK.min(k_end - k0);
+            let b = &mut bbuf[..c + m];
+            b.fill(0.0);
+            for j in 0..m {
+                let src = &y[k0 + j..k0 + j + c + m];
+                for (bt, v) in b.iter_mut().zip(src) {
+                    *bt += v - mu;
+                }
+            }
+            for (t, at) in a[..c].iter_mut().enumerate() {
+                let d = b[t + m] - b[t];
+                *at = d * d;
+            }
+            f(&a[..c]);
+            k0 += c;
+        }
+        return;
+    }
+    let mut sc = TermScratch::new(m);
     let mut a = vec![0.0; m];
-    let len0 = m.min(k_end);
-    block_sums_segment(y, mu, m, 0, &mut suf, &mut bprev[..len0]);
+    sc.segment(y, mu, m, 0, m.min(k_end), None);
     let mut start = 0;
     while start < k_end {
         let len = m.min(k_end - start);
-        // B(k + m) for the same k: the next aligned segment.
-        block_sums_segment(y, mu, m, start + m, &mut suf, &mut bcur[..len]);
-        for r in 0..len {
-            let d = bcur[r] - bprev[r];
-            a[r] = d * d;
-        }
+        // d_m(k) = B(k + m) − B(k): the next aligned segment against the one kept in bprev.
+        sc.segment(y, mu, m, start + m, len, Some(&mut a[..len]));
         f(&a[..len]);
-        std::mem::swap(&mut bprev, &mut bcur);
         start += m;
     }
 }
@@ -212,28 +407,47 @@ fn overlapping_row(y: &[f64], mu: f64, m: usize, window: usize, hop: usize, out:
     let (q, r) = (l / hop, l % hop);
     let k_end = (n_win - 1) * hop + l;
     let nblocks = n_win + q;
-    let mut full = vec![0.0; nblocks];
-    let mut part = vec![0.0; nblocks];
-    let (mut b, mut pos, mut total) = (0usize, 0usize, 0.0f64);
-    for_each_term_chunk(y, mu, m, k_end, |chunk| {
-        let mut i = 0;
-        while i < chunk.len() {
-            let target = if pos < r { r } else { hop };
-            let n = (target - pos).min(chunk.len() - i).min(RUN);
-            total += sum4(&chunk[i..i + n]);
-            pos += n;
-            i += n;
-            if pos == r {
-                part[b] = total;
+    let (full, part) = if hop <= SMALL_HOP {
+        // Short blocks: per-block bookkeeping would cost more than the arithmetic, so keep the
+        // terms and cut them afterwards (the output is already ~k_end/hop values per m).
+        let mut a = Vec::with_capacity(k_end);
+        for_each_term_chunk(y, mu, m, k_end, |chunk| a.extend_from_slice(chunk));
+        if hop == 1 {
+            (a, Vec::new())
+        } else {
+            let mut full = vec![0.0; nblocks];
+            let mut part = vec![0.0; nblocks];
+            for (b, blk) in a.chunks(hop).enumerate() {
+                full[b] = sum4(blk);
+                part[b] = sum4(&blk[..r.min(blk.len())]);
             }
-            if pos == hop {
-                full[b] = total;
-                b += 1;
-                pos = 0;
-                total = 0.0;
-            }
+            (full, part)
         }
-    });
+    } else {
+        let mut full = vec![0.0; nblocks];
+        let mut part = vec![0.0; nblocks];
+        let (mut b, mut pos, mut total) = (0usize, 0usize, 0.0f64);
+        for_each_term_chunk(y, mu, m, k_end, |chunk| {
+            let mut i = 0;
+            while i < chunk.len() {
+                let target = if pos < r { r } else { hop };
+                let n = (target - pos).min(chunk.len() - i).min(RUN);
+                total += sum4(&chunk[i..i + n]);
+                pos += n;
+                i += n;
+                if pos == r {
+                    part[b] = total;
+                }
+                if pos == hop {
+                    full[b] = total;
+                    b += 1;
+                    pos = 0;
+                    total = 0.0;
+                }
+            }
+        });
+        (full, part)
+    };
     let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
     if q == 0 {
         for (o, p) in out.iter_mut().zip(&part) {
@@ -242,7 +456,8 @@ fn overlapping_row(y: &[f64], mu: f64, m: usize, window: usize, hop: usize, out:
     } else {
         let sums = sliding_sums(&full, q, n_win);
         for (j, o) in out.iter_mut().enumerate() {
-            *o = (sums[j] + part[j + q]) * norm;
+            let p = if r == 0 { 0.0 } else { part[j + q] };
+            *o = (sums[j] + p) * norm;
         }
     }
 }
@@ -257,9 +472,13 @@ fn classic_row(y: &[f64], mu: f64, m: usize, window: usize, hop: usize, out: &mu
     let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * terms as f64);
     if n_win == 1 {
         // One window: keep only the strided terms, O(m) memory.
-        // Chunks are the aligned m-segments, so each one's first term is the one on the stride.
         let mut picked = Vec::with_capacity(terms);
-        for_each_term_chunk(y, mu, m, k_end, |chunk| picked.push(chunk[0]));
+        let mut k0 = 0usize;
+        for_each_term_chunk(y, mu, m, k_end, |chunk| {
+            let first = (m - k0 % m) % m;
+            picked.extend(chunk.iter().skip(first).step_by(m));
+            k0 += chunk.len();
+        });
         out[0] = sum4(&picked) * norm;
         return;
     }
@@ -489,15 +708,21 @@ mod tests {
 
     #[test]
     fn block_sums_match_direct() {
-        let y: Vec<f64> = (0..50).map(|i| ((i * 7919) % 23) as f64 - 11.0).collect();
-        for m in 1..8 {
-            let mut suf = vec![0.0; m];
-            let mut out = vec![0.0; m];
+        // Integer-valued data: every order of summation is exact, so equality is exact.
+        let y: Vec<f64> = (0..400).map(|i| ((i * 7919) % 23) as f64 - 11.0).collect();
+        for m in [1, 2, 3, 5, 8, 63, 64, 65, 100, 130] {
             let mut start = 0;
             while start + 2 * m <= y.len() {
-                block_sums_segment(&y, 0.0, m, start, &mut suf, &mut out);
-                for r in 0..m {
-                    assert_eq!(out[r], y[start + r..start + r + m].iter().sum::<f64>());
+                for len in [1, 2, m / 2 + 1, m.saturating_sub(1).max(1), m]
+                    .into_iter()
+                    .filter(|&l| l <= m)
+                {
+                    let mut sc = TermScratch::new(m);
+                    sc.segment(&y, 1.0, m, start, len, None);
+                    for r in 0..len {
+                        let direct: f64 = y[start + r..start + r + m].iter().map(|v| v - 1.0).sum();
+                        assert_eq!(sc.bprev[r], direct, "m {m} start {start} len {len} r {r}");
+                    }
                 }
                 start += m;
             }

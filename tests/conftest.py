@@ -1,0 +1,56 @@
+"""Shared fixtures for the allanite test suite.
+
+Reference data (Stable32 tables, real clock records) live *beside* the repository, not in it (their
+licences do not fit the package). They are found through one setting, ``ALLANITE_SHARED_DATA``,
+defaulting to ``<repo>/../shared/data``; tests that need them skip with a clear reason when absent.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+DEFAULT_SHARED_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+
+
+def shared_data_dir() -> Path:
+    """Where the shared reference data are expected (``ALLANITE_SHARED_DATA`` or the default)."""
+    env = os.environ.get("ALLANITE_SHARED_DATA", "").strip()
+    return Path(env) if env else DEFAULT_SHARED_DATA
+
+
+@pytest.fixture(scope="session")
+def shared_data() -> Path:
+    """The shared reference-data folder; skips the test when it is not there."""
+    path = shared_data_dir()
+    if not path.is_dir():
+        pytest.skip(
+            f"shared reference data not found at {path} (set ALLANITE_SHARED_DATA to the folder "
+            f"holding stable32/, adis16405/, ...)"
+        )
+    return path
+
+
+@pytest.fixture(scope="session")
+def stable32_dir(shared_data: Path) -> Path:
+    path = shared_data / "stable32"
+    if not path.is_dir():
+        pytest.skip(f"Stable32 reference tables not found at {path}")
+    return path
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    """A fresh, fixed-seed generator per test (tests stay independent of their order)."""
+    return np.random.default_rng(20240611)
+
+
+@pytest.fixture(autouse=True)
+def _clean_allanite_env(monkeypatch):
+    """The library reads ALLANITE_NUM_THREADS / ALLANITE_MAX_MEMORY; a value left in the caller's
+    environment must not change what the tests see."""
+    monkeypatch.delenv("ALLANITE_NUM_THREADS", raising=False)
+    monkeypatch.delenv("ALLANITE_MAX_MEMORY", raising=False)
