@@ -6,8 +6,12 @@ fn main() {
     let n: usize = std::env::args()
         .nth(1)
         .map_or(10_000_000, |s| s.parse().unwrap());
-    let window = n / 10;
-    let hop = (n / 1000).max(1);
+    let window = std::env::args()
+        .nth(2)
+        .map_or(n / 10, |s| s.parse().unwrap());
+    let hop = std::env::args()
+        .nth(3)
+        .map_or((n / 1000).max(1), |s| s.parse().unwrap());
     // xorshift noise: no rand dependency needed
     let mut s = 0x9E3779B97F4A7C15u64;
     let y: Vec<f64> = (0..n)

@@ -363,43 +363,58 @@ fn for_each_term_chunk(y: &[f64], mu: f64, m: usize, k_end: usize, mut f: impl F
     }
 }
 
-/// Sums of `q` consecutive non-negative values, f[j..j+q] for j < n_out (Van Herk / Gil-Werman, no
-/// subtraction). Requires f.len() ≥ n_out + q − 1 and q ≥ 1.
-fn sliding_sums(f: &[f64], q: usize, n_out: usize) -> Vec<f64> {
+/// out[j] = Σ f[j..j+q] for j < out.len(), non-negative f (Van Herk / Gil-Werman, no subtraction):
+/// the suffix sum of j's q-segment from j plus the prefix sum of the next segment up to j+q−1.
+/// Written in place, no scratch. Requires f.len() ≥ out.len() + q − 1 and q ≥ 1.
+fn sliding_sums(f: &[f64], q: usize, out: &mut [f64]) {
+    let n_out = out.len();
     if q == 1 {
-        return f[..n_out].to_vec();
+        out.copy_from_slice(&f[..n_out]);
+        return;
     }
-    let n = n_out + q - 1;
-    let mut pre = vec![0.0; n];
-    let mut suf = vec![0.0; n];
+    // Suffix sums within each segment, for the indices that start a window.
     let mut s0 = 0;
-    while s0 < n {
-        let end = (s0 + q).min(n);
-        let mut s = 0.0;
-        for i in s0..end {
-            s += f[i];
-            pre[i] = s;
+    while s0 < n_out {
+        let end = (s0 + q).min(n_out + q - 1);
+        let mut s: f64 = f[n_out.min(end)..end].iter().rev().sum();
+        for j in (s0..end.min(n_out)).rev() {
+            s += f[j];
+            out[j] = s;
         }
-        let mut s = 0.0;
-        for i in (s0..end).rev() {
-            s += f[i];
-            suf[i] = s;
-        }
-        s0 = end;
+        s0 += q;
     }
-    (0..n_out)
-        .map(|j| {
-            if j % q == 0 {
-                suf[j]
-            } else {
-                suf[j] + pre[j + q - 1]
-            }
-        })
-        .collect()
+    // Prefix sums of the following segment complete every window that does not start a segment:
+    // window j (j mod q ≠ 0) ends at i = j + q − 1 inside the next segment.
+    let mut s0 = q;
+    while s0 < n_out + q - 1 {
+        let end = (s0 + q - 1).min(n_out + q - 1); // the segment's last index never ends such a window
+        let mut p = 0.0;
+        for i in s0..end {
+            p += f[i];
+            out[i + 1 - q] += p;
+        }
+        s0 += q;
+    }
+}
+
+/// Reusable buffers of one worker, so that rows do not pay fresh allocations (page faults).
+#[derive(Default)]
+struct RowScratch {
+    terms: Vec<f64>,
+    full: Vec<f64>,
+    part: Vec<f64>,
 }
 
 /// Overlapping Allan variance of every window, for one m, written to `out` (length n_windows).
-fn overlapping_row(y: &[f64], mu: f64, m: usize, window: usize, hop: usize, out: &mut [f64]) {
+fn overlapping_row(
+    y: &[f64],
+    mu: f64,
+    m: usize,
+    window: usize,
+    hop: usize,
+    out: &mut [f64],
+    sc: &mut RowScratch,
+) {
     let n_win = out.len();
     let l = window + 1 - 2 * m;
     // With one window any block size works; a whole-window block keeps memory O(1).
@@ -407,25 +422,25 @@ fn overlapping_row(y: &[f64], mu: f64, m: usize, window: usize, hop: usize, out:
     let (q, r) = (l / hop, l % hop);
     let k_end = (n_win - 1) * hop + l;
     let nblocks = n_win + q;
-    let (full, part) = if hop <= SMALL_HOP {
+    let RowScratch { terms, full, part } = sc;
+    full.clear();
+    full.resize(nblocks, 0.0);
+    part.clear();
+    part.resize(nblocks, 0.0);
+    if hop <= SMALL_HOP {
         // Short blocks: per-block bookkeeping would cost more than the arithmetic, so keep the
         // terms and cut them afterwards (the output is already ~k_end/hop values per m).
-        let mut a = Vec::with_capacity(k_end);
-        for_each_term_chunk(y, mu, m, k_end, |chunk| a.extend_from_slice(chunk));
+        terms.clear();
+        for_each_term_chunk(y, mu, m, k_end, |chunk| terms.extend_from_slice(chunk));
         if hop == 1 {
-            (a, Vec::new())
+            std::mem::swap(terms, full);
         } else {
-            let mut full = vec![0.0; nblocks];
-            let mut part = vec![0.0; nblocks];
-            for (b, blk) in a.chunks(hop).enumerate() {
+            for (b, blk) in terms.chunks(hop).enumerate() {
                 full[b] = sum4(blk);
                 part[b] = sum4(&blk[..r.min(blk.len())]);
             }
-            (full, part)
         }
     } else {
-        let mut full = vec![0.0; nblocks];
-        let mut part = vec![0.0; nblocks];
         let (mut b, mut pos, mut total) = (0usize, 0usize, 0.0f64);
         for_each_term_chunk(y, mu, m, k_end, |chunk| {
             let mut i = 0;
@@ -446,18 +461,17 @@ fn overlapping_row(y: &[f64], mu: f64, m: usize, window: usize, hop: usize, out:
                 }
             }
         });
-        (full, part)
-    };
+    }
     let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
     if q == 0 {
-        for (o, p) in out.iter_mut().zip(&part) {
+        for (o, p) in out.iter_mut().zip(part.iter()) {
             *o = p * norm;
         }
     } else {
-        let sums = sliding_sums(&full, q, n_win);
+        sliding_sums(full, q, out);
         for (j, o) in out.iter_mut().enumerate() {
             let p = if r == 0 { 0.0 } else { part[j + q] };
-            *o = (sums[j] + p) * norm;
+            *o = (*o + p) * norm;
         }
     }
 }
@@ -622,18 +636,19 @@ pub fn dynamic_avar(req: &Request) -> Result<(Vec<f64>, usize)> {
                 .par_iter()
                 .map(|c| compensated_mean(c))
                 .collect();
-            out.par_chunks_mut(n_win)
-                .enumerate()
-                .for_each(|(row, dst)| {
+            out.par_chunks_mut(n_win).enumerate().for_each_init(
+                RowScratch::default,
+                |sc, (row, dst)| {
                     let (a, t) = (row / n_m, row % n_m);
                     let (y, m) = (req.columns[a], req.ms[t]);
                     match req.estimator {
                         Estimator::Overlapping => {
-                            overlapping_row(y, mus[a], m, req.window, req.hop, dst)
+                            overlapping_row(y, mus[a], m, req.window, req.hop, dst, sc)
                         }
                         Estimator::Classic => classic_row(y, mus[a], m, req.window, req.hop, dst),
                     }
-                });
+                },
+            );
         }
         Method::Naive => {
             for (a, y) in req.columns.iter().enumerate() {
@@ -698,10 +713,12 @@ mod tests {
     fn sliding_sums_match_direct() {
         let f: Vec<f64> = (0..37).map(|i| (i * i % 11) as f64).collect();
         for q in 1..10 {
-            let n_out = f.len() - q + 1;
-            let s = sliding_sums(&f, q, n_out);
-            for j in 0..n_out {
-                assert_eq!(s[j], f[j..j + q].iter().sum::<f64>());
+            for n_out in 1..=f.len() - q + 1 {
+                let mut s = vec![f64::NAN; n_out];
+                sliding_sums(&f, q, &mut s);
+                for j in 0..n_out {
+                    assert_eq!(s[j], f[j..j + q].iter().sum::<f64>());
+                }
             }
         }
     }
