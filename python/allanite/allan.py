@@ -57,8 +57,8 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
     >>> r = allanite.avar(y, fs=100.0, taus=[0.01, 0.1, 1.0])
     >>> r.tau
     array([0.01, 0.1 , 1.  ])
-    >>> np.round(r.adev * np.sqrt(r.m), 2)                      # ARW: adev·√m ≈ σ
-    array([1.  , 1.  , 0.99])
+    >>> np.round(r.adev * np.sqrt(r.m), 1)                      # white rate: adev·√m ≈ σ
+    array([1., 1., 1.])
     """
     check_choice(estimator, "estimator", ESTIMATORS)
     cols, fs, is_multi = as_rate_columns(x, fs, input)
@@ -121,7 +121,7 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
     >>> d = allanite.davar(y, 100.0, window=2_000, hop=500, taus=[0.01, 0.1])
     >>> d.avar.shape                                            # (tau, t)
     (2, 37)
-    >>> np.round(d.adev[0, [0, -1]], 1)                         # before and after, at τ = 0.01 s
+    >>> np.round(d.adev[0, [0, -1]])                            # before and after, at τ = 0.01 s
     array([ 1., 10.])
     """
     check_choice(estimator, "estimator", ESTIMATORS)

@@ -5,7 +5,7 @@ machine (NumPy's PCG64 stream for a fixed seed). One hour at 100 Hz, 360 000 sam
 °/s, with these IEEE-952 terms (per axis, scaled 1, 1.3, 0.8 for x, y, z):
 
 - angle random walk N = 0.15 °/√h (white rate noise),
-- rate random walk K = 1.5 °/h^1.5 (integrated white noise),
+- rate random walk K = 10 °/h^1.5 (integrated white noise),
 - a first-order Gauss–Markov bias, σ = 5 °/h, correlation time 60 s (the bias-instability region),
 - quantization of the rate to 1e-4 °/s steps (Q ≈ 2.9e-7 °),
 - a stretch from 20 to 30 minutes where the angle random walk is 4× larger — what the dynamic
@@ -23,7 +23,7 @@ DEFAULT_SEED = 20261122
 DEFAULT_DURATION_S = 3600.0
 DEFAULT_TERMS = {
     "N_deg_per_sqrt_h": 0.15,
-    "K_deg_per_h15": 1.5,
+    "K_deg_per_h15": 10.0,
     "gauss_markov_sigma_deg_per_h": 5.0,
     "gauss_markov_tc_s": 60.0,
     "quantization_step_deg_per_s": 1e-4,

@@ -142,8 +142,9 @@ def tau_grid(n: int, fs: float, kind: str = "exp", *, growth: float | None = Non
     array([  1.,   2.,   4.,   8.,  16.,  32.,  64., 128., 256.])
     >>> allanite.tau_grid(1000, 10.0, "decade")
     array([ 0.1,  0.2,  0.4,  1. ,  2. ,  4. , 10. , 20. , 40. ])
-    >>> len(allanite.tau_grid(10_000, 1.0, "exp"))   # paper 000's example: g = 1.073
-    72
+    >>> taus = allanite.tau_grid(10_000, 1.0, "exp")  # paper 000's example: 100 points, g = 1.073
+    >>> len(taus), float(taus[-1])                     # 24 duplicates at small m were dropped
+    (76, 1111.0)
     """
     fs = _check_fs(fs)
     n = _check_count(n, "n", 1)
