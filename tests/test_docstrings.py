@@ -5,7 +5,7 @@ import importlib
 
 import pytest
 
-MODULES = ["allanite.allan", "allanite.grid", "allanite.datasets"]
+MODULES = ["allanite.allan", "allanite.grid", "allanite.datasets", "allanite.simulate"]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -11,9 +11,10 @@ from .datasets import default_record
 from .errors import AllaniteError, InputError, MemoryBudgetError, ParameterError
 from .grid import tau_grid
 from .results import AllanResult, DynamicAllanResult
+from .simulate import simulate
 
 __all__ = [
-    "avar", "davar", "tau_grid", "default_record",
+    "avar", "davar", "tau_grid", "default_record", "simulate",
     "AllanResult", "DynamicAllanResult",
     "AllaniteError", "InputError", "ParameterError", "MemoryBudgetError",
     "__version__",

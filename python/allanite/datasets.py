@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .simulate import _ar1
+
 __all__ = ["default_record", "DEFAULT_FS", "DEFAULT_SEED"]
 
 DEFAULT_FS = 100.0
@@ -31,21 +33,6 @@ DEFAULT_TERMS = {
     "loud_factor": 4.0,
     "axis_scale": (1.0, 1.3, 0.8),
 }
-
-
-def _ar1(drive: np.ndarray, phi: float, x0: float, block: int = 1024) -> np.ndarray:
-    """x_i = φ·x_{i−1} + drive_i, in blocks: x_i = φ^(i+1)·x0 + φ^i·Σ_{j≤i} φ^(−j)·drive_j, where
-    φ^(−j) stays O(1) inside a block, so the closed form is as exact as the recursion."""
-    out = np.empty_like(drive)
-    j = np.arange(block)
-    grow, shrink = phi ** (j + 1), phi ** j
-    inv = phi ** (-j.astype(float))
-    for s in range(0, drive.size, block):
-        d = drive[s:s + block]
-        k = d.size
-        out[s:s + k] = grow[:k] * x0 + shrink[:k] * np.cumsum(d * inv[:k])
-        x0 = out[s + k - 1]
-    return out
 
 
 def default_record(seed: int = DEFAULT_SEED):

@@ -1,0 +1,186 @@
+"""Simulated gyro rate records with known IEEE-952 noise terms.
+
+Every term is generated so that its Allan variance is the closed form of FORMULAS.md §6 (with the
+discrete-time effects named where they matter):
+
+==========  ====================================  ===========================================
+term        generated as                          Allan variance
+==========  ====================================  ===========================================
+Q           white angle noise, std Q, differenced  3Q²/τ² (exact for m ≥ 1: white phase)
+N           white rate noise, std N/√τ0             N²/τ
+B           flicker rate noise, Kasdin–Walter        (2 ln2/π)·B² plateau (+ the usual roll-off
+            fractional integration (α = 1) of        at τ near τ0 and near the record length)
+            white noise of variance B²
+K           random walk of rate: cumsum of white    K²τ/3 for m ≫ 1; the sampled walk gives
+            rate steps of std K·√τ0                  K²τ0/2 = 1.5 × K²τ/3 at m = 1 (exact:
+                                                     K²τ0(2m² + 1)/(6m))
+R           deterministic ramp R·t                  R²τ²/2
+GM(σ, Tc)   exact AR(1), φ = e^(−τ0/Tc)            discrete AR(1) closed form
+sinusoid    A·sin(2π f0 t + φ)                     A²·[sin²(πf0τ)/(πf0τ)]²
+==========  ====================================  ===========================================
+
+Coefficients may change along the record: pass a number, a callable of t (s) returning an array, or
+a piecewise list ``[(t_start, value), …]`` (value from t_start on). White, flicker, random-walk and
+Gauss–Markov terms scale their driving noise sample by sample; the ramp integrates R(t).
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from .errors import ParameterError
+from .grid import _check_count, _check_fs
+
+__all__ = ["simulate", "kasdin_walter"]
+
+
+def kasdin_walter(n: int, alpha: float, rng: np.random.Generator, variance: float = 1.0) -> np.ndarray:
+    """Power-law noise with one-sided PSD ≈ 2·variance·τ0 / (2π f τ0)^alpha (Kasdin & Walter 1992).
+
+    Fractional integration of white noise of the given variance with the filter
+    h_0 = 1, h_k = h_{k−1}·(k − 1 + alpha/2)/k, applied by FFT convolution over 2n points so that no
+    low-frequency content is lost to circular wrap-around. alpha = 1: flicker, alpha = 2: random walk.
+    """
+    h = np.empty(n)
+    h[0] = 1.0
+    k = np.arange(1, n)
+    h[1:] = np.cumprod((k - 1 + alpha / 2.0) / k)
+    w = rng.normal(scale=np.sqrt(variance), size=n)
+    size = 2 * n
+    out = np.fft.irfft(np.fft.rfft(h, size) * np.fft.rfft(w, size), size)[:n]
+    return out
+
+
+def _profile(value, t: np.ndarray, name: str) -> np.ndarray | float:
+    """A coefficient as a scalar or a per-sample array, validated."""
+    if callable(value):
+        arr = np.asarray(value(t), dtype=np.float64)
+        if arr.shape != t.shape:
+            arr = np.broadcast_to(arr, t.shape).astype(np.float64)
+    elif isinstance(value, (list, tuple)) and value and isinstance(value[0], (list, tuple)):
+        arr = np.zeros_like(t)
+        for start, v in sorted(value, key=lambda p: p[0]):
+            arr[t >= float(start)] = float(v)
+    elif isinstance(value, (numbers.Real, np.floating, np.integer)) and not isinstance(value, bool):
+        arr = float(value)
+    else:
+        raise ParameterError(
+            f"{name} must be a number, a callable of t or a list of (t_start, value) pairs, got {value!r}"
+        )
+    a = np.asarray(arr)
+    if not np.all(np.isfinite(a)) or np.any(a < 0):
+        raise ParameterError(f"{name} must be finite and ≥ 0 everywhere, got {value!r}")
+    return arr
+
+
+def _is_zero(p) -> bool:
+    return np.all(np.asarray(p) == 0)
+
+
+def simulate(n: int, fs: float, *, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0, gauss_markov=(), sinusoid=(),
+             seed=None) -> np.ndarray:
+    """Rate samples with the five IEEE-952 terms, Gauss–Markov processes and sinusoids.
+
+    Parameters
+    ----------
+    n : int
+        Number of rate samples.
+    fs : float
+        Sampling rate, Hz.
+    Q, N, B, K, R : float, callable or list of (t_start, value)
+        Quantization (angle unit, e.g. °), angle random walk (unit/√s, e.g. °/√s), bias instability
+        (rate unit, °/s), rate random walk (unit/s^1.5) and rate ramp (unit/s²), in the caller's
+        unit's base form; 0 leaves a term out.
+    gauss_markov : sequence of (sigma, tc)
+        First-order Gauss–Markov processes: stationary std sigma (rate unit, may vary like the
+        terms above) and correlation time tc (s).
+    sinusoid : sequence of (amplitude, f0) or (amplitude, f0, phase)
+        Sinusoids in the rate, f0 in Hz.
+    seed : int or numpy Generator, optional
+        For reproducible records.
+
+    Returns
+    -------
+    numpy.ndarray
+        n rate samples (the caller's rate unit).
+
+    Examples
+    --------
+    >>> import numpy as np, allanite
+    >>> y = allanite.simulate(200_000, 100.0, N=0.01, seed=1)     # ARW 0.01 °/√s
+    >>> r = allanite.avar(y, 100.0, taus=[1.0, 10.0])
+    >>> np.round(r.adev * np.sqrt(r.tau), 3)                       # adev·√τ = N
+    array([0.01, 0.01])
+    """
+    n = _check_count(n, "n", 2)
+    fs = _check_fs(fs)
+    tau0 = 1.0 / fs
+    rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
+    t = np.arange(n) * tau0
+    y = np.zeros(n)
+    q = _profile(Q, t, "Q")
+    if not _is_zero(q):
+        # white angle noise of std Q on n + 1 angle points, differenced to rate
+        qq = np.append(q, q[-1]) if np.ndim(q) else q
+        theta = rng.normal(size=n + 1) * qq
+        y += np.diff(theta) / tau0
+    nn = _profile(N, t, "N")
+    if not _is_zero(nn):
+        y += rng.normal(size=n) * (nn / np.sqrt(tau0))
+    b = _profile(B, t, "B")
+    if not _is_zero(b):
+        y += kasdin_walter(n, 1.0, rng) * b
+    k = _profile(K, t, "K")
+    if not _is_zero(k):
+        y += np.cumsum(rng.normal(size=n) * (k * np.sqrt(tau0)))
+    r = _profile(R, t, "R")
+    if not _is_zero(r):
+        y += np.cumsum(np.broadcast_to(r, t.shape)) * tau0 if np.ndim(r) else r * t
+    for item in gauss_markov:
+        try:
+            sigma, tc = item
+        except (TypeError, ValueError):
+            raise ParameterError(f"gauss_markov entries must be (sigma, tc) pairs, got {item!r}") from None
+        sig = _profile(sigma, t, "gauss_markov sigma")
+        tc = float(tc)
+        if not np.isfinite(tc) or tc <= 0:
+            raise ParameterError(f"gauss_markov correlation time must be a positive number of seconds, got {tc!r}")
+        phi = np.exp(-tau0 / tc)
+        drive = rng.normal(size=n) * np.sqrt(1.0 - phi * phi)
+        unit = _ar1(drive, phi, rng.normal())
+        y += unit * sig
+    for item in sinusoid:
+        if not isinstance(item, (list, tuple)) or len(item) not in (2, 3):
+            raise ParameterError(f"sinusoid entries must be (amplitude, f0) or (amplitude, f0, phase), got {item!r}")
+        amp = _profile(item[0], t, "sinusoid amplitude")
+        f0 = float(item[1])
+        if not np.isfinite(f0) or f0 <= 0:
+            raise ParameterError(f"sinusoid frequency must be a positive number of Hz, got {item[1]!r}")
+        phase = float(item[2]) if len(item) == 3 else 0.0
+        y += amp * np.sin(2 * np.pi * f0 * t + phase)
+    return y
+
+
+def _ar1(drive: np.ndarray, phi: float, x0: float, block: int = 1024) -> np.ndarray:
+    """x_i = φ·x_{i−1} + drive_i, in blocks: x_i = φ^(i+1)·x0 + φ^i·Σ_{j≤i} φ^(−j)·drive_j, where
+    φ^(−j) stays O(1) inside a block (block ≪ correlation length in samples is not required: for
+    φ^(−block) to overflow, Tc would have to be below ~block/700 samples; those use the plain loop)."""
+    if phi ** block < 1e-200:
+        out = np.empty_like(drive)
+        acc = x0
+        for i, d in enumerate(drive):
+            acc = phi * acc + d
+            out[i] = acc
+        return out
+    out = np.empty_like(drive)
+    j = np.arange(block)
+    grow, shrink = phi ** (j + 1), phi ** j
+    inv = phi ** (-j.astype(float))
+    for s in range(0, drive.size, block):
+        d = drive[s:s + block]
+        k = d.size
+        out[s:s + k] = grow[:k] * x0 + shrink[:k] * np.cumsum(d * inv[:k])
+        x0 = out[s + k - 1]
+    return out
