@@ -16,6 +16,7 @@ from .grid import _check_count, _check_fs
 
 INPUTS = ("rate", "increment", "angle")
 DEFAULT_MAX_MEMORY = 2 * 1024**3
+MAX_WORKERS = 4096
 
 
 def check_choice(value, name: str, allowed) -> str:
@@ -85,23 +86,27 @@ def resolve_workers(workers) -> int:
             workers = int(env)
         except ValueError:
             raise ParameterError(f"ALLANITE_NUM_THREADS={env!r} must be a positive integer") from None
-        if workers < 1:
-            raise ParameterError(f"ALLANITE_NUM_THREADS={env!r} must be a positive integer")
+        if not 1 <= workers <= MAX_WORKERS:
+            raise ParameterError(f"ALLANITE_NUM_THREADS={env!r} must be an integer from 1 to {MAX_WORKERS}")
         return workers
-    return _check_count(workers, "workers", 1)
+    return _check_count(workers, "workers", 1, MAX_WORKERS)
 
 
 def resolve_max_memory(max_memory) -> int:
     """Byte budget for a result: ``max_memory`` if given, else ``ALLANITE_MAX_MEMORY``, else 2 GiB."""
+    name = "max_memory"
     if max_memory is None:
         env = os.environ.get("ALLANITE_MAX_MEMORY", "").strip()
         if not env:
             return DEFAULT_MAX_MEMORY
+        name = f"ALLANITE_MAX_MEMORY={env!r}"
         try:
             max_memory = float(env)
         except ValueError:
-            raise ParameterError(f"ALLANITE_MAX_MEMORY={env!r} must be a number of bytes") from None
-    if isinstance(max_memory, bool) or not isinstance(max_memory, (numbers.Real, np.integer, np.floating)) \
-            or not np.isfinite(max_memory) or max_memory <= 0:
-        raise ParameterError(f"max_memory must be a positive number of bytes, got {max_memory!r}")
-    return int(max_memory)
+            raise ParameterError(f"{name} must be a positive number of bytes") from None
+    if isinstance(max_memory, bool) or not isinstance(max_memory, (numbers.Real, np.integer, np.floating)):
+        raise ParameterError(f"{name} must be a positive number of bytes, got {max_memory!r}")
+    value = float(max_memory)
+    if not np.isfinite(value) or value <= 0:
+        raise ParameterError(f"{name} must be a positive number of bytes, got {max_memory!r}")
+    return int(min(value, 2.0**62))

@@ -138,18 +138,25 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
     nbytes = n_axes * ms.size * n_win * 8
     budget = resolve_max_memory(max_memory)
     if nbytes > budget:
-        # windows scale as 1/hop: the smallest hop whose output fits.
         per_window = n_axes * ms.size * 8
-        max_windows = max(1, budget // per_window)
-        suggest = max(hop + 1, -(-(n - window) // max(1, max_windows - 1)) if max_windows > 1 else n)
+        size = (f"the output would take {nbytes / 2**30:.2f} GiB ({n_axes} axes × {ms.size} τ × {n_win} windows "
+                f"× 8 bytes), over the memory budget of {budget / 2**30:.2f} GiB")
+        if per_window > budget:
+            raise MemoryBudgetError(
+                f"{size}; even one window ({per_window} bytes) does not fit: use fewer τ or raise "
+                f"max_memory / ALLANITE_MAX_MEMORY"
+            )
+        # windows = (n − window)//hop + 1 ≤ budget/per_window: the smallest hop that fits.
+        max_windows = budget // per_window
+        suggest = n if max_windows <= 1 else max(hop + 1, -(-(n - window) // (max_windows - 1)))
         raise MemoryBudgetError(
-            f"the output would take {nbytes / 2**30:.2f} GiB ({n_axes} axes × {ms.size} τ × {n_win} windows "
-            f"× 8 bytes), over the memory budget of {budget / 2**30:.2f} GiB; use hop ≥ {suggest}, fewer τ, "
-            f"or raise max_memory / ALLANITE_MAX_MEMORY"
+            f"{size}; use hop ≥ {suggest}, fewer τ, or raise max_memory / ALLANITE_MAX_MEMORY"
         )
-    out = _core.davar(cols, window, hop, [int(m) for m in ms], estimator, method, resolve_workers(workers))
+    # A hop beyond the record gives one window, as does the record length itself.
+    hop_core = min(hop, n)
+    out = _core.davar(cols, window, hop_core, [int(m) for m in ms], estimator, method, resolve_workers(workers))
     values = out if is_multi else out[0]
-    t = (np.arange(n_win) * hop + window / 2) / fs
+    t = (np.arange(n_win) * float(hop) + window / 2) / fs
     return DynamicAllanResult(
         tau=ms / fs, t=t, avar=values, n=_n_terms(estimator, window, ms), m=ms, window=window, hop=hop,
         method=method, estimator=estimator, fs=fs, n_samples=n, input=input,

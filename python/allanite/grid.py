@@ -37,18 +37,32 @@ def _check_fs(fs) -> float:
     fs = float(fs)
     if not math.isfinite(fs) or fs <= 0:
         raise ParameterError(f"fs must be a positive finite number of samples per second, got {fs!r}")
+    if not math.isfinite(1.0 / fs) or fs < 1e-200:
+        raise ParameterError(f"fs = {fs!r} Hz is too small: the sampling interval 1/fs is not a finite number")
     return fs
 
 
-def _check_count(value, name: str, minimum: int) -> int:
+def _check_real(value, name: str, allowed: str) -> float:
+    """A finite real scalar (not bool, not str), or a ParameterError naming it."""
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
+        raise ParameterError(f"{name} must be {allowed}, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ParameterError(f"{name} must be {allowed}, got {value!r}")
+    return value
+
+
+def _check_count(value, name: str, minimum: int, maximum: int | None = None) -> int:
     if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)):
-        if isinstance(value, (float, np.floating)) and float(value).is_integer():
+        if isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer():
             value = int(value)
         else:
             raise ParameterError(f"{name} must be an integer ≥ {minimum}, got {value!r}")
     value = int(value)
     if value < minimum:
         raise ParameterError(f"{name} must be an integer ≥ {minimum}, got {value}")
+    if maximum is not None and value > maximum:
+        raise ParameterError(f"{name} must be an integer ≤ {maximum}, got {value}")
     return value
 
 
@@ -83,10 +97,11 @@ def _m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0
     if kind == "exp":
         m0 = 1
         if tau_min is not None:
-            m0 = int(math.floor(float(tau_min) * fs + 0.5))
-            if not math.isfinite(float(tau_min)) or m0 < 1 or m0 > top:
+            tmin = _check_real(tau_min, "tau_min", "a positive finite number of seconds")
+            m0 = int(math.floor(tmin * fs + 0.5)) if 0 < tmin * fs < 2.0**62 else 0
+            if m0 < 1 or m0 > top:
                 raise ParameterError(
-                    f"tau_min = {tau_min!r} s maps to m = {m0}; allowed is 1 ≤ m ≤ {top} (τ from "
+                    f"tau_min = {tmin:g} s maps to m = {m0}; allowed is 1 ≤ m ≤ {top} (τ from "
                     f"{1 / fs:g} s to {top / fs:g} s)"
                 )
         if growth is not None and points is not None:
@@ -95,14 +110,19 @@ def _m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0
             points = EXP_DEFAULT_POINTS if points is None else _check_count(points, "points", 2)
             growth = (top / m0) ** (1.0 / (points - 1)) if top > m0 else 2.0
         else:
-            growth = float(growth)
-            if not math.isfinite(growth) or growth <= 1.0:
-                raise ParameterError(f"growth must be a finite factor > 1, got {growth!r}")
-        # τ(i) = τ_con·τ_g^(i−1) (paper 000 §4.2); duplicates after rounding to m are dropped.
+            growth = _check_real(growth, "growth", "a finite factor > 1")
+            if growth <= 1.0:
+                raise ParameterError(f"growth must be a finite factor > 1, got {growth:g}")
+        # τ(i) = τ_con·τ_g^(i−1) (paper 000 §4.2), rounded to m, duplicates dropped. Below
+        # m* = 1/(g − 1) consecutive points are less than one sample apart, so every m appears:
+        # take those directly rather than generating (possibly billions of) duplicates.
+        m_star = min(top, max(m0, int(math.ceil(1.0 / (growth - 1.0))) if growth - 1.0 > 1.0 / top else top))
+        dense = np.arange(m0, m_star + 1, dtype=np.int64)
+        i0 = max(0, int(math.floor(math.log(m_star / m0) / math.log(growth))))
         count = int(math.floor(math.log(top / m0) / math.log(growth) + 1e-9)) + 1
-        raw = np.floor(m0 * growth ** np.arange(count) + 0.5).astype(np.int64)
-        raw = raw[raw <= top]
-        return np.unique(raw)
+        raw = np.floor(m0 * growth ** np.arange(i0, max(i0, count)) + 0.5).astype(np.int64)
+        raw = raw[(raw > m_star) & (raw <= top)]
+        return np.unique(np.concatenate([dense, raw]))
     raise ParameterError(f"unknown τ grid {kind!r}; allowed: {', '.join(map(repr, GRIDS))} or an array of τ in s")
 
 
@@ -161,6 +181,8 @@ def resolve_taus(taus, n: int, fs: float) -> np.ndarray:
     """
     if isinstance(taus, str):
         return _m_grid(taus, n, fs=fs)
+    if taus is None:
+        raise ParameterError(f"taus must be a grid name ({', '.join(GRIDS)}) or a sequence of τ in seconds, got None")
     try:
         arr = np.asarray(taus, dtype=np.float64)
     except (TypeError, ValueError):
@@ -173,9 +195,18 @@ def resolve_taus(taus, n: int, fs: float) -> np.ndarray:
     bad = np.flatnonzero(~np.isfinite(arr) | (arr <= 0))
     if bad.size:
         i = int(bad[0])
-        raise ParameterError(f"taus[{i}] = {arr[i]!r} s: every τ must be a positive finite number of seconds")
+        raise ParameterError(f"taus[{i}] = {float(arr[i])!r} s: every τ must be a positive finite number of seconds")
     limit = max_m(n)
-    ms = np.floor(arr * fs + 0.5).astype(np.int64)
+    scaled = arr * fs
+    too_long = np.flatnonzero(~(scaled < limit + 0.5))
+    if too_long.size:
+        i = int(too_long[0])
+        m_i = f"m = {int(math.floor(scaled[i] + 0.5))}" if scaled[i] < 2.0**62 else f"m ≫ {limit}"
+        raise ParameterError(
+            f"taus[{i}] = {arr[i]:g} s ({m_i}) is too long for {n} samples: the largest τ is "
+            f"{limit / fs:g} s (m = {limit})"
+        )
+    ms = np.floor(scaled + 0.5).astype(np.int64)
     for i, (t, m) in enumerate(zip(arr, ms)):
         if m < 1:
             raise ParameterError(
