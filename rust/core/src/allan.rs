@@ -214,7 +214,7 @@ impl TermScratch {
             // the part's last item is the part's total.
             // next has len − 1 items: every part but the last is full; the last part's final item
             // (index len − 1) has no next sample, which the tail loop below handles.
-            let mut t = [0.0f64; CHAINS];
+            let mut t: [f64; CHAINS];
             assert!(CHAINS * q <= len && next.len() + 1 == len && pre.len() == len);
             let full_q = if CHAINS * q == len { q - 1 } else { q };
             {
