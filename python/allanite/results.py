@@ -44,6 +44,9 @@ class AllanResult:
         Rate samples per axis in the record.
     input : str
         What the samples were (``"rate"``, ``"increment"``, ``"angle"``); results are in rate units.
+    edf, ci_low, ci_high, alpha, confidence : optional
+        Confidence intervals, None until :meth:`with_confidence`: equivalent degrees of freedom
+        and noise type α per τ (shape of ``avar``), bounds on the true Allan variance, coverage.
     """
 
     tau: np.ndarray
@@ -54,6 +57,44 @@ class AllanResult:
     fs: float
     n_samples: int
     input: str = "rate"
+    #: Filled by :meth:`with_confidence` (None until then): EDF, variance bounds and noise type per
+    #: τ, and the coverage probability.
+    edf: np.ndarray | None = None
+    ci_low: np.ndarray | None = None
+    ci_high: np.ndarray | None = None
+    alpha: np.ndarray | None = None
+    confidence: float | None = None
+
+    def with_confidence(self, x=None, *, confidence: float = 0.683, alpha=None, edf_method: str = "greenhall",
+                        chi2: str = "exact", b1_n: str = "averages") -> "AllanResult":
+        """This result with χ² confidence intervals per τ (``edf``, ``ci_low``, ``ci_high``, ``alpha``).
+
+        Pass the samples the result was computed from (``x``, same ``input`` kind) to identify the
+        noise type per τ, or give ``alpha``; see :func:`allanite.confidence_intervals`.
+
+        Examples
+        --------
+        >>> import numpy as np, allanite
+        >>> y = np.random.default_rng(3).normal(size=10_000)
+        >>> r = allanite.avar(y, fs=1.0, taus=[1, 10, 100]).with_confidence(y)
+        >>> r.alpha, np.round(r.edf)
+        (array([0, 0, 0]), array([7826., 1368.,  148.]))
+        """
+        import dataclasses
+
+        from .confidence import confidence_intervals
+
+        ci = confidence_intervals(self, x, confidence=confidence, alpha=alpha, edf_method=edf_method, chi2=chi2,
+                                  b1_n=b1_n)
+        return dataclasses.replace(self, edf=ci.edf, ci_low=ci.ci_low, ci_high=ci.ci_high, alpha=ci.alpha,
+                                   confidence=ci.confidence)
+
+    @property
+    def adev_ci(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(low, high) bounds on the Allan deviation, or None before :meth:`with_confidence`."""
+        if self.ci_low is None:
+            return None
+        return np.sqrt(self.ci_low), np.sqrt(self.ci_high)
 
     @property
     def adev(self) -> np.ndarray:
@@ -70,7 +111,8 @@ class AllanResult:
         return (
             f"AllanResult({self.estimator}, {self.tau.size} τ in {_fmt_range(self.tau, 's')}, "
             f"{self.n_samples} samples at {self.fs:g} Hz{axes}; "
-            f"adev {_fmt_range(np.atleast_2d(self.adev)[0], '')})"
+            f"adev {_fmt_range(np.atleast_2d(self.adev)[0], '')}"
+            f"{'' if self.confidence is None else f'; {self.confidence:.1%} intervals'})"
         )
 
     def plot(self, ax=None, **kwargs):
@@ -107,6 +149,12 @@ class DynamicAllanResult:
     fs : float
     n_samples : int
     input : str
+    edf, alpha : ndarray, (T,) or (axes, T), optional
+        Per-τ EDF and noise type after :meth:`with_confidence` (one ν per τ: all windows have
+        the same length).
+    ci_low, ci_high : ndarray, shape of ``avar``, optional
+        Bounds on the true Allan variance of every window.
+    confidence : float, optional
     """
 
     tau: np.ndarray
@@ -121,6 +169,29 @@ class DynamicAllanResult:
     fs: float
     n_samples: int
     input: str = "rate"
+    #: Filled by :meth:`with_confidence`: ``edf``/``alpha`` per τ (every window has the same
+    #: length, so ν depends on τ only), ``ci_low``/``ci_high`` of the shape of ``avar``.
+    edf: np.ndarray | None = None
+    ci_low: np.ndarray | None = None
+    ci_high: np.ndarray | None = None
+    alpha: np.ndarray | None = None
+    confidence: float | None = None
+
+    def with_confidence(self, x=None, *, confidence: float = 0.683, alpha=None, edf_method: str = "greenhall",
+                        chi2: str = "exact", b1_n: str = "averages") -> "DynamicAllanResult":
+        """This result with χ² confidence intervals for every window and τ.
+
+        ``alpha`` (one per τ, or one for all) is given, or identified once from the whole record
+        ``x``; see :func:`allanite.confidence_intervals`.
+        """
+        import dataclasses
+
+        from .confidence import confidence_intervals
+
+        ci = confidence_intervals(self, x, confidence=confidence, alpha=alpha, edf_method=edf_method, chi2=chi2,
+                                  b1_n=b1_n)
+        return dataclasses.replace(self, edf=ci.edf, ci_low=ci.ci_low, ci_high=ci.ci_high, alpha=ci.alpha,
+                                   confidence=ci.confidence)
 
     @property
     def adev(self) -> np.ndarray:

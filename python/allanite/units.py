@@ -1,0 +1,305 @@
+"""Units of gyro samples and of the Allan-model coefficients reported from them (IEEE Std 952).
+
+Samples are either a *rate* (°/s, rad/s, °/h, …) or an *angle* (°, rad, arcsec, … — per-sample
+increments or cumulative angle). Every unit is stored with its factor to degrees (angles) or degrees
+per second (rates), so any two units of the same kind convert through that base.
+
+Allan-model coefficients come out of a fit in the samples' own unit and seconds ("base form"): with
+samples in a rate unit u,
+
+====  =========================  ==============  ========================
+term  meaning                    base form       IEEE-952 report (default)
+====  =========================  ==============  ========================
+Q     angle quantization         u·s             °  (also arcsec, µrad)
+N     angle random walk          u·√s            °/√h      (×60 for °/s)
+B     bias instability           u               °/h       (×3600)
+K     rate random walk           u/√s            °/h^1.5   (×216000)
+R     rate ramp                  u/s             °/h²      (×1.296e7)
+====  =========================  ==============  ========================
+
+(FORMULAS.md §6: N[°/√h] = 60·N[°/√s], B[°/h] = 3600·B[°/s], K[°/h^1.5] = 216000·K[°/s^1.5],
+R[°/h²] = 1.296e7·R[°/s²], Q[arcsec] = 3600·Q[°].) When the samples are angles (``input=
+"increment"`` or ``"angle"``), the Allan deviation is in that angle per second and the same table
+applies to the rate unit angle/s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from .errors import ParameterError
+
+__all__ = [
+    "Unit", "Quantity", "parse_unit", "rate_unit", "convert", "to_deg_per_s", "ieee952",
+    "adev_unit_label", "RATE_UNITS", "ANGLE_UNITS", "IEEE952_TERMS",
+]
+
+
+@dataclass(frozen=True)
+class Unit:
+    """A unit of gyro samples.
+
+    Attributes
+    ----------
+    name : str
+        Canonical spelling, e.g. ``"deg/s"``, ``"urad/s"``, ``"arcsec"``.
+    kind : {"rate", "angle"}
+    factor : float
+        Size of one unit in degrees (angles) or degrees per second (rates).
+    label : str
+        Typographic form for plots and reports, e.g. ``"°/s"``, ``"µrad/s"``.
+    """
+
+    name: str
+    kind: str
+    factor: float
+    label: str
+
+    def __str__(self) -> str:
+        return self.name
+
+
+_RAD = 180.0 / math.pi
+
+# canonical name: (kind, factor to deg or deg/s, label, aliases). Aliases are matched after
+# normalisation (lower case, no spaces, µ/μ → u, "sec" → "s", "hr"/"hour" → "h", "degree(s)" → "deg").
+_TABLE = {
+    # rates
+    "deg/s": ("rate", 1.0, "°/s", ("°/s", "dps", "deg/s")),
+    "deg/h": ("rate", 1.0 / 3600.0, "°/h", ("°/h", "dph")),
+    "mdeg/s": ("rate", 1e-3, "m°/s", ("mdps",)),
+    "rad/s": ("rate", _RAD, "rad/s", ()),
+    "mrad/s": ("rate", 1e-3 * _RAD, "mrad/s", ()),
+    "urad/s": ("rate", 1e-6 * _RAD, "µrad/s", ()),
+    "arcsec/s": ("rate", 1.0 / 3600.0, "arcsec/s", ('"/s', "asec/s")),
+    "rev/s": ("rate", 360.0, "rev/s", ("rps",)),
+    "rpm": ("rate", 6.0, "rpm", ("rev/min", "r/min")),
+    # angles (increments or cumulative angle)
+    "deg": ("angle", 1.0, "°", ("°",)),
+    "mdeg": ("angle", 1e-3, "m°", ()),
+    "rad": ("angle", _RAD, "rad", ()),
+    "mrad": ("angle", 1e-3 * _RAD, "mrad", ()),
+    "urad": ("angle", 1e-6 * _RAD, "µrad", ()),
+    "arcmin": ("angle", 1.0 / 60.0, "arcmin", ("'",)),
+    "arcsec": ("angle", 1.0 / 3600.0, "arcsec", ('"', "asec")),
+    "rev": ("angle", 360.0, "rev", ()),
+}
+
+_UNITS = {name: Unit(name, kind, factor, label) for name, (kind, factor, label, _) in _TABLE.items()}
+
+#: Canonical names of the accepted rate and angle units.
+RATE_UNITS = tuple(n for n, u in _UNITS.items() if u.kind == "rate")
+ANGLE_UNITS = tuple(n for n, u in _UNITS.items() if u.kind == "angle")
+
+# angle unit → the rate unit "that angle per second"
+_RATE_OF = {"deg": "deg/s", "mdeg": "mdeg/s", "rad": "rad/s", "mrad": "mrad/s", "urad": "urad/s",
+            "arcsec": "arcsec/s", "rev": "rev/s"}
+
+
+def _normalise(s: str) -> str:
+    s = s.strip().lower().replace(" ", "").replace("\u00b5", "u").replace("\u03bc", "u")
+    s = s.replace("micro", "u").replace("milli", "m")
+    s = s.replace("degrees", "deg").replace("degree", "deg").replace("radians", "rad").replace("radian", "rad")
+    s = s.replace("arcseconds", "arcsec").replace("arcsecond", "arcsec")
+    s = s.replace("arcminutes", "arcmin").replace("arcminute", "arcmin")
+    s = s.replace("revolutions", "rev").replace("revolution", "rev")
+    for long, short in (("/second", "/s"), ("/sec", "/s"), ("/hour", "/h"), ("/hr", "/h"), ("/minute", "/min")):
+        if s.endswith(long):
+            s = s[: -len(long)] + short
+    return s
+
+
+_ALIASES: dict = {}
+for _name, (_kind, _f, _label, _aliases) in _TABLE.items():
+    for _a in (_name, _label) + _aliases:
+        _ALIASES[_normalise(_a)] = _name
+
+
+def _allowed(kind=None) -> str:
+    rates = ", ".join(RATE_UNITS)
+    angles = ", ".join(ANGLE_UNITS)
+    if kind == "rate":
+        return f"rate units: {rates}"
+    if kind == "angle":
+        return f"angle units: {angles}"
+    return f"rate units: {rates}; angle units: {angles}"
+
+
+def parse_unit(s, kind=None) -> Unit:
+    """The :class:`Unit` a string names (a :class:`Unit` is returned as is).
+
+    Parameters
+    ----------
+    s : str or Unit
+        ``"deg/s"`` (also ``"°/s"``, ``"dps"``), ``"rad/s"``, ``"deg/h"`` (``"°/h"``, ``"dph"``),
+        ``"mdeg/s"``, ``"mrad/s"``, ``"urad/s"`` (``"µrad/s"``), ``"arcsec/s"``, ``"rev/s"``,
+        ``"rpm"``; angles ``"deg"``, ``"mdeg"``, ``"rad"``, ``"mrad"``, ``"urad"``, ``"arcmin"``,
+        ``"arcsec"``, ``"rev"``. Case and spaces do not matter; ``"/sec"`` and ``"/hr"`` are accepted.
+    kind : {"rate", "angle"}, optional
+        Require this kind.
+
+    Raises
+    ------
+    ParameterError
+        Unknown unit, or a unit of the other kind; the message lists the allowed units.
+
+    Examples
+    --------
+    >>> from allanite.units import parse_unit
+    >>> parse_unit("°/h")
+    Unit(name='deg/h', kind='rate', factor=0.0002777777777777778, label='°/h')
+    >>> parse_unit("µrad").name
+    'urad'
+    """
+    if kind is not None and kind not in ("rate", "angle"):
+        raise ParameterError(f"unknown unit kind {kind!r}; allowed: 'rate', 'angle'")
+    if isinstance(s, Unit):
+        unit = s
+    elif isinstance(s, str):
+        name = _ALIASES.get(_normalise(s))
+        if name is None:
+            raise ParameterError(f"unknown unit {s!r}; allowed {_allowed(kind)}")
+        unit = _UNITS[name]
+    else:
+        raise ParameterError(f"a unit must be a string such as 'deg/s', got {s!r}; allowed {_allowed(kind)}")
+    if kind is not None and unit.kind != kind:
+        raise ParameterError(f"unit {s!r} is {'an' if unit.kind == 'angle' else 'a'} {unit.kind} unit, "
+                             f"but {'an' if kind == 'angle' else 'a'} {kind} unit is needed here; "
+                             f"allowed {_allowed(kind)}")
+    return unit
+
+
+def rate_unit(unit) -> Unit:
+    """The rate unit of an Allan deviation computed from samples in ``unit``: the unit itself for a
+    rate, angle per second for an angle (increments or cumulative angle).
+
+    >>> from allanite.units import rate_unit
+    >>> rate_unit("arcsec").name, rate_unit("dph").name
+    ('arcsec/s', 'deg/h')
+    """
+    u = parse_unit(unit)
+    if u.kind == "rate":
+        return u
+    if u.name in _RATE_OF:
+        return _UNITS[_RATE_OF[u.name]]
+    return Unit(f"{u.name}/s", "rate", u.factor, f"{u.label}/s")
+
+
+def convert(values, src, dst):
+    """Convert values between two units of the same kind.
+
+    >>> from allanite.units import convert
+    >>> float(convert(1.0, "deg/s", "deg/h"))
+    3600.0
+    """
+    a, b = parse_unit(src), parse_unit(dst)
+    if a.kind != b.kind:
+        raise ParameterError(f"cannot convert {a.kind} unit {src!r} to {b.kind} unit {dst!r}; both must be "
+                             f"rates or both angles")
+    return np.asarray(values, dtype=np.float64) * (a.factor / b.factor)
+
+
+def to_deg_per_s(values, unit):
+    """Rate samples in ``unit`` converted to °/s (a float64 array).
+
+    ``unit`` must be a rate unit: increments or angles need τ0 first (see ``input=`` of the estimators).
+
+    >>> from allanite.units import to_deg_per_s
+    >>> to_deg_per_s([3600.0, 7200.0], "deg/h")
+    array([1., 2.])
+    """
+    u = parse_unit(unit, kind="rate")
+    return np.asarray(values, dtype=np.float64) * u.factor
+
+
+# term: (power of seconds in the base form, target unit → (label, factor from deg·s^p base), default)
+_SQH = 60.0  # √3600 s/√h
+_TERMS = {
+    "Q": (1.0, {"deg": ("°", 1.0), "arcsec": ("arcsec", 3600.0), "urad": ("µrad", 1e6 / _RAD),
+                "rad": ("rad", 1.0 / _RAD)}, "deg"),
+    "N": (0.5, {"deg/sqrt(h)": ("°/√h", _SQH), "deg/sqrt(s)": ("°/√s", 1.0),
+                "deg/h/sqrt(Hz)": ("°/h/√Hz", 3600.0), "rad/sqrt(s)": ("rad/√s", 1.0 / _RAD)}, "deg/sqrt(h)"),
+    "B": (0.0, {"deg/h": ("°/h", 3600.0), "deg/s": ("°/s", 1.0), "rad/s": ("rad/s", 1.0 / _RAD)}, "deg/h"),
+    "K": (-0.5, {"deg/h^1.5": ("°/h^1.5", 3600.0 * _SQH), "deg/s^1.5": ("°/s^1.5", 1.0),
+                 "rad/s^1.5": ("rad/s^1.5", 1.0 / _RAD)}, "deg/h^1.5"),
+    "R": (-1.0, {"deg/h^2": ("°/h²", 3600.0**2), "deg/s^2": ("°/s²", 1.0),
+                 "rad/s^2": ("rad/s²", 1.0 / _RAD)}, "deg/h^2"),
+}
+_TERM_ALIASES = {
+    "q": "Q", "quantization": "Q", "quantisation": "Q",
+    "n": "N", "arw": "N", "angle_random_walk": "N",
+    "b": "B", "bias_instability": "B", "bi": "B",
+    "k": "K", "rrw": "K", "rate_random_walk": "K",
+    "r": "R", "rate_ramp": "R", "ramp": "R",
+}
+#: The IEEE-952 terms and the report units each accepts (first: the default).
+IEEE952_TERMS = {t: tuple([d] + [k for k in v[1] if k != d]) for t, v in _TERMS.items() for d in [v[2]]}
+
+
+class Quantity(NamedTuple):
+    """A value with its unit label, e.g. ``Quantity(value=0.15, unit='°/√h')``."""
+
+    value: float
+    unit: str
+
+
+def ieee952(term, value, unit, *, to=None) -> Quantity:
+    """An Allan-model coefficient converted from the samples' unit to IEEE-952 report units.
+
+    Parameters
+    ----------
+    term : {"Q", "N", "B", "K", "R"}
+        Quantization, angle random walk, bias instability, rate random walk, rate ramp (also
+        ``"arw"``, ``"bias_instability"``, ``"rrw"``, …).
+    value : float or array_like
+        The coefficient in base form for samples in ``unit``: Q in unit·s (an angle), N in unit·√s,
+        B in unit, K in unit/√s, R in unit/s, with τ in seconds — what a fit of σ²(τ) returns.
+    unit : str or Unit
+        The samples' unit. An angle unit (increment input) stands for angle per second.
+    to : str, optional
+        Report unit; defaults: Q "deg" (also "arcsec", "urad", "rad"), N "deg/sqrt(h)" (also
+        "deg/sqrt(s)", "deg/h/sqrt(Hz)", "rad/sqrt(s)"), B "deg/h" ("deg/s", "rad/s"), K "deg/h^1.5"
+        ("deg/s^1.5", "rad/s^1.5"), R "deg/h^2" ("deg/s^2", "rad/s^2").
+
+    Returns
+    -------
+    Quantity
+        ``(value, unit label)``.
+
+    Examples
+    --------
+    >>> from allanite.units import ieee952
+    >>> ieee952("N", 0.0025, "deg/s")              # ARW from °/s samples: 0.0025 °/√s
+    Quantity(value=0.15, unit='°/√h')
+    >>> round(ieee952("B", 1e-5, "rad/s").value, 4)  # 1e-5 rad/s in °/h
+    2.0626
+    """
+    t = _TERM_ALIASES.get(term.lower() if isinstance(term, str) else None)
+    if t is None:
+        raise ParameterError(f"unknown IEEE-952 term {term!r}; allowed: 'Q' (quantization), 'N' (angle random "
+                             f"walk), 'B' (bias instability), 'K' (rate random walk), 'R' (rate ramp)")
+    _, targets, default = _TERMS[t]
+    target = default if to is None else to
+    if target not in targets:
+        raise ParameterError(f"unknown report unit {to!r} for term {t}; allowed: {', '.join(IEEE952_TERMS[t])}")
+    label, factor = targets[target]
+    u = rate_unit(unit)
+    v = np.asarray(value, dtype=np.float64) * (u.factor * factor)
+    return Quantity(float(v) if v.ndim == 0 else v, label)
+
+
+def adev_unit_label(unit) -> str:
+    """Axis label for an Allan deviation of samples in ``unit`` (the rate unit; angle → angle/s);
+    ``"rate unit"`` when the unit is not known.
+
+    >>> from allanite.units import adev_unit_label
+    >>> adev_unit_label("dps"), adev_unit_label("urad")
+    ('°/s', 'µrad/s')
+    """
+    if unit is None:
+        return "rate unit"
+    return rate_unit(unit).label
