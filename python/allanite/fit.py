@@ -72,9 +72,9 @@ class Coefficient:
 
     def __repr__(self) -> str:
         u = f" {self.unit}" if self.unit else ""
-        s = f"{self.name} = {self.value:.4g}{u} [{self.ci[0]:.3g}, {self.ci[1]:.3g}]"
+        s = f"{self.name} = {self.value:.4g}{u} [{self.ci[0]:.4g}, {self.ci[1]:.4g}]"
         if self.ieee is not None:
-            s += f" = {self.ieee:.4g} {self.ieee_unit} [{self.ieee_ci[0]:.3g}, {self.ieee_ci[1]:.3g}]"
+            s += f" = {self.ieee:.4g} {self.ieee_unit} [{self.ieee_ci[0]:.4g}, {self.ieee_ci[1]:.4g}]"
         return s
 
 
