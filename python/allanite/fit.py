@@ -178,6 +178,26 @@ class CoefficientSeries:
         return plot_coefficient_series(self, axes=axes, ieee=ieee)
 
 
+#: Correlation of overlapping Allan variance estimates one octave apart, by noise type, measured on
+#: 150 simulated records of 2^18 samples (log-AVAR at octave τ): white angle 0.42, white rate 0.53,
+#: flicker rate 0.68, random-walk rate 0.87 (ramp: taken as random walk). Two estimates a factor r
+#: apart are given ρ^|log2 r|. Classic estimates are less correlated; the same values are used
+#: for them (conservative).
+OCTAVE_CORRELATION = {"Q": 0.42, "N": 0.53, "B": 0.68, "K": 0.87, "R": 0.87}
+
+
+def _estimate_correlation(tau, parts, terms, estimator) -> np.ndarray:
+    """Correlation matrix of the Allan variance estimates at ``tau`` under the model mixture."""
+    share = parts / np.maximum(parts.sum(axis=1, keepdims=True), 1e-300)
+    rho = np.array([OCTAVE_CORRELATION[t] for t in terms])
+    rho_tau = np.clip(share @ rho, 0.0, 0.99)  # per-τ octave correlation of the mixture
+    lt = np.log2(tau)
+    dist = np.abs(lt[:, None] - lt[None, :])
+    # geometric mean of the two ends' octave correlations, to the power of the octave distance
+    base = np.sqrt(np.outer(rho_tau, rho_tau))
+    return np.where(dist == 0, 1.0, base**dist)
+
+
 def _octave_thin(tau: np.ndarray) -> np.ndarray:
     """Indices of τ at least a factor 2 apart, starting from the shortest."""
     keep = [0]
@@ -254,20 +274,26 @@ def _fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
     z = (avar - model) * np.sqrt(w)
     active = theta > 0
     cov = np.full((len(terms), len(terms)), np.nan)
-    fisher = (a * w[:, None]).T @ a
+    # Covariance of the estimates: variances 2σ⁴/ν, correlated across τ (overlapping estimates share
+    # data). The weighted fit treats them as independent, so its covariance is the sandwich
+    # (AᵀWA)⁻¹ AᵀW Σ W A (AᵀWA)⁻¹ with Σ = D R D — R from the octave correlations per noise type.
+    parts = a * theta
+    corr = _estimate_correlation(tau, parts if theta.any() else a, terms, estimator)
+    sd = np.sqrt(2.0 / nu) * model
+    sigma = corr * np.outer(sd, sd)
+
+    def sandwich(idx):
+        aw = a[:, idx] * w[:, None]
+        bread = np.linalg.pinv(aw.T @ a[:, idx])
+        return bread @ (aw.T @ sigma @ aw) @ bread
+
     if active.any():
-        fa = fisher[np.ix_(active, active)]
-        try:
-            cov[np.ix_(active, active)] = np.linalg.inv(fa)
-        except np.linalg.LinAlgError:
-            cov[np.ix_(active, active)] = np.linalg.pinv(fa)
+        idx = np.flatnonzero(active)
+        cov[np.ix_(idx, idx)] = sandwich(idx)
     # Inactive terms: the variance each would have if freed alone with the active ones.
     for k in np.flatnonzero(~active):
         idx = np.append(np.flatnonzero(active), k)
-        try:
-            cov[k, k] = np.linalg.inv(fisher[np.ix_(idx, idx)])[-1, -1]
-        except np.linalg.LinAlgError:
-            cov[k, k] = np.inf
+        cov[k, k] = sandwich(idx)[-1, -1]
     return theta, cov, model, nu, z, it, a
 
 
@@ -369,9 +395,14 @@ def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool
 
     Notes
     -----
-    Intervals come from the inverse Fisher matrix of the weighted fit on the active terms
-    (θ = coefficient², then square-rooted, clipped at zero), inflated by √(χ²/dof) when the model
-    fits worse than its own noise. They treat octave-spaced estimates as independent.
+    Intervals: the covariance of the weighted fit's coefficients (θ = coefficient²) is the sandwich
+    (AᵀWA)⁻¹AᵀWΣWA(AᵀWA)⁻¹, where Σ holds the estimates' variances 2σ⁴/ν and their correlation
+    across τ (octave correlations per noise type, measured by simulation: see
+    ``OCTAVE_CORRELATION``); it is inflated by √(χ²/dof) when the model fits worse than its
+    noise, and intervals are θ ± z·SE, clipped at zero, then square-rooted. On 40 simulated
+    records (1e6 samples; Q, N, B, K each dominating a τ range) 68.3 % intervals covered the
+    truth in 78 % (Q), 75 % (N), 50 % (B) and 60 % (K) of runs: roughly right for Q, N, K, too
+    narrow for B (its information comes from many strongly correlated mid-range points).
 
     Examples
     --------
