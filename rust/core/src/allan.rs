@@ -153,23 +153,15 @@ impl TermScratch {
 
     /// Block sums B(k) = Σ_{i=k}^{k+m−1} (y_i − μ) for k = start + r, r < len, `start` a multiple of
     /// m (Van Herk / Gil-Werman: suffix sum of the segment [start, start+m) from k, plus prefix sum
-    /// of the next segment up to k+m−1). With `terms`, writes a(k−m) = (B(k) − B(k−m))² into `terms`
-    /// and keeps B in `bprev`; without, only fills `bprev`.
+    /// of the next segment up to k+m−1). With `terms`, writes a(k−m) = (B(k) − B(k−m))² over the
+    /// suffix sums in `suf[..len]` and keeps B in `bprev`; without, only fills `bprev`.
     ///
     /// Both running sums are split into `CHAINS` parts whose local sums run interleaved; the parts
     /// are joined in the same pass that forms B, by adding per-part constants (the suffix totals of
     /// the parts above and the prefix totals of the parts below). Every term of every sum lies inside
     /// B(k)'s own range [k, k+m): the rounding error is local, whatever the rest of the record holds.
     /// Requires start + len − 1 + m ≤ y.len().
-    fn segment(
-        &mut self,
-        y: &[f64],
-        mu: f64,
-        m: usize,
-        start: usize,
-        len: usize,
-        terms: Option<&mut [f64]>,
-    ) {
+    fn segment(&mut self, y: &[f64], mu: f64, m: usize, start: usize, len: usize, terms: bool) {
         debug_assert!(len >= 1 && len <= m && start + len - 1 + m <= y.len());
         let seg = &y[start..start + m];
         let next = &y[start + m..start + m + len - 1];
@@ -276,7 +268,8 @@ impl TermScratch {
         }
         let bprev = &mut self.bprev[..len];
         match terms {
-            Some(a) => {
+            true => {
+                // a(k) overwrites the suffix sums in place: one buffer less in cache for large m.
                 for p in 0..CHAINS {
                     let (lo, hi) = if chained {
                         (bd[p], bd[p + 1])
@@ -287,18 +280,18 @@ impl TermScratch {
                     };
                     let c = soff[p] + poff[p];
                     let it = suf[lo..hi]
-                        .iter()
+                        .iter_mut()
                         .zip(&pre[lo..hi])
                         .zip(bprev[lo..hi].iter_mut());
-                    for (((s, pr), bp), ak) in it.zip(a[lo..hi].iter_mut()) {
-                        let b = (s + pr) + c;
+                    for ((s, pr), bp) in it {
+                        let b = (*s + pr) + c;
                         let d = b - *bp;
                         *bp = b;
-                        *ak = d * d;
+                        *s = d * d;
                     }
                 }
             }
-            None => {
+            false => {
                 for p in 0..CHAINS {
                     let (lo, hi) = if chained {
                         (bd[p], bd[p + 1])
@@ -351,14 +344,13 @@ fn for_each_term_chunk(y: &[f64], mu: f64, m: usize, k_end: usize, mut f: impl F
         return;
     }
     let mut sc = TermScratch::new(m);
-    let mut a = vec![0.0; m];
-    sc.segment(y, mu, m, 0, m.min(k_end), None);
+    sc.segment(y, mu, m, 0, m.min(k_end), false);
     let mut start = 0;
     while start < k_end {
         let len = m.min(k_end - start);
         // d_m(k) = B(k + m) − B(k): the next aligned segment against the one kept in bprev.
-        sc.segment(y, mu, m, start + m, len, Some(&mut a[..len]));
-        f(&a[..len]);
+        sc.segment(y, mu, m, start + m, len, true);
+        f(&sc.suf[..len]);
         start += m;
     }
 }
@@ -735,7 +727,7 @@ mod tests {
                     .filter(|&l| l <= m)
                 {
                     let mut sc = TermScratch::new(m);
-                    sc.segment(&y, 1.0, m, start, len, None);
+                    sc.segment(&y, 1.0, m, start, len, false);
                     for r in 0..len {
                         let direct: f64 = y[start + r..start + r + m].iter().map(|v| v - 1.0).sum();
                         assert_eq!(sc.bprev[r], direct, "m {m} start {start} len {len} r {r}");
