@@ -125,13 +125,13 @@ class NoiseFit:
     def curve(self, tau) -> np.ndarray:
         """The fitted Allan variance at any τ (s)."""
         tau = np.asarray(tau, dtype=np.float64)
-        m = np.maximum(1.0, np.round(tau * self.fs))
+        m = np.maximum(1.0, tau * self.fs)  # real m: a smooth curve between the integer points
         return design_matrix(tau, m, self.fs, self.terms) @ self.theta
 
     def component(self, name: str, tau) -> np.ndarray:
         """One term's Allan variance at τ (s)."""
         tau = np.asarray(tau, dtype=np.float64)
-        m = np.maximum(1.0, np.round(tau * self.fs))
+        m = np.maximum(1.0, tau * self.fs)  # real m: a smooth curve between the integer points
         k = self.terms.index(name)
         return design_matrix(tau, m, self.fs, (name,))[:, 0] * self.theta[k]
 
