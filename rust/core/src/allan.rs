@@ -161,7 +161,16 @@ impl TermScratch {
     /// the parts above and the prefix totals of the parts below). Every term of every sum lies inside
     /// B(k)'s own range [k, k+m): the rounding error is local, whatever the rest of the record holds.
     /// Requires start + len − 1 + m ≤ y.len().
-    fn segment(&mut self, y: &[f64], mu: f64, m: usize, start: usize, len: usize, terms: bool) {
+    fn segment(
+        &mut self,
+        y: &[f64],
+        mu: f64,
+        m: usize,
+        start: usize,
+        len: usize,
+        terms: bool,
+        scale: f64,
+    ) {
         debug_assert!(len >= 1 && len <= m && start + len - 1 + m <= y.len());
         let seg = &y[start..start + m];
         let next = &y[start + m..start + m + len - 1];
@@ -287,7 +296,7 @@ impl TermScratch {
                         let b = (*s + pr) + c;
                         let d = b - *bp;
                         *bp = b;
-                        *s = d * d;
+                        *s = d * d * scale;
                     }
                 }
             }
@@ -314,9 +323,17 @@ impl TermScratch {
     }
 }
 
-/// Calls `f` with consecutive chunks of a(k) = d_m(k)² for k = 0, 1, …, k_end − 1 (in order).
+/// Calls `f` with consecutive chunks of a(k) = scale·d_m(k)² for k = 0, 1, …, k_end − 1 (in
+/// order); `scale` folds the estimator's normalisation into the pass that forms the terms.
 /// Requires 1 ≤ k_end ≤ y.len() + 1 − 2m.
-fn for_each_term_chunk(y: &[f64], mu: f64, m: usize, k_end: usize, mut f: impl FnMut(&[f64])) {
+fn for_each_term_chunk(
+    y: &[f64],
+    mu: f64,
+    m: usize,
+    k_end: usize,
+    scale: f64,
+    mut f: impl FnMut(&[f64]),
+) {
     debug_assert!(k_end >= 1 && k_end + 2 * m <= y.len() + 1);
     if m <= DIRECT_M {
         // Short blocks: sum each B(k) directly over its own m samples (exactly local too), in
@@ -336,7 +353,7 @@ fn for_each_term_chunk(y: &[f64], mu: f64, m: usize, k_end: usize, mut f: impl F
             }
             for (t, at) in a[..c].iter_mut().enumerate() {
                 let d = b[t + m] - b[t];
-                *at = d * d;
+                *at = d * d * scale;
             }
             f(&a[..c]);
             k0 += c;
@@ -344,12 +361,12 @@ fn for_each_term_chunk(y: &[f64], mu: f64, m: usize, k_end: usize, mut f: impl F
         return;
     }
     let mut sc = TermScratch::new(m);
-    sc.segment(y, mu, m, 0, m.min(k_end), false);
+    sc.segment(y, mu, m, 0, m.min(k_end), false, 1.0);
     let mut start = 0;
     while start < k_end {
         let len = m.min(k_end - start);
         // d_m(k) = B(k + m) − B(k): the next aligned segment against the one kept in bprev.
-        sc.segment(y, mu, m, start + m, len, true);
+        sc.segment(y, mu, m, start + m, len, true, scale);
         f(&sc.suf[..len]);
         start += m;
     }
@@ -414,6 +431,7 @@ fn overlapping_row(
     let (q, r) = (l / hop, l % hop);
     let k_end = (n_win - 1) * hop + l;
     let nblocks = n_win + q;
+    let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
     let RowScratch { terms, full, part } = sc;
     full.clear();
     full.resize(nblocks, 0.0);
@@ -423,7 +441,9 @@ fn overlapping_row(
         // Short blocks: per-block bookkeeping would cost more than the arithmetic, so keep the
         // terms and cut them afterwards (the output is already ~k_end/hop values per m).
         terms.clear();
-        for_each_term_chunk(y, mu, m, k_end, |chunk| terms.extend_from_slice(chunk));
+        for_each_term_chunk(y, mu, m, k_end, norm, |chunk| {
+            terms.extend_from_slice(chunk)
+        });
         if hop == 1 {
             std::mem::swap(terms, full);
         } else {
@@ -434,7 +454,7 @@ fn overlapping_row(
         }
     } else {
         let (mut b, mut pos, mut total) = (0usize, 0usize, 0.0f64);
-        for_each_term_chunk(y, mu, m, k_end, |chunk| {
+        for_each_term_chunk(y, mu, m, k_end, norm, |chunk| {
             let mut i = 0;
             while i < chunk.len() {
                 let target = if pos < r { r } else { hop };
@@ -454,16 +474,15 @@ fn overlapping_row(
             }
         });
     }
-    let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
+    // The terms already carry the normalisation, so the window sums are the variances.
     if q == 0 {
-        for (o, p) in out.iter_mut().zip(part.iter()) {
-            *o = p * norm;
-        }
+        out.copy_from_slice(&part[..n_win]);
     } else {
         sliding_sums(full, q, out);
-        for (j, o) in out.iter_mut().enumerate() {
-            let p = if r == 0 { 0.0 } else { part[j + q] };
-            *o = (*o + p) * norm;
+        if r != 0 {
+            for (o, p) in out.iter_mut().zip(&part[q..]) {
+                *o += p;
+            }
         }
     }
 }
@@ -480,22 +499,22 @@ fn classic_row(y: &[f64], mu: f64, m: usize, window: usize, hop: usize, out: &mu
         // One window: keep only the strided terms, O(m) memory.
         let mut picked = Vec::with_capacity(terms);
         let mut k0 = 0usize;
-        for_each_term_chunk(y, mu, m, k_end, |chunk| {
+        for_each_term_chunk(y, mu, m, k_end, norm, |chunk| {
             let first = (m - k0 % m) % m;
             picked.extend(chunk.iter().skip(first).step_by(m));
             k0 += chunk.len();
         });
-        out[0] = sum4(&picked) * norm;
+        out[0] = sum4(&picked);
         return;
     }
     let mut a = Vec::with_capacity(k_end);
-    for_each_term_chunk(y, mu, m, k_end, |chunk| a.extend_from_slice(chunk));
+    for_each_term_chunk(y, mu, m, k_end, norm, |chunk| a.extend_from_slice(chunk));
     let mut buf = Vec::with_capacity(terms);
     for (j, o) in out.iter_mut().enumerate() {
         let s = j * hop;
         buf.clear();
         buf.extend((0..terms).map(|i| a[s + i * m]));
-        *o = sum4(&buf) * norm;
+        *o = sum4(&buf);
     }
 }
 
@@ -727,7 +746,7 @@ mod tests {
                     .filter(|&l| l <= m)
                 {
                     let mut sc = TermScratch::new(m);
-                    sc.segment(&y, 1.0, m, start, len, false);
+                    sc.segment(&y, 1.0, m, start, len, false, 1.0);
                     for r in 0..len {
                         let direct: f64 = y[start + r..start + r + m].iter().map(|v| v - 1.0).sum();
                         assert_eq!(sc.bprev[r], direct, "m {m} start {start} len {len} r {r}");

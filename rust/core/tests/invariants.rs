@@ -68,7 +68,9 @@ proptest! {
 
     #[test]
     fn scaling_by_c_scales_avar_by_c_squared(y in record(), c in 1e-3f64..1e3, est in estimator()) {
-        let ms: Vec<usize> = (1..=y.len() / 2).step_by(3).collect();
+        // m ≤ n/9 (≥ 9 clusters): with one or two terms a single second difference can be a
+        // cancellation of nearly equal block sums, whose last digits differ between y and c·y.
+        let ms: Vec<usize> = (1..=(y.len() / 9).max(1)).step_by(3).collect();
         let scaled: Vec<f64> = y.iter().map(|v| v * c).collect();
         let a = static_avar(&[&y[..]], &ms, est).unwrap();
         let b = static_avar(&[&scaled[..]], &ms, est).unwrap();
