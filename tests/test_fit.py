@@ -122,3 +122,17 @@ def test_bad_input():
         allanite.fit(bad)
     with pytest.raises(ParameterError, match=r"needs an AllanResult"):
         allanite.fit(np.ones(10))
+
+
+def test_tau_range_restricts_the_fit():
+    y = allanite.simulate(200_000, FS, N=2e-3, B=1e-3, seed=4)
+    r = allanite.avar(y, FS)
+    f = allanite.fit(r, terms=("N", "B"), tau_range=(0.1, 100.0))
+    assert f.tau[0] >= 0.1 and f.tau[-1] <= 100.0
+    assert f.coefficients["N"].value == pytest.approx(2e-3, rel=0.05)
+    with pytest.raises(ParameterError, match=r"no τ of the result lies in tau_range"):
+        allanite.fit(r, tau_range=(1e6, None))
+    with pytest.raises(ParameterError, match=r"tau_range must satisfy 0 ≤ low < high"):
+        allanite.fit(r, tau_range=(5.0, 1.0))
+    with pytest.raises(ParameterError, match=r"tau_range must be a \(low, high\) pair"):
+        allanite.fit(r, tau_range=3.0)

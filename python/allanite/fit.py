@@ -371,7 +371,8 @@ def _base_unit(term: str, unit) -> str:
     return {"Q": f"({u})·s", "N": f"({u})·√s", "B": u, "K": f"({u})/√s", "R": f"({u})/s"}[term]
 
 
-def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool = True, max_iter: int = 50):
+def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool = True, tau_range=None,
+        max_iter: int = 50):
     """Fit the IEEE-952 noise terms to an Allan variance result.
 
     Parameters
@@ -390,6 +391,10 @@ def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool
     thin : bool
         Use only τ at least an octave apart (default), so correlated neighbours do not overcount
         information; ``False`` uses every τ of the result.
+    tau_range : (float, float), optional
+        Fit only τ in [low, high] seconds (either may be None). Real sensors are often not white
+        at the shortest τ (anti-alias filters, vibration lines): those points carry the largest
+        EDF and can dominate a fit of a model that does not describe them.
     max_iter : int
         Reweighting iterations at most.
 
@@ -399,10 +404,10 @@ def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool
     (AᵀWA)⁻¹AᵀWΣWA(AᵀWA)⁻¹, where Σ holds the estimates' variances 2σ⁴/ν and their correlation
     across τ (octave correlations per noise type, measured by simulation: see
     ``OCTAVE_CORRELATION``); it is inflated by √(χ²/dof) when the model fits worse than its
-    noise, and intervals are θ ± z·SE, clipped at zero, then square-rooted. On 40 simulated
-    records (1e6 samples; Q, N, B, K each dominating a τ range) 68.3 % intervals covered the
-    truth in 78 % (Q), 75 % (N), 50 % (B) and 60 % (K) of runs: roughly right for Q, N, K, too
-    narrow for B (its information comes from many strongly correlated mid-range points).
+    noise, and intervals are θ ± z·SE, clipped at zero, then square-rooted. On 100 simulated
+    records (1e6 samples; Q, N, B, K each dominating a τ range; ``benches/noise_fit.py``) 68.3 %
+    intervals covered the truth in 61 % (Q), 69 % (N), 51 % (B) and 55 % (K) of runs — about
+    right for N, somewhat narrow for Q and K, too narrow for B (see docs/noise-model.md).
 
     Examples
     --------
@@ -414,27 +419,45 @@ def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool
     """
     terms = _check_terms(terms)
     zq = _zq(confidence)
+    tau_range = _check_tau_range(tau_range)
     if unit is not None:
         from .units import rate_unit
 
         rate_unit(unit)
     if isinstance(result, DynamicAllanResult):
-        return _fit_dynamic(result, terms, unit, float(confidence), zq, thin, max_iter)
+        return _fit_dynamic(result, terms, unit, float(confidence), zq, thin, max_iter, tau_range)
     if not isinstance(result, AllanResult):
         raise ParameterError(f"fit needs an AllanResult or DynamicAllanResult, got {type(result).__name__}")
     if result.estimator not in ("oavar", "avar"):
         raise ParameterError(f"fit supports the 'oavar' and 'avar' estimators, not {result.estimator!r}")
     if result.avar.ndim == 2:
-        return [_fit_static_row(result, row, terms, unit, float(confidence), zq, thin, max_iter)
+        return [_fit_static_row(result, row, terms, unit, float(confidence), zq, thin, max_iter, tau_range)
                 for row in result.avar]
-    return _fit_static_row(result, result.avar, terms, unit, float(confidence), zq, thin, max_iter)
+    return _fit_static_row(result, result.avar, terms, unit, float(confidence), zq, thin, max_iter, tau_range)
 
 
-def _select(tau, avar, thin, n_terms, what):
+def _check_tau_range(tau_range):
+    if tau_range is None:
+        return (0.0, np.inf)
+    try:
+        lo, hi = tau_range
+    except (TypeError, ValueError):
+        raise ParameterError(f"tau_range must be a (low, high) pair of seconds, got {tau_range!r}") from None
+    lo = 0.0 if lo is None else float(lo)
+    hi = np.inf if hi is None else float(hi)
+    if not (lo >= 0 and hi > lo) or np.isnan(lo) or np.isnan(hi):
+        raise ParameterError(f"tau_range must satisfy 0 ≤ low < high, got {tau_range!r}")
+    return (lo, hi)
+
+
+def _select(tau, avar, thin, n_terms, what, tau_range=(0.0, np.inf)):
     if not np.all(np.isfinite(avar)):
         i = int(np.flatnonzero(~np.isfinite(avar))[0])
         raise ParameterError(f"{what} has a non-finite Allan variance ({avar[i]}) at τ = {tau[i]:g} s")
-    idx = _octave_thin(tau) if thin else np.arange(tau.size)
+    inside = np.flatnonzero((tau >= tau_range[0]) & (tau <= tau_range[1]))
+    if inside.size == 0:
+        raise ParameterError(f"no τ of {what} lies in tau_range {tau_range} s (τ spans {tau[0]:g}–{tau[-1]:g} s)")
+    idx = inside[_octave_thin(tau[inside])] if thin else inside
     idx = idx[avar[idx] > 0]
     if idx.size <= n_terms:
         raise ParameterError(
@@ -444,11 +467,11 @@ def _select(tau, avar, thin, n_terms, what):
     return idx
 
 
-def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_iter):
+def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_iter, tau_range):
     from scipy.stats import chi2 as chi2_dist
 
     avar_row = np.asarray(avar_row, dtype=np.float64)
-    idx = _select(result.tau, avar_row, thin, len(terms), "the result")
+    idx = _select(result.tau, avar_row, thin, len(terms), "the result", tau_range)
     tau, m, y = result.tau[idx], result.m[idx].astype(np.float64), avar_row[idx]
     theta, cov, model, nu, z, it, a = _fit_core(
         tau, m, y, result.fs, result.n_samples + 1, result.estimator, terms, confidence, max_iter)
@@ -467,11 +490,11 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
     )
 
 
-def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter):
+def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range):
     rows = [result.avar] if result.avar.ndim == 2 else list(result.avar)
     series = []
     for rows_avar in rows:
-        idx = _select(result.tau, rows_avar[:, 0], thin, len(terms), "the dynamic result")
+        idx = _select(result.tau, rows_avar[:, 0], thin, len(terms), "the dynamic result", tau_range)
         tau, m = result.tau[idx], result.m[idx].astype(np.float64)
         cache = {}
         n_t = rows_avar.shape[1]

@@ -26,6 +26,7 @@ Gauss–Markov terms scale their driving noise sample by sample; the ramp integr
 
 from __future__ import annotations
 
+import math
 import numbers
 
 import numpy as np
@@ -56,13 +57,28 @@ def kasdin_walter(n: int, alpha: float, rng: np.random.Generator, variance: floa
 def _profile(value, t: np.ndarray, name: str) -> np.ndarray | float:
     """A coefficient as a scalar or a per-sample array, validated."""
     if callable(value):
-        arr = np.asarray(value(t), dtype=np.float64)
-        if arr.shape != t.shape:
-            arr = np.broadcast_to(arr, t.shape).astype(np.float64)
+        out = value(t)
+        try:
+            arr = np.asarray(out, dtype=np.float64)
+            if arr.shape != t.shape:
+                arr = np.broadcast_to(arr, t.shape).astype(np.float64)
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"{name}: the callable must return a number or an array of {t.size} numbers (one per sample "
+                f"time t), got {type(out).__name__}{f' of shape {out.shape}' if hasattr(out, 'shape') else ''}"
+            ) from None
     elif isinstance(value, (list, tuple)) and value and isinstance(value[0], (list, tuple)):
+        try:
+            pairs = sorted(((float(start), float(v)) for start, v in value), key=lambda p: p[0])
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"{name} as a piecewise profile must be a list of (t_start, value) pairs of numbers, got {value!r}"
+            ) from None
+        if not all(math.isfinite(start) for start, _ in pairs):
+            raise ParameterError(f"{name}: piecewise start times must be finite seconds, got {value!r}")
         arr = np.zeros_like(t)
-        for start, v in sorted(value, key=lambda p: p[0]):
-            arr[t >= float(start)] = float(v)
+        for start, v in pairs:
+            arr[t >= start] = v
     elif isinstance(value, (numbers.Real, np.floating, np.integer)) and not isinstance(value, bool):
         arr = float(value)
     else:
