@@ -1,161 +1,306 @@
-"""The ``allanite`` command line. It only wires the library together: load, estimate, print, plot."""
+"""The ``allanite`` command line. It only wires the library together: read the log
+(:func:`allanite.read_log`), build the report (:mod:`allanite.report`), write it, print a summary.
+
+Exit status: 0 success; 2 a usage or input error, reported as one line ``allanite: error: …`` on
+stderr (never a traceback); 1 an internal error (a bug: the traceback is shown); 130 interrupted.
+"""
 
 from __future__ import annotations
 
 import argparse
-import json
+import re
 import sys
 import time
+import warnings
 from pathlib import Path
 
-import numpy as np
-
 from .errors import AllaniteError
+
+EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
 DESCRIPTION = """\
 allanite: static and dynamic Allan variance for gyroscopes, IMUs and clocks.
 
-Commands:
-  report   Allan deviation table, dynamic Allan variance summary and plots for a log
-           (runs on the bundled simulated gyro record when no log is given).
+commands:
+  report    Allan deviation with intervals, IEEE-952 noise fit and dynamic Allan variance of a
+            log, as an HTML page, a JSON summary and PNG figures"""
 
-Run 'allanite COMMAND --help' for a command's options."""
+EPILOG = """\
+Run 'allanite report --help' for the report's options; 'allanite report' alone analyses the
+bundled record (a simulated 3-axis gyro) and writes the report to ./allanite-report/.
+
+exit status:
+  0    success
+  1    internal error (a bug: please report it with the traceback)
+  2    usage or input error (one line on stderr: 'allanite: error: ...')
+  130  interrupted"""
+
+REPORT_DESCRIPTION = """\
+Analyse a gyro/IMU/clock log: the overlapping Allan deviation with confidence intervals, the
+IEEE-952 noise model (quantization Q, angle random walk N, bias instability B, rate random walk K,
+rate ramp R) with intervals and datasheet read-offs, the dynamic Allan variance (DAVAR) and the
+noise coefficients over time. Prints a summary and writes, into DIR, one self-contained HTML page
+(figures embedded, no network), a JSON file with every number of the page and the figures as PNG.
+
+Without LOG it analyses the bundled record: a deterministic simulated 3-axis gyro, 1 h at 100 Hz
+in deg/s, whose angle random walk is 4x larger from 20 to 30 min."""
 
 REPORT_EPILOG = """\
 examples:
-  allanite report                              # the bundled 3-axis simulated gyro, 1 h at 100 Hz
-  allanite report gyro.npy --fs 200 --window 60000 --hop 2000 --out results/
-  allanite report gyro.csv --fs 100 --unit deg/s
+  allanite report                                 # the bundled record -> ./allanite-report/
+  allanite report imu.csv.gz --fs 100 --columns gyro_x,gyro_y,gyro_z --unit deg/s
+  allanite report gyro.csv --time-column t --unit rad/s --gaps longest --out results/
+  allanite report gyro.npy --fs 200 --window 60000 --hop 2000 --taus exp --quiet
+  allanite report flight.bag                      # ROS 1 bag: sensor_msgs/Imu, rad/s
 
-Outputs in --out: adev.png, davar.png (one panel per axis) and summary.json.
-Exit status: 0 on success, 2 for a usage or input error (one line on stderr)."""
+files written to DIR:
+  report.html              the report, one self-contained page
+  summary.json             every number of the page, with units (schema allanite-report/1)
+  adev.png, davar.png      all axes: Allan deviation with fits; DAVAR heat maps stacked
+  adev_axisK.png           axis K: ADEV with confidence band, fitted model and each term
+  davar_axisK.png          axis K: DAVAR heat map (time x tau, log colour)
+  davar3d_axisK.png        axis K: DAVAR surface (t, log10 tau, log10 ADEV)
+  coefficients_axisK.png   axis K: noise coefficients per DAVAR window with intervals
+
+A progress bar goes to stderr when it is a terminal; --quiet prints nothing but errors.
+
+exit status:
+  0    success
+  1    internal error (a bug: please report it with the traceback)
+  2    usage or input error (one line on stderr: 'allanite: error: ...')
+  130  interrupted"""
+
+#: Options that describe a LOG file; meaningless for the bundled record.
+_LOG_OPTIONS = ("fs", "columns", "time_column", "time_unit", "unit", "input", "gaps")
 
 
-def _load(path: str, fs: float | None):
-    p = Path(path)
-    if not p.exists():
-        raise AllaniteError(f"{path}: no such file")
-    if fs is None:
-        raise AllaniteError(f"{path}: --fs is required for a log file (samples per second)")
-    try:
-        if p.suffix == ".npy":
-            x = np.load(p, mmap_mode="r")
-        else:
-            x = np.loadtxt(p, delimiter="," if p.suffix == ".csv" else None, comments="#", ndmin=1)
-    except (ValueError, OSError) as exc:
-        raise AllaniteError(f"{path}: cannot read numeric samples ({exc})") from None
-    return x, fs, {"what": str(p)}
+class _UsageError(Exception):
+    """A bad command line: reported as one line, exit status 2."""
 
 
-def _report(args) -> int:
-    from . import avar, davar, default_record
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line instead of argparse's usage block
+        raise _UsageError(f"{message} (see '{self.prog} --help')")
 
-    t0 = time.perf_counter()
-    if args.log is None:
-        x, fs, info = default_record()
-        unit = info["unit"]
-    else:
-        x, fs, info = _load(args.log, args.fs)
-        unit = args.unit
-    x = np.asarray(x)
-    n = x.shape[0]
-    window = args.window or max(2, n // 12)
-    hop = args.hop or max(1, window // 25)
-    static = avar(x, fs, taus="octave")
-    dyn = davar(x, fs, window=window, hop=hop, taus="exp")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
 
-    adev = np.atleast_2d(static.adev)
-    n_axes = adev.shape[0]
-    print(f"record: {info['what']} — {n} samples × {n_axes} axes at {fs:g} Hz ({n / fs / 3600:.3g} h), unit {unit}")
-    print(f"\nOverlapping Allan deviation ({unit}):")
-    print("  " + f"{'tau (s)':>10}  {'n':>8}  " + "  ".join(f"{'axis ' + str(k):>11}" for k in range(n_axes)))
-    for i, tau in enumerate(static.tau):
-        print("  " + f"{tau:10.4g}  {static.n[i]:8d}  " + "  ".join(f"{adev[k, i]:11.4e}" for k in range(n_axes)))
-
-    dadev = dyn.adev if dyn.avar.ndim == 3 else dyn.adev[None]
-    print(f"\nDynamic Allan deviation: window {window} samples ({window / fs:g} s), hop {hop} "
-          f"({hop / fs:g} s), {dyn.t.size} windows × {dyn.tau.size} τ ({dyn.tau[0]:g}–{dyn.tau[-1]:g} s)")
-    summary_axes = []
-    for k in range(n_axes):
-        row = dadev[k, 0]
-        med = float(np.median(row))
-        j_max, j_min = int(np.argmax(row)), int(np.argmin(row))
-        print(f"  axis {k}: ADEV at τ = {dyn.tau[0]:g} s over time: median {med:.4e}, "
-              f"max {row[j_max]:.4e} at t = {dyn.t[j_max]:.0f} s, min {row[j_min]:.4e} at t = {dyn.t[j_min]:.0f} s, "
-              f"max/min = {row[j_max] / row[j_min]:.2f}")
-        summary_axes.append({
-            "axis": k,
-            "adev_shortest_tau_median": med,
-            "adev_shortest_tau_max": float(row[j_max]), "t_of_max_s": float(dyn.t[j_max]),
-            "adev_shortest_tau_min": float(row[j_min]), "t_of_min_s": float(dyn.t[j_min]),
-        })
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    static.plot(ax=ax, unit=unit)
-    ax.set_title("Overlapping Allan deviation")
-    fig.tight_layout()
-    fig.savefig(out / "adev.png", dpi=110)
-    plt.close(fig)
-    fig, axs = plt.subplots(n_axes, 1, figsize=(7.5, 2.8 * n_axes), squeeze=False)
-    for k in range(n_axes):
-        dyn.plot(ax=axs[k, 0], axis=k, unit=unit)
-        axs[k, 0].set_title(f"Dynamic Allan deviation, axis {k}")
-    fig.tight_layout()
-    fig.savefig(out / "davar.png", dpi=110)
-    plt.close(fig)
-
-    summary = {
-        "record": {k: v for k, v in info.items() if isinstance(v, (str, int, float, list, tuple))},
-        "unit": unit, "fs_hz": fs, "samples": n, "axes": n_axes,
-        "static": {"estimator": static.estimator, "tau_s": static.tau.tolist(), "n": static.n.tolist(),
-                   "adev": adev.tolist(), "adev_unit": unit},
-        "dynamic": {"window_samples": window, "hop_samples": hop, "windows": int(dyn.t.size),
-                    "tau_s": dyn.tau.tolist(), "axes": summary_axes},
-    }
-    (out / "summary.json").write_text(json.dumps(summary, indent=1))
-    print(f"\nwrote {out / 'adev.png'}, {out / 'davar.png'}, {out / 'summary.json'} "
-          f"in {time.perf_counter() - t0:.1f} s")
-    return 0
+def _formatter(prog):
+    return argparse.RawDescriptionHelpFormatter(prog, max_help_position=30, width=100)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="allanite", description=DESCRIPTION,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     from . import __version__
 
-    parser.add_argument("--version", action="version", version=f"allanite {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    rep = sub.add_parser("report", help="Allan deviation table, DAVAR summary and plots",
-                         description="Allan deviation table, dynamic Allan variance summary and plots.",
-                         epilog=REPORT_EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = _Parser(prog="allanite", usage="%(prog)s [-h] [--version] COMMAND [ARGS ...]", description=DESCRIPTION,
+                     epilog=EPILOG, formatter_class=_formatter)
+    parser.add_argument("--version", action="version", version=f"allanite {__version__}",
+                        help="show the version and exit")
+    # the commands are listed in DESCRIPTION (argparse's own listing adds a stray "COMMAND" line)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", help=argparse.SUPPRESS, parser_class=_Parser)
+    rep = sub.add_parser("report", prog="allanite report", description=REPORT_DESCRIPTION, epilog=REPORT_EPILOG, formatter_class=_formatter)
     rep.add_argument("log", nargs="?", metavar="LOG",
-                     help=".npy (samples or samples × axes) or numeric text/CSV; default: the bundled record")
-    rep.add_argument("--fs", type=float, metavar="HZ", help="sampling rate in Hz (required with LOG)")
-    rep.add_argument("--unit", default="rate unit", help="unit of the samples, for labels (e.g. deg/s)")
-    rep.add_argument("--window", type=int, metavar="N", help="DAVAR window in samples (default: 1/12 of the record)")
-    rep.add_argument("--hop", type=int, metavar="N", help="DAVAR hop in samples (default: window/25)")
-    rep.add_argument("--out", default="allanite-report", metavar="DIR", help="output folder (default: %(default)s)")
+                     help="the log: CSV/TSV/whitespace text (.gz too), .npy, .npz, Parquet, ROS 1 .bag or ROS 2 "
+                          "bag; default: the bundled record")
+
+    inp = rep.add_argument_group("input (LOG only)")
+    inp.add_argument("--fs", type=float, metavar="HZ",
+                     help="sampling rate in Hz (or give --time-column; ROS bags use their stamps)")
+    inp.add_argument("--columns", metavar="C1,C2,...",
+                     help="columns that are the samples, by name or 0-based index, comma-separated; one per "
+                          "axis (default: every column but the time column)")
+    inp.add_argument("--time-column", metavar="C", help="column of sample times: derives --fs, finds gaps")
+    inp.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), help="unit of the time column (default: s)")
+    inp.add_argument("--unit", metavar="U",
+                     help="unit of the samples: deg/s, rad/s, deg/h, mrad/s, urad/s, ... (rate input) or deg, rad, "
+                          "arcsec, ... (increment/angle input); without it the report says the unit is unknown "
+                          "and gives the noise coefficients in base form")
+    inp.add_argument("--input", choices=("rate", "increment", "angle"),
+                     help="what the samples are: rate (default), angle increments per sample, cumulative angle")
+    inp.add_argument("--gaps", choices=("error", "longest", "split"),
+                     help="when the time column shows gaps: stop with the list of gaps (default), analyse the "
+                          "longest gap-free stretch, or the same and list every stretch (split)")
+
+    ana = rep.add_argument_group("analysis")
+    ana.add_argument("--taus", metavar="GRID", default="octave",
+                     help="tau of the static analysis: octave (default), decade, exp, all, or seconds "
+                          "comma-separated (0.01,0.1,1,10)")
+    ana.add_argument("--window", type=int, metavar="N",
+                     help="DAVAR window in samples (default: 1/12 of the record)")
+    ana.add_argument("--hop", type=int, metavar="N",
+                     help="DAVAR hop between windows in samples (default: 1/25 of the window)")
+    ana.add_argument("--no-fit", action="store_true",
+                     help="skip the noise-model fit (whole record and per window)")
+
+    out = rep.add_argument_group("output")
+    out.add_argument("--out", default="allanite-report", metavar="DIR",
+                     help="folder for the report, created if needed (default: %(default)s)")
+    out.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     return parser
 
 
-def main(argv=None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if args.command is None:
-        parser.print_help()
-        return 2
+# --------------------------------------------------------------------------------------------------
+# progress
+
+
+class _Progress:
+    """A tqdm bar over the report's steps, on stderr; off with --quiet or when stderr is no terminal."""
+
+    def __init__(self, quiet: bool):
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=8, file=sys.stderr, disable=True if quiet else None, leave=False, unit="step",
+                        bar_format="{desc:<38.38}|{bar}| {n_fmt}/{total_fmt} [{elapsed}]", dynamic_ncols=True)
+        self.started = False
+
+    def step(self, name: str) -> None:
+        if self.started:
+            self.bar.update(1)
+        self.started = True
+        self.bar.set_description_str(name)
+
+    def add(self, n: int) -> None:
+        self.bar.update(n)
+
+    def expect(self, remaining: int) -> None:
+        """``remaining`` more steps after the current one."""
+        self.bar.total = self.bar.n + 1 + remaining
+        self.bar.refresh()
+
+    def close(self) -> None:
+        if self.started and self.bar.total is not None:
+            self.bar.update(max(0, self.bar.total - self.bar.n))
+        self.bar.close()
+
+
+# --------------------------------------------------------------------------------------------------
+# the report command
+
+
+def _spec_list(text: str, what: str):
+    items = [c.strip() for c in text.split(",")]
+    if not all(items):
+        raise _UsageError(f"{what} {text!r}: empty name in the comma-separated list")
+    return [int(c) if c.isdigit() else c for c in items]
+
+
+def _taus(text: str):
+    if re.fullmatch(r"[A-Za-z]+", text.strip()):
+        return text.strip()
     try:
+        return [float(t) for t in text.split(",")]
+    except ValueError:
+        raise _UsageError(f"argument --taus: {text!r} is neither a grid name (octave, decade, exp, all) nor "
+                          f"comma-separated seconds") from None
+
+
+def _cli_words(message: str) -> str:
+    """Library messages speak Python (gaps='longest'); say it as options, on one line."""
+    message = re.sub(r"\b(gaps|input|time_unit)='([a-z]+)'",
+                     lambda m: f"--{m.group(1).replace('_', '-')} {m.group(2)}", message)
+    message = message.replace("drop fs=,", "drop --fs,").replace("time_unit=", "--time-unit")
+    return " ".join(message.split())
+
+
+def _read(args, progress):
+    from .io import _sniff, read_log
+
+    path = Path(args.log)
+    if not path.exists():
+        raise AllaniteError(f"{path}: no such file")
+    if args.fs is None and args.time_column is None and _sniff(path) not in ("ros1", "ros2"):
+        raise AllaniteError(f"{path}: give the sampling rate with --fs HZ, or the time column with --time-column C")
+    progress.step(f"reading {path.name}")
+    kwargs = {}
+    if args.time_unit is not None:
+        kwargs["time_unit"] = args.time_unit
+    columns = None if args.columns is None else _spec_list(args.columns, "--columns")
+    time_column = None
+    if args.time_column is not None:
+        tc = args.time_column.strip()
+        time_column = int(tc) if tc.isdigit() else tc
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        log = read_log(path, fs=args.fs, columns=columns, time_column=time_column, unit=args.unit,
+                       input=args.input or "rate", gaps=args.gaps or "error", **kwargs)
+    notes = [" ".join(str(w.message).split()) for w in caught]
+    return log, notes
+
+
+def _report(args) -> int:
+    from .report import build_report, from_log
+
+    quiet = args.quiet
+    if args.log is None:
+        given = [f"--{o.replace('_', '-')}" for o in _LOG_OPTIONS if getattr(args, o) is not None]
+        if given:
+            raise _UsageError(f"{', '.join(given)} describe{'s' if len(given) == 1 else ''} a LOG file; without LOG "
+                              f"the bundled record (100 Hz, 3 axes, deg/s) is analysed")
+    taus = _taus(args.taus)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise AllaniteError(f"--out {out}: exists and is not a folder")
+    t0 = time.perf_counter()
+    progress = _Progress(quiet)
+    try:
+        with warnings.catch_warnings():
+            if quiet:
+                warnings.simplefilter("ignore")
+            common = dict(window=args.window, hop=args.hop, taus=taus, fit=not args.no_fit, progress=progress)
+            if args.log is None:
+                from . import default_record
+
+                progress.step("generating the bundled record")
+                x, fs, info = default_record()
+                source = {"name": "bundled record", **{k: (list(v) if isinstance(v, tuple) else v)
+                                                       for k, v in info.items()}}
+                rep = build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common)
+            else:
+                log, notes = _read(args, progress)
+                if not quiet:
+                    for note in notes:
+                        progress.bar.write(f"allanite: warning: {note}", file=sys.stderr)
+                rep = from_log(log, notes=notes, **common)
+            specs = rep.figure_specs()
+            progress.expect(len(specs) + 1)
+            paths = rep.write(out, progress)
+    finally:
+        progress.close()
+    if not quiet:
+        print(rep.text())
+        pngs = [p.name for p in paths[2:]]
+        print(f"\nwrote {paths[0]}\n      {paths[1]}\n      {len(pngs)} figures in {out}/: {', '.join(pngs)}")
+        print(f"in {time.perf_counter() - t0:.1f} s")
+    return EXIT_OK
+
+
+def _error(message: str) -> int:
+    print(f"allanite: error: {_cli_words(message)}", file=sys.stderr)
+    return EXIT_USAGE
+
+
+def main(argv=None) -> int:
+    """Run the command line; returns the exit status (``--help``/``--version`` exit through SystemExit(0))."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help()
+            return EXIT_USAGE
         return _report(args)
+    except _UsageError as exc:
+        return _error(str(exc))
     except AllaniteError as exc:
-        print(f"allanite: error: {exc}", file=sys.stderr)
-        return 2
+        return _error(str(exc))
+    except BrokenPipeError:  # stdout closed early (allanite report | head): not an error worth a message
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_INTERNAL
+    except OSError as exc:  # cannot write the output folder, unreadable file, disk full, …
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        return _error(f"{where}{exc.strerror or exc}")
+    except KeyboardInterrupt:
+        print("allanite: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":  # pragma: no cover

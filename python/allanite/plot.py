@@ -1,32 +1,105 @@
-"""Matplotlib figures for the results (imported lazily: the estimators do not need matplotlib)."""
+"""Matplotlib figures for the results (imported lazily: the estimators do not need matplotlib).
+
+Every function draws into ``ax`` (or ``axes``) when given and returns it; without one it makes a
+new pyplot figure, for notebooks. The report (:mod:`allanite.report`) passes axes of plain
+``matplotlib.figure.Figure`` objects, so it never touches pyplot's global state or backend.
+
+``unit`` is the unit of the samples (``"deg/s"``, ``"rad"``…; labels show the Allan deviation's
+rate unit, e.g. ``°/s``) or any label string, shown as given when it is not a known unit.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["plot_adev", "plot_davar"]
+__all__ = ["plot_adev", "plot_davar", "plot_davar3d", "plot_fit", "plot_coefficient_series"]
 
 
-def _axes(ax):
+def _axes(ax, projection=None):
     if ax is None:
         import matplotlib.pyplot as plt
 
-        _, ax = plt.subplots(figsize=(6.4, 4.4))
+        if projection is None:
+            _, ax = plt.subplots(figsize=(6.4, 4.4))
+        else:
+            fig = plt.figure(figsize=(7.0, 5.2))
+            ax = fig.add_subplot(projection=projection)
     return ax
 
 
-def plot_adev(result, ax=None, unit: str | None = None, labels=None, **kwargs):
-    """Log-log ADEV against τ, one line per axis."""
+def _unit_label(unit) -> str | None:
+    """Label of the Allan deviation's unit: '°/s' for 'deg/s', 'µrad/s' for increments in 'urad'; an
+    unknown string is shown as given."""
+    if unit is None:
+        return None
+    from .errors import AllaniteError
+    from .units import adev_unit_label
+
+    try:
+        return adev_unit_label(unit)
+    except AllaniteError:
+        return str(unit)
+
+
+def _adev_label(unit) -> str:
+    label = _unit_label(unit)
+    return f"Allan deviation ({label})" if label else "Allan deviation"
+
+
+def _rows(result, axis):
+    """(index, row) pairs of a static result's axes to draw."""
+    adev = np.atleast_2d(result.adev)
+    if axis is None:
+        return list(range(adev.shape[0]))
+    if result.n_axes is None:
+        return [0]
+    return [int(axis)]
+
+
+def plot_adev(result, ax=None, unit: str | None = None, labels=None, axis: int | None = None, band: bool = True,
+              **kwargs):
+    """Log-log ADEV against τ, one line per axis, with the confidence band when the result has
+    intervals (:meth:`~allanite.AllanResult.with_confidence`).
+
+    Parameters
+    ----------
+    result : AllanResult
+    ax : matplotlib Axes, optional
+    unit : str, optional
+        Unit of the samples, for the y label.
+    labels : list of str, optional
+        Legend label per axis (default "axis 0", "axis 1", …; none for 1-D input).
+    axis : int, optional
+        Draw only this axis of a multi-axis result.
+    band : bool
+        Shade the confidence interval of each curve (when present).
+    **kwargs
+        Passed to ``Axes.loglog`` for the curves.
+    """
     ax = _axes(ax)
     adev = np.atleast_2d(result.adev)
-    names = labels or ([f"axis {k}" for k in range(adev.shape[0])] if adev.shape[0] > 1 else [None])
-    for row, name in zip(adev, names):
-        ax.loglog(result.tau, row, marker=".", label=name, **kwargs)
+    ci = getattr(result, "adev_ci", None)
+    lo = hi = None
+    if band and ci is not None:
+        lo, hi = np.atleast_2d(ci[0]), np.atleast_2d(ci[1])
+    rows = _rows(result, axis)
+    multi = adev.shape[0] > 1
+    if labels is None:
+        labels = [f"axis {k}" for k in range(adev.shape[0])] if multi else [None]
+    for k in rows:
+        name = labels[k] if k < len(labels) else None
+        (line,) = ax.loglog(result.tau, adev[k], marker=".", label=name if (multi and axis is None) else
+                            (name or "Allan deviation"), **kwargs)
+        if lo is not None:
+            band_label = None
+            if len(rows) == 1:
+                band_label = f"{result.confidence:.1%} interval"
+            ax.fill_between(result.tau, lo[k], hi[k], color=line.get_color(), alpha=0.22, lw=0, label=band_label)
     ax.set_xlabel("τ (s)")
-    ax.set_ylabel(f"Allan deviation ({unit})" if unit else "Allan deviation")
+    ax.set_ylabel(_adev_label(unit))
     ax.grid(True, which="both", alpha=0.3)
-    if adev.shape[0] > 1:
-        ax.legend()
+    if len(rows) > 1 or lo is not None:
+        ax.legend(fontsize="small")
     return ax
 
 
@@ -35,63 +108,142 @@ def plot_davar(result, ax=None, axis: int = 0, unit: str | None = None, cmap: st
     from matplotlib.colors import LogNorm
 
     ax = _axes(ax)
-    adev = result.adev if result.avar.ndim == 2 else result.adev[axis]
+    adev = result.adev if result.avar.ndim == 2 else np.sqrt(result.avar[axis])
     positive = adev[adev > 0]
     norm = LogNorm(vmin=positive.min(), vmax=positive.max()) if positive.size else None
     mesh = ax.pcolormesh(result.t, result.tau, adev, shading="nearest", norm=norm, cmap=cmap, **kwargs)
     ax.set_yscale("log")
     ax.set_xlabel("window centre t (s)")
     ax.set_ylabel("τ (s)")
-    ax.figure.colorbar(mesh, ax=ax, label=f"Allan deviation ({unit})" if unit else "Allan deviation")
+    ax.figure.colorbar(mesh, ax=ax, label=_adev_label(unit))
+    return ax
+
+
+def _thin_index(n: int, max_points: int) -> np.ndarray:
+    """At most ``max_points`` indices spread evenly over 0 … n − 1, both ends included."""
+    if n <= max_points:
+        return np.arange(n)
+    return np.unique(np.round(np.linspace(0, n - 1, max_points)).astype(np.int64))
+
+
+def plot_davar3d(result, ax=None, axis: int = 0, unit: str | None = None, cmap: str = "viridis",
+                 max_points: int = 80, elev: float = 30.0, azim: float = -38.0):
+    """The dynamic ADEV as a 3-D surface, as in the DAVAR papers' figures: window centre t,
+    log₁₀ τ and log₁₀ ADEV.
+
+    Only the drawing is thinned: at most ``max_points`` windows and τ (evenly spaced, ends kept) are
+    drawn, so a result with thousands of windows still renders in a fraction of a second.
+    """
+    import mpl_toolkits.mplot3d  # noqa: F401  (registers the 3-D projection)
+
+    ax = _axes(ax, projection="3d")
+    avar = result.avar if result.avar.ndim == 2 else result.avar[axis]
+    ti = _thin_index(result.t.size, max_points)
+    qi = _thin_index(result.tau.size, max_points)
+    sub = np.sqrt(avar[np.ix_(qi, ti)])
+    positive = sub[sub > 0]
+    floor = positive.min() if positive.size else 1.0
+    z = np.log10(np.maximum(sub, floor))
+    tt, ll = np.meshgrid(result.t[ti], np.log10(result.tau[qi]))
+    ax.plot_surface(tt, ll, z, cmap=cmap, rcount=len(qi), ccount=len(ti), linewidth=0, antialiased=False)
+    ax.set_xlabel("window centre t (s)")
+    ax.set_ylabel("log₁₀ τ (s)")
+    label = _unit_label(unit)
+    ax.set_zlabel(f"log₁₀ ADEV ({label})" if label else "log₁₀ ADEV")
+    ax.view_init(elev=elev, azim=azim)
     return ax
 
 
 _TERM_STYLE = {"Q": "C1", "N": "C2", "B": "C3", "K": "C4", "R": "C5"}
 
 
-def plot_fit(fit, ax=None, unit: str | None = None, tau=None):
-    """ADEV estimates (fit points), the fitted model and each term as its own line."""
+def plot_fit(fit, ax=None, unit: str | None = None, tau=None, points: bool = True, terms: bool = True,
+             color: str = "C0", label: str = "fitted model", lw: float = 2.0):
+    """The fitted model and each term as its own dashed line, over the fit's estimates.
+
+    Parameters
+    ----------
+    fit : NoiseFit
+    tau : array_like, optional
+        Draw the model over min(tau)…max(tau) (default: the τ used in the fit).
+    points : bool
+        Draw the estimates used in the fit with ±1σ bars (off when overlaying on :func:`plot_adev`).
+    terms : bool
+        Draw each non-zero term as a dashed line, labelled with its value.
+    """
     ax = _axes(ax)
     lo = fit.tau[0] if tau is None else np.min(tau)
     hi = fit.tau[-1] if tau is None else np.max(tau)
     grid = np.geomspace(lo, hi, 200)
-    err = np.sqrt(fit.avar) * np.sqrt(2.0 / fit.edf) / 2.0  # 1σ of adev ≈ adev/√(2ν)
-    ax.errorbar(fit.tau, np.sqrt(fit.avar), yerr=err, fmt="o", color="k", ms=4, label="estimate (±1σ)")
-    ax.loglog(grid, np.sqrt(fit.curve(grid)), color="C0", lw=2, label="fitted model")
-    for name in fit.terms:
-        comp = fit.component(name, grid)
-        if np.any(comp > 0):
-            c = fit.coefficients[name]
-            label = f"{name} = {c.ieee:.3g} {c.ieee_unit}" if c.ieee is not None else f"{name} = {c.value:.3g}"
-            ax.loglog(grid, np.sqrt(comp), ls="--", color=_TERM_STYLE[name], label=label)
+    if points:
+        err = np.sqrt(fit.avar) * np.sqrt(2.0 / fit.edf) / 2.0  # 1σ of adev ≈ adev/√(2ν)
+        ax.errorbar(fit.tau, np.sqrt(fit.avar), yerr=err, fmt="o", color="k", ms=4, label="estimate (±1σ)")
+    ax.loglog(grid, np.sqrt(fit.curve(grid)), color=color, lw=lw, label=label)
+    if terms:
+        for name in fit.terms:
+            comp = fit.component(name, grid)
+            if np.any(comp > 0):
+                c = fit.coefficients[name]
+                text = f"{name} = {c.ieee:.3g} {c.ieee_unit}" if c.ieee is not None else f"{name} = {c.value:.3g}"
+                ax.loglog(grid, np.sqrt(comp), ls="--", color=_TERM_STYLE[name], label=text)
     ax.set_xlabel("τ (s)")
-    ax.set_ylabel(f"Allan deviation ({unit or fit.unit})" if (unit or fit.unit) else "Allan deviation")
+    ax.set_ylabel(_adev_label(unit or fit.unit))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize="small")
     return ax
 
 
-def plot_coefficient_series(series, axes=None, ieee: bool = True):
-    """One panel per coefficient against window centre time, with the interval band."""
-    import matplotlib.pyplot as plt
+def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None):
+    """One panel per coefficient against window centre time, with the interval band.
 
+    Parameters
+    ----------
+    series : CoefficientSeries
+    axes : sequence of Axes, optional
+        One per drawn coefficient (the non-zero ones, or all when every one is zero).
+    ieee : bool
+        IEEE-952 units (°/√h, °/h, …) when the series' unit is known, else the base form.
+    reference : NoiseFit, optional
+        Whole-record fit: its value of each coefficient is drawn as a dotted line.
+    """
     names = [t for t in series.terms if np.any(series.values[t] > 0)] or list(series.terms)
     if axes is None:
+        import matplotlib.pyplot as plt
+
         _, axes = plt.subplots(len(names), 1, figsize=(7.0, 1.9 * len(names)), sharex=True, squeeze=False)
         axes = axes[:, 0]
-    for ax, name in zip(np.atleast_1d(axes), names):
+    axes = np.atleast_1d(axes)
+    for ax, name in zip(axes, names):
         scale = 1.0
         label = name
-        if ieee and series.ieee is not None:
-            base = series.values[name]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ratio = np.where(base > 0, series.ieee[name] / base, np.nan)
-            scale = float(np.nanmedian(ratio)) if np.any(np.isfinite(ratio)) else 1.0
-            label = f"{name} ({series.ieee_units[name]})"
-        ax.plot(series.t, series.values[name] * scale, color=_TERM_STYLE.get(name, "C0"))
-        ax.fill_between(series.t, series.ci_low[name] * scale, series.ci_high[name] * scale,
-                        color=_TERM_STYLE.get(name, "C0"), alpha=0.25, lw=0)
+        if series.unit is not None:
+            from .fit import _base_unit
+            from .units import ieee952
+
+            if ieee:
+                q = ieee952(name, 1.0, series.unit)
+                scale, label = q.value, f"{name} ({q.unit})"
+            else:
+                label = f"{name} ({_base_unit(name, series.unit)})"
+        colour = _TERM_STYLE.get(name, "C0")
+        ax.plot(series.t, series.values[name] * scale, color=colour, lw=1.2)
+        ax.fill_between(series.t, series.ci_low[name] * scale, np.minimum(series.ci_high[name], 1e300) * scale,
+                        color=colour, alpha=0.25, lw=0)
+        if reference is not None and name in reference.coefficients:
+            ax.axhline(reference.coefficients[name].value * scale, color="k", ls=":", lw=1,
+                       label="whole record")
+            ax.legend(fontsize="x-small", loc="upper right")
+        finite_hi = series.ci_high[name][np.isfinite(series.ci_high[name])]
+        vmax = float(np.max(series.values[name]))
+        top = float(finite_hi.max()) if finite_hi.size else vmax
+        if vmax > 0:
+            top = min(top, 3.0 * vmax)  # a few windows with huge intervals must not flatten the curve
+        top = max(top, vmax)
+        if reference is not None and name in reference.coefficients:
+            top = max(top, reference.coefficients[name].value)
+        if top > 0:
+            ax.set_ylim(0.0, top * scale * 1.05)
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
-    np.atleast_1d(axes)[-1].set_xlabel("window centre t (s)")
+    axes[-1].set_xlabel("window centre t (s)")
     return axes

@@ -18,7 +18,47 @@ __all__ = ["AllanResult", "DynamicAllanResult"]
 def _fmt_range(a: np.ndarray, unit: str) -> str:
     if a.size == 0:
         return "none"
-    return f"{a[0]:.4g}–{a[-1]:.4g} {unit}" if a.size > 1 else f"{a[0]:.4g} {unit}"
+    u = f" {unit}" if unit else ""
+    return f"{a[0]:.4g}–{a[-1]:.4g}{u}" if a.size > 1 else f"{a[0]:.4g}{u}"
+
+
+def _xarray():
+    """The xarray module, or a MissingDependencyError naming the extra that installs it."""
+    try:
+        import xarray
+    except ImportError:
+        from .io import MissingDependencyError
+
+        raise MissingDependencyError(
+            "to_xarray() needs the optional package 'xarray': pip install 'allanite[xarray]'"
+        ) from None
+    return xarray
+
+
+def _xr_common(result, unit, axis_names):
+    """Dims prefix, coords and unit labels shared by both results' ``to_xarray``."""
+    from .units import adev_unit_label
+
+    label = adev_unit_label(unit)  # "rate unit" when None; checks the unit otherwise
+    coords = {
+        "tau": ("tau", result.tau, {"units": "s", "long_name": "averaging time τ"}),
+        "m": ("tau", result.m, {"units": "1", "long_name": "averaging factor, τ = m/fs"}),
+        "n": ("tau", result.n, {"units": "1", "long_name": "squared differences averaged"}),
+    }
+    axes = ()
+    if result.n_axes is not None:
+        names = list(range(result.n_axes)) if axis_names is None else [str(a) for a in axis_names]
+        if len(names) != result.n_axes:
+            from .errors import ParameterError
+
+            raise ParameterError(f"axis_names has {len(names)} names for {result.n_axes} axes")
+        coords["axis"] = ("axis", names, {"long_name": "sensor axis"})
+        axes = ("axis",)
+    attrs = {"estimator": result.estimator, "fs_hz": result.fs, "n_samples": result.n_samples, "input": result.input,
+             "unit": "unknown" if unit is None else str(unit), "allanite_result": type(result).__name__}
+    if result.confidence is not None:
+        attrs["confidence"] = result.confidence
+    return axes, coords, label, attrs
 
 
 @dataclass(frozen=True, repr=False, eq=False)
@@ -108,12 +148,50 @@ class AllanResult:
 
     def __repr__(self) -> str:
         axes = f", {self.n_axes} axes" if self.n_axes else ""
+        which = " (axis 0)" if self.n_axes else ""
         return (
             f"AllanResult({self.estimator}, {self.tau.size} τ in {_fmt_range(self.tau, 's')}, "
             f"{self.n_samples} samples at {self.fs:g} Hz{axes}; "
-            f"adev {_fmt_range(np.atleast_2d(self.adev)[0], '')}"
+            f"adev{which} {_fmt_range(np.atleast_2d(self.adev)[0], '')}"
             f"{'' if self.confidence is None else f'; {self.confidence:.1%} intervals'})"
         )
+
+    def to_xarray(self, unit=None, axis_names=None):
+        """The result as an ``xarray.Dataset`` with labelled dims ``(axis, tau)`` (``(tau,)`` for 1-D
+        input) and units in the attrs. Needs the optional extra: ``pip install 'allanite[xarray]'``.
+
+        Parameters
+        ----------
+        unit : str, optional
+            Unit of the samples (e.g. ``"deg/s"``), for the ``units`` attrs (default "rate unit").
+        axis_names : list of str, optional
+            Labels of the ``axis`` coordinate (default 0, 1, …).
+
+        Returns
+        -------
+        xarray.Dataset
+            ``avar`` and ``adev``; with intervals also ``ci_low``, ``ci_high`` (variance),
+            ``adev_low``, ``adev_high``, ``edf`` and ``alpha``; coords ``tau`` (s), ``m``, ``n``,
+            ``axis``; attrs ``estimator``, ``fs_hz``, ``n_samples``, ``input``, ``unit``, ``confidence``.
+        """
+        xr = _xarray()
+        axes, coords, label, attrs = _xr_common(self, unit, axis_names)
+        dims = axes + ("tau",)
+        var_units = f"({label})²"
+        data = {
+            "avar": (dims, self.avar, {"units": var_units, "long_name": f"Allan variance ({self.estimator})"}),
+            "adev": (dims, self.adev, {"units": label, "long_name": "Allan deviation"}),
+        }
+        if self.ci_low is not None:
+            level = f"{self.confidence:.1%}"
+            data["ci_low"] = (dims, self.ci_low, {"units": var_units, "long_name": f"{level} lower bound, variance"})
+            data["ci_high"] = (dims, self.ci_high, {"units": var_units, "long_name": f"{level} upper bound, variance"})
+            data["adev_low"] = (dims, np.sqrt(self.ci_low), {"units": label, "long_name": f"{level} lower bound, ADEV"})
+            data["adev_high"] = (dims, np.sqrt(self.ci_high), {"units": label,
+                                                              "long_name": f"{level} upper bound, ADEV"})
+            data["edf"] = (dims, self.edf, {"units": "1", "long_name": "equivalent degrees of freedom"})
+            data["alpha"] = (dims, self.alpha, {"units": "1", "long_name": "noise type α (S_y ∝ f^α)"})
+        return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def plot(self, ax=None, **kwargs):
         """Log-log ADEV against τ (one line per axis). Returns the matplotlib Axes."""
@@ -209,6 +287,33 @@ class DynamicAllanResult:
             f"{_fmt_range(self.tau, 's')} × {self.t.size} windows centred {_fmt_range(self.t, 's')}; "
             f"window {self.window}, hop {self.hop} samples at {self.fs:g} Hz{axes})"
         )
+
+    def to_xarray(self, unit=None, axis_names=None):
+        """The result as an ``xarray.Dataset`` with labelled dims ``(axis, tau, t)`` (``(tau, t)`` for
+        1-D input) and units in the attrs. Needs ``pip install 'allanite[xarray]'``.
+
+        ``avar`` is the result's own array (no copy); ``adev`` is computed (one more array of the
+        same size). With intervals: ``ci_low``, ``ci_high`` (variance, shape of ``avar``), ``edf`` and
+        ``alpha`` per (axis, τ). Coords ``tau`` (s), ``t`` (window centres, s), ``m``, ``n``,
+        ``axis``; attrs as :meth:`AllanResult.to_xarray` plus ``window``, ``hop``, ``method``.
+        """
+        xr = _xarray()
+        axes, coords, label, attrs = _xr_common(self, unit, axis_names)
+        coords["t"] = ("t", self.t, {"units": "s", "long_name": "window centre from the start of the record"})
+        attrs.update(window=self.window, hop=self.hop, method=self.method)
+        dims = axes + ("tau", "t")
+        var_units = f"({label})²"
+        data = {
+            "avar": (dims, self.avar, {"units": var_units, "long_name": f"dynamic Allan variance ({self.estimator})"}),
+            "adev": (dims, self.adev, {"units": label, "long_name": "dynamic Allan deviation"}),
+        }
+        if self.ci_low is not None:
+            level = f"{self.confidence:.1%}"
+            data["ci_low"] = (dims, self.ci_low, {"units": var_units, "long_name": f"{level} lower bound, variance"})
+            data["ci_high"] = (dims, self.ci_high, {"units": var_units, "long_name": f"{level} upper bound, variance"})
+            data["edf"] = (axes + ("tau",), self.edf, {"units": "1", "long_name": "equivalent degrees of freedom"})
+            data["alpha"] = (axes + ("tau",), self.alpha, {"units": "1", "long_name": "noise type α (S_y ∝ f^α)"})
+        return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def plot(self, ax=None, axis: int = 0, **kwargs):
         """Heat map of ADEV over (t, τ), log colour. Returns the matplotlib Axes."""

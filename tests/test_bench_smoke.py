@@ -1,0 +1,53 @@
+"""Smoke test of the engine benchmark script (``benches/bench_engine.py --quick``).
+
+A correctness check only — it never asserts anything about speed: the script must run, write its
+report, and allanite must agree with every baseline (NumPy prefix-sum DAVAR, allantools per window,
+allantools static OADEV, workers=1 vs workers=2) to 1e-9 relative.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+SCRIPT = Path(__file__).resolve().parents[1] / "benches" / "bench_engine.py"
+
+pytestmark = pytest.mark.skipif(not SCRIPT.is_file(), reason=f"{SCRIPT} not found")
+
+
+def test_bench_engine_quick(tmp_path):
+    pytest.importorskip("allantools")
+    proc = subprocess.run(
+        [sys.executable, str(SCRIPT), "--quick", "--out", str(tmp_path)],
+        capture_output=True, text=True, timeout=120,
+    )
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
+    report = json.loads((tmp_path / "engine.json").read_text(encoding="utf-8"))
+    assert (tmp_path / "engine.md").read_text(encoding="utf-8").count("| ") > 10
+    assert report["mode"] == "quick"
+    cases = report["cases"]
+    assert set(cases) == {"case1", "case2", "case3"}
+    expected = {
+        "case1": {"davar_prefix", "allantools_per_window"},
+        "case2": {"davar_prefix", "allantools_per_window", "workers"},
+        "case3": {"allantools_oadev"},
+    }
+    for name, case in cases.items():
+        comps = {c["key"]: c for c in case["comparisons"]}
+        assert set(comps) == expected[name], name
+        assert math.isfinite(case["allanite"]["seconds"]) and case["allanite"]["seconds"] > 0
+        for key, c in comps.items():
+            assert math.isfinite(c["ratio"]) and c["ratio"] > 0, (name, key, c["ratio"])
+            assert math.isfinite(c["max_rel_diff"]), (name, key)
+            assert c["max_rel_diff"] <= 1e-9, (name, key, c["max_rel_diff"])
+            assert c["n_compared"] > 0, (name, key)
+            if "taus_match_exactly" in c:
+                assert c["taus_match_exactly"] and c["taus_missing_from_baseline"] == 0, (name, key)
+        assert len(case["targets"]) >= 1
+    assert cases["case2"]["params"]["n_taus"] > 1
+    assert next(c for c in cases["case2"]["comparisons"] if c["key"] == "workers")["bit_identical"] is True
