@@ -463,3 +463,12 @@ def test_reprs_are_readable():
     assert " )" not in repr(allanite.avar(x[:, 0], fs))
     d = allanite.davar(x, fs, window=5_000, hop=1_000)
     assert "window 5000, hop 1000 samples at 100 Hz, 3 axes" in repr(d)
+
+
+def test_report_module_examples():
+    import doctest
+
+    import allanite.report
+
+    failures, tried = doctest.testmod(allanite.report, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert tried > 0 and failures == 0
