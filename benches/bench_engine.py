@@ -565,7 +565,7 @@ def write_markdown(report: dict, path: Path) -> None:
         f"- versions: " + ", ".join(f"{k} {v}" for k, v in m["versions"].items()) + f", {m['rustc']}",
         f"- environment: " + ", ".join(f"{k}={v}" for k, v in m["env"].items()),
         f"- load average at start: {[round(v, 2) for v in m['loadavg_start']]}, at end: "
-        f"{[round(v, 2) for v in m.get('loadavg_end') or []]}; CPUs busy just before the start: "
+        f"{[round(v, 2) for v in m.get('loadavg_end') or []]}; CPUs busy when the script started (before any idle wait): "
         f"{_pct(m['idle_check'].get('busy_fraction_before_start'))}; CPU share used by other processes during "
         f"each case: " + ", ".join(f"{k} {_pct(c.get('other_processes_cpu_fraction'))}" for k, c in cases.items()),
         f"- total benchmark wall time: {report['total_seconds']:.1f} s",
