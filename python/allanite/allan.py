@@ -9,10 +9,13 @@ from ._input import as_rate_columns, check_choice, resolve_max_memory, resolve_w
 from .errors import MemoryBudgetError, ParameterError
 from .grid import _check_count, resolve_taus
 from .results import AllanResult, DynamicAllanResult
+from .theo import DYNAMIC_THEO_ESTIMATORS, THEO_ESTIMATORS, dynamic_theo, static_theo
 
 __all__ = ["avar", "davar", "ESTIMATORS", "METHODS"]
 
 ESTIMATORS = ("oavar", "avar")
+STATIC_ESTIMATORS = ESTIMATORS + THEO_ESTIMATORS
+DYNAMIC_ESTIMATORS = ESTIMATORS + DYNAMIC_THEO_ESTIMATORS
 METHODS = ("fast", "naive")
 
 
@@ -39,8 +42,12 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
         A grid name (``"octave"``, default; ``"decade"``, ``"all"``, ``"exp"`` — see
         :func:`allanite.tau_grid`) or τ in seconds, each rounded to m = round(τ·fs) and required to be
         valid; ``result.tau`` holds the τ actually used.
-    estimator : {"oavar", "avar"}
-        Overlapping (default; NIST SP 1065 eq. 11) or classic non-overlapping Allan variance.
+    estimator : {"oavar", "avar", "theo1", "theobr", "theoh"}
+        Overlapping (default; NIST SP 1065 eq. 11) or classic non-overlapping Allan variance;
+        Theo1 (even m ≥ 10, τ = 0.75·m/fs, up to 75 % of the record), bias-removed TheoBR, or
+        TheoH (overlapping Allan up to 10 % of the record, TheoBR beyond) — see
+        :mod:`allanite.theo`. For these, named grids span m = 1 … M, ``result.source`` says which
+        estimator each τ came from and ``result.kf`` holds the bias ratio.
     workers : int, optional
         Threads (default: ``ALLANITE_NUM_THREADS``, else all cores). Results do not depend on it.
 
@@ -60,9 +67,15 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
     >>> np.round(r.adev * np.sqrt(r.m), 1)                      # white rate: adev·√m ≈ σ
     array([1., 1., 1.])
     """
-    check_choice(estimator, "estimator", ESTIMATORS)
+    check_choice(estimator, "estimator", STATIC_ESTIMATORS)
     cols, fs, is_multi = as_rate_columns(x, fs, input)
     n = cols[0].size
+    if estimator in THEO_ESTIMATORS:
+        tau, values, n_terms, ms, src, kf = static_theo(cols, fs, taus, estimator, workers)
+        if not is_multi:
+            values, kf = values[0], (None if kf is None else float(kf[0]))
+        return AllanResult(tau=tau, avar=values, n=n_terms, m=ms, estimator=estimator, fs=fs, n_samples=n,
+                           input=input, source=src, kf=kf)
     ms = resolve_taus(taus, n, fs)
     out = _core.davar(cols, n, 1, [int(m) for m in ms], estimator, "fast", resolve_workers(workers))
     values = out[:, :, 0] if is_multi else out[0, :, 0]
@@ -97,8 +110,12 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
         ``"fast"``: sliding block sums, O(record) work per τ whatever the window and hop, exact to
         rounding (no drift, see the core's notes). ``"naive"``: recompute every window from
         scratch — paper 000's DAVAR, O(window) per τ per window; kept as a reference and baseline.
-    estimator : {"oavar", "avar"}
-        Overlapping (default) or classic Allan variance inside each window.
+    estimator : {"oavar", "avar", "theoh", "theoh_a"}
+        Overlapping (default) or classic Allan variance inside each window; or paper 001's dynamic
+        TheoH: ``"theoh"`` (DHVAR: overlapping Allan up to 10 % of the window, TheoBR with the
+        window's own bias ratio beyond, to 75 % of the window) or ``"theoh_a"`` (DHVAR-A: classic
+        Allan below the switch). Theo values belong to τ = 0.75·m/fs; ``result.source`` names the
+        estimator of each τ, ``result.kf`` every window's bias ratio. ``method="fast"`` only.
     input : {"rate", "increment", "angle"}
     workers : int, optional
         Threads (default ``ALLANITE_NUM_THREADS``, else all cores); results are bit-identical for
@@ -124,7 +141,7 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
     >>> np.round(d.adev[0, [0, -1]])                            # before and after, at τ = 0.01 s
     array([ 1., 10.])
     """
-    check_choice(estimator, "estimator", ESTIMATORS)
+    check_choice(estimator, "estimator", DYNAMIC_ESTIMATORS)
     check_choice(method, "method", METHODS)
     cols, fs, is_multi = as_rate_columns(x, fs, input)
     n = cols[0].size
@@ -132,7 +149,15 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
     hop = _check_count(hop, "hop", 1)
     if window > n:
         raise ParameterError(f"window ({window} samples) is longer than the record ({n} samples)")
-    ms = resolve_taus(taus, window, fs)
+    theo = estimator in DYNAMIC_THEO_ESTIMATORS
+    if theo:
+        if method != "fast":
+            raise ParameterError(f"estimator {estimator!r} is computed with method='fast' only, got method={method!r}")
+        from .theo import theo_ms
+
+        ms, src = theo_ms(taus, window, fs, estimator)
+    else:
+        ms = resolve_taus(taus, window, fs)
     n_win = (n - window) // hop + 1
     n_axes = len(cols)
     nbytes = n_axes * ms.size * n_win * 8
@@ -154,9 +179,15 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
         )
     # A hop beyond the record gives one window, as does the record length itself.
     hop_core = min(hop, n)
+    t = (np.arange(n_win) * float(hop) + window / 2) / fs
+    if theo:
+        tau, out, n_terms, ms, src, kf = dynamic_theo(cols, fs, window, hop_core, taus, estimator, workers)
+        return DynamicAllanResult(
+            tau=tau, t=t, avar=out if is_multi else out[0], n=n_terms, m=ms, window=window, hop=hop, method=method,
+            estimator=estimator, fs=fs, n_samples=n, input=input, source=src, kf=kf if is_multi else kf[0],
+        )
     out = _core.davar(cols, window, hop_core, [int(m) for m in ms], estimator, method, resolve_workers(workers))
     values = out if is_multi else out[0]
-    t = (np.arange(n_win) * float(hop) + window / 2) / fs
     return DynamicAllanResult(
         tau=ms / fs, t=t, avar=values, n=_n_terms(estimator, window, ms), m=ms, window=window, hop=hop,
         method=method, estimator=estimator, fs=fs, n_samples=n, input=input,

@@ -77,7 +77,8 @@ class AllanResult:
     m : ndarray, (T,)
         Averaging factors, τ = m / fs.
     estimator : str
-        ``"oavar"`` (overlapping) or ``"avar"`` (classic, non-overlapping).
+        ``"oavar"`` (overlapping) or ``"avar"`` (classic, non-overlapping); ``"theo1"``, ``"theobr"``
+        or ``"theoh"`` (see :mod:`allanite.theo`: Theo1 values belong to τ = 0.75·m/fs).
     fs : float
         Sampling rate, Hz.
     n_samples : int
@@ -87,6 +88,11 @@ class AllanResult:
     edf, ci_low, ci_high, alpha, confidence : optional
         Confidence intervals, None until :meth:`with_confidence`: equivalent degrees of freedom
         and noise type α per τ (shape of ``avar``), bounds on the true Allan variance, coverage.
+    source : ndarray of str, (T,), optional
+        Theo-family estimators: the estimator behind each τ (``"oavar"``, ``"avar"``, ``"theo1"``,
+        ``"theobr"``); None for plain Allan results.
+    kf : ndarray, optional
+        TheoBR's bias ratio per axis (scalar for 1-D input), None when not used.
     """
 
     tau: np.ndarray
@@ -104,6 +110,10 @@ class AllanResult:
     ci_high: np.ndarray | None = None
     alpha: np.ndarray | None = None
     confidence: float | None = None
+    #: Theo-family estimators only: which estimator each τ came from (``"oavar"``, ``"avar"``,
+    #: ``"theo1"``, ``"theobr"``) and TheoBR's bias ratio kf (per axis; per axis and window for DHVAR).
+    source: np.ndarray | None = None
+    kf: np.ndarray | float | None = None
 
     def with_confidence(self, x=None, *, confidence: float = 0.683, alpha=None, edf_method: str = "greenhall",
                         chi2: str = "exact", b1_n: str = "averages") -> "AllanResult":
@@ -223,7 +233,7 @@ class DynamicAllanResult:
     method : str
         ``"fast"`` (sliding sums) or ``"naive"`` (every window recomputed).
     estimator : str
-        ``"oavar"`` or ``"avar"``.
+        ``"oavar"`` or ``"avar"``; ``"theoh"`` (DHVAR) or ``"theoh_a"`` (DHVAR-A).
     fs : float
     n_samples : int
     input : str
@@ -233,6 +243,11 @@ class DynamicAllanResult:
     ci_low, ci_high : ndarray, shape of ``avar``, optional
         Bounds on the true Allan variance of every window.
     confidence : float, optional
+    source : ndarray of str, (T,), optional
+        DHVAR: the estimator behind each τ (``"oavar"`` or ``"avar"`` up to 10 % of the window,
+        ``"theobr"`` beyond).
+    kf : ndarray, (J,) or (axes, J), optional
+        DHVAR: every window's own TheoBR bias ratio.
     """
 
     tau: np.ndarray
@@ -254,6 +269,10 @@ class DynamicAllanResult:
     ci_high: np.ndarray | None = None
     alpha: np.ndarray | None = None
     confidence: float | None = None
+    #: Theo-family estimators only: which estimator each τ came from (``"oavar"``, ``"avar"``,
+    #: ``"theo1"``, ``"theobr"``) and TheoBR's bias ratio kf (per axis; per axis and window for DHVAR).
+    source: np.ndarray | None = None
+    kf: np.ndarray | float | None = None
 
     def with_confidence(self, x=None, *, confidence: float = 0.683, alpha=None, edf_method: str = "greenhall",
                         chi2: str = "exact", b1_n: str = "averages") -> "DynamicAllanResult":

@@ -51,10 +51,10 @@ pub enum Method {
 }
 
 /// Longest run of terms added into one partial sum before it is folded into its block total.
-const RUN: usize = 1024;
+pub(crate) const RUN: usize = 1024;
 
 /// Averaging factors up to this use direct block sums, in chunks of `DIRECT_CHUNK` terms.
-const DIRECT_M: usize = 8;
+pub(crate) const DIRECT_M: usize = 8;
 const DIRECT_CHUNK: usize = 2048;
 
 /// Hops up to this many terms are cut into blocks after the terms are stored.
@@ -102,7 +102,7 @@ pub fn compensated_mean(y: &[f64]) -> f64 {
 
 /// Sum with four partial accumulators: shorter dependency chains and ~¼ the rounding growth.
 #[inline]
-fn sum4(v: &[f64]) -> f64 {
+pub(crate) fn sum4(v: &[f64]) -> f64 {
     let mut acc = [0.0f64; 4];
     let chunks = v.chunks_exact(4);
     let rest = chunks.remainder();
@@ -124,10 +124,10 @@ fn sum4(v: &[f64]) -> f64 {
 const CHAINS: usize = 4; // the hot loops below are unrolled for exactly four
 
 /// Scratch and state for the terms of one m, reused across segments.
-struct TermScratch {
+pub(crate) struct TermScratch {
     suf: Vec<f64>,
     pre: Vec<f64>,
-    bprev: Vec<f64>,
+    pub(crate) bprev: Vec<f64>,
 }
 
 /// Part boundaries for `CHAINS` chains over `len` items: parts of q items, the last takes the rest.
@@ -143,7 +143,7 @@ fn parts(len: usize) -> (usize, [usize; CHAINS + 1]) {
 }
 
 impl TermScratch {
-    fn new(m: usize) -> Self {
+    pub(crate) fn new(m: usize) -> Self {
         TermScratch {
             suf: vec![0.0; m],
             pre: vec![0.0; m],
@@ -161,7 +161,7 @@ impl TermScratch {
     /// the parts above and the prefix totals of the parts below). Every term of every sum lies inside
     /// B(k)'s own range [k, k+m): the rounding error is local, whatever the rest of the record holds.
     /// Requires start + len − 1 + m ≤ y.len().
-    fn segment(
+    pub(crate) fn segment(
         &mut self,
         y: &[f64],
         mu: f64,
@@ -375,7 +375,7 @@ fn for_each_term_chunk(
 /// out[j] = Σ f[j..j+q] for j < out.len(), non-negative f (Van Herk / Gil-Werman, no subtraction):
 /// the suffix sum of j's q-segment from j plus the prefix sum of the next segment up to j+q−1.
 /// Written in place, no scratch. Requires f.len() ≥ out.len() + q − 1 and q ≥ 1.
-fn sliding_sums(f: &[f64], q: usize, out: &mut [f64]) {
+pub(crate) fn sliding_sums(f: &[f64], q: usize, out: &mut [f64]) {
     let n_out = out.len();
     if q == 1 {
         out.copy_from_slice(&f[..n_out]);

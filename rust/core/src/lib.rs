@@ -5,9 +5,11 @@
 
 pub mod allan;
 pub mod error;
+pub mod theo;
 
 pub use allan::{
     compensated_mean, dynamic_avar, max_m, n_terms, n_windows, run_in_pool, static_avar, Estimator,
     Method, Request,
 };
 pub use error::{CoreError, Result};
+pub use theo::{detrended_phase, dynamic_theo1, static_theo1, theo1_direct};

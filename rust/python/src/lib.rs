@@ -2,9 +2,11 @@
 //! Nothing else lives here — validation with friendly messages happens in Python, the arithmetic in
 //! allanite-core, and core errors come back as `allanite.errors.AllaniteError` (a ValueError).
 
-use allanite_core::{dynamic_avar, run_in_pool, CoreError, Estimator, Method, Request};
-use numpy::ndarray::Array3;
-use numpy::{IntoPyArray, PyArray3, PyReadonlyArray1};
+use allanite_core::{
+    dynamic_avar, dynamic_theo1, run_in_pool, static_theo1, CoreError, Estimator, Method, Request,
+};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
 
 /// Raises `allanite.errors.AllaniteError(msg)`; falls back to ValueError if the package is absent.
@@ -86,9 +88,61 @@ fn davar<'py>(
     Ok(arr.into_pyarray(py))
 }
 
+fn contiguous<'a>(
+    py: Python<'_>,
+    columns: &'a [PyReadonlyArray1<'_, f64>],
+) -> PyResult<Vec<&'a [f64]>> {
+    let mut slices: Vec<&[f64]> = Vec::with_capacity(columns.len());
+    for (a, c) in columns.iter().enumerate() {
+        let s = c.as_slice().map_err(|_| {
+            allanite_error(py, format!("axis {a} is not a contiguous float64 array"))
+        })?;
+        slices.push(s);
+    }
+    Ok(slices)
+}
+
+/// Theo1 of each whole rate record at every (even) averaging factor: shape (axes, len(ms)).
+#[pyfunction]
+#[pyo3(signature = (columns, ms, workers))]
+fn theo1_static<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    ms: Vec<usize>,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let slices = contiguous(py, &columns)?;
+    let result = py.detach(|| run_in_pool(workers, || static_theo1(&slices, &ms)));
+    let values = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let arr = Array2::from_shape_vec((slices.len(), ms.len()), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// Theo1 of every sliding window at every (even) averaging factor: shape (axes, len(ms), windows).
+#[pyfunction]
+#[pyo3(signature = (columns, window, hop, ms, workers))]
+fn theo1_dynamic<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    window: usize,
+    hop: usize,
+    ms: Vec<usize>,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let slices = contiguous(py, &columns)?;
+    let result = py.detach(|| run_in_pool(workers, || dynamic_theo1(&slices, window, hop, &ms)));
+    let (values, n_win) = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
+    m.add_function(wrap_pyfunction!(theo1_static, m)?)?;
+    m.add_function(wrap_pyfunction!(theo1_dynamic, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

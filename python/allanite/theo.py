@@ -1,0 +1,217 @@
+"""Theo1, TheoBR and TheoH — whole records and sliding windows (DHVAR) — over the Rust core.
+
+Definitions (Howe & Peppler 2003; Howe 2006; Taylor & Howe 2010; NIST SP 1065 §5.2.16–18), for a
+record of M rate samples, i.e. N = M + 1 phase (angle) points, τ0 = 1/fs, T = M·τ0:
+
+- **Theo1** at even m, 10 ≤ m ≤ N − 1, belongs to τ = 0.75·m·τ0 (not m·τ0 — allantools' label):
+  Theo1 = Σ_{i=0}^{N−m−1} Σ_{δ=0}^{m/2−1} [(x_i − x_{i−δ+m/2}) + (x_{i+m} − x_{i+δ+m/2})]² / (m/2 − δ)
+  / (0.75·(N − m)·(m·τ0)²). Invariant to a constant and a linear phase (frequency offset).
+- **TheoBR** = kf·Theo1 with kf = (n + 1)⁻¹ Σ_{i=0}^{n} AVAR(m = 9 + 3i) / Theo1(m = 12 + 4i), both at
+  τ = (9 + 3i)·τ0, AVAR the overlapping Allan variance, n = ⌊0.1·N/3 − 3⌋ (N phase points; needs
+  N ≥ 90). kf removes Theo1's noise-type-dependent bias against the Allan variance.
+- **TheoH**: the overlapping Allan variance for τ ≤ k = 0.1·T, TheoBR for 0.75·m·τ0 > k up to
+  0.75·T. ``"theoh_a"`` (paper 001's DHVAR-A) uses the classic Allan variance below k instead.
+
+In sliding windows (paper 001's DHVAR), every window of W samples is a record of its own: N = W + 1,
+its own kf, its own switch point 0.1·W·τ0. The Theo1 sums are computed by the Rust core (an O(N²)
+all-m algorithm for whole records, per-(d, m) sliding sums for windows; see ``rust/core/src/theo.rs``)
+and agree with the direct double sum to ≲ 1e-11 relative.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import _core
+from ._input import resolve_workers
+from .errors import ParameterError
+from .grid import GRIDS, _check_fs, _m_grid
+
+__all__ = ["THEO_ESTIMATORS", "DYNAMIC_THEO_ESTIMATORS", "theo_ms", "kf_indices", "switch_m",
+           "static_theo", "dynamic_theo"]
+
+THEO_ESTIMATORS = ("theo1", "theobr", "theoh")
+DYNAMIC_THEO_ESTIMATORS = ("theoh", "theoh_a")
+#: Howe's lower limit on the Theo1 averaging factor.
+THEO1_MIN_M = 10
+#: TheoBR's bias ratio needs n = ⌊0.1·N/3 − 3⌋ ≥ 0, i.e. N ≥ 90 phase points.
+THEOBR_MIN_POINTS = 90
+#: TheoH switches from Allan to TheoBR above this fraction of the span T.
+THEOH_SWITCH = 0.1
+
+
+def kf_indices(n_rate: int) -> tuple[np.ndarray, np.ndarray]:
+    """The averaging factors of TheoBR's bias ratio for ``n_rate`` rate samples: (AVAR m = 9 + 3i,
+    Theo1 m = 12 + 4i), i = 0 … n, n = ⌊0.1·N/3 − 3⌋, N = n_rate + 1 phase points."""
+    n_phase = int(n_rate) + 1
+    if n_phase < THEOBR_MIN_POINTS:
+        raise ParameterError(
+            f"TheoBR/TheoH need at least {THEOBR_MIN_POINTS} phase points ({THEOBR_MIN_POINTS - 1} samples) for the "
+            f"bias ratio, got {n_rate} samples"
+        )
+    n = int(math.floor(0.1 * n_phase / 3.0 - 3.0))
+    i = np.arange(n + 1, dtype=np.int64)
+    return 9 + 3 * i, 12 + 4 * i
+
+
+def switch_m(n_rate: int) -> int:
+    """Largest Allan averaging factor of TheoH: m·τ0 ≤ 0.1·T, T = n_rate·τ0."""
+    return max(1, int(math.floor(THEOH_SWITCH * n_rate + 1e-9)))
+
+
+def _even_theo(ms: np.ndarray, n_rate: int) -> np.ndarray:
+    """Grid factors made valid Theo1 factors: rounded up to even, ≥ 10, ≤ the largest even ≤ N − 1."""
+    top = int(n_rate) - int(n_rate) % 2
+    ev = ms + (ms % 2)
+    ev = ev[(ev >= THEO1_MIN_M) & (ev <= top)]
+    return np.unique(ev)
+
+
+def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, np.ndarray]:
+    """(m, source) for a TheoH-family estimate on ``n_rate`` samples.
+
+    Named grids (``"all"``, ``"octave"``, ``"decade"``, ``"exp"``) are laid out over m = 1 … M (Theo
+    reaches τ = 0.75·M·τ0); Theo1 factors are rounded up to even and kept in 10 … N − 1. For TheoH,
+    grid points with m·τ0 ≤ 0.1·T are Allan ("oavar"/"avar"), the rest TheoBR at τ = 0.75·m·τ0 > 0.1·T.
+    Explicit τ (s) map to the nearest valid factor of the estimator that covers them and must then
+    be honoured exactly (as :func:`allanite.tau_grid`'s rules for Allan τ).
+    """
+    n_rate = int(n_rate)
+    if n_rate < THEO1_MIN_M:
+        raise ParameterError(
+            f"Theo1 needs at least {THEO1_MIN_M} samples (m ≥ {THEO1_MIN_M}, m ≤ N − 1), got {n_rate}"
+        )
+    theo_src = "theo1" if estimator == "theo1" else "theobr"
+    allan_src = "avar" if estimator == "theoh_a" else "oavar"
+    hybrid = estimator in ("theoh", "theoh_a")
+    k = switch_m(n_rate) if hybrid else 0
+    if isinstance(taus, str):
+        if taus not in GRIDS:
+            raise ParameterError(f"unknown τ grid {taus!r}; allowed: {', '.join(map(repr, GRIDS))} or τ in s")
+        grid = _m_grid(taus, 2 * n_rate, fs=fs, m_max=n_rate)
+        a = grid[grid <= k] if hybrid else np.empty(0, np.int64)
+        # Theo part: τ = 0.75 m τ0 > k τ0 ⇔ m > k/0.75.
+        t = _even_theo(grid, n_rate)
+        if hybrid:
+            t = t[0.75 * t > k]
+            first = int(math.floor(k / 0.75)) + 1
+            first += first % 2
+            first = max(first, THEO1_MIN_M)
+            if first <= n_rate - n_rate % 2 and (t.size == 0 or t[0] > first):
+                t = np.concatenate([[first], t])  # no gap at the switch
+        ms = np.concatenate([a, t]).astype(np.int64)
+        src = np.array([allan_src] * a.size + [theo_src] * t.size)
+        return ms, src
+    arr = np.atleast_1d(np.asarray(taus, dtype=np.float64))
+    if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ParameterError(f"taus must be a grid name or a non-empty 1-D sequence of positive τ in s, got {taus!r}")
+    ms, src = [], []
+    top = n_rate - n_rate % 2
+    for i, tau in enumerate(arr):
+        s = tau * fs
+        if hybrid and s <= k + 0.5:
+            m = int(math.floor(s + 0.5))
+            if m < 1:
+                raise ParameterError(f"taus[{i}] = {tau:g} s is shorter than one sample (1/fs = {1 / fs:g} s)")
+            ms.append(m)
+            src.append(allan_src)
+            continue
+        m = 2 * int(math.floor(s / 1.5 + 0.5))
+        if m < THEO1_MIN_M or m > top or (hybrid and 0.75 * m <= k):
+            lo = max(THEO1_MIN_M, 2 * (int(math.floor(k / 1.5)) + 1)) if hybrid else THEO1_MIN_M
+            raise ParameterError(
+                f"taus[{i}] = {tau:g} s maps to Theo1 m = {m} (τ = 0.75·m/fs); allowed for {n_rate} samples: even m "
+                f"from {lo} to {top}, i.e. τ from {0.75 * lo / fs:g} s to {0.75 * top / fs:g} s"
+            )
+        ms.append(m)
+        src.append(theo_src)
+    ms = np.asarray(ms, dtype=np.int64)
+    tau_used = np.where(np.asarray(src) == theo_src, 0.75 * ms, ms.astype(float))
+    if np.any(np.diff(tau_used) <= 0):
+        i = int(np.flatnonzero(np.diff(tau_used) <= 0)[0])
+        raise ParameterError(
+            f"taus[{i}] = {arr[i]:g} s and taus[{i + 1}] = {arr[i + 1]:g} s map to the same or decreasing τ "
+            f"({tau_used[i] / fs:g} s, {tau_used[i + 1] / fs:g} s); τ must be strictly increasing"
+        )
+    return ms, np.asarray(src)
+
+
+def _tau(ms: np.ndarray, src: np.ndarray, fs: float) -> np.ndarray:
+    is_theo = np.isin(src, ("theo1", "theobr"))
+    return np.where(is_theo, 0.75 * ms, ms.astype(np.float64)) / fs
+
+
+def _n_terms(ms: np.ndarray, src: np.ndarray, n_rate: int) -> np.ndarray:
+    """Terms per estimate: (N − m)·m/2 for Theo1 (Stable32's "Thêo1 #"), N − 2m / K − 1 for Allan."""
+    n_phase = n_rate + 1
+    out = np.empty(ms.size, dtype=np.int64)
+    for i, (m, s) in enumerate(zip(ms, src)):
+        if s in ("theo1", "theobr"):
+            out[i] = (n_phase - m) * (m // 2)
+        elif s == "oavar":
+            out[i] = n_rate + 1 - 2 * m
+        else:
+            out[i] = n_rate // m - 1
+    return out
+
+
+def _kf(avar_ka: np.ndarray, theo1_kt: np.ndarray) -> np.ndarray:
+    """Mean of AVAR/Theo1 over the bias-ratio factors (axis 1). A record with no variation at all
+    (Theo1 = 0 there) has nothing to correct: kf = 1, so its zeros stay zeros rather than NaN."""
+    ratio = np.divide(avar_ka, theo1_kt, out=np.ones_like(avar_ka), where=theo1_kt > 0)
+    return np.mean(ratio, axis=1)
+
+
+def static_theo(cols, fs: float, taus, estimator: str, workers):
+    """Theo1/TheoBR/TheoH of whole records: (tau, values (axes, T), n, m, source, kf (axes,) or None)."""
+    fs = _check_fs(fs)
+    n = cols[0].size
+    ms, src = theo_ms(taus, n, fs, estimator)
+    w = resolve_workers(workers)
+    is_theo = np.isin(src, ("theo1", "theobr"))
+    theo_m = ms[is_theo]
+    need_kf = estimator in ("theobr", "theoh", "theoh_a")
+    kf = None
+    values = np.empty((len(cols), ms.size))
+    all_theo = theo_m
+    if need_kf:
+        ka, kt = kf_indices(n)
+        all_theo = np.unique(np.concatenate([theo_m, kt]))
+    if all_theo.size:
+        th = _core.theo1_static(cols, [int(m) for m in all_theo], w)
+        pos = np.searchsorted(all_theo, theo_m)
+        values[:, is_theo] = th[:, pos]
+    if need_kf:
+        av = _core.davar(cols, n, 1, [int(m) for m in ka], "oavar", "fast", w)[:, :, 0]
+        kf = _kf(av, th[:, np.searchsorted(all_theo, kt)])
+        values[:, is_theo] *= kf[:, None]
+    allan = ~is_theo
+    if np.any(allan):
+        est = str(src[allan][0])
+        values[:, allan] = _core.davar(cols, n, 1, [int(m) for m in ms[allan]], est, "fast", w)[:, :, 0]
+    return _tau(ms, src, fs), values, _n_terms(ms, src, n), ms, src, kf
+
+
+def dynamic_theo(cols, fs: float, window: int, hop: int, taus, estimator: str, workers):
+    """TheoH (DHVAR) or TheoH-A (DHVAR-A) of every window: (tau, values (axes, T, J), n, m, source,
+    kf (axes, J)). Every window has its own bias ratio kf and its switch at 0.1·window·τ0."""
+    fs = _check_fs(fs)
+    ms, src = theo_ms(taus, window, fs, estimator)
+    w = resolve_workers(workers)
+    ka, kt = kf_indices(window)
+    is_theo = src == "theobr"
+    theo_m = ms[is_theo]
+    all_theo = np.unique(np.concatenate([theo_m, kt]))
+    th = _core.theo1_dynamic(cols, window, hop, [int(m) for m in all_theo], w)
+    av = _core.davar(cols, window, hop, [int(m) for m in ka], "oavar", "fast", w)
+    kf = _kf(av, th[:, np.searchsorted(all_theo, kt), :])  # (axes, J)
+    n_win = th.shape[2]
+    values = np.empty((len(cols), ms.size, n_win))
+    values[:, is_theo, :] = th[:, np.searchsorted(all_theo, theo_m), :] * kf[:, None, :]
+    allan = ~is_theo
+    if np.any(allan):
+        est = str(src[allan][0])
+        values[:, allan, :] = _core.davar(cols, window, hop, [int(m) for m in ms[allan]], est, "fast", w)
+    return _tau(ms, src, fs), values, _n_terms(ms, src, window), ms, src, kf
