@@ -25,7 +25,8 @@ def _n_terms(estimator: str, window: int, ms: np.ndarray) -> np.ndarray:
     return (window // ms - 1).astype(np.int64)
 
 
-def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar", workers=None) -> AllanResult:
+def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar", workers=None,
+         kf_rule: str = "textbook") -> AllanResult:
     """Allan variance of a whole record.
 
     Parameters
@@ -50,6 +51,9 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
         estimator each τ came from and ``result.kf`` holds the bias ratio.
     workers : int, optional
         Threads (default: ``ALLANITE_NUM_THREADS``, else all cores). Results do not depend on it.
+    kf_rule : {"textbook", "stable32"}
+        TheoBR/TheoH only: the range of the bias ratio kf — Howe's n = ⌊0.1·N/3 − 3⌋ (default) or
+        Stable32's n = ⌊N/6 − 3⌋ (to reproduce Stable32's ThêoH numbers).
 
     Returns
     -------
@@ -71,7 +75,7 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
     cols, fs, is_multi = as_rate_columns(x, fs, input)
     n = cols[0].size
     if estimator in THEO_ESTIMATORS:
-        tau, values, n_terms, ms, src, kf = static_theo(cols, fs, taus, estimator, workers)
+        tau, values, n_terms, ms, src, kf = static_theo(cols, fs, taus, estimator, workers, kf_rule)
         if not is_multi:
             values, kf = values[0], (None if kf is None else float(kf[0]))
         return AllanResult(tau=tau, avar=values, n=n_terms, m=ms, estimator=estimator, fs=fs, n_samples=n,
@@ -86,7 +90,7 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
 
 
 def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: str = "oavar",
-          input: str = "rate", workers=None, max_memory=None) -> DynamicAllanResult:
+          input: str = "rate", workers=None, max_memory=None, kf_rule: str = "textbook") -> DynamicAllanResult:
     """Dynamic Allan variance: the Allan variance of every sliding window (DAVAR).
 
     Column j of the result is exactly the static Allan variance (:func:`avar`) of the ``window``
@@ -123,6 +127,8 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
     max_memory : int, optional
         Byte budget for the output (default ``ALLANITE_MAX_MEMORY`` or 2 GiB). A larger request
         raises :class:`~allanite.errors.MemoryBudgetError` at once, with a hop that fits.
+    kf_rule : {"textbook", "stable32"}
+        DHVAR only: range of each window's bias ratio, as for :func:`avar`.
 
     Returns
     -------
@@ -181,7 +187,7 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
     hop_core = min(hop, n)
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
     if theo:
-        tau, out, n_terms, ms, src, kf = dynamic_theo(cols, fs, window, hop_core, taus, estimator, workers)
+        tau, out, n_terms, ms, src, kf = dynamic_theo(cols, fs, window, hop_core, taus, estimator, workers, kf_rule)
         return DynamicAllanResult(
             tau=tau, t=t, avar=out if is_multi else out[0], n=n_terms, m=ms, window=window, hop=hop, method=method,
             estimator=estimator, fs=fs, n_samples=n, input=input, source=src, kf=kf if is_multi else kf[0],

@@ -47,6 +47,7 @@ import numpy as np
 from .errors import ParameterError
 
 __all__ = [
+    "edf_theo1",
     "ONE_SIGMA", "ALPHAS", "NOISE_NAMES",
     "edf_greenhall", "edf_sp1065", "chi2_interval", "identify_alpha",
     "confidence_intervals", "ConfidenceIntervals",
@@ -371,6 +372,64 @@ def edf_sp1065(alpha, m, N, estimator="oavar"):
 
 # --------------------------------------------------------------------------------------------
 # χ² intervals
+
+
+def edf_theo1(alpha, m, N):
+    """Equivalent degrees of freedom of Theo1 (and TheoBR) at even averaging factor ``m``.
+
+    Howe & Peppler's empirical fits (NIST SP 1065 §5.5.7 / Table 11; Riley's *Handbook* CI notes),
+    with r = 0.75·m (τ/τ0) and N phase points::
+
+        α =  2 (WPM):  [0.86 (N+1)(N − 4r/3) / (N − r)] · [r / (r + 1.14)]
+        α =  1 (FPM):  [(4.798 N² − 6.374 N r + 12.387 r) / (√(r + 36.6) (N − r))] · [r / (r + 0.3)]
+        α =  0 (WFM):  [(4.1 N + 0.8)/r − (3.1 N + 6.5)/N] · [r^1.5 / (r^1.5 + 5.2)]
+        α = −1 (FFM):  [(2 N² − 1.3 N r − 3.5 r) / (N r)] · [r³ / (r³ + 2.3)]
+        α = −2 (RWFM): [(4.4 N − 2) / (2.9 r)] · [((4.4 N − 1)² − 8.6 r (4.4 N − 1) + 11.4 r²) / (4.4 N − 3)²]
+
+    With these and χ² intervals, Stable32's Thêo1 and ThêoH bounds on the Sr87 clock data are
+    reproduced (``tests/test_theo_reference.py``). TheoBR uses the same ν (kf treated as exact).
+
+    Parameters
+    ----------
+    alpha : int or array_like of int
+        Noise type(s), 2 … −2 (α of S_y ∝ f^α; gyro terms: Q 2, N 0, B −1, K −2).
+    m : int or array_like of int
+        Theo1 averaging factors (τ = 0.75·m·τ0).
+    N : int
+        Number of phase (angle) points: rate samples + 1.
+
+    Returns
+    -------
+    float or ndarray
+
+    Examples
+    --------
+    >>> from allanite.confidence import edf_theo1
+    >>> round(float(edf_theo1(0, 10, 1001)), 1)          # white rate, m = 10 (τ = 7.5 τ0)
+    434.3
+    """
+    a = _check_alpha(alpha)
+    m_arr = np.asarray(m, dtype=np.float64)
+    if np.any(~np.isfinite(m_arr)) or np.any(m_arr < 2):
+        raise ParameterError(f"m must be Theo1 averaging factors ≥ 2, got {m!r}")
+    n = float(_check_int(N, "N", 3))
+    a, r = np.broadcast_arrays(a, 0.75 * m_arr)
+    out = np.empty(a.shape, dtype=np.float64)
+    for idx in np.ndindex(a.shape):
+        al, rr = int(a[idx]), float(r[idx])
+        if al == 2:
+            v = 0.86 * (n + 1) * (n - 4 * rr / 3) / (n - rr) * (rr / (rr + 1.14))
+        elif al == 1:
+            v = (4.798 * n * n - 6.374 * n * rr + 12.387 * rr) / (math.sqrt(rr + 36.6) * (n - rr)) * (rr / (rr + 0.3))
+        elif al == 0:
+            v = ((4.1 * n + 0.8) / rr - (3.1 * n + 6.5) / n) * (rr**1.5 / (rr**1.5 + 5.2))
+        elif al == -1:
+            v = (2 * n * n - 1.3 * n * rr - 3.5 * rr) / (n * rr) * (rr**3 / (rr**3 + 2.3))
+        else:
+            q = 4.4 * n
+            v = (q - 2) / (2.9 * rr) * (((q - 1) ** 2 - 8.6 * rr * (q - 1) + 11.4 * rr * rr) / (q - 3) ** 2)
+        out[idx] = max(v, 1.0)  # the fits go below 1 only far outside their range; ν ≥ 1 keeps χ² defined
+    return float(out) if out.ndim == 0 else out
 
 
 def _norm_ppf_stable32(p: np.ndarray) -> np.ndarray:
@@ -719,12 +778,42 @@ def _alpha_for_result(result, x, alpha, shape_edf, b1_n) -> np.ndarray:
     out = np.empty(shape_edf, dtype=np.int64)
     for a_i, y in enumerate(cols):
         data = np.concatenate(([0.0], np.cumsum(y))) if kind == "angle" else y
-        ids = identify_alpha(data, result.m, input=kind, estimator=result.estimator, b1_n=b1_n)
+        est = result.estimator if result.estimator in _ESTIMATORS else "oavar"
+        ids = identify_alpha(data, _allan_m_for_id(result), input=kind, estimator=est, b1_n=b1_n)
         if is_multi:
             out[a_i] = ids
         else:
             out[...] = ids
     return out
+
+
+def _edf_mixed(alpha, m, n_phase, source) -> np.ndarray:
+    """ν per τ of a Theo-family result: Greenhall for its Allan τ, Howe's Theo1 EDF for Theo τ."""
+    nu = np.empty(alpha.shape, dtype=np.float64)
+    theo = np.isin(source, ("theo1", "theobr"))
+    if np.any(theo):
+        nu[theo] = edf_theo1(alpha[theo], m[theo], n_phase)
+    for est in ("oavar", "avar"):
+        sel = source == est
+        if np.any(sel):
+            nu[sel] = edf_greenhall(alpha[sel], 2, m[sel], n_phase, overlapping=est == "oavar")
+    return nu
+
+
+def _allan_m_for_id(result) -> np.ndarray:
+    """Averaging factors at which to identify the noise type. Theo τ = 0.75·m·τ0 is identified at the
+    Allan factor nearest that τ — but Theo reaches τ where fewer than 30 intervals fit, where the
+    identification is a guess (and a wrong "white phase" call would claim thousands of degrees of
+    freedom); there the longest τ with ≥ 30 intervals (lag-1 ACF, reliable) stands in."""
+    from .results import AllanResult
+
+    if result.source is None:
+        return np.asarray(result.m)
+    n = result.n_samples if isinstance(result, AllanResult) else result.window
+    theo = np.isin(result.source, ("theo1", "theobr"))
+    reliable = max(1, n // ACF_MIN_POINTS)
+    m_id = np.where(theo, np.minimum(np.floor(0.75 * result.m + 0.5), reliable), result.m).astype(np.int64)
+    return np.clip(m_id, 1, max(1, n // 2))
 
 
 def confidence_intervals(result, x=None, *, confidence=0.683, alpha=None, edf_method="greenhall",
@@ -790,8 +879,11 @@ def confidence_intervals(result, x=None, *, confidence=0.683, alpha=None, edf_me
     c = _check_confidence(confidence)
     _check_choice(edf_method, "edf_method", _EDF_METHODS)
     _check_choice(chi2, "chi2", _CHI2_METHODS)
-    if result.estimator not in _ESTIMATORS:
+    if result.estimator not in _ESTIMATORS and result.source is None:
         raise ParameterError(f"confidence intervals are implemented for 'oavar' and 'avar', not {result.estimator!r}")
+    if result.source is not None and edf_method != "greenhall":
+        raise ParameterError("Theo-family results use Greenhall's EDF (Allan τ) and Howe's Theo1 EDF (Theo τ); "
+                             f"edf_method={edf_method!r} is for plain Allan results")
     dynamic = isinstance(result, DynamicAllanResult)
     n_axes = result.n_axes
     shape_edf = (result.m.size,) if n_axes is None else (n_axes, result.m.size)
@@ -799,7 +891,9 @@ def confidence_intervals(result, x=None, *, confidence=0.683, alpha=None, edf_me
     a = _alpha_for_result(result, x, alpha, shape_edf, b1_n)
     n_phase = (result.window if dynamic else result.n_samples) + 1
     m_b = np.broadcast_to(result.m, shape_edf)
-    if edf_method == "greenhall":
+    if result.source is not None:
+        nu = _edf_mixed(a, m_b, n_phase, np.broadcast_to(result.source, shape_edf))
+    elif edf_method == "greenhall":
         nu = edf_greenhall(a, 2, m_b, n_phase, overlapping=result.estimator == "oavar")
     else:
         nu = edf_sp1065(a, m_b, n_phase, estimator=result.estimator)

@@ -207,9 +207,13 @@ def _octave_thin(tau: np.ndarray) -> np.ndarray:
     return np.asarray(keep)
 
 
-def _edf(alpha: np.ndarray, m: np.ndarray, n_points: int, estimator: str) -> np.ndarray:
-    from .confidence import edf_greenhall
+def _edf(alpha: np.ndarray, m: np.ndarray, n_points: int, estimator) -> np.ndarray:
+    """ν per τ for one noise type. ``estimator``: "oavar"/"avar", or a tuple naming the estimator of
+    every τ (Theo-family results: Greenhall's EDF for Allan τ, Howe's Theo1 EDF for Theo τ)."""
+    from .confidence import _edf_mixed, edf_greenhall
 
+    if not isinstance(estimator, str):
+        return _edf_mixed(np.asarray(alpha), np.asarray(m), int(n_points), np.asarray(estimator))
     overlapping = estimator == "oavar"
     return np.array([edf_greenhall(int(a), 2, int(mm), int(n_points), overlapping=overlapping)
                      for a, mm in zip(alpha, m)], dtype=np.float64)
@@ -226,8 +230,11 @@ def _nnls(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=50, edf_cache=None):
-    """IRLS for one curve. Returns theta, covariance, model, edf, z, iterations."""
-    a = design_matrix(tau, m, fs, terms)
+    """IRLS for one curve. Returns theta, covariance, model, edf, z, iterations.
+
+    ``m`` are the estimator's averaging factors (for the EDF); the closed forms are evaluated at
+    τ·fs, which is m for the Allan estimators and 0.75·m for Theo1-based points."""
+    a = design_matrix(tau, tau * fs, fs, terms)
     cache = {} if edf_cache is None else edf_cache
     # EDF of each term's noise type at every τ (Greenhall), cached across windows of a dynamic fit.
     nu_terms = []
@@ -425,15 +432,33 @@ def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool
 
         rate_unit(unit)
     if isinstance(result, DynamicAllanResult):
+        _check_fit_estimator(result)
         return _fit_dynamic(result, terms, unit, float(confidence), zq, thin, max_iter, tau_range)
     if not isinstance(result, AllanResult):
         raise ParameterError(f"fit needs an AllanResult or DynamicAllanResult, got {type(result).__name__}")
-    if result.estimator not in ("oavar", "avar"):
-        raise ParameterError(f"fit supports the 'oavar' and 'avar' estimators, not {result.estimator!r}")
+    _check_fit_estimator(result)
     if result.avar.ndim == 2:
         return [_fit_static_row(result, row, terms, unit, float(confidence), zq, thin, max_iter, tau_range)
                 for row in result.avar]
     return _fit_static_row(result, result.avar, terms, unit, float(confidence), zq, thin, max_iter, tau_range)
+
+
+#: Estimators whose values estimate the Allan variance (raw Theo1 does not: it is biased by a
+#: noise-type-dependent factor, which TheoBR's kf removes).
+FIT_ESTIMATORS = ("oavar", "avar", "theobr", "theoh", "theoh_a")
+
+
+def _check_fit_estimator(result) -> None:
+    if result.estimator == "theo1":
+        raise ParameterError("fit needs Allan-variance estimates; raw Theo1 is biased against the Allan variance by "
+                             "a noise-type-dependent factor: use estimator='theobr' or 'theoh'")
+    if result.estimator not in FIT_ESTIMATORS:
+        raise ParameterError(f"fit supports the estimators {FIT_ESTIMATORS}, not {result.estimator!r}")
+
+
+def _est_key(result, idx):
+    """The estimator argument of _fit_core: a name, or a tuple of per-τ sources for Theo-family results."""
+    return result.estimator if result.source is None else tuple(np.asarray(result.source)[idx])
 
 
 def _check_tau_range(tau_range):
@@ -474,7 +499,7 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
     idx = _select(result.tau, avar_row, thin, len(terms), "the result", tau_range)
     tau, m, y = result.tau[idx], result.m[idx].astype(np.float64), avar_row[idx]
     theta, cov, model, nu, z, it, a = _fit_core(
-        tau, m, y, result.fs, result.n_samples + 1, result.estimator, terms, confidence, max_iter)
+        tau, m, y, result.fs, result.n_samples + 1, _est_key(result, idx), terms, confidence, max_iter)
     n_active = int(np.count_nonzero(theta > 0))
     dof = max(1, tau.size - n_active)
     chi2 = float(np.sum(z**2))
@@ -512,7 +537,7 @@ def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range)
                 chi[j] = 0.0
                 continue
             theta, cov, model, nu, z, it, a = _fit_core(
-                tau, m, np.maximum(y, 1e-300), result.fs, result.window + 1, result.estimator, terms,
+                tau, m, np.maximum(y, 1e-300), result.fs, result.window + 1, _est_key(result, idx), terms,
                 confidence, max_iter, edf_cache=cache)
             dof = max(1, tau.size - int(np.count_nonzero(theta > 0)))
             chi[j] = float(np.sum(z**2)) / dof

@@ -8,7 +8,8 @@ record of M rate samples, i.e. N = M + 1 phase (angle) points, τ0 = 1/fs, T = M
   / (0.75·(N − m)·(m·τ0)²). Invariant to a constant and a linear phase (frequency offset).
 - **TheoBR** = kf·Theo1 with kf = (n + 1)⁻¹ Σ_{i=0}^{n} AVAR(m = 9 + 3i) / Theo1(m = 12 + 4i), both at
   τ = (9 + 3i)·τ0, AVAR the overlapping Allan variance, n = ⌊0.1·N/3 − 3⌋ (N phase points; needs
-  N ≥ 90). kf removes Theo1's noise-type-dependent bias against the Allan variance.
+  N ≥ 90). kf removes Theo1's noise-type-dependent bias against the Allan variance. Stable32 averages
+  over n = ⌊N/6 − 3⌋ instead (``kf_rule="stable32"`` reproduces its tables).
 - **TheoH**: the overlapping Allan variance for τ ≤ k = 0.1·T, TheoBR for 0.75·m·τ0 > k up to
   0.75·T. ``"theoh_a"`` (paper 001's DHVAR-A) uses the classic Allan variance below k instead.
 
@@ -42,16 +43,30 @@ THEOBR_MIN_POINTS = 90
 THEOH_SWITCH = 0.1
 
 
-def kf_indices(n_rate: int) -> tuple[np.ndarray, np.ndarray]:
+#: Rules for the range of TheoBR's bias ratio: last index n for N phase points, and the least N.
+KF_RULES = {"textbook": (lambda n_phase: (n_phase - 90) // 30, 90),   # ⌊0.1·N/3 − 3⌋ (Howe; Taylor & Howe)
+            "stable32": (lambda n_phase: (n_phase - 18) // 6, 18)}    # ⌊N/6 − 3⌋ (what Stable32 does)
+
+
+def kf_indices(n_rate: int, rule: str = "textbook") -> tuple[np.ndarray, np.ndarray]:
     """The averaging factors of TheoBR's bias ratio for ``n_rate`` rate samples: (AVAR m = 9 + 3i,
-    Theo1 m = 12 + 4i), i = 0 … n, n = ⌊0.1·N/3 − 3⌋, N = n_rate + 1 phase points."""
+    Theo1 m = 12 + 4i), i = 0 … n, N = n_rate + 1 phase points.
+
+    ``rule="textbook"``: n = ⌊0.1·N/3 − 3⌋ (Howe, Tasset & Taylor; the ratio covers τ up to ≈ 10 % of
+    T). ``rule="stable32"``: n = ⌊N/6 − 3⌋ — what Stable32 uses for its ThêoH and bias-removed Thêo1
+    (found by reproducing its Sr87 and PHASE.DAT tables to printed precision; on Sr87 it gives kf
+    2.43 % larger in variance than the textbook rule).
+    """
+    if rule not in KF_RULES:
+        raise ParameterError(f"kf_rule must be one of {tuple(KF_RULES)}, got {rule!r}")
+    last, least = KF_RULES[rule]
     n_phase = int(n_rate) + 1
-    if n_phase < THEOBR_MIN_POINTS:
+    if n_phase < least:
         raise ParameterError(
-            f"TheoBR/TheoH need at least {THEOBR_MIN_POINTS} phase points ({THEOBR_MIN_POINTS - 1} samples) for the "
-            f"bias ratio, got {n_rate} samples"
+            f"TheoBR/TheoH need at least {least} phase points ({least - 1} samples) for the bias ratio "
+            f"(kf_rule={rule!r}), got {n_rate} samples"
         )
-    n = int(math.floor(0.1 * n_phase / 3.0 - 3.0))
+    n = int(last(n_phase))
     i = np.arange(n + 1, dtype=np.int64)
     return 9 + 3 * i, 12 + 4 * i
 
@@ -72,8 +87,9 @@ def _even_theo(ms: np.ndarray, n_rate: int) -> np.ndarray:
 def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, np.ndarray]:
     """(m, source) for a TheoH-family estimate on ``n_rate`` samples.
 
-    Named grids (``"all"``, ``"octave"``, ``"decade"``, ``"exp"``) are laid out over m = 1 … M (Theo
-    reaches τ = 0.75·M·τ0); Theo1 factors are rounded up to even and kept in 10 … N − 1. For TheoH,
+    Named grids (``"all"``, ``"octave"``, ``"decade"``, ``"exp"``) are laid out over m = 1 … M and end
+    at the largest even m ≤ M (Theo reaches τ = 0.75·M·τ0); Theo1 factors are rounded up to even and
+    kept in 10 … N − 1. For TheoH,
     grid points with m·τ0 ≤ 0.1·T are Allan ("oavar"/"avar"), the rest TheoBR at τ = 0.75·m·τ0 > 0.1·T.
     Explicit τ (s) map to the nearest valid factor of the estimator that covers them and must then
     be honoured exactly (as :func:`allanite.tau_grid`'s rules for Allan τ).
@@ -101,6 +117,9 @@ def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, n
             first = max(first, THEO1_MIN_M)
             if first <= n_rate - n_rate % 2 and (t.size == 0 or t[0] > first):
                 t = np.concatenate([[first], t])  # no gap at the switch
+        top = n_rate - n_rate % 2
+        if top >= THEO1_MIN_M and (t.size == 0 or t[-1] < top):
+            t = np.concatenate([t, [top]])  # Theo's point: reach 0.75·T, as Stable32's grids do
         ms = np.concatenate([a, t]).astype(np.int64)
         src = np.array([allan_src] * a.size + [theo_src] * t.size)
         return ms, src
@@ -157,6 +176,11 @@ def _n_terms(ms: np.ndarray, src: np.ndarray, n_rate: int) -> np.ndarray:
     return out
 
 
+def _check_kf_rule(rule) -> None:
+    if not isinstance(rule, str) or rule not in KF_RULES:
+        raise ParameterError(f"kf_rule must be one of {tuple(KF_RULES)}, got {rule!r}")
+
+
 def _kf(avar_ka: np.ndarray, theo1_kt: np.ndarray) -> np.ndarray:
     """Mean of AVAR/Theo1 over the bias-ratio factors (axis 1). A record with no variation at all
     (Theo1 = 0 there) has nothing to correct: kf = 1, so its zeros stay zeros rather than NaN."""
@@ -164,9 +188,10 @@ def _kf(avar_ka: np.ndarray, theo1_kt: np.ndarray) -> np.ndarray:
     return np.mean(ratio, axis=1)
 
 
-def static_theo(cols, fs: float, taus, estimator: str, workers):
+def static_theo(cols, fs: float, taus, estimator: str, workers, kf_rule: str = "textbook"):
     """Theo1/TheoBR/TheoH of whole records: (tau, values (axes, T), n, m, source, kf (axes,) or None)."""
     fs = _check_fs(fs)
+    _check_kf_rule(kf_rule)
     n = cols[0].size
     ms, src = theo_ms(taus, n, fs, estimator)
     w = resolve_workers(workers)
@@ -177,7 +202,7 @@ def static_theo(cols, fs: float, taus, estimator: str, workers):
     values = np.empty((len(cols), ms.size))
     all_theo = theo_m
     if need_kf:
-        ka, kt = kf_indices(n)
+        ka, kt = kf_indices(n, kf_rule)
         all_theo = np.unique(np.concatenate([theo_m, kt]))
     if all_theo.size:
         th = _core.theo1_static(cols, [int(m) for m in all_theo], w)
@@ -194,13 +219,14 @@ def static_theo(cols, fs: float, taus, estimator: str, workers):
     return _tau(ms, src, fs), values, _n_terms(ms, src, n), ms, src, kf
 
 
-def dynamic_theo(cols, fs: float, window: int, hop: int, taus, estimator: str, workers):
+def dynamic_theo(cols, fs: float, window: int, hop: int, taus, estimator: str, workers, kf_rule: str = "textbook"):
     """TheoH (DHVAR) or TheoH-A (DHVAR-A) of every window: (tau, values (axes, T, J), n, m, source,
     kf (axes, J)). Every window has its own bias ratio kf and its switch at 0.1·window·τ0."""
     fs = _check_fs(fs)
+    _check_kf_rule(kf_rule)
     ms, src = theo_ms(taus, window, fs, estimator)
     w = resolve_workers(workers)
-    ka, kt = kf_indices(window)
+    ka, kt = kf_indices(window, kf_rule)
     is_theo = src == "theobr"
     theo_m = ms[is_theo]
     all_theo = np.unique(np.concatenate([theo_m, kt]))
