@@ -402,21 +402,19 @@ fn add_window_sums(
     }
 }
 
-/// Theo1 of every window at one m, written to `out` (length n_windows).
-fn theo1_row(
+/// Theo1 of every window for a group of m's (rows of `out`, n_windows each). The d-loop is outermost
+/// so that each block-sum sequence B_d is formed once for the whole group; every row still receives
+/// its d-contributions in increasing d, so the numbers do not depend on how m's are grouped.
+fn theo1_group(
     y: &[f64],
     mu: f64,
-    m: usize,
+    ms: &[usize],
     window: usize,
     hop: usize,
     out: &mut [f64],
     sc: &mut TheoScratch,
 ) {
-    let n_win = out.len();
-    let l = window + 1 - m; // terms per window (window + 1 phase points)
-    let hop = if n_win == 1 { l } else { hop };
-    let k_end = (n_win - 1) * hop + l;
-    let norm = 1.0 / (0.75 * l as f64 * (m * m) as f64);
+    let n_win = out.len() / ms.len();
     out.fill(0.0);
     let TheoScratch {
         b,
@@ -425,23 +423,55 @@ fn theo1_row(
         part,
         win,
     } = sc;
-    for d in 1..=m / 2 {
-        let s = m - d;
-        block_sums(y, mu, d, k_end + s, b);
-        let w = norm / d as f64;
-        t.clear();
-        t.extend(b[s..s + k_end].iter().zip(&b[..k_end]).map(|(u, v)| {
-            let e = u - v;
-            e * e * w
-        }));
-        add_window_sums(t, l, hop, out, full, part, win);
+    let h_max = ms.iter().map(|m| m / 2).max().unwrap_or(0);
+    for d in 1..=h_max {
+        // B_d(i) is needed for i < k_end + (m − d) = (n_win − 1)·hop + window + 1 − d, the same for
+        // every m (with one window, "hop" is the window's term count and the product vanishes).
+        let count = (n_win - 1) * hop + window + 1 - d;
+        block_sums(y, mu, d, count, b);
+        for (&m, row) in ms.iter().zip(out.chunks_mut(n_win)) {
+            if m / 2 < d {
+                continue;
+            }
+            let l = window + 1 - m; // terms per window (window + 1 phase points)
+            let hop_m = if n_win == 1 { l } else { hop };
+            let k_end = (n_win - 1) * hop_m + l;
+            let s = m - d;
+            let w = 1.0 / (0.75 * l as f64 * (m * m) as f64) / d as f64;
+            t.clear();
+            t.extend(b[s..s + k_end].iter().zip(&b[..k_end]).map(|(u, v)| {
+                let e = u - v;
+                e * e * w
+            }));
+            add_window_sums(t, l, hop_m, row, full, part, win);
+        }
     }
+}
+
+/// Splits the (sorted) factors into contiguous groups of roughly equal work (Σ m/2 terms each).
+fn work_groups(ms: &[usize], groups: usize) -> Vec<std::ops::Range<usize>> {
+    let total: usize = ms.iter().map(|m| m / 2).sum();
+    let target = total.div_ceil(groups.max(1)).max(1);
+    let mut out = Vec::new();
+    let (mut start, mut acc) = (0, 0);
+    for (i, m) in ms.iter().enumerate() {
+        acc += m / 2;
+        if acc >= target {
+            out.push(start..i + 1);
+            start = i + 1;
+            acc = 0;
+        }
+    }
+    if start < ms.len() {
+        out.push(start..ms.len());
+    }
+    out
 }
 
 /// Theo1 of every window of `window` rate samples (window + 1 phase points), starting every `hop`
 /// samples, at every m, for every axis: values laid out as [axis][m][window] and the window count.
-/// m even, 2 ≤ m ≤ window. Rows (axis, m) run in parallel; each row is sequential (bit-identical
-/// for any number of threads).
+/// m even, 2 ≤ m ≤ window. Groups of m's (per axis) run in parallel; each value is computed by one
+/// sequential routine in a fixed order (bit-identical for any number of threads).
 pub fn dynamic_theo1(
     columns: &[&[f64]],
     window: usize,
@@ -461,15 +491,32 @@ pub fn dynamic_theo1(
     }
     check_ms(window, ms, "window")?;
     let n_win = crate::allan::n_windows(n, window, hop);
-    let n_m = ms.len();
+    let (u, pos) = sorted_unique(ms);
     let mus: Vec<f64> = columns.par_iter().map(|c| compensated_mean(c)).collect();
-    let mut out = vec![0.0f64; columns.len() * n_m * n_win];
-    out.par_chunks_mut(n_win)
-        .enumerate()
-        .for_each_init(TheoScratch::default, |sc, (row, dst)| {
-            let (a, i) = (row / n_m, row % n_m);
-            theo1_row(columns[a], mus[a], ms[i], window, hop, dst, sc);
+    // A fixed number of groups (not the thread count), so grouping never depends on the machine.
+    let groups = work_groups(&u, 8);
+    let mut sorted = vec![0.0f64; columns.len() * u.len() * n_win];
+    let mut tasks: Vec<(usize, std::ops::Range<usize>, &mut [f64])> = Vec::new();
+    for (a, axis_out) in sorted.chunks_mut(u.len() * n_win).enumerate() {
+        let mut rest = axis_out;
+        for g in &groups {
+            let (head, tail) = rest.split_at_mut(g.len() * n_win);
+            tasks.push((a, g.clone(), head));
+            rest = tail;
+        }
+    }
+    tasks
+        .into_par_iter()
+        .for_each_init(TheoScratch::default, |sc, (a, g, dst)| {
+            theo1_group(columns[a], mus[a], &u[g], window, hop, dst, sc);
         });
+    let mut out = Vec::with_capacity(columns.len() * ms.len() * n_win);
+    for a in 0..columns.len() {
+        let base = a * u.len() * n_win;
+        for &p in &pos {
+            out.extend_from_slice(&sorted[base + p * n_win..base + (p + 1) * n_win]);
+        }
+    }
     Ok((out, n_win))
 }
 
