@@ -127,6 +127,10 @@ def build_parser() -> argparse.ArgumentParser:
                      help="DAVAR window in samples (default: 1/12 of the record)")
     ana.add_argument("--hop", type=int, metavar="N",
                      help="DAVAR hop between windows in samples (default: 1/25 of the window)")
+    ana.add_argument("--estimator", choices=("oavar", "theoh"), default="oavar",
+                     help="oavar: overlapping Allan deviation and DAVAR (default); theoh: TheoH for the record and "
+                          "paper 001's dynamic TheoH (DHVAR) over time, reaching 75%% of the record or window "
+                          "(default window then at most 2001 samples)")
     ana.add_argument("--no-fit", action="store_true",
                      help="skip the noise-model fit (whole record and per window)")
 
@@ -244,7 +248,8 @@ def _report(args) -> int:
         with warnings.catch_warnings():
             if quiet:
                 warnings.simplefilter("ignore")
-            common = dict(window=args.window, hop=args.hop, taus=taus, fit=not args.no_fit, progress=progress)
+            common = dict(window=args.window, hop=args.hop, taus=taus, fit=not args.no_fit, progress=progress,
+                          estimator=args.estimator)
             if args.log is None:
                 from . import default_record
 

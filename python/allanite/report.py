@@ -48,6 +48,17 @@ FIT_MODEL = "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²·τ0·(2m²+1
 #: Fraction of the record that is the default DAVAR window, and of the window that is the default hop.
 WINDOW_FRACTION = 12
 HOP_FRACTION = 25
+#: DHVAR's cost grows with the window squared (Theo1 at every m of the bias ratio): its default
+#: window is capped here (paper 001 uses 401 samples).
+DHVAR_MAX_DEFAULT_WINDOW = 2001
+#: ... and its default hop keeps the number of windows (each fitted) to about this.
+DHVAR_MAX_WINDOWS = 400
+#: estimator → (static estimator, dynamic estimator, dynamic τ grid, section titles)
+REPORT_ESTIMATORS = {
+    "oavar": ("oavar", "oavar", "exp", "Overlapping Allan deviation", "Dynamic Allan variance"),
+    "theoh": ("theoh", "theoh", "octave", "TheoH deviation (overlapping Allan ≤ 10 % of the record, TheoBR beyond)",
+              "Dynamic TheoH (DHVAR)"),
+}
 _TERM_NAMES = {"Q": "quantization", "N": "angle random walk", "B": "bias instability",
                "K": "rate random walk", "R": "rate ramp"}
 
@@ -224,7 +235,8 @@ def _check_taus(taus):
 
 
 def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, source=None, window=None, hop=None,
-                 taus="octave", fit: bool = True, confidence: float = 0.683, notes=(), progress=None) -> Report:
+                 taus="octave", fit: bool = True, confidence: float = 0.683, notes=(), progress=None,
+                 estimator: str = "oavar") -> Report:
     """Compute everything the report shows.
 
     Parameters
@@ -245,7 +257,14 @@ def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, sour
         :func:`default_hop` (window/25).
     taus : str or array_like
         τ of the static analysis: a grid name (default ``"octave"``) or τ in seconds. The DAVAR
-        uses paper 000's exponential grid on the window.
+        uses paper 000's exponential grid on the window (DHVAR: the octave grid).
+    estimator : {"oavar", "theoh"}
+        ``"oavar"`` (default): overlapping Allan deviation and DAVAR. ``"theoh"``: TheoH for the
+        whole record and paper 001's DHVAR over time (overlapping Allan up to 10 % of the record or
+        window, bias-removed Theo1 beyond, reaching 75 %); the default window is then capped at
+        ``DHVAR_MAX_DEFAULT_WINDOW`` samples and the default hop keeps ≤ ``DHVAR_MAX_WINDOWS``
+        windows; records over 100 000 samples get their whole-record TheoBR part from block
+        averages (``avar(decimate="auto")``, Taylor & Howe's fast TheoBR).
     fit : bool
         Fit the IEEE-952 noise model (whole record and every window).
     confidence : float
@@ -255,7 +274,9 @@ def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, sour
     progress : object with ``step(name)``, optional
         Told before each step (the CLI's progress bar).
     """
+    from ._input import check_choice
     from .allan import avar, davar
+    from .theo import resolve_decimation
     from .grid import _check_count
     from .units import parse_unit
 
@@ -275,20 +296,34 @@ def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, sour
     if len(axis_names) != n_axes:
         raise ParameterError(f"axis_names has {len(axis_names)} names for {n_axes} axes")
     taus = _check_taus(taus)
+    check_choice(estimator, "estimator", tuple(REPORT_ESTIMATORS))
+    static_est, dynamic_est, dynamic_grid = REPORT_ESTIMATORS[estimator][:3]
 
     progress.step("static Allan deviation")
-    static = avar(x, fs, input=input, taus=taus)
+    extra = {"decimate": "auto"} if static_est == "theoh" else {}
+    static = avar(x, fs, input=input, taus=taus, estimator=static_est, **extra)
     progress.step("confidence intervals")
     static = static.with_confidence(x, confidence=confidence)
 
     n = static.n_samples
     window_given, hop_given = window is not None, hop is not None
-    window = default_window(n) if window is None else _check_count(window, "window", 2)
-    hop = default_hop(window) if hop is None else hop
+    if window is None:
+        window = default_window(n)
+        if estimator == "theoh":
+            window = min(window, DHVAR_MAX_DEFAULT_WINDOW)
+    else:
+        window = _check_count(window, "window", 2)
+    if hop is None:
+        hop = default_hop(window)
+        if estimator == "theoh":
+            # every DHVAR window gets its own fit: keep it to about DHVAR_MAX_WINDOWS of them
+            hop = max(hop, -(-(n - window) // DHVAR_MAX_WINDOWS))
     progress.step("dynamic Allan variance")
-    dynamic = davar(x, fs, window=window, hop=hop, taus="exp", input=input)
+    dynamic = davar(x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est)
     settings = {"window": int(dynamic.window), "hop": int(dynamic.hop), "window_default": not window_given,
-                "hop_default": not hop_given, "taus": taus if isinstance(taus, str) else "explicit"}
+                "hop_default": not hop_given, "taus": taus if isinstance(taus, str) else "explicit",
+                "estimator": estimator, "dynamic_grid": dynamic_grid,
+                "theo_decimation": (resolve_decimation("auto", n, taus) if static_est == "theoh" else None)}
 
     fits = series = None
     fit_error = series_error = None
@@ -425,7 +460,11 @@ def _summary(rep: Report) -> dict:
     }
     static = {
         "estimator": st.estimator, "grid": rep.settings["taus"], "confidence": st.confidence,
-        "edf_method": "greenhall", "tau_s": _list(st.tau), "m": _list(st.m), "n": _list(st.n),
+        "edf_method": "greenhall" if st.source is None else "greenhall (Allan τ), Howe's Theo1 EDF (TheoBR τ)",
+        "tau_s": _list(st.tau), "m": _list(st.m), "n": _list(st.n),
+        "source": None if st.source is None else [str(v) for v in st.source],
+        "kf": None if st.kf is None else _list(np.atleast_1d(st.kf)),
+        "theo_decimation": rep.settings.get("theo_decimation"),
         "adev_unit": au, "adev": _list(adev), "adev_ci_low": _list(lo), "adev_ci_high": _list(hi),
         "edf": _list(np.atleast_2d(st.edf)), "alpha": _list(np.atleast_2d(st.alpha)),
     }
@@ -446,7 +485,9 @@ def _summary(rep: Report) -> dict:
             "adev_max_over_time": _list(np.sqrt(av.max(axis=1))),
         })
     dynamic = {
-        "method": dy.method, "estimator": dy.estimator, "grid": "exp",
+        "method": dy.method, "estimator": dy.estimator, "grid": rep.settings.get("dynamic_grid", "exp"),
+        "source": None if dy.source is None else [str(v) for v in dy.source],
+        "kf_median": None if dy.kf is None else _list(np.median(np.atleast_2d(dy.kf), axis=1)),
         "window_samples": int(dy.window), "hop_samples": int(dy.hop), "window_s": dy.window / fs,
         "hop_s": dy.hop / fs,
         "window_rule": f"record/{WINDOW_FRACTION}" if rep.settings["window_default"] else "given",
@@ -751,9 +792,17 @@ def _html_page(rep: Report, images: dict) -> str:
 
     # static
     conf = st["confidence"]
-    out.append(f"<section id=\"static\"><h2>Overlapping Allan deviation</h2>"
+    theoh = st["source"] is not None
+    titles = REPORT_ESTIMATORS["theoh" if theoh else "oavar"][3:]
+    edf_words = ("Greenhall's equivalent degrees of freedom (ν) at Allan τ and Howe's Theo1 ν at TheoBR τ "
+                 f"(bias ratio kf = {', '.join(_g(k) for k in st['kf'])}; TheoBR values belong to τ = 0.75·m/fs"
+                 + (f"; TheoBR and kf from block averages of {st['theo_decimation']} samples — Taylor & Howe's "
+                    "fast TheoBR — as Theo1 of the full record would cost O(N²)"
+                    if (st.get("theo_decimation") or 1) > 1 else "") + ")"
+                 if theoh else "Greenhall's equivalent degrees of freedom (ν)")
+    out.append(f"<section id=\"static\"><h2>{_e(titles[0])}</h2>"
                f"<p>Estimator <code>{_e(st['estimator'])}</code> on the <code>{_e(st['grid'])}</code> τ grid; "
-               f"{conf:.1%} χ² intervals with Greenhall's equivalent degrees of freedom (ν) for the noise type "
+               f"{conf:.1%} χ² intervals with {edf_words} for the noise type "
                f"identified at each τ. ADEV in {_e(au)}.</p>")
     out.append(_img(images, specs, "adev.png"))
     header = ["τ (s)", "n"] + [h for nm in names for h in (f"{nm} ADEV", "interval", "ν")]
@@ -821,12 +870,14 @@ def _html_page(rep: Report, images: dict) -> str:
     out.append("</section>")
 
     # davar
-    out.append(f"<section id=\"davar\"><h2>Dynamic Allan variance</h2><p>Window {dy['window_samples']} samples "
+    what = ("the static TheoH of its window (its own bias ratio kf and switch point)" if theoh
+            else "the static overlapping Allan variance of its window")
+    grid_words = "octave grid" if dy["grid"] == "octave" else "exponential grid"
+    out.append(f"<section id=\"davar\"><h2>{_e(titles[1])}</h2><p>Window {dy['window_samples']} samples "
                f"({_g(dy['window_s'])} s, {_e(dy['window_rule'])}), hop {dy['hop_samples']} samples "
                f"({_g(dy['hop_s'])} s, {_e(dy['hop_rule'])}): {dy['windows']} windows × {len(dy['tau_s'])} τ "
-               f"({_g(dy['tau_s'][0])}–{_g(dy['tau_s'][-1])} s, exponential grid), method "
-               f"<code>{_e(dy['method'])}</code>. Each column is exactly the static overlapping Allan variance "
-               f"of its window.</p>")
+               f"({_g(dy['tau_s'][0])}–{_g(dy['tau_s'][-1])} s, {grid_words}), method "
+               f"<code>{_e(dy['method'])}</code>. Each column is exactly {what}.</p>")
     rows = [[ax["name"], _g(ax["tau_s"]), _g(ax["adev_shortest_tau_median"]),
              f"{_g(ax['adev_shortest_tau_max'])} at {ax['t_of_max_s']:.0f} s",
              f"{_g(ax['adev_shortest_tau_min'])} at {ax['t_of_min_s']:.0f} s", _g(ax["max_over_min"], 3)]

@@ -188,35 +188,96 @@ def _kf(avar_ka: np.ndarray, theo1_kt: np.ndarray) -> np.ndarray:
     return np.mean(ratio, axis=1)
 
 
-def static_theo(cols, fs: float, taus, estimator: str, workers, kf_rule: str = "textbook"):
-    """Theo1/TheoBR/TheoH of whole records: (tau, values (axes, T), n, m, source, kf (axes,) or None)."""
-    fs = _check_fs(fs)
-    _check_kf_rule(kf_rule)
-    n = cols[0].size
-    ms, src = theo_ms(taus, n, fs, estimator)
-    w = resolve_workers(workers)
+#: Records longer than this are decimated for the Theo part under ``decimate="auto"``: Theo1 of all
+#: the bias-ratio factors is O(N²) (≈ 2 s at N = 1e5 on two cores, ≈ 2 min at 1e6).
+THEO_AUTO_POINTS = 100_000
+
+
+def resolve_decimation(decimate, n_rate: int, taus) -> int:
+    """The block length D for the Theo part: 1 (exact), a given integer, or ``"auto"``:
+    the smallest D with ⌊M/D⌋ ≤ ``THEO_AUTO_POINTS``."""
+    if decimate is None:
+        return 1
+    if isinstance(decimate, str):
+        if decimate != "auto":
+            raise ParameterError(f"decimate must be a positive integer or 'auto', got {decimate!r}")
+        d = max(1, -(-int(n_rate) // THEO_AUTO_POINTS))
+    else:
+        from .grid import _check_count
+
+        d = _check_count(decimate, "decimate", 1)
+    if d > 1 and not isinstance(taus, str):
+        raise ParameterError("decimate > 1 works with a named τ grid ('octave', 'decade', 'all', 'exp'), not with "
+                             "explicit τ: the Theo τ of a decimated record are multiples of 0.75·D/fs")
+    if d > 1 and int(n_rate) // d < THEOBR_MIN_POINTS:
+        raise ParameterError(f"decimate = {d} leaves {int(n_rate) // d} samples of the {n_rate}; TheoBR needs "
+                             f"at least {THEOBR_MIN_POINTS - 1}")
+    return d
+
+
+def _theo_part(cols, ms, src, n, estimator, kf_rule, w):
+    """Theo1 (× kf for TheoBR) at the Theo entries of (ms, src) for records of n samples, and kf."""
     is_theo = np.isin(src, ("theo1", "theobr"))
     theo_m = ms[is_theo]
     need_kf = estimator in ("theobr", "theoh", "theoh_a")
+    values = np.empty((len(cols), theo_m.size))
     kf = None
-    values = np.empty((len(cols), ms.size))
     all_theo = theo_m
     if need_kf:
         ka, kt = kf_indices(n, kf_rule)
         all_theo = np.unique(np.concatenate([theo_m, kt]))
     if all_theo.size:
         th = _core.theo1_static(cols, [int(m) for m in all_theo], w)
-        pos = np.searchsorted(all_theo, theo_m)
-        values[:, is_theo] = th[:, pos]
+        values[:] = th[:, np.searchsorted(all_theo, theo_m)]
     if need_kf:
         av = _core.davar(cols, n, 1, [int(m) for m in ka], "oavar", "fast", w)[:, :, 0]
         kf = _kf(av, th[:, np.searchsorted(all_theo, kt)])
-        values[:, is_theo] *= kf[:, None]
+        values *= kf[:, None]
+    return values, kf
+
+
+def static_theo(cols, fs: float, taus, estimator: str, workers, kf_rule: str = "textbook", decimate=1):
+    """Theo1/TheoBR/TheoH of whole records: (tau, values (axes, T), n, m, source, kf (axes,) or None).
+
+    With ``decimate`` D > 1 the Theo part (and kf) is computed on the rate averaged in blocks of D
+    samples — the phase decimated by D, Taylor & Howe's "fast TheoBR" — at τ = 0.75·m'·D/fs for even
+    m' of the decimated record (reported as m = m'·D); the Allan part stays at full resolution.
+    """
+    fs = _check_fs(fs)
+    _check_kf_rule(kf_rule)
+    n = cols[0].size
+    d = resolve_decimation(decimate, n, taus)
+    ms, src = theo_ms(taus, n, fs, estimator)
+    w = resolve_workers(workers)
+    is_theo = np.isin(src, ("theo1", "theobr"))
     allan = ~is_theo
+    if d > 1:
+        nd = n // d
+        cols_d = [np.ascontiguousarray(c[: nd * d].reshape(nd, d).mean(axis=1)) for c in cols]
+        md, srcd = theo_ms(taus, nd, fs / d, estimator)
+        keep = np.isin(srcd, ("theo1", "theobr"))
+        md, srcd = md[keep], srcd[keep]
+        if estimator in ("theoh", "theoh_a"):
+            k = switch_m(n)
+            ok = 0.75 * md * d > k
+            md, srcd = md[ok], srcd[ok]
+        theo_vals, kf = _theo_part(cols_d, md, srcd, nd, estimator, kf_rule, w)
+        ms = np.concatenate([ms[allan], md * d]).astype(np.int64)
+        src = np.concatenate([src[allan], srcd])
+        n_terms = np.concatenate([_n_terms(ms[: allan.sum()], src[: allan.sum()], n), _n_terms(md, srcd, nd)])
+        tau = np.concatenate([ms[: allan.sum()] / fs, 0.75 * md * d / fs])
+        values = np.empty((len(cols), ms.size))
+        values[:, allan.sum():] = theo_vals
+        is_theo = np.isin(src, ("theo1", "theobr"))
+        allan = ~is_theo
+    else:
+        values = np.empty((len(cols), ms.size))
+        values[:, is_theo], kf = _theo_part(cols, ms, src, n, estimator, kf_rule, w)
+        tau, n_terms = _tau(ms, src, fs), _n_terms(ms, src, n)
     if np.any(allan):
         est = str(src[allan][0])
         values[:, allan] = _core.davar(cols, n, 1, [int(m) for m in ms[allan]], est, "fast", w)[:, :, 0]
-    return _tau(ms, src, fs), values, _n_terms(ms, src, n), ms, src, kf
+    return tau, values, n_terms, ms, src, kf
 
 
 def dynamic_theo(cols, fs: float, window: int, hop: int, taus, estimator: str, workers, kf_rule: str = "textbook"):
