@@ -305,3 +305,33 @@ def test_short_records_are_refused_with_the_reason():
         allanite.davar(np.ones(500), 1.0, window=200, estimator="theoh", method="naive")
     with pytest.raises(allanite.errors.InputError, match="non-finite"):
         allanite.avar(np.r_[np.ones(200), np.nan], 1.0, estimator="theoh")
+
+
+def test_decimated_theobr_tracks_the_exact_one():
+    y = np.random.default_rng(31).normal(size=20_000)
+    exact = allanite.avar(y, 1.0, estimator="theoh", taus="octave")
+    dec = allanite.avar(y, 1.0, estimator="theoh", taus="octave", decimate=4)
+    allan = exact.source == "oavar"
+    np.testing.assert_array_equal(dec.avar[dec.source == "oavar"], exact.avar[allan])  # Allan part untouched
+    theo = dec.source == "theobr"
+    assert np.all(dec.m[theo] % 8 == 0)                      # m = m'·D with m' even
+    np.testing.assert_allclose(dec.tau[theo], 0.75 * dec.m[theo])
+    # same statistic from fewer terms: close to the exact TheoBR at the same τ
+    common = np.intersect1d(dec.m[theo], exact.m[~allan])
+    assert common.size >= 3
+    a = exact.avar[np.isin(exact.m, common) & ~allan]
+    b = dec.avar[np.isin(dec.m, common) & theo]
+    assert np.max(np.abs(b / a - 1)) < 0.05
+    auto = allanite.avar(np.random.default_rng(1).normal(size=250_000), 1.0, estimator="theobr", decimate="auto")
+    assert np.all(auto.m % 6 == 0)                            # D = ⌈250 000 / 100 000⌉ = 3
+
+
+@pytest.mark.parametrize("decimate, match", [(0, "decimate must be an integer ≥ 1"), ("fast", "positive integer or 'auto'"),
+                                             (100, "leaves 20 samples")])
+def test_decimate_errors(decimate, match):
+    with pytest.raises(ParameterError, match=match):
+        allanite.avar(np.random.default_rng(0).normal(size=2_000), 1.0, estimator="theoh", decimate=decimate)
+    with pytest.raises(ParameterError, match="apply to the Theo estimators"):
+        allanite.avar(np.random.default_rng(0).normal(size=2_000), 1.0, decimate=2)
+    with pytest.raises(ParameterError, match="named τ grid"):
+        allanite.avar(np.random.default_rng(0).normal(size=2_000), 1.0, estimator="theoh", taus=[1.0], decimate=2)

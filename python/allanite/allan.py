@@ -80,6 +80,9 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
     check_choice(estimator, "estimator", STATIC_ESTIMATORS)
     cols, fs, is_multi = as_rate_columns(x, fs, input)
     n = cols[0].size
+    if estimator not in THEO_ESTIMATORS and (decimate not in (1, None) or kf_rule != "textbook"):
+        raise ParameterError(f"decimate and kf_rule apply to the Theo estimators {THEO_ESTIMATORS}, not to "
+                             f"estimator={estimator!r}")
     if estimator in THEO_ESTIMATORS:
         tau, values, n_terms, ms, src, kf = static_theo(cols, fs, taus, estimator, workers, kf_rule, decimate)
         if not is_multi:
