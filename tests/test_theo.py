@@ -173,6 +173,19 @@ def test_stable32_theoh_on_sr87(shared_data, grid):
     assert r.kf / tb.kf == pytest.approx(1.024319, abs=2e-6)
 
 
+@pytest.mark.parametrize("grid", ["decade", "many"])
+def test_stable32_theo1_br_on_sr87(shared_data, grid):
+    base = shared_data / "stable32" / "sr87" / "phase"
+    x = np.loadtxt(base / "phase_data.txt")
+    rows = [q for q in _rows(base / grid / "theo1.txt") if len(q) >= 7]
+    ms = np.array([int(q[0]) for q in rows])
+    # Stable32's Sr87 Thêo1 tables (header "Alpha = -1") are bias-removed with its own kf range
+    r = allanite.avar(x, 0.4, input="angle", estimator="theobr", taus=0.75 * ms / 0.4, kf_rule="stable32")
+    assert list(r.m) == list(ms)
+    np.testing.assert_allclose(r.tau, [float(q[1]) for q in rows], rtol=1e-4)
+    assert np.max(_half_units(np.sqrt(r.avar), [float(q[5]) for q in rows])) <= 1.0
+
+
 @pytest.mark.parametrize("name", ["phase_dat_theo1_alpha0.txt", "phase_dat_theo1_alpha0_decade.txt"])
 def test_stable32_raw_theo1_on_phase_dat(shared_data, name):
     base = shared_data / "stable32" / "phasedat"
