@@ -158,6 +158,15 @@ fn add_pairs_body(h: &mut [f64], zp: f64, r: &[f64]) {
 }
 
 #[inline(always)]
+fn add_pairs2_body(h: &mut [f64], za: f64, ra: &[f64], zb: f64, rb: &[f64]) {
+    for ((hv, &u), &v) in h.iter_mut().zip(ra).zip(rb) {
+        let d = za - u;
+        let e = zb - v;
+        *hv += d * d + e * e;
+    }
+}
+
+#[inline(always)]
 fn sq_diff_sum_body(a: &[f64], b: &[f64]) -> f64 {
     let mut acc = [0.0f64; 8];
     let ca = a.chunks_exact(8);
@@ -181,6 +190,7 @@ fn sq_diff_sum_body(a: &[f64], b: &[f64]) -> f64 {
 #[derive(Clone, Copy)]
 struct Kernels {
     add_pairs: fn(&mut [f64], f64, &[f64]),
+    add_pairs2: fn(&mut [f64], f64, &[f64], f64, &[f64]),
     sq_diff_sum: fn(&[f64], &[f64]) -> f64,
 }
 
@@ -191,12 +201,20 @@ mod avx2 {
         super::add_pairs_body(h, zp, r)
     }
     #[target_feature(enable = "avx2")]
+    unsafe fn add_pairs2_impl(h: &mut [f64], za: f64, ra: &[f64], zb: f64, rb: &[f64]) {
+        super::add_pairs2_body(h, za, ra, zb, rb)
+    }
+    #[target_feature(enable = "avx2")]
     unsafe fn sq_diff_sum_impl(a: &[f64], b: &[f64]) -> f64 {
         super::sq_diff_sum_body(a, b)
     }
     pub fn add_pairs(h: &mut [f64], zp: f64, r: &[f64]) {
         // SAFETY: only reachable through `kernels()` after AVX2 was detected.
         unsafe { add_pairs_impl(h, zp, r) }
+    }
+    pub fn add_pairs2(h: &mut [f64], za: f64, ra: &[f64], zb: f64, rb: &[f64]) {
+        // SAFETY: as above.
+        unsafe { add_pairs2_impl(h, za, ra, zb, rb) }
     }
     pub fn sq_diff_sum(a: &[f64], b: &[f64]) -> f64 {
         // SAFETY: as above.
@@ -210,12 +228,14 @@ fn kernels() -> Kernels {
         if std::is_x86_feature_detected!("avx2") {
             return Kernels {
                 add_pairs: avx2::add_pairs,
+                add_pairs2: avx2::add_pairs2,
                 sq_diff_sum: avx2::sq_diff_sum,
             };
         }
     }
     Kernels {
         add_pairs: add_pairs_body,
+        add_pairs2: add_pairs2_body,
         sq_diff_sum: sq_diff_sum_body,
     }
 }
@@ -233,29 +253,72 @@ fn head_pass(z: &[f64], ms: &[usize], want_f: bool, k: Kernels) -> (Vec<f64>, Op
     let inv: Vec<f64> = (0..=mmax)
         .map(|d| if d == 0 { 0.0 } else { 1.0 / d as f64 })
         .collect();
-    for p in 1..=last {
-        // Point p brings the pairs (p − ℓ, p), ℓ = 1..=p; z_{p−ℓ} = zr[n−1−p+ℓ].
-        (k.add_pairs)(&mut h[1..=p], z[p], &zr[n - p..n]);
-        let s = p + 1; // the pairs inside [0, s) are in h
-        if s > mmax {
-            continue;
+    // −W_m(d) − W_m(m−d), d = 1..=m/2, once the pairs inside [0, m) are in h.
+    let full_deposit = |h: &[f64], m: usize| -> f64 {
+        let mut acc = 0.0;
+        for d in 1..=m / 2 {
+            acc += inv[d] * (h[d] + h[m - d]);
         }
-        if let Ok(idx) = ms.binary_search(&s) {
-            // −W_m(d) − W_m(m−d), d = 1..=m/2
-            let m = s;
-            let mut acc = 0.0;
-            for d in 1..=m / 2 {
-                acc += inv[d] * (h[d] + h[m - d]);
-            }
-            part[idx] -= acc;
+        acc
+    };
+    let mut p = 1;
+    while p <= last {
+        let s = p + 1; // stage reached after point p: the pairs inside [0, s)
+                       // Two points per pass over h (half the memory traffic) unless stage s needs all of h.
+        let fuse = p < last && (s > mmax || ms.binary_search(&s).is_err());
+        if fuse {
+            // Points p and p + 1; z_{p−ℓ} = zr[n−1−p+ℓ], z_{p+1−ℓ} = zr[n−2−p+ℓ].
+            (k.add_pairs2)(
+                &mut h[1..=p],
+                z[p],
+                &zr[n - p..n],
+                z[p + 1],
+                &zr[n - p - 1..n - 1],
+            );
+            let d0 = z[p + 1] - z[0];
+            h[p + 1] += d0 * d0;
+        } else {
+            (k.add_pairs)(&mut h[1..=p], z[p], &zr[n - p..n]);
         }
-        // +W_{m−d}(m−2d) at stage s = m − d, for every m with s < m < 2s (d = m − s ≤ m/2).
-        let lo = ms.partition_point(|&m| m <= s);
-        for (idx, &m) in ms.iter().enumerate().skip(lo) {
-            if m >= 2 * s {
-                break;
+        if s <= mmax {
+            if !fuse {
+                if let Ok(idx) = ms.binary_search(&s) {
+                    part[idx] -= full_deposit(&h, s);
+                }
             }
-            part[idx] += inv[m - s] * h[2 * s - m];
+            // +W_{m−d}(m−2d) at stage s = m − d, for every m with s < m < 2s (d = m − s ≤ m/2).
+            let lo = ms.partition_point(|&m| m <= s);
+            for (idx, &m) in ms.iter().enumerate().skip(lo) {
+                if m >= 2 * s {
+                    break;
+                }
+                let l = 2 * s - m;
+                let mut v = h[l];
+                if fuse && l >= 1 {
+                    // h already holds point p + 1's pairs: take its pair at lag l back out.
+                    let e = z[p + 1] - z[p + 1 - l];
+                    v -= e * e;
+                }
+                part[idx] += inv[m - s] * v;
+            }
+        }
+        if fuse {
+            let s2 = p + 2;
+            if s2 <= mmax {
+                if let Ok(idx) = ms.binary_search(&s2) {
+                    part[idx] -= full_deposit(&h, s2);
+                }
+                let lo = ms.partition_point(|&m| m <= s2);
+                for (idx, &m) in ms.iter().enumerate().skip(lo) {
+                    if m >= 2 * s2 {
+                        break;
+                    }
+                    part[idx] += inv[m - s2] * h[2 * s2 - m];
+                }
+            }
+            p += 2;
+        } else {
+            p += 1;
         }
     }
     (part, if want_f { Some(h) } else { None })
