@@ -20,7 +20,7 @@ def test_bench_report_quick(tmp_path):
     rep = json.loads((tmp_path / "report_bench.json").read_text(encoding="utf-8"))
     m = rep["memory"]
     assert m["samples"] == 1_000_000 and m["file_bytes"] > 8_000_000
-    assert m["davar"]["shape"] == [len(m["davar"]["shape"]) and m["davar"]["shape"][0], (1_000_000 - 10_000) // 1_000 + 1]
+    assert m["davar"]["shape"][1] == (1_000_000 - 10_000) // 1_000 + 1 and m["davar"]["shape"][0] > 10
     assert m["davar"]["finite"] and m["avar"]["finite"]
     assert m["davar"]["vmhwm_bytes"] > m["file_bytes"]        # the mapped file's pages were touched
     assert "Report and large-log benchmark" in (tmp_path / "report_bench.md").read_text(encoding="utf-8")
