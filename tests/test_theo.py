@@ -348,3 +348,14 @@ def test_decimate_errors(decimate, match):
         allanite.avar(np.random.default_rng(0).normal(size=2_000), 1.0, decimate=2)
     with pytest.raises(ParameterError, match="named τ grid"):
         allanite.avar(np.random.default_rng(0).normal(size=2_000), 1.0, estimator="theoh", taus=[1.0], decimate=2)
+
+
+def test_to_xarray_carries_source_and_kf():
+    pytest.importorskip("xarray")
+    y = np.column_stack([rate_noises(3000, s)["white"] for s in (1, 2)])
+    ds = allanite.avar(y, 10.0, estimator="theoh").to_xarray(unit="deg/s")
+    assert list(ds["source"].values[-2:]) == ["theobr", "theobr"] and ds["kf"].dims == ("axis",)
+    d = allanite.davar(y, 10.0, window=500, hop=250, estimator="theoh", taus="octave")
+    dd = d.to_xarray()
+    assert dd["kf"].dims == ("axis", "t")
+    np.testing.assert_array_equal(dd["kf"].values, d.kf)

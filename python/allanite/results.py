@@ -58,6 +58,9 @@ def _xr_common(result, unit, axis_names):
              "unit": "unknown" if unit is None else str(unit), "allanite_result": type(result).__name__}
     if result.confidence is not None:
         attrs["confidence"] = result.confidence
+    if result.source is not None:
+        coords["m"][2]["long_name"] = "averaging factor (τ = m/fs; Theo points τ = 0.75·m/fs)"
+        coords["source"] = ("tau", np.asarray(result.source, dtype=str), {"long_name": "estimator of each τ"})
     return axes, coords, label, attrs
 
 
@@ -201,6 +204,8 @@ class AllanResult:
                                                               "long_name": f"{level} upper bound, ADEV"})
             data["edf"] = (dims, self.edf, {"units": "1", "long_name": "equivalent degrees of freedom"})
             data["alpha"] = (dims, self.alpha, {"units": "1", "long_name": "noise type α (S_y ∝ f^α)"})
+        if self.kf is not None:
+            data["kf"] = (axes, np.asarray(self.kf, dtype=float), {"units": "1", "long_name": "TheoBR bias ratio"})
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def plot(self, ax=None, **kwargs):
@@ -332,6 +337,9 @@ class DynamicAllanResult:
             data["ci_high"] = (dims, self.ci_high, {"units": var_units, "long_name": f"{level} upper bound, variance"})
             data["edf"] = (axes + ("tau",), self.edf, {"units": "1", "long_name": "equivalent degrees of freedom"})
             data["alpha"] = (axes + ("tau",), self.alpha, {"units": "1", "long_name": "noise type α (S_y ∝ f^α)"})
+        if self.kf is not None:
+            data["kf"] = (axes + ("t",), np.asarray(self.kf, dtype=float),
+                          {"units": "1", "long_name": "TheoBR bias ratio of each window"})
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def plot(self, ax=None, axis: int = 0, **kwargs):
