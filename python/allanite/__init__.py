@@ -13,12 +13,13 @@ from .errors import AllaniteError, InputError, MemoryBudgetError, ParameterError
 from .fit import CoefficientSeries, NoiseFit, fit
 from .grid import tau_grid
 from .io import Log, read_log
+from .refine import Refinement, refine
 from .results import AllanResult, DynamicAllanResult
 from .simulate import simulate
 
 __all__ = [
     "avar", "davar", "tau_grid", "default_record", "simulate",
-    "read_log", "Log", "fit", "NoiseFit", "CoefficientSeries",
+    "read_log", "Log", "fit", "NoiseFit", "CoefficientSeries", "refine", "Refinement",
     "confidence_intervals", "identify_alpha", "edf_greenhall", "edf_sp1065", "chi2_interval",
     "AllanResult", "DynamicAllanResult",
     "AllaniteError", "InputError", "ParameterError", "MemoryBudgetError",

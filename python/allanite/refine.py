@@ -1,0 +1,598 @@
+"""Close the loop: find what a fitted noise model lacks, add that effect, report the error before and after.
+
+:func:`refine` fits the starting IEEE-952 model (weighted least squares in variance space, as
+:func:`allanite.fit`), looks at the normalised residual per τ, and tries each candidate effect by its
+Allan-variance signature (closed forms, ``../shared/FORMULAS.md`` §6 and the references below):
+
+- ``"gauss_markov"`` — first-order Gauss–Markov rate of variance σ² and correlation time T_c:
+  σ²_A(τ) = σ²·(T_c/τ)²·(2τ/T_c − 3 + 4e^{−τ/T_c} − e^{−2τ/T_c}) (IEEE Std 952 App. C; a bump that
+  peaks near τ ≈ 1.89·T_c, K-like below, N-like above);
+- ``"sinusoid"`` — a rate sinusoid of amplitude A and frequency f0: σ²_A(τ) = A²·sin⁴(πf0τ)/(πf0τ)²
+  (nulls at τ = k/f0);
+- ``"change_point"`` — nonstationarity: the Allan variance of non-overlapping windows is tested for a
+  step in level along the record (all τ jointly), located at sample resolution by the two-segment
+  likelihood of the squared differences at the τ where the step is strongest, with a 2-unit support
+  interval; repeated on each side (binary segmentation).
+
+Nonlinear parameters (T_c, f0) are found by a grid search with the linear coefficients by weighted
+NNLS at each grid point, then refined by a bounded scalar search; their intervals come from the
+profile of χ² (Δχ²_eff = 1). A candidate is accepted only if it earns its parameters by BIC on an
+*effective* χ²: the τ estimates are correlated, so χ² is scaled by n_eff/n with n_eff the number of
+octaves the curve spans (``fit`` thins to octaves for the same reason), and the penalty is
+k·ln(n_eff) per added parameter pair, plus a floor so that chance wiggles on a clean record are not
+modelled (calibrated on clean simulated records: ≤ 5 % false alarms, see ``tests/test_refine.py``).
+The loop stops when χ²/dof ≤ 1.5 or no candidate earns its parameters.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import ParameterError
+from .results import AllanResult
+
+__all__ = ["refine", "Refinement", "Step", "gm_avar", "sinusoid_avar", "CANDIDATES"]
+
+CANDIDATES = ("gauss_markov", "sinusoid", "change_point")
+#: Stop refining once the model is this good (χ²/dof of the diagonal-weighted residuals).
+GOOD_CHI2_DOF = 1.5
+#: Minimum improvement of the effective χ² (beyond the BIC penalty) to accept an effect.
+MIN_GAIN = 6.0
+MAX_STEPS = 4
+
+
+def _fit_module():
+    return sys.modules["allanite.fit"]
+
+
+# ----------------------------------------------------------------------------------------------
+# signatures
+
+
+def gm_avar(tau, tc) -> np.ndarray:
+    """Allan variance of a first-order Gauss–Markov rate of unit variance and correlation time ``tc``."""
+    tau = np.asarray(tau, dtype=np.float64)
+    x = tau / tc
+    big = (2 * x - 3 + 4 * np.exp(-x) - np.exp(-2 * x)) / np.maximum(x, 1e-300) ** 2
+    small = (2.0 / 3.0) * x - 0.5 * x * x + (7.0 / 30.0) * x**3   # series: no cancellation for x ≪ 1
+    return np.where(x < 1e-2, small, big)
+
+
+def sinusoid_avar(tau, f0) -> np.ndarray:
+    """Allan variance of a unit-amplitude rate sinusoid of frequency ``f0``: sin⁴(πf0τ)/(πf0τ)²."""
+    u = np.pi * f0 * np.asarray(tau, dtype=np.float64)
+    return np.sin(u) ** 4 / u**2
+
+
+_PARAM_NAMES = {"gauss_markov": ("sigma", "tc"), "sinusoid": ("amplitude", "f0")}
+
+
+def _column(effect, p, tau):
+    return gm_avar(tau, p) if effect == "gauss_markov" else sinusoid_avar(tau, p)
+
+
+def _alpha_of(effect, p, tau):
+    """Noise type each effect resembles at τ, for the EDF of the estimates."""
+    if effect == "gauss_markov":
+        return np.where(tau < p, -2, 0)
+    return np.zeros(tau.size, dtype=int)
+
+
+# ----------------------------------------------------------------------------------------------
+# weighted fit with extra effects
+
+
+class _Curve:
+    """One Allan curve to fit: τ, m, estimates, record length, estimator (for the EDF)."""
+
+    def __init__(self, tau, m, avar, fs, n_points, estimator):
+        self.tau, self.m, self.avar = tau, m, avar
+        self.fs, self.n_points, self.estimator = fs, n_points, estimator
+        self._edf = {}
+        self.n_eff = max(2.0, math.log2(tau[-1] / tau[0]) + 1.0)
+
+    def edf(self, alpha: int) -> np.ndarray:
+        if alpha not in self._edf:
+            self._edf[alpha] = _fit_module()._edf(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
+        return self._edf[alpha]
+
+
+@dataclass
+class _Solution:
+    theta: np.ndarray
+    model: np.ndarray
+    nu: np.ndarray
+    z: np.ndarray
+    chi2: float
+    dof: int
+    a: np.ndarray
+    cov: np.ndarray
+
+    @property
+    def chi2_dof(self):
+        return self.chi2 / max(1, self.dof)
+
+    def chi2_eff(self, curve):
+        return self.chi2 * curve.n_eff / curve.tau.size
+
+
+def _solve(curve: _Curve, terms, effects, max_iter: int = 40) -> _Solution:
+    """IRLS weighted NNLS of the terms plus effects [(name, nonlinear parameter)]."""
+    fitm = _fit_module()
+    tau = curve.tau
+    cols = [fitm.design_matrix(tau, tau * curve.fs, curve.fs, terms)]
+    alphas = [np.full(tau.size, fitm.TERM_ALPHA[t]) for t in terms]
+    for name, p in effects:
+        cols.append(_column(name, p, tau)[:, None])
+        alphas.append(_alpha_of(name, p, tau))
+    a = np.hstack(cols)
+    nu_cols = np.column_stack([np.where(al == -2, curve.edf(-2), np.where(al == -1, curve.edf(-1),
+                                        np.where(al == 2, curve.edf(2), curve.edf(0)))) for al in alphas])
+    y = curve.avar
+    model = y.copy()
+    nu = nu_cols[:, 1] if len(terms) > 1 else nu_cols[:, 0]
+    theta = np.zeros(a.shape[1])
+    floor = 1e-12 * np.max(y)
+    for it in range(max_iter):
+        w = nu / (2.0 * np.maximum(model, floor) ** 2)
+        sw = np.sqrt(w)
+        new = fitm._nnls(a * sw[:, None], y * sw)
+        parts = a * new
+        new_model = np.maximum(parts.sum(axis=1), floor)
+        done = np.allclose(new, theta, rtol=1e-7, atol=0.0)
+        model = new_model if it == 0 else np.sqrt(model * new_model)
+        theta = new
+        if new.any():
+            tot = parts.sum(axis=1)
+            den = np.sum(parts**2 / nu_cols, axis=1)
+            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
+        if done:
+            break
+    model = np.maximum(a @ theta, floor)
+    w = nu / (2.0 * model**2)
+    z = (y - model) * np.sqrt(w)
+    active = theta > 0
+    cov = np.full((a.shape[1], a.shape[1]), np.nan)
+    if active.any():
+        idx = np.flatnonzero(active)
+        aw = a[:, idx] * w[:, None]
+        cov[np.ix_(idx, idx)] = np.linalg.pinv(aw.T @ a[:, idx]) * (tau.size / curve.n_eff)
+    dof = max(1, tau.size - int(active.sum()) - len(effects))
+    return _Solution(theta, model, nu, z, float(np.sum(z**2)), dof, a, cov)
+
+
+def _metrics(sol: _Solution) -> dict:
+    return {"chi2_dof": sol.chi2_dof, "rms_z": float(np.sqrt(np.mean(sol.z**2)))}
+
+
+def _curve_metrics(curve: _Curve, sol: _Solution) -> dict:
+    out = _metrics(sol)
+    out["rms_adev_pct"] = float(100 * np.sqrt(np.mean((np.sqrt(curve.avar / sol.model) - 1) ** 2)))
+    from scipy.stats import chi2 as chi2_dist
+
+    out["p_value"] = float(chi2_dist.sf(sol.chi2_eff(curve), max(1.0, curve.n_eff - 1)))
+    return out
+
+
+# ----------------------------------------------------------------------------------------------
+# candidates
+
+
+def _residual_evidence(curve, sol) -> dict:
+    """Where the residual is: runs of same-signed |z| > 2, and the τ of the largest |z|."""
+    z = sol.z
+    runs = []
+    i = 0
+    while i < z.size:
+        if abs(z[i]) > 2:
+            j = i
+            while j + 1 < z.size and abs(z[j + 1]) > 2 and np.sign(z[j + 1]) == np.sign(z[i]):
+                j += 1
+            runs.append({"tau_from": float(curve.tau[i]), "tau_to": float(curve.tau[j]),
+                         "sign": int(np.sign(z[i])), "points": int(j - i + 1)})
+            i = j + 1
+        else:
+            i += 1
+    k = int(np.argmax(np.abs(z)))
+    return {"runs_beyond_2sigma": runs, "max_abs_z": float(abs(z[k])), "tau_of_max": float(curve.tau[k])}
+
+
+def _search(curve, terms, effects, name, grid):
+    """Best nonlinear parameter for effect ``name`` on ``grid`` (then refined), its solution and profile."""
+    from scipy.optimize import minimize_scalar
+
+    chis = np.array([_solve(curve, terms, effects + [(name, p)]).chi2 for p in grid])
+    k = int(np.argmin(chis))
+    lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
+    if hi > lo:
+        res = minimize_scalar(lambda lp: _solve(curve, terms, effects + [(name, math.exp(lp))]).chi2,
+                              bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})
+        p = math.exp(res.x)
+    else:
+        p = float(grid[k])
+    sol = _solve(curve, terms, effects + [(name, p)])
+    if sol.chi2 > chis[k]:
+        p, sol = float(grid[k]), _solve(curve, terms, effects + [(name, float(grid[k]))])
+    return p, sol, (grid, chis)
+
+
+def _profile_interval(curve, terms, effects, name, p, sol, grid_chis):
+    """Interval of the nonlinear parameter where the effective χ² rises by ≤ 1 over its minimum."""
+    grid, chis = grid_chis
+    scale = curve.n_eff / curve.tau.size
+    # a finer local profile around p
+    local = p * np.exp(np.linspace(-1.2, 1.2, 49))
+    lc = np.array([_solve(curve, terms, effects + [(name, q)]).chi2 for q in local])
+    base = min(sol.chi2, lc.min())
+    ok = local[(lc - base) * scale <= 1.0]
+    if ok.size == 0:
+        return (p, p)
+    return (float(ok.min()), float(ok.max()))
+
+
+# ----------------------------------------------------------------------------------------------
+# change points (needs the samples)
+
+
+def _change_points(y, fs, terms, max_points=2):
+    """Level steps of the Allan variance along the record: [(t, (t_lo, t_hi), evidence, before, after)]."""
+    allanite = sys.modules["allanite"]
+    n = y.size
+    n_win = 16
+    window = n // n_win
+    if window < 64:
+        return []
+    d = allanite.davar(y, fs, window=window, hop=window, taus="octave")
+    lav = np.log(np.maximum(d.avar, 1e-300))       # (tau, windows)
+    fitm = _fit_module()
+    # SD of log σ̂² per τ: from the EDF of the dominant noise (white rate is a fair middle)
+    nu = fitm._edf(np.zeros(d.m.size, dtype=int), d.m, window + 1, "oavar")
+    # 1/var(log σ̂²): ν/2 for white rate, but long τ scatter more (fewer degrees of freedom for
+    # flicker/random walk): take the larger of 2/ν and the robust scatter of consecutive windows
+    # (median |difference|, insensitive to a few steps).
+    mad = 1.4826 * np.median(np.abs(np.diff(lav, axis=1)), axis=1)
+    w = 1.0 / np.maximum(2.0 / nu, mad**2 / 2.0)
+    out = []
+
+    def best_split(a, b):
+        seg = lav[:, a:b]
+        best = (0.0, None, None)
+        for j in range(a + 1, b):
+            left, right = lav[:, a:j], lav[:, j:b]
+            chi_const = np.sum(w[:, None] * (seg - seg.mean(axis=1, keepdims=True)) ** 2)
+            chi_step = (np.sum(w[:, None] * (left - left.mean(axis=1, keepdims=True)) ** 2)
+                        + np.sum(w[:, None] * (right - right.mean(axis=1, keepdims=True)) ** 2))
+            gain = chi_const - chi_step
+            if gain > best[0]:
+                gain_tau = (np.sum(w[:, None] * (seg - seg.mean(axis=1, keepdims=True)) ** 2, axis=1)
+                            - np.sum(w[:, None] * (left - left.mean(axis=1, keepdims=True)) ** 2, axis=1)
+                            - np.sum(w[:, None] * (right - right.mean(axis=1, keepdims=True)) ** 2, axis=1))
+                best = (gain, j, int(np.argmax(gain_tau)))
+        return best
+
+    # windows are independent but the τ of one window are correlated: penalise per octave count
+    n_tau_eff = max(2.0, math.log2(d.tau[-1] / d.tau[0]) + 1.0)
+    penalty = n_tau_eff * math.log(n_win) + 4.0 * MIN_GAIN
+    stack = [(0, n_win)]
+    while stack and len(out) < max_points:
+        a, b = stack.pop(0)
+        if b - a < 3:
+            continue
+        gain, j, k_tau = best_split(a, b)
+        if j is None or gain * n_tau_eff / d.m.size < penalty / d.m.size * 1.0 and gain < penalty:
+            continue
+        if gain < penalty:
+            continue
+        # locate at sample resolution with the squared differences at the τ of the largest gain
+        m = int(d.m[k_tau])
+        lo_s, hi_s = a * window, b * window
+        t_hat, t_int = _locate(y[lo_s:hi_s], m, fs)
+        t_abs = t_hat + lo_s / fs
+        if any(abs(c["t"] - t_abs) < window / fs for c in out):
+            continue
+        out.append({"t": t_abs, "interval": (t_int[0] + lo_s / fs, t_int[1] + lo_s / fs),
+                    "gain": float(gain), "tau": float(d.tau[k_tau]), "window_s": window / fs,
+                    "coarse_split_s": j * window / fs})
+        # search each side again, leaving out the window that straddles the change
+        jw = int(t_abs * fs // window)
+        stack += [(a, min(jw, j)), (max(jw + 1, j), b)]
+    out.sort(key=lambda c: c["t"])
+    # before/after: per-window log-AVAR against one constant level vs piecewise-constant levels
+    # windows that straddle a change belong to neither level: left out of both comparisons
+    straddle = sorted({int(c["t"] * fs // window) for c in out})
+    keep = np.ones(n_win, dtype=bool)
+    keep[[j for j in straddle if j < n_win]] = False
+    edges = [0] + [j for j in straddle] + [n_win]
+
+    def stats(segments):
+        res, k = [], 0
+        for a, b in segments:
+            sel = np.arange(a, b)[keep[a:b]]
+            if sel.size:
+                r = lav[:, sel] - lav[:, sel].mean(axis=1, keepdims=True)
+                res.append(r)
+                k += lav.shape[0]
+        res = np.concatenate(res, axis=1)
+        z = res * np.sqrt(w)[:, None]
+        return {"chi2_dof": float(np.sum(z**2) / max(1, z.size - k)), "rms_z": float(np.sqrt(np.mean(z**2))),
+                "rms_adev_pct": float(100 * np.sqrt(np.mean((np.exp(res / 2) - 1) ** 2)))}
+
+    before = stats([(0, n_win)])
+    after = stats([(a, b) for a, b in zip(edges[:-1], edges[1:])])
+    for c in out:
+        c["before"], c["after"] = before, after
+    return out
+
+
+def _locate(y, m, fs):
+    """Change in the mean of the squared m-sample second differences: MLE split and 2-unit support."""
+    k = y.size // m
+    b = y[: k * m].reshape(k, m).mean(axis=1)
+    d = np.diff(b) ** 2 + 1e-300                       # independent-ish terms at stride m
+    n = d.size
+    c = np.cumsum(d)
+    j = np.arange(2, n - 1)
+    mu1 = c[j - 1] / j
+    mu2 = (c[-1] - c[j - 1]) / (n - j)
+    ll = -0.5 * (j * np.log(mu1) + (n - j) * np.log(mu2))   # exponential-family profile (χ²₁ terms)
+    i = int(np.argmax(ll))
+    ok = j[ll >= ll[i] - 2.0]
+    to_t = lambda idx: (idx + 1) * m / fs                    # noqa: E731  boundary after term idx
+    return to_t(j[i]), (to_t(ok.min()) - m / fs, to_t(ok.max()) + m / fs)
+
+
+# ----------------------------------------------------------------------------------------------
+# results
+
+
+@dataclass
+class Step:
+    """One effect added by :func:`refine`.
+
+    ``params`` in the input unit's base form (Gauss–Markov: ``sigma`` rate unit, ``tc`` s; sinusoid:
+    ``amplitude`` rate unit, ``f0`` Hz; change point: ``t`` s); ``intervals`` the same keys →
+    (low, high); ``before``/``after``: ``chi2_dof``, ``rms_z``, ``rms_adev_pct`` (and ``p_value``
+    for curve effects); ``evidence``: where in τ or t the residual was; ``truth_error``: relative
+    parameter errors when ``truth`` was given.
+    """
+
+    effect: str
+    params: dict
+    intervals: dict
+    evidence: dict
+    before: dict
+    after: dict
+    delta_chi2_eff: float = 0.0
+    truth_error: dict | None = None
+
+
+@dataclass
+class Refinement:
+    """What :func:`refine` found. ``fit`` is the final model (a NoiseFit whose ``coefficients`` also
+    hold the added effects' parameters), ``start`` the starting model, ``steps`` the effects added."""
+
+    steps: list
+    fit: object
+    start: object
+    result: AllanResult
+    terms: tuple
+    effects: list = field(default_factory=list)
+    change_points: list = field(default_factory=list)
+    considered: dict = field(default_factory=dict)
+
+    @property
+    def found(self) -> list:
+        return [s.effect for s in self.steps]
+
+    def report(self) -> str:
+        """Markdown: the starting residual, each step with its parameters, evidence and errors."""
+        s0 = self.start
+        lines = ["# Model refinement", "",
+                 f"Starting model {'+'.join(self.terms)}: χ²/dof = {s0.chi2_dof:.3g}, "
+                 f"RMS z = {np.sqrt(np.mean(s0.z ** 2)):.3g}.", ""]
+        if not self.steps:
+            lines.append("Nothing added: the residual is consistent with noise or no candidate earned its parameters.")
+        for i, st in enumerate(self.steps, 1):
+            ps = ", ".join(f"{k} = {v:.4g} [{st.intervals[k][0]:.4g}, {st.intervals[k][1]:.4g}]"
+                           for k, v in st.params.items())
+            lines += [f"## Step {i}: {st.effect}", "", f"- parameters: {ps}",
+                      f"- evidence: {st.evidence}",
+                      "- before → after: " + ", ".join(f"{k} {st.before[k]:.3g} → {st.after[k]:.3g}"
+                                                       for k in ("chi2_dof", "rms_z", "rms_adev_pct")), ""]
+            if st.truth_error:
+                lines.append("- error against the truth: " + ", ".join(f"{k} {100 * v:+.1f} %"
+                                                                      for k, v in st.truth_error.items()))
+                lines.append("")
+        return "\n".join(lines)
+
+    def plot(self, fig=None):
+        """Residuals before and after, and the ADEV with the starting and the final model."""
+        import matplotlib.pyplot as plt
+
+        fig = fig or plt.figure(figsize=(11, 4.2))
+        ax1, ax2 = fig.subplots(1, 2)
+        tau = self.start.tau
+        ax1.loglog(tau, np.sqrt(self.start.avar), "ko", ms=3, label="estimate")
+        ax1.loglog(tau, np.sqrt(self.start.model), "C0-", label="starting model")
+        ax1.loglog(self.fit.tau, np.sqrt(self.fit.model), "C3-", label="refined model")
+        ax1.set_xlabel("τ (s)")
+        ax1.set_ylabel("Allan deviation")
+        ax1.legend(fontsize="small")
+        ax2.semilogx(tau, self.start.z, "C0.-", label="before")
+        ax2.semilogx(self.fit.tau, self.fit.z, "C3.-", label="after")
+        ax2.axhspan(-2, 2, color="0.9")
+        ax2.set_xlabel("τ (s)")
+        ax2.set_ylabel("normalised residual z")
+        ax2.legend(fontsize="small")
+        fig.tight_layout()
+        return fig
+
+
+def _noise_fit(curve, terms, effects, sol, result, unit, confidence):
+    """A NoiseFit for the solution, with the effects' parameters among the coefficients."""
+    fitm = _fit_module()
+    from scipy.stats import chi2 as chi2_dist
+
+    zq = fitm._zq(confidence)
+    k = len(terms)
+    inflate = max(1.0, math.sqrt(sol.chi2_dof))
+    coeffs = fitm._coefficients(terms, sol.theta[:k], sol.cov[:k, :k], zq, inflate, unit)
+    comps = {t: sol.a[:, i] * sol.theta[i] for i, t in enumerate(terms)}
+    for j, (name, p) in enumerate(effects):
+        i = k + j
+        key = f"{name}{j + 1}" if sum(e[0] == name for e in effects) > 1 else name
+        comps[key] = sol.a[:, i] * sol.theta[i]
+        coeffs[key] = fitm.Coefficient(name=key, value=float(math.sqrt(max(sol.theta[i], 0.0))),
+                                       ci=fitm._interval(sol.theta[i], sol.cov[i, i], zq, inflate), unit=unit)
+    readoffs = fitm._readoffs(result, np.sqrt(np.atleast_2d(result.avar)[0]))
+    return fitm.NoiseFit(
+        coefficients=coeffs, terms=terms, tau=curve.tau, m=curve.m, avar=curve.avar, edf=sol.nu, model=sol.model,
+        components=comps, z=sol.z, chi2=sol.chi2, dof=sol.dof, chi2_dof=sol.chi2_dof,
+        p_value=float(chi2_dist.sf(sol.chi2, sol.dof)), readoffs=readoffs, fs=curve.fs, confidence=confidence,
+        unit=unit, iterations=0, theta=sol.theta[:k], covariance=sol.cov[:k, :k])
+
+
+# ----------------------------------------------------------------------------------------------
+# the loop
+
+
+def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=CANDIDATES, unit=None,
+           input: str = "rate", tau_range=None, truth=None, confidence: float = 0.683, points: int = 300,
+           axis: int = 0) -> Refinement:
+    """Fit the starting model, find what it lacks, add it, repeat; report the error before and after.
+
+    Parameters
+    ----------
+    x_or_result : array_like or AllanResult
+        Samples (then ``fs`` is needed; the Allan variance is computed on a dense exponential grid of
+        ``points`` τ so that a sinusoid's nulls are resolved, and change points can be searched), or
+        a static :class:`~allanite.AllanResult` (curve effects only).
+    fs : float, optional
+        Sampling rate, Hz (samples only).
+    start : tuple of str
+        The starting model's terms (``"Q"``, ``"N"``, ``"B"``, ``"K"``, ``"R"``).
+    candidates : tuple of str
+        Effects to try: ``"gauss_markov"``, ``"sinusoid"``, ``"change_point"`` (samples only).
+    unit : str, optional
+        Unit of the samples, for IEEE-952 values of the terms.
+    tau_range : (float, float), optional
+        τ (s) to use, as in :func:`allanite.fit` (e.g. to leave out a non-white shortest τ).
+    truth : dict, optional
+        Known parameters per effect (``{"gauss_markov": {"sigma": …, "tc": …}}``, ``{"change_point":
+        {"t": …}}``): each step then records its relative errors.
+    axis : int
+        Which axis of multi-axis input to refine.
+
+    Returns
+    -------
+    Refinement
+
+    Examples
+    --------
+    >>> import allanite
+    >>> y = allanite.simulate(200_000, 100.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 10.0)], seed=3)
+    >>> r = allanite.refine(y, 100.0, start=("N", "K"))
+    >>> r.found, round(r.steps[0].params["tc"], 0)
+    (['gauss_markov'], 10.0)
+    """
+    allanite = sys.modules["allanite"]
+    fitm = _fit_module()
+    start = fitm._check_terms(start)
+    if isinstance(candidates, str):
+        candidates = (candidates,)
+    bad = [c for c in candidates if c not in CANDIDATES]
+    if bad:
+        raise ParameterError(f"unknown candidate effect {bad[0]!r}; allowed: {', '.join(CANDIDATES)}")
+    y = None
+    if isinstance(x_or_result, AllanResult):
+        if fs is not None:
+            raise ParameterError("fs is taken from the result; pass fs only with samples")
+        result = x_or_result
+    elif hasattr(x_or_result, "tau") and hasattr(x_or_result, "t"):
+        raise ParameterError("refine needs samples or a static AllanResult; for a dynamic result pass the samples "
+                             "so that change points can be located")
+    else:
+        if fs is None:
+            raise ParameterError("fs (Hz) is needed with samples")
+        from ._input import as_rate_columns
+
+        cols, fs, _ = as_rate_columns(x_or_result, fs, input)
+        if not 0 <= axis < len(cols):
+            raise ParameterError(f"axis = {axis} is outside 0..{len(cols) - 1}")
+        y = cols[axis]
+        top = max(1, y.size // 9)
+        grid = allanite.tau_grid(y.size, fs, "exp", points=points, m_max=top) if top > 1 else "octave"
+        result = allanite.avar(y, fs, taus=grid)
+    if result.avar.ndim == 2:
+        result = AllanResult(tau=result.tau, avar=result.avar[axis], n=result.n, m=result.m,
+                             estimator=result.estimator, fs=result.fs, n_samples=result.n_samples,
+                             input=result.input, source=result.source)
+    lo, hi = (0.0, np.inf) if tau_range is None else fitm._check_tau_range(tau_range)
+    keep = (result.tau >= lo) & (result.tau <= hi) & (result.avar > 0)
+    if keep.sum() < len(start) + 3:
+        raise ParameterError(f"{int(keep.sum())} usable τ points; refining {len(start)} terms needs at least "
+                             f"{len(start) + 3}")
+    est = result.estimator if result.source is None else tuple(np.asarray(result.source)[keep])
+    curve = _Curve(result.tau[keep], result.m[keep].astype(np.float64), result.avar[keep], result.fs,
+                   result.n_samples + 1, est)
+    effects: list = []
+    steps: list = []
+    sol = _solve(curve, start, effects)
+    start_sol = sol
+    considered = {}
+    tmin, tmax = curve.tau[0], curve.tau[-1]
+    for _ in range(MAX_STEPS):
+        if sol.chi2_dof <= GOOD_CHI2_DOF:
+            break
+        best = None
+        for cand in candidates:
+            if cand == "change_point":
+                continue
+            grid = (np.geomspace(tmin / 2.0, tmax / 1.5, 40) if cand == "gauss_markov"
+                    else np.geomspace(0.25 / tmax, 0.5 / tmin, 120))
+            p, s_new, prof = _search(curve, start, effects, cand, grid)
+            gain = sol.chi2_eff(curve) - s_new.chi2_eff(curve)
+            penalty = 2 * math.log(curve.n_eff) + MIN_GAIN
+            considered.setdefault(cand, []).append({"param": p, "gain_chi2_eff": float(gain), "penalty": penalty})
+            if gain > penalty and s_new.theta[-1] > 0 and (best is None or gain > best[0]):
+                best = (gain, cand, p, s_new, prof)
+        if best is None:
+            break
+        gain, cand, p, s_new, prof = best
+        evidence = _residual_evidence(curve, sol)
+        p_int = _profile_interval(curve, start, effects, cand, p, s_new, prof)
+        new_effects = effects + [(cand, p)]
+        i = s_new.theta.size - 1
+        amp = math.sqrt(s_new.theta[i])
+        var_i = s_new.cov[i, i]
+        sd_amp = math.sqrt(max(var_i, 0.0)) / (2 * amp) if amp > 0 and np.isfinite(var_i) else float("nan")
+        names = _PARAM_NAMES[cand]
+        params = {names[0]: amp, names[1]: p}
+        intervals = {names[0]: (max(0.0, amp - sd_amp), amp + sd_amp), names[1]: p_int}
+        before, after = _curve_metrics(curve, sol), _curve_metrics(curve, s_new)
+        terr = None
+        if truth and cand in truth:
+            terr = {k: params[k] / v - 1 for k, v in truth[cand].items() if k in params}
+        steps.append(Step(effect=cand, params=params, intervals=intervals, evidence=evidence, before=before,
+                          after=after, delta_chi2_eff=float(gain), truth_error=terr))
+        effects, sol = new_effects, s_new
+    change_points = []
+    if y is not None and "change_point" in candidates:
+        change_points = _change_points(y, fs, start)
+        for c in change_points:
+            terr = None
+            if truth and "change_point" in truth:
+                ts = np.atleast_1d(truth["change_point"]["t"])
+                terr = {"t": float(np.min(np.abs(ts - c["t"])) / (y.size / fs))}
+            steps.append(Step(effect="change_point", params={"t": c["t"]}, intervals={"t": c["interval"]},
+                              evidence={"tau": c["tau"], "window_s": c["window_s"], "coarse_split_s": c["coarse_split_s"],
+                                        "gain_chi2": c["gain"]},
+                              before=c["before"], after=c["after"], delta_chi2_eff=c["gain"], truth_error=terr))
+    start_fit = _noise_fit(curve, start, [], start_sol, result, unit, confidence)
+    final_fit = _noise_fit(curve, start, effects, sol, result, unit, confidence)
+    return Refinement(steps=steps, fit=final_fit, start=start_fit, result=result, terms=start, effects=effects,
+                      change_points=change_points, considered=considered)
