@@ -220,18 +220,76 @@ def _search(curve, terms, effects, name, grid):
     return p, sol, (grid, chis)
 
 
+#: Octave-to-octave correlation of Allan estimates used for the parameters' effective sample size
+#: (the mid value of fit.OCTAVE_CORRELATION: 0.42 white angle … 0.87 random walk).
+PROFILE_RHO = 0.68
+
+
 def _profile_interval(curve, terms, effects, name, p, sol, grid_chis):
-    """Interval of the nonlinear parameter where the effective χ² rises by ≤ 1 over its minimum."""
-    grid, chis = grid_chis
-    scale = curve.n_eff / curve.tau.size
-    # a finer local profile around p
-    local = p * np.exp(np.linspace(-1.2, 1.2, 49))
+    """Interval of the nonlinear parameter where the effective χ² rises by ≤ 1 over its minimum.
+
+    χ² of the dense, correlated τ points is scaled to n_eff·(1 − ρ)/(1 + ρ) independent ones (n_eff
+    octaves whose estimates correlate by ρ = ``PROFILE_RHO`` from one to the next); the crossings are
+    interpolated on a fine log grid around the best value."""
+    scale = curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / curve.tau.size
+    local = p * np.exp(np.linspace(-1.5, 1.5, 121))
     lc = np.array([_solve(curve, terms, effects + [(name, q)]).chi2 for q in local])
-    base = min(sol.chi2, lc.min())
-    ok = local[(lc - base) * scale <= 1.0]
-    if ok.size == 0:
-        return (p, p)
-    return (float(ok.min()), float(ok.max()))
+    d = (lc - min(sol.chi2, lc.min())) * scale - 1.0
+    i0 = int(np.argmin(d))
+    lo_i, hi_i = i0, i0
+    while lo_i > 0 and d[lo_i - 1] <= 0:
+        lo_i -= 1
+    while hi_i < local.size - 1 and d[hi_i + 1] <= 0:
+        hi_i += 1
+    ll = np.log(local)
+
+    def cross(i, j):  # log-parameter where d crosses 0 between i (≤ 0) and j (> 0)
+        return math.exp(ll[i] + (ll[j] - ll[i]) * (-d[i]) / (d[j] - d[i]))
+
+    lo = cross(lo_i, lo_i - 1) if lo_i > 0 else float(local[0])
+    hi = cross(hi_i, hi_i + 1) if hi_i < local.size - 1 else float(local[-1])
+    return (min(lo, p), max(hi, p))
+
+
+def _joint(curve, terms, effects, sol, passes: int = 3):
+    """Re-estimate every effect's nonlinear parameter with the others held (coordinate descent): an
+    effect added first may have absorbed part of a later one's signature."""
+    from scipy.optimize import minimize_scalar
+
+    effects = list(effects)
+    for _ in range(passes):
+        moved = False
+        for i, (name, p) in enumerate(effects):
+            def chi(lp, i=i, name=name):
+                trial = effects[:i] + [(name, math.exp(lp))] + effects[i + 1:]
+                return _solve(curve, terms, trial).chi2
+            res = minimize_scalar(chi, bounds=(math.log(p) - 1.5, math.log(p) + 1.5), method="bounded",
+                                  options={"xatol": 1e-4})
+            if res.fun < sol.chi2 - 1e-9:
+                effects[i] = (name, math.exp(res.x))
+                sol = _solve(curve, terms, effects)
+                moved = moved or abs(res.x - math.log(p)) > 1e-3
+        if not moved:
+            break
+    return effects, sol
+
+
+def _update_steps(steps, curve, terms, effects, sol, truth):
+    """Steps' parameters and intervals from the joint solution (in the order the effects were added)."""
+    k = len(terms)
+    curve_steps = [st for st in steps if st.effect in _PARAM_NAMES]
+    for j, (st, (name, p)) in enumerate(zip(curve_steps, effects)):
+        i = k + j
+        amp = math.sqrt(max(sol.theta[i], 0.0))
+        var_i = sol.cov[i, i]
+        sd = math.sqrt(max(var_i, 0.0)) / (2 * amp) if amp > 0 and np.isfinite(var_i) else float("nan")
+        others = effects[:j] + effects[j + 1:]
+        names = _PARAM_NAMES[name]
+        p_int = _profile_interval(curve, terms, others, name, p, sol, None)
+        st.params = {names[0]: amp, names[1]: p}
+        st.intervals = {names[0]: (max(0.0, amp - sd), amp + sd), names[1]: p_int}
+        if truth and name in truth:
+            st.truth_error = {kk: st.params[kk] / v - 1 for kk, v in truth[name].items() if kk in st.params}
 
 
 # ----------------------------------------------------------------------------------------------
@@ -580,6 +638,9 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
         steps.append(Step(effect=cand, params=params, intervals=intervals, evidence=evidence, before=before,
                           after=after, delta_chi2_eff=float(gain), truth_error=terr))
         effects, sol = new_effects, s_new
+        if len(effects) > 1:
+            effects, sol = _joint(curve, start, effects, sol)
+            _update_steps(steps, curve, start, effects, sol, truth)
     change_points = []
     if y is not None and "change_point" in candidates:
         change_points = _change_points(y, fs, start)

@@ -1,0 +1,165 @@
+"""refine(): data with an effect the fitter is not told about — simulated and real noise — and no false alarms."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import allanite
+from allanite.errors import ParameterError
+from allanite.refine import gm_avar, sinusoid_avar
+
+FS = 100.0
+
+
+@pytest.fixture(scope="module")
+def gm_record():
+    truth = {"sigma": 5e-3, "tc": 10.0}
+    y = allanite.simulate(1_000_000, FS, N=2e-3, K=2e-5, gauss_markov=[(truth["sigma"], truth["tc"])], seed=11)
+    return y, truth
+
+
+def test_signatures_match_their_closed_forms():
+    # GM: bump near 1.89·T_c; K-like (2/3·τ/T_c) far below, N-like (2T_c/τ) far above
+    tau = np.geomspace(0.01, 1000, 2001)
+    g = gm_avar(tau, 10.0)
+    assert g[0] == pytest.approx((2 / 3) * 0.01 / 10, rel=1e-3)
+    assert g[-1] == pytest.approx(2 * 10 / 1000, rel=0.02)
+    # the series branch and the exact branch meet smoothly
+    x = np.array([0.0099, 0.0101]) * 10.0
+    assert gm_avar(x, 10.0)[1] / gm_avar(x, 10.0)[0] == pytest.approx(0.0101 / 0.0099, rel=1e-3)
+    # sinusoid: nulls at τ = k/f0
+    s = sinusoid_avar(np.array([10.0, 20.0, 5.0]), 0.1)
+    assert s[0] < 1e-30 and s[1] < 1e-30 and s[2] == pytest.approx(1 / (np.pi * 0.5) ** 2)
+
+
+def test_gm_bump_position():
+    tau = np.geomspace(0.1, 1000, 5001)
+    adev_over_tau = gm_avar(tau, 10.0)
+    # the Allan *deviation* of GM peaks at τ ≈ 1.89 T_c
+    assert tau[np.argmax(adev_over_tau)] == pytest.approx(18.9, rel=0.02)
+
+
+def test_finds_an_undeclared_gauss_markov(gm_record):
+    y, truth = gm_record
+    r = allanite.refine(y, FS, truth={"gauss_markov": truth})
+    assert r.found == ["gauss_markov"]
+    st = r.steps[0]
+    assert abs(st.params["tc"] / truth["tc"] - 1) < 0.2
+    assert abs(st.params["sigma"] / truth["sigma"] - 1) < 0.3
+    assert st.truth_error["tc"] == pytest.approx(st.params["tc"] / truth["tc"] - 1)
+    assert st.before["chi2_dof"] > 3 and st.after["chi2_dof"] <= 2
+    assert st.after["rms_adev_pct"] < st.before["rms_adev_pct"]
+    lo, hi = st.intervals["tc"]
+    assert lo < st.params["tc"] < hi
+    assert st.evidence["runs_beyond_2sigma"]            # where the residual was
+    assert "gauss_markov" in r.fit.coefficients and r.fit.chi2_dof <= 2
+    text = r.report()
+    assert "Step 1: gauss_markov" in text and "tc =" in text
+
+
+def test_finds_an_undeclared_sinusoid():
+    truth = {"amplitude": 3e-3, "f0": 0.05}
+    y = allanite.simulate(400_000, FS, N=2e-3, K=2e-5, sinusoid=[(truth["amplitude"], truth["f0"])], seed=4)
+    r = allanite.refine(y, FS, truth={"sinusoid": truth})
+    assert r.found == ["sinusoid"]
+    st = r.steps[0]
+    assert abs(st.truth_error["f0"]) < 0.2 and abs(st.truth_error["amplitude"]) < 0.3
+    assert st.after["chi2_dof"] <= 2
+
+
+def test_locates_a_variance_step_within_one_window():
+    t_step = 1234.5
+    y = allanite.simulate(300_000, FS, N=[(0.0, 2e-3), (t_step, 6e-3)], K=2e-5, seed=5)
+    r = allanite.refine(y, FS, truth={"change_point": {"t": t_step}})
+    cps = [s for s in r.steps if s.effect == "change_point"]
+    assert len(cps) == 1
+    st = cps[0]
+    window = y.size / 16 / FS
+    assert abs(st.params["t"] - t_step) < window
+    lo, hi = st.intervals["t"]
+    assert lo <= t_step <= hi or abs(st.params["t"] - t_step) < 1.0
+    assert st.before["chi2_dof"] > 10 and st.after["chi2_dof"] <= 2
+
+
+def test_two_effects_at_once():
+    gm = {"sigma": 5e-3, "tc": 5.0}
+    sn = {"amplitude": 4e-3, "f0": 0.02}
+    y = allanite.simulate(1_000_000, FS, N=2e-3, K=1e-5, gauss_markov=[(gm["sigma"], gm["tc"])],
+                          sinusoid=[(sn["amplitude"], sn["f0"])], seed=21)
+    r = allanite.refine(y, FS, truth={"gauss_markov": gm, "sinusoid": sn})
+    assert sorted(r.found) == ["gauss_markov", "sinusoid"]
+    for st in r.steps:
+        key = "tc" if st.effect == "gauss_markov" else "f0"
+        assert abs(st.truth_error[key]) < 0.2
+    assert r.fit.chi2_dof <= 2
+
+
+def test_real_adis_noise_with_an_injected_gauss_markov(shared_data):
+    path = shared_data / "adis16405" / "adis16405_run2_100Hz.csv.gz"
+    if not path.is_file():
+        pytest.skip(f"{path} not found")
+    log = allanite.read_log(path, fs=FS, columns=["gyro_x"], unit="deg/s")
+    y = np.asarray(log.data, dtype=np.float64).ravel()
+    truth = {"sigma": 0.05, "tc": 20.0}
+    gm = allanite.simulate(y.size, FS, gauss_markov=[(truth["sigma"], truth["tc"])], seed=8)
+    # the ADIS shortest τ are not white (quantization/filtering): fit from 0.1 s on, as in fit()
+    clean = allanite.refine(y, FS, tau_range=(0.1, None))
+    r = allanite.refine(y + gm, FS, tau_range=(0.1, None), truth={"gauss_markov": truth})
+    assert "gauss_markov" in r.found and "gauss_markov" not in clean.found
+    st = next(s for s in r.steps if s.effect == "gauss_markov")
+    assert abs(st.truth_error["tc"]) < 0.2 and abs(st.truth_error["sigma"]) < 0.3
+    assert r.fit.chi2_dof <= 2
+
+
+def test_no_false_alarms_on_clean_records():
+    found = 0
+    for seed in range(40):
+        y = allanite.simulate(100_000, FS, Q=3e-4, N=2e-3, B=1e-3, K=2e-5, seed=200 + seed)
+        found += bool(allanite.refine(y, FS).found)
+    assert found <= 2          # ≥ 95 % of 40 seeds add nothing
+
+
+def test_deterministic_and_accepts_a_result(gm_record):
+    y, _ = gm_record
+    a = allanite.refine(y[:200_000], FS)
+    b = allanite.refine(y[:200_000], FS)
+    assert a.found == b.found and [s.params for s in a.steps] == [s.params for s in b.steps]
+    res = allanite.avar(y[:200_000], FS, taus=allanite.tau_grid(200_000, FS, "exp", points=300))
+    c = allanite.refine(res)
+    assert c.found == [e for e in a.found if e != "change_point"]
+
+
+def test_plot_draws():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    y = allanite.simulate(100_000, FS, N=2e-3, gauss_markov=[(5e-3, 3.0)], seed=2)
+    fig = allanite.refine(y, FS).plot()
+    assert len(fig.axes) == 2
+    plt.close(fig)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(candidates=("wobble",)), "unknown candidate effect 'wobble'"),
+    (dict(start=("N", "X")), "X"),
+    (dict(axis=3), "axis = 3"),
+])
+def test_errors(kwargs, match):
+    y = np.random.default_rng(0).normal(size=5_000)
+    with pytest.raises(ParameterError, match=match):
+        allanite.refine(y, FS, **kwargs)
+
+
+def test_error_paths_for_inputs():
+    y = np.random.default_rng(0).normal(size=5_000)
+    with pytest.raises(ParameterError, match="fs"):
+        allanite.refine(y)
+    r = allanite.avar(y, FS)
+    with pytest.raises(ParameterError, match="fs is taken from the result"):
+        allanite.refine(r, FS)
+    d = allanite.davar(y, FS, window=1_000, hop=500)
+    with pytest.raises(ParameterError, match="dynamic result"):
+        allanite.refine(d)
