@@ -163,3 +163,26 @@ def test_error_paths_for_inputs():
     d = allanite.davar(y, FS, window=1_000, hop=500)
     with pytest.raises(ParameterError, match="dynamic result"):
         allanite.refine(d)
+
+
+def test_report_refinement_section(tmp_path):
+    from allanite import cli
+
+    y = allanite.simulate(120_000, FS, N=2e-3, K=2e-5, gauss_markov=[(6e-3, 5.0)], seed=9)
+    np.save(tmp_path / "g.npy", y)
+    out = tmp_path / "out"
+    assert cli.main(["report", str(tmp_path / "g.npy"), "--fs", "100", "--unit", "deg/s", "--refine",
+                     "--window", "20000", "--hop", "10000", "--out", str(out), "--quiet"]) == 0
+    import json
+
+    s = json.loads((out / "summary.json").read_text())
+    ax = s["refinement"]["axes"][0]
+    lib = allanite.refine(y, FS, tau_range=(0.1, None))
+    assert [st["effect"] for st in ax["steps"]] == lib.found
+    assert ax["steps"][0]["params"]["tc"] == pytest.approx(lib.steps[0].params["tc"])
+    assert "Model refinement" in (out / "report.html").read_text()
+    # without --refine there is no section and summary says null
+    out2 = tmp_path / "out2"
+    assert cli.main(["report", str(tmp_path / "g.npy"), "--fs", "100", "--no-fit", "--window", "20000",
+                     "--out", str(out2), "--quiet"]) == 0
+    assert json.loads((out2 / "summary.json").read_text())["refinement"] is None

@@ -131,6 +131,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="oavar: overlapping Allan deviation and DAVAR (default); theoh: TheoH for the record and "
                           "paper 001's dynamic TheoH (DHVAR) over time, reaching 75%% of the record or window "
                           "(default window then at most 2001 samples)")
+    ana.add_argument("--refine", action="store_true",
+                     help="also look for what the noise model lacks (Gauss-Markov, sinusoid, change points) and "
+                          "add a model-refinement section; a few seconds per axis and million samples")
     ana.add_argument("--no-fit", action="store_true",
                      help="skip the noise-model fit (whole record and per window)")
 
@@ -249,7 +252,7 @@ def _report(args) -> int:
             if quiet:
                 warnings.simplefilter("ignore")
             common = dict(window=args.window, hop=args.hop, taus=taus, fit=not args.no_fit, progress=progress,
-                          estimator=args.estimator)
+                          estimator=args.estimator, refine=args.refine)
             if args.log is None:
                 from . import default_record
 

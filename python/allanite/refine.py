@@ -8,7 +8,9 @@ Allan-variance signature (closed forms, ``../shared/FORMULAS.md`` §6 and the re
   σ²_A(τ) = σ²·(T_c/τ)²·(2τ/T_c − 3 + 4e^{−τ/T_c} − e^{−2τ/T_c}) (IEEE Std 952 App. C; a bump that
   peaks near τ ≈ 1.89·T_c, K-like below, N-like above);
 - ``"sinusoid"`` — a rate sinusoid of amplitude A and frequency f0: σ²_A(τ) = A²·sin⁴(πf0τ)/(πf0τ)²
-  (nulls at τ = k/f0);
+  (nulls at τ = k/f0). Only f0 ≥ 2/τ_max are tried: a sinusoid is told apart from a Gauss–Markov bump
+  by its nulls, so at least two (τ = 1/f0, 2/f0) must fall inside the curve (a best f0 or T_c at the
+  edge of its search range is not taken as identified);
 - ``"change_point"`` — nonstationarity: the Allan variance of non-overlapping windows is tested for a
   step in level along the record (all τ jointly), located at sample resolution by the two-segment
   likelihood of the squared differences at the τ where the step is strongest, with a 2-unit support
@@ -611,12 +613,15 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
             if cand == "change_point":
                 continue
             grid = (np.geomspace(tmin / 2.0, tmax / 1.5, 40) if cand == "gauss_markov"
-                    else np.geomspace(0.25 / tmax, 0.5 / tmin, 120))
+                    else np.geomspace(2.0 / tmax, 0.5 / tmin, 120))
             p, s_new, prof = _search(curve, start, effects, cand, grid)
             gain = sol.chi2_eff(curve) - s_new.chi2_eff(curve)
             penalty = 2 * math.log(curve.n_eff) + MIN_GAIN
             considered.setdefault(cand, []).append({"param": p, "gain_chi2_eff": float(gain), "penalty": penalty})
-            if gain > penalty and s_new.theta[-1] > 0 and (best is None or gain > best[0]):
+            # a parameter pinned at its search range's edge is not identified by the curve
+            at_edge = p <= grid[0] * 1.02 or p >= grid[-1] / 1.02
+            if (gain > penalty and s_new.theta[-1] > 0 and not at_edge
+                    and (best is None or gain > best[0])):
                 best = (gain, cand, p, s_new, prof)
         if best is None:
             break
