@@ -6,7 +6,9 @@ Allan-variance signature (closed forms, ``../shared/FORMULAS.md`` §6 and the re
 
 - ``"gauss_markov"`` — first-order Gauss–Markov rate of variance σ² and correlation time T_c:
   σ²_A(τ) = σ²·(T_c/τ)²·(2τ/T_c − 3 + 4e^{−τ/T_c} − e^{−2τ/T_c}) (IEEE Std 952 App. C; a bump that
-  peaks near τ ≈ 1.89·T_c, K-like below, N-like above);
+  peaks near τ ≈ 1.89·T_c, K-like below, N-like above; T_c in [τ_min, τ_max/4] so that the bump lies
+  inside the curve — a "T_c" below the shortest τ would only describe a roll-off there, e.g. an
+  anti-alias filter's);
 - ``"sinusoid"`` — a rate sinusoid of amplitude A and frequency f0: σ²_A(τ) = A²·sin⁴(πf0τ)/(πf0τ)²
   (nulls at τ = k/f0). Only f0 ≥ 2/τ_max are tried: a sinusoid is told apart from a Gauss–Markov bump
   by its nulls, so at least two (τ = 1/f0, 2/f0) must fall inside the curve (a best f0 or T_c at the
@@ -612,7 +614,7 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
         for cand in candidates:
             if cand == "change_point":
                 continue
-            grid = (np.geomspace(tmin / 2.0, tmax / 1.5, 40) if cand == "gauss_markov"
+            grid = (np.geomspace(tmin, tmax / 4.0, 40) if cand == "gauss_markov"
                     else np.geomspace(2.0 / tmax, 0.5 / tmin, 120))
             p, s_new, prof = _search(curve, start, effects, cand, grid)
             gain = sol.chi2_eff(curve) - s_new.chi2_eff(curve)
