@@ -5,7 +5,8 @@ import importlib
 
 import pytest
 
-MODULES = ["allanite.allan", "allanite.grid", "allanite.datasets", "allanite.simulate"]
+MODULES = ["allanite.allan", "allanite.grid", "allanite.datasets", "allanite.simulate", "allanite.refine",
+           "allanite.confidence"]
 
 
 @pytest.mark.parametrize("name", MODULES)
