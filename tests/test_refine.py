@@ -186,3 +186,26 @@ def test_report_refinement_section(tmp_path):
     assert cli.main(["report", str(tmp_path / "g.npy"), "--fs", "100", "--no-fit", "--window", "20000",
                      "--out", str(out2), "--quiet"]) == 0
     assert json.loads((out2 / "summary.json").read_text())["refinement"] is None
+
+
+def test_real_adis_noise_with_an_injected_sinusoid_and_step(shared_data):
+    path = shared_data / "adis16405" / "adis16405_run6_100Hz.csv.gz"
+    if not path.is_file():
+        pytest.skip(f"{path} not found")
+    log = allanite.read_log(path, fs=FS, columns=["gyro_x"], unit="deg/s")
+    y = np.asarray(log.data, dtype=np.float64).ravel()
+    t = np.arange(y.size) / FS
+    sn = {"amplitude": 0.03, "f0": 0.1}
+    r = allanite.refine(y + sn["amplitude"] * np.sin(2 * np.pi * sn["f0"] * t), FS, tau_range=(0.1, None),
+                        truth={"sinusoid": sn}, candidates=("gauss_markov", "sinusoid"))
+    st = next(s for s in r.steps if s.effect == "sinusoid")
+    assert abs(st.truth_error["f0"]) < 0.2 and abs(st.truth_error["amplitude"]) < 0.3
+    assert r.fit.chi2_dof <= 2
+    # a variance step: the second half gets extra white noise of twice the sensor's own level
+    t_step = 6000.0
+    extra = np.where(t >= t_step, 2 * np.std(np.diff(y)) / np.sqrt(2), 0.0)
+    y2 = y + extra * np.random.default_rng(3).normal(size=y.size)
+    r2 = allanite.refine(y2, FS, tau_range=(0.1, None), candidates=("change_point",))
+    cps = [s.params["t"] for s in r2.steps if s.effect == "change_point"]
+    window = y.size / 16 / FS
+    assert any(abs(c - t_step) < window for c in cps)
