@@ -690,6 +690,11 @@ def _figure_specs(rep: Report) -> list:
     st, dy, unit, names = rep.static, rep.dynamic, rep.unit, rep.axis_names
     specs = []
     conf = f"{st.confidence:.1%}"
+    theoh = st.source is not None
+    static_word = "TheoH deviation" if theoh else "Overlapping Allan deviation"
+    dynamic_word = "Dynamic TheoH deviation (DHVAR)" if theoh else "Dynamic Allan deviation"
+    static_lower = "TheoH deviation" if theoh else "Allan deviation"
+    dynamic_lower = "dynamic TheoH deviation (DHVAR)" if theoh else "dynamic Allan deviation"
 
     def overview(fig):
         ax = fig.add_subplot()
@@ -698,7 +703,7 @@ def _figure_specs(rep: Report) -> list:
             for k, f in enumerate(rep.fits):
                 plot_fit(f, ax=ax, unit=unit, tau=st.tau, points=False, terms=False,
                          color=f"C{k % 10}", label=f"{names[k]} fit", lw=1.0)
-        ax.set_title(f"Overlapping Allan deviation, {conf} intervals" + (" and fits" if rep.fits else ""))
+        ax.set_title(f"{static_word}, {conf} intervals" + (" and fits" if rep.fits else ""))
         fig.subplots_adjust(left=0.11, right=0.975, bottom=0.11, top=0.93)
 
     specs.append(("adev.png", "Allan deviation, all axes", f"Overlapping ADEV of every axis with its {conf} "
@@ -708,7 +713,7 @@ def _figure_specs(rep: Report) -> list:
         axs = fig.subplots(rep.n_axes, 1, squeeze=False)
         for k in range(rep.n_axes):
             plot_davar(dy, ax=axs[k, 0], axis=k, unit=unit)
-            axs[k, 0].set_title(f"Dynamic Allan deviation, {names[k]}")
+            axs[k, 0].set_title(f"{dynamic_word}, {names[k]}")
         fig.subplots_adjust(left=0.1, right=1.0, bottom=0.45 / fig.get_figheight(), top=1 - 0.35 / fig.get_figheight(),
                             hspace=0.55)
 
@@ -721,19 +726,19 @@ def _figure_specs(rep: Report) -> list:
             plot_adev(st, ax=ax, unit=unit, labels=names, axis=k)
             if rep.fits is not None:
                 plot_fit(rep.fits[k], ax=ax, unit=unit, tau=st.tau, points=False, color="k")
-            ax.set_title(f"{names[k]}: Allan deviation" + (" and noise model" if rep.fits else ""))
+            ax.set_title(f"{names[k]}: {static_lower}" + (" and noise model" if rep.fits else ""))
             fig.subplots_adjust(left=0.11, right=0.975, bottom=0.11, top=0.93)
 
         def davar_k(fig, k=k):
             ax = fig.add_subplot()
             plot_davar(dy, ax=ax, axis=k, unit=unit)
-            ax.set_title(f"{names[k]}: dynamic Allan deviation (window {dy.window / rep.fs:g} s)")
+            ax.set_title(f"{names[k]}: {dynamic_lower} (window {dy.window / rep.fs:g} s)")
             fig.subplots_adjust(left=0.1, right=1.0, bottom=0.12, top=0.92)
 
         def davar3d_k(fig, k=k):
             ax = fig.add_subplot(projection="3d")
             plot_davar3d(dy, ax=ax, axis=k, unit=unit)
-            ax.set_title(f"{names[k]}: dynamic Allan deviation")
+            ax.set_title(f"{names[k]}: {dynamic_lower}")
             fig.subplots_adjust(left=0.0, right=0.95, bottom=0.05, top=0.95)
 
         specs.append((f"adev_axis{k}.png", f"{names[k]}: Allan deviation",
