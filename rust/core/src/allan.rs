@@ -577,9 +577,8 @@ pub struct Request<'a> {
     pub method: Method,
 }
 
-/// Checks a request; the messages name the value and what is allowed.
-pub fn validate(req: &Request) -> Result<usize> {
-    let cols = req.columns;
+/// At least one axis, all the same length, at least 2 samples: the record length.
+pub(crate) fn check_shape(cols: &[&[f64]]) -> Result<usize> {
     if cols.is_empty() {
         return Err(CoreError::InvalidParameter(
             "no axes given: at least one record is needed".into(),
@@ -599,6 +598,26 @@ pub fn validate(req: &Request) -> Result<usize> {
             got: n,
         });
     }
+    Ok(n)
+}
+
+/// The first NaN or ±inf of any axis, as an error naming it.
+pub(crate) fn check_finite(cols: &[&[f64]]) -> Result<()> {
+    for (a, c) in cols.iter().enumerate() {
+        if let Some(i) = c.iter().position(|v| !v.is_finite()) {
+            return Err(CoreError::NonFinite {
+                axis: a,
+                index: i,
+                value: c[i],
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks a request; the messages name the value and what is allowed.
+pub fn validate(req: &Request) -> Result<usize> {
+    let n = check_shape(req.columns)?;
     if req.window < 2 || req.window > n {
         return Err(CoreError::InvalidParameter(format!(
             "window ({} samples) must be between 2 and the record length ({n} samples)",
@@ -622,15 +641,7 @@ pub fn validate(req: &Request) -> Result<usize> {
             req.window
         )));
     }
-    for (a, c) in cols.iter().enumerate() {
-        if let Some(i) = c.iter().position(|v| !v.is_finite()) {
-            return Err(CoreError::NonFinite {
-                axis: a,
-                index: i,
-                value: c[i],
-            });
-        }
-    }
+    check_finite(req.columns)?;
     Ok(n_windows(n, req.window, req.hop))
 }
 

@@ -31,7 +31,9 @@
 //! hop, and exactly the per-window double sum up to rounding. Theo1 is invariant to the window's own
 //! mean and slope, so one record-wide mean serves every window.
 
-use crate::allan::{compensated_mean, sliding_sums, sum4, TermScratch, DIRECT_M};
+use crate::allan::{
+    check_finite, check_shape, compensated_mean, sliding_sums, sum4, TermScratch, DIRECT_M,
+};
 use crate::error::{CoreError, Result};
 use rayon::prelude::*;
 
@@ -52,34 +54,8 @@ fn check_ms(n_rate: usize, ms: &[usize], what: &str) -> Result<()> {
 }
 
 fn check_columns(columns: &[&[f64]]) -> Result<usize> {
-    if columns.is_empty() {
-        return Err(CoreError::InvalidParameter(
-            "no axes given: at least one record is needed".into(),
-        ));
-    }
-    let n = columns[0].len();
-    if let Some((a, c)) = columns.iter().enumerate().find(|(_, c)| c.len() != n) {
-        return Err(CoreError::InvalidParameter(format!(
-            "axis {a} has {} samples but axis 0 has {n}; all axes must have the same length",
-            c.len()
-        )));
-    }
-    if n < 2 {
-        return Err(CoreError::TooShort {
-            what: "record",
-            needed: 2,
-            got: n,
-        });
-    }
-    for (a, c) in columns.iter().enumerate() {
-        if let Some(i) = c.iter().position(|v| !v.is_finite()) {
-            return Err(CoreError::NonFinite {
-                axis: a,
-                index: i,
-                value: c[i],
-            });
-        }
-    }
+    let n = check_shape(columns)?;
+    check_finite(columns)?;
     Ok(n)
 }
 

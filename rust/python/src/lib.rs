@@ -66,13 +66,7 @@ fn davar<'py>(
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let estimator = parse_estimator(py, estimator)?;
     let method = parse_method(py, method)?;
-    let mut slices: Vec<&[f64]> = Vec::with_capacity(columns.len());
-    for (a, c) in columns.iter().enumerate() {
-        let s = c.as_slice().map_err(|_| {
-            allanite_error(py, format!("axis {a} is not a contiguous float64 array"))
-        })?;
-        slices.push(s);
-    }
+    let slices = contiguous(py, &columns)?;
     let req = Request {
         columns: &slices,
         window,
