@@ -5,7 +5,7 @@ import importlib
 
 import pytest
 
-MODULES = ["allanite.allan", "allanite.grid", "allanite.datasets", "allanite.simulate", "allanite.refine",
+MODULES = ["allanite.allan", "allanite.grid", "allanite.datasets", "allanite.simulate", "allanite.refine", "allanite.fit",
            "allanite.confidence"]
 
 

@@ -10,14 +10,16 @@ from allanite import ParameterError
 
 FS = 100.0
 # Each term dominates a stretch of τ on a 1e6-sample record: Q below ~0.1 s, N to ~10 s,
-# B to ~300 s, K beyond.
-TRUTH = dict(Q=3.5e-4, N=2e-3, B=1e-3, K=6e-5)
+# B to ~130 s, K beyond (1.9 decades). With K = 6e-5 (K only beyond 370 s) the record itself does not
+# hold K to 15 %: information_bound gives a median error ≥ 16.4 % for any unbiased estimator.
+TRUTH = dict(Q=3.5e-4, N=2e-3, B=1e-3, K=1e-4)
+SEEDS = range(12)
 
 
 @pytest.fixture(scope="module")
 def fits():
     out = []
-    for seed in range(8):
+    for seed in SEEDS:
         y = allanite.simulate(1_000_000, FS, seed=seed, **TRUTH)
         out.append(allanite.fit(allanite.avar(y, FS), terms=tuple(TRUTH), unit="deg/s"))
     return out
@@ -29,6 +31,40 @@ def test_recovers_the_terms_over_seeds(fits):
     for name, limit in limits.items():
         err = np.median([abs(f.coefficients[name].value / TRUTH[name] - 1) for f in fits])
         assert err <= limit, f"{name}: median relative error {err:.3f} > {limit}"
+
+
+def test_standard_errors_are_calibrated(fits):
+    # (θ̂ − θ)/SE over seeds and terms: mean square ≈ 1 when the reported covariance is right. The
+    # old independent-weights fit gave ~1.8 here (B and K intervals too narrow).
+    theta = np.array([TRUTH[t] ** 2 for t in TRUTH])
+    z = np.array([(f.theta - theta) / np.sqrt(np.diag(f.covariance)) for f in fits])
+    assert 0.5 <= np.mean(z**2) <= 1.8, np.mean(z**2, axis=0)
+    # and no standard error is far below what the record can hold (the Cramér–Rao bound)
+    bound = allanite.information_bound(1_000_000, FS, **TRUTH)
+    for k, t in enumerate(TRUTH):
+        rel_se = np.median([np.sqrt(f.covariance[k, k]) / (2 * f.theta[k]) for f in fits])
+        assert rel_se >= 0.9 * bound[t], (t, rel_se, bound[t])
+
+
+def test_information_bound():
+    # white noise alone: Var(θ̂)/θ² = 2/n, so the coefficient's relative SD is 1/√(2n)
+    assert allanite.information_bound(10_000, 10.0, N=0.3)["N"] == pytest.approx(1 / np.sqrt(20_000), rel=1e-3)
+    # a sampled random walk alone: its differences are white, same 1/√(2n) (one frequency fewer)
+    assert allanite.information_bound(10_000, 10.0, K=0.3)["K"] == pytest.approx(1 / np.sqrt(20_000), rel=2e-3)
+    # scale-free in the coefficients' common factor; longer records know more
+    a = allanite.information_bound(100_000, FS, **TRUTH)
+    b = allanite.information_bound(100_000, FS, **{k: 7 * v for k, v in TRUTH.items()})
+    assert all(a[t] == pytest.approx(b[t], rel=1e-9) for t in TRUTH)
+    c = allanite.information_bound(400_000, FS, **TRUTH)
+    assert all(c[t] < a[t] for t in TRUTH)
+    with pytest.raises(ParameterError, match="at least one nonzero"):
+        allanite.information_bound(1000, FS)
+    with pytest.raises(ParameterError, match="fs must be a positive"):
+        allanite.information_bound(1000, 0.0, N=1.0)
+    with pytest.raises(ParameterError, match="n must be a whole number"):
+        allanite.information_bound(2.5, FS, N=1.0)
+    with pytest.raises(ParameterError, match="K must be a finite number"):
+        allanite.information_bound(1000, FS, K=-1.0)
 
 
 def test_fit_quality_and_readoffs(fits):
@@ -83,6 +119,31 @@ def test_exp_and_octave_grids_agree_within_intervals():
     for name in ("N", "B"):
         ca, cb = a.coefficients[name], b.coefficients[name]
         assert cb.ci[0] <= ca.value <= cb.ci[1] or ca.ci[0] <= cb.value <= ca.ci[1]
+
+
+def test_dense_grid_fitted_whole_with_its_covariance():
+    # thin=False: every τ of the exp grid in the generalized least squares, correlation included —
+    # the same coefficients as the octave fit, within its intervals
+    y = allanite.simulate(200_000, FS, seed=5, N=2e-3, B=1e-3)
+    r = allanite.avar(y, FS, taus="exp")
+    full = allanite.fit(r, terms=("N", "B"), thin=False)
+    thin = allanite.fit(r, terms=("N", "B"))
+    assert full.tau.size == r.tau.size > 2 * thin.tau.size
+    for name in ("N", "B"):
+        lo, hi = thin.coefficients[name].ci
+        assert lo <= full.coefficients[name].value <= hi
+    # too many τ for the full covariance: a clear error, not minutes of work or a silent fallback
+    dense = allanite.avar(y[:3000], FS, taus="all")
+    with pytest.raises(ParameterError, match=r"1500 τ .* at most 160"):
+        allanite.fit(dense, thin=False)
+
+
+def test_a_bare_ramp_is_fitted():
+    # no stochastic term: the estimates have no sampling variance under the model; the fit falls back
+    # to the independent variance there and still finds R exactly
+    y = 1e-3 * np.arange(100_000) / FS
+    f = allanite.fit(allanite.avar(y, FS), terms=("R",))
+    assert f.coefficients["R"].value == pytest.approx(1e-3, rel=1e-9)
 
 
 def test_dynamic_result_gives_a_coefficient_series_that_sees_the_change():

@@ -10,7 +10,7 @@ from .allan import avar, davar
 from .confidence import chi2_interval, confidence_intervals, edf_greenhall, edf_sp1065, identify_alpha
 from .datasets import default_record
 from .errors import AllaniteError, InputError, MemoryBudgetError, ParameterError
-from .fit import CoefficientSeries, NoiseFit, fit
+from .fit import CoefficientSeries, NoiseFit, fit, information_bound
 from .grid import tau_grid
 from .io import Log, read_log
 from .refine import Refinement, refine
@@ -19,7 +19,7 @@ from .simulate import simulate
 
 __all__ = [
     "avar", "davar", "tau_grid", "default_record", "simulate",
-    "read_log", "Log", "fit", "NoiseFit", "CoefficientSeries", "refine", "Refinement",
+    "read_log", "Log", "fit", "information_bound", "NoiseFit", "CoefficientSeries", "refine", "Refinement",
     "confidence_intervals", "identify_alpha", "edf_greenhall", "edf_sp1065", "chi2_interval",
     "AllanResult", "DynamicAllanResult",
     "AllaniteError", "InputError", "ParameterError", "MemoryBudgetError",
