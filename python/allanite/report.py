@@ -967,7 +967,9 @@ def _html_page(rep: Report, images: dict) -> str:
                    "<code>allanite.refine</code> traced the residual to Gauss–Markov or sinusoid signatures in the "
                    "Allan curve, or to changes of level along the record (16 windows), and kept an effect only where it "
                    "earned its parameters (BIC on an effective χ²). Parameters: σ and amplitude in the rate unit, "
-                   "T<sub>c</sub> and t in s, f0 in Hz; intervals ~68 %.</p>")
+                   "T<sub>c</sub> and t in s, f0 in Hz; intervals ~68 %. Its χ²/dof weights each τ of a dense curve "
+                   "independently, so it is not the fit table's χ²/dof (which accounts for the correlation between "
+                   "τ).</p>")
         rows = []
         for ax in ref["axes"]:
             if ax.get("error"):
