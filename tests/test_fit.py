@@ -69,6 +69,7 @@ def test_information_bound():
 
 def test_fit_quality_and_readoffs(fits):
     for f in fits:
+        assert f.method == "gls"   # overlapping estimates: the exact covariance across τ
         assert 0.2 < f.chi2_dof < 3.0
         assert f.dof == f.tau.size - 4
         assert np.allclose(f.model, sum(f.components.values()))
@@ -136,6 +137,13 @@ def test_dense_grid_fitted_whole_with_its_covariance():
     dense = allanite.avar(y[:3000], FS, taus="all")
     with pytest.raises(ParameterError, match=r"1500 τ .* at most 160"):
         allanite.fit(dense, thin=False)
+
+
+def test_classic_estimates_keep_independent_weights():
+    y = allanite.simulate(200_000, FS, seed=6, N=2e-3, B=1e-3)
+    f = allanite.fit(allanite.avar(y, FS, estimator="avar"), terms=("N", "B"))
+    assert f.method == "wls" and "WLS" in repr(f)
+    assert f.coefficients["N"].value == pytest.approx(2e-3, rel=0.02)
 
 
 def test_a_bare_ramp_is_fitted():

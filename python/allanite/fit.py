@@ -106,6 +106,9 @@ class NoiseFit:
         σ(1 s)·√1 s), ``adev_min``, ``tau_at_min`` and ``bias_instability_readoff`` = min/0.664.
     confidence : float
         Level of the intervals.
+    method : str
+        ``"gls"`` — generalized least squares with the estimates' exact covariance across τ (overlapping
+        results); ``"wls"`` — independent weights with the octave-correlation sandwich (classic, Theo).
     """
 
     coefficients: dict
@@ -126,6 +129,7 @@ class NoiseFit:
     confidence: float
     unit: str | None = None
     iterations: int = 0
+    method: str = "wls"
     theta: np.ndarray = field(default=None)
     covariance: np.ndarray = field(default=None)
 
@@ -143,7 +147,7 @@ class NoiseFit:
         return design_matrix(tau, m, self.fs, (name,))[:, 0] * self.theta[k]
 
     def __repr__(self) -> str:
-        lines = [f"NoiseFit({len(self.tau)} τ, χ²/dof = {self.chi2_dof:.3g}, p = {self.p_value:.3g}, "
+        lines = [f"NoiseFit({len(self.tau)} τ, {self.method.upper()}, χ²/dof = {self.chi2_dof:.3g}, p = {self.p_value:.3g}, "
                  f"{self.confidence:.1%} intervals)"]
         lines += [f"  {c!r}" for c in self.coefficients.values()]
         return "\n".join(lines)
@@ -655,6 +659,8 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
         chi2_dof=chi2_dof, p_value=float(chi2_dist.sf(chi2, dof)),
         readoffs=_readoffs(result, np.sqrt(avar_row)), fs=result.fs, confidence=confidence, unit=unit,
         iterations=it, theta=theta, covariance=cov,
+        method="gls" if _exact_covariance_applies(tau, m, result.fs, result.n_samples + 1,
+                                                  _est_key(result, idx)) else "wls",
     )
 
 

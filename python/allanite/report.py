@@ -551,7 +551,7 @@ def _summary(rep: Report) -> dict:
             "axis": k, "name": rep.axis_names[k],
             "coefficients": {t: _coef_dict(f.coefficients[t], rep.unit, t) for t in f.terms},
             "chi2": _num(f.chi2), "dof": int(f.dof), "chi2_dof": _num(f.chi2_dof), "p_value": _num(f.p_value),
-            "tau_s": _list(f.tau), "iterations": int(f.iterations),
+            "tau_s": _list(f.tau), "iterations": int(f.iterations), "method": f.method,
             "readoffs": _readoffs(f, rep.unit, au),
         } for k, f in enumerate(rep.fits)]
     if rep.fit_requested:
