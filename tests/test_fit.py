@@ -146,6 +146,48 @@ def test_classic_estimates_keep_independent_weights():
     assert f.coefficients["N"].value == pytest.approx(2e-3, rel=0.02)
 
 
+@pytest.fixture(scope="module")
+def filtered_record():
+    # a 4-tap moving average, like a sensor's anti-alias filter: the first octaves fall below the N line
+    y = allanite.simulate(1_000_000, FS, N=2e-3, B=1e-3, K=6e-5, seed=21)
+    return np.convolve(y, np.ones(4) / 4, mode="same")
+
+
+def test_tau_range_auto_drops_the_filtered_short_tau(filtered_record):
+    r = allanite.avar(filtered_record, FS)
+    terms = ("N", "B", "K")
+    whole = allanite.fit(r, terms=terms)
+    auto = allanite.fit(r, terms=terms, tau_range="auto")
+    # all τ: the model cannot describe the filtered octaves, which are the most precise — N is lost
+    # and B absorbs the misfit
+    assert whole.chi2_dof > 100 and "do not describe the estimates" in whole.notes[0]
+    assert whole.coefficients["B"].value > 3e-3
+    # auto: the shortest τ are dropped an octave at a time until the model fits, and it says so
+    assert 0.04 <= auto.tau[0] <= 64 / FS and auto.chi2_dof <= 3.0
+    assert auto.coefficients["N"].value == pytest.approx(2e-3, rel=0.05)
+    assert auto.coefficients["B"].value == pytest.approx(1e-3, rel=0.25)
+    assert len(auto.notes) == 1 and f"τ ≥ {auto.tau[0]:.4g} s" in auto.notes[0] and "1.01e+04" in auto.notes[0]
+    # the same cut by hand gives the same fit
+    hand = allanite.fit(r, terms=terms, tau_range=(auto.tau[0], None))
+    assert hand.coefficients["N"].value == auto.coefficients["N"].value
+
+
+def test_tau_range_auto_keeps_everything_when_the_model_fits(fits):
+    y = allanite.simulate(1_000_000, FS, seed=SEEDS[0], **TRUTH)
+    auto = allanite.fit(allanite.avar(y, FS), terms=tuple(TRUTH), unit="deg/s", tau_range="auto")
+    assert auto.notes == () and auto.tau[0] == fits[0].tau[0]
+    assert auto.coefficients["Q"].value == fits[0].coefficients["Q"].value
+
+
+def test_tau_range_auto_on_a_dynamic_result(filtered_record):
+    d = allanite.davar(filtered_record, FS, window=100_000, hop=50_000)
+    s = allanite.fit(d, terms=("N", "B", "K"), tau_range="auto")
+    assert len(s.notes) == 1 and "tau_range='auto'" in s.notes[0]
+    assert np.median(s.values["N"]) == pytest.approx(2e-3, rel=0.06)
+    with pytest.raises(ParameterError, match="tau_range must be a .* or 'auto'"):
+        allanite.fit(d, tau_range="automatic")
+
+
 def test_a_bare_ramp_is_fitted():
     # no stochastic term: the estimates have no sampling variance under the model; the fit falls back
     # to the independent variance there and still finds R exactly

@@ -105,11 +105,12 @@ def _json_floats(v):
 
 
 def check_fit_matches(summary, static, unit):
-    """summary.json's whole-record coefficients are allanite.fit's, in base and IEEE-952 units."""
-    fits = allanite.fit(static, unit=unit)
+    """summary.json's whole-record coefficients are allanite.fit's (tau_range="auto"), in base and IEEE-952 units."""
+    fits = allanite.fit(static, unit=unit, tau_range="auto")
     assert summary["fit"]["terms"] == list(fits[0].terms)
     for ax, f in zip(summary["fit"]["axes"], fits):
         assert ax["chi2_dof"] == pytest.approx(f.chi2_dof, rel=1e-12)
+        assert ax["notes"] == list(f.notes) and ax["method"] == f.method
         assert ax["dof"] == f.dof
         np.testing.assert_allclose(ax["tau_s"], f.tau, rtol=1e-15)
         for t, c in f.coefficients.items():
@@ -127,8 +128,12 @@ def check_fit_matches(summary, static, unit):
     return fits
 
 
-def check_series_matches(summary, dynamic, unit):
-    series = allanite.fit(dynamic, unit=unit)
+def check_series_matches(summary, dynamic, unit, fits):
+    """The coefficient series are allanite.fit's per axis, on the τ range of that axis's whole-record fit."""
+    import dataclasses
+
+    series = [allanite.fit(dataclasses.replace(dynamic, avar=row), unit=unit, tau_range=(f.tau[0] * (1 - 1e-9), None))
+              for row, f in zip(dynamic.avar, fits)]
     ser = summary["fit"]["series"]
     assert ser["terms"] == list(series[0].terms)
     for ax, s in zip(ser["axes"], series):
@@ -228,8 +233,8 @@ def test_bundled_report_summary_matches_the_library(bundled):
         assert 3.5 < ax["max_over_min"] < 4.5
         np.testing.assert_allclose(ax["adev_max_over_time"], d.adev[k].max(axis=1), rtol=1e-15)
 
-    check_fit_matches(summary, r, "deg/s")
-    check_series_matches(summary, d, "deg/s")
+    fits = check_fit_matches(summary, r, "deg/s")
+    check_series_matches(summary, d, "deg/s", fits)
     # the N time series sees the loud stretch too: 4× the quiet value in its middle
     n_series = summary["fit"]["series"]["axes"][0]["coefficients"]["N"]
     t = np.array(summary["fit"]["series"]["axes"][0]["t_s"])
@@ -305,11 +310,16 @@ def test_adis_report_end_to_end(adis):
 
     d = allanite.davar(x, 100.0, window=summary["dynamic"]["window_samples"], hop=summary["dynamic"]["hop_samples"])
     np.testing.assert_array_equal(summary["dynamic"]["t_s"], d.t)
-    check_fit_matches(summary, r, "deg/s")
-    check_series_matches(summary, d, "deg/s")
-    # ARW of the ADIS16405: its datasheet says 2 °/√h; the fit is in that range on every axis
+    fits = check_fit_matches(summary, r, "deg/s")
+    check_series_matches(summary, d, "deg/s", fits)
+    # ARW of the ADIS16405: its datasheet says 2 °/√h; the fit is in that range on every axis, and B near the
+    # ADEV minimum / 0.664 — because the report drops the filtered shortest τ (and says so): with them the
+    # model gives χ²/dof > 1000 and B of ~200 °/h
     for ax in summary["fit"]["axes"]:
-        assert 1.5 < ax["coefficients"]["N"]["ieee"] < 3.5
+        assert 2.2 < ax["coefficients"]["N"]["ieee"] < 2.7
+        assert 20 < ax["coefficients"]["B"]["ieee"] < 45
+        assert ax["tau_s"][0] == pytest.approx(0.16) and "tau_range='auto'" in ax["notes"][0]
+    assert sum("tau_range='auto'" in n for n in summary["notes"]) == 3
     for name in ADIS_COLUMNS:
         assert name in stdout
 

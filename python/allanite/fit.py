@@ -106,6 +106,8 @@ class NoiseFit:
         σ(1 s)·√1 s), ``adev_min``, ``tau_at_min`` and ``bias_instability_readoff`` = min/0.664.
     confidence : float
         Level of the intervals.
+    notes : tuple of str
+        What the fit decided on its own (e.g. the τ range chosen by ``tau_range="auto"``).
     method : str
         ``"gls"`` — generalized least squares with the estimates' exact covariance across τ (overlapping
         results); ``"wls"`` — independent weights with the octave-correlation sandwich (classic, Theo).
@@ -130,6 +132,7 @@ class NoiseFit:
     unit: str | None = None
     iterations: int = 0
     method: str = "wls"
+    notes: tuple = ()
     theta: np.ndarray = field(default=None)
     covariance: np.ndarray = field(default=None)
 
@@ -150,6 +153,7 @@ class NoiseFit:
         lines = [f"NoiseFit({len(self.tau)} τ, {self.method.upper()}, χ²/dof = {self.chi2_dof:.3g}, p = {self.p_value:.3g}, "
                  f"{self.confidence:.1%} intervals)"]
         lines += [f"  {c!r}" for c in self.coefficients.values()]
+        lines += [f"  note: {n}" for n in self.notes]
         return "\n".join(lines)
 
     def plot(self, ax=None, **kwargs):
@@ -164,7 +168,8 @@ class CoefficientSeries:
     """Coefficients fitted in every window of a dynamic result (paper 002's 2-D representation).
 
     ``values``, ``ci_low``, ``ci_high`` map term → array over ``t`` (input unit's base form);
-    ``ieee`` maps term → array in IEEE-952 units (``ieee_units``) when the unit is known.
+    ``ieee`` maps term → array in IEEE-952 units (``ieee_units``) when the unit is known;
+    ``notes`` says what the fit decided on its own (the τ cut of ``tau_range="auto"``).
     """
 
     t: np.ndarray
@@ -177,6 +182,7 @@ class CoefficientSeries:
     unit: str | None = None
     ieee: dict | None = None
     ieee_units: dict | None = None
+    notes: tuple = ()
 
     def __repr__(self) -> str:
         parts = ", ".join(f"{k} median {np.median(v):.3g}" for k, v in self.values.items())
@@ -537,10 +543,14 @@ def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool
     thin : bool
         Use only τ at least an octave apart (default), so correlated neighbours do not overcount
         information; ``False`` uses every τ of the result.
-    tau_range : (float, float), optional
+    tau_range : (float, float) or "auto", optional
         Fit only τ in [low, high] seconds (either may be None). Real sensors are often not white
         at the shortest τ (anti-alias filters, vibration lines): those points carry the largest
-        EDF and can dominate a fit of a model that does not describe them.
+        EDF and can dominate a fit of a model that does not describe them. ``"auto"``: fit all τ,
+        and if the model does not describe them (χ²/dof > ``AUTO_CHI2_DOF``), drop the shortest τ
+        an octave at a time — up to τ = ``AUTO_MAX_CUT_M`` samples — until it does (or take the cut
+        with the lowest χ²/dof); the choice is stated in ``NoiseFit.notes``. For a dynamic result
+        the cut is chosen on the windows' median curve and applied to every window.
     max_iter : int
         Reweighting iterations at most.
 
@@ -574,21 +584,110 @@ def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool
     """
     terms = _check_terms(terms)
     zq = _zq(confidence)
-    tau_range = _check_tau_range(tau_range)
+    auto = isinstance(tau_range, str)
+    if auto and tau_range != "auto":
+        raise ParameterError(f"tau_range must be a (low, high) pair of seconds or 'auto', got {tau_range!r}")
+    tau_range = (0.0, np.inf) if auto else _check_tau_range(tau_range)
     if unit is not None:
         from .units import rate_unit
 
         rate_unit(unit)
     if isinstance(result, DynamicAllanResult):
         _check_fit_estimator(result)
+        if auto:
+            return _fit_dynamic_auto(result, terms, unit, float(confidence), zq, thin, max_iter)
         return _fit_dynamic(result, terms, unit, float(confidence), zq, thin, max_iter, tau_range)
     if not isinstance(result, AllanResult):
         raise ParameterError(f"fit needs an AllanResult or DynamicAllanResult, got {type(result).__name__}")
     _check_fit_estimator(result)
+    one = _fit_static_auto if auto else _fit_static_row
+    args = (terms, unit, float(confidence), zq, thin, max_iter) + (() if auto else (tau_range,))
     if result.avar.ndim == 2:
-        return [_fit_static_row(result, row, terms, unit, float(confidence), zq, thin, max_iter, tau_range)
-                for row in result.avar]
-    return _fit_static_row(result, result.avar, terms, unit, float(confidence), zq, thin, max_iter, tau_range)
+        return [one(result, row, *args) for row in result.avar]
+    return one(result, result.avar, *args)
+
+
+#: A fit this much worse than its noise says so in ``NoiseFit.notes``.
+MISFIT_CHI2_DOF = 10.0
+
+#: ``tau_range="auto"`` accepts the first lower τ cut at which the model fits this well ...
+AUTO_CHI2_DOF = 3.0
+#: ... and cuts at most the τ up to this many samples (anti-alias filters and correlated sampling
+#: colour the first few octaves; a misfit further out is the model's, not the front end's).
+AUTO_MAX_CUT_M = 64
+
+
+def _auto_cuts(result, avar_row, thin, n_terms):
+    """Lower τ cuts to try: none, then each fitted τ in turn (an octave at a time) up to AUTO_MAX_CUT_M samples,
+    keeping at least n_terms + 3 τ."""
+    idx = _select(result.tau, avar_row, thin, n_terms, "the result")
+    tau, m = result.tau[idx], result.m[idx]
+    cuts = [0.0]
+    for k in range(1, tau.size):
+        if m[k] > AUTO_MAX_CUT_M or tau.size - k < n_terms + 3:
+            break
+        cuts.append(float(tau[k]) * (1.0 - 1e-9))
+    return cuts, float(tau[0])
+
+
+def _auto_choose(cuts, fit_at):
+    """The first cut whose fit has χ²/dof ≤ AUTO_CHI2_DOF, else the lowest χ²/dof; (cut, fit, uncut fit)."""
+    first = best = None
+    for cut in cuts:
+        f = fit_at(cut)
+        if first is None:
+            first = f
+        if best is None or f[1] < best[1][1]:
+            best = (cut, f)
+        if f[1] <= AUTO_CHI2_DOF:
+            return cut, f, first, True
+    return best[0], best[1], first, False
+
+
+def _auto_note(cut, chi2_dof, first_chi2_dof, tau0, ok):
+    if cut == 0.0:
+        return () if ok else (f"tau_range='auto': no cut of the shortest τ (up to {AUTO_MAX_CUT_M} samples) brought "
+                              f"χ²/dof to ≤ {AUTO_CHI2_DOF:g}; all τ kept (χ²/dof {chi2_dof:.3g})",)
+    what = "" if ok else f" (the lowest χ²/dof of the cuts up to {AUTO_MAX_CUT_M} samples; none reached ≤ {AUTO_CHI2_DOF:g})"
+    return (f"fitted from τ ≥ {cut * (1 + 1e-9):.4g} s (tau_range='auto'){what}: with all τ from {tau0:.4g} s the "
+            f"model gave χ²/dof {first_chi2_dof:.3g}, here {chi2_dof:.3g} — the shortest τ are not described by these "
+            f"terms (anti-alias filtering, vibration lines or correlated samples are the usual causes)",)
+
+
+def _fit_static_auto(result, avar_row, terms, unit, confidence, zq, thin, max_iter):
+    import dataclasses
+
+    avar_row = np.asarray(avar_row, dtype=np.float64)
+    cuts, tau0 = _auto_cuts(result, avar_row, thin, len(terms))
+
+    def fit_at(cut):
+        f = _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_iter, (cut, np.inf))
+        return f, f.chi2_dof
+
+    cut, (f, chi), (_, chi0), ok = _auto_choose(cuts, fit_at)
+    return dataclasses.replace(f, notes=_auto_note(cut, chi, chi0, tau0, ok) + f.notes)
+
+
+def _fit_dynamic_auto(result, terms, unit, confidence, zq, thin, max_iter):
+    import dataclasses
+
+    rows = [result.avar] if result.avar.ndim == 2 else list(result.avar)
+    out = []
+    for rows_avar in rows:
+        med = np.median(rows_avar, axis=1)
+        stat = AllanResult(tau=result.tau, avar=med, n=result.n, m=result.m, estimator=result.estimator,
+                           fs=result.fs, n_samples=result.window, input=result.input, source=result.source)
+        cuts, tau0 = _auto_cuts(stat, med, thin, len(terms))
+
+        def fit_at(cut):
+            f = _fit_static_row(stat, med, terms, unit, confidence, zq, thin, max_iter, (cut, np.inf))
+            return f, f.chi2_dof
+
+        cut, (_, chi), (_, chi0), ok = _auto_choose(cuts, fit_at)
+        single = dataclasses.replace(result, avar=rows_avar)
+        s = _fit_dynamic(single, terms, unit, confidence, zq, thin, max_iter, (cut, np.inf))
+        out.append(dataclasses.replace(s, notes=_auto_note(cut, chi, chi0, tau0, ok)))
+    return out[0] if result.avar.ndim == 2 else out
 
 
 #: Estimators whose values estimate the Allan variance (raw Theo1 does not: it is biased by a
@@ -653,12 +752,17 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
     chi2_dof = chi2 / dof
     inflate = max(1.0, math.sqrt(chi2_dof))
     coeffs = _coefficients(terms, theta, cov, zq, inflate, unit)
+    notes = ()
+    if chi2_dof > MISFIT_CHI2_DOF:
+        notes = (f"χ²/dof {chi2_dof:.3g}: these terms do not describe the estimates (intervals widened by "
+                 f"√(χ²/dof) = {inflate:.3g}); look at z, restrict tau_range, or use tau_range='auto' when the "
+                 f"misfit is at the shortest τ",)
     return NoiseFit(
         coefficients=coeffs, terms=terms, tau=tau, m=m, avar=y, edf=nu, model=model,
         components={t: a[:, k] * theta[k] for k, t in enumerate(terms)}, z=z, chi2=chi2, dof=dof,
         chi2_dof=chi2_dof, p_value=float(chi2_dist.sf(chi2, dof)),
         readoffs=_readoffs(result, np.sqrt(avar_row)), fs=result.fs, confidence=confidence, unit=unit,
-        iterations=it, theta=theta, covariance=cov,
+        iterations=it, theta=theta, covariance=cov, notes=notes,
         method="gls" if _exact_covariance_applies(tau, m, result.fs, result.n_samples + 1,
                                                   _est_key(result, idx)) else "wls",
     )

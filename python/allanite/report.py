@@ -338,13 +338,30 @@ def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, sour
 
         progress.step("noise-model fit")
         try:
-            fits = fit_model(static, unit=unit_name, confidence=confidence)
+            # tau_range="auto": a real sensor's shortest τ (anti-alias filter, vibration lines) are often not
+            # the model's; they would dominate the fit and give wrong coefficients. The cut is stated.
+            fits = fit_model(static, unit=unit_name, confidence=confidence, tau_range="auto")
+            if not isinstance(fits, list):
+                fits = [fits]
+            for k, f in enumerate(fits):
+                notes.extend(f"{axis_names[k]}: {note}." for note in f.notes)
         except AllaniteError as exc:
             fit_error = str(exc)
             notes.append(f"The noise model could not be fitted to the whole record: {exc}")
         progress.step("noise-model fit over time")
         try:
-            series = fit_model(dynamic, unit=unit_name, confidence=confidence)
+            # the windows use the same τ range as the whole-record fit of their axis
+            if fits is not None:
+                import dataclasses
+
+                per_axis = [dynamic.avar] if dynamic.avar.ndim == 2 else list(dynamic.avar)
+                series = [fit_model(dataclasses.replace(dynamic, avar=row), unit=unit_name, confidence=confidence,
+                                    tau_range=(float(f.tau[0]) * (1 - 1e-9), None))
+                          for row, f in zip(per_axis, fits)]
+                if dynamic.avar.ndim == 2:
+                    series = series[0]
+            else:
+                series = fit_model(dynamic, unit=unit_name, confidence=confidence, tau_range="auto")
         except AllaniteError as exc:
             series_error = str(exc)
             notes.append(f"The coefficients over time could not be fitted (DAVAR window of {dynamic.window} "
@@ -551,7 +568,7 @@ def _summary(rep: Report) -> dict:
             "axis": k, "name": rep.axis_names[k],
             "coefficients": {t: _coef_dict(f.coefficients[t], rep.unit, t) for t in f.terms},
             "chi2": _num(f.chi2), "dof": int(f.dof), "chi2_dof": _num(f.chi2_dof), "p_value": _num(f.p_value),
-            "tau_s": _list(f.tau), "iterations": int(f.iterations), "method": f.method,
+            "tau_s": _list(f.tau), "iterations": int(f.iterations), "method": f.method, "notes": list(f.notes),
             "readoffs": _readoffs(f, rep.unit, au),
         } for k, f in enumerate(rep.fits)]
     if rep.fit_requested:
