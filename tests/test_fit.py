@@ -188,6 +188,18 @@ def test_tau_range_auto_on_a_dynamic_result(filtered_record):
         allanite.fit(d, tau_range="automatic")
 
 
+def test_flat_stretches():
+    # a constant record has nothing to fit: say so
+    with pytest.raises(ParameterError, match="zero at every τ .* no noise to fit"):
+        allanite.fit(allanite.avar(np.ones(1000), FS))
+    # a flat first window (sensor not yet streaming) must not decide the τ of every window
+    y = allanite.simulate(200_000, FS, N=1e-3, B=2e-4, seed=3)
+    y[:20_000] = 0.0
+    s = allanite.fit(allanite.davar(y, FS, window=20_000, hop=10_000), terms=("N", "B"))
+    assert s.values["N"][0] == 0.0 and s.ci_high["N"][0] == 0.0
+    assert np.median(s.values["N"]) == pytest.approx(1e-3, rel=0.02)
+
+
 def test_a_bare_ramp_is_fitted():
     # no stochastic term: the estimates have no sampling variance under the model; the fit falls back
     # to the independent variance there and still finds R exactly

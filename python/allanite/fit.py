@@ -729,6 +729,9 @@ def _select(tau, avar, thin, n_terms, what, tau_range=(0.0, np.inf)):
     inside = np.flatnonzero((tau >= tau_range[0]) & (tau <= tau_range[1]))
     if inside.size == 0:
         raise ParameterError(f"no τ of {what} lies in tau_range {tau_range} s (τ spans {tau[0]:g}–{tau[-1]:g} s)")
+    if not np.any(avar[inside] > 0):
+        raise ParameterError(f"{what} has an Allan variance of zero at every τ in range (a constant record?): "
+                             f"there is no noise to fit")
     idx = inside[_octave_thin(tau[inside])] if thin else inside
     idx = idx[avar[idx] > 0]
     if idx.size <= n_terms:
@@ -772,7 +775,8 @@ def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range)
     rows = [result.avar] if result.avar.ndim == 2 else list(result.avar)
     series = []
     for rows_avar in rows:
-        idx = _select(result.tau, rows_avar[:, 0], thin, len(terms), "the dynamic result", tau_range)
+        # τ chosen on the windows' median curve: one flat window must not decide for all of them
+        idx = _select(result.tau, np.median(rows_avar, axis=1), thin, len(terms), "the dynamic result", tau_range)
         tau, m = result.tau[idx], result.m[idx].astype(np.float64)
         cache = {}
         n_t = rows_avar.shape[1]
