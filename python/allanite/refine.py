@@ -24,7 +24,8 @@ profile of χ² (Δχ²_eff = 1). A candidate is accepted only if it earns its p
 *effective* χ²: the τ estimates are correlated, so χ² is scaled by n_eff/n with n_eff the number of
 octaves the curve spans (``fit`` thins to octaves for the same reason), and the penalty is
 k·ln(n_eff) per added parameter pair, plus a floor so that chance wiggles on a clean record are not
-modelled (calibrated on clean simulated records: ≤ 5 % false alarms, see ``tests/test_refine.py``).
+modelled (calibrated on clean simulated records: ≤ 5 % false alarms, see ``tests/test_refine.py``); the
+effect must also lower χ²/dof.
 The loop stops when χ²/dof ≤ 1.5 or no candidate earns its parameters.
 """
 
@@ -622,7 +623,9 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
             considered.setdefault(cand, []).append({"param": p, "gain_chi2_eff": float(gain), "penalty": penalty})
             # a parameter pinned at its search range's edge is not identified by the curve
             at_edge = p <= grid[0] * 1.02 or p >= grid[-1] / 1.02
-            if (gain > penalty and s_new.theta[-1] > 0 and not at_edge
+            # ... and an effect must make the fit better per degree of freedom, not only in total (on a grossly
+            # wrong model a χ² drop can pass the BIC test while χ²/dof rises)
+            if (gain > penalty and s_new.theta[-1] > 0 and not at_edge and s_new.chi2_dof < sol.chi2_dof
                     and (best is None or gain > best[0])):
                 best = (gain, cand, p, s_new, prof)
         if best is None:
