@@ -102,3 +102,39 @@ def test_blocks_are_cached_and_read_only():
     assert a[0] is b[0]
     with pytest.raises(ValueError):
         a[0][0, 0, 0, 0] = 1.0
+
+
+def _flicker_cross_exact(d, mi, mj):
+    """r_ij(d) of the flicker kernel in 50-digit decimal arithmetic (no cancellation)."""
+    from decimal import Decimal, getcontext
+
+    getcontext().prec = 50
+    acc = Decimal(0)
+    for a, la in enumerate((1, -2, 1)):
+        for b, lb in enumerate((1, -2, 1)):
+            h = Decimal(d + b * mj - a * mi)
+            if h != 0:
+                acc += la * lb * h * h * abs(h).ln()
+    return float(acc / (2 * Decimal(str(np.pi)) * mi * mj))
+
+
+@pytest.mark.parametrize("mi, mj", [(1, 1), (1, 4), (64, 1024)])
+def test_flicker_tail_keeps_its_precision_far_out(mi, mj):
+    from allanite._covariance import _cross
+
+    d = np.array([0.0, 3.0, 40.0, 1e3, 1e5, -1e7, 1e8])
+    got = _cross(d, mi, mj, 1.0)[2]
+    want = np.array([_flicker_cross_exact(int(v), mi, mj) for v in d])
+    np.testing.assert_allclose(got, want, rtol=1e-9)
+    # the finite-support kernels are exactly zero beyond the shared samples (not rounding noise)
+    far = _cross(np.array([1e8]), mi, mj, 1.0)
+    assert far[0, 0] == far[1, 0] == far[3, 0] == 0.0
+
+
+def test_flicker_variance_scales_as_one_over_n_up_to_1e8():
+    # at m = 1 flicker's estimate variance is ∝ 1/M: n·Var must not drift with the record length (the
+    # nine-term sum of h²·ln|h| used to cancel catastrophically: 10⁴× too large at n = 10⁸)
+    from allanite._covariance import _blocks
+
+    scaled = [n * _blocks(np.array([1, 2, 4]), n, 1.0, ("B",))[0][0, 0, 0, 0] for n in (10**4, 10**6, 10**8)]
+    assert scaled[1] == pytest.approx(scaled[0], rel=1e-3) and scaled[2] == pytest.approx(scaled[0], rel=1e-3)

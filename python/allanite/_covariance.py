@@ -53,12 +53,36 @@ def _kernels(h: np.ndarray, tau0: float) -> np.ndarray:
 
 
 def _cross(d: np.ndarray, mi: int, mj: int, tau0: float) -> np.ndarray:
-    """r_ij(d) per unit squared coefficient of each kernel term: shape (4, d.size)."""
+    """r_ij(d) per unit squared coefficient of each kernel term: shape (4, d.size).
+
+    Outside [−2m_j, 2m_i] the two second differences share no sample: the Q, N and K kernels (δ, |h|,
+    |h|³) give exactly zero there — set so, rather than computed as a difference of huge numbers. The
+    flicker kernel has a tail; far out (|d| ≥ 4 × the offsets' span) it is summed as its Taylor series
+    Σ_k G⁽ᵏ⁾(d)·S_k/k! with S_k = Σλ_aλ_b·o_ab^k (S_k = 0 for k < 4), which keeps full precision where
+    the nine-term sum of h²·ln|h| would cancel catastrophically (10⁸-sample records)."""
     lam = (1.0, -2.0, 1.0)
+    offsets = [(lam[a] * lam[b], float(b * mj - a * mi)) for a in range(3) for b in range(3)]
     acc = np.zeros((4, d.size))
-    for a in range(3):
-        for b in range(3):
-            acc += lam[a] * lam[b] * _kernels(d + b * mj - a * mi, tau0)
+    far = np.abs(d) >= 4.0 * (2 * mi + 2 * mj)
+    near = ~far
+    dn = d[near]
+    for w, o in offsets:
+        acc[:, near] += w * _kernels(dn + o, tau0)
+    outside = (d > 2 * mi) | (d < -2 * mj)
+    acc[0, outside] = acc[1, outside] = acc[3, outside] = 0.0
+    if far.any():
+        # G(h) = h²ln|h| (times τ0²/2π): G⁽ᵏ⁾(h) = 2(−1)^(k−1)(k−3)!/h^(k−2) for h > 0, k ≥ 3; G is even.
+        df = d[far]
+        ad = np.abs(df)
+        sgn = np.sign(df)
+        total = np.zeros(df.size)
+        for k in range(4, 17):
+            s_k = sum(w * o**k for w, o in offsets)
+            if s_k == 0.0:
+                continue
+            g_k = 2.0 * (-1.0) ** (k - 1) * math.factorial(k - 3) / ad ** (k - 2) * sgn**k
+            total += g_k * (s_k / math.factorial(k))
+        acc[2, far] = total * (tau0 * tau0 / (2.0 * math.pi))
     return acc / (mi * mj * tau0 * tau0)
 
 
