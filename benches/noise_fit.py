@@ -79,7 +79,7 @@ from pathlib import Path
 import numpy as np
 
 import allanite
-from allanite.fit import MAX_GLS_TAU, TERMS
+from allanite.model.fitting import MAX_GLS_TAU, TERMS
 from allanite.results import AllanResult
 
 HERE = Path(__file__).resolve().parent
@@ -215,7 +215,7 @@ def recovery(set_name: str, n_seeds: int, n_samples: int, log) -> dict:
 
 def covariance_check(rows, result, truth, terms) -> dict:
     """The model covariance of the octave estimates (what fit uses) against their scatter over the seeds."""
-    from allanite._covariance import assemble, covariance_blocks
+    from allanite.model._covariance import assemble, covariance_blocks
 
     est = np.array([row["octave_avar"] for row in rows])
     for row in rows:
@@ -232,7 +232,7 @@ def covariance_check(rows, result, truth, terms) -> dict:
 
 
 def _blocks_cache_clear():
-    from allanite import _covariance
+    from allanite.model import _covariance
 
     _covariance._blocks_cached.cache_clear()
 

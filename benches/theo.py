@@ -152,7 +152,7 @@ def part_paper001(cfg: dict, out_dir: Path) -> dict:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fit_mod = sys.modules["allanite.fit"]
+    import allanite.model.fitting as fit_mod
     y, (t1, t2) = simulate_paper001(cfg["paper_seconds"])
     window, hop = 401, cfg["paper_hop"]
     res = {

@@ -29,7 +29,7 @@ import numpy as np
 import pytest
 
 import allanite
-from allanite.confidence import (
+from allanite.estimators.confidence import (
     ONE_SIGMA,
     ConfidenceIntervals,
     chi2_interval,
@@ -564,7 +564,7 @@ def test_other_errors(rng):
 
 
 def test_docstring_examples():
-    import allanite.confidence as module
+    import allanite.estimators.confidence as module
     import allanite.results as results
 
     for mod in (module, results):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import allanite
-from allanite._covariance import assemble, covariance_blocks
+from allanite.model._covariance import assemble, covariance_blocks
 
 N_SAMPLES, FS = 300, 10.0
 TAU0 = 1.0 / FS
@@ -120,7 +120,7 @@ def _flicker_cross_exact(d, mi, mj):
 
 @pytest.mark.parametrize("mi, mj", [(1, 1), (1, 4), (64, 1024)])
 def test_flicker_tail_keeps_its_precision_far_out(mi, mj):
-    from allanite._covariance import _cross
+    from allanite.model._covariance import _cross
 
     d = np.array([0.0, 3.0, 40.0, 1e3, 1e5, -1e7, 1e8])
     got = _cross(d, mi, mj, 1.0)[2]
@@ -134,7 +134,7 @@ def test_flicker_tail_keeps_its_precision_far_out(mi, mj):
 def test_flicker_variance_scales_as_one_over_n_up_to_1e8():
     # at m = 1 flicker's estimate variance is ∝ 1/M: n·Var must not drift with the record length (the
     # nine-term sum of h²·ln|h| used to cancel catastrophically: 10⁴× too large at n = 10⁸)
-    from allanite._covariance import _blocks
+    from allanite.model._covariance import _blocks
 
     scaled = [n * _blocks(np.array([1, 2, 4]), n, 1.0, ("B",))[0][0, 0, 0, 0] for n in (10**4, 10**6, 10**8)]
     assert scaled[1] == pytest.approx(scaled[0], rel=1e-3) and scaled[2] == pytest.approx(scaled[0], rel=1e-3)

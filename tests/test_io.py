@@ -616,7 +616,9 @@ def test_log_repr_is_readable(tmp_path, record):
 
 
 def test_docstring_examples():
-    failures, tried = doctest.testmod(aio, optionflags=doctest.NORMALIZE_WHITESPACE)
+    import allanite.io.reader as reader
+
+    failures, tried = doctest.testmod(reader, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert tried > 0 and failures == 0
 
 

@@ -7,7 +7,7 @@ import pytest
 
 import allanite
 from allanite.errors import ParameterError
-from allanite.refine import gm_avar, sinusoid_avar
+from allanite.model.effects import gm_avar, sinusoid_avar
 
 FS = 100.0
 

@@ -478,7 +478,7 @@ def test_reprs_are_readable():
 def test_report_module_examples():
     import doctest
 
-    import allanite.report
+    import allanite.report.build
 
-    failures, tried = doctest.testmod(allanite.report, optionflags=doctest.NORMALIZE_WHITESPACE)
+    failures, tried = doctest.testmod(allanite.report.build, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert tried > 0 and failures == 0

@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 from allanite import _reference as R
-from allanite.confidence import ONE_SIGMA, chi2_interval, edf_greenhall
+from allanite.estimators.confidence import ONE_SIGMA, chi2_interval, edf_greenhall
 
 REL_MARGIN = 1e-8
 

@@ -1,19 +1,19 @@
 """allanite — static and dynamic Allan variance for gyroscopes, IMUs and clocks, with a Rust core.
 
-Main entry points: :func:`avar` (static overlapping/classic Allan variance), :func:`davar` (dynamic
-Allan variance on a sliding window, naive or fast), :func:`tau_grid` (τ grids). Errors are
+Main entry points: :func:`avar` (static overlapping/classic Allan variance, Theo family), :func:`davar`
+(dynamic Allan variance on a sliding window), :func:`tau_grid` (τ grids), :func:`fit` (the IEEE-952
+noise model with intervals), :func:`refine` (what a fitted model lacks). Errors are
 :class:`AllaniteError` subclasses of ``ValueError``.
 """
 
 from ._core import __version__
-from .allan import avar, davar
-from .confidence import chi2_interval, confidence_intervals, edf_greenhall, edf_sp1065, identify_alpha
+from .analysis import avar, davar
 from .datasets import default_record
 from .errors import AllaniteError, InputError, MemoryBudgetError, ParameterError
-from .fit import CoefficientSeries, NoiseFit, fit, information_bound
-from .grid import tau_grid
+from .estimators.confidence import chi2_interval, confidence_intervals, edf_greenhall, edf_sp1065, identify_alpha
+from .estimators.grid import tau_grid
 from .io import Log, read_log
-from .refine import Refinement, refine
+from .model import CoefficientSeries, NoiseFit, Refinement, fit, information_bound, refine
 from .results import AllanResult, DynamicAllanResult
 from .simulate import simulate
 

@@ -8,13 +8,20 @@ stderr (never a traceback); 1 an internal error (a bug: the traceback is shown);
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import sys
 import time
 import warnings
 from pathlib import Path
 
+from tqdm import tqdm
+
+from ._core import __version__
+from .datasets import default_record
 from .errors import AllaniteError
+from .io import read_log, sniff_format
+from .report import build_report, from_log
 
 EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -88,8 +95,6 @@ def _formatter(prog):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from . import __version__
-
     parser = _Parser(prog="allanite", usage="%(prog)s [-h] [--version] COMMAND [ARGS ...]", description=DESCRIPTION,
                      epilog=EPILOG, formatter_class=_formatter)
     parser.add_argument("--version", action="version", version=f"allanite {__version__}",
@@ -152,8 +157,6 @@ class _Progress:
     """A tqdm bar over the report's steps, on stderr; off with --quiet or when stderr is no terminal."""
 
     def __init__(self, quiet: bool):
-        from tqdm import tqdm
-
         self.bar = tqdm(total=8, file=sys.stderr, disable=True if quiet else None, leave=False, unit="step",
                         bar_format="{desc:<38.38}|{bar}| {n_fmt}/{total_fmt} [{elapsed}]", dynamic_ncols=True)
         self.started = False
@@ -208,12 +211,10 @@ def _cli_words(message: str) -> str:
 
 
 def _read(args, progress):
-    from .io import _sniff, read_log
-
     path = Path(args.log)
     if not path.exists():
         raise AllaniteError(f"{path}: no such file")
-    if args.fs is None and args.time_column is None and _sniff(path) not in ("ros1", "ros2"):
+    if args.fs is None and args.time_column is None and sniff_format(path) not in ("ros1", "ros2"):
         raise AllaniteError(f"{path}: give the sampling rate with --fs HZ, or the time column with --time-column C")
     progress.step(f"reading {path.name}")
     kwargs = {}
@@ -233,8 +234,6 @@ def _read(args, progress):
 
 
 def _report(args) -> int:
-    from .report import build_report, from_log
-
     quiet = args.quiet
     if args.log is None:
         given = [f"--{o.replace('_', '-')}" for o in _LOG_OPTIONS if getattr(args, o) is not None]
@@ -254,8 +253,6 @@ def _report(args) -> int:
             common = dict(window=args.window, hop=args.hop, taus=taus, fit=not args.no_fit, progress=progress,
                           estimator=args.estimator, refine=args.refine)
             if args.log is None:
-                from . import default_record
-
                 progress.step("generating the bundled record")
                 x, fs, info = default_record()
                 source = {"name": "bundled record", **{k: (list(v) if isinstance(v, tuple) else v)
@@ -299,8 +296,6 @@ def main(argv=None) -> int:
     except AllaniteError as exc:
         return _error(str(exc))
     except BrokenPipeError:  # stdout closed early (allanite report | head): not an error worth a message
-        import os
-
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_INTERNAL
     except OSError as exc:  # cannot write the output folder, unreadable file, disk full, …

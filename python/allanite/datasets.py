@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .simulate import _ar1
+from .simulate import ar1
 
 __all__ = ["default_record", "DEFAULT_FS", "DEFAULT_SEED"]
 
@@ -63,7 +63,7 @@ def default_record(seed: int = DEFAULT_SEED):
         white = rng.normal(size=n) * (n_arw / np.sqrt(tau0)) * arw_scale
         walk = np.cumsum(rng.normal(size=n)) * (k_rrw * np.sqrt(tau0))
         drive = rng.normal(size=n) * (gm_sigma * np.sqrt(1.0 - phi * phi))
-        gm = _ar1(drive, phi, rng.normal() * gm_sigma)
+        gm = ar1(drive, phi, rng.normal() * gm_sigma)
         rate = scale * (white + walk + gm)
         step = terms["quantization_step_deg_per_s"]
         cols.append(np.round(rate / step) * step)

@@ -12,6 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .errors import AllaniteError
+from .units import adev_unit_label, coefficient_unit, ieee952
+
 __all__ = ["plot_adev", "plot_davar", "plot_davar3d", "plot_fit", "plot_coefficient_series"]
 
 
@@ -32,9 +35,6 @@ def _unit_label(unit) -> str | None:
     unknown string is shown as given."""
     if unit is None:
         return None
-    from .errors import AllaniteError
-    from .units import adev_unit_label
-
     try:
         return adev_unit_label(unit)
     except AllaniteError:
@@ -217,18 +217,27 @@ def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None
         scale = 1.0
         label = name
         if series.unit is not None:
-            from .fit import _base_unit
-            from .units import ieee952
-
             if ieee:
                 q = ieee952(name, 1.0, series.unit)
                 scale, label = q.value, f"{name} ({q.unit})"
             else:
-                label = f"{name} ({_base_unit(name, series.unit)})"
+                label = f"{name} ({coefficient_unit(name, series.unit)})"
         colour = _TERM_STYLE.get(name, "C0")
-        ax.plot(series.t, series.values[name] * scale, color=colour, lw=1.2)
-        ax.fill_between(series.t, series.ci_low[name] * scale, np.minimum(series.ci_high[name], 1e300) * scale,
-                        color=colour, alpha=0.25, lw=0)
+        values = np.asarray(series.values[name], dtype=np.float64)
+        # A window whose fit put the term at zero (non-negative least squares) has not resolved it: the
+        # value is "at most the upper bound", not 0. Draw those windows as gaps in the line, with an
+        # open marker at the upper bound, so that the curve does not jump between 0 and its level.
+        resolved = values > 0
+        shown = np.where(resolved, values, np.nan)
+        ax.plot(series.t, shown * scale, color=colour, lw=1.2, marker="." if resolved.sum() < 60 else None, ms=3)
+        low = np.where(resolved, series.ci_low[name], np.nan)
+        high = np.where(resolved, np.minimum(series.ci_high[name], 1e300), np.nan)
+        ax.fill_between(series.t, low * scale, high * scale, color=colour, alpha=0.25, lw=0)
+        if not resolved.all():
+            up = np.where(~resolved & np.isfinite(series.ci_high[name]), series.ci_high[name], np.nan)
+            ax.plot(series.t, up * scale, ls="none", marker="v", mfc="none", mec=colour, ms=4,
+                    label="not resolved (upper bound)")
+            ax.legend(fontsize="x-small", loc="upper left")
         if reference is not None and name in reference.coefficients:
             ax.axhline(reference.coefficients[name].value * scale, color="k", ls=":", lw=1,
                        label="whole record")

@@ -4,13 +4,23 @@ Axis layout: for 1-D input ``avar`` is ``(tau,)`` (static) or ``(tau, t)`` (dyna
 of shape (samples, axes) an axes dimension comes **first**: ``(axes, tau)`` and ``(axes, tau, t)``,
 so ``result.avar[k]`` is axis k's result, equal to analysing that column alone. In the dynamic
 result the last axis is time, as in ``scipy.signal.spectrogram``.
+
+Both results share :class:`_ResultBase`: the Allan deviation, the confidence intervals (computed by
+:mod:`allanite.estimators.confidence`, below this module), ``to_xarray`` with units, and ``plot``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+
+from .errors import MissingDependencyError, ParameterError
+from .estimators import get as get_estimator
+from .estimators.confidence import confidence_intervals
+from .units import adev_unit_label
 
 __all__ = ["AllanResult", "DynamicAllanResult"]
 
@@ -22,50 +32,136 @@ def _fmt_range(a: np.ndarray, unit: str) -> str:
     return f"{a[0]:.4g}–{a[-1]:.4g}{u}" if a.size > 1 else f"{a[0]:.4g}{u}"
 
 
-def _xarray():
+def _xarray() -> Any:
     """The xarray module, or a MissingDependencyError naming the extra that installs it."""
     try:
         import xarray
     except ImportError:
-        from .io import MissingDependencyError
-
         raise MissingDependencyError(
             "to_xarray() needs the optional package 'xarray': pip install 'allanite[xarray]'"
         ) from None
     return xarray
 
 
-def _xr_common(result, unit, axis_names):
-    """Dims prefix, coords and unit labels shared by both results' ``to_xarray``."""
-    from .units import adev_unit_label
+class _ResultBase:
+    """What every Allan-family result shares: deviation, intervals, labelled export, plotting.
 
-    label = adev_unit_label(unit)  # "rate unit" when None; checks the unit otherwise
-    coords = {
-        "tau": ("tau", result.tau, {"units": "s", "long_name": "averaging time τ"}),
-        "m": ("tau", result.m, {"units": "1", "long_name": "averaging factor, τ = m/fs"}),
-        "n": ("tau", result.n, {"units": "1", "long_name": "squared differences averaged"}),
-    }
-    axes = ()
-    if result.n_axes is not None:
-        names = list(range(result.n_axes)) if axis_names is None else [str(a) for a in axis_names]
-        if len(names) != result.n_axes:
-            from .errors import ParameterError
+    Subclasses are frozen dataclasses with at least ``tau``, ``avar``, ``m``, ``n``, ``estimator``,
+    ``fs``, ``n_samples``, ``input``, the interval fields (``edf``, ``ci_low``, ``ci_high``,
+    ``alpha``, ``confidence``) and ``source``/``kf``; ``_time_dims`` names their dims after τ.
+    """
 
-            raise ParameterError(f"axis_names has {len(names)} names for {result.n_axes} axes")
-        coords["axis"] = ("axis", names, {"long_name": "sensor axis"})
-        axes = ("axis",)
-    attrs = {"estimator": result.estimator, "fs_hz": result.fs, "n_samples": result.n_samples, "input": result.input,
-             "unit": "unknown" if unit is None else str(unit), "allanite_result": type(result).__name__}
-    if result.confidence is not None:
-        attrs["confidence"] = result.confidence
-    if result.source is not None:
-        coords["m"][2]["long_name"] = "averaging factor (τ = m/fs; Theo points τ = 0.75·m/fs)"
-        coords["source"] = ("tau", np.asarray(result.source, dtype=str), {"long_name": "estimator of each τ"})
-    return axes, coords, label, attrs
+    _time_dims: tuple[str, ...] = ()
+
+    tau: np.ndarray
+    avar: np.ndarray
+    m: np.ndarray
+    n: np.ndarray
+    estimator: str
+    fs: float
+    n_samples: int
+    input: str
+    edf: np.ndarray | None
+    ci_low: np.ndarray | None
+    ci_high: np.ndarray | None
+    alpha: np.ndarray | None
+    confidence: float | None
+    source: np.ndarray | None
+    kf: np.ndarray | float | None
+
+    @property
+    def adev(self) -> np.ndarray:
+        """Allan deviation, √avar, in the input's rate unit (computed on access)."""
+        return np.sqrt(self.avar)
+
+    @property
+    def adev_ci(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(low, high) bounds on the Allan deviation, or None before :meth:`with_confidence`."""
+        if self.ci_low is None or self.ci_high is None:
+            return None
+        return np.sqrt(self.ci_low), np.sqrt(self.ci_high)
+
+    @property
+    def n_axes(self) -> int | None:
+        """Number of axes, or None for 1-D input."""
+        return self.avar.shape[0] if self.avar.ndim == 2 + len(self._time_dims) else None
+
+    @property
+    def estimator_label(self) -> str:
+        """The estimator in words (from the estimator registry)."""
+        return get_estimator(self.estimator).label
+
+    def with_confidence(self, x=None, *, confidence: float = 0.683, alpha=None, edf_method: str = "greenhall",
+                        chi2: str = "exact", b1_n: str = "averages"):
+        """This result with χ² confidence intervals per τ (``edf``, ``ci_low``, ``ci_high``, ``alpha``).
+
+        Pass the samples the result was computed from (``x``, same ``input`` kind) to identify the
+        noise type per τ (a dynamic result: once, from the whole record), or give ``alpha``; see
+        :func:`allanite.confidence_intervals`.
+
+        Examples
+        --------
+        >>> import numpy as np, allanite
+        >>> y = np.random.default_rng(3).normal(size=10_000)
+        >>> r = allanite.avar(y, fs=1.0, taus=[1, 10, 100]).with_confidence(y)
+        >>> r.alpha, np.round(r.edf)
+        (array([0, 0, 0]), array([7826., 1368.,  148.]))
+        """
+        ci = confidence_intervals(self, x, confidence=confidence, alpha=alpha, edf_method=edf_method, chi2=chi2,
+                                  b1_n=b1_n)
+        return dataclasses.replace(self, edf=ci.edf, ci_low=ci.ci_low, ci_high=ci.ci_high,  # type: ignore[type-var]
+                                   alpha=ci.alpha, confidence=ci.confidence)
+
+    def _xr_common(self, unit, axis_names):
+        """Dims prefix, coords, unit label and attrs shared by both results' ``to_xarray``."""
+        label = adev_unit_label(unit)  # "rate unit" when None; checks the unit otherwise
+        coords: dict[str, Any] = {
+            "tau": ("tau", self.tau, {"units": "s", "long_name": "averaging time τ"}),
+            "m": ("tau", self.m, {"units": "1", "long_name": "averaging factor, τ = m/fs"}),
+            "n": ("tau", self.n, {"units": "1", "long_name": "squared differences averaged"}),
+        }
+        axes: tuple[str, ...] = ()
+        if self.n_axes is not None:
+            names = list(range(self.n_axes)) if axis_names is None else [str(a) for a in axis_names]
+            if len(names) != self.n_axes:
+                raise ParameterError(f"axis_names has {len(names)} names for {self.n_axes} axes")
+            coords["axis"] = ("axis", names, {"long_name": "sensor axis"})
+            axes = ("axis",)
+        attrs: dict[str, Any] = {"estimator": self.estimator, "fs_hz": self.fs, "n_samples": self.n_samples,
+                                 "input": self.input, "unit": "unknown" if unit is None else str(unit),
+                                 "allanite_result": type(self).__name__}
+        if self.confidence is not None:
+            attrs["confidence"] = self.confidence
+        if self.source is not None:
+            coords["m"][2]["long_name"] = "averaging factor (τ = m/fs; Theo points τ = 0.75·m/fs)"
+            coords["source"] = ("tau", np.asarray(self.source, dtype=str), {"long_name": "estimator of each τ"})
+        return axes, coords, label, attrs
+
+    def _xr_data(self, axes, label):
+        """The data variables: variance, deviation and (when present) their intervals, EDF and α."""
+        dims = axes + ("tau",) + self._time_dims
+        var_units = f"({label})²"
+        dyn = "dynamic " if self._time_dims else ""
+        data = {
+            "avar": (dims, self.avar, {"units": var_units, "long_name": f"{dyn}Allan variance ({self.estimator})"}),
+            "adev": (dims, self.adev, {"units": label, "long_name": f"{dyn}Allan deviation"}),
+        }
+        if self.ci_low is not None and self.ci_high is not None and self.confidence is not None:
+            level = f"{self.confidence:.1%}"
+            data["ci_low"] = (dims, self.ci_low, {"units": var_units, "long_name": f"{level} lower bound, variance"})
+            data["ci_high"] = (dims, self.ci_high, {"units": var_units, "long_name": f"{level} upper bound, variance"})
+            if not self._time_dims:
+                data["adev_low"] = (dims, np.sqrt(self.ci_low), {"units": label,
+                                                                 "long_name": f"{level} lower bound, ADEV"})
+                data["adev_high"] = (dims, np.sqrt(self.ci_high), {"units": label,
+                                                                   "long_name": f"{level} upper bound, ADEV"})
+            data["edf"] = (axes + ("tau",), self.edf, {"units": "1", "long_name": "equivalent degrees of freedom"})
+            data["alpha"] = (axes + ("tau",), self.alpha, {"units": "1", "long_name": "noise type α (S_y ∝ f^α)"})
+        return data
 
 
 @dataclass(frozen=True, repr=False, eq=False)
-class AllanResult:
+class AllanResult(_ResultBase):
     """Static Allan variance of a record.
 
     Attributes
@@ -118,47 +214,6 @@ class AllanResult:
     source: np.ndarray | None = None
     kf: np.ndarray | float | None = None
 
-    def with_confidence(self, x=None, *, confidence: float = 0.683, alpha=None, edf_method: str = "greenhall",
-                        chi2: str = "exact", b1_n: str = "averages") -> "AllanResult":
-        """This result with χ² confidence intervals per τ (``edf``, ``ci_low``, ``ci_high``, ``alpha``).
-
-        Pass the samples the result was computed from (``x``, same ``input`` kind) to identify the
-        noise type per τ, or give ``alpha``; see :func:`allanite.confidence_intervals`.
-
-        Examples
-        --------
-        >>> import numpy as np, allanite
-        >>> y = np.random.default_rng(3).normal(size=10_000)
-        >>> r = allanite.avar(y, fs=1.0, taus=[1, 10, 100]).with_confidence(y)
-        >>> r.alpha, np.round(r.edf)
-        (array([0, 0, 0]), array([7826., 1368.,  148.]))
-        """
-        import dataclasses
-
-        from .confidence import confidence_intervals
-
-        ci = confidence_intervals(self, x, confidence=confidence, alpha=alpha, edf_method=edf_method, chi2=chi2,
-                                  b1_n=b1_n)
-        return dataclasses.replace(self, edf=ci.edf, ci_low=ci.ci_low, ci_high=ci.ci_high, alpha=ci.alpha,
-                                   confidence=ci.confidence)
-
-    @property
-    def adev_ci(self) -> tuple[np.ndarray, np.ndarray] | None:
-        """(low, high) bounds on the Allan deviation, or None before :meth:`with_confidence`."""
-        if self.ci_low is None:
-            return None
-        return np.sqrt(self.ci_low), np.sqrt(self.ci_high)
-
-    @property
-    def adev(self) -> np.ndarray:
-        """Allan deviation, √avar, in the input's rate unit."""
-        return np.sqrt(self.avar)
-
-    @property
-    def n_axes(self) -> int | None:
-        """Number of axes, or None for 1-D input."""
-        return self.avar.shape[0] if self.avar.ndim == 2 else None
-
     def __repr__(self) -> str:
         axes = f", {self.n_axes} axes" if self.n_axes else ""
         which = " (axis 0)" if self.n_axes else ""
@@ -188,35 +243,21 @@ class AllanResult:
             ``axis``; attrs ``estimator``, ``fs_hz``, ``n_samples``, ``input``, ``unit``, ``confidence``.
         """
         xr = _xarray()
-        axes, coords, label, attrs = _xr_common(self, unit, axis_names)
-        dims = axes + ("tau",)
-        var_units = f"({label})²"
-        data = {
-            "avar": (dims, self.avar, {"units": var_units, "long_name": f"Allan variance ({self.estimator})"}),
-            "adev": (dims, self.adev, {"units": label, "long_name": "Allan deviation"}),
-        }
-        if self.ci_low is not None:
-            level = f"{self.confidence:.1%}"
-            data["ci_low"] = (dims, self.ci_low, {"units": var_units, "long_name": f"{level} lower bound, variance"})
-            data["ci_high"] = (dims, self.ci_high, {"units": var_units, "long_name": f"{level} upper bound, variance"})
-            data["adev_low"] = (dims, np.sqrt(self.ci_low), {"units": label, "long_name": f"{level} lower bound, ADEV"})
-            data["adev_high"] = (dims, np.sqrt(self.ci_high), {"units": label,
-                                                              "long_name": f"{level} upper bound, ADEV"})
-            data["edf"] = (dims, self.edf, {"units": "1", "long_name": "equivalent degrees of freedom"})
-            data["alpha"] = (dims, self.alpha, {"units": "1", "long_name": "noise type α (S_y ∝ f^α)"})
+        axes, coords, label, attrs = self._xr_common(unit, axis_names)
+        data = self._xr_data(axes, label)
         if self.kf is not None:
             data["kf"] = (axes, np.asarray(self.kf, dtype=float), {"units": "1", "long_name": "TheoBR bias ratio"})
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def plot(self, ax=None, **kwargs):
         """Log-log ADEV against τ (one line per axis). Returns the matplotlib Axes."""
-        from .plot import plot_adev
+        from .plot import plot_adev  # matplotlib is imported only when a figure is drawn
 
         return plot_adev(self, ax=ax, **kwargs)
 
 
 @dataclass(frozen=True, repr=False, eq=False)
-class DynamicAllanResult:
+class DynamicAllanResult(_ResultBase):
     """Dynamic Allan variance: the Allan variance of every sliding window.
 
     Attributes
@@ -279,30 +320,7 @@ class DynamicAllanResult:
     source: np.ndarray | None = None
     kf: np.ndarray | float | None = None
 
-    def with_confidence(self, x=None, *, confidence: float = 0.683, alpha=None, edf_method: str = "greenhall",
-                        chi2: str = "exact", b1_n: str = "averages") -> "DynamicAllanResult":
-        """This result with χ² confidence intervals for every window and τ.
-
-        ``alpha`` (one per τ, or one for all) is given, or identified once from the whole record
-        ``x``; see :func:`allanite.confidence_intervals`.
-        """
-        import dataclasses
-
-        from .confidence import confidence_intervals
-
-        ci = confidence_intervals(self, x, confidence=confidence, alpha=alpha, edf_method=edf_method, chi2=chi2,
-                                  b1_n=b1_n)
-        return dataclasses.replace(self, edf=ci.edf, ci_low=ci.ci_low, ci_high=ci.ci_high, alpha=ci.alpha,
-                                   confidence=ci.confidence)
-
-    @property
-    def adev(self) -> np.ndarray:
-        """Allan deviation, √avar (computed on access, so the result holds one big array)."""
-        return np.sqrt(self.avar)
-
-    @property
-    def n_axes(self) -> int | None:
-        return self.avar.shape[0] if self.avar.ndim == 3 else None
+    _time_dims = ("t",)
 
     def __repr__(self) -> str:
         axes = f", {self.n_axes} axes" if self.n_axes else ""
@@ -322,21 +340,10 @@ class DynamicAllanResult:
         ``axis``; attrs as :meth:`AllanResult.to_xarray` plus ``window``, ``hop``, ``method``.
         """
         xr = _xarray()
-        axes, coords, label, attrs = _xr_common(self, unit, axis_names)
+        axes, coords, label, attrs = self._xr_common(unit, axis_names)
         coords["t"] = ("t", self.t, {"units": "s", "long_name": "window centre from the start of the record"})
         attrs.update(window=self.window, hop=self.hop, method=self.method)
-        dims = axes + ("tau", "t")
-        var_units = f"({label})²"
-        data = {
-            "avar": (dims, self.avar, {"units": var_units, "long_name": f"dynamic Allan variance ({self.estimator})"}),
-            "adev": (dims, self.adev, {"units": label, "long_name": "dynamic Allan deviation"}),
-        }
-        if self.ci_low is not None:
-            level = f"{self.confidence:.1%}"
-            data["ci_low"] = (dims, self.ci_low, {"units": var_units, "long_name": f"{level} lower bound, variance"})
-            data["ci_high"] = (dims, self.ci_high, {"units": var_units, "long_name": f"{level} upper bound, variance"})
-            data["edf"] = (axes + ("tau",), self.edf, {"units": "1", "long_name": "equivalent degrees of freedom"})
-            data["alpha"] = (axes + ("tau",), self.alpha, {"units": "1", "long_name": "noise type α (S_y ∝ f^α)"})
+        data = self._xr_data(axes, label)
         if self.kf is not None:
             data["kf"] = (axes + ("t",), np.asarray(self.kf, dtype=float),
                           {"units": "1", "long_name": "TheoBR bias ratio of each window"})
@@ -344,6 +351,6 @@ class DynamicAllanResult:
 
     def plot(self, ax=None, axis: int = 0, **kwargs):
         """Heat map of ADEV over (t, τ), log colour. Returns the matplotlib Axes."""
-        from .plot import plot_davar
+        from .plot import plot_davar  # matplotlib is imported only when a figure is drawn
 
         return plot_davar(self, ax=ax, axis=axis, **kwargs)

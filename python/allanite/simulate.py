@@ -32,7 +32,7 @@ import numbers
 import numpy as np
 
 from .errors import ParameterError
-from .grid import _check_count, _check_fs
+from ._validate import check_count, check_fs
 
 __all__ = ["simulate", "kasdin_walter"]
 
@@ -130,8 +130,8 @@ def simulate(n: int, fs: float, *, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0, gauss_mark
     >>> np.round(r.adev * np.sqrt(r.tau), 3)                       # adev·√τ = N
     array([0.01, 0.01])
     """
-    n = _check_count(n, "n", 2)
-    fs = _check_fs(fs)
+    n = check_count(n, "n", 2)
+    fs = check_fs(fs)
     tau0 = 1.0 / fs
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     t = np.arange(n) * tau0
@@ -165,7 +165,7 @@ def simulate(n: int, fs: float, *, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0, gauss_mark
             raise ParameterError(f"gauss_markov correlation time must be a positive number of seconds, got {tc!r}")
         phi = np.exp(-tau0 / tc)
         drive = rng.normal(size=n) * np.sqrt(1.0 - phi * phi)
-        unit = _ar1(drive, phi, rng.normal())
+        unit = ar1(drive, phi, rng.normal())
         y += unit * sig
     for item in sinusoid:
         if not isinstance(item, (list, tuple)) or len(item) not in (2, 3):
@@ -179,7 +179,7 @@ def simulate(n: int, fs: float, *, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0, gauss_mark
     return y
 
 
-def _ar1(drive: np.ndarray, phi: float, x0: float, block: int = 1024) -> np.ndarray:
+def ar1(drive: np.ndarray, phi: float, x0: float, block: int = 1024) -> np.ndarray:
     """x_i = φ·x_{i−1} + drive_i, in blocks: x_i = φ^(i+1)·x0 + φ^i·Σ_{j≤i} φ^(−j)·drive_j, where
     φ^(−j) stays O(1) inside a block (block ≪ correlation length in samples is not required: for
     φ^(−block) to overflow, Tc would have to be below ~block/700 samples; those use the plain loop)."""

@@ -35,7 +35,7 @@ from .errors import ParameterError
 
 __all__ = [
     "Unit", "Quantity", "parse_unit", "rate_unit", "convert", "to_deg_per_s", "ieee952",
-    "adev_unit_label", "RATE_UNITS", "ANGLE_UNITS", "IEEE952_TERMS",
+    "adev_unit_label", "coefficient_unit", "RATE_UNITS", "ANGLE_UNITS", "IEEE952_TERMS",
 ]
 
 
@@ -303,3 +303,18 @@ def adev_unit_label(unit) -> str:
     if unit is None:
         return "rate unit"
     return rate_unit(unit).label
+
+
+def coefficient_unit(term: str, unit) -> str:
+    """Label of a noise coefficient's base form for samples in ``unit``: for °/s, Q in °, N in °/√s,
+    B in °/s, K in °/s^1.5, R in °/s² (what :func:`allanite.fit` returns before IEEE-952 conversion).
+
+    >>> from allanite.units import coefficient_unit
+    >>> coefficient_unit("N", "deg/s"), coefficient_unit("K", "rad/s")
+    ('deg/√s', 'rad/s^1.5')
+    """
+    u = str(rate_unit(unit))
+    if u.endswith("/s"):
+        angle = u[:-2]
+        return {"Q": angle, "N": f"{angle}/√s", "B": u, "K": f"{angle}/s^1.5", "R": f"{angle}/s²"}[term]
+    return {"Q": f"({u})·s", "N": f"({u})·√s", "B": u, "K": f"({u})/√s", "R": f"({u})/s"}[term]

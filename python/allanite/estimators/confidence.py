@@ -44,7 +44,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ParameterError
+from .._validate import as_rate_columns, check_choice, check_count, check_probability
+from ..errors import ParameterError
+from . import _registry
 
 __all__ = [
     "edf_theo1",
@@ -81,17 +83,6 @@ _ESTIMATORS = ("oavar", "avar")
 # argument checks
 
 
-def _check_confidence(confidence) -> float:
-    if isinstance(confidence, bool) or not isinstance(confidence, (numbers.Real, np.floating, np.integer)):
-        raise ParameterError(f"confidence must be a probability strictly between 0 and 1, got {confidence!r}")
-    c = float(confidence)
-    if not (0.0 < c < 1.0):
-        raise ParameterError(
-            f"confidence must be a probability strictly between 0 and 1 (e.g. 0.683 or 0.95), got {confidence!r}"
-        )
-    return c
-
-
 def _check_alpha(alpha, allowed=ALPHAS, what="alpha") -> np.ndarray:
     a = np.asarray(alpha)
     if a.dtype.kind not in "iuf" or a.size == 0:
@@ -104,23 +95,6 @@ def _check_alpha(alpha, allowed=ALPHAS, what="alpha") -> np.ndarray:
             f"got {af[bad].ravel()[0]!r}"
         )
     return af.astype(np.int64)
-
-
-def _check_choice(value, name, allowed):
-    if not isinstance(value, str) or value not in allowed:
-        raise ParameterError(f"unknown {name} {value!r}; allowed: {', '.join(map(repr, allowed))}")
-    return value
-
-
-def _check_int(value, name, minimum) -> int:
-    if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)):
-        if isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer():
-            value = int(value)
-        else:
-            raise ParameterError(f"{name} must be an integer ≥ {minimum}, got {value!r}")
-    if value < minimum:
-        raise ParameterError(f"{name} must be an integer ≥ {minimum}, got {value!r}")
-    return int(value)
 
 
 # --------------------------------------------------------------------------------------------
@@ -286,13 +260,13 @@ def edf_greenhall(alpha, d, m, N, overlapping=True, modified=False):
     --------
     The values of FORMULAS.md §5 (overlapping ADEV of 1001 phase points):
 
-    >>> from allanite.confidence import edf_greenhall
+    >>> from allanite.estimators.confidence import edf_greenhall
     >>> [round(float(edf_greenhall(a, 2, 1, 1001)), 1) for a in (2, 0, -2)]
     [514.0, 782.0, 762.3]
     >>> [round(float(edf_greenhall(a, 2, 100, 1001)), 2) for a in (2, 0, -2)]
     [440.21, 12.81, 7.75]
     """
-    d = _check_int(d, "d", 1)
+    d = check_count(d, "d", 1)
     if d > 3:
         raise ParameterError(f"d must be 1 (first difference), 2 (Allan) or 3 (Hadamard), got {d!r}")
     allowed = tuple(a for a in range(2, -5, -1) if a + 2 * d > 1)
@@ -340,7 +314,7 @@ def edf_sp1065(alpha, m, N, estimator="oavar"):
 
     Examples
     --------
-    >>> from allanite.confidence import edf_sp1065
+    >>> from allanite.estimators.confidence import edf_sp1065
     >>> round(float(edf_sp1065(0, 100, 1001)), 2)     # Greenhall: 12.81
     13.0
     """
@@ -404,7 +378,7 @@ def edf_theo1(alpha, m, N):
 
     Examples
     --------
-    >>> from allanite.confidence import edf_theo1
+    >>> from allanite.estimators.confidence import edf_theo1
     >>> round(float(edf_theo1(0, 10, 1001)), 1)          # white rate, m = 10 (τ = 7.5 τ0)
     434.3
     """
@@ -412,7 +386,7 @@ def edf_theo1(alpha, m, N):
     m_arr = np.asarray(m, dtype=np.float64)
     if np.any(~np.isfinite(m_arr)) or np.any(m_arr < 2):
         raise ParameterError(f"m must be Theo1 averaging factors ≥ 2, got {m!r}")
-    n = float(_check_int(N, "N", 3))
+    n = float(check_count(N, "N", 3))
     a, r = np.broadcast_arrays(a, 0.75 * m_arr)
     out = np.empty(a.shape, dtype=np.float64)
     for idx in np.ndindex(a.shape):
@@ -489,13 +463,13 @@ def chi2_interval(variance, edf, confidence=0.683, *, method="exact"):
 
     Examples
     --------
-    >>> from allanite.confidence import chi2_interval
+    >>> from allanite.estimators.confidence import chi2_interval
     >>> lo, hi = chi2_interval(1.0, 10.0, 0.9)
     >>> round(lo, 4), round(hi, 4)
     (0.5462, 2.5379)
     """
-    c = _check_confidence(confidence)
-    _check_choice(method, "method", _CHI2_METHODS)
+    c = check_probability(confidence)
+    check_choice(method, "method", _CHI2_METHODS)
     var = np.asarray(variance, dtype=np.float64)
     nu = np.asarray(edf, dtype=np.float64)
     if nu.size == 0 or np.any(~np.isfinite(nu)) or np.any(nu <= 0):
@@ -638,17 +612,17 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
     Examples
     --------
     >>> import numpy as np
-    >>> from allanite.confidence import identify_alpha
+    >>> from allanite.estimators.confidence import identify_alpha
     >>> rng = np.random.default_rng(0)
     >>> identify_alpha(rng.normal(size=10_000), [1, 10, 100], input="rate")      # white rate
     array([0, 0, 0])
     >>> identify_alpha(np.cumsum(rng.normal(size=10_000)), [1, 10, 100], input="rate")  # rate random walk
     array([-2, -2, -2])
     """
-    _check_choice(input, "input", _INPUTS)
-    _check_choice(estimator, "estimator", _ESTIMATORS)
-    _check_choice(method, "method", ("auto", "acf", "b1"))
-    _check_choice(b1_n, "b1_n", ("averages", "terms"))
+    check_choice(input, "input", _INPUTS)
+    check_choice(estimator, "estimator", _ESTIMATORS)
+    check_choice(method, "method", ("auto", "acf", "b1"))
+    check_choice(b1_n, "b1_n", ("averages", "terms"))
     arr = np.asarray(x)
     if arr.ndim != 1 or arr.dtype.kind not in "iuf":
         raise ParameterError(
@@ -760,8 +734,6 @@ def _alpha_for_result(result, x, alpha, shape_edf, b1_n) -> np.ndarray:
             "the noise type is needed for the intervals: pass the samples the result was computed from "
             "(x, with the same input kind) to identify it per τ, or give alpha (2 WPM … −2 RWFM)"
         )
-    from ._input import as_rate_columns
-
     cols, _, is_multi = as_rate_columns(x, result.fs, result.input)
     n_axes = result.n_axes
     if (n_axes is None) == is_multi or (n_axes is not None and len(cols) != n_axes):
@@ -778,7 +750,7 @@ def _alpha_for_result(result, x, alpha, shape_edf, b1_n) -> np.ndarray:
     out = np.empty(shape_edf, dtype=np.int64)
     for a_i, y in enumerate(cols):
         data = np.concatenate(([0.0], np.cumsum(y))) if kind == "angle" else y
-        est = result.estimator if result.estimator in _ESTIMATORS else "oavar"
+        est = _registry.get(result.estimator).noise_id
         ids = identify_alpha(data, _allan_m_for_id(result), input=kind, estimator=est, b1_n=b1_n)
         if is_multi:
             out[a_i] = ids
@@ -787,17 +759,30 @@ def _alpha_for_result(result, x, alpha, shape_edf, b1_n) -> np.ndarray:
     return out
 
 
-def _edf_mixed(alpha, m, n_phase, source) -> np.ndarray:
-    """ν per τ of a Theo-family result: Greenhall for its Allan τ, Howe's Theo1 EDF for Theo τ."""
+def edf_of(estimator, alpha, m, n_phase) -> np.ndarray:
+    """ν per τ from the registry's EDF model of each τ's estimator: ``estimator`` is one name, or an
+    array naming the estimator of every τ (hybrid results such as TheoH: Greenhall's EDF at Allan τ,
+    Howe's Theo1 EDF at Theo τ)."""
+    alpha = np.asarray(alpha)
+    m = np.broadcast_to(np.asarray(m), alpha.shape)
+    source = np.broadcast_to(np.asarray(estimator), alpha.shape)
     nu = np.empty(alpha.shape, dtype=np.float64)
-    theo = np.isin(source, ("theo1", "theobr"))
-    if np.any(theo):
-        nu[theo] = edf_theo1(alpha[theo], m[theo], n_phase)
-    for est in ("oavar", "avar"):
-        sel = source == est
-        if np.any(sel):
-            nu[sel] = edf_greenhall(alpha[sel], 2, m[sel], n_phase, overlapping=est == "oavar")
+    for name in np.unique(source):
+        entry = _registry.get(str(name))
+        if entry.edf is None:
+            raise ParameterError(f"estimator {str(name)!r} has no model of its equivalent degrees of freedom")
+        sel = source == name
+        nu[sel] = entry.edf(alpha[sel], m[sel], n_phase)
     return nu
+
+
+def _window_length(result) -> int:
+    """Samples behind every estimate: the window of a dynamic result, the record of a static one."""
+    return int(result.window) if _is_dynamic(result) else int(result.n_samples)
+
+
+def _is_dynamic(result) -> bool:
+    return getattr(result, "window", None) is not None and getattr(result, "t", None) is not None
 
 
 def _allan_m_for_id(result) -> np.ndarray:
@@ -805,12 +790,10 @@ def _allan_m_for_id(result) -> np.ndarray:
     Allan factor nearest that τ — but Theo reaches τ where fewer than 30 intervals fit, where the
     identification is a guess (and a wrong "white phase" call would claim thousands of degrees of
     freedom); there the longest τ with ≥ 30 intervals (lag-1 ACF, reliable) stands in."""
-    from .results import AllanResult
-
     if result.source is None:
         return np.asarray(result.m)
-    n = result.n_samples if isinstance(result, AllanResult) else result.window
-    theo = np.isin(result.source, ("theo1", "theobr"))
+    n = _window_length(result)
+    theo = np.isin(result.source, [e for e in np.unique(result.source) if _registry.get(str(e)).theo_tau])
     reliable = max(1, n // ACF_MIN_POINTS)
     m_id = np.where(theo, np.minimum(np.floor(0.75 * result.m + 0.5), reliable), result.m).astype(np.int64)
     return np.clip(m_id, 1, max(1, n // 2))
@@ -872,31 +855,31 @@ def confidence_intervals(result, x=None, *, confidence=0.683, alpha=None, edf_me
     >>> dci.ci_low.shape == d.avar.shape, np.round(dci.edf, 1)
     (True, array([1564.6,  272.1]))
     """
-    from .results import AllanResult, DynamicAllanResult
-
-    if not isinstance(result, (AllanResult, DynamicAllanResult)):
+    if not all(hasattr(result, a) for a in ("tau", "avar", "m", "estimator", "fs", "n_samples", "input", "source")):
         raise ParameterError(f"result must be an AllanResult or DynamicAllanResult, got {type(result).__name__}")
-    c = _check_confidence(confidence)
-    _check_choice(edf_method, "edf_method", _EDF_METHODS)
-    _check_choice(chi2, "chi2", _CHI2_METHODS)
-    if result.estimator not in _ESTIMATORS and result.source is None:
-        raise ParameterError(f"confidence intervals are implemented for 'oavar' and 'avar', not {result.estimator!r}")
+    c = check_probability(confidence)
+    check_choice(edf_method, "edf_method", _EDF_METHODS)
+    check_choice(chi2, "chi2", _CHI2_METHODS)
+    if result.source is None and _registry.get(result.estimator).edf is None:
+        with_edf = [n for n in _registry.names() if _registry.get(n).edf is not None]
+        raise ParameterError(f"confidence intervals are implemented for {', '.join(map(repr, with_edf))}, "
+                             f"not {result.estimator!r}")
     if result.source is not None and edf_method != "greenhall":
         raise ParameterError("Theo-family results use Greenhall's EDF (Allan τ) and Howe's Theo1 EDF (Theo τ); "
                              f"edf_method={edf_method!r} is for plain Allan results")
-    dynamic = isinstance(result, DynamicAllanResult)
+    if edf_method == "sp1065" and result.estimator not in _ESTIMATORS:
+        raise ParameterError(f"edf_method='sp1065' has formulas for {_ESTIMATORS}, not {result.estimator!r}")
+    dynamic = _is_dynamic(result)
     n_axes = result.n_axes
     shape_edf = (result.m.size,) if n_axes is None else (n_axes, result.m.size)
-    _check_choice(b1_n, "b1_n", ("averages", "terms"))
+    check_choice(b1_n, "b1_n", ("averages", "terms"))
     a = _alpha_for_result(result, x, alpha, shape_edf, b1_n)
-    n_phase = (result.window if dynamic else result.n_samples) + 1
+    n_phase = _window_length(result) + 1
     m_b = np.broadcast_to(result.m, shape_edf)
-    if result.source is not None:
-        nu = _edf_mixed(a, m_b, n_phase, np.broadcast_to(result.source, shape_edf))
-    elif edf_method == "greenhall":
-        nu = edf_greenhall(a, 2, m_b, n_phase, overlapping=result.estimator == "oavar")
-    else:
+    if edf_method == "sp1065":
         nu = edf_sp1065(a, m_b, n_phase, estimator=result.estimator)
+    else:
+        nu = edf_of(result.estimator if result.source is None else result.source, a, m_b, n_phase)
     nu = np.asarray(nu, dtype=np.float64).reshape(shape_edf)
     nu_b = nu[..., None] if dynamic else nu
     low, high = chi2_interval(result.avar, nu_b, c, method=chi2)

@@ -25,16 +25,21 @@ import math
 
 import numpy as np
 
-from . import _core
-from ._input import resolve_workers
-from .errors import ParameterError
-from .grid import GRIDS, _check_fs, _m_grid
+from functools import partial
 
-__all__ = ["THEO_ESTIMATORS", "DYNAMIC_THEO_ESTIMATORS", "theo_ms", "kf_indices", "switch_m",
-           "static_theo", "dynamic_theo"]
+from .. import _core
+from .._validate import check_count, check_fs, resolve_workers
+from ..errors import ParameterError
+from ._registry import Computed, Estimator, register
+from .allan import allan_values
+from .confidence import edf_theo1
+from .grid import GRIDS, m_grid
 
-THEO_ESTIMATORS = ("theo1", "theobr", "theoh")
-DYNAMIC_THEO_ESTIMATORS = ("theoh", "theoh_a")
+__all__ = ["theo_ms", "kf_indices", "switch_m", "static_theo", "dynamic_theo", "resolve_decimation",
+           "THEO_SOURCES"]
+
+#: The estimators whose values belong to τ = 0.75·m/fs.
+THEO_SOURCES = ("theo1", "theobr")
 #: Howe's lower limit on the Theo1 averaging factor.
 THEO1_MIN_M = 10
 #: TheoBR's bias ratio needs n = ⌊0.1·N/3 − 3⌋ ≥ 0, i.e. N ≥ 90 phase points.
@@ -106,7 +111,7 @@ def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, n
     if isinstance(taus, str):
         if taus not in GRIDS:
             raise ParameterError(f"unknown τ grid {taus!r}; allowed: {', '.join(map(repr, GRIDS))} or τ in s")
-        grid = _m_grid(taus, 2 * n_rate, fs=fs, m_max=n_rate)
+        grid = m_grid(taus, 2 * n_rate, fs=fs, m_max=n_rate)
         a = grid[grid <= k] if hybrid else np.empty(0, np.int64)
         # Theo part: τ = 0.75 m τ0 > k τ0 ⇔ m > k/0.75.
         t = _even_theo(grid, n_rate)
@@ -158,7 +163,7 @@ def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, n
 
 
 def _tau(ms: np.ndarray, src: np.ndarray, fs: float) -> np.ndarray:
-    is_theo = np.isin(src, ("theo1", "theobr"))
+    is_theo = np.isin(src, THEO_SOURCES)
     return np.where(is_theo, 0.75 * ms, ms.astype(np.float64)) / fs
 
 
@@ -167,7 +172,7 @@ def _n_terms(ms: np.ndarray, src: np.ndarray, n_rate: int) -> np.ndarray:
     n_phase = n_rate + 1
     out = np.empty(ms.size, dtype=np.int64)
     for i, (m, s) in enumerate(zip(ms, src)):
-        if s in ("theo1", "theobr"):
+        if s in THEO_SOURCES:
             out[i] = (n_phase - m) * (m // 2)
         elif s == "oavar":
             out[i] = n_rate + 1 - 2 * m
@@ -195,17 +200,17 @@ THEO_AUTO_POINTS = 100_000
 
 def resolve_decimation(decimate, n_rate: int, taus) -> int:
     """The block length D for the Theo part: 1 (exact), a given integer, or ``"auto"``:
-    the smallest D with ⌊M/D⌋ ≤ ``THEO_AUTO_POINTS``."""
+    the smallest D with ⌊M/D⌋ ≤ ``THEO_AUTO_POINTS`` on a named τ grid (explicit τ: exact, D = 1)."""
     if decimate is None:
         return 1
     if isinstance(decimate, str):
         if decimate != "auto":
             raise ParameterError(f"decimate must be a positive integer or 'auto', got {decimate!r}")
+        if not isinstance(taus, str):
+            return 1
         d = max(1, -(-int(n_rate) // THEO_AUTO_POINTS))
     else:
-        from .grid import _check_count
-
-        d = _check_count(decimate, "decimate", 1)
+        d = check_count(decimate, "decimate", 1)
     if d > 1 and not isinstance(taus, str):
         raise ParameterError("decimate > 1 works with a named τ grid ('octave', 'decade', 'all', 'exp'), not with "
                              "explicit τ: the Theo τ of a decimated record are multiples of 0.75·D/fs")
@@ -217,7 +222,7 @@ def resolve_decimation(decimate, n_rate: int, taus) -> int:
 
 def _theo_part(cols, ms, src, n, estimator, kf_rule, w):
     """Theo1 (× kf for TheoBR) at the Theo entries of (ms, src) for records of n samples, and kf."""
-    is_theo = np.isin(src, ("theo1", "theobr"))
+    is_theo = np.isin(src, THEO_SOURCES)
     theo_m = ms[is_theo]
     need_kf = estimator in ("theobr", "theoh", "theoh_a")
     values = np.empty((len(cols), theo_m.size))
@@ -230,32 +235,32 @@ def _theo_part(cols, ms, src, n, estimator, kf_rule, w):
         th = _core.theo1_static(cols, [int(m) for m in all_theo], w)
         values[:] = th[:, np.searchsorted(all_theo, theo_m)]
     if need_kf:
-        av = _core.davar(cols, n, 1, [int(m) for m in ka], "oavar", "fast", w)[:, :, 0]
+        av = allan_values(cols, n, 1, ka, "oavar", "fast", w)[:, :, 0]
         kf = _kf(av, th[:, np.searchsorted(all_theo, kt)])
         values *= kf[:, None]
     return values, kf
 
 
-def static_theo(cols, fs: float, taus, estimator: str, workers, kf_rule: str = "textbook", decimate=1):
-    """Theo1/TheoBR/TheoH of whole records: (tau, values (axes, T), n, m, source, kf (axes,) or None).
+def static_theo(cols, fs: float, taus, workers, *, estimator: str, kf_rule: str = "textbook", decimate=1) -> Computed:
+    """Theo1/TheoBR/TheoH of whole records: values (axes, T), per-τ ``source``, kf (axes,) or None.
 
     With ``decimate`` D > 1 the Theo part (and kf) is computed on the rate averaged in blocks of D
     samples — the phase decimated by D, Taylor & Howe's "fast TheoBR" — at τ = 0.75·m'·D/fs for even
     m' of the decimated record (reported as m = m'·D); the Allan part stays at full resolution.
     """
-    fs = _check_fs(fs)
+    fs = check_fs(fs)
     _check_kf_rule(kf_rule)
     n = cols[0].size
     d = resolve_decimation(decimate, n, taus)
     ms, src = theo_ms(taus, n, fs, estimator)
     w = resolve_workers(workers)
-    is_theo = np.isin(src, ("theo1", "theobr"))
+    is_theo = np.isin(src, THEO_SOURCES)
     allan = ~is_theo
     if d > 1:
         nd = n // d
         cols_d = [np.ascontiguousarray(c[: nd * d].reshape(nd, d).mean(axis=1)) for c in cols]
         md, srcd = theo_ms(taus, nd, fs / d, estimator)
-        keep = np.isin(srcd, ("theo1", "theobr"))
+        keep = np.isin(srcd, THEO_SOURCES)
         md, srcd = md[keep], srcd[keep]
         if estimator in ("theoh", "theoh_a"):
             k = switch_m(n)
@@ -268,7 +273,7 @@ def static_theo(cols, fs: float, taus, estimator: str, workers, kf_rule: str = "
         tau = np.concatenate([ms[: allan.sum()] / fs, 0.75 * md * d / fs])
         values = np.empty((len(cols), ms.size))
         values[:, allan.sum():] = theo_vals
-        is_theo = np.isin(src, ("theo1", "theobr"))
+        is_theo = np.isin(src, THEO_SOURCES)
         allan = ~is_theo
     else:
         values = np.empty((len(cols), ms.size))
@@ -276,14 +281,17 @@ def static_theo(cols, fs: float, taus, estimator: str, workers, kf_rule: str = "
         tau, n_terms = _tau(ms, src, fs), _n_terms(ms, src, n)
     if np.any(allan):
         est = str(src[allan][0])
-        values[:, allan] = _core.davar(cols, n, 1, [int(m) for m in ms[allan]], est, "fast", w)[:, :, 0]
-    return tau, values, n_terms, ms, src, kf
+        values[:, allan] = allan_values(cols, n, 1, ms[allan], est, "fast", w)[:, :, 0]
+    return Computed(tau=tau, values=values, n=n_terms, m=ms, source=src, kf=kf)
 
 
-def dynamic_theo(cols, fs: float, window: int, hop: int, taus, estimator: str, workers, kf_rule: str = "textbook"):
-    """TheoH (DHVAR) or TheoH-A (DHVAR-A) of every window: (tau, values (axes, T, J), n, m, source,
-    kf (axes, J)). Every window has its own bias ratio kf and its switch at 0.1·window·τ0."""
-    fs = _check_fs(fs)
+def dynamic_theo(cols, fs: float, window: int, hop: int, taus, method: str, workers, *, estimator: str,
+                 kf_rule: str = "textbook") -> Computed:
+    """TheoH (DHVAR) or TheoH-A (DHVAR-A) of every window: values (axes, T, J), per-τ ``source``, kf
+    (axes, J). Every window has its own bias ratio kf and its switch at 0.1·window·τ0."""
+    if method != "fast":
+        raise ParameterError(f"estimator {estimator!r} is computed with method='fast' only, got method={method!r}")
+    fs = check_fs(fs)
     _check_kf_rule(kf_rule)
     ms, src = theo_ms(taus, window, fs, estimator)
     w = resolve_workers(workers)
@@ -292,7 +300,7 @@ def dynamic_theo(cols, fs: float, window: int, hop: int, taus, estimator: str, w
     theo_m = ms[is_theo]
     all_theo = np.unique(np.concatenate([theo_m, kt]))
     th = _core.theo1_dynamic(cols, window, hop, [int(m) for m in all_theo], w)
-    av = _core.davar(cols, window, hop, [int(m) for m in ka], "oavar", "fast", w)
+    av = allan_values(cols, window, hop, ka, "oavar", "fast", w)
     kf = _kf(av, th[:, np.searchsorted(all_theo, kt), :])  # (axes, J)
     n_win = th.shape[2]
     values = np.empty((len(cols), ms.size, n_win))
@@ -300,5 +308,23 @@ def dynamic_theo(cols, fs: float, window: int, hop: int, taus, estimator: str, w
     allan = ~is_theo
     if np.any(allan):
         est = str(src[allan][0])
-        values[:, allan, :] = _core.davar(cols, window, hop, [int(m) for m in ms[allan]], est, "fast", w)
-    return _tau(ms, src, fs), values, _n_terms(ms, src, window), ms, src, kf
+        values[:, allan, :] = allan_values(cols, window, hop, ms[allan], est, "fast", w)
+    return Computed(tau=_tau(ms, src, fs), values=values, n=_n_terms(ms, src, window), m=ms, source=src, kf=kf)
+
+
+def _theoh_m(estimator: str):
+    return lambda taus, n, fs: theo_ms(taus, n, fs, estimator)[0]
+
+
+_THEO_OPTIONS = {"kf_rule": "textbook", "decimate": "auto"}
+register(Estimator(name="theo1", label="Theo1", family="theo", static=partial(static_theo, estimator="theo1"),
+                   edf=edf_theo1, estimates_allan=False, theo_tau=True, options=_THEO_OPTIONS))
+register(Estimator(name="theobr", label="bias-removed Theo1 (TheoBR)", family="theo",
+                   static=partial(static_theo, estimator="theobr"), edf=edf_theo1, theo_tau=True,
+                   options=_THEO_OPTIONS))
+register(Estimator(name="theoh", label="TheoH (overlapping Allan ≤ 10 % of the span, TheoBR beyond)", family="theo",
+                   static=partial(static_theo, estimator="theoh"), dynamic=partial(dynamic_theo, estimator="theoh"),
+                   options=_THEO_OPTIONS, resolve_m=_theoh_m("theoh")))
+register(Estimator(name="theoh_a", label="TheoH-A (classic Allan ≤ 10 % of the window, TheoBR beyond)",
+                   family="theo", dynamic=partial(dynamic_theo, estimator="theoh_a"),
+                   options={"kf_rule": "textbook"}, noise_id="avar", resolve_m=_theoh_m("theoh_a")))

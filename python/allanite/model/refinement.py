@@ -32,17 +32,25 @@ The loop stops when χ²/dof ≤ 1.5 or no candidate earns its parameters.
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import minimize_scalar
+from scipy.stats import chi2 as chi2_dist
 
-from .errors import ParameterError
-from .results import AllanResult
+from .._validate import as_rate_columns
+from ..analysis import avar, davar
+from ..errors import ParameterError
+from ..estimators.grid import tau_grid
+from ..results import AllanResult
+from . import fitting
+from .effects import EFFECTS, describe, gm_avar, sinusoid_avar
+from .terms import TERM_ALPHA, check_terms, design_matrix
 
 __all__ = ["refine", "Refinement", "Step", "gm_avar", "sinusoid_avar", "CANDIDATES"]
 
-CANDIDATES = ("gauss_markov", "sinusoid", "change_point")
+#: Effects refine can add, from the registry in :mod:`allanite.model.effects`.
+CANDIDATES = tuple(EFFECTS)
 #: Stop refining once the model is this good (χ²/dof of the diagonal-weighted residuals).
 GOOD_CHI2_DOF = 1.5
 #: Minimum improvement of the effective χ² (beyond the BIC penalty) to accept an effect.
@@ -50,41 +58,17 @@ MIN_GAIN = 6.0
 MAX_STEPS = 4
 
 
-def _fit_module():
-    return sys.modules["allanite.fit"]
-
-
-# ----------------------------------------------------------------------------------------------
-# signatures
-
-
-def gm_avar(tau, tc) -> np.ndarray:
-    """Allan variance of a first-order Gauss–Markov rate of unit variance and correlation time ``tc``."""
-    tau = np.asarray(tau, dtype=np.float64)
-    x = tau / tc
-    big = (2 * x - 3 + 4 * np.exp(-x) - np.exp(-2 * x)) / np.maximum(x, 1e-300) ** 2
-    small = (2.0 / 3.0) * x - 0.5 * x * x + (7.0 / 30.0) * x**3   # series: no cancellation for x ≪ 1
-    return np.where(x < 1e-2, small, big)
-
-
-def sinusoid_avar(tau, f0) -> np.ndarray:
-    """Allan variance of a unit-amplitude rate sinusoid of frequency ``f0``: sin⁴(πf0τ)/(πf0τ)²."""
-    u = np.pi * f0 * np.asarray(tau, dtype=np.float64)
-    return np.sin(u) ** 4 / u**2
-
-
-_PARAM_NAMES = {"gauss_markov": ("sigma", "tc"), "sinusoid": ("amplitude", "f0")}
-
-
 def _column(effect, p, tau):
-    return gm_avar(tau, p) if effect == "gauss_markov" else sinusoid_avar(tau, p)
+    sig = EFFECTS[effect].signature
+    assert sig is not None
+    return sig(tau, p)
 
 
 def _alpha_of(effect, p, tau):
     """Noise type each effect resembles at τ, for the EDF of the estimates."""
-    if effect == "gauss_markov":
-        return np.where(tau < p, -2, 0)
-    return np.zeros(tau.size, dtype=int)
+    alpha = EFFECTS[effect].alpha
+    assert alpha is not None
+    return alpha(tau, p)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -102,7 +86,8 @@ class _Curve:
 
     def edf(self, alpha: int) -> np.ndarray:
         if alpha not in self._edf:
-            self._edf[alpha] = _fit_module()._edf(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
+            self._edf[alpha] = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points,
+                                                     self.estimator)
         return self._edf[alpha]
 
 
@@ -127,10 +112,9 @@ class _Solution:
 
 def _solve(curve: _Curve, terms, effects, max_iter: int = 40) -> _Solution:
     """IRLS weighted NNLS of the terms plus effects [(name, nonlinear parameter)]."""
-    fitm = _fit_module()
     tau = curve.tau
-    cols = [fitm.design_matrix(tau, tau * curve.fs, curve.fs, terms)]
-    alphas = [np.full(tau.size, fitm.TERM_ALPHA[t]) for t in terms]
+    cols = [design_matrix(tau, tau * curve.fs, curve.fs, terms)]
+    alphas = [np.full(tau.size, TERM_ALPHA[t]) for t in terms]
     for name, p in effects:
         cols.append(_column(name, p, tau)[:, None])
         alphas.append(_alpha_of(name, p, tau))
@@ -145,7 +129,7 @@ def _solve(curve: _Curve, terms, effects, max_iter: int = 40) -> _Solution:
     for it in range(max_iter):
         w = nu / (2.0 * np.maximum(model, floor) ** 2)
         sw = np.sqrt(w)
-        new = fitm._nnls(a * sw[:, None], y * sw)
+        new = fitting.nnls(a * sw[:, None], y * sw)
         parts = a * new
         new_model = np.maximum(parts.sum(axis=1), floor)
         done = np.allclose(new, theta, rtol=1e-7, atol=0.0)
@@ -177,7 +161,6 @@ def _metrics(sol: _Solution) -> dict:
 def _curve_metrics(curve: _Curve, sol: _Solution) -> dict:
     out = _metrics(sol)
     out["rms_adev_pct"] = float(100 * np.sqrt(np.mean((np.sqrt(curve.avar / sol.model) - 1) ** 2)))
-    from scipy.stats import chi2 as chi2_dist
 
     out["p_value"] = float(chi2_dist.sf(sol.chi2_eff(curve), max(1.0, curve.n_eff - 1)))
     return out
@@ -208,7 +191,6 @@ def _residual_evidence(curve, sol) -> dict:
 
 def _search(curve, terms, effects, name, grid):
     """Best nonlinear parameter for effect ``name`` on ``grid`` (then refined), its solution and profile."""
-    from scipy.optimize import minimize_scalar
 
     chis = np.array([_solve(curve, terms, effects + [(name, p)]).chi2 for p in grid])
     k = int(np.argmin(chis))
@@ -259,7 +241,6 @@ def _profile_interval(curve, terms, effects, name, p, sol, grid_chis):
 def _joint(curve, terms, effects, sol, passes: int = 3):
     """Re-estimate every effect's nonlinear parameter with the others held (coordinate descent): an
     effect added first may have absorbed part of a later one's signature."""
-    from scipy.optimize import minimize_scalar
 
     effects = list(effects)
     for _ in range(passes):
@@ -282,14 +263,14 @@ def _joint(curve, terms, effects, sol, passes: int = 3):
 def _update_steps(steps, curve, terms, effects, sol, truth):
     """Steps' parameters and intervals from the joint solution (in the order the effects were added)."""
     k = len(terms)
-    curve_steps = [st for st in steps if st.effect in _PARAM_NAMES]
+    curve_steps = [st for st in steps if EFFECTS[st.effect].kind == "curve"]
     for j, (st, (name, p)) in enumerate(zip(curve_steps, effects)):
         i = k + j
         amp = math.sqrt(max(sol.theta[i], 0.0))
         var_i = sol.cov[i, i]
         sd = math.sqrt(max(var_i, 0.0)) / (2 * amp) if amp > 0 and np.isfinite(var_i) else float("nan")
         others = effects[:j] + effects[j + 1:]
-        names = _PARAM_NAMES[name]
+        names = EFFECTS[name].param_names
         p_int = _profile_interval(curve, terms, others, name, p, sol, None)
         st.params = {names[0]: amp, names[1]: p}
         st.intervals = {names[0]: (max(0.0, amp - sd), amp + sd), names[1]: p_int}
@@ -303,17 +284,15 @@ def _update_steps(steps, curve, terms, effects, sol, truth):
 
 def _change_points(y, fs, terms, max_points=2):
     """Level steps of the Allan variance along the record: [(t, (t_lo, t_hi), evidence, before, after)]."""
-    allanite = sys.modules["allanite"]
     n = y.size
     n_win = 16
     window = n // n_win
     if window < 64:
         return []
-    d = allanite.davar(y, fs, window=window, hop=window, taus="octave")
+    d = davar(y, fs, window=window, hop=window, taus="octave")
     lav = np.log(np.maximum(d.avar, 1e-300))       # (tau, windows)
-    fitm = _fit_module()
     # SD of log σ̂² per τ: from the EDF of the dominant noise (white rate is a fair middle)
-    nu = fitm._edf(np.zeros(d.m.size, dtype=int), d.m, window + 1, "oavar")
+    nu = fitting.edf_per_tau(np.zeros(d.m.size, dtype=int), d.m, window + 1, "oavar")
     # 1/var(log σ̂²): ν/2 for white rate, but long τ scatter more (fewer degrees of freedom for
     # flicker/random walk): take the larger of 2/ν and the robust scatter of consecutive windows
     # (median |difference|, insensitive to a few steps).
@@ -497,22 +476,19 @@ class Refinement:
 
 def _noise_fit(curve, terms, effects, sol, result, unit, confidence):
     """A NoiseFit for the solution, with the effects' parameters among the coefficients."""
-    fitm = _fit_module()
-    from scipy.stats import chi2 as chi2_dist
-
-    zq = fitm._zq(confidence)
+    zq = fitting.z_quantile(confidence)
     k = len(terms)
     inflate = max(1.0, math.sqrt(sol.chi2_dof))
-    coeffs = fitm._coefficients(terms, sol.theta[:k], sol.cov[:k, :k], zq, inflate, unit)
+    coeffs = fitting.coefficients(terms, sol.theta[:k], sol.cov[:k, :k], zq, inflate, unit)
     comps = {t: sol.a[:, i] * sol.theta[i] for i, t in enumerate(terms)}
     for j, (name, p) in enumerate(effects):
         i = k + j
         key = f"{name}{j + 1}" if sum(e[0] == name for e in effects) > 1 else name
         comps[key] = sol.a[:, i] * sol.theta[i]
-        coeffs[key] = fitm.Coefficient(name=key, value=float(math.sqrt(max(sol.theta[i], 0.0))),
-                                       ci=fitm._interval(sol.theta[i], sol.cov[i, i], zq, inflate), unit=unit)
-    readoffs = fitm._readoffs(result, np.sqrt(np.atleast_2d(result.avar)[0]))
-    return fitm.NoiseFit(
+        coeffs[key] = fitting.Coefficient(name=key, value=float(math.sqrt(max(sol.theta[i], 0.0))),
+                                       ci=fitting.interval(sol.theta[i], sol.cov[i, i], zq, inflate), unit=unit)
+    readoffs = fitting.readoffs(result, np.sqrt(np.atleast_2d(result.avar)[0]))
+    return fitting.NoiseFit(
         coefficients=coeffs, terms=terms, tau=curve.tau, m=curve.m, avar=curve.avar, edf=sol.nu, model=sol.model,
         components=comps, z=sol.z, chi2=sol.chi2, dof=sol.dof, chi2_dof=sol.chi2_dof,
         p_value=float(chi2_dist.sf(sol.chi2, sol.dof)), readoffs=readoffs, fs=curve.fs, confidence=confidence,
@@ -539,7 +515,10 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
     start : tuple of str
         The starting model's terms (``"Q"``, ``"N"``, ``"B"``, ``"K"``, ``"R"``).
     candidates : tuple of str
-        Effects to try: ``"gauss_markov"``, ``"sinusoid"``, ``"change_point"`` (samples only).
+        Effects to try (:data:`CANDIDATES`, the registry :data:`allanite.model.effects.EFFECTS`), with the
+        parameters each step reports and their units ("rate unit": the samples' rate unit):
+
+{effects}
     unit : str, optional
         Unit of the samples, for IEEE-952 values of the terms.
     tau_range : (float, float), optional
@@ -562,9 +541,7 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
     >>> r.found, round(r.steps[0].params["tc"], 1), round(r.steps[0].after["chi2_dof"], 1)
     (['gauss_markov'], 10.2, 1.1)
     """
-    allanite = sys.modules["allanite"]
-    fitm = _fit_module()
-    start = fitm._check_terms(start)
+    start = check_terms(start)
     if isinstance(candidates, str):
         candidates = (candidates,)
     bad = [c for c in candidates if c not in CANDIDATES]
@@ -581,20 +558,18 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
     else:
         if fs is None:
             raise ParameterError("fs (Hz) is needed with samples")
-        from ._input import as_rate_columns
-
         cols, fs, _ = as_rate_columns(x_or_result, fs, input)
         if not 0 <= axis < len(cols):
             raise ParameterError(f"axis = {axis} is outside 0..{len(cols) - 1}")
         y = cols[axis]
         top = max(1, y.size // 9)
-        grid = allanite.tau_grid(y.size, fs, "exp", points=points, m_max=top) if top > 1 else "octave"
-        result = allanite.avar(y, fs, taus=grid)
+        grid = tau_grid(y.size, fs, "exp", points=points, m_max=top) if top > 1 else "octave"
+        result = avar(y, fs, taus=grid)
     if result.avar.ndim == 2:
         result = AllanResult(tau=result.tau, avar=result.avar[axis], n=result.n, m=result.m,
                              estimator=result.estimator, fs=result.fs, n_samples=result.n_samples,
                              input=result.input, source=result.source)
-    lo, hi = (0.0, np.inf) if tau_range is None else fitm._check_tau_range(tau_range)
+    lo, hi = (0.0, np.inf) if tau_range is None else fitting.check_tau_range(tau_range)
     keep = (result.tau >= lo) & (result.tau <= hi) & (result.avar > 0)
     if keep.sum() < len(start) + 3:
         raise ParameterError(f"{int(keep.sum())} usable τ points; refining {len(start)} terms needs at least "
@@ -615,8 +590,9 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
         for cand in candidates:
             if cand == "change_point":
                 continue
-            grid = (np.geomspace(tmin, tmax / 4.0, 40) if cand == "gauss_markov"
-                    else np.geomspace(2.0 / tmax, 0.5 / tmin, 120))
+            search = EFFECTS[cand].search
+            assert search is not None
+            grid = search(tmin, tmax)
             p, s_new, prof = _search(curve, start, effects, cand, grid)
             gain = sol.chi2_eff(curve) - s_new.chi2_eff(curve)
             penalty = 2 * math.log(curve.n_eff) + MIN_GAIN
@@ -638,7 +614,7 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
         amp = math.sqrt(s_new.theta[i])
         var_i = s_new.cov[i, i]
         sd_amp = math.sqrt(max(var_i, 0.0)) / (2 * amp) if amp > 0 and np.isfinite(var_i) else float("nan")
-        names = _PARAM_NAMES[cand]
+        names = EFFECTS[cand].param_names
         params = {names[0]: amp, names[1]: p}
         intervals = {names[0]: (max(0.0, amp - sd_amp), amp + sd_amp), names[1]: p_int}
         before, after = _curve_metrics(curve, sol), _curve_metrics(curve, s_new)
@@ -667,3 +643,6 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
     final_fit = _noise_fit(curve, start, effects, sol, result, unit, confidence)
     return Refinement(steps=steps, fit=final_fit, start=start_fit, result=result, terms=start, effects=effects,
                       change_points=change_points, considered=considered)
+
+
+refine.__doc__ = (refine.__doc__ or "").replace("{effects}", describe())

@@ -12,9 +12,10 @@ import numbers
 
 import numpy as np
 
-from .errors import ParameterError
+from .._validate import check_count, check_fs, check_real
+from ..errors import ParameterError
 
-__all__ = ["tau_grid", "GRIDS", "resolve_taus", "max_m"]
+__all__ = ["tau_grid", "GRIDS", "resolve_taus", "max_m", "m_grid"]
 
 #: Names accepted by :func:`tau_grid` and by the ``taus=`` argument of the estimators.
 GRIDS = ("all", "octave", "decade", "exp")
@@ -31,49 +32,15 @@ def max_m(n: int) -> int:
     return int(n) // 2
 
 
-def _check_fs(fs) -> float:
-    if isinstance(fs, bool) or not isinstance(fs, (numbers.Real, np.floating, np.integer)):
-        raise ParameterError(f"fs must be a positive finite number of samples per second, got {fs!r}")
-    fs = float(fs)
-    if not math.isfinite(fs) or fs <= 0:
-        raise ParameterError(f"fs must be a positive finite number of samples per second, got {fs!r}")
-    if not math.isfinite(1.0 / fs) or fs < 1e-200:
-        raise ParameterError(f"fs = {fs!r} Hz is too small: the sampling interval 1/fs is not a finite number")
-    return fs
-
-
-def _check_real(value, name: str, allowed: str) -> float:
-    """A finite real scalar (not bool, not str), or a ParameterError naming it."""
-    if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
-        raise ParameterError(f"{name} must be {allowed}, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise ParameterError(f"{name} must be {allowed}, got {value!r}")
-    return value
-
-
-def _check_count(value, name: str, minimum: int, maximum: int | None = None) -> int:
-    if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)):
-        if isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer():
-            value = int(value)
-        else:
-            raise ParameterError(f"{name} must be an integer ≥ {minimum}, got {value!r}")
-    value = int(value)
-    if value < minimum:
-        raise ParameterError(f"{name} must be an integer ≥ {minimum}, got {value}")
-    if maximum is not None and value > maximum:
-        raise ParameterError(f"{name} must be an integer ≤ {maximum}, got {value}")
-    return value
-
-
-def _m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0, m_max=None) -> np.ndarray:
+def m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0, m_max=None) -> np.ndarray:
+    """Averaging factors m of a named grid on ``n`` samples (see :func:`tau_grid`)."""
     limit = max_m(n)
     if limit < 1:
         raise ParameterError(
             f"a record or window of {n} samples is too short for any τ: at least 2 samples are needed"
         )
     if m_max is not None:
-        m_max = _check_count(m_max, "m_max", 1)
+        m_max = check_count(m_max, "m_max", 1)
         if m_max > limit:
             raise ParameterError(f"m_max = {m_max} exceeds {limit}, the largest m for {n} samples")
         top = m_max
@@ -97,7 +64,7 @@ def _m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0
     if kind == "exp":
         m0 = 1
         if tau_min is not None:
-            tmin = _check_real(tau_min, "tau_min", "a positive finite number of seconds")
+            tmin = check_real(tau_min, "tau_min", "a positive finite number of seconds")
             m0 = int(math.floor(tmin * fs + 0.5)) if 0 < tmin * fs < 2.0**62 else 0
             if m0 < 1 or m0 > top:
                 raise ParameterError(
@@ -107,10 +74,10 @@ def _m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0
         if growth is not None and points is not None:
             raise ParameterError("give either growth or points for the 'exp' grid, not both")
         if growth is None:
-            points = EXP_DEFAULT_POINTS if points is None else _check_count(points, "points", 2)
+            points = EXP_DEFAULT_POINTS if points is None else check_count(points, "points", 2)
             growth = (top / m0) ** (1.0 / (points - 1)) if top > m0 else 2.0
         else:
-            growth = _check_real(growth, "growth", "a finite factor > 1")
+            growth = check_real(growth, "growth", "a finite factor > 1")
             if growth <= 1.0:
                 raise ParameterError(f"growth must be a finite factor > 1, got {growth:g}")
         # τ(i) = τ_con·τ_g^(i−1) (paper 000 §4.2), rounded to m, duplicates dropped. Below
@@ -166,11 +133,11 @@ def tau_grid(n: int, fs: float, kind: str = "exp", *, growth: float | None = Non
     >>> len(taus), float(taus[-1])                     # 24 duplicates at small m were dropped
     (76, 1111.0)
     """
-    fs = _check_fs(fs)
-    n = _check_count(n, "n", 1)
+    fs = check_fs(fs)
+    n = check_count(n, "n", 1)
     if not isinstance(kind, str):
         raise ParameterError(f"kind must be one of {GRIDS}, got {kind!r}")
-    return _m_grid(kind, n, growth=growth, points=points, tau_min=tau_min, fs=fs, m_max=m_max) / fs
+    return m_grid(kind, n, growth=growth, points=points, tau_min=tau_min, fs=fs, m_max=m_max) / fs
 
 
 def resolve_taus(taus, n: int, fs: float) -> np.ndarray:
@@ -180,7 +147,7 @@ def resolve_taus(taus, n: int, fs: float) -> np.ndarray:
     increasing — otherwise a :class:`ParameterError` says which τ and why.
     """
     if isinstance(taus, str):
-        return _m_grid(taus, n, fs=fs)
+        return m_grid(taus, n, fs=fs)
     if taus is None:
         raise ParameterError(f"taus must be a grid name ({', '.join(GRIDS)}) or a sequence of τ in seconds, got None")
     try:

@@ -1,19 +1,13 @@
 """Fitting the IEEE-952 noise model to an Allan variance: weighted non-negative least squares in linear
 variance space, iteratively reweighted by the model's own variance of each estimate.
 
-Model (FORMULAS.md §6, IEEE Std 952-1997 Annex C), τ in s, coefficients in the input unit's base form:
-
-    σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²·τ0(2m² + 1)/(6m) + R²τ²/2
-
-The rate-random-walk column is the exact Allan variance of a *sampled* random walk (K²τ/3 for
-m ≫ 1, 1.5× that at m = 1); the others are exact for sampled data (white angle, white rate, ramp)
-or the usual asymptote (flicker's plateau).
+The model and its terms: :mod:`allanite.model.terms`.
 
 Why not a line fit in log-log space: ln σ̂² is biased low by ≈ 1/ν and its variance 2/ν makes the
-few-cluster long-τ points weigh as much as the good ones (FORMULAS.md §7).
+few-cluster long-τ points weigh as much as the good ones (``docs/FORMULAS.md`` §7).
 
 Overlapping estimates (the default estimator) are fitted by generalized least squares with their
-exact covariance across τ under the model (:mod:`allanite._covariance`): neighbouring estimates share
+exact covariance across τ under the model (:mod:`allanite.model._covariance`): neighbouring estimates share
 most of their data, and the covariance says by how much, so the fit neither overcounts them nor
 throws information away; it is recomputed from the fitted coefficients until they settle. The
 coefficient covariance is then (AᵀΣ⁻¹A)⁻¹ and χ² is that of the whitened residuals. Classic and
@@ -24,38 +18,29 @@ By default only τ at least an octave apart enter either fit.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import ParameterError
-from .results import AllanResult, DynamicAllanResult
+from scipy.optimize import nnls as _scipy_nnls
+from scipy.stats import chi2 as chi2_dist
+from scipy.stats import norm
 
-__all__ = ["fit", "information_bound", "NoiseFit", "Coefficient", "CoefficientSeries", "TERMS"]
+from .._validate import check_count, check_nonnegative, check_positive
+from ..errors import ParameterError
+from ..estimators import get as get_estimator
+from ..estimators import names as estimator_names
+from ..estimators.confidence import edf_of
+from ..results import AllanResult, DynamicAllanResult
+from ..units import coefficient_unit, ieee952, rate_unit
+from . import _covariance
+from .terms import TERM_ALPHA, TERMS, check_terms, design_matrix
 
-#: Terms of the model, in order.
-TERMS = ("Q", "N", "B", "K", "R")
-#: Power-law noise type (α of S_y ∝ f^α, in phase/angle terms) that each term is, for the EDF.
-TERM_ALPHA = {"Q": 2, "N": 0, "B": -1, "K": -2, "R": -2}
-TERM_NAMES = {
-    "Q": "quantization", "N": "angle random walk", "B": "bias instability",
-    "K": "rate random walk", "R": "rate ramp",
-}
-_FLICKER = 2.0 * math.log(2.0) / math.pi
-
-
-def design_matrix(tau: np.ndarray, m: np.ndarray, fs: float, terms) -> np.ndarray:
-    """Columns of σ²(τ) per squared coefficient, one per term."""
-    tau0 = 1.0 / fs
-    cols = {
-        "Q": 3.0 / tau**2,
-        "N": 1.0 / tau,
-        "B": np.full_like(tau, _FLICKER),
-        "K": tau0 * (2.0 * m**2 + 1.0) / (6.0 * m),
-        "R": tau**2 / 2.0,
-    }
-    return np.column_stack([cols[t] for t in terms])
+__all__ = ["fit", "information_bound", "NoiseFit", "Coefficient", "CoefficientSeries", "TERMS",
+           "edf_per_tau", "nnls", "interval", "readoffs", "z_quantile", "coefficients", "check_tau_range",
+           "MAX_GLS_TAU"]
 
 
 @dataclass(frozen=True)
@@ -158,7 +143,7 @@ class NoiseFit:
 
     def plot(self, ax=None, **kwargs):
         """ADEV estimates with the fitted model and each term as its own line."""
-        from .plot import plot_fit
+        from ..plot import plot_fit  # matplotlib is imported only when a figure is drawn
 
         return plot_fit(self, ax=ax, **kwargs)
 
@@ -190,7 +175,7 @@ class CoefficientSeries:
 
     def plot(self, axes=None, ieee: bool = True):
         """Each coefficient against time, with its interval band."""
-        from .plot import plot_coefficient_series
+        from ..plot import plot_coefficient_series  # matplotlib is imported only when a figure is drawn
 
         return plot_coefficient_series(self, axes=axes, ieee=ieee)
 
@@ -224,25 +209,19 @@ def _octave_thin(tau: np.ndarray) -> np.ndarray:
     return np.asarray(keep)
 
 
-def _edf(alpha: np.ndarray, m: np.ndarray, n_points: int, estimator) -> np.ndarray:
-    """ν per τ for one noise type. ``estimator``: "oavar"/"avar", or a tuple naming the estimator of
+def edf_per_tau(alpha: np.ndarray, m: np.ndarray, n_points: int, estimator) -> np.ndarray:
+    """ν per τ for one noise type. ``estimator``: a registry name, or a tuple naming the estimator of
     every τ (Theo-family results: Greenhall's EDF for Allan τ, Howe's Theo1 EDF for Theo τ)."""
-    from .confidence import _edf_mixed, edf_greenhall
-
-    if not isinstance(estimator, str):
-        return _edf_mixed(np.asarray(alpha), np.asarray(m), int(n_points), np.asarray(estimator))
-    overlapping = estimator == "oavar"
-    return np.array([edf_greenhall(int(a), 2, int(mm), int(n_points), overlapping=overlapping)
-                     for a, mm in zip(alpha, m)], dtype=np.float64)
+    est = estimator if isinstance(estimator, str) else np.asarray(estimator)
+    return np.asarray(edf_of(est, np.asarray(alpha), np.asarray(m, dtype=np.int64), int(n_points)), dtype=np.float64)
 
 
-def _nnls(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    from scipy.optimize import nnls
-
+def nnls(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Non-negative least squares of ``a @ x ≈ b``, with the columns scaled first."""
     # Column scaling keeps the problem well conditioned (columns span many decades in τ).
     scale = np.linalg.norm(a, axis=0)
     scale[scale == 0] = 1.0
-    x, _ = nnls(a / scale, b, maxiter=50 * a.shape[1])
+    x, _ = _scipy_nnls(a / scale, b, maxiter=50 * a.shape[1])
     return x / scale
 
 
@@ -300,7 +279,7 @@ def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
     non-negative least squares of the whitened problem L⁻¹Aθ ≈ L⁻¹σ̂² (Σ = LLᵀ) with Σ from the
     previous pass's coefficients — the quasi-likelihood estimating equation Aᵀ Σ⁻¹ (σ̂² − Aθ) = 0,
     which needs no independence and no thinning. Coefficient covariance: (AᵀΣ⁻¹A)⁻¹."""
-    from ._covariance import assemble, covariance_blocks
+    assemble, covariance_blocks = _covariance.assemble, _covariance.covariance_blocks
 
     theta0, _, _, nu0, _, _, a, _ = start
     s_blk, t_blk = covariance_blocks(m, int(n_points) - 1, fs, terms)
@@ -319,7 +298,7 @@ def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
 
     def step(theta):
         chol = factor(theta)[0]
-        return _nnls(np.linalg.solve(chol, a), np.linalg.solve(chol, avar))
+        return nnls(np.linalg.solve(chol, a), np.linalg.solve(chol, avar))
 
     # convergence in model space: no τ's fitted value moves by more than GLS_TOL of itself (terms too
     # small to matter anywhere may still wander; they do not change the fit)
@@ -386,7 +365,7 @@ def _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
     for t in terms:
         key = (TERM_ALPHA[t], tuple(m), n_points, estimator)
         if key not in cache:
-            cache[key] = _edf(np.full(m.size, TERM_ALPHA[t]), m, n_points, estimator)
+            cache[key] = edf_per_tau(np.full(m.size, TERM_ALPHA[t]), m, n_points, estimator)
         nu_terms.append(cache[key])
     nu_terms = np.column_stack(nu_terms)
 
@@ -408,7 +387,7 @@ def _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
     for it in range(1, max_iter + 1):
         w = nu / (2.0 * np.maximum(model, 1e-300) ** 2)
         sw = np.sqrt(w)
-        new = _nnls(a * sw[:, None], avar * sw)
+        new = nnls(a * sw[:, None], avar * sw)
         parts = a * new
         floor = 1e-12 * np.max(avar)
         new_model = np.maximum(parts.sum(axis=1), floor)
@@ -449,14 +428,17 @@ def _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
     return theta, cov, model, nu, z, it, a, float(np.sum(z**2))
 
 
-def _interval(theta_k, var_k, zq, inflate):
+def interval(theta_k, var_k, zq, inflate):
+    """(low, high) of a coefficient from θ_k = coefficient² and its variance: θ ± z·SE·inflate,
+    clipped at 0, square-rooted."""
     se = math.sqrt(max(var_k, 0.0)) * inflate if np.isfinite(var_k) else math.inf
     lo = max(0.0, theta_k - zq * se)
     hi = theta_k + zq * se
     return math.sqrt(lo), math.sqrt(hi) if np.isfinite(hi) else math.inf
 
 
-def _readoffs(result: AllanResult, adev_row: np.ndarray) -> dict:
+def readoffs(result: AllanResult, adev_row: np.ndarray) -> dict:
+    """Datasheet read-offs of one ADEV curve: σ(1 s), σ_min and where, σ_min/0.664."""
     tau = result.tau
     out = {}
     if tau[0] <= 1.0 <= tau[-1]:
@@ -473,54 +455,29 @@ def _readoffs(result: AllanResult, adev_row: np.ndarray) -> dict:
     return out
 
 
-def _check_terms(terms) -> tuple:
-    if isinstance(terms, str):
-        terms = (terms,)
-    try:
-        terms = tuple(terms)
-    except TypeError:
-        raise ParameterError(f"terms must be a sequence of {TERMS}, got {terms!r}") from None
-    bad = [t for t in terms if t not in TERMS]
-    if bad or not terms or len(set(terms)) != len(terms):
-        raise ParameterError(f"terms must be distinct names from {TERMS}, got {terms!r}")
-    return tuple(t for t in TERMS if t in terms)
-
-
-def _zq(confidence) -> float:
-    from scipy.stats import norm
-
+def z_quantile(confidence) -> float:
+    """The two-sided normal quantile of a confidence level (1.0 for 68.3 %)."""
     if isinstance(confidence, bool) or not isinstance(confidence, (int, float, np.floating)) \
             or not 0.0 < float(confidence) < 1.0:
         raise ParameterError(f"confidence must be a level strictly between 0 and 1, got {confidence!r}")
     return float(norm.ppf(0.5 + float(confidence) / 2.0))
 
 
-def _coefficients(terms, theta, cov, zq, inflate, unit):
-    from .units import ieee952
-
+def coefficients(terms, theta, cov, zq, inflate, unit) -> dict:
+    """Term → :class:`Coefficient` from θ = coefficient² and its covariance (intervals θ ± z·SE,
+    widened by ``inflate``, clipped at 0, square-rooted); IEEE-952 values when ``unit`` is known."""
     coeffs = {}
     for k, name in enumerate(terms):
         value = math.sqrt(theta[k])
-        ci = _interval(theta[k], cov[k, k], zq, inflate)
+        ci = interval(theta[k], cov[k, k], zq, inflate)
         if unit is not None:
             q = ieee952(name, value, unit)
             lo = ieee952(name, ci[0], unit).value
             hi = ieee952(name, ci[1], unit).value if np.isfinite(ci[1]) else math.inf
-            coeffs[name] = Coefficient(name, value, ci, _base_unit(name, unit), q.value, (lo, hi), q.unit)
+            coeffs[name] = Coefficient(name, value, ci, coefficient_unit(name, unit), q.value, (lo, hi), q.unit)
         else:
             coeffs[name] = Coefficient(name, value, ci)
     return coeffs
-
-
-def _base_unit(term: str, unit) -> str:
-    """Label of a coefficient's base form for samples in ``unit`` (°/s → °, °/√s, °/s, °/s^1.5, °/s²)."""
-    from .units import rate_unit
-
-    u = str(rate_unit(unit))
-    if u.endswith("/s"):
-        angle = u[:-2]
-        return {"Q": angle, "N": f"{angle}/√s", "B": u, "K": f"{angle}/s^1.5", "R": f"{angle}/s²"}[term]
-    return {"Q": f"({u})·s", "N": f"({u})·√s", "B": u, "K": f"({u})/√s", "R": f"({u})/s"}[term]
 
 
 def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool = True, tau_range=None,
@@ -582,15 +539,13 @@ def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool
     >>> round(f.coefficients["N"].value, 3), f.coefficients["N"].ieee_unit
     (0.01, '°/√h')
     """
-    terms = _check_terms(terms)
-    zq = _zq(confidence)
+    terms = check_terms(terms)
+    zq = z_quantile(confidence)
     auto = isinstance(tau_range, str)
     if auto and tau_range != "auto":
         raise ParameterError(f"tau_range must be a (low, high) pair of seconds or 'auto', got {tau_range!r}")
-    tau_range = (0.0, np.inf) if auto else _check_tau_range(tau_range)
+    tau_range = (0.0, np.inf) if auto else check_tau_range(tau_range)
     if unit is not None:
-        from .units import rate_unit
-
         rate_unit(unit)
     if isinstance(result, DynamicAllanResult):
         _check_fit_estimator(result)
@@ -655,8 +610,6 @@ def _auto_note(cut, chi2_dof, first_chi2_dof, tau0, ok):
 
 
 def _fit_static_auto(result, avar_row, terms, unit, confidence, zq, thin, max_iter):
-    import dataclasses
-
     avar_row = np.asarray(avar_row, dtype=np.float64)
     cuts, tau0 = _auto_cuts(result, avar_row, thin, len(terms))
 
@@ -669,8 +622,6 @@ def _fit_static_auto(result, avar_row, terms, unit, confidence, zq, thin, max_it
 
 
 def _fit_dynamic_auto(result, terms, unit, confidence, zq, thin, max_iter):
-    import dataclasses
-
     rows = [result.avar] if result.avar.ndim == 2 else list(result.avar)
     out = []
     for rows_avar in rows:
@@ -690,17 +641,19 @@ def _fit_dynamic_auto(result, terms, unit, confidence, zq, thin, max_iter):
     return out[0] if result.avar.ndim == 2 else out
 
 
-#: Estimators whose values estimate the Allan variance (raw Theo1 does not: it is biased by a
-#: noise-type-dependent factor, which TheoBR's kf removes).
-FIT_ESTIMATORS = ("oavar", "avar", "theobr", "theoh", "theoh_a")
-
-
 def _check_fit_estimator(result) -> None:
+    """The result's values must estimate the Allan variance (the registry's ``estimates_allan``)."""
     if result.estimator == "theo1":
         raise ParameterError("fit needs Allan-variance estimates; raw Theo1 is biased against the Allan variance by "
                              "a noise-type-dependent factor: use estimator='theobr' or 'theoh'")
-    if result.estimator not in FIT_ESTIMATORS:
-        raise ParameterError(f"fit supports the estimators {FIT_ESTIMATORS}, not {result.estimator!r}")
+    if not get_estimator(result.estimator).estimates_allan:
+        raise ParameterError(f"fit supports the estimators {fit_estimators()}, not {result.estimator!r}")
+
+
+def fit_estimators() -> tuple[str, ...]:
+    """Estimators whose values estimate the Allan variance, so that :func:`fit` accepts them (raw Theo1
+    does not: it is biased by a noise-type-dependent factor, which TheoBR's kf removes)."""
+    return tuple(n for n in estimator_names() if get_estimator(n).estimates_allan)
 
 
 def _est_key(result, idx):
@@ -708,7 +661,8 @@ def _est_key(result, idx):
     return result.estimator if result.source is None else tuple(np.asarray(result.source)[idx])
 
 
-def _check_tau_range(tau_range):
+def check_tau_range(tau_range):
+    """A (low, high) τ range in seconds (None for an open end) as floats, or a ParameterError."""
     if tau_range is None:
         return (0.0, np.inf)
     try:
@@ -743,8 +697,6 @@ def _select(tau, avar, thin, n_terms, what, tau_range=(0.0, np.inf)):
 
 
 def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_iter, tau_range):
-    from scipy.stats import chi2 as chi2_dist
-
     avar_row = np.asarray(avar_row, dtype=np.float64)
     idx = _select(result.tau, avar_row, thin, len(terms), "the result", tau_range)
     tau, m, y = result.tau[idx], result.m[idx].astype(np.float64), avar_row[idx]
@@ -754,7 +706,7 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
     dof = max(1, tau.size - n_active)
     chi2_dof = chi2 / dof
     inflate = max(1.0, math.sqrt(chi2_dof))
-    coeffs = _coefficients(terms, theta, cov, zq, inflate, unit)
+    coeffs = coefficients(terms, theta, cov, zq, inflate, unit)
     notes = ()
     if chi2_dof > MISFIT_CHI2_DOF:
         notes = (f"χ²/dof {chi2_dof:.3g}: these terms do not describe the estimates (intervals widened by "
@@ -764,7 +716,7 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
         coefficients=coeffs, terms=terms, tau=tau, m=m, avar=y, edf=nu, model=model,
         components={t: a[:, k] * theta[k] for k, t in enumerate(terms)}, z=z, chi2=chi2, dof=dof,
         chi2_dof=chi2_dof, p_value=float(chi2_dist.sf(chi2, dof)),
-        readoffs=_readoffs(result, np.sqrt(avar_row)), fs=result.fs, confidence=confidence, unit=unit,
+        readoffs=readoffs(result, np.sqrt(avar_row)), fs=result.fs, confidence=confidence, unit=unit,
         iterations=it, theta=theta, covariance=cov, notes=notes,
         method="gls" if _exact_covariance_applies(tau, m, result.fs, result.n_samples + 1,
                                                   _est_key(result, idx)) else "wls",
@@ -801,11 +753,9 @@ def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range)
             inflate = max(1.0, math.sqrt(chi[j]))
             for k, t in enumerate(terms):
                 vals[t][j] = math.sqrt(theta[k])
-                lo[t][j], hi[t][j] = _interval(theta[k], cov[k, k], zq, inflate)
+                lo[t][j], hi[t][j] = interval(theta[k], cov[k, k], zq, inflate)
         ieee = ieee_units = None
         if unit is not None:
-            from .units import ieee952
-
             ieee = {t: ieee952(t, vals[t], unit).value for t in terms}
             ieee_units = {t: ieee952(t, 1.0, unit).unit for t in terms}
         series.append(CoefficientSeries(t=result.t, terms=terms, values=vals, ci_low=lo, ci_high=hi,
@@ -842,13 +792,13 @@ def information_bound(n: int, fs: float, *, Q: float = 0.0, N: float = 0.0, B: f
     >>> round(100 * 0.674 * b["K"], 1)   # median |error| of K no unbiased estimator beats: 16 %
     16.4
     """
-    n = int(_check_int_like(n, "n", 4))
-    tau0 = 1.0 / _positive(fs, "fs")
+    n = int(check_count(n, "n", 4))
+    tau0 = 1.0 / check_positive(fs, "fs")
     given = {"Q": Q, "N": N, "B": B, "K": K}
     terms = []
     theta = []
     for name, v in given.items():
-        v = _nonnegative(v, name)
+        v = check_nonnegative(v, name)
         if v > 0:
             terms.append(name)
             theta.append(v * v)
@@ -870,22 +820,3 @@ def information_bound(n: int, fs: float, *, Q: float = 0.0, N: float = 0.0, B: f
         info += dw @ dw.T
     cov = np.linalg.inv(info)
     return {t: float(math.sqrt(cov[i, i]) / (2.0 * theta[i])) for i, t in enumerate(terms)}
-
-
-def _check_int_like(v, name, minimum):
-    if isinstance(v, bool) or not isinstance(v, (int, np.integer, float, np.floating)) or not np.isfinite(v) \
-            or v != int(v) or v < minimum:
-        raise ParameterError(f"{name} must be a whole number ≥ {minimum}, got {v!r}")
-    return int(v)
-
-
-def _positive(v, name):
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not np.isfinite(v) or v <= 0:
-        raise ParameterError(f"{name} must be a positive finite number, got {v!r}")
-    return float(v)
-
-
-def _nonnegative(v, name):
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not np.isfinite(v) or v < 0:
-        raise ParameterError(f"{name} must be a finite number ≥ 0, got {v!r}")
-    return float(v)

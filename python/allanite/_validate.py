@@ -1,28 +1,98 @@
-"""Turning what users pass into what the core needs: contiguous float64 rate columns.
+"""Every shared check of user input, with the public error messages in one place.
 
-Kept apart from the estimators so that readers, the CLI and later estimators share one set of
-checks and one set of messages.
+Turning what users pass into what the core needs (contiguous float64 rate columns) and checking
+scalar options (sampling rate, counts, probabilities, choices). Kept apart from the estimators so
+that readers, the CLI, the model and every estimator share one set of checks and one set of
+messages. Public to the package (no leading underscores), private to users.
 """
 
 from __future__ import annotations
 
+import math
 import numbers
 import os
+from collections.abc import Iterable
 
 import numpy as np
 
 from .errors import InputError, ParameterError
-from .grid import _check_count, _check_fs
 
 INPUTS = ("rate", "increment", "angle")
 DEFAULT_MAX_MEMORY = 2 * 1024**3
 MAX_WORKERS = 4096
 
 
-def check_choice(value, name: str, allowed) -> str:
+def check_choice(value: object, name: str, allowed: Iterable[str]) -> str:
+    """``value`` if it is one of the strings ``allowed``, else a ParameterError listing them."""
+    allowed = tuple(allowed)
     if not isinstance(value, str) or value not in allowed:
         raise ParameterError(f"unknown {name} {value!r}; allowed: {', '.join(map(repr, allowed))}")
     return value
+
+
+def check_fs(fs: object) -> float:
+    """A sampling rate: a positive finite number whose inverse is finite."""
+    if isinstance(fs, bool) or not isinstance(fs, (numbers.Real, np.floating, np.integer)):
+        raise ParameterError(f"fs must be a positive finite number of samples per second, got {fs!r}")
+    fs = float(fs)
+    if not math.isfinite(fs) or fs <= 0:
+        raise ParameterError(f"fs must be a positive finite number of samples per second, got {fs!r}")
+    if not math.isfinite(1.0 / fs) or fs < 1e-200:
+        raise ParameterError(f"fs = {fs!r} Hz is too small: the sampling interval 1/fs is not a finite number")
+    return fs
+
+
+def check_real(value: object, name: str, allowed: str) -> float:
+    """A finite real scalar (not bool, not str), or a ParameterError naming it and ``allowed``."""
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
+        raise ParameterError(f"{name} must be {allowed}, got {value!r}")
+    out = float(value)
+    if not math.isfinite(out):
+        raise ParameterError(f"{name} must be {allowed}, got {value!r}")
+    return out
+
+
+def check_count(value: object, name: str, minimum: int, maximum: int | None = None) -> int:
+    """An integer (or an integral float) in [minimum, maximum]."""
+    if isinstance(value, bool) or not isinstance(value, (numbers.Integral, np.integer)):
+        if isinstance(value, (float, np.floating)) and math.isfinite(value) and float(value).is_integer():
+            value = int(value)
+        else:
+            raise ParameterError(f"{name} must be an integer ≥ {minimum}, got {value!r}")
+    out = int(value)
+    if out < minimum:
+        raise ParameterError(f"{name} must be an integer ≥ {minimum}, got {out}")
+    if maximum is not None and out > maximum:
+        raise ParameterError(f"{name} must be an integer ≤ {maximum}, got {out}")
+    return out
+
+
+def check_positive(value: object, name: str) -> float:
+    """A positive finite number."""
+    v = check_real(value, name, "a positive finite number")
+    if v <= 0:
+        raise ParameterError(f"{name} must be a positive finite number, got {value!r}")
+    return v
+
+
+def check_nonnegative(value: object, name: str) -> float:
+    """A finite number ≥ 0."""
+    v = check_real(value, name, "a finite number ≥ 0")
+    if v < 0:
+        raise ParameterError(f"{name} must be a finite number ≥ 0, got {value!r}")
+    return v
+
+
+def check_probability(value: object, name: str = "confidence") -> float:
+    """A probability strictly between 0 and 1 (a confidence level)."""
+    if isinstance(value, bool) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
+        raise ParameterError(f"{name} must be a probability strictly between 0 and 1, got {value!r}")
+    c = float(value)
+    if not (0.0 < c < 1.0):
+        raise ParameterError(
+            f"{name} must be a probability strictly between 0 and 1 (e.g. 0.683 or 0.95), got {value!r}"
+        )
+    return c
 
 
 def as_rate_columns(x, fs, input: str):
@@ -33,7 +103,7 @@ def as_rate_columns(x, fs, input: str):
     (angle per sample) is divided by τ0; ``input="angle"`` (cumulative angle, M + 1 points) is
     differenced first. All three describe the same record and give the same Allan variance.
     """
-    fs = _check_fs(fs)
+    fs = check_fs(fs)
     check_choice(input, "input", INPUTS)
     try:
         arr = np.asarray(x)
@@ -89,7 +159,7 @@ def resolve_workers(workers) -> int:
         if not 1 <= workers <= MAX_WORKERS:
             raise ParameterError(f"ALLANITE_NUM_THREADS={env!r} must be an integer from 1 to {MAX_WORKERS}")
         return workers
-    return _check_count(workers, "workers", 1, MAX_WORKERS)
+    return check_count(workers, "workers", 1, MAX_WORKERS)
 
 
 def resolve_max_memory(max_memory) -> int:

@@ -22,12 +22,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ._input import INPUTS, check_choice
-from .errors import AllaniteError, InputError, ParameterError
-from .grid import _check_fs
-from .units import Unit, parse_unit
+from .._validate import INPUTS, check_choice, check_fs
+from ..errors import DataGapError, InputError, MissingDependencyError, ParameterError
+from ..units import Unit, parse_unit
 
-__all__ = ["read_log", "Log", "Gap", "MissingDependencyError", "GAP_MODES", "GAP_FACTOR"]
+__all__ = ["read_log", "Log", "Gap", "sniff_format", "GAP_MODES", "GAP_FACTOR"]
 
 #: What ``gaps=`` accepts.
 GAP_MODES = ("error", "longest", "split")
@@ -44,11 +43,6 @@ _BAG_FIELDS = ("angular_velocity_x", "angular_velocity_y", "angular_velocity_z",
                "linear_acceleration_x", "linear_acceleration_y", "linear_acceleration_z")
 _TIME_NAMES = {"t", "time", "times", "timestamp", "timestamps", "stamp", "time_s", "t_s", "sec", "seconds",
                "time[s]", "time(s)", "time_ns", "timestamp_ns", "time_us", "time_ms", "epoch"}
-
-
-class MissingDependencyError(AllaniteError, ImportError):
-    """An optional package needed for this file format is not installed (the message names the
-    ``pip install`` extra)."""
 
 
 @dataclass(frozen=True)
@@ -248,7 +242,7 @@ def read_log(path, *, fs=None, columns=None, time_column=None, unit=None, input=
     check_choice(gaps, "gaps", GAP_MODES)
     check_choice(time_unit, "time_unit", tuple(TIME_UNITS))
     if fs is not None:
-        fs = _check_fs(fs)
+        fs = check_fs(fs)
     u = None
     if unit is not None:
         need = "rate" if input == "rate" else "angle"
@@ -264,7 +258,7 @@ def read_log(path, *, fs=None, columns=None, time_column=None, unit=None, input=
     if not path.exists():
         raise InputError(f"{path}: no such file")
 
-    fmt = _sniff(path)
+    fmt = sniff_format(path)
     if fmt in ("ros1", "ros2"):
         rec = _read_bag(path, fmt, columns, time_column, topic)
         if u is None and input == "rate":
@@ -319,7 +313,9 @@ def _check_column_spec(spec, name, single=False):
     raise ParameterError(f"{name} must be {what}, got {spec!r}")
 
 
-def _sniff(path: Path) -> str:
+def sniff_format(path: Path) -> str:
+    """The format of ``path`` from its content and name: "csv", "csv.gz", "npy", "npz", "parquet",
+    "ros1" or "ros2" — or an InputError saying what the file is not."""
     if path.is_dir():
         if (path / "metadata.yaml").is_file() or any(path.glob("*.db3")) or any(path.glob("*.mcap")):
             return "ros2"
@@ -477,7 +473,7 @@ def _finish(path, fmt, rec: _Record, fs, unit, input, gaps) -> Log:
     if gap_list and gaps == "error":
         shown = "; ".join(str(g) for g in gap_list[:10])
         more = f"; … and {len(gap_list) - 10} more" if len(gap_list) > 10 else ""
-        raise InputError(
+        raise DataGapError(
             f"{path}: {len(gap_list)} gap(s) in time column {rec.time_name!r} (a step over {GAP_FACTOR}× the "
             f"nominal {1.0 / fs:g} s): {shown}{more}. Pass gaps='longest' to keep the longest gap-free "
             f"stretch, or gaps='split' for every stretch"

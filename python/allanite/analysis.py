@@ -1,32 +1,29 @@
-"""Static and dynamic Allan variance — the public entry points over the Rust core."""
+"""Static and dynamic Allan variance — the public entry points: input checks, the estimator registry,
+result objects.
+
+Which estimators exist, what options each takes and how each is computed is the registry's business
+(:mod:`allanite.estimators`); this module turns samples into rate columns, asks the entry, guards the
+memory budget and wraps the arrays into :class:`~allanite.AllanResult` /
+:class:`~allanite.DynamicAllanResult`.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from . import _core
-from ._input import as_rate_columns, check_choice, resolve_max_memory, resolve_workers
+from . import estimators
+from ._validate import as_rate_columns, check_choice, check_count, resolve_max_memory
 from .errors import MemoryBudgetError, ParameterError
-from .grid import _check_count, resolve_taus
 from .results import AllanResult, DynamicAllanResult
-from .theo import DYNAMIC_THEO_ESTIMATORS, THEO_ESTIMATORS, dynamic_theo, static_theo
 
-__all__ = ["avar", "davar", "ESTIMATORS", "METHODS"]
+__all__ = ["avar", "davar", "METHODS"]
 
-ESTIMATORS = ("oavar", "avar")
-STATIC_ESTIMATORS = ESTIMATORS + THEO_ESTIMATORS
-DYNAMIC_ESTIMATORS = ESTIMATORS + DYNAMIC_THEO_ESTIMATORS
+#: ``method=`` of :func:`davar`: sliding sums, or every window recomputed (paper 000's DAVAR).
 METHODS = ("fast", "naive")
 
 
-def _n_terms(estimator: str, window: int, ms: np.ndarray) -> np.ndarray:
-    if estimator == "oavar":
-        return (window + 1 - 2 * ms).astype(np.int64)
-    return (window // ms - 1).astype(np.int64)
-
-
 def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar", workers=None,
-         kf_rule: str = "textbook", decimate=1) -> AllanResult:
+         kf_rule: str = "textbook", decimate="auto") -> AllanResult:
     """Allan variance of a whole record.
 
     Parameters
@@ -47,7 +44,7 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
         Overlapping (default; NIST SP 1065 eq. 11) or classic non-overlapping Allan variance;
         Theo1 (even m ≥ 10, τ = 0.75·m/fs, up to 75 % of the record), bias-removed TheoBR, or
         TheoH (overlapping Allan up to 10 % of the record, TheoBR beyond) — see
-        :mod:`allanite.theo`. For these, named grids span m = 1 … M, ``result.source`` says which
+        :mod:`allanite.estimators.theo`. For these, named grids span m = 1 … M, ``result.source`` says which
         estimator each τ came from and ``result.kf`` holds the bias ratio.
     workers : int, optional
         Threads (default: ``ALLANITE_NUM_THREADS``, else all cores). Results do not depend on it.
@@ -58,8 +55,9 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
         Theo estimators only. Theo1 of a whole record costs O(N²) (≈ 2 s at N = 1e5, minutes at
         1e6). With D > 1 the Theo part and kf are computed on the rate averaged in blocks of D
         samples (the phase decimated by D: Taylor & Howe's fast TheoBR), at τ = 0.75·m'·D/fs,
-        reported as m = m'·D; the Allan part stays exact. ``"auto"``: the smallest D that leaves
-        ≤ 100 000 samples. Default 1 (exact). Named τ grids only.
+        reported as m = m'·D; the Allan part stays exact. ``"auto"`` (default): on a named τ grid,
+        the smallest D that leaves ≤ 100 000 samples (records up to 100 000 samples stay exact);
+        explicit τ are computed exactly. ``decimate=1``: always exact (O(N²); Ctrl-C stops it).
 
     Returns
     -------
@@ -77,25 +75,16 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
     >>> np.round(r.adev * np.sqrt(r.m), 1)                      # white rate: adev·√m ≈ σ
     array([1., 1., 1.])
     """
-    check_choice(estimator, "estimator", STATIC_ESTIMATORS)
+    entry = estimators.get(estimator, "static")
+    options = entry.check_options({"kf_rule": kf_rule, "decimate": decimate})
     cols, fs, is_multi = as_rate_columns(x, fs, input)
-    n = cols[0].size
-    if estimator not in THEO_ESTIMATORS and (decimate not in (1, None) or kf_rule != "textbook"):
-        raise ParameterError(f"decimate and kf_rule apply to the Theo estimators {THEO_ESTIMATORS}, not to "
-                             f"estimator={estimator!r}")
-    if estimator in THEO_ESTIMATORS:
-        tau, values, n_terms, ms, src, kf = static_theo(cols, fs, taus, estimator, workers, kf_rule, decimate)
-        if not is_multi:
-            values, kf = values[0], (None if kf is None else float(kf[0]))
-        return AllanResult(tau=tau, avar=values, n=n_terms, m=ms, estimator=estimator, fs=fs, n_samples=n,
-                           input=input, source=src, kf=kf)
-    ms = resolve_taus(taus, n, fs)
-    out = _core.davar(cols, n, 1, [int(m) for m in ms], estimator, "fast", resolve_workers(workers))
-    values = out[:, :, 0] if is_multi else out[0, :, 0]
-    return AllanResult(
-        tau=ms / fs, avar=values, n=_n_terms(estimator, n, ms), m=ms,
-        estimator=estimator, fs=fs, n_samples=n, input=input,
-    )
+    assert entry.static is not None
+    out = entry.static(cols, fs, taus, workers, **options)
+    values, kf = out.values, out.kf
+    if not is_multi:
+        values, kf = values[0], (None if kf is None else float(kf[0]))
+    return AllanResult(tau=out.tau, avar=values, n=out.n, m=out.m, estimator=estimator, fs=fs,
+                       n_samples=cols[0].size, input=input, source=out.source, kf=kf)
 
 
 def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: str = "oavar",
@@ -156,23 +145,20 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
     >>> np.round(d.adev[0, [0, -1]])                            # before and after, at τ = 0.01 s
     array([ 1., 10.])
     """
-    check_choice(estimator, "estimator", DYNAMIC_ESTIMATORS)
+    entry = estimators.get(estimator, "dynamic")
     check_choice(method, "method", METHODS)
+    options = entry.check_options({"kf_rule": kf_rule})
     cols, fs, is_multi = as_rate_columns(x, fs, input)
     n = cols[0].size
-    window = _check_count(window, "window", 2)
-    hop = _check_count(hop, "hop", 1)
+    window = check_count(window, "window", 2)
+    hop = check_count(hop, "hop", 1)
     if window > n:
         raise ParameterError(f"window ({window} samples) is longer than the record ({n} samples)")
-    theo = estimator in DYNAMIC_THEO_ESTIMATORS
-    if theo:
-        if method != "fast":
-            raise ParameterError(f"estimator {estimator!r} is computed with method='fast' only, got method={method!r}")
-        from .theo import theo_ms
-
-        ms, src = theo_ms(taus, window, fs, estimator)
-    else:
-        ms = resolve_taus(taus, window, fs)
+    if method not in entry.methods:
+        raise ParameterError(f"estimator {estimator!r} is computed with method={entry.methods[0]!r} only, "
+                             f"got method={method!r}")
+    assert entry.dynamic is not None and entry.resolve_m is not None
+    ms = entry.resolve_m(taus, window, fs)
     n_win = (n - window) // hop + 1
     n_axes = len(cols)
     nbytes = n_axes * ms.size * n_win * 8
@@ -195,15 +181,10 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
     # A hop beyond the record gives one window, as does the record length itself.
     hop_core = min(hop, n)
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
-    if theo:
-        tau, out, n_terms, ms, src, kf = dynamic_theo(cols, fs, window, hop_core, taus, estimator, workers, kf_rule)
-        return DynamicAllanResult(
-            tau=tau, t=t, avar=out if is_multi else out[0], n=n_terms, m=ms, window=window, hop=hop, method=method,
-            estimator=estimator, fs=fs, n_samples=n, input=input, source=src, kf=kf if is_multi else kf[0],
-        )
-    out = _core.davar(cols, window, hop_core, [int(m) for m in ms], estimator, method, resolve_workers(workers))
-    values = out if is_multi else out[0]
+    out = entry.dynamic(cols, fs, window, hop_core, taus, method, workers, **options)
+    kf = out.kf
     return DynamicAllanResult(
-        tau=ms / fs, t=t, avar=values, n=_n_terms(estimator, window, ms), m=ms, window=window, hop=hop,
-        method=method, estimator=estimator, fs=fs, n_samples=n, input=input,
+        tau=out.tau, t=t, avar=out.values if is_multi else out.values[0], n=out.n, m=out.m, window=window, hop=hop,
+        method=method, estimator=estimator, fs=fs, n_samples=n, input=input, source=out.source,
+        kf=kf if (kf is None or is_multi) else kf[0],
     )

@@ -1,0 +1,62 @@
+"""The overlapping and the classic Allan variance — registry entries over the Rust core.
+
+``"oavar"``: NIST SP 1065 eq. 11, (1 / 2τ²(N − 2m)) Σ (x_{i+2m} − 2x_{i+m} + x_i)² over all N − 2m
+second differences of the angle (phase) x. ``"avar"``: the classic estimator on non-overlapping
+m-sample clusters. Both are computed by one drift-free sliding kernel (``rust/core/src/allan.rs``):
+a whole record is the window that spans it.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+
+from .. import _core
+from .._validate import resolve_workers
+from ._registry import Computed, Estimator, register
+from .confidence import edf_greenhall
+from .grid import resolve_taus
+
+__all__ = ["n_terms", "allan_values"]
+
+
+def n_terms(estimator: str, window: int, ms: np.ndarray) -> np.ndarray:
+    """Squared differences averaged per estimate: N − 2m + 1 rate-sample windows (overlapping), or
+    ⌊W/m⌋ − 1 (classic)."""
+    if estimator == "oavar":
+        return (window + 1 - 2 * ms).astype(np.int64)
+    return (window // ms - 1).astype(np.int64)
+
+
+def allan_values(cols, window: int, hop: int, ms, estimator: str, method: str, threads: int) -> np.ndarray:
+    """The core's Allan variance of every window: (axes, len(ms), windows). ``threads``: as resolved by
+    :func:`allanite._validate.resolve_workers` (0 = rayon's default)."""
+    return _core.davar(cols, window, hop, [int(m) for m in ms], estimator, method, threads)
+
+
+def _static(cols, fs, taus, workers, *, estimator: str) -> Computed:
+    n = cols[0].size
+    ms = resolve_taus(taus, n, fs)
+    values = allan_values(cols, n, 1, ms, estimator, "fast", resolve_workers(workers))[:, :, 0]
+    return Computed(tau=ms / fs, values=values, n=n_terms(estimator, n, ms), m=ms)
+
+
+def _dynamic(cols, fs, window, hop, taus, method, workers, *, estimator: str) -> Computed:
+    ms = resolve_taus(taus, window, fs)
+    values = allan_values(cols, window, hop, ms, estimator, method, resolve_workers(workers))
+    return Computed(tau=ms / fs, values=values, n=n_terms(estimator, window, ms), m=ms)
+
+
+def _edf(alpha, m, n_phase, *, overlapping: bool):
+    return edf_greenhall(alpha, 2, m, n_phase, overlapping=overlapping)
+
+
+for _name, _label, _overlapping in (("oavar", "overlapping Allan variance", True),
+                                    ("avar", "Allan variance (classic, non-overlapping)", False)):
+    register(Estimator(
+        name=_name, label=_label, family="allan",
+        static=partial(_static, estimator=_name), dynamic=partial(_dynamic, estimator=_name),
+        edf=partial(_edf, overlapping=_overlapping), methods=("fast", "naive"), noise_id=_name,
+        resolve_m=resolve_taus,
+    ))

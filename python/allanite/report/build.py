@@ -1,0 +1,360 @@
+"""The allanite report: static Allan deviation with confidence intervals, the IEEE-952 noise model,
+the dynamic Allan variance and the noise coefficients over time — as numbers, text, figures and one
+self-contained HTML page.
+
+:func:`build_report` (or :func:`from_log` for a :class:`~allanite.Log`) computes everything and
+returns a :class:`Report`; :meth:`Report.write` writes ``report.html``, ``summary.json`` and the
+PNG figures into a folder; :meth:`Report.text` is the terminal summary. ``allanite report`` (the
+command line, :mod:`allanite.cli`) only wires :func:`allanite.read_log` and these together.
+
+Every number the page shows is read from :meth:`Report.summary`, the dictionary written as
+``summary.json``, so the two cannot disagree. Its conventions: times and τ in seconds (keys ending
+in ``_s``), rates in Hz, Allan deviations in the samples' rate unit (``adev_unit``), coefficients
+in their base form (``unit``) and in IEEE-952 units (``ieee_unit``); ``null`` stands for a number
+that does not exist (no unit given, an unbounded interval, a read-off outside the τ range).
+
+Examples
+--------
+>>> import numpy as np, allanite, tempfile
+>>> from allanite.report import build_report
+>>> y = allanite.simulate(20_000, 100.0, N=0.01, K=1e-3, seed=1)[:, None]
+>>> rep = build_report(y, 100.0, unit="deg/s", window=4_000, hop=1_000)
+>>> rep.summary()["fit"]["axes"][0]["coefficients"]["N"]["ieee_unit"]
+'°/√h'
+>>> paths = rep.write(tempfile.mkdtemp())
+>>> sorted(p.name for p in paths if p.suffix != ".png")
+['report.html', 'summary.json']
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import datetime as _dt
+import io as _io
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._validate import check_choice, check_count
+from ..analysis import avar, davar
+from ..errors import AllaniteError, ParameterError
+from ..estimators.theo import resolve_decimation
+from ..model import fit as fit_model
+from ..model import refine as refine_axis
+from ..units import adev_unit_label, parse_unit
+from .figures import figure_specs
+from .fmt import json_number
+from .page import html_page
+from .settings import (DHVAR_MAX_DEFAULT_WINDOW, DHVAR_MAX_WINDOWS, REPORT_ESTIMATORS, default_hop,
+                       default_window)
+from .summary import summarize, text_summary
+
+__all__ = ["Report", "build_report", "from_log", "log_source"]
+
+
+class _NoProgress:
+    def step(self, name: str) -> None:
+        pass
+
+    def add(self, n: int) -> None:
+        pass
+
+
+@dataclass
+class Report:
+    """Everything the report shows. Build it with :func:`build_report` or :func:`from_log`.
+
+    Attributes
+    ----------
+    static : AllanResult
+        Overlapping Allan variance of the whole record, with confidence intervals, (axes, τ).
+    dynamic : DynamicAllanResult
+        DAVAR, (axes, τ, t).
+    fits : list of NoiseFit or None
+        Whole-record noise-model fit per axis (None with ``fit=False`` or when it failed: ``fit_error``).
+    series : list of CoefficientSeries or None
+        The coefficients fitted in every DAVAR window, per axis (``series_error`` when it failed).
+    unit : str or None
+        Unit of the samples (canonical name, e.g. ``"deg/s"``); None when unknown.
+    axis_names : list of str
+    source : dict
+        Where the record came from (JSON-able): path, format, columns, gaps, …
+    notes : list of str
+        Things the reader must know (unit unknown, gaps, warnings while reading).
+    """
+
+    static: object
+    dynamic: object
+    fits: list | None
+    series: list | None
+    fs: float
+    unit: str | None
+    input: str
+    axis_names: list
+    source: dict
+    settings: dict
+    notes: list = field(default_factory=list)
+    fit_requested: bool = True
+    fit_error: str | None = None
+    series_error: str | None = None
+    created: str = ""
+    #: per axis :class:`~allanite.Refinement` (``refine=True``), else None
+    refinements: list | None = None
+    _summary: dict | None = field(default=None, repr=False)
+
+    # ---------------------------------------------------------------------------- properties
+    @property
+    def n_axes(self) -> int:
+        return len(self.axis_names)
+
+    @property
+    def adev_unit(self) -> str | None:
+        """Label of the Allan deviation's unit (e.g. ``"°/s"``), None when the unit is unknown."""
+        if self.unit is None:
+            return None
+        return adev_unit_label(self.unit)
+
+    def __repr__(self) -> str:
+        fit = "not fitted" if self.fits is None else f"{len(self.fits)} noise fits"
+        return (f"Report({self.source.get('name', 'record')!r}: {self.static.n_samples} samples × {self.n_axes} "
+                f"axes at {self.fs:g} Hz, unit {self.unit or 'unknown'}; {self.static.tau.size} τ, "
+                f"{self.dynamic.t.size} DAVAR windows; {fit})")
+
+    # ---------------------------------------------------------------------------- summary
+    def summary(self) -> dict:
+        """Every number of the report, JSON-able (what ``summary.json`` holds)."""
+        if self._summary is None:
+            self._summary = summarize(self)
+        return self._summary
+
+    def text(self) -> str:
+        """The terminal summary: ADEV table with intervals, fitted coefficients, DAVAR summary."""
+        return text_summary(self.summary())
+
+    # ---------------------------------------------------------------------------- figures
+    def figure_specs(self) -> list:
+        """(file name, title, caption, draw) for every figure; ``draw(fig)`` fills a matplotlib Figure."""
+        return figure_specs(self)
+
+    def render_figures(self, progress=None, dpi: int = 100) -> dict:
+        """File name → PNG bytes of every figure."""
+        from matplotlib.figure import Figure  # matplotlib only when figures are drawn
+
+        progress = progress or _NoProgress()
+        images = {}
+        for name, _title, _caption, size, draw in self.figure_specs():
+            progress.step(f"figure {name}")
+            fig = Figure(figsize=size, dpi=dpi)
+            draw(fig)
+            buf = _io.BytesIO()
+            fig.savefig(buf, format="png", dpi=dpi)
+            images[name] = buf.getvalue()
+        return images
+
+    def html(self, images: dict) -> str:
+        """The self-contained HTML page, with ``images`` (file name → PNG bytes) embedded as data URIs."""
+        return html_page(self, images)
+
+    def write(self, out, progress=None, dpi: int = 100) -> list:
+        """Write ``report.html``, ``summary.json`` and the PNG figures into folder ``out`` (created if
+        needed). Returns the paths written, report.html and summary.json first."""
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        progress = progress or _NoProgress()
+        images = self.render_figures(progress, dpi=dpi)
+        progress.step("writing report.html, summary.json")
+        pngs = []
+        for name, data in images.items():
+            p = out / name
+            p.write_bytes(data)
+            pngs.append(p)
+        summary = self.summary()
+        summary["files"] = {"html": "report.html", "summary": "summary.json", "figures": list(images)}
+        (out / "summary.json").write_text(json.dumps(summary, indent=1, ensure_ascii=False, allow_nan=False),
+                                          encoding="utf-8")
+        (out / "report.html").write_text(self.html(images), encoding="utf-8")
+        return [out / "report.html", out / "summary.json"] + pngs
+
+
+def _check_taus(taus):
+    if isinstance(taus, str):
+        return taus
+    return np.asarray(taus, dtype=np.float64)
+
+
+def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, source=None, window=None, hop=None,
+                 taus="octave", fit: bool = True, confidence: float = 0.683, notes=(), progress=None,
+                 estimator: str = "oavar", refine: bool = False) -> Report:
+    """Compute everything the report shows.
+
+    Parameters
+    ----------
+    x : array_like, (samples,) or (samples, axes)
+        The samples (rate, increments or cumulative angle, per ``input``).
+    fs : float
+        Sampling rate, Hz.
+    unit : str, optional
+        Unit of the samples (a rate unit, or an angle unit for increments/angle). Without it the
+        numbers are in "the samples' unit" and the coefficients stay in base form.
+    axis_names : list of str, optional
+        One per axis (default "axis 0", "axis 1", …).
+    source : dict, optional
+        JSON-able description of where the record came from (shown in the Record section).
+    window, hop : int, optional
+        DAVAR window and hop in samples; defaults :func:`default_window` (record/12) and
+        :func:`default_hop` (window/25).
+    taus : str or array_like
+        τ of the static analysis: a grid name (default ``"octave"``) or τ in seconds. The DAVAR
+        uses paper 000's exponential grid on the window (DHVAR: the octave grid).
+    refine : bool
+        Also run :func:`allanite.refine` on every axis (a few seconds per 10⁶ samples): the page gains a
+        "Model refinement" section — the effects the five-term model lacks, their parameters and the
+        error before and after.
+    estimator : {"oavar", "theoh"}
+        ``"oavar"`` (default): overlapping Allan deviation and DAVAR. ``"theoh"``: TheoH for the
+        whole record and paper 001's DHVAR over time (overlapping Allan up to 10 % of the record or
+        window, bias-removed Theo1 beyond, reaching 75 %); the default window is then capped at
+        ``DHVAR_MAX_DEFAULT_WINDOW`` samples and the default hop keeps ≤ ``DHVAR_MAX_WINDOWS``
+        windows; records over 100 000 samples get their whole-record TheoBR part from block
+        averages (``avar(decimate="auto")``, Taylor & Howe's fast TheoBR).
+    fit : bool
+        Fit the IEEE-952 noise model (whole record and every window).
+    confidence : float
+        Level of all intervals (default 68.3 %).
+    notes : sequence of str
+        Extra notes to show (warnings from reading, …).
+    progress : object with ``step(name)``, optional
+        Told before each step (the CLI's progress bar).
+    """
+    progress = progress or _NoProgress()
+    notes = list(notes)
+    x = np.asarray(x) if not isinstance(x, np.ndarray) else x
+    if x.ndim == 1:
+        x = x[:, None]
+    unit_name = None if unit is None else parse_unit(unit, kind="rate" if input == "rate" else "angle").name
+    if unit_name is None:
+        notes.append("The unit of the samples is unknown (not given): Allan deviations are in the "
+                     "samples' own unit and the noise coefficients in base form, without IEEE-952 conversion.")
+    n_axes = x.shape[1]
+    if axis_names is None:
+        axis_names = [f"axis {k}" for k in range(n_axes)]
+    axis_names = [str(a) for a in axis_names]
+    if len(axis_names) != n_axes:
+        raise ParameterError(f"axis_names has {len(axis_names)} names for {n_axes} axes")
+    taus = _check_taus(taus)
+    check_choice(estimator, "estimator", tuple(REPORT_ESTIMATORS))
+    static_est, dynamic_est, dynamic_grid = REPORT_ESTIMATORS[estimator][:3]
+
+    progress.step("static Allan deviation")
+    extra = {"decimate": "auto"} if static_est == "theoh" else {}
+    static = avar(x, fs, input=input, taus=taus, estimator=static_est, **extra)
+    progress.step("confidence intervals")
+    static = static.with_confidence(x, confidence=confidence)
+
+    n = static.n_samples
+    window_given, hop_given = window is not None, hop is not None
+    if window is None:
+        window = default_window(n)
+        if estimator == "theoh":
+            window = min(window, DHVAR_MAX_DEFAULT_WINDOW)
+    else:
+        window = check_count(window, "window", 2)
+    if hop is None:
+        hop = default_hop(window)
+        if estimator == "theoh":
+            # every DHVAR window gets its own fit: keep it to about DHVAR_MAX_WINDOWS of them
+            hop = max(hop, -(-(n - window) // DHVAR_MAX_WINDOWS))
+    progress.step("dynamic Allan variance")
+    dynamic = davar(x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est)
+    settings = {"window": int(dynamic.window), "hop": int(dynamic.hop), "window_default": not window_given,
+                "hop_default": not hop_given, "taus": taus if isinstance(taus, str) else "explicit",
+                "estimator": estimator, "dynamic_grid": dynamic_grid,
+                "theo_decimation": (resolve_decimation("auto", n, taus) if static_est == "theoh" else None)}
+
+    fits = series = None
+    fit_error = series_error = None
+    if fit:
+        progress.step("noise-model fit")
+        try:
+            # tau_range="auto": a real sensor's shortest τ (anti-alias filter, vibration lines) are often not
+            # the model's; they would dominate the fit and give wrong coefficients. The cut is stated.
+            fits = fit_model(static, unit=unit_name, confidence=confidence, tau_range="auto")
+            if not isinstance(fits, list):
+                fits = [fits]
+            for k, f in enumerate(fits):
+                notes.extend(f"{axis_names[k]}: {note}." for note in f.notes)
+        except AllaniteError as exc:
+            fit_error = str(exc)
+            notes.append(f"The noise model could not be fitted to the whole record: {exc}")
+        progress.step("noise-model fit over time")
+        try:
+            # the windows use the same τ range as the whole-record fit of their axis
+            if fits is not None:
+                per_axis = [dynamic.avar] if dynamic.avar.ndim == 2 else list(dynamic.avar)
+                series = [fit_model(dataclasses.replace(dynamic, avar=row), unit=unit_name, confidence=confidence,
+                                    tau_range=(float(f.tau[0]) * (1 - 1e-9), None))
+                          for row, f in zip(per_axis, fits)]
+                if dynamic.avar.ndim == 2:
+                    series = series[0]
+            else:
+                series = fit_model(dynamic, unit=unit_name, confidence=confidence, tau_range="auto")
+        except AllaniteError as exc:
+            series_error = str(exc)
+            notes.append(f"The coefficients over time could not be fitted (DAVAR window of {dynamic.window} "
+                         f"samples): {exc}")
+    else:
+        progress.add(2)
+
+    refinements = None
+    if refine:
+        progress.step("model refinement")
+        refinements = []
+        # the same τ range the whole-record fit used (none unless given): start at 0.1 s when the
+        # shortest τ are below it, as real gyros' anti-alias filters colour them
+        t0 = 0.1 if static.tau[0] < 0.1 else None
+        for k in range(n_axes):
+            try:
+                refinements.append(refine_axis(np.asarray(x[:, k], dtype=np.float64), fs, input=input,
+                                               unit=unit_name, tau_range=None if t0 is None else (t0, None)))
+            except AllaniteError as exc:
+                refinements.append(None)
+                notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")
+    created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
+    return Report(refinements=refinements, static=static, dynamic=dynamic, fits=fits, series=series, fs=float(static.fs), unit=unit_name,
+                  input=input, axis_names=axis_names, source=dict(source or {}), settings=settings, notes=notes,
+                  fit_requested=bool(fit), fit_error=fit_error, series_error=series_error, created=created)
+
+
+
+
+def log_source(log) -> dict:
+    """JSON-able description of a :class:`~allanite.Log` for the report's Record section."""
+    src = {
+        "name": log.path.name, "path": str(log.path), "format": log.format, "columns": list(log.columns),
+        "fs_hz": float(log.fs), "fs_from": "time column" if log.time is not None else "given",
+        "unit": log.unit.name if log.unit is not None else None, "input": log.input,
+        "t0_s": json_number(log.t0), "samples_in_file": int(log.n_record),
+        "kept": [int(log.span[0]), int(log.span[1])],
+        "gaps": [{"after_sample": g.index - 1, "time_s": g.time, "duration_s": g.duration, "missing_samples": g.missing}
+                 for g in log.gaps],
+        "jitter": json_number(log.jitter),
+    }
+    if log.segment_spans is not None:
+        src["segments"] = [[int(a), int(b)] for a, b in log.segment_spans]
+    return src
+
+
+def from_log(log, **kwargs) -> Report:
+    """:func:`build_report` on a :class:`~allanite.Log` from :func:`allanite.read_log` (its unit,
+    input kind, column names and reading notes)."""
+    notes = list(kwargs.pop("notes", ()))
+    if log.gaps:
+        notes.append(f"The log has {len(log.gaps)} gap(s); only the longest gap-free stretch, samples "
+                     f"{log.span[0]}–{log.span[1] - 1} of {log.n_record}, is analysed"
+                     + (f" (all {len(log.segment_spans)} stretches are listed in summary.json)."
+                        if log.segment_spans is not None else "."))
+    unit = kwargs.pop("unit", None) or (log.unit.name if log.unit is not None else None)
+    return build_report(log.data, log.fs, unit=unit, input=log.input, axis_names=list(log.columns),
+                        source=log_source(log), notes=notes, **kwargs)
