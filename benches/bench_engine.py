@@ -171,8 +171,10 @@ def machine_info() -> dict:
         "versions": versions,
         "rustc": _cmd_output(["rustc", "--version"]),
         "git_commit": None if git is None else git + ("+dirty" if dirty else ""),
-        "env": {k: os.environ.get(k) for k in
-                ("OPENBLAS_CORETYPE", "ALLANITE_NUM_THREADS", "RAYON_NUM_THREADS", "OMP_NUM_THREADS")},
+        "env": {
+            k: os.environ.get(k)
+            for k in ("OPENBLAS_CORETYPE", "ALLANITE_NUM_THREADS", "RAYON_NUM_THREADS", "OMP_NUM_THREADS")
+        },
         "date_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
         "loadavg_start": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
     }
@@ -180,11 +182,13 @@ def machine_info() -> dict:
 
 def cpu_busy_fraction(interval: float = 1.0) -> float | None:
     """Fraction of all CPUs busy over ``interval`` seconds (from /proc/stat), None if unknown."""
+
     def snap():
         f = Path("/proc/stat").read_text().splitlines()[0].split()[1:]
         v = [int(x) for x in f]
         idle = v[3] + (v[4] if len(v) > 4 else 0)
         return sum(v[:8]), idle
+
     try:
         t0, i0 = snap()
         time.sleep(interval)
@@ -240,8 +244,11 @@ def wait_idle(max_wait: float, threshold: float = 0.10) -> dict:
         if calm == 0:
             log(f"waiting for an idle machine: CPUs {busy:.0%} busy")
         busy = cpu_busy_fraction()
-    return {"waited_seconds": round(time.perf_counter() - t0, 1), "busy_fraction_before_start": busy,
-            "idle": None if busy is None else busy < threshold}
+    return {
+        "waited_seconds": round(time.perf_counter() - t0, 1),
+        "busy_fraction_before_start": busy,
+        "idle": None if busy is None else busy < threshold,
+    }
 
 
 def log(msg: str) -> None:
@@ -261,20 +268,20 @@ def allantools_oadev_avar(allantools, y, fs, taus):
 def matched(ours_m, their_taus, fs):
     """Indices into ours and theirs where allantools' τ are exactly ours (same m)."""
     their_m = np.round(np.asarray(their_taus) * fs).astype(np.int64)
-    common, i_ours, i_theirs = np.intersect1d(np.asarray(ours_m, dtype=np.int64), their_m,
-                                              assume_unique=True, return_indices=True)
+    common, i_ours, i_theirs = np.intersect1d(
+        np.asarray(ours_m, dtype=np.int64), their_m, assume_unique=True, return_indices=True
+    )
     exact = bool(np.all(their_taus[i_theirs] == np.asarray(ours_m, dtype=np.float64)[i_ours] / fs))
     return i_ours, i_theirs, exact
 
 
-def allantools_per_window(allantools, y, fs, window, hop, ms, taus, n_win, count, allanite_avar,
-                          prefix_avar=None):
+def allantools_per_window(allantools, y, fs, window, hop, ms, taus, n_win, count, allanite_avar, prefix_avar=None):
     """allantools.oadev on a sample of windows; per-window times; comparison at shared τ."""
     idx = sample_starts(n_win, count)
     times, worst, worst_prefix, n_cmp, exact_all, missing = [], 0.0, 0.0, 0, True, 0
     for j in idx:
         s = int(j) * hop
-        seg = y[s:s + window]
+        seg = y[s : s + window]
         t0 = time.perf_counter()
         t_used, av = allantools_oadev_avar(allantools, seg, fs, taus)
         times.append(time.perf_counter() - t0)
@@ -321,8 +328,9 @@ def case_dynamic(name, title, y, cfg, repeats_fast, allantools, prefix_repeats, 
     log(f"[{name}] N={n} window={window} hop={hop} τ={taus.size} windows={n_win}")
 
     def run(workers=None):
-        return lambda: allanite.davar(y, FS, window=window, hop=hop, taus=taus, method="fast",
-                                      estimator="oavar", workers=workers)
+        return lambda: allanite.davar(
+            y, FS, window=window, hop=hop, taus=taus, method="fast", estimator="oavar", workers=workers
+        )
 
     best, reps, res = timed(run(), repeats_fast, warmup=True)
     ms = np.asarray(res.m, dtype=np.int64)
@@ -331,33 +339,52 @@ def case_dynamic(name, title, y, cfg, repeats_fast, allantools, prefix_repeats, 
     pbest, preps, pref = timed(lambda: _reference.davar_prefix(y, FS, window, hop, ms), prefix_repeats)
     log(f"[{name}] davar_prefix: best {pbest:.4f} s of {[round(t, 4) for t in preps]}")
 
-    comps = [{
-        "baseline": "allanite._reference.davar_prefix (NumPy prefix sums)",
-        "key": "davar_prefix",
-        "seconds": pbest,
-        "repeats": preps,
-        "extrapolated": False,
-        "ratio": pbest / best,
-        "max_rel_diff": max_rel_diff(res.avar, pref),
-        "n_compared": int(pref.size),
-    }]
+    comps = [
+        {
+            "baseline": "allanite._reference.davar_prefix (NumPy prefix sums)",
+            "key": "davar_prefix",
+            "seconds": pbest,
+            "repeats": preps,
+            "extrapolated": False,
+            "ratio": pbest / best,
+            "max_rel_diff": max_rel_diff(res.avar, pref),
+            "n_compared": int(pref.size),
+        }
+    ]
     if allantools is not None:
-        at = allantools_per_window(allantools, y, FS, window, hop, ms, taus, n_win, cfg["sample_windows"],
-                                   res.avar, pref)
+        at = allantools_per_window(
+            allantools, y, FS, window, hop, ms, taus, n_win, cfg["sample_windows"], res.avar, pref
+        )
         at["key"] = "allantools_per_window"
         at["ratio"] = at["seconds"] / best
         comps.append(at)
-        log(f"[{name}] allantools.oadev: {at['mean_per_window_seconds']:.4f} s/window over "
-            f"{at['sample_count']} windows -> {at['seconds']:.1f} s extrapolated")
+        log(
+            f"[{name}] allantools.oadev: {at['mean_per_window_seconds']:.4f} s/window over "
+            f"{at['sample_count']} windows -> {at['seconds']:.1f} s extrapolated"
+        )
 
     out = {
         "name": name,
         "title": title,
-        "params": {"n": n, "window": window, "hop": hop, "fs": FS, "grid": "exp",
-                   "points_requested": cfg["points"] or 100, "n_taus": int(taus.size),
-                   "m_min": int(ms[0]), "m_max": int(ms[-1]), "n_windows": n_win},
-        "allanite": {"call": "allanite.davar(method='fast', estimator='oavar')", "workers": "default (all cores)",
-                     "seconds": best, "repeats": reps, "warmup": True},
+        "params": {
+            "n": n,
+            "window": window,
+            "hop": hop,
+            "fs": FS,
+            "grid": "exp",
+            "points_requested": cfg["points"] or 100,
+            "n_taus": int(taus.size),
+            "m_min": int(ms[0]),
+            "m_max": int(ms[-1]),
+            "n_windows": n_win,
+        },
+        "allanite": {
+            "call": "allanite.davar(method='fast', estimator='oavar')",
+            "workers": "default (all cores)",
+            "seconds": best,
+            "repeats": reps,
+            "warmup": True,
+        },
         "comparisons": comps,
     }
     del pref
@@ -375,19 +402,21 @@ def case_dynamic(name, title, y, cfg, repeats_fast, allantools, prefix_repeats, 
             r2.append(t2)
         b1, b2 = min(r1), min(r2)
         log(f"[{name}] workers=1 {b1:.4f} s, workers=2 {b2:.4f} s")
-        comps.append({
-            "baseline": "allanite workers=1 (vs workers=2)",
-            "key": "workers",
-            "seconds": b1,
-            "repeats": r1,
-            "allanite_workers2_seconds": b2,
-            "allanite_workers2_repeats": r2,
-            "extrapolated": False,
-            "ratio": b1 / b2,
-            "max_rel_diff": max_rel_diff(res2.avar, res1.avar),
-            "bit_identical": bit_identical(res1.avar, res2.avar) and bit_identical(res.avar, res1.avar),
-            "n_compared": int(res1.avar.size),
-        })
+        comps.append(
+            {
+                "baseline": "allanite workers=1 (vs workers=2)",
+                "key": "workers",
+                "seconds": b1,
+                "repeats": r1,
+                "allanite_workers2_seconds": b2,
+                "allanite_workers2_repeats": r2,
+                "extrapolated": False,
+                "ratio": b1 / b2,
+                "max_rel_diff": max_rel_diff(res2.avar, res1.avar),
+                "bit_identical": bit_identical(res1.avar, res2.avar) and bit_identical(res.avar, res1.avar),
+                "n_compared": int(res1.avar.size),
+            }
+        )
     return out
 
 
@@ -406,26 +435,40 @@ def case_static(name, title, y, cfg, repeats_fast, allantools):
         abest, areps, (t_used, av) = timed(lambda: allantools_oadev_avar(allantools, y, FS, taus), 1)
         io, it, exact = matched(ms, t_used, FS)
         log(f"[{name}] allantools.oadev: {abest:.3f} s; {io.size}/{ms.size} τ shared")
-        comps.append({
-            "baseline": "allantools.oadev(data_type='freq', taus=same)",
-            "key": "allantools_oadev",
-            "seconds": abest,
-            "repeats": areps,
-            "extrapolated": False,
-            "ratio": abest / best,
-            "max_rel_diff": max_rel_diff(res.avar[io], av[it]),
-            "max_rel_diff_adev": max_rel_diff(np.sqrt(res.avar[io]), np.sqrt(av[it])),
-            "n_compared": int(io.size),
-            "taus_match_exactly": exact,
-            "taus_missing_from_baseline": int(ms.size - io.size),
-        })
+        comps.append(
+            {
+                "baseline": "allantools.oadev(data_type='freq', taus=same)",
+                "key": "allantools_oadev",
+                "seconds": abest,
+                "repeats": areps,
+                "extrapolated": False,
+                "ratio": abest / best,
+                "max_rel_diff": max_rel_diff(res.avar[io], av[it]),
+                "max_rel_diff_adev": max_rel_diff(np.sqrt(res.avar[io]), np.sqrt(av[it])),
+                "n_compared": int(io.size),
+                "taus_match_exactly": exact,
+                "taus_missing_from_baseline": int(ms.size - io.size),
+            }
+        )
     return {
         "name": name,
         "title": title,
-        "params": {"n": n, "fs": FS, "grid": "exp", "points_requested": cfg["points"], "n_taus": int(taus.size),
-                   "m_min": int(ms[0]), "m_max": int(ms[-1])},
-        "allanite": {"call": "allanite.avar(estimator='oavar')", "workers": "default (all cores)",
-                     "seconds": best, "repeats": reps, "warmup": True},
+        "params": {
+            "n": n,
+            "fs": FS,
+            "grid": "exp",
+            "points_requested": cfg["points"],
+            "n_taus": int(taus.size),
+            "m_min": int(ms[0]),
+            "m_max": int(ms[-1]),
+        },
+        "allanite": {
+            "call": "allanite.avar(estimator='oavar')",
+            "workers": "default (all cores)",
+            "seconds": best,
+            "repeats": reps,
+            "warmup": True,
+        },
         "comparisons": comps,
     }
 
@@ -440,15 +483,41 @@ def evaluate_targets(cases: dict) -> None:
 
     c1, c2, c3 = cases["case1"], cases["case2"], cases["case3"]
     checks = {
-        "case1": [("speed-up vs davar_prefix ≥ 5×", comp(c1, "davar_prefix"), "ratio",
-                   TARGETS["case1_speedup_vs_prefix"], "ge")],
-        "case2": [("speed-up vs davar_prefix ≥ 12×", comp(c2, "davar_prefix"), "ratio",
-                   TARGETS["case2_speedup_vs_prefix"], "ge"),
-                  ("allanite wall time ≤ 1.5 s", c2["allanite"], "seconds", TARGETS["case2_wall_seconds"], "le")],
-        "case3": [("speed-up vs allantools.oadev ≥ 20×", comp(c3, "allantools_oadev"), "ratio",
-                   TARGETS["case3_speedup_vs_allantools"], "ge"),
-                  ("max relative difference ≤ 1e-10", comp(c3, "allantools_oadev"), "max_rel_diff",
-                   TARGETS["case3_max_rel_diff"], "le")],
+        "case1": [
+            (
+                "speed-up vs davar_prefix ≥ 5×",
+                comp(c1, "davar_prefix"),
+                "ratio",
+                TARGETS["case1_speedup_vs_prefix"],
+                "ge",
+            )
+        ],
+        "case2": [
+            (
+                "speed-up vs davar_prefix ≥ 12×",
+                comp(c2, "davar_prefix"),
+                "ratio",
+                TARGETS["case2_speedup_vs_prefix"],
+                "ge",
+            ),
+            ("allanite wall time ≤ 1.5 s", c2["allanite"], "seconds", TARGETS["case2_wall_seconds"], "le"),
+        ],
+        "case3": [
+            (
+                "speed-up vs allantools.oadev ≥ 20×",
+                comp(c3, "allantools_oadev"),
+                "ratio",
+                TARGETS["case3_speedup_vs_allantools"],
+                "ge",
+            ),
+            (
+                "max relative difference ≤ 1e-10",
+                comp(c3, "allantools_oadev"),
+                "max_rel_diff",
+                TARGETS["case3_max_rel_diff"],
+                "le",
+            ),
+        ],
     }
     for key, items in checks.items():
         out = []
@@ -505,8 +574,10 @@ def write_markdown(report: dict, path: Path) -> None:
         c = cases[key]
         p = c["params"]
         if "window" in p:
-            label = (f"{key[-1]}. DAVAR N={p['n']:.0e}, window={p['window']:.0e}, hop={p['hop']:g}, "
-                     f"{p['n_taus']} τ, {p['n_windows']} windows")
+            label = (
+                f"{key[-1]}. DAVAR N={p['n']:.0e}, window={p['window']:.0e}, hop={p['hop']:g}, "
+                f"{p['n_taus']} τ, {p['n_windows']} windows"
+            )
         else:
             label = f"{key[-1]}. static OAVAR N={p['n']:.0e}, {p['n_taus']} τ"
         label = label.replace("e+0", "e")
@@ -526,44 +597,64 @@ def write_markdown(report: dict, path: Path) -> None:
                 base = "allanite workers=1 → ratio = parallel speed-up of workers=2"
                 target = "bit-identical"
                 met = comp["bit_identical"]
-            lines.append(f"| {label} | {_fmt_s(a_s)} | {base} | {b_s} | {_fmt_ratio(comp['ratio'])} | "
-                         f"{target} | {_fmt_met(met)} | {comp['max_rel_diff']:.2g} |")
+            lines.append(
+                f"| {label} | {_fmt_s(a_s)} | {base} | {b_s} | {_fmt_ratio(comp['ratio'])} | "
+                f"{target} | {_fmt_met(met)} | {comp['max_rel_diff']:.2g} |"
+            )
     lines += ["", "## Details", ""]
     for key in ("case1", "case2", "case3"):
         c = cases[key]
         lines.append(f"**{c['title']}** — params: " + ", ".join(f"{k}={v}" for k, v in c["params"].items()))
         lines.append("")
-        lines.append(f"- allanite `{c['allanite']['call']}`: repeats " +
-                     ", ".join(f"{t:.4f}" for t in c["allanite"]["repeats"]) + " s (after one warm-up call)")
+        lines.append(
+            f"- allanite `{c['allanite']['call']}`: repeats "
+            + ", ".join(f"{t:.4f}" for t in c["allanite"]["repeats"])
+            + " s (after one warm-up call)"
+        )
         for comp in c["comparisons"]:
             if comp["key"] == "workers":
-                lines.append(f"- workers=1: " + ", ".join(f"{t:.4f}" for t in comp["repeats"]) + " s; workers=2: " +
-                             ", ".join(f"{t:.4f}" for t in comp["allanite_workers2_repeats"]) +
-                             f" s; speed-up {comp['ratio']:.2f}×; bit-identical: {comp['bit_identical']}")
+                lines.append(
+                    "- workers=1: "
+                    + ", ".join(f"{t:.4f}" for t in comp["repeats"])
+                    + " s; workers=2: "
+                    + ", ".join(f"{t:.4f}" for t in comp["allanite_workers2_repeats"])
+                    + f" s; speed-up {comp['ratio']:.2f}×; bit-identical: {comp['bit_identical']}"
+                )
             elif comp.get("extrapolated"):
                 extra = ""
                 if "davar_prefix_vs_allantools_max_rel_diff" in comp:
-                    extra = (f"; on the same windows davar_prefix differs from allantools by up to "
-                             f"{comp['davar_prefix_vs_allantools_max_rel_diff']:.2g}")
-                lines.append(f"- {comp['baseline']}: {comp['sample_count']} windows sampled evenly over the record "
-                             f"(indices {comp['sample_windows'][0]} … {comp['sample_windows'][-1]}), "
-                             f"{comp['mean_per_window_seconds'] * 1e3:.3g} ms/window mean → "
-                             f"{comp['seconds']:.4g} s for all windows (extrapolated); "
-                             f"τ match exactly: {comp['taus_match_exactly']}, τ missing: "
-                             f"{comp['taus_missing_from_baseline']}{extra}")
+                    extra = (
+                        f"; on the same windows davar_prefix differs from allantools by up to "
+                        f"{comp['davar_prefix_vs_allantools_max_rel_diff']:.2g}"
+                    )
+                lines.append(
+                    f"- {comp['baseline']}: {comp['sample_count']} windows sampled evenly over the record "
+                    f"(indices {comp['sample_windows'][0]} … {comp['sample_windows'][-1]}), "
+                    f"{comp['mean_per_window_seconds'] * 1e3:.3g} ms/window mean → "
+                    f"{comp['seconds']:.4g} s for all windows (extrapolated); "
+                    f"τ match exactly: {comp['taus_match_exactly']}, τ missing: "
+                    f"{comp['taus_missing_from_baseline']}{extra}"
+                )
             else:
-                lines.append(f"- {comp['baseline']}: repeats " + ", ".join(f"{t:.4f}" for t in comp["repeats"]) +
-                             f" s; compared {comp['n_compared']} values" +
-                             (f"; τ match exactly: {comp['taus_match_exactly']}, τ missing: "
-                              f"{comp['taus_missing_from_baseline']}" if "taus_match_exactly" in comp else ""))
+                lines.append(
+                    f"- {comp['baseline']}: repeats "
+                    + ", ".join(f"{t:.4f}" for t in comp["repeats"])
+                    + f" s; compared {comp['n_compared']} values"
+                    + (
+                        f"; τ match exactly: {comp['taus_match_exactly']}, τ missing: "
+                        f"{comp['taus_missing_from_baseline']}"
+                        if "taus_match_exactly" in comp
+                        else ""
+                    )
+                )
         lines.append("")
     lines += [
         "## Machine",
         "",
         f"- CPU: {m['cpu_model']}, {m['cpu_count']} logical CPUs ({m['cpus_usable']} usable)",
         f"- platform: {m['platform']}",
-        f"- versions: " + ", ".join(f"{k} {v}" for k, v in m["versions"].items()) + f", {m['rustc']}",
-        f"- environment: " + ", ".join(f"{k}={v}" for k, v in m["env"].items()),
+        "- versions: " + ", ".join(f"{k} {v}" for k, v in m["versions"].items()) + f", {m['rustc']}",
+        "- environment: " + ", ".join(f"{k}={v}" for k, v in m["env"].items()),
         f"- load average at start: {[round(v, 2) for v in m['loadavg_start']]}, at end: "
         f"{[round(v, 2) for v in m.get('loadavg_end') or []]}; CPUs busy when the script started (before any idle wait): "
         f"{_pct(m['idle_check'].get('busy_fraction_before_start'))}; CPU share used by other processes during "
@@ -576,8 +667,11 @@ def write_markdown(report: dict, path: Path) -> None:
         "workers=1 vs workers=2: one warm-up each, then interleaved repeats, best of each.",
     ]
     if report["mode"] == "quick":
-        lines += ["", "_Quick mode: sizes are far smaller than the targets refer to; a correctness smoke test, "
-                      "not a timing check._"]
+        lines += [
+            "",
+            "_Quick mode: sizes are far smaller than the targets refer to; a correctness smoke test, "
+            "not a timing check._",
+        ]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
@@ -611,19 +705,28 @@ def run(quick: bool = False, out: Path | None = None, wait: float = 0.0) -> dict
 
     settle("case1")
     with OtherLoad() as ld:
-        cases["case1"] = case_dynamic("case1", "Case 1 — DAVAR, hop 1, exponential grid", y, cfg["case1"], rf, allantools,
-                              prefix_repeats=rf)
+        cases["case1"] = case_dynamic(
+            "case1", "Case 1 — DAVAR, hop 1, exponential grid", y, cfg["case1"], rf, allantools, prefix_repeats=rf
+        )
     loads["case1"] = ld.fraction
     settle("case2")
     with OtherLoad() as ld:
-        cases["case2"] = case_dynamic("case2", "Case 2 — DAVAR, long record, 150-point exponential grid", y,
-                                      cfg["case2"], rf, allantools, prefix_repeats=1 if not quick else rf,
-                                      with_workers=True)
+        cases["case2"] = case_dynamic(
+            "case2",
+            "Case 2 — DAVAR, long record, 150-point exponential grid",
+            y,
+            cfg["case2"],
+            rf,
+            allantools,
+            prefix_repeats=1 if not quick else rf,
+            with_workers=True,
+        )
     loads["case2"] = ld.fraction
     settle("case3")
     with OtherLoad() as ld:
-        cases["case3"] = case_static("case3", "Case 3 — static overlapping Allan variance", y, cfg["case3"], rf,
-                                     allantools)
+        cases["case3"] = case_static(
+            "case3", "Case 3 — static overlapping Allan variance", y, cfg["case3"], rf, allantools
+        )
     loads["case3"] = ld.fraction
     for key, frac in loads.items():
         cases[key]["other_processes_cpu_fraction"] = frac
@@ -637,11 +740,16 @@ def run(quick: bool = False, out: Path | None = None, wait: float = 0.0) -> dict
         "benchmark": "engine",
         "mode": mode,
         "machine": machine,
-        "data": {"kind": "white noise, standard normal", "seed": SEED, "generator": "numpy.random.default_rng",
-                 "fs": FS, "n_generated": n_max},
+        "data": {
+            "kind": "white noise, standard normal",
+            "seed": SEED,
+            "generator": "numpy.random.default_rng",
+            "fs": FS,
+            "n_generated": n_max,
+        },
         "repeats_fast": rf,
         "timing": "time.perf_counter; allanite: warm-up + best of repeats_fast; davar_prefix: best of repeats_fast "
-                  "(case 1) or 1 (case 2, full mode); allantools: 1 run (per sampled window, extrapolated)",
+        "(case 1) or 1 (case 2, full mode); allantools: 1 run (per sampled window, extrapolated)",
         "targets": TARGETS,
         "cases": cases,
         "total_seconds": time.perf_counter() - t_start,
@@ -655,16 +763,28 @@ def run(quick: bool = False, out: Path | None = None, wait: float = 0.0) -> dict
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--quick", action="store_true",
-                    help="small sizes (< 30 s): a smoke test of the script and of correctness, not of speed")
-    ap.add_argument("--out", type=Path, default=None,
-                    help="output folder for engine.json / engine.md (default: benches/results, or a temporary "
-                         "folder with --quick)")
-    ap.add_argument("--wait-idle", type=float, default=0.0, metavar="SECONDS",
-                    help="before each case, wait up to SECONDS for the CPUs to be idle (< 10%% busy for 3 s "
-                         "running); the waits are recorded")
+    ap = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="small sizes (< 30 s): a smoke test of the script and of correctness, not of speed",
+    )
+    ap.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="output folder for engine.json / engine.md (default: benches/results, or a temporary folder with --quick)",
+    )
+    ap.add_argument(
+        "--wait-idle",
+        type=float,
+        default=0.0,
+        metavar="SECONDS",
+        help="before each case, wait up to SECONDS for the CPUs to be idle (< 10%% busy for 3 s "
+        "running); the waits are recorded",
+    )
     args = ap.parse_args(argv)
     run(quick=args.quick, out=args.out, wait=args.wait_idle)
     return 0

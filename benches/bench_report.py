@@ -95,8 +95,20 @@ def part_report(repeats: int) -> dict:
         return {"skipped": f"{src} not found"}
     import allanite
 
-    cmd = [sys.executable, "-m", "allanite", "report", str(src), "--fs", "100", "--columns", "gyro_x,gyro_y,gyro_z",
-           "--unit", "deg/s", "--quiet"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "allanite",
+        "report",
+        str(src),
+        "--fs",
+        "100",
+        "--columns",
+        "gyro_x,gyro_y,gyro_z",
+        "--unit",
+        "deg/s",
+        "--quiet",
+    ]
     times = []
     with tempfile.TemporaryDirectory() as tmp, OtherLoad() as load:
         for k in range(repeats):
@@ -110,9 +122,16 @@ def part_report(repeats: int) -> dict:
         allanite.read_log(src, fs=100.0, columns=["gyro_x", "gyro_y", "gyro_z"], unit="deg/s")
         read_s = time.perf_counter() - t0
     be.log(f"ADIS report: best {min(times):.2f} s of {[round(t, 2) for t in times]}; read_log alone {read_s:.2f} s")
-    return {"file": ADIS, "samples": summary["record"]["samples"], "axes": summary["record"]["axes"],
-            "seconds": min(times), "repeats": times, "read_log_seconds": read_s,
-            "windows": summary["dynamic"]["windows"], "other_processes_cpu_fraction": load.fraction}
+    return {
+        "file": ADIS,
+        "samples": summary["record"]["samples"],
+        "axes": summary["record"]["axes"],
+        "seconds": min(times),
+        "repeats": times,
+        "read_log_seconds": read_s,
+        "windows": summary["dynamic"]["windows"],
+        "other_processes_cpu_fraction": load.fraction,
+    }
 
 
 def part_memory(cfg: dict) -> dict:
@@ -122,15 +141,20 @@ def part_memory(cfg: dict) -> dict:
         write_big_npy(path, cfg["big_n"])
         size = path.stat().st_size
         for mode in ("davar", "avar"):
-            proc = subprocess.run([sys.executable, "-c", CHILD, str(path), mode, str(cfg["window"]), str(cfg["hop"])],
-                                  capture_output=True, text=True)
+            proc = subprocess.run(
+                [sys.executable, "-c", CHILD, str(path), mode, str(cfg["window"]), str(cfg["hop"])],
+                capture_output=True,
+                text=True,
+            )
             if proc.returncode != 0:
                 raise RuntimeError(proc.stderr)
             r = json.loads(proc.stdout.strip().splitlines()[-1])
             r["peak_over_file"] = r["vmhwm_bytes"] / size
             out[mode] = r
-            be.log(f"{mode} on {cfg['big_n']:.0e} samples: {r['wall_s']:.1f} s, peak {r['vmhwm_bytes'] / 2**20:.0f} MiB "
-                   f"= {r['peak_over_file']:.2f}× the file")
+            be.log(
+                f"{mode} on {cfg['big_n']:.0e} samples: {r['wall_s']:.1f} s, peak {r['vmhwm_bytes'] / 2**20:.0f} MiB "
+                f"= {r['peak_over_file']:.2f}× the file"
+            )
         out["file_bytes"] = size
         out["samples"] = cfg["big_n"]
         out["window"], out["hop"] = cfg["window"], cfg["hop"]
@@ -138,30 +162,46 @@ def part_memory(cfg: dict) -> dict:
 
 
 def write_markdown(rep: dict, path: Path) -> None:
-    lines = ["# Report and large-log benchmark", "",
-             f"Recorded by `benches/bench_report.py` on {rep['machine'].get('date_utc')} "
-             f"({rep['machine'].get('cpu_count')} CPUs).", "",
-             "| case | measured | baseline (same run) | target | met |", "|---|---|---|---|---|"]
+    lines = [
+        "# Report and large-log benchmark",
+        "",
+        f"Recorded by `benches/bench_report.py` on {rep['machine'].get('date_utc')} "
+        f"({rep['machine'].get('cpu_count')} CPUs).",
+        "",
+        "| case | measured | baseline (same run) | target | met |",
+        "|---|---|---|---|---|",
+    ]
     r = rep["report"]
     if "skipped" in r:
         lines.append(f"| ADIS16405 report | skipped: {r['skipped']} | | ≤ 15 s | — |")
     else:
-        lines.append(f"| `allanite report` on ADIS16405 run 1 ({r['axes']} axes × {r['samples']:,} samples, gzip CSV; "
-                     f"{r['windows']} DAVAR windows per axis) | {r['seconds']:.2f} s (best of {len(r['repeats'])}: "
-                     + ", ".join(f"{t:.2f}" for t in r["repeats"]) + f") | `read_log` alone {r['read_log_seconds']:.2f} s "
-                     f"| ≤ 15 s | {'yes' if r['seconds'] <= 15 else 'NO'} |")
+        lines.append(
+            f"| `allanite report` on ADIS16405 run 1 ({r['axes']} axes × {r['samples']:,} samples, gzip CSV; "
+            f"{r['windows']} DAVAR windows per axis) | {r['seconds']:.2f} s (best of {len(r['repeats'])}: "
+            + ", ".join(f"{t:.2f}" for t in r["repeats"])
+            + f") | `read_log` alone {r['read_log_seconds']:.2f} s "
+            f"| ≤ 15 s | {'yes' if r['seconds'] <= 15 else 'NO'} |"
+        )
     m = rep["memory"]
-    for mode, what in (("davar", f"`davar(window={m['window']:,}, hop={m['hop']:,}, taus='exp')`"),
-                       ("avar", "`avar(taus='octave')`")):
+    for mode, what in (
+        ("davar", f"`davar(window={m['window']:,}, hop={m['hop']:,}, taus='exp')`"),
+        ("avar", "`avar(taus='octave')`"),
+    ):
         x = m[mode]
-        lines.append(f"| {m['samples']:.0e}-sample .npy ({m['file_bytes'] / 1e6:.0f} MB), `read_log` (memory map) + {what} "
-                     f"| peak {x['vmhwm_bytes'] / 2**20:.0f} MiB = {x['peak_over_file']:.2f}× the file, {x['wall_s']:.1f} s "
-                     f"| the file itself: 1× | ≤ ~3× | {'yes' if x['peak_over_file'] <= 3 else 'NO'} |")
-    lines += ["", "Peak memory is the child process's VmHWM, which includes the pages of the memory-mapped file it "
-                  "touched; every case runs in a fresh process. (In `--quick` mode the small file is dwarfed by the interpreter's own "
-                  "~40 MB, so the ratio there means nothing.)",
-              f"Other processes' CPU share during the report runs: "
-              f"{100 * (r.get('other_processes_cpu_fraction') or 0):.1f} %.", ""]
+        lines.append(
+            f"| {m['samples']:.0e}-sample .npy ({m['file_bytes'] / 1e6:.0f} MB), `read_log` (memory map) + {what} "
+            f"| peak {x['vmhwm_bytes'] / 2**20:.0f} MiB = {x['peak_over_file']:.2f}× the file, {x['wall_s']:.1f} s "
+            f"| the file itself: 1× | ≤ ~3× | {'yes' if x['peak_over_file'] <= 3 else 'NO'} |"
+        )
+    lines += [
+        "",
+        "Peak memory is the child process's VmHWM, which includes the pages of the memory-mapped file it "
+        "touched; every case runs in a fresh process. (In `--quick` mode the small file is dwarfed by the interpreter's own "
+        "~40 MB, so the ratio there means nothing.)",
+        f"Other processes' CPU share during the report runs: "
+        f"{100 * (r.get('other_processes_cpu_fraction') or 0):.1f} %.",
+        "",
+    ]
     path.write_text("\n".join(lines))
 
 

@@ -88,15 +88,24 @@ FS = 100.0
 PLATEAU = math.sqrt(2.0 * math.log(2.0) / math.pi)  # 0.664
 
 SETS = {
-    "A": {"truth": {"Q": 3.5e-4, "N": 2e-3, "B": 1e-3, "K": 6e-5}, "seed0": 1000,
-          "ranges": "Q < 0.09 s, N 0.09–9 s, B 9–370 s, K > 370 s"},
-    "B": {"truth": {"Q": 3.5e-4, "N": 2e-3, "B": 1e-3, "R": 3e-6}, "seed0": 2000,
-          "ranges": "Q < 0.09 s, N 0.09–9 s, B 9–310 s, R > 310 s"},
-    "C": {"truth": {"Q": 3.5e-4, "N": 2e-3, "B": 1e-3, "K": 1e-4}, "seed0": 4000,
-          "ranges": "Q < 0.09 s, N 0.09–9 s, B 9–130 s, K > 130 s"},
+    "A": {
+        "truth": {"Q": 3.5e-4, "N": 2e-3, "B": 1e-3, "K": 6e-5},
+        "seed0": 1000,
+        "ranges": "Q < 0.09 s, N 0.09–9 s, B 9–370 s, K > 370 s",
+    },
+    "B": {
+        "truth": {"Q": 3.5e-4, "N": 2e-3, "B": 1e-3, "R": 3e-6},
+        "seed0": 2000,
+        "ranges": "Q < 0.09 s, N 0.09–9 s, B 9–310 s, R > 310 s",
+    },
+    "C": {
+        "truth": {"Q": 3.5e-4, "N": 2e-3, "B": 1e-3, "K": 1e-4},
+        "seed0": 4000,
+        "ranges": "Q < 0.09 s, N 0.09–9 s, B 9–130 s, K > 130 s",
+    },
 }
 PEER_EFFECT = {"Q": "quantization", "N": "white", "B": "flicker", "K": "walk", "R": "ramp"}
-IEEE_FACTOR = {"Q": 1.0, "N": 60.0, "B": 3600.0, "K": 216000.0, "R": 1.296e7}   # from °/s base form
+IEEE_FACTOR = {"Q": 1.0, "N": 60.0, "B": 3600.0, "K": 216000.0, "R": 1.296e7}  # from °/s base form
 IEEE_UNIT = {"Q": "°", "N": "°/√h", "B": "°/h", "K": "°/h^1.5", "R": "°/h²"}
 ESTIMATORS = ("allanite", "allanite_5terms", "peer", "peer_octave", "slope")
 EST_LABEL = {
@@ -141,8 +150,14 @@ def slope_readoff(result, terms) -> dict:
         else:
             i = int(np.nanargmin(np.abs(s - target[name])))
             sig, t = adev[i], tau[i]
-            out[name] = float({"Q": sig * t / math.sqrt(3.0), "N": sig * math.sqrt(t),
-                               "K": sig * math.sqrt(3.0 / t), "R": sig * math.sqrt(2.0) / t}[name])
+            out[name] = float(
+                {
+                    "Q": sig * t / math.sqrt(3.0),
+                    "N": sig * math.sqrt(t),
+                    "K": sig * math.sqrt(3.0 / t),
+                    "R": sig * math.sqrt(2.0) / t,
+                }[name]
+            )
         where[name] = (float(tau[i]), None if name == "B" else float(s[i]))
     return out, where
 
@@ -204,13 +219,21 @@ def recovery(set_name: str, n_seeds: int, n_samples: int, log) -> dict:
     # RMS relative error about the truth (not the SD about the estimates' mean: a biased estimator can
     # scatter less than the bound and still be further off)
     summary["rms_over_bound"] = {
-        est: {t: float(np.sqrt(np.mean([(r[est][t] / truth[t] - 1.0) ** 2 for r in rows])) / bound[t])
-              for t in bound}
-        for est in ESTIMATORS}
+        est: {t: float(np.sqrt(np.mean([(r[est][t] / truth[t] - 1.0) ** 2 for r in rows])) / bound[t]) for t in bound}
+        for est in ESTIMATORS
+    }
     summary["time_allanite_uncached_s"] = rows[0]["time_allanite_uncached_s"]
     summary["covariance_check"] = covariance_check(rows, r, truth, terms)
-    return {"truth": truth, "terms": list(terms), "ranges": spec["ranges"], "n_samples": n_samples, "fs": FS,
-            "seeds": [r["seed"] for r in rows], "rows": rows, "summary": summary}
+    return {
+        "truth": truth,
+        "terms": list(terms),
+        "ranges": spec["ranges"],
+        "n_samples": n_samples,
+        "fs": FS,
+        "seeds": [r["seed"] for r in rows],
+        "rows": rows,
+        "summary": summary,
+    }
 
 
 def covariance_check(rows, result, truth, terms) -> dict:
@@ -227,8 +250,13 @@ def covariance_check(rows, result, truth, terms) -> dict:
     sd_ratio = np.sqrt(np.diag(mc) / np.diag(model))
     corr_mc = np.diag(mc / np.sqrt(np.outer(np.diag(mc), np.diag(mc))), 1)
     corr_model = np.diag(model / np.sqrt(np.outer(np.diag(model), np.diag(model))), 1)
-    return {"n_records": int(est.shape[0]), "tau": result.tau.tolist(), "sd_ratio_mc_over_model": sd_ratio.tolist(),
-            "octave_corr_mc": corr_mc.tolist(), "octave_corr_model": corr_model.tolist()}
+    return {
+        "n_records": int(est.shape[0]),
+        "tau": result.tau.tolist(),
+        "sd_ratio_mc_over_model": sd_ratio.tolist(),
+        "octave_corr_mc": corr_mc.tolist(),
+        "octave_corr_model": corr_model.tolist(),
+    }
 
 
 def _blocks_cache_clear():
@@ -246,8 +274,11 @@ def summarize_recovery(rows, truth, terms) -> dict:
             rel = v / truth[t] - 1.0
             med[t] = float(np.median(np.abs(rel)))
             bias[t] = float(np.median(rel))
-        out[est] = {"median_abs_rel_error": med, "median_rel_error": bias,
-                    "median_abs_rel_error_bootstrap95": _bootstrap_median(rows, est, truth, terms)}
+        out[est] = {
+            "median_abs_rel_error": med,
+            "median_rel_error": bias,
+            "median_abs_rel_error_bootstrap95": _bootstrap_median(rows, est, truth, terms),
+        }
     cov, cal, cov5 = {}, {}, {}
     for t in terms:
         ci = np.array([r["allanite_ci"][t] for r in rows])
@@ -332,33 +363,59 @@ def table2(n_seeds: int, n_samples: int, log) -> dict:
         s = {}
         for t in terms:
             ok = [agree(r[pair[0]], r[pair[1]], t) for r in rows]
-            diff = [abs(r[pair[0]][t][0] - r[pair[1]][t][0]) / max(1e-300, (r[pair[1]][t][2] - r[pair[1]][t][1]) / 2)
-                    for r in rows]
-            s[t] = {"mutually_inside": float(np.mean(ok)), "median_diff_over_halfwidth": float(np.median(diff)),
-                    "max_diff_over_halfwidth": float(np.max(diff))}
+            diff = [
+                abs(r[pair[0]][t][0] - r[pair[1]][t][0]) / max(1e-300, (r[pair[1]][t][2] - r[pair[1]][t][1]) / 2)
+                for r in rows
+            ]
+            s[t] = {
+                "mutually_inside": float(np.mean(ok)),
+                "median_diff_over_halfwidth": float(np.median(diff)),
+                "max_diff_over_halfwidth": float(np.max(diff)),
+            }
         summary["_vs_".join(pair)] = s
     err = {}
     for label in ("all_thin", "exp_thin", "exp_full"):
         err[label] = {t: float(np.median([abs(r[label][t][0] / truth[t] - 1) for r in rows])) for t in terms}
-        err[label + "_coverage"] = {t: float(np.mean([r[label][t][1] <= truth[t] <= r[label][t][2] for r in rows]))
-                                    for t in terms}
-    return {"truth": truth, "n_samples": n_samples, "fs": FS, "m_max": m_max, "rows": rows, "agreement": summary,
-            "median_abs_rel_error": err}
+        err[label + "_coverage"] = {
+            t: float(np.mean([r[label][t][1] <= truth[t] <= r[label][t][2] for r in rows])) for t in terms
+        }
+    return {
+        "truth": truth,
+        "n_samples": n_samples,
+        "fs": FS,
+        "m_max": m_max,
+        "rows": rows,
+        "agreement": summary,
+        "median_abs_rel_error": err,
+    }
 
 
 # ----------------------------------------------------------------------------------------------
 # 3. paper 001: nonstationary bias instability through DAVAR
 
 
-P001 = {"fs": 25.0, "n": 40_000, "window": 401, "hop": 25, "tc": 0.5, "white_per_sample": 0.03,
-        "var_out": 1e-3, "var_in": 1e-2, "t_in": (400.0, 800.0), "terms": ("N", "B", "K", "R")}
+P001 = {
+    "fs": 25.0,
+    "n": 40_000,
+    "window": 401,
+    "hop": 25,
+    "tc": 0.5,
+    "white_per_sample": 0.03,
+    "var_out": 1e-3,
+    "var_in": 1e-2,
+    "t_in": (400.0, 800.0),
+    "terms": ("N", "B", "K", "R"),
+}
 
 
 def paper001(seeds, out_dir: Path | None, log) -> dict:
     p = P001
     fs = p["fs"]
-    sig = [(0.0, math.sqrt(p["var_out"])), (p["t_in"][0], math.sqrt(p["var_in"])),
-           (p["t_in"][1], math.sqrt(p["var_out"]))]
+    sig = [
+        (0.0, math.sqrt(p["var_out"])),
+        (p["t_in"][0], math.sqrt(p["var_in"])),
+        (p["t_in"][1], math.sqrt(p["var_out"])),
+    ]
     n_coef = p["white_per_sample"] / math.sqrt(fs)  # (°/h)·√s
     runs = []
     first = None
@@ -373,15 +430,24 @@ def paper001(seeds, out_dir: Path | None, log) -> dict:
         t = s.t
         inside = (t > p["t_in"][0] + half) & (t < p["t_in"][1] - half)
         outside = (t < p["t_in"][0] - half) | (t > p["t_in"][1] + half)
-        run = {"seed": seed, "seconds_davar_and_fit": el, "n_windows": int(t.size),
-               "tau": [float(v) for v in d.tau], "static_fit": {k: static.coefficients[k].value for k in p["terms"]}}
+        run = {
+            "seed": seed,
+            "seconds_davar_and_fit": el,
+            "n_windows": int(t.size),
+            "tau": [float(v) for v in d.tau],
+            "static_fit": {k: static.coefficients[k].value for k in p["terms"]},
+        }
         for name in p["terms"]:
             v = s.values[name]
             bin_ = float(np.median(v[inside]))
             bout = float(np.median(v[outside]))
-            run[name] = {"median_inside": bin_, "median_outside": bout,
-                         "ratio": bin_ / bout if bout > 0 else None,
-                         "mean_inside": float(np.mean(v[inside])), "mean_outside": float(np.mean(v[outside]))}
+            run[name] = {
+                "median_inside": bin_,
+                "median_outside": bout,
+                "ratio": bin_ / bout if bout > 0 else None,
+                "mean_inside": float(np.mean(v[inside])),
+                "mean_outside": float(np.mean(v[outside])),
+            }
         # where the B series switches: the two-level step fit of B (one level outside [t_up, t_down),
         # another inside) with the least squared error — a change-point estimate, no threshold to pick
         run["B"]["change_points_s"] = _two_change_points(t, s.values["B"])
@@ -395,9 +461,13 @@ def paper001(seeds, out_dir: Path | None, log) -> dict:
             se = (s.ci_high[name][idx] - s.ci_low[name][idx]) / 2.0
             run[name]["outside_sd_over_median_se"] = float(np.std(v, ddof=1) / np.median(se))
         lo_in = s.ci_low["B"][inside]
-        run["B"]["share_inside_windows_lower_bound_above_outside_median"] = float(np.mean(lo_in > run["B"]["median_outside"]))
+        run["B"]["share_inside_windows_lower_bound_above_outside_median"] = float(
+            np.mean(lo_in > run["B"]["median_outside"])
+        )
         hi_out = s.ci_high["B"][outside]
-        run["B"]["share_outside_windows_upper_bound_below_inside_median"] = float(np.mean(hi_out < run["B"]["median_inside"]))
+        run["B"]["share_outside_windows_upper_bound_below_inside_median"] = float(
+            np.mean(hi_out < run["B"]["median_inside"])
+        )
         runs.append(run)
         if first is None:
             first = (y, d, s)
@@ -406,14 +476,23 @@ def paper001(seeds, out_dir: Path | None, log) -> dict:
     if out_dir is not None and first is not None:
         fig = _plot_paper001(first, out_dir / "noise_fit_paper001.png")
     ratios = [r["B"]["ratio"] for r in runs]
-    return {"params": {**p, "terms": list(p["terms"]), "t_in": list(p["t_in"]), "N_coefficient": n_coef,
-                       "sigma_profile": sig}, "runs": runs,
-            "B_ratio_median": float(np.median(ratios)), "B_ratio_expected_if_B_scaled_with_sigma": math.sqrt(10.0),
-            "figure": fig}
+    return {
+        "params": {
+            **p,
+            "terms": list(p["terms"]),
+            "t_in": list(p["t_in"]),
+            "N_coefficient": n_coef,
+            "sigma_profile": sig,
+        },
+        "runs": runs,
+        "B_ratio_median": float(np.median(ratios)),
+        "B_ratio_expected_if_B_scaled_with_sigma": math.sqrt(10.0),
+        "figure": fig,
+    }
 
 
 def _two_change_points(t: np.ndarray, v: np.ndarray) -> list:
-    x = np.asarray(v, dtype=np.float64)   # linear scale: windows where B was fitted as 0 stay mild outliers
+    x = np.asarray(v, dtype=np.float64)  # linear scale: windows where B was fitted as 0 stay mild outliers
     n = x.size
     c1 = np.concatenate(([0.0], np.cumsum(x)))
     c2 = np.concatenate(([0.0], np.cumsum(x * x)))
@@ -448,12 +527,14 @@ def _plot_paper001(first, path: Path) -> str:
     t = np.arange(y.size) / fs
     axes[0].plot(t, y, lw=0.3, color="0.4")
     axes[0].set_ylabel("rate, °/h")
-    axes[0].set_title("Paper 001's record rebuilt: GM bias variance 0.001 → 0.01 (400–800 s) → 0.001, "
-                      "window 401 at 25 Hz", fontsize=9)
+    axes[0].set_title(
+        "Paper 001's record rebuilt: GM bias variance 0.001 → 0.01 (400–800 s) → 0.001, window 401 at 25 Hz", fontsize=9
+    )
     for ax, name in zip(axes[1:], ("B", "N", "K")):
         v, lo, hi = s.values[name], s.ci_low[name], s.ci_high[name]
-        ax.fill_between(s.t, lo, np.minimum(hi, np.nanmax(v) * 3), color="C0", alpha=0.25, lw=0,
-                        label="68.3 % interval")
+        ax.fill_between(
+            s.t, lo, np.minimum(hi, np.nanmax(v) * 3), color="C0", alpha=0.25, lw=0, label="68.3 % interval"
+        )
         ax.plot(s.t, v, lw=0.8, color="C0", label=f"{name}(t)")
         ax.set_ylabel({"B": "B, °/h", "N": "N, (°/h)·√s", "K": "K, (°/h)/√s"}[name])
         ax.legend(loc="upper right", fontsize=8)
@@ -470,8 +551,8 @@ def _plot_paper001(first, path: Path) -> str:
 # 4. real data
 
 
-ADIS_LSB = 0.05        # °/s
-ADIS_TAU_MIN = 0.16    # s, the short-τ cut of the "recommended" fit (see the report)
+ADIS_LSB = 0.05  # °/s
+ADIS_TAU_MIN = 0.16  # s, the short-τ cut of the "recommended" fit (see the report)
 
 
 def adis_runs(data_dir: Path, log, out_dir: Path | None = None) -> dict | None:
@@ -490,8 +571,12 @@ def adis_runs(data_dir: Path, log, out_dir: Path | None = None) -> dict | None:
         full = allanite.fit(r, unit="deg/s")
         cut = allanite.fit(r_cut, terms=("N", "B", "K", "R"), unit="deg/s")
         auto = allanite.fit(r, unit="deg/s", tau_range="auto")
-        run = {"file": path.name, "n_samples": int(y.shape[0]), "mean_deg_s": [float(v) for v in y.mean(axis=0)],
-               "axes": {}}
+        run = {
+            "file": path.name,
+            "n_samples": int(y.shape[0]),
+            "mean_deg_s": [float(v) for v in y.mean(axis=0)],
+            "axes": {},
+        }
         for ax, a_full, a_cut, a_auto, k in zip("xyz", full, cut, auto, range(3)):
             x = y[:, k] - y[:, k].mean()
             acf = [float(np.dot(x[:-j], x[j:]) / np.dot(x, x)) for j in (1, 2, 3, 5)]
@@ -519,11 +604,16 @@ def adis_runs(data_dir: Path, log, out_dir: Path | None = None) -> dict | None:
                 half = np.array([(c["ieee_ci"][1] - c["ieee_ci"][0]) / 2 for c in vals])
                 lo = max(c["ieee_ci"][0] for c in vals)
                 hi = min(c["ieee_ci"][1] for c in vals)
-                s[term] = {"mean": float(v.mean()), "sd": float(v.std(ddof=1)), "min": float(v.min()),
-                           "max": float(v.max()), "median_halfwidth": float(np.median(half)),
-                           "sd_over_halfwidth": float(v.std(ddof=1) / np.median(half)) if np.median(half) > 0 else None,
-                           "common_interval": [float(lo), float(hi)] if lo <= hi else None,
-                           "max_over_min": float(v.max() / v.min()) if v.min() > 0 else None}
+                s[term] = {
+                    "mean": float(v.mean()),
+                    "sd": float(v.std(ddof=1)),
+                    "min": float(v.min()),
+                    "max": float(v.max()),
+                    "median_halfwidth": float(np.median(half)),
+                    "sd_over_halfwidth": float(v.std(ddof=1) / np.median(half)) if np.median(half) > 0 else None,
+                    "common_interval": [float(lo), float(hi)] if lo <= hi else None,
+                    "max_over_min": float(v.max() / v.min()) if v.min() > 0 else None,
+                }
             summary[ax][fit_name] = s
     tau0 = 1.0 / FS
     quant = {
@@ -533,8 +623,13 @@ def adis_runs(data_dir: Path, log, out_dir: Path | None = None) -> dict | None:
         "angle_quantization_Q_deg": ADIS_LSB * tau0 / math.sqrt(12.0),
         "angle_quantization_avar_at_tau0": 3.0 * (ADIS_LSB * tau0 / math.sqrt(12.0)) ** 2 / tau0**2,
     }
-    return {"runs": runs, "summary": summary, "quantization": quant, "tau_min_cut": ADIS_TAU_MIN,
-            "figure": figure if out_dir is not None else None}
+    return {
+        "runs": runs,
+        "summary": summary,
+        "quantization": quant,
+        "tau_min_cut": ADIS_TAU_MIN,
+        "figure": figure if out_dir is not None else None,
+    }
 
 
 def _plot_adis(r, full, cut, path: Path) -> str:
@@ -547,11 +642,23 @@ def _plot_adis(r, full, cut, path: Path) -> str:
     tt = np.geomspace(r.tau[0], r.tau[-1], 300)
     for k, (ax, name) in enumerate(zip(axes, "xyz")):
         ax.loglog(r.tau, 3600 * r.adev[k], "o", ms=4, color="k", label="ADEV (octave)")
-        ax.loglog(tt, 3600 * np.sqrt(full[k].curve(tt)), "--", color="C3", lw=1,
-                  label=f"fit, all τ (χ²/dof {full[k].chi2_dof:.0f})")
+        ax.loglog(
+            tt,
+            3600 * np.sqrt(full[k].curve(tt)),
+            "--",
+            color="C3",
+            lw=1,
+            label=f"fit, all τ (χ²/dof {full[k].chi2_dof:.0f})",
+        )
         tc = tt[tt >= ADIS_TAU_MIN]
-        ax.loglog(tc, 3600 * np.sqrt(cut[k].curve(tc)), "-", color="C0", lw=1.5,
-                  label=f"fit, τ ≥ {ADIS_TAU_MIN} s (χ²/dof {cut[k].chi2_dof:.1f})")
+        ax.loglog(
+            tc,
+            3600 * np.sqrt(cut[k].curve(tc)),
+            "-",
+            color="C0",
+            lw=1.5,
+            label=f"fit, τ ≥ {ADIS_TAU_MIN} s (χ²/dof {cut[k].chi2_dof:.1f})",
+        )
         for j, term in enumerate(cut[k].terms):
             comp = cut[k].component(term, tc)
             if np.any(comp > 0):
@@ -571,12 +678,22 @@ def _plot_adis(r, full, cut, path: Path) -> str:
 def _fit_record(f) -> dict:
     c = {}
     for name, co in f.coefficients.items():
-        c[name] = {"value": co.value, "ci": list(co.ci), "ieee": co.ieee,
-                   "ieee_ci": None if co.ieee_ci is None else list(co.ieee_ci),
-                   "ieee_unit": co.ieee_unit}
-    return {"coefficients": c, "chi2_dof": f.chi2_dof, "p_value": f.p_value, "n_tau": int(f.tau.size),
-            "tau_range": [float(f.tau[0]), float(f.tau[-1])], "z": [float(v) for v in f.z],
-            "readoffs": f.readoffs}
+        c[name] = {
+            "value": co.value,
+            "ci": list(co.ci),
+            "ieee": co.ieee,
+            "ieee_ci": None if co.ieee_ci is None else list(co.ieee_ci),
+            "ieee_unit": co.ieee_unit,
+        }
+    return {
+        "coefficients": c,
+        "chi2_dof": f.chi2_dof,
+        "p_value": f.p_value,
+        "n_tau": int(f.tau.size),
+        "tau_range": [float(f.tau[0]), float(f.tau[-1])],
+        "z": [float(v) for v in f.z],
+        "readoffs": f.readoffs,
+    }
 
 
 def load_avar_curve(path: Path) -> dict:
@@ -596,8 +713,9 @@ def load_avar_curve(path: Path) -> dict:
         # the avar package's estimator sums T − 2m terms and divides by T − 2m + 1 (one term fewer
         # than the textbook overlapping AVAR, ≤ 6e-6 relative on these curves): kept as is; the
         # EDF only needs the record length and m.
-        out[ch] = AllanResult(tau=m / fs, avar=a[:, 1], n=(n + 1 - 2 * m).astype(np.int64), m=m, estimator="oavar",
-                              fs=fs, n_samples=n)
+        out[ch] = AllanResult(
+            tau=m / fs, avar=a[:, 1], n=(n + 1 - 2 * m).astype(np.int64), m=m, estimator="oavar", fs=fs, n_samples=n
+        )
     return {"sensor": meta.get("sensor", path.stem).strip(), "fs": fs, "n": n, "channels": out}
 
 
@@ -612,13 +730,15 @@ def avlr_navchip(curves) -> dict:
             vals.extend(fn(np.sqrt(r.avar[i]), r.tau[i]))
         return float(np.exp(np.mean(vals)))
 
-    return {"N": pooled(range(6, 9), lambda ad, t: np.log(ad) + np.log(t) / 2),
-            "Q": pooled(range(1, 5), lambda ad, t: np.log(ad) + np.log(t)) / math.sqrt(3.0),
-            "K": math.sqrt(3.0) * pooled(range(10, 14), lambda ad, t: np.log(ad) - np.log(t) / 2)}
+    return {
+        "N": pooled(range(6, 9), lambda ad, t: np.log(ad) + np.log(t) / 2),
+        "Q": pooled(range(1, 5), lambda ad, t: np.log(ad) + np.log(t)) / math.sqrt(3.0),
+        "K": math.sqrt(3.0) * pooled(range(10, 14), lambda ad, t: np.log(ad) - np.log(t) / 2),
+    }
 
 
 NAVCHIP_PRINTED = {"N": 5.945877e-05, "Q": 7.208553e-06, "K": 3.062325e-05}
-CURVE_UNITS = {"adis_av": "deg/s", "navchip_av": "rad/s"}   # ADIS: known; NavChip: inferred (see report)
+CURVE_UNITS = {"adis_av": "deg/s", "navchip_av": "rad/s"}  # ADIS: known; NavChip: inferred (see report)
 
 
 def avar_curves(data_dir: Path, adis, log) -> dict | None:
@@ -632,17 +752,27 @@ def avar_curves(data_dir: Path, adis, log) -> dict | None:
         entry = {"sensor": c["sensor"], "fs": c["fs"], "n": c["n"], "unit": unit or "not stated", "gyro": {}}
         for ch in ("Gyro. X", "Gyro. Y", "Gyro. Z"):
             r = c["channels"][ch]
-            e = {"tau_range": [float(r.tau[0]), float(r.tau[-1])], "n_tau": int(r.tau.size),
-                 "all_tau": _fit_record(allanite.fit(r, unit=unit))}
+            e = {
+                "tau_range": [float(r.tau[0]), float(r.tau[-1])],
+                "n_tau": int(r.tau.size),
+                "all_tau": _fit_record(allanite.fit(r, unit=unit)),
+            }
             if path.stem == "adis_av":
                 keep = r.tau >= ADIS_TAU_MIN - 1e-12
-                rc = AllanResult(tau=r.tau[keep], avar=r.avar[keep], n=r.n[keep], m=r.m[keep], estimator="oavar",
-                                 fs=r.fs, n_samples=r.n_samples)
+                rc = AllanResult(
+                    tau=r.tau[keep],
+                    avar=r.avar[keep],
+                    n=r.n[keep],
+                    m=r.m[keep],
+                    estimator="oavar",
+                    fs=r.fs,
+                    n_samples=r.n_samples,
+                )
                 e["tau_ge_0.16"] = _fit_record(allanite.fit(rc, terms=("N", "B", "K", "R"), unit=unit))
             entry["gyro"][ch] = e
         if path.stem == "navchip_av":
             entry["avlr_reproduced"] = avlr_navchip(c)
-            rows = np.arange(5, 8)   # avlr's wn_gyro = 6:8
+            rows = np.arange(5, 8)  # avlr's wn_gyro = 6:8
             entry["wn_readoff_per_axis"] = {}
             for a in "XYZ":
                 r = c["channels"][f"Gyro. {a}"]
@@ -650,7 +780,8 @@ def avar_curves(data_dir: Path, adis, log) -> dict | None:
                 entry["wn_readoff_per_axis"][a] = {
                     "readoff": float(np.exp(np.mean(np.log(np.sqrt(r.avar[rows] * r.tau[rows]))))),
                     "fitted_curve": float(np.exp(np.mean(np.log(np.sqrt(f.curve(r.tau[rows]) * r.tau[rows]))))),
-                    "N": f.coefficients["N"].value}
+                    "N": f.coefficients["N"].value,
+                }
             entry["avlr_printed"] = NAVCHIP_PRINTED
         out[path.stem] = entry
         log(f"  {path.name}: fitted")
@@ -684,20 +815,24 @@ def write_markdown(rep: dict, path: Path) -> None:
     w = L.append
     w("# Noise-model fit: validation results")
     w("")
-    w(f"Written by `benches/noise_fit.py` ({rep['mode']} run, {rep['date']}; allanite {rep['versions']['allanite']}, "
-      f"allan-variance {rep['versions'].get('allan_variance')}, NumPy {rep['versions']['numpy']}, "
-      f"SciPy {rep['versions']['scipy']}; {rep['machine']['cpu_count']} CPUs, Python {rep['machine']['python']}). "
-      f"Every number below is in `noise_fit.json` with the per-seed values. Method details: the script's "
-      f"docstring and `docs/noise-model.md`.")
+    w(
+        f"Written by `benches/noise_fit.py` ({rep['mode']} run, {rep['date']}; allanite {rep['versions']['allanite']}, "
+        f"allan-variance {rep['versions'].get('allan_variance')}, NumPy {rep['versions']['numpy']}, "
+        f"SciPy {rep['versions']['scipy']}; {rep['machine']['cpu_count']} CPUs, Python {rep['machine']['python']}). "
+        f"Every number below is in `noise_fit.json` with the per-seed values. Method details: the script's "
+        f"docstring and `docs/noise-model.md`."
+    )
     w("")
     targets = {"Q": 0.03, "N": 0.02, "B": 0.10, "K": 0.15}
     for set_name, rec in rep.get("recovery", {}).items():
         s = rec["summary"]
         terms = rec["terms"]
         truth = rec["truth"]
-        w(f"## 1{set_name.lower()}. Recovery, set {set_name}: "
-          + ", ".join(f"{t} = {truth[t]:g}" for t in terms)
-          + f" (°/s base units); {s['n_seeds']} seeds, {rec['n_samples']:.0e} samples at {rec['fs']:g} Hz")
+        w(
+            f"## 1{set_name.lower()}. Recovery, set {set_name}: "
+            + ", ".join(f"{t} = {truth[t]:g}" for t in terms)
+            + f" (°/s base units); {s['n_seeds']} seeds, {rec['n_samples']:.0e} samples at {rec['fs']:g} Hz"
+        )
         w("")
         w(f"Dominant ranges: {rec['ranges']}. Median |relative error| (median signed error in brackets):")
         w("")
@@ -705,29 +840,48 @@ def write_markdown(rep: dict, path: Path) -> None:
         w("|---|" + "---|" * len(terms))
         for est in ESTIMATORS:
             e = s[est]
-            w(f"| {EST_LABEL[est]} | " + " | ".join(
-                f"{_pct(e['median_abs_rel_error'][t])} ({100 * e['median_rel_error'][t]:+.1f} %)" for t in terms) + " |")
+            w(
+                f"| {EST_LABEL[est]} | "
+                + " | ".join(
+                    f"{_pct(e['median_abs_rel_error'][t])} ({100 * e['median_rel_error'][t]:+.1f} %)" for t in terms
+                )
+                + " |"
+            )
         b = s["allanite"]["median_abs_rel_error_bootstrap95"]
         bp = s["peer"]["median_abs_rel_error_bootstrap95"]
-        w("| allanite, 95 % bootstrap range of the median | " + " | ".join(
-            f"{_pct(b[t][0])}–{_pct(b[t][1])}" for t in terms) + " |")
-        w("| peer (as shipped), 95 % bootstrap range | " + " | ".join(
-            f"{_pct(bp[t][0])}–{_pct(bp[t][1])}" for t in terms) + " |")
+        w(
+            "| allanite, 95 % bootstrap range of the median | "
+            + " | ".join(f"{_pct(b[t][0])}–{_pct(b[t][1])}" for t in terms)
+            + " |"
+        )
+        w(
+            "| peer (as shipped), 95 % bootstrap range | "
+            + " | ".join(f"{_pct(bp[t][0])}–{_pct(bp[t][1])}" for t in terms)
+            + " |"
+        )
         bm = s.get("bound_median_abs_rel_error", {})
         if bm:
-            w("| information bound (≈ median error of an efficient unbiased estimator) | "
-              + " | ".join(_pct(bm.get(t)) for t in terms) + " |")
+            w(
+                "| information bound (≈ median error of an efficient unbiased estimator) | "
+                + " | ".join(_pct(bm.get(t)) for t in terms)
+                + " |"
+            )
         w("| issue target (median) | " + " | ".join(_pct(targets[t]) if t in targets else "—" for t in terms) + " |")
         w("")
         if bm:
-            w("RMS relative error over seeds / the bound's relative SD (1 = as precise as the record allows for "
-              "an unbiased estimator; the RMS counts bias as well as scatter):")
+            w(
+                "RMS relative error over seeds / the bound's relative SD (1 = as precise as the record allows for "
+                "an unbiased estimator; the RMS counts bias as well as scatter):"
+            )
             w("")
             w("| estimator | " + " | ".join(t for t in terms if t in bm) + " |")
             w("|---|" + "---|" * len(bm))
             for est in ESTIMATORS:
-                w(f"| {EST_LABEL[est]} | " + " | ".join(_fmt(s["rms_over_bound"][est][t], 3) for t in terms if t in bm)
-                  + " |")
+                w(
+                    f"| {EST_LABEL[est]} | "
+                    + " | ".join(_fmt(s["rms_over_bound"][est][t], 3) for t in terms if t in bm)
+                    + " |"
+                )
             w("")
         verdict = []
         for t in terms:
@@ -737,20 +891,32 @@ def write_markdown(rep: dict, path: Path) -> None:
                 ok_target = "beyond"
             cmp_peer = [_paired(rec["rows"], rec["truth"], t, other) for other in ("peer", "peer_octave")]
             cmp_slope = _paired(rec["rows"], rec["truth"], t, "slope")
-            tgt_txt = ("no target" if ok_target is None else
-                       f"target **not met** — and not reachable: the record's information bound is "
-                       f"{_pct(bm[t])}" if ok_target == "beyond" else
-                       "target met" if ok_target else "target **not met**")
-            verdict.append(f"{t}: {tgt_txt}; against the peer as shipped / on our curve: {cmp_peer[0]} / "
-                           f"{cmp_peer[1]}; against the slope read-off: {cmp_slope}")
-        w("Verdict (allanite.fit with the set's terms; comparisons are paired over the same seeds — 'better' or "
-          "'worse' only when the 95 % bootstrap interval of the difference of median |error| excludes zero): "
-          + "; ".join(verdict) + ".")
+            tgt_txt = (
+                "no target"
+                if ok_target is None
+                else f"target **not met** — and not reachable: the record's information bound is {_pct(bm[t])}"
+                if ok_target == "beyond"
+                else "target met"
+                if ok_target
+                else "target **not met**"
+            )
+            verdict.append(
+                f"{t}: {tgt_txt}; against the peer as shipped / on our curve: {cmp_peer[0]} / "
+                f"{cmp_peer[1]}; against the slope read-off: {cmp_slope}"
+            )
+        w(
+            "Verdict (allanite.fit with the set's terms; comparisons are paired over the same seeds — 'better' or "
+            "'worse' only when the 95 % bootstrap interval of the difference of median |error| excludes zero): "
+            + "; ".join(verdict)
+            + "."
+        )
         w("")
         lo, hi = s["coverage_expected_range_95"]
-        w(f"Coverage of allanite's 68.3 % intervals (share of seeds whose interval holds the truth; with "
-          f"{s['n_seeds']} seeds a correct 68.3 % interval gives {lo:.0%}–{hi:.0%} in 95 % of benchmark runs), "
-          f"and SD of the estimates / median reported standard error (1 = calibrated, > 1 = intervals too narrow):")
+        w(
+            f"Coverage of allanite's 68.3 % intervals (share of seeds whose interval holds the truth; with "
+            f"{s['n_seeds']} seeds a correct 68.3 % interval gives {lo:.0%}–{hi:.0%} in 95 % of benchmark runs), "
+            f"and SD of the estimates / median reported standard error (1 = calibrated, > 1 = intervals too narrow):"
+        )
         w("")
         w("| | " + " | ".join(terms) + " |")
         w("|---|" + "---|" * len(terms))
@@ -764,78 +930,110 @@ def write_markdown(rep: dict, path: Path) -> None:
         if cc:
             sdr = np.array(cc["sd_ratio_mc_over_model"])
             dc = np.abs(np.array(cc["octave_corr_mc"]) - np.array(cc["octave_corr_model"]))
-            w(f"The covariance the fit uses, against the scatter of the {cc['n_records']} octave curves: SD over "
-              f"the seeds / model SD {sdr.min():.2f}–{sdr.max():.2f} (median {np.median(sdr):.2f}) across the "
-              f"{sdr.size} τ; correlation one octave apart, seeds vs model: median difference {np.median(dc):.3f}, "
-              f"largest {dc.max():.3f} (sampling error of a correlation from {cc['n_records']} records ≈ "
-              f"{1 / math.sqrt(cc['n_records']):.2f}).")
+            w(
+                f"The covariance the fit uses, against the scatter of the {cc['n_records']} octave curves: SD over "
+                f"the seeds / model SD {sdr.min():.2f}–{sdr.max():.2f} (median {np.median(sdr):.2f}) across the "
+                f"{sdr.size} τ; correlation one octave apart, seeds vs model: median difference {np.median(dc):.3f}, "
+                f"largest {dc.max():.3f} (sampling error of a correlation from {cc['n_records']} records ≈ "
+                f"{1 / math.sqrt(cc['n_records']):.2f})."
+            )
             w("")
-        w(f"Median χ²/dof {s['median_chi2_dof']:.2f}; median fit time {1e3 * s['median_time_allanite_s']:.0f} ms "
-          f"(allanite.fit on the octave curve{unc_txt}) vs {1e3 * s['median_time_peer_s']:.0f} ms (allan-variance's "
-          f"compute_avar + estimate_parameters, {rec['rows'][0]['peer_tau_range'][2]} τ from "
-          f"{rec['rows'][0]['peer_tau_range'][0]:g} to {rec['rows'][0]['peer_tau_range'][1]:g} s).")
+        w(
+            f"Median χ²/dof {s['median_chi2_dof']:.2f}; median fit time {1e3 * s['median_time_allanite_s']:.0f} ms "
+            f"(allanite.fit on the octave curve{unc_txt}) vs {1e3 * s['median_time_peer_s']:.0f} ms (allan-variance's "
+            f"compute_avar + estimate_parameters, {rec['rows'][0]['peer_tau_range'][2]} τ from "
+            f"{rec['rows'][0]['peer_tau_range'][0]:g} to {rec['rows'][0]['peer_tau_range'][1]:g} s)."
+        )
         w("")
     t2 = rep.get("table2")
     if t2:
-        w(f"## 2. Paper 000 Table 2: exponential vs full linear τ grid ({len(t2['rows'])} seeds, "
-          f"{t2['n_samples']:.0e} samples at {t2['fs']:g} Hz, m ≤ N/9 = {t2['m_max']})")
+        w(
+            f"## 2. Paper 000 Table 2: exponential vs full linear τ grid ({len(t2['rows'])} seeds, "
+            f"{t2['n_samples']:.0e} samples at {t2['fs']:g} Hz, m ≤ N/9 = {t2['m_max']})"
+        )
         w("")
-        w("Truth " + ", ".join(f"{k} = {v:g}" for k, v in t2["truth"].items())
-          + f". Linear grid: every m = 1…{t2['m_max']} ({t2['rows'][0]['n_tau_all']} τ); exponential grid "
-          f"`\"exp\"` ({t2['rows'][0]['n_tau_exp']} τ). \"Mutually inside\": share of seeds where each grid's value "
-          f"lies in the other's 68.3 % interval; \"diff/half-width\": |difference| over the exp grid's interval half-width.")
+        w(
+            "Truth "
+            + ", ".join(f"{k} = {v:g}" for k, v in t2["truth"].items())
+            + f". Linear grid: every m = 1…{t2['m_max']} ({t2['rows'][0]['n_tau_all']} τ); exponential grid "
+            f'`"exp"` ({t2["rows"][0]["n_tau_exp"]} τ). "Mutually inside": share of seeds where each grid\'s value '
+            f"lies in the other's 68.3 % interval; \"diff/half-width\": |difference| over the exp grid's interval half-width."
+        )
         w("")
         w("| comparison | " + " | ".join(t2["truth"]) + " |")
         w("|---|" + "---|" * len(t2["truth"]))
         for pair, s in t2["agreement"].items():
-            w(f"| {pair.replace('_vs_', ' vs ')}: mutually inside | "
-              + " | ".join(_pct(s[t]["mutually_inside"]) for t in t2["truth"]) + " |")
-            w(f"| {pair.replace('_vs_', ' vs ')}: median (max) diff/half-width | "
-              + " | ".join(f"{s[t]['median_diff_over_halfwidth']:.2f} ({s[t]['max_diff_over_halfwidth']:.2f})"
-                           for t in t2["truth"]) + " |")
+            w(
+                f"| {pair.replace('_vs_', ' vs ')}: mutually inside | "
+                + " | ".join(_pct(s[t]["mutually_inside"]) for t in t2["truth"])
+                + " |"
+            )
+            w(
+                f"| {pair.replace('_vs_', ' vs ')}: median (max) diff/half-width | "
+                + " | ".join(
+                    f"{s[t]['median_diff_over_halfwidth']:.2f} ({s[t]['max_diff_over_halfwidth']:.2f})"
+                    for t in t2["truth"]
+                )
+                + " |"
+            )
         for label in ("all_thin", "exp_thin", "exp_full"):
             e = t2["median_abs_rel_error"][label]
             c = t2["median_abs_rel_error"][label + "_coverage"]
-            w(f"| {label}: median abs. error vs truth (coverage) | "
-              + " | ".join(f"{_pct(e[t])} ({_pct(c[t])})" for t in t2["truth"]) + " |")
+            w(
+                f"| {label}: median abs. error vs truth (coverage) | "
+                + " | ".join(f"{_pct(e[t])} ({_pct(c[t])})" for t in t2["truth"])
+                + " |"
+            )
         w("")
-        w("`*_thin`: the default fit (τ at least an octave apart, so the linear grid reduces to m = 1, 2, 4, …); "
-          "`exp_full`: `thin=False`, every τ of the exp grid in the generalized least-squares fit with their full "
-          "covariance. The full linear grid cannot be fitted that way (its covariance would need ~5.5 million τ "
-          f"pairs; `fit` allows at most {MAX_GLS_TAU} τ with thin=False and says so).")
+        w(
+            "`*_thin`: the default fit (τ at least an octave apart, so the linear grid reduces to m = 1, 2, 4, …); "
+            "`exp_full`: `thin=False`, every τ of the exp grid in the generalized least-squares fit with their full "
+            "covariance. The full linear grid cannot be fitted that way (its covariance would need ~5.5 million τ "
+            f"pairs; `fit` allows at most {MAX_GLS_TAU} τ with thin=False and says so)."
+        )
         w("")
-        w("Reading: the two grids give the same coefficients well inside their intervals — paper 000's point "
-          "holds — and so does the exp grid fitted on all its τ at once: with the estimates' covariance in the fit, "
-          "dense correlated τ add no spurious weight.")
+        w(
+            "Reading: the two grids give the same coefficients well inside their intervals — paper 000's point "
+            "holds — and so does the exp grid fitted on all its τ at once: with the estimates' covariance in the fit, "
+            "dense correlated τ add no spurious weight."
+        )
         w("")
     p1 = rep.get("paper001")
     if p1:
         pr = p1["params"]
-        w(f"## 3. Paper 001: bias-instability variance 0.001 → 0.01 (400–800 s) → 0.001 through DAVAR")
+        w("## 3. Paper 001: bias-instability variance 0.001 → 0.01 (400–800 s) → 0.001 through DAVAR")
         w("")
-        w(f"{pr['n']} samples at {pr['fs']:g} Hz ({pr['n'] / pr['fs']:g} s); first-order Gauss–Markov bias, "
-          f"T_c = {pr['tc']} s, σ² = {pr['var_out']} (°/h)² outside and {pr['var_in']} inside 400–800 s; white noise "
-          f"{pr['white_per_sample']} °/h per sample (N = {pr['N_coefficient']:.4g} (°/h)·√s). The paper gives "
-          f"neither T_c nor the white level: these are our choices. `davar(window={pr['window']}, "
-          f"hop={pr['hop']})` (exp grid, τ {p1['runs'][0]['tau'][0]:g}–{p1['runs'][0]['tau'][-1]:g} s) → "
-          f"`fit(terms={tuple(pr['terms'])}, unit=\"deg/h\")` per window. Windows overlapping a switch "
-          f"(±{pr['window'] / pr['fs'] / 2:.1f} s) are left out of the medians.")
+        w(
+            f"{pr['n']} samples at {pr['fs']:g} Hz ({pr['n'] / pr['fs']:g} s); first-order Gauss–Markov bias, "
+            f"T_c = {pr['tc']} s, σ² = {pr['var_out']} (°/h)² outside and {pr['var_in']} inside 400–800 s; white noise "
+            f"{pr['white_per_sample']} °/h per sample (N = {pr['N_coefficient']:.4g} (°/h)·√s). The paper gives "
+            f"neither T_c nor the white level: these are our choices. `davar(window={pr['window']}, "
+            f"hop={pr['hop']})` (exp grid, τ {p1['runs'][0]['tau'][0]:g}–{p1['runs'][0]['tau'][-1]:g} s) → "
+            f'`fit(terms={tuple(pr["terms"])}, unit="deg/h")` per window. Windows overlapping a switch '
+            f"(±{pr['window'] / pr['fs'] / 2:.1f} s) are left out of the medians."
+        )
         w("")
-        w("| seed | B inside, °/h | B outside, °/h | ratio | B change points (step fit), s | "
-          "inside windows with B lower bound > outside median | K ratio | N ratio | whole-record B, °/h | "
-          "outside: SD(B)/SE(B), SD(N)/SE(N) |")
+        w(
+            "| seed | B inside, °/h | B outside, °/h | ratio | B change points (step fit), s | "
+            "inside windows with B lower bound > outside median | K ratio | N ratio | whole-record B, °/h | "
+            "outside: SD(B)/SE(B), SD(N)/SE(N) |"
+        )
         w("|---|---|---|---|---|---|---|---|---|---|")
         for r in p1["runs"]:
             b = r["B"]
-            w(f"| {r['seed']} | {b['median_inside']:.4f} | {b['median_outside']:.4f} | {b['ratio']:.2f} | "
-              f"{b['change_points_s'][0]:.0f}, {b['change_points_s'][1]:.0f} | "
-              f"{_pct(b['share_inside_windows_lower_bound_above_outside_median'])} | "
-              f"{_fmt(r['K']['ratio'], 3)} | {_fmt(r['N']['ratio'], 3)} | {r['static_fit']['B']:.4f} | "
-              f"{b['outside_sd_over_median_se']:.2f}, {r['N']['outside_sd_over_median_se']:.2f} |")
+            w(
+                f"| {r['seed']} | {b['median_inside']:.4f} | {b['median_outside']:.4f} | {b['ratio']:.2f} | "
+                f"{b['change_points_s'][0]:.0f}, {b['change_points_s'][1]:.0f} | "
+                f"{_pct(b['share_inside_windows_lower_bound_above_outside_median'])} | "
+                f"{_fmt(r['K']['ratio'], 3)} | {_fmt(r['N']['ratio'], 3)} | {r['static_fit']['B']:.4f} | "
+                f"{b['outside_sd_over_median_se']:.2f}, {r['N']['outside_sd_over_median_se']:.2f} |"
+            )
         w("")
-        w(f"Median B ratio inside/outside {p1['B_ratio_median']:.2f} (√10 = 3.16 would be B scaling with σ; the "
-          f"window sees τ ≤ {p1['runs'][0]['tau'][-1]:g} s, where the Gauss–Markov curve is only partly flat, "
-          f"and the white noise does not change, so the fitted B moves by less). Figure: `{p1['figure']}`.")
+        w(
+            f"Median B ratio inside/outside {p1['B_ratio_median']:.2f} (√10 = 3.16 would be B scaling with σ; the "
+            f"window sees τ ≤ {p1['runs'][0]['tau'][-1]:g} s, where the Gauss–Markov curve is only partly flat, "
+            f"and the white noise does not change, so the fitted B moves by less). Figure: `{p1['figure']}`."
+        )
         w("")
     real = rep.get("real")
     if real and real.get("adis"):
@@ -849,7 +1047,7 @@ def _auto_cell(f) -> str:
     if f is None:
         return "—"
     c = f["coefficients"]
-    return (f"{f['tau_range'][0]:g} s, {c['N']['ieee']:.3f}, {c['B']['ieee']:.1f}, {f['chi2_dof']:.2f}")
+    return f"{f['tau_range'][0]:g} s, {c['N']['ieee']:.3f}, {c['B']['ieee']:.1f}, {f['chi2_dof']:.2f}"
 
 
 def _write_adis(w, adis):
@@ -863,21 +1061,25 @@ def _write_adis(w, adis):
     acf5 = [r["axes"]["z"]["acf_lag_1_2_3_5"][3] for r in runs]
     b_xy = [r["axes"][ax]["all_tau"] for r in runs for ax in "xy"]
     b_ratio = [f["coefficients"]["B"]["ieee"] / (3600 * f["readoffs"]["adev_min"] / PLATEAU) for f in b_xy]
-    w("Two fits per axis. **All τ** (octave grid from τ0, all five terms): the model does not fit the shortest τ "
-      f"— χ²/dof {min(f['chi2_dof'] for f in allfits):.0f}–{max(f['chi2_dof'] for f in allfits):.0f} — because the "
-      f"sensor's output is not white there: x and y have a lag-1 autocorrelation of {min(acf1):.2f}–{max(acf1):.2f} "
-      "(internal low-pass filtering: the Allan variance at τ0 sits below the white-noise line) and z carries a "
-      f"narrow-band component near 20 Hz (lag-5 autocorrelation {min(acf5):+.2f} to {max(acf5):+.2f}). With weights "
-      "from the EDF those very precise short-τ points dominate, N is pulled low and B absorbs the misfit "
-      f"(x, y: B = {min(f['coefficients']['B']['ieee'] for f in b_xy):.0f}–"
-      f"{max(f['coefficients']['B']['ieee'] for f in b_xy):.0f} °/h, {min(b_ratio):.1f}–{max(b_ratio):.1f} × the "
-      f"ADEV minimum / 0.664). **τ ≥ {adis['tau_min_cut']} s** (terms N, B, K, R; Q is not identifiable there): "
-      f"χ²/dof {min(f['chi2_dof'] for f in cutfits):.1f}–{max(f['chi2_dof'] for f in cutfits):.1f} — these are the "
-      "values to quote. IEEE-952 units, 68.3 % intervals. Figure (run 1): "
-      f"`{adis.get('figure')}`.")
+    w(
+        "Two fits per axis. **All τ** (octave grid from τ0, all five terms): the model does not fit the shortest τ "
+        f"— χ²/dof {min(f['chi2_dof'] for f in allfits):.0f}–{max(f['chi2_dof'] for f in allfits):.0f} — because the "
+        f"sensor's output is not white there: x and y have a lag-1 autocorrelation of {min(acf1):.2f}–{max(acf1):.2f} "
+        "(internal low-pass filtering: the Allan variance at τ0 sits below the white-noise line) and z carries a "
+        f"narrow-band component near 20 Hz (lag-5 autocorrelation {min(acf5):+.2f} to {max(acf5):+.2f}). With weights "
+        "from the EDF those very precise short-τ points dominate, N is pulled low and B absorbs the misfit "
+        f"(x, y: B = {min(f['coefficients']['B']['ieee'] for f in b_xy):.0f}–"
+        f"{max(f['coefficients']['B']['ieee'] for f in b_xy):.0f} °/h, {min(b_ratio):.1f}–{max(b_ratio):.1f} × the "
+        f"ADEV minimum / 0.664). **τ ≥ {adis['tau_min_cut']} s** (terms N, B, K, R; Q is not identifiable there): "
+        f"χ²/dof {min(f['chi2_dof'] for f in cutfits):.1f}–{max(f['chi2_dof'] for f in cutfits):.1f} — these are the "
+        "values to quote. IEEE-952 units, 68.3 % intervals. Figure (run 1): "
+        f"`{adis.get('figure')}`."
+    )
     w("")
-    w("| run | axis | N, °/√h | B, °/h | K, °/h^1.5 | R, °/h² | χ²/dof | all-τ fit: N, B, χ²/dof | ADEV min, °/h (τ) "
-      "| tau_range='auto': from τ, N, B, χ²/dof |")
+    w(
+        "| run | axis | N, °/√h | B, °/h | K, °/h^1.5 | R, °/h² | χ²/dof | all-τ fit: N, B, χ²/dof | ADEV min, °/h (τ) "
+        "| tau_range='auto': from τ, N, B, χ²/dof |"
+    )
     w("|---|---|---|---|---|---|---|---|---|---|")
     for i, run in enumerate(adis["runs"], 1):
         for ax in "xyz":
@@ -885,79 +1087,104 @@ def _write_adis(w, adis):
             c = a["tau_ge_0.16"]["coefficients"]
             f = a["all_tau"]
             ro = f["readoffs"]
-            w(f"| {i} | {ax} | {c['N']['ieee']:.3f} {_ci(c['N'])} | {c['B']['ieee']:.1f} {_ci(c['B'])} | "
-              f"{c['K']['ieee']:.0f} {_ci(c['K'])} | {c['R']['ieee']:.0f} {_ci(c['R'])} | "
-              f"{a['tau_ge_0.16']['chi2_dof']:.2f} | {f['coefficients']['N']['ieee']:.3f}, "
-              f"{f['coefficients']['B']['ieee']:.1f}, {f['chi2_dof']:.0f} | "
-              f"{3600 * ro['adev_min']:.1f} ({ro['tau_at_min']:g} s) | " + _auto_cell(a.get("auto")) + " |")
+            w(
+                f"| {i} | {ax} | {c['N']['ieee']:.3f} {_ci(c['N'])} | {c['B']['ieee']:.1f} {_ci(c['B'])} | "
+                f"{c['K']['ieee']:.0f} {_ci(c['K'])} | {c['R']['ieee']:.0f} {_ci(c['R'])} | "
+                f"{a['tau_ge_0.16']['chi2_dof']:.2f} | {f['coefficients']['N']['ieee']:.3f}, "
+                f"{f['coefficients']['B']['ieee']:.1f}, {f['chi2_dof']:.0f} | "
+                f"{3600 * ro['adev_min']:.1f} ({ro['tau_at_min']:g} s) | " + _auto_cell(a.get("auto")) + " |"
+            )
     w("")
-    w("Run to run (τ ≥ 0.16 s fit): mean ± SD over the six runs, and that SD over the median interval half-width "
-      "(≈ 1 when the runs differ by what the intervals say):")
+    w(
+        "Run to run (τ ≥ 0.16 s fit): mean ± SD over the six runs, and that SD over the median interval half-width "
+        "(≈ 1 when the runs differ by what the intervals say):"
+    )
     w("")
     w("| axis | N, °/√h | B, °/h | K, °/h^1.5 | SD/half-width N, B, K | max/min N, B |")
     w("|---|---|---|---|---|---|")
     for ax in "xyz":
         s = adis["summary"][ax]["tau_ge_0.16"]
-        w(f"| {ax} | {s['N']['mean']:.3f} ± {s['N']['sd']:.3f} | {s['B']['mean']:.1f} ± {s['B']['sd']:.1f} | "
-          f"{s['K']['mean']:.0f} ± {s['K']['sd']:.0f} | {_fmt(s['N']['sd_over_halfwidth'], 2)}, "
-          f"{_fmt(s['B']['sd_over_halfwidth'], 2)}, {_fmt(s['K']['sd_over_halfwidth'], 2)} | "
-          f"{_fmt(s['N']['max_over_min'], 3)}, {_fmt(s['B']['max_over_min'], 3)} |")
+        w(
+            f"| {ax} | {s['N']['mean']:.3f} ± {s['N']['sd']:.3f} | {s['B']['mean']:.1f} ± {s['B']['sd']:.1f} | "
+            f"{s['K']['mean']:.0f} ± {s['K']['sd']:.0f} | {_fmt(s['N']['sd_over_halfwidth'], 2)}, "
+            f"{_fmt(s['B']['sd_over_halfwidth'], 2)}, {_fmt(s['K']['sd_over_halfwidth'], 2)} | "
+            f"{_fmt(s['N']['max_over_min'], 3)}, {_fmt(s['B']['max_over_min'], 3)} |"
+        )
     w("")
     qs = [adis["runs"][i]["axes"][ax]["all_tau"]["coefficients"]["Q"] for i in range(len(adis["runs"])) for ax in "xyz"]
-    w(f"Quantization (LSB {q['lsb_deg_s']} °/s). Rounding the *rate* adds white rate noise of variance LSB²/12: "
-      f"an ARW of LSB·√(τ0/12) = {q['rate_quantization_as_white_rate_N_deg_sqrt_s']:.3g} °/√s = "
-      f"{q['rate_quantization_as_white_rate_N_deg_sqrt_h']:.3f} °/√h, i.e. ≈ 0.1 % of the measured N² — invisible, "
-      f"and of N's slope, not Q's. Read as angle quantization, LSB·τ0/√12 = {q['angle_quantization_Q_deg']:.3g} ° "
-      f"would add 3Q²/τ0² = {q['angle_quantization_avar_at_tau0']:.2g} (°/s)² at τ0, 0.6 % of the measured "
-      f"≈ 0.1 (°/s)². The all-τ fit gives "
-      + (f"Q = 0 on all {len(qs)} run-axes " if max(c['ieee'] for c in qs) == 0 else
-         f"Q = {_fmt(min(c['ieee'] for c in qs), 3)}–{_fmt(max(c['ieee'] for c in qs), 3)} ° ")
-      + f"with 68.3 % upper bounds {_fmt(min(c['ieee_ci'][1] for c in qs), 3)}–{_fmt(max(c['ieee_ci'][1] for c in qs), 3)} °: "
-      f"consistent with the LSB-based {q['angle_quantization_Q_deg']:.3g} °, but not a measurement of it.")
+    w(
+        f"Quantization (LSB {q['lsb_deg_s']} °/s). Rounding the *rate* adds white rate noise of variance LSB²/12: "
+        f"an ARW of LSB·√(τ0/12) = {q['rate_quantization_as_white_rate_N_deg_sqrt_s']:.3g} °/√s = "
+        f"{q['rate_quantization_as_white_rate_N_deg_sqrt_h']:.3f} °/√h, i.e. ≈ 0.1 % of the measured N² — invisible, "
+        f"and of N's slope, not Q's. Read as angle quantization, LSB·τ0/√12 = {q['angle_quantization_Q_deg']:.3g} ° "
+        f"would add 3Q²/τ0² = {q['angle_quantization_avar_at_tau0']:.2g} (°/s)² at τ0, 0.6 % of the measured "
+        f"≈ 0.1 (°/s)². The all-τ fit gives "
+        + (
+            f"Q = 0 on all {len(qs)} run-axes "
+            if max(c["ieee"] for c in qs) == 0
+            else f"Q = {_fmt(min(c['ieee'] for c in qs), 3)}–{_fmt(max(c['ieee'] for c in qs), 3)} ° "
+        )
+        + f"with 68.3 % upper bounds {_fmt(min(c['ieee_ci'][1] for c in qs), 3)}–{_fmt(max(c['ieee_ci'][1] for c in qs), 3)} °: "
+        f"consistent with the LSB-based {q['angle_quantization_Q_deg']:.3g} °, but not a measurement of it."
+    )
     w("")
 
 
 def _write_curves(w, curves, adis):
     w("## 5. Real data: the avar package's Allan-variance curves")
     w("")
-    w("Each curve rebuilt as an `AllanResult` (τ from the CSV, m = τ·fs, `n_samples` and fs from the header line, "
-      "estimator \"oavar\"; the avar estimator's one-term-short numerator changes values by ≤ 6e-6 and is left as is) "
-      "and fitted with all five terms on every τ, and for the ADIS curve also from τ ≥ 0.16 s. Base-form values in "
-      "the curve's own unit (not stated by the package: ADIS is °/s as in the raw runs; NavChip inferred rad/s, see "
-      "below); 68.3 % intervals.")
+    w(
+        "Each curve rebuilt as an `AllanResult` (τ from the CSV, m = τ·fs, `n_samples` and fs from the header line, "
+        'estimator "oavar"; the avar estimator\'s one-term-short numerator changes values by ≤ 6e-6 and is left as is) '
+        "and fitted with all five terms on every τ, and for the ADIS curve also from τ ≥ 0.16 s. Base-form values in "
+        "the curve's own unit (not stated by the package: ADIS is °/s as in the raw runs; NavChip inferred rad/s, see "
+        "below); 68.3 % intervals."
+    )
     w("")
     w("| curve | fs, n | axis | Q | N | B | K | R | χ²/dof |")
     w("|---|---|---|---|---|---|---|---|---|")
     for name, e in curves.items():
         for ch, g in e["gyro"].items():
             c = g["all_tau"]["coefficients"]
-            w(f"| {name} ({e['unit']}) | {e['fs']:g} Hz, {e['n']:.3g} | {ch[-1]} | "
-              + " | ".join(f"{_fmt(c[t]['value'], 3)} [{_fmt(c[t]['ci'][0], 2)}, {_fmt(c[t]['ci'][1], 2)}]"
-                           for t in ("Q", "N", "B", "K", "R"))
-              + f" | {g['all_tau']['chi2_dof']:.3g} |")
+            w(
+                f"| {name} ({e['unit']}) | {e['fs']:g} Hz, {e['n']:.3g} | {ch[-1]} | "
+                + " | ".join(
+                    f"{_fmt(c[t]['value'], 3)} [{_fmt(c[t]['ci'][0], 2)}, {_fmt(c[t]['ci'][1], 2)}]"
+                    for t in ("Q", "N", "B", "K", "R")
+                )
+                + f" | {g['all_tau']['chi2_dof']:.3g} |"
+            )
     w("")
     if "adis_av" in curves and adis:
-        w("ADIS16405 run 1: the avar curve against allanite's own Allan variance of the raw run (τ ≥ 0.16 s fit, IEEE "
-          "units):")
+        w(
+            "ADIS16405 run 1: the avar curve against allanite's own Allan variance of the raw run (τ ≥ 0.16 s fit, IEEE "
+            "units):"
+        )
         w("")
         w("| axis | N from curve | N from raw | B from curve | B from raw | K from curve | K from raw |")
         w("|---|---|---|---|---|---|---|")
         for ax, ch in zip("xyz", ("Gyro. X", "Gyro. Y", "Gyro. Z")):
             cc = curves["adis_av"]["gyro"][ch]["tau_ge_0.16"]["coefficients"]
             rc = adis["runs"][0]["axes"][ax]["tau_ge_0.16"]["coefficients"]
-            w(f"| {ax} | {cc['N']['ieee']:.4f} | {rc['N']['ieee']:.4f} | {cc['B']['ieee']:.2f} | {rc['B']['ieee']:.2f} | "
-              f"{cc['K']['ieee']:.1f} | {rc['K']['ieee']:.1f} |")
+            w(
+                f"| {ax} | {cc['N']['ieee']:.4f} | {rc['N']['ieee']:.4f} | {cc['B']['ieee']:.2f} | {rc['B']['ieee']:.2f} | "
+                f"{cc['K']['ieee']:.1f} | {rc['K']['ieee']:.1f} |"
+            )
         w("")
     nav = curves.get("navchip_av")
     if nav:
         rep_ = nav["avlr_reproduced"]
         pr = nav["avlr_printed"]
         rad = 180.0 / math.pi
-        w("NavChip. The avar vignette fits `avlr(navchip_av, qn_gyro = 1:4, wn_gyro = 6:8, rw_gyro = 10:13)`: the "
-          "slope read-offs σ·√τ (WN), σ·τ/√3 (QN) and √3·σ/√τ (RW) at those rows, geometric mean pooled over the "
-          "three gyro axes. Recomputed here from the CSV:")
+        w(
+            "NavChip. The avar vignette fits `avlr(navchip_av, qn_gyro = 1:4, wn_gyro = 6:8, rw_gyro = 10:13)`: the "
+            "slope read-offs σ·√τ (WN), σ·τ/√3 (QN) and √3·σ/√τ (RW) at those rows, geometric mean pooled over the "
+            "three gyro axes. Recomputed here from the CSV:"
+        )
         w("")
-        w("| | printed (vignette) | recomputed | allanite.fit, X / Y / Z (68.3 % interval) | allanite, IEEE units if rad/s |")
+        w(
+            "| | printed (vignette) | recomputed | allanite.fit, X / Y / Z (68.3 % interval) | allanite, IEEE units if rad/s |"
+        )
         w("|---|---|---|---|---|")
         for t, lab in (("N", "WN"), ("Q", "QN"), ("K", "RW"), ("B", "—")):
             fits = [nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"][t] for a in "XYZ"]
@@ -965,31 +1192,42 @@ def _write_curves(w, curves, adis):
             unit = {"N": "°/√h", "Q": "°", "K": "°/h^1.5", "B": "°/h"}[t]
             if t == "B":
                 ieee = " / ".join(f"{conv * c['value']:.3g}" for c in fits)
-                w(f"| bias instability (B) | — | — | "
-                  + " / ".join(f"{c['value']:.3g} [{_fmt(c['ci'][0], 2)}, {_fmt(c['ci'][1], 2)}]" for c in fits)
-                  + f" | {ieee} {unit} |")
+                w(
+                    "| bias instability (B) | — | — | "
+                    + " / ".join(f"{c['value']:.3g} [{_fmt(c['ci'][0], 2)}, {_fmt(c['ci'][1], 2)}]" for c in fits)
+                    + f" | {ieee} {unit} |"
+                )
                 continue
             ieee = " / ".join(f"{conv * c['value']:.3g}" for c in fits)
-            w(f"| {lab} ({t}) | {pr[t]:.6e} | {rep_[t]:.6e} | "
-              + " / ".join(f"{c['value']:.3g} [{_fmt(c['ci'][0], 2)}, {_fmt(c['ci'][1], 2)}]" for c in fits)
-              + f" | {ieee} {unit} |")
+            w(
+                f"| {lab} ({t}) | {pr[t]:.6e} | {rep_[t]:.6e} | "
+                + " / ".join(f"{c['value']:.3g} [{_fmt(c['ci'][0], 2)}, {_fmt(c['ci'][1], 2)}]" for c in fits)
+                + f" | {ieee} {unit} |"
+            )
         w("")
         per = nav["wn_readoff_per_axis"]
         dev = [abs(per[a]["fitted_curve"] / per[a]["readoff"] - 1) for a in "XYZ"]
         low = [1 - per[a]["N"] / per[a]["readoff"] for a in "XYZ"]
-        kr = [pr["K"] / nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"]["K"]["value"] for a in "XYZ"
-              if nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"]["K"]["value"] > 0]
+        kr = [
+            pr["K"] / nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"]["K"]["value"]
+            for a in "XYZ"
+            if nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"]["K"]["value"] > 0
+        ]
         chis = [nav["gyro"][f"Gyro. {a}"]["all_tau"]["chi2_dof"] for a in "XYZ"]
-        w("The vignette's WN is read at τ = 0.26–1 s, where bias instability still adds to the curve: allanite's "
-          f"fitted curve reproduces each axis's read-off σ·√τ there to {100 * max(dev):.1f} %, while N alone is "
-          f"{100 * min(low):.0f}–{100 * max(low):.0f} % lower (checked in tests/test_fit_real.py). Its RW is read at "
-          "τ = 4–33 s, the flat bottom of the curve, so it is mostly bias instability too; allanite's K is "
-          + (f"{min(kr):.1f}–{max(kr):.1f} × smaller" if kr else "0")
-          + f" and poorly determined. The fits' χ²/dof ({min(chis):.0f}–{max(chis):.0f}) say the five-term model is "
-          "only an approximation of this sensor's curve.")
+        w(
+            "The vignette's WN is read at τ = 0.26–1 s, where bias instability still adds to the curve: allanite's "
+            f"fitted curve reproduces each axis's read-off σ·√τ there to {100 * max(dev):.1f} %, while N alone is "
+            f"{100 * min(low):.0f}–{100 * max(low):.0f} % lower (checked in tests/test_fit_real.py). Its RW is read at "
+            "τ = 4–33 s, the flat bottom of the curve, so it is mostly bias instability too; allanite's K is "
+            + (f"{min(kr):.1f}–{max(kr):.1f} × smaller" if kr else "0")
+            + f" and poorly determined. The fits' χ²/dof ({min(chis):.0f}–{max(chis):.0f}) say the five-term model is "
+            "only an approximation of this sensor's curve."
+        )
         w("")
-        w("Units: the package does not state them; rad/s is inferred (WN 5.95e-5 → 0.204 °/√h and an ADEV minimum "
-          "of ≈ 5.8e-5 → 12 °/h are MEMS-chip values; in °/s they would be 100 × too good).")
+        w(
+            "Units: the package does not state them; rad/s is inferred (WN 5.95e-5 → 0.204 °/√h and an ADEV minimum "
+            "of ≈ 5.8e-5 → 12 °/h are MEMS-chip values; in °/s they would be 100 × too good)."
+        )
         w("")
 
 
@@ -1002,8 +1240,11 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, default=None, help="seeds per recovery set (default 100; quick 3)")
     ap.add_argument("--out", type=Path, default=None, help="output folder (default benches/results)")
     ap.add_argument("--skip", nargs="*", default=[], choices=["recovery", "table2", "paper001", "real"])
-    ap.add_argument("--report-only", action="store_true",
-                    help="rewrite noise_fit.md from the existing noise_fit.json (no computation)")
+    ap.add_argument(
+        "--report-only",
+        action="store_true",
+        help="rewrite noise_fit.md from the existing noise_fit.json (no computation)",
+    )
     args = ap.parse_args(argv)
     if args.report_only:
         folder = args.out or (HERE / "results")
@@ -1032,8 +1273,7 @@ def main(argv=None) -> int:
         "mode": "quick" if quick else "full",
         "date": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
         "versions": versions,
-        "machine": {"python": platform.python_version(), "platform": platform.platform(),
-                    "cpu_count": os.cpu_count()},
+        "machine": {"python": platform.python_version(), "platform": platform.platform(), "cpu_count": os.cpu_count()},
     }
     t0 = time.perf_counter()
     if "recovery" not in args.skip:

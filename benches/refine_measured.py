@@ -41,15 +41,26 @@ def shared() -> Path:
 
 def summarize(name, r) -> dict:
     s0 = r.start
-    row = {"record": name, "start_chi2_dof": s0.chi2_dof, "start_rms_z": float(np.sqrt(np.mean(s0.z ** 2))),
-           "start_rms_adev_pct": float(100 * np.sqrt(np.mean((np.sqrt(s0.avar / s0.model) - 1) ** 2))),
-           "final_chi2_dof": r.fit.chi2_dof,
-           "final_rms_adev_pct": float(100 * np.sqrt(np.mean((np.sqrt(r.fit.avar / r.fit.model) - 1) ** 2))),
-           "steps": []}
+    row = {
+        "record": name,
+        "start_chi2_dof": s0.chi2_dof,
+        "start_rms_z": float(np.sqrt(np.mean(s0.z**2))),
+        "start_rms_adev_pct": float(100 * np.sqrt(np.mean((np.sqrt(s0.avar / s0.model) - 1) ** 2))),
+        "final_chi2_dof": r.fit.chi2_dof,
+        "final_rms_adev_pct": float(100 * np.sqrt(np.mean((np.sqrt(r.fit.avar / r.fit.model) - 1) ** 2))),
+        "steps": [],
+    }
     for st in r.steps:
-        row["steps"].append({"effect": st.effect, "params": {k: float(v) for k, v in st.params.items()},
-                             "intervals": {k: [float(a), float(b)] for k, (a, b) in st.intervals.items()},
-                             "before": st.before, "after": st.after, "evidence": _jsonable(st.evidence)})
+        row["steps"].append(
+            {
+                "effect": st.effect,
+                "params": {k: float(v) for k, v in st.params.items()},
+                "intervals": {k: [float(a), float(b)] for k, (a, b) in st.intervals.items()},
+                "before": st.before,
+                "after": st.after,
+                "evidence": _jsonable(st.evidence),
+            }
+        )
     return row
 
 
@@ -72,13 +83,17 @@ def run(quick: bool, out: Path) -> dict:
         log = allanite.read_log(path, fs=100.0, columns=AXES, unit="deg/s")
         for a, ax in enumerate(AXES[:1] if quick else AXES):
             t0 = time.perf_counter()
-            r = allanite.refine(np.asarray(log.data[:, a], dtype=np.float64), 100.0, tau_range=(0.1, None),
-                                unit="deg/s")
+            r = allanite.refine(
+                np.asarray(log.data[:, a], dtype=np.float64), 100.0, tau_range=(0.1, None), unit="deg/s"
+            )
             row = summarize(f"ADIS16405 run {k} {ax}", r)
             row["seconds"] = time.perf_counter() - t0
             rows["adis"].append(row)
-            print(f"{row['record']}: χ²/dof {row['start_chi2_dof']:.2f} → {row['final_chi2_dof']:.2f}, "
-                  f"found {[s['effect'] for s in row['steps']]}", flush=True)
+            print(
+                f"{row['record']}: χ²/dof {row['start_chi2_dof']:.2f} → {row['final_chi2_dof']:.2f}, "
+                f"found {[s['effect'] for s in row['steps']]}",
+                flush=True,
+            )
     files = sorted((data / "avar-curves").glob("*_av.csv"))
     for f in files[:1] if quick else files:
         cur = load_avar_curve(f)
@@ -90,8 +105,11 @@ def run(quick: bool, out: Path) -> dict:
                 continue
             row = summarize(f"{cur['sensor']} {ch}", r)
             rows["curves"].append(row)
-            print(f"{row['record']}: χ²/dof {row['start_chi2_dof']:.2f} → {row['final_chi2_dof']:.2f}, "
-                  f"found {[s['effect'] for s in row['steps']]}", flush=True)
+            print(
+                f"{row['record']}: χ²/dof {row['start_chi2_dof']:.2f} → {row['final_chi2_dof']:.2f}, "
+                f"found {[s['effect'] for s in row['steps']]}",
+                flush=True,
+            )
     out.mkdir(parents=True, exist_ok=True)
     (out / "refine.json").write_text(json.dumps(rows, indent=1, default=float))
     write_md(rows, out / "refine.md")
@@ -99,41 +117,58 @@ def run(quick: bool, out: Path) -> dict:
 
 
 def _fmt_params(st):
-    return "; ".join(f"{k} = {v:.3g} [{st['intervals'][k][0]:.3g}, {st['intervals'][k][1]:.3g}]"
-                     for k, v in st["params"].items())
+    return "; ".join(
+        f"{k} = {v:.3g} [{st['intervals'][k][0]:.3g}, {st['intervals'][k][1]:.3g}]" for k, v in st["params"].items()
+    )
 
 
 def write_md(rows, path: Path) -> None:
-    L = ["# `refine` on measured data", "",
-         "Written by `benches/refine_measured.py`. Per record: the five-term model's residual, what it was traced to, "
-         "the parameters added (input unit's base form: σ and amplitude in the rate unit, T_c in s, f0 in Hz, t in s) "
-         "and the error before → after (χ²/dof of the normalised residuals, RMS of the ADEV error in %). "
-         "All fits use τ ≥ 0.1 s. Change points are tested on 16 non-overlapping windows (ADIS only: curves have no time axis); their before/after is "
-         "the windows' Allan variance against one level vs piecewise levels.", "",
-         "| record | five-term χ²/dof | RMS ADEV err | traced to | parameters | χ²/dof before → after | RMS ADEV err before → after |",
-         "|---|---|---|---|---|---|---|"]
+    L = [
+        "# `refine` on measured data",
+        "",
+        "Written by `benches/refine_measured.py`. Per record: the five-term model's residual, what it was traced to, "
+        "the parameters added (input unit's base form: σ and amplitude in the rate unit, T_c in s, f0 in Hz, t in s) "
+        "and the error before → after (χ²/dof of the normalised residuals, RMS of the ADEV error in %). "
+        "All fits use τ ≥ 0.1 s. Change points are tested on 16 non-overlapping windows (ADIS only: curves have no time axis); their before/after is "
+        "the windows' Allan variance against one level vs piecewise levels.",
+        "",
+        "| record | five-term χ²/dof | RMS ADEV err | traced to | parameters | χ²/dof before → after | RMS ADEV err before → after |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for group in ("adis", "curves"):
         for row in rows[group]:
             if "error" in row:
                 L.append(f"| {row['record']} | — | — | not fitted: {row['error']} | | | |")
                 continue
             if not row["steps"]:
-                L.append(f"| {row['record']} | {row['start_chi2_dof']:.2f} | {row['start_rms_adev_pct']:.1f} % | "
-                         "nothing found | | | |")
+                L.append(
+                    f"| {row['record']} | {row['start_chi2_dof']:.2f} | {row['start_rms_adev_pct']:.1f} % | "
+                    "nothing found | | | |"
+                )
                 continue
             for i, st in enumerate(row["steps"]):
-                head = (f"| {row['record']} | {row['start_chi2_dof']:.2f} | {row['start_rms_adev_pct']:.1f} % "
-                        if i == 0 else "| | | ")
-                L.append(head + f"| {st['effect']} | {_fmt_params(st)} | {st['before']['chi2_dof']:.2f} → "
-                         f"{st['after']['chi2_dof']:.2f} | {st['before']['rms_adev_pct']:.1f} → "
-                         f"{st['after']['rms_adev_pct']:.1f} % |")
+                head = (
+                    f"| {row['record']} | {row['start_chi2_dof']:.2f} | {row['start_rms_adev_pct']:.1f} % "
+                    if i == 0
+                    else "| | | "
+                )
+                L.append(
+                    head + f"| {st['effect']} | {_fmt_params(st)} | {st['before']['chi2_dof']:.2f} → "
+                    f"{st['after']['chi2_dof']:.2f} | {st['before']['rms_adev_pct']:.1f} → "
+                    f"{st['after']['rms_adev_pct']:.1f} % |"
+                )
     n_adis = len(rows["adis"])
     found = {}
     for row in rows["adis"] + rows["curves"]:
         for st in row.get("steps", []):
             found[st["effect"]] = found.get(st["effect"], 0) + 1
-    L += ["", f"Effects found over {n_adis} ADIS axes and {len(rows['curves'])} curve channels: "
-          + (", ".join(f"{k} × {v}" for k, v in sorted(found.items())) or "none") + ".", ""]
+    L += [
+        "",
+        f"Effects found over {n_adis} ADIS axes and {len(rows['curves'])} curve channels: "
+        + (", ".join(f"{k} × {v}" for k, v in sorted(found.items())) or "none")
+        + ".",
+        "",
+    ]
     path.write_text("\n".join(L))
 
 

@@ -101,33 +101,89 @@ METHODS = {
 #   at_all_windows, at_all_m, at_exp_windows — allantools per window
 FULL = {
     "table": {
-        1_000: dict(naive_windows=None, naive_m=None, fast_m=None, prefix_all_m=None, prefix_exp_m=None,
-                    at_all_windows=None, at_all_m=None, at_exp_windows=None),
-        10_000: dict(naive_windows=None, naive_m=None, fast_m=None, prefix_all_m=None, prefix_exp_m=None,
-                     at_all_windows=200, at_all_m=None, at_exp_windows=1000),
-        100_000: dict(naive_windows=100, naive_m=None, fast_m=None, prefix_all_m=None, prefix_exp_m=None,
-                      at_all_windows=20, at_all_m=None, at_exp_windows=200),
-        1_000_000: dict(naive_windows=20, naive_m=100, fast_m=100, prefix_all_m=100, prefix_exp_m=None,
-                        at_all_windows=5, at_all_m=100, at_exp_windows=10),
-        10_000_000: dict(naive_windows=10, naive_m=20, fast_m=20, prefix_all_m=20, prefix_exp_m=30,
-                         at_all_windows=3, at_all_m=20, at_exp_windows=3),
+        1_000: dict(
+            naive_windows=None,
+            naive_m=None,
+            fast_m=None,
+            prefix_all_m=None,
+            prefix_exp_m=None,
+            at_all_windows=None,
+            at_all_m=None,
+            at_exp_windows=None,
+        ),
+        10_000: dict(
+            naive_windows=None,
+            naive_m=None,
+            fast_m=None,
+            prefix_all_m=None,
+            prefix_exp_m=None,
+            at_all_windows=200,
+            at_all_m=None,
+            at_exp_windows=1000,
+        ),
+        100_000: dict(
+            naive_windows=100,
+            naive_m=None,
+            fast_m=None,
+            prefix_all_m=None,
+            prefix_exp_m=None,
+            at_all_windows=20,
+            at_all_m=None,
+            at_exp_windows=200,
+        ),
+        1_000_000: dict(
+            naive_windows=20,
+            naive_m=100,
+            fast_m=100,
+            prefix_all_m=100,
+            prefix_exp_m=None,
+            at_all_windows=5,
+            at_all_m=100,
+            at_exp_windows=10,
+        ),
+        10_000_000: dict(
+            naive_windows=10,
+            naive_m=20,
+            fast_m=20,
+            prefix_all_m=20,
+            prefix_exp_m=30,
+            at_all_windows=3,
+            at_all_m=20,
+            at_exp_windows=3,
+        ),
     },
-    "chunk_bytes": 512 * 2**20,      # largest output of one timed call; above: chunks of m (see prewarm)
+    "chunk_bytes": 512 * 2**20,  # largest output of one timed call; above: chunks of m (see prewarm)
     "single_call_diagnostic": [100_000],  # also time the fast "all" grid as one call (output 3.35 GiB)
-    "probe_windows": 100_000,        # windows kept per compared row (evenly strided)
-    "probe_rows": 200,               # m values kept for comparisons when a grid was run in full
+    "probe_windows": 100_000,  # windows kept per compared row (evenly strided)
+    "probe_rows": 200,  # m values kept for comparisons when a grid was run in full
     "scaling": [10_000, 100_000, 1_000_000, 10_000_000, 100_000_000],
     "scaling_repeats": {100_000_000: 1},  # default 3 (best of)
 }
 
 QUICK = {
     "table": {
-        1_000: dict(naive_windows=None, naive_m=None, fast_m=None, prefix_all_m=None, prefix_exp_m=None,
-                    at_all_windows=50, at_all_m=None, at_exp_windows=None),
-        4_000: dict(naive_windows=10, naive_m=20, fast_m=20, prefix_all_m=20, prefix_exp_m=10,
-                    at_all_windows=3, at_all_m=20, at_exp_windows=5),
+        1_000: dict(
+            naive_windows=None,
+            naive_m=None,
+            fast_m=None,
+            prefix_all_m=None,
+            prefix_exp_m=None,
+            at_all_windows=50,
+            at_all_m=None,
+            at_exp_windows=None,
+        ),
+        4_000: dict(
+            naive_windows=10,
+            naive_m=20,
+            fast_m=20,
+            prefix_all_m=20,
+            prefix_exp_m=10,
+            at_all_windows=3,
+            at_all_m=20,
+            at_exp_windows=5,
+        ),
     },
-    "chunk_bytes": 2**19,            # 512 KiB: exercises the chunked path
+    "chunk_bytes": 2**19,  # 512 KiB: exercises the chunked path
     "single_call_diagnostic": [1_000],
     "probe_windows": 1_000,
     "probe_rows": 50,
@@ -253,9 +309,14 @@ def compare(blocks_a: list[Block], blocks_b: list[Block], m_split: int) -> dict:
                 n = int(sel.sum()) * ia_w.size
                 count[part] += n
                 count["all"] += n
-    return {"max_rel_diff": worst["all"], "n_compared": count["all"],
-            "max_rel_diff_m_le_w9": worst["low"], "n_compared_m_le_w9": count["low"],
-            "max_rel_diff_m_gt_w9": worst["high"], "n_compared_m_gt_w9": count["high"]}
+    return {
+        "max_rel_diff": worst["all"],
+        "n_compared": count["all"],
+        "max_rel_diff_m_le_w9": worst["low"],
+        "n_compared_m_le_w9": count["low"],
+        "max_rel_diff_m_gt_w9": worst["high"],
+        "n_compared_m_gt_w9": count["high"],
+    }
 
 
 def checked_diff(pair: str, c: dict):
@@ -272,8 +333,9 @@ def checked_diff(pair: str, c: dict):
 def allanite_fixed(allanite, y, method: str) -> float:
     """Per-call fixed cost of allanite.davar on this record: input checks and mean, no real work
     (window 2, one window, m = 1). Best of 3."""
-    best, _, _ = timed(lambda: allanite.davar(y, FS, window=2, hop=y.size, taus=[1 / FS], method=method,
-                                              workers=WORKERS), short=1e9)
+    best, _, _ = timed(
+        lambda: allanite.davar(y, FS, window=2, hop=y.size, taus=[1 / FS], method=method, workers=WORKERS), short=1e9
+    )
     return best
 
 
@@ -297,7 +359,7 @@ def run_rows(name, fn, ms_timed, n_win, chunk_bytes, probe: Probe, fixed: float)
     counted (it would not be paid by one call). Returns (seconds, details, blocks)."""
     per_row = n_win * 8
     rows_per_chunk = max(1, int(chunk_bytes // per_row))
-    chunks = [ms_timed[i:i + rows_per_chunk] for i in range(0, ms_timed.size, rows_per_chunk)]
+    chunks = [ms_timed[i : i + rows_per_chunk] for i in range(0, ms_timed.size, rows_per_chunk)]
     warm = prewarm(min(chunk_bytes, ms_timed.size * per_row) + 64 * 2**20)
     total, details, blocks = 0.0, [], []
     for ch in chunks:
@@ -309,13 +371,16 @@ def run_rows(name, fn, ms_timed, n_win, chunk_bytes, probe: Probe, fixed: float)
     if len(chunks) > 1:
         raw = total
         total = raw - (len(chunks) - 1) * min(fixed, 0.5 * raw / len(chunks))
-        log(f"    {name}: {len(chunks)} chunks of ≤ {rows_per_chunk} m ({ms_timed.size * per_row / GiB:.2f} GiB "
-            f"in all): {raw:.3g} s, {total:.3g} s without the extra calls' fixed cost")
+        log(
+            f"    {name}: {len(chunks)} chunks of ≤ {rows_per_chunk} m ({ms_timed.size * per_row / GiB:.2f} GiB "
+            f"in all): {raw:.3g} s, {total:.3g} s without the extra calls' fixed cost"
+        )
     return total, {"chunks": details, "prewarm_seconds": warm, "chunk_rows": rows_per_chunk}, blocks
 
 
-def measure_n(n, cfg, y_all, allanite, reference, allantools, chunk_bytes, probe_rows, probe_windows,
-              single_call=False):
+def measure_n(
+    n, cfg, y_all, allanite, reference, allantools, chunk_bytes, probe_rows, probe_windows, single_call=False
+):
     """Every method at one N. Returns (dict of measurements, dict of blocks)."""
     y = y_all[:n]
     window = n // 10
@@ -335,15 +400,32 @@ def measure_n(n, cfg, y_all, allanite, reference, allantools, chunk_bytes, probe
     j_at_all = sample_starts(n_win, cfg["at_all_windows"] or n_win)
     j_at_exp = sample_starts(n_win, cfg["at_exp_windows"] or n_win)
     stride = max(1, math.ceil(n_win / probe_windows))
-    probe = Probe(probe_m, np.arange(0, n_win, stride),
-                  np.concatenate([j_naive if naive_hop > 1 else [], j_at_all if cfg["at_all_windows"] else [],
-                                  j_at_exp if cfg["at_exp_windows"] else []]).astype(np.int64))
-    info = {"n": n, "window": window, "hop": 1, "n_windows": n_win, "n_m_all": int(m_all.size),
-            "n_m_exp": int(m_exp.size), "m_exp": [int(m) for m in m_exp],
-            "all_grid_output_gib": m_all.size * n_win * 8 / GiB,
-            "exp_grid_output_gib": m_exp.size * n_win * 8 / GiB}
-    log(f"N = {n}: window {window}, {n_win} windows, all grid {m_all.size} m "
-        f"({info['all_grid_output_gib']:.2f} GiB at hop 1), exp grid {m_exp.size} m")
+    probe = Probe(
+        probe_m,
+        np.arange(0, n_win, stride),
+        np.concatenate(
+            [
+                j_naive if naive_hop > 1 else [],
+                j_at_all if cfg["at_all_windows"] else [],
+                j_at_exp if cfg["at_exp_windows"] else [],
+            ]
+        ).astype(np.int64),
+    )
+    info = {
+        "n": n,
+        "window": window,
+        "hop": 1,
+        "n_windows": n_win,
+        "n_m_all": int(m_all.size),
+        "n_m_exp": int(m_exp.size),
+        "m_exp": [int(m) for m in m_exp],
+        "all_grid_output_gib": m_all.size * n_win * 8 / GiB,
+        "exp_grid_output_gib": m_exp.size * n_win * 8 / GiB,
+    }
+    log(
+        f"N = {n}: window {window}, {n_win} windows, all grid {m_all.size} m "
+        f"({info['all_grid_output_gib']:.2f} GiB at hop 1), exp grid {m_exp.size} m"
+    )
     res, blocks = {}, {}
     mem = int(chunk_bytes) + 1
 
@@ -352,15 +434,18 @@ def measure_n(n, cfg, y_all, allanite, reference, allantools, chunk_bytes, probe
     info["allanite_fixed_seconds"] = {"fast": fixed_fast, "naive": fixed_naive}
 
     def dav(ms, method, hop=1):
-        return allanite.davar(y, FS, window=window, hop=hop, taus=ms / FS, method=method, workers=WORKERS,
-                              max_memory=mem).avar
+        return allanite.davar(
+            y, FS, window=window, hop=hop, taus=ms / FS, method=method, workers=WORKERS, max_memory=mem
+        ).avar
 
     # fast DAVAR, all m
     ms_t = m_all if s_m is None else s_m
-    t, chunks, blocks["fast"] = run_rows("fast", lambda ms: dav(ms, "fast"), ms_t, n_win, chunk_bytes, probe,
-                                         fixed_fast)
-    res["fast"] = scaled_rows(t, fixed_fast, ms_t.size, m_all.size, chunks,
-                              "allanite.davar(method='fast', hop=1, workers=1)")
+    t, chunks, blocks["fast"] = run_rows(
+        "fast", lambda ms: dav(ms, "fast"), ms_t, n_win, chunk_bytes, probe, fixed_fast
+    )
+    res["fast"] = scaled_rows(
+        t, fixed_fast, ms_t.size, m_all.size, chunks, "allanite.davar(method='fast', hop=1, workers=1)"
+    )
     if single_call and s_m is None:
         # Diagnostic: the whole "all" surface from one call, as a user would make it — once as it comes,
         # once right after touching that much memory (see prewarm). Not used in the table.
@@ -371,33 +456,48 @@ def measure_n(n, cfg, y_all, allanite, reference, allantools, chunk_bytes, probe
                 diag["prewarm_seconds"] = prewarm(nbytes + 64 * 2**20)
             gc.collect()
             t0 = time.perf_counter()
-            out = allanite.davar(y, FS, window=window, hop=1, taus="all", method="fast", workers=WORKERS,
-                                 max_memory=nbytes + 1).avar
+            out = allanite.davar(
+                y, FS, window=window, hop=1, taus="all", method="fast", workers=WORKERS, max_memory=nbytes + 1
+            ).avar
             diag[f"seconds_{label}"] = time.perf_counter() - t0
             del out
         info["single_call_diagnostic"] = diag
-        log(f"    fast, one call ({diag['output_gib']:.2f} GiB output): {diag['seconds_as_is']:.3g} s as is, "
-            f"{diag['seconds_after_prewarm']:.3g} s after touching that memory ({diag['prewarm_seconds']:.3g} s)")
+        log(
+            f"    fast, one call ({diag['output_gib']:.2f} GiB output): {diag['seconds_as_is']:.3g} s as is, "
+            f"{diag['seconds_after_prewarm']:.3g} s after touching that memory ({diag['prewarm_seconds']:.3g} s)"
+        )
     # improved fast DAVAR, exp grid, always in full
-    t, chunks, blocks["improved"] = run_rows("improved", lambda ms: dav(ms, "fast"), m_exp, n_win, chunk_bytes,
-                                             probe, fixed_fast)
-    res["improved"] = scaled_rows(t, fixed_fast, m_exp.size, m_exp.size, chunks,
-                                  "allanite.davar(method='fast', taus=exp grid, hop=1, workers=1)")
+    t, chunks, blocks["improved"] = run_rows(
+        "improved", lambda ms: dav(ms, "fast"), m_exp, n_win, chunk_bytes, probe, fixed_fast
+    )
+    res["improved"] = scaled_rows(
+        t, fixed_fast, m_exp.size, m_exp.size, chunks, "allanite.davar(method='fast', taus=exp grid, hop=1, workers=1)"
+    )
     # DAVAR (naive), windows 0, h, 2h, …, m all or sampled
     ms_n = m_all if cfg["naive_m"] is None else evenly(m_all, cfg["naive_m"])
     if naive_hop == 1 and cfg["naive_m"] is None:
-        t, chunks, blocks["naive"] = run_rows("naive", lambda ms: dav(ms, "naive"), m_all, n_win, chunk_bytes,
-                                              probe, fixed_naive)
-        res["naive"] = scaled_rows(t, fixed_naive, m_all.size, m_all.size, chunks,
-                                   "allanite.davar(method='naive', hop=1, workers=1)")
+        t, chunks, blocks["naive"] = run_rows(
+            "naive", lambda ms: dav(ms, "naive"), m_all, n_win, chunk_bytes, probe, fixed_naive
+        )
+        res["naive"] = scaled_rows(
+            t, fixed_naive, m_all.size, m_all.size, chunks, "allanite.davar(method='naive', hop=1, workers=1)"
+        )
     else:
         best, reps, out = timed(lambda: dav(ms_n, "naive", naive_hop))
         blocks["naive"] = [Block(ms_n, j_naive, out)]
         del out
-        rec = {"how": "", "measured_seconds": best, "repeats": reps, "fixed_seconds": fixed_naive,
-               "windows_timed": int(naive_n), "windows_total": int(n_win), "m_timed": int(ms_n.size),
-               "m_total": int(m_all.size), "extrapolated": True,
-               "call": f"allanite.davar(method='naive', hop={naive_hop}, workers=1)"}
+        rec = {
+            "how": "",
+            "measured_seconds": best,
+            "repeats": reps,
+            "fixed_seconds": fixed_naive,
+            "windows_timed": int(naive_n),
+            "windows_total": int(n_win),
+            "m_timed": int(ms_n.size),
+            "m_total": int(m_all.size),
+            "extrapolated": True,
+            "call": f"allanite.davar(method='naive', hop={naive_hop}, workers=1)",
+        }
         fixed_naive = min(fixed_naive, 0.5 * best)  # never let a noisy fixed cost swallow the work
         rec["fixed_seconds_used"] = fixed_naive
         if ms_n.size < m_all.size:
@@ -410,17 +510,25 @@ def measure_n(n, cfg, y_all, allanite, reference, allantools, chunk_bytes, probe
             work = (best - a_best) / naive_n
             term_scale = (n_terms(window, m_all).sum() - 1) / max(1, n_terms(window, ms_n).sum() - 1)
             per_window_all = angle + work * term_scale
-            rec.update(angle_call_seconds=a_best, angle_call_repeats=a_reps, angle_per_window_seconds=angle,
-                       term_scale=float(term_scale))
-            rec["how"] = (f"{naive_n} windows (hop {naive_hop}) × {ms_n.size} evenly spread m timed "
-                          f"({best:.3g} s), and the same windows at m = W/2 alone ({a_best:.3g} s: window angles "
-                          f"+ overhead); per window: angle + (difference / {naive_n}) × "
-                          f"Σ_all(W+1−2m)/Σ_sample(W+1−2m)"
-                          f" = {term_scale:.4g}; × {n_win} windows; + fixed {fixed_naive:.2g} s")
+            rec.update(
+                angle_call_seconds=a_best,
+                angle_call_repeats=a_reps,
+                angle_per_window_seconds=angle,
+                term_scale=float(term_scale),
+            )
+            rec["how"] = (
+                f"{naive_n} windows (hop {naive_hop}) × {ms_n.size} evenly spread m timed "
+                f"({best:.3g} s), and the same windows at m = W/2 alone ({a_best:.3g} s: window angles "
+                f"+ overhead); per window: angle + (difference / {naive_n}) × "
+                f"Σ_all(W+1−2m)/Σ_sample(W+1−2m)"
+                f" = {term_scale:.4g}; × {n_win} windows; + fixed {fixed_naive:.2g} s"
+            )
         else:
             per_window_all = (best - fixed_naive) / naive_n
-            rec["how"] = (f"{naive_n} windows (hop {naive_hop}) at every m timed ({best:.3g} s); "
-                          f"(time − fixed {fixed_naive:.2g} s) / {naive_n} × {n_win} windows + fixed")
+            rec["how"] = (
+                f"{naive_n} windows (hop {naive_hop}) at every m timed ({best:.3g} s); "
+                f"(time − fixed {fixed_naive:.2g} s) / {naive_n} × {n_win} windows + fixed"
+            )
         rec["seconds"] = fixed_naive + per_window_all * n_win
         res["naive"] = rec
 
@@ -442,13 +550,22 @@ def measure_n(n, cfg, y_all, allanite, reference, allantools, chunk_bytes, probe
         else:
             ms_t = evenly(grid, count)
         t, chunks, blocks[key] = run_rows(key, pref, ms_t, n_win, chunk_bytes, probe, fixed_prefix)
-        res[key] = scaled_rows(t, fixed_prefix, ms_t.size, grid.size, chunks,
-                               "allanite._reference.davar_prefix(hop=1)", fixed_name="cumulative angle")
+        res[key] = scaled_rows(
+            t,
+            fixed_prefix,
+            ms_t.size,
+            grid.size,
+            chunks,
+            "allanite._reference.davar_prefix(hop=1)",
+            fixed_name="cumulative angle",
+        )
 
     # allantools per window
     if allantools is not None:
-        for key, grid, nw, count in (("allantools_all", m_all, cfg["at_all_windows"], cfg["at_all_m"]),
-                                     ("allantools_exp", m_exp, cfg["at_exp_windows"], None)):
+        for key, grid, nw, count in (
+            ("allantools_all", m_all, cfg["at_all_windows"], cfg["at_all_m"]),
+            ("allantools_exp", m_exp, cfg["at_exp_windows"], None),
+        ):
             ms_t = grid if count is None else (s_m if s_m is not None and count == s_m.size else evenly(grid, count))
             js = sample_starts(n_win, nw or n_win)
             res[key], blocks[key] = allantools_windows(allantools, y, window, n_win, js, grid, ms_t)
@@ -460,12 +577,21 @@ def measure_n(n, cfg, y_all, allanite, reference, allantools, chunk_bytes, probe
 def scaled_rows(t, fixed, n_timed, n_total, det, call, fixed_name="input checks and mean"):
     """A whole-record method timed on ``n_timed`` of ``n_total`` m (each m costs about the same)."""
     chunks = det["chunks"]
-    rec = {"call": call, "measured_seconds": t, **det, "m_timed": int(n_timed), "m_total": int(n_total),
-           "fixed_seconds": fixed, "extrapolated": n_timed < n_total}
+    rec = {
+        "call": call,
+        "measured_seconds": t,
+        **det,
+        "m_timed": int(n_timed),
+        "m_total": int(n_total),
+        "fixed_seconds": fixed,
+        "extrapolated": n_timed < n_total,
+    }
     how = f"all {n_total} m timed" if n_timed == n_total else f"{n_timed} of {n_total} m timed"
     if len(chunks) > 1:
-        how += (f" in {len(chunks)} calls of ≤ {det['chunk_rows']} m (outputs ≤ chunk size); sum of the call times "
-                f"minus {len(chunks) - 1} × the fixed cost ({fixed:.2g} s [{fixed_name}])")
+        how += (
+            f" in {len(chunks)} calls of ≤ {det['chunk_rows']} m (outputs ≤ chunk size); sum of the call times "
+            f"minus {len(chunks) - 1} × the fixed cost ({fixed:.2g} s [{fixed_name}])"
+        )
     else:
         reps = chunks[0]["repeats"]
         if len(reps) > 1:
@@ -474,8 +600,10 @@ def scaled_rows(t, fixed, n_timed, n_total, det, call, fixed_name="input checks 
         fixed = min(fixed, 0.5 * t)  # tiny (quick-mode) runs: never let a noisy fixed cost swallow the work
         rec["fixed_seconds_used"] = fixed
         rec["seconds"] = fixed + (t - fixed) * n_total / n_timed
-        how += (f" ({t:.3g} s, evenly spread m); extrapolated: (time − fixed {fixed:.2g} s [{fixed_name}]) × "
-                f"{n_total}/{n_timed} + fixed")
+        how += (
+            f" ({t:.3g} s, evenly spread m); extrapolated: (time − fixed {fixed:.2g} s [{fixed_name}]) × "
+            f"{n_total}/{n_timed} + fixed"
+        )
     else:
         rec["seconds"] = t
     rec["how"] = how
@@ -488,7 +616,7 @@ def allantools_windows(allantools, y, window, n_win, js, grid, ms_t):
     term_scale = float(n_terms(window, grid).sum() / n_terms(window, ms_t).sum())
     taus = ms_t / FS
     for j in js:
-        seg = y[int(j):int(j) + window]
+        seg = y[int(j) : int(j) + window]
         t0 = time.perf_counter()
         allantools.frequency2phase(seg, FS)
         t_phase = time.perf_counter() - t0
@@ -505,27 +633,37 @@ def allantools_windows(allantools, y, window, n_win, js, grid, ms_t):
     mean = float(np.mean(per_window))
     rec = {
         "call": "allantools.oadev(y[j:j+W], rate=fs, data_type='freq', taus=m/fs) per window",
-        "windows_timed": int(len(js)), "windows_total": int(n_win), "m_timed": int(ms_t.size),
-        "m_total": int(grid.size), "sample_windows": [int(j) for j in js[:50]],
-        "mean_phase_seconds": float(np.mean(phase_times)), "term_scale": term_scale,
-        "mean_per_window_seconds": mean, "seconds": mean * n_win,
+        "windows_timed": int(len(js)),
+        "windows_total": int(n_win),
+        "m_timed": int(ms_t.size),
+        "m_total": int(grid.size),
+        "sample_windows": [int(j) for j in js[:50]],
+        "mean_phase_seconds": float(np.mean(phase_times)),
+        "term_scale": term_scale,
+        "mean_per_window_seconds": mean,
+        "seconds": mean * n_win,
         "extrapolated": len(js) < n_win or ms_t.size < grid.size,
-        "taus_missing_from_allantools": missing, "taus_subset_of_requested": exact,
+        "taus_missing_from_allantools": missing,
+        "taus_subset_of_requested": exact,
     }
     if not rec["extrapolated"]:
         rec["how"] = f"every window at every m, one run ({mean * n_win:.3g} s)"
     else:
         how = f"{len(js)} evenly spread windows"
         if ms_t.size < grid.size:
-            how += (f" × {ms_t.size} evenly spread m; per window: phase (frequency2phase, timed alone) + the rest "
-                    f"× Σ_all(W+1−2m)/Σ_sample(W+1−2m) = {term_scale:.4g}")
+            how += (
+                f" × {ms_t.size} evenly spread m; per window: phase (frequency2phase, timed alone) + the rest "
+                f"× Σ_all(W+1−2m)/Σ_sample(W+1−2m) = {term_scale:.4g}"
+            )
         else:
             how += " at every m"
         how += f"; mean per window {mean:.3g} s × {n_win} windows"
         rec["how"] = how
     if missing:
-        rec["note"] = (f"allantools drops m with a single term (m = W/2): {missing} of the requested m not "
-                       f"returned; timed as called")
+        rec["note"] = (
+            f"allantools drops m with a single term (m = W/2): {missing} of the requested m not "
+            f"returned; timed as called"
+        )
     return rec, blocks
 
 
@@ -564,15 +702,26 @@ def child_scaling(n: int, workers: int, repeats: int) -> dict:
         times.append(time.perf_counter() - t0)
     peak = vm_hwm()
     ru_maxrss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-    return {"n": n, "window": window, "hop": hop, "workers": workers, "n_m": int(res.m.size),
-            "n_windows": int(res.avar.shape[1]), "seconds": min(times), "repeats": times,
-            "input_bytes": int(y.nbytes), "output_bytes": int(res.avar.nbytes),
-            "peak_rss_bytes": int(peak), "rss_before_call_bytes": int(rss_before),
-            "call_extra_peak_bytes": int(peak - rss_before), "ru_maxrss_bytes": int(ru_maxrss),
-            # bit-exact fingerprint (np.sum would not do: its SIMD pairwise order depends on the array's
-            # alignment, so equal arrays can sum differently)
-            "sha256": hashlib.sha256(np.ascontiguousarray(res.avar).tobytes()).hexdigest(),
-            "fsum": math.fsum(res.avar.ravel().tolist())}
+    return {
+        "n": n,
+        "window": window,
+        "hop": hop,
+        "workers": workers,
+        "n_m": int(res.m.size),
+        "n_windows": int(res.avar.shape[1]),
+        "seconds": min(times),
+        "repeats": times,
+        "input_bytes": int(y.nbytes),
+        "output_bytes": int(res.avar.nbytes),
+        "peak_rss_bytes": int(peak),
+        "rss_before_call_bytes": int(rss_before),
+        "call_extra_peak_bytes": int(peak - rss_before),
+        "ru_maxrss_bytes": int(ru_maxrss),
+        # bit-exact fingerprint (np.sum would not do: its SIMD pairwise order depends on the array's
+        # alignment, so equal arrays can sum differently)
+        "sha256": hashlib.sha256(np.ascontiguousarray(res.avar).tobytes()).hexdigest(),
+        "fsum": math.fsum(res.avar.ravel().tolist()),
+    }
 
 
 def scaling(sizes, repeats_map, wait: float = 0.0) -> list[dict]:
@@ -590,9 +739,11 @@ def scaling(sizes, repeats_map, wait: float = 0.0) -> list[dict]:
             r["other_processes_cpu_fraction"] = ld.fraction
             r["idle_wait"] = idle
             out.append(r)
-            log(f"  scaling N={n:>11,} workers={w}: {r['seconds']:.4f} s, "
+            log(
+                f"  scaling N={n:>11,} workers={w}: {r['seconds']:.4f} s, "
                 f"peak RSS {r['peak_rss_bytes'] / 2**20:.0f} MiB"
-                f" (before the call {r['rss_before_call_bytes'] / 2**20:.0f} MiB)")
+                f" (before the call {r['rss_before_call_bytes'] / 2**20:.0f} MiB)"
+            )
     by_n = {}
     for r in out:
         by_n.setdefault(r["n"], {})[r["workers"]] = r
@@ -646,23 +797,36 @@ def fmt_diff(d) -> str:
 
 
 PAIRS = [
-    ("naive", "fast"), ("improved", "fast"), ("prefix_all", "fast"), ("allantools_all", "fast"),
-    ("naive", "improved"), ("prefix_exp", "improved"), ("allantools_exp", "improved"),
-    ("prefix_all", "naive"), ("allantools_all", "naive"), ("prefix_exp", "prefix_all"),
-    ("allantools_all", "prefix_all"), ("allantools_exp", "prefix_exp"), ("allantools_exp", "allantools_all"),
+    ("naive", "fast"),
+    ("improved", "fast"),
+    ("prefix_all", "fast"),
+    ("allantools_all", "fast"),
+    ("naive", "improved"),
+    ("prefix_exp", "improved"),
+    ("allantools_exp", "improved"),
+    ("prefix_all", "naive"),
+    ("allantools_all", "naive"),
+    ("prefix_exp", "prefix_all"),
+    ("allantools_all", "prefix_all"),
+    ("allantools_exp", "prefix_exp"),
+    ("allantools_exp", "allantools_all"),
 ]
 
 
 def ratios(row):
     def sec(k):
         return row["methods"].get(k, {}).get("seconds")
+
     out = {}
-    for key, (a, b) in {"naive_over_fast": ("naive", "fast"), "fast_over_improved": ("fast", "improved"),
-                        "naive_over_improved": ("naive", "improved"),
-                        "prefix_all_over_fast": ("prefix_all", "fast"),
-                        "prefix_exp_over_improved": ("prefix_exp", "improved"),
-                        "allantools_all_over_fast": ("allantools_all", "fast"),
-                        "allantools_exp_over_improved": ("allantools_exp", "improved")}.items():
+    for key, (a, b) in {
+        "naive_over_fast": ("naive", "fast"),
+        "fast_over_improved": ("fast", "improved"),
+        "naive_over_improved": ("naive", "improved"),
+        "prefix_all_over_fast": ("prefix_all", "fast"),
+        "prefix_exp_over_improved": ("prefix_exp", "improved"),
+        "allantools_all_over_fast": ("allantools_all", "fast"),
+        "allantools_exp_over_improved": ("allantools_exp", "improved"),
+    }.items():
         sa, sb = sec(a), sec(b)
         out[key] = None if sa is None or sb is None or sb <= 0 else sa / sb
     p = PAPER.get(row["n"])
@@ -685,7 +849,7 @@ def write_markdown(report, path: Path):
         "",
         "Paper: Matlab 7.11 on a 3 GHz Core 2 Duo. Ours: white noise (standard normal, seed "
         f"{SEED}), window W = N/10, hop 1, one thread (`workers=1`) for every method. "
-        "\"(extrap.)\" marks a time extrapolated from a timed sample (see *How each number was obtained*).",
+        '"(extrap.)" marks a time extrapolated from a timed sample (see *How each number was obtained*).',
         "",
         "| N | W | DAVAR (ours) | DAVAR (paper) | fast (ours) | fast (paper) | improved (ours) | improved (paper) | "
         "DAVAR / fast (ours) | (paper) | fast / improved (ours) | (paper) |",
@@ -697,23 +861,28 @@ def write_markdown(report, path: Path):
         def cell(k):
             d = me.get(k)
             return "—" if d is None else fmt_s(d["seconds"], d["extrapolated"])
+
         lines.append(
             f"| {fmt_n(r['n'])} | {r['window']:,} | {cell('naive')} | {fmt_s(p.get('naive'))} | {cell('fast')} | "
             f"{fmt_s(p.get('fast'))} | {cell('improved')} | {fmt_s(p.get('improved'))} | "
             f"{fmt_ratio(q['naive_over_fast'])} | {fmt_ratio(q['paper_naive_over_fast'])} | "
-            f"{fmt_ratio(q['fast_over_improved'])} | {fmt_ratio(q['paper_fast_over_improved'])} |")
-    loads = [f"{fmt_n(r['n'])}: {r['other_processes_cpu_fraction']:.0%}" for r in rows
-             if r.get("other_processes_cpu_fraction") is not None]
+            f"{fmt_ratio(q['fast_over_improved'])} | {fmt_ratio(q['paper_fast_over_improved'])} |"
+        )
+    loads = [
+        f"{fmt_n(r['n'])}: {r['other_processes_cpu_fraction']:.0%}"
+        for r in rows
+        if r.get("other_processes_cpu_fraction") is not None
+    ]
     lines += [
         "",
         "Share of the CPUs used by other processes while each N ran (the machine is shared; 2 cores, our "
         "calls use one): " + ", ".join(loads) + ".",
         "",
-        "Grids: DAVAR and fast DAVAR evaluate every m = 1 … W/2 (allanite's `taus=\"all\"`; paper 000 writes "
+        'Grids: DAVAR and fast DAVAR evaluate every m = 1 … W/2 (allanite\'s `taus="all"`; paper 000 writes '
         "m = 1 … N_w/2 − 1, one row fewer); improved fast DAVAR evaluates paper 000 §4.2's exponential grid "
-        "(`taus=\"exp\"`: 100 points up to m = W/9, duplicates dropped — the number of m is in the last table).",
+        '(`taus="exp"`: 100 points up to m = W/9, duplicates dropped — the number of m is in the last table).',
         "",
-        f"Window: W = N/10 (paper 000 does not give one). It keeps ~0.9 N windows, so the DAVAR surface is as long "
+        "Window: W = N/10 (paper 000 does not give one). It keeps ~0.9 N windows, so the DAVAR surface is as long "
         "as the record, and at N = 1e3 W/9 = 11 still leaves the exponential grid 11 τ.",
         "",
     ]
@@ -726,11 +895,17 @@ def write_markdown(report, path: Path):
             if a["n"] in PAPER and b["n"] in PAPER:
                 head += " (paper) |"
                 rule += "---|"
-        lines += ["### Growth per decade of N (time at 10 N / time at N)", "",
-                  head + " work model, W = N/10 |", rule + "---|"]
-    models = {"naive": "(N − W + 1) windows × Σ_m (W + 1 − 2m) ≈ 0.9 N · W²/4 ∝ N³: ×1000",
-              "fast": "W/2 values of m × O(N) each ∝ N²: ×100",
-              "improved": "exp-grid size (56 → 92 m from W = 1e3 to 1e6) × O(N) ∝ N: ×10–13"}
+        lines += [
+            "### Growth per decade of N (time at 10 N / time at N)",
+            "",
+            head + " work model, W = N/10 |",
+            rule + "---|",
+        ]
+    models = {
+        "naive": "(N − W + 1) windows × Σ_m (W + 1 − 2m) ≈ 0.9 N · W²/4 ∝ N³: ×1000",
+        "fast": "W/2 values of m × O(N) each ∝ N²: ×100",
+        "improved": "exp-grid size (56 → 92 m from W = 1e3 to 1e6) × O(N) ∝ N: ×10–13",
+    }
     for k in ("naive", "fast", "improved") if decades else ():
         cells = []
         for a, b in decades:
@@ -756,14 +931,22 @@ def write_markdown(report, path: Path):
                 return "—"
             s = fmt_s(d["seconds"], d["extrapolated"])
             return s if ratio is None else f"{s} = {fmt_ratio(q[ratio])}"
-        lines.append(f"| {fmt_n(r['n'])} | {cell('fast')} | {cell('prefix_all', 'prefix_all_over_fast')} | "
-                     f"{cell('allantools_all', 'allantools_all_over_fast')} | {cell('improved')} | "
-                     f"{cell('prefix_exp', 'prefix_exp_over_improved')} | "
-                     f"{cell('allantools_exp', 'allantools_exp_over_improved')} |")
-    lines += ["", "(× = that method's time over allanite's on the same grid.)", "",
-              "## Agreement (max relative difference |a − b| / |b| at every shared m and window kept)", "",
-              "| a vs b | " + " | ".join(f"N = {fmt_n(r['n'])}" for r in rows) + " |",
-              "|---|" + "---|" * len(rows)]
+
+        lines.append(
+            f"| {fmt_n(r['n'])} | {cell('fast')} | {cell('prefix_all', 'prefix_all_over_fast')} | "
+            f"{cell('allantools_all', 'allantools_all_over_fast')} | {cell('improved')} | "
+            f"{cell('prefix_exp', 'prefix_exp_over_improved')} | "
+            f"{cell('allantools_exp', 'allantools_exp_over_improved')} |"
+        )
+    lines += [
+        "",
+        "(× = that method's time over allanite's on the same grid.)",
+        "",
+        "## Agreement (max relative difference |a − b| / |b| at every shared m and window kept)",
+        "",
+        "| a vs b | " + " | ".join(f"N = {fmt_n(r['n'])}" for r in rows) + " |",
+        "|---|" + "---|" * len(rows),
+    ]
     for a, b in PAIRS:
         cells = []
         for r in rows:
@@ -771,84 +954,109 @@ def write_markdown(report, path: Path):
             if c is None or c["n_compared"] == 0:
                 cells.append("—")
             elif "prefix" in a or "prefix" in b:
-                hi = ("" if not c["n_compared_m_gt_w9"] else
-                      f"; m > W/9: {fmt_diff(c['max_rel_diff_m_gt_w9'])} ({c['n_compared_m_gt_w9']:,})")
-                cells.append(f"m ≤ W/9: **{fmt_diff(c['max_rel_diff_m_le_w9'])}** "
-                             f"({c['n_compared_m_le_w9']:,}){hi}")
+                hi = (
+                    ""
+                    if not c["n_compared_m_gt_w9"]
+                    else f"; m > W/9: {fmt_diff(c['max_rel_diff_m_gt_w9'])} ({c['n_compared_m_gt_w9']:,})"
+                )
+                cells.append(f"m ≤ W/9: **{fmt_diff(c['max_rel_diff_m_le_w9'])}** ({c['n_compared_m_le_w9']:,}){hi}")
             else:
                 cells.append(f"**{fmt_diff(c['max_rel_diff'])}** ({c['n_compared']:,})")
         if any(c != "—" for c in cells):
             lines.append(f"| {a} vs {b} | " + " | ".join(cells) + " |")
     worst = report["max_rel_diff_overall"]
-    lines += ["", f"In parentheses: values compared; in bold: what the 1e-9 check applies to. Largest checked "
-              f"difference: {fmt_diff(worst)} — {'within' if worst is not None and worst <= 1e-9 else 'NOT within'}"
-              f" the 1e-9 tolerance. Every pair of allanite (naive, fast, improved) and allantools is checked at "
-              "every shared value. The NumPy prefix-sum twin is checked at m ≤ W/9 (paper 000's range, ≥ 9 "
-              "clusters): beyond, a window holds few terms (one at m = W/2) and its global cumulative sums, "
-              "differenced, cancel catastrophically — its own rounding (`_reference.davar_prefix` says so), shown "
-              "as the m > W/9 figure, not a disagreement among the others.",
-              "",
-              "Kept for comparison: every method's values at the m of the exp grid plus an evenly spread set of "
-              "the \"all\" grid's m (or the timed sample), at evenly strided windows, and every computed m at the "
-              "naive and allantools sample windows.", "",
-              "## How each number was obtained", "",
-              "| N | method | seconds | extrapolated | how |", "|---|---|---|---|---|"]
+    lines += [
+        "",
+        f"In parentheses: values compared; in bold: what the 1e-9 check applies to. Largest checked "
+        f"difference: {fmt_diff(worst)} — {'within' if worst is not None and worst <= 1e-9 else 'NOT within'}"
+        f" the 1e-9 tolerance. Every pair of allanite (naive, fast, improved) and allantools is checked at "
+        "every shared value. The NumPy prefix-sum twin is checked at m ≤ W/9 (paper 000's range, ≥ 9 "
+        "clusters): beyond, a window holds few terms (one at m = W/2) and its global cumulative sums, "
+        "differenced, cancel catastrophically — its own rounding (`_reference.davar_prefix` says so), shown "
+        "as the m > W/9 figure, not a disagreement among the others.",
+        "",
+        "Kept for comparison: every method's values at the m of the exp grid plus an evenly spread set of "
+        'the "all" grid\'s m (or the timed sample), at evenly strided windows, and every computed m at the '
+        "naive and allantools sample windows.",
+        "",
+        "## How each number was obtained",
+        "",
+        "| N | method | seconds | extrapolated | how |",
+        "|---|---|---|---|---|",
+    ]
     for r in rows:
         for k, d in r["methods"].items():
             ex = "extrapolated" if d["extrapolated"] else "no"
-            lines.append(f"| {fmt_n(r['n'])} | {k} | {fmt_s(d['seconds'])} | {ex}"
-                         f" | {d['how']} |")
+            lines.append(f"| {fmt_n(r['n'])} | {k} | {fmt_s(d['seconds'])} | {ex} | {d['how']} |")
     full_n = max((r for r in rows if not r["methods"]["fast"]["extrapolated"]), key=lambda r: r["n"])
-    lines += ["", "Timing: `time.perf_counter` around each call; a call under 1 s is repeated up to 3 times (under "
-              "0.05 s: 9 times) and the best kept (every repeat is in the JSON). Fixed per-call costs are "
-              "measured separately and not "
-              "scaled when extrapolating.", "",
-              f"Memory: a hop-1 surface is large (all m at N = {fmt_n(full_n['n'])}: "
-              f"{full_n['all_grid_output_gib']:.2f}"
-              f" GiB), so outputs are produced in calls of at most {fmt_bytes(report['setup']['chunk_bytes'])} "
-              "(chunks of m; every value is computed, the times are summed, and the extra calls' fixed cost is "
-              "subtracted), and that much memory is touched just before the first call. Reason: on this VM, memory "
-              "the guest has not used for a few seconds goes back to the host, and touching it again costs "
-              "~3 s/GiB — a hypervisor cost, not DAVAR's."]
+    lines += [
+        "",
+        "Timing: `time.perf_counter` around each call; a call under 1 s is repeated up to 3 times (under "
+        "0.05 s: 9 times) and the best kept (every repeat is in the JSON). Fixed per-call costs are "
+        "measured separately and not "
+        "scaled when extrapolating.",
+        "",
+        f"Memory: a hop-1 surface is large (all m at N = {fmt_n(full_n['n'])}: "
+        f"{full_n['all_grid_output_gib']:.2f}"
+        f" GiB), so outputs are produced in calls of at most {fmt_bytes(report['setup']['chunk_bytes'])} "
+        "(chunks of m; every value is computed, the times are summed, and the extra calls' fixed cost is "
+        "subtracted), and that much memory is touched just before the first call. Reason: on this VM, memory "
+        "the guest has not used for a few seconds goes back to the host, and touching it again costs "
+        "~3 s/GiB — a hypervisor cost, not DAVAR's.",
+    ]
     for r in rows:
         d = r.get("single_call_diagnostic")
         if d:
-            lines.append(f"For scale, at N = {fmt_n(r['n'])} the fast DAVAR's whole surface "
-                         f"({d['output_gib']:.2f} GiB) "
-                         f"from one call took {d['seconds_as_is']:.3g} s as it came and "
-                         f"{d['seconds_after_prewarm']:.3g} s right after touching that much memory "
-                         f"({d['prewarm_seconds']:.3g} s), against {r['methods']['fast']['seconds']:.3g} s in "
-                         f"chunks (the table).")
+            lines.append(
+                f"For scale, at N = {fmt_n(r['n'])} the fast DAVAR's whole surface "
+                f"({d['output_gib']:.2f} GiB) "
+                f"from one call took {d['seconds_as_is']:.3g} s as it came and "
+                f"{d['seconds_after_prewarm']:.3g} s right after touching that much memory "
+                f"({d['prewarm_seconds']:.3g} s), against {r['methods']['fast']['seconds']:.3g} s in "
+                f"chunks (the table)."
+            )
     lines.append("")
     sc = report.get("scaling")
     if sc:
         sr = report.get("scaling_run")
         lines += ["## Scaling — improved fast DAVAR, window N/10, hop N/1000, exp grid (fresh process per row)", ""]
         if sr:
-            lines += [f"Run separately (`--scaling-only`) on {sr['date_utc']}, load average at start "
-                      f"{', '.join(f'{v:.2f}' for v in sr['loadavg_start'])}.", ""]
+            lines += [
+                f"Run separately (`--scaling-only`) on {sr['date_utc']}, load average at start "
+                f"{', '.join(f'{v:.2f}' for v in sr['loadavg_start'])}.",
+                "",
+            ]
         lines += [
-                  "| N | window | hop | m | windows | workers | seconds | ns per sample per m | speed-up 2 vs 1 | "
-                  "peak RSS (MiB) | RSS before call (MiB) | call's extra peak (MiB) | other processes' CPU share |",
-                  "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+            "| N | window | hop | m | windows | workers | seconds | ns per sample per m | speed-up 2 vs 1 | "
+            "peak RSS (MiB) | RSS before call (MiB) | call's extra peak (MiB) | other processes' CPU share |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        ]
         for s in sc:
             nsps = s["seconds"] / (s["n"] * s["n_m"]) * 1e9
-            lines.append(f"| {fmt_n(s['n'])} | {s['window']:,} | {s['hop']:,} | {s['n_m']} | {s['n_windows']} | "
-                         f"{s['workers']} | {s['seconds']:.4g} | {nsps:.2f} | "
-                         f"{fmt_ratio(s.get('speedup_2_workers')) if s['workers'] == 2 else ''} | "
-                         f"{s['peak_rss_bytes'] / 2**20:,.0f} | {s['rss_before_call_bytes'] / 2**20:,.0f} | "
-                         f"{s['call_extra_peak_bytes'] / 2**20:,.0f} | "
-                         f"{fmt_share(s.get('other_processes_cpu_fraction'))} |")
-        lines += ["", "Peak RSS is the child's VmHWM (/proc/self/status; `ru_maxrss` is not used because on Linux a "
-                  "child started by fork + exec inherits its parent's high-water mark — recorded in the JSON "
-                  "anyway). It includes the Python interpreter, NumPy, allanite and the "
-                  "input record (8 bytes per sample); \"before call\" is the same after the record was generated; "
-                  "the difference is what the DAVAR call added at its peak. "
-                  + ("Results with 1 and 2 workers are bit-identical at every N (SHA-256 of the outputs equal)."
-                     if all(s.get("bit_identical_1_vs_2", True) for s in sc) else
-                     "Results with 1 and 2 workers are NOT bit-identical at N = "
-                     + ", ".join(sorted({fmt_n(s["n"]) for s in sc if s.get("bit_identical_1_vs_2") is False})) + "."),
-                  ""]
+            lines.append(
+                f"| {fmt_n(s['n'])} | {s['window']:,} | {s['hop']:,} | {s['n_m']} | {s['n_windows']} | "
+                f"{s['workers']} | {s['seconds']:.4g} | {nsps:.2f} | "
+                f"{fmt_ratio(s.get('speedup_2_workers')) if s['workers'] == 2 else ''} | "
+                f"{s['peak_rss_bytes'] / 2**20:,.0f} | {s['rss_before_call_bytes'] / 2**20:,.0f} | "
+                f"{s['call_extra_peak_bytes'] / 2**20:,.0f} | "
+                f"{fmt_share(s.get('other_processes_cpu_fraction'))} |"
+            )
+        lines += [
+            "",
+            "Peak RSS is the child's VmHWM (/proc/self/status; `ru_maxrss` is not used because on Linux a "
+            "child started by fork + exec inherits its parent's high-water mark — recorded in the JSON "
+            "anyway). It includes the Python interpreter, NumPy, allanite and the "
+            'input record (8 bytes per sample); "before call" is the same after the record was generated; '
+            "the difference is what the DAVAR call added at its peak. "
+            + (
+                "Results with 1 and 2 workers are bit-identical at every N (SHA-256 of the outputs equal)."
+                if all(s.get("bit_identical_1_vs_2", True) for s in sc)
+                else "Results with 1 and 2 workers are NOT bit-identical at N = "
+                + ", ".join(sorted({fmt_n(s["n"]) for s in sc if s.get("bit_identical_1_vs_2") is False}))
+                + "."
+            ),
+            "",
+        ]
     if report["mode"] == "quick":
         lines += ["_Quick mode: tiny sizes — a correctness smoke test of the script, not a timing result._", ""]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
@@ -862,12 +1070,15 @@ def plot(report, out: Path):
 
     rows = report["table"]
     fig, ax = plt.subplots(figsize=(11, 6))
-    styles = {"naive": ("C3", "o", "DAVAR (naive)"), "fast": ("C0", "s", "fast DAVAR"),
-              "improved": ("C2", "^", "improved fast DAVAR"),
-              "prefix_all": ("C1", "D", "NumPy prefix sums, all m"),
-              "prefix_exp": ("C1", "v", "NumPy prefix sums, exp"),
-              "allantools_all": ("C4", "P", "allantools per window, all m"),
-              "allantools_exp": ("C4", "X", "allantools per window, exp")}
+    styles = {
+        "naive": ("C3", "o", "DAVAR (naive)"),
+        "fast": ("C0", "s", "fast DAVAR"),
+        "improved": ("C2", "^", "improved fast DAVAR"),
+        "prefix_all": ("C1", "D", "NumPy prefix sums, all m"),
+        "prefix_exp": ("C1", "v", "NumPy prefix sums, exp"),
+        "allantools_all": ("C4", "P", "allantools per window, all m"),
+        "allantools_exp": ("C4", "X", "allantools per window, exp"),
+    }
     for k, (c, mk, label) in styles.items():
         pts = [(r["n"], r["methods"][k]["seconds"], r["methods"][k]["extrapolated"]) for r in rows if k in r["methods"]]
         if not pts:
@@ -879,15 +1090,26 @@ def plot(report, out: Path):
     for k, mk in (("naive", "o"), ("fast", "s"), ("improved", "^")):
         ns = sorted(PAPER)
         ax.plot(ns, [PAPER[n][k] for n in ns], "--", color=styles[k][0], lw=1, alpha=0.6)
-        ax.plot(ns, [PAPER[n][k] for n in ns], mk, color="k", mfc=styles[k][0], ms=9, alpha=0.5,
-                label=f"paper 000 Table 3: {styles[k][2]}")
+        ax.plot(
+            ns,
+            [PAPER[n][k] for n in ns],
+            mk,
+            color="k",
+            mfc=styles[k][0],
+            ms=9,
+            alpha=0.5,
+            label=f"paper 000 Table 3: {styles[k][2]}",
+        )
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("record length N (samples); window N/10, hop 1")
     ax.set_ylabel("seconds")
     m = report["machine"]
-    ax.set_title(f"DAVAR timing vs paper 000 Table 3 (Matlab, Core 2 Duo 3 GHz)\nours: {m['cpu_model']}, 1 thread"
-                 + (" — QUICK MODE" if report["mode"] == "quick" else ""), fontsize=9)
+    ax.set_title(
+        f"DAVAR timing vs paper 000 Table 3 (Matlab, Core 2 Duo 3 GHz)\nours: {m['cpu_model']}, 1 thread"
+        + (" — QUICK MODE" if report["mode"] == "quick" else ""),
+        fontsize=9,
+    )
     ax.grid(True, which="both", alpha=0.3)
     ax.plot([], [], "o", color="grey", mfc="none", label="hollow: extrapolated from a timed sample")
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
@@ -901,10 +1123,20 @@ def plot(report, out: Path):
         for w, c in ((1, "C0"), (2, "C2")):
             pts = [s for s in sc if s["workers"] == w]
             a1.plot([s["n"] for s in pts], [s["seconds"] for s in pts], "o-", color=c, label=f"{w} worker(s)")
-            a2.plot([s["n"] for s in pts], [s["peak_rss_bytes"] / 2**20 for s in pts], "o-", color=c,
-                    label=f"peak RSS, {w} worker(s)")
-            a2.plot([s["n"] for s in pts], [s["call_extra_peak_bytes"] / 2**20 for s in pts], "x:", color=c,
-                    label=f"added by the call, {w} worker(s)")
+            a2.plot(
+                [s["n"] for s in pts],
+                [s["peak_rss_bytes"] / 2**20 for s in pts],
+                "o-",
+                color=c,
+                label=f"peak RSS, {w} worker(s)",
+            )
+            a2.plot(
+                [s["n"] for s in pts],
+                [s["call_extra_peak_bytes"] / 2**20 for s in pts],
+                "x:",
+                color=c,
+                label=f"added by the call, {w} worker(s)",
+            )
         big = max(sc, key=lambda s: (s["n"], -s["workers"]))
         ns = np.array(sorted({s["n"] for s in sc}), dtype=float)
         a1.plot(ns, big["seconds"] * ns / big["n"], "k--", lw=0.8, alpha=0.6, label="∝ N")
@@ -955,19 +1187,29 @@ def run_criterion(out: Path) -> None:
         name = mt.group(1).strip()
         rows.append([name, mt.group(2), ""])
     m = machine_info()
-    lines = ["# Criterion benches of the Rust core (`cargo bench -p allanite-core`)", "",
-             f"Run {m['date_utc']} on {m['cpu_model']} ({m['cpus_usable']} usable cores), {m.get('rustc')}, git "
-             f"{m.get('git_commit')}; load average at start {', '.join(f'{v:.2f}' for v in load)}; "
-             f"{wall:.0f} s in all. Benches: `rust/core/benches/core_loops.rs` (one thread each).", "",
-             "Times are criterion's [lower bound, estimate, upper bound] of the time per iteration.", "",
-             "| bench id | time per iteration | throughput |", "|---|---|---|"]
+    lines = [
+        "# Criterion benches of the Rust core (`cargo bench -p allanite-core`)",
+        "",
+        f"Run {m['date_utc']} on {m['cpu_model']} ({m['cpus_usable']} usable cores), {m.get('rustc')}, git "
+        f"{m.get('git_commit')}; load average at start {', '.join(f'{v:.2f}' for v in load)}; "
+        f"{wall:.0f} s in all. Benches: `rust/core/benches/core_loops.rs` (one thread each).",
+        "",
+        "Times are criterion's [lower bound, estimate, upper bound] of the time per iteration.",
+        "",
+        "| bench id | time per iteration | throughput |",
+        "|---|---|---|",
+    ]
     for r in rows:
         lines.append(f"| `{r[0]}` | {r[1]} | {r[2] or '—'} |")
-    lines += ["", "Rerun: `cargo bench -p allanite-core` (or `python benches/table3.py --criterion`, which also "
-              "rewrites this file). Bench ids: `fast_one_m/<m>` — one averaging factor over 200 000 samples "
-              "(window 40 000, hop 100); `davar_n1e5_w1e4/*` — DAVAR of 1e5 samples, window 1e4, "
-              "paper 000's exponential grid, fast at hop 1 and 100, classic (non-overlapping) at hop 100, naive "
-              "at hop 1000.", ""]
+    lines += [
+        "",
+        "Rerun: `cargo bench -p allanite-core` (or `python benches/table3.py --criterion`, which also "
+        "rewrites this file). Bench ids: `fast_one_m/<m>` — one averaging factor over 200 000 samples "
+        "(window 40 000, hop 100); `davar_n1e5_w1e4/*` — DAVAR of 1e5 samples, window 1e4, "
+        "paper 000's exponential grid, fast at hop 1 and 100, classic (non-overlapping) at hop 100, naive "
+        "at hop 1000.",
+        "",
+    ]
     (out / "criterion.md").write_text("\n".join(lines), encoding="utf-8")
     log((out / "criterion.md").read_text(encoding="utf-8"))
 
@@ -986,8 +1228,11 @@ def rerun_scaling(quick: bool, out: Path | None, wait: float) -> dict:
     log("scaling only (fresh process per measurement)")
     start = {"date_utc": machine_info()["date_utc"], "loadavg_start": list(os.getloadavg())}
     report["scaling"] = scaling(cfg["scaling"], cfg["scaling_repeats"], min(wait, 60.0) if wait else 0.0)
-    report["scaling_run"] = {**start, "loadavg_end": list(os.getloadavg()),
-                             "note": "scaling re-run separately (--scaling-only) from the table"}
+    report["scaling_run"] = {
+        **start,
+        "loadavg_end": list(os.getloadavg()),
+        "note": "scaling re-run separately (--scaling-only) from the table",
+    }
     path.write_text(json.dumps(report, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
     write_markdown(report, out / "table3.md")
     plot(report, out)
@@ -1020,13 +1265,22 @@ def run(quick: bool, out: Path | None, wait: float, skip_scaling: bool = False) 
     for n in sizes:
         idle_n = wait_idle(min(wait, 60.0)) if wait > 0 and n != sizes[0] else None
         with Load() as ld:
-            info, res, blocks = measure_n(n, cfg["table"][n], y, allanite, _reference, allantools, cfg["chunk_bytes"],
-                                          cfg["probe_rows"], cfg["probe_windows"],
-                                          single_call=n in cfg.get("single_call_diagnostic", ()))
+            info, res, blocks = measure_n(
+                n,
+                cfg["table"][n],
+                y,
+                allanite,
+                _reference,
+                allantools,
+                cfg["chunk_bytes"],
+                cfg["probe_rows"],
+                cfg["probe_windows"],
+                single_call=n in cfg.get("single_call_diagnostic", ()),
+            )
         agreement = {}
         keys = list(res)
         for i, a in enumerate(keys):
-            for b in keys[i + 1:]:
+            for b in keys[i + 1 :]:
                 pair = (a, b) if (a, b) in PAIRS else (b, a)
                 name = f"{pair[0]} vs {pair[1]}"
                 c = compare(blocks[pair[0]], blocks[pair[1]], info["window"] // 9)
@@ -1035,9 +1289,14 @@ def run(quick: bool, out: Path | None, wait: float, skip_scaling: bool = False) 
                 agreement[name] = c
         del blocks
         gc.collect()
-        row = {**info, "methods": res, "agreement": agreement, "other_processes_cpu_fraction": ld.fraction,
-               "idle_wait": idle_n,
-               "paper_seconds": PAPER.get(n)}
+        row = {
+            **info,
+            "methods": res,
+            "agreement": agreement,
+            "other_processes_cpu_fraction": ld.fraction,
+            "idle_wait": idle_n,
+            "paper_seconds": PAPER.get(n),
+        }
         row["ratios"] = ratios(row)
         table.append(row)
         if ld.fraction is not None and ld.fraction > 0.05:
@@ -1055,15 +1314,29 @@ def run(quick: bool, out: Path | None, wait: float, skip_scaling: bool = False) 
         "benchmark": "paper 000 Table 3",
         "mode": mode,
         "machine": machine,
-        "data": {"kind": "white noise, standard normal", "seed": SEED, "generator": "numpy.random.default_rng",
-                 "fs": FS},
-        "setup": {"window": "N/10", "hop": 1, "workers": WORKERS, "estimator": "oavar (overlapping)",
-                  "grids": {"all": "m = 1 … W/2 (paper 000: 1 … W/2 − 1)",
-                            "exp": "paper 000 §4.2: 100 points m0·g^(i−1) up to W/9, rounded, duplicates dropped"},
-                  "sampling": {str(n): c for n, c in cfg["table"].items()}, "chunk_bytes": cfg["chunk_bytes"]},
+        "data": {
+            "kind": "white noise, standard normal",
+            "seed": SEED,
+            "generator": "numpy.random.default_rng",
+            "fs": FS,
+        },
+        "setup": {
+            "window": "N/10",
+            "hop": 1,
+            "workers": WORKERS,
+            "estimator": "oavar (overlapping)",
+            "grids": {
+                "all": "m = 1 … W/2 (paper 000: 1 … W/2 − 1)",
+                "exp": "paper 000 §4.2: 100 points m0·g^(i−1) up to W/9, rounded, duplicates dropped",
+            },
+            "sampling": {str(n): c for n, c in cfg["table"].items()},
+            "chunk_bytes": cfg["chunk_bytes"],
+        },
         "methods": METHODS,
-        "paper": {"source": "paper 000 Table 3, Matlab 7.11, 3 GHz Core 2 Duo",
-                  "seconds": {str(k): v for k, v in PAPER.items()}},
+        "paper": {
+            "source": "paper 000 Table 3, Matlab 7.11, 3 GHz Core 2 Duo",
+            "seconds": {str(k): v for k, v in PAPER.items()},
+        },
         "table": table,
         "max_rel_diff_overall": max(diffs) if diffs else None,
         "scaling": sc,
@@ -1074,26 +1347,43 @@ def run(quick: bool, out: Path | None, wait: float, skip_scaling: bool = False) 
     plot(report, out)
     log("")
     log((out / "table3.md").read_text(encoding="utf-8"))
-    log(f"wrote {out / 'table3.json'}, table3.md, table3.png{', scaling.png' if sc else ''} "
-        f"({report['total_seconds']:.1f} s)")
+    log(
+        f"wrote {out / 'table3.json'}, table3.md, table3.png{', scaling.png' if sc else ''} "
+        f"({report['total_seconds']:.1f} s)"
+    )
     return report
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     ap.add_argument("--quick", action="store_true", help="tiny sizes (< 30 s): a smoke test, not a timing result")
-    ap.add_argument("--out", type=Path, default=None,
-                    help="output folder (default benches/results; with --quick a temporary folder)")
-    ap.add_argument("--wait-idle", type=float, default=0.0, metavar="SECONDS",
-                    help="first wait up to SECONDS for the CPUs to be idle (< 10%% busy for 3 s running)")
+    ap.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="output folder (default benches/results; with --quick a temporary folder)",
+    )
+    ap.add_argument(
+        "--wait-idle",
+        type=float,
+        default=0.0,
+        metavar="SECONDS",
+        help="first wait up to SECONDS for the CPUs to be idle (< 10%% busy for 3 s running)",
+    )
     ap.add_argument("--no-scaling", action="store_true", help="skip the scaling part")
-    ap.add_argument("--scaling-only", action="store_true",
-                    help="redo only the scaling part, merged into the table3.json already in --out")
-    ap.add_argument("--criterion", action="store_true",
-                    help="only run `cargo bench -p allanite-core` and write criterion.md to --out")
-    ap.add_argument("--_child-scaling", nargs=3, type=int, metavar=("N", "WORKERS", "REPEATS"),
-                    help=argparse.SUPPRESS)
+    ap.add_argument(
+        "--scaling-only",
+        action="store_true",
+        help="redo only the scaling part, merged into the table3.json already in --out",
+    )
+    ap.add_argument(
+        "--criterion",
+        action="store_true",
+        help="only run `cargo bench -p allanite-core` and write criterion.md to --out",
+    )
+    ap.add_argument("--_child-scaling", nargs=3, type=int, metavar=("N", "WORKERS", "REPEATS"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args._child_scaling:
         print(json.dumps(child_scaling(*args._child_scaling)))

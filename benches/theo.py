@@ -50,10 +50,24 @@ import bench_engine as be  # noqa: E402  (timing helpers, machine info, idle wai
 SEED = 20261122
 
 CONFIGS = {
-    "full": {"theoh_n": 100_000, "theo1_n": 10_000, "dhvar_n": 40_000, "dhvar_window": 401, "repeats": 3,
-             "paper_seconds": 1200.0, "paper_hop": 25},
-    "quick": {"theoh_n": 5_000, "theo1_n": 600, "dhvar_n": 4_000, "dhvar_window": 401, "repeats": 1,
-              "paper_seconds": 240.0, "paper_hop": 100},
+    "full": {
+        "theoh_n": 100_000,
+        "theo1_n": 10_000,
+        "dhvar_n": 40_000,
+        "dhvar_window": 401,
+        "repeats": 3,
+        "paper_seconds": 1200.0,
+        "paper_hop": 25,
+    },
+    "quick": {
+        "theoh_n": 5_000,
+        "theo1_n": 600,
+        "dhvar_n": 4_000,
+        "dhvar_window": 401,
+        "repeats": 1,
+        "paper_seconds": 240.0,
+        "paper_hop": 100,
+    },
 }
 TARGETS = {"theoh_seconds": 2.0, "theo1_speedup_vs_allantools": 1000.0, "dhvar_seconds": 0.5}
 
@@ -76,18 +90,27 @@ def part_timings(cfg: dict) -> dict:
     with be.OtherLoad() as load:
         best, times, r = be.timed(lambda: allanite.avar(y, 1.0, estimator="theoh", taus="exp"), reps, warmup=True)
         a_best, a_times, _ = be.timed(lambda: allanite.avar(y, 1.0, taus="exp"), reps, warmup=True)
-    out["theoh"] = {"n": y.size, "grid": "exp", "tau_points": int(r.tau.size), "seconds": best, "repeats": times,
-                    "oavar_seconds": a_best, "oavar_repeats": a_times, "kf": r.kf,
-                    "theobr_points": int(np.sum(r.source == "theobr")),
-                    "other_processes_cpu_fraction": load.fraction}
+    out["theoh"] = {
+        "n": y.size,
+        "grid": "exp",
+        "tau_points": int(r.tau.size),
+        "seconds": best,
+        "repeats": times,
+        "oavar_seconds": a_best,
+        "oavar_repeats": a_times,
+        "kf": r.kf,
+        "theobr_points": int(np.sum(r.source == "theobr")),
+        "other_processes_cpu_fraction": load.fraction,
+    }
     be.log(f"TheoH N={y.size}: {best:.3f} s ({r.tau.size} τ; OAVAR same grid {a_best:.3f} s)")
 
     # 2. Theo1 vs allantools, N = 1e4, octave grid of even m
     y = rng.normal(size=cfg["theo1_n"])
     ms = [m for m in (10, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192) if m <= y.size]
     with be.OtherLoad() as load:
-        best, times, r = be.timed(lambda: allanite.avar(y, 1.0, estimator="theo1", taus=0.75 * np.array(ms)),
-                                  reps, warmup=True)
+        best, times, r = be.timed(
+            lambda: allanite.avar(y, 1.0, estimator="theo1", taus=0.75 * np.array(ms)), reps, warmup=True
+        )
     entry = {"n": y.size, "m": ms, "seconds": best, "repeats": times, "other_processes_cpu_fraction": load.fraction}
     try:
         import allantools
@@ -95,32 +118,53 @@ def part_timings(cfg: dict) -> dict:
         entry["allantools"] = "not installed"
     else:
         with be.OtherLoad() as load:
-            t_at, _, res = be.timed(lambda: allantools.theo1(y, rate=1.0, data_type="freq",
-                                                             taus=np.array(ms, dtype=float)), 1)
+            t_at, _, res = be.timed(
+                lambda: allantools.theo1(y, rate=1.0, data_type="freq", taus=np.array(ms, dtype=float)), 1
+            )
         taus_at, dev_at = np.asarray(res[0]), np.asarray(res[1])
         m_at = np.round(taus_at).astype(int)
         ours = {int(m): v for m, v in zip(r.m, r.avar)}
         common = [i for i, m in enumerate(m_at) if m in ours]
         diff = max(abs(dev_at[i] ** 2 / ours[m_at[i]] - 1) for i in common) if common else None
-        entry.update({"allantools_seconds": t_at, "speedup": t_at / best, "allantools_version": allantools.__version__,
-                      "allantools_m": m_at.tolist(), "allantools_tau_label": taus_at.tolist(),
-                      "compared_points": len(common), "max_rel_diff_variance": diff,
-                      "allantools_other_processes_cpu_fraction": load.fraction})
-        be.log(f"Theo1 N={y.size}: allanite {best * 1e3:.2f} ms, allantools {t_at:.1f} s → {t_at / best:.0f}×, "
-               f"max rel diff {diff:.2e} at corrected τ")
+        entry.update(
+            {
+                "allantools_seconds": t_at,
+                "speedup": t_at / best,
+                "allantools_version": allantools.__version__,
+                "allantools_m": m_at.tolist(),
+                "allantools_tau_label": taus_at.tolist(),
+                "compared_points": len(common),
+                "max_rel_diff_variance": diff,
+                "allantools_other_processes_cpu_fraction": load.fraction,
+            }
+        )
+        be.log(
+            f"Theo1 N={y.size}: allanite {best * 1e3:.2f} ms, allantools {t_at:.1f} s → {t_at / best:.0f}×, "
+            f"max rel diff {diff:.2e} at corrected τ"
+        )
     out["theo1"] = entry
 
     # 3. DHVAR, N = 4e4, window 401, hop 1
     y = rng.normal(size=cfg["dhvar_n"])
     w = cfg["dhvar_window"]
     with be.OtherLoad() as load:
-        best, times, d = be.timed(lambda: allanite.davar(y, 25.0, window=w, hop=1, estimator="theoh", taus="exp"),
-                                  reps, warmup=True)
-        a_best, a_times, da = be.timed(lambda: allanite.davar(y, 25.0, window=w, hop=1, taus="exp"), reps,
-                                       warmup=True)
-    out["dhvar"] = {"n": y.size, "window": w, "hop": 1, "windows": int(d.t.size), "tau_points": int(d.tau.size),
-                    "seconds": best, "repeats": times, "davar_seconds": a_best, "davar_repeats": a_times,
-                    "davar_tau_points": int(da.tau.size), "other_processes_cpu_fraction": load.fraction}
+        best, times, d = be.timed(
+            lambda: allanite.davar(y, 25.0, window=w, hop=1, estimator="theoh", taus="exp"), reps, warmup=True
+        )
+        a_best, a_times, da = be.timed(lambda: allanite.davar(y, 25.0, window=w, hop=1, taus="exp"), reps, warmup=True)
+    out["dhvar"] = {
+        "n": y.size,
+        "window": w,
+        "hop": 1,
+        "windows": int(d.t.size),
+        "tau_points": int(d.tau.size),
+        "seconds": best,
+        "repeats": times,
+        "davar_seconds": a_best,
+        "davar_repeats": a_times,
+        "davar_tau_points": int(da.tau.size),
+        "other_processes_cpu_fraction": load.fraction,
+    }
     be.log(f"DHVAR N={y.size} W={w}: {best:.3f} s ({d.tau.size} τ × {d.t.size} windows); DAVAR {a_best:.3f} s")
     return out
 
@@ -146,13 +190,15 @@ def true_avar(tau):
 
 
 def part_paper001(cfg: dict, out_dir: Path) -> dict:
-    import allanite
     import matplotlib
+
+    import allanite
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     import allanite.model.fitting as fit_mod
+
     y, (t1, t2) = simulate_paper001(cfg["paper_seconds"])
     window, hop = 401, cfg["paper_hop"]
     res = {
@@ -169,8 +215,11 @@ def part_paper001(cfg: dict, out_dir: Path) -> dict:
         s = fit_mod.fit(d, unit=unit)
         series[name] = s
         table[name] = {k: float(np.mean(s.ieee[k])) for k in s.terms}
-    ieee_units = {k: c.ieee_unit for k, c in expected.coefficients.items()} if hasattr(
-        next(iter(expected.coefficients.values())), "ieee_unit") else {}
+    ieee_units = (
+        {k: c.ieee_unit for k, c in expected.coefficients.items()}
+        if hasattr(next(iter(expected.coefficients.values())), "ieee_unit")
+        else {}
+    )
 
     # Scatter inside the stationary stretch (windows entirely before the loud part), at matched τ:
     # Theo τ = 0.75·m/fs; DAVAR evaluated at the same τ where it exists (m ≤ window/2).
@@ -187,9 +236,11 @@ def part_paper001(cfg: dict, out_dir: Path) -> dict:
             if i.size == 0:
                 continue
             v = d.avar[i[0], quiet]
-            row[name] = {"rel_spread": float(np.std(v) / np.mean(v)),
-                         "rms_rel_error": float(np.sqrt(np.mean((v / row["true_avar"] - 1) ** 2))),
-                         "mean_rel_bias": float(np.mean(v) / row["true_avar"] - 1)}
+            row[name] = {
+                "rel_spread": float(np.std(v) / np.mean(v)),
+                "rms_rel_error": float(np.sqrt(np.mean((v / row["true_avar"] - 1) ** 2))),
+                "mean_rel_bias": float(np.mean(v) / row["true_avar"] - 1),
+            }
         scatter.append(row)
     narrowing = []
     for row in scatter:
@@ -221,8 +272,12 @@ def part_paper001(cfg: dict, out_dir: Path) -> dict:
     ax[0].legend()
     ax[0].set_title("bias instability per window (paper 001 Fig. 7)")
     for name in res:
-        ax[1].plot([r["tau"] for r in scatter if name in r], [r[name]["rms_rel_error"] for r in scatter if name in r],
-                   "o-", label=name)
+        ax[1].plot(
+            [r["tau"] for r in scatter if name in r],
+            [r[name]["rms_rel_error"] for r in scatter if name in r],
+            "o-",
+            label=name,
+        )
     ax[1].set_xscale("log")
     ax[1].set_xlabel("τ (s)")
     ax[1].set_ylabel("RMS relative error of σ² across quiet windows")
@@ -230,12 +285,23 @@ def part_paper001(cfg: dict, out_dir: Path) -> dict:
     fig.tight_layout()
     fig.savefig(out_dir / "theo_paper001_series.png", dpi=90)
     plt.close(fig)
-    return {"seconds": cfg["paper_seconds"], "fs": FS, "window": window, "hop": hop, "gm_tc": GM_TC,
-            "gm_var": [GM_VAR_QUIET, GM_VAR_LOUD], "white_N": WHITE_N, "quantization": QUANT,
-            "loud_interval_s": [t1, t2], "quiet_windows": int(quiet.sum()), "table": table,
-            "ieee_units": ieee_units, "scatter": scatter,
-            "median_rms_error_reduction_dhvar_vs_davar": float(np.median(narrowing)) if narrowing else None,
-            "kf_median": {n: float(np.median(d.kf)) for n, d in res.items() if d.kf is not None}}
+    return {
+        "seconds": cfg["paper_seconds"],
+        "fs": FS,
+        "window": window,
+        "hop": hop,
+        "gm_tc": GM_TC,
+        "gm_var": [GM_VAR_QUIET, GM_VAR_LOUD],
+        "white_N": WHITE_N,
+        "quantization": QUANT,
+        "loud_interval_s": [t1, t2],
+        "quiet_windows": int(quiet.sum()),
+        "table": table,
+        "ieee_units": ieee_units,
+        "scatter": scatter,
+        "median_rms_error_reduction_dhvar_vs_davar": float(np.median(narrowing)) if narrowing else None,
+        "kf_median": {n: float(np.median(d.kf)) for n, d in res.items() if d.kf is not None},
+    }
 
 
 def _fmt(v, digits=4):
@@ -244,48 +310,76 @@ def _fmt(v, digits=4):
 
 def write_markdown(report: dict, path: Path) -> None:
     t = report["timings"]
-    lines = ["# TheoH / DHVAR benchmark", "",
-             f"Recorded by `benches/theo.py` on {report['machine'].get('date_utc')}; "
-             f"{report['machine'].get('cpu_count')} CPUs. Times are best of {report['config']['repeats']} after a "
-             "warm-up; every repeat is in theo.json.", "",
-             "| case | allanite | baseline (same run) | ratio | target | met |", "|---|---|---|---|---|---|"]
+    lines = [
+        "# TheoH / DHVAR benchmark",
+        "",
+        f"Recorded by `benches/theo.py` on {report['machine'].get('date_utc')}; "
+        f"{report['machine'].get('cpu_count')} CPUs. Times are best of {report['config']['repeats']} after a "
+        "warm-up; every repeat is in theo.json.",
+        "",
+        "| case | allanite | baseline (same run) | ratio | target | met |",
+        "|---|---|---|---|---|---|",
+    ]
     th = t["theoh"]
-    lines.append(f"| TheoH, N = {th['n']:,}, exp grid ({th['tau_points']} τ, {th['theobr_points']} TheoBR) | "
-                 f"{th['seconds']:.3f} s | OAVAR same grid {th['oavar_seconds']:.3f} s | "
-                 f"{th['seconds'] / th['oavar_seconds']:.0f}× OAVAR's time | ≤ 2 s | "
-                 f"{'yes' if th['seconds'] <= TARGETS['theoh_seconds'] else 'NO'} |")
+    lines.append(
+        f"| TheoH, N = {th['n']:,}, exp grid ({th['tau_points']} τ, {th['theobr_points']} TheoBR) | "
+        f"{th['seconds']:.3f} s | OAVAR same grid {th['oavar_seconds']:.3f} s | "
+        f"{th['seconds'] / th['oavar_seconds']:.0f}× OAVAR's time | ≤ 2 s | "
+        f"{'yes' if th['seconds'] <= TARGETS['theoh_seconds'] else 'NO'} |"
+    )
     t1 = t["theo1"]
     if "speedup" in t1:
-        lines.append(f"| Theo1, N = {t1['n']:,}, m = {t1['m'][0]}…{t1['m'][-1]} (octave) | {t1['seconds'] * 1e3:.2f} ms | "
-                     f"allantools.theo1 {t1['allantools_seconds']:.1f} s | {t1['speedup']:,.0f}× | ≥ 1000× | "
-                     f"{'yes' if t1['speedup'] >= TARGETS['theo1_speedup_vs_allantools'] else 'NO'} |")
+        lines.append(
+            f"| Theo1, N = {t1['n']:,}, m = {t1['m'][0]}…{t1['m'][-1]} (octave) | {t1['seconds'] * 1e3:.2f} ms | "
+            f"allantools.theo1 {t1['allantools_seconds']:.1f} s | {t1['speedup']:,.0f}× | ≥ 1000× | "
+            f"{'yes' if t1['speedup'] >= TARGETS['theo1_speedup_vs_allantools'] else 'NO'} |"
+        )
     dh = t["dhvar"]
-    lines.append(f"| DHVAR, N = {dh['n']:,}, window {dh['window']}, hop 1 ({dh['tau_points']} τ × {dh['windows']:,} "
-                 f"windows) | {dh['seconds']:.3f} s | DAVAR same windows {dh['davar_seconds']:.3f} s | — | ≤ 0.5 s | "
-                 f"{'yes' if dh['seconds'] <= TARGETS['dhvar_seconds'] else 'NO'} |")
+    lines.append(
+        f"| DHVAR, N = {dh['n']:,}, window {dh['window']}, hop 1 ({dh['tau_points']} τ × {dh['windows']:,} "
+        f"windows) | {dh['seconds']:.3f} s | DAVAR same windows {dh['davar_seconds']:.3f} s | — | ≤ 0.5 s | "
+        f"{'yes' if dh['seconds'] <= TARGETS['dhvar_seconds'] else 'NO'} |"
+    )
     if "max_rel_diff_variance" in t1:
-        lines += ["", f"allantools.theo1 labels its values τ = m·τ0; at m (τ = 0.75·m·τ0) they equal allanite's Theo1 "
-                      f"to {_fmt(t1['max_rel_diff_variance'], 2)} relative ({t1['compared_points']} points)."]
+        lines += [
+            "",
+            f"allantools.theo1 labels its values τ = m·τ0; at m (τ = 0.75·m·τ0) they equal allanite's Theo1 "
+            f"to {_fmt(t1['max_rel_diff_variance'], 2)} relative ({t1['compared_points']} points).",
+        ]
     loads = {k: v.get("other_processes_cpu_fraction") for k, v in t.items()}
-    lines += ["", "Other processes' CPU share during each case: " +
-              ", ".join(f"{k} {_fmt(100 * v, 2) if v is not None else '?'} %" for k, v in loads.items()), ""]
+    lines += [
+        "",
+        "Other processes' CPU share during each case: "
+        + ", ".join(f"{k} {_fmt(100 * v, 2) if v is not None else '?'} %" for k, v in loads.items()),
+        "",
+    ]
 
     p = report["paper001"]
-    lines += ["## Paper 001 rebuilt: DAVAR vs DHVAR-A vs DHVAR", "",
-              f"{p['seconds']:.0f} s at {p['fs']:g} Hz; Gauss–Markov bias (T_c = {p['gm_tc']} s) of variance "
-              f"{p['gm_var'][0]} (°/s)² outside {p['loud_interval_s'][0]:.0f}–{p['loud_interval_s'][1]:.0f} s and "
-              f"{p['gm_var'][1]} inside; white rate {p['white_N']} °/√s; quantization {p['quantization']} °. "
-              f"Window {p['window']}, hop {p['hop']}. Mean of each fitted coefficient over all windows, vs the "
-              "whole-record Allan fit (the paper's \"expected\"):", "",
-              "| term | expected | DAVAR | DHVAR-A | DHVAR |", "|---|---|---|---|---|"]
+    lines += [
+        "## Paper 001 rebuilt: DAVAR vs DHVAR-A vs DHVAR",
+        "",
+        f"{p['seconds']:.0f} s at {p['fs']:g} Hz; Gauss–Markov bias (T_c = {p['gm_tc']} s) of variance "
+        f"{p['gm_var'][0]} (°/s)² outside {p['loud_interval_s'][0]:.0f}–{p['loud_interval_s'][1]:.0f} s and "
+        f"{p['gm_var'][1]} inside; white rate {p['white_N']} °/√s; quantization {p['quantization']} °. "
+        f"Window {p['window']}, hop {p['hop']}. Mean of each fitted coefficient over all windows, vs the "
+        'whole-record Allan fit (the paper\'s "expected"):',
+        "",
+        "| term | expected | DAVAR | DHVAR-A | DHVAR |",
+        "|---|---|---|---|---|",
+    ]
     units = {"Q": "°", "N": "°/√h", "B": "°/h", "K": "°/h^1.5", "R": "°/h²"}
     for k in ("Q", "N", "B", "K", "R"):
         row = [p["table"][c].get(k) for c in ("expected", "DAVAR", "DHVAR-A", "DHVAR")]
         lines.append(f"| {k} ({units[k]}) | " + " | ".join(_fmt(v) for v in row) + " |")
-    lines += ["", f"Scatter across the {p['quiet_windows']} windows inside the stationary stretch (before "
-                  f"{p['loud_interval_s'][0]:.0f} s), at matched τ: RMS relative error of σ² against the closed form "
-                  "(relative spread std/mean in brackets). DAVAR stops at τ = window/2.", "",
-              "| τ (s) | DAVAR | DHVAR-A | DHVAR |", "|---|---|---|---|"]
+    lines += [
+        "",
+        f"Scatter across the {p['quiet_windows']} windows inside the stationary stretch (before "
+        f"{p['loud_interval_s'][0]:.0f} s), at matched τ: RMS relative error of σ² against the closed form "
+        "(relative spread std/mean in brackets). DAVAR stops at τ = window/2.",
+        "",
+        "| τ (s) | DAVAR | DHVAR-A | DHVAR |",
+        "|---|---|---|---|",
+    ]
     for row in p["scatter"]:
         cells = []
         for name in ("DAVAR", "DHVAR-A", "DHVAR"):
@@ -293,9 +387,16 @@ def write_markdown(report: dict, path: Path) -> None:
             cells.append("—" if c is None else f"{c['rms_rel_error']:.3f} ({c['rel_spread']:.3f})")
         lines.append(f"| {row['tau']:.2f} | " + " | ".join(cells) + " |")
     red = p["median_rms_error_reduction_dhvar_vs_davar"]
-    lines += ["", f"Median reduction of the RMS error, DHVAR vs DAVAR, where both exist: {_fmt(100 * red, 3) if red is not None else '—'} % "
-                  "(paper 001 claims ≥ 30 % at medium/long τ).", "",
-              "![surfaces](theo_paper001_surfaces.png)", "", "![series](theo_paper001_series.png)", ""]
+    lines += [
+        "",
+        f"Median reduction of the RMS error, DHVAR vs DAVAR, where both exist: {_fmt(100 * red, 3) if red is not None else '—'} % "
+        "(paper 001 claims ≥ 30 % at medium/long τ).",
+        "",
+        "![surfaces](theo_paper001_surfaces.png)",
+        "",
+        "![series](theo_paper001_series.png)",
+        "",
+    ]
     path.write_text("\n".join(lines))
 
 

@@ -24,7 +24,9 @@ def test_bench_engine_quick(tmp_path):
     pytest.importorskip("allantools")
     proc = subprocess.run(
         [sys.executable, str(SCRIPT), "--quick", "--out", str(tmp_path)],
-        capture_output=True, text=True, timeout=120,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
     report = json.loads((tmp_path / "engine.json").read_text(encoding="utf-8"))

@@ -78,8 +78,14 @@ def test_report_on_a_npy_log(tmp_path, npy_log, capsys):
     assert n["ieee"] == pytest.approx(n["value"] * 180 / np.pi * 60, rel=1e-12)
     f = allanite.fit(allanite.avar(y[:, None], 50.0), unit="rad/s")[0]
     assert n["value"] == f.coefficients["N"].value and n["ieee"] == f.coefficients["N"].ieee
-    for name in ("adev.png", "davar.png", "adev_axis0.png", "davar_axis0.png", "davar3d_axis0.png",
-                 "coefficients_axis0.png"):
+    for name in (
+        "adev.png",
+        "davar.png",
+        "adev_axis0.png",
+        "davar_axis0.png",
+        "davar3d_axis0.png",
+        "coefficients_axis0.png",
+    ):
         check_png(out / name)
     assert str(out / "report.html") in printed
 
@@ -89,8 +95,12 @@ def test_report_on_a_csv_log_with_named_columns(tmp_path, rng):
     log = tmp_path / "imu.csv"
     np.savetxt(log, X, delimiter=",", header="gx,gy,acc", comments="")
     out = tmp_path / "out"
-    assert cli.main(["report", str(log), "--fs", "10", "--columns", "gx,gy", "--unit", "deg/s", "--quiet",
-                     "--out", str(out)]) == 0
+    assert (
+        cli.main(
+            ["report", str(log), "--fs", "10", "--columns", "gx,gy", "--unit", "deg/s", "--quiet", "--out", str(out)]
+        )
+        == 0
+    )
     summary = json.loads((out / "summary.json").read_text())
     assert summary["axes"] == 2 and summary["record"]["axis_names"] == ["gx", "gy"]
     r = allanite.avar(X[:, :2], 10.0, taus="octave")
@@ -115,21 +125,39 @@ def test_time_column_gives_fs_and_gaps_are_reported(tmp_path, rng, capsys):
     assert "Pass --gaps longest" in err and "--gaps split" in err  # options, not Python keywords
     assert not (out / "summary.json").exists()
 
-    rc = cli.main(["report", str(log), "--time-column", "t", "--unit", "deg/s", "--gaps", "longest", "--no-fit",
-                   "--out", str(out)])
+    rc = cli.main(
+        [
+            "report",
+            str(log),
+            "--time-column",
+            "t",
+            "--unit",
+            "deg/s",
+            "--gaps",
+            "longest",
+            "--no-fit",
+            "--out",
+            str(out),
+        ]
+    )
     assert rc == 0
     printed = capsys.readouterr().out
     assert "only the longest gap-free stretch, samples 0–1799 of 3000" in printed
     summary = json.loads((out / "summary.json").read_text())
     src = summary["record"]["source"]
     assert summary["fs_hz"] == 50.0 and src["fs_from"] == "time column" and summary["samples"] == 1_800
-    assert src["gaps"] == [{"after_sample": 1799, "time_s": pytest.approx(35.98), "duration_s": pytest.approx(2.0),
-                            "missing_samples": 100}]
+    assert src["gaps"] == [
+        {"after_sample": 1799, "time_s": pytest.approx(35.98), "duration_s": pytest.approx(2.0), "missing_samples": 100}
+    ]
     assert src["kept"] == [0, 1_800]
 
     out3 = tmp_path / "out3"
-    assert cli.main(["report", str(log), "--time-column", "0", "--gaps", "split", "--no-fit", "--quiet",
-                     "--out", str(out3)]) == 0
+    assert (
+        cli.main(
+            ["report", str(log), "--time-column", "0", "--gaps", "split", "--no-fit", "--quiet", "--out", str(out3)]
+        )
+        == 0
+    )
     s3 = json.loads((out3 / "summary.json").read_text())
     assert s3["record"]["source"]["segments"] == [[0, 1_800], [1_800, 3_000]]
     assert s3["static"]["adev"] == summary["static"]["adev"]
@@ -140,8 +168,25 @@ def test_increment_input_with_an_angle_unit(tmp_path, rng):
     log = tmp_path / "inc.npy"
     np.save(log, rate / 100.0)  # arcsec per sample at 100 Hz
     out = tmp_path / "out"
-    assert cli.main(["report", str(log), "--fs", "100", "--input", "increment", "--unit", "arcsec", *SMALL,
-                     "--quiet", "--out", str(out)]) == 0
+    assert (
+        cli.main(
+            [
+                "report",
+                str(log),
+                "--fs",
+                "100",
+                "--input",
+                "increment",
+                "--unit",
+                "arcsec",
+                *SMALL,
+                "--quiet",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     summary = json.loads((out / "summary.json").read_text())
     assert summary["record"]["adev_unit"] == "arcsec/s" and summary["record"]["input"] == "increment"
     r = allanite.avar(rate, 100.0)
@@ -168,8 +213,24 @@ def test_unknown_unit_still_fits_in_base_form(tmp_path, npy_log, capsys):
 def test_no_fit_and_explicit_taus(tmp_path, npy_log):
     log, y = npy_log
     out = tmp_path / "out"
-    assert cli.main(["report", str(log), "--fs", "50", *SMALL, "--taus", "0.02,0.2,2,20", "--no-fit", "--quiet",
-                     "--out", str(out)]) == 0
+    assert (
+        cli.main(
+            [
+                "report",
+                str(log),
+                "--fs",
+                "50",
+                *SMALL,
+                "--taus",
+                "0.02,0.2,2,20",
+                "--no-fit",
+                "--quiet",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     summary = json.loads((out / "summary.json").read_text())
     assert summary["static"]["tau_s"] == [0.02, 0.2, 2.0, 20.0] and summary["static"]["grid"] == "explicit"
     np.testing.assert_array_equal(summary["static"]["adev"], [allanite.avar(y, 50.0, taus=[0.02, 0.2, 2, 20]).adev])
@@ -177,8 +238,12 @@ def test_no_fit_and_explicit_taus(tmp_path, npy_log):
     assert not list(out.glob("coefficients_axis*.png"))
     assert "Not fitted (<code>--no-fit</code>)" in (out / "report.html").read_text(encoding="utf-8")
     out2 = tmp_path / "out2"
-    assert cli.main(["report", str(log), "--fs", "50", *SMALL, "--taus", "decade", "--no-fit", "--quiet",
-                     "--out", str(out2)]) == 0
+    assert (
+        cli.main(
+            ["report", str(log), "--fs", "50", *SMALL, "--taus", "decade", "--no-fit", "--quiet", "--out", str(out2)]
+        )
+        == 0
+    )
     s2 = json.loads((out2 / "summary.json").read_text())
     np.testing.assert_array_equal(s2["static"]["tau_s"], allanite.tau_grid(6_000, 50.0, "decade"))
 
@@ -207,8 +272,16 @@ def test_progress_bar_on_a_terminal_and_not_with_quiet(tmp_path, npy_log, monkey
     monkeypatch.setattr(sys, "stderr", err)
     assert cli.main(["report", str(log), "--fs", "50", *SMALL, "--out", str(tmp_path / "a")]) == 0
     bar = err.getvalue()
-    for step in ("reading gyro.npy", "static Allan deviation", "confidence intervals", "dynamic Allan variance",
-                 "noise-model fit", "figure adev.png", "figure davar3d_axis0.png", "writing report.html"):
+    for step in (
+        "reading gyro.npy",
+        "static Allan deviation",
+        "confidence intervals",
+        "dynamic Allan variance",
+        "noise-model fit",
+        "figure adev.png",
+        "figure davar3d_axis0.png",
+        "writing report.html",
+    ):
         assert step in bar
     assert "\r" in bar and "allanite: error" not in bar
     err = _Terminal()
@@ -237,33 +310,39 @@ def test_reader_warnings_are_one_line_and_in_the_report(tmp_path, rng, capfd):
 # errors: exit status 2 and one line on stderr
 
 
-@pytest.mark.parametrize("args, message", [
-    (["report", "missing.npy", "--fs", "1"], "missing.npy: no such file"),
-    (["report", "{log}"], "give the sampling rate with --fs HZ, or the time column with --time-column C"),
-    (["report", "{log}", "--fs", "abc"], "argument --fs: invalid float value: 'abc' (see 'allanite report --help')"),
-    (["report", "{log}", "--fs", "0"], "fs must be a positive finite number"),
-    (["report", "{log}", "--fs", "-5"], "fs must be a positive finite number"),
-    (["report", "{log}", "--fs", "nan"], "fs must be a positive finite number"),
-    (["report", "{log}", "--fs", "1", "--unit", "furlongs"], "unknown unit 'furlongs'; allowed rate units: deg/s"),
-    (["report", "{log}", "--fs", "1", "--unit", "deg"], "(--input rate needs a rate unit)"),
-    (["report", "{log}", "--fs", "1", "--input", "increment", "--unit", "deg/s"], "an angle unit is needed"),
-    (["report", "{bad}", "--fs", "1"], "column 'col0': non-finite value nan"),
-    (["report", "{log}", "--fs", "1", "--window", "5000"], "window (5000 samples) is longer than the record (100"),
-    (["report", "{log}", "--fs", "1", "--window", "x"], "argument --window: invalid int value: 'x'"),
-    (["report", "{log}", "--fs", "1", "--hop", "0"], "hop must be an integer ≥ 1, got 0"),
-    (["report", "{log}", "--fs", "1", "--taus", "fortnightly"], "unknown τ grid 'fortnightly'"),
-    (["report", "{log}", "--fs", "1", "--taus", "0.5,x"], "is neither a grid name"),
-    (["report", "{log}", "--fs", "1", "--taus", "1000"], "is too long for 100 samples"),
-    (["report", "{log}", "--fs", "1", "--columns", "gx"], "no column named 'gx'"),
-    (["report", "{log}", "--fs", "1", "--columns", "a,,b"], "empty name"),
-    (["report", "{log}", "--fs", "1", "--gaps", "ignore"], "argument --gaps: invalid choice: 'ignore'"),
-    (["report", "{text}", "--fs", "1"], "'world' is not a number"),
-    (["report", "{log}", "--fs", "1", "--bogus"], "unrecognized arguments: --bogus"),
-    (["report", "--fs", "100"], "--fs describes a LOG file; without LOG the bundled record"),
-    (["report", "--unit", "deg/s", "--columns", "a"], "--columns, --unit describe a LOG file"),
-    (["frobnicate"], "invalid choice: 'frobnicate'"),
-    (["report", "{log}", "--fs", "1", "--out", "{file}"], "exists and is not a folder"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["report", "missing.npy", "--fs", "1"], "missing.npy: no such file"),
+        (["report", "{log}"], "give the sampling rate with --fs HZ, or the time column with --time-column C"),
+        (
+            ["report", "{log}", "--fs", "abc"],
+            "argument --fs: invalid float value: 'abc' (see 'allanite report --help')",
+        ),
+        (["report", "{log}", "--fs", "0"], "fs must be a positive finite number"),
+        (["report", "{log}", "--fs", "-5"], "fs must be a positive finite number"),
+        (["report", "{log}", "--fs", "nan"], "fs must be a positive finite number"),
+        (["report", "{log}", "--fs", "1", "--unit", "furlongs"], "unknown unit 'furlongs'; allowed rate units: deg/s"),
+        (["report", "{log}", "--fs", "1", "--unit", "deg"], "(--input rate needs a rate unit)"),
+        (["report", "{log}", "--fs", "1", "--input", "increment", "--unit", "deg/s"], "an angle unit is needed"),
+        (["report", "{bad}", "--fs", "1"], "column 'col0': non-finite value nan"),
+        (["report", "{log}", "--fs", "1", "--window", "5000"], "window (5000 samples) is longer than the record (100"),
+        (["report", "{log}", "--fs", "1", "--window", "x"], "argument --window: invalid int value: 'x'"),
+        (["report", "{log}", "--fs", "1", "--hop", "0"], "hop must be an integer ≥ 1, got 0"),
+        (["report", "{log}", "--fs", "1", "--taus", "fortnightly"], "unknown τ grid 'fortnightly'"),
+        (["report", "{log}", "--fs", "1", "--taus", "0.5,x"], "is neither a grid name"),
+        (["report", "{log}", "--fs", "1", "--taus", "1000"], "is too long for 100 samples"),
+        (["report", "{log}", "--fs", "1", "--columns", "gx"], "no column named 'gx'"),
+        (["report", "{log}", "--fs", "1", "--columns", "a,,b"], "empty name"),
+        (["report", "{log}", "--fs", "1", "--gaps", "ignore"], "argument --gaps: invalid choice: 'ignore'"),
+        (["report", "{text}", "--fs", "1"], "'world' is not a number"),
+        (["report", "{log}", "--fs", "1", "--bogus"], "unrecognized arguments: --bogus"),
+        (["report", "--fs", "100"], "--fs describes a LOG file; without LOG the bundled record"),
+        (["report", "--unit", "deg/s", "--columns", "a"], "--columns, --unit describe a LOG file"),
+        (["frobnicate"], "invalid choice: 'frobnicate'"),
+        (["report", "{log}", "--fs", "1", "--out", "{file}"], "exists and is not a folder"),
+    ],
+)
 def test_report_errors_exit_2_with_one_line(tmp_path, monkeypatch, capsys, args, message):
     monkeypatch.chdir(tmp_path)
     np.save(tmp_path / "log.npy", np.arange(100.0) % 7)
@@ -272,8 +351,12 @@ def test_report_errors_exit_2_with_one_line(tmp_path, monkeypatch, capsys, args,
     np.save(tmp_path / "bad.npy", bad)
     (tmp_path / "text.txt").write_text("hello\nworld\n")
     (tmp_path / "afile").write_text("")
-    paths = {"log": str(tmp_path / "log.npy"), "bad": str(tmp_path / "bad.npy"), "text": str(tmp_path / "text.txt"),
-             "file": str(tmp_path / "afile")}
+    paths = {
+        "log": str(tmp_path / "log.npy"),
+        "bad": str(tmp_path / "bad.npy"),
+        "text": str(tmp_path / "text.txt"),
+        "file": str(tmp_path / "afile"),
+    }
     argv = [a.format(**paths) for a in args]
     if "--out" not in argv:
         argv += ["--out", str(tmp_path / "out")] if argv[0] == "report" else []
@@ -298,8 +381,12 @@ def test_unwritable_output_folder_is_a_one_line_error(tmp_path, npy_log, capsys)
 
 
 def test_python_m_allanite_exit_status_and_no_traceback(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "allanite", "report", str(tmp_path / "nope.csv"), "--fs", "100"],
-                          capture_output=True, text=True, timeout=120)
+    proc = subprocess.run(
+        [sys.executable, "-m", "allanite", "report", str(tmp_path / "nope.csv"), "--fs", "100"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert proc.returncode == 2
     assert proc.stderr == f"allanite: error: {tmp_path / 'nope.csv'}: no such file\n"
     assert proc.stdout == ""
@@ -327,18 +414,35 @@ def test_report_help_reads_like_a_unix_tool(capsys):
     out = capsys.readouterr().out
     assert out.startswith("usage: allanite report [-h]") and "[LOG]" in out
     # option groups, examples, the files written and the exit status, in this order
-    heads = ["positional arguments:", "input (LOG only):", "analysis:", "output:", "examples:",
-             "files written to DIR:", "exit status:"]
+    heads = [
+        "positional arguments:",
+        "input (LOG only):",
+        "analysis:",
+        "output:",
+        "examples:",
+        "files written to DIR:",
+        "exit status:",
+    ]
     positions = [out.index(h) for h in heads]
     assert positions == sorted(positions)
-    for option in ("--fs HZ", "--columns", "--time-column", "--unit U", "--input {rate,increment,angle}",
-                   "--gaps {error,longest,split}", "--taus GRID", "--window N", "--hop N", "--no-fit", "--out DIR",
-                   "-q, --quiet"):
+    for option in (
+        "--fs HZ",
+        "--columns",
+        "--time-column",
+        "--unit U",
+        "--input {rate,increment,angle}",
+        "--gaps {error,longest,split}",
+        "--taus GRID",
+        "--window N",
+        "--hop N",
+        "--no-fit",
+        "--out DIR",
+        "-q, --quiet",
+    ):
         assert option in out
     assert "1/12 of the record" in out and "1/25 of the window" in out  # the defaults are documented
     assert "allanite report imu.csv.gz --fs 100 --columns gyro_x,gyro_y,gyro_z --unit deg/s" in out
-    for name in ("report.html", "summary.json", "adev.png", "davar.png", "davar3d_axisK.png",
-                 "coefficients_axisK.png"):
+    for name in ("report.html", "summary.json", "adev.png", "davar.png", "davar3d_axisK.png", "coefficients_axisK.png"):
         assert name in out
     assert max(len(line) for line in out.splitlines()) <= 100
 

@@ -29,6 +29,7 @@ import numpy as np
 import pytest
 
 import allanite
+from allanite.errors import ParameterError
 from allanite.estimators.confidence import (
     ONE_SIGMA,
     ConfidenceIntervals,
@@ -38,7 +39,6 @@ from allanite.estimators.confidence import (
     edf_sp1065,
     identify_alpha,
 )
-from allanite.errors import ParameterError
 
 # ------------------------------------------------------------------------------------------
 # Stable32 tables
@@ -64,8 +64,14 @@ def read_stable32(path: Path) -> dict:
         rows.append([float(v) for v in s.split()])
     t = np.array(rows)
     return {
-        "header": header, "m": t[:, 0].astype(np.int64), "tau": t[:, 1], "n": t[:, 2].astype(np.int64),
-        "alpha": t[:, 3].astype(np.int64), "lo": t[:, 4], "sigma": t[:, 5], "hi": t[:, 6],
+        "header": header,
+        "m": t[:, 0].astype(np.int64),
+        "tau": t[:, 1],
+        "n": t[:, 2].astype(np.int64),
+        "alpha": t[:, 3].astype(np.int64),
+        "lo": t[:, 4],
+        "sigma": t[:, 5],
+        "hi": t[:, 6],
     }
 
 
@@ -145,7 +151,7 @@ def test_edf_sp1065_close_to_greenhall_but_different():
     for a in (2, 1, 0, -1, -2):
         g = edf_greenhall(a, 2, ms, 1001)
         s = edf_sp1065(a, ms, 1001)
-        assert np.all(np.abs(s / g - 1) < 0.45), (a, s / g)     # FPM: up to 40 % apart
+        assert np.all(np.abs(s / g - 1) < 0.45), (a, s / g)  # FPM: up to 40 % apart
     assert edf_sp1065(2, 1, 1001) == pytest.approx(1002 * 999 / 2000)
     assert edf_sp1065(0, 100, 1001) == pytest.approx((1500 / 100 - 2 * 999 / 1001) * 40000 / 40005)
 
@@ -213,8 +219,8 @@ def test_stable32_conventions_pinned_down(s32):
             nu_o = edf_greenhall(t["alpha"], 2, t["m"], n_phase, overlapping=True)
             lo = np.sqrt(chi2_interval(var, nu_o, ONE_SIGMA, method="stable32")[0])
             worst["adev_as_oadev"] = max(worst["adev_as_oadev"], float(np.max(np.abs(lo / t["lo"] - 1))))
-    assert worst["0.683"] > 2.0          # misses the printed digits by more than twice the rounding
-    assert worst["sp1065"] > 1e-3        # ≈ 0.2–1.3 % off: not Stable32's EDF
+    assert worst["0.683"] > 2.0  # misses the printed digits by more than twice the rounding
+    assert worst["sp1065"] > 1e-3  # ≈ 0.2–1.3 % off: not Stable32's EDF
     assert worst["adev_as_oadev"] > 1e-2  # ADEV bounds are those of the classic estimator
 
 
@@ -233,10 +239,8 @@ ALPHA_TABLES = [
     ("ocxo/stable32_adev_alltau.txt", "ocxo/ocxo_frequency.txt", "rate", "avar", 0.87, None),
     ("tic-floor/tic_oadev.txt", "tic-floor/tic_phase.txt", "angle", "oavar", 0.9, {8192: (1, 0)}),
     ("tic-floor/tic_adev.txt", "tic-floor/tic_phase.txt", "angle", "avar", 0.88, None),
-    ("gps1pps/stable32_OADEV_octave.txt", "gps1pps/gps_1pps_phase_data.txt.gz", "angle", "oavar", 0.9,
-     {32768: (0, 1)}),
-    ("gps1pps/stable32_ADEV_decade.txt", "gps1pps/gps_1pps_phase_data.txt.gz", "angle", "avar", 0.9,
-     {40000: (0, 1)}),
+    ("gps1pps/stable32_OADEV_octave.txt", "gps1pps/gps_1pps_phase_data.txt.gz", "angle", "oavar", 0.9, {32768: (0, 1)}),
+    ("gps1pps/stable32_ADEV_decade.txt", "gps1pps/gps_1pps_phase_data.txt.gz", "angle", "avar", 0.9, {40000: (0, 1)}),
     ("cs5071a/oadev_decade.txt", "cs5071a/5071A_phase.txt.gz", "angle", "oavar", 1.0, {}),
     ("cs5071a/adev_decade.txt", "cs5071a/5071A_phase.txt.gz", "angle", "avar", 1.0, {}),
     ("cs5071a/oadev_all.txt", "cs5071a/5071A_phase.txt.gz", "angle", "oavar", 0.98, None),
@@ -317,11 +321,12 @@ def test_end_to_end_phase_dat(s32):
     for name, est in (("phasedat/phase_dat_oadev_octave.txt", "oavar"), ("phasedat/phase_dat_adev_octave.txt", "avar")):
         t = _table(s32, name)
         r = allanite.avar(x, 1.0, input="angle", taus=t["m"], estimator=est).with_confidence(
-            x, confidence=ONE_SIGMA, chi2="stable32", b1_n="terms")
+            x, confidence=ONE_SIGMA, chi2="stable32", b1_n="terms"
+        )
         assert r.confidence == ONE_SIGMA
         assert np.allclose(r.adev, t["sigma"], rtol=6e-5)
         same = r.alpha == t["alpha"]
-        assert same.sum() == 7 and not same[-1]        # m = 128: FPM (ours) vs WFM (Stable32)
+        assert same.sum() == 7 and not same[-1]  # m = 128: FPM (ours) vs WFM (Stable32)
         lo, hi = r.adev_ci
         # relative bounds (bound/σ) against Stable32's, where the noise type agrees
         assert np.allclose((lo / r.adev)[same], (t["lo"] / t["sigma"])[same], rtol=3.5e-4)
@@ -373,7 +378,7 @@ def test_identify_simulated(alpha, rng):
     assert list(identify_alpha(y, ms, input="rate")) == want
     assert list(identify_alpha(x, ms, input="angle")) == want
     assert list(identify_alpha(y * 0.01, ms, input="increment", estimator="avar")) == want
-    assert identify_alpha(x + 1e6, 4, input="angle") == alpha     # offsets do not matter
+    assert identify_alpha(x + 1e6, 4, input="angle") == alpha  # offsets do not matter
     if alpha % 2:
         assert np.all(np.abs(identify_alpha(y, [16, 64, 256], input="rate") - alpha) <= 1)
 
@@ -415,22 +420,28 @@ def _coverage(make, ms, alpha, runs, estimator="oavar", n=4096, identify=False):
 
 
 def _white_rate(rng, n, ms):
-    return rng.normal(size=n), 1.0 / ms                    # AVAR = σ²/m exactly
+    return rng.normal(size=n), 1.0 / ms  # AVAR = σ²/m exactly
 
 
 def _white_angle(rng, n, ms):
-    return np.diff(rng.normal(size=n + 1)), 3.0 / ms**2     # AVAR = 3σx²/τ² exactly
+    return np.diff(rng.normal(size=n + 1)), 3.0 / ms**2  # AVAR = 3σx²/τ² exactly
 
 
-@pytest.mark.parametrize("make,alpha,estimator", [
-    (_white_rate, 0, "oavar"), (_white_rate, 0, "avar"), (_white_angle, 2, "oavar"),
-], ids=["white-rate-oavar", "white-rate-avar", "white-angle-oavar"])
+@pytest.mark.parametrize(
+    "make,alpha,estimator",
+    [
+        (_white_rate, 0, "oavar"),
+        (_white_rate, 0, "avar"),
+        (_white_angle, 2, "oavar"),
+    ],
+    ids=["white-rate-oavar", "white-rate-avar", "white-angle-oavar"],
+)
 def test_coverage(make, alpha, estimator):
     runs = 300
     ms = [1, 8, 64, 256]
     cov, below, est, truth, nu = _coverage(make, ms, alpha, runs, estimator)
     p = 0.683
-    tol = 4 * math.sqrt(p * (1 - p) / runs)            # 4 binomial standard deviations
+    tol = 4 * math.sqrt(p * (1 - p) / runs)  # 4 binomial standard deviations
     assert np.all(np.abs(cov - p) < tol), cov
     # equal tails: each side misses ≈ 15.9 %
     assert np.all(np.abs(below - (1 - p) / 2) < 4 * math.sqrt(0.159 * 0.841 / runs)), below
@@ -476,7 +487,7 @@ def test_multi_axis(rng):
     assert list(r.alpha[0]) == [0, 0, 0] and list(r.alpha[1]) == [-2, -2, -2]
     r1 = allanite.avar(y[:, 1], 1.0, taus=[1, 4, 16]).with_confidence(y[:, 1])
     assert np.array_equal(r1.ci_low, r.ci_low[1])
-    rg = allanite.avar(y, 1.0, taus=[1, 4, 16]).with_confidence(alpha=[0, -1, -2])   # one per τ
+    rg = allanite.avar(y, 1.0, taus=[1, 4, 16]).with_confidence(alpha=[0, -1, -2])  # one per τ
     assert np.array_equal(rg.alpha, [[0, -1, -2]] * 2)
 
 

@@ -15,7 +15,7 @@ M = np.array([1, 2, 3, 5, 8, 16, 40, 90])
 
 def _estimator_matrices(n, m_values):
     """σ̂²(m) = yᵀ B_m y for rate samples y (the overlapping estimator written out as a quadratic form)."""
-    phase = np.tril(np.ones((n + 1, n)), -1) * TAU0      # x_k = τ0 Σ_{j<k} y_j
+    phase = np.tril(np.ones((n + 1, n)), -1) * TAU0  # x_k = τ0 Σ_{j<k} y_j
     out = []
     for m in m_values:
         count = n + 1 - 2 * m
@@ -53,9 +53,9 @@ def rate_covariances():
     diff[np.arange(n), np.arange(n)] = -1.0 / TAU0
     diff[np.arange(n), np.arange(n) + 1] = 1.0 / TAU0
     return {
-        "Q": diff @ diff.T,                   # white angle of variance 1, differenced
-        "N": np.eye(n) / TAU0,                # white rate of variance 1/τ0
-        "K": walk @ walk.T * TAU0,            # random walk with steps of variance τ0
+        "Q": diff @ diff.T,  # white angle of variance 1, differenced
+        "N": np.eye(n) / TAU0,  # white rate of variance 1/τ0
+        "K": walk @ walk.T * TAU0,  # random walk with steps of variance τ0
     }
 
 
@@ -70,7 +70,7 @@ def test_mixture_and_ramp(rate_covariances):
     c = rate_covariances
     terms = ("Q", "N", "K", "R")
     theta = np.array([0.5, 0.3, 2.0, 0.49])
-    mean = 0.7 * np.arange(N_SAMPLES) * TAU0          # R = 0.7: a deterministic ramp
+    mean = 0.7 * np.arange(N_SAMPLES) * TAU0  # R = 0.7: a deterministic ramp
     want = _exact(0.5 * c["Q"] + 0.3 * c["N"] + 2.0 * c["K"], mean)
     s, t = covariance_blocks(M, N_SAMPLES, FS, terms)
     assert _rel_err(assemble(s, t, theta, terms), want) < 3e-4

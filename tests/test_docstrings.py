@@ -20,6 +20,16 @@ def test_docstring_examples(name):
 
 
 def test_the_public_entry_points_have_examples():
-    for name in ("avar", "davar", "tau_grid", "fit", "refine", "confidence_intervals", "identify_alpha",
-                 "information_bound", "simulate", "default_record"):
+    for name in (
+        "avar",
+        "davar",
+        "tau_grid",
+        "fit",
+        "refine",
+        "confidence_intervals",
+        "identify_alpha",
+        "information_bound",
+        "simulate",
+        "default_record",
+    ):
         assert ">>>" in (getattr(allanite, name).__doc__ or ""), f"allanite.{name} has no example"

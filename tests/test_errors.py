@@ -34,13 +34,13 @@ def test_error_hierarchy():
 # The samples
 # --------------------------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
 @pytest.mark.parametrize("input", ["rate", "increment", "angle"])
 def test_non_finite_sample_1d(y, bad, input):
     y = y.copy()
     y[17] = bad
-    for call in (lambda: allanite.avar(y, 1.0, input=input),
-                 lambda: allanite.davar(y, 1.0, window=20, input=input)):
+    for call in (lambda: allanite.avar(y, 1.0, input=input), lambda: allanite.davar(y, 1.0, window=20, input=input)):
         with pytest.raises(InputError, match=rf"non-finite value \({re.escape(str(bad))}\) at sample 17;"):
             call()
 
@@ -56,13 +56,16 @@ def test_non_finite_sample_2d_names_sample_and_axis():
         allanite.davar(x, 1.0, window=10)
 
 
-@pytest.mark.parametrize("x, msg", [
-    (np.array([]), r"record has 0 samples; at least 2 are needed"),
-    ([], r"record has 0 samples; at least 2 are needed"),
-    (np.zeros((0, 2)), r"record has 0 samples; at least 2 are needed"),
-    ([1.0], r"record has 1 samples; at least 2 are needed"),
-    (np.zeros((1, 3)), r"record has 1 samples; at least 2 are needed"),
-])
+@pytest.mark.parametrize(
+    "x, msg",
+    [
+        (np.array([]), r"record has 0 samples; at least 2 are needed"),
+        ([], r"record has 0 samples; at least 2 are needed"),
+        (np.zeros((0, 2)), r"record has 0 samples; at least 2 are needed"),
+        ([1.0], r"record has 1 samples; at least 2 are needed"),
+        (np.zeros((1, 3)), r"record has 1 samples; at least 2 are needed"),
+    ],
+)
 def test_too_short_records(x, msg):
     with pytest.raises(InputError, match=msg):
         allanite.avar(x, 1.0)
@@ -81,12 +84,15 @@ def test_angle_input_needs_three_points():
     assert allanite.avar([1.0, 2.0], 1.0).avar[0] == pytest.approx(0.5)
 
 
-@pytest.mark.parametrize("x, msg", [
-    (np.zeros((10, 2, 2)), r"1-D \(samples,\) or 2-D \(samples, axes\), got 3-D with shape \(10, 2, 2\)"),
-    (np.float64(3.0), r"got 0-D with shape \(\)"),
-    (3.0, r"got 0-D"),
-    (np.zeros((10, 0)), r"samples have shape \(10, 0\): at least one axis is needed"),
-])
+@pytest.mark.parametrize(
+    "x, msg",
+    [
+        (np.zeros((10, 2, 2)), r"1-D \(samples,\) or 2-D \(samples, axes\), got 3-D with shape \(10, 2, 2\)"),
+        (np.float64(3.0), r"got 0-D with shape \(\)"),
+        (3.0, r"got 0-D"),
+        (np.zeros((10, 0)), r"samples have shape \(10, 0\): at least one axis is needed"),
+    ],
+)
 def test_bad_shapes(x, msg):
     with pytest.raises(InputError, match=msg):
         allanite.avar(x, 1.0)
@@ -94,17 +100,20 @@ def test_bad_shapes(x, msg):
         allanite.davar(x, 1.0, window=2)
 
 
-@pytest.mark.parametrize("x, kind", [
-    (np.arange(10) + 0j, r"complex128 \('c' kind\)"),
-    (np.arange(10) > 4, r"bool \('bool' kind\)"),
-    (np.array(["1", "2", "3"]), r"<U1 \('U' kind\)"),
-    (np.array([b"1", b"2"]), r"\|S1 \('S' kind\)"),
-    (np.array([1.0, 2.0, 3.0], dtype=object), r"object \('O' kind\)"),
-    ([1, "2", 3.0], r"<U\d+ \('U' kind\)"),
-    (None, r"object \('O' kind\)"),
-    (np.arange(5).astype("datetime64[s]"), r"datetime64\[s\] \('M' kind\)"),
-    ([10**400, 1, 2], r"object"),
-])
+@pytest.mark.parametrize(
+    "x, kind",
+    [
+        (np.arange(10) + 0j, r"complex128 \('c' kind\)"),
+        (np.arange(10) > 4, r"bool \('bool' kind\)"),
+        (np.array(["1", "2", "3"]), r"<U1 \('U' kind\)"),
+        (np.array([b"1", b"2"]), r"\|S1 \('S' kind\)"),
+        (np.array([1.0, 2.0, 3.0], dtype=object), r"object \('O' kind\)"),
+        ([1, "2", 3.0], r"<U\d+ \('U' kind\)"),
+        (None, r"object \('O' kind\)"),
+        (np.arange(5).astype("datetime64[s]"), r"datetime64\[s\] \('M' kind\)"),
+        ([10**400, 1, 2], r"object"),
+    ],
+)
 def test_non_real_dtypes(x, kind):
     with pytest.raises(InputError, match=r"samples must be real numbers \(integer or float dtype\), got dtype " + kind):
         allanite.avar(x, 1.0)
@@ -119,10 +128,23 @@ def test_ragged_input():
 # fs, window, hop
 # --------------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("fs, shown", [
-    (0, "0.0"), (0.0, "0.0"), (-1.0, "-1.0"), (-np.inf, "-inf"), (np.nan, "nan"), (np.inf, "inf"),
-    ("100", "'100'"), (None, "None"), (True, "True"), (1 + 0j, r"\(1\+0j\)"), (np.array([1.0]), r"array\(\[1\.\]\)"),
-])
+
+@pytest.mark.parametrize(
+    "fs, shown",
+    [
+        (0, "0.0"),
+        (0.0, "0.0"),
+        (-1.0, "-1.0"),
+        (-np.inf, "-inf"),
+        (np.nan, "nan"),
+        (np.inf, "inf"),
+        ("100", "'100'"),
+        (None, "None"),
+        (True, "True"),
+        (1 + 0j, r"\(1\+0j\)"),
+        (np.array([1.0]), r"array\(\[1\.\]\)"),
+    ],
+)
 def test_bad_fs(y, fs, shown):
     msg = rf"fs must be a positive finite number of samples per second, got {shown}"
     with pytest.raises(ParameterError, match=msg):
@@ -148,15 +170,35 @@ def test_window_below_two(y, window, shown):
         allanite.davar(y, 1.0, window=window)
 
 
-@pytest.mark.parametrize("window, shown", [(10.5, "10.5"), ("10", "'10'"), (None, "None"), (True, "True"),
-                                           (np.nan, "nan"), (np.inf, "inf"), ([10], r"\[10\]")])
+@pytest.mark.parametrize(
+    "window, shown",
+    [
+        (10.5, "10.5"),
+        ("10", "'10'"),
+        (None, "None"),
+        (True, "True"),
+        (np.nan, "nan"),
+        (np.inf, "inf"),
+        ([10], r"\[10\]"),
+    ],
+)
 def test_window_not_an_integer(y, window, shown):
     with pytest.raises(ParameterError, match=rf"window must be an integer ≥ 2, got {shown}"):
         allanite.davar(y, 1.0, window=window)
 
 
-@pytest.mark.parametrize("hop, shown", [(0, "0"), (-1, "-1"), (1.5, "1.5"), ("2", "'2'"), (None, "None"),
-                                        (False, "False"), (np.float64(0.5), r"(np\.float64\()?0\.5")])
+@pytest.mark.parametrize(
+    "hop, shown",
+    [
+        (0, "0"),
+        (-1, "-1"),
+        (1.5, "1.5"),
+        ("2", "'2'"),
+        (None, "None"),
+        (False, "False"),
+        (np.float64(0.5), r"(np\.float64\()?0\.5"),
+    ],
+)
 def test_bad_hop(y, hop, shown):
     with pytest.raises(ParameterError, match=rf"hop must be an integer ≥ 1, got {shown}"):
         allanite.davar(y, 1.0, window=10, hop=hop)
@@ -170,8 +212,11 @@ def test_integral_floats_are_accepted_for_counts(y):
 
 
 def test_window_too_short_for_the_taus(y):
-    with pytest.raises(ParameterError, match=r"taus\[0\] = 3 s \(m = 3\) is too long for 5 samples: "
-                                             r"the largest τ is 2 s \(m = 2\)"):
+    with pytest.raises(
+        ParameterError,
+        match=r"taus\[0\] = 3 s \(m = 3\) is too long for 5 samples: "
+        r"the largest τ is 2 s \(m = 2\)",
+    ):
         allanite.davar(y, 1.0, window=5, taus=[3.0])
     with pytest.raises(ParameterError, match=r"taus\[0\] = 2 s \(m = 2\) is too long for 2 samples"):
         allanite.davar(y, 1.0, window=2, taus=[2.0])
@@ -183,24 +228,31 @@ def test_window_too_short_for_the_taus(y):
 # τ
 # --------------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("taus, msg", [
-    ([1.0, -2.0], r"taus\[1\] = .*-2\.0.* s: every τ must be a positive finite number of seconds"),
-    ([0.0], r"taus\[0\] = .*0\.0.* s: every τ must be a positive finite number of seconds"),
-    ([1.0, np.nan], r"taus\[1\] = .*nan.* s: every τ must be a positive finite number"),
-    ([np.inf], r"taus\[0\] = .*inf.* s: every τ must be a positive finite number"),
-    ([0.04], r"taus\[0\] = 0\.04 s is shorter than one sample \(1/fs = 0\.1 s\)"),
-    ([1.0, 5.1], r"taus\[1\] = 5\.1 s \(m = 51\) is too long for 100 samples: the largest τ is 5 s \(m = 50\)"),
-    ([0.21, 0.24], r"taus\[0\] = 0\.21 s and taus\[1\] = 0\.24 s map to m = 2 and 2; τ must map to strictly increasing"),
-    ([0.4, 0.2], r"taus\[0\] = 0\.4 s and taus\[1\] = 0\.2 s map to m = 4 and 2"),
-    ([], r"taus must be a non-empty 1-D sequence of τ in seconds, got shape \(0,\)"),
-    ([[0.1, 0.2]], r"got shape \(1, 2\)"),
-    (["a"], r"taus must be a grid name \(all, octave, decade, exp\) or a sequence of τ in seconds"),
-    ([1 + 1j], r"taus must be a grid name"),
-    ({0.1, 0.2}, r"taus must be a grid name"),
-    ("linear", r"unknown τ grid 'linear'; allowed: 'all', 'octave', 'decade', 'exp'"),
-    ("Octave", r"unknown τ grid 'Octave'"),
-    ("", r"unknown τ grid ''"),
-])
+
+@pytest.mark.parametrize(
+    "taus, msg",
+    [
+        ([1.0, -2.0], r"taus\[1\] = .*-2\.0.* s: every τ must be a positive finite number of seconds"),
+        ([0.0], r"taus\[0\] = .*0\.0.* s: every τ must be a positive finite number of seconds"),
+        ([1.0, np.nan], r"taus\[1\] = .*nan.* s: every τ must be a positive finite number"),
+        ([np.inf], r"taus\[0\] = .*inf.* s: every τ must be a positive finite number"),
+        ([0.04], r"taus\[0\] = 0\.04 s is shorter than one sample \(1/fs = 0\.1 s\)"),
+        ([1.0, 5.1], r"taus\[1\] = 5\.1 s \(m = 51\) is too long for 100 samples: the largest τ is 5 s \(m = 50\)"),
+        (
+            [0.21, 0.24],
+            r"taus\[0\] = 0\.21 s and taus\[1\] = 0\.24 s map to m = 2 and 2; τ must map to strictly increasing",
+        ),
+        ([0.4, 0.2], r"taus\[0\] = 0\.4 s and taus\[1\] = 0\.2 s map to m = 4 and 2"),
+        ([], r"taus must be a non-empty 1-D sequence of τ in seconds, got shape \(0,\)"),
+        ([[0.1, 0.2]], r"got shape \(1, 2\)"),
+        (["a"], r"taus must be a grid name \(all, octave, decade, exp\) or a sequence of τ in seconds"),
+        ([1 + 1j], r"taus must be a grid name"),
+        ({0.1, 0.2}, r"taus must be a grid name"),
+        ("linear", r"unknown τ grid 'linear'; allowed: 'all', 'octave', 'decade', 'exp'"),
+        ("Octave", r"unknown τ grid 'Octave'"),
+        ("", r"unknown τ grid ''"),
+    ],
+)
 def test_bad_taus(y, taus, msg):
     with pytest.raises(ParameterError, match=msg):
         allanite.avar(y, 10.0, taus=taus)
@@ -211,6 +263,7 @@ def test_bad_taus(y, taus, msg):
 # --------------------------------------------------------------------------------------------------
 # Choices
 # --------------------------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("value", ["mdev", "OAVAR", "", None, b"oavar", 1])
 def test_unknown_estimator(y, value):
@@ -248,25 +301,29 @@ def test_bad_workers(y, workers, shown):
 # tau_grid options
 # --------------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("kwargs, msg", [
-    (dict(kind="exp", growth=1.5, points=10), r"give either growth or points for the 'exp' grid, not both"),
-    (dict(kind="exp", growth=1.0), r"growth must be a finite factor > 1, got 1\b"),
-    (dict(kind="exp", growth=0.5), r"growth must be a finite factor > 1, got 0\.5"),
-    (dict(kind="exp", growth=-2), r"growth must be a finite factor > 1, got -2"),
-    (dict(kind="exp", growth=math.inf), r"growth must be a finite factor > 1, got inf"),
-    (dict(kind="exp", growth=math.nan), r"growth must be a finite factor > 1, got nan"),
-    (dict(kind="octave", growth=2.0), r"growth, points and tau_min apply to the 'exp' grid only, not 'octave'"),
-    (dict(kind="all", points=5), r"apply to the 'exp' grid only, not 'all'"),
-    (dict(kind="decade", tau_min=2.0), r"apply to the 'exp' grid only, not 'decade'"),
-    (dict(kind="exp", points=1), r"points must be an integer ≥ 2, got 1"),
-    (dict(kind="exp", points=2.5), r"points must be an integer ≥ 2, got 2\.5"),
-    (dict(kind="exp", tau_min=0.0), r"tau_min = 0 s maps to m = 0; allowed is 1 ≤ m ≤ 111"),
-    (dict(kind="exp", tau_min=500.0), r"tau_min = 500 s maps to m = 500; allowed is 1 ≤ m ≤ 111"),
-    (dict(kind="exp", m_max=501), r"m_max = 501 exceeds 500, the largest m for 1000 samples"),
-    (dict(kind="all", m_max=0), r"m_max must be an integer ≥ 1, got 0"),
-    (dict(kind="bad"), r"unknown τ grid 'bad'"),
-    (dict(kind=None), r"kind must be one of \('all', 'octave', 'decade', 'exp'\), got None"),
-])
+
+@pytest.mark.parametrize(
+    "kwargs, msg",
+    [
+        (dict(kind="exp", growth=1.5, points=10), r"give either growth or points for the 'exp' grid, not both"),
+        (dict(kind="exp", growth=1.0), r"growth must be a finite factor > 1, got 1\b"),
+        (dict(kind="exp", growth=0.5), r"growth must be a finite factor > 1, got 0\.5"),
+        (dict(kind="exp", growth=-2), r"growth must be a finite factor > 1, got -2"),
+        (dict(kind="exp", growth=math.inf), r"growth must be a finite factor > 1, got inf"),
+        (dict(kind="exp", growth=math.nan), r"growth must be a finite factor > 1, got nan"),
+        (dict(kind="octave", growth=2.0), r"growth, points and tau_min apply to the 'exp' grid only, not 'octave'"),
+        (dict(kind="all", points=5), r"apply to the 'exp' grid only, not 'all'"),
+        (dict(kind="decade", tau_min=2.0), r"apply to the 'exp' grid only, not 'decade'"),
+        (dict(kind="exp", points=1), r"points must be an integer ≥ 2, got 1"),
+        (dict(kind="exp", points=2.5), r"points must be an integer ≥ 2, got 2\.5"),
+        (dict(kind="exp", tau_min=0.0), r"tau_min = 0 s maps to m = 0; allowed is 1 ≤ m ≤ 111"),
+        (dict(kind="exp", tau_min=500.0), r"tau_min = 500 s maps to m = 500; allowed is 1 ≤ m ≤ 111"),
+        (dict(kind="exp", m_max=501), r"m_max = 501 exceeds 500, the largest m for 1000 samples"),
+        (dict(kind="all", m_max=0), r"m_max must be an integer ≥ 1, got 0"),
+        (dict(kind="bad"), r"unknown τ grid 'bad'"),
+        (dict(kind=None), r"kind must be one of \('all', 'octave', 'decade', 'exp'\), got None"),
+    ],
+)
 def test_tau_grid_option_misuse(kwargs, msg):
     with pytest.raises(ParameterError, match=msg):
         allanite.tau_grid(1000, 1.0, **kwargs)
@@ -282,8 +339,10 @@ def test_tau_grid_bad_n(n, shown):
 # Memory budget and environment
 # --------------------------------------------------------------------------------------------------
 
-_BUDGET_RE = re.compile(r"the output would take (\d+\.\d\d) GiB \((\d+) axes × (\d+) τ × (\d+) windows × 8 bytes\), "
-                        r"over the memory budget of (\d+\.\d\d) GiB; use hop ≥ (\d+), fewer τ")
+_BUDGET_RE = re.compile(
+    r"the output would take (\d+\.\d\d) GiB \((\d+) axes × (\d+) τ × (\d+) windows × 8 bytes\), "
+    r"over the memory budget of (\d+\.\d\d) GiB; use hop ≥ (\d+), fewer τ"
+)
 
 
 def _budget_error(x, window, hop, max_memory, taus="exp"):
@@ -314,8 +373,14 @@ def test_memory_budget_error_and_its_suggested_hop():
 
 
 @settings(max_examples=40, deadline=None)
-@given(n=st.integers(50, 5_000), window=st.integers(2, 50), hop=st.integers(1, 5),
-       n_tau=st.integers(1, 10), windows_fitting=st.integers(1, 400), extra=st.integers(0, 7))
+@given(
+    n=st.integers(50, 5_000),
+    window=st.integers(2, 50),
+    hop=st.integers(1, 5),
+    n_tau=st.integers(1, 10),
+    windows_fitting=st.integers(1, 400),
+    extra=st.integers(0, 7),
+)
 def test_suggested_hop_always_fits(n, window, hop, n_tau, windows_fitting, extra):
     """For any budget that holds at least one window's output, the suggested hop fits."""
     n_tau = min(n_tau, window // 2)
@@ -332,7 +397,7 @@ def test_suggested_hop_always_fits(n, window, hop, n_tau, windows_fitting, extra
 
 
 def test_max_memory_env_and_argument(monkeypatch, y):
-    monkeypatch.setenv("ALLANITE_MAX_MEMORY", "1000")   # 1000 bytes: 51 windows × 5 τ × 8 = 2040 > 1000
+    monkeypatch.setenv("ALLANITE_MAX_MEMORY", "1000")  # 1000 bytes: 51 windows × 5 τ × 8 = 2040 > 1000
     with pytest.raises(MemoryBudgetError, match=r"over the memory budget"):
         allanite.davar(y, 1.0, window=50, taus="octave")
     assert allanite.davar(y, 1.0, window=50, taus="octave", max_memory=10_000).avar.shape == (5, 51)
@@ -340,12 +405,15 @@ def test_max_memory_env_and_argument(monkeypatch, y):
     assert allanite.davar(y, 1.0, window=50, taus="octave").avar.shape == (5, 51)
 
 
-@pytest.mark.parametrize("value, msg", [
-    ("abc", r"ALLANITE_NUM_THREADS='abc' must be a positive integer"),
-    ("0", r"ALLANITE_NUM_THREADS='0' must be an integer from 1 to 4096"),
-    ("-2", r"ALLANITE_NUM_THREADS='-2' must be an integer from 1 to 4096"),
-    ("1.5", r"ALLANITE_NUM_THREADS='1\.5' must be a positive integer"),
-])
+@pytest.mark.parametrize(
+    "value, msg",
+    [
+        ("abc", r"ALLANITE_NUM_THREADS='abc' must be a positive integer"),
+        ("0", r"ALLANITE_NUM_THREADS='0' must be an integer from 1 to 4096"),
+        ("-2", r"ALLANITE_NUM_THREADS='-2' must be an integer from 1 to 4096"),
+        ("1.5", r"ALLANITE_NUM_THREADS='1\.5' must be a positive integer"),
+    ],
+)
 def test_bad_num_threads_env(monkeypatch, y, value, msg):
     monkeypatch.setenv("ALLANITE_NUM_THREADS", value)
     with pytest.raises(ParameterError, match=msg):
@@ -355,14 +423,17 @@ def test_bad_num_threads_env(monkeypatch, y, value, msg):
     assert allanite.avar(y, 1.0, workers=1).avar.size > 0  # an explicit value does not read the variable
 
 
-@pytest.mark.parametrize("value, msg", [
-    ("lots", r"ALLANITE_MAX_MEMORY='lots' must be a positive number of bytes"),
-    ("2GB", r"ALLANITE_MAX_MEMORY='2GB' must be a positive number of bytes"),
-    ("0", r"ALLANITE_MAX_MEMORY='0' must be a positive number of bytes, got 0\.0"),
-    ("-5", r"ALLANITE_MAX_MEMORY='-5' must be a positive number of bytes, got -5\.0"),
-    ("nan", r"ALLANITE_MAX_MEMORY='nan' must be a positive number of bytes, got nan"),
-    ("inf", r"ALLANITE_MAX_MEMORY='inf' must be a positive number of bytes, got inf"),
-])
+@pytest.mark.parametrize(
+    "value, msg",
+    [
+        ("lots", r"ALLANITE_MAX_MEMORY='lots' must be a positive number of bytes"),
+        ("2GB", r"ALLANITE_MAX_MEMORY='2GB' must be a positive number of bytes"),
+        ("0", r"ALLANITE_MAX_MEMORY='0' must be a positive number of bytes, got 0\.0"),
+        ("-5", r"ALLANITE_MAX_MEMORY='-5' must be a positive number of bytes, got -5\.0"),
+        ("nan", r"ALLANITE_MAX_MEMORY='nan' must be a positive number of bytes, got nan"),
+        ("inf", r"ALLANITE_MAX_MEMORY='inf' must be a positive number of bytes, got inf"),
+    ],
+)
 def test_bad_max_memory_env(monkeypatch, y, value, msg):
     monkeypatch.setenv("ALLANITE_MAX_MEMORY", value)
     with pytest.raises(ParameterError, match=msg):
@@ -370,8 +441,10 @@ def test_bad_max_memory_env(monkeypatch, y, value, msg):
     assert allanite.davar(y, 1.0, window=10, max_memory=1e9).avar.size > 0
 
 
-@pytest.mark.parametrize("value, shown", [(0, "0"), (-1, "-1"), (math.nan, "nan"), (math.inf, "inf"),
-                                          ("1e9", "'1e9'"), (True, "True"), (None, None)])
+@pytest.mark.parametrize(
+    "value, shown",
+    [(0, "0"), (-1, "-1"), (math.nan, "nan"), (math.inf, "inf"), ("1e9", "'1e9'"), (True, "True"), (None, None)],
+)
 def test_bad_max_memory_argument(y, value, shown):
     if value is None:
         assert allanite.davar(y, 1.0, window=10, max_memory=None).avar.size > 0
@@ -383,6 +456,7 @@ def test_bad_max_memory_argument(y, value, shown):
 # --------------------------------------------------------------------------------------------------
 # Fuzz: either a consistent result or an AllaniteError, never anything else
 # --------------------------------------------------------------------------------------------------
+
 
 def _mostly(draw, good, bad, p_good=0.93):
     """Draw from ``good`` most of the time, so that many calls succeed, else from ``bad``."""
@@ -423,19 +497,27 @@ def _calls(draw):
     good_taus = _grid_names
     if isinstance(fs, (int, float, np.floating)) and math.isfinite(fs) and fs > 0:
         # explicit τ that map to valid m for most records and windows: m/fs, m small
-        good_taus = st.one_of(_grid_names, st.lists(st.integers(1, max(1, n // 4)), min_size=1, max_size=4,
-                                                    unique=True).map(lambda ms: np.sort(ms) / float(fs)))
-    kw = dict(fs=fs,
-              input=_mostly(draw, st.sampled_from(["rate", "increment", "angle"]), st.just("phase")),
-              taus=_mostly(draw, good_taus, _bad_taus),
-              estimator=_mostly(draw, st.sampled_from(["oavar", "avar"]), st.just("x")),
-              workers=_mostly(draw, st.sampled_from([None, 1, 2]), st.sampled_from([0, -1, 1.5])))
+        good_taus = st.one_of(
+            _grid_names,
+            st.lists(st.integers(1, max(1, n // 4)), min_size=1, max_size=4, unique=True).map(
+                lambda ms: np.sort(ms) / float(fs)
+            ),
+        )
+    kw = dict(
+        fs=fs,
+        input=_mostly(draw, st.sampled_from(["rate", "increment", "angle"]), st.just("phase")),
+        taus=_mostly(draw, good_taus, _bad_taus),
+        estimator=_mostly(draw, st.sampled_from(["oavar", "avar"]), st.just("x")),
+        workers=_mostly(draw, st.sampled_from([None, 1, 2]), st.sampled_from([0, -1, 1.5])),
+    )
     dynamic = draw(st.booleans())
     if dynamic:
-        kw.update(window=_mostly(draw, st.integers(max(2, n // 2), max(2, n)), _bad_count),
-                  hop=_mostly(draw, st.integers(1, max(1, n + 3)), _bad_count),
-                  method=_mostly(draw, st.sampled_from(["fast", "naive"]), st.just("?")),
-                  max_memory=_mostly(draw, st.sampled_from([None, 1e9]), st.sampled_from([1, 100, 0, -1, math.nan])))
+        kw.update(
+            window=_mostly(draw, st.integers(max(2, n // 2), max(2, n)), _bad_count),
+            hop=_mostly(draw, st.integers(1, max(1, n + 3)), _bad_count),
+            method=_mostly(draw, st.sampled_from(["fast", "naive"]), st.just("?")),
+            max_memory=_mostly(draw, st.sampled_from([None, 1e9]), st.sampled_from([1, 100, 0, -1, math.nan])),
+        )
     return dynamic, x, kw
 
 
@@ -475,6 +557,7 @@ def test_fuzz_only_allanite_errors(call):
 # Known gaps: inputs that escape as something other than an AllaniteError (library bugs)
 # --------------------------------------------------------------------------------------------------
 
+
 def _gap(call, reason):
     return pytest.param(call, marks=pytest.mark.xfail(strict=True, raises=AssertionError, reason=reason))
 
@@ -492,17 +575,29 @@ def _expect_allanite_error(call):
 _Y = np.linspace(0.0, 1.0, 100) ** 2
 
 
-@pytest.mark.parametrize("call", [
-    lambda: allanite.avar(_Y, 1.0, workers=2**64),
-    lambda: allanite.tau_grid(1000, 1.0, "exp", tau_min=math.nan),
-    lambda: allanite.tau_grid(1000, 1.0, "exp", tau_min=math.inf),
-    lambda: allanite.tau_grid(1000, 1.0, "exp", tau_min=[2.0]),
-    lambda: allanite.tau_grid(1000, 1.0, "exp", tau_min="2"),
-    lambda: allanite.tau_grid(1000, 1.0, "exp", growth="abc"),
-    lambda: allanite.tau_grid(1000, 1.0, "exp", growth="2"),
-    lambda: allanite.avar(_Y, 1e-320),
-], ids=["workers=2**64", "tau_min=nan", "tau_min=inf", "tau_min=list", "tau_min=str", "growth=str",
-        "growth=numeric-str", "fs=subnormal"])
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: allanite.avar(_Y, 1.0, workers=2**64),
+        lambda: allanite.tau_grid(1000, 1.0, "exp", tau_min=math.nan),
+        lambda: allanite.tau_grid(1000, 1.0, "exp", tau_min=math.inf),
+        lambda: allanite.tau_grid(1000, 1.0, "exp", tau_min=[2.0]),
+        lambda: allanite.tau_grid(1000, 1.0, "exp", tau_min="2"),
+        lambda: allanite.tau_grid(1000, 1.0, "exp", growth="abc"),
+        lambda: allanite.tau_grid(1000, 1.0, "exp", growth="2"),
+        lambda: allanite.avar(_Y, 1e-320),
+    ],
+    ids=[
+        "workers=2**64",
+        "tau_min=nan",
+        "tau_min=inf",
+        "tau_min=list",
+        "tau_min=str",
+        "growth=str",
+        "growth=numeric-str",
+        "fs=subnormal",
+    ],
+)
 def test_formerly_escaping_inputs_raise_allanite_errors(call):
     _expect_allanite_error(call)
 

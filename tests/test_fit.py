@@ -1,6 +1,5 @@
 """The noise-model fit: recovery of known terms, units, dynamic series, bad input."""
 
-import sys
 
 import numpy as np
 import pytest
@@ -69,7 +68,7 @@ def test_information_bound():
 
 def test_fit_quality_and_readoffs(fits):
     for f in fits:
-        assert f.method == "gls"   # overlapping estimates: the exact covariance across τ
+        assert f.method == "gls"  # overlapping estimates: the exact covariance across τ
         assert 0.2 < f.chi2_dof < 3.0
         assert f.dof == f.tau.size - 4
         assert np.allclose(f.model, sum(f.components.values()))
@@ -105,6 +104,7 @@ def test_curve_matches_the_closed_forms():
 
 def test_rate_random_walk_column_is_the_sampled_walk():
     import allanite.model.fitting as fit_mod
+
     m = np.array([1.0, 2.0, 100.0])
     col = fit_mod.design_matrix(m / FS, m, FS, ("K",))[:, 0]
     # exact sampled-walk AVAR: K²τ0(2m²+1)/(6m) — 1.5× K²τ/3 at m = 1, → K²τ/3 for large m
@@ -166,7 +166,11 @@ def test_tau_range_auto_drops_the_filtered_short_tau(filtered_record):
     assert 0.04 <= auto.tau[0] <= 64 / FS and auto.chi2_dof <= 3.0
     assert auto.coefficients["N"].value == pytest.approx(2e-3, rel=0.05)
     assert auto.coefficients["B"].value == pytest.approx(1e-3, rel=0.25)
-    assert len(auto.notes) == 1 and f"τ ≥ {auto.tau[0]:.4g} s" in auto.notes[0] and f"χ²/dof {whole.chi2_dof:.3g}," in auto.notes[0]
+    assert (
+        len(auto.notes) == 1
+        and f"τ ≥ {auto.tau[0]:.4g} s" in auto.notes[0]
+        and f"χ²/dof {whole.chi2_dof:.3g}," in auto.notes[0]
+    )
     # the same cut by hand gives the same fit
     hand = allanite.fit(r, terms=terms, tau_range=(auto.tau[0], None))
     assert hand.coefficients["N"].value == auto.coefficients["N"].value

@@ -34,10 +34,10 @@ import allanite
 from allanite.results import AllanResult
 
 FS = 100.0
-LSB = 0.05                          # °/s
-TAU_MIN = 0.16                      # s: the short-τ cut where the model starts to fit
+LSB = 0.05  # °/s
+TAU_MIN = 0.16  # s: the short-τ cut where the model starts to fit
 CUT_TAUS = [2**k / FS for k in range(19) if 2**k / FS >= TAU_MIN - 1e-12]
-Q_LSB = LSB * (1.0 / FS) / math.sqrt(12.0)    # 1.44e-4 °, angle quantization of one LSB·τ0
+Q_LSB = LSB * (1.0 / FS) / math.sqrt(12.0)  # 1.44e-4 °, angle quantization of one LSB·τ0
 NAVCHIP_PRINTED = {"N": 5.945877e-05, "Q": 7.208553e-06, "K": 3.062325e-05}
 
 
@@ -64,8 +64,10 @@ def adis(adis_dir):
     runs = []
     for i, path in enumerate(sorted(adis_dir.glob("adis16405_run*_100Hz.csv.gz"))):
         y = allanite.read_log(path, fs=100, columns=["gyro_x", "gyro_y", "gyro_z"], unit="deg/s").data
-        run = {"name": path.name,
-               "cut": allanite.fit(allanite.avar(y, FS, taus=CUT_TAUS), terms=("N", "B", "K", "R"), unit="deg/s")}
+        run = {
+            "name": path.name,
+            "cut": allanite.fit(allanite.avar(y, FS, taus=CUT_TAUS), terms=("N", "B", "K", "R"), unit="deg/s"),
+        }
         if i == 0:
             run["full"] = allanite.fit(allanite.avar(y, FS), unit="deg/s")
             run["lsb_multiple"] = bool(np.allclose(y / LSB, np.round(y / LSB), rtol=0, atol=1e-6))
@@ -88,8 +90,7 @@ def load_curve(path: Path) -> dict:
     for ch, v in chans.items():
         a = np.array(v)
         m = np.round(a[:, 0] * fs).astype(np.int64)
-        out[ch] = AllanResult(tau=m / fs, avar=a[:, 1], n=n + 1 - 2 * m, m=m, estimator="oavar", fs=fs,
-                              n_samples=n)
+        out[ch] = AllanResult(tau=m / fs, avar=a[:, 1], n=n + 1 - 2 * m, m=m, estimator="oavar", fs=fs, n_samples=n)
     return out
 
 
@@ -138,8 +139,15 @@ def test_avar_curve_of_run1_gives_run1s_coefficients(adis, curves_dir):
     for k, ch in enumerate(("Gyro. X", "Gyro. Y", "Gyro. Z")):
         r = curves[ch]
         keep = r.tau >= TAU_MIN - 1e-12
-        rc = AllanResult(tau=r.tau[keep], avar=r.avar[keep], n=r.n[keep], m=r.m[keep], estimator="oavar",
-                         fs=r.fs, n_samples=r.n_samples)
+        rc = AllanResult(
+            tau=r.tau[keep],
+            avar=r.avar[keep],
+            n=r.n[keep],
+            m=r.m[keep],
+            estimator="oavar",
+            fs=r.fs,
+            n_samples=r.n_samples,
+        )
         f = allanite.fit(rc, terms=("N", "B", "K", "R"), unit="deg/s")
         raw = adis[0]["cut"][k]
         assert np.array_equal(f.tau, raw.tau)
@@ -160,12 +168,14 @@ def test_navchip_vignette_values_and_allanite_fit(curves_dir):
 
     # avlr(navchip_av, qn_gyro = 1:4, wn_gyro = 6:8, rw_gyro = 10:13): slope read-offs, geometric mean
     # pooled over the three axes (SMAC-Group/avar R/avlr.R)
-    avlr = {"N": pooled(range(6, 9), lambda ad, t: np.log(ad) + np.log(t) / 2),
-            "Q": pooled(range(1, 5), lambda ad, t: np.log(ad) + np.log(t)) / math.sqrt(3.0),
-            "K": math.sqrt(3.0) * pooled(range(10, 14), lambda ad, t: np.log(ad) - np.log(t) / 2)}
+    avlr = {
+        "N": pooled(range(6, 9), lambda ad, t: np.log(ad) + np.log(t) / 2),
+        "Q": pooled(range(1, 5), lambda ad, t: np.log(ad) + np.log(t)) / math.sqrt(3.0),
+        "K": math.sqrt(3.0) * pooled(range(10, 14), lambda ad, t: np.log(ad) - np.log(t) / 2),
+    }
     for term, v in NAVCHIP_PRINTED.items():
         assert avlr[term] == pytest.approx(v, rel=1e-6)
-    rows = np.arange(5, 8)   # avlr's wn_gyro = 6:8, τ = 0.256–1.024 s
+    rows = np.arange(5, 8)  # avlr's wn_gyro = 6:8, τ = 0.256–1.024 s
     for g in gyros:
         f = allanite.fit(g)
         for term in ("N", "Q"):

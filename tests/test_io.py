@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 
 import allanite
-import allanite.io as aio
 from allanite import AllaniteError, InputError, Log, ParameterError, read_log
 from allanite.io import Gap, MissingDependencyError
 
@@ -30,8 +29,7 @@ def record(rng):
     return t, x
 
 
-def write_text(path, t, x, *, delim=",", header="t,gx,gy,gz", comments=("# test log",), newline="\n",
-               compress=False):
+def write_text(path, t, x, *, delim=",", header="t,gx,gy,gz", comments=("# test log",), newline="\n", compress=False):
     rows = []
     rows += list(comments)
     if header is not None:
@@ -57,13 +55,17 @@ def lines_file(tmp_path, name, lines):
 # Round trips
 # --------------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("name, delim, compress, newline", [
-    ("log.csv", ",", False, "\n"),
-    ("log.csv.gz", ",", True, "\n"),
-    ("log.tsv", "\t", False, "\n"),
-    ("log.txt", None, False, "\n"),       # whitespace
-    ("log.dat", ";", False, "\r\n"),      # semicolons, Windows line ends
-])
+
+@pytest.mark.parametrize(
+    "name, delim, compress, newline",
+    [
+        ("log.csv", ",", False, "\n"),
+        ("log.csv.gz", ",", True, "\n"),
+        ("log.tsv", "\t", False, "\n"),
+        ("log.txt", None, False, "\n"),  # whitespace
+        ("log.dat", ";", False, "\r\n"),  # semicolons, Windows line ends
+    ],
+)
 def test_text_round_trip_with_time_column(tmp_path, record, name, delim, compress, newline):
     t, x = record
     p = write_text(tmp_path / name, t, x, delim=delim, compress=compress, newline=newline)
@@ -71,7 +73,7 @@ def test_text_round_trip_with_time_column(tmp_path, record, name, delim, compres
     assert isinstance(log, Log)
     assert log.format == "text"
     assert log.data.dtype == np.float64 and log.data.shape == (N, 3)
-    np.testing.assert_array_equal(log.data, x)           # exact: repr round-trips float64
+    np.testing.assert_array_equal(log.data, x)  # exact: repr round-trips float64
     assert log.columns == ["gx", "gy", "gz"]
     assert log.fs == pytest.approx(FS, rel=1e-9)
     assert log.t0 == 12.5
@@ -98,17 +100,17 @@ def test_text_column_selection(tmp_path, record):
     one = read_log(p, time_column=0, columns="gy")
     assert one.data.shape == (N,) and one.columns == ["gy"]
     np.testing.assert_array_equal(one.data, x[:, 1])
-    two = read_log(p, fs=FS, columns=["gz", -3])                 # by name and by (negative) index
+    two = read_log(p, fs=FS, columns=["gz", -3])  # by name and by (negative) index
     np.testing.assert_array_equal(two.data, x[:, [2, 0]])
     assert two.columns == ["gz", "gx"]
-    lst = read_log(p, fs=FS, columns=["GY"])                     # case-insensitive fallback; a list → 2-D
+    lst = read_log(p, fs=FS, columns=["GY"])  # case-insensitive fallback; a list → 2-D
     assert lst.data.shape == (N, 1)
 
 
 def test_text_savetxt_comment_header_and_inline_comments(tmp_path, record):
     t, x = record
     p = tmp_path / "np.txt"
-    np.savetxt(p, np.c_[t, x], header="time gx gy gz", fmt="%.17g")   # writes "# time gx gy gz"
+    np.savetxt(p, np.c_[t, x], header="time gx gy gz", fmt="%.17g")  # writes "# time gx gy gz"
     log = read_log(p, time_column="time")
     assert log.columns == ["gx", "gy", "gz"]
     np.testing.assert_array_equal(log.data, x)
@@ -120,12 +122,13 @@ def test_text_savetxt_comment_header_and_inline_comments(tmp_path, record):
 def test_text_subset_with_commas_in_comments_and_quoted_header(tmp_path):
     # reading a subset of columns checks row lengths by counting delimiters; commas inside comments
     # must not turn into a false "ragged row"
-    p = lines_file(tmp_path, "q.csv", ['"t","a","b","label"', "0,1,2,3", "# x, y, z", "0.5,4,5,6 # note, with commas",
-                                       "1.0,7,8,9"])
+    p = lines_file(
+        tmp_path, "q.csv", ['"t","a","b","label"', "0,1,2,3", "# x, y, z", "0.5,4,5,6 # note, with commas", "1.0,7,8,9"]
+    )
     log = read_log(p, time_column="t", columns=["b"])
-    np.testing.assert_array_equal(log.data, [[2.0], [5.0], [8.0]])     # a list of columns gives 2-D
+    np.testing.assert_array_equal(log.data, [[2.0], [5.0], [8.0]])  # a list of columns gives 2-D
     assert log.fs == 2.0
-    w = lines_file(tmp_path, "w.txt", ["t  a   b", "0 1\t2", "1   3 4"])     # mixed whitespace
+    w = lines_file(tmp_path, "w.txt", ["t  a   b", "0 1\t2", "1   3 4"])  # mixed whitespace
     np.testing.assert_array_equal(read_log(w, time_column="t", columns="b").data, [2.0, 4.0])
     with pytest.raises(InputError, match=r"w2\.txt: line 3: ragged row — 4 fields \(separated by whitespace\)"):
         read_log(lines_file(tmp_path, "w2.txt", ["t a b", "0 1 2", "1 3 4 5"]), time_column="t", columns="b")
@@ -185,7 +188,7 @@ def test_npz_round_trip(tmp_path, record):
     np.testing.assert_array_equal(log.data, x)
     q = tmp_path / "two.npz"
     np.savez_compressed(q, gyro=x, acc=x * 2, t=t)
-    log = read_log(q, array="gyro", time_column="t")            # the time array lives beside the samples
+    log = read_log(q, array="gyro", time_column="t")  # the time array lives beside the samples
     np.testing.assert_array_equal(log.data, x)
     assert log.fs == pytest.approx(FS) and log.t0 == 12.5
     np.testing.assert_array_equal(read_log(q, array="acc", fs=FS, columns=[0]).data, x[:, :1] * 2)
@@ -200,8 +203,9 @@ def test_parquet_round_trip(tmp_path, record):
     pq = pytest.importorskip("pyarrow.parquet")
     t, x = record
     p = tmp_path / "log.parquet"
-    pq.write_table(pa.table({"t": t, "gx": x[:, 0], "gy": x[:, 1], "gz": x[:, 2].astype(np.float32),
-                             "label": ["a"] * N}), p)
+    pq.write_table(
+        pa.table({"t": t, "gx": x[:, 0], "gy": x[:, 1], "gz": x[:, 2].astype(np.float32), "label": ["a"] * N}), p
+    )
     log = read_log(p, time_column="t", columns=["gx", "gy", "gz"], unit="deg/h")
     assert log.format == "parquet"
     np.testing.assert_array_equal(log.data, np.c_[x[:, :2], x[:, 2].astype(np.float32)])
@@ -215,7 +219,9 @@ def test_parquet_round_trip(tmp_path, record):
     assert log.fs == pytest.approx(FS, rel=1e-12) and log.t0 == pytest.approx(1.7e9, abs=1e-6)
     with pytest.raises(InputError, match=r"log\.parquet: column 'label' has type string, not a number"):
         read_log(p, fs=FS, columns=["gx", "label"])
-    with pytest.raises(InputError, match=r"log\.parquet: no column named 'gw'; available: 't', 'gx', 'gy', 'gz', 'label'"):
+    with pytest.raises(
+        InputError, match=r"log\.parquet: no column named 'gw'; available: 't', 'gx', 'gy', 'gz', 'label'"
+    ):
         read_log(p, fs=FS, columns=["gw"])
     nul = tmp_path / "null.parquet"
     pq.write_table(pa.table({"w": pa.array([1.0, 2.0, None, 4.0])}), nul)
@@ -244,14 +250,22 @@ def _write_bag(path, ros, stamps_ns, w, topic="/imu/data"):
         con = writer.add_connection(topic, Imu.__msgtype__, typestore=ts)
         for i, ns in enumerate(stamps_ns):
             ns = int(ns)
-            header = Header(seq=i, stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id="imu") if ros == 1 \
+            header = (
+                Header(seq=i, stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id="imu")
+                if ros == 1
                 else Header(stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id="imu")
-            msg = Imu(header=header, orientation=Q(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=cov,
-                      angular_velocity=V(x=float(w[i, 0]), y=float(w[i, 1]), z=float(w[i, 2])),
-                      angular_velocity_covariance=cov,
-                      linear_acceleration=V(x=0.0, y=0.0, z=9.81), linear_acceleration_covariance=cov)
+            )
+            msg = Imu(
+                header=header,
+                orientation=Q(x=0.0, y=0.0, z=0.0, w=1.0),
+                orientation_covariance=cov,
+                angular_velocity=V(x=float(w[i, 0]), y=float(w[i, 1]), z=float(w[i, 2])),
+                angular_velocity_covariance=cov,
+                linear_acceleration=V(x=0.0, y=0.0, z=9.81),
+                linear_acceleration_covariance=cov,
+            )
             raw = ts.serialize_ros1(msg, Imu.__msgtype__) if ros == 1 else ts.serialize_cdr(msg, Imu.__msgtype__)
-            writer.write(con, ns + 1_000, raw)   # receive time a little after the stamp
+            writer.write(con, ns + 1_000, raw)  # receive time a little after the stamp
 
 
 @pytest.mark.parametrize("ros", [1, 2])
@@ -259,7 +273,7 @@ def test_ros_bag_round_trip(tmp_path, rng, ros):
     pytest.importorskip("rosbags", reason="rosbags is not installed (pip install 'allanite[ros]')")
     n = 60
     w = rng.normal(scale=0.01, size=(n, 3))
-    stamps = 1_700_000_000_000_000_000 + np.arange(n, dtype=np.int64) * 5_000_000   # 200 Hz
+    stamps = 1_700_000_000_000_000_000 + np.arange(n, dtype=np.int64) * 5_000_000  # 200 Hz
     path = tmp_path / ("imu.bag" if ros == 1 else "imu_bag")
     _write_bag(path, ros, stamps, w)
     log = read_log(path)
@@ -268,7 +282,7 @@ def test_ros_bag_round_trip(tmp_path, rng, ros):
     assert log.columns == ["angular_velocity_x", "angular_velocity_y", "angular_velocity_z"]
     assert log.fs == pytest.approx(200.0, rel=1e-9)
     assert log.t0 == pytest.approx(1.7e9, abs=1e-6)
-    assert log.unit.name == "rad/s"          # REP 103 default
+    assert log.unit.name == "rad/s"  # REP 103 default
     acc = read_log(path, columns="linear_acceleration_z", unit="deg/s")
     np.testing.assert_array_equal(acc.data, np.full(n, 9.81))
     assert acc.unit.name == "deg/s"
@@ -283,11 +297,14 @@ def test_ros_bag_gap(tmp_path, rng):
     n = 60
     w = rng.normal(size=(n, 3))
     stamps = np.arange(n, dtype=np.int64) * 5_000_000 + 10**9
-    stamps[30:] += 100_000_000                   # 0.1 s without messages after message 29
+    stamps[30:] += 100_000_000  # 0.1 s without messages after message 29
     path = tmp_path / "gappy"
     _write_bag(path, 2, stamps, w)
-    with pytest.raises(InputError, match=r"gappy: 1 gap\(s\) in time column 'header\.stamp'.*0\.1 s \(≈20 samples\) "
-                                         r"missing after sample 29 at t = 0\.145 s"):
+    with pytest.raises(
+        InputError,
+        match=r"gappy: 1 gap\(s\) in time column 'header\.stamp'.*0\.1 s \(≈20 samples\) "
+        r"missing after sample 29 at t = 0\.145 s",
+    ):
         read_log(path)
     log = read_log(path, gaps="longest")
     np.testing.assert_array_equal(log.data, w[:30])
@@ -308,11 +325,17 @@ def test_missing_optional_packages_are_named(tmp_path, monkeypatch):
     monkeypatch.setattr(builtins, "__import__", no_optional)
     for mod in [m for m in sys.modules if m.split(".")[0] in ("pyarrow", "rosbags")]:
         monkeypatch.delitem(sys.modules, mod)
-    with pytest.raises(MissingDependencyError, match=r"Parquet files needs the optional package 'pyarrow': "
-                                                     r"pip install 'allanite\[parquet\]'"):
+    with pytest.raises(
+        MissingDependencyError,
+        match=r"Parquet files needs the optional package 'pyarrow': "
+        r"pip install 'allanite\[parquet\]'",
+    ):
         read_log(p, fs=1.0)
-    with pytest.raises(MissingDependencyError, match=r"ROS bags needs the optional package 'rosbags': "
-                                                     r"pip install 'allanite\[ros\]'"):
+    with pytest.raises(
+        MissingDependencyError,
+        match=r"ROS bags needs the optional package 'rosbags': "
+        r"pip install 'allanite\[ros\]'",
+    ):
         read_log(bag)
     assert issubclass(MissingDependencyError, ImportError) and issubclass(MissingDependencyError, AllaniteError)
 
@@ -331,54 +354,90 @@ def with_line(k, text):
     return out
 
 
-@pytest.mark.parametrize("lines, kwargs, pattern", [
-    # ragged rows, short and long, with all columns and with a subset
-    (with_line(5, "0.02,5"), {"time_column": "t"},
-     r"bad\.csv: line 5: ragged row — 2 fields \(separated by ','\) where line 3 and the header have 3"),
-    (with_line(4, "0.01,3,4,9"), {"time_column": "t"},
-     r"bad\.csv: line 4: ragged row — 4 fields"),
-    (with_line(6, "0.03,7,8,9"), {"fs": 100, "columns": ["gx"]},
-     r"bad\.csv: line 6: ragged row — 4 fields"),
-    (with_line(6, "0.03"), {"fs": 100, "columns": ["gy"]},
-     r"bad\.csv: line 6: ragged row — 1 fields"),
-    # text in a numeric column, and an empty field
-    (with_line(4, "0.01,3,abc"), {"time_column": "t"},
-     r"bad\.csv: line 4, column 3 \('gy'\): 'abc' is not a number"),
-    (with_line(5, "0.02,,6"), {"time_column": "t"},
-     r"bad\.csv: line 5, column 2 \('gx'\): '\(empty\)' is not a number"),
-    (with_line(6, "oops,7,8"), {"time_column": "t"},
-     r"bad\.csv: line 6, column 1 \('t'\): 'oops' is not a number"),
-    (with_line(3, "0.00,1e,2"), {"fs": 100, "columns": [1]},
-     r"bad\.csv: line 3, column 2 \('gx'\): '1e' is not a number"),
-    # NaN / inf in the data
-    (with_line(5, "0.02,nan,6"), {"time_column": "t"},
-     r"bad\.csv: line 5, column 2 \('gx'\): non-finite value nan"),
-    (with_line(6, "0.03,7,-inf"), {"time_column": "t"},
-     r"bad\.csv: line 6, column 3 \('gy'\): non-finite value -inf"),
-    (with_line(4, "nan,3,4"), {"time_column": "t"},
-     r"bad\.csv: line 4, time column 't': non-finite time nan"),
-    # missing columns
-    (GOOD, {"time_column": "t", "columns": ["gx", "gz"]},
-     r"bad\.csv: no column named 'gz'; available: 't', 'gx', 'gy'"),
-    (GOOD, {"time_column": "t", "columns": [7]},
-     r"bad\.csv: column index 7 is out of range: the file has 3 columns \(indices 0–2: t, gx, gy\)"),
-    (GOOD, {"time_column": "time"},
-     r"bad\.csv: no time column named 'time'; available: 't', 'gx', 'gy'"),
-    # wrong time column: a gyro column is no clock
-    (with_line(5, "0.02,-5,6"), {"time_column": "gx"},
-     r"bad\.csv: line 5, time column 'gx': time goes backwards \(-5\.0 after 3\.0\); times must increase — is 'gx' "
-     r"really the time column\?"),
-    # non-monotonic and repeated time
-    (with_line(5, "0.005,5,6"), {"time_column": "t"},
-     r"bad\.csv: line 5, time column 't': time goes backwards \(0\.005 after 0\.01\)"),
-    (with_line(4, "0.00,3,4"), {"time_column": 0},
-     r"bad\.csv: line 4, time column 't': time repeats \(0\.0 after 0\.0\)"),
-    # a header that does not match the rows
-    (["t,gx,gy,gz", "0,1,2"], {"time_column": "t"},
-     r"bad\.csv: the header on line 1 names 4 columns but line 2 has 3 fields"),
-    (["# only a header", "t,gx,gy"], {"time_column": "t"},
-     r"bad\.csv: line 2 is a header \(t, gx, gy\) but no data rows follow"),
-])
+@pytest.mark.parametrize(
+    "lines, kwargs, pattern",
+    [
+        # ragged rows, short and long, with all columns and with a subset
+        (
+            with_line(5, "0.02,5"),
+            {"time_column": "t"},
+            r"bad\.csv: line 5: ragged row — 2 fields \(separated by ','\) where line 3 and the header have 3",
+        ),
+        (with_line(4, "0.01,3,4,9"), {"time_column": "t"}, r"bad\.csv: line 4: ragged row — 4 fields"),
+        (with_line(6, "0.03,7,8,9"), {"fs": 100, "columns": ["gx"]}, r"bad\.csv: line 6: ragged row — 4 fields"),
+        (with_line(6, "0.03"), {"fs": 100, "columns": ["gy"]}, r"bad\.csv: line 6: ragged row — 1 fields"),
+        # text in a numeric column, and an empty field
+        (
+            with_line(4, "0.01,3,abc"),
+            {"time_column": "t"},
+            r"bad\.csv: line 4, column 3 \('gy'\): 'abc' is not a number",
+        ),
+        (
+            with_line(5, "0.02,,6"),
+            {"time_column": "t"},
+            r"bad\.csv: line 5, column 2 \('gx'\): '\(empty\)' is not a number",
+        ),
+        (with_line(6, "oops,7,8"), {"time_column": "t"}, r"bad\.csv: line 6, column 1 \('t'\): 'oops' is not a number"),
+        (
+            with_line(3, "0.00,1e,2"),
+            {"fs": 100, "columns": [1]},
+            r"bad\.csv: line 3, column 2 \('gx'\): '1e' is not a number",
+        ),
+        # NaN / inf in the data
+        (
+            with_line(5, "0.02,nan,6"),
+            {"time_column": "t"},
+            r"bad\.csv: line 5, column 2 \('gx'\): non-finite value nan",
+        ),
+        (
+            with_line(6, "0.03,7,-inf"),
+            {"time_column": "t"},
+            r"bad\.csv: line 6, column 3 \('gy'\): non-finite value -inf",
+        ),
+        (with_line(4, "nan,3,4"), {"time_column": "t"}, r"bad\.csv: line 4, time column 't': non-finite time nan"),
+        # missing columns
+        (
+            GOOD,
+            {"time_column": "t", "columns": ["gx", "gz"]},
+            r"bad\.csv: no column named 'gz'; available: 't', 'gx', 'gy'",
+        ),
+        (
+            GOOD,
+            {"time_column": "t", "columns": [7]},
+            r"bad\.csv: column index 7 is out of range: the file has 3 columns \(indices 0–2: t, gx, gy\)",
+        ),
+        (GOOD, {"time_column": "time"}, r"bad\.csv: no time column named 'time'; available: 't', 'gx', 'gy'"),
+        # wrong time column: a gyro column is no clock
+        (
+            with_line(5, "0.02,-5,6"),
+            {"time_column": "gx"},
+            r"bad\.csv: line 5, time column 'gx': time goes backwards \(-5\.0 after 3\.0\); times must increase — is 'gx' "
+            r"really the time column\?",
+        ),
+        # non-monotonic and repeated time
+        (
+            with_line(5, "0.005,5,6"),
+            {"time_column": "t"},
+            r"bad\.csv: line 5, time column 't': time goes backwards \(0\.005 after 0\.01\)",
+        ),
+        (
+            with_line(4, "0.00,3,4"),
+            {"time_column": 0},
+            r"bad\.csv: line 4, time column 't': time repeats \(0\.0 after 0\.0\)",
+        ),
+        # a header that does not match the rows
+        (
+            ["t,gx,gy,gz", "0,1,2"],
+            {"time_column": "t"},
+            r"bad\.csv: the header on line 1 names 4 columns but line 2 has 3 fields",
+        ),
+        (
+            ["# only a header", "t,gx,gy"],
+            {"time_column": "t"},
+            r"bad\.csv: line 2 is a header \(t, gx, gy\) but no data rows follow",
+        ),
+    ],
+)
 def test_malformed_text(tmp_path, lines, kwargs, pattern):
     p = lines_file(tmp_path, "bad.csv", lines)
     with pytest.raises(InputError, match=pattern) as info:
@@ -403,11 +462,14 @@ def test_gzipped_malformed_line_numbers(tmp_path):
         read_log(p, time_column="t")
 
 
-@pytest.mark.parametrize("content, pattern", [
-    ("", r"empty\.csv: empty file — it holds nothing, no data rows"),
-    ("\n\n  \n", r"empty\.csv: empty file — it holds nothing, no data rows"),
-    ("# just\n# comments\n", r"empty\.csv: empty file — it holds only comment lines, no data rows"),
-])
+@pytest.mark.parametrize(
+    "content, pattern",
+    [
+        ("", r"empty\.csv: empty file — it holds nothing, no data rows"),
+        ("\n\n  \n", r"empty\.csv: empty file — it holds nothing, no data rows"),
+        ("# just\n# comments\n", r"empty\.csv: empty file — it holds only comment lines, no data rows"),
+    ],
+)
 def test_empty_files(tmp_path, content, pattern):
     p = tmp_path / "empty.csv"
     p.write_text(content)
@@ -417,7 +479,7 @@ def test_empty_files(tmp_path, content, pattern):
 
 def test_broken_binary_files(tmp_path):
     gz = tmp_path / "broken.csv.gz"
-    gz.write_bytes(gzip.compress(b"t,w\n0,1\n0.01,2\n")[:-12])       # truncated
+    gz.write_bytes(gzip.compress(b"t,w\n0,1\n0.01,2\n")[:-12])  # truncated
     with pytest.raises(InputError, match=r"broken\.csv\.gz: cannot be read as gzip"):
         read_log(gz, fs=100)
     npy = tmp_path / "fake.npy"
@@ -456,7 +518,9 @@ def test_non_finite_and_bad_arrays(tmp_path):
         read_log(c, fs=100)
     one = tmp_path / "one.npy"
     np.save(one, np.arange(5.0))
-    with pytest.raises(InputError, match=r"one\.npy: the array is 1-D \(one column\), so it cannot hold a time column 0"):
+    with pytest.raises(
+        InputError, match=r"one\.npy: the array is 1-D \(one column\), so it cannot hold a time column 0"
+    ):
         read_log(one, time_column=0)
     e = tmp_path / "e.npy"
     np.save(e, np.zeros((0, 3)))
@@ -467,16 +531,25 @@ def test_non_finite_and_bad_arrays(tmp_path):
 def test_parameter_errors(tmp_path, record):
     t, x = record
     p = write_text(tmp_path / "log.csv", t, x)
-    with pytest.raises(ParameterError, match=r"log\.csv: give the sampling rate \(fs=… in Hz\) or the time column "
-                                             r"\(time_column=…\) — neither was passed"):
+    with pytest.raises(
+        ParameterError,
+        match=r"log\.csv: give the sampling rate \(fs=… in Hz\) or the time column "
+        r"\(time_column=…\) — neither was passed",
+    ):
         read_log(p, columns=["gx"])
     with pytest.raises(ParameterError, match=r"log\.csv: column 't' looks like a time column; pass time_column='t'"):
         read_log(p, fs=FS)
-    with pytest.raises(ParameterError, match=r"log\.csv: fs = 50 Hz, but the median step of time column 't' is 0\.01 "
-                                             r"\(100 Hz\)"):
+    with pytest.raises(
+        ParameterError,
+        match=r"log\.csv: fs = 50 Hz, but the median step of time column 't' is 0\.01 "
+        r"\(100 Hz\)",
+    ):
         read_log(p, fs=50, time_column="t")
-    with pytest.raises(ParameterError, match=r"unit 'deg/s' is a rate unit, but an angle unit is needed here.*"
-                                             r"input='increment' needs an angle unit"):
+    with pytest.raises(
+        ParameterError,
+        match=r"unit 'deg/s' is a rate unit, but an angle unit is needed here.*"
+        r"input='increment' needs an angle unit",
+    ):
         read_log(p, time_column="t", unit="deg/s", input="increment")
     with pytest.raises(ParameterError, match=r"unit 'rad' is an angle unit, but a rate unit is needed"):
         read_log(p, time_column="t", unit="rad")
@@ -502,9 +575,26 @@ def test_parameter_errors(tmp_path, record):
 def test_every_failure_is_an_allanite_error(tmp_path, rng):
     """A fuzz of damaged CSV files: whatever is wrong, the error is an AllaniteError naming the file."""
     base = ["t,a,b"] + [f"{i / 100!r},{float(v[0])!r},{float(v[1])!r}" for i, v in enumerate(rng.normal(size=(30, 2)))]
-    read_log(lines_file(tmp_path, "base.csv", base), time_column="t")       # the undamaged file reads
-    junk = ["", "x", ",", ",,,", "1,2", "1,2,3,4", "nan", "1e999", "--1", "0x10", "\x00", "1;2;3", '"1",2,3',
-            "1_0", "\u0661", "1.5e", " infinity"]
+    read_log(lines_file(tmp_path, "base.csv", base), time_column="t")  # the undamaged file reads
+    junk = [
+        "",
+        "x",
+        ",",
+        ",,,",
+        "1,2",
+        "1,2,3,4",
+        "nan",
+        "1e999",
+        "--1",
+        "0x10",
+        "\x00",
+        "1;2;3",
+        '"1",2,3',
+        "1_0",
+        "\u0661",
+        "1.5e",
+        " infinity",
+    ]
     raised = 0
     for k in range(120):
         lines = list(base)
@@ -526,6 +616,7 @@ def test_every_failure_is_an_allanite_error(tmp_path, rng):
 # --------------------------------------------------------------------------------------------------
 # Gaps and irregular sampling
 # --------------------------------------------------------------------------------------------------
+
 
 def gappy(tmp_path, rng, remove):
     """A 100 Hz record of 1000 samples with the sample ranges in `remove` cut out."""
@@ -552,8 +643,10 @@ def test_gaps_longest_and_split(tmp_path, rng):
     p, t, x = gappy(tmp_path, rng, [(300, 310), (700, 900)])
     # kept record (790 samples): 0..299 (300), 310..699 (390), 900..999 (100)
     log = read_log(p, time_column="time", gaps="longest")
-    assert log.gaps == [Gap(index=300, time=pytest.approx(2.99), duration=pytest.approx(0.1), missing=10),
-                        Gap(index=690, time=pytest.approx(6.99), duration=pytest.approx(2.0), missing=200)]
+    assert log.gaps == [
+        Gap(index=300, time=pytest.approx(2.99), duration=pytest.approx(0.1), missing=10),
+        Gap(index=690, time=pytest.approx(6.99), duration=pytest.approx(2.0), missing=200),
+    ]
     assert log.span == (300, 690) and log.n_record == 790
     np.testing.assert_array_equal(log.data, x[300:690])
     assert log.t0 == pytest.approx(3.10)
@@ -579,12 +672,12 @@ def test_no_gaps_split_gives_one_segment(tmp_path, rng):
 
 def test_step_just_below_threshold_is_no_gap_but_jitter(tmp_path):
     t = np.arange(20) / FS
-    t[10:] += 0.004                       # one step of 1.4 nominal steps: irregular, not a gap
+    t[10:] += 0.004  # one step of 1.4 nominal steps: irregular, not a gap
     p = write_text(tmp_path / "jit.csv", t, np.ones((20, 1)), header="t,w")
     with pytest.warns(UserWarning, match=r"jit\.csv: irregular sampling — a time step differs from the nominal"):
         log = read_log(p, time_column="t")
     assert log.gaps == [] and log.jitter == pytest.approx(0.4, rel=1e-6)
-    t[10:] += 0.002                       # now 1.6 steps: a gap of 0.006 s
+    t[10:] += 0.002  # now 1.6 steps: a gap of 0.006 s
     p = write_text(tmp_path / "gap.csv", t, np.ones((20, 1)), header="t,w")
     log = read_log(p, time_column="t", gaps="longest")
     assert len(log.gaps) == 1 and log.gaps[0].index == 10 and log.gaps[0].duration == pytest.approx(0.006)
@@ -598,7 +691,7 @@ def test_many_gaps_message_is_bounded(tmp_path):
 
 
 def test_time_unit(tmp_path):
-    t_ms = 1000.0 + np.arange(50) * 2.0               # 500 Hz in milliseconds
+    t_ms = 1000.0 + np.arange(50) * 2.0  # 500 Hz in milliseconds
     p = write_text(tmp_path / "ms.csv", t_ms, np.ones((50, 1)), header="time_ms,w")
     log = read_log(p, time_column="time_ms", time_unit="ms")
     assert log.fs == pytest.approx(500.0) and log.t0 == pytest.approx(1.0)
@@ -626,6 +719,7 @@ def test_docstring_examples():
 # The real ADIS16405 run (shared data)
 # --------------------------------------------------------------------------------------------------
 
+
 def test_adis16405_run1(shared_data):
     path = shared_data / "adis16405" / "adis16405_run1_100Hz.csv.gz"
     if not path.is_file():
@@ -634,7 +728,7 @@ def test_adis16405_run1(shared_data):
     assert log.data.shape == (1_000_000, 3) and log.data.dtype == np.float64
     assert log.columns == ["gyro_x", "gyro_y", "gyro_z"]
     lsb = log.data / 0.05
-    assert np.max(np.abs(lsb - np.round(lsb))) * 0.05 < 1e-9       # multiples of the 0.05 °/s LSB
+    assert np.max(np.abs(lsb - np.round(lsb))) * 0.05 < 1e-9  # multiples of the 0.05 °/s LSB
     np.testing.assert_allclose(log.data.mean(axis=0), [0.40, -0.42, -0.29], atol=0.01)
     assert log.duration == pytest.approx(10_000.0)
     # the first data row, as in the file

@@ -40,6 +40,7 @@ def assert_same_result(r1, r2):
 # davar against the per-window NumPy recomputation
 # --------------------------------------------------------------------------------------------------
 
+
 def check_davar_against_reference(y, fs, window, hop, taus, estimator, methods=METHODS, rtol=1e-9):
     for method in methods:
         d = allanite.davar(y, fs, window=window, hop=hop, taus=taus, method=method, estimator=estimator)
@@ -129,7 +130,7 @@ def test_every_davar_column_is_the_static_avar_of_its_window(rng):
     fs, window, hop = 10.0, 700, 230
     d = allanite.davar(y, fs, window=window, hop=hop, taus="octave")
     for j in range(d.t.size):
-        s = allanite.avar(y[j * hop: j * hop + window], fs, taus=d.tau)
+        s = allanite.avar(y[j * hop : j * hop + window], fs, taus=d.tau)
         assert max_rel(d.avar[:, j], s.avar) <= 1e-12
 
 
@@ -137,10 +138,11 @@ def test_every_davar_column_is_the_static_avar_of_its_window(rng):
 # allantools
 # --------------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("estimator, fn", [("oavar", allantools.oadev), ("avar", allantools.adev)],
-                         ids=["oadev", "adev"])
-@pytest.mark.parametrize("grid, n", [("octave", 5_000), ("decade", 5_000), ("exp", 5_000),
-                                     ("all", 301), ("all", 300)])
+
+@pytest.mark.parametrize(
+    "estimator, fn", [("oavar", allantools.oadev), ("avar", allantools.adev)], ids=["oadev", "adev"]
+)
+@pytest.mark.parametrize("grid, n", [("octave", 5_000), ("decade", 5_000), ("exp", 5_000), ("all", 301), ("all", 300)])
 @pytest.mark.parametrize("fs", [1.0, 250.0])
 def test_avar_matches_allantools(rng, estimator, fn, grid, n, fs):
     y = rng.normal(size=n) * 2e-3 + 0.5 + np.cumsum(rng.normal(size=n)) * 1e-4
@@ -159,6 +161,7 @@ def test_avar_matches_allantools(rng, estimator, fn, grid, n, fs):
 # Equivalent inputs
 # --------------------------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("estimator", ESTIMATORS)
 @pytest.mark.parametrize("fs", [1.0, 100.0, 0.25])
 def test_rate_increment_angle_inputs_agree(rng, estimator, fs):
@@ -170,8 +173,10 @@ def test_rate_increment_angle_inputs_agree(rng, estimator, fs):
     # nearly cancelling cluster differences amplifies that to ~3e-9 — see the next test, which
     # shows the library adds nothing to it.)
     taus = allanite.tau_grid(y.size, fs, "all", m_max=y.size // 10)
-    results = {inp: allanite.avar(x, fs, input=inp, taus=taus, estimator=estimator)
-               for inp, x in (("rate", y), ("increment", inc), ("angle", ang))}
+    results = {
+        inp: allanite.avar(x, fs, input=inp, taus=taus, estimator=estimator)
+        for inp, x in (("rate", y), ("increment", inc), ("angle", ang))
+    }
     base = results["rate"]
     for inp in ("increment", "angle"):
         r = results[inp]
@@ -179,8 +184,10 @@ def test_rate_increment_angle_inputs_agree(rng, estimator, fs):
         np.testing.assert_array_equal(r.tau, base.tau)
         np.testing.assert_array_equal(r.n, base.n)
         assert max_rel(r.avar, base.avar) <= 1e-10
-    dyn = {inp: allanite.davar(x, fs, input=inp, window=900, hop=170, taus="exp", estimator=estimator)
-           for inp, x in (("rate", y), ("increment", inc), ("angle", ang))}
+    dyn = {
+        inp: allanite.davar(x, fs, input=inp, window=900, hop=170, taus="exp", estimator=estimator)
+        for inp, x in (("rate", y), ("increment", inc), ("angle", ang))
+    }
     for inp in ("increment", "angle"):
         np.testing.assert_array_equal(dyn[inp].t, dyn["rate"].t)
         np.testing.assert_array_equal(dyn[inp].tau, dyn["rate"].tau)
@@ -204,10 +211,10 @@ def test_angle_input_is_exact_for_the_record_it_is_given(rng, estimator):
 # dtypes and memory layouts
 # --------------------------------------------------------------------------------------------------
 
+
 def both(x, fs=20.0, **kw):
     """avar and davar of x (same options)."""
-    return (allanite.avar(x, fs, taus="all", **kw),
-            allanite.davar(x, fs, window=64, hop=9, taus="all", **kw))
+    return (allanite.avar(x, fs, taus="all", **kw), allanite.davar(x, fs, window=64, hop=9, taus="all", **kw))
 
 
 def assert_both_equal(a, b):
@@ -270,6 +277,7 @@ def test_two_dimensional_layouts(rng):
 # Multiple axes
 # --------------------------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("estimator", ESTIMATORS)
 def test_multi_axis_equals_stacked_single_axes(rng, estimator, method):
@@ -284,8 +292,12 @@ def test_multi_axis_equals_stacked_single_axes(rng, estimator, method):
         assert np.array_equal(s.avar[k], sk.avar)
     d = allanite.davar(X, fs, window=400, hop=130, taus="exp", estimator=estimator, method=method)
     assert d.avar.shape == (3, d.tau.size, d.t.size) and d.n_axes == 3
-    stacked = np.stack([allanite.davar(X[:, k], fs, window=400, hop=130, taus="exp", estimator=estimator,
-                                       method=method).avar for k in range(3)])
+    stacked = np.stack(
+        [
+            allanite.davar(X[:, k], fs, window=400, hop=130, taus="exp", estimator=estimator, method=method).avar
+            for k in range(3)
+        ]
+    )
     assert np.array_equal(d.avar, stacked)
     one = allanite.avar(X[:, :1], fs, taus="octave", estimator=estimator)
     assert one.avar.shape == (1, s.tau.size)
@@ -295,6 +307,7 @@ def test_multi_axis_equals_stacked_single_axes(rng, estimator, method):
 # --------------------------------------------------------------------------------------------------
 # Threads
 # --------------------------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("method", METHODS)
 def test_worker_count_does_not_change_a_bit(rng, monkeypatch, method):
@@ -328,6 +341,7 @@ def test_num_threads_env_is_read_and_explicit_workers_win(rng, monkeypatch):
 # τ grids
 # --------------------------------------------------------------------------------------------------
 
+
 def grid_ms(taus, fs):
     ms = np.rint(np.asarray(taus) * fs).astype(np.int64)
     np.testing.assert_array_equal(taus, ms / fs)  # exact multiples m/fs
@@ -335,8 +349,7 @@ def grid_ms(taus, fs):
 
 
 @settings(max_examples=60, deadline=None)
-@given(n=st.integers(2, 2_000_000), fs=st.sampled_from([1.0, 100.0, 0.1, 3.0, 1e4, 400.0]),
-       kind=st.sampled_from(GRIDS))
+@given(n=st.integers(2, 2_000_000), fs=st.sampled_from([1.0, 100.0, 0.1, 3.0, 1e4, 400.0]), kind=st.sampled_from(GRIDS))
 def test_named_grids_properties(n, fs, kind):
     taus = allanite.tau_grid(n, fs, kind)
     ms = grid_ms(taus, fs)
@@ -386,8 +399,9 @@ def test_exp_grid_options(n, fs, data):
 
 def test_grid_docstring_examples():
     np.testing.assert_array_equal(allanite.tau_grid(1000, 1.0, "octave"), 2.0 ** np.arange(9))
-    np.testing.assert_array_equal(allanite.tau_grid(1000, 10.0, "decade"),
-                                  np.array([1, 2, 4, 10, 20, 40, 100, 200, 400]) / 10.0)
+    np.testing.assert_array_equal(
+        allanite.tau_grid(1000, 10.0, "decade"), np.array([1, 2, 4, 10, 20, 40, 100, 200, 400]) / 10.0
+    )
     # Paper 000's example (N = 10 000, 100 points, m_max = N/9 = 1111, g = 1111^(1/99) ≈ 1.073):
     # m = round(g^i), duplicates dropped, leaves 76 distinct m.
     g = 1111 ** (1 / 99)
@@ -445,19 +459,26 @@ def adversarial_record():
     rng = np.random.default_rng(7)
     third = ADV_N // 3
     std = np.full(ADV_N, 1e-3)
-    std[third:2 * third] = 1e3
+    std[third : 2 * third] = 1e3
     return rng.standard_normal(ADV_N) * std + ADV_OFFSET
 
 
 def adversarial_windows(n_win):
     third = ADV_N // 3
-    first_quiet_after = -(-2 * third // ADV_HOP)     # first window entirely after the loud part
+    first_quiet_after = -(-2 * third // ADV_HOP)  # first window entirely after the loud part
     last_quiet_before = (third - ADV_WINDOW) // ADV_HOP
-    js = {0, last_quiet_before,                      # quiet, before
-          (third + 1) // ADV_HOP + 5, n_win // 2,    # inside the loud part
-          (2 * third) // ADV_HOP - 3,                 # straddling the loud→quiet edge
-          first_quiet_after, first_quiet_after + 1, first_quiet_after + 7,
-          n_win - 10, n_win - 1}                      # quiet, long after
+    js = {
+        0,
+        last_quiet_before,  # quiet, before
+        (third + 1) // ADV_HOP + 5,
+        n_win // 2,  # inside the loud part
+        (2 * third) // ADV_HOP - 3,  # straddling the loud→quiet edge
+        first_quiet_after,
+        first_quiet_after + 1,
+        first_quiet_after + 7,
+        n_win - 10,
+        n_win - 1,
+    }  # quiet, long after
     return sorted(j for j in js if 0 <= j < n_win)
 
 
@@ -475,8 +496,9 @@ def test_adversarial_dynamic_range(adversarial_record, dtype):
     worst = 0.0
     for j in js:
         s = j * ADV_HOP
-        ref = _reference.davar_reference(y64[s:s + ADV_WINDOW], 1.0, ADV_WINDOW, ADV_HOP, d.m,
-                                         dtype=np.longdouble)[:, 0]
+        ref = _reference.davar_reference(y64[s : s + ADV_WINDOW], 1.0, ADV_WINDOW, ADV_HOP, d.m, dtype=np.longdouble)[
+            :, 0
+        ]
         worst = max(worst, max_rel(d.avar[:, j], ref))
     assert worst <= 1e-9, f"max relative error against extended precision: {worst:.3g}"
 
@@ -489,7 +511,7 @@ def test_adversarial_record_defeats_plain_prefix_sums(adversarial_record):
     j = (ADV_N - ADV_WINDOW) // ADV_HOP  # last window, quiet
     s = j * ADV_HOP
     naive_prefix = _reference.davar_prefix(y[: s + ADV_WINDOW], 1.0, ADV_WINDOW, ADV_HOP, ms)[:, j]
-    ref = _reference.davar_reference(y[s:s + ADV_WINDOW], 1.0, ADV_WINDOW, ADV_HOP, ms, dtype=np.longdouble)[:, 0]
+    ref = _reference.davar_reference(y[s : s + ADV_WINDOW], 1.0, ADV_WINDOW, ADV_HOP, ms, dtype=np.longdouble)[:, 0]
     assert np.max(np.abs(naive_prefix - ref) / ref) > 1e-2
     ours = allanite.davar(y[: s + ADV_WINDOW], 1.0, window=ADV_WINDOW, hop=ADV_HOP, taus=ms.astype(float)).avar[:, j]
     assert max_rel(ours, ref) <= 1e-9
@@ -501,13 +523,14 @@ def test_fast_survives_a_single_huge_outlier(rng):
     y[1_000] = 1e6
     d = allanite.davar(y, 1.0, window=1_000, hop=1, taus=[1.0, 10.0, 100.0])
     for j in (5_000, 200_000, d.t.size - 1):
-        ref = _reference.davar_reference(y[j:j + 1_000], 1.0, 1_000, 1, d.m, dtype=np.longdouble)[:, 0]
+        ref = _reference.davar_reference(y[j : j + 1_000], 1.0, 1_000, 1, d.m, dtype=np.longdouble)[:, 0]
         assert max_rel(d.avar[:, j], ref) <= 1e-12
 
 
 # --------------------------------------------------------------------------------------------------
 # Exact invariants
 # --------------------------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("c", [0.0, 1.0, -3.3, 0.1, 1 / 3, 1e6 + 0.1, math.pi, 7e-300, 1e300])
 @pytest.mark.parametrize("estimator", ESTIMATORS)
@@ -530,8 +553,9 @@ def test_linear_angle_has_zero_allan_variance(fs, slope, offset):
     exact = 0.5 * np.arange(1_001)  # every difference exactly 0.5
     for estimator in ESTIMATORS:
         assert np.all(allanite.avar(exact, fs, input="angle", taus="all", estimator=estimator).avar == 0.0)
-        assert np.all(allanite.davar(exact, fs, input="angle", window=300, hop=11, taus="all",
-                                     estimator=estimator).avar == 0.0)
+        assert np.all(
+            allanite.davar(exact, fs, input="angle", window=300, hop=11, taus="all", estimator=estimator).avar == 0.0
+        )
 
 
 @pytest.mark.parametrize("c", [3.7, -2.0, 1e-5, 1e5])
@@ -557,4 +581,3 @@ def test_white_noise_level(rng):
     r = allanite.avar(y, 50.0, taus=np.array([1, 10, 100, 1000]) / 50.0)
     np.testing.assert_allclose(r.avar * r.m, sigma**2, rtol=0.1)
     np.testing.assert_allclose(r.adev, np.sqrt(r.avar), rtol=0)
-

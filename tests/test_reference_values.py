@@ -69,8 +69,7 @@ def test_nbs14_generator():
     assert np.all((y > 0) & (y < 1))
 
 
-@pytest.mark.parametrize("estimator, table", [("oavar", NIST_OADEV), ("avar", NIST_ADEV)],
-                         ids=["OADEV", "ADEV"])
+@pytest.mark.parametrize("estimator, table", [("oavar", NIST_OADEV), ("avar", NIST_ADEV)], ids=["OADEV", "ADEV"])
 @pytest.mark.parametrize("input", ["rate", "increment", "angle"])
 def test_nist_sp1065_1000_point_suite(estimator, table, input):
     y = _reference.nbs14_1000()
@@ -80,8 +79,9 @@ def test_nist_sp1065_1000_point_suite(estimator, table, input):
     np.testing.assert_array_equal(r.m, taus)
     np.testing.assert_array_equal(r.tau, taus)
     assert [significant_digits(table[t]) for t in taus] == [7, 7, 7]
-    assert_matches_printed(r.adev, [table[t] for t in taus], [f"τ={t}" for t in taus],
-                           f"NIST SP 1065 {estimator} ({input} input)")
+    assert_matches_printed(
+        r.adev, [table[t] for t in taus], [f"τ={t}" for t in taus], f"NIST SP 1065 {estimator} ({input} input)"
+    )
     # number of terms: N − 2m (overlapping), ⌊M/m⌋ − 1 (classic), N = M + 1 = 1001
     expected_n = [1001 - 2 * t for t in taus] if estimator == "oavar" else [1000 // t - 1 for t in taus]
     np.testing.assert_array_equal(r.n, expected_n)
@@ -99,13 +99,14 @@ def test_nist_printed_precision_is_actually_tight():
 # Stable32 tables
 # --------------------------------------------------------------------------------------------------
 
+
 @dataclass
 class Stable32Table:
     path: Path
-    sigma_type: str          # "Overlapping Allan", "Allan", ...
-    data_kind: str           # "Phase" or "Frequency"
-    data_points: int         # points in the analysed record, from the header
-    columns: dict            # column name -> list of tokens
+    sigma_type: str  # "Overlapping Allan", "Allan", ...
+    data_kind: str  # "Phase" or "Frequency"
+    data_points: int  # points in the analysed record, from the header
+    columns: dict  # column name -> list of tokens
 
     def ints(self, name):
         return np.array([int(t) for t in self.columns[name]], dtype=np.int64)
@@ -150,7 +151,7 @@ def read_stable32(path: Path) -> Stable32Table:
     return Stable32Table(path, sigma_type, data_kind, data_points, columns)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _load_record(folder: str, dataset: str):
     """(samples, input kind, fs) for a Stable32 dataset, read once per session."""
     base = Path(folder) / dataset
@@ -215,8 +216,7 @@ def _table(stable32_dir, dataset, fname) -> Stable32Table:
     return read_stable32(path)
 
 
-@pytest.mark.parametrize("dataset, fname, estimator, step", CASES,
-                         ids=[f"{c[0]}/{c[1]}" for c in CASES])
+@pytest.mark.parametrize("dataset, fname, estimator, step", CASES, ids=[f"{c[0]}/{c[1]}" for c in CASES])
 def test_stable32_table(stable32_dir, dataset, fname, estimator, step):
     table = _table(stable32_dir, dataset, fname)
     x, input, fs = load_record(stable32_dir, dataset)
@@ -247,18 +247,25 @@ def test_stable32_table(stable32_dir, dataset, fname, estimator, step):
     sig_tokens = [table.columns["Sigma"][i] for i in rows]
     if keep.any():
         assert all(significant_digits(t) == 5 for t in sig_tokens)
-        assert_matches_printed(r.adev[keep], [t for t, k in zip(sig_tokens, keep) if k],
-                               [f"AF {a}" for a in af[keep]], f"{dataset}/{fname} Sigma")
+        assert_matches_printed(
+            r.adev[keep],
+            [t for t, k in zip(sig_tokens, keep) if k],
+            [f"AF {a}" for a in af[keep]],
+            f"{dataset}/{fname} Sigma",
+        )
 
 
-@pytest.mark.parametrize("dataset, fname, grid", [
-    ("phasedat", "phase_dat_oadev_octave.txt", "octave"),
-    ("phasedat", "phase_dat_adev_octave.txt", "octave"),
-    ("ocxo", "oadev_octave.txt", "octave"),
-    ("ocxo", "adev_octave.txt", "octave"),
-    ("cs5071a", "oadev_decade.txt", "decade"),
-    ("cs5071a", "adev_decade.txt", "decade"),
-])
+@pytest.mark.parametrize(
+    "dataset, fname, grid",
+    [
+        ("phasedat", "phase_dat_oadev_octave.txt", "octave"),
+        ("phasedat", "phase_dat_adev_octave.txt", "octave"),
+        ("ocxo", "oadev_octave.txt", "octave"),
+        ("ocxo", "adev_octave.txt", "octave"),
+        ("cs5071a", "oadev_decade.txt", "decade"),
+        ("cs5071a", "adev_decade.txt", "decade"),
+    ],
+)
 def test_named_grids_extend_stable32_grids(stable32_dir, dataset, fname, grid):
     """Stable32's octave/decade AF lists are the start of allanite's grids of the same name (Stable32
     stops earlier: N/4 for OADEV, N/5 for ADEV; allanite goes to N/2)."""
@@ -301,7 +308,7 @@ def test_ocxo_octave_defects_reproduced(stable32_dir):
     af = oct_o.ints("AF")
     emu = []
     for m in af:
-        d = x[2 * m:] - 2 * x[m:-m] + x[:-2 * m]
+        d = x[2 * m :] - 2 * x[m:-m] + x[: -2 * m]
         emu.append(np.sqrt(np.mean(d * d) / (2.0 * m * m)))
     assert_matches_printed(emu, oct_o.columns["Sigma"], [f"AF {a}" for a in af], "emulated OADEV octave")
 
@@ -316,7 +323,10 @@ def test_ocxo_octave_defects_reproduced(stable32_dir):
 
     # allanite is the accurate one: extended-precision recomputation at the defect rows.
     y, _, _ = load_record(stable32_dir, "ocxo")
-    for estimator, ms in (("oavar", af), ("avar", np.array(sorted(KNOWN_REFERENCE_DEFECTS[("ocxo", "adev_octave.txt")])))):
+    for estimator, ms in (
+        ("oavar", af),
+        ("avar", np.array(sorted(KNOWN_REFERENCE_DEFECTS[("ocxo", "adev_octave.txt")]))),
+    ):
         ours = allanite.avar(y, 1.0, taus=ms.astype(float), estimator=estimator).avar
         ref = _reference.avar_reference(y, 1.0, ms, estimator, dtype=np.longdouble).astype(float)
         np.testing.assert_allclose(ours, ref, rtol=1e-12, atol=0)
@@ -327,8 +337,10 @@ def test_ocxo_octave_defects_reproduced(stable32_dir):
     assert np.all(np.abs(r.adev - oct_o.floats("Sigma")) > tol)
     defect_rows = [i for i, a in enumerate(af_a) if a in KNOWN_REFERENCE_DEFECTS[("ocxo", "adev_octave.txt")]]
     ra = allanite.avar(y, 1.0, taus=af_a[defect_rows].astype(float), estimator="avar")
-    assert np.all(np.abs(ra.adev - oct_a.floats("Sigma")[defect_rows])
-                  > np.array([printed_tolerance(oct_a.columns["Sigma"][i]) for i in defect_rows]))
+    assert np.all(
+        np.abs(ra.adev - oct_a.floats("Sigma")[defect_rows])
+        > np.array([printed_tolerance(oct_a.columns["Sigma"][i]) for i in defect_rows])
+    )
 
     # The two OADEV tables of the same program disagree where they overlap; allanite sides with all-τ.
     shared = np.intersect1d(af, all_o.ints("AF"))

@@ -52,7 +52,7 @@ def test_finds_an_undeclared_gauss_markov(gm_record):
     assert st.after["rms_adev_pct"] < st.before["rms_adev_pct"]
     lo, hi = st.intervals["tc"]
     assert lo < st.params["tc"] < hi
-    assert st.evidence["runs_beyond_2sigma"]            # where the residual was
+    assert st.evidence["runs_beyond_2sigma"]  # where the residual was
     assert "gauss_markov" in r.fit.coefficients and r.fit.chi2_dof <= 2
     text = r.report()
     assert "Step 1: gauss_markov" in text and "tc =" in text
@@ -85,8 +85,15 @@ def test_locates_a_variance_step_within_one_window():
 def test_two_effects_at_once():
     gm = {"sigma": 5e-3, "tc": 5.0}
     sn = {"amplitude": 4e-3, "f0": 0.02}
-    y = allanite.simulate(1_000_000, FS, N=2e-3, K=1e-5, gauss_markov=[(gm["sigma"], gm["tc"])],
-                          sinusoid=[(sn["amplitude"], sn["f0"])], seed=21)
+    y = allanite.simulate(
+        1_000_000,
+        FS,
+        N=2e-3,
+        K=1e-5,
+        gauss_markov=[(gm["sigma"], gm["tc"])],
+        sinusoid=[(sn["amplitude"], sn["f0"])],
+        seed=21,
+    )
     r = allanite.refine(y, FS, truth={"gauss_markov": gm, "sinusoid": sn})
     assert sorted(r.found) == ["gauss_markov", "sinusoid"]
     for st in r.steps:
@@ -117,7 +124,7 @@ def test_no_false_alarms_on_clean_records():
     for seed in range(40):
         y = allanite.simulate(100_000, FS, Q=3e-4, N=2e-3, B=1e-3, K=2e-5, seed=200 + seed)
         found += bool(allanite.refine(y, FS).found)
-    assert found <= 2          # ≥ 95 % of 40 seeds add nothing
+    assert found <= 2  # ≥ 95 % of 40 seeds add nothing
 
 
 def test_deterministic_and_accepts_a_result(gm_record):
@@ -142,11 +149,14 @@ def test_plot_draws():
     plt.close(fig)
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    (dict(candidates=("wobble",)), "unknown candidate effect 'wobble'"),
-    (dict(start=("N", "X")), "X"),
-    (dict(axis=3), "axis = 3"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(candidates=("wobble",)), "unknown candidate effect 'wobble'"),
+        (dict(start=("N", "X")), "X"),
+        (dict(axis=3), "axis = 3"),
+    ],
+)
 def test_errors(kwargs, match):
     y = np.random.default_rng(0).normal(size=5_000)
     with pytest.raises(ParameterError, match=match):
@@ -171,8 +181,27 @@ def test_report_refinement_section(tmp_path):
     y = allanite.simulate(120_000, FS, N=2e-3, K=2e-5, gauss_markov=[(6e-3, 5.0)], seed=9)
     np.save(tmp_path / "g.npy", y)
     out = tmp_path / "out"
-    assert cli.main(["report", str(tmp_path / "g.npy"), "--fs", "100", "--unit", "deg/s", "--refine",
-                     "--window", "20000", "--hop", "10000", "--out", str(out), "--quiet"]) == 0
+    assert (
+        cli.main(
+            [
+                "report",
+                str(tmp_path / "g.npy"),
+                "--fs",
+                "100",
+                "--unit",
+                "deg/s",
+                "--refine",
+                "--window",
+                "20000",
+                "--hop",
+                "10000",
+                "--out",
+                str(out),
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     import json
 
     s = json.loads((out / "summary.json").read_text())
@@ -183,8 +212,23 @@ def test_report_refinement_section(tmp_path):
     assert "Model refinement" in (out / "report.html").read_text()
     # without --refine there is no section and summary says null
     out2 = tmp_path / "out2"
-    assert cli.main(["report", str(tmp_path / "g.npy"), "--fs", "100", "--no-fit", "--window", "20000",
-                     "--out", str(out2), "--quiet"]) == 0
+    assert (
+        cli.main(
+            [
+                "report",
+                str(tmp_path / "g.npy"),
+                "--fs",
+                "100",
+                "--no-fit",
+                "--window",
+                "20000",
+                "--out",
+                str(out2),
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     assert json.loads((out2 / "summary.json").read_text())["refinement"] is None
 
 
@@ -196,8 +240,13 @@ def test_real_adis_noise_with_an_injected_sinusoid_and_step(shared_data):
     y = np.asarray(log.data, dtype=np.float64).ravel()
     t = np.arange(y.size) / FS
     sn = {"amplitude": 0.03, "f0": 0.1}
-    r = allanite.refine(y + sn["amplitude"] * np.sin(2 * np.pi * sn["f0"] * t), FS, tau_range=(0.1, None),
-                        truth={"sinusoid": sn}, candidates=("gauss_markov", "sinusoid"))
+    r = allanite.refine(
+        y + sn["amplitude"] * np.sin(2 * np.pi * sn["f0"] * t),
+        FS,
+        tau_range=(0.1, None),
+        truth={"sinusoid": sn},
+        candidates=("gauss_markov", "sinusoid"),
+    )
     st = next(s for s in r.steps if s.effect == "sinusoid")
     assert abs(st.truth_error["f0"]) < 0.2 and abs(st.truth_error["amplitude"]) < 0.3
     assert r.fit.chi2_dof <= 2

@@ -63,8 +63,22 @@ def check_self_contained(html: str, out) -> list:
     Returns the image file names in page order."""
     assert html.startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
     low = html.lower()
-    for bad in ('src="http', "src='http", 'href="http', "href='http", "src=\"//", "href=\"//", "<script", "<link",
-                "<iframe", "<object", "<embed", "@import", "url(", "file:"):
+    for bad in (
+        'src="http',
+        "src='http",
+        'href="http',
+        "href='http",
+        'src="//',
+        'href="//',
+        "<script",
+        "<link",
+        "<iframe",
+        "<object",
+        "<embed",
+        "@import",
+        "url(",
+        "file:",
+    ):
         assert bad not in low, bad
     parser = _Tags()
     parser.feed(html)
@@ -100,8 +114,12 @@ def run_cli(argv):
 def _json_floats(v):
     """JSON list (None for non-finite) → float array (None → inf: the only non-finite the report writes is an
     unbounded interval)."""
-    return np.array([[np.inf if x is None else x for x in row] for row in v] if v and isinstance(v[0], list)
-                    else [np.inf if x is None else x for x in v], dtype=np.float64)
+    return np.array(
+        [[np.inf if x is None else x for x in row] for row in v]
+        if v and isinstance(v[0], list)
+        else [np.inf if x is None else x for x in v],
+        dtype=np.float64,
+    )
 
 
 def check_fit_matches(summary, static, unit):
@@ -132,8 +150,10 @@ def check_series_matches(summary, dynamic, unit, fits):
     """The coefficient series are allanite.fit's per axis, on the τ range of that axis's whole-record fit."""
     import dataclasses
 
-    series = [allanite.fit(dataclasses.replace(dynamic, avar=row), unit=unit, tau_range=(f.tau[0] * (1 - 1e-9), None))
-              for row, f in zip(dynamic.avar, fits)]
+    series = [
+        allanite.fit(dataclasses.replace(dynamic, avar=row), unit=unit, tau_range=(f.tau[0] * (1 - 1e-9), None))
+        for row, f in zip(dynamic.avar, fits)
+    ]
     ser = summary["fit"]["series"]
     assert ser["terms"] == list(series[0].terms)
     for ax, s in zip(ser["axes"], series):
@@ -256,8 +276,11 @@ def test_bundled_report_prints_tables_and_paths(bundled):
         for k in range(3):
             assert f"{st['adev'][k][i]:.4g}" in row
     assert "Noise model (IEEE 952) in IEEE-952 units" in stdout
-    for term, unit in (("N angle random walk", "°/√h"), ("B bias instability", "°/h"),
-                       ("K rate random walk", "°/h^1.5")):
+    for term, unit in (
+        ("N angle random walk", "°/√h"),
+        ("B bias instability", "°/h"),
+        ("K rate random walk", "°/h^1.5"),
+    ):
         line = next(line for line in stdout.splitlines() if term in line)
         assert unit in line
     n = summary["fit"]["axes"][0]["coefficients"]["N"]
@@ -277,8 +300,9 @@ def adis(tmp_path_factory, shared_data):
     if not path.is_file():
         pytest.skip(f"ADIS16405 run 1 not found at {path}")
     out = tmp_path_factory.mktemp("adis")
-    rc, stdout, stderr, seconds = run_cli(["report", str(path), "--fs", "100", "--columns", ",".join(ADIS_COLUMNS),
-                                           "--unit", "deg/s", "--out", str(out)])
+    rc, stdout, stderr, seconds = run_cli(
+        ["report", str(path), "--fs", "100", "--columns", ",".join(ADIS_COLUMNS), "--unit", "deg/s", "--out", str(out)]
+    )
     return rc, out, stdout, stderr, seconds, path
 
 

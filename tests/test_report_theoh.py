@@ -42,8 +42,23 @@ def test_cli_estimator_theoh(tmp_path, record):
     log = tmp_path / "g.npy"
     np.save(log, record)
     out = tmp_path / "out"
-    rc = cli.main(["report", str(log), "--fs", "50", "--unit", "deg/s", "--estimator", "theoh", "--window", "1000",
-                   "--out", str(out), "--quiet"])
+    rc = cli.main(
+        [
+            "report",
+            str(log),
+            "--fs",
+            "50",
+            "--unit",
+            "deg/s",
+            "--estimator",
+            "theoh",
+            "--window",
+            "1000",
+            "--out",
+            str(out),
+            "--quiet",
+        ]
+    )
     assert rc == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["static"]["estimator"] == "theoh" and s["dynamic"]["estimator"] == "theoh"

@@ -123,7 +123,7 @@ def test_wrong_closed_forms_are_rejected():
     ys = records(n_short=1, K=1e-4)
     r = allanite.avar(ys[-1], FS).with_confidence(alpha=-2, confidence=0.95)
     naive = 1e-8 * r.tau / 3
-    assert not (r.ci_low[0] <= naive[0] <= r.ci_high[0])          # m = 1: off by 1.5×
+    assert not (r.ci_low[0] <= naive[0] <= r.ci_high[0])  # m = 1: off by 1.5×
     ys = records(n_short=1, B=1e-3)
     r = allanite.avar(ys[-1], FS).with_confidence(alpha=-1, confidence=0.95)
     plateau = np.full(r.tau.size, 1e-6 * PLATEAU)
@@ -146,7 +146,7 @@ def test_rate_ramp_is_exact():
 def test_ramp_plus_white_noise():
     r_coef, n_coef = 2e-5, 1e-2
     closed = lambda r: n_coef**2 / r.tau + r_coef**2 * r.tau**2 / 2  # noqa: E731
-    share = inside_share(records(N=n_coef, R=r_coef), closed, 0)   # the ramp adds no variance
+    share = inside_share(records(N=n_coef, R=r_coef), closed, 0)  # the ramp adds no variance
     assert share >= 0.85
 
 
@@ -164,7 +164,7 @@ def test_gauss_markov_matches_the_discrete_ar1_form():
 
 
 def test_sinusoid_matches_its_closed_form_and_nulls():
-    amp, f0 = 0.5, 0.5                                  # nulls at τ = 2 s, 4 s, …
+    amp, f0 = 0.5, 0.5  # nulls at τ = 2 s, 4 s, …
     y = allanite.simulate(200_000, FS, sinusoid=[(amp, f0, 0.3)])
     taus = [0.01, 0.1, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 10.0, 33.0]
     r = allanite.avar(y, FS, taus=taus)
@@ -181,14 +181,23 @@ def test_sum_of_terms_is_the_sum_of_closed_forms():
     kw = dict(Q=3.5e-4, N=2e-3, B=1e-3, K=6e-5)
 
     def closed(r):
-        return (3 * kw["Q"] ** 2 / r.tau**2 + kw["N"] ** 2 / r.tau
-                + kw["B"] ** 2 * np.array([flicker_avar(m) for m in r.m])
-                + kw["K"] ** 2 * TAU0 * (2 * r.m**2 + 1) / (6 * r.m))
+        return (
+            3 * kw["Q"] ** 2 / r.tau**2
+            + kw["N"] ** 2 / r.tau
+            + kw["B"] ** 2 * np.array([flicker_avar(m) for m in r.m])
+            + kw["K"] ** 2 * TAU0 * (2 * r.m**2 + 1) / (6 * r.m)
+        )
 
     def alpha(r, model):
         # the dominant term's noise type at each τ
-        parts = np.vstack([3 * kw["Q"] ** 2 / r.tau**2, kw["N"] ** 2 / r.tau,
-                           np.full(r.tau.size, kw["B"] ** 2 * PLATEAU), kw["K"] ** 2 * r.tau / 3])
+        parts = np.vstack(
+            [
+                3 * kw["Q"] ** 2 / r.tau**2,
+                kw["N"] ** 2 / r.tau,
+                np.full(r.tau.size, kw["B"] ** 2 * PLATEAU),
+                kw["K"] ** 2 * r.tau / 3,
+            ]
+        )
         return np.array([2, 0, -1, -2])[np.argmax(parts, axis=0)]
 
     share = inside_share(records(n_short=2, **kw), closed, alpha)
@@ -207,7 +216,7 @@ def _segment_share(y, lo, hi, closed, alpha):
 
 
 def test_piecewise_white_noise_gives_each_level_locally():
-    t_switch = 1_000.0                              # s: sample 100 000 of 200 000
+    t_switch = 1_000.0  # s: sample 100 000 of 200 000
     hits = []
     for seed in range(3):
         y = allanite.simulate(200_000, FS, N=[(0.0, 1e-3), (t_switch, 4e-3)], seed=seed)
@@ -224,7 +233,7 @@ def test_callable_white_noise_follows_the_function():
         y = allanite.simulate(n, FS, N=fn, seed=seed)
         for lo in range(0, n, 50_000):
             t = np.arange(lo, lo + 50_000) / FS
-            n2 = float(np.mean(fn(t) ** 2))        # the segment's mean variance level
+            n2 = float(np.mean(fn(t) ** 2))  # the segment's mean variance level
             hits.append(_segment_share(y, lo, lo + 50_000, lambda r, n2=n2: n2 / r.tau, 0))
     assert np.mean(np.concatenate(hits)) >= 0.85
     # and the levels really differ: last quarter vs first quarter, 13.19/1.94 = 6.8 in variance

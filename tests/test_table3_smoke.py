@@ -27,7 +27,9 @@ def test_table3_quick(tmp_path):
     pytest.importorskip("matplotlib")
     proc = subprocess.run(
         [sys.executable, str(SCRIPT), "--quick", "--out", str(tmp_path)],
-        capture_output=True, text=True, timeout=300,
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-4000:]
     report = json.loads((tmp_path / "table3.json").read_text(encoding="utf-8"))
@@ -42,7 +44,8 @@ def test_table3_quick(tmp_path):
             assert math.isfinite(m["seconds"]) and m["seconds"] > 0, (row["n"], key, m["seconds"])
             assert isinstance(m["extrapolated"], bool) and m["how"], (row["n"], key)
         assert any(m["extrapolated"] for m in row["methods"].values()) or row["n"] == min(
-            r["n"] for r in report["table"])
+            r["n"] for r in report["table"]
+        )
         compared = 0
         for pair, c in row["agreement"].items():
             if c["n_compared"] == 0:

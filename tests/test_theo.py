@@ -4,17 +4,14 @@ tests/test_theo_reference.py), against Stable32's own tables and against allanto
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 import pytest
 
 import allanite
-from allanite import _reference as ref
-from allanite.estimators.confidence import edf_theo1
-from allanite.errors import ParameterError
-
 import allanite.model.fitting as fit_mod
+from allanite import _reference as ref
+from allanite.errors import ParameterError
+from allanite.estimators.confidence import edf_theo1
 
 
 def rel(a, b):
@@ -68,8 +65,9 @@ def test_theo1_float32_and_input_kinds_agree():
     x32 = ref.angle_from_rate(y.astype(np.float32).astype(np.longdouble), 10.0, dtype=np.longdouble)
     assert rel(r32.avar, ref.theo1_reference(x32, 0.1, r32.m, dtype=np.longdouble)) < 1e-11
     inc = allanite.avar(y / 10.0, 10.0, input="increment", estimator="theo1", taus="octave")
-    ang = allanite.avar(np.concatenate(([0.0], np.cumsum(y / 10.0))), 10.0, input="angle", estimator="theo1",
-                        taus="octave")
+    ang = allanite.avar(
+        np.concatenate(([0.0], np.cumsum(y / 10.0))), 10.0, input="angle", estimator="theo1", taus="octave"
+    )
     assert rel(inc.avar, base.avar) < 1e-10 and rel(ang.avar, base.avar) < 1e-10
 
 
@@ -195,7 +193,7 @@ def test_stable32_raw_theo1_on_phase_dat(shared_data, name):
     r = allanite.avar(x, 1.0, input="angle", estimator="theo1", taus=0.75 * ms)
     assert list(r.m) == list(ms)
     np.testing.assert_allclose(r.tau, [float(q[1]) for q in rows])
-    assert np.max(_half_units(r.n, [float(q[2]) for q in rows])) <= 1.0      # "Thêo1 #", printed to 5 digits
+    assert np.max(_half_units(r.n, [float(q[2]) for q in rows])) <= 1.0  # "Thêo1 #", printed to 5 digits
     assert np.max(_half_units(np.sqrt(r.avar), [float(q[5]) for q in rows])) <= 1.0
 
 
@@ -205,7 +203,7 @@ def test_allantools_theo1_equals_ours_at_corrected_tau():
     ms = np.array([10, 16, 32, 64, 128, 256])
     taus, dev = allantools.theo1(y, rate=1.0, data_type="freq", taus=ms.astype(float))[:2]
     ours = allanite.avar(y, 1.0, estimator="theo1", taus=0.75 * np.round(taus))
-    np.testing.assert_array_equal(np.round(taus), ours.m)      # allantools labels τ = m·τ0 ...
+    np.testing.assert_array_equal(np.round(taus), ours.m)  # allantools labels τ = m·τ0 ...
     np.testing.assert_allclose(ours.tau, 0.75 * np.asarray(taus))  # ... the statistic is at 0.75·m·τ0
     assert rel(ours.avar, np.asarray(dev) ** 2) < 1e-12
 
@@ -233,7 +231,7 @@ def test_dhvar_window_equals_static_theoh_and_is_thread_independent():
     d2 = allanite.davar(y, 1.0, window=500, hop=250, estimator="theoh", taus="octave", workers=2)
     np.testing.assert_array_equal(d1.avar, d2.avar)
     for j in range(d1.t.size):
-        s = allanite.avar(y[j * 250:j * 250 + 500], 1.0, estimator="theoh", taus="octave")
+        s = allanite.avar(y[j * 250 : j * 250 + 500], 1.0, estimator="theoh", taus="octave")
         assert rel(d1.avar[:, j], s.avar) < 1e-12 and d1.kf[j] == pytest.approx(s.kf, rel=1e-12)
 
 
@@ -274,9 +272,9 @@ def test_theoh_confidence_intervals_use_each_estimators_edf():
 def test_fit_on_theoh_recovers_terms():
     y = allanite.simulate(200_000, 100.0, N=0.01, B=1e-3, K=1e-4, seed=3)
     f = fit_mod.fit(allanite.avar(y, 100.0, estimator="theoh", taus="octave"), unit="deg/s")
-    assert f.coefficients["N"].ieee == pytest.approx(0.6, rel=0.03)      # 0.01 °/√s
-    assert f.coefficients["B"].ieee == pytest.approx(3.6, rel=0.3)       # 1e-3 °/s
-    assert f.coefficients["K"].ieee == pytest.approx(6.0, rel=0.3)       # 1e-4 °/s^1.5
+    assert f.coefficients["N"].ieee == pytest.approx(0.6, rel=0.03)  # 0.01 °/√s
+    assert f.coefficients["B"].ieee == pytest.approx(3.6, rel=0.3)  # 1e-3 °/s
+    assert f.coefficients["K"].ieee == pytest.approx(6.0, rel=0.3)  # 1e-4 °/s^1.5
     with pytest.raises(ParameterError, match="raw Theo1 is biased"):
         fit_mod.fit(allanite.avar(y[:5000], 100.0, estimator="theo1"))
 
@@ -293,15 +291,18 @@ def test_fit_on_dhvar_gives_a_series():
 # errors
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    (dict(estimator="theo2"), "estimator"),
-    (dict(estimator="theoh", kf_rule="nist"), "kf_rule"),
-    (dict(estimator="theo1", taus=[3.0]), r"m = 4 .*even m from 10"),
-    (dict(estimator="theo1", taus=[1e6]), "allowed for 500 samples"),
-    (dict(estimator="theo1", taus="weekly"), "unknown τ grid"),
-    (dict(estimator="theo1", taus=[30.0, 22.5]), "strictly increasing"),
-    (dict(estimator="theo1", taus=[np.nan]), "positive τ"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(estimator="theo2"), "estimator"),
+        (dict(estimator="theoh", kf_rule="nist"), "kf_rule"),
+        (dict(estimator="theo1", taus=[3.0]), r"m = 4 .*even m from 10"),
+        (dict(estimator="theo1", taus=[1e6]), "allowed for 500 samples"),
+        (dict(estimator="theo1", taus="weekly"), "unknown τ grid"),
+        (dict(estimator="theo1", taus=[30.0, 22.5]), "strictly increasing"),
+        (dict(estimator="theo1", taus=[np.nan]), "positive τ"),
+    ],
+)
 def test_static_errors(kwargs, match):
     with pytest.raises(ParameterError, match=match):
         allanite.avar(np.random.default_rng(0).normal(size=500), 1.0, **kwargs)
@@ -327,7 +328,7 @@ def test_decimated_theobr_tracks_the_exact_one():
     allan = exact.source == "oavar"
     np.testing.assert_array_equal(dec.avar[dec.source == "oavar"], exact.avar[allan])  # Allan part untouched
     theo = dec.source == "theobr"
-    assert np.all(dec.m[theo] % 8 == 0)                      # m = m'·D with m' even
+    assert np.all(dec.m[theo] % 8 == 0)  # m = m'·D with m' even
     np.testing.assert_allclose(dec.tau[theo], 0.75 * dec.m[theo])
     # same statistic from fewer terms: close to the exact TheoBR at the same τ
     common = np.intersect1d(dec.m[theo], exact.m[~allan])
@@ -336,11 +337,13 @@ def test_decimated_theobr_tracks_the_exact_one():
     b = dec.avar[np.isin(dec.m, common) & theo]
     assert np.max(np.abs(b / a - 1)) < 0.05
     auto = allanite.avar(np.random.default_rng(1).normal(size=250_000), 1.0, estimator="theobr", decimate="auto")
-    assert np.all(auto.m % 6 == 0)                            # D = ⌈250 000 / 100 000⌉ = 3
+    assert np.all(auto.m % 6 == 0)  # D = ⌈250 000 / 100 000⌉ = 3
 
 
-@pytest.mark.parametrize("decimate, match", [(0, "decimate must be an integer ≥ 1"), ("fast", "positive integer or 'auto'"),
-                                             (100, "leaves 20 samples")])
+@pytest.mark.parametrize(
+    "decimate, match",
+    [(0, "decimate must be an integer ≥ 1"), ("fast", "positive integer or 'auto'"), (100, "leaves 20 samples")],
+)
 def test_decimate_errors(decimate, match):
     with pytest.raises(ParameterError, match=match):
         allanite.avar(np.random.default_rng(0).normal(size=2_000), 1.0, estimator="theoh", decimate=decimate)

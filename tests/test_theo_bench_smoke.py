@@ -17,8 +17,9 @@ pytestmark = pytest.mark.skipif(not SCRIPT.is_file(), reason=f"{SCRIPT} not foun
 
 def test_theo_bench_quick(tmp_path):
     pytest.importorskip("allantools")
-    proc = subprocess.run([sys.executable, str(SCRIPT), "--quick", "--out", str(tmp_path)],
-                          capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(
+        [sys.executable, str(SCRIPT), "--quick", "--out", str(tmp_path)], capture_output=True, text=True, timeout=300
+    )
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
     rep = json.loads((tmp_path / "theo.json").read_text(encoding="utf-8"))
     t = rep["timings"]

@@ -41,8 +41,8 @@ def assert_printed(ours, tokens, labels, what, extra_rel=0.0):
     err = np.abs(ours - printed)
     bad = np.flatnonzero(~(err <= tol))
     assert bad.size == 0, f"{what}: {bad.size}/{len(tokens)} outside printed precision: " + "; ".join(
-        f"{labels[i]}: ours {ours[i]:.9e} printed {tokens[i]} (err {err[i]:.3g} > {tol[i]:.3g})"
-        for i in bad[:5])
+        f"{labels[i]}: ours {ours[i]:.9e} printed {tokens[i]} (err {err[i]:.3g} > {tol[i]:.3g})" for i in bad[:5]
+    )
 
 
 def nbs14_phase():
@@ -53,6 +53,7 @@ def nbs14_phase():
 # --------------------------------------------------------------------------------------------------
 # no shared data needed
 # --------------------------------------------------------------------------------------------------
+
 
 def _theo1_loops(x, tau0, m):
     """Theo1 as two literal Python loops (tiny records only)."""
@@ -98,12 +99,13 @@ def test_nbs14_theo1_deviation(m, printed):
 
 def test_nbs14_kf_textbook():
     x = nbs14_phase()
-    assert R.theobr_n(x.size) == 30                     # ⌊1001/30 − 3⌋ (1000 gives the same)
+    assert R.theobr_n(x.size) == 30  # ⌊1001/30 − 3⌋ (1000 gives the same)
     assert_printed([R.theobr_kf(x, 1.0)], ["1.0856664"], ["kf"], "NBS14 kf")
     # classic AVAR in the ratio, or one ratio more/less, would not match
-    for wrong in (R.theobr_kf(x, 1.0, rule="stable32"),
-                  np.mean([R._avar_tau0(x, 1.0, 9 + 3 * i) / R.theo1_from_angle(x, 1.0, 12 + 4 * i)
-                           for i in range(31)])):
+    for wrong in (
+        R.theobr_kf(x, 1.0, rule="stable32"),
+        np.mean([R._avar_tau0(x, 1.0, 9 + 3 * i) / R.theo1_from_angle(x, 1.0, 12 + 4 * i) for i in range(31)]),
+    ):
         assert abs(wrong - 1.0856664) > 1e-3
 
 
@@ -120,13 +122,13 @@ def test_theobr_n_rules():
 
 
 def test_theoh_grid_and_sources():
-    x = nbs14_phase()                                    # N = 1001, T = 1000 → k = 100
+    x = nbs14_phase()  # N = 1001, T = 1000 → k = 100
     assert R.theoh_switch(1001) == 100
     avar_ms, theo_ms = R.theoh_grid(1001)
     assert avar_ms[0] == 1 and avar_ms[-1] == 100
-    assert theo_ms[0] == 134 and theo_ms[-1] == 1000     # 0.75·132 = 99 ≤ 100 < 100.5 = 0.75·134
+    assert theo_ms[0] == 134 and theo_ms[-1] == 1000  # 0.75·132 = 99 ≤ 100 < 100.5 = 0.75·134
     r = R.theoh_reference(x, 1.0, avar_ms=[1, 10, 100, 101], theo_ms=[100, 132, 134, 500, 1000, 1001])
-    assert list(r.m) == [1, 10, 100, 134, 500, 1000]     # out-of-range entries dropped
+    assert list(r.m) == [1, 10, 100, 134, 500, 1000]  # out-of-range entries dropped
     assert list(r.source) == ["oavar"] * 3 + ["theobr"] * 3
     np.testing.assert_array_equal(r.tau, [1, 10, 100, 100.5, 375, 750])
     assert r.kf == pytest.approx(1.0856664, abs=5e-8)
@@ -141,14 +143,14 @@ def test_theoh_grid_and_sources():
 @pytest.mark.parametrize("estimator, short", [("theoh", "oavar"), ("theoh_a", "avar")])
 def test_dhvar_is_theoh_per_window(rng, estimator, short):
     y = rng.standard_normal(150)
-    window, hop, fs = 120, 15, 4.0                        # N = 121 phase points, T = 30 s, k_m = 12
+    window, hop, fs = 120, 15, 4.0  # N = 121 phase points, T = 30 s, k_m = 12
     d = R.dhvar_reference(y, fs, window, hop, estimator=estimator)
     assert d.var.shape == (d.tau.size, 3)
     assert set(d.source) == {short, "theobr"}
     assert d.m[d.source == short].max() == 12 and d.m[d.source == "theobr"].min() == 18
     assert d.m.max() == 120 and d.tau.max() == pytest.approx(0.75 * 120 / fs)
     for j in range(3):
-        x = R.angle_from_rate(y[j * hop: j * hop + window], fs)
+        x = R.angle_from_rate(y[j * hop : j * hop + window], fs)
         r = R.theoh_reference(x, 1 / fs, short=short)
         np.testing.assert_array_equal(r.m, d.m)
         np.testing.assert_allclose(d.var[:, j], r.var, rtol=1e-14)
@@ -158,13 +160,14 @@ def test_dhvar_is_theoh_per_window(rng, estimator, short):
 def test_theo1_edf_formulas():
     # hand-evaluated at N = 1253, m = 10 (r = 7.5): FFM (2N² − 1.3Nr − 3.5r)/(Nr)·r³/(r³ + 2.3)
     n, r = 1253.0, 7.5
-    assert R.theo1_edf(-1, 10, 1253) == pytest.approx((2 * n * n - 1.3 * n * r - 3.5 * r) / (n * r)
-                                                      * r ** 3 / (r ** 3 + 2.3), rel=1e-15)
+    assert R.theo1_edf(-1, 10, 1253) == pytest.approx(
+        (2 * n * n - 1.3 * n * r - 3.5 * r) / (n * r) * r**3 / (r**3 + 2.3), rel=1e-15
+    )
     assert R.theo1_edf(0, 10, 1253) == pytest.approx(544.20, abs=0.01)
     for a in (2, 1, 0, -1, -2):
         nu = [R.theo1_edf(a, m, 1001) for m in (10, 100, 500)]
         assert min(nu) > 0
-        if a <= 0:                                       # ν falls with m for the FM noises
+        if a <= 0:  # ν falls with m for the FM noises
             assert nu[0] > nu[1] > nu[2]
     with pytest.raises(ValueError):
         R.theo1_edf(3, 10, 100)
@@ -177,6 +180,7 @@ def test_theo1_noise_type_from_kf():
 # --------------------------------------------------------------------------------------------------
 # Stable32 tables (shared data)
 # --------------------------------------------------------------------------------------------------
+
 
 def read_theo_table(path: Path, ncols: int):
     """Stable32 Thêo1 (7 columns) / ThêoH (8 columns) table: 'Alpha = a' header, rows of numbers.
@@ -201,17 +205,17 @@ def _data(stable32_dir: Path, rel: str) -> Path:
     return p
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _phase(path: str) -> np.ndarray:
     return np.loadtxt(path, comments="#")
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _theo1(path: str, tau0: float, m: int) -> float:
     return R.theo1_from_angle(_phase(path), tau0, m)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _kf(path: str, tau0: float, rule: str) -> float:
     return R.theobr_kf(_phase(path), tau0, rule)
 
@@ -249,8 +253,13 @@ def test_phase_dat_theo1(stable32_dir, fname, alpha):
         assert abs(textbook / float(rows[0][5]) - 1) > 0.3
 
 
-SR87_TABLES = [("phase", "decade"), ("phase", "many"), ("phase0", "decade"), ("phase0", "many"),
-               ("phase0", "octave")]       # phase/octave/theo1.txt is an MTIE table (SOURCE.txt)
+SR87_TABLES = [
+    ("phase", "decade"),
+    ("phase", "many"),
+    ("phase0", "decade"),
+    ("phase0", "many"),
+    ("phase0", "octave"),
+]  # phase/octave/theo1.txt is an MTIE table (SOURCE.txt)
 
 
 def _sr87(stable32_dir, folder):
@@ -265,8 +274,13 @@ def _check_bounds(values, nus, lo_tokens, hi_tokens, labels, what, extra_rel=Non
         toks = np.asarray(toks)
         if big.any():
             extra = 0.0 if extra_rel is None else np.asarray(extra_rel)[big]
-            assert_printed(ours[big], list(toks[big]), [labels[i] for i in np.flatnonzero(big)],
-                           f"{what} {side} (ν > 100)", extra_rel=extra)
+            assert_printed(
+                ours[big],
+                list(toks[big]),
+                [labels[i] for i in np.flatnonzero(big)],
+                f"{what} {side} (ν > 100)",
+                extra_rel=extra,
+            )
         if (~big).any():
             printed = toks[~big].astype(float)
             np.testing.assert_allclose(ours[~big], printed, rtol=3e-4, err_msg=f"{what} {side} (ν ≤ 100)")
@@ -281,7 +295,7 @@ def test_sr87_kf_stable32_vs_textbook(stable32_dir):
     assert kf6 == pytest.approx(1.3491114, abs=5e-8)
     assert kft == pytest.approx(1.3170812, abs=5e-8)
     assert kf6 / kft == pytest.approx(1.02432, abs=5e-6)
-    assert R.theo1_noise_type(kf6) == -1                 # the tables' "Alpha = -1"
+    assert R.theo1_noise_type(kf6) == -1  # the tables' "Alpha = -1"
 
 
 @pytest.mark.parametrize("folder, grid", SR87_TABLES)
@@ -301,13 +315,22 @@ def test_sr87_theo1(stable32_dir, folder, grid):
     # the textbook kf misses every row by ~1.2 % in deviation
     textbook = np.sqrt(_kf(data, 2.5, "textbook") / kf) * dev
     assert np.all(np.abs(textbook / np.array([float(r[5]) for r in rows]) - 1) > 0.01)
-    if float(rows[0][4]) > 0:                            # 'many' tables print no bounds
+    if float(rows[0][4]) > 0:  # 'many' tables print no bounds
         nus = [R.theo1_edf(alpha, m, x.size) for m in ms]
         _check_bounds(dev, nus, [r[4] for r in rows], [r[6] for r in rows], labels, f"sr87 {folder}/{grid}")
 
 
-@pytest.mark.parametrize("folder, grid", [("phase", "decade"), ("phase", "octave"), ("phase", "many"),
-                                          ("phase0", "decade"), ("phase0", "octave"), ("phase0", "many")])
+@pytest.mark.parametrize(
+    "folder, grid",
+    [
+        ("phase", "decade"),
+        ("phase", "octave"),
+        ("phase", "many"),
+        ("phase0", "decade"),
+        ("phase0", "octave"),
+        ("phase0", "many"),
+    ],
+)
 def test_sr87_theoh(stable32_dir, folder, grid):
     """ThêoH table: 'Sigma' = OADEV at τ = AF·τ0 (listed for AF ≤ N/4), 'Thêo1 Dev' = TheoBR with
     Stable32's kf at τ = 0.75·AF·τ0 (listed for even AF ≥ ⌊N/5⌋ here); 'ThêoH Tau' is 0.75·AF·τ0 where
@@ -331,16 +354,19 @@ def test_sr87_theoh(stable32_dir, folder, grid):
     theo = np.array([np.sqrt(kf * _theo1(data, 2.5, int(m))) if t else 0.0 for m, t in zip(ms, has_theo)])
     assert_printed(sig[has_sigma], [r[4] for r, s in zip(rows, has_sigma) if s], list(ms[has_sigma]), "Sigma")
     assert_printed(theo[has_theo], [r[5] for r, t in zip(rows, has_theo) if t], list(ms[has_theo]), "Thêo1 Dev")
-    if float(rows[0][6]) > 0:                            # 'many' tables print no bounds
+    if float(rows[0][6]) > 0:  # 'many' tables print no bounds
         values = np.where(has_sigma, sig, theo)
-        nus = [float(edf_greenhall(alpha, 2, int(m), n)) if s else R.theo1_edf(alpha, int(m), n)
-               for m, s in zip(ms, has_sigma)]
+        nus = [
+            float(edf_greenhall(alpha, 2, int(m), n)) if s else R.theo1_edf(alpha, int(m), n)
+            for m, s in zip(ms, has_sigma)
+        ]
         # One OADEV bound (AF 10, ν = 169.6: ours 9.29894e-17, printed 9.2990e-17) lies 6e-6 relative
         # past the rounding boundary — Stable32's own OADEV table prints the same number, so this is
         # its Greenhall-EDF/χ² arithmetic, not ThêoH: 1e-5 relative extra slack on the OADEV rows only.
         extra = np.where(has_sigma, 1e-5, 0.0)
-        _check_bounds(values, nus, [r[6] for r in rows], [r[7] for r in rows], list(ms), f"{folder}/{grid} ThêoH",
-                      extra_rel=extra)
+        _check_bounds(
+            values, nus, [r[6] for r in rows], [r[7] for r in rows], list(ms), f"{folder}/{grid} ThêoH", extra_rel=extra
+        )
 
 
 def test_sr87_octave_theo1_trap(stable32_dir):

@@ -15,18 +15,38 @@ from allanite.units import adev_unit_label, convert, ieee952, parse_unit, rate_u
 D2R = math.pi / 180.0
 
 
-@pytest.mark.parametrize("spelling, name, kind", [
-    ("deg/s", "deg/s", "rate"), ("°/s", "deg/s", "rate"), ("dps", "deg/s", "rate"),
-    ("DEG / SEC", "deg/s", "rate"), ("degrees/second", "deg/s", "rate"),
-    ("rad/s", "rad/s", "rate"), ("rad/sec", "rad/s", "rate"),
-    ("deg/h", "deg/h", "rate"), ("°/h", "deg/h", "rate"), ("dph", "deg/h", "rate"), ("deg/hr", "deg/h", "rate"),
-    ("mrad/s", "mrad/s", "rate"), ("urad/s", "urad/s", "rate"), ("\u00b5rad/s", "urad/s", "rate"),
-    ("\u03bcrad/s", "urad/s", "rate"), ("arcsec/s", "arcsec/s", "rate"), ("rpm", "rpm", "rate"),
-    ("rev/s", "rev/s", "rate"), ("mdps", "mdeg/s", "rate"),
-    ("deg", "deg", "angle"), ("°", "deg", "angle"), ("rad", "rad", "angle"), ("mrad", "mrad", "angle"),
-    ("urad", "urad", "angle"), ("µrad", "urad", "angle"), ("arcsec", "arcsec", "angle"),
-    ("arcmin", "arcmin", "angle"),
-])
+@pytest.mark.parametrize(
+    "spelling, name, kind",
+    [
+        ("deg/s", "deg/s", "rate"),
+        ("°/s", "deg/s", "rate"),
+        ("dps", "deg/s", "rate"),
+        ("DEG / SEC", "deg/s", "rate"),
+        ("degrees/second", "deg/s", "rate"),
+        ("rad/s", "rad/s", "rate"),
+        ("rad/sec", "rad/s", "rate"),
+        ("deg/h", "deg/h", "rate"),
+        ("°/h", "deg/h", "rate"),
+        ("dph", "deg/h", "rate"),
+        ("deg/hr", "deg/h", "rate"),
+        ("mrad/s", "mrad/s", "rate"),
+        ("urad/s", "urad/s", "rate"),
+        ("\u00b5rad/s", "urad/s", "rate"),
+        ("\u03bcrad/s", "urad/s", "rate"),
+        ("arcsec/s", "arcsec/s", "rate"),
+        ("rpm", "rpm", "rate"),
+        ("rev/s", "rev/s", "rate"),
+        ("mdps", "mdeg/s", "rate"),
+        ("deg", "deg", "angle"),
+        ("°", "deg", "angle"),
+        ("rad", "rad", "angle"),
+        ("mrad", "mrad", "angle"),
+        ("urad", "urad", "angle"),
+        ("µrad", "urad", "angle"),
+        ("arcsec", "arcsec", "angle"),
+        ("arcmin", "arcmin", "angle"),
+    ],
+)
 def test_parse_unit_aliases(spelling, name, kind):
     u = parse_unit(spelling)
     assert (u.name, u.kind) == (name, kind)
@@ -34,12 +54,25 @@ def test_parse_unit_aliases(spelling, name, kind):
     assert parse_unit(u) is u
 
 
-@pytest.mark.parametrize("name, factor", [
-    ("deg/s", 1.0), ("rad/s", 180 / math.pi), ("deg/h", 1 / 3600), ("mrad/s", 0.180 / math.pi),
-    ("urad/s", 1.8e-4 / math.pi), ("arcsec/s", 1 / 3600), ("rpm", 6.0), ("rev/s", 360.0),
-    ("deg", 1.0), ("rad", 180 / math.pi), ("mrad", 0.180 / math.pi), ("urad", 1.8e-4 / math.pi),
-    ("arcsec", 1 / 3600), ("arcmin", 1 / 60),
-])
+@pytest.mark.parametrize(
+    "name, factor",
+    [
+        ("deg/s", 1.0),
+        ("rad/s", 180 / math.pi),
+        ("deg/h", 1 / 3600),
+        ("mrad/s", 0.180 / math.pi),
+        ("urad/s", 1.8e-4 / math.pi),
+        ("arcsec/s", 1 / 3600),
+        ("rpm", 6.0),
+        ("rev/s", 360.0),
+        ("deg", 1.0),
+        ("rad", 180 / math.pi),
+        ("mrad", 0.180 / math.pi),
+        ("urad", 1.8e-4 / math.pi),
+        ("arcsec", 1 / 3600),
+        ("arcmin", 1 / 60),
+    ],
+)
 def test_unit_factors_to_degrees(name, factor):
     assert parse_unit(name).factor == pytest.approx(factor, rel=1e-15)
 
@@ -65,8 +98,7 @@ def test_convert_rejects_mixed_kinds():
 
 def test_to_deg_per_s():
     np.testing.assert_allclose(to_deg_per_s([3600.0, -7200.0], "deg/h"), [1.0, -2.0], rtol=1e-15)
-    np.testing.assert_allclose(to_deg_per_s(np.array([1.0, 2.0]), "rad/s"), [180 / math.pi, 360 / math.pi],
-                               rtol=1e-15)
+    np.testing.assert_allclose(to_deg_per_s(np.array([1.0, 2.0]), "rad/s"), [180 / math.pi, 360 / math.pi], rtol=1e-15)
     out = to_deg_per_s([1, 2], "deg/s")
     assert out.dtype == np.float64 and out.tolist() == [1.0, 2.0]
 
@@ -78,8 +110,11 @@ def test_to_deg_per_s_needs_a_rate_unit():
 
 @pytest.mark.parametrize("bad", ["furlong/fortnight", "deg/s/s", "", "g"])
 def test_unknown_unit_lists_allowed(bad):
-    with pytest.raises(ParameterError, match=rf"unknown unit {bad!r}; allowed rate units: deg/s, .*rad/s.*"
-                                             rf"angle units: deg, .*arcsec"):
+    with pytest.raises(
+        ParameterError,
+        match=rf"unknown unit {bad!r}; allowed rate units: deg/s, .*rad/s.*"
+        rf"angle units: deg, .*arcsec",
+    ):
         parse_unit(bad)
 
 
@@ -90,8 +125,11 @@ def test_unit_must_be_string():
 
 def test_parse_unit_kind_restriction():
     assert parse_unit("rad", kind="angle").name == "rad"
-    with pytest.raises(ParameterError, match=r"unit 'rad/s' is a rate unit, but an angle unit is needed here; "
-                                             r"allowed angle units: deg"):
+    with pytest.raises(
+        ParameterError,
+        match=r"unit 'rad/s' is a rate unit, but an angle unit is needed here; "
+        r"allowed angle units: deg",
+    ):
         parse_unit("rad/s", kind="angle")
     with pytest.raises(ParameterError, match=r"unknown unit kind 'speed'"):
         parse_unit("rad/s", kind="speed")
@@ -106,18 +144,21 @@ def test_rate_unit_of_angles():
 
 
 # IEEE-952 factors (FORMULAS.md §6), from °/s samples
-@pytest.mark.parametrize("term, to, factor, label", [
-    ("N", None, 60.0, "°/√h"),                 # 1 °/√s = 60 °/√h
-    ("B", None, 3600.0, "°/h"),                # 1 °/s = 3600 °/h
-    ("K", None, 216000.0, "°/h^1.5"),          # 1 °/s^1.5 = 216000 °/h^1.5
-    ("R", None, 1.296e7, "°/h²"),              # 1 °/s² = 1.296e7 °/h²
-    ("Q", None, 1.0, "°"),
-    ("Q", "arcsec", 3600.0, "arcsec"),         # Q[arcsec] = 3600 Q[°]
-    ("Q", "urad", 1e6 * math.pi / 180, "µrad"),
-    ("N", "deg/sqrt(s)", 1.0, "°/√s"),
-    ("N", "deg/h/sqrt(Hz)", 3600.0, "°/h/√Hz"),
-    ("B", "rad/s", math.pi / 180, "rad/s"),
-])
+@pytest.mark.parametrize(
+    "term, to, factor, label",
+    [
+        ("N", None, 60.0, "°/√h"),  # 1 °/√s = 60 °/√h
+        ("B", None, 3600.0, "°/h"),  # 1 °/s = 3600 °/h
+        ("K", None, 216000.0, "°/h^1.5"),  # 1 °/s^1.5 = 216000 °/h^1.5
+        ("R", None, 1.296e7, "°/h²"),  # 1 °/s² = 1.296e7 °/h²
+        ("Q", None, 1.0, "°"),
+        ("Q", "arcsec", 3600.0, "arcsec"),  # Q[arcsec] = 3600 Q[°]
+        ("Q", "urad", 1e6 * math.pi / 180, "µrad"),
+        ("N", "deg/sqrt(s)", 1.0, "°/√s"),
+        ("N", "deg/h/sqrt(Hz)", 3600.0, "°/h/√Hz"),
+        ("B", "rad/s", math.pi / 180, "rad/s"),
+    ],
+)
 def test_ieee952_factors_from_deg_per_s(term, to, factor, label):
     q = ieee952(term, 1.0, "deg/s", to=to)
     assert q.value == pytest.approx(factor, rel=1e-14)

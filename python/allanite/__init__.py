@@ -15,13 +15,32 @@ from .estimators.grid import tau_grid
 from .io import Log, read_log
 from .model import CoefficientSeries, NoiseFit, Refinement, fit, information_bound, refine
 from .results import AllanResult, DynamicAllanResult
-from .simulate import simulate
+from .simulation import simulate
 
 __all__ = [
-    "avar", "davar", "tau_grid", "default_record", "simulate",
-    "read_log", "Log", "fit", "information_bound", "NoiseFit", "CoefficientSeries", "refine", "Refinement",
-    "confidence_intervals", "identify_alpha", "edf_greenhall", "edf_sp1065", "chi2_interval",
-    "AllanResult", "DynamicAllanResult",
-    "AllaniteError", "InputError", "ParameterError", "MemoryBudgetError",
+    "avar",
+    "davar",
+    "tau_grid",
+    "default_record",
+    "simulate",
+    "read_log",
+    "Log",
+    "fit",
+    "information_bound",
+    "NoiseFit",
+    "CoefficientSeries",
+    "refine",
+    "Refinement",
+    "confidence_intervals",
+    "identify_alpha",
+    "edf_greenhall",
+    "edf_sp1065",
+    "chi2_interval",
+    "AllanResult",
+    "DynamicAllanResult",
+    "AllaniteError",
+    "InputError",
+    "ParameterError",
+    "MemoryBudgetError",
     "__version__",
 ]

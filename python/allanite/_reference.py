@@ -27,7 +27,7 @@ def oavar_from_angle(x, fs, m) -> float:
     x = np.asarray(x)
     n = x.size
     tau0 = 1.0 / fs
-    d = x[2 * m:] - 2 * x[m:n - m] + x[:n - 2 * m]
+    d = x[2 * m :] - 2 * x[m : n - m] + x[: n - 2 * m]
     return float(np.sum(d * d) / (2.0 * m * m * tau0 * tau0 * (n - 2 * m)))
 
 
@@ -36,7 +36,7 @@ def avar_from_angle(x, fs, m) -> float:
     x = np.asarray(x)
     tau0 = 1.0 / fs
     k = (x.size - 1) // m
-    xs = x[: k * m + 1: m]
+    xs = x[: k * m + 1 : m]
     d = xs[2:] - 2 * xs[1:-1] + xs[:-2]
     return float(np.sum(d * d) / (2.0 * m * m * tau0 * tau0 * (k - 1)))
 
@@ -55,7 +55,7 @@ def davar_reference(y, fs, window, hop, ms, estimator="oavar", dtype=np.float64)
     out = np.empty((len(ms), n_win))
     for j in range(n_win):
         s = j * hop
-        out[:, j] = avar_reference(y[s:s + window], fs, ms, estimator, dtype=dtype)
+        out[:, j] = avar_reference(y[s : s + window], fs, ms, estimator, dtype=dtype)
     return out
 
 
@@ -72,7 +72,7 @@ def davar_prefix(y, fs, window, hop, ms) -> np.ndarray:
     out = np.empty((len(ms), starts.size))
     for i, m in enumerate(ms):
         m = int(m)
-        d = x[2 * m:] - 2 * x[m:n - m] + x[:n - 2 * m]
+        d = x[2 * m :] - 2 * x[m : n - m] + x[: n - 2 * m]
         c = np.concatenate(([0.0], np.cumsum(d * d)))
         terms = window + 1 - 2 * m
         out[i] = (c[starts + terms] - c[starts]) / (2.0 * m * m * tau0 * tau0 * terms)
@@ -152,7 +152,7 @@ def _oavar_tau0(x, tau0, m, dtype=np.float64):
     n = x.size
     if n - 2 * m < 1:
         raise ValueError(f"overlapping AVAR needs N − 2m ≥ 1, got N = {n}, m = {m}")
-    d = x[2 * m:] - 2 * x[m:n - m] + x[:n - 2 * m]
+    d = x[2 * m :] - 2 * x[m : n - m] + x[: n - 2 * m]
     return np.sum(d * d) / (dtype(2) * dtype(m) ** 2 * dtype(tau0) ** 2 * dtype(n - 2 * m))
 
 
@@ -162,7 +162,7 @@ def _avar_tau0(x, tau0, m, dtype=np.float64):
     k = (x.size - 1) // m
     if k < 2:
         raise ValueError(f"classic AVAR needs ⌊(N−1)/m⌋ ≥ 2, got N = {x.size}, m = {m}")
-    xs = x[: k * m + 1: m]
+    xs = x[: k * m + 1 : m]
     d = xs[2:] - 2 * xs[1:-1] + xs[:-2]
     return np.sum(d * d) / (dtype(2) * dtype(m) ** 2 * dtype(tau0) ** 2 * dtype(k - 1))
 
@@ -177,9 +177,9 @@ def theobr_n(n_points, rule="textbook") -> int:
     """
     n_points = int(n_points)
     if rule == "textbook":
-        return (n_points - 90) // 30          # ⌊N/30 − 3⌋
+        return (n_points - 90) // 30  # ⌊N/30 − 3⌋
     if rule == "stable32":
-        return (n_points - 18) // 6           # ⌊N/6 − 3⌋
+        return (n_points - 18) // 6  # ⌊N/6 − 3⌋
     raise ValueError(f"unknown kf rule {rule!r}; allowed: 'textbook', 'stable32'")
 
 
@@ -193,8 +193,9 @@ def theobr_kf(x, tau0, rule="textbook", dtype=np.float64) -> float:
     n = theobr_n(x.size, rule)
     if n < 0:
         raise ValueError(f"TheoBR needs n = {n} ≥ 0 (N = {x.size} phase points too few for rule {rule!r})")
-    ratios = [_oavar_tau0(x, tau0, 9 + 3 * i, dtype) / theo1_from_angle(x, tau0, 12 + 4 * i, dtype)
-              for i in range(n + 1)]
+    ratios = [
+        _oavar_tau0(x, tau0, 9 + 3 * i, dtype) / theo1_from_angle(x, tau0, 12 + 4 * i, dtype) for i in range(n + 1)
+    ]
     return np.sum(np.array(ratios, dtype=dtype)) / dtype(n + 1)
 
 
@@ -206,10 +207,11 @@ def theobr_reference(x, tau0, ms, rule="textbook", dtype=np.float64) -> np.ndarr
 
 class TheoH(NamedTuple):
     """A TheoH result: averaging factor, τ, variance and which estimator gave each entry."""
-    m: np.ndarray        # averaging factor (AVAR: τ = m·τ0; TheoBR: τ = 0.75·m·τ0)
+
+    m: np.ndarray  # averaging factor (AVAR: τ = m·τ0; TheoBR: τ = 0.75·m·τ0)
     tau: np.ndarray
     var: np.ndarray
-    source: np.ndarray   # "oavar" | "avar" (short τ) or "theobr" (long τ)
+    source: np.ndarray  # "oavar" | "avar" (short τ) or "theobr" (long τ)
     kf: float
 
 
@@ -228,8 +230,9 @@ def theoh_grid(n_points, fraction=Fraction(1, 10)):
     return avar_ms, theo_ms
 
 
-def theoh_reference(x, tau0, avar_ms=None, theo_ms=None, short="oavar", rule="textbook",
-                    fraction=Fraction(1, 10), dtype=np.float64) -> TheoH:
+def theoh_reference(
+    x, tau0, avar_ms=None, theo_ms=None, short="oavar", rule="textbook", fraction=Fraction(1, 10), dtype=np.float64
+) -> TheoH:
     """TheoH (Howe 2006; paper 001): Allan variance for τ ≤ k, TheoBR beyond.
 
     k = k_m·τ0 with k_m = ⌊0.1·(N − 1)⌋ (largest τ ≤ 10 % of T = (N − 1)·τ0). Short τ: every m of
@@ -255,21 +258,28 @@ def theoh_reference(x, tau0, avar_ms=None, theo_ms=None, short="oavar", rule="te
     var = [f(x, tau0, m, dtype) for m in avar_ms] + [kf * theo1_from_angle(x, tau0, m, dtype) for m in theo_ms]
     source = [short] * len(avar_ms) + ["theobr"] * len(theo_ms)
     order = np.argsort(np.array(tau, dtype=np.float64), kind="stable")
-    return TheoH(np.array(ms, dtype=np.int64)[order], np.array(tau, dtype=np.float64)[order],
-                 np.array(var, dtype=dtype)[order], np.array(source)[order], kf)
+    return TheoH(
+        np.array(ms, dtype=np.int64)[order],
+        np.array(tau, dtype=np.float64)[order],
+        np.array(var, dtype=dtype)[order],
+        np.array(source)[order],
+        kf,
+    )
 
 
 class DHVAR(NamedTuple):
     """Dynamic TheoH: one column of variances per window (rows follow m/tau/source)."""
+
     m: np.ndarray
     tau: np.ndarray
     source: np.ndarray
-    var: np.ndarray      # shape (len(tau), windows)
-    kf: np.ndarray       # kf of each window
+    var: np.ndarray  # shape (len(tau), windows)
+    kf: np.ndarray  # kf of each window
 
 
-def dhvar_reference(y, fs, window, hop, avar_ms=None, theo_ms=None, estimator="theoh",
-                    rule="textbook", dtype=np.float64) -> DHVAR:
+def dhvar_reference(
+    y, fs, window, hop, avar_ms=None, theo_ms=None, estimator="theoh", rule="textbook", dtype=np.float64
+) -> DHVAR:
     """Dynamic TheoH of paper 001 (Zhu, Wang, Chen, Xue, J. BUAA 2017): DAVAR with TheoH per window.
 
     Window j holds the rate samples y[j·hop : j·hop + window] (paper 001: a rectangular window of
@@ -292,7 +302,7 @@ def dhvar_reference(y, fs, window, hop, avar_ms=None, theo_ms=None, estimator="t
     cols, kfs, first = [], [], None
     for j in range(n_win):
         s = j * hop
-        x = angle_from_rate(y[s:s + window], fs, dtype=dtype)
+        x = angle_from_rate(y[s : s + window], fs, dtype=dtype)
         r = theoh_reference(x, 1.0 / fs, avar_ms, theo_ms, short=short, rule=rule, dtype=dtype)
         first = first or r
         cols.append(r.var)
@@ -320,9 +330,9 @@ def theo1_edf(alpha, m, n_points) -> float:
     if alpha == 1:
         return (4.798 * n * n - 6.374 * n * r + 12.387 * r) / (np.sqrt(r + 36.6) * (n - r)) * (r / (r + 0.3))
     if alpha == 0:
-        return ((4.1 * n + 0.8) / r - (3.1 * n + 6.5) / n) * (r ** 1.5 / (r ** 1.5 + 5.2))
+        return ((4.1 * n + 0.8) / r - (3.1 * n + 6.5) / n) * (r**1.5 / (r**1.5 + 5.2))
     if alpha == -1:
-        return (2 * n * n - 1.3 * n * r - 3.5 * r) / (n * r) * (r ** 3 / (r ** 3 + 2.3))
+        return (2 * n * n - 1.3 * n * r - 3.5 * r) / (n * r) * (r**3 / (r**3 + 2.3))
     if alpha == -2:
         a = 4.4 * n
         return (a - 2) / (2.9 * r) * (((a - 1) ** 2 - 8.6 * r * (a - 1) + 11.4 * r * r) / (a - 3) ** 2)
@@ -331,7 +341,7 @@ def theo1_edf(alpha, m, n_points) -> float:
 
 def theo1_noise_type(kf) -> int:
     """Stable32's run-wide noise type from kf: the nominal bias (THEO1_NOMINAL_BIAS) nearest in log."""
-    alphas = sorted(THEO1_NOMINAL_BIAS, reverse=True)      # 2, 1, 0, −1, −2: bias increasing
+    alphas = sorted(THEO1_NOMINAL_BIAS, reverse=True)  # 2, 1, 0, −1, −2: bias increasing
     for a, b in zip(alphas[:-1], alphas[1:]):
         if kf < np.sqrt(THEO1_NOMINAL_BIAS[a] * THEO1_NOMINAL_BIAS[b]):
             return a

@@ -22,8 +22,17 @@ __all__ = ["avar", "davar", "METHODS"]
 METHODS = ("fast", "naive")
 
 
-def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar", workers=None,
-         kf_rule: str = "textbook", decimate="auto") -> AllanResult:
+def avar(
+    x,
+    fs,
+    *,
+    input: str = "rate",
+    taus="octave",
+    estimator: str = "oavar",
+    workers=None,
+    kf_rule: str = "textbook",
+    decimate="auto",
+) -> AllanResult:
     """Allan variance of a whole record.
 
     Parameters
@@ -83,12 +92,34 @@ def avar(x, fs, *, input: str = "rate", taus="octave", estimator: str = "oavar",
     values, kf = out.values, out.kf
     if not is_multi:
         values, kf = values[0], (None if kf is None else float(kf[0]))
-    return AllanResult(tau=out.tau, avar=values, n=out.n, m=out.m, estimator=estimator, fs=fs,
-                       n_samples=cols[0].size, input=input, source=out.source, kf=kf)
+    return AllanResult(
+        tau=out.tau,
+        avar=values,
+        n=out.n,
+        m=out.m,
+        estimator=estimator,
+        fs=fs,
+        n_samples=cols[0].size,
+        input=input,
+        source=out.source,
+        kf=kf,
+    )
 
 
-def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: str = "oavar",
-          input: str = "rate", workers=None, max_memory=None, kf_rule: str = "textbook") -> DynamicAllanResult:
+def davar(
+    x,
+    fs,
+    *,
+    window,
+    hop=1,
+    taus="exp",
+    method: str = "fast",
+    estimator: str = "oavar",
+    input: str = "rate",
+    workers=None,
+    max_memory=None,
+    kf_rule: str = "textbook",
+) -> DynamicAllanResult:
     """Dynamic Allan variance: the Allan variance of every sliding window (DAVAR).
 
     Column j of the result is exactly the static Allan variance (:func:`avar`) of the ``window``
@@ -155,8 +186,9 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
     if window > n:
         raise ParameterError(f"window ({window} samples) is longer than the record ({n} samples)")
     if method not in entry.methods:
-        raise ParameterError(f"estimator {estimator!r} is computed with method={entry.methods[0]!r} only, "
-                             f"got method={method!r}")
+        raise ParameterError(
+            f"estimator {estimator!r} is computed with method={entry.methods[0]!r} only, got method={method!r}"
+        )
     assert entry.dynamic is not None and entry.resolve_m is not None
     ms = entry.resolve_m(taus, window, fs)
     n_win = (n - window) // hop + 1
@@ -165,8 +197,10 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
     budget = resolve_max_memory(max_memory)
     if nbytes > budget:
         per_window = n_axes * ms.size * 8
-        size = (f"the output would take {nbytes / 2**30:.2f} GiB ({n_axes} axes × {ms.size} τ × {n_win} windows "
-                f"× 8 bytes), over the memory budget of {budget / 2**30:.2f} GiB")
+        size = (
+            f"the output would take {nbytes / 2**30:.2f} GiB ({n_axes} axes × {ms.size} τ × {n_win} windows "
+            f"× 8 bytes), over the memory budget of {budget / 2**30:.2f} GiB"
+        )
         if per_window > budget:
             raise MemoryBudgetError(
                 f"{size}; even one window ({per_window} bytes) does not fit: use fewer τ or raise "
@@ -175,16 +209,25 @@ def davar(x, fs, *, window, hop=1, taus="exp", method: str = "fast", estimator: 
         # windows = (n − window)//hop + 1 ≤ budget/per_window: the smallest hop that fits.
         max_windows = budget // per_window
         suggest = n if max_windows <= 1 else max(hop + 1, -(-(n - window) // (max_windows - 1)))
-        raise MemoryBudgetError(
-            f"{size}; use hop ≥ {suggest}, fewer τ, or raise max_memory / ALLANITE_MAX_MEMORY"
-        )
+        raise MemoryBudgetError(f"{size}; use hop ≥ {suggest}, fewer τ, or raise max_memory / ALLANITE_MAX_MEMORY")
     # A hop beyond the record gives one window, as does the record length itself.
     hop_core = min(hop, n)
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
     out = entry.dynamic(cols, fs, window, hop_core, taus, method, workers, **options)
     kf = out.kf
     return DynamicAllanResult(
-        tau=out.tau, t=t, avar=out.values if is_multi else out.values[0], n=out.n, m=out.m, window=window, hop=hop,
-        method=method, estimator=estimator, fs=fs, n_samples=n, input=input, source=out.source,
+        tau=out.tau,
+        t=t,
+        avar=out.values if is_multi else out.values[0],
+        n=out.n,
+        m=out.m,
+        window=window,
+        hop=hop,
+        method=method,
+        estimator=estimator,
+        fs=fs,
+        n_samples=n,
+        input=input,
+        source=out.source,
         kf=kf if (kf is None or is_multi) else kf[0],
     )

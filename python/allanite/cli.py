@@ -95,56 +95,99 @@ def _formatter(prog):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="allanite", usage="%(prog)s [-h] [--version] COMMAND [ARGS ...]", description=DESCRIPTION,
-                     epilog=EPILOG, formatter_class=_formatter)
-    parser.add_argument("--version", action="version", version=f"allanite {__version__}",
-                        help="show the version and exit")
+    parser = _Parser(
+        prog="allanite",
+        usage="%(prog)s [-h] [--version] COMMAND [ARGS ...]",
+        description=DESCRIPTION,
+        epilog=EPILOG,
+        formatter_class=_formatter,
+    )
+    parser.add_argument(
+        "--version", action="version", version=f"allanite {__version__}", help="show the version and exit"
+    )
     # the commands are listed in DESCRIPTION (argparse's own listing adds a stray "COMMAND" line)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", help=argparse.SUPPRESS, parser_class=_Parser)
-    rep = sub.add_parser("report", prog="allanite report", description=REPORT_DESCRIPTION, epilog=REPORT_EPILOG, formatter_class=_formatter)
-    rep.add_argument("log", nargs="?", metavar="LOG",
-                     help="the log: CSV/TSV/whitespace text (.gz too), .npy, .npz, Parquet, ROS 1 .bag or ROS 2 "
-                          "bag; default: the bundled record")
+    rep = sub.add_parser(
+        "report",
+        prog="allanite report",
+        description=REPORT_DESCRIPTION,
+        epilog=REPORT_EPILOG,
+        formatter_class=_formatter,
+    )
+    rep.add_argument(
+        "log",
+        nargs="?",
+        metavar="LOG",
+        help="the log: CSV/TSV/whitespace text (.gz too), .npy, .npz, Parquet, ROS 1 .bag or ROS 2 "
+        "bag; default: the bundled record",
+    )
 
     inp = rep.add_argument_group("input (LOG only)")
-    inp.add_argument("--fs", type=float, metavar="HZ",
-                     help="sampling rate in Hz (or give --time-column; ROS bags use their stamps)")
-    inp.add_argument("--columns", metavar="C1,C2,...",
-                     help="columns that are the samples, by name or 0-based index, comma-separated; one per "
-                          "axis (default: every column but the time column)")
+    inp.add_argument(
+        "--fs", type=float, metavar="HZ", help="sampling rate in Hz (or give --time-column; ROS bags use their stamps)"
+    )
+    inp.add_argument(
+        "--columns",
+        metavar="C1,C2,...",
+        help="columns that are the samples, by name or 0-based index, comma-separated; one per "
+        "axis (default: every column but the time column)",
+    )
     inp.add_argument("--time-column", metavar="C", help="column of sample times: derives --fs, finds gaps")
     inp.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), help="unit of the time column (default: s)")
-    inp.add_argument("--unit", metavar="U",
-                     help="unit of the samples: deg/s, rad/s, deg/h, mrad/s, urad/s, ... (rate input) or deg, rad, "
-                          "arcsec, ... (increment/angle input); without it the report says the unit is unknown "
-                          "and gives the noise coefficients in base form")
-    inp.add_argument("--input", choices=("rate", "increment", "angle"),
-                     help="what the samples are: rate (default), angle increments per sample, cumulative angle")
-    inp.add_argument("--gaps", choices=("error", "longest", "split"),
-                     help="when the time column shows gaps: stop with the list of gaps (default), analyse the "
-                          "longest gap-free stretch, or the same and list every stretch (split)")
+    inp.add_argument(
+        "--unit",
+        metavar="U",
+        help="unit of the samples: deg/s, rad/s, deg/h, mrad/s, urad/s, ... (rate input) or deg, rad, "
+        "arcsec, ... (increment/angle input); without it the report says the unit is unknown "
+        "and gives the noise coefficients in base form",
+    )
+    inp.add_argument(
+        "--input",
+        choices=("rate", "increment", "angle"),
+        help="what the samples are: rate (default), angle increments per sample, cumulative angle",
+    )
+    inp.add_argument(
+        "--gaps",
+        choices=("error", "longest", "split"),
+        help="when the time column shows gaps: stop with the list of gaps (default), analyse the "
+        "longest gap-free stretch, or the same and list every stretch (split)",
+    )
 
     ana = rep.add_argument_group("analysis")
-    ana.add_argument("--taus", metavar="GRID", default="octave",
-                     help="tau of the static analysis: octave (default), decade, exp, all, or seconds "
-                          "comma-separated (0.01,0.1,1,10)")
-    ana.add_argument("--window", type=int, metavar="N",
-                     help="DAVAR window in samples (default: 1/12 of the record)")
-    ana.add_argument("--hop", type=int, metavar="N",
-                     help="DAVAR hop between windows in samples (default: 1/25 of the window)")
-    ana.add_argument("--estimator", choices=("oavar", "theoh"), default="oavar",
-                     help="oavar: overlapping Allan deviation and DAVAR (default); theoh: TheoH for the record and "
-                          "paper 001's dynamic TheoH (DHVAR) over time, reaching 75%% of the record or window "
-                          "(default window then at most 2001 samples)")
-    ana.add_argument("--refine", action="store_true",
-                     help="also look for what the noise model lacks (Gauss-Markov, sinusoid, change points) and "
-                          "add a model-refinement section; a few seconds per axis and million samples")
-    ana.add_argument("--no-fit", action="store_true",
-                     help="skip the noise-model fit (whole record and per window)")
+    ana.add_argument(
+        "--taus",
+        metavar="GRID",
+        default="octave",
+        help="tau of the static analysis: octave (default), decade, exp, all, or seconds "
+        "comma-separated (0.01,0.1,1,10)",
+    )
+    ana.add_argument("--window", type=int, metavar="N", help="DAVAR window in samples (default: 1/12 of the record)")
+    ana.add_argument(
+        "--hop", type=int, metavar="N", help="DAVAR hop between windows in samples (default: 1/25 of the window)"
+    )
+    ana.add_argument(
+        "--estimator",
+        choices=("oavar", "theoh"),
+        default="oavar",
+        help="oavar: overlapping Allan deviation and DAVAR (default); theoh: TheoH for the record and "
+        "paper 001's dynamic TheoH (DHVAR) over time, reaching 75%% of the record or window "
+        "(default window then at most 2001 samples)",
+    )
+    ana.add_argument(
+        "--refine",
+        action="store_true",
+        help="also look for what the noise model lacks (Gauss-Markov, sinusoid, change points) and "
+        "add a model-refinement section; a few seconds per axis and million samples",
+    )
+    ana.add_argument("--no-fit", action="store_true", help="skip the noise-model fit (whole record and per window)")
 
     out = rep.add_argument_group("output")
-    out.add_argument("--out", default="allanite-report", metavar="DIR",
-                     help="folder for the report, created if needed (default: %(default)s)")
+    out.add_argument(
+        "--out",
+        default="allanite-report",
+        metavar="DIR",
+        help="folder for the report, created if needed (default: %(default)s)",
+    )
     out.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     return parser
 
@@ -157,8 +200,15 @@ class _Progress:
     """A tqdm bar over the report's steps, on stderr; off with --quiet or when stderr is no terminal."""
 
     def __init__(self, quiet: bool):
-        self.bar = tqdm(total=8, file=sys.stderr, disable=True if quiet else None, leave=False, unit="step",
-                        bar_format="{desc:<38.38}|{bar}| {n_fmt}/{total_fmt} [{elapsed}]", dynamic_ncols=True)
+        self.bar = tqdm(
+            total=8,
+            file=sys.stderr,
+            disable=True if quiet else None,
+            leave=False,
+            unit="step",
+            bar_format="{desc:<38.38}|{bar}| {n_fmt}/{total_fmt} [{elapsed}]",
+            dynamic_ncols=True,
+        )
         self.started = False
 
     def step(self, name: str) -> None:
@@ -198,14 +248,16 @@ def _taus(text: str):
     try:
         return [float(t) for t in text.split(",")]
     except ValueError:
-        raise _UsageError(f"argument --taus: {text!r} is neither a grid name (octave, decade, exp, all) nor "
-                          f"comma-separated seconds") from None
+        raise _UsageError(
+            f"argument --taus: {text!r} is neither a grid name (octave, decade, exp, all) nor comma-separated seconds"
+        ) from None
 
 
 def _cli_words(message: str) -> str:
     """Library messages speak Python (gaps='longest'); say it as options, on one line."""
-    message = re.sub(r"\b(gaps|input|time_unit)='([a-z]+)'",
-                     lambda m: f"--{m.group(1).replace('_', '-')} {m.group(2)}", message)
+    message = re.sub(
+        r"\b(gaps|input|time_unit)='([a-z]+)'", lambda m: f"--{m.group(1).replace('_', '-')} {m.group(2)}", message
+    )
     message = message.replace("drop fs=,", "drop --fs,").replace("time_unit=", "--time-unit")
     return " ".join(message.split())
 
@@ -227,8 +279,16 @@ def _read(args, progress):
         time_column = int(tc) if tc.isdigit() else tc
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        log = read_log(path, fs=args.fs, columns=columns, time_column=time_column, unit=args.unit,
-                       input=args.input or "rate", gaps=args.gaps or "error", **kwargs)
+        log = read_log(
+            path,
+            fs=args.fs,
+            columns=columns,
+            time_column=time_column,
+            unit=args.unit,
+            input=args.input or "rate",
+            gaps=args.gaps or "error",
+            **kwargs,
+        )
     notes = [" ".join(str(w.message).split()) for w in caught]
     return log, notes
 
@@ -238,8 +298,10 @@ def _report(args) -> int:
     if args.log is None:
         given = [f"--{o.replace('_', '-')}" for o in _LOG_OPTIONS if getattr(args, o) is not None]
         if given:
-            raise _UsageError(f"{', '.join(given)} describe{'s' if len(given) == 1 else ''} a LOG file; without LOG "
-                              f"the bundled record (100 Hz, 3 axes, deg/s) is analysed")
+            raise _UsageError(
+                f"{', '.join(given)} describe{'s' if len(given) == 1 else ''} a LOG file; without LOG "
+                f"the bundled record (100 Hz, 3 axes, deg/s) is analysed"
+            )
     taus = _taus(args.taus)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
@@ -250,13 +312,22 @@ def _report(args) -> int:
         with warnings.catch_warnings():
             if quiet:
                 warnings.simplefilter("ignore")
-            common = dict(window=args.window, hop=args.hop, taus=taus, fit=not args.no_fit, progress=progress,
-                          estimator=args.estimator, refine=args.refine)
+            common = dict(
+                window=args.window,
+                hop=args.hop,
+                taus=taus,
+                fit=not args.no_fit,
+                progress=progress,
+                estimator=args.estimator,
+                refine=args.refine,
+            )
             if args.log is None:
                 progress.step("generating the bundled record")
                 x, fs, info = default_record()
-                source = {"name": "bundled record", **{k: (list(v) if isinstance(v, tuple) else v)
-                                                       for k, v in info.items()}}
+                source = {
+                    "name": "bundled record",
+                    **{k: (list(v) if isinstance(v, tuple) else v) for k, v in info.items()},
+                }
                 rep = build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common)
             else:
                 log, notes = _read(args, progress)

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .simulate import ar1
+from .simulation import ar1
 
 __all__ = ["default_record", "DEFAULT_FS", "DEFAULT_SEED"]
 

@@ -7,8 +7,14 @@ wrong and what is allowed. The Rust core's errors arrive as the same classes.
 
 from __future__ import annotations
 
-__all__ = ["AllaniteError", "InputError", "ParameterError", "MemoryBudgetError", "DataGapError",
-           "MissingDependencyError"]
+__all__ = [
+    "AllaniteError",
+    "InputError",
+    "ParameterError",
+    "MemoryBudgetError",
+    "DataGapError",
+    "MissingDependencyError",
+]
 
 
 class AllaniteError(ValueError):

@@ -56,8 +56,9 @@ def _rows(result, axis):
     return [int(axis)]
 
 
-def plot_adev(result, ax=None, unit: str | None = None, labels=None, axis: int | None = None, band: bool = True,
-              **kwargs):
+def plot_adev(
+    result, ax=None, unit: str | None = None, labels=None, axis: int | None = None, band: bool = True, **kwargs
+):
     """Log-log ADEV against τ, one line per axis, with the confidence band when the result has
     intervals (:meth:`~allanite.AllanResult.with_confidence`).
 
@@ -88,8 +89,13 @@ def plot_adev(result, ax=None, unit: str | None = None, labels=None, axis: int |
         labels = [f"axis {k}" for k in range(adev.shape[0])] if multi else [None]
     for k in rows:
         name = labels[k] if k < len(labels) else None
-        (line,) = ax.loglog(result.tau, adev[k], marker=".", label=name if (multi and axis is None) else
-                            (name or "Allan deviation"), **kwargs)
+        (line,) = ax.loglog(
+            result.tau,
+            adev[k],
+            marker=".",
+            label=name if (multi and axis is None) else (name or "Allan deviation"),
+            **kwargs,
+        )
         if lo is not None:
             band_label = None
             if len(rows) == 1:
@@ -126,8 +132,16 @@ def _thin_index(n: int, max_points: int) -> np.ndarray:
     return np.unique(np.round(np.linspace(0, n - 1, max_points)).astype(np.int64))
 
 
-def plot_davar3d(result, ax=None, axis: int = 0, unit: str | None = None, cmap: str = "viridis",
-                 max_points: int = 80, elev: float = 30.0, azim: float = -38.0):
+def plot_davar3d(
+    result,
+    ax=None,
+    axis: int = 0,
+    unit: str | None = None,
+    cmap: str = "viridis",
+    max_points: int = 80,
+    elev: float = 30.0,
+    azim: float = -38.0,
+):
     """The dynamic ADEV as a 3-D surface, as in the DAVAR papers' figures: window centre t,
     log₁₀ τ and log₁₀ ADEV.
 
@@ -157,8 +171,17 @@ def plot_davar3d(result, ax=None, axis: int = 0, unit: str | None = None, cmap: 
 _TERM_STYLE = {"Q": "C1", "N": "C2", "B": "C3", "K": "C4", "R": "C5"}
 
 
-def plot_fit(fit, ax=None, unit: str | None = None, tau=None, points: bool = True, terms: bool = True,
-             color: str = "C0", label: str = "fitted model", lw: float = 2.0):
+def plot_fit(
+    fit,
+    ax=None,
+    unit: str | None = None,
+    tau=None,
+    points: bool = True,
+    terms: bool = True,
+    color: str = "C0",
+    label: str = "fitted model",
+    lw: float = 2.0,
+):
     """The fitted model and each term as its own dashed line, over the fit's estimates.
 
     Parameters
@@ -235,12 +258,19 @@ def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None
         ax.fill_between(series.t, low * scale, high * scale, color=colour, alpha=0.25, lw=0)
         if not resolved.all():
             up = np.where(~resolved & np.isfinite(series.ci_high[name]), series.ci_high[name], np.nan)
-            ax.plot(series.t, up * scale, ls="none", marker="v", mfc="none", mec=colour, ms=4,
-                    label="not resolved (upper bound)")
+            ax.plot(
+                series.t,
+                up * scale,
+                ls="none",
+                marker="v",
+                mfc="none",
+                mec=colour,
+                ms=4,
+                label="not resolved (upper bound)",
+            )
             ax.legend(fontsize="x-small", loc="upper left")
         if reference is not None and name in reference.coefficients:
-            ax.axhline(reference.coefficients[name].value * scale, color="k", ls=":", lw=1,
-                       label="whole record")
+            ax.axhline(reference.coefficients[name].value * scale, color="k", ls=":", lw=1, label="whole record")
             ax.legend(fontsize="x-small", loc="upper right")
         finite_hi = series.ci_high[name][np.isfinite(series.ci_high[name])]
         vmax = float(np.max(series.values[name]))

@@ -91,8 +91,16 @@ class _ResultBase:
         """The estimator in words (from the estimator registry)."""
         return get_estimator(self.estimator).label
 
-    def with_confidence(self, x=None, *, confidence: float = 0.683, alpha=None, edf_method: str = "greenhall",
-                        chi2: str = "exact", b1_n: str = "averages"):
+    def with_confidence(
+        self,
+        x=None,
+        *,
+        confidence: float = 0.683,
+        alpha=None,
+        edf_method: str = "greenhall",
+        chi2: str = "exact",
+        b1_n: str = "averages",
+    ):
         """This result with χ² confidence intervals per τ (``edf``, ``ci_low``, ``ci_high``, ``alpha``).
 
         Pass the samples the result was computed from (``x``, same ``input`` kind) to identify the
@@ -107,10 +115,17 @@ class _ResultBase:
         >>> r.alpha, np.round(r.edf)
         (array([0, 0, 0]), array([7826., 1368.,  148.]))
         """
-        ci = confidence_intervals(self, x, confidence=confidence, alpha=alpha, edf_method=edf_method, chi2=chi2,
-                                  b1_n=b1_n)
-        return dataclasses.replace(self, edf=ci.edf, ci_low=ci.ci_low, ci_high=ci.ci_high,  # type: ignore[type-var]
-                                   alpha=ci.alpha, confidence=ci.confidence)
+        ci = confidence_intervals(
+            self, x, confidence=confidence, alpha=alpha, edf_method=edf_method, chi2=chi2, b1_n=b1_n
+        )
+        return dataclasses.replace(
+            self,
+            edf=ci.edf,
+            ci_low=ci.ci_low,
+            ci_high=ci.ci_high,  # type: ignore[type-var]
+            alpha=ci.alpha,
+            confidence=ci.confidence,
+        )
 
     def _xr_common(self, unit, axis_names):
         """Dims prefix, coords, unit label and attrs shared by both results' ``to_xarray``."""
@@ -127,9 +142,14 @@ class _ResultBase:
                 raise ParameterError(f"axis_names has {len(names)} names for {self.n_axes} axes")
             coords["axis"] = ("axis", names, {"long_name": "sensor axis"})
             axes = ("axis",)
-        attrs: dict[str, Any] = {"estimator": self.estimator, "fs_hz": self.fs, "n_samples": self.n_samples,
-                                 "input": self.input, "unit": "unknown" if unit is None else str(unit),
-                                 "allanite_result": type(self).__name__}
+        attrs: dict[str, Any] = {
+            "estimator": self.estimator,
+            "fs_hz": self.fs,
+            "n_samples": self.n_samples,
+            "input": self.input,
+            "unit": "unknown" if unit is None else str(unit),
+            "allanite_result": type(self).__name__,
+        }
         if self.confidence is not None:
             attrs["confidence"] = self.confidence
         if self.source is not None:
@@ -151,10 +171,16 @@ class _ResultBase:
             data["ci_low"] = (dims, self.ci_low, {"units": var_units, "long_name": f"{level} lower bound, variance"})
             data["ci_high"] = (dims, self.ci_high, {"units": var_units, "long_name": f"{level} upper bound, variance"})
             if not self._time_dims:
-                data["adev_low"] = (dims, np.sqrt(self.ci_low), {"units": label,
-                                                                 "long_name": f"{level} lower bound, ADEV"})
-                data["adev_high"] = (dims, np.sqrt(self.ci_high), {"units": label,
-                                                                   "long_name": f"{level} upper bound, ADEV"})
+                data["adev_low"] = (
+                    dims,
+                    np.sqrt(self.ci_low),
+                    {"units": label, "long_name": f"{level} lower bound, ADEV"},
+                )
+                data["adev_high"] = (
+                    dims,
+                    np.sqrt(self.ci_high),
+                    {"units": label, "long_name": f"{level} upper bound, ADEV"},
+                )
             data["edf"] = (axes + ("tau",), self.edf, {"units": "1", "long_name": "equivalent degrees of freedom"})
             data["alpha"] = (axes + ("tau",), self.alpha, {"units": "1", "long_name": "noise type α (S_y ∝ f^α)"})
         return data
@@ -345,8 +371,11 @@ class DynamicAllanResult(_ResultBase):
         attrs.update(window=self.window, hop=self.hop, method=self.method)
         data = self._xr_data(axes, label)
         if self.kf is not None:
-            data["kf"] = (axes + ("t",), np.asarray(self.kf, dtype=float),
-                          {"units": "1", "long_name": "TheoBR bias ratio of each window"})
+            data["kf"] = (
+                axes + ("t",),
+                np.asarray(self.kf, dtype=float),
+                {"units": "1", "long_name": "TheoBR bias ratio of each window"},
+            )
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
     def plot(self, ax=None, axis: int = 0, **kwargs):

@@ -34,8 +34,18 @@ import numpy as np
 from .errors import ParameterError
 
 __all__ = [
-    "Unit", "Quantity", "parse_unit", "rate_unit", "convert", "to_deg_per_s", "ieee952",
-    "adev_unit_label", "coefficient_unit", "RATE_UNITS", "ANGLE_UNITS", "IEEE952_TERMS",
+    "Unit",
+    "Quantity",
+    "parse_unit",
+    "rate_unit",
+    "convert",
+    "to_deg_per_s",
+    "ieee952",
+    "adev_unit_label",
+    "coefficient_unit",
+    "RATE_UNITS",
+    "ANGLE_UNITS",
+    "IEEE952_TERMS",
 ]
 
 
@@ -96,8 +106,15 @@ RATE_UNITS = tuple(n for n, u in _UNITS.items() if u.kind == "rate")
 ANGLE_UNITS = tuple(n for n, u in _UNITS.items() if u.kind == "angle")
 
 # angle unit → the rate unit "that angle per second"
-_RATE_OF = {"deg": "deg/s", "mdeg": "mdeg/s", "rad": "rad/s", "mrad": "mrad/s", "urad": "urad/s",
-            "arcsec": "arcsec/s", "rev": "rev/s"}
+_RATE_OF = {
+    "deg": "deg/s",
+    "mdeg": "mdeg/s",
+    "rad": "rad/s",
+    "mrad": "mrad/s",
+    "urad": "urad/s",
+    "arcsec": "arcsec/s",
+    "rev": "rev/s",
+}
 
 
 def _normalise(s: str) -> str:
@@ -167,9 +184,11 @@ def parse_unit(s, kind=None) -> Unit:
     else:
         raise ParameterError(f"a unit must be a string such as 'deg/s', got {s!r}; allowed {_allowed(kind)}")
     if kind is not None and unit.kind != kind:
-        raise ParameterError(f"unit {s!r} is {'an' if unit.kind == 'angle' else 'a'} {unit.kind} unit, "
-                             f"but {'an' if kind == 'angle' else 'a'} {kind} unit is needed here; "
-                             f"allowed {_allowed(kind)}")
+        raise ParameterError(
+            f"unit {s!r} is {'an' if unit.kind == 'angle' else 'a'} {unit.kind} unit, "
+            f"but {'an' if kind == 'angle' else 'a'} {kind} unit is needed here; "
+            f"allowed {_allowed(kind)}"
+        )
     return unit
 
 
@@ -198,8 +217,9 @@ def convert(values, src, dst):
     """
     a, b = parse_unit(src), parse_unit(dst)
     if a.kind != b.kind:
-        raise ParameterError(f"cannot convert {a.kind} unit {src!r} to {b.kind} unit {dst!r}; both must be "
-                             f"rates or both angles")
+        raise ParameterError(
+            f"cannot convert {a.kind} unit {src!r} to {b.kind} unit {dst!r}; both must be rates or both angles"
+        )
     return np.asarray(values, dtype=np.float64) * (a.factor / b.factor)
 
 
@@ -219,22 +239,53 @@ def to_deg_per_s(values, unit):
 # term: (power of seconds in the base form, target unit → (label, factor from deg·s^p base), default)
 _SQH = 60.0  # √3600 s/√h
 _TERMS = {
-    "Q": (1.0, {"deg": ("°", 1.0), "arcsec": ("arcsec", 3600.0), "urad": ("µrad", 1e6 / _RAD),
-                "rad": ("rad", 1.0 / _RAD)}, "deg"),
-    "N": (0.5, {"deg/sqrt(h)": ("°/√h", _SQH), "deg/sqrt(s)": ("°/√s", 1.0),
-                "deg/h/sqrt(Hz)": ("°/h/√Hz", 3600.0), "rad/sqrt(s)": ("rad/√s", 1.0 / _RAD)}, "deg/sqrt(h)"),
+    "Q": (
+        1.0,
+        {"deg": ("°", 1.0), "arcsec": ("arcsec", 3600.0), "urad": ("µrad", 1e6 / _RAD), "rad": ("rad", 1.0 / _RAD)},
+        "deg",
+    ),
+    "N": (
+        0.5,
+        {
+            "deg/sqrt(h)": ("°/√h", _SQH),
+            "deg/sqrt(s)": ("°/√s", 1.0),
+            "deg/h/sqrt(Hz)": ("°/h/√Hz", 3600.0),
+            "rad/sqrt(s)": ("rad/√s", 1.0 / _RAD),
+        },
+        "deg/sqrt(h)",
+    ),
     "B": (0.0, {"deg/h": ("°/h", 3600.0), "deg/s": ("°/s", 1.0), "rad/s": ("rad/s", 1.0 / _RAD)}, "deg/h"),
-    "K": (-0.5, {"deg/h^1.5": ("°/h^1.5", 3600.0 * _SQH), "deg/s^1.5": ("°/s^1.5", 1.0),
-                 "rad/s^1.5": ("rad/s^1.5", 1.0 / _RAD)}, "deg/h^1.5"),
-    "R": (-1.0, {"deg/h^2": ("°/h²", 3600.0**2), "deg/s^2": ("°/s²", 1.0),
-                 "rad/s^2": ("rad/s²", 1.0 / _RAD)}, "deg/h^2"),
+    "K": (
+        -0.5,
+        {
+            "deg/h^1.5": ("°/h^1.5", 3600.0 * _SQH),
+            "deg/s^1.5": ("°/s^1.5", 1.0),
+            "rad/s^1.5": ("rad/s^1.5", 1.0 / _RAD),
+        },
+        "deg/h^1.5",
+    ),
+    "R": (
+        -1.0,
+        {"deg/h^2": ("°/h²", 3600.0**2), "deg/s^2": ("°/s²", 1.0), "rad/s^2": ("rad/s²", 1.0 / _RAD)},
+        "deg/h^2",
+    ),
 }
 _TERM_ALIASES = {
-    "q": "Q", "quantization": "Q", "quantisation": "Q",
-    "n": "N", "arw": "N", "angle_random_walk": "N",
-    "b": "B", "bias_instability": "B", "bi": "B",
-    "k": "K", "rrw": "K", "rate_random_walk": "K",
-    "r": "R", "rate_ramp": "R", "ramp": "R",
+    "q": "Q",
+    "quantization": "Q",
+    "quantisation": "Q",
+    "n": "N",
+    "arw": "N",
+    "angle_random_walk": "N",
+    "b": "B",
+    "bias_instability": "B",
+    "bi": "B",
+    "k": "K",
+    "rrw": "K",
+    "rate_random_walk": "K",
+    "r": "R",
+    "rate_ramp": "R",
+    "ramp": "R",
 }
 #: The IEEE-952 terms and the report units each accepts (first: the default).
 IEEE952_TERMS = {t: tuple([d] + [k for k in v[1] if k != d]) for t, v in _TERMS.items() for d in [v[2]]}
@@ -280,8 +331,10 @@ def ieee952(term, value, unit, *, to=None) -> Quantity:
     """
     t = _TERM_ALIASES.get(term.lower() if isinstance(term, str) else None)
     if t is None:
-        raise ParameterError(f"unknown IEEE-952 term {term!r}; allowed: 'Q' (quantization), 'N' (angle random "
-                             f"walk), 'B' (bias instability), 'K' (rate random walk), 'R' (rate ramp)")
+        raise ParameterError(
+            f"unknown IEEE-952 term {term!r}; allowed: 'Q' (quantization), 'N' (angle random "
+            f"walk), 'B' (bias instability), 'K' (rate random walk), 'R' (rate ramp)"
+        )
     _, targets, default = _TERMS[t]
     target = default if to is None else to
     if target not in targets:

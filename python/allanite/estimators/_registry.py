@@ -99,9 +99,7 @@ class Estimator:
                 out[key] = value
             elif not _is_default(value, key):
                 takers = [e.name for e in _ESTIMATORS.values() if key in e.options]
-                raise ParameterError(
-                    f"{key} applies to the estimators {tuple(takers)}, not to estimator={self.name!r}"
-                )
+                raise ParameterError(f"{key} applies to the estimators {tuple(takers)}, not to estimator={self.name!r}")
         return out
 
 
@@ -169,8 +167,10 @@ def get_taper(name: object, estimator: str) -> Taper:
         raise ParameterError(f"unknown taper {name!r}; allowed: {', '.join(map(repr, TAPERS))}")
     taper = TAPERS[name]
     if taper.estimators is not None and estimator not in taper.estimators:
-        pairs = "; ".join(f"{t.name!r} with {'any estimator' if t.estimators is None else ', '.join(map(repr, t.estimators))}"
-                          for t in TAPERS.values())
+        pairs = "; ".join(
+            f"{t.name!r} with {'any estimator' if t.estimators is None else ', '.join(map(repr, t.estimators))}"
+            for t in TAPERS.values()
+        )
         raise ParameterError(f"taper {name!r} does not apply to estimator {estimator!r}; valid pairs: {pairs}")
     return taper
 

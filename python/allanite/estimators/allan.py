@@ -52,11 +52,20 @@ def _edf(alpha, m, n_phase, *, overlapping: bool):
     return edf_greenhall(alpha, 2, m, n_phase, overlapping=overlapping)
 
 
-for _name, _label, _overlapping in (("oavar", "overlapping Allan variance", True),
-                                    ("avar", "Allan variance (classic, non-overlapping)", False)):
-    register(Estimator(
-        name=_name, label=_label, family="allan",
-        static=partial(_static, estimator=_name), dynamic=partial(_dynamic, estimator=_name),
-        edf=partial(_edf, overlapping=_overlapping), methods=("fast", "naive"), noise_id=_name,
-        resolve_m=resolve_taus,
-    ))
+for _name, _label, _overlapping in (
+    ("oavar", "overlapping Allan variance", True),
+    ("avar", "Allan variance (classic, non-overlapping)", False),
+):
+    register(
+        Estimator(
+            name=_name,
+            label=_label,
+            family="allan",
+            static=partial(_static, estimator=_name),
+            dynamic=partial(_dynamic, estimator=_name),
+            edf=partial(_edf, overlapping=_overlapping),
+            methods=("fast", "naive"),
+            noise_id=_name,
+            resolve_m=resolve_taus,
+        )
+    )

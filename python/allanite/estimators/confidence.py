@@ -39,7 +39,6 @@ For ν > 100 Stable32 also replaces the χ² quantile by an approximation (``chi
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,9 +49,15 @@ from . import _registry
 
 __all__ = [
     "edf_theo1",
-    "ONE_SIGMA", "ALPHAS", "NOISE_NAMES",
-    "edf_greenhall", "edf_sp1065", "chi2_interval", "identify_alpha",
-    "confidence_intervals", "ConfidenceIntervals",
+    "ONE_SIGMA",
+    "ALPHAS",
+    "NOISE_NAMES",
+    "edf_greenhall",
+    "edf_sp1065",
+    "chi2_interval",
+    "identify_alpha",
+    "confidence_intervals",
+    "ConfidenceIntervals",
 ]
 
 #: The probability of a normal variable falling within one standard deviation, erf(1/√2).
@@ -167,15 +172,15 @@ _J_MAX = 100
 
 
 def _edf_greenhall_one(alpha: int, d: int, m: int, N: int, overlapping: bool, modified: bool) -> float:
-    F = 1 if modified else m          # filter factor
-    S = m if overlapping else 1       # stride factor
-    L = (m // F) + m * d              # span of the estimator's filter, in phase samples
+    F = 1 if modified else m  # filter factor
+    S = m if overlapping else 1  # stride factor
+    L = (m // F) + m * d  # span of the estimator's filter, in phase samples
     if N < L:
         raise ParameterError(
             f"N = {N} phase points is too short for m = {m} with d = {d} "
             f"({'modified' if modified else 'unmodified'} estimator): at least {L} are needed"
         )
-    M = 1 + math.floor(S * (N - L) / m)   # number of summands
+    M = 1 + math.floor(S * (N - L) / m)  # number of summands
     J = min(M, (d + 1) * S)
     r = M / S
 
@@ -198,7 +203,8 @@ def _edf_greenhall_one(alpha: int, d: int, m: int, N: int, overlapping: bool, mo
         else:
             mp = _J_MAX / r
             inv = _basic_sum(_J_MAX, _J_MAX, mp, math.inf, alpha, d) / (
-                _J_MAX * float(_sz(0.0, math.inf, alpha, d)) ** 2)
+                _J_MAX * float(_sz(0.0, math.inf, alpha, d)) ** 2
+            )
     elif alpha == 1:  # case 3: unmodified, FPM
         b0, b1 = _TABLE3[d]
         if J <= _J_MAX:
@@ -274,8 +280,13 @@ def edf_greenhall(alpha, d, m, N, overlapping=True, modified=False):
     m_arr = np.asarray(m)
     n_arr = np.asarray(N)
     for name, arr, lo in (("m", m_arr, 1), ("N", n_arr, 2)):
-        if arr.dtype.kind not in "iuf" or arr.size == 0 or not np.all(np.isfinite(arr)) \
-                or np.any(arr < lo) or np.any(np.asarray(arr, dtype=np.float64) % 1 != 0):
+        if (
+            arr.dtype.kind not in "iuf"
+            or arr.size == 0
+            or not np.all(np.isfinite(arr))
+            or np.any(arr < lo)
+            or np.any(np.asarray(arr, dtype=np.float64) % 1 != 0)
+        ):
             raise ParameterError(f"{name} must be integers ≥ {lo}, got {arr if arr.ndim else arr.item()!r}")
     a_b, m_b, n_b = np.broadcast_arrays(a_arr, m_arr.astype(np.int64), n_arr.astype(np.int64))
     out = np.empty(a_b.shape, dtype=np.float64)
@@ -474,9 +485,7 @@ def chi2_interval(variance, edf, confidence=0.683, *, method="exact"):
     nu = np.asarray(edf, dtype=np.float64)
     if nu.size == 0 or np.any(~np.isfinite(nu)) or np.any(nu <= 0):
         bad = nu[~(np.isfinite(nu) & (nu > 0))].ravel() if nu.size else nu
-        raise ParameterError(
-            f"edf must be positive finite degrees of freedom, got {bad[0] if bad.size else edf!r}"
-        )
+        raise ParameterError(f"edf must be positive finite degrees of freedom, got {bad[0] if bad.size else edf!r}")
     if np.any(var < 0):
         raise ParameterError(f"variance must be ≥ 0, got {var[var < 0].ravel()[0]!r}")
     var, nu = np.broadcast_arrays(var, nu)
@@ -508,7 +517,7 @@ def _acf_alpha(z: np.ndarray, phase: bool, dmax: int = 2) -> float:
     d = 0
     while True:
         r1 = _lag1_acf(z)
-        delta = r1 / (1.0 + r1) if r1 > -1.0 else -1e9   # r1 → −1: as white as it gets
+        delta = r1 / (1.0 + r1) if r1 > -1.0 else -1e9  # r1 → −1: as white as it gets
         if delta < 0.25 or d >= dmax or z.size < 4:
             p = -2.0 * (delta + d)
             return p + 2.0 if phase else p
@@ -536,7 +545,7 @@ def _b1_rn_alpha(x: np.ndarray, y: np.ndarray, m: int, n_ref: int) -> int:
     # N at which the expected B1 is evaluated: the number of averages (Barnes), or what the caller
     # chose (Stable32: the estimator's number of terms).
     N = max(int(n_ref), 2)
-    mus = (1, 0, -1, -2)               # RWFM, FFM, WFM, WPM/FPM
+    mus = (1, 0, -1, -2)  # RWFM, FFM, WFM, WPM/FPM
     mu = -2
     for hi, lo in zip(mus[:-1], mus[1:]):
         if b1 > math.sqrt(_b1_expected(N, hi) * _b1_expected(N, lo)):
@@ -547,7 +556,7 @@ def _b1_rn_alpha(x: np.ndarray, y: np.ndarray, m: int, n_ref: int) -> int:
     n = x.size
     if n - 3 * m + 1 < 1:
         return 1  # R(n) needs 3m + 1 points; FPM is the conservative (smaller-ν) choice
-    dd = x[2 * m:] - 2.0 * x[m:n - m] + x[: n - 2 * m]
+    dd = x[2 * m :] - 2.0 * x[m : n - m] + x[: n - 2 * m]
     oav = float(np.mean(dd * dd))
     if oav == 0.0:
         return 2
@@ -658,7 +667,7 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
         else:
             k = rate.size // mi
             z = rate[: k * mi].reshape(k, mi).mean(axis=1)
-        points = (n_phase - 1) // mi   # τ-intervals in the record, for either kind of data
+        points = (n_phase - 1) // mi  # τ-intervals in the record, for either kind of data
         use_acf = method == "acf" or (method == "auto" and points >= ACF_MIN_POINTS)
         if use_acf:
             a = int(np.clip(round(_acf_alpha(z, phase=input == "angle")), -2, 2))
@@ -715,8 +724,10 @@ class ConfidenceIntervals:
         return np.sqrt(self.ci_high)
 
     def __repr__(self) -> str:
-        return (f"ConfidenceIntervals({self.confidence:.1%}, ν by {self.edf_method}, {self.edf.shape[-1]} τ, "
-                f"ν from {np.min(self.edf):.3g} to {np.max(self.edf):.3g})")
+        return (
+            f"ConfidenceIntervals({self.confidence:.1%}, ν by {self.edf_method}, {self.edf.shape[-1]} τ, "
+            f"ν from {np.min(self.edf):.3g} to {np.max(self.edf):.3g})"
+        )
 
 
 def _alpha_for_result(result, x, alpha, shape_edf, b1_n) -> np.ndarray:
@@ -799,8 +810,9 @@ def _allan_m_for_id(result) -> np.ndarray:
     return np.clip(m_id, 1, max(1, n // 2))
 
 
-def confidence_intervals(result, x=None, *, confidence=0.683, alpha=None, edf_method="greenhall",
-                         chi2="exact", b1_n="averages") -> ConfidenceIntervals:
+def confidence_intervals(
+    result, x=None, *, confidence=0.683, alpha=None, edf_method="greenhall", chi2="exact", b1_n="averages"
+) -> ConfidenceIntervals:
     """χ² confidence intervals of a static or dynamic Allan-variance result, per τ.
 
     ν per τ comes from :func:`edf_greenhall` (or :func:`edf_sp1065`) for the result's estimator
@@ -862,11 +874,14 @@ def confidence_intervals(result, x=None, *, confidence=0.683, alpha=None, edf_me
     check_choice(chi2, "chi2", _CHI2_METHODS)
     if result.source is None and _registry.get(result.estimator).edf is None:
         with_edf = [n for n in _registry.names() if _registry.get(n).edf is not None]
-        raise ParameterError(f"confidence intervals are implemented for {', '.join(map(repr, with_edf))}, "
-                             f"not {result.estimator!r}")
+        raise ParameterError(
+            f"confidence intervals are implemented for {', '.join(map(repr, with_edf))}, not {result.estimator!r}"
+        )
     if result.source is not None and edf_method != "greenhall":
-        raise ParameterError("Theo-family results use Greenhall's EDF (Allan τ) and Howe's Theo1 EDF (Theo τ); "
-                             f"edf_method={edf_method!r} is for plain Allan results")
+        raise ParameterError(
+            "Theo-family results use Greenhall's EDF (Allan τ) and Howe's Theo1 EDF (Theo τ); "
+            f"edf_method={edf_method!r} is for plain Allan results"
+        )
     if edf_method == "sp1065" and result.estimator not in _ESTIMATORS:
         raise ParameterError(f"edf_method='sp1065' has formulas for {_ESTIMATORS}, not {result.estimator!r}")
     dynamic = _is_dynamic(result)
@@ -883,5 +898,12 @@ def confidence_intervals(result, x=None, *, confidence=0.683, alpha=None, edf_me
     nu = np.asarray(nu, dtype=np.float64).reshape(shape_edf)
     nu_b = nu[..., None] if dynamic else nu
     low, high = chi2_interval(result.avar, nu_b, c, method=chi2)
-    return ConfidenceIntervals(edf=nu, ci_low=np.asarray(low), ci_high=np.asarray(high), alpha=a,
-                               confidence=c, edf_method=edf_method, chi2=chi2)
+    return ConfidenceIntervals(
+        edf=nu,
+        ci_low=np.asarray(low),
+        ci_high=np.asarray(high),
+        alpha=a,
+        confidence=c,
+        edf_method=edf_method,
+        chi2=chi2,
+    )

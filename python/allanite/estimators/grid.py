@@ -8,7 +8,6 @@ rounded to the nearest m and must then be valid — they are never silently repl
 from __future__ import annotations
 
 import math
-import numbers
 
 import numpy as np
 
@@ -36,9 +35,7 @@ def m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0,
     """Averaging factors m of a named grid on ``n`` samples (see :func:`tau_grid`)."""
     limit = max_m(n)
     if limit < 1:
-        raise ParameterError(
-            f"a record or window of {n} samples is too short for any τ: at least 2 samples are needed"
-        )
+        raise ParameterError(f"a record or window of {n} samples is too short for any τ: at least 2 samples are needed")
     if m_max is not None:
         m_max = check_count(m_max, "m_max", 1)
         if m_max > limit:
@@ -93,8 +90,16 @@ def m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0,
     raise ParameterError(f"unknown τ grid {kind!r}; allowed: {', '.join(map(repr, GRIDS))} or an array of τ in s")
 
 
-def tau_grid(n: int, fs: float, kind: str = "exp", *, growth: float | None = None, points: int | None = None,
-             tau_min: float | None = None, m_max: int | None = None) -> np.ndarray:
+def tau_grid(
+    n: int,
+    fs: float,
+    kind: str = "exp",
+    *,
+    growth: float | None = None,
+    points: int | None = None,
+    tau_min: float | None = None,
+    m_max: int | None = None,
+) -> np.ndarray:
     """Averaging times (s) of a named grid for a record or window of ``n`` rate samples.
 
     Parameters

@@ -22,10 +22,9 @@ and agree with the direct double sum to ≲ 1e-11 relative.
 from __future__ import annotations
 
 import math
+from functools import partial
 
 import numpy as np
-
-from functools import partial
 
 from .. import _core
 from .._validate import check_count, check_fs, resolve_workers
@@ -35,8 +34,7 @@ from .allan import allan_values
 from .confidence import edf_theo1
 from .grid import GRIDS, m_grid
 
-__all__ = ["theo_ms", "kf_indices", "switch_m", "static_theo", "dynamic_theo", "resolve_decimation",
-           "THEO_SOURCES"]
+__all__ = ["theo_ms", "kf_indices", "switch_m", "static_theo", "dynamic_theo", "resolve_decimation", "THEO_SOURCES"]
 
 #: The estimators whose values belong to τ = 0.75·m/fs.
 THEO_SOURCES = ("theo1", "theobr")
@@ -49,8 +47,10 @@ THEOH_SWITCH = 0.1
 
 
 #: Rules for the range of TheoBR's bias ratio: last index n for N phase points, and the least N.
-KF_RULES = {"textbook": (lambda n_phase: (n_phase - 90) // 30, 90),   # ⌊0.1·N/3 − 3⌋ (Howe; Taylor & Howe)
-            "stable32": (lambda n_phase: (n_phase - 18) // 6, 18)}    # ⌊N/6 − 3⌋ (what Stable32 does)
+KF_RULES = {
+    "textbook": (lambda n_phase: (n_phase - 90) // 30, 90),  # ⌊0.1·N/3 − 3⌋ (Howe; Taylor & Howe)
+    "stable32": (lambda n_phase: (n_phase - 18) // 6, 18),
+}  # ⌊N/6 − 3⌋ (what Stable32 does)
 
 
 def kf_indices(n_rate: int, rule: str = "textbook") -> tuple[np.ndarray, np.ndarray]:
@@ -101,9 +101,7 @@ def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, n
     """
     n_rate = int(n_rate)
     if n_rate < THEO1_MIN_M:
-        raise ParameterError(
-            f"Theo1 needs at least {THEO1_MIN_M} samples (m ≥ {THEO1_MIN_M}, m ≤ N − 1), got {n_rate}"
-        )
+        raise ParameterError(f"Theo1 needs at least {THEO1_MIN_M} samples (m ≥ {THEO1_MIN_M}, m ≤ N − 1), got {n_rate}")
     theo_src = "theo1" if estimator == "theo1" else "theobr"
     allan_src = "avar" if estimator == "theoh_a" else "oavar"
     hybrid = estimator in ("theoh", "theoh_a")
@@ -212,11 +210,15 @@ def resolve_decimation(decimate, n_rate: int, taus) -> int:
     else:
         d = check_count(decimate, "decimate", 1)
     if d > 1 and not isinstance(taus, str):
-        raise ParameterError("decimate > 1 works with a named τ grid ('octave', 'decade', 'all', 'exp'), not with "
-                             "explicit τ: the Theo τ of a decimated record are multiples of 0.75·D/fs")
+        raise ParameterError(
+            "decimate > 1 works with a named τ grid ('octave', 'decade', 'all', 'exp'), not with "
+            "explicit τ: the Theo τ of a decimated record are multiples of 0.75·D/fs"
+        )
     if d > 1 and int(n_rate) // d < THEOBR_MIN_POINTS:
-        raise ParameterError(f"decimate = {d} leaves {int(n_rate) // d} samples of the {n_rate}; TheoBR needs "
-                             f"at least {THEOBR_MIN_POINTS - 1}")
+        raise ParameterError(
+            f"decimate = {d} leaves {int(n_rate) // d} samples of the {n_rate}; TheoBR needs "
+            f"at least {THEOBR_MIN_POINTS - 1}"
+        )
     return d
 
 
@@ -272,7 +274,7 @@ def static_theo(cols, fs: float, taus, workers, *, estimator: str, kf_rule: str 
         n_terms = np.concatenate([_n_terms(ms[: allan.sum()], src[: allan.sum()], n), _n_terms(md, srcd, nd)])
         tau = np.concatenate([ms[: allan.sum()] / fs, 0.75 * md * d / fs])
         values = np.empty((len(cols), ms.size))
-        values[:, allan.sum():] = theo_vals
+        values[:, allan.sum() :] = theo_vals
         is_theo = np.isin(src, THEO_SOURCES)
         allan = ~is_theo
     else:
@@ -285,8 +287,9 @@ def static_theo(cols, fs: float, taus, workers, *, estimator: str, kf_rule: str 
     return Computed(tau=tau, values=values, n=n_terms, m=ms, source=src, kf=kf)
 
 
-def dynamic_theo(cols, fs: float, window: int, hop: int, taus, method: str, workers, *, estimator: str,
-                 kf_rule: str = "textbook") -> Computed:
+def dynamic_theo(
+    cols, fs: float, window: int, hop: int, taus, method: str, workers, *, estimator: str, kf_rule: str = "textbook"
+) -> Computed:
     """TheoH (DHVAR) or TheoH-A (DHVAR-A) of every window: values (axes, T, J), per-τ ``source``, kf
     (axes, J). Every window has its own bias ratio kf and its switch at 0.1·window·τ0."""
     if method != "fast":
@@ -317,14 +320,48 @@ def _theoh_m(estimator: str):
 
 
 _THEO_OPTIONS = {"kf_rule": "textbook", "decimate": "auto"}
-register(Estimator(name="theo1", label="Theo1", family="theo", static=partial(static_theo, estimator="theo1"),
-                   edf=edf_theo1, estimates_allan=False, theo_tau=True, options=_THEO_OPTIONS))
-register(Estimator(name="theobr", label="bias-removed Theo1 (TheoBR)", family="theo",
-                   static=partial(static_theo, estimator="theobr"), edf=edf_theo1, theo_tau=True,
-                   options=_THEO_OPTIONS))
-register(Estimator(name="theoh", label="TheoH (overlapping Allan ≤ 10 % of the span, TheoBR beyond)", family="theo",
-                   static=partial(static_theo, estimator="theoh"), dynamic=partial(dynamic_theo, estimator="theoh"),
-                   options=_THEO_OPTIONS, resolve_m=_theoh_m("theoh")))
-register(Estimator(name="theoh_a", label="TheoH-A (classic Allan ≤ 10 % of the window, TheoBR beyond)",
-                   family="theo", dynamic=partial(dynamic_theo, estimator="theoh_a"),
-                   options={"kf_rule": "textbook"}, noise_id="avar", resolve_m=_theoh_m("theoh_a")))
+register(
+    Estimator(
+        name="theo1",
+        label="Theo1",
+        family="theo",
+        static=partial(static_theo, estimator="theo1"),
+        edf=edf_theo1,
+        estimates_allan=False,
+        theo_tau=True,
+        options=_THEO_OPTIONS,
+    )
+)
+register(
+    Estimator(
+        name="theobr",
+        label="bias-removed Theo1 (TheoBR)",
+        family="theo",
+        static=partial(static_theo, estimator="theobr"),
+        edf=edf_theo1,
+        theo_tau=True,
+        options=_THEO_OPTIONS,
+    )
+)
+register(
+    Estimator(
+        name="theoh",
+        label="TheoH (overlapping Allan ≤ 10 % of the span, TheoBR beyond)",
+        family="theo",
+        static=partial(static_theo, estimator="theoh"),
+        dynamic=partial(dynamic_theo, estimator="theoh"),
+        options=_THEO_OPTIONS,
+        resolve_m=_theoh_m("theoh"),
+    )
+)
+register(
+    Estimator(
+        name="theoh_a",
+        label="TheoH-A (classic Allan ≤ 10 % of the window, TheoBR beyond)",
+        family="theo",
+        dynamic=partial(dynamic_theo, estimator="theoh_a"),
+        options={"kf_rule": "textbook"},
+        noise_id="avar",
+        resolve_m=_theoh_m("theoh_a"),
+    )
+)

@@ -39,10 +39,33 @@ TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9}
 JITTER_WARN = 0.25
 
 _IMU_TYPES = ("sensor_msgs/msg/Imu", "sensor_msgs/Imu")
-_BAG_FIELDS = ("angular_velocity_x", "angular_velocity_y", "angular_velocity_z",
-               "linear_acceleration_x", "linear_acceleration_y", "linear_acceleration_z")
-_TIME_NAMES = {"t", "time", "times", "timestamp", "timestamps", "stamp", "time_s", "t_s", "sec", "seconds",
-               "time[s]", "time(s)", "time_ns", "timestamp_ns", "time_us", "time_ms", "epoch"}
+_BAG_FIELDS = (
+    "angular_velocity_x",
+    "angular_velocity_y",
+    "angular_velocity_z",
+    "linear_acceleration_x",
+    "linear_acceleration_y",
+    "linear_acceleration_z",
+)
+_TIME_NAMES = {
+    "t",
+    "time",
+    "times",
+    "timestamp",
+    "timestamps",
+    "stamp",
+    "time_s",
+    "t_s",
+    "sec",
+    "seconds",
+    "time[s]",
+    "time(s)",
+    "time_ns",
+    "timestamp_ns",
+    "time_us",
+    "time_ms",
+    "epoch",
+}
 
 
 @dataclass(frozen=True)
@@ -68,8 +91,10 @@ class Gap:
     missing: int
 
     def __str__(self) -> str:
-        return (f"{self.duration:.6g} s (≈{self.missing} samples) missing after sample {self.index - 1} "
-                f"at t = {self.time:.6g} s")
+        return (
+            f"{self.duration:.6g} s (≈{self.missing} samples) missing after sample {self.index - 1} "
+            f"at t = {self.time:.6g} s"
+        )
 
 
 @dataclass(repr=False)
@@ -162,11 +187,15 @@ class Log:
         if len(self.gaps) > 5:
             lines.append(f"    … and {len(self.gaps) - 5} more")
         if self.span != (0, self.n_record):
-            lines.append(f"  kept samples {self.span[0]}–{self.span[1] - 1} of {self.n_record} (longest gap-free stretch)")
+            lines.append(
+                f"  kept samples {self.span[0]}–{self.span[1] - 1} of {self.n_record} (longest gap-free stretch)"
+            )
         if self.segments is not None:
-            lines.append(f"  segments: {len(self.segments)} "
-                         f"({', '.join(f'{a}–{b - 1}' for a, b in self.segment_spans[:6])}"
-                         f"{', …' if len(self.segments) > 6 else ''})")
+            lines.append(
+                f"  segments: {len(self.segments)} "
+                f"({', '.join(f'{a}–{b - 1}' for a, b in self.segment_spans[:6])}"
+                f"{', …' if len(self.segments) > 6 else ''})"
+            )
         return "\n".join(lines)
 
 
@@ -174,8 +203,20 @@ class Log:
 # public entry point
 
 
-def read_log(path, *, fs=None, columns=None, time_column=None, unit=None, input="rate", gaps="error",
-             delimiter=None, time_unit="s", array=None, topic=None) -> Log:
+def read_log(
+    path,
+    *,
+    fs=None,
+    columns=None,
+    time_column=None,
+    unit=None,
+    input="rate",
+    gaps="error",
+    delimiter=None,
+    time_unit="s",
+    array=None,
+    topic=None,
+) -> Log:
     """Read a gyro log.
 
     Parameters
@@ -249,8 +290,9 @@ def read_log(path, *, fs=None, columns=None, time_column=None, unit=None, input=
         try:
             u = parse_unit(unit, kind=need)
         except ParameterError as exc:
-            raise ParameterError(f"{exc} (input={input!r} needs {'a rate' if need == 'rate' else 'an angle'} unit)") \
-                from None
+            raise ParameterError(
+                f"{exc} (input={input!r} needs {'a rate' if need == 'rate' else 'an angle'} unit)"
+            ) from None
     if columns is not None:
         _check_column_spec(columns, "columns")
     if time_column is not None:
@@ -266,8 +308,7 @@ def read_log(path, *, fs=None, columns=None, time_column=None, unit=None, input=
     else:
         if fs is None and time_column is None:
             raise ParameterError(
-                f"{path}: give the sampling rate (fs=… in Hz) or the time column (time_column=…) — "
-                f"neither was passed"
+                f"{path}: give the sampling rate (fs=… in Hz) or the time column (time_column=…) — neither was passed"
             )
         if fmt == "npy":
             rec = _read_npy(path, columns, time_column)
@@ -291,13 +332,13 @@ def read_log(path, *, fs=None, columns=None, time_column=None, unit=None, input=
 class _Record:
     """What a format reader hands to :func:`_finish`."""
 
-    data: np.ndarray          # (n, k) or (n,)
+    data: np.ndarray  # (n, k) or (n,)
     names: list
-    time: np.ndarray | None   # float seconds (or time_unit units when time_is_seconds is False)
+    time: np.ndarray | None  # float seconds (or time_unit units when time_is_seconds is False)
     time_name: str | None
-    where: object             # callable: sample index → "line 12" / "row 11" / "message 11"
+    where: object  # callable: sample index → "line 12" / "row 11" / "message 11"
     time_is_seconds: bool = False
-    t_first: float = 0.0      # absolute time of sample 0 when `time` is relative (bags)
+    t_first: float = 0.0  # absolute time of sample 0 when `time` is relative (bags)
     checked_finite: bool = False
 
 
@@ -363,8 +404,10 @@ def _resolve(spec, names, path, what="column"):
         raise InputError(f"{path}: no {what} named {spec!r}; available: {', '.join(map(repr, names))}")
     k = int(spec)
     if not -n <= k < n:
-        raise InputError(f"{path}: {what} index {k} is out of range: the file has {n} columns "
-                         f"(indices 0–{n - 1}: {', '.join(names)})")
+        raise InputError(
+            f"{path}: {what} index {k} is out of range: the file has {n} columns "
+            f"(indices 0–{n - 1}: {', '.join(names)})"
+        )
     return k % n
 
 
@@ -416,12 +459,14 @@ def _finish(path, fmt, rec: _Record, fs, unit, input, gaps) -> Log:
         arr2 = data if data.ndim == 2 else data[:, None]
         chunk = max(1, 4_000_000 // max(1, arr2.shape[1]))
         for s in range(0, n, chunk):
-            hit = _first_nonfinite(np.asarray(arr2[s:s + chunk], dtype=np.float64))
+            hit = _first_nonfinite(np.asarray(arr2[s : s + chunk], dtype=np.float64))
             if hit is not None:
                 r, c = hit
                 v = arr2[s + r, c]
-                raise InputError(f"{path}: {rec.where(s + r)}, column {names[c]!r}: non-finite value {v} "
-                                 f"(NaN or inf); only finite numbers are allowed")
+                raise InputError(
+                    f"{path}: {rec.where(s + r)}, column {names[c]!r}: non-finite value {v} "
+                    f"(NaN or inf); only finite numbers are allowed"
+                )
 
     t = rec.time
     gap_list: list = []
@@ -462,8 +507,10 @@ def _finish(path, fmt, rec: _Record, fs, unit, input, gaps) -> Log:
             dur = float(d[i] - dt)
             gap_list.append(Gap(index=i + 1, time=float(t[i] - t[0]), duration=dur, missing=int(round(dur * fs))))
         if jitter > JITTER_WARN:
-            warnings.warn(f"{path}: irregular sampling — a time step differs from the nominal {dt:g} s by "
-                          f"{100 * jitter:.3g} %", stacklevel=3)
+            warnings.warn(
+                f"{path}: irregular sampling — a time step differs from the nominal {dt:g} s by {100 * jitter:.3g} %",
+                stacklevel=3,
+            )
         t0 = float(t[0]) + rec.t_first
     elif fs is None:  # pragma: no cover - read_log checks this first
         raise ParameterError(f"{path}: give fs= or time_column=")
@@ -484,14 +531,28 @@ def _finish(path, fmt, rec: _Record, fs, unit, input, gaps) -> Log:
     if gaps == "split":
         segments = [data[a:b] for a, b in spans]
         segment_spans = spans
-    kept = data[span[0]:span[1]] if span != (0, n) else data
+    kept = data[span[0] : span[1]] if span != (0, n) else data
     time_rel = None
     if t is not None:
-        time_rel = t[span[0]:span[1]] - t[span[0]]
+        time_rel = t[span[0] : span[1]] - t[span[0]]
         t0 = float(t[span[0]]) + rec.t_first
-    return Log(data=kept, fs=float(fs), columns=list(names), unit=unit, input=input, t0=t0, path=path,
-               format=fmt, gaps=gap_list, span=span, segments=segments, segment_spans=segment_spans,
-               time=time_rel, jitter=jitter, n_record=n)
+    return Log(
+        data=kept,
+        fs=float(fs),
+        columns=list(names),
+        unit=unit,
+        input=input,
+        t0=t0,
+        path=path,
+        format=fmt,
+        gaps=gap_list,
+        span=span,
+        segments=segments,
+        segment_spans=segment_spans,
+        time=time_rel,
+        jitter=jitter,
+        n_record=n,
+    )
 
 
 # --------------------------------------------------------------------------------------------------
@@ -552,8 +613,9 @@ def _read_text(path, columns, time_column, delimiter, gz):
         delim = _guess_delimiter(_strip_comment(lines[i0]))
     else:
         if not isinstance(delimiter, str) or len(delimiter) != 1 and delimiter.strip() != "":
-            raise ParameterError(f"delimiter must be one character (',', '\\t', ';', …) or ' ' for whitespace, "
-                                 f"got {delimiter!r}")
+            raise ParameterError(
+                f"delimiter must be one character (',', '\\t', ';', …) or ' ' for whitespace, got {delimiter!r}"
+            )
         delim = None if delimiter.strip() == "" else delimiter
     first = _split(_strip_comment(lines[i0]), delim)
     header = None
@@ -566,8 +628,9 @@ def _read_text(path, columns, time_column, delimiter, gz):
             raise InputError(f"{path}: line {i0 + 1} is a header ({', '.join(header)}) but no data rows follow")
         ncols = len(_split(_strip_comment(lines[i1]), delim))
         if len(header) != ncols:
-            raise InputError(f"{path}: the header on line {i0 + 1} names {len(header)} columns but line {i1 + 1} "
-                             f"has {ncols} fields")
+            raise InputError(
+                f"{path}: the header on line {i0 + 1} names {len(header)} columns but line {i1 + 1} has {ncols} fields"
+            )
     else:
         start = i0
         ncols = len(first)
@@ -610,14 +673,22 @@ def _read_text(path, columns, time_column, delimiter, gz):
     hit = _first_nonfinite(data)
     if hit is not None:
         r, c = hit
-        raise InputError(f"{path}: {where(r)}, column {idx[c] + 1} ({names[idx[c]]!r}): non-finite value "
-                         f"{data[r, c]} (NaN or inf); only finite numbers are allowed")
+        raise InputError(
+            f"{path}: {where(r)}, column {idx[c] + 1} ({names[idx[c]]!r}): non-finite value "
+            f"{data[r, c]} (NaN or inf); only finite numbers are allowed"
+        )
     time = arr[:, pos[t_idx]].copy() if t_idx is not None else None
     del arr
     if squeeze:
         data = data[:, 0].copy()
-    return _Record(data=data, names=[names[i] for i in idx], time=time,
-                   time_name=names[t_idx] if t_idx is not None else None, where=where, checked_finite=True)
+    return _Record(
+        data=data,
+        names=[names[i] for i in idx],
+        time=time,
+        time_name=names[t_idx] if t_idx is not None else None,
+        where=where,
+        checked_finite=True,
+    )
 
 
 def _line_of_row(lines, start, r):
@@ -647,9 +718,7 @@ def _diagnose(path, lines, start, delim, ncols, need, names, first_line):
         for c in need:
             if not _is_number(fields[c]):
                 shown = fields[c] if fields[c] else "(empty)"
-                raise InputError(
-                    f"{path}: line {i + 1}, column {c + 1} ({names[c]!r}): {shown!r} is not a number"
-                )
+                raise InputError(f"{path}: line {i + 1}, column {c + 1} ({names[c]!r}): {shown!r} is not a number")
 
 
 # --------------------------------------------------------------------------------------------------
@@ -666,7 +735,7 @@ def _columns_of(mm, idx):
     if len(idx) == mm.shape[1] and idx == list(range(mm.shape[1])):
         return mm
     if idx == list(range(idx[0], idx[0] + len(idx))):
-        return mm[:, idx[0]:idx[0] + len(idx)]
+        return mm[:, idx[0] : idx[0] + len(idx)]
     return np.asarray(mm[:, idx])
 
 
@@ -683,15 +752,22 @@ def _array_record(path, arr, columns, time_column, label, extra_time=None):
         time = np.asarray(arr[names[t_idx]], dtype=np.float64) if t_idx is not None else None
         if squeeze:
             data = data[:, 0]
-        return _Record(data=data, names=[names[i] for i in idx], time=time,
-                       time_name=names[t_idx] if t_idx is not None else None, where=lambda r: f"row {r}")
+        return _Record(
+            data=data,
+            names=[names[i] for i in idx],
+            time=time,
+            time_name=names[t_idx] if t_idx is not None else None,
+            where=lambda r: f"row {r}",
+        )
     _numeric_check(path, arr, label)
     tname = None
     if arr.ndim == 1:
         names = ["col0"]
         if time_column is not None and extra_time is None:
-            raise InputError(f"{path}: {label} is 1-D (one column), so it cannot hold a time column "
-                             f"{time_column!r} besides the samples")
+            raise InputError(
+                f"{path}: {label} is 1-D (one column), so it cannot hold a time column "
+                f"{time_column!r} besides the samples"
+            )
         data, time = arr, extra_time
         if columns is not None:
             _, _, squeeze = _select(columns, None, names, path)
@@ -711,13 +787,16 @@ def _array_record(path, arr, columns, time_column, label, extra_time=None):
         time = np.asarray(arr[:, t_idx], dtype=np.float64) if t_idx is not None else extra_time
         out_names = [names[i] for i in idx]
     else:
-        raise InputError(f"{path}: {label} has shape {arr.shape}; samples must be 1-D (samples,) or 2-D "
-                         f"(samples, axes)")
+        raise InputError(
+            f"{path}: {label} has shape {arr.shape}; samples must be 1-D (samples,) or 2-D (samples, axes)"
+        )
     if extra_time is not None:
         tname = time_column
         if extra_time.shape != (arr.shape[0],):
-            raise InputError(f"{path}: time array {time_column!r} has shape {extra_time.shape} but the samples "
-                             f"have {arr.shape[0]} rows")
+            raise InputError(
+                f"{path}: time array {time_column!r} has shape {extra_time.shape} but the samples "
+                f"have {arr.shape[0]} rows"
+            )
     elif arr.ndim == 2 and time_column is not None:
         tname = names[t_idx]
     return _Record(data=data, names=out_names, time=time, time_name=tname, where=lambda r: f"row {r}")
@@ -749,8 +828,10 @@ def _read_npz(path, columns, time_column, array):
             if array is None:
                 cand = [f for f in files if f != (time_column if time_arr is not None else None)]
                 if len(cand) != 1:
-                    raise ParameterError(f"{path}: the archive holds arrays {', '.join(map(repr, files))}; pass "
-                                         f"array=… to choose the samples")
+                    raise ParameterError(
+                        f"{path}: the archive holds arrays {', '.join(map(repr, files))}; pass "
+                        f"array=… to choose the samples"
+                    )
                 array = cand[0]
             elif array not in files:
                 raise InputError(f"{path}: no array named {array!r}; available: {', '.join(map(repr, files))}")
@@ -774,8 +855,7 @@ def _need(module: str, extra: str, what: str):
         return importlib.import_module(module)
     except ImportError:
         raise MissingDependencyError(
-            f"reading {what} needs the optional package {module.split('.')[0]!r}: "
-            f"pip install 'allanite[{extra}]'"
+            f"reading {what} needs the optional package {module.split('.')[0]!r}: pip install 'allanite[{extra}]'"
         ) from None
 
 
@@ -801,8 +881,10 @@ def _read_parquet(path, columns, time_column):
         typ = col.type
         if col.null_count:
             mask = np.asarray(col.is_null().to_numpy(zero_copy_only=False))
-            raise InputError(f"{path}: row {int(np.argmax(mask))}, column {name!r}: missing value (null); "
-                             f"only finite numbers are allowed")
+            raise InputError(
+                f"{path}: row {int(np.argmax(mask))}, column {name!r}: missing value (null); "
+                f"only finite numbers are allowed"
+            )
         if is_time and pa.types.is_timestamp(typ):
             ns = np.asarray(col.cast(pa.timestamp("ns")).cast(pa.int64()).to_numpy(), dtype=np.int64)
             if ns.size == 0:
@@ -821,9 +903,15 @@ def _read_parquet(path, columns, time_column):
         time, first = column(names[t_idx], True)
         if first is not None:
             t_first, secs = first, True
-    return _Record(data=data, names=[names[i] for i in idx], time=time,
-                   time_name=names[t_idx] if t_idx is not None else None, where=lambda r: f"row {r}",
-                   time_is_seconds=secs, t_first=t_first)
+    return _Record(
+        data=data,
+        names=[names[i] for i in idx],
+        time=time,
+        time_name=names[t_idx] if t_idx is not None else None,
+        where=lambda r: f"row {r}",
+        time_is_seconds=secs,
+        t_first=t_first,
+    )
 
 
 # --------------------------------------------------------------------------------------------------
@@ -834,8 +922,10 @@ def _read_bag(path, fmt, columns, time_column, topic):
     hl = _need("rosbags.highlevel", "ros", "ROS bags")
     bag = path.parent if (fmt == "ros2" and path.is_file()) else path
     if time_column not in (None, "header", "receive"):
-        raise ParameterError(f"for a ROS bag, time_column must be None or 'header' (header.stamp) or 'receive' "
-                             f"(the bag's receive time), got {time_column!r}")
+        raise ParameterError(
+            f"for a ROS bag, time_column must be None or 'header' (header.stamp) or 'receive' "
+            f"(the bag's receive time), got {time_column!r}"
+        )
     names = list(_BAG_FIELDS)
     idx, _, squeeze = _select(columns, None, names, path, default=None if columns is not None else names[:3])
     try:
@@ -850,8 +940,9 @@ def _read_bag(path, fmt, columns, time_column, topic):
             if len(topics) != 1:
                 others = sorted({f"{c.topic} ({c.msgtype})" for c in reader.connections})
                 if not topics:
-                    raise InputError(f"{path}: no sensor_msgs/Imu topic in the bag; it holds: "
-                                     f"{', '.join(others) or 'nothing'}")
+                    raise InputError(
+                        f"{path}: no sensor_msgs/Imu topic in the bag; it holds: {', '.join(others) or 'nothing'}"
+                    )
                 raise ParameterError(f"{path}: several sensor_msgs/Imu topics ({', '.join(topics)}); pass topic=…")
             topic = topics[0]
         elif topic not in topics:
@@ -881,9 +972,17 @@ def _read_bag(path, fmt, columns, time_column, topic):
         data = data[:, 0].copy()
     ns = np.asarray(stamps, dtype=np.int64)
     if time_column != "receive" and not ns.any():
-        raise InputError(f"{path}: every header.stamp on {topic} is zero; pass time_column='receive' to use the "
-                         f"bag's receive times")
+        raise InputError(
+            f"{path}: every header.stamp on {topic} is zero; pass time_column='receive' to use the bag's receive times"
+        )
     time = (ns - ns[0]).astype(np.float64) * 1e-9
     tname = "receive time" if time_column == "receive" else "header.stamp"
-    return _Record(data=data, names=[names[i] for i in idx], time=time, time_name=tname,
-                   where=lambda r: f"message {r} on {topic}", time_is_seconds=True, t_first=float(ns[0]) * 1e-9)
+    return _Record(
+        data=data,
+        names=[names[i] for i in idx],
+        time=time,
+        time_name=tname,
+        where=lambda r: f"message {r} on {topic}",
+        time_is_seconds=True,
+        t_first=float(ns[0]) * 1e-9,
+    )

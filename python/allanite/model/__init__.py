@@ -8,5 +8,15 @@ from .fitting import CoefficientSeries, NoiseFit, fit, information_bound
 from .refinement import Refinement, Step, refine
 from .terms import TERM_NAMES, TERMS
 
-__all__ = ["fit", "information_bound", "NoiseFit", "CoefficientSeries", "refine", "Refinement", "Step",
-           "TERMS", "TERM_NAMES", "EFFECTS"]
+__all__ = [
+    "fit",
+    "information_bound",
+    "NoiseFit",
+    "CoefficientSeries",
+    "refine",
+    "Refinement",
+    "Step",
+    "TERMS",
+    "TERM_NAMES",
+    "EFFECTS",
+]

@@ -73,9 +73,12 @@ EFFECTS: dict[str, Effect] = {
     e.name: e
     for e in (
         Effect(
-            "gauss_markov", "curve",
-            (("sigma", "rate unit", "standard deviation of the Gauss–Markov rate"),
-             ("tc", "s", "correlation time T_c")),
+            "gauss_markov",
+            "curve",
+            (
+                ("sigma", "rate unit", "standard deviation of the Gauss–Markov rate"),
+                ("tc", "s", "correlation time T_c"),
+            ),
             "first-order Gauss–Markov rate: σ²·(T_c/τ)²·(2τ/T_c − 3 + 4e^{−τ/T_c} − e^{−2τ/T_c}); a bump near "
             "τ ≈ 1.89·T_c, T_c searched in [τ_min, τ_max/4] so the bump lies inside the curve",
             signature=gm_avar,
@@ -83,7 +86,8 @@ EFFECTS: dict[str, Effect] = {
             search=lambda tmin, tmax: np.geomspace(tmin, tmax / 4.0, 40),
         ),
         Effect(
-            "sinusoid", "curve",
+            "sinusoid",
+            "curve",
             (("amplitude", "rate unit", "amplitude A of the rate sinusoid"), ("f0", "Hz", "frequency f0")),
             "rate sinusoid A·sin(2πf0t): A²·sin⁴(πf0τ)/(πf0τ)², nulls at τ = k/f0; f0 ≥ 2/τ_max so that two "
             "nulls fall inside the curve",
@@ -92,7 +96,8 @@ EFFECTS: dict[str, Effect] = {
             search=lambda tmin, tmax: np.geomspace(2.0 / tmax, 0.5 / tmin, 120),
         ),
         Effect(
-            "change_point", "time",
+            "change_point",
+            "time",
             (("t", "s", "time of a step in the noise level, from the start of the record"),),
             "a step in the Allan variance of non-overlapping windows along the record (all τ jointly), located "
             "to the sample by a two-segment likelihood; needs the samples",

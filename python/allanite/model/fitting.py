@@ -23,7 +23,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-
 from scipy.optimize import nnls as _scipy_nnls
 from scipy.stats import chi2 as chi2_dist
 from scipy.stats import norm
@@ -38,9 +37,22 @@ from ..units import coefficient_unit, ieee952, rate_unit
 from . import _covariance
 from .terms import TERM_ALPHA, TERMS, check_terms, design_matrix
 
-__all__ = ["fit", "information_bound", "NoiseFit", "Coefficient", "CoefficientSeries", "TERMS",
-           "edf_per_tau", "nnls", "interval", "readoffs", "z_quantile", "coefficients", "check_tau_range",
-           "MAX_GLS_TAU"]
+__all__ = [
+    "fit",
+    "information_bound",
+    "NoiseFit",
+    "Coefficient",
+    "CoefficientSeries",
+    "TERMS",
+    "edf_per_tau",
+    "nnls",
+    "interval",
+    "readoffs",
+    "z_quantile",
+    "coefficients",
+    "check_tau_range",
+    "MAX_GLS_TAU",
+]
 
 
 @dataclass(frozen=True)
@@ -135,8 +147,10 @@ class NoiseFit:
         return design_matrix(tau, m, self.fs, (name,))[:, 0] * self.theta[k]
 
     def __repr__(self) -> str:
-        lines = [f"NoiseFit({len(self.tau)} τ, {self.method.upper()}, χ²/dof = {self.chi2_dof:.3g}, p = {self.p_value:.3g}, "
-                 f"{self.confidence:.1%} intervals)"]
+        lines = [
+            f"NoiseFit({len(self.tau)} τ, {self.method.upper()}, χ²/dof = {self.chi2_dof:.3g}, p = {self.p_value:.3g}, "
+            f"{self.confidence:.1%} intervals)"
+        ]
         lines += [f"  {c!r}" for c in self.coefficients.values()]
         lines += [f"  note: {n}" for n in self.notes]
         return "\n".join(lines)
@@ -235,7 +249,8 @@ def _fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
         raise ParameterError(
             f"{m.size} τ of an overlapping estimate would be fitted with their full covariance; at most "
             f"{MAX_GLS_TAU} are supported (the covariance costs ~n_τ² lag sums) — use thin=True, or a sparser "
-            f"grid such as taus='exp'")
+            f"grid such as taus='exp'"
+        )
     if _exact_covariance_applies(tau, m, fs, n_points, estimator):
         # a few independent-weights passes are enough for a start (and its EDF for a bare ramp)
         out = _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, min(max_iter, 8), edf_cache)
@@ -244,9 +259,13 @@ def _fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
 
 
 def _exact_covariance_applies(tau, m, fs, n_points, estimator) -> bool:
-    return (isinstance(estimator, str) and estimator == "oavar"
-            and np.allclose(tau * fs, m, rtol=1e-9) and np.all(m == np.round(m))
-            and np.all(2 * m <= n_points - 1))
+    return (
+        isinstance(estimator, str)
+        and estimator == "oavar"
+        and np.allclose(tau * fs, m, rtol=1e-9)
+        and np.all(m == np.round(m))
+        and np.all(2 * m <= n_points - 1)
+    )
 
 
 #: The generalized least-squares iteration stops when no fitted value moves by more than this (relative).
@@ -457,8 +476,11 @@ def readoffs(result: AllanResult, adev_row: np.ndarray) -> dict:
 
 def z_quantile(confidence) -> float:
     """The two-sided normal quantile of a confidence level (1.0 for 68.3 %)."""
-    if isinstance(confidence, bool) or not isinstance(confidence, (int, float, np.floating)) \
-            or not 0.0 < float(confidence) < 1.0:
+    if (
+        isinstance(confidence, bool)
+        or not isinstance(confidence, (int, float, np.floating))
+        or not 0.0 < float(confidence) < 1.0
+    ):
         raise ParameterError(f"confidence must be a level strictly between 0 and 1, got {confidence!r}")
     return float(norm.ppf(0.5 + float(confidence) / 2.0))
 
@@ -480,8 +502,9 @@ def coefficients(terms, theta, cov, zq, inflate, unit) -> dict:
     return coeffs
 
 
-def fit(result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool = True, tau_range=None,
-        max_iter: int = 50):
+def fit(
+    result, *, terms=TERMS, unit=None, confidence: float = 0.683, thin: bool = True, tau_range=None, max_iter: int = 50
+):
     """Fit the IEEE-952 noise terms to an Allan variance result.
 
     Parameters
@@ -601,12 +624,24 @@ def _auto_choose(cuts, fit_at):
 
 def _auto_note(cut, chi2_dof, first_chi2_dof, tau0, ok):
     if cut == 0.0:
-        return () if ok else (f"tau_range='auto': no cut of the shortest τ (up to {AUTO_MAX_CUT_M} samples) brought "
-                              f"χ²/dof to ≤ {AUTO_CHI2_DOF:g}; all τ kept (χ²/dof {chi2_dof:.3g})",)
-    what = "" if ok else f" (the lowest χ²/dof of the cuts up to {AUTO_MAX_CUT_M} samples; none reached ≤ {AUTO_CHI2_DOF:g})"
-    return (f"fitted from τ ≥ {cut * (1 + 1e-9):.4g} s (tau_range='auto'){what}: with all τ from {tau0:.4g} s the "
-            f"model gave χ²/dof {first_chi2_dof:.3g}, here {chi2_dof:.3g} — the shortest τ are not described by these "
-            f"terms (anti-alias filtering, vibration lines or correlated samples are the usual causes)",)
+        return (
+            ()
+            if ok
+            else (
+                f"tau_range='auto': no cut of the shortest τ (up to {AUTO_MAX_CUT_M} samples) brought "
+                f"χ²/dof to ≤ {AUTO_CHI2_DOF:g}; all τ kept (χ²/dof {chi2_dof:.3g})",
+            )
+        )
+    what = (
+        ""
+        if ok
+        else f" (the lowest χ²/dof of the cuts up to {AUTO_MAX_CUT_M} samples; none reached ≤ {AUTO_CHI2_DOF:g})"
+    )
+    return (
+        f"fitted from τ ≥ {cut * (1 + 1e-9):.4g} s (tau_range='auto'){what}: with all τ from {tau0:.4g} s the "
+        f"model gave χ²/dof {first_chi2_dof:.3g}, here {chi2_dof:.3g} — the shortest τ are not described by these "
+        f"terms (anti-alias filtering, vibration lines or correlated samples are the usual causes)",
+    )
 
 
 def _fit_static_auto(result, avar_row, terms, unit, confidence, zq, thin, max_iter):
@@ -626,11 +661,20 @@ def _fit_dynamic_auto(result, terms, unit, confidence, zq, thin, max_iter):
     out = []
     for rows_avar in rows:
         med = np.median(rows_avar, axis=1)
-        stat = AllanResult(tau=result.tau, avar=med, n=result.n, m=result.m, estimator=result.estimator,
-                           fs=result.fs, n_samples=result.window, input=result.input, source=result.source)
+        stat = AllanResult(
+            tau=result.tau,
+            avar=med,
+            n=result.n,
+            m=result.m,
+            estimator=result.estimator,
+            fs=result.fs,
+            n_samples=result.window,
+            input=result.input,
+            source=result.source,
+        )
         cuts, tau0 = _auto_cuts(stat, med, thin, len(terms))
 
-        def fit_at(cut):
+        def fit_at(cut, stat=stat, med=med):
             f = _fit_static_row(stat, med, terms, unit, confidence, zq, thin, max_iter, (cut, np.inf))
             return f, f.chi2_dof
 
@@ -644,8 +688,10 @@ def _fit_dynamic_auto(result, terms, unit, confidence, zq, thin, max_iter):
 def _check_fit_estimator(result) -> None:
     """The result's values must estimate the Allan variance (the registry's ``estimates_allan``)."""
     if result.estimator == "theo1":
-        raise ParameterError("fit needs Allan-variance estimates; raw Theo1 is biased against the Allan variance by "
-                             "a noise-type-dependent factor: use estimator='theobr' or 'theoh'")
+        raise ParameterError(
+            "fit needs Allan-variance estimates; raw Theo1 is biased against the Allan variance by "
+            "a noise-type-dependent factor: use estimator='theobr' or 'theoh'"
+        )
     if not get_estimator(result.estimator).estimates_allan:
         raise ParameterError(f"fit supports the estimators {fit_estimators()}, not {result.estimator!r}")
 
@@ -684,8 +730,9 @@ def _select(tau, avar, thin, n_terms, what, tau_range=(0.0, np.inf)):
     if inside.size == 0:
         raise ParameterError(f"no τ of {what} lies in tau_range {tau_range} s (τ spans {tau[0]:g}–{tau[-1]:g} s)")
     if not np.any(avar[inside] > 0):
-        raise ParameterError(f"{what} has an Allan variance of zero at every τ in range (a constant record?): "
-                             f"there is no noise to fit")
+        raise ParameterError(
+            f"{what} has an Allan variance of zero at every τ in range (a constant record?): there is no noise to fit"
+        )
     idx = inside[_octave_thin(tau[inside])] if thin else inside
     idx = idx[avar[idx] > 0]
     if idx.size <= n_terms:
@@ -701,7 +748,8 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
     idx = _select(result.tau, avar_row, thin, len(terms), "the result", tau_range)
     tau, m, y = result.tau[idx], result.m[idx].astype(np.float64), avar_row[idx]
     theta, cov, model, nu, z, it, a, chi2 = _fit_core(
-        tau, m, y, result.fs, result.n_samples + 1, _est_key(result, idx), terms, confidence, max_iter)
+        tau, m, y, result.fs, result.n_samples + 1, _est_key(result, idx), terms, confidence, max_iter
+    )
     n_active = int(np.count_nonzero(theta > 0))
     dof = max(1, tau.size - n_active)
     chi2_dof = chi2 / dof
@@ -709,17 +757,36 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
     coeffs = coefficients(terms, theta, cov, zq, inflate, unit)
     notes = ()
     if chi2_dof > MISFIT_CHI2_DOF:
-        notes = (f"χ²/dof {chi2_dof:.3g}: these terms do not describe the estimates (intervals widened by "
-                 f"√(χ²/dof) = {inflate:.3g}); look at z, restrict tau_range, or use tau_range='auto' when the "
-                 f"misfit is at the shortest τ",)
+        notes = (
+            f"χ²/dof {chi2_dof:.3g}: these terms do not describe the estimates (intervals widened by "
+            f"√(χ²/dof) = {inflate:.3g}); look at z, restrict tau_range, or use tau_range='auto' when the "
+            f"misfit is at the shortest τ",
+        )
     return NoiseFit(
-        coefficients=coeffs, terms=terms, tau=tau, m=m, avar=y, edf=nu, model=model,
-        components={t: a[:, k] * theta[k] for k, t in enumerate(terms)}, z=z, chi2=chi2, dof=dof,
-        chi2_dof=chi2_dof, p_value=float(chi2_dist.sf(chi2, dof)),
-        readoffs=readoffs(result, np.sqrt(avar_row)), fs=result.fs, confidence=confidence, unit=unit,
-        iterations=it, theta=theta, covariance=cov, notes=notes,
-        method="gls" if _exact_covariance_applies(tau, m, result.fs, result.n_samples + 1,
-                                                  _est_key(result, idx)) else "wls",
+        coefficients=coeffs,
+        terms=terms,
+        tau=tau,
+        m=m,
+        avar=y,
+        edf=nu,
+        model=model,
+        components={t: a[:, k] * theta[k] for k, t in enumerate(terms)},
+        z=z,
+        chi2=chi2,
+        dof=dof,
+        chi2_dof=chi2_dof,
+        p_value=float(chi2_dist.sf(chi2, dof)),
+        readoffs=readoffs(result, np.sqrt(avar_row)),
+        fs=result.fs,
+        confidence=confidence,
+        unit=unit,
+        iterations=it,
+        theta=theta,
+        covariance=cov,
+        notes=notes,
+        method="gls"
+        if _exact_covariance_applies(tau, m, result.fs, result.n_samples + 1, _est_key(result, idx))
+        else "wls",
     )
 
 
@@ -746,8 +813,17 @@ def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range)
                 chi[j] = 0.0
                 continue
             theta, cov, model, nu, z, it, a, chi2 = _fit_core(
-                tau, m, np.maximum(y, 1e-300), result.fs, result.window + 1, _est_key(result, idx), terms,
-                confidence, max_iter, edf_cache=cache)
+                tau,
+                m,
+                np.maximum(y, 1e-300),
+                result.fs,
+                result.window + 1,
+                _est_key(result, idx),
+                terms,
+                confidence,
+                max_iter,
+                edf_cache=cache,
+            )
             dof = max(1, tau.size - int(np.count_nonzero(theta > 0)))
             chi[j] = chi2 / dof
             inflate = max(1.0, math.sqrt(chi[j]))
@@ -758,9 +834,20 @@ def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range)
         if unit is not None:
             ieee = {t: ieee952(t, vals[t], unit).value for t in terms}
             ieee_units = {t: ieee952(t, 1.0, unit).unit for t in terms}
-        series.append(CoefficientSeries(t=result.t, terms=terms, values=vals, ci_low=lo, ci_high=hi,
-                                        chi2_dof=chi, confidence=confidence, unit=unit, ieee=ieee,
-                                        ieee_units=ieee_units))
+        series.append(
+            CoefficientSeries(
+                t=result.t,
+                terms=terms,
+                values=vals,
+                ci_low=lo,
+                ci_high=hi,
+                chi2_dof=chi,
+                confidence=confidence,
+                unit=unit,
+                ieee=ieee,
+                ieee_units=ieee_units,
+            )
+        )
     return series[0] if result.avar.ndim == 2 else series
 
 
@@ -812,8 +899,7 @@ def information_bound(n: int, fs: float, *, Q: float = 0.0, N: float = 0.0, B: f
         k = np.arange(start, min(n_freq, start + chunk - 1) + 1, dtype=np.float64)
         f = k * (fs / n)
         s2 = np.sin(np.pi * f * tau0) ** 2
-        cols = {"Q": 8.0 * s2 / tau0, "N": np.full_like(f, 2.0), "B": 1.0 / (np.pi * f),
-                "K": tau0 * tau0 / (2.0 * s2)}
+        cols = {"Q": 8.0 * s2 / tau0, "N": np.full_like(f, 2.0), "B": 1.0 / (np.pi * f), "K": tau0 * tau0 / (2.0 * s2)}
         d = np.array([cols[t] for t in terms])
         spec = theta @ d
         dw = d / spec

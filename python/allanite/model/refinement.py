@@ -86,8 +86,7 @@ class _Curve:
 
     def edf(self, alpha: int) -> np.ndarray:
         if alpha not in self._edf:
-            self._edf[alpha] = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points,
-                                                     self.estimator)
+            self._edf[alpha] = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
         return self._edf[alpha]
 
 
@@ -119,8 +118,16 @@ def _solve(curve: _Curve, terms, effects, max_iter: int = 40) -> _Solution:
         cols.append(_column(name, p, tau)[:, None])
         alphas.append(_alpha_of(name, p, tau))
     a = np.hstack(cols)
-    nu_cols = np.column_stack([np.where(al == -2, curve.edf(-2), np.where(al == -1, curve.edf(-1),
-                                        np.where(al == 2, curve.edf(2), curve.edf(0)))) for al in alphas])
+    nu_cols = np.column_stack(
+        [
+            np.where(
+                al == -2,
+                curve.edf(-2),
+                np.where(al == -1, curve.edf(-1), np.where(al == 2, curve.edf(2), curve.edf(0))),
+            )
+            for al in alphas
+        ]
+    )
     y = curve.avar
     model = y.copy()
     nu = nu_cols[:, 1] if len(terms) > 1 else nu_cols[:, 0]
@@ -180,8 +187,14 @@ def _residual_evidence(curve, sol) -> dict:
             j = i
             while j + 1 < z.size and abs(z[j + 1]) > 2 and np.sign(z[j + 1]) == np.sign(z[i]):
                 j += 1
-            runs.append({"tau_from": float(curve.tau[i]), "tau_to": float(curve.tau[j]),
-                         "sign": int(np.sign(z[i])), "points": int(j - i + 1)})
+            runs.append(
+                {
+                    "tau_from": float(curve.tau[i]),
+                    "tau_to": float(curve.tau[j]),
+                    "sign": int(np.sign(z[i])),
+                    "points": int(j - i + 1),
+                }
+            )
             i = j + 1
         else:
             i += 1
@@ -196,8 +209,12 @@ def _search(curve, terms, effects, name, grid):
     k = int(np.argmin(chis))
     lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
     if hi > lo:
-        res = minimize_scalar(lambda lp: _solve(curve, terms, effects + [(name, math.exp(lp))]).chi2,
-                              bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})
+        res = minimize_scalar(
+            lambda lp: _solve(curve, terms, effects + [(name, math.exp(lp))]).chi2,
+            bounds=(lo, hi),
+            method="bounded",
+            options={"xatol": 1e-4},
+        )
         p = math.exp(res.x)
     else:
         p = float(grid[k])
@@ -246,11 +263,14 @@ def _joint(curve, terms, effects, sol, passes: int = 3):
     for _ in range(passes):
         moved = False
         for i, (name, p) in enumerate(effects):
+
             def chi(lp, i=i, name=name):
-                trial = effects[:i] + [(name, math.exp(lp))] + effects[i + 1:]
+                trial = effects[:i] + [(name, math.exp(lp))] + effects[i + 1 :]
                 return _solve(curve, terms, trial).chi2
-            res = minimize_scalar(chi, bounds=(math.log(p) - 1.5, math.log(p) + 1.5), method="bounded",
-                                  options={"xatol": 1e-4})
+
+            res = minimize_scalar(
+                chi, bounds=(math.log(p) - 1.5, math.log(p) + 1.5), method="bounded", options={"xatol": 1e-4}
+            )
             if res.fun < sol.chi2 - 1e-9:
                 effects[i] = (name, math.exp(res.x))
                 sol = _solve(curve, terms, effects)
@@ -269,7 +289,7 @@ def _update_steps(steps, curve, terms, effects, sol, truth):
         amp = math.sqrt(max(sol.theta[i], 0.0))
         var_i = sol.cov[i, i]
         sd = math.sqrt(max(var_i, 0.0)) / (2 * amp) if amp > 0 and np.isfinite(var_i) else float("nan")
-        others = effects[:j] + effects[j + 1:]
+        others = effects[:j] + effects[j + 1 :]
         names = EFFECTS[name].param_names
         p_int = _profile_interval(curve, terms, others, name, p, sol, None)
         st.params = {names[0]: amp, names[1]: p}
@@ -290,7 +310,7 @@ def _change_points(y, fs, terms, max_points=2):
     if window < 64:
         return []
     d = davar(y, fs, window=window, hop=window, taus="octave")
-    lav = np.log(np.maximum(d.avar, 1e-300))       # (tau, windows)
+    lav = np.log(np.maximum(d.avar, 1e-300))  # (tau, windows)
     # SD of log σ̂² per τ: from the EDF of the dominant noise (white rate is a fair middle)
     nu = fitting.edf_per_tau(np.zeros(d.m.size, dtype=int), d.m, window + 1, "oavar")
     # 1/var(log σ̂²): ν/2 for white rate, but long τ scatter more (fewer degrees of freedom for
@@ -306,13 +326,16 @@ def _change_points(y, fs, terms, max_points=2):
         for j in range(a + 1, b):
             left, right = lav[:, a:j], lav[:, j:b]
             chi_const = np.sum(w[:, None] * (seg - seg.mean(axis=1, keepdims=True)) ** 2)
-            chi_step = (np.sum(w[:, None] * (left - left.mean(axis=1, keepdims=True)) ** 2)
-                        + np.sum(w[:, None] * (right - right.mean(axis=1, keepdims=True)) ** 2))
+            chi_step = np.sum(w[:, None] * (left - left.mean(axis=1, keepdims=True)) ** 2) + np.sum(
+                w[:, None] * (right - right.mean(axis=1, keepdims=True)) ** 2
+            )
             gain = chi_const - chi_step
             if gain > best[0]:
-                gain_tau = (np.sum(w[:, None] * (seg - seg.mean(axis=1, keepdims=True)) ** 2, axis=1)
-                            - np.sum(w[:, None] * (left - left.mean(axis=1, keepdims=True)) ** 2, axis=1)
-                            - np.sum(w[:, None] * (right - right.mean(axis=1, keepdims=True)) ** 2, axis=1))
+                gain_tau = (
+                    np.sum(w[:, None] * (seg - seg.mean(axis=1, keepdims=True)) ** 2, axis=1)
+                    - np.sum(w[:, None] * (left - left.mean(axis=1, keepdims=True)) ** 2, axis=1)
+                    - np.sum(w[:, None] * (right - right.mean(axis=1, keepdims=True)) ** 2, axis=1)
+                )
                 best = (gain, j, int(np.argmax(gain_tau)))
         return best
 
@@ -336,9 +359,16 @@ def _change_points(y, fs, terms, max_points=2):
         t_abs = t_hat + lo_s / fs
         if any(abs(c["t"] - t_abs) < window / fs for c in out):
             continue
-        out.append({"t": t_abs, "interval": (t_int[0] + lo_s / fs, t_int[1] + lo_s / fs),
-                    "gain": float(gain), "tau": float(d.tau[k_tau]), "window_s": window / fs,
-                    "coarse_split_s": j * window / fs})
+        out.append(
+            {
+                "t": t_abs,
+                "interval": (t_int[0] + lo_s / fs, t_int[1] + lo_s / fs),
+                "gain": float(gain),
+                "tau": float(d.tau[k_tau]),
+                "window_s": window / fs,
+                "coarse_split_s": j * window / fs,
+            }
+        )
         # search each side again, leaving out the window that straddles the change
         jw = int(t_abs * fs // window)
         stack += [(a, min(jw, j)), (max(jw + 1, j), b)]
@@ -360,8 +390,11 @@ def _change_points(y, fs, terms, max_points=2):
                 k += lav.shape[0]
         res = np.concatenate(res, axis=1)
         z = res * np.sqrt(w)[:, None]
-        return {"chi2_dof": float(np.sum(z**2) / max(1, z.size - k)), "rms_z": float(np.sqrt(np.mean(z**2))),
-                "rms_adev_pct": float(100 * np.sqrt(np.mean((np.exp(res / 2) - 1) ** 2)))}
+        return {
+            "chi2_dof": float(np.sum(z**2) / max(1, z.size - k)),
+            "rms_z": float(np.sqrt(np.mean(z**2))),
+            "rms_adev_pct": float(100 * np.sqrt(np.mean((np.exp(res / 2) - 1) ** 2))),
+        }
 
     before = stats([(0, n_win)])
     after = stats([(a, b) for a, b in zip(edges[:-1], edges[1:])])
@@ -374,16 +407,16 @@ def _locate(y, m, fs):
     """Change in the mean of the squared m-sample second differences: MLE split and 2-unit support."""
     k = y.size // m
     b = y[: k * m].reshape(k, m).mean(axis=1)
-    d = np.diff(b) ** 2 + 1e-300                       # independent-ish terms at stride m
+    d = np.diff(b) ** 2 + 1e-300  # independent-ish terms at stride m
     n = d.size
     c = np.cumsum(d)
     j = np.arange(2, n - 1)
     mu1 = c[j - 1] / j
     mu2 = (c[-1] - c[j - 1]) / (n - j)
-    ll = -0.5 * (j * np.log(mu1) + (n - j) * np.log(mu2))   # exponential-family profile (χ²₁ terms)
+    ll = -0.5 * (j * np.log(mu1) + (n - j) * np.log(mu2))  # exponential-family profile (χ²₁ terms)
     i = int(np.argmax(ll))
     ok = j[ll >= ll[i] - 2.0]
-    to_t = lambda idx: (idx + 1) * m / fs                    # noqa: E731  boundary after term idx
+    to_t = lambda idx: (idx + 1) * m / fs  # noqa: E731  boundary after term idx
     return to_t(j[i]), (to_t(ok.min()) - m / fs, to_t(ok.max()) + m / fs)
 
 
@@ -433,21 +466,35 @@ class Refinement:
     def report(self) -> str:
         """Markdown: the starting residual, each step with its parameters, evidence and errors."""
         s0 = self.start
-        lines = ["# Model refinement", "",
-                 f"Starting model {'+'.join(self.terms)}: χ²/dof = {s0.chi2_dof:.3g}, "
-                 f"RMS z = {np.sqrt(np.mean(s0.z ** 2)):.3g}.", ""]
+        lines = [
+            "# Model refinement",
+            "",
+            f"Starting model {'+'.join(self.terms)}: χ²/dof = {s0.chi2_dof:.3g}, "
+            f"RMS z = {np.sqrt(np.mean(s0.z**2)):.3g}.",
+            "",
+        ]
         if not self.steps:
             lines.append("Nothing added: the residual is consistent with noise or no candidate earned its parameters.")
         for i, st in enumerate(self.steps, 1):
-            ps = ", ".join(f"{k} = {v:.4g} [{st.intervals[k][0]:.4g}, {st.intervals[k][1]:.4g}]"
-                           for k, v in st.params.items())
-            lines += [f"## Step {i}: {st.effect}", "", f"- parameters: {ps}",
-                      f"- evidence: {st.evidence}",
-                      "- before → after: " + ", ".join(f"{k} {st.before[k]:.3g} → {st.after[k]:.3g}"
-                                                       for k in ("chi2_dof", "rms_z", "rms_adev_pct")), ""]
+            ps = ", ".join(
+                f"{k} = {v:.4g} [{st.intervals[k][0]:.4g}, {st.intervals[k][1]:.4g}]" for k, v in st.params.items()
+            )
+            lines += [
+                f"## Step {i}: {st.effect}",
+                "",
+                f"- parameters: {ps}",
+                f"- evidence: {st.evidence}",
+                "- before → after: "
+                + ", ".join(
+                    f"{k} {st.before[k]:.3g} → {st.after[k]:.3g}" for k in ("chi2_dof", "rms_z", "rms_adev_pct")
+                ),
+                "",
+            ]
             if st.truth_error:
-                lines.append("- error against the truth: " + ", ".join(f"{k} {100 * v:+.1f} %"
-                                                                      for k, v in st.truth_error.items()))
+                lines.append(
+                    "- error against the truth: "
+                    + ", ".join(f"{k} {100 * v:+.1f} %" for k, v in st.truth_error.items())
+                )
                 lines.append("")
         return "\n".join(lines)
 
@@ -481,65 +528,97 @@ def _noise_fit(curve, terms, effects, sol, result, unit, confidence):
     inflate = max(1.0, math.sqrt(sol.chi2_dof))
     coeffs = fitting.coefficients(terms, sol.theta[:k], sol.cov[:k, :k], zq, inflate, unit)
     comps = {t: sol.a[:, i] * sol.theta[i] for i, t in enumerate(terms)}
-    for j, (name, p) in enumerate(effects):
+    for j, (name, _param) in enumerate(effects):
         i = k + j
         key = f"{name}{j + 1}" if sum(e[0] == name for e in effects) > 1 else name
         comps[key] = sol.a[:, i] * sol.theta[i]
-        coeffs[key] = fitting.Coefficient(name=key, value=float(math.sqrt(max(sol.theta[i], 0.0))),
-                                       ci=fitting.interval(sol.theta[i], sol.cov[i, i], zq, inflate), unit=unit)
+        coeffs[key] = fitting.Coefficient(
+            name=key,
+            value=float(math.sqrt(max(sol.theta[i], 0.0))),
+            ci=fitting.interval(sol.theta[i], sol.cov[i, i], zq, inflate),
+            unit=unit,
+        )
     readoffs = fitting.readoffs(result, np.sqrt(np.atleast_2d(result.avar)[0]))
     return fitting.NoiseFit(
-        coefficients=coeffs, terms=terms, tau=curve.tau, m=curve.m, avar=curve.avar, edf=sol.nu, model=sol.model,
-        components=comps, z=sol.z, chi2=sol.chi2, dof=sol.dof, chi2_dof=sol.chi2_dof,
-        p_value=float(chi2_dist.sf(sol.chi2, sol.dof)), readoffs=readoffs, fs=curve.fs, confidence=confidence,
-        unit=unit, iterations=0, theta=sol.theta[:k], covariance=sol.cov[:k, :k])
+        coefficients=coeffs,
+        terms=terms,
+        tau=curve.tau,
+        m=curve.m,
+        avar=curve.avar,
+        edf=sol.nu,
+        model=sol.model,
+        components=comps,
+        z=sol.z,
+        chi2=sol.chi2,
+        dof=sol.dof,
+        chi2_dof=sol.chi2_dof,
+        p_value=float(chi2_dist.sf(sol.chi2, sol.dof)),
+        readoffs=readoffs,
+        fs=curve.fs,
+        confidence=confidence,
+        unit=unit,
+        iterations=0,
+        theta=sol.theta[:k],
+        covariance=sol.cov[:k, :k],
+    )
 
 
 # ----------------------------------------------------------------------------------------------
 # the loop
 
 
-def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=CANDIDATES, unit=None,
-           input: str = "rate", tau_range=None, truth=None, confidence: float = 0.683, points: int = 300,
-           axis: int = 0) -> Refinement:
+def refine(
+    x_or_result,
+    fs=None,
+    *,
+    start=("Q", "N", "B", "K", "R"),
+    candidates=CANDIDATES,
+    unit=None,
+    input: str = "rate",
+    tau_range=None,
+    truth=None,
+    confidence: float = 0.683,
+    points: int = 300,
+    axis: int = 0,
+) -> Refinement:
     """Fit the starting model, find what it lacks, add it, repeat; report the error before and after.
 
-    Parameters
-    ----------
-    x_or_result : array_like or AllanResult
-        Samples (then ``fs`` is needed; the Allan variance is computed on a dense exponential grid of
-        ``points`` τ so that a sinusoid's nulls are resolved, and change points can be searched), or
-        a static :class:`~allanite.AllanResult` (curve effects only).
-    fs : float, optional
-        Sampling rate, Hz (samples only).
-    start : tuple of str
-        The starting model's terms (``"Q"``, ``"N"``, ``"B"``, ``"K"``, ``"R"``).
-    candidates : tuple of str
-        Effects to try (:data:`CANDIDATES`, the registry :data:`allanite.model.effects.EFFECTS`), with the
-        parameters each step reports and their units ("rate unit": the samples' rate unit):
+        Parameters
+        ----------
+        x_or_result : array_like or AllanResult
+            Samples (then ``fs`` is needed; the Allan variance is computed on a dense exponential grid of
+            ``points`` τ so that a sinusoid's nulls are resolved, and change points can be searched), or
+            a static :class:`~allanite.AllanResult` (curve effects only).
+        fs : float, optional
+            Sampling rate, Hz (samples only).
+        start : tuple of str
+            The starting model's terms (``"Q"``, ``"N"``, ``"B"``, ``"K"``, ``"R"``).
+        candidates : tuple of str
+            Effects to try (:data:`CANDIDATES`, the registry :data:`allanite.model.effects.EFFECTS`), with the
+            parameters each step reports and their units ("rate unit": the samples' rate unit):
 
-{effects}
-    unit : str, optional
-        Unit of the samples, for IEEE-952 values of the terms.
-    tau_range : (float, float), optional
-        τ (s) to use, as in :func:`allanite.fit` (e.g. to leave out a non-white shortest τ).
-    truth : dict, optional
-        Known parameters per effect (``{"gauss_markov": {"sigma": …, "tc": …}}``, ``{"change_point":
-        {"t": …}}``): each step then records its relative errors.
-    axis : int
-        Which axis of multi-axis input to refine.
+    {effects}
+        unit : str, optional
+            Unit of the samples, for IEEE-952 values of the terms.
+        tau_range : (float, float), optional
+            τ (s) to use, as in :func:`allanite.fit` (e.g. to leave out a non-white shortest τ).
+        truth : dict, optional
+            Known parameters per effect (``{"gauss_markov": {"sigma": …, "tc": …}}``, ``{"change_point":
+            {"t": …}}``): each step then records its relative errors.
+        axis : int
+            Which axis of multi-axis input to refine.
 
-    Returns
-    -------
-    Refinement
+        Returns
+        -------
+        Refinement
 
-    Examples
-    --------
-    >>> import allanite
-    >>> y = allanite.simulate(1_000_000, 100.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 10.0)], seed=11)
-    >>> r = allanite.refine(y, 100.0)               # the generator's GM is not in the starting model
-    >>> r.found, round(r.steps[0].params["tc"], 1), round(r.steps[0].after["chi2_dof"], 1)
-    (['gauss_markov'], 10.2, 1.1)
+        Examples
+        --------
+        >>> import allanite
+        >>> y = allanite.simulate(1_000_000, 100.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 10.0)], seed=11)
+        >>> r = allanite.refine(y, 100.0)               # the generator's GM is not in the starting model
+        >>> r.found, round(r.steps[0].params["tc"], 1), round(r.steps[0].after["chi2_dof"], 1)
+        (['gauss_markov'], 10.2, 1.1)
     """
     start = check_terms(start)
     if isinstance(candidates, str):
@@ -553,8 +632,10 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
             raise ParameterError("fs is taken from the result; pass fs only with samples")
         result = x_or_result
     elif hasattr(x_or_result, "tau") and hasattr(x_or_result, "t"):
-        raise ParameterError("refine needs samples or a static AllanResult; for a dynamic result pass the samples "
-                             "so that change points can be located")
+        raise ParameterError(
+            "refine needs samples or a static AllanResult; for a dynamic result pass the samples "
+            "so that change points can be located"
+        )
     else:
         if fs is None:
             raise ParameterError("fs (Hz) is needed with samples")
@@ -566,17 +647,27 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
         grid = tau_grid(y.size, fs, "exp", points=points, m_max=top) if top > 1 else "octave"
         result = avar(y, fs, taus=grid)
     if result.avar.ndim == 2:
-        result = AllanResult(tau=result.tau, avar=result.avar[axis], n=result.n, m=result.m,
-                             estimator=result.estimator, fs=result.fs, n_samples=result.n_samples,
-                             input=result.input, source=result.source)
+        result = AllanResult(
+            tau=result.tau,
+            avar=result.avar[axis],
+            n=result.n,
+            m=result.m,
+            estimator=result.estimator,
+            fs=result.fs,
+            n_samples=result.n_samples,
+            input=result.input,
+            source=result.source,
+        )
     lo, hi = (0.0, np.inf) if tau_range is None else fitting.check_tau_range(tau_range)
     keep = (result.tau >= lo) & (result.tau <= hi) & (result.avar > 0)
     if keep.sum() < len(start) + 3:
-        raise ParameterError(f"{int(keep.sum())} usable τ points; refining {len(start)} terms needs at least "
-                             f"{len(start) + 3}")
+        raise ParameterError(
+            f"{int(keep.sum())} usable τ points; refining {len(start)} terms needs at least {len(start) + 3}"
+        )
     est = result.estimator if result.source is None else tuple(np.asarray(result.source)[keep])
-    curve = _Curve(result.tau[keep], result.m[keep].astype(np.float64), result.avar[keep], result.fs,
-                   result.n_samples + 1, est)
+    curve = _Curve(
+        result.tau[keep], result.m[keep].astype(np.float64), result.avar[keep], result.fs, result.n_samples + 1, est
+    )
     effects: list = []
     steps: list = []
     sol = _solve(curve, start, effects)
@@ -601,8 +692,13 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
             at_edge = p <= grid[0] * 1.02 or p >= grid[-1] / 1.02
             # ... and an effect must make the fit better per degree of freedom, not only in total (on a grossly
             # wrong model a χ² drop can pass the BIC test while χ²/dof rises)
-            if (gain > penalty and s_new.theta[-1] > 0 and not at_edge and s_new.chi2_dof < sol.chi2_dof
-                    and (best is None or gain > best[0])):
+            if (
+                gain > penalty
+                and s_new.theta[-1] > 0
+                and not at_edge
+                and s_new.chi2_dof < sol.chi2_dof
+                and (best is None or gain > best[0])
+            ):
                 best = (gain, cand, p, s_new, prof)
         if best is None:
             break
@@ -621,8 +717,18 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
         terr = None
         if truth and cand in truth:
             terr = {k: params[k] / v - 1 for k, v in truth[cand].items() if k in params}
-        steps.append(Step(effect=cand, params=params, intervals=intervals, evidence=evidence, before=before,
-                          after=after, delta_chi2_eff=float(gain), truth_error=terr))
+        steps.append(
+            Step(
+                effect=cand,
+                params=params,
+                intervals=intervals,
+                evidence=evidence,
+                before=before,
+                after=after,
+                delta_chi2_eff=float(gain),
+                truth_error=terr,
+            )
+        )
         effects, sol = new_effects, s_new
         if len(effects) > 1:
             effects, sol = _joint(curve, start, effects, sol)
@@ -635,14 +741,35 @@ def refine(x_or_result, fs=None, *, start=("Q", "N", "B", "K", "R"), candidates=
             if truth and "change_point" in truth:
                 ts = np.atleast_1d(truth["change_point"]["t"])
                 terr = {"t": float(np.min(np.abs(ts - c["t"])) / (y.size / fs))}
-            steps.append(Step(effect="change_point", params={"t": c["t"]}, intervals={"t": c["interval"]},
-                              evidence={"tau": c["tau"], "window_s": c["window_s"], "coarse_split_s": c["coarse_split_s"],
-                                        "gain_chi2": c["gain"]},
-                              before=c["before"], after=c["after"], delta_chi2_eff=c["gain"], truth_error=terr))
+            steps.append(
+                Step(
+                    effect="change_point",
+                    params={"t": c["t"]},
+                    intervals={"t": c["interval"]},
+                    evidence={
+                        "tau": c["tau"],
+                        "window_s": c["window_s"],
+                        "coarse_split_s": c["coarse_split_s"],
+                        "gain_chi2": c["gain"],
+                    },
+                    before=c["before"],
+                    after=c["after"],
+                    delta_chi2_eff=c["gain"],
+                    truth_error=terr,
+                )
+            )
     start_fit = _noise_fit(curve, start, [], start_sol, result, unit, confidence)
     final_fit = _noise_fit(curve, start, effects, sol, result, unit, confidence)
-    return Refinement(steps=steps, fit=final_fit, start=start_fit, result=result, terms=start, effects=effects,
-                      change_points=change_points, considered=considered)
+    return Refinement(
+        steps=steps,
+        fit=final_fit,
+        start=start_fit,
+        result=result,
+        terms=start,
+        effects=effects,
+        change_points=change_points,
+        considered=considered,
+    )
 
 
 refine.__doc__ = (refine.__doc__ or "").replace("{effects}", describe())

@@ -47,8 +47,7 @@ from ..units import adev_unit_label, parse_unit
 from .figures import figure_specs
 from .fmt import json_number
 from .page import html_page
-from .settings import (DHVAR_MAX_DEFAULT_WINDOW, DHVAR_MAX_WINDOWS, REPORT_ESTIMATORS, default_hop,
-                       default_window)
+from .settings import DHVAR_MAX_DEFAULT_WINDOW, DHVAR_MAX_WINDOWS, REPORT_ESTIMATORS, default_hop, default_window
 from .summary import summarize, text_summary
 
 __all__ = ["Report", "build_report", "from_log", "log_source"]
@@ -118,9 +117,11 @@ class Report:
 
     def __repr__(self) -> str:
         fit = "not fitted" if self.fits is None else f"{len(self.fits)} noise fits"
-        return (f"Report({self.source.get('name', 'record')!r}: {self.static.n_samples} samples × {self.n_axes} "
-                f"axes at {self.fs:g} Hz, unit {self.unit or 'unknown'}; {self.static.tau.size} τ, "
-                f"{self.dynamic.t.size} DAVAR windows; {fit})")
+        return (
+            f"Report({self.source.get('name', 'record')!r}: {self.static.n_samples} samples × {self.n_axes} "
+            f"axes at {self.fs:g} Hz, unit {self.unit or 'unknown'}; {self.static.tau.size} τ, "
+            f"{self.dynamic.t.size} DAVAR windows; {fit})"
+        )
 
     # ---------------------------------------------------------------------------- summary
     def summary(self) -> dict:
@@ -172,8 +173,9 @@ class Report:
             pngs.append(p)
         summary = self.summary()
         summary["files"] = {"html": "report.html", "summary": "summary.json", "figures": list(images)}
-        (out / "summary.json").write_text(json.dumps(summary, indent=1, ensure_ascii=False, allow_nan=False),
-                                          encoding="utf-8")
+        (out / "summary.json").write_text(
+            json.dumps(summary, indent=1, ensure_ascii=False, allow_nan=False), encoding="utf-8"
+        )
         (out / "report.html").write_text(self.html(images), encoding="utf-8")
         return [out / "report.html", out / "summary.json"] + pngs
 
@@ -184,9 +186,24 @@ def _check_taus(taus):
     return np.asarray(taus, dtype=np.float64)
 
 
-def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, source=None, window=None, hop=None,
-                 taus="octave", fit: bool = True, confidence: float = 0.683, notes=(), progress=None,
-                 estimator: str = "oavar", refine: bool = False) -> Report:
+def build_report(
+    x,
+    fs,
+    *,
+    unit=None,
+    input: str = "rate",
+    axis_names=None,
+    source=None,
+    window=None,
+    hop=None,
+    taus="octave",
+    fit: bool = True,
+    confidence: float = 0.683,
+    notes=(),
+    progress=None,
+    estimator: str = "oavar",
+    refine: bool = False,
+) -> Report:
     """Compute everything the report shows.
 
     Parameters
@@ -235,8 +252,10 @@ def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, sour
         x = x[:, None]
     unit_name = None if unit is None else parse_unit(unit, kind="rate" if input == "rate" else "angle").name
     if unit_name is None:
-        notes.append("The unit of the samples is unknown (not given): Allan deviations are in the "
-                     "samples' own unit and the noise coefficients in base form, without IEEE-952 conversion.")
+        notes.append(
+            "The unit of the samples is unknown (not given): Allan deviations are in the "
+            "samples' own unit and the noise coefficients in base form, without IEEE-952 conversion."
+        )
     n_axes = x.shape[1]
     if axis_names is None:
         axis_names = [f"axis {k}" for k in range(n_axes)]
@@ -268,10 +287,16 @@ def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, sour
             hop = max(hop, -(-(n - window) // DHVAR_MAX_WINDOWS))
     progress.step("dynamic Allan variance")
     dynamic = davar(x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est)
-    settings = {"window": int(dynamic.window), "hop": int(dynamic.hop), "window_default": not window_given,
-                "hop_default": not hop_given, "taus": taus if isinstance(taus, str) else "explicit",
-                "estimator": estimator, "dynamic_grid": dynamic_grid,
-                "theo_decimation": (resolve_decimation("auto", n, taus) if static_est == "theoh" else None)}
+    settings = {
+        "window": int(dynamic.window),
+        "hop": int(dynamic.hop),
+        "window_default": not window_given,
+        "hop_default": not hop_given,
+        "taus": taus if isinstance(taus, str) else "explicit",
+        "estimator": estimator,
+        "dynamic_grid": dynamic_grid,
+        "theo_decimation": (resolve_decimation("auto", n, taus) if static_est == "theoh" else None),
+    }
 
     fits = series = None
     fit_error = series_error = None
@@ -293,17 +318,24 @@ def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, sour
             # the windows use the same τ range as the whole-record fit of their axis
             if fits is not None:
                 per_axis = [dynamic.avar] if dynamic.avar.ndim == 2 else list(dynamic.avar)
-                series = [fit_model(dataclasses.replace(dynamic, avar=row), unit=unit_name, confidence=confidence,
-                                    tau_range=(float(f.tau[0]) * (1 - 1e-9), None))
-                          for row, f in zip(per_axis, fits)]
+                series = [
+                    fit_model(
+                        dataclasses.replace(dynamic, avar=row),
+                        unit=unit_name,
+                        confidence=confidence,
+                        tau_range=(float(f.tau[0]) * (1 - 1e-9), None),
+                    )
+                    for row, f in zip(per_axis, fits)
+                ]
                 if dynamic.avar.ndim == 2:
                     series = series[0]
             else:
                 series = fit_model(dynamic, unit=unit_name, confidence=confidence, tau_range="auto")
         except AllaniteError as exc:
             series_error = str(exc)
-            notes.append(f"The coefficients over time could not be fitted (DAVAR window of {dynamic.window} "
-                         f"samples): {exc}")
+            notes.append(
+                f"The coefficients over time could not be fitted (DAVAR window of {dynamic.window} samples): {exc}"
+            )
     else:
         progress.add(2)
 
@@ -316,29 +348,57 @@ def build_report(x, fs, *, unit=None, input: str = "rate", axis_names=None, sour
         t0 = 0.1 if static.tau[0] < 0.1 else None
         for k in range(n_axes):
             try:
-                refinements.append(refine_axis(np.asarray(x[:, k], dtype=np.float64), fs, input=input,
-                                               unit=unit_name, tau_range=None if t0 is None else (t0, None)))
+                refinements.append(
+                    refine_axis(
+                        np.asarray(x[:, k], dtype=np.float64),
+                        fs,
+                        input=input,
+                        unit=unit_name,
+                        tau_range=None if t0 is None else (t0, None),
+                    )
+                )
             except AllaniteError as exc:
                 refinements.append(None)
                 notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")
     created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
-    return Report(refinements=refinements, static=static, dynamic=dynamic, fits=fits, series=series, fs=float(static.fs), unit=unit_name,
-                  input=input, axis_names=axis_names, source=dict(source or {}), settings=settings, notes=notes,
-                  fit_requested=bool(fit), fit_error=fit_error, series_error=series_error, created=created)
-
-
+    return Report(
+        refinements=refinements,
+        static=static,
+        dynamic=dynamic,
+        fits=fits,
+        series=series,
+        fs=float(static.fs),
+        unit=unit_name,
+        input=input,
+        axis_names=axis_names,
+        source=dict(source or {}),
+        settings=settings,
+        notes=notes,
+        fit_requested=bool(fit),
+        fit_error=fit_error,
+        series_error=series_error,
+        created=created,
+    )
 
 
 def log_source(log) -> dict:
     """JSON-able description of a :class:`~allanite.Log` for the report's Record section."""
     src = {
-        "name": log.path.name, "path": str(log.path), "format": log.format, "columns": list(log.columns),
-        "fs_hz": float(log.fs), "fs_from": "time column" if log.time is not None else "given",
-        "unit": log.unit.name if log.unit is not None else None, "input": log.input,
-        "t0_s": json_number(log.t0), "samples_in_file": int(log.n_record),
+        "name": log.path.name,
+        "path": str(log.path),
+        "format": log.format,
+        "columns": list(log.columns),
+        "fs_hz": float(log.fs),
+        "fs_from": "time column" if log.time is not None else "given",
+        "unit": log.unit.name if log.unit is not None else None,
+        "input": log.input,
+        "t0_s": json_number(log.t0),
+        "samples_in_file": int(log.n_record),
         "kept": [int(log.span[0]), int(log.span[1])],
-        "gaps": [{"after_sample": g.index - 1, "time_s": g.time, "duration_s": g.duration, "missing_samples": g.missing}
-                 for g in log.gaps],
+        "gaps": [
+            {"after_sample": g.index - 1, "time_s": g.time, "duration_s": g.duration, "missing_samples": g.missing}
+            for g in log.gaps
+        ],
         "jitter": json_number(log.jitter),
     }
     if log.segment_spans is not None:
@@ -351,10 +411,23 @@ def from_log(log, **kwargs) -> Report:
     input kind, column names and reading notes)."""
     notes = list(kwargs.pop("notes", ()))
     if log.gaps:
-        notes.append(f"The log has {len(log.gaps)} gap(s); only the longest gap-free stretch, samples "
-                     f"{log.span[0]}–{log.span[1] - 1} of {log.n_record}, is analysed"
-                     + (f" (all {len(log.segment_spans)} stretches are listed in summary.json)."
-                        if log.segment_spans is not None else "."))
+        notes.append(
+            f"The log has {len(log.gaps)} gap(s); only the longest gap-free stretch, samples "
+            f"{log.span[0]}–{log.span[1] - 1} of {log.n_record}, is analysed"
+            + (
+                f" (all {len(log.segment_spans)} stretches are listed in summary.json)."
+                if log.segment_spans is not None
+                else "."
+            )
+        )
     unit = kwargs.pop("unit", None) or (log.unit.name if log.unit is not None else None)
-    return build_report(log.data, log.fs, unit=unit, input=log.input, axis_names=list(log.columns),
-                        source=log_source(log), notes=notes, **kwargs)
+    return build_report(
+        log.data,
+        log.fs,
+        unit=unit,
+        input=log.input,
+        axis_names=list(log.columns),
+        source=log_source(log),
+        notes=notes,
+        **kwargs,
+    )

@@ -25,26 +25,52 @@ def figure_specs(rep) -> list:
         plot_adev(st, ax=ax, unit=unit, labels=names)
         if rep.fits is not None:
             for k, f in enumerate(rep.fits):
-                plot_fit(f, ax=ax, unit=unit, tau=st.tau, points=False, terms=False,
-                         color=f"C{k % 10}", label=f"{names[k]} fit", lw=1.0)
+                plot_fit(
+                    f,
+                    ax=ax,
+                    unit=unit,
+                    tau=st.tau,
+                    points=False,
+                    terms=False,
+                    color=f"C{k % 10}",
+                    label=f"{names[k]} fit",
+                    lw=1.0,
+                )
         ax.set_title(f"{static_word}, {conf} intervals" + (" and fits" if rep.fits else ""))
         fig.subplots_adjust(left=0.11, right=0.975, bottom=0.11, top=0.93)
 
-    specs.append(("adev.png", "Allan deviation, all axes", f"Overlapping ADEV of every axis with its {conf} "
-                  "interval band" + (" and fitted model." if rep.fits else "."), (7.2, 4.8), overview))
+    specs.append(
+        (
+            "adev.png",
+            "Allan deviation, all axes",
+            f"Overlapping ADEV of every axis with its {conf} "
+            "interval band" + (" and fitted model." if rep.fits else "."),
+            (7.2, 4.8),
+            overview,
+        )
+    )
 
     def davar_all(fig):
         axs = fig.subplots(rep.n_axes, 1, squeeze=False)
         for k in range(rep.n_axes):
             plot_davar(dy, ax=axs[k, 0], axis=k, unit=unit)
             axs[k, 0].set_title(f"{dynamic_word}, {names[k]}")
-        fig.subplots_adjust(left=0.1, right=1.0, bottom=0.45 / fig.get_figheight(), top=1 - 0.35 / fig.get_figheight(),
-                            hspace=0.55)
+        fig.subplots_adjust(
+            left=0.1, right=1.0, bottom=0.45 / fig.get_figheight(), top=1 - 0.35 / fig.get_figheight(), hspace=0.55
+        )
 
-    specs.append(("davar.png", "Dynamic Allan deviation, all axes", "DAVAR heat maps, one panel per axis.",
-                  (7.5, 2.7 * rep.n_axes + 0.3), davar_all))
+    specs.append(
+        (
+            "davar.png",
+            "Dynamic Allan deviation, all axes",
+            "DAVAR heat maps, one panel per axis.",
+            (7.5, 2.7 * rep.n_axes + 0.3),
+            davar_all,
+        )
+    )
 
     for k in range(rep.n_axes):
+
         def adev_k(fig, k=k):
             ax = fig.add_subplot()
             plot_adev(st, ax=ax, unit=unit, labels=names, axis=k)
@@ -65,14 +91,34 @@ def figure_specs(rep) -> list:
             ax.set_title(f"{names[k]}: {dynamic_lower}")
             fig.subplots_adjust(left=0.0, right=0.95, bottom=0.05, top=0.95)
 
-        specs.append((f"adev_axis{k}.png", f"{names[k]}: Allan deviation",
-                      f"ADEV of {names[k]} with its {conf} interval band"
-                      + ("; fitted model (black) and each term (dashed)." if rep.fits else "."), (7.2, 4.8), adev_k))
-        specs.append((f"davar_axis{k}.png", f"{names[k]}: DAVAR heat map",
-                      "ADEV of every window: window centre on x, τ on y, log colour.", (7.5, 4.2), davar_k))
-        specs.append((f"davar3d_axis{k}.png", f"{names[k]}: DAVAR surface",
-                      "The same as a surface (t, log₁₀ τ, log₁₀ ADEV), drawn on a thinned grid.", (7.5, 5.6),
-                      davar3d_k))
+        specs.append(
+            (
+                f"adev_axis{k}.png",
+                f"{names[k]}: Allan deviation",
+                f"ADEV of {names[k]} with its {conf} interval band"
+                + ("; fitted model (black) and each term (dashed)." if rep.fits else "."),
+                (7.2, 4.8),
+                adev_k,
+            )
+        )
+        specs.append(
+            (
+                f"davar_axis{k}.png",
+                f"{names[k]}: DAVAR heat map",
+                "ADEV of every window: window centre on x, τ on y, log colour.",
+                (7.5, 4.2),
+                davar_k,
+            )
+        )
+        specs.append(
+            (
+                f"davar3d_axis{k}.png",
+                f"{names[k]}: DAVAR surface",
+                "The same as a surface (t, log₁₀ τ, log₁₀ ADEV), drawn on a thinned grid.",
+                (7.5, 5.6),
+                davar3d_k,
+            )
+        )
         if rep.series is not None:
             s = rep.series[k]
             n_panels = len([t for t in s.terms if np.any(s.values[t] > 0)] or s.terms)
@@ -81,10 +127,22 @@ def figure_specs(rep) -> list:
                 axs = fig.subplots(n_panels, 1, sharex=True, squeeze=False)[:, 0]
                 plot_coefficient_series(s, axes=axs, reference=rep.fits[k] if rep.fits else None)
                 axs[0].set_title(f"{names[k]}: noise coefficients per DAVAR window, {s.confidence:.1%} intervals")
-                fig.subplots_adjust(left=0.13, right=0.975, bottom=0.5 / fig.get_figheight(),
-                                    top=1 - 0.35 / fig.get_figheight(), hspace=0.12)
+                fig.subplots_adjust(
+                    left=0.13,
+                    right=0.975,
+                    bottom=0.5 / fig.get_figheight(),
+                    top=1 - 0.35 / fig.get_figheight(),
+                    hspace=0.12,
+                )
 
-            specs.append((f"coefficients_axis{k}.png", f"{names[k]}: coefficients over time",
-                          "Coefficients fitted in every DAVAR window (non-zero terms), with interval bands; "
-                          "dotted: the whole-record value.", (7.5, 1.2 + 1.7 * n_panels), coef_k))
+            specs.append(
+                (
+                    f"coefficients_axis{k}.png",
+                    f"{names[k]}: coefficients over time",
+                    "Coefficients fitted in every DAVAR window (non-zero terms), with interval bands; "
+                    "dotted: the whole-record value.",
+                    (7.5, 1.2 + 1.7 * n_panels),
+                    coef_k,
+                )
+            )
     return specs

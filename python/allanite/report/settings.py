@@ -2,8 +2,16 @@
 
 from __future__ import annotations
 
-__all__ = ["FIT_MODEL", "WINDOW_FRACTION", "HOP_FRACTION", "DHVAR_MAX_DEFAULT_WINDOW", "DHVAR_MAX_WINDOWS",
-           "REPORT_ESTIMATORS", "default_window", "default_hop"]
+__all__ = [
+    "FIT_MODEL",
+    "WINDOW_FRACTION",
+    "HOP_FRACTION",
+    "DHVAR_MAX_DEFAULT_WINDOW",
+    "DHVAR_MAX_WINDOWS",
+    "REPORT_ESTIMATORS",
+    "default_window",
+    "default_hop",
+]
 
 #: The model the report fits (docs/FORMULAS.md §6; the K column is exact for a sampled random walk).
 FIT_MODEL = "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²·τ0·(2m²+1)/(6m) + R²·τ²/2"
@@ -18,9 +26,16 @@ DHVAR_MAX_WINDOWS = 400
 #: estimator → (static estimator, dynamic estimator, dynamic τ grid, section titles)
 REPORT_ESTIMATORS = {
     "oavar": ("oavar", "oavar", "exp", "Overlapping Allan deviation", "Dynamic Allan variance"),
-    "theoh": ("theoh", "theoh", "octave", "TheoH deviation (overlapping Allan ≤ 10 % of the record, TheoBR beyond)",
-              "Dynamic TheoH (DHVAR)"),
+    "theoh": (
+        "theoh",
+        "theoh",
+        "octave",
+        "TheoH deviation (overlapping Allan ≤ 10 % of the record, TheoBR beyond)",
+        "Dynamic TheoH (DHVAR)",
+    ),
 }
+
+
 def default_window(n_samples: int) -> int:
     """The report's default DAVAR window: 1/12 of the record (at least 2 samples)."""
     return max(2, int(n_samples) // WINDOW_FRACTION)

@@ -24,41 +24,65 @@ def refinement_dict(rep) -> dict | None:
             axes.append({"axis": k, "name": rep.axis_names[k], "error": True})
             continue
         s0 = r.start
-        axes.append({
-            "axis": k, "name": rep.axis_names[k], "terms": list(r.terms),
-            "tau_from_s": json_number(s0.tau[0]),
-            "start": {"chi2_dof": json_number(s0.chi2_dof), "rms_z": json_number(np.sqrt(np.mean(s0.z ** 2)))},
-            "final": {"chi2_dof": json_number(r.fit.chi2_dof)},
-            "steps": [{"effect": st.effect, "params": {p: json_number(v) for p, v in st.params.items()},
-                       "intervals": {p: [json_number(a), json_number(b)] for p, (a, b) in st.intervals.items()},
-                       "before": {q: json_number(v) for q, v in st.before.items()},
-                       "after": {q: json_number(v) for q, v in st.after.items()}} for st in r.steps],
-        })
-    return {"method": "allanite.refine: Gauss–Markov / sinusoid signatures and change points, added by BIC on an "
-                      "effective χ²; params in the rate unit (σ, amplitude), s (tc, t), Hz (f0)", "axes": axes}
-
-
+        axes.append(
+            {
+                "axis": k,
+                "name": rep.axis_names[k],
+                "terms": list(r.terms),
+                "tau_from_s": json_number(s0.tau[0]),
+                "start": {"chi2_dof": json_number(s0.chi2_dof), "rms_z": json_number(np.sqrt(np.mean(s0.z**2)))},
+                "final": {"chi2_dof": json_number(r.fit.chi2_dof)},
+                "steps": [
+                    {
+                        "effect": st.effect,
+                        "params": {p: json_number(v) for p, v in st.params.items()},
+                        "intervals": {p: [json_number(a), json_number(b)] for p, (a, b) in st.intervals.items()},
+                        "before": {q: json_number(v) for q, v in st.before.items()},
+                        "after": {q: json_number(v) for q, v in st.after.items()},
+                    }
+                    for st in r.steps
+                ],
+            }
+        )
+    return {
+        "method": "allanite.refine: Gauss–Markov / sinusoid signatures and change points, added by BIC on an "
+        "effective χ²; params in the rate unit (σ, amplitude), s (tc, t), Hz (f0)",
+        "axes": axes,
+    }
 
 
 def _coef_dict(c, unit, name) -> dict:
-    d = {"name": TERM_NAMES[name], "value": json_number(c.value), "ci": [json_number(c.ci[0]), json_number(c.ci[1])],
-         "unit": c.unit, "ieee": json_number(c.ieee),
-         "ieee_ci": None if c.ieee_ci is None else [json_number(c.ieee_ci[0]), json_number(c.ieee_ci[1])],
-         "ieee_unit": c.ieee_unit}
+    d = {
+        "name": TERM_NAMES[name],
+        "value": json_number(c.value),
+        "ci": [json_number(c.ci[0]), json_number(c.ci[1])],
+        "unit": c.unit,
+        "ieee": json_number(c.ieee),
+        "ieee_ci": None if c.ieee_ci is None else [json_number(c.ieee_ci[0]), json_number(c.ieee_ci[1])],
+        "ieee_unit": c.ieee_unit,
+    }
     if name == "Q" and unit is not None:
         q = ieee952("Q", c.value, unit, to="urad")
-        d["also"] = {"value": json_number(q.value), "ci": [json_number(ieee952("Q", c.ci[0], unit, to="urad").value),
-                                                     json_number(ieee952("Q", c.ci[1], unit, to="urad").value)],
-                     "unit": q.unit}
+        d["also"] = {
+            "value": json_number(q.value),
+            "ci": [
+                json_number(ieee952("Q", c.ci[0], unit, to="urad").value),
+                json_number(ieee952("Q", c.ci[1], unit, to="urad").value),
+            ],
+            "unit": q.unit,
+        }
     return d
 
 
 def _readoffs(f, unit, adev_unit) -> dict:
     r = f.readoffs
     out = {
-        "adev_at_1s": json_number(r["adev_at_1s"]), "adev_at_1s_interpolated": r["adev_at_1s_interpolated"],
-        "adev_min": json_number(r["adev_min"]), "tau_at_min_s": json_number(r["tau_at_min"]),
-        "bias_instability_readoff": json_number(r["bias_instability_readoff"]), "adev_unit": adev_unit,
+        "adev_at_1s": json_number(r["adev_at_1s"]),
+        "adev_at_1s_interpolated": r["adev_at_1s_interpolated"],
+        "adev_min": json_number(r["adev_min"]),
+        "tau_at_min_s": json_number(r["tau_at_min"]),
+        "bias_instability_readoff": json_number(r["bias_instability_readoff"]),
+        "adev_unit": adev_unit,
     }
     if unit is not None:
         n_ro = ieee952("N", r["adev_at_1s"], unit) if r["adev_at_1s"] is not None else None
@@ -74,18 +98,33 @@ def _series_dict(s, unit) -> dict:
     coeffs = {}
     for t in s.terms:
         v, lo, hi = s.values[t], s.ci_low[t], s.ci_high[t]
-        d = {"name": TERM_NAMES[t], "unit": coefficient_unit(t, unit) if unit is not None else None,
-             "value": json_list(v), "ci_low": json_list(lo), "ci_high": json_list(hi)}
+        d = {
+            "name": TERM_NAMES[t],
+            "unit": coefficient_unit(t, unit) if unit is not None else None,
+            "value": json_list(v),
+            "ci_low": json_list(lo),
+            "ci_high": json_list(hi),
+        }
         show, show_unit = v, d["unit"]
         if unit is not None:
             ie = ieee952(t, v, unit)
             show, show_unit = np.asarray(ie.value), ie.unit
-            d.update(ieee_unit=ie.unit, ieee=json_list(show), ieee_ci_low=json_list(ieee952(t, lo, unit).value),
-                     ieee_ci_high=json_list(ieee952(t, hi, unit).value))
+            d.update(
+                ieee_unit=ie.unit,
+                ieee=json_list(show),
+                ieee_ci_low=json_list(ieee952(t, lo, unit).value),
+                ieee_ci_high=json_list(ieee952(t, hi, unit).value),
+            )
         j_max, j_min = int(np.argmax(show)), int(np.argmin(show))
-        d["stats"] = {"median": json_number(np.median(show)), "min": json_number(show[j_min]), "t_of_min_s": json_number(s.t[j_min]),
-                      "max": json_number(show[j_max]), "t_of_max_s": json_number(s.t[j_max]), "unit": show_unit,
-                      "windows_nonzero": int(np.count_nonzero(v > 0))}
+        d["stats"] = {
+            "median": json_number(np.median(show)),
+            "min": json_number(show[j_min]),
+            "t_of_min_s": json_number(s.t[j_min]),
+            "max": json_number(show[j_max]),
+            "t_of_max_s": json_number(s.t[j_max]),
+            "unit": show_unit,
+            "windows_nonzero": int(np.count_nonzero(v > 0)),
+        }
         coeffs[t] = d
     return {"t_s": json_list(s.t), "chi2_dof": json_list(s.chi2_dof), "coefficients": coeffs}
 
@@ -99,19 +138,35 @@ def summarize(rep) -> dict:
     n = st.n_samples
     au = rep.adev_unit
     record = {
-        "name": rep.source.get("name", "record"), "samples": n, "axes": rep.n_axes, "axis_names": rep.axis_names,
-        "fs_hz": fs, "duration_s": n / fs, "unit": rep.unit, "unit_known": rep.unit is not None,
-        "adev_unit": au, "input": rep.input, "source": rep.source,
+        "name": rep.source.get("name", "record"),
+        "samples": n,
+        "axes": rep.n_axes,
+        "axis_names": rep.axis_names,
+        "fs_hz": fs,
+        "duration_s": n / fs,
+        "unit": rep.unit,
+        "unit_known": rep.unit is not None,
+        "adev_unit": au,
+        "input": rep.input,
+        "source": rep.source,
     }
     static = {
-        "estimator": st.estimator, "grid": rep.settings["taus"], "confidence": st.confidence,
+        "estimator": st.estimator,
+        "grid": rep.settings["taus"],
+        "confidence": st.confidence,
         "edf_method": "greenhall" if st.source is None else "greenhall (Allan τ), Howe's Theo1 EDF (TheoBR τ)",
-        "tau_s": json_list(st.tau), "m": json_list(st.m), "n": json_list(st.n),
+        "tau_s": json_list(st.tau),
+        "m": json_list(st.m),
+        "n": json_list(st.n),
         "source": None if st.source is None else [str(v) for v in st.source],
         "kf": None if st.kf is None else json_list(np.atleast_1d(st.kf)),
         "theo_decimation": rep.settings.get("theo_decimation"),
-        "adev_unit": au, "adev": json_list(adev), "adev_ci_low": json_list(lo), "adev_ci_high": json_list(hi),
-        "edf": json_list(np.atleast_2d(st.edf)), "alpha": json_list(np.atleast_2d(st.alpha)),
+        "adev_unit": au,
+        "adev": json_list(adev),
+        "adev_ci_low": json_list(lo),
+        "adev_ci_high": json_list(hi),
+        "edf": json_list(np.atleast_2d(st.edf)),
+        "alpha": json_list(np.atleast_2d(st.alpha)),
     }
     d_axes = []
     for k in range(rep.n_axes):
@@ -119,41 +174,71 @@ def summarize(rep) -> dict:
         row = np.sqrt(av[0])
         med = float(np.median(row))
         j_max, j_min = int(np.argmax(row)), int(np.argmin(row))
-        d_axes.append({
-            "axis": k, "name": rep.axis_names[k], "tau_s": json_number(dy.tau[0]),
-            "adev_shortest_tau_median": med,
-            "adev_shortest_tau_max": float(row[j_max]), "t_of_max_s": float(dy.t[j_max]),
-            "adev_shortest_tau_min": float(row[j_min]), "t_of_min_s": float(dy.t[j_min]),
-            "max_over_min": json_number(row[j_max] / row[j_min]) if row[j_min] > 0 else None,
-            "adev_median_over_time": json_list(np.sqrt(np.median(av, axis=1))),
-            "adev_min_over_time": json_list(np.sqrt(av.min(axis=1))),
-            "adev_max_over_time": json_list(np.sqrt(av.max(axis=1))),
-        })
+        d_axes.append(
+            {
+                "axis": k,
+                "name": rep.axis_names[k],
+                "tau_s": json_number(dy.tau[0]),
+                "adev_shortest_tau_median": med,
+                "adev_shortest_tau_max": float(row[j_max]),
+                "t_of_max_s": float(dy.t[j_max]),
+                "adev_shortest_tau_min": float(row[j_min]),
+                "t_of_min_s": float(dy.t[j_min]),
+                "max_over_min": json_number(row[j_max] / row[j_min]) if row[j_min] > 0 else None,
+                "adev_median_over_time": json_list(np.sqrt(np.median(av, axis=1))),
+                "adev_min_over_time": json_list(np.sqrt(av.min(axis=1))),
+                "adev_max_over_time": json_list(np.sqrt(av.max(axis=1))),
+            }
+        )
     dynamic = {
-        "method": dy.method, "estimator": dy.estimator, "grid": rep.settings.get("dynamic_grid", "exp"),
+        "method": dy.method,
+        "estimator": dy.estimator,
+        "grid": rep.settings.get("dynamic_grid", "exp"),
         "source": None if dy.source is None else [str(v) for v in dy.source],
         "kf_median": None if dy.kf is None else json_list(np.median(np.atleast_2d(dy.kf), axis=1)),
-        "window_samples": int(dy.window), "hop_samples": int(dy.hop), "window_s": dy.window / fs,
+        "window_samples": int(dy.window),
+        "hop_samples": int(dy.hop),
+        "window_s": dy.window / fs,
         "hop_s": dy.hop / fs,
         "window_rule": f"record/{WINDOW_FRACTION}" if rep.settings["window_default"] else "given",
         "hop_rule": f"window/{HOP_FRACTION}" if rep.settings["hop_default"] else "given",
-        "windows": int(dy.t.size), "tau_s": json_list(dy.tau), "t_s": json_list(dy.t), "adev_unit": au,
+        "windows": int(dy.t.size),
+        "tau_s": json_list(dy.tau),
+        "t_s": json_list(dy.t),
+        "adev_unit": au,
         "axes": d_axes,
     }
-    fit = {"requested": rep.fit_requested, "model": FIT_MODEL, "unit": rep.unit, "unit_known": rep.unit is not None,
-           "confidence": st.confidence if rep.fit_requested else None, "error": rep.fit_error, "axes": None,
-           "series": None}
+    fit = {
+        "requested": rep.fit_requested,
+        "model": FIT_MODEL,
+        "unit": rep.unit,
+        "unit_known": rep.unit is not None,
+        "confidence": st.confidence if rep.fit_requested else None,
+        "error": rep.fit_error,
+        "axes": None,
+        "series": None,
+    }
     if rep.fits is not None:
         f0 = rep.fits[0]
         fit["terms"] = list(f0.terms)
         fit["confidence"] = f0.confidence
-        fit["axes"] = [{
-            "axis": k, "name": rep.axis_names[k],
-            "coefficients": {t: _coef_dict(f.coefficients[t], rep.unit, t) for t in f.terms},
-            "chi2": json_number(f.chi2), "dof": int(f.dof), "chi2_dof": json_number(f.chi2_dof), "p_value": json_number(f.p_value),
-            "tau_s": json_list(f.tau), "iterations": int(f.iterations), "method": f.method, "notes": list(f.notes),
-            "readoffs": _readoffs(f, rep.unit, au),
-        } for k, f in enumerate(rep.fits)]
+        fit["axes"] = [
+            {
+                "axis": k,
+                "name": rep.axis_names[k],
+                "coefficients": {t: _coef_dict(f.coefficients[t], rep.unit, t) for t in f.terms},
+                "chi2": json_number(f.chi2),
+                "dof": int(f.dof),
+                "chi2_dof": json_number(f.chi2_dof),
+                "p_value": json_number(f.p_value),
+                "tau_s": json_list(f.tau),
+                "iterations": int(f.iterations),
+                "method": f.method,
+                "notes": list(f.notes),
+                "readoffs": _readoffs(f, rep.unit, au),
+            }
+            for k, f in enumerate(rep.fits)
+        ]
     if rep.fit_requested:
         ser = {"error": rep.series_error, "axes": None}
         if rep.series is not None:
@@ -161,18 +246,28 @@ def summarize(rep) -> dict:
             ser["confidence"] = rep.series[0].confidence
             ser["window_samples"] = int(dy.window)
             ser["hop_samples"] = int(dy.hop)
-            ser["axes"] = [dict(axis=k, name=rep.axis_names[k], **_series_dict(s, rep.unit))
-                           for k, s in enumerate(rep.series)]
+            ser["axes"] = [
+                dict(axis=k, name=rep.axis_names[k], **_series_dict(s, rep.unit)) for k, s in enumerate(rep.series)
+            ]
         fit["series"] = ser
     return {
-        "schema": "allanite-report/1", "allanite_version": __version__, "created": rep.created,
-        "unit": rep.unit, "fs_hz": fs, "samples": n, "axes": rep.n_axes,
-        "record": record, "notes": list(rep.notes), "static": static, "dynamic": dynamic, "fit": fit,
+        "schema": "allanite-report/1",
+        "allanite_version": __version__,
+        "created": rep.created,
+        "unit": rep.unit,
+        "fs_hz": fs,
+        "samples": n,
+        "axes": rep.n_axes,
+        "record": record,
+        "notes": list(rep.notes),
+        "static": static,
+        "dynamic": dynamic,
+        "fit": fit,
         "refinement": refinement_dict(rep),
         "conventions": "times and τ in s (keys ending _s), fs in Hz; Allan deviations in adev_unit (the samples' "
-                       "rate unit); coefficients: value/ci in base form ('unit'), ieee/ieee_ci in IEEE-952 units "
-                       "('ieee_unit'); intervals at 'confidence'; null = does not exist (unknown unit, unbounded "
-                       "interval, read-off outside the τ range)",
+        "rate unit); coefficients: value/ci in base form ('unit'), ieee/ieee_ci in IEEE-952 units "
+        "('ieee_unit'); intervals at 'confidence'; null = does not exist (unknown unit, unbounded "
+        "interval, read-off outside the τ range)",
     }
 
 
@@ -185,15 +280,17 @@ def text_summary(s: dict) -> str:
     rec, st, dy, fit = s["record"], s["static"], s["dynamic"], s["fit"]
     names = rec["axis_names"]
     au = rec["adev_unit"] or "samples' unit"
-    lines = [f"allanite report: {rec['name']}",
-             f"  {rec['samples']} samples × {rec['axes']} axes ({', '.join(names)}) at {rec['fs_hz']:g} Hz = "
-             f"{duration(rec['duration_s'])}; unit {rec['unit'] or 'unknown (give --unit)'}, {rec['input']} input"]
+    lines = [
+        f"allanite report: {rec['name']}",
+        f"  {rec['samples']} samples × {rec['axes']} axes ({', '.join(names)}) at {rec['fs_hz']:g} Hz = "
+        f"{duration(rec['duration_s'])}; unit {rec['unit'] or 'unknown (give --unit)'}, {rec['input']} input",
+    ]
     for note in s["notes"]:
         lines.append(f"  note: {note}")
     conf = st["confidence"]
     lines += ["", f"Overlapping Allan deviation ({au}), {conf:.1%} interval as −/+ % of the value"]
     w = 27
-    lines.append(f"  {'tau (s)':>9} {'n':>10}  " + "".join(f"{nm[:w - 1]:<{w}}" for nm in names).rstrip())
+    lines.append(f"  {'tau (s)':>9} {'n':>10}  " + "".join(f"{nm[: w - 1]:<{w}}" for nm in names).rstrip())
     for i, tau in enumerate(st["tau_s"]):
         cells = []
         for k in range(len(names)):
@@ -203,10 +300,14 @@ def text_summary(s: dict) -> str:
 
     if fit["axes"] is not None:
         ieee = fit["unit_known"]
-        lines += ["", f"Noise model (IEEE 952) {'in IEEE-952 units' if ieee else 'in base form (unit unknown)'}, "
-                      f"{fit['confidence']:.1%} intervals", f"  {fit['model']}"]
+        lines += [
+            "",
+            f"Noise model (IEEE 952) {'in IEEE-952 units' if ieee else 'in base form (unit unknown)'}, "
+            f"{fit['confidence']:.1%} intervals",
+            f"  {fit['model']}",
+        ]
         w2 = 26
-        lines.append(f"  {'term':<25}{'unit':<10}" + "".join(f"{nm[:w2 - 1]:<{w2}}" for nm in names).rstrip())
+        lines.append(f"  {'term':<25}{'unit':<10}" + "".join(f"{nm[: w2 - 1]:<{w2}}" for nm in names).rstrip())
         for t in fit["terms"]:
             c0 = fit["axes"][0]["coefficients"][t]
             unit = (c0["ieee_unit"] if ieee else c0["unit"]) or ""
@@ -214,44 +315,58 @@ def text_summary(s: dict) -> str:
             for ax in fit["axes"]:
                 c = ax["coefficients"][t]
                 v, ci = (c["ieee"], c["ieee_ci"]) if ieee else (c["value"], c["ci"])
-                cells.append(f"{g(v, 3)} [{g(ci[0], 3)}, {g(ci[1] if ci[1] is not None else math.inf, 3)}]"
-                             .ljust(w2))
+                cells.append(f"{g(v, 3)} [{g(ci[0], 3)}, {g(ci[1] if ci[1] is not None else math.inf, 3)}]".ljust(w2))
             lines.append(f"  {t + ' ' + c0['name']:<25}{unit:<10}" + "".join(cells).rstrip())
-        lines.append(f"  {'χ²/dof':<25}{'':<10}" + "".join(f"{g(ax['chi2_dof'], 3):<{w2}}" for ax in fit["axes"])
-                     .rstrip())
+        lines.append(
+            f"  {'χ²/dof':<25}{'':<10}" + "".join(f"{g(ax['chi2_dof'], 3):<{w2}}" for ax in fit["axes"]).rstrip()
+        )
         ro = [ax["readoffs"] for ax in fit["axes"]]
         if ieee:
-            lines.append(f"  {'read-off N = σ(1 s)':<25}{ro[0]['arw_readoff_ieee_unit']:<10}"
-                         + "".join(f"{g(r['arw_readoff_ieee'], 3):<{w2}}" for r in ro).rstrip())
-            lines.append(f"  {'read-off B = σmin/0.664':<25}{ro[0]['bias_instability_readoff_ieee_unit']:<10}"
-                         + "".join(f"{g(r['bias_instability_readoff_ieee'], 3):<{w2}}" for r in ro).rstrip())
-        lines.append(f"  {'σmin (at τ)':<25}{rec['adev_unit'] or '':<10}"
-                     + "".join(f"{g(r['adev_min'], 3) + ' (' + g(r['tau_at_min_s'], 3) + ' s)':<{w2}}"
-                               for r in ro).rstrip())
+            lines.append(
+                f"  {'read-off N = σ(1 s)':<25}{ro[0]['arw_readoff_ieee_unit']:<10}"
+                + "".join(f"{g(r['arw_readoff_ieee'], 3):<{w2}}" for r in ro).rstrip()
+            )
+            lines.append(
+                f"  {'read-off B = σmin/0.664':<25}{ro[0]['bias_instability_readoff_ieee_unit']:<10}"
+                + "".join(f"{g(r['bias_instability_readoff_ieee'], 3):<{w2}}" for r in ro).rstrip()
+            )
+        lines.append(
+            f"  {'σmin (at τ)':<25}{rec['adev_unit'] or '':<10}"
+            + "".join(f"{g(r['adev_min'], 3) + ' (' + g(r['tau_at_min_s'], 3) + ' s)':<{w2}}" for r in ro).rstrip()
+        )
     elif fit["requested"] and fit["error"]:
         lines += ["", f"Noise model: not fitted ({fit['error']})"]
 
-    lines += ["", f"Dynamic Allan deviation: window {dy['window_samples']} samples ({g(dy['window_s'])} s, "
-                  f"{dy['window_rule']}), hop {dy['hop_samples']} ({g(dy['hop_s'])} s, {dy['hop_rule']}); "
-                  f"{dy['windows']} windows × {len(dy['tau_s'])} τ ({g(dy['tau_s'][0])}–{g(dy['tau_s'][-1])} s)"]
+    lines += [
+        "",
+        f"Dynamic Allan deviation: window {dy['window_samples']} samples ({g(dy['window_s'])} s, "
+        f"{dy['window_rule']}), hop {dy['hop_samples']} ({g(dy['hop_s'])} s, {dy['hop_rule']}); "
+        f"{dy['windows']} windows × {len(dy['tau_s'])} τ ({g(dy['tau_s'][0])}–{g(dy['tau_s'][-1])} s)",
+    ]
     for ax in dy["axes"]:
         ratio = g(ax["max_over_min"], 3)
-        lines.append(f"  {ax['name']}: ADEV at τ = {g(ax['tau_s'])} s over time: median "
-                     f"{g(ax['adev_shortest_tau_median'])}, max {g(ax['adev_shortest_tau_max'])} at t = "
-                     f"{ax['t_of_max_s']:.0f} s, min {g(ax['adev_shortest_tau_min'])} at t = "
-                     f"{ax['t_of_min_s']:.0f} s, max/min = {ratio}")
+        lines.append(
+            f"  {ax['name']}: ADEV at τ = {g(ax['tau_s'])} s over time: median "
+            f"{g(ax['adev_shortest_tau_median'])}, max {g(ax['adev_shortest_tau_max'])} at t = "
+            f"{ax['t_of_max_s']:.0f} s, min {g(ax['adev_shortest_tau_min'])} at t = "
+            f"{ax['t_of_min_s']:.0f} s, max/min = {ratio}"
+        )
     ser = fit.get("series")
     if ser and ser["axes"] is not None:
-        lines.append(f"  noise coefficients over the windows, median [min, max]"
-                     f"{' in IEEE-952 units' if fit['unit_known'] else ' (base form)'}:")
+        lines.append(
+            f"  noise coefficients over the windows, median [min, max]"
+            f"{' in IEEE-952 units' if fit['unit_known'] else ' (base form)'}:"
+        )
         for ax in ser["axes"]:
             parts = []
             for t, c in ax["coefficients"].items():
                 if c["stats"]["windows_nonzero"] == 0:
                     continue
                 st_ = c["stats"]
-                parts.append(f"{t} {g(st_['median'], 3)} [{g(st_['min'], 3)}, {g(st_['max'], 3)}]"
-                             f"{' ' + st_['unit'] if st_['unit'] else ''}")
+                parts.append(
+                    f"{t} {g(st_['median'], 3)} [{g(st_['min'], 3)}, {g(st_['max'], 3)}]"
+                    f"{' ' + st_['unit'] if st_['unit'] else ''}"
+                )
             lines.append(f"    {ax['name']}: " + ("; ".join(parts) or "all zero"))
     elif ser and ser["error"]:
         lines.append(f"  noise coefficients over time: not fitted ({ser['error']})")

@@ -31,8 +31,8 @@ import numbers
 
 import numpy as np
 
-from .errors import ParameterError
 from ._validate import check_count, check_fs
+from .errors import ParameterError
 
 __all__ = ["simulate", "kasdin_walter"]
 
@@ -95,8 +95,9 @@ def _is_zero(p) -> bool:
     return np.all(np.asarray(p) == 0)
 
 
-def simulate(n: int, fs: float, *, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0, gauss_markov=(), sinusoid=(),
-             seed=None) -> np.ndarray:
+def simulate(
+    n: int, fs: float, *, Q=0.0, N=0.0, B=0.0, K=0.0, R=0.0, gauss_markov=(), sinusoid=(), seed=None
+) -> np.ndarray:
     """Rate samples with the five IEEE-952 terms, Gauss–Markov processes and sinusoids.
 
     Parameters
@@ -183,7 +184,7 @@ def ar1(drive: np.ndarray, phi: float, x0: float, block: int = 1024) -> np.ndarr
     """x_i = φ·x_{i−1} + drive_i, in blocks: x_i = φ^(i+1)·x0 + φ^i·Σ_{j≤i} φ^(−j)·drive_j, where
     φ^(−j) stays O(1) inside a block (block ≪ correlation length in samples is not required: for
     φ^(−block) to overflow, Tc would have to be below ~block/700 samples; those use the plain loop)."""
-    if phi ** block < 1e-200:
+    if phi**block < 1e-200:
         out = np.empty_like(drive)
         acc = x0
         for i, d in enumerate(drive):
@@ -192,11 +193,11 @@ def ar1(drive: np.ndarray, phi: float, x0: float, block: int = 1024) -> np.ndarr
         return out
     out = np.empty_like(drive)
     j = np.arange(block)
-    grow, shrink = phi ** (j + 1), phi ** j
+    grow, shrink = phi ** (j + 1), phi**j
     inv = phi ** (-j.astype(float))
     for s in range(0, drive.size, block):
-        d = drive[s:s + block]
+        d = drive[s : s + block]
         k = d.size
-        out[s:s + k] = grow[:k] * x0 + shrink[:k] * np.cumsum(d * inv[:k])
+        out[s : s + k] = grow[:k] * x0 + shrink[:k] * np.cumsum(d * inv[:k])
         x0 = out[s + k - 1]
     return out

@@ -1,0 +1,256 @@
+"""The package's structure holds: imports run one way, no circles, no private names across modules.
+
+Read from the source (AST), so a violation fails here before anyone meets it as an import error or
+a tangle. The layers, bottom up (a module may import only from its own layer or below):
+
+    0  errors, _core                       the exceptions; the Rust extension
+    1  units, _validate                    shared checks and units
+    2  estimators.*, io.*                  the registry and its entries, EDF; the readers
+    3  plot, results                       figures; result objects (EDF sits below them)
+    4  analysis, simulation, datasets, _reference
+    5  model.*                             terms, covariance, fit, effects, refine
+    6  report.*
+    7  cli, __main__, __init__
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+import allanite
+
+PACKAGE = Path(allanite.__file__).parent
+
+LAYERS = {
+    "errors": 0,
+    "_core": 0,
+    "units": 1,
+    "_validate": 1,
+    "estimators": 2,
+    "io": 2,
+    "plot": 3,
+    "results": 3,
+    "analysis": 4,
+    "simulation": 4,
+    "datasets": 4,
+    "_reference": 4,
+    "model": 5,
+    "report": 6,
+    "cli": 7,
+    "__main__": 7,
+    "__init__": 7,
+}
+
+
+def _modules() -> dict[str, Path]:
+    out = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(PACKAGE).with_suffix("")
+        parts = list(rel.parts)
+        if parts[-1] == "__init__" and len(parts) > 1:
+            parts = parts[:-1]
+        out[".".join(parts)] = path
+    return out
+
+
+MODULES = _modules()
+
+
+def _resolve(module: str, node: ast.ImportFrom) -> str:
+    """The absolute in-package name an ``from … import`` refers to ('' when outside the package)."""
+    if node.level == 0:
+        name = node.module or ""
+        return name[len("allanite.") :] if name.startswith("allanite.") else ("" if name != "allanite" else "__init__")
+    is_pkg = MODULES[module].name == "__init__.py"
+    base = module.split(".") if is_pkg else module.split(".")[:-1]
+    if module == "__init__":
+        base = []
+    base = base[: len(base) - (node.level - 1)] if node.level > 1 else base
+    tail = [node.module] if node.module else []
+    return ".".join(base + tail)
+
+
+def _imports(module: str):
+    """(target module, names, line, top-level?) for every in-package import of ``module``."""
+    tree = ast.parse(MODULES[module].read_text(encoding="utf-8"))
+    top = set(id(n) for n in tree.body)
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            target = _resolve(module, node)
+            if not target:
+                continue
+            names = [a.name for a in node.names]
+            # "from . import x" / "from .pkg import mod": the names may be modules themselves
+            for a in names:
+                if f"{target}.{a}".lstrip(".") in MODULES:
+                    yield f"{target}.{a}".lstrip("."), [], node.lineno, id(node) in top
+                    names = [n for n in names if n != a]
+            if names and target in MODULES:
+                yield target, names, node.lineno, id(node) in top
+        elif isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name.startswith("allanite."):
+                    yield a.name[len("allanite.") :], [], node.lineno, id(node) in top
+
+
+def _layer(module: str) -> int:
+    return LAYERS[module.split(".")[0]]
+
+
+def test_every_module_has_a_layer():
+    assert sorted(m for m in MODULES if m.split(".")[0] not in LAYERS) == []
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_imports_run_one_way(module):
+    up = [(t, line) for t, _, line, _ in _imports(module) if _layer(t) > _layer(module)]
+    assert up == [], f"{module} imports upward: {up}"
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_no_private_names_across_modules(module):
+    bad = [
+        (t, n, line)
+        for t, names, line, _ in _imports(module)
+        for n in names
+        if n.startswith("_") and n != "__version__" and t != module
+    ]
+    assert bad == [], f"{module} takes private names of other modules: {bad}"
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_no_reaching_through_sys_modules(module):
+    text = MODULES[module].read_text(encoding="utf-8")
+    assert "sys.modules" not in text
+
+
+def test_no_import_cycles():
+    graph = {m: {t for t, _, _, top in _imports(m) if top and t != m} for m in MODULES}
+    # a package's __init__ importing its own submodules is the package being assembled, not a circle
+    for m in graph:
+        graph[m] = {t for t in graph[m] if not t.startswith(m + ".")}
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(m):
+        state[m] = 1
+        stack.append(m)
+        for t in graph.get(m, ()):
+            if state.get(t) == 1:
+                raise AssertionError("import circle: " + " → ".join(stack[stack.index(t) :] + [t]))
+            if t not in state:
+                visit(t)
+        stack.pop()
+        state[m] = 2
+
+    for m in graph:
+        if m not in state:
+            visit(m)
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_no_function_shares_a_name_with_a_sibling_module(module):
+    siblings = {p.stem for p in MODULES[module].parent.glob("*.py")} | {
+        p.name for p in MODULES[module].parent.iterdir() if p.is_dir() and (p / "__init__.py").exists()
+    }
+    tree = ast.parse(MODULES[module].read_text(encoding="utf-8"))
+    clash = [n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef)) and n.name in siblings]
+    assert clash == [], f"{module} defines {clash}, which are also module names beside it"
+
+
+def test_the_public_api_is_pinned():
+    """Every name the package exports, and the parameters of each public function (new keyword
+    arguments may be added at the end; nothing may disappear or change kind)."""
+    import inspect
+
+    assert sorted(allanite.__all__) == sorted(PINNED)
+    for name, params in PINNED.items():
+        obj = getattr(allanite, name)
+        if params is None:
+            continue
+        sig = inspect.signature(obj)
+        got = [(p.name, p.kind.name) for p in sig.parameters.values()]
+        assert got[: len(params)] == params, f"allanite.{name}{sig}"
+        assert all(p.kind.name in ("KEYWORD_ONLY", "VAR_KEYWORD") for p in list(sig.parameters.values())[len(params) :])
+
+
+P, K = "POSITIONAL_OR_KEYWORD", "KEYWORD_ONLY"
+PINNED = {
+    "avar": [
+        ("x", P),
+        ("fs", P),
+        ("input", K),
+        ("taus", K),
+        ("estimator", K),
+        ("workers", K),
+        ("kf_rule", K),
+        ("decimate", K),
+    ],
+    "davar": [
+        ("x", P),
+        ("fs", P),
+        ("window", K),
+        ("hop", K),
+        ("taus", K),
+        ("method", K),
+        ("estimator", K),
+        ("input", K),
+        ("workers", K),
+        ("max_memory", K),
+        ("kf_rule", K),
+    ],
+    "tau_grid": [("n", P), ("fs", P), ("kind", P), ("growth", K), ("points", K), ("tau_min", K), ("m_max", K)],
+    "default_record": [("seed", P)],
+    "simulate": None,
+    "read_log": None,
+    "Log": None,
+    "fit": [
+        ("result", P),
+        ("terms", K),
+        ("unit", K),
+        ("confidence", K),
+        ("thin", K),
+        ("tau_range", K),
+        ("max_iter", K),
+    ],
+    "information_bound": [("n", P), ("fs", P), ("Q", K), ("N", K), ("B", K), ("K", K)],
+    "NoiseFit": None,
+    "CoefficientSeries": None,
+    "refine": [
+        ("x_or_result", P),
+        ("fs", P),
+        ("start", K),
+        ("candidates", K),
+        ("unit", K),
+        ("input", K),
+        ("tau_range", K),
+        ("truth", K),
+        ("confidence", K),
+        ("points", K),
+        ("axis", K),
+    ],
+    "Refinement": None,
+    "confidence_intervals": [
+        ("result", P),
+        ("x", P),
+        ("confidence", K),
+        ("alpha", K),
+        ("edf_method", K),
+        ("chi2", K),
+        ("b1_n", K),
+    ],
+    "identify_alpha": [("x", P), ("m", P), ("input", K), ("estimator", K), ("method", K), ("b1_n", K)],
+    "edf_greenhall": [("alpha", P), ("d", P), ("m", P), ("N", P), ("overlapping", P), ("modified", P)],
+    "edf_sp1065": [("alpha", P), ("m", P), ("N", P), ("estimator", P)],
+    "chi2_interval": [("variance", P), ("edf", P), ("confidence", P), ("method", K)],
+    "AllanResult": None,
+    "DynamicAllanResult": None,
+    "AllaniteError": None,
+    "InputError": None,
+    "ParameterError": None,
+    "MemoryBudgetError": None,
+    "__version__": None,
+}
