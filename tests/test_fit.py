@@ -1,6 +1,5 @@
 """The noise-model fit: recovery of known terms, units, dynamic series, bad input."""
 
-
 import numpy as np
 import pytest
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from html import unescape
 
 import matplotlib
 
@@ -62,7 +63,7 @@ def test_cli_estimator_theoh(tmp_path, record):
     assert rc == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["static"]["estimator"] == "theoh" and s["dynamic"]["estimator"] == "theoh"
-    html = (out / "report.html").read_text()
+    html = unescape((out / "report.html").read_text())
     assert "TheoH deviation" in html and "Dynamic TheoH (DHVAR)" in html and "Howe's Theo1" in html
     # default hop keeps about 400 windows at most (each window is fitted)
     assert s["dynamic"]["windows"] <= 401

@@ -40,6 +40,8 @@ class Effect:
     ----------
     name : str
         What ``candidates=`` and ``Step.effect`` call it.
+    label : str
+        Its name in words, for reports.
     kind : {"curve", "time"}
         Found on the Allan curve by its signature, or in the samples along time.
     params : tuple of (name, unit, meaning)
@@ -57,6 +59,7 @@ class Effect:
     """
 
     name: str
+    label: str
     kind: str
     params: tuple[tuple[str, str, str], ...]
     description: str
@@ -74,6 +77,7 @@ EFFECTS: dict[str, Effect] = {
     for e in (
         Effect(
             "gauss_markov",
+            "Gauss–Markov",
             "curve",
             (
                 ("sigma", "rate unit", "standard deviation of the Gauss–Markov rate"),
@@ -87,6 +91,7 @@ EFFECTS: dict[str, Effect] = {
         ),
         Effect(
             "sinusoid",
+            "sinusoid",
             "curve",
             (("amplitude", "rate unit", "amplitude A of the rate sinusoid"), ("f0", "Hz", "frequency f0")),
             "rate sinusoid A·sin(2πf0t): A²·sin⁴(πf0τ)/(πf0τ)², nulls at τ = k/f0; f0 ≥ 2/τ_max so that two "
@@ -97,6 +102,7 @@ EFFECTS: dict[str, Effect] = {
         ),
         Effect(
             "change_point",
+            "changes of noise level",
             "time",
             (("t", "s", "time of a step in the noise level, from the start of the record"),),
             "a step in the Allan variance of non-overlapping windows along the record (all τ jointly), located "

@@ -1,10 +1,18 @@
-"""The report's HTML page."""
+"""The report's HTML page: ``template.html.j2`` and ``report.css``, rendered by Jinja2.
+
+Every number comes from the report's summary (what ``summary.json`` holds), so page and JSON cannot
+disagree; this module only shapes the summary into the tables and sentences the template lays out.
+"""
 
 from __future__ import annotations
 
 import base64
-import html as _html
 import math
+from functools import lru_cache
+from importlib import resources
+from typing import Any
+
+import jinja2
 
 from .._core import __version__
 from .fmt import duration, g
@@ -13,76 +21,32 @@ from .settings import REPORT_ESTIMATORS
 __all__ = ["html_page"]
 
 
-# --------------------------------------------------------------------------------------------------
-# HTML
-
-_CSS = """
-body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,Helvetica,Arial,sans-serif;margin:0 auto;
-max-width:1100px;padding:1em 1.5em;color:#1b1b1b;line-height:1.45}
-h1{font-size:1.6em;margin-bottom:.1em}h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:1.6em}
-h3{margin-bottom:.3em}.sub{color:#555;margin-top:0}nav a{margin-right:1em}
-table{border-collapse:collapse;margin:.6em 0;font-size:.9em}
-th,td{border:1px solid #ddd;padding:.25em .6em;text-align:right;font-variant-numeric:tabular-nums}
-th{background:#f3f3f3}td.l,th.l{text-align:left}
-figure{margin:.8em 0;display:inline-block;vertical-align:top;max-width:100%}
-figure img{max-width:100%;height:auto;border:1px solid #eee}
-figcaption{font-size:.85em;color:#555;max-width:720px}
-.note{background:#fff7e0;border-left:4px solid #e0a800;padding:.4em .8em;margin:.4em 0}
-.pair figure{max-width:49%}code{background:#f3f3f3;padding:0 .2em}
-footer{margin-top:2em;color:#777;font-size:.85em}
-"""
+@lru_cache(maxsize=1)
+def _template() -> jinja2.Template:
+    here = resources.files(__package__)
+    env = jinja2.Environment(autoescape=True, trim_blocks=False, lstrip_blocks=False, undefined=jinja2.StrictUndefined)
+    return env.from_string(here.joinpath("template.html.j2").read_text(encoding="utf-8"))
 
 
-def _e(s) -> str:
-    return _html.escape(str(s), quote=True)
+@lru_cache(maxsize=1)
+def _css() -> str:
+    return resources.files(__package__).joinpath("report.css").read_text(encoding="utf-8")
 
 
-def _table(header, rows, left=1) -> str:
-    h = "".join(f'<th class="l">{_e(c)}</th>' if i < left else f"<th>{_e(c)}</th>" for i, c in enumerate(header))
-    body = []
-    for r in rows:
-        body.append(
-            "<tr>"
-            + "".join(f'<td class="l">{_e(c)}</td>' if i < left else f"<td>{_e(c)}</td>" for i, c in enumerate(r))
-            + "</tr>"
-        )
-    return f"<table><thead><tr>{h}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+def _table(header, rows, left: int = 1) -> dict[str, Any]:
+    return {"header": list(header), "rows": [list(r) for r in rows], "left": left}
 
 
-def _img(images, specs_by_name, name) -> str:
-    if name not in images:
-        return ""
-    _, title, caption, _, _ = specs_by_name[name]
-    data = base64.b64encode(images[name]).decode("ascii")
-    return (
-        f'<figure><img src="data:image/png;base64,{data}" alt="{_e(title)}">'
-        f"<figcaption>{_e(caption)} <code>{_e(name)}</code></figcaption></figure>"
-    )
+def _ci(v, ci) -> str:
+    hi = ci[1] if ci[1] is not None else math.inf
+    return f"{g(v)} [{g(ci[0])}, {g(hi)}]"
 
 
-def html_page(rep, images: dict) -> str:
-    """The self-contained HTML page of a report, figures embedded as data URIs."""
-    s = rep.summary()
-    specs = {sp[0]: sp for sp in rep.figure_specs()}
-    rec, st, dy, fit = s["record"], s["static"], s["dynamic"], s["fit"]
-    names = rec["axis_names"]
-    au = rec["adev_unit"] or "samples' unit"
-    out = []
-    out.append(
-        f"<header><h1>Allan variance report — {_e(rec['name'])}</h1>"
-        f'<p class="sub">allanite {_e(__version__)} · {_e(s["created"])}</p></header>'
-    )
-    out.append(
-        '<nav><a href="#record">Record</a><a href="#static">Allan deviation</a>'
-        '<a href="#model">Noise model</a><a href="#davar">Dynamic Allan variance</a>'
-        '<a href="#series">Coefficients over time</a></nav>'
-    )
-
-    # record
+def _record(rec: dict) -> dict:
     src = rec["source"]
-    rows = [
+    rows: list[tuple[str, Any]] = [
         ("samples per axis", rec["samples"]),
-        ("axes", f"{rec['axes']} ({', '.join(names)})"),
+        ("axes", f"{rec['axes']} ({', '.join(rec['axis_names'])})"),
         ("sampling rate", f"{rec['fs_hz']:g} Hz"),
         ("duration", f"{g(rec['duration_s'], 6)} s ({duration(rec['duration_s'])})"),
         ("unit", rec["unit"] or "unknown"),
@@ -99,42 +63,28 @@ def html_page(rep, images: dict) -> str:
         if src.get(key) is not None:
             rows.append((label, src[key]))
     if src.get("gaps"):
-        rows.append(
-            (
-                "gaps",
-                "; ".join(f"{g['duration_s']:.6g} s after sample {g['after_sample']}" for g in src["gaps"][:10])
-                + (" …" if len(src["gaps"]) > 10 else ""),
-            )
-        )
-    out.append('<section id="record"><h2>Record</h2>' + _table(("", ""), rows, left=1))
-    for note in s["notes"]:
-        out.append(f'<p class="note">{_e(note)}</p>')
-    out.append("</section>")
+        shown = "; ".join(f"{gap['duration_s']:.6g} s after sample {gap['after_sample']}" for gap in src["gaps"][:10])
+        rows.append(("gaps", shown + (" …" if len(src["gaps"]) > 10 else "")))
+    return _table(("", ""), rows, left=1)
 
-    # static
-    conf = st["confidence"]
+
+def _static(st: dict, names: list) -> dict:
     theoh = st["source"] is not None
-    titles = REPORT_ESTIMATORS["theoh" if theoh else "oavar"][3:]
-    edf_words = (
-        "Greenhall's equivalent degrees of freedom (ν) at Allan τ and Howe's Theo1 ν at TheoBR τ "
-        f"(bias ratio kf = {', '.join(g(k) for k in st['kf'])}; TheoBR values belong to τ = 0.75·m/fs"
-        + (
-            f"; TheoBR and kf from block averages of {st['theo_decimation']} samples — Taylor & Howe's "
-            "fast TheoBR — as Theo1 of the full record would cost O(N²)"
-            if (st.get("theo_decimation") or 1) > 1
-            else ""
+    if theoh:
+        decimated = (st.get("theo_decimation") or 1) > 1
+        edf_words = (
+            "Greenhall's equivalent degrees of freedom (ν) at Allan τ and Howe's Theo1 ν at TheoBR τ (bias ratio "
+            f"kf = {', '.join(g(k) for k in st['kf'])}; TheoBR values belong to τ = 0.75·m/fs"
+            + (
+                f"; TheoBR and kf from block averages of {st['theo_decimation']} samples — Taylor & Howe's fast "
+                "TheoBR — as Theo1 of the full record would cost O(N²)"
+                if decimated
+                else ""
+            )
+            + ")"
         )
-        + ")"
-        if theoh
-        else "Greenhall's equivalent degrees of freedom (ν)"
-    )
-    out.append(
-        f'<section id="static"><h2>{_e(titles[0])}</h2>'
-        f"<p>Estimator <code>{_e(st['estimator'])}</code> on the <code>{_e(st['grid'])}</code> τ grid; "
-        f"{conf:.1%} χ² intervals with {edf_words} for the noise type "
-        f"identified at each τ. ADEV in {_e(au)}.</p>"
-    )
-    out.append(_img(images, specs, "adev.png"))
+    else:
+        edf_words = "Greenhall's equivalent degrees of freedom (ν)"
     header = ["τ (s)", "n"] + [h for nm in names for h in (f"{nm} ADEV", "interval", "ν")]
     rows = []
     for i, tau in enumerate(st["tau_s"]):
@@ -143,101 +93,84 @@ def html_page(rep, images: dict) -> str:
             lo, hi = st["adev_ci_low"][k][i], st["adev_ci_high"][k][i]
             r += [g(st["adev"][k][i]), f"[{g(lo)}, {g(hi)}]", g(st["edf"][k][i], 3)]
         rows.append(r)
-    out.append(_table(header, rows, left=0) + "</section>")
+    return {
+        "title": REPORT_ESTIMATORS["theoh" if theoh else "oavar"][3],
+        "estimator": st["estimator"],
+        "grid": st["grid"],
+        "intervals": f"{st['confidence']:.1%} χ² intervals with {edf_words}",
+        "table": _table(header, rows, left=0),
+    }
 
-    # model
-    out.append('<section id="model"><h2>Noise model (IEEE Std 952)</h2>')
-    if fit["axes"] is not None:
-        ieee = fit["unit_known"]
-        out.append(
-            f"<p>Weighted non-negative least squares in variance space, iteratively reweighted, on "
-            f"octave-spaced τ: <code>{_e(fit['model'])}</code>. {fit['confidence']:.1%} intervals. "
-            + (
-                "Coefficients in IEEE-952 units; base form in the second table."
-                if ieee
-                else "The unit is unknown, so coefficients are in base form (the samples' unit and seconds)."
-            )
-            + "</p>"
-        )
-        if ieee:
-            header = ["term", "unit"] + names
-            rows = []
-            for t in fit["terms"]:
-                c0 = fit["axes"][0]["coefficients"][t]
-                rows.append(
-                    [f"{t} — {c0['name']}", c0["ieee_unit"]]
-                    + [
-                        f"{g(c['ieee'])} [{g(c['ieee_ci'][0])}, {g(c['ieee_ci'][1] if c['ieee_ci'][1] is not None else math.inf)}]"
-                        for c in (ax["coefficients"][t] for ax in fit["axes"])
-                    ]
-                )
-                if "also" in c0:
-                    rows.append(
-                        [f"{t} — {c0['name']}", c0["also"]["unit"]]
-                        + [
-                            f"{g(c['also']['value'])} [{g(c['also']['ci'][0])}, "
-                            f"{g(c['also']['ci'][1] if c['also']['ci'][1] is not None else math.inf)}]"
-                            for c in (ax["coefficients"][t] for ax in fit["axes"])
-                        ]
-                    )
-            out.append(_table(header, rows, left=2))
-        header = ["term", "base unit"] + names
+
+def _model(fit: dict, names: list, au: str) -> dict:
+    if fit["axes"] is None:
+        return {"status": "error" if fit["requested"] else "not requested", "error": fit["error"]}
+    ieee = fit["unit_known"]
+    axes = fit["axes"]
+    tables = []
+    if ieee:
         rows = []
         for t in fit["terms"]:
-            c0 = fit["axes"][0]["coefficients"][t]
+            c0 = axes[0]["coefficients"][t]
             rows.append(
-                [f"{t} — {c0['name']}", c0["unit"] or "(samples' unit)·s^p"]
-                + [
-                    f"{g(c['value'])} [{g(c['ci'][0])}, {g(c['ci'][1] if c['ci'][1] is not None else math.inf)}]"
-                    for c in (ax["coefficients"][t] for ax in fit["axes"])
-                ]
+                [f"{t} — {c0['name']}", c0["ieee_unit"]]
+                + [_ci(c["ieee"], c["ieee_ci"]) for c in (ax["coefficients"][t] for ax in axes)]
             )
-        out.append(_table(header, rows, left=2))
-        rows = [
-            ["χ²/dof"] + [g(ax["chi2_dof"], 4) for ax in fit["axes"]],
-            ["χ², dof"] + [f"{g(ax['chi2'], 4)}, {ax['dof']}" for ax in fit["axes"]],
-            ["p-value"] + [g(ax["p_value"], 3) for ax in fit["axes"]],
-            ["τ points fitted"]
-            + [f"{len(ax['tau_s'])} ({g(ax['tau_s'][0])}–{g(ax['tau_s'][-1])} s)" for ax in fit["axes"]],
-        ]
-        ro = [ax["readoffs"] for ax in fit["axes"]]
+            if "also" in c0:
+                rows.append(
+                    [f"{t} — {c0['name']}", c0["also"]["unit"]]
+                    + [_ci(c["also"]["value"], c["also"]["ci"]) for c in (ax["coefficients"][t] for ax in axes)]
+                )
+        tables.append(_table(["term", "unit"] + names, rows, left=2))
+    rows = []
+    for t in fit["terms"]:
+        c0 = axes[0]["coefficients"][t]
         rows.append(
-            [f"σ(1 s) ({au})"]
-            + [g(r["adev_at_1s"]) + (" (interpolated)" if r["adev_at_1s_interpolated"] else "") for r in ro]
+            [f"{t} — {c0['name']}", c0["unit"] or "(samples' unit)·s^p"]
+            + [_ci(c["value"], c["ci"]) for c in (ax["coefficients"][t] for ax in axes)]
         )
-        rows.append([f"σ minimum ({au}) at τ (s)"] + [f"{g(r['adev_min'])} at {g(r['tau_at_min_s'])}" for r in ro])
-        rows.append([f"σmin/0.664 ({au})"] + [g(r["bias_instability_readoff"]) for r in ro])
-        if ieee:
-            rows.append(
-                [f"read-off N = σ(1 s)·√1 s ({ro[0]['arw_readoff_ieee_unit']})"]
-                + [g(r["arw_readoff_ieee"]) for r in ro]
-            )
-            rows.append(
-                [f"read-off B = σmin/0.664 ({ro[0]['bias_instability_readoff_ieee_unit']})"]
-                + [g(r["bias_instability_readoff_ieee"]) for r in ro]
-            )
-        out.append("<h3>Goodness of fit and datasheet read-offs</h3>" + _table([""] + names, rows, left=1))
-    elif not fit["requested"]:
-        out.append("<p>Not fitted (<code>--no-fit</code>).</p>")
-    else:
-        out.append(f'<p class="note">Not fitted: {_e(fit["error"])}</p>')
-    out.append("<div>" + "".join(_img(images, specs, f"adev_axis{k}.png") for k in range(len(names))) + "</div>")
-    out.append("</section>")
+    tables.append(_table(["term", "base unit"] + names, rows, left=2))
+    ro = [ax["readoffs"] for ax in axes]
+    good = [
+        ["χ²/dof"] + [g(ax["chi2_dof"], 4) for ax in axes],
+        ["χ², dof"] + [f"{g(ax['chi2'], 4)}, {ax['dof']}" for ax in axes],
+        ["p-value"] + [g(ax["p_value"], 3) for ax in axes],
+        ["τ points fitted"] + [f"{len(ax['tau_s'])} ({g(ax['tau_s'][0])}–{g(ax['tau_s'][-1])} s)" for ax in axes],
+        [f"σ(1 s) ({au})"]
+        + [g(r["adev_at_1s"]) + (" (interpolated)" if r["adev_at_1s_interpolated"] else "") for r in ro],
+        [f"σ minimum ({au}) at τ (s)"] + [f"{g(r['adev_min'])} at {g(r['tau_at_min_s'])}" for r in ro],
+        [f"σmin/0.664 ({au})"] + [g(r["bias_instability_readoff"]) for r in ro],
+    ]
+    if ieee:
+        good.append(
+            [f"read-off N = σ(1 s)·√1 s ({ro[0]['arw_readoff_ieee_unit']})"] + [g(r["arw_readoff_ieee"]) for r in ro]
+        )
+        good.append(
+            [f"read-off B = σmin/0.664 ({ro[0]['bias_instability_readoff_ieee_unit']})"]
+            + [g(r["bias_instability_readoff_ieee"]) for r in ro]
+        )
+    methods = {ax["method"] for ax in axes}
+    how = (
+        "Generalized least squares with the estimates' exact covariance across τ"
+        if methods == {"gls"}
+        else "Weighted non-negative least squares in variance space, iteratively reweighted"
+    )
+    return {
+        "status": "fitted",
+        "method": f"{how}, on octave-spaced τ",
+        "formula": fit["model"],
+        "confidence": f"{fit['confidence']:.1%}",
+        "tables": tables,
+        "goodness": _table([""] + names, good, left=1),
+        "units_note": (
+            "Coefficients in IEEE-952 units; base form in the second table."
+            if ieee
+            else "The unit is unknown, so coefficients are in base form (the samples' unit and seconds)."
+        ),
+    }
 
-    # davar
-    what = (
-        "the static TheoH of its window (its own bias ratio kf and switch point)"
-        if theoh
-        else "the static overlapping Allan variance of its window"
-    )
-    grid_words = "octave grid" if dy["grid"] == "octave" else "exponential grid"
-    out.append(
-        f'<section id="davar"><h2>{_e(titles[1])}</h2><p>Window {dy["window_samples"]} samples '
-        f"({g(dy['window_s'])} s, {_e(dy['window_rule'])}), hop {dy['hop_samples']} samples "
-        f"({g(dy['hop_s'])} s, {_e(dy['hop_rule'])}): {dy['windows']} windows × {len(dy['tau_s'])} τ "
-        f"({g(dy['tau_s'][0])}–{g(dy['tau_s'][-1])} s, {grid_words}), method "
-        f"<code>{_e(dy['method'])}</code>. Each column is exactly {what}.</p>"
-    )
+
+def _dynamic(dy: dict, theoh: bool, au: str) -> dict:
     rows = [
         [
             ax["name"],
@@ -249,73 +182,75 @@ def html_page(rep, images: dict) -> str:
         ]
         for ax in dy["axes"]
     ]
-    out.append(_table(["axis", "τ (s)", f"median ADEV ({au})", "max at t", "min at t", "max/min"], rows, left=1))
-    for k, nm in enumerate(names):
-        out.append(
-            f'<h3>{_e(nm)}</h3><div class="pair">'
-            + _img(images, specs, f"davar_axis{k}.png")
-            + _img(images, specs, f"davar3d_axis{k}.png")
-            + "</div>"
-        )
-    out.append("</section>")
+    grid_words = "octave grid" if dy["grid"] == "octave" else "exponential grid"
+    return {
+        "title": REPORT_ESTIMATORS["theoh" if theoh else "oavar"][4],
+        "window": f"{dy['window_samples']} samples ({g(dy['window_s'])} s, {dy['window_rule']})",
+        "hop": f"{dy['hop_samples']} samples ({g(dy['hop_s'])} s, {dy['hop_rule']})",
+        "grid": f"{dy['windows']} windows × {len(dy['tau_s'])} τ ({g(dy['tau_s'][0])}–{g(dy['tau_s'][-1])} s, "
+        f"{grid_words})"
+        + (f"; the last {dy['unused_samples']} samples fall after the last window" if dy.get("unused_samples") else ""),
+        "method": dy["method"],
+        "what": (
+            "the static TheoH of its window (its own bias ratio kf and switch point)"
+            if theoh
+            else "the static overlapping Allan variance of its window"
+        ),
+        "table": _table(["axis", "τ (s)", f"median ADEV ({au})", "max at t", "min at t", "max/min"], rows, left=1),
+    }
 
-    # series
-    out.append('<section id="series"><h2>Noise coefficients over time</h2>')
+
+def _series(fit: dict) -> dict:
     ser = fit.get("series")
-    if ser and ser["axes"] is not None:
-        out.append(
-            f"<p>The noise model fitted in every DAVAR window ({ser['confidence']:.1%} intervals) — paper "
-            f"002's 2-D representation. Median, minimum and maximum over the windows"
-            f"{', in IEEE-952 units' if fit['unit_known'] else ' (base form)'}:</p>"
+    if not ser or ser["axes"] is None:
+        return {"status": "error" if fit["requested"] else "not requested", "error": (ser or {}).get("error")}
+    rows = []
+    for ax in ser["axes"]:
+        for t, c in ax["coefficients"].items():
+            sc = c["stats"]
+            rows.append(
+                [
+                    ax["name"],
+                    f"{t} — {c['name']}",
+                    sc["unit"] or "",
+                    g(sc["median"]),
+                    f"{g(sc['min'])} at {g(sc['t_of_min_s'])} s",
+                    f"{g(sc['max'])} at {g(sc['t_of_max_s'])} s",
+                    f"{sc['windows_nonzero']}/{len(ax['t_s'])}",
+                ]
+            )
+    return {
+        "status": "fitted",
+        "confidence": f"{ser['confidence']:.1%}",
+        "units_note": ", in IEEE-952 units" if fit["unit_known"] else " (base form)",
+        "table": _table(["axis", "term", "unit", "median", "min", "max", "windows resolved (> 0)"], rows, left=3),
+    }
+
+
+def _refinement(ref: dict | None) -> dict | None:
+    if ref is None:
+        return None
+    curve_rows, change_rows, summary_rows = [], [], []
+    for ax in ref["axes"]:
+        if ax.get("error"):
+            summary_rows.append([ax["name"], "failed", "", "", ""])
+            continue
+        summary_rows.append(
+            [
+                ax["name"],
+                ", ".join(st["effect"] for st in ax["steps"]) or "nothing found",
+                f"{g(ax['start']['chi2_dof'], 3)} → {g(ax['final']['chi2_dof'], 3)}",
+                f"{g(ax['start']['rms_adev_pct'], 3)} → {g(ax['final']['rms_adev_pct'], 3)} %",
+                ax["tau_from_s"] is not None and f"{g(ax['tau_from_s'])} s" or "",
+            ]
         )
-        rows = []
-        for ax in ser["axes"]:
-            for t, c in ax["coefficients"].items():
-                sc = c["stats"]
-                rows.append(
-                    [
-                        ax["name"],
-                        f"{t} — {c['name']}",
-                        sc["unit"] or "",
-                        g(sc["median"]),
-                        f"{g(sc['min'])} at {g(sc['t_of_min_s'])} s",
-                        f"{g(sc['max'])} at {g(sc['t_of_max_s'])} s",
-                        f"{sc['windows_nonzero']}/{len(ax['t_s'])}",
-                    ]
-                )
-        out.append(_table(["axis", "term", "unit", "median", "min", "max", "windows > 0"], rows, left=3))
-        out.append(
-            "<div>" + "".join(_img(images, specs, f"coefficients_axis{k}.png") for k in range(len(names))) + "</div>"
-        )
-    elif not fit["requested"]:
-        out.append("<p>Not fitted (<code>--no-fit</code>).</p>")
-    else:
-        out.append(f'<p class="note">Not fitted: {_e((ser or {}).get("error"))}</p>')
-    out.append("</section>")
-    ref = s.get("refinement")
-    if ref is not None:
-        out.append(
-            '<section id="refinement"><h2>Model refinement</h2><p>What the five-term model lacks: '
-            "<code>allanite.refine</code> traced the residual to Gauss–Markov or sinusoid signatures in the "
-            "Allan curve, or to changes of level along the record (16 windows), and kept an effect only where it "
-            "earned its parameters (BIC on an effective χ²). Parameters: σ and amplitude in the rate unit, "
-            "T<sub>c</sub> and t in s, f0 in Hz; intervals ~68 %. Its χ²/dof weights each τ of a dense curve "
-            "independently, so it is not the fit table's χ²/dof (which accounts for the correlation between "
-            "τ).</p>"
-        )
-        rows = []
-        for ax in ref["axes"]:
-            if ax.get("error"):
-                rows.append([ax["name"], "failed", "", "", ""])
-                continue
-            if not ax["steps"]:
-                rows.append([ax["name"], "nothing found", "", f"{g(ax['start']['chi2_dof'], 3)}", ""])
-            for st in ax["steps"]:
-                params = "; ".join(
-                    f"{p} = {g(v, 3)} [{g(st['intervals'][p][0], 3)}, {g(st['intervals'][p][1], 3)}]"
-                    for p, v in st["params"].items()
-                )
-                rows.append(
+        for st in ax["steps"]:
+            params = "; ".join(
+                f"{p} = {g(v, 3)} [{g(st['intervals'][p][0], 3)}, {g(st['intervals'][p][1], 3)}]"
+                for p, v in st["params"].items()
+            )
+            if st["statistic"] == "allan_curve":
+                curve_rows.append(
                     [
                         ax["name"],
                         st["effect"],
@@ -324,20 +259,82 @@ def html_page(rep, images: dict) -> str:
                         f"{g(st['before']['rms_adev_pct'], 3)} → {g(st['after']['rms_adev_pct'], 3)} %",
                     ]
                 )
-        out.append(
+            else:
+                change_rows.append(
+                    [ax["name"], params, f"{g(st['before']['chi2_dof'], 3)} → {g(st['after']['chi2_dof'], 3)}"]
+                )
+    tables = [
+        _table(
+            ["axis", "effects added", "curve χ²/dof start → final", "RMS ADEV error start → final", "fitted from τ"],
+            summary_rows,
+            left=2,
+        )
+    ]
+    if curve_rows:
+        tables.append(
             _table(
-                ["axis", "effect", "parameters", "χ²/dof before → after", "RMS ADEV error before → after"], rows, left=3
+                [
+                    "axis",
+                    "effect on the Allan curve",
+                    "parameters",
+                    "χ²/dof before → after",
+                    "RMS ADEV error before → after",
+                ],
+                curve_rows,
+                left=3,
             )
         )
-        out.append("</section>")
-    out.append(
-        f"<footer>Every number on this page is in <code>summary.json</code> beside it, with its unit. "
-        f"Figures: {', '.join(_e(n) for n in images)}.</footer>"
-    )
-    body = "\n".join(out)
-    return (
-        f'<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
-        f'<meta name="viewport" content="width=device-width, initial-scale=1">'
-        f"<title>allanite report — {_e(rec['name'])}</title><style>{_CSS}</style></head>\n<body>\n{body}\n"
-        f"</body></html>\n"
-    )
+    if change_rows:
+        tables.append(
+            _table(
+                [
+                    "axis",
+                    "change of noise level at",
+                    "window-level χ²/dof: one level → levels split at every change found",
+                ],
+                change_rows,
+                left=2,
+            )
+        )
+    return {
+        "candidates": ref["candidates"],
+        "units": ref["units"],
+        "tables": tables,
+        "chi2_note": (
+            "Curve effects are judged on the Allan curve (χ²/dof weighting each τ of a dense curve "
+            "independently — not the fit table's χ²/dof, which accounts for the correlation between τ); "
+            "changes of level along the record on the Allan variances of 16 windows (their own χ² "
+            "scale), so they do not change the curve's start → final numbers."
+        ),
+    }
+
+
+def html_page(rep: Any, images: dict) -> str:
+    """The self-contained HTML page of a report, figures embedded as data URIs."""
+    s = rep.summary()
+    rec, st, dy, fit = s["record"], s["static"], s["dynamic"], s["fit"]
+    names = rec["axis_names"]
+    au = rec["adev_unit"] or "samples' unit"
+    specs = {sp[0]: sp for sp in rep.figure_specs()}
+    figures = {
+        name: {"data": base64.b64encode(data).decode("ascii"), "title": specs[name][1], "caption": specs[name][2]}
+        for name, data in images.items()
+    }
+    context = {
+        "name": rec["name"],
+        "version": __version__,
+        "created": s["created"],
+        "css": _css(),
+        "record": _record(rec),
+        "notes": s["notes"],
+        "adev_unit": au,
+        "axes": list(range(len(names))),
+        "axis_names": names,
+        "static": _static(st, names),
+        "model": _model(fit, names, au),
+        "dynamic": _dynamic(dy, st["source"] is not None, au),
+        "series": _series(fit),
+        "refinement": _refinement(s.get("refinement")),
+        "figures": figures,
+    }
+    return _template().render(**context).rstrip() + "\n"

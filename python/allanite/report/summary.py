@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from .._core import __version__
+from ..model.effects import EFFECTS
 from ..model.terms import TERM_NAMES
 from ..units import coefficient_unit, ieee952
 from .fmt import duration, g, json_list, json_number, pct
@@ -15,27 +16,41 @@ from .settings import FIT_MODEL, HOP_FRACTION, WINDOW_FRACTION
 __all__ = ["summarize", "text_summary", "refinement_dict"]
 
 
+def _fit_errors(f) -> dict:
+    """χ²/dof, RMS z and RMS ADEV error (%) of a NoiseFit against its own estimates."""
+    return {
+        "chi2_dof": json_number(f.chi2_dof),
+        "rms_z": json_number(np.sqrt(np.mean(f.z**2))),
+        "rms_adev_pct": json_number(100 * np.sqrt(np.mean((np.sqrt(f.avar / f.model) - 1) ** 2))),
+    }
+
+
 def refinement_dict(rep) -> dict | None:
+    """The refinement of every axis: the curve fit's errors at the start and at the end, and each step —
+    curve effects judged on the Allan curve, changes of level on the Allan variances of windows along
+    the record (``statistic`` says which: the two are on different χ² scales)."""
     if rep.refinements is None:
         return None
+    rate = rep.adev_unit or "rate unit"
     axes = []
     for k, r in enumerate(rep.refinements):
         if r is None:
             axes.append({"axis": k, "name": rep.axis_names[k], "error": True})
             continue
-        s0 = r.start
         axes.append(
             {
                 "axis": k,
                 "name": rep.axis_names[k],
                 "terms": list(r.terms),
-                "tau_from_s": json_number(s0.tau[0]),
-                "start": {"chi2_dof": json_number(s0.chi2_dof), "rms_z": json_number(np.sqrt(np.mean(s0.z**2)))},
-                "final": {"chi2_dof": json_number(r.fit.chi2_dof)},
+                "tau_from_s": json_number(r.start.tau[0]),
+                "start": _fit_errors(r.start),
+                "final": _fit_errors(r.fit),
                 "steps": [
                     {
                         "effect": st.effect,
+                        "statistic": "allan_curve" if EFFECTS[st.effect].kind == "curve" else "window_levels",
                         "params": {p: json_number(v) for p, v in st.params.items()},
+                        "units": {p: rate if u == "rate unit" else u for p, u, _ in EFFECTS[st.effect].params},
                         "intervals": {p: [json_number(a), json_number(b)] for p, (a, b) in st.intervals.items()},
                         "before": {q: json_number(v) for q, v in st.before.items()},
                         "after": {q: json_number(v) for q, v in st.after.items()},
@@ -44,9 +59,20 @@ def refinement_dict(rep) -> dict | None:
                 ],
             }
         )
+    curve = [e for e in EFFECTS.values() if e.kind == "curve"]
+    timed = [e for e in EFFECTS.values() if e.kind != "curve"]
     return {
-        "method": "allanite.refine: Gauss–Markov / sinusoid signatures and change points, added by BIC on an "
-        "effective χ²; params in the rate unit (σ, amplitude), s (tc, t), Hz (f0)",
+        "method": "allanite.refine: effect signatures on the Allan curve and changes along the record, each added "
+        "only where it earns its parameters (BIC on an effective χ²)",
+        "candidates": f"{' / '.join(e.label for e in curve)} signatures in the Allan curve, or "
+        + " or ".join(f"{e.label} along the record" for e in timed),
+        "units": "; ".join(f"{e.name}: " + ", ".join(f"{p} in {u}" for p, u, _ in e.params) for e in EFFECTS.values()),
+        "statistics": {
+            "allan_curve": "before/after: χ²/dof, RMS z and RMS ADEV error (%) of the Allan-curve fit, each τ of the "
+            "dense curve weighted independently",
+            "window_levels": "before/after: one level vs piecewise levels (split at every change found) of the "
+            "log Allan variances of 16 windows along the record",
+        },
         "axes": axes,
     }
 
@@ -370,4 +396,19 @@ def text_summary(s: dict) -> str:
             lines.append(f"    {ax['name']}: " + ("; ".join(parts) or "all zero"))
     elif ser and ser["error"]:
         lines.append(f"  noise coefficients over time: not fitted ({ser['error']})")
+    ref = s.get("refinement")
+    if ref is not None:
+        lines += ["", "Model refinement (what the five-term model lacks; allanite.refine)"]
+        for ax in ref["axes"]:
+            if ax.get("error"):
+                lines.append(f"  {ax['name']}: failed (see the notes)")
+                continue
+            found = ", ".join(st["effect"] for st in ax["steps"]) or "nothing added"
+            lines.append(
+                f"  {ax['name']}: {found}; curve χ²/dof {g(ax['start']['chi2_dof'], 3)} → {g(ax['final']['chi2_dof'], 3)}, "
+                f"RMS ADEV error {g(ax['start']['rms_adev_pct'], 3)} → {g(ax['final']['rms_adev_pct'], 3)} %"
+            )
+            for st in ax["steps"]:
+                params = ", ".join(f"{p} = {g(v, 3)} {st['units'][p]}" for p, v in st["params"].items())
+                lines.append(f"    {st['effect']}: {params}")
     return "\n".join(lines)
