@@ -378,6 +378,7 @@ def sniff_format(path: Path) -> str:
     if suffix in (".db3", ".mcap"):
         return "ros2"
     if head.startswith(b"\x1f\x8b"):
+        _check_text(path, gz=True)
         return "text.gz"
     if suffix == ".npy":
         raise InputError(f"{path}: not a valid .npy file (no NumPy header)")
@@ -389,7 +390,28 @@ def sniff_format(path: Path) -> str:
         raise InputError(f"{path}: not a valid ROS 1 bag (no #ROSBAG header)")
     if suffix == ".gz":
         raise InputError(f"{path}: not a valid gzip file")
+    _check_text(path, gz=False)
     return "text"
+
+
+#: Bytes that never occur in a text log (NUL and the C0 controls other than tab, newline, CR, FF, VT).
+_BINARY_BYTES = bytes(range(0, 9)) + bytes(range(14, 32))
+
+
+def _check_text(path: Path, gz: bool) -> None:
+    """An InputError naming what the file is not, when its first 4 KiB hold bytes no text log has."""
+    try:
+        with gzip.open(path, "rb") if gz else open(path, "rb") as f:
+            head = f.read(4096)
+    except (OSError, EOFError, zlib.error):
+        return  # the reader reports a damaged gzip stream with its own message
+    bad = sum(head.count(b) for b in _BINARY_BYTES)
+    if head and (b"\x00" in head or bad > max(2, len(head) // 100)):
+        kind = "gzip-compressed data that is not text" if gz else "binary data"
+        raise InputError(
+            f"{path}: not a log allanite can read — it holds {kind} ({bad} control bytes in the first "
+            f"{len(head)}); allanite reads text (CSV/TSV, optionally .gz), .npy, .npz, Parquet and ROS bag files"
+        )
 
 
 def _resolve(spec, names, path, what="column"):

@@ -456,8 +456,19 @@ def interval(theta_k, var_k, zq, inflate):
     return math.sqrt(lo), math.sqrt(hi) if np.isfinite(hi) else math.inf
 
 
+#: σ_min is read off only where the estimate has at least this many equivalent degrees of freedom for
+#: flicker rate noise (the bias-instability floor where σ_min sits): the ADEV is then known to ≈ ±22 %.
+#: The last τ of a curve (a few clusters; Theo points reaching 75 % of the record) have ν ≈ 1–5: their
+#: scatter, not the sensor, would set the minimum.
+READOFF_MIN_EDF = 10.0
+
+
 def readoffs(result: AllanResult, adev_row: np.ndarray) -> dict:
-    """Datasheet read-offs of one ADEV curve: σ(1 s), σ_min and where, σ_min/0.664."""
+    """Datasheet read-offs of one ADEV curve: σ(1 s), σ_min and where, σ_min/0.664.
+
+    σ_min is searched over the τ whose estimate has ν ≥ :data:`READOFF_MIN_EDF` for flicker rate noise
+    (``readoff_tau_max`` is the longest such τ): a minimum at a τ with ν ≈ 1 is the estimate's scatter.
+    """
     tau = result.tau
     out = {}
     if tau[0] <= 1.0 <= tau[-1]:
@@ -467,7 +478,14 @@ def readoffs(result: AllanResult, adev_row: np.ndarray) -> dict:
     else:
         out["adev_at_1s"] = None
         out["adev_at_1s_interpolated"] = None
-    i = int(np.argmin(adev_row))
+    src = result.estimator if result.source is None else np.asarray(result.source)
+    window = getattr(result, "window", None) or result.n_samples
+    nu = edf_per_tau(np.full(tau.size, -1), np.asarray(result.m), window + 1, src)
+    usable = np.flatnonzero(nu >= READOFF_MIN_EDF)
+    if usable.size == 0:
+        usable = np.arange(tau.size)
+    i = int(usable[np.argmin(np.asarray(adev_row)[usable])])
+    out["readoff_tau_max"] = float(tau[usable[-1]])
     out["adev_min"] = float(adev_row[i])
     out["tau_at_min"] = float(tau[i])
     out["bias_instability_readoff"] = float(adev_row[i] / 0.664)
@@ -738,7 +756,8 @@ def _select(tau, avar, thin, n_terms, what, tau_range=(0.0, np.inf)):
     if idx.size <= n_terms:
         raise ParameterError(
             f"{what} has {idx.size} usable τ{' (octave-spaced)' if thin else ''} for {n_terms} terms; "
-            f"at least {n_terms + 1} are needed — use a wider τ grid, fewer terms, or thin=False"
+            f"at least {n_terms + 1} are needed — use a wider τ grid or fewer terms"
+            + (", or fit every τ (thin=False)" if thin else "")
         )
     return idx
 

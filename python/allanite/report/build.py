@@ -47,7 +47,15 @@ from ..units import adev_unit_label, parse_unit
 from .figures import figure_specs
 from .fmt import json_number
 from .page import html_page
-from .settings import DHVAR_MAX_DEFAULT_WINDOW, DHVAR_MAX_WINDOWS, REPORT_ESTIMATORS, default_hop, default_window
+from .settings import (
+    DHVAR_MAX_DEFAULT_WINDOW,
+    DHVAR_MAX_WINDOWS,
+    HOP_FRACTION,
+    REPORT_ESTIMATORS,
+    WINDOW_FRACTION,
+    default_hop,
+    default_window,
+)
 from .summary import summarize, text_summary
 
 __all__ = ["Report", "build_report", "from_log", "log_source"]
@@ -274,17 +282,34 @@ def build_report(
 
     n = static.n_samples
     window_given, hop_given = window is not None, hop is not None
+    window_rule = hop_rule = "given"
     if window is None:
         window = default_window(n)
-        if estimator == "theoh":
-            window = min(window, DHVAR_MAX_DEFAULT_WINDOW)
+        window_rule = f"record/{WINDOW_FRACTION}"
+        if estimator == "theoh" and window > DHVAR_MAX_DEFAULT_WINDOW:
+            window = DHVAR_MAX_DEFAULT_WINDOW
+            window_rule = f"record/{WINDOW_FRACTION}, capped at {DHVAR_MAX_DEFAULT_WINDOW} samples for DHVAR"
     else:
         window = check_count(window, "window", 2)
     if hop is None:
         hop = default_hop(window)
+        hop_rule = f"window/{HOP_FRACTION}"
         if estimator == "theoh":
-            # every DHVAR window gets its own fit: keep it to about DHVAR_MAX_WINDOWS of them
-            hop = max(hop, -(-(n - window) // DHVAR_MAX_WINDOWS))
+            # every DHVAR window gets its own fit: keep it to about DHVAR_MAX_WINDOWS of them — but never
+            # hop past a window's end, which would leave samples out of every window
+            fewer = min(window, -(-(n - window) // DHVAR_MAX_WINDOWS))
+            if fewer > hop:
+                hop = fewer
+                hop_rule = f"raised from window/{HOP_FRACTION} to keep about {DHVAR_MAX_WINDOWS} windows" + (
+                    " (at most the window, so that no sample is left out)" if hop == window else ""
+                )
+    else:
+        hop = check_count(hop, "hop", 1)
+        if hop > n:
+            raise ParameterError(
+                f"hop ({hop} samples) is longer than the record ({n} samples): give a hop of at most "
+                f"the window ({window} samples) so that every sample is in a window"
+            )
     progress.step("dynamic Allan variance")
     dynamic = davar(x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est)
     settings = {
@@ -292,6 +317,8 @@ def build_report(
         "hop": int(dynamic.hop),
         "window_default": not window_given,
         "hop_default": not hop_given,
+        "window_rule": window_rule,
+        "hop_rule": hop_rule,
         "taus": taus if isinstance(taus, str) else "explicit",
         "estimator": estimator,
         "dynamic_grid": dynamic_grid,
@@ -319,12 +346,7 @@ def build_report(
             if fits is not None:
                 per_axis = [dynamic.avar] if dynamic.avar.ndim == 2 else list(dynamic.avar)
                 series = [
-                    fit_model(
-                        dataclasses.replace(dynamic, avar=row),
-                        unit=unit_name,
-                        confidence=confidence,
-                        tau_range=(float(f.tau[0]) * (1 - 1e-9), None),
-                    )
+                    _fit_windows(dataclasses.replace(dynamic, avar=row), unit_name, confidence, float(f.tau[0]))
                     for row, f in zip(per_axis, fits)
                 ]
                 if dynamic.avar.ndim == 2:
@@ -379,6 +401,19 @@ def build_report(
         series_error=series_error,
         created=created,
     )
+
+
+def _fit_windows(dynamic, unit, confidence, tau_from):
+    """The coefficients of every window, on the τ range of the whole-record fit of that axis. A short
+    window (DHVAR's ≤ 2001 samples) holds few octaves: when thinning to octaves leaves too few τ for the
+    terms, every τ is fitted (their correlation is in the covariance for overlapping estimates)."""
+    tau_range = (tau_from * (1 - 1e-9), None)
+    try:
+        return fit_model(dynamic, unit=unit, confidence=confidence, tau_range=tau_range)
+    except ParameterError as exc:
+        if "usable τ (octave-spaced)" not in str(exc):
+            raise
+        return fit_model(dynamic, unit=unit, confidence=confidence, tau_range=tau_range, thin=False)
 
 
 def log_source(log) -> dict:

@@ -7,11 +7,12 @@ import math
 import numpy as np
 
 from .._core import __version__
+from ..estimators import get as get_estimator
 from ..model.effects import EFFECTS
 from ..model.terms import TERM_NAMES
 from ..units import coefficient_unit, ieee952
 from .fmt import duration, g, json_list, json_number, pct
-from .settings import FIT_MODEL, HOP_FRACTION, WINDOW_FRACTION
+from .settings import FIT_MODEL
 
 __all__ = ["summarize", "text_summary", "refinement_dict"]
 
@@ -108,6 +109,7 @@ def _readoffs(f, unit, adev_unit) -> dict:
         "adev_min": json_number(r["adev_min"]),
         "tau_at_min_s": json_number(r["tau_at_min"]),
         "bias_instability_readoff": json_number(r["bias_instability_readoff"]),
+        "readoff_tau_max_s": json_number(r.get("readoff_tau_max")),
         "adev_unit": adev_unit,
     }
     if unit is not None:
@@ -155,6 +157,16 @@ def _series_dict(s, unit) -> dict:
     return {"t_s": json_list(s.t), "chi2_dof": json_list(s.chi2_dof), "coefficients": coeffs}
 
 
+def _positions(st) -> np.ndarray:
+    """Terms per estimate that the reader can compare with the record: Allan τ as counted by the estimator,
+    Theo τ as the N − m positions of the Theo1 sum (the double sum's (N − m)·m/2 terms exceed the record)."""
+    n = np.asarray(st.n, dtype=np.int64).copy()
+    if st.source is not None:
+        theo = np.array([get_estimator(str(s)).theo_tau for s in st.source])
+        n[theo] = st.n_samples + 1 - np.asarray(st.m)[theo]
+    return n
+
+
 def summarize(rep) -> dict:
     """Every number of the report, JSON-able (``summary.json``)."""
     st, dy = rep.static, rep.dynamic
@@ -183,7 +195,10 @@ def summarize(rep) -> dict:
         "edf_method": "greenhall" if st.source is None else "greenhall (Allan τ), Howe's Theo1 EDF (TheoBR τ)",
         "tau_s": json_list(st.tau),
         "m": json_list(st.m),
-        "n": json_list(st.n),
+        # n: squared differences averaged (Allan τ), or positions i of the Theo1 sum, N − m (Theo τ) — at most
+        # the record. Stable32's "Thêo1 #" counts every term of the double sum, (N − m)·m/2: n_stable32.
+        "n": json_list(_positions(st)),
+        "n_stable32": json_list(st.n),
         "source": None if st.source is None else [str(v) for v in st.source],
         "kf": None if st.kf is None else json_list(np.atleast_1d(st.kf)),
         "theo_decimation": rep.settings.get("theo_decimation"),
@@ -226,8 +241,9 @@ def summarize(rep) -> dict:
         "hop_samples": int(dy.hop),
         "window_s": dy.window / fs,
         "hop_s": dy.hop / fs,
-        "window_rule": f"record/{WINDOW_FRACTION}" if rep.settings["window_default"] else "given",
-        "hop_rule": f"window/{HOP_FRACTION}" if rep.settings["hop_default"] else "given",
+        "window_rule": rep.settings["window_rule"],
+        "hop_rule": rep.settings["hop_rule"],
+        "unused_samples": int(n - ((dy.t.size - 1) * dy.hop + dy.window)),
         "windows": int(dy.t.size),
         "tau_s": json_list(dy.tau),
         "t_s": json_list(dy.t),
