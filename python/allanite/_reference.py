@@ -308,6 +308,7 @@ def dhvar_reference(
         cols.append(r.var)
         kfs.append(r.kf)
     var = np.array(cols, dtype=dtype).T if cols else np.empty((0, 0))
+    assert first is not None, "at least one window"
     return DHVAR(first.m, first.tau, first.source, var, np.array(kfs))
 
 

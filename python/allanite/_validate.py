@@ -95,7 +95,7 @@ def check_probability(value: object, name: str = "confidence") -> float:
     return c
 
 
-def as_rate_columns(x, fs, input: str):
+def as_rate_columns(x: object, fs: object, input: str) -> tuple[list[np.ndarray], float, bool]:
     """Validate samples and convert them to rate columns.
 
     Returns ``(columns, fs, is_multi)``: a list of C-contiguous float64 arrays (one per axis) of rate
@@ -145,7 +145,7 @@ def as_rate_columns(x, fs, input: str):
     return out, fs, is_multi
 
 
-def resolve_workers(workers) -> int:
+def resolve_workers(workers: object) -> int:
     """Threads for the core: ``workers`` if given, else ``ALLANITE_NUM_THREADS``, else 0 (rayon's
     default: ``RAYON_NUM_THREADS`` or the number of cores)."""
     if workers is None:
@@ -162,7 +162,7 @@ def resolve_workers(workers) -> int:
     return check_count(workers, "workers", 1, MAX_WORKERS)
 
 
-def resolve_max_memory(max_memory) -> int:
+def resolve_max_memory(max_memory: object) -> int:
     """Byte budget for a result: ``max_memory`` if given, else ``ALLANITE_MAX_MEMORY``, else 2 GiB."""
     name = "max_memory"
     if max_memory is None:

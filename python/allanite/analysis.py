@@ -89,9 +89,10 @@ def avar(
     cols, fs, is_multi = as_rate_columns(x, fs, input)
     assert entry.static is not None
     out = entry.static(cols, fs, taus, workers, **options)
-    values, kf = out.values, out.kf
+    values: np.ndarray = out.values
+    kf: np.ndarray | float | None = out.kf
     if not is_multi:
-        values, kf = values[0], (None if kf is None else float(kf[0]))
+        values, kf = values[0], (None if out.kf is None else float(out.kf[0]))
     return AllanResult(
         tau=out.tau,
         avar=values,

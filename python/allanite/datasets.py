@@ -14,6 +14,8 @@ machine (NumPy's PCG64 stream for a fixed seed). One hour at 100 Hz, 360 000 sam
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .simulation import ar1
@@ -23,7 +25,7 @@ __all__ = ["default_record", "DEFAULT_FS", "DEFAULT_SEED"]
 DEFAULT_FS = 100.0
 DEFAULT_SEED = 20261122
 DEFAULT_DURATION_S = 3600.0
-DEFAULT_TERMS = {
+DEFAULT_TERMS: dict[str, Any] = {
     "N_deg_per_sqrt_h": 0.15,
     "K_deg_per_h15": 10.0,
     "gauss_markov_sigma_deg_per_h": 5.0,

@@ -80,7 +80,8 @@ def plot_adev(
     ax = _axes(ax)
     adev = np.atleast_2d(result.adev)
     ci = getattr(result, "adev_ci", None)
-    lo = hi = None
+    lo: np.ndarray | None = None
+    hi: np.ndarray | None = None
     if band and ci is not None:
         lo, hi = np.atleast_2d(ci[0]), np.atleast_2d(ci[1])
     rows = _rows(result, axis)
@@ -96,7 +97,7 @@ def plot_adev(
             label=name if (multi and axis is None) else (name or "Allan deviation"),
             **kwargs,
         )
-        if lo is not None:
+        if lo is not None and hi is not None:
             band_label = None
             if len(rows) == 1:
                 band_label = f"{result.confidence:.1%} interval"

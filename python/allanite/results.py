@@ -20,6 +20,7 @@ import numpy as np
 from .errors import MissingDependencyError, ParameterError
 from .estimators import get as get_estimator
 from .estimators.confidence import confidence_intervals
+from .plot import plot_adev, plot_davar  # plot imports matplotlib only when a figure is drawn
 from .units import adev_unit_label
 
 __all__ = ["AllanResult", "DynamicAllanResult"]
@@ -277,8 +278,6 @@ class AllanResult(_ResultBase):
 
     def plot(self, ax=None, **kwargs):
         """Log-log ADEV against τ (one line per axis). Returns the matplotlib Axes."""
-        from .plot import plot_adev  # matplotlib is imported only when a figure is drawn
-
         return plot_adev(self, ax=ax, **kwargs)
 
 
@@ -380,6 +379,4 @@ class DynamicAllanResult(_ResultBase):
 
     def plot(self, ax=None, axis: int = 0, **kwargs):
         """Heat map of ADEV over (t, τ), log colour. Returns the matplotlib Axes."""
-        from .plot import plot_davar  # matplotlib is imported only when a figure is drawn
-
         return plot_davar(self, ax=ax, axis=axis, **kwargs)

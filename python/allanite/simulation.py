@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from typing import Any
 
 import numpy as np
 
@@ -54,7 +55,7 @@ def kasdin_walter(n: int, alpha: float, rng: np.random.Generator, variance: floa
     return out
 
 
-def _profile(value, t: np.ndarray, name: str) -> np.ndarray | float:
+def _profile(value, t: np.ndarray, name: str) -> Any:
     """A coefficient as a scalar or a per-sample array, validated."""
     if callable(value):
         out = value(t)
@@ -80,7 +81,7 @@ def _profile(value, t: np.ndarray, name: str) -> np.ndarray | float:
         for start, v in pairs:
             arr[t >= start] = v
     elif isinstance(value, (numbers.Real, np.floating, np.integer)) and not isinstance(value, bool):
-        arr = float(value)
+        arr = float(value)  # type: ignore[assignment]  # a constant coefficient stays a scalar
     else:
         raise ParameterError(
             f"{name} must be a number, a callable of t or a list of (t_start, value) pairs, got {value!r}"
@@ -92,7 +93,7 @@ def _profile(value, t: np.ndarray, name: str) -> np.ndarray | float:
 
 
 def _is_zero(p) -> bool:
-    return np.all(np.asarray(p) == 0)
+    return bool(np.all(np.asarray(p) == 0))
 
 
 def simulate(

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -294,7 +294,7 @@ IEEE952_TERMS = {t: tuple([d] + [k for k in v[1] if k != d]) for t, v in _TERMS.
 class Quantity(NamedTuple):
     """A value with its unit label, e.g. ``Quantity(value=0.15, unit='°/√h')``."""
 
-    value: float
+    value: Any
     unit: str
 
 
@@ -329,7 +329,7 @@ def ieee952(term, value, unit, *, to=None) -> Quantity:
     >>> round(ieee952("B", 1e-5, "rad/s").value, 4)  # 1e-5 rad/s in °/h
     2.0626
     """
-    t = _TERM_ALIASES.get(term.lower() if isinstance(term, str) else None)
+    t = _TERM_ALIASES.get(term.lower()) if isinstance(term, str) else None
     if t is None:
         raise ParameterError(
             f"unknown IEEE-952 term {term!r}; allowed: 'Q' (quantization), 'N' (angle random "

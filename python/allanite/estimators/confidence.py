@@ -42,6 +42,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.stats import chi2 as chi2_dist
 
 from .._validate import as_rate_columns, check_choice, check_count, check_probability
 from ..errors import ParameterError
@@ -428,9 +429,7 @@ def _norm_ppf_stable32(p: np.ndarray) -> np.ndarray:
 
 
 def _chi2_ppf(p: float, nu: np.ndarray, method: str) -> np.ndarray:
-    from scipy.stats import chi2
-
-    exact = chi2.ppf(p, nu)
+    exact = chi2_dist.ppf(p, nu)
     if method == "exact":
         return exact
     # Stable32: Wilson–Hilferty (A&S 26.4.17) for ν > 100, an iterative inverse below (converged to

@@ -52,7 +52,7 @@ def m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0,
     if kind == "octave":
         return 2 ** np.arange(0, int(math.floor(math.log2(top))) + 1, dtype=np.int64)
     if kind == "decade":
-        out = []
+        out: list[int] = []
         dec = 1
         while dec <= top:
             out.extend(v for v in (dec, 2 * dec, 4 * dec) if v <= top)

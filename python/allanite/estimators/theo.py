@@ -129,7 +129,8 @@ def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, n
     arr = np.atleast_1d(np.asarray(taus, dtype=np.float64))
     if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
         raise ParameterError(f"taus must be a grid name or a non-empty 1-D sequence of positive τ in s, got {taus!r}")
-    ms, src = [], []
+    m_list: list[int] = []
+    src_list: list[str] = []
     top = n_rate - n_rate % 2
     for i, tau in enumerate(arr):
         s = tau * fs
@@ -137,8 +138,8 @@ def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, n
             m = int(math.floor(s + 0.5))
             if m < 1:
                 raise ParameterError(f"taus[{i}] = {tau:g} s is shorter than one sample (1/fs = {1 / fs:g} s)")
-            ms.append(m)
-            src.append(allan_src)
+            m_list.append(m)
+            src_list.append(allan_src)
             continue
         m = 2 * int(math.floor(s / 1.5 + 0.5))
         if m < THEO1_MIN_M or m > top or (hybrid and 0.75 * m <= k):
@@ -147,17 +148,18 @@ def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, n
                 f"taus[{i}] = {tau:g} s maps to Theo1 m = {m} (τ = 0.75·m/fs); allowed for {n_rate} samples: even m "
                 f"from {lo} to {top}, i.e. τ from {0.75 * lo / fs:g} s to {0.75 * top / fs:g} s"
             )
-        ms.append(m)
-        src.append(theo_src)
-    ms = np.asarray(ms, dtype=np.int64)
-    tau_used = np.where(np.asarray(src) == theo_src, 0.75 * ms, ms.astype(float))
+        m_list.append(m)
+        src_list.append(theo_src)
+    ms = np.asarray(m_list, dtype=np.int64)
+    src = np.asarray(src_list)
+    tau_used = np.where(src == theo_src, 0.75 * ms, ms.astype(float))
     if np.any(np.diff(tau_used) <= 0):
         i = int(np.flatnonzero(np.diff(tau_used) <= 0)[0])
         raise ParameterError(
             f"taus[{i}] = {arr[i]:g} s and taus[{i + 1}] = {arr[i + 1]:g} s map to the same or decreasing τ "
             f"({tau_used[i] / fs:g} s, {tau_used[i + 1] / fs:g} s); τ must be strictly increasing"
         )
-    return ms, np.asarray(src)
+    return ms, src
 
 
 def _tau(ms: np.ndarray, src: np.ndarray, fs: float) -> np.ndarray:

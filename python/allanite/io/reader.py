@@ -17,6 +17,7 @@ import numbers
 import os
 import warnings
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -193,7 +194,7 @@ class Log:
         if self.segments is not None:
             lines.append(
                 f"  segments: {len(self.segments)} "
-                f"({', '.join(f'{a}–{b - 1}' for a, b in self.segment_spans[:6])}"
+                f"({', '.join(f'{a}–{b - 1}' for a, b in (self.segment_spans or [])[:6])}"
                 f"{', …' if len(self.segments) > 6 else ''})"
             )
         return "\n".join(lines)
@@ -336,7 +337,7 @@ class _Record:
     names: list
     time: np.ndarray | None  # float seconds (or time_unit units when time_is_seconds is False)
     time_name: str | None
-    where: object  # callable: sample index → "line 12" / "row 11" / "message 11"
+    where: Callable[[int], str]  # sample index → "line 12" / "row 11" / "message 11"
     time_is_seconds: bool = False
     t_first: float = 0.0  # absolute time of sample 0 when `time` is relative (bags)
     checked_finite: bool = False
@@ -406,7 +407,8 @@ def _check_text(path: Path, gz: bool) -> None:
     except (OSError, EOFError, zlib.error):
         return  # the reader reports a damaged gzip stream with its own message
     bad = sum(head.count(b) for b in _BINARY_BYTES)
-    if head and (b"\x00" in head or bad > max(2, len(head) // 100)):
+    # one stray control byte is a damaged line (the text reader names it); many are not text at all
+    if head and bad > max(2, len(head) // 100):
         kind = "gzip-compressed data that is not text" if gz else "binary data"
         raise InputError(
             f"{path}: not a log allanite can read — it holds {kind} ({bad} control bytes in the first "
@@ -524,8 +526,8 @@ def _finish(path, fmt, rec: _Record, fs, unit, input, gaps) -> Log:
         is_gap = d > GAP_FACTOR * dt
         rel = np.abs(d[~is_gap] - dt) / dt
         jitter = float(rel.max()) if rel.size else 0.0
-        for i in np.flatnonzero(is_gap):
-            i = int(i)
+        for gi in np.flatnonzero(is_gap):
+            i = int(gi)
             dur = float(d[i] - dt)
             gap_list.append(Gap(index=i + 1, time=float(t[i] - t[0]), duration=dur, missing=int(round(dur * fs))))
         if jitter > JITTER_WARN:

@@ -16,7 +16,7 @@ import numpy as np
 __all__ = ["Effect", "EFFECTS", "gm_avar", "sinusoid_avar", "describe"]
 
 
-def gm_avar(tau, tc) -> np.ndarray:
+def gm_avar(tau: np.ndarray | float, tc: float) -> np.ndarray:
     """Allan variance of a first-order Gauss–Markov rate of unit variance and correlation time ``tc``:
     (T_c/τ)²·(2τ/T_c − 3 + 4e^{−τ/T_c} − e^{−2τ/T_c}) (IEEE Std 952 App. C)."""
     tau = np.asarray(tau, dtype=np.float64)
@@ -26,7 +26,7 @@ def gm_avar(tau, tc) -> np.ndarray:
     return np.where(x < 1e-2, small, big)
 
 
-def sinusoid_avar(tau, f0) -> np.ndarray:
+def sinusoid_avar(tau: np.ndarray | float, f0: float) -> np.ndarray:
     """Allan variance of a unit-amplitude rate sinusoid of frequency ``f0``: sin⁴(πf0τ)/(πf0τ)²."""
     u = np.pi * f0 * np.asarray(tau, dtype=np.float64)
     return np.sin(u) ** 4 / u**2

@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy.optimize import nnls as _scipy_nnls
@@ -32,6 +33,7 @@ from ..errors import ParameterError
 from ..estimators import get as get_estimator
 from ..estimators import names as estimator_names
 from ..estimators.confidence import edf_of
+from ..plot import plot_coefficient_series, plot_fit  # matplotlib only when a figure is drawn
 from ..results import AllanResult, DynamicAllanResult
 from ..units import coefficient_unit, ieee952, rate_unit
 from . import _covariance
@@ -75,7 +77,7 @@ class Coefficient:
     def __repr__(self) -> str:
         u = f" {self.unit}" if self.unit else ""
         s = f"{self.name} = {self.value:.4g}{u} [{self.ci[0]:.4g}, {self.ci[1]:.4g}]"
-        if self.ieee is not None:
+        if self.ieee is not None and self.ieee_ci is not None:
             s += f" = {self.ieee:.4g} {self.ieee_unit} [{self.ieee_ci[0]:.4g}, {self.ieee_ci[1]:.4g}]"
         return s
 
@@ -130,8 +132,8 @@ class NoiseFit:
     iterations: int = 0
     method: str = "wls"
     notes: tuple = ()
-    theta: np.ndarray = field(default=None)
-    covariance: np.ndarray = field(default=None)
+    theta: np.ndarray = field(default=None)  # type: ignore[arg-type]  # always set by fit
+    covariance: np.ndarray = field(default=None)  # type: ignore[arg-type]
 
     def curve(self, tau) -> np.ndarray:
         """The fitted Allan variance at any τ (s)."""
@@ -157,8 +159,6 @@ class NoiseFit:
 
     def plot(self, ax=None, **kwargs):
         """ADEV estimates with the fitted model and each term as its own line."""
-        from ..plot import plot_fit  # matplotlib is imported only when a figure is drawn
-
         return plot_fit(self, ax=ax, **kwargs)
 
 
@@ -189,8 +189,6 @@ class CoefficientSeries:
 
     def plot(self, axes=None, ieee: bool = True):
         """Each coefficient against time, with its interval band."""
-        from ..plot import plot_coefficient_series  # matplotlib is imported only when a figure is drawn
-
         return plot_coefficient_series(self, axes=axes, ieee=ieee)
 
 
@@ -259,7 +257,7 @@ def _fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
 
 
 def _exact_covariance_applies(tau, m, fs, n_points, estimator) -> bool:
-    return (
+    return bool(
         isinstance(estimator, str)
         and estimator == "oavar"
         and np.allclose(tau * fs, m, rtol=1e-9)
@@ -470,7 +468,7 @@ def readoffs(result: AllanResult, adev_row: np.ndarray) -> dict:
     (``readoff_tau_max`` is the longest such τ): a minimum at a τ with ν ≈ 1 is the estimate's scatter.
     """
     tau = result.tau
-    out = {}
+    out: dict[str, Any] = {}
     if tau[0] <= 1.0 <= tau[-1]:
         # log-log interpolation between the neighbours of 1 s (exact when 1 s is on the grid)
         out["adev_at_1s"] = float(np.exp(np.interp(0.0, np.log(tau), np.log(adev_row))))
@@ -910,7 +908,7 @@ def information_bound(n: int, fs: float, *, Q: float = 0.0, N: float = 0.0, B: f
             theta.append(v * v)
     if not terms:
         raise ParameterError("information_bound needs at least one nonzero coefficient among Q, N, B, K")
-    theta = np.array(theta)
+    theta_arr = np.array(theta)
     info = np.zeros((len(terms), len(terms)))
     n_freq = n // 2
     chunk = 1 << 20
@@ -920,8 +918,8 @@ def information_bound(n: int, fs: float, *, Q: float = 0.0, N: float = 0.0, B: f
         s2 = np.sin(np.pi * f * tau0) ** 2
         cols = {"Q": 8.0 * s2 / tau0, "N": np.full_like(f, 2.0), "B": 1.0 / (np.pi * f), "K": tau0 * tau0 / (2.0 * s2)}
         d = np.array([cols[t] for t in terms])
-        spec = theta @ d
+        spec = theta_arr @ d
         dw = d / spec
         info += dw @ dw.T
     cov = np.linalg.inv(info)
-    return {t: float(math.sqrt(cov[i, i]) / (2.0 * theta[i])) for i, t in enumerate(terms)}
+    return {t: float(math.sqrt(cov[i, i]) / (2.0 * theta_arr[i])) for i, t in enumerate(terms)}

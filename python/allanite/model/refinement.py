@@ -451,8 +451,8 @@ class Refinement:
     hold the added effects' parameters), ``start`` the starting model, ``steps`` the effects added."""
 
     steps: list
-    fit: object
-    start: object
+    fit: fitting.NoiseFit
+    start: fitting.NoiseFit
     result: AllanResult
     terms: tuple
     effects: list = field(default_factory=list)
@@ -672,7 +672,7 @@ def refine(
     steps: list = []
     sol = _solve(curve, start, effects)
     start_sol = sol
-    considered = {}
+    considered: dict[str, list] = {}
     tmin, tmax = curve.tau[0], curve.tau[-1]
     for _ in range(MAX_STEPS):
         if sol.chi2_dof <= GOOD_CHI2_DOF:

@@ -70,7 +70,7 @@ def check_terms(terms: object) -> tuple[str, ...]:
     if isinstance(terms, str):
         terms = (terms,)
     try:
-        given = tuple(terms)  # type: ignore[arg-type]
+        given: tuple[str, ...] = tuple(terms)  # type: ignore[arg-type]
     except TypeError:
         raise ParameterError(f"terms must be a sequence of {TERMS}, got {terms!r}") from None
     bad = [t for t in given if t not in TERMS]

@@ -41,8 +41,10 @@ from .._validate import check_choice, check_count
 from ..analysis import avar, davar
 from ..errors import AllaniteError, ParameterError
 from ..estimators.theo import resolve_decimation
+from ..model import Refinement
 from ..model import fit as fit_model
 from ..model import refine as refine_axis
+from ..results import AllanResult, DynamicAllanResult
 from ..units import adev_unit_label, parse_unit
 from .figures import figure_specs
 from .fmt import json_number
@@ -92,8 +94,8 @@ class Report:
         Things the reader must know (unit unknown, gaps, warnings while reading).
     """
 
-    static: object
-    dynamic: object
+    static: AllanResult
+    dynamic: DynamicAllanResult
     fits: list | None
     series: list | None
     fs: float
@@ -108,7 +110,7 @@ class Report:
     series_error: str | None = None
     created: str = ""
     #: per axis :class:`~allanite.Refinement` (``refine=True``), else None
-    refinements: list | None = None
+    refinements: list[Refinement | None] | None = None
     _summary: dict | None = field(default=None, repr=False)
 
     # ---------------------------------------------------------------------------- properties
@@ -361,7 +363,7 @@ def build_report(
     else:
         progress.add(2)
 
-    refinements = None
+    refinements: list[Refinement | None] | None = None
     if refine:
         progress.step("model refinement")
         refinements = []

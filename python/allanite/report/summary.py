@@ -420,9 +420,10 @@ def text_summary(s: dict) -> str:
                 lines.append(f"  {ax['name']}: failed (see the notes)")
                 continue
             found = ", ".join(st["effect"] for st in ax["steps"]) or "nothing added"
+            a, b = ax["start"], ax["final"]
             lines.append(
-                f"  {ax['name']}: {found}; curve χ²/dof {g(ax['start']['chi2_dof'], 3)} → {g(ax['final']['chi2_dof'], 3)}, "
-                f"RMS ADEV error {g(ax['start']['rms_adev_pct'], 3)} → {g(ax['final']['rms_adev_pct'], 3)} %"
+                f"  {ax['name']}: {found}; curve χ²/dof {g(a['chi2_dof'], 3)} → {g(b['chi2_dof'], 3)}, "
+                f"RMS ADEV error {g(a['rms_adev_pct'], 3)} → {g(b['rms_adev_pct'], 3)} %"
             )
             for st in ax["steps"]:
                 params = ", ".join(f"{p} = {g(v, 3)} {st['units'][p]}" for p, v in st["params"].items())
