@@ -146,7 +146,8 @@ class Accuracy:
     Attributes
     ----------
     C : float
-        S2/S1, the residual SD over the data SD (``inf`` when S1 = 0 and S2 > 0, 0 when both are 0).
+        S2/S1, the residual SD over the data SD. For constant data (S1 at round-off level) C = 0 and
+        P = 1 when S2 is at round-off level too, else C = inf and P = 0.
     P : float
         Small-error probability: share of residuals with |e − ē| < 0.6745·S1.
     c_grade : int
@@ -204,11 +205,16 @@ def accuracy(
     e = x - p
     S1 = float(np.std(x, ddof=ddof))
     S2 = float(np.std(e, ddof=ddof))
-    if S1 > 0:
+    # Constant data (S1 at round-off level): C is 0/0. Call a residual spread at round-off level a
+    # perfect fit (C = 0, P = 1) and anything more an infinitely bad one (C = inf, P = 0).
+    tol = 64 * np.finfo(np.float64).eps * max(float(np.max(np.abs(x))), float(np.max(np.abs(p))), 1e-300)
+    if S1 > tol:
         C = S2 / S1
+        P = float(np.mean(np.abs(e - e.mean()) < 0.6745 * S1))
+    elif S2 <= tol:
+        C, P = 0.0, 1.0
     else:
-        C = 0.0 if S2 == 0 else math.inf
-    P = float(np.mean(np.abs(e - e.mean()) < 0.6745 * S1))
+        C, P = math.inf, 0.0
     return Accuracy(C, P, c_grade(C), joint_grade(C, P), S1, S2, int(x.size), sd, bool(include_first))
 
 
@@ -359,7 +365,7 @@ class GM11(_Forecaster):
         if nonpos.size and not allow_nonpositive:
             i = int(nonpos[0])
             raise InputError(
-                f"series[{i}] = {x[i]!r} is not positive ({nonpos.size} value(s) <= 0); GM(1,1) needs positive "
+                f"series[{i}] = {float(x[i])!r} is not positive ({nonpos.size} value(s) <= 0); GM(1,1) needs positive "
                 "values. A noise coefficient at 0 usually means the fit did not resolve that term: do not "
                 "forecast it. If the values are genuinely signed, pass allow_nonpositive=True (shift='auto' "
                 "then adds a constant) or shift=<number>."
@@ -369,7 +375,7 @@ class GM11(_Forecaster):
             c = 0.0
             if nonpos.size:
                 raise ParameterError(
-                    f"shift=None but series[{int(nonpos[0])}] = {x[nonpos[0]]!r} is not positive; "
+                    f"shift=None but series[{int(nonpos[0])}] = {float(x[nonpos[0]])!r} is not positive; "
                     "use shift='auto' or a number"
                 )
             if not self.level_ratio.passed:
@@ -393,7 +399,7 @@ class GM11(_Forecaster):
                 raise ParameterError(f"shift = {shift!r} is not allowed; use 'auto', a number or None") from None
             if not np.isfinite(c) or np.min(x) + c <= 0:
                 raise ParameterError(
-                    f"shift = {shift!r} leaves min(series) + shift = {np.min(x) + c!r} <= 0; GM(1,1) needs "
+                    f"shift = {shift!r} leaves min(series) + shift = {float(np.min(x) + c)!r} <= 0; GM(1,1) needs "
                     "positive values"
                 )
             if c:
@@ -689,31 +695,43 @@ class _ResidualCorrected:
         self.on = on
         self.applied = False
         self.reason = ""
+        # The last 1-AGO residual is Σx⁰ − x̂¹(n), which the least squares leaves close to 0, so its sign is
+        # often noise: a same-sign run may end at the last or the second-to-last index.
         if residual_from == "auto":
-            # start of the longest same-sign tail of nonzero residuals; GM(1,1) needs ≥ 4 of them
-            s = np.sign(q[-1])
-            i = n - 1
-            while i > 0 and np.sign(q[i - 1]) == s and s != 0:
-                i -= 1
-            if s == 0 or n - i < 4:
-                self.reason = f"no same-sign residual tail of 4 or more values (tail from index {i})"
+            i, end = None, None
+            for stop in (n, n - 1):
+                s = np.sign(q[stop - 1])
+                j = stop - 1
+                while s != 0 and j > 0 and np.sign(q[j - 1]) == s:
+                    j -= 1
+                if s != 0 and stop - j >= 4 and (i is None or stop - j > end - i):
+                    i, end = j, stop
+            if i is None:
+                self.reason = "no same-sign run of 4 or more residuals ending at the last or second-to-last value"
                 self.i = None
                 return
         else:
-            i = int(residual_from)
-            if not (1 <= i <= n - 4):
+            if isinstance(residual_from, bool) or not isinstance(residual_from, (int, np.integer)) or not (
+                1 <= residual_from <= n - 4
+            ):
                 raise ParameterError(
                     f"residual_from = {residual_from!r} must be 'auto' or an index in 1..{n - 4} (4 residuals needed)"
                 )
-            tail = q[i:]
-            if not (np.all(tail > 0) or np.all(tail < 0)):
+            i = int(residual_from)
+            end = None
+            for stop in (n, n - 1):
+                tail = q[i:stop]
+                if tail.size >= 4 and (np.all(tail > 0) or np.all(tail < 0)):
+                    end = stop
+                    break
+            if end is None:
                 raise ParameterError(
                     f"residual_from = {i}: the residuals from there change sign (or are 0); the residual GM(1,1) "
-                    "needs a same-sign tail — use 'auto' or a later index"
+                    "needs a same-sign run to the last or second-to-last value — use 'auto' or a later index"
                 )
-        self.i = i
-        self.sign = float(np.sign(q[-1]))
-        self.model = GM11(self.sign * q[i:], shift="auto", allow_nonpositive=False)
+        self.i, self.end = i, end
+        self.sign = float(np.sign(q[end - 1]))
+        self.model = GM11(self.sign * q[i:end], shift="auto", allow_nonpositive=False)
         self.applied = True
 
     def _correction_series(self, k: np.ndarray) -> np.ndarray:
@@ -756,8 +774,10 @@ class ImprovedGM11(_Forecaster):
        k ≥ i on the 1-AGO series (``residual_on="ago"``, eq. 16), modelled by a GM(1,1) of sign·q;
        x̂¹ gets sign·q̂ added for k ≥ i and is restored by differencing, as GM11 restores. (Eq. 18 as
        printed adds the residual model's value to x̂⁰ directly; that matches ``residual_on="series"``,
-       where q = x⁰ − x̂⁰.) ``residual_from="auto"`` takes the longest same-sign tail of residuals; if it is
-       shorter than 4 the correction is skipped and said so in ``notes``.
+       where q = x⁰ − x̂⁰.) ``residual_from="auto"`` takes the longest run of same-sign residuals that ends at
+       the last or the second-to-last value (the last 1-AGO residual, Σx⁰ − x̂¹(n), is held near 0 by the
+       least squares, so its sign is often noise; a run ending before it leaves it out of the residual
+       model); with no such run of 4 or more the correction is skipped and said so in ``notes``.
     5. ``metabolic`` — forecasts by the metabolic (rolling) re-fit: predict one step, append the prediction,
        drop the oldest value, re-fit steps 3–4, repeat (paper 004 §3.2 step 3: the new value is the
        model's own (n+1)-th value). Without it, ``predict(h)`` extrapolates the one model.
@@ -821,7 +841,7 @@ class ImprovedGM11(_Forecaster):
         if nonpos.size:
             i = int(nonpos[0])
             raise InputError(
-                f"series[{i}] = {x[i]!r} is not positive ({nonpos.size} value(s) <= 0); GM(1,1) needs positive "
+                f"series[{i}] = {float(x[i])!r} is not positive ({nonpos.size} value(s) <= 0); GM(1,1) needs positive "
                 "values. A noise coefficient at 0 usually means the fit did not resolve that term: do not "
                 "forecast it (or use GM11(..., allow_nonpositive=True) for genuinely signed data)."
             )
@@ -915,6 +935,11 @@ class Score:
         Paper 004's rule: a-posteriori values over build and check together — the in-sample ``fitted``
         against the series the model was fitted to (``processed`` for the improved model, else the raw
         build), then ``forecast`` against the raw check — with x⁰(1) left out.
+    rmse : float
+        Root-mean-square forecast error against the raw check values.
+    bias : float
+        Mean of (check − forecast). C and P ignore a constant offset (S2 is the SD of e about its mean,
+        so any constant forecast has C = 1 exactly); ``bias`` and ``rmse`` show it.
     model : object
         The fitted model.
     """
@@ -923,6 +948,8 @@ class Score:
     forecast: np.ndarray
     honest: Accuracy
     paper_rule: Accuracy
+    rmse: float
+    bias: float
     model: Any = field(repr=False)
 
     @property
@@ -985,4 +1012,13 @@ def score(
     paper = accuracy(
         np.concatenate([basis, c]), np.concatenate([model.fitted, fc]), sd=sd, include_first=False
     )
-    return Score(name or getattr(model, "name", str(method)), fc, honest, paper, model)
+    e = c - fc
+    return Score(
+        name or getattr(model, "name", str(method)),
+        fc,
+        honest,
+        paper,
+        float(np.sqrt(np.mean(e * e))),
+        float(np.mean(e)),
+        model,
+    )
