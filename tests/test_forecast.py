@@ -319,15 +319,31 @@ def test_residual_correction_from_index():
     assert (auto._rc.i, auto._rc.end) == (36, 59)
     with pytest.raises(ParameterError, match=r"residual_from = 1: the residuals from there change sign"):
         ImprovedGM11(x, detect=False, smooth=False, metabolic=False, residual_from=1)
-    with pytest.raises(ParameterError, match=r"residual_from = 58 must be 'auto' or an index in 1\.\.56"):
+    with pytest.raises(ParameterError, match=r"residual_from = 58 must be 'auto' or an index in 1\.\.54 \(6 residuals"):
         ImprovedGM11(x, detect=False, smooth=False, metabolic=False, residual_from=58)
+
+
+def test_residual_guards():
+    x = _drifting(noise=0.0) + 0.02 * np.sin(np.arange(60) / 6.0)
+    base = ImprovedGM11(x, detect=False, smooth=False, metabolic=False, residual=False)
+    m = ImprovedGM11(x, detect=False, smooth=False, metabolic=False, residual_from=40, residual_max_a=1e-6)
+    assert not m._rc.applied
+    assert "residual model |a'| = " in " ".join(m.notes) and "exceeds residual_max_a = 1e-06" in " ".join(m.notes)
+    np.testing.assert_array_equal(m.fitted, base.fitted)
+    # the run 36..58 has 23 residuals: a minimum of 24 rules it out
+    long = ImprovedGM11(x, detect=False, smooth=False, metabolic=False, residual_min_len=24)
+    assert not long._rc.applied and "no same-sign run of 24 or more" in " ".join(long.notes)
+    with pytest.raises(ParameterError, match=r"residual_min_len = 3 must be an integer >= 4"):
+        ImprovedGM11(x, residual_min_len=3)
+    with pytest.raises(ParameterError, match=r"residual_max_a = -1\.0 must be a positive number"):
+        ImprovedGM11(x, residual_max_a=-1.0)
 
 
 def test_residual_skipped_is_said():
     x = np.array([1.0, 1.2, 1.1, 1.3, 1.2, 1.4, 1.3, 1.5])  # 1-AGO residuals alternate in sign
     m = ImprovedGM11(x, detect=False, smooth=False, metabolic=False, residual=True)
     assert not m._rc.applied
-    assert "residual correction skipped: no same-sign run of 4" in " ".join(m.notes)
+    assert "residual correction skipped: no same-sign run of 6" in " ".join(m.notes)
     np.testing.assert_allclose(m.fitted, GM11(x).fitted, rtol=1e-14)
 
 

@@ -682,7 +682,7 @@ def _smooth(x: np.ndarray, wavelet: str, level: int | None, mode: str) -> tuple[
 class _ResidualCorrected:
     """A GM(1,1) with the residual GM(1,1) correction of paper 004 eqs. 16–18 (1-AGO domain)."""
 
-    def __init__(self, base: GM11, residual_from: int | str, on: str) -> None:
+    def __init__(self, base: GM11, residual_from: int | str, on: str, min_len: int = 6, max_a: float = 0.3) -> None:
         self.base = base
         y = base._y  # shifted series the base model fitted
         n = y.size
@@ -704,24 +704,27 @@ class _ResidualCorrected:
                 j = stop - 1
                 while s != 0 and j > 0 and np.sign(q[j - 1]) == s:
                     j -= 1
-                if s != 0 and stop - j >= 4 and (i is None or stop - j > end - i):
+                if s != 0 and stop - j >= min_len and (i is None or stop - j > end - i):
                     i, end = j, stop
             if i is None:
-                self.reason = "no same-sign run of 4 or more residuals ending at the last or second-to-last value"
+                self.reason = (
+                    f"no same-sign run of {min_len} or more residuals ending at the last or second-to-last value"
+                )
                 self.i = None
                 return
         else:
             if isinstance(residual_from, bool) or not isinstance(residual_from, (int, np.integer)) or not (
-                1 <= residual_from <= n - 4
+                1 <= residual_from <= n - min_len
             ):
                 raise ParameterError(
-                    f"residual_from = {residual_from!r} must be 'auto' or an index in 1..{n - 4} (4 residuals needed)"
+                    f"residual_from = {residual_from!r} must be 'auto' or an index in 1..{n - min_len} "
+                    f"({min_len} residuals needed, residual_min_len)"
                 )
             i = int(residual_from)
             end = None
             for stop in (n, n - 1):
                 tail = q[i:stop]
-                if tail.size >= 4 and (np.all(tail > 0) or np.all(tail < 0)):
+                if tail.size >= min_len and (np.all(tail > 0) or np.all(tail < 0)):
                     end = stop
                     break
             if end is None:
@@ -732,6 +735,13 @@ class _ResidualCorrected:
         self.i, self.end = i, end
         self.sign = float(np.sign(q[end - 1]))
         self.model = GM11(self.sign * q[i:end], shift="auto", allow_nonpositive=False)
+        if abs(self.model.a) > max_a:
+            # e^{−a'k} over a 30-step horizon: |a'| = 0.2 already multiplies the correction by 400
+            self.reason = (
+                f"residual model |a'| = {abs(self.model.a):.3g} exceeds residual_max_a = {max_a:g} "
+                f"(run {i}..{end - 1}); its extrapolation would explode"
+            )
+            return
         self.applied = True
 
     def _correction_series(self, k: np.ndarray) -> np.ndarray:
@@ -777,7 +787,11 @@ class ImprovedGM11(_Forecaster):
        where q = x⁰ − x̂⁰.) ``residual_from="auto"`` takes the longest run of same-sign residuals that ends at
        the last or the second-to-last value (the last 1-AGO residual, Σx⁰ − x̂¹(n), is held near 0 by the
        least squares, so its sign is often noise; a run ending before it leaves it out of the residual
-       model); with no such run of 4 or more the correction is skipped and said so in ``notes``.
+       model); with no such run of ``residual_min_len`` (default 6; GM(1,1)'s minimum is 4) or more, or
+       when the residual model's |a'| exceeds ``residual_max_a`` (default 0.3, the usual bound of
+       GM(1,1) for more than short-term forecasts: beyond it e^{−a'k} explodes over the horizon — on a
+       4-point run an a' = −0.21 turned a 30-step K forecast into −49 for data near 0.5), the
+       correction is skipped and said so in ``notes``.
     5. ``metabolic`` — forecasts by the metabolic (rolling) re-fit: predict one step, append the prediction,
        drop the oldest value, re-fit steps 3–4, repeat (paper 004 §3.2 step 3: the new value is the
        model's own (n+1)-th value). Without it, ``predict(h)`` extrapolates the one model.
@@ -796,6 +810,8 @@ class ImprovedGM11(_Forecaster):
         First 0-based index of the residual model.
     residual_on : {"ago", "series"}
         Residual of the 1-AGO series (eq. 16) or of the series itself.
+    residual_min_len, residual_max_a : int, float
+        Guards of the residual model (see step 4).
     shift, sd, include_first
         As in :class:`GM11`.
 
@@ -831,6 +847,8 @@ class ImprovedGM11(_Forecaster):
         wavelet_mode: str = "symmetric",
         residual_from: int | str = "auto",
         residual_on: str = "ago",
+        residual_min_len: int = 6,
+        residual_max_a: float = 0.3,
         shift: str | float | None = "auto",
         sd: str = "population",
         include_first: bool = True,
@@ -860,7 +878,13 @@ class ImprovedGM11(_Forecaster):
         self.steps = {"detect": bool(detect), "smooth": bool(smooth), "metabolic": bool(metabolic),
                       "residual": bool(residual)}
         self.notes: list[str] = []
+        if isinstance(residual_min_len, bool) or not isinstance(residual_min_len, (int, np.integer)) or \
+                residual_min_len < 4:
+            raise ParameterError(f"residual_min_len = {residual_min_len!r} must be an integer >= 4")
+        if not (np.isfinite(residual_max_a) and residual_max_a > 0):
+            raise ParameterError(f"residual_max_a = {residual_max_a!r} must be a positive number")
         self._opts = dict(residual=bool(residual), residual_from=residual_from, residual_on=residual_on,
+                          residual_min_len=int(residual_min_len), residual_max_a=float(residual_max_a),
                           shift=shift)
         y = x
         self.detection: Detection | None = None
@@ -888,7 +912,8 @@ class ImprovedGM11(_Forecaster):
         m = GM11(y, shift=self._opts["shift"], sd=self.sd, include_first=self.include_first,
                  allow_nonpositive=True)
         if self._opts["residual"]:
-            rc = _ResidualCorrected(m, self._opts["residual_from"], self._opts["residual_on"])
+            rc = _ResidualCorrected(m, self._opts["residual_from"], self._opts["residual_on"],
+                                    self._opts["residual_min_len"], self._opts["residual_max_a"])
         else:
             rc = _ResidualCorrected.__new__(_ResidualCorrected)
             rc.base, rc.applied, rc.reason, rc.on = m, False, "switched off", "ago"
