@@ -19,17 +19,19 @@ effect is visible); persistence; build mean; linear trend; Holt.
 A term whose series has values ≤ 0 (the fit did not resolve it) is reported as not forecastable.
 
 The demo (``python benches/paper004_forecast.py``) runs it on synthetic coefficient series that really
-drift: ARW rising 30 % along a warm-up curve (time constant 45 frames, so it still rises by ≈ 4 % in the
-check part), bias instability stepping once by 20 %, the other terms
-constant, each with multiplicative (log-normal) frame-to-frame estimation noise of a size typical of a
-per-frame Allan fit (Q 5 %, N 3 %, B 10 %, K 25 %, R 40 %). ``--seeds S`` repeats it over S seeds and
-reports the mean and spread of C (a C from 30 values is itself noisy). ``--out FILE`` also writes the
-markdown.
+drift (see :func:`synthetic_coefficients`): ARW rising 30 % along a warm-up curve (scenario ``warmup``:
+mostly in the build part; ``steady``: almost linear, still rising in the check part), bias instability
+stepping once by 20 %, the other terms constant, each with multiplicative (log-normal) frame-to-frame
+estimation noise of a size typical of a per-frame Allan fit (Q 5 %, N 3 % / 1 %, B 10 %, K 25 %,
+R 40 %). A "true curve (oracle)" row forecasts with the noise-free truth: the best C this check part
+allows. ``--seeds S`` repeats it over S seeds and reports the mean and spread of C (a C from 30 values is
+itself noisy) and the median RMSE relative to persistence. ``--out FILE`` also writes the markdown.
 
 Usage::
 
     python benches/paper004_forecast.py                 # one seed, tables on stdout
-    python benches/paper004_forecast.py --seeds 50      # mean ± SD of C over 50 seeds
+    python benches/paper004_forecast.py --seeds 50      # + mean ± SD of C over 50 seeds (≈ 30 s);
+                                                        #   recorded in benches/results/paper004_synthetic.md
 """
 
 from __future__ import annotations
@@ -38,10 +40,10 @@ import argparse
 import functools
 import math
 import sys
-from typing import Any, Callable, Mapping
+from collections.abc import Mapping
+from typing import Any, Callable
 
 import numpy as np
-
 from allanite.errors import AllaniteError
 from allanite.forecast import (
     GM11,
@@ -55,7 +57,7 @@ from allanite.forecast import (
     split,
 )
 
-ALL_OFF = dict(detect=False, smooth=False, metabolic=False, residual=False)
+ALL_OFF = {"detect": False, "smooth": False, "metabolic": False, "residual": False}
 
 
 def default_methods() -> dict[str, Callable[..., Any]]:
@@ -81,6 +83,7 @@ def forecast_table(
     check: int = 30,
     methods: Mapping[str, Callable[..., Any]] | None = None,
     sd: str = "population",
+    truth: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """C/P of every method's forecast of every coefficient series.
 
@@ -93,6 +96,9 @@ def forecast_table(
     methods : mapping, optional
         Name → model factory; default :func:`default_methods`.
     sd : {"population", "sample"}
+    truth : mapping, optional
+        Term → the noise-free per-frame values (simulations only). Adds a row "true curve (oracle)" whose
+        forecast is the truth itself: the best C any method could reach on this check part.
 
     Returns
     -------
@@ -104,6 +110,8 @@ def forecast_table(
         improved model — no forecast involved) and ``notes``.
     """
     methods = dict(methods or default_methods())
+    if truth is not None:
+        methods["true curve (oracle)"] = None  # filled per term below
     out: dict[str, Any] = {"terms": [], "methods": list(methods), "cells": {m: {} for m in methods}, "skipped": {}}
     for term, values in coefficients.items():
         x = np.asarray(values, dtype=np.float64)
@@ -115,6 +123,8 @@ def forecast_table(
         out["terms"].append(term)
         smoothed_check = None
         for name, factory in methods.items():
+            if factory is None:
+                factory = functools.partial(_Oracle, truth=np.asarray(truth[term], dtype=np.float64))
             try:
                 s = score(factory, b, c, sd=sd, name=name)
             except AllaniteError as exc:
@@ -144,6 +154,21 @@ def forecast_table(
     return out
 
 
+class _Oracle:
+    """'Forecast' = the true noise-free curve (simulation only): the floor of C on a check part."""
+
+    name = "true curve (oracle)"
+
+    def __init__(self, series: Any, *, truth: np.ndarray) -> None:
+        self.n = len(series)
+        self.fitted = truth[: self.n]
+        self.truth = truth
+        self.accuracy = accuracy(series, self.fitted)
+
+    def predict(self, h: int) -> np.ndarray:
+        return self.truth[self.n : self.n + h]
+
+
 def _fmt(v: float | None, nd: int = 2) -> str:
     if v is None:
         return "—"
@@ -168,7 +193,8 @@ def to_markdown(table: Mapping[str, Any], *, title: str = "") -> str:
             for t in terms:
                 cell = cells[m].get(t)
                 row.append("error" if cell is None or "error" in cell else fn(cell))
-            lines.append(f"| {m.strip() if not m.startswith('  ') else '&nbsp;&nbsp;' + m.strip()} | " + " | ".join(row) + " |")
+            label = m.strip() if not m.startswith("  ") else "&nbsp;&nbsp;" + m.strip()
+            lines.append(f"| {label} | " + " | ".join(row) + " |")
 
     block("honest: C (Table 2 grade) / P of the forecast vs the raw check values",
           lambda c: f"{_fmt(c['C'])} ({c['c_grade']}) / {_fmt(c['P'])}")
@@ -193,36 +219,61 @@ def to_markdown(table: Mapping[str, Any], *, title: str = "") -> str:
 #: term → (nominal value, relative frame noise); units as the rest of allanite's fit output
 SYNTH = {"Q": (2.0e-6, 0.05), "N": (0.10, 0.03), "B": (1.0, 0.10), "K": (0.5, 0.25), "R": (0.05, 0.40)}
 
+#: scenario → (warm-up time constant of the ARW rise in frames, relative frame noise of N)
+SCENARIOS = {"warmup": (45.0, 0.03), "steady": (400.0, 0.01)}
 
-def synthetic_coefficients(seed: int = 0, frames: int = 90) -> dict[str, np.ndarray]:
-    """Per-frame coefficient series that drift: ARW +30 % along a warm-up curve 1 − e^{−t/45 frames}
-    (scaled to reach +30 % at the last frame), bias instability +20 % from frame 45, the rest constant;
-    each value times exp(σ·ε − σ²/2), ε standard normal, σ the term's relative frame noise."""
+
+def synthetic_coefficients(
+    seed: int = 0, frames: int = 90, scenario: str = "warmup"
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """Per-frame coefficient series that drift, and their noise-free truth.
+
+    ARW rises 30 % over the record along 1 − e^{−t/τ} (scaled to reach +30 % at the last frame):
+    ``warmup`` τ = 45 frames (most of the rise in the build part, ≈ 4 % left in the check part, N frame
+    noise 3 %); ``steady`` τ = 400 frames (almost a straight line, ≈ 10 % rise in the check part, N
+    frame noise 1 %). Bias instability steps +20 % at frame 45; Q, K, R constant. Each value is the
+    truth times exp(σ·ε − σ²/2), ε standard normal, σ the term's relative frame noise (``SYNTH``)."""
+    tau, n_noise = SCENARIOS[scenario]
     rng = np.random.default_rng(seed)
     k = np.arange(frames, dtype=np.float64)
-    warm = (1 - np.exp(-k / 45.0)) / (1 - np.exp(-(frames - 1) / 45.0))
+    warm = (1 - np.exp(-k / tau)) / (1 - np.exp(-(frames - 1) / tau))
     trend = {"Q": np.ones(frames), "N": 1 + 0.3 * warm, "B": np.where(k >= 45, 1.2, 1.0),
              "K": np.ones(frames), "R": np.ones(frames)}
-    out = {}
+    out, truth = {}, {}
     for term, (nominal, sigma) in SYNTH.items():
-        out[term] = nominal * trend[term] * np.exp(sigma * rng.standard_normal(frames) - 0.5 * sigma**2)
-    return out
+        if term == "N":
+            sigma = n_noise
+        truth[term] = nominal * trend[term]
+        out[term] = truth[term] * np.exp(sigma * rng.standard_normal(frames) - 0.5 * sigma**2)
+    return out, truth
 
 
 def _mean_table(tables: list[dict[str, Any]]) -> str:
     t0 = tables[0]
     terms, methods = t0["terms"], t0["methods"]
-    lines = ["", f"**honest C over {len(tables)} seeds: mean ± SD (share of seeds in grade 1–2); "
-                 "paper-rule C mean in brackets**", "",
-             "| method | " + " | ".join(terms) + " |", "|---|" + "---|" * len(terms)]
-    for m in methods:
-        row = []
-        for t in terms:
-            cs = np.array([tb["cells"][m][t]["C"] for tb in tables if "C" in tb["cells"][m].get(t, {})])
-            cp = np.array([tb["cells"][m][t]["C_paper"] for tb in tables if "C" in tb["cells"][m].get(t, {})])
-            good = np.mean(cs < 0.5)
-            row.append(f"{np.mean(cs):.2f} ± {np.std(cs):.2f} ({100 * good:.0f} %) [{np.mean(cp):.2f}]")
-        lines.append(f"| {m.strip() if not m.startswith('  ') else '&nbsp;&nbsp;' + m.strip()} | " + " | ".join(row) + " |")
+
+    def rows(head: str, fn: Callable[[str, str], str]) -> list[str]:
+        out = ["", head, "", "| method | " + " | ".join(terms) + " |", "|---|" + "---|" * len(terms)]
+        for m in methods:
+            label = m.strip() if not m.startswith("  ") else "&nbsp;&nbsp;" + m.strip()
+            out.append(f"| {label} | " + " | ".join(fn(m, t) for t in terms) + " |")
+        return out
+
+    def vals(m: str, t: str, key: str) -> np.ndarray:
+        return np.array([tb["cells"][m][t][key] for tb in tables if key in tb["cells"][m].get(t, {})])
+
+    def c_cell(m: str, t: str) -> str:
+        cs, cp = vals(m, t, "C"), vals(m, t, "C_paper")
+        return f"{np.mean(cs):.2f} ± {np.std(cs):.2f} ({100 * np.mean(cs < 0.5):.0f} %) [{np.mean(cp):.2f}]"
+
+    def r_cell(m: str, t: str) -> str:
+        r = vals(m, t, "rmse") / vals("persistence", t, "rmse")
+        return f"{np.median(r):.2f}"
+
+    lines = rows(f"**honest C over {len(tables)} seeds: mean ± SD (share of seeds with C < 0.5, grade 1–2); "
+                 "paper-rule C mean in brackets**", c_cell)
+    lines += rows(f"**RMSE of the 30-frame forecast / RMSE of persistence, median over {len(tables)} seeds "
+                  "(< 1: better than the last value)**", r_cell)
     return "\n".join(lines) + "\n"
 
 
@@ -230,12 +281,22 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--seeds", type=int, default=0, help="also average C over this many seeds")
+    ap.add_argument("--scenario", choices=sorted(SCENARIOS), action="append",
+                    help="synthetic scenario(s); default both")
     ap.add_argument("--out", default=None, help="write the markdown here too")
     args = ap.parse_args(argv)
-    text = to_markdown(forecast_table(synthetic_coefficients(args.seed)),
-                       title=f"synthetic drifting coefficients, seed {args.seed}, 60 build / 30 check")
-    if args.seeds:
-        text += _mean_table([forecast_table(synthetic_coefficients(s)) for s in range(args.seeds)])
+    text = ""
+    for scen in args.scenario or ["warmup", "steady"]:
+        coeffs, truth = synthetic_coefficients(args.seed, scenario=scen)
+        text += to_markdown(forecast_table(coeffs, truth=truth),
+                            title=f"synthetic '{scen}', seed {args.seed}, 60 build / 30 check")
+        if args.seeds:
+            tables = []
+            for sd in range(args.seeds):
+                c, t = synthetic_coefficients(sd, scenario=scen)
+                tables.append(forecast_table(c, truth=t))
+            text += _mean_table(tables)
+        text += "\n"
     sys.stdout.write(text)
     if args.out:
         with open(args.out, "w", encoding="utf-8") as fh:

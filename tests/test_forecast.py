@@ -8,7 +8,6 @@ import math
 
 import numpy as np
 import pytest
-
 from allanite.errors import InputError, ParameterError
 from allanite.forecast import (
     GM11,
@@ -438,3 +437,50 @@ def test_bad_options():
         ImprovedGM11(CLASSIC, detect_threshold=0)
     with pytest.raises(InputError, match=r"actual has 5 values but predicted has 4"):
         accuracy(CLASSIC, CLASSIC[:4])
+
+
+# ---------------------------------------------------------------------------------------------- bench
+
+
+def _bench():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benches" / "paper004_forecast.py"
+    if not path.is_file():
+        pytest.skip(f"{path} not found")
+    spec = importlib.util.spec_from_file_location("paper004_forecast", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_bench_table_on_a_steady_drift():
+    bench = _bench()
+    coeffs, truth = bench.synthetic_coefficients(0, scenario="steady")
+    coeffs["Zero"] = np.r_[np.full(10, 0.0), np.ones(80)]  # a term the fit did not resolve
+    table = bench.forecast_table(coeffs, truth=truth)
+    assert table["terms"] == ["Q", "N", "B", "K", "R"]
+    assert "not forecastable" in table["skipped"]["Zero"]
+    cells = table["cells"]
+    assert set(cells) == set(bench.default_methods()) | {"true curve (oracle)"}
+    n = {m: cells[m]["N"] for m in cells}
+    # a constant forecast explains none of the check spread; a trend follower explains some of it
+    assert n["persistence"]["C"] == pytest.approx(1.0) and n["build mean"]["C"] == pytest.approx(1.0)
+    assert n["linear trend"]["C"] < 0.6 and n["GM(1,1)"]["C"] < 0.6
+    assert n["true curve (oracle)"]["C"] <= min(c["C"] for c in n.values()) + 0.05
+    # the paper's rule, dominated by the in-sample build fit, flatters every trend method
+    assert n["GM(1,1)"]["C_paper"] < 0.5 * n["GM(1,1)"]["C"]
+    md = bench.to_markdown(table, title="t")
+    assert md.count("| GM(1,1) |") == 4 and "Zero: 10 frame(s) at or below 0" in md
+    with pytest.raises(ParameterError, match=r"build \+ check = 60 \+ 30 = 90 exceeds the series length \(50\)"):
+        bench.forecast_table({"N": np.ones(50)})
+
+
+def test_docstring_examples():
+    import doctest
+
+    import allanite.forecast as mod
+
+    failures, tried = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert tried > 0 and failures == 0

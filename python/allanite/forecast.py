@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence
+from typing import Any, Callable
 
 import numpy as np
 import pywt
@@ -43,13 +43,15 @@ from scipy import optimize
 from allanite.errors import InputError, ParameterError
 
 __all__ = [
-    "Accuracy",
     "GM11",
-    "ImprovedGM11",
-    "Persistence",
+    "Accuracy",
     "BuildMean",
-    "LinearTrend",
+    "Detection",
     "Holt",
+    "ImprovedGM11",
+    "LevelRatio",
+    "LinearTrend",
+    "Persistence",
     "Score",
     "accuracy",
     "c_grade",
@@ -57,8 +59,6 @@ __all__ = [
     "level_ratio_test",
     "score",
     "split",
-    "Detection",
-    "LevelRatio",
 ]
 
 #: Paper 004 Table 2 as printed: grade 1 C < 0.35, grade 2 C < 0.5, grade 3 C < 0.65, grade 4 otherwise.
@@ -342,6 +342,14 @@ class GM11(_Forecaster):
         In-sample x̂⁰ (``fitted[0] == series[0]``).
     notes : list of str
         What was done to the series, in words.
+
+    Examples
+    --------
+    >>> m = GM11([2.874, 3.278, 3.337, 3.390, 3.679])
+    >>> print(f"a = {m.a:.6f}, b = {m.b:.6f}, C = {m.C:.4f}, P = {m.P}, {m.grade}")
+    a = -0.037204, b = 3.065363, C = 0.2125, P = 1.0, good
+    >>> print(m.predict(2).round(4))
+    [3.7507 3.8928]
     """
 
     name = "GM(1,1)"
@@ -513,7 +521,8 @@ class LinearTrend(_Forecaster):
 class Holt(_Forecaster):
     """Holt's linear (additive-trend) exponential smoothing.
 
-    Level ℓ and trend b: ℓ_k = α·x_k + (1 − α)(ℓ_{k−1} + b_{k−1}), b_k = β(ℓ_k − ℓ_{k−1}) + (1 − β)b_{k−1},
+    Level ℓ and trend b: ℓ_k = α·x_k + (1 − α)(ℓ_{k−1} + b_{k−1}),
+    b_k = β(ℓ_k − ℓ_{k−1}) + (1 − β)b_{k−1},
     started at ℓ_0 = x_0, b_0 = x_1 − x_0. α and β (in [0, 1]) minimise the sum of squared one-step
     in-sample errors unless given. ``fitted[k]`` is the one-step forecast ℓ_{k−1} + b_{k−1}
     (``fitted[0] = series[0]``); ``predict(h)`` is ℓ_n + j·b_n, j = 1 … h.
@@ -883,9 +892,9 @@ class ImprovedGM11(_Forecaster):
             raise ParameterError(f"residual_min_len = {residual_min_len!r} must be an integer >= 4")
         if not (np.isfinite(residual_max_a) and residual_max_a > 0):
             raise ParameterError(f"residual_max_a = {residual_max_a!r} must be a positive number")
-        self._opts = dict(residual=bool(residual), residual_from=residual_from, residual_on=residual_on,
-                          residual_min_len=int(residual_min_len), residual_max_a=float(residual_max_a),
-                          shift=shift)
+        self._opts = {"residual": bool(residual), "residual_from": residual_from, "residual_on": residual_on,
+                          "residual_min_len": int(residual_min_len), "residual_max_a": float(residual_max_a),
+                          "shift": shift}
         y = x
         self.detection: Detection | None = None
         if detect:
@@ -894,7 +903,8 @@ class ImprovedGM11(_Forecaster):
                 self.notes.append(f"bad values replaced at {self.detection.bad.tolist()}")
             if self.detection.breaks.size:
                 self.notes.append(
-                    f"breaks after {self.detection.breaks.tolist()} (steps {np.round(self.detection.steps, 6).tolist()}); "
+                    f"breaks after {self.detection.breaks.tolist()} "
+                    f"(steps {np.round(self.detection.steps, 6).tolist()}); "
                     "older values aligned to the newest level"
                 )
         if smooth:
@@ -1024,6 +1034,14 @@ def score(
     Returns
     -------
     Score
+
+    Examples
+    --------
+    >>> x = [1.0, 1.1, 1.25, 1.3, 1.45, 1.5, 1.62, 1.7, 1.85, 1.9]
+    >>> build, check = split(x, 7, 3)
+    >>> s = score(GM11, build, check)
+    >>> print(f"{s.name}: C = {s.honest.C:.3f} ({s.honest.grade}), rmse = {s.rmse:.3f}")
+    GM(1,1): C = 0.466 (qualified), rmse = 0.080
     """
     _check_sd(sd)
     b = _as_series(build, name="build")
