@@ -484,3 +484,38 @@ def test_docstring_examples():
 
     failures, tried = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert tried > 0 and failures == 0
+
+
+def test_overflowing_horizon_is_an_error():
+    m = GM11(np.exp(0.5 * np.arange(8)), shift=None)  # a ≈ −0.5: e^{0.5k} overflows near k = 1420
+    assert np.all(np.isfinite(m.predict(100)))
+    with pytest.raises(ParameterError, match=r"h = 2000: the forecast overflows at step 14\d\d"):
+        m.predict(2000)
+
+
+def test_residual_on_series_adds_the_residual_model():
+    x = _drifting(noise=0.0) + 0.02 * np.sin(np.arange(60) / 6.0)
+    base = ImprovedGM11(x, detect=False, smooth=False, metabolic=False, residual=False)
+    e = x - base.fitted
+    m = ImprovedGM11(x, detect=False, smooth=False, metabolic=False, residual_on="series")
+    rc = m._rc
+    assert rc.applied and rc.on == "series"
+    s = np.sign(e[rc.end - 1])
+    assert np.all(s * e[rc.i : rc.end] > 0) and rc.end - rc.i >= 6
+    qhat = s * np.r_[rc.model.fitted, rc.model.predict(60 - rc.end)]
+    np.testing.assert_allclose(m.fitted[rc.i :] - base.fitted[rc.i :], qhat, rtol=1e-9)
+    np.testing.assert_array_equal(m.fitted[: rc.i], base.fitted[: rc.i])
+
+
+def test_short_series_is_not_smoothed_and_says_so():
+    m = ImprovedGM11(CLASSIC)
+    assert "series too short for sym4 smoothing; not smoothed" in m.notes
+    np.testing.assert_allclose(m.processed, CLASSIC)
+    assert np.all(np.isfinite(m.predict(3)))
+
+
+def test_improved_overflowing_horizon_is_an_error():
+    x = np.exp(0.3 * np.arange(12))
+    m = ImprovedGM11(x, detect=False, smooth=False, residual=False, metabolic=False, shift=None)
+    with pytest.raises(ParameterError, match=r"h = 3000: the forecast overflows at step 2373"):
+        m.predict(3000)

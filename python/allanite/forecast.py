@@ -426,6 +426,11 @@ class GM11(_Forecaster):
         if not (np.isfinite(self.a) and np.isfinite(self.b)):  # pragma: no cover - guarded by validation
             raise InputError("GM(1,1) least squares gave non-finite a, b for this series")
         self.fitted = self._x0hat(np.arange(x.size)) - c
+        if not np.all(np.isfinite(self.fitted)):
+            raise InputError(
+                f"GM(1,1) fitted values overflow for this series (n = {x.size}, a = {self.a:.6g}): "
+                "e^(−a·k) exceeds the float range; use a shorter series"
+            )
 
     # k below is 0-based: value index k is the paper's x(k+1)
     def _x0hat(self, k: np.ndarray) -> np.ndarray:
@@ -434,20 +439,28 @@ class GM11(_Forecaster):
         a, b, x0 = self.a, self.b, self._y[0]
         em = math.expm1(a)
         # (1 − e^a)(x0 − b/a)·e^{−ak} = e^{−ak}·(b·φ(a) − expm1(a)·x0): no division by a.
-        vals = np.exp(-a * k) * (b * float(_phi(a)) - em * x0)
+        with np.errstate(over="ignore"):  # an overflow is reported by the callers, by name
+            vals = np.exp(-a * k) * (b * float(_phi(a)) - em * x0)
         return np.where(k == 0, x0, vals)
 
     def _x1hat(self, k: np.ndarray) -> np.ndarray:
         """1-AGO time response of the shifted series at 0-based indices k: x⁰(1)e^{−ak} + b·k·φ(−ak)."""
         k = np.asarray(k, dtype=np.float64)
         a, b, x0 = self.a, self.b, self._y[0]
-        return x0 * np.exp(-a * k) + b * k * _phi(-a * k)
+        with np.errstate(over="ignore", invalid="ignore"):
+            return x0 * np.exp(-a * k) + b * k * _phi(-a * k)
 
     def predict(self, h: int) -> np.ndarray:
         """The next ``h`` values x̂⁰(n+1) … x̂⁰(n+h), shift removed."""
         h = _check_horizon(h)
         n = self.series.size
-        return self._x0hat(np.arange(n, n + h)) - self.shift_applied
+        out = self._x0hat(np.arange(n, n + h)) - self.shift_applied
+        if not np.all(np.isfinite(out)):
+            j = int(np.flatnonzero(~np.isfinite(out))[0])
+            raise ParameterError(
+                f"h = {h}: the forecast overflows at step {j + 1} (e^(−a·k) with a = {self.a:.6g}); use a shorter horizon"
+            )
+        return out
 
     def __repr__(self) -> str:
         return f"GM11(n={self.series.size}, a={self.a:.6g}, b={self.b:.6g}, shift={self.shift_applied:.6g})"
@@ -938,16 +951,24 @@ class ImprovedGM11(_Forecaster):
         """The next ``h`` values (metabolic re-fit when switched on)."""
         h = _check_horizon(h)
         n = self.series.size
-        if not self.steps["metabolic"]:
-            return self._rc.x0hat(np.arange(n, n + h)) - self.model.shift_applied
-        window = self.processed.copy()
-        m, rc = self.model, self._rc
-        out = np.empty(h)
-        for j in range(h):
-            out[j] = float(rc.x0hat(np.array([n]))[0]) - m.shift_applied
-            window = np.append(window[1:], out[j])
-            if j + 1 < h:
-                m, rc = self._fit(window)
+        with np.errstate(over="ignore", invalid="ignore"):
+            if not self.steps["metabolic"]:
+                out = self._rc.x0hat(np.arange(n, n + h)) - self.model.shift_applied
+            else:
+                window = self.processed.copy()
+                m, rc = self.model, self._rc
+                out = np.empty(h)
+                for j in range(h):
+                    out[j] = float(rc.x0hat(np.array([n]))[0]) - m.shift_applied
+                    if not np.isfinite(out[j]):
+                        out[j + 1 :] = np.nan
+                        break
+                    window = np.append(window[1:], out[j])
+                    if j + 1 < h:
+                        m, rc = self._fit(window)
+        if not np.all(np.isfinite(out)):
+            j = int(np.flatnonzero(~np.isfinite(out))[0])
+            raise ParameterError(f"h = {h}: the forecast overflows at step {j + 1}; use a shorter horizon")
         return out
 
 
