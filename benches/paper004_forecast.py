@@ -44,6 +44,7 @@ from collections.abc import Mapping
 from typing import Any, Callable
 
 import numpy as np
+
 from allanite.errors import AllaniteError
 from allanite.forecast import (
     GM11,
@@ -141,8 +142,9 @@ def forecast_table(
                 "rmse": s.rmse,
                 "bias": s.bias,
                 "C_smoothed": None,
-                "C_insample": (s.model.accuracy_processed.C if isinstance(s.model, ImprovedGM11)
-                               else s.model.accuracy.C),
+                "C_insample": (
+                    s.model.accuracy_processed.C if isinstance(s.model, ImprovedGM11) else s.model.accuracy.C
+                ),
                 "notes": list(getattr(s.model, "notes", [])),
             }
             if isinstance(s.model, ImprovedGM11) and s.model.steps["smooth"]:
@@ -196,19 +198,29 @@ def to_markdown(table: Mapping[str, Any], *, title: str = "") -> str:
             label = m.strip() if not m.startswith("  ") else "&nbsp;&nbsp;" + m.strip()
             lines.append(f"| {label} | " + " | ".join(row) + " |")
 
-    block("honest: C (Table 2 grade) / P of the forecast vs the raw check values",
-          lambda c: f"{_fmt(c['C'])} ({c['c_grade']}) / {_fmt(c['P'])}")
-    block("paper 004's rule: C (grade) / P over build fit + check forecast, x⁰(1) left out",
-          lambda c: f"{_fmt(c['C_paper'])} ({c['c_grade_paper']}) / {_fmt(c['P_paper'])}")
-    block("in-sample C (grade) of the build-part fit against the series the model fitted (no forecast)",
-          lambda c: f"{_fmt(c['C_insample'])} ({'1234'[min(3, sum(c['C_insample'] >= b for b in (0.35, 0.5, 0.65)))]})")
-    block("RMSE / bias (check − forecast) vs the raw check values",
-          lambda c: f"{c['rmse']:.3g} / {c['bias']:+.2g}")
+    block(
+        "honest: C (Table 2 grade) / P of the forecast vs the raw check values",
+        lambda c: f"{_fmt(c['C'])} ({c['c_grade']}) / {_fmt(c['P'])}",
+    )
+    block(
+        "paper 004's rule: C (grade) / P over build fit + check forecast, x⁰(1) left out",
+        lambda c: f"{_fmt(c['C_paper'])} ({c['c_grade_paper']}) / {_fmt(c['P_paper'])}",
+    )
+    block(
+        "in-sample C (grade) of the build-part fit against the series the model fitted (no forecast)",
+        lambda c: f"{_fmt(c['C_insample'])} ({'1234'[min(3, sum(c['C_insample'] >= b for b in (0.35, 0.5, 0.65)))]})",
+    )
+    block("RMSE / bias (check − forecast) vs the raw check values", lambda c: f"{c['rmse']:.3g} / {c['bias']:+.2g}")
     lines.append("")
-    lines.append("C of the improved forecast against check values smoothed together with the build part "
-                 "(not honest): " + ", ".join(
-                     f"{t} {_fmt(cells['improved GM(1,1)'][t].get('C_smoothed'))}" for t in terms
-                     if "improved GM(1,1)" in cells and t in cells["improved GM(1,1)"]))
+    lines.append(
+        "C of the improved forecast against check values smoothed together with the build part "
+        "(not honest): "
+        + ", ".join(
+            f"{t} {_fmt(cells['improved GM(1,1)'][t].get('C_smoothed'))}"
+            for t in terms
+            if "improved GM(1,1)" in cells and t in cells["improved GM(1,1)"]
+        )
+    )
     for t, why in table["skipped"].items():
         lines.append(f"- {t}: {why}")
     return "\n".join(lines) + "\n"
@@ -237,8 +249,13 @@ def synthetic_coefficients(
     rng = np.random.default_rng(seed)
     k = np.arange(frames, dtype=np.float64)
     warm = (1 - np.exp(-k / tau)) / (1 - np.exp(-(frames - 1) / tau))
-    trend = {"Q": np.ones(frames), "N": 1 + 0.3 * warm, "B": np.where(k >= 45, 1.2, 1.0),
-             "K": np.ones(frames), "R": np.ones(frames)}
+    trend = {
+        "Q": np.ones(frames),
+        "N": 1 + 0.3 * warm,
+        "B": np.where(k >= 45, 1.2, 1.0),
+        "K": np.ones(frames),
+        "R": np.ones(frames),
+    }
     out, truth = {}, {}
     for term, (nominal, sigma) in SYNTH.items():
         if term == "N":
@@ -270,10 +287,16 @@ def _mean_table(tables: list[dict[str, Any]]) -> str:
         r = vals(m, t, "rmse") / vals("persistence", t, "rmse")
         return f"{np.median(r):.2f}"
 
-    lines = rows(f"**honest C over {len(tables)} seeds: mean ± SD (share of seeds with C < 0.5, grade 1–2); "
-                 "paper-rule C mean in brackets**", c_cell)
-    lines += rows(f"**RMSE of the 30-frame forecast / RMSE of persistence, median over {len(tables)} seeds "
-                  "(< 1: better than the last value)**", r_cell)
+    lines = rows(
+        f"**honest C over {len(tables)} seeds: mean ± SD (share of seeds with C < 0.5, grade 1–2); "
+        "paper-rule C mean in brackets**",
+        c_cell,
+    )
+    lines += rows(
+        f"**RMSE of the 30-frame forecast / RMSE of persistence, median over {len(tables)} seeds "
+        "(< 1: better than the last value)**",
+        r_cell,
+    )
     return "\n".join(lines) + "\n"
 
 
@@ -281,15 +304,17 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--seeds", type=int, default=0, help="also average C over this many seeds")
-    ap.add_argument("--scenario", choices=sorted(SCENARIOS), action="append",
-                    help="synthetic scenario(s); default both")
+    ap.add_argument(
+        "--scenario", choices=sorted(SCENARIOS), action="append", help="synthetic scenario(s); default both"
+    )
     ap.add_argument("--out", default=None, help="write the markdown here too")
     args = ap.parse_args(argv)
     text = ""
     for scen in args.scenario or ["warmup", "steady"]:
         coeffs, truth = synthetic_coefficients(args.seed, scenario=scen)
-        text += to_markdown(forecast_table(coeffs, truth=truth),
-                            title=f"synthetic '{scen}', seed {args.seed}, 60 build / 30 check")
+        text += to_markdown(
+            forecast_table(coeffs, truth=truth), title=f"synthetic '{scen}', seed {args.seed}, 60 build / 30 check"
+        )
         if args.seeds:
             tables = []
             for sd in range(args.seeds):

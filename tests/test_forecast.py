@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+
 from allanite.errors import InputError, ParameterError
 from allanite.forecast import (
     GM11,

@@ -8,7 +8,7 @@ a tangle. The layers, bottom up (a module may import only from its own layer or 
     2  estimators.*, io.*                  the registry and its entries, EDF; the readers
     3  plot, results                       figures; result objects (EDF sits below them)
     4  analysis, simulation, datasets, _reference
-    5  model.*                             terms, covariance, fit, effects, refine
+    5  model.*, forecast                   terms, covariance, fit, effects, refine; GM(1,1) forecasts
     6  report.*
     7  cli, __main__, __init__
 """
@@ -38,6 +38,7 @@ LAYERS = {
     "datasets": 4,
     "_reference": 4,
     "model": 5,
+    "forecast": 5,
     "report": 6,
     "cli": 7,
     "__main__": 7,

@@ -389,8 +389,11 @@ def test_report_without_fit_and_with_too_short_windows(tmp_path):
     s = rep.summary()
     assert s["fit"]["requested"] is False and s["fit"]["axes"] is None and s["fit"]["series"] is None
     assert {sp[0] for sp in rep.figure_specs()} == expected_figures(1, fit=False)
-    # a 250-sample window has too few octave τ for five terms: the series is skipped with a note
+    # a 250-sample window has too few octave τ for five terms: its windows are fitted on every τ
     rep = build_report(y, 10.0, unit="deg/s")
+    assert rep.series is not None and rep.series_error is None
+    # a 50-sample window has too few τ even then: the series is skipped with a note
+    rep = build_report(y[:600], 10.0, unit="deg/s")
     s = rep.summary()
     assert s["fit"]["axes"] is not None and s["fit"]["series"]["axes"] is None
     assert "usable τ" in s["fit"]["series"]["error"]

@@ -40,7 +40,7 @@ import numpy as np
 import pywt
 from scipy import optimize
 
-from allanite.errors import InputError, ParameterError
+from .errors import InputError, ParameterError
 
 __all__ = [
     "GM11",
@@ -175,9 +175,7 @@ class Accuracy:
     include_first: bool
 
 
-def accuracy(
-    actual: Any, predicted: Any, *, sd: str = "population", include_first: bool = True
-) -> Accuracy:
+def accuracy(actual: Any, predicted: Any, *, sd: str = "population", include_first: bool = True) -> Accuracy:
     """C, P and grades of ``predicted`` against ``actual``.
 
     Parameters
@@ -458,7 +456,8 @@ class GM11(_Forecaster):
         if not np.all(np.isfinite(out)):
             j = int(np.flatnonzero(~np.isfinite(out))[0])
             raise ParameterError(
-                f"h = {h}: the forecast overflows at step {j + 1} (e^(−a·k) with a = {self.a:.6g}); use a shorter horizon"
+                f"h = {h}: the forecast overflows at step {j + 1} (e^(−a·k) with a = {self.a:.6g}); "
+                "use a shorter horizon"
             )
         return out
 
@@ -648,7 +647,7 @@ def _detect(x: np.ndarray, k_sigma: float) -> tuple[np.ndarray, Detection]:
     """
     n = x.size
     xp = x if n % 2 == 0 else np.append(x, x[-1])
-    (_, d), = pywt.swt(xp, "haar", level=1, trim_approx=False, norm=False)
+    ((_, d),) = pywt.swt(xp, "haar", level=1, trim_approx=False, norm=False)
     d = d[: n - 1]  # the last SWT detail wraps around to x[0]; drop it
     sigma = float(np.median(np.abs(d)) / 0.6745)
     thr = k_sigma * sigma
@@ -660,8 +659,8 @@ def _detect(x: np.ndarray, k_sigma: float) -> tuple[np.ndarray, Detection]:
             bad.append(j)
             used[j - 1] = used[j] = True
     breaks: list[int] = []
-    for j in np.flatnonzero(jump & ~used):
-        j = int(j)
+    for jj in np.flatnonzero(jump & ~used):
+        j = int(jj)
         if j == 0:
             bad.append(0)
         elif j == n - 2:
@@ -720,13 +719,14 @@ class _ResidualCorrected:
         # The last 1-AGO residual is Σx⁰ − x̂¹(n), which the least squares leaves close to 0, so its sign is
         # often noise: a same-sign run may end at the last or the second-to-last index.
         if residual_from == "auto":
-            i, end = None, None
+            i: int | None = None
+            end: int | None = None
             for stop in (n, n - 1):
                 s = np.sign(q[stop - 1])
                 j = stop - 1
                 while s != 0 and j > 0 and np.sign(q[j - 1]) == s:
                     j -= 1
-                if s != 0 and stop - j >= min_len and (i is None or stop - j > end - i):
+                if s != 0 and stop - j >= min_len and (i is None or end is None or stop - j > end - i):
                     i, end = j, stop
             if i is None:
                 self.reason = (
@@ -735,8 +735,10 @@ class _ResidualCorrected:
                 self.i = None
                 return
         else:
-            if isinstance(residual_from, bool) or not isinstance(residual_from, (int, np.integer)) or not (
-                1 <= residual_from <= n - min_len
+            if (
+                isinstance(residual_from, bool)
+                or not isinstance(residual_from, (int, np.integer))
+                or not (1 <= residual_from <= n - min_len)
             ):
                 raise ParameterError(
                     f"residual_from = {residual_from!r} must be 'auto' or an index in 1..{n - min_len} "
@@ -754,6 +756,7 @@ class _ResidualCorrected:
                     f"residual_from = {i}: the residuals from there change sign (or are 0); the residual GM(1,1) "
                     "needs a same-sign run to the last or second-to-last value — use 'auto' or a later index"
                 )
+        assert i is not None and end is not None
         self.i, self.end = i, end
         self.sign = float(np.sign(q[end - 1]))
         self.model = GM11(self.sign * q[i:end], shift="auto", allow_nonpositive=False)
@@ -897,17 +900,29 @@ class ImprovedGM11(_Forecaster):
             raise ParameterError(f"smooth_level = {smooth_level!r} must be a positive integer or None")
         self.series = x
         self.sd, self.include_first = sd, bool(include_first)
-        self.steps = {"detect": bool(detect), "smooth": bool(smooth), "metabolic": bool(metabolic),
-                      "residual": bool(residual)}
+        self.steps = {
+            "detect": bool(detect),
+            "smooth": bool(smooth),
+            "metabolic": bool(metabolic),
+            "residual": bool(residual),
+        }
         self.notes: list[str] = []
-        if isinstance(residual_min_len, bool) or not isinstance(residual_min_len, (int, np.integer)) or \
-                residual_min_len < 4:
+        if (
+            isinstance(residual_min_len, bool)
+            or not isinstance(residual_min_len, (int, np.integer))
+            or residual_min_len < 4
+        ):
             raise ParameterError(f"residual_min_len = {residual_min_len!r} must be an integer >= 4")
         if not (np.isfinite(residual_max_a) and residual_max_a > 0):
             raise ParameterError(f"residual_max_a = {residual_max_a!r} must be a positive number")
-        self._opts = {"residual": bool(residual), "residual_from": residual_from, "residual_on": residual_on,
-                          "residual_min_len": int(residual_min_len), "residual_max_a": float(residual_max_a),
-                          "shift": shift}
+        self._opts = {
+            "residual": bool(residual),
+            "residual_from": residual_from,
+            "residual_on": residual_on,
+            "residual_min_len": int(residual_min_len),
+            "residual_max_a": float(residual_max_a),
+            "shift": shift,
+        }
         y = x
         self.detection: Detection | None = None
         if detect:
@@ -932,11 +947,10 @@ class ImprovedGM11(_Forecaster):
         self.fitted = self._rc.x0hat(np.arange(x.size)) - self.model.shift_applied
 
     def _fit(self, y: np.ndarray) -> tuple[GM11, _ResidualCorrected]:
-        m = GM11(y, shift=self._opts["shift"], sd=self.sd, include_first=self.include_first,
-                 allow_nonpositive=True)
+        m = GM11(y, shift=self._opts["shift"], sd=self.sd, include_first=self.include_first, allow_nonpositive=True)
         if self._opts["residual"]:
-            rc = _ResidualCorrected(m, self._opts["residual_from"], self._opts["residual_on"],
-                                    self._opts["residual_min_len"], self._opts["residual_max_a"])
+            o: dict[str, Any] = self._opts
+            rc = _ResidualCorrected(m, o["residual_from"], o["residual_on"], o["residual_min_len"], o["residual_max_a"])
         else:
             rc = _ResidualCorrected.__new__(_ResidualCorrected)
             rc.base, rc.applied, rc.reason, rc.on = m, False, "switched off", "ago"
@@ -1073,12 +1087,10 @@ def score(
         raise InputError(f"{name or getattr(model, 'name', method)} gave a non-finite or mis-sized forecast")
     honest = accuracy(c, fc, sd=sd, include_first=True)
     basis = np.asarray(getattr(model, "processed", b), dtype=np.float64)
-    paper = accuracy(
-        np.concatenate([basis, c]), np.concatenate([model.fitted, fc]), sd=sd, include_first=False
-    )
+    paper = accuracy(np.concatenate([basis, c]), np.concatenate([model.fitted, fc]), sd=sd, include_first=False)
     e = c - fc
     return Score(
-        name or getattr(model, "name", str(method)),
+        str(name or getattr(model, "name", None) or method),
         fc,
         honest,
         paper,

@@ -80,10 +80,13 @@ def m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0,
         # τ(i) = τ_con·τ_g^(i−1) (paper 000 §4.2), rounded to m, duplicates dropped. Below
         # m* = 1/(g − 1) consecutive points are less than one sample apart, so every m appears:
         # take those directly rather than generating (possibly billions of) duplicates.
-        m_star = min(top, max(m0, int(math.ceil(1.0 / (growth - 1.0))) if growth - 1.0 > 1.0 / top else top))
+        # The grid ends at its last point ≤ top, which may round below top: the dense part stops there too
+        # (n = 20, m_max = 3, g = 1.25 ends at round(1.25⁴) = 2, not 3).
+        count = int(math.floor(math.log(top / m0) / math.log(growth) + 1e-9)) + 1
+        last = int(math.floor(m0 * growth ** (count - 1) + 0.5))
+        m_star = min(top, last, max(m0, int(math.ceil(1.0 / (growth - 1.0))) if growth - 1.0 > 1.0 / top else top))
         dense = np.arange(m0, m_star + 1, dtype=np.int64)
         i0 = max(0, int(math.floor(math.log(m_star / m0) / math.log(growth))))
-        count = int(math.floor(math.log(top / m0) / math.log(growth) + 1e-9)) + 1
         raw = np.floor(m0 * growth ** np.arange(i0, max(i0, count)) + 0.5).astype(np.int64)
         raw = raw[(raw > m_star) & (raw <= top)]
         return np.unique(np.concatenate([dense, raw]))
