@@ -29,18 +29,27 @@ Needs numpy, allanite and allantools (``pip install -e '.[bench]'``); no externa
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
 import math
 import os
-import platform
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+
+from _common import (
+    OtherLoad,
+    bit_identical,
+    cpu_busy_fraction,
+    log,
+    machine_info,
+    max_rel_diff,
+    sample_starts,
+    timed,
+    wait_idle,
+)
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
@@ -71,188 +80,6 @@ TARGETS = {
     "case3_speedup_vs_allantools": 20.0,
     "case3_max_rel_diff": 1e-10,
 }
-
-
-# ----------------------------------------------------------------------------------------------
-# helpers
-
-
-def timed(fn, repeats: int, warmup: bool = False):
-    """Run ``fn`` (optionally once untimed first), then ``repeats`` timed runs.
-
-    Returns (best seconds, list of every repeat's seconds, the last result)."""
-    if warmup:
-        fn()
-    times = []
-    out = None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return min(times), times, out
-
-
-def max_rel_diff(a, b) -> float:
-    """max |a − b| / |b| over all entries (0 where both are 0; inf where only b is 0)."""
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    if a.shape != b.shape:
-        raise ValueError(f"shape mismatch {a.shape} vs {b.shape}")
-    if a.size == 0:
-        return float("nan")
-    diff = np.abs(a - b)
-    den = np.abs(b)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rel = np.where(diff == 0, 0.0, diff / den)
-    return float(np.max(rel))
-
-
-def bit_identical(a, b) -> bool:
-    a = np.ascontiguousarray(a, dtype=np.float64)
-    b = np.ascontiguousarray(b, dtype=np.float64)
-    return a.shape == b.shape and bool(np.array_equal(a.view(np.uint64), b.view(np.uint64)))
-
-
-def sample_starts(n_win: int, count: int) -> np.ndarray:
-    """``count`` window indices spread evenly over the record, first and last included."""
-    count = max(1, min(count, n_win))
-    return np.unique(np.round(np.linspace(0, n_win - 1, count)).astype(np.int64))
-
-
-def _cmd_output(cmd) -> str | None:
-    try:
-        return subprocess.run(cmd, capture_output=True, text=True, timeout=30, check=True).stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        return None
-
-
-def machine_info() -> dict:
-    cpu_model = None
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.lower().startswith("model name"):
-                cpu_model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    if cpu_model is None:
-        cpu_model = platform.processor() or platform.machine()
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except AttributeError:
-        usable = os.cpu_count()
-    versions = {"python": platform.python_version(), "numpy": np.__version__}
-    try:
-        import allanite
-
-        versions["allanite"] = allanite.__version__
-    except Exception:  # pragma: no cover - reported, not fatal
-        versions["allanite"] = None
-    try:
-        import allantools
-
-        versions["allantools"] = getattr(allantools, "__version__", None)
-    except ImportError:
-        versions["allantools"] = None
-    if versions.get("allantools") is None:
-        try:
-            from importlib.metadata import version
-
-            versions["allantools"] = version("allantools")
-        except Exception:
-            pass
-    git = _cmd_output(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"])
-    dirty = _cmd_output(["git", "-C", str(REPO), "status", "--porcelain", "--untracked-files=no"])
-    return {
-        "cpu_model": cpu_model,
-        "cpu_count": os.cpu_count(),
-        "cpus_usable": usable,
-        "platform": platform.platform(),
-        "versions": versions,
-        "rustc": _cmd_output(["rustc", "--version"]),
-        "git_commit": None if git is None else git + ("+dirty" if dirty else ""),
-        "env": {
-            k: os.environ.get(k)
-            for k in ("OPENBLAS_CORETYPE", "ALLANITE_NUM_THREADS", "RAYON_NUM_THREADS", "OMP_NUM_THREADS")
-        },
-        "date_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-        "loadavg_start": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
-    }
-
-
-def cpu_busy_fraction(interval: float = 1.0) -> float | None:
-    """Fraction of all CPUs busy over ``interval`` seconds (from /proc/stat), None if unknown."""
-
-    def snap():
-        f = Path("/proc/stat").read_text().splitlines()[0].split()[1:]
-        v = [int(x) for x in f]
-        idle = v[3] + (v[4] if len(v) > 4 else 0)
-        return sum(v[:8]), idle
-
-    try:
-        t0, i0 = snap()
-        time.sleep(interval)
-        t1, i1 = snap()
-    except (OSError, ValueError, IndexError):
-        return None
-    return 1.0 - (i1 - i0) / max(1, t1 - t0)
-
-
-class OtherLoad:
-    """CPU time used by *other* processes while a block runs, as a fraction of all CPUs' time
-    (total busy time from /proc/stat minus this process's own user+system time)."""
-
-    def __enter__(self):
-        self.t0 = time.perf_counter()
-        self.busy0 = self._busy()
-        self.self0 = self._self()
-        return self
-
-    def __exit__(self, *exc):
-        wall = time.perf_counter() - self.t0
-        busy = self._busy()
-        if busy is None or self.busy0 is None or wall <= 0:
-            self.fraction = None
-        else:
-            others = (busy - self.busy0) - (self._self() - self.self0)
-            self.fraction = max(0.0, others / (wall * (os.cpu_count() or 1)))
-        return False
-
-    @staticmethod
-    def _busy():
-        try:
-            v = [int(x) for x in Path("/proc/stat").read_text().splitlines()[0].split()[1:9]]
-        except (OSError, ValueError):
-            return None
-        return (sum(v) - v[3] - v[4]) / os.sysconf("SC_CLK_TCK")
-
-    @staticmethod
-    def _self():
-        t = os.times()
-        return t.user + t.system
-
-
-def wait_idle(max_wait: float, threshold: float = 0.10) -> dict:
-    """Wait (up to ``max_wait`` s) until the CPUs are < ``threshold`` busy for 3 s running."""
-    t0 = time.perf_counter()
-    calm = 0
-    busy = cpu_busy_fraction()
-    while busy is not None and time.perf_counter() - t0 < max_wait:
-        calm = calm + 1 if busy < threshold else 0
-        if calm >= 3:
-            break
-        if calm == 0:
-            log(f"waiting for an idle machine: CPUs {busy:.0%} busy")
-        busy = cpu_busy_fraction()
-    return {
-        "waited_seconds": round(time.perf_counter() - t0, 1),
-        "busy_fraction_before_start": busy,
-        "idle": None if busy is None else busy < threshold,
-    }
-
-
-def log(msg: str) -> None:
-    print(msg, flush=True)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -33,11 +33,10 @@ from pathlib import Path
 
 import numpy as np
 
+import _common
+
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-sys.path.insert(0, str(HERE))
-
-import bench_engine as be  # noqa: E402
 
 ADIS = "adis16405/adis16405_run1_100Hz.csv.gz"
 CONFIGS = {
@@ -62,17 +61,13 @@ print(json.dumps({"mode": mode, "wall_s": wall, "vmhwm_bytes": int(status["VmHWM
 """
 
 
-class OtherLoad(be.OtherLoad):
-    """As bench_engine's, but the report runs in child processes: count their CPU time as ours."""
+class OtherLoad(_common.OtherLoad):
+    """As _common's, but the report runs in child processes: count their CPU time as ours."""
 
     @staticmethod
     def _self():
         t = os.times()
         return t.user + t.system + t.children_user + t.children_system
-
-
-def shared_data() -> Path:
-    return Path(os.environ.get("ALLANITE_SHARED_DATA", REPO.parent / "shared" / "data"))
 
 
 def write_big_npy(path: Path, n: int) -> None:
@@ -90,7 +85,7 @@ def write_big_npy(path: Path, n: int) -> None:
 
 
 def part_report(repeats: int) -> dict:
-    src = shared_data() / ADIS
+    src = _common.shared_data_dir() / ADIS
     if not src.is_file():
         return {"skipped": f"{src} not found"}
     import allanite
@@ -121,7 +116,9 @@ def part_report(repeats: int) -> dict:
         t0 = time.perf_counter()
         allanite.read_log(src, fs=100.0, columns=["gyro_x", "gyro_y", "gyro_z"], unit="deg/s")
         read_s = time.perf_counter() - t0
-    be.log(f"ADIS report: best {min(times):.2f} s of {[round(t, 2) for t in times]}; read_log alone {read_s:.2f} s")
+    _common.log(
+        f"ADIS report: best {min(times):.2f} s of {[round(t, 2) for t in times]}; read_log alone {read_s:.2f} s"
+    )
     return {
         "file": ADIS,
         "samples": summary["record"]["samples"],
@@ -151,7 +148,7 @@ def part_memory(cfg: dict) -> dict:
             r = json.loads(proc.stdout.strip().splitlines()[-1])
             r["peak_over_file"] = r["vmhwm_bytes"] / size
             out[mode] = r
-            be.log(
+            _common.log(
                 f"{mode} on {cfg['big_n']:.0e} samples: {r['wall_s']:.1f} s, peak {r['vmhwm_bytes'] / 2**20:.0f} MiB "
                 f"= {r['peak_over_file']:.2f}× the file"
             )
@@ -209,12 +206,12 @@ def run(quick: bool, out: Path | None, wait: float) -> dict:
     cfg = CONFIGS["quick" if quick else "full"]
     out = Path(out) if out else (Path(tempfile.mkdtemp()) if quick else HERE / "results")
     out.mkdir(parents=True, exist_ok=True)
-    rep = {"config": cfg, "machine": be.machine_info(), "idle_wait": be.wait_idle(wait) if wait > 0 else None}
+    rep = {"config": cfg, "machine": _common.machine_info(), "idle_wait": _common.wait_idle(wait) if wait > 0 else None}
     rep["report"] = part_report(cfg["repeats"]) if not quick else {"skipped": "--quick"}
     rep["memory"] = part_memory(cfg)
     (out / "report_bench.json").write_text(json.dumps(rep, indent=1))
     write_markdown(rep, out / "report_bench.md")
-    be.log(f"wrote {out / 'report_bench.md'}")
+    _common.log(f"wrote {out / 'report_bench.md'}")
     return rep
 
 

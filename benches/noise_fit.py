@@ -71,14 +71,15 @@ import json
 import math
 import os
 import platform
-import re
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
+import _common
 import allanite
+from _common import load_avar_curve
 from allanite.model.fitting import MAX_GLS_TAU, TERMS
 from allanite.results import AllanResult
 
@@ -115,11 +116,6 @@ EST_LABEL = {
     "peer_octave": "allan-variance NNLS on allanite's octave curve",
     "slope": "slope read-off (exp grid)",
 }
-
-
-def shared_data_dir() -> Path:
-    env = os.environ.get("ALLANITE_SHARED_DATA", "").strip()
-    return Path(env) if env else REPO.parent / "shared" / "data"
 
 
 # ----------------------------------------------------------------------------------------------
@@ -696,29 +692,6 @@ def _fit_record(f) -> dict:
     }
 
 
-def load_avar_curve(path: Path) -> dict:
-    """The avar package's curve CSV → {channel: AllanResult}. Meta from the first comment line."""
-    lines = path.read_text().splitlines()
-    meta = dict(re.findall(r"(\w+)=([^;]+)", lines[0]))
-    fs = float(meta["freq_Hz"])
-    n = int(float(meta["n"]))
-    rows = [ln.split(",") for ln in lines if ln and not ln.startswith("#")][1:]
-    chans: dict = {}
-    for r in rows:
-        chans.setdefault(r[0], []).append((float(r[1]), float(r[2])))
-    out = {}
-    for ch, v in chans.items():
-        a = np.array(v)
-        m = np.round(a[:, 0] * fs).astype(np.int64)
-        # the avar package's estimator sums T − 2m terms and divides by T − 2m + 1 (one term fewer
-        # than the textbook overlapping AVAR, ≤ 6e-6 relative on these curves): kept as is; the
-        # EDF only needs the record length and m.
-        out[ch] = AllanResult(
-            tau=m / fs, avar=a[:, 1], n=(n + 1 - 2 * m).astype(np.int64), m=m, estimator="oavar", fs=fs, n_samples=n
-        )
-    return {"sensor": meta.get("sensor", path.stem).strip(), "fs": fs, "n": n, "channels": out}
-
-
 def avlr_navchip(curves) -> dict:
     """The avar vignette's avlr fit: geometric means of the read-offs pooled over the 3 gyro axes."""
     g = [curves["channels"][f"Gyro. {a}"] for a in "XYZ"]
@@ -1287,7 +1260,7 @@ def main(argv=None) -> int:
         log("paper 001")
         rep["paper001"] = paper001([1] if quick else [1, 2, 3, 4, 5], out, log)
     if "real" not in args.skip:
-        data = shared_data_dir()
+        data = _common.shared_data_dir()
         if data.is_dir():
             log("real data")
             adis = None if quick else adis_runs(data, log, out)

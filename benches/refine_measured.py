@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import tempfile
 import time
@@ -26,17 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
+import _common
+import allanite
+from _common import load_avar_curve
 
-import allanite  # noqa: E402
-from noise_fit import load_avar_curve  # noqa: E402
+HERE = Path(__file__).resolve().parent
 
 AXES = ["gyro_x", "gyro_y", "gyro_z"]
-
-
-def shared() -> Path:
-    return Path(os.environ.get("ALLANITE_SHARED_DATA", HERE.parent.parent / "shared" / "data"))
 
 
 def summarize(name, r) -> dict:
@@ -76,7 +71,7 @@ def _jsonable(v):
 
 def run(quick: bool, out: Path) -> dict:
     rows = {"adis": [], "curves": []}
-    data = shared()
+    data = _common.shared_data_dir()
     runs = [1] if quick else range(1, 7)
     for k in runs:
         path = data / "adis16405" / f"adis16405_run{k}_100Hz.csv.gz"

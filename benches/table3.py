@@ -65,11 +65,10 @@ from pathlib import Path
 
 import numpy as np
 
+from _common import OtherLoad, log, machine_info, max_rel_diff, sample_starts, wait_idle
+
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-sys.path.insert(0, str(HERE))
-
-from bench_engine import OtherLoad, machine_info, max_rel_diff, sample_starts, wait_idle  # noqa: E402
 
 SEED = 20240611
 FS = 100.0
@@ -195,16 +194,12 @@ WORKERS = 1  # the table: one thread for every method (NumPy, allantools and the
 
 
 class Load(OtherLoad):
-    """OtherLoad (bench_engine) that also counts this process's finished children as its own."""
+    """OtherLoad (_common) that also counts this process's finished children as its own."""
 
     @staticmethod
     def _self():
         t = os.times()
         return t.user + t.system + t.children_user + t.children_system
-
-
-def log(msg: str) -> None:
-    print(msg, flush=True)
 
 
 # ----------------------------------------------------------------------------------------------

@@ -42,10 +42,9 @@ from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
+import _common
 
-import bench_engine as be  # noqa: E402  (timing helpers, machine info, idle wait)
+HERE = Path(__file__).resolve().parent
 
 SEED = 20261122
 
@@ -87,9 +86,9 @@ def part_timings(cfg: dict) -> dict:
 
     # 1. TheoH, N = 1e5, exp grid
     y = rng.normal(size=cfg["theoh_n"])
-    with be.OtherLoad() as load:
-        best, times, r = be.timed(lambda: allanite.avar(y, 1.0, estimator="theoh", taus="exp"), reps, warmup=True)
-        a_best, a_times, _ = be.timed(lambda: allanite.avar(y, 1.0, taus="exp"), reps, warmup=True)
+    with _common.OtherLoad() as load:
+        best, times, r = _common.timed(lambda: allanite.avar(y, 1.0, estimator="theoh", taus="exp"), reps, warmup=True)
+        a_best, a_times, _ = _common.timed(lambda: allanite.avar(y, 1.0, taus="exp"), reps, warmup=True)
     out["theoh"] = {
         "n": y.size,
         "grid": "exp",
@@ -102,13 +101,13 @@ def part_timings(cfg: dict) -> dict:
         "theobr_points": int(np.sum(r.source == "theobr")),
         "other_processes_cpu_fraction": load.fraction,
     }
-    be.log(f"TheoH N={y.size}: {best:.3f} s ({r.tau.size} τ; OAVAR same grid {a_best:.3f} s)")
+    _common.log(f"TheoH N={y.size}: {best:.3f} s ({r.tau.size} τ; OAVAR same grid {a_best:.3f} s)")
 
     # 2. Theo1 vs allantools, N = 1e4, octave grid of even m
     y = rng.normal(size=cfg["theo1_n"])
     ms = [m for m in (10, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192) if m <= y.size]
-    with be.OtherLoad() as load:
-        best, times, r = be.timed(
+    with _common.OtherLoad() as load:
+        best, times, r = _common.timed(
             lambda: allanite.avar(y, 1.0, estimator="theo1", taus=0.75 * np.array(ms)), reps, warmup=True
         )
     entry = {"n": y.size, "m": ms, "seconds": best, "repeats": times, "other_processes_cpu_fraction": load.fraction}
@@ -117,8 +116,8 @@ def part_timings(cfg: dict) -> dict:
     except ImportError:
         entry["allantools"] = "not installed"
     else:
-        with be.OtherLoad() as load:
-            t_at, _, res = be.timed(
+        with _common.OtherLoad() as load:
+            t_at, _, res = _common.timed(
                 lambda: allantools.theo1(y, rate=1.0, data_type="freq", taus=np.array(ms, dtype=float)), 1
             )
         taus_at, dev_at = np.asarray(res[0]), np.asarray(res[1])
@@ -138,7 +137,7 @@ def part_timings(cfg: dict) -> dict:
                 "allantools_other_processes_cpu_fraction": load.fraction,
             }
         )
-        be.log(
+        _common.log(
             f"Theo1 N={y.size}: allanite {best * 1e3:.2f} ms, allantools {t_at:.1f} s → {t_at / best:.0f}×, "
             f"max rel diff {diff:.2e} at corrected τ"
         )
@@ -147,11 +146,13 @@ def part_timings(cfg: dict) -> dict:
     # 3. DHVAR, N = 4e4, window 401, hop 1
     y = rng.normal(size=cfg["dhvar_n"])
     w = cfg["dhvar_window"]
-    with be.OtherLoad() as load:
-        best, times, d = be.timed(
+    with _common.OtherLoad() as load:
+        best, times, d = _common.timed(
             lambda: allanite.davar(y, 25.0, window=w, hop=1, estimator="theoh", taus="exp"), reps, warmup=True
         )
-        a_best, a_times, da = be.timed(lambda: allanite.davar(y, 25.0, window=w, hop=1, taus="exp"), reps, warmup=True)
+        a_best, a_times, da = _common.timed(
+            lambda: allanite.davar(y, 25.0, window=w, hop=1, taus="exp"), reps, warmup=True
+        )
     out["dhvar"] = {
         "n": y.size,
         "window": w,
@@ -165,7 +166,7 @@ def part_timings(cfg: dict) -> dict:
         "davar_tau_points": int(da.tau.size),
         "other_processes_cpu_fraction": load.fraction,
     }
-    be.log(f"DHVAR N={y.size} W={w}: {best:.3f} s ({d.tau.size} τ × {d.t.size} windows); DAVAR {a_best:.3f} s")
+    _common.log(f"DHVAR N={y.size} W={w}: {best:.3f} s ({d.tau.size} τ × {d.t.size} windows); DAVAR {a_best:.3f} s")
     return out
 
 
@@ -404,13 +405,13 @@ def run(quick: bool = False, out: Path | None = None, wait: float = 0.0) -> dict
     cfg = CONFIGS["quick" if quick else "full"]
     out = Path(out) if out is not None else (Path(tempfile.mkdtemp()) if quick else HERE / "results")
     out.mkdir(parents=True, exist_ok=True)
-    idle = be.wait_idle(wait) if wait > 0 else None
-    report = {"config": cfg, "machine": be.machine_info(), "idle_wait": idle}
+    idle = _common.wait_idle(wait) if wait > 0 else None
+    report = {"config": cfg, "machine": _common.machine_info(), "idle_wait": idle}
     report["timings"] = part_timings(cfg)
     report["paper001"] = part_paper001(cfg, out)
     (out / "theo.json").write_text(json.dumps(report, indent=1, default=float))
     write_markdown(report, out / "theo.md")
-    be.log(f"wrote {out / 'theo.md'}")
+    _common.log(f"wrote {out / 'theo.md'}")
     return report
 
 

@@ -8,10 +8,13 @@ defaulting to ``<repo>/../shared/data``; tests that need them skip with a clear 
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from allanite.results import AllanResult
 
 DEFAULT_SHARED_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
@@ -40,6 +43,32 @@ def stable32_dir(shared_data: Path) -> Path:
     if not path.is_dir():
         pytest.skip(f"Stable32 reference tables not found at {path}")
     return path
+
+
+def read_avar_curve(path: Path) -> dict:
+    """The avar package's curve CSV → {channel: AllanResult}; fs and n from the first comment line.
+    (Its estimator sums T − 2m terms over T − 2m + 1, ≤ 6e-6 from the textbook value: left as is.)"""
+    lines = path.read_text().splitlines()
+    meta = dict(re.findall(r"(\w+)=([^;]+)", lines[0]))
+    fs, n = float(meta["freq_Hz"]), int(float(meta["n"]))
+    chans: dict = {}
+    for row in (ln.split(",") for ln in lines[1:] if ln and not ln.startswith("#")):
+        if row[0] == "channel":
+            continue
+        chans.setdefault(row[0], []).append((float(row[1]), float(row[2])))
+    out = {}
+    for ch, v in chans.items():
+        a = np.array(v)
+        m = np.round(a[:, 0] * fs).astype(np.int64)
+        out[ch] = AllanResult(tau=m / fs, avar=a[:, 1], n=n + 1 - 2 * m, m=m, estimator="oavar", fs=fs, n_samples=n)
+    return out
+
+
+@pytest.fixture(scope="session")
+def load_avar_curve():
+    """The reader of the ``avar`` package's Allan-curve CSVs (``../shared/data/avar-curves``), as a
+    fixture so that test modules share it without importing one another."""
+    return read_avar_curve
 
 
 @pytest.fixture

@@ -1,4 +1,4 @@
-"""Confidence intervals: Greenhall EDF, noise identification, χ² bounds — against FORMULAS.md §5,
+"""Confidence intervals: Greenhall EDF, noise identification, χ² bounds — against docs/FORMULAS.md §7, §8,
 Stable32's printed tables (PHASE.DAT, OCXO and the other clock records in ../shared/data/stable32)
 and coverage by simulation.
 
@@ -117,7 +117,7 @@ def _table(s32: Path, name: str) -> dict:
 
 
 def test_edf_greenhall_formulas_check_values():
-    """FORMULAS.md §5: OADEV, N = 1001: ν(m=1) = 514, 782, 762; ν(m=100) = 440, 12.8, 7.75."""
+    """docs/FORMULAS.md §7.2: OADEV, N = 1001: ν(m=1) = 514, 782, 762; ν(m=100) = 440, 12.8, 7.75."""
     at1 = [edf_greenhall(a, 2, 1, 1001) for a in (2, 0, -2)]
     at100 = [edf_greenhall(a, 2, 100, 1001) for a in (2, 0, -2)]
     assert [round(v) for v in at1] == [514, 782, 762]

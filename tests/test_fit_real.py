@@ -24,7 +24,6 @@ Reading one ADIS file takes about a second; the module reads all six once.
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 
 import numpy as np
@@ -75,25 +74,6 @@ def adis(adis_dir):
     return runs
 
 
-def load_curve(path: Path) -> dict:
-    """The avar package's curve CSV → {channel: AllanResult}; fs and n from the first comment line.
-    (Its estimator sums T − 2m terms over T − 2m + 1, ≤ 6e-6 from the textbook value: left as is.)"""
-    lines = path.read_text().splitlines()
-    meta = dict(re.findall(r"(\w+)=([^;]+)", lines[0]))
-    fs, n = float(meta["freq_Hz"]), int(float(meta["n"]))
-    chans: dict = {}
-    for row in (ln.split(",") for ln in lines[1:] if ln and not ln.startswith("#")):
-        if row[0] == "channel":
-            continue
-        chans.setdefault(row[0], []).append((float(row[1]), float(row[2])))
-    out = {}
-    for ch, v in chans.items():
-        a = np.array(v)
-        m = np.round(a[:, 0] * fs).astype(np.int64)
-        out[ch] = AllanResult(tau=m / fs, avar=a[:, 1], n=n + 1 - 2 * m, m=m, estimator="oavar", fs=fs, n_samples=n)
-    return out
-
-
 def test_adis_samples_are_lsb_multiples(adis):
     assert adis[0]["lsb_multiple"]
 
@@ -134,8 +114,8 @@ def test_adis_quantization_is_consistent_with_the_lsb_but_not_resolved(adis):
         assert n_q / f.coefficients["N"].value < 0.05
 
 
-def test_avar_curve_of_run1_gives_run1s_coefficients(adis, curves_dir):
-    curves = load_curve(curves_dir / "adis_av.csv")
+def test_avar_curve_of_run1_gives_run1s_coefficients(adis, curves_dir, load_avar_curve):
+    curves = load_avar_curve(curves_dir / "adis_av.csv")
     for k, ch in enumerate(("Gyro. X", "Gyro. Y", "Gyro. Z")):
         r = curves[ch]
         keep = r.tau >= TAU_MIN - 1e-12
@@ -157,8 +137,8 @@ def test_avar_curve_of_run1_gives_run1s_coefficients(adis, curves_dir):
             assert run["cut"][k].coefficients["N"].value == pytest.approx(f.coefficients["N"].value, rel=0.15)
 
 
-def test_navchip_vignette_values_and_allanite_fit(curves_dir):
-    curves = load_curve(curves_dir / "navchip_av.csv")
+def test_navchip_vignette_values_and_allanite_fit(curves_dir, load_avar_curve):
+    curves = load_avar_curve(curves_dir / "navchip_av.csv")
     gyros = [curves[f"Gyro. {a}"] for a in "XYZ"]
     assert gyros[0].fs == 250.0 and gyros[0].n_samples == 3_105_250
 

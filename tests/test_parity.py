@@ -444,7 +444,7 @@ def test_results_report_the_grid_they_used(rng, kind):
 
 
 # --------------------------------------------------------------------------------------------------
-# Numerics: the adversarial record (FORMULAS.md §2: plain prefix sums lose every digit here)
+# Numerics: the adversarial record (docs/FORMULAS.md §3.3: plain prefix sums lose every digit here)
 # --------------------------------------------------------------------------------------------------
 
 ADV_N = 2_100_000
@@ -518,7 +518,7 @@ def test_adversarial_record_defeats_plain_prefix_sums(adversarial_record):
 
 
 def test_fast_survives_a_single_huge_outlier(rng):
-    """FORMULAS.md §2's drift scenario, scaled down: one 1e6 outlier long before the windows checked."""
+    """The drift scenario of docs/FORMULAS.md §3.3, scaled down: one 1e6 outlier long before the windows checked."""
     y = rng.normal(size=400_000)
     y[1_000] = 1e6
     d = allanite.davar(y, 1.0, window=1_000, hop=1, taus=[1.0, 10.0, 100.0])

@@ -260,19 +260,14 @@ def test_real_adis_noise_with_an_injected_sinusoid_and_step(shared_data):
     assert any(abs(c - t_step) < window for c in cps)
 
 
-def test_an_effect_must_lower_chi2_dof(shared_data):
+def test_an_effect_must_lower_chi2_dof(shared_data, load_avar_curve):
     # LN200 accelerometer Y (avar package's curve): the five terms are grossly wrong (χ²/dof ~2000); after a
     # sinusoid-shaped bump a Gauss–Markov term still passed the BIC test while raising χ²/dof (301.6 → 306.2).
     # Every accepted step must lower χ²/dof.
-    import sys
-
-    sys.path.insert(0, str(__import__("pathlib").Path(__file__).parent))
-    from test_fit_real import load_curve
-
     path = shared_data / "avar-curves" / "ln200_av.csv"
     if not path.is_file():
         pytest.skip(f"{path} not present")
-    res = load_curve(path)["Accel. Y"]
+    res = load_avar_curve(path)["Accel. Y"]
     r = allanite.refine(res, candidates=("gauss_markov", "sinusoid"), tau_range=(0.1, None))
     assert r.steps and r.steps[0].before["chi2_dof"] > 1000
     for st in r.steps:

@@ -1,4 +1,4 @@
-"""The simulator: every term's Allan variance against its closed form (FORMULAS.md §6), within the
+"""The simulator: every term's Allan variance against its closed form (docs/FORMULAS.md §4.4, §5), within the
 estimate's own χ² interval across τ; time-varying coefficients; bad parameters.
 
 How the check works. For each term a few records (10⁵ and 10⁶ samples at 100 Hz, fixed seeds) are
@@ -16,7 +16,7 @@ Discrete-time effects, handled rather than skipped:
   plateau (2 ln2/π)B² at m = 8, 0.04 % at m = 64; the plateau itself from m > 1024;
 * Gauss–Markov: the discrete AR(1) form σ_w²[n − 3φ − nφ² + 4φ^(n+1) − φ^(2n+1)]/[n²(1−φ)²(1−φ²)];
 * sinusoid: the m-sample average's exact Ω0²·sin²(πf0τ)·[sin(πf0τ)/(m·sin(πf0τ0))]², which tends
-  to the continuous Ω0²·sin⁴(πf0τ)/(πf0τ)² (FORMULAS writes it Ω0²[sin²(πf0τ)/(πf0τ)]²);
+  to the continuous Ω0²·sin⁴(πf0τ)/(πf0τ)² (docs/FORMULAS.md §5 writes it Ω0²[sin²(πf0τ)/(πf0τ)]²);
 * quantization (white angle, differenced), white rate and the ramp are exact for sampled data.
 """
 
@@ -156,7 +156,7 @@ def test_gauss_markov_matches_the_discrete_ar1_form():
     closed = lambda r: ar1_avar(r.m, phi, sigma)  # noqa: E731
     share = inside_share(records(gauss_markov=[(sigma, tc)]), closed, lambda r, mdl: alpha_from_slope(r.tau, mdl))
     assert share >= 0.85
-    # the peak of the ADEV: τ ≈ 1.893 Tc, σ ≈ 0.4365·q_c·√Tc with q_c = σ√(2/Tc) (FORMULAS §6)
+    # the peak of the ADEV: τ ≈ 1.893 Tc, σ ≈ 0.4365·q_c·√Tc with q_c = σ√(2/Tc) (docs/FORMULAS.md §5)
     tau = np.linspace(0.2, 3.0, 2801)
     adev = np.sqrt(ar1_avar(tau * FS, phi, sigma))
     assert tau[np.argmax(adev)] == pytest.approx(1.893 * tc, rel=0.01)
@@ -172,7 +172,7 @@ def test_sinusoid_matches_its_closed_form_and_nulls():
     # deterministic: the estimate differs from the phase-averaged form by O(1/periods in the record)
     assert np.allclose(r.avar, closed, rtol=1e-2, atol=1e-3 * amp**2)
     assert r.avar[r.tau == 2.0][0] < 1e-6 * amp**2 and r.avar[r.tau == 4.0][0] < 1e-6 * amp**2
-    # the continuous-time form of FORMULAS §6, Ω0²[sin²(πf0τ)/(πf0τ)]², is the same to < 1e-3
+    # the continuous-time form of docs/FORMULAS.md §5, Ω0²[sin²(πf0τ)/(πf0τ)]², is the same to < 1e-3
     x = np.pi * f0 * r.tau
     assert np.allclose(closed, amp**2 * (np.sin(x) ** 2 / x) ** 2, rtol=1e-3, atol=1e-9)
 

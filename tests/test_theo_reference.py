@@ -88,7 +88,7 @@ def test_theo1_rejects_bad_m(m):
 
 @pytest.mark.parametrize("m, printed", [(10, "0.107573989"), (100, "0.0317893126"), (1000, "0.0050523996")])
 def test_nbs14_theo1_deviation(m, printed):
-    """FORMULAS.md §4: the phase is the cumulative sum of the NBS14 frequencies with x_0 = 0
+    """docs/FORMULAS.md §6.4: the phase is the cumulative sum of the NBS14 frequencies with x_0 = 0
     (N = 1001 phase points, τ0 = 1); τ = 0.75·m."""
     x = nbs14_phase()
     dev = np.sqrt(R.theo1_from_angle(x, 1.0, m))

@@ -143,7 +143,7 @@ def test_rate_unit_of_angles():
     assert rate_unit("arcmin").factor == pytest.approx(1 / 60)  # arcmin/s, not in the table
 
 
-# IEEE-952 factors (FORMULAS.md §6), from °/s samples
+# IEEE-952 factors (docs/FORMULAS.md §4.2), from °/s samples
 @pytest.mark.parametrize(
     "term, to, factor, label",
     [

@@ -80,7 +80,7 @@ def davar_prefix(y, fs, window, hop, ms) -> np.ndarray:
 
 
 def nbs14_1000() -> np.ndarray:
-    """The NBS14 / NIST SP 1065 1000-point test data (FORMULAS.md §4): n₀ = 1234567890,
+    """The NBS14 / NIST SP 1065 1000-point test data (docs/FORMULAS.md §2.4): n₀ = 1234567890,
     n_{i+1} = 16807·n_i mod 2147483647, y_i = n_i / 2147483647, the seed being the first sample."""
     n = 1234567890
     out = np.empty(1000)
@@ -170,7 +170,7 @@ def _avar_tau0(x, tau0, m, dtype=np.float64):
 def theobr_n(n_points, rule="textbook") -> int:
     """Last index n of the kf average for N phase points.
 
-    ``"textbook"``: n = ⌊0.1·N/3 − 3⌋ (Howe, Tasset & Taylor; FORMULAS.md §3), the AVAR m = 9 … 9+3n
+    ``"textbook"``: n = ⌊0.1·N/3 − 3⌋ (Howe, Tasset & Taylor; docs/FORMULAS.md §6.2), the AVAR m = 9 … 9+3n
     covering τ up to ≈ 10 % of T. ``"stable32"``: n = ⌊N/6 − 3⌋, AVAR m up to ≈ N/2 (found by
     reproducing Stable32's Thêo1/ThêoH tables; the same rule is noted in allantoolkit's docs for
     Stable32's Run/Plot functions). Computed in exact integer arithmetic.

@@ -1,6 +1,6 @@
 """Simulated gyro rate records with known IEEE-952 noise terms.
 
-Every term is generated so that its Allan variance is the closed form of FORMULAS.md §6 (with the
+Every term is generated so that its Allan variance is the closed form of docs/FORMULAS.md §4.4, §5 (with the
 discrete-time effects named where they matter):
 
 ==========  ====================================  ===========================================

@@ -17,7 +17,7 @@ K     rate random walk           u/√s            °/h^1.5   (×216000)
 R     rate ramp                  u/s             °/h²      (×1.296e7)
 ====  =========================  ==============  ========================
 
-(FORMULAS.md §6: N[°/√h] = 60·N[°/√s], B[°/h] = 3600·B[°/s], K[°/h^1.5] = 216000·K[°/s^1.5],
+(docs/FORMULAS.md §4.2: N[°/√h] = 60·N[°/√s], B[°/h] = 3600·B[°/s], K[°/h^1.5] = 216000·K[°/s^1.5],
 R[°/h²] = 1.296e7·R[°/s²], Q[arcsec] = 3600·Q[°].) When the samples are angles (``input=
 "increment"`` or ``"angle"``), the Allan deviation is in that angle per second and the same table
 applies to the rate unit angle/s.

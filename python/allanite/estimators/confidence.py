@@ -265,7 +265,7 @@ def edf_greenhall(alpha, d, m, N, overlapping=True, modified=False):
 
     Examples
     --------
-    The values of FORMULAS.md §5 (overlapping ADEV of 1001 phase points):
+    The values of docs/FORMULAS.md §7.2 (overlapping ADEV of 1001 phase points):
 
     >>> from allanite.estimators.confidence import edf_greenhall
     >>> [round(float(edf_greenhall(a, 2, 1, 1001)), 1) for a in (2, 0, -2)]

@@ -4,7 +4,7 @@ variance space, iteratively reweighted by the model's own variance of each estim
 The model and its terms: :mod:`allanite.model.terms`.
 
 Why not a line fit in log-log space: ln σ̂² is biased low by ≈ 1/ν and its variance 2/ν makes the
-few-cluster long-τ points weigh as much as the good ones (``docs/FORMULAS.md`` §7).
+few-cluster long-τ points weigh as much as the good ones (``docs/FORMULAS.md`` §9).
 
 Overlapping estimates (the default estimator) are fitted by generalized least squares with their
 exact covariance across τ under the model (:mod:`allanite.model._covariance`): neighbouring estimates share

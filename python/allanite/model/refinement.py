@@ -2,7 +2,7 @@
 
 :func:`refine` fits the starting IEEE-952 model (weighted least squares in variance space, as
 :func:`allanite.fit`), looks at the normalised residual per τ, and tries each candidate effect by its
-Allan-variance signature (closed forms, ``../shared/FORMULAS.md`` §6 and the references below):
+Allan-variance signature (closed forms, ``docs/FORMULAS.md`` §5 and the references below):
 
 - ``"gauss_markov"`` — first-order Gauss–Markov rate of variance σ² and correlation time T_c:
   σ²_A(τ) = σ²·(T_c/τ)²·(2τ/T_c − 3 + 4e^{−τ/T_c} − e^{−2τ/T_c}) (IEEE Std 952 App. C; a bump that

@@ -1,6 +1,6 @@
 """The IEEE-952 noise terms — one registry entry each: name, meaning, noise type, Allan-variance column.
 
-Model (``docs/FORMULAS.md`` §6, IEEE Std 952-1997 Annex C), τ in s, coefficients in the input unit's
+Model (``docs/FORMULAS.md`` §4.1, IEEE Std 952-1997 Annex C), τ in s, coefficients in the input unit's
 base form:
 
     σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²·τ0(2m² + 1)/(6m) + R²τ²/2

@@ -13,7 +13,7 @@ __all__ = [
     "default_hop",
 ]
 
-#: The model the report fits (docs/FORMULAS.md §6; the K column is exact for a sampled random walk).
+#: The model the report fits (docs/FORMULAS.md §4.1; the K column is exact for a sampled random walk).
 FIT_MODEL = "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²·τ0·(2m²+1)/(6m) + R²·τ²/2"
 #: Fraction of the record that is the default DAVAR window, and of the window that is the default hop.
 WINDOW_FRACTION = 12

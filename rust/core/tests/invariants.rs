@@ -116,7 +116,7 @@ proptest! {
 
 #[test]
 fn nist_sp1065_suite() {
-    // NBS14 1000-point data, FORMULAS.md §4.
+    // NBS14 1000-point data, docs/FORMULAS.md §2.4.
     let mut n: u64 = 1234567890;
     let y: Vec<f64> = (0..1000)
         .map(|_| {
