@@ -204,7 +204,7 @@ class AllanResult(_ResultBase):
         Averaging factors, τ = m / fs.
     estimator : str
         ``"oavar"`` (overlapping) or ``"avar"`` (classic, non-overlapping); ``"theo1"``, ``"theobr"``
-        or ``"theoh"`` (see :mod:`allanite.theo`: Theo1 values belong to τ = 0.75·m/fs).
+        or ``"theoh"`` (see :mod:`allanite.estimators.theo`: Theo1 values belong to τ = 0.75·m/fs).
     fs : float
         Sampling rate, Hz.
     n_samples : int

@@ -24,7 +24,7 @@ in between (Euler–Maclaurin error < 1e-3 relative); for flicker, whose correla
 the tail is integrated on octave-growing pieces out to the record length.
 
 Only the overlapping estimator is covered (the classic estimator and Theo keep the octave-correlation
-model of :mod:`allanite.fit`).
+model of :func:`allanite.fit`).
 """
 
 from __future__ import annotations

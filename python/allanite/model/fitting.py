@@ -290,7 +290,7 @@ def _chol(cov: np.ndarray) -> np.ndarray:
 def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
     """Generalized least squares with the estimates' exact covariance, iterated from the model.
 
-    Σ(θ) = Cov(σ̂²(τ_i), σ̂²(τ_j)) under the fitted model (:mod:`allanite._covariance`: the
+    Σ(θ) = Cov(σ̂²(τ_i), σ̂²(τ_j)) under the fitted model (:mod:`allanite.model._covariance`: the
     overlapping estimator's second differences, each term's generalized covariance, summed over all
     lags), so correlated neighbours are neither overcounted nor thrown away. Each pass solves the
     non-negative least squares of the whitened problem L⁻¹Aθ ≈ L⁻¹σ̂² (Σ = LLᵀ) with Σ from the
