@@ -314,7 +314,10 @@ def test_reader_warnings_are_one_line_and_in_the_report(tmp_path, rng, capfd):
     "args, message",
     [
         (["report", "missing.npy", "--fs", "1"], "missing.npy: no such file"),
-        (["report", "{log}"], "give the sampling rate with --fs HZ, or the time column with --time-column C"),
+        (
+            ["report", "{log}"],
+            "give the sampling rate (--fs HZ) or the time column (--time-column C) — neither was passed",
+        ),
         (
             ["report", "{log}", "--fs", "abc"],
             "argument --fs: invalid float value: 'abc' (see 'allanite report --help')",

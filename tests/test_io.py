@@ -531,12 +531,18 @@ def test_non_finite_and_bad_arrays(tmp_path):
 def test_parameter_errors(tmp_path, record):
     t, x = record
     p = write_text(tmp_path / "log.csv", t, x)
+    # neither fs nor time_column: the column named "t" is recognised as the time column, and said so
+    log = read_log(p, columns=["gx"])
+    assert log.time_column == "t" and log.time_column_recognised and log.fs == FS
+    assert "time column 't' (recognised by its name)" in repr(log)
+    q = tmp_path / "nameless.csv"
+    q.write_text("a,b\n1,2\n3,4\n")
     with pytest.raises(
         ParameterError,
-        match=r"log\.csv: give the sampling rate \(fs=… in Hz\) or the time column "
-        r"\(time_column=…\) — neither was passed",
+        match=r"nameless\.csv: give the sampling rate \(fs=… in Hz\) or the time column "
+        r"\(time_column=…\) — neither was passed, and no column is named like a time column",
     ):
-        read_log(p, columns=["gx"])
+        read_log(q)
     with pytest.raises(ParameterError, match=r"log\.csv: column 't' looks like a time column; pass time_column='t'"):
         read_log(p, fs=FS)
     with pytest.raises(

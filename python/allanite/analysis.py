@@ -9,17 +9,66 @@ memory budget and wraps the arrays into :class:`~allanite.AllanResult` /
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 
 from . import estimators
 from ._validate import as_rate_columns, check_choice, check_count, resolve_max_memory
-from .errors import MemoryBudgetError, ParameterError
+from .errors import InputError, MemoryBudgetError, ParameterError
 from .results import AllanResult, DynamicAllanResult
 
 __all__ = ["avar", "davar", "METHODS"]
 
 #: ``method=`` of :func:`davar`: sliding sums, or every window recomputed (paper 000's DAVAR).
 METHODS = ("fast", "naive")
+
+#: Samples whose largest magnitude lies outside [2^-SAFE_EXP, 2^SAFE_EXP] are scaled by a power of two
+#: (exact in floating point) before the core squares them, and the result is scaled back: squares of
+#: 1e154 overflow and of 1e-160 underflow, while the Allan variance itself may be representable.
+SAFE_EXP = 200
+
+
+def _scale_columns(cols: list[np.ndarray]) -> tuple[list[np.ndarray], list[int]]:
+    """Columns scaled into the safe range, and each column's power-of-two exponent e (sample = scaled·2^e)."""
+    out, exps = [], []
+    for c in cols:
+        peak = float(np.max(np.abs(c))) if c.size else 0.0
+        if peak == 0.0 or 2.0**-SAFE_EXP < peak < 2.0**SAFE_EXP:
+            out.append(c)
+            exps.append(0)
+            continue
+        e = math.frexp(peak)[1]
+        out.append(np.ldexp(c, -e))
+        exps.append(e)
+    return out, exps
+
+
+def _unscale(values: np.ndarray, exps: list[int], power: int, cols: list[np.ndarray], what: str) -> np.ndarray:
+    """Values (axes first) scaled back by 2^(power·e) per axis, or an InputError when the result is not a
+    float64 (overflow, or below the normal range) — naming the scale of the samples."""
+    out = []
+    for a, (v, e) in enumerate(zip(values, exps)):
+        peak = float(np.max(np.abs(cols[a]))) if cols[a].size else 0.0
+        where = f"axis {a}: " if len(values) > 1 else ""
+        pos = v[v > 0]
+        # binary exponent of the result: log2 of the scaled value plus power·e, judged before scaling back
+        top = float(np.log2(pos.max())) + power * e if pos.size else -math.inf
+        bottom = float(np.log2(pos.min())) + power * e if pos.size else math.inf
+        if not np.all(np.isfinite(v)) or top >= 1024:
+            raise InputError(
+                f"{where}the {what} of samples of magnitude up to {peak:.3g} exceeds float64's range (≈1.8e308): "
+                f"express the samples in a larger unit (e.g. divide them by 1e{max(1, int(math.log10(peak)) // 2)})"
+            )
+        if bottom < -1022:
+            raise InputError(
+                f"{where}the {what} (about 2^{bottom:.0f} ≈ 1e{bottom * math.log10(2):.0f}) is below float64's normal "
+                f"range (2.2e-308) for samples of magnitude up to {peak:.3g}: express the samples in a smaller unit "
+                f"(e.g. multiply them by 1e{max(1, int(-math.log10(peak)) // 2) if peak > 0 else 100})"
+            )
+        out.append(np.ldexp(v, power * e) if e else v)
+    return np.stack(out) if any(exps) else values
 
 
 def avar(
@@ -88,8 +137,9 @@ def avar(
     options = entry.check_options({"kf_rule": kf_rule, "decimate": decimate})
     cols, fs, is_multi = as_rate_columns(x, fs, input)
     assert entry.static is not None
-    out = entry.static(cols, fs, taus, workers, **options)
-    values: np.ndarray = out.values
+    scaled, exps = _scale_columns(cols)
+    out = entry.static(scaled, fs, taus, workers, **options)
+    values: np.ndarray = _unscale(out.values, exps, entry.unit_power, cols, entry.label)
     kf: np.ndarray | float | None = out.kf
     if not is_multi:
         values, kf = values[0], (None if out.kf is None else float(out.kf[0]))
@@ -214,7 +264,9 @@ def davar(
     # A hop beyond the record gives one window, as does the record length itself.
     hop_core = min(hop, n)
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
-    out = entry.dynamic(cols, fs, window, hop_core, taus, method, workers, **options)
+    scaled, exps = _scale_columns(cols)
+    out = entry.dynamic(scaled, fs, window, hop_core, taus, method, workers, **options)
+    out = dataclasses.replace(out, values=_unscale(out.values, exps, entry.unit_power, cols, entry.label))
     kf = out.kf
     return DynamicAllanResult(
         tau=out.tau,

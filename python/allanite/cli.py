@@ -20,7 +20,7 @@ from tqdm import tqdm
 from ._core import __version__
 from .datasets import default_record
 from .errors import AllaniteError
-from .io import read_log, sniff_format
+from .io import read_log
 from .report import build_report, from_log
 
 EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
@@ -259,6 +259,7 @@ def _cli_words(message: str) -> str:
         r"\b(gaps|input|time_unit)='([a-z]+)'", lambda m: f"--{m.group(1).replace('_', '-')} {m.group(2)}", message
     )
     message = message.replace("drop fs=,", "drop --fs,").replace("time_unit=", "--time-unit")
+    message = message.replace("(fs=… in Hz)", "(--fs HZ)").replace("(time_column=…)", "(--time-column C)")
     return " ".join(message.split())
 
 
@@ -266,8 +267,6 @@ def _read(args, progress):
     path = Path(args.log)
     if not path.exists():
         raise AllaniteError(f"{path}: no such file")
-    if args.fs is None and args.time_column is None and sniff_format(path) not in ("ros1", "ros2"):
-        raise AllaniteError(f"{path}: give the sampling rate with --fs HZ, or the time column with --time-column C")
     progress.step(f"reading {path.name}")
     kwargs = {}
     if args.time_unit is not None:

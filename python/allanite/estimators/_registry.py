@@ -74,6 +74,9 @@ class Estimator:
     resolve_m : callable, optional
         ``resolve_m(taus, n, fs) -> m`` — the averaging factors ``taus`` give on ``n`` samples, checked,
         before anything is computed (to size the output against the memory budget).
+    unit_power : int
+        Its values scale as the samples to this power (2 for variances): samples scaled by c give
+        values scaled by c**unit_power.
     """
 
     name: str
@@ -88,6 +91,7 @@ class Estimator:
     methods: tuple[str, ...] = ("fast",)
     noise_id: str = "oavar"
     resolve_m: Callable[..., np.ndarray] | None = None
+    unit_power: int = 2
 
     def check_options(self, given: Mapping[str, Any]) -> dict[str, Any]:
         """The options this estimator takes, from ``given`` (name → value as passed). A value other

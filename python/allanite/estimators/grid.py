@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from .._validate import check_count, check_fs, check_real
-from ..errors import ParameterError
+from .._validate import check_count, check_fs, check_real, resolve_max_memory
+from ..errors import MemoryBudgetError, ParameterError
 
 __all__ = ["tau_grid", "GRIDS", "resolve_taus", "max_m", "m_grid"]
 
@@ -21,6 +21,8 @@ GRIDS = ("all", "octave", "decade", "exp")
 
 #: Paper 000 §4.2 keeps at least 9 clusters at the largest τ (≈ 25 % estimate error).
 EXP_MIN_CLUSTERS = 9
+#: Sample counts beyond this (4.6e18) are no record: m and term counts must fit in int64.
+MAX_SAMPLES = 2**62
 #: Paper 000's example uses 100 points.
 EXP_DEFAULT_POINTS = 100
 
@@ -29,6 +31,19 @@ def max_m(n: int) -> int:
     """Largest averaging factor the Allan estimators accept for ``n`` rate samples (N − 2m ≥ 1
     angle differences, at least two clusters): ``n // 2``."""
     return int(n) // 2
+
+
+def _check_budget(count: int, kind: str, n: int) -> None:
+    """Refuse a grid whose m array alone would exceed the memory budget, before allocating it."""
+    budget = resolve_max_memory(None)
+    nbytes = 8 * int(count)
+    if nbytes > budget:
+        raise MemoryBudgetError(
+            f"the {kind!r} τ grid for {n} samples has {count} τ ({nbytes / 2**30:.3g} GiB as int64), over the "
+            f"memory budget of {budget / 2**30:.3g} GiB (ALLANITE_MAX_MEMORY): "
+            + ("use a larger growth or fewer points" if kind == "exp" else "use the 'exp', 'octave' or 'decade' grid")
+            + ", or m_max"
+        )
 
 
 def m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0, m_max=None) -> np.ndarray:
@@ -48,6 +63,7 @@ def m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0,
     if kind != "exp" and (growth is not None or points is not None or tau_min is not None):
         raise ParameterError(f"growth, points and tau_min apply to the 'exp' grid only, not {kind!r}")
     if kind == "all":
+        _check_budget(top, kind, n)
         return np.arange(1, top + 1, dtype=np.int64)
     if kind == "octave":
         return 2 ** np.arange(0, int(math.floor(math.log2(top))) + 1, dtype=np.int64)
@@ -85,6 +101,7 @@ def m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0,
         count = int(math.floor(math.log(top / m0) / math.log(growth) + 1e-9)) + 1
         last = int(math.floor(m0 * growth ** (count - 1) + 0.5))
         m_star = min(top, last, max(m0, int(math.ceil(1.0 / (growth - 1.0))) if growth - 1.0 > 1.0 / top else top))
+        _check_budget(m_star - m0 + 1, kind, n)
         dense = np.arange(m0, m_star + 1, dtype=np.int64)
         i0 = max(0, int(math.floor(math.log(m_star / m0) / math.log(growth))))
         raw = np.floor(m0 * growth ** np.arange(i0, max(i0, count)) + 0.5).astype(np.int64)
@@ -142,7 +159,7 @@ def tau_grid(
     (76, 1111.0)
     """
     fs = check_fs(fs)
-    n = check_count(n, "n", 1)
+    n = check_count(n, "n", 1, MAX_SAMPLES)
     if not isinstance(kind, str):
         raise ParameterError(f"kind must be one of {GRIDS}, got {kind!r}")
     return m_grid(kind, n, growth=growth, points=points, tau_min=tau_min, fs=fs, m_max=m_max) / fs

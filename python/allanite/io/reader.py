@@ -15,7 +15,9 @@ from __future__ import annotations
 import gzip
 import numbers
 import os
+import tokenize
 import warnings
+import zipfile
 import zlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -24,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from .._validate import INPUTS, check_choice, check_fs
-from ..errors import DataGapError, InputError, MissingDependencyError, ParameterError
+from ..errors import AllaniteError, DataGapError, InputError, MissingDependencyError, ParameterError
 from ..units import Unit, parse_unit
 
 __all__ = ["read_log", "Log", "Gap", "sniff_format", "GAP_MODES", "GAP_FACTOR"]
@@ -48,6 +50,8 @@ _BAG_FIELDS = (
     "linear_acceleration_y",
     "linear_acceleration_z",
 )
+#: Names shown in the message when no time column is recognised.
+_KNOWN_TIME_SHOWN = ("time", "t", "timestamp", "stamp", "sec", "seconds", "header.stamp")
 _TIME_NAMES = {
     "t",
     "time",
@@ -66,6 +70,11 @@ _TIME_NAMES = {
     "time_us",
     "time_ms",
     "epoch",
+    "header.stamp",
+    "header_stamp",
+    "header.stamp.sec",
+    "%time",
+    "field.header.stamp",
 }
 
 
@@ -152,6 +161,10 @@ class Log:
     time: np.ndarray | None = None
     jitter: float | None = None
     n_record: int = 0
+    #: Name of the time column the times came from (None without one), and whether it was recognised
+    #: by its name because neither ``fs`` nor ``time_column`` was given.
+    time_column: str | None = None
+    time_column_recognised: bool = False
 
     @property
     def n_samples(self) -> int:
@@ -182,7 +195,16 @@ class Log:
             lines.append("  timing: no time column (fs given; gaps cannot be detected)")
         else:
             jit = f", max jitter {100 * self.jitter:.3g} % of the step" if self.jitter is not None else ""
-            lines.append(f"  timing: t0 = {self.t0:.16g} s, {len(self.gaps)} gap(s){jit}")
+            which = (
+                (
+                    f"time column {self.time_column!r}"
+                    + (" (recognised by its name)" if self.time_column_recognised else "")
+                    + ", "
+                )
+                if self.time_column
+                else ""
+            )
+            lines.append(f"  timing: {which}t0 = {self.t0:.16g} s, {len(self.gaps)} gap(s){jit}")
         for g in self.gaps[:5]:
             lines.append(f"    gap: {g}")
         if len(self.gaps) > 5:
@@ -235,7 +257,10 @@ def read_log(
     time_column : str or int, optional
         Column of sample times (seconds unless ``time_unit`` says otherwise). Used to derive ``fs``
         and to find gaps and irregular sampling. For ``.npz`` it may also name a separate array. ROS
-        bags always use ``header.stamp`` (``time_column="receive"``: the bag's receive time).
+        bags always use ``header.stamp`` (``time_column="receive"``: the bag's receive time). When
+        neither ``fs`` nor ``time_column`` is given, a column named like a time column (``time``,
+        ``t``, ``timestamp``, ``stamp``, ``sec``, ``seconds``, ``header.stamp``, …) is taken as the
+        time column; ``Log.time_column`` says which (``Log.time_column_recognised`` is then True).
     unit : str, optional
         Unit of the samples (:func:`allanite.units.parse_unit`): a rate unit for ``input="rate"``, an
         angle unit for ``"increment"`` and ``"angle"``. ROS bags default to ``"rad/s"``.
@@ -308,9 +333,8 @@ def read_log(
             u = parse_unit("rad/s")  # REP 103: ROS angular velocity is in rad/s
     else:
         if fs is None and time_column is None:
-            raise ParameterError(
-                f"{path}: give the sampling rate (fs=… in Hz) or the time column (time_column=…) — neither was passed"
-            )
+            # neither given: a column named like a time column (time, t, timestamp, …) is the time column
+            time_column = AUTO_TIME
         if fmt == "npy":
             rec = _read_npy(path, columns, time_column)
         elif fmt == "npz":
@@ -322,7 +346,9 @@ def read_log(
         if rec.time is not None and rec.time_is_seconds is False:
             rec.time = rec.time * TIME_UNITS[time_unit]
     fmt = "text" if fmt == "text.gz" else fmt
-    return _finish(path, fmt, rec, fs, u, input, gaps)
+    log = _finish(path, fmt, rec, fs, u, input, gaps)
+    log.time_column_recognised = time_column is AUTO_TIME and rec.time_name is not None
+    return log
 
 
 # --------------------------------------------------------------------------------------------------
@@ -435,9 +461,28 @@ def _resolve(spec, names, path, what="column"):
     return k % n
 
 
+#: Passed as ``time_column`` when neither fs nor a time column was given: recognise the time column by name.
+AUTO_TIME = "<recognise by name>"
+
+
+def _recognise_time(names, path) -> int:
+    """Index of the column whose name says it is time (``_TIME_NAMES``), or the error that fs is needed."""
+    hits = [i for i, c in enumerate(names) if c.strip().lower() in _TIME_NAMES]
+    if not hits:
+        raise ParameterError(
+            f"{path}: give the sampling rate (fs=… in Hz) or the time column (time_column=…) — neither was passed, "
+            f"and no column is named like a time column ({', '.join(sorted(_KNOWN_TIME_SHOWN))}, …); "
+            f"columns: {', '.join(map(repr, names[:12]))}"
+        )
+    return hits[0]
+
+
 def _select(columns, time_column, names, path, default=None):
     """(data column indices, time column index or None, squeeze to 1-D)."""
-    t_idx = None if time_column is None else _resolve(time_column, names, path, "time column")
+    if time_column is AUTO_TIME:
+        t_idx: int | None = _recognise_time(names, path)
+    else:
+        t_idx = None if time_column is None else _resolve(time_column, names, path, "time column")
     if columns is None:
         if default is not None:
             idx = [names.index(d) for d in default]
@@ -576,6 +621,7 @@ def _finish(path, fmt, rec: _Record, fs, unit, input, gaps) -> Log:
         time=time_rel,
         jitter=jitter,
         n_record=n,
+        time_column=rec.time_name if t is not None else None,
     )
 
 
@@ -787,6 +833,8 @@ def _array_record(path, arr, columns, time_column, label, extra_time=None):
     tname = None
     if arr.ndim == 1:
         names = ["col0"]
+        if time_column is AUTO_TIME:
+            _recognise_time(names, path)  # a lone column is never a time column: fs is needed
         if time_column is not None and extra_time is None:
             raise InputError(
                 f"{path}: {label} is 1-D (one column), so it cannot hold a time column "
@@ -826,19 +874,38 @@ def _array_record(path, arr, columns, time_column, label, extra_time=None):
     return _Record(data=data, names=out_names, time=time, time_name=tname, where=lambda r: f"row {r}")
 
 
+#: What NumPy's readers raise on damaged .npy/.npz bytes (header parser, zip layer, decompression).
+_DAMAGED = (
+    ValueError,
+    OSError,
+    EOFError,
+    zlib.error,
+    zipfile.BadZipFile,
+    tokenize.TokenError,
+    SyntaxError,
+    KeyError,
+    IndexError,
+    TypeError,
+    OverflowError,
+    MemoryError,
+    NotImplementedError,
+    UnicodeDecodeError,
+)
+
+
 def _read_npy(path, columns, time_column):
     try:
         arr = np.load(path, mmap_mode="r", allow_pickle=False)
-    except (ValueError, OSError, EOFError) as exc:
-        raise InputError(f"{path}: not a readable .npy file ({exc})") from None
+    except _DAMAGED as exc:  # a damaged header fails in NumPy's header parser with many exception types
+        raise InputError(f"{path}: not a readable .npy file ({type(exc).__name__}: {exc})") from None
     return _array_record(path, arr, columns, time_column, "the array")
 
 
 def _read_npz(path, columns, time_column, array):
     try:
         z = np.load(path, allow_pickle=False)
-    except (ValueError, OSError, EOFError, zlib.error) as exc:
-        raise InputError(f"{path}: not a readable .npz file ({exc})") from None
+    except _DAMAGED as exc:
+        raise InputError(f"{path}: not a readable .npz file ({type(exc).__name__}: {exc})") from None
     try:
         with z:
             files = list(z.files)
@@ -861,11 +928,13 @@ def _read_npz(path, columns, time_column, array):
                 raise InputError(f"{path}: no array named {array!r}; available: {', '.join(map(repr, files))}")
             try:
                 arr = z[array]
-            except (ValueError, OSError, EOFError, zlib.error) as exc:
-                raise InputError(f"{path}: array {array!r} cannot be read ({exc})") from None
+            except _DAMAGED as exc:
+                raise InputError(f"{path}: array {array!r} cannot be read ({type(exc).__name__}: {exc})") from None
             return _array_record(path, arr, columns, time_column, f"array {array!r}", extra_time=time_arr)
-    except (OSError, EOFError, zlib.error) as exc:  # pragma: no cover - damaged archive members
-        raise InputError(f"{path}: not a readable .npz file ({exc})") from None
+    except AllaniteError:
+        raise
+    except _DAMAGED as exc:  # damaged members: bad CRC, truncated streams, broken member headers
+        raise InputError(f"{path}: not a readable .npz file ({type(exc).__name__}: {exc})") from None
 
 
 # --------------------------------------------------------------------------------------------------

@@ -427,6 +427,8 @@ def log_source(log) -> dict:
         "columns": list(log.columns),
         "fs_hz": float(log.fs),
         "fs_from": "time column" if log.time is not None else "given",
+        "time_column": log.time_column,
+        "time_column_recognised": bool(log.time_column_recognised),
         "unit": log.unit.name if log.unit is not None else None,
         "input": log.input,
         "t0_s": json_number(log.t0),
@@ -447,6 +449,11 @@ def from_log(log, **kwargs) -> Report:
     """:func:`build_report` on a :class:`~allanite.Log` from :func:`allanite.read_log` (its unit,
     input kind, column names and reading notes)."""
     notes = list(kwargs.pop("notes", ()))
+    if log.time_column_recognised:
+        notes.append(
+            f"Neither fs nor a time column was given: column {log.time_column!r} was taken as the time "
+            f"column by its name; fs = {log.fs:g} Hz from its median step."
+        )
     if log.gaps:
         notes.append(
             f"The log has {len(log.gaps)} gap(s); only the longest gap-free stretch, samples "

@@ -62,6 +62,13 @@ def _record(rec: dict) -> dict:
     ):
         if src.get(key) is not None:
             rows.append((label, src[key]))
+    if src.get("time_column"):
+        how = (
+            " (recognised by its name: neither fs nor a time column was given)"
+            if src.get("time_column_recognised")
+            else ""
+        )
+        rows.append(("time column", f"{src['time_column']}{how}"))
     if src.get("gaps"):
         shown = "; ".join(f"{gap['duration_s']:.6g} s after sample {gap['after_sample']}" for gap in src["gaps"][:10])
         rows.append(("gaps", shown + (" …" if len(src["gaps"]) > 10 else "")))
