@@ -345,7 +345,7 @@ TABLES = [
     *(f"sr87/{d}/{g}/{s}.txt" for d in ["freq", "phase", "phase0"] for g in ["decade", "octave", "many"]
       for s in ["mdev", "omod", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev",
                 "mtie", "tierms"]
-      if not (d == "freq" and s in ("mtie", "tierms"))),
+      if not (d == "freq" and s in ("mtie", "tierms")) and not (g == "many" and s == "mtie")),
     "sr87/phase/fastu/mtie.txt", "sr87/phase0/fastu/mtie.txt",
 ]
 

@@ -299,8 +299,7 @@ impl TotScratch {
             *v = (*v - centre) - slope * (k as f64 - c);
         }
         // Uninverted even reflection: [rev(u), u, rev(u)].
-        for k in 0..n3 {
-            let v = u[k];
+        for (k, &v) in u.iter().enumerate() {
             self.star[n3 - 1 - k] = v;
             self.star[n3 + k] = v;
             self.star[3 * n3 - 1 - k] = v;
