@@ -55,7 +55,7 @@ TWIN = {"mvar": tw.mvar, "hvar": tw.hvar, "ohvar": tw.ohvar, "totvar": tw.totvar
 
 def max_m(est: str, n_rate: int) -> int:
     return {"mvar": (n_rate + 1) // 3, "mtotvar": (n_rate + 1) // 3, "hvar": n_rate // 3,
-            "ohvar": n_rate // 3, "htotvar": n_rate // 3, "totvar": n_rate - 1,
+            "ohvar": n_rate // 3, "htotvar": n_rate // 3, "totvar": n_rate,
             "oavar": n_rate // 2}[est]
 
 

@@ -64,13 +64,14 @@ impl Kind {
 /// Largest averaging factor `kind` accepts for a record of `n_rate` rate samples (0: none).
 ///
 /// OAVAR: 2m ≤ M; MVAR and MTOTVAR: 3m ≤ N = M + 1; HVAR, OHVAR and HTOTVAR: 3m ≤ M;
-/// TOTVAR: m ≤ M − 1 (the reflected record of SP 1065 eq. 25 reaches that far).
+/// TOTVAR: m ≤ M = N − 1 (the reflected record of SP 1065 eq. 25 reaches that far; allantools'
+/// "all" grid goes there too).
 pub fn max_m(kind: Kind, n_rate: usize) -> usize {
     match kind {
         Kind::Oavar => n_rate / 2,
         Kind::Mvar | Kind::Mtotvar => (n_rate + 1) / 3,
         Kind::Hvar | Kind::Ohvar | Kind::Htotvar => n_rate / 3,
-        Kind::Totvar => n_rate.saturating_sub(1),
+        Kind::Totvar => n_rate,
     }
 }
 
