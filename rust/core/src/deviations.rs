@@ -165,13 +165,6 @@ fn sum_sq(v: &[f64]) -> f64 {
     acc.get()
 }
 
-/// B(k) = Σ_{i=k}^{k+m−1} f_i for k < f.len() + 1 − m (no subtraction: local rounding only).
-fn block_sums(f: &[f64], m: usize) -> Vec<f64> {
-    let mut b = vec![0.0; f.len() + 1 - m];
-    sliding_sums(f, m, &mut b);
-    b
-}
-
 /// The rate minus its mean, NaN (gaps) replaced by 0 so that sums over gap-free ranges are exact
 /// and sums touching a gap stay finite (those terms are discarded by the caller).
 fn centred(y: &[f64]) -> Vec<f64> {
@@ -182,33 +175,71 @@ fn centred(y: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// The terms t_k of a "sum of squares over all start points" estimator and the number of rate
-/// samples each one spans (term k uses f[k .. k + span]); the estimate is Σ t_k² · scale / count.
+/// Terms per chunk at least; a chunk also spans ≥ 4m terms so the O(m) edge work stays ≤ ¼ of it.
+/// Memory per (axis, m) task is O(chunk + m), not O(M): a 10⁸-sample record stays cheap.
+const TERM_CHUNK: usize = 1 << 16;
+
+/// Span (rate samples per term) and scale of the overlapping estimators:
 ///
 /// OAVAR  t_k = B(k+m) − B(k),                       span 2m,     scale 1/(2m²)
 /// MVAR   t_j = Σ_{i=j}^{j+m−1} (B(i+m) − B(i)),      span 3m − 1, scale 1/(2m⁴)
 /// OHVAR  t_k = B(k+2m) − 2B(k+m) + B(k),            span 3m,     scale 1/(6m²)
-fn overlapping_terms(kind: Kind, f: &[f64], m: usize) -> (Vec<f64>, usize, f64) {
+///
+/// Term k uses f[k .. k + span]; the estimate is Σ t_k² · scale / count.
+fn span_scale(kind: Kind, m: usize) -> (usize, f64) {
     let mf = m as f64;
-    let b = block_sums(f, m);
     match kind {
-        Kind::Oavar => {
-            let t: Vec<f64> = b[m..].iter().zip(&b).map(|(p, q)| p - q).collect();
-            (t, 2 * m, 1.0 / (2.0 * mf * mf))
+        Kind::Oavar => (2 * m, 1.0 / (2.0 * mf * mf)),
+        Kind::Mvar => (3 * m - 1, 1.0 / (2.0 * mf * mf * mf * mf)),
+        Kind::Ohvar => (3 * m, 1.0 / (6.0 * mf * mf)),
+        _ => unreachable!("span_scale called for {kind:?}"),
+    }
+}
+
+/// Scratch of one (axis, m) task of the overlapping estimators.
+#[derive(Default)]
+struct TermBuf {
+    b: Vec<f64>,
+    d: Vec<f64>,
+    t: Vec<f64>,
+}
+
+/// Calls `g(k0, terms)` for consecutive chunks of the terms t_k, k = 0 … count − 1 (count =
+/// f.len() + 1 − span). Each chunk's block sums are formed from f over the chunk's own range only
+/// (Van Herk / Gil-Werman via `sliding_sums`), so rounding is local and no sum runs along the record.
+fn for_each_term_chunk(
+    kind: Kind,
+    f: &[f64],
+    m: usize,
+    buf: &mut TermBuf,
+    mut g: impl FnMut(usize, &[f64]),
+) {
+    let (span, _) = span_scale(kind, m);
+    let count = f.len() + 1 - span;
+    let chunk = TERM_CHUNK.max(4 * m);
+    let mut k0 = 0;
+    while k0 < count {
+        let c = chunk.min(count - k0);
+        let TermBuf { b, d, t } = &mut *buf;
+        let nb = c + span - m; // B(k0) … B(k0 + c − 1 + span − m)
+        b.clear();
+        b.resize(nb, 0.0);
+        sliding_sums(&f[k0..k0 + nb + m - 1], m, b);
+        t.clear();
+        match kind {
+            Kind::Oavar => t.extend(b[m..m + c].iter().zip(&b[..c]).map(|(p, q)| p - q)),
+            Kind::Ohvar => t.extend((0..c).map(|k| (b[k + 2 * m] - b[k + m]) - (b[k + m] - b[k]))),
+            Kind::Mvar => {
+                // d(i) = B(i+m) − B(i) for i < c + m − 1, then t_j = Σ_{i=j}^{j+m−1} d(i).
+                d.clear();
+                d.extend(b[m..].iter().zip(b.iter()).map(|(p, q)| p - q));
+                t.resize(c, 0.0);
+                sliding_sums(&d[..c + m - 1], m, t);
+            }
+            _ => unreachable!(),
         }
-        Kind::Mvar => {
-            let d: Vec<f64> = b[m..].iter().zip(&b).map(|(p, q)| p - q).collect();
-            let t = block_sums(&d, m);
-            (t, 3 * m - 1, 1.0 / (2.0 * mf * mf * mf * mf))
-        }
-        Kind::Ohvar => {
-            let l = b.len() - 2 * m;
-            let t: Vec<f64> = (0..l)
-                .map(|k| (b[k + 2 * m] - b[k + m]) - (b[k + m] - b[k]))
-                .collect();
-            (t, 3 * m, 1.0 / (6.0 * mf * mf))
-        }
-        _ => unreachable!("overlapping_terms called for {kind:?}"),
+        g(k0, t);
+        k0 += c;
     }
 }
 
@@ -216,9 +247,14 @@ fn overlapping_terms(kind: Kind, f: &[f64], m: usize) -> (Vec<f64>, usize, f64) 
 ///   Mod σ²(τ) = 1/(2 m² τ² (N−3m+1)) Σ_{j=1}^{N−3m+1} [ Σ_{i=j}^{j+m−1} (x_{i+2m} − 2x_{i+m} + x_i) ]².
 /// OHVAR (SP 1065 eq. 20):
 ///   Hσ²(τ) = 1/(6 τ² (N−3m)) Σ_{i=1}^{N−3m} (x_{i+3m} − 3x_{i+2m} + 3x_{i+m} − x_i)².
+/// OAVAR (SP 1065 eq. 11), for the gap-aware path.
 fn overlapping_value(kind: Kind, f: &[f64], m: usize) -> f64 {
-    let (t, _, scale) = overlapping_terms(kind, f, m);
-    sum_sq(&t) * scale / t.len() as f64
+    let (span, scale) = span_scale(kind, m);
+    let mut acc = Acc::default();
+    for_each_term_chunk(kind, f, m, &mut TermBuf::default(), |_, t| {
+        acc.add(sum_sq(t))
+    });
+    acc.get() * scale / (f.len() + 1 - span) as f64
 }
 
 /// HVAR (SP 1065 eq. 17, frequency form): with ȳ_j the non-overlapping m-sample averages, K = ⌊M/m⌋,
@@ -241,23 +277,35 @@ fn hvar_value(f: &[f64], m: usize) -> f64 {
 /// y*_{M+j} = y_{M−1−j}, so every term is B*(p) − B*(p−m) over the extended rate, p = 1 … M−1.
 fn totvar_value(f: &[f64], m: usize) -> f64 {
     let mm = f.len();
-    // z[q − (1 − m)] = y*_q for q = 1−m … M+m−2.
-    let z: Vec<f64> = (0..mm + 2 * m - 2)
-        .map(|i| {
-            let q = i as isize + 1 - m as isize;
-            if q < 0 {
-                f[(-q - 1) as usize]
-            } else if (q as usize) < mm {
-                f[q as usize]
-            } else {
-                f[2 * mm - 1 - q as usize]
-            }
-        })
-        .collect();
-    let b = block_sums(&z, m); // b[i] = B*(i + 1 − m)
-    let t: Vec<f64> = (1..mm).map(|p| b[p + m - 1] - b[p - 1]).collect();
+    // y*_q for q = 1−m … M+m−2 (even reflection of the rate), generated per chunk of centres.
+    let ext = |q: isize| -> f64 {
+        if q < 0 {
+            f[(-q - 1) as usize]
+        } else if (q as usize) < mm {
+            f[q as usize]
+        } else {
+            f[2 * mm - 1 - q as usize]
+        }
+    };
+    let chunk = TERM_CHUNK.max(4 * m);
+    let (mut z, mut b) = (Vec::new(), Vec::new());
+    let mut acc = Acc::default();
+    let mut p0 = 1;
+    while p0 < mm {
+        let c = chunk.min(mm - p0);
+        // Centres p0 … p0+c−1 need B*(p − m) and B*(p): y* over [p0 − m, p0 + c − 1 + m).
+        let lo = p0 as isize - m as isize;
+        z.clear();
+        z.extend((0..c + 2 * m - 1).map(|i| ext(lo + i as isize)));
+        b.clear();
+        b.resize(c + m, 0.0); // b[i] = B*(lo + i)
+        sliding_sums(&z, m, &mut b);
+        let t: Vec<f64> = (0..c).map(|i| b[i + m] - b[i]).collect();
+        acc.add(sum_sq(&t));
+        p0 += c;
+    }
     let mf = m as f64;
-    sum_sq(&t) / (2.0 * mf * mf * t.len() as f64)
+    acc.get() / (2.0 * mf * mf * (mm - 1) as f64)
 }
 
 /// Subsequences per parallel chunk in MTOTVAR/HTOTVAR (fixed: results independent of threads).
@@ -479,22 +527,24 @@ pub fn gap_deviation(columns: &[&[f64]], ms: &[usize], kind: Kind) -> Result<(Ve
         .map(|row| {
             let (f, cnt) = &prepared[row / n_m];
             let m = ms[row % n_m];
-            if cnt[f.len()] == 0 {
-                let (t, _, scale) = overlapping_terms(kind, f, m);
-                return (sum_sq(&t) * scale / t.len() as f64, t.len() as u64);
-            }
-            let (mut t, span, scale) = overlapping_terms(kind, f, m);
-            let mut kept = 0usize;
-            for k in 0..t.len() {
-                if cnt[k + span] == cnt[k] {
-                    t[kept] = t[k];
-                    kept += 1;
-                }
-            }
+            let (span, scale) = span_scale(kind, m);
+            let (mut acc, mut kept) = (Acc::default(), 0usize);
+            let mut keep = Vec::new();
+            for_each_term_chunk(kind, f, m, &mut TermBuf::default(), |k0, t| {
+                keep.clear();
+                keep.extend(
+                    t.iter()
+                        .enumerate()
+                        .filter(|(i, _)| cnt[k0 + i + span] == cnt[k0 + i])
+                        .map(|(_, v)| *v),
+                );
+                kept += keep.len();
+                acc.add(sum_sq(&keep));
+            });
             if kept == 0 {
                 (f64::NAN, 0)
             } else {
-                (sum_sq(&t[..kept]) * scale / kept as f64, kept as u64)
+                (acc.get() * scale / kept as f64, kept as u64)
             }
         })
         .collect();
@@ -620,7 +670,12 @@ pub fn dynamic_ohvar(
             let (f, m) = (&centred[row / n_m], ms[row % n_m]);
             let l = window + 1 - 3 * m;
             let k_end = (n_win - 1) * hop + l;
-            let (t, _, scale) = overlapping_terms(Kind::Ohvar, &f[..k_end + 3 * m - 1], m);
+            let (_, scale) = span_scale(Kind::Ohvar, m);
+            let mut t = Vec::with_capacity(k_end);
+            let mut tb = TermBuf::default();
+            for_each_term_chunk(Kind::Ohvar, &f[..k_end + 3 * m - 1], m, &mut tb, |_, c| {
+                t.extend_from_slice(c)
+            });
             let norm = scale / l as f64;
             let hop_b = if n_win == 1 { l } else { hop };
             let (q, r) = (l / hop_b, l % hop_b);
