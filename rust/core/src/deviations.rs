@@ -311,10 +311,11 @@ fn totvar_value(f: &[f64], m: usize) -> f64 {
 /// Subsequences per parallel chunk in MTOTVAR/HTOTVAR (fixed: results independent of threads).
 const SUB_CHUNK: usize = 256;
 
-/// Scratch of one subsequence: the 9m reflected sequence and its compensated prefix sums.
+/// Scratch of one subsequence: compensated prefix sums of it and of its 9m-point reflection.
 struct TotScratch {
     u: Vec<f64>,
-    star: Vec<f64>,
+    p3h: Vec<f64>,
+    p3l: Vec<f64>,
     ph: Vec<f64>,
     pl: Vec<f64>,
 }
@@ -323,7 +324,8 @@ impl TotScratch {
     fn new(m: usize) -> Self {
         TotScratch {
             u: vec![0.0; 3 * m],
-            star: vec![0.0; 9 * m],
+            p3h: vec![0.0; 3 * m + 1],
+            p3l: vec![0.0; 3 * m + 1],
             ph: vec![0.0; 9 * m + 1],
             pl: vec![0.0; 9 * m + 1],
         }
@@ -338,48 +340,71 @@ impl TotScratch {
         let n3 = 3 * m;
         let (h1, h2) = (n3 / 2, n3.div_ceil(2));
         let u = &mut self.u;
-        let mean1 = u[..h1].iter().sum::<f64>() / h1 as f64;
-        let mean2 = u[h2..].iter().sum::<f64>() / (n3 - h2) as f64;
+        let mean1 = sum4(&u[..h1]) / h1 as f64;
+        let mean2 = sum4(&u[h2..]) / (n3 - h2) as f64;
         let slope = (mean2 - mean1) / h2 as f64;
         // Centre the ramp on the subsequence so the detrended values stay small.
         let c = (n3 - 1) as f64 / 2.0;
-        let centre = u.iter().sum::<f64>() / n3 as f64;
+        let centre = sum4(u) / n3 as f64;
         for (k, v) in u.iter_mut().enumerate() {
             *v = (*v - centre) - slope * (k as f64 - c);
         }
-        // Uninverted even reflection: [rev(u), u, rev(u)].
-        for (k, &v) in u.iter().enumerate() {
-            self.star[n3 - 1 - k] = v;
-            self.star[n3 + k] = v;
-            self.star[3 * n3 - 1 - k] = v;
-        }
-        // Prefix sums as an unevaluated pair (hi + lo, TwoSum): block sums by differences of
-        // nearby prefixes lose nothing to the prefix's magnitude.
-        let (ph, pl) = (&mut self.ph, &mut self.pl);
-        ph[0] = 0.0;
-        pl[0] = 0.0;
+        // Prefix sums P(t) = Σ_{s<t} u_s of the detrended subsequence as an unevaluated pair
+        // (hi + lo, TwoSum): block sums by differences of nearby prefixes lose nothing to the
+        // prefix's magnitude. Only 3m serial steps; the reflected record is never built.
+        let (p3h, p3l) = (&mut self.p3h, &mut self.p3l);
+        p3h[0] = 0.0;
+        p3l[0] = 0.0;
         let (mut s, mut e) = (0.0f64, 0.0f64);
-        for (i, &v) in self.star.iter().enumerate() {
+        for (i, &v) in u.iter().enumerate() {
             let t = s + v;
             let bp = t - s;
             e += (s - (t - bp)) + (v - bp);
             s = t;
-            ph[i + 1] = s;
-            pl[i + 1] = e;
+            p3h[i + 1] = s;
+            p3l[i + 1] = e;
         }
+        // Prefix sums Q of the uninverted even reflection [rev(u), u, rev(u)] (9m values), from P:
+        //   Q(t) = T − P(3m − t) (t ≤ 3m),  T + P(t − 3m) (3m ≤ t ≤ 6m),  3T − P(9m − t) (t ≥ 6m),
+        // T = P(3m) ≈ 0 (u is centred and its ramp removed), so no large value enters a difference.
+        let (th, tl) = (p3h[n3], p3l[n3]);
+        let (ph, pl) = (&mut self.ph, &mut self.pl);
+        for t in 0..=n3 {
+            ph[t] = th - p3h[n3 - t];
+            pl[t] = tl - p3l[n3 - t];
+            ph[n3 + t] = th + p3h[t];
+            pl[n3 + t] = tl + p3l[t];
+            ph[3 * n3 - t] = 3.0 * th - p3h[t];
+            pl[3 * n3 - t] = 3.0 * tl - p3l[t];
+        }
+        // z_j·m = Q(j+3m) − 3Q(j+2m) + 3Q(j+m) − Q(j), j < 6m; squares summed in runs of RUN with
+        // four accumulators (independent chains), the runs with compensation.
         let mut acc = Acc::default();
-        let mut run = 0.0;
-        for j in 0..2 * n3 {
-            let hi = (ph[j + 3 * m] - ph[j]) - 3.0 * (ph[j + 2 * m] - ph[j + m]);
-            let lo = (pl[j + 3 * m] - pl[j]) - 3.0 * (pl[j + 2 * m] - pl[j + m]);
-            let z = hi + lo;
-            run += z * z;
-            if j % RUN == RUN - 1 {
-                acc.add(run);
-                run = 0.0;
+        let mut buf = [0.0f64; RUN];
+        let mut j0 = 0;
+        while j0 < 2 * n3 {
+            let c = RUN.min(2 * n3 - j0);
+            let (a0, a1, a2, a3) = (
+                &ph[j0..],
+                &ph[j0 + m..],
+                &ph[j0 + 2 * m..],
+                &ph[j0 + 3 * m..],
+            );
+            let (b0, b1, b2, b3) = (
+                &pl[j0..],
+                &pl[j0 + m..],
+                &pl[j0 + 2 * m..],
+                &pl[j0 + 3 * m..],
+            );
+            for (i, z2) in buf[..c].iter_mut().enumerate() {
+                let hi = (a3[i] - a0[i]) - 3.0 * (a2[i] - a1[i]);
+                let lo = (b3[i] - b0[i]) - 3.0 * (b2[i] - b1[i]);
+                let z = hi + lo;
+                *z2 = z * z;
             }
+            acc.add(sum4(&buf[..c]));
+            j0 += c;
         }
-        acc.add(run);
         acc.get()
     }
 }
