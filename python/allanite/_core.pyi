@@ -31,3 +31,53 @@ def theo1_dynamic(
     workers: int,
 ) -> npt.NDArray[np.float64]:
     """Theo1 of every sliding window at every even m: shape (axes, len(ms), windows)."""
+
+def deviation_static(
+    columns: Sequence[npt.NDArray[np.float64]],
+    ms: Sequence[int],
+    estimator: str,
+    workers: int,
+) -> npt.NDArray[np.float64]:
+    """'mvar' | 'hvar' | 'ohvar' | 'totvar' | 'mtotvar' | 'htotvar' of each whole rate record, as a
+    variance for τ0 = 1 (no bias correction): shape (axes, len(ms)). m ranges (M rate samples):
+    mvar, mtotvar 1..=(M+1)//3; hvar, ohvar, htotvar 1..=M//3; totvar 1..=M."""
+
+def ttotvar_static(
+    columns: Sequence[npt.NDArray[np.float64]],
+    ms: Sequence[int],
+    tau0: float,
+    workers: int,
+) -> npt.NDArray[np.float64]:
+    """Time total variance (m·tau0)²/3 · MTOTVAR: shape (axes, len(ms))."""
+
+def deviation_gaps(
+    columns: Sequence[npt.NDArray[np.float64]],
+    ms: Sequence[int],
+    estimator: str,
+    workers: int,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+    """Gap-aware 'oavar' | 'mvar' | 'ohvar' (NaN = missing sample): (values, complete-term counts),
+    each of shape (axes, len(ms)); a τ with no complete term gives NaN and 0."""
+
+def ohvar_dynamic(
+    columns: Sequence[npt.NDArray[np.float64]],
+    window: int,
+    hop: int,
+    ms: Sequence[int],
+    workers: int,
+) -> npt.NDArray[np.float64]:
+    """Overlapping Hadamard variance of every sliding window: shape (axes, len(ms), windows)."""
+
+def mtie_phase(
+    columns: Sequence[npt.NDArray[np.float64]],
+    ms: Sequence[int],
+    workers: int,
+) -> npt.NDArray[np.float64]:
+    """MTIE of each phase record (windows of m + 1 points, 1 ≤ m ≤ N − 1): shape (axes, len(ms))."""
+
+def tierms_phase(
+    columns: Sequence[npt.NDArray[np.float64]],
+    ms: Sequence[int],
+    workers: int,
+) -> npt.NDArray[np.float64]:
+    """TIE rms of each phase record (1 ≤ m ≤ N − 1): shape (axes, len(ms))."""

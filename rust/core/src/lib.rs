@@ -4,6 +4,7 @@
 //! entry point validates its arguments and returns [`CoreError`] instead of panicking.
 
 pub mod allan;
+pub mod deviations;
 pub mod error;
 pub mod theo;
 

@@ -3,7 +3,8 @@
 //! allanite-core, and core errors come back as `allanite.errors.AllaniteError` (a ValueError).
 
 use allanite_core::{
-    dynamic_avar, dynamic_theo1, run_in_pool, static_theo1, CoreError, Estimator, Method, Request,
+    deviations, dynamic_avar, dynamic_theo1, run_in_pool, static_theo1, CoreError, Estimator,
+    Method, Request,
 };
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1};
@@ -132,11 +133,170 @@ fn theo1_dynamic<'py>(
     Ok(arr.into_pyarray(py))
 }
 
+fn parse_kind(py: Python<'_>, s: &str, allowed: &[&str]) -> PyResult<deviations::Kind> {
+    use deviations::Kind;
+    let kind = match s {
+        "oavar" => Some(Kind::Oavar),
+        "mvar" => Some(Kind::Mvar),
+        "hvar" => Some(Kind::Hvar),
+        "ohvar" => Some(Kind::Ohvar),
+        "totvar" => Some(Kind::Totvar),
+        "mtotvar" => Some(Kind::Mtotvar),
+        "htotvar" => Some(Kind::Htotvar),
+        _ => None,
+    };
+    match kind {
+        Some(k) if allowed.contains(&s) => Ok(k),
+        _ => Err(allanite_error(
+            py,
+            format!("unknown estimator {s:?}; allowed: {}", allowed.join(", ")),
+        )),
+    }
+}
+
+fn to_2d<'py>(
+    py: Python<'py>,
+    rows: usize,
+    cols: usize,
+    values: Vec<f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let arr = Array2::from_shape_vec((rows, cols), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// One deviation of each whole rate record at every averaging factor: shape (axes, len(ms)).
+///
+/// `estimator`: 'mvar', 'hvar', 'ohvar', 'totvar', 'mtotvar' or 'htotvar' (variances for τ0 = 1,
+/// no bias correction). NaN and ±inf are rejected.
+#[pyfunction]
+#[pyo3(signature = (columns, ms, estimator, workers))]
+fn deviation_static<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    ms: Vec<usize>,
+    estimator: &str,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let kind = parse_kind(
+        py,
+        estimator,
+        &["mvar", "hvar", "ohvar", "totvar", "mtotvar", "htotvar"],
+    )?;
+    let slices = contiguous(py, &columns)?;
+    let result =
+        py.detach(|| run_in_pool(workers, || deviations::static_deviation(&slices, &ms, kind)));
+    let values = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    to_2d(py, slices.len(), ms.len(), values)
+}
+
+/// Time total variance (τ²/3)·MTOTVAR, τ = m·tau0, of each rate record: shape (axes, len(ms)).
+#[pyfunction]
+#[pyo3(signature = (columns, ms, tau0, workers))]
+fn ttotvar_static<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    ms: Vec<usize>,
+    tau0: f64,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let slices = contiguous(py, &columns)?;
+    let result =
+        py.detach(|| run_in_pool(workers, || deviations::static_ttotvar(&slices, &ms, tau0)));
+    let values = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    to_2d(py, slices.len(), ms.len(), values)
+}
+
+/// Gap-aware OAVAR/MVAR/OHVAR of rate records with NaN-marked gaps: (values, counts), each of
+/// shape (axes, len(ms)); counts (int64) are the complete terms used; no term gives NaN, 0.
+#[pyfunction]
+#[pyo3(signature = (columns, ms, estimator, workers))]
+#[allow(clippy::type_complexity)]
+fn deviation_gaps<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    ms: Vec<usize>,
+    estimator: &str,
+    workers: usize,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
+    let kind = parse_kind(py, estimator, &["oavar", "mvar", "ohvar"])?;
+    let slices = contiguous(py, &columns)?;
+    let result =
+        py.detach(|| run_in_pool(workers, || deviations::gap_deviation(&slices, &ms, kind)));
+    let (values, counts) = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let counts: Vec<i64> = counts.into_iter().map(|c| c as i64).collect();
+    let c = Array2::from_shape_vec((slices.len(), ms.len()), counts)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok((
+        to_2d(py, slices.len(), ms.len(), values)?,
+        c.into_pyarray(py),
+    ))
+}
+
+/// Overlapping Hadamard variance of every sliding window: shape (axes, len(ms), windows).
+#[pyfunction]
+#[pyo3(signature = (columns, window, hop, ms, workers))]
+fn ohvar_dynamic<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    window: usize,
+    hop: usize,
+    ms: Vec<usize>,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let slices = contiguous(py, &columns)?;
+    let result = py.detach(|| {
+        run_in_pool(workers, || {
+            deviations::dynamic_ohvar(&slices, window, hop, &ms)
+        })
+    });
+    let (values, n_win) = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// MTIE of each *phase* record (windows of m + 1 points): shape (axes, len(ms)).
+#[pyfunction]
+#[pyo3(signature = (columns, ms, workers))]
+fn mtie_phase<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    ms: Vec<usize>,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let slices = contiguous(py, &columns)?;
+    let result = py.detach(|| run_in_pool(workers, || deviations::mtie(&slices, &ms)));
+    let values = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    to_2d(py, slices.len(), ms.len(), values)
+}
+
+/// TIE rms of each *phase* record: shape (axes, len(ms)).
+#[pyfunction]
+#[pyo3(signature = (columns, ms, workers))]
+fn tierms_phase<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    ms: Vec<usize>,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let slices = contiguous(py, &columns)?;
+    let result = py.detach(|| run_in_pool(workers, || deviations::tie_rms(&slices, &ms)));
+    let values = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    to_2d(py, slices.len(), ms.len(), values)
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_static, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_dynamic, m)?)?;
+    m.add_function(wrap_pyfunction!(deviation_static, m)?)?;
+    m.add_function(wrap_pyfunction!(ttotvar_static, m)?)?;
+    m.add_function(wrap_pyfunction!(deviation_gaps, m)?)?;
+    m.add_function(wrap_pyfunction!(ohvar_dynamic, m)?)?;
+    m.add_function(wrap_pyfunction!(mtie_phase, m)?)?;
+    m.add_function(wrap_pyfunction!(tierms_phase, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
