@@ -44,24 +44,34 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import twins_deviations as tw
-from allanite import _core
-from allanite import _reference
+from allanite import _core, _reference
 from allanite.errors import AllaniteError
 
 ESTIMATORS = ["mvar", "hvar", "ohvar", "totvar", "mtotvar", "htotvar"]
-TWIN = {"mvar": tw.mvar, "hvar": tw.hvar, "ohvar": tw.ohvar, "totvar": tw.totvar,
-        "mtotvar": tw.mtotvar, "htotvar": tw.htotvar}
+TWIN = {
+    "mvar": tw.mvar,
+    "hvar": tw.hvar,
+    "ohvar": tw.ohvar,
+    "totvar": tw.totvar,
+    "mtotvar": tw.mtotvar,
+    "htotvar": tw.htotvar,
+}
 
 
 def max_m(est: str, n_rate: int) -> int:
-    return {"mvar": (n_rate + 1) // 3, "mtotvar": (n_rate + 1) // 3, "hvar": n_rate // 3,
-            "ohvar": n_rate // 3, "htotvar": n_rate // 3, "totvar": n_rate,
-            "oavar": n_rate // 2}[est]
+    return {
+        "mvar": (n_rate + 1) // 3,
+        "mtotvar": (n_rate + 1) // 3,
+        "hvar": n_rate // 3,
+        "ohvar": n_rate // 3,
+        "htotvar": n_rate // 3,
+        "totvar": n_rate,
+        "oavar": n_rate // 2,
+    }[est]
 
 
 def core(est, y, ms, workers=0):
-    return _core.deviation_static([np.ascontiguousarray(y, dtype=float)], [int(m) for m in ms], est,
-                                  workers)[0]
+    return _core.deviation_static([np.ascontiguousarray(y, dtype=float)], [int(m) for m in ms], est, workers)[0]
 
 
 def rel_err(a, b):
@@ -75,15 +85,18 @@ def rel_err(a, b):
 
 records = st.builds(
     lambda n, seed, scale, offset, kind: _make_record(n, seed, scale, offset, kind),
-    st.integers(9, 70), st.integers(0, 2**32 - 1), st.sampled_from([1e-12, 1.0, 1e6]),
-    st.sampled_from([0.0, 3.0, -1e3]), st.sampled_from(["white", "walk", "drift"]))
+    st.integers(9, 70),
+    st.integers(0, 2**32 - 1),
+    st.sampled_from([1e-12, 1.0, 1e6]),
+    st.sampled_from([0.0, 3.0, -1e3]),
+    st.sampled_from(["white", "walk", "drift"]),
+)
 
 
 def _make_record(n, seed, scale, offset, kind):
     rng = np.random.default_rng(seed)
     w = rng.standard_normal(n)
-    y = {"white": w, "walk": np.cumsum(w) * 0.3 + w,
-         "drift": w + 0.05 * np.arange(n)}[kind]
+    y = {"white": w, "walk": np.cumsum(w) * 0.3 + w, "drift": w + 0.05 * np.arange(n)}[kind]
     return (offset + y) * scale
 
 
@@ -115,14 +128,13 @@ def test_mtie_and_tierms_equal_twins(y):
     x = tw.phase(y)
     ms = list(range(1, x.size))
     np.testing.assert_array_equal(_core.mtie_phase([x], ms, 0)[0], [tw.mtie(x, m) for m in ms])
-    np.testing.assert_allclose(_core.tierms_phase([x], ms, 0)[0], [tw.tierms(x, m) for m in ms],
-                               rtol=1e-13, atol=0)
+    np.testing.assert_allclose(_core.tierms_phase([x], ms, 0)[0], [tw.tierms(x, m) for m in ms], rtol=1e-13, atol=0)
 
 
 def test_twins_are_literal_definitions():
     """The twins themselves against hand-expanded cases (so a twin bug cannot hide a kernel bug)."""
     y = np.array([1.0, 4.0, 2.0, 8.0, 5.0, 7.0])
-    x = np.concatenate([[0], np.cumsum(y)])        # 0 1 5 7 15 20 27
+    x = np.concatenate([[0], np.cumsum(y)])  # 0 1 5 7 15 20 27
     # MVAR m=1 = OAVAR m=1: mean of (x_{i+2} − 2x_{i+1} + x_i)²/2 over 5 terms.
     d = x[2:] - 2 * x[1:-1] + x[:-2]
     assert tw.mvar(y, 1) == pytest.approx(np.mean(d * d) / 2)
@@ -138,6 +150,7 @@ def test_twins_are_literal_definitions():
 # --------------------------------------------------------------------------------------------------
 # Invariants
 # --------------------------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("est", ["hvar", "ohvar", "htotvar"])
 def test_hadamard_family_ignores_constant_and_linear_rate(est, rng):
@@ -168,13 +181,13 @@ def _vectorised(est, y, m):
     x = np.concatenate([[0.0], np.cumsum(y - y.mean())])
     n = x.size
     if est == "oavar":
-        d = x[2 * m:] - 2 * x[m:n - m] + x[:n - 2 * m]
+        d = x[2 * m :] - 2 * x[m : n - m] + x[: n - 2 * m]
         return np.mean(d * d) / (2.0 * m * m)
     if est == "ohvar":
-        d = x[3 * m:] - 3 * x[2 * m:n - m] + 3 * x[m:n - 2 * m] - x[:n - 3 * m]
+        d = x[3 * m :] - 3 * x[2 * m : n - m] + 3 * x[m : n - 2 * m] - x[: n - 3 * m]
         return np.mean(d * d) / (6.0 * m * m)
     if est == "mvar":
-        d = x[2 * m:] - 2 * x[m:n - m] + x[:n - 2 * m]
+        d = x[2 * m :] - 2 * x[m : n - m] + x[: n - 2 * m]
         c = np.concatenate([[0.0], np.cumsum(d)])
         s = c[m:] - c[:-m]
         return np.mean(s * s) / (2.0 * m**4)
@@ -222,10 +235,15 @@ def test_long_record_offset_does_not_cost_digits(rng):
 NBS14_9 = np.array([892, 809, 823, 798, 671, 644, 883, 903, 677], float)
 
 
-@pytest.mark.parametrize("name, printed", [
-    ("mdev", ("91.22945", "74.78849")), ("hdev", ("70.80607", "116.7980")),
-    ("tdev", ("52.67135", "86.35831")), ("totdev", ("91.22945", "93.90379")),
-])
+@pytest.mark.parametrize(
+    "name, printed",
+    [
+        ("mdev", ("91.22945", "74.78849")),
+        ("hdev", ("70.80607", "116.7980")),
+        ("tdev", ("52.67135", "86.35831")),
+        ("totdev", ("91.22945", "93.90379")),
+    ],
+)
 def test_nbs14_nine_points(name, printed):
     y = NBS14_9
     if name == "tdev":
@@ -254,19 +272,30 @@ def printed_tolerance(token: str) -> float:
 def assert_printed(ours, tokens, what, labels=None, rel=None, extra=None):
     ours = np.asarray(ours, float)
     want = np.array([float(t) for t in tokens])
-    tol = (np.array([printed_tolerance(t) for t in tokens]) if rel is None else rel * np.abs(want))
+    tol = np.array([printed_tolerance(t) for t in tokens]) if rel is None else rel * np.abs(want)
     if extra is not None:
         tol = tol + np.asarray(extra) * np.abs(want)
     bad = np.flatnonzero(~(np.abs(ours - want) <= tol))
     labels = labels or [str(i) for i in range(len(tokens))]
     assert bad.size == 0, f"{what}: {bad.size}/{len(tokens)} outside; " + "; ".join(
-        f"{labels[i]}: ours {ours[i]:.7e} printed {tokens[i]}" for i in bad[:6])
+        f"{labels[i]}: ours {ours[i]:.7e} printed {tokens[i]}" for i in bad[:6]
+    )
 
 
-SIGMA_TYPES = {"Modified Allan": "mdev", "Overlapping and Modified Allan": "omod", "Time": "tdev",
-               "Hadamard": "hdev", "Overlapping Hadamard": "ohdev", "Total": "totdev",
-               "Modified Total": "mtotdev", "Time Total": "ttotdev", "Hadamard Total": "htotdev",
-               "MTIE": "mtie", "MTIE (Fast)": "mtie", "TIE rms": "tierms"}
+SIGMA_TYPES = {
+    "Modified Allan": "mdev",
+    "Overlapping and Modified Allan": "omod",
+    "Time": "tdev",
+    "Hadamard": "hdev",
+    "Overlapping Hadamard": "ohdev",
+    "Total": "totdev",
+    "Modified Total": "mtotdev",
+    "Time Total": "ttotdev",
+    "Hadamard Total": "htotdev",
+    "MTIE": "mtie",
+    "MTIE (Fast)": "mtie",
+    "TIE rms": "tierms",
+}
 
 
 def read_table(path: Path) -> dict:
@@ -367,37 +396,77 @@ def ours_for(est, x, y, tau0, ms):
         return np.sqrt(_core.ttotvar_static([y], ms, tau0, 0)[0])
     if est == "tdev":
         return mf * tau0 * np.sqrt(core("mvar", y, ms) / 3.0)
-    name = {"mdev": "mvar", "omod": "mvar", "hdev": "hvar", "ohdev": "ohvar", "totdev": "totvar",
-            "mtotdev": "mtotvar", "htotdev": "htotvar"}[est]
+    name = {
+        "mdev": "mvar",
+        "omod": "mvar",
+        "hdev": "hvar",
+        "ohdev": "ohvar",
+        "totdev": "totvar",
+        "mtotdev": "mtotvar",
+        "htotdev": "htotvar",
+    }[est]
     return np.sqrt(core(name, y, ms))
 
 
 TABLES = [
-    *(f"phasedat/phase_dat_{s}.txt" for s in [
-        "mdev", "mdev_octave", "tdev", "tdev_octave", "hdev", "hdev_octave", "ohdev", "ohdev_octave",
-        "totdev", "totdev_octave", "mtotdev", "mtotdev_decade", "mtotdev_octave",
-        "mtotdev_octave_alpha0", "ttotdev_all", "ttotdev_decade", "ttotdev_octave", "htotdev_octave",
-        "htotdev_octave_nobias", "mtie", "tierms"]),
+    *(
+        f"phasedat/phase_dat_{s}.txt"
+        for s in [
+            "mdev",
+            "mdev_octave",
+            "tdev",
+            "tdev_octave",
+            "hdev",
+            "hdev_octave",
+            "ohdev",
+            "ohdev_octave",
+            "totdev",
+            "totdev_octave",
+            "mtotdev",
+            "mtotdev_decade",
+            "mtotdev_octave",
+            "mtotdev_octave_alpha0",
+            "ttotdev_all",
+            "ttotdev_decade",
+            "ttotdev_octave",
+            "htotdev_octave",
+            "htotdev_octave_nobias",
+            "mtie",
+            "tierms",
+        ]
+    ),
     *(f"ocxo/stable32_{s}_alltau.txt" for s in ["mdev", "tdev", "hdev", "ohdev", "totdev"]),
     *(f"ocxo/{s}_octave.txt" for s in ["mdev", "tdev", "hdev", "ohdev", "totdev"]),
-    *(f"cs5071a/{s}_{g}.txt" for s in ["mdev", "tdev", "hdev", "ohdev", "totdev", "mtie", "tierms"]
-      for g in ["all", "decade"]),
+    *(
+        f"cs5071a/{s}_{g}.txt"
+        for s in ["mdev", "tdev", "hdev", "ohdev", "totdev", "mtie", "tierms"]
+        for g in ["all", "decade"]
+    ),
     "cs5071a/mtie_fast.txt",
     *(f"gps1pps/stable32_{s}_octave.txt" for s in ["MDEV", "TDEV", "HDEV", "OHDEV", "TOTDEV"]),
     *(f"tic-floor/tic_{s}.txt" for s in ["mdev", "tdev", "hdev", "ohdev", "totdev", "tierms"]),
-    *(f"sr87/{d}/{g}/{s}.txt" for d in ["freq", "phase", "phase0"] for g in ["decade", "octave", "many"]
-      for s in ["mdev", "omod", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev",
-                "mtie", "tierms"]
-      if not (d == "freq" and s in ("mtie", "tierms")) and not (g == "many" and s == "mtie")),
-    "sr87/phase/fastu/mtie.txt", "sr87/phase0/fastu/mtie.txt",
+    *(
+        f"sr87/{d}/{g}/{s}.txt"
+        for d in ["freq", "phase", "phase0"]
+        for g in ["decade", "octave", "many"]
+        for s in ["mdev", "omod", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev", "mtie", "tierms"]
+        if not (d == "freq" and s in ("mtie", "tierms")) and not (g == "many" and s == "mtie")
+    ),
+    "sr87/phase/fastu/mtie.txt",
+    "sr87/phase0/fastu/mtie.txt",
 ]
 
 #: Files whose content is another statistic than their name says (checked, then skipped).
 MISLABELLED = {"sr87/phase/octave/mdev.txt": "Overlapping Allan"}
 
 #: Tables computed by Stable32 on data normalised to ≈ 1 (module docstring): checked to 2e-3 only.
-NORMALISED_INPUT = {"ocxo/mdev_octave.txt", "ocxo/tdev_octave.txt", "ocxo/hdev_octave.txt",
-                    "ocxo/ohdev_octave.txt", "ocxo/totdev_octave.txt"}
+NORMALISED_INPUT = {
+    "ocxo/mdev_octave.txt",
+    "ocxo/tdev_octave.txt",
+    "ocxo/hdev_octave.txt",
+    "ocxo/ohdev_octave.txt",
+    "ocxo/totdev_octave.txt",
+}
 
 
 def _dataset(rel: str) -> str:
@@ -441,14 +510,23 @@ def test_stable32_table(stable32_dir, rel):
     else:
         assert_printed(ours, tokens, rel, labels)
     # "#" column: the term counts of the definitions (Stable32's MTIE "#" is not a term count).
-    if est in ("mdev", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev",
-               "tierms") and rel not in NORMALISED_INPUT:
+    if (
+        est in ("mdev", "tdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev", "tierms")
+        and rel not in NORMALISED_INPUT
+    ):
         m_rate = y.size
-        want = {"mdev": m_rate + 2 - 3 * af, "omod": m_rate + 2 - 3 * af, "tdev": m_rate + 2 - 3 * af,
-                "hdev": m_rate // af - 2, "ohdev": m_rate + 1 - 3 * af, "totdev": 0 * af + m_rate - 1,
-                "mtotdev": m_rate + 2 - 3 * af, "ttotdev": m_rate + 2 - 3 * af,
-                "htotdev": np.where(af == 1, m_rate - 2, m_rate + 1 - 3 * af),
-                "tierms": n_phase - af}[est]
+        want = {
+            "mdev": m_rate + 2 - 3 * af,
+            "omod": m_rate + 2 - 3 * af,
+            "tdev": m_rate + 2 - 3 * af,
+            "hdev": m_rate // af - 2,
+            "ohdev": m_rate + 1 - 3 * af,
+            "totdev": 0 * af + m_rate - 1,
+            "mtotdev": m_rate + 2 - 3 * af,
+            "ttotdev": m_rate + 2 - 3 * af,
+            "htotdev": np.where(af == 1, m_rate - 2, m_rate + 1 - 3 * af),
+            "tierms": n_phase - af,
+        }[est]
         np.testing.assert_array_equal([int(r[2]) for r in rows], want, err_msg=f"{rel} '#'")
 
 
@@ -458,7 +536,7 @@ def test_boundary_row_confirmed_in_extended_precision(stable32_dir):
     xl = x.astype(np.longdouble)
     n = xl.size
     for m in [47]:
-        d = xl[2 * m:] - 2 * xl[m:n - m] + xl[:n - 2 * m]
+        d = xl[2 * m :] - 2 * xl[m : n - m] + xl[: n - 2 * m]
         c = np.concatenate([[0], np.cumsum(d)])
         s = c[m:] - c[:-m]
         tdev_ld = float(np.sqrt(np.sum(s * s) / (2 * m**4 * (n - 3 * m + 1)) * m * m / 3))
@@ -469,9 +547,11 @@ def test_boundary_row_confirmed_in_extended_precision(stable32_dir):
 
 def test_stable32_rules_are_needed(stable32_dir):
     """The bias rules are not decoration: without them these tables are far outside their digits."""
-    for rel, est, worst in [("sr87/phase/many/mtotdev.txt", "mtotdev", 0.10),
-                            ("sr87/phase/octave/htotdev.txt", "htotdev", 0.05),
-                            ("sr87/phase/many/totdev.txt", "totdev", 0.05)]:
+    for rel, est, worst in [
+        ("sr87/phase/many/mtotdev.txt", "mtotdev", 0.10),
+        ("sr87/phase/octave/htotdev.txt", "htotdev", 0.05),
+        ("sr87/phase/many/totdev.txt", "totdev", 0.05),
+    ]:
         path = stable32_dir / rel
         if not path.exists():
             pytest.skip(f"{path} is absent")
@@ -490,8 +570,7 @@ def test_stable32_rules_are_needed(stable32_dir):
 allantools = pytest.importorskip("allantools")
 
 
-@pytest.mark.parametrize("name", ["mdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev",
-                                  "htotdev", "tdev"])
+@pytest.mark.parametrize("name", ["mdev", "hdev", "ohdev", "totdev", "mtotdev", "ttotdev", "htotdev", "tdev"])
 @pytest.mark.parametrize("data_type", ["freq", "phase"])
 def test_allantools_peer(name, data_type, rng):
     n = 400
@@ -548,7 +627,7 @@ def test_gaps_equal_twin(est, y, holes):
     y = y.copy()
     for pos, width in holes:
         a = int(pos * (y.size - 1))
-        y[a:a + width] = np.nan
+        y[a : a + width] = np.nan
     ms = list(range(1, max_m(est, y.size) + 1))
     v, n = gaps(y, ms, est)
     want = [tw.gap_var(y, m, est) for m in ms]
@@ -600,6 +679,7 @@ def test_gaps_reject_inf_and_other_estimators():
 # Dynamic OHVAR
 # --------------------------------------------------------------------------------------------------
 
+
 @settings(max_examples=30, deadline=None)
 @given(y=records, wfrac=st.floats(0.3, 1.0), hop=st.integers(1, 12))
 def test_dynamic_ohvar_equals_twin(y, wfrac, hop):
@@ -628,6 +708,7 @@ def test_dynamic_ohvar_one_window_is_static_and_ignores_ramps(rng):
 # --------------------------------------------------------------------------------------------------
 # Bad input: clear errors, never a panic
 # --------------------------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("est", ESTIMATORS)
 def test_bad_input_errors(est):

@@ -6,12 +6,11 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 import pytest
 
 import test_deviations_core as T
-from allanite import _edf_deviations as E
 from allanite.errors import ParameterError
+from allanite.estimators import _edf_deviations as E
 
 confidence = pytest.importorskip("allanite.confidence")
 
@@ -28,8 +27,7 @@ def _edf(est, alpha, m, n_phase, n_file=None):
     n_file = n_phase if n_file is None else n_file
     gh = confidence.edf_greenhall
     if est in ("mdev", "tdev", "hdev", "ohdev"):
-        d, ov, mod = E.GREENHALL_PARAMETERS[{"mdev": "mvar", "tdev": "tvar", "hdev": "hvar",
-                                              "ohdev": "ohvar"}[est]]
+        d, ov, mod = E.GREENHALL_PARAMETERS[{"mdev": "mvar", "tdev": "tvar", "hdev": "hvar", "ohdev": "ohvar"}[est]]
         return float(gh(alpha, d, m, n_phase, overlapping=ov, modified=mod)), "rule"
     if est == "totdev":
         if alpha in (0, -1, -2):
@@ -45,9 +43,12 @@ def _edf(est, alpha, m, n_phase, n_file=None):
     raise KeyError(est)
 
 
-CI_TABLES = [r for r in T.TABLES if not r.startswith(("ocxo/mdev_oct", "ocxo/tdev_oct", "ocxo/hdev_oct",
-                                                      "ocxo/ohdev_oct", "ocxo/totdev_oct"))
-             and not r.endswith(("mtie.txt", "tierms.txt", "omod.txt"))]
+CI_TABLES = [
+    r
+    for r in T.TABLES
+    if not r.startswith(("ocxo/mdev_oct", "ocxo/tdev_oct", "ocxo/hdev_oct", "ocxo/ohdev_oct", "ocxo/totdev_oct"))
+    and not r.endswith(("mtie.txt", "tierms.txt", "omod.txt"))
+]
 
 
 @pytest.mark.parametrize("rel", CI_TABLES)

@@ -54,7 +54,7 @@ def hvar(y, m: int) -> float:
     (ȳ_{j+2} − 2ȳ_{j+1} + ȳ_j)²."""
     y = np.asarray(y, dtype=float)
     k = y.size // m
-    ybar = [np.mean(y[j * m:(j + 1) * m]) for j in range(k)]
+    ybar = [np.mean(y[j * m : (j + 1) * m]) for j in range(k)]
     s = 0.0
     for j in range(k - 2):
         d = ybar[j + 2] - 2 * ybar[j + 1] + ybar[j]
@@ -100,7 +100,7 @@ def mtotvar(y, m: int) -> float:
     n = x.size
     total = 0.0
     for start in range(n - 3 * m + 1):
-        xs = _detrend_reflect(x[start:start + 3 * m])
+        xs = _detrend_reflect(x[start : start + 3 * m])
         inner = 0.0
         for i in range(6 * m):
             z = sum(xs[j + 2 * m] - 2 * xs[j + m] + xs[j] for j in range(i, i + m)) / m
@@ -124,10 +124,10 @@ def htotvar(y, m: int) -> float:
     total = 0.0
     count = y.size - 3 * m + 1
     for start in range(count):
-        ys = _detrend_reflect(y[start:start + 3 * m])
+        ys = _detrend_reflect(y[start : start + 3 * m])
         inner = 0.0
         for i in range(6 * m):
-            a = [np.mean(ys[i + k * m:i + (k + 1) * m]) for k in range(3)]
+            a = [np.mean(ys[i + k * m : i + (k + 1) * m]) for k in range(3)]
             h = a[2] - 2 * a[1] + a[0]
             inner += h * h
         total += inner / (6.0 * m)
@@ -139,7 +139,7 @@ def mtie(x, m: int) -> float:
     x = np.asarray(x, dtype=float)
     best = 0.0
     for k in range(x.size - m):
-        w = x[k:k + m + 1]
+        w = x[k : k + m + 1]
         best = max(best, float(w.max() - w.min()))
     return best
 
@@ -153,8 +153,9 @@ def tierms(x, m: int) -> float:
 
 # ---- gap-aware twins: the same sums over only the terms whose rate samples are all present --------
 
+
 def _span_ok(y, start, span) -> bool:
-    return not np.any(np.isnan(y[start:start + span]))
+    return not np.any(np.isnan(y[start : start + span]))
 
 
 def gap_terms(y, m: int, estimator: str):
@@ -170,7 +171,7 @@ def gap_terms(y, m: int, estimator: str):
     for k in range(mm - span + 1):
         if not _span_ok(y, k, span):
             continue
-        seg = y[k:k + span] - mu
+        seg = y[k : k + span] - mu
         xs = np.concatenate([[0.0], np.cumsum(seg)])  # local phase, x_k relative
         if estimator == "oavar":
             t = xs[2 * m] - 2 * xs[m] + xs[0]
@@ -194,4 +195,4 @@ def dynamic_ohvar(y, window: int, hop: int, m: int) -> np.ndarray:
     """OHVAR of every window y[j·hop, j·hop + window)."""
     y = np.asarray(y, dtype=float)
     n_win = (y.size - window) // hop + 1
-    return np.array([ohvar(y[j * hop:j * hop + window], m) for j in range(n_win)])
+    return np.array([ohvar(y[j * hop : j * hop + window], m) for j in range(n_win)])

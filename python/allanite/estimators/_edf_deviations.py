@@ -42,11 +42,18 @@ import math
 
 import numpy as np
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = [
-    "GREENHALL_PARAMETERS", "edf_totvar", "edf_mtotvar", "edf_ttotvar", "edf_htotvar",
-    "htotvar_uses_ohvar_edf", "totvar_bias", "mtotvar_bias", "htotvar_bias",
+    "GREENHALL_PARAMETERS",
+    "edf_totvar",
+    "edf_mtotvar",
+    "edf_ttotvar",
+    "edf_htotvar",
+    "htotvar_uses_ohvar_edf",
+    "totvar_bias",
+    "mtotvar_bias",
+    "htotvar_bias",
 ]
 
 #: (d, overlapping, modified) for Greenhall & Riley's EDF algorithm, per estimator.
@@ -59,8 +66,7 @@ GREENHALL_PARAMETERS = {
 
 _TOTVAR_EDF = {0: (1.50, 0.0), -1: (1.17, 0.22), -2: (0.93, 0.36)}
 _MTOTVAR_EDF = {2: (1.90, 2.10), 1: (1.20, 1.40), 0: (1.10, 1.20), -1: (0.85, 0.50), -2: (0.75, 0.31)}
-_HTOTVAR_EDF = {0: (0.559, 1.004), -1: (0.868, 1.140), -2: (0.938, 1.696), -3: (2.554, 0.974),
-                -4: (3.149, 1.276)}
+_HTOTVAR_EDF = {0: (0.559, 1.004), -1: (0.868, 1.140), -2: (0.938, 1.696), -3: (2.554, 0.974), -4: (3.149, 1.276)}
 _TOTVAR_BIAS = {-1: 1.0 / (3.0 * math.log(2.0)), -2: 0.75}
 _MTOTVAR_BIAS = {2: 0.94, 1: 0.83, 0: 0.73, -1: 0.70, -2: 0.69}
 _HTOTVAR_BIAS = {0: 0.995, -1: 0.851, -2: 0.771, -3: 0.717, -4: 0.679}
@@ -72,7 +78,8 @@ HTOTVAR_EDF_MIN_M = 16
 def _check(alpha, m, n_points, allowed, what):
     if isinstance(alpha, bool) or not isinstance(alpha, (int, np.integer)) or int(alpha) not in allowed:
         raise ParameterError(
-            f"{what}: noise type alpha = {alpha!r} is not covered; allowed: {sorted(allowed, reverse=True)}")
+            f"{what}: noise type alpha = {alpha!r} is not covered; allowed: {sorted(allowed, reverse=True)}"
+        )
     for name, v, lo in (("m", m, 1), ("n_points", n_points, 2)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
             raise ParameterError(f"{what}: {name} = {v!r} must be an integer ≥ {lo}")
@@ -124,8 +131,10 @@ def edf_htotvar(alpha: int, m: int, n_points: int) -> float:
     """
     a, m, n = _check(alpha, m, n_points, _HTOTVAR_EDF, "HTOTVAR EDF")
     if m < HTOTVAR_EDF_MIN_M:
-        raise ParameterError(f"HTOTVAR EDF: m = {m} < {HTOTVAR_EDF_MIN_M} uses the overlapping "
-                             "Hadamard EDF (Greenhall, d = 3), not the HTOTVAR formula")
+        raise ParameterError(
+            f"HTOTVAR EDF: m = {m} < {HTOTVAR_EDF_MIN_M} uses the overlapping "
+            "Hadamard EDF (Greenhall, d = 3), not the HTOTVAR formula"
+        )
     b0, b1 = _HTOTVAR_EDF[a]
     r = n / m
     return r / (b0 + b1 / r)
