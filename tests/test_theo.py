@@ -362,3 +362,15 @@ def test_to_xarray_carries_source_and_kf():
     dd = d.to_xarray()
     assert dd["kf"].dims == ("axis", "t")
     np.testing.assert_array_equal(dd["kf"].values, d.kf)
+
+
+def test_theoh_tau_maps_to_one_estimator_on_both_paths():
+    """davar's τ handed back to avar give the same estimator and value at every τ — including the switch
+    point (τ = 40.5 samples at k = 40 is TheoBR's m = 54, not Allan's m = 40; 18 % apart before)."""
+    y = allanite.simulate(40_000, 10.0, N=1e-2, K=1e-4, seed=5)
+    d = allanite.davar(y, 10.0, window=401, hop=50, estimator="theoh")
+    for j in (0, 3, d.t.size - 1):
+        s = allanite.avar(y[j * 50 : j * 50 + 401], 10.0, estimator="theoh", taus=d.tau)
+        assert list(s.source) == list(d.source)
+        np.testing.assert_array_equal(s.m, d.m)
+        np.testing.assert_allclose(s.avar, d.avar[:, j], rtol=1e-12)

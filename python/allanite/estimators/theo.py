@@ -134,7 +134,12 @@ def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, n
     top = n_rate - n_rate % 2
     for i, tau in enumerate(arr):
         s = tau * fs
-        if hybrid and s <= k + 0.5:
+        # One mapping for both paths: a τ that is exactly a TheoBR point above the switch (τ = 0.75·m/fs,
+        # even m, 0.75·m > k) is that point — davar's result.tau handed back to avar gives the same
+        # estimator at every τ (τ = 40.5 samples at k = 40 was rounded to the Allan m = 40 before).
+        m_theo = 2 * int(math.floor(s / 1.5 + 0.5))
+        exact_theo = m_theo >= THEO1_MIN_M and abs(0.75 * m_theo - s) <= 1e-9 * s and (not hybrid or 0.75 * m_theo > k)
+        if hybrid and s <= k + 0.5 and not exact_theo:
             m = int(math.floor(s + 0.5))
             if m < 1:
                 raise ParameterError(f"taus[{i}] = {tau:g} s is shorter than one sample (1/fs = {1 / fs:g} s)")
