@@ -34,9 +34,12 @@ def max_m(n: int) -> int:
 
 
 def _check_budget(count: int, kind: str, n: int) -> None:
-    """Refuse a grid whose m array alone would exceed the memory budget, before allocating it."""
-    budget = resolve_max_memory(None)
+    """Refuse a grid whose m array alone would exceed the memory budget, before allocating it. Grids
+    up to 64 MiB (8 million τ) are never refused: the outputs they size are budgeted where they are made."""
     nbytes = 8 * int(count)
+    if nbytes <= 64 * 2**20:
+        return
+    budget = resolve_max_memory(None)
     if nbytes > budget:
         raise MemoryBudgetError(
             f"the {kind!r} τ grid for {n} samples has {count} τ ({nbytes / 2**30:.3g} GiB as int64), over the "
