@@ -58,39 +58,43 @@ def _modules() -> dict[str, Path]:
 
 
 MODULES = _modules()
+#: Compiled modules of the package (no source to read): the Rust core.
+EXTENSIONS = {"_core"}
 
 
-def _resolve(module: str, node: ast.ImportFrom) -> str:
-    """The absolute in-package name an ``from … import`` refers to ('' when outside the package)."""
+def _resolve(module: str, node: ast.ImportFrom) -> str | None:
+    """The in-package name (dotted, '' for the package itself) an ``from … import`` refers to, or None
+    when it is outside the package."""
     if node.level == 0:
         name = node.module or ""
-        return name[len("allanite.") :] if name.startswith("allanite.") else ("" if name != "allanite" else "__init__")
+        if name == "allanite":
+            return ""
+        return name[len("allanite.") :] if name.startswith("allanite.") else None
     is_pkg = MODULES[module].name == "__init__.py"
-    base = module.split(".") if is_pkg else module.split(".")[:-1]
-    if module == "__init__":
-        base = []
-    base = base[: len(base) - (node.level - 1)] if node.level > 1 else base
-    tail = [node.module] if node.module else []
-    return ".".join(base + tail)
+    base = [] if module == "__init__" else (module.split(".") if is_pkg else module.split(".")[:-1])
+    if node.level > 1:
+        base = base[: len(base) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
 
 
 def _imports(module: str):
     """(target module, names, line, top-level?) for every in-package import of ``module``."""
     tree = ast.parse(MODULES[module].read_text(encoding="utf-8"))
-    top = set(id(n) for n in tree.body)
+    top = {id(n) for n in tree.body}
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
             target = _resolve(module, node)
-            if not target:
+            if target is None:
                 continue
-            names = [a.name for a in node.names]
-            # "from . import x" / "from .pkg import mod": the names may be modules themselves
-            for a in names:
-                if f"{target}.{a}".lstrip(".") in MODULES:
-                    yield f"{target}.{a}".lstrip("."), [], node.lineno, id(node) in top
-                    names = [n for n in names if n != a]
-            if names and target in MODULES:
-                yield target, names, node.lineno, id(node) in top
+            names = []
+            for a in node.names:
+                sub = f"{target}.{a.name}" if target else a.name
+                if sub in MODULES or sub in EXTENSIONS:  # "from . import x": the name is a module
+                    yield sub, [], node.lineno, id(node) in top
+                else:
+                    names.append(a.name)
+            if names:
+                yield (target or "__init__"), names, node.lineno, id(node) in top
         elif isinstance(node, ast.Import):
             for a in node.names:
                 if a.name.startswith("allanite."):
