@@ -100,7 +100,8 @@ class _ResultBase:
         alpha=None,
         edf_method: str = "greenhall",
         chi2: str = "exact",
-        b1_n: str = "averages",
+        b1_n: str = "terms",
+        fallback: str = "previous",
     ):
         """This result with χ² confidence intervals per τ (``edf``, ``ci_low``, ``ci_high``, ``alpha``).
 
@@ -117,7 +118,14 @@ class _ResultBase:
         (array([0, 0, 0]), array([7826., 1368.,  148.]))
         """
         ci = confidence_intervals(
-            self, x, confidence=confidence, alpha=alpha, edf_method=edf_method, chi2=chi2, b1_n=b1_n
+            self,
+            x,
+            confidence=confidence,
+            alpha=alpha,
+            edf_method=edf_method,
+            chi2=chi2,
+            b1_n=b1_n,
+            fallback=fallback,
         )
         return dataclasses.replace(
             self,

@@ -70,7 +70,8 @@ class Estimator:
     methods : tuple of str
         ``method=`` values its dynamic form offers.
     noise_id : str
-        The estimator whose term count the noise identification uses (``b1_n="terms"``).
+        The estimator whose term count (``b1_n="terms"``) and minimum of τ-intervals (``fallback``)
+        the noise identification uses.
     resolve_m : callable, optional
         ``resolve_m(taus, n, fs) -> m`` — the averaging factors ``taus`` give on ``n`` samples, checked,
         before anything is computed (to size the output against the memory budget).

@@ -22,7 +22,8 @@ The pieces, usable on their own:
   :func:`edf_sp1065` — the older simple formulas of NIST SP 1065 Table 5 (overlapping ADEV).
 * :func:`identify_alpha` — the dominant α per τ from the samples: the lag-1 autocorrelation method
   (Riley & Greenhall, EFTF 2004) with Stable32's fallback to the B1 ratio and R(n) when fewer than
-  30 points remain at that τ.
+  30 points remain at that τ, and — as Stable32 — no identification at all below 8 (OADEV) / 10
+  (ADEV) points: there the nearest shorter τ's α (``docs/confidence.md``).
 * :func:`chi2_interval` — the two-sided χ² interval for the true variance (SP 1065 eq. 45).
 
 and the one most users want, :func:`confidence_intervals` (also reachable as
@@ -38,6 +39,7 @@ For ν > 100 Stable32 also replaces the χ² quantile by an approximation (``chi
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -78,6 +80,14 @@ NOISE_NAMES = {
 
 #: Stable32 switches from the lag-1 ACF to the B1 ratio below this many points at a given τ.
 ACF_MIN_POINTS = 30
+
+#: Fewest τ-intervals (⌊samples/m⌋) at which Stable32 identifies the noise type from that τ's own
+#: samples, per estimator; at longer τ it prints the α of the previous τ. Read off its tables (all 34
+#: ADEV/OADEV tables of the shared data: docs/confidence.md): OADEV identifies at 8 intervals and
+#: carries over at 7, ADEV identifies at 10 and carries over at 9.
+ID_MIN_POINTS = {"oavar": 8, "avar": 10}
+
+_FALLBACKS = ("previous", "none")
 
 _EDF_METHODS = ("greenhall", "sp1065")
 _CHI2_METHODS = ("exact", "stable32")
@@ -567,7 +577,7 @@ def _b1_rn_alpha(x: np.ndarray, y: np.ndarray, m: int, n_ref: int) -> int:
     return 1 if rn > math.sqrt(rn_wpm * rn_fpm) else 2
 
 
-def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_n="averages"):
+def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_n="terms", fallback="previous"):
     """Dominant power-law noise type α at each averaging factor, by Stable32's method.
 
     At each m the data are brought to τ = m·τ0 — phase (angle) data decimated (every m-th point),
@@ -582,6 +592,11 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
     * ``"auto"`` (default, Stable32's rule): ACF where the record holds at least 30 intervals of
       length τ (⌊M/m⌋ ≥ 30 for M samples), B1/R(n) below.
 
+    Where too few samples remain — fewer than 8 τ-intervals for ``"oavar"``, 10 for ``"avar"``
+    (:data:`ID_MIN_POINTS`) — α is not identified from that τ's samples but taken from the nearest
+    shorter τ of ``m`` (``fallback="previous"``): Stable32's rule, which its Alpha columns follow
+    row by row (``docs/confidence.md``).
+
     Parameters
     ----------
     x : array_like, 1-D
@@ -593,16 +608,26 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
         What ``x`` holds. ``"angle"`` follows Stable32's phase-data path (decimation), ``"rate"`` and
         ``"increment"`` its frequency-data path (block averages).
     estimator : {"oavar", "avar"}
-        The estimator the α is for; matters only with ``b1_n="terms"``.
+        The estimator the α is for: its number of terms (``b1_n="terms"``) and its minimum of
+        τ-intervals (``fallback``) depend on it.
     method : {"auto", "acf", "b1"}
-    b1_n : {"averages", "terms"}
-        The N at which Barnes' expected B1(N, μ) is evaluated. ``"averages"`` (default): the
-        number of τ-averages the measured ratio is made of — Barnes' definition. ``"terms"``: the
-        estimator's number of terms, N − 2m (overlapping) or ⌊(N − 1)/m⌋ − 1 (classic), the
-        "#" column — what reproduces Stable32's Alpha column best. For the overlapping estimator
-        that N is far larger than the number of averages, so the RWFM expectation (N/2) is out of
-        reach and random-walk noise comes out as FFM: in simulation it identifies RWFM 0 % and
-        FFM 24 % of the time at 7–26 averages, against 67 % and 59 % for ``"averages"``.
+    b1_n : {"terms", "averages"}
+        The N at which Barnes' expected B1(N, μ) is evaluated. ``"terms"`` (default, Stable32's):
+        the estimator's number of terms, N − 2m (overlapping) or ⌊(N − 1)/m⌋ − 1 (classic), the
+        "#" column — with ``fallback="previous"`` it reproduces every Alpha of the Stable32
+        ADEV/OADEV octave and decade tables in ``docs/confidence.md``. ``"averages"``: the number
+        of τ-averages the measured ratio is made of — Barnes' definition. For the overlapping
+        estimator the number of terms is far larger than the number of averages, so with
+        ``"terms"`` the RWFM expectation (N/2) is out of reach and random-walk noise comes out as
+        FFM: in simulation it identifies RWFM 0 % and FFM 24 % of the time at 7–26 averages,
+        against 67 % and 59 % for ``"averages"``. Prefer ``"averages"`` to tell rate random walk
+        from bias instability at long τ of an overlapping curve.
+    fallback : {"previous", "none"}
+        ``"previous"`` (default): where too few samples remain (see above), α is that of the
+        nearest shorter τ of ``m`` identified on its own samples; if ``m`` holds none, α is
+        identified at the longest averaging factor that still has enough τ-intervals.
+        ``"none"``: every τ on its own samples, however few (with 2 averages B1 is exactly 1,
+        "white FM", whatever the noise).
 
     Returns
     -------
@@ -631,6 +656,7 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
     check_choice(estimator, "estimator", _ESTIMATORS)
     check_choice(method, "method", ("auto", "acf", "b1"))
     check_choice(b1_n, "b1_n", ("averages", "terms"))
+    check_choice(fallback, "fallback", _FALLBACKS)
     arr = np.asarray(x)
     if arr.ndim != 1 or arr.dtype.kind not in "iuf":
         raise ParameterError(
@@ -659,9 +685,46 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
         raise ParameterError(
             f"m = {int(m_arr[too_big][0])} is too large for {n_phase - 1} samples (largest: {(n_phase - 1) // 2})"
         )
+    each = functools.partial(
+        _identify_each, phase, rate, phase_input=input == "angle", estimator=estimator, method=method, b1_n=b1_n
+    )
+    own = each(m_arr)
+    out = own if fallback == "none" else _fall_back(own, m_arr, n_phase - 1, ID_MIN_POINTS[estimator], each)
+    return int(out[0]) if np.ndim(m) == 0 else out
+
+
+def _fall_back(own: np.ndarray, m: np.ndarray, n_intervals: int, min_points: int, identify) -> np.ndarray:
+    """Stable32's rule for τ with too few samples (see :func:`identify_alpha`): every τ with fewer than
+    ``min_points`` τ-intervals takes the α of the nearest shorter τ of ``m`` identified on its own; with
+    none, the α identified at the longest averaging factor that still has ``min_points`` intervals."""
+    needs = n_intervals // m < min_points
+    if not needs.any():
+        return own
+    out = own.copy()
+    donors = np.flatnonzero(~needs)
+    if donors.size:
+        # m need not be sorted: for each τ, the donor with the largest m below it
+        order = donors[np.argsort(m[donors], kind="stable")]
+        pos = np.searchsorted(m[order], m[needs], side="left") - 1
+    else:
+        pos = np.full(int(needs.sum()), -1)
+    ref = None
+    for i, p in zip(np.flatnonzero(needs), pos):
+        if p >= 0:
+            out[i] = own[order[p]]
+        else:
+            if ref is None:
+                ref = int(identify(np.array([max(1, n_intervals // min_points)]))[0])
+            out[i] = ref
+    return out
+
+
+def _identify_each(phase, rate, m_arr, *, phase_input, estimator, method, b1_n) -> np.ndarray:
+    """α at each m on that τ's own samples (no fallback)."""
+    n_phase = phase.size
     out = np.empty(m_arr.shape, dtype=np.int64)
     for i, mi in enumerate(m_arr.tolist()):
-        if input == "angle":
+        if phase_input:
             z = phase[::mi]
         else:
             k = rate.size // mi
@@ -669,7 +732,7 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
         points = (n_phase - 1) // mi  # τ-intervals in the record, for either kind of data
         use_acf = method == "acf" or (method == "auto" and points >= ACF_MIN_POINTS)
         if use_acf:
-            a = int(np.clip(round(_acf_alpha(z, phase=input == "angle")), -2, 2))
+            a = int(np.clip(round(_acf_alpha(z, phase=phase_input)), -2, 2))
         else:
             if b1_n == "averages":
                 n_ref = points
@@ -679,7 +742,7 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
                 n_ref = (n_phase - 1) // mi - 1
             a = _b1_rn_alpha(phase, rate, mi, n_ref)
         out[i] = a
-    return int(out[0]) if np.ndim(m) == 0 else out
+    return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -729,7 +792,7 @@ class ConfidenceIntervals:
         )
 
 
-def _alpha_for_result(result, x, alpha, shape_edf, b1_n) -> np.ndarray:
+def _alpha_for_result(result, x, alpha, shape_edf, b1_n, fallback) -> np.ndarray:
     if alpha is not None:
         a = _check_alpha(alpha)
         try:
@@ -761,7 +824,7 @@ def _alpha_for_result(result, x, alpha, shape_edf, b1_n) -> np.ndarray:
     for a_i, y in enumerate(cols):
         data = np.concatenate(([0.0], np.cumsum(y))) if kind == "angle" else y
         est = _registry.get(result.estimator).noise_id
-        ids = identify_alpha(data, _allan_m_for_id(result), input=kind, estimator=est, b1_n=b1_n)
+        ids = identify_alpha(data, _allan_m_for_id(result), input=kind, estimator=est, b1_n=b1_n, fallback=fallback)
         if is_multi:
             out[a_i] = ids
         else:
@@ -810,7 +873,15 @@ def _allan_m_for_id(result) -> np.ndarray:
 
 
 def confidence_intervals(
-    result, x=None, *, confidence=0.683, alpha=None, edf_method="greenhall", chi2="exact", b1_n="averages"
+    result,
+    x=None,
+    *,
+    confidence=0.683,
+    alpha=None,
+    edf_method="greenhall",
+    chi2="exact",
+    b1_n="terms",
+    fallback="previous",
 ) -> ConfidenceIntervals:
     """χ² confidence intervals of a static or dynamic Allan-variance result, per τ.
 
@@ -839,9 +910,15 @@ def confidence_intervals(
         EDF algorithm (SP 1065 formulas exist for ``"oavar"`` only).
     chi2 : {"exact", "stable32"}
         χ² quantiles, see :func:`chi2_interval`.
-    b1_n : {"averages", "terms"}
+    b1_n : {"terms", "averages"}
         Convention of the B1 branch of the noise identification, see :func:`identify_alpha`
-        (``"terms"`` and ``chi2="stable32"``, ``confidence=ONE_SIGMA`` for Stable32's numbers).
+        (the default ``"terms"`` with ``chi2="stable32"``, ``confidence=ONE_SIGMA`` for Stable32's
+        numbers; ``"averages"`` to tell rate random walk from bias instability at long τ).
+    fallback : {"previous", "none"}
+        Where too few samples remain to identify the noise type (fewer than 8 τ-intervals for
+        ``"oavar"``, 10 for ``"avar"``), α is the nearest shorter τ's (``"previous"``, Stable32's
+        rule, see :func:`identify_alpha`), so the last points get the wide interval their few terms
+        warrant instead of one from a guessed "white/flicker phase" type.
 
     Returns
     -------
@@ -887,7 +964,8 @@ def confidence_intervals(
     n_axes = result.n_axes
     shape_edf = (result.m.size,) if n_axes is None else (n_axes, result.m.size)
     check_choice(b1_n, "b1_n", ("averages", "terms"))
-    a = _alpha_for_result(result, x, alpha, shape_edf, b1_n)
+    check_choice(fallback, "fallback", _FALLBACKS)
+    a = _alpha_for_result(result, x, alpha, shape_edf, b1_n, fallback)
     n_phase = _window_length(result) + 1
     m_b = np.broadcast_to(result.m, shape_edf)
     if edf_method == "sp1065":
