@@ -153,8 +153,9 @@ impl TermScratch {
 
     /// Block sums B(k) = Σ_{i=k}^{k+m−1} (y_i − μ) for k = start + r, r < len, `start` a multiple of
     /// m (Van Herk / Gil-Werman: suffix sum of the segment [start, start+m) from k, plus prefix sum
-    /// of the next segment up to k+m−1). With `terms`, writes a(k−m) = (B(k) − B(k−m))² over the
-    /// suffix sums in `suf[..len]` and keeps B in `bprev`; without, only fills `bprev`.
+    /// of the next segment up to k+m−1). With `terms = Some(scale)`, writes a(k−m) =
+    /// scale·(B(k) − B(k−m))² over the suffix sums in `suf[..len]` and keeps B in `bprev`; with
+    /// `None`, only fills `bprev`.
     ///
     /// Both running sums are split into `CHAINS` parts whose local sums run interleaved; the parts
     /// are joined in the same pass that forms B, by adding per-part constants (the suffix totals of
@@ -168,8 +169,7 @@ impl TermScratch {
         m: usize,
         start: usize,
         len: usize,
-        terms: bool,
-        scale: f64,
+        terms: Option<f64>,
     ) {
         debug_assert!(len >= 1 && len <= m && start + len - 1 + m <= y.len());
         let seg = &y[start..start + m];
@@ -277,7 +277,7 @@ impl TermScratch {
         }
         let bprev = &mut self.bprev[..len];
         match terms {
-            true => {
+            Some(scale) => {
                 // a(k) overwrites the suffix sums in place: one buffer less in cache for large m.
                 for p in 0..CHAINS {
                     let (lo, hi) = if chained {
@@ -300,7 +300,7 @@ impl TermScratch {
                     }
                 }
             }
-            false => {
+            None => {
                 for p in 0..CHAINS {
                     let (lo, hi) = if chained {
                         (bd[p], bd[p + 1])
@@ -361,12 +361,12 @@ fn for_each_term_chunk(
         return;
     }
     let mut sc = TermScratch::new(m);
-    sc.segment(y, mu, m, 0, m.min(k_end), false, 1.0);
+    sc.segment(y, mu, m, 0, m.min(k_end), None);
     let mut start = 0;
     while start < k_end {
         let len = m.min(k_end - start);
         // d_m(k) = B(k + m) − B(k): the next aligned segment against the one kept in bprev.
-        sc.segment(y, mu, m, start + m, len, true, scale);
+        sc.segment(y, mu, m, start + m, len, Some(scale));
         f(&sc.suf[..len]);
         start += m;
     }
@@ -757,7 +757,7 @@ mod tests {
                     .filter(|&l| l <= m)
                 {
                     let mut sc = TermScratch::new(m);
-                    sc.segment(&y, 1.0, m, start, len, false, 1.0);
+                    sc.segment(&y, 1.0, m, start, len, None);
                     for r in 0..len {
                         let direct: f64 = y[start + r..start + r + m].iter().map(|v| v - 1.0).sum();
                         assert_eq!(sc.bprev[r], direct, "m {m} start {start} len {len} r {r}");

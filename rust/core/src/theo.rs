@@ -383,7 +383,7 @@ fn block_sums(y: &[f64], mu: f64, d: usize, count: usize, out: &mut Vec<f64>) {
     let mut start = 0;
     while start < count {
         let len = d.min(count - start);
-        sc.segment(y, mu, d, start, len, false, 1.0);
+        sc.segment(y, mu, d, start, len, None);
         out.extend_from_slice(&sc.bprev[..len]);
         start += d;
     }
