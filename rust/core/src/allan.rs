@@ -29,6 +29,7 @@
 //! Each (axis, m) row is computed by one sequential routine, so results are bit-identical for any
 //! number of worker threads.
 
+use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use rayon::prelude::*;
 
@@ -153,8 +154,9 @@ impl TermScratch {
 
     /// Block sums B(k) = Σ_{i=k}^{k+m−1} (y_i − μ) for k = start + r, r < len, `start` a multiple of
     /// m (Van Herk / Gil-Werman: suffix sum of the segment [start, start+m) from k, plus prefix sum
-    /// of the next segment up to k+m−1). With `terms`, writes a(k−m) = (B(k) − B(k−m))² over the
-    /// suffix sums in `suf[..len]` and keeps B in `bprev`; without, only fills `bprev`.
+    /// of the next segment up to k+m−1). With `terms = Some(scale)`, writes a(k−m) =
+    /// scale·(B(k) − B(k−m))² over the suffix sums in `suf[..len]` and keeps B in `bprev`; with
+    /// `None`, only fills `bprev`.
     ///
     /// Both running sums are split into `CHAINS` parts whose local sums run interleaved; the parts
     /// are joined in the same pass that forms B, by adding per-part constants (the suffix totals of
@@ -168,8 +170,7 @@ impl TermScratch {
         m: usize,
         start: usize,
         len: usize,
-        terms: bool,
-        scale: f64,
+        terms: Option<f64>,
     ) {
         debug_assert!(len >= 1 && len <= m && start + len - 1 + m <= y.len());
         let seg = &y[start..start + m];
@@ -277,7 +278,7 @@ impl TermScratch {
         }
         let bprev = &mut self.bprev[..len];
         match terms {
-            true => {
+            Some(scale) => {
                 // a(k) overwrites the suffix sums in place: one buffer less in cache for large m.
                 for p in 0..CHAINS {
                     let (lo, hi) = if chained {
@@ -300,7 +301,7 @@ impl TermScratch {
                     }
                 }
             }
-            false => {
+            None => {
                 for p in 0..CHAINS {
                     let (lo, hi) = if chained {
                         (bd[p], bd[p + 1])
@@ -325,6 +326,7 @@ impl TermScratch {
 
 /// Calls `f` with consecutive chunks of a(k) = scale·d_m(k)² for k = 0, 1, …, k_end − 1 (in
 /// order); `scale` folds the estimator's normalisation into the pass that forms the terms.
+/// Stops early (the chunks seen so far are then incomplete) once `cancel` is set.
 /// Requires 1 ≤ k_end ≤ y.len() + 1 − 2m.
 fn for_each_term_chunk(
     y: &[f64],
@@ -332,6 +334,7 @@ fn for_each_term_chunk(
     m: usize,
     k_end: usize,
     scale: f64,
+    cancel: &Cancel,
     mut f: impl FnMut(&[f64]),
 ) {
     debug_assert!(k_end >= 1 && k_end + 2 * m <= y.len() + 1);
@@ -342,6 +345,9 @@ fn for_each_term_chunk(
         let mut a = vec![0.0; DIRECT_CHUNK];
         let mut k0 = 0;
         while k0 < k_end {
+            if cancel.is_cancelled() {
+                return;
+            }
             let c = DIRECT_CHUNK.min(k_end - k0);
             let b = &mut bbuf[..c + m];
             b.fill(0.0);
@@ -361,12 +367,16 @@ fn for_each_term_chunk(
         return;
     }
     let mut sc = TermScratch::new(m);
-    sc.segment(y, mu, m, 0, m.min(k_end), false, 1.0);
+    sc.segment(y, mu, m, 0, m.min(k_end), None);
     let mut start = 0;
     while start < k_end {
+        // One load per chunk of m > DIRECT_M terms: negligible next to forming them.
+        if cancel.is_cancelled() {
+            return;
+        }
         let len = m.min(k_end - start);
         // d_m(k) = B(k + m) − B(k): the next aligned segment against the one kept in bprev.
-        sc.segment(y, mu, m, start + m, len, true, scale);
+        sc.segment(y, mu, m, start + m, len, Some(scale));
         f(&sc.suf[..len]);
         start += m;
     }
@@ -415,6 +425,8 @@ struct RowScratch {
 }
 
 /// Overlapping Allan variance of every window, for one m, written to `out` (length n_windows).
+/// Once `cancel` is set, `out` holds garbage (the caller returns `Cancelled` instead).
+#[allow(clippy::too_many_arguments)] // the row's geometry (y, mu, m, window, hop) is irreducible
 fn overlapping_row(
     y: &[f64],
     mu: f64,
@@ -423,6 +435,7 @@ fn overlapping_row(
     hop: usize,
     out: &mut [f64],
     sc: &mut RowScratch,
+    cancel: &Cancel,
 ) {
     let n_win = out.len();
     let l = window + 1 - 2 * m;
@@ -441,7 +454,7 @@ fn overlapping_row(
         // Short blocks: per-block bookkeeping would cost more than the arithmetic, so keep the
         // terms and cut them afterwards (the output is already ~k_end/hop values per m).
         terms.clear();
-        for_each_term_chunk(y, mu, m, k_end, norm, |chunk| {
+        for_each_term_chunk(y, mu, m, k_end, norm, cancel, |chunk| {
             terms.extend_from_slice(chunk)
         });
         if hop == 1 {
@@ -454,7 +467,7 @@ fn overlapping_row(
         }
     } else {
         let (mut b, mut pos, mut total) = (0usize, 0usize, 0.0f64);
-        for_each_term_chunk(y, mu, m, k_end, norm, |chunk| {
+        for_each_term_chunk(y, mu, m, k_end, norm, cancel, |chunk| {
             let mut i = 0;
             while i < chunk.len() {
                 let target = if pos < r { r } else { hop };
@@ -474,6 +487,9 @@ fn overlapping_row(
             }
         });
     }
+    if cancel.is_cancelled() {
+        return;
+    }
     // The terms already carry the normalisation, so the window sums are the variances.
     if q == 0 {
         out.copy_from_slice(&part[..n_win]);
@@ -489,7 +505,15 @@ fn overlapping_row(
 
 /// Classic (non-overlapping) Allan variance of every window, for one m: clusters start at the
 /// window's first sample, so window j uses the terms a(s + i·m), i = 0 … K−2, s = j·hop.
-fn classic_row(y: &[f64], mu: f64, m: usize, window: usize, hop: usize, out: &mut [f64]) {
+fn classic_row(
+    y: &[f64],
+    mu: f64,
+    m: usize,
+    window: usize,
+    hop: usize,
+    out: &mut [f64],
+    cancel: &Cancel,
+) {
     let n_win = out.len();
     let k = window / m;
     let terms = k - 1;
@@ -499,7 +523,7 @@ fn classic_row(y: &[f64], mu: f64, m: usize, window: usize, hop: usize, out: &mu
         // One window: keep only the strided terms, O(m) memory.
         let mut picked = Vec::with_capacity(terms);
         let mut k0 = 0usize;
-        for_each_term_chunk(y, mu, m, k_end, norm, |chunk| {
+        for_each_term_chunk(y, mu, m, k_end, norm, cancel, |chunk| {
             let first = (m - k0 % m) % m;
             picked.extend(chunk.iter().skip(first).step_by(m));
             k0 += chunk.len();
@@ -508,9 +532,18 @@ fn classic_row(y: &[f64], mu: f64, m: usize, window: usize, hop: usize, out: &mu
         return;
     }
     let mut a = Vec::with_capacity(k_end);
-    for_each_term_chunk(y, mu, m, k_end, norm, |chunk| a.extend_from_slice(chunk));
+    for_each_term_chunk(y, mu, m, k_end, norm, cancel, |chunk| {
+        a.extend_from_slice(chunk)
+    });
+    if cancel.is_cancelled() {
+        return;
+    }
     let mut buf = Vec::with_capacity(terms);
     for (j, o) in out.iter_mut().enumerate() {
+        // Many long windows add up: look at the flag per window (each is `terms` additions).
+        if cancel.is_cancelled() {
+            return;
+        }
         let s = j * hop;
         buf.clear();
         buf.extend((0..terms).map(|i| a[s + i * m]));
@@ -580,13 +613,13 @@ pub struct Request<'a> {
 /// At least one axis, all the same length, at least 2 samples: the record length.
 pub(crate) fn check_shape(cols: &[&[f64]]) -> Result<usize> {
     if cols.is_empty() {
-        return Err(CoreError::InvalidParameter(
+        return Err(CoreError::InvalidInput(
             "no axes given: at least one record is needed".into(),
         ));
     }
     let n = cols[0].len();
     if let Some((a, c)) = cols.iter().enumerate().find(|(_, c)| c.len() != n) {
-        return Err(CoreError::InvalidParameter(format!(
+        return Err(CoreError::InvalidInput(format!(
             "axis {a} has {} samples but axis 0 has {n}; all axes must have the same length",
             c.len()
         )));
@@ -648,6 +681,12 @@ pub fn validate(req: &Request) -> Result<usize> {
 /// Allan variance of every window at every m, for every axis, in the calling rayon pool.
 /// Returns (values laid out as [axis][m][window], number of windows).
 pub fn dynamic_avar(req: &Request) -> Result<(Vec<f64>, usize)> {
+    dynamic_avar_cancellable(req, &Cancel::new())
+}
+
+/// [`dynamic_avar`] that stops within one row chunk (at most a few thousand terms per worker) once
+/// `cancel` is set, and then returns [`CoreError::Cancelled`].
+pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f64>, usize)> {
     let n_win = validate(req)?;
     let (n_axes, n_m) = (req.columns.len(), req.ms.len());
     let mut out = vec![0.0f64; n_axes * n_m * n_win];
@@ -661,13 +700,18 @@ pub fn dynamic_avar(req: &Request) -> Result<(Vec<f64>, usize)> {
             out.par_chunks_mut(n_win).enumerate().for_each_init(
                 RowScratch::default,
                 |sc, (row, dst)| {
+                    if cancel.is_cancelled() {
+                        return;
+                    }
                     let (a, t) = (row / n_m, row % n_m);
                     let (y, m) = (req.columns[a], req.ms[t]);
                     match req.estimator {
                         Estimator::Overlapping => {
-                            overlapping_row(y, mus[a], m, req.window, req.hop, dst, sc)
+                            overlapping_row(y, mus[a], m, req.window, req.hop, dst, sc, cancel)
                         }
-                        Estimator::Classic => classic_row(y, mus[a], m, req.window, req.hop, dst),
+                        Estimator::Classic => {
+                            classic_row(y, mus[a], m, req.window, req.hop, dst, cancel)
+                        }
                     }
                 },
             );
@@ -679,6 +723,9 @@ pub fn dynamic_avar(req: &Request) -> Result<(Vec<f64>, usize)> {
                     .map_init(Vec::new, |angle, j| {
                         let s = j * req.hop;
                         let mut col = vec![0.0; n_m];
+                        if cancel.is_cancelled() {
+                            return col;
+                        }
                         naive_window(
                             &y[s..s + req.window],
                             req.ms,
@@ -689,6 +736,7 @@ pub fn dynamic_avar(req: &Request) -> Result<(Vec<f64>, usize)> {
                         col
                     })
                     .collect();
+                cancel.check()?;
                 let block = &mut out[a * n_m * n_win..(a + 1) * n_m * n_win];
                 for (j, col) in cols.iter().enumerate() {
                     for (t, v) in col.iter().enumerate() {
@@ -698,6 +746,8 @@ pub fn dynamic_avar(req: &Request) -> Result<(Vec<f64>, usize)> {
             }
         }
     }
+    // A row that stopped early left garbage: never return it.
+    cancel.check()?;
     Ok((out, n_win))
 }
 
@@ -718,13 +768,17 @@ pub fn static_avar(columns: &[&[f64]], ms: &[usize], estimator: Estimator) -> Re
 /// Runs `f` in a rayon pool of `workers` threads (0: rayon's default, i.e. RAYON_NUM_THREADS or
 /// the number of cores).
 pub fn run_in_pool<R: Send>(workers: usize, f: impl FnOnce() -> R + Send) -> Result<R> {
-    let pool = rayon::ThreadPoolBuilder::new()
+    Ok(build_pool(workers)?.install(f))
+}
+
+/// A rayon pool of `workers` threads (0: rayon's default).
+pub(crate) fn build_pool(workers: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
         .num_threads(workers)
         .build()
         .map_err(|e| {
             CoreError::InvalidParameter(format!("cannot start {workers} worker threads: {e}"))
-        })?;
-    Ok(pool.install(f))
+        })
 }
 
 #[cfg(test)]
@@ -757,7 +811,7 @@ mod tests {
                     .filter(|&l| l <= m)
                 {
                     let mut sc = TermScratch::new(m);
-                    sc.segment(&y, 1.0, m, start, len, false, 1.0);
+                    sc.segment(&y, 1.0, m, start, len, None);
                     for r in 0..len {
                         let direct: f64 = y[start + r..start + r + m].iter().map(|v| v - 1.0).sum();
                         assert_eq!(sc.bprev[r], direct, "m {m} start {start} len {len} r {r}");

@@ -25,6 +25,7 @@
 //! (axis, τ) value is one deterministic computation).
 
 use crate::allan::{check_shape, compensated_mean, sliding_sums, sum4};
+use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use rayon::prelude::*;
 
@@ -415,10 +416,10 @@ impl TotScratch {
 /// x# the 3m-point phase subsequence x_n … x_{n+3m−1}, its half-average slope removed, extended to 9m
 /// points by uninverted even reflection. No bias correction (Stable32 divides by a noise-dependent
 /// factor; see tests/test_deviations_core.py).
-fn mtotvar_value(f: &[f64], m: usize) -> f64 {
+fn mtotvar_value(f: &[f64], m: usize, cancel: &Cancel) -> f64 {
     let l = f.len() + 2 - 3 * m;
     let n3 = 3 * m;
-    let total = chunked_sum(l, m, |sc, n| {
+    let total = chunked_sum(l, m, cancel, |sc, n| {
         // Local phase: x_{n+k} − x_n = Σ_{i<k} f_{n+i}, summed from the subsequence's own samples.
         let mut x = 0.0;
         sc.u[0] = 0.0;
@@ -439,13 +440,13 @@ fn mtotvar_value(f: &[f64], m: usize) -> f64 {
 /// y# the 3m-sample frequency subsequence y_n … y_{n+3m−1}, half-average slope removed, extended to
 /// 9m samples by uninverted even reflection. At m = 1 it is OHVAR (Riley: "for best consistency";
 /// Stable32 and allantools do the same). No bias correction.
-fn htotvar_value(f: &[f64], m: usize) -> f64 {
+fn htotvar_value(f: &[f64], m: usize, cancel: &Cancel) -> f64 {
     if m == 1 {
         return overlapping_value(Kind::Ohvar, f, 1);
     }
     let l = f.len() + 1 - 3 * m;
     let n3 = 3 * m;
-    let total = chunked_sum(l, m, |sc, n| {
+    let total = chunked_sum(l, m, cancel, |sc, n| {
         sc.u.copy_from_slice(&f[n..n + n3]);
         sc.reflected_square_sum(m)
     });
@@ -454,12 +455,20 @@ fn htotvar_value(f: &[f64], m: usize) -> f64 {
 }
 
 /// Σ_{n<l} g(n) over fixed chunks of subsequences, in parallel; chunk totals added in order.
-fn chunked_sum(l: usize, m: usize, g: impl Fn(&mut TotScratch, usize) -> f64 + Sync) -> f64 {
+fn chunked_sum(
+    l: usize,
+    m: usize,
+    cancel: &Cancel,
+    g: impl Fn(&mut TotScratch, usize) -> f64 + Sync,
+) -> f64 {
     let parts: Vec<f64> = (0..l.div_ceil(SUB_CHUNK))
         .into_par_iter()
         .map_init(
             || TotScratch::new(m),
             |sc, c| {
+                if cancel.is_cancelled() {
+                    return 0.0; // the caller checks the flag and discards the value
+                }
                 let mut acc = Acc::default();
                 for n in c * SUB_CHUNK..((c + 1) * SUB_CHUNK).min(l) {
                     acc.add(g(sc, n));
@@ -475,39 +484,65 @@ fn chunked_sum(l: usize, m: usize, g: impl Fn(&mut TotScratch, usize) -> f64 + S
     acc.get()
 }
 
-fn value(kind: Kind, f: &[f64], m: usize) -> f64 {
+fn value(kind: Kind, f: &[f64], m: usize, cancel: &Cancel) -> f64 {
+    if cancel.is_cancelled() {
+        return 0.0;
+    }
     match kind {
         Kind::Oavar | Kind::Mvar | Kind::Ohvar => overlapping_value(kind, f, m),
         Kind::Hvar => hvar_value(f, m),
         Kind::Totvar => totvar_value(f, m),
-        Kind::Mtotvar => mtotvar_value(f, m),
-        Kind::Htotvar => htotvar_value(f, m),
+        Kind::Mtotvar => mtotvar_value(f, m, cancel),
+        Kind::Htotvar => htotvar_value(f, m, cancel),
     }
 }
 
 /// `kind` of each whole rate record at every m, laid out [axis][m], in the calling rayon pool.
 /// Rejects NaN/±inf (use [`gap_deviation`] for NaN-marked gaps).
 pub fn static_deviation(columns: &[&[f64]], ms: &[usize], kind: Kind) -> Result<Vec<f64>> {
+    static_deviation_cancellable(columns, ms, kind, &Cancel::new())
+}
+
+/// [`static_deviation`], stopping early (with [`CoreError::Cancelled`]) once `cancel` is set; the
+/// flag is looked at per (axis, m) row and per chunk of the total variances' subsequences.
+pub fn static_deviation_cancellable(
+    columns: &[&[f64]],
+    ms: &[usize],
+    kind: Kind,
+    cancel: &Cancel,
+) -> Result<Vec<f64>> {
     let n = check_shape(columns)?;
     check_ms(kind, n, ms, "record")?;
     check_values(columns, false)?;
     let centred: Vec<Vec<f64>> = columns.par_iter().map(|c| centred(c)).collect();
     let n_m = ms.len();
-    Ok((0..columns.len() * n_m)
+    let out: Vec<f64> = (0..columns.len() * n_m)
         .into_par_iter()
-        .map(|row| value(kind, &centred[row / n_m], ms[row % n_m]))
-        .collect())
+        .map(|row| value(kind, &centred[row / n_m], ms[row % n_m], cancel))
+        .collect();
+    cancel.check()?;
+    Ok(out)
 }
 
 /// TTOTVAR (SP 1065 eq. 28, corrected: τ²/3, not τ³): Ttot var(τ) = (τ²/3)·Mod Totvar(τ), τ = m·τ0,
 /// in the rate's units × time² (τ0 in the unit of time wanted). [axis][m].
 pub fn static_ttotvar(columns: &[&[f64]], ms: &[usize], tau0: f64) -> Result<Vec<f64>> {
+    static_ttotvar_cancellable(columns, ms, tau0, &Cancel::new())
+}
+
+/// [`static_ttotvar`] with a cancel flag, as [`static_deviation_cancellable`].
+pub fn static_ttotvar_cancellable(
+    columns: &[&[f64]],
+    ms: &[usize],
+    tau0: f64,
+    cancel: &Cancel,
+) -> Result<Vec<f64>> {
     if !(tau0.is_finite() && tau0 > 0.0) {
         return Err(CoreError::InvalidParameter(format!(
             "tau0 ({tau0}) must be a finite positive sampling interval"
         )));
     }
-    let v = static_deviation(columns, ms, Kind::Mtotvar)?;
+    let v = static_deviation_cancellable(columns, ms, Kind::Mtotvar, cancel)?;
     let n_m = ms.len();
     Ok(v.iter()
         .enumerate()

@@ -1,5 +1,7 @@
 //! Errors of the core. Every public entry point returns `Result<_, CoreError>`; nothing panics on user
-//! input. The binding maps these to `allanite.AllaniteError` (a `ValueError` subclass).
+//! input. The binding maps each variant to its `allanite.errors` class: `TooShort`, `NonFinite` and
+//! `InvalidInput` to `InputError`, `InvalidParameter` to `ParameterError` (both `ValueError`s), and
+//! `Cancelled` to `KeyboardInterrupt`.
 
 use std::fmt;
 
@@ -13,12 +15,16 @@ pub enum CoreError {
     },
     /// A parameter outside its allowed range; the message names the value and the range.
     InvalidParameter(String),
+    /// The records themselves are unusable (no axis, axes of different lengths); the message says why.
+    InvalidInput(String),
     /// NaN or ±inf in the input, at `index` of axis `axis`.
     NonFinite {
         axis: usize,
         index: usize,
         value: f64,
     },
+    /// The caller asked the computation to stop (Ctrl-C); no partial result is returned.
+    Cancelled,
 }
 
 impl fmt::Display for CoreError {
@@ -30,12 +36,13 @@ impl fmt::Display for CoreError {
                     "{what} is too short: {got} samples, at least {needed} needed"
                 )
             }
-            CoreError::InvalidParameter(msg) => write!(f, "{msg}"),
+            CoreError::InvalidParameter(msg) | CoreError::InvalidInput(msg) => write!(f, "{msg}"),
             CoreError::NonFinite { axis, index, value } => write!(
                 f,
                 "input contains a non-finite value ({value}) at sample {index} of axis {axis}; \
                  only finite numbers are allowed"
             ),
+            CoreError::Cancelled => write!(f, "the computation was interrupted"),
         }
     }
 }

@@ -4,13 +4,18 @@
 //! entry point validates its arguments and returns [`CoreError`] instead of panicking.
 
 pub mod allan;
+pub mod cancel;
 pub mod deviations;
 pub mod error;
 pub mod theo;
 
 pub use allan::{
-    compensated_mean, dynamic_avar, max_m, n_terms, n_windows, run_in_pool, static_avar, Estimator,
-    Method, Request,
+    compensated_mean, dynamic_avar, dynamic_avar_cancellable, max_m, n_terms, n_windows,
+    run_in_pool, static_avar, Estimator, Method, Request,
 };
+pub use cancel::{run_in_pool_interruptible, Cancel};
 pub use error::{CoreError, Result};
-pub use theo::{detrended_phase, dynamic_theo1, static_theo1, theo1_direct};
+pub use theo::{
+    detrended_phase, dynamic_theo1, dynamic_theo1_cancellable, static_theo1,
+    static_theo1_cancellable, theo1_direct,
+};

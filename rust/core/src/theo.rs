@@ -34,6 +34,7 @@
 use crate::allan::{
     check_finite, check_shape, compensated_mean, sliding_sums, sum4, TermScratch, DIRECT_M,
 };
+use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use rayon::prelude::*;
 
@@ -218,7 +219,14 @@ fn kernels() -> Kernels {
 
 /// The W-part of T(m) from the pairs inside the first points of `z`, for each m of `ms` (sorted,
 /// distinct, even). With `want_f` the pass continues to all points and also returns F_ℓ (ℓ < N).
-fn head_pass(z: &[f64], ms: &[usize], want_f: bool, k: Kernels) -> (Vec<f64>, Option<Vec<f64>>) {
+/// Stops early, with meaningless sums, once `cancel` is set.
+fn head_pass(
+    z: &[f64],
+    ms: &[usize],
+    want_f: bool,
+    k: Kernels,
+    cancel: &Cancel,
+) -> (Vec<f64>, Option<Vec<f64>>) {
     let n = z.len();
     let mmax = *ms.last().expect("ms checked non-empty");
     let last = if want_f { n - 1 } else { mmax - 1 };
@@ -239,6 +247,10 @@ fn head_pass(z: &[f64], ms: &[usize], want_f: bool, k: Kernels) -> (Vec<f64>, Op
     };
     let mut p = 1;
     while p <= last {
+        // Each step adds p pairs: one load of the flag per step is lost in that work.
+        if cancel.is_cancelled() {
+            break;
+        }
         let s = p + 1; // stage reached after point p: the pairs inside [0, s)
                        // Two points per pass over h (half the memory traffic) unless stage s needs all of h.
         let fuse = p < last && (s > mmax || ms.binary_search(&s).is_err());
@@ -301,7 +313,8 @@ fn head_pass(z: &[f64], ms: &[usize], want_f: bool, k: Kernels) -> (Vec<f64>, Op
 }
 
 /// Theo1 of one whole record of phase points `x` (detrended) at each m of `ms` (sorted, distinct).
-fn static_theo1_phase(x: &[f64], ms: &[usize]) -> Vec<f64> {
+/// Returns `Cancelled` once `cancel` is set.
+fn static_theo1_phase(x: &[f64], ms: &[usize], cancel: &Cancel) -> Result<Vec<f64>> {
     let n = x.len();
     let k = kernels();
     let mmax = *ms.last().expect("ms checked non-empty");
@@ -309,16 +322,17 @@ fn static_theo1_phase(x: &[f64], ms: &[usize]) -> Vec<f64> {
     let want_f = 2 * mmax > n;
     let xr: Vec<f64> = x.iter().rev().copied().collect();
     let ((head, f_head), (tail, _)) = rayon::join(
-        || head_pass(x, ms, want_f, k),
-        || head_pass(&xr, ms, false, k),
+        || head_pass(x, ms, want_f, k, cancel),
+        || head_pass(&xr, ms, false, k, cancel),
     );
+    cancel.check()?;
     let f: Vec<f64> = match f_head {
         Some(f) => f,
         None => (0..mmax + 1)
             .into_par_iter()
             .with_min_len(16)
             .map(|l| {
-                if l == 0 {
+                if l == 0 || cancel.is_cancelled() {
                     0.0
                 } else {
                     (k.sq_diff_sum)(&x[l..], &x[..n - l])
@@ -326,7 +340,9 @@ fn static_theo1_phase(x: &[f64], ms: &[usize]) -> Vec<f64> {
             })
             .collect(),
     };
-    ms.iter()
+    cancel.check()?;
+    Ok(ms
+        .iter()
         .enumerate()
         .map(|(idx, &m)| {
             let h = m / 2;
@@ -339,7 +355,7 @@ fn static_theo1_phase(x: &[f64], ms: &[usize]) -> Vec<f64> {
             let t = acc - harmonic * f[m] + head[idx] + tail[idx];
             t / (0.75 * (n - m) as f64 * (m * m) as f64)
         })
-        .collect()
+        .collect())
 }
 
 /// Sorted distinct copy of `ms` and, for each original position, its index in the copy.
@@ -354,13 +370,23 @@ fn sorted_unique(ms: &[usize]) -> (Vec<usize>, Vec<usize>) {
 /// Theo1 of each whole rate record at every m: values laid out as [axis][m]. Phase per record:
 /// N = M + 1 points; m even, 2 ≤ m ≤ M. Axes run one after another, each on the calling pool.
 pub fn static_theo1(columns: &[&[f64]], ms: &[usize]) -> Result<Vec<f64>> {
+    static_theo1_cancellable(columns, ms, &Cancel::new())
+}
+
+/// [`static_theo1`] that stops within one pass step (O(N) work) once `cancel` is set, and then
+/// returns [`CoreError::Cancelled`].
+pub fn static_theo1_cancellable(
+    columns: &[&[f64]],
+    ms: &[usize],
+    cancel: &Cancel,
+) -> Result<Vec<f64>> {
     let n = check_columns(columns)?;
     check_ms(n, ms, "record")?;
     let (u, pos) = sorted_unique(ms);
     let mut out = Vec::with_capacity(columns.len() * ms.len());
     for y in columns {
         let x = detrended_phase(y);
-        let vals = static_theo1_phase(&x, &u);
+        let vals = static_theo1_phase(&x, &u, cancel)?;
         out.extend(pos.iter().map(|&p| vals[p]));
     }
     Ok(out)
@@ -383,7 +409,7 @@ fn block_sums(y: &[f64], mu: f64, d: usize, count: usize, out: &mut Vec<f64>) {
     let mut start = 0;
     while start < count {
         let len = d.min(count - start);
-        sc.segment(y, mu, d, start, len, false, 1.0);
+        sc.segment(y, mu, d, start, len, None);
         out.extend_from_slice(&sc.bprev[..len]);
         start += d;
     }
@@ -444,6 +470,8 @@ fn add_window_sums(
 /// Theo1 of every window for a group of m's (rows of `out`, n_windows each). The d-loop is outermost
 /// so that each block-sum sequence B_d is formed once for the whole group; every row still receives
 /// its d-contributions in increasing d, so the numbers do not depend on how m's are grouped.
+/// Stops early, leaving `out` meaningless, once `cancel` is set.
+#[allow(clippy::too_many_arguments)] // the group's geometry (y, mu, ms, window, hop) is irreducible
 fn theo1_group(
     y: &[f64],
     mu: f64,
@@ -452,6 +480,7 @@ fn theo1_group(
     hop: usize,
     out: &mut [f64],
     sc: &mut TheoScratch,
+    cancel: &Cancel,
 ) {
     let n_win = out.len() / ms.len();
     out.fill(0.0);
@@ -464,12 +493,16 @@ fn theo1_group(
     } = sc;
     let h_max = ms.iter().map(|m| m / 2).max().unwrap_or(0);
     for d in 1..=h_max {
+        if cancel.is_cancelled() {
+            return;
+        }
         // B_d(i) is needed for i < k_end + (m − d) = (n_win − 1)·hop + window + 1 − d, the same for
         // every m (with one window, "hop" is the window's term count and the product vanishes).
         let count = (n_win - 1) * hop + window + 1 - d;
         block_sums(y, mu, d, count, b);
         for (&m, row) in ms.iter().zip(out.chunks_mut(n_win)) {
-            if m / 2 < d {
+            // A (d, m) pass is O(record): look at the flag before each one.
+            if m / 2 < d || cancel.is_cancelled() {
                 continue;
             }
             let l = window + 1 - m; // terms per window (window + 1 phase points)
@@ -517,6 +550,18 @@ pub fn dynamic_theo1(
     hop: usize,
     ms: &[usize],
 ) -> Result<(Vec<f64>, usize)> {
+    dynamic_theo1_cancellable(columns, window, hop, ms, &Cancel::new())
+}
+
+/// [`dynamic_theo1`] that stops within one (d, m) pass (O(M) work per worker) once `cancel` is set,
+/// and then returns [`CoreError::Cancelled`].
+pub fn dynamic_theo1_cancellable(
+    columns: &[&[f64]],
+    window: usize,
+    hop: usize,
+    ms: &[usize],
+    cancel: &Cancel,
+) -> Result<(Vec<f64>, usize)> {
     let n = check_columns(columns)?;
     if window < 2 || window > n {
         return Err(CoreError::InvalidParameter(format!(
@@ -547,8 +592,10 @@ pub fn dynamic_theo1(
     tasks
         .into_par_iter()
         .for_each_init(TheoScratch::default, |sc, (a, g, dst)| {
-            theo1_group(columns[a], mus[a], &u[g], window, hop, dst, sc);
+            theo1_group(columns[a], mus[a], &u[g], window, hop, dst, sc, cancel);
         });
+    // A group that stopped early left garbage: never return it.
+    cancel.check()?;
     let mut out = Vec::with_capacity(columns.len() * ms.len() * n_win);
     for a in 0..columns.len() {
         let base = a * u.len() * n_win;

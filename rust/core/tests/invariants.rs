@@ -137,13 +137,13 @@ fn nist_sp1065_suite() {
 
 #[test]
 fn errors_name_the_value() {
-    let y = vec![0.0, 1.0, f64::NAN, 2.0];
+    let y = [0.0, 1.0, f64::NAN, 2.0];
     let cols = [&y[..]];
     let err = static_avar(&cols, &[1], Estimator::Overlapping)
         .unwrap_err()
         .to_string();
     assert!(err.contains("sample 2") && err.contains("NaN"), "{err}");
-    let y = vec![0.0; 10];
+    let y = [0.0; 10];
     let cols = [&y[..]];
     let bad = |window, hop, ms: &[usize]| {
         let req = Request {

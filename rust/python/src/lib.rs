@@ -1,20 +1,30 @@
 //! The `allanite._core` extension module: numpy in, numpy out, GIL released around the work.
 //! Nothing else lives here — validation with friendly messages happens in Python, the arithmetic in
-//! allanite-core, and core errors come back as `allanite.errors.AllaniteError` (a ValueError).
+//! allanite-core, and core errors come back as the matching `allanite.errors` class (`InputError`,
+//! `ParameterError`; both ValueErrors).
+//!
+//! Every long call goes through [`run_interruptible`], so Ctrl-C stops it: a kernel takes a
+//! `&Cancel` (see allanite_core::cancel) and the binding calls it as
+//! `run_interruptible(py, workers, |cancel| kernel_cancellable(..., cancel))`.
 
 use allanite_core::{
-    deviations, dynamic_avar, dynamic_theo1, run_in_pool, static_theo1, CoreError, Estimator,
-    Method, Request,
+    deviations, dynamic_avar_cancellable, dynamic_theo1_cancellable, run_in_pool_interruptible,
+    static_theo1_cancellable, Cancel, CoreError, Estimator, Method, Request,
 };
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
+use std::time::Duration;
 
-/// Raises `allanite.errors.AllaniteError(msg)`; falls back to ValueError if the package is absent.
-fn allanite_error(py: Python<'_>, msg: String) -> PyErr {
+/// How often the calling thread looks for a pending signal while the workers run: often enough
+/// for Ctrl-C to land well within a second, rarely enough that taking the GIL costs nothing.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// `allanite.errors.<class_name>(msg)`; falls back to ValueError if the package is absent.
+fn allanite_error_of(py: Python<'_>, class_name: &str, msg: String) -> PyErr {
     let made = py
         .import("allanite.errors")
-        .and_then(|m| m.getattr("AllaniteError"))
+        .and_then(|m| m.getattr(class_name))
         .and_then(|cls| cls.call1((msg.clone(),)));
     match made {
         Ok(instance) => PyErr::from_value(instance),
@@ -22,16 +32,53 @@ fn allanite_error(py: Python<'_>, msg: String) -> PyErr {
     }
 }
 
+/// Raises `allanite.errors.AllaniteError(msg)`; falls back to ValueError if the package is absent.
+fn allanite_error(py: Python<'_>, msg: String) -> PyErr {
+    allanite_error_of(py, "AllaniteError", msg)
+}
+
+/// Each core error as its `allanite.errors` class, message unchanged.
 fn core_error(py: Python<'_>, e: CoreError) -> PyErr {
-    allanite_error(py, e.to_string())
+    let class_name = match &e {
+        CoreError::TooShort { .. } | CoreError::NonFinite { .. } | CoreError::InvalidInput(_) => {
+            "InputError"
+        }
+        CoreError::InvalidParameter(_) => "ParameterError",
+        CoreError::Cancelled => {
+            return pyo3::exceptions::PyKeyboardInterrupt::new_err(e.to_string());
+        }
+    };
+    allanite_error_of(py, class_name, e.to_string())
+}
+
+/// Runs a core kernel on `workers` rayon threads (0: rayon's default) with the GIL released, and
+/// makes it interruptible: while the workers run, this thread takes the GIL every `SIGNAL_POLL`
+/// to run Python's signal handlers (`check_signals`; a no-op off the main thread). If a handler
+/// raises (Ctrl-C: KeyboardInterrupt), the kernel's `Cancel` flag is set, the workers are waited
+/// for (they stop at their next check), and the handler's exception is returned. Core errors come
+/// back as their `allanite.errors` classes.
+///
+/// Every kernel of this module goes through here: `job` receives the flag and passes it on.
+fn run_interruptible<R: Send>(
+    py: Python<'_>,
+    workers: usize,
+    job: impl FnOnce(&Cancel) -> allanite_core::Result<R> + Send,
+) -> PyResult<R> {
+    let outcome = py.detach(|| {
+        run_in_pool_interruptible(workers, SIGNAL_POLL, job, || {
+            Python::attach(|py| py.check_signals())
+        })
+    })?;
+    outcome.map_err(|e| core_error(py, e))
 }
 
 fn parse_estimator(py: Python<'_>, s: &str) -> PyResult<Estimator> {
     match s {
         "oavar" => Ok(Estimator::Overlapping),
         "avar" => Ok(Estimator::Classic),
-        other => Err(allanite_error(
+        other => Err(allanite_error_of(
             py,
+            "ParameterError",
             format!("unknown estimator {other:?}; allowed: 'oavar', 'avar'"),
         )),
     }
@@ -41,8 +88,9 @@ fn parse_method(py: Python<'_>, s: &str) -> PyResult<Method> {
     match s {
         "fast" => Ok(Method::Fast),
         "naive" => Ok(Method::Naive),
-        other => Err(allanite_error(
+        other => Err(allanite_error_of(
             py,
+            "ParameterError",
             format!("unknown method {other:?}; allowed: 'fast', 'naive'"),
         )),
     }
@@ -76,8 +124,8 @@ fn davar<'py>(
         estimator,
         method,
     };
-    let result = py.detach(|| run_in_pool(workers, || dynamic_avar(&req)));
-    let (values, n_win) = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let (values, n_win) =
+        run_interruptible(py, workers, |cancel| dynamic_avar_cancellable(&req, cancel))?;
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
@@ -90,7 +138,11 @@ fn contiguous<'a>(
     let mut slices: Vec<&[f64]> = Vec::with_capacity(columns.len());
     for (a, c) in columns.iter().enumerate() {
         let s = c.as_slice().map_err(|_| {
-            allanite_error(py, format!("axis {a} is not a contiguous float64 array"))
+            allanite_error_of(
+                py,
+                "InputError",
+                format!("axis {a} is not a contiguous float64 array"),
+            )
         })?;
         slices.push(s);
     }
@@ -107,8 +159,9 @@ fn theo1_static<'py>(
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let slices = contiguous(py, &columns)?;
-    let result = py.detach(|| run_in_pool(workers, || static_theo1(&slices, &ms)));
-    let values = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let values = run_interruptible(py, workers, |cancel| {
+        static_theo1_cancellable(&slices, &ms, cancel)
+    })?;
     let arr = Array2::from_shape_vec((slices.len(), ms.len()), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
@@ -126,8 +179,9 @@ fn theo1_dynamic<'py>(
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let slices = contiguous(py, &columns)?;
-    let result = py.detach(|| run_in_pool(workers, || dynamic_theo1(&slices, window, hop, &ms)));
-    let (values, n_win) = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let (values, n_win) = run_interruptible(py, workers, |cancel| {
+        dynamic_theo1_cancellable(&slices, window, hop, &ms, cancel)
+    })?;
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
@@ -184,9 +238,9 @@ fn deviation_static<'py>(
         &["mvar", "hvar", "ohvar", "totvar", "mtotvar", "htotvar"],
     )?;
     let slices = contiguous(py, &columns)?;
-    let result =
-        py.detach(|| run_in_pool(workers, || deviations::static_deviation(&slices, &ms, kind)));
-    let values = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let values = run_interruptible(py, workers, |cancel| {
+        deviations::static_deviation_cancellable(&slices, &ms, kind, cancel)
+    })?;
     to_2d(py, slices.len(), ms.len(), values)
 }
 
@@ -201,9 +255,9 @@ fn ttotvar_static<'py>(
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let slices = contiguous(py, &columns)?;
-    let result =
-        py.detach(|| run_in_pool(workers, || deviations::static_ttotvar(&slices, &ms, tau0)));
-    let values = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let values = run_interruptible(py, workers, |cancel| {
+        deviations::static_ttotvar_cancellable(&slices, &ms, tau0, cancel)
+    })?;
     to_2d(py, slices.len(), ms.len(), values)
 }
 
@@ -221,9 +275,10 @@ fn deviation_gaps<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
     let kind = parse_kind(py, estimator, &["oavar", "mvar", "ohvar"])?;
     let slices = contiguous(py, &columns)?;
-    let result =
-        py.detach(|| run_in_pool(workers, || deviations::gap_deviation(&slices, &ms, kind)));
-    let (values, counts) = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    // O(N) per τ: the signal is looked at while it runs and acted on when it returns
+    let (values, counts) = run_interruptible(py, workers, |_cancel| {
+        deviations::gap_deviation(&slices, &ms, kind)
+    })?;
     let counts: Vec<i64> = counts.into_iter().map(|c| c as i64).collect();
     let c = Array2::from_shape_vec((slices.len(), ms.len()), counts)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
@@ -245,12 +300,9 @@ fn ohvar_dynamic<'py>(
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let slices = contiguous(py, &columns)?;
-    let result = py.detach(|| {
-        run_in_pool(workers, || {
-            deviations::dynamic_ohvar(&slices, window, hop, &ms)
-        })
-    });
-    let (values, n_win) = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let (values, n_win) = run_interruptible(py, workers, |_cancel| {
+        deviations::dynamic_ohvar(&slices, window, hop, &ms)
+    })?;
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
@@ -266,8 +318,7 @@ fn mtie_phase<'py>(
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let slices = contiguous(py, &columns)?;
-    let result = py.detach(|| run_in_pool(workers, || deviations::mtie(&slices, &ms)));
-    let values = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let values = run_interruptible(py, workers, |_cancel| deviations::mtie(&slices, &ms))?;
     to_2d(py, slices.len(), ms.len(), values)
 }
 
@@ -281,8 +332,7 @@ fn tierms_phase<'py>(
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let slices = contiguous(py, &columns)?;
-    let result = py.detach(|| run_in_pool(workers, || deviations::tie_rms(&slices, &ms)));
-    let values = result.and_then(|r| r).map_err(|e| core_error(py, e))?;
+    let values = run_interruptible(py, workers, |_cancel| deviations::tie_rms(&slices, &ms))?;
     to_2d(py, slices.len(), ms.len(), values)
 }
 

@@ -1,0 +1,129 @@
+"""Ctrl-C stops a long Rust call: KeyboardInterrupt arrives within a second, from every kernel.
+
+Each call below would run for tens of seconds (38-57 s on one worker, about half on two: scaled
+from timed shorter runs of the same calls); a SIGINT sent 0.3 s in must end it promptly. The bound
+on the time after the signal (2 s) is generous: it tells "cancelled" from "ran to the end", it is
+not a benchmark.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+from allanite import _core
+
+pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGINT") or os.name == "nt", reason="needs POSIX SIGINT")
+
+WORKERS = 2  # more than one worker: every worker must see the flag
+
+
+def _davar_long():
+    y = np.random.default_rng(1).normal(size=2_000_000)
+    # 100 windows of ~2e6 samples with hop 1 at 6000 τ: ~38 s on one worker.
+    return lambda: _core.davar([y], y.size - 99, 1, list(range(1, 6001)), "oavar", "fast", WORKERS)
+
+
+def _theo1_static_long():
+    y = np.random.default_rng(2).normal(size=800_000)
+    # m up to N: the O(N²) pass over the whole record, ~57 s on one worker.
+    return lambda: _core.theo1_static([y], [2, 100, 799_998], WORKERS)
+
+
+def _theo1_dynamic_long():
+    y = np.random.default_rng(3).normal(size=1_000_000)
+    # 901 windows of 1e5 samples at every even m up to 600: ~50 s on one worker.
+    return lambda: _core.theo1_dynamic([y], 100_000, 1_000, list(range(2, 601, 2)), WORKERS)
+
+
+def _mtotvar_long():
+    y = np.random.default_rng(4).normal(size=300_000)
+    # MTOTVAR's O((N − 3m)·m) subsequences at m = 30 000 and 60 000: tens of seconds.
+    return lambda: _core.deviation_static([y], [30_000, 60_000, 90_000], "mtotvar", WORKERS)
+
+
+LONG_CALLS = {
+    "davar": _davar_long,
+    "mtotvar": _mtotvar_long,
+    "theo1_static": _theo1_static_long,
+    "theo1_dynamic": _theo1_dynamic_long,
+}
+
+
+def _interrupt_after(call, delay: float) -> tuple[float, float]:
+    """Runs `call` in the main thread, SIGINT after `delay` s; (seconds to the signal, seconds after it)."""
+    sent = {}
+
+    def fire():
+        sent["t"] = time.monotonic()
+        os.kill(os.getpid(), signal.SIGINT)
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    timer = threading.Timer(delay, fire)
+    try:
+        start = time.monotonic()
+        timer.start()
+        with pytest.raises(KeyboardInterrupt):
+            call()
+        end = time.monotonic()
+    finally:
+        timer.cancel()
+        signal.signal(signal.SIGINT, previous)
+    assert "t" in sent, "the call ended before the signal was sent"
+    return sent["t"] - start, end - sent["t"]
+
+
+@pytest.mark.parametrize("kernel", sorted(LONG_CALLS))
+def test_ctrl_c_interrupts_the_kernel(kernel):
+    call = LONG_CALLS[kernel]()
+    before, after = _interrupt_after(call, 0.3)
+    assert before == pytest.approx(0.3, abs=0.25)
+    assert after < 2.0, f"{kernel}: KeyboardInterrupt {after:.2f} s after SIGINT"
+
+
+def test_the_module_still_works_after_an_interrupt():
+    _interrupt_after(_theo1_static_long(), 0.3)
+    y = np.random.default_rng(4).normal(size=5_000)
+    a = _core.davar([y], y.size, 1, [1, 10, 100], "oavar", "fast", 1)
+    b = _core.davar([y], y.size, 1, [1, 10, 100], "oavar", "fast", WORKERS)
+    assert np.array_equal(a, b)
+    # σ² of unit white noise at m = 1 is 1 (within sampling error of 5000 samples).
+    assert a[0, 0, 0] == pytest.approx(1.0, rel=0.1)
+
+
+def _mid_sized_calls():
+    y = np.random.default_rng(5).normal(size=200_000)
+    return {
+        "davar": lambda w: _core.davar([y], 20_000, 7, [1, 3, 50, 700], "oavar", "fast", w),
+        "theo1_static": lambda w: _core.theo1_static([y[:30_000]], [2, 10, 1_000, 29_998], w),
+        "theo1_dynamic": lambda w: _core.theo1_dynamic([y], 2_000, 97, [2, 10, 100, 2_000], w),
+    }
+
+
+@pytest.mark.parametrize("kernel", ["davar", "theo1_static", "theo1_dynamic"])
+def test_calls_from_another_thread_complete(kernel):
+    # check_signals is a no-op off the main thread: the polling must not get in the way there.
+    call = _mid_sized_calls()[kernel]
+    main = call(WORKERS)
+    box = {}
+
+    def work():
+        try:
+            box["out"] = call(WORKERS)
+        except BaseException as exc:  # noqa: BLE001 - report anything to the main thread
+            box["exc"] = exc
+
+    th = threading.Thread(target=work)
+    th.start()
+    th.join(timeout=120)
+    assert not th.is_alive()
+    assert "exc" not in box, repr(box.get("exc"))
+    # Bit-identical to the main thread's call, and to one worker.
+    assert np.array_equal(box["out"], main)
+    assert np.array_equal(call(1), main)
+    assert np.all(np.isfinite(main)) and np.all(main > 0)
