@@ -180,6 +180,19 @@ def build_parser() -> argparse.ArgumentParser:
         "add a model-refinement section; a few seconds per axis and million samples",
     )
     ana.add_argument("--no-fit", action="store_true", help="skip the noise-model fit (whole record and per window)")
+    ana.add_argument(
+        "--frames",
+        type=float,
+        metavar="SEC",
+        help="time-frame DAVAR (paper 004): fit the noise model in consecutive frames of SEC seconds and add a "
+        "coefficient-forecast section (GM(1,1), improved GM(1,1) and baselines)",
+    )
+    ana.add_argument(
+        "--forecast",
+        metavar="BUILD:CHECK",
+        help="frames that build / check the forecast (e.g. 60:30; default 2/3 : 1/3 of the frames); without "
+        "--frames the record is cut into BUILD+CHECK frames",
+    )
 
     out = rep.add_argument_group("output")
     out.add_argument(
@@ -320,6 +333,8 @@ def _report(args) -> int:
                 progress=progress,
                 estimator=args.estimator,
                 refine=args.refine,
+                frames=args.frames,
+                forecast=args.forecast,
             )
             if args.log is None:
                 progress.step("generating the bundled record")
