@@ -37,10 +37,10 @@ import datetime as _dt
 import math
 import sys
 import time
+from importlib import metadata
 from pathlib import Path
 
 import numpy as np
-import pywt
 import scipy
 
 import _common
@@ -231,7 +231,7 @@ def main(argv: list[str] | None = None) -> int:
         "",
         f"Rerun: `ALLANITE_SHARED_DATA=/path/to/shared/data python benches/paper004.py` ({elapsed:.0f} s here). "
         f"Recorded {_dt.date.today().isoformat()} with allanite {allanite.__version__}, numpy {np.__version__}, "
-        f"scipy {scipy.__version__}, PyWavelets {pywt.__version__}.",
+        f"scipy {scipy.__version__}, PyWavelets {metadata.version('PyWavelets')}.",
         "",
         f"Each run: {FRAMES} frames of {runs[next(iter(runs))][0][0].frame_s:g} s "
         f"({runs[next(iter(runs))][0][0].frame_samples} samples, 10 samples left over), the five-term model fitted "

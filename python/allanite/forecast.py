@@ -16,7 +16,8 @@ frames build the model, the last 30 check it. This module gives
 
 Every model takes the series first and its options keyword-only, and exposes ``series``, ``fitted``
 (the in-sample values x̂⁰), ``predict(h)``, ``accuracy`` and its fields ``C``, ``P``, ``c_grade``,
-``grade``. Indices in this module are 0-based: ``series[0]`` is the paper's x⁰(1).
+``grade``. Indices in this module are 0-based: ``series[0]`` is the paper's x⁰(1). The formulas and
+conventions: ``docs/FORMULAS.md §11``.
 
 Conventions (the literature is not uniform; each is a parameter):
 
@@ -32,6 +33,7 @@ Conventions (the literature is not uniform; each is a parameter):
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -231,9 +233,10 @@ class _Forecaster:
     def predict(self, h: int) -> np.ndarray:  # pragma: no cover - overridden
         raise NotImplementedError
 
-    @property
+    @functools.cached_property
     def accuracy(self) -> Accuracy:
-        """In-sample :class:`Accuracy` of ``fitted`` against ``series``."""
+        """In-sample :class:`Accuracy` of ``fitted`` against ``series`` (computed once: a fitted model does not
+        change)."""
         return accuracy(self.series, self.fitted, sd=self.sd, include_first=self.include_first)
 
     @property
@@ -772,6 +775,13 @@ class _ResidualCorrected:
             return
         self.applied = True
 
+    @classmethod
+    def switched_off(cls, base: GM11) -> _ResidualCorrected:
+        """The base model unchanged (``residual=False``)."""
+        rc = cls.__new__(cls)
+        rc.base, rc.applied, rc.reason, rc.on, rc.i = base, False, "switched off", "ago", None
+        return rc
+
     def _correction_series(self, k: np.ndarray) -> np.ndarray:
         """sign·q̂ at 0-based indices k (0 before the start index i)."""
         out = np.zeros(k.size)
@@ -955,8 +965,7 @@ class ImprovedGM11(_Forecaster):
             o: dict[str, Any] = self._opts
             rc = _ResidualCorrected(m, o["residual_from"], o["residual_on"], o["residual_min_len"], o["residual_max_a"])
         else:
-            rc = _ResidualCorrected.__new__(_ResidualCorrected)
-            rc.base, rc.applied, rc.reason, rc.on = m, False, "switched off", "ago"
+            rc = _ResidualCorrected.switched_off(m)
         return m, rc
 
     @property

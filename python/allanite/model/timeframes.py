@@ -5,7 +5,7 @@ model fitted in each, and the per-frame coefficient series forecast.
 one Allan variance per non-overlapping frame, one fit with intervals per frame. The coefficient series
 of the frames are what paper 004 forecasts with GM(1,1) (:mod:`allanite.forecast`);
 :meth:`TimeFrames.forecast` runs that comparison — every method, honest and paper-rule C/P — on the terms
-the frame fits resolve.
+the frame fits resolve. Definitions: ``docs/FORMULAS.md §11``.
 """
 
 from __future__ import annotations
