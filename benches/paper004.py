@@ -22,12 +22,12 @@ frames); "steady": τ = 4 records (an almost straight rise, still rising in the 
 coefficient-level synthetic study — 50 seeds, each improvement step alone — is ``benches/paper004_forecast.py``,
 recorded in ``benches/results/paper004_synthetic.md``.)
 
-Rerun (≈ 1 min)::
+Rerun (≈ 20 s)::
 
     ALLANITE_SHARED_DATA=/path/to/shared/data python benches/paper004.py
 
 writes ``benches/results/paper004.md`` and the figures ``benches/results/paper004_*.png`` (``--out DIR`` for
-another folder).
+another folder; ``--quick --out DIR``: the smoke run of ``tests/test_paper004_bench_smoke.py``).
 """
 
 from __future__ import annotations
@@ -127,6 +127,10 @@ def paper_layout(results, method: str, fn=_c) -> list[str]:
     return lines
 
 
+def seeds_of(sims, scen) -> list[int]:
+    return sorted(sd for sc, sd in sims if sc == scen)
+
+
 def _median_of(cells, key) -> float:
     return float(np.median([c[key] for c in cells])) if cells else math.nan
 
@@ -150,7 +154,7 @@ def findings(runs, rows, sims, cal) -> list[str]:
     def sim_med(scen, t, m, key):
         cs = [
             sims[(scen, sd)][1]["cells"][m][t]
-            for sd in range(SIM_SEEDS)
+            for sd in seeds_of(sims, scen)
             if t in sims[(scen, sd)][1]["terms"] and "error" not in sims[(scen, sd)][1]["cells"][m][t]
         ]
         return _median_of(cs, key)
@@ -205,7 +209,14 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", default=str(_common.HERE / "results"), help="folder for paper004.md and the figures")
     ap.add_argument("--runs", default="1,2,3,4,5,6", help="ADIS16405 runs (comma-separated)")
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="smoke run (a few seconds, for the tests): run 1 only, one seed of 270 000 samples per scenario",
+    )
     args = ap.parse_args(argv)
+    runs_arg = "1" if args.quick else args.runs
+    n_seeds, n_sim = (1, 270_000) if args.quick else (SIM_SEEDS, 1_000_000)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     data = _common.shared_data_dir() / "adis16405"
@@ -215,13 +226,13 @@ def main(argv: list[str] | None = None) -> int:
     methods = list(default_methods())
     t0 = time.perf_counter()
     runs = {}
-    for k in (int(r) for r in args.runs.split(",")):
+    for k in (int(r) for r in runs_arg.split(",")):
         runs[f"run {k}"] = analyse(load_run(k))
         print(f"run {k} done ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
     sims = {
-        (scen, seed): analyse(drifting_record(scen, seed)[:, None])[0]
+        (scen, seed): analyse(drifting_record(scen, seed, n_sim)[:, None])[0]
         for scen in SCENARIOS
-        for seed in range(SIM_SEEDS)
+        for seed in range(n_seeds)
     }
     print(f"simulations done ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
     elapsed = time.perf_counter() - t0
@@ -328,7 +339,7 @@ def main(argv: list[str] | None = None) -> int:
     ]
     md += [
         "",
-        f"## Simulated drifting records ({SIM_SEEDS} seeds per scenario)",
+        f"## Simulated drifting records ({n_seeds} seeds per scenario, {n_sim} samples each)",
         "",
         "Per scenario and term: honest C median [min, max] over the seeds · paper-rule C median · median "
         "forecast RMSE over the frame fits' SE (rmse/SE; ≈ 1 is the floor set by the frames' estimation noise). "
@@ -339,7 +350,7 @@ def main(argv: list[str] | None = None) -> int:
     ]
     for scen in SCENARIOS:
         for t in TERMS:
-            tabs = [sims[(scen, sd)][1] for sd in range(SIM_SEEDS) if t in sims[(scen, sd)][1]["terms"]]
+            tabs = [sims[(scen, sd)][1] for sd in seeds_of(sims, scen) if t in sims[(scen, sd)][1]["terms"]]
             if not tabs:
                 continue
             cells = []
