@@ -7,6 +7,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 
 import matplotlib
 
@@ -238,7 +239,8 @@ def test_report_text_page_and_figures(report):
     assert {"frames_axis0.png", "forecast_axis0.png", "frames_axis1.png"} <= set(specs)
     html = report.html({})
     assert '<section id="forecast"><h2>Coefficient forecast</h2>' in html and 'href="#forecast"' in html
-    assert "Not forecastable: axis 1 K" in html
+    assert re.search(r"so no model is given them: axis 0: .*; axis 1: [^<]*K \(at 0 in \d+ of 90 frames\)", html)
+    assert report.summary()["forecast"]["axes"][1]["frames_at_zero"]["K"] > 0
 
 
 def test_report_without_frames_has_no_forecast_section(record):

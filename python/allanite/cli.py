@@ -59,6 +59,7 @@ examples:
   allanite report gyro.csv --time-column t --unit rad/s --gaps longest --out results/
   allanite report gyro.npy --fs 200 --window 60000 --hop 2000 --taus exp --quiet
   allanite report flight.bag                      # ROS 1 bag: sensor_msgs/Imu, rad/s
+  allanite report imu.npy --fs 500 --frames 20 --forecast 60:30   # paper 004: GM(1,1) forecasts
 
 files written to DIR:
   report.html              the report, one self-contained page
@@ -68,6 +69,8 @@ files written to DIR:
   davar_axisK.png          axis K: DAVAR heat map (time x tau, log colour)
   davar3d_axisK.png        axis K: DAVAR surface (t, log10 tau, log10 ADEV)
   coefficients_axisK.png   axis K: noise coefficients per DAVAR window with intervals
+  frames_axisK.png         axis K (--frames/--forecast): coefficients per frame with intervals
+  forecast_axisK.png       axis K (--frames/--forecast): forecasts of the resolved coefficients
 
 A progress bar goes to stderr when it is a terminal; --quiet prints nothing but errors.
 

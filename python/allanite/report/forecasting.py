@@ -149,6 +149,7 @@ def forecast_dict(rep) -> dict | None:
                 "ci_low": {t: json_list(lo[t]) for t in f.terms},
                 "ci_high": {t: json_list(hi[t]) for t in f.terms},
                 "forecastable": dict(f.forecastable),
+                "frames_at_zero": {t: int(np.count_nonzero(f.series.values[t] <= 0)) for t in f.terms},
                 "not_forecastable": {t: tab["skipped"].get(t, f.not_forecastable.get(t)) for t in tab["skipped"]},
                 "terms": list(tab["terms"]),
                 "scatter": {t: json_number(v) for t, v in tab["scatter"].items()},
@@ -182,10 +183,15 @@ def forecast_dict(rep) -> dict | None:
     }
 
 
+def _f2(v) -> str:
+    """Two decimals; None (a non-finite C in the JSON) as ∞."""
+    return "∞" if v is None else f"{v:.2f}"
+
+
 def _cell_text(c: dict) -> str:
     if "error" in c:
         return "error"
-    return f"{g(c['C'], 2)} ({c['c_grade']}) P {g(c['P'], 2)}"
+    return f"{_f2(c['C'])} ({c['c_grade']}) P {_f2(c['P'])}"
 
 
 def forecast_text(d: dict | None) -> list[str]:
@@ -206,13 +212,11 @@ def forecast_text(d: dict | None) -> list[str]:
             parts = []
             for m in d["methods"]:
                 c = ax["cells"][m][t]
-                paper = "" if "error" in c else f" [{g(c['C_paper'], 2)}]"
+                paper = "" if "error" in c else f" [{_f2(c['C_paper'])}]"
                 parts.append(f"{m} {_cell_text(c)}{paper}")
             lines.append(f"  {ax['name']} {t}: " + "; ".join(parts))
         if ax["not_forecastable"]:
-            zeros = ", ".join(
-                f"{t} {sum(1 for v in ax['values'][t] if not v or v <= 0)}" for t in ax["not_forecastable"]
-            )
+            zeros = ", ".join(f"{t} {ax['frames_at_zero'][t]}" for t in ax["not_forecastable"])
             lines.append(
                 f"  {ax['name']}: not forecastable (not resolved in every frame; frames at 0 of {d['frames']}: {zeros})"
             )
@@ -238,8 +242,8 @@ def forecast_page(d: dict | None) -> dict | None:
                     row.append(
                         "error"
                         if "error" in c
-                        else f"{g(c['C'], 2)} ({c['c_grade']}) / {g(c['P'], 2)} · paper {g(c['C_paper'], 2)} "
-                        f"({c['c_grade_paper']}) · rmse/SE {g(c['rmse_over_se'], 2)}"
+                        else f"{_f2(c['C'])} ({c['c_grade']}) / {_f2(c['P'])} · paper {_f2(c['C_paper'])} "
+                        f"({c['c_grade_paper']}) · rmse/SE {_f2(c['rmse_over_se'])}"
                     )
                 rows.append(row)
             tables.append(
@@ -248,8 +252,13 @@ def forecast_page(d: dict | None) -> dict | None:
                     "table": {"header": ["method"] + terms, "rows": rows, "left": 1},
                 }
             )
-        for t, why in ax["not_forecastable"].items():
-            skipped.append(f"{ax['name']} {t}: {why}")
+        if ax["not_forecastable"]:
+            skipped.append(
+                f"{ax['name']}: "
+                + ", ".join(
+                    f"{t} (at 0 in {ax['frames_at_zero'][t]} of {d['frames']} frames)" for t in ax["not_forecastable"]
+                )
+            )
     return {
         "status": "computed",
         "intro": (
