@@ -78,6 +78,9 @@ def test_one_axis_gives_one_object_and_units_follow_the_fit(record):
 
 def test_a_term_the_frames_do_not_resolve_is_not_forecastable(frames2):
     f = frames2[1]  # white noise only: K is at 0 in most frames
+    # its interval bounds still convert to IEEE units by the term's own factor (°/√s^3 → °/h^1.5: 60·3600)
+    lo, hi = f.intervals()
+    np.testing.assert_allclose(hi["K"], f.series.ci_high["K"] * 60.0 * 3600.0)
     assert f.forecastable["N"] is True
     assert f.forecastable["K"] is False and "frames (not resolved there)" in f.not_forecastable["K"]
     tab = f.forecast(60, 30)

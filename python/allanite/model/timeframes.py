@@ -20,6 +20,7 @@ from ..analysis import davar
 from ..errors import ParameterError
 from ..forecast import compare
 from ..results import DynamicAllanResult
+from ..units import ieee952
 from .fitting import CoefficientSeries, fit, z_quantile
 from .terms import TERMS
 
@@ -91,7 +92,7 @@ class TimeFrames:
             # the IEEE value is a fixed multiple of the base value: scale the bounds by the same factor
             lo, hi = {}, {}
             for t in s.terms:
-                f = _factor(s.values[t], s.ieee[t])
+                f = float(ieee952(t, 1.0, s.unit).value)
                 lo[t], hi[t] = s.ci_low[t] * f, s.ci_high[t] * f
             return lo, hi
         return dict(s.ci_low), dict(s.ci_high)
@@ -212,14 +213,6 @@ class TimeFrames:
             ax.legend(fontsize="x-small", loc="best", ncol=2)
         axes[-1].set_xlabel(f"frame ({self.frame_s:g} s each); build 1–{b}, check {b + 1}–{b + c}")
         return list(axes)
-
-
-def _factor(base: np.ndarray, ieee: np.ndarray) -> float:
-    """The constant ieee/base of a term (its values are proportional)."""
-    nz = np.flatnonzero(base != 0)
-    if nz.size == 0:
-        return 1.0
-    return float(ieee[nz[0]] / base[nz[0]])
 
 
 def frames(
