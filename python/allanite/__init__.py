@@ -2,7 +2,8 @@
 
 Main entry points: :func:`avar` (static overlapping/classic Allan variance, Theo family), :func:`davar`
 (dynamic Allan variance on a sliding window), :func:`tau_grid` (τ grids), :func:`fit` (the IEEE-952
-noise model with intervals), :func:`refine` (what a fitted model lacks). Errors are
+noise model with intervals), :func:`refine` (what a fitted model lacks), :func:`frames` (time-frame
+DAVAR, paper 004; its coefficient series are forecast by :mod:`allanite.forecast`). Errors are
 :class:`AllaniteError` subclasses of ``ValueError``.
 """
 
@@ -13,7 +14,7 @@ from .errors import AllaniteError, InputError, MemoryBudgetError, ParameterError
 from .estimators.confidence import chi2_interval, confidence_intervals, edf_greenhall, edf_sp1065, identify_alpha
 from .estimators.grid import tau_grid
 from .io import Log, read_log
-from .model import CoefficientSeries, NoiseFit, Refinement, fit, information_bound, refine
+from .model import CoefficientSeries, NoiseFit, Refinement, TimeFrames, fit, frames, information_bound, refine
 from .results import AllanResult, DynamicAllanResult
 from .simulation import simulate
 
@@ -29,6 +30,8 @@ __all__ = [
     "information_bound",
     "NoiseFit",
     "CoefficientSeries",
+    "frames",
+    "TimeFrames",
     "refine",
     "Refinement",
     "confidence_intervals",

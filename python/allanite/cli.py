@@ -59,6 +59,7 @@ examples:
   allanite report gyro.csv --time-column t --unit rad/s --gaps longest --out results/
   allanite report gyro.npy --fs 200 --window 60000 --hop 2000 --taus exp --quiet
   allanite report flight.bag                      # ROS 1 bag: sensor_msgs/Imu, rad/s
+  allanite report imu.npy --fs 500 --frames 20 --forecast 60:30   # paper 004: GM(1,1) forecasts
 
 files written to DIR:
   report.html              the report, one self-contained page
@@ -68,6 +69,8 @@ files written to DIR:
   davar_axisK.png          axis K: DAVAR heat map (time x tau, log colour)
   davar3d_axisK.png        axis K: DAVAR surface (t, log10 tau, log10 ADEV)
   coefficients_axisK.png   axis K: noise coefficients per DAVAR window with intervals
+  frames_axisK.png         axis K (--frames/--forecast): coefficients per frame with intervals
+  forecast_axisK.png       axis K (--frames/--forecast): forecasts of the resolved coefficients
 
 A progress bar goes to stderr when it is a terminal; --quiet prints nothing but errors.
 
@@ -180,6 +183,19 @@ def build_parser() -> argparse.ArgumentParser:
         "add a model-refinement section; a few seconds per axis and million samples",
     )
     ana.add_argument("--no-fit", action="store_true", help="skip the noise-model fit (whole record and per window)")
+    ana.add_argument(
+        "--frames",
+        type=float,
+        metavar="SEC",
+        help="time-frame DAVAR (paper 004): fit the noise model in consecutive frames of SEC seconds and add a "
+        "coefficient-forecast section (GM(1,1), improved GM(1,1) and baselines)",
+    )
+    ana.add_argument(
+        "--forecast",
+        metavar="BUILD:CHECK",
+        help="frames that build / check the forecast (e.g. 60:30; default 2/3 : 1/3 of the frames); without "
+        "--frames the record is cut into BUILD+CHECK frames",
+    )
 
     out = rep.add_argument_group("output")
     out.add_argument(
@@ -319,6 +335,8 @@ def _report(args) -> int:
                 progress=progress,
                 estimator=args.estimator,
                 refine=args.refine,
+                frames=args.frames,
+                forecast=args.forecast,
             )
             if args.log is None:
                 progress.step("generating the bundled record")

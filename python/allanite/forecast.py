@@ -16,7 +16,8 @@ frames build the model, the last 30 check it. This module gives
 
 Every model takes the series first and its options keyword-only, and exposes ``series``, ``fitted``
 (the in-sample values x̂⁰), ``predict(h)``, ``accuracy`` and its fields ``C``, ``P``, ``c_grade``,
-``grade``. Indices in this module are 0-based: ``series[0]`` is the paper's x⁰(1).
+``grade``. Indices in this module are 0-based: ``series[0]`` is the paper's x⁰(1). The formulas and
+conventions: ``docs/FORMULAS.md §11``.
 
 Conventions (the literature is not uniform; each is a parameter):
 
@@ -32,7 +33,9 @@ Conventions (the literature is not uniform; each is a parameter):
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -40,7 +43,7 @@ import numpy as np
 import pywt
 from scipy import optimize
 
-from .errors import InputError, ParameterError
+from .errors import AllaniteError, InputError, ParameterError
 
 __all__ = [
     "GM11",
@@ -55,6 +58,8 @@ __all__ = [
     "Score",
     "accuracy",
     "c_grade",
+    "compare",
+    "default_methods",
     "joint_grade",
     "level_ratio_test",
     "score",
@@ -228,9 +233,10 @@ class _Forecaster:
     def predict(self, h: int) -> np.ndarray:  # pragma: no cover - overridden
         raise NotImplementedError
 
-    @property
+    @functools.cached_property
     def accuracy(self) -> Accuracy:
-        """In-sample :class:`Accuracy` of ``fitted`` against ``series``."""
+        """In-sample :class:`Accuracy` of ``fitted`` against ``series`` (computed once: a fitted model does not
+        change)."""
         return accuracy(self.series, self.fitted, sd=self.sd, include_first=self.include_first)
 
     @property
@@ -769,6 +775,13 @@ class _ResidualCorrected:
             return
         self.applied = True
 
+    @classmethod
+    def switched_off(cls, base: GM11) -> _ResidualCorrected:
+        """The base model unchanged (``residual=False``)."""
+        rc = cls.__new__(cls)
+        rc.base, rc.applied, rc.reason, rc.on, rc.i = base, False, "switched off", "ago", None
+        return rc
+
     def _correction_series(self, k: np.ndarray) -> np.ndarray:
         """sign·q̂ at 0-based indices k (0 before the start index i)."""
         out = np.zeros(k.size)
@@ -952,8 +965,7 @@ class ImprovedGM11(_Forecaster):
             o: dict[str, Any] = self._opts
             rc = _ResidualCorrected(m, o["residual_from"], o["residual_on"], o["residual_min_len"], o["residual_max_a"])
         else:
-            rc = _ResidualCorrected.__new__(_ResidualCorrected)
-            rc.base, rc.applied, rc.reason, rc.on = m, False, "switched off", "ago"
+            rc = _ResidualCorrected.switched_off(m)
         return m, rc
 
     @property
@@ -1098,3 +1110,145 @@ def score(
         float(np.mean(e)),
         model,
     )
+
+
+# --------------------------------------------------------------------------------------------------
+# every method on every coefficient series
+
+
+def default_methods() -> dict[str, Callable[..., Any]]:
+    """Name → model factory of the methods :func:`compare` judges, in table order: the traditional and the
+    improved GM(1,1) (all steps on) and the four baselines."""
+    return {
+        "GM(1,1)": GM11,
+        "improved GM(1,1)": ImprovedGM11,
+        "persistence": Persistence,
+        "build mean": BuildMean,
+        "linear trend": LinearTrend,
+        "Holt": Holt,
+    }
+
+
+def compare(
+    series: Mapping[str, Any],
+    build: int,
+    check: int,
+    *,
+    methods: Mapping[str, Callable[..., Any]] | None = None,
+    sd: str = "population",
+    noise: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
+    """Judge every method on every series (e.g. one noise coefficient per time frame, paper 004 §4).
+
+    Parameters
+    ----------
+    series : mapping
+        Name (a noise term) → values, at least ``build + check`` of them (the first ``build + check`` are
+        used). A series with a value ≤ 0 (a term the frame fits did not resolve) is not forecastable:
+        it is listed in ``skipped`` with the reason and fed to no model.
+    build, check : int
+        The split: build on the first ``build`` values, forecast and check the next ``check`` (paper 004:
+        60 / 30).
+    methods : mapping, optional
+        Name → factory called as ``factory(build_values)``; default :func:`default_methods`.
+    sd : {"population", "sample"}
+        SD convention of C and P.
+    noise : mapping, optional
+        Name → per-value standard error of the series itself (e.g. the frame fits' intervals). Adds
+        ``se_check``, the RMS standard error over the check values, and ``rmse_over_se`` to every cell: a
+        forecast cannot be expected to beat the estimation noise of the values it is checked against
+        (≈ 1 means the forecast error is that noise).
+
+    Returns
+    -------
+    dict
+        ``{"build", "check", "sd", "terms", "methods", "cells": {method: {term: cell}}, "skipped": {term:
+        reason}, "scatter": {term: robust SD of successive differences / √2}, "se_check": {term: …}}``. A
+        cell holds the forecast (``forecast``), the in-sample ``fitted`` values, ``C``, ``P``, ``c_grade``,
+        ``grade`` (honest: against the raw check values), ``C_paper``, ``P_paper``, ``c_grade_paper``,
+        ``grade_paper`` (paper 004's rule, see :class:`Score`), ``rmse``, ``bias``, ``notes`` — or
+        ``error`` when the method failed on that series.
+
+    Raises
+    ------
+    ParameterError
+        The split does not fit a series (``build`` < 4, ``check`` < 2, ``build + check`` > its length).
+    InputError
+        A series is not 1-D finite numbers, or is shorter than 4 values.
+
+    Examples
+    --------
+    >>> x = 1.03 ** np.arange(12) + 0.02 * np.sin(2.0 * np.arange(12))  # exponential growth + a wiggle
+    >>> t = compare({"N": x}, 8, 4)
+    >>> for m in ("GM(1,1)", "persistence", "linear trend"):
+    ...     c = t["cells"][m]["N"]
+    ...     print(f"{m}: C = {c['C']:.2f} ({c['grade']}), rmse = {c['rmse']:.3f}")
+    GM(1,1): C = 0.23 (good), rmse = 0.013
+    persistence: C = 1.00 (fail), rmse = 0.090
+    linear trend: C = 0.32 (good), rmse = 0.020
+    """
+    _check_sd(sd)
+    methods = default_methods() if methods is None else dict(methods)
+    if not methods:
+        raise ParameterError("methods is empty; give at least one name → model factory")
+    cells: dict[str, dict[str, Any]] = {m: {} for m in methods}
+    out: dict[str, Any] = {
+        "build": build,
+        "check": check,
+        "sd": sd,
+        "terms": [],
+        "methods": list(methods),
+        "cells": cells,
+        "skipped": {},
+        "scatter": {},
+        "se_check": {},
+    }
+    for term, values in series.items():
+        x = _as_series(values, name=f"series[{term!r}]")
+        b, c = split(x, build, check)
+        used = x[: build + check]
+        d = np.diff(used)
+        # robust frame-to-frame scatter: successive differences of independent noise have SD √2·σ
+        out["scatter"][term] = float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
+        se = None
+        if noise is not None and term in noise:
+            se_all = np.asarray(noise[term], dtype=np.float64)
+            if se_all.shape[0] < build + check:
+                raise InputError(f"noise[{term!r}] has {se_all.shape[0]} values; {build + check} needed")
+            se = float(np.sqrt(np.mean(se_all[build : build + check] ** 2)))
+            out["se_check"][term] = se
+        nonpos = np.flatnonzero(used <= 0)
+        if nonpos.size:
+            out["skipped"][term] = (
+                f"{nonpos.size} of {used.size} values at or below 0 (first at index {int(nonpos[0])}): the term is "
+                "not resolved there, so it is not forecastable (GM(1,1) needs positive values)"
+            )
+            continue
+        out["terms"].append(term)
+        for name, factory in methods.items():
+            try:
+                s = score(factory, b, c, sd=sd, name=name)
+            except AllaniteError as exc:
+                cells[name][term] = {"error": str(exc)}
+                continue
+            cell: dict[str, Any] = {
+                "forecast": s.forecast,
+                "fitted": np.asarray(s.model.fitted, dtype=np.float64),
+                "C": s.honest.C,
+                "P": s.honest.P,
+                "c_grade": s.honest.c_grade,
+                "grade": s.honest.grade,
+                "C_paper": s.paper_rule.C,
+                "P_paper": s.paper_rule.P,
+                "c_grade_paper": s.paper_rule.c_grade,
+                "grade_paper": s.paper_rule.grade,
+                "rmse": s.rmse,
+                "bias": s.bias,
+                "notes": list(getattr(s.model, "notes", [])),
+            }
+            if isinstance(s.model, ImprovedGM11):
+                cell["processed"] = s.model.processed
+            if se is not None:
+                cell["rmse_over_se"] = s.rmse / se if se > 0 else math.inf
+            cells[name][term] = cell
+    return out

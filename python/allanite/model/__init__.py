@@ -7,6 +7,7 @@ from .effects import EFFECTS
 from .fitting import CoefficientSeries, NoiseFit, fit, information_bound
 from .refinement import Refinement, Step, refine
 from .terms import TERM_NAMES, TERMS
+from .timeframes import TimeFrames, frame_for_count, frames
 
 __all__ = [
     "fit",
@@ -19,4 +20,7 @@ __all__ = [
     "TERMS",
     "TERM_NAMES",
     "EFFECTS",
+    "frames",
+    "frame_for_count",
+    "TimeFrames",
 ]

@@ -48,6 +48,7 @@ from ..results import AllanResult, DynamicAllanResult
 from ..units import adev_unit_label, parse_unit
 from .figures import figure_specs
 from .fmt import json_number
+from .forecasting import check_forecast_options, plan_forecast, run_forecast
 from .page import html_page
 from .settings import (
     DHVAR_MAX_DEFAULT_WINDOW,
@@ -111,6 +112,12 @@ class Report:
     created: str = ""
     #: per axis :class:`~allanite.Refinement` (``refine=True``), else None
     refinements: list[Refinement | None] | None = None
+    #: per axis :class:`~allanite.TimeFrames` and :func:`allanite.forecast.compare` table (``frames=`` or
+    #: ``forecast=`` given), else None; ``forecast_error`` when they could not be computed
+    frames: list | None = None
+    forecasts: list | None = None
+    forecast_settings: dict | None = None
+    forecast_error: str | None = None
     _summary: dict | None = field(default=None, repr=False)
 
     # ---------------------------------------------------------------------------- properties
@@ -213,6 +220,8 @@ def build_report(
     progress=None,
     estimator: str = "oavar",
     refine: bool = False,
+    frames=None,
+    forecast=None,
 ) -> Report:
     """Compute everything the report shows.
 
@@ -254,10 +263,21 @@ def build_report(
         Extra notes to show (warnings from reading, …).
     progress : object with ``step(name)``, optional
         Told before each step (the CLI's progress bar).
+    frames : float, optional
+        Time-frame DAVAR (paper 004): frames of this many seconds, the noise model fitted in each, and a
+        "Coefficient forecast" section. Without ``forecast`` the first 2/3 of the frames build, the rest check.
+    forecast : (int, int) or "BUILD:CHECK", optional
+        The build/check split in frames (paper 004: 60:30). Without ``frames`` the record is cut into
+        BUILD + CHECK frames.
     """
     progress = progress or _NoProgress()
     notes = list(notes)
+    frame_s, split = check_forecast_options(frames, forecast)
     x = np.asarray(x) if not isinstance(x, np.ndarray) else x
+    plan = None
+    if frame_s is not None or split is not None:
+        # before anything is computed: a frame or split that does not fit the record is the caller's option
+        plan = plan_forecast(int(x.shape[0]), float(fs), frame_s, split)
     if x.ndim == 1:
         x = x[:, None]
     unit_name = None if unit is None else parse_unit(unit, kind="rate" if input == "rate" else "angle").name
@@ -384,8 +404,21 @@ def build_report(
             except AllaniteError as exc:
                 refinements.append(None)
                 notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")
+    frame_fits = forecasts = forecast_settings = forecast_error = None
+    if plan is not None:
+        progress.step("time frames and coefficient forecast")
+        forecast_settings = plan
+        try:
+            frame_fits, forecasts = run_forecast(x, fs, plan, unit=unit_name, input=input, confidence=confidence)
+        except AllaniteError as exc:
+            forecast_error = str(exc)
+            notes.append(f"The coefficient forecast could not be computed: {exc}")
     created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
     return Report(
+        frames=frame_fits,
+        forecasts=forecasts,
+        forecast_settings=forecast_settings,
+        forecast_error=forecast_error,
         refinements=refinements,
         static=static,
         dynamic=dynamic,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..plot import plot_adev, plot_coefficient_series, plot_davar, plot_davar3d, plot_fit
+from .forecasting import forecast_specs
 
 __all__ = ["figure_specs"]
 
@@ -145,4 +146,5 @@ def figure_specs(rep) -> list:
                     coef_k,
                 )
             )
+    specs.extend(forecast_specs(rep))
     return specs

@@ -16,6 +16,7 @@ import jinja2
 
 from .._core import __version__
 from .fmt import duration, g
+from .forecasting import forecast_page
 from .settings import REPORT_ESTIMATORS
 
 __all__ = ["html_page"]
@@ -342,6 +343,7 @@ def html_page(rep: Any, images: dict) -> str:
         "dynamic": _dynamic(dy, st["source"] is not None, au),
         "series": _series(fit),
         "refinement": _refinement(s.get("refinement")),
+        "forecast": forecast_page(s.get("forecast")),
         "figures": figures,
     }
     return _template().render(**context).rstrip() + "\n"
