@@ -79,7 +79,11 @@ def main() -> int:
     ]
     lines += [f"| `{name}` | {int(n) + int(f)} | {f} |" for name, _, n, f, _ in props]
     lines += ["", "Findings (failing inputs as hypothesis shrank them):", ""]
-    failures = re.findall(r"Falsifying example: .*?(?=\n\n|\Z)", text, flags=re.S)
+    failures = []
+    for block in re.findall(r"^E\s+(\w+Error: .*?)\n((?:E .*\n)+?)E\s+\)\n", text, flags=re.M):
+        error, body = block
+        case = "\n".join(line[1:].rstrip() for line in body.splitlines() if "Failing test case" in line or "=" in line)
+        failures.append(f"{error}\n{case}")
     lines += [f"```\n{f.strip()}\n```" for f in failures] or ["none"]
     args.out.write_text("\n".join(line for line in lines if line is not None) + "\n", encoding="utf-8")
     print("\n".join(lines))

@@ -249,11 +249,20 @@ def _fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
             f"{MAX_GLS_TAU} are supported (the covariance costs ~n_τ² lag sums) — use thin=True, or a sparser "
             f"grid such as taus='exp'"
         )
+    # The fit is linear in the variance: fitted on estimates scaled by a power of two near their peak (exact),
+    # so that variances of 1e-300 or 1e300 (samples in extreme units) neither underflow nor overflow in the
+    # squares and products of the weights; θ, its covariance and the model are scaled back.
+    peak = float(np.max(avar))
+    scale = math.ldexp(1.0, math.frexp(peak)[1]) if peak > 0 and math.isfinite(peak) else 1.0
+    y = np.asarray(avar, dtype=np.float64) / scale
     if _exact_covariance_applies(tau, m, fs, n_points, estimator):
         # a few independent-weights passes are enough for a start (and its EDF for a bare ramp)
-        out = _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, min(max_iter, 8), edf_cache)
-        return _fit_gls(tau, m, avar, fs, n_points, terms, out, max_iter)
-    return _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter, edf_cache)
+        start = _fit_irls(tau, m, y, fs, n_points, estimator, terms, confidence, min(max_iter, 8), edf_cache)
+        out = _fit_gls(tau, m, y, fs, n_points, terms, start, max_iter)
+    else:
+        out = _fit_irls(tau, m, y, fs, n_points, estimator, terms, confidence, max_iter, edf_cache)
+    theta, cov, model, nu, z, it, a, chi2 = out
+    return theta * scale, cov * (scale * scale), model * scale, nu, z, it, a, chi2
 
 
 def _exact_covariance_applies(tau, m, fs, n_points, estimator) -> bool:
