@@ -6,7 +6,7 @@ a tangle. The layers, bottom up (a module may import only from its own layer or 
     0  errors, _core                       the exceptions; the Rust extension
     1  units, _validate                    shared checks and units
     2  estimators.*, io.*                  the registry and its entries, EDF; the readers
-    3  plot, results                       figures; result objects (EDF sits below them)
+    3  plot, results, _display             figures; result objects (EDF sits below them); notebook HTML
     4  analysis, simulation, datasets, _reference
     5  model.*, forecast                   terms, covariance, fit, effects, refine; GM(1,1) forecasts
     6  report.*
@@ -33,6 +33,7 @@ LAYERS = {
     "io": 2,
     "plot": 3,
     "results": 3,
+    "_display": 3,
     "analysis": 4,
     "simulation": 4,
     "datasets": 4,
