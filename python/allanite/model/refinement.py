@@ -39,6 +39,7 @@ from scipy.optimize import minimize_scalar
 from scipy.stats import chi2 as chi2_dist
 
 from .._display import RichDisplay, Summary, Table, fmt_ci, thin
+from .._progress import StepBar
 from .._validate import as_rate_columns
 from ..analysis import avar, davar
 from ..errors import ParameterError
@@ -645,6 +646,7 @@ def refine(
     confidence: float = 0.683,
     points: int = 300,
     axis: int = 0,
+    progress=None,
 ) -> Refinement:
     """Fit the starting model, find what it lacks, add it, repeat; report the error before and after.
 
@@ -672,6 +674,9 @@ def refine(
             {"t": …}}``): each step then records its relative errors.
         axis : int
             Which axis of multi-axis input to refine.
+        progress : bool, optional
+            A ``tqdm.auto`` bar over the steps (the search of each step is the long part on real logs):
+            None (default) shows it only in a notebook or a terminal, True always, False never.
 
         Returns
         -------
@@ -685,6 +690,13 @@ def refine(
         >>> r.found, round(r.steps[0].params["tc"], 1), round(r.steps[0].after["chi2_dof"], 1)
         (['gauss_markov'], 10.2, 1.1)
     """
+    with StepBar(progress, 2 + MAX_STEPS, "refine") as bar:
+        return _refine(x_or_result, fs, start, candidates, unit, input, tau_range, truth, confidence, points, axis, bar)
+
+
+def _refine(x_or_result, fs, start, candidates, unit, input, tau_range, truth, confidence, points, axis, bar):
+    """:func:`refine`, telling ``bar`` before each stage."""
+    bar.step("Allan variance")
     start = check_terms(start)
     if isinstance(candidates, str):
         candidates = (candidates,)
@@ -739,9 +751,10 @@ def refine(
     start_sol = sol
     considered: dict[str, list] = {}
     tmin, tmax = curve.tau[0], curve.tau[-1]
-    for _ in range(MAX_STEPS):
+    for k in range(MAX_STEPS):
         if sol.chi2_dof <= GOOD_CHI2_DOF:
             break
+        bar.step(f"search {k + 1} (χ²/dof {sol.chi2_dof:.3g})")
         best = None
         for cand in candidates:
             if cand == "change_point":
@@ -800,6 +813,7 @@ def refine(
             _update_steps(steps, curve, start, effects, sol, truth)
     change_points = []
     if y is not None and "change_point" in candidates:
+        bar.step("change points")
         change_points = _change_points(y, fs, start)
         for c in change_points:
             terr = None
