@@ -198,3 +198,21 @@ def test_thin_and_fmt():
     assert i[0] == 0 and i[-1] == 1000 and i.size <= 300
     assert _display.fmt(float("inf")) == "∞" and _display.fmt(np.float32(1.23456)) == "1.235"
     assert _display.fmt(np.int64(7)) == "7" and _display.fmt(None) == "—"
+
+
+def test_to_xarray_attrs_label_xarrays_own_plots(static, dynamic):
+    """CF-style ``units``/``long_name`` on every variable and coordinate: xarray's .plot() labels axes."""
+    pytest.importorskip("xarray")
+    figure = pytest.importorskip("matplotlib.figure")
+    ds = static.to_xarray(unit="deg/s")
+    for name in ("avar", "adev", "adev_low", "adev_high", "edf", "tau", "m", "n"):
+        assert {"units", "long_name"} <= set(ds[name].attrs), name
+    ax = figure.Figure().add_subplot()
+    ds.adev.plot(ax=ax, xscale="log", yscale="log")
+    assert ax.get_xlabel() == "averaging time τ [s]" and ax.get_ylabel() == "Allan deviation [°/s]"
+    dd = dynamic.to_xarray(unit="deg/s")
+    ax = figure.Figure().add_subplot()
+    mesh = dd.adev.plot(ax=ax, x="t", y="tau", yscale="log")
+    assert " ".join(ax.get_xlabel().split()) == "window centre from the start of the record [s]"  # xarray wraps
+    assert ax.get_ylabel() == "averaging time τ [s]"
+    assert mesh.colorbar.ax.get_ylabel() == "dynamic Allan deviation [°/s]"

@@ -43,7 +43,7 @@ def test_notebook_runs(path, monkeypatch):
     # the shared data: the tests' default (../shared/data from the repository) made absolute for the kernel
     shared = os.environ.get("ALLANITE_SHARED_DATA", str(EXAMPLES.parent.parent / "shared" / "data"))
     monkeypatch.setenv("ALLANITE_SHARED_DATA", str(Path(shared).resolve()))
-    monkeypatch.setenv("MPLBACKEND", "Agg")
+    monkeypatch.delenv("MPLBACKEND", raising=False)  # the kernel's inline backend, as in Jupyter
     book = nbformat.read(path, as_version=4)
     client = nbclient.NotebookClient(
         book, timeout=CELL_TIMEOUT, kernel_name="python3", resources={"metadata": {"path": str(EXAMPLES)}}

@@ -77,6 +77,7 @@ class StepBar:
         self.started = False
         self.bar = _tqdm()(
             total=total,
+            desc=desc,
             file=sys.stderr,
             disable=not show_progress(progress),
             leave=False,

@@ -135,7 +135,7 @@ class _ResultBase(RichDisplay):
         """The summary lines every result shows: the record and the τ range."""
         axes = f", {self.n_axes} axes" if self.n_axes else ""
         facts: list = [
-            ("record", f"{self.n_samples} samples at {self.fs:g} Hz ({self.n_samples / self.fs:.4g} s){axes}"),
+            ("record", f"{self.n_samples} samples at {self.fs:g} Hz ({self.n_samples / self.fs:.6g} s){axes}"),
             ("input", f"{self.input} (results in the samples' rate unit)"),
             ("τ", f"{self.tau.size} values, {fmt_range(self.tau, 's')}"),
         ]
