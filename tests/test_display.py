@@ -114,7 +114,12 @@ def _results(record, static, dynamic):
         ),
         "CoefficientSeries": (
             series,
-            [f"{np.median(series.ieee['N']):.4g}", "°/√h", f"{series.t.size}, centred"],
+            [
+                f"{np.median(series.ieee['N'][series.values['N'] > 0]):.4g}",
+                "°/√h",
+                f"{series.t.size}, centred",
+                f"{int(np.sum(series.values['N'] > 0))} of {series.t.size}",
+            ],
         ),
         "Refinement": (ref, ["Q+N+B+K+R", f"{ref.fit.chi2_dof:.3g}", "final model", "°/√h"]),
     }
@@ -216,3 +221,24 @@ def test_to_xarray_attrs_label_xarrays_own_plots(static, dynamic):
     assert " ".join(ax.get_xlabel().split()) == "window centre from the start of the record [s]"  # xarray wraps
     assert ax.get_ylabel() == "averaging time τ [s]"
     assert mesh.colorbar.ax.get_ylabel() == "dynamic Allan deviation [°/s]"
+
+
+def test_coefficient_series_leaves_unresolved_windows_out():
+    """A window whose fit put a term at 0 has only an upper bound: not a zero in the median, min or max."""
+    from allanite.model.fitting import CoefficientSeries
+
+    t = np.arange(6.0)
+    values = {"N": np.array([1.0, 1.1, 0.9, 1.0, 1.2, 1.0]), "K": np.array([0.5, 0.0, 0.6, 0.0, 0.0, 0.4])}
+    s = CoefficientSeries(
+        t=t,
+        terms=("N", "K"),
+        values=values,
+        ci_low={k: 0.8 * v for k, v in values.items()},
+        ci_high={k: 1.2 * v + 0.3 for k, v in values.items()},
+        chi2_dof=np.ones(6),
+        confidence=0.683,
+    )
+    p = parse(s._repr_html_())
+    cells = [c.strip() for c in p.text if c.strip()]
+    k = cells.index("K")
+    assert cells[k + 1 : k + 7] == ["rate random walk", "3 of 6", "0.5", "0.4", "0.6", "1.5"]

@@ -23,7 +23,8 @@ def test_silent_without_a_terminal_or_notebook(capsys):
     assert capsys.readouterr().err == ""
 
 
-def test_progress_true_draws_a_bar_on_stderr_and_false_none(capsys):
+def test_progress_true_draws_a_bar_on_stderr_and_false_none(capsys, monkeypatch):
+    monkeypatch.setattr(_progress, "DELAY", 0.0)  # these calls are quicker than the bar's delay
     y = allanite.simulate(50_000, 100.0, N=2e-3, seed=1)
     allanite.refine(y, 100.0, progress=True)
     err = capsys.readouterr().err
@@ -52,7 +53,8 @@ def test_progress_must_be_a_bool_or_none():
 
 
 @pytest.mark.parametrize("estimator", ["theoh", "theoh_a"])
-def test_dhvar_in_groups_equals_one_call(estimator, capsys):
+def test_dhvar_in_groups_equals_one_call(estimator, capsys, monkeypatch):
+    monkeypatch.setattr(_progress, "DELAY", 0.0)
     rng = np.random.default_rng(5)
     x = np.column_stack([rng.normal(size=30_000), np.cumsum(rng.normal(size=30_000)) * 1e-3])
     one = allanite.davar(x, 10.0, window=3_000, hop=700, estimator=estimator, progress=False)
@@ -62,3 +64,9 @@ def test_dhvar_in_groups_equals_one_call(estimator, capsys):
     np.testing.assert_allclose(grouped.avar, one.avar, rtol=1e-12, atol=0)
     np.testing.assert_allclose(grouped.kf, one.kf, rtol=1e-12, atol=0)
     np.testing.assert_array_equal(grouped.source, one.source)
+
+
+def test_quick_calls_stay_silent_even_when_allowed(capsys):
+    y = allanite.simulate(20_000, 100.0, N=2e-3, seed=1)
+    allanite.refine(y, 100.0, progress=True)  # well under DELAY
+    assert capsys.readouterr().err == ""

@@ -7,6 +7,8 @@ Every long call takes ``progress``:
   file or a pipe, a test run or a service gets nothing.
 - ``True``: always a bar; ``False``: never.
 
+A bar appears only after :data:`DELAY` seconds, so quick calls print nothing either way.
+
 The CLI keeps its own bar on stderr (``--quiet`` turns it off) and passes its step object to
 ``build_report``, which then uses it instead of making one.
 """
@@ -20,7 +22,10 @@ from typing import Any
 
 from .errors import ParameterError
 
-__all__ = ["StepBar", "attached", "show_progress"]
+__all__ = ["DELAY", "StepBar", "attached", "show_progress"]
+
+#: Seconds before a bar appears: quick calls stay silent even when a bar is allowed.
+DELAY = 1.0
 
 
 def attached() -> bool:
@@ -79,6 +84,8 @@ class StepBar:
             total=total,
             desc=desc,
             file=sys.stderr,
+            delay=DELAY,  # a call that ends sooner shows nothing
+            mininterval=0.5,
             disable=not show_progress(progress),
             leave=False,
             unit="step",
@@ -89,7 +96,8 @@ class StepBar:
         if self.started:
             self.bar.update(1)
         self.started = True
-        self.bar.set_description_str(f"{self.desc}: {name}" if self.desc else name)
+        # no refresh here: a refresh would draw the bar before its delay
+        self.bar.set_description_str(f"{self.desc}: {name}" if self.desc else name, refresh=False)
 
     def add(self, n: int) -> None:
         self.bar.update(n)
@@ -97,7 +105,6 @@ class StepBar:
     def expect(self, remaining: int) -> None:
         """``remaining`` more steps after the current one."""
         self.bar.total = self.bar.n + 1 + remaining
-        self.bar.refresh()
 
     def close(self) -> None:
         if self.started and self.bar.total is not None:

@@ -213,8 +213,9 @@ def davar(
         DHVAR only: range of each window's bias ratio, as for :func:`avar`.
     progress : bool, optional
         DHVAR only (the slow dynamic estimator): a ``tqdm.auto`` bar over the windows — None (default)
-        shows it only in a notebook or a terminal, True always, False never. With a bar the windows are
-        computed in up to 20 groups (each window is computed on its own samples either way).
+        shows it in a notebook or a terminal when the windows hold ≥ ``DHVAR_BAR_SAMPLES`` samples in
+        all, True always, False never. With a bar the windows are computed in up to 20 groups (each
+        window is computed on its own samples either way).
 
     Returns
     -------
@@ -271,7 +272,8 @@ def davar(
     hop_core = min(hop, n)
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
     scaled, exps = _scale_columns(cols)
-    if entry.family == "theo" and n_win >= 2 and show_progress(progress):
+    big = n_win * window >= DHVAR_BAR_SAMPLES
+    if entry.family == "theo" and n_win >= 2 and show_progress(progress) and (big or progress is True):
         out = _in_groups(entry, scaled, fs, window, hop_core, taus, method, workers, options, n_win, progress)
     else:
         out = entry.dynamic(scaled, fs, window, hop_core, taus, method, workers, **options)
@@ -293,6 +295,10 @@ def davar(
         source=out.source,
         kf=kf if (kf is None or is_multi) else kf[0],
     )
+
+
+#: DHVAR work (windows × window length) from which ``progress=None`` shows a bar (some seconds).
+DHVAR_BAR_SAMPLES = 2_000_000
 
 
 def _in_groups(entry, cols, fs, window, hop, taus, method, workers, options, n_win, progress):

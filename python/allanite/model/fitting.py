@@ -259,12 +259,14 @@ class CoefficientSeries(RichDisplay):
         for k in self.terms:
             unit = units[k]
             v: np.ndarray = np.asarray(values[k], dtype=np.float64)
-            ok = v[np.isfinite(v)]
+            # a window whose non-negative fit put the term at 0 has not resolved it (only an upper bound)
+            ok = v[np.asarray(self.values[k]) > 0]
+            resolved = f"{ok.size} of {v.size}"
             if ok.size == 0:
-                rows.append([k, TERM_NAMES.get(k, ""), None, None, None, None, unit])
+                rows.append([k, TERM_NAMES.get(k, ""), resolved, None, None, None, None, unit])
                 continue
             lo, hi = float(ok.min()), float(ok.max())
-            rows.append([k, TERM_NAMES.get(k, ""), float(np.median(ok)), lo, hi, hi / lo if lo > 0 else np.inf, unit])
+            rows.append([k, TERM_NAMES.get(k, ""), resolved, float(np.median(ok)), lo, hi, hi / lo, unit])
         chi = np.asarray(self.chi2_dof, dtype=float)
         facts: list = [
             ("windows", f"{self.t.size}, centred {fmt_range(self.t, 's')}"),
@@ -278,12 +280,14 @@ class CoefficientSeries(RichDisplay):
             facts=facts,
             tables=[
                 Table(
-                    ("term", "", "median", "min over t", "max over t", "max/min", "unit"),
+                    ("term", "", "resolved in", "median", "min over t", "max over t", "max/min", "unit"),
                     rows,
-                    "IEEE-952 units" if ieee else "base form of the samples' unit",
+                    "over the windows that resolved the term; "
+                    + ("IEEE-952 units" if ieee else "base form of the samples' unit"),
                 )
             ],
-            notes=list(self.notes),
+            notes=list(self.notes)
+            + ["a window that did not resolve a term has only an upper bound (ci_high), left out of the table"],
             figure=self._draw_small,
         )
 
@@ -292,9 +296,10 @@ class CoefficientSeries(RichDisplay):
         j = thin(self.t.size)
         for n, k in enumerate(self.terms):
             v = np.asarray(self.values[k], dtype=float)
-            med = np.nanmedian(v)
-            if np.isfinite(med) and med > 0:
-                ax.semilogy(self.t[j], v[j] / med, f"C{n}-", lw=1, label=k)
+            ok = v > 0  # resolved windows only
+            if ok.sum() >= max(2, v.size // 2):
+                shown = np.where(ok, v, np.nan)[j]
+                ax.semilogy(self.t[j], shown / np.median(v[ok]), f"C{n}-", lw=1, label=k)
         ax.set_xlabel("t (s)")
         ax.set_ylabel("coefficient / median")
         ax.legend(fontsize="small", frameon=False, ncol=len(self.terms))
