@@ -242,3 +242,23 @@ def test_coefficient_series_leaves_unresolved_windows_out():
     cells = [c.strip() for c in p.text if c.strip()]
     k = cells.index("K")
     assert cells[k + 1 : k + 7] == ["rate random walk", "3 of 6", "0.5", "0.4", "0.6", "1.5"]
+
+
+def test_forecast_models_and_scores_render():
+    """The forecast models (one base: every GM(1,1) variant and baseline) and their scores."""
+    from allanite import forecast
+
+    x = [2.874, 3.278, 3.337, 3.390, 3.679]
+    m = forecast.GM11(x)
+    p = parse(m._repr_html_())
+    text = " ".join(" ".join(p.text).split())
+    assert "GM(1,1)" in text and f"{m.a:.6g}" in text and f"{m.b:.6g}" in text
+    assert f"{m.C:.4g}" in text and m.grade in text and "svg" in p.tags
+    series = 1.0 + 0.05 * np.arange(40) + 0.02 * np.sin(np.arange(40))
+    for model in (forecast.ImprovedGM11(series), forecast.Holt(series), forecast.Persistence(series)):
+        text = " ".join(parse(model._repr_html_()).text)
+        assert f"{model.C:.4g}" in text and "40 values" in text
+    build, check = forecast.split(series, 30, 10)
+    sc = forecast.score(forecast.GM11, build, check)
+    text = " ".join(" ".join(parse(sc._repr_html_()).text).split())
+    assert f"{sc.rmse:.4g}" in text and f"{sc.honest.C:.4g}" in text and f"{sc.paper_rule.C:.4g}" in text
