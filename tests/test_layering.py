@@ -4,9 +4,9 @@ Read from the source (AST), so a violation fails here before anyone meets it as 
 a tangle. The layers, bottom up (a module may import only from its own layer or below):
 
     0  errors, _core                       the exceptions; the Rust extension
-    1  units, _validate                    shared checks and units
+    1  units, _validate, _progress         shared checks and units; progress bars of long calls
     2  estimators.*, io.*                  the registry and its entries, EDF; the readers
-    3  plot, results                       figures; result objects (EDF sits below them)
+    3  plot, results, _display             figures; result objects (EDF sits below them); notebook HTML
     4  analysis, simulation, datasets, _reference
     5  model.*, forecast                   terms, covariance, fit, effects, refine; GM(1,1) forecasts
     6  report.*
@@ -29,10 +29,12 @@ LAYERS = {
     "_core": 0,
     "units": 1,
     "_validate": 1,
+    "_progress": 1,
     "estimators": 2,
     "io": 2,
     "plot": 3,
     "results": 3,
+    "_display": 3,
     "analysis": 4,
     "simulation": 4,
     "datasets": 4,

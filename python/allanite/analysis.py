@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from . import estimators
+from ._progress import StepBar, show_progress
 from ._validate import as_rate_columns, check_choice, check_count, resolve_max_memory
 from .errors import InputError, MemoryBudgetError, ParameterError
 from .results import AllanResult, DynamicAllanResult
@@ -170,6 +171,7 @@ def davar(
     workers=None,
     max_memory=None,
     kf_rule: str = "textbook",
+    progress=None,
 ) -> DynamicAllanResult:
     """Dynamic Allan variance: the Allan variance of every sliding window (DAVAR).
 
@@ -209,6 +211,11 @@ def davar(
         raises :class:`~allanite.errors.MemoryBudgetError` at once, with a hop that fits.
     kf_rule : {"textbook", "stable32"}
         DHVAR only: range of each window's bias ratio, as for :func:`avar`.
+    progress : bool, optional
+        DHVAR only (the slow dynamic estimator): a ``tqdm.auto`` bar over the windows — None (default)
+        shows it in a notebook or a terminal when the windows hold ≥ ``DHVAR_BAR_SAMPLES`` samples in
+        all, True always, False never. With a bar the windows are computed in up to 20 groups (each
+        window is computed on its own samples either way).
 
     Returns
     -------
@@ -265,7 +272,11 @@ def davar(
     hop_core = min(hop, n)
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
     scaled, exps = _scale_columns(cols)
-    out = entry.dynamic(scaled, fs, window, hop_core, taus, method, workers, **options)
+    big = n_win * window >= DHVAR_BAR_SAMPLES
+    if entry.family == "theo" and n_win >= 2 and show_progress(progress) and (big or progress is True):
+        out = _in_groups(entry, scaled, fs, window, hop_core, taus, method, workers, options, n_win, progress)
+    else:
+        out = entry.dynamic(scaled, fs, window, hop_core, taus, method, workers, **options)
     out = dataclasses.replace(out, values=_unscale(out.values, exps, entry.unit_power, cols, entry.label))
     kf = out.kf
     return DynamicAllanResult(
@@ -283,4 +294,28 @@ def davar(
         input=input,
         source=out.source,
         kf=kf if (kf is None or is_multi) else kf[0],
+    )
+
+
+#: DHVAR work (windows × window length) from which ``progress=None`` shows a bar (some seconds).
+DHVAR_BAR_SAMPLES = 2_000_000
+
+
+def _in_groups(entry, cols, fs, window, hop, taus, method, workers, options, n_win, progress):
+    """The dynamic estimator on groups of consecutive windows, one bar step per group: window j of a
+    group starting at window j0 is computed from samples j·hop … j·hop + window − 1 of the record, as
+    in one call (the windows share no state: each has its own τ grid — fixed by the window length — and
+    its own bias ratio)."""
+    groups = np.array_split(np.arange(n_win), min(n_win, 20))
+    parts = []
+    with StepBar(progress, len(groups), "DHVAR") as bar:
+        for g in groups:
+            bar.step(f"windows {g[0] + 1}–{g[-1] + 1} of {n_win}")
+            a, b = int(g[0]) * hop, int(g[-1]) * hop + window
+            parts.append(entry.dynamic([c[a:b] for c in cols], fs, window, hop, taus, method, workers, **options))
+    first = parts[0]
+    return dataclasses.replace(
+        first,
+        values=np.concatenate([p.values for p in parts], axis=-1),
+        kf=None if first.kf is None else np.concatenate([p.kf for p in parts], axis=-1),
     )

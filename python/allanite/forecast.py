@@ -43,6 +43,7 @@ import numpy as np
 import pywt
 from scipy import optimize
 
+from ._display import RichDisplay, Summary, Table, thin
 from .errors import AllaniteError, InputError, ParameterError
 
 __all__ = [
@@ -221,8 +222,16 @@ def accuracy(actual: Any, predicted: Any, *, sd: str = "population", include_fir
     return Accuracy(C, P, c_grade(C), joint_grade(C, P), S1, S2, int(x.size), sd, bool(include_first))
 
 
-class _Forecaster:
-    """Shared read-only accessors of a fitted model's in-sample accuracy."""
+def _accuracy_rows(acc: Accuracy, label: str) -> list:
+    return [
+        [f"C = S2/S1 ({label})", acc.C, f"grade {acc.c_grade}"],
+        [f"P ({label})", acc.P, acc.grade],
+        [f"S1, S2 ({label})", f"{acc.S1:.4g}, {acc.S2:.4g}", f"{acc.n} values, {acc.sd} SD"],
+    ]
+
+
+class _Forecaster(RichDisplay):
+    """Shared read-only accessors of a fitted model's in-sample accuracy, and its notebook display."""
 
     series: np.ndarray
     fitted: np.ndarray
@@ -254,6 +263,29 @@ class _Forecaster:
     @property
     def grade(self) -> str:
         return self.accuracy.grade
+
+    def _summary(self) -> Summary:
+        params = [
+            (k, v)
+            for k in ("a", "b", "shift_applied", "alpha", "beta")
+            if isinstance(v := getattr(self, k, None), (int, float, np.floating)) and not isinstance(v, bool)
+        ]
+        return Summary(
+            title=f"{type(self).__name__} · {self.name}",
+            what="forecast model of a coefficient series (paper 004)",
+            facts=[("series", f"{self.series.size} values")] + [(k, f"{float(v):.6g}") for k, v in params],
+            tables=[Table(("in-sample check", "value", "grade"), _accuracy_rows(self.accuracy, "in-sample"))],
+            notes=list(getattr(self, "notes", None) or []),
+            figure=self._draw_small,
+        )
+
+    def _draw_small(self, ax) -> None:
+        """The inline figure: the series and the in-sample fit (≤ MAX_POINTS points each)."""
+        i = thin(self.series.size)
+        ax.plot(i, self.series[i], "k.", ms=3, label="series")
+        ax.plot(i, np.asarray(self.fitted)[i], "C3-", lw=1, label="fitted")
+        ax.set_xlabel("index")
+        ax.legend(fontsize="small", frameon=False)
 
 
 # --------------------------------------------------------------------------------------------------
@@ -1003,7 +1035,7 @@ class ImprovedGM11(_Forecaster):
 
 
 @dataclass(frozen=True)
-class Score:
+class Score(RichDisplay):
     """A method judged on a build/check split.
 
     Attributes
@@ -1038,6 +1070,25 @@ class Score:
     def differs(self) -> bool:
         """Whether the paper's rule gives another C (to 3 decimals) than the honest one."""
         return round(self.paper_rule.C, 3) != round(self.honest.C, 3)
+
+    def _summary(self) -> Summary:
+        notes = ["the paper's rule gives another C than the honest check"] if self.differs else []
+        return Summary(
+            title=f"Score · {self.name}",
+            what="a forecast judged on a build/check split",
+            facts=[
+                ("forecast", f"{np.asarray(self.forecast).size} values of the check part"),
+                ("RMSE", f"{self.rmse:.4g}"),
+                ("bias (check − forecast)", f"{self.bias:.4g}"),
+            ],
+            tables=[
+                Table(
+                    ("check", "value", "grade"),
+                    _accuracy_rows(self.honest, "honest") + _accuracy_rows(self.paper_rule, "paper's rule"),
+                )
+            ],
+            notes=notes,
+        )
 
 
 def split(series: Any, build: int, check: int) -> tuple[np.ndarray, np.ndarray]:

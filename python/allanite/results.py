@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ._display import RichDisplay, Summary, Table, fmt_ci, fmt_range, thin
 from .errors import MissingDependencyError, ParameterError
 from .estimators import get as get_estimator
 from .estimators.confidence import confidence_intervals
@@ -44,8 +45,10 @@ def _xarray() -> Any:
     return xarray
 
 
-class _ResultBase:
-    """What every Allan-family result shares: deviation, intervals, labelled export, plotting.
+class _ResultBase(RichDisplay):
+    """What every Allan-family result shares: deviation, intervals, labelled export, plotting, and the
+    notebook display (``_repr_html_`` from :class:`allanite._display.RichDisplay`; each result gives its
+    ``_summary``).
 
     Subclasses are frozen dataclasses with at least ``tau``, ``avar``, ``m``, ``n``, ``estimator``,
     ``fs``, ``n_samples``, ``input``, the interval fields (``edf``, ``ci_low``, ``ci_high``,
@@ -135,6 +138,20 @@ class _ResultBase:
             alpha=ci.alpha,
             confidence=ci.confidence,
         )
+
+    def _record_facts(self) -> list:
+        """The summary lines every result shows: the record and the τ range."""
+        axes = f", {self.n_axes} axes" if self.n_axes else ""
+        facts: list = [
+            ("record", f"{self.n_samples} samples at {self.fs:g} Hz ({self.n_samples / self.fs:.6g} s){axes}"),
+            ("input", f"{self.input} (results in the samples' rate unit)"),
+            ("τ", f"{self.tau.size} values, {fmt_range(self.tau, 's')}"),
+        ]
+        if self.confidence is None:
+            facts.append(("intervals", "none yet — .with_confidence(x) adds them"))
+        else:
+            facts.append(("intervals", f"{self.confidence:.1%} χ² intervals"))
+        return facts
 
     def _xr_common(self, unit, axis_names):
         """Dims prefix, coords, unit label and attrs shared by both results' ``to_xarray``."""
@@ -259,6 +276,59 @@ class AllanResult(_ResultBase):
             f"{'' if self.confidence is None else f'; {self.confidence:.1%} intervals'})"
         )
 
+    def _summary(self) -> Summary:
+        adev = np.atleast_2d(self.adev)
+        ci = self.adev_ci
+        lo, hi = (np.atleast_2d(ci[0]), np.atleast_2d(ci[1])) if ci is not None else (None, None)
+        shown = min(adev.shape[0], 3)
+        header = ["τ (s)", "m"]
+        header += [f"ADEV{'' if self.n_axes is None else f' axis {k}'}" for k in range(shown)]
+        if self.edf is not None:
+            header += ["ν (EDF)", "α"]
+        if self.source is not None:
+            header.append("estimator")
+        rows = []
+        for i in range(self.tau.size):
+            row: list = [self.tau[i], int(self.m[i])]
+            for k in range(shown):
+                row.append(adev[k, i] if lo is None or hi is None else fmt_ci(adev[k, i], lo[k, i], hi[k, i]))
+            if self.edf is not None and self.alpha is not None:
+                row += [np.atleast_2d(self.edf)[0, i], int(np.atleast_2d(self.alpha)[0, i])]
+            if self.source is not None:
+                row.append(str(self.source[i]))
+            rows.append(row)
+        notes = []
+        if self.n_axes is not None and self.n_axes > shown:
+            notes.append(f"axes 0–{shown - 1} of {self.n_axes} shown")
+        if self.edf is not None and self.n_axes is not None:
+            notes.append("ν and α of axis 0")
+        if self.kf is not None:
+            kf = np.atleast_1d(np.asarray(self.kf, dtype=float))
+            notes.append("TheoBR bias ratio kf = " + ", ".join(f"{v:.4g}" for v in kf[:shown]))
+        imin = int(np.argmin(adev[0]))
+        facts = self._record_facts()
+        facts.append(("minimum ADEV", f"{adev[0, imin]:.4g} at τ = {self.tau[imin]:.4g} s"))
+        level = "" if self.confidence is None else f" [{self.confidence:.1%} interval]"
+        return Summary(
+            title=f"AllanResult · {self.estimator_label}",
+            what=f"static deviation of the whole record ({self.estimator})",
+            facts=facts,
+            tables=[Table(header=header, rows=rows, caption=f"deviation in the samples' rate unit{level}")],
+            notes=notes,
+            figure=self._draw_small,
+        )
+
+    def _draw_small(self, ax) -> None:
+        """The inline figure: ADEV of axis 0 (band: its interval), at most MAX_POINTS points."""
+        i = thin(self.tau.size)
+        adev = np.atleast_2d(self.adev)[0][i]
+        ci = self.adev_ci
+        if ci is not None:
+            ax.fill_between(self.tau[i], np.atleast_2d(ci[0])[0][i], np.atleast_2d(ci[1])[0][i], color="C0", alpha=0.25)
+        ax.loglog(self.tau[i], adev, "C0.-", ms=3, lw=1)
+        ax.set_xlabel("τ (s)")
+        ax.set_ylabel("ADEV")
+
     def to_xarray(self, unit=None, axis_names=None):
         """The result as an ``xarray.Dataset`` with labelled dims ``(axis, tau)`` (``(tau,)`` for 1-D
         input) and units in the attrs. Needs the optional extra: ``pip install 'allanite[xarray]'``.
@@ -362,6 +432,50 @@ class DynamicAllanResult(_ResultBase):
             f"{_fmt_range(self.tau, 's')} × {self.t.size} windows centred {_fmt_range(self.t, 's')}; "
             f"window {self.window}, hop {self.hop} samples at {self.fs:g} Hz{axes})"
         )
+
+    def _summary(self) -> Summary:
+        adev = self.adev if self.n_axes is None else self.adev[0]
+        med = np.median(adev, axis=1)
+        header = ["τ (s)", "m", "ADEV median", "min over t", "max over t", "max/min"]
+        rows = [
+            [self.tau[i], int(self.m[i]), med[i], adev[i].min(), adev[i].max(), adev[i].max() / adev[i].min()]
+            for i in range(self.tau.size)
+        ]
+        facts = self._record_facts()
+        facts[2:2] = [
+            ("windows", f"{self.t.size}, centred {fmt_range(self.t, 's')}"),
+            (
+                "window, hop",
+                f"{self.window} and {self.hop} samples ({self.window / self.fs:.4g} s, {self.hop / self.fs:.4g} s)",
+            ),
+        ]
+        which = "" if self.n_axes is None else ", axis 0"
+        notes = []
+        if self.tau.size and rows[0][5] > 2.0:  # at the shortest τ every window's estimate is tight
+            notes.append(
+                f"ADEV at τ = {self.tau[0]:.4g} s varies ×{rows[0][5]:.3g} across the windows: "
+                "the noise level changes along the record"
+            )
+        return Summary(
+            title=f"DynamicAllanResult · {self.estimator_label}",
+            what=f"deviation of every sliding window ({self.estimator}, {self.method})",
+            facts=facts,
+            tables=[Table(header=header, rows=rows, caption=f"ADEV across the windows, samples' rate unit{which}")],
+            notes=notes,
+            figure=self._draw_small,
+        )
+
+    def _draw_small(self, ax) -> None:
+        """The inline figure: log ADEV over (t, τ) of axis 0, at most 60 × 60 cells."""
+        adev = self.adev if self.n_axes is None else self.adev[0]
+        i, j = thin(self.tau.size, 60), thin(self.t.size, 60)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z = np.log10(adev[np.ix_(i, j)])
+        mesh = ax.pcolormesh(self.t[j], self.tau[i], z, shading="nearest", cmap="viridis", rasterized=True)
+        ax.set_yscale("log")
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel("τ (s)")
+        ax.figure.colorbar(mesh, ax=ax, label="log₁₀ ADEV")
 
     def to_xarray(self, unit=None, axis_names=None):
         """The result as an ``xarray.Dataset`` with labelled dims ``(axis, tau, t)`` (``(tau, t)`` for

@@ -28,6 +28,7 @@ from scipy.optimize import nnls as _scipy_nnls
 from scipy.stats import chi2 as chi2_dist
 from scipy.stats import norm
 
+from .._display import RichDisplay, Summary, Table, fmt_ci, fmt_range, thin
 from .._validate import check_count, check_nonnegative, check_positive
 from ..errors import ParameterError
 from ..estimators import get as get_estimator
@@ -37,7 +38,7 @@ from ..plot import plot_coefficient_series, plot_fit  # matplotlib only when a f
 from ..results import AllanResult, DynamicAllanResult
 from ..units import coefficient_unit, ieee952, rate_unit
 from . import _covariance
-from .terms import TERM_ALPHA, TERMS, check_terms, design_matrix
+from .terms import TERM_ALPHA, TERM_NAMES, TERMS, check_terms, design_matrix
 
 __all__ = [
     "fit",
@@ -82,8 +83,26 @@ class Coefficient:
         return s
 
 
+def coefficient_table(coefficients: dict, caption: str) -> Table:
+    """The coefficients as a display table: value [interval] in base form and in IEEE-952 units."""
+    rows = []
+    for c in coefficients.values():
+        ieee = "—" if c.ieee is None or c.ieee_ci is None else fmt_ci(c.ieee, *c.ieee_ci)
+        rows.append(
+            [
+                c.name,
+                TERM_NAMES.get(c.name, ""),
+                fmt_ci(c.value, *c.ci),
+                c.unit or "base form",
+                ieee,
+                c.ieee_unit or "—",
+            ]
+        )
+    return Table(("term", "", "value [interval]", "unit", "IEEE-952 [interval]", "IEEE unit"), rows, caption)
+
+
 @dataclass(frozen=True, repr=False, eq=False)
-class NoiseFit:
+class NoiseFit(RichDisplay):
     """The fitted model: coefficients with intervals, the fitted curve and the residuals.
 
     Attributes
@@ -161,9 +180,46 @@ class NoiseFit:
         """ADEV estimates with the fitted model and each term as its own line."""
         return plot_fit(self, ax=ax, **kwargs)
 
+    def _summary(self) -> Summary:
+        ro = self.readoffs or {}
+        u = f" {self.unit}" if self.unit else ""
+        facts: list = [
+            ("fitted", f"{len(self.tau)} τ, {fmt_range(self.tau, 's')} ({self.method.upper()})"),
+            ("goodness", f"χ²/dof = {self.chi2_dof:.3g} (dof {self.dof}), p = {self.p_value:.3g}"),
+            ("intervals", f"{self.confidence:.1%}"),
+        ]
+        if ro.get("adev_at_1s") is not None:
+            facts.append(("σ(1 s) read-off", f"{ro['adev_at_1s']:.4g}{u}"))
+        if ro.get("adev_min") is not None:
+            facts.append(
+                (
+                    "σ minimum read-off",
+                    f"{ro['adev_min']:.4g}{u} at τ = {ro['tau_at_min']:.4g} s; "
+                    f"÷ 0.664 = {ro['bias_instability_readoff']:.4g}{u}",
+                )
+            )
+        return Summary(
+            title="NoiseFit",
+            what="IEEE-952 noise model fitted to the Allan variance" + ("" if self.unit else " (unit unknown)"),
+            facts=facts,
+            tables=[coefficient_table(self.coefficients, "coefficients")],
+            notes=list(self.notes),  # what the fit decided itself, e.g. "fitted from τ ≥ 0.16 s (tau_range='auto')"
+            figure=self._draw_small,
+        )
+
+    def _draw_small(self, ax) -> None:
+        """The inline figure: the estimates and the fitted model (≤ MAX_POINTS points each)."""
+        i = thin(len(self.tau))
+        ax.loglog(self.tau[i], np.sqrt(self.avar[i]), "k.", ms=3, label="estimate")
+        grid = np.geomspace(self.tau[0], self.tau[-1], 120)
+        ax.loglog(grid, np.sqrt(np.maximum(self.curve(grid), 0.0)), "C3-", lw=1, label="model")
+        ax.set_xlabel("τ (s)")
+        ax.set_ylabel("ADEV")
+        ax.legend(fontsize="small", frameon=False)
+
 
 @dataclass(frozen=True, repr=False, eq=False)
-class CoefficientSeries:
+class CoefficientSeries(RichDisplay):
     """Coefficients fitted in every window of a dynamic result (paper 002's 2-D representation).
 
     ``values``, ``ci_low``, ``ci_high`` map term → array over ``t`` (input unit's base form);
@@ -190,6 +246,63 @@ class CoefficientSeries:
     def plot(self, axes=None, ieee: bool = True):
         """Each coefficient against time, with its interval band."""
         return plot_coefficient_series(self, axes=axes, ieee=ieee)
+
+    def _summary(self) -> Summary:
+        values, units = (
+            self.values,
+            {k: coefficient_unit(k, self.unit) if self.unit else "base form" for k in self.terms},
+        )
+        ieee = self.ieee is not None and self.ieee_units is not None
+        if self.ieee is not None and self.ieee_units is not None:
+            values, units = self.ieee, self.ieee_units
+        rows: list = []
+        for k in self.terms:
+            unit = units[k]
+            v: np.ndarray = np.asarray(values[k], dtype=np.float64)
+            # a window whose non-negative fit put the term at 0 has not resolved it (only an upper bound)
+            ok = v[np.asarray(self.values[k]) > 0]
+            resolved = f"{ok.size} of {v.size}"
+            if ok.size == 0:
+                rows.append([k, TERM_NAMES.get(k, ""), resolved, None, None, None, None, unit])
+                continue
+            lo, hi = float(ok.min()), float(ok.max())
+            rows.append([k, TERM_NAMES.get(k, ""), resolved, float(np.median(ok)), lo, hi, hi / lo, unit])
+        chi = np.asarray(self.chi2_dof, dtype=float)
+        facts: list = [
+            ("windows", f"{self.t.size}, centred {fmt_range(self.t, 's')}"),
+            ("terms", "+".join(self.terms)),
+            ("intervals", f"{self.confidence:.1%} per window"),
+            ("χ²/dof", f"median {np.nanmedian(chi):.3g}, max {np.nanmax(chi):.3g}" if chi.size else "—"),
+        ]
+        return Summary(
+            title="CoefficientSeries",
+            what="noise coefficients fitted in every window of a dynamic result",
+            facts=facts,
+            tables=[
+                Table(
+                    ("term", "", "resolved in", "median", "min over t", "max over t", "max/min", "unit"),
+                    rows,
+                    "over the windows that resolved the term; "
+                    + ("IEEE-952 units" if ieee else "base form of the samples' unit"),
+                )
+            ],
+            notes=list(self.notes)
+            + ["a window that did not resolve a term has only an upper bound (ci_high), left out of the table"],
+            figure=self._draw_small,
+        )
+
+    def _draw_small(self, ax) -> None:
+        """The inline figure: each coefficient over time relative to its median (≤ MAX_POINTS points)."""
+        j = thin(self.t.size)
+        for n, k in enumerate(self.terms):
+            v = np.asarray(self.values[k], dtype=float)
+            ok = v > 0  # resolved windows only
+            if ok.sum() >= max(2, v.size // 2):
+                shown = np.where(ok, v, np.nan)[j]
+                ax.semilogy(self.t[j], shown / np.median(v[ok]), f"C{n}-", lw=1, label=k)
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel("coefficient / median")
+        ax.legend(fontsize="small", frameon=False, ncol=len(self.terms))
 
 
 #: Correlation of overlapping Allan variance estimates one octave apart, by noise type, measured on

@@ -38,6 +38,8 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.stats import chi2 as chi2_dist
 
+from .._display import RichDisplay, Summary, Table, fmt_ci, thin
+from .._progress import StepBar
 from .._validate import as_rate_columns
 from ..analysis import avar, davar
 from ..errors import ParameterError
@@ -446,7 +448,7 @@ class Step:
 
 
 @dataclass
-class Refinement:
+class Refinement(RichDisplay):
     """What :func:`refine` found. ``fit`` is the final model (a NoiseFit whose ``coefficients`` also
     hold the added effects' parameters), ``start`` the starting model, ``steps`` the effects added."""
 
@@ -497,6 +499,70 @@ class Refinement:
                 )
                 lines.append("")
         return "\n".join(lines)
+
+    def _summary(self) -> Summary:
+        s0, s1 = self.start, self.fit
+        rows = []
+        for i, st in enumerate(self.steps, 1):
+            units = {name: unit for name, unit, _ in EFFECTS[st.effect].params} if st.effect in EFFECTS else {}
+            ps = "; ".join(
+                f"{k} = {fmt_ci(v, *st.intervals[k])} {units.get(k, '')}".rstrip() for k, v in st.params.items()
+            )
+            rows.append(
+                [
+                    i,
+                    st.effect,
+                    ps,
+                    f"{st.before['chi2_dof']:.3g} → {st.after['chi2_dof']:.3g}",
+                    f"{st.before['rms_adev_pct']:.3g} → {st.after['rms_adev_pct']:.3g}",
+                ]
+            )
+        facts: list = [
+            ("starting model", "+".join(self.terms)),
+            ("found", ", ".join(self.found) if self.steps else "nothing: the starting model fits"),
+            ("χ²/dof", f"{s0.chi2_dof:.3g} → {s1.chi2_dof:.3g}"),
+            ("RMS z", f"{np.sqrt(np.mean(s0.z**2)):.3g} → {np.sqrt(np.mean(s1.z**2)):.3g}"),
+            (
+                "record",
+                f"{self.result.n_samples} samples at {self.result.fs:g} Hz, τ {s0.tau[0]:.4g}–{s0.tau[-1]:.4g} s",
+            ),
+        ]
+        if self.change_points:
+            facts.append(("change points", ", ".join(f"t = {float(c['t']):.4g} s" for c in self.change_points)))
+        tables = []
+        if rows:
+            tables.append(
+                Table(
+                    (
+                        "step",
+                        "effect",
+                        "parameters [interval]",
+                        "χ²/dof before → after",
+                        "RMS ADEV error % before → after",
+                    ),
+                    rows,
+                    "effects added",
+                )
+            )
+        tables.append(fitting.coefficient_table(s1.coefficients, "final model"))
+        return Summary(
+            title="Refinement",
+            what="what the starting noise model lacked, found and fitted by allanite.refine",
+            facts=facts,
+            tables=tables,
+            notes=list(s1.notes),
+            figure=self._draw_small,
+        )
+
+    def _draw_small(self, ax) -> None:
+        """The inline figure: estimates, starting and refined model (≤ MAX_POINTS points each)."""
+        i, j = thin(len(self.start.tau)), thin(len(self.fit.tau))
+        ax.loglog(self.start.tau[i], np.sqrt(self.start.avar[i]), "k.", ms=2, label="estimate")
+        ax.loglog(self.start.tau[i], np.sqrt(self.start.model[i]), "C0-", lw=1, label="start")
+        ax.loglog(self.fit.tau[j], np.sqrt(self.fit.model[j]), "C3-", lw=1, label="refined")
+        ax.set_xlabel("τ (s)")
+        ax.set_ylabel("ADEV")
+        ax.legend(fontsize="small", frameon=False)
 
     def plot(self, fig=None):
         """Residuals before and after, and the ADEV with the starting and the final model."""
@@ -580,6 +646,7 @@ def refine(
     confidence: float = 0.683,
     points: int = 300,
     axis: int = 0,
+    progress=None,
 ) -> Refinement:
     """Fit the starting model, find what it lacks, add it, repeat; report the error before and after.
 
@@ -607,6 +674,9 @@ def refine(
             {"t": …}}``): each step then records its relative errors.
         axis : int
             Which axis of multi-axis input to refine.
+        progress : bool, optional
+            A ``tqdm.auto`` bar over the steps (the search of each step is the long part on real logs):
+            None (default) shows it only in a notebook or a terminal, True always, False never.
 
         Returns
         -------
@@ -620,6 +690,13 @@ def refine(
         >>> r.found, round(r.steps[0].params["tc"], 1), round(r.steps[0].after["chi2_dof"], 1)
         (['gauss_markov'], 10.2, 1.1)
     """
+    with StepBar(progress, 2 + MAX_STEPS, "refine") as bar:
+        return _refine(x_or_result, fs, start, candidates, unit, input, tau_range, truth, confidence, points, axis, bar)
+
+
+def _refine(x_or_result, fs, start, candidates, unit, input, tau_range, truth, confidence, points, axis, bar):
+    """:func:`refine`, telling ``bar`` before each stage."""
+    bar.step("Allan variance")
     start = check_terms(start)
     if isinstance(candidates, str):
         candidates = (candidates,)
@@ -674,9 +751,10 @@ def refine(
     start_sol = sol
     considered: dict[str, list] = {}
     tmin, tmax = curve.tau[0], curve.tau[-1]
-    for _ in range(MAX_STEPS):
+    for k in range(MAX_STEPS):
         if sol.chi2_dof <= GOOD_CHI2_DOF:
             break
+        bar.step(f"search {k + 1} (χ²/dof {sol.chi2_dof:.3g})")
         best = None
         for cand in candidates:
             if cand == "change_point":
@@ -735,6 +813,7 @@ def refine(
             _update_steps(steps, curve, start, effects, sol, truth)
     change_points = []
     if y is not None and "change_point" in candidates:
+        bar.step("change points")
         change_points = _change_points(y, fs, start)
         for c in change_points:
             terr = None

@@ -37,6 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._progress import StepBar
 from .._validate import check_choice, check_count
 from ..analysis import avar, davar
 from ..errors import AllaniteError, ParameterError
@@ -64,12 +65,12 @@ from .summary import summarize, text_summary
 __all__ = ["Report", "build_report", "from_log", "log_source"]
 
 
-class _NoProgress:
-    def step(self, name: str) -> None:
-        pass
-
-    def add(self, n: int) -> None:
-        pass
+def _steps(progress, total: int, desc: str):
+    """(step object, made here?): the caller's (the CLI's bar), or a :class:`StepBar` for ``progress``
+    None/True/False — None shows one only in a notebook or a terminal (see :mod:`allanite._progress`)."""
+    if progress is None or isinstance(progress, bool):
+        return StepBar(progress, total, desc), True
+    return progress, False
 
 
 @dataclass
@@ -160,15 +161,18 @@ class Report:
         """File name → PNG bytes of every figure."""
         from matplotlib.figure import Figure  # matplotlib only when figures are drawn
 
-        progress = progress or _NoProgress()
+        specs = self.figure_specs()
+        progress, own = _steps(progress, len(specs), "figures")
         images = {}
-        for name, _title, _caption, size, draw in self.figure_specs():
+        for name, _title, _caption, size, draw in specs:
             progress.step(f"figure {name}")
             fig = Figure(figsize=size, dpi=dpi)
             draw(fig)
             buf = _io.BytesIO()
             fig.savefig(buf, format="png", dpi=dpi)
             images[name] = buf.getvalue()
+        if own:
+            progress.close()
         return images
 
     def html(self, images: dict) -> str:
@@ -180,7 +184,7 @@ class Report:
         needed). Returns the paths written, report.html and summary.json first."""
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
-        progress = progress or _NoProgress()
+        progress, own = _steps(progress, len(self.figure_specs()) + 1, "report files")
         images = self.render_figures(progress, dpi=dpi)
         progress.step("writing report.html, summary.json")
         pngs = []
@@ -194,6 +198,8 @@ class Report:
             json.dumps(summary, indent=1, ensure_ascii=False, allow_nan=False), encoding="utf-8"
         )
         (out / "report.html").write_text(self.html(images), encoding="utf-8")
+        if own:
+            progress.close()
         return [out / "report.html", out / "summary.json"] + pngs
 
 
@@ -261,8 +267,10 @@ def build_report(
         Level of all intervals (default 68.3 %).
     notes : sequence of str
         Extra notes to show (warnings from reading, …).
-    progress : object with ``step(name)``, optional
-        Told before each step (the CLI's progress bar).
+    progress : bool or object with ``step(name)``, optional
+        None (default): a ``tqdm.auto`` bar when a notebook or a terminal is attached, none otherwise;
+        True/False: always/never; an object with ``step(name)`` and ``add(n)`` (the CLI's bar) is told
+        before each step instead.
     frames : float, optional
         Time-frame DAVAR (paper 004): frames of this many seconds, the noise model fitted in each, and a
         "Coefficient forecast" section. Without ``forecast`` the first 2/3 of the frames build, the rest check.
@@ -270,7 +278,6 @@ def build_report(
         The build/check split in frames (paper 004: 60:30). Without ``frames`` the record is cut into
         BUILD + CHECK frames.
     """
-    progress = progress or _NoProgress()
     notes = list(notes)
     frame_s, split = check_forecast_options(frames, forecast)
     x = np.asarray(x) if not isinstance(x, np.ndarray) else x
@@ -278,6 +285,7 @@ def build_report(
     if frame_s is not None or split is not None:
         # before anything is computed: a frame or split that does not fit the record is the caller's option
         plan = plan_forecast(int(x.shape[0]), float(fs), frame_s, split)
+    progress, own_bar = _steps(progress, 5 + bool(refine) + (plan is not None), "report")
     if x.ndim == 1:
         x = x[:, None]
     unit_name = None if unit is None else parse_unit(unit, kind="rate" if input == "rate" else "angle").name
@@ -414,6 +422,8 @@ def build_report(
             forecast_error = str(exc)
             notes.append(f"The coefficient forecast could not be computed: {exc}")
     created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
+    if own_bar:
+        progress.close()
     return Report(
         frames=frame_fits,
         forecasts=forecasts,
