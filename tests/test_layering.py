@@ -39,6 +39,7 @@ LAYERS = {
     "_reference": 4,
     "model": 5,
     "forecast": 5,
+    "compat": 5,
     "report": 6,
     "cli": 7,
     "__main__": 7,
