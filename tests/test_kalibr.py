@@ -144,3 +144,26 @@ def test_adis16405_run(shared_data, tmp_path):
     # the ADIS16405 datasheet's order of magnitude: ARW ≈ 2 °/√h (5.8e-4 rad/s/√Hz), VRW ≈ 0.2 m/s/√h (3e-3)
     assert 1e-4 < y["gyroscope_noise_density"] < 1e-2
     assert 3e-4 < y["accelerometer_noise_density"] < 3e-2
+
+
+def test_cli_report_writes_kalibr_yaml(tmp_path):
+    from allanite.cli import main
+
+    rng = np.random.default_rng(7)
+    n = 40_000
+    g = np.column_stack([kalibr_sensor(rng, n, 1e-3, 2e-5, fs=100.0) for _ in range(3)]) * (180 / math.pi)
+    a = np.column_stack([kalibr_sensor(rng, n, 2e-3, 1e-4, fs=100.0) for _ in range(3)]) / STANDARD_GRAVITY
+    path = tmp_path / "imu.npz"
+    np.savez(path, data=np.column_stack([g, a]))
+    out = tmp_path / "rep"
+    yml = tmp_path / "imu.yaml"
+    argv = [
+        "report", str(path), "--fs", "100", "--columns", "0,1,2", "--unit", "deg/s", "--accel-columns", "3,4,5",
+        "--accel-unit", "g", "--kalibr", str(yml), "--out", str(out), "-q",
+    ]  # fmt: skip
+    assert main(argv) == 0
+    y, text = read(yml)
+    assert y["gyroscope_noise_density"] == pytest.approx(1e-3, rel=0.05)
+    assert y["accelerometer_noise_density"] == pytest.approx(2e-3, rel=0.05)
+    assert y["update_rate"] == 100 and y["rostopic"] == "/imu0"
+    assert "accelerometer (samples in g)" in text
