@@ -110,3 +110,32 @@ def test_read_log_fills_gaps_with_nan(tmp_path, rng):
     np.testing.assert_allclose(log.time, np.arange(100) / 10.0, atol=1e-9)
     r = allanite.avar(log.data, log.fs, gaps="skip", taus=[0.1])
     assert r.n[0] == 99 - 4 - 2  # m = 1 terms are neighbouring pairs: 4 touch samples 30–32, 2 touch sample 70
+
+
+@pytest.mark.parametrize("est", ["oavar", "mvar", "ohvar"])
+def test_edf_follows_the_complete_terms(est, rng):
+    y = rng.standard_normal(2000)
+    plain = allanite.avar(y, FS, estimator=est)
+    ci_plain = allanite.confidence_intervals(plain, alpha=0)
+    # without gaps the term-count route is the record-length route
+    want = allanite.edf_greenhall(
+        np.zeros(plain.m.size), {"oavar": 2, "mvar": 2, "ohvar": 3}[est], plain.m, y.size + 1,
+        overlapping=True, modified=est == "mvar",
+    )  # fmt: skip
+    np.testing.assert_allclose(ci_plain.edf, want, rtol=1e-12)
+    # a record with a hole: the EDF of a gapless record with as many terms, NaN where none is complete
+    z = y.copy()
+    z[600:1400] = np.nan
+    r = allanite.avar(z, FS, estimator=est, gaps="skip")
+    ci = allanite.confidence_intervals(r, alpha=0)
+    assert np.all(ci.edf[r.n > 0] < ci_plain.edf[r.n > 0])
+    assert np.all(np.isnan(ci.edf[r.n == 0]))
+    for i in np.flatnonzero(r.n > 0):
+        short = allanite.avar(
+            y[: int(r.n[i]) + ({"oavar": 2, "mvar": 3, "ohvar": 3}[est]) * int(r.m[i]) - 1 - (est == "mvar")],
+            FS,
+            estimator=est,
+            taus=[r.tau[i]],
+        )
+        assert short.n[0] == r.n[i]
+        assert ci.edf[i] == pytest.approx(allanite.confidence_intervals(short, alpha=0).edf[0], rel=1e-12)

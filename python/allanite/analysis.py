@@ -127,7 +127,8 @@ def avar(
         in); every term that touches a missing *rate* sample is left out (a missing angle point makes the
         two rate samples beside it missing), and ``result.n`` holds the complete terms per τ — shape (T,)
         when every axis has the same count, else (axes, T). A τ with no complete term has n = 0 and
-        NaN. Estimators ``"oavar"``, ``"mvar"``, ``"tvar"``, ``"ohvar"`` only (others raise
+        NaN; :func:`~allanite.confidence_intervals` takes the EDF of a gapless record with as many
+        terms (give it ``alpha=``). Estimators ``"oavar"``, ``"mvar"``, ``"tvar"``, ``"ohvar"`` only (others raise
         :class:`~allanite.errors.ParameterError`). allantools' ``gradev`` instead skips a term when one
         of its own *phase* points is NaN: the same at m = 1, more terms kept for m > 1 (it uses phase
         differences across a gap, which are unknown when samples of rate are missing).
