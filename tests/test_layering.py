@@ -41,6 +41,8 @@ LAYERS = {
     "_reference": 4,
     "model": 5,
     "forecast": 5,
+    "compat": 5,
+    "kalibr": 6,
     "report": 6,
     "cli": 7,
     "__main__": 7,
@@ -254,6 +256,14 @@ PINNED = {
         ("axis", K),
     ],
     "Refinement": None,
+    "to_kalibr": [
+        ("path", P),
+        ("gyro", K),
+        ("accel", K),
+        ("update_rate", K),
+        ("rostopic", K),
+        ("aggregate", K),
+    ],
     "confidence_intervals": [
         ("result", P),
         ("x", P),

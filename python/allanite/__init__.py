@@ -14,6 +14,7 @@ from .errors import AllaniteError, InputError, MemoryBudgetError, ParameterError
 from .estimators.confidence import chi2_interval, confidence_intervals, edf_greenhall, edf_sp1065, identify_alpha
 from .estimators.grid import tau_grid
 from .io import Log, read_log
+from .kalibr import to_kalibr
 from .model import CoefficientSeries, NoiseFit, Refinement, TimeFrames, fit, frames, information_bound, refine
 from .results import AllanResult, DynamicAllanResult
 from .simulation import simulate
@@ -34,6 +35,7 @@ __all__ = [
     "TimeFrames",
     "refine",
     "Refinement",
+    "to_kalibr",
     "confidence_intervals",
     "identify_alpha",
     "edf_greenhall",

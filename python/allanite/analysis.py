@@ -18,9 +18,13 @@ from . import estimators
 from ._progress import StepBar, show_progress
 from ._validate import as_rate_columns, check_choice, check_count, resolve_max_memory
 from .errors import InputError, MemoryBudgetError, ParameterError
+from .estimators.deviations import GAP_ESTIMATORS, gap_static
 from .results import AllanResult, DynamicAllanResult
 
-__all__ = ["avar", "davar", "METHODS"]
+__all__ = ["avar", "davar", "METHODS", "GAPS"]
+
+#: ``gaps=`` of :func:`avar`: NaN is an error (default), or marks a missing sample whose terms are skipped.
+GAPS = ("error", "skip")
 
 #: ``method=`` of :func:`davar`: sliding sums, or every window recomputed (paper 000's DAVAR).
 METHODS = ("fast", "naive")
@@ -82,6 +86,7 @@ def avar(
     workers=None,
     kf_rule: str = "textbook",
     decimate="auto",
+    gaps: str = "error",
 ) -> AllanResult:
     """Allan variance of a whole record.
 
@@ -117,6 +122,17 @@ def avar(
         reported as m = m'·D; the Allan part stays exact. ``"auto"`` (default): on a named τ grid,
         the smallest D that leaves ≤ 100 000 samples (records up to 100 000 samples stay exact);
         explicit τ are computed exactly. ``decimate=1``: always exact (O(N²); Ctrl-C stops it).
+    gaps : {"error", "skip"}
+        ``"error"`` (default): a NaN sample is an :class:`~allanite.errors.InputError` naming its
+        position. ``"skip"``: NaN marks a missing sample (e.g. rows ``read_log(..., gaps="nan")`` filled
+        in); every term that touches a missing *rate* sample is left out (a missing angle point makes the
+        two rate samples beside it missing), and ``result.n`` holds the complete terms per τ — shape (T,)
+        when every axis has the same count, else (axes, T). A τ with no complete term has n = 0 and
+        NaN; :func:`~allanite.confidence_intervals` takes the EDF of a gapless record with as many
+        terms (give it ``alpha=``). Estimators ``"oavar"``, ``"mvar"``, ``"tvar"``, ``"ohvar"`` only (others raise
+        :class:`~allanite.errors.ParameterError`). allantools' ``gradev`` instead skips a term when one
+        of its own *phase* points is NaN: the same at m = 1, more terms kept for m > 1 (it uses phase
+        differences across a gap, which are unknown when samples of rate are missing).
 
     Returns
     -------
@@ -134,6 +150,9 @@ def avar(
     >>> np.round(r.adev * np.sqrt(r.m), 1)                      # white rate: adev·√m ≈ σ
     array([1., 1., 1.])
     """
+    check_choice(gaps, "gaps", GAPS)
+    if gaps == "skip":
+        return _avar_skipping_gaps(x, fs, input, taus, estimator, workers)
     entry = estimators.get(estimator, "static")
     options = entry.check_options({"kf_rule": kf_rule, "decimate": decimate})
     cols, fs, is_multi = as_rate_columns(x, fs, input)
@@ -155,6 +174,39 @@ def avar(
         input=input,
         source=out.source,
         kf=kf,
+    )
+
+
+def _avar_skipping_gaps(x, fs, input, taus, estimator, workers) -> AllanResult:
+    """avar(..., gaps="skip"): NaN-marked missing samples, terms touching one skipped."""
+    if estimator not in GAP_ESTIMATORS:
+        raise ParameterError(
+            f'gaps="skip" is supported by the estimators {", ".join(GAP_ESTIMATORS)}; got estimator={estimator!r}'
+        )
+    arr = np.asarray(x)
+    missing = np.isnan(arr) if arr.dtype.kind == "f" else np.zeros(arr.shape, dtype=bool)
+    # validate the record with the gaps filled, then mark the missing rate samples again
+    cols, fs, is_multi = as_rate_columns(np.where(missing, 0.0, arr) if missing.any() else arr, fs, input)
+    miss2 = np.atleast_2d(missing.T).T  # (points, axes)
+    out_cols = []
+    for a, c in enumerate(cols):
+        c = np.array(c, dtype=np.float64)  # own copy: never write into the caller's array
+        mk = miss2[:, a]
+        c[(mk[1:] | mk[:-1]) if input == "angle" else mk] = np.nan
+        out_cols.append(c)
+    out = gap_static(out_cols, fs, taus, workers, estimator)
+    counts = np.asarray(out.n, dtype=np.int64)
+    n = counts[0] if np.all(counts == counts[0]) else counts
+    values = out.values if is_multi else out.values[0]
+    return AllanResult(
+        tau=out.tau,
+        avar=values,
+        n=n,
+        m=out.m,
+        estimator=estimator,
+        fs=fs,
+        n_samples=cols[0].size,
+        input=input,
     )
 
 

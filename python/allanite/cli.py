@@ -18,10 +18,14 @@ from pathlib import Path
 from tqdm import tqdm
 
 from ._core import __version__
+from .analysis import avar
 from .datasets import default_record
 from .errors import AllaniteError
 from .io import read_log
+from .kalibr import to_kalibr
+from .model import fit as fit_model
 from .report import build_report, from_log
+from .units import ACCEL_UNITS
 
 EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -81,7 +85,7 @@ exit status:
   130  interrupted"""
 
 #: Options that describe a LOG file; meaningless for the bundled record.
-_LOG_OPTIONS = ("fs", "columns", "time_column", "time_unit", "unit", "input", "gaps")
+_LOG_OPTIONS = ("fs", "columns", "time_column", "time_unit", "unit", "input", "gaps", "accel_columns", "accel_unit")
 
 
 class _UsageError(Exception):
@@ -156,6 +160,18 @@ def build_parser() -> argparse.ArgumentParser:
         "longest gap-free stretch, or the same and list every stretch (split)",
     )
 
+    inp.add_argument(
+        "--accel-columns",
+        metavar="C1,C2,...",
+        help="accelerometer columns of the same log, for --kalibr (fitted like the gyro, written as "
+        "accelerometer_noise_density and accelerometer_random_walk)",
+    )
+    inp.add_argument(
+        "--accel-unit",
+        choices=ACCEL_UNITS,
+        help="unit of the accelerometer columns (default: m/s^2; g = 9.80665 m/s^2)",
+    )
+
     ana = rep.add_argument_group("analysis")
     ana.add_argument(
         "--taus",
@@ -203,6 +219,18 @@ def build_parser() -> argparse.ArgumentParser:
         default="allanite-report",
         metavar="DIR",
         help="folder for the report, created if needed (default: %(default)s)",
+    )
+    out.add_argument(
+        "--kalibr",
+        metavar="YAML",
+        help="also write a Kalibr / ROS imu.yaml (noise densities and random walks in SI, the worst axis; "
+        "needs --unit for a LOG)",
+    )
+    out.add_argument(
+        "--kalibr-aggregate",
+        choices=("worst", "mean"),
+        default="worst",
+        help="one value from the axes: the largest (default, as allan_variance_ros) or the mean (as imu_utils)",
     )
     out.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
     return parser
@@ -308,6 +336,41 @@ def _read(args, progress):
     return log, notes
 
 
+def _kalibr(args, rep, progress) -> Path:
+    """imu.yaml from the report's gyro fits and, with --accel-columns, the accelerometer's."""
+    if rep.fits is None:
+        raise AllaniteError(f"--kalibr needs the noise-model fit: {rep.fit_error or 'drop --no-fit'}")
+    if args.accel_columns is not None and args.log is None:
+        raise _UsageError("--accel-columns describes a LOG file; the bundled record has no accelerometer")
+    accel = None
+    if args.accel_columns is not None:
+        progress.step("accelerometer fit")
+        time_column = None
+        if args.time_column is not None:
+            tc = args.time_column.strip()
+            time_column = int(tc) if tc.isdigit() else tc
+        kwargs = {} if args.time_unit is None else {"time_unit": args.time_unit}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the gyro read already reported the timing
+            alog = read_log(
+                Path(args.log),
+                fs=args.fs,
+                columns=_spec_list(args.accel_columns, "--accel-columns"),
+                time_column=time_column,
+                gaps=args.gaps or "error",
+                **kwargs,
+            )
+        accel = fit_model(avar(alog.data, alog.fs), tau_range="auto")
+    return to_kalibr(
+        Path(args.kalibr),
+        gyro=rep.fits,
+        accel=accel,
+        update_rate=rep.fs,
+        aggregate=args.kalibr_aggregate,
+        accel_unit=args.accel_unit or "m/s^2",
+    )
+
+
 def _report(args) -> int:
     quiet = args.quiet
     if args.log is None:
@@ -352,6 +415,7 @@ def _report(args) -> int:
                     for note in notes:
                         progress.bar.write(f"allanite: warning: {note}", file=sys.stderr)
                 rep = from_log(log, notes=notes, **common)
+            kalibr_path = _kalibr(args, rep, progress) if args.kalibr else None
             specs = rep.figure_specs()
             progress.expect(len(specs) + 1)
             paths = rep.write(out, progress)
@@ -361,6 +425,8 @@ def _report(args) -> int:
         print(rep.text())
         pngs = [p.name for p in paths[2:]]
         print(f"\nwrote {paths[0]}\n      {paths[1]}\n      {len(pngs)} figures in {out}/: {', '.join(pngs)}")
+        if kalibr_path is not None:
+            print(f"      {kalibr_path} (Kalibr)")
         print(f"in {time.perf_counter() - t0:.1f} s")
     return EXIT_OK
 

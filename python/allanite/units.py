@@ -46,6 +46,9 @@ __all__ = [
     "RATE_UNITS",
     "ANGLE_UNITS",
     "IEEE952_TERMS",
+    "STANDARD_GRAVITY",
+    "ACCEL_UNITS",
+    "accel_factor",
 ]
 
 
@@ -371,3 +374,37 @@ def coefficient_unit(term: str, unit) -> str:
         angle = u[:-2]
         return {"Q": angle, "N": f"{angle}/√s", "B": u, "K": f"{angle}/s^1.5", "R": f"{angle}/s²"}[term]
     return {"Q": f"({u})·s", "N": f"({u})·√s", "B": u, "K": f"({u})/√s", "R": f"({u})/s"}[term]
+
+
+# ----------------------------------------------------------------------------------------------
+# accelerometer units (for IMU noise files: Kalibr wants SI)
+
+#: Standard gravity, m/s² (CGPM 1901; the "g" of accelerometer datasheets such as the ADIS16405's).
+STANDARD_GRAVITY = 9.80665
+
+# canonical name: (factor to m/s², aliases after normalisation)
+_ACCEL = {
+    "m/s^2": (1.0, ("m/s2", "m/s²", "m/s/s", "mps2", "m/s**2")),
+    "mm/s^2": (1e-3, ("mm/s2", "mm/s²")),
+    "g": (STANDARD_GRAVITY, ("gee", "g0")),
+    "mg": (1e-3 * STANDARD_GRAVITY, ("milli-g",)),
+    "ug": (1e-6 * STANDARD_GRAVITY, ("micro-g",)),
+}
+
+#: Canonical names of the accepted accelerometer units.
+ACCEL_UNITS = tuple(_ACCEL)
+
+
+def accel_factor(unit: str) -> float:
+    """Size of one accelerometer ``unit`` in m/s² (g = 9.80665 m/s²).
+
+    >>> from allanite.units import accel_factor
+    >>> accel_factor("g"), accel_factor("mg"), accel_factor("m/s^2")
+    (9.80665, 0.00980665, 1.0)
+    """
+    if isinstance(unit, str):
+        key = unit.strip().lower().replace(" ", "").replace("\u00b5", "u").replace("\u03bc", "u")
+        for name, (factor, aliases) in _ACCEL.items():
+            if key == name or key in aliases:
+                return factor
+    raise ParameterError(f"unknown accelerometer unit {unit!r}; allowed: {', '.join(ACCEL_UNITS)} (g = 9.80665 m/s²)")

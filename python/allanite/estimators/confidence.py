@@ -849,6 +849,24 @@ def edf_of(estimator, alpha, m, n_phase) -> np.ndarray:
     return nu
 
 
+#: (span in m, offset): a record of N phase points has N − span·m + offset terms of these estimators.
+_GAP_SPAN = {"oavar": (2, 0), "mvar": (3, 1), "tvar": (3, 1), "ohvar": (3, 0)}
+
+
+def _edf_from_terms(result, a, m_b, shape_edf) -> np.ndarray:
+    """Greenhall's EDF with the record length that gives each τ's *actual* term count ``result.n``:
+    the same as the record's own length without gaps; with ``gaps="skip"`` the complete terms only
+    (a τ without one: NaN)."""
+    span, offset = _GAP_SPAN[result.estimator]
+    n_terms = np.broadcast_to(np.asarray(result.n), shape_edf)
+    n_eff = n_terms + span * m_b - offset
+    nu = np.full(shape_edf, np.nan)
+    for n_phase in np.unique(n_eff[n_terms > 0]):
+        sel = (n_eff == n_phase) & (n_terms > 0)
+        nu[sel] = edf_of(result.estimator, a[sel], m_b[sel], int(n_phase))
+    return nu
+
+
 def _window_length(result) -> int:
     """Samples behind every estimate: the window of a dynamic result, the record of a static one."""
     return int(result.window) if _is_dynamic(result) else int(result.n_samples)
@@ -970,11 +988,19 @@ def confidence_intervals(
     m_b = np.broadcast_to(result.m, shape_edf)
     if edf_method == "sp1065":
         nu = edf_sp1065(a, m_b, n_phase, estimator=result.estimator)
+    elif not dynamic and result.source is None and result.estimator in _GAP_SPAN:
+        nu = _edf_from_terms(result, a, m_b, shape_edf)
     else:
         nu = edf_of(result.estimator if result.source is None else result.source, a, m_b, n_phase)
     nu = np.asarray(nu, dtype=np.float64).reshape(shape_edf)
     nu_b = nu[..., None] if dynamic else nu
-    low, high = chi2_interval(result.avar, nu_b, c, method=chi2)
+    if np.all(np.isfinite(nu)):
+        low, high = chi2_interval(result.avar, nu_b, c, method=chi2)
+    else:  # gaps="skip": a τ without a complete term has no EDF and no interval (NaN)
+        ok = np.isfinite(nu_b) & np.isfinite(result.avar)
+        low, high = np.full(result.avar.shape, np.nan), np.full(result.avar.shape, np.nan)
+        if ok.any():
+            low[ok], high[ok] = chi2_interval(result.avar[ok], nu_b[ok], c, method=chi2)
     return ConfidenceIntervals(
         edf=nu,
         ci_low=np.asarray(low),

@@ -34,7 +34,7 @@ from ._registry import Computed, Estimator, register
 from .confidence import edf_greenhall
 from .grid import m_grid, resolve_taus
 
-__all__ = ["max_m", "n_terms", "DEVIATIONS"]
+__all__ = ["max_m", "n_terms", "DEVIATIONS", "GAP_ESTIMATORS", "gap_static"]
 
 
 def max_m(estimator: str, n: int) -> int:
@@ -99,6 +99,28 @@ def _static(cols, fs, taus, workers, *, estimator: str) -> Computed:
     else:
         values = _core.deviation_static(cols, mlist, estimator, w)
     return Computed(tau=tau, values=values, n=n_terms(estimator, n, ms), m=ms)
+
+
+#: Estimators computed with ``gaps="skip"`` (NaN-marked missing samples): the core's gap-aware kernels.
+GAP_ESTIMATORS = ("oavar", "mvar", "tvar", "ohvar")
+
+
+def gap_static(cols, fs: float, taus, workers, estimator: str) -> Computed:
+    """``estimator`` of whole records with NaN-marked missing rate samples: every term that touches a
+    missing sample is skipped; ``n`` (axes, T) is the number of complete terms per axis (0 → NaN)."""
+    if estimator not in GAP_ESTIMATORS:
+        raise ParameterError(
+            f'gaps="skip" is supported by the estimators {", ".join(GAP_ESTIMATORS)}; got estimator={estimator!r} '
+            '(use gaps="error" and analyse a stretch without gaps)'
+        )
+    n = cols[0].size
+    ms = resolve_taus(taus, n, fs) if estimator == "oavar" else _resolve(estimator, taus, n, fs)
+    core_name = "mvar" if estimator == "tvar" else estimator
+    values, counts = _core.deviation_gaps(cols, [int(m) for m in ms], core_name, resolve_workers(workers))
+    tau = ms / fs
+    if estimator == "tvar":
+        values = values * (tau**2 / 3.0)
+    return Computed(tau=tau, values=values, n=counts, m=ms)
 
 
 def _dynamic_ohvar(cols, fs, window, hop, taus, method, workers) -> Computed:

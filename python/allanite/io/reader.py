@@ -32,7 +32,7 @@ from ..units import Unit, parse_unit
 __all__ = ["read_log", "Log", "Gap", "sniff_format", "GAP_MODES", "GAP_FACTOR"]
 
 #: What ``gaps=`` accepts.
-GAP_MODES = ("error", "longest", "split")
+GAP_MODES = ("error", "longest", "split", "nan")
 #: A time step longer than this many nominal steps is a gap.
 GAP_FACTOR = 1.5
 #: Time-column units accepted by ``time_unit=`` (seconds per unit).
@@ -266,10 +266,12 @@ def read_log(
         angle unit for ``"increment"`` and ``"angle"``. ROS bags default to ``"rad/s"``.
     input : {"rate", "increment", "angle"}
         What the samples are, as for :func:`allanite.avar`.
-    gaps : {"error", "longest", "split"}
+    gaps : {"error", "longest", "split", "nan"}
         What to do when the time column shows gaps (a step > 1.5 nominal steps): raise an error
-        listing them (default), keep the longest gap-free stretch, or keep every stretch in
-        ``Log.segments`` (``data`` is then the longest).
+        listing them (default), keep the longest gap-free stretch, keep every stretch in
+        ``Log.segments`` (``data`` is then the longest), or fill each gap with ``Gap.missing`` rows of
+        NaN (``data`` is then float64 on the nominal time grid, ``span`` the whole record) for
+        :func:`allanite.avar` with ``gaps="skip"``.
     delimiter : str, optional
         Text field separator; default: guessed from the first data line (``,``, tab, ``;`` or
         whitespace).
@@ -518,6 +520,38 @@ def _first_nonfinite(block):
     return r, c
 
 
+def _filled_with_nan(path, fmt, rec, data, t, fs, unit, input, t0, gap_list, jitter, names) -> Log:
+    """The record with every gap filled by ``Gap.missing`` NaN rows (times on the nominal grid)."""
+    dt = 1.0 / fs
+    pieces, times, start = [], [], 0
+    for g in gap_list:
+        pieces.append(np.asarray(data[start : g.index], dtype=np.float64))
+        times.append(t[start : g.index])
+        pieces.append(np.full((g.missing,) + data.shape[1:], np.nan))
+        times.append(t[g.index - 1] + dt * np.arange(1, g.missing + 1))
+        start = g.index
+    pieces.append(np.asarray(data[start:], dtype=np.float64))
+    times.append(t[start:])
+    filled = np.concatenate(pieces)
+    tt = np.concatenate(times)
+    return Log(
+        data=filled,
+        fs=float(fs),
+        columns=list(names),
+        unit=unit,
+        input=input,
+        t0=t0,
+        path=path,
+        format=fmt,
+        gaps=gap_list,
+        span=(0, int(data.shape[0])),
+        time=tt - tt[0],
+        jitter=jitter,
+        n_record=int(data.shape[0]),
+        time_column=rec.time_name,
+    )
+
+
 def _finish(path, fmt, rec: _Record, fs, unit, input, gaps) -> Log:
     data = rec.data
     n = int(data.shape[0])
@@ -594,6 +628,8 @@ def _finish(path, fmt, rec: _Record, fs, unit, input, gaps) -> Log:
             f"nominal {1.0 / fs:g} s): {shown}{more}. Pass gaps='longest' to keep the longest gap-free "
             f"stretch, or gaps='split' for every stretch"
         )
+    if gaps == "nan" and gap_list:
+        return _filled_with_nan(path, fmt, rec, data, t, fs, unit, input, t0, gap_list, jitter, names)
     longest = max(range(len(spans)), key=lambda j: spans[j][1] - spans[j][0])
     span = spans[longest]
     segments = segment_spans = None
