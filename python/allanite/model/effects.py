@@ -173,10 +173,11 @@ EFFECTS: dict[str, Effect] = {
                 ("tc", "s", "correlation time T_c"),
             ),
             "first-order Gauss–Markov rate: σ²·(T_c/τ)²·(2τ/T_c − 3 + 4e^{−τ/T_c} − e^{−2τ/T_c}); a bump near "
-            "τ ≈ 1.89·T_c, T_c searched in [τ_min, τ_max/4] so the bump lies inside the curve",
+            "τ ≈ 1.89·T_c, T_c searched in [5·τ_min, τ_max/4] so the bump lies inside the curve (a shorter T_c is "
+            "a roll-off of the shortest τ: the bandwidth)",
             signature=lambda tau, tc, fs: gm_avar(tau, tc),
             alpha=lambda tau, tc: np.where(tau < tc, -2, 0),
-            search=lambda tmin, tmax: np.geomspace(tmin, tmax / 4.0, 40),
+            search=lambda tmin, tmax: np.geomspace(5.0 * tmin, tmax / 4.0, 40),
         ),
         Effect(
             "sinusoid",

@@ -6,7 +6,7 @@ of the registry :data:`allanite.model.effects.EFFECTS`:
 
 - on the **Allan curve**, by signature (closed forms, ``docs/FORMULAS.md`` §5): ``"bandwidth"`` — the
   sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett FIR), exact in
-  discrete time, replacing the N column; ``"gauss_markov"`` — a bump, T_c in [τ_min, τ_max/4]; and, for
+  discrete time, replacing the N column; ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4]; and, for
   curve-only input, ``"sinusoid"`` (nulls at τ = k/f0, f0 ≥ 2/τ_max);
 - in the **PSD** (Welch) for spectral lines: ``"sinusoid"`` with f0 from the periodogram peak, refined;
 - in **time**: ``"drift"`` (warm-up a·e^{−t/T} on block means) and ``"change_point"`` (steps of the noise
@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.stats import chi2 as chi2_dist
+from scipy.stats import t as t_dist
 
 from .._validate import as_rate_columns
 from ..analysis import avar, davar
@@ -72,6 +73,13 @@ MAX_STEPS = 4
 N_BOOT = 1000
 #: Blocks for the held-out error of time-localised effects (odd blocks predict even ones and back).
 HELDOUT_BLOCKS = 8
+#: A bandwidth that raises the held-out error alone may enter with a Gauss–Markov term if its statistic is
+#: at least this multiple of the threshold.
+PAIR_FACTOR = 100.0
+#: Share of ``level`` for each time-domain test (regression on channels, drift).
+TIME_SHARE = 0.075
+#: Blocks of the jackknife of a regression coefficient (t with blocks − 1 degrees of freedom).
+REGRESSION_BLOCKS = 8
 #: Held-out error: only τ whose held-out ADEV estimate is within ±10 % (EDF ≥ 50, white rate noise).
 HELDOUT_MIN_EDF = 50.0
 #: Kept for the change-point test's penalty (calibrated with it on clean records).
@@ -290,6 +298,24 @@ class _Split:
         return float(np.mean(errs))
 
 
+def _theta_terms(sol, terms, effects):
+    """Squared coefficients of the terms (a bandwidth's N in place of the zeroed N column)."""
+    k = len(terms)
+    theta = sol.theta[:k].copy()
+    for j, (key, _p) in enumerate(effects):
+        if EFFECTS[_base(key)].replaces == "N" and "N" in terms:
+            theta[list(terms).index("N")] = sol.theta[k + j]
+    return theta
+
+
+def _splits(y, fs, m_all, lo, hi):
+    """Halves and alternate blocks of the record for the held-out error, or (None, None) if too short."""
+    try:
+        return _Split(y, fs, m_all, lo, hi, "oavar", {}, 2), _Split(y, fs, m_all, lo, hi, "oavar", {}, HELDOUT_BLOCKS)
+    except ValueError:
+        return None, None
+
+
 # ----------------------------------------------------------------------------------------------
 # candidates on the curve
 
@@ -376,15 +402,19 @@ def _profile_interval(curve, terms, effects, key, p, sol):
 
 def _bandwidth_grids(curve):
     """Search grids per filter kind: single-pole cutoffs whose roll-off falls inside the curve, FIR lengths."""
+    # the roll-off must reach into the curve: a time constant (or FIR span) of at least a third of the
+    # shortest τ — a faster filter leaves no mark on it
     fs = curve.fs
     f_lo = 1.0 / (2 * math.pi * 10 * curve.tau[0])
+    f_hi = min(0.45 * fs, 3.0 / (2 * math.pi * curve.tau[0]))
     grids = {}
-    if f_lo < 0.45 * fs:
-        grids["single_pole"] = np.geomspace(f_lo, 0.45 * fs, 24)
+    if f_lo < f_hi:
+        grids["single_pole"] = np.geomspace(f_lo, f_hi, 24)
+    l_min = max(2, int(math.ceil(curve.tau[0] * fs / 3)))
     l_max = int(max(2, min(64, 10 * curve.tau[0] * fs)))
-    if l_max >= 2:
-        grids["moving_average"] = np.arange(2, l_max + 1, dtype=np.float64)
-        grids["bartlett"] = np.arange(2, max(3, l_max // 2) + 1, dtype=np.float64)
+    if l_max > l_min:
+        grids["moving_average"] = np.arange(l_min, l_max + 1, dtype=np.float64)
+        grids["bartlett"] = np.arange(max(2, l_min // 2), max(3, l_max // 2) + 1, dtype=np.float64)
     return grids
 
 
@@ -393,7 +423,9 @@ def _families(curve, candidates, has_samples, channel_names, drift_grid):
     fam = []
     tmin, tmax = curve.tau[0], curve.tau[-1]
     if "gauss_markov" in candidates:
-        fam += [_column("gauss_markov", p, curve) for p in np.geomspace(tmin, tmax / 4, 40)]
+        search = EFFECTS["gauss_markov"].search
+        assert search is not None
+        fam += [_column("gauss_markov", p, curve) for p in search(tmin, tmax)]
     if "bandwidth" in candidates:
         for kind, grid in _bandwidth_grids(curve).items():
             fam += [_column(f"bandwidth:{kind}", p, curve) - 1.0 / curve.tau for p in grid]
@@ -874,64 +906,101 @@ def refine(
         )
     est = result.estimator if result.source is None else tuple(np.asarray(result.source)[keep])
     fs = result.fs
-    chan_curves = {k: avar(c, fs, taus=result.tau[keep]).avar for k, c in chans.items()}
-    curve = _Curve(
-        result.tau[keep],
-        result.m[keep].astype(np.float64),
-        result.avar[keep],
-        fs,
-        result.n_samples + 1,
-        est,
-        channels=chan_curves,
-    )
-    halves = blocks = None
+
+    def build(res, samples):
+        """The curve (and, with samples, the held-out splits) of ``res``'s estimates in the τ range."""
+        c = _Curve(
+            res.tau[keep], res.m[keep].astype(np.float64), res.avar[keep], fs, res.n_samples + 1, est, channels={}
+        )
+        if samples is None:
+            return c, (None, None)
+        return c, _splits(samples, fs, np.asarray(res.m, dtype=np.int64), lo, hi)
+
+    curve, (halves, blocks) = build(result, y)
     note = "curve-only input (an AllanResult without samples): no held-out error; steps rest on the calibrated test"
     if y is not None:
-        m_all = np.asarray(result.m, dtype=np.int64)
-        try:
-            halves = _Split(y, fs, m_all, lo, hi, "oavar", chans, 2)
-            blocks = _Split(y, fs, m_all, lo, hi, "oavar", chans, HELDOUT_BLOCKS)
-            note = (
-                "fit on one half of the record, predict the other half's Allan curve (both ways, mean RMS ADEV "
-                f"error); drift by alternate blocks ({HELDOUT_BLOCKS} blocks, odd ↔ even)"
+        note = (
+            "fit on one half of the record, predict the other half's Allan curve (both ways, mean RMS ADEV "
+            f"error); drift by alternate blocks ({HELDOUT_BLOCKS} blocks, odd ↔ even)"
+            if halves is not None
+            else "record too short to hold out halves: no held-out error"
+        )
+    k_terms = len(start)
+    steps: list = []
+    sol = _solve(curve, start, [])
+    start_sol = sol
+    start_heldout = halves.error(start, []) if halves is not None else None
+    alpha_curve = level * (1.0 - LINE_SHARE - CHANGE_POINT_SHARE - 2 * TIME_SHARE)
+
+    # removing a time-domain component (after the curve effects are in the model)
+    def removal_step(name, component, split, params, intervals, evidence, truth_key, held_in_time=None):
+        """Accept removing ``component`` if the held-out error falls; returns the step or None.
+
+        ``held_in_time``: for a regression, the held-out test in time (the residual variance of each half with
+        the coefficient of the other half, relative to its raw variance) decides instead: removing a white-like
+        component changes the Allan curve's level, not how well one half predicts the other's."""
+        nonlocal y, result, curve, halves, blocks, sol
+        assert y is not None
+        y_new = y - component
+        res_new = avar(y_new, fs, taus=result.tau)
+        c_new, (h_new, b_new) = build(res_new, y_new)
+        old_split, new_split = (halves, h_new) if split == "halves" else (blocks, b_new)
+        ho_b = old_split.error(start, effects) if old_split is not None else None
+        ho_a = new_split.error(start, effects) if new_split is not None else None
+        s_new = _solve(c_new, start, effects)
+        if held_in_time is not None:
+            evidence["heldout_variance_ratio"] = held_in_time
+            rejected = not held_in_time < 1.0
+        else:
+            rejected = ho_b is not None and ho_a is not None and not ho_a < ho_b
+        if rejected:
+            considered.setdefault(name, []).append(
+                params
+                | {
+                    "rejected": f"held-out error {ho_b} → {ho_a} %, variance ratio {held_in_time}",
+                    "test": evidence["test"],
+                }
             )
-        except ValueError:
-            halves = blocks = None
-            note = "record too short to hold out halves: no held-out error"
+            return None
+        terr = None
+        if truth and truth_key in truth:
+            terr = {k: params[k] / v - 1 for k, v in truth[truth_key].items() if k in params and v}
+        st = Step(
+            effect=name,
+            params=params,
+            intervals=intervals,
+            evidence=evidence,
+            before=_curve_metrics(curve, sol, ho_b),
+            after=_curve_metrics(c_new, s_new, ho_a),
+            delta_chi2_eff=float(sol.chi2_eff(curve) - s_new.chi2_eff(c_new)),
+            truth_error=terr,
+        )
+        y, result, curve, halves, blocks, sol = y_new, res_new, c_new, h_new, b_new, s_new
+        return st
+
+    considered: dict[str, list] = {}
     exact = y is not None or (isinstance(est, str) and est == "oavar")
     thin = tracing.thin_indices(curve.tau)
     sub = curve.subset(thin)
-    alpha_curve = level * (1.0 - LINE_SHARE - CHANGE_POINT_SHARE)
     lines = tracing.spectral_lines(y, fs, level * LINE_SHARE) if y is not None and "sinusoid" in candidates else []
-    drift = tracing.drift_fit(y, fs) if y is not None and "drift" in candidates else None
-    regs = {k: tracing.regression_fit(y, c) for k, c in chans.items()} if y is not None else {}
-    k_terms = len(start)
-
+    drift = None
+    regs: dict = {}
     effects: list = []
-    steps: list = []
-    sol = _solve(curve, start, effects)
-    start_sol = sol
-    start_heldout = halves.error(start, []) if halves is not None else None
-    considered: dict[str, list] = {}
     tmin, tmax = curve.tau[0], curve.tau[-1]
     for n_step in range(MAX_STEPS):
         keys = [e[0] for e in effects]
-        theta_t = sol.theta[:k_terms].copy()
-        for j, (key, _p) in enumerate(effects):
-            if EFFECTS[_base(key)].replaces == "N" and "N" in start:
-                theta_t[list(start).index("N")] = sol.theta[k_terms + j]
+        theta_t = _theta_terms(sol, start, effects)
         model_t = np.maximum(design_matrix(sub.tau, sub.m, fs, start) @ theta_t, 1e-300)
         cov_t = None
         if exact:
             cov_t = tracing.exact_covariance(sub.m.astype(np.int64), curve.n_points - 1, fs, start, theta_t)
         a_thin, _ = _design(sub, start, effects)
         test = tracing.ScoreTest(sol.model[thin], model_t, sol.nu[thin], sub.tau, a_thin[:, sol.theta > 0], cov_t)
-        added_regs = {k.split(":", 1)[1] for k in keys if _base(k) == "regression"}
         fam = _families(
             sub,
             candidates,
             y is not None,
-            [c for c in chans if c not in added_regs],
+            [],
             drift["grid"] if drift is not None and "drift" not in keys else None,
         )
         thr = test.threshold(fam, alpha_curve, N_BOOT, seed=n_step)
@@ -977,12 +1046,6 @@ def refine(
             s_new = _solve(curve, start, effects + [("drift", drift["T"])])
             stat = test.statistic(sub.avar, _column("drift", drift["T"], sub))
             propose("drift", drift["T"], s_new, drift["at_edge"], stat, thr, blocks)
-        for name in chans:
-            if name in added_regs or "regression" not in candidates:
-                continue
-            key = f"regression:{name}"
-            s_new = _solve(curve, start, effects + [(key, 1.0)])
-            propose(key, 1.0, s_new, False, test.statistic(sub.avar, curve.channels[name][thin]), thr, halves)
         for pr in props:
             considered.setdefault(_base(pr["key"]), []).append(
                 {"param": float(pr["p"]), "statistic": float(pr["stat"]), "threshold": float(pr["thr"])}
@@ -1010,6 +1073,31 @@ def refine(
                     continue
             chosen = (pr, ho_b, ho_a)
             break
+        bw = next((pr for pr in ok if _base(pr["key"]) == "bandwidth"), None)
+        # (only for an unmistakable roll-off: its statistic ≥ PAIR_FACTOR × the threshold)
+        if (
+            chosen is None
+            and bw is not None
+            and bw["split"] is not None
+            and bw["stat"] >= PAIR_FACTOR * bw["thr"]
+            and "gauss_markov" in candidates
+        ):
+            # a bandwidth alone can lower the held-out fit where a bump sits further up the curve (the five
+            # terms bend to the bump once the short τ are right): try it with a Gauss–Markov term on top
+            search = EFFECTS["gauss_markov"].search
+            assert search is not None
+            with_bw = effects + [(bw["key"], bw["p"])]
+            p_g, s_pair, edge_g = _search(curve, start, with_bw, "gauss_markov", search(tmin, tmax))
+            if not edge_g and s_pair.theta[-1] > 0:
+                ho_b = bw["split"].error(start, effects)
+                ho_alone = bw["split"].error(start, with_bw)
+                ho_pair = bw["split"].error(start, with_bw + [("gauss_markov", p_g)])
+                if ho_pair < ho_b:
+                    bw["pair_note"] = (
+                        f"accepted with the Gauss–Markov term of the next step: alone it moved the held-out error "
+                        f"{ho_b:.3g} → {ho_alone:.3g} %, with it → {ho_pair:.3g} %"
+                    )
+                    chosen = (bw, ho_b, ho_alone)
         if chosen is None:
             break
         pr, ho_b, ho_a = chosen
@@ -1025,6 +1113,8 @@ def refine(
         )
         if _base(key) == "bandwidth":
             evidence["N"] = math.sqrt(max(s_new.theta[-1], 0.0))
+        if "pair_note" in pr:
+            evidence["held_out"] = pr["pair_note"]
         terr = None
         base = _base(key)
         if truth and base in truth:
@@ -1046,21 +1136,64 @@ def refine(
             )
         )
         effects, sol = effects + [(key, p)], s_new
+    n_curve = len(steps)
     # an effect whose amplitude a later one took over entirely is dropped (refit without it)
     dead = [j for j in range(len(effects)) if sol.theta[k_terms + j] <= 0]
     if dead:
         for j in reversed(dead):
             considered.setdefault(_base(effects[j][0]), []).append({"param": float(effects[j][1]), "absorbed": True})
             del effects[j], steps[j]
+            n_curve -= 1
         sol = _solve(curve, start, effects)
     # amplitudes of earlier curve steps from the final joint solution
-    for j, (st, (key, _p)) in enumerate(zip(steps, effects)):
+    for j, (st, (key, _p)) in enumerate(zip(steps[:n_curve], effects)):
         base = _base(key)
         if base in ("gauss_markov",) or (base == "sinusoid" and y is None):
             names = EFFECTS[base].param_names
             st.params[names[0]] = math.sqrt(max(sol.theta[k_terms + j], 0.0))
             if truth and base in truth and st.truth_error is not None:
                 st.truth_error = {kk: st.params[kk] / v - 1 for kk, v in truth[base].items() if kk in st.params}
+    # ---- time domain: other channels, then a warm-up drift; each removed from the samples and refitted
+    if y is not None and chans and "regression" in candidates:
+        t_thr = t_dist.isf(TIME_SHARE * level / (2 * len(chans)), REGRESSION_BLOCKS - 1)
+        for name, ch in chans.items():
+            rg = tracing.regression_fit(y, ch, REGRESSION_BLOCKS)
+            t_stat = abs(rg["coefficient"]) / rg["se"] if rg["se"] > 0 else 0.0
+            ev = {"domain": "channels", "test": {"t": t_stat, "threshold": float(t_thr), "alpha": TIME_SHARE * level}}
+            if not t_stat > t_thr:
+                considered.setdefault("regression", []).append({"channel": name, "t": t_stat, "threshold": t_thr})
+                continue
+            st = removal_step(
+                "regression",
+                rg["coefficient"] * (ch - ch.mean()),
+                "halves",
+                {"channel": name, "coefficient": rg["coefficient"]},
+                {"coefficient": (rg["coefficient"] - rg["se"], rg["coefficient"] + rg["se"])},
+                ev,
+                "regression",
+                tracing.regression_heldout(y, ch),
+            )
+            if st is not None:
+                steps.append(st)
+    if y is not None and "drift" in candidates:
+        dr = tracing.drift_fit(y, fs)
+        thr_d = tracing.drift_threshold(y.size, fs, start, _theta_terms(sol, start, effects), TIME_SHARE * level)
+        ev = {"domain": "time", "test": {"statistic": dr["statistic"], "threshold": thr_d, "alpha": TIME_SHARE * level}}
+        if dr["statistic"] > thr_d and not dr["at_edge"]:
+            t_s = np.arange(y.size) / fs
+            st = removal_step(
+                "drift",
+                dr["amplitude"] * np.exp(-t_s / dr["T"]),
+                "blocks",
+                {"amplitude": dr["amplitude"], "T": dr["T"]},
+                {"amplitude": dr["amplitude_interval"], "T": dr["T_interval"]},
+                ev,
+                "drift",
+            )
+            if st is not None:
+                steps.append(st)
+        else:
+            considered.setdefault("drift", []).append({"T": dr["T"], "statistic": dr["statistic"], "threshold": thr_d})
     change_points = []
     if y is not None and "change_point" in candidates:
         change_points = _change_points(y, fs, start)

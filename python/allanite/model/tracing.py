@@ -29,12 +29,26 @@ from scipy import signal
 from scipy.linalg import solve_triangular
 from scipy.optimize import minimize_scalar
 from scipy.stats import chi2 as chi2_dist
+from scipy.stats import f as f_dist
 from scipy.stats import norm
 
+from ..simulation import simulate
 from . import _covariance
 
-__all__ = ["spectral_lines", "drift_fit", "regression_fit", "ScoreTest", "thin_indices"]
+__all__ = [
+    "spectral_lines",
+    "drift_fit",
+    "drift_threshold",
+    "regression_fit",
+    "regression_heldout",
+    "ScoreTest",
+    "thin_indices",
+]
 
+#: Block means a drift is fitted to.
+DRIFT_BLOCKS = 500
+#: Lowest Welch bin searched for lines (below, the window's leakage of a steep 1/f² spectrum dominates).
+MIN_BIN = 6
 #: Octave-to-octave correlation of Allan estimates where no exact covariance applies (curves only).
 OCTAVE_RHO = 0.68
 
@@ -49,22 +63,27 @@ def spectral_lines(y: np.ndarray, fs: float, alpha: float, max_lines: int = 4) -
     dof = max(2.0, 2.0 * nseg * 0.947)  # Hann, 50 % overlap: equivalent degrees of freedom (Welch 1967)
     bias = chi2_dist.median(dof) / dof
     med = np.full(p.size, np.nan)
+    half = np.zeros(p.size)
     k_all = np.arange(p.size)
     for w in range(4, 33):
-        ks = k_all[(np.clip(k_all // 2, 4, 32) == w) & (k_all >= 3) & (k_all < p.size - w)]
+        ks = k_all[(np.clip(k_all // 2, 4, 32) == w) & (k_all >= MIN_BIN) & (k_all < p.size - w)]
         if ks.size == 0:
             continue
         lo = np.maximum(1, ks - w)
         win = sliding_window_view(np.concatenate([p, np.full(2 * w + 1, np.nan)]), 2 * w + 1)
         rows = win[lo]
         med[ks] = np.nanmedian(rows, axis=1)
+        half[ks] = w
     ratio = p / (med / bias)
     searched = np.isfinite(ratio)
     n_bins = int(searched.sum())
     if n_bins == 0:
         return []
-    thr = chi2_dist.isf(alpha / n_bins, dof) / dof
-    hits = np.flatnonzero(searched & (ratio > thr))
+    # the neighbours' median is itself an estimate: the ratio is F-distributed, the median's degrees of
+    # freedom those of (2w + 1)/3 independent bins (adjacent Hann bins overlap)
+    dof_med = np.maximum(dof, dof * (2 * half + 1) / 3.0)
+    thr_all = np.where(searched, f_dist.isf(alpha / n_bins, dof, dof_med), np.inf)
+    hits = np.flatnonzero(searched & (ratio > thr_all))
     peaks: list[int] = []
     for k in hits[np.argsort(-ratio[hits])]:
         if all(abs(k - q) > 3 for q in peaks):
@@ -84,7 +103,7 @@ def spectral_lines(y: np.ndarray, fs: float, alpha: float, max_lines: int = 4) -
                 "amplitude": float(math.hypot(coef[0], coef[1])),
                 "phase": float(math.atan2(coef[0], coef[1])),
                 "psd_ratio": float(ratio[k]),
-                "threshold": float(thr),
+                "threshold": float(thr_all[k]),
                 "bin_hz": float(df),
             }
         )
@@ -110,41 +129,76 @@ def _refine_f0(x: np.ndarray, fs: float, f_bin: float, df: float) -> float:
     return float(res.x)
 
 
-def drift_fit(y: np.ndarray, fs: float, n_blocks: int = 1000) -> dict:
-    """Least-squares warm-up c + a·e^{−t/T} on block means; T searched from L/200 to L/2 (L the record)."""
-    n = y.size
-    nb = min(n_blocks, n)
-    per = n // nb
-    b = y[: nb * per].reshape(nb, per).mean(axis=1)
-    tb = (np.arange(nb) * per + 0.5 * (per - 1)) / fs
-    length = n / fs
+def _drift_stat(b, tb, length, with_interval=False):
+    """Warm-up c + r·t + a·e^{−t/T} against the ramp c + r·t on block means: statistic n·ln(RSS_ramp/RSS)."""
+    nb = b.size
+    base = np.column_stack([np.ones(nb), tb])
+    r0 = b - base @ np.linalg.lstsq(base, b, rcond=None)[0]
+    rss0 = float(r0 @ r0)
 
     def rss(lt):
-        e = np.exp(-tb / math.exp(lt))
-        a = np.column_stack([np.ones(nb), e])
-        coef, res, *_ = np.linalg.lstsq(a, b, rcond=None)
+        a = np.column_stack([base, np.exp(-tb / math.exp(lt))])
+        coef = np.linalg.lstsq(a, b, rcond=None)[0]
         r = b - a @ coef
         return float(r @ r), coef
 
-    grid = np.linspace(math.log(length / 200), math.log(length / 2), 40)
+    grid = np.linspace(math.log(length / 200), math.log(length / 2), 24)
     vals = [rss(g)[0] for g in grid]
     j = int(np.argmin(vals))
     lo, hi = grid[max(0, j - 1)], grid[min(grid.size - 1, j + 1)]
-    res = minimize_scalar(lambda lt: rss(lt)[0], bounds=(lo, hi), method="bounded", options={"xatol": 1e-4})
+    res = minimize_scalar(lambda lt: rss(lt)[0], bounds=(lo, hi), method="bounded", options={"xatol": 1e-3})
     lt = float(res.x)
     r_min, coef = rss(lt)
-    # interval of T: block means carry coloured noise; scale the RSS by its minimum per degree of freedom
-    s2 = r_min / max(1, nb - 3)
-    fine = np.linspace(lt - 1.5, lt + 1.5, 61)
-    d = np.array([rss(v)[0] for v in fine]) / s2 - r_min / s2
-    ok = fine[d <= 1.0]
-    return {
-        "T": math.exp(lt),
-        "amplitude": float(coef[1]),
-        "T_interval": (math.exp(ok.min()), math.exp(ok.max())) if ok.size else (math.exp(lt), math.exp(lt)),
-        "at_edge": bool(j == 0 or j == grid.size - 1),
-        "grid": np.exp(grid),
-    }
+    stat = nb * math.log(rss0 / max(r_min, 1e-300))
+    out = {"statistic": stat, "T": math.exp(lt), "amplitude": float(coef[2]), "at_edge": j in (0, grid.size - 1)}
+    if with_interval:
+        # T and a where nb·ln(RSS) rises by ≤ 1 over its minimum (a profile likelihood interval)
+        fine = np.linspace(lt - 1.5, lt + 1.5, 61)
+        d = nb * np.log(np.array([rss(v)[0] for v in fine]) / r_min)
+        ok = fine[d <= 1.0]
+        out["T_interval"] = (math.exp(ok.min()), math.exp(ok.max())) if ok.size else (out["T"], out["T"])
+        a_sd = abs(out["amplitude"]) / math.sqrt(max(stat, 1e-12))
+        out["amplitude_interval"] = (out["amplitude"] - a_sd, out["amplitude"] + a_sd)
+    return out
+
+
+def _block_means(y, n_blocks):
+    nb = min(n_blocks, y.size)
+    per = y.size // nb
+    return y[: nb * per].reshape(nb, per).mean(axis=1), per
+
+
+def drift_fit(y: np.ndarray, fs: float, n_blocks: int = DRIFT_BLOCKS) -> dict:
+    """Least-squares warm-up c + r·t + a·e^{−t/T} on block means (T from L/200 to L/2, L the record), with
+    the statistic nb·ln(RSS_ramp/RSS_warm-up) against a ramp (a constant slope is the R term, not a drift)."""
+    b, per = _block_means(y, n_blocks)
+    tb = (np.arange(b.size) * per + 0.5 * (per - 1)) / fs
+    return _drift_stat(b, tb, y.size / fs, with_interval=True)
+
+
+def drift_threshold(n: int, fs: float, terms, theta, alpha: float, n_boot: int = 400, seed: int = 0) -> float:
+    """(1 − α) quantile of the drift statistic on records of the fitted five-term model (parametric bootstrap).
+
+    Only the block means matter, so each record is simulated at the block rate (white rate, flicker and
+    random walk of rate keep their coefficients; white angle noise averages out)."""
+    nb = min(DRIFT_BLOCKS, n)
+    per = n // nb
+    fs_b = fs / per
+    coef = {t: math.sqrt(max(float(v), 0.0)) for t, v in zip(terms, theta)}
+    tb = (np.arange(nb) * per + 0.5 * (per - 1)) / fs
+    stats = []
+    for k in range(n_boot):
+        b = simulate(
+            nb,
+            fs_b,
+            N=coef.get("N", 0.0),
+            B=coef.get("B", 0.0),
+            K=coef.get("K", 0.0),
+            R=coef.get("R", 0.0),
+            seed=seed + 7919 * k,
+        )
+        stats.append(_drift_stat(np.asarray(b, dtype=np.float64).ravel(), tb, n / fs)["statistic"])
+    return float(np.quantile(stats, 1.0 - alpha))
 
 
 def regression_fit(y: np.ndarray, ch: np.ndarray, n_blocks: int = 8) -> dict:
@@ -162,6 +216,19 @@ def regression_fit(y: np.ndarray, ch: np.ndarray, n_blocks: int = 8) -> dict:
             parts.append(float((y[sl] - y[sl].mean()) @ cj) / dj)
     se = float(np.std(parts, ddof=1) / math.sqrt(len(parts))) if len(parts) > 1 else float("nan")
     return {"coefficient": coef, "se": se}
+
+
+def regression_heldout(y: np.ndarray, ch: np.ndarray) -> float:
+    """Held-out test of a regression in time: each half's residual variance with the other half's coefficient,
+    over its raw variance (mean of the two ways; < 1 means the coefficient carries over)."""
+    h = y.size // 2
+    parts = [(y[:h], ch[:h]), (y[h:], ch[h:])]
+    ratios = []
+    for (yf, cf), (yh, chh) in ((parts[0], parts[1]), (parts[1], parts[0])):
+        c = regression_fit(yf, cf, 2)["coefficient"]
+        yh0, ch0 = yh - yh.mean(), chh - chh.mean()
+        ratios.append(float(np.var(yh0 - c * ch0) / np.var(yh0)))
+    return float(np.mean(ratios))
 
 
 def thin_indices(tau: np.ndarray, per_octave: int = 4) -> np.ndarray:
