@@ -769,9 +769,13 @@ def _step_params(key, p, sol, i, curve, terms, effects_before, extra):
             "coefficient": (r["coefficient"] - r["se"], r["coefficient"] + r["se"])
         }
     names = EFFECTS[base].param_names
-    p_int = _profile_interval(curve, terms, effects_before, key, p, sol)
     if base == "sinusoid" and extra.get("line") is not None:
-        amp = extra["line"]["amplitude"]
+        ln = extra["line"]  # found in the PSD: amplitude and f0 from the samples, with their intervals
+        return {names[0]: ln["amplitude"], names[1]: p}, {
+            names[0]: ln["amplitude_interval"],
+            names[1]: ln["f0_interval"],
+        }
+    p_int = _profile_interval(curve, terms, effects_before, key, p, sol)
     return {names[0]: amp, names[1]: p}, {names[0]: amp_int, names[1]: p_int}
 
 

@@ -97,10 +97,19 @@ def spectral_lines(y: np.ndarray, fs: float, alpha: float, max_lines: int = 4) -
         f0 = _refine_f0(x, fs, f[k], df)
         c, s = np.cos(2 * np.pi * f0 * t), np.sin(2 * np.pi * f0 * t)
         coef, *_ = np.linalg.lstsq(np.column_stack([c, s, np.ones(n)]), x, rcond=None)
+        amp = float(math.hypot(coef[0], coef[1]))
+        s1 = float(med[k] / bias)  # the noise's one-sided PSD under the line
+        length = n / fs
+        # least squares in locally white noise of that level: SE(A) = √(S₁/T); Cramér–Rao for f0:
+        # σ_f = (f_s/2π)·√(6·S₁·f_s/(A²n³))
+        se_a = math.sqrt(s1 / length)
+        se_f = fs / (2 * math.pi) * math.sqrt(6 * s1 * fs / (max(amp, 1e-300) ** 2 * float(n) ** 3))
         out.append(
             {
                 "f0": f0,
-                "amplitude": float(math.hypot(coef[0], coef[1])),
+                "amplitude": amp,
+                "amplitude_interval": (max(0.0, amp - se_a), amp + se_a),
+                "f0_interval": (f0 - se_f, f0 + se_f),
                 "phase": float(math.atan2(coef[0], coef[1])),
                 "psd_ratio": float(ratio[k]),
                 "threshold": float(thr_all[k]),
@@ -239,6 +248,19 @@ def thin_indices(tau: np.ndarray, per_octave: int = 4) -> np.ndarray:
     return idx
 
 
+def _psd_cholesky(corr: np.ndarray) -> np.ndarray:
+    """Cholesky factor of a correlation matrix; if rounding (or the effects' approximate share of the
+    covariance) left it indefinite, of its nearest positive definite correlation (eigenvalues clipped)."""
+    try:
+        return np.linalg.cholesky(corr + 1e-9 * np.eye(corr.shape[0]))
+    except np.linalg.LinAlgError:
+        w, v = np.linalg.eigh(corr)
+        w = np.maximum(w, 1e-6 * max(float(w.max()), 1e-300))
+        c = (v * w) @ v.T
+        d = np.sqrt(np.diag(c))
+        return np.linalg.cholesky(c / np.outer(d, d) + 1e-9 * np.eye(corr.shape[0]))
+
+
 class ScoreTest:
     """GLS score statistic for one more non-negative column, and its bootstrap threshold.
 
@@ -263,8 +285,7 @@ class ScoreTest:
         else:
             lt = np.log2(tau)
             corr = OCTAVE_RHO ** np.abs(lt[:, None] - lt[None, :])
-        corr = 0.5 * (corr + corr.T) + 1e-9 * np.eye(tau.size)
-        self.corr_chol = np.linalg.cholesky(corr)
+        self.corr_chol = _psd_cholesky(0.5 * (corr + corr.T))
         self.nu = nu
         self.chol = self.corr_chol * sd[:, None]  # Σ = D R D
         xw = solve_triangular(self.chol, columns, lower=True) if columns.size else np.zeros((tau.size, 0))
