@@ -111,6 +111,17 @@ def test_clean_adis_run_names_its_bandwidth_not_sinusoids(shared_data):
     assert st.before["chi2_dof"] > 100 and st.after["chi2_dof"] < 2
 
 
+def test_adis_through_an_injected_decimation_filter(shared_data):
+    # the ADIS run filtered by a further 8-tap moving average: the cascade (−3 dB at 5.46 Hz) is named a
+    # bandwidth with its cutoff (the nearest of the family: a Bartlett FIR)
+    (y,) = _adis(shared_data, 5, ["gyro_y"])
+    z = signal.lfilter(np.ones(8) / 8, [1], y - y.mean())
+    r = allanite.refine(z, FS)
+    st = r.steps[0]
+    assert st.effect == "bandwidth" and abs(st.params["cutoff"] / 5.46 - 1) < 0.2
+    _falls(st)
+
+
 def test_adis_with_injected_sinusoid_at_0p02_hz(shared_data):
     # issue 16: run 5 y + 0.03 °/s at 0.02 Hz was not found with default arguments (f0 reported 1.54 Hz)
     (y,) = _adis(shared_data, 5, ["gyro_y"])

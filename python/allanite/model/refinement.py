@@ -411,7 +411,7 @@ def _bandwidth_grids(curve):
     if f_lo < f_hi:
         grids["single_pole"] = np.geomspace(f_lo, f_hi, 24)
     l_min = max(2, int(math.ceil(curve.tau[0] * fs / 3)))
-    l_max = int(max(2, min(64, 10 * curve.tau[0] * fs)))
+    l_max = int(max(2, min(64, 0.1 * curve.tau[-1] * fs)))
     if l_max > l_min:
         grids["moving_average"] = np.arange(l_min, l_max + 1, dtype=np.float64)
         grids["bartlett"] = np.arange(max(2, l_min // 2), max(3, l_max // 2) + 1, dtype=np.float64)

@@ -185,7 +185,7 @@ def drift_fit(y: np.ndarray, fs: float, n_blocks: int = DRIFT_BLOCKS) -> dict:
     return _drift_stat(b, tb, y.size / fs, with_interval=True)
 
 
-def drift_threshold(n: int, fs: float, terms, theta, alpha: float, n_boot: int = 400, seed: int = 0) -> float:
+def drift_threshold(n: int, fs: float, terms, theta, alpha: float, n_boot: int = 1000, seed: int = 0) -> float:
     """(1 − α) quantile of the drift statistic on records of the fitted five-term model (parametric bootstrap).
 
     Only the block means matter, so each record is simulated at the block rate (white rate, flicker and
