@@ -84,7 +84,7 @@ def test_finds_a_simulated_bandwidth():
 
 @pytest.mark.xfail(
     strict=True,
-    reason="the drift passes its calibrated test (statistic 1834 vs 727) but the held-out ADEV error of "
+    reason="the drift passes its calibrated test (time-domain bootstrap) but the held-out ADEV error of "
     "alternate blocks (τ ≤ block/9) does not fall, so it is not accepted — see docs/refinement.md, Limits",
 )
 def test_finds_a_simulated_warm_up_drift():
