@@ -8,12 +8,29 @@ the samples along time (``kind="time"``: change points). Adding an effect is one
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Effect", "EFFECTS", "gm_avar", "sinusoid_avar", "describe"]
+__all__ = [
+    "Effect",
+    "EFFECTS",
+    "gm_avar",
+    "sinusoid_avar",
+    "filtered_white_avar",
+    "filter_autocorrelation",
+    "filter_cutoff",
+    "drift_avar",
+    "describe",
+    "FILTERS",
+]
+
+#: Low-pass filters a "bandwidth" effect can be: a single pole (first-order IIR, impulse-invariant:
+#: a = e^{−2πf_c/f_s}), a moving average of L taps (the boxcar decimation filter of MEMS parts), and a
+#: Bartlett (triangular, two cascaded moving averages: 2L − 1 taps).
+FILTERS = ("single_pole", "moving_average", "bartlett")
 
 
 def gm_avar(tau: np.ndarray | float, tc: float) -> np.ndarray:
@@ -30,6 +47,70 @@ def sinusoid_avar(tau: np.ndarray | float, f0: float) -> np.ndarray:
     """Allan variance of a unit-amplitude rate sinusoid of frequency ``f0``: sin⁴(πf0τ)/(πf0τ)²."""
     u = np.pi * f0 * np.asarray(tau, dtype=np.float64)
     return np.sin(u) ** 4 / u**2
+
+
+def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
+    """Normalised autocorrelation r(l), l = 0, 1, …, of unit-DC-gain filtered white noise: Σ_l r(|l|) = 1.
+
+    ``kind`` one of :data:`FILTERS`; ``p`` the cutoff (Hz) for ``"single_pole"``, the length L (taps of one
+    moving average) for the FIRs."""
+    if kind == "single_pole":
+        a = math.exp(-2.0 * math.pi * p / fs)
+        n = int(min(200_000, math.ceil(40.0 / max(1.0 - a, 1e-9)))) + 1
+        return (1.0 - a) / (1.0 + a) * a ** np.arange(n, dtype=np.float64)
+    taps = max(1, int(round(p)))
+    h = np.full(taps, 1.0 / taps)
+    if kind == "bartlett":
+        h = np.convolve(h, h)
+    r = np.correlate(h, h, mode="full")[h.size - 1 :]
+    return r
+
+
+def filter_cutoff(kind: str, p: float, fs: float) -> float:
+    """−3 dB frequency (Hz) of a filter of :data:`FILTERS` (``p`` as in :func:`filter_autocorrelation`)."""
+    if kind == "single_pole":
+        return float(p)
+    r = filter_autocorrelation(kind, p, fs)
+    f = np.linspace(0.0, fs / 2.0, 4097)
+    lags = np.arange(1, r.size)
+    power = r[0] + 2.0 * np.cos(2.0 * np.pi * np.outer(f / fs, lags)) @ r[1:]
+    below = np.flatnonzero(power <= 0.5 * power[0])
+    return float(f[below[0]]) if below.size else float(fs / 2.0)
+
+
+def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float) -> np.ndarray:
+    """Allan variance of low-pass filtered white rate noise per unit N² — exact in discrete time.
+
+    σ²(m) = (1/2m²)·Σ_l A_m(l)·R(l) with A_m(l) = 2·tri_m(l) − tri_m(l − m) − tri_m(l + m) (tri_m(l) =
+    max(0, m − |l|): the autocorrelation of the Allan kernel of m ones then m minus ones) and R the
+    autocorrelation of the filtered samples; N² = σ²_w·τ0 of the white input. Unity DC gain, so the curve
+    tends to N²/τ for τ well above 1/f_c (the filter only reshapes the shortest τ)."""
+    tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
+    m = np.maximum(1.0, np.round(tau * fs))
+    r = filter_autocorrelation(kind, p, fs)
+    lag = np.arange(r.size, dtype=np.float64)
+
+    def tri(x: np.ndarray) -> np.ndarray:
+        return np.maximum(0.0, m[:, None] - np.abs(x))
+
+    a = 2.0 * tri(lag[None, :]) - tri(lag[None, :] - m[:, None]) - tri(lag[None, :] + m[:, None])
+    w = np.full(r.size, 2.0)
+    w[0] = 1.0
+    s = a @ (w * r)
+    return s / (2.0 * m * m) * fs  # σ_w² = N²·f_s
+
+
+def drift_avar(tau: np.ndarray | float, t_const: float, fs: float, n: int) -> np.ndarray:
+    """Overlapping Allan variance of a unit warm-up drift e^{−t/T} sampled at ``fs`` over ``n`` samples —
+    exact: block means at stride j are e^{−jτ0/T}·g, g = (1 − q^m)/(m(1 − q)), q = e^{−τ0/T}, so the M = n − 2m + 1
+    squared differences sum to g²(1 − q^m)²·(1 − q^{2M})/(1 − q²)."""
+    tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
+    m = np.maximum(1.0, np.round(tau * fs))
+    q = math.exp(-1.0 / (fs * t_const))
+    big_m = np.maximum(1.0, n - 2.0 * m + 1.0)
+    g = -np.expm1(m * math.log(q)) / (m * (1.0 - q))
+    geo = -np.expm1(2.0 * big_m * math.log(q)) / (1.0 - q * q)
+    return g * g * np.expm1(m * math.log(q)) ** 2 * geo / (2.0 * big_m)
 
 
 @dataclass(frozen=True)
@@ -51,11 +132,17 @@ class Effect:
     description : str
         What it is, with its Allan-variance form.
     signature : callable, optional
-        ``signature(tau, p)``: Allan variance per unit amplitude squared (curve effects).
+        ``signature(tau, p, fs)``: Allan variance per unit amplitude squared (curve effects).
     alpha : callable, optional
         ``alpha(tau, p)``: the power-law noise type it resembles at each τ (for the estimates' EDF).
     search : callable, optional
         ``search(tau_min, tau_max)``: the grid of the nonlinear parameter to search.
+    domain : str
+        Where it is traced: "allan" (the curve's residual), "psd" (Welch periodogram), "time" (the samples
+        along time), "channels" (other channels of the log).
+    replaces : str, optional
+        The term whose column the effect's column replaces ("N" for a bandwidth: the filtered white noise
+        *is* the white rate noise).
     """
 
     name: str
@@ -63,9 +150,11 @@ class Effect:
     kind: str
     params: tuple[tuple[str, str, str], ...]
     description: str
-    signature: Callable[[np.ndarray, float], np.ndarray] | None = None
+    signature: Callable[[np.ndarray, float, float], np.ndarray] | None = None
     alpha: Callable[[np.ndarray, float], np.ndarray] | None = None
     search: Callable[[float, float], np.ndarray] | None = None
+    domain: str = "allan"
+    replaces: str | None = None
 
     @property
     def param_names(self) -> tuple[str, ...]:
@@ -84,21 +173,62 @@ EFFECTS: dict[str, Effect] = {
                 ("tc", "s", "correlation time T_c"),
             ),
             "first-order Gauss–Markov rate: σ²·(T_c/τ)²·(2τ/T_c − 3 + 4e^{−τ/T_c} − e^{−2τ/T_c}); a bump near "
-            "τ ≈ 1.89·T_c, T_c searched in [τ_min, τ_max/4] so the bump lies inside the curve",
-            signature=gm_avar,
+            "τ ≈ 1.89·T_c, T_c searched in [5·τ_min, τ_max/4] so the bump lies inside the curve (a shorter T_c is "
+            "a roll-off of the shortest τ: the bandwidth)",
+            signature=lambda tau, tc, fs: gm_avar(tau, tc),
             alpha=lambda tau, tc: np.where(tau < tc, -2, 0),
-            search=lambda tmin, tmax: np.geomspace(tmin, tmax / 4.0, 40),
+            search=lambda tmin, tmax: np.geomspace(5.0 * tmin, tmax / 4.0, 40),
         ),
         Effect(
             "sinusoid",
             "sinusoid",
             "curve",
             (("amplitude", "rate unit", "amplitude A of the rate sinusoid"), ("f0", "Hz", "frequency f0")),
-            "rate sinusoid A·sin(2πf0t): A²·sin⁴(πf0τ)/(πf0τ)², nulls at τ = k/f0; f0 ≥ 2/τ_max so that two "
-            "nulls fall inside the curve",
-            signature=sinusoid_avar,
+            "rate sinusoid A·sin(2πf0t): A²·sin⁴(πf0τ)/(πf0τ)², nulls at τ = k/f0. With samples it is found as a "
+            "line of the Welch PSD (a bin above its neighbours' median beyond the χ² quantile of the Welch "
+            "average, Bonferroni over the bins), f0 refined on the periodogram, A and phase by least squares; "
+            "on a curve only, f0 ≥ 2/τ_max so that two nulls fall inside it",
+            signature=lambda tau, f0, fs: sinusoid_avar(tau, f0),
             alpha=lambda tau, f0: np.zeros(np.asarray(tau).size, dtype=int),
             search=lambda tmin, tmax: np.geomspace(2.0 / tmax, 0.5 / tmin, 120),
+            domain="psd",
+        ),
+        Effect(
+            "bandwidth",
+            "sensor bandwidth (low-pass)",
+            "curve",
+            (
+                ("cutoff", "Hz", "−3 dB frequency of the low-pass on the rate noise"),
+                ("taps", "samples", "FIR length (moving average L, Bartlett 2L − 1); 0 for a single pole"),
+            ),
+            "the sensor's low-pass on its white rate noise (single pole, or the moving-average/Bartlett FIR of a "
+            "decimating MEMS part): N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, replacing N²/τ — a "
+            "roll-off of the shortest τ; the N it reports is the white noise before the filter",
+            signature=None,
+            alpha=lambda tau, p: np.zeros(np.asarray(tau).size, dtype=int),
+            search=None,
+            replaces="N",
+        ),
+        Effect(
+            "drift",
+            "warm-up drift",
+            "time",
+            (("amplitude", "rate unit", "amplitude a of a·e^{−t/T} at t = 0"), ("T", "s", "time constant T")),
+            "an exponential warm-up a·e^{−t/T} of the rate, fitted to block means along the record (T from "
+            "L/200 to L/2; a constant slope stays the R term); its Allan variance in closed form",
+            domain="time",
+        ),
+        Effect(
+            "regression",
+            "regression on another channel",
+            "time",
+            (
+                ("channel", "", "name of the other channel (as passed in channels=)"),
+                ("coefficient", "rate unit per channel unit", "sensitivity: g-sensitivity, temperature, coupling"),
+            ),
+            "the rate regressed on another channel of the log (least squares on the de-meaned samples), "
+            "removed before the noise fit; its Allan variance is the coefficient² times the channel's",
+            domain="channels",
         ),
         Effect(
             "change_point",
@@ -107,6 +237,7 @@ EFFECTS: dict[str, Effect] = {
             (("t", "s", "time of a step in the noise level, from the start of the record"),),
             "a step in the Allan variance of non-overlapping windows along the record (all τ jointly), located "
             "to the sample by a two-segment likelihood; needs the samples",
+            domain="time",
         ),
     )
 }

@@ -1,32 +1,36 @@
 """Close the loop: find what a fitted noise model lacks, add that effect, report the error before and after.
 
 :func:`refine` fits the starting IEEE-952 model (weighted least squares in variance space, as
-:func:`allanite.fit`), looks at the normalised residual per τ, and tries each candidate effect by its
-Allan-variance signature (closed forms, ``docs/FORMULAS.md`` §5 and the references below):
+:func:`allanite.fit`), then traces what it leaves in more than one domain and tries each candidate effect
+of the registry :data:`allanite.model.effects.EFFECTS`:
 
-- ``"gauss_markov"`` — first-order Gauss–Markov rate of variance σ² and correlation time T_c:
-  σ²_A(τ) = σ²·(T_c/τ)²·(2τ/T_c − 3 + 4e^{−τ/T_c} − e^{−2τ/T_c}) (IEEE Std 952 App. C; a bump that
-  peaks near τ ≈ 1.89·T_c, K-like below, N-like above; T_c in [τ_min, τ_max/4] so that the bump lies
-  inside the curve — a "T_c" below the shortest τ would only describe a roll-off there, e.g. an
-  anti-alias filter's);
-- ``"sinusoid"`` — a rate sinusoid of amplitude A and frequency f0: σ²_A(τ) = A²·sin⁴(πf0τ)/(πf0τ)²
-  (nulls at τ = k/f0). Only f0 ≥ 2/τ_max are tried: a sinusoid is told apart from a Gauss–Markov bump
-  by its nulls, so at least two (τ = 1/f0, 2/f0) must fall inside the curve (a best f0 or T_c at the
-  edge of its search range is not taken as identified);
-- ``"change_point"`` — nonstationarity: the Allan variance of non-overlapping windows is tested for a
-  step in level along the record (all τ jointly), located at sample resolution by the two-segment
-  likelihood of the squared differences at the τ where the step is strongest, with a 2-unit support
-  interval; repeated on each side (binary segmentation).
+- on the **Allan curve**, by signature (closed forms, ``docs/FORMULAS.md`` §5): ``"bandwidth"`` — the
+  sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett FIR), exact in
+  discrete time, replacing the N column; ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4]; and, for
+  curve-only input, ``"sinusoid"`` (nulls at τ = k/f0, f0 ≥ 2/τ_max);
+- in the **PSD** (Welch) for spectral lines: ``"sinusoid"`` with f0 from the periodogram peak, refined;
+- in **time**: ``"drift"`` (warm-up a·e^{−t/T} on block means) and ``"change_point"`` (steps of the noise
+  level along the record);
+- in **other channels** of the log (``channels=``): ``"regression"`` — the rate regressed on each.
 
-Nonlinear parameters (T_c, f0) are found by a grid search with the linear coefficients by weighted
-NNLS at each grid point, then refined by a bounded scalar search; their intervals come from the
-profile of χ² (Δχ²_eff = 1). A candidate is accepted only if it earns its parameters by BIC on an
-*effective* χ²: the τ estimates are correlated, so χ² is scaled by n_eff/n with n_eff the number of
-octaves the curve spans (``fit`` thins to octaves for the same reason), and the penalty is
-k·ln(n_eff) per added parameter pair, plus a floor so that chance wiggles on a clean record are not
-modelled (calibrated on clean simulated records: ≤ 5 % false alarms, see ``tests/test_refine.py``); the
-effect must also lower χ²/dof.
-The loop stops when χ²/dof ≤ 1.5 or no candidate earns its parameters.
+Every effect enters the model as a non-negative column of Allan variance (time-domain ones through their
+own Allan variance: c²·AVAR(channel), a²·AVAR(e^{−t/T})). A candidate is **accepted** only if
+
+1. a calibrated test says the residual asks for it: the GLS score statistic on ~4 τ per octave with the
+   covariance of the estimates across τ (exact for the five terms, :mod:`allanite.model._covariance`),
+   above the (1 − α) quantile of its maximum over all candidate families under the fitted model
+   (parametric bootstrap, :class:`allanite.model.tracing.ScoreTest`); spectral lines by their own
+   χ² test on the Welch PSD (Bonferroni over the bins); α splits the per-record ``level``;
+2. its parameter is not pinned at the edge of its search range and its amplitude is positive;
+3. χ²/dof of the dense curve falls; and
+4. the **held-out** error falls: the model with and without it is fitted on one half of the record and
+   predicts the other half's Allan curve (both ways, RMS ADEV error averaged); time-localised effects
+   (drift) by alternate blocks in time (8 blocks: odd ones predict even ones and back). Curve-only input
+   has no held-out error (reported as None) and relies on the calibrated test.
+
+Nonlinear parameters (T_c, cutoff, f0 on curves) are found by a grid search with the linear coefficients
+by weighted NNLS at each grid point, then refined by a bounded scalar search; their intervals come from the
+profile of χ² (Δχ²_eff = 1). The loop stops when no candidate is accepted or after ``MAX_STEPS`` effects.
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.stats import chi2 as chi2_dist
+from scipy.stats import t as t_dist
 
 from .._display import RichDisplay, Summary, Table, fmt_ci, thin
 from .._progress import StepBar
@@ -45,31 +50,70 @@ from ..analysis import avar, davar
 from ..errors import ParameterError
 from ..estimators.grid import tau_grid
 from ..results import AllanResult
-from . import fitting
-from .effects import EFFECTS, describe, gm_avar, sinusoid_avar
+from . import fitting, tracing
+from .effects import (
+    EFFECTS,
+    describe,
+    drift_avar,
+    filter_cutoff,
+    filtered_white_avar,
+    gm_avar,
+    sinusoid_avar,
+)
 from .terms import TERM_ALPHA, check_terms, design_matrix
 
-__all__ = ["refine", "Refinement", "Step", "gm_avar", "sinusoid_avar", "CANDIDATES"]
+__all__ = ["refine", "Refinement", "Step", "gm_avar", "sinusoid_avar", "CANDIDATES", "LEVEL"]
 
 #: Effects refine can add, from the registry in :mod:`allanite.model.effects`.
 CANDIDATES = tuple(EFFECTS)
-#: Stop refining once the model is this good (χ²/dof of the diagonal-weighted residuals).
-GOOD_CHI2_DOF = 1.5
-#: Minimum improvement of the effective χ² (beyond the BIC penalty) to accept an effect.
-MIN_GAIN = 6.0
+#: Default false-alarm level per record (clean record: probability that anything is added).
+LEVEL = 0.05
+#: Share of ``level`` spent on spectral lines (the rest on the Allan-curve families and change points).
+LINE_SHARE = 0.2
+CHANGE_POINT_SHARE = 0.2
 MAX_STEPS = 4
+N_BOOT = 1000
+#: Blocks for the held-out error of time-localised effects (odd blocks predict even ones and back).
+HELDOUT_BLOCKS = 8
+#: A bandwidth that raises the held-out error alone may enter with a Gauss–Markov term if its statistic is
+#: at least this multiple of the threshold.
+PAIR_FACTOR = 100.0
+#: Share of ``level`` for each time-domain test (regression on channels, drift).
+TIME_SHARE = 0.075
+#: Blocks of the jackknife of a regression coefficient (t with blocks − 1 degrees of freedom).
+REGRESSION_BLOCKS = 8
+#: Held-out error: only τ whose held-out ADEV estimate is within ±10 % (EDF ≥ 50, white rate noise).
+HELDOUT_MIN_EDF = 50.0
+#: Kept for the change-point test's penalty (calibrated with it on clean records).
+MIN_GAIN = 6.0
 
 
-def _column(effect, p, tau):
-    sig = EFFECTS[effect].signature
+def _base(key: str) -> str:
+    return key.split(":", 1)[0]
+
+
+def _column(key, p, curve):
+    """Allan variance per unit amplitude² of effect ``key`` with nonlinear parameter ``p`` on ``curve``."""
+    base = _base(key)
+    tau = curve.tau
+    if base == "bandwidth":
+        return filtered_white_avar(tau, key.split(":", 1)[1], p, curve.fs)
+    if base == "drift":
+        return sum(
+            math.exp(-2.0 * s0 / (curve.fs * p)) * drift_avar(tau, p, curve.fs, nb) for s0, nb in curve.blocks
+        ) / len(curve.blocks)
+    if base == "regression":
+        return curve.channels[key.split(":", 1)[1]]
+    sig = EFFECTS[base].signature
     assert sig is not None
-    return sig(tau, p)
+    return sig(tau, p, curve.fs)
 
 
-def _alpha_of(effect, p, tau):
+def _alpha_of(key, p, tau):
     """Noise type each effect resembles at τ, for the EDF of the estimates."""
-    alpha = EFFECTS[effect].alpha
-    assert alpha is not None
+    alpha = EFFECTS[_base(key)].alpha
+    if alpha is None:
+        return np.zeros(tau.size, dtype=int)
     return alpha(tau, p)
 
 
@@ -78,11 +122,14 @@ def _alpha_of(effect, p, tau):
 
 
 class _Curve:
-    """One Allan curve to fit: τ, m, estimates, record length, estimator (for the EDF)."""
+    """One Allan curve to fit: τ, m, estimates, record length, estimator (for the EDF); the blocks of
+    samples it averages ([(first sample, samples)]) and the channels' Allan curves on it."""
 
-    def __init__(self, tau, m, avar, fs, n_points, estimator):
+    def __init__(self, tau, m, avar, fs, n_points, estimator, blocks=None, channels=None):
         self.tau, self.m, self.avar = tau, m, avar
         self.fs, self.n_points, self.estimator = fs, n_points, estimator
+        self.blocks = blocks or [(0, n_points - 1)]
+        self.channels = channels or {}
         self._edf = {}
         self.n_eff = max(2.0, math.log2(tau[-1] / tau[0]) + 1.0)
 
@@ -90,6 +137,19 @@ class _Curve:
         if alpha not in self._edf:
             self._edf[alpha] = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
         return self._edf[alpha]
+
+    def subset(self, idx):
+        c = _Curve(
+            self.tau[idx],
+            self.m[idx],
+            self.avar[idx],
+            self.fs,
+            self.n_points,
+            self.estimator if isinstance(self.estimator, str) else tuple(np.asarray(self.estimator)[idx]),
+            self.blocks,
+            {k: v[idx] for k, v in self.channels.items()},
+        )
+        return c
 
 
 @dataclass
@@ -111,15 +171,22 @@ class _Solution:
         return self.chi2 * curve.n_eff / curve.tau.size
 
 
-def _solve(curve: _Curve, terms, effects, max_iter: int = 40) -> _Solution:
-    """IRLS weighted NNLS of the terms plus effects [(name, nonlinear parameter)]."""
+def _design(curve, terms, effects):
     tau = curve.tau
-    cols = [design_matrix(tau, tau * curve.fs, curve.fs, terms)]
-    alphas = [np.full(tau.size, TERM_ALPHA[t]) for t in terms]
-    for name, p in effects:
-        cols.append(_column(name, p, tau)[:, None])
-        alphas.append(_alpha_of(name, p, tau))
-    a = np.hstack(cols)
+    a0 = design_matrix(tau, tau * curve.fs, curve.fs, terms)
+    for key, _p in effects:
+        rep = EFFECTS[_base(key)].replaces
+        if rep in terms:
+            a0[:, list(terms).index(rep)] = 0.0
+    cols = [a0] + [_column(key, p, curve)[:, None] for key, p in effects]
+    alphas = [np.full(tau.size, TERM_ALPHA[t]) for t in terms] + [_alpha_of(k, p, tau) for k, p in effects]
+    return np.hstack(cols), alphas
+
+
+def _solve(curve: _Curve, terms, effects, max_iter: int = 40) -> _Solution:
+    """IRLS weighted NNLS of the terms plus effects [(key, nonlinear parameter)]."""
+    tau = curve.tau
+    a, alphas = _design(curve, terms, effects)
     nu_cols = np.column_stack(
         [
             np.where(
@@ -141,7 +208,7 @@ def _solve(curve: _Curve, terms, effects, max_iter: int = 40) -> _Solution:
         new = fitting.nnls(a * sw[:, None], y * sw)
         parts = a * new
         new_model = np.maximum(parts.sum(axis=1), floor)
-        done = np.allclose(new, theta, rtol=1e-7, atol=0.0)
+        done = np.allclose(new, theta, rtol=1e-6, atol=0.0)
         model = new_model if it == 0 else np.sqrt(model * new_model)
         theta = new
         if new.any():
@@ -163,20 +230,96 @@ def _solve(curve: _Curve, terms, effects, max_iter: int = 40) -> _Solution:
     return _Solution(theta, model, nu, z, float(np.sum(z**2)), dof, a, cov)
 
 
-def _metrics(sol: _Solution) -> dict:
-    return {"chi2_dof": sol.chi2_dof, "rms_z": float(np.sqrt(np.mean(sol.z**2)))}
+def _rms_adev_pct(obs, model) -> float:
+    return float(100 * np.sqrt(np.mean((np.sqrt(obs / model) - 1) ** 2)))
 
 
-def _curve_metrics(curve: _Curve, sol: _Solution) -> dict:
-    out = _metrics(sol)
-    out["rms_adev_pct"] = float(100 * np.sqrt(np.mean((np.sqrt(curve.avar / sol.model) - 1) ** 2)))
-
-    out["p_value"] = float(chi2_dist.sf(sol.chi2_eff(curve), max(1.0, curve.n_eff - 1)))
-    return out
+def _curve_metrics(curve: _Curve, sol: _Solution, heldout) -> dict:
+    return {
+        "chi2_dof": sol.chi2_dof,
+        "rms_z": float(np.sqrt(np.mean(sol.z**2))),
+        "rms_adev_pct": _rms_adev_pct(curve.avar, sol.model),
+        "p_value": float(chi2_dist.sf(sol.chi2_eff(curve), max(1.0, curve.n_eff - 1))),
+        "heldout_rms_adev_pct": heldout,
+    }
 
 
 # ----------------------------------------------------------------------------------------------
-# candidates
+# held-out error
+
+
+class _Split:
+    """Two complementary sets of blocks of the record, each with its averaged Allan curve."""
+
+    def __init__(self, y, fs, grid_m, lo, hi, estimator, channels, n_blocks):
+        n = y.size
+        per = n // n_blocks
+        self.parts = []
+        for parity in (0, 1):
+            blocks = [(j * per, per) for j in range(n_blocks) if j % 2 == parity]
+            m = grid_m[grid_m <= per // 9]
+            if m.size < 8:
+                raise ValueError("record too short for held-out blocks")
+            av = np.mean([avar(y[s : s + nb], fs, taus=m / fs).avar for s, nb in blocks], axis=0)
+            chans = {
+                k: np.mean([avar(c[s : s + nb], fs, taus=m / fs).avar for s, nb in blocks], axis=0)
+                for k, c in channels.items()
+            }
+            tau = m / fs
+            keep = (tau >= lo) & (tau <= hi) & (av > 0)
+            self.parts.append(
+                _Curve(
+                    tau[keep],
+                    m[keep].astype(np.float64),
+                    av[keep],
+                    fs,
+                    per + 1,
+                    estimator,
+                    blocks,
+                    {k: v[keep] for k, v in chans.items()},
+                )
+            )
+        common = min(p.tau.size for p in self.parts)
+        self.parts = [p.subset(np.arange(common)) for p in self.parts]
+        # score only the τ whose held-out estimate is itself informative (ADEV ±10 %: EDF ≥ 50 for white
+        # rate noise); beyond, the other part's own scatter (flicker, random walk) would decide the score
+        # and weigh every octave alike (4 τ per octave), not the dense grid's points
+        scored = np.zeros(common, dtype=bool)
+        scored[tracing.thin_indices(self.parts[0].tau)] = True
+        self.scored = scored & (self.parts[0].edf(0) >= HELDOUT_MIN_EDF)
+
+    def error(self, terms, effects) -> float:
+        """RMS ADEV error (%) of the model fitted on one part predicting the other, averaged both ways."""
+        errs = []
+        for f, h in ((0, 1), (1, 0)):
+            sol = _solve(self.parts[f], terms, effects)
+            a_h, _ = _design(self.parts[h], terms, effects)
+            pred = np.maximum(a_h @ sol.theta, 1e-300)
+            sc = self.scored
+            errs.append(_rms_adev_pct(self.parts[h].avar[sc], pred[sc]))
+        return float(np.mean(errs))
+
+
+def _theta_terms(sol, terms, effects):
+    """Squared coefficients of the terms (a bandwidth's N in place of the zeroed N column)."""
+    k = len(terms)
+    theta = sol.theta[:k].copy()
+    for j, (key, _p) in enumerate(effects):
+        if EFFECTS[_base(key)].replaces == "N" and "N" in terms:
+            theta[list(terms).index("N")] = sol.theta[k + j]
+    return theta
+
+
+def _splits(y, fs, m_all, lo, hi):
+    """Halves and alternate blocks of the record for the held-out error, or (None, None) if too short."""
+    try:
+        return _Split(y, fs, m_all, lo, hi, "oavar", {}, 2), _Split(y, fs, m_all, lo, hi, "oavar", {}, HELDOUT_BLOCKS)
+    except ValueError:
+        return None, None
+
+
+# ----------------------------------------------------------------------------------------------
+# candidates on the curve
 
 
 def _residual_evidence(curve, sol) -> dict:
@@ -204,26 +347,28 @@ def _residual_evidence(curve, sol) -> dict:
     return {"runs_beyond_2sigma": runs, "max_abs_z": float(abs(z[k])), "tau_of_max": float(curve.tau[k])}
 
 
-def _search(curve, terms, effects, name, grid):
-    """Best nonlinear parameter for effect ``name`` on ``grid`` (then refined), its solution and profile."""
+def _search(curve, terms, effects, key, grid, continuous=True):
+    """Best nonlinear parameter for effect ``key`` on ``grid`` (then refined), its solution and profile."""
 
-    chis = np.array([_solve(curve, terms, effects + [(name, p)]).chi2 for p in grid])
+    chis = np.array([_solve(curve, terms, effects + [(key, p)]).chi2 for p in grid])
     k = int(np.argmin(chis))
     lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
-    if hi > lo:
+    p = float(grid[k])
+    if continuous and hi > lo:
         res = minimize_scalar(
-            lambda lp: _solve(curve, terms, effects + [(name, math.exp(lp))]).chi2,
+            lambda lp: _solve(curve, terms, effects + [(key, math.exp(lp))]).chi2,
             bounds=(lo, hi),
             method="bounded",
-            options={"xatol": 1e-4},
+            options={"xatol": 1e-3},
         )
         p = math.exp(res.x)
-    else:
-        p = float(grid[k])
-    sol = _solve(curve, terms, effects + [(name, p)])
+    sol = _solve(curve, terms, effects + [(key, p)])
     if sol.chi2 > chis[k]:
-        p, sol = float(grid[k]), _solve(curve, terms, effects + [(name, float(grid[k]))])
-    return p, sol, (grid, chis)
+        p, sol = float(grid[k]), _solve(curve, terms, effects + [(key, float(grid[k]))])
+    # a best value at the edge of its range is not identified — except a FIR's shortest length (2 taps):
+    # below it lies "no filter", which is the null model itself
+    at_edge = (k == 0 and continuous) or k == grid.size - 1
+    return p, sol, at_edge
 
 
 #: Octave-to-octave correlation of Allan estimates used for the parameters' effective sample size
@@ -231,15 +376,15 @@ def _search(curve, terms, effects, name, grid):
 PROFILE_RHO = 0.68
 
 
-def _profile_interval(curve, terms, effects, name, p, sol, grid_chis):
+def _profile_interval(curve, terms, effects, key, p, sol):
     """Interval of the nonlinear parameter where the effective χ² rises by ≤ 1 over its minimum.
 
     χ² of the dense, correlated τ points is scaled to n_eff·(1 − ρ)/(1 + ρ) independent ones (n_eff
     octaves whose estimates correlate by ρ = ``PROFILE_RHO`` from one to the next); the crossings are
-    interpolated on a fine log grid around the best value."""
+    interpolated on a log grid around the best value."""
     scale = curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / curve.tau.size
-    local = p * np.exp(np.linspace(-1.5, 1.5, 121))
-    lc = np.array([_solve(curve, terms, effects + [(name, q)]).chi2 for q in local])
+    local = p * np.exp(np.linspace(-1.5, 1.5, 41))
+    lc = np.array([_solve(curve, terms, effects + [(key, q)]).chi2 for q in local])
     d = (lc - min(sol.chi2, lc.min())) * scale - 1.0
     i0 = int(np.argmin(d))
     lo_i, hi_i = i0, i0
@@ -257,47 +402,42 @@ def _profile_interval(curve, terms, effects, name, p, sol, grid_chis):
     return (min(lo, p), max(hi, p))
 
 
-def _joint(curve, terms, effects, sol, passes: int = 3):
-    """Re-estimate every effect's nonlinear parameter with the others held (coordinate descent): an
-    effect added first may have absorbed part of a later one's signature."""
-
-    effects = list(effects)
-    for _ in range(passes):
-        moved = False
-        for i, (name, p) in enumerate(effects):
-
-            def chi(lp, i=i, name=name):
-                trial = effects[:i] + [(name, math.exp(lp))] + effects[i + 1 :]
-                return _solve(curve, terms, trial).chi2
-
-            res = minimize_scalar(
-                chi, bounds=(math.log(p) - 1.5, math.log(p) + 1.5), method="bounded", options={"xatol": 1e-4}
-            )
-            if res.fun < sol.chi2 - 1e-9:
-                effects[i] = (name, math.exp(res.x))
-                sol = _solve(curve, terms, effects)
-                moved = moved or abs(res.x - math.log(p)) > 1e-3
-        if not moved:
-            break
-    return effects, sol
+def _bandwidth_grids(curve):
+    """Search grids per filter kind: single-pole cutoffs whose roll-off falls inside the curve, FIR lengths."""
+    # the roll-off must reach into the curve: a time constant (or FIR span) of at least a third of the
+    # shortest τ — a faster filter leaves no mark on it
+    fs = curve.fs
+    f_lo = 1.0 / (2 * math.pi * 10 * curve.tau[0])
+    f_hi = min(0.45 * fs, 3.0 / (2 * math.pi * curve.tau[0]))
+    grids = {}
+    if f_lo < f_hi:
+        grids["single_pole"] = np.geomspace(f_lo, f_hi, 24)
+    l_min = max(2, int(math.ceil(curve.tau[0] * fs / 3)))
+    l_max = int(max(2, min(64, 0.1 * curve.tau[-1] * fs)))
+    if l_max > l_min:
+        grids["moving_average"] = np.arange(l_min, l_max + 1, dtype=np.float64)
+        grids["bartlett"] = np.arange(max(2, l_min // 2), max(3, l_max // 2) + 1, dtype=np.float64)
+    return grids
 
 
-def _update_steps(steps, curve, terms, effects, sol, truth):
-    """Steps' parameters and intervals from the joint solution (in the order the effects were added)."""
-    k = len(terms)
-    curve_steps = [st for st in steps if EFFECTS[st.effect].kind == "curve"]
-    for j, (st, (name, p)) in enumerate(zip(curve_steps, effects)):
-        i = k + j
-        amp = math.sqrt(max(sol.theta[i], 0.0))
-        var_i = sol.cov[i, i]
-        sd = math.sqrt(max(var_i, 0.0)) / (2 * amp) if amp > 0 and np.isfinite(var_i) else float("nan")
-        others = effects[:j] + effects[j + 1 :]
-        names = EFFECTS[name].param_names
-        p_int = _profile_interval(curve, terms, others, name, p, sol, None)
-        st.params = {names[0]: amp, names[1]: p}
-        st.intervals = {names[0]: (max(0.0, amp - sd), amp + sd), names[1]: p_int}
-        if truth and name in truth:
-            st.truth_error = {kk: st.params[kk] / v - 1 for kk, v in truth[name].items() if kk in st.params}
+def _families(curve, candidates, has_samples, channel_names, drift_grid):
+    """Every column the curve-domain candidates could add, for the bootstrap of the maximum statistic."""
+    fam = []
+    tmin, tmax = curve.tau[0], curve.tau[-1]
+    if "gauss_markov" in candidates:
+        search = EFFECTS["gauss_markov"].search
+        assert search is not None
+        fam += [_column("gauss_markov", p, curve) for p in search(tmin, tmax)]
+    if "bandwidth" in candidates:
+        for kind, grid in _bandwidth_grids(curve).items():
+            fam += [_column(f"bandwidth:{kind}", p, curve) - 1.0 / curve.tau for p in grid]
+    if "sinusoid" in candidates and not has_samples:
+        fam += [_column("sinusoid", p, curve) for p in np.geomspace(2.0 / tmax, 0.5 / tmin, 120)]
+    if "drift" in candidates and drift_grid is not None:
+        fam += [_column("drift", p, curve) for p in drift_grid]
+    if "regression" in candidates:
+        fam += [curve.channels[c] for c in channel_names]
+    return np.column_stack(fam) if fam else np.zeros((curve.tau.size, 0))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -430,11 +570,14 @@ def _locate(y, m, fs):
 class Step:
     """One effect added by :func:`refine`.
 
-    ``params`` in the input unit's base form (Gauss–Markov: ``sigma`` rate unit, ``tc`` s; sinusoid:
-    ``amplitude`` rate unit, ``f0`` Hz; change point: ``t`` s); ``intervals`` the same keys →
-    (low, high); ``before``/``after``: ``chi2_dof``, ``rms_z``, ``rms_adev_pct`` (and ``p_value``
-    for curve effects); ``evidence``: where in τ or t the residual was; ``truth_error``: relative
-    parameter errors when ``truth`` was given.
+    ``params`` in the input unit's base form (see :data:`allanite.model.effects.EFFECTS` for each
+    effect's parameters and units: Gauss–Markov ``sigma`` rate unit, ``tc`` s; sinusoid ``amplitude``
+    rate unit, ``f0`` Hz; bandwidth ``cutoff`` Hz, ``taps``, ``filter``; drift ``amplitude`` rate unit,
+    ``T`` s; regression ``channel``, ``coefficient`` rate unit per channel unit; change point ``t`` s);
+    ``intervals`` the numeric keys → (low, high); ``before``/``after``: ``chi2_dof``, ``rms_z``,
+    ``rms_adev_pct``, ``p_value`` and ``heldout_rms_adev_pct`` (None for curve-only input and change
+    points); ``evidence``: where in τ, f or t the residual was and the test that accepted it;
+    ``truth_error``: relative parameter errors when ``truth`` was given.
     """
 
     effect: str
@@ -450,7 +593,8 @@ class Step:
 @dataclass
 class Refinement(RichDisplay):
     """What :func:`refine` found. ``fit`` is the final model (a NoiseFit whose ``coefficients`` also
-    hold the added effects' parameters), ``start`` the starting model, ``steps`` the effects added."""
+    hold the added effects' parameters), ``start`` the starting model, ``steps`` the effects added.
+    ``heldout_note`` says how (or why not) the held-out error was computed."""
 
     steps: list
     fit: fitting.NoiseFit
@@ -460,6 +604,9 @@ class Refinement(RichDisplay):
     effects: list = field(default_factory=list)
     change_points: list = field(default_factory=list)
     considered: dict = field(default_factory=dict)
+    heldout_note: str = ""
+    start_heldout_rms_adev_pct: float | None = None
+    tau_range: tuple = (0.0, math.inf)
 
     @property
     def found(self) -> list:
@@ -468,19 +615,22 @@ class Refinement(RichDisplay):
     def report(self) -> str:
         """Markdown: the starting residual, each step with its parameters, evidence and errors."""
         s0 = self.start
+        ho = self.start_heldout_rms_adev_pct
         lines = [
             "# Model refinement",
             "",
             f"Starting model {'+'.join(self.terms)}: χ²/dof = {s0.chi2_dof:.3g}, "
-            f"RMS z = {np.sqrt(np.mean(s0.z**2)):.3g}.",
+            f"RMS z = {np.sqrt(np.mean(s0.z**2)):.3g}, RMS ADEV error = "
+            f"{_rms_adev_pct(s0.avar, s0.model):.3g} %, held-out RMS ADEV error = "
+            + (f"{ho:.3g} %." if ho is not None else "n/a."),
+            "",
+            f"Held-out error: {self.heldout_note}",
             "",
         ]
         if not self.steps:
             lines.append("Nothing added: the residual is consistent with noise or no candidate earned its parameters.")
         for i, st in enumerate(self.steps, 1):
-            ps = ", ".join(
-                f"{k} = {v:.4g} [{st.intervals[k][0]:.4g}, {st.intervals[k][1]:.4g}]" for k, v in st.params.items()
-            )
+            ps = ", ".join(_fmt_param(k, v, st.intervals.get(k)) for k, v in st.params.items())
             lines += [
                 f"## Step {i}: {st.effect}",
                 "",
@@ -488,7 +638,8 @@ class Refinement(RichDisplay):
                 f"- evidence: {st.evidence}",
                 "- before → after: "
                 + ", ".join(
-                    f"{k} {st.before[k]:.3g} → {st.after[k]:.3g}" for k in ("chi2_dof", "rms_z", "rms_adev_pct")
+                    f"{k} {_fmt(st.before.get(k))} → {_fmt(st.after.get(k))}"
+                    for k in ("chi2_dof", "rms_z", "rms_adev_pct", "heldout_rms_adev_pct")
                 ),
                 "",
             ]
@@ -587,19 +738,41 @@ class Refinement(RichDisplay):
         return fig
 
 
+def _fmt(v) -> str:
+    return "n/a" if v is None else f"{v:.3g}"
+
+
+def _fmt_param(k, v, iv) -> str:
+    if isinstance(v, str):
+        return f"{k} = {v}"
+    if iv is None:
+        return f"{k} = {v:.4g}"
+    return f"{k} = {v:.4g} [{iv[0]:.4g}, {iv[1]:.4g}]"
+
+
 def _noise_fit(curve, terms, effects, sol, result, unit, confidence):
     """A NoiseFit for the solution, with the effects' parameters among the coefficients."""
     zq = fitting.z_quantile(confidence)
     k = len(terms)
     inflate = max(1.0, math.sqrt(sol.chi2_dof))
-    coeffs = fitting.coefficients(terms, sol.theta[:k], sol.cov[:k, :k], zq, inflate, unit)
+    theta = sol.theta[:k].copy()
+    cov = sol.cov[:k, :k].copy()
+    # a bandwidth carries the white rate noise N (before the filter): report it as N
+    for j, (key, _p) in enumerate(effects):
+        if EFFECTS[_base(key)].replaces == "N" and "N" in terms:
+            i_n = list(terms).index("N")
+            theta[i_n] = sol.theta[k + j]
+            cov[i_n, :] = cov[:, i_n] = np.nan
+            cov[i_n, i_n] = sol.cov[k + j, k + j]
+    coeffs = fitting.coefficients(terms, theta, cov, zq, inflate, unit)
     comps = {t: sol.a[:, i] * sol.theta[i] for i, t in enumerate(terms)}
-    for j, (name, _param) in enumerate(effects):
+    for j, (key, _param) in enumerate(effects):
         i = k + j
-        key = f"{name}{j + 1}" if sum(e[0] == name for e in effects) > 1 else name
-        comps[key] = sol.a[:, i] * sol.theta[i]
-        coeffs[key] = fitting.Coefficient(
-            name=key,
+        name = _base(key) if _base(key) != "regression" else key.replace(":", "_")
+        name = f"{name}{j + 1}" if sum(_base(e[0]) == _base(key) for e in effects) > 1 else name
+        comps[name] = sol.a[:, i] * sol.theta[i]
+        coeffs[name] = fitting.Coefficient(
+            name=name,
             value=float(math.sqrt(max(sol.theta[i], 0.0))),
             ci=fitting.interval(sol.theta[i], sol.cov[i, i], zq, inflate),
             unit=unit,
@@ -624,13 +797,61 @@ def _noise_fit(curve, terms, effects, sol, result, unit, confidence):
         confidence=confidence,
         unit=unit,
         iterations=0,
-        theta=sol.theta[:k],
-        covariance=sol.cov[:k, :k],
+        theta=theta,
+        covariance=cov,
     )
 
 
 # ----------------------------------------------------------------------------------------------
 # the loop
+
+
+def _step_params(key, p, sol, i, curve, terms, effects_before, extra):
+    """Parameters and intervals of the effect in column ``i`` of ``sol``."""
+    base = _base(key)
+    amp = math.sqrt(max(sol.theta[i], 0.0))
+    var_i = sol.cov[i, i]
+    sd = math.sqrt(max(var_i, 0.0)) / (2 * amp) if amp > 0 and np.isfinite(var_i) else float("nan")
+    amp_int = (max(0.0, amp - sd), amp + sd)
+    if base == "bandwidth":
+        kind = key.split(":", 1)[1]
+        cut = filter_cutoff(kind, p, curve.fs)
+        if kind == "single_pole":
+            taps, c_int = 0, _profile_interval(curve, terms, effects_before, key, p, sol)
+        else:
+            taps = int(p) if kind == "moving_average" else 2 * int(p) - 1
+            c_int = (filter_cutoff(kind, p + 1, curve.fs), filter_cutoff(kind, max(1.0, p - 1), curve.fs))
+        return {"cutoff": cut, "taps": taps, "filter": kind}, {"cutoff": c_int}
+    if base == "drift":
+        d = extra["drift"]
+        return {"amplitude": d["amplitude"], "T": d["T"]}, {
+            "amplitude": (d["amplitude"] * (1 - sd / amp), d["amplitude"] * (1 + sd / amp)) if amp > 0 else amp_int,
+            "T": d["T_interval"],
+        }
+    if base == "regression":
+        name = key.split(":", 1)[1]
+        r = extra["regression"][name]
+        return {"channel": name, "coefficient": r["coefficient"]}, {
+            "coefficient": (r["coefficient"] - r["se"], r["coefficient"] + r["se"])
+        }
+    names = EFFECTS[base].param_names
+    if base == "sinusoid" and extra.get("line") is not None:
+        ln = extra["line"]  # found in the PSD: amplitude and f0 from the samples, with their intervals
+        return {names[0]: ln["amplitude"], names[1]: p}, {
+            names[0]: ln["amplitude_interval"],
+            names[1]: ln["f0_interval"],
+        }
+    p_int = _profile_interval(curve, terms, effects_before, key, p, sol)
+    return {names[0]: amp, names[1]: p}, {names[0]: amp_int, names[1]: p_int}
+
+
+def _resolve_tau_range(tau_range, result, start):
+    if isinstance(tau_range, str):
+        if tau_range != "auto":
+            raise ParameterError(f"tau_range must be a (low, high) pair of seconds or 'auto', got {tau_range!r}")
+        nf = fitting.fit(result, terms=start, tau_range="auto")
+        return float(nf.tau[0]) * (1 - 1e-9), math.inf
+    return (0.0, math.inf) if tau_range is None else fitting.check_tau_range(tau_range)
 
 
 def refine(
@@ -646,6 +867,8 @@ def refine(
     confidence: float = 0.683,
     points: int = 300,
     axis: int = 0,
+    channels=None,
+    level: float = LEVEL,
     progress=None,
 ) -> Refinement:
     """Fit the starting model, find what it lacks, add it, repeat; report the error before and after.
@@ -654,8 +877,9 @@ def refine(
         ----------
         x_or_result : array_like or AllanResult
             Samples (then ``fs`` is needed; the Allan variance is computed on a dense exponential grid of
-            ``points`` τ so that a sinusoid's nulls are resolved, and change points can be searched), or
-            a static :class:`~allanite.AllanResult` (curve effects only).
+            ``points`` τ so that a sinusoid's nulls are resolved, the PSD and the record along time are
+            searched too, and the held-out error is computed), or a static :class:`~allanite.AllanResult`
+            (curve effects only; no held-out error).
         fs : float, optional
             Sampling rate, Hz (samples only).
         start : tuple of str
@@ -667,16 +891,22 @@ def refine(
     {effects}
         unit : str, optional
             Unit of the samples, for IEEE-952 values of the terms.
-        tau_range : (float, float), optional
-            τ (s) to use, as in :func:`allanite.fit` (e.g. to leave out a non-white shortest τ).
+        tau_range : (float, float) or "auto", optional
+            τ (s) to use, as in :func:`allanite.fit`. Default: every τ — the shortest τ carry the sensor's
+            bandwidth, which is a candidate effect; ``"auto"`` cuts them as ``fit`` does.
+        channels : dict of str → array_like, optional
+            Other channels of the same log (same length as the samples: temperature, other axes,
+            accelerometers): the rate is regressed on each ("regression" effect).
+        level : float
+            False-alarm probability per record on a clean record (default 0.05), split between spectral
+            lines, the Allan-curve test and change points.
+        progress : bool, optional
+            A ``tqdm.auto`` bar: None (default) in a notebook or a terminal only, True/False always/never.
         truth : dict, optional
             Known parameters per effect (``{"gauss_markov": {"sigma": …, "tc": …}}``, ``{"change_point":
             {"t": …}}``): each step then records its relative errors.
         axis : int
             Which axis of multi-axis input to refine.
-        progress : bool, optional
-            A ``tqdm.auto`` bar over the steps (the search of each step is the long part on real logs):
-            None (default) shows it only in a notebook or a terminal, True always, False never.
 
         Returns
         -------
@@ -687,22 +917,53 @@ def refine(
         >>> import allanite
         >>> y = allanite.simulate(1_000_000, 100.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 10.0)], seed=11)
         >>> r = allanite.refine(y, 100.0)               # the generator's GM is not in the starting model
-        >>> r.found, round(r.steps[0].params["tc"], 1), round(r.steps[0].after["chi2_dof"], 1)
-        (['gauss_markov'], 10.2, 1.1)
+        >>> r.found, round(r.steps[0].params["tc"], 0)
+        (['gauss_markov'], 10.0)
     """
-    with StepBar(progress, 2 + MAX_STEPS, "refine") as bar:
-        return _refine(x_or_result, fs, start, candidates, unit, input, tau_range, truth, confidence, points, axis, bar)
+    with StepBar(progress, 1, "refine") as bar:
+        bar.step("fit, trace and test the candidates")
+        return _refine(
+            x_or_result,
+            fs,
+            start=start,
+            candidates=candidates,
+            unit=unit,
+            input=input,
+            tau_range=tau_range,
+            truth=truth,
+            confidence=confidence,
+            points=points,
+            axis=axis,
+            channels=channels,
+            level=level,
+        )
 
 
-def _refine(x_or_result, fs, start, candidates, unit, input, tau_range, truth, confidence, points, axis, bar):
-    """:func:`refine`, telling ``bar`` before each stage."""
-    bar.step("Allan variance")
+def _refine(
+    x_or_result,
+    fs=None,
+    *,
+    start=("Q", "N", "B", "K", "R"),
+    candidates=CANDIDATES,
+    unit=None,
+    input: str = "rate",
+    tau_range=None,
+    truth=None,
+    confidence: float = 0.683,
+    points: int = 300,
+    axis: int = 0,
+    channels=None,
+    level: float = LEVEL,
+) -> Refinement:
+    """The loop behind :func:`refine` (its parameters, without ``progress``)."""
     start = check_terms(start)
     if isinstance(candidates, str):
         candidates = (candidates,)
     bad = [c for c in candidates if c not in CANDIDATES]
     if bad:
         raise ParameterError(f"unknown candidate effect {bad[0]!r}; allowed: {', '.join(CANDIDATES)}")
+    if not (isinstance(level, (int, float)) and 0.0 < level < 1.0):
+        raise ParameterError(f"level must be a probability in (0, 1), got {level!r}")
     y = None
     if isinstance(x_or_result, AllanResult):
         if fs is not None:
@@ -723,6 +984,17 @@ def _refine(x_or_result, fs, start, candidates, unit, input, tau_range, truth, c
         top = max(1, y.size // 9)
         grid = tau_grid(y.size, fs, "exp", points=points, m_max=top) if top > 1 else "octave"
         result = avar(y, fs, taus=grid)
+    chans: dict = {}
+    if channels:
+        if y is None:
+            raise ParameterError("channels need samples (a regression is fitted along time), not an AllanResult")
+        for name, c in channels.items():
+            c = np.asarray(c, dtype=np.float64).ravel()
+            if c.size != y.size:
+                raise ParameterError(f"channel {name!r} has {c.size} samples; the rate has {y.size}")
+            if not np.all(np.isfinite(c)):
+                raise ParameterError(f"channel {name!r} has non-finite samples")
+            chans[str(name)] = c
     if result.avar.ndim == 2:
         result = AllanResult(
             tau=result.tau,
@@ -735,97 +1007,318 @@ def _refine(x_or_result, fs, start, candidates, unit, input, tau_range, truth, c
             input=result.input,
             source=result.source,
         )
-    lo, hi = (0.0, np.inf) if tau_range is None else fitting.check_tau_range(tau_range)
+    lo, hi = _resolve_tau_range(tau_range, result, start)
     keep = (result.tau >= lo) & (result.tau <= hi) & (result.avar > 0)
     if keep.sum() < len(start) + 3:
         raise ParameterError(
             f"{int(keep.sum())} usable τ points; refining {len(start)} terms needs at least {len(start) + 3}"
         )
     est = result.estimator if result.source is None else tuple(np.asarray(result.source)[keep])
-    curve = _Curve(
-        result.tau[keep], result.m[keep].astype(np.float64), result.avar[keep], result.fs, result.n_samples + 1, est
-    )
-    effects: list = []
+    fs = result.fs
+
+    def build(res, samples):
+        """The curve (and, with samples, the held-out splits) of ``res``'s estimates in the τ range."""
+        c = _Curve(
+            res.tau[keep], res.m[keep].astype(np.float64), res.avar[keep], fs, res.n_samples + 1, est, channels={}
+        )
+        if samples is None:
+            return c, (None, None)
+        return c, _splits(samples, fs, np.asarray(res.m, dtype=np.int64), lo, hi)
+
+    curve, (halves, blocks) = build(result, y)
+    note = "curve-only input (an AllanResult without samples): no held-out error; steps rest on the calibrated test"
+    if y is not None:
+        note = (
+            "fit on one half of the record, predict the other half's Allan curve (both ways, mean RMS ADEV "
+            f"error); drift by alternate blocks ({HELDOUT_BLOCKS} blocks, odd ↔ even)"
+            if halves is not None
+            else "record too short to hold out halves: no held-out error"
+        )
+    k_terms = len(start)
     steps: list = []
-    sol = _solve(curve, start, effects)
+    sol = _solve(curve, start, [])
     start_sol = sol
-    considered: dict[str, list] = {}
-    tmin, tmax = curve.tau[0], curve.tau[-1]
-    for k in range(MAX_STEPS):
-        if sol.chi2_dof <= GOOD_CHI2_DOF:
-            break
-        bar.step(f"search {k + 1} (χ²/dof {sol.chi2_dof:.3g})")
-        best = None
-        for cand in candidates:
-            if cand == "change_point":
-                continue
-            search = EFFECTS[cand].search
-            assert search is not None
-            grid = search(tmin, tmax)
-            p, s_new, prof = _search(curve, start, effects, cand, grid)
-            gain = sol.chi2_eff(curve) - s_new.chi2_eff(curve)
-            penalty = 2 * math.log(curve.n_eff) + MIN_GAIN
-            considered.setdefault(cand, []).append({"param": p, "gain_chi2_eff": float(gain), "penalty": penalty})
-            # a parameter pinned at its search range's edge is not identified by the curve
-            at_edge = p <= grid[0] * 1.02 or p >= grid[-1] / 1.02
-            # ... and an effect must make the fit better per degree of freedom, not only in total (on a grossly
-            # wrong model a χ² drop can pass the BIC test while χ²/dof rises)
-            if (
-                gain > penalty
-                and s_new.theta[-1] > 0
-                and not at_edge
-                and s_new.chi2_dof < sol.chi2_dof
-                and (best is None or gain > best[0])
-            ):
-                best = (gain, cand, p, s_new, prof)
-        if best is None:
-            break
-        gain, cand, p, s_new, prof = best
-        evidence = _residual_evidence(curve, sol)
-        p_int = _profile_interval(curve, start, effects, cand, p, s_new, prof)
-        new_effects = effects + [(cand, p)]
-        i = s_new.theta.size - 1
-        amp = math.sqrt(s_new.theta[i])
-        var_i = s_new.cov[i, i]
-        sd_amp = math.sqrt(max(var_i, 0.0)) / (2 * amp) if amp > 0 and np.isfinite(var_i) else float("nan")
-        names = EFFECTS[cand].param_names
-        params = {names[0]: amp, names[1]: p}
-        intervals = {names[0]: (max(0.0, amp - sd_amp), amp + sd_amp), names[1]: p_int}
-        before, after = _curve_metrics(curve, sol), _curve_metrics(curve, s_new)
+    start_heldout = halves.error(start, []) if halves is not None else None
+    alpha_curve = level * (1.0 - LINE_SHARE - CHANGE_POINT_SHARE - 2 * TIME_SHARE)
+
+    # removing a time-domain component (after the curve effects are in the model)
+    def removal_step(name, component, split, params, intervals, evidence, truth_key, held_in_time=None):
+        """Accept removing ``component`` if the held-out error falls; returns the step or None.
+
+        ``held_in_time``: for a regression, the held-out test in time (the residual variance of each half with
+        the coefficient of the other half, relative to its raw variance) decides instead: removing a white-like
+        component changes the Allan curve's level, not how well one half predicts the other's."""
+        nonlocal y, result, curve, halves, blocks, sol
+        assert y is not None
+        y_new = y - component
+        res_new = avar(y_new, fs, taus=result.tau)
+        c_new, (h_new, b_new) = build(res_new, y_new)
+        old_split, new_split = (halves, h_new) if split == "halves" else (blocks, b_new)
+        ho_b = old_split.error(start, effects) if old_split is not None else None
+        ho_a = new_split.error(start, effects) if new_split is not None else None
+        s_new = _solve(c_new, start, effects)
+        if held_in_time is not None:
+            evidence["heldout_variance_ratio"] = held_in_time
+            rejected = not held_in_time < 1.0
+        else:
+            rejected = ho_b is not None and ho_a is not None and not ho_a < ho_b
+        if rejected:
+            considered.setdefault(name, []).append(
+                params
+                | {
+                    "rejected": f"held-out error {ho_b} → {ho_a} %, variance ratio {held_in_time}",
+                    "test": evidence["test"],
+                }
+            )
+            return None
         terr = None
-        if truth and cand in truth:
-            terr = {k: params[k] / v - 1 for k, v in truth[cand].items() if k in params}
+        if truth and truth_key in truth:
+            terr = {k: params[k] / v - 1 for k, v in truth[truth_key].items() if k in params and v}
+        st = Step(
+            effect=name,
+            params=params,
+            intervals=intervals,
+            evidence=evidence,
+            before=_curve_metrics(curve, sol, ho_b),
+            after=_curve_metrics(c_new, s_new, ho_a),
+            delta_chi2_eff=float(sol.chi2_eff(curve) - s_new.chi2_eff(c_new)),
+            truth_error=terr,
+        )
+        y, result, curve, halves, blocks, sol = y_new, res_new, c_new, h_new, b_new, s_new
+        return st
+
+    considered: dict[str, list] = {}
+    exact = y is not None or (isinstance(est, str) and est == "oavar")
+    thin = tracing.thin_indices(curve.tau)
+    sub = curve.subset(thin)
+    lines = tracing.spectral_lines(y, fs, level * LINE_SHARE) if y is not None and "sinusoid" in candidates else []
+    drift = None
+    regs: dict = {}
+    effects: list = []
+    tmin, tmax = curve.tau[0], curve.tau[-1]
+    for n_step in range(MAX_STEPS):
+        keys = [e[0] for e in effects]
+        theta_t = _theta_terms(sol, start, effects)
+        model_t = np.maximum(design_matrix(sub.tau, sub.m, fs, start) @ theta_t, 1e-300)
+        cov_t = None
+        if exact:
+            cov_t = tracing.exact_covariance(sub.m.astype(np.int64), curve.n_points - 1, fs, start, theta_t)
+        a_thin, _ = _design(sub, start, effects)
+        test = tracing.ScoreTest(sol.model[thin], model_t, sol.nu[thin], sub.tau, a_thin[:, sol.theta > 0], cov_t)
+        fam = _families(
+            sub,
+            candidates,
+            y is not None,
+            [],
+            drift["grid"] if drift is not None and "drift" not in keys else None,
+        )
+        thr = test.threshold(fam, alpha_curve, N_BOOT, seed=n_step)
+        props: list[dict] = []
+
+        def propose(key, p, s_new, edge, stat, threshold, split, props=props, **extra):
+            props.append(
+                {"key": key, "p": p, "sol": s_new, "edge": edge, "stat": stat, "thr": threshold, "split": split} | extra
+            )
+
+        if "gauss_markov" in candidates:
+            search = EFFECTS["gauss_markov"].search
+            assert search is not None
+            p, s_new, edge = _search(curve, start, effects, "gauss_markov", search(tmin, tmax))
+            propose(
+                "gauss_markov", p, s_new, edge, test.statistic(sub.avar, _column("gauss_markov", p, sub)), thr, halves
+            )
+        if "bandwidth" in candidates and not any(_base(k) == "bandwidth" for k in keys) and "N" in start:
+            best = None
+            for kind, grid in _bandwidth_grids(curve).items():
+                key = f"bandwidth:{kind}"
+                p, s_new, edge = _search(curve, start, effects, key, grid, continuous=kind == "single_pole")
+                if best is None or s_new.chi2 < best[2].chi2:
+                    best = (key, p, s_new, edge)
+            if best is not None:
+                key, p, s_new, edge = best
+                stat = test.statistic(sub.avar, _column(key, p, sub) - 1.0 / sub.tau)
+                propose(key, p, s_new, edge, stat, thr, halves)
+        if "sinusoid" in candidates:
+            if y is not None:
+                done_f = [p for k, p in effects if k == "sinusoid"]
+                for ln in lines:
+                    if all(abs(ln["f0"] - f) > 2 * ln["bin_hz"] for f in done_f):
+                        s_new = _solve(curve, start, effects + [("sinusoid", ln["f0"])])
+                        propose("sinusoid", ln["f0"], s_new, False, ln["psd_ratio"], ln["threshold"], halves, line=ln)
+                        break
+            else:
+                search = EFFECTS["sinusoid"].search
+                assert search is not None
+                p, s_new, edge = _search(curve, start, effects, "sinusoid", search(tmin, tmax))
+                propose("sinusoid", p, s_new, edge, test.statistic(sub.avar, _column("sinusoid", p, sub)), thr, halves)
+        if drift is not None and "drift" not in keys:
+            s_new = _solve(curve, start, effects + [("drift", drift["T"])])
+            stat = test.statistic(sub.avar, _column("drift", drift["T"], sub))
+            propose("drift", drift["T"], s_new, drift["at_edge"], stat, thr, blocks)
+        for pr in props:
+            considered.setdefault(_base(pr["key"]), []).append(
+                {"param": float(pr["p"]), "statistic": float(pr["stat"]), "threshold": float(pr["thr"])}
+            )
+        ok = [
+            pr
+            for pr in props
+            if pr["stat"] > pr["thr"]
+            and not pr["edge"]
+            and pr["sol"].theta[-1] > 0
+            and pr["sol"].chi2_dof < sol.chi2_dof
+        ]
+        # a spectral line is the most specific evidence (a sinusoid also raises a bump on the curve that a
+        # Gauss–Markov term would otherwise take): lines first, then by the statistic over its threshold
+        ok.sort(key=lambda pr: (pr.get("line") is None, -pr["stat"] / pr["thr"]))
+        chosen = None
+        for pr in ok:
+            split = pr["split"]
+            ho_b = ho_a = None
+            if split is not None:
+                ho_b = split.error(start, effects)
+                ho_a = split.error(start, effects + [(pr["key"], pr["p"])])
+                if not ho_a < ho_b:
+                    considered[_base(pr["key"])][-1]["rejected"] = f"held-out error {ho_b:.3g} → {ho_a:.3g} %"
+                    continue
+            chosen = (pr, ho_b, ho_a)
+            break
+        bw = next((pr for pr in ok if _base(pr["key"]) == "bandwidth"), None)
+        # (only for an unmistakable roll-off: its statistic ≥ PAIR_FACTOR × the threshold)
+        if (
+            chosen is None
+            and bw is not None
+            and bw["split"] is not None
+            and bw["stat"] >= PAIR_FACTOR * bw["thr"]
+            and "gauss_markov" in candidates
+        ):
+            # a bandwidth alone can lower the held-out fit where a bump sits further up the curve (the five
+            # terms bend to the bump once the short τ are right): try it with a Gauss–Markov term on top
+            search = EFFECTS["gauss_markov"].search
+            assert search is not None
+            with_bw = effects + [(bw["key"], bw["p"])]
+            p_g, s_pair, edge_g = _search(curve, start, with_bw, "gauss_markov", search(tmin, tmax))
+            if not edge_g and s_pair.theta[-1] > 0:
+                ho_b = bw["split"].error(start, effects)
+                ho_alone = bw["split"].error(start, with_bw)
+                ho_pair = bw["split"].error(start, with_bw + [("gauss_markov", p_g)])
+                if ho_pair < ho_b:
+                    bw["pair_note"] = (
+                        f"accepted with the Gauss–Markov term of the next step: alone it moved the held-out error "
+                        f"{ho_b:.3g} → {ho_alone:.3g} %, with it → {ho_pair:.3g} %"
+                    )
+                    chosen = (bw, ho_b, ho_alone)
+        if chosen is None:
+            break
+        pr, ho_b, ho_a = chosen
+        key, p, s_new = pr["key"], pr["p"], pr["sol"]
+        extra = {"drift": drift, "regression": regs, "line": pr.get("line")}
+        params, intervals = _step_params(key, p, s_new, s_new.theta.size - 1, curve, start, effects, extra)
+        evidence = _residual_evidence(curve, sol)
+        evidence["domain"] = EFFECTS[_base(key)].domain
+        evidence["test"] = (
+            {"psd_ratio": pr["stat"], "threshold": pr["thr"], "alpha": level * LINE_SHARE}
+            if pr.get("line") is not None
+            else {"gls_score": pr["stat"], "threshold": pr["thr"], "alpha": alpha_curve}
+        )
+        if _base(key) == "bandwidth":
+            evidence["N"] = math.sqrt(max(s_new.theta[-1], 0.0))
+        if "pair_note" in pr:
+            evidence["held_out"] = pr["pair_note"]
+        terr = None
+        base = _base(key)
+        if truth and base in truth:
+            terr = {
+                kk: params[kk] / v - 1
+                for kk, v in truth[base].items()
+                if kk in params and not isinstance(params[kk], str) and v
+            }
         steps.append(
             Step(
-                effect=cand,
+                effect=base,
                 params=params,
                 intervals=intervals,
                 evidence=evidence,
-                before=before,
-                after=after,
-                delta_chi2_eff=float(gain),
+                before=_curve_metrics(curve, sol, ho_b),
+                after=_curve_metrics(curve, s_new, ho_a),
+                delta_chi2_eff=float(sol.chi2_eff(curve) - s_new.chi2_eff(curve)),
                 truth_error=terr,
             )
         )
-        effects, sol = new_effects, s_new
-        if len(effects) > 1:
-            effects, sol = _joint(curve, start, effects, sol)
-            _update_steps(steps, curve, start, effects, sol, truth)
+        effects, sol = effects + [(key, p)], s_new
+    n_curve = len(steps)
+    # an effect whose amplitude a later one took over entirely is dropped (refit without it)
+    dead = [j for j in range(len(effects)) if sol.theta[k_terms + j] <= 0]
+    if dead:
+        for j in reversed(dead):
+            considered.setdefault(_base(effects[j][0]), []).append({"param": float(effects[j][1]), "absorbed": True})
+            del effects[j], steps[j]
+            n_curve -= 1
+        sol = _solve(curve, start, effects)
+    # amplitudes of earlier curve steps from the final joint solution
+    for j, (st, (key, _p)) in enumerate(zip(steps[:n_curve], effects)):
+        base = _base(key)
+        if base in ("gauss_markov",) or (base == "sinusoid" and y is None):
+            names = EFFECTS[base].param_names
+            st.params[names[0]] = math.sqrt(max(sol.theta[k_terms + j], 0.0))
+            if truth and base in truth and st.truth_error is not None:
+                st.truth_error = {kk: st.params[kk] / v - 1 for kk, v in truth[base].items() if kk in st.params}
+    # ---- time domain: other channels, then a warm-up drift; each removed from the samples and refitted
+    if y is not None and chans and "regression" in candidates:
+        t_thr = t_dist.isf(TIME_SHARE * level / (2 * len(chans)), REGRESSION_BLOCKS - 1)
+        for name, ch in chans.items():
+            rg = tracing.regression_fit(y, ch, REGRESSION_BLOCKS)
+            t_stat = abs(rg["coefficient"]) / rg["se"] if rg["se"] > 0 else 0.0
+            ev = {"domain": "channels", "test": {"t": t_stat, "threshold": float(t_thr), "alpha": TIME_SHARE * level}}
+            if not t_stat > t_thr:
+                considered.setdefault("regression", []).append({"channel": name, "t": t_stat, "threshold": t_thr})
+                continue
+            st = removal_step(
+                "regression",
+                rg["coefficient"] * (ch - ch.mean()),
+                "halves",
+                {"channel": name, "coefficient": rg["coefficient"]},
+                {"coefficient": (rg["coefficient"] - rg["se"], rg["coefficient"] + rg["se"])},
+                ev,
+                "regression",
+                tracing.regression_heldout(y, ch),
+            )
+            if st is not None:
+                steps.append(st)
+    if y is not None and "drift" in candidates:
+        dr = tracing.drift_fit(y, fs)
+        thr_d = tracing.drift_threshold(y.size, fs, start, _theta_terms(sol, start, effects), TIME_SHARE * level)
+        ev = {"domain": "time", "test": {"statistic": dr["statistic"], "threshold": thr_d, "alpha": TIME_SHARE * level}}
+        if dr["statistic"] > thr_d and not dr["at_edge"]:
+            t_s = np.arange(y.size) / fs
+            st = removal_step(
+                "drift",
+                dr["amplitude"] * np.exp(-t_s / dr["T"]),
+                "blocks",
+                {"amplitude": dr["amplitude"], "T": dr["T"]},
+                {"amplitude": dr["amplitude_interval"], "T": dr["T_interval"]},
+                ev,
+                "drift",
+            )
+            if st is not None:
+                steps.append(st)
+        else:
+            considered.setdefault("drift", []).append({"T": dr["T"], "statistic": dr["statistic"], "threshold": thr_d})
     change_points = []
     if y is not None and "change_point" in candidates:
-        bar.step("change points")
         change_points = _change_points(y, fs, start)
         for c in change_points:
             terr = None
             if truth and "change_point" in truth:
                 ts = np.atleast_1d(truth["change_point"]["t"])
                 terr = {"t": float(np.min(np.abs(ts - c["t"])) / (y.size / fs))}
+            c["before"]["heldout_rms_adev_pct"] = c["after"]["heldout_rms_adev_pct"] = None
             steps.append(
                 Step(
                     effect="change_point",
                     params={"t": c["t"]},
                     intervals={"t": c["interval"]},
                     evidence={
+                        "domain": "time",
                         "tau": c["tau"],
                         "window_s": c["window_s"],
                         "coarse_split_s": c["coarse_split_s"],
@@ -848,6 +1341,9 @@ def _refine(x_or_result, fs, start, candidates, unit, input, tau_range, truth, c
         effects=effects,
         change_points=change_points,
         considered=considered,
+        heldout_note=note,
+        start_heldout_rms_adev_pct=start_heldout,
+        tau_range=(lo, hi),
     )
 
 

@@ -235,6 +235,13 @@ def _series(fit: dict) -> dict:
     }
 
 
+def _heldout(st: dict) -> str:
+    a, b = st["before"].get("heldout_rms_adev_pct"), st["after"].get("heldout_rms_adev_pct")
+    if a is None or b is None:
+        return "n/a (no samples)"
+    return f"{g(a, 3)} → {g(b, 3)} %"
+
+
 def _refinement(ref: dict | None) -> dict | None:
     if ref is None:
         return None
@@ -254,7 +261,13 @@ def _refinement(ref: dict | None) -> dict | None:
         )
         for st in ax["steps"]:
             params = "; ".join(
-                f"{p} = {g(v, 3)} [{g(st['intervals'][p][0], 3)}, {g(st['intervals'][p][1], 3)}]"
+                f"{p} = {v}"
+                if isinstance(v, str)
+                else (
+                    f"{p} = {g(v, 3)} [{g(st['intervals'][p][0], 3)}, {g(st['intervals'][p][1], 3)}]"
+                    if p in st["intervals"]
+                    else f"{p} = {g(v, 3)}"
+                )
                 for p, v in st["params"].items()
             )
             if st["statistic"] == "allan_curve":
@@ -265,6 +278,7 @@ def _refinement(ref: dict | None) -> dict | None:
                         params,
                         f"{g(st['before']['chi2_dof'], 3)} → {g(st['after']['chi2_dof'], 3)}",
                         f"{g(st['before']['rms_adev_pct'], 3)} → {g(st['after']['rms_adev_pct'], 3)} %",
+                        _heldout(st),
                     ]
                 )
             else:
@@ -287,6 +301,7 @@ def _refinement(ref: dict | None) -> dict | None:
                     "parameters",
                     "χ²/dof before → after",
                     "RMS ADEV error before → after",
+                    "held-out RMS ADEV error before → after",
                 ],
                 curve_rows,
                 left=3,

@@ -46,16 +46,20 @@ def refinement_dict(rep) -> dict | None:
                 "terms": list(r.terms),
                 "tau_from_s": json_number(r.start.tau[0]),
                 "start": _fit_errors(r.start),
+                "start_heldout_rms_adev_pct": json_number(r.start_heldout_rms_adev_pct),
+                "heldout_note": r.heldout_note,
                 "final": _fit_errors(r.fit),
                 "steps": [
                     {
                         "effect": st.effect,
-                        "statistic": "allan_curve" if EFFECTS[st.effect].kind == "curve" else "window_levels",
-                        "params": {p: json_number(v) for p, v in st.params.items()},
+                        "statistic": "window_levels" if st.effect == "change_point" else "allan_curve",
+                        "domain": EFFECTS[st.effect].domain,
+                        "params": {p: v if isinstance(v, str) else json_number(v) for p, v in st.params.items()},
                         "units": {p: rate if u == "rate unit" else u for p, u, _ in EFFECTS[st.effect].params},
                         "intervals": {p: [json_number(a), json_number(b)] for p, (a, b) in st.intervals.items()},
                         "before": {q: json_number(v) for q, v in st.before.items()},
                         "after": {q: json_number(v) for q, v in st.after.items()},
+                        "test": _jsonable_test(st.evidence.get("test")),
                     }
                     for st in r.steps
                 ],
@@ -64,19 +68,28 @@ def refinement_dict(rep) -> dict | None:
     curve = [e for e in EFFECTS.values() if e.kind == "curve"]
     timed = [e for e in EFFECTS.values() if e.kind != "curve"]
     return {
-        "method": "allanite.refine: effect signatures on the Allan curve and changes along the record, each added "
-        "only where it earns its parameters (BIC on an effective χ²)",
+        "method": "allanite.refine: the residual traced on the Allan curve, in the PSD, along time and in other "
+        "channels; an effect is added only if a calibrated test asks for it (GLS score with a bootstrap threshold, "
+        "a χ² line test on the Welch PSD, a t test of a regression, a bootstrap of the drift statistic) and it "
+        "lowers the held-out error (fit on one half of the record, predict the other)",
         "candidates": f"{' / '.join(e.label for e in curve)} signatures in the Allan curve, or "
         + " or ".join(f"{e.label} along the record" for e in timed),
         "units": "; ".join(f"{e.name}: " + ", ".join(f"{p} in {u}" for p, u, _ in e.params) for e in EFFECTS.values()),
         "statistics": {
             "allan_curve": "before/after: χ²/dof, RMS z and RMS ADEV error (%) of the Allan-curve fit, each τ of the "
-            "dense curve weighted independently",
+            "dense curve weighted independently; heldout_rms_adev_pct: the model fitted on one half predicting the "
+            "other half's curve (null for curve-only input)",
             "window_levels": "before/after: one level vs piecewise levels (split at every change found) of the "
             "log Allan variances of 16 windows along the record",
         },
         "axes": axes,
     }
+
+
+def _jsonable_test(t):
+    if not isinstance(t, dict):
+        return None
+    return {k: json_number(v) for k, v in t.items()}
 
 
 def _coef_dict(c, unit, name) -> dict:
@@ -428,7 +441,10 @@ def text_summary(s: dict) -> str:
                 f"RMS ADEV error {g(a['rms_adev_pct'], 3)} → {g(b['rms_adev_pct'], 3)} %"
             )
             for st in ax["steps"]:
-                params = ", ".join(f"{p} = {g(v, 3)} {st['units'][p]}" for p, v in st["params"].items())
+                params = ", ".join(
+                    f"{p} = {v}" if isinstance(v, str) else f"{p} = {g(v, 3)} {st['units'][p]}".rstrip()
+                    for p, v in st["params"].items()
+                )
                 lines.append(f"    {st['effect']}: {params}")
     lines += forecast_text(s.get("forecast"))
     return "\n".join(lines)

@@ -1,0 +1,348 @@
+"""Tracing a residual in more than one domain, and a calibrated test for adding an effect.
+
+Used by :func:`allanite.refine`:
+
+- :func:`spectral_lines` — lines of the Welch PSD (scipy.signal): a bin stands out when its power over
+  the median of its neighbours exceeds the χ² quantile of a Welch average of that many degrees of freedom,
+  Bonferroni-corrected over the bins searched; the neighbourhood grows with frequency (±k/2 bins, 4…32)
+  so that a 1/f or 1/f² slope is not read as a line (the median of a monotone spectrum over a window
+  symmetric about k is its value at k). f0 is then refined on the periodogram of block means, the
+  amplitude and phase by least squares on the samples.
+- :func:`drift_fit` — an exponential warm-up a·e^{−t/T} on block means along the record.
+- :func:`regression_fit` — the rate regressed on another channel, with a block-jackknife interval.
+- :class:`ScoreTest` — a generalised-least-squares score (likelihood-ratio in the linearised model)
+  statistic for adding one non-negative column to the fitted Allan-variance model, with the covariance of
+  the estimates across τ (exact for the five terms and the overlapping estimator, docs/FORMULAS.md §5 via
+  :mod:`allanite.model._covariance`; effects enter by scaling it with the model's level), and its null
+  distribution by a parametric bootstrap: Allan curves drawn from the fitted model with χ² marginals of
+  the estimates' EDF tied by a Gaussian copula of their correlation. The maximum of the statistic over
+  every candidate family's columns is bootstrapped, so the look-elsewhere effect is in the threshold.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+from scipy import signal
+from scipy.linalg import solve_triangular
+from scipy.optimize import minimize_scalar
+from scipy.stats import chi2 as chi2_dist
+from scipy.stats import f as f_dist
+from scipy.stats import norm
+
+from ..simulation import simulate
+from . import _covariance
+
+__all__ = [
+    "spectral_lines",
+    "drift_fit",
+    "drift_threshold",
+    "regression_fit",
+    "regression_heldout",
+    "ScoreTest",
+    "thin_indices",
+]
+
+#: Block means a drift is fitted to.
+DRIFT_BLOCKS = 500
+#: Lowest Welch bin searched for lines (below, the window's leakage of a steep 1/f² spectrum dominates).
+MIN_BIN = 6
+#: Octave-to-octave correlation of Allan estimates where no exact covariance applies (curves only).
+OCTAVE_RHO = 0.68
+
+
+def spectral_lines(y: np.ndarray, fs: float, alpha: float, max_lines: int = 4) -> list[dict]:
+    """Significant lines of the Welch PSD of ``y``, strongest first: f0 (Hz), amplitude, phase, evidence."""
+    n = y.size
+    nper = int(min(2**15, 2 ** int(math.log2(max(n // 8, 256)))))
+    x = y - y.mean()
+    f, p = signal.welch(x, fs=fs, nperseg=nper, detrend="linear")
+    nseg = (n - nper) // (nper // 2) + 1
+    dof = max(2.0, 2.0 * nseg * 0.947)  # Hann, 50 % overlap: equivalent degrees of freedom (Welch 1967)
+    bias = chi2_dist.median(dof) / dof
+    med = np.full(p.size, np.nan)
+    half = np.zeros(p.size)
+    k_all = np.arange(p.size)
+    for w in range(4, 33):
+        ks = k_all[(np.clip(k_all // 2, 4, 32) == w) & (k_all >= MIN_BIN) & (k_all < p.size - w)]
+        if ks.size == 0:
+            continue
+        lo = np.maximum(1, ks - w)
+        win = sliding_window_view(np.concatenate([p, np.full(2 * w + 1, np.nan)]), 2 * w + 1)
+        rows = win[lo]
+        med[ks] = np.nanmedian(rows, axis=1)
+        half[ks] = w
+    ratio = p / (med / bias)
+    searched = np.isfinite(ratio)
+    n_bins = int(searched.sum())
+    if n_bins == 0:
+        return []
+    # the neighbours' median is itself an estimate: the ratio is F-distributed, the median's degrees of
+    # freedom those of (2w + 1)/3 independent bins (adjacent Hann bins overlap)
+    dof_med = np.maximum(dof, dof * (2 * half + 1) / 3.0)
+    thr_all = np.where(searched, f_dist.isf(alpha / n_bins, dof, dof_med), np.inf)
+    hits = np.flatnonzero(searched & (ratio > thr_all))
+    peaks: list[int] = []
+    for k in hits[np.argsort(-ratio[hits])]:
+        if all(abs(k - q) > 3 for q in peaks):
+            peaks.append(int(k))
+        if len(peaks) >= max_lines:
+            break
+    t = np.arange(n) / fs
+    out = []
+    df = fs / nper
+    for k in peaks:
+        f0 = _refine_f0(x, fs, f[k], df)
+        c, s = np.cos(2 * np.pi * f0 * t), np.sin(2 * np.pi * f0 * t)
+        coef, *_ = np.linalg.lstsq(np.column_stack([c, s, np.ones(n)]), x, rcond=None)
+        amp = float(math.hypot(coef[0], coef[1]))
+        s1 = float(med[k] / bias)  # the noise's one-sided PSD under the line
+        length = n / fs
+        # least squares in locally white noise of that level: SE(A) = √(S₁/T); Cramér–Rao for f0:
+        # σ_f = (f_s/2π)·√(6·S₁·f_s/(A²n³))
+        se_a = math.sqrt(s1 / length)
+        se_f = fs / (2 * math.pi) * math.sqrt(6 * s1 * fs / (max(amp, 1e-300) ** 2 * float(n) ** 3))
+        out.append(
+            {
+                "f0": f0,
+                "amplitude": amp,
+                "amplitude_interval": (max(0.0, amp - se_a), amp + se_a),
+                "f0_interval": (f0 - se_f, f0 + se_f),
+                "phase": float(math.atan2(coef[0], coef[1])),
+                "psd_ratio": float(ratio[k]),
+                "threshold": float(thr_all[k]),
+                "bin_hz": float(df),
+            }
+        )
+    return out
+
+
+def _refine_f0(x: np.ndarray, fs: float, f_bin: float, df: float) -> float:
+    """Frequency of the periodogram maximum within ±1 bin of ``f_bin``, on block means (fast, no aliasing:
+    the decimated rate stays ≥ 8·f0)."""
+    dec = int(max(1, min(1000, fs // (8 * (f_bin + df)))))
+    k = x.size // dec
+    b = x[: k * dec].reshape(k, dec).mean(axis=1)
+    tb = (np.arange(k) * dec + 0.5 * (dec - 1)) / fs
+
+    def neg_power(f):
+        ph = 2 * np.pi * f * tb
+        return -(np.dot(b, np.cos(ph)) ** 2 + np.dot(b, np.sin(ph)) ** 2)
+
+    grid = np.linspace(max(f_bin - df, df / 4), f_bin + df, 41)
+    j = int(np.argmin([neg_power(g) for g in grid]))
+    lo, hi = grid[max(0, j - 1)], grid[min(grid.size - 1, j + 1)]
+    res = minimize_scalar(neg_power, bounds=(lo, hi), method="bounded", options={"xatol": df * 1e-4})
+    return float(res.x)
+
+
+def _drift_stat(b, tb, length, with_interval=False):
+    """Warm-up c + r·t + a·e^{−t/T} against the ramp c + r·t on block means: statistic n·ln(RSS_ramp/RSS)."""
+    nb = b.size
+    base = np.column_stack([np.ones(nb), tb])
+    r0 = b - base @ np.linalg.lstsq(base, b, rcond=None)[0]
+    rss0 = float(r0 @ r0)
+
+    def rss(lt):
+        a = np.column_stack([base, np.exp(-tb / math.exp(lt))])
+        coef = np.linalg.lstsq(a, b, rcond=None)[0]
+        r = b - a @ coef
+        return float(r @ r), coef
+
+    grid = np.linspace(math.log(length / 200), math.log(length / 2), 24)
+    vals = [rss(g)[0] for g in grid]
+    j = int(np.argmin(vals))
+    lo, hi = grid[max(0, j - 1)], grid[min(grid.size - 1, j + 1)]
+    res = minimize_scalar(lambda lt: rss(lt)[0], bounds=(lo, hi), method="bounded", options={"xatol": 1e-3})
+    lt = float(res.x)
+    r_min, coef = rss(lt)
+    stat = nb * math.log(rss0 / max(r_min, 1e-300))
+    out = {"statistic": stat, "T": math.exp(lt), "amplitude": float(coef[2]), "at_edge": j in (0, grid.size - 1)}
+    if with_interval:
+        # T and a where nb·ln(RSS) rises by ≤ 1 over its minimum (a profile likelihood interval)
+        fine = np.linspace(lt - 1.5, lt + 1.5, 61)
+        d = nb * np.log(np.array([rss(v)[0] for v in fine]) / r_min)
+        ok = fine[d <= 1.0]
+        out["T_interval"] = (math.exp(ok.min()), math.exp(ok.max())) if ok.size else (out["T"], out["T"])
+        a_sd = abs(out["amplitude"]) / math.sqrt(max(stat, 1e-12))
+        out["amplitude_interval"] = (out["amplitude"] - a_sd, out["amplitude"] + a_sd)
+    return out
+
+
+def _block_means(y, n_blocks):
+    nb = min(n_blocks, y.size)
+    per = y.size // nb
+    return y[: nb * per].reshape(nb, per).mean(axis=1), per
+
+
+def drift_fit(y: np.ndarray, fs: float, n_blocks: int = DRIFT_BLOCKS) -> dict:
+    """Least-squares warm-up c + r·t + a·e^{−t/T} on block means (T from L/200 to L/2, L the record), with
+    the statistic nb·ln(RSS_ramp/RSS_warm-up) against a ramp (a constant slope is the R term, not a drift)."""
+    b, per = _block_means(y, n_blocks)
+    tb = (np.arange(b.size) * per + 0.5 * (per - 1)) / fs
+    return _drift_stat(b, tb, y.size / fs, with_interval=True)
+
+
+def _grid_stats(b: np.ndarray, tb: np.ndarray, length: float) -> np.ndarray:
+    """The drift statistic on the T grid only, for many records at once (columns of ``b``)."""
+    nb = b.shape[0]
+    base = np.column_stack([np.ones(nb), tb])
+    q0 = np.linalg.qr(base)[0]
+    r0 = b - q0 @ (q0.T @ b)
+    rss0 = np.sum(r0 * r0, axis=0)
+    best = np.full(b.shape[1], np.inf)
+    for lt in np.linspace(math.log(length / 200), math.log(length / 2), 24):
+        q = np.linalg.qr(np.column_stack([base, np.exp(-tb / math.exp(lt))]))[0]
+        r = b - q @ (q.T @ b)
+        best = np.minimum(best, np.sum(r * r, axis=0))
+    return nb * np.log(rss0 / np.maximum(best, 1e-300))
+
+
+def drift_threshold(n: int, fs: float, terms, theta, alpha: float, n_boot: int = 1000, seed: int = 0) -> float:
+    """(1 − α) quantile of the drift statistic on records of the fitted five-term model (parametric bootstrap).
+
+    Only the block means matter, so the records are simulated at the block rate (white rate, flicker and
+    random walk of rate keep their coefficients; white angle noise averages out), all at once as the
+    consecutive pieces of one long record; the statistic is taken on the T grid (the observed one is refined
+    between grid points, so the test errs on the safe side by at most that refinement)."""
+    nb = min(DRIFT_BLOCKS, n)
+    per = n // nb
+    fs_b = fs / per
+    coef = {t: math.sqrt(max(float(v), 0.0)) for t, v in zip(terms, theta)}
+    tb = (np.arange(nb) * per + 0.5 * (per - 1)) / fs
+    long = simulate(
+        nb * n_boot,
+        fs_b,
+        N=coef.get("N", 0.0),
+        B=coef.get("B", 0.0),
+        K=coef.get("K", 0.0),
+        R=coef.get("R", 0.0),
+        seed=seed,
+    )
+    b = np.asarray(long, dtype=np.float64).ravel().reshape(n_boot, nb).T
+    return float(np.quantile(_grid_stats(b, tb, n / fs), 1.0 - alpha))
+
+
+def regression_fit(y: np.ndarray, ch: np.ndarray, n_blocks: int = 8) -> dict:
+    """Least-squares coefficient of the rate on a channel (both de-meaned), with a block-jackknife SE."""
+    yc, cc = y - y.mean(), ch - ch.mean()
+    den = float(cc @ cc)
+    coef = float(yc @ cc) / den if den > 0 else 0.0
+    per = y.size // n_blocks
+    parts = []
+    for j in range(n_blocks):
+        sl = slice(j * per, (j + 1) * per)
+        cj = ch[sl] - ch[sl].mean()
+        dj = float(cj @ cj)
+        if dj > 0:
+            parts.append(float((y[sl] - y[sl].mean()) @ cj) / dj)
+    se = float(np.std(parts, ddof=1) / math.sqrt(len(parts))) if len(parts) > 1 else float("nan")
+    return {"coefficient": coef, "se": se}
+
+
+def regression_heldout(y: np.ndarray, ch: np.ndarray) -> float:
+    """Held-out test of a regression in time: each half's residual variance with the other half's coefficient,
+    over its raw variance (mean of the two ways; < 1 means the coefficient carries over)."""
+    h = y.size // 2
+    parts = [(y[:h], ch[:h]), (y[h:], ch[h:])]
+    ratios = []
+    for (yf, cf), (yh, chh) in ((parts[0], parts[1]), (parts[1], parts[0])):
+        c = regression_fit(yf, cf, 2)["coefficient"]
+        yh0, ch0 = yh - yh.mean(), chh - chh.mean()
+        ratios.append(float(np.var(yh0 - c * ch0) / np.var(yh0)))
+    return float(np.mean(ratios))
+
+
+def thin_indices(tau: np.ndarray, per_octave: int = 4) -> np.ndarray:
+    """Indices of ``tau`` (sorted) nearest to a grid of ``per_octave`` points per octave, unique."""
+    n_oct = math.log2(tau[-1] / tau[0])
+    target = np.geomspace(tau[0], tau[-1], max(2, int(round(n_oct * per_octave)) + 1))
+    idx = np.unique(np.clip(np.searchsorted(tau, target), 0, tau.size - 1))
+    return idx
+
+
+def _psd_cholesky(corr: np.ndarray) -> np.ndarray:
+    """Cholesky factor of a correlation matrix; if rounding (or the effects' approximate share of the
+    covariance) left it indefinite, of its nearest positive definite correlation (eigenvalues clipped)."""
+    try:
+        return np.linalg.cholesky(corr + 1e-9 * np.eye(corr.shape[0]))
+    except np.linalg.LinAlgError:
+        w, v = np.linalg.eigh(corr)
+        w = np.maximum(w, 1e-6 * max(float(w.max()), 1e-300))
+        c = (v * w) @ v.T
+        d = np.sqrt(np.diag(c))
+        return np.linalg.cholesky(c / np.outer(d, d) + 1e-9 * np.eye(corr.shape[0]))
+
+
+class ScoreTest:
+    """GLS score statistic for one more non-negative column, and its bootstrap threshold.
+
+    Parameters
+    ----------
+    tau, m, avar : arrays on the thinned τ
+    model : the current model on those τ
+    model_terms : the current model's five-term part (its covariance is exact; effects scale it)
+    nu : EDF of each estimate
+    columns : (n_tau, k) active columns of the current model (projected out: the refit absorbs them)
+    cov_terms : (n_tau, n_tau) exact covariance of the five-term part, or None (octave-correlation model)
+    """
+
+    def __init__(self, model, model_terms, nu, tau, columns, cov_terms=None):
+        self.model = model
+        sd = model * np.sqrt(2.0 / nu)
+        if cov_terms is not None:
+            s = model / np.maximum(model_terms, 1e-300)
+            c = cov_terms * np.outer(s, s)
+            d = np.sqrt(np.maximum(np.diag(c), 1e-300))
+            corr = c / np.outer(d, d)
+        else:
+            lt = np.log2(tau)
+            corr = OCTAVE_RHO ** np.abs(lt[:, None] - lt[None, :])
+        self.corr_chol = _psd_cholesky(0.5 * (corr + corr.T))
+        self.nu = nu
+        self.chol = self.corr_chol * sd[:, None]  # Σ = D R D
+        xw = solve_triangular(self.chol, columns, lower=True) if columns.size else np.zeros((tau.size, 0))
+        self.q = np.linalg.qr(xw)[0] if xw.shape[1] else np.zeros((tau.size, 0))
+
+    def _perp(self, v):
+        vw = solve_triangular(self.chol, v, lower=True)
+        return vw - self.q @ (self.q.T @ vw)
+
+    def directions(self, cols: np.ndarray) -> np.ndarray:
+        """Unit whitened directions of candidate columns (n_tau, n_cols) orthogonal to the model's."""
+        cp = self._perp(cols)
+        cw = solve_triangular(self.chol, cols, lower=True)
+        nrm = np.linalg.norm(cp, axis=0)
+        keep = nrm > 1e-3 * np.maximum(np.linalg.norm(cw, axis=0), 1e-300)
+        return (cp[:, keep] / nrm[keep]).T
+
+    def statistic(self, y: np.ndarray, col: np.ndarray) -> float:
+        """(c⊥ᵀ Σ⁻¹ r)₊² / (c⊥ᵀ Σ⁻¹ c⊥) for residual r = y − model: Δχ² of the GLS fit when the column is added."""
+        u = self.directions(col[:, None])
+        if u.size == 0:
+            return 0.0
+        rp = self._perp((y - self.model)[:, None])[:, 0]
+        return float(max(0.0, float(u[0] @ rp)) ** 2)
+
+    def threshold(self, family: np.ndarray, alpha: float, n_boot: int = 1000, seed: int = 0) -> float:
+        """(1 − α) quantile of the maximum statistic over ``family`` (n_tau, n_cols) on curves drawn from
+        the model: χ²_ν/ν marginals, Gaussian copula with the estimates' correlation."""
+        u = self.directions(family)
+        if u.size == 0:
+            return math.inf
+        rng = np.random.default_rng(seed)
+        z = self.corr_chol @ rng.standard_normal((self.model.size, n_boot))
+        pr = norm.cdf(z)
+        ystar = self.model[:, None] * chi2_dist.ppf(pr, self.nu[:, None]) / self.nu[:, None]
+        rp = self._perp(ystar - self.model[:, None])
+        stat = np.max(np.maximum(u @ rp, 0.0) ** 2, axis=0)
+        return float(np.quantile(stat, 1.0 - alpha))
+
+
+def exact_covariance(m, n_samples, fs, terms, theta) -> np.ndarray:
+    """Covariance of overlapping AVAR estimates at ``m`` for the five-term model ``theta`` (squared
+    coefficients ordered as ``terms``)."""
+    s_blk, t_blk = _covariance.covariance_blocks(m, n_samples, fs, terms)
+    return _covariance.assemble(s_blk, t_blk, theta, terms)

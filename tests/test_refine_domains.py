@@ -1,0 +1,188 @@
+"""refine() with default arguments on data with an undeclared effect: bandwidth, drift, regression on another
+channel, spectral lines — simulated and injected into real ADIS16405 noise; the calibrated test and the
+held-out error."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import signal
+
+import allanite
+from allanite.errors import ParameterError
+from allanite.model.effects import EFFECTS, drift_avar, filter_cutoff, filtered_white_avar
+from allanite.model.tracing import regression_fit
+
+FS = 100.0
+
+
+def _adis(shared_data, run, cols):
+    path = shared_data / "adis16405" / f"adis16405_run{run}_100Hz.csv.gz"
+    if not path.is_file():
+        pytest.skip(f"{path} not found")
+    log = allanite.read_log(path, fs=FS, columns=cols, unit="deg/s")
+    d = np.asarray(log.data, dtype=np.float64).reshape(-1, len(cols))
+    return d.T
+
+
+def _falls(st):
+    assert st.after["chi2_dof"] < st.before["chi2_dof"]
+    assert st.after["rms_adev_pct"] < st.before["rms_adev_pct"] + 0.5  # in-sample: never notably worse
+    assert st.after["heldout_rms_adev_pct"] < st.before["heldout_rms_adev_pct"]
+
+
+@pytest.mark.parametrize("kind, p", [("single_pole", 5.0), ("moving_average", 4), ("bartlett", 3)])
+def test_filtered_white_avar_matches_a_simulation(kind, p):
+    tau = np.array([0.01, 0.02, 0.05, 0.1, 1.0])
+    w = np.random.default_rng(0).normal(size=1_000_000) * np.sqrt(FS)
+    if kind == "single_pole":
+        a = np.exp(-2 * np.pi * p / FS)
+        y = signal.lfilter([1 - a], [1, -a], w)
+    else:
+        h = np.ones(p) / p
+        y = signal.lfilter(np.convolve(h, h) if kind == "bartlett" else h, [1], w)
+    sim = allanite.avar(y, FS, taus=tau).avar
+    exact = filtered_white_avar(tau, kind, p, FS)
+    np.testing.assert_allclose(sim, exact, rtol=0.03)
+    # unity DC gain: the curve tends to N²/τ
+    assert filtered_white_avar(100.0, kind, p, FS)[0] * 100.0 == pytest.approx(1.0, rel=1e-3)
+
+
+def test_filter_cutoffs_and_drift_closed_form():
+    assert filter_cutoff("moving_average", 2, FS) == pytest.approx(25.0, rel=0.01)  # cos²(πf/fs) = ½
+    fc = filter_cutoff("moving_average", 4, FS)
+    x = np.pi * fc / FS
+    assert (np.sin(4 * x) / (4 * np.sin(x))) ** 2 == pytest.approx(0.5, abs=2e-3)  # the −3 dB point
+    t = np.arange(200_000) / FS
+    tau = np.array([0.01, 1.0, 10.0, 100.0])
+    np.testing.assert_allclose(
+        drift_avar(tau, 300.0, FS, t.size), allanite.avar(np.exp(-t / 300.0), FS, taus=tau).avar, rtol=1e-9
+    )
+
+
+def test_registry_documents_every_effect():
+    for name in ("bandwidth", "drift", "regression", "sinusoid", "gauss_markov", "change_point"):
+        e = EFFECTS[name]
+        assert e.params and all(unit is not None for _, unit, _ in e.params)
+        assert name in (allanite.refine.__doc__ or "")
+    assert EFFECTS["bandwidth"].params[0][:2] == ("cutoff", "Hz")
+    assert EFFECTS["drift"].params[1][:2] == ("T", "s")
+    assert [p[0] for p in EFFECTS["regression"].params] == ["channel", "coefficient"]
+
+
+def test_finds_a_simulated_bandwidth():
+    w = allanite.simulate(400_000, FS, N=2e-3, K=2e-5, seed=3)
+    a = np.exp(-2 * np.pi * 8.0 / FS)
+    y = signal.lfilter([1 - a], [1, -a], w)
+    r = allanite.refine(y, FS)
+    assert r.found[0] == "bandwidth"
+    st = r.steps[0]
+    assert abs(st.params["cutoff"] / 8.0 - 1) < 0.2
+    _falls(st)
+    assert r.fit.coefficients["N"].value == pytest.approx(2e-3, rel=0.1)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="the drift passes its calibrated test (time-domain bootstrap) but the held-out ADEV error of "
+    "alternate blocks (τ ≤ block/9) does not fall, so it is not accepted — see docs/refinement.md, Limits",
+)
+def test_finds_a_simulated_warm_up_drift():
+    n = 400_000
+    t = np.arange(n) / FS
+    # a warm-up that stands out on the Allan curve (ADEV ≈ 5× the noise's near τ ≈ T/2)
+    y = allanite.simulate(n, FS, N=2e-3, K=2e-5, seed=6) + 0.03 * np.exp(-t / 400.0)
+    r = allanite.refine(y, FS, truth={"drift": {"amplitude": 0.03, "T": 400.0}})
+    st = next(s for s in r.steps if s.effect == "drift")
+    assert abs(st.truth_error["T"]) < 0.2 and abs(st.truth_error["amplitude"]) < 0.2
+    _falls(st)
+
+
+def test_clean_adis_run_names_its_bandwidth_not_sinusoids(shared_data):
+    (y,) = _adis(shared_data, 5, ["gyro_y"])
+    r = allanite.refine(y, FS)
+    assert r.found[0] == "bandwidth"
+    st = r.steps[0]
+    # the ADIS16405's gyro: a 2-tap moving average (decimation) — −3 dB at f_s/4
+    assert st.params["filter"] == "moving_average" and st.params["taps"] == 2
+    assert st.params["cutoff"] == pytest.approx(25.0, rel=0.05)
+    assert "sinusoid" not in r.found and "drift" not in r.found
+    _falls(st)
+    assert st.before["chi2_dof"] > 100 and st.after["chi2_dof"] < 2
+
+
+def test_adis_through_an_injected_decimation_filter(shared_data):
+    # the ADIS run filtered by a further 8-tap moving average: the cascade (−3 dB at 5.46 Hz) is named a
+    # bandwidth with its cutoff (the nearest of the family: a Bartlett FIR)
+    (y,) = _adis(shared_data, 5, ["gyro_y"])
+    z = signal.lfilter(np.ones(8) / 8, [1], y - y.mean())
+    r = allanite.refine(z, FS)
+    st = r.steps[0]
+    assert st.effect == "bandwidth" and abs(st.params["cutoff"] / 5.46 - 1) < 0.2
+    _falls(st)
+
+
+def test_adis_with_injected_sinusoid_at_0p02_hz(shared_data):
+    # issue 16: run 5 y + 0.03 °/s at 0.02 Hz was not found with default arguments (f0 reported 1.54 Hz)
+    (y,) = _adis(shared_data, 5, ["gyro_y"])
+    t = np.arange(y.size) / FS
+    sn = {"amplitude": 0.03, "f0": 0.02}
+    r = allanite.refine(y + sn["amplitude"] * np.sin(2 * np.pi * sn["f0"] * t + 0.3), FS, truth={"sinusoid": sn})
+    st = next(s for s in r.steps if s.effect == "sinusoid")
+    assert abs(st.truth_error["f0"]) < 0.02 and abs(st.truth_error["amplitude"]) < 0.2
+    assert st.evidence["domain"] == "psd"
+    assert r.found.count("sinusoid") == 1
+    _falls(st)
+
+
+def test_adis_with_injected_gauss_markov_and_g_sensitivity(shared_data):
+    # two effects at once in real noise: a Gauss–Markov rate and a g-sensitivity through the accelerometer
+    gx, az = _adis(shared_data, 2, ["gyro_x", "acc_z"])
+    gm = {"sigma": 0.05, "tc": 20.0}
+    g_sens = 2.0  # °/s per g: large, so that its Allan curve shows (the static log's acc_z is mostly noise)
+    y = gx + allanite.simulate(gx.size, FS, gauss_markov=[(gm["sigma"], gm["tc"])], seed=8) + g_sens * az
+    # the clean log already couples gyro_x to acc_z (≈ 1.03 °/s per g, t ≈ 13 over 8 blocks: what the data
+    # really has); the injected sensitivity adds to it
+    base = regression_fit(gx, az)["coefficient"]
+    assert base == pytest.approx(1.03, abs=0.1)
+    r = allanite.refine(
+        y, FS, channels={"acc_z": az}, truth={"gauss_markov": gm, "regression": {"coefficient": g_sens + base}}
+    )
+    st = next(s for s in r.steps if s.effect == "gauss_markov")
+    assert abs(st.truth_error["tc"]) < 0.2 and abs(st.truth_error["sigma"]) < 0.2
+    _falls(st)
+    rg = next(s for s in r.steps if s.effect == "regression")
+    assert rg.params["channel"] == "acc_z" and abs(rg.truth_error["coefficient"]) < 0.2
+    # held out in time: each half's coefficient lowers the other half's variance (the
+    # Allan-curve held-out error is not the right score for removing a white-like component: its level
+    # changes, not how well one half predicts the other — recorded, not asserted)
+    assert rg.evidence["heldout_variance_ratio"] < 1.0
+    # (in-sample, the Allan-curve fit does not improve here: 2.2 → 3.5 % — reported in docs/refinement.md)
+
+
+def test_calibrated_test_and_heldout_are_reported(gm_small=None):
+    y = allanite.simulate(200_000, FS, N=2e-3, K=2e-5, gauss_markov=[(6e-3, 5.0)], seed=12)
+    r = allanite.refine(y, FS)
+    assert r.found[:1] == ["gauss_markov"]
+    st = r.steps[0]
+    assert st.evidence["test"]["gls_score"] > st.evidence["test"]["threshold"] > 0
+    assert st.before["heldout_rms_adev_pct"] > st.after["heldout_rms_adev_pct"]
+    assert "held-out" in r.report().lower()
+    # curve-only input: no held-out error, and the result says so
+    c = allanite.refine(allanite.avar(y, FS, taus=allanite.tau_grid(y.size, FS, "exp", points=300)))
+    assert c.start_heldout_rms_adev_pct is None and "no held-out error" in c.heldout_note
+    assert all(s.after["heldout_rms_adev_pct"] is None for s in c.steps)
+
+
+def test_tau_range_auto_and_bad_arguments():
+    y = allanite.simulate(100_000, FS, N=2e-3, K=2e-5, seed=1)
+    r = allanite.refine(y, FS, tau_range="auto")
+    assert r.tau_range[0] >= 0.0 and not r.steps
+    with pytest.raises(ParameterError, match="tau_range"):
+        allanite.refine(y, FS, tau_range="all")
+    with pytest.raises(ParameterError, match="level"):
+        allanite.refine(y, FS, level=1.5)
+    with pytest.raises(ParameterError, match="channel 'T'"):
+        allanite.refine(y, FS, channels={"T": y[:10]})
+    with pytest.raises(ParameterError, match="channels need samples"):
+        allanite.refine(allanite.avar(y, FS), channels={"T": y})
