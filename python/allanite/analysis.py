@@ -81,6 +81,7 @@ def avar(
     workers=None,
     kf_rule: str = "textbook",
     decimate="auto",
+    taper: str = "rect",
 ) -> AllanResult:
     """Allan variance of a whole record.
 
@@ -116,6 +117,12 @@ def avar(
         reported as m = m'·D; the Allan part stays exact. ``"auto"`` (default): on a named τ grid,
         the smallest D that leaves ≤ 100 000 samples (records up to 100 000 samples stay exact);
         explicit τ are computed exactly. ``decimate=1``: always exact (O(N²); Ctrl-C stops it).
+    taper : {"rect", "hann", "hann_signal"}
+        Weighting of the terms (paper 002; docs/FORMULAS.md §10), ``estimator="oavar"`` only for the
+        tapers: ``"rect"`` (default) weights every squared difference equally; ``"hann"`` weights them
+        by a Hann taper (unbiased; the static counterpart of ``davar(..., taper="hann")``);
+        ``"hann_signal"`` tapers the samples themselves (paper 002 eq. 1; biased, see docs/tapers.md).
+        Named τ grids keep the m that leave at least 3 terms.
 
     Returns
     -------
@@ -134,11 +141,15 @@ def avar(
     array([1., 1., 1.])
     """
     entry = estimators.get(estimator, "static")
+    tapered = estimators.get_taper(taper, estimator)
     options = entry.check_options({"kf_rule": kf_rule, "decimate": decimate})
     cols, fs, is_multi = as_rate_columns(x, fs, input)
     assert entry.static is not None
     scaled, exps = _scale_columns(cols)
-    out = entry.static(scaled, fs, taus, workers, **options)
+    if tapered.static is None:
+        out = entry.static(scaled, fs, taus, workers, **options)
+    else:
+        out = tapered.static(scaled, fs, taus, workers)
     values: np.ndarray = _unscale(out.values, exps, entry.unit_power, cols, entry.label)
     kf: np.ndarray | float | None = out.kf
     if not is_multi:
@@ -154,6 +165,7 @@ def avar(
         input=input,
         source=out.source,
         kf=kf,
+        taper=taper,
     )
 
 
@@ -170,6 +182,7 @@ def davar(
     workers=None,
     max_memory=None,
     kf_rule: str = "textbook",
+    taper: str = "rect",
 ) -> DynamicAllanResult:
     """Dynamic Allan variance: the Allan variance of every sliding window (DAVAR).
 
@@ -209,6 +222,13 @@ def davar(
         raises :class:`~allanite.errors.MemoryBudgetError` at once, with a hop that fits.
     kf_rule : {"textbook", "stable32"}
         DHVAR only: range of each window's bias ratio, as for :func:`avar`.
+    taper : {"rect", "hann", "hann_signal"}
+        Weighting inside each window (paper 002; docs/FORMULAS.md §10), ``estimator="oavar"`` only for
+        the tapers. ``"hann"``: the M = window − 2m + 1 squared differences weighted by
+        w_i = ½ − ½·cos(2π(i + 1)/(M + 1)) and normalised by Σw — unbiased, O(1) per output (Rust core);
+        window = record gives ``avar(..., taper="hann")``. ``"hann_signal"``: the window's samples
+        tapered, then OAVAR (paper 002 eq. 1; biased, NumPy, O(window) per τ and window). Every τ
+        must leave at least 3 terms.
 
     Returns
     -------
@@ -228,6 +248,7 @@ def davar(
     array([ 1., 10.])
     """
     entry = estimators.get(estimator, "dynamic")
+    tapered = estimators.get_taper(taper, estimator)
     check_choice(method, "method", METHODS)
     options = entry.check_options({"kf_rule": kf_rule})
     cols, fs, is_multi = as_rate_columns(x, fs, input)
@@ -241,6 +262,8 @@ def davar(
             f"estimator {estimator!r} is computed with method={entry.methods[0]!r} only, got method={method!r}"
         )
     assert entry.dynamic is not None and entry.resolve_m is not None
+    if method not in tapered.methods:
+        raise ParameterError(f"taper {taper!r} is computed with method in {tapered.methods}, got method={method!r}")
     ms = entry.resolve_m(taus, window, fs)
     n_win = (n - window) // hop + 1
     n_axes = len(cols)
@@ -265,7 +288,10 @@ def davar(
     hop_core = min(hop, n)
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
     scaled, exps = _scale_columns(cols)
-    out = entry.dynamic(scaled, fs, window, hop_core, taus, method, workers, **options)
+    if tapered.dynamic is None:
+        out = entry.dynamic(scaled, fs, window, hop_core, taus, method, workers, **options)
+    else:
+        out = tapered.dynamic(scaled, fs, window, hop_core, taus, method, workers)
     out = dataclasses.replace(out, values=_unscale(out.values, exps, entry.unit_power, cols, entry.label))
     kf = out.kf
     return DynamicAllanResult(
@@ -283,4 +309,5 @@ def davar(
         input=input,
         source=out.source,
         kf=kf if (kf is None or is_multi) else kf[0],
+        taper=taper,
     )
