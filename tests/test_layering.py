@@ -37,6 +37,7 @@ LAYERS = {
     "simulation": 4,
     "datasets": 4,
     "_reference": 4,
+    "wavelet": 4,
     "model": 5,
     "forecast": 5,
     "report": 6,
@@ -258,4 +259,14 @@ PINNED = {
     "ParameterError": None,
     "MemoryBudgetError": None,
     "__version__": None,
+    "wavelet_split": [
+        ("x", P),
+        ("fs", P),
+        ("wavelet", K),
+        ("level", K),
+        ("bands", K),
+        ("trend", K),
+        ("trend_freq", K),
+    ],
+    "Split": None,
 }

@@ -16,6 +16,7 @@ from .io import Log, read_log
 from .model import CoefficientSeries, NoiseFit, Refinement, fit, information_bound, refine
 from .results import AllanResult, DynamicAllanResult
 from .simulation import simulate
+from .wavelet import Split, wavelet_split
 
 __all__ = [
     "avar",
@@ -43,4 +44,6 @@ __all__ = [
     "ParameterError",
     "MemoryBudgetError",
     "__version__",
+    "wavelet_split",
+    "Split",
 ]
