@@ -48,7 +48,8 @@ def test_user_grouping_and_periodic_trend():
     assert p.trend_freq == pytest.approx(0.5, abs=0.002)
     t = np.arange(y.size) / fs
     truth = 3.0 * np.sin(2 * np.pi * 0.5 * t + 0.3) + 0.5 * np.cos(2 * np.pi * 1.0 * t)
-    assert np.sqrt(np.mean((p.trend - truth) ** 2)) < 0.05  # noise σ = 1: the fit recovers the trend
+    # noise σ = 1, 11 parameters on 8192 samples: ≈ 0.04 rms from the noise alone
+    assert np.sqrt(np.mean((p.trend - truth) ** 2)) < 0.08
     q = allanite.wavelet_split(y, fs, trend="periodic", trend_freq=0.5)
     assert q.trend_freq == 0.5 and q.bands["low"]["levels"][0] == "a5"
 

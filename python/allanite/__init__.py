@@ -8,6 +8,7 @@ noise model with intervals), :func:`refine` (what a fitted model lacks). Errors 
 
 from ._core import __version__
 from .analysis import avar, davar
+from .combination import Combination, combine
 from .datasets import default_record
 from .errors import AllaniteError, InputError, MemoryBudgetError, ParameterError
 from .estimators.confidence import chi2_interval, confidence_intervals, edf_greenhall, edf_sp1065, identify_alpha
@@ -46,4 +47,6 @@ __all__ = [
     "__version__",
     "wavelet_split",
     "Split",
+    "combine",
+    "Combination",
 ]

@@ -180,6 +180,17 @@ def build_parser() -> argparse.ArgumentParser:
         "add a model-refinement section; a few seconds per axis and million samples",
     )
     ana.add_argument("--no-fit", action="store_true", help="skip the noise-model fit (whole record and per window)")
+    ana.add_argument(
+        "--taper",
+        choices=("hann", "hann_signal"),
+        help="add a section: the DAVAR with this taper beside the rectangular one, coefficients per window (paper 002)",
+    )
+    ana.add_argument(
+        "--split",
+        metavar="WAVELET",
+        help="add a section: wavelet split (e.g. db5, 5 levels) and the window-function combination "
+        "(low band rect, high band Hann), coefficients per window (paper 002)",
+    )
 
     out = rep.add_argument_group("output")
     out.add_argument(
@@ -319,6 +330,8 @@ def _report(args) -> int:
                 progress=progress,
                 estimator=args.estimator,
                 refine=args.refine,
+                taper=args.taper,
+                split=args.split,
             )
             if args.log is None:
                 progress.step("generating the bundled record")

@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from ._validate import as_rate_columns, check_choice, check_count
 from .errors import MissingDependencyError, ParameterError
@@ -25,9 +26,12 @@ __all__ = ["Split", "wavelet_split", "TRENDS", "level_bands", "periodic_trend"]
 #: ``trend=`` of :func:`wavelet_split`.
 TRENDS = ("a5", "periodic", "none")
 
-#: Harmonics of the table frequency in the periodic trend (scale-factor error at f0, misalignment and
-#: nonlinearity at 2·f0).
-HARMONICS = 2
+#: Harmonics of the table frequency in the periodic trend (scale-factor error at f0; an asymmetric scale
+#: factor, ∝ ω|ω|, puts power at 3·f0 and 5·f0; a quadratic one at 2·f0).
+HARMONICS = 5
+
+#: A periodic trend identified from the periodogram has at least this many cycles in the record.
+MIN_CYCLES = 20
 
 
 def _pywt():
@@ -129,8 +133,11 @@ def _check_bands(bands, level: int, trend: str) -> dict[str, tuple[str, ...]]:
 def periodic_trend(y: np.ndarray, fs: float, freq: float | None = None, harmonics: int = HARMONICS):
     """Least-squares fit of c + Σ_h (a_h cos 2πh·f0·t + b_h sin 2πh·f0·t) to each column of ``y``
     (samples, axes); returns (fitted trend, f0). Without ``freq``, f0 is the periodogram's peak (mean
-    removed, DC excluded) of the first column, refined to the frequency within ±1 bin that maximises
-    the fitted power."""
+    removed; the bin most prominent over the median of its ±25 neighbours, at least ``MIN_CYCLES`` cycles
+    in the record) of the first
+    column, refined to the frequency within ±1 bin that maximises
+    the fitted power; a fundamental of which that line is a harmonic is taken when its harmonics
+    explain > 5 % more power)."""
     n = y.shape[0]
     t = np.arange(n) / fs
 
@@ -143,11 +150,52 @@ def periodic_trend(y: np.ndarray, fs: float, freq: float | None = None, harmonic
     if freq is None:
         z = y[:, 0] - y[:, 0].mean()
         spec = np.abs(np.fft.rfft(z)) ** 2
-        k = int(np.argmax(spec[1:])) + 1
+        # the most prominent line, not the largest bin: slow noise (random walk, flicker) holds the
+        # largest power at the lowest frequencies; judge each bin against its neighbourhood's median
+        half = 25
+        pad = np.pad(spec, half, mode="edge")
+        background = np.median(np.lib.stride_tricks.sliding_window_view(pad, 2 * half + 1), axis=1)
+        # and at least MIN_CYCLES cycles in the record: the lowest bins of a random walk are not a table
+        if spec.size <= MIN_CYCLES + 1:
+            raise ParameterError(
+                f"{n} samples are too few to identify a periodic trend ({MIN_CYCLES} cycles needed): give trend_freq"
+            )
+        k = int(np.argmax(spec[MIN_CYCLES:] / np.maximum(background[MIN_CYCLES:], 1e-300))) + MIN_CYCLES
         df = fs / n
-        grid = np.linspace(max((k - 1) * df, df / 4), (k + 1) * df, 41)
-        power = [np.sum((design(f) @ np.linalg.lstsq(design(f), z, rcond=None)[0]) ** 2) for f in grid]
-        freq = float(grid[int(np.argmax(power))])
+
+        def fitted_power(f):
+            # ‖projection of z on the columns‖² = bᵀG⁻¹b by the normal equations: the columns (mean,
+            # cos, sin of distinct harmonics) are near-orthogonal, so G is well conditioned
+            a = design(f)
+            b = a.T @ z
+            return float(b @ np.linalg.solve(a.T @ a, b))
+
+        def best_near(f_c):
+            # a grid over ±1 bin, then a bounded scalar search around its best point: a phase drift of
+            # 2π·Δf·T over the record must stay ≪ 1 rad, so Δf ≪ 1/T (a fraction of a bin)
+            grid = np.linspace(max(f_c - df, df / 4), f_c + df, 21)
+            power = [fitted_power(f) for f in grid]
+            i = int(np.argmax(power))
+            step = grid[1] - grid[0]
+            res = minimize_scalar(
+                lambda f: -fitted_power(f),
+                bounds=(grid[i] - step, grid[i] + step),
+                method="bounded",
+                options={"xatol": 1e-6 * df},
+            )
+            if -res.fun > power[i]:
+                return float(res.x), float(-res.fun)
+            return float(grid[i]), float(power[i])
+
+        # the most prominent line may be a harmonic (an asymmetric scale factor puts much power at 3·f0):
+        # try the fundamentals it could be a harmonic of; a lower one must explain clearly more power
+        freq, best = best_near(k * df)
+        for h in range(2, harmonics + 1):
+            if k * df / h < 2 * df:
+                break
+            f_h, p_h = best_near(k * df / h)
+            if p_h > 1.05 * best:
+                freq, best = f_h, p_h
     elif not (np.isfinite(freq) and 0 < freq < fs / 2):
         raise ParameterError(f"trend_freq = {freq!r} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
     a = design(freq)

@@ -49,6 +49,7 @@ from ..units import adev_unit_label, parse_unit
 from .figures import figure_specs
 from .fmt import json_number
 from .page import html_page
+from .paper002 import compute as paper002_sections
 from .settings import (
     DHVAR_MAX_DEFAULT_WINDOW,
     DHVAR_MAX_WINDOWS,
@@ -111,6 +112,8 @@ class Report:
     created: str = ""
     #: per axis :class:`~allanite.Refinement` (``refine=True``), else None
     refinements: list[Refinement | None] | None = None
+    #: the paper-002 sections (``taper=`` / ``split=``; :mod:`allanite.report.paper002`), else None
+    paper002: dict | None = None
     _summary: dict | None = field(default=None, repr=False)
 
     # ---------------------------------------------------------------------------- properties
@@ -213,6 +216,8 @@ def build_report(
     progress=None,
     estimator: str = "oavar",
     refine: bool = False,
+    taper: str | None = None,
+    split: str | None = None,
 ) -> Report:
     """Compute everything the report shows.
 
@@ -384,8 +389,25 @@ def build_report(
             except AllaniteError as exc:
                 refinements.append(None)
                 notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")
+    paper002 = None
+    if taper or split:
+        progress.step("paper 002 sections")
+        paper002 = paper002_sections(
+            x,
+            fs,
+            input=input,
+            window=dynamic.window,
+            hop=dynamic.hop,
+            taus=dynamic.tau,
+            unit=unit_name,
+            axis_names=axis_names,
+            taper=taper,
+            split=split,
+            notes=notes,
+        )
     created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
     return Report(
+        paper002=paper002,
         refinements=refinements,
         static=static,
         dynamic=dynamic,

@@ -16,6 +16,7 @@ import jinja2
 
 from .._core import __version__
 from .fmt import duration, g
+from .paper002 import page_context as paper002_page
 from .settings import REPORT_ESTIMATORS
 
 __all__ = ["html_page"]
@@ -342,6 +343,7 @@ def html_page(rep: Any, images: dict) -> str:
         "dynamic": _dynamic(dy, st["source"] is not None, au),
         "series": _series(fit),
         "refinement": _refinement(s.get("refinement")),
+        "paper002": paper002_page(s.get("paper002")),
         "figures": figures,
     }
     return _template().render(**context).rstrip() + "\n"
