@@ -9,9 +9,9 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
-import _common
 import numpy as np
 
+import _common
 import allanite
 
 OUT = _common.HERE / "results" / "hann_timing.md"
