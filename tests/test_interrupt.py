@@ -29,6 +29,12 @@ def _davar_long():
     return lambda: _core.davar([y], y.size - 99, 1, list(range(1, 6001)), "oavar", "fast", WORKERS)
 
 
+def _davar_hann_long():
+    y = np.random.default_rng(5).normal(size=2_000_000)
+    # the Hann-weighted kernel (issue 14) on the same geometry as _davar_long
+    return lambda: _core.davar_hann([y], y.size - 99, 1, list(range(1, 6001)), "fast", WORKERS)
+
+
 def _theo1_static_long():
     y = np.random.default_rng(2).normal(size=800_000)
     # m up to N: the O(N²) pass over the whole record, ~57 s on one worker.
@@ -49,6 +55,7 @@ def _mtotvar_long():
 
 LONG_CALLS = {
     "davar": _davar_long,
+    "davar_hann": _davar_hann_long,
     "mtotvar": _mtotvar_long,
     "theo1_static": _theo1_static_long,
     "theo1_dynamic": _theo1_dynamic_long,

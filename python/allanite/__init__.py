@@ -9,6 +9,7 @@ DAVAR, paper 004; its coefficient series are forecast by :mod:`allanite.forecast
 
 from ._core import __version__
 from .analysis import avar, davar
+from .combination import Combination, combine
 from .datasets import default_record
 from .errors import AllaniteError, InputError, MemoryBudgetError, ParameterError
 from .estimators.confidence import chi2_interval, confidence_intervals, edf_greenhall, edf_sp1065, identify_alpha
@@ -18,6 +19,7 @@ from .kalibr import to_kalibr
 from .model import CoefficientSeries, NoiseFit, Refinement, TimeFrames, fit, frames, information_bound, refine
 from .results import AllanResult, DynamicAllanResult
 from .simulation import simulate
+from .wavelet import Split, wavelet_split
 
 __all__ = [
     "avar",
@@ -48,4 +50,8 @@ __all__ = [
     "ParameterError",
     "MemoryBudgetError",
     "__version__",
+    "wavelet_split",
+    "Split",
+    "combine",
+    "Combination",
 ]

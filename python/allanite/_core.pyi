@@ -16,6 +16,16 @@ def davar(
 ) -> npt.NDArray[np.float64]:
     """Allan variance of every window at every m for every axis: shape (axes, len(ms), windows)."""
 
+def davar_hann(
+    columns: Sequence[npt.NDArray[np.float64]],
+    window: int,
+    hop: int,
+    ms: Sequence[int],
+    method: str,
+    workers: int,
+) -> npt.NDArray[np.float64]:
+    """Hann-weighted overlapping Allan variance of every window: shape (axes, len(ms), windows)."""
+
 def theo1_static(
     columns: Sequence[npt.NDArray[np.float64]],
     ms: Sequence[int],

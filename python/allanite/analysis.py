@@ -87,6 +87,7 @@ def avar(
     kf_rule: str = "textbook",
     decimate="auto",
     gaps: str = "error",
+    taper: str = "rect",
 ) -> AllanResult:
     """Allan variance of a whole record.
 
@@ -133,6 +134,12 @@ def avar(
         :class:`~allanite.errors.ParameterError`). allantools' ``gradev`` instead skips a term when one
         of its own *phase* points is NaN: the same at m = 1, more terms kept for m > 1 (it uses phase
         differences across a gap, which are unknown when samples of rate are missing).
+    taper : {"rect", "hann", "hann_signal"}
+        Weighting of the terms (paper 002; docs/FORMULAS.md §10), ``estimator="oavar"`` only for the
+        tapers: ``"rect"`` (default) weights every squared difference equally; ``"hann"`` weights them
+        by a Hann taper (unbiased; the static counterpart of ``davar(..., taper="hann")``);
+        ``"hann_signal"`` tapers the samples themselves (paper 002 eq. 1; biased, see docs/tapers.md).
+        Named τ grids keep the m that leave at least 3 terms.
 
     Returns
     -------
@@ -152,13 +159,19 @@ def avar(
     """
     check_choice(gaps, "gaps", GAPS)
     if gaps == "skip":
+        if taper != "rect":
+            raise ParameterError(f"gaps='skip' works with taper='rect' only, got taper={taper!r}")
         return _avar_skipping_gaps(x, fs, input, taus, estimator, workers)
     entry = estimators.get(estimator, "static")
+    tapered = estimators.get_taper(taper, estimator)
     options = entry.check_options({"kf_rule": kf_rule, "decimate": decimate})
     cols, fs, is_multi = as_rate_columns(x, fs, input)
     assert entry.static is not None
     scaled, exps = _scale_columns(cols)
-    out = entry.static(scaled, fs, taus, workers, **options)
+    if tapered.static is None:
+        out = entry.static(scaled, fs, taus, workers, **options)
+    else:
+        out = tapered.static(scaled, fs, taus, workers)
     values: np.ndarray = _unscale(out.values, exps, entry.unit_power, cols, entry.label)
     kf: np.ndarray | float | None = out.kf
     if not is_multi:
@@ -174,6 +187,7 @@ def avar(
         input=input,
         source=out.source,
         kf=kf,
+        taper=taper,
     )
 
 
@@ -224,6 +238,7 @@ def davar(
     max_memory=None,
     kf_rule: str = "textbook",
     progress=None,
+    taper: str = "rect",
 ) -> DynamicAllanResult:
     """Dynamic Allan variance: the Allan variance of every sliding window (DAVAR).
 
@@ -268,6 +283,13 @@ def davar(
         shows it in a notebook or a terminal when the windows hold ≥ ``DHVAR_BAR_SAMPLES`` samples in
         all, True always, False never. With a bar the windows are computed in up to 20 groups (each
         window is computed on its own samples either way).
+    taper : {"rect", "hann", "hann_signal"}
+        Weighting inside each window (paper 002; docs/FORMULAS.md §10), ``estimator="oavar"`` only for
+        the tapers. ``"hann"``: the M = window − 2m + 1 squared differences weighted by
+        w_i = ½ − ½·cos(2π(i + 1)/(M + 1)) and normalised by Σw — unbiased, O(1) per output (Rust core);
+        window = record gives ``avar(..., taper="hann")``. ``"hann_signal"``: the window's samples
+        tapered, then OAVAR (paper 002 eq. 1; biased, NumPy, O(window) per τ and window). Every τ
+        must leave at least 3 terms.
 
     Returns
     -------
@@ -287,6 +309,7 @@ def davar(
     array([ 1., 10.])
     """
     entry = estimators.get(estimator, "dynamic")
+    tapered = estimators.get_taper(taper, estimator)
     check_choice(method, "method", METHODS)
     options = entry.check_options({"kf_rule": kf_rule})
     cols, fs, is_multi = as_rate_columns(x, fs, input)
@@ -300,6 +323,8 @@ def davar(
             f"estimator {estimator!r} is computed with method={entry.methods[0]!r} only, got method={method!r}"
         )
     assert entry.dynamic is not None and entry.resolve_m is not None
+    if method not in tapered.methods:
+        raise ParameterError(f"taper {taper!r} is computed with method in {tapered.methods}, got method={method!r}")
     ms = entry.resolve_m(taus, window, fs)
     n_win = (n - window) // hop + 1
     n_axes = len(cols)
@@ -325,7 +350,9 @@ def davar(
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
     scaled, exps = _scale_columns(cols)
     big = n_win * window >= DHVAR_BAR_SAMPLES
-    if entry.family == "theo" and n_win >= 2 and show_progress(progress) and (big or progress is True):
+    if tapered.dynamic is not None:
+        out = tapered.dynamic(scaled, fs, window, hop_core, taus, method, workers)
+    elif entry.family == "theo" and n_win >= 2 and show_progress(progress) and (big or progress is True):
         out = _in_groups(entry, scaled, fs, window, hop_core, taus, method, workers, options, n_win, progress)
     else:
         out = entry.dynamic(scaled, fs, window, hop_core, taus, method, workers, **options)
@@ -346,6 +373,7 @@ def davar(
         input=input,
         source=out.source,
         kf=kf if (kf is None or is_multi) else kf[0],
+        taper=taper,
     )
 
 

@@ -212,6 +212,17 @@ def build_parser() -> argparse.ArgumentParser:
         help="frames that build / check the forecast (e.g. 60:30; default 2/3 : 1/3 of the frames); without "
         "--frames the record is cut into BUILD+CHECK frames",
     )
+    ana.add_argument(
+        "--taper",
+        choices=("hann", "hann_signal"),
+        help="add a section: the DAVAR with this taper beside the rectangular one, coefficients per window (paper 002)",
+    )
+    ana.add_argument(
+        "--split",
+        metavar="WAVELET",
+        help="add a section: wavelet split (e.g. db5, 5 levels) and the window-function combination "
+        "(low band rect, high band Hann), coefficients per window (paper 002)",
+    )
 
     out = rep.add_argument_group("output")
     out.add_argument(
@@ -400,6 +411,8 @@ def _report(args) -> int:
                 refine=args.refine,
                 frames=args.frames,
                 forecast=args.forecast,
+                taper=args.taper,
+                split=args.split,
             )
             if args.log is None:
                 progress.step("generating the bundled record")

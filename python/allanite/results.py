@@ -265,6 +265,8 @@ class AllanResult(_ResultBase):
     #: ``"theo1"``, ``"theobr"``) and TheoBR's bias ratio kf (per axis; per axis and window for DHVAR).
     source: np.ndarray | None = None
     kf: np.ndarray | float | None = None
+    #: Weighting of the terms inside the window (``"rect"``, ``"hann"``, ``"hann_signal"``; paper 002).
+    taper: str = "rect"
 
     def __repr__(self) -> str:
         axes = f", {self.n_axes} axes" if self.n_axes else ""
@@ -422,6 +424,8 @@ class DynamicAllanResult(_ResultBase):
     #: ``"theo1"``, ``"theobr"``) and TheoBR's bias ratio kf (per axis; per axis and window for DHVAR).
     source: np.ndarray | None = None
     kf: np.ndarray | float | None = None
+    #: Weighting of the terms inside the window (``"rect"``, ``"hann"``, ``"hann_signal"``; paper 002).
+    taper: str = "rect"
 
     _time_dims = ("t",)
 

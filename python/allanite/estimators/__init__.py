@@ -6,7 +6,7 @@ the noise identification and the χ² intervals; ``grid`` the τ grids. Nothing 
 objects — :mod:`allanite.analysis` does, above this package.
 """
 
-from . import allan, deviations, theo  # noqa: F401  (each registers its estimators)
+from . import allan, deviations, taper, theo  # noqa: F401  (each registers its estimators / tapers)
 from ._registry import Computed, Estimator, Taper, get, get_taper, names
 from .grid import GRIDS, tau_grid
 

@@ -148,12 +148,20 @@ def get(name: object, kind: str | None = None) -> Estimator:
 class Taper:
     """A window weighting of the terms inside each window.
 
-    ``estimators``: the estimators it applies to (None: every one).
+    ``estimators``: the estimators it applies to (None: every one). ``static`` / ``dynamic``: the
+    functions that compute the tapered estimator, with the signatures of :class:`Estimator`'s (no
+    options); None for ``"rect"``, which is the estimator's own computation. ``edf_factor(m, window)``:
+    the share of the untapered estimator's EDF a tapered estimate keeps (None: no EDF model).
+    ``methods``: the ``method=`` values the dynamic form offers.
     """
 
     name: str
     label: str
     estimators: tuple[str, ...] | None = None
+    static: Callable[..., Computed] | None = None
+    dynamic: Callable[..., Computed] | None = None
+    edf_factor: Callable[..., Any] | None = None
+    methods: tuple[str, ...] = ("fast", "naive")
 
 
 TAPERS: dict[str, Taper] = {}
@@ -180,4 +188,4 @@ def get_taper(name: object, estimator: str) -> Taper:
     return taper
 
 
-register_taper(Taper("rect", "rectangular (every term weighted equally)"))
+register_taper(Taper("rect", "rectangular (every term weighted equally)", edf_factor=lambda m, window: 1.0))

@@ -993,6 +993,12 @@ def confidence_intervals(
     else:
         nu = edf_of(result.estimator if result.source is None else result.source, a, m_b, n_phase)
     nu = np.asarray(nu, dtype=np.float64).reshape(shape_edf)
+    taper = _registry.TAPERS[getattr(result, "taper", "rect")]
+    if taper.edf_factor is None:
+        raise ParameterError(f"taper {taper.name!r} has no model of its equivalent degrees of freedom")
+    if taper.name != "rect":
+        # the tapered estimate keeps the share (Σw)²/(M·Σw²) of the rectangular window's ν
+        nu = nu * taper.edf_factor(m_b, n_phase - 1)
     nu_b = nu[..., None] if dynamic else nu
     if np.all(np.isfinite(nu)):
         low, high = chi2_interval(result.avar, nu_b, c, method=chi2)

@@ -51,6 +51,7 @@ from .figures import figure_specs
 from .fmt import json_number
 from .forecasting import check_forecast_options, plan_forecast, run_forecast
 from .page import html_page
+from .paper002 import compute as paper002_sections
 from .settings import (
     DHVAR_MAX_DEFAULT_WINDOW,
     DHVAR_MAX_WINDOWS,
@@ -119,6 +120,8 @@ class Report:
     forecasts: list | None = None
     forecast_settings: dict | None = None
     forecast_error: str | None = None
+    #: the paper-002 sections (``taper=`` / ``split=``; :mod:`allanite.report.paper002`), else None
+    paper002: dict | None = None
     _summary: dict | None = field(default=None, repr=False)
 
     # ---------------------------------------------------------------------------- properties
@@ -228,6 +231,8 @@ def build_report(
     refine: bool = False,
     frames=None,
     forecast=None,
+    taper: str | None = None,
+    split: str | None = None,
 ) -> Report:
     """Compute everything the report shows.
 
@@ -279,12 +284,12 @@ def build_report(
         BUILD + CHECK frames.
     """
     notes = list(notes)
-    frame_s, split = check_forecast_options(frames, forecast)
+    frame_s, fc_split = check_forecast_options(frames, forecast)
     x = np.asarray(x) if not isinstance(x, np.ndarray) else x
     plan = None
-    if frame_s is not None or split is not None:
+    if frame_s is not None or fc_split is not None:
         # before anything is computed: a frame or split that does not fit the record is the caller's option
-        plan = plan_forecast(int(x.shape[0]), float(fs), frame_s, split)
+        plan = plan_forecast(int(x.shape[0]), float(fs), frame_s, fc_split)
     progress, own_bar = _steps(progress, 5 + bool(refine) + (plan is not None), "report")
     if x.ndim == 1:
         x = x[:, None]
@@ -421,6 +426,22 @@ def build_report(
         except AllaniteError as exc:
             forecast_error = str(exc)
             notes.append(f"The coefficient forecast could not be computed: {exc}")
+    paper002 = None
+    if taper or split:
+        progress.step("paper 002 sections")
+        paper002 = paper002_sections(
+            x,
+            fs,
+            input=input,
+            window=dynamic.window,
+            hop=dynamic.hop,
+            taus=dynamic.tau,
+            unit=unit_name,
+            axis_names=axis_names,
+            taper=taper,
+            split=split,
+            notes=notes,
+        )
     created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
     if own_bar:
         progress.close()
@@ -429,6 +450,7 @@ def build_report(
         forecasts=forecasts,
         forecast_settings=forecast_settings,
         forecast_error=forecast_error,
+        paper002=paper002,
         refinements=refinements,
         static=static,
         dynamic=dynamic,

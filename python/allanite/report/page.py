@@ -17,6 +17,7 @@ import jinja2
 from .._core import __version__
 from .fmt import duration, g
 from .forecasting import forecast_page
+from .paper002 import page_context as paper002_page
 from .settings import REPORT_ESTIMATORS
 
 __all__ = ["html_page"]
@@ -359,6 +360,7 @@ def html_page(rep: Any, images: dict) -> str:
         "series": _series(fit),
         "refinement": _refinement(s.get("refinement")),
         "forecast": forecast_page(s.get("forecast")),
+        "paper002": paper002_page(s.get("paper002")),
         "figures": figures,
     }
     return _template().render(**context).rstrip() + "\n"

@@ -13,6 +13,7 @@ from ..model.terms import TERM_NAMES
 from ..units import coefficient_unit, ieee952
 from .fmt import duration, g, json_list, json_number, pct
 from .forecasting import forecast_dict, forecast_text
+from .paper002 import text_lines as paper002_text
 from .settings import FIT_MODEL
 
 __all__ = ["summarize", "text_summary", "refinement_dict"]
@@ -321,6 +322,7 @@ def summarize(rep) -> dict:
         "fit": fit,
         "refinement": refinement_dict(rep),
         "forecast": forecast_dict(rep),
+        "paper002": getattr(rep, "paper002", None),
         "conventions": "times and τ in s (keys ending _s), fs in Hz; Allan deviations in adev_unit (the samples' "
         "rate unit); coefficients: value/ci in base form ('unit'), ieee/ieee_ci in IEEE-952 units "
         "('ieee_unit'); intervals at 'confidence'; null = does not exist (unknown unit, unbounded "
@@ -447,4 +449,5 @@ def text_summary(s: dict) -> str:
                 )
                 lines.append(f"    {st['effect']}: {params}")
     lines += forecast_text(s.get("forecast"))
+    lines += paper002_text(s.get("paper002"))
     return "\n".join(lines)

@@ -328,7 +328,7 @@ impl TermScratch {
 /// order); `scale` folds the estimator's normalisation into the pass that forms the terms.
 /// Stops early (the chunks seen so far are then incomplete) once `cancel` is set.
 /// Requires 1 ≤ k_end ≤ y.len() + 1 − 2m.
-fn for_each_term_chunk(
+pub(crate) fn for_each_term_chunk(
     y: &[f64],
     mu: f64,
     m: usize,

@@ -7,6 +7,7 @@ pub mod allan;
 pub mod cancel;
 pub mod deviations;
 pub mod error;
+pub mod taper;
 pub mod theo;
 
 pub use allan::{
@@ -15,6 +16,7 @@ pub use allan::{
 };
 pub use cancel::{run_in_pool_interruptible, Cancel};
 pub use error::{CoreError, Result};
+pub use taper::{dynamic_hann, dynamic_hann_cancellable, static_hann};
 pub use theo::{
     detrended_phase, dynamic_theo1, dynamic_theo1_cancellable, static_theo1,
     static_theo1_cancellable, theo1_direct,

@@ -7,6 +7,7 @@
 //! `&Cancel` (see allanite_core::cancel) and the binding calls it as
 //! `run_interruptible(py, workers, |cancel| kernel_cancellable(..., cancel))`.
 
+use allanite_core::dynamic_hann_cancellable;
 use allanite_core::{
     deviations, dynamic_avar_cancellable, dynamic_theo1_cancellable, run_in_pool_interruptible,
     static_theo1_cancellable, Cancel, CoreError, Estimator, Method, Request,
@@ -126,6 +127,37 @@ fn davar<'py>(
     };
     let (values, n_win) =
         run_interruptible(py, workers, |cancel| dynamic_avar_cancellable(&req, cancel))?;
+    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// Hann-weighted overlapping Allan variance of every window at every averaging factor, for every
+/// axis (paper 002; docs/FORMULAS.md §10): shape (axes, len(ms), windows). `window == len(record)`
+/// gives the static estimator. Every m must leave M = window + 1 − 2m ≥ 3 terms.
+#[pyfunction]
+#[pyo3(signature = (columns, window, hop, ms, method, workers))]
+fn davar_hann<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    window: usize,
+    hop: usize,
+    ms: Vec<usize>,
+    method: &str,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let method = parse_method(py, method)?;
+    let slices = contiguous(py, &columns)?;
+    let req = Request {
+        columns: &slices,
+        window,
+        hop,
+        ms: &ms,
+        estimator: Estimator::Overlapping,
+        method,
+    };
+    let (values, n_win) =
+        run_interruptible(py, workers, |cancel| dynamic_hann_cancellable(&req, cancel))?;
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
@@ -339,6 +371,7 @@ fn tierms_phase<'py>(
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
+    m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_static, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_dynamic, m)?)?;
     m.add_function(wrap_pyfunction!(deviation_static, m)?)?;
