@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -136,3 +137,93 @@ def test_bad_input_is_named(client):
         adask.avar(da.from_array(np.ones(100), chunks=10), 1.0, estimator="theo1")
     with pytest.raises(ParameterError, match="longer than the record"):
         adask.davar(da.from_array(np.ones(100), chunks=10), 1.0, window=101)
+
+
+# ------------------------------------------------------------------------------------------------
+# fleets
+
+
+def _fleet(root, n_good=3, seed=1):
+    import gzip
+
+    rng = np.random.default_rng(seed)
+    for i in range(n_good):
+        d = root / "logs" / ("a" if i < 2 else "b")
+        d.mkdir(parents=True, exist_ok=True)
+        y = rng.normal(size=(4_000, 2)) * (30.0 if i == n_good - 1 else 1.0)
+        with gzip.open(d / f"s{i}.csv.gz", "wt") as f:
+            f.write("gx,gy\n")
+            np.savetxt(f, y, fmt="%.8e", delimiter=",")
+    (root / "logs" / "b" / "bad.csv.gz").write_bytes(b"not gzip at all")
+    return str(root / "logs" / "**" / "*.csv.gz")
+
+
+def test_batch_reports_each_file_and_survives_a_malformed_one(client, tmp_path):
+    import csv
+
+    from allanite.report import from_log
+
+    pattern = _fleet(tmp_path)
+    out = tmp_path / "res"
+    res = adask.batch(pattern, out=out, fs=100.0, unit="deg/s", client=client)
+    status = {Path(f["path"]).name: f["status"] for f in res.files}
+    assert status == {"s0.csv.gz": "ok", "s1.csv.gz": "ok", "s2.csv.gz": "ok", "bad.csv.gz": "error"}
+    assert "gzip" in res.failed[0]["error"]
+    for rel in ("a/s0", "a/s1", "b/s2"):
+        assert (out / rel / "report.html").is_file() and (out / rel / "summary.json").is_file()
+    assert not list(out.rglob(".*tmp-*"))  # nothing half-written
+    # the fleet table: the same N as `allanite report` on one file
+    rows = list(csv.DictReader((out / "fleet.csv").open(encoding="utf-8")))
+    assert len(rows) == 3 * 2 + 1
+    one = from_log(allanite.read_log(tmp_path / "logs" / "a" / "s1.csv.gz", fs=100.0, unit="deg/s"))
+    r = next(r for r in rows if r["file"].endswith("s1.csv.gz") and r["axis"] == "gy")
+    assert float(r["N"]) == pytest.approx(one.fits[1].coefficients["N"].ieee, rel=1e-12)
+    bad = next(r for r in rows if r["status"] == "error")
+    assert "gzip" in bad["error"]
+    assert (out / "fleet.html").read_text(encoding="utf-8").count("bad.csv.gz") >= 1
+    # --resume: nothing newer, nothing redone
+    again = adask.batch(pattern, out=out, fs=100.0, unit="deg/s", client=client, resume=True)
+    assert sorted(f["status"] for f in again.files) == ["error", "skipped", "skipped", "skipped"]
+
+
+def test_robust_z_flags_the_outlier():
+    from allanite.dask.fleet import robust_z
+
+    z = robust_z([1.0, 1.1, 0.9, 1.05, 0.95, 30.0])
+    assert abs(z[-1]) > 3.5 and np.all(np.abs(z[:-1]) < 3.5)
+
+
+def test_batch_survives_a_killed_worker(tmp_path):
+    import os
+    import signal
+    import threading
+    import time
+
+    pattern = _fleet(tmp_path, n_good=4, seed=2)
+    out = tmp_path / "res"
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+        ) as cluster,
+        Client(cluster, timeout="30s") as c,
+    ):
+        pids = list(c.run(os.getpid).values())
+        killed = []
+
+        def killer():
+            deadline = time.monotonic() + 60
+            while time.monotonic() < deadline and not killed:
+                if list(out.rglob(".*tmp-*")):  # a report is being written: kill its worker mid-run
+                    os.kill(pids[0], signal.SIGKILL)
+                    killed.append(pids[0])
+                time.sleep(0.01)
+
+        t = threading.Thread(target=killer, daemon=True)
+        t.start()
+        res = adask.batch(pattern, out=out, fs=100.0, client=c, retries=3)
+        t.join()
+    assert killed, "no worker was killed"
+    assert sorted(f["status"] for f in res.files) == ["error", "ok", "ok", "ok", "ok"]
+    for rel in ("a/s0", "a/s1", "b/s2", "b/s3"):
+        assert (out / rel / "summary.json").is_file()
+    assert not list(out.rglob(".*tmp-*"))

@@ -6,5 +6,6 @@ summary. ``import allanite`` never imports this package (nor dask).
 """
 
 from .arrays import avar, davar
+from .fleet import FleetResult, batch
 
-__all__ = ["avar", "davar"]
+__all__ = ["avar", "davar", "batch", "FleetResult"]
