@@ -227,3 +227,26 @@ def test_batch_survives_a_killed_worker(tmp_path):
     for rel in ("a/s0", "a/s1", "b/s2", "b/s3"):
         assert (out / rel / "summary.json").is_file()
     assert not list(out.rglob(".*tmp-*"))
+
+
+def test_zarr_record(client, tmp_path):
+    zarr = pytest.importorskip("zarr", reason="zarr not installed")
+    y = _record(12_345, 2)
+    z = zarr.create_array(store=str(tmp_path / "rec.zarr"), shape=y.shape, chunks=(1000, 2), dtype="f8")
+    z[:] = y
+    x = da.from_zarr(str(tmp_path / "rec.zarr"))
+    ref = allanite.avar(y, 100.0)
+    assert _rel(adask.avar(x, 100.0, chunk=3000, client=client).avar, ref.avar) <= REL
+    refd = allanite.davar(y[:, :1], 100.0, window=3_001, hop=500)
+    with client.as_current():
+        got = adask.davar(x[:, :1], 100.0, window=3_001, hop=500, chunk=2_000)
+    assert _rel(got.avar, refd.avar) <= REL
+
+
+def test_cli_batch_help(capsys):
+    from allanite.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["batch", "--help"])
+    assert exc.value.code == 0
+    assert "--dask-workers" in capsys.readouterr().out
