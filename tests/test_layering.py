@@ -10,7 +10,7 @@ a tangle. The layers, bottom up (a module may import only from its own layer or 
     4  analysis, simulation, datasets, _reference
     5  model.*, forecast                   terms, covariance, fit, effects, refine; GM(1,1) forecasts
     6  report.*
-    7  cli, __main__, __init__
+    7  cli, __main__, __init__, dask.*     allanite.dask: arrays larger than memory, fleets (never imported by allanite)
 """
 
 from __future__ import annotations
@@ -47,6 +47,7 @@ LAYERS = {
     "combination": 5,
     "report": 6,
     "cli": 7,
+    "dask": 7,
     "__main__": 7,
     "__init__": 7,
 }

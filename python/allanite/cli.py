@@ -34,7 +34,9 @@ allanite: static and dynamic Allan variance for gyroscopes, IMUs and clocks.
 
 commands:
   report    Allan deviation with intervals, IEEE-952 noise fit and dynamic Allan variance of a
-            log, as an HTML page, a JSON summary and PNG figures"""
+            log, as an HTML page, a JSON summary and PNG figures
+  batch     one report per log of a fleet, as Dask tasks, and a fleet summary (fleet.csv,
+            fleet.parquet, fleet.html); needs allanite[dask]"""
 
 EPILOG = """\
 Run 'allanite report --help' for the report's options; 'allanite report' alone analyses the
@@ -452,6 +454,11 @@ def _error(message: str) -> int:
 def main(argv=None) -> int:
     """Run the command line; returns the exit status (``--help``/``--version`` exit through SystemExit(0))."""
     parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["batch"]:  # fleets on Dask (issue 19): its own parser, dask imported only here
+        from .dask.fleet import main as batch_main
+
+        return batch_main(argv[1:])
     try:
         args = parser.parse_args(argv)
         if args.command is None:

@@ -1,0 +1,473 @@
+"""Static and dynamic Allan variance of a ``dask.array`` — records larger than memory.
+
+Both functions give the numbers of the single-machine calls (:func:`allanite.avar`,
+:func:`allanite.davar`) without ever holding the record in one place:
+
+* :func:`davar` rechunks the samples to chunks whose length is a multiple of the hop, appends the
+  next ``window − 1`` samples to every chunk (``map_overlap`` with ``depth={0: (0, window − 1)}``,
+  ``boundary="none"``, ``trim=False``) and calls :func:`allanite.davar` — the registry's Rust kernel,
+  the same code path as on one machine — on every block. A window is computed from its own samples
+  only, but the core centres each call's record on that record's own mean and aligns its block sums
+  to the record's start, so a block rounds differently from the whole record: equal to rounding
+  (≲ 1e-15 relative when |mean| ≲ 100 σ; ≈ ε·|mean|/σ·√m otherwise, 5e-11 at |mean| = 7000 σ), and
+  bitwise only when one block is the whole record. Bitwise everywhere would need a core entry taking
+  the record's mean and the block's offset.
+* :func:`avar` cannot do that: the overlap would be 2m samples, a whole record at the longest τ. It works
+  on the angle instead. Every rate sample y is split exactly into a whole number of quanta
+  q = 2^(E − 26) (2^E > max|y|) and a remainder |r| ≤ q/2: the cumulative sum of the quanta is an
+  exact int64 sum, chunk offsets included (Python integers on the client), and only the tiny
+  remainders are summed in floating point. Each τ's terms x[i+2m] − 2x[i+m] + x[i] come from three
+  shifted slices of that angle; each chunk returns its sum of squares and the client adds the
+  partial sums with :func:`math.fsum` (exact). The single-machine kernel sums block sums of the rate
+  in another order, so the two agree to rounding, not bitwise: ≤ 1e-12 relative (measured: a few
+  1e-16, see tests/test_dask.py).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import analysis, estimators
+from ..errors import InputError, MissingDependencyError, ParameterError
+from ..estimators.allan import n_terms
+from ..estimators.grid import resolve_taus
+from ..results import AllanResult, DynamicAllanResult
+
+try:
+    import dask
+    import dask.array as da
+except ImportError as exc:  # pragma: no cover - exercised only without the extra
+    raise MissingDependencyError("allanite.dask needs dask and distributed: pip install 'allanite[dask]'") from exc
+
+__all__ = ["davar", "avar", "davar_chunks", "DEFAULT_CHUNK"]
+
+#: Samples per chunk when the caller's chunks are rechunked (2^22 float64 = 32 MiB per axis).
+DEFAULT_CHUNK = 1 << 22
+
+#: Bits of a quantum below the largest sample: with |y/q| ≤ 2^26, a chunk of ≤ 2^36 samples sums
+#: exactly in int64 and a second difference at m < 2^26 is an exact float64.
+QUANTUM_BITS = 26
+
+_ESTIMATORS = ("oavar", "avar")
+_INPUTS = ("rate", "increment")
+
+
+def _as_dask(x) -> da.Array:
+    arr = x if isinstance(x, da.Array) else da.asarray(x)
+    if arr.ndim not in (1, 2):
+        raise InputError(f"samples must be 1-D (samples,) or 2-D (samples, axes), got {arr.ndim}-D shape {arr.shape}")
+    if arr.dtype.kind not in "iuf":
+        raise InputError(f"samples must be real numbers (integer or float dtype), got dtype {arr.dtype}")
+    if any(math.isnan(s) for s in arr.shape):
+        raise InputError("samples have an unknown length (NaN chunks): call .compute_chunk_sizes() first")
+    if arr.ndim == 2 and arr.shape[1] == 0:
+        raise InputError(f"samples have shape {arr.shape}: at least one axis is needed")
+    return arr
+
+
+def _check(estimator: str, input: str, fs) -> float:
+    if estimator not in _ESTIMATORS:
+        raise ParameterError(f"estimator {estimator!r}: allanite.dask computes {', '.join(map(repr, _ESTIMATORS))}")
+    if input not in _INPUTS:
+        raise ParameterError(f"input {input!r}: allanite.dask takes {', '.join(map(repr, _INPUTS))}")
+    try:
+        fs = float(fs)
+    except (TypeError, ValueError):
+        raise ParameterError(f"fs must be a positive finite number of Hz, got {fs!r}") from None
+    if not (math.isfinite(fs) and fs > 0):
+        raise ParameterError(f"fs must be a positive finite number of Hz, got {fs!r}")
+    return fs
+
+
+def davar_chunks(n: int, window: int, hop: int, target: int) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """Input chunks along the samples and DAVAR windows per chunk, for ``map_overlap``.
+
+    Every chunk but the last holds a multiple of ``hop`` samples (so each block's first window starts
+    on the global hop grid) and at least ``window − 1`` (so one neighbour supplies the whole overlap);
+    the last chunk takes the remainder. Block k then computes the windows that *start* in it; the
+    counts are exact — dask accepts wrong ``chunks=`` silently, so they are computed, not guessed.
+    """
+    size = max(target, window - 1, hop)
+    size = -(-size // hop) * hop
+    n_win = (n - window) // hop + 1
+    k = max(1, n // size)
+    chunks = [size] * (k - 1) + [n - size * (k - 1)]
+    counts = []
+    start = 0
+    for c in chunks:
+        first = -(-start // hop)  # first window index starting at or after `start`
+        last = min((start + c - 1) // hop, n_win - 1)  # last window index starting inside the chunk
+        counts.append(max(0, last - first + 1))
+        start += c
+    assert sum(counts) == n_win
+    return tuple(chunks), tuple(counts)
+
+
+def _davar_block(block, *, fs, window, hop, taus, method, estimator, input, n_tau, n_out, block_info=None):
+    """One block: the single-machine :func:`allanite.davar` on the chunk and its overlap, laid out
+    (windows, axes·τ) so the windows run along the samples' dimension."""
+    k = block_info[None]["chunk-location"][0] if block_info else 0
+    count = n_out[k]
+    n_axes = block.shape[1] if block.ndim == 2 else 1
+    if count == 0:
+        return np.zeros((0, n_axes * n_tau), dtype=np.float64)
+    # the block holds exactly the windows that start in chunk k (chunk lengths are multiples of hop)
+    use = block[: (count - 1) * hop + window]
+    res = analysis.davar(use, fs, window=window, hop=hop, taus=taus, method=method, estimator=estimator, input=input)
+    vals = res.avar if res.avar.ndim == 3 else res.avar[None]  # (axes, τ, windows)
+    if vals.shape[2] != count:  # pragma: no cover - a wrong chunk plan would be a bug
+        raise AssertionError(f"block {k}: {vals.shape[2]} windows, expected {count}")
+    return np.ascontiguousarray(vals.reshape(n_axes * n_tau, count).T)
+
+
+def davar(
+    x,
+    fs,
+    *,
+    window: int,
+    hop: int = 1,
+    taus="exp",
+    method: str = "fast",
+    estimator: str = "oavar",
+    input: str = "rate",
+    chunk: int | None = None,
+    compute: bool = True,
+):
+    """Dynamic Allan variance of a dask array: :func:`allanite.davar`, block by block.
+
+    Parameters
+    ----------
+    x : dask.array.Array or array_like, shape (samples,) or (samples, axes)
+        Rate or increment samples (e.g. ``da.from_zarr``, ``da.from_array(np.load(p, mmap_mode="r"))``,
+        an HDF5 dataset); any chunks — they are rechunked along the samples (one chunk across the axes).
+    fs, window, hop, taus, method, input
+        As for :func:`allanite.davar`.
+    estimator : {"oavar", "avar"}
+    chunk : int, optional
+        Samples per chunk before rounding up to a multiple of ``hop`` and to at least ``window − 1``
+        (default: the caller's first chunk, at least :data:`DEFAULT_CHUNK`/4).
+    compute : bool
+        True (default): a :class:`~allanite.DynamicAllanResult`, as the single-machine one.
+        False: the lazy (axes, τ, windows) dask array of the Allan variance.
+
+    Notes
+    -----
+    Equal to :func:`allanite.davar` to the core's rounding (see the module notes: the core centres each
+    block on the block's mean); bitwise when one block is the whole record. Memory per task: one chunk
+    plus ``window − 1`` samples plus its
+    output.
+    """
+    fs = _check(estimator, input, fs)
+    arr = _as_dask(x)
+    n = int(arr.shape[0])
+    if not isinstance(window, (int, np.integer)) or window < 2:
+        raise ParameterError(f"window must be an integer ≥ 2 samples, got {window!r}")
+    if not isinstance(hop, (int, np.integer)) or hop < 1:
+        raise ParameterError(f"hop must be an integer ≥ 1 sample, got {hop!r}")
+    window, hop = int(window), int(hop)
+    if window > n:
+        raise ParameterError(f"window ({window} samples) is longer than the record ({n} samples)")
+    entry = estimators.get(estimator, "dynamic")
+    assert entry.resolve_m is not None
+    ms = entry.resolve_m(taus, window, fs)
+    n_tau = int(ms.size)
+    n_axes = int(arr.shape[1]) if arr.ndim == 2 else 1
+    target = chunk if chunk is not None else max(int(arr.chunks[0][0]), DEFAULT_CHUNK // 4)
+    chunks, counts = davar_chunks(n, window, hop, int(target))
+    arr = arr.rechunk({0: chunks, 1: -1} if arr.ndim == 2 else {0: chunks})
+    kwargs = dict(
+        fs=fs, window=window, hop=hop, taus=taus, method=method, estimator=estimator, input=input, n_tau=n_tau
+    )
+    out_chunks = (counts, (n_axes * n_tau,))
+    if len(chunks) == 1:
+        out = arr.map_blocks(
+            _davar_block,
+            n_out=counts,
+            chunks=out_chunks,
+            dtype=np.float64,
+            new_axis=None if arr.ndim == 2 else 1,
+            **kwargs,
+        )
+    else:
+        out = arr.map_overlap(
+            _davar_block,
+            depth={0: (0, window - 1), 1: 0} if arr.ndim == 2 else {0: (0, window - 1)},
+            boundary="none",
+            trim=False,
+            allow_rechunk=False,
+            n_out=counts,
+            chunks=out_chunks,
+            dtype=np.float64,
+            new_axis=None if arr.ndim == 2 else [1],
+            **kwargs,
+        )
+    n_win = (n - window) // hop + 1
+    values = out.T.reshape(n_axes, n_tau, n_win)
+    if not compute:
+        return values
+    result = values.compute()
+    t = (np.arange(n_win) * float(hop) + window / 2) / fs
+    return DynamicAllanResult(
+        tau=ms / fs,
+        t=t,
+        avar=result if arr.ndim == 2 else result[0],
+        n=n_terms(estimator, window, ms),
+        m=ms,
+        window=window,
+        hop=hop,
+        method=method,
+        estimator=estimator,
+        fs=fs,
+        n_samples=n,
+        input=input,
+        source=None,
+        kf=None,
+    )
+
+
+# ------------------------------------------------------------------------------------------------
+# static: the exact angle
+
+
+def _rate(block, fs: float, input: str) -> np.ndarray:
+    b = np.asarray(block, dtype=np.float64)
+    if b.ndim == 1:
+        b = b[:, None]
+    # the single-machine conversion, element by element (allanite._validate.as_rate_columns)
+    return b * fs if input == "increment" else b
+
+
+def _peak_block(block, fs: float, input: str):
+    y = _rate(block, fs, input)
+    finite = np.isfinite(y)
+    if not finite.all():
+        i, a = np.unravel_index(int(np.argmin(finite)), y.shape)
+        return np.array([[math.inf, float(i), float(a)]])
+    return np.array([[float(np.max(np.abs(y))) if y.size else 0.0, -1.0, -1.0]])
+
+
+def _split(y: np.ndarray, q_exp: int) -> tuple[np.ndarray, np.ndarray]:
+    """y/q = whole quanta + remainder, both exact (q a power of two)."""
+    u = np.ldexp(y, -q_exp)
+    whole = np.rint(u)
+    return whole.astype(np.int64), u - whole
+
+
+def _totals_block(block, fs: float, input: str, q_exp: int):
+    whole, rest = _split(_rate(block, fs, input), q_exp)
+    return np.stack([whole.sum(axis=0).astype(np.float64), rest.sum(axis=0)])[None]  # (1, 2, axes)
+
+
+def _chunk_of(bounds: np.ndarray, i: int) -> int:
+    """The chunk holding sample i (the last chunk for i = n, the final angle point)."""
+    return min(int(np.searchsorted(bounds, i, side="right")) - 1, bounds.size - 2)
+
+
+def _needed(bounds: np.ndarray, lo: int, hi: int) -> list[int]:
+    """Chunks whose samples give the angle points X[lo:hi] (X[j] = Σ_{t<j} y[t]): from the chunk that
+    holds sample lo to the one holding sample hi − 2."""
+    k0 = _chunk_of(bounds, lo)
+    return list(range(k0, max(k0, _chunk_of(bounds, hi - 2)) + 1))
+
+
+def _sum_block(blocks, ks, bounds, offsets, *, fs, input, q_exp, plan, classic):
+    """Σ over this task's terms of (x[i+2m] − 2x[i+m] + x[i])², in quanta², per (plan item, axis).
+
+    ``blocks[j]`` is chunk ``ks[j]``; ``offsets[j]`` the exact angle at its first sample (int64 quanta,
+    float remainder). ``plan``: (τ index, m, i0, i1) — the terms i0 ≤ i < i1 of that m. The angle of
+    every run of consecutive chunks is built once: an exact int64 cumulative sum of whole quanta plus a
+    float cumulative sum of the remainders (|r| ≤ 1/2 quantum)."""
+    runs = []  # (first sample, X whole, X remainder) over runs of consecutive chunks
+    j = 0
+    while j < len(ks):
+        j1 = j
+        while j1 + 1 < len(ks) and ks[j1 + 1] == ks[j1] + 1:
+            j1 += 1
+        y = _rate(np.concatenate(blocks[j : j1 + 1]) if j1 > j else blocks[j], fs, input)
+        whole, rest = _split(y, q_exp)
+        xw = np.empty((y.shape[0] + 1, y.shape[1]), dtype=np.int64)
+        xr = np.empty((y.shape[0] + 1, y.shape[1]), dtype=np.float64)
+        xw[0], xr[0] = offsets[j]
+        np.cumsum(whole, axis=0, out=xw[1:])
+        np.cumsum(rest, axis=0, out=xr[1:])
+        xw[1:] += offsets[j][0]
+        xr[1:] += offsets[j][1]
+        del y, whole, rest
+        runs.append((int(bounds[ks[j]]), xw, xr))
+        j = j1 + 1
+
+    def angle(lo: int, hi: int, step: int):
+        for s, xw, xr in runs:
+            if s <= lo and hi - s <= xw.shape[0]:
+                return xw[lo - s : hi - s : step], xr[lo - s : hi - s : step]
+        raise AssertionError(f"angle points {lo}:{hi} are not in this task's chunks {ks}")  # pragma: no cover
+
+    n_axes = runs[0][1].shape[1]
+    out = np.zeros((len(plan), n_axes))
+    for p, (_j, m, i0, i1) in enumerate(plan):
+        step = m if classic else 1
+        if classic:
+            i0 = -(-i0 // m) * m  # classic terms start at multiples of m
+        if i0 >= i1:
+            continue
+        a_w, a_r = angle(i0, i1, step)
+        b_w, b_r = angle(i0 + m, i1 + m, step)
+        c_w, c_r = angle(i0 + 2 * m, i1 + 2 * m, step)
+        dw = c_w - 2 * b_w + a_w  # exact (int64)
+        d = dw.astype(np.float64) + ((c_r - b_r) - (b_r - a_r))
+        out[p] = np.einsum("ij,ij->j", d, d)
+    return out
+
+
+def avar(
+    x,
+    fs,
+    *,
+    taus="octave",
+    estimator: str = "oavar",
+    input: str = "rate",
+    chunk: int | None = None,
+    client=None,
+) -> AllanResult:
+    """Static (overlapping or classic) Allan variance of a dask array, on the exact angle.
+
+    Parameters
+    ----------
+    x : dask.array.Array or array_like, shape (samples,) or (samples, axes)
+    fs, taus, input
+        As for :func:`allanite.avar` (``input`` "rate" or "increment").
+    estimator : {"oavar", "avar"}
+    chunk : int, optional
+        Samples per chunk (default: the caller's first chunk, at least :data:`DEFAULT_CHUNK`/4).
+    client : distributed.Client, optional
+        Where to compute (default: dask's current scheduler).
+
+    Returns
+    -------
+    AllanResult
+        Equal to :func:`allanite.avar` within a few units of rounding (≤ 1e-12 relative; not bitwise:
+        the single-machine kernel sums the same terms in another order).
+
+    Notes
+    -----
+    Three passes over the record: the largest |sample| (the quantum), the exact sum of every chunk
+    (the angle offsets), then per task the terms of the τ whose three slices fall into it — for
+    m < chunk one task per chunk reads that chunk and the next two; for larger m each (chunk, m)
+    reads at most six chunks. No task holds more than six chunks.
+    """
+    fs = _check(estimator, input, fs)
+    arr = _as_dask(x)
+    n = int(arr.shape[0])
+    if n < 2:
+        raise InputError(f"record has {n} samples; at least 2 are needed for any Allan variance")
+    n_axes = int(arr.shape[1]) if arr.ndim == 2 else 1
+    ms = resolve_taus(taus, n, fs)
+    target = int(chunk if chunk is not None else max(int(arr.chunks[0][0]), DEFAULT_CHUNK // 4))
+    target = max(1, min(target, 1 << 34))
+    arr = arr.rechunk({0: target, 1: -1} if arr.ndim == 2 else {0: target})
+    bounds = np.concatenate([[0], np.cumsum(arr.chunks[0])]).astype(np.int64)
+    blocks = arr.to_delayed().ravel().tolist()
+    compute = client.compute if client is not None else None
+
+    def run(tasks):
+        if compute is None:
+            return dask.compute(*tasks)
+        return [f.result() for f in compute(tasks)]
+
+    # pass 1: the largest sample → the quantum (and the first non-finite sample, if any)
+    peaks = np.concatenate(run([dask.delayed(_peak_block)(b, fs, input) for b in blocks]))
+    bad = np.flatnonzero(~np.isfinite(peaks[:, 0]))
+    if bad.size:
+        k = int(bad[0])
+        i, a = int(bounds[k] + peaks[k, 1]), int(peaks[k, 2])
+        raise InputError(
+            f"samples contain a non-finite value at sample {i}"
+            + (f" of axis {a}" if n_axes > 1 else "")
+            + "; only finite numbers are allowed"
+        )
+    peak = float(peaks[:, 0].max())
+    if peak == 0.0:
+        values = np.zeros((n_axes, ms.size))
+        return _static_result(values, ms, estimator, fs, n, input, arr.ndim == 2)
+    q_exp = math.frexp(peak)[1] - QUANTUM_BITS  # 2^(E−26) with 2^E > peak
+
+    # pass 2: exact chunk totals → exact angle offsets (Python ints for the whole quanta)
+    totals = np.concatenate(run([dask.delayed(_totals_block)(b, fs, input, q_exp) for b in blocks]))
+    off_w = [np.zeros(n_axes, dtype=np.int64)]
+    off_r = [np.zeros(n_axes)]
+    acc_w = [0] * n_axes
+    rests: list[list[float]] = [[] for _ in range(n_axes)]
+    for k in range(len(blocks) - 1):
+        for a in range(n_axes):
+            acc_w[a] += int(totals[k, 0, a])
+            rests[a].append(float(totals[k, 1, a]))
+        off_w.append(np.array(acc_w, dtype=np.int64))
+        off_r.append(np.array([math.fsum(r) for r in rests]))
+    offsets = list(zip(off_w, off_r))
+
+    # pass 3: partial sums of squared second differences
+    c = int(arr.chunks[0][0])
+    n_chunks = len(blocks)
+    tasks, where = [], []
+    small = [(j, int(m)) for j, m in enumerate(ms) if m < c]
+    large = [(j, int(m)) for j, m in enumerate(ms) if m >= c]
+    classic = estimator == "avar"
+    for k in range(n_chunks):
+        i0, i1 = int(bounds[k]), int(bounds[k + 1])
+        groups = []
+        if small:  # every small m at once: the chunk and the next two at most
+            plan = [(j, m, i0, min(i1, n + 1 - 2 * m)) for j, m in small]
+            groups.append([p for p in plan if p[3] > p[2]])
+        for j, m in large:  # one task per (chunk, large m): three slices, ≤ six chunks
+            groups.append([(j, m, i0, min(i1, n + 1 - 2 * m))] if n + 1 - 2 * m > i0 else [])
+        for plan in groups:
+            if not plan:
+                continue
+            ks = sorted({kk for _j, m, a, b in plan for s in (0, m, 2 * m) for kk in _needed(bounds, a + s, b + s)})
+            tasks.append(
+                dask.delayed(_sum_block)(
+                    [blocks[kk] for kk in ks],
+                    ks,
+                    bounds,
+                    [offsets[kk] for kk in ks],
+                    fs=fs,
+                    input=input,
+                    q_exp=q_exp,
+                    plan=plan,
+                    classic=classic,
+                )
+            )
+            where.append(plan)
+    partial = run(tasks)
+    sums: list[list[list[float]]] = [[[] for _ in range(ms.size)] for _ in range(n_axes)]
+    for plan, part in zip(where, partial):
+        for p, (j, *_rest) in enumerate(plan):
+            for a in range(n_axes):
+                sums[a][j].append(float(part[p, a]))
+    counts = n_terms(estimator, n, ms)
+    values = np.empty((n_axes, ms.size))
+    for a in range(n_axes):
+        for j, m in enumerate(ms):
+            s = math.fsum(sums[a][j])
+            # Σ (q·d)² / (2 m² n): scaled back by q² = 2^(2·q_exp) last, so no intermediate overflows
+            values[a, j] = math.ldexp(s / (2.0 * float(m) * float(m) * float(counts[j])), 2 * q_exp)
+    if not np.all(np.isfinite(values)):
+        raise InputError(f"the Allan variance of samples of magnitude up to {peak:.3g} exceeds float64's range")
+    return _static_result(values, ms, estimator, fs, n, input, arr.ndim == 2)
+
+
+def _static_result(values, ms, estimator, fs, n, input, is_multi) -> AllanResult:
+    return AllanResult(
+        tau=ms / fs,
+        avar=values if is_multi else values[0],
+        n=n_terms(estimator, n, ms),
+        m=ms,
+        estimator=estimator,
+        fs=fs,
+        n_samples=n,
+        input=input,
+        source=None,
+        kf=None,
+    )

@@ -1,0 +1,455 @@
+"""Fleets of logs on Dask: one ``allanite report`` per file, then a fleet summary.
+
+``allanite batch 'logs/**/*.csv.gz' --fs 100 --out results/`` (and :func:`batch`) reads every file
+that matches, builds its report (:func:`allanite.report.from_log`, what ``allanite report`` writes) as a
+Dask task — a LocalCluster by default, any scheduler given by its address — and writes
+
+* ``out/<path relative to the glob's root, extensions stripped>/`` — the file's report;
+* ``out/fleet.csv`` (and ``fleet.parquet`` when pyarrow is installed) — one row per file and axis: the
+  fitted N, B, K with their intervals (IEEE-952 units), the effects ``refine`` found, robust z-scores
+  of N, B, K against the fleet and a flag when one is beyond :data:`Z_FLAG`, or the file's error;
+* ``out/fleet.html`` — the fleet's distributions.
+
+Reliability: a file that fails (malformed, gaps, …) becomes a row with its error and does not stop the
+others; a report is written into a temporary folder and renamed into place, so a worker killed
+mid-write leaves nothing half-written (Dask retries the task); ``resume=True`` skips files whose report
+is complete and newer than the file.
+"""
+
+from __future__ import annotations
+
+import argparse
+import base64
+import csv
+import glob
+import io
+import json
+import math
+import os
+import shutil
+import sys
+import time
+import uuid
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import AllaniteError, ParameterError
+from ..io import read_log
+from ..report import from_log
+
+__all__ = ["batch", "FleetResult", "main", "Z_FLAG", "TERMS"]
+
+#: |robust z| above which a sensor is flagged as outside the fleet's spread.
+Z_FLAG = 3.5
+
+#: The coefficients summarised per sensor axis.
+TERMS = ("N", "B", "K")
+
+_EXTENSIONS = {".gz", ".bz2", ".xz", ".zst", ".csv", ".tsv", ".txt", ".dat", ".npy", ".npz", ".parquet", ".bag"}
+
+
+@dataclass
+class FleetResult:
+    """What :func:`batch` did: ``rows`` (the fleet table, one dict per file and axis), ``files`` (one
+    status dict per input: path, out, status ok/skipped/error, error) and the paths written."""
+
+    rows: list
+    files: list
+    paths: dict = field(default_factory=dict)
+
+    @property
+    def failed(self) -> list:
+        return [f for f in self.files if f["status"] == "error"]
+
+
+def glob_root(pattern: str) -> Path:
+    """The folder of the pattern before its first wildcard component: outputs are named relative to it."""
+    parts = Path(pattern).parts
+    fixed = []
+    for p in parts[:-1]:
+        if glob.has_magic(p):
+            break
+        fixed.append(p)
+    return Path(*fixed) if fixed else Path(".")
+
+
+def out_folder(path: Path, root: Path, out: Path) -> Path:
+    """``out/<path relative to root, extensions stripped>`` (``a/b.csv.gz`` → ``out/a/b``)."""
+    rel = path.relative_to(root)
+    name = rel.name
+    while Path(name).suffix.lower() in _EXTENSIONS:
+        name = name[: -len(Path(name).suffix)]
+    return out / rel.parent / name
+
+
+def _complete(folder: Path, source: Path) -> bool:
+    need = [folder / "summary.json", folder / "report.html"]
+    return all(p.is_file() for p in need) and min(p.stat().st_mtime for p in need) >= source.stat().st_mtime
+
+
+def run_one(path: str, folder: str, read_opts: dict, report_opts: dict) -> dict:
+    """One file: read it, build its report, write it atomically; never raises for a bad file."""
+    src, dst = Path(path), Path(folder)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            log = read_log(src, **read_opts)
+            rep = from_log(log, **report_opts)
+            dst.parent.mkdir(parents=True, exist_ok=True)
+            tmp = dst.parent / f".{dst.name}.tmp-{uuid.uuid4().hex[:8]}"
+            try:
+                rep.write(tmp)
+                if dst.exists():
+                    old = dst.parent / f".{dst.name}.old-{uuid.uuid4().hex[:8]}"
+                    os.rename(dst, old)
+                    os.rename(tmp, dst)
+                    shutil.rmtree(old, ignore_errors=True)
+                else:
+                    os.rename(tmp, dst)
+            finally:
+                if tmp.exists():
+                    shutil.rmtree(tmp, ignore_errors=True)
+        return {"path": path, "out": folder, "status": "ok", "error": None}
+    except (AllaniteError, OSError, ValueError) as exc:
+        return {"path": path, "out": folder, "status": "error", "error": f"{type(exc).__name__}: {exc}"}
+
+
+def _rows(status: dict) -> list:
+    """Fleet rows of one file, from its summary.json (the same for a fresh and a resumed report)."""
+    base = {"file": status["path"], "out": status["out"], "status": status["status"], "error": status["error"]}
+    if status["status"] == "error":
+        return [dict(base, axis=None)]
+    summary = json.loads((Path(status["out"]) / "summary.json").read_text(encoding="utf-8"))
+    fit = summary.get("fit") or {}
+    ref = summary.get("refinement") or {}
+    ref_axes = {a["axis"]: a for a in (ref.get("axes") or [])}
+    rows = []
+    for ax in fit.get("axes") or [{"axis": k, "name": str(k)} for k in range(int(summary["record"]["axes"]))]:
+        row = dict(base, axis=ax.get("name"))
+        coefs = ax.get("coefficients") or {}
+        for t in TERMS:
+            c = coefs.get(t)
+            row[t] = None if c is None else c.get("ieee")
+            ci = None if c is None else c.get("ieee_ci")
+            row[f"{t}_low"], row[f"{t}_high"] = (None, None) if ci is None else (ci[0], ci[1])
+            row[f"{t}_unit"] = None if c is None else c.get("ieee_unit")
+        steps = ref_axes.get(ax.get("axis"), {}).get("steps") or []
+        row["effects"] = ";".join(s["effect"] for s in steps) if ref else None
+        rows.append(row)
+    return rows
+
+
+def robust_z(values) -> np.ndarray:
+    """0.6745·(v − median)/MAD (Iglewicz & Hoaglin); NaN where v is missing or MAD is 0."""
+    v = np.array([np.nan if x is None else float(x) for x in values])
+    ok = np.isfinite(v)
+    z = np.full(v.shape, np.nan)
+    if ok.sum() >= 3:
+        med = np.median(v[ok])
+        mad = np.median(np.abs(v[ok] - med))
+        if mad > 0:
+            z[ok] = 0.6745 * (v[ok] - med) / mad
+    return z
+
+
+def _flag(rows: list) -> None:
+    ok = [r for r in rows if r["status"] != "error"]
+    for t in TERMS:
+        # log10: N, B, K spread over decades; a sensor 10× off is as far as one 10× better
+        z = robust_z([None if (r.get(t) is None or r[t] <= 0) else math.log10(r[t]) for r in ok])
+        for r, zi in zip(ok, z):
+            r[f"z_{t}"] = None if not np.isfinite(zi) else round(float(zi), 3)
+    for r in rows:
+        out = [t for t in TERMS if r.get(f"z_{t}") is not None and abs(r[f"z_{t}"]) > Z_FLAG]
+        r["flag"] = ",".join(out) if out else ""
+
+
+COLUMNS = (
+    ["file", "axis", "status", "error"]
+    + [f"{t}{s}" for t in TERMS for s in ("", "_low", "_high", "_unit")]
+    + ["effects"]
+    + [f"z_{t}" for t in TERMS]
+    + ["flag", "out"]
+)
+
+
+def _atomic_write(path: Path, data: bytes) -> None:
+    tmp = path.with_name(f".{path.name}.tmp-{uuid.uuid4().hex[:8]}")
+    tmp.write_bytes(data)
+    os.replace(tmp, path)
+
+
+def _write_table(rows: list, out: Path) -> dict:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=COLUMNS, extrasaction="ignore", lineterminator="\n")
+    w.writeheader()
+    for r in rows:
+        w.writerow({k: ("" if r.get(k) is None else r.get(k)) for k in COLUMNS})
+    paths = {"csv": out / "fleet.csv"}
+    _atomic_write(paths["csv"], buf.getvalue().encode("utf-8"))
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        return paths
+    table = pa.table({k: [r.get(k) for r in rows] for k in COLUMNS})
+    sink = io.BytesIO()
+    pq.write_table(table, sink)
+    paths["parquet"] = out / "fleet.parquet"
+    _atomic_write(paths["parquet"], sink.getvalue())
+    return paths
+
+
+def _write_html(rows: list, files: list, out: Path) -> Path:
+    from html import escape
+
+    from matplotlib.figure import Figure
+
+    ok = [r for r in rows if r["status"] != "error"]
+    fig = Figure(figsize=(10, 3.2), dpi=100)
+    for i, t in enumerate(TERMS):
+        ax = fig.add_subplot(1, 3, i + 1)
+        v = np.array([r[t] for r in ok if r.get(t) is not None and r[t] > 0])
+        flagged = np.array([r[t] for r in ok if r.get(t) is not None and r[t] > 0 and t in r["flag"].split(",")])
+        if v.size:
+            bins = list(np.logspace(np.log10(v.min()) - 0.05, np.log10(v.max()) + 0.05, 20))
+            ax.hist(v, bins=bins, color="0.6", label="fleet")
+            if flagged.size:
+                ax.hist(flagged, bins=bins, color="C3", label="flagged")
+            ax.set_xscale("log")
+        unit = next((r[f"{t}_unit"] for r in ok if r.get(f"{t}_unit")), "")
+        ax.set_title(f"{t} ({unit})" if unit else t)
+        ax.set_ylabel("sensor axes" if i == 0 else "")
+    fig.tight_layout()
+    png = io.BytesIO()
+    fig.savefig(png, format="png")
+    img = base64.b64encode(png.getvalue()).decode("ascii")
+    flagged_rows = [r for r in rows if r.get("flag")]
+    failed = [f for f in files if f["status"] == "error"]
+
+    def table(rs, cols):
+        head = "".join(f"<th>{escape(c)}</th>" for c in cols)
+        body = "".join(
+            "<tr>" + "".join(f"<td>{escape('' if r.get(c) is None else str(r.get(c)))}</td>" for c in cols) + "</tr>"
+            for r in rs
+        )
+        return f"<table><tr>{head}</tr>{body}</table>"
+
+    page = (
+        "<!doctype html><meta charset='utf-8'><title>allanite fleet</title>"
+        "<style>body{font-family:sans-serif;margin:2em}td,th{padding:2px 8px;border-bottom:1px solid #ddd}</style>"
+        f"<h1>Fleet: {len(files)} files, {len(ok)} sensor axes</h1>"
+        f"<p>{len(failed)} failed; {len(flagged_rows)} axes flagged (|robust z| of log10 N, B or K > {Z_FLAG}).</p>"
+        f"<img alt='distributions of N, B, K' src='data:image/png;base64,{img}'>"
+        "<h2>Flagged</h2>" + table(flagged_rows, ["file", "axis", "N", "B", "K", "z_N", "z_B", "z_K", "flag"]) + ""
+        "<h2>Failed</h2>" + table(failed, ["path", "error"]) + "<h2>All</h2>" + table(rows, COLUMNS[:-1])
+    )
+    path = out / "fleet.html"
+    _atomic_write(path, page.encode("utf-8"))
+    return path
+
+
+def batch(
+    pattern: str,
+    *,
+    out,
+    fs=None,
+    columns=None,
+    time_column=None,
+    unit=None,
+    input: str = "rate",
+    gaps: str = "error",
+    window=None,
+    hop=None,
+    taus="octave",
+    estimator: str = "oavar",
+    refine: bool = False,
+    fit: bool = True,
+    scheduler: str | None = None,
+    dask_workers: int | None = None,
+    client=None,
+    resume: bool = False,
+    quiet: bool = True,
+    retries: int = 2,
+) -> FleetResult:
+    """Reports for every file matching ``pattern`` (``**`` recursive), as Dask tasks, and the fleet summary.
+
+    Parameters
+    ----------
+    pattern : str
+        Glob of the logs; outputs are named relative to the folder before its first wildcard.
+    out : path
+        Output folder.
+    fs, columns, time_column, unit, input, gaps
+        As for :func:`allanite.read_log` (the same for every file).
+    window, hop, taus, estimator, refine, fit
+        As for ``allanite report``.
+    scheduler : str, optional
+        Address of a running Dask scheduler (e.g. ``tcp://host:8786``); only ever the one given.
+    dask_workers : int, optional
+        Workers of the LocalCluster started when neither ``scheduler`` nor ``client`` is given
+        (default 2).
+    client : distributed.Client, optional
+        Use this client.
+    resume : bool
+        Skip files whose report is complete and newer than the file.
+    quiet : bool
+        No progress bar.
+    retries : int
+        Dask retries of a task whose worker died.
+    """
+    from distributed import Client, LocalCluster, as_completed
+
+    out = Path(out)
+    root = glob_root(pattern)
+    paths = sorted(Path(p) for p in glob.glob(pattern, recursive=True) if Path(p).is_file())
+    if not paths:
+        raise ParameterError(f"no file matches {pattern!r}")
+    folders: dict[Path, Path] = {}
+    for p in paths:
+        f = out_folder(p, root, out)
+        if f in folders:
+            raise ParameterError(f"{folders[f]} and {p} would share the report folder {f}: rename one")
+        folders[f] = p
+    out.mkdir(parents=True, exist_ok=True)
+    read_opts = {"fs": fs, "columns": columns, "time_column": time_column, "unit": unit, "input": input}
+    read_opts = {k: v for k, v in read_opts.items() if v is not None}
+    read_opts["gaps"] = gaps
+    report_opts = {"window": window, "hop": hop, "taus": taus, "estimator": estimator, "refine": refine, "fit": fit}
+    statuses: dict[str, dict] = {}
+    todo = []
+    for f, p in folders.items():
+        if resume and _complete(f, p):
+            statuses[str(p)] = {"path": str(p), "out": str(f), "status": "skipped", "error": None}
+        else:
+            todo.append((str(p), str(f)))
+
+    own = []
+    if client is None:
+        if scheduler is not None:
+            client = Client(scheduler, timeout="30s")
+        else:
+            cluster = LocalCluster(
+                n_workers=dask_workers or 2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None
+            )
+            own.append(cluster)
+            client = Client(cluster)
+        own.insert(0, client)
+    try:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(todo), disable=quiet, unit="file", file=sys.stderr, desc="allanite batch")
+        futures = [
+            client.submit(
+                run_one, p, f, read_opts, report_opts, key=f"allanite-report-{uuid.uuid4().hex}", retries=retries
+            )
+            for p, f in todo
+        ]
+        for fut in as_completed(futures):
+            try:
+                st = fut.result()
+            except Exception as exc:  # the task itself died (e.g. its worker, beyond the retries)
+                i = futures.index(fut)
+                st = {"path": todo[i][0], "out": todo[i][1], "status": "error", "error": f"{type(exc).__name__}: {exc}"}
+            statuses[st["path"]] = st
+            bar.update(1)
+        bar.close()
+    finally:
+        for o in own:
+            o.close()
+    # a worker killed mid-write leaves its temporary folder behind (its retry wrote a fresh one)
+    for f in folders:
+        for stale in [*f.parent.glob(f".{f.name}.tmp-*"), *f.parent.glob(f".{f.name}.old-*")]:
+            shutil.rmtree(stale, ignore_errors=True)
+    files = [statuses[str(p)] for p in paths]
+    rows = []
+    for st in files:
+        try:
+            rows.extend(_rows(st))
+        except (OSError, ValueError, KeyError) as exc:  # a resumed report that cannot be read
+            rows.extend(_rows(dict(st, status="error", error=f"summary.json unreadable: {exc}")))
+    _flag(rows)
+    written = _write_table(rows, out)
+    written["html"] = _write_html(rows, files, out)
+    return FleetResult(rows=rows, files=files, paths=written)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="allanite batch",
+        description="One report per log matching PATTERN, as Dask tasks, and a fleet summary "
+        "(out/fleet.csv, fleet.parquet, fleet.html).",
+    )
+    p.add_argument("pattern", metavar="PATTERN", help="glob of the logs, quoted ('logs/**/*.csv.gz')")
+    p.add_argument("--fs", type=float, metavar="HZ")
+    p.add_argument("--columns", metavar="C1,C2,...")
+    p.add_argument("--time-column", metavar="C")
+    p.add_argument("--unit", metavar="U")
+    p.add_argument("--input", choices=("rate", "increment", "angle"), default="rate")
+    p.add_argument("--gaps", choices=("error", "longest", "split"), default="error")
+    p.add_argument("--taus", default="octave")
+    p.add_argument("--window", type=int)
+    p.add_argument("--hop", type=int)
+    p.add_argument("--estimator", choices=("oavar", "theoh"), default="oavar")
+    p.add_argument("--refine", action="store_true")
+    p.add_argument("--no-fit", action="store_true")
+    p.add_argument("--out", required=True, metavar="DIR")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://host:8786")
+    where.add_argument("--dask-workers", type=int, metavar="N", help="LocalCluster workers (default 2)")
+    p.add_argument("--resume", action="store_true", help="skip files whose report is complete and newer")
+    p.add_argument("-q", "--quiet", action="store_true")
+    return p
+
+
+def _spec(text):
+    if text is None:
+        return None
+    items = [c.strip() for c in text.split(",")]
+    return [int(c) if c.isdigit() else c for c in items]
+
+
+def main(argv=None) -> int:
+    """``allanite batch``: exit 0 when every file succeeded, 3 when some failed, 2 on a usage error."""
+    args = build_parser().parse_args(argv)
+    t0 = time.perf_counter()
+    taus = args.taus if args.taus.isalpha() else [float(t) for t in args.taus.split(",")]
+    tc = args.time_column
+    try:
+        res = batch(
+            args.pattern,
+            out=args.out,
+            fs=args.fs,
+            columns=_spec(args.columns),
+            time_column=None if tc is None else (int(tc) if tc.isdigit() else tc),
+            unit=args.unit,
+            input=args.input,
+            gaps=args.gaps,
+            window=args.window,
+            hop=args.hop,
+            taus=taus,
+            estimator=args.estimator,
+            refine=args.refine,
+            fit=not args.no_fit,
+            scheduler=args.scheduler,
+            dask_workers=args.dask_workers,
+            resume=args.resume,
+            quiet=args.quiet,
+        )
+    except AllaniteError as exc:
+        print(f"allanite: error: {exc}", file=sys.stderr)
+        return 2
+    if not args.quiet:
+        n_ok = sum(f["status"] == "ok" for f in res.files)
+        n_skip = sum(f["status"] == "skipped" for f in res.files)
+        print(f"{len(res.files)} files: {n_ok} reported, {n_skip} skipped (resume), {len(res.failed)} failed")
+        for f in res.failed:
+            print(f"  failed: {f['path']}: {f['error']}")
+        flagged = [r for r in res.rows if r.get("flag")]
+        for r in flagged:
+            print(f"  flagged: {r['file']} axis {r['axis']}: {r['flag']}")
+        print(f"wrote {', '.join(str(p) for p in res.paths.values())} in {time.perf_counter() - t0:.1f} s")
+    return 3 if res.failed else 0
