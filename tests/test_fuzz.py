@@ -353,3 +353,9 @@ def test_fit_is_scale_invariant(scale):
     for t in ("N", "K"):
         assert f.coefficients[t].value / scale == pytest.approx(f0.coefficients[t].value, rel=1e-12)
     assert f.chi2_dof == pytest.approx(f0.chi2_dof, rel=1e-12)
+
+
+def test_refine_refuses_samples_beyond_its_scale_range():
+    x = np.random.default_rng(0).normal(size=4000) * 1e-150  # scipy's NNLS raised ValueError here before
+    with pytest.raises(allanite.InputError, match=r"refine needs samples of magnitude within 1e-100…1e\+100"):
+        allanite.refine(x, 100.0, candidates=("gauss_markov",))

@@ -47,7 +47,7 @@ from .._display import RichDisplay, Summary, Table, fmt_ci, thin
 from .._progress import StepBar
 from .._validate import as_rate_columns
 from ..analysis import avar, davar
-from ..errors import ParameterError
+from ..errors import InputError, ParameterError
 from ..estimators.grid import tau_grid
 from ..results import AllanResult
 from . import fitting, tracing
@@ -854,6 +854,28 @@ def _resolve_tau_range(tau_range, result, start):
     return (0.0, math.inf) if tau_range is None else fitting.check_tau_range(tau_range)
 
 
+#: refine's searches square and multiply variances: samples beyond this magnitude range are refused (fit and
+#: avar handle any scale exactly; refine's NNLS searches on 1e-300 variances do not).
+REFINE_SCALE = (1e-100, 1e100)
+
+
+def _check_scale(x_or_result) -> None:
+    values = x_or_result.avar if isinstance(x_or_result, AllanResult) else x_or_result
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        return  # the samples' own checks report it
+    finite = arr[np.isfinite(arr)] if arr.size else arr
+    peak = float(np.max(np.abs(finite))) if finite.size else 0.0
+    if isinstance(x_or_result, AllanResult):
+        peak = peak**0.5
+    if peak > 0 and not REFINE_SCALE[0] < peak < REFINE_SCALE[1]:
+        raise InputError(
+            f"refine needs samples of magnitude within {REFINE_SCALE[0]:g}…{REFINE_SCALE[1]:g}, got {peak:.3g}: "
+            f"express them in another unit (avar and fit take any scale)"
+        )
+
+
 def refine(
     x_or_result,
     fs=None,
@@ -920,6 +942,7 @@ def refine(
         >>> r.found, round(r.steps[0].params["tc"], 0)
         (['gauss_markov'], 10.0)
     """
+    _check_scale(x_or_result)
     with StepBar(progress, 1, "refine") as bar:
         bar.step("fit, trace and test the candidates")
         return _refine(
