@@ -359,3 +359,9 @@ def test_refine_refuses_samples_beyond_its_scale_range():
     x = np.random.default_rng(0).normal(size=4000) * 1e-150  # scipy's NNLS raised ValueError here before
     with pytest.raises(allanite.InputError, match=r"refine needs samples of magnitude within 1e-100…1e\+100"):
         allanite.refine(x, 100.0, candidates=("gauss_markov",))
+
+
+def test_theo_tau_far_beyond_the_record_is_a_parameter_error():
+    y = np.random.default_rng(1).normal(size=200)
+    with pytest.raises(allanite.ParameterError, match=r"taus\[0\] = 1\.348e\+215 s is beyond the record"):
+        allanite.avar(y, 1.3333e93, taus=[1.348e215], estimator="theoh")  # OverflowError before (fuzz finding)

@@ -134,6 +134,10 @@ def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, n
     top = n_rate - n_rate % 2
     for i, tau in enumerate(arr):
         s = tau * fs
+        if not s < 2.0**62:  # far beyond any record (also inf): no int conversion of it
+            raise ParameterError(
+                f"taus[{i}] = {tau:g} s is beyond the record: Theo τ reach 0.75·{top}/fs = {0.75 * top / fs:g} s"
+            )
         # One mapping for both paths: a τ that is exactly a TheoBR point above the switch (τ = 0.75·m/fs,
         # even m, 0.75·m > k) is that point — davar's result.tau handed back to avar gives the same
         # estimator at every τ (τ = 40.5 samples at k = 40 was rounded to the Allan m = 40 before).
