@@ -365,3 +365,11 @@ def test_theo_tau_far_beyond_the_record_is_a_parameter_error():
     y = np.random.default_rng(1).normal(size=200)
     with pytest.raises(allanite.ParameterError, match=r"taus\[0\] = 1\.348e\+215 s is beyond the record"):
         allanite.avar(y, 1.3333e93, taus=[1.348e215], estimator="theoh")  # OverflowError before (fuzz finding)
+
+
+def test_refine_on_a_short_record_with_a_tau_range_has_no_held_out_error_instead_of_crashing():
+    x = np.random.default_rng(0).normal(size=580)  # IndexError in the held-out split before (fuzz finding)
+    try:
+        allanite.refine(x, 100.0, candidates=("gauss_markov",), tau_range=(0.1, None))
+    except allanite.AllaniteError:
+        pass

@@ -267,6 +267,8 @@ class _Split:
             }
             tau = m / fs
             keep = (tau >= lo) & (tau <= hi) & (av > 0)
+            if np.count_nonzero(keep) < 2:
+                raise ValueError("too few τ in range for held-out blocks")  # _splits: no held-out error
             self.parts.append(
                 _Curve(
                     tau[keep],
