@@ -581,3 +581,44 @@ def test_white_noise_level(rng):
     r = allanite.avar(y, 50.0, taus=np.array([1, 10, 100, 1000]) / 50.0)
     np.testing.assert_allclose(r.avar * r.m, sigma**2, rtol=0.1)
     np.testing.assert_allclose(r.adev, np.sqrt(r.avar), rtol=0)
+
+
+# --------------------------------------------------------------------------------------------------
+# The static classic estimator: cluster sums gathered from one double-word prefix (rust/core/src/gather.rs)
+# --------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_static_classic_gather_on_the_adversarial_record(adversarial_record, dtype):
+    y = adversarial_record.astype(dtype)
+    ms = np.unique(np.round(np.geomspace(1, ADV_N // 2, 40)).astype(np.int64))
+    r = allanite.avar(y, 1.0, taus=ms.astype(float), estimator="avar")
+    ref = _reference.avar_reference(y.astype(np.float64), 1.0, r.m, "avar", dtype=np.longdouble)
+    assert r.m.size == ms.size
+    assert max_rel(r.avar, ref) <= 1e-9
+
+
+def test_static_classic_gather_dense_taus_several_axes(rng):
+    # a dense linear τ list (every m up to N/2, as ROS/Kalibr users ask for) on three axes of different
+    # level and offset: each axis equals its plain twin, and the same as its single-axis call
+    n = 20_011
+    X = rng.normal(size=(n, 3)) * [1.0, 1e-5, 1e4] + [0.0, 7.0, -3e4]
+    ms = np.arange(1, n // 2 + 1)
+    r = allanite.avar(X, 10.0, taus=ms / 10.0, estimator="avar")
+    assert r.avar.shape == (3, ms.size)
+    for a in range(3):
+        ref = _reference.avar_reference(X[:, a], 10.0, ms, "avar", dtype=np.longdouble)
+        assert max_rel(r.avar[a], ref) <= 1e-11
+        single = allanite.avar(X[:, a], 10.0, taus=ms / 10.0, estimator="avar").avar
+        assert np.array_equal(single, r.avar[a])
+    for workers in (1, 2, 3):
+        assert np.array_equal(allanite.avar(X, 10.0, taus=ms / 10.0, estimator="avar", workers=workers).avar, r.avar)
+
+
+def test_static_classic_gather_equals_the_sliding_path(rng):
+    # two windows take the streaming (sliding-sum) path, one window the gather: same numbers
+    y = rng.normal(size=12_000) + 2.0
+    ms = np.array([1, 2, 5, 64, 999, 2_500])
+    two = allanite.davar(y, 1.0, window=10_000, hop=2_000, taus=ms.astype(float), estimator="avar").avar
+    one = allanite.avar(y[:10_000], 1.0, taus=ms.astype(float), estimator="avar").avar
+    assert max_rel(one, two[:, 0]) <= 1e-12

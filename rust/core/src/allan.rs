@@ -26,11 +26,16 @@
 //!    blocks are combined per window by the same Van Herk split over the block array. A window's sum
 //!    therefore has relative error ≲ (RUN + window/RUN)·ε, whatever the rest of the record holds.
 //!
+//! 3. The static classic estimator (one window) gathers its ⌊W/m⌋ cluster sums from one double-word
+//!    prefix per axis instead of streaming the record per m (`crate::gather`): O(W/m) per τ, so dense τ
+//!    lists cost what their arithmetic costs.
+//!
 //! Each (axis, m) row is computed by one sequential routine, so results are bit-identical for any
 //! number of worker threads.
 
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
+use crate::gather::{classic_window, GATHER_MAX};
 use rayon::prelude::*;
 
 /// Which Allan estimator.
@@ -697,6 +702,16 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
                 .par_iter()
                 .map(|c| compensated_mean(c))
                 .collect();
+            if req.estimator == Estimator::Classic
+                && n_win == 1
+                && req.window * n_axes <= GATHER_MAX
+            {
+                // One window (the static estimator): gather cluster sums from one exact prefix
+                // instead of streaming the record once per m (see `crate::gather`).
+                classic_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
+                cancel.check()?;
+                return Ok((out, n_win));
+            }
             out.par_chunks_mut(n_win).enumerate().for_each_init(
                 RowScratch::default,
                 |sc, (row, dst)| {

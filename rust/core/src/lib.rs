@@ -7,6 +7,7 @@ pub mod allan;
 pub mod cancel;
 pub mod deviations;
 pub mod error;
+mod gather;
 pub mod taper;
 pub mod theo;
 
