@@ -273,3 +273,15 @@ def test_an_effect_must_lower_chi2_dof(shared_data, load_avar_curve):
     for st in r.steps:
         assert st.after["chi2_dof"] < st.before["chi2_dof"], (st.effect, st.before["chi2_dof"], st.after["chi2_dof"])
     assert r.found == ["sinusoid"]
+
+
+def test_complex_samples_are_refused_without_a_cast_warning():
+    # the scale check must not cast complex samples to float (NumPy would warn and drop the imaginary part):
+    # the samples' own check names the dtype
+    import warnings
+
+    y = np.random.default_rng(0).standard_normal(20_000) + 1j
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(allanite.InputError, match="complex"):
+            allanite.refine(y, 100.0)
