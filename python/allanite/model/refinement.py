@@ -302,6 +302,57 @@ class _Split:
         return float(np.mean(errs))
 
 
+class _TimeSplit:
+    """Alternate blocks in time (odd ↔ even) for the held-out error of a time-localised effect.
+
+    Each part's blocks are joined end to end (samples keep their true times): a time effect is fitted on one
+    part's samples and removed from both parts, the noise model fitted on that part's Allan curve predicts the
+    other part's. Joining keeps τ up to part/9 (a warm-up's time scale) where an Allan curve per block would
+    stop at block/9; the seams affect the model with and without the effect alike."""
+
+    def __init__(self, y, fs, grid_m, lo, hi, estimator, n_blocks):
+        n = y.size
+        per = n // n_blocks
+        self.fs, self.estimator = fs, estimator
+        self.idx = [
+            np.concatenate([np.arange(j * per, (j + 1) * per) for j in range(n_blocks) if j % 2 == parity])
+            for parity in (0, 1)
+        ]
+        size = min(i.size for i in self.idx)
+        self.idx = [i[:size] for i in self.idx]
+        self.t = [i / fs for i in self.idx]
+        m = grid_m[grid_m <= size // 9]
+        tau = m / fs
+        keep = (tau >= lo) & (tau <= hi)
+        if np.count_nonzero(keep) < 8:
+            raise ValueError("too few τ in range for held-out blocks")
+        self.m, self.size = m[keep], size
+        probe = self._curve(y[self.idx[0]])
+        scored = np.zeros(self.m.size, dtype=bool)
+        scored[tracing.thin_indices(probe.tau)] = True
+        self.scored = scored & (probe.edf(0) >= HELDOUT_MIN_EDF)
+
+    def _curve(self, z):
+        av = np.maximum(avar(z, self.fs, taus=self.m / self.fs).avar, 1e-300)
+        return _Curve(self.m / self.fs, self.m.astype(np.float64), av, self.fs, self.size + 1, self.estimator)
+
+    def error(self, y, terms, effects, remove=None) -> float:
+        """RMS ADEV error (%) of one part's model predicting the other's curve, both ways; ``remove(samples,
+        t)`` fits a time component on the held-in part and returns it as a function of time."""
+        errs = []
+        for f, h in ((0, 1), (1, 0)):
+            yf, yh = y[self.idx[f]], y[self.idx[h]]
+            if remove is not None:
+                g = remove(yf, self.t[f])
+                yf, yh = yf - g(self.t[f]), yh - g(self.t[h])
+            cf, ch = self._curve(yf), self._curve(yh)
+            sol = _solve(cf, terms, effects)
+            a_h, _ = _design(ch, terms, effects)
+            pred = np.maximum(a_h @ sol.theta, 1e-300)
+            errs.append(_rms_adev_pct(ch.avar[self.scored], pred[self.scored]))
+        return float(np.mean(errs))
+
+
 def _theta_terms(sol, terms, effects):
     """Squared coefficients of the terms (a bandwidth's N in place of the zeroed N column)."""
     k = len(terms)
@@ -315,7 +366,7 @@ def _theta_terms(sol, terms, effects):
 def _splits(y, fs, m_all, lo, hi):
     """Halves and alternate blocks of the record for the held-out error, or (None, None) if too short."""
     try:
-        return _Split(y, fs, m_all, lo, hi, "oavar", {}, 2), _Split(y, fs, m_all, lo, hi, "oavar", {}, HELDOUT_BLOCKS)
+        return _Split(y, fs, m_all, lo, hi, "oavar", {}, 2), _TimeSplit(y, fs, m_all, lo, hi, "oavar", HELDOUT_BLOCKS)
     except ValueError:
         return None, None
 
@@ -1080,9 +1131,12 @@ def _refine(
         y_new = y - component
         res_new = avar(y_new, fs, taus=result.tau)
         c_new, (h_new, b_new) = build(res_new, y_new)
-        old_split, new_split = (halves, h_new) if split == "halves" else (blocks, b_new)
-        ho_b = old_split.error(start, effects) if old_split is not None else None
-        ho_a = new_split.error(start, effects) if new_split is not None else None
+        if split == "halves":
+            ho_b = halves.error(start, effects) if halves is not None else None
+            ho_a = h_new.error(start, effects) if h_new is not None else None
+        else:  # alternate blocks in time: the component refitted on the held-in part (``split`` fits it)
+            ho_b = blocks.error(y, start, effects) if blocks is not None else None
+            ho_a = blocks.error(y, start, effects, remove=split) if blocks is not None else None
         s_new = _solve(c_new, start, effects)
         if held_in_time is not None:
             evidence["heldout_variance_ratio"] = held_in_time
@@ -1115,13 +1169,45 @@ def _refine(
         return st
 
     considered: dict[str, list] = {}
+    effects: list = []
+    first_steps: list = []  # time effects removed before the curve loop (kept apart: steps[j] ↔ effects[j] below)
+    drift_removed = None
+    # ---- a warm-up drift first: its time-domain evidence is unambiguous, and left in the samples it bends
+    # the long-τ curve that every curve effect is fitted against (its threshold comes from the five-term fit,
+    # which the drift itself inflates: conservative)
+    if y is not None and "drift" in candidates:
+        dr = tracing.drift_fit(y, fs)
+        thr_d = tracing.drift_threshold(y.size, fs, start, _theta_terms(sol, start, effects), TIME_SHARE * level)
+        ev = {"domain": "time", "test": {"statistic": dr["statistic"], "threshold": thr_d, "alpha": TIME_SHARE * level}}
+        if dr["statistic"] > thr_d and not dr["at_edge"]:
+            t_s = np.arange(y.size) / fs
+            span = y.size / fs
+            pieces = HELDOUT_BLOCKS // 2
+            drift_comp = dr["amplitude"] * np.exp(-t_s / dr["T"])
+
+            def drift_refit(z, t, span=span, pieces=pieces):
+                return tracing.drift_component(z, t, span, pieces)
+
+            st = removal_step(
+                "drift",
+                drift_comp,
+                drift_refit,
+                {"amplitude": dr["amplitude"], "T": dr["T"]},
+                {"amplitude": dr["amplitude_interval"], "T": dr["T_interval"]},
+                ev,
+                "drift",
+            )
+            if st is not None:
+                first_steps.append(st)
+                drift_removed = (drift_comp, drift_refit)
+        else:
+            considered.setdefault("drift", []).append({"T": dr["T"], "statistic": dr["statistic"], "threshold": thr_d})
     exact = y is not None or (isinstance(est, str) and est == "oavar")
     thin = tracing.thin_indices(curve.tau)
     sub = curve.subset(thin)
     lines = tracing.spectral_lines(y, fs, level * LINE_SHARE) if y is not None and "sinusoid" in candidates else []
     drift = None
     regs: dict = {}
-    effects: list = []
     tmin, tmax = curve.tau[0], curve.tau[-1]
     for n_step in range(MAX_STEPS):
         keys = [e[0] for e in effects]
@@ -1137,7 +1223,7 @@ def _refine(
             candidates,
             y is not None,
             [],
-            drift["grid"] if drift is not None and "drift" not in keys else None,
+            None,
         )
         thr = test.threshold(fam, alpha_curve, N_BOOT, seed=n_step)
         props: list[dict] = []
@@ -1178,10 +1264,6 @@ def _refine(
                 assert search is not None
                 p, s_new, edge = _search(curve, start, effects, "sinusoid", search(tmin, tmax))
                 propose("sinusoid", p, s_new, edge, test.statistic(sub.avar, _column("sinusoid", p, sub)), thr, halves)
-        if drift is not None and "drift" not in keys:
-            s_new = _solve(curve, start, effects + [("drift", drift["T"])])
-            stat = test.statistic(sub.avar, _column("drift", drift["T"], sub))
-            propose("drift", drift["T"], s_new, drift["at_edge"], stat, thr, blocks)
         for pr in props:
             considered.setdefault(_base(pr["key"]), []).append(
                 {"param": float(pr["p"]), "statistic": float(pr["stat"]), "threshold": float(pr["thr"])}
@@ -1311,25 +1393,6 @@ def _refine(
             )
             if st is not None:
                 steps.append(st)
-    if y is not None and "drift" in candidates:
-        dr = tracing.drift_fit(y, fs)
-        thr_d = tracing.drift_threshold(y.size, fs, start, _theta_terms(sol, start, effects), TIME_SHARE * level)
-        ev = {"domain": "time", "test": {"statistic": dr["statistic"], "threshold": thr_d, "alpha": TIME_SHARE * level}}
-        if dr["statistic"] > thr_d and not dr["at_edge"]:
-            t_s = np.arange(y.size) / fs
-            st = removal_step(
-                "drift",
-                dr["amplitude"] * np.exp(-t_s / dr["T"]),
-                "blocks",
-                {"amplitude": dr["amplitude"], "T": dr["T"]},
-                {"amplitude": dr["amplitude_interval"], "T": dr["T_interval"]},
-                ev,
-                "drift",
-            )
-            if st is not None:
-                steps.append(st)
-        else:
-            considered.setdefault("drift", []).append({"T": dr["T"], "statistic": dr["statistic"], "threshold": thr_d})
     change_points = []
     if y is not None and "change_point" in candidates:
         change_points = _change_points(y, fs, start)
@@ -1357,6 +1420,21 @@ def _refine(
                     truth_error=terr,
                 )
             )
+    if drift_removed is not None:
+        # the drift went first (on the five terms alone); its before/after are scored at the end against the
+        # final model — the same curve effects with and without the drift in the samples
+        comp, refit = drift_removed
+        y_raw = y + comp
+        c_raw, _ = build(avar(y_raw, fs, taus=result.tau), None)
+        s_raw = _solve(c_raw, start, effects)
+        st = first_steps[0]
+        st.before = _curve_metrics(c_raw, s_raw, blocks.error(y_raw, start, effects) if blocks is not None else None)
+        st.after = _curve_metrics(
+            curve, sol, blocks.error(y_raw, start, effects, remove=refit) if blocks is not None else None
+        )
+        st.delta_chi2_eff = float(s_raw.chi2_eff(c_raw) - sol.chi2_eff(curve))
+        st.evidence["scored_with"] = [_base(k) for k, _p in effects] or "the five terms"
+    steps = first_steps + steps
     start_fit = _noise_fit(curve, start, [], start_sol, result, unit, confidence)
     final_fit = _noise_fit(curve, start, effects, sol, result, unit, confidence)
     return Refinement(

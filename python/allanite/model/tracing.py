@@ -38,6 +38,7 @@ from . import _covariance
 __all__ = [
     "spectral_lines",
     "drift_fit",
+    "drift_component",
     "drift_threshold",
     "regression_fit",
     "regression_heldout",
@@ -183,6 +184,21 @@ def drift_fit(y: np.ndarray, fs: float, n_blocks: int = DRIFT_BLOCKS) -> dict:
     b, per = _block_means(y, n_blocks)
     tb = (np.arange(b.size) * per + 0.5 * (per - 1)) / fs
     return _drift_stat(b, tb, y.size / fs, with_interval=True)
+
+
+def drift_component(y: np.ndarray, t: np.ndarray, length: float, pieces: int = 1, n_blocks: int = DRIFT_BLOCKS // 2):
+    """The warm-up a·e^{−t/T} fitted (as in :func:`drift_fit`) on samples ``y`` taken at times ``t`` (s): the
+    ``pieces`` equal runs of consecutive samples (a part of alternate blocks) are each cut into block means,
+    so no block straddles a seam. Returns the component as a function of time, for the held-out error."""
+    per_piece = max(1, n_blocks // pieces)
+    run = y.size // pieces
+    per = max(1, run // per_piece)
+    use = per_piece * per
+    yb = y[: pieces * run].reshape(pieces, run)[:, :use].reshape(-1, per)
+    tb = t[: pieces * run].reshape(pieces, run)[:, :use].reshape(-1, per)
+    d = _drift_stat(yb.mean(axis=1), tb.mean(axis=1), length)
+    a, t_c = d["amplitude"], d["T"]
+    return lambda tt: a * np.exp(-np.asarray(tt) / t_c)
 
 
 def _grid_stats(b: np.ndarray, tb: np.ndarray, length: float) -> np.ndarray:
