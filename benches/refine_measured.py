@@ -42,10 +42,10 @@ def summarize(name, r) -> dict:
         "record": name,
         "start_chi2_dof": s0.chi2_dof,
         "start_rms_z": float(np.sqrt(np.mean(s0.z**2))),
-        "start_rms_adev_pct": float(100 * np.sqrt(np.mean((np.sqrt(s0.avar / s0.model) - 1) ** 2))),
+        "start_rms_adev_pct": r.rms_adev_pct(s0),
         "start_heldout_rms_adev_pct": r.start_heldout_rms_adev_pct,
         "final_chi2_dof": r.fit.chi2_dof,
-        "final_rms_adev_pct": float(100 * np.sqrt(np.mean((np.sqrt(r.fit.avar / r.fit.model) - 1) ** 2))),
+        "final_rms_adev_pct": r.rms_adev_pct(r.fit),
         "steps": [],
     }
     for st in r.steps:

@@ -23,10 +23,15 @@ own Allan variance: c²·AVAR(channel), a²·AVAR(e^{−t/T})). A candidate is *
    χ² test on the Welch PSD (Bonferroni over the bins); α splits the per-record ``level``;
 2. its parameter is not pinned at the edge of its search range and its amplitude is positive;
 3. χ²/dof of the dense curve falls; and
-4. the **held-out** error falls: the model with and without it is fitted on one half of the record and
-   predicts the other half's Allan curve (both ways, RMS ADEV error averaged); time-localised effects
-   (drift) by alternate blocks in time (8 blocks: odd ones predict even ones and back). Curve-only input
-   has no held-out error (reported as None) and relies on the calibrated test.
+4. the **held-out** error falls: the record is cut into 8 blocks, the odd and the even ones joined end to end;
+   the model with and without the effect is fitted on one part's Allan curve and predicts the other's (both
+   ways, RMS ADEV error averaged, on the τ whose estimate is within ±10 %). A drift or regression is refitted
+   on the held-in part's samples; change points are held out per segment (each segment's own alternate
+   blocks, predicted by the segment's model vs the one-level model). Curve-only input has no held-out error
+   (reported as None) and relies on the calibrated test.
+
+RMS ADEV errors (in-sample and held out) are scored on 4 τ per octave whose estimate is informative (EDF ≥ 50
+under the five-term fit: ±10 %); beyond, the estimate's own scatter, not the model, would decide the score.
 
 Nonlinear parameters (T_c, cutoff, f0 on curves) are found by a grid search with the linear coefficients
 by weighted NNLS at each grid point, then refined by a bounded scalar search; their intervals come from the
@@ -73,7 +78,7 @@ LINE_SHARE = 0.2
 CHANGE_POINT_SHARE = 0.2
 MAX_STEPS = 4
 N_BOOT = 1000
-#: Blocks for the held-out error of time-localised effects (odd blocks predict even ones and back).
+#: Blocks for the held-out error (odd blocks predict even ones and back).
 HELDOUT_BLOCKS = 8
 #: A bandwidth that raises the held-out error alone may enter with a Gauss–Markov term if its statistic is
 #: at least this multiple of the threshold.
@@ -82,7 +87,7 @@ PAIR_FACTOR = 100.0
 TIME_SHARE = 0.075
 #: Blocks of the jackknife of a regression coefficient (t with blocks − 1 degrees of freedom).
 REGRESSION_BLOCKS = 8
-#: Held-out error: only τ whose held-out ADEV estimate is within ±10 % (EDF ≥ 50, white rate noise).
+#: RMS ADEV errors: only τ whose ADEV estimate is within ±10 % (EDF ≥ 50 under the five-term fit).
 HELDOUT_MIN_EDF = 50.0
 #: Kept for the change-point test's penalty (calibrated with it on clean records).
 MIN_GAIN = 6.0
@@ -234,11 +239,24 @@ def _rms_adev_pct(obs, model) -> float:
     return float(100 * np.sqrt(np.mean((np.sqrt(obs / model) - 1) ** 2)))
 
 
-def _curve_metrics(curve: _Curve, sol: _Solution, heldout) -> dict:
+def _informative(tau, nu) -> np.ndarray:
+    """The τ an RMS ADEV error is scored on: 4 per octave (each octave weighs alike, not the dense grid's
+    points) whose estimate is itself within ±10 % — EDF ≥ 50 under the five-term fit's own noise mix (white
+    at short τ; far fewer for flicker and random walk at long τ). Beyond, the estimate's own scatter would
+    decide the score. Falls back to every thinned τ if fewer than 4 qualify."""
+    thin = tracing.thin_indices(tau)
+    mask = np.zeros(tau.size, dtype=bool)
+    mask[thin] = True
+    good = mask & (nu >= HELDOUT_MIN_EDF)
+    return good if np.count_nonzero(good) >= 4 else mask
+
+
+def _curve_metrics(curve: _Curve, sol: _Solution, heldout, scored=None) -> dict:
+    sc = slice(None) if scored is None else scored
     return {
         "chi2_dof": sol.chi2_dof,
         "rms_z": float(np.sqrt(np.mean(sol.z**2))),
-        "rms_adev_pct": _rms_adev_pct(curve.avar, sol.model),
+        "rms_adev_pct": _rms_adev_pct(curve.avar[sc], sol.model[sc]),
         "p_value": float(chi2_dist.sf(sol.chi2_eff(curve), max(1.0, curve.n_eff - 1))),
         "heldout_rms_adev_pct": heldout,
     }
@@ -249,68 +267,17 @@ def _curve_metrics(curve: _Curve, sol: _Solution, heldout) -> dict:
 
 
 class _Split:
-    """Two complementary sets of blocks of the record, each with its averaged Allan curve."""
+    """Alternate blocks in time (odd ↔ even) for the held-out error.
 
-    def __init__(self, y, fs, grid_m, lo, hi, estimator, channels, n_blocks):
-        n = y.size
-        per = n // n_blocks
-        self.parts = []
-        for parity in (0, 1):
-            blocks = [(j * per, per) for j in range(n_blocks) if j % 2 == parity]
-            m = grid_m[grid_m <= per // 9]
-            if m.size < 8:
-                raise ValueError("record too short for held-out blocks")
-            av = np.mean([avar(y[s : s + nb], fs, taus=m / fs).avar for s, nb in blocks], axis=0)
-            chans = {
-                k: np.mean([avar(c[s : s + nb], fs, taus=m / fs).avar for s, nb in blocks], axis=0)
-                for k, c in channels.items()
-            }
-            tau = m / fs
-            keep = (tau >= lo) & (tau <= hi) & (av > 0)
-            if np.count_nonzero(keep) < 2:
-                raise ValueError("too few τ in range for held-out blocks")  # _splits: no held-out error
-            self.parts.append(
-                _Curve(
-                    tau[keep],
-                    m[keep].astype(np.float64),
-                    av[keep],
-                    fs,
-                    per + 1,
-                    estimator,
-                    blocks,
-                    {k: v[keep] for k, v in chans.items()},
-                )
-            )
-        common = min(p.tau.size for p in self.parts)
-        self.parts = [p.subset(np.arange(common)) for p in self.parts]
-        # score only the τ whose held-out estimate is itself informative (ADEV ±10 %: EDF ≥ 50 for white
-        # rate noise); beyond, the other part's own scatter (flicker, random walk) would decide the score
-        # and weigh every octave alike (4 τ per octave), not the dense grid's points
-        scored = np.zeros(common, dtype=bool)
-        scored[tracing.thin_indices(self.parts[0].tau)] = True
-        self.scored = scored & (self.parts[0].edf(0) >= HELDOUT_MIN_EDF)
+    Each part's blocks are joined end to end (samples keep their true times); the model fitted on one part's
+    Allan curve predicts the other part's, both ways. Interleaved parts share the record's slow changes (a
+    noise level that steps, a warm-up), so the score asks whether the model carries over, not whether the
+    two halves of a non-stationary record agree at long τ. A time effect is fitted on one part's samples
+    and removed from both. Joining keeps τ up to part/9 (a warm-up's time scale) where an Allan curve per
+    block would stop at block/9; the seams affect the model with and without an effect alike."""
 
-    def error(self, terms, effects) -> float:
-        """RMS ADEV error (%) of the model fitted on one part predicting the other, averaged both ways."""
-        errs = []
-        for f, h in ((0, 1), (1, 0)):
-            sol = _solve(self.parts[f], terms, effects)
-            a_h, _ = _design(self.parts[h], terms, effects)
-            pred = np.maximum(a_h @ sol.theta, 1e-300)
-            sc = self.scored
-            errs.append(_rms_adev_pct(self.parts[h].avar[sc], pred[sc]))
-        return float(np.mean(errs))
-
-
-class _TimeSplit:
-    """Alternate blocks in time (odd ↔ even) for the held-out error of a time-localised effect.
-
-    Each part's blocks are joined end to end (samples keep their true times): a time effect is fitted on one
-    part's samples and removed from both parts, the noise model fitted on that part's Allan curve predicts the
-    other part's. Joining keeps τ up to part/9 (a warm-up's time scale) where an Allan curve per block would
-    stop at block/9; the seams affect the model with and without the effect alike."""
-
-    def __init__(self, y, fs, grid_m, lo, hi, estimator, n_blocks):
+    def __init__(self, y, fs, grid_m, lo, hi, estimator, n_blocks, terms):
+        self.y = y
         n = y.size
         per = n // n_blocks
         self.fs, self.estimator = fs, estimator
@@ -320,37 +287,65 @@ class _TimeSplit:
         ]
         size = min(i.size for i in self.idx)
         self.idx = [i[:size] for i in self.idx]
-        self.t = [i / fs for i in self.idx]
         m = grid_m[grid_m <= size // 9]
         tau = m / fs
         keep = (tau >= lo) & (tau <= hi)
         if np.count_nonzero(keep) < 8:
             raise ValueError("too few τ in range for held-out blocks")
         self.m, self.size = m[keep], size
-        probe = self._curve(y[self.idx[0]])
-        scored = np.zeros(self.m.size, dtype=bool)
-        scored[tracing.thin_indices(probe.tau)] = True
-        self.scored = scored & (probe.edf(0) >= HELDOUT_MIN_EDF)
+        self.curves = [self._curve(y[i]) for i in self.idx]
+        self.scored = _informative(self.curves[0].tau, _solve(self.curves[0], terms, []).nu)
 
     def _curve(self, z):
         av = np.maximum(avar(z, self.fs, taus=self.m / self.fs).avar, 1e-300)
         return _Curve(self.m / self.fs, self.m.astype(np.float64), av, self.fs, self.size + 1, self.estimator)
 
-    def error(self, y, terms, effects, remove=None) -> float:
+    def error(self, terms, effects, remove=None) -> float:
         """RMS ADEV error (%) of one part's model predicting the other's curve, both ways; ``remove(samples,
-        t)`` fits a time component on the held-in part and returns it as a function of time."""
+        indices)`` fits a component on the held-in part and returns it as a function of sample indices."""
         errs = []
         for f, h in ((0, 1), (1, 0)):
-            yf, yh = y[self.idx[f]], y[self.idx[h]]
-            if remove is not None:
-                g = remove(yf, self.t[f])
-                yf, yh = yf - g(self.t[f]), yh - g(self.t[h])
-            cf, ch = self._curve(yf), self._curve(yh)
+            if remove is None:
+                cf, ch = self.curves[f], self.curves[h]
+            else:
+                yf, yh = self.y[self.idx[f]], self.y[self.idx[h]]
+                g = remove(yf, self.idx[f])
+                cf, ch = self._curve(yf - g(self.idx[f])), self._curve(yh - g(self.idx[h]))
             sol = _solve(cf, terms, effects)
             a_h, _ = _design(ch, terms, effects)
             pred = np.maximum(a_h @ sol.theta, 1e-300)
             errs.append(_rms_adev_pct(ch.avar[self.scored], pred[self.scored]))
         return float(np.mean(errs))
+
+
+def _upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4.0):
+    """``theta`` with each slow term (flicker, random walk of rate) raised to the upper end of what the curve
+    allows: the largest value with the others refitted (weighted NNLS, the fit's weights) whose χ² rises by
+    at most ``delta_chi2`` (≈ 2σ; in effective points). A null model for a time-domain test must not leave out a random walk the
+    curve merely could not pin down: one that is there makes warm-up-like wander in the block means."""
+    out = theta.copy()
+    a, _ = _design(curve, terms, effects)
+    w = np.sqrt(sol.nu / (2.0 * sol.model**2))
+    aw, yw = a * w[:, None], curve.avar * w
+    chi_min = float(np.sum((yw - aw @ fitting.nnls(aw, yw)) ** 2))
+    # the dense curve's points are strongly correlated: χ² counts ~n_eff independent ones (as the fit's
+    # covariance does), so the rise allowed on the dense χ² is scaled by points / n_eff
+    delta_chi2 = delta_chi2 * curve.tau.size / curve.n_eff
+    for name in slow:
+        if name not in terms:
+            continue
+        j = list(terms).index(name)
+        col = aw[:, j]
+        others = np.delete(aw, j, axis=1)
+        top = float(np.min(curve.avar / np.maximum(a[:, j], 1e-300)))  # alone it would explain a point
+        best = 0.0
+        for v in top * np.geomspace(1e-4, 1.0, 41):
+            r = yw - v * col
+            chi = float(np.sum((r - others @ fitting.nnls(others, r)) ** 2))
+            if chi - chi_min <= delta_chi2:
+                best = v
+        out[j] = max(out[j], best)
+    return out
 
 
 def _theta_terms(sol, terms, effects):
@@ -363,12 +358,35 @@ def _theta_terms(sol, terms, effects):
     return theta
 
 
-def _splits(y, fs, m_all, lo, hi):
-    """Halves and alternate blocks of the record for the held-out error, or (None, None) if too short."""
+def _heldout_split(y, fs, m_all, lo, hi, terms):
+    """Alternate blocks of the record for the held-out error, or None if the record is too short."""
     try:
-        return _Split(y, fs, m_all, lo, hi, "oavar", {}, 2), _TimeSplit(y, fs, m_all, lo, hi, "oavar", HELDOUT_BLOCKS)
+        return _Split(y, fs, m_all, lo, hi, "oavar", HELDOUT_BLOCKS, terms)
     except ValueError:
-        return None, None
+        return None
+
+
+def _segments_heldout(whole: _Split, y, fs, m_all, lo, hi, terms, effects, times):
+    """Held-out error of change points at ``times`` (s): (without, with), or None if a segment is too short.
+
+    Each segment between change points gets its own alternate blocks; its held-out part's Allan curve is
+    predicted once by the model fitted on the held-in part of the whole record (no change point) and once by
+    the model fitted on the segment's own held-in part (the noise level changes there). Mean over both ways,
+    segments weighted by their length. A change point that is not real leaves the segments alike, and the
+    segment's model, fitted on less data, predicts no better."""
+    edges = [0] + sorted(int(round(t * fs)) for t in times) + [y.size]
+    out = np.zeros(2)
+    for a, b in zip(edges[:-1], edges[1:]):
+        seg = _heldout_split(y[a:b], fs, m_all, lo, hi, terms)
+        if seg is None:
+            return None
+        for f, h in ((0, 1), (1, 0)):
+            a_h, _ = _design(seg.curves[h], terms, effects)
+            obs = seg.curves[h].avar[seg.scored]
+            for k, part in enumerate((whole.curves[f], seg.curves[f])):
+                pred = np.maximum(a_h @ _solve(part, terms, effects).theta, 1e-300)[seg.scored]
+                out[k] += 0.5 * (b - a) / y.size * _rms_adev_pct(obs, pred)
+    return float(out[0]), float(out[1])
 
 
 # ----------------------------------------------------------------------------------------------
@@ -628,8 +646,8 @@ class Step:
     rate unit, ``f0`` Hz; bandwidth ``cutoff`` Hz, ``taps``, ``filter``; drift ``amplitude`` rate unit,
     ``T`` s; regression ``channel``, ``coefficient`` rate unit per channel unit; change point ``t`` s);
     ``intervals`` the numeric keys → (low, high); ``before``/``after``: ``chi2_dof``, ``rms_z``,
-    ``rms_adev_pct``, ``p_value`` and ``heldout_rms_adev_pct`` (None for curve-only input and change
-    points); ``evidence``: where in τ, f or t the residual was and the test that accepted it;
+    ``rms_adev_pct`` (on ``Refinement.scored_tau``), ``p_value`` and ``heldout_rms_adev_pct`` (None for
+    curve-only input); ``evidence``: where in τ, f or t the residual was and the test that accepted it;
     ``truth_error``: relative parameter errors when ``truth`` was given.
     """
 
@@ -647,7 +665,8 @@ class Step:
 class Refinement(RichDisplay):
     """What :func:`refine` found. ``fit`` is the final model (a NoiseFit whose ``coefficients`` also
     hold the added effects' parameters), ``start`` the starting model, ``steps`` the effects added.
-    ``heldout_note`` says how (or why not) the held-out error was computed."""
+    ``heldout_note`` says how (or why not) the held-out error was computed; ``scored_tau`` the τ the RMS ADEV
+    errors are scored on (:meth:`rms_adev_pct` gives a fit's)."""
 
     steps: list
     fit: fitting.NoiseFit
@@ -660,6 +679,13 @@ class Refinement(RichDisplay):
     heldout_note: str = ""
     start_heldout_rms_adev_pct: float | None = None
     tau_range: tuple = (0.0, math.inf)
+    scored_tau: np.ndarray | None = None
+
+    def rms_adev_pct(self, fit) -> float:
+        """RMS ADEV error (%) of a fit (``start`` or ``fit``) on the τ the steps' errors are scored on
+        (``scored_tau``: 4 per octave, each estimate within ±10 %, EDF ≥ 50 under the five-term fit)."""
+        sel = np.isin(fit.tau, self.scored_tau) if self.scored_tau is not None else slice(None)
+        return _rms_adev_pct(fit.avar[sel], fit.model[sel])
 
     @property
     def found(self) -> list:
@@ -674,7 +700,7 @@ class Refinement(RichDisplay):
             "",
             f"Starting model {'+'.join(self.terms)}: χ²/dof = {s0.chi2_dof:.3g}, "
             f"RMS z = {np.sqrt(np.mean(s0.z**2)):.3g}, RMS ADEV error = "
-            f"{_rms_adev_pct(s0.avar, s0.model):.3g} %, held-out RMS ADEV error = "
+            f"{self.rms_adev_pct(s0):.3g} %, held-out RMS ADEV error = "
             + (f"{ho:.3g} %." if ho is not None else "n/a."),
             "",
             f"Held-out error: {self.heldout_note}",
@@ -1095,48 +1121,55 @@ def _refine(
     fs = result.fs
 
     def build(res, samples):
-        """The curve (and, with samples, the held-out splits) of ``res``'s estimates in the τ range."""
+        """The curve (and, with samples, the held-out split) of ``res``'s estimates in the τ range."""
         c = _Curve(
             res.tau[keep], res.m[keep].astype(np.float64), res.avar[keep], fs, res.n_samples + 1, est, channels={}
         )
         if samples is None:
-            return c, (None, None)
-        return c, _splits(samples, fs, np.asarray(res.m, dtype=np.int64), lo, hi)
+            return c, None
+        return c, _heldout_split(samples, fs, np.asarray(res.m, dtype=np.int64), lo, hi, start)
 
-    curve, (halves, blocks) = build(result, y)
+    curve, heldout = build(result, y)
     note = "curve-only input (an AllanResult without samples): no held-out error; steps rest on the calibrated test"
     if y is not None:
         note = (
-            "fit on one half of the record, predict the other half's Allan curve (both ways, mean RMS ADEV "
-            f"error); drift by alternate blocks ({HELDOUT_BLOCKS} blocks, odd ↔ even)"
-            if halves is not None
-            else "record too short to hold out halves: no held-out error"
+            f"alternate blocks in time ({HELDOUT_BLOCKS}; odd ↔ even, each part's blocks joined): the model fitted "
+            "on one part predicts the other part's Allan curve, both ways, mean RMS ADEV error on the τ whose "
+            "estimate is within ±10 % (4 per octave); a drift is refitted on the held-in part"
+            if heldout is not None
+            else "record too short to hold out alternate blocks: no held-out error"
         )
     k_terms = len(start)
     steps: list = []
     sol = _solve(curve, start, [])
     start_sol = sol
-    start_heldout = halves.error(start, []) if halves is not None else None
+    # in-sample RMS ADEV error: on the τ whose estimate is informative under the five-term fit (fixed for
+    # the whole refinement, so every before/after compares the same τ)
+    scored = _informative(curve.tau, sol.nu)
+
+    def metrics(c, s, ho):
+        return _curve_metrics(c, s, ho, scored)
+
+    start_heldout = heldout.error(start, []) if heldout is not None else None
     alpha_curve = level * (1.0 - LINE_SHARE - CHANGE_POINT_SHARE - 2 * TIME_SHARE)
 
     # removing a time-domain component (after the curve effects are in the model)
-    def removal_step(name, component, split, params, intervals, evidence, truth_key, held_in_time=None):
+    def removal_step(name, component, refit, params, intervals, evidence, truth_key, held_in_time=None):
         """Accept removing ``component`` if the held-out error falls; returns the step or None.
+
+        ``refit(samples, indices)`` fits the component on the held-in part's samples (at those sample indices)
+        and returns it as a function of sample indices, for the held-out error.
 
         ``held_in_time``: for a regression, the held-out test in time (the residual variance of each half with
         the coefficient of the other half, relative to its raw variance) decides instead: removing a white-like
         component changes the Allan curve's level, not how well one half predicts the other's."""
-        nonlocal y, result, curve, halves, blocks, sol
+        nonlocal y, result, curve, heldout, sol
         assert y is not None
         y_new = y - component
         res_new = avar(y_new, fs, taus=result.tau)
-        c_new, (h_new, b_new) = build(res_new, y_new)
-        if split == "halves":
-            ho_b = halves.error(start, effects) if halves is not None else None
-            ho_a = h_new.error(start, effects) if h_new is not None else None
-        else:  # alternate blocks in time: the component refitted on the held-in part (``split`` fits it)
-            ho_b = blocks.error(y, start, effects) if blocks is not None else None
-            ho_a = blocks.error(y, start, effects, remove=split) if blocks is not None else None
+        c_new, h_new = build(res_new, y_new)
+        ho_b = heldout.error(start, effects) if heldout is not None else None
+        ho_a = heldout.error(start, effects, remove=refit) if heldout is not None else None
         s_new = _solve(c_new, start, effects)
         if held_in_time is not None:
             evidence["heldout_variance_ratio"] = held_in_time
@@ -1160,12 +1193,12 @@ def _refine(
             params=params,
             intervals=intervals,
             evidence=evidence,
-            before=_curve_metrics(curve, sol, ho_b),
-            after=_curve_metrics(c_new, s_new, ho_a),
+            before=metrics(curve, sol, ho_b),
+            after=metrics(c_new, s_new, ho_a),
             delta_chi2_eff=float(sol.chi2_eff(curve) - s_new.chi2_eff(c_new)),
             truth_error=terr,
         )
-        y, result, curve, halves, blocks, sol = y_new, res_new, c_new, h_new, b_new, s_new
+        y, result, curve, heldout, sol = y_new, res_new, c_new, h_new, s_new
         return st
 
     considered: dict[str, list] = {}
@@ -1177,7 +1210,8 @@ def _refine(
     # which the drift itself inflates: conservative)
     if y is not None and "drift" in candidates:
         dr = tracing.drift_fit(y, fs)
-        thr_d = tracing.drift_threshold(y.size, fs, start, _theta_terms(sol, start, effects), TIME_SHARE * level)
+        theta_null = _upper_theta(curve, sol, start, effects, _theta_terms(sol, start, effects))
+        thr_d = tracing.drift_threshold(y.size, fs, start, theta_null, TIME_SHARE * level)
         ev = {"domain": "time", "test": {"statistic": dr["statistic"], "threshold": thr_d, "alpha": TIME_SHARE * level}}
         if dr["statistic"] > thr_d and not dr["at_edge"]:
             t_s = np.arange(y.size) / fs
@@ -1185,8 +1219,9 @@ def _refine(
             pieces = HELDOUT_BLOCKS // 2
             drift_comp = dr["amplitude"] * np.exp(-t_s / dr["T"])
 
-            def drift_refit(z, t, span=span, pieces=pieces):
-                return tracing.drift_component(z, t, span, pieces)
+            def drift_refit(z, idx, span=span, pieces=pieces):
+                g = tracing.drift_component(z, idx / fs, span, pieces)
+                return lambda i: g(i / fs)
 
             st = removal_step(
                 "drift",
@@ -1238,7 +1273,7 @@ def _refine(
             assert search is not None
             p, s_new, edge = _search(curve, start, effects, "gauss_markov", search(tmin, tmax))
             propose(
-                "gauss_markov", p, s_new, edge, test.statistic(sub.avar, _column("gauss_markov", p, sub)), thr, halves
+                "gauss_markov", p, s_new, edge, test.statistic(sub.avar, _column("gauss_markov", p, sub)), thr, heldout
             )
         if "bandwidth" in candidates and not any(_base(k) == "bandwidth" for k in keys) and "N" in start:
             best = None
@@ -1250,20 +1285,20 @@ def _refine(
             if best is not None:
                 key, p, s_new, edge = best
                 stat = test.statistic(sub.avar, _column(key, p, sub) - 1.0 / sub.tau)
-                propose(key, p, s_new, edge, stat, thr, halves)
+                propose(key, p, s_new, edge, stat, thr, heldout)
         if "sinusoid" in candidates:
             if y is not None:
                 done_f = [p for k, p in effects if k == "sinusoid"]
                 for ln in lines:
                     if all(abs(ln["f0"] - f) > 2 * ln["bin_hz"] for f in done_f):
                         s_new = _solve(curve, start, effects + [("sinusoid", ln["f0"])])
-                        propose("sinusoid", ln["f0"], s_new, False, ln["psd_ratio"], ln["threshold"], halves, line=ln)
+                        propose("sinusoid", ln["f0"], s_new, False, ln["psd_ratio"], ln["threshold"], heldout, line=ln)
                         break
             else:
                 search = EFFECTS["sinusoid"].search
                 assert search is not None
                 p, s_new, edge = _search(curve, start, effects, "sinusoid", search(tmin, tmax))
-                propose("sinusoid", p, s_new, edge, test.statistic(sub.avar, _column("sinusoid", p, sub)), thr, halves)
+                propose("sinusoid", p, s_new, edge, test.statistic(sub.avar, _column("sinusoid", p, sub)), thr, heldout)
         for pr in props:
             considered.setdefault(_base(pr["key"]), []).append(
                 {"param": float(pr["p"]), "statistic": float(pr["stat"]), "threshold": float(pr["thr"])}
@@ -1347,8 +1382,8 @@ def _refine(
                 params=params,
                 intervals=intervals,
                 evidence=evidence,
-                before=_curve_metrics(curve, sol, ho_b),
-                after=_curve_metrics(curve, s_new, ho_a),
+                before=metrics(curve, sol, ho_b),
+                after=metrics(curve, s_new, ho_a),
                 delta_chi2_eff=float(sol.chi2_eff(curve) - s_new.chi2_eff(curve)),
                 truth_error=terr,
             )
@@ -1381,10 +1416,15 @@ def _refine(
             if not t_stat > t_thr:
                 considered.setdefault("regression", []).append({"channel": name, "t": t_stat, "threshold": t_thr})
                 continue
+
+            def reg_refit(z, idx, ch=ch):
+                cf = tracing.regression_fit(z, ch[idx], 2)["coefficient"]
+                return lambda i: cf * (ch[i] - ch.mean())
+
             st = removal_step(
                 "regression",
                 rg["coefficient"] * (ch - ch.mean()),
-                "halves",
+                reg_refit,
                 {"channel": name, "coefficient": rg["coefficient"]},
                 {"coefficient": (rg["coefficient"] - rg["se"], rg["coefficient"] + rg["se"])},
                 ev,
@@ -1396,12 +1436,27 @@ def _refine(
     change_points = []
     if y is not None and "change_point" in candidates:
         change_points = _change_points(y, fs, start)
+        ho_cp = None
+        if change_points and heldout is not None:
+            m_all = np.asarray(result.m, dtype=np.int64)
+            ho_cp = _segments_heldout(heldout, y, fs, m_all, lo, hi, start, effects, [c["t"] for c in change_points])
+        if ho_cp is not None and not ho_cp[1] < ho_cp[0]:
+            for c in change_points:
+                considered.setdefault("change_point", []).append(
+                    {
+                        "t": c["t"],
+                        "gain_chi2": c["gain"],
+                        "rejected": f"held-out error {ho_cp[0]:.3g} → {ho_cp[1]:.3g} %",
+                    }
+                )
+            change_points = []
         for c in change_points:
             terr = None
             if truth and "change_point" in truth:
                 ts = np.atleast_1d(truth["change_point"]["t"])
                 terr = {"t": float(np.min(np.abs(ts - c["t"])) / (y.size / fs))}
-            c["before"]["heldout_rms_adev_pct"] = c["after"]["heldout_rms_adev_pct"] = None
+            c["before"]["heldout_rms_adev_pct"] = None if ho_cp is None else ho_cp[0]
+            c["after"]["heldout_rms_adev_pct"] = None if ho_cp is None else ho_cp[1]
             steps.append(
                 Step(
                     effect="change_point",
@@ -1425,13 +1480,11 @@ def _refine(
         # final model — the same curve effects with and without the drift in the samples
         comp, refit = drift_removed
         y_raw = y + comp
-        c_raw, _ = build(avar(y_raw, fs, taus=result.tau), None)
+        c_raw, h_raw = build(avar(y_raw, fs, taus=result.tau), y_raw)
         s_raw = _solve(c_raw, start, effects)
         st = first_steps[0]
-        st.before = _curve_metrics(c_raw, s_raw, blocks.error(y_raw, start, effects) if blocks is not None else None)
-        st.after = _curve_metrics(
-            curve, sol, blocks.error(y_raw, start, effects, remove=refit) if blocks is not None else None
-        )
+        st.before = metrics(c_raw, s_raw, h_raw.error(start, effects) if h_raw is not None else None)
+        st.after = metrics(curve, sol, h_raw.error(start, effects, remove=refit) if h_raw is not None else None)
         st.delta_chi2_eff = float(s_raw.chi2_eff(c_raw) - sol.chi2_eff(curve))
         st.evidence["scored_with"] = [_base(k) for k, _p in effects] or "the five terms"
     steps = first_steps + steps
@@ -1448,6 +1501,7 @@ def _refine(
         considered=considered,
         heldout_note=note,
         start_heldout_rms_adev_pct=start_heldout,
+        scored_tau=curve.tau[scored],
         tau_range=(lo, hi),
     )
 

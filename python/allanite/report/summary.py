@@ -19,12 +19,12 @@ from .settings import FIT_MODEL
 __all__ = ["summarize", "text_summary", "refinement_dict"]
 
 
-def _fit_errors(f) -> dict:
-    """χ²/dof, RMS z and RMS ADEV error (%) of a NoiseFit against its own estimates."""
+def _fit_errors(f, r) -> dict:
+    """χ²/dof, RMS z and RMS ADEV error (%, on the refinement's scored τ) of a NoiseFit against its estimates."""
     return {
         "chi2_dof": json_number(f.chi2_dof),
         "rms_z": json_number(np.sqrt(np.mean(f.z**2))),
-        "rms_adev_pct": json_number(100 * np.sqrt(np.mean((np.sqrt(f.avar / f.model) - 1) ** 2))),
+        "rms_adev_pct": json_number(r.rms_adev_pct(f)),
     }
 
 
@@ -46,10 +46,10 @@ def refinement_dict(rep) -> dict | None:
                 "name": rep.axis_names[k],
                 "terms": list(r.terms),
                 "tau_from_s": json_number(r.start.tau[0]),
-                "start": _fit_errors(r.start),
+                "start": _fit_errors(r.start, r),
                 "start_heldout_rms_adev_pct": json_number(r.start_heldout_rms_adev_pct),
                 "heldout_note": r.heldout_note,
-                "final": _fit_errors(r.fit),
+                "final": _fit_errors(r.fit, r),
                 "steps": [
                     {
                         "effect": st.effect,
