@@ -10,7 +10,7 @@ from scipy import signal
 
 import allanite
 from allanite.errors import ParameterError
-from allanite.model.effects import EFFECTS, drift_avar, filter_cutoff, filtered_white_avar
+from allanite.model.effects import EFFECTS, drift_avar, filter_autocorrelation, filter_cutoff, filtered_white_avar
 from allanite.model.tracing import regression_fit
 
 FS = 100.0
@@ -46,6 +46,23 @@ def test_filtered_white_avar_matches_a_simulation(kind, p):
     np.testing.assert_allclose(sim, exact, rtol=0.03)
     # unity DC gain: the curve tends to N²/τ
     assert filtered_white_avar(100.0, kind, p, FS)[0] * 100.0 == pytest.approx(1.0, rel=1e-3)
+
+
+def test_boxcar_of_any_span_matches_a_simulation():
+    # a boxcar of 1.4 output samples: a 14-tap average at 10× the output rate, read every 10th sample
+    w = np.random.default_rng(1).normal(size=4_000_000) * np.sqrt(10 * FS)
+    y = signal.lfilter(np.ones(14) / 14, [1], w)[13::10]
+    tau = np.array([0.01, 0.02, 0.03, 0.05, 0.1, 1.0])
+    sim, exact = allanite.avar(y, FS, taus=tau).avar, filtered_white_avar(tau, "boxcar", 1.4, FS)
+    # the shape (N is the output's own long-τ white level: overlapping reads count some input twice)
+    np.testing.assert_allclose(sim / sim[-1], exact / exact[-1], rtol=0.03)
+    r = filter_autocorrelation("boxcar", 1.4, FS)
+    assert r[1] / r[0] == pytest.approx(1 - 1 / 1.4) and r.size == 2
+    # a whole span is the moving average of that many taps; the cutoff is the continuous boxcar's
+    np.testing.assert_allclose(
+        filter_autocorrelation("boxcar", 3.0, FS), filter_autocorrelation("moving_average", 3, FS)
+    )
+    assert filter_cutoff("boxcar", 2.0, FS) == pytest.approx(0.44295 * FS / 2.0)
 
 
 def test_filter_cutoffs_and_drift_closed_form():
@@ -113,9 +130,21 @@ def test_clean_adis_run_names_its_bandwidth_not_sinusoids(shared_data):
     r = allanite.refine(y, FS)
     assert r.found[0] == "bandwidth"
     st = r.steps[0]
-    # the ADIS16405's gyro: a 2-tap moving average (decimation) — −3 dB at f_s/4
-    assert st.params["filter"] == "moving_average" and st.params["taps"] == 2
-    assert st.params["cutoff"] == pytest.approx(25.0, rel=0.05)
+    # the gyro's samples are an MA(1)-like process (lag-1 correlation ≈ 0.2, none beyond): a boxcar a little
+    # longer than one sample — averaged at the part's internal rate, read at 100 Hz — not a 2-tap average
+    # (lag-1 correlation 0.5), which with white angle noise on top fits the Allan curve as well
+    assert st.params["filter"] == "boxcar" and 1.05 < st.params["taps"] < 2.0
+    assert st.params["cutoff"] == pytest.approx(0.443 * FS / st.params["taps"], rel=1e-3)
+    # the named filter predicts the measured spectrum's roll-off (Welch PSD 40–48 Hz over 2–10 Hz: 0.30;
+    # a 2-tap average would say 0.04)
+    f, p = signal.welch(y - y.mean(), fs=FS, nperseg=1024)
+    measured = p[(f >= 40) & (f <= 48)].mean() / p[(f >= 2) & (f <= 10)].mean()
+    rr = filter_autocorrelation("boxcar", st.params["taps"], FS)
+
+    def psd(fr):
+        return rr[0] + 2 * np.cos(2 * np.pi * np.outer(fr / FS, np.arange(1, rr.size))) @ rr[1:]
+
+    assert psd(np.arange(40, 49)).mean() / psd(np.arange(2, 11)).mean() == pytest.approx(measured, rel=0.15)
     assert "sinusoid" not in r.found and "drift" not in r.found
     _falls(st)
     assert st.before["chi2_dof"] > 100 and st.after["chi2_dof"] < 2

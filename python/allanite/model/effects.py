@@ -28,9 +28,11 @@ __all__ = [
 ]
 
 #: Low-pass filters a "bandwidth" effect can be: a single pole (first-order IIR, impulse-invariant:
-#: a = e^{−2πf_c/f_s}), a moving average of L taps (the boxcar decimation filter of MEMS parts), and a
-#: Bartlett (triangular, two cascaded moving averages: 2L − 1 taps).
-FILTERS = ("single_pole", "moving_average", "bartlett")
+#: a = e^{−2πf_c/f_s}), a moving average of L taps (the boxcar decimation filter of MEMS parts), a Bartlett
+#: (triangular, two cascaded moving averages: 2L − 1 taps), and a boxcar of any span D (a moving average a
+#: part computes at its internal rate and the host reads at the output rate, so D·f_s need not be whole:
+#: the samples' autocorrelation is the triangle (1 − l/(D·f_s))₊; −3 dB at 0.443/D).
+FILTERS = ("single_pole", "moving_average", "bartlett", "boxcar")
 
 
 def gm_avar(tau: np.ndarray | float, tc: float) -> np.ndarray:
@@ -53,11 +55,15 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
     """Normalised autocorrelation r(l), l = 0, 1, …, of unit-DC-gain filtered white noise: Σ_l r(|l|) = 1.
 
     ``kind`` one of :data:`FILTERS`; ``p`` the cutoff (Hz) for ``"single_pole"``, the length L (taps of one
-    moving average) for the FIRs."""
+    moving average) for the FIRs, the span D·f_s (samples, ≥ 1, any real) for ``"boxcar"``."""
     if kind == "single_pole":
         a = math.exp(-2.0 * math.pi * p / fs)
         n = int(min(200_000, math.ceil(40.0 / max(1.0 - a, 1e-9)))) + 1
         return (1.0 - a) / (1.0 + a) * a ** np.arange(n, dtype=np.float64)
+    if kind == "boxcar":
+        span = max(1.0, float(p))
+        tri = 1.0 - np.arange(int(math.ceil(span)), dtype=np.float64) / span
+        return tri / (tri[0] + 2.0 * tri[1:].sum())
     taps = max(1, int(round(p)))
     h = np.full(taps, 1.0 / taps)
     if kind == "bartlett":
@@ -67,9 +73,12 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
 
 
 def filter_cutoff(kind: str, p: float, fs: float) -> float:
-    """−3 dB frequency (Hz) of a filter of :data:`FILTERS` (``p`` as in :func:`filter_autocorrelation`)."""
+    """−3 dB frequency (Hz) of a filter of :data:`FILTERS` (``p`` as in :func:`filter_autocorrelation`); for a
+    boxcar the continuous filter's, 0.4430/D (sinc² = ½), before the output sampling aliases it."""
     if kind == "single_pole":
         return float(p)
+    if kind == "boxcar":
+        return float(0.44295 * fs / max(1.0, float(p)))
     r = filter_autocorrelation(kind, p, fs)
     f = np.linspace(0.0, fs / 2.0, 4097)
     lags = np.arange(1, r.size)
@@ -199,10 +208,16 @@ EFFECTS: dict[str, Effect] = {
             "curve",
             (
                 ("cutoff", "Hz", "−3 dB frequency of the low-pass on the rate noise"),
-                ("taps", "samples", "FIR length (moving average L, Bartlett 2L − 1); 0 for a single pole"),
+                (
+                    "taps",
+                    "samples",
+                    "FIR length (moving average L, Bartlett 2L − 1; a boxcar's span D·f_s, any real); "
+                    "0 for a single pole",
+                ),
             ),
-            "the sensor's low-pass on its white rate noise (single pole, or the moving-average/Bartlett FIR of a "
-            "decimating MEMS part): N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, replacing N²/τ — a "
+            "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
+            "decimating MEMS part, or a boxcar of any span read at the output rate): "
+            "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, replacing N²/τ — a "
             "roll-off of the shortest τ; the N it reports is the white noise before the filter",
             signature=None,
             alpha=lambda tau, p: np.zeros(np.asarray(tau).size, dtype=int),

@@ -321,8 +321,9 @@ class _Split:
 def _upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4.0):
     """``theta`` with each slow term (flicker, random walk of rate) raised to the upper end of what the curve
     allows: the largest value with the others refitted (weighted NNLS, the fit's weights) whose χ² rises by
-    at most ``delta_chi2`` (≈ 2σ; in effective points). A null model for a time-domain test must not leave out a random walk the
-    curve merely could not pin down: one that is there makes warm-up-like wander in the block means."""
+    at most ``delta_chi2`` (≈ 2σ; in effective points). A null model for a time-domain test must not leave
+    out a random walk the curve merely could not pin down: one that is there makes warm-up-like wander in the
+    block means."""
     out = theta.copy()
     a, _ = _design(curve, terms, effects)
     w = np.sqrt(sol.nu / (2.0 * sol.model**2))
@@ -421,7 +422,8 @@ def _residual_evidence(curve, sol) -> dict:
 def _search(curve, terms, effects, key, grid, continuous=True):
     """Best nonlinear parameter for effect ``key`` on ``grid`` (then refined), its solution and profile."""
 
-    chis = np.array([_solve(curve, terms, effects + [(key, p)]).chi2 for p in grid])
+    # screen the grid with a few reweighting passes (the ranking settles early), then solve fully
+    chis = np.array([_solve(curve, terms, effects + [(key, p)], max_iter=6).chi2 for p in grid])
     k = int(np.argmin(chis))
     lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
     p = float(grid[k])
@@ -434,8 +436,10 @@ def _search(curve, terms, effects, key, grid, continuous=True):
         )
         p = math.exp(res.x)
     sol = _solve(curve, terms, effects + [(key, p)])
-    if sol.chi2 > chis[k]:
-        p, sol = float(grid[k]), _solve(curve, terms, effects + [(key, float(grid[k]))])
+    if p != float(grid[k]):
+        at_k = _solve(curve, terms, effects + [(key, float(grid[k]))])
+        if sol.chi2 > at_k.chi2:
+            p, sol = float(grid[k]), at_k
     # a best value at the edge of its range is not identified — except a FIR's shortest length (2 taps):
     # below it lies "no filter", which is the null model itself
     at_edge = (k == 0 and continuous) or k == grid.size - 1
@@ -488,6 +492,7 @@ def _bandwidth_grids(curve):
     if l_max > l_min:
         grids["moving_average"] = np.arange(l_min, l_max + 1, dtype=np.float64)
         grids["bartlett"] = np.arange(max(2, l_min // 2), max(3, l_max // 2) + 1, dtype=np.float64)
+        grids["boxcar"] = np.geomspace(max(1.02, curve.tau[0] * fs / 3), l_max, 32)
     return grids
 
 
@@ -897,6 +902,12 @@ def _step_params(key, p, sol, i, curve, terms, effects_before, extra):
         cut = filter_cutoff(kind, p, curve.fs)
         if kind == "single_pole":
             taps, c_int = 0, _profile_interval(curve, terms, effects_before, key, p, sol)
+        elif kind == "boxcar":
+            s_lo, s_hi = _profile_interval(curve, terms, effects_before, key, p, sol)
+            return {"cutoff": cut, "taps": float(p), "filter": kind}, {
+                "cutoff": (filter_cutoff(kind, s_hi, curve.fs), filter_cutoff(kind, s_lo, curve.fs)),
+                "taps": (s_lo, s_hi),
+            }
         else:
             taps = int(p) if kind == "moving_average" else 2 * int(p) - 1
             c_int = (filter_cutoff(kind, p + 1, curve.fs), filter_cutoff(kind, max(1.0, p - 1), curve.fs))
@@ -1277,10 +1288,22 @@ def _refine(
             )
         if "bandwidth" in candidates and not any(_base(k) == "bandwidth" for k in keys) and "N" in start:
             best = None
+            # the kind with the lowest χ²; within one effective point of it, the one that needs fewer other
+            # terms (a 2-tap average plus white angle noise and a boxcar of 1.2 samples are the same MA(1)
+            # process: the single filter is the physical reading)
+            tie = curve.tau.size / curve.n_eff
             for kind, grid in _bandwidth_grids(curve).items():
                 key = f"bandwidth:{kind}"
-                p, s_new, edge = _search(curve, start, effects, key, grid, continuous=kind == "single_pole")
-                if best is None or s_new.chi2 < best[2].chi2:
+                p, s_new, edge = _search(curve, start, effects, key, grid, continuous=kind in ("single_pole", "boxcar"))
+                if (
+                    best is None
+                    or s_new.chi2 < best[2].chi2 - tie
+                    or (
+                        s_new.chi2 < best[2].chi2 + tie
+                        and (np.count_nonzero(s_new.theta > 0), s_new.chi2)
+                        < (np.count_nonzero(best[2].theta > 0), best[2].chi2)
+                    )
+                ):
                     best = (key, p, s_new, edge)
             if best is not None:
                 key, p, s_new, edge = best
