@@ -68,5 +68,5 @@ def test_dhvar_in_groups_equals_one_call(estimator, capsys, monkeypatch):
 
 def test_quick_calls_stay_silent_even_when_allowed(capsys):
     y = allanite.simulate(20_000, 100.0, N=2e-3, seed=1)
-    allanite.refine(y, 100.0, progress=True)  # well under DELAY
+    allanite.davar(y, 100.0, window=2_000, hop=500, progress=True)  # milliseconds: far under DELAY
     assert capsys.readouterr().err == ""

@@ -10,7 +10,14 @@ from scipy import signal
 
 import allanite
 from allanite.errors import ParameterError
-from allanite.model.effects import EFFECTS, drift_avar, filter_autocorrelation, filter_cutoff, filtered_white_avar
+from allanite.model.effects import (
+    EFFECTS,
+    drift_avar,
+    filter_autocorrelation,
+    filter_cutoff,
+    filtered_white_avar,
+    resonance_avar,
+)
 from allanite.model.tracing import regression_fit
 
 FS = 100.0
@@ -78,7 +85,7 @@ def test_filter_cutoffs_and_drift_closed_form():
 
 
 def test_registry_documents_every_effect():
-    for name in ("bandwidth", "drift", "regression", "sinusoid", "gauss_markov", "change_point"):
+    for name in ("bandwidth", "drift", "regression", "sinusoid", "gauss_markov", "change_point", "resonance"):
         e = EFFECTS[name]
         assert e.params and all(unit is not None for _, unit, _ in e.params)
         assert name in (allanite.refine.__doc__ or "")
@@ -225,3 +232,47 @@ def test_tau_range_auto_and_bad_arguments():
         allanite.refine(y, FS, channels={"T": y[:10]})
     with pytest.raises(ParameterError, match="channels need samples"):
         allanite.refine(allanite.avar(y, FS), channels={"T": y})
+
+
+def _narrowband(n, f_r, q, sigma, seed):
+    """Narrowband noise with autocorrelation σ²·e^{−πf_r·l/(q·f_s)}·cos(2πf_r·l/f_s): a complex AR(1)'s real part."""
+    rho = np.exp(-np.pi * f_r / (q * FS) + 2j * np.pi * f_r / FS)
+    rng = np.random.default_rng(seed)
+    e = (rng.normal(size=n) + 1j * rng.normal(size=n)) * np.sqrt(1 - abs(rho) ** 2)
+    return sigma * signal.lfilter([1], [1, -rho], e).real
+
+
+def test_resonance_avar_matches_a_simulation():
+    y = _narrowband(2_000_000, 20.0, 2.0, 1.0, 0)
+    tau = np.array([0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 1.0])
+    np.testing.assert_allclose(
+        allanite.avar(y, FS, taus=tau).avar / y.var(), resonance_avar(tau, 20.0, 2.0, FS), rtol=0.02
+    )
+    # the closed geometric sums equal the lag sum Σ_l A_m(l)·R(l)/2m² term by term
+    m = 7
+    lag = np.arange(-400, 401)
+    r = np.exp(-np.pi * 20.0 * np.abs(lag) / (2.0 * FS)) * np.cos(2 * np.pi * 20.0 * lag / FS)
+    tri = lambda x: np.maximum(0, m - np.abs(x))  # noqa: E731
+    direct = np.sum((2 * tri(lag) - tri(lag - m) - tri(lag + m)) * r) / (2 * m * m)
+    assert resonance_avar(m / FS, 20.0, 2.0, FS)[0] == pytest.approx(direct, rel=1e-12)
+
+
+def test_finds_a_simulated_resonance():
+    n = 400_000
+    y = allanite.simulate(n, FS, N=2e-3, K=2e-5, seed=4) + _narrowband(n, 12.0, 4.0, 1e-2, 7)
+    r = allanite.refine(y, FS, truth={"resonance": {"sigma": 1e-2, "f0": 12.0}})
+    assert r.found == ["resonance"]
+    st = r.steps[0]
+    assert abs(st.truth_error["f0"]) < 0.02 and abs(st.truth_error["sigma"]) < 0.2 and st.params["q"] == 4.0
+    lo, hi = st.intervals["f0"]
+    assert lo <= 12.0 <= hi or abs(st.truth_error["f0"]) < 0.005
+    _falls(st)
+
+
+def test_adis_z_gyro_hump_is_a_resonance(shared_data):
+    # the z gyros' broad PSD hump near 20 Hz (5× the floor from ~18 to ~23 Hz): named a resonance there
+    (y,) = _adis(shared_data, 1, ["gyro_z"])
+    r = allanite.refine(y, FS)
+    st = next(s for s in r.steps if s.effect == "resonance")
+    assert 18.0 < st.params["f0"] < 23.0 and st.params["q"] >= 4
+    _falls(st)

@@ -58,11 +58,13 @@ from ..results import AllanResult
 from . import fitting, tracing
 from .effects import (
     EFFECTS,
+    RESONANCE_Q,
     describe,
     drift_avar,
     filter_cutoff,
     filtered_white_avar,
     gm_avar,
+    resonance_avar,
     sinusoid_avar,
 )
 from .terms import TERM_ALPHA, check_terms, design_matrix
@@ -109,6 +111,8 @@ def _column(key, p, curve):
         ) / len(curve.blocks)
     if base == "regression":
         return curve.channels[key.split(":", 1)[1]]
+    if base == "resonance":
+        return resonance_avar(tau, p, float(key.split(":", 1)[1]), curve.fs)
     sig = EFFECTS[base].signature
     assert sig is not None
     return sig(tau, p, curve.fs)
@@ -507,6 +511,10 @@ def _families(curve, candidates, has_samples, channel_names, drift_grid):
     if "bandwidth" in candidates:
         for kind, grid in _bandwidth_grids(curve).items():
             fam += [_column(f"bandwidth:{kind}", p, curve) - 1.0 / curve.tau for p in grid]
+    if "resonance" in candidates:
+        search = EFFECTS["resonance"].search
+        assert search is not None
+        fam += [_column(f"resonance:{q:g}", p, curve) for q in RESONANCE_Q for p in search(tmin, tmax)]
     if "sinusoid" in candidates and not has_samples:
         fam += [_column("sinusoid", p, curve) for p in np.geomspace(2.0 / tmax, 0.5 / tmin, 120)]
     if "drift" in candidates and drift_grid is not None:
@@ -925,6 +933,9 @@ def _step_params(key, p, sol, i, curve, terms, effects_before, extra):
             "coefficient": (r["coefficient"] - r["se"], r["coefficient"] + r["se"])
         }
     names = EFFECTS[base].param_names
+    if base == "resonance":
+        p_int = _profile_interval(curve, terms, effects_before, key, p, sol)
+        return {"sigma": amp, "f0": p, "q": float(key.split(":", 1)[1])}, {"sigma": amp_int, "f0": p_int}
     if base == "sinusoid" and extra.get("line") is not None:
         ln = extra["line"]  # found in the PSD: amplitude and f0 from the samples, with their intervals
         return {names[0]: ln["amplitude"], names[1]: p}, {
@@ -1286,6 +1297,18 @@ def _refine(
             propose(
                 "gauss_markov", p, s_new, edge, test.statistic(sub.avar, _column("gauss_markov", p, sub)), thr, heldout
             )
+        if "resonance" in candidates:
+            search = EFFECTS["resonance"].search
+            assert search is not None
+            best_r = None
+            for q in RESONANCE_Q:
+                key = f"resonance:{q:g}"
+                p, s_new, edge = _search(curve, start, effects, key, search(tmin, tmax))
+                if best_r is None or s_new.chi2 < best_r[2].chi2:
+                    best_r = (key, p, s_new, edge)
+            assert best_r is not None
+            key, p, s_new, edge = best_r
+            propose(key, p, s_new, edge, test.statistic(sub.avar, _column(key, p, sub)), thr, heldout)
         if "bandwidth" in candidates and not any(_base(k) == "bandwidth" for k in keys) and "N" in start:
             best = None
             # the kind with the lowest χ²; within one effective point of it, the one that needs fewer other
@@ -1337,18 +1360,27 @@ def _refine(
         # a spectral line is the most specific evidence (a sinusoid also raises a bump on the curve that a
         # Gauss–Markov term would otherwise take): lines first, then by the statistic over its threshold
         ok.sort(key=lambda pr: (pr.get("line") is None, -pr["stat"] / pr["thr"]))
-        chosen = None
-        for pr in ok:
-            split = pr["split"]
-            ho_b = ho_a = None
-            if split is not None:
-                ho_b = split.error(start, effects)
-                ho_a = split.error(start, effects + [(pr["key"], pr["p"])])
-                if not ho_a < ho_b:
-                    considered[_base(pr["key"])][-1]["rejected"] = f"held-out error {ho_b:.3g} → {ho_a:.3g} %"
-                    continue
-            chosen = (pr, ho_b, ho_a)
-            break
+        # a resonance near the shortest τ can stand in for the sensor's roll-off: while a bandwidth passes its
+        # test and is not in the model, the resonance waits until the bandwidth (alone or paired) was tried
+        deferred = []
+        if any(_base(pr["key"]) == "bandwidth" for pr in ok):
+            deferred = [pr for pr in ok if _base(pr["key"]) == "resonance"]
+            ok = [pr for pr in ok if _base(pr["key"]) != "resonance"]
+
+        def first_heldout_winner(cands, effects=effects):
+            for pr in cands:
+                split = pr["split"]
+                ho_b = ho_a = None
+                if split is not None:
+                    ho_b = split.error(start, effects)
+                    ho_a = split.error(start, effects + [(pr["key"], pr["p"])])
+                    if not ho_a < ho_b:
+                        considered[_base(pr["key"])][-1]["rejected"] = f"held-out error {ho_b:.3g} → {ho_a:.3g} %"
+                        continue
+                return (pr, ho_b, ho_a)
+            return None
+
+        chosen = first_heldout_winner(ok)
         bw = next((pr for pr in ok if _base(pr["key"]) == "bandwidth"), None)
         # (only for an unmistakable roll-off: its statistic ≥ PAIR_FACTOR × the threshold)
         if (
@@ -1374,6 +1406,8 @@ def _refine(
                         f"{ho_b:.3g} → {ho_alone:.3g} %, with it → {ho_pair:.3g} %"
                     )
                     chosen = (bw, ho_b, ho_alone)
+        if chosen is None and deferred:
+            chosen = first_heldout_winner(deferred)
         if chosen is None:
             break
         pr, ho_b, ho_a = chosen
@@ -1424,7 +1458,7 @@ def _refine(
     # amplitudes of earlier curve steps from the final joint solution
     for j, (st, (key, _p)) in enumerate(zip(steps[:n_curve], effects)):
         base = _base(key)
-        if base in ("gauss_markov",) or (base == "sinusoid" and y is None):
+        if base in ("gauss_markov", "resonance") or (base == "sinusoid" and y is None):
             names = EFFECTS[base].param_names
             st.params[names[0]] = math.sqrt(max(sol.theta[k_terms + j], 0.0))
             if truth and base in truth and st.truth_error is not None:
