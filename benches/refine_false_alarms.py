@@ -27,6 +27,7 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
+from scipy.stats import beta
 
 import _common
 import allanite
@@ -53,6 +54,14 @@ def record(mix: str, seed: int) -> np.ndarray:
 
 
 MIXES = ("white", "flicker", "quantized", "with_K", "issue16")
+
+
+def clopper_pearson(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
+    """Exact binomial interval of a rate k/n."""
+    a = (1 - level) / 2
+    lo = beta.ppf(a, k, n - k + 1) if k > 0 else 0.0
+    hi = beta.isf(a, k + 1, n - k) if k < n else 1.0
+    return float(lo), float(hi)
 
 
 def run(per_mix: int, out: Path) -> dict:
@@ -86,6 +95,7 @@ def run(per_mix: int, out: Path) -> dict:
         "records": total,
         "records_with_alarm": alarms,
         "rate": alarms / total,
+        "rate_interval_95": clopper_pearson(alarms, total),
         "seconds": time.perf_counter() - t_all,
         "machine": _common.machine_info(),
     }
@@ -104,7 +114,12 @@ def run(per_mix: int, out: Path) -> dict:
         lines.append(
             f"| {mix} | {r['records']} | {r['records_with_alarm']} | {100 * r['rate']:.1f} % | {eff} | {r['mean_s']:.2f} s |"
         )
-    lines += ["", f"All: {alarms} of {total} records = {100 * alarms / total:.1f} %."]
+    lo, hi = clopper_pearson(alarms, total)
+    lines += [
+        "",
+        f"All: {alarms} of {total} records = {100 * alarms / total:.1f} % "
+        f"(95 % Clopper–Pearson interval {100 * lo:.1f}–{100 * hi:.1f} %).",
+    ]
     (out / "refine_false_alarms.md").write_text("\n".join(lines) + "\n")
     return report
 

@@ -139,10 +139,11 @@ def write_md(rows, path: Path) -> None:
         "Written by `benches/refine_measured.py`. Per record: the five-term model's residual, what it was traced to, "
         "the parameters added (input unit's base form: σ and amplitude in the rate unit — °/s for gyros, g for "
         "accelerometers —, T_c and t in s, f0 and cutoff in Hz) and the error before → after: χ²/dof of the "
-        "normalised residuals, RMS of the ADEV error in % in-sample and held out (fit on one half, predict the other "
-        "half's curve; n/a for curves without samples and for change points). Default call `refine(x, 100.0)` / "
-        "`refine(curve)`: all τ. Change points are tested on 16 non-overlapping windows (ADIS only); their "
-        "before/after is the windows' Allan variance against one level vs piecewise levels.",
+        "normalised residuals, RMS of the ADEV error in % (4 τ per octave whose estimate is within ±10 %) "
+        "in-sample and held out (8 alternate blocks: fit on the odd ones, predict the even ones' curve and back; "
+        "n/a for curves without samples). Default call `refine(x, 100.0)` / `refine(curve)`: all τ. Change "
+        "points are tested on 16 non-overlapping windows (ADIS only); their in-sample before/after is the "
+        "windows' Allan variance against one level vs piecewise levels, held out per segment.",
         "",
         "| record | five-term χ²/dof | RMS ADEV err (held out) | traced to | parameters | χ²/dof before → after "
         "| RMS ADEV err before → after | held-out err before → after |",

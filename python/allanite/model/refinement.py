@@ -5,9 +5,11 @@
 of the registry :data:`allanite.model.effects.EFFECTS`:
 
 - on the **Allan curve**, by signature (closed forms, ``docs/FORMULAS.md`` §5): ``"bandwidth"`` — the
-  sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett FIR), exact in
-  discrete time, replacing the N column; ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4]; and, for
-  curve-only input, ``"sinusoid"`` (nulls at τ = k/f0, f0 ≥ 2/τ_max);
+  sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett FIR, or a boxcar of
+  any span), exact in discrete time, replacing the N column; ``"gauss_markov"`` — a bump, T_c in
+  [5·τ_min, τ_max/4]; ``"resonance"`` — narrowband noise, a PSD hump at f_r with quality factor Q (near the
+  shortest τ, tried after the bandwidth); and, for curve-only input, ``"sinusoid"`` (nulls at τ = k/f0,
+  f0 ≥ 2/τ_max);
 - in the **PSD** (Welch) for spectral lines: ``"sinusoid"`` with f0 from the periodogram peak, refined;
 - in **time**: ``"drift"`` (warm-up a·e^{−t/T} on block means) and ``"change_point"`` (steps of the noise
   level along the record);
@@ -91,6 +93,8 @@ TIME_SHARE = 0.075
 REGRESSION_BLOCKS = 8
 #: RMS ADEV errors: only τ whose ADEV estimate is within ±10 % (EDF ≥ 50 under the five-term fit).
 HELDOUT_MIN_EDF = 50.0
+#: Held-out error: only τ where the two parts' own ADEV agree within this fraction.
+HELDOUT_AGREE = 0.2
 #: Kept for the change-point test's penalty (calibrated with it on clean records).
 MIN_GAIN = 6.0
 
@@ -299,6 +303,13 @@ class _Split:
         self.m, self.size = m[keep], size
         self.curves = [self._curve(y[i]) for i in self.idx]
         self.scored = _informative(self.curves[0].tau, _solve(self.curves[0], terms, []).nu)
+        # ... and where the record reproduces itself: the two parts' own ADEV agree within ±20 % (twice the
+        # ±10 % of EDF 50). Beyond, the parts differ more than their estimates scatter (a non-stationary
+        # record, an under-estimated EDF at long τ), no model predicts both, and the score would be decided
+        # by which model happens to sit nearer the other part's values there.
+        agree = np.abs(np.sqrt(self.curves[0].avar / self.curves[1].avar) - 1.0) <= HELDOUT_AGREE
+        if np.count_nonzero(self.scored & agree) >= 4:
+            self.scored &= agree
 
     def _curve(self, z):
         av = np.maximum(avar(z, self.fs, taus=self.m / self.fs).avar, 1e-300)
@@ -1184,7 +1195,7 @@ def _refine(
 
         ``held_in_time``: for a regression, the held-out test in time (the residual variance of each half with
         the coefficient of the other half, relative to its raw variance) decides instead: removing a white-like
-        component changes the Allan curve's level, not how well one half predicts the other's."""
+        component changes the Allan curve's level, not how well one part predicts the other's."""
         nonlocal y, result, curve, heldout, sol
         assert y is not None
         y_new = y - component

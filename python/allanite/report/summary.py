@@ -72,16 +72,18 @@ def refinement_dict(rep) -> dict | None:
         "method": "allanite.refine: the residual traced on the Allan curve, in the PSD, along time and in other "
         "channels; an effect is added only if a calibrated test asks for it (GLS score with a bootstrap threshold, "
         "a χ² line test on the Welch PSD, a t test of a regression, a bootstrap of the drift statistic) and it "
-        "lowers the held-out error (fit on one half of the record, predict the other)",
+        "lowers the held-out error (fit on the odd blocks of the record, predict the even ones, and back)",
         "candidates": f"{' / '.join(e.label for e in curve)} signatures in the Allan curve, or "
         + " or ".join(f"{e.label} along the record" for e in timed),
         "units": "; ".join(f"{e.name}: " + ", ".join(f"{p} in {u}" for p, u, _ in e.params) for e in EFFECTS.values()),
         "statistics": {
-            "allan_curve": "before/after: χ²/dof, RMS z and RMS ADEV error (%) of the Allan-curve fit, each τ of the "
-            "dense curve weighted independently; heldout_rms_adev_pct: the model fitted on one half predicting the "
-            "other half's curve (null for curve-only input)",
+            "allan_curve": "before/after: χ²/dof and RMS z of the Allan-curve fit (each τ of the dense curve weighted "
+            "independently), RMS ADEV error (%) on 4 τ per octave whose estimate is within ±10 %; "
+            "heldout_rms_adev_pct: the model fitted on alternate blocks (8, joined) predicting the other blocks' "
+            "curve, both ways (null for curve-only input)",
             "window_levels": "before/after: one level vs piecewise levels (split at every change found) of the "
-            "log Allan variances of 16 windows along the record",
+            "log Allan variances of 16 windows along the record; held out per segment (each segment's alternate "
+            "blocks predicted by its own model vs the one-level model)",
         },
         "axes": axes,
     }
