@@ -22,11 +22,11 @@ def holed(rng, n=600, holes=((10, 2), (200, 1), (341, 7), (599, 1))):
     return y
 
 
-@pytest.mark.parametrize("est", ["oavar", "mvar", "tvar", "ohvar"])
+@pytest.mark.parametrize("est", ["oavar", "avar", "mvar", "tvar", "ohvar", "hvar"])
 def test_skip_equals_the_twin(est, rng):
     y = holed(rng)
     r = allanite.avar(
-        y, FS, taus="all" if est == "oavar" else [m / FS for m in range(1, 200)], estimator=est, gaps="skip"
+        y, FS, taus="all" if est in ("oavar", "avar") else [m / FS for m in range(1, 200)], estimator=est, gaps="skip"
     )
     core = "mvar" if est == "tvar" else est
     want = [tw.gap_var(y, int(m), core) for m in r.m]
@@ -37,7 +37,7 @@ def test_skip_equals_the_twin(est, rng):
     assert np.all(np.isnan(r.avar[~ok]))
 
 
-@pytest.mark.parametrize("est", ["oavar", "mvar", "tvar", "ohvar"])
+@pytest.mark.parametrize("est", ["oavar", "avar", "mvar", "tvar", "ohvar", "hvar"])
 def test_skip_without_nan_is_the_plain_estimate(est, rng):
     y = rng.standard_normal(500)
     a = allanite.avar(y, FS, estimator=est, gaps="skip")
@@ -86,8 +86,10 @@ def test_default_still_refuses_nan_and_other_estimators_refuse_gaps(rng):
     keep = y.copy()
     with pytest.raises(InputError, match="non-finite value \\(nan\\) at sample 17"):
         allanite.avar(y, FS)
-    for est in ("avar", "totvar", "theo1", "hvar"):
-        with pytest.raises(ParameterError, match='gaps="skip" is supported by the estimators oavar, mvar, tvar, ohvar'):
+    for est in ("totvar", "theo1", "mtotvar"):
+        with pytest.raises(
+            ParameterError, match='gaps="skip" is supported by the estimators oavar, avar, mvar, tvar, ohvar, hvar'
+        ):
             allanite.avar(y, FS, estimator=est, gaps="skip")
     with pytest.raises(ParameterError, match="gaps"):
         allanite.avar(y, FS, gaps="drop")
@@ -139,3 +141,21 @@ def test_edf_follows_the_complete_terms(est, rng):
         )
         assert short.n[0] == r.n[i]
         assert ci.edf[i] == pytest.approx(allanite.confidence_intervals(short, alpha=0).edf[0], rel=1e-12)
+
+
+@pytest.mark.parametrize("est, clusters", [("avar", 1), ("hvar", 2)])
+def test_classic_edf_follows_the_complete_terms(est, clusters, rng):
+    # a classic estimate with n complete terms has the EDF of a gapless record of (n + k)·m samples
+    y = rng.standard_normal(2000)
+    z = y.copy()
+    z[700:1300] = np.nan
+    r = allanite.avar(z, FS, estimator=est, gaps="skip")
+    ci = allanite.confidence_intervals(r, alpha=0)
+    plain = allanite.confidence_intervals(allanite.avar(y, FS, estimator=est), alpha=0)
+    ok = r.n > 0
+    assert np.all(ci.edf[ok] < plain.edf[ok]) and np.all(np.isnan(ci.edf[~ok]))
+    for i in np.flatnonzero(ok)[:12]:
+        m = int(r.m[i])
+        short = allanite.avar(y[: (int(r.n[i]) + clusters) * m], FS, estimator=est, taus=[r.tau[i]])
+        assert short.n[0] == r.n[i]
+        np.testing.assert_allclose(ci.edf[i], allanite.confidence_intervals(short, alpha=0).edf[0], rtol=1e-12)

@@ -159,16 +159,19 @@ def _span_ok(y, start, span) -> bool:
 
 
 def gap_terms(y, m: int, estimator: str):
-    """(Σ term², number of complete terms) for 'oavar' | 'mvar' | 'ohvar' on a rate record with NaN
+    """(Σ term², number of complete terms) for 'oavar' | 'avar' | 'mvar' | 'ohvar' | 'hvar' on a rate record with NaN
     gaps. A term is complete when every rate sample it spans is present: OAVAR term k spans y[k, k+2m),
     MVAR term j spans y[j, j+3m−1), OHVAR term k spans y[k, k+3m). Phase differences are summed from
     the rate samples inside the span (the phase across a gap is unknown)."""
     y = np.asarray(y, dtype=float)
     mu = np.nanmean(y) if np.any(~np.isnan(y)) else 0.0
     mm = y.size
+    # classic AVAR / HVAR: the OAVAR / OHVAR terms that start at a cluster boundary (k a multiple of m)
+    classic = estimator in ("avar", "hvar")
+    estimator = {"avar": "oavar", "hvar": "ohvar"}.get(estimator, estimator)
     span = {"oavar": 2 * m, "mvar": 3 * m - 1, "ohvar": 3 * m}[estimator]
     s, n = 0.0, 0
-    for k in range(mm - span + 1):
+    for k in range(0, mm - span + 1, m if classic else 1):
         if not _span_ok(y, k, span):
             continue
         seg = y[k : k + span] - mu
@@ -187,7 +190,9 @@ def gap_terms(y, m: int, estimator: str):
 def gap_var(y, m: int, estimator: str):
     """(variance, complete-term count); NaN and 0 when no term is complete."""
     s, n = gap_terms(y, m, estimator)
-    norm = {"oavar": 2.0 * m * m, "mvar": 2.0 * m**4, "ohvar": 6.0 * m * m}[estimator]
+    norm = {"oavar": 2.0 * m * m, "avar": 2.0 * m * m, "mvar": 2.0 * m**4, "ohvar": 6.0 * m * m, "hvar": 6.0 * m * m}[
+        estimator
+    ]
     return (s / (norm * n) if n else float("nan")), n
 
 

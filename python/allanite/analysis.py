@@ -130,10 +130,12 @@ def avar(
         two rate samples beside it missing), and ``result.n`` holds the complete terms per τ — shape (T,)
         when every axis has the same count, else (axes, T). A τ with no complete term has n = 0 and
         NaN; :func:`~allanite.confidence_intervals` takes the EDF of a gapless record with as many
-        terms (give it ``alpha=``). Estimators ``"oavar"``, ``"mvar"``, ``"tvar"``, ``"ohvar"`` only (others raise
-        :class:`~allanite.errors.ParameterError`). allantools' ``gradev`` instead skips a term when one
-        of its own *phase* points is NaN: the same at m = 1, more terms kept for m > 1 (it uses phase
-        differences across a gap, which are unknown when samples of rate are missing).
+        terms (give it ``alpha=``). Estimators ``"oavar"``, ``"avar"``, ``"mvar"``, ``"tvar"``, ``"ohvar"``,
+        ``"hvar"`` only (others raise :class:`~allanite.errors.ParameterError`); the classic ``"avar"`` and
+        ``"hvar"`` keep their cluster grid from the first sample (clusters do not shift around a gap).
+        allantools' ``gradev`` instead skips a term when one of its own *phase* points is NaN: the same
+        at m = 1, more terms kept for m > 1 (it uses phase differences across a gap, which are unknown
+        when samples of rate are missing).
     taper : {"rect", "hann", "hann_signal"}
         Weighting of the terms (paper 002; docs/FORMULAS.md §10), ``estimator="oavar"`` only for the
         tapers: ``"rect"`` (default) weights every squared difference equally; ``"hann"`` weights them

@@ -851,15 +851,20 @@ def edf_of(estimator, alpha, m, n_phase) -> np.ndarray:
 
 #: (span in m, offset): a record of N phase points has N − span·m + offset terms of these estimators.
 _GAP_SPAN = {"oavar": (2, 0), "mvar": (3, 1), "tvar": (3, 1), "ohvar": (3, 0)}
+#: Classic estimators: a record of (n + k)·m rate samples has n terms (clusters − 1 for AVAR, − 2 for HVAR).
+_GAP_CLUSTERS = {"avar": 1, "hvar": 2}
 
 
 def _edf_from_terms(result, a, m_b, shape_edf) -> np.ndarray:
     """Greenhall's EDF with the record length that gives each τ's *actual* term count ``result.n``:
     the same as the record's own length without gaps; with ``gaps="skip"`` the complete terms only
     (a τ without one: NaN)."""
-    span, offset = _GAP_SPAN[result.estimator]
     n_terms = np.broadcast_to(np.asarray(result.n), shape_edf)
-    n_eff = n_terms + span * m_b - offset
+    if result.estimator in _GAP_CLUSTERS:
+        n_eff = (n_terms + _GAP_CLUSTERS[result.estimator]) * m_b + 1
+    else:
+        span, offset = _GAP_SPAN[result.estimator]
+        n_eff = n_terms + span * m_b - offset
     nu = np.full(shape_edf, np.nan)
     for n_phase in np.unique(n_eff[n_terms > 0]):
         sel = (n_eff == n_phase) & (n_terms > 0)
@@ -988,7 +993,7 @@ def confidence_intervals(
     m_b = np.broadcast_to(result.m, shape_edf)
     if edf_method == "sp1065":
         nu = edf_sp1065(a, m_b, n_phase, estimator=result.estimator)
-    elif not dynamic and result.source is None and result.estimator in _GAP_SPAN:
+    elif not dynamic and result.source is None and (result.estimator in _GAP_SPAN or result.estimator in _GAP_CLUSTERS):
         nu = _edf_from_terms(result, a, m_b, shape_edf)
     else:
         nu = edf_of(result.estimator if result.source is None else result.source, a, m_b, n_phase)

@@ -102,7 +102,7 @@ def _static(cols, fs, taus, workers, *, estimator: str) -> Computed:
 
 
 #: Estimators computed with ``gaps="skip"`` (NaN-marked missing samples): the core's gap-aware kernels.
-GAP_ESTIMATORS = ("oavar", "mvar", "tvar", "ohvar")
+GAP_ESTIMATORS = ("oavar", "avar", "mvar", "tvar", "ohvar", "hvar")
 
 
 def gap_static(cols, fs: float, taus, workers, estimator: str) -> Computed:
@@ -114,7 +114,8 @@ def gap_static(cols, fs: float, taus, workers, estimator: str) -> Computed:
             '(use gaps="error" and analyse a stretch without gaps)'
         )
     n = cols[0].size
-    ms = resolve_taus(taus, n, fs) if estimator == "oavar" else _resolve(estimator, taus, n, fs)
+    ms = resolve_taus(taus, n, fs) if estimator in ("oavar", "avar") else _resolve(estimator, taus, n, fs)
+    # classic AVAR and HVAR: the OAVAR and OHVAR terms that start at multiples of m (cluster boundaries)
     core_name = "mvar" if estimator == "tvar" else estimator
     values, counts = _core.deviation_gaps(cols, [int(m) for m in ms], core_name, resolve_workers(workers))
     tau = ms / fs

@@ -557,10 +557,19 @@ pub fn static_ttotvar_cancellable(
 /// whose span (see `overlapping_terms`) holds no NaN. Returns (values [axis][m], term counts
 /// [axis][m]); a τ with no complete term gives NaN and count 0. Without NaN it equals the plain
 /// estimator. ±inf is still an error.
-pub fn gap_deviation(columns: &[&[f64]], ms: &[usize], kind: Kind) -> Result<(Vec<f64>, Vec<u64>)> {
-    if !matches!(kind, Kind::Oavar | Kind::Mvar | Kind::Ohvar) {
+///
+/// `classic`: only the terms that start at a multiple of m — the non-overlapping estimators, classic
+/// AVAR from the OAVAR terms and HVAR from the OHVAR terms (cluster k's term starts at sample k·m).
+pub fn gap_deviation(
+    columns: &[&[f64]],
+    ms: &[usize],
+    kind: Kind,
+    classic: bool,
+) -> Result<(Vec<f64>, Vec<u64>)> {
+    if !matches!(kind, Kind::Oavar | Kind::Mvar | Kind::Ohvar) || (classic && kind == Kind::Mvar) {
         return Err(CoreError::InvalidParameter(format!(
-            "gap-aware estimation is available for OAVAR, MVAR and OHVAR, not {}",
+            "gap-aware estimation is available for OAVAR, MVAR and OHVAR (and classic AVAR/HVAR), not {}{}",
+            if classic { "classic " } else { "" },
             kind.name()
         )));
     }
@@ -595,7 +604,9 @@ pub fn gap_deviation(columns: &[&[f64]], ms: &[usize], kind: Kind) -> Result<(Ve
                 keep.extend(
                     t.iter()
                         .enumerate()
-                        .filter(|(i, _)| cnt[k0 + i + span] == cnt[k0 + i])
+                        .filter(|(i, _)| {
+                            cnt[k0 + i + span] == cnt[k0 + i] && (!classic || (k0 + i) % m == 0)
+                        })
                         .map(|(_, v)| *v),
                 );
                 kept += keep.len();

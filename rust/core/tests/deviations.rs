@@ -77,11 +77,23 @@ proptest! {
         for kind in [Kind::Mvar, Kind::Ohvar] {
             let ms = all_ms(kind, y.len());
             let plain = static_deviation(&[&y], &ms, kind).unwrap();
-            let (v, n) = gap_deviation(&[&y], &ms, kind).unwrap();
+            let (v, n) = gap_deviation(&[&y], &ms, kind, false).unwrap();
             prop_assert_eq!(&v, &plain);
             for (i, &m) in ms.iter().enumerate() {
                 prop_assert_eq!(n[i] as usize, n_terms(kind, y.len(), m));
             }
+        }
+    }
+
+    #[test]
+    fn classic_gaps_without_nan_equal_plain_hvar(y in record()) {
+        // HVAR is the OHVAR terms that start at multiples of m (same terms, same count)
+        let ms = all_ms(Kind::Hvar, y.len());
+        let plain = static_deviation(&[&y], &ms, Kind::Hvar).unwrap();
+        let (v, n) = gap_deviation(&[&y], &ms, Kind::Ohvar, true).unwrap();
+        for (i, &m) in ms.iter().enumerate() {
+            prop_assert!(close(v[i], plain[i], 1e-12), "m = {}: {} vs {}", m, v[i], plain[i]);
+            prop_assert_eq!(n[i] as usize, n_terms(Kind::Hvar, y.len(), m));
         }
     }
 
@@ -92,7 +104,7 @@ proptest! {
         let g = ((z.len() - 1) as f64 * at) as usize;
         z[g] = f64::NAN;
         let ms = all_ms(Kind::Ohvar, z.len());
-        let (v, n) = gap_deviation(&[&z], &ms, Kind::Ohvar).unwrap();
+        let (v, n) = gap_deviation(&[&z], &ms, Kind::Ohvar, false).unwrap();
         for (i, &m) in ms.iter().enumerate() {
             let total = z.len() + 1 - 3 * m;
             let touching = (0..total).filter(|&k| k <= g && g < k + 3 * m).count();
@@ -137,7 +149,7 @@ proptest! {
             let ok = n >= 2 && !ms.is_empty() && ms.iter().all(|&m| m >= 1 && m <= max_m(kind, n));
             prop_assert_eq!(static_deviation(&[&y], &ms, kind).is_ok(), ok, "{:?} n {} ms {:?}", kind, n, ms);
         }
-        let _ = gap_deviation(&[&y], &ms, Kind::Oavar);
+        let _ = gap_deviation(&[&y], &ms, Kind::Oavar, false);
         let _ = mtie(&[&y], &ms);
         let _ = tie_rms(&[&y], &ms);
         let _ = dynamic_ohvar(&[&y], n.max(1), 1, &ms);
@@ -191,7 +203,7 @@ fn errors_name_the_value() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("m = 3") && e.contains("1..=2"), "{e}");
-    let e = gap_deviation(&[&y], &[1], Kind::Totvar)
+    let e = gap_deviation(&[&y], &[1], Kind::Totvar, false)
         .unwrap_err()
         .to_string();
     assert!(e.contains("TOTVAR"), "{e}");

@@ -293,7 +293,7 @@ fn ttotvar_static<'py>(
     to_2d(py, slices.len(), ms.len(), values)
 }
 
-/// Gap-aware OAVAR/MVAR/OHVAR of rate records with NaN-marked gaps: (values, counts), each of
+/// Gap-aware OAVAR/MVAR/OHVAR (and classic AVAR/HVAR: "avar", "hvar") of rate records with NaN-marked gaps: (values, counts), each of
 /// shape (axes, len(ms)); counts (int64) are the complete terms used; no term gives NaN, 0.
 #[pyfunction]
 #[pyo3(signature = (columns, ms, estimator, workers))]
@@ -305,11 +305,17 @@ fn deviation_gaps<'py>(
     estimator: &str,
     workers: usize,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
-    let kind = parse_kind(py, estimator, &["oavar", "mvar", "ohvar"])?;
+    // classic AVAR and HVAR: the OAVAR and OHVAR terms that start at multiples of m
+    let (name, classic) = match estimator {
+        "avar" => ("oavar", true),
+        "hvar" => ("ohvar", true),
+        other => (other, false),
+    };
+    let kind = parse_kind(py, name, &["oavar", "mvar", "ohvar"])?;
     let slices = contiguous(py, &columns)?;
     // O(N) per τ: the signal is looked at while it runs and acted on when it returns
     let (values, counts) = run_interruptible(py, workers, |_cancel| {
-        deviations::gap_deviation(&slices, &ms, kind)
+        deviations::gap_deviation(&slices, &ms, kind, classic)
     })?;
     let counts: Vec<i64> = counts.into_iter().map(|c| c as i64).collect();
     let c = Array2::from_shape_vec((slices.len(), ms.len()), counts)
