@@ -157,6 +157,16 @@ def test_clean_adis_run_names_its_bandwidth_not_sinusoids(shared_data):
     assert st.before["chi2_dof"] > 100 and st.after["chi2_dof"] < 2
 
 
+def test_roll_off_is_kept_where_the_record_reproduces_itself(shared_data):
+    # run 1 y: over every informative τ the held-out error rose with the bandwidth (7.24 → 7.83 %), decided by
+    # τ ≥ 40 s where the two parts differ by more than ±20 %; scored where they agree, it falls
+    (y,) = _adis(shared_data, 1, ["gyro_y"])
+    r = allanite.refine(y, FS)
+    assert r.found[0] == "bandwidth" and r.steps[0].params["filter"] == "boxcar"
+    _falls(r.steps[0])
+    assert r.steps[0].after["chi2_dof"] < 1
+
+
 def test_adis_through_an_injected_decimation_filter(shared_data):
     # the ADIS run filtered by a further 8-tap moving average: the cascade (−3 dB at 5.46 Hz) is named a
     # bandwidth with its cutoff (the nearest of the family: a Bartlett FIR)
