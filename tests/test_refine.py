@@ -53,6 +53,8 @@ def test_finds_an_undeclared_gauss_markov(gm_record):
     lo, hi = st.intervals["tc"]
     assert lo < st.params["tc"] < hi
     assert st.evidence["runs_beyond_2sigma"]  # where the residual was
+    # a second domain: the residual's autocorrelation in time gives the same correlation time
+    assert st.evidence["autocorrelation"]["tc"] == pytest.approx(truth["tc"], rel=0.1)
     assert "gauss_markov" in r.fit.coefficients and r.fit.chi2_dof <= 2
     text = r.report()
     assert "Step 1: gauss_markov" in text and "tc =" in text

@@ -206,6 +206,7 @@ def test_adis_with_injected_gauss_markov_and_g_sensitivity(shared_data):
     )
     st = next(s for s in r.steps if s.effect == "gauss_markov")
     assert abs(st.truth_error["tc"]) < 0.2 and abs(st.truth_error["sigma"]) < 0.2
+    assert st.evidence["autocorrelation"]["tc"] == pytest.approx(gm["tc"], rel=0.2)  # in time, too
     _falls(st)
     rg = next(s for s in r.steps if s.effect == "regression")
     assert rg.params["channel"] == "acc_z" and abs(rg.truth_error["coefficient"]) < 0.2

@@ -1434,6 +1434,9 @@ def _refine(
         )
         if _base(key) == "bandwidth":
             evidence["N"] = math.sqrt(max(s_new.theta[-1], 0.0))
+        if _base(key) == "gauss_markov" and y is not None:
+            # a second domain: the correlation time the residual's autocorrelation in time gives
+            evidence["autocorrelation"] = tracing.gm_autocorrelation(y, fs, p)
         if "pair_note" in pr:
             evidence["held_out"] = pr["pair_note"]
         terr = None

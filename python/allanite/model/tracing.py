@@ -41,6 +41,7 @@ __all__ = [
     "drift_component",
     "drift_threshold",
     "regression_fit",
+    "gm_autocorrelation",
     "regression_heldout",
     "ScoreTest",
     "thin_indices",
@@ -239,6 +240,27 @@ def drift_threshold(n: int, fs: float, terms, theta, alpha: float, n_boot: int =
     )
     b = np.asarray(long, dtype=np.float64).ravel().reshape(n_boot, nb).T
     return float(np.quantile(_grid_stats(b, tb, n / fs), 1.0 - alpha))
+
+
+def gm_autocorrelation(y: np.ndarray, fs: float, tc: float) -> dict | None:
+    """A Gauss–Markov term's correlation time from the residual's autocorrelation in time (evidence in a
+    second domain for a term found on the Allan curve).
+
+    Means of blocks Δ ≈ T_c/4 long, the ramp removed: white noise of any level adds nothing to their
+    autocovariance at lags ≥ 1, and a GM adds σ_b²·φ^k with φ = e^{−Δ/T_c} (the block averaging scales every
+    lag ≥ 1 alike), so φ̂ = R(2)/R(1) and T̂_c = −Δ/ln φ̂. None if fewer than 50 blocks fit; ``tc`` NaN when
+    the autocovariance does not decay like a GM's (R(1) ≤ 0 or R(2) ∉ (0, R(1)))."""
+    per = max(1, int(round(tc * fs / 4.0)))
+    nb = y.size // per
+    if nb < 50:
+        return None
+    b = y[: nb * per].reshape(nb, per).mean(axis=1)
+    k = np.arange(nb, dtype=np.float64)
+    b = b - np.polyval(np.polyfit(k, b, 1), k)
+    r0, r1, r2 = float(b @ b) / nb, float(b[:-1] @ b[1:]) / nb, float(b[:-2] @ b[2:]) / nb
+    dt = per / fs
+    tc_hat = -dt / math.log(r2 / r1) if 0.0 < r2 < r1 else float("nan")
+    return {"tc": tc_hat, "block_s": dt, "blocks": nb, "lag1": r1 / r0 if r0 > 0 else float("nan")}
 
 
 def regression_fit(y: np.ndarray, ch: np.ndarray, n_blocks: int = 8) -> dict:
