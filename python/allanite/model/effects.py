@@ -25,6 +25,7 @@ __all__ = [
     "drift_avar",
     "describe",
     "FILTERS",
+    "CASCADE_SPANS",
     "RESONANCE_Q",
     "resonance_avar",
 ]
@@ -34,7 +35,10 @@ __all__ = [
 #: (triangular, two cascaded moving averages: 2L − 1 taps), and a boxcar of any span D (a moving average a
 #: part computes at its internal rate and the host reads at the output rate, so D·f_s need not be whole:
 #: the samples' autocorrelation is the triangle (1 − l/(D·f_s))₊; −3 dB at 0.443/D).
-FILTERS = ("single_pole", "moving_average", "bartlett", "boxcar")
+FILTERS = ("single_pole", "moving_average", "bartlett", "boxcar", "single_pole+boxcar")
+#: Spans (samples) of the boxcar a single pole may follow ("single_pole+boxcar:<span>": a filter added after
+#: a part's own averaging, e.g. an anti-alias stage or a user's low-pass on the logged rate).
+CASCADE_SPANS = (1.2, 1.4, 1.7, 2.0)
 
 
 def gm_avar(tau: np.ndarray | float, tc: float) -> np.ndarray:
@@ -66,6 +70,12 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
         span = max(1.0, float(p))
         tri = 1.0 - np.arange(int(math.ceil(span)), dtype=np.float64) / span
         return tri / (tri[0] + 2.0 * tri[1:].sum())
+    if kind.startswith("single_pole+boxcar:"):
+        # the cascade's autocorrelation: the two (two-sided, unit-sum) autocorrelations convolved
+        a = filter_autocorrelation("single_pole", p, fs)
+        b = filter_autocorrelation("boxcar", float(kind.split(":", 1)[1]), fs)
+        both = np.convolve(np.concatenate([a[:0:-1], a]), np.concatenate([b[:0:-1], b]))
+        return both[both.size // 2 :]
     taps = max(1, int(round(p)))
     h = np.full(taps, 1.0 / taps)
     if kind == "bartlett":
@@ -81,12 +91,20 @@ def filter_cutoff(kind: str, p: float, fs: float) -> float:
         return float(p)
     if kind == "boxcar":
         return float(0.44295 * fs / max(1.0, float(p)))
+    # any other kind (the FIRs, a cascade): where the sampled filter's power falls to half
     r = filter_autocorrelation(kind, p, fs)
     f = np.linspace(0.0, fs / 2.0, 4097)
     lags = np.arange(1, r.size)
     power = r[0] + 2.0 * np.cos(2.0 * np.pi * np.outer(f / fs, lags)) @ r[1:]
     below = np.flatnonzero(power <= 0.5 * power[0])
-    return float(f[below[0]]) if below.size else float(fs / 2.0)
+    if not below.size:
+        return float(fs / 2.0)
+    j = int(below[0])
+    if j == 0:
+        return 0.0
+    # linear between the two grid frequencies around the half-power point
+    p0, p1, half = power[j - 1], power[j], 0.5 * power[0]
+    return float(f[j - 1] + (f[j] - f[j - 1]) * (p0 - half) / (p0 - p1))
 
 
 def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float) -> np.ndarray:

@@ -59,6 +59,7 @@ from ..estimators.grid import tau_grid
 from ..results import AllanResult
 from . import fitting, tracing
 from .effects import (
+    CASCADE_SPANS,
     EFFECTS,
     RESONANCE_Q,
     describe,
@@ -508,6 +509,10 @@ def _bandwidth_grids(curve):
         grids["moving_average"] = np.arange(l_min, l_max + 1, dtype=np.float64)
         grids["bartlett"] = np.arange(max(2, l_min // 2), max(3, l_max // 2) + 1, dtype=np.float64)
         grids["boxcar"] = np.geomspace(max(1.02, curve.tau[0] * fs / 3), l_max, 32)
+    if "single_pole" in grids and curve.tau[0] * fs <= 1.0:
+        # a single pole after the part's own short averaging (only where the curve starts at one sample)
+        for span in CASCADE_SPANS:
+            grids[f"single_pole+boxcar:{span:g}"] = grids["single_pole"]
     return grids
 
 
@@ -921,6 +926,13 @@ def _step_params(key, p, sol, i, curve, terms, effects_before, extra):
         cut = filter_cutoff(kind, p, curve.fs)
         if kind == "single_pole":
             taps, c_int = 0, _profile_interval(curve, terms, effects_before, key, p, sol)
+        elif kind.startswith("single_pole+boxcar:"):
+            p_lo, p_hi = _profile_interval(curve, terms, effects_before, key, p, sol)
+            span = float(kind.split(":", 1)[1])
+            return {"cutoff": cut, "taps": span, "filter": "single_pole+boxcar", "pole_cutoff": float(p)}, {
+                "cutoff": (filter_cutoff(kind, p_lo, curve.fs), filter_cutoff(kind, p_hi, curve.fs)),
+                "pole_cutoff": (p_lo, p_hi),
+            }
         elif kind == "boxcar":
             s_lo, s_hi = _profile_interval(curve, terms, effects_before, key, p, sol)
             return {"cutoff": cut, "taps": float(p), "filter": kind}, {
@@ -1325,17 +1337,22 @@ def _refine(
             # the kind with the lowest χ²; within one effective point of it, the one that needs fewer other
             # terms (a 2-tap average plus white angle noise and a boxcar of 1.2 samples are the same MA(1)
             # process: the single filter is the physical reading)
+            # (a cascade counts one parameter more: its boxcar span)
             tie = curve.tau.size / curve.n_eff
+
+            def n_par(key, sol):
+                return np.count_nonzero(sol.theta > 0) + ("+" in key)
+
             for kind, grid in _bandwidth_grids(curve).items():
                 key = f"bandwidth:{kind}"
-                p, s_new, edge = _search(curve, start, effects, key, grid, continuous=kind in ("single_pole", "boxcar"))
+                cont = kind in ("single_pole", "boxcar") or kind.startswith("single_pole+")
+                p, s_new, edge = _search(curve, start, effects, key, grid, continuous=cont)
                 if (
                     best is None
                     or s_new.chi2 < best[2].chi2 - tie
                     or (
                         s_new.chi2 < best[2].chi2 + tie
-                        and (np.count_nonzero(s_new.theta > 0), s_new.chi2)
-                        < (np.count_nonzero(best[2].theta > 0), best[2].chi2)
+                        and (n_par(key, s_new), s_new.chi2) < (n_par(best[0], best[2]), best[2].chi2)
                     )
                 ):
                     best = (key, p, s_new, edge)
