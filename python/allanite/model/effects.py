@@ -72,9 +72,9 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
         return tri / (tri[0] + 2.0 * tri[1:].sum())
     if kind.startswith("single_pole+boxcar:"):
         # the cascade's autocorrelation: the two (two-sided, unit-sum) autocorrelations convolved
-        a = filter_autocorrelation("single_pole", p, fs)
-        b = filter_autocorrelation("boxcar", float(kind.split(":", 1)[1]), fs)
-        both = np.convolve(np.concatenate([a[:0:-1], a]), np.concatenate([b[:0:-1], b]))
+        r_pole = filter_autocorrelation("single_pole", p, fs)
+        r_box = filter_autocorrelation("boxcar", float(kind.split(":", 1)[1]), fs)
+        both = np.convolve(np.concatenate([r_pole[:0:-1], r_pole]), np.concatenate([r_box[:0:-1], r_box]))
         return both[both.size // 2 :]
     taps = max(1, int(round(p)))
     h = np.full(taps, 1.0 / taps)
