@@ -23,13 +23,19 @@ from allanite.model.tracing import regression_fit
 FS = 100.0
 
 
+_LOGS: dict = {}
+
+
 def _adis(shared_data, run, cols):
+    """Channels of an ADIS16405 run (each log is read once per session; callers get copies)."""
     path = shared_data / "adis16405" / f"adis16405_run{run}_100Hz.csv.gz"
     if not path.is_file():
         pytest.skip(f"{path} not found")
-    log = allanite.read_log(path, fs=FS, columns=cols, unit="deg/s")
-    d = np.asarray(log.data, dtype=np.float64).reshape(-1, len(cols))
-    return d.T
+    key = (str(path), tuple(cols))
+    if key not in _LOGS:
+        log = allanite.read_log(path, fs=FS, columns=cols, unit="deg/s")
+        _LOGS[key] = np.asarray(log.data, dtype=np.float64).reshape(-1, len(cols)).T
+    return _LOGS[key].copy()
 
 
 def _falls(st):
@@ -102,6 +108,8 @@ def test_finds_a_simulated_bandwidth():
     assert r.found[0] == "bandwidth"
     st = r.steps[0]
     assert abs(st.params["cutoff"] / 8.0 - 1) < 0.2
+    # a second domain: the roll-off the filter predicts in the Welch PSD is the data's
+    assert st.evidence["psd"]["predicted"] == pytest.approx(st.evidence["psd"]["measured"], rel=0.1)
     _falls(st)
     assert r.fit.coefficients["N"].value == pytest.approx(2e-3, rel=0.1)
 
@@ -152,6 +160,9 @@ def test_clean_adis_run_names_its_bandwidth_not_sinusoids(shared_data):
         return rr[0] + 2 * np.cos(2 * np.pi * np.outer(fr / FS, np.arange(1, rr.size))) @ rr[1:]
 
     assert psd(np.arange(40, 49)).mean() / psd(np.arange(2, 11)).mean() == pytest.approx(measured, rel=0.15)
+    assert st.evidence["psd"]["predicted"] == pytest.approx(
+        st.evidence["psd"]["measured"], rel=0.1
+    )  # the same, as refine reports it
     assert "sinusoid" not in r.found and "drift" not in r.found
     _falls(st)
     assert st.before["chi2_dof"] > 100 and st.after["chi2_dof"] < 2

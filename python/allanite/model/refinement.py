@@ -64,6 +64,7 @@ from .effects import (
     RESONANCE_Q,
     describe,
     drift_avar,
+    filter_autocorrelation,
     filter_cutoff,
     filtered_white_avar,
     gm_avar,
@@ -1451,6 +1452,8 @@ def _refine(
         )
         if _base(key) == "bandwidth":
             evidence["N"] = math.sqrt(max(s_new.theta[-1], 0.0))
+            if y is not None:  # a second domain: the roll-off the filter predicts in the spectrum, and the data's
+                evidence["psd"] = tracing.rolloff_psd(y, fs, filter_autocorrelation(key.split(":", 1)[1], p, fs))
         if _base(key) == "gauss_markov" and y is not None:
             # a second domain: the correlation time the residual's autocorrelation in time gives
             evidence["autocorrelation"] = tracing.gm_autocorrelation(y, fs, p)

@@ -42,6 +42,7 @@ __all__ = [
     "drift_threshold",
     "regression_fit",
     "gm_autocorrelation",
+    "rolloff_psd",
     "regression_heldout",
     "ScoreTest",
     "thin_indices",
@@ -261,6 +262,25 @@ def gm_autocorrelation(y: np.ndarray, fs: float, tc: float) -> dict | None:
     dt = per / fs
     tc_hat = -dt / math.log(r2 / r1) if 0.0 < r2 < r1 else float("nan")
     return {"tc": tc_hat, "block_s": dt, "blocks": nb, "lag1": r1 / r0 if r0 > 0 else float("nan")}
+
+
+def rolloff_psd(y: np.ndarray, fs: float, r: np.ndarray) -> dict:
+    """A bandwidth's roll-off checked in the spectrum (evidence in a second domain for a filter found on the
+    Allan curve): the Welch PSD's power at 0.40–0.48·f_s over its power at 0.02–0.10·f_s, measured and as the
+    filter with normalised autocorrelation ``r`` predicts for white input (r₀ + 2Σ r_l cos 2πfl/f_s)."""
+    nper = int(min(4096, 2 ** int(math.log2(max(y.size // 8, 256)))))
+    f, p = signal.welch(y - y.mean(), fs=fs, nperseg=nper)
+    hi, lo = (f >= 0.40 * fs) & (f <= 0.48 * fs), (f >= 0.02 * fs) & (f <= 0.10 * fs)
+    lags = np.arange(1, r.size)
+
+    def model(fr):
+        return r[0] + 2.0 * np.cos(2.0 * np.pi * np.outer(fr / fs, lags)) @ r[1:]
+
+    return {
+        "measured": float(p[hi].mean() / p[lo].mean()),
+        "predicted": float(model(f[hi]).mean() / model(f[lo]).mean()),
+        "bands_hz": (0.02 * fs, 0.10 * fs, 0.40 * fs, 0.48 * fs),
+    }
 
 
 def regression_fit(y: np.ndarray, ch: np.ndarray, n_blocks: int = 8) -> dict:
