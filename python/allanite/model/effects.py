@@ -38,7 +38,7 @@ __all__ = [
 FILTERS = ("single_pole", "moving_average", "bartlett", "boxcar", "single_pole+boxcar")
 #: Spans (samples) of the boxcar a single pole may follow ("single_pole+boxcar:<span>": a filter added after
 #: a part's own averaging, e.g. an anti-alias stage or a user's low-pass on the logged rate).
-CASCADE_SPANS = (1.2, 1.4, 1.7, 2.0)
+CASCADE_SPANS = (1.2, 1.5, 2.0)
 
 
 def gm_avar(tau: np.ndarray | float, tc: float) -> np.ndarray:

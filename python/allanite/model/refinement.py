@@ -223,7 +223,7 @@ def _solve(curve: _Curve, terms, effects, max_iter: int = 40) -> _Solution:
         new = fitting.nnls(a * sw[:, None], y * sw)
         parts = a * new
         new_model = np.maximum(parts.sum(axis=1), floor)
-        done = np.allclose(new, theta, rtol=1e-6, atol=0.0)
+        done = bool(np.all(np.abs(new - theta) <= 1e-6 * np.abs(theta)))  # np.allclose(rtol=1e-6, atol=0)
         model = new_model if it == 0 else np.sqrt(model * new_model)
         theta = new
         if new.any():
@@ -1348,12 +1348,20 @@ def _refine(
                 key = f"bandwidth:{kind}"
                 cont = kind in ("single_pole", "boxcar") or kind.startswith("single_pole+")
                 p, s_new, edge = _search(curve, start, effects, key, grid, continuous=cont)
+                # a kind whose best parameter sits at the edge of its range is not identified: any kind that
+                # is comes first
                 if (
                     best is None
-                    or s_new.chi2 < best[2].chi2 - tie
+                    or (best[3] and not edge)
                     or (
-                        s_new.chi2 < best[2].chi2 + tie
-                        and (n_par(key, s_new), s_new.chi2) < (n_par(best[0], best[2]), best[2].chi2)
+                        best[3] == edge
+                        and (
+                            s_new.chi2 < best[2].chi2 - tie
+                            or (
+                                s_new.chi2 < best[2].chi2 + tie
+                                and (n_par(key, s_new), s_new.chi2) < (n_par(best[0], best[2]), best[2].chi2)
+                            )
+                        )
                     )
                 ):
                     best = (key, p, s_new, edge)
