@@ -36,6 +36,10 @@ use rayon::prelude::*;
 const BLOCK: usize = 1 << 16;
 /// Terms per chunk of the term pass.
 const CHUNK: usize = 1 << 13;
+/// Chunks per super-chunk (one rayon task).
+const SUPER: usize = 16;
+/// Factors up to this run chunk by chunk inside a super-chunk, longer ones factor by factor.
+const SHORT_M: usize = CHUNK / 2;
 /// Independent partial sums per chunk and m (the vector width the term loop is written for).
 const LANES: usize = 8;
 
@@ -192,20 +196,6 @@ fn chunk_sum(hi: &[f64], lo: &[f64], m: usize, k0: usize, len: usize) -> f64 {
     ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
 }
 
-/// The partial sums of chunk `c` for every m into `dst` (0 where the chunk is past m's last term).
-#[inline(always)]
-fn chunk_all_m(hi: &[f64], lo: &[f64], ms: &[usize], n: usize, c: usize, dst: &mut [f64]) {
-    let k0 = c * CHUNK;
-    for (o, &m) in dst.iter_mut().zip(ms) {
-        let l = n + 1 - 2 * m;
-        *o = if k0 < l {
-            chunk_sum(hi, lo, m, k0, CHUNK.min(l - k0))
-        } else {
-            0.0
-        };
-    }
-}
-
 /// [`chunk_sum`] in AVX2 intrinsics: the same IEEE operations per lane in the same order (no FMA),
 /// so the same bits.
 #[cfg(target_arch = "x86_64")]
@@ -258,23 +248,48 @@ unsafe fn chunk_sum_avx2(hi: &[f64], lo: &[f64], m: usize, k0: usize, len: usize
     ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
 }
 
-/// The partial sums of chunk `c` for every m into `dst`, with the AVX2 term loop where the CPU has it.
-fn chunk_all_m_dispatch(hi: &[f64], lo: &[f64], ms: &[usize], n: usize, c: usize, dst: &mut [f64]) {
+/// Σ d² of one (chunk, m), with the AVX2 term loop where the CPU has it.
+#[inline(always)]
+fn chunk_sum_dispatch(avx2: bool, hi: &[f64], lo: &[f64], m: usize, k0: usize, len: usize) -> f64 {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        let k0 = c * CHUNK;
-        for (o, &m) in dst.iter_mut().zip(ms) {
-            let l = n + 1 - 2 * m;
-            *o = if k0 < l {
-                // SAFETY: the CPU has AVX2 (checked just above).
-                unsafe { chunk_sum_avx2(hi, lo, m, k0, CHUNK.min(l - k0)) }
-            } else {
-                0.0
-            };
-        }
-        return;
+    if avx2 {
+        // SAFETY: the caller checked that the CPU has AVX2.
+        return unsafe { chunk_sum_avx2(hi, lo, m, k0, len) };
     }
-    chunk_all_m(hi, lo, ms, n, c, dst)
+    let _ = avx2;
+    chunk_sum(hi, lo, m, k0, len)
+}
+
+/// The partial sums of the chunks `c0 ..` of one super-chunk, rows of `n_m` in `dst`. Short m run
+/// chunk by chunk, every m per chunk (their three reads share the chunk's cache lines); long m run
+/// m by m over the super-chunk's chunks, so that only six streams are in flight at a time.
+fn super_chunk(hi: &[f64], lo: &[f64], ms: &[usize], n: usize, c0: usize, dst: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    let avx2 = std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    let avx2 = false;
+    let n_m = ms.len();
+    let one = |t: usize, c: usize| -> f64 {
+        let (m, k0) = (ms[t], c * CHUNK);
+        let l = n + 1 - 2 * m;
+        if k0 < l {
+            chunk_sum_dispatch(avx2, hi, lo, m, k0, CHUNK.min(l - k0))
+        } else {
+            0.0
+        }
+    };
+    for (r, row) in dst.chunks_mut(n_m).enumerate() {
+        for (t, o) in row.iter_mut().enumerate() {
+            if ms[t] <= SHORT_M {
+                *o = one(t, c0 + r);
+            }
+        }
+    }
+    for t in (0..n_m).filter(|&t| ms[t] > SHORT_M) {
+        for (r, row) in dst.chunks_mut(n_m).enumerate() {
+            row[t] = one(t, c0 + r);
+        }
+    }
 }
 
 /// Overlapping Allan variance of the windows `y[..window]` of every axis at every m of `ms` (each
@@ -303,11 +318,11 @@ pub(crate) fn overlapping_window(
         phase_prefix(&y[..n], mus[a], hi, lo);
         let (hi, lo) = (&*hi, &*lo);
         partial
-            .par_chunks_mut(n_m)
+            .par_chunks_mut(SUPER * n_m)
             .enumerate()
-            .for_each(|(c, dst)| {
+            .for_each(|(s, dst)| {
                 if !cancel.is_cancelled() {
-                    chunk_all_m_dispatch(hi, lo, ms, n, c, dst);
+                    super_chunk(hi, lo, ms, n, s * SUPER, dst);
                 }
             });
         for (t, &m) in ms.iter().enumerate() {
