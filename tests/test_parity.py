@@ -622,3 +622,64 @@ def test_static_classic_gather_equals_the_sliding_path(rng):
     two = allanite.davar(y, 1.0, window=10_000, hop=2_000, taus=ms.astype(float), estimator="avar").avar
     one = allanite.avar(y[:10_000], 1.0, taus=ms.astype(float), estimator="avar").avar
     assert max_rel(one, two[:, 0]) <= 1e-12
+
+
+# --------------------------------------------------------------------------------------------------
+# The static overlapping estimator: every m from one double-word phase (rust/core/src/oavar.rs)
+# --------------------------------------------------------------------------------------------------
+
+
+def _growth_ms(n, growth=1.2):
+    k = np.arange(int(np.log(n / 2) / np.log(growth)) + 2)
+    ms = np.unique(np.round(growth**k).astype(np.int64))
+    return ms[ms <= n // 2]
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_static_oavar_phase_on_the_adversarial_record(adversarial_record, dtype):
+    # 10⁶ level changes (2.1·10⁶ samples, offset 5), float64 and float32 input, m up to N/2
+    y = adversarial_record.astype(dtype)
+    ms = _growth_ms(ADV_N, 1.5)
+    r = allanite.avar(y, 1.0, taus=ms.astype(float))
+    ref = _reference.avar_reference(y.astype(np.float64), 1.0, r.m, "oavar", dtype=np.longdouble)
+    assert np.array_equal(r.m, ms)
+    assert max_rel(r.avar, ref) <= 1e-9
+
+
+def test_static_oavar_phase_small_noise_on_a_large_slow_swing(rng):
+    # a rate swing 10⁴ × the noise over the record: the phase reaches ~10⁸·σ while the terms at short m
+    # are ~σ — a plain f64 prefix loses ~1e-8 relative there; the double-word phase keeps every digit
+    n = 400_003
+    t = np.arange(n)
+    y = 1e4 * np.sin(2 * np.pi * t / n) + rng.normal(size=n)
+    ms = _growth_ms(n)
+    r = allanite.avar(y, 1.0, taus=ms.astype(float))
+    ref = _reference.avar_reference(y, 1.0, ms, "oavar", dtype=np.longdouble)
+    assert max_rel(r.avar, ref) <= 1e-11
+    x = np.concatenate(([0.0], np.cumsum(y)))  # what the plain prefix gives, to show the test can fail
+    plain = np.array([np.mean((x[2 * m :] - 2 * x[m:-m] + x[: -2 * m]) ** 2) / (2.0 * m * m) for m in ms[:3]])
+    assert max_rel(plain, ref[:3]) > 1e-10
+
+
+def test_static_oavar_phase_several_axes_and_any_thread_count(rng):
+    # axes of different level and offset, a length that is no multiple of the chunks: each axis equals
+    # its plain twin and its single-axis call, bit for bit whatever the thread count
+    n = 300_007
+    X = rng.normal(size=(n, 3)) * [1.0, 1e-5, 1e4] + [0.0, 7.0, -3e4]
+    ms = _growth_ms(n)
+    r = allanite.avar(X, 10.0, taus=ms / 10.0)
+    for a in range(3):
+        ref = _reference.avar_reference(X[:, a], 10.0, ms, "oavar", dtype=np.longdouble)
+        assert max_rel(r.avar[a], ref) <= 1e-11
+        assert np.array_equal(allanite.avar(X[:, a], 10.0, taus=ms / 10.0).avar, r.avar[a])
+    for workers in (1, 2, 3):
+        assert np.array_equal(allanite.avar(X, 10.0, taus=ms / 10.0, workers=workers).avar, r.avar)
+
+
+def test_static_oavar_phase_equals_the_sliding_path(rng):
+    # two windows take the streaming (sliding-sum) path, one window the phase: same numbers
+    y = rng.normal(size=12_000) + 2.0
+    ms = np.array([1, 2, 5, 8, 9, 64, 999, 4_096, 5_000])
+    two = allanite.davar(y, 1.0, window=10_000, hop=2_000, taus=ms.astype(float)).avar
+    one = allanite.avar(y[:10_000], 1.0, taus=ms.astype(float)).avar
+    assert max_rel(one, two[:, 0]) <= 1e-12

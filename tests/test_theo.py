@@ -11,6 +11,7 @@ import allanite
 import allanite.model.fitting as fit_mod
 from allanite import _reference as ref
 from allanite.errors import ParameterError
+from allanite.estimators import theo as theo_mod
 from allanite.estimators.confidence import edf_theo1
 
 
@@ -365,12 +366,49 @@ def test_to_xarray_carries_source_and_kf():
 
 
 def test_theoh_tau_maps_to_one_estimator_on_both_paths():
-    """davar's τ handed back to avar give the same estimator and value at every τ — including the switch
-    point (τ = 40.5 samples at k = 40 is TheoBR's m = 54, not Allan's m = 40; 18 % apart before)."""
+    """davar's τ handed back to avar give the same estimator and value at every τ of every window —
+    including the switch point (τ = 40.5 samples at k = 40 is TheoBR's m = 54, not Allan's m = 40;
+    18 % apart when the explicit-τ rule and the grid's rule were two things)."""
     y = allanite.simulate(40_000, 10.0, N=1e-2, K=1e-4, seed=5)
     d = allanite.davar(y, 10.0, window=401, hop=50, estimator="theoh")
-    for j in (0, 3, d.t.size - 1):
+    assert d.tau.size == 65 and d.source[31] == "theobr" and d.m[31] == 54 and d.m[30] == 40
+    for j in range(d.t.size):
         s = allanite.avar(y[j * 50 : j * 50 + 401], 10.0, estimator="theoh", taus=d.tau)
         assert list(s.source) == list(d.source)
         np.testing.assert_array_equal(s.m, d.m)
-        np.testing.assert_allclose(s.avar, d.avar[:, j], rtol=1e-12)
+        np.testing.assert_allclose(s.avar, d.avar[:, j], rtol=1e-12, atol=0)
+
+
+def test_theoh_a_tau_maps_to_one_estimator_on_both_paths():
+    """TheoH-A has no whole-record form: each window equals the classic Allan variance at its Allan τ
+    and TheoBR (the window's own kf) at its Theo τ, those τ mapped by the same rule as TheoH's."""
+    y = allanite.simulate(40_000, 10.0, N=1e-2, K=1e-4, seed=5)
+    d = allanite.davar(y, 10.0, window=401, hop=50, estimator="theoh_a")
+    h = allanite.davar(y[:2000], 10.0, window=401, hop=50, estimator="theoh")
+    np.testing.assert_array_equal(d.m, h.m)
+    assert list(np.where(d.source == "avar", "oavar", d.source)) == list(h.source)
+    short, long_ = d.source == "avar", d.source == "theobr"
+    assert short.sum() == 31 and long_.sum() == 34
+    for j in range(d.t.size):
+        w = y[j * 50 : j * 50 + 401]
+        a = allanite.avar(w, 10.0, estimator="avar", taus=d.tau[short])
+        b = allanite.avar(w, 10.0, estimator="theobr", taus=d.tau[long_])
+        np.testing.assert_array_equal(a.m, d.m[short])
+        np.testing.assert_array_equal(b.m, d.m[long_])
+        np.testing.assert_allclose(a.avar, d.avar[short, j], rtol=1e-12, atol=0)
+        np.testing.assert_allclose(b.avar, d.avar[long_, j], rtol=1e-12, atol=0)
+        assert b.kf == pytest.approx(d.kf[j], rel=1e-12)
+
+
+@pytest.mark.parametrize("estimator", ["theoh", "theoh_a", "theobr", "theo1"])
+def test_theo_grid_tau_map_back_to_their_own_m_and_source(estimator):
+    """The one τ → (estimator, m) mapping is idempotent on its own output: for every window length and
+    grid, the τ a result reports map back to the same (m, source)."""
+    for fs in (10.0, 25.0, 1.0, 3.0, 7.3):
+        for n in [*range(90, 700), 4001, 10_007, 99_999]:
+            for grid in ("exp", "octave", "decade") + (("all",) if n < 2000 else ()):
+                ms, src = theo_mod.theo_ms(grid, n, fs, estimator)
+                tau = np.where(np.isin(src, theo_mod.THEO_SOURCES), 0.75 * ms, ms) / fs
+                ms2, src2 = theo_mod.theo_ms(tau, n, fs, estimator)
+                np.testing.assert_array_equal(ms2, ms)
+                np.testing.assert_array_equal(src2, src)

@@ -50,23 +50,29 @@ def _scale_columns(cols: list[np.ndarray]) -> tuple[list[np.ndarray], list[int]]
     return out, exps
 
 
+def _peak(c: np.ndarray) -> float:
+    """Largest magnitude of a column (for messages only: a pass over the record)."""
+    return float(np.max(np.abs(c))) if c.size else 0.0
+
+
 def _unscale(values: np.ndarray, exps: list[int], power: int, cols: list[np.ndarray], what: str) -> np.ndarray:
     """Values (axes first) scaled back by 2^(power·e) per axis, or an InputError when the result is not a
     float64 (overflow, or below the normal range) — naming the scale of the samples."""
     out = []
     for a, (v, e) in enumerate(zip(values, exps)):
-        peak = float(np.max(np.abs(cols[a]))) if cols[a].size else 0.0
         where = f"axis {a}: " if len(values) > 1 else ""
         pos = v[v > 0]
         # binary exponent of the result: log2 of the scaled value plus power·e, judged before scaling back
         top = float(np.log2(pos.max())) + power * e if pos.size else -math.inf
         bottom = float(np.log2(pos.min())) + power * e if pos.size else math.inf
         if not np.all(np.isfinite(v)) or top >= 1024:
+            peak = _peak(cols[a])
             raise InputError(
                 f"{where}the {what} of samples of magnitude up to {peak:.3g} exceeds float64's range (≈1.8e308): "
                 f"express the samples in a larger unit (e.g. divide them by 1e{max(1, int(math.log10(peak)) // 2)})"
             )
         if bottom < -1022:
+            peak = _peak(cols[a])
             raise InputError(
                 f"{where}the {what} (about 2^{bottom:.0f} ≈ 1e{bottom * math.log10(2):.0f}) is below float64's normal "
                 f"range (2.2e-308) for samples of magnitude up to {peak:.3g}: express the samples in a smaller unit "

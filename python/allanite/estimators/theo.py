@@ -90,7 +90,10 @@ def _even_theo(ms: np.ndarray, n_rate: int) -> np.ndarray:
 
 
 def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, np.ndarray]:
-    """(m, source) for a TheoH-family estimate on ``n_rate`` samples.
+    """(m, source) for a TheoH-family estimate on ``n_rate`` samples — THE τ → (estimator, m) mapping:
+    :func:`static_theo`, :func:`dynamic_theo` and the registry's ``resolve_m`` all call it, and a named
+    grid is first laid out as τ and then mapped by the same rule as explicit τ (:func:`_map_tau`), so
+    the τ a result reports, handed back as ``taus=``, give the same estimator and m on either path.
 
     Named grids (``"all"``, ``"octave"``, ``"decade"``, ``"exp"``) are laid out over m = 1 … M and end
     at the largest even m ≤ M (Theo reaches τ = 0.75·M·τ0); Theo1 factors are rounded up to even and
@@ -102,70 +105,84 @@ def theo_ms(taus, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, n
     n_rate = int(n_rate)
     if n_rate < THEO1_MIN_M:
         raise ParameterError(f"Theo1 needs at least {THEO1_MIN_M} samples (m ≥ {THEO1_MIN_M}, m ≤ N − 1), got {n_rate}")
+    if isinstance(taus, str):
+        if taus not in GRIDS:
+            raise ParameterError(f"unknown τ grid {taus!r}; allowed: {', '.join(map(repr, GRIDS))} or τ in s")
+        s = _grid_samples(taus, n_rate, fs, estimator)
+        return _map_tau(s, s / fs, n_rate, fs, estimator)
+    arr = np.atleast_1d(np.asarray(taus, dtype=np.float64))
+    if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ParameterError(f"taus must be a grid name or a non-empty 1-D sequence of positive τ in s, got {taus!r}")
+    return _map_tau(arr * fs, arr, n_rate, fs, estimator)
+
+
+def _grid_samples(name: str, n_rate: int, fs: float, estimator: str) -> np.ndarray:
+    """A named grid laid out as τ in samples: Allan m (τ = m·τ0) up to the switch, then Theo1's even m
+    at τ = 0.75·m·τ0 beyond it (no gap at the switch), ending at Theo's last point 0.75·T."""
+    hybrid = estimator in ("theoh", "theoh_a")
+    k = switch_m(n_rate) if hybrid else 0
+    grid = m_grid(name, 2 * n_rate, fs=fs, m_max=n_rate)
+    a = grid[grid <= k] if hybrid else np.empty(0, np.int64)
+    # Theo part: τ = 0.75 m τ0 > k τ0 ⇔ m > k/0.75.
+    t = _even_theo(grid, n_rate)
+    if hybrid:
+        t = t[0.75 * t > k]
+        first = int(math.floor(k / 0.75)) + 1
+        first += first % 2
+        first = max(first, THEO1_MIN_M)
+        if first <= n_rate - n_rate % 2 and (t.size == 0 or t[0] > first):
+            t = np.concatenate([[first], t])  # no gap at the switch
+    top = n_rate - n_rate % 2
+    if top >= THEO1_MIN_M and (t.size == 0 or t[-1] < top):
+        t = np.concatenate([t, [top]])  # Theo's point: reach 0.75·T, as Stable32's grids do
+    return np.concatenate([a.astype(np.float64), 0.75 * t.astype(np.float64)])
+
+
+def _map_tau(s: np.ndarray, taus: np.ndarray, n_rate: int, fs: float, estimator: str) -> tuple[np.ndarray, np.ndarray]:
+    """τ in samples ``s`` (``taus`` in s, for messages) → (m, source), one rule for every τ.
+
+    TheoH/TheoH-A: a τ that is exactly a TheoBR point above the switch k (τ = 0.75·m·τ0, even m ≥ 10,
+    0.75·m > k) is that point; any other τ ≤ (k + ½)·τ0 is the Allan factor m = round(τ/τ0); the rest
+    map to Theo1's even m = 2·round(τ/(1.5·τ0)). So every τ a result reports maps back to its own (m,
+    source): an Allan m ≤ k is never 0.75·m' of an even m' above the switch, and a Theo point is
+    recognised as such (τ = 40.5 samples at k = 40 is TheoBR's m = 54, not Allan's m = 40).
+    """
     theo_src = "theo1" if estimator == "theo1" else "theobr"
     allan_src = "avar" if estimator == "theoh_a" else "oavar"
     hybrid = estimator in ("theoh", "theoh_a")
     k = switch_m(n_rate) if hybrid else 0
-    if isinstance(taus, str):
-        if taus not in GRIDS:
-            raise ParameterError(f"unknown τ grid {taus!r}; allowed: {', '.join(map(repr, GRIDS))} or τ in s")
-        grid = m_grid(taus, 2 * n_rate, fs=fs, m_max=n_rate)
-        a = grid[grid <= k] if hybrid else np.empty(0, np.int64)
-        # Theo part: τ = 0.75 m τ0 > k τ0 ⇔ m > k/0.75.
-        t = _even_theo(grid, n_rate)
-        if hybrid:
-            t = t[0.75 * t > k]
-            first = int(math.floor(k / 0.75)) + 1
-            first += first % 2
-            first = max(first, THEO1_MIN_M)
-            if first <= n_rate - n_rate % 2 and (t.size == 0 or t[0] > first):
-                t = np.concatenate([[first], t])  # no gap at the switch
-        top = n_rate - n_rate % 2
-        if top >= THEO1_MIN_M and (t.size == 0 or t[-1] < top):
-            t = np.concatenate([t, [top]])  # Theo's point: reach 0.75·T, as Stable32's grids do
-        ms = np.concatenate([a, t]).astype(np.int64)
-        src = np.array([allan_src] * a.size + [theo_src] * t.size)
-        return ms, src
-    arr = np.atleast_1d(np.asarray(taus, dtype=np.float64))
-    if arr.ndim != 1 or arr.size == 0 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise ParameterError(f"taus must be a grid name or a non-empty 1-D sequence of positive τ in s, got {taus!r}")
-    m_list: list[int] = []
-    src_list: list[str] = []
     top = n_rate - n_rate % 2
-    for i, tau in enumerate(arr):
-        s = tau * fs
-        if not s < 2.0**62:  # far beyond any record (also inf): no int conversion of it
-            raise ParameterError(
-                f"taus[{i}] = {tau:g} s is beyond the record: Theo τ reach 0.75·{top}/fs = {0.75 * top / fs:g} s"
-            )
-        # One mapping for both paths: a τ that is exactly a TheoBR point above the switch (τ = 0.75·m/fs,
-        # even m, 0.75·m > k) is that point — davar's result.tau handed back to avar gives the same
-        # estimator at every τ (τ = 40.5 samples at k = 40 was rounded to the Allan m = 40 before).
-        m_theo = 2 * int(math.floor(s / 1.5 + 0.5))
-        exact_theo = m_theo >= THEO1_MIN_M and abs(0.75 * m_theo - s) <= 1e-9 * s and (not hybrid or 0.75 * m_theo > k)
-        if hybrid and s <= k + 0.5 and not exact_theo:
-            m = int(math.floor(s + 0.5))
-            if m < 1:
-                raise ParameterError(f"taus[{i}] = {tau:g} s is shorter than one sample (1/fs = {1 / fs:g} s)")
-            m_list.append(m)
-            src_list.append(allan_src)
-            continue
-        m = 2 * int(math.floor(s / 1.5 + 0.5))
-        if m < THEO1_MIN_M or m > top or (hybrid and 0.75 * m <= k):
-            lo = max(THEO1_MIN_M, 2 * (int(math.floor(k / 1.5)) + 1)) if hybrid else THEO1_MIN_M
-            raise ParameterError(
-                f"taus[{i}] = {tau:g} s maps to Theo1 m = {m} (τ = 0.75·m/fs); allowed for {n_rate} samples: even m "
-                f"from {lo} to {top}, i.e. τ from {0.75 * lo / fs:g} s to {0.75 * top / fs:g} s"
-            )
-        m_list.append(m)
-        src_list.append(theo_src)
-    ms = np.asarray(m_list, dtype=np.int64)
-    src = np.asarray(src_list)
+    far = ~(s < 2.0**62)  # far beyond any record (also inf): no int conversion of it
+    if np.any(far):
+        i = int(np.flatnonzero(far)[0])
+        raise ParameterError(
+            f"taus[{i}] = {taus[i]:g} s is beyond the record: Theo τ reach 0.75·{top}/fs = {0.75 * top / fs:g} s"
+        )
+    m_theo = 2 * np.floor(s / 1.5 + 0.5).astype(np.int64)
+    exact_theo = (m_theo >= THEO1_MIN_M) & (np.abs(0.75 * m_theo - s) <= 1e-9 * s)
+    if hybrid:
+        exact_theo &= 0.75 * m_theo > k
+    is_allan = (s <= k + 0.5) & ~exact_theo if hybrid else np.zeros(s.size, dtype=bool)
+    m_allan = np.floor(s + 0.5).astype(np.int64)
+    short = is_allan & (m_allan < 1)
+    if np.any(short):
+        i = int(np.flatnonzero(short)[0])
+        raise ParameterError(f"taus[{i}] = {taus[i]:g} s is shorter than one sample (1/fs = {1 / fs:g} s)")
+    bad = ~is_allan & ((m_theo < THEO1_MIN_M) | (m_theo > top) | ((0.75 * m_theo <= k) if hybrid else False))
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        lo = max(THEO1_MIN_M, 2 * (int(math.floor(k / 1.5)) + 1)) if hybrid else THEO1_MIN_M
+        raise ParameterError(
+            f"taus[{i}] = {taus[i]:g} s maps to Theo1 m = {m_theo[i]} (τ = 0.75·m/fs); allowed for {n_rate} samples: "
+            f"even m from {lo} to {top}, i.e. τ from {0.75 * lo / fs:g} s to {0.75 * top / fs:g} s"
+        )
+    ms = np.where(is_allan, m_allan, m_theo)
+    src = np.where(is_allan, allan_src, theo_src)
     tau_used = np.where(src == theo_src, 0.75 * ms, ms.astype(float))
     if np.any(np.diff(tau_used) <= 0):
         i = int(np.flatnonzero(np.diff(tau_used) <= 0)[0])
         raise ParameterError(
-            f"taus[{i}] = {arr[i]:g} s and taus[{i + 1}] = {arr[i + 1]:g} s map to the same or decreasing τ "
+            f"taus[{i}] = {taus[i]:g} s and taus[{i + 1}] = {taus[i + 1]:g} s map to the same or decreasing τ "
             f"({tau_used[i] / fs:g} s, {tau_used[i + 1] / fs:g} s); τ must be strictly increasing"
         )
     return ms, src

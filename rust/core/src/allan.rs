@@ -36,6 +36,7 @@
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::gather::{classic_window, GATHER_MAX};
+use crate::oavar::overlapping_window;
 use rayon::prelude::*;
 
 /// Which Allan estimator.
@@ -709,6 +710,13 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
                 // One window (the static estimator): gather cluster sums from one exact prefix
                 // instead of streaming the record once per m (see `crate::gather`).
                 classic_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
+                cancel.check()?;
+                return Ok((out, n_win));
+            }
+            if req.estimator == Estimator::Overlapping && n_win == 1 && req.window <= GATHER_MAX {
+                // One window (the static estimator): every m from one double-word phase, all m per
+                // pass over the record (see `crate::oavar`).
+                overlapping_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
                 cancel.check()?;
                 return Ok((out, n_win));
             }

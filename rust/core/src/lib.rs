@@ -8,6 +8,7 @@ pub mod cancel;
 pub mod deviations;
 pub mod error;
 mod gather;
+mod oavar;
 pub mod taper;
 pub mod theo;
 
