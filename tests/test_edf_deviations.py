@@ -11,8 +11,7 @@ import pytest
 import test_deviations_core as T
 from allanite.errors import ParameterError
 from allanite.estimators import _edf_deviations as E
-
-confidence = pytest.importorskip("allanite.confidence")
+from allanite.estimators import confidence
 
 #: Stable32 iterates its χ² quantiles to ~1e-4 below ν = 100 (see allanite.confidence.chi2_interval);
 #: at ν < 10 its bounds move by up to 7e-4 (sr87 TOTDEV AF 400, ν = 3.45).
