@@ -671,8 +671,8 @@ def test_gaps_reject_inf_and_other_estimators():
     y[3] = np.inf
     with pytest.raises(AllaniteError, match="non-finite value \\(inf\\) at sample 3"):
         gaps(y, [1], "oavar")
-    with pytest.raises(AllaniteError, match='unknown estimator "totvar"'):
-        gaps(np.ones(20), [1], "totvar")
+    with pytest.raises(AllaniteError, match='unknown estimator "ttotvar"'):
+        gaps(np.ones(20), [1], "ttotvar")
 
 
 # --------------------------------------------------------------------------------------------------

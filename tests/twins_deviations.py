@@ -196,6 +196,51 @@ def gap_var(y, m: int, estimator: str):
     return (s / (norm * n) if n else float("nan")), n
 
 
+def gap_total(y, m: int, estimator: str):
+    """(variance, complete-term count) of 'totvar' | 'mtotvar' | 'htotvar' on a rate record with NaN gaps.
+
+    TOTVAR: the term at phase point p (1 ≤ p ≤ N − 2) is Σ y*[p, p+m) − Σ y*[p−m, p) over the evenly
+    reflected rate y* (y*_{−1−j} = y_j, y*_{M+j} = y_{M−1−j}: the rate of SP 1065's reflected phase); it is
+    complete when every *original* sample it reads (reflected ones mapped back) is present.
+    MTOTVAR: the 3m-point phase subsequence from x_n, i.e. the rate samples y[n, n + 3m − 1); HTOTVAR: the
+    3m rate samples y[n, n + 3m) (m = 1: the OHVAR terms). Complete subsequences only, each detrended and
+    reflected as in the gapless twins."""
+    y = np.asarray(y, dtype=float)
+    mm = y.size
+    if estimator == "htotvar" and m == 1:
+        return gap_var(y, 1, "ohvar")
+    mu = np.nanmean(y)
+    s, n = 0.0, 0
+    if estimator == "totvar":
+        for p in range(1, mm):
+            q = np.arange(p - m, p + m)
+            orig = np.where(q < 0, -q - 1, np.where(q < mm, q, 2 * mm - 1 - q))
+            v = y[orig] - mu
+            if np.any(np.isnan(v)):
+                continue
+            t = v[m:].sum() - v[:m].sum()
+            s += t * t
+            n += 1
+        return (s / (2.0 * m * m * n) if n else float("nan")), n
+    span = 3 * m - 1 if estimator == "mtotvar" else 3 * m
+    for start in range(mm - span + 1):
+        seg = y[start : start + span]
+        if np.any(np.isnan(seg)):
+            continue
+        if estimator == "mtotvar":
+            xs = _detrend_reflect(np.concatenate([[0.0], np.cumsum(seg - mu)]))
+            z = [sum(xs[j + 2 * m] - 2 * xs[j + m] + xs[j] for j in range(i, i + m)) / m for i in range(6 * m)]
+        else:
+            ys = _detrend_reflect(seg)
+            z = [np.mean(ys[i + 2 * m : i + 3 * m]) - 2 * np.mean(ys[i + m : i + 2 * m]) + np.mean(ys[i : i + m])
+                 for i in range(6 * m)]  # fmt: skip
+        s += float(np.sum(np.square(z))) / (6.0 * m)
+        n += 1
+    if not n:
+        return float("nan"), 0
+    return (s / (2.0 * m * m * n) if estimator == "mtotvar" else s / (6.0 * n)), n
+
+
 def dynamic_ohvar(y, window: int, hop: int, m: int) -> np.ndarray:
     """OHVAR of every window y[j·hop, j·hop + window)."""
     y = np.asarray(y, dtype=float)

@@ -66,8 +66,30 @@ def deviation_gaps(
     estimator: str,
     workers: int,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
-    """Gap-aware 'oavar' | 'mvar' | 'ohvar' (NaN = missing sample): (values, complete-term counts),
-    each of shape (axes, len(ms)); a τ with no complete term gives NaN and 0."""
+    """Gap-aware 'oavar' | 'avar' | 'mvar' | 'ohvar' | 'hvar' | 'totvar' | 'mtotvar' | 'htotvar' (NaN = missing
+    sample): (values, complete-term counts), each of shape (axes, len(ms)); a τ with no complete term gives NaN
+    and 0."""
+
+def deviation_gaps_dynamic(
+    columns: Sequence[npt.NDArray[np.float64]],
+    window: int,
+    hop: int,
+    ms: Sequence[int],
+    estimator: str,
+    workers: int,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+    """Gap-aware 'oavar' | 'ohvar' of every sliding window: (values, complete-term counts), each of shape
+    (axes, len(ms), windows); a window with no complete term at some m gives NaN and 0 there."""
+
+def tie_gaps(
+    phases: Sequence[npt.NDArray[np.float64]],
+    gaps: Sequence[npt.NDArray[np.uint64]],
+    ms: Sequence[int],
+    estimator: str,
+    workers: int,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+    """Gap-aware 'mtie' | 'tierms' of phase records with the prefix counts of missing rate samples (length N):
+    (values, kept windows), each of shape (axes, len(ms))."""
 
 def ohvar_dynamic(
     columns: Sequence[npt.NDArray[np.float64]],

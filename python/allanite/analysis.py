@@ -18,7 +18,7 @@ from . import estimators
 from ._progress import StepBar, show_progress
 from ._validate import as_rate_columns, check_choice, check_count, resolve_max_memory
 from .errors import InputError, MemoryBudgetError, ParameterError
-from .estimators.deviations import GAP_ESTIMATORS, gap_static
+from .estimators.deviations import GAP_DYNAMIC_ESTIMATORS, GAP_ESTIMATORS, gap_dynamic, gap_static
 from .results import AllanResult, DynamicAllanResult
 
 __all__ = ["avar", "davar", "METHODS", "GAPS"]
@@ -137,8 +137,14 @@ def avar(
         when every axis has the same count, else (axes, T). A τ with no complete term has n = 0 and
         NaN; :func:`~allanite.confidence_intervals` takes the EDF of a gapless record with as many
         terms (give it ``alpha=``). Estimators ``"oavar"``, ``"avar"``, ``"mvar"``, ``"tvar"``, ``"ohvar"``,
-        ``"hvar"`` only (others raise :class:`~allanite.errors.ParameterError`); the classic ``"avar"`` and
-        ``"hvar"`` keep their cluster grid from the first sample (clusters do not shift around a gap).
+        ``"hvar"``, ``"totvar"``, ``"mtotvar"``, ``"ttotvar"``, ``"htotvar"``, ``"mtie"``, ``"tierms"`` (the
+        Theo family raises :class:`~allanite.errors.ParameterError`); the classic ``"avar"`` and ``"hvar"``
+        keep their cluster grid from the first sample (clusters do not shift around a gap). The total family
+        keeps a term when
+        every original sample it reads is present: TOTVAR's reflected samples mirror samples inside the
+        term's own range, so its term at phase point p needs rate samples [p − m, p + m) clipped to the
+        record; MTOTVAR/TTOTVAR need their 3m-point phase subsequence, HTOTVAR its 3m rate samples; an
+        MTIE window or TIE difference over phase points [k, k + m] needs rate samples [k, k + m).
         allantools' ``gradev`` instead skips a term when one of its own *phase* points is NaN: the same
         at m = 1, more terms kept for m > 1 (it uses phase differences across a gap, which are unknown
         when samples of rate are missing).
@@ -199,12 +205,9 @@ def avar(
     )
 
 
-def _avar_skipping_gaps(x, fs, input, taus, estimator, workers) -> AllanResult:
-    """avar(..., gaps="skip"): NaN-marked missing samples, terms touching one skipped."""
-    if estimator not in GAP_ESTIMATORS:
-        raise ParameterError(
-            f'gaps="skip" is supported by the estimators {", ".join(GAP_ESTIMATORS)}; got estimator={estimator!r}'
-        )
+def _gap_columns(x, fs, input):
+    """Rate columns of a record whose NaN marks missing samples (a missing angle point makes the two
+    rate samples beside it missing): (columns with NaN at the missing rate samples, fs, is_multi)."""
     arr = np.asarray(x)
     missing = np.isnan(arr) if arr.dtype.kind == "f" else np.zeros(arr.shape, dtype=bool)
     # validate the record with the gaps filled, then mark the missing rate samples again
@@ -216,6 +219,16 @@ def _avar_skipping_gaps(x, fs, input, taus, estimator, workers) -> AllanResult:
         mk = miss2[:, a]
         c[(mk[1:] | mk[:-1]) if input == "angle" else mk] = np.nan
         out_cols.append(c)
+    return out_cols, fs, is_multi
+
+
+def _avar_skipping_gaps(x, fs, input, taus, estimator, workers) -> AllanResult:
+    """avar(..., gaps="skip"): NaN-marked missing samples, terms touching one skipped."""
+    if estimator not in GAP_ESTIMATORS:
+        raise ParameterError(
+            f'gaps="skip" is supported by the estimators {", ".join(GAP_ESTIMATORS)}; got estimator={estimator!r}'
+        )
+    out_cols, fs, is_multi = _gap_columns(x, fs, input)
     out = gap_static(out_cols, fs, taus, workers, estimator)
     counts = np.asarray(out.n, dtype=np.int64)
     n = counts[0] if np.all(counts == counts[0]) else counts
@@ -227,7 +240,7 @@ def _avar_skipping_gaps(x, fs, input, taus, estimator, workers) -> AllanResult:
         m=out.m,
         estimator=estimator,
         fs=fs,
-        n_samples=cols[0].size,
+        n_samples=out_cols[0].size,
         input=input,
     )
 
@@ -247,6 +260,7 @@ def davar(
     kf_rule: str = "textbook",
     progress=None,
     taper: str = "rect",
+    gaps: str = "error",
 ) -> DynamicAllanResult:
     """Dynamic Allan variance: the Allan variance of every sliding window (DAVAR).
 
@@ -298,6 +312,15 @@ def davar(
         window = record gives ``avar(..., taper="hann")``. ``"hann_signal"``: the window's samples
         tapered, then OAVAR (paper 002 eq. 1; biased, NumPy, O(window) per τ and window). Every τ
         must leave at least 3 terms.
+    gaps : {"error", "skip"}
+        As for :func:`avar`: ``"skip"`` treats NaN as a missing sample and every window averages only
+        its terms that touch no missing rate sample; ``result.n`` is then the complete-term count of
+        every window, shape (T, windows) — (axes, T, windows) when the axes' counts differ — and a
+        window with no complete term at some τ holds NaN there (n = 0).
+        :func:`~allanite.confidence_intervals` gives each window the EDF of a gapless window with as
+        many terms (pass ``alpha=``). ``estimator="oavar"`` or ``"ohvar"`` (dynamic Hadamard, blind to
+        rate ramps), ``method="fast"``, ``taper="rect"``. Exact as without gaps: each window's sum is
+        formed from its own terms only (docs/compat.md).
 
     Returns
     -------
@@ -319,8 +342,21 @@ def davar(
     entry = estimators.get(estimator, "dynamic")
     tapered = estimators.get_taper(taper, estimator)
     check_choice(method, "method", METHODS)
+    check_choice(gaps, "gaps", GAPS)
     options = entry.check_options({"kf_rule": kf_rule})
-    cols, fs, is_multi = as_rate_columns(x, fs, input)
+    if gaps == "skip":
+        if taper != "rect" or method != "fast":
+            raise ParameterError(
+                f"gaps='skip' works with taper='rect' and method='fast' only, got taper={taper!r}, method={method!r}"
+            )
+        if estimator not in GAP_DYNAMIC_ESTIMATORS:
+            raise ParameterError(
+                f'davar(gaps="skip") is supported by the estimators {", ".join(GAP_DYNAMIC_ESTIMATORS)}; got '
+                f"estimator={estimator!r}"
+            )
+        cols, fs, is_multi = _gap_columns(x, fs, input)
+    else:
+        cols, fs, is_multi = as_rate_columns(x, fs, input)
     n = cols[0].size
     window = check_count(window, "window", 2)
     hop = check_count(hop, "hop", 1)
@@ -336,10 +372,10 @@ def davar(
     ms = entry.resolve_m(taus, window, fs)
     n_win = (n - window) // hop + 1
     n_axes = len(cols)
-    nbytes = n_axes * ms.size * n_win * 8
+    nbytes = n_axes * ms.size * n_win * (16 if gaps == "skip" else 8)  # with gaps: values and counts
     budget = resolve_max_memory(max_memory)
     if nbytes > budget:
-        per_window = n_axes * ms.size * 8
+        per_window = n_axes * ms.size * (16 if gaps == "skip" else 8)
         size = (
             f"the output would take {nbytes / 2**30:.2f} GiB ({n_axes} axes × {ms.size} τ × {n_win} windows "
             f"× 8 bytes), over the memory budget of {budget / 2**30:.2f} GiB"
@@ -356,6 +392,23 @@ def davar(
     # A hop beyond the record gives one window, as does the record length itself.
     hop_core = min(hop, n)
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
+    if gaps == "skip":
+        out = gap_dynamic(cols, fs, window, hop_core, ms, workers, estimator)
+        counts = np.asarray(out.n, dtype=np.int64)
+        return DynamicAllanResult(
+            tau=out.tau,
+            t=t,
+            avar=out.values if is_multi else out.values[0],
+            n=counts[0] if np.all(counts == counts[0]) else counts,
+            m=out.m,
+            window=window,
+            hop=hop,
+            method=method,
+            estimator=estimator,
+            fs=fs,
+            n_samples=n,
+            input=input,
+        )
     scaled, exps = _scale_columns(cols)
     big = n_win * window >= DHVAR_BAR_SAMPLES
     if tapered.dynamic is not None:

@@ -850,7 +850,16 @@ def edf_of(estimator, alpha, m, n_phase) -> np.ndarray:
 
 
 #: (span in m, offset): a record of N phase points has N − span·m + offset terms of these estimators.
-_GAP_SPAN = {"oavar": (2, 0), "mvar": (3, 1), "tvar": (3, 1), "ohvar": (3, 0)}
+_GAP_SPAN = {
+    "oavar": (2, 0),
+    "mvar": (3, 1),
+    "tvar": (3, 1),
+    "ohvar": (3, 0),
+    "totvar": (0, -2),
+    "mtotvar": (3, 1),
+    "ttotvar": (3, 1),
+    "htotvar": (3, 0),
+}
 #: Classic estimators: a record of (n + k)·m rate samples has n terms (clusters − 1 for AVAR, − 2 for HVAR).
 _GAP_CLUSTERS = {"avar": 1, "hvar": 2}
 
@@ -946,8 +955,9 @@ def confidence_intervals(
     Returns
     -------
     ConfidenceIntervals
-        ``edf`` and ``alpha`` of shape (T,) or (axes, T); ``ci_low``/``ci_high`` of the shape of
-        ``result.avar``; ``adev_low``/``adev_high`` for deviations.
+        ``edf`` and ``alpha`` of shape (T,) or (axes, T) — ``edf`` of the shape of ``result.avar`` for a
+        ``davar(..., gaps="skip")`` result, whose windows hold different numbers of complete terms;
+        ``ci_low``/``ci_high`` of the shape of ``result.avar``; ``adev_low``/``adev_high`` for deviations.
 
     Examples
     --------
@@ -991,8 +1001,18 @@ def confidence_intervals(
     a = _alpha_for_result(result, x, alpha, shape_edf, b1_n, fallback)
     n_phase = _window_length(result) + 1
     m_b = np.broadcast_to(result.m, shape_edf)
+    per_window = dynamic and np.ndim(result.n) >= 2
+    if per_window and edf_method == "sp1065":
+        raise ParameterError(
+            "results of davar(gaps='skip') use Greenhall's EDF per window; edf_method='sp1065' has none"
+        )
     if edf_method == "sp1065":
         nu = edf_sp1065(a, m_b, n_phase, estimator=result.estimator)
+    elif per_window:
+        # davar(gaps="skip"): every window's own count of complete terms → one EDF per window
+        full = np.shape(result.avar)
+        nu = _edf_from_terms(result, np.broadcast_to(a[..., None], full), np.broadcast_to(m_b[..., None], full), full)
+        shape_edf = full
     elif not dynamic and result.source is None and (result.estimator in _GAP_SPAN or result.estimator in _GAP_CLUSTERS):
         nu = _edf_from_terms(result, a, m_b, shape_edf)
     else:
@@ -1004,7 +1024,7 @@ def confidence_intervals(
     if taper.name != "rect":
         # the tapered estimate keeps the share (Σw)²/(M·Σw²) of the rectangular window's ν
         nu = nu * taper.edf_factor(m_b, n_phase - 1)
-    nu_b = nu[..., None] if dynamic else nu
+    nu_b = nu[..., None] if dynamic and not per_window else nu
     if np.all(np.isfinite(nu)):
         low, high = chi2_interval(result.avar, nu_b, c, method=chi2)
     else:  # gaps="skip": a τ without a complete term has no EDF and no interval (NaN)

@@ -34,7 +34,7 @@ from ._registry import Computed, Estimator, register
 from .confidence import edf_greenhall
 from .grid import m_grid, resolve_taus
 
-__all__ = ["max_m", "n_terms", "DEVIATIONS", "GAP_ESTIMATORS", "gap_static"]
+__all__ = ["max_m", "n_terms", "DEVIATIONS", "GAP_ESTIMATORS", "GAP_DYNAMIC_ESTIMATORS", "gap_static", "gap_dynamic"]
 
 
 def max_m(estimator: str, n: int) -> int:
@@ -102,7 +102,20 @@ def _static(cols, fs, taus, workers, *, estimator: str) -> Computed:
 
 
 #: Estimators computed with ``gaps="skip"`` (NaN-marked missing samples): the core's gap-aware kernels.
-GAP_ESTIMATORS = ("oavar", "avar", "mvar", "tvar", "ohvar", "hvar")
+GAP_ESTIMATORS = (
+    "oavar",
+    "avar",
+    "mvar",
+    "tvar",
+    "ohvar",
+    "hvar",
+    "totvar",
+    "mtotvar",
+    "ttotvar",
+    "htotvar",
+    "mtie",
+    "tierms",
+)
 
 
 def gap_static(cols, fs: float, taus, workers, estimator: str) -> Computed:
@@ -115,13 +128,39 @@ def gap_static(cols, fs: float, taus, workers, estimator: str) -> Computed:
         )
     n = cols[0].size
     ms = resolve_taus(taus, n, fs) if estimator in ("oavar", "avar") else _resolve(estimator, taus, n, fs)
+    if estimator in ("mtie", "tierms"):
+        # the phase as without gaps (a missing rate sample counts 0: the offset after it is unknown, and
+        # only windows whose rate samples are all present — exact phase differences — are kept)
+        phase = [np.concatenate(([0.0], np.cumsum(np.where(np.isnan(c), 0.0, c)) / fs)) for c in cols]
+        gaps = [np.concatenate(([0], np.cumsum(np.isnan(c)))).astype(np.uint64) for c in cols]
+        values, counts = _core.tie_gaps(phase, gaps, [int(m) for m in ms], estimator, resolve_workers(workers))
+        return Computed(tau=ms / fs, values=values**2, n=counts, m=ms)
     # classic AVAR and HVAR: the OAVAR and OHVAR terms that start at multiples of m (cluster boundaries)
-    core_name = "mvar" if estimator == "tvar" else estimator
+    core_name = {"tvar": "mvar", "ttotvar": "mtotvar"}.get(estimator, estimator)
     values, counts = _core.deviation_gaps(cols, [int(m) for m in ms], core_name, resolve_workers(workers))
     tau = ms / fs
-    if estimator == "tvar":
+    if estimator in ("tvar", "ttotvar"):
         values = values * (tau**2 / 3.0)
     return Computed(tau=tau, values=values, n=counts, m=ms)
+
+
+#: Sliding-window estimators computed with ``gaps="skip"``.
+GAP_DYNAMIC_ESTIMATORS = ("oavar", "ohvar")
+
+
+def gap_dynamic(cols, fs: float, window: int, hop: int, ms, workers, estimator: str) -> Computed:
+    """``estimator`` of every window of records with NaN-marked missing rate samples: each window's
+    terms that touch a missing sample are skipped; ``n`` (axes, T, windows) counts the complete ones."""
+    if estimator not in GAP_DYNAMIC_ESTIMATORS:
+        raise ParameterError(
+            f'davar(gaps="skip") is supported by the estimators {", ".join(GAP_DYNAMIC_ESTIMATORS)}; got '
+            f'estimator={estimator!r} (use gaps="error" and analyse a stretch without gaps)'
+        )
+    ms = np.asarray(ms, dtype=np.int64)
+    values, counts = _core.deviation_gaps_dynamic(
+        cols, int(window), int(hop), [int(m) for m in ms], estimator, resolve_workers(workers)
+    )
+    return Computed(tau=ms / fs, values=values, n=counts, m=ms)
 
 
 def _dynamic_ohvar(cols, fs, window, hop, taus, method, workers) -> Computed:

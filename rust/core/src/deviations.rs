@@ -277,6 +277,16 @@ fn hvar_value(f: &[f64], m: usize) -> f64 {
 /// x*_{N+j} = 2x_N − x_{N−j}. On the rate this is the *even* reflection y*_{−1−j} = y_j,
 /// y*_{M+j} = y_{M−1−j}, so every term is B*(p) − B*(p−m) over the extended rate, p = 1 … M−1.
 fn totvar_value(f: &[f64], m: usize) -> f64 {
+    let (s, kept) = totvar_sum(f, m, None);
+    let mf = m as f64;
+    s / (2.0 * mf * mf * kept as f64)
+}
+
+/// Σ of the squared TOTVAR terms (block-sum differences, τ0 = 1) and their count. With `cnt` (the
+/// prefix count of gaps, `f` holding 0 at a gap) only the complete terms: the term centred at p uses
+/// the extended rate over [p − m, p + m), whose reflected parts mirror samples already inside
+/// [max(0, p − m), min(M, p + m)) — so it is complete iff that original range holds no gap.
+fn totvar_sum(f: &[f64], m: usize, cnt: Option<&[u32]>) -> (f64, usize) {
     let mm = f.len();
     // y*_q for q = 1−m … M+m−2 (even reflection of the rate), generated per chunk of centres.
     let ext = |q: isize| -> f64 {
@@ -291,6 +301,7 @@ fn totvar_value(f: &[f64], m: usize) -> f64 {
     let chunk = TERM_CHUNK.max(4 * m);
     let (mut z, mut b) = (Vec::new(), Vec::new());
     let mut acc = Acc::default();
+    let mut kept = 0usize;
     let mut p0 = 1;
     while p0 < mm {
         let c = chunk.min(mm - p0);
@@ -301,12 +312,21 @@ fn totvar_value(f: &[f64], m: usize) -> f64 {
         b.clear();
         b.resize(c + m, 0.0); // b[i] = B*(lo + i)
         sliding_sums(&z, m, &mut b);
-        let t: Vec<f64> = (0..c).map(|i| b[i + m] - b[i]).collect();
+        let t: Vec<f64> = match cnt {
+            None => (0..c).map(|i| b[i + m] - b[i]).collect(),
+            Some(cnt) => (0..c)
+                .filter(|&i| {
+                    let p = p0 + i;
+                    cnt[(p + m).min(mm)] == cnt[p.saturating_sub(m)]
+                })
+                .map(|i| b[i + m] - b[i])
+                .collect(),
+        };
+        kept += t.len();
         acc.add(sum_sq(&t));
         p0 += c;
     }
-    let mf = m as f64;
-    acc.get() / (2.0 * mf * mf * (mm - 1) as f64)
+    (acc.get(), kept)
 }
 
 /// Subsequences per parallel chunk in MTOTVAR/HTOTVAR (fixed: results independent of threads).
@@ -417,9 +437,20 @@ impl TotScratch {
 /// points by uninverted even reflection. No bias correction (Stable32 divides by a noise-dependent
 /// factor; see tests/test_deviations_core.py).
 fn mtotvar_value(f: &[f64], m: usize, cancel: &Cancel) -> f64 {
+    mtotvar_gap(f, m, None, cancel).0
+}
+
+/// MTOTVAR and its count of subsequences; with `cnt` (prefix count of gaps) only the subsequences
+/// whose 3m − 1 rate samples hold no gap (NaN with no complete subsequence).
+fn mtotvar_gap(f: &[f64], m: usize, cnt: Option<&[u32]>, cancel: &Cancel) -> (f64, u64) {
     let l = f.len() + 2 - 3 * m;
     let n3 = 3 * m;
-    let total = chunked_sum(l, m, cancel, |sc, n| {
+    let (total, kept) = chunked_sum(l, m, cancel, |sc, n| {
+        if let Some(c) = cnt {
+            if c[n + n3 - 1] != c[n] {
+                return None;
+            }
+        }
         // Local phase: x_{n+k} − x_n = Σ_{i<k} f_{n+i}, summed from the subsequence's own samples.
         let mut x = 0.0;
         sc.u[0] = 0.0;
@@ -427,11 +458,12 @@ fn mtotvar_value(f: &[f64], m: usize, cancel: &Cancel) -> f64 {
             x += f[n + k - 1];
             sc.u[k] = x;
         }
-        sc.reflected_square_sum(m)
+        Some(sc.reflected_square_sum(m))
     });
     let mf = m as f64;
     // Σ (S/m)²/(6m) / (2 m² L): S the block-sum second difference in phase units (τ0 = 1).
-    total / (mf * mf) / (6.0 * mf) / (2.0 * mf * mf * l as f64)
+    let v = total / (mf * mf) / (6.0 * mf) / (2.0 * mf * mf * kept as f64);
+    (if kept == 0 { f64::NAN } else { v }, kept as u64)
 }
 
 /// HTOTVAR (SP 1065 eq. 30, Howe et al.):
@@ -444,44 +476,63 @@ fn htotvar_value(f: &[f64], m: usize, cancel: &Cancel) -> f64 {
     if m == 1 {
         return overlapping_value(Kind::Ohvar, f, 1);
     }
-    let l = f.len() + 1 - 3 * m;
-    let n3 = 3 * m;
-    let total = chunked_sum(l, m, cancel, |sc, n| {
-        sc.u.copy_from_slice(&f[n..n + n3]);
-        sc.reflected_square_sum(m)
-    });
-    let mf = m as f64;
-    total / (mf * mf) / (6.0 * mf) / (6.0 * l as f64)
+    htotvar_gap(f, m, None, cancel).0
 }
 
-/// Σ_{n<l} g(n) over fixed chunks of subsequences, in parallel; chunk totals added in order.
+/// HTOTVAR (m ≥ 2) and its count of subsequences; with `cnt` only those whose 3m rate samples hold no
+/// gap.
+fn htotvar_gap(f: &[f64], m: usize, cnt: Option<&[u32]>, cancel: &Cancel) -> (f64, u64) {
+    let l = f.len() + 1 - 3 * m;
+    let n3 = 3 * m;
+    let (total, kept) = chunked_sum(l, m, cancel, |sc, n| {
+        if let Some(c) = cnt {
+            if c[n + n3] != c[n] {
+                return None;
+            }
+        }
+        sc.u.copy_from_slice(&f[n..n + n3]);
+        Some(sc.reflected_square_sum(m))
+    });
+    let mf = m as f64;
+    let v = total / (mf * mf) / (6.0 * mf) / (6.0 * kept as f64);
+    (if kept == 0 { f64::NAN } else { v }, kept as u64)
+}
+
+/// Σ_{n<l} g(n) over fixed chunks of subsequences, in parallel; chunk totals added in order. A
+/// subsequence for which `g` returns None (it touches a gap) is skipped; returns (Σ, count kept).
 fn chunked_sum(
     l: usize,
     m: usize,
     cancel: &Cancel,
-    g: impl Fn(&mut TotScratch, usize) -> f64 + Sync,
-) -> f64 {
-    let parts: Vec<f64> = (0..l.div_ceil(SUB_CHUNK))
+    g: impl Fn(&mut TotScratch, usize) -> Option<f64> + Sync,
+) -> (f64, usize) {
+    let parts: Vec<(f64, usize)> = (0..l.div_ceil(SUB_CHUNK))
         .into_par_iter()
         .map_init(
             || TotScratch::new(m),
             |sc, c| {
                 if cancel.is_cancelled() {
-                    return 0.0; // the caller checks the flag and discards the value
+                    return (0.0, 0); // the caller checks the flag and discards the value
                 }
                 let mut acc = Acc::default();
+                let mut kept = 0;
                 for n in c * SUB_CHUNK..((c + 1) * SUB_CHUNK).min(l) {
-                    acc.add(g(sc, n));
+                    if let Some(v) = g(sc, n) {
+                        acc.add(v);
+                        kept += 1;
+                    }
                 }
-                acc.get()
+                (acc.get(), kept)
             },
         )
         .collect();
     let mut acc = Acc::default();
-    for p in parts {
+    let mut kept = 0;
+    for (p, k) in parts {
         acc.add(p);
+        kept += k;
     }
-    acc.get()
+    (acc.get(), kept)
 }
 
 fn value(kind: Kind, f: &[f64], m: usize, cancel: &Cancel) -> f64 {
@@ -553,10 +604,11 @@ pub fn static_ttotvar_cancellable(
         .collect())
 }
 
-/// Gap-aware OAVAR, MVAR or OHVAR: NaN samples mark gaps; each estimate averages only the terms
-/// whose span (see `overlapping_terms`) holds no NaN. Returns (values [axis][m], term counts
-/// [axis][m]); a τ with no complete term gives NaN and count 0. Without NaN it equals the plain
-/// estimator. ±inf is still an error.
+/// Gap-aware OAVAR, MVAR, OHVAR, TOTVAR, MTOTVAR and HTOTVAR: NaN samples mark gaps; each estimate
+/// averages only the terms whose span holds no NaN (a term of the overlapping estimators: see
+/// `span_scale`; of TOTVAR: see `totvar_sum`; of MTOTVAR/HTOTVAR: its 3m-point subsequence). Returns
+/// (values [axis][m], term counts [axis][m]); a τ with no complete term gives NaN and count 0.
+/// Without NaN it equals the plain estimator. ±inf is still an error.
 ///
 /// `classic`: only the terms that start at a multiple of m — the non-overlapping estimators, classic
 /// AVAR from the OAVAR terms and HVAR from the OHVAR terms (cluster k's term starts at sample k·m).
@@ -566,9 +618,21 @@ pub fn gap_deviation(
     kind: Kind,
     classic: bool,
 ) -> Result<(Vec<f64>, Vec<u64>)> {
-    if !matches!(kind, Kind::Oavar | Kind::Mvar | Kind::Ohvar) || (classic && kind == Kind::Mvar) {
+    gap_deviation_cancellable(columns, ms, kind, classic, &Cancel::new())
+}
+
+/// [`gap_deviation`] with a cancel flag, as [`static_deviation_cancellable`].
+pub fn gap_deviation_cancellable(
+    columns: &[&[f64]],
+    ms: &[usize],
+    kind: Kind,
+    classic: bool,
+    cancel: &Cancel,
+) -> Result<(Vec<f64>, Vec<u64>)> {
+    if kind == Kind::Hvar || (classic && !matches!(kind, Kind::Oavar | Kind::Ohvar)) {
         return Err(CoreError::InvalidParameter(format!(
-            "gap-aware estimation is available for OAVAR, MVAR and OHVAR (and classic AVAR/HVAR), not {}{}",
+            "gap-aware estimation is available for OAVAR, MVAR, OHVAR, TOTVAR, MTOTVAR and HTOTVAR (and \
+             classic AVAR/HVAR), not {}{}",
             if classic { "classic " } else { "" },
             kind.name()
         )));
@@ -596,30 +660,50 @@ pub fn gap_deviation(
         .map(|row| {
             let (f, cnt) = &prepared[row / n_m];
             let m = ms[row % n_m];
-            let (span, scale) = span_scale(kind, m);
-            let (mut acc, mut kept) = (Acc::default(), 0usize);
-            let mut keep = Vec::new();
-            for_each_term_chunk(kind, f, m, &mut TermBuf::default(), |k0, t| {
-                keep.clear();
-                keep.extend(
-                    t.iter()
-                        .enumerate()
-                        .filter(|(i, _)| {
-                            cnt[k0 + i + span] == cnt[k0 + i] && (!classic || (k0 + i) % m == 0)
-                        })
-                        .map(|(_, v)| *v),
-                );
-                kept += keep.len();
-                acc.add(sum_sq(&keep));
-            });
-            if kept == 0 {
-                (f64::NAN, 0)
-            } else {
-                (acc.get() * scale / kept as f64, kept as u64)
+            if cancel.is_cancelled() {
+                return (0.0, 0);
+            }
+            match kind {
+                Kind::Totvar => {
+                    let (s, kept) = totvar_sum(f, m, Some(cnt));
+                    let mf = m as f64;
+                    let v = s / (2.0 * mf * mf * kept as f64);
+                    (if kept == 0 { f64::NAN } else { v }, kept as u64)
+                }
+                Kind::Mtotvar => mtotvar_gap(f, m, Some(cnt), cancel),
+                Kind::Htotvar if m > 1 => htotvar_gap(f, m, Some(cnt), cancel),
+                Kind::Htotvar => overlapping_gap(Kind::Ohvar, f, cnt, m, false),
+                _ => overlapping_gap(kind, f, cnt, m, classic),
             }
         })
         .collect();
+    cancel.check()?;
     Ok(res.into_iter().unzip())
+}
+
+/// One gap-aware overlapping (or, `classic`, non-overlapping) estimate and its count of terms.
+fn overlapping_gap(kind: Kind, f: &[f64], cnt: &[u32], m: usize, classic: bool) -> (f64, u64) {
+    let (span, scale) = span_scale(kind, m);
+    let (mut acc, mut kept) = (Acc::default(), 0usize);
+    let mut keep = Vec::new();
+    for_each_term_chunk(kind, f, m, &mut TermBuf::default(), |k0, t| {
+        keep.clear();
+        keep.extend(
+            t.iter()
+                .enumerate()
+                .filter(|(i, _)| {
+                    cnt[k0 + i + span] == cnt[k0 + i] && (!classic || (k0 + i) % m == 0)
+                })
+                .map(|(_, v)| *v),
+        );
+        kept += keep.len();
+        acc.add(sum_sq(&keep));
+    });
+    if kept == 0 {
+        (f64::NAN, 0)
+    } else {
+        (acc.get() * scale / kept as f64, kept as u64)
+    }
 }
 
 /// MTIE (ITU-T G.810 §B.2, SP 1065 §5.2.15) of each *phase* record at window m: the largest
@@ -658,6 +742,61 @@ pub fn tie_rms(phases: &[&[f64]], ms: &[usize]) -> Result<Vec<f64>> {
             (sum_sq(&d) / d.len() as f64).sqrt()
         })
         .collect())
+}
+
+/// Gap-aware MTIE (`mtie` true) or TIE rms of phase records built from rate samples with gaps:
+/// `gaps[a]` is axis a's prefix count of missing *rate* samples (length N), the phase holding any
+/// finite value where its offset is unknown. A window of phase points [k, k + m] (MTIE) or a
+/// difference x_{k+m} − x_k (TIE) is kept iff its rate samples [k, k + m) are all present — then its
+/// phase differences are exact whatever offset a gap before it left. Returns (values [axis][m], kept
+/// windows [axis][m]); NaN and 0 where none is complete.
+pub fn tie_gaps(
+    phases: &[&[f64]],
+    gaps: &[&[u64]],
+    ms: &[usize],
+    mtie: bool,
+) -> Result<(Vec<f64>, Vec<u64>)> {
+    let n = check_phase(phases, ms, if mtie { "MTIE" } else { "TIE rms" })?;
+    if gaps.len() != phases.len() || gaps.iter().any(|g| g.len() != n) {
+        return Err(CoreError::InvalidParameter(format!(
+            "gap counts must be one array of {n} values per axis ({} axes)",
+            phases.len()
+        )));
+    }
+    let n_m = ms.len();
+    let res: Vec<(f64, u64)> = (0..phases.len() * n_m)
+        .into_par_iter()
+        .map(|row| {
+            let (x, g, m) = (phases[row / n_m], gaps[row / n_m], ms[row % n_m]);
+            let complete = |k: usize| g[k + m] == g[k];
+            let (value, kept) = if mtie {
+                let hi = running_extreme(x, m + 1, f64::max);
+                let lo = running_extreme(x, m + 1, f64::min);
+                let mut best = 0.0f64;
+                let mut kept = 0u64;
+                for (k, (a, b)) in hi.iter().zip(&lo).enumerate() {
+                    if complete(k) {
+                        best = best.max(a - b);
+                        kept += 1;
+                    }
+                }
+                (best, kept)
+            } else {
+                let d: Vec<f64> = (0..n - m)
+                    .filter(|&k| complete(k))
+                    .map(|k| x[k + m] - x[k])
+                    .collect();
+                let kept = d.len() as u64;
+                ((sum_sq(&d) / kept as f64).sqrt(), kept)
+            };
+            if kept == 0 {
+                (f64::NAN, 0)
+            } else {
+                (value, kept)
+            }
+        })
+        .collect();
+    Ok(res.into_iter().unzip())
 }
 
 fn check_phase(phases: &[&[f64]], ms: &[usize], what: &str) -> Result<usize> {
@@ -782,4 +921,127 @@ pub fn dynamic_ohvar(
             }
         });
     Ok((out, n_win))
+}
+
+/// Gap-aware dynamic OAVAR or OHVAR: the estimate of every window of `window` samples, `hop` apart,
+/// from the terms inside the window whose span holds no NaN (as [`gap_deviation`] on that window
+/// alone). Returns (values [axis][m][window], complete-term counts [axis][m][window], windows); a
+/// window with no complete term at some m gives NaN and 0 there.
+///
+/// The same scheme as [`dynamic_ohvar`]: the record's terms are formed once per (axis, m), their
+/// squares (0 for an incomplete term) summed per block of `hop` terms with compensation, each window's
+/// sum the Van Herk sliding sum of whole blocks plus the partial block — sums of non-negative values of
+/// the window's own terms only, so a level change of 10⁶ elsewhere costs nothing. The counts are exact
+/// integer prefix differences. Memory per running (axis, m) task: the record's terms (8 bytes each)
+/// and their prefix count (8 bytes each).
+pub fn gap_dynamic(
+    columns: &[&[f64]],
+    window: usize,
+    hop: usize,
+    ms: &[usize],
+    kind: Kind,
+    cancel: &Cancel,
+) -> Result<(Vec<f64>, Vec<u64>, usize)> {
+    if !matches!(kind, Kind::Oavar | Kind::Ohvar) {
+        return Err(CoreError::InvalidParameter(format!(
+            "gap-aware sliding-window estimation is available for OAVAR and OHVAR, not {}",
+            kind.name()
+        )));
+    }
+    let n = check_shape(columns)?;
+    if window < 2 || window > n {
+        return Err(CoreError::InvalidParameter(format!(
+            "window ({window} samples) must be between 2 and the record length ({n} samples)"
+        )));
+    }
+    if hop == 0 {
+        return Err(CoreError::InvalidParameter(
+            "hop (0) must be at least 1 sample".into(),
+        ));
+    }
+    check_ms(kind, window, ms, "window")?;
+    check_values(columns, true)?;
+    let n_win = (n - window) / hop + 1;
+    let n_m = ms.len();
+    let prepared: Vec<(Vec<f64>, Vec<u32>)> = columns
+        .par_iter()
+        .map(|c| {
+            let mut cnt = Vec::with_capacity(c.len() + 1);
+            cnt.push(0u32);
+            let mut k = 0u32;
+            for v in c.iter() {
+                k = k.wrapping_add(v.is_nan() as u32);
+                cnt.push(k);
+            }
+            (centred(c), cnt)
+        })
+        .collect();
+    let mut out = vec![0.0; columns.len() * n_m * n_win];
+    let mut counts = vec![0u64; columns.len() * n_m * n_win];
+    out.par_chunks_mut(n_win)
+        .zip(counts.par_chunks_mut(n_win))
+        .enumerate()
+        .for_each(|(row, (dst, dcnt))| {
+            if cancel.is_cancelled() {
+                return;
+            }
+            let ((f, gap), m) = (&prepared[row / n_m], ms[row % n_m]);
+            let (span, scale) = span_scale(kind, m);
+            let l = window + 1 - span; // terms per window
+            let k_end = (n_win - 1) * hop + l; // terms used by some window
+                                               // squares of the complete terms (0 otherwise) and the prefix count of complete terms;
+                                               // a gap count that wrapped (≥ 2³² NaN) still differs across a span holding a NaN unless
+                                               // the span holds exactly 2³² of them, which a span of < 2³² samples cannot
+            let mut t = Vec::with_capacity(k_end);
+            let mut done = vec![0u64; k_end + 1];
+            let mut tb = TermBuf::default();
+            for_each_term_chunk(kind, &f[..k_end + span - 1], m, &mut tb, |k0, c| {
+                for (i, v) in c.iter().enumerate() {
+                    let k = k0 + i;
+                    let ok = gap[k + span] == gap[k];
+                    t.push(if ok { v * v } else { 0.0 });
+                    done[k + 1] = done[k] + ok as u64;
+                }
+            });
+            for (j, o) in dcnt.iter_mut().enumerate() {
+                *o = done[j * hop + l] - done[j * hop];
+            }
+            let hop_b = if n_win == 1 { l } else { hop };
+            let (q, r) = (l / hop_b, l % hop_b);
+            let nblocks = n_win + q;
+            let mut full = vec![0.0; nblocks];
+            let mut part = vec![0.0; nblocks];
+            for (b, blk) in t[..k_end].chunks(hop_b).enumerate() {
+                let mut acc = Acc::default();
+                let mut pacc = Acc::default();
+                for (c, sub) in blk.chunks(RUN).enumerate() {
+                    acc.add(sum4(sub));
+                    let lo = c * RUN;
+                    if lo < r {
+                        pacc.add(sum4(&sub[..(r - lo).min(sub.len())]));
+                    }
+                }
+                full[b] = acc.get();
+                part[b] = pacc.get();
+            }
+            if q == 0 {
+                dst.copy_from_slice(&part[..n_win]);
+            } else {
+                sliding_sums(&full, q, dst);
+                if r != 0 {
+                    for (o, p) in dst.iter_mut().zip(&part[q..]) {
+                        *o += p;
+                    }
+                }
+            }
+            for (o, &c) in dst.iter_mut().zip(dcnt.iter()) {
+                *o = if c == 0 {
+                    f64::NAN
+                } else {
+                    *o * scale / c as f64
+                };
+            }
+        });
+    cancel.check()?;
+    Ok((out, counts, n_win))
 }

@@ -4,10 +4,10 @@
 //! bad input gives an error, never a panic.
 
 use allanite_core::deviations::{
-    dynamic_ohvar, gap_deviation, max_m, mtie, n_terms, static_deviation, static_ttotvar, tie_rms,
-    Kind,
+    dynamic_ohvar, gap_deviation, gap_dynamic, max_m, mtie, n_terms, static_deviation,
+    static_ttotvar, tie_rms, Kind,
 };
-use allanite_core::run_in_pool;
+use allanite_core::{run_in_pool, Cancel};
 use proptest::prelude::*;
 
 const ALL: [Kind; 6] = [
@@ -74,7 +74,7 @@ proptest! {
 
     #[test]
     fn gaps_without_nan_equal_plain_and_count(y in record()) {
-        for kind in [Kind::Mvar, Kind::Ohvar] {
+        for kind in [Kind::Mvar, Kind::Ohvar, Kind::Totvar, Kind::Mtotvar, Kind::Htotvar] {
             let ms = all_ms(kind, y.len());
             let plain = static_deviation(&[&y], &ms, kind).unwrap();
             let (v, n) = gap_deviation(&[&y], &ms, kind, false).unwrap();
@@ -110,6 +110,59 @@ proptest! {
             let touching = (0..total).filter(|&k| k <= g && g < k + 3 * m).count();
             prop_assert_eq!(n[i] as usize, total - touching);
             prop_assert_eq!(v[i].is_nan(), n[i] == 0);
+        }
+    }
+
+    #[test]
+    fn nan_gaps_drop_the_touching_total_terms(y in record(), at in 0f64..1.0) {
+        // One NaN at g: TOTVAR's term centred at p (1 ≤ p < M) uses [max(0, p−m), min(M, p+m)) (its
+        // reflected parts mirror samples inside that range); MTOTVAR's subsequence n uses
+        // [n, n + 3m − 1), HTOTVAR's [n, n + 3m) (m = 1: OHVAR's terms, [k, k + 3)).
+        let mut z = y.clone();
+        let mm = z.len();
+        let g = ((mm - 1) as f64 * at) as usize;
+        z[g] = f64::NAN;
+        for kind in [Kind::Totvar, Kind::Mtotvar, Kind::Htotvar] {
+            let ms = all_ms(kind, mm);
+            let (v, n) = gap_deviation(&[&z], &ms, kind, false).unwrap();
+            for (i, &m) in ms.iter().enumerate() {
+                let spans: Vec<(usize, usize)> = match kind {
+                    Kind::Totvar => (1..mm).map(|p| (p.saturating_sub(m), (p + m).min(mm))).collect(),
+                    Kind::Mtotvar => (0..mm + 2 - 3 * m).map(|k| (k, k + 3 * m - 1)).collect(),
+                    _ => (0..mm + 1 - 3 * m).map(|k| (k, k + 3 * m)).collect(),
+                };
+                let complete = spans.iter().filter(|(a, b)| !(*a <= g && g < *b)).count();
+                prop_assert_eq!(n[i] as usize, complete, "{:?} m = {}", kind, m);
+                prop_assert_eq!(v[i].is_nan(), complete == 0);
+            }
+        }
+    }
+
+    #[test]
+    fn gap_windows_are_the_static_gap_estimate_of_each_window(
+        y in record(), holes in prop::collection::vec(0f64..1.0, 0..4), wfrac in 0.3f64..1.0, hop in 1usize..13
+    ) {
+        let mut z = y.clone();
+        for h in &holes {
+            let g = ((z.len() - 1) as f64 * h) as usize;
+            z[g] = f64::NAN;
+        }
+        let window = ((z.len() as f64 * wfrac) as usize).max(6);
+        for kind in [Kind::Oavar, Kind::Ohvar] {
+            let ms = all_ms(kind, window);
+            let (v, c, n_win) = gap_dynamic(&[&z], window, hop, &ms, kind, &Cancel::new()).unwrap();
+            prop_assert_eq!(n_win, (z.len() - window) / hop + 1);
+            for j in 0..n_win {
+                let w = &z[j * hop..j * hop + window];
+                let (sv, sc) = gap_deviation(&[w], &ms, kind, false).unwrap();
+                for i in 0..ms.len() {
+                    let (a, b) = (v[i * n_win + j], sv[i]);
+                    prop_assert_eq!(c[i * n_win + j], sc[i]);
+                    // each window is centred on the whole record's mean, the static call on its own
+                    let ok = (a.is_nan() && b.is_nan()) || close(a, b, 1e-9);
+                    prop_assert!(ok, "{:?} m = {} window {}: {} vs {}", kind, ms[i], j, a, b);
+                }
+            }
         }
     }
 
@@ -203,10 +256,14 @@ fn errors_name_the_value() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("m = 3") && e.contains("1..=2"), "{e}");
-    let e = gap_deviation(&[&y], &[1], Kind::Totvar, false)
+    let e = gap_deviation(&[&y], &[1], Kind::Hvar, false)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("TOTVAR"), "{e}");
+    assert!(e.contains("HVAR") && e.contains("classic AVAR/HVAR"), "{e}");
+    let e = gap_deviation(&[&y], &[1], Kind::Totvar, true)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("classic TOTVAR"), "{e}");
     let e = static_ttotvar(&[&y], &[1], f64::NAN)
         .unwrap_err()
         .to_string();

@@ -311,11 +311,14 @@ fn deviation_gaps<'py>(
         "hvar" => ("ohvar", true),
         other => (other, false),
     };
-    let kind = parse_kind(py, name, &["oavar", "mvar", "ohvar"])?;
+    let kind = parse_kind(
+        py,
+        name,
+        &["oavar", "mvar", "ohvar", "totvar", "mtotvar", "htotvar"],
+    )?;
     let slices = contiguous(py, &columns)?;
-    // O(N) per τ: the signal is looked at while it runs and acted on when it returns
-    let (values, counts) = run_interruptible(py, workers, |_cancel| {
-        deviations::gap_deviation(&slices, &ms, kind, classic)
+    let (values, counts) = run_interruptible(py, workers, |cancel| {
+        deviations::gap_deviation_cancellable(&slices, &ms, kind, classic, cancel)
     })?;
     let counts: Vec<i64> = counts.into_iter().map(|c| c as i64).collect();
     let c = Array2::from_shape_vec((slices.len(), ms.len()), counts)
@@ -344,6 +347,78 @@ fn ohvar_dynamic<'py>(
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
+}
+
+/// (values, counts) of a gap-aware whole-record estimate.
+type ValuesCounts2<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
+
+/// (values, counts) of a gap-aware sliding-window estimate.
+type ValuesCounts3<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<i64>>);
+
+/// Gap-aware OAVAR or OHVAR of every sliding window (NaN marks a missing rate sample): values and
+/// complete-term counts, each of shape (axes, len(ms), windows).
+#[pyfunction]
+#[pyo3(signature = (columns, window, hop, ms, estimator, workers))]
+fn deviation_gaps_dynamic<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    window: usize,
+    hop: usize,
+    ms: Vec<usize>,
+    estimator: &str,
+    workers: usize,
+) -> PyResult<ValuesCounts3<'py>> {
+    let kind = parse_kind(py, estimator, &["oavar", "ohvar"])?;
+    let slices = contiguous(py, &columns)?;
+    let (values, counts, n_win) = run_interruptible(py, workers, |cancel| {
+        deviations::gap_dynamic(&slices, window, hop, &ms, kind, cancel)
+    })?;
+    let shape = (slices.len(), ms.len(), n_win);
+    let v = Array3::from_shape_vec(shape, values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    let c = Array3::from_shape_vec(shape, counts.into_iter().map(|c| c as i64).collect())
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok((v.into_pyarray(py), c.into_pyarray(py)))
+}
+
+/// Gap-aware MTIE or TIE rms of phase records with the prefix counts of missing rate samples:
+/// (values, kept windows), each of shape (axes, len(ms)).
+#[pyfunction]
+#[pyo3(signature = (phases, gaps, ms, estimator, workers))]
+fn tie_gaps<'py>(
+    py: Python<'py>,
+    phases: Vec<PyReadonlyArray1<'py, f64>>,
+    gaps: Vec<PyReadonlyArray1<'py, u64>>,
+    ms: Vec<usize>,
+    estimator: &str,
+    workers: usize,
+) -> PyResult<ValuesCounts2<'py>> {
+    let mtie = match estimator {
+        "mtie" => true,
+        "tierms" => false,
+        other => {
+            return Err(allanite_error(
+                py,
+                format!("unknown estimator {other:?}; allowed: mtie, tierms"),
+            ))
+        }
+    };
+    let slices = contiguous(py, &phases)?;
+    let g: Vec<&[u64]> = gaps
+        .iter()
+        .map(|a| a.as_slice())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| allanite_error(py, format!("gap counts must be contiguous: {e}")))?;
+    let (values, counts) = run_interruptible(py, workers, |_cancel| {
+        deviations::tie_gaps(&slices, &g, &ms, mtie)
+    })?;
+    let counts: Vec<i64> = counts.into_iter().map(|c| c as i64).collect();
+    let c = Array2::from_shape_vec((slices.len(), ms.len()), counts)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok((
+        to_2d(py, slices.len(), ms.len(), values)?,
+        c.into_pyarray(py),
+    ))
 }
 
 /// MTIE of each *phase* record (windows of m + 1 points): shape (axes, len(ms)).
@@ -384,6 +459,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ttotvar_static, m)?)?;
     m.add_function(wrap_pyfunction!(deviation_gaps, m)?)?;
     m.add_function(wrap_pyfunction!(ohvar_dynamic, m)?)?;
+    m.add_function(wrap_pyfunction!(deviation_gaps_dynamic, m)?)?;
+    m.add_function(wrap_pyfunction!(tie_gaps, m)?)?;
     m.add_function(wrap_pyfunction!(mtie_phase, m)?)?;
     m.add_function(wrap_pyfunction!(tierms_phase, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
