@@ -95,9 +95,7 @@ def write(res: dict) -> None:
         "|---|---:|---:|---:|---:|---|",
     ]
     for est, w in sorted(res["stable32"].items()):
-        lines.append(
-            f"| {est} | {w['tables']} | {w['rows']} | {w['rel']:.2e} | {w['digits']:.3g} | {w['where']} |"
-        )
+        lines.append(f"| {est} | {w['tables']} | {w['rows']} | {w['rel']:.2e} | {w['digits']:.3g} | {w['where']} |")
     lines += [
         "",
         "NBS14 9-point frequency set (SP 1065 Table 31, τ = 1, 2):",
