@@ -39,8 +39,10 @@ def _adis(shared_data, run, cols):
 
 
 def _falls(st):
+    # in-sample χ²/dof and RMS ADEV error (a time-domain removal: both on the curve it was removed from),
+    # and the held-out error
     assert st.after["chi2_dof"] < st.before["chi2_dof"]
-    assert st.after["rms_adev_pct"] < st.before["rms_adev_pct"] + 0.5  # in-sample: never notably worse
+    assert st.after["rms_adev_pct"] < st.before["rms_adev_pct"]
     assert st.after["heldout_rms_adev_pct"] < st.before["heldout_rms_adev_pct"]
 
 
@@ -249,7 +251,9 @@ def test_adis_with_injected_gauss_markov_and_g_sensitivity(shared_data):
     # Allan-curve held-out error is not the right score for removing a white-like component: its level
     # changes, not how well one half predicts the other — recorded, not asserted)
     assert rg.evidence["heldout_variance_ratio"] < 1.0
-    # (in-sample, the Allan-curve fit does not improve here: 2.2 → 3.5 % — reported in docs/refinement.md)
+    assert rg.after["heldout_rms_adev_pct"] < rg.before["heldout_rms_adev_pct"]
+    # (in-sample, on the curve it was removed from, the Allan-curve fit does not improve: χ²/dof ≈ 0.5 before
+    # and after — a white-like component is absorbed by N; docs/refinement.md)
 
 
 def test_calibrated_test_and_heldout_are_reported(gm_small=None):

@@ -261,6 +261,24 @@ def _informative(tau, nu) -> np.ndarray:
     return good if np.count_nonzero(good) >= 4 else mask
 
 
+def _removal_metrics(curve: _Curve, sol: _Solution, component_avar, n_params: int, heldout, scored) -> dict:
+    """In-sample errors of a time-domain removal on the curve it was removed *from*: the noise model
+    fitted after the removal plus the removed component's own Allan variance, against the same
+    estimates the "before" model was scored on (apples to apples; the cross term of an independent
+    component averages to zero)."""
+    model = np.maximum(sol.model + component_avar, 1e-300)
+    z = (curve.avar - model) * np.sqrt(sol.nu / (2.0 * model**2))
+    chi2 = float(np.sum(z**2))
+    dof = max(1, sol.dof - n_params)
+    return {
+        "chi2_dof": chi2 / dof,
+        "rms_z": float(np.sqrt(np.mean(z**2))),
+        "rms_adev_pct": _rms_adev_pct(curve.avar[scored], model[scored]),
+        "p_value": float(chi2_dist.sf(chi2 * curve.n_eff / curve.tau.size, max(1.0, curve.n_eff - 1))),
+        "heldout_rms_adev_pct": heldout,
+    }
+
+
 def _curve_metrics(curve: _Curve, sol: _Solution, heldout, scored=None) -> dict:
     sc = slice(None) if scored is None else scored
     return {
@@ -1240,7 +1258,15 @@ def _refine(
             intervals=intervals,
             evidence=evidence,
             before=metrics(curve, sol, ho_b),
-            after=metrics(c_new, s_new, ho_a),
+            # on the same curve as "before": the new noise model plus the component's own Allan variance
+            after=_removal_metrics(
+                curve,
+                s_new,
+                avar(np.asarray(component, dtype=np.float64), fs, taus=result.tau).avar[keep],
+                len(params),
+                ho_a,
+                scored,
+            ),
             delta_chi2_eff=float(sol.chi2_eff(curve) - s_new.chi2_eff(c_new)),
             truth_error=terr,
         )
@@ -1583,7 +1609,10 @@ def _refine(
         s_raw = _solve(c_raw, start, effects)
         st = first_steps[0]
         st.before = metrics(c_raw, s_raw, h_raw.error(start, effects) if h_raw is not None else None)
-        st.after = metrics(curve, sol, h_raw.error(start, effects, remove=refit) if h_raw is not None else None)
+        # after: on the raw curve too — the final model plus the drift's own Allan variance
+        comp_av = avar(np.asarray(comp, dtype=np.float64), fs, taus=result.tau).avar[keep]
+        ho_after = h_raw.error(start, effects, remove=refit) if h_raw is not None else None
+        st.after = _removal_metrics(c_raw, sol, comp_av, 2, ho_after, scored)
         st.delta_chi2_eff = float(s_raw.chi2_eff(c_raw) - sol.chi2_eff(curve))
         st.evidence["scored_with"] = [_base(k) for k, _p in effects] or "the five terms"
     steps = first_steps + steps
