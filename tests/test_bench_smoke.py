@@ -33,11 +33,12 @@ def test_bench_engine_quick(tmp_path):
     assert (tmp_path / "engine.md").read_text(encoding="utf-8").count("| ") > 10
     assert report["mode"] == "quick"
     cases = report["cases"]
-    assert set(cases) == {"case1", "case2", "case3"}
+    assert set(cases) == {"case1", "case2", "case3", "case4"}
     expected = {
         "case1": {"davar_prefix", "allantools_per_window"},
-        "case2": {"davar_prefix", "allantools_per_window", "workers"},
-        "case3": {"allantools_oadev"},
+        "case2": {"davar_prefix", "allantools_per_window"},
+        "case3": {"davar_prefix", "allantools_per_window", "workers"},
+        "case4": {"allantools_oadev"},
     }
     for name, case in cases.items():
         comps = {c["key"]: c for c in case["comparisons"]}
@@ -52,4 +53,4 @@ def test_bench_engine_quick(tmp_path):
                 assert c["taus_match_exactly"] and c["taus_missing_from_baseline"] == 0, (name, key)
         assert len(case["targets"]) >= 1
     assert cases["case2"]["params"]["n_taus"] > 1
-    assert next(c for c in cases["case2"]["comparisons"] if c["key"] == "workers")["bit_identical"] is True
+    assert next(c for c in cases["case3"]["comparisons"] if c["key"] == "workers")["bit_identical"] is True

@@ -397,8 +397,33 @@ pub(crate) fn sliding_sums(f: &[f64], q: usize, out: &mut [f64]) {
         out.copy_from_slice(&f[..n_out]);
         return;
     }
-    // Suffix sums within each segment, for the indices that start a window.
-    let mut s0 = 0;
+    // Each segment's running sum is a chain of dependent additions (latency-bound); `CHAINS`
+    // segments are run interleaved so their latencies overlap. Every chain adds the same values in
+    // the same order as one segment at a time: the results are bit-identical either way.
+    // Suffix sums within each segment, for the indices that start a window. Full segments (whose
+    // windows all start inside the output and read no tail) go CHAINS at a time.
+    let full_suffix = if n_out >= q { n_out / q } else { 0 }; // segments [g·q, g·q + q) ⊂ [0, n_out)
+    let mut g = 0;
+    while g + CHAINS <= full_suffix {
+        let b = [g * q, (g + 1) * q, (g + 2) * q, (g + 3) * q];
+        let (mut s0, mut s1, mut s2, mut s3) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        assert!(b[3] + q <= n_out && n_out <= f.len());
+        for i in (0..q).rev() {
+            // SAFETY: b[p] + i < b[3] + q ≤ n_out = out.len() ≤ f.len() (asserted above).
+            unsafe {
+                s0 += *f.get_unchecked(b[0] + i);
+                s1 += *f.get_unchecked(b[1] + i);
+                s2 += *f.get_unchecked(b[2] + i);
+                s3 += *f.get_unchecked(b[3] + i);
+                *out.get_unchecked_mut(b[0] + i) = s0;
+                *out.get_unchecked_mut(b[1] + i) = s1;
+                *out.get_unchecked_mut(b[2] + i) = s2;
+                *out.get_unchecked_mut(b[3] + i) = s3;
+            }
+        }
+        g += CHAINS;
+    }
+    let mut s0 = g * q;
     while s0 < n_out {
         let end = (s0 + q).min(n_out + q - 1);
         let mut s: f64 = f[n_out.min(end)..end].iter().rev().sum();
@@ -409,8 +434,30 @@ pub(crate) fn sliding_sums(f: &[f64], q: usize, out: &mut [f64]) {
         s0 += q;
     }
     // Prefix sums of the following segment complete every window that does not start a segment:
-    // window j (j mod q ≠ 0) ends at i = j + q − 1 inside the next segment.
-    let mut s0 = q;
+    // window j (j mod q ≠ 0) ends at i = j + q − 1 inside the next segment. Segment g (from g·q)
+    // runs over [g·q, g·q + q − 1) when that lies below n_out + q − 1.
+    let mut g = 1;
+    while (g + CHAINS - 1) * q <= n_out {
+        let b = [g * q, (g + 1) * q, (g + 2) * q, (g + 3) * q];
+        let (mut p0, mut p1, mut p2, mut p3) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        assert!(b[3] <= n_out && b[3] + q - 1 <= f.len() && b[0] >= q - 1);
+        for i in 0..q - 1 {
+            // SAFETY: b[p] + i < b[3] + q − 1 ≤ f.len(), and the output index b[p] + i + 1 − q
+            // < b[3] + q − 1 + 1 − q ≤ n_out (asserted above).
+            unsafe {
+                p0 += *f.get_unchecked(b[0] + i);
+                p1 += *f.get_unchecked(b[1] + i);
+                p2 += *f.get_unchecked(b[2] + i);
+                p3 += *f.get_unchecked(b[3] + i);
+                *out.get_unchecked_mut(b[0] + i + 1 - q) += p0;
+                *out.get_unchecked_mut(b[1] + i + 1 - q) += p1;
+                *out.get_unchecked_mut(b[2] + i + 1 - q) += p2;
+                *out.get_unchecked_mut(b[3] + i + 1 - q) += p3;
+            }
+        }
+        g += CHAINS;
+    }
+    let mut s0 = g * q;
     while s0 < n_out + q - 1 {
         let end = (s0 + q - 1).min(n_out + q - 1); // the segment's last index never ends such a window
         let mut p = 0.0;
@@ -696,6 +743,7 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
     let n_win = validate(req)?;
     let (n_axes, n_m) = (req.columns.len(), req.ms.len());
     let mut out = vec![0.0f64; n_axes * n_m * n_win];
+    crate::oavar::advise_huge_pages(&mut out);
     match req.method {
         Method::Fast => {
             let mus: Vec<f64> = req
@@ -717,6 +765,44 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
                 // One window (the static estimator): every m from one double-word phase, all m per
                 // pass over the record (see `crate::oavar`).
                 overlapping_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
+                cancel.check()?;
+                return Ok((out, n_win));
+            }
+            // samples any window reads
+            let n_used = ((n_win - 1) * req.hop + req.window).min(req.columns[0].len());
+            if req.estimator == Estimator::Overlapping && n_used * n_axes <= GATHER_MAX {
+                // Every window from one double-word phase per axis (see `crate::oavar`): each term is
+                // three reads of it, instead of two running-sum passes over the record per m.
+                let n_m_win = n_m * n_win;
+                for (a, y) in req.columns.iter().enumerate() {
+                    if cancel.is_cancelled() {
+                        break;
+                    }
+                    let ph = crate::oavar::Phase::new(&y[..n_used], mus[a]);
+                    let (hi, lo) = ph.parts();
+                    if n_win >= 2 && req.hop >= crate::oavar::SMALL_HOP {
+                        crate::oavar::overlapping_dynamic_tiled(
+                            hi,
+                            lo,
+                            req.ms,
+                            req.window,
+                            req.hop,
+                            &mut out[a * n_m_win..(a + 1) * n_m_win],
+                            cancel,
+                        );
+                        continue;
+                    }
+                    out[a * n_m_win..(a + 1) * n_m_win]
+                        .par_chunks_mut(n_win)
+                        .enumerate()
+                        .for_each_init(crate::oavar::DynScratch::default, |sc, (t, dst)| {
+                            if !cancel.is_cancelled() {
+                                crate::oavar::overlapping_dynamic_row(
+                                    hi, lo, req.ms[t], req.window, req.hop, dst, sc,
+                                );
+                            }
+                        });
+                }
                 cancel.check()?;
                 return Ok((out, n_win));
             }
@@ -818,6 +904,63 @@ mod tests {
                 for j in 0..n_out {
                     assert_eq!(s[j], f[j..j + q].iter().sum::<f64>());
                 }
+            }
+        }
+    }
+
+    /// The one-segment-at-a-time form `sliding_sums` interleaves: the same additions in the same order.
+    fn sliding_sums_serial(f: &[f64], q: usize, out: &mut [f64]) {
+        let n_out = out.len();
+        let mut s0 = 0;
+        while s0 < n_out {
+            let end = (s0 + q).min(n_out + q - 1);
+            let mut s: f64 = f[n_out.min(end)..end].iter().rev().sum();
+            for j in (s0..end.min(n_out)).rev() {
+                s += f[j];
+                out[j] = s;
+            }
+            s0 += q;
+        }
+        let mut s0 = q;
+        while s0 < n_out + q - 1 {
+            let end = (s0 + q - 1).min(n_out + q - 1);
+            let mut p = 0.0;
+            for i in s0..end {
+                p += f[i];
+                out[i + 1 - q] += p;
+            }
+            s0 += q;
+        }
+    }
+
+    #[test]
+    fn interleaved_sliding_sums_are_bit_identical_to_serial() {
+        let f: Vec<f64> = (0..5000u64)
+            .map(|i| ((i.wrapping_mul(2654435761) % 1000) as f64 / 7.0).sqrt() * 1e-3)
+            .collect();
+        for q in [2, 3, 7, 64, 100, 333, 1000, 1249, 1250, 1251, 2500, 4999] {
+            for n_out in [
+                1,
+                2,
+                q - 1,
+                q,
+                q + 1,
+                4 * q - 1,
+                4 * q,
+                4 * q + 1,
+                9 * q + 5,
+                f.len() + 1 - q,
+            ] {
+                if n_out == 0 || n_out + q - 1 > f.len() {
+                    continue;
+                }
+                let (mut a, mut b) = (vec![0.0; n_out], vec![0.0; n_out]);
+                sliding_sums(&f, q, &mut a);
+                sliding_sums_serial(&f, q, &mut b);
+                assert!(
+                    a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                    "q {q} n_out {n_out}"
+                );
             }
         }
     }

@@ -121,6 +121,28 @@ pub(crate) fn phase_prefix(y: &[f64], mu: f64, hi: &mut [f64], lo: &mut [f64]) {
         .for_each(|((h, l), &(oh, ol))| add_offset_dispatch(h, l, oh, ol));
 }
 
+/// Advises the kernel to back the 2 MiB-aligned interior of `v` with 2 MiB pages (Linux; advice only,
+/// an error is ignored). For large fresh zeroed outputs: written once, they cost a page fault per 4 KiB
+/// otherwise — a third of a hop-1 DAVAR's time (75 MB of output at N = 10⁵, window 10⁴). Call it before
+/// the first write.
+pub(crate) fn advise_huge_pages(v: &mut [f64]) {
+    #[cfg(target_os = "linux")]
+    {
+        let addr = v.as_ptr() as usize;
+        let start = addr.next_multiple_of(HUGE);
+        let end = (addr + std::mem::size_of_val(v)) / HUGE * HUGE;
+        if end > start {
+            // SAFETY: [start, end) lies inside v's allocation and is 2 MiB aligned; MADV_HUGEPAGE
+            // changes no contents.
+            unsafe {
+                libc::madvise(start as *mut libc::c_void, end - start, libc::MADV_HUGEPAGE);
+            }
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = v;
+}
+
 /// A zeroed f64 buffer whose pages the kernel may back with 2 MiB pages: the phase of a long record
 /// is 16 bytes per sample, and faulting it in 4 KiB pages cost more than building it (~80 ms of
 /// ~100 ms at 10⁷ samples). The zeroed allocation is fresh memory (calloc maps it untouched), so the
@@ -330,6 +352,235 @@ pub(crate) fn overlapping_window(
             let l = (n + 1 - 2 * m) as f64;
             out[a * n_m + t] = s / (2.0 * (m as f64) * (m as f64) * l);
         }
+    }
+}
+
+/// Writes d_k² for k = k0 … k0 + out.len() − 1 at factor m from the phase (the terms of the hop-1
+/// path; the same operations per term as [`chunk_sum`]).
+#[inline(always)]
+fn terms_into(hi: &[f64], lo: &[f64], m: usize, k0: usize, out: &mut [f64]) {
+    let len = out.len();
+    let h0 = &hi[k0..k0 + len];
+    let h1 = &hi[k0 + m..k0 + m + len];
+    let h2 = &hi[k0 + 2 * m..k0 + 2 * m + len];
+    let l0 = &lo[k0..k0 + len];
+    let l1 = &lo[k0 + m..k0 + m + len];
+    let l2 = &lo[k0 + 2 * m..k0 + 2 * m + len];
+    for (i, o) in out.iter_mut().enumerate() {
+        let dh = (h2[i] - h1[i]) - (h1[i] - h0[i]);
+        let dl = (l2[i] - l1[i]) - (l1[i] - l0[i]);
+        let d = dh + dl;
+        *o = d * d;
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn terms_into_avx2(hi: &[f64], lo: &[f64], m: usize, k0: usize, out: &mut [f64]) {
+    terms_into(hi, lo, m, k0, out)
+}
+
+/// Scratch of one worker of [`overlapping_dynamic`].
+#[derive(Default)]
+pub(crate) struct DynScratch {
+    terms: Vec<f64>,
+    full: Vec<f64>,
+    part: Vec<f64>,
+}
+
+/// Hops below this keep every term and cut blocks afterwards; longer hops sum each block directly.
+pub(crate) const SMALL_HOP: usize = 64;
+
+/// Overlapping Allan variance of every window `y[j·hop .. j·hop + window)`, j < out.len(), at factor m,
+/// from the record's phase (hi, lo): the terms of window j are k = j·hop … j·hop + L − 1, L = window +
+/// 1 − 2m. Each block of `hop` terms is summed once (first its r = L mod hop terms, then the rest), and
+/// every window is the Van Herk sliding sum of q = ⌊L/hop⌋ whole blocks plus the next block's first r
+/// terms — sums of non-negative values over the window's own terms only. Every d_k comes from the
+/// phase as in [`overlapping_window`], so its rounding is local to its block sums.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn overlapping_dynamic_row(
+    hi: &[f64],
+    lo: &[f64],
+    m: usize,
+    window: usize,
+    hop: usize,
+    out: &mut [f64],
+    sc: &mut DynScratch,
+) {
+    #[cfg(target_arch = "x86_64")]
+    let avx2 = std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    let avx2 = false;
+    let n_win = out.len();
+    let l = window + 1 - 2 * m;
+    let hop = if n_win == 1 { l } else { hop };
+    let (q, r) = (l / hop, l % hop);
+    let k_end = (n_win - 1) * hop + l;
+    let nblocks = n_win + q;
+    let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
+    let DynScratch { terms, full, part } = sc;
+    full.clear();
+    full.resize(nblocks, 0.0);
+    part.clear();
+    part.resize(nblocks, 0.0);
+    if hop < SMALL_HOP {
+        terms.clear();
+        terms.resize(k_end, 0.0);
+        #[cfg(target_arch = "x86_64")]
+        if avx2 {
+            // SAFETY: the CPU has AVX2 (checked above).
+            unsafe { terms_into_avx2(hi, lo, m, 0, terms) };
+        } else {
+            terms_into(hi, lo, m, 0, terms);
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        terms_into(hi, lo, m, 0, terms);
+        for t in terms.iter_mut() {
+            *t *= norm;
+        }
+        if hop == 1 {
+            std::mem::swap(terms, full);
+        } else {
+            for (b, blk) in terms.chunks(hop).enumerate() {
+                full[b] = crate::allan::sum4(blk);
+                part[b] = crate::allan::sum4(&blk[..r.min(blk.len())]);
+            }
+        }
+    } else {
+        for b in 0..nblocks {
+            let k0 = b * hop;
+            if k0 >= k_end {
+                break;
+            }
+            let len = hop.min(k_end - k0);
+            let rr = r.min(len);
+            let p = chunk_sum_dispatch(avx2, hi, lo, m, k0, rr);
+            let rest = chunk_sum_dispatch(avx2, hi, lo, m, k0 + rr, len - rr);
+            part[b] = p * norm;
+            full[b] = (p + rest) * norm;
+        }
+    }
+    if q == 0 {
+        out.copy_from_slice(&part[..n_win]);
+    } else {
+        crate::allan::sliding_sums(full, q, out);
+        if r != 0 {
+            for (o, p) in out.iter_mut().zip(&part[q..]) {
+                *o += p;
+            }
+        }
+    }
+}
+
+/// [`overlapping_dynamic_row`] for every m of `ms` at once, for hops ≥ `SMALL_HOP`: the block sums
+/// (part: a block's first r_m terms, full: all its terms) are formed tile by tile — a tile is a run of
+/// whole blocks, ≈ `CHUNK` terms or one block — and within a tile every m with m ≤ `SHORT_M` reads
+/// the tile's phase from cache (the three reads at k, k + m, k + 2m land in the same few lines for
+/// every such m), as [`super_chunk`] does for the static estimator. Tiles run in parallel; each
+/// (m, block) sum is one sequential routine, so the bits do not depend on the thread count. Writes
+/// `out` laid out [m][window] (n_win = out.len() / ms.len()).
+pub(crate) fn overlapping_dynamic_tiled(
+    hi: &[f64],
+    lo: &[f64],
+    ms: &[usize],
+    window: usize,
+    hop: usize,
+    out: &mut [f64],
+    cancel: &Cancel,
+) {
+    #[cfg(target_arch = "x86_64")]
+    let avx2 = std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    let avx2 = false;
+    let n_m = ms.len();
+    let n_win = out.len() / n_m;
+    debug_assert!(n_win >= 2 && hop >= SMALL_HOP);
+    let geo: Vec<(usize, usize, usize, usize)> = ms
+        .iter()
+        .map(|&m| {
+            let l = window + 1 - 2 * m;
+            (l / hop, l % hop, (n_win - 1) * hop + l, m) // (q, r, k_end, m)
+        })
+        .collect();
+    let nblocks = geo.iter().map(|g| n_win + g.0).max().unwrap_or(0);
+    let tile_blocks = (CHUNK / hop).max(1);
+    let n_tiles = nblocks.div_ceil(tile_blocks);
+    // [tile][m][block in tile] → (part, full)
+    let mut sums = vec![(0.0f64, 0.0f64); n_tiles * n_m * tile_blocks];
+    sums.par_chunks_mut(n_m * tile_blocks)
+        .enumerate()
+        .for_each(|(tile, dst)| {
+            if cancel.is_cancelled() {
+                return;
+            }
+            let one = |t: usize, bi: usize| -> (f64, f64) {
+                let (_q, r, k_end, m) = geo[t];
+                let k0 = (tile * tile_blocks + bi) * hop;
+                if k0 >= k_end {
+                    return (0.0, 0.0);
+                }
+                let len = hop.min(k_end - k0);
+                let rr = r.min(len);
+                let p = chunk_sum_dispatch(avx2, hi, lo, m, k0, rr);
+                let rest = chunk_sum_dispatch(avx2, hi, lo, m, k0 + rr, len - rr);
+                (p, p + rest)
+            };
+            // short m block by block (the tile's phase in cache for all of them), long m m by m
+            for bi in 0..tile_blocks {
+                for t in (0..n_m).filter(|&t| ms[t] <= SHORT_M) {
+                    dst[t * tile_blocks + bi] = one(t, bi);
+                }
+            }
+            for t in (0..n_m).filter(|&t| ms[t] > SHORT_M) {
+                for bi in 0..tile_blocks {
+                    dst[t * tile_blocks + bi] = one(t, bi);
+                }
+            }
+        });
+    if cancel.is_cancelled() {
+        return;
+    }
+    out.par_chunks_mut(n_win).enumerate().for_each(|(t, row)| {
+        let (q, r, _k_end, m) = geo[t];
+        let l = window + 1 - 2 * m;
+        let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
+        let nb = n_win + q;
+        let block = |b: usize| sums[((b / tile_blocks) * n_m + t) * tile_blocks + b % tile_blocks];
+        let part: Vec<f64> = (0..nb).map(|b| block(b).0 * norm).collect();
+        let full: Vec<f64> = (0..nb).map(|b| block(b).1 * norm).collect();
+        if q == 0 {
+            row.copy_from_slice(&part[..n_win]);
+        } else {
+            crate::allan::sliding_sums(&full, q, row);
+            if r != 0 {
+                for (o, p) in row.iter_mut().zip(&part[q..]) {
+                    *o += p;
+                }
+            }
+        }
+    });
+}
+
+/// The phase of one axis for [`overlapping_dynamic_row`]: (hi, lo) of its first `n` samples.
+pub(crate) struct Phase {
+    hi: PhaseBuf,
+    lo: PhaseBuf,
+}
+
+impl Phase {
+    pub(crate) fn new(y: &[f64], mu: f64) -> Self {
+        let n = y.len();
+        let mut hi = PhaseBuf::new(n + 1);
+        let mut lo = PhaseBuf::new(n + 1);
+        phase_prefix(y, mu, hi.slice(), lo.slice());
+        Phase { hi, lo }
+    }
+
+    pub(crate) fn parts(&self) -> (&[f64], &[f64]) {
+        (
+            &self.hi.v[self.hi.off..self.hi.off + self.hi.len],
+            &self.lo.v[self.lo.off..self.lo.off + self.lo.len],
+        )
     }
 }
 
