@@ -355,10 +355,10 @@ pub(crate) fn overlapping_window(
     }
 }
 
-/// Writes d_k² for k = k0 … k0 + out.len() − 1 at factor m from the phase (the terms of the hop-1
-/// path; the same operations per term as [`chunk_sum`]).
+/// Writes d_k²·scale for k = k0 … k0 + out.len() − 1 at factor m from the phase (the terms of the
+/// short-hop path; d formed with the same operations as in [`chunk_sum`]).
 #[inline(always)]
-fn terms_into(hi: &[f64], lo: &[f64], m: usize, k0: usize, out: &mut [f64]) {
+fn terms_into(hi: &[f64], lo: &[f64], m: usize, k0: usize, scale: f64, out: &mut [f64]) {
     let len = out.len();
     let h0 = &hi[k0..k0 + len];
     let h1 = &hi[k0 + m..k0 + m + len];
@@ -370,14 +370,21 @@ fn terms_into(hi: &[f64], lo: &[f64], m: usize, k0: usize, out: &mut [f64]) {
         let dh = (h2[i] - h1[i]) - (h1[i] - h0[i]);
         let dl = (l2[i] - l1[i]) - (l1[i] - l0[i]);
         let d = dh + dl;
-        *o = d * d;
+        *o = d * d * scale;
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn terms_into_avx2(hi: &[f64], lo: &[f64], m: usize, k0: usize, out: &mut [f64]) {
-    terms_into(hi, lo, m, k0, out)
+unsafe fn terms_into_avx2(
+    hi: &[f64],
+    lo: &[f64],
+    m: usize,
+    k0: usize,
+    scale: f64,
+    out: &mut [f64],
+) {
+    terms_into(hi, lo, m, k0, scale, out)
 }
 
 /// Scratch of one worker of [`overlapping_dynamic`].
@@ -419,34 +426,36 @@ pub(crate) fn overlapping_dynamic_row(
     let nblocks = n_win + q;
     let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
     let DynScratch { terms, full, part } = sc;
-    full.clear();
-    full.resize(nblocks, 0.0);
-    part.clear();
-    part.resize(nblocks, 0.0);
     if hop < SMALL_HOP {
         terms.clear();
         terms.resize(k_end, 0.0);
         #[cfg(target_arch = "x86_64")]
         if avx2 {
             // SAFETY: the CPU has AVX2 (checked above).
-            unsafe { terms_into_avx2(hi, lo, m, 0, terms) };
+            unsafe { terms_into_avx2(hi, lo, m, 0, norm, terms) };
         } else {
-            terms_into(hi, lo, m, 0, terms);
+            terms_into(hi, lo, m, 0, norm, terms);
         }
         #[cfg(not(target_arch = "x86_64"))]
-        terms_into(hi, lo, m, 0, terms);
-        for t in terms.iter_mut() {
-            *t *= norm;
-        }
+        terms_into(hi, lo, m, 0, norm, terms);
         if hop == 1 {
+            // the terms are the one-term blocks (k_end = n_win + q − 1 of them: all sliding_sums reads)
             std::mem::swap(terms, full);
         } else {
+            full.clear();
+            full.resize(nblocks, 0.0);
+            part.clear();
+            part.resize(nblocks, 0.0);
             for (b, blk) in terms.chunks(hop).enumerate() {
                 full[b] = crate::allan::sum4(blk);
                 part[b] = crate::allan::sum4(&blk[..r.min(blk.len())]);
             }
         }
     } else {
+        full.clear();
+        full.resize(nblocks, 0.0);
+        part.clear();
+        part.resize(nblocks, 0.0);
         for b in 0..nblocks {
             let k0 = b * hop;
             if k0 >= k_end {
