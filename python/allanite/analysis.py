@@ -111,12 +111,16 @@ def avar(
         A grid name (``"octave"``, default; ``"decade"``, ``"all"``, ``"exp"`` — see
         :func:`allanite.tau_grid`) or τ in seconds, each rounded to m = round(τ·fs) and required to be
         valid; ``result.tau`` holds the τ actually used.
-    estimator : {"oavar", "avar", "theo1", "theobr", "theoh"}
-        Overlapping (default; NIST SP 1065 eq. 11) or classic non-overlapping Allan variance;
-        Theo1 (even m ≥ 10, τ = 0.75·m/fs, up to 75 % of the record), bias-removed TheoBR, or
-        TheoH (overlapping Allan up to 10 % of the record, TheoBR beyond) — see
-        :mod:`allanite.estimators.theo`. For these, named grids span m = 1 … M, ``result.source`` says which
-        estimator each τ came from and ``result.kf`` holds the bias ratio.
+    estimator : str
+        ``"oavar"`` (default; NIST SP 1065 eq. 11) or ``"avar"``: overlapping or classic non-overlapping
+        Allan variance. ``"theo1"`` (even m ≥ 10, τ = 0.75·m/fs, up to 75 % of the record), bias-removed
+        ``"theobr"``, or ``"theoh"`` (overlapping Allan up to 10 % of the record, TheoBR beyond) — see
+        :mod:`allanite.estimators.theo`; for these, named grids span m = 1 … M, ``result.source`` says which
+        estimator each τ came from and ``result.kf`` holds the bias ratio. The rest of the deviation family
+        (docs/deviations.md: which to use when): ``"mvar"`` modified, ``"tvar"`` time (τ²/3·MVAR),
+        ``"hvar"``/``"ohvar"`` Hadamard (classic/overlapping; blind to a rate ramp), ``"totvar"``,
+        ``"mtotvar"``, ``"ttotvar"``, ``"htotvar"`` total variances (definitions' values, no bias
+        correction), ``"mtie"`` and ``"tierms"`` (of the angle; ``result.adev`` holds them).
     workers : int, optional
         Threads (default: ``ALLANITE_NUM_THREADS``, else all cores). Results do not depend on it.
     kf_rule : {"textbook", "stable32"}
