@@ -700,3 +700,16 @@ def test_every_hop_regime_matches_the_reference(rng, hop):
         s = j * hop
         ref = _reference.davar_reference(y[s : s + window], 1.0, window, window, ms, dtype=np.longdouble)[:, 0]
         assert max_rel(d.avar[:, j], ref) <= 1e-10, (hop, j)
+
+
+def test_short_hop_long_m_streams_and_matches_the_reference(rng):
+    """Short hops take m ≤ 8 192 from the phase and longer m from the streaming block sums: both kinds
+    of row in one call, against the plain recomputation."""
+    y = rng.normal(size=24_000) + 1e3
+    window = 20_000
+    ms = np.array([3, 8_192, 8_193, 9_999])
+    d = allanite.davar(y, 1.0, window=window, hop=7, taus=ms.astype(float))
+    for j in (0, d.t.size // 2, d.t.size - 1):
+        s = j * 7
+        ref = _reference.davar_reference(y[s : s + window], 1.0, window, window, ms, dtype=np.longdouble)[:, 0]
+        assert max_rel(d.avar[:, j], ref) <= 1e-10, j

@@ -157,6 +157,14 @@ const HUGE: usize = 2 << 20;
 
 impl PhaseBuf {
     fn new(len: usize) -> Self {
+        if len * 8 < HUGE {
+            // a small phase: no 2 MiB padding, no advice (their syscalls would cost more than the faults)
+            return PhaseBuf {
+                v: vec![0.0f64; len],
+                off: 0,
+                len,
+            };
+        }
         let v = vec![0.0f64; len + HUGE / 8];
         let addr = v.as_ptr() as usize;
         let off = (addr.next_multiple_of(HUGE) - addr) / 8;
