@@ -121,7 +121,11 @@ def write(r: dict, machine: dict) -> None:
         f"Cost per gathered cluster sum (all axes, all τ): {r['ns_per_cluster_sum']:.2f} ns. About 0.1 s of the "
         "allanite time is fixed per call (compensated mean, finite check and the 16 B/sample/axis prefix); the rest "
         "is strided reads of the prefix, latency-bound at long strides. The target (≥ 2× the gather) is at the "
-        "edge on this 2-core machine: the ratio moved between 1.96× and 2.07× across four runs on 2026-11-24. The gather's 2e-9 difference is its plain prefix losing digits on the axes with an offset.",
+        f"edge on this 2-core machine: {r['ratio_vs_gather']:.2f}× in this run (load average "
+        f"{r['loadavg_start_end'][0]:.2f} → {r['loadavg_start_end'][1]:.2f}; both sides are memory-latency-bound "
+        "and the prefix pass is serial, so another job's load moves the ratio), 1.96–2.07× in four runs on a quiet "
+        "machine on 2026-11-24. The gather's 2e-9 difference is its plain prefix losing digits on the axes with an "
+        "offset.",
         "",
     ]
     path = _common.HERE / "results" / "classic.md"
