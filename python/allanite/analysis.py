@@ -330,7 +330,9 @@ def davar(
     -------
     DynamicAllanResult
         ``tau``, ``t`` (window centres, s), ``avar`` of shape (tau, t) — or (axes, tau, t) for 2-D
-        input —, ``adev``, ``n`` (terms per window at each τ).
+        input —, ``adev``, ``n`` (terms per window at each τ). A window whose samples are all equal
+        (a sensor not yet streaming) has Allan variance 0; the result there may be its rounding residue,
+        ~ε²·(value − record mean)² — some 1e-38 of the record's values — rather than an exact 0.
 
     Examples
     --------

@@ -116,7 +116,9 @@ def plot_davar(result, ax=None, axis: int = 0, unit: str | None = None, cmap: st
 
     ax = _axes(ax)
     adev = result.adev if result.avar.ndim == 2 else np.sqrt(result.avar[axis])
-    positive = adev[adev > 0]
+    # colour range over the resolved values: a flat window's rounding residue (~1e-19 of the largest ADEV,
+    # where the definition gives 0) would stretch the scale over 19 decades
+    positive = adev[adev > 1e-12 * np.nanmax(adev)] if np.any(adev > 0) else adev[adev > 0]
     norm = LogNorm(vmin=positive.min(), vmax=positive.max()) if positive.size else None
     mesh = ax.pcolormesh(result.t, result.tau, adev, shading="nearest", norm=norm, cmap=cmap, **kwargs)
     ax.set_yscale("log")

@@ -929,6 +929,11 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
     )
 
 
+#: A dynamic result's window is flat when every Allan variance in it is at most this share of the result's
+#: largest (its rounding residue is ~1e-38 of it; a real noise level 10⁶ lower in amplitude is 1e-12).
+FLAT_FLOOR = 1e-24
+
+
 def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range):
     rows = [result.avar] if result.avar.ndim == 2 else list(result.avar)
     series = []
@@ -938,6 +943,11 @@ def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range)
         tau, m = result.tau[idx], result.m[idx].astype(np.float64)
         cache = {}
         n_t = rows_avar.shape[1]
+        # a window whose samples are all equal (a sensor not yet streaming) has Allan variance 0; the core
+        # returns its rounding residue, ~ε²·offset² (≈ 1e-38 of the record's largest value), not always an
+        # exact 0: such a window is flat, not a fit
+        finite = rows_avar[np.isfinite(rows_avar)]
+        flat_floor = FLAT_FLOOR * (float(finite.max()) if finite.size else 0.0)
         vals = {t: np.empty(n_t) for t in terms}
         lo = {t: np.empty(n_t) for t in terms}
         hi = {t: np.empty(n_t) for t in terms}
@@ -946,7 +956,7 @@ def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range)
             y = rows_avar[idx, j]
             if not np.all(np.isfinite(y)):
                 raise ParameterError(f"the dynamic result has a non-finite Allan variance in window {j}")
-            if np.all(y == 0):
+            if np.all(y <= flat_floor):
                 for t in terms:
                     vals[t][j] = lo[t][j] = hi[t][j] = 0.0
                 chi[j] = 0.0
