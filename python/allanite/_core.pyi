@@ -16,6 +16,27 @@ def davar(
 ) -> npt.NDArray[np.float64]:
     """Allan variance of every window at every m for every axis: shape (axes, len(ms), windows)."""
 
+def davar_part(
+    columns: Sequence[npt.NDArray[np.float64]],
+    window: int,
+    hop: int,
+    ms: Sequence[int],
+    estimator: str,
+    method: str,
+    workers: int,
+    mus: Sequence[float],
+    first_window: int,
+    n_windows: int,
+) -> npt.NDArray[np.float64]:
+    """davar of windows first_window.. of a record of n_windows windows, from its samples from
+    first_window·hop on, centred on the record's means: bit for bit the whole-record values."""
+
+def compensated_sums(
+    columns: Sequence[npt.NDArray[np.float64]],
+    state: Sequence[tuple[float, float]],
+) -> list[tuple[float, float]]:
+    """Neumaier's compensated sum of each column continued from state[(sum, compensation) per axis]."""
+
 def davar_hann(
     columns: Sequence[npt.NDArray[np.float64]],
     window: int,

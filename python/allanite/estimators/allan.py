@@ -18,7 +18,7 @@ from ._registry import Computed, Estimator, register
 from .confidence import edf_greenhall
 from .grid import resolve_taus
 
-__all__ = ["n_terms", "allan_values"]
+__all__ = ["n_terms", "allan_values", "part_values", "compensated_sums"]
 
 
 def n_terms(estimator: str, window: int, ms: np.ndarray) -> np.ndarray:
@@ -33,6 +33,46 @@ def allan_values(cols, window: int, hop: int, ms, estimator: str, method: str, t
     """The core's Allan variance of every window: (axes, len(ms), windows). ``threads``: as resolved by
     :func:`allanite._validate.resolve_workers` (0 = rayon's default)."""
     return _core.davar(cols, window, hop, [int(m) for m in ms], estimator, method, threads)
+
+
+def part_values(
+    cols,
+    window: int,
+    hop: int,
+    ms,
+    estimator: str,
+    method: str,
+    threads: int,
+    *,
+    mus,
+    first_window: int,
+    n_windows: int,
+) -> np.ndarray:
+    """:func:`allan_values` of windows ``first_window ..`` of a record of ``n_windows`` windows, from a part
+    of it: ``cols`` hold the record's samples from ``first_window·hop`` on, ``mus`` the record's centring
+    values (:func:`compensated_sums` over its parts, in order, divided by its length). Bit for bit the
+    whole-record values: the core forms the same terms, block and window sums in the same order
+    (``dynamic_avar_part_cancellable`` in rust/core/src/allan.rs). Internal: for :mod:`allanite.dask`."""
+    return _core.davar_part(
+        cols,
+        window,
+        hop,
+        [int(m) for m in ms],
+        estimator,
+        method,
+        threads,
+        [float(m) for m in mus],
+        int(first_window),
+        int(n_windows),
+    )
+
+
+def compensated_sums(cols, state) -> list[tuple[float, float]]:
+    """The core's compensated (Neumaier) sum of each column, continued from ``state`` — (sum,
+    compensation) per axis, (0, 0) at the record's start. Fed a record's parts in order, the final
+    (s + c)/n is the centring value the core gives the whole record, bit for bit. Internal: for
+    :mod:`allanite.dask`."""
+    return _core.compensated_sums(cols, [(float(s), float(c)) for s, c in state])
 
 
 def _static(cols, fs, taus, workers, *, estimator: str) -> Computed:

@@ -13,8 +13,9 @@ pub mod taper;
 pub mod theo;
 
 pub use allan::{
-    compensated_mean, dynamic_avar, dynamic_avar_cancellable, max_m, n_terms, n_windows,
-    run_in_pool, static_avar, Estimator, Method, Request,
+    compensated_mean, compensated_sum_from, dynamic_avar, dynamic_avar_cancellable,
+    dynamic_avar_part_cancellable, max_m, n_terms, n_windows, run_in_pool, static_avar, Estimator,
+    Method, Request,
 };
 pub use cancel::{run_in_pool_interruptible, Cancel};
 pub use error::{CoreError, Result};

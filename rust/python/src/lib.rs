@@ -8,6 +8,7 @@
 //! `run_interruptible(py, workers, |cancel| kernel_cancellable(..., cancel))`.
 
 use allanite_core::dynamic_hann_cancellable;
+use allanite_core::{compensated_sum_from, dynamic_avar_part_cancellable};
 use allanite_core::{
     deviations, dynamic_avar_cancellable, dynamic_theo1_cancellable, run_in_pool_interruptible,
     static_theo1_cancellable, Cancel, CoreError, Estimator, Method, Request,
@@ -130,6 +131,76 @@ fn davar<'py>(
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
+}
+
+/// [`davar`] of the windows `first_window ..` of a record of `n_windows` windows, from a part of it
+/// (`columns`: the record's samples from `first_window · hop` on) centred on the record's means
+/// `mus`: bit for bit the whole-record values (allanite-core `dynamic_avar_part_cancellable`). For
+/// allanite.dask, whose blocks hold parts of a record.
+#[pyfunction]
+#[pyo3(signature = (columns, window, hop, ms, estimator, method, workers, mus, first_window, n_windows))]
+#[allow(clippy::too_many_arguments)]
+fn davar_part<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    window: usize,
+    hop: usize,
+    ms: Vec<usize>,
+    estimator: &str,
+    method: &str,
+    workers: usize,
+    mus: Vec<f64>,
+    first_window: usize,
+    n_windows: usize,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let estimator = parse_estimator(py, estimator)?;
+    let method = parse_method(py, method)?;
+    let slices = contiguous(py, &columns)?;
+    let req = Request {
+        columns: &slices,
+        window,
+        hop,
+        ms: &ms,
+        estimator,
+        method,
+    };
+    let (values, n_win) = run_interruptible(py, workers, |cancel| {
+        dynamic_avar_part_cancellable(&req, &mus, first_window, n_windows, cancel)
+    })?;
+    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// Neumaier's compensated sum of each column continued from `state` ((sum, compensation) per axis):
+/// the new state per axis. Fed a record's parts in order, it ends at the state whose (s + c) / n is
+/// the core's centring value of the whole record, bit for bit (allanite-core `compensated_sum_from`).
+#[pyfunction]
+#[pyo3(signature = (columns, state))]
+fn compensated_sums(
+    py: Python<'_>,
+    columns: Vec<PyReadonlyArray1<'_, f64>>,
+    state: Vec<(f64, f64)>,
+) -> PyResult<Vec<(f64, f64)>> {
+    let slices = contiguous(py, &columns)?;
+    if state.len() != slices.len() {
+        return Err(allanite_error_of(
+            py,
+            "ParameterError",
+            format!(
+                "{} states given for {} axes: one (sum, compensation) per axis is needed",
+                state.len(),
+                slices.len()
+            ),
+        ));
+    }
+    Ok(py.detach(|| {
+        slices
+            .iter()
+            .zip(state)
+            .map(|(c, st)| compensated_sum_from(c, st))
+            .collect()
+    }))
 }
 
 /// Hann-weighted overlapping Allan variance of every window at every averaging factor, for every
@@ -453,6 +524,8 @@ fn tierms_phase<'py>(
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
     m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
+    m.add_function(wrap_pyfunction!(davar_part, m)?)?;
+    m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_static, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_dynamic, m)?)?;
     m.add_function(wrap_pyfunction!(deviation_static, m)?)?;
