@@ -5,13 +5,13 @@ Both functions give the numbers of the single-machine calls (:func:`allanite.ava
 
 * :func:`davar` rechunks the samples to chunks whose length is a multiple of the hop, appends the
   next ``window − 1`` samples to every chunk (``map_overlap`` with ``depth={0: (0, window − 1)}``,
-  ``boundary="none"``, ``trim=False``) and calls :func:`allanite.davar` — the registry's Rust kernel,
-  the same code path as on one machine — on every block. A window is computed from its own samples
-  only, but the core centres each call's record on that record's own mean and aligns its block sums
-  to the record's start, so a block rounds differently from the whole record: equal to rounding
-  (≲ 1e-15 relative when |mean| ≲ 100 σ; ≈ ε·|mean|/σ·√m otherwise, 5e-11 at |mean| = 7000 σ), and
-  bitwise only when one block is the whole record. Bitwise everywhere would need a core entry taking
-  the record's mean and the block's offset.
+  ``boundary="none"``, ``trim=False``) and hands every block to the Rust core as a *part of the record*
+  (``dynamic_avar_part_cancellable``): with the record's centring value and the block's first window,
+  the core forms the same terms, block sums and window sums in the same order as for the whole
+  record, so the result is :func:`allanite.davar`'s **bit for bit**. The centring value is the core's
+  compensated (Neumaier) sum, which is sequential: a first pass runs it over the chunks in order (a
+  chain of small tasks, :data:`CENTRE_BATCH` chunks per compute), continuing each chunk from the state
+  the previous one left.
 * :func:`avar` cannot do that: the overlap would be 2m samples, a whole record at the longest τ. It works
   on the angle instead. Every rate sample y is split exactly into a whole number of quanta
   q = 2^(E − 26) (2^E > max|y|) and a remainder |r| ≤ q/2: the cumulative sum of the quanta is an
@@ -30,8 +30,9 @@ import math
 import numpy as np
 
 from .. import analysis, estimators
+from .._validate import check_choice, resolve_workers
 from ..errors import InputError, MissingDependencyError, ParameterError
-from ..estimators.allan import n_terms
+from ..estimators.allan import compensated_sums, n_terms, part_values
 from ..estimators.grid import resolve_taus
 from ..results import AllanResult, DynamicAllanResult
 
@@ -41,7 +42,7 @@ try:
 except ImportError as exc:  # pragma: no cover - exercised only without the extra
     raise MissingDependencyError("allanite.dask needs dask and distributed: pip install 'allanite[dask]'") from exc
 
-__all__ = ["davar", "avar", "davar_chunks", "DEFAULT_CHUNK"]
+__all__ = ["davar", "avar", "davar_chunks", "scale_exponent", "DEFAULT_CHUNK", "CENTRE_BATCH"]
 
 #: Samples per chunk when the caller's chunks are rechunked (2^22 float64 = 32 MiB per axis).
 DEFAULT_CHUNK = 1 << 22
@@ -105,20 +106,104 @@ def davar_chunks(n: int, window: int, hop: int, target: int) -> tuple[tuple[int,
     return tuple(chunks), tuple(counts)
 
 
-def _davar_block(block, *, fs, window, hop, taus, method, estimator, input, n_tau, n_out, block_info=None):
-    """One block: the single-machine :func:`allanite.davar` on the chunk and its overlap, laid out
-    (windows, axes·τ) so the windows run along the samples' dimension."""
+#: Chunks whose compensated sums one ``dask.compute`` chains (the centring pass is sequential: the
+#: record's mean is the core's Neumaier sum run over the chunks in order). Bounds what the pass holds.
+CENTRE_BATCH = 4
+
+
+def scale_exponent(peak: float) -> int:
+    """The power of two the single-machine call scales a column by (``allanite.analysis``: samples whose
+    largest magnitude lies outside (2^-SAFE_EXP, 2^SAFE_EXP) are scaled into it, exactly)."""
+    if peak == 0.0 or 2.0**-analysis.SAFE_EXP < peak < 2.0**analysis.SAFE_EXP:
+        return 0
+    return math.frexp(peak)[1]
+
+
+def _columns(block, fs: float, input: str, exps) -> list[np.ndarray]:
+    """The core's columns of a block: rate, scaled by 2^-e per axis as the single-machine call scales them."""
+    y = _rate(block, fs, input)
+    return [np.ascontiguousarray(np.ldexp(y[:, a], -e) if e else y[:, a]) for a, e in enumerate(exps)]
+
+
+def _centre_step(acc, block, start: int, fs: float, input: str, exps):
+    """One chunk of the centring pass: the compensated sums continued over the chunk (in order), the
+    largest |sample| per axis, and the first non-finite sample (record index, axis) if any."""
+    state, peak, bad = acc
+    if bad is not None:
+        return acc
+    y = _rate(block, fs, input)
+    finite = np.isfinite(y)
+    if not finite.all():
+        i, a = np.unravel_index(int(np.argmin(finite)), y.shape)
+        return state, peak, (start + int(i), int(a), float(y[i, a]))
+    state = compensated_sums(_columns(block, fs, input, exps), state)
+    if y.shape[0]:
+        peak = np.maximum(peak, np.max(np.abs(y), axis=0))
+    return state, peak, None
+
+
+def _centre(blocks, bounds, n_axes: int, fs: float, input: str, exps):
+    """The compensated sums of the whole record, chunk after chunk, in batches of CENTRE_BATCH chunks."""
+    acc = ([(0.0, 0.0)] * n_axes, np.zeros(n_axes), None)
+    for k0 in range(0, len(blocks), CENTRE_BATCH):
+        step = acc
+        for k in range(k0, min(len(blocks), k0 + CENTRE_BATCH)):
+            step = dask.delayed(_centre_step)(step, blocks[k], int(bounds[k]), fs, input, exps)
+        (acc,) = dask.compute(step)
+        if acc[2] is not None:
+            break
+    return acc
+
+
+def _davar_block(
+    block,
+    *,
+    fs,
+    window,
+    hop,
+    ms,
+    method,
+    estimator,
+    input,
+    n_out,
+    first,
+    n_windows,
+    mus,
+    exps,
+    power,
+    threads,
+    block_info=None,
+):
+    """One block: the windows that start in chunk k, from the chunk and its overlap, laid out
+    (windows, axes·τ) so the windows run along the samples' dimension. The core computes them as parts
+    of the whole record (its centring values ``mus``, the block's first window ``first[k]`` of
+    ``n_windows``): bit for bit the single-machine :func:`allanite.davar`."""
     k = block_info[None]["chunk-location"][0] if block_info else 0
     count = n_out[k]
-    n_axes = block.shape[1] if block.ndim == 2 else 1
+    n_axes = len(exps)
+    n_tau = len(ms)
     if count == 0:
         return np.zeros((0, n_axes * n_tau), dtype=np.float64)
     # the block holds exactly the windows that start in chunk k (chunk lengths are multiples of hop)
     use = block[: (count - 1) * hop + window]
-    res = analysis.davar(use, fs, window=window, hop=hop, taus=taus, method=method, estimator=estimator, input=input)
-    vals = res.avar if res.avar.ndim == 3 else res.avar[None]  # (axes, τ, windows)
+    vals = part_values(
+        _columns(use, fs, input, exps),
+        window,
+        hop,
+        ms,
+        estimator,
+        method,
+        threads,
+        mus=mus,
+        first_window=first[k],
+        n_windows=n_windows,
+    )  # (axes, τ, windows)
     if vals.shape[2] != count:  # pragma: no cover - a wrong chunk plan would be a bug
         raise AssertionError(f"block {k}: {vals.shape[2]} windows, expected {count}")
+    # scaled back as the single-machine call does (exact: powers of two)
+    vals = np.stack([np.ldexp(v, power * e) if e else v for v, e in zip(vals, exps)])
+    if not np.all(np.isfinite(vals)):
+        raise InputError("the Allan variance of these samples exceeds float64's range: express them in a larger unit")
     return np.ascontiguousarray(vals.reshape(n_axes * n_tau, count).T)
 
 
@@ -135,13 +220,14 @@ def davar(
     chunk: int | None = None,
     compute: bool = True,
 ):
-    """Dynamic Allan variance of a dask array: :func:`allanite.davar`, block by block.
+    """Dynamic Allan variance of a dask array: :func:`allanite.davar`, block by block, bit for bit.
 
     Parameters
     ----------
     x : dask.array.Array or array_like, shape (samples,) or (samples, axes)
         Rate or increment samples (e.g. ``da.from_zarr``, ``da.from_array(np.load(p, mmap_mode="r"))``,
-        an HDF5 dataset); any chunks — they are rechunked along the samples (one chunk across the axes).
+        an HDF5 dataset); any chunks and any real dtype (float32 is widened exactly, as on one machine) —
+        they are rechunked along the samples (one chunk across the axes).
     fs, window, hop, taus, method, input
         As for :func:`allanite.davar`.
     estimator : {"oavar", "avar"}
@@ -150,14 +236,17 @@ def davar(
         (default: the caller's first chunk, at least :data:`DEFAULT_CHUNK`/4).
     compute : bool
         True (default): a :class:`~allanite.DynamicAllanResult`, as the single-machine one.
-        False: the lazy (axes, τ, windows) dask array of the Allan variance.
+        False: the lazy (axes, τ, windows) dask array of the Allan variance (the centring pass runs now).
 
     Notes
     -----
-    Equal to :func:`allanite.davar` to the core's rounding (see the module notes: the core centres each
-    block on the block's mean); bitwise when one block is the whole record. Memory per task: one chunk
-    plus ``window − 1`` samples plus its
-    output.
+    Equal to :func:`allanite.davar` bit for bit. Two passes over the record: the centring pass runs the
+    core's compensated sum over the chunks in order (a chain of tasks, :data:`CENTRE_BATCH` chunks per
+    ``dask.compute``; a second chain only when the samples need the power-of-two scaling of the
+    single-machine call, |sample| ≥ 2^200 or < 2^-200), which gives the record's centring value and
+    the first non-finite sample; then every block hands the core its part of the record with that
+    centring value and its first window, and the core forms the same terms and sums in the same order
+    as for the whole record. Memory per task: one chunk plus ``window − 1`` samples plus its output.
     """
     fs = _check(estimator, input, fs)
     arr = _as_dask(x)
@@ -169,6 +258,7 @@ def davar(
     window, hop = int(window), int(hop)
     if window > n:
         raise ParameterError(f"window ({window} samples) is longer than the record ({n} samples)")
+    check_choice(method, "method", analysis.METHODS)
     entry = estimators.get(estimator, "dynamic")
     assert entry.resolve_m is not None
     ms = entry.resolve_m(taus, window, fs)
@@ -177,8 +267,38 @@ def davar(
     target = chunk if chunk is not None else max(int(arr.chunks[0][0]), DEFAULT_CHUNK // 4)
     chunks, counts = davar_chunks(n, window, hop, int(target))
     arr = arr.rechunk({0: chunks, 1: -1} if arr.ndim == 2 else {0: chunks})
+    bounds = np.concatenate([[0], np.cumsum(chunks)]).astype(np.int64)
+    n_win = (n - window) // hop + 1
+    hop_core = min(hop, n)  # as the single-machine call: a hop beyond the record gives one window
+
+    # pass 1: the record's centring value (the core's compensated mean), chunk after chunk in order
+    blocks = arr.to_delayed().ravel().tolist()
+    exps = [0] * n_axes
+    state, peak, bad = _centre(blocks, bounds, n_axes, fs, input, exps)
+    if bad is not None:
+        i, a, v = bad
+        where = f"sample {i}" + (f" of axis {a}" if arr.ndim == 2 else "")
+        raise InputError(f"samples contain a non-finite value ({v}) at {where}; only finite numbers are allowed")
+    exps = [scale_exponent(float(p)) for p in peak]
+    if any(exps):  # the single-machine call centres the scaled columns: sum those
+        state, _peak, _bad = _centre(blocks, bounds, n_axes, fs, input, exps)
+    mus = [(s + c) / float(n) for s, c in state]
+
+    # pass 2: every block's windows, as parts of the record
     kwargs = dict(
-        fs=fs, window=window, hop=hop, taus=taus, method=method, estimator=estimator, input=input, n_tau=n_tau
+        fs=fs,
+        window=window,
+        hop=hop_core,
+        ms=[int(m) for m in ms],
+        method=method,
+        estimator=estimator,
+        input=input,
+        first=[int(b) // hop for b in bounds[:-1]],
+        n_windows=n_win,
+        mus=mus,
+        exps=exps,
+        power=entry.unit_power,
+        threads=resolve_workers(None),
     )
     out_chunks = (counts, (n_axes * n_tau,))
     if len(chunks) == 1:
@@ -203,7 +323,6 @@ def davar(
             new_axis=None if arr.ndim == 2 else [1],
             **kwargs,
         )
-    n_win = (n - window) // hop + 1
     values = out.T.reshape(n_axes, n_tau, n_win)
     if not compute:
         return values
