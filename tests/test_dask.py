@@ -166,6 +166,77 @@ def test_scale_exponent_is_the_single_machine_rule():
         assert adask.arrays.scale_exponent(peak) == e
 
 
+@pytest.mark.parametrize(
+    ("wavelet", "level", "trend", "chunk"),
+    [("db5", 5, "a5", 3_000), ("sym8", 6, "none", 2_000), ("haar", 7, "a5", 500), ("db5", 5, "none", 100_000)],
+)
+def test_wavelet_split_equals_single_machine(client, wavelet, level, trend, chunk):
+    # odd length, the caller's chunks off the 2^level grid, three axes (one at 7000 σ)
+    y = _biased(20_011)
+    x = da.from_array(y, chunks=(1_777, 3))
+    ref = allanite.wavelet_split(y, 100.0, wavelet=wavelet, level=level, trend=trend)
+    with client.as_current():
+        got = adask.wavelet_split(x, 100.0, wavelet=wavelet, level=level, trend=trend, chunk=chunk)
+    for part in ("trend", "low", "high"):
+        np.testing.assert_array_equal(getattr(got, part), getattr(ref, part))  # bit for bit
+    assert got.bands == ref.bands and (got.wavelet, got.level, got.fs) == (ref.wavelet, ref.level, ref.fs)
+    if chunk < y.shape[0] and wavelet != "haar":  # Haar's sums never leave an aligned block of 2^level
+        # the overlap is needed: with less than half of it the samples next to the block edges change
+        overlap = adask.arrays.wavelet_overlap(pywt_dec_len(wavelet), level)
+        half = (overlap // 2 >> level << level) - (1 << level)
+        short = _split_with_overlap(y, wavelet, level, trend, chunk, half)
+        assert not np.array_equal(short, np.concatenate([ref.trend, ref.low, ref.high], axis=1))
+
+
+def pywt_dec_len(wavelet):
+    import pywt
+
+    return pywt.Wavelet(wavelet).dec_len
+
+
+def _split_with_overlap(y, wavelet, level, trend, chunk, overlap):
+    """[trend | low | high] as allanite.dask forms them, with a given overlap (a shorter one fails)."""
+    chunks = adask.arrays.wavelet_chunks(y.shape[0], level, overlap, chunk)
+    out, start = [], 0
+    for c in chunks:
+        a, b = max(0, start - overlap), min(y.shape[0], start + c + overlap)
+        s = allanite.wavelet_split(y[a:b], 100.0, wavelet=wavelet, level=level, trend=trend)
+        keep = slice(start - a, start - a + c)
+        out.append(np.concatenate([s.trend[keep], s.low[keep], s.high[keep]], axis=1))
+        start += c
+    return np.concatenate(out)
+
+
+def test_wavelet_split_1d_lazy_float32_and_custom_bands(client):
+    y = _biased(9_001)[:, 1].astype(np.float32)
+    bands = {"trend": ("a4",), "low": ("d4",), "high": ("d3", "d2", "d1")}
+    ref = allanite.wavelet_split(y, 10.0, level=4, bands=bands)
+    with client.as_current():
+        lazy = adask.wavelet_split(da.from_array(y, chunks=1_000), 10.0, level=4, bands=bands, compute=False)
+        assert isinstance(lazy.high, da.Array) and lazy.high.shape == y.shape
+        parts = da.compute(lazy.trend, lazy.low, lazy.high)
+    for got, want in zip(parts, (ref.trend, ref.low, ref.high)):
+        np.testing.assert_array_equal(got, want)
+    assert lazy.bands == ref.bands
+
+
+def test_wavelet_split_refuses_what_it_cannot_chunk(client):
+    x = da.from_array(np.ones(1_000), chunks=100)
+    with pytest.raises(ParameterError, match="periodic"):
+        adask.wavelet_split(x, 1.0, trend="periodic")
+    with pytest.raises(ParameterError, match="unknown wavelet"):
+        adask.wavelet_split(x, 1.0, wavelet="morl")
+    with pytest.raises(ParameterError, match="too deep"):
+        adask.wavelet_split(x, 1.0, level=9)
+    with pytest.raises(ParameterError, match="partition"):
+        adask.wavelet_split(x, 1.0, bands={"low": ("d5",)})
+    y = np.ones(5_000)
+    y[4_321] = np.nan
+    with client.as_current(), pytest.raises(InputError, match="sample 4321"):
+        adask.wavelet_split(da.from_array(y, chunks=700), 1.0, level=3, chunk=700)
+    assert adask.arrays.wavelet_overlap(10, 5) == 320  # db5 at level 5: the issue's 320 samples
+
+
 def test_davar_chunk_plan_is_exact():
     for n, w, h, t in [(20_011, 5_000, 333, 4_000), (10, 10, 1, 3), (1_000_003, 10_000, 1_000, 65_536)]:
         chunks, counts = adask.arrays.davar_chunks(n, w, h, t)
