@@ -286,6 +286,7 @@ def _fleet(root, n_good=3, seed=1):
         with gzip.open(d / f"s{i}.csv.gz", "wt") as f:
             f.write("gx,gy\n")
             np.savetxt(f, y, fmt="%.8e", delimiter=",")
+    (root / "logs" / "b").mkdir(parents=True, exist_ok=True)
     (root / "logs" / "b" / "bad.csv.gz").write_bytes(b"not gzip at all")
     return str(root / "logs" / "**" / "*.csv.gz")
 
@@ -335,7 +336,7 @@ def test_batch_survives_a_killed_worker(tmp_path):
     out = tmp_path / "res"
     with (
         LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+            n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=":0"
         ) as cluster,
         Client(cluster, timeout="30s") as c,
     ):
@@ -359,6 +360,54 @@ def test_batch_survives_a_killed_worker(tmp_path):
     for rel in ("a/s0", "a/s1", "b/s2", "b/s3"):
         assert (out / rel / "summary.json").is_file()
     assert not list(out.rglob(".*tmp-*"))
+
+
+def test_cli_batch_on_a_given_scheduler(tmp_path):
+    """`allanite batch ... --scheduler ADDRESS` runs its reports on that cluster (not a LocalCluster of its own)."""
+    import csv
+    import json
+
+    pattern = _fleet(tmp_path, n_good=2, seed=4)  # logs/a/s0, logs/a/s1 and a malformed logs/b/bad
+    out = tmp_path / "res"
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=":0"
+        ) as cluster,
+        Client(cluster, timeout="30s") as c,
+    ):
+        cmd = [sys.executable, "-m", "allanite", "batch", pattern, "--fs", "100", "--unit", "deg/s", "--out", str(out)]
+        run = subprocess.run(
+            [*cmd, "--scheduler", cluster.scheduler_address], capture_output=True, text=True, timeout=300
+        )
+        # the reports ran as tasks of this scheduler, on its workers
+        prefixes = c.run_on_scheduler(lambda dask_scheduler: sorted(dask_scheduler.task_prefixes))
+        workers = c.run_on_scheduler(
+            lambda dask_scheduler: sorted(
+                ws.address for ws in dask_scheduler.workers.values() if ws.metrics.get("task_counts") is not None
+            )
+        )
+    assert run.returncode == 3, run.stderr  # 3: some files failed (the malformed one)
+    assert "3 files: 2 reported, 0 skipped (resume), 1 failed" in run.stdout
+    assert "bad.csv.gz" in run.stdout
+    assert "allanite-report" in prefixes and len(workers) == 2
+    for rel in ("a/s0", "a/s1"):
+        summary = json.loads((out / rel / "summary.json").read_text(encoding="utf-8"))
+        assert summary["record"]["axes"] == 2
+        assert (out / rel / "report.html").is_file()
+    assert not (out / "b" / "bad").exists()
+    rows = list(csv.DictReader((out / "fleet.csv").open(encoding="utf-8")))
+    assert [(Path(r["file"]).name, r["axis"], r["status"]) for r in rows] == [
+        ("s0.csv.gz", "gx", "ok"),
+        ("s0.csv.gz", "gy", "ok"),
+        ("s1.csv.gz", "gx", "ok"),
+        ("s1.csv.gz", "gy", "ok"),
+        ("bad.csv.gz", "", "error"),
+    ]
+    # white rate noise of σ = 1 °/s (s0) and 30 °/s (s1) at 100 Hz: N = σ/√fs = 0.1 and 3 °/√s = 6 and 180 °/√h
+    for r in rows[:4]:
+        want = 6.0 if r["file"].endswith("s0.csv.gz") else 180.0
+        assert r["N_unit"] == "°/√h" and float(r["N"]) == pytest.approx(want, rel=0.1)
+    assert (out / "fleet.parquet").is_file() and (out / "fleet.html").is_file()
 
 
 def test_zarr_record(client, tmp_path):
