@@ -9,6 +9,7 @@ exact angle agrees to rounding (≤ 1e-12 relative; the core sums in another ord
 
 from __future__ import annotations
 
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -79,6 +80,35 @@ def test_static_equals_single_machine(client, estimator, chunk):
     got1 = adask.avar(da.from_array(y1, chunks=300), 10.0, estimator=estimator, taus="exp", chunk=97, client=client)
     assert got1.avar.shape == ref1.avar.shape
     assert _rel(got1.avar, ref1.avar) <= REL
+
+
+@pytest.mark.parametrize("classic", [False, True])
+def test_static_kernel_equals_its_numpy_twin(classic):
+    # the Rust per-task kernel forms the same exact second differences as the NumPy code it replaced
+    # (allanite._reference.angle_term_sums); only the summation of d² differs
+    from allanite._reference import angle_term_sums as twin
+    from allanite.estimators.allan import angle_term_sums
+
+    y = _biased(40_003, seed=5)
+    q_exp = math.frexp(float(np.max(np.abs(y))))[1] - adask.arrays.QUANTUM_BITS
+    cut = [0, 9_000, 17_000, 26_000, 40_003]
+    whole = np.rint(np.ldexp(y, -q_exp)).astype(np.int64)
+    rest = np.ldexp(y, -q_exp) - np.rint(np.ldexp(y, -q_exp))
+    off_w = [whole[:c].sum(axis=0) for c in cut[:-1]]
+    off_r = [np.array([math.fsum(rest[:c, a]) for a in range(3)]) for c in cut[:-1]]
+    blocks = [y[a:b] for a, b in zip(cut, cut[1:])]
+    for ks, plan in [
+        ([0, 1, 2], [(1, 0, 9_000), (7, 100, 9_000), (4_000, 0, 9_000), (8_499, 0, 9_000), (333, 5_000, 9_000)]),
+        ([0, 2], [(8_600, 8_500, 8_601)]),  # the three slices in two runs of chunks
+        ([0, 2, 3], [(8_500, 8_500, 9_000)]),
+    ]:
+        args = ([blocks[k] for k in ks], [cut[k] for k in ks], [off_w[k] for k in ks], [off_r[k] for k in ks])
+        got = angle_term_sums(*args, q_exp, plan, classic, 1)
+        want = twin(*args, q_exp, plan, classic)
+        assert got.shape == want.shape == (len(plan), 3)
+        assert _rel(got, want) <= 1e-13
+        # and bit-identical for any number of threads
+        np.testing.assert_array_equal(angle_term_sums(*args, q_exp, plan, classic, 2), got)
 
 
 def test_static_increment_input_and_scale(client):

@@ -37,6 +37,18 @@ def compensated_sums(
 ) -> list[tuple[float, float]]:
     """Neumaier's compensated sum of each column continued from state[(sum, compensation) per axis]."""
 
+def angle_term_sums(
+    blocks: Sequence[npt.NDArray[np.float64]],
+    starts: Sequence[int],
+    off_w: Sequence[Sequence[int]],
+    off_r: Sequence[Sequence[float]],
+    q_exp: int,
+    plan: Sequence[tuple[int, int, int]],
+    classic: bool,
+    workers: int,
+) -> npt.NDArray[np.float64]:
+    """Σ (X[i+2m] − 2X[i+m] + X[i])² in quanta² per plan item and axis, X the exact angle of the blocks."""
+
 def davar_hann(
     columns: Sequence[npt.NDArray[np.float64]],
     window: int,

@@ -17,8 +17,9 @@ The functions give the numbers of the single-machine calls (:func:`allanite.avar
   q = 2^(E − 26) (2^E > max|y|) and a remainder |r| ≤ q/2: the cumulative sum of the quanta is an
   exact int64 sum, chunk offsets included (Python integers on the client), and only the tiny
   remainders are summed in floating point. Each τ's terms x[i+2m] − 2x[i+m] + x[i] come from three
-  shifted slices of that angle; each chunk returns its sum of squares and the client adds the
-  partial sums with :func:`math.fsum` (exact). The single-machine kernel sums block sums of the rate
+  shifted slices of that angle, formed and squared and summed per task by a Rust kernel (one pass per
+  τ, ``rust/core/src/angle.rs``; ≤ 5e-15 from the NumPy twin ``allanite._reference.angle_term_sums``);
+  the client adds the tasks' partial sums with :func:`math.fsum` (exact). The single-machine kernel sums block sums of the rate
   in another order, so the two agree to rounding, not bitwise: ≤ 1e-12 relative (measured: a few
   1e-16, see tests/test_dask.py).
 * :func:`wavelet_split` chunks on multiples of 2^level with :func:`wavelet_overlap` samples of each
@@ -36,7 +37,7 @@ from .. import analysis, estimators
 from .. import wavelet as wavelet_mod
 from .._validate import check_choice, check_count, resolve_workers
 from ..errors import InputError, MissingDependencyError, ParameterError
-from ..estimators.allan import compensated_sums, n_terms, part_values
+from ..estimators.allan import angle_term_sums, compensated_sums, n_terms, part_values
 from ..estimators.grid import resolve_taus
 from ..results import AllanResult, DynamicAllanResult
 
@@ -61,9 +62,13 @@ __all__ = [
 #: Samples per chunk when the caller's chunks are rechunked (2^22 float64 = 32 MiB per axis).
 DEFAULT_CHUNK = 1 << 22
 
-#: Bits of a quantum below the largest sample: with |y/q| ≤ 2^26, a chunk of ≤ 2^36 samples sums
-#: exactly in int64 and a second difference at m < 2^26 is an exact float64.
+#: Bits of a quantum below the largest sample: |y/q| ≤ 2^26, so the whole quanta of a task's run of
+#: chunks (≤ 6 chunks of ≤ :data:`MAX_STATIC_CHUNK` samples) sum exactly in float64 (< 2^52), a chunk's
+#: total exactly in int64, and a second difference at m < 2^25 is an exact float64.
 QUANTUM_BITS = 26
+
+#: Longest chunk of the static variance (6 · 2^23 · 2^26 < 2^52: see :data:`QUANTUM_BITS`).
+MAX_STATIC_CHUNK = 1 << 23
 
 _ESTIMATORS = ("oavar", "avar")
 _INPUTS = ("rate", "increment")
@@ -551,8 +556,9 @@ def _split(y: np.ndarray, q_exp: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _totals_block(block, fs: float, input: str, q_exp: int):
+    """The chunk's exact sum of whole quanta (int64, per axis) and its sum of remainders."""
     whole, rest = _split(_rate(block, fs, input), q_exp)
-    return np.stack([whole.sum(axis=0).astype(np.float64), rest.sum(axis=0)])[None]  # (1, 2, axes)
+    return whole.sum(axis=0), rest.sum(axis=0)
 
 
 def _chunk_of(bounds: np.ndarray, i: int) -> int:
@@ -567,53 +573,24 @@ def _needed(bounds: np.ndarray, lo: int, hi: int) -> list[int]:
     return list(range(k0, max(k0, _chunk_of(bounds, hi - 2)) + 1))
 
 
-def _sum_block(blocks, ks, bounds, offsets, *, fs, input, q_exp, plan, classic):
+def _sum_block(blocks, ks, bounds, offsets, *, fs, input, q_exp, plan, classic, threads):
     """Σ over this task's terms of (x[i+2m] − 2x[i+m] + x[i])², in quanta², per (plan item, axis).
 
     ``blocks[j]`` is chunk ``ks[j]``; ``offsets[j]`` the exact angle at its first sample (int64 quanta,
-    float remainder). ``plan``: (τ index, m, i0, i1) — the terms i0 ≤ i < i1 of that m. The angle of
-    every run of consecutive chunks is built once: an exact int64 cumulative sum of whole quanta plus a
-    float cumulative sum of the remainders (|r| ≤ 1/2 quantum)."""
-    runs = []  # (first sample, X whole, X remainder) over runs of consecutive chunks
-    j = 0
-    while j < len(ks):
-        j1 = j
-        while j1 + 1 < len(ks) and ks[j1 + 1] == ks[j1] + 1:
-            j1 += 1
-        y = _rate(np.concatenate(blocks[j : j1 + 1]) if j1 > j else blocks[j], fs, input)
-        whole, rest = _split(y, q_exp)
-        xw = np.empty((y.shape[0] + 1, y.shape[1]), dtype=np.int64)
-        xr = np.empty((y.shape[0] + 1, y.shape[1]), dtype=np.float64)
-        xw[0], xr[0] = offsets[j]
-        np.cumsum(whole, axis=0, out=xw[1:])
-        np.cumsum(rest, axis=0, out=xr[1:])
-        xw[1:] += offsets[j][0]
-        xr[1:] += offsets[j][1]
-        del y, whole, rest
-        runs.append((int(bounds[ks[j]]), xw, xr))
-        j = j1 + 1
-
-    def angle(lo: int, hi: int, step: int):
-        for s, xw, xr in runs:
-            if s <= lo and hi - s <= xw.shape[0]:
-                return xw[lo - s : hi - s : step], xr[lo - s : hi - s : step]
-        raise AssertionError(f"angle points {lo}:{hi} are not in this task's chunks {ks}")  # pragma: no cover
-
-    n_axes = runs[0][1].shape[1]
-    out = np.zeros((len(plan), n_axes))
-    for p, (_j, m, i0, i1) in enumerate(plan):
-        step = m if classic else 1
-        if classic:
-            i0 = -(-i0 // m) * m  # classic terms start at multiples of m
-        if i0 >= i1:
-            continue
-        a_w, a_r = angle(i0, i1, step)
-        b_w, b_r = angle(i0 + m, i1 + m, step)
-        c_w, c_r = angle(i0 + 2 * m, i1 + 2 * m, step)
-        dw = c_w - 2 * b_w + a_w  # exact (int64)
-        d = dw.astype(np.float64) + ((c_r - b_r) - (b_r - a_r))
-        out[p] = np.einsum("ij,ij->j", d, d)
-    return out
+    float remainder). ``plan``: (τ index, m, i0, i1) — the terms i0 ≤ i < i1 of that m. The Rust kernel
+    (``angle_term_sums``) builds the angle of every run of consecutive chunks once — an exact int64
+    running sum of whole quanta plus a float running sum of the remainders (|r| ≤ 1/2 quantum) — and
+    sums every item's terms in one pass."""
+    return angle_term_sums(
+        [_rate(b, fs, input) for b in blocks],
+        [int(bounds[k]) for k in ks],
+        [o[0] for o in offsets],
+        [o[1] for o in offsets],
+        q_exp,
+        [(m, i0, i1) for _j, m, i0, i1 in plan],
+        classic,
+        threads,
+    )
 
 
 def avar(
@@ -660,7 +637,7 @@ def avar(
     n_axes = int(arr.shape[1]) if arr.ndim == 2 else 1
     ms = resolve_taus(taus, n, fs)
     target = int(chunk if chunk is not None else max(int(arr.chunks[0][0]), DEFAULT_CHUNK // 4))
-    target = max(1, min(target, 1 << 34))
+    target = max(1, min(target, MAX_STATIC_CHUNK))
     arr = arr.rechunk({0: target, 1: -1} if arr.ndim == 2 else {0: target})
     bounds = np.concatenate([[0], np.cumsum(arr.chunks[0])]).astype(np.int64)
     blocks = arr.to_delayed().ravel().tolist()
@@ -689,20 +666,21 @@ def avar(
     q_exp = math.frexp(peak)[1] - QUANTUM_BITS  # 2^(E−26) with 2^E > peak
 
     # pass 2: exact chunk totals → exact angle offsets (Python ints for the whole quanta)
-    totals = np.concatenate(run([dask.delayed(_totals_block)(b, fs, input, q_exp) for b in blocks]))
+    totals = run([dask.delayed(_totals_block)(b, fs, input, q_exp) for b in blocks])
     off_w = [np.zeros(n_axes, dtype=np.int64)]
     off_r = [np.zeros(n_axes)]
     acc_w = [0] * n_axes
     rests: list[list[float]] = [[] for _ in range(n_axes)]
     for k in range(len(blocks) - 1):
         for a in range(n_axes):
-            acc_w[a] += int(totals[k, 0, a])
-            rests[a].append(float(totals[k, 1, a]))
+            acc_w[a] += int(totals[k][0][a])
+            rests[a].append(float(totals[k][1][a]))
         off_w.append(np.array(acc_w, dtype=np.int64))
         off_r.append(np.array([math.fsum(r) for r in rests]))
     offsets = list(zip(off_w, off_r))
 
     # pass 3: partial sums of squared second differences
+    threads = resolve_workers(None)
     c = int(arr.chunks[0][0])
     n_chunks = len(blocks)
     tasks, where = [], []
@@ -732,6 +710,7 @@ def avar(
                     q_exp=q_exp,
                     plan=plan,
                     classic=classic,
+                    threads=threads,
                 )
             )
             where.append(plan)

@@ -18,7 +18,7 @@ from ._registry import Computed, Estimator, register
 from .confidence import edf_greenhall
 from .grid import resolve_taus
 
-__all__ = ["n_terms", "allan_values", "part_values", "compensated_sums"]
+__all__ = ["n_terms", "allan_values", "part_values", "compensated_sums", "angle_term_sums"]
 
 
 def n_terms(estimator: str, window: int, ms: np.ndarray) -> np.ndarray:
@@ -73,6 +73,23 @@ def compensated_sums(cols, state) -> list[tuple[float, float]]:
     (s + c)/n is the centring value the core gives the whole record, bit for bit. Internal: for
     :mod:`allanite.dask`."""
     return _core.compensated_sums(cols, [(float(s), float(c)) for s, c in state])
+
+
+def angle_term_sums(blocks, starts, off_w, off_r, q_exp: int, plan, classic: bool, threads: int) -> np.ndarray:
+    """Σ (X[i+2m] − 2X[i+m] + X[i])² in quanta² for every plan item (m, i0, i1) and axis: (items, axes).
+    X is the exact angle of the rate ``blocks`` ((samples, axes) each, consecutive ones forming runs),
+    in quanta 2^q_exp: int64 whole quanta from the exact offsets ``off_w`` plus float remainders from
+    ``off_r`` (rust/core/src/angle.rs). Internal: the per-task kernel of :func:`allanite.dask.avar`."""
+    return _core.angle_term_sums(
+        [np.ascontiguousarray(b, dtype=np.float64) for b in blocks],
+        [int(s) for s in starts],
+        [[int(v) for v in w] for w in off_w],
+        [[float(v) for v in r] for r in off_r],
+        int(q_exp),
+        [(int(m), int(a), int(b)) for m, a, b in plan],
+        bool(classic),
+        int(threads),
+    )
 
 
 def _static(cols, fs, taus, workers, *, estimator: str) -> Computed:

@@ -8,13 +8,14 @@
 //! `run_interruptible(py, workers, |cancel| kernel_cancellable(..., cancel))`.
 
 use allanite_core::dynamic_hann_cancellable;
+use allanite_core::{angle_term_sums_cancellable, AngleChunk};
 use allanite_core::{compensated_sum_from, dynamic_avar_part_cancellable};
 use allanite_core::{
     deviations, dynamic_avar_cancellable, dynamic_theo1_cancellable, run_in_pool_interruptible,
     static_theo1_cancellable, Cancel, CoreError, Estimator, Method, Request,
 };
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use std::time::Duration;
 
@@ -201,6 +202,72 @@ fn compensated_sums(
             .map(|(c, st)| compensated_sum_from(c, st))
             .collect()
     }))
+}
+
+/// Σ (X[i+2m] − 2X[i+m] + X[i])² in quanta² per plan item (m, i0, i1) and axis, X the exact angle of
+/// the chunks given (rate samples (samples, axes) C-contiguous, each with its record start and exact
+/// angle offset per axis: whole quanta and remainder), q = 2^q_exp: shape (items, axes). The kernel
+/// of allanite.dask.avar (allanite-core `angle_term_sums_cancellable`).
+#[pyfunction]
+#[pyo3(signature = (blocks, starts, off_w, off_r, q_exp, plan, classic, workers))]
+#[allow(clippy::too_many_arguments)]
+fn angle_term_sums<'py>(
+    py: Python<'py>,
+    blocks: Vec<PyReadonlyArray2<'py, f64>>,
+    starts: Vec<usize>,
+    off_w: Vec<Vec<i64>>,
+    off_r: Vec<Vec<f64>>,
+    q_exp: i32,
+    plan: Vec<(usize, usize, usize)>,
+    classic: bool,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let n = blocks.len();
+    if starts.len() != n || off_w.len() != n || off_r.len() != n || n == 0 {
+        return Err(allanite_error_of(
+            py,
+            "ParameterError",
+            format!(
+                "{n} blocks, {} starts, {} and {} offsets: one of each per block is needed",
+                starts.len(),
+                off_w.len(),
+                off_r.len()
+            ),
+        ));
+    }
+    let n_axes = blocks[0].as_array().ncols();
+    let mut chunks = Vec::with_capacity(n);
+    for (j, b) in blocks.iter().enumerate() {
+        let y = b.as_slice().map_err(|_| {
+            allanite_error_of(
+                py,
+                "InputError",
+                format!("block {j} is not a C-contiguous float64 (samples, axes) array"),
+            )
+        })?;
+        if b.as_array().ncols() != n_axes {
+            return Err(allanite_error_of(
+                py,
+                "InputError",
+                format!(
+                    "block {j} has {} axes, block 0 has {n_axes}",
+                    b.as_array().ncols()
+                ),
+            ));
+        }
+        chunks.push(AngleChunk {
+            start: starts[j],
+            y,
+            off_w: &off_w[j],
+            off_r: &off_r[j],
+        });
+    }
+    let values = run_interruptible(py, workers, |cancel| {
+        angle_term_sums_cancellable(&chunks, n_axes, q_exp, &plan, classic, cancel)
+    })?;
+    let arr = Array2::from_shape_vec((plan.len(), n_axes), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
 }
 
 /// Hann-weighted overlapping Allan variance of every window at every averaging factor, for every
@@ -526,6 +593,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;
     m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;
+    m.add_function(wrap_pyfunction!(angle_term_sums, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_static, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_dynamic, m)?)?;
     m.add_function(wrap_pyfunction!(deviation_static, m)?)?;
