@@ -188,6 +188,25 @@ def test_davar_bitwise_naive_increment_and_scaled(client):
             np.testing.assert_array_equal(got.avar, ref.avar)
 
 
+def test_unaligned_blocks(client):
+    # blocks that arrive from another worker may sit at odd addresses (seen on a process cluster):
+    # the same numbers as from aligned memory
+    y = _biased(6_007)
+    raw = bytearray(y.nbytes + 1)
+    u = np.frombuffer(raw, dtype=np.float64, offset=1).reshape(y.shape)
+    u[...] = y
+    x = da.from_array(u, chunks=(1_000, 3))
+    with client.as_current():
+        np.testing.assert_array_equal(
+            adask.davar(x, 10.0, window=1_500, hop=100, chunk=1_200).avar,
+            allanite.davar(y, 10.0, window=1_500, hop=100).avar,
+        )
+        np.testing.assert_array_equal(
+            adask.wavelet_split(x, 10.0, level=3, chunk=1_000).high, allanite.wavelet_split(y, 10.0, level=3).high
+        )
+    assert _rel(adask.avar(x, 10.0, chunk=1_000, client=client).avar, allanite.avar(y, 10.0).avar) <= REL
+
+
 def test_scale_exponent_is_the_single_machine_rule():
     # the exponent by which allanite.davar scales a column (allanite.analysis) for the same peaks
     from allanite.analysis import SAFE_EXP

@@ -92,15 +92,17 @@ def angle_term_sums(blocks, starts, off_w, off_r, q_exp, plan, classic) -> np.nd
         j1 = j
         while j1 + 1 < len(blocks) and starts[j1 + 1] == starts[j1] + len(blocks[j1]):
             j1 += 1
-        y = np.concatenate(blocks[j : j1 + 1]).astype(np.float64)
-        u = np.ldexp(y, -q_exp)
-        whole = np.rint(u)
-        rest = u - whole
+        y = np.concatenate(blocks[j : j1 + 1]) if j1 > j else blocks[j]
+        rest = np.ldexp(np.asarray(y, dtype=np.float64), -q_exp)
+        whole = np.rint(rest)
+        rest -= whole
         xw = np.empty((y.shape[0] + 1, y.shape[1]), dtype=np.int64)
         xr = np.empty((y.shape[0] + 1, y.shape[1]), dtype=np.float64)
         xw[0], xr[0] = off_w[j], off_r[j]
         np.cumsum(whole.astype(np.int64), axis=0, out=xw[1:])
+        del whole
         np.cumsum(rest, axis=0, out=xr[1:])
+        del y, rest
         xw[1:] += np.asarray(off_w[j], dtype=np.int64)
         xr[1:] += np.asarray(off_r[j], dtype=np.float64)
         runs.append((int(starts[j]), xw, xr))

@@ -19,8 +19,8 @@ The functions give the numbers of the single-machine calls (:func:`allanite.avar
   remainders are summed in floating point. Each τ's terms x[i+2m] − 2x[i+m] + x[i] come from three
   shifted slices of that angle, formed and squared and summed per task by a Rust kernel (one pass per
   τ, ``rust/core/src/angle.rs``; ≤ 5e-15 from the NumPy twin ``allanite._reference.angle_term_sums``);
-  the client adds the tasks' partial sums with :func:`math.fsum` (exact). The single-machine kernel sums block sums of the rate
-  in another order, so the two agree to rounding, not bitwise: ≤ 1e-12 relative (measured: a few
+  the client adds the tasks' partial sums with :func:`math.fsum` (exact). The single-machine kernel sums
+  block sums of the rate in another order, so the two agree to rounding, not bitwise: ≤ 1e-12 relative (measured: a few
   1e-16, see tests/test_dask.py).
 * :func:`wavelet_split` chunks on multiples of 2^level with :func:`wavelet_overlap` samples of each
   neighbour (320 for db5 at level 5) and keeps every block's own chunk: bit for bit the single-machine
@@ -149,7 +149,11 @@ def scale_exponent(peak: float) -> int:
 def _columns(block, fs: float, input: str, exps) -> list[np.ndarray]:
     """The core's columns of a block: rate, scaled by 2^-e per axis as the single-machine call scales them."""
     y = _rate(block, fs, input)
-    return [np.ascontiguousarray(np.ldexp(y[:, a], -e) if e else y[:, a]) for a, e in enumerate(exps)]
+    # C-contiguous and aligned (a block received from another worker may sit at an odd address)
+    return [
+        np.require(np.ldexp(y[:, a], -e) if e else y[:, a], requirements=("C_CONTIGUOUS", "ALIGNED"))
+        for a, e in enumerate(exps)
+    ]
 
 
 def _centre_step(acc, block, start: int, fs: float, input: str, exps):

@@ -81,7 +81,7 @@ def angle_term_sums(blocks, starts, off_w, off_r, q_exp: int, plan, classic: boo
     in quanta 2^q_exp: int64 whole quanta from the exact offsets ``off_w`` plus float remainders from
     ``off_r`` (rust/core/src/angle.rs). Internal: the per-task kernel of :func:`allanite.dask.avar`."""
     return _core.angle_term_sums(
-        [np.ascontiguousarray(b, dtype=np.float64) for b in blocks],
+        [np.require(b, dtype=np.float64, requirements=("C_CONTIGUOUS", "ALIGNED")) for b in blocks],
         [int(s) for s in starts],
         [[int(v) for v in w] for w in off_w],
         [[float(v) for v in r] for r in off_r],

@@ -290,6 +290,199 @@ fn term_sum(
     s + comp
 }
 
+/// The angle of one axis of a run of consecutive chunks, produced point by point without storing it:
+/// the same running sums as [`build_run`] (so the same values), for a plan item that reads the run
+/// only once (one factor per task: a few slices far apart, where building the whole run would cost
+/// more than the terms).
+struct Cursor<'a> {
+    chunks: &'a [AngleChunk<'a>],
+    axis: usize,
+    n_axes: usize,
+    q_exp: i32,
+    /// chunk and row of the next sample
+    ci: usize,
+    row: usize,
+    w_acc: f64,
+    r_acc: f64,
+    or: f64,
+    base: i64,
+    peak: f64,
+    consumed: usize,
+}
+
+impl<'a> Cursor<'a> {
+    fn new(chunks: &'a [AngleChunk<'a>], axis: usize, n_axes: usize, q_exp: i32) -> Self {
+        Cursor {
+            chunks,
+            axis,
+            n_axes,
+            q_exp,
+            ci: 0,
+            row: 0,
+            w_acc: 0.0,
+            r_acc: 0.0,
+            or: chunks[0].off_r[axis],
+            base: chunks[0].off_w[axis],
+            peak: 0.0,
+            consumed: 0,
+        }
+    }
+
+    /// Adds the next `k` samples (the angle moves k points on); stops at the end of the run.
+    #[inline(always)]
+    fn advance(&mut self, mut k: usize) {
+        while k > 0 && self.ci < self.chunks.len() {
+            let c = &self.chunks[self.ci];
+            let rows = c.y.len() / self.n_axes;
+            let take = k.min(rows - self.row);
+            for r in self.row..self.row + take {
+                let u = scale(c.y[r * self.n_axes + self.axis], -self.q_exp);
+                let w = rint(u);
+                self.peak = self.peak.max(w.abs());
+                self.w_acc += w;
+                self.r_acc += u - w;
+            }
+            self.row += take;
+            self.consumed += take;
+            k -= take;
+            if self.row == rows {
+                self.ci += 1;
+                self.row = 0;
+            }
+        }
+    }
+
+    /// Writes the next h.len() points (hi, lo), one sample apart, and moves past them: the points of
+    /// [`build_run`], for one block of terms at a time (cache-resident).
+    #[inline(always)]
+    fn fill(&mut self, h: &mut [f64], l: &mut [f64]) {
+        let n = h.len();
+        let mut t = 0;
+        while t < n {
+            if self.ci >= self.chunks.len() {
+                // past the run's last sample: only the point at its end remains
+                let (hv, lv) = self.point();
+                h[t..].fill(hv);
+                l[t..].fill(lv);
+                return;
+            }
+            let c = &self.chunks[self.ci];
+            let rows = c.y.len() / self.n_axes;
+            let take = (n - t).min(rows - self.row);
+            let (hs, ls) = (&mut h[t..t + take], &mut l[t..t + take]);
+            let ys = &c.y[self.row * self.n_axes..(self.row + take) * self.n_axes];
+            let (mut w_acc, mut r_acc, mut peak) = (self.w_acc, self.r_acc, self.peak);
+            for ((hv, lv), row) in hs
+                .iter_mut()
+                .zip(ls.iter_mut())
+                .zip(ys.chunks_exact(self.n_axes))
+            {
+                *hv = w_acc;
+                *lv = r_acc + self.or;
+                let u = scale(row[self.axis], -self.q_exp);
+                let w = rint(u);
+                peak = peak.max(w.abs());
+                w_acc += w;
+                r_acc += u - w;
+            }
+            (self.w_acc, self.r_acc, self.peak) = (w_acc, r_acc, peak);
+            self.row += take;
+            self.consumed += take;
+            t += take;
+            if self.row == rows {
+                self.ci += 1;
+                self.row = 0;
+            }
+        }
+    }
+
+    /// (hi, lo) of the current point, as [`build_run`] stores them.
+    #[inline(always)]
+    fn point(&self) -> (f64, f64) {
+        (self.w_acc, self.r_acc + self.or)
+    }
+
+    fn check(&self) -> Result<()> {
+        if self.peak <= MAX_WHOLE && self.peak * self.consumed as f64 <= MAX_LOCAL {
+            Ok(())
+        } else {
+            Err(CoreError::InvalidParameter(format!(
+                "{} samples of up to {} quanta of 2^{} may sum beyond 2^52: use shorter chunks",
+                self.consumed, self.peak, self.q_exp
+            )))
+        }
+    }
+}
+
+/// [`term_sum`] of one plan item read through three cursors: the same terms and the same partial sums
+/// (LANES lanes in runs of RUN terms, runs added by Neumaier), so the same bits.
+fn stream_sum(
+    avx2: bool,
+    cur: &mut [Cursor; 3],
+    starts: [usize; 3],
+    count: usize,
+    step: usize,
+) -> Result<f64> {
+    for (c, &s) in cur.iter_mut().zip(&starts) {
+        c.advance(s);
+    }
+    let k = cur[2]
+        .base
+        .wrapping_sub(cur[1].base.wrapping_mul(2))
+        .wrapping_add(cur[0].base) as f64;
+    let (mut s, mut comp) = (0.0f64, 0.0f64);
+    let mut done = 0;
+    let mut buf = vec![0.0f64; 6 * RUN];
+    while done < count {
+        let n = RUN.min(count - done);
+        let run = if step == 1 {
+            // the block's points of the three slices, then the vectorised sum of the stored path
+            let (h, l) = buf.split_at_mut(3 * RUN);
+            let (h0, h12) = h.split_at_mut(RUN);
+            let (h1, h2) = h12.split_at_mut(RUN);
+            let (l0, l12) = l.split_at_mut(RUN);
+            let (l1, l2) = l12.split_at_mut(RUN);
+            cur[0].fill(&mut h0[..n], &mut l0[..n]);
+            cur[1].fill(&mut h1[..n], &mut l1[..n]);
+            cur[2].fill(&mut h2[..n], &mut l2[..n]);
+            run_sum_dispatch(
+                avx2,
+                [&h0[..n], &h1[..n], &h2[..n]],
+                [&l0[..n], &l1[..n], &l2[..n]],
+                k,
+            )
+        } else {
+            let mut acc = [0.0f64; LANES];
+            for (t, a) in (0..n).zip((0..LANES).cycle()) {
+                if t > 0 || done > 0 {
+                    for c in cur.iter_mut() {
+                        c.advance(step);
+                    }
+                }
+                let ((ha, la), (hb, lb), (hc, lc)) =
+                    (cur[0].point(), cur[1].point(), cur[2].point());
+                let dh = (hc - hb) - (hb - ha);
+                let dl = (lc - lb) - (lb - la);
+                let d = (dh + k) + dl;
+                acc[a] += d * d;
+            }
+            ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
+        };
+        let t = s + run;
+        if s.abs() >= run.abs() {
+            comp += (s - t) + run;
+        } else {
+            comp += (run - t) + s;
+        }
+        s = t;
+        done += n;
+    }
+    for c in cur.iter() {
+        c.check()?;
+    }
+    Ok(s + comp)
+}
+
 /// For every plan item and axis, Σ (X[i+2m] − 2X[i+m] + X[i])² in quanta² over the item's terms, X the
 /// exact angle of the chunks (see the module notes): [item][axis]. `chunks` in record order; those that
 /// follow each other form runs, and each of a term range's three slices must lie in one run.
@@ -380,6 +573,43 @@ pub fn angle_term_sums_cancellable(
     #[cfg(not(target_arch = "x86_64"))]
     let avx2 = false;
     let mut out = vec![0.0f64; plan.len() * n_axes];
+    let busy: Vec<usize> = (0..items.len()).filter(|&p| items[p].4 > 0).collect();
+    if busy.len() == 1 {
+        // One factor (a long one: its slices lie far apart): stream the three slices, store nothing.
+        let (m, i0, last, step, count) = items[busy[0]];
+        let mut at = [(0usize, 0usize); 3]; // (group, first point's offset in it)
+        for (j, s) in [0, m, 2 * m].into_iter().enumerate() {
+            let (lo, hi) = (i0 + s, last + s);
+            at[j] = groups
+                .iter()
+                .enumerate()
+                .find_map(|(g, grp)| {
+                    let len: usize = grp.iter().map(|c| c.y.len() / n_axes).sum();
+                    (grp[0].start <= lo && hi - grp[0].start <= len + 1)
+                        .then(|| (g, lo - grp[0].start))
+                })
+                .ok_or_else(|| {
+                    CoreError::InvalidParameter(format!(
+                        "angle points {lo}..{hi} (m = {m}) are not in the chunks given"
+                    ))
+                })?;
+        }
+        let sums: Vec<Result<f64>> = (0..n_axes)
+            .into_par_iter()
+            .map(|axis| {
+                if cancel.is_cancelled() {
+                    return Ok(0.0);
+                }
+                let mut cur = at.map(|(g, _)| Cursor::new(groups[g], axis, n_axes, q_exp));
+                stream_sum(avx2, &mut cur, at.map(|(_, o)| o), count, step)
+            })
+            .collect();
+        for (axis, s) in sums.into_iter().enumerate() {
+            out[busy[0] * n_axes + axis] = s?;
+        }
+        cancel.check()?;
+        return Ok(out);
+    }
     for axis in 0..n_axes {
         cancel.check()?;
         let runs: Vec<Run> = groups
@@ -489,6 +719,69 @@ mod tests {
         assert_eq!(ok.unwrap()[1], want);
         let bad = angle_term_sums_cancellable(&two, 2, 0, &[(320, 0, 10)], false, &Cancel::new());
         assert!(matches!(bad, Err(CoreError::InvalidParameter(_))));
+    }
+
+    #[test]
+    fn streaming_one_factor_gives_the_stored_paths_bits() {
+        // noisy, biased, three axes; chunks of uneven length in two runs
+        let n = 5000;
+        let na = 3;
+        let mut x = 0x9E3779B97F4A7C15u64;
+        let y: Vec<f64> = (0..n * na)
+            .map(|i| {
+                x = x
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * [1.0, 3e-3, 40.0][i % na]
+                    + [0.0, 7.0, -900.0][i % na]
+            })
+            .collect();
+        let q_exp = -16; // |y/q| ≤ 2^26
+        let cut = [0, 700, 1900, 2600, 5000];
+        let offs_w: Vec<Vec<i64>> = cut[..4].iter().map(|&c| vec![c as i64 * 3; na]).collect();
+        let offs_r: Vec<Vec<f64>> = cut[..4]
+            .iter()
+            .map(|&c| vec![c as f64 * 1e-3; na])
+            .collect();
+        let chunk = |j: usize| AngleChunk {
+            start: cut[j],
+            y: &y[na * cut[j]..na * cut[j + 1]],
+            off_w: &offs_w[j],
+            off_r: &offs_r[j],
+        };
+        let all = [chunk(0), chunk(1), chunk(2), chunk(3)];
+        let two = [chunk(0), chunk(2), chunk(3)];
+        let c = Cancel::new();
+        for classic in [false, true] {
+            for (chunks, item) in [
+                (&all[..], (1usize, 0usize, 4998usize)),
+                (&all[..], (37, 650, 2700)),
+                (&all[..], (1200, 100, 2500)),
+                (&two[..], (1300, 600, 650)), // slices in two runs: [600,650) and [1900,1950), [3200,3250)
+            ] {
+                let one =
+                    angle_term_sums_cancellable(chunks, na, q_exp, &[item], classic, &c).unwrap();
+                // a second (empty-free) item makes the call build and store the runs
+                let stored = angle_term_sums_cancellable(
+                    chunks,
+                    na,
+                    q_exp,
+                    &[item, (1, 0, 10)],
+                    classic,
+                    &c,
+                )
+                .unwrap();
+                for a in 0..na {
+                    assert_eq!(
+                        one[a].to_bits(),
+                        stored[a].to_bits(),
+                        "{item:?} {classic} {a}"
+                    );
+                    let terms = (item.1..item.2).any(|i| !classic || i % item.0 == 0);
+                    assert_eq!(one[a] > 0.0, terms);
+                }
+            }
+        }
     }
 
     #[test]
