@@ -29,7 +29,8 @@ def davar_part(
     n_windows: int,
 ) -> npt.NDArray[np.float64]:
     """davar of windows first_window.. of a record of n_windows windows, from its samples from
-    first_window·hop on, centred on the record's means: bit for bit the whole-record values."""
+    first_window·hop on, centred on the record's means: the whole-record values (bit for bit where the
+    record's call streams; to a few ε on its phase path)."""
 
 def compensated_sums(
     columns: Sequence[npt.NDArray[np.float64]],

@@ -6,12 +6,17 @@ The functions give the numbers of the single-machine calls (:func:`allanite.avar
 * :func:`davar` rechunks the samples to chunks whose length is a multiple of the hop, appends the
   next ``window − 1`` samples to every chunk (``map_overlap`` with ``depth={0: (0, window − 1)}``,
   ``boundary="none"``, ``trim=False``) and hands every block to the Rust core as a *part of the record*
-  (``dynamic_avar_part_cancellable``): with the record's centring value and the block's first window,
-  the core forms the same terms, block sums and window sums in the same order as for the whole
-  record, so the result is :func:`allanite.davar`'s **bit for bit**. The centring value is the core's
-  compensated (Neumaier) sum, which is sequential: a first pass runs it over the chunks in order (a
-  chain of small tasks, :data:`CENTRE_BATCH` chunks per compute), continuing each chunk from the state
-  the previous one left.
+  (``dynamic_avar_part_cancellable``) with the record's centring value and the block's first window;
+  the core follows the record's own path. Where the single-machine call streams its sums (the
+  classic estimator; the overlapping one when its windows read more than 2^26 samples × axes, 512 MB
+  of float64 — the records Dask is for) the part forms the same terms, block sums and window sums in the same
+  order: **bit for bit**. Below that the single machine builds a double-word phase of the whole
+  record (a running sum from its start); a block rebuilds it from its own start, so each term is the
+  same quantity from differently rounded phase values: equal to a few ε of the term's block sums
+  (≤ 1.4e-14 relative in tests, 3.4e-13 on an axis whose mean jumps by 7000 σ), not bitwise. The
+  centring value is the core's compensated (Neumaier) sum, which is sequential: a first pass runs it
+  over the chunks in order (a chain of small tasks, :data:`CENTRE_BATCH` chunks per compute),
+  continuing each chunk from the state the previous one left.
 * :func:`avar` cannot do that: the overlap would be 2m samples, a whole record at the longest τ. It works
   on the angle instead. Every rate sample y is split exactly into a whole number of quanta
   q = 2^(E − 26) (2^E > max|y|) and a remainder |r| ≤ q/2: the cumulative sum of the quanta is an
@@ -208,7 +213,7 @@ def _davar_block(
     """One block: the windows that start in chunk k, from the chunk and its overlap, laid out
     (windows, axes·τ) so the windows run along the samples' dimension. The core computes them as parts
     of the whole record (its centring values ``mus``, the block's first window ``first[k]`` of
-    ``n_windows``): bit for bit the single-machine :func:`allanite.davar`."""
+    ``n_windows``): the single-machine :func:`allanite.davar` (bit for bit where it streams)."""
     k = block_info[None]["chunk-location"][0] if block_info else 0
     count = n_out[k]
     n_axes = len(exps)
@@ -251,7 +256,7 @@ def davar(
     chunk: int | None = None,
     compute: bool = True,
 ):
-    """Dynamic Allan variance of a dask array: :func:`allanite.davar`, block by block, bit for bit.
+    """Dynamic Allan variance of a dask array: :func:`allanite.davar`, block by block.
 
     Parameters
     ----------
@@ -271,7 +276,10 @@ def davar(
 
     Notes
     -----
-    Equal to :func:`allanite.davar` bit for bit. Two passes over the record: the centring pass runs the
+    Equal to :func:`allanite.davar` bit for bit where it streams its sums (``estimator="avar"``, and
+    ``"oavar"`` when the windows read more than 2^26 samples × axes, 512 MB of float64),
+    to a few ε of each term's block sums below that, where one machine takes its phase path (see the
+    module notes). Two passes over the record: the centring pass runs the
     core's compensated sum over the chunks in order (a chain of tasks, :data:`CENTRE_BATCH` chunks per
     ``dask.compute``; a second chain only when the samples need the power-of-two scaling of the
     single-machine call, |sample| ≥ 2^200 or < 2^-200), which gives the record's centring value and

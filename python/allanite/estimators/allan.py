@@ -50,9 +50,10 @@ def part_values(
 ) -> np.ndarray:
     """:func:`allan_values` of windows ``first_window ..`` of a record of ``n_windows`` windows, from a part
     of it: ``cols`` hold the record's samples from ``first_window·hop`` on, ``mus`` the record's centring
-    values (:func:`compensated_sums` over its parts, in order, divided by its length). Bit for bit the
-    whole-record values: the core forms the same terms, block and window sums in the same order
-    (``dynamic_avar_part_cancellable`` in rust/core/src/allan.rs). Internal: for :mod:`allanite.dask`."""
+    values (:func:`compensated_sums` over its parts, in order, divided by its length). The whole-record
+    values along the record's own path (``dynamic_avar_part_cancellable`` in rust/core/src/allan.rs):
+    bit for bit where the record's call streams its sums, to a few ε where it takes the phase path.
+    Internal: for :mod:`allanite.dask`."""
     return _core.davar_part(
         cols,
         window,

@@ -136,7 +136,8 @@ fn davar<'py>(
 
 /// [`davar`] of the windows `first_window ..` of a record of `n_windows` windows, from a part of it
 /// (`columns`: the record's samples from `first_window · hop` on) centred on the record's means
-/// `mus`: bit for bit the whole-record values (allanite-core `dynamic_avar_part_cancellable`). For
+/// `mus`: the whole-record values, bit for bit where the record's call streams and to a few ε on its
+/// phase path (allanite-core `dynamic_avar_part_cancellable`). For
 /// allanite.dask, whose blocks hold parts of a record.
 #[pyfunction]
 #[pyo3(signature = (columns, window, hop, ms, estimator, method, workers, mus, first_window, n_windows))]
