@@ -242,6 +242,17 @@ def test_dtypes(rng, dtype):
     assert_both_equal(both(x), both(x.astype(np.float64)))
 
 
+def test_unaligned_memory(rng):
+    # float64 samples at an odd byte offset, as arrays received from a network buffer can be (a Dask
+    # task's input): used as they are, not refused as "not contiguous"
+    y = rng.normal(size=(300, 2))
+    raw = bytearray(y.nbytes + 1)
+    x = np.frombuffer(raw, dtype=np.float64, offset=1).reshape(300, 2)
+    x[...] = y
+    assert not x.flags["ALIGNED"]
+    assert_both_equal(both(x), both(y))
+
+
 def test_python_lists_and_tuples(rng):
     y = rng.normal(size=200)
     assert_both_equal(both(y.tolist()), both(y))

@@ -16,6 +16,40 @@ def davar(
 ) -> npt.NDArray[np.float64]:
     """Allan variance of every window at every m for every axis: shape (axes, len(ms), windows)."""
 
+def davar_part(
+    columns: Sequence[npt.NDArray[np.float64]],
+    window: int,
+    hop: int,
+    ms: Sequence[int],
+    estimator: str,
+    method: str,
+    workers: int,
+    mus: Sequence[float],
+    first_window: int,
+    n_windows: int,
+) -> npt.NDArray[np.float64]:
+    """davar of windows first_window.. of a record of n_windows windows, from its samples from
+    first_window·hop on, centred on the record's means: the whole-record values (bit for bit where the
+    record's call streams; to a few ε on its phase path)."""
+
+def compensated_sums(
+    columns: Sequence[npt.NDArray[np.float64]],
+    state: Sequence[tuple[float, float]],
+) -> list[tuple[float, float]]:
+    """Neumaier's compensated sum of each column continued from state[(sum, compensation) per axis]."""
+
+def angle_term_sums(
+    blocks: Sequence[npt.NDArray[np.float64]],
+    starts: Sequence[int],
+    off_w: Sequence[Sequence[int]],
+    off_r: Sequence[Sequence[float]],
+    q_exp: int,
+    plan: Sequence[tuple[int, int, int]],
+    classic: bool,
+    workers: int,
+) -> npt.NDArray[np.float64]:
+    """Σ (X[i+2m] − 2X[i+m] + X[i])² in quanta² per plan item and axis, X the exact angle of the blocks."""
+
 def davar_hann(
     columns: Sequence[npt.NDArray[np.float64]],
     window: int,

@@ -136,7 +136,8 @@ def as_rate_columns(x: object, fs: object, input: str) -> tuple[list[np.ndarray]
             where = f"sample {i}" + (f" of axis {a}" if is_multi else "")
             raise InputError(f"samples contain a non-finite value ({c[i]}) at {where}; only finite numbers are allowed")
         if input == "rate":
-            y = np.ascontiguousarray(c)
+            # aligned too: arrays read from a network buffer (e.g. a Dask task's input) may not be
+            y = np.require(c, requirements=("C_CONTIGUOUS", "ALIGNED"))
         elif input == "increment":
             y = c * fs
         else:

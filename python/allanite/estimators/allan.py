@@ -18,7 +18,7 @@ from ._registry import Computed, Estimator, register
 from .confidence import edf_greenhall
 from .grid import resolve_taus
 
-__all__ = ["n_terms", "allan_values"]
+__all__ = ["n_terms", "allan_values", "part_values", "compensated_sums", "angle_term_sums"]
 
 
 def n_terms(estimator: str, window: int, ms: np.ndarray) -> np.ndarray:
@@ -33,6 +33,64 @@ def allan_values(cols, window: int, hop: int, ms, estimator: str, method: str, t
     """The core's Allan variance of every window: (axes, len(ms), windows). ``threads``: as resolved by
     :func:`allanite._validate.resolve_workers` (0 = rayon's default)."""
     return _core.davar(cols, window, hop, [int(m) for m in ms], estimator, method, threads)
+
+
+def part_values(
+    cols,
+    window: int,
+    hop: int,
+    ms,
+    estimator: str,
+    method: str,
+    threads: int,
+    *,
+    mus,
+    first_window: int,
+    n_windows: int,
+) -> np.ndarray:
+    """:func:`allan_values` of windows ``first_window ..`` of a record of ``n_windows`` windows, from a part
+    of it: ``cols`` hold the record's samples from ``first_window·hop`` on, ``mus`` the record's centring
+    values (:func:`compensated_sums` over its parts, in order, divided by its length). The whole-record
+    values along the record's own path (``dynamic_avar_part_cancellable`` in rust/core/src/allan.rs):
+    bit for bit where the record's call streams its sums, to a few ε where it takes the phase path.
+    Internal: for :mod:`allanite.dask`."""
+    return _core.davar_part(
+        cols,
+        window,
+        hop,
+        [int(m) for m in ms],
+        estimator,
+        method,
+        threads,
+        [float(m) for m in mus],
+        int(first_window),
+        int(n_windows),
+    )
+
+
+def compensated_sums(cols, state) -> list[tuple[float, float]]:
+    """The core's compensated (Neumaier) sum of each column, continued from ``state`` — (sum,
+    compensation) per axis, (0, 0) at the record's start. Fed a record's parts in order, the final
+    (s + c)/n is the centring value the core gives the whole record, bit for bit. Internal: for
+    :mod:`allanite.dask`."""
+    return _core.compensated_sums(cols, [(float(s), float(c)) for s, c in state])
+
+
+def angle_term_sums(blocks, starts, off_w, off_r, q_exp: int, plan, classic: bool, threads: int) -> np.ndarray:
+    """Σ (X[i+2m] − 2X[i+m] + X[i])² in quanta² for every plan item (m, i0, i1) and axis: (items, axes).
+    X is the exact angle of the rate ``blocks`` ((samples, axes) each, consecutive ones forming runs),
+    in quanta 2^q_exp: int64 whole quanta from the exact offsets ``off_w`` plus float remainders from
+    ``off_r`` (rust/core/src/angle.rs). Internal: the per-task kernel of :func:`allanite.dask.avar`."""
+    return _core.angle_term_sums(
+        [np.require(b, dtype=np.float64, requirements=("C_CONTIGUOUS", "ALIGNED")) for b in blocks],
+        [int(s) for s in starts],
+        [[int(v) for v in w] for w in off_w],
+        [[float(v) for v in r] for r in off_r],
+        int(q_exp),
+        [(int(m), int(a), int(b)) for m, a, b in plan],
+        bool(classic),
+        int(threads),
+    )
 
 
 def _static(cols, fs, taus, workers, *, estimator: str) -> Computed:

@@ -94,7 +94,17 @@ pub fn compensated_mean(y: &[f64]) -> f64 {
     if y.is_empty() {
         return 0.0;
     }
-    let (mut s, mut c) = (0.0f64, 0.0f64);
+    let (s, c) = compensated_sum_from(y, (0.0, 0.0));
+    (s + c) / y.len() as f64
+}
+
+/// Neumaier's compensated sum of `y` continued from the state (sum, compensation) = `state`: the
+/// loop of [`compensated_mean`], so feeding a record's parts in order, each from the state the
+/// previous one left, gives the state of the whole record bit for bit — and
+/// `(s + c) / n` its [`compensated_mean`]. This is how a record held in pieces (a Dask array)
+/// gets the centring value the whole-record call uses.
+pub fn compensated_sum_from(y: &[f64], state: (f64, f64)) -> (f64, f64) {
+    let (mut s, mut c) = state;
     for &v in y {
         let t = s + v;
         if s.abs() >= v.abs() {
@@ -104,7 +114,7 @@ pub fn compensated_mean(y: &[f64]) -> f64 {
         }
         s = t;
     }
-    (s + c) / y.len() as f64
+    (s, c)
 }
 
 /// Sum with four partial accumulators: shorter dependency chains and ~¼ the rounding growth.
@@ -341,24 +351,55 @@ pub(crate) fn for_each_term_chunk(
     k_end: usize,
     scale: f64,
     cancel: &Cancel,
-    mut f: impl FnMut(&[f64]),
+    f: impl FnMut(&[f64]),
 ) {
     debug_assert!(k_end >= 1 && k_end + 2 * m <= y.len() + 1);
+    for_each_term_chunk_at(y, 0, mu, m, (0, k_end), k_end, scale, cancel, f)
+}
+
+/// [`for_each_term_chunk`] of a whole record of which `y` holds a part: `y[i]` is the record's
+/// sample `off + i`, the record's terms run to `k_end` (exclusive), and this call gives the terms
+/// `k_lo ≤ k < k_hi` (`range`, in record indices) — the same values, in chunks with the same
+/// boundaries (cut at `range`) as the whole-record call gives them.
+///
+/// The whole-record pass cuts the terms into chunks at multiples of `DIRECT_CHUNK` (m ≤ `DIRECT_M`)
+/// or of m, and forms each block sum B(k) from a segment aligned to a multiple of m whose length is
+/// set by `k_end`; both only shape the rounding. Here the segments keep the record's alignment and
+/// lengths. A segment reaching outside `y` (the first one may start before `off`, the last ones may
+/// need up to m samples past `y`) is read from a copy padded with `mu`: B(k) reads only
+/// y[k .. k+m) (see [`TermScratch::segment`]), so the padding reaches no term of the range.
+/// Requires off ≤ k_lo < k_hi ≤ k_end and k_hi + 2m − 1 ≤ off + y.len().
+#[allow(clippy::too_many_arguments)] // the part's place in the record is irreducible
+pub(crate) fn for_each_term_chunk_at(
+    y: &[f64],
+    off: usize,
+    mu: f64,
+    m: usize,
+    range: (usize, usize),
+    k_end: usize,
+    scale: f64,
+    cancel: &Cancel,
+    mut f: impl FnMut(&[f64]),
+) {
+    let (k_lo, k_hi) = range;
+    debug_assert!(off <= k_lo && k_lo < k_hi && k_hi <= k_end && k_hi + 2 * m <= off + y.len() + 1);
     if m <= DIRECT_M {
         // Short blocks: sum each B(k) directly over its own m samples (exactly local too), in
         // chunks of k so the per-call bookkeeping of the segment scheme is not paid per sample.
         let mut bbuf = vec![0.0; DIRECT_CHUNK + m];
         let mut a = vec![0.0; DIRECT_CHUNK];
-        let mut k0 = 0;
-        while k0 < k_end {
+        let mut k0 = k_lo;
+        while k0 < k_hi {
             if cancel.is_cancelled() {
                 return;
             }
-            let c = DIRECT_CHUNK.min(k_end - k0);
+            // chunks end at the record's multiples of DIRECT_CHUNK
+            let c = ((k0 / DIRECT_CHUNK + 1) * DIRECT_CHUNK).min(k_hi) - k0;
             let b = &mut bbuf[..c + m];
             b.fill(0.0);
+            let i0 = k0 - off;
             for j in 0..m {
-                let src = &y[k0 + j..k0 + j + c + m];
+                let src = &y[i0 + j..i0 + j + c + m];
                 for (bt, v) in b.iter_mut().zip(src) {
                     *bt += v - mu;
                 }
@@ -372,18 +413,43 @@ pub(crate) fn for_each_term_chunk(
         }
         return;
     }
+    // The record's segment at p (a multiple of m) is formed with this many block sums.
+    let seg_len = |p: usize| {
+        if p == 0 {
+            m.min(k_end)
+        } else {
+            m.min(k_end + m - p)
+        }
+    };
     let mut sc = TermScratch::new(m);
-    sc.segment(y, mu, m, 0, m.min(k_end), None);
-    let mut start = 0;
-    while start < k_end {
+    let mut pad: Vec<f64> = Vec::new();
+    // The segment at record index p with `len` block sums, read from y or from a padded copy.
+    let mut segment = |sc: &mut TermScratch, p: usize, len: usize, terms: Option<f64>| {
+        let need = m + len - 1; // samples the segment reads: [p, p + need)
+        if p >= off && p + need <= off + y.len() {
+            sc.segment(y, mu, m, p - off, len, terms);
+        } else {
+            pad.clear();
+            pad.resize(need, mu);
+            let (a, b) = (p.max(off), (p + need).min(off + y.len()));
+            if a < b {
+                pad[a - p..b - p].copy_from_slice(&y[a - off..b - off]);
+            }
+            sc.segment(&pad, mu, m, 0, len, terms);
+        }
+    };
+    let mut start = k_lo / m * m;
+    segment(&mut sc, start, seg_len(start), None);
+    while start < k_hi {
         // One load per chunk of m > DIRECT_M terms: negligible next to forming them.
         if cancel.is_cancelled() {
             return;
         }
-        let len = m.min(k_end - start);
-        // d_m(k) = B(k + m) − B(k): the next aligned segment against the one kept in bprev.
-        sc.segment(y, mu, m, start + m, len, Some(scale));
-        f(&sc.suf[..len]);
+        let len = seg_len(start + m); // = min(m, k_end − start)
+                                      // d_m(k) = B(k + m) − B(k): the next aligned segment against the one kept in bprev.
+        segment(&mut sc, start + m, len, Some(scale));
+        let (a, b) = (k_lo.max(start) - start, k_hi.min(start + len) - start);
+        f(&sc.suf[a..b]);
         start += m;
     }
 }
@@ -484,6 +550,68 @@ struct RowScratch {
     part: Vec<f64>,
 }
 
+/// The windows of a record that one call computes: windows `first .. first + out.len()` of the
+/// record's `total`, from samples that start at the record's sample `first · hop`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Part {
+    first: usize,
+    total: usize,
+}
+
+impl Part {
+    /// The whole record: every one of its `n_win` windows.
+    fn whole(n_win: usize) -> Self {
+        Part {
+            first: 0,
+            total: n_win,
+        }
+    }
+}
+
+/// `sliding_sums` of a part of the record's block array: `f[i]` is the record's block `g0 + i`,
+/// `out[j]` the record's window `g0 + j`, and the record has `n_total` windows. Every value is
+/// formed by the same additions in the same order as the whole-record `sliding_sums(f_record, q,
+/// out_record)` forms it: the segments stay aligned to the record's multiples of q, the suffix sums
+/// run from the record's segment end down, and the last segment is cut where the record's is.
+/// Requires f.len() ≥ out.len() + q − 1, q ≥ 1 and g0 + out.len() ≤ n_total.
+pub(crate) fn sliding_sums_at(f: &[f64], q: usize, g0: usize, n_total: usize, out: &mut [f64]) {
+    let (lo, hi) = (g0, g0 + out.len());
+    debug_assert!(q >= 1 && hi <= n_total && f.len() + 1 >= out.len() + q);
+    if q == 1 {
+        out.copy_from_slice(&f[..out.len()]);
+        return;
+    }
+    // Suffix sums within each of the record's segments, down to the first window of this part.
+    let mut s0 = lo / q * q;
+    while s0 < hi {
+        let end = (s0 + q).min(n_total + q - 1);
+        let mut s: f64 = f[n_total.min(end) - g0..end - g0].iter().rev().sum();
+        for j in (s0.max(lo)..end.min(n_total)).rev() {
+            s += f[j - g0];
+            if j < hi {
+                out[j - g0] = s;
+            }
+        }
+        s0 += q;
+    }
+    // Prefix sums of the following segment: window w (w mod q ≠ 0) ends at i = w + q − 1, in the
+    // segment from its own segment's end; this part's windows end at i ∈ [lo + q − 1, hi + q − 1).
+    let stop = (hi + q - 1).min(n_total + q - 1);
+    let mut s0 = (lo.div_ceil(q) * q).max(q); // the segment holding i = lo + q − 1
+    while s0 < stop {
+        let end = (s0 + q - 1).min(n_total + q - 1);
+        let mut p = 0.0;
+        for i in s0..end.min(stop) {
+            p += f[i - g0];
+            let w = i + 1 - q;
+            if w >= lo {
+                out[w - g0] += p;
+            }
+        }
+        s0 += q;
+    }
+}
+
 /// Overlapping Allan variance of every window, for one m, written to `out` (length n_windows).
 /// Once `cancel` is set, `out` holds garbage (the caller returns `Cancelled` instead).
 #[allow(clippy::too_many_arguments)] // the row's geometry (y, mu, m, window, hop) is irreducible
@@ -497,24 +625,50 @@ fn overlapping_row(
     sc: &mut RowScratch,
     cancel: &Cancel,
 ) {
+    let part = Part::whole(out.len());
+    overlapping_row_at(y, part, mu, m, window, hop, out, sc, cancel)
+}
+
+/// [`overlapping_row`] of the windows `part` of a record, from `y` = the record's samples from
+/// `part.first · hop` on: the values the whole-record call gives them, bit for bit (the same terms,
+/// block sums and window sums, see [`for_each_term_chunk_at`] and [`sliding_sums_at`]).
+#[allow(clippy::too_many_arguments)]
+fn overlapping_row_at(
+    y: &[f64],
+    part: Part,
+    mu: f64,
+    m: usize,
+    window: usize,
+    hop: usize,
+    out: &mut [f64],
+    sc: &mut RowScratch,
+    cancel: &Cancel,
+) {
     let n_win = out.len();
     let l = window + 1 - 2 * m;
     // With one window any block size works; a whole-window block keeps memory O(1).
-    let hop = if n_win == 1 { l } else { hop };
+    let hop = if part.total == 1 { l } else { hop };
     let (q, r) = (l / hop, l % hop);
-    let k_end = (n_win - 1) * hop + l;
+    let off = part.first * hop; // the record's index of y[0] and of this part's first term
+    let k_end = (part.total - 1) * hop + l; // the record's terms
+    let k_hi = off + (n_win - 1) * hop + l; // this part's
     let nblocks = n_win + q;
     let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
-    let RowScratch { terms, full, part } = sc;
+    let RowScratch {
+        terms,
+        full,
+        part: head,
+    } = sc;
     full.clear();
     full.resize(nblocks, 0.0);
-    part.clear();
-    part.resize(nblocks, 0.0);
+    head.clear();
+    head.resize(nblocks, 0.0);
+    let range = (off, k_hi);
     if hop <= SMALL_HOP {
         // Short blocks: per-block bookkeeping would cost more than the arithmetic, so keep the
         // terms and cut them afterwards (the output is already ~k_end/hop values per m).
         terms.clear();
-        for_each_term_chunk(y, mu, m, k_end, norm, cancel, |chunk| {
+        for_each_term_chunk_at(y, off, mu, m, range, k_end, norm, cancel, |chunk| {
             terms.extend_from_slice(chunk)
         });
         if hop == 1 {
@@ -522,12 +676,12 @@ fn overlapping_row(
         } else {
             for (b, blk) in terms.chunks(hop).enumerate() {
                 full[b] = sum4(blk);
-                part[b] = sum4(&blk[..r.min(blk.len())]);
+                head[b] = sum4(&blk[..r.min(blk.len())]);
             }
         }
     } else {
         let (mut b, mut pos, mut total) = (0usize, 0usize, 0.0f64);
-        for_each_term_chunk(y, mu, m, k_end, norm, cancel, |chunk| {
+        for_each_term_chunk_at(y, off, mu, m, range, k_end, norm, cancel, |chunk| {
             let mut i = 0;
             while i < chunk.len() {
                 let target = if pos < r { r } else { hop };
@@ -536,7 +690,7 @@ fn overlapping_row(
                 pos += n;
                 i += n;
                 if pos == r {
-                    part[b] = total;
+                    head[b] = total;
                 }
                 if pos == hop {
                     full[b] = total;
@@ -552,11 +706,15 @@ fn overlapping_row(
     }
     // The terms already carry the normalisation, so the window sums are the variances.
     if q == 0 {
-        out.copy_from_slice(&part[..n_win]);
+        out.copy_from_slice(&head[..n_win]);
     } else {
-        sliding_sums(full, q, out);
+        if part.first == 0 && n_win == part.total {
+            sliding_sums(full, q, out);
+        } else {
+            sliding_sums_at(full, q, part.first, part.total, out);
+        }
         if r != 0 {
-            for (o, p) in out.iter_mut().zip(&part[q..]) {
+            for (o, p) in out.iter_mut().zip(&head[q..]) {
                 *o += p;
             }
         }
@@ -574,16 +732,36 @@ fn classic_row(
     out: &mut [f64],
     cancel: &Cancel,
 ) {
+    let part = Part::whole(out.len());
+    classic_row_at(y, part, mu, m, window, hop, out, cancel)
+}
+
+/// [`classic_row`] of the windows `part` of a record, from `y` = the record's samples from
+/// `part.first · hop` on: bit for bit the whole-record values (the same terms; each window's sum
+/// is formed from its own terms in the same order).
+#[allow(clippy::too_many_arguments)]
+fn classic_row_at(
+    y: &[f64],
+    part: Part,
+    mu: f64,
+    m: usize,
+    window: usize,
+    hop: usize,
+    out: &mut [f64],
+    cancel: &Cancel,
+) {
     let n_win = out.len();
     let k = window / m;
     let terms = k - 1;
-    let k_end = (n_win - 1) * hop + (terms - 1) * m + 1;
+    let k_end = (part.total - 1) * hop + (terms - 1) * m + 1;
+    let off = part.first * hop;
+    let range = (off, off + (n_win - 1) * hop + (terms - 1) * m + 1);
     let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * terms as f64);
-    if n_win == 1 {
+    if part.total == 1 {
         // One window: keep only the strided terms, O(m) memory.
         let mut picked = Vec::with_capacity(terms);
         let mut k0 = 0usize;
-        for_each_term_chunk(y, mu, m, k_end, norm, cancel, |chunk| {
+        for_each_term_chunk_at(y, off, mu, m, range, k_end, norm, cancel, |chunk| {
             let first = (m - k0 % m) % m;
             picked.extend(chunk.iter().skip(first).step_by(m));
             k0 += chunk.len();
@@ -591,8 +769,8 @@ fn classic_row(
         out[0] = sum4(&picked);
         return;
     }
-    let mut a = Vec::with_capacity(k_end);
-    for_each_term_chunk(y, mu, m, k_end, norm, cancel, |chunk| {
+    let mut a = Vec::with_capacity(range.1 - range.0);
+    for_each_term_chunk_at(y, off, mu, m, range, k_end, norm, cancel, |chunk| {
         a.extend_from_slice(chunk)
     });
     if cancel.is_cancelled() {
@@ -883,6 +1061,153 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
     Ok((out, n_win))
 }
 
+/// The windows `first_window ..` of a record of `n_windows_total` windows, from a part of it: what
+/// [`dynamic_avar`] of the whole record gives those windows — bit for bit wherever the record's call
+/// streams its sums, to rounding (a few ε) where it takes the double-word phase path.
+///
+/// `req.columns` hold the record's samples from `first_window · hop` on (at least one window's
+/// worth; the part's windows are those that fit, up to the record's last); `mus` is the record's
+/// centring value per axis, its [`compensated_mean`] (build it part by part with
+/// [`compensated_sum_from`]). The path is the record's: [`dynamic_avar`] takes the phase path for the
+/// overlapping estimator when the samples its windows read, times the axes, are at most
+/// `GATHER_MAX` (2^26), and streams otherwise (and for the classic estimator, and for rows of
+/// m > `PHASE_M_MAX` at hops below 64).
+///
+/// * Streaming: the part centres on `mus`, cuts the terms and block sums at the record's boundaries
+///   (multiples of m, of the hop, of the window sums' segments) and sizes the edge segments as the
+///   record does — the same additions in the same order: **bit for bit**.
+/// * Phase path: the record's phase is a double-word running sum of y − μ from the record's start;
+///   the part builds the same running sum from its own start (on the record's μ), so each term is
+///   the same quantity formed from differently rounded phase values — equal to a few ε of the
+///   term's own block sums (measured ≲ 1e-14 relative). A part that starts at the record's start
+///   has the record's phase and is bit for bit (except a one-window part of a many-window record).
+///   Bit for bit everywhere would need the record's phase at the part's start and the record's
+///   block offsets (a second sequential pass over the record).
+/// * Naive: each window from its own samples anyway: bit for bit.
+///
+/// Returns ([axis][m][window], windows).
+pub fn dynamic_avar_part_cancellable(
+    req: &Request,
+    mus: &[f64],
+    first_window: usize,
+    n_windows_total: usize,
+    cancel: &Cancel,
+) -> Result<(Vec<f64>, usize)> {
+    let n_part = validate(req)?;
+    let n_axes = req.columns.len();
+    if mus.len() != n_axes || mus.iter().any(|v| !v.is_finite()) {
+        return Err(CoreError::InvalidParameter(format!(
+            "the record's means must be {n_axes} finite numbers (one per axis), got {mus:?}"
+        )));
+    }
+    if first_window >= n_windows_total {
+        return Err(CoreError::InvalidParameter(format!(
+            "first window {first_window} is not a window of a record of {n_windows_total} windows"
+        )));
+    }
+    let n_win = n_part.min(n_windows_total - first_window);
+    let part = Part {
+        first: first_window,
+        total: n_windows_total,
+    };
+    let mut out = vec![0.0f64; n_axes * req.ms.len() * n_win];
+    if req.method == Method::Naive {
+        let (all, n) = dynamic_avar_cancellable(req, cancel)?;
+        for (row, dst) in out.chunks_mut(n_win).enumerate() {
+            dst.copy_from_slice(&all[row * n..row * n + n_win]);
+        }
+        return Ok((out, n_win));
+    }
+    if n_windows_total == 1 {
+        // The record's one window (the static estimator's paths, on the record's mean).
+        if req.estimator == Estimator::Classic && req.window * n_axes <= GATHER_MAX {
+            classic_window(req.columns, mus, req.ms, req.window, &mut out, cancel);
+            cancel.check()?;
+            return Ok((out, n_win));
+        }
+        if req.estimator == Estimator::Overlapping && req.window <= GATHER_MAX {
+            overlapping_window(req.columns, mus, req.ms, req.window, &mut out, cancel);
+            cancel.check()?;
+            return Ok((out, n_win));
+        }
+    }
+    // the samples the record's windows read
+    let n_used_record = (n_windows_total - 1) * req.hop + req.window;
+    let phase = req.estimator == Estimator::Overlapping && n_used_record * n_axes <= GATHER_MAX;
+    part_rows(req, mus, part, phase, &mut out, cancel);
+    cancel.check()?;
+    Ok((out, n_win))
+}
+
+/// The fast path of [`dynamic_avar_part_cancellable`] into `out` ([axis][m][window]): the record's
+/// phase path when `phase`, its streaming rows otherwise (and for what the phase path streams).
+fn part_rows(
+    req: &Request,
+    mus: &[f64],
+    part: Part,
+    phase: bool,
+    out: &mut [f64],
+    cancel: &Cancel,
+) {
+    let n_m = req.ms.len();
+    let n_win = out.len() / (req.columns.len() * n_m);
+    let n_m_win = n_m * n_win;
+    if phase {
+        // as dynamic_avar's phase branch, on the part's own phase
+        let n_used = (n_win - 1) * req.hop + req.window;
+        for (a, y) in req.columns.iter().enumerate() {
+            if cancel.is_cancelled() {
+                return;
+            }
+            let ph = crate::oavar::Phase::new(&y[..n_used], mus[a]);
+            let (hi, lo) = ph.parts();
+            let dst_axis = &mut out[a * n_m_win..(a + 1) * n_m_win];
+            if part.total >= 2 && n_win >= 2 && req.hop >= crate::oavar::SMALL_HOP {
+                crate::oavar::overlapping_dynamic_tiled(
+                    hi, lo, req.ms, req.window, req.hop, dst_axis, cancel,
+                );
+                continue;
+            }
+            dst_axis.par_chunks_mut(n_win).enumerate().for_each_init(
+                || (crate::oavar::DynScratch::default(), RowScratch::default()),
+                |(sc, rs), (t, dst)| {
+                    if cancel.is_cancelled() {
+                        return;
+                    }
+                    let m = req.ms[t];
+                    if m <= PHASE_M_MAX || part.total == 1 {
+                        crate::oavar::overlapping_dynamic_row(
+                            hi, lo, m, req.window, req.hop, dst, sc,
+                        );
+                    } else {
+                        overlapping_row_at(
+                            y, part, mus[a], m, req.window, req.hop, dst, rs, cancel,
+                        );
+                    }
+                },
+            );
+        }
+        return;
+    }
+    out.par_chunks_mut(n_win)
+        .enumerate()
+        .for_each_init(RowScratch::default, |sc, (row, dst)| {
+            if cancel.is_cancelled() {
+                return;
+            }
+            let (a, t) = (row / n_m, row % n_m);
+            let (y, m) = (req.columns[a], req.ms[t]);
+            match req.estimator {
+                Estimator::Overlapping => {
+                    overlapping_row_at(y, part, mus[a], m, req.window, req.hop, dst, sc, cancel)
+                }
+                Estimator::Classic => {
+                    classic_row_at(y, part, mus[a], m, req.window, req.hop, dst, cancel)
+                }
+            }
+        });
+}
+
 /// Static Allan variance of each whole record at every m: [axis][m].
 pub fn static_avar(columns: &[&[f64]], ms: &[usize], estimator: Estimator) -> Result<Vec<f64>> {
     let n = columns.first().map_or(0, |c| c.len());
@@ -986,6 +1311,209 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn sliding_sums_at_is_the_records_arithmetic() {
+        let f: Vec<f64> = (0..300u64)
+            .map(|i| ((i.wrapping_mul(2654435761) % 1000) as f64 / 7.0).sqrt() * 1e-3)
+            .collect();
+        for q in [1, 2, 3, 7, 16, 33, 100] {
+            for n_total in [1, 2, q, q + 1, 3 * q + 2, f.len() + 1 - q] {
+                if n_total + q - 1 > f.len() {
+                    continue;
+                }
+                let mut whole = vec![f64::NAN; n_total];
+                sliding_sums(&f[..n_total + q - 1], q, &mut whole);
+                for g0 in 0..n_total {
+                    for len in [1, 2, 5, q, q + 3, n_total] {
+                        let len = len.min(n_total - g0);
+                        let mut part = vec![f64::NAN; len];
+                        sliding_sums_at(&f[g0..g0 + len + q - 1], q, g0, n_total, &mut part);
+                        for j in 0..len {
+                            assert_eq!(
+                                part[j].to_bits(),
+                                whole[g0 + j].to_bits(),
+                                "q {q} n {n_total} g0 {g0} len {len} j {j}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// A record whose mean is far above its noise (7000 σ) and whose noise level changes: centring
+    /// and block alignment matter in the last bits.
+    fn biased_record(n: usize, seed: u64) -> Vec<f64> {
+        let mut x = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (0..n)
+            .map(|i| {
+                x = x
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                let u = (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                7000.0 + u * if i < n / 3 { 3.0 } else { 1.0 }
+            })
+            .collect()
+    }
+
+    /// The streaming path of a part (what the record's call does when it streams).
+    fn streamed(req: &Request, mus: &[f64], first: usize, total: usize) -> Vec<f64> {
+        let n_win = validate(req).unwrap().min(total - first);
+        let mut out = vec![0.0; req.columns.len() * req.ms.len() * n_win];
+        let part = Part { first, total };
+        part_rows(req, mus, part, false, &mut out, &Cancel::new());
+        out
+    }
+
+    #[test]
+    fn a_part_of_the_record_gives_the_records_windows() {
+        let n = 3001;
+        let cols_owned = [biased_record(n, 1), biased_record(n, 2)];
+        let cols: Vec<&[f64]> = cols_owned.iter().map(|c| c.as_slice()).collect();
+        let mus: Vec<f64> = cols.iter().map(|c| compensated_mean(c)).collect();
+        // (window, hop): m ≤ 8 and > 8, hop 1, ≤ 64, > 64, hops longer than some terms (q = 0),
+        // a single window.
+        let cases = [
+            (500, 1),
+            (500, 7),
+            (401, 64),
+            (700, 65),
+            (1000, 130),
+            (300, 290),
+            (2999, 3),
+            (n, 1),
+            (2500, 600),
+        ];
+        let (mut differ, mut compared, mut worst) = (0usize, 0usize, 0.0f64);
+        for estimator in [Estimator::Overlapping, Estimator::Classic] {
+            for (window, hop) in cases {
+                let mut ms: Vec<usize> = vec![1, 2, 3, 8, 9, 10, 17, 64, 100, 149, window / 2];
+                ms.retain(|&m| m <= window / 2);
+                ms.dedup();
+                let req = Request {
+                    columns: &cols,
+                    window,
+                    hop,
+                    ms: &ms,
+                    estimator,
+                    method: Method::Fast,
+                };
+                let (record, n_win) = dynamic_avar(&req).unwrap();
+                let whole = streamed(&req, &mus, 0, n_win);
+                // this record is small: the record's call streams only the classic estimator
+                let phase = estimator == Estimator::Overlapping;
+                if !phase && n_win >= 2 {
+                    assert!(whole
+                        .iter()
+                        .zip(&record)
+                        .all(|(a, b)| a.to_bits() == b.to_bits()));
+                }
+                let starts: Vec<usize> = (0..n_win)
+                    .step_by(1 + n_win / 7)
+                    .chain([n_win - 1])
+                    .collect();
+                for &first in &starts {
+                    for count in [1, 2, 3, n_win] {
+                        let count = count.min(n_win - first);
+                        let s0 = first * hop;
+                        let len = ((count - 1) * hop + window).min(n - s0);
+                        let part_cols: Vec<&[f64]> =
+                            cols.iter().map(|c| &c[s0..s0 + len]).collect();
+                        let preq = Request {
+                            columns: &part_cols,
+                            ..req
+                        };
+                        let (got, k) = dynamic_avar_part_cancellable(
+                            &preq,
+                            &mus,
+                            first,
+                            n_win,
+                            &Cancel::new(),
+                        )
+                        .unwrap();
+                        assert_eq!(k, count);
+                        let part = streamed(&preq, &mus, first, n_win);
+                        // the part on its own (its own mean and alignment) rounds differently
+                        let (alone, _) = dynamic_avar(&preq).unwrap();
+                        let per_row = alone.len() / (cols.len() * ms.len());
+                        for row in 0..cols.len() * ms.len() {
+                            for j in 0..count {
+                                let w = whole[row * n_win + first + j];
+                                differ += usize::from(alone[row * per_row + j] != w);
+                                compared += 1;
+                                // streaming: the same additions in the same order
+                                assert_eq!(
+                                    part[row * count + j].to_bits(),
+                                    w.to_bits(),
+                                    "{estimator:?} window {window} hop {hop} first {first} \
+                                     count {count} row {row} j {j}"
+                                );
+                                // the part entry against the record's call (its path)
+                                let (g, r) =
+                                    (got[row * count + j], record[row * n_win + first + j]);
+                                let exact = !phase || (first == 0 && (count >= 2 || n_win == 1));
+                                if exact {
+                                    assert_eq!(
+                                        g.to_bits(),
+                                        r.to_bits(),
+                                        "{estimator:?} {window} {hop}"
+                                    );
+                                } else {
+                                    worst = worst.max((g / r - 1.0).abs());
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // the phase path of a part: the record's terms from differently rounded phase values
+        assert!(worst > 0.0 && worst < 1e-13, "worst {worst:e}");
+        // the streaming equality is not a property of any part: computed on their own (their own
+        // mean, their own alignment) a quarter of these values differ in the last bits
+        assert!(differ * 10 > compared, "{differ} of {compared} differ");
+    }
+
+    #[test]
+    fn the_record_mean_from_its_parts_is_bit_identical() {
+        let y = biased_record(10_007, 3);
+        let mut st = (0.0, 0.0);
+        for c in y.chunks(977) {
+            st = compensated_sum_from(c, st);
+        }
+        assert_eq!(
+            ((st.0 + st.1) / y.len() as f64).to_bits(),
+            compensated_mean(&y).to_bits()
+        );
+    }
+
+    #[test]
+    fn a_part_names_bad_arguments() {
+        let y = biased_record(100, 4);
+        let cols = [y.as_slice()];
+        let req = Request {
+            columns: &cols,
+            window: 10,
+            hop: 5,
+            ms: &[1, 2],
+            estimator: Estimator::Overlapping,
+            method: Method::Fast,
+        };
+        let c = Cancel::new();
+        assert!(dynamic_avar_part_cancellable(&req, &[f64::NAN], 0, 30, &c).is_err());
+        assert!(dynamic_avar_part_cancellable(&req, &[1.0, 2.0], 0, 30, &c).is_err());
+        assert!(dynamic_avar_part_cancellable(&req, &[1.0], 30, 30, &c).is_err());
+        // a part longer than the rest of the record gives the record's windows only
+        assert_eq!(
+            dynamic_avar_part_cancellable(&req, &[1.0], 25, 28, &c)
+                .unwrap()
+                .1,
+            3
+        );
     }
 
     #[test]

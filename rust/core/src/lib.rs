@@ -4,6 +4,7 @@
 //! entry point validates its arguments and returns [`CoreError`] instead of panicking.
 
 pub mod allan;
+pub mod angle;
 pub mod cancel;
 pub mod deviations;
 pub mod error;
@@ -13,9 +14,11 @@ pub mod taper;
 pub mod theo;
 
 pub use allan::{
-    compensated_mean, dynamic_avar, dynamic_avar_cancellable, max_m, n_terms, n_windows,
-    run_in_pool, static_avar, Estimator, Method, Request,
+    compensated_mean, compensated_sum_from, dynamic_avar, dynamic_avar_cancellable,
+    dynamic_avar_part_cancellable, max_m, n_terms, n_windows, run_in_pool, static_avar, Estimator,
+    Method, Request,
 };
+pub use angle::{angle_term_sums_cancellable, AngleChunk};
 pub use cancel::{run_in_pool_interruptible, Cancel};
 pub use error::{CoreError, Result};
 pub use taper::{dynamic_hann, dynamic_hann_cancellable, static_hann};

@@ -8,12 +8,14 @@
 //! `run_interruptible(py, workers, |cancel| kernel_cancellable(..., cancel))`.
 
 use allanite_core::dynamic_hann_cancellable;
+use allanite_core::{angle_term_sums_cancellable, AngleChunk};
+use allanite_core::{compensated_sum_from, dynamic_avar_part_cancellable};
 use allanite_core::{
     deviations, dynamic_avar_cancellable, dynamic_theo1_cancellable, run_in_pool_interruptible,
     static_theo1_cancellable, Cancel, CoreError, Estimator, Method, Request,
 };
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use std::time::Duration;
 
@@ -128,6 +130,143 @@ fn davar<'py>(
     let (values, n_win) =
         run_interruptible(py, workers, |cancel| dynamic_avar_cancellable(&req, cancel))?;
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// [`davar`] of the windows `first_window ..` of a record of `n_windows` windows, from a part of it
+/// (`columns`: the record's samples from `first_window · hop` on) centred on the record's means
+/// `mus`: the whole-record values, bit for bit where the record's call streams and to a few ε on its
+/// phase path (allanite-core `dynamic_avar_part_cancellable`). For
+/// allanite.dask, whose blocks hold parts of a record.
+#[pyfunction]
+#[pyo3(signature = (columns, window, hop, ms, estimator, method, workers, mus, first_window, n_windows))]
+#[allow(clippy::too_many_arguments)]
+fn davar_part<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    window: usize,
+    hop: usize,
+    ms: Vec<usize>,
+    estimator: &str,
+    method: &str,
+    workers: usize,
+    mus: Vec<f64>,
+    first_window: usize,
+    n_windows: usize,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let estimator = parse_estimator(py, estimator)?;
+    let method = parse_method(py, method)?;
+    let slices = contiguous(py, &columns)?;
+    let req = Request {
+        columns: &slices,
+        window,
+        hop,
+        ms: &ms,
+        estimator,
+        method,
+    };
+    let (values, n_win) = run_interruptible(py, workers, |cancel| {
+        dynamic_avar_part_cancellable(&req, &mus, first_window, n_windows, cancel)
+    })?;
+    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// Neumaier's compensated sum of each column continued from `state` ((sum, compensation) per axis):
+/// the new state per axis. Fed a record's parts in order, it ends at the state whose (s + c) / n is
+/// the core's centring value of the whole record, bit for bit (allanite-core `compensated_sum_from`).
+#[pyfunction]
+#[pyo3(signature = (columns, state))]
+fn compensated_sums(
+    py: Python<'_>,
+    columns: Vec<PyReadonlyArray1<'_, f64>>,
+    state: Vec<(f64, f64)>,
+) -> PyResult<Vec<(f64, f64)>> {
+    let slices = contiguous(py, &columns)?;
+    if state.len() != slices.len() {
+        return Err(allanite_error_of(
+            py,
+            "ParameterError",
+            format!(
+                "{} states given for {} axes: one (sum, compensation) per axis is needed",
+                state.len(),
+                slices.len()
+            ),
+        ));
+    }
+    Ok(py.detach(|| {
+        slices
+            .iter()
+            .zip(state)
+            .map(|(c, st)| compensated_sum_from(c, st))
+            .collect()
+    }))
+}
+
+/// Σ (X[i+2m] − 2X[i+m] + X[i])² in quanta² per plan item (m, i0, i1) and axis, X the exact angle of
+/// the chunks given (rate samples (samples, axes) C-contiguous, each with its record start and exact
+/// angle offset per axis: whole quanta and remainder), q = 2^q_exp: shape (items, axes). The kernel
+/// of allanite.dask.avar (allanite-core `angle_term_sums_cancellable`).
+#[pyfunction]
+#[pyo3(signature = (blocks, starts, off_w, off_r, q_exp, plan, classic, workers))]
+#[allow(clippy::too_many_arguments)]
+fn angle_term_sums<'py>(
+    py: Python<'py>,
+    blocks: Vec<PyReadonlyArray2<'py, f64>>,
+    starts: Vec<usize>,
+    off_w: Vec<Vec<i64>>,
+    off_r: Vec<Vec<f64>>,
+    q_exp: i32,
+    plan: Vec<(usize, usize, usize)>,
+    classic: bool,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let n = blocks.len();
+    if starts.len() != n || off_w.len() != n || off_r.len() != n || n == 0 {
+        return Err(allanite_error_of(
+            py,
+            "ParameterError",
+            format!(
+                "{n} blocks, {} starts, {} and {} offsets: one of each per block is needed",
+                starts.len(),
+                off_w.len(),
+                off_r.len()
+            ),
+        ));
+    }
+    let n_axes = blocks[0].as_array().ncols();
+    let mut chunks = Vec::with_capacity(n);
+    for (j, b) in blocks.iter().enumerate() {
+        let y = b.as_slice().map_err(|_| {
+            allanite_error_of(
+                py,
+                "InputError",
+                format!("block {j} is not a C-contiguous float64 (samples, axes) array"),
+            )
+        })?;
+        if b.as_array().ncols() != n_axes {
+            return Err(allanite_error_of(
+                py,
+                "InputError",
+                format!(
+                    "block {j} has {} axes, block 0 has {n_axes}",
+                    b.as_array().ncols()
+                ),
+            ));
+        }
+        chunks.push(AngleChunk {
+            start: starts[j],
+            y,
+            off_w: &off_w[j],
+            off_r: &off_r[j],
+        });
+    }
+    let values = run_interruptible(py, workers, |cancel| {
+        angle_term_sums_cancellable(&chunks, n_axes, q_exp, &plan, classic, cancel)
+    })?;
+    let arr = Array2::from_shape_vec((plan.len(), n_axes), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
 }
@@ -453,6 +592,9 @@ fn tierms_phase<'py>(
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
     m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
+    m.add_function(wrap_pyfunction!(davar_part, m)?)?;
+    m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;
+    m.add_function(wrap_pyfunction!(angle_term_sums, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_static, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_dynamic, m)?)?;
     m.add_function(wrap_pyfunction!(deviation_static, m)?)?;
