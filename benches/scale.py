@@ -6,8 +6,10 @@ Writes benches/results/<--out>.json (default scale.json); benches/results/scale.
 measured. ``--compare-numpy`` also runs the static tasks with the NumPy kernel they used before the
 Rust one (allanite._reference.angle_term_sums), in the same run. The record is written to ``--scratch`` as a .npy and
 read memory-mapped; it is deleted at the end. Workers get ``--memory-limit`` (default 400 MB, well
-below the record's 8·samples bytes). Peak memory: the client's ru_maxrss, and each worker process's
-RSS sampled every 0.2 s.
+below the record's 8·samples bytes). Peak memory: each worker process's RSS and the client's
+RSS, sampled every 0.2 s during the Dask calls (``*_client_peak_rss``), and the client's ru_maxrss over
+the whole run (``client_peak_rss``: includes writing the record through a memory map and, unless
+``--no-single``, loading it for the single-machine calls).
 """
 
 from __future__ import annotations
@@ -142,17 +144,19 @@ def bench_record(args) -> dict:
         with cluster, client:
             pids = list(client.run(os.getpid).values())
             x = from_npy(path, args.chunk)
-            mon = RssPeak(pids)
+            mon, me = RssPeak(pids), RssPeak([os.getpid()])
             t = time.perf_counter()
             d = adask.davar(x, 100.0, window=window, hop=hop, taus="octave", chunk=args.chunk)
             out["davar_s"] = time.perf_counter() - t
             out["davar_worker_peak_rss"] = mon.close()
+            out["davar_client_peak_rss"] = me.close()
             print("davar on Dask", out["davar_s"], "s", flush=True)
-            mon = RssPeak(pids)
+            mon, me = RssPeak(pids), RssPeak([os.getpid()])
             t = time.perf_counter()
             s = adask.avar(x, 100.0, taus="octave", chunk=args.chunk, client=client)
             out["avar_s"] = time.perf_counter() - t
             out["avar_worker_peak_rss"] = mon.close()
+            out["avar_client_peak_rss"] = me.close()
             print("static OAVAR on Dask", out["avar_s"], "s", flush=True)
             if args.compare_numpy:  # the same tasks with the NumPy kernel they used before
                 rust_kernel = adask.arrays._sum_block

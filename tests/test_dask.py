@@ -491,6 +491,28 @@ def test_zarr_record(client, tmp_path):
     assert _rel(got.avar, refd.avar) <= 1e-14
 
 
+def test_from_npy_reads_rows_in_the_tasks(client, tmp_path):
+    import pickle
+
+    y = _record(12_345, 2)
+    np.save(tmp_path / "rec.npy", y)
+    x = adask.from_npy(tmp_path / "rec.npy", chunk=3_000)
+    assert x.shape == y.shape and x.chunks[0] == (3_000,) * 4 + (345,)
+    # the graph names the file, it does not carry the samples (a pickled memmap would: 197 kB)
+    assert len(pickle.dumps(dict(x.__dask_graph__()))) < 20_000
+    assert np.array_equal(x.compute(), y)
+    ref = allanite.avar(y, 100.0)
+    assert _rel(adask.avar(x, 100.0, client=client).avar, ref.avar) <= REL
+    np.save(tmp_path / "cube.npy", np.zeros((4, 3, 2)))
+    with pytest.raises(InputError, match=r"3-D array of shape \(4, 3, 2\)"):
+        adask.from_npy(tmp_path / "cube.npy")
+    (tmp_path / "bad.npy").write_text("not a npy")
+    with pytest.raises(InputError, match="not a readable .npy"):
+        adask.from_npy(tmp_path / "bad.npy")
+    with pytest.raises(ParameterError, match="chunk"):
+        adask.from_npy(tmp_path / "rec.npy", chunk=0)
+
+
 def test_cli_batch_help(capsys):
     from allanite.cli import main
 

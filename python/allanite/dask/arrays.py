@@ -53,6 +53,7 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
     raise MissingDependencyError("allanite.dask needs dask and distributed: pip install 'allanite[dask]'") from exc
 
 __all__ = [
+    "from_npy",
     "davar",
     "avar",
     "wavelet_split",
@@ -77,6 +78,51 @@ MAX_STATIC_CHUNK = 1 << 23
 
 _ESTIMATORS = ("oavar", "avar")
 _INPUTS = ("rate", "increment")
+
+
+def _read_npy_rows(path: str, a: int, b: int) -> np.ndarray:
+    return np.array(np.load(path, mmap_mode="r")[a:b])
+
+
+def from_npy(path, *, chunk: int = DEFAULT_CHUNK) -> da.Array:
+    """A .npy file on disk as a dask array whose tasks read their own rows (memory-mapped).
+
+    ``da.from_array(np.load(path, mmap_mode="r"))`` looks equivalent but is not on a cluster: the
+    memory map is pickled into the task graph, and a NumPy memmap pickles as its whole contents — an
+    8 GB record sent to the scheduler. Here every task opens the file and copies only its rows, so
+    the client and the scheduler hold nothing but the file's name. The path must be readable by the
+    workers (a shared or local disk).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A .npy file of shape (samples,) or (samples, axes), any real dtype.
+    chunk : int
+        Rows per chunk (default :data:`DEFAULT_CHUNK`).
+
+    Returns
+    -------
+    dask.array.Array
+    """
+    path = str(path)
+    chunk = check_count(chunk, "chunk", 1)
+    try:
+        head = np.load(path, mmap_mode="r")
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path!r} is not a readable .npy file: {exc}") from None
+    if head.ndim not in (1, 2):
+        raise InputError(f"{path!r} holds a {head.ndim}-D array of shape {head.shape}: (samples,) or (samples, axes)")
+    n, tail, dtype = head.shape[0], head.shape[1:], head.dtype
+    del head
+    parts = [
+        da.from_delayed(
+            dask.delayed(_read_npy_rows, pure=True)(path, a, min(n, a + chunk)), (min(n, a + chunk) - a, *tail), dtype
+        )
+        for a in range(0, n, chunk)
+    ]
+    if not parts:
+        return da.zeros((0, *tail), dtype=dtype)
+    return da.concatenate(parts)
 
 
 def _pywt():
@@ -261,8 +307,8 @@ def davar(
     Parameters
     ----------
     x : dask.array.Array or array_like, shape (samples,) or (samples, axes)
-        Rate or increment samples (e.g. ``da.from_zarr``, ``da.from_array(np.load(p, mmap_mode="r"))``,
-        an HDF5 dataset); any chunks and any real dtype (float32 is widened exactly, as on one machine) —
+        Rate or increment samples (e.g. ``da.from_zarr``, :func:`from_npy` for a .npy on disk, an HDF5
+        dataset); any chunks and any real dtype (float32 is widened exactly, as on one machine) —
         they are rechunked along the samples (one chunk across the axes).
     fs, window, hop, taus, method, input
         As for :func:`allanite.davar`.
