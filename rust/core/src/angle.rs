@@ -24,6 +24,7 @@
 
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
+use crate::oavar::PhaseBuf;
 use rayon::prelude::*;
 
 /// Longest run of terms summed into the lane accumulators before it is folded into the total.
@@ -60,57 +61,13 @@ fn scale(y: f64, k: i32) -> f64 {
     }
 }
 
-/// A zeroed f64 buffer whose 2 MiB-aligned interior the kernel may back with 2 MiB pages: a task's
-/// angle is 16 bytes per sample, written once, and faulting it in 4 KiB pages costs more than
-/// building it. (The same device as `oavar`'s phase buffer; calloc maps fresh memory untouched, so
-/// the advice lands before the first write.)
-struct HugeBuf {
-    v: Vec<f64>,
-    off: usize,
-    len: usize,
-}
-
-const HUGE: usize = 2 << 20;
-
-impl HugeBuf {
-    fn new(len: usize) -> Self {
-        let v = vec![0.0f64; len + HUGE / 8];
-        let addr = v.as_ptr() as usize;
-        let off = (addr.next_multiple_of(HUGE) - addr) / 8;
-        #[cfg(target_os = "linux")]
-        {
-            let bytes = (len * 8) / HUGE * HUGE;
-            if bytes > 0 {
-                // SAFETY: [v + off, v + off + bytes) lies inside v's allocation and is 2 MiB
-                // aligned; MADV_HUGEPAGE is advice only (an error is ignored: 4 KiB pages).
-                unsafe {
-                    libc::madvise(
-                        v.as_ptr().add(off) as *mut libc::c_void,
-                        bytes,
-                        libc::MADV_HUGEPAGE,
-                    );
-                }
-            }
-        }
-        HugeBuf { v, off, len }
-    }
-
-    fn get(&self) -> &[f64] {
-        &self.v[self.off..self.off + self.len]
-    }
-
-    fn get_mut(&mut self) -> &mut [f64] {
-        &mut self.v[self.off..self.off + self.len]
-    }
-}
-
 /// The angle of one run of consecutive chunks, one axis: X_w = base + hi exactly (hi the whole quanta
 /// since the run's start, an integer below 2^52 in magnitude, so exact in f64), X_r = lo.
 struct Run {
     start: usize,
     base: i64,
-    hi: HugeBuf,
-    lo: HugeBuf,
+    hi: PhaseBuf,
+    lo: PhaseBuf,
 }
 
 /// Whole quanta per sample beyond this mean the quantum was chosen too small for the samples.
@@ -139,9 +96,9 @@ fn build_run(
     q_exp: i32,
     len: usize,
 ) -> Result<Run> {
-    let mut hi_buf = HugeBuf::new(len + 1);
-    let mut lo_buf = HugeBuf::new(len + 1);
-    let (hi, lo) = (hi_buf.get_mut(), lo_buf.get_mut());
+    let mut hi_buf = PhaseBuf::new(len + 1);
+    let mut lo_buf = PhaseBuf::new(len + 1);
+    let (hi, lo) = (hi_buf.slice(), lo_buf.slice());
     let (base, or) = (chunks[0].off_w[axis], chunks[0].off_r[axis]);
     lo[0] = or;
     let (mut w_acc, mut r_acc) = (0.0f64, 0.0f64);
@@ -182,7 +139,7 @@ fn build_run(
 /// The run holding angle points [lo, hi), and the offset of `lo` in it.
 fn find(runs: &[Run], lo: usize, hi: usize) -> Option<(&Run, usize)> {
     runs.iter()
-        .find(|r| r.start <= lo && hi - r.start <= r.hi.len)
+        .find(|r| r.start <= lo && hi - r.start <= r.hi.get().len())
         .map(|r| (r, lo - r.start))
 }
 

@@ -146,8 +146,8 @@ pub(crate) fn advise_huge_pages(v: &mut [f64]) {
 /// A zeroed f64 buffer whose pages the kernel may back with 2 MiB pages: the phase of a long record
 /// is 16 bytes per sample, and faulting it in 4 KiB pages cost more than building it (~80 ms of
 /// ~100 ms at 10⁷ samples). The zeroed allocation is fresh memory (calloc maps it untouched), so the
-/// advice lands before the first touch.
-struct PhaseBuf {
+/// advice lands before the first touch. Also the buffer of the Dask tasks' angles (`angle.rs`).
+pub(crate) struct PhaseBuf {
     v: Vec<f64>,
     off: usize,
     len: usize,
@@ -156,7 +156,7 @@ struct PhaseBuf {
 const HUGE: usize = 2 << 20;
 
 impl PhaseBuf {
-    fn new(len: usize) -> Self {
+    pub(crate) fn new(len: usize) -> Self {
         if len * 8 < HUGE {
             // a small phase: no 2 MiB padding, no advice (their syscalls would cost more than the faults)
             return PhaseBuf {
@@ -186,8 +186,12 @@ impl PhaseBuf {
         PhaseBuf { v, off, len }
     }
 
-    fn slice(&mut self) -> &mut [f64] {
+    pub(crate) fn slice(&mut self) -> &mut [f64] {
         &mut self.v[self.off..self.off + self.len]
+    }
+
+    pub(crate) fn get(&self) -> &[f64] {
+        &self.v[self.off..self.off + self.len]
     }
 }
 
