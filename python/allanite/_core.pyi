@@ -30,7 +30,10 @@ def davar_part(
 ) -> npt.NDArray[np.float64]:
     """davar of windows first_window.. of a record of n_windows windows, from its samples from
     first_window·hop on, centred on the record's means: the whole-record values (bit for bit where the
-    record's call streams; to a few ε on its phase path)."""
+    record's call streams, and from a part_grid start on its phase path; to a few ε elsewhere)."""
+
+def part_grid(n: int, n_axes: int, window: int, hop: int, estimator: str, method: str) -> int:
+    """Samples between the cuts of a record into davar_part parts that give the whole call bit for bit."""
 
 def compensated_sums(
     columns: Sequence[npt.NDArray[np.float64]],

@@ -130,9 +130,9 @@ def as_rate_columns(x: object, fs: object, input: str) -> tuple[list[np.ndarray]
     out = []
     for a, c in enumerate(cols):
         c = np.asarray(c, dtype=np.float64)
-        finite = np.isfinite(c)
-        if not finite.all():
-            i = int(np.argmin(finite))
+        # min and max are NaN if any sample is, ±inf if any is: no per-sample temporary unless one is bad
+        if not (np.isfinite(c.min()) and np.isfinite(c.max())):
+            i = int(np.argmin(np.isfinite(c)))
             where = f"sample {i}" + (f" of axis {a}" if is_multi else "")
             raise InputError(f"samples contain a non-finite value ({c[i]}) at {where}; only finite numbers are allowed")
         if input == "rate":

@@ -39,7 +39,7 @@ def _scale_columns(cols: list[np.ndarray]) -> tuple[list[np.ndarray], list[int]]
     """Columns scaled into the safe range, and each column's power-of-two exponent e (sample = scaled·2^e)."""
     out, exps = [], []
     for c in cols:
-        peak = float(np.max(np.abs(c))) if c.size else 0.0
+        peak = _peak(c)
         if peak == 0.0 or 2.0**-SAFE_EXP < peak < 2.0**SAFE_EXP:
             out.append(c)
             exps.append(0)
@@ -51,8 +51,8 @@ def _scale_columns(cols: list[np.ndarray]) -> tuple[list[np.ndarray], list[int]]
 
 
 def _peak(c: np.ndarray) -> float:
-    """Largest magnitude of a column (for messages only: a pass over the record)."""
-    return float(np.max(np.abs(c))) if c.size else 0.0
+    """Largest magnitude of a column: two passes over the record, no temporary (``np.abs`` would copy it)."""
+    return max(float(c.max()), -float(c.min())) if c.size else 0.0
 
 
 def _unscale(values: np.ndarray, exps: list[int], power: int, cols: list[np.ndarray], what: str) -> np.ndarray:
@@ -61,11 +61,14 @@ def _unscale(values: np.ndarray, exps: list[int], power: int, cols: list[np.ndar
     out = []
     for a, (v, e) in enumerate(zip(values, exps)):
         where = f"axis {a}: " if len(values) > 1 else ""
-        pos = v[v > 0]
-        # binary exponent of the result: log2 of the scaled value plus power·e, judged before scaling back
-        top = float(np.log2(pos.max())) + power * e if pos.size else -math.inf
-        bottom = float(np.log2(pos.min())) + power * e if pos.size else math.inf
-        if not np.all(np.isfinite(v)) or top >= 1024:
+        # binary exponent of the result: log2 of the scaled value plus power·e, judged before scaling back.
+        # Row by row, so no temporary the size of the output (a hop-1 surface can be gigabytes).
+        hi = float(v.max()) if v.size else 0.0  # NaN if any value is, inf if any is
+        rows = v.reshape(-1, v.shape[-1]) if v.size else ()
+        lo_pos = min((float(np.min(r, where=r > 0, initial=math.inf)) for r in rows), default=math.inf)
+        top = math.log2(hi) + power * e if hi > 0 else -math.inf
+        bottom = math.log2(lo_pos) + power * e if lo_pos < math.inf else math.inf
+        if not math.isfinite(hi) or (v.size and not math.isfinite(float(v.min()))) or top >= 1024:
             peak = _peak(cols[a])
             raise InputError(
                 f"{where}the {what} of samples of magnitude up to {peak:.3g} exceeds float64's range (≈1.8e308): "

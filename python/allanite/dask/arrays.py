@@ -7,13 +7,14 @@ The functions give the numbers of the single-machine calls (:func:`allanite.avar
   next ``window − 1`` samples to every chunk (``map_overlap`` with ``depth={0: (0, window − 1)}``,
   ``boundary="none"``, ``trim=False``) and hands every block to the Rust core as a *part of the record*
   (``dynamic_avar_part_cancellable``) with the record's centring value and the block's first window;
-  the core follows the record's own path. Where the single-machine call streams its sums (the
-  classic estimator; the overlapping one when its windows read more than 2^26 samples × axes, 512 MB
-  of float64 — the records Dask is for) the part forms the same terms, block sums and window sums in the same
-  order: **bit for bit**. Below that the single machine builds a double-word phase of the whole
-  record (a running sum from its start); a block rebuilds it from its own start, so each term is the
-  same quantity from differently rounded phase values: equal to a few ε of the term's block sums
-  (≤ 1.4e-14 relative in tests, 3.4e-13 on an axis whose mean jumps by 7000 σ), not bitwise. The
+  the core follows the record's own path, and the chunks are cut where the core's parts give the
+  whole call's values: **bit for bit**, at every size. Where the single-machine call streams its sums
+  (the classic estimator; the overlapping one when its windows read more than 2^26 samples × axes,
+  512 MB of float64 — the records Dask is for) any cut on the hop grid does: the part forms the same
+  terms, block sums and window sums in the same order. Below that the single machine builds a
+  double-word phase per *segment* of max(2^22, 16 · window) samples' worth of windows (a running sum
+  from the segment's first sample), and the chunks are whole segments (``_core.part_grid``): each
+  block rebuilds exactly its segments' phases. The
   centring value is the core's compensated (Neumaier) sum, which is sequential: a first pass runs it
   over the chunks in order (a chain of small tasks, :data:`CENTRE_BATCH` chunks per compute),
   continuing each chunk from the state the previous one left.
@@ -38,7 +39,7 @@ import math
 
 import numpy as np
 
-from .. import analysis, estimators
+from .. import _core, analysis, estimators
 from .. import wavelet as wavelet_mod
 from .._validate import check_choice, check_count, resolve_workers
 from ..errors import InputError, MissingDependencyError, ParameterError
@@ -160,16 +161,23 @@ def _check(estimator: str, input: str, fs) -> float:
     return fs
 
 
-def davar_chunks(n: int, window: int, hop: int, target: int) -> tuple[tuple[int, ...], tuple[int, ...]]:
+def davar_chunks(
+    n: int, window: int, hop: int, target: int, unit: int | None = None
+) -> tuple[tuple[int, ...], tuple[int, ...]]:
     """Input chunks along the samples and DAVAR windows per chunk, for ``map_overlap``.
 
-    Every chunk but the last holds a multiple of ``hop`` samples (so each block's first window starts
-    on the global hop grid) and at least ``window − 1`` (so one neighbour supplies the whole overlap);
-    the last chunk takes the remainder. Block k then computes the windows that *start* in it; the
-    counts are exact — dask accepts wrong ``chunks=`` silently, so they are computed, not guessed.
+    Every chunk but the last holds a multiple of ``unit`` samples (default ``hop``; a multiple of it —
+    the core's ``part_grid``, where a cut gives the whole call's values bit for bit), so each block's
+    first window starts on the global hop grid, and at least ``window − 1`` (so one neighbour supplies
+    the whole overlap); the last chunk takes the remainder. Block k then computes the windows that
+    *start* in it; the counts are exact — dask accepts wrong ``chunks=`` silently, so they are
+    computed, not guessed.
     """
+    unit = hop if unit is None else unit
+    if unit % hop:
+        raise ParameterError(f"unit ({unit} samples) must be a multiple of the hop ({hop})")
     size = max(target, window - 1, hop)
-    size = -(-size // hop) * hop
+    size = -(-size // unit) * unit
     n_win = (n - window) // hop + 1
     k = max(1, n // size)
     chunks = [size] * (k - 1) + [n - size * (k - 1)]
@@ -314,18 +322,20 @@ def davar(
         As for :func:`allanite.davar`.
     estimator : {"oavar", "avar"}
     chunk : int, optional
-        Samples per chunk before rounding up to a multiple of ``hop`` and to at least ``window − 1``
-        (default: the caller's first chunk, at least :data:`DEFAULT_CHUNK`/4).
+        Samples per chunk before rounding up to at least ``window − 1`` and to a multiple of the
+        core's part grid: the hop where the single-machine call streams its sums, whole phase segments
+        (max(2^22, 16 · window) samples' worth of windows) where it takes its phase path — records of
+        at most 2^26 samples × axes (default: the caller's first chunk, at least :data:`DEFAULT_CHUNK`/4).
     compute : bool
         True (default): a :class:`~allanite.DynamicAllanResult`, as the single-machine one.
         False: the lazy (axes, τ, windows) dask array of the Allan variance (the centring pass runs now).
 
     Notes
     -----
-    Equal to :func:`allanite.davar` bit for bit where it streams its sums (``estimator="avar"``, and
-    ``"oavar"`` when the windows read more than 2^26 samples × axes, 512 MB of float64),
-    to a few ε of each term's block sums below that, where one machine takes its phase path (see the
-    module notes). Two passes over the record: the centring pass runs the
+    Equal to :func:`allanite.davar` bit for bit: the chunks are cut where the core's parts give the
+    whole call's values (on the hop grid where it streams its sums — ``estimator="avar"``, and
+    ``"oavar"`` when the windows read more than 2^26 samples × axes, 512 MB of float64 — and at its
+    phase segments below that; see the module notes). Two passes over the record: the centring pass runs the
     core's compensated sum over the chunks in order (a chain of tasks, :data:`CENTRE_BATCH` chunks per
     ``dask.compute``; a second chain only when the samples need the power-of-two scaling of the
     single-machine call, |sample| ≥ 2^200 or < 2^-200), which gives the record's centring value and
@@ -350,7 +360,9 @@ def davar(
     n_tau = int(ms.size)
     n_axes = int(arr.shape[1]) if arr.ndim == 2 else 1
     target = chunk if chunk is not None else max(int(arr.chunks[0][0]), DEFAULT_CHUNK // 4)
-    chunks, counts = davar_chunks(n, window, hop, int(target))
+    # cut where the core's parts are the whole call's values bit for bit (its phase segments or the hop)
+    grid = _core.part_grid(n, n_axes, window, min(hop, n), estimator, method)
+    chunks, counts = davar_chunks(n, window, min(hop, n), int(target), grid)
     arr = arr.rechunk({0: chunks, 1: -1} if arr.ndim == 2 else {0: chunks})
     bounds = np.concatenate([[0], np.cumsum(chunks)]).astype(np.int64)
     n_win = (n - window) // hop + 1

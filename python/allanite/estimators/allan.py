@@ -52,7 +52,8 @@ def part_values(
     of it: ``cols`` hold the record's samples from ``first_window·hop`` on, ``mus`` the record's centring
     values (:func:`compensated_sums` over its parts, in order, divided by its length). The whole-record
     values along the record's own path (``dynamic_avar_part_cancellable`` in rust/core/src/allan.rs):
-    bit for bit where the record's call streams its sums, to a few ε where it takes the phase path.
+    bit for bit when ``first_window · hop`` is a multiple of ``_core.part_grid`` (the hop where the record's
+    call streams its sums, a phase segment where it takes the phase path), to a few ε otherwise.
     Internal: for :mod:`allanite.dask`."""
     return _core.davar_part(
         cols,

@@ -612,26 +612,11 @@ pub(crate) fn sliding_sums_at(f: &[f64], q: usize, g0: usize, n_total: usize, ou
     }
 }
 
-/// Overlapping Allan variance of every window, for one m, written to `out` (length n_windows).
-/// Once `cancel` is set, `out` holds garbage (the caller returns `Cancelled` instead).
-#[allow(clippy::too_many_arguments)] // the row's geometry (y, mu, m, window, hop) is irreducible
-fn overlapping_row(
-    y: &[f64],
-    mu: f64,
-    m: usize,
-    window: usize,
-    hop: usize,
-    out: &mut [f64],
-    sc: &mut RowScratch,
-    cancel: &Cancel,
-) {
-    let part = Part::whole(out.len());
-    overlapping_row_at(y, part, mu, m, window, hop, out, sc, cancel)
-}
-
-/// [`overlapping_row`] of the windows `part` of a record, from `y` = the record's samples from
-/// `part.first · hop` on: the values the whole-record call gives them, bit for bit (the same terms,
-/// block sums and window sums, see [`for_each_term_chunk_at`] and [`sliding_sums_at`]).
+/// Overlapping Allan variance of the windows `part` of a record, for one m, written to `out` (length: the
+/// part's windows), from `y` = the record's samples from `part.first · hop` on: the values the
+/// whole-record call gives them, bit for bit (the same terms, block sums and window sums, see
+/// [`for_each_term_chunk_at`] and [`sliding_sums_at`]). Once `cancel` is set, `out` holds garbage
+/// (the caller returns `Cancelled` instead).
 #[allow(clippy::too_many_arguments)]
 fn overlapping_row_at(
     y: &[f64],
@@ -721,24 +706,10 @@ fn overlapping_row_at(
     }
 }
 
-/// Classic (non-overlapping) Allan variance of every window, for one m: clusters start at the
-/// window's first sample, so window j uses the terms a(s + i·m), i = 0 … K−2, s = j·hop.
-fn classic_row(
-    y: &[f64],
-    mu: f64,
-    m: usize,
-    window: usize,
-    hop: usize,
-    out: &mut [f64],
-    cancel: &Cancel,
-) {
-    let part = Part::whole(out.len());
-    classic_row_at(y, part, mu, m, window, hop, out, cancel)
-}
-
-/// [`classic_row`] of the windows `part` of a record, from `y` = the record's samples from
-/// `part.first · hop` on: bit for bit the whole-record values (the same terms; each window's sum
-/// is formed from its own terms in the same order).
+/// Classic (non-overlapping) Allan variance of the windows `part` of a record, for one m: clusters
+/// start at the window's first sample, so window j uses the terms a(s + i·m), i = 0 … K−2, s = j·hop;
+/// `y` = the record's samples from `part.first · hop` on. Bit for bit the whole-record values (the same
+/// terms; each window's sum is formed from its own terms in the same order).
 #[allow(clippy::too_many_arguments)]
 fn classic_row_at(
     y: &[f64],
@@ -960,71 +931,8 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
             }
             // samples any window reads
             let n_used = ((n_win - 1) * req.hop + req.window).min(req.columns[0].len());
-            if req.estimator == Estimator::Overlapping && n_used * n_axes <= GATHER_MAX {
-                // Every window from one double-word phase per axis (see `crate::oavar`): each term is
-                // three reads of it, instead of two running-sum passes over the record per m.
-                let n_m_win = n_m * n_win;
-                for (a, y) in req.columns.iter().enumerate() {
-                    if cancel.is_cancelled() {
-                        break;
-                    }
-                    let ph = crate::oavar::Phase::new(&y[..n_used], mus[a]);
-                    let (hi, lo) = ph.parts();
-                    if n_win >= 2 && req.hop >= crate::oavar::SMALL_HOP {
-                        crate::oavar::overlapping_dynamic_tiled(
-                            hi,
-                            lo,
-                            req.ms,
-                            req.window,
-                            req.hop,
-                            &mut out[a * n_m_win..(a + 1) * n_m_win],
-                            cancel,
-                        );
-                        continue;
-                    }
-                    out[a * n_m_win..(a + 1) * n_m_win]
-                        .par_chunks_mut(n_win)
-                        .enumerate()
-                        .for_each_init(
-                            || (crate::oavar::DynScratch::default(), RowScratch::default()),
-                            |(sc, rs), (t, dst)| {
-                                if cancel.is_cancelled() {
-                                    return;
-                                }
-                                let m = req.ms[t];
-                                if m <= PHASE_M_MAX || n_win == 1 {
-                                    crate::oavar::overlapping_dynamic_row(
-                                        hi, lo, m, req.window, req.hop, dst, sc,
-                                    );
-                                } else {
-                                    overlapping_row(
-                                        y, mus[a], m, req.window, req.hop, dst, rs, cancel,
-                                    );
-                                }
-                            },
-                        );
-                }
-                cancel.check()?;
-                return Ok((out, n_win));
-            }
-            out.par_chunks_mut(n_win).enumerate().for_each_init(
-                RowScratch::default,
-                |sc, (row, dst)| {
-                    if cancel.is_cancelled() {
-                        return;
-                    }
-                    let (a, t) = (row / n_m, row % n_m);
-                    let (y, m) = (req.columns[a], req.ms[t]);
-                    match req.estimator {
-                        Estimator::Overlapping => {
-                            overlapping_row(y, mus[a], m, req.window, req.hop, dst, sc, cancel)
-                        }
-                        Estimator::Classic => {
-                            classic_row(y, mus[a], m, req.window, req.hop, dst, cancel)
-                        }
-                    }
-                },
-            );
+            let phase = takes_phase_path(req.estimator, n_used, n_axes);
+            part_rows(req, &mus, Part::whole(n_win), phase, &mut out, cancel);
         }
         Method::Naive => {
             for (a, y) in req.columns.iter().enumerate() {
@@ -1062,8 +970,8 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
 }
 
 /// The windows `first_window ..` of a record of `n_windows_total` windows, from a part of it: what
-/// [`dynamic_avar`] of the whole record gives those windows — bit for bit wherever the record's call
-/// streams its sums, to rounding (a few ε) where it takes the double-word phase path.
+/// [`dynamic_avar`] of the whole record gives those windows — bit for bit for a part that starts on
+/// the record's [`part_grid`], to rounding (a few ε) for one that starts inside a phase segment.
 ///
 /// `req.columns` hold the record's samples from `first_window · hop` on (at least one window's
 /// worth; the part's windows are those that fit, up to the record's last); `mus` is the record's
@@ -1076,13 +984,13 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
 /// * Streaming: the part centres on `mus`, cuts the terms and block sums at the record's boundaries
 ///   (multiples of m, of the hop, of the window sums' segments) and sizes the edge segments as the
 ///   record does — the same additions in the same order: **bit for bit**.
-/// * Phase path: the record's phase is a double-word running sum of y − μ from the record's start;
-///   the part builds the same running sum from its own start (on the record's μ), so each term is
-///   the same quantity formed from differently rounded phase values — equal to a few ε of the
-///   term's own block sums (measured ≲ 1e-14 relative). A part that starts at the record's start
-///   has the record's phase and is bit for bit (except a one-window part of a many-window record).
-///   Bit for bit everywhere would need the record's phase at the part's start and the record's
-///   block offsets (a second sequential pass over the record).
+/// * Phase path: the record's phase is a double-word running sum of y − μ from the first sample of
+///   each phase segment (runs of `segment_windows` windows, see [`part_rows`]); the part cuts its
+///   windows at the same segment starts, so a part that starts on a segment start has the record's
+///   segments, phases and block sums: **bit for bit**. A part that starts inside a segment builds
+///   its first segment's phase from its own start, so each term there is the same quantity formed
+///   from differently rounded phase values — equal to a few ε of the term's own block sums
+///   (measured ≲ 1e-14 relative).
 /// * Naive: each window from its own samples anyway: bit for bit.
 ///
 /// Returns ([axis][m][window], windows).
@@ -1133,14 +1041,53 @@ pub fn dynamic_avar_part_cancellable(
     }
     // the samples the record's windows read
     let n_used_record = (n_windows_total - 1) * req.hop + req.window;
-    let phase = req.estimator == Estimator::Overlapping && n_used_record * n_axes <= GATHER_MAX;
+    let phase = takes_phase_path(req.estimator, n_used_record, n_axes);
     part_rows(req, mus, part, phase, &mut out, cancel);
     cancel.check()?;
     Ok((out, n_win))
 }
 
-/// The fast path of [`dynamic_avar_part_cancellable`] into `out` ([axis][m][window]): the record's
-/// phase path when `phase`, its streaming rows otherwise (and for what the phase path streams).
+/// Whether the fast dynamic estimator of a record of several windows takes the double-word phase
+/// path: the overlapping estimator when its windows read at most `GATHER_MAX` (2^26) samples × axes.
+/// Longer records stream their sums (which a record cut into parts gives bit for bit at any cut on
+/// the hop grid, see [`dynamic_avar_part_cancellable`]).
+fn takes_phase_path(estimator: Estimator, n_used: usize, n_axes: usize) -> bool {
+    estimator == Estimator::Overlapping && n_used.saturating_mul(n_axes) <= GATHER_MAX
+}
+
+/// Samples between the places a record of `n` samples × `n_axes` can be cut into parts whose
+/// [`dynamic_avar_part_cancellable`] values are the whole call's bit for bit: parts must start at
+/// a multiple of this (the hop where the call streams; a phase segment, `segment_windows` · hop,
+/// on the phase path). `None` if the arguments do not describe a valid dynamic call.
+pub fn part_grid(
+    n: usize,
+    n_axes: usize,
+    window: usize,
+    hop: usize,
+    estimator: Estimator,
+    method: Method,
+) -> Option<usize> {
+    if hop == 0 || window < 2 || window > n || n_axes == 0 {
+        return None;
+    }
+    let n_win = n_windows(n, window, hop);
+    let n_used = (n_win - 1) * hop + window;
+    if method == Method::Fast && n_win >= 2 && takes_phase_path(estimator, n_used, n_axes) {
+        Some(crate::oavar::segment_windows(window, hop) * hop)
+    } else {
+        Some(hop)
+    }
+}
+
+/// The fast path of [`dynamic_avar_part_cancellable`] (and of [`dynamic_avar`], as the part that is
+/// the whole record) into `out` ([axis][m][window]): the record's phase path when `phase`, its
+/// streaming rows otherwise (and for what the phase path streams).
+///
+/// The phase path runs segment by segment: the record's windows are cut into runs of
+/// `segment_windows` (a grid on the record's window index, so a part that starts on it cuts where
+/// the record does), and each run's phase is built from its own first sample — memory for one
+/// segment's phase, not the record's. Within a segment: every m from the phase, tiled for hops ≥ 64;
+/// at shorter hops the rows of m > `PHASE_M_MAX` stream the segment's samples instead.
 fn part_rows(
     req: &Request,
     mus: &[f64],
@@ -1153,39 +1100,79 @@ fn part_rows(
     let n_win = out.len() / (req.columns.len() * n_m);
     let n_m_win = n_m * n_win;
     if phase {
-        // as dynamic_avar's phase branch, on the part's own phase
-        let n_used = (n_win - 1) * req.hop + req.window;
+        let seg = crate::oavar::segment_windows(req.window, req.hop);
         for (a, y) in req.columns.iter().enumerate() {
-            if cancel.is_cancelled() {
-                return;
-            }
-            let ph = crate::oavar::Phase::new(&y[..n_used], mus[a]);
-            let (hi, lo) = ph.parts();
             let dst_axis = &mut out[a * n_m_win..(a + 1) * n_m_win];
-            if part.total >= 2 && n_win >= 2 && req.hop >= crate::oavar::SMALL_HOP {
-                crate::oavar::overlapping_dynamic_tiled(
-                    hi, lo, req.ms, req.window, req.hop, dst_axis, cancel,
-                );
-                continue;
+            // the part's windows j0 .. j1 (its own index), cut where the record's segments start
+            let mut j0 = 0;
+            while j0 < n_win {
+                if cancel.is_cancelled() {
+                    return;
+                }
+                let g = part.first + j0; // the record's window index
+                let j1 = ((g / seg + 1) * seg - part.first).min(n_win);
+                let nw = j1 - j0;
+                let s0 = j0 * req.hop;
+                let ys = &y[s0..s0 + (nw - 1) * req.hop + req.window];
+                let ph = crate::oavar::Phase::new(ys, mus[a]);
+                let (hi, lo) = ph.parts();
+                if part.total >= 2 && nw >= 2 && req.hop >= crate::oavar::SMALL_HOP {
+                    crate::oavar::overlapping_dynamic_tiled(
+                        hi,
+                        lo,
+                        req.ms,
+                        req.window,
+                        req.hop,
+                        dst_axis,
+                        (n_win, j0, nw),
+                        cancel,
+                    );
+                } else {
+                    let sub = Part {
+                        first: g,
+                        total: part.total,
+                    };
+                    dst_axis.par_chunks_mut(n_win).enumerate().for_each_init(
+                        || (crate::oavar::DynScratch::default(), RowScratch::default()),
+                        |(sc, rs), (t, row)| {
+                            if cancel.is_cancelled() {
+                                return;
+                            }
+                            let dst = &mut row[j0..j1];
+                            let m = req.ms[t];
+                            // (a one-window run at a hop ≥ 64 is the tiled path's blocks)
+                            if m <= PHASE_M_MAX
+                                || part.total == 1
+                                || req.hop >= crate::oavar::SMALL_HOP
+                            {
+                                crate::oavar::overlapping_dynamic_row(
+                                    hi,
+                                    lo,
+                                    m,
+                                    req.window,
+                                    req.hop,
+                                    part.total == 1,
+                                    dst,
+                                    sc,
+                                );
+                            } else {
+                                overlapping_row_at(
+                                    &y[s0..],
+                                    sub,
+                                    mus[a],
+                                    m,
+                                    req.window,
+                                    req.hop,
+                                    dst,
+                                    rs,
+                                    cancel,
+                                );
+                            }
+                        },
+                    );
+                }
+                j0 = j1;
             }
-            dst_axis.par_chunks_mut(n_win).enumerate().for_each_init(
-                || (crate::oavar::DynScratch::default(), RowScratch::default()),
-                |(sc, rs), (t, dst)| {
-                    if cancel.is_cancelled() {
-                        return;
-                    }
-                    let m = req.ms[t];
-                    if m <= PHASE_M_MAX || part.total == 1 {
-                        crate::oavar::overlapping_dynamic_row(
-                            hi, lo, m, req.window, req.hop, dst, sc,
-                        );
-                    } else {
-                        overlapping_row_at(
-                            y, part, mus[a], m, req.window, req.hop, dst, rs, cancel,
-                        );
-                    }
-                },
-            );
         }
         return;
     }
@@ -1455,7 +1442,9 @@ mod tests {
                                 // the part entry against the record's call (its path)
                                 let (g, r) =
                                     (got[row * count + j], record[row * n_win + first + j]);
-                                let exact = !phase || (first == 0 && (count >= 2 || n_win == 1));
+                                // (the phase path: bit for bit from a segment's start)
+                                let seg = crate::oavar::segment_windows(window, hop);
+                                let exact = !phase || first % seg == 0;
                                 if exact {
                                     assert_eq!(
                                         g.to_bits(),
@@ -1476,6 +1465,101 @@ mod tests {
         // the streaming equality is not a property of any part: computed on their own (their own
         // mean, their own alignment) a quarter of these values differ in the last bits
         assert!(differ * 10 > compared, "{differ} of {compared} differ");
+    }
+
+    /// The phase path in segments (the unit tests' segments span 2^12 samples): parts that start on
+    /// the segment grid are the record's call bit for bit, others to a few ε; every value matches
+    /// the plain recomputation of its window.
+    #[test]
+    fn phase_segments_cut_where_parts_can() {
+        let n = 20_011;
+        let cols_owned = [biased_record(n, 7), biased_record(n, 8)];
+        let cols: Vec<&[f64]> = cols_owned.iter().map(|c| c.as_slice()).collect();
+        let mus: Vec<f64> = cols.iter().map(|c| compensated_mean(c)).collect();
+        // hop 1 (rows), 7 (rows, blocks), 64 and 100 (tiled), a hop longer than a segment's span
+        for (window, hop) in [(300, 1), (500, 7), (256, 64), (1000, 100), (200, 5000)] {
+            let seg = crate::oavar::segment_windows(window, hop);
+            let ms: Vec<usize> = [1, 2, 5, 16, 33, window / 2]
+                .into_iter()
+                .filter(|&m| m <= window / 2)
+                .collect();
+            let req = Request {
+                columns: &cols,
+                window,
+                hop,
+                ms: &ms,
+                estimator: Estimator::Overlapping,
+                method: Method::Fast,
+            };
+            let (record, n_win) = dynamic_avar(&req).unwrap();
+            assert!(
+                n_win > seg || hop > 4096,
+                "window {window} hop {hop}: one segment only"
+            );
+            assert_eq!(
+                part_grid(n, 2, window, hop, Estimator::Overlapping, Method::Fast),
+                Some(seg * hop)
+            );
+            // every value against the window's own plain recomputation
+            for (a, y) in cols.iter().enumerate() {
+                for (t, &m) in ms.iter().enumerate() {
+                    for j in (0..n_win).step_by(1 + n_win / 40) {
+                        let w = &y[j * hop..j * hop + window];
+                        let mut x = vec![0.0f64; window + 1];
+                        let mu = compensated_mean(w);
+                        for (i, v) in w.iter().enumerate() {
+                            x[i + 1] = x[i] + (v - mu);
+                        }
+                        let l = window + 1 - 2 * m;
+                        let s: f64 = (0..l)
+                            .map(|k| (x[k + 2 * m] - 2.0 * x[k + m] + x[k]).powi(2))
+                            .sum();
+                        let plain = s / (2.0 * (m * m) as f64 * l as f64);
+                        let got = record[(a * ms.len() + t) * n_win + j];
+                        assert!(
+                            (got / plain - 1.0).abs() < 1e-9,
+                            "{window} {hop} m {m} j {j}: {got} vs {plain}"
+                        );
+                    }
+                }
+            }
+            let (mut worst, mut off_grid) = (0.0f64, 0usize);
+            for first in [0, seg, 2 * seg, seg / 2 + 1, seg + 3] {
+                if first >= n_win {
+                    continue;
+                }
+                for count in [1, seg, seg + 1, n_win] {
+                    let count = count.min(n_win - first);
+                    let s0 = first * hop;
+                    let len = ((count - 1) * hop + window).min(n - s0);
+                    let part_cols: Vec<&[f64]> = cols.iter().map(|c| &c[s0..s0 + len]).collect();
+                    let preq = Request {
+                        columns: &part_cols,
+                        ..req
+                    };
+                    let (got, k) =
+                        dynamic_avar_part_cancellable(&preq, &mus, first, n_win, &Cancel::new())
+                            .unwrap();
+                    assert_eq!(k, count);
+                    for row in 0..cols.len() * ms.len() {
+                        for j in 0..count {
+                            let (g, r) = (got[row * count + j], record[row * n_win + first + j]);
+                            if first % seg == 0 {
+                                assert_eq!(
+                                    g.to_bits(),
+                                    r.to_bits(),
+                                    "{window} {hop} first {first} count {count}"
+                                );
+                            } else {
+                                worst = worst.max((g / r - 1.0).abs());
+                                off_grid += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            assert!(off_grid == 0 || worst < 1e-13, "{window} {hop}: {worst:e}");
+        }
     }
 
     #[test]

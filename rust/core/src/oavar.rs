@@ -415,7 +415,9 @@ pub(crate) const SMALL_HOP: usize = 64;
 /// 1 − 2m. Each block of `hop` terms is summed once (first its r = L mod hop terms, then the rest), and
 /// every window is the Van Herk sliding sum of q = ⌊L/hop⌋ whole blocks plus the next block's first r
 /// terms — sums of non-negative values over the window's own terms only. Every d_k comes from the
-/// phase as in [`overlapping_window`], so its rounding is local to its block sums.
+/// phase as in [`overlapping_window`], so its rounding is local to its block sums. `one_window`: the
+/// record has one window (its terms are one block); a run of windows of a longer record keeps the
+/// record's blocks even when it holds one window, so its values do not depend on where it ends.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn overlapping_dynamic_row(
     hi: &[f64],
@@ -423,6 +425,7 @@ pub(crate) fn overlapping_dynamic_row(
     m: usize,
     window: usize,
     hop: usize,
+    one_window: bool,
     out: &mut [f64],
     sc: &mut DynScratch,
 ) {
@@ -432,7 +435,7 @@ pub(crate) fn overlapping_dynamic_row(
     let avx2 = false;
     let n_win = out.len();
     let l = window + 1 - 2 * m;
-    let hop = if n_win == 1 { l } else { hop };
+    let hop = if one_window { l } else { hop };
     let (q, r) = (l / hop, l % hop);
     let k_end = (n_win - 1) * hop + l;
     let nblocks = n_win + q;
@@ -499,7 +502,8 @@ pub(crate) fn overlapping_dynamic_row(
 /// the tile's phase from cache (the three reads at k, k + m, k + 2m land in the same few lines for
 /// every such m), as [`super_chunk`] does for the static estimator. Tiles run in parallel; each
 /// (m, block) sum is one sequential routine, so the bits do not depend on the thread count. Writes
-/// `out` laid out [m][window] (n_win = out.len() / ms.len()).
+/// the `n_win` windows into `out` laid out [m][stride], at `first .. first + n_win` of each row.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn overlapping_dynamic_tiled(
     hi: &[f64],
     lo: &[f64],
@@ -507,6 +511,7 @@ pub(crate) fn overlapping_dynamic_tiled(
     window: usize,
     hop: usize,
     out: &mut [f64],
+    (stride, first, n_win): (usize, usize, usize),
     cancel: &Cancel,
 ) {
     #[cfg(target_arch = "x86_64")]
@@ -514,8 +519,8 @@ pub(crate) fn overlapping_dynamic_tiled(
     #[cfg(not(target_arch = "x86_64"))]
     let avx2 = false;
     let n_m = ms.len();
-    let n_win = out.len() / n_m;
-    debug_assert!(n_win >= 2 && hop >= SMALL_HOP);
+    debug_assert!(n_win >= 2 && hop >= SMALL_HOP && first + n_win <= stride);
+    debug_assert_eq!(out.len(), n_m * stride);
     let geo: Vec<(usize, usize, usize, usize)> = ms
         .iter()
         .map(|&m| {
@@ -561,7 +566,8 @@ pub(crate) fn overlapping_dynamic_tiled(
     if cancel.is_cancelled() {
         return;
     }
-    out.par_chunks_mut(n_win).enumerate().for_each(|(t, row)| {
+    out.par_chunks_mut(stride).enumerate().for_each(|(t, row)| {
+        let row = &mut row[first..first + n_win];
         let (q, r, _k_end, m) = geo[t];
         let l = window + 1 - 2 * m;
         let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
@@ -580,6 +586,28 @@ pub(crate) fn overlapping_dynamic_tiled(
             }
         }
     });
+}
+
+/// Fewest samples a phase segment spans (see [`segment_windows`]): 2^22, 64 MiB of phase.
+#[cfg(not(test))]
+const SEGMENT_SPAN: usize = 1 << 22;
+/// The unit tests' segments are short, so small records cross several.
+#[cfg(test)]
+const SEGMENT_SPAN: usize = 1 << 12;
+
+/// A phase segment spans at least this many windows' worth of samples, so the `window − hop` samples
+/// two neighbouring segments both read cost at most 1/16 more work.
+const SEGMENT_WINDOWS: usize = 16;
+
+/// Windows per phase segment. The dynamic estimator's phase path cuts a record's windows into runs
+/// of this many (the record's windows 0 .. K, K .. 2K, …: a grid that does not depend on the record's
+/// length or the thread count) and builds each run's double-word phase from the run's first sample,
+/// so it holds 16 bytes per sample of one segment — at most max(2^22, 16 · window) samples — instead
+/// of 16 per sample of the record. A part of the record that starts on this grid has its segments'
+/// phases bit for bit.
+pub fn segment_windows(window: usize, hop: usize) -> usize {
+    let span = SEGMENT_SPAN.max(SEGMENT_WINDOWS.saturating_mul(window));
+    (span.saturating_sub(window) / hop.max(1)).saturating_add(1)
 }
 
 /// The phase of one axis for [`overlapping_dynamic_row`]: (hi, lo) of its first `n` samples.

@@ -136,8 +136,8 @@ fn davar<'py>(
 
 /// [`davar`] of the windows `first_window ..` of a record of `n_windows` windows, from a part of it
 /// (`columns`: the record's samples from `first_window · hop` on) centred on the record's means
-/// `mus`: the whole-record values, bit for bit where the record's call streams and to a few ε on its
-/// phase path (allanite-core `dynamic_avar_part_cancellable`). For
+/// `mus`: the whole-record values, bit for bit when the part starts on the record's [`part_grid`]
+/// (to a few ε elsewhere on the phase path; allanite-core `dynamic_avar_part_cancellable`). For
 /// allanite.dask, whose blocks hold parts of a record.
 #[pyfunction]
 #[pyo3(signature = (columns, window, hop, ms, estimator, method, workers, mus, first_window, n_windows))]
@@ -172,6 +172,34 @@ fn davar_part<'py>(
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
+}
+
+/// Samples between the places a record of `n` samples × `n_axes` may be cut into [`davar_part`] parts
+/// that give the whole call's values bit for bit: the hop where the call streams its sums, a phase
+/// segment's windows × hop on its phase path (allanite-core `part_grid`). For allanite.dask's chunks.
+#[pyfunction]
+#[pyo3(signature = (n, n_axes, window, hop, estimator, method))]
+fn part_grid(
+    py: Python<'_>,
+    n: usize,
+    n_axes: usize,
+    window: usize,
+    hop: usize,
+    estimator: &str,
+    method: &str,
+) -> PyResult<usize> {
+    let estimator = parse_estimator(py, estimator)?;
+    let method = parse_method(py, method)?;
+    allanite_core::part_grid(n, n_axes, window, hop, estimator, method).ok_or_else(|| {
+        allanite_error_of(
+            py,
+            "ParameterError",
+            format!(
+                "no dynamic call of window {window} and hop {hop} on {n} samples × {n_axes} axes: \
+                 2 ≤ window ≤ samples, hop ≥ 1 and at least one axis are needed"
+            ),
+        )
+    })
 }
 
 /// Neumaier's compensated sum of each column continued from `state` ((sum, compensation) per axis):
@@ -593,6 +621,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
     m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;
+    m.add_function(wrap_pyfunction!(part_grid, m)?)?;
     m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;
     m.add_function(wrap_pyfunction!(angle_term_sums, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_static, m)?)?;
