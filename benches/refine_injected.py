@@ -113,6 +113,14 @@ def cases(quick: bool):
     t = np.arange(y5.size) / FS
     gm = allanite.simulate(gx.size, FS, gauss_markov=[(0.05, 20.0)], seed=8)
     base = regression_fit(gx, az)["coefficient"]
+    # a multi-position test: acc_z turned between +1 g and −1 g every 200–600 s (the log's own acc_z noise kept);
+    # the gyro responds to the true acceleration at 0.01 °/s/g. The regression's expected coefficient is the
+    # least-squares value of that response plus gyro_x's own coupling to acc_z's noise (`base`).
+    edges = np.cumsum(np.random.default_rng(5).uniform(200, 600, size=400) * FS).astype(int)
+    tumble = np.where(np.searchsorted(edges, np.arange(gx.size), side="right") % 2 == 0, 1.0, -1.0)
+    tumble -= tumble.mean()
+    ch_t = az - az.mean() + tumble
+    tumble_truth = float((0.01 * tumble + base * (az - az.mean())) @ ch_t / (ch_t @ ch_t))
     white = np.random.default_rng(3).normal(size=y6.size) * np.where(t >= 6000.0, 2 * np.std(np.diff(y6)), 0.0)
     out += [
         (
@@ -144,6 +152,12 @@ def cases(quick: bool):
             gx + gm + 2.0 * az,
             {"gauss_markov": {"sigma": 0.05, "tc": 20.0}, "regression": {"coefficient": 2.0 + base}},
             {"channels": {"acc_z": az}},
+        ),
+        (
+            "ADIS run 2 x + 0.01 °/s/g × a multi-position acc_z (±1 g every 200–600 s, `channels=`)",
+            gx + 0.01 * tumble,
+            {"regression": {"coefficient": tumble_truth}},
+            {"channels": {"acc_z": az - az.mean() + tumble}},
         ),
         (
             "ADIS run 6 x + white noise ×3 from 6000 s",
@@ -195,7 +209,7 @@ def run(quick: bool, out: Path) -> dict:
         "# `refine` on data with an undeclared effect (default call)",
         "",
         "Written by `benches/refine_injected.py`. Each record holds effects the five-term model lacks; "
-        "`refine(y, 100.0)` (with `channels=` for the g-sensitivity row). Per injected effect: its parameter "
+        "`refine(y, 100.0)` (with `channels=` for the g-sensitivity rows). Per injected effect: its parameter "
         "errors against the truth (change point: distance as a fraction of the record) and its step's χ²/dof, "
         "in-sample RMS ADEV error and held-out RMS ADEV error (alternate blocks) before → after.",
         "",

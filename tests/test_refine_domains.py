@@ -18,7 +18,7 @@ from allanite.model.effects import (
     filtered_white_avar,
     resonance_avar,
 )
-from allanite.model.tracing import regression_fit
+from allanite.model.tracing import band_component, band_regression, regression_fit, regression_heldout
 
 FS = 100.0
 
@@ -254,6 +254,51 @@ def test_adis_with_injected_gauss_markov_and_g_sensitivity(shared_data):
     assert rg.after["heldout_rms_adev_pct"] < rg.before["heldout_rms_adev_pct"]
     # (in-sample, on the curve it was removed from, the Allan-curve fit does not improve: χ²/dof ≈ 0.5 before
     # and after — a white-like component is absorbed by N; docs/refinement.md)
+
+
+def test_band_regression_keeps_one_coefficient_unless_the_bands_differ():
+    rng = np.random.default_rng(1)
+    n = 400_000
+    a = rng.normal(size=n)
+    # one coupling at every frequency: no band keeps its own, the component is c·(a − mean) exactly
+    y = rng.normal(size=n) + 0.5 * a
+    br = band_regression(y, a, FS, 0.01)
+    assert not any(b["own"] for b in br["bands"]) and br["coefficient"] == pytest.approx(0.5, abs=0.01)
+    np.testing.assert_array_equal(band_component(a - a.mean(), br["used"]), br["coefficient"] * (a - a.mean()))
+    # the bands sum to the channel, and they span 0 … fs/2
+    assert sum(b["f_hi"] - b["f_lo"] for b in br["bands"]) == pytest.approx(FS / 2)
+    # a coupling of 1 above 10 Hz and of 0.05 below (the whole-record coefficient, 0.81, fits neither): the
+    # bands away from 10 Hz find their own, and the residual falls
+    hi = signal.sosfiltfilt(signal.butter(8, 10.0, "high", fs=FS, output="sos"), a)
+    noise = 0.3 * rng.normal(size=n)
+    y = noise + 0.05 * (a - hi) + 1.0 * hi
+    br = band_regression(y, a, FS, 0.01)
+    assert br["coefficient"] == pytest.approx(0.81, abs=0.02)
+    top = [b for b in br["bands"] if b["f_lo"] >= 12.5]
+    low = [b for b in br["bands"] if b["f_hi"] <= 6.25 and b["se"] < 0.005]  # well-determined ones
+    assert len(top) == 2 and all(b["own"] and b["coefficient"] == pytest.approx(1.0, abs=0.02) for b in top)
+    assert len(low) >= 3 and all(b["own"] and b["coefficient"] == pytest.approx(0.05, abs=0.015) for b in low)
+    one = np.var(y - y.mean() - br["coefficient"] * (a - a.mean()))
+    banded = np.var(y - y.mean() - band_component(a - a.mean(), br["used"]))
+    assert banded < 0.8 * one
+    assert regression_heldout(y, a, FS, 0.01) < regression_heldout(y, a)
+
+
+def test_adis_multi_position_g_sensitivity(shared_data):
+    # a realistic g-sensitivity test: acc_z turned between ±1 g every 200–600 s, the gyro responding to the
+    # true acceleration at 0.01 °/s/g (the log's own noise and its coupling to acc_z's noise kept)
+    gx, az = _adis(shared_data, 2, ["gyro_x", "acc_z"])
+    edges = np.cumsum(np.random.default_rng(5).uniform(200, 600, size=400) * FS).astype(int)
+    tumble = np.where(np.searchsorted(edges, np.arange(gx.size), side="right") % 2 == 0, 1.0, -1.0)
+    tumble -= tumble.mean()
+    ch = az - az.mean() + tumble
+    base = regression_fit(gx, az)["coefficient"]
+    truth = float((0.01 * tumble + base * (az - az.mean())) @ ch / (ch @ ch))
+    r = allanite.refine(gx + 0.01 * tumble, FS, channels={"acc_z": ch}, truth={"regression": {"coefficient": truth}})
+    rg = next(s for s in r.steps if s.effect == "regression")
+    assert abs(rg.truth_error["coefficient"]) < 0.2
+    assert rg.evidence["heldout_variance_ratio"] < 1.0
+    _falls(rg)
 
 
 def test_calibrated_test_and_heldout_are_reported(gm_small=None):

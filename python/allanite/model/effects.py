@@ -307,8 +307,9 @@ EFFECTS: dict[str, Effect] = {
                 ("channel", "", "name of the other channel (as passed in channels=)"),
                 ("coefficient", "rate unit per channel unit", "sensitivity: g-sensitivity, temperature, coupling"),
             ),
-            "the rate regressed on another channel of the log (least squares on the de-meaned samples), "
-            "removed before the noise fit; its Allan variance is the coefficient² times the channel's",
+            "the rate regressed on another channel of the log (least squares on the de-meaned samples; "
+            "coefficient: the whole-record value), band by band (octaves) where the coupling differs across "
+            "frequency (evidence['bands']); removed before the noise fit",
             domain="channels",
         ),
         Effect(

@@ -13,10 +13,12 @@ of the registry :data:`allanite.model.effects.EFFECTS`:
 - in the **PSD** (Welch) for spectral lines: ``"sinusoid"`` with f0 from the periodogram peak, refined;
 - in **time**: ``"drift"`` (warm-up a·e^{−t/T} on block means) and ``"change_point"`` (steps of the noise
   level along the record);
-- in **other channels** of the log (``channels=``): ``"regression"`` — the rate regressed on each.
+- in **other channels** of the log (``channels=``): ``"regression"`` — the rate regressed on each, band by
+  band (octaves) where the coupling differs across frequency (:func:`allanite.model.tracing.band_regression`).
 
-Every effect enters the model as a non-negative column of Allan variance (time-domain ones through their
-own Allan variance: c²·AVAR(channel), a²·AVAR(e^{−t/T})). A candidate is **accepted** only if
+Every curve effect enters the model as a non-negative column of Allan variance; the time-domain ones (drift,
+regression) are removed from the samples, and their in-sample "after" adds back what the removal changed in
+the curve, AVAR(y) − AVAR(y − component) (own variance and cross terms, exactly). A candidate is **accepted** only if
 
 1. a calibrated test says the residual asks for it: the GLS score statistic on ~4 τ per octave with the
    covariance of the estimates across τ (exact for the five terms, :mod:`allanite.model._covariance`),
@@ -261,12 +263,14 @@ def _informative(tau, nu) -> np.ndarray:
     return good if np.count_nonzero(good) >= 4 else mask
 
 
-def _removal_metrics(curve: _Curve, sol: _Solution, component_avar, n_params: int, heldout, scored) -> dict:
+def _removal_metrics(curve: _Curve, sol: _Solution, change, n_params: int, heldout, scored) -> dict:
     """In-sample errors of a time-domain removal on the curve it was removed *from*: the noise model
-    fitted after the removal plus the removed component's own Allan variance, against the same
-    estimates the "before" model was scored on (apples to apples; the cross term of an independent
-    component averages to zero)."""
-    model = np.maximum(sol.model + component_avar, 1e-300)
+    fitted after the removal plus the change the removal made to the Allan curve, against the same
+    estimates the "before" model was scored on (apples to apples). ``change`` = AVAR(y) − AVAR(y − c):
+    the component's own Allan variance and its cross terms with the rest of the record, exactly — a
+    regression's component is *not* independent of the noise (a channel's coupling varies across
+    frequency, so the residual keeps a band-by-band cross term that the component's own variance misses)."""
+    model = np.maximum(sol.model + change, 1e-300)
     z = (curve.avar - model) * np.sqrt(sol.nu / (2.0 * model**2))
     chi2 = float(np.sum(z**2))
     dof = max(1, sol.dof - n_params)
@@ -1063,7 +1067,8 @@ def refine(
             bandwidth, which is a candidate effect; ``"auto"`` cuts them as ``fit`` does.
         channels : dict of str → array_like, optional
             Other channels of the same log (same length as the samples: temperature, other axes,
-            accelerometers): the rate is regressed on each ("regression" effect).
+            accelerometers): the rate is regressed on each ("regression" effect; band by band where the
+            coupling differs across frequency, the bands in the step's ``evidence["bands"]``).
         level : float
             False-alarm probability per record on a clean record (default 0.05), split between spectral
             lines, the Allan-curve test and change points.
@@ -1258,12 +1263,13 @@ def _refine(
             intervals=intervals,
             evidence=evidence,
             before=metrics(curve, sol, ho_b),
-            # on the same curve as "before": the new noise model plus the component's own Allan variance
+            # on the same curve as "before": the new noise model plus what the removal changed in the curve
             after=_removal_metrics(
                 curve,
                 s_new,
-                avar(np.asarray(component, dtype=np.float64), fs, taus=result.tau).avar[keep],
-                len(params),
+                result.avar[keep] - res_new.avar[keep],
+                # fitted numbers only (a regression's channel is a name), one per band keeping its own coupling
+                sum(not isinstance(v, str) for v in params.values()) + len(evidence.get("bands", ())),
                 ho_a,
                 scored,
             ),
@@ -1542,19 +1548,28 @@ def _refine(
                 considered.setdefault("regression", []).append({"channel": name, "t": t_stat, "threshold": t_thr})
                 continue
 
-            def reg_refit(z, idx, ch=ch):
+            # band by band where the coupling differs across frequency (the whole-record coefficient elsewhere)
+            br = tracing.band_regression(y, ch, fs, TIME_SHARE * level)
+            own = [b for b in br["bands"] if b["own"]]
+            if own:
+                ev["bands"] = own
+
+            def reg_refit(z, idx, ch=ch, banded=bool(own)):
+                if banded:
+                    used = tracing.band_regression(z, ch[idx], fs, TIME_SHARE * level)["used"]
+                    return lambda i: tracing.band_component(ch[i] - ch.mean(), used)
                 cf = tracing.regression_fit(z, ch[idx], 2)["coefficient"]
                 return lambda i: cf * (ch[i] - ch.mean())
 
             st = removal_step(
                 "regression",
-                rg["coefficient"] * (ch - ch.mean()),
+                tracing.band_component(ch - ch.mean(), br["used"]),
                 reg_refit,
                 {"channel": name, "coefficient": rg["coefficient"]},
                 {"coefficient": (rg["coefficient"] - rg["se"], rg["coefficient"] + rg["se"])},
                 ev,
                 "regression",
-                tracing.regression_heldout(y, ch),
+                tracing.regression_heldout(y, ch, fs, TIME_SHARE * level) if own else tracing.regression_heldout(y, ch),
             )
             if st is not None:
                 steps.append(st)
@@ -1609,10 +1624,10 @@ def _refine(
         s_raw = _solve(c_raw, start, effects)
         st = first_steps[0]
         st.before = metrics(c_raw, s_raw, h_raw.error(start, effects) if h_raw is not None else None)
-        # after: on the raw curve too — the final model plus the drift's own Allan variance
-        comp_av = avar(np.asarray(comp, dtype=np.float64), fs, taus=result.tau).avar[keep]
+        # after: on the raw curve too — the final model plus what removing the drift changed in the curve
+        # (y_raw − comp is the final samples, whose curve the final model was fitted to)
         ho_after = h_raw.error(start, effects, remove=refit) if h_raw is not None else None
-        st.after = _removal_metrics(c_raw, sol, comp_av, 2, ho_after, scored)
+        st.after = _removal_metrics(c_raw, sol, c_raw.avar - curve.avar, 2, ho_after, scored)
         st.delta_chi2_eff = float(s_raw.chi2_eff(c_raw) - sol.chi2_eff(curve))
         st.evidence["scored_with"] = [_base(k) for k, _p in effects] or "the five terms"
     steps = first_steps + steps

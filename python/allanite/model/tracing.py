@@ -9,7 +9,8 @@ Used by :func:`allanite.refine`:
   symmetric about k is its value at k). f0 is then refined on the periodogram of block means, the
   amplitude and phase by least squares on the samples.
 - :func:`drift_fit` — an exponential warm-up a·e^{−t/T} on block means along the record.
-- :func:`regression_fit` — the rate regressed on another channel, with a block-jackknife interval.
+- :func:`regression_fit` — the rate regressed on another channel, with a block-jackknife interval;
+  :func:`band_regression` — the same band by band (octaves), where the coupling differs across frequency.
 - :class:`ScoreTest` — a generalised-least-squares score (likelihood-ratio in the linearised model)
   statistic for adding one non-negative column to the fitted Allan-variance model, with the covariance of
   the estimates across τ (exact for the five terms and the overlapping estimator, docs/FORMULAS.md §5 via
@@ -44,6 +45,8 @@ __all__ = [
     "gm_autocorrelation",
     "rolloff_psd",
     "regression_heldout",
+    "band_regression",
+    "band_component",
     "ScoreTest",
     "thin_indices",
 ]
@@ -306,17 +309,100 @@ def regression_fit(y: np.ndarray, ch: np.ndarray, n_blocks: int = 8) -> dict:
     return {"coefficient": coef, "se": se}
 
 
-def regression_heldout(y: np.ndarray, ch: np.ndarray) -> float:
+def regression_heldout(y: np.ndarray, ch: np.ndarray, fs: float | None = None, alpha: float | None = None) -> float:
     """Held-out test of a regression in time: each half's residual variance with the other half's coefficient,
-    over its raw variance (mean of the two ways; < 1 means the coefficient carries over)."""
+    over its raw variance (mean of the two ways; < 1 means the coefficient carries over). With ``fs`` and
+    ``alpha``: the other half's band regression (:func:`band_regression`) instead of one coefficient."""
     h = y.size // 2
     parts = [(y[:h], ch[:h]), (y[h:], ch[h:])]
     ratios = []
     for (yf, cf), (yh, chh) in ((parts[0], parts[1]), (parts[1], parts[0])):
-        c = regression_fit(yf, cf, 2)["coefficient"]
         yh0, ch0 = yh - yh.mean(), chh - chh.mean()
-        ratios.append(float(np.var(yh0 - c * ch0) / np.var(yh0)))
+        if fs is None or alpha is None:
+            comp = regression_fit(yf, cf, 2)["coefficient"] * ch0
+        else:
+            comp = band_component(ch0, band_regression(yf, cf, fs, alpha)["used"])
+        ratios.append(float(np.var(yh0 - comp) / np.var(yh0)))
     return float(np.mean(ratios))
+
+
+#: Blocks of the batch-means error of a band's coefficient; a band is formed only where each block holds
+#: ≥ 8 of its widest smoothing windows.
+BAND_BLOCKS = 8
+
+
+def _bands(x: np.ndarray, levels: int):
+    """Octave bands of ``x`` that sum to it exactly: S_{k−1} − S_k for k = 1 … levels, S_k the zero-phase
+    (forward–backward) 4th-order Butterworth low-pass of ``x`` at fs/2^(k+1) (S_0 = x), then the remainder
+    S_levels. Yields one band at a time (each the record's length)."""
+    prev = x
+    for k in range(1, levels + 1):
+        sos = signal.butter(4, 2.0**-k, "low", output="sos")  # cutoff fs/2^(k+1): 2^-k of Nyquist
+        cur = signal.sosfiltfilt(sos, x)
+        yield prev - cur
+        prev = cur
+    yield prev
+
+
+def band_levels(n: int) -> int:
+    """Smoothing levels for a record of ``n`` samples: 2^levels · 8 · BAND_BLOCKS ≤ n (at least 1)."""
+    return max(1, int(math.floor(math.log2(max(2, n // (8 * BAND_BLOCKS))))))
+
+
+def band_regression(y: np.ndarray, ch: np.ndarray, fs: float, alpha: float) -> dict:
+    """The rate regressed on a channel band by band (octaves, zero-phase Butterworth), for a coupling that
+    differs across frequency — a g-sensitivity seen through slow attitude changes and a vibration coupling
+    seen through the channel's noise, say.
+
+    Every band of the channel (and the same band of the rate) gives its own least-squares coefficient and a
+    batch-means standard error over :data:`BAND_BLOCKS` blocks in time. A band keeps its own coefficient only
+    where it differs from the whole-record coefficient by more than the two-sided t quantile (BAND_BLOCKS − 1
+    degrees of freedom) at ``alpha`` Bonferroni-split over the bands; elsewhere the whole-record coefficient
+    stands. With one coefficient for every band the component is exactly ``coefficient · (ch − mean)``
+    (the bands sum to the channel).
+
+    Returns ``coefficient`` and ``se`` (:func:`regression_fit`), ``bands``: one dict per band (``f_lo``,
+    ``f_hi`` in Hz, ``coefficient``, ``se``, ``own``: whether it keeps its coefficient), and ``used``: the
+    coefficient applied to each band.
+    """
+    from scipy.stats import t as t_dist
+
+    whole = regression_fit(y, ch, BAND_BLOCKS)
+    c0 = whole["coefficient"]
+    levels = band_levels(y.size)
+    thr = float(t_dist.isf(alpha / (2 * (levels + 1)), BAND_BLOCKS - 1))
+    yc, cc = y - y.mean(), ch - ch.mean()
+    per = y.size // BAND_BLOCKS
+    bands, used = [], []
+    for k, (yb, cb) in enumerate(zip(_bands(yc, levels), _bands(cc, levels)), start=1):
+        den = float(cb @ cb)
+        ck = float(yb @ cb) / den if den > 0 else 0.0
+        parts = []
+        for j in range(BAND_BLOCKS):
+            sl = slice(j * per, (j + 1) * per)
+            d = float(cb[sl] @ cb[sl])
+            if d > 0:
+                parts.append(float(yb[sl] @ cb[sl]) / d)
+        se = float(np.std(parts, ddof=1) / math.sqrt(len(parts))) if len(parts) > 1 else math.inf
+        own = bool(den > 0 and se > 0 and abs(ck - c0) / se > thr)
+        f_hi = fs / 2**k if k <= levels else fs / 2 ** (levels + 1)
+        f_lo = fs / 2 ** (k + 1) if k <= levels else 0.0
+        if k == 1:
+            f_hi = fs / 2
+        bands.append({"f_lo": f_lo, "f_hi": f_hi, "coefficient": ck, "se": se, "own": own})
+        used.append(ck if own else c0)
+    return {"coefficient": c0, "se": whole["se"], "bands": bands, "used": used, "threshold": thr}
+
+
+def band_component(ch_centred: np.ndarray, used) -> np.ndarray:
+    """Σ_k used[k] · band_k(ch): the component a :func:`band_regression` removes (``ch_centred`` de-meaned)."""
+    levels = len(used) - 1
+    if all(u == used[0] for u in used):
+        return used[0] * ch_centred
+    out = np.zeros_like(ch_centred, dtype=np.float64)
+    for u, b in zip(used, _bands(ch_centred, levels)):
+        out += u * b
+    return out
 
 
 def thin_indices(tau: np.ndarray, per_octave: int = 4) -> np.ndarray:
