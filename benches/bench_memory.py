@@ -1,15 +1,16 @@
 #!/usr/bin/env python3
 """Memory of the dynamic Allan variance: what a call holds beyond its input and its output.
 
-Issue 17 kept the engine's memory "as today": the overlapping DAVAR's double-word phase path (records
-whose windows read ≤ 2^26 samples × axes) holds 16 bytes of phase per sample, so it is built per
-*segment* of max(2^22, 16 · window) samples' worth of windows, not for the whole record; longer records
-stream their sums in O(window) per worker. This bench measures it: every case runs in a fresh
+Issue 17 kept the engine's memory "as today": the overlapping DAVAR's double-word phase path holds 16
+bytes of phase per sample, so it is built per *segment* of max(2^22, 16 · window) samples' worth of
+windows, not for the whole record (4 · window on records over 2^26 samples × axes). Records of ≤ 2^26
+samples × axes take it at any window, longer ones for windows ≤ 2^21 (a segment of ≤ 2^23 samples);
+longer windows on longer records stream their sums in O(window) per worker. This bench measures it: every case runs in a fresh
 process that builds a seeded white-noise record (float64), notes its resident set, calls
 ``allanite.davar`` and reads the peak resident set (``ru_maxrss``); the extra memory is
 peak − (resident before the call) − (the output array's bytes). Reported per sample of the record,
 against the bound the segments promise (16 B × segment span + per-worker scratch) and as a fraction
-of the input; the streaming path (a record past 2^26 samples) is the reference in the same run. A
+of the input; the streaming path (a window over 2^21 samples on a record past 2^26) is the reference. A
 C-ordered (samples, axes) array is copied to contiguous columns (8 B per sample and axis); a
 Fortran-ordered one is not — both cases are measured.
 
@@ -41,7 +42,8 @@ CASES = [
     ("phase path, 3 axes (C order), 2^24 samples, window 1e5, hop 1e3", 1 << 24, 3, 100_000, 1_000),
     ("phase path, 3 axes (Fortran order), 2^24 samples, window 1e5, hop 1e3", 1 << 24, -3, 100_000, 1_000),
     ("phase path, 1 axis, 10^7 samples, window 1e6, hop 1e4 (one segment)", 10_000_000, 1, 1_000_000, 10_000),
-    ("streaming path, 1 axis, 7·10^7 samples, window 1e4, hop 1e3", 70_000_000, 1, 10_000, 1_000),
+    ("phase path (segments), 1 axis, 7·10^7 samples, window 1e4, hop 1e3", 70_000_000, 1, 10_000, 1_000),
+    ("streaming path, 1 axis, 7·10^7 samples, window 2^22, hop 1e6", 70_000_000, 1, 1 << 22, 1_000_000),
 ]
 QUICK = [
     ("phase path, 1 axis, 2^23 samples, window 1e4, hop 1e3", 1 << 23, 1, 10_000, 1_000),
@@ -93,7 +95,7 @@ def run_case(n: int, axes: int, window: int, hop: int) -> dict:
 def segment_bound(n: int, axes: int, window: int, hop: int, workers: int = 2) -> int:
     """Bytes the phase path may hold beyond input and output: one segment's phase (16 B/sample) plus,
     at hops < 64, each worker's terms and block sums of one segment (8 + 16/hop B/sample)."""
-    span = min(max(1 << 22, 16 * window), n)
+    span = min(max(1 << 22, (4 if n * axes > 1 << 26 else 16) * window), n)
     per = 16 * span
     if hop < 64:
         per += workers * (8 + 16 / hop) * span
@@ -111,7 +113,8 @@ def main() -> int:
         log(f"{label} …")
         d = run_case(n, axes, window, hop)
         d.update(label=label, n=n, axes=abs(axes), window=window, hop=hop)
-        d["bound"] = segment_bound(n, abs(axes), window, hop) if n * abs(axes) <= 1 << 26 else None
+        phase = n * abs(axes) <= 1 << 26 or max(1 << 22, 4 * window) <= 1 << 23
+        d["bound"] = segment_bound(n, abs(axes), window, hop) if phase else None
         log(f"  extra {d['extra'] / 2**20:.0f} MiB, {d['seconds']:.2f} s")
         rows.append(d)
     args.out.mkdir(parents=True, exist_ok=True)
@@ -135,7 +138,8 @@ def main() -> int:
         )
     lines += [
         "",
-        "The bound: one segment's phase (16 B × max(2^22, 16 · window) samples, capped at the record) plus, at",
+        "The bound: one segment's phase (16 B × max(2^22, 16 · window) samples — 4 · window past 2^26 samples ×",
+        "axes —, capped at the record) plus, at",
         "hops below 64, each worker's terms and block sums of one segment. A C-ordered (samples, axes) input",
         "adds a contiguous copy of its columns (8 B per sample and axis, made before the call reaches the core);",
         "`np.asfortranarray` input avoids it.",

@@ -9,12 +9,12 @@ The functions give the numbers of the single-machine calls (:func:`allanite.avar
   (``dynamic_avar_part_cancellable``) with the record's centring value and the block's first window;
   the core follows the record's own path, and the chunks are cut where the core's parts give the
   whole call's values: **bit for bit**, at every size. Where the single-machine call streams its sums
-  (the classic estimator; the overlapping one when its windows read more than 2^26 samples × axes,
-  512 MB of float64 — the records Dask is for) any cut on the hop grid does: the part forms the same
-  terms, block sums and window sums in the same order. Below that the single machine builds a
-  double-word phase per *segment* of max(2^22, 16 · window) samples' worth of windows (a running sum
-  from the segment's first sample), and the chunks are whole segments (``_core.part_grid``): each
-  block rebuilds exactly its segments' phases. The
+  (the classic estimator; the overlapping one with windows over 2^21 samples on records over 2^26
+  samples × axes) any cut on the hop grid does: the part forms the same terms, block sums and window
+  sums in the same order. Elsewhere the single machine builds a double-word phase per *segment* of
+  max(2^22, 16 · window) samples' worth of windows — max(2^22, 4 · window) on records over 2^26
+  samples × axes — (a running sum from the segment's first sample), and the chunks are whole segments
+  (``_core.part_grid``): each block rebuilds exactly its segments' phases. The
   centring value is the core's compensated (Neumaier) sum, which is sequential: a first pass runs it
   over the chunks in order (a chain of small tasks, :data:`CENTRE_BATCH` chunks per compute),
   continuing each chunk from the state the previous one left.
@@ -324,8 +324,10 @@ def davar(
     chunk : int, optional
         Samples per chunk before rounding up to at least ``window − 1`` and to a multiple of the
         core's part grid: the hop where the single-machine call streams its sums, whole phase segments
-        (max(2^22, 16 · window) samples' worth of windows) where it takes its phase path — records of
-        at most 2^26 samples × axes (default: the caller's first chunk, at least :data:`DEFAULT_CHUNK`/4).
+        (max(2^22, 16 · window) samples' worth of windows; 4 · window on records over 2^26 samples ×
+        axes) where it takes its phase path — records of
+        at most 2^26 samples × axes, and windows of at most 2^21 samples on any record (default: the
+        caller's first chunk, at least :data:`DEFAULT_CHUNK`/4).
     compute : bool
         True (default): a :class:`~allanite.DynamicAllanResult`, as the single-machine one.
         False: the lazy (axes, τ, windows) dask array of the Allan variance (the centring pass runs now).
@@ -334,14 +336,15 @@ def davar(
     -----
     Equal to :func:`allanite.davar` bit for bit: the chunks are cut where the core's parts give the
     whole call's values (on the hop grid where it streams its sums — ``estimator="avar"``, and
-    ``"oavar"`` when the windows read more than 2^26 samples × axes, 512 MB of float64 — and at its
-    phase segments below that; see the module notes). Two passes over the record: the centring pass runs the
+    ``"oavar"`` with windows over 2^21 samples on records over 2^26 samples × axes — and at its phase
+    segments elsewhere; see the module notes). Two passes over the record: the centring pass runs the
     core's compensated sum over the chunks in order (a chain of tasks, :data:`CENTRE_BATCH` chunks per
     ``dask.compute``; a second chain only when the samples need the power-of-two scaling of the
     single-machine call, |sample| ≥ 2^200 or < 2^-200), which gives the record's centring value and
     the first non-finite sample; then every block hands the core its part of the record with that
     centring value and its first window, and the core forms the same terms and sums in the same order
-    as for the whole record. Memory per task: one chunk plus ``window − 1`` samples plus its output.
+    as for the whole record. Memory per task: one chunk plus ``window − 1`` samples plus its output, and on the
+    phase path one segment's phase (16 B per sample of max(2^22, 4 · window) on records over 2^26 samples).
     """
     fs = _check(estimator, input, fs)
     arr = _as_dask(x)

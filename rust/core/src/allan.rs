@@ -931,7 +931,7 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
             }
             // samples any window reads
             let n_used = ((n_win - 1) * req.hop + req.window).min(req.columns[0].len());
-            let phase = takes_phase_path(req.estimator, n_used, n_axes);
+            let phase = takes_phase_path(req.estimator, n_used, n_axes, req.window);
             part_rows(req, &mus, Part::whole(n_win), phase, &mut out, cancel);
         }
         Method::Naive => {
@@ -977,9 +977,9 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
 /// worth; the part's windows are those that fit, up to the record's last); `mus` is the record's
 /// centring value per axis, its [`compensated_mean`] (build it part by part with
 /// [`compensated_sum_from`]). The path is the record's: [`dynamic_avar`] takes the phase path for the
-/// overlapping estimator when the samples its windows read, times the axes, are at most
-/// `GATHER_MAX` (2^26), and streams otherwise (and for the classic estimator, and for rows of
-/// m > `PHASE_M_MAX` at hops below 64).
+/// overlapping estimator when the samples its windows read, times the axes, are at most 2^26 or its
+/// window is at most 2^21 samples (see `takes_phase_path`), and streams otherwise (and for the
+/// classic estimator, and for rows of m > `PHASE_M_MAX` at hops below 64).
 ///
 /// * Streaming: the part centres on `mus`, cuts the terms and block sums at the record's boundaries
 ///   (multiples of m, of the hop, of the window sums' segments) and sizes the edge segments as the
@@ -1041,18 +1041,28 @@ pub fn dynamic_avar_part_cancellable(
     }
     // the samples the record's windows read
     let n_used_record = (n_windows_total - 1) * req.hop + req.window;
-    let phase = takes_phase_path(req.estimator, n_used_record, n_axes);
+    let phase = takes_phase_path(req.estimator, n_used_record, n_axes, req.window);
     part_rows(req, mus, part, phase, &mut out, cancel);
     cancel.check()?;
     Ok((out, n_win))
 }
 
+/// Whether a record whose windows read `n_used` samples × `n_axes` is *long* for the phase path
+/// (more than `PHASE_RECORD_MAX`, 2^26): its segments are shorter, and long windows stream.
+fn long_record(n_used: usize, n_axes: usize) -> bool {
+    n_used.saturating_mul(n_axes) > crate::oavar::PHASE_RECORD_MAX
+}
+
 /// Whether the fast dynamic estimator of a record of several windows takes the double-word phase
-/// path: the overlapping estimator when its windows read at most `GATHER_MAX` (2^26) samples × axes.
-/// Longer records stream their sums (which a record cut into parts gives bit for bit at any cut on
-/// the hop grid, see [`dynamic_avar_part_cancellable`]).
-fn takes_phase_path(estimator: Estimator, n_used: usize, n_axes: usize) -> bool {
-    estimator == Estimator::Overlapping && n_used.saturating_mul(n_axes) <= GATHER_MAX
+/// path: the overlapping estimator on a short record (≤ 2^26 samples × axes) at any window, on a long
+/// one while its segments span at most `PHASE_SPAN_MAX` (2^23) samples — windows up to 2^21. The phase
+/// it holds is one segment's either way. Longer windows on long records stream their sums (which a
+/// record cut into parts gives bit for bit at any cut on the hop grid, see
+/// [`dynamic_avar_part_cancellable`]).
+fn takes_phase_path(estimator: Estimator, n_used: usize, n_axes: usize, window: usize) -> bool {
+    let long = long_record(n_used, n_axes);
+    estimator == Estimator::Overlapping
+        && (!long || crate::oavar::segment_span(window, true) <= crate::oavar::PHASE_SPAN_MAX)
 }
 
 /// Samples between the places a record of `n` samples × `n_axes` can be cut into parts whose
@@ -1072,8 +1082,8 @@ pub fn part_grid(
     }
     let n_win = n_windows(n, window, hop);
     let n_used = (n_win - 1) * hop + window;
-    if method == Method::Fast && n_win >= 2 && takes_phase_path(estimator, n_used, n_axes) {
-        Some(crate::oavar::segment_windows(window, hop) * hop)
+    if method == Method::Fast && n_win >= 2 && takes_phase_path(estimator, n_used, n_axes, window) {
+        Some(crate::oavar::segment_windows(window, hop, long_record(n_used, n_axes)) * hop)
     } else {
         Some(hop)
     }
@@ -1100,7 +1110,9 @@ fn part_rows(
     let n_win = out.len() / (req.columns.len() * n_m);
     let n_m_win = n_m * n_win;
     if phase {
-        let seg = crate::oavar::segment_windows(req.window, req.hop);
+        let n_used_record = (part.total - 1) * req.hop + req.window;
+        let long = long_record(n_used_record, req.columns.len());
+        let seg = crate::oavar::segment_windows(req.window, req.hop, long);
         for (a, y) in req.columns.iter().enumerate() {
             let dst_axis = &mut out[a * n_m_win..(a + 1) * n_m_win];
             // the part's windows j0 .. j1 (its own index), cut where the record's segments start
@@ -1443,7 +1455,7 @@ mod tests {
                                 let (g, r) =
                                     (got[row * count + j], record[row * n_win + first + j]);
                                 // (the phase path: bit for bit from a segment's start)
-                                let seg = crate::oavar::segment_windows(window, hop);
+                                let seg = crate::oavar::segment_windows(window, hop, false);
                                 let exact = !phase || first % seg == 0;
                                 if exact {
                                     assert_eq!(
@@ -1472,13 +1484,34 @@ mod tests {
     /// the plain recomputation of its window.
     #[test]
     fn phase_segments_cut_where_parts_can() {
-        let n = 20_011;
-        let cols_owned = [biased_record(n, 7), biased_record(n, 8)];
+        // a long record in the unit tests (> 2^14 samples × axes: segments of max(2^12, 4·window)) and
+        // a short one (segments of max(2^12, 16·window))
+        let long_cases = vec![
+            (300, 1),
+            (500, 7),
+            (256, 64),
+            (1000, 100),
+            (200, 5000),
+            (2500, 100),
+        ];
+        let short_cases = vec![(200, 1), (250, 3), (200, 64)];
+        for (n, n_axes, long, cases) in [
+            (20_011, 2, true, long_cases),
+            (16_000, 1, false, short_cases),
+        ] {
+            segments_case(n, n_axes, long, &cases);
+        }
+    }
+
+    fn segments_case(n: usize, n_axes: usize, long: bool, cases: &[(usize, usize)]) {
+        let cols_owned: Vec<Vec<f64>> = (0..n_axes)
+            .map(|a| biased_record(n, 7 + a as u64))
+            .collect();
         let cols: Vec<&[f64]> = cols_owned.iter().map(|c| c.as_slice()).collect();
         let mus: Vec<f64> = cols.iter().map(|c| compensated_mean(c)).collect();
-        // hop 1 (rows), 7 (rows, blocks), 64 and 100 (tiled), a hop longer than a segment's span
-        for (window, hop) in [(300, 1), (500, 7), (256, 64), (1000, 100), (200, 5000)] {
-            let seg = crate::oavar::segment_windows(window, hop);
+        // hop 1 (rows), 3 and 7 (rows, blocks), 64 and 100 (tiled), a hop longer than a segment's span
+        for &(window, hop) in cases {
+            let seg = crate::oavar::segment_windows(window, hop, long);
             let ms: Vec<usize> = [1, 2, 5, 16, 33, window / 2]
                 .into_iter()
                 .filter(|&m| m <= window / 2)
@@ -1492,13 +1525,16 @@ mod tests {
                 method: Method::Fast,
             };
             let (record, n_win) = dynamic_avar(&req).unwrap();
+            // (the unit tests' span limit for a long record is 2^13: window 2500 streams, the others
+            // keep the phase path; a short record keeps it at any window)
+            let phase = !long || window * 4 <= 1 << 13;
             assert!(
-                n_win > seg || hop > 4096,
+                n_win > seg || hop > 4096 || !phase,
                 "window {window} hop {hop}: one segment only"
             );
             assert_eq!(
-                part_grid(n, 2, window, hop, Estimator::Overlapping, Method::Fast),
-                Some(seg * hop)
+                part_grid(n, n_axes, window, hop, Estimator::Overlapping, Method::Fast),
+                Some(if phase { seg * hop } else { hop })
             );
             // every value against the window's own plain recomputation
             for (a, y) in cols.iter().enumerate() {
@@ -1544,7 +1580,7 @@ mod tests {
                     for row in 0..cols.len() * ms.len() {
                         for j in 0..count {
                             let (g, r) = (got[row * count + j], record[row * n_win + first + j]);
-                            if first % seg == 0 {
+                            if first % seg == 0 || !phase {
                                 assert_eq!(
                                     g.to_bits(),
                                     r.to_bits(),

@@ -595,19 +595,37 @@ const SEGMENT_SPAN: usize = 1 << 22;
 #[cfg(test)]
 const SEGMENT_SPAN: usize = 1 << 12;
 
-/// A phase segment spans at least this many windows' worth of samples, so the `window − hop` samples
-/// two neighbouring segments both read cost at most 1/16 more work.
-const SEGMENT_WINDOWS: usize = 16;
+/// Records of at most this many samples × axes (the windows' samples) are *short*: 2^26, 512 MiB of
+/// float64. A short record's segments span 16 windows' worth (≤ 1/16 of the work rebuilt where two
+/// segments overlap) and it takes the phase path at any window.
+#[cfg(not(test))]
+pub(crate) const PHASE_RECORD_MAX: usize = 1 << 26;
+#[cfg(test)]
+pub(crate) const PHASE_RECORD_MAX: usize = 1 << 14;
+
+/// A long record's segments span 4 windows' worth (≤ 1/3 rebuilt), so that a Dask task that holds whole
+/// segments stays small, and it takes the phase path while a segment spans at most this many samples:
+/// 2^23 (128 MiB of phase; windows up to 2^21 samples). Longer windows stream their sums in O(window)
+/// per worker.
+#[cfg(not(test))]
+pub(crate) const PHASE_SPAN_MAX: usize = 1 << 23;
+#[cfg(test)]
+pub(crate) const PHASE_SPAN_MAX: usize = 1 << 13;
+
+/// Samples a phase segment spans at most: max(2^22, 16 · window) on a short record, max(2^22, 4 · window)
+/// on a long one (see [`PHASE_RECORD_MAX`]).
+pub(crate) fn segment_span(window: usize, long_record: bool) -> usize {
+    SEGMENT_SPAN.max(window.saturating_mul(if long_record { 4 } else { 16 }))
+}
 
 /// Windows per phase segment. The dynamic estimator's phase path cuts a record's windows into runs
-/// of this many (the record's windows 0 .. K, K .. 2K, …: a grid that does not depend on the record's
-/// length or the thread count) and builds each run's double-word phase from the run's first sample,
-/// so it holds 16 bytes per sample of one segment — at most max(2^22, 16 · window) samples — instead
-/// of 16 per sample of the record. A part of the record that starts on this grid has its segments'
-/// phases bit for bit.
-pub fn segment_windows(window: usize, hop: usize) -> usize {
-    let span = SEGMENT_SPAN.max(SEGMENT_WINDOWS.saturating_mul(window));
-    (span.saturating_sub(window) / hop.max(1)).saturating_add(1)
+/// of this many (the record's windows 0 .. K, K .. 2K, …: a grid that depends on the record's length
+/// only through whether it is long, and not on the thread count) and builds each run's double-word
+/// phase from the run's first sample, so it holds 16 bytes per sample of one segment — at most
+/// [`segment_span`] samples — instead of 16 per sample of the record. A part of the record that starts
+/// on this grid has its segments' phases bit for bit.
+pub fn segment_windows(window: usize, hop: usize, long_record: bool) -> usize {
+    (segment_span(window, long_record).saturating_sub(window) / hop.max(1)).saturating_add(1)
 }
 
 /// The phase of one axis for [`overlapping_dynamic_row`]: (hi, lo) of its first `n` samples.
