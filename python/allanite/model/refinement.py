@@ -93,7 +93,7 @@ HELDOUT_BLOCKS = 8
 PAIR_FACTOR = 100.0
 #: Share of ``level`` for each time-domain test (regression on channels, drift).
 TIME_SHARE = 0.075
-#: Blocks of the jackknife of a regression coefficient (t with blocks − 1 degrees of freedom).
+#: Blocks in time of a regression (each de-meaned; SE from the blocks' scores, t with at most blocks − 1 dof).
 REGRESSION_BLOCKS = 8
 #: RMS ADEV errors: only τ whose ADEV estimate is within ±10 % (EDF ≥ 50 under the five-term fit).
 HELDOUT_MIN_EDF = 50.0
@@ -1539,9 +1539,10 @@ def _refine(
                 st.truth_error = {kk: st.params[kk] / v - 1 for kk, v in truth[base].items() if kk in st.params}
     # ---- time domain: other channels, then a warm-up drift; each removed from the samples and refitted
     if y is not None and chans and "regression" in candidates:
-        t_thr = t_dist.isf(TIME_SHARE * level / (2 * len(chans)), REGRESSION_BLOCKS - 1)
         for name, ch in chans.items():
             rg = tracing.regression_fit(y, ch, REGRESSION_BLOCKS)
+            # t with the blocks' effective number − 1 degrees of freedom (≤ REGRESSION_BLOCKS − 1)
+            t_thr = t_dist.isf(TIME_SHARE * level / (2 * len(chans)), rg["dof"])
             t_stat = abs(rg["coefficient"]) / rg["se"] if rg["se"] > 0 else 0.0
             ev = {"domain": "channels", "test": {"t": t_stat, "threshold": float(t_thr), "alpha": TIME_SHARE * level}}
             if not t_stat > t_thr:
