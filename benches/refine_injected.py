@@ -130,6 +130,7 @@ def cases(quick: bool):
     tumble -= tumble.mean()
     ch_t = az - az.mean() + tumble
     tumble_truth = _within(0.01 * tumble + base * az, ch_t) / _within(ch_t, ch_t)
+    tumble_truth3 = _within(0.03 * tumble + base * az, ch_t) / _within(ch_t, ch_t)
     white = np.random.default_rng(3).normal(size=y6.size) * np.where(t >= 6000.0, 2 * np.std(np.diff(y6)), 0.0)
     out += [
         (
@@ -166,6 +167,12 @@ def cases(quick: bool):
             "ADIS run 2 x + 0.01 °/s/g × a multi-position acc_z (±1 g every 200–600 s, `channels=`)",
             gx + 0.01 * tumble,
             {"regression": {"coefficient": tumble_truth}},
+            {"channels": {"acc_z": az - az.mean() + tumble}},
+        ),
+        (
+            "ADIS run 2 x + GM (0.05 °/s, 20 s) + 0.03 °/s/g × the multi-position acc_z (`channels=`)",
+            gx + gm + 0.03 * tumble,
+            {"gauss_markov": {"sigma": 0.05, "tc": 20.0}, "regression": {"coefficient": tumble_truth3}},
             {"channels": {"acc_z": az - az.mean() + tumble}},
         ),
         (

@@ -256,13 +256,13 @@ def test_adis_with_injected_gauss_markov_and_g_sensitivity(shared_data):
     _falls(st)
     rg = next(s for s in r.steps if s.effect == "regression")
     assert rg.params["channel"] == "acc_z" and abs(rg.truth_error["coefficient"]) < 0.2
-    # held out in time: each half's coefficient lowers the other half's variance (the
-    # Allan-curve held-out error is not the right score for removing a white-like component: its level
-    # changes, not how well one half predicts the other — recorded, not asserted)
+    # held out in time: each half's coefficient lowers the other half's variance — what decides a regression.
+    # On the Allan curve a white-like component is absorbed by N: the in-sample RMS error falls (0.71 → 0.63 %)
+    # but χ²/dof (≈ 0.5) and the held-out curve error (3.39 → 3.45 %) stay within their scatter
+    # (docs/refinement.md)
     assert rg.evidence["heldout_variance_ratio"] < 1.0
-    assert rg.after["heldout_rms_adev_pct"] < rg.before["heldout_rms_adev_pct"]
-    # (in-sample, on the curve it was removed from, the Allan-curve fit does not improve: χ²/dof ≈ 0.5 before
-    # and after — a white-like component is absorbed by N; docs/refinement.md)
+    assert rg.after["rms_adev_pct"] < rg.before["rms_adev_pct"]
+    assert rg.after["heldout_rms_adev_pct"] == pytest.approx(rg.before["heldout_rms_adev_pct"], rel=0.05)
 
 
 def test_band_regression_keeps_one_coefficient_unless_the_bands_differ():
@@ -308,6 +308,30 @@ def test_adis_multi_position_g_sensitivity(shared_data):
     assert abs(rg.truth_error["coefficient"]) < 0.2
     assert rg.evidence["heldout_variance_ratio"] < 1.0
     _falls(rg)
+
+
+def test_adis_gauss_markov_and_multi_position_g_sensitivity_at_once(shared_data):
+    # two effects at once in real noise: a Gauss–Markov rate and a g-sensitivity seen through a ±1 g
+    # multi-position profile. The regression goes first (its test is in time): left in, the profile's steps
+    # would be taken by the Gauss–Markov term
+    gx, az = _adis(shared_data, 2, ["gyro_x", "acc_z"])
+    edges = np.cumsum(np.random.default_rng(5).uniform(200, 600, size=400) * FS).astype(int)
+    tumble = np.where(np.searchsorted(edges, np.arange(gx.size), side="right") % 2 == 0, 1.0, -1.0)
+    tumble -= tumble.mean()
+    ch = az - az.mean() + tumble
+    base = regression_fit(gx, az)["coefficient"]
+    gm = {"sigma": 0.05, "tc": 20.0}
+    y = gx + allanite.simulate(gx.size, FS, gauss_markov=[(gm["sigma"], gm["tc"])], seed=8) + 0.03 * tumble
+    truth = {
+        "gauss_markov": gm,
+        "regression": {"coefficient": _within(0.03 * tumble + base * az, ch) / _within(ch, ch)},
+    }
+    r = allanite.refine(y, FS, channels={"acc_z": ch}, truth=truth)
+    assert r.found[0] == "regression" and "gauss_markov" in r.found
+    for effect in ("regression", "gauss_markov"):
+        st = next(s for s in r.steps if s.effect == effect)
+        assert all(abs(v) < 0.2 for v in st.truth_error.values()), (effect, st.truth_error)
+        _falls(st)
 
 
 def test_simulated_multi_position_g_sensitivity():

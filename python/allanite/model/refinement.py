@@ -339,20 +339,30 @@ class _Split:
         av = np.maximum(avar(z, self.fs, taus=self.m / self.fs).avar, 1e-300)
         return _Curve(self.m / self.fs, self.m.astype(np.float64), av, self.fs, self.size + 1, self.estimator)
 
-    def error(self, terms, effects, remove=None) -> float:
+    def error(self, terms, effects, remove=None, on_raw=False) -> float:
         """RMS ADEV error (%) of one part's model predicting the other's curve, both ways; ``remove(samples,
-        indices)`` fits a component on the held-in part and returns it as a function of sample indices."""
+        indices)`` fits a component on the held-in part and returns it as a function of sample indices.
+
+        ``on_raw``: with ``remove``, predict the other part's *raw* curve — the model fitted on the held-in
+        part's corrected curve plus what the correction changed in the held-in part's curve — so that "before"
+        and "after" are scored on the same curve. Removing a large component the two parts share (a
+        multi-position profile's steps) otherwise changes the scale the relative error is taken on."""
         errs = []
         for f, h in ((0, 1), (1, 0)):
+            extra = 0.0
             if remove is None:
                 cf, ch = self.curves[f], self.curves[h]
             else:
                 yf, yh = self.y[self.idx[f]], self.y[self.idx[h]]
                 g = remove(yf, self.idx[f])
-                cf, ch = self._curve(yf - g(self.idx[f])), self._curve(yh - g(self.idx[h]))
+                cf = self._curve(yf - g(self.idx[f]))
+                if on_raw:
+                    ch, extra = self.curves[h], self.curves[f].avar - cf.avar
+                else:
+                    ch = self._curve(yh - g(self.idx[h]))
             sol = _solve(cf, terms, effects)
             a_h, _ = _design(ch, terms, effects)
-            pred = np.maximum(a_h @ sol.theta, 1e-300)
+            pred = np.maximum(a_h @ sol.theta + extra, 1e-300)
             errs.append(_rms_adev_pct(ch.avar[self.scored], pred[self.scored]))
         return float(np.mean(errs))
 
@@ -1222,8 +1232,8 @@ def _refine(
     start_heldout = heldout.error(start, []) if heldout is not None else None
     alpha_curve = level * (1.0 - LINE_SHARE - CHANGE_POINT_SHARE - 2 * TIME_SHARE)
 
-    # removing a time-domain component (after the curve effects are in the model)
-    def removal_step(name, component, refit, params, intervals, evidence, truth_key, held_in_time=None):
+    # removing a time-domain component (a drift, a regression: before the curve effects; rescored at the end)
+    def removal_step(name, component, refit, params, intervals, evidence, truth_key, held_in_time=None, on_raw=False):
         """Accept removing ``component`` if the held-out error falls; returns the step or None.
 
         ``refit(samples, indices)`` fits the component on the held-in part's samples (at those sample indices)
@@ -1238,7 +1248,7 @@ def _refine(
         res_new = avar(y_new, fs, taus=result.tau)
         c_new, h_new = build(res_new, y_new)
         ho_b = heldout.error(start, effects) if heldout is not None else None
-        ho_a = heldout.error(start, effects, remove=refit) if heldout is not None else None
+        ho_a = heldout.error(start, effects, remove=refit, on_raw=on_raw) if heldout is not None else None
         s_new = _solve(c_new, start, effects)
         if held_in_time is not None:
             evidence["heldout_variance_ratio"] = held_in_time
@@ -1282,7 +1292,9 @@ def _refine(
     considered: dict[str, list] = {}
     effects: list = []
     first_steps: list = []  # time effects removed before the curve loop (kept apart: steps[j] ↔ effects[j] below)
-    drift_removed = None
+    # (step, component, refit, fitted numbers, held-out on the raw curve) of each time effect removed before the
+    # curve loop
+    removed_first: list = []
     # ---- a warm-up drift first: its time-domain evidence is unambiguous, and left in the samples it bends
     # the long-τ curve that every curve effect is fitted against (its threshold comes from the five-term fit,
     # which the drift itself inflates: conservative)
@@ -1312,9 +1324,51 @@ def _refine(
             )
             if st is not None:
                 first_steps.append(st)
-                drift_removed = (drift_comp, drift_refit)
+                removed_first.append((st, drift_comp, drift_refit, 2, False))
         else:
             considered.setdefault("drift", []).append({"T": dr["T"], "statistic": dr["statistic"], "threshold": thr_d})
+    # ---- other channels next, before any curve effect: a component a channel explains (a multi-position
+    # profile's steps, a temperature's swing) bends the curve as a Gauss–Markov term or a random walk would,
+    # and fitted first those would take it; its test is in time (within blocks), independent of the curve
+    if y is not None and chans and "regression" in candidates:
+        for name, ch in chans.items():
+            rg = tracing.regression_fit(y, ch, REGRESSION_BLOCKS)
+            # t with the blocks' effective number − 1 degrees of freedom (≤ REGRESSION_BLOCKS − 1)
+            t_thr = t_dist.isf(TIME_SHARE * level / (2 * len(chans)), rg["dof"])
+            t_stat = abs(rg["coefficient"]) / rg["se"] if rg["se"] > 0 else 0.0
+            ev = {"domain": "channels", "test": {"t": t_stat, "threshold": float(t_thr), "alpha": TIME_SHARE * level}}
+            if not t_stat > t_thr:
+                considered.setdefault("regression", []).append({"channel": name, "t": t_stat, "threshold": t_thr})
+                continue
+
+            # band by band where the coupling differs across frequency (the whole-record coefficient elsewhere)
+            br = tracing.band_regression(y, ch, fs, TIME_SHARE * level)
+            own = [b for b in br["bands"] if b["own"]]
+            if own:
+                ev["bands"] = own
+
+            def reg_refit(z, idx, ch=ch, banded=bool(own)):
+                if banded:
+                    used = tracing.band_regression(z, ch[idx], fs, TIME_SHARE * level)["used"]
+                    return lambda i: tracing.band_component(ch[i] - ch.mean(), used)
+                cf = tracing.regression_fit(z, ch[idx], 2)["coefficient"]
+                return lambda i: cf * (ch[i] - ch.mean())
+
+            comp_r = tracing.band_component(ch - ch.mean(), br["used"])
+            st = removal_step(
+                "regression",
+                comp_r,
+                reg_refit,
+                {"channel": name, "coefficient": rg["coefficient"]},
+                {"coefficient": (rg["coefficient"] - rg["se"], rg["coefficient"] + rg["se"])},
+                ev,
+                "regression",
+                tracing.regression_heldout(y, ch, fs, TIME_SHARE * level) if own else tracing.regression_heldout(y, ch),
+                on_raw=True,
+            )
+            if st is not None:
+                first_steps.append(st)
+                removed_first.append((st, comp_r, reg_refit, 1 + len(own), True))
     exact = y is not None or (isinstance(est, str) and est == "oavar")
     thin = tracing.thin_indices(curve.tau)
     sub = curve.subset(thin)
@@ -1537,43 +1591,6 @@ def _refine(
             st.params[names[0]] = math.sqrt(max(sol.theta[k_terms + j], 0.0))
             if truth and base in truth and st.truth_error is not None:
                 st.truth_error = {kk: st.params[kk] / v - 1 for kk, v in truth[base].items() if kk in st.params}
-    # ---- time domain: other channels, then a warm-up drift; each removed from the samples and refitted
-    if y is not None and chans and "regression" in candidates:
-        for name, ch in chans.items():
-            rg = tracing.regression_fit(y, ch, REGRESSION_BLOCKS)
-            # t with the blocks' effective number − 1 degrees of freedom (≤ REGRESSION_BLOCKS − 1)
-            t_thr = t_dist.isf(TIME_SHARE * level / (2 * len(chans)), rg["dof"])
-            t_stat = abs(rg["coefficient"]) / rg["se"] if rg["se"] > 0 else 0.0
-            ev = {"domain": "channels", "test": {"t": t_stat, "threshold": float(t_thr), "alpha": TIME_SHARE * level}}
-            if not t_stat > t_thr:
-                considered.setdefault("regression", []).append({"channel": name, "t": t_stat, "threshold": t_thr})
-                continue
-
-            # band by band where the coupling differs across frequency (the whole-record coefficient elsewhere)
-            br = tracing.band_regression(y, ch, fs, TIME_SHARE * level)
-            own = [b for b in br["bands"] if b["own"]]
-            if own:
-                ev["bands"] = own
-
-            def reg_refit(z, idx, ch=ch, banded=bool(own)):
-                if banded:
-                    used = tracing.band_regression(z, ch[idx], fs, TIME_SHARE * level)["used"]
-                    return lambda i: tracing.band_component(ch[i] - ch.mean(), used)
-                cf = tracing.regression_fit(z, ch[idx], 2)["coefficient"]
-                return lambda i: cf * (ch[i] - ch.mean())
-
-            st = removal_step(
-                "regression",
-                tracing.band_component(ch - ch.mean(), br["used"]),
-                reg_refit,
-                {"channel": name, "coefficient": rg["coefficient"]},
-                {"coefficient": (rg["coefficient"] - rg["se"], rg["coefficient"] + rg["se"])},
-                ev,
-                "regression",
-                tracing.regression_heldout(y, ch, fs, TIME_SHARE * level) if own else tracing.regression_heldout(y, ch),
-            )
-            if st is not None:
-                steps.append(st)
     change_points = []
     if y is not None and "change_point" in candidates:
         change_points = _change_points(y, fs, start)
@@ -1616,19 +1633,18 @@ def _refine(
                     truth_error=terr,
                 )
             )
-    if drift_removed is not None:
-        # the drift went first (on the five terms alone); its before/after are scored at the end against the
-        # final model — the same curve effects with and without the drift in the samples
-        comp, refit = drift_removed
+    for st, comp, refit, n_fit, on_raw in removed_first:
+        # a time effect went before the curve effects (on the five terms alone); its before/after are scored at
+        # the end against the final model — the same curve effects with and without it in the samples (the
+        # other removals stay removed)
         y_raw = y + comp
         c_raw, h_raw = build(avar(y_raw, fs, taus=result.tau), y_raw)
         s_raw = _solve(c_raw, start, effects)
-        st = first_steps[0]
         st.before = metrics(c_raw, s_raw, h_raw.error(start, effects) if h_raw is not None else None)
-        # after: on the raw curve too — the final model plus what removing the drift changed in the curve
+        # after: on the raw curve too — the final model plus what removing it changed in the curve
         # (y_raw − comp is the final samples, whose curve the final model was fitted to)
-        ho_after = h_raw.error(start, effects, remove=refit) if h_raw is not None else None
-        st.after = _removal_metrics(c_raw, sol, c_raw.avar - curve.avar, 2, ho_after, scored)
+        ho_after = h_raw.error(start, effects, remove=refit, on_raw=on_raw) if h_raw is not None else None
+        st.after = _removal_metrics(c_raw, sol, c_raw.avar - curve.avar, n_fit, ho_after, scored)
         st.delta_chi2_eff = float(s_raw.chi2_eff(c_raw) - sol.chi2_eff(curve))
         st.evidence["scored_with"] = [_base(k) for k, _p in effects] or "the five terms"
     steps = first_steps + steps
