@@ -46,6 +46,12 @@ def _within(a, b, blocks=8):
     return float(np.sum((a - a.mean(axis=1, keepdims=True)) * (b - b.mean(axis=1, keepdims=True))))
 
 
+def _tumble(n, seed, turns):
+    """A multi-position profile of n samples: ±1 g, turned every 200–600 s (seeded)."""
+    edges = np.cumsum(np.random.default_rng(seed).uniform(200, 600, size=turns) * FS).astype(int)
+    return np.where(np.searchsorted(edges, np.arange(n), side="right") % 2 == 0, 1.0, -1.0)
+
+
 def _falls(st):
     # in-sample χ²/dof and RMS ADEV error (a time-domain removal: both on the curve it was removed from),
     # and the held-out error
@@ -297,8 +303,7 @@ def test_adis_multi_position_g_sensitivity(shared_data):
     # a realistic g-sensitivity test: acc_z turned between ±1 g every 200–600 s, the gyro responding to the
     # true acceleration at 0.01 °/s/g (the log's own noise and its coupling to acc_z's noise kept)
     gx, az = _adis(shared_data, 2, ["gyro_x", "acc_z"])
-    edges = np.cumsum(np.random.default_rng(5).uniform(200, 600, size=400) * FS).astype(int)
-    tumble = np.where(np.searchsorted(edges, np.arange(gx.size), side="right") % 2 == 0, 1.0, -1.0)
+    tumble = _tumble(gx.size, seed=5, turns=400)
     tumble -= tumble.mean()
     ch = az - az.mean() + tumble
     base = regression_fit(gx, az)["coefficient"]
@@ -315,8 +320,7 @@ def test_adis_gauss_markov_and_multi_position_g_sensitivity_at_once(shared_data)
     # multi-position profile. The regression goes first (its test is in time): left in, the profile's steps
     # would be taken by the Gauss–Markov term
     gx, az = _adis(shared_data, 2, ["gyro_x", "acc_z"])
-    edges = np.cumsum(np.random.default_rng(5).uniform(200, 600, size=400) * FS).astype(int)
-    tumble = np.where(np.searchsorted(edges, np.arange(gx.size), side="right") % 2 == 0, 1.0, -1.0)
+    tumble = _tumble(gx.size, seed=5, turns=400)
     tumble -= tumble.mean()
     ch = az - az.mean() + tumble
     base = regression_fit(gx, az)["coefficient"]
@@ -339,8 +343,7 @@ def test_simulated_multi_position_g_sensitivity():
     # ±1 g turns every 200–600 s at 0.01 °/s/g. Most 500-s blocks see one turn or none, so the coefficient
     # is weighed within blocks (a per-block-coefficient error put t at 1.3 here; within blocks it is ≈ 220)
     n = 400_000
-    edges = np.cumsum(np.random.default_rng(9).uniform(200, 600, size=200) * FS).astype(int)
-    tumble = np.where(np.searchsorted(edges, np.arange(n), side="right") % 2 == 0, 1.0, -1.0)
+    tumble = _tumble(n, seed=9, turns=200)
     acc = tumble + 2e-3 * np.random.default_rng(10).normal(size=n)
     y = allanite.simulate(n, FS, N=2e-3, K=2e-5, seed=12) + 0.01 * tumble
     truth = 0.01 * _within(tumble, acc) / _within(acc, acc)

@@ -402,10 +402,8 @@ def band_regression(y: np.ndarray, ch: np.ndarray, fs: float, alpha: float) -> d
                 parts.append(float(yb[sl] @ cb[sl]) / d)
         se = float(np.std(parts, ddof=1) / math.sqrt(len(parts))) if len(parts) > 1 else math.inf
         own = bool(den > 0 and se > 0 and abs(ck - c0) / se > thr)
-        f_hi = fs / 2**k if k <= levels else fs / 2 ** (levels + 1)
+        f_hi = fs / 2**k  # band k: fs/2^(k+1) … fs/2^k; the remainder (k = levels + 1): 0 … fs/2^k
         f_lo = fs / 2 ** (k + 1) if k <= levels else 0.0
-        if k == 1:
-            f_hi = fs / 2
         bands.append({"f_lo": f_lo, "f_hi": f_hi, "coefficient": ck, "se": se, "own": own})
         used.append(ck if own else c0)
     return {"coefficient": c0, "se": whole["se"], "bands": bands, "used": used, "threshold": thr}
