@@ -95,13 +95,18 @@ def check_probability(value: object, name: str = "confidence") -> float:
     return c
 
 
-def as_rate_columns(x: object, fs: object, input: str) -> tuple[list[np.ndarray], float, bool]:
+def as_rate_columns(
+    x: object, fs: object, input: str, *, peaks: list[float] | None = None
+) -> tuple[list[np.ndarray], float, bool]:
     """Validate samples and convert them to rate columns.
 
     Returns ``(columns, fs, is_multi)``: a list of C-contiguous float64 arrays (one per axis) of rate
     samples, the sampling rate, and whether the input had an axes dimension. ``input="increment"``
     (angle per sample) is divided by τ0; ``input="angle"`` (cumulative angle, M + 1 points) is
     differenced first. All three describe the same record and give the same Allan variance.
+
+    ``peaks``: a list that receives each column's largest magnitude (the finite check's min and max
+    give it for rate input, so a caller that scales the columns need not read the record again).
     """
     fs = check_fs(fs)
     check_choice(input, "input", INPUTS)
@@ -131,7 +136,8 @@ def as_rate_columns(x: object, fs: object, input: str) -> tuple[list[np.ndarray]
     for a, c in enumerate(cols):
         c = np.asarray(c, dtype=np.float64)
         # min and max are NaN if any sample is, ±inf if any is: no per-sample temporary unless one is bad
-        if not (np.isfinite(c.min()) and np.isfinite(c.max())):
+        c_min, c_max = c.min(), c.max()
+        if not (np.isfinite(c_min) and np.isfinite(c_max)):
             i = int(np.argmin(np.isfinite(c)))
             where = f"sample {i}" + (f" of axis {a}" if is_multi else "")
             raise InputError(f"samples contain a non-finite value ({c[i]}) at {where}; only finite numbers are allowed")
@@ -142,6 +148,11 @@ def as_rate_columns(x: object, fs: object, input: str) -> tuple[list[np.ndarray]
             y = c * fs
         else:
             y = np.diff(c) * fs
+        if peaks is not None:
+            if y is c:
+                peaks.append(max(float(c_max), -float(c_min)))
+            else:
+                peaks.append(max(float(y.max()), -float(y.min())) if y.size else 0.0)
         out.append(y)
     return out, fs, is_multi
 

@@ -35,11 +35,12 @@ METHODS = ("fast", "naive")
 SAFE_EXP = 200
 
 
-def _scale_columns(cols: list[np.ndarray]) -> tuple[list[np.ndarray], list[int]]:
-    """Columns scaled into the safe range, and each column's power-of-two exponent e (sample = scaled·2^e)."""
+def _scale_columns(cols: list[np.ndarray], peaks: list[float] | None = None) -> tuple[list[np.ndarray], list[int]]:
+    """Columns scaled into the safe range, and each column's power-of-two exponent e (sample = scaled·2^e).
+    ``peaks``: the columns' largest magnitudes when the caller has them (``as_rate_columns(peaks=)``)."""
     out, exps = [], []
-    for c in cols:
-        peak = _peak(c)
+    for i, c in enumerate(cols):
+        peak = peaks[i] if peaks is not None else _peak(c)
         if peak == 0.0 or 2.0**-SAFE_EXP < peak < 2.0**SAFE_EXP:
             out.append(c)
             exps.append(0)
@@ -186,9 +187,10 @@ def avar(
     entry = estimators.get(estimator, "static")
     tapered = estimators.get_taper(taper, estimator)
     options = entry.check_options({"kf_rule": kf_rule, "decimate": decimate})
-    cols, fs, is_multi = as_rate_columns(x, fs, input)
+    peaks: list[float] = []
+    cols, fs, is_multi = as_rate_columns(x, fs, input, peaks=peaks)
     assert entry.static is not None
-    scaled, exps = _scale_columns(cols)
+    scaled, exps = _scale_columns(cols, peaks)
     if tapered.static is None:
         out = entry.static(scaled, fs, taus, workers, **options)
     else:
@@ -353,6 +355,7 @@ def davar(
     check_choice(method, "method", METHODS)
     check_choice(gaps, "gaps", GAPS)
     options = entry.check_options({"kf_rule": kf_rule})
+    peaks: list[float] | None
     if gaps == "skip":
         if taper != "rect" or method != "fast":
             raise ParameterError(
@@ -364,8 +367,10 @@ def davar(
                 f"estimator={estimator!r}"
             )
         cols, fs, is_multi = _gap_columns(x, fs, input)
+        peaks = None
     else:
-        cols, fs, is_multi = as_rate_columns(x, fs, input)
+        peaks = []
+        cols, fs, is_multi = as_rate_columns(x, fs, input, peaks=peaks)
     n = cols[0].size
     window = check_count(window, "window", 2)
     hop = check_count(hop, "hop", 1)
@@ -418,7 +423,7 @@ def davar(
             n_samples=n,
             input=input,
         )
-    scaled, exps = _scale_columns(cols)
+    scaled, exps = _scale_columns(cols, peaks)
     big = n_win * window >= DHVAR_BAR_SAMPLES
     if tapered.dynamic is not None:
         out = tapered.dynamic(scaled, fs, window, hop_core, taus, method, workers)

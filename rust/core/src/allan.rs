@@ -859,6 +859,13 @@ pub(crate) fn check_finite(cols: &[&[f64]]) -> Result<()> {
 
 /// Checks a request; the messages name the value and what is allowed.
 pub fn validate(req: &Request) -> Result<usize> {
+    let n_win = validate_shape(req)?;
+    check_finite(req.columns)?;
+    Ok(n_win)
+}
+
+/// [`validate`] without the finite check (for a path that checks while it reads the samples).
+fn validate_shape(req: &Request) -> Result<usize> {
     let n = check_shape(req.columns)?;
     if req.window < 2 || req.window > n {
         return Err(CoreError::InvalidParameter(format!(
@@ -883,7 +890,6 @@ pub fn validate(req: &Request) -> Result<usize> {
             req.window
         )));
     }
-    check_finite(req.columns)?;
     Ok(n_windows(n, req.window, req.hop))
 }
 
@@ -896,7 +902,7 @@ pub fn dynamic_avar(req: &Request) -> Result<(Vec<f64>, usize)> {
 /// [`dynamic_avar`] that stops within one row chunk (at most a few thousand terms per worker) once
 /// `cancel` is set, and then returns [`CoreError::Cancelled`].
 pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f64>, usize)> {
-    let n_win = validate(req)?;
+    let n_win = validate_shape(req)?;
     let (n_axes, n_m) = (req.columns.len(), req.ms.len());
     let mut out = vec![0.0f64; n_axes * n_m * n_win];
     if (4 << 20..=1 << 30).contains(&(out.len() * 8)) {
@@ -905,6 +911,27 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
         // below a few MB the advice's syscall costs more than it saves.
         crate::oavar::advise_huge_pages(&mut out);
     }
+    if req.method == Method::Fast
+        && req.estimator == Estimator::Overlapping
+        && n_win == 1
+        && req.window <= GATHER_MAX
+    {
+        // One window (the static estimator): every m from one double-word phase, all m per pass over
+        // the record (see `crate::oavar`); its centring value comes from the same parallel pass
+        // that checks the samples are finite (the samples after the window too).
+        let tails: Vec<&[f64]> = req.columns.iter().map(|c| &c[req.window..]).collect();
+        check_finite(&tails)?;
+        let mus = req
+            .columns
+            .iter()
+            .enumerate()
+            .map(|(a, c)| crate::oavar::centre(&c[..req.window], a))
+            .collect::<Result<Vec<f64>>>()?;
+        overlapping_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
+        cancel.check()?;
+        return Ok((out, n_win));
+    }
+    check_finite(req.columns)?;
     match req.method {
         Method::Fast => {
             let mus: Vec<f64> = req
@@ -919,13 +946,6 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
                 // One window (the static estimator): gather cluster sums from one exact prefix
                 // instead of streaming the record once per m (see `crate::gather`).
                 classic_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
-                cancel.check()?;
-                return Ok((out, n_win));
-            }
-            if req.estimator == Estimator::Overlapping && n_win == 1 && req.window <= GATHER_MAX {
-                // One window (the static estimator): every m from one double-word phase, all m per
-                // pass over the record (see `crate::oavar`).
-                overlapping_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
                 cancel.check()?;
                 return Ok((out, n_win));
             }
@@ -1034,7 +1054,14 @@ pub fn dynamic_avar_part_cancellable(
             return Ok((out, n_win));
         }
         if req.estimator == Estimator::Overlapping && req.window <= GATHER_MAX {
-            overlapping_window(req.columns, mus, req.ms, req.window, &mut out, cancel);
+            // centred as the whole-record call centres it (the part is the record's one window)
+            let mus = req
+                .columns
+                .iter()
+                .enumerate()
+                .map(|(a, c)| crate::oavar::centre(&c[..req.window], a))
+                .collect::<Result<Vec<f64>>>()?;
+            overlapping_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
             cancel.check()?;
             return Ok((out, n_win));
         }

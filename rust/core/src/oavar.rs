@@ -10,13 +10,26 @@
 //! A plain f64 prefix carries an absolute error ~ε·max|P| into every d: a quiet stretch after a loud
 //! one, or small noise on a slow large swing of the rate, loses its digits. P is kept as hi + lo:
 //! hi the running f64 sum, lo the running sum of the exact rounding errors of hi (Knuth's TwoSum),
-//! built in fixed blocks whose double-word offsets are added afterwards (TwoSum again). Its error
-//! is ~ε²·(samples)·max|P|, i.e. ≲ 10⁻²⁵·max|P| for 10⁸ samples.
+//! built in fixed blocks, each started from its double-word offset (the blocks' totals are summed
+//! first, in parallel, and scanned in double words), each pair stored normalised (|lo| ≲ ½ ulp(hi)).
+//! Its error is ~ε²·(samples)·max|P|, i.e. ≲ 10⁻²⁵·max|P| for 10⁸ samples. μ is the window's mean
+//! from the same blocks' double-word total (that pass is also the finite check).
 //!
 //! A term is then d = [(hi₂ − hi₁) − (hi₁ − hi₀)] + [(lo₂ − lo₁) − (lo₁ − lo₀)]. The differences of
 //! hi are rounded once each: hi₂ − hi₁ is the block sum B_{k+m} (to within the lo parts), so the
 //! error of d is ≲ ε·(|B_k| + |B_{k+m}| + |d|) + O(ε²·max|P|) — relative to the term's own block sums,
 //! never to the rest of the record. The terms d² ≥ 0 are summed without cancellation.
+//!
+//! # Single words where they are provably enough
+//! Dropping lo halves the reads and the arithmetic, and costs each term at most 4ε·max|hi| + 4·max|lo|
+//! over the pairs it reads (+ ε|d|) — small against the terms unless the phase is far larger than
+//! they are. Each (chunk, m) partial sum is therefore first formed from hi alone and kept only if a
+//! rigorous bound on its difference from the double-word sum, from the chunk's largest |hi| and |lo|
+//! (recorded while the phase is built), is within 10⁻¹¹ of it ([`single_word_holds`]); otherwise the
+//! chunk is summed in double words. White noise of 10⁷ samples passes everywhere; a quiet stretch
+//! after a loud one, a steep ramp of the rate or a random-walk rate fall back where they need to
+//! (the unit test `single_word_partials_stand_for_the_double_word_ones` checks every partial of such
+//! records against the double-word one).
 //!
 //! # Speed
 //! The record is cut into chunks of `CHUNK` terms; a chunk computes its partial sums for every m,
@@ -27,7 +40,8 @@
 //!
 //! # Bit-identical for any thread count
 //! Block and chunk boundaries depend on the record length only; each chunk's partial sums are
-//! formed by one sequential routine, and the partials are added in chunk order.
+//! formed by one sequential routine (whose single- or double-word choice depends on the data and
+//! that grid only), and the partials are added in chunk order.
 
 use crate::cancel::Cancel;
 use rayon::prelude::*;
@@ -52,55 +66,132 @@ fn two_sum(a: f64, b: f64) -> (f64, f64) {
     (s, e)
 }
 
-/// Local compensated prefix of one block: h[i] + l[i] = Σ_{j ≤ i} (src_j − μ); returns the totals.
+/// The double-word total of `src − μ` (each fl(v − μ) as the prefix pass rounds it), in `LANES`
+/// independent TwoSum accumulators so that it vectorises; their exact errors are kept and the lanes
+/// are joined with TwoSum. Error ≲ ε²·len·Σ|v − μ|.
 #[inline(always)]
-fn block_prefix(src: &[f64], mu: f64, h: &mut [f64], l: &mut [f64]) -> (f64, f64) {
-    let (mut s, mut c) = (0.0f64, 0.0f64);
-    for ((hv, lv), &v) in h.iter_mut().zip(l.iter_mut()).zip(src) {
-        let (t, e) = two_sum(s, v - mu);
-        s = t;
-        c += e;
-        *hv = s;
-        *lv = c;
+fn block_total(src: &[f64], mu: f64) -> (f64, f64) {
+    let mut s = [0.0f64; LANES];
+    let mut c = [0.0f64; LANES];
+    let body = src.chunks_exact(LANES);
+    let tail = body.remainder();
+    for v in body {
+        for j in 0..LANES {
+            let (t, e) = two_sum(s[j], v[j] - mu);
+            s[j] = t;
+            c[j] += e;
+        }
     }
-    (s, c)
-}
-
-/// Adds the double-word offset (oh, ol) to every (h, l) of a block.
-#[inline(always)]
-fn add_offset(h: &mut [f64], l: &mut [f64], oh: f64, ol: f64) {
-    for (hv, lv) in h.iter_mut().zip(l.iter_mut()) {
-        let (t, e) = two_sum(oh, *hv);
-        *hv = t;
-        *lv += e + ol;
+    for (j, &v) in tail.iter().enumerate() {
+        let (t, e) = two_sum(s[j], v - mu);
+        s[j] = t;
+        c[j] += e;
     }
+    let (mut th, mut tl) = (0.0f64, 0.0f64);
+    for j in 0..LANES {
+        let (t, e) = two_sum(th, s[j]);
+        th = t;
+        tl += e + c[j];
+    }
+    (th, tl)
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn add_offset_avx2(h: &mut [f64], l: &mut [f64], oh: f64, ol: f64) {
-    add_offset(h, l, oh, ol)
+#[target_feature(enable = "avx2")]
+unsafe fn block_total_avx2(src: &[f64], mu: f64) -> (f64, f64) {
+    block_total(src, mu)
 }
 
-fn add_offset_dispatch(h: &mut [f64], l: &mut [f64], oh: f64, ol: f64) {
+fn block_total_dispatch(src: &[f64], mu: f64) -> (f64, f64) {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the CPU has the features the function is compiled for (checked just above).
-        return unsafe { add_offset_avx2(h, l, oh, ol) };
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has the feature the function is compiled for (checked just above).
+        return unsafe { block_total_avx2(src, mu) };
     }
-    add_offset(h, l, oh, ol)
+    block_total(src, mu)
 }
 
-/// The phase of `y − μ` as hi[j] + lo[j], j = 0 … y.len() (hi, lo of length y.len() + 1; P_0 = 0).
-pub(crate) fn phase_prefix(y: &[f64], mu: f64, hi: &mut [f64], lo: &mut [f64]) {
+/// The phase of one block from its double-word offset (oh, ol): running TwoSum of fl(v − μ) from
+/// s = oh with the exact errors summed in c (from ol), each (s, c) stored normalised (|l| ≤ ½ ulp(h):
+/// hi alone is the phase rounded once). Returns, into `maxima`, the largest |h| and
+/// |l| of each run of `CHUNK` pairs (the bounds the single-word term pass checks itself against, see
+/// [`single_word_holds`]).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn block_phase(
+    src: &[f64],
+    mu: f64,
+    oh: f64,
+    ol: f64,
+    h: &mut [f64],
+    l: &mut [f64],
+    maxima: &mut [(f64, f64)],
+) {
+    let (mut s, mut c) = (oh, ol);
+    for (((hc, lc), yc), mx) in h
+        .chunks_mut(CHUNK)
+        .zip(l.chunks_mut(CHUNK))
+        .zip(src.chunks(CHUNK))
+        .zip(maxima.iter_mut())
+    {
+        let (mut mh, mut ml) = (0.0f64, 0.0f64);
+        for ((hv, lv), &v) in hc.iter_mut().zip(lc.iter_mut()).zip(yc) {
+            let (t, e) = two_sum(s, v - mu);
+            s = t;
+            c += e;
+            // Fast2Sum (|c| ≪ |s| but where s crosses zero; there the pair is off by ≲ ε·|c|, far
+            // below the phase's own error): hi = the phase rounded once
+            let p = s + c;
+            let q = c - (p - s);
+            *hv = p;
+            *lv = q;
+            // plain compares (maxsd): the samples are finite, so NaN needs no care here
+            mh = if p.abs() > mh { p.abs() } else { mh };
+            ml = if q.abs() > ml { q.abs() } else { ml };
+        }
+        *mx = (mh, ml);
+    }
+}
+
+/// The centring value of one static window and its finite check, in one parallel pass: the mean
+/// from the double-word total of fixed blocks (joined in block order, so the same bits for any
+/// thread count). A sample that is NaN or ±inf makes the total non-finite and is then located.
+pub(crate) fn centre(y: &[f64], axis: usize) -> crate::Result<f64> {
+    let totals: Vec<(f64, f64)> = y
+        .par_chunks(BLOCK)
+        .map(|src| block_total_dispatch(src, 0.0))
+        .collect();
+    let (mut th, mut tl) = (0.0f64, 0.0f64);
+    for &(s, c) in &totals {
+        let (t, e) = two_sum(th, s);
+        th = t;
+        tl += e + c;
+    }
+    let total = th + tl;
+    if !total.is_finite() {
+        if let Some(index) = y.iter().position(|v| !v.is_finite()) {
+            return Err(crate::CoreError::NonFinite {
+                axis,
+                index,
+                value: y[index],
+            });
+        }
+        // finite samples whose sum overflows: the sequential compensated mean, as elsewhere
+        return Ok(crate::allan::compensated_mean(y));
+    }
+    Ok(total / y.len() as f64)
+}
+
+/// The phase of `y − μ` as hi[j] + lo[j], j = 0 … y.len() (hi, lo of length y.len() + 1; P_0 = 0),
+/// each pair normalised (|lo| ≤ ½ ulp(hi)). Returns the largest |hi| and |lo| over the pairs
+/// 1 + c·CHUNK ..= (c + 1)·CHUNK, c = 0, 1, … (see [`max_slot`]; P_0 = 0 needs none).
+pub(crate) fn phase_prefix(y: &[f64], mu: f64, hi: &mut [f64], lo: &mut [f64]) -> Vec<(f64, f64)> {
     debug_assert!(hi.len() == y.len() + 1 && lo.len() == y.len() + 1);
     hi[0] = 0.0;
     lo[0] = 0.0;
-    let totals: Vec<(f64, f64)> = hi[1..]
-        .par_chunks_mut(BLOCK)
-        .zip(lo[1..].par_chunks_mut(BLOCK))
-        .zip(y.par_chunks(BLOCK))
-        .map(|((h, l), src)| block_prefix(src, mu, h, l))
+    let totals: Vec<(f64, f64)> = y
+        .par_chunks(BLOCK)
+        .map(|src| block_total_dispatch(src, mu))
         .collect();
     // Exclusive scan of the block totals in double-word arithmetic (sequential, n / BLOCK steps).
     let mut offs = Vec::with_capacity(totals.len());
@@ -113,12 +204,21 @@ pub(crate) fn phase_prefix(y: &[f64], mu: f64, hi: &mut [f64], lo: &mut [f64]) {
         ol = low - (h - t);
         oh = h;
     }
+    let mut maxima = vec![(0.0f64, 0.0f64); y.len().div_ceil(CHUNK)];
     hi[1..]
         .par_chunks_mut(BLOCK)
         .zip(lo[1..].par_chunks_mut(BLOCK))
+        .zip(y.par_chunks(BLOCK))
         .zip(offs.par_iter())
-        .skip(1)
-        .for_each(|((h, l), &(oh, ol))| add_offset_dispatch(h, l, oh, ol));
+        .zip(maxima.par_chunks_mut(BLOCK / CHUNK))
+        .for_each(|((((h, l), src), &(oh, ol)), mx)| block_phase(src, mu, oh, ol, h, l, mx));
+    maxima
+}
+
+/// The slot of [`phase_prefix`]'s maxima that covers phase index j.
+#[inline(always)]
+fn max_slot(j: usize) -> usize {
+    j.saturating_sub(1) / CHUNK
 }
 
 /// Advises the kernel to back the 2 MiB-aligned interior of `v` with 2 MiB pages (Linux; advice only,
@@ -294,36 +394,176 @@ fn chunk_sum_dispatch(avx2: bool, hi: &[f64], lo: &[f64], m: usize, k0: usize, l
     chunk_sum(hi, lo, m, k0, len)
 }
 
+/// Σ dₕ² over k = k0 … k0 + len − 1 at factor m from hi alone, dₕ = (hi₂ − hi₁) − (hi₁ − hi₀): half
+/// the reads and arithmetic of [`chunk_sum`]; used only where [`single_word_holds`] certifies it.
+#[inline(always)]
+fn chunk_sum_hi(hi: &[f64], m: usize, k0: usize, len: usize) -> f64 {
+    let h0 = &hi[k0..k0 + len];
+    let h1 = &hi[k0 + m..k0 + m + len];
+    let h2 = &hi[k0 + 2 * m..k0 + 2 * m + len];
+    let mut acc = [0.0f64; LANES];
+    let it = h0
+        .chunks_exact(LANES)
+        .zip(h1.chunks_exact(LANES))
+        .zip(h2.chunks_exact(LANES));
+    for ((a0, a1), a2) in it {
+        for j in 0..LANES {
+            let d = (a2[j] - a1[j]) - (a1[j] - a0[j]);
+            acc[j] += d * d;
+        }
+    }
+    let done = len - len % LANES;
+    for (j, i) in (done..len).enumerate() {
+        let d = (h2[i] - h1[i]) - (h1[i] - h0[i]);
+        acc[j] += d * d;
+    }
+    ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
+}
+
+/// [`chunk_sum_hi`] in AVX2 intrinsics (the same IEEE operations per lane in the same order).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn chunk_sum_hi_avx2(hi: &[f64], m: usize, k0: usize, len: usize) -> f64 {
+    use std::arch::x86_64::*;
+    assert!(k0 + 2 * m + len <= hi.len());
+    // SAFETY (every pointer below): offsets k0 + {0, m, 2m} + i with i < len stay within hi
+    // (asserted above); loads are unaligned.
+    let h0 = hi.as_ptr().add(k0);
+    let (h1, h2) = (h0.add(m), h0.add(2 * m));
+    let mut acc_a = _mm256_setzero_pd();
+    let mut acc_b = _mm256_setzero_pd();
+    let done = len - len % LANES;
+    let mut i = 0;
+    while i < done {
+        let a0 = _mm256_loadu_pd(h0.add(i));
+        let a1 = _mm256_loadu_pd(h1.add(i));
+        let a2 = _mm256_loadu_pd(h2.add(i));
+        let d = _mm256_sub_pd(_mm256_sub_pd(a2, a1), _mm256_sub_pd(a1, a0));
+        acc_a = _mm256_add_pd(acc_a, _mm256_mul_pd(d, d));
+        let a0 = _mm256_loadu_pd(h0.add(i + 4));
+        let a1 = _mm256_loadu_pd(h1.add(i + 4));
+        let a2 = _mm256_loadu_pd(h2.add(i + 4));
+        let d = _mm256_sub_pd(_mm256_sub_pd(a2, a1), _mm256_sub_pd(a1, a0));
+        acc_b = _mm256_add_pd(acc_b, _mm256_mul_pd(d, d));
+        i += LANES;
+    }
+    let mut acc = [0.0f64; LANES];
+    _mm256_storeu_pd(acc.as_mut_ptr(), acc_a);
+    _mm256_storeu_pd(acc.as_mut_ptr().add(4), acc_b);
+    for (j, i) in (done..len).enumerate() {
+        let d = (*h2.add(i) - *h1.add(i)) - (*h1.add(i) - *h0.add(i));
+        acc[j] += d * d;
+    }
+    ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
+}
+
+#[inline(always)]
+fn chunk_sum_hi_dispatch(avx2: bool, hi: &[f64], m: usize, k0: usize, len: usize) -> f64 {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: the caller checked that the CPU has AVX2.
+        return unsafe { chunk_sum_hi_avx2(hi, m, k0, len) };
+    }
+    let _ = avx2;
+    chunk_sum_hi(hi, m, k0, len)
+}
+
+/// Relative bound the single-word sum must meet to stand for the double-word one: 10⁻¹¹, a hundredth
+/// of the 10⁻⁹ the estimator promises against an extended-precision recomputation.
+const SINGLE_WORD_TOL: f64 = 1e-11;
+
+/// The largest |hi| and |lo| over the phase indices k0 + j·m … k0 + j·m + len − 1, j = 0, 1, 2 (the
+/// pairs one (chunk, m) reads), from [`phase_prefix`]'s maxima.
+#[inline(always)]
+fn region_maxima(maxima: &[(f64, f64)], m: usize, k0: usize, len: usize) -> (f64, f64) {
+    let (mut mh, mut ml) = (0.0f64, 0.0f64);
+    for j in 0..3 {
+        let a = k0 + j * m;
+        for &(h, l) in &maxima[max_slot(a)..=max_slot(a + len - 1)] {
+            mh = mh.max(h);
+            ml = ml.max(l);
+        }
+    }
+    (mh, ml)
+}
+
+/// Whether Σ dₕ² = `s` over `len` terms is within `SINGLE_WORD_TOL`·s of the sum of the exact
+/// squares of the double-word terms d = (H₂+L₂) − 2(H₁+L₁) + (H₀+L₀), given |H| ≤ `mh`, |L| ≤ `ml`
+/// over the pairs read. Each term: |dₕ − d| ≤ A + u|dₕ| with A = 4u·mh + 4·ml (u = 2⁻⁵³: the three
+/// rounded differences of hi, |hᵢ − hⱼ| ≤ 2·mh; the dropped lo parts, ≤ 4·ml). Summed, with
+/// Σ|dₕ| ≤ √(len·s) (Cauchy–Schwarz): |Σd² − s| ≤ 2A(1+u)√(len·s) + (2u+u²)s + len·A². A bound, not
+/// an estimate: where it holds the result is the double-word one to 10⁻¹¹; where it does not (a
+/// phase far larger than the terms: a quiet stretch after a loud one, a large slow swing of the rate),
+/// the chunk is summed in double words.
+#[inline(always)]
+fn single_word_holds(s: f64, len: usize, mh: f64, ml: f64) -> bool {
+    const U: f64 = f64::EPSILON / 2.0;
+    let a = 4.0 * U * mh + 4.0 * ml;
+    let l = len as f64;
+    let bound = 2.0 * a * (1.0 + U) * (l * s).sqrt() + (2.0 * U + U * U) * s + l * a * a;
+    bound <= SINGLE_WORD_TOL * s
+}
+
 /// The partial sums of the chunks `c0 ..` of one super-chunk, rows of `n_m` in `dst`. Short m run
 /// chunk by chunk, every m per chunk (their three reads share the chunk's cache lines); long m run
-/// m by m over the super-chunk's chunks, so that only six streams are in flight at a time.
-fn super_chunk(hi: &[f64], lo: &[f64], ms: &[usize], n: usize, c0: usize, dst: &mut [f64]) {
+/// m by m over the super-chunk's chunks, so that only a few streams are in flight at a time.
+///
+/// Each (chunk, m) is summed from hi alone when [`single_word_holds`] certifies the result, in double
+/// words otherwise. Which one is tried first follows the previous chunk of the same m in this
+/// super-chunk (the first tries hi; `single_word` false: double words throughout): a record that needs double words pays for one wasted
+/// single-word chunk per change, not one per chunk. The choice depends on the data and the fixed
+/// chunk grid only, so the bits do not depend on the thread count. Returns how many (chunk, m) were
+/// summed in double words.
+#[allow(clippy::too_many_arguments)]
+fn super_chunk(
+    hi: &[f64],
+    lo: &[f64],
+    maxima: &[(f64, f64)],
+    ms: &[usize],
+    n: usize,
+    c0: usize,
+    dst: &mut [f64],
+    single_word: bool,
+) -> usize {
     #[cfg(target_arch = "x86_64")]
     let avx2 = std::arch::is_x86_feature_detected!("avx2");
     #[cfg(not(target_arch = "x86_64"))]
     let avx2 = false;
     let n_m = ms.len();
-    let one = |t: usize, c: usize| -> f64 {
+    let mut doubles = 0usize;
+    let mut one = |t: usize, c: usize, try_hi: &mut bool| -> f64 {
         let (m, k0) = (ms[t], c * CHUNK);
         let l = n + 1 - 2 * m;
-        if k0 < l {
-            chunk_sum_dispatch(avx2, hi, lo, m, k0, CHUNK.min(l - k0))
-        } else {
-            0.0
+        if k0 >= l {
+            return 0.0;
         }
+        let len = CHUNK.min(l - k0);
+        let (mh, ml) = region_maxima(maxima, m, k0, len);
+        if *try_hi {
+            let s = chunk_sum_hi_dispatch(avx2, hi, m, k0, len);
+            if single_word_holds(s, len, mh, ml) {
+                return s;
+            }
+        }
+        doubles += 1;
+        let s = chunk_sum_dispatch(avx2, hi, lo, m, k0, len);
+        *try_hi = single_word && single_word_holds(s, len, mh, ml);
+        s
     };
+    let mut try_hi = vec![single_word; n_m];
     for (r, row) in dst.chunks_mut(n_m).enumerate() {
         for (t, o) in row.iter_mut().enumerate() {
             if ms[t] <= SHORT_M {
-                *o = one(t, c0 + r);
+                *o = one(t, c0 + r, &mut try_hi[t]);
             }
         }
     }
     for t in (0..n_m).filter(|&t| ms[t] > SHORT_M) {
         for (r, row) in dst.chunks_mut(n_m).enumerate() {
-            row[t] = one(t, c0 + r);
+            row[t] = one(t, c0 + r, &mut try_hi[t]);
         }
     }
+    doubles
 }
 
 /// Overlapping Allan variance of the windows `y[..window]` of every axis at every m of `ms` (each
@@ -349,14 +589,14 @@ pub(crate) fn overlapping_window(
         if cancel.is_cancelled() {
             return;
         }
-        phase_prefix(&y[..n], mus[a], hi, lo);
-        let (hi, lo) = (&*hi, &*lo);
+        let maxima = phase_prefix(&y[..n], mus[a], hi, lo);
+        let (hi, lo, maxima) = (&*hi, &*lo, &maxima[..]);
         partial
             .par_chunks_mut(SUPER * n_m)
             .enumerate()
             .for_each(|(s, dst)| {
                 if !cancel.is_cancelled() {
-                    super_chunk(hi, lo, ms, n, s * SUPER, dst);
+                    let _ = super_chunk(hi, lo, maxima, ms, n, s * SUPER, dst, true);
                 }
             });
         for (t, &m) in ms.iter().enumerate() {
@@ -703,6 +943,68 @@ mod tests {
         for (o, &m) in out.iter().zip(&ms) {
             let want = direct(&y, m);
             assert!(((o - want) / want).abs() < 1e-10, "m={m}: {o} vs {want}");
+        }
+    }
+
+    /// Every (chunk, m) partial sum of a record, with the single-word terms where certified or in
+    /// double words throughout.
+    fn partials(y: &[f64], ms: &[usize], single_word: bool) -> (Vec<f64>, usize) {
+        let n = y.len();
+        let mu = crate::oavar::centre(y, 0).unwrap();
+        let (mut hi, mut lo) = (vec![0.0; n + 1], vec![0.0; n + 1]);
+        let maxima = phase_prefix(y, mu, &mut hi, &mut lo);
+        let n_chunks = (n + 1 - 2 * ms.iter().min().unwrap()).div_ceil(CHUNK);
+        let mut out = vec![0.0; n_chunks * ms.len()];
+        let mut doubles = 0;
+        for (s, dst) in out.chunks_mut(SUPER * ms.len()).enumerate() {
+            doubles += super_chunk(&hi, &lo, &maxima, ms, n, s * SUPER, dst, single_word);
+        }
+        (out, doubles)
+    }
+
+    #[test]
+    fn single_word_partials_stand_for_the_double_word_ones() {
+        let n = 3 * BLOCK + 1234;
+        let ms = [1usize, 2, 3, 7, 9, 100, 4097, CHUNK + 1, n / 3];
+        let white = noise(n, 3);
+        let mut loud_quiet = noise(n, 4);
+        for v in loud_quiet[..n / 3].iter_mut() {
+            *v *= 1e6;
+        }
+        // a rate ramp of 10⁴ noise levels plus an offset: a phase far larger than the short terms
+        let ramp: Vec<f64> = noise(n, 6)
+            .iter()
+            .enumerate()
+            .map(|(i, v)| 300.0 + 1e4 * i as f64 / n as f64 + v)
+            .collect();
+        let mut walk = noise(n, 8);
+        for i in 1..n {
+            walk[i] += walk[i - 1];
+        }
+        for (name, y, hi_share) in [
+            ("white", &white, 0.99),
+            ("loud then quiet", &loud_quiet, 0.1),
+            ("ramp", &ramp, 0.1),
+            ("random-walk rate", &walk, 0.1),
+        ] {
+            let (adaptive, doubles) = partials(y, &ms, true);
+            let (double, all) = partials(y, &ms, false);
+            for (i, (a, d)) in adaptive.iter().zip(&double).enumerate() {
+                assert!(
+                    (a - d).abs() <= 2e-11 * d.abs(),
+                    "{name}: partial {i} (m = {}): {a} vs {d}",
+                    ms[i % ms.len()]
+                );
+            }
+            // `all`: the (chunk, m) that have terms; each tried in single words is counted once
+            let share = 1.0 - doubles as f64 / all as f64;
+            assert!(
+                share >= hi_share,
+                "{name}: single words in {share:.3} of the partials"
+            );
+            if name != "white" {
+                assert!(doubles > 0, "{name}: no partial needed double words");
+            }
         }
     }
 
