@@ -911,25 +911,11 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
         // below a few MB the advice's syscall costs more than it saves.
         crate::oavar::advise_huge_pages(&mut out);
     }
-    if req.method == Method::Fast
-        && req.estimator == Estimator::Overlapping
-        && n_win == 1
-        && req.window <= GATHER_MAX
-    {
-        // One window (the static estimator): every m from one double-word phase, all m per pass over
-        // the record (see `crate::oavar`); its centring value comes from the same parallel pass
-        // that checks the samples are finite (the samples after the window too).
-        let tails: Vec<&[f64]> = req.columns.iter().map(|c| &c[req.window..]).collect();
-        check_finite(&tails)?;
-        let mus = req
-            .columns
-            .iter()
-            .enumerate()
-            .map(|(a, c)| crate::oavar::centre(&c[..req.window], a))
-            .collect::<Result<Vec<f64>>>()?;
-        overlapping_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
-        cancel.check()?;
-        return Ok((out, n_win));
+    if req.method == Method::Fast && n_win == 1 {
+        if let Some(r) = static_window(req, &mut out, cancel) {
+            r?;
+            return Ok((out, n_win));
+        }
     }
     check_finite(req.columns)?;
     match req.method {
@@ -939,16 +925,6 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
                 .par_iter()
                 .map(|c| compensated_mean(c))
                 .collect();
-            if req.estimator == Estimator::Classic
-                && n_win == 1
-                && req.window * n_axes <= GATHER_MAX
-            {
-                // One window (the static estimator): gather cluster sums from one exact prefix
-                // instead of streaming the record once per m (see `crate::gather`).
-                classic_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
-                cancel.check()?;
-                return Ok((out, n_win));
-            }
             // samples any window reads
             let n_used = ((n_win - 1) * req.hop + req.window).min(req.columns[0].len());
             let phase = takes_phase_path(req.estimator, n_used, n_axes, req.window);
@@ -996,7 +972,8 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
 /// `req.columns` hold the record's samples from `first_window · hop` on (at least one window's
 /// worth; the part's windows are those that fit, up to the record's last); `mus` is the record's
 /// centring value per axis, its [`compensated_mean`] (build it part by part with
-/// [`compensated_sum_from`]). The path is the record's: [`dynamic_avar`] takes the phase path for the
+/// [`compensated_sum_from`]; a record of one window is centred from the window itself, as the
+/// whole-record call does, and `mus` is only checked). The path is the record's: [`dynamic_avar`] takes the phase path for the
 /// overlapping estimator when the samples its windows read, times the axes, are at most 2^26 or its
 /// window is at most 2^21 samples (see `takes_phase_path`), and streams otherwise (and for the
 /// classic estimator, and for rows of m > `PHASE_M_MAX` at hops below 64).
@@ -1047,22 +1024,10 @@ pub fn dynamic_avar_part_cancellable(
         return Ok((out, n_win));
     }
     if n_windows_total == 1 {
-        // The record's one window (the static estimator's paths, on the record's mean).
-        if req.estimator == Estimator::Classic && req.window * n_axes <= GATHER_MAX {
-            classic_window(req.columns, mus, req.ms, req.window, &mut out, cancel);
-            cancel.check()?;
-            return Ok((out, n_win));
-        }
-        if req.estimator == Estimator::Overlapping && req.window <= GATHER_MAX {
-            // centred as the whole-record call centres it (the part is the record's one window)
-            let mus = req
-                .columns
-                .iter()
-                .enumerate()
-                .map(|(a, c)| crate::oavar::centre(&c[..req.window], a))
-                .collect::<Result<Vec<f64>>>()?;
-            overlapping_window(req.columns, &mus, req.ms, req.window, &mut out, cancel);
-            cancel.check()?;
+        // The record's one window: the static estimator's paths, centred as the whole-record call
+        // centres it (from the window itself; `mus` is not needed).
+        if let Some(r) = static_window(req, &mut out, cancel) {
+            r?;
             return Ok((out, n_win));
         }
     }
@@ -1072,6 +1037,42 @@ pub fn dynamic_avar_part_cancellable(
     part_rows(req, mus, part, phase, &mut out, cancel);
     cancel.check()?;
     Ok((out, n_win))
+}
+
+/// The one window `y[..window]` of a request by the static estimators' paths — every m from one
+/// double-word phase (overlapping, `crate::oavar`) or cluster sums gathered from one double-word
+/// prefix (classic, `crate::gather`) — centred on each window's mean from the parallel pass that
+/// also checks the samples are finite (the samples after the window are checked too). `None` when
+/// the window is too long for them (`GATHER_MAX`); the caller then streams.
+fn static_window(req: &Request, out: &mut [f64], cancel: &Cancel) -> Option<Result<()>> {
+    let n_axes = req.columns.len();
+    let fits = match req.estimator {
+        Estimator::Overlapping => req.window <= GATHER_MAX,
+        Estimator::Classic => req.window * n_axes <= GATHER_MAX,
+    };
+    if !fits {
+        return None;
+    }
+    let mut run = || -> Result<()> {
+        let tails: Vec<&[f64]> = req.columns.iter().map(|c| &c[req.window..]).collect();
+        check_finite(&tails)?;
+        let mus = req
+            .columns
+            .iter()
+            .enumerate()
+            .map(|(a, c)| crate::oavar::centre(&c[..req.window], a))
+            .collect::<Result<Vec<f64>>>()?;
+        match req.estimator {
+            Estimator::Overlapping => {
+                overlapping_window(req.columns, &mus, req.ms, req.window, out, cancel)
+            }
+            Estimator::Classic => {
+                classic_window(req.columns, &mus, req.ms, req.window, out, cancel)
+            }
+        }
+        cancel.check()
+    };
+    Some(run())
 }
 
 /// Whether a record whose windows read `n_used` samples × `n_axes` is *long* for the phase path

@@ -17,8 +17,9 @@
 //! far below any cluster sum's own size. The squared differences d² ≥ 0 are then summed without
 //! cancellation, as in [`crate::allan`].
 //!
-//! The prefix costs 16 bytes per sample and axis (the m run in parallel); every m is one sequential routine, so results are bit-identical for any
-//! number of worker threads.
+//! The prefix costs 16 bytes per sample and axis and is built in parallel over fixed blocks (each from
+//! its double-word offset); the m run in parallel, each one sequential routine, so results are
+//! bit-identical for any number of worker threads.
 
 use crate::cancel::Cancel;
 use rayon::prelude::*;
@@ -44,22 +45,53 @@ fn quick_two_sum(a: f64, b: f64) -> (f64, f64) {
     (s, b - (s - a))
 }
 
+/// Samples per block of the parallel prefix build.
+const PBLOCK: usize = 1 << 16;
+
 /// Double-word prefix sums of every axis, interleaved: `p[j·A + a] = (hi, lo)` holds P_j of axis a,
 /// P_0 = 0, so that one gather at sample j reads the prefixes of all A axes from adjacent memory (at
 /// long strides every read is a cache miss; one miss then serves every axis).
+///
+/// Built in parallel over fixed blocks of `PBLOCK` samples: each block's double-word total first
+/// (vectorised TwoSum lanes), the totals scanned in double words, then each block's prefixes from its
+/// offset — the same blocks for any thread count, so the same bits.
 pub(crate) fn prefix(cols: &[&[f64]], mus: &[f64], len: usize) -> Vec<[f64; 2]> {
     let n_axes = cols.len();
     let mut p = vec![[0.0f64; 2]; (len + 1) * n_axes];
-    // the axes advance together: their TwoSum chains are independent, so their latencies overlap
-    let mut state = vec![[0.0f64; 2]; n_axes];
-    for (j, row) in p[n_axes..].chunks_exact_mut(n_axes).enumerate() {
-        for (a, (dst, st)) in row.iter_mut().zip(state.iter_mut()).enumerate() {
-            let (s, e) = two_sum(st[0], cols[a][j] - mus[a]);
-            let (h, l) = quick_two_sum(s, st[1] + e);
-            *st = [h, l];
-            *dst = [h, l];
+    // offsets[b·A + a]: P of axis a at the start of block b
+    let n_blocks = len.div_ceil(PBLOCK);
+    let mut offsets = vec![[0.0f64; 2]; n_blocks * n_axes];
+    for (a, (c, &mu)) in cols.iter().zip(mus).enumerate() {
+        let totals: Vec<(f64, f64)> = c[..len]
+            .par_chunks(PBLOCK)
+            .map(|src| crate::oavar::block_total_dispatch(src, mu))
+            .collect();
+        let (mut oh, mut ol) = (0.0f64, 0.0f64);
+        for (b, &(s, c)) in totals.iter().enumerate() {
+            offsets[b * n_axes + a] = [oh, ol];
+            let (t, e) = two_sum(oh, s);
+            let (h, l) = quick_two_sum(t, e + (ol + c));
+            oh = h;
+            ol = l;
         }
     }
+    p[n_axes..]
+        .par_chunks_mut(PBLOCK * n_axes)
+        .zip(offsets.par_chunks(n_axes))
+        .enumerate()
+        .for_each(|(b, (rows, off))| {
+            // the axes advance together: their TwoSum chains are independent, so their latencies overlap
+            let mut state = off.to_vec();
+            for (jj, row) in rows.chunks_exact_mut(n_axes).enumerate() {
+                let j = b * PBLOCK + jj;
+                for (a, (dst, st)) in row.iter_mut().zip(state.iter_mut()).enumerate() {
+                    let (s, e) = two_sum(st[0], cols[a][j] - mus[a]);
+                    let (h, l) = quick_two_sum(s, st[1] + e);
+                    *st = [h, l];
+                    *dst = [h, l];
+                }
+            }
+        });
     p
 }
 

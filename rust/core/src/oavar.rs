@@ -102,7 +102,7 @@ unsafe fn block_total_avx2(src: &[f64], mu: f64) -> (f64, f64) {
     block_total(src, mu)
 }
 
-fn block_total_dispatch(src: &[f64], mu: f64) -> (f64, f64) {
+pub(crate) fn block_total_dispatch(src: &[f64], mu: f64) -> (f64, f64) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: the CPU has the feature the function is compiled for (checked just above).
