@@ -5,7 +5,9 @@
 //! Streaming all W samples per m (what the sliding-sum path does) costs O(W) per τ; a dense τ list
 //! (every 0.1 s to 1000 s: ~10⁴ values of m) then costs 10⁴ passes over the record. Here one prefix
 //! P_j = Σ_{i<j} (y_i − μ) is built once per axis and each m reads only its W/m + 1 prefix values, so the
-//! whole list costs Σ_m W/m ≈ W·ln(m_max) reads.
+//! whole list costs Σ_m W/m ≈ W·ln(m_max) reads. At long strides each of those reads is a cache miss,
+//! so a dense list's long m instead share sweeps over the prefix in order ([`classic_sweep`]: the same
+//! cluster sums, the same bits), each m taking its rows from the cached stretch the sweep is on.
 //!
 //! # Why the prefix does not drift
 //! A plain f64 prefix carries an absolute error of ~ε·max|P| into every later difference: a quiet
@@ -131,6 +133,74 @@ pub(crate) fn classic_from_prefix(
     }
 }
 
+/// Rows of the prefix one step of [`classic_sweep`] holds in cache.
+const SWEEP_ROWS: usize = 2048;
+
+/// Factors whose rows lie at least this many bytes apart are gathered by [`classic_sweep`].
+const SWEEP_STRIDE_BYTES: usize = 4096;
+
+/// [`classic_from_prefix`] for many long m at once, by one sweep over the prefix instead of one
+/// strided walk per m. At long strides every row a walk reads is a cache miss (the prefix is 16 bytes
+/// per sample and axis, far larger than the caches, and each m reads it at its own stride); here the
+/// prefix is read once, in order, `SWEEP_ROWS` rows at a time, and every m whose next multiple falls in
+/// those rows takes its cluster sum from cache, keeping its previous prefix row and cluster sum in its
+/// own small state. Each m still forms the same cluster sums and squared differences in the same
+/// order with the same operations as [`classic_from_prefix`]: the same bits. `out` is [m][axis]
+/// (left partly written once `cancel` is set).
+pub(crate) fn classic_sweep(
+    p: &[[f64; 2]],
+    n_axes: usize,
+    ms: &[usize],
+    window: usize,
+    out: &mut [f64],
+    cancel: &Cancel,
+) {
+    let n_m = ms.len();
+    // per m: position of its next multiple, clusters done, and per axis P at the last multiple, the
+    // last cluster sum and the four partial sums
+    let mut next: Vec<usize> = ms.to_vec();
+    let last: Vec<usize> = ms.iter().map(|&m| (window / m) * m).collect();
+    let mut done = vec![0usize; n_m];
+    let mut prev_p: Vec<[f64; 2]> = (0..n_m).flat_map(|_| p[..n_axes].iter().copied()).collect();
+    let mut prev_b = vec![0.0f64; n_m * n_axes];
+    let mut acc = vec![[0.0f64; 4]; n_m * n_axes];
+    let mut row_start = 0;
+    while row_start <= window {
+        if cancel.is_cancelled() {
+            return;
+        }
+        let row_end = (row_start + SWEEP_ROWS).min(window + 1);
+        for t in 0..n_m {
+            let m = ms[t];
+            while next[t] < row_end && next[t] <= last[t] {
+                let j = next[t] * n_axes;
+                let c = done[t];
+                for a in 0..n_axes {
+                    let i = t * n_axes + a;
+                    let b = diff(prev_p[i], p[j + a]);
+                    if c >= 1 {
+                        let d = b - prev_b[i];
+                        acc[i][(c - 1) & 3] += d * d;
+                    }
+                    prev_b[i] = b;
+                    prev_p[i] = p[j + a];
+                }
+                done[t] = c + 1;
+                next[t] += m;
+            }
+        }
+        row_start = row_end;
+    }
+    for (t, &m) in ms.iter().enumerate() {
+        let k = window / m;
+        let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * (k - 1) as f64);
+        for a in 0..n_axes {
+            let s = acc[t * n_axes + a];
+            out[t * n_axes + a] = ((s[0] + s[1]) + (s[2] + s[3])) * norm;
+        }
+    }
+}
+
 /// Classic Allan variance of the windows `y[..window]` of every axis at every m of `ms`, into `out`
 /// laid out [axis][m], in the calling rayon pool (parallel over m). Stops early (leaving `out` partly
 /// written) once `cancel` is set; the caller checks the flag.
@@ -147,19 +217,53 @@ pub(crate) fn classic_window(
     if cancel.is_cancelled() {
         return;
     }
-    let per_m: Vec<Vec<f64>> = ms
+    // Short strides walk the prefix per m (their rows share cache lines); long ones share sweeps —
+    // when they are many: a sweep reads every row once, in order (~10× cheaper per row than a
+    // walk's cache miss), so a few long m (an octave grid) walk their window/m rows instead.
+    let n_groups = rayon::current_num_threads().max(1);
+    let far = |m: usize| m * n_axes * 16 >= SWEEP_STRIDE_BYTES;
+    let walked_rows: usize = ms.iter().filter(|&&m| far(m)).map(|&m| window / m).sum();
+    let sweep = walked_rows.saturating_mul(10) >= window.saturating_mul(n_groups);
+    let long = |m: usize| sweep && far(m);
+    let short: Vec<usize> = (0..ms.len()).filter(|&t| !long(ms[t])).collect();
+    let swept: Vec<usize> = (0..ms.len()).filter(|&t| long(ms[t])).collect();
+    let per_m: Vec<Vec<f64>> = short
         .par_iter()
-        .map(|&m| {
+        .map(|&t| {
             let mut v = vec![0.0; n_axes];
             if !cancel.is_cancelled() {
-                classic_from_prefix(&p, n_axes, m, window, &mut v);
+                classic_from_prefix(&p, n_axes, ms[t], window, &mut v);
             }
             v
         })
         .collect();
-    for (t, v) in per_m.iter().enumerate() {
+    for (&t, v) in short.iter().zip(&per_m) {
         for (a, x) in v.iter().enumerate() {
             out[a * ms.len() + t] = *x;
+        }
+    }
+    if swept.is_empty() || cancel.is_cancelled() {
+        return;
+    }
+    // one sweep per worker, over every n_groups-th long m (each m's bits do not depend on its group)
+    let n_groups = n_groups.min(swept.len());
+    let groups: Vec<(Vec<usize>, Vec<f64>)> = (0..n_groups)
+        .into_par_iter()
+        .map(|g| {
+            let ts: Vec<usize> = swept.iter().copied().skip(g).step_by(n_groups).collect();
+            let gms: Vec<usize> = ts.iter().map(|&t| ms[t]).collect();
+            let mut v = vec![0.0; gms.len() * n_axes];
+            if !cancel.is_cancelled() {
+                classic_sweep(&p, n_axes, &gms, window, &mut v, cancel);
+            }
+            (ts, v)
+        })
+        .collect();
+    for (ts, v) in &groups {
+        for (i, &t) in ts.iter().enumerate() {
+            for a in 0..n_axes {
+                out[a * ms.len() + t] = v[i * n_axes + a];
+            }
         }
     }
 }
@@ -208,6 +312,45 @@ mod tests {
                 ((got - want) / want).abs() < 1e-12,
                 "m={m}: {got} vs {want}"
             );
+        }
+    }
+
+    #[test]
+    fn the_sweep_gives_every_m_the_walks_bits() {
+        let n = 3 * SWEEP_ROWS + 17;
+        let cols: Vec<Vec<f64>> = (0..3).map(|a| noise(n, 20 + a)).collect();
+        let refs: Vec<&[f64]> = cols.iter().map(|c| &c[..]).collect();
+        let p = prefix(&refs, &[0.1, 0.0, -0.2], n);
+        // multiples inside one block, across blocks, ending on the last row, and k = 2
+        let ms = [1usize, 5, 300, SWEEP_ROWS - 1, SWEEP_ROWS + 3, n / 3, n / 2];
+        let mut swept = vec![0.0; ms.len() * 3];
+        classic_sweep(&p, 3, &ms, n, &mut swept, &Cancel::new());
+        for (t, &m) in ms.iter().enumerate() {
+            let mut walked = [0.0; 3];
+            classic_from_prefix(&p, 3, m, n, &mut walked);
+            for a in 0..3 {
+                assert_eq!(
+                    swept[t * 3 + a].to_bits(),
+                    walked[a].to_bits(),
+                    "m={m} axis {a}"
+                );
+            }
+        }
+        // and a dense list through the window, which splits it between walks and sweeps (any thread
+        // count: the same bits)
+        let ms: Vec<usize> = (1..=n / 2).step_by(5).collect();
+        let mut out = vec![0.0; 3 * ms.len()];
+        classic_window(&refs, &[0.1, 0.0, -0.2], &ms, n, &mut out, &Cancel::new());
+        for (t, &m) in ms.iter().enumerate() {
+            let mut walked = [0.0; 3];
+            classic_from_prefix(&p, 3, m, n, &mut walked);
+            for a in 0..3 {
+                assert_eq!(
+                    out[a * ms.len() + t].to_bits(),
+                    walked[a].to_bits(),
+                    "m={m} axis {a}"
+                );
+            }
         }
     }
 
