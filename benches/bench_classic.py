@@ -118,13 +118,16 @@ def write(r: dict, machine: dict) -> None:
         )
     lines += [
         "",
-        f"Cost per gathered cluster sum (all axes, all τ): {r['ns_per_cluster_sum']:.2f} ns. About 0.1 s of the "
-        "allanite time is fixed per call (compensated mean, finite check and the 16 B/sample/axis prefix); the rest "
-        "is strided reads of the prefix, latency-bound at long strides. The target (≥ 2× the gather) is at the "
-        f"edge on this 2-core machine: {r['ratio_vs_gather']:.2f}× in this run (load average "
-        f"{r['loadavg_start_end'][0]:.2f} → {r['loadavg_start_end'][1]:.2f}; both sides are memory-latency-bound "
-        "and the prefix pass is serial, so another job's load moves the ratio), 1.96–2.07× in four runs on a quiet "
-        "machine on 2026-11-24. The gather's 2e-9 difference is its plain prefix losing digits on the axes with an "
+        f"Cost per gathered cluster sum (all axes, all τ): {r['ns_per_cluster_sum']:.2f} ns. About 0.09 s of the "
+        "allanite time is fixed per call (the six C-ordered columns copied and checked, each window's mean and "
+        "finite check in one parallel pass, and the 16 B/sample/axis prefix built in parallel blocks); the rest is "
+        "the cluster sums: short m walk the prefix per m, the long ones (rows ≥ 4 KiB apart) share one in-order "
+        "sweep of the prefix per worker, each taking its rows from the cached stretch (before the sweeps every long "
+        "m walked its own stride, a cache miss per row: 0.26 s on a quiet machine on 2026-11-24 and 0.42–0.47 s on "
+        "this one today, 1.5–2.1× the gather). Ratio in this run: "
+        f"{r['ratio_vs_gather']:.2f}× (load average {r['loadavg_start_end'][0]:.2f} → "
+        f"{r['loadavg_start_end'][1]:.2f}; both sides read memory at long strides, so another job's load moves it). "
+        "The gather's 2e-9 difference is its plain prefix losing digits on the axes with an "
         "offset.",
         "",
     ]
