@@ -63,13 +63,20 @@ def _unscale(values: np.ndarray, exps: list[int], power: int, cols: list[np.ndar
     for a, (v, e) in enumerate(zip(values, exps)):
         where = f"axis {a}: " if len(values) > 1 else ""
         # binary exponent of the result: log2 of the scaled value plus power·e, judged before scaling back.
-        # Row by row, so no temporary the size of the output (a hop-1 surface can be gigabytes).
+        # No temporary the size of the output (a hop-1 surface can be gigabytes): a max and a min pass, and
+        # the smallest positive value from the min unless some value is ≤ 0 (then a masked pass, row by row).
         hi = float(v.max()) if v.size else 0.0  # NaN if any value is, inf if any is
-        rows = v.reshape(-1, v.shape[-1]) if v.size else ()
-        lo_pos = min((float(np.min(r, where=r > 0, initial=math.inf)) for r in rows), default=math.inf)
+        lo = float(v.min()) if v.size else 0.0
+        if lo > 0:
+            lo_pos = lo
+        elif not hi > 0:
+            lo_pos = math.inf
+        else:
+            rows = v.reshape(-1, v.shape[-1])
+            lo_pos = min((float(np.min(r, where=r > 0, initial=math.inf)) for r in rows), default=math.inf)
         top = math.log2(hi) + power * e if hi > 0 else -math.inf
         bottom = math.log2(lo_pos) + power * e if lo_pos < math.inf else math.inf
-        if not math.isfinite(hi) or (v.size and not math.isfinite(float(v.min()))) or top >= 1024:
+        if not math.isfinite(hi) or not math.isfinite(lo) or top >= 1024:
             peak = _peak(cols[a])
             raise InputError(
                 f"{where}the {what} of samples of magnitude up to {peak:.3g} exceeds float64's range (≈1.8e308): "
