@@ -998,7 +998,8 @@ pub fn dynamic_avar_part_cancellable(
     n_windows_total: usize,
     cancel: &Cancel,
 ) -> Result<(Vec<f64>, usize)> {
-    let n_part = validate(req)?;
+    // the finite check: in the static paths' pass, or below (the naive path makes its own)
+    let n_part = validate_shape(req)?;
     let n_axes = req.columns.len();
     if mus.len() != n_axes || mus.iter().any(|v| !v.is_finite()) {
         return Err(CoreError::InvalidParameter(format!(
@@ -1031,6 +1032,7 @@ pub fn dynamic_avar_part_cancellable(
             return Ok((out, n_win));
         }
     }
+    check_finite(req.columns)?;
     // the samples the record's windows read
     let n_used_record = (n_windows_total - 1) * req.hop + req.window;
     let phase = takes_phase_path(req.estimator, n_used_record, n_axes, req.window);
@@ -1054,8 +1056,16 @@ fn static_window(req: &Request, out: &mut [f64], cancel: &Cancel) -> Option<Resu
         return None;
     }
     let mut run = || -> Result<()> {
-        let tails: Vec<&[f64]> = req.columns.iter().map(|c| &c[req.window..]).collect();
-        check_finite(&tails)?;
+        for (axis, c) in req.columns.iter().enumerate() {
+            if let Some(i) = c[req.window..].iter().position(|v| !v.is_finite()) {
+                let index = req.window + i;
+                return Err(CoreError::NonFinite {
+                    axis,
+                    index,
+                    value: c[index],
+                });
+            }
+        }
         let mus = req
             .columns
             .iter()
@@ -1662,6 +1672,48 @@ mod tests {
                 .1,
             3
         );
+    }
+
+    #[test]
+    fn parts_name_a_non_finite_sample() {
+        // a part of several windows (checked before its rows) and a record's one window (checked in
+        // the static paths' centring pass), a NaN in the window and an inf after it
+        let mut y: Vec<f64> = (0..1000).map(|i| ((i * 37) % 11) as f64).collect();
+        y[700] = f64::NAN;
+        let mut z = y.clone();
+        z[700] = 1.0;
+        z[900] = f64::INFINITY;
+        for (col, index, window, total) in
+            [(&y, 700, 500, 6), (&y, 700, 1000, 1), (&z, 900, 800, 1)]
+        {
+            for estimator in [Estimator::Overlapping, Estimator::Classic] {
+                let cols = [&col[..]];
+                let req = Request {
+                    columns: &cols,
+                    window,
+                    hop: 100,
+                    ms: &[1, 2],
+                    estimator,
+                    method: Method::Fast,
+                };
+                let err = dynamic_avar_part_cancellable(&req, &[0.0], 0, total, &Cancel::new())
+                    .unwrap_err();
+                assert!(
+                    matches!(err, CoreError::NonFinite { axis: 0, index: i, .. } if i == index),
+                    "{window} {estimator:?}: {err}"
+                );
+                assert!(err.to_string().contains("only finite numbers are allowed"));
+                if total == 1 {
+                    // the whole-record call of one window (hop past the record's end): the same
+                    let req = Request { hop: 1000, ..req };
+                    let err = dynamic_avar(&req).unwrap_err();
+                    assert!(
+                        matches!(err, CoreError::NonFinite { axis: 0, index: i, .. } if i == index),
+                        "whole record {window} {estimator:?}: {err}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
