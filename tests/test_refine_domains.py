@@ -52,6 +52,17 @@ def _tumble(n, seed, turns):
     return np.where(np.searchsorted(edges, np.arange(n), side="right") % 2 == 0, 1.0, -1.0)
 
 
+def _adis_multi_position(shared_data):
+    """Run 2's gyro_x and acc_z, a zero-mean ±1 g profile (seed 5, 400 turns), the channel a multi-position
+    test would record (acc_z's own noise plus the profile) and gyro_x's coefficient on the static acc_z (its
+    noise coupling, part of the truth)."""
+    gx, az = _adis(shared_data, 2, ["gyro_x", "acc_z"])
+    tumble = _tumble(gx.size, seed=5, turns=400)
+    tumble -= tumble.mean()
+    ch = az - az.mean() + tumble
+    return gx, az, tumble, ch, regression_fit(gx, az)["coefficient"]
+
+
 def _falls(st):
     # in-sample χ²/dof and RMS ADEV error (a time-domain removal: both on the curve it was removed from),
     # and the held-out error
@@ -302,11 +313,7 @@ def test_band_regression_keeps_one_coefficient_unless_the_bands_differ():
 def test_adis_multi_position_g_sensitivity(shared_data):
     # a realistic g-sensitivity test: acc_z turned between ±1 g every 200–600 s, the gyro responding to the
     # true acceleration at 0.01 °/s/g (the log's own noise and its coupling to acc_z's noise kept)
-    gx, az = _adis(shared_data, 2, ["gyro_x", "acc_z"])
-    tumble = _tumble(gx.size, seed=5, turns=400)
-    tumble -= tumble.mean()
-    ch = az - az.mean() + tumble
-    base = regression_fit(gx, az)["coefficient"]
+    gx, az, tumble, ch, base = _adis_multi_position(shared_data)
     truth = _within(0.01 * tumble + base * az, ch) / _within(ch, ch)
     r = allanite.refine(gx + 0.01 * tumble, FS, channels={"acc_z": ch}, truth={"regression": {"coefficient": truth}})
     rg = next(s for s in r.steps if s.effect == "regression")
@@ -319,11 +326,7 @@ def test_adis_gauss_markov_and_multi_position_g_sensitivity_at_once(shared_data)
     # two effects at once in real noise: a Gauss–Markov rate and a g-sensitivity seen through a ±1 g
     # multi-position profile. The regression goes first (its test is in time): left in, the profile's steps
     # would be taken by the Gauss–Markov term
-    gx, az = _adis(shared_data, 2, ["gyro_x", "acc_z"])
-    tumble = _tumble(gx.size, seed=5, turns=400)
-    tumble -= tumble.mean()
-    ch = az - az.mean() + tumble
-    base = regression_fit(gx, az)["coefficient"]
+    gx, az, tumble, ch, base = _adis_multi_position(shared_data)
     gm = {"sigma": 0.05, "tc": 20.0}
     y = gx + allanite.simulate(gx.size, FS, gauss_markov=[(gm["sigma"], gm["tc"])], seed=8) + 0.03 * tumble
     truth = {

@@ -68,13 +68,8 @@ pub(crate) fn prefix(cols: &[&[f64]], mus: &[f64], len: usize) -> Vec<[f64; 2]> 
             .par_chunks(PBLOCK)
             .map(|src| crate::oavar::block_total_dispatch(src, mu))
             .collect();
-        let (mut oh, mut ol) = (0.0f64, 0.0f64);
-        for (b, &(s, c)) in totals.iter().enumerate() {
+        for (b, (oh, ol)) in crate::oavar::block_offsets(&totals).into_iter().enumerate() {
             offsets[b * n_axes + a] = [oh, ol];
-            let (t, e) = two_sum(oh, s);
-            let (h, l) = quick_two_sum(t, e + (ol + c));
-            oh = h;
-            ol = l;
         }
     }
     p[n_axes..]

@@ -153,6 +153,22 @@ fn block_phase(
     }
 }
 
+/// Exclusive scan of blocks' double-word totals in double-word arithmetic (sequential, one step per
+/// block): each block's offset, the phase at its first sample.
+pub(crate) fn block_offsets(totals: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut offs = Vec::with_capacity(totals.len());
+    let (mut oh, mut ol) = (0.0f64, 0.0f64);
+    for &(s, c) in totals {
+        offs.push((oh, ol));
+        let (t, e) = two_sum(oh, s);
+        let low = e + (ol + c);
+        let h = t + low;
+        ol = low - (h - t);
+        oh = h;
+    }
+    offs
+}
+
 /// The centring value of one static window and its finite check, in one parallel pass: the mean
 /// from the double-word total of fixed blocks (joined in block order, so the same bits for any
 /// thread count). A sample that is NaN or ±inf makes the total non-finite and is then located.
@@ -193,17 +209,7 @@ pub(crate) fn phase_prefix(y: &[f64], mu: f64, hi: &mut [f64], lo: &mut [f64]) -
         .par_chunks(BLOCK)
         .map(|src| block_total_dispatch(src, mu))
         .collect();
-    // Exclusive scan of the block totals in double-word arithmetic (sequential, n / BLOCK steps).
-    let mut offs = Vec::with_capacity(totals.len());
-    let (mut oh, mut ol) = (0.0f64, 0.0f64);
-    for &(s, c) in &totals {
-        offs.push((oh, ol));
-        let (t, e) = two_sum(oh, s);
-        let low = e + (ol + c);
-        let h = t + low;
-        ol = low - (h - t);
-        oh = h;
-    }
+    let offs = block_offsets(&totals);
     let mut maxima = vec![(0.0f64, 0.0f64); y.len().div_ceil(CHUNK)];
     hi[1..]
         .par_chunks_mut(BLOCK)
@@ -295,15 +301,27 @@ impl PhaseBuf {
     }
 }
 
-/// Σ d_k² over k = k0 … k0 + len − 1 at factor m, from the phase (hi, lo).
+/// Σ d_k² over k = k0 … k0 + len − 1 at factor m, from the phase: with `LO`, the double-word term
+/// d = [(hi₂ − hi₁) − (hi₁ − hi₀)] + [(lo₂ − lo₁) − (lo₁ − lo₀)]; without, dₕ = the hi bracket alone —
+/// half the reads and arithmetic, used only where [`single_word_holds`] certifies it (`lo` unread).
 #[inline(always)]
-fn chunk_sum(hi: &[f64], lo: &[f64], m: usize, k0: usize, len: usize) -> f64 {
+fn chunk_sum<const LO: bool>(hi: &[f64], lo: &[f64], m: usize, k0: usize, len: usize) -> f64 {
     let h0 = &hi[k0..k0 + len];
     let h1 = &hi[k0 + m..k0 + m + len];
     let h2 = &hi[k0 + 2 * m..k0 + 2 * m + len];
+    // without LO the lo "streams" are hi's, never read
+    let lo = if LO { lo } else { hi };
     let l0 = &lo[k0..k0 + len];
     let l1 = &lo[k0 + m..k0 + m + len];
     let l2 = &lo[k0 + 2 * m..k0 + 2 * m + len];
+    let term = |a0: f64, a1: f64, a2: f64, b0: f64, b1: f64, b2: f64| -> f64 {
+        let dh = (a2 - a1) - (a1 - a0);
+        if LO {
+            dh + ((b2 - b1) - (b1 - b0))
+        } else {
+            dh
+        }
+    };
     let mut acc = [0.0f64; LANES];
     let it = h0
         .chunks_exact(LANES)
@@ -314,17 +332,13 @@ fn chunk_sum(hi: &[f64], lo: &[f64], m: usize, k0: usize, len: usize) -> f64 {
         .zip(l2.chunks_exact(LANES));
     for (((((a0, a1), a2), b0), b1), b2) in it {
         for j in 0..LANES {
-            let dh = (a2[j] - a1[j]) - (a1[j] - a0[j]);
-            let dl = (b2[j] - b1[j]) - (b1[j] - b0[j]);
-            let d = dh + dl;
+            let d = term(a0[j], a1[j], a2[j], b0[j], b1[j], b2[j]);
             acc[j] += d * d;
         }
     }
     let done = len - len % LANES;
     for (j, i) in (done..len).enumerate() {
-        let dh = (h2[i] - h1[i]) - (h1[i] - h0[i]);
-        let dl = (l2[i] - l1[i]) - (l1[i] - l0[i]);
-        let d = dh + dl;
+        let d = term(h0[i], h1[i], h2[i], l0[i], l1[i], l2[i]);
         acc[j] += d * d;
     }
     ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
@@ -334,39 +348,45 @@ fn chunk_sum(hi: &[f64], lo: &[f64], m: usize, k0: usize, len: usize) -> f64 {
 /// so the same bits.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn chunk_sum_avx2(hi: &[f64], lo: &[f64], m: usize, k0: usize, len: usize) -> f64 {
+unsafe fn chunk_sum_avx2<const LO: bool>(
+    hi: &[f64],
+    lo: &[f64],
+    m: usize,
+    k0: usize,
+    len: usize,
+) -> f64 {
     use std::arch::x86_64::*;
-    assert!(k0 + 2 * m + len <= hi.len() && k0 + 2 * m + len <= lo.len());
-    // SAFETY (every pointer below): offsets k0 + {0, m, 2m} + i with i < len stay within hi and lo
-    // (asserted above); loads are unaligned.
+    assert!(k0 + 2 * m + len <= hi.len() && (!LO || k0 + 2 * m + len <= lo.len()));
+    // SAFETY (every pointer below): offsets k0 + {0, m, 2m} + i with i < len stay within hi and,
+    // when LO, lo (asserted above); loads are unaligned.
     let h0 = hi.as_ptr().add(k0);
     let (h1, h2) = (h0.add(m), h0.add(2 * m));
-    let l0 = lo.as_ptr().add(k0);
+    let l0 = if LO { lo.as_ptr().add(k0) } else { h0 };
     let (l1, l2) = (l0.add(m), l0.add(2 * m));
+    // the term of the four lanes from offset i
+    let term = |i: usize| -> __m256d {
+        let a0 = _mm256_loadu_pd(h0.add(i));
+        let a1 = _mm256_loadu_pd(h1.add(i));
+        let a2 = _mm256_loadu_pd(h2.add(i));
+        let dh = _mm256_sub_pd(_mm256_sub_pd(a2, a1), _mm256_sub_pd(a1, a0));
+        if LO {
+            let b0 = _mm256_loadu_pd(l0.add(i));
+            let b1 = _mm256_loadu_pd(l1.add(i));
+            let b2 = _mm256_loadu_pd(l2.add(i));
+            let dl = _mm256_sub_pd(_mm256_sub_pd(b2, b1), _mm256_sub_pd(b1, b0));
+            _mm256_add_pd(dh, dl)
+        } else {
+            dh
+        }
+    };
     let mut acc_a = _mm256_setzero_pd();
     let mut acc_b = _mm256_setzero_pd();
     let done = len - len % LANES;
     let mut i = 0;
     while i < done {
-        let a0 = _mm256_loadu_pd(h0.add(i));
-        let a1 = _mm256_loadu_pd(h1.add(i));
-        let a2 = _mm256_loadu_pd(h2.add(i));
-        let b0 = _mm256_loadu_pd(l0.add(i));
-        let b1 = _mm256_loadu_pd(l1.add(i));
-        let b2 = _mm256_loadu_pd(l2.add(i));
-        let dh = _mm256_sub_pd(_mm256_sub_pd(a2, a1), _mm256_sub_pd(a1, a0));
-        let dl = _mm256_sub_pd(_mm256_sub_pd(b2, b1), _mm256_sub_pd(b1, b0));
-        let d = _mm256_add_pd(dh, dl);
+        let d = term(i);
         acc_a = _mm256_add_pd(acc_a, _mm256_mul_pd(d, d));
-        let a0 = _mm256_loadu_pd(h0.add(i + 4));
-        let a1 = _mm256_loadu_pd(h1.add(i + 4));
-        let a2 = _mm256_loadu_pd(h2.add(i + 4));
-        let b0 = _mm256_loadu_pd(l0.add(i + 4));
-        let b1 = _mm256_loadu_pd(l1.add(i + 4));
-        let b2 = _mm256_loadu_pd(l2.add(i + 4));
-        let dh = _mm256_sub_pd(_mm256_sub_pd(a2, a1), _mm256_sub_pd(a1, a0));
-        let dl = _mm256_sub_pd(_mm256_sub_pd(b2, b1), _mm256_sub_pd(b1, b0));
-        let d = _mm256_add_pd(dh, dl);
+        let d = term(i + 4);
         acc_b = _mm256_add_pd(acc_b, _mm256_mul_pd(d, d));
         i += LANES;
     }
@@ -375,97 +395,34 @@ unsafe fn chunk_sum_avx2(hi: &[f64], lo: &[f64], m: usize, k0: usize, len: usize
     _mm256_storeu_pd(acc.as_mut_ptr().add(4), acc_b);
     for (j, i) in (done..len).enumerate() {
         let dh = (*h2.add(i) - *h1.add(i)) - (*h1.add(i) - *h0.add(i));
-        let dl = (*l2.add(i) - *l1.add(i)) - (*l1.add(i) - *l0.add(i));
-        let d = dh + dl;
+        let d = if LO {
+            dh + ((*l2.add(i) - *l1.add(i)) - (*l1.add(i) - *l0.add(i)))
+        } else {
+            dh
+        };
         acc[j] += d * d;
     }
     ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
 }
 
-/// Σ d² of one (chunk, m), with the AVX2 term loop where the CPU has it.
+/// Σ d² of one (chunk, m) (double words with `LO`, hi alone without), with the AVX2 term loop where
+/// the CPU has it.
 #[inline(always)]
-fn chunk_sum_dispatch(avx2: bool, hi: &[f64], lo: &[f64], m: usize, k0: usize, len: usize) -> f64 {
+fn chunk_sum_dispatch<const LO: bool>(
+    avx2: bool,
+    hi: &[f64],
+    lo: &[f64],
+    m: usize,
+    k0: usize,
+    len: usize,
+) -> f64 {
     #[cfg(target_arch = "x86_64")]
     if avx2 {
         // SAFETY: the caller checked that the CPU has AVX2.
-        return unsafe { chunk_sum_avx2(hi, lo, m, k0, len) };
+        return unsafe { chunk_sum_avx2::<LO>(hi, lo, m, k0, len) };
     }
     let _ = avx2;
-    chunk_sum(hi, lo, m, k0, len)
-}
-
-/// Σ dₕ² over k = k0 … k0 + len − 1 at factor m from hi alone, dₕ = (hi₂ − hi₁) − (hi₁ − hi₀): half
-/// the reads and arithmetic of [`chunk_sum`]; used only where [`single_word_holds`] certifies it.
-#[inline(always)]
-fn chunk_sum_hi(hi: &[f64], m: usize, k0: usize, len: usize) -> f64 {
-    let h0 = &hi[k0..k0 + len];
-    let h1 = &hi[k0 + m..k0 + m + len];
-    let h2 = &hi[k0 + 2 * m..k0 + 2 * m + len];
-    let mut acc = [0.0f64; LANES];
-    let it = h0
-        .chunks_exact(LANES)
-        .zip(h1.chunks_exact(LANES))
-        .zip(h2.chunks_exact(LANES));
-    for ((a0, a1), a2) in it {
-        for j in 0..LANES {
-            let d = (a2[j] - a1[j]) - (a1[j] - a0[j]);
-            acc[j] += d * d;
-        }
-    }
-    let done = len - len % LANES;
-    for (j, i) in (done..len).enumerate() {
-        let d = (h2[i] - h1[i]) - (h1[i] - h0[i]);
-        acc[j] += d * d;
-    }
-    ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
-}
-
-/// [`chunk_sum_hi`] in AVX2 intrinsics (the same IEEE operations per lane in the same order).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn chunk_sum_hi_avx2(hi: &[f64], m: usize, k0: usize, len: usize) -> f64 {
-    use std::arch::x86_64::*;
-    assert!(k0 + 2 * m + len <= hi.len());
-    // SAFETY (every pointer below): offsets k0 + {0, m, 2m} + i with i < len stay within hi
-    // (asserted above); loads are unaligned.
-    let h0 = hi.as_ptr().add(k0);
-    let (h1, h2) = (h0.add(m), h0.add(2 * m));
-    let mut acc_a = _mm256_setzero_pd();
-    let mut acc_b = _mm256_setzero_pd();
-    let done = len - len % LANES;
-    let mut i = 0;
-    while i < done {
-        let a0 = _mm256_loadu_pd(h0.add(i));
-        let a1 = _mm256_loadu_pd(h1.add(i));
-        let a2 = _mm256_loadu_pd(h2.add(i));
-        let d = _mm256_sub_pd(_mm256_sub_pd(a2, a1), _mm256_sub_pd(a1, a0));
-        acc_a = _mm256_add_pd(acc_a, _mm256_mul_pd(d, d));
-        let a0 = _mm256_loadu_pd(h0.add(i + 4));
-        let a1 = _mm256_loadu_pd(h1.add(i + 4));
-        let a2 = _mm256_loadu_pd(h2.add(i + 4));
-        let d = _mm256_sub_pd(_mm256_sub_pd(a2, a1), _mm256_sub_pd(a1, a0));
-        acc_b = _mm256_add_pd(acc_b, _mm256_mul_pd(d, d));
-        i += LANES;
-    }
-    let mut acc = [0.0f64; LANES];
-    _mm256_storeu_pd(acc.as_mut_ptr(), acc_a);
-    _mm256_storeu_pd(acc.as_mut_ptr().add(4), acc_b);
-    for (j, i) in (done..len).enumerate() {
-        let d = (*h2.add(i) - *h1.add(i)) - (*h1.add(i) - *h0.add(i));
-        acc[j] += d * d;
-    }
-    ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
-}
-
-#[inline(always)]
-fn chunk_sum_hi_dispatch(avx2: bool, hi: &[f64], m: usize, k0: usize, len: usize) -> f64 {
-    #[cfg(target_arch = "x86_64")]
-    if avx2 {
-        // SAFETY: the caller checked that the CPU has AVX2.
-        return unsafe { chunk_sum_hi_avx2(hi, m, k0, len) };
-    }
-    let _ = avx2;
-    chunk_sum_hi(hi, m, k0, len)
+    chunk_sum::<LO>(hi, lo, m, k0, len)
 }
 
 /// Relative bound the single-word sum must meet to stand for the double-word one: 10⁻¹¹, a hundredth
@@ -540,13 +497,13 @@ fn super_chunk(
         let len = CHUNK.min(l - k0);
         let (mh, ml) = region_maxima(maxima, m, k0, len);
         if *try_hi {
-            let s = chunk_sum_hi_dispatch(avx2, hi, m, k0, len);
+            let s = chunk_sum_dispatch::<false>(avx2, hi, lo, m, k0, len);
             if single_word_holds(s, len, mh, ml) {
                 return s;
             }
         }
         doubles += 1;
-        let s = chunk_sum_dispatch(avx2, hi, lo, m, k0, len);
+        let s = chunk_sum_dispatch::<true>(avx2, hi, lo, m, k0, len);
         *try_hi = single_word && single_word_holds(s, len, mh, ml);
         s
     };
@@ -718,8 +675,8 @@ pub(crate) fn overlapping_dynamic_row(
             }
             let len = hop.min(k_end - k0);
             let rr = r.min(len);
-            let p = chunk_sum_dispatch(avx2, hi, lo, m, k0, rr);
-            let rest = chunk_sum_dispatch(avx2, hi, lo, m, k0 + rr, len - rr);
+            let p = chunk_sum_dispatch::<true>(avx2, hi, lo, m, k0, rr);
+            let rest = chunk_sum_dispatch::<true>(avx2, hi, lo, m, k0 + rr, len - rr);
             part[b] = p * norm;
             full[b] = (p + rest) * norm;
         }
@@ -787,8 +744,8 @@ pub(crate) fn overlapping_dynamic_tiled(
                 }
                 let len = hop.min(k_end - k0);
                 let rr = r.min(len);
-                let p = chunk_sum_dispatch(avx2, hi, lo, m, k0, rr);
-                let rest = chunk_sum_dispatch(avx2, hi, lo, m, k0 + rr, len - rr);
+                let p = chunk_sum_dispatch::<true>(avx2, hi, lo, m, k0, rr);
+                let rest = chunk_sum_dispatch::<true>(avx2, hi, lo, m, k0 + rr, len - rr);
                 (p, p + rest)
             };
             // short m block by block (the tile's phase in cache for all of them), long m m by m
