@@ -2,7 +2,7 @@
 that is cheap) or raises an AllaniteError — never another exception, a hang, a crash or an allocation
 beyond the memory budget.
 
-CI runs a fixed, bounded number of examples (derandomized: the same inputs on every run).
+Every run takes a fixed, bounded number of examples (derandomized: the same inputs on every run).
 ``ALLANITE_FUZZ_EXAMPLES=N`` raises the count per property; ``python benches/fuzz.py`` runs 10⁵+ inputs and
 records what they found in ``benches/results/fuzz.md``.
 """
@@ -27,7 +27,8 @@ from allanite.errors import AllaniteError
 EXAMPLES = int(os.environ.get("ALLANITE_FUZZ_EXAMPLES", "60"))
 FUZZ = settings(
     max_examples=EXAMPLES,
-    derandomize=os.environ.get("ALLANITE_FUZZ_RANDOM", "") == "",
+    # fixed inputs unless exploring (ALLANITE_EXPLORE=1, as every property test; ALLANITE_FUZZ_RANDOM=1 for these alone)
+    derandomize=not any(os.environ.get(v, "").strip() not in ("", "0") for v in ("ALLANITE_EXPLORE", "ALLANITE_FUZZ_RANDOM")),
     deadline=5000,  # a hang or a runaway allocation shows up as a deadline error
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.function_scoped_fixture],
     database=None,

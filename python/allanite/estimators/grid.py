@@ -96,14 +96,15 @@ def m_grid(kind: str, n: int, *, growth=None, points=None, tau_min=None, fs=1.0,
             growth = check_real(growth, "growth", "a finite factor > 1")
             if growth <= 1.0:
                 raise ParameterError(f"growth must be a finite factor > 1, got {growth:g}")
-        # τ(i) = τ_con·τ_g^(i−1) (paper 000 §4.2), rounded to m, duplicates dropped. Below
-        # m* = 1/(g − 1) consecutive points are less than one sample apart, so every m appears:
-        # take those directly rather than generating (possibly billions of) duplicates.
+        # τ(i) = τ_con·τ_g^(i−1) (paper 000 §4.2), rounded to m, duplicates dropped. Points below
+        # 1/(g − 1) are less than one sample from the next, so every m up to m* = ⌊1/(g − 1)⌋ appears:
+        # take those directly rather than generating (possibly billions of) duplicates. (Not ⌈1/(g − 1)⌉:
+        # g = 1.23828125 steps from 4.4 to 5.5, rounding to 4 and 6, and m = 5 is not on the grid.)
         # The grid ends at its last point ≤ top, which may round below top: the dense part stops there too
         # (n = 20, m_max = 3, g = 1.25 ends at round(1.25⁴) = 2, not 3).
         count = int(math.floor(math.log(top / m0) / math.log(growth) + 1e-9)) + 1
         last = int(math.floor(m0 * growth ** (count - 1) + 0.5))
-        m_star = min(top, last, max(m0, int(math.ceil(1.0 / (growth - 1.0))) if growth - 1.0 > 1.0 / top else top))
+        m_star = min(top, last, max(m0, int(math.floor(1.0 / (growth - 1.0))) if growth - 1.0 > 1.0 / top else top))
         _check_budget(m_star - m0 + 1, kind, n)
         dense = np.arange(m0, m_star + 1, dtype=np.int64)
         i0 = max(0, int(math.floor(math.log(m_star / m0) / math.log(growth))))
