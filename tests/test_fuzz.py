@@ -28,7 +28,9 @@ EXAMPLES = int(os.environ.get("ALLANITE_FUZZ_EXAMPLES", "60"))
 FUZZ = settings(
     max_examples=EXAMPLES,
     # fixed inputs unless exploring (ALLANITE_EXPLORE=1, as every property test; ALLANITE_FUZZ_RANDOM=1 for these alone)
-    derandomize=not any(os.environ.get(v, "").strip() not in ("", "0") for v in ("ALLANITE_EXPLORE", "ALLANITE_FUZZ_RANDOM")),
+    derandomize=not any(
+        os.environ.get(v, "").strip() not in ("", "0") for v in ("ALLANITE_EXPLORE", "ALLANITE_FUZZ_RANDOM")
+    ),
     deadline=5000,  # a hang or a runaway allocation shows up as a deadline error
     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.function_scoped_fixture],
     database=None,
