@@ -29,6 +29,7 @@ from .units import ACCEL_UNITS
 
 EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
+#: ``allanite --help``: what the command line does.
 DESCRIPTION = """\
 allanite: static and dynamic Allan variance for gyroscopes, IMUs and clocks.
 
@@ -38,6 +39,7 @@ commands:
   batch     one report per log of a fleet, as Dask tasks, and a fleet summary (fleet.csv,
             fleet.parquet, fleet.html); needs allanite[dask]"""
 
+#: ``allanite --help``, after the options: the exit statuses.
 EPILOG = """\
 Run 'allanite report --help' for the report's options; 'allanite report' alone analyses the
 bundled record (a simulated 3-axis gyro) and writes the report to ./allanite-report/.
@@ -48,6 +50,7 @@ exit status:
   2    usage or input error (one line on stderr: 'allanite: error: ...')
   130  interrupted"""
 
+#: ``allanite report --help``: what the report holds and the bundled record it runs on by default.
 REPORT_DESCRIPTION = """\
 Analyse a gyro/IMU/clock log: the overlapping Allan deviation with confidence intervals, the
 IEEE-952 noise model (quantization Q, angle random walk N, bias instability B, rate random walk K,
@@ -58,6 +61,7 @@ noise coefficients over time. Prints a summary and writes, into DIR, one self-co
 Without LOG it analyses the bundled record: a deterministic simulated 3-axis gyro, 1 h at 100 Hz
 in deg/s, whose angle random walk is 4x larger from 20 to 30 min."""
 
+#: ``allanite report --help``, after the options.
 REPORT_EPILOG = """\
 examples:
   allanite report                                 # the bundled record -> ./allanite-report/
@@ -104,6 +108,7 @@ def _formatter(prog):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``allanite`` argument parser: the ``report`` and ``batch`` subcommands and their options."""
     parser = _Parser(
         prog="allanite",
         usage="%(prog)s [-h] [--version] COMMAND [ARGS ...]",

@@ -62,6 +62,7 @@ class FleetResult:
 
     @property
     def failed(self) -> list:
+        """The files whose report failed, each with its error (a failing file stops nothing)."""
         return [f for f in self.files if f["status"] == "error"]
 
 

@@ -168,10 +168,12 @@ class Log:
 
     @property
     def n_samples(self) -> int:
+        """Number of samples (rows) in the log."""
         return int(self.data.shape[0])
 
     @property
     def n_axes(self) -> int:
+        """Number of axes (columns) read; 1 for a one-dimensional log."""
         return 1 if self.data.ndim == 1 else int(self.data.shape[1])
 
     @property

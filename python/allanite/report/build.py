@@ -127,6 +127,7 @@ class Report:
     # ---------------------------------------------------------------------------- properties
     @property
     def n_axes(self) -> int:
+        """Number of axes the report analyses."""
         return len(self.axis_names)
 
     @property

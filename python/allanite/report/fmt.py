@@ -33,6 +33,7 @@ def json_list(a):
 
 
 def g(v, d: int = 4) -> str:
+    """A number with ``d`` significant digits; "—" for None, "∞" for infinity."""
     if v is None:
         return "—"
     if isinstance(v, float) and math.isinf(v):
@@ -41,6 +42,7 @@ def g(v, d: int = 4) -> str:
 
 
 def pct(v, b) -> str:
+    """How far the bound ``b`` is from the value ``v``, in percent; "?" when either is missing or v is 0."""
     if v is None or b is None or v == 0:
         return "?"
     p = abs(b / v - 1.0) * 100.0
@@ -48,6 +50,7 @@ def pct(v, b) -> str:
 
 
 def duration(s: float) -> str:
+    """A duration in seconds as h, min or s."""
     if s >= 3600:
         return f"{s / 3600:.3g} h"
     if s >= 60:

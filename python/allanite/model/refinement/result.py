@@ -69,6 +69,7 @@ class Refinement(RichDisplay):
 
     @property
     def found(self) -> list:
+        """Names of the effects kept, in the order they were added."""
         return [s.effect for s in self.steps]
 
     def report(self) -> str:
