@@ -16,7 +16,7 @@ import pytest
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 #: Where the run with the shared data leaves each executed notebook; the documentation site renders these
 #: (docs/_site/hooks.py), so its notebooks show their outputs without the site's build running them.
-EXECUTED = EXAMPLES.parent / "build" / "notebooks"
+EXECUTED = EXAMPLES.parent / "build" / "notebooks" / "examples"
 NOTEBOOKS = sorted(EXAMPLES.glob("*.ipynb"))
 CELL_TIMEOUT = 120  # s, per cell; every notebook runs in well under a minute
 

@@ -61,9 +61,15 @@ def test_readme_examples_print_what_the_readme_shows():
 # docstring coverage
 
 
-def test_every_public_name_has_a_docstring():
+@pytest.fixture(scope="module")
+def package():
+    """(docs/_site/api.py, the package as Griffe reads it), loaded once for the module."""
     api = _api()
-    pkg = api.load()
+    return api, api.load()
+
+
+def test_every_public_name_has_a_docstring(package):
+    api, pkg = package
     objects = api.public_objects(pkg)
     assert len(objects) > 300  # modules, functions, classes, methods, properties, constants
     missing = api.undocumented(pkg)
@@ -72,9 +78,8 @@ def test_every_public_name_has_a_docstring():
     )
 
 
-def test_every_public_name_has_an_entry_in_the_reference():
-    api = _api()
-    pkg = api.load()
+def test_every_public_name_has_an_entry_in_the_reference(package):
+    api, pkg = package
     ref = api.reference(pkg)
     for obj in api.public_objects(pkg):
         if not obj.is_module:
@@ -139,9 +144,8 @@ def test_the_site_holds_every_page(site):
     assert (site / "benches" / "index.html").is_file()  # benches/README.md
 
 
-def test_the_reference_documents_every_public_name(site):
-    api = _api()
-    pkg = api.load()
+def test_the_reference_documents_every_public_name(site, package):
+    api, pkg = package
     ref = api.reference(pkg)
     pages = {}
     for anchor, module in ref.page_of.items():

@@ -7,8 +7,9 @@ one generated page per public module (``docs/_site/api.py`` decides what is publ
 names — a new docs/*.md, a new results page — are added to their section by these hooks, so the site
 never silently leaves a page out.
 
-A notebook is rendered from its executed copy when ``tests/test_notebooks.py`` left one (``build/notebooks/``,
-at least as new as the notebook), else as stored (code without outputs); the build never runs a notebook.
+A notebook is rendered from its executed copy when ``tests/test_notebooks.py`` left one
+(``build/notebooks/examples/``, at least as new as the notebook), else as stored (code without outputs);
+the build never runs a notebook.
 """
 
 from __future__ import annotations
@@ -98,12 +99,9 @@ def on_files(files: Files, config) -> Files:
     kept = [f for f in files if not f.src_dir or Path(f.src_dir).resolve() != Path(config.docs_dir).resolve()]
     out = Files(kept)
     for path in _sources():
-        executed = EXECUTED / Path(path).name
-        source = ROOT / path
-        if path.endswith(".ipynb") and executed.is_file() and executed.stat().st_mtime >= source.stat().st_mtime:
-            out.append(File.generated(config, path, abs_src_path=str(executed)))
-        else:
-            out.append(File(path, str(ROOT), config.site_dir, config.use_directory_urls))
+        executed, source = EXECUTED / path, ROOT / path
+        fresh = path.endswith(".ipynb") and executed.is_file() and executed.stat().st_mtime >= source.stat().st_mtime
+        out.append(File(path, str(EXECUTED if fresh else ROOT), config.site_dir, config.use_directory_urls))
     for path, text in _api_pages().items():
         out.append(File.generated(config, path, content=text))
     return out
