@@ -55,10 +55,12 @@ class Round:
 
     @property
     def tmin(self) -> float:
+        """Shortest τ of the curve (s)."""
         return float(self.curve.tau[0])
 
     @property
     def tmax(self) -> float:
+        """Longest τ of the curve (s)."""
         return float(self.curve.tau[-1])
 
 
@@ -82,6 +84,7 @@ class Proposal:
 
     @property
     def effect(self) -> str:
+        """The effect's name (``key`` without its kind)."""
         return base_name(self.key)
 
 

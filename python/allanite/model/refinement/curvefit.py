@@ -73,17 +73,22 @@ class Curve:
         self.n_eff = max(2.0, math.log2(tau[-1] / tau[0]) + 1.0)
 
     def edf(self, alpha: int) -> np.ndarray:
+        """EDF of each estimate for noise type ``alpha`` (computed once per α)."""
         if alpha not in self._edf:
             self._edf[alpha] = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
         return self._edf[alpha]
 
     def subset(self, idx):
+        """The curve at the τ indexed by ``idx``."""
         est = self.estimator if isinstance(self.estimator, str) else tuple(np.asarray(self.estimator)[idx])
         return Curve(self.tau[idx], self.m[idx], self.avar[idx], self.fs, self.n_points, est)
 
 
 @dataclass
 class Solution:
+    """A weighted fit of a curve: coefficients ``theta``, the model and EDF per τ, normalised residuals ``z``,
+    χ² and its degrees of freedom, the design matrix ``a`` and the coefficients' covariance."""
+
     theta: np.ndarray
     model: np.ndarray
     nu: np.ndarray
@@ -95,9 +100,11 @@ class Solution:
 
     @property
     def chi2_dof(self):
+        """χ² per degree of freedom."""
         return self.chi2 / max(1, self.dof)
 
     def chi2_eff(self, curve):
+        """χ² scaled to the curve's effective number of independent points (``curve.n_eff`` of its τ)."""
         return self.chi2 * curve.n_eff / curve.tau.size
 
 
