@@ -15,7 +15,7 @@ Covariance of the means b_i of blocks [s_i, e_i) of w_i = e_i − s_i seconds (t
 - random walk of rate K from the record's start (Brownian, K²·min(s, t)): K²·(s_i + w_i/3) on the diagonal,
   K²·(s_i + e_i)/2 off it (i < j);
 - flicker B (S = B²/(2πf)): a sum of Gauss–Markov processes with correlation times spaced by e^{1/2} from a
-  twentieth of a block to 100 record lengths, each of variance B²·ln(e^{1/2})/π (their Lorentzians add up to
+  twentieth of a block to 10 record lengths, each of variance B²·ln(e^{1/2})/π (their Lorentzians add up to
   B²/(2πf) across the band); a GM of time constant T adds σ²·[T(1 − e^{−w_i/T})][T(1 − e^{−w_j/T})]·
   e^{−(s_j − e_i)/T}/(w_i w_j) off the diagonal and σ²·2T(w − T(1 − e^{−w/T}))/w² on it;
 - a ramp R·t of unknown sign: a random slope of variance R², R²·(t_i − t̄)(t_j − t̄) — not a free column, which
@@ -34,7 +34,7 @@ from scipy.linalg import solve_triangular
 from ..analysis import avar
 from .fitting import fit
 
-__all__ = ["block_covariance", "gls_warmup", "warmup_fit", "noise_terms", "BLOCKS", "T_GRID_POINTS"]
+__all__ = ["block_covariance", "gls_warmup", "warmup_fit", "warmup_component", "noise_terms", "BLOCKS", "T_GRID_POINTS"]
 
 #: Block means the warm-up is fitted to (as the drift test's).
 BLOCKS = 500
@@ -48,21 +48,7 @@ def block_covariance(edges: np.ndarray, N: float = 0.0, B: float = 0.0, K: float
     """Covariance of the rate's means over blocks [edges[i], edges[i+1]) (s) for the noise terms N, B, K, R
     (the rate unit's base form: unit/√s, unit, unit/s^1.5, unit/s²)."""
     e = np.asarray(edges, dtype=np.float64)
-    s0, s1 = e[:-1], e[1:]
-    w = s1 - s0
-    nb = w.size
-    cov = np.diag(N * N / w)
-    if K > 0:
-        rw = np.minimum.outer(0.5 * (s0 + s1), 0.5 * (s0 + s1))
-        rw[np.diag_indices(nb)] = s0 + w / 3.0
-        cov += K * K * rw
-    if B > 0:
-        cov += B * B * _flicker(s0, s1, w, e[-1] - e[0])
-    if R > 0:
-        tc = 0.5 * (s0 + s1)
-        tc = tc - tc.mean()
-        cov += R * R * np.outer(tc, tc)
-    return cov
+    return _cov_of_blocks(np.column_stack([e[:-1], e[1:]]), {"N": N, "B": B, "K": K, "R": R})
 
 
 def _flicker(s0, s1, w, length) -> np.ndarray:
@@ -71,7 +57,7 @@ def _flicker(s0, s1, w, length) -> np.ndarray:
     out = np.zeros((w.size, w.size))
     gap = s0[None, :] - s1[:, None]  # s_j − e_i: ≥ 0 above the diagonal
     gap = np.where(gap >= 0, gap, gap.T)
-    for lt in np.arange(math.log(0.05 * w.min()), math.log(100.0 * length), _FLICKER_STEP):
+    for lt in np.arange(math.log(0.05 * w.min()), math.log(10.0 * length), _FLICKER_STEP):
         t = math.exp(lt)
         f = t * -np.expm1(-w / t) / w
         blk = np.outer(f, f) * np.exp(-gap / t)
@@ -83,7 +69,7 @@ def _flicker(s0, s1, w, length) -> np.ndarray:
 def gls_warmup(b: np.ndarray, tb: np.ndarray, cov: np.ndarray, length: float) -> dict:
     """GLS fit of c + a·e^{−t/T} to block means ``b`` at times ``tb`` with covariance ``cov``, T profiled on a
     log grid over [L/200, L/2]; 68.3 % profile intervals for T and a."""
-    chol = np.linalg.cholesky(cov + 1e-12 * np.trace(cov) / cov.shape[0] * np.eye(cov.shape[0]))
+    chol = _cholesky(cov)
     wb = solve_triangular(chol, b, lower=True)
     one = solve_triangular(chol, np.ones_like(tb), lower=True)
     grid = np.linspace(math.log(length / 200.0), math.log(length / 2.0), T_GRID_POINTS)
@@ -109,6 +95,17 @@ def gls_warmup(b: np.ndarray, tb: np.ndarray, cov: np.ndarray, length: float) ->
         "chi2": float(chi2[j]),
         "at_edge": j in (0, grid.size - 1),
     }
+
+
+def _cholesky(cov: np.ndarray) -> np.ndarray:
+    """Cholesky factor of ``cov``; where rounding of its slow (nearly constant) parts leaves it indefinite, of
+    the nearest positive definite matrix (eigenvalues clipped at 1e-10 of the largest)."""
+    try:
+        return np.linalg.cholesky(cov)
+    except np.linalg.LinAlgError:
+        w, v = np.linalg.eigh(0.5 * (cov + cov.T))
+        w = np.maximum(w, 1e-10 * float(w.max()))
+        return np.linalg.cholesky((v * w) @ v.T)
 
 
 def _blocks(y: np.ndarray, fs: float, n_blocks: int):
@@ -142,3 +139,40 @@ def noise_terms(z: np.ndarray, fs: float) -> dict:
     sensor's bandwidth bends them (``tau_range="auto"``): what the block means are weighed against."""
     f = fit(avar(z, fs, taus="octave"), tau_range="auto")
     return {k: float(f.coefficients[k].value) for k in ("N", "B", "K", "R")}
+
+
+def warmup_component(z: np.ndarray, t: np.ndarray, noise: dict, length: float, pieces: int = 1, n_blocks: int = BLOCKS // 2):
+    """The warm-up fitted as :func:`warmup_fit` does on samples ``z`` taken at times ``t`` (s) — a part of
+    alternate blocks: its ``pieces`` runs of consecutive samples are each cut into block means, so no block
+    straddles a seam, and the blocks' covariance follows their real times. Returns the component as a function
+    of time (s), for the held-out error."""
+    fs = (t.size - 1) / max(t[-1] - t[0], 1e-300) if t.size > 1 else 1.0
+    run = z.size // pieces
+    per = max(1, run // max(1, n_blocks // pieces))
+    use = (run // per) * per
+    zb = z[: pieces * run].reshape(pieces, run)[:, :use].reshape(-1, per).mean(axis=1)
+    starts = t[: pieces * run].reshape(pieces, run)[:, :use].reshape(-1, per)[:, 0]
+    edges = np.column_stack([starts, starts + per / fs])
+    cov = _cov_of_blocks(edges, noise)
+    d = gls_warmup(zb, edges.mean(axis=1), cov, length)
+    a, t_c = d["amplitude"], d["T"]
+    return lambda tt: a * np.exp(-np.asarray(tt) / t_c)
+
+
+def _cov_of_blocks(edges: np.ndarray, noise: dict) -> np.ndarray:
+    """:func:`block_covariance` for blocks [edges[i, 0], edges[i, 1]) that need not touch (a held-in part)."""
+    s0, s1 = edges[:, 0], edges[:, 1]
+    w = s1 - s0
+    cov = np.diag(noise.get("N", 0.0) ** 2 / w)
+    k, b, r = noise.get("K", 0.0), noise.get("B", 0.0), noise.get("R", 0.0)
+    if k > 0:
+        rw = np.minimum.outer(0.5 * (s0 + s1), 0.5 * (s0 + s1))
+        rw[np.diag_indices(w.size)] = s0 + w / 3.0
+        cov += k * k * rw
+    if b > 0:
+        cov += b * b * _flicker(s0, s1, w, s1[-1] - s0[0])
+    if r > 0:
+        tc = 0.5 * (s0 + s1)
+        tc = tc - tc.mean()
+        cov += r * r * np.outer(tc, tc)
+    return cov
