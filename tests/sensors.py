@@ -112,7 +112,12 @@ def _inject(kind: str, kw: dict, t: np.ndarray, fs: float, rng: np.random.Genera
         return comp, {"temp": logged}, Injected("regression", truth), None
     if kind == "square":
         comp = kw["amplitude"] * signal.square(2 * np.pi * kw["f0"] * t + 0.3)
-        return comp, {}, Injected("periodic", {"fundamentals": [kw["f0"]], "rms": kw["amplitude"]}, ("fundamentals",)), None
+        return (
+            comp,
+            {},
+            Injected("periodic", {"fundamentals": [kw["f0"]], "rms": kw["amplitude"]}, ("fundamentals",)),
+            None,
+        )
     if kind == "sawtooth":
         comp = kw["amplitude"] * signal.sawtooth(2 * np.pi * kw["f0"] * t + 1.1)
         rms = kw["amplitude"] / math.sqrt(3.0)
@@ -125,7 +130,12 @@ def _inject(kind: str, kw: dict, t: np.ndarray, fs: float, rng: np.random.Genera
     if kind == "beat":
         comp = _sample_rate_beat(t, kw["amplitude"], kw["f1"], kw["f2"], fs, kw.get("mode", "drop"))
         rms = kw["amplitude"] / math.sqrt(2.0)
-        return comp, {}, Injected("periodic", {"fundamentals": [kw["f1"], kw["f2"]], "rms": rms}, ("fundamentals",)), None
+        return (
+            comp,
+            {},
+            Injected("periodic", {"fundamentals": [kw["f1"], kw["f2"]], "rms": rms}, ("fundamentals",)),
+            None,
+        )
     if kind == "lines":
         # a consumer IMU's families: a fundamental with harmonics, and pairs of sidebands k·f1 ± f2
         f0, f1, f2, a = kw["f0"], kw["f1"], kw["f2"], kw["amplitude"]
@@ -140,7 +150,12 @@ def _inject(kind: str, kw: dict, t: np.ndarray, fs: float, rng: np.random.Genera
                 ak = 0.6 * a / k
                 comp += ak * np.sin(2 * np.pi * (k * f1 + s * f2) * t + 0.4 * k + s)
                 power += ak * ak / 2
-        return comp, {}, Injected("periodic", {"fundamentals": [f0, f1, f2], "rms": math.sqrt(power)}, ("fundamentals",)), None
+        return (
+            comp,
+            {},
+            Injected("periodic", {"fundamentals": [f0, f1, f2], "rms": math.sqrt(power)}, ("fundamentals",)),
+            None,
+        )
     if kind == "warmup":
         comp = kw["amplitude"] * np.exp(-t / kw["T"])
         return comp, {}, Injected("drift", {"amplitude": kw["amplitude"], "T": kw["T"]}), None
@@ -395,7 +410,9 @@ def judge(r, case: Case) -> dict:
     out["unexplained"] = unexplained
     out["explained"] = unexplained is not None and len(unexplained) == 0
     out["found"] = list(r.found)
-    out["passed"] = bool(out["named"] and out["params"] and out["falling"] and out["heldout_falling"] and out["explained"])
+    out["passed"] = bool(
+        out["named"] and out["params"] and out["falling"] and out["heldout_falling"] and out["explained"]
+    )
     return out
 
 

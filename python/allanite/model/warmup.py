@@ -141,7 +141,9 @@ def noise_terms(z: np.ndarray, fs: float) -> dict:
     return {k: float(f.coefficients[k].value) for k in ("N", "B", "K", "R")}
 
 
-def warmup_component(z: np.ndarray, t: np.ndarray, noise: dict, length: float, pieces: int = 1, n_blocks: int = BLOCKS // 2):
+def warmup_component(
+    z: np.ndarray, t: np.ndarray, noise: dict, length: float, pieces: int = 1, n_blocks: int = BLOCKS // 2
+):
     """The warm-up fitted as :func:`warmup_fit` does on samples ``z`` taken at times ``t`` (s) — a part of
     alternate blocks: its ``pieces`` runs of consecutive samples are each cut into block means, so no block
     straddles a seam, and the blocks' covariance follows their real times. Returns the component as a function
