@@ -133,6 +133,7 @@ MODEL_RANKS = {
     "model.fitting": 1,
     "model.tracing": 1,
     "model.timeframes": 2,
+    "model.warmup": 2,
     "model.refinement.levels": 2,
     "model.refinement.curvefit": 3,
     "model.refinement.scoring": 4,
@@ -141,9 +142,10 @@ MODEL_RANKS = {
     "model.refinement.candidates": 6,
     "model.refinement.removals": 6,
     "model.refinement.changes": 6,
-    "model.refinement.loop": 7,
-    "model.refinement": 8,
-    "model": 9,
+    "model.refinement.missing": 7,
+    "model.refinement.loop": 8,
+    "model.refinement": 9,
+    "model": 10,
 }
 MODEL_MODULES = sorted(m for m in MODULES if m.split(".")[0] == "model")
 

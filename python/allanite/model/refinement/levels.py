@@ -8,7 +8,17 @@ calibrated with the rest on clean records (``benches/refine_false_alarms.py``).
 
 from __future__ import annotations
 
-__all__ = ["LEVEL", "LINE_SHARE", "CHANGE_POINT_SHARE", "TIME_SHARE", "SHARES", "TIME_SHARES", "share", "alpha"]
+__all__ = [
+    "LEVEL",
+    "LINE_SHARE",
+    "CHANGE_POINT_SHARE",
+    "TIME_SHARE",
+    "UNEXPLAINED_SHARES",
+    "SHARES",
+    "TIME_SHARES",
+    "share",
+    "alpha",
+]
 
 #: Default false-alarm level per record (clean record: probability that anything is added).
 LEVEL = 0.05
@@ -19,8 +29,16 @@ CHANGE_POINT_SHARE = 0.2
 #: Share of ``level`` for each time-domain test (regression on channels, drift).
 TIME_SHARE = 0.075
 
+#: Share of ``level`` spent on saying what the final model still misses (``Refinement.unexplained``), split
+#: between its checks: the Allan curve, lines in the PSD, a drift in time.
+UNEXPLAINED_SHARES = {"allan": 0.075, "psd": 0.025, "time": 0.025}
+
 #: Tests with a share of their own, by name (the Allan-curve test, ``"curve"``, takes the rest).
-SHARES = {"lines": LINE_SHARE, "change_point": CHANGE_POINT_SHARE}
+SHARES = {
+    "lines": LINE_SHARE,
+    "change_point": CHANGE_POINT_SHARE,
+    **{f"unexplained:{k}": v for k, v in UNEXPLAINED_SHARES.items()},
+}
 #: The share of each time-domain removal, by effect name (one entry per removal of ``removals.REMOVALS``).
 TIME_SHARES = {"drift": TIME_SHARE, "regression": TIME_SHARE}
 

@@ -29,6 +29,7 @@ from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families
 from .changes import change_points
 from .curvefit import Curve, base_name, noise_fit, solve
 from .levels import LEVEL, alpha
+from .missing import MissingContext, unexplained
 from .removals import REMOVALS, Removal, RemovalContext
 from .result import Refinement, Step
 from .scoring import HELDOUT_BLOCKS, curve_metrics, heldout_split, informative, removal_metrics, segments_heldout
@@ -152,7 +153,7 @@ def refine(
         run.add_curve_effects(candidates)
         cp_steps = run.change_point_steps(candidates)
         run.rescore_removals()
-        return run.refinement(cp_steps, unit, confidence)
+        return run.refinement(cp_steps, unit, confidence, run.unexplained(chans))
 
 
 def _check_candidates(candidates, level) -> tuple:
@@ -481,7 +482,16 @@ class _Run:
             st.delta_chi2_eff = float(s_raw.chi2_eff(c_raw) - sol.chi2_eff(self.curve))
             st.evidence["scored_with"] = [base_name(k) for k, _p in effects] or "the five terms"
 
-    def refinement(self, cp_steps, unit, confidence) -> Refinement:
+    def unexplained(self, chans) -> list:
+        """What the final model still misses, every domain's check at its own share of ``level``."""
+        exact = self.y is not None or (isinstance(self.est, str) and self.est == "oavar")
+        thin = tracing.thin_indices(self.curve.tau)
+        ctx = MissingContext(
+            self.curve, thin, self.sol, self.start, self.effects, self.y, self.fs, self.level, exact, chans
+        )
+        return unexplained(ctx)
+
+    def refinement(self, cp_steps, unit, confidence, missing) -> Refinement:
         start_fit = noise_fit(self.curve, self.start, [], self.start_sol, self.result, unit, confidence)
         final_fit = noise_fit(self.curve, self.start, self.effects, self.sol, self.result, unit, confidence)
         return Refinement(
@@ -497,6 +507,7 @@ class _Run:
             start_heldout_rms_adev_pct=self.start_heldout,
             scored_tau=self.curve.tau[self.scored],
             tau_range=(self.lo, self.hi),
+            unexplained=missing,
         )
 
 

@@ -10,6 +10,9 @@ changed in the Allan curve, AVAR(y) − AVAR(y − component), cross terms inclu
 
 - ``"drift"`` — a warm-up a·e^{−t/T} on block means, tested against block means drawn from the five-term fit
   with its slow terms at the upper end of what the curve allows (:func:`allanite.model.tracing.drift_fit`);
+  a and T and their intervals by generalised least squares against the block means' covariance under the
+  record's own noise terms (:mod:`allanite.model.warmup`: flicker and random walk tie the block means together,
+  and an ordinary fit's intervals then miss the truth);
 - ``"regression"`` — the rate regressed on each channel of ``channels=`` within blocks in time (t test with the
   blocks' effective dof), band by band where the coupling differs across frequency.
 
@@ -26,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import t as t_dist
 
-from .. import tracing
+from .. import tracing, warmup
 from .calibrated import tested
 from .curvefit import Curve, Solution, theta_terms, upper_theta
 from .levels import alpha
@@ -108,18 +111,26 @@ def _drift(ctx: RemovalContext) -> Iterator[Removal]:
     t_s = np.arange(y.size) / fs
     span = y.size / fs
     pieces = HELDOUT_BLOCKS // 2
+    w = warmup.warmup_fit(y, fs, warmup.noise_terms(y, fs), refit_noise=lambda z: warmup.noise_terms(z, fs))
+    if w["at_edge"]:
+        ctx.consider("drift", {"T": w["T"], "statistic": dr["statistic"], "threshold": thr_d, "at_edge": True})
+        return
 
     def refit(z, idx):
-        g = tracing.drift_component(z, idx / fs, span, pieces)
+        g = warmup.warmup_component(z, idx / fs, w["noise"], span, pieces)
         return lambda i: g(i / fs)
 
     yield Removal(
         "drift",
-        dr["amplitude"] * np.exp(-t_s / dr["T"]),
+        w["amplitude"] * np.exp(-t_s / w["T"]),
         refit,
-        {"amplitude": dr["amplitude"], "T": dr["T"]},
-        {"amplitude": dr["amplitude_interval"], "T": dr["T_interval"]},
-        {"domain": "time", "test": tested("statistic", dr["statistic"], thr_d, a)},
+        {"amplitude": w["amplitude"], "T": w["T"]},
+        {"amplitude": w["amplitude_interval"], "T": w["T_interval"]},
+        {
+            "domain": "time",
+            "test": tested("statistic", dr["statistic"], thr_d, a),
+            "noise": w["noise"],  # the noise terms the block means were weighed against (base form)
+        },
         2,
     )
 

@@ -14,7 +14,7 @@ from .. import fitting
 from ..effects import EFFECTS
 from .scoring import rms_adev_pct
 
-__all__ = ["Step", "Refinement"]
+__all__ = ["Step", "Refinement", "describe_region"]
 
 
 @dataclass
@@ -46,7 +46,11 @@ class Refinement(RichDisplay):
     """What :func:`refine` found. ``fit`` is the final model (a NoiseFit whose ``coefficients`` also
     hold the added effects' parameters), ``start`` the starting model, ``steps`` the effects added.
     ``heldout_note`` says how (or why not) the held-out error was computed; ``scored_tau`` the τ the RMS ADEV
-    errors are scored on (:meth:`rms_adev_pct` gives a fit's)."""
+    errors are scored on (:meth:`rms_adev_pct` gives a fit's). ``unexplained`` lists what the final model still
+    misses — empty when every domain's calibrated check passes (at its share of ``level``), else one dict per
+    region, largest misfit first: ``"domain"``, ``"tau"`` (lo, hi) s, ``"band_hz"`` (lo, hi) or None,
+    ``"chi2_dof"`` over that τ range, ``"what"``, and the test's ``"statistic"``, ``"threshold"``, ``"alpha"``
+    (:mod:`allanite.model.refinement.missing`)."""
 
     steps: list
     fit: fitting.NoiseFit
@@ -60,6 +64,7 @@ class Refinement(RichDisplay):
     start_heldout_rms_adev_pct: float | None = None
     tau_range: tuple = (0.0, math.inf)
     scored_tau: np.ndarray | None = None
+    unexplained: list = field(default_factory=list)
 
     def rms_adev_pct(self, fit) -> float:
         """RMS ADEV error (%) of a fit (``start`` or ``fit``) on the τ the steps' errors are scored on
@@ -88,7 +93,11 @@ class Refinement(RichDisplay):
             "",
         ]
         if not self.steps:
-            lines.append("Nothing added: the residual is consistent with noise or no candidate earned its parameters.")
+            lines.append(
+                "Nothing added: the starting model passes every calibrated check."
+                if not self.unexplained
+                else "Nothing added: no candidate earned its parameters — but the model still misses something (below)."
+            )
         for i, st in enumerate(self.steps, 1):
             ps = ", ".join(_fmt_param(k, v, st.intervals.get(k)) for k, v in st.params.items())
             lines += [
@@ -109,6 +118,10 @@ class Refinement(RichDisplay):
                     + ", ".join(f"{k} {100 * v:+.1f} %" for k, v in st.truth_error.items())
                 )
                 lines.append("")
+        lines += ["## What the model still misses", ""]
+        lines += [f"- {describe_region(r)}" for r in self.unexplained] or [
+            "Nothing: every domain's calibrated check passes against the final model."
+        ]
         return "\n".join(lines)
 
     def _summary(self) -> Summary:
@@ -138,6 +151,14 @@ class Refinement(RichDisplay):
                 f"{self.result.n_samples} samples at {self.result.fs:g} Hz, τ {s0.tau[0]:.4g}–{s0.tau[-1]:.4g} s",
             ),
         ]
+        facts.append(
+            (
+                "still missing",
+                "; ".join(describe_region(r) for r in self.unexplained)
+                if self.unexplained
+                else "nothing: every calibrated check passes",
+            )
+        )
         if self.change_points:
             facts.append(("change points", ", ".join(f"t = {float(c['t']):.4g} s" for c in self.change_points)))
         tables = []
@@ -208,3 +229,24 @@ def _fmt_param(k, v, iv) -> str:
     if iv is None:
         return f"{k} = {v:.4g}"
     return f"{k} = {v:.4g} [{iv[0]:.4g}, {iv[1]:.4g}]"
+
+
+def describe_region(reg: dict) -> str:
+    """One entry of ``Refinement.unexplained`` in words: "the model still misses τ 0.2–3 s (≈ 0.17–2.5 Hz): …"."""
+    lo, hi = reg["tau"]
+    text = f"τ {_num(lo)}–{_num(hi)} s" if hi > lo else f"τ {_num(lo)} s"
+    band = reg.get("band_hz")
+    if band is not None:
+        text += f" (≈ {_num(band[0])}–{_num(band[1])} Hz)"
+    if reg.get("what"):
+        text += f": {reg['what']}"
+    if reg.get("chi2_dof") is not None and math.isfinite(reg["chi2_dof"]):
+        text += f", χ²/dof {_num(reg['chi2_dof'])} there"
+    return text
+
+
+def _num(v: float) -> str:
+    if v == 0 or not math.isfinite(v):
+        return f"{v:g}"
+    digits = max(0, 1 - int(math.floor(math.log10(abs(v)))))
+    return f"{v:.{min(digits, 6)}f}" if abs(v) < 1000 else f"{v:.3g}"
