@@ -445,6 +445,35 @@ def test_plots_draw_on_given_axes_and_on_their_own():
         plt.close("all")
 
 
+def test_plot_labels_name_each_line_and_only_the_lines():
+    # issue 32: ``ax.legend(names)`` after ``r.plot()`` paired the names with the bands; ``labels=`` names lines
+    import matplotlib.pyplot as plt
+
+    x, fs, _ = allanite.default_record()
+    x = x[:30_000]
+    s = allanite.avar(x, fs).with_confidence(x)
+    names = ["gyro_x", "gyro_y", "gyro_z"]
+    try:
+        ax = s.plot(labels=names)
+        handles, texts = ax.get_legend_handles_labels()
+        assert texts == names
+        assert all(h in ax.lines for h in handles)  # lines, not the interval bands
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == names
+        ax = s.plot(labels=names, axis=1)
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == ["gyro_y", "68.3% interval"]
+        one = allanite.avar(x[:, 0], fs)
+        ax = one.plot(labels="gyro_x")
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == ["gyro_x"]
+        ax = s.plot()
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == ["axis 0", "axis 1", "axis 2"]
+        with pytest.raises(allanite.AllaniteError, match="labels has 2 name.* of 3 axes: give one label per axis"):
+            s.plot(labels=names[:2])
+        with pytest.raises(allanite.AllaniteError, match="labels has 3 name.* of 1 axis"):
+            one.plot(labels=names)
+    finally:
+        plt.close("all")
+
+
 def test_to_xarray_static_and_dynamic():
     xr = pytest.importorskip("xarray")
     x, fs, _ = allanite.default_record()

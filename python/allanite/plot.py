@@ -57,7 +57,13 @@ def _rows(result, axis):
 
 
 def plot_adev(
-    result, ax=None, unit: str | None = None, labels=None, axis: int | None = None, band: bool = True, **kwargs
+    result,
+    ax=None,
+    unit: str | None = None,
+    labels=None,
+    axis: int | None = None,
+    band: bool = True,
+    **kwargs,
 ):
     """Log-log ADEV against τ, one line per axis, with the confidence band when the result has
     intervals (:meth:`~allanite.AllanResult.with_confidence`).
@@ -68,14 +74,21 @@ def plot_adev(
     ax : matplotlib Axes, optional
     unit : str, optional
         Unit of the samples, for the y label.
-    labels : list of str, optional
-        Legend label per axis (default "axis 0", "axis 1", …; none for 1-D input).
+    labels : str or sequence of str, optional
+        Legend label of each axis' line, one per axis of the result (default "axis 0", "axis 1", …;
+        "Allan deviation" for 1-D input). With ``axis`` the label of that axis is used. Pass the names
+        here rather than to ``ax.legend``: the band of an interval is drawn too, and a list given to
+        ``legend`` afterwards would pair the names with the wrong artists.
     axis : int, optional
         Draw only this axis of a multi-axis result.
     band : bool
         Shade the confidence interval of each curve (when present).
     **kwargs
         Passed to ``Axes.loglog`` for the curves.
+
+    Returns
+    -------
+    matplotlib Axes
     """
     ax = _axes(ax)
     adev = np.atleast_2d(result.adev)
@@ -85,18 +98,9 @@ def plot_adev(
     if band and ci is not None:
         lo, hi = np.atleast_2d(ci[0]), np.atleast_2d(ci[1])
     rows = _rows(result, axis)
-    multi = adev.shape[0] > 1
-    if labels is None:
-        labels = [f"axis {k}" for k in range(adev.shape[0])] if multi else [None]
+    names = _line_labels(labels, adev.shape[0])
     for k in rows:
-        name = labels[k] if k < len(labels) else None
-        (line,) = ax.loglog(
-            result.tau,
-            adev[k],
-            marker=".",
-            label=name if (multi and axis is None) else (name or "Allan deviation"),
-            **kwargs,
-        )
+        (line,) = ax.loglog(result.tau, adev[k], marker=".", label=names[k], **kwargs)
         if lo is not None and hi is not None:
             band_label = None
             if len(rows) == 1:
@@ -105,9 +109,20 @@ def plot_adev(
     ax.set_xlabel("τ (s)")
     ax.set_ylabel(_adev_label(unit))
     ax.grid(True, which="both", alpha=0.3)
-    if len(rows) > 1 or lo is not None:
+    if len(rows) > 1 or lo is not None or labels is not None:
         ax.legend(fontsize="small")
     return ax
+
+
+def _line_labels(labels, n_axes: int) -> list[str]:
+    """One legend label per axis: the given ones (checked against the number of axes) or the defaults."""
+    if labels is None:
+        return [f"axis {k}" for k in range(n_axes)] if n_axes > 1 else ["Allan deviation"]
+    names = [labels] if isinstance(labels, str) else [str(v) for v in labels]
+    if len(names) != n_axes:
+        axes = "1 axis" if n_axes == 1 else f"{n_axes} axes"
+        raise AllaniteError(f"labels has {len(names)} name(s) for a result of {axes}: give one label per axis")
+    return names
 
 
 def plot_davar(result, ax=None, axis: int = 0, unit: str | None = None, cmap: str = "viridis", **kwargs):

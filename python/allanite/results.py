@@ -356,9 +356,31 @@ class AllanResult(_ResultBase):
             data["kf"] = (axes, np.asarray(self.kf, dtype=float), {"units": "1", "long_name": "TheoBR bias ratio"})
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
-    def plot(self, ax=None, **kwargs):
-        """Log-log ADEV against τ (one line per axis). Returns the matplotlib Axes."""
-        return plot_adev(self, ax=ax, **kwargs)
+    def plot(self, ax=None, *, labels=None, unit=None, axis=None, band=True, **kwargs):
+        """Log-log ADEV against τ, one line per axis, with the interval band when there is one.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Draw here (default: a new figure).
+        labels : str or sequence of str, optional
+            Legend label of each axis' line, one per axis, e.g. ``labels=["gyro_x", "gyro_y", "gyro_z"]``
+            (default "axis 0", "axis 1", …). Pass the names here rather than to ``ax.legend``, which
+            would pair them with the interval bands as well as the lines.
+        unit : str, optional
+            Unit of the samples (e.g. ``"deg/s"``), for the y label.
+        axis : int, optional
+            Draw only this axis of a multi-axis result.
+        band : bool
+            Shade the confidence interval (when the result has one).
+        **kwargs
+            Passed to ``Axes.loglog`` for the curves.
+
+        Returns
+        -------
+        matplotlib Axes
+        """
+        return plot_adev(self, ax=ax, unit=unit, labels=labels, axis=axis, band=band, **kwargs)
 
 
 @dataclass(frozen=True, repr=False, eq=False)
