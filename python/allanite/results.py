@@ -141,7 +141,7 @@ class _ResultBase(RichDisplay):
 
     def _record_facts(self) -> list:
         """The summary lines every result shows: the record and the τ range."""
-        axes = f", {self.n_axes} axes" if self.n_axes else ""
+        axes = f", {self.n_axes} {'axis' if self.n_axes == 1 else 'axes'}" if self.n_axes else ""
         facts: list = [
             ("record", f"{self.n_samples} samples at {self.fs:g} Hz ({self.n_samples / self.fs:.6g} s){axes}"),
             ("input", f"{self.input} (results in the samples' rate unit)"),
@@ -269,7 +269,7 @@ class AllanResult(_ResultBase):
     taper: str = "rect"
 
     def __repr__(self) -> str:
-        axes = f", {self.n_axes} axes" if self.n_axes else ""
+        axes = f", {self.n_axes} {'axis' if self.n_axes == 1 else 'axes'}" if self.n_axes else ""
         which = " (axis 0)" if self.n_axes else ""
         return (
             f"AllanResult({self.estimator}, {self.tau.size} τ in {_fmt_range(self.tau, 's')}, "
@@ -452,7 +452,7 @@ class DynamicAllanResult(_ResultBase):
     _time_dims = ("t",)
 
     def __repr__(self) -> str:
-        axes = f", {self.n_axes} axes" if self.n_axes else ""
+        axes = f", {self.n_axes} {'axis' if self.n_axes == 1 else 'axes'}" if self.n_axes else ""
         return (
             f"DynamicAllanResult({self.estimator}/{self.method}, {self.tau.size} τ in "
             f"{_fmt_range(self.tau, 's')} × {self.t.size} windows centred {_fmt_range(self.t, 's')}; "
