@@ -104,7 +104,7 @@ class _ResultBase(RichDisplay):
         edf_method: str = "greenhall",
         chi2: str = "exact",
         b1_n: str = "terms",
-        fallback: str = "previous",
+        fallback: str = "prudent",
     ):
         """This result with χ² confidence intervals per τ (``edf``, ``ci_low``, ``ci_high``, ``alpha``).
 
