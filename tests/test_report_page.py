@@ -231,3 +231,42 @@ def test_console_and_page_say_the_same_when_nothing_is_added():
     assert f"axis 0: {NOTHING_ADDED};" in rep.text()
     assert "nothing found" not in html + rep.text()
     assert json.dumps(rep.summary(), allow_nan=False)
+
+
+# ------------------------------------------------------------------------------------------------
+# the per-axis ADEV figure (issue 32 item 4)
+
+
+def test_adev_figure_draws_terms_where_they_matter_and_marks_the_unfitted_tau():
+    import matplotlib.pyplot as plt
+
+    y = allanite.simulate(200_000, FS, N=2e-3, K=2e-5, Q=1e-4, seed=5)
+    r = allanite.avar(y, FS).with_confidence(y)
+    f = allanite.fit(r, unit="deg/s", tau_range=(0.1, None))
+    assert f.tau[0] > r.tau[0]
+    try:
+        ax = r.plot(unit="deg/s")
+        f.plot(ax=ax, tau=r.tau, points=False, color="k")
+        lines = {ln.get_label(): ln for ln in ax.lines}
+        model = lines["fitted model"]
+        x, v = model.get_xdata(), model.get_ydata()
+        assert np.all(np.isnan(v[x < f.tau[0] * (1 - 1e-9)])) and np.all(np.isfinite(v[x >= f.tau[0]]))
+        dotted = [ln for ln in ax.lines if ln.get_linestyle() == ":"]
+        assert len(dotted) == 1 and np.nanmin(dotted[0].get_xdata()[np.isfinite(dotted[0].get_ydata())]) == r.tau[0]
+        labels = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert "τ not fitted" in labels
+        terms = [ln for name, ln in lines.items() if name[:1] in "QNBKR" and " = " in name]
+        assert len(terms) >= 2
+        full = np.sqrt(f.curve(x))
+        for ln in terms:
+            tv = ln.get_ydata()
+            drawn = np.isfinite(tv)
+            assert drawn.any() and not drawn.all()
+            assert np.all(tv[drawn] >= full[drawn] / 10 * (1 - 1e-12))  # within a decade of the model
+            assert np.all(ln.get_xdata()[drawn] >= f.tau[0] * (1 - 1e-9))  # not over the τ left out
+        # every term over the whole fitted range on request
+        ax2 = f.plot(term_decades=None)
+        n_line = next(ln for ln in ax2.lines if ln.get_label().startswith("N = "))
+        assert np.all(np.isfinite(n_line.get_ydata()))
+    finally:
+        plt.close("all")

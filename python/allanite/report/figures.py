@@ -38,6 +38,7 @@ def figure_specs(rep) -> list:
                     color=f"C{k % 10}",
                     label=f"{names[k]} fit",
                     lw=1.0,
+                    shade_unfitted=False,
                 )
         ax.set_title(f"{static_word}, {conf} intervals" + (" and fits" if rep.fits else ""))
         fig.subplots_adjust(left=0.11, right=0.975, bottom=0.11, top=0.93)
@@ -47,7 +48,7 @@ def figure_specs(rep) -> list:
             "adev.png",
             "Allan deviation, all axes",
             f"Overlapping ADEV of every axis with its {conf} "
-            "interval band" + (" and fitted model." if rep.fits else "."),
+            "interval band" + (" and fitted model (dotted over the τ its fit left out)." if rep.fits else "."),
             (7.2, 4.8),
             overview,
         )
@@ -99,7 +100,12 @@ def figure_specs(rep) -> list:
                 f"adev_axis{k}.png",
                 f"{names[k]}: Allan deviation",
                 f"ADEV of {names[k]} with its {conf} interval band"
-                + ("; fitted model (black) and each term (dashed)." if rep.fits else "."),
+                + (
+                    "; fitted model (black; dotted over the τ the fit left out, shaded) and each term (dashed, "
+                    "where it is within a decade of the model)."
+                    if rep.fits
+                    else "."
+                ),
                 (7.2, 4.8),
                 adev_k,
             )
