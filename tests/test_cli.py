@@ -57,7 +57,7 @@ def test_report_on_a_npy_log(tmp_path, npy_log, capsys):
     printed = captured.out
     assert captured.err == ""
     assert printed.startswith("allanite report: gyro.npy")
-    assert "6000 samples × 1 axes (col0) at 50 Hz" in printed and "unit rad/s" in printed
+    assert "6000 samples × 1 axis (col0) at 50 Hz" in printed and "unit rad/s" in printed
     assert "Overlapping Allan deviation (rad/s)" in printed
     assert "Dynamic Allan deviation: window 1200 samples (24 s, given), hop 300 (6 s, given)" in printed
     summary = json.loads((out / "summary.json").read_text())
