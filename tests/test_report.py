@@ -267,7 +267,8 @@ def test_bundled_report_summary_matches_the_library(bundled):
 def test_bundled_report_prints_tables_and_paths(bundled):
     rc, out, stdout, stderr = bundled
     summary = json.loads((out / "summary.json").read_text())
-    assert stdout.startswith("allanite report: bundled record")
+    assert stdout.startswith("[") and "] generating the bundled record\n" in stdout  # a line per step: no terminal
+    assert "\nallanite report: bundled record" in stdout
     assert "Overlapping Allan deviation (°/s)" in stdout and "68.3% interval" in stdout
     # one table row per τ, with the ADEV of each axis as in summary.json
     st = summary["static"]

@@ -267,7 +267,7 @@ def _outside(values: np.ndarray, inside: np.ndarray) -> np.ndarray:
 
 
 def _shade_unfitted(ax, lo: float, hi: float, fit_lo: float, fit_hi: float) -> None:
-    label = "τ not fitted"
+    label: str | None = "τ not fitted"
     for a, b in ((lo, fit_lo), (fit_hi, hi)):
         if b > a * (1 + 1e-9):
             ax.axvspan(a, b, color="0.5", alpha=0.12, lw=0, label=label)
