@@ -149,7 +149,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--columns",
         metavar="C1,C2,...",
         help="columns that are the samples, by name or 0-based index, comma-separated; one per "
-        "axis (default: every column but the time column)",
+        "axis (default: every column but the time column — or, when the header also names "
+        "accelerometer columns (acc_x, ...), the ones it names as gyro (gyro_x, ...))",
     )
     inp.add_argument("--time-column", metavar="C", help="column of sample times: derives --fs, finds gaps")
     inp.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), help="unit of the time column (default: s)")
