@@ -187,10 +187,10 @@ class Report:
         """Write ``report.html``, ``summary.json`` and the PNG figures into folder ``out`` (created if
         needed). Returns the paths written, report.html and summary.json first."""
         out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
         progress, own = _steps(progress, len(self.figure_specs()) + 1, "report files")
         images = self.render_figures(progress, dpi=dpi)
         progress.step("writing report.html, summary.json")
-        out.mkdir(parents=True, exist_ok=True)  # after the slow part: an interrupt leaves no empty folder
         pngs = []
         for name, data in images.items():
             p = out / name
