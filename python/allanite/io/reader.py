@@ -187,7 +187,8 @@ class Log:
         dur_s = f"{dur / 3600:.3g} h" if dur >= 3600 else f"{dur:.4g} s"
         lines = [
             f"Log({self.path.name!r}, {self.format})",
-            f"  data: {self.n_samples} samples × {self.n_axes} axes, {kind}{self.data.dtype}, "
+            f"  data: {self.n_samples} samples × {self.n_axes} {'axis' if self.n_axes == 1 else 'axes'}, "
+            f"{kind}{self.data.dtype}, "
             f"fs = {self.fs:g} Hz ({dur_s})",
             f"  columns: {', '.join(self.columns)}",
             f"  unit: {self.unit.name + ' (' + self.unit.kind + ')' if self.unit else 'not given'}, "

@@ -9,6 +9,7 @@ __all__ = [
     "DHVAR_MAX_DEFAULT_WINDOW",
     "DHVAR_MAX_WINDOWS",
     "REPORT_ESTIMATORS",
+    "NOTHING_ADDED",
     "default_window",
     "default_hop",
 ]
@@ -24,6 +25,8 @@ HOP_FRACTION = 25
 DHVAR_MAX_DEFAULT_WINDOW = 2001
 #: ... and its default hop keeps the number of windows (each fitted) to about this.
 DHVAR_MAX_WINDOWS = 400
+#: What the page and the console say for an axis to which refine added no effect.
+NOTHING_ADDED = "nothing added"
 #: estimator → (static estimator, dynamic estimator, dynamic τ grid, section titles)
 REPORT_ESTIMATORS = {
     "oavar": ("oavar", "oavar", "exp", "Overlapping Allan deviation", "Dynamic Allan variance"),
