@@ -24,6 +24,7 @@ from scipy import signal
 
 import allanite
 from allanite.model.effects import EFFECTS
+from allanite.simulation import kasdin_walter
 
 #: Relative tolerance on parameters, and on frequencies.
 PARAM_TOL = 0.2
@@ -59,13 +60,16 @@ class Case:
 
 
 def temperature_profile(t: np.ndarray, kind: str, rng: np.random.Generator, lo=5.0, hi=20.0) -> np.ndarray:
-    """A slow temperature (°C) over the record: ``"cycle"`` (a thermal chamber's cycles plus a little wander)
-    or ``"walk"`` (a room drifting: an integrated random walk, smooth to minutes)."""
+    """A slow temperature (°C) over the record: ``"cycle"`` (a thermal chamber's cycles plus a little wander),
+    ``"swing"`` (a housing warming up once, then steady) or ``"walk"`` (a room drifting: a random walk through
+    the housing's thermal lag)."""
     span = t[-1] - t[0] if t.size > 1 else 1.0
     fs = (t.size - 1) / span if t.size > 1 else 1.0
     # a housing's thermal mass: the wander reaches the sensor through a lag of span/200 (smooth to minutes)
     wander = first_order_lag(np.cumsum(rng.standard_normal(t.size)), fs, span / 200.0)
-    if kind == "cycle":
+    if kind == "swing":  # a housing warming up once: most of the change within the first eighth of the record
+        x = -np.exp(-t / (span / 25.0)) + 0.1 * wander / max(np.ptp(wander), 1e-300)
+    elif kind == "cycle":
         period = span / 3.0
         wander = 0.25 * wander / max(np.ptp(wander), 1e-300)
         x = np.sin(2 * np.pi * t / period - 0.5 * np.pi) + wander
@@ -181,7 +185,13 @@ def make(case: Case):
     t = np.arange(case.n) / case.fs
     noise = dict(case.noise)
     n_white = noise.pop("N", 0.0)
+    b = noise.pop("B", 0.0)
     y = allanite.simulate(case.n, case.fs, seed=rng, **noise)
+    if b:
+        # stationary flicker: Kasdin–Walter over up to 8× the record, its last part kept (started at the record's
+        # first sample, the fractional integration lacks the power of f ≲ 10/T: −15 % Allan variance at T/9)
+        pad = max(2, min(8, 2**25 // case.n))
+        y = y + b * kasdin_walter(pad * case.n, 1.0, rng)[-case.n :]
     white = rng.standard_normal(case.n) * (n_white * math.sqrt(case.fs))
     channels: dict = {}
     case.injected = []
@@ -221,6 +231,16 @@ CASES = [
         [("temperature", {"coefficient": 4.5e-4, "profile": "cycle"})],
         unit="rad/s",
         seed=1,
+        ci=True,
+    ),
+    Case(
+        "temperature swinging once, 1 Hz × 25 h",
+        1.0,
+        90_000,
+        {"N": 1.5e-3, "B": 2e-4, "K": 2e-6},
+        [("temperature", {"coefficient": 4.5e-4, "profile": "swing"})],
+        unit="rad/s",
+        seed=17,
         ci=True,
     ),
     Case(

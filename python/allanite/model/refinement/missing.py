@@ -11,7 +11,7 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   non-negative column, the maximum over every curve candidate's family — sinusoids' nulls included — and the
   start terms' own columns, bootstrapped under the final model); the region is where the winning column, with
   the model's fitted directions projected out, carries its weight, and further regions follow with the winner
-  added to the model, at the same threshold. With samples the frequency band is refined on the PSD of the
+  added to the model, at the same threshold (reported where the dense curve's χ²/dof there exceeds 1). With samples the frequency band is refined on the PSD of the
   final residual samples: the part of ≈ 1/(2τ_hi) … 1/(2τ_lo) (widened ×2) that stands above the spectrum's
   running median.
 - ``"psd"`` — spectral lines of the final samples (:func:`allanite.model.tracing.spectral_lines`) that no
@@ -102,6 +102,9 @@ def _curve(ctx: MissingContext, a: float) -> list[dict]:
             break
         i, j = _region_of(test, fam[:, c])
         lo, hi = float(sub.tau[i]), float(sub.tau[j])
+        test = _with_column(test, fam[:, c])
+        if out and not _chi2_dof(ctx, lo, hi) > 1.0:
+            continue  # a further column the residual leans on, where the curve itself is within its scatter
         out.append(
             {
                 "domain": "allan",
@@ -114,7 +117,6 @@ def _curve(ctx: MissingContext, a: float) -> list[dict]:
                 "alpha": a,
             }
         )
-        test = _with_column(test, fam[:, c])
     return out
 
 
@@ -163,7 +165,7 @@ def _lines(ctx: MissingContext, a: float) -> list[dict]:
         return []
     have = [p for k, p in ctx.effects if base_name(k) == "sinusoid"]
     out = []
-    for ln in tracing.spectral_lines(ctx.y, ctx.fs, a):
+    for ln in tracing.spectral_lines(ctx.y, ctx.fs, a, max_lines=len(have) + 4):
         if any(abs(ln["f0"] - f) <= 2 * ln["bin_hz"] for f in have):
             continue
         f0 = float(ln["f0"])
