@@ -16,7 +16,7 @@ Covariance of the means b_i of blocks [s_i, e_i) of w_i = e_i − s_i seconds (t
   K²·(s_i + e_i)/2 off it (i < j);
 - flicker B (S = B²/(2πf)): a sum of Gauss–Markov processes with correlation times spaced by e^{1/2} from a
   twentieth of a block to 10 record lengths, each of variance B²·ln(e^{1/2})/π (their Lorentzians add up to
-  B²/(2πf) across the band); a GM of time constant T adds σ²·[T(1 − e^{−w_i/T})][T(1 − e^{−w_j/T})]·
+  B²/(2πf) across the band); a GM of time constant T adds σ²·T²(1 − e^{−w_i/T})(1 − e^{−w_j/T})·
   e^{−(s_j − e_i)/T}/(w_i w_j) off the diagonal and σ²·2T(w − T(1 − e^{−w/T}))/w² on it;
 - a ramp R·t of unknown sign: a random slope of variance R², R²·(t_i − t̄)(t_j − t̄) — not a free column, which
   a long T would trade against.
