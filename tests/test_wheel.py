@@ -102,8 +102,11 @@ def test_the_wheel_installs_and_runs_without_rust(wheel, tmp_path):
     env.update(PATH=path, VIRTUAL_ENV=str(venv))
     assert shutil.which("cargo", path=path) is None and shutil.which("rustc", path=path) is None
     python = str(venv / "bin" / "python")
-    # this environment's pip installs into the venv (``--python``), which saves the venv a pip of its own
-    pip = [sys.executable, "-m", "pip", "--python", python, "install", "-q", "--no-deps", "--no-index", str(wheel)]
+    # this environment's pip installs into the venv (``--python``), which saves the venv a pip of its own;
+    # --ignore-installed: the venv sees this environment's allanite (the same version), which pip would otherwise
+    # call "already satisfied" and leave the venv without its own copy
+    pip = [sys.executable, "-m", "pip", "--python", python, "install", "-q", "--no-deps", "--no-index",
+           "--ignore-installed", str(wheel)]
     subprocess.run(pip, check=True, env=env, cwd=tmp_path)
     code = (
         "import sys, numpy as np, allanite\n"
@@ -112,7 +115,8 @@ def test_the_wheel_installs_and_runs_without_rust(wheel, tmp_path):
         "r = allanite.avar(y, 100.0, taus=[1.0])\n"
         "print(f'{r.adev[0]:.2e}')\n"
     )
-    out = subprocess.run([python, "-c", code], check=True, env=env, cwd=tmp_path, capture_output=True, text=True)
+    out = subprocess.run([python, "-c", code], env=env, cwd=tmp_path, capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
     assert abs(float(out.stdout) / 2e-3 - 1) < 0.05  # white rate noise: ADEV(1 s) = N
     cli = subprocess.run(
         [str(venv / "bin" / "allanite"), "report", "--help"], env=env, cwd=tmp_path, capture_output=True, text=True
