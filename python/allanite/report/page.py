@@ -15,6 +15,7 @@ from typing import Any
 import jinja2
 
 from .._core import __version__
+from ..model.effects import format_param
 from .fmt import duration, g
 from .forecasting import forecast_page
 from .paper002 import page_context as paper002_page
@@ -243,10 +244,15 @@ def _heldout(st: dict) -> str:
     return f"{g(a, 3)} → {g(b, 3)} %"
 
 
+def _params(st: dict, key: str, ikey: str) -> str:
+    """A step's parameters (strings, ints, numbers, lists) with units and intervals wherever they have one."""
+    return "; ".join(format_param(p, v, st[ikey].get(p), st["units"].get(p, ""), 3) for p, v in st[key].items())
+
+
 def _refinement(ref: dict | None) -> dict | None:
     if ref is None:
         return None
-    curve_rows, change_rows, summary_rows = [], [], []
+    curve_rows, change_rows, summary_rows, move_rows = [], [], [], []
     for ax in ref["axes"]:
         if ax.get("error"):
             summary_rows.append([ax["name"], "failed", "", "", ""])
@@ -260,31 +266,28 @@ def _refinement(ref: dict | None) -> dict | None:
                 ax["tau_from_s"] is not None and f"{g(ax['tau_from_s'])} s" or "",
             ]
         )
+        move_rows += [[ax["name"], m["text"]] for m in ax.get("term_moves", [])]
         for st in ax["steps"]:
-            params = "; ".join(
-                f"{p} = {v}"
-                if isinstance(v, str)
-                else (
-                    f"{p} = {g(v, 3)} [{g(st['intervals'][p][0], 3)}, {g(st['intervals'][p][1], 3)}]"
-                    if p in st["intervals"]
-                    else f"{p} = {g(v, 3)}"
-                )
-                for p, v in st["params"].items()
+            curve_rows.append(
+                [
+                    ax["name"],
+                    st["effect"],
+                    _params(st, "params", "intervals"),
+                    _params(st, "final_params", "final_intervals"),
+                    f"{g(st['before']['chi2_dof'], 3)} → {g(st['after']['chi2_dof'], 3)}",
+                    f"{g(st['before']['rms_adev_pct'], 3)} → {g(st['after']['rms_adev_pct'], 3)} %",
+                    _heldout(st),
+                ]
             )
-            if st["statistic"] == "allan_curve":
-                curve_rows.append(
+            if "window_levels" in st:
+                w = st["window_levels"]
+                change_rows.append(
                     [
                         ax["name"],
-                        st["effect"],
-                        params,
-                        f"{g(st['before']['chi2_dof'], 3)} → {g(st['after']['chi2_dof'], 3)}",
-                        f"{g(st['before']['rms_adev_pct'], 3)} → {g(st['after']['rms_adev_pct'], 3)} %",
-                        _heldout(st),
+                        _params(st, "params", "intervals"),
+                        f"{g(w['before']['chi2_dof'], 3)} → {g(w['after']['chi2_dof'], 3)}",
+                        _heldout({"before": w["before"], "after": w["after"]}),
                     ]
-                )
-            else:
-                change_rows.append(
-                    [ax["name"], params, f"{g(st['before']['chi2_dof'], 3)} → {g(st['after']['chi2_dof'], 3)}"]
                 )
     tables = [
         _table(
@@ -298,14 +301,15 @@ def _refinement(ref: dict | None) -> dict | None:
             _table(
                 [
                     "axis",
-                    "effect on the Allan curve",
-                    "parameters",
+                    "effect",
+                    "parameters at acceptance",
+                    "after the final joint refit",
                     "χ²/dof before → after",
                     "RMS ADEV error before → after",
                     "held-out RMS ADEV error before → after",
                 ],
                 curve_rows,
-                left=3,
+                left=4,
             )
         )
     if change_rows:
@@ -315,20 +319,26 @@ def _refinement(ref: dict | None) -> dict | None:
                     "axis",
                     "change of noise level at",
                     "window-level χ²/dof: one level → levels split at every change found",
+                    "held out per segment: one-level model → each segment's own",
                 ],
                 change_rows,
                 left=2,
             )
+        )
+    if move_rows:
+        tables.append(
+            _table(["axis", "a term the refinement moved outside the plain fit's interval"], move_rows, left=2)
         )
     return {
         "candidates": ref["candidates"],
         "units": ref["units"],
         "tables": tables,
         "chi2_note": (
-            "Curve effects are judged on the Allan curve (χ²/dof weighting each τ of a dense curve "
-            "independently — not the fit table's χ²/dof, which accounts for the correlation between τ); "
-            "changes of level along the record on the Allan variances of 16 windows (their own χ² "
-            "scale), so they do not change the curve's start → final numbers."
+            "Every step is scored on the record's own Allan curve, a component removed in time part of the model "
+            "through what it changed in the curve, so each step's before is the previous step's after (χ²/dof "
+            "weights each τ of a dense curve independently — not the fit table's χ²/dof, which accounts for the "
+            "correlation between τ). A change of noise level leaves the record's curve as it is: it was found "
+            "and is judged on the Allan variances of 16 windows along the record (their own χ² scale)."
         ),
     }
 

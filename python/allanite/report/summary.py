@@ -8,7 +8,8 @@ import numpy as np
 
 from .._core import __version__
 from ..estimators import get as get_estimator
-from ..model.effects import EFFECTS
+from ..model.effects import EFFECTS, format_param, param_units
+from ..model.refinement.result import term_move_text
 from ..model.terms import TERM_NAMES
 from ..units import coefficient_unit, ieee952
 from .fmt import duration, g, json_list, json_number, pct
@@ -29,9 +30,10 @@ def _fit_errors(f, r) -> dict:
 
 
 def refinement_dict(rep) -> dict | None:
-    """The refinement of every axis: the curve fit's errors at the start and at the end, and each step —
-    curve effects judged on the Allan curve, changes of level on the Allan variances of windows along
-    the record (``statistic`` says which: the two are on different χ² scales)."""
+    """The refinement of every axis: the curve fit's errors at the start and at the end, and each step with its
+    errors before → after on the record's Allan curve (each step's before is the previous step's after);
+    ``statistic`` says what accepted it — the Allan curve, or for a change of level the Allan variances of
+    windows along the record (a different χ² scale, its numbers under ``window_levels``)."""
     if rep.refinements is None:
         return None
     rate = rep.adev_unit or "rate unit"
@@ -50,20 +52,19 @@ def refinement_dict(rep) -> dict | None:
                 "start_heldout_rms_adev_pct": json_number(r.start_heldout_rms_adev_pct),
                 "heldout_note": r.heldout_note,
                 "final": _fit_errors(r.fit, r),
-                "steps": [
+                "term_moves": [
                     {
-                        "effect": st.effect,
-                        "statistic": "window_levels" if st.effect == "change_point" else "allan_curve",
-                        "domain": EFFECTS[st.effect].domain,
-                        "params": {p: v if isinstance(v, str) else json_number(v) for p, v in st.params.items()},
-                        "units": {p: rate if u == "rate unit" else u for p, u, _ in EFFECTS[st.effect].params},
-                        "intervals": {p: [json_number(a), json_number(b)] for p, (a, b) in st.intervals.items()},
-                        "before": {q: json_number(v) for q, v in st.before.items()},
-                        "after": {q: json_number(v) for q, v in st.after.items()},
-                        "test": _jsonable_test(st.evidence.get("test")),
+                        "term": m["term"],
+                        "start": json_number(m["start"]),
+                        "start_interval": _json_value(m["start_interval"]),
+                        "final": json_number(m["final"]),
+                        "final_interval": _json_value(m["final_interval"]),
+                        "moved_by": [{k: _json_value(v) for k, v in mv.items()} for mv in m["moves"]],
+                        "text": term_move_text(m, r.fit.unit),
                     }
-                    for st in r.steps
+                    for m in r.term_moves
                 ],
+                "steps": [_step_dict(st, rate) for st in r.steps],
             }
         )
     curve = [e for e in EFFECTS.values() if e.kind == "curve"]
@@ -75,18 +76,59 @@ def refinement_dict(rep) -> dict | None:
         "lowers the held-out error (fit on the odd blocks of the record, predict the even ones, and back)",
         "candidates": f"{' / '.join(e.label for e in curve)} signatures in the Allan curve, or "
         + " or ".join(f"{e.label} along the record" for e in timed),
-        "units": "; ".join(f"{e.name}: " + ", ".join(f"{p} in {u}" for p, u, _ in e.params) for e in EFFECTS.values()),
+        "units": "; ".join(
+            f"{e.name}: " + ", ".join(f"{p} in {u}" if u else p for p, u in param_units(e.name, rate).items())
+            for e in EFFECTS.values()
+        ),
         "statistics": {
-            "allan_curve": "before/after: χ²/dof and RMS z of the Allan-curve fit (each τ of the dense curve weighted "
-            "independently), RMS ADEV error (%) on 4 τ per octave whose estimate is within ±10 %; "
-            "heldout_rms_adev_pct: the model fitted on alternate blocks (8, joined) predicting the other blocks' "
-            "curve, both ways (null for curve-only input)",
-            "window_levels": "before/after: one level vs piecewise levels (split at every change found) of the "
-            "log Allan variances of 16 windows along the record; held out per segment (each segment's alternate "
-            "blocks predicted by its own model vs the one-level model)",
+            "allan_curve": "every step's before/after, on the record's own Allan curve (a component removed in "
+            "time is part of the model through what it changed in the curve, AVAR(y) − AVAR(y − component)), so "
+            "that each step's before is the previous step's after: χ²/dof and RMS z of the Allan-curve fit (each "
+            "τ of the dense curve weighted independently), RMS ADEV error (%) on 4 τ per octave whose estimate is "
+            "within ±10 %; heldout_rms_adev_pct: the model fitted on alternate blocks (8, joined; removals refitted "
+            "on them) predicting the other blocks' curve, both ways (null for curve-only input). A change of noise "
+            "level leaves the curve as it is (before = after)",
+            "window_levels": "what accepted a change point (its step's window_levels): one level vs piecewise "
+            "levels (split at every change found) of the log Allan variances of 16 windows along the record; held "
+            "out per segment (each segment's alternate blocks predicted by its own model vs the one-level model)",
         },
         "axes": axes,
     }
+
+
+def _json_value(v):
+    """A parameter or an interval as JSON: strings as they are, numbers (NaN/inf → null), lists and pairs as
+    arrays (a list parameter's intervals: one pair per entry)."""
+    if isinstance(v, str):
+        return v
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return [_json_value(x) for x in v]
+    return json_number(v)
+
+
+def _step_dict(st, rate) -> dict:
+    """One refinement step as JSON: its parameters at acceptance and after the final joint refit, with units
+    and intervals; before/after on the record's Allan curve (each step's before the previous step's after);
+    the test that accepted it; a change point's window-level statistic."""
+    fp, fi = (st.final_params, st.final_intervals) if st.final_params else (st.params, st.intervals)
+    out = {
+        "effect": st.effect,
+        "statistic": "window_levels" if st.effect == "change_point" else "allan_curve",
+        "domain": EFFECTS[st.effect].domain if st.effect in EFFECTS else None,
+        "params": {p: _json_value(v) for p, v in st.params.items()},
+        "final_params": {p: _json_value(v) for p, v in fp.items()},
+        "units": param_units(st.effect, rate),
+        "intervals": {p: _json_value(iv) for p, iv in st.intervals.items()},
+        "final_intervals": {p: _json_value(iv) for p, iv in fi.items()},
+        "before": {q: json_number(v) for q, v in st.before.items()},
+        "after": {q: json_number(v) for q, v in st.after.items()},
+        "test": _jsonable_test(st.evidence.get("test")),
+    }
+    if "window_levels" in st.evidence:
+        out["window_levels"] = {
+            k: {q: json_number(v) for q, v in d.items()} for k, d in st.evidence["window_levels"].items()
+        }
+    return out
 
 
 def _jsonable_test(t):
@@ -446,10 +488,10 @@ def text_summary(s: dict) -> str:
             )
             for st in ax["steps"]:
                 params = ", ".join(
-                    f"{p} = {v}" if isinstance(v, str) else f"{p} = {g(v, 3)} {st['units'][p]}".rstrip()
-                    for p, v in st["params"].items()
+                    format_param(p, v, None, st["units"].get(p, ""), 3) for p, v in st["final_params"].items()
                 )
                 lines.append(f"    {st['effect']}: {params}")
+            lines += [f"    {m['text']}" for m in ax.get("term_moves", [])]
     lines += forecast_text(s.get("forecast"))
     lines += paper002_text(s.get("paper002"))
     return "\n".join(lines)
