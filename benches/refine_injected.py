@@ -206,13 +206,19 @@ def run(quick: bool, out: Path) -> dict:
             if st.effect not in truth:
                 continue
             errs = st.truth_error or {}
+            before, after = st.before, st.after
+            if "window_levels" in st.evidence:  # a change point: what found it, on the windows' levels
+                w, ho = st.evidence["window_levels"], st.evidence.get("heldout_test") or {}
+                before = w["before"] | {"heldout_rms_adev_pct": ho.get("before")}
+                after = w["after"] | {"heldout_rms_adev_pct": ho.get("after")}
             steps.append(
                 {
                     "effect": st.effect,
                     "params": {k: v if isinstance(v, str) else float(v) for k, v in st.params.items()},
+                    "final_params": {k: v if isinstance(v, str) else float(v) for k, v in st.final_params.items()},
                     "truth_error": {k: float(v) for k, v in errs.items()},
-                    "before": {k: st.before.get(k) for k in ("chi2_dof", "rms_adev_pct", "heldout_rms_adev_pct")},
-                    "after": {k: st.after.get(k) for k in ("chi2_dof", "rms_adev_pct", "heldout_rms_adev_pct")},
+                    "before": {k: before.get(k) for k in ("chi2_dof", "rms_adev_pct", "heldout_rms_adev_pct")},
+                    "after": {k: after.get(k) for k in ("chi2_dof", "rms_adev_pct", "heldout_rms_adev_pct")},
                 }
             )
         missed = sorted(set(truth) - {s["effect"] for s in steps})
@@ -226,8 +232,12 @@ def run(quick: bool, out: Path) -> dict:
         "",
         "Written by `benches/refine_injected.py`. Each record holds effects the five-term model lacks; "
         "`refine(y, 100.0)` (with `channels=` for the g-sensitivity rows). Per injected effect: its parameter "
-        "errors against the truth (change point: distance as a fraction of the record) and its step's χ²/dof, "
-        "in-sample RMS ADEV error and held-out RMS ADEV error (alternate blocks) before → after.",
+        "errors against the truth (change point: distance as a fraction of the record; amplitudes from the final "
+        "joint refit, a spectral line's from the samples) and its step's χ²/dof, in-sample RMS ADEV error and "
+        "held-out RMS ADEV error (alternate blocks) before → after, on the record's Allan curve (each step's "
+        "before is the previous step's after; a removal in time is part of the model through what it changed in "
+        "the curve). A change point leaves that curve as it is: its row shows what found it, the Allan variance "
+        "of 16 windows against one level vs piecewise levels, held out per segment.",
         "",
         "| record | found | injected effect | parameter errors | χ²/dof | RMS ADEV % | held-out RMS ADEV % |",
         "|---|---|---|---|---|---|---|",

@@ -30,6 +30,7 @@ import numpy as np
 import _common
 import allanite
 from _common import load_avar_curve
+from allanite.model.effects import format_param
 
 HERE = Path(__file__).resolve().parent
 
@@ -49,16 +50,21 @@ def summarize(name, r) -> dict:
         "steps": [],
     }
     for st in r.steps:
-        row["steps"].append(
-            {
-                "effect": st.effect,
-                "params": {k: (v if isinstance(v, str) else float(v)) for k, v in st.params.items()},
-                "intervals": {k: [float(a), float(b)] for k, (a, b) in st.intervals.items()},
-                "before": st.before,
-                "after": st.after,
-                "evidence": _jsonable(st.evidence),
-            }
-        )
+        step = {
+            "effect": st.effect,
+            "params": _jsonable(st.params),
+            "intervals": _jsonable(st.intervals),
+            "final_params": _jsonable(st.final_params),
+            "final_intervals": _jsonable(st.final_intervals),
+            "before": st.before,
+            "after": st.after,
+            "evidence": _jsonable(st.evidence),
+        }
+        if "window_levels" in st.evidence:  # a change point: what found it, on the windows' levels
+            w, ho = st.evidence["window_levels"], st.evidence.get("heldout_test") or {}
+            step["before"] = w["before"] | {"heldout_rms_adev_pct": ho.get("before")}
+            step["after"] = w["after"] | {"heldout_rms_adev_pct": ho.get("after")}
+        row["steps"].append(step)
     return row
 
 
@@ -116,15 +122,14 @@ def run(quick: bool, out: Path) -> dict:
 
 
 def _fmt_params(st):
-    out = []
-    for k, v in st["params"].items():
-        if isinstance(v, str):
-            out.append(f"{k} = {v}")
-        elif k in st["intervals"]:
-            out.append(f"{k} = {v:.3g} [{st['intervals'][k][0]:.3g}, {st['intervals'][k][1]:.3g}]")
-        else:
-            out.append(f"{k} = {v:.3g}")
-    return "; ".join(out)
+    """Parameters at acceptance with their intervals; where the final joint refit changed one, its final value
+    after "→ final:" (units: the table's header)."""
+    out = "; ".join(format_param(k, v, st["intervals"].get(k), "", 3) for k, v in st["params"].items())
+    fp, fi = st.get("final_params") or {}, st.get("final_intervals") or {}
+    changed = [k for k, v in fp.items() if v != st["params"].get(k) or fi.get(k) != st["intervals"].get(k)]
+    if changed:
+        out += " → final: " + "; ".join(format_param(k, fp[k], fi.get(k), "", 3) for k in changed)
+    return out
 
 
 def _ho(d):
@@ -138,12 +143,14 @@ def write_md(rows, path: Path) -> None:
         "",
         "Written by `benches/refine_measured.py`. Per record: the five-term model's residual, what it was traced to, "
         "the parameters added (input unit's base form: σ and amplitude in the rate unit — °/s for gyros, g for "
-        "accelerometers —, T_c and t in s, f0 and cutoff in Hz) and the error before → after: χ²/dof of the "
-        "normalised residuals, RMS of the ADEV error in % (4 τ per octave whose estimate is within ±10 %) "
-        "in-sample and held out (8 alternate blocks: fit on the odd ones, predict the even ones' curve and back; "
-        "n/a for curves without samples). Default call `refine(x, 100.0)` / `refine(curve)`: all τ. Change "
-        "points are tested on 16 non-overlapping windows (ADIS only); their in-sample before/after is the "
-        "windows' Allan variance against one level vs piecewise levels, held out per segment.",
+        'accelerometers —, T_c and t in s, f0 and cutoff in Hz; at acceptance, and after "→ final:" what the '
+        "final joint refit changed) and the error before → after on the record's Allan curve (each step's before "
+        "is the previous step's after): χ²/dof of the normalised residuals, RMS of the ADEV error in % (4 τ per "
+        "octave whose estimate is within ±10 %) in-sample and held out (8 alternate blocks: fit on the odd ones, "
+        "predict the even ones' curve and back; n/a for curves without samples). Default call `refine(x, 100.0)` "
+        "/ `refine(curve)`: all τ. Change points are tested on 16 non-overlapping windows (ADIS only); they leave "
+        "the record's curve as it is, and their rows show what found them: the windows' Allan variance against "
+        "one level vs piecewise levels, held out per segment.",
         "",
         "| record | five-term χ²/dof | RMS ADEV err (held out) | traced to | parameters | χ²/dof before → after "
         "| RMS ADEV err before → after | held-out err before → after |",

@@ -157,13 +157,14 @@ def test_finds_a_warm_up_drift_injected_into_adis_noise(shared_data):
     (y,) = _adis(shared_data, 3, ["gyro_x"])
     t = np.arange(y.size) / FS
     r = allanite.refine(y + 0.2 * np.exp(-t / 600.0), FS, truth={"drift": {"amplitude": 0.2, "T": 600.0}})
-    assert r.found[0] == "drift"
-    st = r.steps[0]
+    assert "drift" in r.found
+    st = next(s for s in r.steps if s.effect == "drift")
     assert abs(st.truth_error["T"]) < 0.2 and abs(st.truth_error["amplitude"]) < 0.2
     lo, hi = st.intervals["T"]
     assert lo < st.params["T"] < hi
-    # scored against the final model (bandwidth and what follows), with and without the drift
-    assert st.evidence["scored_with"] == r.found[1 : 1 + len(r.effects)]
+    # removed before the curve effects were searched; on the chain it comes after them and is scored with them
+    # (bandwidth and what follows) in the model, with and without the drift
+    assert r.found[: len(r.effects)] == st.evidence["scored_with"] and r.found[len(r.effects)] == "drift"
     _falls(st)
 
 
@@ -334,7 +335,9 @@ def test_adis_gauss_markov_and_multi_position_g_sensitivity_at_once(shared_data)
         "regression": {"coefficient": _within(0.03 * tumble + base * az, ch) / _within(ch, ch)},
     }
     r = allanite.refine(y, FS, channels={"acc_z": ch}, truth=truth)
-    assert r.found[0] == "regression" and "gauss_markov" in r.found
+    assert "regression" in r.found and "gauss_markov" in r.found
+    # searched first, scored after the curve effects (the chain's order): with the Gauss–Markov term in the model
+    assert "gauss_markov" in next(s for s in r.steps if s.effect == "regression").evidence["scored_with"]
     for effect in ("regression", "gauss_markov"):
         st = next(s for s in r.steps if s.effect == effect)
         assert all(abs(v) < 0.2 for v in st.truth_error.values()), (effect, st.truth_error)

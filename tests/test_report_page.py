@@ -122,8 +122,8 @@ def test_parameters_that_are_strings_lists_or_ints_render():
     }
     text = step_params(step, 100.0, 3000.0, units=True, intervals=True)
     assert text == (
-        "channel = temperature; coefficient = 0.0123 °/s per channel unit [0.011, 0.0136]; taps = 7 samples; "
-        "bands = [1.5, 3, x]"
+        "channel = temperature; coefficient = 0.0123 [0.011, 0.0136] °/s per channel unit; taps = 7 samples; "
+        "bands = 1.5, 3, x"
     )
     assert num(1234.6, 3) == "1235" and num(0.5) == "0.5" and num(3.7e-5) == "3.7e-05"
     assert param_text(None) == "—" and param_text(np.int64(4)) == "4"

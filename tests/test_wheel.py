@@ -105,8 +105,19 @@ def test_the_wheel_installs_and_runs_without_rust(wheel, tmp_path):
     # this environment's pip installs into the venv (``--python``), which saves the venv a pip of its own;
     # --ignore-installed: the venv sees this environment's allanite (the same version), which pip would otherwise
     # call "already satisfied" and leave the venv without its own copy
-    pip = [sys.executable, "-m", "pip", "--python", python, "install", "-q", "--no-deps", "--no-index",
-           "--ignore-installed", str(wheel)]
+    pip = [
+        sys.executable,
+        "-m",
+        "pip",
+        "--python",
+        python,
+        "install",
+        "-q",
+        "--no-deps",
+        "--no-index",
+        "--ignore-installed",
+        str(wheel),
+    ]
     subprocess.run(pip, check=True, env=env, cwd=tmp_path)
     code = (
         "import sys, numpy as np, allanite\n"

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -24,6 +25,9 @@ __all__ = [
     "filter_cutoff",
     "drift_avar",
     "describe",
+    "param_units",
+    "format_param",
+    "format_params",
     "FILTERS",
     "CASCADE_SPANS",
     "RESONANCE_Q",
@@ -334,3 +338,67 @@ def describe() -> str:
         params = ", ".join(f"``{n}`` ({u})" for n, u, _ in e.params)
         lines.append(f"        - ``{e.name!r}`` — {params}: {e.description}.")
     return "\n".join(lines)
+
+
+def param_units(name: str, rate_unit: str | None = None) -> dict:
+    """Each parameter's unit for effect ``name`` (as :data:`EFFECTS` states it), "rate unit" spelled as
+    ``rate_unit`` when known; {} for a name the registry does not hold."""
+    if name not in EFFECTS:
+        return {}
+    rate = rate_unit or "rate unit"
+    return {p: u.replace("rate unit", rate) for p, u, _ in EFFECTS[name].params}
+
+
+def _number(v: Any, digits: int) -> str:
+    if v is None:
+        return "—"
+    if isinstance(v, str):
+        return v
+    if isinstance(v, (bool, np.bool_)):
+        return str(bool(v))
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    f = float(v)
+    if math.isnan(f):
+        return "NaN"
+    if math.isinf(f):
+        return "∞" if f > 0 else "−∞"
+    return f"{f:.{digits}g}"
+
+
+def _is_pair(iv: Any) -> bool:
+    return (
+        isinstance(iv, (tuple, list, np.ndarray))
+        and len(iv) == 2
+        and all(isinstance(x, (int, float, np.integer, np.floating)) for x in iv)
+    )
+
+
+def _with_interval(v: Any, iv: Any, digits: int) -> str:
+    text = _number(v, digits)
+    return f"{text} [{_number(iv[0], digits)}, {_number(iv[1], digits)}]" if _is_pair(iv) else text
+
+
+def format_param(name: str, value: Any, interval: Any = None, unit: str = "", digits: int = 4) -> str:
+    """``name = value [low, high] unit`` for any parameter a step reports: a string (a filter kind, a
+    channel's name), an int (taps, a count of lines), a number, or a list of numbers (e.g. fundamentals, with
+    ``interval`` one (low, high) per entry); the interval only where there is one."""
+    u = f" {unit}" if unit else ""
+    if isinstance(value, str):
+        return f"{name} = {value}"
+    if isinstance(value, (list, tuple, np.ndarray)):
+        values = list(value)
+        ivs = list(interval) if isinstance(interval, (list, tuple)) and len(interval) == len(values) else []
+        ivs = ivs if all(_is_pair(iv) for iv in ivs) else []
+        text = ", ".join(_with_interval(v, ivs[i] if ivs else None, digits) for i, v in enumerate(values))
+        return f"{name} = {text or 'none'}{u}"
+    if value is None or isinstance(value, (bool, np.bool_)):
+        return f"{name} = {_number(value, digits)}"
+    return f"{name} = {_with_interval(value, interval, digits)}{u}"
+
+
+def format_params(name: str, params: dict, intervals: dict, rate_unit: str | None = None, digits: int = 4) -> str:
+    """Every parameter of a step of effect ``name``, with its interval where it has one and its unit from the
+    registry, ``"; "``-separated."""
+    units = param_units(name, rate_unit)
+    return "; ".join(format_param(k, v, (intervals or {}).get(k), units.get(k, ""), digits) for k, v in params.items())

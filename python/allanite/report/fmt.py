@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from ..model.effects import format_param
+
 __all__ = [
     "json_number",
     "json_list",
@@ -126,24 +128,25 @@ def clock(t, fs=None, long: bool = False, unit: bool = True) -> str:
 LONG_RECORD_S = 3600.0
 
 
-def step_params(st: dict, fs, duration_s, *, units: bool = False, intervals: bool = False) -> str:
-    """The parameters of a refinement step (one ``summary.json`` step) as ``"p = v unit [lo, hi]"``
-    joined by "; ". The time of a change point is a time along the record, to the sample
-    (:func:`clock`); strings, ints and lists are shown as they are (:func:`param_text`)."""
+def step_params(st: dict, fs, duration_s, *, units: bool = False, intervals: bool = False, final: bool = False) -> str:
+    """The parameters of a refinement step (one ``summary.json`` step) as ``"p = v [lo, hi] unit"``
+    joined by "; " — at acceptance, or after the final joint refit (``final``). The time of a change point is a
+    time along the record, to the sample (:func:`clock`); strings, ints and lists (one interval per entry) as
+    :func:`allanite.model.effects.format_param` writes them."""
     long = duration_s is not None and duration_s > LONG_RECORD_S
+    use_final = final and st.get("final_params")
+    pkey, ikey = ("final_params", "final_intervals") if use_final else ("params", "intervals")
     parts = []
-    for p, v in st["params"].items():
-        unit = st.get("units", {}).get(p) or ""
-        iv = st.get("intervals", {}).get(p) if intervals else None
+    for p, v in st[pkey].items():
+        unit = (st.get("units", {}).get(p) or "") if units else ""
+        iv = st.get(ikey, {}).get(p) if intervals else None
         if st.get("statistic") == "window_levels" and p == "t" and not isinstance(v, (str, list)):
             text = clock(v, fs, long, unit=units)
             if iv is not None:
                 text += f" [{clock(iv[0], fs, long, unit=False)}, {clock(iv[1], fs, long, unit=False)}]"
+            parts.append(f"{p} = {text}")
         else:
-            text = param_text(v) + (f" {unit}" if units and unit and not isinstance(v, str) else "")
-            if iv is not None:
-                text += f" [{param_text(iv[0])}, {param_text(iv[1]) if iv[1] is not None else '∞'}]"
-        parts.append(f"{p} = {text}")
+            parts.append(format_param(p, v, iv, unit, 3))
     return "; ".join(parts)
 
 

@@ -254,7 +254,7 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
     if ref is None:
         return None
     fs, duration_s = rec["fs_hz"], rec["duration_s"]
-    curve_rows, change_rows, summary_rows = [], [], []
+    curve_rows, change_rows, summary_rows, move_rows = [], [], [], []
     for ax in ref["axes"]:
         if ax.get("error"):
             summary_rows.append([ax["name"], "failed (see the notes)", "—", "—", "—"])
@@ -268,22 +268,28 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
                 f"{g(ax['tau_from_s'])} s" if ax["tau_from_s"] is not None else "—",
             ]
         )
+        move_rows += [[ax["name"], m["text"]] for m in ax.get("term_moves", [])]
         for st in ax["steps"]:
-            params = step_params(st, fs, duration_s, units=True, intervals=True)
-            if st["statistic"] == "allan_curve":
-                curve_rows.append(
+            curve_rows.append(
+                [
+                    ax["name"],
+                    st["effect"],
+                    step_params(st, fs, duration_s, units=True, intervals=True),
+                    step_params(st, fs, duration_s, units=True, intervals=True, final=True),
+                    f"{g(st['before']['chi2_dof'], 3)} → {g(st['after']['chi2_dof'], 3)}",
+                    f"{g(st['before']['rms_adev_pct'], 3)} → {g(st['after']['rms_adev_pct'], 3)} %",
+                    _heldout(st),
+                ]
+            )
+            if "window_levels" in st:
+                w = st["window_levels"]
+                change_rows.append(
                     [
                         ax["name"],
-                        st["effect"],
-                        params,
-                        f"{g(st['before']['chi2_dof'], 3)} → {g(st['after']['chi2_dof'], 3)}",
-                        f"{g(st['before']['rms_adev_pct'], 3)} → {g(st['after']['rms_adev_pct'], 3)} %",
-                        _heldout(st),
+                        step_params(st, fs, duration_s, units=True, intervals=True),
+                        f"{g(w['before']['chi2_dof'], 3)} → {g(w['after']['chi2_dof'], 3)}",
+                        _heldout({"before": w["before"], "after": w["after"]}),
                     ]
-                )
-            else:
-                change_rows.append(
-                    [ax["name"], params, f"{g(st['before']['chi2_dof'], 3)} → {g(st['after']['chi2_dof'], 3)}"]
                 )
     tables = [
         _table(
@@ -297,14 +303,15 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
             _table(
                 [
                     "axis",
-                    "effect on the Allan curve",
-                    "parameters",
+                    "effect",
+                    "parameters at acceptance",
+                    "after the final joint refit",
                     "χ²/dof before → after",
                     "RMS ADEV error before → after",
                     "held-out RMS ADEV error before → after",
                 ],
                 curve_rows,
-                left=3,
+                left=4,
             )
         )
     if change_rows:
@@ -314,20 +321,26 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
                     "axis",
                     "change of noise level at",
                     "window-level χ²/dof: one level → levels split at every change found",
+                    "held out per segment: one-level model → each segment's own",
                 ],
                 change_rows,
                 left=2,
             )
+        )
+    if move_rows:
+        tables.append(
+            _table(["axis", "a term the refinement moved outside the plain fit's interval"], move_rows, left=2)
         )
     return {
         "candidates": ref["candidates"],
         "units": ref["units"],
         "tables": tables,
         "chi2_note": (
-            "Curve effects are judged on the Allan curve (χ²/dof weighting each τ of a dense curve "
-            "independently — not the fit table's χ²/dof, which accounts for the correlation between τ); "
-            "changes of level along the record on the Allan variances of 16 windows (their own χ² "
-            "scale), so they do not change the curve's start → final numbers."
+            "Every step is scored on the record's own Allan curve, a component removed in time part of the model "
+            "through what it changed in the curve, so each step's before is the previous step's after (χ²/dof "
+            "weights each τ of a dense curve independently — not the fit table's χ²/dof, which accounts for the "
+            "correlation between τ). A change of noise level leaves the record's curve as it is: it was found "
+            "and is judged on the Allan variances of 16 windows along the record (their own χ² scale)."
         ),
     }
 

@@ -8,7 +8,8 @@ import numpy as np
 
 from .._core import __version__
 from ..estimators import get as get_estimator
-from ..model.effects import EFFECTS
+from ..model.effects import EFFECTS, param_units
+from ..model.refinement.result import term_move_text
 from ..model.terms import TERM_NAMES
 from ..units import coefficient_unit, ieee952
 from .fmt import count, duration, g, json_list, json_number, json_value, pct, step_params
@@ -29,9 +30,10 @@ def _fit_errors(f, r) -> dict:
 
 
 def refinement_dict(rep) -> dict | None:
-    """The refinement of every axis: the curve fit's errors at the start and at the end, and each step —
-    curve effects judged on the Allan curve, changes of level on the Allan variances of windows along
-    the record (``statistic`` says which: the two are on different χ² scales)."""
+    """The refinement of every axis: the curve fit's errors at the start and at the end, and each step with its
+    errors before → after on the record's Allan curve (each step's before is the previous step's after);
+    ``statistic`` says what accepted it — the Allan curve, or for a change of level the Allan variances of
+    windows along the record (a different χ² scale, its numbers under ``window_levels``)."""
     if rep.refinements is None:
         return None
     rate = rep.adev_unit or "rate unit"
@@ -50,20 +52,19 @@ def refinement_dict(rep) -> dict | None:
                 "start_heldout_rms_adev_pct": json_number(r.start_heldout_rms_adev_pct),
                 "heldout_note": r.heldout_note,
                 "final": _fit_errors(r.fit, r),
-                "steps": [
+                "term_moves": [
                     {
-                        "effect": st.effect,
-                        "statistic": "window_levels" if st.effect == "change_point" else "allan_curve",
-                        "domain": EFFECTS[st.effect].domain,
-                        "params": {p: json_value(v) for p, v in st.params.items()},
-                        "units": {p: rate if u == "rate unit" else u for p, u, _ in EFFECTS[st.effect].params},
-                        "intervals": {p: [json_number(a), json_number(b)] for p, (a, b) in st.intervals.items()},
-                        "before": {q: json_number(v) for q, v in st.before.items()},
-                        "after": {q: json_number(v) for q, v in st.after.items()},
-                        "test": _jsonable_test(st.evidence.get("test")),
+                        "term": m["term"],
+                        "start": json_number(m["start"]),
+                        "start_interval": json_value(m["start_interval"]),
+                        "final": json_number(m["final"]),
+                        "final_interval": json_value(m["final_interval"]),
+                        "moved_by": [{k: json_value(v) for k, v in mv.items()} for mv in m["moves"]],
+                        "text": term_move_text(m, r.fit.unit),
                     }
-                    for st in r.steps
+                    for m in r.term_moves
                 ],
+                "steps": [_step_dict(st, rate) for st in r.steps],
             }
         )
     curve = [e for e in EFFECTS.values() if e.kind == "curve"]
@@ -79,13 +80,16 @@ def refinement_dict(rep) -> dict | None:
             f"{e.name}: " + ", ".join(_param_words(p, u, m, rate) for p, u, m in e.params) for e in EFFECTS.values()
         ),
         "statistics": {
-            "allan_curve": "before/after: χ²/dof and RMS z of the Allan-curve fit (each τ of the dense curve weighted "
-            "independently), RMS ADEV error (%) on 4 τ per octave whose estimate is within ±10 %; "
-            "heldout_rms_adev_pct: the model fitted on alternate blocks (8, joined) predicting the other blocks' "
-            "curve, both ways (null for curve-only input)",
-            "window_levels": "before/after: one level vs piecewise levels (split at every change found) of the "
-            "log Allan variances of 16 windows along the record; held out per segment (each segment's alternate "
-            "blocks predicted by its own model vs the one-level model)",
+            "allan_curve": "every step's before/after, on the record's own Allan curve (a component removed in "
+            "time is part of the model through what it changed in the curve, AVAR(y) − AVAR(y − component)), so "
+            "that each step's before is the previous step's after: χ²/dof and RMS z of the Allan-curve fit (each "
+            "τ of the dense curve weighted independently), RMS ADEV error (%) on 4 τ per octave whose estimate is "
+            "within ±10 %; heldout_rms_adev_pct: the model fitted on alternate blocks (8, joined; removals refitted "
+            "on them) predicting the other blocks' curve, both ways (null for curve-only input). A change of noise "
+            "level leaves the curve as it is (before = after)",
+            "window_levels": "what accepted a change point (its step's window_levels): one level vs piecewise "
+            "levels (split at every change found) of the log Allan variances of 16 windows along the record; held "
+            "out per segment (each segment's alternate blocks predicted by its own model vs the one-level model)",
         },
         "axes": axes,
     }
@@ -96,6 +100,31 @@ def _param_words(name: str, unit: str, meaning: str, rate: str) -> str:
     if unit:
         return f"{name} in {unit.replace('rate unit', rate)}"
     return f"{name} ({meaning.split(' (')[0]})"
+
+
+def _step_dict(st, rate) -> dict:
+    """One refinement step as JSON: its parameters at acceptance and after the final joint refit, with units
+    and intervals; before/after on the record's Allan curve (each step's before the previous step's after);
+    the test that accepted it; a change point's window-level statistic."""
+    fp, fi = (st.final_params, st.final_intervals) if st.final_params else (st.params, st.intervals)
+    out = {
+        "effect": st.effect,
+        "statistic": "window_levels" if st.effect == "change_point" else "allan_curve",
+        "domain": EFFECTS[st.effect].domain if st.effect in EFFECTS else None,
+        "params": {p: json_value(v) for p, v in st.params.items()},
+        "final_params": {p: json_value(v) for p, v in fp.items()},
+        "units": param_units(st.effect, rate),
+        "intervals": {p: json_value(iv) for p, iv in st.intervals.items()},
+        "final_intervals": {p: json_value(iv) for p, iv in fi.items()},
+        "before": {q: json_number(v) for q, v in st.before.items()},
+        "after": {q: json_number(v) for q, v in st.after.items()},
+        "test": _jsonable_test(st.evidence.get("test")),
+    }
+    if "window_levels" in st.evidence:
+        out["window_levels"] = {
+            k: {q: json_number(v) for q, v in d.items()} for k, d in st.evidence["window_levels"].items()
+        }
+    return out
 
 
 def _jsonable_test(t):
@@ -464,7 +493,10 @@ def text_summary(s: dict) -> str:
                 f"RMS ADEV error {g(a['rms_adev_pct'], 3)} → {g(b['rms_adev_pct'], 3)} %"
             )
             for st in ax["steps"]:
-                lines.append(f"    {st['effect']}: {step_params(st, rec['fs_hz'], rec['duration_s'], units=True)}")
+                lines.append(
+                    f"    {st['effect']}: {step_params(st, rec['fs_hz'], rec['duration_s'], units=True, final=True)}"
+                )
+            lines += [f"    {m['text']}" for m in ax.get("term_moves", [])]
     lines += forecast_text(s.get("forecast"))
     lines += paper002_text(s.get("paper002"))
     return "\n".join(lines)

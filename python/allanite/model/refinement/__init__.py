@@ -17,8 +17,11 @@ of the registry :data:`allanite.model.effects.EFFECTS`:
   band (octaves) where the coupling differs across frequency (:func:`allanite.model.tracing.band_regression`).
 
 Every curve effect enters the model as a non-negative column of Allan variance; the time-domain ones (drift,
-regression) are removed from the samples, and their in-sample "after" adds back what the removal changed in
-the curve, AVAR(y) − AVAR(y − component) (own variance and cross terms, exactly). A candidate is **accepted** only if
+regression) are removed from the samples, and the model adds back what the removal changed in the curve,
+AVAR(y) − AVAR(y − component) (own variance and cross terms, exactly). Every step is scored on the record's own
+Allan curve along one chain — each step's before is the previous step's after, the last after the final
+model's (curve effects first, then the removals in time with every curve effect in the model, then change
+points). A candidate is **accepted** only if
 
 1. a calibrated test says the residual asks for it: the GLS score statistic on ~4 τ per octave with the
    covariance of the estimates across τ (exact for the five terms, :mod:`allanite.model._covariance`),

@@ -29,7 +29,16 @@ from ..effects import CASCADE_SPANS, EFFECTS, RESONANCE_Q, filter_autocorrelatio
 from .curvefit import Curve, Solution, base_name, column, profile_interval, search, solve
 from .scoring import Split
 
-__all__ = ["Proposal", "Round", "CurveCandidate", "CURVE_CANDIDATES", "PAIR_FACTOR", "families", "choose"]
+__all__ = [
+    "Proposal",
+    "Round",
+    "CurveCandidate",
+    "CURVE_CANDIDATES",
+    "PAIR_FACTOR",
+    "families",
+    "choose",
+    "final_params",
+]
 
 #: A bandwidth that raises the held-out error alone may enter with a Gauss–Markov term if its statistic is
 #: at least this multiple of the threshold.
@@ -38,20 +47,21 @@ PAIR_FACTOR = 100.0
 
 @dataclass
 class Round:
-    """What one step of the loop offers every curve candidate: the curve and its thinned τ, the current
-    model (terms ``start`` plus ``effects``, solution ``sol``), the curve test and its threshold, the
-    held-out split, the samples (None for curve-only input) and the spectral lines found in them."""
+    """What one step of the loop offers every curve candidate: the curve, the current model (terms ``start``
+    plus ``effects``, solution ``sol``), the thinned curve with the curve test and its threshold, the held-out
+    split, the samples (None for curve-only input) and the spectral lines found in them. (A round that only
+    reads an effect's parameters off a solution needs the first four.)"""
 
     curve: Curve
-    sub: Curve
     start: tuple
     effects: list
     sol: Solution
-    test: tracing.ScoreTest
-    thr: float
-    split: Split | None
-    y: np.ndarray | None
-    lines: list
+    sub: Curve | None = None
+    test: tracing.ScoreTest | None = None
+    thr: float = math.nan
+    split: Split | None = None
+    y: np.ndarray | None = None
+    lines: list = field(default_factory=list)
 
     @property
     def tmin(self) -> float:
@@ -81,6 +91,8 @@ class Proposal:
     line: dict | None = None
     pair_note: str | None = None
     record: dict = field(default_factory=dict)
+    #: its column in ``sol`` (the last while it is proposed; its place in the final model afterwards)
+    column: int = -1
 
     @property
     def effect(self) -> str:
@@ -114,6 +126,7 @@ def _amplitude(sol: Solution, i: int) -> tuple[float, float, tuple[float, float]
 
 def _with_stat(rnd: Round, key: str, p: float, sol: Solution, edge: bool, bump: np.ndarray | None = None):
     """A proposal judged by the curve test (its column on the thinned τ, less ``bump`` if given)."""
+    assert rnd.sub is not None and rnd.test is not None
     col = column(key, p, rnd.sub) if bump is None else column(key, p, rnd.sub) - bump
     return Proposal(key, p, sol, edge, rnd.test.statistic(rnd.sub.avar, col), rnd.thr, rnd.split)
 
@@ -144,7 +157,7 @@ def _gm_evidence(pr: Proposal, rnd: Round) -> dict:
 def _amplitude_and_profile(pr: Proposal, rnd: Round) -> tuple:
     """(amplitude, nonlinear parameter) with the amplitude's ±1 SD and the parameter's profile interval."""
     names = EFFECTS[pr.effect].param_names
-    amp, _sd, amp_int = _amplitude(pr.sol, pr.sol.theta.size - 1)
+    amp, _sd, amp_int = _amplitude(pr.sol, pr.column)
     p_int = profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol)
     return {names[0]: amp, names[1]: pr.p}, {names[0]: amp_int, names[1]: p_int}
 
@@ -215,6 +228,7 @@ def _bw_propose(rnd: Round) -> list:
     if best is None:
         return []
     key, p, s_new, edge = best
+    assert rnd.sub is not None
     return [_with_stat(rnd, key, p, s_new, edge, bump=1.0 / rnd.sub.tau)]
 
 
@@ -280,7 +294,7 @@ def _res_propose(rnd: Round) -> list:
 
 
 def _res_params(pr: Proposal, rnd: Round) -> tuple:
-    amp, _sd, amp_int = _amplitude(pr.sol, pr.sol.theta.size - 1)
+    amp, _sd, amp_int = _amplitude(pr.sol, pr.column)
     p_int = profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol)
     return {"sigma": amp, "f0": pr.p, "q": float(pr.key.split(":", 1)[1])}, {"sigma": amp_int, "f0": p_int}
 
@@ -420,3 +434,17 @@ def choose(props: list, rnd: Round, candidates):
     if chosen is None and deferred:
         chosen = _first_heldout_winner(deferred, rnd)
     return chosen
+
+
+def final_params(key: str, p: float, line: dict | None, intervals: dict, j: int, rnd: Round) -> tuple[dict, dict]:
+    """Parameters and intervals of effect ``j`` of the final model ``rnd.sol`` (terms ``rnd.start`` plus
+    ``rnd.effects``): its amplitude from the final joint fit, its nonlinear parameter as accepted (the joint fit
+    refits amplitudes only) with the interval profiled again beside the other effects. A spectral line keeps
+    its f0 interval from the samples (``intervals``, at acceptance)."""
+    others = rnd.effects[:j] + rnd.effects[j + 1 :]
+    column_j = len(rnd.start) + j
+    if line is not None:
+        amp, _sd, amp_int = _amplitude(rnd.sol, column_j)
+        return {"amplitude": amp, "f0": p}, {"amplitude": amp_int, "f0": intervals["f0"]}
+    pr = Proposal(key, p, rnd.sol, False, math.nan, math.nan, None, column=column_j)
+    return CURVE_CANDIDATES[base_name(key)].params(pr, Round(rnd.curve, rnd.start, others, rnd.sol))

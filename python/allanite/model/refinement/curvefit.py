@@ -305,8 +305,14 @@ def effect_column_name(key, j, effects) -> str:
     return f"{name}{j + 1}" if sum(base_name(e[0]) == base_name(key) for e in effects) > 1 else name
 
 
-def noise_fit(curve, terms, effects, sol, result, unit, confidence):
-    """A NoiseFit for the solution, with the effects' parameters among the coefficients."""
+def noise_fit(curve, terms, effects, sol, result, unit, confidence, removed=None):
+    """A NoiseFit for the solution, with the effects' parameters among the coefficients.
+
+    ``removed``: (change, numbers, [(name, own change)]) when components were removed from the samples before
+    ``sol`` was fitted: ``curve`` is then the original record's, the model ``sol``'s plus ``change`` (what the
+    removals changed in the Allan curve, AVAR(y) − AVAR(y − components)), its χ² on ``curve`` with the
+    removals' fitted ``numbers`` off the degrees of freedom, and each removal's own change one of the
+    components."""
     zq = fitting.z_quantile(confidence)
     k = len(terms)
     inflate = max(1.0, math.sqrt(sol.chi2_dof))
@@ -314,6 +320,13 @@ def noise_fit(curve, terms, effects, sol, result, unit, confidence):
     comps = {t: sol.a[:, i] * sol.theta[i] for i, t in enumerate(terms)}
     for j, (key, _param) in enumerate(effects):
         comps[effect_column_name(key, j, effects)] = sol.a[:, k + j] * sol.theta[k + j]
+    model, z, chi2, dof = sol.model, sol.z, sol.chi2, sol.dof
+    if removed is not None:
+        change, numbers, own = removed
+        comps.update(own)
+        model = np.maximum(sol.model + change, 1e-300)
+        z = (curve.avar - model) * np.sqrt(sol.nu / (2.0 * model**2))
+        chi2, dof = float(np.sum(z**2)), max(1, sol.dof - numbers)
     readoffs = fitting.readoffs(result, np.sqrt(np.atleast_2d(result.avar)[0]))
     return fitting.NoiseFit(
         coefficients=coeffs,
@@ -322,13 +335,13 @@ def noise_fit(curve, terms, effects, sol, result, unit, confidence):
         m=curve.m,
         avar=curve.avar,
         edf=sol.nu,
-        model=sol.model,
+        model=model,
         components=comps,
-        z=sol.z,
-        chi2=sol.chi2,
-        dof=sol.dof,
-        chi2_dof=sol.chi2_dof,
-        p_value=float(chi2_dist.sf(sol.chi2, sol.dof)),
+        z=z,
+        chi2=chi2,
+        dof=dof,
+        chi2_dof=chi2 / max(1, dof),
+        p_value=float(chi2_dist.sf(chi2, dof)),
         readoffs=readoffs,
         fs=curve.fs,
         confidence=confidence,

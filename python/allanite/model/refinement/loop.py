@@ -25,14 +25,14 @@ from .. import fitting, tracing
 from ..effects import EFFECTS, describe
 from ..terms import check_terms
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
-from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families
+from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families, final_params
 from .changes import change_points
-from .curvefit import Curve, base_name, noise_fit, solve
+from .curvefit import Curve, base_name, noise_fit, solve, theta_terms
 from .levels import LEVEL, alpha
 from .missing import MissingContext, unexplained
 from .removals import REMOVALS, Removal, RemovalContext
-from .result import Refinement, Step
-from .scoring import HELDOUT_BLOCKS, curve_metrics, heldout_split, informative, removal_metrics, segments_heldout
+from .result import Refinement, Step, term_moves
+from .scoring import HELDOUT_BLOCKS, chain_metrics, heldout_split, informative, segments_heldout
 
 __all__ = ["refine", "CANDIDATES", "MAX_STEPS", "REFINE_SCALE"]
 
@@ -152,7 +152,6 @@ def refine(
         run.remove_in_time(candidates, chans)
         run.add_curve_effects(candidates)
         cp_steps = run.change_point_steps(candidates)
-        run.rescore_removals()
         return run.refinement(cp_steps, unit, confidence, run.unexplained(chans))
 
 
@@ -234,7 +233,17 @@ def _heldout_note(y, heldout) -> str:
 
 class _Run:
     """One refinement under way: the samples and their curve as removals change them, the model so far, the
-    steps, and what was considered and turned down."""
+    steps, and what was considered and turned down.
+
+    Every step is scored on the original record's Allan curve (``curve0``) and held out on its alternate blocks
+    (``split0``), along one chain: each step's "before" is the previous step's "after", the first "before" the
+    start's, the last "after" the final model's. The curve effects come first in it, fitted on the record's
+    own curve; then the removals in time (removed from the samples before the curve effects were searched, so
+    that those are found on the corrected samples), each scored with every curve effect in the model — a
+    removed component's exact Allan variance, AVAR(y) − AVAR(y − components), part of it, and held out with
+    the removals refitted on each held-in part; change points last. The held-out comparison that accepted a
+    step (on the samples as they were when it was tested, or per segment for change points) is kept in its
+    ``evidence["heldout_test"]`` where it differs."""
 
     def __init__(self, y, result, start, tau_range, level, truth):
         self.y, self.result, self.start, self.level, self.truth = y, result, start, level, truth
@@ -253,12 +262,19 @@ class _Run:
         # in-sample RMS ADEV error: on the τ whose estimate is informative under the five-term fit (fixed for
         # the whole refinement, so every before/after compares the same τ)
         self.scored = informative(self.curve.tau, self.sol.nu)
-        self.start_heldout = self.heldout.error(start, []) if self.heldout is not None else None
+        # the original record: what every step is scored on
+        self.result0, self.curve0, self.split0 = result, self.curve, self.heldout
+        self.raw = self.split0.raw_parts() if self.split0 is not None else None
+        self.state = self.chain(self.sol, [])  # (metrics, effective χ², terms' coefficients) of the model so far
+        self.start_heldout = self.state[0]["heldout_rms_adev_pct"]
         self.effects: list = []  # curve effects [(key, nonlinear parameter)], steps[j] ↔ effects[j]
         self.steps: list = []
-        self.amplitudes: list = []  # per curve step: its parameter that is the column's amplitude, or None
-        self.first_steps: list = []  # time effects removed before the curve effects
-        self.removed: list = []  # (step, removal) of each
+        self.lines: list = []  # per curve step: the spectral line it came from, or None
+        # per time effect removed before the curve effects: (step, removal, its own change of the curve, the
+        # curve after it, the held-out parts with the removals so far refitted on them)
+        self.removed: list = []
+        self.states: list = [self.state]  # the chain: the model before the first step and after each
+        self.change_points: list = []
         self.considered: dict[str, list] = {}
 
     def build(self, res, samples):
@@ -270,8 +286,24 @@ class _Run:
         m_all = np.asarray(res.m, dtype=np.int64)
         return c, heldout_split(samples, self.fs, m_all, self.lo, self.hi, self.start)
 
-    def metrics(self, c, s, ho) -> dict:
-        return curve_metrics(c, s, ho, self.scored)
+    def chain(self, sol, effects, curve=None, n_removed=0, parts=None) -> tuple:
+        """The model ``sol`` (terms plus ``effects``, fitted on ``curve``: the record's, or the one the removals
+        left, with ``n_removed`` numbers fitted by them) scored on the record's curve, held out with ``parts``
+        (the raw parts when None): (metrics, effective χ², the terms' coefficients √θ)."""
+        curve = self.curve0 if curve is None else curve
+        ho = None
+        if self.split0 is not None:
+            ho = self.split0.predict(self.raw if parts is None else parts, self.start, effects)
+        change = self.curve0.avar - curve.avar
+        metrics, chi2_eff = chain_metrics(self.curve0, sol, change, n_removed, ho, self.scored)
+        return metrics, chi2_eff, np.sqrt(np.maximum(theta_terms(sol, self.start, effects), 0.0))
+
+    def advance(self, st: Step, state: tuple) -> None:
+        """Score ``st`` from the chain's last state to ``state``."""
+        st.before, st.after = dict(self.state[0]), dict(state[0])
+        st.delta_chi2_eff = float(self.state[1] - state[1])
+        self.state = state
+        self.states.append(state)
 
     def consider(self, effect: str, entry: dict) -> None:
         self.considered.setdefault(effect, []).append(entry)
@@ -283,7 +315,7 @@ class _Run:
         return {
             k: params[k] / v - 1
             for k, v in self.truth[effect].items()
-            if k in params and not isinstance(params[k], str) and v
+            if k in params and isinstance(params[k], (int, float)) and v
         }
 
     # ---- time-domain removals, before the curve effects
@@ -298,15 +330,12 @@ class _Run:
             if name not in candidates:
                 continue
             for rem in remover(ctx):
-                st = self.remove(rem)
-                if st is not None:
-                    self.first_steps.append(st)
-                    self.removed.append((st, rem))
+                if self.remove(rem):
                     ctx.y, ctx.curve, ctx.sol = self.y, self.curve, self.sol
 
-    def remove(self, rem: Removal) -> Step | None:
-        """Remove ``rem.component`` if the held-out error falls (or its held-out test in time passes); the step,
-        or None (recorded among the considered)."""
+    def remove(self, rem: Removal) -> bool:
+        """Remove ``rem.component`` if the held-out error falls (or its held-out test in time passes); else
+        record it among the considered. Its step is scored once the curve effects are in (:meth:`score`)."""
         y, start, effects, heldout = self.y, self.start, self.effects, self.heldout
         assert y is not None
         y_new = y - rem.component
@@ -314,7 +343,6 @@ class _Run:
         c_new, h_new = self.build(res_new, y_new)
         ho_b = heldout.error(start, effects) if heldout is not None else None
         ho_a = heldout.error(start, effects, remove=rem.refit, on_raw=rem.on_raw) if heldout is not None else None
-        s_new = solve(c_new, start, effects)
         if rem.heldout_in_time is not None:
             rem.evidence["heldout_variance_ratio"] = rem.heldout_in_time
             rejected = not rem.heldout_in_time < 1.0
@@ -323,29 +351,34 @@ class _Run:
         if rejected:
             why = f"held-out error {ho_b} → {ho_a} %, variance ratio {rem.heldout_in_time}"
             self.consider(rem.effect, rem.params | {"rejected": why, "test": rem.evidence["test"]})
-            return None
-        keep = self.keep
+            return False
+        if ho_b is not None:  # on the samples as they were, the five terms alone
+            rem.evidence["heldout_test"] = {"before": ho_b, "after": ho_a}
+        params = dict(rem.params)
         st = Step(
             effect=rem.effect,
-            params=rem.params,
+            params=params,
             intervals=rem.intervals,
             evidence=rem.evidence,
-            before=self.metrics(self.curve, self.sol, ho_b),
-            # on the same curve as "before": the new noise model plus what the removal changed in the curve
-            after=removal_metrics(
-                self.curve, s_new, self.result.avar[keep] - res_new.avar[keep], rem.n_fitted, ho_a, self.scored
-            ),
-            delta_chi2_eff=float(self.sol.chi2_eff(self.curve) - s_new.chi2_eff(c_new)),
-            truth_error=self.truth_error(rem.effect, rem.params),
+            before={},
+            after={},
+            truth_error=self.truth_error(rem.effect, params),
+            final_params=dict(params),
+            final_intervals=dict(rem.intervals),
         )
-        self.y, self.result, self.curve, self.heldout, self.sol = y_new, res_new, c_new, h_new, s_new
-        return st
+        parts = None
+        if self.split0 is not None:
+            parts = self.split0.corrected(self.removed[-1][4] if self.removed else self.raw, rem.refit, rem.on_raw)
+        self.removed.append((st, rem, self.curve.avar - c_new.avar, c_new, parts))
+        self.y, self.result, self.curve, self.heldout = y_new, res_new, c_new, h_new
+        self.sol = solve(c_new, start, effects)
+        return True
 
     # ---- curve effects
 
     def add_curve_effects(self, candidates) -> None:
         """Curve effects one per step (at most :data:`MAX_STEPS`) while one is accepted; then an effect whose
-        amplitude a later one took over entirely is dropped, and the amplitudes come from the joint fit."""
+        amplitude a later one took over entirely is dropped, and the steps are scored along the chain."""
         y = self.y
         exact = y is not None or (isinstance(self.est, str) and self.est == "oavar")
         thin = tracing.thin_indices(self.curve.tau)
@@ -356,6 +389,7 @@ class _Run:
             if not self.curve_step(n_step, candidates, thin, exact, lines):
                 break
         self.drop_absorbed()
+        self.score()
 
     def curve_step(self, n_step, candidates, thin, exact, lines) -> bool:
         """One step: every candidate's proposal, the one :func:`choose` accepts added; False if none."""
@@ -363,7 +397,7 @@ class _Run:
         test = curve_test(self.curve, thin, self.sol, self.start, self.effects, exact)
         fam = families(sub, candidates, self.y is not None)
         thr = test.threshold(fam, alpha("curve", self.level), N_BOOT, seed=n_step)
-        rnd = Round(self.curve, sub, self.start, self.effects, self.sol, test, thr, self.heldout, self.y, lines)
+        rnd = Round(self.curve, self.start, self.effects, self.sol, sub, test, thr, self.heldout, self.y, lines)
         props = [pr for name, c in CURVE_CANDIDATES.items() if name in candidates for pr in c.propose(rnd)]
         for pr in props:
             pr.record = {"param": float(pr.p), "statistic": float(pr.stat), "threshold": float(pr.thr)}
@@ -373,11 +407,12 @@ class _Run:
             return False
         pr, ho_b, ho_a = chosen
         self.steps.append(self.curve_effect_step(pr, rnd, ho_b, ho_a))
-        self.amplitudes.append(CURVE_CANDIDATES[pr.effect].amplitude(pr))
+        self.lines.append(pr.line)
         self.effects, self.sol = self.effects + [(pr.key, pr.p)], pr.sol
         return True
 
     def curve_effect_step(self, pr: Proposal, rnd: Round, ho_b, ho_a) -> Step:
+        """The step of an accepted curve proposal (scored along the chain once the loop is done)."""
         cand = CURVE_CANDIDATES[pr.effect]
         params, intervals = cand.params(pr, rnd)
         evidence = residual_evidence(self.curve, self.sol)
@@ -389,41 +424,51 @@ class _Run:
         evidence.update(cand.evidence(pr, rnd))
         if pr.pair_note is not None:
             evidence["held_out"] = pr.pair_note
-        return Step(
-            effect=pr.effect,
-            params=params,
-            intervals=intervals,
-            evidence=evidence,
-            before=self.metrics(self.curve, self.sol, ho_b),
-            after=self.metrics(self.curve, pr.sol, ho_a),
-            delta_chi2_eff=float(self.sol.chi2_eff(self.curve) - pr.sol.chi2_eff(self.curve)),
-            truth_error=self.truth_error(pr.effect, params),
-        )
+        if ho_b is not None and self.removed:  # held out on the samples after the removals, not the record's
+            evidence["heldout_test"] = {"before": ho_b, "after": ho_a}
+        return Step(effect=pr.effect, params=params, intervals=intervals, evidence=evidence, before={}, after={})
 
     def drop_absorbed(self) -> None:
-        """Drop an effect whose amplitude a later one took over entirely (refit without it); take each curve
-        step's amplitude from the final joint solution."""
+        """Drop an effect whose amplitude a later one took over entirely (refit without it)."""
         k = len(self.start)
         dead = [j for j in range(len(self.effects)) if self.sol.theta[k + j] <= 0]
         if dead:
             for j in reversed(dead):
                 key, p = self.effects[j]
                 self.consider(base_name(key), {"param": float(p), "absorbed": True})
-                del self.effects[j], self.steps[j], self.amplitudes[j]
+                del self.effects[j], self.steps[j], self.lines[j]
             self.sol = solve(self.curve, self.start, self.effects)
-        for j, (st, name) in enumerate(zip(self.steps, self.amplitudes)):
-            if name is not None:
-                st.params[name] = math.sqrt(max(self.sol.theta[k + j], 0.0))
-                if st.truth_error is not None:
-                    st.truth_error = self.truth_error(st.effect, st.params)
 
-    # ---- change points, and the removals scored against the final model
+    def score(self) -> None:
+        """The chain: each curve step with the effects up to it, fitted on the record's own curve; then each
+        removal in time, the samples corrected by it and the ones before it, with every curve effect in the
+        model (the last state is the final model). Each curve step's parameters after the final joint refit."""
+        final = Round(self.curve, self.start, self.effects, self.sol)
+        for j, st in enumerate(self.steps):
+            effects = self.effects[: j + 1]
+            last = j == len(self.steps) - 1 and not self.removed
+            sol = self.sol if last else solve(self.curve0, self.start, effects)
+            self.advance(st, self.chain(sol, effects))
+            key, p = self.effects[j]
+            st.final_params, st.final_intervals = final_params(key, p, self.lines[j], st.intervals, j, final)
+            # against the truth: the final joint fit's values, but a spectral line's amplitude from the samples
+            st.truth_error = self.truth_error(st.effect, st.params if self.lines[j] is not None else st.final_params)
+        n_removed = 0
+        for i, (st, rem, _own, curve, parts) in enumerate(self.removed):
+            n_removed += rem.n_fitted
+            sol = self.sol if i == len(self.removed) - 1 else solve(curve, self.start, self.effects)
+            self.advance(st, self.chain(sol, self.effects, curve, n_removed, parts))
+            st.evidence["scored_with"] = [base_name(k) for k, _p in self.effects] or "the five terms"
+
+    # ---- change points
 
     def change_point_steps(self, candidates) -> list:
-        """Steps of the change points the held-out error confirms (their statistic: the windows' levels)."""
+        """Steps of the change points the held-out error per segment confirms. A change of level leaves the
+        record's Allan curve as it is (one model of the five terms fits the whole curve as well as the
+        segments' models together): on the chain its before and after are the final model's; its own
+        statistic, on the windows' levels along the record, is in its evidence."""
         y = self.y
         if y is None or "change_point" not in candidates:
-            self.change_points = []
             return []
         cps = change_points(y, self.fs, self.start)
         ho_cp = None
@@ -453,34 +498,26 @@ class _Run:
             "window_s": c["window_s"],
             "coarse_split_s": c["coarse_split_s"],
             "gain_chi2": c["gain"],
+            "window_levels": {"before": dict(c["before"]), "after": dict(c["after"])},
         }
-        return Step(
+        if ho_cp is not None:
+            evidence["heldout_test"] = {"before": ho_cp[0], "after": ho_cp[1], "per": "segment"}
+        params, intervals = {"t": c["t"]}, {"t": c["interval"]}
+        st = Step(
             effect="change_point",
-            params={"t": c["t"]},
-            intervals={"t": c["interval"]},
+            params=params,
+            intervals=intervals,
             evidence=evidence,
-            before=c["before"],
-            after=c["after"],
-            delta_chi2_eff=c["gain"],
+            before={},
+            after={},
             truth_error=terr,
+            final_params=dict(params),
+            final_intervals=dict(intervals),
         )
+        self.advance(st, self.state)
+        return st
 
-    def rescore_removals(self) -> None:
-        """A time effect went before the curve effects (on the five terms alone); its before/after are scored
-        against the final model — the same curve effects with and without it in the samples (the other
-        removals stay removed)."""
-        start, effects, sol = self.start, self.effects, self.sol
-        for st, rem in self.removed:
-            y_raw = self.y + rem.component
-            c_raw, h_raw = self.build(avar(y_raw, self.fs, taus=self.result.tau), y_raw)
-            s_raw = solve(c_raw, start, effects)
-            st.before = self.metrics(c_raw, s_raw, h_raw.error(start, effects) if h_raw is not None else None)
-            # after: on the raw curve too — the final model plus what removing it changed in the curve
-            # (y_raw − comp is the final samples, whose curve the final model was fitted to)
-            ho_after = h_raw.error(start, effects, remove=rem.refit, on_raw=rem.on_raw) if h_raw is not None else None
-            st.after = removal_metrics(c_raw, sol, c_raw.avar - self.curve.avar, rem.n_fitted, ho_after, self.scored)
-            st.delta_chi2_eff = float(s_raw.chi2_eff(c_raw) - sol.chi2_eff(self.curve))
-            st.evidence["scored_with"] = [base_name(k) for k, _p in effects] or "the five terms"
+    # ---- the result
 
     def unexplained(self, chans) -> list:
         """What the final model still misses, every domain's check at its own share of ``level``."""
@@ -492,23 +529,38 @@ class _Run:
         return unexplained(ctx)
 
     def refinement(self, cp_steps, unit, confidence, missing) -> Refinement:
-        start_fit = noise_fit(self.curve, self.start, [], self.start_sol, self.result, unit, confidence)
-        final_fit = noise_fit(self.curve, self.start, self.effects, self.sol, self.result, unit, confidence)
+        """The result: the start and the final model on the original record's curve, the steps in order."""
+        removed = None
+        if self.removed:
+            own = {_component_name(st): change for st, _rem, change, _c, _p in self.removed}
+            n_removed = sum(rem.n_fitted for _st, rem, _change, _c, _p in self.removed)
+            removed = (self.curve0.avar - self.curve.avar, n_removed, own)
+        res0, c0 = self.result0, self.curve0
+        start_fit = noise_fit(c0, self.start, [], self.start_sol, res0, unit, confidence)
+        final_fit = noise_fit(c0, self.start, self.effects, self.sol, res0, unit, confidence, removed)
+        steps = self.steps + [st for st, *_rest in self.removed] + cp_steps
         return Refinement(
-            steps=self.first_steps + self.steps + cp_steps,
+            steps=steps,
             fit=final_fit,
             start=start_fit,
-            result=self.result,
+            result=res0,
             terms=self.start,
             effects=self.effects,
             change_points=self.change_points,
             considered=self.considered,
             heldout_note=self.note,
             start_heldout_rms_adev_pct=self.start_heldout,
-            scored_tau=self.curve.tau[self.scored],
+            scored_tau=c0.tau[self.scored],
             tau_range=(self.lo, self.hi),
             unexplained=missing,
+            corrected=self.result if self.removed else None,
+            term_moves=term_moves(start_fit, final_fit, steps, [s[2] for s in self.states]),
         )
+
+
+def _component_name(st: Step) -> str:
+    """A removal's name among the final fit's components ("regression_<channel>" for a regression)."""
+    return st.effect if st.effect != "regression" else f"regression_{st.params['channel']}"
 
 
 refine.__doc__ = (refine.__doc__ or "").replace("{effects}", describe())

@@ -11,9 +11,9 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   non-negative column, the maximum over every curve candidate's family — sinusoids' nulls included — and the
   start terms' own columns, bootstrapped under the final model); the region is where the winning column, with
   the model's fitted directions projected out, carries its weight, and further regions follow with the winner
-  added to the model, at the same threshold (reported where the dense curve's χ²/dof there exceeds 1). With samples the frequency band is refined on the PSD of the
-  final residual samples: the part of ≈ 1/(2τ_hi) … 1/(2τ_lo) (widened ×2) that stands above the spectrum's
-  running median.
+  added to the model, at the same threshold (reported where the dense curve's χ²/dof there exceeds 1). With
+  samples the frequency band is refined on the PSD of the final residual samples: the part of
+  ≈ 1/(2τ_hi) … 1/(2τ_lo) (widened ×2) that stands above the spectrum's running median.
 - ``"psd"`` — spectral lines of the final samples (:func:`allanite.model.tracing.spectral_lines`) that no
   sinusoid of the model accounts for.
 - ``"time"`` — a warm-up drift left in the final samples (:func:`allanite.model.tracing.drift_fit` against its

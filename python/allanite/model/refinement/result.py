@@ -10,25 +10,36 @@ import numpy as np
 
 from ..._display import RichDisplay, Summary, Table, fmt_ci, thin
 from ...results import AllanResult
+from ...units import ieee952
 from .. import fitting
-from ..effects import EFFECTS
+from ..effects import EFFECTS, format_params
+from ..terms import TERM_NAMES
 from .scoring import rms_adev_pct
 
-__all__ = ["Step", "Refinement", "describe_region"]
+__all__ = ["Step", "Refinement", "term_moves", "term_move_text", "describe_region"]
+
+#: The errors each step reports before and after it.
+ERRORS = ("chi2_dof", "rms_z", "rms_adev_pct", "heldout_rms_adev_pct")
 
 
 @dataclass
 class Step:
     """One effect added by :func:`refine`.
 
-    ``params`` in the input unit's base form (see :data:`allanite.model.effects.EFFECTS` for each
-    effect's parameters and units: Gauss–Markov ``sigma`` rate unit, ``tc`` s; sinusoid ``amplitude``
+    ``params`` in the input unit's base form, at acceptance (see :data:`allanite.model.effects.EFFECTS` for
+    each effect's parameters and units: Gauss–Markov ``sigma`` rate unit, ``tc`` s; sinusoid ``amplitude``
     rate unit, ``f0`` Hz; bandwidth ``cutoff`` Hz, ``taps``, ``filter``; drift ``amplitude`` rate unit,
     ``T`` s; regression ``channel``, ``coefficient`` rate unit per channel unit; change point ``t`` s);
-    ``intervals`` the numeric keys → (low, high); ``before``/``after``: ``chi2_dof``, ``rms_z``,
-    ``rms_adev_pct`` (on ``Refinement.scored_tau``), ``p_value`` and ``heldout_rms_adev_pct`` (None for
-    curve-only input); ``evidence``: where in τ, f or t the residual was and the test that accepted it;
-    ``truth_error``: relative parameter errors when ``truth`` was given.
+    ``intervals`` the numeric keys → (low, high); ``final_params``/``final_intervals`` the same after the final
+    joint refit (a curve effect's amplitude refitted beside every other effect, its nonlinear parameter's
+    interval profiled again; a removal in time or a change point as accepted). ``before``/``after``:
+    ``chi2_dof``, ``rms_z``, ``rms_adev_pct`` (on ``Refinement.scored_tau``), ``p_value`` and
+    ``heldout_rms_adev_pct`` (None for curve-only input) of the model before and after the step, all on the
+    original record's Allan curve — each step's ``before`` is the previous step's ``after`` (the steps in the
+    chain's order: curve effects, then the removals in time, which were searched first, then change points);
+    ``evidence``: where in τ, f or t the residual was and the test that accepted it (``heldout_test``: the held-out
+    comparison that accepted it, where that is not the chain's; a change point's statistic on the windows'
+    levels in ``window_levels``); ``truth_error``: relative parameter errors when ``truth`` was given.
     """
 
     effect: str
@@ -39,17 +50,83 @@ class Step:
     after: dict
     delta_chi2_eff: float = 0.0
     truth_error: dict | None = None
+    final_params: dict = field(default_factory=dict)
+    final_intervals: dict = field(default_factory=dict)
+
+
+def term_moves(start: fitting.NoiseFit, final: fitting.NoiseFit, steps: list, along: list) -> list:
+    """The terms whose refined interval no longer overlaps the plain fit's, and which steps moved them: [{term,
+    start, start_interval, final, final_interval, unit, moves: [{step, effect, before, after}]}] (base form;
+    ``along[i]`` the terms' coefficients after ``i`` steps). The moves of at least a tenth of the whole change, in
+    step order."""
+    out = []
+    for i, t in enumerate(start.terms):
+        s, f = start.coefficients[t], final.coefficients[t]
+        if f.ci[0] <= s.ci[1] and s.ci[0] <= f.ci[1]:
+            continue
+        vals = [float(v[i]) for v in along]
+        moves = [
+            {"step": k + 1, "effect": st.effect, "before": vals[k], "after": vals[k + 1]}
+            for k, st in enumerate(steps)
+            if k + 1 < len(vals) and vals[k + 1] != vals[k]
+        ]
+        moves.sort(key=lambda m: -abs(m["after"] - m["before"]))
+        whole = abs(f.value - s.value)
+        moves = sorted(
+            [m for m in moves if abs(m["after"] - m["before"]) >= 0.1 * whole] or moves[:1], key=lambda m: m["step"]
+        )
+        out.append(
+            {
+                "term": t,
+                "start": s.value,
+                "start_interval": tuple(s.ci),
+                "final": f.value,
+                "final_interval": tuple(f.ci),
+                "unit": s.unit,
+                "moves": moves,
+            }
+        )
+    return out
+
+
+def term_move_text(m: dict, unit) -> str:
+    """One sentence: which term the refinement moved away from the plain fit, and which steps moved it."""
+    t = m["term"]
+    conv, u = (lambda v: v), m["unit"] or "(base form)"
+    if unit is not None:
+        u = ieee952(t, 1.0, unit).unit
+        conv = lambda v: ieee952(t, v, unit).value if np.isfinite(v) else v  # noqa: E731
+    s0, (a0, b0) = conv(m["start"]), map(conv, m["start_interval"])
+    s1, (a1, b1) = conv(m["final"]), map(conv, m["final_interval"])
+    moves = ", ".join(
+        f"step {mv['step']} ({mv['effect']}) {conv(mv['before']):.3g} → {conv(mv['after']):.3g}" for mv in m["moves"]
+    )
+    return (
+        f"{t} ({TERM_NAMES.get(t, t)}) is {s1:.3g} [{a1:.3g}, {b1:.3g}] {u} refined, {s0:.3g} [{a0:.3g}, {b0:.3g}] "
+        f"in the plain fit — the intervals do not overlap: the effects added took over (or gave back) part of "
+        f"the curve the term had described; moved by {moves}."
+    )
+
+
+def _effect_name(steps, i) -> str:
+    st = steps[i]
+    same = [j for j, s in enumerate(steps) if s.effect == st.effect]
+    return st.effect if len(same) == 1 else f"{st.effect} {same.index(i) + 1}"
 
 
 @dataclass
 class Refinement(RichDisplay):
-    """What :func:`refine` found. ``fit`` is the final model (a NoiseFit whose ``coefficients`` also
-    hold the added effects' parameters), ``start`` the starting model, ``steps`` the effects added.
-    ``heldout_note`` says how (or why not) the held-out error was computed; ``scored_tau`` the τ the RMS ADEV
-    errors are scored on (:meth:`rms_adev_pct` gives a fit's). ``unexplained`` lists what the final model still
-    misses — empty when every domain's calibrated check passes (at its share of ``level``), else one dict per
-    region, largest misfit first: ``"domain"``, ``"tau"`` (lo, hi) s, ``"band_hz"`` (lo, hi) or None,
-    ``"chi2_dof"`` over that τ range, ``"what"``, and the test's ``"statistic"``, ``"threshold"``, ``"alpha"``
+    """What :func:`refine` found. ``fit`` is the final model (a NoiseFit whose ``coefficients`` also hold the
+    curve effects' amplitudes, and whose ``components`` hold what each removal in time changed in the curve),
+    ``start`` the starting model, ``steps`` the effects added — both fits, and every step's before/after, on
+    the original record's Allan curve ``result``; ``corrected`` the curve of the samples after the removals in
+    time (None when nothing was removed). ``heldout_note`` says how (or why not) the held-out error was
+    computed; ``scored_tau`` the τ the RMS ADEV errors are scored on (:meth:`rms_adev_pct` gives a fit's);
+    ``term_moves`` the terms whose refined interval no longer overlaps the plain fit's, and the steps that
+    moved them. ``unexplained`` lists what the final model still misses — empty when every
+    domain's calibrated check passes (at its share of ``level``), else one dict per region, largest misfit first:
+    ``"domain"``, ``"tau"`` (lo, hi) s, ``"band_hz"`` (lo, hi) or None, ``"chi2_dof"`` over that τ range,
+    ``"what"``, and the test's ``"statistic"``, ``"threshold"``, ``"alpha"``
     (:mod:`allanite.model.refinement.missing`)."""
 
     steps: list
@@ -65,6 +142,8 @@ class Refinement(RichDisplay):
     tau_range: tuple = (0.0, math.inf)
     scored_tau: np.ndarray | None = None
     unexplained: list = field(default_factory=list)
+    corrected: AllanResult | None = None
+    term_moves: list = field(default_factory=list)
 
     def rms_adev_pct(self, fit) -> float:
         """RMS ADEV error (%) of a fit (``start`` or ``fit``) on the τ the steps' errors are scored on
@@ -77,8 +156,32 @@ class Refinement(RichDisplay):
         """Names of the effects kept, in the order they were added."""
         return [s.effect for s in self.steps]
 
+    @property
+    def final_heldout_rms_adev_pct(self) -> float | None:
+        """The held-out error of the final model (the last step's after; the start's if nothing was added)."""
+        return self.steps[-1].after.get("heldout_rms_adev_pct") if self.steps else self.start_heldout_rms_adev_pct
+
+    def _rate_unit(self) -> str | None:
+        return self.fit.unit
+
+    def params_text(self, st: Step, final: bool = False, digits: int = 4) -> str:
+        """A step's parameters (at acceptance, or after the final joint refit) with intervals and units."""
+        p, iv = (st.final_params, st.final_intervals) if final and st.final_params else (st.params, st.intervals)
+        return format_params(st.effect, p, iv, self._rate_unit(), digits)
+
+    def notes(self) -> list:
+        """What a reader must know to read the numbers: where they are scored, and the terms refinement moved."""
+        out = [
+            "Every step is scored on the original record's Allan curve: each step's before is the previous step's "
+            "after. Curve effects come first; then the components removed in time (removed before the curve "
+            "effects were searched), each with every curve effect in the model and its exact Allan variance, "
+            "AVAR(y) − AVAR(y − component), part of it. A change of noise level leaves the record's curve as it "
+            "is; its own statistic is on the windows' levels along the record (evidence['window_levels'])."
+        ]
+        return out + [term_move_text(m, self.fit.unit) for m in self.term_moves]
+
     def report(self) -> str:
-        """Markdown: the starting residual, each step with its parameters, evidence and errors."""
+        """Markdown: the starting residual, each step with its parameters, evidence and errors, the final model."""
         s0 = self.start
         ho = self.start_heldout_rms_adev_pct
         lines = [
@@ -99,53 +202,101 @@ class Refinement(RichDisplay):
                 else "Nothing added: no candidate earned its parameters — but the model still misses something (below)."
             )
         for i, st in enumerate(self.steps, 1):
-            ps = ", ".join(_fmt_param(k, v, st.intervals.get(k)) for k, v in st.params.items())
+            lines += self._step_lines(i, st)
+        return "\n".join(lines + self._final_lines() + self._missing_lines())
+
+    def _missing_lines(self) -> list:
+        lines = ["", "## What the model still misses", ""]
+        return lines + (
+            [f"- {describe_region(r)}" for r in self.unexplained]
+            or ["Nothing: every domain's calibrated check passes against the final model."]
+        )
+
+    def _step_lines(self, i: int, st: Step) -> list:
+        lines = [
+            f"## Step {i}: {st.effect}",
+            "",
+            f"- parameters at acceptance: {self.params_text(st)}",
+            f"- after the final joint refit: {self.params_text(st, final=True)}",
+            f"- evidence: {st.evidence}",
+            "- before → after: " + ", ".join(f"{k} {_fmt(st.before.get(k))} → {_fmt(st.after.get(k))}" for k in ERRORS),
+            "",
+        ]
+        if st.truth_error:
             lines += [
-                f"## Step {i}: {st.effect}",
-                "",
-                f"- parameters: {ps}",
-                f"- evidence: {st.evidence}",
-                "- before → after: "
-                + ", ".join(
-                    f"{k} {_fmt(st.before.get(k))} → {_fmt(st.after.get(k))}"
-                    for k in ("chi2_dof", "rms_z", "rms_adev_pct", "heldout_rms_adev_pct")
-                ),
+                "- error against the truth: " + ", ".join(f"{k} {100 * v:+.1f} %" for k, v in st.truth_error.items()),
                 "",
             ]
-            if st.truth_error:
-                lines.append(
-                    "- error against the truth: "
-                    + ", ".join(f"{k} {100 * v:+.1f} %" for k, v in st.truth_error.items())
-                )
-                lines.append("")
-        lines += ["## What the model still misses", ""]
-        lines += [f"- {describe_region(r)}" for r in self.unexplained] or [
-            "Nothing: every domain's calibrated check passes against the final model."
-        ]
-        return "\n".join(lines)
+        return lines
 
-    def _summary(self) -> Summary:
-        s0, s1 = self.start, self.fit
+    def _final_lines(self) -> list:
+        s1 = self.fit
+        ho = self.final_heldout_rms_adev_pct
+        lines = [
+            "## Final model",
+            "",
+            f"χ²/dof = {s1.chi2_dof:.3g}, RMS z = {np.sqrt(np.mean(s1.z**2)):.3g}, RMS ADEV error = "
+            f"{self.rms_adev_pct(s1):.3g} %, held-out RMS ADEV error = "
+            + (f"{ho:.3g} %." if ho is not None else "n/a."),
+            "",
+        ]
+        lines += [f"- {c!r}" for t, c in s1.coefficients.items() if t in self.terms]
+        lines += [
+            f"- {_effect_name(self.steps, i)}: {self.params_text(st, final=True)}" for i, st in enumerate(self.steps)
+        ]
+        return lines + [""] + [f"{n}" for n in self.notes()[1:]]
+
+    def _steps_table(self) -> Table:
         rows = []
         for i, st in enumerate(self.steps, 1):
-            units = {name: unit for name, unit, _ in EFFECTS[st.effect].params} if st.effect in EFFECTS else {}
-            ps = "; ".join(
-                f"{k} = {fmt_ci(v, *st.intervals[k])} {units.get(k, '')}".rstrip() for k, v in st.params.items()
-            )
+            b, a = st.before, st.after
             rows.append(
                 [
                     i,
                     st.effect,
-                    ps,
-                    f"{st.before['chi2_dof']:.3g} → {st.after['chi2_dof']:.3g}",
-                    f"{st.before['rms_adev_pct']:.3g} → {st.after['rms_adev_pct']:.3g}",
+                    self.params_text(st),
+                    self.params_text(st, final=True),
+                    f"{_fmt(b.get('chi2_dof'))} → {_fmt(a.get('chi2_dof'))}",
+                    f"{_fmt(b.get('rms_adev_pct'))} → {_fmt(a.get('rms_adev_pct'))}",
+                    f"{_fmt(b.get('heldout_rms_adev_pct'))} → {_fmt(a.get('heldout_rms_adev_pct'))}",
                 ]
             )
+        header = (
+            "step",
+            "effect",
+            "parameters at acceptance [interval]",
+            "after the final joint refit",
+            "χ²/dof before → after",
+            "RMS ADEV error % before → after",
+            "held-out % before → after",
+        )
+        return Table(header, rows, "effects added (each scored on the record's Allan curve)")
+
+    def _final_table(self) -> Table:
+        """The final model: each term, then each effect once, with the registry's units."""
+        rows = []
+        for t, c in self.fit.coefficients.items():
+            if t not in self.terms:
+                continue
+            ieee = "—" if c.ieee is None or c.ieee_ci is None else fmt_ci(c.ieee, *c.ieee_ci)
+            rows.append(
+                [t, TERM_NAMES.get(t, ""), fmt_ci(c.value, *c.ci), c.unit or "base form", ieee, c.ieee_unit or "—"]
+            )
+        for i, st in enumerate(self.steps):
+            label = EFFECTS[st.effect].label if st.effect in EFFECTS else ""
+            rows.append([_effect_name(self.steps, i), label, self.params_text(st, final=True), "", "—", "—"])
+        header = ("term or effect", "", "value [interval]", "unit", "IEEE-952 [interval]", "IEEE unit")
+        return Table(header, rows, "final model")
+
+    def _summary(self) -> Summary:
+        s0, s1 = self.start, self.fit
         facts: list = [
             ("starting model", "+".join(self.terms)),
             ("found", ", ".join(self.found) if self.steps else "nothing: the starting model fits"),
             ("χ²/dof", f"{s0.chi2_dof:.3g} → {s1.chi2_dof:.3g}"),
             ("RMS z", f"{np.sqrt(np.mean(s0.z**2)):.3g} → {np.sqrt(np.mean(s1.z**2)):.3g}"),
+            ("RMS ADEV error %", f"{self.rms_adev_pct(s0):.3g} → {self.rms_adev_pct(s1):.3g}"),
+            ("held-out %", f"{_fmt(self.start_heldout_rms_adev_pct)} → {_fmt(self.final_heldout_rms_adev_pct)}"),
             (
                 "record",
                 f"{self.result.n_samples} samples at {self.result.fs:g} Hz, τ {s0.tau[0]:.4g}–{s0.tau[-1]:.4g} s",
@@ -161,28 +312,14 @@ class Refinement(RichDisplay):
         )
         if self.change_points:
             facts.append(("change points", ", ".join(f"t = {float(c['t']):.4g} s" for c in self.change_points)))
-        tables = []
-        if rows:
-            tables.append(
-                Table(
-                    (
-                        "step",
-                        "effect",
-                        "parameters [interval]",
-                        "χ²/dof before → after",
-                        "RMS ADEV error % before → after",
-                    ),
-                    rows,
-                    "effects added",
-                )
-            )
-        tables.append(fitting.coefficient_table(s1.coefficients, "final model"))
+        tables = [self._steps_table()] if self.steps else []
+        tables.append(self._final_table())
         return Summary(
             title="Refinement",
             what="what the starting noise model lacked, found and fitted by allanite.refine",
             facts=facts,
             tables=tables,
-            notes=list(s1.notes),
+            notes=list(s1.notes) + self.notes(),
             figure=self._draw_small,
         )
 
@@ -221,14 +358,6 @@ class Refinement(RichDisplay):
 
 def _fmt(v) -> str:
     return "n/a" if v is None else f"{v:.3g}"
-
-
-def _fmt_param(k, v, iv) -> str:
-    if isinstance(v, str):
-        return f"{k} = {v}"
-    if iv is None:
-        return f"{k} = {v:.4g}"
-    return f"{k} = {v:.4g} [{iv[0]:.4g}, {iv[1]:.4g}]"
 
 
 def describe_region(reg: dict) -> str:

@@ -23,8 +23,7 @@ __all__ = [
     "HELDOUT_AGREE",
     "rms_adev_pct",
     "informative",
-    "curve_metrics",
-    "removal_metrics",
+    "chain_metrics",
     "Split",
     "heldout_split",
     "segments_heldout",
@@ -55,36 +54,30 @@ def informative(tau, nu) -> np.ndarray:
     return good if np.count_nonzero(good) >= 4 else mask
 
 
-def removal_metrics(curve: Curve, sol: Solution, change, n_params: int, heldout, scored) -> dict:
-    """In-sample errors of a time-domain removal on the curve it was removed *from*: the noise model
-    fitted after the removal plus the change the removal made to the Allan curve, against the same
-    estimates the "before" model was scored on (apples to apples). ``change`` = AVAR(y) − AVAR(y − c):
-    the component's own Allan variance and its cross terms with the rest of the record, exactly — a
-    regression's component is *not* independent of the noise (a channel's coupling varies across
-    frequency, so the residual keeps a band-by-band cross term that the component's own variance misses)."""
+def chain_metrics(curve0: Curve, sol: Solution, change, n_removed: int, heldout, scored) -> tuple[dict, float]:
+    """Errors of a model on the original record's Allan curve ``curve0`` — the one every step is scored on, so
+    that each step's "before" is the previous step's "after".
+
+    The model is the noise model ``sol`` (fitted on the curve the removals so far left) plus what they changed
+    in the curve, ``change`` = AVAR(y) − AVAR(y − components): their own Allan variance and their cross terms
+    with the rest of the record, exactly — a regression's component is *not* independent of the noise (a
+    channel's coupling varies across frequency, so the residual keeps a band-by-band cross term that the
+    component's own variance misses). ``n_removed`` numbers fitted by the removals come off the degrees of
+    freedom. Returns the metrics (χ²/dof, RMS z, RMS ADEV error on ``scored``, p-value, ``heldout``) and the
+    effective χ² (in independent points, ~one per octave)."""
     model = np.maximum(sol.model + change, 1e-300)
-    z = (curve.avar - model) * np.sqrt(sol.nu / (2.0 * model**2))
+    z = (curve0.avar - model) * np.sqrt(sol.nu / (2.0 * model**2))
     chi2 = float(np.sum(z**2))
-    dof = max(1, sol.dof - n_params)
-    return {
+    dof = max(1, sol.dof - n_removed)
+    chi2_eff = chi2 * curve0.n_eff / curve0.tau.size
+    metrics = {
         "chi2_dof": chi2 / dof,
         "rms_z": float(np.sqrt(np.mean(z**2))),
-        "rms_adev_pct": rms_adev_pct(curve.avar[scored], model[scored]),
-        "p_value": float(chi2_dist.sf(chi2 * curve.n_eff / curve.tau.size, max(1.0, curve.n_eff - 1))),
+        "rms_adev_pct": rms_adev_pct(curve0.avar[scored], model[scored]),
+        "p_value": float(chi2_dist.sf(chi2_eff, max(1.0, curve0.n_eff - 1))),
         "heldout_rms_adev_pct": heldout,
     }
-
-
-def curve_metrics(curve: Curve, sol: Solution, heldout, scored=None) -> dict:
-    """In-sample errors of a solution on its own curve (RMS ADEV error on ``scored``), with ``heldout``."""
-    sc = slice(None) if scored is None else scored
-    return {
-        "chi2_dof": sol.chi2_dof,
-        "rms_z": float(np.sqrt(np.mean(sol.z**2))),
-        "rms_adev_pct": rms_adev_pct(curve.avar[sc], sol.model[sc]),
-        "p_value": float(chi2_dist.sf(sol.chi2_eff(curve), max(1.0, curve.n_eff - 1))),
-        "heldout_rms_adev_pct": heldout,
-    }
+    return metrics, chi2_eff
 
 
 class Split:
@@ -128,6 +121,54 @@ class Split:
         """The Allan curve of one part's samples ``z`` on the split's τ."""
         av = np.maximum(avar(z, self.fs, taus=self.m / self.fs).avar, 1e-300)
         return Curve(self.m / self.fs, self.m.astype(np.float64), av, self.fs, self.size + 1, self.estimator)
+
+    def raw_parts(self) -> list:
+        """Per direction (held-in part f → held-out part h), nothing removed yet: the held-in samples and their
+        curve, the held-out samples and their curve, and no change of the curve to add back — the start of
+        :meth:`corrected`."""
+        return [
+            {
+                "zf": self.y[self.idx[f]],
+                "cf": self.curves[f],
+                "zh": self.y[self.idx[h]],
+                "ch": self.curves[h],
+                "extra": 0.0,
+            }
+            for f, h in ((0, 1), (1, 0))
+        ]
+
+    def corrected(self, parts: list, refit, on_raw: bool) -> list:
+        """``parts`` with one more removal, refitted on each held-in part's (already corrected) samples:
+        ``refit(samples, indices)`` returns the component as a function of sample indices. The model is then
+        fitted on the corrected held-in curve and predicts the held-out part's *raw* curve with what the removals
+        changed in the curve added back — for ``on_raw`` the change they made to the held-in part's curve, else
+        the change the held-in fit makes to the held-out part's curve, AVAR(z_h) − AVAR(z_h − g(h)) (a warm-up
+        both parts share, whose held-out change the held-in part's own does not carry over to)."""
+        out = []
+        for (f, h), p in zip(((0, 1), (1, 0)), parts):
+            g = refit(p["zf"], self.idx[f])
+            zf, zh = p["zf"] - g(self.idx[f]), p["zh"] - g(self.idx[h])
+            cf = self.curve(zf)
+            if on_raw:
+                ch, change = None, p["cf"].avar - cf.avar
+            else:
+                ch = self.curve(zh)
+                change = (p["ch"] if p["ch"] is not None else self.curve(p["zh"])).avar - ch.avar
+            out.append({"zf": zf, "cf": cf, "zh": zh, "ch": ch, "extra": p["extra"] + change})
+        return out
+
+    def predict(self, parts: list, terms, effects) -> float:
+        """RMS ADEV error (%) of the model fitted on each corrected held-in part (plus what the removals changed
+        in the curve) predicting the other part's raw curve, both ways: the held-out error on the original
+        record, removals refitted on the held-in samples."""
+        errs = []
+        for h, p in zip((1, 0), parts):
+            ch = self.curves[h]
+            sol = solve(p["cf"], terms, effects)
+            a_h, _ = design(ch, terms, effects)
+            pred = np.maximum(a_h @ sol.theta + p["extra"], 1e-300)
+            errs.append(rms_adev_pct(ch.avar[self.scored], pred[self.scored]))
+        return float(np.mean(errs))
 
     def error(self, terms, effects, remove=None, on_raw=False) -> float:
         """RMS ADEV error (%) of one part's model predicting the other's curve, both ways; ``remove(samples,
