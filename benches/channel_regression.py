@@ -36,7 +36,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import beta
+from scipy.stats import beta, chi2
 from scipy.stats import t as t_dist
 
 import _common
@@ -139,6 +139,7 @@ def null_main(records):
                 "block": bool(b),
                 "routed": bool(w.accepted if slow else b),
                 "lr": w.test["statistic"],
+                "whittle_chi2": bool(w.test["statistic"] > chi2.isf(ALPHA, 1)),
                 "lr_threshold": w.test["threshold"],
                 "nu": w.test["dof"],
                 "block_t": tt,
@@ -303,7 +304,7 @@ def _fmt(r):
 
 def summarize(main_rows, term_rows, pw, cst, records):
     s = {"alpha": ALPHA, "term_alpha": {k: v * LEVEL for k, v in TERM_SHARE.items()}}
-    s["null"] = {key: _rate(main_rows, key) for key in ("routed", "whittle", "block")}
+    s["null"] = {key: _rate(main_rows, key) for key in ("routed", "whittle", "block", "whittle_chi2")}
     s["null_by_kind"] = {
         k: {key: _rate(main_rows, key, lambda r, k=k: r["kind"] == k) for key in ("routed", "whittle", "block")}
         | {"slow_share_routed": float(np.mean([r["slow"] for r in main_rows if r["kind"] == k] or [0]))}
@@ -319,6 +320,8 @@ def summarize(main_rows, term_rows, pw, cst, records):
         k: {
             "records": len(v),
             "found": sum(p["found"] for p in v),
+            "accepted": sum(p["accepted"] for p in v),
+            "routed_slow": sum(p["slow_share"] >= 0.5 for p in v),
             "block_found": sum(p["block_found"] for p in v),
             "max_abs_error": {e: max(abs(p["errors"].get(e, math.inf)) for p in v) for e in v[0]["errors"]},
             "median_lr_over_threshold": float(np.median([p["lr"] / p["lr_threshold"] for p in v])),
@@ -362,6 +365,8 @@ def markdown(s, records, machine):
     lines += [
         f"| **all** | | **{_fmt(n['routed'])}** | {_fmt(n['whittle'])} | {_fmt(n['block'])} |",
         "",
+        f"`regress_channel` with χ²₁ instead of F(1, ν) (the noise level taken as known): {_fmt(n['whittle_chi2'])}.",
+        "",
         f"## Optional terms on records with a real linear coupling only ({s['null_terms_accepted']['records']} slow "
         f"channels; each term at {100 * LEVEL * TERM_SHARE['quadratic']:.2f} %)",
         "",
@@ -380,9 +385,9 @@ def markdown(s, records, machine):
         "coupling). LR/thr: the likelihood ratio over its F(1, ν) threshold; block t/thr: the within-block test "
         "it replaces on slow channels (t over its Satterthwaite-dof quantile). Held-out: even ↔ odd DFT bins.",
         "",
-        "| case | records | found | largest |error| | truth in the 68 % interval | median LR/thr | "
-        "within blocks: found, median t/thr | median held-out ratio | median time |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| case | records | routed slow | accepted | found | largest |error| | truth in the 68 % interval | "
+        "median LR/thr | within blocks: found, median t/thr | median held-out ratio | median time |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for k, v in s["power"].items():
         errs = ", ".join(f"{e} {100 * x:.1f} %" for e, x in v["max_abs_error"].items())
@@ -393,7 +398,8 @@ def markdown(s, records, machine):
             extra = f" (ADEV effect/noise up to {v['adev_ratio']:.1f}×)"
         cov = ", ".join(f"{e} {c}/{v['records']}" for e, c in v["covered_68"].items())
         lines.append(
-            f"| {k}{extra} | {v['records']} | {v['found']} | {errs} | {cov} | {v['median_lr_over_threshold']:.1f} | "
+            f"| {k}{extra} | {v['records']} | {v['routed_slow']} | {v['accepted']} | {v['found']} | {errs} | {cov} | "
+            f"{v['median_lr_over_threshold']:.1f} | "
             f"{v['block_found']}, {v['median_block_t_over_threshold']:.2f} | {v['median_heldout_ratio']:.3f} | "
             f"{v['median_seconds']:.2f} s |"
         )

@@ -170,19 +170,37 @@ class ChannelRegression:
     noise: dict = field(default_factory=dict)
     signal_bands: list | None = None
 
-    def component(self, ch) -> np.ndarray:
-        """What the coupling puts into the rate, for the channel samples ``ch`` (the whole record: a lag runs
-        along it), with the means of the fit."""
+    def columns(self, ch) -> np.ndarray:
+        """The regressors of the kept terms, (k, n), for the channel samples ``ch`` (the whole record: a lag
+        runs along it): the channel's signal bands (through the lag), then its square and its derivative where
+        kept; the fit's means."""
         x = np.asarray(ch, dtype=np.float64)
         xs = band_limited(x, self.fs, self.signal_bands)
         cols = _columns(xs, self.mean, self.quad_mean, self.fs, self.params.get("lag_s"))
-        p = self.params
-        out = p["coefficient"] * cols[0]
-        if "quadratic" in p:
-            out = out + p["quadratic"] * cols[1]
-        if "rate_coefficient" in p:
-            out = out + p["rate_coefficient"] * cols[2]
-        return out
+        keep = [0] + [i for i, k in ((1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
+        return np.array([cols[i] for i in keep])
+
+    def coefficients(self) -> np.ndarray:
+        """The kept terms' coefficients, in the order of :meth:`columns`."""
+        return np.array([self.params[k] for k in ("coefficient", "quadratic", "rate_coefficient") if k in self.params])
+
+    def component(self, ch) -> np.ndarray:
+        """What the coupling puts into the rate, for the channel samples ``ch`` (the whole record)."""
+        return self.coefficients() @ self.columns(ch)
+
+    def refit(self, samples, indices, ch):
+        """The same terms (and lag) refitted on ``samples`` taken at ``indices`` of the record (a held-in part:
+        alternate blocks joined end to end), the regressors built on the whole channel ``ch`` first; returns the
+        component as a function of sample indices (for a held-out error in time)."""
+        cols = self.columns(ch)
+        z = np.asarray(samples, dtype=np.float64)
+        sub = cols[:, np.asarray(indices)]
+        n_use = wh.usable_length(z.size)
+        bands = wh.spectra(z[:n_use], list(sub[:, :n_use]), self.fs)
+        one = np.ones(bands.m.size)
+        c = wh.joint_fit(bands, wh.Design(list(range(len(cols))), [one] * len(cols)))["c"]
+        comp = c @ cols
+        return lambda i: comp[np.asarray(i)]
 
 
 def lagged(x: np.ndarray, lag_s: float, fs: float) -> np.ndarray:
