@@ -301,3 +301,29 @@ def test_adis_accelerometers_are_fast_channels(shared_data):
     assert slow_share(az) < 0.1 and not is_slow(az)
     r = regress_channel(gx, az, 100.0, name="acc_z", terms=())
     assert r.params["coefficient"] < -3.0 < 0.0 < regression_fit(gx, az)["coefficient"]
+
+
+def test_refine_finds_the_issue_temperature_and_says_what_the_terms_had_taken():
+    # the issue's call: refine(y, 1.0, unit="rad/s", channels={"temp": T}) with default arguments
+    noise, true, logged = _heater(1)
+    y = noise + 4.5e-4 * (true - true.mean())
+    r = allanite.refine(y, 1.0, unit="rad/s", channels={"temp": logged}, truth={"regression": {"coefficient": 4.5e-4}})
+    st = next(s for s in r.steps if s.effect == "regression")
+    assert st.params["channel"] == "temp" and abs(st.truth_error["coefficient"]) < 0.2
+    assert st.evidence["test"]["likelihood_ratio"] > st.evidence["test"]["threshold"]
+    assert st.evidence["heldout_variance_ratio"] < 1.0
+    tba = st.evidence["terms_before_after"]
+    assert tba["terms"] == ["Q", "N", "B", "K", "R"]
+    # the temperature had gone into the ramp (R 146 → 9 °/h²) and the random walk; after the removal the terms
+    # are those of the noise alone (the same refine's starting fit on the record without the coupling)
+    alone = allanite.refine(noise, 1.0, unit="rad/s", candidates=()).start.coefficients
+    assert tba["before"]["R"][0] > 5 * tba["after"]["R"][0]
+    for t in ("N", "B", "K"):
+        assert tba["after"][t][0] == pytest.approx(alone[t].value, rel=0.05)
+    assert tba["before"]["K"][0] > tba["after"]["K"][0]
+    assert tba["ieee"]["after"]["K"][3] == "°/h^1.5"
+    text = r.report()
+    assert "noise terms fitted before → after the removal: Q" in text and "°/h^1.5 →" in text
+    # a constant channel is refused by name
+    with pytest.raises(ParameterError, match="channel 'temp' is constant"):
+        allanite.refine(y, 1.0, channels={"temp": np.full(y.size, 20.0)})

@@ -232,11 +232,11 @@ def channel_signal(x: np.ndarray, fs: float) -> tuple[float, list | None]:
     ends = np.append(starts[1:], n_bins + 1)
     out: list = []
     for a, b in zip(starts[ok], ends[ok]):
-        lo = 0.0 if a == 1 else (a - 0.5) * fs / d.size
+        lo, hi = (0.0 if a == 1 else float((a - 0.5) * fs / d.size)), float((b - 0.5) * fs / d.size)
         if out and abs(out[-1][1] - lo) < 1e-12 * fs:
-            out[-1] = (out[-1][0], (b - 0.5) * fs / d.size)
+            out[-1] = (out[-1][0], hi)
         else:
-            out.append((lo, (b - 0.5) * fs / d.size))
+            out.append((lo, hi))
     return floor, out or [(0.0, 0.0)]
 
 

@@ -8,7 +8,19 @@ calibrated with the rest on clean records (``benches/refine_false_alarms.py``).
 
 from __future__ import annotations
 
-__all__ = ["LEVEL", "LINE_SHARE", "CHANGE_POINT_SHARE", "TIME_SHARE", "SHARES", "TIME_SHARES", "share", "alpha"]
+from ..channels import TERM_SHARE
+
+__all__ = [
+    "LEVEL",
+    "LINE_SHARE",
+    "CHANGE_POINT_SHARE",
+    "TIME_SHARE",
+    "SHARES",
+    "TIME_SHARES",
+    "CONDITIONAL_SHARES",
+    "share",
+    "alpha",
+]
 
 #: Default false-alarm level per record (clean record: probability that anything is added).
 LEVEL = 0.05
@@ -23,15 +35,23 @@ TIME_SHARE = 0.075
 SHARES = {"lines": LINE_SHARE, "change_point": CHANGE_POINT_SHARE}
 #: The share of each time-domain removal, by effect name (one entry per removal of ``removals.REMOVALS``).
 TIME_SHARES = {"drift": TIME_SHARE, "regression": TIME_SHARE}
+#: Tests run only once another has accepted its effect — a slow channel's optional terms (quadratic,
+#: d(channel)/dt, lag; :data:`allanite.model.channels.TERM_SHARE`), each at this share of ``level``. On a clean
+#: record they never run unless the regression itself is a false alarm, so they take nothing from the
+#: per-record budget; on a record with a linear coupling each is the rate of naming a term that is not there
+#: (0 of 600 each, benches/results/channel_regression.md).
+CONDITIONAL_SHARES = {f"regression:{k}": v for k, v in TERM_SHARE.items()}
 
 
 def share(test: str) -> float:
-    """The share of ``level`` spent on ``test`` (a key of :data:`SHARES` or :data:`TIME_SHARES`, or ``"curve"``:
-    what the others leave)."""
+    """The share of ``level`` spent on ``test`` (a key of :data:`SHARES`, :data:`TIME_SHARES` or
+    :data:`CONDITIONAL_SHARES`, or ``"curve"``: what the others leave — the conditional ones take nothing)."""
     if test in SHARES:
         return SHARES[test]
     if test in TIME_SHARES:
         return TIME_SHARES[test]
+    if test in CONDITIONAL_SHARES:
+        return CONDITIONAL_SHARES[test]
     if test != "curve":
         raise KeyError(test)
     rest = 1.0

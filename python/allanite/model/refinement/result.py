@@ -12,6 +12,7 @@ from ..._display import RichDisplay, Summary, Table, fmt_ci, thin
 from ...results import AllanResult
 from .. import fitting
 from ..effects import EFFECTS
+from ..terms import TERM_NAMES
 from .scoring import rms_adev_pct
 
 __all__ = ["Step", "Refinement"]
@@ -94,7 +95,7 @@ class Refinement(RichDisplay):
                 f"## Step {i}: {st.effect}",
                 "",
                 f"- parameters: {ps}",
-                f"- evidence: {st.evidence}",
+                f"- evidence: { {k: v for k, v in st.evidence.items() if k != 'terms_before_after'} }",
                 "- before → after: "
                 + ", ".join(
                     f"{k} {_fmt(st.before.get(k))} → {_fmt(st.after.get(k))}"
@@ -102,6 +103,9 @@ class Refinement(RichDisplay):
                 ),
                 "",
             ]
+            tba = st.evidence.get("terms_before_after")
+            if tba:
+                lines += [f"- noise terms fitted before → after the removal: {_terms_side_by_side(tba)}", ""]
             if st.truth_error:
                 lines.append(
                     "- error against the truth: "
@@ -154,6 +158,12 @@ class Refinement(RichDisplay):
                     "effects added",
                 )
             )
+        for i, st in enumerate(self.steps, 1):
+            tba = st.evidence.get("terms_before_after")
+            if tba:
+                tables.append(
+                    _terms_table(tba, f"step {i} ({st.effect}): the noise terms before and after the removal")
+                )
         tables.append(fitting.coefficient_table(s1.coefficients, "final model"))
         return Summary(
             title="Refinement",
@@ -207,3 +217,27 @@ def _fmt_param(k, v, iv) -> str:
     if iv is None:
         return f"{k} = {v:.4g}"
     return f"{k} = {v:.4g} [{iv[0]:.4g}, {iv[1]:.4g}]"
+
+
+def _terms_values(tba: dict, when: str) -> dict:
+    """Term → "value [lo, hi] unit" (IEEE-952 units where the fit had a unit, else base form)."""
+    ieee = tba.get("ieee", {}).get(when, {})
+    out = {}
+    for t, (v, lo, hi) in tba[when].items():
+        if t in ieee:
+            v, lo, hi, u = ieee[t]
+            out[t] = f"{fmt_ci(v, lo, hi)} {u}"
+        else:
+            out[t] = fmt_ci(v, lo, hi)
+    return out
+
+
+def _terms_side_by_side(tba: dict) -> str:
+    before, after = _terms_values(tba, "before"), _terms_values(tba, "after")
+    return "; ".join(f"{t} {before[t]} → {after[t]}" for t in tba["terms"])
+
+
+def _terms_table(tba: dict, caption: str) -> Table:
+    before, after = _terms_values(tba, "before"), _terms_values(tba, "after")
+    rows = [[t, TERM_NAMES.get(t, ""), before[t], after[t]] for t in tba["terms"]]
+    return Table(("term", "", "before [interval]", "after [interval]"), rows, caption)
