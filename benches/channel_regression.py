@@ -352,14 +352,18 @@ def summarize(main_rows, term_rows, pw, cst, records):
     return s
 
 
+def _load(v) -> str:
+    return "?" if not v else "[" + ", ".join(f"{x:.1f}" for x in v) + "]"
+
+
 def markdown(s, records, machine):
     a = 100 * s["alpha"]
     lines = [
         "# Regressions on slow channels — `benches/channel_regression.py`",
         "",
-        f"Machine: {machine.get('cpu_model', '?')} ({machine.get('cpus_usable', '?')} usable CPUs), load average at "
-        f"the start {machine.get('loadavg_start', '?')} (other workers share the machine), commit "
-        f"{machine.get('git_commit', '?')}.",
+        f"Machine: {machine.get('cpu_model', '?')} ({machine.get('cpus_usable', '?')} usable CPUs), load average "
+        f"(1, 5, 15 min) at the start {_load(machine.get('loadavg_start'))} and at the end "
+        f"{_load(machine.get('loadavg_end'))} (other workers share the machine), commit {machine.get('git_commit', '?')}.",
         "",
         f"## False alarms of the coupling's test ({records} null records, level {a:.3f} % each)",
         "",
@@ -425,9 +429,8 @@ def markdown(s, records, machine):
         "A default `refine` on 10⁶ samples (100 Hz, 2.8 h) with a slow channel (heater steps, 0.01 per °C): "
         f"{c['refine_with_channel_s']:.2f} s (found {', '.join(c['found_with_channel']) or 'nothing'}); without the "
         f"channel {c['refine_without_channel_s']:.2f} s — ratio {c['ratio']:.2f}; `regress_channel` alone (every "
-        f"optional term) {c['regress_channel_s']:.2f} s (best of 3). One run each; load average at the end "
-        f"{[round(v, 1) for v in c['loadavg_end']]} on 2 CPUs shared with other workers: the ratio is the number "
-        "to read.",
+        f"optional term) {c['regress_channel_s']:.2f} s (best of 3). One run each; load average after them "
+        f"{_load(c['loadavg_end'])} on 2 CPUs shared with other workers: the ratio is the number to read.",
     ]
     return "\n".join(lines) + "\n"
 
@@ -440,6 +443,7 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     records = 14 if a.quick else a.records
     t0 = time.perf_counter()
+    machine = _common.machine_info()
     main_rows = null_main(records)
     term_rows = null_terms(records // 2 if a.quick else records)
     pw = power() if not a.quick else []
@@ -456,7 +460,7 @@ def main(argv=None) -> int:
         }
     )
     s = summarize(main_rows, term_rows, pw, cst, records)
-    machine = _common.machine_info()
+    machine["loadavg_end"] = list(os.getloadavg())
     report = {
         "summary": s,
         "null": main_rows,
