@@ -132,6 +132,8 @@ MODEL_RANKS = {
     "model.effects": 0,
     "model.fitting": 1,
     "model.tracing": 1,
+    "model._whittle": 0,
+    "model.channels": 1,
     "model.timeframes": 2,
     "model.warmup": 2,
     "model.refinement.levels": 2,

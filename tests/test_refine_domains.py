@@ -124,7 +124,13 @@ def test_registry_documents_every_effect():
         assert name in (allanite.refine.__doc__ or "")
     assert EFFECTS["bandwidth"].params[0][:2] == ("cutoff", "Hz")
     assert EFFECTS["drift"].params[1][:2] == ("T", "s")
-    assert [p[0] for p in EFFECTS["regression"].params] == ["channel", "coefficient"]
+    assert [p[:2] for p in EFFECTS["regression"].params] == [
+        ("channel", ""),
+        ("coefficient", "rate unit per channel unit"),
+        ("quadratic", "rate unit per channel unit²"),
+        ("rate_coefficient", "rate unit per (channel unit/s)"),
+        ("lag_s", "s"),
+    ]
 
 
 def test_finds_a_simulated_bandwidth():

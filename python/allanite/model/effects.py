@@ -312,10 +312,16 @@ EFFECTS: dict[str, Effect] = {
             (
                 ("channel", "", "name of the other channel (as passed in channels=)"),
                 ("coefficient", "rate unit per channel unit", "sensitivity: g-sensitivity, temperature, coupling"),
+                ("quadratic", "rate unit per channel unit²", "on (channel − mean)², slow channels, when kept"),
+                ("rate_coefficient", "rate unit per (channel unit/s)", "on d(channel)/dt, slow channels, when kept"),
+                ("lag_s", "s", "the rate follows the channel through a first-order lag, slow channels, when kept"),
             ),
-            "the rate regressed on another channel of the log (least squares on the de-meaned samples; "
-            "coefficient: the whole-record value), band by band (octaves) where the coupling differs across "
-            "frequency (evidence['bands']); removed before the noise fit",
+            "the rate regressed on another channel of the log, removed before the noise fit. A fast channel "
+            "(an accelerometer, a multi-position profile): least squares within 8 blocks in time (coefficient: "
+            "the whole-record value), band by band (octaves) where the coupling differs across frequency "
+            "(evidence['bands']). A slow channel (≥ 50 % of its variance between the blocks' means: a "
+            "temperature): Whittle GLS against the record's own noise, with a quadratic, a d(channel)/dt term or "
+            "a lag where their own tests keep them (allanite.model.channels, docs/channels.md)",
             domain="channels",
         ),
         Effect(

@@ -8,6 +8,8 @@ calibrated with the rest on clean records (``benches/refine_false_alarms.py``).
 
 from __future__ import annotations
 
+from ..channels import TERM_SHARE
+
 __all__ = [
     "LEVEL",
     "LINE_SHARE",
@@ -16,6 +18,7 @@ __all__ = [
     "UNEXPLAINED_SHARES",
     "SHARES",
     "TIME_SHARES",
+    "CONDITIONAL_SHARES",
     "share",
     "alpha",
 ]
@@ -41,15 +44,23 @@ SHARES = {
 }
 #: The share of each time-domain removal, by effect name (one entry per removal of ``removals.REMOVALS``).
 TIME_SHARES = {"drift": TIME_SHARE, "regression": TIME_SHARE}
+#: Tests run only once another has accepted its effect — a slow channel's optional terms (quadratic,
+#: d(channel)/dt, lag; :data:`allanite.model.channels.TERM_SHARE`), each at this share of ``level``. On a clean
+#: record they never run unless the regression itself is a false alarm, so they take nothing from the
+#: per-record budget; on a record with a linear coupling each is the rate of naming a term that is not there
+#: (0 of 600 each, benches/results/channel_regression.md).
+CONDITIONAL_SHARES = {f"regression:{k}": v for k, v in TERM_SHARE.items()}
 
 
 def share(test: str) -> float:
-    """The share of ``level`` spent on ``test`` (a key of :data:`SHARES` or :data:`TIME_SHARES`, or ``"curve"``:
-    what the others leave)."""
+    """The share of ``level`` spent on ``test`` (a key of :data:`SHARES`, :data:`TIME_SHARES` or
+    :data:`CONDITIONAL_SHARES`, or ``"curve"``: what the others leave — the conditional ones take nothing)."""
     if test in SHARES:
         return SHARES[test]
     if test in TIME_SHARES:
         return TIME_SHARES[test]
+    if test in CONDITIONAL_SHARES:
+        return CONDITIONAL_SHARES[test]
     if test != "curve":
         raise KeyError(test)
     rest = 1.0

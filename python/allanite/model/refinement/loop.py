@@ -22,6 +22,7 @@ from ...errors import InputError, ParameterError
 from ...estimators.grid import tau_grid
 from ...results import AllanResult
 from .. import fitting, tracing
+from ..channels import check_channel, terms_before_after
 from ..effects import EFFECTS, describe
 from ..terms import check_terms
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
@@ -148,7 +149,7 @@ def refine(
         start = check_terms(start)
         candidates = _check_candidates(candidates, level)
         y, result, chans = _inputs(x_or_result, fs, input, points, axis, channels)
-        run = _Run(y, result, start, tau_range, level, truth)
+        run = _Run(y, result, start, tau_range, level, truth, unit)
         run.remove_in_time(candidates, chans)
         run.add_curve_effects(candidates)
         cp_steps = run.change_point_steps(candidates)
@@ -210,12 +211,7 @@ def _channels(channels, y) -> dict:
         if y is None:
             raise ParameterError("channels need samples (a regression is fitted along time), not an AllanResult")
         for name, c in channels.items():
-            c = np.asarray(c, dtype=np.float64).ravel()
-            if c.size != y.size:
-                raise ParameterError(f"channel {name!r} has {c.size} samples; the rate has {y.size}")
-            if not np.all(np.isfinite(c)):
-                raise ParameterError(f"channel {name!r} has non-finite samples")
-            chans[str(name)] = c
+            chans[str(name)] = check_channel(str(name), c, y.size)
     return chans
 
 
@@ -245,8 +241,9 @@ class _Run:
     step (on the samples as they were when it was tested, or per segment for change points) is kept in its
     ``evidence["heldout_test"]`` where it differs."""
 
-    def __init__(self, y, result, start, tau_range, level, truth):
+    def __init__(self, y, result, start, tau_range, level, truth, unit=None):
         self.y, self.result, self.start, self.level, self.truth = y, result, start, level, truth
+        self.unit = unit
         self.lo, self.hi = _resolve_tau_range(tau_range, result, start)
         keep = (result.tau >= self.lo) & (result.tau <= self.hi) & (result.avar > 0)
         if keep.sum() < len(start) + 3:
@@ -355,6 +352,13 @@ class _Run:
         if ho_b is not None:  # on the samples as they were, the five terms alone
             rem.evidence["heldout_test"] = {"before": ho_b, "after": ho_a}
         params = dict(rem.params)
+        s_new = solve(c_new, start, effects)
+        # the noise terms fitted with the component in the samples and without it, side by side: what the
+        # start model had taken of it (a temperature swing into B, K and R)
+        rem.evidence["terms_before_after"] = terms_before_after(
+            noise_fit(self.curve, start, effects, self.sol, self.result, self.unit, 0.683),
+            noise_fit(c_new, start, effects, s_new, res_new, self.unit, 0.683),
+        )
         st = Step(
             effect=rem.effect,
             params=params,
@@ -371,7 +375,7 @@ class _Run:
             parts = self.split0.corrected(self.removed[-1][4] if self.removed else self.raw, rem.refit, rem.on_raw)
         self.removed.append((st, rem, self.curve.avar - c_new.avar, c_new, parts))
         self.y, self.result, self.curve, self.heldout = y_new, res_new, c_new, h_new
-        self.sol = solve(c_new, start, effects)
+        self.sol = s_new
         return True
 
     # ---- curve effects

@@ -13,8 +13,10 @@ changed in the Allan curve, AVAR(y) − AVAR(y − component), cross terms inclu
   a and T and their intervals by generalised least squares against the block means' covariance under the
   record's own noise terms (:mod:`allanite.model.warmup`: flicker and random walk tie the block means together,
   and an ordinary fit's intervals then miss the truth);
-- ``"regression"`` — the rate regressed on each channel of ``channels=`` within blocks in time (t test with the
-  blocks' effective dof), band by band where the coupling differs across frequency.
+- ``"regression"`` — the rate regressed on each channel of ``channels=``: a fast channel within blocks in time
+  (t test with the blocks' effective dof), band by band where the coupling differs across frequency; a slow one
+  (:func:`allanite.model.channels.is_slow`: a temperature) against the record's own noise by a Whittle GLS, with
+  its optional terms (:func:`allanite.model.channels.regress_channel`).
 
 Removals run before the curve effects (a component left in the samples bends the curve every curve effect is
 fitted against), in the order of :data:`REMOVALS`. A new one (line families removed in time, spikes replaced,
@@ -29,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import t as t_dist
 
-from .. import tracing, warmup
+from .. import channels, tracing, warmup
 from .calibrated import tested
 from .curvefit import Curve, Solution, theta_terms, upper_theta
 from .levels import alpha
@@ -142,6 +144,9 @@ def _regression(ctx: RemovalContext) -> Iterator[Removal]:
     independent of the curve."""
     fs, a = ctx.fs, alpha("regression", ctx.level)
     for name, ch in ctx.channels.items():
+        if channels.is_slow(ch):
+            yield from _slow_regression(ctx, name, ch, a / len(ctx.channels))
+            continue
         rg = tracing.regression_fit(ctx.y, ch, REGRESSION_BLOCKS)
         # t with the blocks' effective number − 1 degrees of freedom (≤ REGRESSION_BLOCKS − 1)
         t_thr = t_dist.isf(a / (2 * len(ctx.channels)), rg["dof"])
@@ -176,6 +181,37 @@ def _regression(ctx: RemovalContext) -> Iterator[Removal]:
             on_raw=True,
             heldout_in_time=held,
         )
+
+
+def _slow_regression(ctx: RemovalContext, name: str, ch: np.ndarray, a: float) -> Iterator[Removal]:
+    """A slow channel (most of its variance between the blocks' means, where the within-block test is blind):
+    Whittle GLS against the record's own noise, the noise refitted on y − ĉ·ch; optional terms by their own
+    tests; held out across frequency (a temperature that moves once moves in one part of any split in time)."""
+    r = channels.regress_channel(ctx.y, ch, ctx.fs, name=name, alpha=a, level=ctx.level)
+    test = tested("likelihood_ratio", r.test["statistic"], r.test["threshold"], a) | {"dof": r.test["dof"]}
+    if not r.accepted:
+        ctx.consider("regression", {"channel": name} | test)
+        return
+    ev = {
+        "domain": "channels",
+        "test": test,
+        "method": "slow channel: Whittle GLS against the record's own noise (docs/channels.md)",
+        "slow_share": channels.slow_share(ch),
+        "terms": r.terms,
+        "signal_bands_hz": r.signal_bands,
+        "heldout": "even ↔ odd DFT bins",
+    }
+    yield Removal(
+        "regression",
+        r.component(ch),
+        lambda z, idx, r=r, ch=ch: r.refit(z, idx, ch),
+        {"channel": name} | r.params,
+        r.intervals,
+        ev,
+        len(r.params),
+        on_raw=True,
+        heldout_in_time=channels.heldout_ratio(ctx.y, ch, ctx.fs, r),
+    )
 
 
 #: The time-domain removals, in the order they run (each before the curve effects).

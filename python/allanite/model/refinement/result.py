@@ -218,10 +218,13 @@ class Refinement(RichDisplay):
             "",
             f"- parameters at acceptance: {self.params_text(st)}",
             f"- after the final joint refit: {self.params_text(st, final=True)}",
-            f"- evidence: {st.evidence}",
+            f"- evidence: { {k: v for k, v in st.evidence.items() if k != 'terms_before_after'} }",
             "- before → after: " + ", ".join(f"{k} {_fmt(st.before.get(k))} → {_fmt(st.after.get(k))}" for k in ERRORS),
             "",
         ]
+        tba = st.evidence.get("terms_before_after")
+        if tba:
+            lines += [f"- noise terms fitted before → after the removal: {_terms_side_by_side(tba)}", ""]
         if st.truth_error:
             lines += [
                 "- error against the truth: " + ", ".join(f"{k} {100 * v:+.1f} %" for k, v in st.truth_error.items()),
@@ -314,6 +317,12 @@ class Refinement(RichDisplay):
             facts.append(("change points", ", ".join(f"t = {float(c['t']):.4g} s" for c in self.change_points)))
         tables = [self._steps_table()] if self.steps else []
         tables.append(self._final_table())
+        for i, st in enumerate(self.steps, 1):
+            tba = st.evidence.get("terms_before_after")
+            if tba:
+                tables.insert(
+                    -1, _terms_table(tba, f"step {i} ({st.effect}): the noise terms before and after the removal")
+                )
         return Summary(
             title="Refinement",
             what="what the starting noise model lacked, found and fitted by allanite.refine",
@@ -379,3 +388,27 @@ def _num(v: float) -> str:
         return f"{v:g}"
     digits = max(0, 1 - int(math.floor(math.log10(abs(v)))))
     return f"{v:.{min(digits, 6)}f}" if abs(v) < 1000 else f"{v:.3g}"
+
+
+def _terms_values(tba: dict, when: str) -> dict:
+    """Term → "value [lo, hi] unit" (IEEE-952 units where the fit had a unit, else base form)."""
+    ieee = tba.get("ieee", {}).get(when, {})
+    out = {}
+    for t, (v, lo, hi) in tba[when].items():
+        if t in ieee:
+            v, lo, hi, u = ieee[t]
+            out[t] = f"{fmt_ci(v, lo, hi)} {u}"
+        else:
+            out[t] = fmt_ci(v, lo, hi)
+    return out
+
+
+def _terms_side_by_side(tba: dict) -> str:
+    before, after = _terms_values(tba, "before"), _terms_values(tba, "after")
+    return "; ".join(f"{t} {before[t]} → {after[t]}" for t in tba["terms"])
+
+
+def _terms_table(tba: dict, caption: str) -> Table:
+    before, after = _terms_values(tba, "before"), _terms_values(tba, "after")
+    rows = [[t, TERM_NAMES.get(t, ""), before[t], after[t]] for t in tba["terms"]]
+    return Table(("term", "", "before [interval]", "after [interval]"), rows, caption)

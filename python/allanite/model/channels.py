@@ -1,0 +1,558 @@
+"""The rate regressed on another channel of the log (a temperature, an accelerometer), tested against the
+record's own noise — slow channels and fast ones alike.
+
+:func:`regress_channel` estimates the coupling and the noise together by Whittle's frequency-domain likelihood
+(:mod:`allanite.model._whittle`): the record and the channel differenced and tapered, their DFT pooled into
+bands, the noise PSD of the differenced record modelled by the IEEE-952 terms (Q, N, B, K, plus Gauss–Markov
+terms) in the low bands and by each band's own level above. The coefficient is the generalised least-squares
+estimate weighted by that PSD, the noise is refitted on y − ĉ·ch, and the two alternate until the likelihood
+settles — the noise never takes the channel's share first. The test is the likelihood ratio 2Δℓ against no
+coupling, referred to F(1, ν): ν is the effective number of degrees of freedom of the noise level the
+coefficient is weighed against (a Satterthwaite count from the noise fit's own covariance), so a channel that
+moves only at the lowest frequencies, where a random walk's level is known to ±20 %, is tested as such.
+O(N log N) (one FFT of the record and one per regressor).
+
+Why not within time blocks (the test it replaces, :func:`allanite.model.tracing.regression_fit`): de-meaning 8
+blocks takes out the slow wander the channel and the noise share, and with it the slow channel itself — a
+temperature that moves within one or two blocks leaves ≈ 1.25 effective degrees of freedom and a t threshold of
+64. Here the wander is not removed but weighed: a random walk's and flicker's power at each frequency is in S.
+
+Optional terms, each kept only by its own nested test at its own share of the level:
+
+- ``quadratic`` — on (ch − mean)² (per channel unit²): likelihood ratio, F(1, ν);
+- ``rate_coefficient`` — on d(ch)/dt (per channel unit/s, central differences): likelihood ratio, F(1, ν);
+- ``lag_s`` — the rate follows the channel through a first-order lag of that time constant (s): the family
+  c·ch + c_L·(L_T[ch] − ch)/T over T on a log grid (T → 0 is the d(ch)/dt direction), its largest score
+  statistic against the t-process upcrossing bound (Davies 1987; Worsley 1994: P(F(1, ν) > u) +
+  (V/π)·(1 + u/ν)^{−(ν−1)/2}, V the arc length of the whitened family over the grid). A lag and a d(ch)/dt
+  term are nearly collinear: when both pass, the lag is kept only if the pure lag model c·L_T[ch] beats the
+  rate model by :data:`LAG_MARGIN` in 2Δℓ; otherwise the rate term is kept — never both.
+
+Intervals: the coefficients ±t_ν quantile × the inverse Fisher information's standard error; the lag from the
+profile likelihood.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import fft as sfft
+from scipy import signal
+from scipy.optimize import brentq
+from scipy.stats import f as f_dist
+from scipy.stats import t as t_dist
+
+from .._validate import check_fs, check_probability
+from ..errors import InputError, ParameterError
+from . import _whittle as wh
+
+__all__ = [
+    "regress_channel",
+    "ChannelRegression",
+    "heldout_ratio",
+    "check_channel",
+    "slow_share",
+    "is_slow",
+    "terms_before_after",
+    "SUBTERMS",
+    "TERM_SHARE",
+    "SLOW_SHARE",
+]
+
+#: Optional terms of a channel regression, in the order they are tried.
+SUBTERMS = ("quadratic", "rate_coefficient", "lag_s")
+#: Share of the per-record level spent on each optional term's test (a test run only once the coupling itself
+#: is accepted).
+TERM_SHARE = {"quadratic": 0.02, "rate_coefficient": 0.02, "lag_s": 0.02}
+#: Default per-record level and the default share of it for the coupling's test (refine's time-domain share).
+LEVEL = 0.05
+ALPHA = 0.075 * LEVEL
+#: The pure lag replaces a kept rate term only if it fits better by this much in 2Δℓ ("positive" evidence).
+LAG_MARGIN = 4.0
+#: Lag grid: points per octave, from 2 samples to a quarter of the record.
+LAG_PER_OCTAVE = 8
+#: Share of the channel's information (Σ_b |Z_b|²/S_b) whose bands the held-out ratio is summed over.
+HELDOUT_INFO = 0.99
+#: A band of the channel takes part only where its power is this many times its measurement noise's.
+CHANNEL_SNR = 20.0
+#: A channel is slow when at least this share of its variance is between the means of 8 blocks in time (the
+#: block test's blind spot, :func:`allanite.model.tracing.regression_fit`).
+SLOW_SHARE = 0.5
+#: Shortest record.
+MIN_SAMPLES = 64
+
+
+def check_channel(name: str, ch, n: int) -> np.ndarray:
+    """The channel as float64 of the rate's length ``n``, finite and not constant, or an AllaniteError naming it."""
+    try:
+        x = np.asarray(ch, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise ParameterError(f"channel {name!r} must be an array of numbers, got {type(ch).__name__}") from None
+    if x.size != n:
+        raise ParameterError(f"channel {name!r} has {x.size} samples; the rate has {n}")
+    bad = np.flatnonzero(~np.isfinite(x))
+    if bad.size:
+        raise InputError(
+            f"channel {name!r} has non-finite samples ({bad.size}; the first at index {bad[0]}: {x[bad[0]]!r}); "
+            "every sample must be finite"
+        )
+    if not np.ptp(x) > 0:
+        raise ParameterError(f"channel {name!r} is constant (every sample {x[0]!r}): there is nothing to regress on")
+    return x
+
+
+def slow_share(x, blocks: int = 8) -> float:
+    """Share of the channel's variance that lies between the means of ``blocks`` blocks in time — what
+    de-meaning each block (the within-block test) throws away. A temperature that rises once or wanders as a
+    random walk: ≈ 0.9; a ±1 g multi-position profile turned every few minutes, an accelerometer's noise: ≈ 0."""
+    x = np.asarray(x, dtype=np.float64)
+    per = x.size // blocks
+    xb = x[: per * blocks].reshape(blocks, per)
+    total = float(np.sum((xb - xb.mean()) ** 2))
+    within = float(np.sum((xb - xb.mean(axis=1, keepdims=True)) ** 2))
+    return 1.0 - within / total if total > 0 else 0.0
+
+
+def is_slow(x, blocks: int = 8) -> bool:
+    """Whether a channel is slow (:data:`SLOW_SHARE`): tested by :func:`regress_channel`, not within blocks."""
+    return slow_share(x, blocks) >= SLOW_SHARE
+
+
+def terms_before_after(before, after) -> dict:
+    """The noise terms of two :class:`~allanite.model.fitting.NoiseFit` — before and after a removal — side
+    by side: ``{"terms": [...], "before": {term: (value, lo, hi)}, "after": {...}, "unit": ...}`` in the
+    input unit's base form (IEEE-952 units where the fits have them, under ``"ieee"``)."""
+    out: dict = {"terms": list(before.coefficients), "before": {}, "after": {}, "ieee": {"before": {}, "after": {}}}
+    for key, f in (("before", before), ("after", after)):
+        for name, c in f.coefficients.items():
+            out[key][name] = (float(c.value), float(c.ci[0]), float(c.ci[1]))
+            if c.ieee is not None and c.ieee_ci is not None:
+                out["ieee"][key][name] = (float(c.ieee), float(c.ieee_ci[0]), float(c.ieee_ci[1]), c.ieee_unit)
+    return out
+
+
+def _check_rate(y, fs) -> tuple[np.ndarray, float]:
+    fs = check_fs(fs)
+    try:
+        y = np.asarray(y, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        raise InputError(f"the rate must be an array of numbers, got {type(y).__name__}") from None
+    if y.size < MIN_SAMPLES:
+        raise InputError(f"a channel regression needs at least {MIN_SAMPLES} samples, got {y.size}")
+    bad = np.flatnonzero(~np.isfinite(y))
+    if bad.size:
+        raise InputError(f"the rate has non-finite samples (the first at index {bad[0]}: {y[bad[0]]!r})")
+    return y, fs
+
+
+@dataclass(frozen=True)
+class ChannelRegression:
+    """A channel's coupling into the rate, with its tests.
+
+    ``params``: ``coefficient`` (rate unit per channel unit) and the optional terms kept — ``quadratic`` (per
+    channel unit²), ``rate_coefficient`` (per channel unit/s), ``lag_s`` (s); ``intervals`` the same keys;
+    ``test``: the coupling's likelihood ratio (``statistic``, 2Δℓ), ``threshold``, ``alpha``, ``dof`` (ν),
+    ``p_value``; ``terms``: each optional term's test (``statistic``, ``threshold``, ``alpha``, ``dof``,
+    ``kept``, and why not); ``accepted``: the coupling passed its test (optional terms are tried only then).
+    """
+
+    name: str
+    accepted: bool
+    params: dict
+    intervals: dict
+    test: dict
+    terms: dict
+    fs: float
+    mean: float
+    quad_mean: float
+    noise: dict = field(default_factory=dict)
+    signal_bands: list | None = None
+
+    def columns(self, ch) -> np.ndarray:
+        """The regressors of the kept terms, (k, n), for the channel samples ``ch`` (the whole record: a lag
+        runs along it): the channel's signal bands (through the lag), then its square and its derivative where
+        kept; the fit's means."""
+        x = np.asarray(ch, dtype=np.float64)
+        xs = band_limited(x, self.fs, self.signal_bands)
+        cols = _columns(xs, self.mean, self.quad_mean, self.fs, self.params.get("lag_s"))
+        keep = [0] + [i for i, k in ((1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
+        return np.array([cols[i] for i in keep])
+
+    def coefficients(self) -> np.ndarray:
+        """The kept terms' coefficients, in the order of :meth:`columns`."""
+        return np.array([self.params[k] for k in ("coefficient", "quadratic", "rate_coefficient") if k in self.params])
+
+    def component(self, ch) -> np.ndarray:
+        """What the coupling puts into the rate, for the channel samples ``ch`` (the whole record)."""
+        return self.coefficients() @ self.columns(ch)
+
+    def refit(self, samples, indices, ch):
+        """The same terms (and lag) refitted on ``samples`` taken at ``indices`` of the record (a held-in part:
+        alternate blocks joined end to end), the regressors built on the whole channel ``ch`` first; returns the
+        component as a function of sample indices (for a held-out error in time)."""
+        cols = self.columns(ch)
+        z = np.asarray(samples, dtype=np.float64)
+        sub = cols[:, np.asarray(indices)]
+        n_use = wh.usable_length(z.size)
+        bands = wh.spectra(z[:n_use], list(sub[:, :n_use]), self.fs)
+        one = np.ones(bands.m.size)
+        c = wh.joint_fit(bands, wh.Design(list(range(len(cols))), [one] * len(cols)))["c"]
+        comp = c @ cols
+        return lambda i: comp[np.asarray(i)]
+
+
+def lagged(x: np.ndarray, lag_s: float, fs: float) -> np.ndarray:
+    """``x`` through a first-order lag of time constant ``lag_s`` (impulse invariant, a = 1 − e^{−1/(fs·T)}),
+    starting in equilibrium with the first sample."""
+    a = -math.expm1(-1.0 / (fs * lag_s))
+    return signal.lfilter([a], [1.0, a - 1.0], x - x[0]) + x[0]
+
+
+def channel_signal(x: np.ndarray, fs: float) -> tuple[float, list | None]:
+    """The channel's white measurement noise per sample (variance) and the frequency intervals (Hz) where it
+    stands above it, from one periodogram of its differences.
+
+    The floor: the median of P_k/s_k² (s_k = 2 sin(πk/M)) over the upper half of the band (f ≥ f_s/4), over
+    ln 2 (an exponential's median is ln 2 × its mean). The intervals: merged runs of the bands of
+    :mod:`allanite.model._whittle` whose power is at least :data:`CHANNEL_SNR` × the floor's (σ²·s²); None
+    when that is every band (no noise to keep out)."""
+    d = np.diff(x)
+    n_bins = d.size // 2
+    p = np.abs(sfft.rfft(d)[1 : n_bins + 1]) ** 2 / d.size
+    k = np.arange(1, n_bins + 1)
+    s2 = 4.0 * np.sin(np.pi * k / d.size) ** 2
+    top = k >= d.size // 4
+    floor = float(np.median(p[top] / s2[top]) / math.log(2.0)) if top.any() else 0.0
+    starts = wh.band_starts(n_bins)
+    ok = np.add.reduceat(p, starts - 1) >= CHANNEL_SNR * floor * np.add.reduceat(s2, starts - 1)
+    if ok.all():
+        return floor, None
+    ends = np.append(starts[1:], n_bins + 1)
+    out: list = []
+    for a, b in zip(starts[ok], ends[ok]):
+        lo, hi = (0.0 if a == 1 else float((a - 0.5) * fs / d.size)), float((b - 0.5) * fs / d.size)
+        if out and abs(out[-1][1] - lo) < 1e-12 * fs:
+            out[-1] = (out[-1][0], hi)
+        else:
+            out.append((lo, hi))
+    return floor, out or [(0.0, 0.0)]
+
+
+def band_limited(x: np.ndarray, fs: float, bands: list | None) -> np.ndarray:
+    """``x`` with only the frequency intervals ``bands`` (Hz) of its differences kept (None: all), integrated
+    back from the first sample (filtered as differences, so the record's two ends need not meet)."""
+    if bands is None:
+        return x
+    d = np.diff(x)
+    f = np.fft.rfftfreq(d.size, 1.0 / fs)
+    mask = np.zeros(f.size, dtype=bool)
+    mask[0] = True
+    for lo, hi in bands:
+        mask |= (f >= lo) & (f <= hi)
+    return x[0] + np.concatenate([[0.0], np.cumsum(sfft.irfft(sfft.rfft(d) * mask, d.size))])
+
+
+def _lag_response(f: np.ndarray, lag_s: float, fs: float) -> np.ndarray:
+    a = -math.expm1(-1.0 / (fs * lag_s))
+    return a / (1.0 - (1.0 - a) * np.exp(-2j * np.pi * f / fs))
+
+
+def _f_test(stat: float, dof: float, alpha: float) -> dict:
+    return {
+        "statistic": float(stat),
+        "threshold": float(f_dist.isf(alpha, 1, dof)),
+        "alpha": float(alpha),
+        "dof": float(dof),
+        "p_value": float(f_dist.sf(max(stat, 0.0), 1, dof)),
+    }
+
+
+def _new_direction(bands, design, s) -> np.ndarray:
+    """The last regressor of ``design`` made orthogonal to the others (GLS metric), as a combination."""
+    info = design.gram(bands, 1.0 / s)[0]
+    v = np.zeros(len(design))
+    v[-1] = 1.0
+    if len(design) > 1:
+        v[:-1] = -np.linalg.solve(info[:-1, :-1], info[:-1, -1])
+    return v
+
+
+def _nested(bands, design, fit_small, alpha) -> tuple[dict, dict]:
+    """Likelihood-ratio test of the last regressor of ``design`` (both models refitted, noise included)."""
+    big = wh.joint_fit(bands, design)
+    v = _new_direction(bands, design, big["s"])
+    dof = wh.noise_dof(bands, big, wh.band_info(bands, design, v))
+    return _f_test(2.0 * (big["loglik"] - fit_small["loglik"]), dof, alpha), big
+
+
+def _lag_grid(n: int, fs: float) -> np.ndarray:
+    lo, hi = 2.0 / fs, n / fs / 4.0
+    k = max(2, int(round(LAG_PER_OCTAVE * math.log2(hi / lo))) + 1)
+    return np.geomspace(lo, hi, k)
+
+
+def _lag_test(bands, design, fit, alpha, grid) -> dict:
+    """The largest score statistic of (L_T[ch] − ch) added to ``design`` over the lag grid, against the
+    upcrossing bound of its t process (module docstring)."""
+    w = 1.0 / fit["s"]
+    src = design.src[0]
+    mult = np.array([_lag_response(bands.f, t, bands.fs) - 1.0 for t in grid])  # (n_T, nb)
+    gw = bands.G[:, src, src].real * w
+    # the family's Gram matrix is needed only on its diagonal and first off-diagonal (the arc length)
+    c_diag = 2.0 * np.sum(np.abs(mult) ** 2 * gw, axis=1)
+    c_next = 2.0 * np.sum((np.conj(mult[:-1]) * mult[1:]).real * gw, axis=1)
+    c_fd = np.column_stack(
+        [2.0 * ((np.conj(mult) * (m * bands.G[:, src, k])).real @ w) for k, m in zip(design.src, design.mult)]
+    )
+    i_dd = 2.0 * wh.cross(bands, design, design, w)
+    sol = np.linalg.solve(i_dd, c_fd.T)
+    var = np.maximum(c_diag - np.sum(c_fd * sol.T, axis=1), 1e-300)
+    cov_next = c_next - np.sum(c_fd[:-1] * sol.T[1:], axis=1)
+    sc = 2.0 * ((np.conj(mult) * bands.g[:, src]).real @ w) - c_fd @ fit["c"]
+    stat = sc**2 / var
+    j = int(np.argmax(stat))
+    cos = np.abs(cov_next) / np.sqrt(var[:-1] * var[1:])
+    arc = float(np.sum(np.arccos(np.clip(cos, 0.0, 1.0))))
+    v = np.append(-np.linalg.solve(i_dd, c_fd[j]), 1.0)
+    full = design.plus(src, mult[j])
+    dof = wh.noise_dof(bands, fit, wh.band_info(bands, full, v))
+
+    def p_value(u):
+        return float(f_dist.sf(u, 1, dof) + arc / math.pi * (1.0 + u / dof) ** (-(dof - 1.0) / 2.0))
+
+    thr = brentq(lambda u: p_value(u) - alpha, 1e-6, 1e4) if p_value(1e-6) > alpha else 0.0
+    return {
+        "statistic": float(stat[j]),
+        "threshold": float(thr),
+        "alpha": float(alpha),
+        "dof": float(dof),
+        "p_value": min(1.0, p_value(float(stat[j]))),
+        "arc_length": arc,
+        "at_lag_s": float(grid[j]),
+    }
+
+
+def _lag_objective(bands, design, s, lag_s) -> float:
+    """Σ ĉᵀ·score with the noise fixed (the likelihood up to a constant) for the pure lag model: the channel
+    column of ``design`` (its first) through the lag ``lag_s``."""
+    d = wh.Design(design.src, [_lag_response(bands.f, lag_s, bands.fs)] + design.mult[1:])
+    info, sc = d.gram(bands, 1.0 / s)
+    return float(sc @ np.linalg.solve(info, sc))
+
+
+def _lag_profile(bands, design, s, grid, z2) -> tuple[float, tuple]:
+    """The pure lag model's T (profile likelihood, noise fixed) and its interval where 2Δℓ ≤ ``z2``."""
+    prof = np.array([_lag_objective(bands, design, s, t) for t in grid])
+    j = int(np.argmax(prof))
+    lo, hi = math.log(grid[max(0, j - 1)]), math.log(grid[min(grid.size - 1, j + 1)])
+    from scipy.optimize import minimize_scalar
+
+    res = minimize_scalar(lambda lt: -_lag_objective(bands, design, s, math.exp(lt)), bounds=(lo, hi), method="bounded")
+    best, top = math.exp(float(res.x)), -float(res.fun)
+
+    def gap(lt):
+        return 2.0 * (top - _lag_objective(bands, design, s, math.exp(lt))) - z2
+
+    ends = []
+    for side in (range(j, -1, -1), range(j, grid.size)):
+        inner, end = math.log(best), None
+        for k in side:
+            if gap(math.log(grid[k])) > 0:
+                end = math.exp(brentq(gap, *sorted((inner, math.log(grid[k])))))
+                break
+            inner = math.log(grid[k])
+        ends.append(end if end is not None else float(grid[side[-1]] if len(side) else best))
+    return best, (min(ends[0], best), max(ends[1], best))
+
+
+def _columns(xs: np.ndarray, mean: float, quad_mean: float, fs: float, lag_s: float | None) -> list:
+    """The regressors from the channel's signal bands (``xs``, :func:`band_limited`): the channel (through the
+    lag), its square and its derivative. The sensor responds to the true temperature, not to the logging
+    sensor's noise, and that noise — squared, differentiated, or only weighed where the gyro's noise is low —
+    would bias every coefficient toward zero: a d(ch)/dt coupling of 0.1 rad/s per °C/s came out as 0.019
+    through a temperature logged to 0.01 °C with 0.02 °C of noise (0.095–0.102 from its signal bands)."""
+    xm = xs - mean
+    base = lagged(xm, lag_s, fs) if lag_s else xm
+    return [base, xm**2 - quad_mean, np.gradient(xs) * fs]
+
+
+def _design(keys, nb: int) -> wh.Design:
+    one = np.ones(nb)
+    d = wh.Design([0], [one])
+    if "quadratic" in keys:
+        d = d.plus(1, one)
+    if "rate_coefficient" in keys:
+        d = d.plus(2, one)
+    return d
+
+
+def _optional_terms(bands, fit, terms, level, grid, z2):
+    """Quadratic first, then d(ch)/dt or a lag (never both). Returns (kept keys, fit, lag_s, tests)."""
+    nb = bands.m.size
+    keys: list = []
+    tests: dict = {}
+    if "quadratic" in terms:
+        t_q, big = _nested(bands, _design(["quadratic"], nb), fit, TERM_SHARE["quadratic"] * level)
+        tests["quadratic"] = t_q | {"kept": t_q["statistic"] > t_q["threshold"]}
+        if tests["quadratic"]["kept"]:
+            keys, fit = ["quadratic"], big
+    design = _design(keys, nb)
+    rate_ok, fit_r = False, None
+    if "rate_coefficient" in terms:
+        t_r, fit_r = _nested(
+            bands, _design(keys + ["rate_coefficient"], nb), fit, TERM_SHARE["rate_coefficient"] * level
+        )
+        rate_ok = t_r["statistic"] > t_r["threshold"]
+        tests["rate_coefficient"] = t_r | {"kept": rate_ok}
+    lag_s = None
+    if "lag_s" in terms:
+        t_l = _lag_test(bands, design, fit, TERM_SHARE["lag_s"] * level, grid)
+        tests["lag_s"] = t_l | {"kept": False}
+        if t_l["statistic"] > t_l["threshold"]:
+            best, interval = _lag_profile(bands, design, fit["s"], grid, z2)
+            lag_design = wh.Design(design.src, [_lag_response(bands.f, best, bands.fs)] + design.mult[1:])
+            fit_l = wh.joint_fit(bands, lag_design)
+            margin = 2.0 * (fit_l["loglik"] - fit_r["loglik"]) if rate_ok and fit_r is not None else math.inf
+            tests["lag_s"] |= {"lag_s": best, "interval": interval, "against_rate": margin}
+            if margin > LAG_MARGIN:
+                tests["lag_s"]["kept"] = True
+                if rate_ok:
+                    tests["rate_coefficient"] |= {"kept": False, "why": "the lag fits better (2Δℓ > LAG_MARGIN)"}
+                rate_ok, lag_s = False, best
+            elif rate_ok:
+                tests["lag_s"]["why"] = "the d(ch)/dt term fits as well (a lag and a rate term are nearly collinear)"
+    if rate_ok:
+        keys, fit = keys + ["rate_coefficient"], fit_r
+    return keys, fit, lag_s, tests
+
+
+def _params(fit, keys, dofs, confidence, lag):
+    names = ["coefficient"] + [k for k in ("quadratic", "rate_coefficient") if k in keys]
+    params, intervals = {}, {}
+    for i, k in enumerate(names):
+        c, se = float(fit["c"][i]), math.sqrt(max(float(fit["cov"][i, i]), 0.0))
+        half = float(t_dist.isf((1.0 - confidence) / 2.0, dofs[k])) * se
+        params[k], intervals[k] = c, (c - half, c + half)
+    if lag is not None:
+        params["lag_s"], intervals["lag_s"] = lag
+    return params, intervals
+
+
+def regress_channel(
+    y,
+    ch,
+    fs: float,
+    *,
+    name: str = "channel",
+    alpha: float = ALPHA,
+    level: float = LEVEL,
+    terms=SUBTERMS,
+    confidence: float = 0.683,
+) -> ChannelRegression:
+    """The rate ``y`` regressed on the channel ``ch`` against the record's own noise (module docstring).
+
+    Parameters
+    ----------
+    y, ch : array_like
+        Rate samples and the channel's samples (same length; a temperature, an accelerometer axis).
+    fs : float
+        Sampling rate, Hz.
+    name : str
+        The channel's name, for messages.
+    alpha : float
+        Level of the coupling's test (default 0.375 %: refine's time-domain share of the 5 % per-record level).
+    level : float
+        Per-record level; each optional term is tested at its :data:`TERM_SHARE` of it.
+    terms : sequence of {"quadratic", "rate_coefficient", "lag_s"}
+        Optional terms to try once the coupling is accepted (default all).
+    confidence : float
+        Level of the intervals (default 68.3 %).
+
+    Returns
+    -------
+    ChannelRegression
+
+    Examples
+    --------
+    >>> import numpy as np, allanite
+    >>> from allanite.model.channels import regress_channel
+    >>> t = np.arange(90_000.0)                                          # 25 h at 1 Hz
+    >>> temp = 5 + 15 / (1 + np.exp(-(t - 30_000) / 2_500))              # °C, a warm-up in one block
+    >>> y = allanite.simulate(t.size, 1.0, N=1.5e-3, B=1e-4, K=3e-6, seed=2) + 4.5e-4 * temp
+    >>> r = regress_channel(y, temp, 1.0, name="temp")
+    >>> r.accepted, round(r.params["coefficient"] * 1e4, 1)            # rad/s per °C, ×1e4
+    (True, 4.4)
+    """
+    y, fs = _check_rate(y, fs)
+    x = check_channel(name, ch, y.size)
+    alpha = check_probability(alpha, "alpha")
+    level = check_probability(level, "level")
+    confidence = check_probability(confidence)
+    terms = (terms,) if isinstance(terms, str) else tuple(terms)
+    bad = [t for t in terms if t not in SUBTERMS]
+    if bad:
+        raise ParameterError(f"unknown channel regression term {bad[0]!r}; allowed: {', '.join(SUBTERMS)}")
+    n_use = wh.usable_length(y.size)
+    y, x = y[:n_use], x[:n_use]
+    floor, sig = channel_signal(x, fs)
+    xs = band_limited(x, fs, sig)
+    mean = float(xs.mean())
+    quad_mean = float(np.mean((xs - mean) ** 2))
+    bands = wh.spectra(y, _columns(xs, mean, quad_mean, fs, None), fs)
+    null = wh.joint_fit(bands, wh.Design([], []))
+    test, fit = _nested(bands, _design([], bands.m.size), null, alpha)
+    accepted = test["statistic"] > test["threshold"]
+    keys, lag, tests = [], None, {}
+    if accepted:
+        z2 = float(t_dist.isf((1.0 - confidence) / 2.0, test["dof"])) ** 2
+        keys, fit, lag_s, tests = _optional_terms(bands, fit, terms, level, _lag_grid(y.size, fs), z2)
+        if lag_s is not None:
+            lag = (lag_s, tests["lag_s"]["interval"])
+            exact = wh.spectra(y, _columns(xs, mean, quad_mean, fs, lag_s), fs)
+            fit = wh.joint_fit(exact, _design(keys, exact.m.size))
+    dofs = {"coefficient": test["dof"]} | {k: tests[k]["dof"] for k in keys}
+    params, intervals = _params(fit, keys, dofs, confidence, lag)
+    # the noise model's amounts are not read as IEEE-952 terms: over the few octaves of the parametric bands
+    # K, B and the Gauss–Markov shapes trade against each other (the level they add up to is what is used);
+    # the terms before and after a removal come from the Allan fits (terms_before_after)
+    noise = {"channel_noise": math.sqrt(floor), "whittle_loglik_gain": float(fit["loglik"] - null["loglik"])}
+    return ChannelRegression(name, bool(accepted), params, intervals, test, tests, fs, mean, quad_mean, noise, sig)
+
+
+def _informative(info: np.ndarray) -> np.ndarray:
+    """Mask of the fewest bands that together hold HELDOUT_INFO of ``info``."""
+    order = np.argsort(-info)
+    n = int(np.searchsorted(np.cumsum(info[order]), HELDOUT_INFO * info.sum())) + 1
+    mask = np.zeros(info.size, dtype=bool)
+    mask[order[:n]] = True
+    return mask
+
+
+def heldout_ratio(y, ch, fs: float, reg: ChannelRegression) -> float:
+    """Held out across frequency: the coupling (the same terms and lag) fitted on the even DFT bins predicts the
+    odd ones and back — each side's noise-weighted residual power Σ_b R_b/S_b (S from that side's own noise fit)
+    with the other side's coefficients, over the same without any coupling; mean of the two ways. Below 1: the
+    coupling carries over. Summed over the bands that hold :data:`HELDOUT_INFO` of the channel's information
+    (elsewhere the coupling changes nothing, and thousands of bands of noise would only dilute the ratio).
+
+    Why across frequency, not in time: a temperature that moves once (a warm-up, a door opened) moves in one
+    half or one block of the record only, and no split in time leaves it in both parts; its spectrum, though,
+    spreads over many bins, and interleaved bins of the noise are nearly independent (the Whittle
+    approximation the test rests on)."""
+    y, fs = _check_rate(y, fs)
+    n_use = wh.usable_length(y.size)
+    y, x = y[:n_use], check_channel(reg.name, ch, y.size)[:n_use]
+    xs = band_limited(x, fs, reg.signal_bands)
+    cols = _columns(xs, reg.mean, reg.quad_mean, fs, reg.params.get("lag_s"))
+    sides = [wh.spectra(y, cols, fs, parity) for parity in (0, 1)]
+    keys = list(reg.params)
+    coefs = [wh.joint_fit(b, _design(keys, b.m.size))["c"] for b in sides]
+    ratios = []
+    for held, c_other in ((sides[0], coefs[1]), (sides[1], coefs[0])):
+        s = wh.joint_fit(held, wh.Design([], []))["s"]
+        d = _design(keys, held.m.size)
+        use = _informative(held.G[:, 0, 0].real / s)
+        ratios.append(float(np.sum(wh.residual_power(held, d, c_other)[use] / s[use]) / np.sum(held.q[use] / s[use])))
+    return float(np.mean(ratios))
