@@ -192,15 +192,15 @@ def _orient(gens: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return gens, coefs
 
 
-def _fit_family(y, fs, fam, found_lines, passes, alpha, taken_f, extend=True) -> LineFamily:
-    """Refine the generators, add the lattice points the targeted test accepts (``extend``), fit amplitudes."""
+def _fit_family(y, fs, fam, found_lines, passes, alpha, taken_f) -> LineFamily:
+    """Refine the generators, add the lattice points the targeted test accepts, fit amplitudes."""
     n = y.size
     gens, coefs = _orient(np.asarray(fam["gens"], dtype=np.float64), np.asarray(fam["coefs"], dtype=np.int64))
     amp = np.array([d["amplitude"] for d in found_lines])
     noise = np.array([d["noise"] for d in found_lines])
     gens, cov = linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, n))
     found = np.ones(coefs.shape[0], dtype=bool)
-    rows, f_t = _targets({"coefs": coefs}, gens, passes, taken_f, fs) if extend else (np.zeros((0, 1)), np.zeros(0))
+    rows, f_t = _targets({"coefs": coefs}, gens, passes, taken_f, fs)
     added = 0
     if rows.size:
         ratio, dof, dof_med = _ratio_at(passes, f_t)
@@ -244,11 +244,13 @@ def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
     members = {i for g in groups for i in g["members"]}
     taken_f = np.array([d["f"] for d in found_lines])
     fams = [_fit_family(y, fs, g, [found_lines[i] for i in g["members"]], passes, alpha, taken_f) for g in groups]
-    sins = []
+    sins: list[LineFamily] = []
     for i, d in enumerate(found_lines):
         if i in members:
             continue
+        # a lone line's harmonics, tested where they must be: found, the line is a family of its own
         one = {"gens": np.array([d["f"] / fs]), "coefs": np.array([[1]])}
-        sins.append(_fit_family(y, fs, one, [d], passes, alpha, taken_f, extend=False))
+        fit = _fit_family(y, fs, one, [d], passes, alpha, taken_f)
+        (fams if fit.coefs.shape[0] > 1 else sins).append(fit)
     fams.sort(key=lambda fm: -fm.coefs.shape[0])
     return {"families": fams, "sinusoids": sins, "lines": found_lines, "bins": found["bins"]}
