@@ -132,16 +132,20 @@ def find_lines(y: np.ndarray, fs: float, alpha: float) -> dict:
 
     Returns ``lines`` (strongest first; each ``f`` Hz, ``amplitude`` (from the PSD), ``psd_ratio`` (bin over
     the noise level), ``threshold``, ``noise`` (one-sided PSD under it, unit²/Hz), ``bin_hz``, ``pass``),
-    ``bins`` (the number searched: the Bonferroni factor) and ``passes`` (:func:`line_spectrum`)."""
+    ``bins`` (the number searched: the Bonferroni factor), ``p_value`` (the smallest bin's, times ``bins``: the
+    record's Bonferroni p-value) and ``passes`` (:func:`line_spectrum`)."""
     passes = line_spectrum(y, fs)
     n_bins = int(sum(np.count_nonzero(np.isfinite(ps["noise"])) for ps in passes))
     out: list[dict] = []
     if n_bins == 0:
-        return {"lines": out, "bins": 0, "passes": passes}
+        return {"lines": out, "bins": 0, "passes": passes, "p_value": 1.0}
+    p_min = 1.0
     for j, ps in enumerate(passes):
         ok = np.isfinite(ps["noise"])
         ratio = np.full(ps["p"].size, -np.inf)
         ratio[ok] = ps["p"][ok] / ps["noise"][ok]
+        if ok.any():
+            p_min = min(p_min, float(np.min(f_dist.sf(ratio[ok], ps["dof"], ps["dof_med"][ok]))))
         thr = np.full(ps["p"].size, np.inf)
         thr[ok] = f_dist.isf(alpha / n_bins, ps["dof"], ps["dof_med"][ok])
         hits = np.flatnonzero(ratio > thr)
@@ -152,7 +156,7 @@ def find_lines(y: np.ndarray, fs: float, alpha: float) -> dict:
         for k in peaks:
             out.append(_describe(ps, k, float(ratio[k]), float(thr[k]), j))
     out.sort(key=lambda d: -d["psd_ratio"])
-    return {"lines": out, "bins": n_bins, "passes": passes}
+    return {"lines": out, "bins": n_bins, "passes": passes, "p_value": min(1.0, p_min * n_bins)}
 
 
 def _describe(ps: dict, k: int, ratio: float, thr: float, j: int) -> dict:

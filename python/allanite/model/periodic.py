@@ -236,7 +236,8 @@ def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
     """Lines of ``y`` at false-alarm probability ``alpha`` per record, as families and isolated sinusoids.
 
     Returns ``families`` (:class:`LineFamily`, two or more lines each, largest first), ``sinusoids`` (one-line
-    :class:`LineFamily` each, strongest first), ``lines`` and ``bins`` of the search."""
+    :class:`LineFamily` each, strongest first), ``lines``, ``bins`` and ``p_value`` of the search
+    (:func:`allanite.model.lines.find_lines`)."""
     y = np.asarray(y, dtype=np.float64)
     found = lines.find_lines(y, fs, alpha)
     found_lines, passes = found["lines"], found["passes"]
@@ -253,4 +254,10 @@ def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
         fit = _fit_family(y, fs, one, [d], passes, alpha, taken_f)
         (fams if fit.coefs.shape[0] > 1 else sins).append(fit)
     fams.sort(key=lambda fm: -fm.coefs.shape[0])
-    return {"families": fams, "sinusoids": sins, "lines": found_lines, "bins": found["bins"]}
+    return {
+        "families": fams,
+        "sinusoids": sins,
+        "lines": found_lines,
+        "bins": found["bins"],
+        "p_value": found["p_value"],
+    }
