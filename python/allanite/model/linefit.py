@@ -45,18 +45,29 @@ def runs(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return idx[starts], ends - starts
 
 
-def dirichlet(omega: np.ndarray, starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-    """S(ω) = Σ_runs Σ_{n = a}^{a + m − 1} e^{iωn} = Σ_runs e^{iω(a + (m − 1)/2)}·sin(mω/2)/sin(ω/2)."""
+def dirichlet(omega: np.ndarray, starts: np.ndarray, lengths: np.ndarray, centre: float | None = None) -> np.ndarray:
+    """S(ω) = Σ_runs Σ_{n = a}^{a + m − 1} e^{iωn} = Σ_runs e^{iωc}·D(ω), c = a + (m − 1)/2 and
+    D(ω) = sin(mω/2)/sin(ω/2); with ``centre``, Σ (n − centre)·e^{iωn} = Σ_runs e^{iωc}·((c − centre)·D − i·D′)."""
     omega = np.asarray(omega, dtype=np.float64)
     # ω is 2π-periodic: wrap to (−π, π] so that sin(ω/2) vanishes only at ω ≡ 0
     w = omega - 2 * np.pi * np.round(omega / (2 * np.pi))
     out = np.zeros(w.shape, dtype=np.complex128)
     half = np.sin(w / 2)
-    small = np.abs(half) < 1e-300
+    small = np.abs(half) < 1e-6
+    safe = np.where(small, 1.0, half)
     for a, m in zip(starts, lengths):
-        centre = a + (m - 1) / 2.0
-        ratio = np.where(small, float(m), np.sin(m * w / 2) / np.where(small, 1.0, half))
-        out += np.exp(1j * _wrap(w * centre)) * ratio
+        c = a + (m - 1) / 2.0
+        d = np.where(small, m - m * (m * m - 1.0) * w * w / 24.0, np.sin(m * w / 2) / safe)
+        phase = np.exp(1j * _wrap(w * c))
+        if centre is None:
+            out += phase * d
+            continue
+        dp = np.where(
+            small,
+            -m * (m * m - 1.0) * w / 12.0,
+            (0.5 * m * np.cos(m * w / 2) * half - 0.5 * np.sin(m * w / 2) * np.cos(w / 2)) / safe**2,
+        )
+        out += phase * ((c - centre) * d - 1j * dp)
     return out
 
 
@@ -141,28 +152,37 @@ def _omegas(gens, coefs) -> np.ndarray:
 
 
 def solve(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Least-squares (a_i, b_i) of Σ_i a_i cos ω_i n + b_i sin ω_i n on the samples ``y`` at indices ``idx``
-    (a straight line through them removed first: the record's mean and slope are not lines)."""
+    """Least-squares (a_i, b_i) of c₀ + c₁·n + Σ_i a_i cos ω_i n + b_i sin ω_i n on the samples ``y`` at indices
+    ``idx`` (a straight line is fitted with the lines — the record's mean and slope are not lines — exactly:
+    its cross terms with the lines are Dirichlet sums too)."""
     idx = np.asarray(idx, dtype=np.int64)
     y = np.asarray(y, dtype=np.float64)
-    t = (idx - idx.mean()) / max(1.0, float(np.ptp(idx)))
-    yd = y - np.polyval(np.polyfit(t, y, 1), t) if idx.size > 2 else y - y.mean()
-    d = dtft(yd, idx, gens, coefs)
+    centre = float(idx.mean())
+    t = idx - centre
+    yc = y - y.mean()
+    d = dtft(yc, idx, gens, coefs)
     om = _omegas(gens, coefs)
     starts, lengths = runs(idx)
     s_minus = dirichlet(om[:, None] - om[None, :], starts, lengths)
     s_plus = dirichlet(om[:, None] + om[None, :], starts, lengths)
+    s_one = dirichlet(om, starts, lengths)
+    s_t = dirichlet(om, starts, lengths, centre)
     cc = 0.5 * (s_minus + s_plus).real
     ss = 0.5 * (s_minus - s_plus).real
     cs = 0.5 * (s_plus - s_minus).imag
-    gram = np.block([[cc, cs], [cs.T, ss]])
-    rhs = np.concatenate([d.real, -d.imag])
+    scale = max(1.0, float(np.max(np.abs(t))))  # the slope column in units of the half-span: conditioning
+    nuis = np.array([[float(idx.size), float(t.sum()) / scale], [float(t.sum()) / scale, float(t @ t) / scale**2]])
+    cross = np.vstack(
+        [np.concatenate([s_one.real, s_one.imag]), np.concatenate([s_t.real, s_t.imag]) / scale]
+    )  # (2, 2L): Σ 1·cos, Σ 1·sin; Σ t·cos, Σ t·sin
+    gram = np.block([[nuis, cross], [cross.T, np.block([[cc, cs], [cs.T, ss]])]])
+    rhs = np.concatenate([[float(yc.sum()), float(t @ yc) / scale], d.real, -d.imag])
     try:
         sol = np.linalg.solve(gram, rhs)
     except np.linalg.LinAlgError:
         sol = np.linalg.lstsq(gram, rhs, rcond=1e-12)[0]
     n_lines = om.size
-    return sol[:n_lines], sol[n_lines:]
+    return sol[2 : 2 + n_lines], sol[2 + n_lines :]
 
 
 def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

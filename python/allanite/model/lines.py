@@ -6,7 +6,7 @@ median, Bonferroni-corrected over every bin searched. The neighbours are ±(5 �
 to 4 … 32 (the window's main lobe, ±4 bins, is left out so that a line does not raise its own reference;
 beyond it the window leaks ≤ −92 dB, so a line 10⁹ above the floor makes no false neighbours; a symmetric
 window's median of a monotone 1/f or 1/f² slope is its value at the centre). Two passes: segments of
-2^⌊log₂ N/8⌋ (≤ 2¹⁵) samples over the band, and segments of ≈ N/2 below it, so that lines down to ≈ 18/T
+2^⌊log₂ N/8⌋ (≤ 2¹⁵) samples over the band, and three segments of N/2 below it, so that lines down to 18/T
 (T the record) are searched. Degrees of freedom: the Welch average's 2K/(1 + 2Σ(1 − m/K)ρ_m²) (Percival &
 Walden 1993, eq. 292b; ρ_m the window's overlap correlation), the median's that times its neighbours'
 effective number (2w/(1 + 2Σρ_j²), ρ_j the correlation of bins j apart) times 2/π (a sample median's
@@ -119,11 +119,10 @@ def line_spectrum(y: np.ndarray, fs: float) -> list[dict]:
     nper = int(min(MAX_SEGMENT, 2 ** int(math.log2(max(n // 8, 256)))))
     first = LOBE + NEIGHBOURS[0] + 1
     passes = [_one_pass(x, fs, nper, first, nper // 2)]
-    long = int(2 ** int(math.log2(n // 2)))
-    ratio = long // nper
-    if ratio >= 2:
-        # below the first searched bin of the band-wide pass: longer segments (≈ 3 of them)
-        passes.insert(0, _one_pass(x, fs, long, first, first * ratio))
+    long = 2 * (n // 4)  # three half-overlapping segments (any length: the FFT needs no power of two)
+    if long >= 2 * nper:
+        # below the first searched bin of the band-wide pass: its bin `first` sits at bin first·long/nper here
+        passes.insert(0, _one_pass(x, fs, long, first, int(math.ceil(first * long / nper))))
     return passes
 
 

@@ -38,7 +38,7 @@ import numpy as np
 from scipy.ndimage import median_filter
 from scipy.optimize import brentq
 from scipy.special import ndtr
-from scipy.stats import norm, poisson
+from scipy.stats import poisson
 
 __all__ = ["outlier_test", "replace_outliers", "lattice_step", "robust_sigma", "CUTS", "MEDIAN_SPAN"]
 
@@ -80,8 +80,9 @@ def _inner(a: float, sigma: float, step: float) -> float:
     """P(|d + U| < a), d ~ N(0, σ²), U uniform on (−L/2, L/2): (1/L)∫ [Φ((a−u)/σ) − Φ((−a−u)/σ)] du, closed
     form with ∫Φ(x/σ)dx = xΦ(x/σ) + σφ(x/σ)."""
 
-    def psi(x):
-        return x * ndtr(x / sigma) + sigma * norm.pdf(x / sigma)
+    def psi(x: float) -> float:
+        z = x / sigma
+        return x * 0.5 * math.erfc(-z / math.sqrt(2.0)) + sigma * math.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
 
     h = step / 2.0
     return float((psi(a + h) - psi(a - h) - psi(-a + h) + psi(-a - h)) / step)
