@@ -88,19 +88,40 @@ def test_sparse_spikes_are_flagged_exactly():
     assert np.max(np.abs(clean - _gauss(n, 4))) < 0.5
 
 
-def test_heavy_tails_are_flagged_and_their_replacement_restores_the_gaussian_core():
+def test_heavy_tails_are_flagged_and_their_replacement_moves_n_toward_the_gaussian_core():
     n = 400_000
     rng = np.random.default_rng(6)
     core = _gauss(n, 6)
     wild = (rng.random(n) < 0.14) * rng.normal(size=n) * 0.1 * 8  # 14 % of samples with 8× the spread
     y = core + wild
     r = outliers.outlier_test(y, FS, ALPHA)
-    assert r["accepted"] and r["cut"] == 4.0
-    assert 0.05 < r["rate"] < 0.14
+    assert r["accepted"] and r["cut"] <= 4.0
+    assert 0.03 < r["rate"] < 0.14
+    assert r["expected_gaussian_flags"] <= 0.05 * r["rate"] * n
     clean = outliers.replace_outliers(y, r["flags"])
-    assert np.std(np.diff(clean)) < 0.5 * np.std(np.diff(y))
-    a_raw, a_clean = allanite.avar(y, FS, taus=[0.01, 0.1]), allanite.avar(clean, FS, taus=[0.01, 0.1])
-    assert np.all(a_clean.adev < 0.6 * a_raw.adev)
+    n_core, n_raw, n_clean = (allanite.fit(allanite.avar(z, FS)).coefficients["N"].value for z in (core, y, clean))
+    assert n_core < n_clean < 0.6 * n_raw  # toward the core's white noise; the contamination inside the cut stays
+
+
+def test_spikes_on_a_low_passed_record_are_flagged_and_replaced_without_a_trace():
+    # a smooth record's samples stand far off their local median at its extremes: the second-difference rule
+    # flags only the spikes, and the replacement (the line between neighbours plus the second difference's
+    # noise) leaves the Allan curve as the spike-free record's
+    n = 400_000
+    rng = np.random.default_rng(9)
+    smooth = _gauss(n, 9, lowpass=0.1)
+    at = rng.choice(np.arange(10, n - 10), 40, replace=False)
+    y = smooth.copy()
+    y[at] += rng.choice([-1.0, 1.0], 40) * 0.5
+    r = outliers.outlier_test(y, FS, ALPHA)
+    assert r["accepted"]
+    flagged = set(np.flatnonzero(r["flags"]).tolist())
+    # every spike; Gaussian samples make at most 2Φ̄(c*)·n of the flags (0.23 at c* = 5 here: one, a smooth peak)
+    assert flagged >= set(at.tolist()) and len(flagged - set(at.tolist())) <= 2
+    assert r["expected_gaussian_flags"] < 1.0
+    clean = outliers.replace_outliers(y, r["flags"])
+    a0, a1 = allanite.avar(smooth, FS, taus="octave"), allanite.avar(clean, FS, taus="octave")
+    np.testing.assert_allclose(a1.adev, a0.adev, rtol=0.01)
 
 
 def test_a_step_of_the_mean_is_not_an_outlier():
