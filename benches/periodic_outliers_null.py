@@ -79,7 +79,8 @@ def record(i: int):
     if rng.random() < 0.2:
         kw["R"] = math.sqrt(2.0 / tau_x**3) * 10 ** rng.uniform(-1.0, 0.0)
         feats.append("R")
-    y = allanite.simulate(n, fs, seed=rng, **kw)
+    pad = 4096  # filters start from rest: their transient is simulated and cut off
+    y = allanite.simulate(n + pad, fs, seed=rng, **kw)
     if rng.random() < 0.4:
         kind = rng.integers(3)
         if kind < 2:
@@ -89,8 +90,9 @@ def record(i: int):
             feats.append(f"butter{int(kind) + 1}")
         else:
             taps = int(rng.integers(2, 9))
-            y = np.convolve(y, np.full(taps, 1.0 / taps), mode="same")
+            y = np.convolve(y, np.full(taps, 1.0 / taps), mode="full")[: y.size]  # causal, as a sensor's
             feats.append("moving average")
+    y = y[pad:]
     if rng.random() < 0.4:
         lsb = float(np.std(np.diff(y[:20_000]))) * 10 ** rng.uniform(math.log10(0.03), math.log10(2.0))
         y = np.round(y / lsb) * lsb

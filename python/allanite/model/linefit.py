@@ -90,6 +90,14 @@ def _grid(kmax: int) -> int:
     return int(2 ** max(12, math.ceil(math.log2(256 * max(1, kmax)))))
 
 
+def _oriented(gens: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two generators put so that the second has the fewer distinct coefficients (one fold per distinct value:
+    a carrier with 60 sidebands is one fold at the spacing, not 60 at the carrier); the lines keep their order."""
+    if gens.size == 2 and np.unique(coefs[:, 0]).size < np.unique(coefs[:, 1]).size:
+        return gens[::-1].copy(), coefs[:, ::-1].copy()
+    return gens, coefs
+
+
 def _groups(coefs: np.ndarray, nu2: float, idx: np.ndarray):
     """(s, rows, e^{i2πsν2 n} or None for s = 0) for each distinct second coefficient s (0 for one-generator
     lattices); the phasors as powers of one table lookup, by increasing |s| (one complex product each)."""
@@ -130,8 +138,9 @@ def _fold(z: np.ndarray, u: np.ndarray, m_bins: int, seg: np.ndarray | None, n_s
 def dtft(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray, n_seg: int = 1) -> np.ndarray:
     """D_i = Σ_{n ∈ idx} y_n e^{−i2πν_i n}, ν_i = coefs_i · gens; with ``n_seg`` > 1, per contiguous piece of
     ``idx`` (shape (n_seg, lines)), else shape (lines,)."""
-    gens = np.atleast_1d(np.asarray(gens, dtype=np.float64))
-    coefs = np.atleast_2d(np.asarray(coefs, dtype=np.int64))
+    gens, coefs = _oriented(
+        np.atleast_1d(np.asarray(gens, dtype=np.float64)), np.atleast_2d(np.asarray(coefs, dtype=np.int64))
+    )
     idx = np.asarray(idx, dtype=np.int64)
     y = np.asarray(y, dtype=np.float64)
     out = np.zeros((n_seg, coefs.shape[0]), dtype=np.complex128)
@@ -187,8 +196,9 @@ def solve(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray) -> tuple[np.n
 
 def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Σ_i a_i cos ω_i n + b_i sin ω_i n at the sample indices ``idx``."""
-    gens = np.atleast_1d(np.asarray(gens, dtype=np.float64))
-    coefs = np.atleast_2d(np.asarray(coefs, dtype=np.int64))
+    gens, coefs = _oriented(
+        np.atleast_1d(np.asarray(gens, dtype=np.float64)), np.atleast_2d(np.asarray(coefs, dtype=np.int64))
+    )
     idx = np.asarray(idx, dtype=np.int64)
     out = np.zeros(idx.size)
     u = np.mod(idx * gens[0], 1.0)

@@ -6,18 +6,22 @@ median, Bonferroni-corrected over every bin searched. The neighbours are ±(5 �
 to 4 … 32 (the window's main lobe, ±4 bins, is left out so that a line does not raise its own reference;
 beyond it the window leaks ≤ −92 dB, so a line 10⁹ above the floor makes no false neighbours; a symmetric
 window's median of a monotone 1/f or 1/f² slope is its value at the centre). Two passes: segments of
-2^⌊log₂ N/8⌋ (≤ 2¹⁵) samples over the band, and three segments of N/2 below it, so that lines down to 18/T
-(T the record) are searched. Degrees of freedom: the Welch average's 2K/(1 + 2Σ(1 − m/K)ρ_m²) (Percival &
-Walden 1993, eq. 292b; ρ_m the window's overlap correlation), the median's that times its neighbours'
-effective number (2w/(1 + 2Σρ_j²), ρ_j the correlation of bins j apart) times 2/π (a sample median's
-efficiency).
+2^⌊log₂ N/8⌋ (≤ 2¹⁵) samples from its bin 36 up, and three segments of N/2 below, so that lines down to 18/T
+(T the record) are searched, and the lowest bins of the short segments (steep floors, crowded neighbourhoods)
+are searched at the long segments' finer resolution. Degrees of freedom: the Welch average's
+2K/(1 + 2Σ(1 − m/K)ρ_m²) (Percival & Walden 1993, eq. 292b; ρ_m the window's overlap correlation), the
+median's that times its neighbours' effective number (2w/(1 + 2Σρ_j²), ρ_j the correlation of bins j
+apart) times 2/π (a sample median's efficiency). Lines close together raise each other's reference, so the
+search repeats with the lines found left out of every median (in mirror pairs, keeping it centred).
 
 :func:`group_lines` — lines into families on a lattice: harmonics k·f0 (one generator) or sidebands
 k·f1 + s·f2 (two), with aliases folded into [0, f_s/2]. Greedy: every seed (a strong line over h = 1 … 6,
 differences of strong lines, a strong line as carrier with a difference as spacing) is grown by matching
 lines within their tolerance and refitting the generators by weighted least squares; the family kept is the
 one that explains most lines beyond what chance would match (lines × lattice points × window), needing at
-least one line more than it has generators. A line no family takes stays a ``"sinusoid"``.
+least one line more than it has generators; two generators in a small ratio (p/q, q ≤ 4) are one (g1/q).
+A two-generator basis is reduced to the larger generator and the other modulo it (the sidebands' offset).
+A line no family takes stays a ``"sinusoid"``.
 """
 
 from __future__ import annotations
@@ -39,13 +43,15 @@ MAX_SEGMENT = 2**15
 #: Neighbours per side: w = k/2 clipped to this range (bins).
 NEIGHBOURS = (4, 32)
 WINDOW = "blackmanharris"
+#: The band-wide pass starts at this bin; below it the long-segment pass searches (when the record allows).
+SWITCH = 36
 #: Seeds: the strongest lines tried as fundamentals (over h = 1 … SUBHARMONICS) and pairwise spacings.
 SEEDS = 12
 SUBHARMONICS = 6
 #: The strongest lines tried as carriers of a sideband lattice (with a spacing of two of them).
 CARRIERS = 6
-#: Largest |s| of a sideband lattice.
-MAX_SIDEBAND = 12
+#: Largest |s| of a sideband lattice (a sample-rate beat's sawtooth phase modulation spreads over dozens).
+MAX_SIDEBAND = 64
 
 
 def fold_frequency(nu: np.ndarray) -> np.ndarray:
@@ -86,26 +92,68 @@ def _welch(x: np.ndarray, fs: float, win: np.ndarray, nper: int) -> tuple[np.nda
 
 
 def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int) -> dict:
-    """Welch PSD of one segment length and, on bins k_lo ≤ k < k_hi, the noise level under each bin
-    (the neighbours' median over its bias) and the degrees of freedom of the ratio's F law."""
+    """Welch PSD of one segment length, the bins k_lo ≤ k < k_hi it searches (grouped by their neighbourhood
+    w) and, unmasked, the noise level under each (:func:`_noise`)."""
     win = signal.get_window(WINDOW, nper)
     f, p = _welch(x, fs, win, nper)
     dof, kappa, k_seg = _edof(win, x.size, nper)
-    noise = np.full(p.size, np.nan)
-    dof_med = np.full(p.size, np.nan)
     ks_all = np.arange(p.size)
     width = np.clip(ks_all // 2, *NEIGHBOURS)
     k_hi = min(k_hi, p.size - 1 - LOBE - NEIGHBOURS[0])
-    bias = chi2_dist.median(dof) / dof
+    groups = []
     for w in range(NEIGHBOURS[0], NEIGHBOURS[1] + 1):
         ks = ks_all[(width == w) & (ks_all >= max(k_lo, LOBE + w + 1)) & (ks_all < k_hi)]
         ks = ks[ks + LOBE + w < p.size - 1]
-        if ks.size == 0:
+        if ks.size:
+            groups.append((w, ks))
+    ps = {"f": f, "p": p, "dof": dof, "kappa": kappa, "df": fs / nper, "segments": k_seg, "groups": groups}
+    ps["noise"], ps["dof_med"] = _noise(ps, np.zeros(p.size, dtype=bool))
+    return ps
+
+
+def _noise(ps: dict, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The noise level under each searched bin — the median of its neighbours ±(LOBE + 1 … LOBE + w) over the
+    median's bias — leaving out masked bins (other lines' main lobes) in mirror pairs (a bin and its mirror
+    across k go together, so that the median of a sloped spectrum stays its centre value); where fewer than w/2
+    pairs are left, pairs out to ±(LOBE + 2w) join. Degrees of freedom of the median: the Welch average's times
+    the bins used over their correlation factor times 2/π."""
+    p, dof = ps["p"], ps["dof"]
+    noise = np.full(p.size, np.nan)
+    dof_med = np.full(p.size, np.nan)
+    bias = chi2_dist.median(dof) / dof
+    for w, ks in ps["groups"]:
+        near = np.arange(LOBE + 1, LOBE + w + 1)
+        if not mask.any():
+            both = np.concatenate([-near[::-1], near])
+            noise[ks] = np.median(p[ks[:, None] + both[None, :]], axis=1) / bias
+            dof_med[ks] = dof * (2.0 * w / ps["kappa"]) * (2.0 / math.pi)
             continue
-        off = np.concatenate([np.arange(-LOBE - w, -LOBE), np.arange(LOBE + 1, LOBE + w + 1)])
-        noise[ks] = np.median(p[ks[:, None] + off[None, :]], axis=1) / bias
-        dof_med[ks] = dof * (2.0 * w / kappa) * (2.0 / math.pi)
-    return {"f": f, "p": p, "noise": noise, "dof": dof, "dof_med": dof_med, "df": fs / nper, "segments": k_seg}
+        med = np.full(ks.size, np.nan)
+        used = np.zeros(ks.size)
+        for reach in (near, np.arange(LOBE + 1, LOBE + 2 * w + 1)):
+            todo = np.flatnonzero(~np.isfinite(med))
+            if todo.size == 0:
+                break
+            lo, hi = ks[todo, None] - reach[None, :], ks[todo, None] + reach[None, :]
+            inside = (lo >= 1) & (hi <= p.size - 2)
+            lo_c, hi_c = np.clip(lo, 0, p.size - 1), np.clip(hi, 0, p.size - 1)
+            keep = inside & ~mask[lo_c] & ~mask[hi_c]
+            count = keep.sum(axis=1)
+            enough = count >= max(2, w // 2)
+            vals = np.where(np.concatenate([keep, keep], axis=1), np.concatenate([p[lo_c], p[hi_c]], axis=1), np.nan)
+            sel = todo[enough]
+            if sel.size:
+                med[sel] = np.nanmedian(vals[enough], axis=1)
+                used[sel] = 2 * count[enough]
+        # a bin whose neighbourhood is all lines keeps its unmasked reference
+        lost = ~np.isfinite(med)
+        if lost.any():
+            both = np.concatenate([-near[::-1], near])
+            med[lost] = np.median(p[ks[lost, None] + both[None, :]], axis=1)
+            used[lost] = 2 * w
+        noise[ks] = med / bias
+        dof_med[ks] = dof * (used / ps["kappa"]) * (2.0 / math.pi)
+    return noise, dof_med
 
 
 def line_spectrum(y: np.ndarray, fs: float) -> list[dict]:
@@ -118,42 +166,74 @@ def line_spectrum(y: np.ndarray, fs: float) -> list[dict]:
         return []
     nper = int(min(MAX_SEGMENT, 2 ** int(math.log2(max(n // 8, 256)))))
     first = LOBE + NEIGHBOURS[0] + 1
-    passes = [_one_pass(x, fs, nper, first, nper // 2)]
     long = 2 * (n // 4)  # three half-overlapping segments (any length: the FFT needs no power of two)
-    if long >= 2 * nper:
-        # below the first searched bin of the band-wide pass: its bin `first` sits at bin first·long/nper here
-        passes.insert(0, _one_pass(x, fs, long, first, int(math.ceil(first * long / nper))))
-    return passes
+    if long < 2 * nper:
+        return [_one_pass(x, fs, nper, first, nper // 2)]
+    # the long segments take the lowest SWITCH bins of the band-wide pass, where a steep 1/f² floor and a
+    # line's neighbours crowd its short neighbourhoods
+    return [
+        _one_pass(x, fs, long, first, int(math.ceil(SWITCH * long / nper))),
+        _one_pass(x, fs, nper, SWITCH, nper // 2),
+    ]
 
 
-def find_lines(y: np.ndarray, fs: float, alpha: float) -> dict:
+def _peaks(ps: dict, alpha_bin: float) -> tuple[list[int], np.ndarray, np.ndarray]:
+    """Bins beyond the F threshold, strongest first, one per main lobe; and the ratio and threshold arrays."""
+    ok = np.isfinite(ps["noise"])
+    ratio = np.full(ps["p"].size, -np.inf)
+    ratio[ok] = ps["p"][ok] / ps["noise"][ok]
+    thr = np.full(ps["p"].size, np.inf)
+    thr[ok] = f_dist.isf(alpha_bin, ps["dof"], ps["dof_med"][ok])
+    hits = np.flatnonzero(ratio > thr)
+    peaks: list[int] = []
+    for k in hits[np.argsort(-ratio[hits])]:
+        if all(abs(int(k) - q) > LOBE for q in peaks):
+            peaks.append(int(k))
+    return peaks, ratio, thr
+
+
+def find_lines(y: np.ndarray, fs: float, alpha: float, rounds: int = 4) -> dict:
     """Significant narrow lines of ``y`` (rate samples at ``fs``): false-alarm probability ``alpha`` per record.
+
+    Lines close together raise each other's reference (a median of neighbours that are partly lines), so the
+    search is repeated (up to ``rounds`` times) with the main lobes of the lines found left out of every median;
+    with no line in the first round nothing changes (the null is the first round's).
 
     Returns ``lines`` (strongest first; each ``f`` Hz, ``amplitude`` (from the PSD), ``psd_ratio`` (bin over
     the noise level), ``threshold``, ``noise`` (one-sided PSD under it, unit²/Hz), ``bin_hz``, ``pass``),
-    ``bins`` (the number searched: the Bonferroni factor), ``p_value`` (the smallest bin's, times ``bins``: the
-    record's Bonferroni p-value) and ``passes`` (:func:`line_spectrum`)."""
+    ``bins`` (the number searched: the Bonferroni factor), ``p_value`` (the smallest bin's in the first round,
+    times ``bins``: the record's Bonferroni p-value) and ``passes`` (:func:`line_spectrum`)."""
     passes = line_spectrum(y, fs)
     n_bins = int(sum(np.count_nonzero(np.isfinite(ps["noise"])) for ps in passes))
     out: list[dict] = []
     if n_bins == 0:
         return {"lines": out, "bins": 0, "passes": passes, "p_value": 1.0}
     p_min = 1.0
-    for j, ps in enumerate(passes):
+    for ps in passes:
         ok = np.isfinite(ps["noise"])
-        ratio = np.full(ps["p"].size, -np.inf)
-        ratio[ok] = ps["p"][ok] / ps["noise"][ok]
         if ok.any():
-            p_min = min(p_min, float(np.min(f_dist.sf(ratio[ok], ps["dof"], ps["dof_med"][ok]))))
-        thr = np.full(ps["p"].size, np.inf)
-        thr[ok] = f_dist.isf(alpha / n_bins, ps["dof"], ps["dof_med"][ok])
-        hits = np.flatnonzero(ratio > thr)
-        peaks: list[int] = []
-        for k in hits[np.argsort(-ratio[hits])]:
-            if all(abs(int(k) - q) > LOBE for q in peaks):
-                peaks.append(int(k))
-        for k in peaks:
-            out.append(_describe(ps, k, float(ratio[k]), float(thr[k]), j))
+            r = ps["p"][ok] / ps["noise"][ok]
+            p_min = min(p_min, float(np.min(f_dist.sf(r, ps["dof"], ps["dof_med"][ok]))))
+    masks = [np.zeros(ps["p"].size, dtype=bool) for ps in passes]
+    found: list[list[int]] = [[] for _ in passes]
+    for _ in range(rounds):
+        changed = False
+        for j, ps in enumerate(passes):
+            if masks[j].any():
+                ps["noise"], ps["dof_med"] = _noise(ps, masks[j])
+            peaks, ratio, thr = _peaks(ps, alpha / n_bins)
+            new = np.zeros_like(masks[j])
+            for k in peaks:
+                new[max(0, k - LOBE) : k + LOBE + 1] = True
+            if sorted(peaks) != sorted(found[j]) or not np.array_equal(new, masks[j]):
+                changed = True
+            found[j], masks[j] = peaks, new
+            ps["ratio"], ps["thr"] = ratio, thr
+        if not changed:
+            break
+    for j, ps in enumerate(passes):
+        for k in found[j]:
+            out.append(_describe(ps, k, float(ps["ratio"][k]), float(ps["thr"][k]), j))
     out.sort(key=lambda d: -d["psd_ratio"])
     return {"lines": out, "bins": n_bins, "passes": passes, "p_value": min(1.0, p_min * n_bins)}
 
@@ -292,6 +372,34 @@ def _seeds(nu: np.ndarray, tol: np.ndarray, strength: np.ndarray) -> list[tuple[
     return out
 
 
+def _commensurate(gens: np.ndarray, tol: float, q_max: int = 4) -> bool:
+    """Whether g2 = (p/q)·g1 within ``tol`` for some q ≤ q_max: then the lattice is one generator's, g1/q."""
+    for q in range(1, q_max + 1):
+        p = round(gens[1] * q / gens[0])
+        if p > 0 and abs(gens[1] - p * gens[0] / q) <= tol:
+            return True
+    return False
+
+
+def _reduce(gens: np.ndarray, coefs: np.ndarray, gen_sd: np.ndarray):
+    """One basis for a two-generator lattice: the larger generator first, the second reduced modulo it to
+    (0, g1/2] — (1.37, 1.18) and (1.37, 0.19) Hz span the same lines; the second is the one a user names (the
+    offset of the sidebands). Rows follow (k + s·q, s), signs made k ≥ 0 (s > 0 when k = 0)."""
+    if gens.size != 2:
+        return gens, coefs, gen_sd
+    if gens[1] > gens[0]:
+        gens, coefs, gen_sd = gens[::-1].copy(), coefs[:, ::-1].copy(), gen_sd[::-1].copy()
+    q = int(np.round(gens[1] / gens[0]))
+    g2 = gens[1] - q * gens[0]
+    coefs = np.column_stack([coefs[:, 0] + q * coefs[:, 1], coefs[:, 1]])
+    if g2 < 0:
+        g2, coefs = -g2, np.column_stack([coefs[:, 0], -coefs[:, 1]])
+    flip = (coefs[:, 0] < 0) | ((coefs[:, 0] == 0) & (coefs[:, 1] < 0))
+    coefs = np.where(flip[:, None], -coefs, coefs)
+    sd2 = math.hypot(gen_sd[1], q * gen_sd[0])
+    return np.array([gens[0], g2]), coefs, np.array([gen_sd[0], sd2])
+
+
 def group_lines(lines: list[dict], fs: float) -> list[dict]:
     """Families of ``lines`` (:func:`find_lines`' dicts): each ``gens`` (normalised generators), ``coefs``
     (integer rows, one per member), ``members`` (indices into ``lines``), ``gen_sd``; lines no family takes
@@ -306,7 +414,7 @@ def group_lines(lines: list[dict], fs: float) -> list[dict]:
     left = np.arange(nu.size)
     fams: list[dict] = []
     while left.size >= 2:
-        best = None
+        best: dict = {1: None, 2: None}
         sub_nu, sub_tol, sub_w = nu[left], tol[left], w[left]
         for g, g_sd in _seeds(sub_nu, sub_tol, strength[left]):
             if np.any(g <= 2.0 * np.mean(sub_tol)):
@@ -320,12 +428,16 @@ def group_lines(lines: list[dict], fs: float) -> list[dict]:
             score = m.size - chance
             if score < gens.size + 0.5:
                 continue
-            key = (score, -gens.size)
-            if best is None or key > best[0]:
-                best = (key, gens, coefs, m, gen_sd)
-        if best is None:
+            if best[gens.size] is None or score > best[gens.size][0]:
+                best[gens.size] = (score, gens, coefs, m, gen_sd)
+        one, two = best[1], best[2]
+        if two is not None and _commensurate(two[1], 2.0 * float(np.mean(sub_tol))):
+            two = None  # (2f0, 425f0) is the harmonics of f0 in another basis: the one-generator family says it
+        pick = two if two is not None and (one is None or two[0] > one[0]) else one
+        if pick is None:
             break
-        _, gens, coefs, m, gen_sd = best
+        _, gens, coefs, m, gen_sd = pick
+        gens, coefs, gen_sd = _reduce(gens, coefs, gen_sd)
         fams.append({"gens": gens, "coefs": coefs, "members": left[m].tolist(), "gen_sd": gen_sd})
         left = np.delete(left, m)
     return fams

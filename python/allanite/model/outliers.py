@@ -22,20 +22,18 @@ only beyond :data:`TAIL_FACTOR` (2) times the Gaussian count — real sensors' n
 5.2 σ: no spikes, yet an exact Gaussian null rejects on two of them) — so
 P(Poisson(2λ) ≥ count) ≤ ``alpha``/len(CUTS) accepts (Bonferroni over the cuts).
 
-The samples then flagged are those that stand off their neighbours at a cut c*: the second difference
-e_t = y_t − (y_{t−1} + y_{t+1})/2 beyond c*·σ_e (its robust σ in the block; linear, so Gaussian for any
-spectrum: Gaussian samples make at most 2Φ̄(c*) of the flags) and the distance from the local median
-(5 samples) beyond c* white-noise σ, and the largest second difference of the three around it (so a spike's
-neighbours are not flagged with it) — c* the lowest of
-:data:`FLAG_CUTS` at which Gaussian samples would make at most 5 % of the flags (the flagged share is the
-outliers', not the Gaussian tail's). A step of the mean moves the local median with it and is not flagged.
-:func:`replace_outliers` replaces each flagged sample by a draw from what Gaussian noise would have put there
-(the local level plus white noise where the noise is white at the shortest lag; the line between its
-neighbours plus the second difference's noise elsewhere): how :func:`allanite.refine` refits the noise after
-removing them. Sparse spikes are replaced cleanly. Heavy tails are not separable from the Gaussian core by
-any cut: the contaminated samples inside it stay (N falls toward the core's, not to it), and removing those
-outside it by their distance from their neighbours bends the shortest τ (14 % of samples with 8× the spread:
-the five-term fit's χ²/dof 0.9 on the core alone, ≈ 90 after replacing the 5 % flagged).
+The samples then flagged are those off both neighbours at a cut c*: the differences into and out of the
+sample both beyond c*·σ_d (the lattice's next step on quantised samples) and of opposite signs — Gaussian
+samples are flagged at most as often as one difference exceeds the cut, λ(c*), for any spectrum (the lattice
+model holds for the differences; a low-passed record's differences move together, so opposite signs are rarer
+still) — c* the lowest of :data:`FLAG_CUTS` at which λ is at most 5 % of the flags (the flagged share is the
+outliers', not the Gaussian tail's). A spike's neighbours (one large difference each) and a step of the mean
+(one) are not flagged. :func:`replace_outliers` replaces each flagged sample by a draw from what Gaussian
+noise would have put there (the local level plus white noise where the noise is white at the shortest lag;
+the line between its neighbours plus the second difference's noise elsewhere): how :func:`allanite.refine`
+refits the noise after removing them. Sparse spikes are replaced cleanly. Heavy tails are not separable from
+the Gaussian core by any cut: the contaminated samples inside it stay (N falls toward the core's, not to it),
+and removing those outside it by their distance from their neighbours bends the shortest τ.
 """
 
 from __future__ import annotations
@@ -43,12 +41,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.ndimage import maximum_filter1d, median_filter
+from scipy.ndimage import median_filter
 from scipy.optimize import brentq
 from scipy.special import ndtr
 from scipy.stats import poisson
 
-__all__ = ["outlier_test", "replace_outliers", "lattice_step", "robust_sigma", "CUTS", "MEDIAN_SPAN"]
+__all__ = ["outlier_test", "replace_outliers", "lattice_step", "robust_sigma", "CUTS", "FLAG_CUTS"]
 
 #: Cuts (in robust σ of the differences) at which exceedances are counted.
 CUTS = (4.0, 5.0, 6.0, 7.0)
@@ -56,8 +54,6 @@ CUTS = (4.0, 5.0, 6.0, 7.0)
 #: TAIL_FACTOR × λ", so that a sensor whose noise is only slightly non-Gaussian is not flagged (the
 #: ADIS16405 gyros' differences hold 1.1–1.5× the Gaussian count at 3–4 σ, none beyond 5.2 σ: no spikes).
 TAIL_FACTOR = 2.0
-#: Samples of the local median a flagged sample is replaced by (odd).
-MEDIAN_SPAN = 5
 #: Samples per block of the robust scale (at most MAX_BLOCKS blocks, at least one).
 BLOCK = 8192
 MAX_BLOCKS = 64
@@ -66,12 +62,10 @@ MAX_BLOCKS = 64
 #: noise quantised with steps of 0.7 … 2 σ and offsets 0, ¼, ½ step (2·10⁶ samples): the count beyond 4 σ is
 #: within 0.8–1.3× the model up to a step of 1.4 σ (std ≥ 0.7 step), 2.25× at 2 σ.
 COARSE = 0.7
-#: Cuts (white-noise σ) at which samples are flagged: the lowest at which Gaussian samples would make at most
-#: EXCESS_SHARE of the flags.
+#: Cuts (σ of the differences) at which samples are flagged: the lowest at which Gaussian samples would make at
+#: most EXCESS_SHARE of the flags.
 FLAG_CUTS = (3.0, 3.5, 4.0, 4.5, 5.0, 6.0, 7.0, 8.0)
 EXCESS_SHARE = 0.05
-#: Variance (in σ² of white noise) of the tail of y_t − median of the 5 samples around it.
-RESIDUAL_VAR = 1.2
 #: Samples of the local level a flagged sample of white noise is replaced around (odd).
 LEVEL_SPAN = 65
 #: σ_e²/σ_d² at or above which a block's noise counts as white at the shortest lag (white 0.75, random walk 0.5,
@@ -157,7 +151,7 @@ def outlier_test(y: np.ndarray, fs: float, alpha: float) -> dict:
     ``p_value`` of the count under Poisson(TAIL_FACTOR·λ), ``p_gaussian`` under Poisson(λ)),
     ``alpha_per_cut``, ``step`` (the quantisation step, 0 if continuous), ``sigma_d`` (the differences'
     robust σ, median over blocks, rate unit) and, when accepted, ``cut`` (c*), ``flags`` (bool per sample),
-    ``rate`` (flagged share of the samples) and ``threshold`` (rate unit: c* white-noise σ, median over
+    ``rate`` (flagged share of the samples) and ``threshold`` (rate unit: the differences' cut at c*, median over
     blocks). ``fs`` only labels the record (the test is on samples)."""
     y = np.asarray(y, dtype=np.float64)
     n = y.size
@@ -195,31 +189,39 @@ def outlier_test(y: np.ndarray, fs: float, alpha: float) -> dict:
         out["cuts"].append({"c": c, "count": count, "expected": lam, "p_value": pv, "p_gaussian": pg})
     if not any(r["p_value"] <= out["alpha_per_cut"] for r in out["cuts"]):
         return out
-    loc = _local(y, step)
-    out["sigma_white"] = float(np.median(loc["sigma_e"]) / math.sqrt(1.5))
     for c in FLAG_CUTS:
-        flags = _flags(loc, c)
+        flags, lam = _flags(d, blocks, sig, step, c)
         k = int(np.count_nonzero(flags))
-        # Gaussian samples flagged: at most those whose second difference is beyond c·σ_e (exactly 2Φ̄(c))
-        expected = y.size * float(2.0 * ndtr(-c))
-        if k and expected <= EXCESS_SHARE * k:
-            out.update(
-                accepted=True,
-                cut=c,
-                flags=flags,
-                rate=k / y.size,
-                threshold=float(c * math.sqrt(RESIDUAL_VAR / 1.5) * np.median(loc["sigma_e"])),
-                expected_gaussian_flags=expected,
-            )
+        # Gaussian samples flagged: at most the differences beyond the cut, λ (exact for the lattice too)
+        if k and lam <= EXCESS_SHARE * k:
+            cut = float(np.median([_tail(c, s_b, step)[0] for s_b in sig]))
+            out.update(accepted=True, cut=c, flags=flags, rate=k / y.size, threshold=cut, expected_gaussian_flags=lam)
             return out
-    out["note"] = "the differences' tail exceeds twice the Gaussian's, but too few samples stand off their neighbours"
+    out["note"] = "the differences' tail exceeds twice the Gaussian's, but too few samples stand off both neighbours"
     return out
 
 
+def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float) -> tuple[np.ndarray, float]:
+    """Samples off both neighbours: the differences into and out of the sample both beyond the cut (c·σ_d of
+    its block, the lattice's next step on quantised samples) and of opposite signs. Gaussian samples are
+    flagged at most as often as a difference exceeds the cut (λ, returned) — for any spectrum (a low-passed
+    record's differences move together: opposite signs are rarer still); a spike's neighbours (one large
+    difference each) and a step of the mean (one) are not flagged."""
+    big = np.zeros(d.size, dtype=bool)
+    lam = 0.0
+    for b, s_b in zip(blocks, sig):
+        cut, p = _tail(c, s_b, step)
+        big[b] = np.abs(d[b]) > cut
+        lam += (b.stop - b.start) * p
+    both = big[:-1] & big[1:] & (np.sign(d[:-1]) != np.sign(d[1:]))
+    flags = np.zeros(d.size + 1, dtype=bool)
+    flags[1:-1] = both  # d[t-1] = y_t − y_{t−1} and d[t] = y_{t+1} − y_t flag sample t
+    return flags, lam
+
+
 def _local(y: np.ndarray, step: float) -> dict:
-    """Per sample: its distance from the median of the :data:`MEDIAN_SPAN` samples around it (``r``), its second
-    difference e_t = y_t − (y_{t−1} + y_{t+1})/2 (``e``), the robust σ of e in its block (``sigma_e``) and of the
-    first differences' (``sigma_d``)."""
+    """Per sample: the robust σ of the second difference e_t = y_t − (y_{t−1} + y_{t+1})/2 (``sigma_e``) and of
+    the first differences (``sigma_d``) in its block (for the replacement)."""
     e = np.zeros(y.size)
     e[1:-1] = y[1:-1] - 0.5 * (y[:-2] + y[2:])
     d = np.concatenate([[0.0], np.diff(y)])
@@ -231,19 +233,7 @@ def _local(y: np.ndarray, step: float) -> dict:
             sig_e[b] = se
         if np.isfinite(sd) and sd > 0:
             sig_d[b] = sd
-    return {"r": y - median_filter(y, size=MEDIAN_SPAN, mode="nearest"), "e": e, "sigma_e": sig_e, "sigma_d": sig_d}
-
-
-def _flags(loc: dict, c: float) -> np.ndarray:
-    """Samples off their neighbours: the second difference beyond c·σ_e — a linear, hence Gaussian, statistic
-    for any spectrum, so Gaussian samples make at most 2Φ̄(c) of the flags — and the distance from the local
-    median beyond c white-noise σ (√(1.2/1.5)·c·σ_e: y − median₅ of white noise has the tail of N(0, 1.2σ²) or
-    lighter) — and the largest second difference of the three around it: a spike's neighbours (second difference
-    −a/2) are not flagged with it."""
-    se = loc["sigma_e"]
-    ae = np.abs(loc["e"])
-    peak = ae >= maximum_filter1d(ae, 3, mode="nearest")  # a spike's own, not its neighbours' (a/2)
-    return peak & (ae > c * se) & (np.abs(loc["r"]) > c * math.sqrt(RESIDUAL_VAR / 1.5) * se)
+    return {"sigma_e": sig_e, "sigma_d": sig_d}
 
 
 def replace_outliers(y: np.ndarray, flags: np.ndarray, seed: int = 0) -> np.ndarray:
