@@ -22,8 +22,9 @@ ratio is largest — 3 is the issue's "detectable size"; smaller sizes give the 
 fc, f1 log-uniform with every named line inside 20/T … 0.4·f_s (T the record). Reported per kind and size:
 the share named right (a family for the periodic kinds, one sinusoid for ``isolated``; outliers accepted),
 frequencies within 1 % (each true fundamental; a carrier modulo the found spacing), RMS within 20 %, χ²/dof of
-the five-term fit before and after removing what was found (median), and for outliers the flagged share against
-the truth and N before/after against the true N.
+the five-term fit before and after removing what was found (median; and after over the noise alone's — a
+low-pass or a quantiser makes the noise itself misfit the five terms), and for outliers the flagged share
+against the truth and N before/after against the true N.
 
 Usage::
 
@@ -153,6 +154,7 @@ def run_periodic(kind, size, seed):
         removed = sum(f.component() for f in r["families"] + r["sinusoids"])
         out["chi2_before"], out["chi2_after"] = _chi2(y, fs), _chi2(y - removed, fs)
         out["chi2_noise_only"] = _chi2(y0, fs)
+        out["chi2_ratio"] = out["chi2_after"] / out["chi2_noise_only"]
     return out
 
 
@@ -243,6 +245,7 @@ def run_impulsive(kind, seed):
     out["N_noise_only"] = float(fit0.coefficients["N"].value)
     out["N_before"] = float(fit_raw.coefficients["N"].value)
     out["chi2_before"] = float(fit_raw.chi2_dof)
+    out["chi2_noise_only"] = float(fit0.chi2_dof)
     if r["accepted"]:
         clean = outliers.replace_outliers(y, r["flags"])
         fit_clean = allanite.fit(allanite.avar(clean, fs))
@@ -312,7 +315,7 @@ def markdown(rep, sizes) -> str:
         "## Line families (α = 1 %)",
         "",
         "| kind | size (ADEV ratio) | named right | frequencies within 1 % | RMS within 20 % | lines (median) "
-        "| χ²/dof before → after (median) | noise alone | CPU s (median) |",
+        "| χ²/dof before → after (median) | after / noise alone (median) | CPU s (median) |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for kind in PERIODIC:
@@ -323,7 +326,7 @@ def markdown(rep, sizes) -> str:
             lines.append(
                 f"| {kind} | {size:g} | {_share(sub, 'named')} | {_share(sub, 'freq_ok')} | {_share(sub, 'rms_ok')} "
                 f"| {_med(sub, 'lines')} | {_med(sub, 'chi2_before')} → {_med(sub, 'chi2_after')} "
-                f"| {_med(sub, 'chi2_noise_only')} | {_med(sub, 'cpu_s')} |"
+                f"| {_med(sub, 'chi2_ratio')} | {_med(sub, 'cpu_s')} |"
             )
     imu = [r for r in rows if r["kind"] == "imu"]
     if imu:
@@ -348,7 +351,7 @@ def markdown(rep, sizes) -> str:
         "## Outliers (α = 0.25 %)",
         "",
         "| kind | accepted | flagged share vs truth (spikes: within 20 %) | N before → after (true 1; noise alone) "
-        "| χ²/dof before → after | CPU s |",
+        "| χ²/dof before → after (noise alone) | CPU s |",
         "|---|---|---|---|---|---|",
     ]
     for r in [r for r in rows if r["kind"] in IMPULSIVE]:
@@ -365,7 +368,7 @@ def markdown(rep, sizes) -> str:
         lines.append(
             f"| {r['kind']} (fs {r['fs']:.3g}, n {r['n']}) | {r['named']} | {got} vs {truth}{ok} "
             f"| {r['N_before']:.3g} → {after} ({r['N_noise_only']:.3g}) | {r['chi2_before']:.3g} → {chi_after} "
-            f"| {r['cpu_s']:.2f} |"
+            f"({r['chi2_noise_only']:.3g}) | {r['cpu_s']:.2f} |"
         )
     return "\n".join(lines) + "\n"
 

@@ -29,8 +29,12 @@ def _gauss(n, seed, lowpass=None):
 
 
 def test_lattice_step_is_found_only_on_whole_multiples():
-    assert outliers.lattice_step(np.array([0.0, 0.05, -0.15, 0.1]) * 3) == pytest.approx(0.15)
-    assert outliers.lattice_step(np.array([0.05, 0.15, 0.07])) == 0.0
+    rng = np.random.default_rng(0)
+    on = rng.integers(-20, 21, 10_000) * 0.15
+    assert outliers.lattice_step(on) == pytest.approx(0.15)
+    assert outliers.lattice_step(np.concatenate([on, [0.4371, 2.91]])) == pytest.approx(0.15)  # a few outliers
+    assert outliers.lattice_step(rng.normal(size=10_000)) == 0.0
+    assert outliers.lattice_step(np.concatenate([on[:100], rng.normal(size=100)])) == 0.0
     assert outliers.lattice_step(np.zeros(5)) == 0.0
 
 

@@ -253,8 +253,9 @@ def refine_generators(
     """Generators refined by Gauss–Newton on the lines' frequency offsets; returns (gens, covariance).
 
     ``var_nu``: each line's frequency variance (cycles/sample)², the weights of the least-squares step
-    (:func:`frequency_sd` / f_s, squared). A line whose offset lies beyond 4 σ of the fitted lattice is
-    left out of the next step (a weak line's zoom may pick a noise peak)."""
+    (:func:`frequency_sd` / f_s, squared). A line whose offset lies beyond 4 of the offsets' robust σ (the
+    median |z| scaled; at least 1) from the fitted lattice is left out of that step (a weak line's zoom may
+    pick a noise peak; the weights from the PSD's amplitudes are themselves rough)."""
     gens = np.atleast_1d(np.asarray(gens, dtype=np.float64)).copy()
     coefs = np.atleast_2d(np.asarray(coefs, dtype=np.int64))
     n = y.size
@@ -262,13 +263,13 @@ def refine_generators(
     centres = (np.arange(n_seg) + 0.5) * n / n_seg
     c = coefs[:, : gens.size].astype(np.float64)
     w = 1.0 / np.maximum(np.asarray(var_nu, dtype=np.float64), 1e-300)
-    use = np.ones(coefs.shape[0], dtype=bool)
     yd = y - y.mean()
     cov = np.full((gens.size, gens.size), np.nan)
     for _ in range(n_iter):
         d_seg = dtft(yd, idx, gens, coefs, n_seg=n_seg)
         # the zoom spans ± half a piece's resolution: the pieces' phases then advance by < π between pieces
         delta = _zoom_offsets(d_seg, centres, 0.9 * np.pi * n_seg / n) / (2 * np.pi)
+        use = np.ones(coefs.shape[0], dtype=bool)
         for _k in range(3):
             cw = c[use] * w[use, None]
             info = c[use].T @ cw
@@ -276,8 +277,9 @@ def refine_generators(
                 return gens, cov
             step = np.linalg.solve(info, cw.T @ delta[use])
             z = (delta - c @ step) * np.sqrt(w)
-            keep = np.abs(z) <= 4.0
-            if np.array_equal(keep, use) or keep.sum() < gens.size:
+            scale = max(1.0, 1.4826 * float(np.median(np.abs(z[use]))))
+            keep = np.abs(z) <= 4.0 * scale
+            if np.array_equal(keep, use) or keep.sum() < gens.size + 1:
                 break
             use = keep
         gens = gens + step

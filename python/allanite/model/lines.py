@@ -50,8 +50,8 @@ SEEDS = 12
 SUBHARMONICS = 6
 #: The strongest lines tried as carriers of a sideband lattice (with a spacing of two of them).
 CARRIERS = 6
-#: Largest |s| of a sideband lattice (a sample-rate beat's sawtooth phase modulation spreads over dozens).
-MAX_SIDEBAND = 64
+#: Largest |s| of a sideband lattice (a sample-rate beat's sawtooth phase modulation spreads over the band).
+MAX_SIDEBAND = 256
 
 
 def fold_frequency(nu: np.ndarray) -> np.ndarray:
@@ -303,18 +303,22 @@ def _match(nu, tol, gens, gen_sd, k_max, s_max):
     return coefs, row, slack
 
 
-def _grow(nu, tol, w, gens, gen_sd, k_max, s_max, iters: int = 6):
+def _grow(nu, tol, w, gens, gen_sd, k_max, s_max, iters: int = 10):
     """Match lines to the lattice of ``gens`` and refit the generators on the matched lines (weighted least
-    squares in the unfolded frequency), the lattice widened from its low rows as the generators sharpen;
-    returns (gens, coefs of matched lines, matched index, generator SDs, chance count)."""
+    squares in the unfolded frequency). The lattice starts at its lowest rows (k ≤ 4 for harmonics; k ≤ 1,
+    |s| ≤ 2 for sidebands) and grows only as far as lines are matched (to twice the extents in use, or two
+    more): a lattice wider than its lines is dense enough, aliased, to put some far row next to any line,
+    which then pulls the generators off. Returns (gens, coefs of matched lines, matched index, generator SDs,
+    chance count)."""
     gens = np.asarray(gens, dtype=np.float64)
     gen_sd = np.asarray(gen_sd, dtype=np.float64)
-    k_now, s_now = min(k_max, 8), min(s_max, 2)
+    k_now, s_now = (min(k_max, 4), 0) if gens.size == 1 else (1, min(s_max, 2))
     m = np.zeros(0, dtype=np.int64)
     coefs = np.zeros((0, gens.size), dtype=np.int64)
     row = np.full(nu.size, -1)
     slack = np.zeros(0)
-    for it in range(iters):
+    last = None
+    for _ in range(iters):
         coefs, row, slack = _match(nu, tol, gens, gen_sd, k_now, s_now)
         m = np.flatnonzero(row >= 0)
         if m.size < gens.size + 1:
@@ -330,9 +334,14 @@ def _grow(nu, tol, w, gens, gen_sd, k_max, s_max, iters: int = 6):
             break  # the matched rows do not pin both generators
         gens = np.linalg.solve(info, cw.T @ target)
         gen_sd = np.sqrt(np.maximum(np.diag(np.linalg.inv(info)), 0.0))
-        if k_now == k_max and s_now == s_max and it >= 2:
+        top = np.max(np.abs(c), axis=0).astype(int)
+        k_next = min(k_max, max(2 * top[0], top[0] + 2))
+        s_next = min(s_max, max(2 * top[1], top[1] + 2)) if gens.size == 2 else 0
+        state = (k_next, s_next, m.size)
+        if state == last:
             break
-        k_now, s_now = min(k_max, 4 * k_now), min(s_max, 2 * s_now)
+        last = state
+        k_now, s_now = k_next, s_next
     if m.size == 0:
         return gens, coefs[:0], m, gen_sd, 0.0
     used = coefs[row[m]]
@@ -381,10 +390,12 @@ def _commensurate(gens: np.ndarray, tol: float, q_max: int = 4) -> bool:
     return False
 
 
-def _reduce(gens: np.ndarray, coefs: np.ndarray, gen_sd: np.ndarray):
+def _reduce(gens: np.ndarray, coefs: np.ndarray, gen_sd: np.ndarray, strength: np.ndarray):
     """One basis for a two-generator lattice: the larger generator first, the second reduced modulo it to
     (0, g1/2] — (1.37, 1.18) and (1.37, 0.19) Hz span the same lines; the second is the one a user names (the
-    offset of the sidebands). Rows follow (k + s·q, s), signs made k ≥ 0 (s > 0 when k = 0)."""
+    offset of the sidebands) — and, when the strongest line is a first multiple (k = 1), the first generator
+    moved onto it by multiples of the second (a tone's sidebands: the tone is the carrier, not a sideband).
+    Rows follow, signs made k ≥ 0 (s > 0 when k = 0)."""
     if gens.size != 2:
         return gens, coefs, gen_sd
     if gens[1] > gens[0]:
@@ -397,7 +408,13 @@ def _reduce(gens: np.ndarray, coefs: np.ndarray, gen_sd: np.ndarray):
     flip = (coefs[:, 0] < 0) | ((coefs[:, 0] == 0) & (coefs[:, 1] < 0))
     coefs = np.where(flip[:, None], -coefs, coefs)
     sd2 = math.hypot(gen_sd[1], q * gen_sd[0])
-    return np.array([gens[0], g2]), coefs, np.array([gen_sd[0], sd2])
+    g1 = gens[0]
+    top = int(np.argmax(strength))
+    if coefs[top, 0] == 1 and coefs[top, 1] != 0:
+        shift = int(coefs[top, 1])
+        g1 = g1 + shift * g2
+        coefs = np.column_stack([coefs[:, 0], coefs[:, 1] - coefs[:, 0] * shift])
+    return np.array([g1, g2]), coefs, np.array([gen_sd[0], sd2])
 
 
 def group_lines(lines: list[dict], fs: float) -> list[dict]:
@@ -437,7 +454,7 @@ def group_lines(lines: list[dict], fs: float) -> list[dict]:
         if pick is None:
             break
         _, gens, coefs, m, gen_sd = pick
-        gens, coefs, gen_sd = _reduce(gens, coefs, gen_sd)
+        gens, coefs, gen_sd = _reduce(gens, coefs, gen_sd, strength[left[m]])
         fams.append({"gens": gens, "coefs": coefs, "members": left[m].tolist(), "gen_sd": gen_sd})
         left = np.delete(left, m)
     return fams

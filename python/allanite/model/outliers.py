@@ -74,17 +74,21 @@ WHITE_RATIO = 0.65
 
 
 def lattice_step(x: np.ndarray) -> float:
-    """The quantisation step L of ``x`` if every nonzero |x| is a whole multiple of the smallest (to 1e-6),
-    else 0 (continuous)."""
+    """The quantisation step L of ``x``: the smallest nonzero |x| that recurs, if at least 99 % of the nonzero
+    |x| are whole multiples of it (to 1e-6) — a few off-lattice values (the outliers themselves, added to a
+    quantised record) do not hide the lattice; else 0 (continuous)."""
     a = np.abs(np.asarray(x, dtype=np.float64))
     nz = a[a > 0]
     if nz.size == 0:
         return 0.0
-    step = float(nz.min())
+    vals, counts = np.unique(np.round(nz, 12), return_counts=True)
+    recurring = vals[counts >= 3]
+    if recurring.size == 0:
+        return 0.0
+    step = float(recurring[0])
     q = nz / step
-    if np.all(np.abs(q - np.round(q)) <= 1e-6 * np.maximum(1.0, q)):
-        return step
-    return 0.0
+    on = np.abs(q - np.round(q)) <= 1e-6 * np.maximum(1.0, q)
+    return step if np.mean(on) >= 0.99 else 0.0
 
 
 def _inner(a: float, sigma: float, step: float) -> float:

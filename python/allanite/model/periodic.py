@@ -235,7 +235,7 @@ def _fit_family(y, fs, fam, found_lines, passes, alpha, taken_f) -> LineFamily:
 def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
     """Lines of ``y`` at false-alarm probability ``alpha`` per record, as families and isolated sinusoids.
 
-    Returns ``families`` (:class:`LineFamily`, two or more lines each, largest first), ``sinusoids`` (one-line
+    Returns ``families`` (:class:`LineFamily`, two or more lines each, strongest (RMS) first), ``sinusoids`` (one-line
     :class:`LineFamily` each, strongest first), ``lines``, ``bins`` and ``p_value`` of the search
     (:func:`allanite.model.lines.find_lines`)."""
     y = np.asarray(y, dtype=np.float64)
@@ -253,7 +253,7 @@ def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
         one = {"gens": np.array([d["f"] / fs]), "coefs": np.array([[1]])}
         fit = _fit_family(y, fs, one, [d], passes, alpha, taken_f)
         (fams if fit.coefs.shape[0] > 1 else sins).append(fit)
-    fams.sort(key=lambda fm: -fm.coefs.shape[0])
+    fams.sort(key=lambda fm: -fm.rms)
     return {
         "families": fams,
         "sinusoids": sins,
