@@ -98,6 +98,18 @@ def fmt_ci(v: Any, lo: Any, hi: Any, digits: int = 4) -> str:
     return f"{fmt(v, digits)} [{fmt(lo, digits)}, {fmt(hi, digits)}]"
 
 
+def fmt_param(v: Any, interval: Any = None, digits: int = 4) -> str:
+    """A parameter of any kind with its interval if it has one: a string as it is, an int as an int, a number
+    as ``value [low, high]``, a list as ``[a [lo, hi], b [lo, hi]]`` (``interval`` a list of pairs, one per
+    entry, or None)."""
+    if isinstance(v, (list, tuple, np.ndarray)):
+        ivs = list(interval) if interval is not None else [None] * len(v)
+        return "[" + ", ".join(fmt_param(x, iv, digits) for x, iv in zip(v, ivs)) + "]"
+    if interval is None or isinstance(v, (str, bool, int, np.integer)):
+        return fmt(v, digits)
+    return fmt_ci(v, interval[0], interval[1], digits)
+
+
 def fmt_range(a: Any, unit: str = "") -> str:
     """First–last of an array with a unit (``"0.01–3600 s"``)."""
     a = np.asarray(a)

@@ -46,7 +46,7 @@ from scipy.optimize import brentq
 from scipy.special import ndtr
 from scipy.stats import poisson
 
-__all__ = ["outlier_test", "replace_outliers", "lattice_step", "robust_sigma", "CUTS", "FLAG_CUTS"]
+__all__ = ["outlier_test", "flag_at", "replace_outliers", "lattice_step", "robust_sigma", "CUTS", "FLAG_CUTS"]
 
 #: Cuts (in robust σ of the differences) at which exceedances are counted.
 CUTS = (4.0, 5.0, 6.0, 7.0)
@@ -81,11 +81,12 @@ def lattice_step(x: np.ndarray) -> float:
     nz = a[a > 0]
     if nz.size == 0:
         return 0.0
-    vals, counts = np.unique(np.round(nz, 12), return_counts=True)
-    recurring = vals[counts >= 3]
+    scale = float(nz.max())
+    vals, counts = np.unique(np.round(nz / scale, 12), return_counts=True)  # 12 digits: rounding noise merges
+    recurring = vals[(counts >= 3) & (vals > 0)]
     if recurring.size == 0:
         return 0.0
-    step = float(recurring[0])
+    step = float(np.min(nz[np.abs(nz / scale - recurring[0]) <= 1e-12]))
     q = nz / step
     on = np.abs(q - np.round(q)) <= 1e-6 * np.maximum(1.0, q)
     return step if np.mean(on) >= 0.99 else 0.0
@@ -203,6 +204,19 @@ def outlier_test(y: np.ndarray, fs: float, alpha: float) -> dict:
             return out
     out["note"] = "the differences' tail exceeds twice the Gaussian's, but too few samples stand off both neighbours"
     return out
+
+
+def flag_at(y: np.ndarray, c: float) -> tuple[np.ndarray, float]:
+    """Flags of the samples ``y`` at the cut ``c`` (σ of the differences, each block's own) and the number of
+    Gaussian samples expected among them (λ): the flagging of :func:`outlier_test` at a given cut."""
+    y = np.asarray(y, dtype=np.float64)
+    d = np.diff(y)
+    step = lattice_step(d)
+    blocks = _blocks(d.size)
+    sig = np.array([robust_sigma(d[b], step) for b in blocks])
+    if not np.isfinite(sig).all():
+        return np.zeros(y.size, dtype=bool), 0.0
+    return _flags(d, blocks, sig, step, c)
 
 
 def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float) -> tuple[np.ndarray, float]:

@@ -28,7 +28,7 @@ from scipy.stats import f as f_dist
 
 from . import linefit, lines
 
-__all__ = ["LineFamily", "periodic_search"]
+__all__ = ["LineFamily", "periodic_search", "sinusoid_lines"]
 
 
 @dataclass
@@ -261,3 +261,37 @@ def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
         "bins": found["bins"],
         "p_value": found["p_value"],
     }
+
+
+def sinusoid_lines(search: dict, families: bool = False) -> list[dict]:
+    """The lines of a :func:`periodic_search` as the ``"sinusoid"`` candidate takes them, strongest first: each
+    ``f0`` (Hz, refined), ``amplitude`` and ``phase`` (least squares), ``f0_interval`` and
+    ``amplitude_interval`` (±1σ), ``psd_ratio``, ``threshold`` and ``bin_hz`` of the search. The lone lines;
+    with ``families``, every family's lines too (when families are not removed as a whole)."""
+    out: list[dict] = []
+    found = np.array([d["f"] for d in search["lines"]])
+    sources = list(search["sinusoids"]) + (list(search["families"]) if families else [])
+    for fam in sources:
+        freqs, amps, amp_sd = fam.frequencies, fam.amplitudes, fam.amplitude_sd
+        lone = freqs.size == 1 and np.all(np.isfinite(fam.gens_sd))
+        f_sd = fam.gens_sd if lone else linefit.frequency_sd(amps, fam.noise, fam.fs, fam.n)
+        for i in range(freqs.size):
+            if found.size == 0:
+                break
+            near = search["lines"][int(np.argmin(np.abs(found - freqs[i])))]
+            if abs(near["f"] - freqs[i]) > 2 * near["bin_hz"]:
+                continue  # a lattice point the targeted test added: not a line of the search itself
+            out.append(
+                {
+                    "f0": float(freqs[i]),
+                    "amplitude": float(amps[i]),
+                    "phase": float(math.atan2(fam.a[i], fam.b[i])),
+                    "f0_interval": (float(freqs[i] - f_sd[i]), float(freqs[i] + f_sd[i])),
+                    "amplitude_interval": (max(0.0, float(amps[i] - amp_sd[i])), float(amps[i] + amp_sd[i])),
+                    "psd_ratio": float(near["psd_ratio"]),
+                    "threshold": float(near["threshold"]),
+                    "bin_hz": float(near["bin_hz"]),
+                }
+            )
+    out.sort(key=lambda d: -d["psd_ratio"])
+    return out

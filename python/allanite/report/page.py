@@ -15,7 +15,7 @@ from typing import Any
 import jinja2
 
 from .._core import __version__
-from .fmt import duration, g
+from .fmt import duration, g, param_text
 from .forecasting import forecast_page
 from .paper002 import page_context as paper002_page
 from .settings import REPORT_ESTIMATORS
@@ -261,16 +261,7 @@ def _refinement(ref: dict | None) -> dict | None:
             ]
         )
         for st in ax["steps"]:
-            params = "; ".join(
-                f"{p} = {v}"
-                if isinstance(v, str)
-                else (
-                    f"{p} = {g(v, 3)} [{g(st['intervals'][p][0], 3)}, {g(st['intervals'][p][1], 3)}]"
-                    if p in st["intervals"]
-                    else f"{p} = {g(v, 3)}"
-                )
-                for p, v in st["params"].items()
-            )
+            params = "; ".join(f"{p} = {param_text(v, st['intervals'].get(p))}" for p, v in st["params"].items())
             if st["statistic"] == "allan_curve":
                 curve_rows.append(
                     [

@@ -11,7 +11,7 @@ from ..estimators import get as get_estimator
 from ..model.effects import EFFECTS
 from ..model.terms import TERM_NAMES
 from ..units import coefficient_unit, ieee952
-from .fmt import duration, g, json_list, json_number, pct
+from .fmt import duration, g, json_interval, json_list, json_number, json_value, param_text, pct
 from .forecasting import forecast_dict, forecast_text
 from .paper002 import text_lines as paper002_text
 from .settings import FIT_MODEL
@@ -55,9 +55,9 @@ def refinement_dict(rep) -> dict | None:
                         "effect": st.effect,
                         "statistic": "window_levels" if st.effect == "change_point" else "allan_curve",
                         "domain": EFFECTS[st.effect].domain,
-                        "params": {p: v if isinstance(v, str) else json_number(v) for p, v in st.params.items()},
+                        "params": {p: json_value(v) for p, v in st.params.items()},
                         "units": {p: rate if u == "rate unit" else u for p, u, _ in EFFECTS[st.effect].params},
-                        "intervals": {p: [json_number(a), json_number(b)] for p, (a, b) in st.intervals.items()},
+                        "intervals": {p: json_interval(iv) for p, iv in st.intervals.items()},
                         "before": {q: json_number(v) for q, v in st.before.items()},
                         "after": {q: json_number(v) for q, v in st.after.items()},
                         "test": _jsonable_test(st.evidence.get("test")),
@@ -446,7 +446,7 @@ def text_summary(s: dict) -> str:
             )
             for st in ax["steps"]:
                 params = ", ".join(
-                    f"{p} = {v}" if isinstance(v, str) else f"{p} = {g(v, 3)} {st['units'][p]}".rstrip()
+                    f"{p} = {param_text(v)} {'' if isinstance(v, str) else st['units'][p]}".rstrip()
                     for p, v in st["params"].items()
                 )
                 lines.append(f"    {st['effect']}: {params}")

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._display import RichDisplay, Summary, Table, fmt_ci, thin
+from ..._display import RichDisplay, Summary, Table, fmt_param, thin
 from ...results import AllanResult
 from .. import fitting
 from ..effects import EFFECTS
@@ -116,7 +116,7 @@ class Refinement(RichDisplay):
         for i, st in enumerate(self.steps, 1):
             units = {name: unit for name, unit, _ in EFFECTS[st.effect].params} if st.effect in EFFECTS else {}
             ps = "; ".join(
-                f"{k} = {fmt_ci(v, *st.intervals[k])} {units.get(k, '')}".rstrip() for k, v in st.params.items()
+                f"{k} = {fmt_param(v, st.intervals.get(k))} {units.get(k, '')}".rstrip() for k, v in st.params.items()
             )
             rows.append(
                 [
@@ -202,8 +202,4 @@ def _fmt(v) -> str:
 
 
 def _fmt_param(k, v, iv) -> str:
-    if isinstance(v, str):
-        return f"{k} = {v}"
-    if iv is None:
-        return f"{k} = {v:.4g}"
-    return f"{k} = {v:.4g} [{iv[0]:.4g}, {iv[1]:.4g}]"
+    return f"{k} = {fmt_param(v, iv)}"
