@@ -174,21 +174,25 @@ def test_adis_run1_z_default_call_chains(adis_run1_z):
     w = cp.evidence["window_levels"]
     assert w["after"]["chi2_dof"] < w["before"]["chi2_dof"]
     assert cp.evidence["heldout_test"]["after"] < cp.evidence["heldout_test"]["before"]
-    # the curve steps lower every error along the chain
+    # every curve step lowers the χ² it was accepted on (a second line inside the resonance's hump may cost the
+    # RMS ADEV error a little: 3.34 → 3.46 %); the chain as a whole lowers every error
     for st in r.steps:
         if st.effect != "change_point":
-            assert st.after["chi2_dof"] < st.before["chi2_dof"] and st.after["rms_adev_pct"] < st.before["rms_adev_pct"]
+            assert st.after["chi2_dof"] < st.before["chi2_dof"]
+    first, last = r.steps[0].before, r.steps[-1].after
+    assert all(last[k] < first[k] for k in ("chi2_dof", "rms_adev_pct", "heldout_rms_adev_pct"))
 
 
 def test_adis_run1_z_final_params_beside_acceptance(adis_run1_z):
     r = adis_run1_z
     curve = [s for s in r.steps if s.effect in ("sinusoid", "bandwidth", "resonance", "gauss_markov")]
-    assert len(curve) == len(r.effects) == len({s.effect for s in curve})
-    for st in curve:
+    assert len(curve) == len(r.effects)
+    names = [n for n in r.fit.coefficients if n not in r.terms]  # "sinusoid1", "sinusoid2", "bandwidth", …
+    for key, st in zip(names, curve):  # steps[j] ↔ effects[j]
         assert set(st.final_params) == set(st.params)
         amp = {"sinusoid": "amplitude", "resonance": "sigma", "gauss_markov": "sigma"}.get(st.effect)
         if amp:  # the final joint fit's amplitude: its column's √θ in the final model
-            assert st.final_params[amp] == pytest.approx(r.fit.coefficients[st.effect].value, rel=1e-12)
+            assert st.final_params[amp] == pytest.approx(r.fit.coefficients[key].value, rel=1e-12)
     sn = next(s for s in r.steps if s.effect == "sinusoid")
     # at acceptance from the samples (least squares at the line), after the joint refit from the curve
     assert sn.params["amplitude"] != sn.final_params["amplitude"] and sn.final_params["f0"] == sn.params["f0"]
@@ -213,7 +217,7 @@ def test_adis_run1_z_renders_every_param_everywhere(adis_run1_z):
     # bandwidth, a sinusoid's f0 is in Hz)
     final = text.split("## Final model", 1)[1]
     assert final.count("- bandwidth:") == 1 and "filter = boxcar" in final.split("- bandwidth:", 1)[1].split("\n")[0]
-    assert "f0 = " in final and " Hz" in final.split("- sinusoid:", 1)[1].split("\n")[0]
+    assert "f0 = " in final and " Hz" in final.split("- sinusoid 1:", 1)[1].split("\n")[0]
     assert "deg/s" not in final.split("- bandwidth:", 1)[1].split("\n")[0]
     # a term the refinement moved outside the plain fit's interval: which steps moved it, in words, everywhere
     assert r.term_moves and all(m["moves"] for m in r.term_moves)

@@ -325,6 +325,48 @@ EFFECTS: dict[str, Effect] = {
             domain="channels",
         ),
         Effect(
+            "periodic",
+            "family of spectral lines",
+            "time",
+            (
+                (
+                    "fundamentals",
+                    "Hz",
+                    "the family's generators: [f0] for harmonics k·f0, [f1, f2] for lines k·f1 + s·f2 (sidebands "
+                    "±s·f2 around the multiples of f1)",
+                ),
+                ("lines", "", "lines in the family"),
+                ("rms", "rate unit", "RMS of the family's component, √(Σ A_i²/2)"),
+            ),
+            "every significant line of the Welch PSD (Blackman–Harris, the neighbours' median, Bonferroni over the "
+            "bins, at the line share of level) grouped into families on a lattice — harmonics k·f0, sidebands "
+            "k·f1 ± s·f2, aliases folded — each family's lattice points tested where it predicts them, the "
+            "frequencies refined on the samples (Gauss–Newton on the lines' offsets) and the family removed in time "
+            "by least squares at them (allanite.model.periodic); held out, amplitudes and phases are refitted on "
+            "the held-in blocks with the frequencies fixed. A line no family takes stays a sinusoid",
+            domain="psd",
+        ),
+        Effect(
+            "outliers",
+            "impulsive noise (outliers)",
+            "time",
+            (
+                ("rate", "", "share of the samples flagged"),
+                (
+                    "threshold",
+                    "rate unit",
+                    "a sample is flagged when the differences into and out of it both exceed this, with opposite signs",
+                ),
+            ),
+            "samples beyond what Gaussian noise predicts: clusters of first differences beyond 4–7 robust σ (per "
+            "block; lattice-aware on quantised samples) against more than twice their Gaussian expectation "
+            "(Poisson, Bonferroni over the cuts, at the outlier share of level); the flagged samples replaced by a "
+            "draw from what Gaussian noise puts there (the local level plus white noise of the block's σ where "
+            "the noise is white at the shortest lag, else the line between the neighbours plus the second "
+            "difference's noise) and the noise refitted (allanite.model.outliers). Never applied by avar",
+            domain="time",
+        ),
+        Effect(
             "change_point",
             "changes of noise level",
             "time",

@@ -2,12 +2,7 @@
 
 Used by :func:`allanite.refine`:
 
-- :func:`spectral_lines` — lines of the Welch PSD (scipy.signal): a bin stands out when its power over
-  the median of its neighbours exceeds the χ² quantile of a Welch average of that many degrees of freedom,
-  Bonferroni-corrected over the bins searched; the neighbourhood grows with frequency (±k/2 bins, 4…32)
-  so that a 1/f or 1/f² slope is not read as a line (the median of a monotone spectrum over a window
-  symmetric about k is its value at k). f0 is then refined on the periodogram of block means, the
-  amplitude and phase by least squares on the samples.
+- lines of the spectrum: :mod:`allanite.model.lines` (the search, the families) and :mod:`allanite.model.periodic`.
 - :func:`drift_fit` — an exponential warm-up a·e^{−t/T} on block means along the record.
 - :func:`regression_fit` — the rate regressed on another channel, with a block-jackknife interval;
   :func:`band_regression` — the same band by band (octaves), where the coupling differs across frequency.
@@ -25,19 +20,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
 from scipy import signal
 from scipy.linalg import solve_triangular
 from scipy.optimize import minimize_scalar
 from scipy.stats import chi2 as chi2_dist
-from scipy.stats import f as f_dist
 from scipy.stats import norm
 
 from ..simulation import simulate
 from . import _covariance
 
 __all__ = [
-    "spectral_lines",
     "drift_fit",
     "drift_component",
     "drift_threshold",
@@ -53,101 +45,8 @@ __all__ = [
 
 #: Block means a drift is fitted to.
 DRIFT_BLOCKS = 500
-#: Lowest Welch bin searched for lines (below, the window's leakage of a steep 1/f² spectrum dominates).
-MIN_BIN = 6
 #: Octave-to-octave correlation of Allan estimates where no exact covariance applies (curves only).
 OCTAVE_RHO = 0.68
-
-
-def spectral_lines(y: np.ndarray, fs: float, alpha: float, max_lines: int = 4) -> list[dict]:
-    """Significant lines of the Welch PSD of ``y``, strongest first: f0 (Hz), amplitude, phase, evidence."""
-    n = y.size
-    nper = int(min(2**15, 2 ** int(math.log2(max(n // 8, 256)))))
-    x = y - y.mean()
-    f, p = signal.welch(x, fs=fs, nperseg=nper, detrend="linear")
-    nseg = (n - nper) // (nper // 2) + 1
-    dof = max(2.0, 2.0 * nseg * 0.947)  # Hann, 50 % overlap: equivalent degrees of freedom (Welch 1967)
-    bias = chi2_dist.median(dof) / dof
-    med = np.full(p.size, np.nan)
-    half = np.zeros(p.size)
-    k_all = np.arange(p.size)
-    for w in range(4, 33):
-        ks = k_all[(np.clip(k_all // 2, 4, 32) == w) & (k_all >= MIN_BIN) & (k_all < p.size - w)]
-        if ks.size == 0:
-            continue
-        lo = np.maximum(1, ks - w)
-        win = sliding_window_view(np.concatenate([p, np.full(2 * w + 1, np.nan)]), 2 * w + 1)
-        rows = win[lo]
-        med[ks] = np.nanmedian(rows, axis=1)
-        half[ks] = w
-    ratio = p / (med / bias)
-    searched = np.isfinite(ratio)
-    n_bins = int(searched.sum())
-    if n_bins == 0:
-        return []
-    # the neighbours' median is itself an estimate: the ratio is F-distributed, the median's degrees of
-    # freedom those of (2w + 1)/3 independent bins (adjacent Hann bins overlap)
-    dof_med = np.maximum(dof, dof * (2 * half + 1) / 3.0)
-    thr_all = np.where(searched, f_dist.isf(alpha / n_bins, dof, dof_med), np.inf)
-    hits = np.flatnonzero(searched & (ratio > thr_all))
-    peaks: list[int] = []
-    for k in hits[np.argsort(-ratio[hits])]:
-        if all(abs(k - q) > 3 for q in peaks):
-            peaks.append(int(k))
-        if len(peaks) >= max_lines:
-            break
-    t = np.arange(n) / fs
-    out = []
-    df = fs / nper
-    for k in peaks:
-        f0 = _refine_f0(x, fs, f[k], df)
-        c, s = np.cos(2 * np.pi * f0 * t), np.sin(2 * np.pi * f0 * t)
-        coef, *_ = np.linalg.lstsq(np.column_stack([c, s, np.ones(n)]), x, rcond=None)
-        amp = float(math.hypot(coef[0], coef[1]))
-        s1 = float(med[k] / bias)  # the noise's one-sided PSD under the line
-        length = n / fs
-        # least squares in locally white noise of that level: SE(A) = √(S₁/T); Cramér–Rao for f0:
-        # σ_f = (f_s/2π)·√(6·S₁·f_s/(A²n³))
-        se_a = math.sqrt(s1 / length)
-        se_f = fs / (2 * math.pi) * math.sqrt(6 * s1 * fs / (max(amp, 1e-300) ** 2 * float(n) ** 3))
-        out.append(
-            {
-                "f0": f0,
-                "amplitude": amp,
-                "amplitude_interval": (max(0.0, amp - se_a), amp + se_a),
-                "f0_interval": (f0 - se_f, f0 + se_f),
-                "phase": float(math.atan2(coef[0], coef[1])),
-                "psd_ratio": float(ratio[k]),
-                "threshold": float(thr_all[k]),
-                "bin_hz": float(df),
-            }
-        )
-    return out
-
-
-def _refine_f0(x: np.ndarray, fs: float, f_bin: float, df: float) -> float:
-    """Frequency of the periodogram maximum within ±1 bin of ``f_bin``, on block means (fast, no aliasing:
-    the decimated rate stays ≥ 8·f0)."""
-    dec = int(max(1, min(1000, fs // (8 * (f_bin + df)))))
-    k = x.size // dec
-    b = x[: k * dec].reshape(k, dec).mean(axis=1)
-    tb = (np.arange(k) * dec + 0.5 * (dec - 1)) / fs
-
-    def neg_power(f):
-        ph = 2 * np.pi * f * tb
-        return -(np.dot(b, np.cos(ph)) ** 2 + np.dot(b, np.sin(ph)) ** 2)
-
-    grid = np.linspace(max(f_bin - df, df / 4), f_bin + df, 41)
-    # the grid at once, in slices of the block means (a (41, k) phase matrix per slice stays small)
-    power_c, power_s = np.zeros(grid.size), np.zeros(grid.size)
-    for a in range(0, k, 8192):
-        ph = 2 * np.pi * np.outer(grid, tb[a : a + 8192])
-        power_c += np.cos(ph) @ b[a : a + 8192]
-        power_s += np.sin(ph) @ b[a : a + 8192]
-    j = int(np.argmax(power_c**2 + power_s**2))
-    lo, hi = grid[max(0, j - 1)], grid[min(grid.size - 1, j + 1)]
-    res = minimize_scalar(neg_power, bounds=(lo, hi), method="bounded", options={"xatol": df * 1e-4})
-    return float(res.x)
 
 
 def _drift_stat(b, tb, length, with_interval=False):

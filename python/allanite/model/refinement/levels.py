@@ -15,6 +15,7 @@ __all__ = [
     "LINE_SHARE",
     "CHANGE_POINT_SHARE",
     "TIME_SHARE",
+    "OUTLIER_SHARE",
     "UNEXPLAINED_SHARES",
     "SHARES",
     "TIME_SHARES",
@@ -25,12 +26,19 @@ __all__ = [
 
 #: Default false-alarm level per record (clean record: probability that anything is added).
 LEVEL = 0.05
-#: Share of ``level`` spent on spectral lines (the Welch PSD's χ² test, Bonferroni over the bins).
+#: Share of ``level`` spent on spectral lines (the Welch PSD's F test, Bonferroni over the bins): one search
+#: for the lone ``"sinusoid"`` lines and the ``"periodic"`` families alike (a family's lattice points are tested
+#: only after a line was found, so under the null they spend nothing more). Measured over 640 null records:
+#: benches/results/periodic_outliers_null.md.
 LINE_SHARE = 0.2
 #: Share of ``level`` spent on change points of the noise level along the record.
 CHANGE_POINT_SHARE = 0.2
 #: Share of ``level`` for each time-domain test (regression on channels, drift).
 TIME_SHARE = 0.075
+#: Share of ``level`` for the outlier test (clusters of large differences against twice their Gaussian
+#: expectation, Bonferroni over its cuts): proposed 0.05 (α = 0.25 % at level 0.05); its power on spikes and
+#: heavy tails is far above what the share costs (benches/results/periodic_outliers_power.md).
+OUTLIER_SHARE = 0.05
 
 #: Share of ``level`` spent on saying what the final model still misses (``Refinement.unexplained``), split
 #: between its checks: the Allan curve, lines in the PSD, a drift in time.
@@ -42,8 +50,9 @@ SHARES = {
     "change_point": CHANGE_POINT_SHARE,
     **{f"unexplained:{k}": v for k, v in UNEXPLAINED_SHARES.items()},
 }
-#: The share of each time-domain removal, by effect name (one entry per removal of ``removals.REMOVALS``).
-TIME_SHARES = {"drift": TIME_SHARE, "regression": TIME_SHARE}
+#: The share of each time-domain removal, by effect name (one entry per removal of ``removals.REMOVALS``; the
+#: ``"periodic"`` removal spends the ``"lines"`` share).
+TIME_SHARES = {"outliers": OUTLIER_SHARE, "drift": TIME_SHARE, "regression": TIME_SHARE}
 #: Tests run only once another has accepted its effect — a slow channel's optional terms (quadratic,
 #: d(channel)/dt, lag; :data:`allanite.model.channels.TERM_SHARE`), each at this share of ``level``. On a clean
 #: record they never run unless the regression itself is a false alarm, so they take nothing from the

@@ -21,7 +21,7 @@ from ...analysis import avar
 from ...errors import InputError, ParameterError
 from ...estimators.grid import tau_grid
 from ...results import AllanResult
-from .. import fitting, tracing
+from .. import fitting, periodic, tracing
 from ..channels import check_channel, terms_before_after
 from ..effects import EFFECTS, describe
 from ..terms import check_terms
@@ -273,6 +273,7 @@ class _Run:
         self.states: list = [self.state]  # the chain: the model before the first step and after each
         self.change_points: list = []
         self.considered: dict[str, list] = {}
+        self.line_search: dict | None = None  # the periodic removal's line search, for the sinusoid candidate
 
     def build(self, res, samples):
         """The curve (and, with samples, the held-out split) of ``res``'s estimates in the τ range."""
@@ -329,6 +330,7 @@ class _Run:
             for rem in remover(ctx):
                 if self.remove(rem):
                     ctx.y, ctx.curve, ctx.sol = self.y, self.curve, self.sol
+        self.line_search = ctx.lines
 
     def remove(self, rem: Removal) -> bool:
         """Remove ``rem.component`` if the held-out error falls (or its held-out test in time passes); else
@@ -388,7 +390,11 @@ class _Run:
         thin = tracing.thin_indices(self.curve.tau)
         lines = []
         if y is not None and "sinusoid" in candidates:
-            lines = tracing.spectral_lines(y, self.fs, alpha("lines", self.level))
+            # one line search for both line effects (one share of level): the periodic removal's, or now
+            search = self.line_search
+            if search is None:
+                search = periodic.periodic_search(y, self.fs, alpha("lines", self.level))
+            lines = periodic.sinusoid_lines(search, families="periodic" not in candidates)
         for n_step in range(MAX_STEPS):
             if not self.curve_step(n_step, candidates, thin, exact, lines):
                 break

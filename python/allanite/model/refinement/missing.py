@@ -14,8 +14,8 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   added to the model, at the same threshold (reported where the dense curve's χ²/dof there exceeds 1). With
   samples the frequency band is refined on the PSD of the final residual samples: the part of
   ≈ 1/(2τ_hi) … 1/(2τ_lo) (widened ×2) that stands above the spectrum's running median.
-- ``"psd"`` — spectral lines of the final samples (:func:`allanite.model.tracing.spectral_lines`) that no
-  sinusoid of the model accounts for.
+- ``"psd"`` — spectral lines of the final samples (:func:`allanite.model.lines.find_lines`: the line search of
+  the periodic effect, afresh) that no sinusoid of the model accounts for.
 - ``"time"`` — a warm-up drift left in the final samples (:func:`allanite.model.tracing.drift_fit` against its
   bootstrap threshold under the final model's slow terms).
 """
@@ -30,7 +30,7 @@ import numpy as np
 from scipy import signal
 from scipy.linalg import solve_triangular
 
-from .. import tracing
+from .. import lines, tracing
 from ..terms import design_matrix
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
@@ -165,10 +165,10 @@ def _lines(ctx: MissingContext, a: float) -> list[dict]:
         return []
     have = [p for k, p in ctx.effects if base_name(k) == "sinusoid"]
     out = []
-    for ln in tracing.spectral_lines(ctx.y, ctx.fs, a, max_lines=len(have) + 4):
-        if any(abs(ln["f0"] - f) <= 2 * ln["bin_hz"] for f in have):
+    for ln in lines.find_lines(ctx.y, ctx.fs, a)["lines"]:
+        if any(abs(ln["f"] - f) <= 2 * ln["bin_hz"] for f in have):
             continue
-        f0 = float(ln["f0"])
+        f0 = float(ln["f"])
         lo, hi = max(0.2 / f0, float(ctx.curve.tau[0])), min(1.0 / f0, float(ctx.curve.tau[-1]))
         out.append(
             {

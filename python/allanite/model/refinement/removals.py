@@ -17,10 +17,16 @@ changed in the Allan curve, AVAR(y) − AVAR(y − component), cross terms inclu
   (t test with the blocks' effective dof), band by band where the coupling differs across frequency; a slow one
   (:func:`allanite.model.channels.is_slow`: a temperature) against the record's own noise by a Whittle GLS, with
   its optional terms (:func:`allanite.model.channels.regress_channel`).
+- ``"outliers"`` — samples beyond what Gaussian noise predicts, replaced (:mod:`allanite.model.outliers`); first,
+  since a spike reaches every other test;
+- ``"periodic"`` — each family of spectral lines (harmonics, sidebands) removed by least squares at its
+  frequencies (:mod:`allanite.model.periodic`); last, on the samples the others left: a channel that cycles
+  (a temperature) is its regression, not a line. The search's lone lines go to the ``"sinusoid"`` curve
+  candidate (:attr:`RemovalContext.lines`): one search, one share of ``level``.
 
 Removals run before the curve effects (a component left in the samples bends the curve every curve effect is
-fitted against), in the order of :data:`REMOVALS`. A new one (line families removed in time, spikes replaced,
-a richer regression on slow channels) is one entry here and one share in :data:`.levels.TIME_SHARES`.
+fitted against), in the order of :data:`REMOVALS`. A new one is one entry here and one share in
+:data:`.levels.TIME_SHARES`.
 """
 
 from __future__ import annotations
@@ -31,7 +37,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import t as t_dist
 
-from .. import channels, tracing, warmup
+from ...analysis import avar
+from .. import channels, outliers, periodic, tracing, warmup
 from .calibrated import tested
 from .curvefit import Curve, Solution, theta_terms, upper_theta
 from .levels import alpha
@@ -96,6 +103,8 @@ class RemovalContext:
     level: float
     consider: Callable[[str, dict], None]
     effects: list = field(default_factory=list)
+    #: The line search's result (:func:`allanite.model.periodic.periodic_search`), once the periodic removal ran.
+    lines: dict | None = None
 
 
 def _drift(ctx: RemovalContext) -> Iterator[Removal]:
@@ -214,5 +223,90 @@ def _slow_regression(ctx: RemovalContext, name: str, ch: np.ndarray, a: float) -
     )
 
 
+def _outliers(ctx: RemovalContext) -> Iterator[Removal]:
+    """Samples beyond the Gaussian noise, replaced by a draw from what Gaussian noise puts there. Held out in
+    time: each part of alternate blocks (even, odd) flagged on its own at the cut found on the whole record;
+    the Gaussian share of those flags, λ/flags, must stay below 1 (the flagged are outliers there too)."""
+    y, a = ctx.y, alpha("outliers", ctx.level)
+    r = outliers.outlier_test(y, ctx.fs, a)
+    best = min(r["cuts"], key=lambda c: c["p_value"]) if r["cuts"] else None
+    test = tested("clusters", best["count"], 2.0 * best["expected"], a) if best else {"alpha": a}
+    if not r["accepted"]:
+        entry = {"cuts": r["cuts"], "test": test} | ({"note": r["note"]} if "note" in r else {})
+        ctx.consider("outliers", entry)
+        return
+    flags, cut = r["flags"], r["cut"]
+    clean = outliers.replace_outliers(y, flags)
+    per = y.size // HELDOUT_BLOCKS
+    lam = count = 0.0
+    for parity in (0, 1):
+        part = np.concatenate([y[j * per : (j + 1) * per] for j in range(HELDOUT_BLOCKS) if j % 2 == parity])
+        f_p, l_p = outliers.flag_at(part, cut)
+        lam, count = lam + l_p, count + int(f_p.sum())
+
+    def refit(z, idx, flags=flags, comp=y - clean):
+        # the flags come from the whole record's neighbourhoods; the held-in part's samples set nothing new
+        return lambda i: comp[i]
+
+    k = int(flags.sum())
+    taus = 2.0 ** np.arange(0, int(np.log2(max(2, y.size // 9))) + 1) / ctx.fs
+    evidence = {
+        "domain": "time",
+        "test": test,
+        "cut_sigma": cut,
+        "flagged": k,
+        "flagged_s": [float(i / ctx.fs) for i in np.flatnonzero(flags)[:50]],
+        "expected_gaussian_flags": r["expected_gaussian_flags"],
+        "cuts": r["cuts"],
+        "adev_tau_s": [float(t) for t in taus],
+        "adev_before": [float(v) for v in avar(y, ctx.fs, taus=taus).adev],
+        "adev_after": [float(v) for v in avar(clean, ctx.fs, taus=taus).adev],
+    }
+    sd = np.sqrt(max(k, 1)) / y.size
+    yield Removal(
+        "outliers",
+        y - clean,
+        refit,
+        {"rate": r["rate"], "threshold": r["threshold"]},
+        {"rate": (max(0.0, r["rate"] - sd), r["rate"] + sd)},
+        evidence,
+        2,
+        heldout_in_time=lam / max(count, 1e-12),
+    )
+
+
+def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
+    """Every family of spectral lines, strongest first, each removed by least squares at its lattice's
+    frequencies (refitted on the held-in blocks with the frequencies fixed for the held-out error); the lone
+    lines are left to the ``"sinusoid"`` curve candidate."""
+    a = alpha("lines", ctx.level)
+    search = periodic.periodic_search(ctx.y, ctx.fs, a)
+    ctx.lines = search
+    for fam in search["families"]:
+        ratios = fam.evidence["psd_ratio"]
+        i = int(np.argmax(ratios))
+        sd = fam.gens_sd
+        params = {"fundamentals": [float(g) for g in fam.gens], "lines": int(fam.coefs.shape[0]), "rms": fam.rms}
+        intervals = {
+            "fundamentals": [(float(g - s), float(g + s)) for g, s in zip(fam.gens, sd)],
+            "rms": (max(0.0, fam.rms - fam.rms_sd), fam.rms + fam.rms_sd),
+        }
+        evidence = {
+            "domain": "psd",
+            "test": tested("psd_ratio", float(ratios[i]), fam.evidence["threshold"], a),
+            "frequencies_hz": [float(f) for f in fam.frequencies],
+            "coefficients": fam.coefs.tolist(),
+            "amplitudes": [float(v) for v in fam.amplitudes],
+            "targeted": fam.evidence["targeted"],
+            "bins_searched": search["bins"],
+        }
+        yield Removal("periodic", fam.component(), fam.refit, params, intervals, evidence, 2 * fam.coefs.shape[0] + 2)
+
+
 #: The time-domain removals, in the order they run (each before the curve effects).
-REMOVALS: dict[str, Callable[[RemovalContext], Iterator[Removal]]] = {"drift": _drift, "regression": _regression}
+REMOVALS: dict[str, Callable[[RemovalContext], Iterator[Removal]]] = {
+    "outliers": _outliers,
+    "drift": _drift,
+    "regression": _regression,
+    "periodic": _periodic,
+}

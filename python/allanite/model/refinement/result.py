@@ -372,10 +372,10 @@ def _fmt(v) -> str:
 def describe_region(reg: dict) -> str:
     """One entry of ``Refinement.unexplained`` in words: "the model still misses τ 0.2–3 s (≈ 0.17–2.5 Hz): …"."""
     lo, hi = reg["tau"]
-    text = f"τ {_num(lo)}–{_num(hi)} s" if hi > lo else f"τ {_num(lo)} s"
+    text = f"τ {_span(lo, hi)} s"
     band = reg.get("band_hz")
     if band is not None:
-        text += f" (≈ {_num(band[0])}–{_num(band[1])} Hz)"
+        text += f" (≈ {_span(band[0], band[1])} Hz)"
     if reg.get("what"):
         text += f": {reg['what']}"
     if reg.get("chi2_dof") is not None and math.isfinite(reg["chi2_dof"]):
@@ -383,11 +383,24 @@ def describe_region(reg: dict) -> str:
     return text
 
 
-def _num(v: float) -> str:
+def _span(lo: float, hi: float) -> str:
+    """``lo–hi`` with as many digits as it takes to tell them apart (one value if they are equal)."""
+    if not hi > lo:
+        return _num(lo)
+    for extra in range(4):
+        a, b = _num(lo, extra), _num(hi, extra)
+        if a != b:
+            return f"{a}–{b}"
+    return f"{a}–{b}"
+
+
+def _num(v: float, extra: int = 0) -> str:
     if v == 0 or not math.isfinite(v):
         return f"{v:g}"
-    digits = max(0, 1 - int(math.floor(math.log10(abs(v)))))
-    return f"{v:.{min(digits, 6)}f}" if abs(v) < 1000 else f"{v:.3g}"
+    if abs(v) >= 1000:
+        return f"{v:.0f}"
+    digits = max(0, 1 - int(math.floor(math.log10(abs(v))))) + extra
+    return f"{v:.{min(digits, 6)}f}"
 
 
 def _terms_values(tba: dict, when: str) -> dict:

@@ -1,0 +1,289 @@
+"""Least squares at a lattice of frequencies: the numerics behind :mod:`allanite.model.lines`.
+
+A family of spectral lines sits on a lattice: line i at the normalised frequency ν_i = C_i · g (cycles per
+sample), g the family's generators (one: harmonics k·f0; two: sidebands k·f1 + s·f2) and C_i a row of
+integers. Everything here is O(N) in the samples per distinct second coefficient s, whatever the number of
+lines:
+
+- :func:`dtft` — Σ_n y_n e^{−i2πν_i n} at every line at once. The samples, heterodyned by e^{−i2πsν2 n}, are
+  *folded* at ν1: spread onto M phase bins of u_n = frac(ν1 n) by linear interpolation (two ``bincount``),
+  one FFT of the bins, and the interpolation kernel's transform sinc²(k/M) divided out. Exact up to aliases
+  of weight ≈ (k/M)² (M ≥ 256·max k); agrees with the direct sum to ~1e-10 on 10⁶ samples.
+- :func:`solve` — the amplitudes (a_i, b_i) of a_i cos ω_i n + b_i sin ω_i n by least squares over any set of
+  sample indices (the held-in blocks of a held-out test too): the Gram matrix in closed form (Dirichlet sums
+  over the index runs), so a line's negative-frequency image and its neighbours are accounted for exactly.
+- :func:`evaluate` — the fitted component at any sample indices: per s, the waveform Σ_k c_k e^{i2πku} on
+  M phase points (one inverse FFT, the kernel pre-compensated) interpolated at frac(ν1 n).
+- :func:`refine_generators` — the generators by Gauss–Newton on the lines' own frequency offsets: each
+  line's offset maximises the power of its DTFTs over Q contiguous pieces re-phased (a zoom around the
+  line), and the generators are their weighted least-squares combination (weights: the inverse Cramér–Rao
+  variances, A²N³/(12·S₁f_s) per line — Kay's bound var(ω̂) = 24σ²/(A²N³) for a real sinusoid in white
+  noise σ² = S₁f_s/2 locally).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["runs", "dirichlet", "dtft", "solve", "evaluate", "refine_generators", "frequency_sd", "TABLE_BITS"]
+
+#: Phasors e^{i2πu} are read from a table of 2^TABLE_BITS + 1 points, linearly interpolated (error ≈ 1e-9).
+TABLE_BITS = 16
+_TABLE = np.exp(2j * np.pi * np.arange(2**TABLE_BITS + 1) / 2**TABLE_BITS)
+
+
+def runs(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Starts and lengths of the runs of consecutive integers in sorted ``idx``."""
+    idx = np.asarray(idx, dtype=np.int64)
+    if idx.size == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    brk = np.flatnonzero(np.diff(idx) != 1) + 1
+    starts = np.concatenate([[0], brk])
+    ends = np.concatenate([brk, [idx.size]])
+    return idx[starts], ends - starts
+
+
+def dirichlet(omega: np.ndarray, starts: np.ndarray, lengths: np.ndarray, centre: float | None = None) -> np.ndarray:
+    """S(ω) = Σ_runs Σ_{n = a}^{a + m − 1} e^{iωn} = Σ_runs e^{iωc}·D(ω), c = a + (m − 1)/2 and
+    D(ω) = sin(mω/2)/sin(ω/2); with ``centre``, Σ (n − centre)·e^{iωn} = Σ_runs e^{iωc}·((c − centre)·D − i·D′)."""
+    omega = np.asarray(omega, dtype=np.float64)
+    # ω is 2π-periodic: wrap to (−π, π] so that sin(ω/2) vanishes only at ω ≡ 0
+    w = omega - 2 * np.pi * np.round(omega / (2 * np.pi))
+    out = np.zeros(w.shape, dtype=np.complex128)
+    half = np.sin(w / 2)
+    small = np.abs(half) < 1e-6
+    safe = np.where(small, 1.0, half)
+    for a, m in zip(starts, lengths):
+        c = a + (m - 1) / 2.0
+        d = np.where(small, m - m * (m * m - 1.0) * w * w / 24.0, np.sin(m * w / 2) / safe)
+        phase = np.exp(1j * _wrap(w * c))
+        if centre is None:
+            out += phase * d
+            continue
+        dp = np.where(
+            small,
+            -m * (m * m - 1.0) * w / 12.0,
+            (0.5 * m * np.cos(m * w / 2) * half - 0.5 * np.sin(m * w / 2) * np.cos(w / 2)) / safe**2,
+        )
+        out += phase * ((c - centre) * d - 1j * dp)
+    return out
+
+
+def _wrap(x: np.ndarray) -> np.ndarray:
+    """x modulo 2π in (−π, π] (keeps phases of large n accurate)."""
+    return x - 2 * np.pi * np.round(x / (2 * np.pi))
+
+
+def _phasor(nu: float, idx: np.ndarray) -> np.ndarray:
+    """e^{i2πν n} at the indices (table lookup, linear interpolation)."""
+    u = np.mod(idx * nu, 1.0) * 2**TABLE_BITS
+    j = u.astype(np.int64)
+    f = u - j
+    return _TABLE[j] * (1.0 - f) + _TABLE[j + 1] * f
+
+
+def _grid(kmax: int) -> int:
+    """Phase bins for harmonics up to ``kmax``: a power of two ≥ 256·kmax (≥ 4096), so that the aliases of
+    the linear interpolation weigh ≤ (k/M)² ≤ 1.5e-5."""
+    return int(2 ** max(12, math.ceil(math.log2(256 * max(1, kmax)))))
+
+
+def _oriented(gens: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two generators put so that the second has the fewer distinct coefficients (one fold per distinct value:
+    a carrier with 60 sidebands is one fold at the spacing, not 60 at the carrier); the lines keep their order."""
+    if gens.size == 2 and np.unique(coefs[:, 0]).size < np.unique(coefs[:, 1]).size:
+        return gens[::-1].copy(), coefs[:, ::-1].copy()
+    return gens, coefs
+
+
+def _groups(coefs: np.ndarray, nu2: float, idx: np.ndarray):
+    """(s, rows, e^{i2πsν2 n} or None for s = 0) for each distinct second coefficient s (0 for one-generator
+    lattices); the phasors as powers of one table lookup, by increasing |s| (one complex product each)."""
+    s_all = coefs[:, 1] if coefs.shape[1] > 1 else np.zeros(coefs.shape[0], dtype=np.int64)
+    present = set(np.unique(s_all).tolist())
+    if 0 in present:
+        yield 0, np.flatnonzero(s_all == 0), None
+    top = max((abs(v) for v in present), default=0)
+    base = _phasor(nu2, idx) if top else np.ones(0)
+    cur = base
+    for a in range(1, top + 1):
+        cur = base if a == 1 else cur * base
+        for s in (a, -a):
+            if s in present:
+                yield s, np.flatnonzero(s_all == s), (cur if s > 0 else np.conj(cur))
+
+
+def _fold(z: np.ndarray, u: np.ndarray, m_bins: int, seg: np.ndarray | None, n_seg: int) -> np.ndarray:
+    """Σ z_n e^{−i2πk u_n} for k = 0 … M − 1 (per segment: shape (n_seg, M)), by linear gridding + FFT."""
+    x = u * m_bins
+    j = x.astype(np.int64)
+    w = x - j
+    j1 = np.where(j + 1 >= m_bins, 0, j + 1)
+    off = 0 if seg is None else seg * m_bins
+    size = m_bins * n_seg
+    parts = []
+    for part in (z.real, z.imag) if np.iscomplexobj(z) else (z,):
+        hi = part * w
+        g = np.bincount(j + off, part - hi, minlength=size) + np.bincount(j1 + off, hi, minlength=size)
+        parts.append(g)
+    g = parts[0] + 1j * parts[1] if len(parts) == 2 else parts[0]
+    out = np.fft.fft(g.reshape(n_seg, m_bins), axis=1)
+    k = np.arange(m_bins)
+    ks = np.where(k > m_bins // 2, k - m_bins, k)
+    return out / np.sinc(ks / m_bins) ** 2
+
+
+def dtft(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray, n_seg: int = 1) -> np.ndarray:
+    """D_i = Σ_{n ∈ idx} y_n e^{−i2πν_i n}, ν_i = coefs_i · gens; with ``n_seg`` > 1, per contiguous piece of
+    ``idx`` (shape (n_seg, lines)), else shape (lines,)."""
+    gens, coefs = _oriented(
+        np.atleast_1d(np.asarray(gens, dtype=np.float64)), np.atleast_2d(np.asarray(coefs, dtype=np.int64))
+    )
+    idx = np.asarray(idx, dtype=np.int64)
+    y = np.asarray(y, dtype=np.float64)
+    out = np.zeros((n_seg, coefs.shape[0]), dtype=np.complex128)
+    seg = None if n_seg == 1 else np.minimum(np.arange(idx.size) * n_seg // max(1, idx.size), n_seg - 1)
+    u = np.mod(idx * gens[0], 1.0)
+    nu2 = float(gens[1]) if gens.size > 1 else 0.0
+    for _s, rows, ph in _groups(coefs, nu2, idx):
+        k = coefs[rows, 0]
+        m_bins = _grid(int(np.max(np.abs(k))))
+        z = y if ph is None else y * np.conj(ph)
+        g = _fold(z, u, m_bins, seg, n_seg)
+        out[:, rows] = g[:, np.mod(k, m_bins)]
+    return out if n_seg > 1 else out[0]
+
+
+def _omegas(gens, coefs) -> np.ndarray:
+    return 2 * np.pi * (np.atleast_2d(coefs) @ np.atleast_1d(np.asarray(gens, dtype=np.float64)))
+
+
+def solve(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares (a_i, b_i) of c₀ + c₁·n + Σ_i a_i cos ω_i n + b_i sin ω_i n on the samples ``y`` at indices
+    ``idx`` (a straight line is fitted with the lines — the record's mean and slope are not lines — exactly:
+    its cross terms with the lines are Dirichlet sums too)."""
+    idx = np.asarray(idx, dtype=np.int64)
+    y = np.asarray(y, dtype=np.float64)
+    centre = float(idx.mean())
+    t = idx - centre
+    yc = y - y.mean()
+    d = dtft(yc, idx, gens, coefs)
+    om = _omegas(gens, coefs)
+    starts, lengths = runs(idx)
+    s_minus = dirichlet(om[:, None] - om[None, :], starts, lengths)
+    s_plus = dirichlet(om[:, None] + om[None, :], starts, lengths)
+    s_one = dirichlet(om, starts, lengths)
+    s_t = dirichlet(om, starts, lengths, centre)
+    cc = 0.5 * (s_minus + s_plus).real
+    ss = 0.5 * (s_minus - s_plus).real
+    cs = 0.5 * (s_plus - s_minus).imag
+    scale = max(1.0, float(np.max(np.abs(t))))  # the slope column in units of the half-span: conditioning
+    nuis = np.array([[float(idx.size), float(t.sum()) / scale], [float(t.sum()) / scale, float(t @ t) / scale**2]])
+    cross = np.vstack(
+        [np.concatenate([s_one.real, s_one.imag]), np.concatenate([s_t.real, s_t.imag]) / scale]
+    )  # (2, 2L): Σ 1·cos, Σ 1·sin; Σ t·cos, Σ t·sin
+    gram = np.block([[nuis, cross], [cross.T, np.block([[cc, cs], [cs.T, ss]])]])
+    rhs = np.concatenate([[float(yc.sum()), float(t @ yc) / scale], d.real, -d.imag])
+    try:
+        sol = np.linalg.solve(gram, rhs)
+    except np.linalg.LinAlgError:
+        sol = np.linalg.lstsq(gram, rhs, rcond=1e-12)[0]
+    n_lines = om.size
+    return sol[2 : 2 + n_lines], sol[2 + n_lines :]
+
+
+def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Σ_i a_i cos ω_i n + b_i sin ω_i n at the sample indices ``idx``."""
+    gens, coefs = _oriented(
+        np.atleast_1d(np.asarray(gens, dtype=np.float64)), np.atleast_2d(np.asarray(coefs, dtype=np.int64))
+    )
+    idx = np.asarray(idx, dtype=np.int64)
+    out = np.zeros(idx.size)
+    u = np.mod(idx * gens[0], 1.0)
+    nu2 = float(gens[1]) if gens.size > 1 else 0.0
+    for _s, rows, ph in _groups(coefs, nu2, idx):
+        k = coefs[rows, 0]
+        m_bins = _grid(int(np.max(np.abs(k))))
+        spec = np.zeros(m_bins, dtype=np.complex128)
+        # a cos θ + b sin θ = Re[(a − ib)e^{iθ}]; the linear interpolation's sinc² is divided out beforehand
+        np.add.at(spec, np.mod(k, m_bins), (a[rows] - 1j * b[rows]) / np.sinc(k / m_bins) ** 2)
+        wave = np.fft.ifft(spec) * m_bins
+        wave = np.append(wave, wave[0])
+        x = u * m_bins
+        j = x.astype(np.int64)
+        f = x - j
+        val = wave[j] * (1.0 - f) + wave[j + 1] * f
+        if ph is not None:
+            val = val * ph
+        out += val.real
+    return out
+
+
+def frequency_sd(amplitude: np.ndarray, s1: np.ndarray, fs: float, n: int) -> np.ndarray:
+    """Cramér–Rao standard deviation of a line's frequency (Hz): (f_s/2π)·√(12·S₁f_s/(A²N³)) for a real
+    sinusoid of amplitude A in locally white noise of one-sided PSD S₁ over N samples."""
+    amp = np.maximum(np.asarray(amplitude, dtype=np.float64), 1e-300)
+    return fs / (2 * np.pi) * np.sqrt(12.0 * np.asarray(s1) * fs / (amp**2 * float(n) ** 3))
+
+
+def _zoom_offsets(d_seg: np.ndarray, centres: np.ndarray, span: float, points: int = 65) -> np.ndarray:
+    """Per line, the offset δ (rad/sample) in (−span, span) maximising |Σ_q D_q e^{−iδ n̄_q}|² (a parabola
+    through the best grid point and its neighbours)."""
+    grid = np.linspace(-span, span, points)
+    ph = np.exp(-1j * np.outer(grid, centres))  # (points, Q)
+    power = np.abs(ph @ d_seg) ** 2  # (points, lines)
+    j = np.clip(np.argmax(power, axis=0), 1, points - 2)
+    cols = np.arange(power.shape[1])
+    p0, p1, p2 = power[j - 1, cols], power[j, cols], power[j + 1, cols]
+    den = p0 - 2 * p1 + p2
+    frac = np.where(den < 0, 0.5 * (p0 - p2) / np.where(den < 0, den, -1.0), 0.0)
+    return grid[j] + np.clip(frac, -1.0, 1.0) * (grid[1] - grid[0])
+
+
+def refine_generators(
+    y: np.ndarray,
+    gens,
+    coefs: np.ndarray,
+    var_nu: np.ndarray,
+    n_iter: int = 3,
+    n_seg: int = 32,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Generators refined by Gauss–Newton on the lines' frequency offsets; returns (gens, covariance).
+
+    ``var_nu``: each line's frequency variance (cycles/sample)², the weights of the least-squares step
+    (:func:`frequency_sd` / f_s, squared). A line whose offset lies beyond 4 of the offsets' robust σ (the
+    median |z| scaled; at least 1) from the fitted lattice is left out of that step (a weak line's zoom may
+    pick a noise peak; the weights from the PSD's amplitudes are themselves rough)."""
+    gens = np.atleast_1d(np.asarray(gens, dtype=np.float64)).copy()
+    coefs = np.atleast_2d(np.asarray(coefs, dtype=np.int64))
+    n = y.size
+    idx = np.arange(n, dtype=np.int64)
+    centres = (np.arange(n_seg) + 0.5) * n / n_seg
+    c = coefs[:, : gens.size].astype(np.float64)
+    w = 1.0 / np.maximum(np.asarray(var_nu, dtype=np.float64), 1e-300)
+    yd = y - y.mean()
+    cov = np.full((gens.size, gens.size), np.nan)
+    for _ in range(n_iter):
+        d_seg = dtft(yd, idx, gens, coefs, n_seg=n_seg)
+        # the zoom spans ± half a piece's resolution: the pieces' phases then advance by < π between pieces
+        delta = _zoom_offsets(d_seg, centres, 0.9 * np.pi * n_seg / n) / (2 * np.pi)
+        use = np.ones(coefs.shape[0], dtype=bool)
+        for _k in range(3):
+            cw = c[use] * w[use, None]
+            info = c[use].T @ cw
+            if np.linalg.matrix_rank(info) < gens.size:
+                return gens, cov
+            step = np.linalg.solve(info, cw.T @ delta[use])
+            z = (delta - c @ step) * np.sqrt(w)
+            scale = max(1.0, 1.4826 * float(np.median(np.abs(z[use]))))
+            keep = np.abs(z) <= 4.0 * scale
+            if np.array_equal(keep, use) or keep.sum() < gens.size + 1:
+                break
+            use = keep
+        gens = gens + step
+        cov = np.linalg.inv(info)
+        if np.all(np.abs(step) <= 0.01 * np.sqrt(np.diag(cov))):
+            break
+    return gens, cov

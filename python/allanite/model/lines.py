@@ -1,0 +1,460 @@
+"""Every significant narrow line of a record's spectrum, and the families they form.
+
+:func:`find_lines` — the lines of the Welch PSD (Blackman–Harris window, 50 % overlap): a bin stands out
+when its power over the median of its neighbours exceeds the F quantile of a Welch average against that
+median, Bonferroni-corrected over every bin searched. The neighbours are ±(5 … 4 + w) bins, w = k/2 clipped
+to 4 … 32 (the window's main lobe, ±4 bins, is left out so that a line does not raise its own reference;
+beyond it the window leaks ≤ −92 dB, so a line 10⁹ above the floor makes no false neighbours; a symmetric
+window's median of a monotone 1/f or 1/f² slope is its value at the centre). Two passes: segments of
+2^⌊log₂ N/8⌋ (≤ 2¹⁵) samples from its bin 36 up, and three segments of N/2 below, so that lines down to 18/T
+(T the record) are searched, and the lowest bins of the short segments (steep floors, crowded neighbourhoods)
+are searched at the long segments' finer resolution. Degrees of freedom: the Welch average's
+2K/(1 + 2Σ(1 − m/K)ρ_m²) (Percival & Walden 1993, eq. 292b; ρ_m the window's overlap correlation), the
+median's that times its neighbours' effective number (2w/(1 + 2Σρ_j²), ρ_j the correlation of bins j
+apart) times 2/π (a sample median's efficiency). Lines close together raise each other's reference, so the
+search repeats with the lines found left out of every median (in mirror pairs, keeping it centred).
+
+:func:`group_lines` — lines into families on a lattice: harmonics k·f0 (one generator) or sidebands
+k·f1 + s·f2 (two), with aliases folded into [0, f_s/2]. Greedy: every seed (a strong line over h = 1 … 6,
+differences of strong lines, a strong line as carrier with a difference as spacing) is grown by matching
+lines within their tolerance and refitting the generators by weighted least squares; the family kept is the
+one that explains most lines beyond what chance would match (lines × lattice points × window), needing at
+least one line more than it has generators; two generators in a small ratio (p/q, q ≤ 4) are one (g1/q).
+A two-generator basis is reduced to the larger generator and the other modulo it (the sidebands' offset).
+A line no family takes stays a ``"sinusoid"``.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+from scipy import signal
+from scipy.stats import chi2 as chi2_dist
+from scipy.stats import f as f_dist
+
+__all__ = ["find_lines", "line_spectrum", "group_lines", "LOBE", "MAX_SEGMENT", "fold_frequency"]
+
+#: Main-lobe half width of the Blackman–Harris window, bins (to its first null; −92 dB beyond).
+LOBE = 4
+#: Longest segment of the band-wide pass (samples).
+MAX_SEGMENT = 2**15
+#: Neighbours per side: w = k/2 clipped to this range (bins).
+NEIGHBOURS = (4, 32)
+WINDOW = "blackmanharris"
+#: The band-wide pass starts at this bin; below it the long-segment pass searches (when the record allows).
+SWITCH = 36
+#: Seeds: the strongest lines tried as fundamentals (over h = 1 … SUBHARMONICS) and pairwise spacings.
+SEEDS = 12
+SUBHARMONICS = 6
+#: The strongest lines tried as carriers of a sideband lattice (with a spacing of two of them).
+CARRIERS = 6
+#: Largest |s| of a sideband lattice (a sample-rate beat's sawtooth phase modulation spreads over the band).
+MAX_SIDEBAND = 256
+
+
+def fold_frequency(nu: np.ndarray) -> np.ndarray:
+    """A normalised frequency (cycles per sample) folded into [0, ½] (its alias as sampled)."""
+    nu = np.asarray(nu, dtype=np.float64)
+    return np.abs(nu - np.round(nu))
+
+
+def _edof(win: np.ndarray, n: int, nper: int) -> tuple[float, float, int]:
+    """Welch's equivalent degrees of freedom, the bins' correlation factor 1 + 2Σρ_j², and the segments."""
+    h = win / math.sqrt(float(win @ win))
+    step = nper // 2
+    k = (n - nper) // step + 1
+    rho = [float(h[: nper - m * step] @ h[m * step :]) for m in range(1, min(k, nper // step))]
+    dof = 2.0 * k / (1.0 + 2.0 * sum((1 - (m + 1) / k) * r * r for m, r in enumerate(rho)))
+    # white noise's periodogram bins j apart correlate by |Σ h_t² e^{−i2πjt/n}|² (Σ h² = 1)
+    corr = np.abs(np.fft.rfft(h * h)[1 : 2 * LOBE]) ** 2
+    return dof, 1.0 + 2.0 * float(np.sum(corr)), k
+
+
+def _welch(x: np.ndarray, fs: float, win: np.ndarray, nper: int) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided Welch PSD (unit²/Hz) of 50 %-overlapping segments, each with its least-squares line removed
+    (as ``scipy.signal.welch(detrend="linear")``, without a least-squares solve per segment)."""
+    step = nper // 2
+    k = (x.size - nper) // step + 1
+    t = np.arange(nper) - (nper - 1) / 2.0
+    tt = float(t @ t)
+    scale = 1.0 / (fs * float(win @ win))
+    p = np.zeros(nper // 2 + 1)
+    for a in range(0, k, 16):  # a few segments at a time: bounded memory for long records
+        idx = (np.arange(a, min(k, a + 16)) * step)[:, None] + np.arange(nper)[None, :]
+        seg = x[idx]
+        seg = seg - seg.mean(axis=1, keepdims=True) - np.outer(seg @ t / tt, t)
+        p += np.sum(np.abs(np.fft.rfft(seg * win, axis=1)) ** 2, axis=0)
+    p *= scale / k
+    p[1:-1] *= 2.0  # one-sided (the Nyquist bin of an even nper once)
+    return np.arange(p.size) * fs / nper, p
+
+
+def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int) -> dict:
+    """Welch PSD of one segment length, the bins k_lo ≤ k < k_hi it searches (grouped by their neighbourhood
+    w) and, unmasked, the noise level under each (:func:`_noise`)."""
+    win = signal.get_window(WINDOW, nper)
+    f, p = _welch(x, fs, win, nper)
+    dof, kappa, k_seg = _edof(win, x.size, nper)
+    ks_all = np.arange(p.size)
+    width = np.clip(ks_all // 2, *NEIGHBOURS)
+    k_hi = min(k_hi, p.size - 1 - LOBE - NEIGHBOURS[0])
+    groups = []
+    for w in range(NEIGHBOURS[0], NEIGHBOURS[1] + 1):
+        ks = ks_all[(width == w) & (ks_all >= max(k_lo, LOBE + w + 1)) & (ks_all < k_hi)]
+        ks = ks[ks + LOBE + w < p.size - 1]
+        if ks.size:
+            groups.append((w, ks))
+    ps = {"f": f, "p": p, "dof": dof, "kappa": kappa, "df": fs / nper, "segments": k_seg, "groups": groups}
+    ps["noise"], ps["dof_med"] = _noise(ps, np.zeros(p.size, dtype=bool))
+    return ps
+
+
+def _noise(ps: dict, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The noise level under each searched bin — the median of its neighbours ±(LOBE + 1 … LOBE + w) over the
+    median's bias — leaving out masked bins (other lines' main lobes) in mirror pairs (a bin and its mirror
+    across k go together, so that the median of a sloped spectrum stays its centre value); where fewer than w/2
+    pairs are left, pairs out to ±(LOBE + 2w) join. Degrees of freedom of the median: the Welch average's times
+    the bins used over their correlation factor times 2/π."""
+    p, dof = ps["p"], ps["dof"]
+    noise = np.full(p.size, np.nan)
+    dof_med = np.full(p.size, np.nan)
+    bias = chi2_dist.median(dof) / dof
+    for w, ks in ps["groups"]:
+        near = np.arange(LOBE + 1, LOBE + w + 1)
+        if not mask.any():
+            both = np.concatenate([-near[::-1], near])
+            noise[ks] = np.median(p[ks[:, None] + both[None, :]], axis=1) / bias
+            dof_med[ks] = dof * (2.0 * w / ps["kappa"]) * (2.0 / math.pi)
+            continue
+        med = np.full(ks.size, np.nan)
+        used = np.zeros(ks.size)
+        for reach in (near, np.arange(LOBE + 1, LOBE + 2 * w + 1)):
+            todo = np.flatnonzero(~np.isfinite(med))
+            if todo.size == 0:
+                break
+            lo, hi = ks[todo, None] - reach[None, :], ks[todo, None] + reach[None, :]
+            inside = (lo >= 1) & (hi <= p.size - 2)
+            lo_c, hi_c = np.clip(lo, 0, p.size - 1), np.clip(hi, 0, p.size - 1)
+            keep = inside & ~mask[lo_c] & ~mask[hi_c]
+            count = keep.sum(axis=1)
+            enough = count >= max(2, w // 2)
+            vals = np.where(np.concatenate([keep, keep], axis=1), np.concatenate([p[lo_c], p[hi_c]], axis=1), np.nan)
+            sel = todo[enough]
+            if sel.size:
+                med[sel] = np.nanmedian(vals[enough], axis=1)
+                used[sel] = 2 * count[enough]
+        # a bin whose neighbourhood is all lines keeps its unmasked reference
+        lost = ~np.isfinite(med)
+        if lost.any():
+            both = np.concatenate([-near[::-1], near])
+            med[lost] = np.median(p[ks[lost, None] + both[None, :]], axis=1)
+            used[lost] = 2 * w
+        noise[ks] = med / bias
+        dof_med[ks] = dof * (used / ps["kappa"]) * (2.0 / math.pi)
+    return noise, dof_med
+
+
+def line_spectrum(y: np.ndarray, fs: float) -> list[dict]:
+    """The passes :func:`find_lines` searches: per pass the Welch PSD (``f``, ``p``), the noise level under
+    each searched bin (``noise``, NaN elsewhere), the degrees of freedom (``dof``, ``dof_med``) and ``df``."""
+    x = np.asarray(y, dtype=np.float64)
+    x = x - x.mean()
+    n = x.size
+    if n < 2048:
+        return []
+    nper = int(min(MAX_SEGMENT, 2 ** int(math.log2(max(n // 8, 256)))))
+    first = LOBE + NEIGHBOURS[0] + 1
+    long = 2 * (n // 4)  # three half-overlapping segments (any length: the FFT needs no power of two)
+    if long < 2 * nper:
+        return [_one_pass(x, fs, nper, first, nper // 2)]
+    # the long segments take the lowest SWITCH bins of the band-wide pass, where a steep 1/f² floor and a
+    # line's neighbours crowd its short neighbourhoods
+    return [
+        _one_pass(x, fs, long, first, int(math.ceil(SWITCH * long / nper))),
+        _one_pass(x, fs, nper, SWITCH, nper // 2),
+    ]
+
+
+def _peaks(ps: dict, alpha_bin: float) -> tuple[list[int], np.ndarray, np.ndarray]:
+    """Bins beyond the F threshold, strongest first, one per main lobe; and the ratio and threshold arrays."""
+    ok = np.isfinite(ps["noise"])
+    ratio = np.full(ps["p"].size, -np.inf)
+    ratio[ok] = ps["p"][ok] / ps["noise"][ok]
+    thr = np.full(ps["p"].size, np.inf)
+    thr[ok] = f_dist.isf(alpha_bin, ps["dof"], ps["dof_med"][ok])
+    hits = np.flatnonzero(ratio > thr)
+    peaks: list[int] = []
+    for k in hits[np.argsort(-ratio[hits])]:
+        if all(abs(int(k) - q) > LOBE for q in peaks):
+            peaks.append(int(k))
+    return peaks, ratio, thr
+
+
+def find_lines(y: np.ndarray, fs: float, alpha: float, rounds: int = 4) -> dict:
+    """Significant narrow lines of ``y`` (rate samples at ``fs``): false-alarm probability ``alpha`` per record.
+
+    Lines close together raise each other's reference (a median of neighbours that are partly lines), so the
+    search is repeated (up to ``rounds`` times) with the main lobes of the lines found left out of every median;
+    with no line in the first round nothing changes (the null is the first round's).
+
+    Returns ``lines`` (strongest first; each ``f`` Hz, ``amplitude`` (from the PSD), ``psd_ratio`` (bin over
+    the noise level), ``threshold``, ``noise`` (one-sided PSD under it, unit²/Hz), ``bin_hz``, ``pass``),
+    ``bins`` (the number searched: the Bonferroni factor), ``p_value`` (the smallest bin's in the first round,
+    times ``bins``: the record's Bonferroni p-value) and ``passes`` (:func:`line_spectrum`)."""
+    passes = line_spectrum(y, fs)
+    n_bins = int(sum(np.count_nonzero(np.isfinite(ps["noise"])) for ps in passes))
+    out: list[dict] = []
+    if n_bins == 0:
+        return {"lines": out, "bins": 0, "passes": passes, "p_value": 1.0}
+    p_min = 1.0
+    for ps in passes:
+        ok = np.isfinite(ps["noise"])
+        if ok.any():
+            r = ps["p"][ok] / ps["noise"][ok]
+            p_min = min(p_min, float(np.min(f_dist.sf(r, ps["dof"], ps["dof_med"][ok]))))
+    masks = [np.zeros(ps["p"].size, dtype=bool) for ps in passes]
+    found: list[list[int]] = [[] for _ in passes]
+    for _ in range(rounds):
+        changed = False
+        for j, ps in enumerate(passes):
+            if masks[j].any():
+                ps["noise"], ps["dof_med"] = _noise(ps, masks[j])
+            peaks, ratio, thr = _peaks(ps, alpha / n_bins)
+            new = np.zeros_like(masks[j])
+            for k in peaks:
+                new[max(0, k - LOBE) : k + LOBE + 1] = True
+            if sorted(peaks) != sorted(found[j]) or not np.array_equal(new, masks[j]):
+                changed = True
+            found[j], masks[j] = peaks, new
+            ps["ratio"], ps["thr"] = ratio, thr
+        if not changed:
+            break
+    for j, ps in enumerate(passes):
+        for k in found[j]:
+            out.append(_describe(ps, k, float(ps["ratio"][k]), float(ps["thr"][k]), j))
+    out.sort(key=lambda d: -d["psd_ratio"])
+    return {"lines": out, "bins": n_bins, "passes": passes, "p_value": min(1.0, p_min * n_bins)}
+
+
+def _describe(ps: dict, k: int, ratio: float, thr: float, j: int) -> dict:
+    """A peak's frequency (log-parabola through the bin and its neighbours), amplitude from the power above
+    the noise over the main lobe (A²/2 = Σ (p − noise)·df), and the test."""
+    p, df = ps["p"], ps["df"]
+    lp = np.log(np.maximum(p[k - 1 : k + 2], 1e-300))
+    den = lp[0] - 2 * lp[1] + lp[2]
+    delta = 0.5 * (lp[0] - lp[2]) / den if den < 0 else 0.0
+    delta = float(np.clip(delta, -0.5, 0.5))
+    noise = float(ps["noise"][k])
+    power = float(np.sum(np.maximum(p[k - LOBE : k + LOBE + 1] - noise, 0.0)) * df)
+    return {
+        "f": (k + delta) * df,
+        "amplitude": math.sqrt(2.0 * power),
+        "psd_ratio": ratio,
+        "threshold": thr,
+        "noise": noise,
+        "bin_hz": df,
+        "pass": j,
+    }
+
+
+# ----------------------------------------------------------------------------------------------
+# families
+
+
+@lru_cache(maxsize=64)
+def _rows(n_gens: int, k_max: int, s_max: int) -> np.ndarray:
+    """Integer rows of a lattice — k ≥ 1 for one generator; (k, s) with k ≥ 0, |s| ≤ s_max and s > 0 when
+    k = 0 for two (a row and its negative are one real line)."""
+    if n_gens == 1:
+        return np.arange(1, k_max + 1)[:, None]
+    k, s = np.meshgrid(np.arange(0, k_max + 1), np.arange(-s_max, s_max + 1), indexing="ij")
+    coefs = np.column_stack([k.ravel(), s.ravel()])
+    return coefs[(coefs[:, 0] > 0) | (coefs[:, 1] > 0)]
+
+
+def _lattice(gens: np.ndarray, k_max: int, s_max: int) -> tuple[np.ndarray, np.ndarray]:
+    """The lattice's rows (:func:`_rows`) and their frequencies folded into [0, ½]."""
+    coefs = _rows(gens.size, k_max, s_max)
+    return coefs, fold_frequency(coefs @ gens)
+
+
+def _match(nu, tol, gens, gen_sd, k_max, s_max):
+    """For each line the lattice row nearest to it within its tolerance plus twice the row's uncertainty
+    (|k|·σ_g1 + |s|·σ_g2), or −1; a lattice point takes only its nearest line. Returns (rows, match, slack):
+    slack the rows' uncertainty, for the chance count."""
+    coefs, pos = _lattice(gens, k_max, s_max)
+    slack = 2.0 * (np.abs(coefs) @ gen_sd)
+    order = np.argsort(pos)
+    ps = pos[order]
+    j = np.searchsorted(ps, nu)
+    lo, hi = np.clip(j - 1, 0, ps.size - 1), np.clip(j, 0, ps.size - 1)
+    pick = np.where(np.abs(ps[lo] - nu) <= np.abs(ps[hi] - nu), lo, hi)
+    row = order[pick]
+    dist = np.abs(pos[row] - nu)
+    row = np.where(dist <= tol + slack[row], row, -1)
+    # a lattice point keeps its nearest line only
+    m = np.flatnonzero(row >= 0)
+    if m.size:
+        srt = m[np.lexsort((dist[m], row[m]))]
+        dup = np.concatenate([[False], row[srt][1:] == row[srt][:-1]])
+        row[srt[dup]] = -1
+    return coefs, row, slack
+
+
+def _grow(nu, tol, w, gens, gen_sd, k_max, s_max, iters: int = 10):
+    """Match lines to the lattice of ``gens`` and refit the generators on the matched lines (weighted least
+    squares in the unfolded frequency). The lattice starts at its lowest rows (k ≤ 4 for harmonics; k ≤ 1,
+    |s| ≤ 2 for sidebands) and grows only as far as lines are matched (to twice the extents in use, or two
+    more): a lattice wider than its lines is dense enough, aliased, to put some far row next to any line,
+    which then pulls the generators off. Returns (gens, coefs of matched lines, matched index, generator SDs,
+    chance count)."""
+    gens = np.asarray(gens, dtype=np.float64)
+    gen_sd = np.asarray(gen_sd, dtype=np.float64)
+    k_now, s_now = (min(k_max, 4), 0) if gens.size == 1 else (1, min(s_max, 2))
+    m = np.zeros(0, dtype=np.int64)
+    coefs = np.zeros((0, gens.size), dtype=np.int64)
+    row = np.full(nu.size, -1)
+    slack = np.zeros(0)
+    last = None
+    for _ in range(iters):
+        coefs, row, slack = _match(nu, tol, gens, gen_sd, k_now, s_now)
+        m = np.flatnonzero(row >= 0)
+        if m.size < gens.size + 1:
+            break
+        c = coefs[row[m]].astype(np.float64)
+        raw = c @ gens
+        alias = np.round(raw)
+        sign = np.where(raw - alias >= 0, 1.0, -1.0)
+        target = alias + sign * nu[m]  # the unfolded frequency the row stands for
+        cw = c * w[m, None]
+        info = c.T @ cw
+        if gens.size == 2 and np.linalg.det(info) <= 1e-9 * info[0, 0] * info[1, 1]:
+            break  # the matched rows do not pin both generators
+        gens = np.linalg.solve(info, cw.T @ target)
+        gen_sd = np.sqrt(np.maximum(np.diag(np.linalg.inv(info)), 0.0))
+        top = np.max(np.abs(c), axis=0).astype(int)
+        k_next = min(k_max, max(2 * top[0], top[0] + 2))
+        s_next = min(s_max, max(2 * top[1], top[1] + 2)) if gens.size == 2 else 0
+        state = (k_next, s_next, m.size)
+        if state == last:
+            break
+        last = state
+        k_now, s_now = k_next, s_next
+    if m.size == 0:
+        return gens, coefs[:0], m, gen_sd, 0.0
+    used = coefs[row[m]]
+    # chance: lines that random frequencies would put within the matching window of the lattice points
+    # inside the used extents
+    ext = np.all(np.abs(coefs) <= np.max(np.abs(used), axis=0), axis=1)
+    chance = nu.size * min(1.0, float(np.sum(4.0 * (np.mean(tol) + slack[ext]))))
+    return gens, used, m, gen_sd, chance
+
+
+def _seeds(nu: np.ndarray, tol: np.ndarray, strength: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """(generators, their SDs) to grow families from: the strongest lines over h and their spacings as
+    fundamentals; the few strongest as carriers with a spacing as offset (both orders). Near-duplicates
+    (within a tolerance) are tried once."""
+    top = np.argsort(-strength)[:SEEDS]
+    seeds = [(np.array([nu[i] / h]), np.array([tol[i] / h])) for i in top for h in range(1, SUBHARMONICS + 1)]
+    diffs: list[tuple[float, float]] = []
+    for i, a in enumerate(top):
+        for b in top[i + 1 :]:
+            diffs.append((float(abs(nu[a] - nu[b])), math.hypot(tol[a], tol[b])))
+    seeds += [(np.array([d]), np.array([sd])) for d, sd in diffs]
+    few = top[:CARRIERS]
+    for a in few:
+        for i, b in enumerate(few):
+            for c in few[i + 1 :]:
+                gap, gap_sd = float(abs(nu[b] - nu[c])), math.hypot(tol[b], tol[c])
+                seeds.append((np.array([nu[a], gap]), np.array([tol[a], gap_sd])))
+                seeds.append((np.array([gap, nu[a]]), np.array([gap_sd, tol[a]])))
+    out: list[tuple[np.ndarray, np.ndarray]] = []
+    seen: set = set()
+    res = float(np.min(tol))
+    for g, sd in seeds:
+        key = tuple(np.round(g / res).astype(np.int64).tolist())
+        if key not in seen:
+            seen.add(key)
+            out.append((g, sd))
+    return out
+
+
+def _commensurate(gens: np.ndarray, tol: float, q_max: int = 4) -> bool:
+    """Whether g2 = (p/q)·g1 within ``tol`` for some q ≤ q_max: then the lattice is one generator's, g1/q."""
+    for q in range(1, q_max + 1):
+        p = round(gens[1] * q / gens[0])
+        if p > 0 and abs(gens[1] - p * gens[0] / q) <= tol:
+            return True
+    return False
+
+
+def _reduce(gens: np.ndarray, coefs: np.ndarray, gen_sd: np.ndarray, strength: np.ndarray):
+    """One basis for a two-generator lattice: the larger generator first, the second reduced modulo it to
+    (0, g1/2] — (1.37, 1.18) and (1.37, 0.19) Hz span the same lines; the second is the one a user names (the
+    offset of the sidebands) — and, when the strongest line is a first multiple (k = 1), the first generator
+    moved onto it by multiples of the second (a tone's sidebands: the tone is the carrier, not a sideband).
+    Rows follow, signs made k ≥ 0 (s > 0 when k = 0)."""
+    if gens.size != 2:
+        return gens, coefs, gen_sd
+    if gens[1] > gens[0]:
+        gens, coefs, gen_sd = gens[::-1].copy(), coefs[:, ::-1].copy(), gen_sd[::-1].copy()
+    q = int(np.round(gens[1] / gens[0]))
+    g2 = gens[1] - q * gens[0]
+    coefs = np.column_stack([coefs[:, 0] + q * coefs[:, 1], coefs[:, 1]])
+    if g2 < 0:
+        g2, coefs = -g2, np.column_stack([coefs[:, 0], -coefs[:, 1]])
+    flip = (coefs[:, 0] < 0) | ((coefs[:, 0] == 0) & (coefs[:, 1] < 0))
+    coefs = np.where(flip[:, None], -coefs, coefs)
+    sd2 = math.hypot(gen_sd[1], q * gen_sd[0])
+    g1 = gens[0]
+    top = int(np.argmax(strength))
+    if coefs[top, 0] == 1 and coefs[top, 1] != 0:
+        shift = int(coefs[top, 1])
+        g1 = g1 + shift * g2
+        coefs = np.column_stack([coefs[:, 0], coefs[:, 1] - coefs[:, 0] * shift])
+    return np.array([g1, g2]), coefs, np.array([gen_sd[0], sd2])
+
+
+def group_lines(lines: list[dict], fs: float) -> list[dict]:
+    """Families of ``lines`` (:func:`find_lines`' dicts): each ``gens`` (normalised generators), ``coefs``
+    (integer rows, one per member), ``members`` (indices into ``lines``), ``gen_sd``; lines no family takes
+    are not listed.
+
+    The family explaining most lines beyond chance first; a family needs one line more than it has
+    generators and must beat chance by more than its generators (see the module's docstring)."""
+    nu = np.array([d["f"] / fs for d in lines])
+    tol = np.array([0.5 * d["bin_hz"] / fs for d in lines])
+    strength = np.array([d["psd_ratio"] for d in lines])
+    w = 1.0 / tol**2
+    left = np.arange(nu.size)
+    fams: list[dict] = []
+    while left.size >= 2:
+        best: dict = {1: None, 2: None}
+        sub_nu, sub_tol, sub_w = nu[left], tol[left], w[left]
+        for g, g_sd in _seeds(sub_nu, sub_tol, strength[left]):
+            if np.any(g <= 2.0 * np.mean(sub_tol)):
+                continue
+            k_max = int(min(4096, math.floor(2.0 / g[0])))  # up to 4·(f_s/2): aliases of a sampled waveform
+            if g.size == 2:
+                k_max = int(min(k_max, 64))
+            gens, coefs, m, gen_sd, chance = _grow(sub_nu, sub_tol, sub_w, g, g_sd, max(1, k_max), MAX_SIDEBAND)
+            if m.size < gens.size + 1:
+                continue
+            score = m.size - chance
+            if score < gens.size + 0.5:
+                continue
+            if best[gens.size] is None or score > best[gens.size][0]:
+                best[gens.size] = (score, gens, coefs, m, gen_sd)
+        one, two = best[1], best[2]
+        if two is not None and _commensurate(two[1], 2.0 * float(np.mean(sub_tol))):
+            two = None  # (2f0, 425f0) is the harmonics of f0 in another basis: the one-generator family says it
+        pick = two if two is not None and (one is None or two[0] > one[0]) else one
+        if pick is None:
+            break
+        _, gens, coefs, m, gen_sd = pick
+        gens, coefs, gen_sd = _reduce(gens, coefs, gen_sd, strength[left[m]])
+        fams.append({"gens": gens, "coefs": coefs, "members": left[m].tolist(), "gen_sd": gen_sd})
+        left = np.delete(left, m)
+    return fams

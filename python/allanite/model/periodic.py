@@ -1,0 +1,297 @@
+"""Periodic components of a record: every significant line, grouped into families, fitted in the time domain.
+
+:func:`periodic_search` runs the pipeline behind the ``"periodic"`` and ``"sinusoid"`` effects of
+:func:`allanite.refine`:
+
+1. :func:`allanite.model.lines.find_lines` — every line of the Welch PSD beyond its neighbours' median,
+   at a false-alarm probability ``alpha`` for the whole record (Bonferroni over the bins searched);
+2. :func:`allanite.model.lines.group_lines` — the lines into families on a lattice (harmonics k·f0,
+   sidebands k·f1 + s·f2); a line no family takes is a sinusoid of its own;
+3. per family, the generators refined on the samples (Gauss–Newton on the lines' frequency offsets,
+   :func:`allanite.model.linefit.refine_generators`), then the lattice points the family predicts but the
+   search did not flag are tested one by one (the F test of the PSD ratio at the point's bin, Bonferroni
+   over the points tried, at the same ``alpha``: a family's weak harmonics and sidebands, known in advance,
+   need far less than a line found anywhere among all bins); under the null nothing reaches this stage, so
+   it adds nothing to the record's false-alarm probability;
+4. amplitudes and phases by least squares at the lattice frequencies (:func:`allanite.model.linefit.solve`)
+   — on the whole record, or, for a held-out test, on the held-in samples with the frequencies fixed
+   (:meth:`LineFamily.refit`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.stats import f as f_dist
+
+from . import linefit, lines
+
+__all__ = ["LineFamily", "periodic_search", "sinusoid_lines"]
+
+
+@dataclass
+class LineFamily:
+    """A family of lines on a lattice ν_i = coefs_i · gens (one generator: harmonics; two: sidebands).
+
+    Attributes
+    ----------
+    fs : float
+        Sampling rate, Hz.
+    gens : ndarray
+        Generators (fundamentals), Hz.
+    gens_cov : ndarray
+        Their covariance, Hz² (Cramér–Rao of the lines combined; NaN if not determined).
+    coefs : ndarray of int, shape (lines, generators)
+        Each line's integer coefficients.
+    a, b : ndarray
+        Least-squares amplitudes of a cos ω n + b sin ω n (rate unit).
+    noise : ndarray
+        One-sided noise PSD under each line (rate unit²/Hz), for the amplitudes' errors.
+    found : ndarray of bool
+        True for lines the search flagged among all bins, False for lattice points added by the targeted test.
+    n : int
+        Samples the amplitudes were fitted on.
+    """
+
+    fs: float
+    gens: np.ndarray
+    gens_cov: np.ndarray
+    coefs: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    noise: np.ndarray
+    found: np.ndarray
+    n: int
+    evidence: dict = field(default_factory=dict)
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """Each line's frequency as sampled (folded into [0, f_s/2]), Hz."""
+        return lines.fold_frequency(self.coefs @ (self.gens / self.fs)) * self.fs
+
+    @property
+    def amplitudes(self) -> np.ndarray:
+        return np.hypot(self.a, self.b)
+
+    @property
+    def amplitude_sd(self) -> np.ndarray:
+        """SD of each amplitude: √(S₁/T) (least squares in locally white noise, T = n/f_s)."""
+        return np.sqrt(self.noise * self.fs / self.n)
+
+    @property
+    def rms(self) -> float:
+        """RMS of the family's component, √(Σ A_i²/2) (rate unit)."""
+        return float(math.sqrt(np.sum(self.amplitudes**2) / 2.0))
+
+    @property
+    def rms_sd(self) -> float:
+        """SD of :attr:`rms` (delta method: var(rms²) = Σ A_i²·var A_i)."""
+        r = self.rms
+        if r <= 0:
+            return float("nan")
+        return float(math.sqrt(np.sum(self.amplitudes**2 * self.amplitude_sd**2)) / (2.0 * r))
+
+    @property
+    def gens_sd(self) -> np.ndarray:
+        return np.sqrt(np.maximum(np.diag(self.gens_cov), 0.0))
+
+    def component(self, idx: np.ndarray | None = None) -> np.ndarray:
+        """The fitted lines at sample indices ``idx`` (all n samples by default)."""
+        idx = np.arange(self.n) if idx is None else np.asarray(idx, dtype=np.int64)
+        return linefit.evaluate(idx, self.gens / self.fs, self.coefs, self.a, self.b)
+
+    def refit(self, samples: np.ndarray, idx: np.ndarray):
+        """Amplitudes and phases refitted on ``samples`` taken at indices ``idx`` (the held-in blocks), the
+        frequencies fixed; returns the component as a function of sample indices."""
+        idx = np.asarray(idx, dtype=np.int64)
+        g = self.gens / self.fs
+        a, b = linefit.solve(np.asarray(samples, dtype=np.float64), idx, g, self.coefs)
+        return lambda i: linefit.evaluate(np.asarray(i, dtype=np.int64), g, self.coefs, a, b)
+
+
+def _noise_at(passes: list[dict], f: np.ndarray) -> np.ndarray:
+    """The noise level (one-sided PSD) under frequencies ``f``: the finest pass that searched there, else the
+    nearest searched bin of the band-wide pass."""
+    out = np.full(f.size, np.nan)
+    for ps in reversed(passes):  # the band-wide pass last in the list: finest first is the low pass
+        k = np.clip(np.round(f / ps["df"]).astype(np.int64), 0, ps["noise"].size - 1)
+        val = ps["noise"][k]
+        out = np.where(np.isnan(out) & np.isfinite(val), val, out)
+    if np.any(np.isnan(out)) and passes:
+        ps = passes[-1]
+        ok = np.flatnonzero(np.isfinite(ps["noise"]))
+        if ok.size:
+            k = np.clip(np.round(f / ps["df"]).astype(np.int64), 0, ps["noise"].size - 1)
+            near = ok[np.clip(np.searchsorted(ok, k), 0, ok.size - 1)]
+            out = np.where(np.isnan(out), ps["noise"][near], out)
+    return out
+
+
+def _targets(fam: dict, gens_nu: np.ndarray, passes: list[dict], taken_f: np.ndarray, fs: float):
+    """Lattice rows the family predicts inside the searched band that no detected line occupies."""
+    coefs = fam["coefs"]
+    k_top = int(np.max(np.abs(coefs[:, 0])))
+    if gens_nu.size == 1:
+        k_end = max(k_top, int(math.floor(0.5 / gens_nu[0])))
+        rows = np.arange(1, k_end + 1)[:, None]
+    else:
+        s_top = int(np.max(np.abs(coefs[:, 1]))) + 1
+        k_end = max(k_top, int(math.floor(0.5 / max(gens_nu[0], 1e-12))))
+        k_end = min(k_end, k_top + 1) if k_top < 64 else k_end
+        k, s = np.meshgrid(np.arange(0, k_end + 1), np.arange(-s_top, s_top + 1), indexing="ij")
+        rows = np.column_stack([k.ravel(), s.ravel()])
+        rows = rows[(rows[:, 0] > 0) | (rows[:, 1] > 0)]
+    raw = rows @ gens_nu
+    if gens_nu.size == 1:
+        keep = raw < 0.5
+    else:
+        keep = (np.abs(raw) < 0.5) & (np.abs(raw) > 0)
+    rows, f = rows[keep], np.abs(raw[keep]) * fs
+    lo = min(ps["f"][np.flatnonzero(np.isfinite(ps["noise"]))[0]] for ps in passes if np.isfinite(ps["noise"]).any())
+    near = np.zeros(f.size, dtype=bool)
+    if taken_f.size:
+        df = passes[-1]["df"]
+        d = np.abs(f[:, None] - taken_f[None, :])
+        near = np.any(d <= (lines.LOBE + 1) * df, axis=1)
+    ok = (f >= lo) & ~near
+    return rows[ok], f[ok]
+
+
+def _ratio_at(passes: list[dict], f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per frequency: the larger PSD ratio of the two bins around it (in the pass that searched there), and
+    the F law's degrees of freedom of that bin."""
+    ratio = np.full(f.size, -np.inf)
+    dof = np.ones(f.size)
+    dof_med = np.ones(f.size)
+    for ps in passes:
+        k0 = np.floor(f / ps["df"]).astype(np.int64)
+        for k in (k0, k0 + 1):
+            kk = np.clip(k, 0, ps["p"].size - 1)
+            nz = ps["noise"][kk]
+            ok = np.isfinite(nz)
+            r = np.where(ok, ps["p"][kk] / np.where(ok, nz, 1.0), -np.inf)
+            better = r > ratio
+            ratio = np.where(better, r, ratio)
+            dof = np.where(better, ps["dof"], dof)
+            dof_med = np.where(better, ps["dof_med"][kk], dof_med)
+    return ratio, dof, dof_med
+
+
+def _line_var(amp: np.ndarray, noise: np.ndarray, fs: float, n: int) -> np.ndarray:
+    """Frequency variance of each line in (cycles/sample)² (Cramér–Rao)."""
+    return (linefit.frequency_sd(amp, noise, fs, n) / fs) ** 2
+
+
+def _orient(gens: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows made k ≥ 0 (and s > 0 when k = 0): a row and its negative are the same real line."""
+    if gens.size == 2:
+        flip = (coefs[:, 0] < 0) | ((coefs[:, 0] == 0) & (coefs[:, 1] < 0))
+        coefs = np.where(flip[:, None], -coefs, coefs)
+    return gens, coefs
+
+
+def _fit_family(y, fs, fam, found_lines, passes, alpha, taken_f) -> LineFamily:
+    """Refine the generators, add the lattice points the targeted test accepts, fit amplitudes."""
+    n = y.size
+    gens, coefs = _orient(np.asarray(fam["gens"], dtype=np.float64), np.asarray(fam["coefs"], dtype=np.int64))
+    amp = np.array([d["amplitude"] for d in found_lines])
+    noise = np.array([d["noise"] for d in found_lines])
+    gens, cov = linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, n))
+    found = np.ones(coefs.shape[0], dtype=bool)
+    rows, f_t = _targets({"coefs": coefs}, gens, passes, taken_f, fs)
+    added = 0
+    if rows.size:
+        ratio, dof, dof_med = _ratio_at(passes, f_t)
+        thr = f_dist.isf(alpha / (2.0 * rows.shape[0]), dof, dof_med)
+        hit = ratio > thr
+        if hit.any():
+            coefs = np.vstack([coefs, rows[hit]])
+            noise = np.concatenate([noise, _noise_at(passes, f_t[hit])])
+            found = np.concatenate([found, np.zeros(int(hit.sum()), dtype=bool)])
+            added = int(hit.sum())
+    a, b = linefit.solve(y, np.arange(n), gens, coefs)
+    if not np.all(np.isfinite(cov)):
+        cov = np.diag(np.full(gens.size, np.nan))
+    return LineFamily(
+        fs=fs,
+        gens=gens * fs,
+        gens_cov=cov * fs * fs,
+        coefs=coefs,
+        a=a,
+        b=b,
+        noise=noise,
+        found=found,
+        n=n,
+        evidence={
+            "psd_ratio": [float(d["psd_ratio"]) for d in found_lines],
+            "threshold": float(min(d["threshold"] for d in found_lines)),
+            "targeted": {"tried": int(rows.shape[0]), "added": added},
+        },
+    )
+
+
+def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
+    """Lines of ``y`` at false-alarm probability ``alpha`` per record, as families and isolated sinusoids.
+
+    Returns ``families`` (:class:`LineFamily`, two or more lines each, strongest (RMS) first), ``sinusoids`` (one-line
+    :class:`LineFamily` each, strongest first), ``lines``, ``bins`` and ``p_value`` of the search
+    (:func:`allanite.model.lines.find_lines`)."""
+    y = np.asarray(y, dtype=np.float64)
+    found = lines.find_lines(y, fs, alpha)
+    found_lines, passes = found["lines"], found["passes"]
+    groups = lines.group_lines(found_lines, fs)
+    members = {i for g in groups for i in g["members"]}
+    taken_f = np.array([d["f"] for d in found_lines])
+    fams = [_fit_family(y, fs, g, [found_lines[i] for i in g["members"]], passes, alpha, taken_f) for g in groups]
+    sins: list[LineFamily] = []
+    for i, d in enumerate(found_lines):
+        if i in members:
+            continue
+        # a lone line's harmonics, tested where they must be: found, the line is a family of its own
+        one = {"gens": np.array([d["f"] / fs]), "coefs": np.array([[1]])}
+        fit = _fit_family(y, fs, one, [d], passes, alpha, taken_f)
+        (fams if fit.coefs.shape[0] > 1 else sins).append(fit)
+    fams.sort(key=lambda fm: -fm.rms)
+    return {
+        "families": fams,
+        "sinusoids": sins,
+        "lines": found_lines,
+        "bins": found["bins"],
+        "p_value": found["p_value"],
+    }
+
+
+def sinusoid_lines(search: dict, families: bool = False) -> list[dict]:
+    """The lines of a :func:`periodic_search` as the ``"sinusoid"`` candidate takes them, strongest first: each
+    ``f0`` (Hz, refined), ``amplitude`` and ``phase`` (least squares), ``f0_interval`` and
+    ``amplitude_interval`` (±1σ), ``psd_ratio``, ``threshold`` and ``bin_hz`` of the search. The lone lines;
+    with ``families``, every family's lines too (when families are not removed as a whole)."""
+    out: list[dict] = []
+    found = np.array([d["f"] for d in search["lines"]])
+    sources = list(search["sinusoids"]) + (list(search["families"]) if families else [])
+    for fam in sources:
+        freqs, amps, amp_sd = fam.frequencies, fam.amplitudes, fam.amplitude_sd
+        lone = freqs.size == 1 and np.all(np.isfinite(fam.gens_sd))
+        f_sd = fam.gens_sd if lone else linefit.frequency_sd(amps, fam.noise, fam.fs, fam.n)
+        for i in range(freqs.size):
+            if found.size == 0:
+                break
+            near = search["lines"][int(np.argmin(np.abs(found - freqs[i])))]
+            if abs(near["f"] - freqs[i]) > 2 * near["bin_hz"]:
+                continue  # a lattice point the targeted test added: not a line of the search itself
+            out.append(
+                {
+                    "f0": float(freqs[i]),
+                    "amplitude": float(amps[i]),
+                    "phase": float(math.atan2(fam.a[i], fam.b[i])),
+                    "f0_interval": (float(freqs[i] - f_sd[i]), float(freqs[i] + f_sd[i])),
+                    "amplitude_interval": (max(0.0, float(amps[i] - amp_sd[i])), float(amps[i] + amp_sd[i])),
+                    "psd_ratio": float(near["psd_ratio"]),
+                    "threshold": float(near["threshold"]),
+                    "bin_hz": float(near["bin_hz"]),
+                }
+            )
+    out.sort(key=lambda d: -d["psd_ratio"])
+    return out
