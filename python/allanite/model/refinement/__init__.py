@@ -42,7 +42,8 @@ under the five-term fit: ±10 %); beyond, the estimate's own scatter, not the mo
 
 Nonlinear parameters (T_c, cutoff, f0 on curves) are found by a grid search with the linear coefficients
 by weighted NNLS at each grid point, then refined by a bounded scalar search; their intervals come from the
-profile of χ² (Δχ²_eff = 1). The loop stops when no candidate is accepted or after ``MAX_STEPS`` effects.
+profile of χ² (Δχ²_eff = 1). The loop stops when no candidate is accepted or after ``MAX_STEPS`` curve effects (removals
+in time and change points do not count).
 """
 
 from ..effects import gm_avar, sinusoid_avar

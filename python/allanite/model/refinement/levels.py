@@ -41,8 +41,9 @@ TIME_SHARE = 0.075
 OUTLIER_SHARE = 0.05
 
 #: Share of ``level`` spent on saying what the final model still misses (``Refinement.unexplained``), split
-#: between its checks: the Allan curve, lines in the PSD, a drift in time.
-UNEXPLAINED_SHARES = {"allan": 0.075, "psd": 0.025, "time": 0.025}
+#: between its checks: the Allan curve, lines in the PSD, a drift in time, a coupling to a channel left in the
+#: samples, impulsive noise left in them (:data:`allanite.model.refinement.missing.CHECKS`).
+UNEXPLAINED_SHARES = {"allan": 0.05, "psd": 0.025, "time": 0.025, "channels": 0.0125, "outliers": 0.0125}
 
 #: Tests with a share of their own, by name (the Allan-curve test, ``"curve"``, takes the rest).
 SHARES = {

@@ -39,8 +39,9 @@ __all__ = ["refine", "CANDIDATES", "MAX_STEPS", "REFINE_SCALE"]
 
 #: Effects refine can add, from the registry in :mod:`allanite.model.effects`.
 CANDIDATES = tuple(EFFECTS)
-#: Curve effects added at most (time-domain removals and change points come on top).
-MAX_STEPS = 4
+#: Curve effects added at most (time-domain removals and change points come on top): two injected curve effects,
+#: the bandwidth and a resonance beside it (ADIS16405 run 1 z takes four) with room for one more.
+MAX_STEPS = 6
 
 
 def _resolve_tau_range(tau_range, result, start):
@@ -534,7 +535,7 @@ class _Run:
         exact = self.y is not None or (isinstance(self.est, str) and self.est == "oavar")
         thin = tracing.thin_indices(self.curve.tau)
         ctx = MissingContext(
-            self.curve, thin, self.sol, self.start, self.effects, self.y, self.fs, self.level, exact, chans
+            self.curve, thin, self.sol, self.start, self.effects, self.y, self.fs, self.level, exact, chans, self.unit
         )
         return unexplained(ctx)
 

@@ -18,6 +18,9 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   the periodic effect, afresh) that no sinusoid of the model accounts for.
 - ``"time"`` — a warm-up drift left in the final samples (:func:`allanite.model.tracing.drift_fit` against its
   bootstrap threshold under the final model's slow terms).
+- ``"channels"`` — a coupling to a channel of ``channels=`` left in the final samples (the regression's tests:
+  the Whittle GLS for a slow channel, within blocks for a fast one).
+- ``"outliers"`` — impulsive noise left in the final samples (:func:`allanite.model.outliers.outlier_test`).
 """
 
 from __future__ import annotations
@@ -29,8 +32,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import signal
 from scipy.linalg import solve_triangular
+from scipy.stats import t as t_dist
 
-from .. import lines, tracing
+from .. import channels, lines, outliers, tracing
 from ..terms import design_matrix
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
@@ -49,7 +53,7 @@ REGION_SHARE = 0.3
 class MissingContext:
     """The final state a check looks at: the curve and its fitted solution (terms ``start`` + ``effects``), the
     thinned τ, the final samples (None for curve-only input) and their rate, the channels, ``level``, and
-    whether the five terms' covariance across τ is exact."""
+    whether the five terms' covariance across τ is exact; ``unit`` the rate's unit when known."""
 
     curve: Curve
     thin: np.ndarray
@@ -61,6 +65,7 @@ class MissingContext:
     level: float
     exact: bool
     channels: dict = field(default_factory=dict)
+    unit: str | None = None
 
 
 def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
@@ -209,8 +214,60 @@ def _drift(ctx: MissingContext, a: float) -> list[dict]:
     ]
 
 
+def _channels(ctx: MissingContext, a: float) -> list[dict]:
+    """A coupling to a channel of ``channels=`` left in the final samples (the regression candidate turned
+    down or left out): a slow channel by the Whittle GLS of :func:`allanite.model.channels.regress_channel`, a
+    fast one by the within-block t test — each at ``a`` split over the channels."""
+    if ctx.y is None or not ctx.channels:
+        return []
+    a_ch, out = a / len(ctx.channels), []
+    t_lo, t_hi = float(ctx.curve.tau[0]), float(ctx.curve.tau[-1])
+    for name, ch in ctx.channels.items():
+        if channels.is_slow(ch):
+            r = channels.regress_channel(ctx.y, ch, ctx.fs, name=name, alpha=a_ch, level=ctx.level, terms=())
+            hit, stat, thr = r.accepted, float(r.test["statistic"]), float(r.test["threshold"])
+            coef = float(r.params.get("coefficient", float("nan")))
+            lo = max(t_lo, min(t_hi, 0.1 * ctx.y.size / ctx.fs))  # a slow channel moves the longest τ
+        else:
+            rg = tracing.regression_fit(ctx.y, ch, 8)
+            stat = abs(rg["coefficient"]) / rg["se"] if rg["se"] > 0 else 0.0
+            thr = float(t_dist.isf(a_ch / 2, rg["dof"]))
+            hit, coef, lo = stat > thr, float(rg["coefficient"]), t_lo
+        if hit:
+            what = f"the rate still follows channel {name!r} (≈ {coef:.3g} {ctx.unit or 'rate unit'} per channel unit)"
+            out.append(
+                {"domain": "channels", "tau": (lo, t_hi), "band_hz": None, "chi2_dof": _chi2_dof(ctx, lo, t_hi)}
+                | {"what": what, "statistic": stat, "threshold": thr, "alpha": a_ch}
+            )
+    return out
+
+
+def _outliers(ctx: MissingContext, a: float) -> list[dict]:
+    """Samples beyond the Gaussian noise left in the final samples (:func:`allanite.model.outliers.outlier_test`
+    on them): impulsive noise the model's Gaussian terms cannot describe."""
+    if ctx.y is None:
+        return []
+    r = outliers.outlier_test(ctx.y, ctx.fs, a)
+    if not r["accepted"]:
+        return []
+    best = min(r["cuts"], key=lambda c: c["p_value"])
+    tau = float(ctx.curve.tau[0])
+    what = (
+        f"impulsive noise: {int(r['flags'].sum())} samples ({r['rate']:.2g} of the record) beyond the Gaussian "
+        f"noise's cut at {r['cut']:g} σ"
+    )
+    reg = {"domain": "outliers", "tau": (tau, tau), "band_hz": None, "chi2_dof": _chi2_dof(ctx, tau, tau)}
+    return [reg | {"what": what, "statistic": float(best["count"]), "threshold": 2.0 * best["expected"], "alpha": a}]
+
+
 #: The checks, by the name of their share in :data:`.levels.SHARES` (``"unexplained:<name>"``).
-CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {"allan": _curve, "psd": _lines, "time": _drift}
+CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
+    "allan": _curve,
+    "psd": _lines,
+    "time": _drift,
+    "channels": _channels,
+    "outliers": _outliers,
+}
 
 
 def unexplained(ctx: MissingContext) -> list[dict]:
