@@ -8,6 +8,7 @@ pub mod angle;
 pub mod cancel;
 pub mod deviations;
 pub mod error;
+pub mod fit;
 mod gather;
 mod oavar;
 pub mod taper;

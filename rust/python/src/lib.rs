@@ -15,7 +15,9 @@ use allanite_core::{
     static_theo1_cancellable, Cancel, CoreError, Estimator, Method, Request,
 };
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{
+    IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use std::time::Duration;
 
@@ -330,6 +332,83 @@ fn davar_hann<'py>(
     Ok(arr.into_pyarray(py))
 }
 
+/// The noise-model fit of every window (allanite-core `fit::fit_windows`): `avar` (windows, n_tau) at
+/// the fitted τ; what the windows share as in `fit::Problem` (covariance blocks flattened, absent for
+/// the IRLS fit). Returns (windows, n_terms + n_terms² + 3): θ, covariance, χ², iterations, status.
+#[pyfunction]
+#[pyo3(signature = (avar, design, nu_terms, start_col, irls_iter, max_iter, gls_tol, irls_rtol, rho, log2_tau, s_blk, t_blk, stoch, ramp, workers))]
+#[allow(clippy::too_many_arguments)]
+fn fit_windows<'py>(
+    py: Python<'py>,
+    avar: PyReadonlyArray2<'py, f64>,
+    design: PyReadonlyArray2<'py, f64>,
+    nu_terms: PyReadonlyArray2<'py, f64>,
+    start_col: usize,
+    irls_iter: usize,
+    max_iter: usize,
+    gls_tol: f64,
+    irls_rtol: f64,
+    rho: Vec<f64>,
+    log2_tau: Vec<f64>,
+    s_blk: Option<PyReadonlyArray1<'py, f64>>,
+    t_blk: Option<PyReadonlyArray1<'py, f64>>,
+    stoch: Vec<usize>,
+    ramp: Option<usize>,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (y, a, nu) = (
+        c_slice(py, &avar, "avar")?,
+        c_slice(py, &design, "design")?,
+        c_slice(py, &nu_terms, "nu_terms")?,
+    );
+    let blocks = match (&s_blk, &t_blk) {
+        (Some(s), Some(t)) => Some((s.as_slice()?, t.as_slice()?)),
+        _ => None,
+    };
+    let (n_tau, n_terms) = (design.shape()[0], design.shape()[1]);
+    let problem = allanite_core::fit::Problem {
+        n_tau,
+        n_terms,
+        design: a,
+        nu_terms: nu,
+        start_col,
+        irls_iter,
+        max_iter,
+        gls_tol,
+        irls_rtol,
+        rho: &rho,
+        log2_tau: &log2_tau,
+        gls: blocks.map(|(s, t)| allanite_core::fit::Gls {
+            s_blk: s,
+            t_blk: t,
+            stoch: &stoch,
+            ramp,
+        }),
+    };
+    let n_windows = avar.shape()[0];
+    let values = run_interruptible(py, workers, |cancel| {
+        allanite_core::fit::fit_windows(&problem, y, cancel)
+    })?;
+    let width = allanite_core::fit::record_width(n_terms);
+    let arr = Array2::from_shape_vec((n_windows, width), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+fn c_slice<'a>(
+    py: Python<'_>,
+    a: &'a PyReadonlyArray2<'_, f64>,
+    what: &str,
+) -> PyResult<&'a [f64]> {
+    a.as_slice().map_err(|_| {
+        allanite_error_of(
+            py,
+            "ParameterError",
+            format!("{what} must be a C-contiguous float64 array"),
+        )
+    })
+}
+
 fn contiguous<'a>(
     py: Python<'_>,
     columns: &'a [PyReadonlyArray1<'_, f64>],
@@ -620,6 +699,7 @@ fn tierms_phase<'py>(
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
     m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_windows, m)?)?;
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;
     m.add_function(wrap_pyfunction!(part_grid, m)?)?;
     m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;
