@@ -227,6 +227,7 @@ PINNED = {
         ("thin", K),
         ("tau_range", K),
         ("max_iter", K),
+        ("progress", K),
     ],
     "information_bound": [("n", P), ("fs", P), ("Q", K), ("N", K), ("B", K), ("K", K)],
     "NoiseFit": None,
@@ -243,6 +244,7 @@ PINNED = {
         ("tau_range", K),
         ("thin", K),
         ("workers", K),
+        ("progress", K),
     ],
     "TimeFrames": None,
     "refine": [
@@ -310,6 +312,7 @@ PINNED = {
         ("gauss_markov", K),
         ("unit", K),
         ("workers", K),
+        ("progress", K),
     ],
     "Combination": None,
 }
