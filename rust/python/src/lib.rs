@@ -9,7 +9,9 @@
 
 use allanite_core::dynamic_hann_cancellable;
 use allanite_core::{angle_term_sums_cancellable, AngleChunk};
-use allanite_core::{compensated_sum_from, dynamic_avar_part_cancellable};
+use allanite_core::{
+    compensated_sum_from, dynamic_avar_part_cancellable, dynamic_avar_ranged_cancellable,
+};
 use allanite_core::{
     deviations, dynamic_avar_cancellable, dynamic_theo1_cancellable, run_in_pool_interruptible,
     static_theo1_cancellable, Cancel, CoreError, Estimator, Method, Request,
@@ -134,6 +136,48 @@ fn davar<'py>(
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
+}
+
+/// [`davar`] and the range of every (axis, m) row of the result: (values, ranges), ranges of shape
+/// (axes, len(ms), 3) holding each row's largest value, smallest value and 1.0 where a value is not
+/// finite (allanite-core `dynamic_avar_ranged_cancellable`; the rows of a hop-1 surface are noted while
+/// in cache, so that the caller's range check need not read the surface again).
+#[pyfunction]
+#[pyo3(signature = (columns, window, hop, ms, estimator, method, workers))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn davar_ranged<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    window: usize,
+    hop: usize,
+    ms: Vec<usize>,
+    estimator: &str,
+    method: &str,
+    workers: usize,
+) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
+    let estimator = parse_estimator(py, estimator)?;
+    let method = parse_method(py, method)?;
+    let slices = contiguous(py, &columns)?;
+    let req = Request {
+        columns: &slices,
+        window,
+        hop,
+        ms: &ms,
+        estimator,
+        method,
+    };
+    let (values, n_win, ranges) = run_interruptible(py, workers, |cancel| {
+        dynamic_avar_ranged_cancellable(&req, cancel)
+    })?;
+    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    let flat: Vec<f64> = ranges
+        .iter()
+        .flat_map(|r| [r.max, r.min, if r.non_finite { 1.0 } else { 0.0 }])
+        .collect();
+    let rng = Array3::from_shape_vec((slices.len(), ms.len(), 3), flat)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok((arr.into_pyarray(py), rng.into_pyarray(py)))
 }
 
 /// [`davar`] of the windows `first_window ..` of a record of `n_windows` windows, from a part of it
@@ -698,6 +742,7 @@ fn tierms_phase<'py>(
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
+    m.add_function(wrap_pyfunction!(davar_ranged, m)?)?;
     m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
     m.add_function(wrap_pyfunction!(fit_windows, m)?)?;
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;
