@@ -9,10 +9,8 @@
 pub(crate) fn cholesky(a: &[f64], n: usize, ridge: f64, l: &mut [f64]) -> bool {
     for j in 0..n {
         let lj = j * n;
-        let mut s = a[lj + j] + ridge;
-        for p in 0..j {
-            s -= l[lj + p] * l[lj + p];
-        }
+        let row_j = &l[lj..lj + j];
+        let s = a[lj + j] + ridge - dot(row_j, row_j);
         if s.is_nan() || s <= 0.0 {
             return false;
         }
@@ -20,10 +18,7 @@ pub(crate) fn cholesky(a: &[f64], n: usize, ridge: f64, l: &mut [f64]) -> bool {
         l[lj + j] = d;
         for i in j + 1..n {
             let li = i * n;
-            let mut t = a[li + j];
-            for p in 0..j {
-                t -= l[li + p] * l[lj + p];
-            }
+            let t = a[li + j] - dot(&l[li..li + j], &l[lj..lj + j]);
             l[li + j] = t / d;
         }
         for v in &mut l[lj + j + 1..lj + n] {
@@ -33,14 +28,29 @@ pub(crate) fn cholesky(a: &[f64], n: usize, ridge: f64, l: &mut [f64]) -> bool {
     true
 }
 
+/// Σ aᵢbᵢ over the shorter of the two, in four interleaved partial sums (the products pipeline instead of
+/// waiting on one running sum).
+#[inline]
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut acc = [0.0f64; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for k in 0..4 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
+}
+
 /// Solves L·z = b in place (L lower triangular n×n, row-major).
 pub(crate) fn forward_solve(l: &[f64], n: usize, b: &mut [f64]) {
     for i in 0..n {
         let li = i * n;
-        let mut s = b[i];
-        for p in 0..i {
-            s -= l[li + p] * b[p];
-        }
+        let s = b[i] - dot(&l[li..li + i], &b[..i]);
         b[i] = s / l[li + i];
     }
 }

@@ -241,23 +241,30 @@ impl Window {
         for (q, &c) in g.stoch.iter().enumerate() {
             self.th_s[q] = theta[c];
         }
+        // Σ is symmetric and only its lower triangle is read below (Cholesky): only that is formed
         self.cov.fill(0.0);
+        let mut add = |w: f64, blk: &[f64]| {
+            if w != 0.0 {
+                for i in 0..nt {
+                    let (c, b) = (
+                        &mut self.cov[i * nt..i * nt + i + 1],
+                        &blk[i * nt..i * nt + i + 1],
+                    );
+                    c.iter_mut().zip(b).for_each(|(c, s)| *c += w * s);
+                }
+            }
+        };
         for a in 0..ns {
             for b in 0..ns {
-                let w = self.th_s[a] * self.th_s[b];
-                if w != 0.0 {
-                    let blk = &g.s_blk[(a * ns + b) * nn..(a * ns + b + 1) * nn];
-                    self.cov.iter_mut().zip(blk).for_each(|(c, s)| *c += w * s);
-                }
+                add(
+                    self.th_s[a] * self.th_s[b],
+                    &g.s_blk[(a * ns + b) * nn..(a * ns + b + 1) * nn],
+                );
             }
         }
         if let Some(r) = g.ramp {
             for a in 0..ns {
-                let w = theta[r] * self.th_s[a];
-                if w != 0.0 {
-                    let blk = &g.t_blk[a * nn..(a + 1) * nn];
-                    self.cov.iter_mut().zip(blk).for_each(|(c, t)| *c += w * t);
-                }
+                add(theta[r] * self.th_s[a], &g.t_blk[a * nn..(a + 1) * nn]);
             }
         }
         for i in 0..nt {
@@ -277,7 +284,7 @@ impl Window {
             self.tmp[i] = c.max(1e-300).sqrt();
         }
         for i in 0..nt {
-            for j in 0..nt {
+            for j in 0..=i {
                 self.corr[i * nt + j] = self.cov[i * nt + j] / (self.tmp[i] * self.tmp[j]);
             }
         }
