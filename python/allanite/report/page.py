@@ -225,7 +225,7 @@ def _series(fit: dict) -> dict:
                     g(sc["median"]),
                     f"{g(sc['min'])} at {g(sc['t_of_min_s'])} s",
                     f"{g(sc['max'])} at {g(sc['t_of_max_s'])} s",
-                    f"{sc['windows_nonzero']}/{len(ax['t_s'])}",
+                    f"{sc['windows_nonzero']}/{sc['windows']}",
                 ]
             )
     return {
