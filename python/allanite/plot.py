@@ -135,11 +135,17 @@ def plot_davar(result, ax=None, axis: int = 0, unit: str | None = None, cmap: st
     t = result.t
     if t.size > MAX_COLUMNS:
         starts = _bins(t.size, MAX_COLUMNS)
-        ok = np.isfinite(avar)
-        count = np.add.reduceat(ok, starts, axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            avar = np.add.reduceat(np.where(ok, avar, 0.0), starts, axis=1) / np.where(count > 0, count, np.nan)
-        t = np.add.reduceat(t, starts) / np.diff(np.append(starts, result.t.size))
+        width = np.diff(np.append(starts, t.size))
+        binned = np.empty((avar.shape[0], starts.size))
+        for i, row in enumerate(avar):  # row by row: no temporary the size of the surface
+            ok = np.isfinite(row)
+            if ok.all():
+                binned[i] = np.add.reduceat(row, starts) / width
+            else:  # windows with gaps (NaN) left out of their bin's mean
+                count = np.add.reduceat(ok, starts)
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    binned[i] = np.add.reduceat(np.where(ok, row, 0.0), starts) / np.where(count > 0, count, np.nan)
+        avar, t = binned, np.add.reduceat(t, starts) / width
     adev = np.sqrt(avar)
     # colour range over the resolved values: a flat window's rounding residue (~1e-19 of the largest ADEV,
     # where the definition gives 0) would stretch the scale over 19 decades
