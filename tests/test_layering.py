@@ -30,6 +30,7 @@ LAYERS = {
     "units": 1,
     "_validate": 1,
     "_progress": 1,
+    "_dist": 1,
     "estimators": 2,
     "io": 2,
     "plot": 3,

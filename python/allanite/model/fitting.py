@@ -24,11 +24,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.optimize import nnls as _scipy_nnls
-from scipy.stats import chi2 as chi2_dist
-from scipy.stats import norm
 
 from .._display import RichDisplay, Summary, Table, fmt_ci, fmt_range, thin
+from .._dist import chi2_sf, norm_ppf
 from .._progress import show_progress
 from .._validate import check_count, check_nonnegative, check_positive
 from ..errors import ParameterError
@@ -348,7 +346,9 @@ def nnls(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # Column scaling keeps the problem well conditioned (columns span many decades in τ).
     scale = np.linalg.norm(a, axis=0)
     scale[scale == 0] = 1.0
-    x, _ = _scipy_nnls(a / scale, b, maxiter=50 * a.shape[1])
+    from scipy.optimize import nnls as scipy_nnls  # scipy.optimize when a fit runs, not at import
+
+    x, _ = scipy_nnls(a / scale, b, maxiter=50 * a.shape[1])
     return x / scale
 
 
@@ -631,7 +631,7 @@ def z_quantile(confidence) -> float:
         or not 0.0 < float(confidence) < 1.0
     ):
         raise ParameterError(f"confidence must be a level strictly between 0 and 1, got {confidence!r}")
-    return float(norm.ppf(0.5 + float(confidence) / 2.0))
+    return float(norm_ppf(0.5 + float(confidence) / 2.0))
 
 
 def coefficients(terms, theta, cov, zq, inflate, unit) -> dict:
@@ -942,7 +942,7 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
         chi2=chi2,
         dof=dof,
         chi2_dof=chi2_dof,
-        p_value=float(chi2_dist.sf(chi2, dof)),
+        p_value=float(chi2_sf(chi2, dof)),
         readoffs=readoffs(result, np.sqrt(avar_row)),
         fs=result.fs,
         confidence=confidence,
