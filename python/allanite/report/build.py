@@ -30,10 +30,10 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
-import io as _io
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -43,9 +43,7 @@ from ..analysis import avar, davar
 from ..errors import AllaniteError, ParameterError
 from ..estimators import get as get_estimator
 from ..estimators.theo import resolve_decimation
-from ..model import Refinement
 from ..model import fit as fit_model
-from ..model import refine as refine_axis
 from ..model.terms import TERMS
 from ..results import AllanResult, DynamicAllanResult
 from ..units import adev_unit_label, parse_unit
@@ -55,6 +53,7 @@ from .fmt import count, json_number
 from .forecasting import check_forecast_options, plan_forecast, run_forecast
 from .page import html_page
 from .paper002 import compute as paper002_sections
+from .rendering import render_pngs
 from .settings import (
     DHVAR_MAX_DEFAULT_WINDOW,
     DHVAR_MAX_WINDOWS,
@@ -66,6 +65,9 @@ from .settings import (
 )
 from .sidefiles import write_side_files
 from .summary import summarize, text_summary
+
+if TYPE_CHECKING:
+    from ..model import Refinement
 
 __all__ = ["Report", "build_report", "from_log", "log_source"]
 
@@ -167,19 +169,11 @@ class Report:
         return figure_specs(self)
 
     def render_figures(self, progress=None, dpi: int = 100) -> dict:
-        """File name → PNG bytes of every figure."""
-        from matplotlib.figure import Figure  # matplotlib only when figures are drawn
-
+        """File name → PNG bytes of every figure (drawn on two processes where two cores are available:
+        :mod:`allanite.report.rendering`)."""
         specs = self.figure_specs()
         progress, own = _steps(progress, len(specs), "figures")
-        images = {}
-        for name, _title, _caption, size, draw in specs:
-            progress.step(f"figure {name}")
-            fig = Figure(figsize=size, dpi=dpi)
-            draw(fig)
-            buf = _io.BytesIO()
-            fig.savefig(buf, format="png", dpi=dpi)
-            images[name] = buf.getvalue()
+        images = render_pngs(specs, dpi, progress.step)
         if own:
             progress.close()
         return images
@@ -394,6 +388,8 @@ def build_report(
     refinements: list[Refinement | None] | None = None
     if refine:
         progress.step("model refinement")
+        from ..model import refine as refine_axis  # the refinement package (scipy.signal) only when asked
+
         refinements = []
         # the same τ range the whole-record fit used (none unless given): start at 0.1 s when the
         # shortest τ are below it, as real gyros' anti-alias filters colour them
