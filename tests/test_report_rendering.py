@@ -44,3 +44,13 @@ def test_a_figure_failing_in_the_child_fails_in_the_parent():
 
 def test_figure_processes_is_one_or_two():
     assert figure_processes() in (1, 2)
+
+
+def test_a_report_drawn_in_a_worker_thread_forks_nothing():
+    import threading
+
+    seen = []
+    t = threading.Thread(target=lambda: seen.append(figure_processes()))
+    t.start()
+    t.join()
+    assert seen == [1]
