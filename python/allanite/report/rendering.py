@@ -1,12 +1,13 @@
 """The report's figures as PNG bytes, drawn on two processes where the machine gives this one two cores.
 
 Drawing and rasterising a figure is matplotlib's Python (ticks, text layout) under one interpreter lock; the
-report's 14 figures of a three-axis log are most of its wall time. Where ``os.fork`` exists, at least two
-cores are available and the report is drawn from the main thread, a forked child draws every other figure
-(``fork``: the figures' drawing closures need no pickling, the child holds the report already) and hands its
-PNGs back through a pipe; the parent draws the rest meanwhile. The PNGs are the same bytes as drawn one after
-another. A child that fails or is killed leaves its figures to the parent, which then draws them itself (so an
-error in a figure is raised here, with its traceback); Ctrl-C ends the child with the parent.
+report's 14 figures of a three-axis log are most of its wall time. Where ``os.fork`` exists, at least two cores
+are available, one of them idle (the load average) and the report is drawn from the main thread, a forked child
+draws every other figure (``fork``: the figures' drawing closures need no pickling, the child holds the report
+already) and hands its PNGs back through a pipe; the parent draws the rest meanwhile. The PNGs are the same
+bytes as drawn one after another. A child that fails or is killed leaves its figures to the parent, which then
+draws them itself (so an error in a figure is raised here, with its traceback); Ctrl-C ends the child with the
+parent.
 """
 
 from __future__ import annotations
@@ -27,16 +28,19 @@ MIN_FIGURES_TO_SPLIT = 4
 
 
 def figure_processes() -> int:
-    """Processes that draw the figures: 2 where ``fork`` exists, two cores are available and this is the main
-    thread, else 1 (a report built in a worker thread — Dask's ``allanite batch`` — gets its parallelism
-    from its workers, and a fork beside running threads could copy a lock one of them holds)."""
+    """Processes that draw the figures: 2 where ``fork`` exists, two cores are available, the last minute's
+    load average leaves one of them idle and this is the main thread, else 1 (a report built in a worker
+    thread — Dask's ``allanite batch`` — gets its parallelism from its workers, and a fork beside running
+    threads could copy a lock one of them holds)."""
     if not hasattr(os, "fork") or sys.platform != "linux" or threading.current_thread() is not threading.main_thread():
         return 1
     try:
         cores = len(os.sched_getaffinity(0))
     except (AttributeError, OSError):
         cores = os.cpu_count() or 1
-    return 2 if cores >= 2 else 1
+    # a second process pays off only on a core left idle: on a machine busy with other work it adds the
+    # child's share (~15 % more CPU in all) and gains no core (measured: benches/results/pipeline.md)
+    return 2 if cores >= 2 and os.getloadavg()[0] <= cores - 1 else 1
 
 
 def png(spec, dpi: int) -> bytes:
