@@ -20,7 +20,9 @@ from .budget import SIDE_FILE_WINDOWS
 
 __all__ = ["NPZ", "PARQUET", "uses_side_files", "side_files_entry", "series_columns", "write_side_files"]
 
+#: File name of the per-window series in NumPy's ``.npz`` format (always written; ``numpy.load``).
 NPZ = "series.npz"
+#: File name of the same series as a Parquet table (written where pyarrow is installed).
 PARQUET = "series.parquet"
 
 
