@@ -21,6 +21,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import allanite
+import allanite.model.refinement  # noqa: F401  (refine's package loads on first use: not inside a timed example)
 from allanite import _reference as ref
 from allanite.errors import AllaniteError
 

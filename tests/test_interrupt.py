@@ -53,7 +53,25 @@ def _mtotvar_long():
     return lambda: _core.deviation_static([y], [30_000, 60_000, 90_000], "mtotvar", WORKERS)
 
 
+def _fit_windows_long():
+    # the per-window noise fit (issue 30): 2000 windows of 60 τ, never converging (tolerance 0), so each
+    # runs all 50 passes: ~40 s on one worker. Blocks: each stochastic term's estimates independent.
+    nt, k = 60, 5
+    tau = np.geomspace(0.01, 100.0, nt)
+    a = np.column_stack([3 / tau**2, 1 / tau, np.full(nt, 0.44), tau / 3, tau**2 / 2])
+    noise = np.random.default_rng(6).uniform(0.8, 1.2, size=(2000, nt))
+    y = (a @ np.array([1e-8, 1e-4, 1e-6, 1e-8, 1e-12]))[None, :] * noise
+    s_blk = np.zeros((4, 4, nt, nt))
+    for p in range(4):
+        s_blk[p, p] = np.eye(nt)
+    t_blk = np.zeros((4, nt, nt))
+    nu = np.full((nt, k), 10.0)
+    shared = (a, nu, 1, 8, 50, 0.0, 0.0, [0.4] * k, list(np.log2(tau)), s_blk.ravel(), t_blk.ravel(), [0, 1, 2, 3], 4)
+    return lambda: _core.fit_windows(y, *shared, WORKERS)
+
+
 LONG_CALLS = {
+    "fit_windows": _fit_windows_long,
     "davar": _davar_long,
     "davar_hann": _davar_hann_long,
     "mtotvar": _mtotvar_long,

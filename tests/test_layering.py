@@ -30,6 +30,7 @@ LAYERS = {
     "units": 1,
     "_validate": 1,
     "_progress": 1,
+    "_dist": 1,
     "estimators": 2,
     "io": 2,
     "plot": 3,
@@ -127,6 +128,7 @@ def test_imports_run_one_way(module):
 #: budget, the weighted fit with effects, the errors in-sample and held out, the curve test and the result,
 #: the proposals per domain (curve candidates, removals in time, change points), the loop, the package.
 MODEL_RANKS = {
+    "model._batched": 0,
     "model._covariance": 0,
     "model.terms": 0,
     "model.effects": 0,
@@ -277,6 +279,7 @@ PINNED = {
         ("thin", K),
         ("tau_range", K),
         ("max_iter", K),
+        ("progress", K),
     ],
     "information_bound": [("n", P), ("fs", P), ("Q", K), ("N", K), ("B", K), ("K", K)],
     "NoiseFit": None,
@@ -293,6 +296,7 @@ PINNED = {
         ("tau_range", K),
         ("thin", K),
         ("workers", K),
+        ("progress", K),
     ],
     "TimeFrames": None,
     "refine": [
@@ -360,6 +364,7 @@ PINNED = {
         ("gauss_markov", K),
         ("unit", K),
         ("workers", K),
+        ("progress", K),
     ],
     "Combination": None,
 }

@@ -7,6 +7,8 @@ DAVAR, paper 004; its coefficient series are forecast by :mod:`allanite.forecast
 :class:`AllaniteError` subclasses of ``ValueError``.
 """
 
+from typing import TYPE_CHECKING
+
 from ._core import __version__
 from .analysis import avar, davar
 from .combination import Combination, combine
@@ -16,10 +18,22 @@ from .estimators.confidence import chi2_interval, confidence_intervals, edf_gree
 from .estimators.grid import tau_grid
 from .io import Log, read_log
 from .kalibr import to_kalibr
-from .model import CoefficientSeries, NoiseFit, Refinement, TimeFrames, fit, frames, information_bound, refine
+from .model import CoefficientSeries, NoiseFit, TimeFrames, fit, frames, information_bound
 from .results import AllanResult, DynamicAllanResult
 from .simulation import simulate
 from .wavelet import Split, wavelet_split
+
+if TYPE_CHECKING:
+    from .model import Refinement, refine
+
+
+def __getattr__(name: str):
+    if name in ("refine", "Refinement"):  # allanite.model loads the refinement package on first use
+        from . import model
+
+        return getattr(model, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "avar",

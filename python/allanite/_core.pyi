@@ -17,6 +17,38 @@ def davar(
 ) -> npt.NDArray[np.float64]:
     """Allan variance of every window at every m for every axis: shape (axes, len(ms), windows)."""
 
+def davar_ranged(
+    columns: Sequence[npt.NDArray[np.float64]],
+    window: int,
+    hop: int,
+    ms: Sequence[int],
+    estimator: str,
+    method: str,
+    workers: int,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """``davar`` and each (axis, m) row's range: shape (axes, len(ms), 3) — largest value, smallest value,
+    1.0 where some value is not finite."""
+
+def fit_windows(
+    avar: npt.NDArray[np.float64],
+    design: npt.NDArray[np.float64],
+    nu_terms: npt.NDArray[np.float64],
+    start_col: int,
+    irls_iter: int,
+    max_iter: int,
+    gls_tol: float,
+    irls_rtol: float,
+    rho: Sequence[float],
+    log2_tau: Sequence[float],
+    s_blk: npt.NDArray[np.float64] | None,
+    t_blk: npt.NDArray[np.float64] | None,
+    stoch: Sequence[int],
+    ramp: int | None,
+    workers: int,
+) -> npt.NDArray[np.float64]:
+    """The noise fit of every window (rows of ``avar``): (windows, terms + terms² + 3) — θ, covariance,
+    χ², iterations, status (0 fitted; else refit the window in Python)."""
+
 def davar_part(
     columns: Sequence[npt.NDArray[np.float64]],
     window: int,

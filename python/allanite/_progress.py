@@ -75,9 +75,11 @@ class StepBar:
         Steps expected (``expect`` may change it).
     desc : str
         What the bar is for; shown before the step name.
+    unit : str
+        What a step is (shown with the rate).
     """
 
-    def __init__(self, progress: Any, total: int, desc: str = "") -> None:
+    def __init__(self, progress: Any, total: int, desc: str = "", unit: str = "step") -> None:
         self.desc = desc
         self.started = False
         self.bar = _tqdm()(
@@ -88,7 +90,7 @@ class StepBar:
             mininterval=0.5,
             disable=not show_progress(progress),
             leave=False,
-            unit="step",
+            unit=unit,
             dynamic_ncols=True,
         )
 

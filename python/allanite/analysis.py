@@ -57,17 +57,20 @@ def _peak(c: np.ndarray) -> float:
     return max(float(c.max()), -float(c.min())) if c.size else 0.0
 
 
-def _unscale(values: np.ndarray, exps: list[int], power: int, cols: list[np.ndarray], what: str) -> np.ndarray:
+def _unscale(
+    values: np.ndarray, exps: list[int], power: int, cols: list[np.ndarray], what: str, ranges=None
+) -> np.ndarray:
     """Values (axes first) scaled back by 2^(power·e) per axis, or an InputError when the result is not a
-    float64 (overflow, or below the normal range) — naming the scale of the samples."""
+    float64 (overflow, or below the normal range) — naming the scale of the samples. ``ranges``: the rows'
+    (max, min, non-finite flag) when the core noted them (``Computed.ranges``)."""
     out = []
     for a, (v, e) in enumerate(zip(values, exps)):
         where = f"axis {a}: " if len(values) > 1 else ""
         # binary exponent of the result: log2 of the scaled value plus power·e, judged before scaling back.
-        # No temporary the size of the output (a hop-1 surface can be gigabytes): a max and a min pass, and
-        # the smallest positive value from the min unless some value is ≤ 0 (then a masked pass, row by row).
-        hi = float(v.max()) if v.size else 0.0  # NaN if any value is, inf if any is
-        lo = float(v.min()) if v.size else 0.0
+        # No temporary the size of the output (a hop-1 surface can be gigabytes): the core's row ranges, or a
+        # max and a min pass; the smallest positive value from the min unless some value is ≤ 0 (then a
+        # masked pass, row by row).
+        hi, lo = _extremes(v, None if ranges is None else ranges[a])
         if lo > 0:
             lo_pos = lo
         elif not hi > 0:
@@ -92,6 +95,18 @@ def _unscale(values: np.ndarray, exps: list[int], power: int, cols: list[np.ndar
             )
         out.append(np.ldexp(v, power * e) if e else v)
     return np.stack(out) if any(exps) else values
+
+
+def _extremes(v: np.ndarray, ranges) -> tuple[float, float]:
+    """(largest, smallest) value of ``v`` — NaN as the largest when some value is not finite (as ``v.max()``
+    gives for NaN; an infinite value is caught by the caller either way) — from the rows' noted ranges when
+    given, else from two passes."""
+    if not v.size:
+        return 0.0, 0.0
+    if ranges is not None:
+        r = np.asarray(ranges, dtype=np.float64).reshape(-1, 3)
+        return (math.nan if r[:, 2].any() else float(r[:, 0].max())), float(r[:, 1].min())
+    return float(v.max()), float(v.min())  # NaN if any value is, inf if any is
 
 
 def avar(
@@ -442,7 +457,8 @@ def davar(
         out = _in_groups(entry, scaled, fs, window, hop_core, taus, method, workers, options, n_win, progress)
     else:
         out = entry.dynamic(scaled, fs, window, hop_core, taus, method, workers, **options)
-    out = dataclasses.replace(out, values=_unscale(out.values, exps, entry.unit_power, cols, entry.label))
+    values = _unscale(out.values, exps, entry.unit_power, cols, entry.label, out.ranges)
+    out = dataclasses.replace(out, values=values)
     kf = out.kf
     return DynamicAllanResult(
         tau=out.tau,

@@ -219,6 +219,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     ana.add_argument("--no-fit", action="store_true", help="skip the noise-model fit (whole record and per window)")
     ana.add_argument(
+        "--max-memory",
+        type=float,
+        metavar="BYTES",
+        help="memory budget of the report (default: ALLANITE_MAX_MEMORY or 2 GiB); a request over it is "
+        "refused at once with a --hop that fits",
+    )
+    ana.add_argument(
         "--frames",
         type=float,
         metavar="SEC",
@@ -346,6 +353,9 @@ def _cli_words(message: str) -> str:
         r"\b(gaps|input|time_unit)='([a-z]+)'", lambda m: f"--{m.group(1).replace('_', '-')} {m.group(2)}", message
     )
     message = message.replace("drop fs=,", "drop --fs,").replace("time_unit=", "--time-unit")
+    message = re.sub(r"\bhop=(\d+)", r"--hop \1", message).replace(
+        "max_memory / ALLANITE_MAX_MEMORY", "--max-memory / ALLANITE_MAX_MEMORY"
+    )
     message = message.replace("(fs=… in Hz)", "(--fs HZ)").replace("(time_column=…)", "(--time-column C)")
     message = re.sub(r"\btime_column='([^']*)'", r"--time-column \1", message).replace("columns=[…]", "--columns")
     return " ".join(message.split())
@@ -483,6 +493,7 @@ def _report(args) -> int:
                 forecast=args.forecast,
                 taper=args.taper,
                 split=args.split,
+                max_memory=args.max_memory,
             )
             if args.log is None:
                 progress.step("generating the bundled record")
@@ -512,8 +523,11 @@ def _report(args) -> int:
         progress.close()
     if not quiet:
         print(rep.text())
-        pngs = [p.name for p in paths[2:]]
+        pngs = [p.name for p in paths[2:] if p.suffix == ".png"]
         print(f"\nwrote {paths[0]}\n      {paths[1]}\n      {len(pngs)} figures in {out}/: {', '.join(pngs)}")
+        side = [p.name for p in paths[2:] if p.suffix != ".png"]
+        if side:
+            print(f"      per-window series in {out}/: {', '.join(side)} (named in summary.json)")
         if kalibr_path is not None:
             print(f"      {kalibr_path} (Kalibr)")
         print(f"in {time.perf_counter() - t0:.1f} s")

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._progress import StepBar
 from .analysis import davar
 from .errors import ParameterError
 from .estimators import get_taper
@@ -100,11 +101,13 @@ class Combination:
         return fig
 
 
-def _cross_term(split: Split, fs, window, hop, taus, workers) -> np.ndarray:
+def _cross_term(split: Split, fs, window, hop, taus, workers, done) -> np.ndarray:
+    """``done``: band → its rectangular DAVAR when already computed (the band's taper is "rect")."""
     kw = dict(window=window, hop=hop, taus=taus, workers=workers)
     both = davar(split.low + split.high, fs, **kw).avar
-    parts = davar(split.low, fs, **kw).avar + davar(split.high, fs, **kw).avar
-    rel = (both - parts) / np.where(both > 0, both, 1.0)
+    low = done["low"].avar if "low" in done else davar(split.low, fs, **kw).avar
+    high = done["high"].avar if "high" in done else davar(split.high, fs, **kw).avar
+    rel = (both - (low + high)) / np.where(both > 0, both, 1.0)
     return np.median(rel, axis=-1)
 
 
@@ -147,6 +150,7 @@ def combine(
     gauss_markov: bool = False,
     unit=None,
     workers=None,
+    progress=None,
 ) -> Combination:
     """Paper 002's window-function combination: split, DAVAR per band with its own taper, the summed
     surface, and every noise coefficient per window.
@@ -177,6 +181,9 @@ def combine(
     unit : str, optional
         Rate unit of the samples (IEEE-952 values in the coefficient series).
     workers : int, optional
+    progress : bool, optional
+        A ``tqdm.auto`` bar over the steps (split, DAVARs, cross term, fits per window): None (default)
+        in a notebook or a terminal, True always, False never; it appears after a second.
 
     Returns
     -------
@@ -185,26 +192,31 @@ def combine(
     terms = check_terms(terms)
     for taper in (low_taper, high_taper):
         get_taper(taper, "oavar")  # before any work: unknown names fail at once
-    if isinstance(split, Split):
-        parts = split
-    elif split is None or isinstance(split, dict):
-        parts = wavelet_split(x, fs, **(split or {}))
-    else:
+    if not isinstance(split, (Split, dict)) and split is not None:
         raise ParameterError(f"split must be a Split, a dict of wavelet_split options or None, got {split!r}")
-    if parts.low.ndim != 1:
-        raise ParameterError("combine takes one axis at a time: pass x of shape (samples,)")
-    kw = dict(window=window, hop=hop, workers=workers)
-    high = davar(parts.high, fs, taus=taus, taper=high_taper, **kw)
-    low = davar(parts.low, fs, taus=high.tau, taper=low_taper, **kw)
-    combined = dataclasses.replace(low, avar=low.avar + high.avar, taper=low_taper)
-    cross = _cross_term(parts, fs, window, hop, high.tau, workers)
-    gm = None
-    to_fit = combined
-    if gauss_markov:
-        tc, sigma, part = _gauss_markov(combined, terms)
-        gm = {"tc": tc, "sigma": sigma}
-        to_fit = dataclasses.replace(combined, avar=np.maximum(combined.avar - part, 1e-30 * combined.avar))
-    coefficients = fit(to_fit, terms=terms, unit=unit)
+    with StepBar(progress, 5 + bool(gauss_markov), "combine") as bar:
+        bar.step("wavelet split")
+        parts = split if isinstance(split, Split) else wavelet_split(x, fs, **(split or {}))
+        if parts.low.ndim != 1:
+            raise ParameterError("combine takes one axis at a time: pass x of shape (samples,)")
+        kw = dict(window=window, hop=hop, workers=workers)
+        bar.step(f"DAVAR, high band ({high_taper})")
+        high = davar(parts.high, fs, taus=taus, taper=high_taper, **kw)
+        bar.step(f"DAVAR, low band ({low_taper})")
+        low = davar(parts.low, fs, taus=high.tau, taper=low_taper, **kw)
+        combined = dataclasses.replace(low, avar=low.avar + high.avar, taper=low_taper)
+        bar.step("band cross term")
+        rect = {band: res for band, res in (("low", low), ("high", high)) if res.taper == "rect"}
+        cross = _cross_term(parts, fs, window, hop, high.tau, workers, rect)
+        gm = None
+        to_fit = combined
+        if gauss_markov:
+            bar.step("Gauss–Markov term")
+            tc, sigma, part = _gauss_markov(combined, terms)
+            gm = {"tc": tc, "sigma": sigma}
+            to_fit = dataclasses.replace(combined, avar=np.maximum(combined.avar - part, 1e-30 * combined.avar))
+        bar.step("noise fit per window")
+        coefficients = fit(to_fit, terms=terms, unit=unit, progress=False)
     assert isinstance(coefficients, CoefficientSeries)
     return Combination(
         split=parts, low=low, high=high, combined=combined, cross=cross, coefficients=coefficients, gauss_markov=gm

@@ -41,7 +41,6 @@ from typing import Any, Callable
 
 import numpy as np
 import pywt
-from scipy import optimize
 
 from ._display import RichDisplay, Summary, Table, thin
 from .errors import AllaniteError, InputError, ParameterError
@@ -621,6 +620,8 @@ class Holt(_Forecaster):
             grid = np.linspace(0.05, 0.95, 10)
             starts = [np.array(g) for g in np.array(np.meshgrid(*([grid] * len(free)))).reshape(len(free), -1).T]
             best = min(starts, key=obj)
+            from scipy import optimize  # at its first use: keeps scipy.optimize out of import allanite
+
             res = optimize.minimize(obj, best, method="L-BFGS-B", bounds=[(0.0, 1.0)] * len(free))
             q = res.x if res.fun <= obj(best) else best
             fixed[free] = q

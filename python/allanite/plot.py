@@ -10,6 +10,8 @@ rate unit, e.g. ``°/s``) or any label string, shown as given when it is not a k
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from .errors import AllaniteError
@@ -114,6 +116,16 @@ def plot_adev(
     return ax
 
 
+#: Windows drawn at most across a figure: more are merged into this many columns (a figure is ~750 pixels
+#: wide; a hop-1 DAVAR has hundreds of thousands of windows).
+MAX_COLUMNS = 2000
+
+
+def _bins(n: int, max_bins: int) -> np.ndarray:
+    """Starts of at most ``max_bins`` consecutive, near-equal bins over 0 … n − 1."""
+    return np.unique(np.linspace(0, n, min(n, max_bins) + 1).astype(np.int64)[:-1])
+
+
 def _line_labels(labels, n_axes: int) -> list[str]:
     """One legend label per axis: the given ones (checked against the number of axes) or the defaults."""
     if labels is None:
@@ -126,16 +138,35 @@ def _line_labels(labels, n_axes: int) -> list[str]:
 
 
 def plot_davar(result, ax=None, axis: int = 0, unit: str | None = None, cmap: str = "viridis", **kwargs):
-    """Heat map of the dynamic ADEV: time on x, τ on a log y axis, log colour."""
+    """Heat map of the dynamic ADEV: time on x, τ on a log y axis, log colour.
+
+    More than ``MAX_COLUMNS`` windows are drawn as ``MAX_COLUMNS`` columns, each the ADEV of its consecutive
+    windows' mean Allan variance (at the figure's width a column is less than a pixel either way).
+    """
     from matplotlib.colors import LogNorm
 
     ax = _axes(ax)
-    adev = result.adev if result.avar.ndim == 2 else np.sqrt(result.avar[axis])
+    avar = result.avar if result.avar.ndim == 2 else result.avar[axis]
+    t = result.t
+    if t.size > MAX_COLUMNS:
+        starts = _bins(t.size, MAX_COLUMNS)
+        width = np.diff(np.append(starts, t.size))
+        binned = np.empty((avar.shape[0], starts.size))
+        for i, row in enumerate(avar):  # row by row: no temporary the size of the surface
+            ok = np.isfinite(row)
+            if ok.all():
+                binned[i] = np.add.reduceat(row, starts) / width
+            else:  # windows with gaps (NaN) left out of their bin's mean
+                count = np.add.reduceat(ok, starts)
+                with np.errstate(invalid="ignore", divide="ignore"):
+                    binned[i] = np.add.reduceat(np.where(ok, row, 0.0), starts) / np.where(count > 0, count, np.nan)
+        avar, t = binned, np.add.reduceat(t, starts) / width
+    adev = np.sqrt(avar)
     # colour range over the resolved values: a flat window's rounding residue (~1e-19 of the largest ADEV,
     # where the definition gives 0) would stretch the scale over 19 decades
     positive = adev[adev > 1e-12 * np.nanmax(adev)] if np.any(adev > 0) else adev[adev > 0]
     norm = LogNorm(vmin=positive.min(), vmax=positive.max()) if positive.size else None
-    mesh = ax.pcolormesh(result.t, result.tau, adev, shading="nearest", norm=norm, cmap=cmap, **kwargs)
+    mesh = ax.pcolormesh(t, result.tau, adev, shading="nearest", norm=norm, cmap=cmap, **kwargs)
     ax.set_yscale("log")
     ax.set_xlabel("window centre t (s)")
     ax.set_ylabel("τ (s)")
@@ -256,6 +287,24 @@ def plot_fit(
     return ax
 
 
+def _envelope(t: np.ndarray, low: np.ndarray, high: np.ndarray, max_bins: int = MAX_COLUMNS):
+    """(t, y) drawing ``low`` … ``high`` over ``t`` with at most 2·``max_bins`` points: below that many
+    windows every window as it is (t, low) — twice over for a band, (t, low, t, high) pairs interleaved —,
+    above it each bin's smallest ``low`` and largest ``high`` at the bin's centre (the min–max envelope:
+    at the figure's width the same picture; NaN, a gap, where a bin has none)."""
+    if t.size <= max_bins:
+        if low is high:
+            return t, low
+        return np.repeat(t, 2), np.column_stack([low, high]).ravel()
+    starts = _bins(t.size, max_bins)
+    centre = np.add.reduceat(t, starts) / np.diff(np.append(starts, t.size))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN bins stay NaN
+        lo = np.fmin.reduceat(low, starts)
+        hi = np.fmax.reduceat(high, starts)
+    return np.repeat(centre, 2), np.column_stack([lo, hi]).ravel()
+
+
 def _outside(values: np.ndarray, inside: np.ndarray) -> np.ndarray:
     """``values`` outside the fitted range (NaN inside), joined to the fitted part at its ends."""
     out = np.where(inside, np.nan, values)
@@ -310,14 +359,17 @@ def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None
         # open marker at the upper bound, so that the curve does not jump between 0 and its level.
         resolved = values > 0
         shown = np.where(resolved, values, np.nan)
-        ax.plot(series.t, shown * scale, color=colour, lw=1.2, marker="." if resolved.sum() < 60 else None, ms=3)
+        t, line = _envelope(series.t, shown, shown)
+        ax.plot(t, line * scale, color=colour, lw=1.2, marker="." if resolved.sum() < 60 else None, ms=3)
         low = np.where(resolved, series.ci_low[name], np.nan)
         high = np.where(resolved, np.minimum(series.ci_high[name], 1e300), np.nan)
-        ax.fill_between(series.t, low * scale, high * scale, color=colour, alpha=0.25, lw=0)
+        t, band = _envelope(series.t, low, high)
+        ax.fill_between(t[::2], band[::2] * scale, band[1::2] * scale, color=colour, alpha=0.25, lw=0)
         if not resolved.all():
             up = np.where(~resolved & np.isfinite(series.ci_high[name]), series.ci_high[name], np.nan)
+            t, up = _envelope(series.t, up, up)
             ax.plot(
-                series.t,
+                t,
                 up * scale,
                 ls="none",
                 marker="v",

@@ -16,7 +16,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ._validate import as_rate_columns, check_choice, check_count
 from .errors import MissingDependencyError, ParameterError
@@ -177,6 +176,8 @@ def periodic_trend(y: np.ndarray, fs: float, freq: float | None = None, harmonic
             power = [fitted_power(f) for f in grid]
             i = int(np.argmax(power))
             step = grid[1] - grid[0]
+            from scipy.optimize import minimize_scalar  # at its first use, not at import allanite
+
             res = minimize_scalar(
                 lambda f: -fitted_power(f),
                 bounds=(grid[i] - step, grid[i] + step),

@@ -30,7 +30,8 @@ class Computed:
 
     ``values`` is (axes, T) for a whole record, (axes, T, J) for J windows; ``tau``, ``n`` and ``m``
     are (T,); ``source`` (T,) names the estimator behind each τ for hybrid estimators (TheoH), and
-    ``kf`` holds TheoBR's bias ratio, (axes,) or (axes, J).
+    ``kf`` holds TheoBR's bias ratio, (axes,) or (axes, J); ``ranges`` (axes, T, 3), when the core noted
+    them, each (axis, τ) row's largest and smallest value and 1.0 where one is not finite.
     """
 
     tau: np.ndarray
@@ -39,6 +40,7 @@ class Computed:
     m: np.ndarray
     source: np.ndarray | None = None
     kf: np.ndarray | None = None
+    ranges: np.ndarray | None = None
 
 
 @dataclass(frozen=True)

@@ -103,8 +103,11 @@ def _static(cols, fs, taus, workers, *, estimator: str) -> Computed:
 
 def _dynamic(cols, fs, window, hop, taus, method, workers, *, estimator: str) -> Computed:
     ms = resolve_taus(taus, window, fs)
-    values = allan_values(cols, window, hop, ms, estimator, method, resolve_workers(workers))
-    return Computed(tau=ms / fs, values=values, n=n_terms(estimator, window, ms), m=ms)
+    # with the rows' ranges: the caller's range check then needs no pass over a (hop-1: huge) surface
+    values, ranges = _core.davar_ranged(
+        cols, window, hop, [int(m) for m in ms], estimator, method, resolve_workers(workers)
+    )
+    return Computed(tau=ms / fs, values=values, n=n_terms(estimator, window, ms), m=ms, ranges=ranges)
 
 
 def _edf(alpha, m, n_phase, *, overlapping: bool):

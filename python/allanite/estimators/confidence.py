@@ -44,8 +44,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import chi2 as chi2_dist
 
+from .._dist import chi2_ppf
 from .._validate import as_rate_columns, check_choice, check_count, check_probability
 from ..errors import ParameterError
 from . import _registry
@@ -182,6 +182,7 @@ _TABLE3 = {1: (6.0, 4.0), 2: (15.23, 12.0), 3: (47.8, 40.0)}  # α = 1: (b0, b1)
 _J_MAX = 100
 
 
+@functools.lru_cache(maxsize=4096)  # the fits ask for the same (α, m, N) once per candidate model
 def _edf_greenhall_one(alpha: int, d: int, m: int, N: int, overlapping: bool, modified: bool) -> float:
     F = 1 if modified else m  # filter factor
     S = m if overlapping else 1  # stride factor
@@ -439,7 +440,7 @@ def _norm_ppf_stable32(p: np.ndarray) -> np.ndarray:
 
 
 def _chi2_ppf(p: float, nu: np.ndarray, method: str) -> np.ndarray:
-    exact = chi2_dist.ppf(p, nu)
+    exact = chi2_ppf(p, nu)
     if method == "exact":
         return exact
     # Stable32: Wilson–Hilferty (A&S 26.4.17) for ν > 100, an iterative inverse below (converged to

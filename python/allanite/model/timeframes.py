@@ -231,6 +231,7 @@ def frames(
     tau_range=None,
     thin: bool = True,
     workers=None,
+    progress=None,
 ):
     """Time-frame DAVAR: the noise model fitted in consecutive rectangular frames (paper 004).
 
@@ -253,6 +254,8 @@ def frames(
         frame/9).
     workers : int, optional
         Threads of the DAVAR.
+    progress : bool, optional
+        A ``tqdm.auto`` bar over the frames' fits when there are very many, as for :func:`allanite.fit`.
 
     Returns
     -------
@@ -284,7 +287,7 @@ def frames(
             f"frame = {frame!r} s ({n_frame} samples) is longer than the record ({n} samples, {n / fs_v:g} s)"
         )
     dyn = davar(x, fs_v, window=n_frame, hop=n_frame, taus=taus, input=input, workers=workers)
-    fitted = fit(dyn, terms=terms, unit=unit, confidence=confidence, thin=thin, tau_range=tau_range)
+    fitted = fit(dyn, terms=terms, unit=unit, confidence=confidence, thin=thin, tau_range=tau_range, progress=progress)
     series = fitted if isinstance(fitted, list) else [fitted]
     n_frames = int(dyn.t.size)
     dropped = int(dyn.n_samples - n_frames * n_frame)

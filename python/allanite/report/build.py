@@ -30,28 +30,30 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
-import io as _io
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .._progress import StepBar
-from .._validate import check_choice, check_count
+from .._validate import check_choice, check_count, check_positive
 from ..analysis import avar, davar
 from ..errors import AllaniteError, ParameterError
+from ..estimators import get as get_estimator
 from ..estimators.theo import resolve_decimation
-from ..model import Refinement
 from ..model import fit as fit_model
-from ..model import refine as refine_axis
+from ..model.terms import TERMS
 from ..results import AllanResult, DynamicAllanResult
 from ..units import adev_unit_label, parse_unit
+from .budget import check_report_memory
 from .figures import figure_specs
 from .fmt import count, json_number
 from .forecasting import check_forecast_options, plan_forecast, run_forecast
 from .page import html_page
 from .paper002 import compute as paper002_sections
+from .rendering import render_pngs
 from .settings import (
     DHVAR_MAX_DEFAULT_WINDOW,
     DHVAR_MAX_WINDOWS,
@@ -61,7 +63,11 @@ from .settings import (
     default_hop,
     default_window,
 )
+from .sidefiles import write_side_files
 from .summary import summarize, text_summary
+
+if TYPE_CHECKING:
+    from ..model import Refinement
 
 __all__ = ["Report", "build_report", "from_log", "log_source"]
 
@@ -163,19 +169,11 @@ class Report:
         return figure_specs(self)
 
     def render_figures(self, progress=None, dpi: int = 100) -> dict:
-        """File name → PNG bytes of every figure."""
-        from matplotlib.figure import Figure  # matplotlib only when figures are drawn
-
+        """File name → PNG bytes of every figure (drawn on two processes where two cores are available:
+        :mod:`allanite.report.rendering`)."""
         specs = self.figure_specs()
         progress, own = _steps(progress, len(specs), "figures")
-        images = {}
-        for name, _title, _caption, size, draw in specs:
-            progress.step(f"figure {name}")
-            fig = Figure(figsize=size, dpi=dpi)
-            draw(fig)
-            buf = _io.BytesIO()
-            fig.savefig(buf, format="png", dpi=dpi)
-            images[name] = buf.getvalue()
+        images = render_pngs(specs, dpi, progress.step)
         if own:
             progress.close()
         return images
@@ -186,7 +184,9 @@ class Report:
 
     def write(self, out, progress=None, dpi: int = 100) -> list:
         """Write ``report.html``, ``summary.json`` and the PNG figures into folder ``out`` (created if
-        needed). Returns the paths written, report.html and summary.json first."""
+        needed), and the side files of a report of more than ``SIDE_FILE_WINDOWS`` windows
+        (:mod:`allanite.report.sidefiles`). Returns the paths written, report.html and summary.json first,
+        the side files last."""
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         progress, own = _steps(progress, len(self.figure_specs()) + 1, "report files")
@@ -198,14 +198,20 @@ class Report:
             p.write_bytes(data)
             pngs.append(p)
         summary = self.summary()
-        summary["files"] = {"html": "report.html", "summary": "summary.json", "figures": list(images)}
+        side = write_side_files(self, out) if summary.get("side_files") else []
+        summary["files"] = {
+            "html": "report.html",
+            "summary": "summary.json",
+            "figures": list(images),
+            "side_files": [p.name for p in side],
+        }
         (out / "summary.json").write_text(
             json.dumps(summary, indent=1, ensure_ascii=False, allow_nan=False), encoding="utf-8"
         )
         (out / "report.html").write_text(self.html(images), encoding="utf-8")
         if own:
             progress.close()
-        return [out / "report.html", out / "summary.json"] + pngs
+        return [out / "report.html", out / "summary.json"] + pngs + side
 
 
 def _check_taus(taus):
@@ -235,6 +241,7 @@ def build_report(
     forecast=None,
     taper: str | None = None,
     split: str | None = None,
+    max_memory=None,
 ) -> Report:
     """Compute everything the report shows.
 
@@ -284,6 +291,11 @@ def build_report(
     forecast : (int, int) or "BUILD:CHECK", optional
         The build/check split in frames (paper 004: 60:30). Without ``frames`` the record is cut into
         BUILD + CHECK frames.
+    max_memory : int, optional
+        Byte budget of the report (default ``ALLANITE_MAX_MEMORY`` or 2 GiB, as :func:`allanite.davar`): the
+        DAVAR surface, the per-window fits and what the report keeps of them
+        (:func:`allanite.report.budget.report_memory`). A request over it raises
+        :class:`~allanite.errors.MemoryBudgetError` before any heavy work, with a hop that fits.
     """
     notes = list(notes)
     frame_s, fc_split = check_forecast_options(frames, forecast)
@@ -311,56 +323,31 @@ def build_report(
     check_choice(estimator, "estimator", tuple(REPORT_ESTIMATORS))
     static_est, dynamic_est, dynamic_grid = REPORT_ESTIMATORS[estimator][:3]
 
+    # the request's size before any heavy work: over the memory budget, it is refused here
+    n = int(x.shape[0]) - (input == "angle")  # rate samples (angle input: differenced)
+    window, hop, settings = _window_and_hop(n, window, hop, estimator)
+    resolve_m = get_estimator(dynamic_est).resolve_m
+    assert resolve_m is not None  # every dynamic estimator of the report resolves its grid
+    dyn_ms = resolve_m(dynamic_grid, window, check_positive(fs, "fs"))
+    n_fit = _octaves(dyn_ms) if estimator == "oavar" else dyn_ms.size  # DHVAR's short windows: every τ
+    cost = check_report_memory(n, n_axes, window, hop, dyn_ms.size, n_fit, len(TERMS), fit, max_memory)
     progress.step("static Allan deviation")
     extra = {"decimate": "auto"} if static_est == "theoh" else {}
     static = avar(x, fs, input=input, taus=taus, estimator=static_est, **extra)
     progress.step("confidence intervals")
     static = static.with_confidence(x, confidence=confidence)
 
-    n = static.n_samples
-    window_given, hop_given = window is not None, hop is not None
-    window_rule = hop_rule = "given"
-    if window is None:
-        window = default_window(n)
-        window_rule = f"record/{WINDOW_FRACTION}"
-        if estimator == "theoh" and window > DHVAR_MAX_DEFAULT_WINDOW:
-            window = DHVAR_MAX_DEFAULT_WINDOW
-            window_rule = f"record/{WINDOW_FRACTION}, capped at {DHVAR_MAX_DEFAULT_WINDOW} samples for DHVAR"
-    else:
-        window = check_count(window, "window", 2)
-    if hop is None:
-        hop = default_hop(window)
-        hop_rule = f"window/{HOP_FRACTION}"
-        if estimator == "theoh":
-            # every DHVAR window gets its own fit: keep it to about DHVAR_MAX_WINDOWS of them — but never
-            # hop past a window's end, which would leave samples out of every window
-            fewer = min(window, -(-(n - window) // DHVAR_MAX_WINDOWS))
-            if fewer > hop:
-                hop = fewer
-                hop_rule = f"raised from window/{HOP_FRACTION} to keep about {DHVAR_MAX_WINDOWS} windows" + (
-                    " (at most the window, so that no sample is left out)" if hop == window else ""
-                )
-    else:
-        hop = check_count(hop, "hop", 1)
-        if hop > n:
-            raise ParameterError(
-                f"hop ({hop} samples) is longer than the record ({n} samples): give a hop of at most "
-                f"the window ({window} samples) so that every sample is in a window"
-            )
     progress.step("dynamic Allan variance")
-    dynamic = davar(x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est)
-    settings = {
-        "window": int(dynamic.window),
-        "hop": int(dynamic.hop),
-        "window_default": not window_given,
-        "hop_default": not hop_given,
-        "window_rule": window_rule,
-        "hop_rule": hop_rule,
-        "taus": taus if isinstance(taus, str) else "explicit",
-        "estimator": estimator,
-        "dynamic_grid": dynamic_grid,
-        "theo_decimation": (resolve_decimation("auto", n, taus) if static_est == "theoh" else None),
-    }
+    dynamic = davar(
+        x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est, max_memory=max_memory
+    )
+    settings.update(
+        taus=taus if isinstance(taus, str) else "explicit",
+        estimator=estimator,
+        dynamic_grid=dynamic_grid,
+        theo_decimation=(resolve_decimation("auto", n, taus) if static_est == "theoh" else None),
+        memory_estimate_bytes=int(cost["total"]),
+    )
 
     fits = series = None
     fit_error = series_error = None
@@ -401,6 +388,8 @@ def build_report(
     refinements: list[Refinement | None] | None = None
     if refine:
         progress.step("model refinement")
+        from ..model import refine as refine_axis  # the refinement package (scipy.signal) only when asked
+
         refinements = []
         # the same τ range the whole-record fit used (none unless given): start at 0.1 s when the
         # shortest τ are below it, as real gyros' anti-alias filters colour them
@@ -470,6 +459,59 @@ def build_report(
         series_error=series_error,
         created=created,
     )
+
+
+def _window_and_hop(n, window, hop, estimator):
+    """The DAVAR window and hop (given, or the report's defaults) and how they were chosen."""
+    window_given, hop_given = window is not None, hop is not None
+    window_rule = hop_rule = "given"
+    if window is None:
+        window = default_window(n)
+        window_rule = f"record/{WINDOW_FRACTION}"
+        if estimator == "theoh" and window > DHVAR_MAX_DEFAULT_WINDOW:
+            window = DHVAR_MAX_DEFAULT_WINDOW
+            window_rule = f"record/{WINDOW_FRACTION}, capped at {DHVAR_MAX_DEFAULT_WINDOW} samples for DHVAR"
+    else:
+        window = check_count(window, "window", 2)
+    if window > n:
+        raise ParameterError(f"window ({window} samples) is longer than the record ({n} samples)")
+    if hop is None:
+        hop = default_hop(window)
+        hop_rule = f"window/{HOP_FRACTION}"
+        if estimator == "theoh":
+            # every DHVAR window gets its own fit: keep it to about DHVAR_MAX_WINDOWS of them — but never
+            # hop past a window's end, which would leave samples out of every window
+            fewer = min(window, -(-(n - window) // DHVAR_MAX_WINDOWS))
+            if fewer > hop:
+                hop = fewer
+                hop_rule = f"raised from window/{HOP_FRACTION} to keep about {DHVAR_MAX_WINDOWS} windows" + (
+                    " (at most the window, so that no sample is left out)" if hop == window else ""
+                )
+    else:
+        hop = check_count(hop, "hop", 1)
+        if hop > n:
+            raise ParameterError(
+                f"hop ({hop} samples) is longer than the record ({n} samples): give a hop of at most "
+                f"the window ({window} samples) so that every sample is in a window"
+            )
+    settings = {
+        "window": int(window),
+        "hop": int(hop),
+        "window_default": not window_given,
+        "hop_default": not hop_given,
+        "window_rule": window_rule,
+        "hop_rule": hop_rule,
+    }
+    return window, hop, settings
+
+
+def _octaves(ms) -> int:
+    """How many of the averaging factors ``ms`` an octave-thinned fit keeps (each at least twice the last)."""
+    kept, last = 0, 0.0
+    for m in ms:
+        if m >= 2.0 * last * (1 - 1e-12):
+            kept, last = kept + 1, float(m)
+    return kept
 
 
 def _fit_windows(dynamic, unit, confidence, tau_from):

@@ -9,6 +9,7 @@ import numpy as np
 from .._core import __version__
 from ..estimators import get as get_estimator
 from ..model.effects import EFFECTS, param_units
+from ..model.fitting import row_medians
 from ..model.refinement.result import term_move_text
 from ..model.terms import TERM_NAMES
 from ..units import coefficient_unit, ieee952
@@ -16,6 +17,7 @@ from .fmt import count, duration, g, json_list, json_number, json_value, pct, st
 from .forecasting import forecast_dict, forecast_text
 from .paper002 import text_lines as paper002_text
 from .settings import FIT_MODEL, NOTHING_ADDED
+from .sidefiles import side_files_entry, uses_side_files
 
 __all__ = ["summarize", "text_summary", "refinement_dict"]
 
@@ -177,16 +179,18 @@ def _readoffs(f, unit, adev_unit) -> dict:
     return out
 
 
-def _series_dict(s, unit) -> dict:
+def _series_dict(s, unit, inline: bool = True) -> dict:
+    """One axis's coefficient series; ``inline`` False: statistics only (the per-window lists are in the
+    side files, :mod:`allanite.report.sidefiles`)."""
     coeffs = {}
     for t in s.terms:
         v, lo, hi = s.values[t], s.ci_low[t], s.ci_high[t]
         d = {
             "name": TERM_NAMES[t],
             "unit": coefficient_unit(t, unit) if unit is not None else None,
-            "value": json_list(v),
-            "ci_low": json_list(lo),
-            "ci_high": json_list(hi),
+            "value": json_list(v) if inline else None,
+            "ci_low": json_list(lo) if inline else None,
+            "ci_high": json_list(hi) if inline else None,
         }
         show, show_unit = v, d["unit"]
         if unit is not None:
@@ -194,12 +198,14 @@ def _series_dict(s, unit) -> dict:
             show, show_unit = np.asarray(ie.value), ie.unit
             d.update(
                 ieee_unit=ie.unit,
-                ieee=json_list(show),
-                ieee_ci_low=json_list(ieee952(t, lo, unit).value),
-                ieee_ci_high=json_list(ieee952(t, hi, unit).value),
+                ieee=json_list(show) if inline else None,
+                ieee_ci_low=json_list(ieee952(t, lo, unit).value) if inline else None,
+                ieee_ci_high=json_list(ieee952(t, hi, unit).value) if inline else None,
             )
         d["stats"] = _resolved_stats(np.asarray(show, dtype=np.float64), v, s.t, show_unit)
         coeffs[t] = d
+    if not inline:
+        return {"t_s": None, "chi2_dof": None, "per_window": "side_files", "coefficients": coeffs}
     return {"t_s": json_list(s.t), "chi2_dof": json_list(s.chi2_dof), "coefficients": coeffs}
 
 
@@ -234,6 +240,7 @@ def _positions(st) -> np.ndarray:
 def summarize(rep) -> dict:
     """Every number of the report, JSON-able (``summary.json``)."""
     st, dy = rep.static, rep.dynamic
+    inline = not uses_side_files(rep)  # per-window lists in the JSON, or in the side files
     adev = np.atleast_2d(st.adev)
     lo, hi = (np.atleast_2d(a) for a in st.adev_ci)
     fs = rep.fs
@@ -290,7 +297,7 @@ def summarize(rep) -> dict:
                 "adev_shortest_tau_min": float(row[j_min]),
                 "t_of_min_s": float(dy.t[j_min]),
                 "max_over_min": json_number(row[j_max] / row[j_min]) if row[j_min] > 0 else None,
-                "adev_median_over_time": json_list(np.sqrt(np.median(av, axis=1))),
+                "adev_median_over_time": json_list(np.sqrt(row_medians(av))),
                 "adev_min_over_time": json_list(np.sqrt(av.min(axis=1))),
                 "adev_max_over_time": json_list(np.sqrt(av.max(axis=1))),
             }
@@ -310,7 +317,7 @@ def summarize(rep) -> dict:
         "unused_samples": int(n - ((dy.t.size - 1) * dy.hop + dy.window)),
         "windows": int(dy.t.size),
         "tau_s": json_list(dy.tau),
-        "t_s": json_list(dy.t),
+        "t_s": json_list(dy.t) if inline else None,
         "adev_unit": au,
         "axes": d_axes,
     }
@@ -353,7 +360,8 @@ def summarize(rep) -> dict:
             ser["window_samples"] = int(dy.window)
             ser["hop_samples"] = int(dy.hop)
             ser["axes"] = [
-                dict(axis=k, name=rep.axis_names[k], **_series_dict(s, rep.unit)) for k, s in enumerate(rep.series)
+                dict(axis=k, name=rep.axis_names[k], **_series_dict(s, rep.unit, inline))
+                for k, s in enumerate(rep.series)
             ]
         fit["series"] = ser
     return {
@@ -372,6 +380,7 @@ def summarize(rep) -> dict:
         "refinement": refinement_dict(rep),
         "forecast": forecast_dict(rep),
         "paper002": getattr(rep, "paper002", None),
+        "side_files": None if inline else side_files_entry(rep),
         "conventions": "times and τ in s (keys ending _s), fs in Hz; Allan deviations in adev_unit (the samples' "
         "rate unit); coefficients: value/ci in base form ('unit'), ieee/ieee_ci in IEEE-952 units "
         "('ieee_unit'); intervals at 'confidence'; null = does not exist (unknown unit, unbounded "

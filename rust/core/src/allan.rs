@@ -37,6 +37,7 @@ use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use crate::gather::{classic_window, GATHER_MAX};
 use crate::oavar::overlapping_window;
+use crate::range::Range;
 use rayon::prelude::*;
 
 /// Which Allan estimator.
@@ -902,6 +903,29 @@ pub fn dynamic_avar(req: &Request) -> Result<(Vec<f64>, usize)> {
 /// [`dynamic_avar`] that stops within one row chunk (at most a few thousand terms per worker) once
 /// `cancel` is set, and then returns [`CoreError::Cancelled`].
 pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f64>, usize)> {
+    dynamic_avar_rows(req, cancel).map(|(out, n_win, _)| (out, n_win))
+}
+
+/// [`dynamic_avar_cancellable`] and the [`Range`] of every (axis, m) row of the result, [axis][m]:
+/// noted as each row is formed where the path allows it (the hop-1 surfaces, whose second read would
+/// cost as much as the call), else from one parallel pass over the rows.
+pub fn dynamic_avar_ranged_cancellable(
+    req: &Request,
+    cancel: &Cancel,
+) -> Result<(Vec<f64>, usize, Vec<Range>)> {
+    let (out, n_win, ranges) = dynamic_avar_rows(req, cancel)?;
+    let ranges = match ranges {
+        Some(r) => r,
+        None => out.par_chunks(n_win.max(1)).map(Range::of).collect(),
+    };
+    cancel.check()?;
+    Ok((out, n_win, ranges))
+}
+
+/// The values, the number of windows, and the rows' ranges when the path noted them.
+type Rows = (Vec<f64>, usize, Option<Vec<Range>>);
+
+fn dynamic_avar_rows(req: &Request, cancel: &Cancel) -> Result<Rows> {
     let n_win = validate_shape(req)?;
     let (n_axes, n_m) = (req.columns.len(), req.ms.len());
     let mut out = vec![0.0f64; n_axes * n_m * n_win];
@@ -914,10 +938,11 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
     if req.method == Method::Fast && n_win == 1 {
         if let Some(r) = static_window(req, &mut out, cancel) {
             r?;
-            return Ok((out, n_win));
+            return Ok((out, n_win, None));
         }
     }
     check_finite(req.columns)?;
+    let mut ranges = None;
     match req.method {
         Method::Fast => {
             let mus: Vec<f64> = req
@@ -928,7 +953,7 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
             // samples any window reads
             let n_used = ((n_win - 1) * req.hop + req.window).min(req.columns[0].len());
             let phase = takes_phase_path(req.estimator, n_used, n_axes, req.window);
-            part_rows(req, &mus, Part::whole(n_win), phase, &mut out, cancel);
+            ranges = part_rows(req, &mus, Part::whole(n_win), phase, &mut out, cancel);
         }
         Method::Naive => {
             for (a, y) in req.columns.iter().enumerate() {
@@ -962,7 +987,7 @@ pub fn dynamic_avar_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
     }
     // A row that stopped early left garbage: never return it.
     cancel.check()?;
-    Ok((out, n_win))
+    Ok((out, n_win, ranges))
 }
 
 /// The windows `first_window ..` of a record of `n_windows_total` windows, from a part of it: what
@@ -1143,10 +1168,13 @@ fn part_rows(
     phase: bool,
     out: &mut [f64],
     cancel: &Cancel,
-) {
+) -> Option<Vec<Range>> {
     let n_m = req.ms.len();
     let n_win = out.len() / (req.columns.len() * n_m);
     let n_m_win = n_m * n_win;
+    // each row's range, noted right after the row is formed (in cache); the tiled path leaves it open
+    let mut ranges = vec![Range::default(); req.columns.len() * n_m];
+    let mut noted = true;
     if phase {
         let n_used_record = (part.total - 1) * req.hop + req.window;
         let long = long_record(n_used_record, req.columns.len());
@@ -1157,7 +1185,7 @@ fn part_rows(
             let mut j0 = 0;
             while j0 < n_win {
                 if cancel.is_cancelled() {
-                    return;
+                    return None;
                 }
                 let g = part.first + j0; // the record's window index
                 let j1 = ((g / seg + 1) * seg - part.first).min(n_win);
@@ -1167,6 +1195,7 @@ fn part_rows(
                 let ph = crate::oavar::Phase::new(ys, mus[a]);
                 let (hi, lo) = ph.parts();
                 if part.total >= 2 && nw >= 2 && req.hop >= crate::oavar::SMALL_HOP {
+                    noted = false;
                     crate::oavar::overlapping_dynamic_tiled(
                         hi,
                         lo,
@@ -1182,55 +1211,64 @@ fn part_rows(
                         first: g,
                         total: part.total,
                     };
-                    dst_axis.par_chunks_mut(n_win).enumerate().for_each_init(
-                        || (crate::oavar::DynScratch::default(), RowScratch::default()),
-                        |(sc, rs), (t, row)| {
-                            if cancel.is_cancelled() {
-                                return;
-                            }
-                            let dst = &mut row[j0..j1];
-                            let m = req.ms[t];
-                            // (a one-window run at a hop ≥ 64 is the tiled path's blocks)
-                            if m <= PHASE_M_MAX
-                                || part.total == 1
-                                || req.hop >= crate::oavar::SMALL_HOP
-                            {
-                                crate::oavar::overlapping_dynamic_row(
-                                    hi,
-                                    lo,
-                                    m,
-                                    req.window,
-                                    req.hop,
-                                    part.total == 1,
-                                    dst,
-                                    sc,
-                                );
-                            } else {
-                                overlapping_row_at(
-                                    &y[s0..],
-                                    sub,
-                                    mus[a],
-                                    m,
-                                    req.window,
-                                    req.hop,
-                                    dst,
-                                    rs,
-                                    cancel,
-                                );
-                            }
-                        },
-                    );
+                    let rows: Vec<Range> = dst_axis
+                        .par_chunks_mut(n_win)
+                        .enumerate()
+                        .map_init(
+                            || (crate::oavar::DynScratch::default(), RowScratch::default()),
+                            |(sc, rs), (t, row)| {
+                                if cancel.is_cancelled() {
+                                    return Range::default();
+                                }
+                                let dst = &mut row[j0..j1];
+                                let m = req.ms[t];
+                                // (a one-window run at a hop ≥ 64 is the tiled path's blocks)
+                                if m <= PHASE_M_MAX
+                                    || part.total == 1
+                                    || req.hop >= crate::oavar::SMALL_HOP
+                                {
+                                    crate::oavar::overlapping_dynamic_row(
+                                        hi,
+                                        lo,
+                                        m,
+                                        req.window,
+                                        req.hop,
+                                        part.total == 1,
+                                        dst,
+                                        sc,
+                                    )
+                                } else {
+                                    overlapping_row_at(
+                                        &y[s0..],
+                                        sub,
+                                        mus[a],
+                                        m,
+                                        req.window,
+                                        req.hop,
+                                        dst,
+                                        rs,
+                                        cancel,
+                                    );
+                                    Range::of(dst)
+                                }
+                            },
+                        )
+                        .collect();
+                    for (t, r) in rows.into_iter().enumerate() {
+                        ranges[a * n_m + t] = ranges[a * n_m + t].merge(r);
+                    }
                 }
                 j0 = j1;
             }
         }
-        return;
+        return noted.then_some(ranges);
     }
-    out.par_chunks_mut(n_win)
+    let rows: Vec<Range> = out
+        .par_chunks_mut(n_win)
         .enumerate()
-        .for_each_init(RowScratch::default, |sc, (row, dst)| {
+        .map_init(RowScratch::default, |sc, (row, dst)| {
             if cancel.is_cancelled() {
-                return;
+                return Range::default();
             }
             let (a, t) = (row / n_m, row % n_m);
             let (y, m) = (req.columns[a], req.ms[t]);
@@ -1242,7 +1280,10 @@ fn part_rows(
                     classic_row_at(y, part, mus[a], m, req.window, req.hop, dst, cancel)
                 }
             }
-        });
+            Range::of(dst)
+        })
+        .collect();
+    Some(rows)
 }
 
 /// Static Allan variance of each whole record at every m: [axis][m].

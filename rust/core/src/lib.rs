@@ -8,15 +8,17 @@ pub mod angle;
 pub mod cancel;
 pub mod deviations;
 pub mod error;
+pub mod fit;
 mod gather;
 mod oavar;
+pub mod range;
 pub mod taper;
 pub mod theo;
 
 pub use allan::{
     compensated_mean, compensated_sum_from, dynamic_avar, dynamic_avar_cancellable,
-    dynamic_avar_part_cancellable, max_m, n_terms, n_windows, part_grid, run_in_pool, static_avar,
-    Estimator, Method, Request,
+    dynamic_avar_part_cancellable, dynamic_avar_ranged_cancellable, max_m, n_terms, n_windows,
+    part_grid, run_in_pool, static_avar, Estimator, Method, Request,
 };
 pub use angle::{angle_term_sums_cancellable, AngleChunk};
 pub use cancel::{run_in_pool_interruptible, Cancel};

@@ -44,6 +44,7 @@
 //! that grid only), and the partials are added in chunk order.
 
 use crate::cancel::Cancel;
+use crate::range::Range;
 use rayon::prelude::*;
 
 /// Samples per block of the phase build.
@@ -625,7 +626,7 @@ pub(crate) fn overlapping_dynamic_row(
     one_window: bool,
     out: &mut [f64],
     sc: &mut DynScratch,
-) {
+) -> Range {
     #[cfg(target_arch = "x86_64")]
     let avx2 = std::arch::is_x86_feature_detected!("avx2");
     #[cfg(not(target_arch = "x86_64"))]
@@ -639,7 +640,7 @@ pub(crate) fn overlapping_dynamic_row(
     let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
     let DynScratch { terms, full, part } = sc;
     if hop < SMALL_HOP {
-        terms.clear();
+        // every term is written below: the buffer is only sized (no fill of what it already holds)
         terms.resize(k_end, 0.0);
         #[cfg(target_arch = "x86_64")]
         if avx2 {
@@ -691,6 +692,8 @@ pub(crate) fn overlapping_dynamic_row(
             }
         }
     }
+    // noted while the row is in cache: the caller's range check then reads nothing again
+    Range::of(out)
 }
 
 /// [`overlapping_dynamic_row`] for every m of `ms` at once, for hops ≥ `SMALL_HOP`: the block sums

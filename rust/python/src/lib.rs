@@ -9,13 +9,17 @@
 
 use allanite_core::dynamic_hann_cancellable;
 use allanite_core::{angle_term_sums_cancellable, AngleChunk};
-use allanite_core::{compensated_sum_from, dynamic_avar_part_cancellable};
+use allanite_core::{
+    compensated_sum_from, dynamic_avar_part_cancellable, dynamic_avar_ranged_cancellable,
+};
 use allanite_core::{
     deviations, dynamic_avar_cancellable, dynamic_theo1_cancellable, run_in_pool_interruptible,
     static_theo1_cancellable, Cancel, CoreError, Estimator, Method, Request,
 };
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{
+    IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use std::time::Duration;
 
@@ -132,6 +136,48 @@ fn davar<'py>(
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
+}
+
+/// [`davar`] and the range of every (axis, m) row of the result: (values, ranges), ranges of shape
+/// (axes, len(ms), 3) holding each row's largest value, smallest value and 1.0 where a value is not
+/// finite (allanite-core `dynamic_avar_ranged_cancellable`; the rows of a hop-1 surface are noted while
+/// in cache, so that the caller's range check need not read the surface again).
+#[pyfunction]
+#[pyo3(signature = (columns, window, hop, ms, estimator, method, workers))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn davar_ranged<'py>(
+    py: Python<'py>,
+    columns: Vec<PyReadonlyArray1<'py, f64>>,
+    window: usize,
+    hop: usize,
+    ms: Vec<usize>,
+    estimator: &str,
+    method: &str,
+    workers: usize,
+) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
+    let estimator = parse_estimator(py, estimator)?;
+    let method = parse_method(py, method)?;
+    let slices = contiguous(py, &columns)?;
+    let req = Request {
+        columns: &slices,
+        window,
+        hop,
+        ms: &ms,
+        estimator,
+        method,
+    };
+    let (values, n_win, ranges) = run_interruptible(py, workers, |cancel| {
+        dynamic_avar_ranged_cancellable(&req, cancel)
+    })?;
+    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    let flat: Vec<f64> = ranges
+        .iter()
+        .flat_map(|r| [r.max, r.min, if r.non_finite { 1.0 } else { 0.0 }])
+        .collect();
+    let rng = Array3::from_shape_vec((slices.len(), ms.len(), 3), flat)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok((arr.into_pyarray(py), rng.into_pyarray(py)))
 }
 
 /// [`davar`] of the windows `first_window ..` of a record of `n_windows` windows, from a part of it
@@ -328,6 +374,83 @@ fn davar_hann<'py>(
     let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
         .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok(arr.into_pyarray(py))
+}
+
+/// The noise-model fit of every window (allanite-core `fit::fit_windows`): `avar` (windows, n_tau) at
+/// the fitted τ; what the windows share as in `fit::Problem` (covariance blocks flattened, absent for
+/// the IRLS fit). Returns (windows, n_terms + n_terms² + 3): θ, covariance, χ², iterations, status.
+#[pyfunction]
+#[pyo3(signature = (avar, design, nu_terms, start_col, irls_iter, max_iter, gls_tol, irls_rtol, rho, log2_tau, s_blk, t_blk, stoch, ramp, workers))]
+#[allow(clippy::too_many_arguments)]
+fn fit_windows<'py>(
+    py: Python<'py>,
+    avar: PyReadonlyArray2<'py, f64>,
+    design: PyReadonlyArray2<'py, f64>,
+    nu_terms: PyReadonlyArray2<'py, f64>,
+    start_col: usize,
+    irls_iter: usize,
+    max_iter: usize,
+    gls_tol: f64,
+    irls_rtol: f64,
+    rho: Vec<f64>,
+    log2_tau: Vec<f64>,
+    s_blk: Option<PyReadonlyArray1<'py, f64>>,
+    t_blk: Option<PyReadonlyArray1<'py, f64>>,
+    stoch: Vec<usize>,
+    ramp: Option<usize>,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (y, a, nu) = (
+        c_slice(py, &avar, "avar")?,
+        c_slice(py, &design, "design")?,
+        c_slice(py, &nu_terms, "nu_terms")?,
+    );
+    let blocks = match (&s_blk, &t_blk) {
+        (Some(s), Some(t)) => Some((s.as_slice()?, t.as_slice()?)),
+        _ => None,
+    };
+    let (n_tau, n_terms) = (design.shape()[0], design.shape()[1]);
+    let problem = allanite_core::fit::Problem {
+        n_tau,
+        n_terms,
+        design: a,
+        nu_terms: nu,
+        start_col,
+        irls_iter,
+        max_iter,
+        gls_tol,
+        irls_rtol,
+        rho: &rho,
+        log2_tau: &log2_tau,
+        gls: blocks.map(|(s, t)| allanite_core::fit::Gls {
+            s_blk: s,
+            t_blk: t,
+            stoch: &stoch,
+            ramp,
+        }),
+    };
+    let n_windows = avar.shape()[0];
+    let values = run_interruptible(py, workers, |cancel| {
+        allanite_core::fit::fit_windows(&problem, y, cancel)
+    })?;
+    let width = allanite_core::fit::record_width(n_terms);
+    let arr = Array2::from_shape_vec((n_windows, width), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+fn c_slice<'a>(
+    py: Python<'_>,
+    a: &'a PyReadonlyArray2<'_, f64>,
+    what: &str,
+) -> PyResult<&'a [f64]> {
+    a.as_slice().map_err(|_| {
+        allanite_error_of(
+            py,
+            "ParameterError",
+            format!("{what} must be a C-contiguous float64 array"),
+        )
+    })
 }
 
 fn contiguous<'a>(
@@ -619,7 +742,9 @@ fn tierms_phase<'py>(
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
+    m.add_function(wrap_pyfunction!(davar_ranged, m)?)?;
     m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
+    m.add_function(wrap_pyfunction!(fit_windows, m)?)?;
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;
     m.add_function(wrap_pyfunction!(part_grid, m)?)?;
     m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;

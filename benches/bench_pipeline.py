@@ -1,0 +1,474 @@
+#!/usr/bin/env python3
+"""The whole pipeline at engine speed (issue 30): each row of the issue's table, before and after, as ratios
+measured in one run.
+
+Rows
+1. ``allanite report <ADIS run 1> --fs 100 --columns gyro_x,gyro_y,gyro_z --unit deg/s`` in a fresh process
+   (wall time, peak RSS), against the same run's baselines: reading the log alone (``read_log``), the engine
+   calls inside the report (``avar`` + ``davar`` as the report makes them), and — with ``--baseline DIR``, a
+   ``python/`` folder of an earlier checkout (e.g. main) holding its compiled core — the same command on it.
+   Inside the report: its figures drawn one after another against two processes (the same PNG bytes).
+2. ``fit(davar(...))`` of the ADIS run (3 axes × its windows), batched against the per-window reference
+   (``_fit_core`` on each window, what the fit did before).
+3. ``allanite.combine(y, 100, window=401, hop=10)`` of 10⁶ simulated samples (10⁵ windows), against the
+   per-window fits of the same windows (timed on a slice of them, per window) — and with ``--baseline``,
+   the baseline's ``combine`` on a fifth of the record (per window).
+4. ``fit(davar)`` of 10⁵ windows (window 401, hop 10), batched against the per-window fit (per window).
+5. The hop-1 request ``--columns gyro_x --window 500000 --hop 1``: refused or answered, its wall time and
+   peak RSS (the issue's "before": 593 s, 4.4 GB peak, 376 MB summary.json — not rerun here).
+6. ``import allanite``: wall time of a fresh interpreter's import (median of 5), after and baseline, and
+   the top of ``python -X importtime``.
+
+Not measured here (issue 30 items 4 and 5, not done on this branch): the 10⁸ × 3 memory-mapped ``.npy``
+report, and DAVAR's hop-1 case against its write floor.
+
+Usage::
+
+    python benches/bench_pipeline.py --baseline /path/to/main/python   # -> benches/results/pipeline.{md,json}
+    python benches/bench_pipeline.py --quick --out /tmp/p              # a few minutes: fewer windows, 1 repeat
+
+Timing lives here, never in a pass/fail test. The machine's load is noted at the start and the end.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+import _common
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+ADIS = "adis16405/adis16405_run1_100Hz.csv.gz"
+REPORT_ARGS = ["--fs", "100", "--columns", "gyro_x,gyro_y,gyro_z", "--unit", "deg/s", "--quiet"]
+HOP1_ARGS = ["--fs", "100", "--columns", "gyro_x", "--unit", "deg/s", "--window", "500000", "--hop", "1", "--quiet"]
+CONFIGS = {
+    "full": {
+        "repeats": 3,
+        "n_combine": 1_000_000,
+        "n_baseline_combine": 50_000,
+        "ref_windows": 400,
+        "import_repeats": 5,
+    },
+    "quick": {
+        "repeats": 1,
+        "n_combine": 200_000,
+        "n_baseline_combine": 20_000,
+        "ref_windows": 100,
+        "import_repeats": 3,
+    },
+}
+
+
+def cpu_timed(fn, repeats: int, warmup: bool = False):
+    """(best wall s, CPU s of this process in that run, last result) of ``repeats`` runs of ``fn``."""
+    if warmup:
+        fn()
+    best = (float("inf"), float("nan"))
+    out = None
+    for _ in range(repeats):
+        t0, c0 = time.perf_counter(), time.process_time()
+        out = fn()
+        best = min(best, (time.perf_counter() - t0, time.process_time() - c0))
+    return best[0], best[1], out
+
+
+def _env(python_dir: Path | None) -> dict:
+    env = dict(os.environ)
+    if python_dir is not None:
+        env["PYTHONPATH"] = str(python_dir)
+    return env
+
+
+def run_timed(cmd: list, env: dict, timeout: float) -> dict:
+    """Wall time, exit status and peak RSS (the child's own ru_maxrss from wait4, file pages included;
+    a child's children count where larger) of one command."""
+    with tempfile.TemporaryFile() as fo, tempfile.TemporaryFile() as fe:
+        t0 = time.perf_counter()
+        p = subprocess.Popen(cmd, env=env, stdout=fo, stderr=fe)
+        status = "timeout"
+        while True:
+            pid, code, ru = os.wait4(p.pid, os.WNOHANG)
+            if pid:
+                status = os.waitstatus_to_exitcode(code)
+                break
+            if time.perf_counter() - t0 > timeout:
+                p.kill()
+                _, _, ru = os.wait4(p.pid, 0)
+                break
+            time.sleep(0.01)
+        wall = time.perf_counter() - t0
+        p.returncode = -1 if status == "timeout" else status  # reaped here, not by Popen
+        fo.seek(0)
+        fe.seek(0)
+        out, err = fo.read(), fe.read()
+    return {
+        "wall_s": wall,
+        "status": status,
+        "cpu_s": ru.ru_utime + ru.ru_stime,  # its own and its reaped children's (the figure process)
+        "peak_rss_mb": ru.ru_maxrss / 1024,
+        "stderr_tail": err.decode(errors="replace").strip().splitlines()[-2:],
+        "stdout_tail": out.decode(errors="replace").strip().splitlines()[-1:],
+    }
+
+
+def _report_cmd(path: Path, out: Path, extra: list) -> list:
+    return [sys.executable, "-m", "allanite", "report", str(path), *extra, "--out", str(out)]
+
+
+def row_report(data: Path, cfg: dict, baseline: Path | None, tmp: Path) -> dict:
+    row: dict = {"command": "allanite report <run1> " + " ".join(REPORT_ARGS)}
+    for label, pdir in (("after", REPO / "python"), ("before", baseline)):
+        if label == "before" and pdir is None:
+            continue
+        runs = [
+            run_timed(_report_cmd(data, tmp / f"rep_{label}_{i}", REPORT_ARGS), _env(pdir), 900)
+            for i in range(cfg["repeats"])
+        ]
+        best = min(runs, key=lambda r: r["wall_s"])
+        row[label] = {"best_s": best["wall_s"], "cpu_s": best["cpu_s"], "runs_s": [r["wall_s"] for r in runs]}
+        row[label]["status"] = runs[-1]["status"]
+        row[label]["peak_rss_mb"] = max(r["peak_rss_mb"] for r in runs)
+    # the same run's baselines, in-process: reading, the engine calls, the figures serial vs two processes
+    import allanite
+    from allanite.report.build import from_log
+    from allanite.report.rendering import render_pngs
+
+    best_read, _, log = _common.timed(
+        lambda: allanite.read_log(data, fs=100, columns=["gyro_x", "gyro_y", "gyro_z"], unit="deg/s"), cfg["repeats"]
+    )
+    rep = from_log(log)
+    dy = rep.dynamic
+    best_engine, _, _ = _common.timed(
+        lambda: (
+            allanite.avar(log.data, 100.0, taus=rep.static.tau),
+            allanite.davar(log.data, 100.0, window=dy.window, hop=dy.hop, taus=dy.tau),
+        ),
+        cfg["repeats"],
+    )
+    best_build, _, _ = _common.timed(lambda: from_log(log), cfg["repeats"])
+    specs = rep.figure_specs()
+    render_pngs(specs[:1], 100, lambda s: None, processes=1)  # matplotlib's set-up outside the timing
+    best_serial, _, serial = _common.timed(lambda: render_pngs(specs, 100, lambda s: None, processes=1), cfg["repeats"])
+    best_two, _, two = _common.timed(lambda: render_pngs(specs, 100, lambda s: None, processes=2), cfg["repeats"])
+    row.update(
+        read_s=best_read,
+        engine_s=best_engine,
+        build_s=best_build,
+        figures=len(specs),
+        figures_serial_s=best_serial,
+        figures_two_processes_s=best_two,
+        figures_identical=all(serial[k] == two[k] for k in serial),
+    )
+    return row
+
+
+def _per_window_reference(result, rows_avar, k_windows: int):
+    """Seconds per window of the per-window fit (``_fit_core`` on each), on ``k_windows`` windows spread over
+    one axis (``rows_avar``, τ × windows) of ``result``, at the τ the fit selects."""
+    from allanite.model import fitting
+
+    idx = fitting._select(result.tau, fitting.row_medians(rows_avar), True, len(fitting.TERMS), "x", (0.0, np.inf))
+    cols = _common.sample_starts(rows_avar.shape[1], min(k_windows, rows_avar.shape[1]))
+    y = np.ascontiguousarray(rows_avar[idx][:, cols].T)
+    t0, c0 = time.perf_counter(), time.process_time()
+    fitting._window_fits_reference(result, idx, y, fitting.TERMS, 0.683, 50)
+    return (time.perf_counter() - t0) / y.shape[0], (time.process_time() - c0) / y.shape[0]
+
+
+def row_fit_adis(data: Path, cfg: dict) -> dict:
+    import allanite
+
+    log = allanite.read_log(data, fs=100, columns=["gyro_x", "gyro_y", "gyro_z"], unit="deg/s")
+    from allanite.report.build import from_log
+
+    dy = from_log(log, fit=False).dynamic
+    best, cpu, _ = cpu_timed(lambda: allanite.fit(dy, unit="deg/s"), cfg["repeats"], warmup=True)
+    n_win = dy.t.size * dy.avar.shape[0]
+    refs = [_per_window_reference(dy, dy.avar[k], dy.t.size) for k in range(dy.avar.shape[0])]
+    per_ref, per_ref_cpu = float(np.mean([r[0] for r in refs])), float(np.mean([r[1] for r in refs]))
+    return {
+        "call": f"fit(davar(ADIS run 1)) — {dy.avar.shape[0]} axes × {dy.t.size} windows",
+        "batched_s": best,
+        "batched_us_per_window": best / n_win * 1e6,
+        "batched_cpu_us_per_window": cpu / n_win * 1e6,
+        "per_window_ref_us": per_ref * 1e6,
+        "per_window_ref_cpu_us": per_ref_cpu * 1e6,
+        "per_window_ref_total_s": per_ref * n_win,
+        "ratio": per_ref * n_win / best,
+        "cpu_ratio": per_ref_cpu * n_win / cpu,
+    }
+
+
+def row_combine_and_fit(cfg: dict, baseline: Path | None) -> tuple[dict, dict]:
+    import allanite
+
+    n = cfg["n_combine"]
+    y = allanite.simulate(n, 100.0, Q=1e-4, N=0.01, B=1e-3, K=1e-4, seed=30)
+    best_c, cpu_c, comb = cpu_timed(lambda: allanite.combine(y, 100.0, window=401, hop=10), 1)
+    res = allanite.davar(y, 100.0, window=401, hop=10)
+    best_d, _, _ = _common.timed(lambda: allanite.davar(y, 100.0, window=401, hop=10), cfg["repeats"])
+    best_f, cpu_f, _ = cpu_timed(lambda: allanite.fit(res), cfg["repeats"], warmup=True)
+    per_ref, per_ref_cpu = _per_window_reference(res, res.avar, cfg["ref_windows"])
+    w = res.t.size
+    comb_row = {
+        "call": f"combine(y, 100, window=401, hop=10), {n:,} samples, {w:,} windows",
+        "after_s": best_c,
+        "after_cpu_s": cpu_c,
+        "per_window_fits_estimate_s": per_ref * w,
+        "ratio_vs_per_window_fits": per_ref * w / best_c,
+    }
+    if baseline is not None:
+        n_b = cfg["n_baseline_combine"]
+        code = (
+            f"import time, allanite; y = allanite.simulate({n_b}, 100.0, Q=1e-4, N=0.01, B=1e-3, K=1e-4, seed=30); "
+            "t = time.perf_counter(); c = allanite.combine(y, 100.0, window=401, hop=10); "
+            "print(time.perf_counter() - t)"
+        )
+        r = run_timed([sys.executable, "-c", code], _env(baseline), 1800)
+        try:
+            t_b = float(r["stdout_tail"][0].split()[0])
+            w_b = (n_b - 401) // 10 + 1
+            comb_row.update(
+                baseline_samples=n_b,
+                baseline_s=t_b,
+                baseline_us_per_window=t_b / w_b * 1e6,
+                after_us_per_window=best_c / w * 1e6,
+                ratio_vs_baseline_per_window=(t_b / w_b) / (best_c / w),
+            )
+        except (IndexError, ValueError):
+            comb_row["baseline_error"] = r["stderr_tail"]
+    fit_row = {
+        "call": f"fit(davar(y, window=401, hop=10)), {w:,} windows",
+        "davar_s": best_d,
+        "batched_s": best_f,
+        "batched_us_per_window": best_f / w * 1e6,
+        "batched_cpu_us_per_window": cpu_f / w * 1e6,
+        "per_window_ref_us": per_ref * 1e6,
+        "per_window_ref_cpu_us": per_ref_cpu * 1e6,
+        "per_window_ref_total_s": per_ref * w,
+        "ratio": per_ref * w / best_f,
+        "cpu_ratio": per_ref_cpu * w / cpu_f,
+    }
+    del comb
+    return comb_row, fit_row
+
+
+def row_hop1(data: Path, tmp: Path) -> dict:
+    r = run_timed(_report_cmd(data, tmp / "hop1", HOP1_ARGS), _env(REPO / "python"), 900)
+    side = sorted(p.name for p in (tmp / "hop1").glob("*")) if (tmp / "hop1").is_dir() else []
+    summ = tmp / "hop1" / "summary.json"
+    return {
+        "command": "allanite report <run1> " + " ".join(HOP1_ARGS),
+        "status": r["status"],
+        "answer": "refused" if r["status"] not in (0, "timeout") else ("answered" if r["status"] == 0 else "timeout"),
+        "wall_s": r["wall_s"],
+        "peak_rss_mb": r["peak_rss_mb"],
+        "summary_json_mb": summ.stat().st_size / 2**20 if summ.exists() else None,
+        "files": side,
+        "message": r["stderr_tail"],
+        "before_from_issue": {"wall_s": 593, "peak_gb": 4.4, "summary_json_mb": 376},
+    }
+
+
+def row_import(cfg: dict, baseline: Path | None) -> dict:
+    code = "import time; t = time.perf_counter(); import allanite; print(time.perf_counter() - t)"
+    out = {}
+    for label, pdir in (("after", REPO / "python"), ("before", baseline)):
+        if pdir is None:
+            continue
+        ts = []
+        for _ in range(cfg["import_repeats"]):
+            p = subprocess.run([sys.executable, "-c", code], env=_env(pdir), capture_output=True, text=True)
+            ts.append(float(p.stdout.strip()))
+        p = subprocess.run(
+            [sys.executable, "-X", "importtime", "-c", "import allanite"],
+            env=_env(pdir),
+            capture_output=True,
+            text=True,
+        )
+        rows = [ln.split("|") for ln in p.stderr.splitlines() if ln.startswith("import time:") and "|" in ln]
+        cum = sorted(((int(r[1]), r[2].strip()) for r in rows if r[1].strip().isdigit()), reverse=True)
+        heavy = [
+            n
+            for n in ("scipy.stats", "scipy.signal", "scipy.optimize", "scipy.special", "matplotlib")
+            if any(name == n for _, name in cum)
+        ]
+        out[label] = {
+            "median_s": float(np.median(ts)),
+            "runs_s": ts,
+            "heavy_modules_imported": heavy,
+            "top_cumulative_us": cum[:6],
+        }
+    if "before" in out:
+        out["ratio"] = out["before"]["median_s"] / out["after"]["median_s"]
+    return out
+
+
+def parallel_capacity() -> dict:
+    """Wall time of two forked processes spinning against one: how many cores the run really had."""
+    import math
+
+    def spin():
+        x = 0.0
+        for i in range(4_000_000):
+            x += math.sqrt(i)
+        return x
+
+    t0 = time.perf_counter()
+    spin()
+    one = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    pid = os.fork()
+    if pid == 0:
+        spin()
+        os._exit(0)
+    spin()
+    os.waitpid(pid, 0)
+    two = time.perf_counter() - t0
+    return {"one_s": one, "two_s": two, "two_over_one": two / one}
+
+
+def load_note() -> dict:
+    return {"loadavg": Path("/proc/loadavg").read_text().split()[:3], "cpu_busy": _common.cpu_busy_fraction()}
+
+
+def write_md(res: dict, path: Path) -> None:
+    r, L = res["rows"], []
+    L.append("# Pipeline benchmark (issue 30): the report and the per-window fits at engine speed\n")
+    L.append(
+        f"`python benches/bench_pipeline.py{' --quick' if res['quick'] else ''}` — {res['date']}, "
+        f"{res['machine'].get('cpu_model', '')}, {res['machine'].get('cpu_count', '')} CPUs shared with other workers; "
+        f"branch commit {res['commit']}. Cores this run could use: two spinning processes took "
+        f"{res['parallel_capacity']['two_over_one']:.2f}× one's time (1.0 = two idle cores, 2.0 = one). "
+    )
+    L.append(
+        f"Load at start: {res['load_start']}; at end: {res['load_end']}. Baseline: {res['baseline'] or 'none given'}.\n"
+    )
+    rep = r["report"]
+    L.append("| row | before | after | ratio | same run's reference |")
+    L.append("|---|---|---|---|---|")
+    b = rep.get("before", {}).get("best_s")
+    bc = rep.get("before", {}).get("cpu_s")
+    a, ac = rep["after"]["best_s"], rep["after"]["cpu_s"]
+    L.append(
+        f"| ADIS report (3 axes, fresh process) | {b and f'{b:.2f} s (CPU {bc:.2f} s)'} | {a:.2f} s (CPU {ac:.2f} s) | "
+        f"{b and f'{b / a:.2f}× (CPU {bc / ac:.2f}×)'} | "
+        f"read {rep['read_s']:.2f} s, engine (avar+davar) {rep['engine_s']:.3f} s, build {rep['build_s']:.2f} s |"
+    )
+    L.append(
+        f"| its {rep['figures']} figures | serial {rep['figures_serial_s']:.2f} s | two processes "
+        f"{rep['figures_two_processes_s']:.2f} s | {rep['figures_serial_s'] / rep['figures_two_processes_s']:.2f}× | "
+        f"PNG bytes identical: {rep['figures_identical']} |"
+    )
+    f = r["fit_adis"]
+    L.append(
+        f"| {f['call']} | per-window {f['per_window_ref_total_s']:.2f} s ({f['per_window_ref_us']:.0f} µs/window) | "
+        f"{f['batched_s']:.3f} s ({f['batched_us_per_window']:.1f} µs/window; CPU {f['batched_cpu_us_per_window']:.1f} µs) | {f['ratio']:.0f}× | |"
+    )
+    c = r["combine"]
+    bl = (
+        (
+            f"baseline {c['baseline_s']:.1f} s on {c['baseline_samples']:,} samples = {c['baseline_us_per_window']:.0f} µs/window; "
+            f"{c['ratio_vs_baseline_per_window']:.0f}× per window"
+        )
+        if "baseline_s" in c
+        else "no baseline run"
+    )
+    L.append(
+        f"| {c['call']} | per-window fits alone ≈ {c['per_window_fits_estimate_s']:.1f} s | {c['after_s']:.2f} s "
+        f"(CPU {c['after_cpu_s']:.2f} s) | "
+        f"{c['ratio_vs_per_window_fits']:.0f}× | {bl} |"
+    )
+    g = r["fit_many"]
+    L.append(
+        f"| {g['call']} | per-window ≈ {g['per_window_ref_total_s']:.1f} s ({g['per_window_ref_us']:.0f} µs/window) | "
+        f"{g['batched_s']:.2f} s ({g['batched_us_per_window']:.1f} µs/window; CPU {g['batched_cpu_us_per_window']:.1f} µs) | "
+        f"{g['ratio']:.0f}× (CPU {g['cpu_ratio']:.0f}×) | per-window CPU {g['per_window_ref_cpu_us']:.0f} µs; davar {g['davar_s']:.2f} s |"
+    )
+    h = r["hop1"]
+    L.append(
+        f"| hop-1 `--window 500000 --hop 1` | 593 s, 4.4 GB, 376 MB JSON (issue; not rerun) | {h['answer']} in "
+        f"{h['wall_s']:.1f} s, peak RSS {h['peak_rss_mb']:.0f} MB"
+        + (f", summary.json {h['summary_json_mb']:.2f} MB" if h["summary_json_mb"] is not None else "")
+        + f" | {593 / h['wall_s']:.0f}× | files: {', '.join(h['files'])} |"
+    )
+    im = r["import"]
+    ib = im.get("before", {}).get("median_s")
+    heavy_b = ", ".join(im.get("before", {}).get("heavy_modules_imported", []))
+    heavy_a = ", ".join(im["after"]["heavy_modules_imported"]) or "no scipy/matplotlib"
+    ratio = im.get("ratio")
+    L.append(
+        f"| `import allanite` (median) | {ib and f'{ib:.2f} s'} ({heavy_b}) | "
+        f"{im['after']['median_s']:.2f} s ({heavy_a}) | {ratio and f'{ratio:.2f}×'} | |"
+    )
+    L.append("")
+    L.append(
+        "Wall times are the best of the repeats on a machine shared with other workers (its load above); CPU "
+        "times (this process's, and a report's figure process's) are less sensitive to that load. "
+    )
+    L.append(
+        "Per-window reference: `_fit_core` on each window in turn (today's reference path, what `fit(dynamic)` "
+        "did before the batched core), timed on windows spread over the record, per window × the number of windows."
+    )
+    L.append("")
+    L.append(
+        "Not measured (issue 30 items 4 and 5 were not done on this branch): the 10⁸ × 3 memory-mapped `.npy` "
+        "report, and DAVAR's hop-1 case against its write floor (case 1's old target in engine.md stands)."
+    )
+    path.write_text("\n".join(L) + "\n", encoding="utf-8")
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="fewer windows and one repeat: a few minutes")
+    ap.add_argument("--baseline", type=Path, default=None, help="python/ folder of the checkout to compare with")
+    ap.add_argument("--out", type=Path, default=HERE / "results", help="folder for pipeline.md and pipeline.json")
+    args = ap.parse_args()
+    cfg = CONFIGS["quick" if args.quick else "full"]
+    data = _common.shared_data_dir() / ADIS
+    if not data.exists():
+        print(f"the ADIS16405 log {data} is absent (set ALLANITE_SHARED_DATA): nothing to measure", file=sys.stderr)
+        return 2
+    res = {
+        "quick": args.quick,
+        "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+        "machine": _common.machine_info(),
+        "baseline": str(args.baseline) if args.baseline else None,
+        "load_start": load_note(),
+        "commit": subprocess.run(
+            ["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
+        ).stdout.strip(),
+        "parallel_capacity": parallel_capacity(),
+        "rows": {},
+    }
+    with tempfile.TemporaryDirectory() as tmp:
+        t = Path(tmp)
+        _common.log("import")
+        res["rows"]["import"] = row_import(cfg, args.baseline)
+        _common.log("report")
+        res["rows"]["report"] = row_report(data, cfg, args.baseline, t)
+        _common.log("fit of the ADIS windows")
+        res["rows"]["fit_adis"] = row_fit_adis(data, cfg)
+        _common.log("combine and fit of many windows")
+        res["rows"]["combine"], res["rows"]["fit_many"] = row_combine_and_fit(cfg, args.baseline)
+        _common.log("hop-1 request")
+        res["rows"]["hop1"] = row_hop1(data, t)
+    res["load_end"] = load_note()
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "pipeline.json").write_text(json.dumps(res, indent=1, default=str), encoding="utf-8")
+    write_md(res, args.out / "pipeline.md")
+    print((args.out / "pipeline.md").read_text())
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

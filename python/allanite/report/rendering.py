@@ -1,0 +1,132 @@
+"""The report's figures as PNG bytes, drawn on two processes where the machine gives this one two cores.
+
+Drawing and rasterising a figure is matplotlib's Python (ticks, text layout) under one interpreter lock; the
+report's 14 figures of a three-axis log are most of its wall time. Where ``os.fork`` exists, at least two cores
+are available, one of them idle (the load average) and the report is drawn from the main thread, a forked child
+draws every other figure (``fork``: the figures' drawing closures need no pickling, the child holds the report
+already) and hands its PNGs back through a pipe; the parent draws the rest meanwhile. The PNGs are the same
+bytes as drawn one after another. A child that fails or is killed leaves its figures to the parent, which then
+draws them itself (so an error in a figure is raised here, with its traceback); Ctrl-C ends the child with the
+parent.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import pickle
+import signal
+import sys
+import threading
+import warnings
+
+__all__ = ["render_pngs", "figure_processes"]
+
+#: Fewer figures than this are drawn in this process (forking costs ~10 ms and a child's first figure pays
+#: matplotlib's font set-up again).
+MIN_FIGURES_TO_SPLIT = 4
+
+
+def figure_processes() -> int:
+    """Processes that draw the figures: 2 where ``fork`` exists, two cores are available, the last minute's
+    load average leaves one of them idle and this is the main thread, else 1 (a report built in a worker
+    thread — Dask's ``allanite batch`` — gets its parallelism from its workers, and a fork beside running
+    threads could copy a lock one of them holds)."""
+    if not hasattr(os, "fork") or sys.platform != "linux" or threading.current_thread() is not threading.main_thread():
+        return 1
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
+    # a second process pays off only on a core left idle: on a machine busy with other work it adds the
+    # child's share (~15 % more CPU in all) and gains no core (measured: benches/results/pipeline.md)
+    return 2 if cores >= 2 and os.getloadavg()[0] <= cores - 1 else 1
+
+
+def png(spec, dpi: int) -> bytes:
+    """One figure of :func:`allanite.report.figures.figure_specs` drawn and encoded as PNG."""
+    from matplotlib.figure import Figure  # matplotlib only when figures are drawn
+
+    _name, _title, _caption, size, draw = spec
+    fig = Figure(figsize=size, dpi=dpi)
+    draw(fig)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    return buf.getvalue()
+
+
+def render_pngs(specs: list, dpi: int, step, processes: int | None = None) -> dict:
+    """File name → PNG bytes of every spec, in the specs' order; ``step(text)`` is called once per figure.
+    ``processes``: 1 draws them here one after another; None chooses (:func:`figure_processes`)."""
+    processes = figure_processes() if processes is None else processes
+    pngs: list[bytes | None] = [None] * len(specs)
+    theirs = list(range(1, len(specs), 2)) if processes > 1 and len(specs) >= MIN_FIGURES_TO_SPLIT else []
+    child = _fork_child(specs, theirs, dpi) if theirs else None
+    try:
+        for i, spec in enumerate(specs):
+            if child is None or i not in theirs:
+                step(f"figure {spec[0]}")
+                pngs[i] = png(spec, dpi)
+        got = _collect(child) if child is not None else None
+    finally:
+        if child is not None:
+            _end(child)
+    for j, i in enumerate(theirs):
+        step(f"figure {specs[i][0]}")
+        pngs[i] = got[j] if got is not None else png(specs[i], dpi)
+    return {spec[0]: data for spec, data in zip(specs, pngs)}
+
+
+def _fork_child(specs: list, indices: list, dpi: int):
+    """(pid, read end) of a child drawing ``specs[indices]``; None where fork fails."""
+    r, w = os.pipe()
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)  # 3.12+: fork with the core's idle threads
+            pid = os.fork()
+    except OSError:
+        os.close(r)
+        os.close(w)
+        return None
+    if pid == 0:  # the child: draw, hand back, exit without running the parent's exit handlers
+        status = 1
+        try:
+            os.close(r)
+            signal.signal(signal.SIGINT, signal.SIG_DFL)
+            data = pickle.dumps([png(specs[i], dpi) for i in indices], protocol=pickle.HIGHEST_PROTOCOL)
+            with os.fdopen(w, "wb") as f:
+                f.write(data)
+            status = 0
+        finally:
+            os._exit(status)
+    os.close(w)
+    return pid, r
+
+
+def _collect(child) -> list | None:
+    """The child's PNGs, or None where it failed (its figures are then drawn by the caller)."""
+    pid, r = child
+    chunks = []
+    while chunk := os.read(r, 1 << 20):
+        chunks.append(chunk)
+    _, status = os.waitpid(pid, 0)
+    if status != 0 or not chunks:
+        return None
+    try:
+        return pickle.loads(b"".join(chunks))
+    except Exception:  # a truncated hand-over: draw them here
+        return None
+
+
+def _end(child) -> None:
+    """Close the pipe and reap the child; kill it first if it is still drawing (the parent was interrupted
+    or failed)."""
+    pid, r = child
+    os.close(r)
+    try:
+        done, _ = os.waitpid(pid, os.WNOHANG)
+        if done == 0:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+    except ChildProcessError:  # already reaped by _collect
+        pass

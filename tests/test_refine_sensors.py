@@ -1,0 +1,38 @@
+"""``refine`` with default arguments on simulated sensors unlike the ADIS16405 (issue 29): the CI subset of
+``tests/sensors.py`` — a 25-hour 1 Hz log whose bias follows its temperature channel, a square wave's line
+family, sparse spikes. Each must be named with its parameters (20 %, frequencies 1 %), lower the errors in sample
+and held out, and leave nothing unexplained; refined without its effect's candidate, the model cannot be
+complete, and ``unexplained`` must say so. The whole suite (17 cases) is ``benches/refine_sensors.py``."""
+
+from __future__ import annotations
+
+import pytest
+
+import allanite
+import sensors
+
+CI_CASES = [c for c in sensors.CASES if c.ci]
+
+
+@pytest.fixture(scope="module", params=CI_CASES, ids=lambda c: c.name.split(",")[0])
+def case_record(request):
+    case = request.param
+    y, fs, channels = sensors.make(case)
+    return case, y, fs, ({"channels": channels} if channels else {})
+
+
+def test_the_default_call_names_the_effect_and_leaves_nothing_unexplained(case_record):
+    case, y, fs, kw = case_record
+    r = allanite.refine(y, fs, unit=case.unit, progress=False, **kw)
+    v = sensors.judge(r, case)
+    assert v["named"] and v["params"], (r.found, v["param_errors"])
+    assert v["falling"] and v["heldout_falling"], (v.get("rms_adev_pct"), v.get("heldout_rms_adev_pct"))
+    assert v["explained"], [u["what"] for u in r.unexplained]
+
+
+def test_without_its_candidate_the_model_says_what_it_misses(case_record):
+    case, y, fs, kw = case_record
+    r = allanite.refine(y, fs, unit=case.unit, candidates=sensors.candidates_without(case), progress=False, **kw)
+    assert not set(r.found) & {i.effect for i in case.injected}
+    assert r.unexplained, f"{case.name}: refined without {[i.effect for i in case.injected]}, nothing said"
+    assert "still misses" in r.report() and all(u["alpha"] > 0 for u in r.unexplained)

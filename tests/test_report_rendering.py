@@ -1,0 +1,56 @@
+"""The report's figures drawn on two processes: the same PNG bytes, in the same order, as drawn one after
+another; a figure failing in the child is drawn again (and fails) in the parent."""
+
+import os
+
+import numpy as np
+import pytest
+
+from allanite.report.rendering import figure_processes, render_pngs
+
+pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="figures are drawn on two processes only with fork")
+
+
+def _spec(k, fail=False):
+    def draw(fig):
+        if fail:
+            raise ValueError(f"figure {k} cannot be drawn")
+        ax = fig.add_subplot()
+        x = np.logspace(-2, 3, 40)
+        ax.loglog(x, (k + 1) / np.sqrt(x), marker=".")
+        ax.set_title(f"figure {k}")
+        ax.grid(True, which="both")
+
+    return (f"f{k}.png", f"figure {k}", "caption", (2.4, 1.8), draw)
+
+
+def test_two_processes_give_the_serial_bytes_in_order():
+    specs = [_spec(k) for k in range(5)]
+    steps_1, steps_2 = [], []
+    serial = render_pngs(specs, 60, steps_1.append, processes=1)
+    split = render_pngs(specs, 60, steps_2.append, processes=2)
+    assert list(split) == [f"f{k}.png" for k in range(5)] == list(serial)
+    assert all(split[k] == serial[k] for k in serial)
+    assert all(v.startswith(b"\x89PNG") for v in split.values())
+    assert len(set(split.values())) == 5  # five different figures, not one repeated
+    assert sorted(steps_2) == sorted(steps_1) == sorted(f"figure f{k}.png" for k in range(5))
+
+
+def test_a_figure_failing_in_the_child_fails_in_the_parent():
+    specs = [_spec(0), _spec(1, fail=True), _spec(2), _spec(3)]  # odd indices go to the child
+    with pytest.raises(ValueError, match="figure 1 cannot be drawn"):
+        render_pngs(specs, 60, lambda text: None, processes=2)
+
+
+def test_figure_processes_is_one_or_two():
+    assert figure_processes() in (1, 2)
+
+
+def test_a_report_drawn_in_a_worker_thread_forks_nothing():
+    import threading
+
+    seen = []
+    t = threading.Thread(target=lambda: seen.append(figure_processes()))
+    t.start()
+    t.join()
+    assert seen == [1]
