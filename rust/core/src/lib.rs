@@ -10,6 +10,8 @@ pub mod deviations;
 pub mod error;
 mod gather;
 mod oavar;
+pub mod phase_terms;
+pub mod streaming;
 pub mod taper;
 pub mod theo;
 
