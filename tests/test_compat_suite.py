@@ -1,41 +1,37 @@
 """allantools 2024.6's own test suite, run against allanite.compat (issue 31).
 
-The sdist is downloaded from PyPI into a cache outside the clone (tests/allantools_sdist.py: ``pip
+The sdist is downloaded from PyPI into a cache outside the clone (benches/_allantools_sdist.py: ``pip
 download``, sha256 pinned), its ``tests/`` unpacked into a temporary folder and run by pytest in a
 subprocess where a meta-path blocker makes the real allantools unimportable (asserted) and
 ``install_as_allantools()`` makes ``allantools`` and its submodules resolve to allanite.compat; np.random
-is seeded per test (tests/allantools_suite_plugin.py). Every test that passes on allantools 2024.6
-itself (all of them, seeded the same way: docs/compat.md has the counts) must pass here, except those
-in ``EXCEPTIONS`` (none today) — xfail tests may xfail or xpass. Under ``CI=true`` a failed download
-fails; elsewhere it skips with the reason. Nothing of allantools is stored in this repository.
+is seeded per test (benches/_allantools_suite_plugin.py; both are bench helpers, loaded here by their
+path). Every test that passes on allantools 2024.6 itself (all of them, seeded the same way:
+docs/compat.md has the counts) must pass here, except those in ``EXCEPTIONS`` (none today; the slow cases
+in ``DESELECTED`` run in benches/compat_suite.py) — xfail tests may xfail or xpass. Under ``CI=true`` a
+failed download fails; elsewhere it skips with the reason. Nothing of allantools is stored here.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import subprocess
 from pathlib import Path
 
 import pytest
 
-import allantools_sdist as sdist
+BENCHES = Path(__file__).resolve().parents[1] / "benches"
 
-#: the suite's size as allantools 2024.6 collects it (all of it runs there; docs/compat.md)
-COLLECTED = 358
 
-#: slow cases left to ``benches/compat_bench.py --suite`` (they pass there, docs/compat.md): each reads
-#: the 556 990-point Cs 5071A record from its gzip text once per row of its Stable32 table, ~10 s of the
-#: test's own file parsing per test, whatever computes the deviations
-DESELECTED = [
-    f"tests/Cs5071A/test_CS5071A_decade.py::TestCS::test_{name}_ci"
-    for name in ("adev", "oadev", "mdev", "hdev", "ohdev", "totdev")
-]
+def _load(name: str):
+    spec = importlib.util.spec_from_file_location(name, BENCHES / f"{name}.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
 
-#: {node id: reason} of tests that pass on allantools 2024.6 but not on allanite.compat
-EXCEPTIONS: dict[str, str] = {}
 
-#: skipped by allantools' suite itself (``@pytest.mark.skip``)
-SKIPPED = ["tests/ocxo/test_ocxo.py::TestOCXO::test_totdev_ci"]
+sdist = _load("_allantools_sdist")
+COLLECTED, DESELECTED, EXCEPTIONS, SKIPPED = sdist.COLLECTED, sdist.DESELECTED, sdist.EXCEPTIONS, sdist.SKIPPED
 
 
 @pytest.fixture(scope="module")
@@ -68,8 +64,7 @@ def test_allantools_suite_passes_on_compat(suite_root, tmp_path):
 
 
 def test_the_blocker_refuses_the_real_allantools():
-    import allantools_suite_plugin as plugin
-
+    plugin = _load("_allantools_suite_plugin")
     with pytest.raises(ImportError, match="allantools.ci: the real allantools is blocked"):
         plugin.RealAllantoolsBlocker().find_spec("allantools.ci")
     assert plugin.RealAllantoolsBlocker().find_spec("allanite") is None

@@ -26,11 +26,16 @@ def confidence_interval(dev, edf, ci=ONE_SIGMA_CI):
     >>> round(float(lo), 4), round(float(hi), 4)
     (0.7391, 1.5931)
     """
+    c = check_ci(ci)
+    lo, hi = chi2_interval(np.square(dev), edf, max(c, 1.0 - c))
+    return np.sqrt(lo), np.sqrt(hi)
+
+
+def check_ci(ci) -> float:
     c = float(ci)
     if not 0.0 < c < 1.0:
         raise ParameterError(f"ci must be a probability in (0, 1), got {ci!r}")
-    lo, hi = chi2_interval(np.square(dev), edf, max(c, 1.0 - c))
-    return np.sqrt(lo), np.sqrt(hi)
+    return c
 
 
 def edf_simple(N, m, alpha):

@@ -32,7 +32,7 @@ from .. import _core
 from .._validate import check_count
 from ..errors import InputError, ParameterError
 from ._input import Arrays, NoTauError, Record, averaging_factors, check_rate, finish, refuse_nonfinite, with_errs
-from ._intervals import confidence_interval, edf_simple
+from ._intervals import check_ci, confidence_interval, edf_simple
 from ._tools import (
     frequency2fractional,
     frequency2phase,
@@ -112,7 +112,7 @@ def adev(data, rate=1.0, data_type="phase", taus=None) -> Arrays:
     >>> x = [0, 103.11111, 123.22222, 157.33333, 166.44444, 48.55555, -96.33333, -2.22222, 111.88889, 0]
     >>> taus, devs, errs, ns = adev(x, taus=[1, 2])
     >>> devs.round(4).tolist(), ns.tolist()
-    [[91.2294, 115.8082], [8.0, 3.0]]
+    ([91.2294, 115.8082], [8.0, 3.0])
     """
     rec = Record(data, rate, data_type)
     ms = averaging_factors(taus, rec.n, rec.rate)
@@ -346,16 +346,20 @@ def gradev(data, rate=1.0, data_type="phase", taus=None, ci=0.9, noisetype="wp")
     ms, sums, counts = ms[keep], sums[keep], counts[keep].astype(np.float64)
     devs = np.sqrt(sums / (2.0 * counts)) * rec.rate / ms
     n_present = int(np.count_nonzero(~np.isnan(rec.phase)))
-    bounds = np.array([_gradev_bounds(d, m, n_present, noisetype, ci) for d, m in zip(devs, ms)]).reshape(-1, 2)
-    return ms / rec.rate, devs, [devs - bounds[:, 0], bounds[:, 1] - devs], counts
+    lo, hi = _gradev_bounds(devs, ms, n_present, noisetype, ci)
+    return ms / rec.rate, devs, [devs - lo, hi - devs], counts
 
 
-def _gradev_bounds(dev: float, m: float, n_present: int, noisetype, ci) -> tuple[float, float]:
-    """gradev's interval at one τ; NaN where SP 1065's formula has no positive EDF (too few points)."""
-    try:
-        lo, hi = confidence_interval(dev, edf_simple(n_present, m, _GRADEV_NOISE.get(noisetype)), ci)
-    except ParameterError:
-        if not 0.0 < float(ci) < 1.0:
-            raise
-        return np.nan, np.nan
-    return float(lo), float(hi)
+def _gradev_bounds(devs: np.ndarray, ms: np.ndarray, n_present: int, noisetype, ci) -> tuple[np.ndarray, np.ndarray]:
+    """gradev's χ² bounds at every τ; NaN where SP 1065's formula has no EDF (N < 2m + 1 points)."""
+    check_ci(ci)
+    alpha = _GRADEV_NOISE.get(noisetype)
+    edf = np.full(ms.size, np.nan)
+    ok = n_present >= 2 * ms + 1
+    if ok.any():
+        edf[ok] = edf_simple(n_present, ms[ok], alpha)
+    ok &= edf > 0
+    lo, hi = np.full(ms.size, np.nan), np.full(ms.size, np.nan)
+    if ok.any():
+        lo[ok], hi[ok] = confidence_interval(devs[ok], edf[ok], ci)
+    return lo, hi

@@ -22,7 +22,7 @@ class Dataset:
     >>> from allanite.compat import Dataset
     >>> ds = Dataset(data=np.arange(100.0) ** 2, rate=1.0)
     >>> r = ds.compute("oadev")
-    >>> ds.out["stat_id"], r["taus"][:3].tolist(), float(r["stat"][0])
+    >>> ds.out["stat_id"], r["taus"][:3].tolist(), round(float(r["stat"][0]) ** 2, 12)  # AVAR = (Δ²x)²/2
     ('oadev', [1.0, 2.0, 4.0], 2.0)
     """
 

@@ -1,4 +1,5 @@
-"""pytest plugin for running allantools' own test suite in a subprocess (tests/test_compat_suite.py).
+"""pytest plugin for running allantools' own test suite in a subprocess (tests/test_compat_suite.py,
+benches/compat_suite.py; started by _allantools_sdist.run_suite).
 
 With ``ALLANITE_SUITE_TARGET=compat`` (the default) a meta-path blocker makes the real allantools
 unimportable — asserted before anything else — and ``allanite.compat.install_as_allantools()`` makes
