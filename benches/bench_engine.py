@@ -15,8 +15,8 @@ them). The DAVAR τ lists are the issue's "exp grid": m = unique(round(1.073^k))
    every value checked against an extended-precision (np.longdouble) recomputation, and the time
    put against a STREAM-like copy of the record measured in the same run (ns per sample and τ).
 
-The dense-τ classic AVAR case is ``benches/bench_classic.py``. A full run also rewrites the README's speed
-table (between ``<!-- bench-table -->`` and ``<!-- /bench-table -->``) from these numbers.
+The dense-τ classic AVAR case is ``benches/bench_classic.py``. A full run also rewrites the speed
+table of docs/performance.md (between ``<!-- bench-table -->`` and ``<!-- /bench-table -->``) from these numbers.
 
 Timing: ``time.perf_counter``; allanite gets one untimed warm-up call, then the best of 5 repeats (3 with
 ``--quick``); fast baselines (davar_prefix in cases 1–2) best of as many, slow ones (davar_prefix in case 3, allantools)
@@ -685,13 +685,13 @@ def run(quick: bool = False, out: Path | None = None, wait: float = 0.0) -> dict
     log((out / "engine.md").read_text(encoding="utf-8"))
     log(f"wrote {out / 'engine.json'} and {out / 'engine.md'} ({report['total_seconds']:.1f} s)")
     if not quick and out.resolve() == (HERE / "results").resolve():
-        write_readme_table(report, REPO / "README.md")
-        log(f"rewrote the speed table in {REPO / 'README.md'}")
+        write_speed_table(report, REPO / "docs" / "performance.md")
+        log(f"rewrote the speed table in {REPO / 'docs' / 'performance.md'}")
     return report
 
 
-def write_readme_table(report: dict, readme: Path) -> None:
-    """The README's speed table from a full run, between its ``<!-- bench-table -->`` markers."""
+def write_speed_table(report: dict, page: Path) -> None:
+    """docs/performance.md's speed table from a full run, between its ``<!-- bench-table -->`` markers."""
     m, cases = report["machine"], report["cases"]
 
     def comp(key, which):
@@ -744,13 +744,13 @@ def write_readme_table(report: dict, readme: Path) -> None:
         f"{a4['workers1_ns_per_sample_per_tau'] / cases['case4']['roofline']['ns_per_sample']:.2f} record copies) | "
         f"allantools.oadev {_fmt_s(c4['seconds'])} s | {_fmt_ratio(c4['ratio'])} | ≥ 25× — {met('case4')} |"
     )
-    text = readme.read_text(encoding="utf-8")
+    text = page.read_text(encoding="utf-8")
     start, end = "<!-- bench-table -->", "<!-- /bench-table -->"
     if start not in text or end not in text:
-        raise SystemExit(f"{readme}: the speed table's markers {start} … {end} are missing")
+        raise SystemExit(f"{page}: the speed table's markers {start} … {end} are missing")
     head, rest = text.split(start, 1)
     _old, tail = rest.split(end, 1)
-    readme.write_text(head + start + "\n" + "\n".join(rows) + "\n" + end + tail, encoding="utf-8")
+    page.write_text(head + start + "\n" + "\n".join(rows) + "\n" + end + tail, encoding="utf-8")
 
 
 def main(argv=None) -> int:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import io
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -56,8 +57,17 @@ def test_report_on_a_npy_log(tmp_path, npy_log, capsys):
     captured = capsys.readouterr()
     printed = captured.out
     assert captured.err == ""
-    assert printed.startswith("allanite report: gyro.npy")
-    assert "6000 samples × 1 axes (col0) at 50 Hz" in printed and "unit rad/s" in printed
+    # stdout is no terminal here: a line per step as it starts, then the summary (issue 32)
+    stages = printed[: printed.index("allanite report: gyro.npy")].splitlines()
+    assert [line.split("] ", 1)[1] for line in stages[:4]] == [
+        "reading gyro.npy",
+        "static Allan deviation",
+        "confidence intervals",
+        "dynamic Allan variance",
+    ]
+    assert all(line.startswith("[") and " s] " in line for line in stages)
+    assert stages[-1].endswith("] writing report.html, summary.json")
+    assert "6000 samples × 1 axis (col0) at 50 Hz" in printed and "unit rad/s" in printed
     assert "Overlapping Allan deviation (rad/s)" in printed
     assert "Dynamic Allan deviation: window 1200 samples (24 s, given), hop 300 (6 s, given)" in printed
     summary = json.loads((out / "summary.json").read_text())
@@ -369,7 +379,8 @@ def test_report_errors_exit_2_with_one_line(tmp_path, monkeypatch, capsys, args,
     err = captured.err
     assert err.startswith("allanite: error: ") and message in err
     assert err.count("\n") == 1 and "Traceback" not in err
-    assert captured.out == ""
+    # stdout is no terminal here: at most the steps reached before the error, one line each
+    assert all(re.fullmatch(r"\[ *\d+\.\d s\] .+", line) for line in captured.out.splitlines()), captured.out
     assert not (tmp_path / "out").exists()
 
 

@@ -472,6 +472,7 @@ def test_cli_batch_on_a_given_scheduler(tmp_path):
         )
     assert run.returncode == 3, run.stderr  # 3: some files failed (the malformed one)
     assert "3 files: 2 reported, 0 skipped (resume), 1 failed" in run.stdout
+    assert "allanite batch:" not in run.stderr and "\r" not in run.stderr  # no progress bar into a pipe (issue 32)
     assert "bad.csv.gz" in run.stdout
     assert "allanite-report" in prefixes and len(workers) == 2
     for rel in ("a/s0", "a/s1"):

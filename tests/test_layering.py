@@ -124,6 +124,50 @@ def test_imports_run_one_way(module):
     assert up == [], f"{module} imports upward: {up}"
 
 
+#: Inside ``model``, bottom up: a model module imports only model modules of a lower rank. The registries of
+#: terms and effects and the covariance; the fit and the tracing tools; then refine's house — its false-alarm
+#: budget, the weighted fit with effects, the errors in-sample and held out, the curve test and the result,
+#: the proposals per domain (curve candidates, removals in time, change points), the loop, the package.
+MODEL_RANKS = {
+    "model._covariance": 0,
+    "model.terms": 0,
+    "model.effects": 0,
+    "model.fitting": 1,
+    "model.tracing": 1,
+    "model.timeframes": 2,
+    "model.warmup": 2,
+    "model.refinement.levels": 2,
+    "model.refinement.curvefit": 3,
+    "model.refinement.scoring": 4,
+    "model.refinement.calibrated": 5,
+    "model.refinement.result": 5,
+    "model.refinement.candidates": 6,
+    "model.refinement.removals": 6,
+    "model.refinement.changes": 6,
+    "model.refinement.missing": 7,
+    "model.refinement.loop": 8,
+    "model.refinement": 9,
+    "model": 10,
+}
+MODEL_MODULES = sorted(m for m in MODULES if m.split(".")[0] == "model")
+
+
+def test_every_model_module_has_a_rank():
+    assert sorted(m for m in MODEL_MODULES if m not in MODEL_RANKS) == []
+
+
+@pytest.mark.parametrize("module", MODEL_MODULES)
+def test_model_imports_run_one_way(module):
+    own = MODEL_RANKS[module]
+    # a package assembling its own submodules is not an import across ranks
+    up = [
+        (t, line)
+        for t, _, line, _ in _imports(module)
+        if t.split(".")[0] == "model" and not t.startswith(module + ".") and MODEL_RANKS.get(t, own + 1) >= own
+    ]
+    assert up == [], f"{module} imports model modules of its own rank or above: {up}"
+
+
 @pytest.mark.parametrize("module", sorted(MODULES))
 def test_no_private_names_across_modules(module):
     bad = [

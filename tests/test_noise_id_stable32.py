@@ -16,7 +16,7 @@ import pytest
 import allanite
 import stable32_noise_id as s32cmp
 from allanite.errors import ParameterError
-from allanite.estimators.confidence import ID_MIN_POINTS, confidence_intervals, identify_alpha
+from allanite.estimators.confidence import ACF_MIN_POINTS, ID_MIN_POINTS, confidence_intervals, identify_alpha
 from test_confidence import TIC_ADEV_DIFFERENCES, half_ulp5
 
 # ------------------------------------------------------------------------------------------
@@ -52,12 +52,84 @@ def test_fallback_none_is_the_old_behaviour():
     y = np.random.default_rng(0).normal(size=2**17)
     r = allanite.avar(y, 50.0)
     old = r.with_confidence(y, fallback="none")
-    new = r.with_confidence(y)
+    new = r.with_confidence(y, fallback="previous")
     assert old.alpha[-1] == 1
     points = y.size // r.m
     own = points >= ID_MIN_POINTS["oavar"]
     assert np.array_equal(old.alpha[own], new.alpha[own])  # where enough samples remain: unchanged
     assert np.all(new.alpha[~own] == new.alpha[own][-1])
+
+
+# ------------------------------------------------------------------------------------------
+# issue 32: a rise of α read on few points (the default, fallback="prudent")
+
+
+def test_white_noise_long_tau_keeps_white_fm():
+    """The issue's record: Stable32's rule reads flicker phase (α = +1) at m = 4096 (32 τ-intervals, lag-1
+    ACF) and 8192 (16, B1) between white-FM neighbours, and ν jumps from 94 to 511 — an interval 2.3×
+    too narrow where the data are scarce. The prudent rule keeps α = 0 there."""
+    y = np.random.default_rng(101).standard_normal(2**17) * 0.05
+    r = allanite.avar(y, 100.0)
+    stable32 = r.with_confidence(y, fallback="previous")
+    at = np.isin(r.m, [4096, 8192])
+    assert stable32.alpha[at].tolist() == [1, 1] and stable32.edf[at][0] > 500
+    new = r.with_confidence(y)
+    assert new.alpha[at].tolist() == [0, 0]
+    assert np.all(new.edf[at] <= 94)
+    assert np.all(new.alpha == 0)
+    assert np.all(np.diff(new.edf) < 0)
+
+
+@pytest.mark.parametrize("estimator", ["oavar", "avar"])
+def test_octave_grid_nu_falls_unless_alpha_changes(estimator):
+    """On one record and the octave grid: ν does not rise with m where α stays, and α is above both
+    neighbours only where each τ of that rise was identified on ≥ 30 τ-intervals (white, flicker and
+    random-walk rate records, 2¹⁶ samples, 12 seeds each)."""
+    for seed in range(12):
+        rng = np.random.default_rng(seed)
+        white = rng.normal(size=2**16)
+        for y in (
+            white,
+            np.cumsum(rng.normal(size=2**16)) * 1e-2 + white,
+            allanite.simulate(2**16, 1.0, B=1.0, seed=seed),
+        ):
+            r = allanite.avar(y, 1.0, estimator=estimator)
+            ci = r.with_confidence(y)
+            a, nu, points = ci.alpha, ci.edf, y.size // r.m
+            same = a[1:] == a[:-1]
+            assert np.all(np.diff(nu)[same] < 0), (seed, a, nu)
+            for i in range(1, a.size - 1):
+                j = i
+                while j + 1 < a.size and a[j + 1] == a[i]:
+                    j += 1
+                if j + 1 < a.size and a[i] > a[i - 1] and a[i] > a[j + 1]:
+                    assert np.all(points[i : j + 1] >= ACF_MIN_POINTS), (seed, a, points)
+            # the rule only levels: where it changed α, to the α before the rise
+            prev = r.with_confidence(y, fallback="previous").alpha
+            assert np.all(a <= prev)
+
+
+def test_prudent_rule_leaves_dense_grids_and_dips_alone():
+    from allanite.estimators.confidence import _level_weak_peaks
+
+    m = 2 ** np.arange(8)
+    few = np.array([100, 50, 40, 29, 20, 15, 9, 8])
+    assert _level_weak_peaks(np.array([0, 0, 0, 1, 1, 0, 0, 0]), m, few).tolist() == [0] * 8
+    assert _level_weak_peaks(np.array([0, 0, 1, 2, 1, 0, 0, 0]), m, few).tolist() == [0] * 8  # nested rise
+    assert _level_weak_peaks(np.array([0, 0, 0, -1, -1, 0, 0, 0]), m, few).tolist() == [0, 0, 0, -1, -1, 0, 0, 0]
+    assert _level_weak_peaks(np.array([0, 1, 0, 0, 0, 0, 0, 0]), m, few).tolist() == [0, 1, 0, 0, 0, 0, 0, 0]  # 50 ≥ 30
+    assert _level_weak_peaks(np.array([0, 0, 0, 0, 0, 0, 1, 1]), m, few).tolist() == [
+        0,
+        0,
+        0,
+        0,
+        0,
+        0,
+        1,
+        1,
+    ]  # no right side
+    dense = np.arange(1, 9)
+    assert _level_weak_peaks(np.array([0, 0, 0, 1, 1, 0, 0, 0]), dense, few).tolist() == [0, 0, 0, 1, 1, 0, 0, 0]
 
 
 # ------------------------------------------------------------------------------------------

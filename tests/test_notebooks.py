@@ -14,6 +14,9 @@ from pathlib import Path
 import pytest
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+#: Where the run with the shared data leaves each executed notebook; the documentation site renders these
+#: (docs/_site/hooks.py), so its notebooks show their outputs without the site's build running them.
+EXECUTED = EXAMPLES.parent / "build" / "notebooks" / "examples"
 NOTEBOOKS = sorted(EXAMPLES.glob("*.ipynb"))
 CELL_TIMEOUT = 120  # s, per cell; every notebook runs in well under a minute
 
@@ -35,8 +38,9 @@ def test_outputs_are_stripped(path):
     assert dirty == [], f"{path.name}: cells {dirty} carry outputs; strip them before committing"
 
 
-def _run(path, monkeypatch, shared: str):
-    """Run the notebook with ``ALLANITE_SHARED_DATA=shared``; returns the executed notebook."""
+def _run(path, monkeypatch, shared: str, keep: Path | None = None):
+    """Run the notebook with ``ALLANITE_SHARED_DATA=shared``; returns the text of its outputs and, with
+    ``keep``, writes the executed notebook there."""
     nbformat = pytest.importorskip("nbformat", reason="nbformat is needed to run the notebooks (test extra)")
     nbclient = pytest.importorskip("nbclient", reason="nbclient is needed to run the notebooks (test extra)")
     pytest.importorskip("ipykernel", reason="ipykernel is needed to run the notebooks (test extra)")
@@ -52,6 +56,9 @@ def _run(path, monkeypatch, shared: str):
     # every result the notebook shows renders as HTML (the rich display), not only as text
     html = [o for c in book.cells if c.cell_type == "code" for o in c.outputs if "text/html" in o.get("data", {})]
     assert html, f"{path.name}: no rich result displayed"
+    if keep is not None:
+        keep.mkdir(parents=True, exist_ok=True)
+        nbformat.write(book, keep / path.name)
     return "".join(o.get("text", "") for c in book.cells if c.cell_type == "code" for o in c.outputs)
 
 
@@ -59,7 +66,7 @@ def _run(path, monkeypatch, shared: str):
 def test_notebook_runs(path, monkeypatch):
     # the shared data: the tests' default (../shared/data from the repository) made absolute for the kernel
     shared = os.environ.get("ALLANITE_SHARED_DATA", str(EXAMPLES.parent.parent / "shared" / "data"))
-    text = _run(path, monkeypatch, str(Path(shared).resolve()))
+    text = _run(path, monkeypatch, str(Path(shared).resolve()), keep=EXECUTED)
     uses_shared = path.name != "02_dynamic_view.ipynb"  # 02 simulates on purpose (a known change)
     if uses_shared and Path(shared).is_dir():
         assert "real data" in text

@@ -205,8 +205,8 @@ def test_bundled_report_html_is_self_contained(bundled):
     rc, out, stdout, stderr = bundled
     html = (out / "report.html").read_text(encoding="utf-8")
     shown = check_self_contained(html, out)
-    # every per-axis figure is on the page (davar.png repeats the per-axis heat maps and is a file only)
-    assert set(shown) == expected_figures(3) - {"davar.png"}
+    # every figure written is on the page (issue 32: davar.png, all axes on one time axis, was a file only)
+    assert set(shown) == expected_figures(3)
     for section in ('id="record"', 'id="static"', 'id="model"', 'id="davar"', 'id="series"'):
         assert section in html
     summary = json.loads((out / "summary.json").read_text())
@@ -267,7 +267,8 @@ def test_bundled_report_summary_matches_the_library(bundled):
 def test_bundled_report_prints_tables_and_paths(bundled):
     rc, out, stdout, stderr = bundled
     summary = json.loads((out / "summary.json").read_text())
-    assert stdout.startswith("allanite report: bundled record")
+    assert stdout.startswith("[") and "] generating the bundled record\n" in stdout  # a line per step: no terminal
+    assert "\nallanite report: bundled record" in stdout
     assert "Overlapping Allan deviation (°/s)" in stdout and "68.3% interval" in stdout
     # one table row per τ, with the ADEV of each axis as in summary.json
     st = summary["static"]
@@ -315,7 +316,7 @@ def test_adis_report_end_to_end(adis):
     for p in out.glob("*.png"):
         check_png(p)
     html = (out / "report.html").read_text(encoding="utf-8")
-    assert len(check_self_contained(html, out)) == len(expected_figures(3)) - 1
+    assert len(check_self_contained(html, out)) == len(expected_figures(3))  # davar.png too (issue 32)
     assert "adis16405_run1_100Hz.csv.gz" in html and "gyro_z" in html
 
     summary = json.loads((out / "summary.json").read_text())
@@ -441,6 +442,35 @@ def test_plots_draw_on_given_axes_and_on_their_own():
         assert ax3.name == "3d" and ax3.get_zlabel() == "log₁₀ ADEV (°/s)"
         fig, ax = plt.subplots()
         assert s.plot(ax=ax, axis=0) is ax and len(ax.lines) == 1
+    finally:
+        plt.close("all")
+
+
+def test_plot_labels_name_each_line_and_only_the_lines():
+    # issue 32: ``ax.legend(names)`` after ``r.plot()`` paired the names with the bands; ``labels=`` names lines
+    import matplotlib.pyplot as plt
+
+    x, fs, _ = allanite.default_record()
+    x = x[:30_000]
+    s = allanite.avar(x, fs).with_confidence(x)
+    names = ["gyro_x", "gyro_y", "gyro_z"]
+    try:
+        ax = s.plot(labels=names)
+        handles, texts = ax.get_legend_handles_labels()
+        assert texts == names
+        assert all(h in ax.lines for h in handles)  # lines, not the interval bands
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == names
+        ax = s.plot(labels=names, axis=1)
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == ["gyro_y", "68.3% interval"]
+        one = allanite.avar(x[:, 0], fs)
+        ax = one.plot(labels="gyro_x")
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == ["gyro_x"]
+        ax = s.plot()
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == ["axis 0", "axis 1", "axis 2"]
+        with pytest.raises(allanite.AllaniteError, match="labels has 2 name.* of 3 axes: give one label per axis"):
+            s.plot(labels=names[:2])
+        with pytest.raises(allanite.AllaniteError, match="labels has 3 name.* of 1 axis"):
+            one.plot(labels=names)
     finally:
         plt.close("all")
 

@@ -3,6 +3,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
+#: The package version (the Rust crates' version, Cargo.toml).
 __version__: str
 
 def davar(

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import textwrap
 
 import numpy as np
 
@@ -301,12 +302,15 @@ def davar(
         ``"fast"``: sliding block sums, O(record) work per τ whatever the window and hop, exact to
         rounding (no drift, see the core's notes). ``"naive"``: recompute every window from
         scratch — paper 000's DAVAR, O(window) per τ per window; kept as a reference and baseline.
-    estimator : {"oavar", "avar", "theoh", "theoh_a"}
-        Overlapping (default) or classic Allan variance inside each window; or paper 001's dynamic
-        TheoH: ``"theoh"`` (DHVAR: overlapping Allan up to 10 % of the window, TheoBR with the
-        window's own bias ratio beyond, to 75 % of the window) or ``"theoh_a"`` (DHVAR-A: classic
-        Allan below the switch). Theo values belong to τ = 0.75·m/fs; ``result.source`` names the
-        estimator of each τ, ``result.kf`` every window's bias ratio. ``method="fast"`` only.
+    estimator : str
+        Every estimator of the registry with a dynamic form: {dynamic_estimators}.
+        ``"oavar"`` (default) or ``"avar"``: overlapping or classic Allan variance inside each window;
+        ``"ohvar"``: the overlapping Hadamard variance of each window (blind to a rate ramp); paper
+        001's dynamic TheoH: ``"theoh"`` (DHVAR: overlapping Allan up to 10 % of the window, TheoBR
+        with the window's own bias ratio beyond, to 75 % of the window) or ``"theoh_a"`` (DHVAR-A:
+        classic Allan below the switch) — Theo values belong to τ = 0.75·m/fs; ``result.source``
+        names the estimator of each τ, ``result.kf`` every window's bias ratio; ``method="fast"``
+        only. The rest of the deviation family is static only (:func:`avar`): {static_only}.
     input : {"rate", "increment", "angle"}
     workers : int, optional
         Threads (default ``ALLANITE_NUM_THREADS``, else all cores); results are bit-identical for
@@ -461,6 +465,29 @@ def davar(
 
 #: DHVAR work (windows × window length) from which ``progress=None`` shows a bar (some seconds).
 DHVAR_BAR_SAMPLES = 2_000_000
+
+
+def _registry_words(text: str) -> str:
+    """``text`` with ``{dynamic_estimators}`` and ``{static_only}`` filled from the estimator registry,
+    each placeholder's line re-wrapped to the docstring's width."""
+    dynamic = estimators.names("dynamic")
+    fill = {
+        "{dynamic_estimators}": ", ".join(f'``"{n}"``' for n in dynamic),
+        "{static_only}": ", ".join(f'``"{n}"``' for n in estimators.names("static") if n not in dynamic),
+    }
+    lines = []
+    for line in text.split("\n"):
+        if any(k in line for k in fill):
+            for k, v in fill.items():
+                line = line.replace(k, v)
+            indent = line[: len(line) - len(line.lstrip())]
+            line = textwrap.fill(line.strip(), width=104, initial_indent=indent, subsequent_indent=indent)
+        lines.append(line)
+    return "\n".join(lines)
+
+
+if davar.__doc__:  # the accepted names come from the registry, so help(davar) cannot fall behind it
+    davar.__doc__ = _registry_words(davar.__doc__)
 
 
 def _in_groups(entry, cols, fs, window, hop, taus, method, workers, options, n_win, progress):

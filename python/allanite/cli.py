@@ -8,13 +8,16 @@ stderr (never a traceback); 1 an internal error (a bug: the traceback is shown);
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import re
+import shutil
 import sys
 import time
 import warnings
 from pathlib import Path
 
+import numpy as np
 from tqdm import tqdm
 
 from ._core import __version__
@@ -24,11 +27,13 @@ from .errors import AllaniteError
 from .io import read_log
 from .kalibr import to_kalibr
 from .model import fit as fit_model
+from .model.effects import EFFECTS
 from .report import build_report, from_log
 from .units import ACCEL_UNITS
 
 EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
+#: ``allanite --help``: what the command line does.
 DESCRIPTION = """\
 allanite: static and dynamic Allan variance for gyroscopes, IMUs and clocks.
 
@@ -38,6 +43,7 @@ commands:
   batch     one report per log of a fleet, as Dask tasks, and a fleet summary (fleet.csv,
             fleet.parquet, fleet.html); needs allanite[dask]"""
 
+#: ``allanite --help``, after the options: the exit statuses.
 EPILOG = """\
 Run 'allanite report --help' for the report's options; 'allanite report' alone analyses the
 bundled record (a simulated 3-axis gyro) and writes the report to ./allanite-report/.
@@ -48,6 +54,7 @@ exit status:
   2    usage or input error (one line on stderr: 'allanite: error: ...')
   130  interrupted"""
 
+#: ``allanite report --help``: what the report holds and the bundled record it runs on by default.
 REPORT_DESCRIPTION = """\
 Analyse a gyro/IMU/clock log: the overlapping Allan deviation with confidence intervals, the
 IEEE-952 noise model (quantization Q, angle random walk N, bias instability B, rate random walk K,
@@ -58,6 +65,7 @@ noise coefficients over time. Prints a summary and writes, into DIR, one self-co
 Without LOG it analyses the bundled record: a deterministic simulated 3-axis gyro, 1 h at 100 Hz
 in deg/s, whose angle random walk is 4x larger from 20 to 30 min."""
 
+#: ``allanite report --help``, after the options.
 REPORT_EPILOG = """\
 examples:
   allanite report                                 # the bundled record -> ./allanite-report/
@@ -75,16 +83,22 @@ files written to DIR:
   davar_axisK.png          axis K: DAVAR heat map (time x tau, log colour)
   davar3d_axisK.png        axis K: DAVAR surface (t, log10 tau, log10 ADEV)
   coefficients_axisK.png   axis K: noise coefficients per DAVAR window with intervals
+  refinement_axisK.png     axis K (--refine): starting and refined model, residuals before/after
   frames_axisK.png         axis K (--frames/--forecast): coefficients per frame with intervals
   forecast_axisK.png       axis K (--frames/--forecast): forecasts of the resolved coefficients
 
-A progress bar goes to stderr when it is a terminal; --quiet prints nothing but errors.
+A progress bar goes to stderr when it is a terminal; when stdout is not one (a pipe, a log file),
+each step is also printed there as it starts. --quiet prints nothing but errors.
 
 exit status:
   0    success
   1    internal error (a bug: please report it with the traceback)
   2    usage or input error (one line on stderr: 'allanite: error: ...')
   130  interrupted"""
+
+_KALIBR_NEEDS_UNIT = (
+    "--kalibr needs the gyro's unit to write SI values: give --unit (e.g. --unit deg/s or --unit rad/s)"
+)
 
 #: Options that describe a LOG file; meaningless for the bundled record.
 _LOG_OPTIONS = ("fs", "columns", "time_column", "time_unit", "unit", "input", "gaps", "accel_columns", "accel_unit")
@@ -104,6 +118,7 @@ def _formatter(prog):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``allanite`` argument parser: the ``report`` and ``batch`` subcommands and their options."""
     parser = _Parser(
         prog="allanite",
         usage="%(prog)s [-h] [--version] COMMAND [ARGS ...]",
@@ -139,7 +154,8 @@ def build_parser() -> argparse.ArgumentParser:
         "--columns",
         metavar="C1,C2,...",
         help="columns that are the samples, by name or 0-based index, comma-separated; one per "
-        "axis (default: every column but the time column)",
+        "axis (default: every column but the time column — or, when the header also names "
+        "accelerometer columns (acc_x, ...), the ones it names as gyro (gyro_x, ...))",
     )
     inp.add_argument("--time-column", metavar="C", help="column of sample times: derives --fs, finds gaps")
     inp.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), help="unit of the time column (default: s)")
@@ -197,8 +213,9 @@ def build_parser() -> argparse.ArgumentParser:
     ana.add_argument(
         "--refine",
         action="store_true",
-        help="also look for what the noise model lacks (Gauss-Markov, sinusoid, change points) and "
-        "add a model-refinement section; a few seconds per axis and million samples",
+        help="also look for what the noise model lacks ("
+        + ", ".join(e.label for e in EFFECTS.values() if e.domain != "channels")
+        + ") and add a model-refinement section; a few seconds per axis and million samples",
     )
     ana.add_argument("--no-fit", action="store_true", help="skip the noise-model fit (whole record and per window)")
     ana.add_argument(
@@ -254,9 +271,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 class _Progress:
-    """A tqdm bar over the report's steps, on stderr; off with --quiet or when stderr is no terminal."""
+    """A tqdm bar over the report's steps, on stderr; off with --quiet or when stderr is no terminal.
+    When stdout is no terminal (a pipe, a log file) each step is also printed there as it starts, with
+    the seconds since the start, so that a log shows where the run is."""
 
     def __init__(self, quiet: bool):
+        self.lines = not quiet and not _isatty(sys.stdout)
+        self.t0 = time.perf_counter()
         self.bar = tqdm(
             total=8,
             file=sys.stderr,
@@ -273,6 +294,8 @@ class _Progress:
             self.bar.update(1)
         self.started = True
         self.bar.set_description_str(name)
+        if self.lines:
+            print(f"[{time.perf_counter() - self.t0:7.1f} s] {name}", flush=True)
 
     def add(self, n: int) -> None:
         self.bar.update(n)
@@ -286,6 +309,13 @@ class _Progress:
         if self.started and self.bar.total is not None:
             self.bar.update(max(0, self.bar.total - self.bar.n))
         self.bar.close()
+
+
+def _isatty(stream) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError):  # no isatty, or a closed stream
+        return False
 
 
 # --------------------------------------------------------------------------------------------------
@@ -317,6 +347,7 @@ def _cli_words(message: str) -> str:
     )
     message = message.replace("drop fs=,", "drop --fs,").replace("time_unit=", "--time-unit")
     message = message.replace("(fs=… in Hz)", "(--fs HZ)").replace("(time_column=…)", "(--time-column C)")
+    message = re.sub(r"\btime_column='([^']*)'", r"--time-column \1", message).replace("columns=[…]", "--columns")
     return " ".join(message.split())
 
 
@@ -346,11 +377,47 @@ def _read(args, progress):
             **kwargs,
         )
     notes = [" ".join(str(w.message).split()) for w in caught]
+    if columns is None:
+        log, note = _gyro_columns(log)
+        notes += [note] if note else []
     return log, notes
+
+
+#: Column names that say "gyro" and "accelerometer" (case-insensitive): gyro_x, omega_y, angular_velocity.z,
+#: wx / gx; acc_x, accel_y, specific_force_z, ax.
+_GYRO_NAME = re.compile(r"gyr|omega|angular|ang_?vel|^[wg]_?[xyz]$", re.IGNORECASE)
+_ACCEL_NAME = re.compile(r"acc|specific_?force|^a_?[xyz]$", re.IGNORECASE)
+
+
+def _gyro_columns(log):
+    """Without --columns: a log with accelerometer columns beside others is analysed on the columns its
+    header names as gyro ones (with a note); when it names none, the user is asked (a usage error that
+    lists the columns). A log without accelerometer-named columns is analysed whole, as before."""
+    names = [str(c) for c in log.columns]
+    accel = [n for n in names if _ACCEL_NAME.search(n)]
+    if not accel or len(accel) == len(names):
+        return log, None
+    gyro = [i for i, n in enumerate(names) if _GYRO_NAME.search(n) and not _ACCEL_NAME.search(n)]
+    if not gyro:
+        raise _UsageError(
+            f"{log.path.name} has accelerometer columns ({', '.join(accel)}) beside others, and its header names "
+            f"none as a gyro: give the gyro's with --columns (the columns are: {', '.join(names)})"
+        )
+    pick = gyro if len(gyro) > 1 else gyro[0]
+    chosen = [names[i] for i in gyro]
+    left = [n for n in names if n not in chosen]
+    note = (
+        f"columns {', '.join(chosen)} analysed, chosen by their names (gyro); left out: {', '.join(left)} — "
+        "give --columns to choose others (and --accel-columns with --kalibr for the accelerometer)"
+    )
+    segments = None if log.segments is None else [np.asarray(seg)[:, pick] for seg in log.segments]
+    return dataclasses.replace(log, data=log.data[:, pick], columns=chosen, segments=segments), note
 
 
 def _kalibr(args, rep, progress) -> Path:
     """imu.yaml from the report's gyro fits and, with --accel-columns, the accelerometer's."""
+    if rep.unit is None:
+        raise _UsageError(_KALIBR_NEEDS_UNIT)
     if rep.fits is None:
         raise AllaniteError(f"--kalibr needs the noise-model fit: {rep.fit_error or 'drop --no-fit'}")
     if args.accel_columns is not None and args.log is None:
@@ -397,6 +464,7 @@ def _report(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise AllaniteError(f"--out {out}: exists and is not a folder")
+    out_existed = out.exists()
     t0 = time.perf_counter()
     progress = _Progress(quiet)
     try:
@@ -426,6 +494,8 @@ def _report(args) -> int:
                 rep = build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common)
             else:
                 log, notes = _read(args, progress)
+                if args.kalibr and log.unit is None:
+                    raise _UsageError(_KALIBR_NEEDS_UNIT)
                 if not quiet:
                     for note in notes:
                         progress.bar.write(f"allanite: warning: {note}", file=sys.stderr)
@@ -434,6 +504,10 @@ def _report(args) -> int:
             specs = rep.figure_specs()
             progress.expect(len(specs) + 1)
             paths = rep.write(out, progress)
+    except KeyboardInterrupt:
+        if not out_existed and out.is_dir():  # a folder this run made holds a half-written report at most
+            shutil.rmtree(out, ignore_errors=True)
+        raise
     finally:
         progress.close()
     if not quiet:

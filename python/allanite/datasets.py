@@ -22,7 +22,9 @@ from .simulation import ar1
 
 __all__ = ["default_record", "DEFAULT_FS", "DEFAULT_SEED"]
 
+#: Sampling rate of the bundled record, Hz.
 DEFAULT_FS = 100.0
+#: Seed of the bundled record's generator (the record is the same on every machine).
 DEFAULT_SEED = 20261122
 DEFAULT_DURATION_S = 3600.0
 DEFAULT_TERMS: dict[str, Any] = {

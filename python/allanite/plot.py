@@ -57,7 +57,13 @@ def _rows(result, axis):
 
 
 def plot_adev(
-    result, ax=None, unit: str | None = None, labels=None, axis: int | None = None, band: bool = True, **kwargs
+    result,
+    ax=None,
+    unit: str | None = None,
+    labels=None,
+    axis: int | None = None,
+    band: bool = True,
+    **kwargs,
 ):
     """Log-log ADEV against τ, one line per axis, with the confidence band when the result has
     intervals (:meth:`~allanite.AllanResult.with_confidence`).
@@ -68,14 +74,21 @@ def plot_adev(
     ax : matplotlib Axes, optional
     unit : str, optional
         Unit of the samples, for the y label.
-    labels : list of str, optional
-        Legend label per axis (default "axis 0", "axis 1", …; none for 1-D input).
+    labels : str or sequence of str, optional
+        Legend label of each axis' line, one per axis of the result (default "axis 0", "axis 1", …;
+        "Allan deviation" for 1-D input). With ``axis`` the label of that axis is used. Pass the names
+        here rather than to ``ax.legend``: the band of an interval is drawn too, and a list given to
+        ``legend`` afterwards would pair the names with the wrong artists.
     axis : int, optional
         Draw only this axis of a multi-axis result.
     band : bool
         Shade the confidence interval of each curve (when present).
     **kwargs
         Passed to ``Axes.loglog`` for the curves.
+
+    Returns
+    -------
+    matplotlib Axes
     """
     ax = _axes(ax)
     adev = np.atleast_2d(result.adev)
@@ -85,18 +98,9 @@ def plot_adev(
     if band and ci is not None:
         lo, hi = np.atleast_2d(ci[0]), np.atleast_2d(ci[1])
     rows = _rows(result, axis)
-    multi = adev.shape[0] > 1
-    if labels is None:
-        labels = [f"axis {k}" for k in range(adev.shape[0])] if multi else [None]
+    names = _line_labels(labels, adev.shape[0])
     for k in rows:
-        name = labels[k] if k < len(labels) else None
-        (line,) = ax.loglog(
-            result.tau,
-            adev[k],
-            marker=".",
-            label=name if (multi and axis is None) else (name or "Allan deviation"),
-            **kwargs,
-        )
+        (line,) = ax.loglog(result.tau, adev[k], marker=".", label=names[k], **kwargs)
         if lo is not None and hi is not None:
             band_label = None
             if len(rows) == 1:
@@ -105,9 +109,20 @@ def plot_adev(
     ax.set_xlabel("τ (s)")
     ax.set_ylabel(_adev_label(unit))
     ax.grid(True, which="both", alpha=0.3)
-    if len(rows) > 1 or lo is not None:
+    if len(rows) > 1 or lo is not None or labels is not None:
         ax.legend(fontsize="small")
     return ax
+
+
+def _line_labels(labels, n_axes: int) -> list[str]:
+    """One legend label per axis: the given ones (checked against the number of axes) or the defaults."""
+    if labels is None:
+        return [f"axis {k}" for k in range(n_axes)] if n_axes > 1 else ["Allan deviation"]
+    names = [labels] if isinstance(labels, str) else [str(v) for v in labels]
+    if len(names) != n_axes:
+        axes = "1 axis" if n_axes == 1 else f"{n_axes} axes"
+        raise AllaniteError(f"labels has {len(names)} name(s) for a result of {axes}: give one label per axis")
+    return names
 
 
 def plot_davar(result, ax=None, axis: int = 0, unit: str | None = None, cmap: str = "viridis", **kwargs):
@@ -184,6 +199,8 @@ def plot_fit(
     color: str = "C0",
     label: str = "fitted model",
     lw: float = 2.0,
+    term_decades: float | None = 1.0,
+    shade_unfitted: bool = True,
 ):
     """The fitted model and each term as its own dashed line, over the fit's estimates.
 
@@ -191,32 +208,70 @@ def plot_fit(
     ----------
     fit : NoiseFit
     tau : array_like, optional
-        Draw the model over min(tau)…max(tau) (default: the τ used in the fit).
+        Draw the model over min(tau)…max(tau) (default: the τ used in the fit). Where this reaches
+        past the τ the fit used (``tau_range="auto"`` leaves out the shortest τ when the model cannot
+        describe them), the model is drawn dotted there, as an extrapolation, not as a fit.
     points : bool
         Draw the estimates used in the fit with ±1σ bars (off when overlaying on :func:`plot_adev`).
     terms : bool
         Draw each non-zero term as a dashed line, labelled with its value.
+    term_decades : float or None
+        Draw each term only where its deviation is within this many decades below the model's
+        (default 1: where it matters to the curve); None draws every term over the whole fitted τ
+        range. Terms are not drawn over the τ the fit left out.
+    shade_unfitted : bool
+        Shade the τ outside the fitted range (when ``tau`` reaches past it) and label it "τ not fitted".
+
+    Returns
+    -------
+    matplotlib Axes
     """
     ax = _axes(ax)
-    lo = fit.tau[0] if tau is None else np.min(tau)
-    hi = fit.tau[-1] if tau is None else np.max(tau)
+    lo = fit.tau[0] if tau is None else min(np.min(tau), fit.tau[0])
+    hi = fit.tau[-1] if tau is None else max(np.max(tau), fit.tau[-1])
     grid = np.geomspace(lo, hi, 200)
+    inside = (grid >= fit.tau[0] * (1 - 1e-9)) & (grid <= fit.tau[-1] * (1 + 1e-9))
     if points:
         err = np.sqrt(fit.avar) * np.sqrt(2.0 / fit.edf) / 2.0  # 1σ of adev ≈ adev/√(2ν)
         ax.errorbar(fit.tau, np.sqrt(fit.avar), yerr=err, fmt="o", color="k", ms=4, label="estimate (±1σ)")
-    ax.loglog(grid, np.sqrt(fit.curve(grid)), color=color, lw=lw, label=label)
+    model = np.sqrt(fit.curve(grid))
+    ax.loglog(grid, np.where(inside, model, np.nan), color=color, lw=lw, label=label)
+    if not inside.all():
+        ax.loglog(grid, _outside(model, inside), color=color, lw=max(lw / 2, 0.8), ls=":", label=None)
+        if shade_unfitted:
+            _shade_unfitted(ax, lo, hi, fit.tau[0], fit.tau[-1])
     if terms:
         for name in fit.terms:
-            comp = fit.component(name, grid)
-            if np.any(comp > 0):
+            comp = np.sqrt(fit.component(name, grid))
+            keep = inside if term_decades is None else inside & (comp >= model * 10.0**-term_decades)
+            shown = np.where(keep, comp, np.nan)
+            if np.any(comp > 0) and np.any(np.isfinite(shown) & (shown > 0)):
                 c = fit.coefficients[name]
                 text = f"{name} = {c.ieee:.3g} {c.ieee_unit}" if c.ieee is not None else f"{name} = {c.value:.3g}"
-                ax.loglog(grid, np.sqrt(comp), ls="--", color=_TERM_STYLE[name], label=text)
+                ax.loglog(grid, shown, ls="--", color=_TERM_STYLE[name], label=text)
     ax.set_xlabel("τ (s)")
     ax.set_ylabel(_adev_label(unit or fit.unit))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize="small")
     return ax
+
+
+def _outside(values: np.ndarray, inside: np.ndarray) -> np.ndarray:
+    """``values`` outside the fitted range (NaN inside), joined to the fitted part at its ends."""
+    out = np.where(inside, np.nan, values)
+    idx = np.flatnonzero(inside)
+    if idx.size:
+        out[idx[0]] = values[idx[0]]
+        out[idx[-1]] = values[idx[-1]]
+    return out
+
+
+def _shade_unfitted(ax, lo: float, hi: float, fit_lo: float, fit_hi: float) -> None:
+    label: str | None = "τ not fitted"
+    for a, b in ((lo, fit_lo), (fit_hi, hi)):
+        if b > a * (1 + 1e-9):
+            ax.axvspan(a, b, color="0.5", alpha=0.12, lw=0, label=label)
+            label = None
 
 
 def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None):

@@ -104,7 +104,7 @@ class _ResultBase(RichDisplay):
         edf_method: str = "greenhall",
         chi2: str = "exact",
         b1_n: str = "terms",
-        fallback: str = "previous",
+        fallback: str = "prudent",
     ):
         """This result with χ² confidence intervals per τ (``edf``, ``ci_low``, ``ci_high``, ``alpha``).
 
@@ -141,7 +141,7 @@ class _ResultBase(RichDisplay):
 
     def _record_facts(self) -> list:
         """The summary lines every result shows: the record and the τ range."""
-        axes = f", {self.n_axes} axes" if self.n_axes else ""
+        axes = f", {self.n_axes} {'axis' if self.n_axes == 1 else 'axes'}" if self.n_axes else ""
         facts: list = [
             ("record", f"{self.n_samples} samples at {self.fs:g} Hz ({self.n_samples / self.fs:.6g} s){axes}"),
             ("input", f"{self.input} (results in the samples' rate unit)"),
@@ -269,7 +269,7 @@ class AllanResult(_ResultBase):
     taper: str = "rect"
 
     def __repr__(self) -> str:
-        axes = f", {self.n_axes} axes" if self.n_axes else ""
+        axes = f", {self.n_axes} {'axis' if self.n_axes == 1 else 'axes'}" if self.n_axes else ""
         which = " (axis 0)" if self.n_axes else ""
         return (
             f"AllanResult({self.estimator}, {self.tau.size} τ in {_fmt_range(self.tau, 's')}, "
@@ -356,9 +356,31 @@ class AllanResult(_ResultBase):
             data["kf"] = (axes, np.asarray(self.kf, dtype=float), {"units": "1", "long_name": "TheoBR bias ratio"})
         return xr.Dataset(data, coords=coords, attrs=attrs)
 
-    def plot(self, ax=None, **kwargs):
-        """Log-log ADEV against τ (one line per axis). Returns the matplotlib Axes."""
-        return plot_adev(self, ax=ax, **kwargs)
+    def plot(self, ax=None, *, labels=None, unit=None, axis=None, band=True, **kwargs):
+        """Log-log ADEV against τ, one line per axis, with the interval band when there is one.
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+            Draw here (default: a new figure).
+        labels : str or sequence of str, optional
+            Legend label of each axis' line, one per axis, e.g. ``labels=["gyro_x", "gyro_y", "gyro_z"]``
+            (default "axis 0", "axis 1", …). Pass the names here rather than to ``ax.legend``, which
+            would pair them with the interval bands as well as the lines.
+        unit : str, optional
+            Unit of the samples (e.g. ``"deg/s"``), for the y label.
+        axis : int, optional
+            Draw only this axis of a multi-axis result.
+        band : bool
+            Shade the confidence interval (when the result has one).
+        **kwargs
+            Passed to ``Axes.loglog`` for the curves.
+
+        Returns
+        -------
+        matplotlib Axes
+        """
+        return plot_adev(self, ax=ax, unit=unit, labels=labels, axis=axis, band=band, **kwargs)
 
 
 @dataclass(frozen=True, repr=False, eq=False)
@@ -430,7 +452,7 @@ class DynamicAllanResult(_ResultBase):
     _time_dims = ("t",)
 
     def __repr__(self) -> str:
-        axes = f", {self.n_axes} axes" if self.n_axes else ""
+        axes = f", {self.n_axes} {'axis' if self.n_axes == 1 else 'axes'}" if self.n_axes else ""
         return (
             f"DynamicAllanResult({self.estimator}/{self.method}, {self.tau.size} τ in "
             f"{_fmt_range(self.tau, 's')} × {self.t.size} windows centred {_fmt_range(self.t, 's')}; "

@@ -104,8 +104,9 @@ _TABLE = {
 
 _UNITS = {name: Unit(name, kind, factor, label) for name, (kind, factor, label, _) in _TABLE.items()}
 
-#: Canonical names of the accepted rate and angle units.
+#: Canonical names of the accepted rate units.
 RATE_UNITS = tuple(n for n, u in _UNITS.items() if u.kind == "rate")
+#: Canonical names of the accepted angle units.
 ANGLE_UNITS = tuple(n for n, u in _UNITS.items() if u.kind == "angle")
 
 # angle unit → the rate unit "that angle per second"

@@ -62,6 +62,7 @@ class FleetResult:
 
     @property
     def failed(self) -> list:
+        """The files whose report failed, each with its error (a failing file stops nothing)."""
         return [f for f in self.files if f["status"] == "error"]
 
 
@@ -341,7 +342,10 @@ def batch(
     try:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(todo), disable=quiet, unit="file", file=sys.stderr, desc="allanite batch")
+        # disable=None: no bar when stderr is no terminal (a pipe, a log file)
+        bar = tqdm(
+            total=len(todo), disable=True if quiet else None, unit="file", file=sys.stderr, desc="allanite batch"
+        )
         futures = [
             client.submit(
                 run_one, p, f, read_opts, report_opts, key=f"allanite-report-{uuid.uuid4().hex}", retries=retries

@@ -87,7 +87,7 @@ ACF_MIN_POINTS = 30
 #: carries over at 7, ADEV identifies at 10 and carries over at 9.
 ID_MIN_POINTS = {"oavar": 8, "avar": 10}
 
-_FALLBACKS = ("previous", "none")
+_FALLBACKS = ("prudent", "previous", "none")
 
 _EDF_METHODS = ("greenhall", "sp1065")
 _CHI2_METHODS = ("exact", "stable32")
@@ -577,7 +577,7 @@ def _b1_rn_alpha(x: np.ndarray, y: np.ndarray, m: int, n_ref: int) -> int:
     return 1 if rn > math.sqrt(rn_wpm * rn_fpm) else 2
 
 
-def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_n="terms", fallback="previous"):
+def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_n="terms", fallback="prudent"):
     """Dominant power-law noise type α at each averaging factor, by Stable32's method.
 
     At each m the data are brought to τ = m·τ0 — phase (angle) data decimated (every m-th point),
@@ -595,7 +595,9 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
     Where too few samples remain — fewer than 8 τ-intervals for ``"oavar"``, 10 for ``"avar"``
     (:data:`ID_MIN_POINTS`) — α is not identified from that τ's samples but taken from the nearest
     shorter τ of ``m`` (``fallback="previous"``): Stable32's rule, which its Alpha columns follow
-    row by row (``docs/confidence.md``).
+    row by row (``docs/confidence.md``). The default, ``fallback="prudent"``, adds one more rule on
+    octave-spaced (or sparser) grids: α may rise above both neighbours' only on ≥ 30 τ-intervals
+    (:data:`ACF_MIN_POINTS`) at every τ of the rise; a rise read on fewer falls back to the α before it.
 
     Parameters
     ----------
@@ -622,12 +624,18 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
         FFM: in simulation it identifies RWFM 0 % and FFM 24 % of the time at 7–26 averages,
         against 67 % and 59 % for ``"averages"``. Prefer ``"averages"`` to tell rate random walk
         from bias instability at long τ of an overlapping curve.
-    fallback : {"previous", "none"}
-        ``"previous"`` (default): where too few samples remain (see above), α is that of the
+    fallback : {"prudent", "previous", "none"}
+        ``"previous"``: where too few samples remain (see above), α is that of the
         nearest shorter τ of ``m`` identified on its own samples; if ``m`` holds none, α is
         identified at the longest averaging factor that still has enough τ-intervals.
-        ``"none"``: every τ on its own samples, however few (with 2 averages B1 is exactly 1,
-        "white FM", whatever the noise).
+        ``"prudent"`` (default): the same, and on a grid whose neighbouring m are ≥ 2× apart a *peak*
+        — consecutive τ whose α is above the α on both sides — stands only if each of its τ was
+        identified on ≥ 30 τ-intervals; otherwise it takes the α before it. A sum of power-law noises
+        has α fall as τ grows, and a higher α means a larger ν: a chance rise read on few points would
+        give an interval too narrow where data are scarce (e.g. 2¹⁷ white-rate samples read as flicker
+        phase at m = 4096 and 8192, ν 94 → 511). On the Stable32 tables of ``docs/confidence.md`` it
+        changes no α. ``"none"``: every τ on its own samples, however few (with 2 averages B1 is
+        exactly 1, "white FM", whatever the noise).
 
     Returns
     -------
@@ -689,8 +697,45 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
         _identify_each, phase, rate, phase_input=input == "angle", estimator=estimator, method=method, b1_n=b1_n
     )
     own = each(m_arr)
-    out = own if fallback == "none" else _fall_back(own, m_arr, n_phase - 1, ID_MIN_POINTS[estimator], each)
+    out = own
+    if fallback != "none":
+        out = _fall_back(own, m_arr, n_phase - 1, ID_MIN_POINTS[estimator], each)
+    if fallback == "prudent":
+        out = _level_weak_peaks(out, m_arr, (n_phase - 1) // m_arr)
     return int(out[0]) if np.ndim(m) == 0 else out
+
+
+def _level_weak_peaks(alpha: np.ndarray, m: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """A peak — a run of consecutive τ (in order of m) whose α is above the α on both sides of it —
+    stands only if every τ of the run was identified on at least :data:`ACF_MIN_POINTS` τ-intervals;
+    otherwise the run takes the α before it. A sum of power-law noises has its α fall, never rise, as τ
+    grows; a rise that falls back is a chance reading of few points, and a higher α gives a larger ν —
+    an interval too narrow exactly where the data are scarce. Dips (a lower α, a wider interval) stay.
+
+    Only on a grid whose neighbouring m are at least a factor 2 apart (octave, decade): on a denser
+    grid neighbouring τ re-read nearly the same averages, so a neighbour is no second reading."""
+    steps = np.diff(np.unique(m).astype(np.float64))
+    if steps.size and np.min(steps / np.unique(m)[:-1]) < 0.99:
+        return alpha
+    order = np.argsort(m, kind="stable")
+    a = alpha[order].copy()
+    weak = points[order] < ACF_MIN_POINTS
+    i = 1
+    while i < a.size:
+        j = i
+        while j + 1 < a.size and a[j + 1] == a[i]:
+            j += 1
+        # run i..j; a peak needs a neighbour on both sides, both below it
+        if j + 1 < a.size and a[i] > a[i - 1] and a[i] > a[j + 1] and weak[i : j + 1].any():
+            a[i : j + 1] = a[i - 1]
+            i = max(1, i - 1)  # the run joined its left neighbour's: look at that run again
+            while i > 1 and a[i - 1] == a[i]:
+                i -= 1
+            continue
+        i = j + 1
+    out = np.empty_like(alpha)
+    out[order] = a
+    return out
 
 
 def _fall_back(own: np.ndarray, m: np.ndarray, n_intervals: int, min_points: int, identify) -> np.ndarray:
@@ -913,7 +958,7 @@ def confidence_intervals(
     edf_method="greenhall",
     chi2="exact",
     b1_n="terms",
-    fallback="previous",
+    fallback="prudent",
 ) -> ConfidenceIntervals:
     """χ² confidence intervals of a static or dynamic Allan-variance result, per τ.
 
@@ -946,11 +991,13 @@ def confidence_intervals(
         Convention of the B1 branch of the noise identification, see :func:`identify_alpha`
         (the default ``"terms"`` with ``chi2="stable32"``, ``confidence=ONE_SIGMA`` for Stable32's
         numbers; ``"averages"`` to tell rate random walk from bias instability at long τ).
-    fallback : {"previous", "none"}
+    fallback : {"prudent", "previous", "none"}
         Where too few samples remain to identify the noise type (fewer than 8 τ-intervals for
         ``"oavar"``, 10 for ``"avar"``), α is the nearest shorter τ's (``"previous"``, Stable32's
         rule, see :func:`identify_alpha`), so the last points get the wide interval their few terms
-        warrant instead of one from a guessed "white/flicker phase" type.
+        warrant instead of one from a guessed "white/flicker phase" type. ``"prudent"`` (default)
+        also keeps a rise of α above both neighbours (a larger ν) on an octave grid only where it
+        was read on ≥ 30 τ-intervals; ``"none"`` identifies every τ on its own samples.
 
     Returns
     -------

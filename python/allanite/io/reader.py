@@ -168,10 +168,12 @@ class Log:
 
     @property
     def n_samples(self) -> int:
+        """Number of samples (rows) in the log."""
         return int(self.data.shape[0])
 
     @property
     def n_axes(self) -> int:
+        """Number of axes (columns) read; 1 for a one-dimensional log."""
         return 1 if self.data.ndim == 1 else int(self.data.shape[1])
 
     @property
@@ -185,7 +187,8 @@ class Log:
         dur_s = f"{dur / 3600:.3g} h" if dur >= 3600 else f"{dur:.4g} s"
         lines = [
             f"Log({self.path.name!r}, {self.format})",
-            f"  data: {self.n_samples} samples × {self.n_axes} axes, {kind}{self.data.dtype}, "
+            f"  data: {self.n_samples} samples × {self.n_axes} {'axis' if self.n_axes == 1 else 'axes'}, "
+            f"{kind}{self.data.dtype}, "
             f"fs = {self.fs:g} Hz ({dur_s})",
             f"  columns: {', '.join(self.columns)}",
             f"  unit: {self.unit.name + ' (' + self.unit.kind + ')' if self.unit else 'not given'}, "

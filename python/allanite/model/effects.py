@@ -214,9 +214,11 @@ class Effect:
 
     @property
     def param_names(self) -> tuple[str, ...]:
+        """Names of the effect's parameters, in order."""
         return tuple(p[0] for p in self.params)
 
 
+#: The candidates :func:`allanite.refine` may add, by name, in the order they are tried.
 EFFECTS: dict[str, Effect] = {
     e.name: e
     for e in (

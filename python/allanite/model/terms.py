@@ -39,6 +39,7 @@ class Term:
     column: Callable[[np.ndarray, np.ndarray, float], np.ndarray]
 
 
+#: The IEEE-952 terms of the model by name (Q, N, B, K, R), each with its Allan form and units.
 REGISTRY: dict[str, Term] = {
     t.name: t
     for t in (

@@ -68,14 +68,17 @@ class TimeFrames:
 
     @property
     def terms(self) -> tuple:
+        """The terms fitted in every frame."""
         return self.series.terms
 
     @property
     def unit(self) -> str | None:
+        """Unit of the samples (None when unknown)."""
         return self.series.unit
 
     @property
     def n_frames(self) -> int:
+        """Number of frames."""
         return int(self.t.size)
 
     def values(self, ieee: bool = True) -> dict:

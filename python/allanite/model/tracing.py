@@ -446,7 +446,7 @@ class ScoreTest:
 
     Parameters
     ----------
-    tau, m, avar : arrays on the thinned τ
+    tau : the thinned τ (s)
     model : the current model on those τ
     model_terms : the current model's five-term part (its covariance is exact; effects scale it)
     nu : EDF of each estimate

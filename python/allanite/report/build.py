@@ -48,7 +48,7 @@ from ..model import refine as refine_axis
 from ..results import AllanResult, DynamicAllanResult
 from ..units import adev_unit_label, parse_unit
 from .figures import figure_specs
-from .fmt import json_number
+from .fmt import count, json_number
 from .forecasting import check_forecast_options, plan_forecast, run_forecast
 from .page import html_page
 from .paper002 import compute as paper002_sections
@@ -127,6 +127,7 @@ class Report:
     # ---------------------------------------------------------------------------- properties
     @property
     def n_axes(self) -> int:
+        """Number of axes the report analyses."""
         return len(self.axis_names)
 
     @property
@@ -139,8 +140,9 @@ class Report:
     def __repr__(self) -> str:
         fit = "not fitted" if self.fits is None else f"{len(self.fits)} noise fits"
         return (
-            f"Report({self.source.get('name', 'record')!r}: {self.static.n_samples} samples × {self.n_axes} "
-            f"axes at {self.fs:g} Hz, unit {self.unit or 'unknown'}; {self.static.tau.size} τ, "
+            f"Report({self.source.get('name', 'record')!r}: {self.static.n_samples} samples × "
+            f"{count(self.n_axes, 'axis', 'axes')} at {self.fs:g} Hz, unit {self.unit or 'unknown'}; "
+            f"{self.static.tau.size} τ, "
             f"{self.dynamic.t.size} DAVAR windows; {fit})"
         )
 

@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..plot import plot_adev, plot_coefficient_series, plot_davar, plot_davar3d, plot_fit
+from ..units import adev_unit_label
 from .forecasting import forecast_specs
+from .settings import NOTHING_ADDED
 
 __all__ = ["figure_specs"]
 
@@ -36,6 +38,7 @@ def figure_specs(rep) -> list:
                     color=f"C{k % 10}",
                     label=f"{names[k]} fit",
                     lw=1.0,
+                    shade_unfitted=False,
                 )
         ax.set_title(f"{static_word}, {conf} intervals" + (" and fits" if rep.fits else ""))
         fig.subplots_adjust(left=0.11, right=0.975, bottom=0.11, top=0.93)
@@ -45,7 +48,7 @@ def figure_specs(rep) -> list:
             "adev.png",
             "Allan deviation, all axes",
             f"Overlapping ADEV of every axis with its {conf} "
-            "interval band" + (" and fitted model." if rep.fits else "."),
+            "interval band" + (" and fitted model (dotted over the τ its fit left out)." if rep.fits else "."),
             (7.2, 4.8),
             overview,
         )
@@ -97,7 +100,12 @@ def figure_specs(rep) -> list:
                 f"adev_axis{k}.png",
                 f"{names[k]}: Allan deviation",
                 f"ADEV of {names[k]} with its {conf} interval band"
-                + ("; fitted model (black) and each term (dashed)." if rep.fits else "."),
+                + (
+                    "; fitted model (black; dotted over the τ the fit left out, shaded) and each term (dashed, "
+                    "where it is within a decade of the model)."
+                    if rep.fits
+                    else "."
+                ),
                 (7.2, 4.8),
                 adev_k,
             )
@@ -146,5 +154,40 @@ def figure_specs(rep) -> list:
                     coef_k,
                 )
             )
+    specs.extend(_refinement_specs(rep))
     specs.extend(forecast_specs(rep))
+    return specs
+
+
+def _refinement_specs(rep) -> list:
+    """One figure per refined axis: :meth:`allanite.Refinement.plot` (the starting and the refined model
+    on the Allan curve, and the normalised residuals before and after)."""
+    if rep.refinements is None:
+        return []
+    label = adev_unit_label(rep.unit) if rep.unit is not None else None
+    specs = []
+    for k, r in enumerate(rep.refinements):
+        if r is None:
+            continue
+        name = rep.axis_names[k]
+
+        def draw(fig, r=r, name=name):
+            r.plot(fig)
+            if label:
+                fig.axes[0].set_ylabel(f"Allan deviation ({label})")
+            found = ", ".join(st.effect for st in r.steps) or NOTHING_ADDED
+            fig.suptitle(f"{name}: model refinement — {found}", fontsize="medium")
+            fig.tight_layout()
+
+        specs.append(
+            (
+                f"refinement_axis{k}.png",
+                f"{name}: model refinement",
+                "Left: the Allan deviation the refinement fitted (its τ range) with the starting five-term model "
+                "(blue) and the refined model (red). Right: the normalised residuals z before and after; the "
+                "band is |z| ≤ 2.",
+                (10.0, 4.0),
+                draw,
+            )
+        )
     return specs

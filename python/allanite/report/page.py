@@ -15,10 +15,10 @@ from typing import Any
 import jinja2
 
 from .._core import __version__
-from .fmt import duration, g
+from .fmt import LONG_RECORD_S, clock, duration, g, num, step_params
 from .forecasting import forecast_page
 from .paper002 import page_context as paper002_page
-from .settings import REPORT_ESTIMATORS
+from .settings import NOTHING_ADDED, REPORT_ESTIMATORS
 
 __all__ = ["html_page"]
 
@@ -36,7 +36,8 @@ def _css() -> str:
 
 
 def _table(header, rows, left: int = 1) -> dict[str, Any]:
-    return {"header": list(header), "rows": [list(r) for r in rows], "left": left}
+    """A table for the template; ``header`` None for a table of label/value rows without a header row."""
+    return {"header": None if header is None else list(header), "rows": [list(r) for r in rows], "left": left}
 
 
 def _ci(v, ci) -> str:
@@ -74,7 +75,7 @@ def _record(rec: dict) -> dict:
     if src.get("gaps"):
         shown = "; ".join(f"{gap['duration_s']:.6g} s after sample {gap['after_sample']}" for gap in src["gaps"][:10])
         rows.append(("gaps", shown + (" …" if len(src["gaps"]) > 10 else "")))
-    return _table(("", ""), rows, left=1)
+    return _table(None, rows, left=1)
 
 
 def _static(st: dict, names: list) -> dict:
@@ -209,10 +210,16 @@ def _dynamic(dy: dict, theoh: bool, au: str) -> dict:
     }
 
 
-def _series(fit: dict) -> dict:
+def _series(fit: dict, rec: dict) -> dict:
     ser = fit.get("series")
     if not ser or ser["axes"] is None:
         return {"status": "error" if fit["requested"] else "not requested", "error": (ser or {}).get("error")}
+    long = rec["duration_s"] > LONG_RECORD_S
+
+    def at(v, t):
+        # a window centre: whole seconds (h:mm:ss on a long record) say where; the window is far wider
+        return "—" if v is None else f"{g(v)} at " + (clock(t, 1.0, long=True) if long else f"{num(t, 7)} s")
+
     rows = []
     for ax in ser["axes"]:
         for t, c in ax["coefficients"].items():
@@ -223,9 +230,9 @@ def _series(fit: dict) -> dict:
                     f"{t} — {c['name']}",
                     sc["unit"] or "",
                     g(sc["median"]),
-                    f"{g(sc['min'])} at {g(sc['t_of_min_s'])} s",
-                    f"{g(sc['max'])} at {g(sc['t_of_max_s'])} s",
-                    f"{sc['windows_nonzero']}/{len(ax['t_s'])}",
+                    at(sc["min"], sc["t_of_min_s"]),
+                    at(sc["max"], sc["t_of_max_s"]),
+                    f"{sc['windows_nonzero']}/{sc['windows']}",
                 ]
             )
     return {
@@ -243,34 +250,26 @@ def _heldout(st: dict) -> str:
     return f"{g(a, 3)} → {g(b, 3)} %"
 
 
-def _refinement(ref: dict | None) -> dict | None:
+def _refinement(ref: dict | None, rec: dict) -> dict | None:
     if ref is None:
         return None
+    fs, duration_s = rec["fs_hz"], rec["duration_s"]
     curve_rows, change_rows, summary_rows = [], [], []
     for ax in ref["axes"]:
         if ax.get("error"):
-            summary_rows.append([ax["name"], "failed", "", "", ""])
+            summary_rows.append([ax["name"], "failed (see the notes)", "—", "—", "—"])
             continue
         summary_rows.append(
             [
                 ax["name"],
-                ", ".join(st["effect"] for st in ax["steps"]) or "nothing found",
+                ", ".join(st["effect"] for st in ax["steps"]) or NOTHING_ADDED,
                 f"{g(ax['start']['chi2_dof'], 3)} → {g(ax['final']['chi2_dof'], 3)}",
                 f"{g(ax['start']['rms_adev_pct'], 3)} → {g(ax['final']['rms_adev_pct'], 3)} %",
-                ax["tau_from_s"] is not None and f"{g(ax['tau_from_s'])} s" or "",
+                f"{g(ax['tau_from_s'])} s" if ax["tau_from_s"] is not None else "—",
             ]
         )
         for st in ax["steps"]:
-            params = "; ".join(
-                f"{p} = {v}"
-                if isinstance(v, str)
-                else (
-                    f"{p} = {g(v, 3)} [{g(st['intervals'][p][0], 3)}, {g(st['intervals'][p][1], 3)}]"
-                    if p in st["intervals"]
-                    else f"{p} = {g(v, 3)}"
-                )
-                for p, v in st["params"].items()
-            )
+            params = step_params(st, fs, duration_s, units=True, intervals=True)
             if st["statistic"] == "allan_curve":
                 curve_rows.append(
                     [
@@ -357,8 +356,8 @@ def html_page(rep: Any, images: dict) -> str:
         "static": _static(st, names),
         "model": _model(fit, names, au),
         "dynamic": _dynamic(dy, st["source"] is not None, au),
-        "series": _series(fit),
-        "refinement": _refinement(s.get("refinement")),
+        "series": _series(fit, rec),
+        "refinement": _refinement(s.get("refinement"), rec),
         "forecast": forecast_page(s.get("forecast")),
         "paper002": paper002_page(s.get("paper002")),
         "figures": figures,

@@ -9,20 +9,24 @@ __all__ = [
     "DHVAR_MAX_DEFAULT_WINDOW",
     "DHVAR_MAX_WINDOWS",
     "REPORT_ESTIMATORS",
+    "NOTHING_ADDED",
     "default_window",
     "default_hop",
 ]
 
 #: The model the report fits (docs/FORMULAS.md §4.1; the K column is exact for a sampled random walk).
 FIT_MODEL = "σ²(τ) = 3Q²/τ² + N²/τ + (2 ln2/π)·B² + K²·τ0·(2m²+1)/(6m) + R²·τ²/2"
-#: Fraction of the record that is the default DAVAR window, and of the window that is the default hop.
+#: The default DAVAR window is 1/WINDOW_FRACTION of the record.
 WINDOW_FRACTION = 12
+#: The default hop is 1/HOP_FRACTION of the window.
 HOP_FRACTION = 25
 #: DHVAR's cost grows with the window squared (Theo1 at every m of the bias ratio): its default
 #: window is capped here (paper 001 uses 401 samples).
 DHVAR_MAX_DEFAULT_WINDOW = 2001
 #: ... and its default hop keeps the number of windows (each fitted) to about this.
 DHVAR_MAX_WINDOWS = 400
+#: What the page and the console say for an axis to which refine added no effect.
+NOTHING_ADDED = "nothing added"
 #: estimator → (static estimator, dynamic estimator, dynamic τ grid, section titles)
 REPORT_ESTIMATORS = {
     "oavar": ("oavar", "oavar", "exp", "Overlapping Allan deviation", "Dynamic Allan variance"),

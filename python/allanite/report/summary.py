@@ -11,10 +11,10 @@ from ..estimators import get as get_estimator
 from ..model.effects import EFFECTS
 from ..model.terms import TERM_NAMES
 from ..units import coefficient_unit, ieee952
-from .fmt import duration, g, json_list, json_number, pct
+from .fmt import count, duration, g, json_list, json_number, json_value, pct, step_params
 from .forecasting import forecast_dict, forecast_text
 from .paper002 import text_lines as paper002_text
-from .settings import FIT_MODEL
+from .settings import FIT_MODEL, NOTHING_ADDED
 
 __all__ = ["summarize", "text_summary", "refinement_dict"]
 
@@ -55,7 +55,7 @@ def refinement_dict(rep) -> dict | None:
                         "effect": st.effect,
                         "statistic": "window_levels" if st.effect == "change_point" else "allan_curve",
                         "domain": EFFECTS[st.effect].domain,
-                        "params": {p: v if isinstance(v, str) else json_number(v) for p, v in st.params.items()},
+                        "params": {p: json_value(v) for p, v in st.params.items()},
                         "units": {p: rate if u == "rate unit" else u for p, u, _ in EFFECTS[st.effect].params},
                         "intervals": {p: [json_number(a), json_number(b)] for p, (a, b) in st.intervals.items()},
                         "before": {q: json_number(v) for q, v in st.before.items()},
@@ -75,7 +75,9 @@ def refinement_dict(rep) -> dict | None:
         "lowers the held-out error (fit on the odd blocks of the record, predict the even ones, and back)",
         "candidates": f"{' / '.join(e.label for e in curve)} signatures in the Allan curve, or "
         + " or ".join(f"{e.label} along the record" for e in timed),
-        "units": "; ".join(f"{e.name}: " + ", ".join(f"{p} in {u}" for p, u, _ in e.params) for e in EFFECTS.values()),
+        "units": "; ".join(
+            f"{e.name}: " + ", ".join(_param_words(p, u, m, rate) for p, u, m in e.params) for e in EFFECTS.values()
+        ),
         "statistics": {
             "allan_curve": "before/after: χ²/dof and RMS z of the Allan-curve fit (each τ of the dense curve weighted "
             "independently), RMS ADEV error (%) on 4 τ per octave whose estimate is within ±10 %; "
@@ -87,6 +89,13 @@ def refinement_dict(rep) -> dict | None:
         },
         "axes": axes,
     }
+
+
+def _param_words(name: str, unit: str, meaning: str, rate: str) -> str:
+    """ "sigma in °/s", or what a parameter without a unit is ("q (quality factor …)", "channel (name of …)")."""
+    if unit:
+        return f"{name} in {unit.replace('rate unit', rate)}"
+    return f"{name} ({meaning.split(' (')[0]})"
 
 
 def _jsonable_test(t):
@@ -160,18 +169,27 @@ def _series_dict(s, unit) -> dict:
                 ieee_ci_low=json_list(ieee952(t, lo, unit).value),
                 ieee_ci_high=json_list(ieee952(t, hi, unit).value),
             )
-        j_max, j_min = int(np.argmax(show)), int(np.argmin(show))
-        d["stats"] = {
-            "median": json_number(np.median(show)),
-            "min": json_number(show[j_min]),
-            "t_of_min_s": json_number(s.t[j_min]),
-            "max": json_number(show[j_max]),
-            "t_of_max_s": json_number(s.t[j_max]),
-            "unit": show_unit,
-            "windows_nonzero": int(np.count_nonzero(v > 0)),
-        }
+        d["stats"] = _resolved_stats(np.asarray(show, dtype=np.float64), v, s.t, show_unit)
         coeffs[t] = d
     return {"t_s": json_list(s.t), "chi2_dof": json_list(s.chi2_dof), "coefficients": coeffs}
+
+
+def _resolved_stats(show: np.ndarray, value: np.ndarray, t: np.ndarray, unit) -> dict:
+    """Median, minimum and maximum of a coefficient over the windows that resolve it (value > 0): a
+    window whose fit leaves the term at 0 says "at most its upper bound", not 0. None when none does."""
+    resolved = np.flatnonzero(np.asarray(value) > 0)
+    out = {"unit": unit, "windows_nonzero": int(resolved.size), "windows": int(np.size(value))}
+    if resolved.size == 0:
+        return out | {"median": None, "min": None, "t_of_min_s": None, "max": None, "t_of_max_s": None}
+    shown = show[resolved]
+    j_min, j_max = resolved[int(np.argmin(shown))], resolved[int(np.argmax(shown))]
+    return out | {
+        "median": json_number(np.median(shown)),
+        "min": json_number(show[j_min]),
+        "t_of_min_s": json_number(t[j_min]),
+        "max": json_number(show[j_max]),
+        "t_of_max_s": json_number(t[j_max]),
+    }
 
 
 def _positions(st) -> np.ndarray:
@@ -343,7 +361,8 @@ def text_summary(s: dict) -> str:
     au = rec["adev_unit"] or "samples' unit"
     lines = [
         f"allanite report: {rec['name']}",
-        f"  {rec['samples']} samples × {rec['axes']} axes ({', '.join(names)}) at {rec['fs_hz']:g} Hz = "
+        f"  {rec['samples']} samples × {count(rec['axes'], 'axis', 'axes')} ({', '.join(names)}) at "
+        f"{rec['fs_hz']:g} Hz = "
         f"{duration(rec['duration_s'])}; unit {rec['unit'] or 'unknown (give --unit)'}, {rec['input']} input",
     ]
     for note in s["notes"]:
@@ -415,8 +434,8 @@ def text_summary(s: dict) -> str:
     ser = fit.get("series")
     if ser and ser["axes"] is not None:
         lines.append(
-            f"  noise coefficients over the windows, median [min, max]"
-            f"{' in IEEE-952 units' if fit['unit_known'] else ' (base form)'}:"
+            f"  noise coefficients{' in IEEE-952 units' if fit['unit_known'] else ' (base form)'} over the windows "
+            "that resolve them (> 0): median [min, max] (windows resolving / all)"
         )
         for ax in ser["axes"]:
             parts = []
@@ -426,7 +445,7 @@ def text_summary(s: dict) -> str:
                 st_ = c["stats"]
                 parts.append(
                     f"{t} {g(st_['median'], 3)} [{g(st_['min'], 3)}, {g(st_['max'], 3)}]"
-                    f"{' ' + st_['unit'] if st_['unit'] else ''}"
+                    f"{' ' + st_['unit'] if st_['unit'] else ''} ({st_['windows_nonzero']}/{st_['windows']})"
                 )
             lines.append(f"    {ax['name']}: " + ("; ".join(parts) or "all zero"))
     elif ser and ser["error"]:
@@ -438,18 +457,14 @@ def text_summary(s: dict) -> str:
             if ax.get("error"):
                 lines.append(f"  {ax['name']}: failed (see the notes)")
                 continue
-            found = ", ".join(st["effect"] for st in ax["steps"]) or "nothing added"
+            found = ", ".join(st["effect"] for st in ax["steps"]) or NOTHING_ADDED
             a, b = ax["start"], ax["final"]
             lines.append(
                 f"  {ax['name']}: {found}; curve χ²/dof {g(a['chi2_dof'], 3)} → {g(b['chi2_dof'], 3)}, "
                 f"RMS ADEV error {g(a['rms_adev_pct'], 3)} → {g(b['rms_adev_pct'], 3)} %"
             )
             for st in ax["steps"]:
-                params = ", ".join(
-                    f"{p} = {v}" if isinstance(v, str) else f"{p} = {g(v, 3)} {st['units'][p]}".rstrip()
-                    for p, v in st["params"].items()
-                )
-                lines.append(f"    {st['effect']}: {params}")
+                lines.append(f"    {st['effect']}: {step_params(st, rec['fs_hz'], rec['duration_s'], units=True)}")
     lines += forecast_text(s.get("forecast"))
     lines += paper002_text(s.get("paper002"))
     return "\n".join(lines)

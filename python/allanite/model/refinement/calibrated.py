@@ -1,0 +1,68 @@
+"""The calibrated tests' glue: the Allan-curve score test of a fitted solution and its bootstrap threshold,
+and what the residual looked like when a test fired.
+
+The statistic is the GLS score for one more non-negative column on ~4 τ per octave with the covariance of
+the estimates across τ (exact for the five terms, :mod:`allanite.model._covariance`); its threshold the
+(1 − α) quantile of its maximum over every candidate family under the fitted model (parametric bootstrap,
+:class:`allanite.model.tracing.ScoreTest`), so the look-elsewhere effect is in it. α is the curve's share of
+``level`` (:mod:`.levels`); the other domains' tests (spectral lines, drift, regression, change points) are
+in :mod:`allanite.model.tracing` and :mod:`.changes`, each at its own share.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import tracing
+from ..terms import design_matrix
+from .curvefit import Curve, Solution, design, theta_terms
+
+__all__ = ["N_BOOT", "curve_test", "residual_evidence", "tested"]
+
+#: Bootstrap draws of the Allan-curve test's null distribution.
+N_BOOT = 1000
+
+
+def curve_test(curve: Curve, thin: np.ndarray, sol: Solution, start, effects, exact: bool) -> tracing.ScoreTest:
+    """The score test for one more column on the thinned τ ``thin`` of ``curve``, under the solution ``sol``
+    of the terms ``start`` plus ``effects``; ``exact``: the five terms' covariance across τ in closed form
+    (samples, or the overlapping estimator), else the octave-correlation model."""
+    sub = curve.subset(thin)
+    theta_t = theta_terms(sol, start, effects)
+    model_t = np.maximum(design_matrix(sub.tau, sub.m, curve.fs, start) @ theta_t, 1e-300)
+    cov_t = None
+    if exact:
+        cov_t = tracing.exact_covariance(sub.m.astype(np.int64), curve.n_points - 1, curve.fs, start, theta_t)
+    a_thin, _ = design(sub, start, effects)
+    return tracing.ScoreTest(sol.model[thin], model_t, sol.nu[thin], sub.tau, a_thin[:, sol.theta > 0], cov_t)
+
+
+def residual_evidence(curve: Curve, sol: Solution) -> dict:
+    """Where the residual is: runs of same-signed |z| > 2, and the τ of the largest |z|."""
+    z = sol.z
+    runs = []
+    i = 0
+    while i < z.size:
+        if abs(z[i]) > 2:
+            j = i
+            while j + 1 < z.size and abs(z[j + 1]) > 2 and np.sign(z[j + 1]) == np.sign(z[i]):
+                j += 1
+            runs.append(
+                {
+                    "tau_from": float(curve.tau[i]),
+                    "tau_to": float(curve.tau[j]),
+                    "sign": int(np.sign(z[i])),
+                    "points": int(j - i + 1),
+                }
+            )
+            i = j + 1
+        else:
+            i += 1
+    k = int(np.argmax(np.abs(z)))
+    return {"runs_beyond_2sigma": runs, "max_abs_z": float(abs(z[k])), "tau_of_max": float(curve.tau[k])}
+
+
+def tested(statistic: str, value: float, threshold: float, alpha: float) -> dict:
+    """A step's ``evidence["test"]``: which statistic, its value, the threshold it had to pass and the α
+    (share of ``level``) that threshold spends."""
+    return {statistic: value, "threshold": threshold, "alpha": alpha}

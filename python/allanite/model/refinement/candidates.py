@@ -1,0 +1,422 @@
+"""Effects proposed on the Allan curve — one registry entry each: how the effect's columns enter the
+bootstrap of the curve test (its family), how its best parameter is found at a step (its proposal), the
+parameters and intervals a step reports, and what a second domain says about it.
+
+- ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4];
+- ``"bandwidth"`` — the sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett
+  FIR, a boxcar of any span, a single pole after a short boxcar), replacing the N column; the kind with the
+  lowest χ² (ties: the one needing fewer other terms);
+- ``"resonance"`` — narrowband noise near the shortest τ, at quality factors :data:`RESONANCE_Q`;
+- ``"sinusoid"`` — with samples, the strongest spectral line of the Welch PSD not yet in the model (its own χ²
+  test); for curve-only input by its nulls at τ = k/f0.
+
+A proposal is accepted by :func:`choose`: its test passes, its parameter is not at the edge of its range, its
+amplitude is positive, χ²/dof falls, and the held-out error falls (spectral lines first, then by statistic
+over threshold; a resonance waits for a bandwidth that passes; an unmistakable bandwidth may enter with a
+Gauss–Markov term when alone it would raise the held-out error).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .. import tracing
+from ..effects import CASCADE_SPANS, EFFECTS, RESONANCE_Q, filter_autocorrelation, filter_cutoff
+from .curvefit import Curve, Solution, base_name, column, profile_interval, search, solve
+from .scoring import Split
+
+__all__ = ["Proposal", "Round", "CurveCandidate", "CURVE_CANDIDATES", "PAIR_FACTOR", "families", "choose"]
+
+#: A bandwidth that raises the held-out error alone may enter with a Gauss–Markov term if its statistic is
+#: at least this multiple of the threshold.
+PAIR_FACTOR = 100.0
+
+
+@dataclass
+class Round:
+    """What one step of the loop offers every curve candidate: the curve and its thinned τ, the current
+    model (terms ``start`` plus ``effects``, solution ``sol``), the curve test and its threshold, the
+    held-out split, the samples (None for curve-only input) and the spectral lines found in them."""
+
+    curve: Curve
+    sub: Curve
+    start: tuple
+    effects: list
+    sol: Solution
+    test: tracing.ScoreTest
+    thr: float
+    split: Split | None
+    y: np.ndarray | None
+    lines: list
+
+    @property
+    def tmin(self) -> float:
+        """Shortest τ of the curve (s)."""
+        return float(self.curve.tau[0])
+
+    @property
+    def tmax(self) -> float:
+        """Longest τ of the curve (s)."""
+        return float(self.curve.tau[-1])
+
+
+@dataclass
+class Proposal:
+    """One candidate's best column at a step: ``key`` (effect, with its kind), nonlinear parameter ``p``,
+    the solution with it, whether ``p`` sits at the edge of its range, the statistic and its threshold,
+    the held-out split to judge it on, the spectral line it came from (if any), and its entry in
+    ``Refinement.considered``."""
+
+    key: str
+    p: float
+    sol: Solution
+    edge: bool
+    stat: float
+    thr: float
+    split: Split | None
+    line: dict | None = None
+    pair_note: str | None = None
+    record: dict = field(default_factory=dict)
+
+    @property
+    def effect(self) -> str:
+        """The effect's name (``key`` without its kind)."""
+        return base_name(self.key)
+
+
+@dataclass(frozen=True)
+class CurveCandidate:
+    """A curve effect's entry: ``family(sub, has_samples)`` its columns on the thinned curve for the
+    bootstrap of the maximum statistic; ``propose(round)`` its proposals at a step; ``params(pr, round)``
+    the step's parameters and intervals; ``evidence(pr, round)`` what another domain says (or {});
+    ``amplitude`` the parameter that is the column's amplitude, updated from the final joint fit (None:
+    none, or it came from the samples)."""
+
+    name: str
+    family: Callable[[Curve, bool], list]
+    propose: Callable[[Round], list]
+    params: Callable[[Proposal, Round], tuple]
+    evidence: Callable[[Proposal, Round], dict] = lambda pr, rnd: {}
+    amplitude: Callable[[Proposal], str | None] = lambda pr: None
+
+
+def _amplitude(sol: Solution, i: int) -> tuple[float, float, tuple[float, float]]:
+    """Amplitude of column ``i`` (√θ), its SD, and the ±1 SD interval clipped at 0."""
+    amp = math.sqrt(max(sol.theta[i], 0.0))
+    var_i = sol.cov[i, i]
+    sd = math.sqrt(max(var_i, 0.0)) / (2 * amp) if amp > 0 and np.isfinite(var_i) else float("nan")
+    return amp, sd, (max(0.0, amp - sd), amp + sd)
+
+
+def _with_stat(rnd: Round, key: str, p: float, sol: Solution, edge: bool, bump: np.ndarray | None = None):
+    """A proposal judged by the curve test (its column on the thinned τ, less ``bump`` if given)."""
+    col = column(key, p, rnd.sub) if bump is None else column(key, p, rnd.sub) - bump
+    return Proposal(key, p, sol, edge, rnd.test.statistic(rnd.sub.avar, col), rnd.thr, rnd.split)
+
+
+# ---- Gauss–Markov
+
+
+def _gm_grid(tmin, tmax):
+    grid = EFFECTS["gauss_markov"].search
+    assert grid is not None
+    return grid(tmin, tmax)
+
+
+def _gm_family(sub: Curve, has_samples: bool) -> list:
+    return [column("gauss_markov", p, sub) for p in _gm_grid(sub.tau[0], sub.tau[-1])]
+
+
+def _gm_propose(rnd: Round) -> list:
+    p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, "gauss_markov", _gm_grid(rnd.tmin, rnd.tmax))
+    return [_with_stat(rnd, "gauss_markov", p, s_new, edge)]
+
+
+def _gm_evidence(pr: Proposal, rnd: Round) -> dict:
+    # a second domain: the correlation time the residual's autocorrelation in time gives
+    return {} if rnd.y is None else {"autocorrelation": tracing.gm_autocorrelation(rnd.y, rnd.curve.fs, pr.p)}
+
+
+def _amplitude_and_profile(pr: Proposal, rnd: Round) -> tuple:
+    """(amplitude, nonlinear parameter) with the amplitude's ±1 SD and the parameter's profile interval."""
+    names = EFFECTS[pr.effect].param_names
+    amp, _sd, amp_int = _amplitude(pr.sol, pr.sol.theta.size - 1)
+    p_int = profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol)
+    return {names[0]: amp, names[1]: pr.p}, {names[0]: amp_int, names[1]: p_int}
+
+
+# ---- bandwidth
+
+
+def bandwidth_grids(curve: Curve) -> dict:
+    """Search grids per filter kind: single-pole cutoffs whose roll-off falls inside the curve, FIR lengths."""
+    # the roll-off must reach into the curve: a time constant (or FIR span) of at least a third of the
+    # shortest τ — a faster filter leaves no mark on it
+    fs = curve.fs
+    f_lo = 1.0 / (2 * math.pi * 10 * curve.tau[0])
+    f_hi = min(0.45 * fs, 3.0 / (2 * math.pi * curve.tau[0]))
+    grids = {}
+    if f_lo < f_hi:
+        grids["single_pole"] = np.geomspace(f_lo, f_hi, 24)
+    l_min = max(2, int(math.ceil(curve.tau[0] * fs / 3)))
+    l_max = int(max(2, min(64, 0.1 * curve.tau[-1] * fs)))
+    if l_max > l_min:
+        grids["moving_average"] = np.arange(l_min, l_max + 1, dtype=np.float64)
+        grids["bartlett"] = np.arange(max(2, l_min // 2), max(3, l_max // 2) + 1, dtype=np.float64)
+        grids["boxcar"] = np.geomspace(max(1.02, curve.tau[0] * fs / 3), l_max, 32)
+    if "single_pole" in grids and curve.tau[0] * fs <= 1.0:
+        # a single pole after the part's own short averaging (only where the curve starts at one sample)
+        for span in CASCADE_SPANS:
+            grids[f"single_pole+boxcar:{span:g}"] = grids["single_pole"]
+    return grids
+
+
+def _bw_family(sub: Curve, has_samples: bool) -> list:
+    return [
+        column(f"bandwidth:{kind}", p, sub) - 1.0 / sub.tau for kind, grid in bandwidth_grids(sub).items() for p in grid
+    ]
+
+
+def _bw_better(new, best, tie) -> bool:
+    """Whether the bandwidth kind ``new`` = (key, p, sol, edge) beats ``best``: a kind whose best parameter sits
+    at the edge of its range is not identified (any kind that is comes first); then the lowest χ², and within
+    one effective point of it the one that needs fewer other terms (a 2-tap average plus white angle noise and
+    a boxcar of 1.2 samples are the same MA(1) process: the single filter is the physical reading; a cascade
+    counts one parameter more, its boxcar span)."""
+    if best is None or (best[3] and not new[3]):
+        return True
+    if best[3] != new[3]:
+        return False
+
+    def n_par(key, sol):
+        return np.count_nonzero(sol.theta > 0) + ("+" in key)
+
+    s_new, s_best = new[2], best[2]
+    return s_new.chi2 < s_best.chi2 - tie or (
+        s_new.chi2 < s_best.chi2 + tie and (n_par(new[0], s_new), s_new.chi2) < (n_par(best[0], s_best), s_best.chi2)
+    )
+
+
+def _bw_propose(rnd: Round) -> list:
+    if any(base_name(k) == "bandwidth" for k, _p in rnd.effects) or "N" not in rnd.start:
+        return []
+    best = None
+    tie = rnd.curve.tau.size / rnd.curve.n_eff
+    for kind, grid in bandwidth_grids(rnd.curve).items():
+        key = f"bandwidth:{kind}"
+        cont = kind in ("single_pole", "boxcar") or kind.startswith("single_pole+")
+        p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, key, grid, continuous=cont)
+        if _bw_better((key, p, s_new, edge), best, tie):
+            best = (key, p, s_new, edge)
+    if best is None:
+        return []
+    key, p, s_new, edge = best
+    return [_with_stat(rnd, key, p, s_new, edge, bump=1.0 / rnd.sub.tau)]
+
+
+def _bw_params(pr: Proposal, rnd: Round) -> tuple:
+    kind, p, fs = pr.key.split(":", 1)[1], pr.p, rnd.curve.fs
+    cut = filter_cutoff(kind, p, fs)
+
+    def profile():
+        return profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, p, pr.sol)
+
+    if kind == "single_pole":
+        return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": profile()}
+    if kind.startswith("single_pole+boxcar:"):
+        p_lo, p_hi = profile()
+        span = float(kind.split(":", 1)[1])
+        return {"cutoff": cut, "taps": span, "filter": "single_pole+boxcar", "pole_cutoff": float(p)}, {
+            "cutoff": (filter_cutoff(kind, p_lo, fs), filter_cutoff(kind, p_hi, fs)),
+            "pole_cutoff": (p_lo, p_hi),
+        }
+    if kind == "boxcar":
+        s_lo, s_hi = profile()
+        return {"cutoff": cut, "taps": float(p), "filter": kind}, {
+            "cutoff": (filter_cutoff(kind, s_hi, fs), filter_cutoff(kind, s_lo, fs)),
+            "taps": (s_lo, s_hi),
+        }
+    taps = int(p) if kind == "moving_average" else 2 * int(p) - 1
+    c_int = (filter_cutoff(kind, p + 1, fs), filter_cutoff(kind, max(1.0, p - 1), fs))
+    return {"cutoff": cut, "taps": taps, "filter": kind}, {"cutoff": c_int}
+
+
+def _bw_evidence(pr: Proposal, rnd: Round) -> dict:
+    ev: dict = {"N": math.sqrt(max(pr.sol.theta[-1], 0.0))}
+    if rnd.y is not None:  # a second domain: the roll-off the filter predicts in the spectrum, and the data's
+        r = filter_autocorrelation(pr.key.split(":", 1)[1], pr.p, rnd.curve.fs)
+        ev["psd"] = tracing.rolloff_psd(rnd.y, rnd.curve.fs, r)
+    return ev
+
+
+# ---- resonance
+
+
+def _res_grid(tmin, tmax):
+    grid = EFFECTS["resonance"].search
+    assert grid is not None
+    return grid(tmin, tmax)
+
+
+def _res_family(sub: Curve, has_samples: bool) -> list:
+    grid = _res_grid(sub.tau[0], sub.tau[-1])
+    return [column(f"resonance:{q:g}", p, sub) for q in RESONANCE_Q for p in grid]
+
+
+def _res_propose(rnd: Round) -> list:
+    best_r = None
+    for q in RESONANCE_Q:
+        key = f"resonance:{q:g}"
+        p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, key, _res_grid(rnd.tmin, rnd.tmax))
+        if best_r is None or s_new.chi2 < best_r[2].chi2:
+            best_r = (key, p, s_new, edge)
+    assert best_r is not None
+    key, p, s_new, edge = best_r
+    return [_with_stat(rnd, key, p, s_new, edge)]
+
+
+def _res_params(pr: Proposal, rnd: Round) -> tuple:
+    amp, _sd, amp_int = _amplitude(pr.sol, pr.sol.theta.size - 1)
+    p_int = profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol)
+    return {"sigma": amp, "f0": pr.p, "q": float(pr.key.split(":", 1)[1])}, {"sigma": amp_int, "f0": p_int}
+
+
+# ---- sinusoid
+
+
+def _sin_grid(tmin, tmax):
+    grid = EFFECTS["sinusoid"].search
+    assert grid is not None
+    return grid(tmin, tmax)
+
+
+def _sin_family(sub: Curve, has_samples: bool) -> list:
+    # with samples a sinusoid is found in the PSD (its own test), not on the curve
+    return [] if has_samples else [column("sinusoid", p, sub) for p in _sin_grid(sub.tau[0], sub.tau[-1])]
+
+
+def _sin_propose(rnd: Round) -> list:
+    if rnd.y is None:
+        p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, "sinusoid", _sin_grid(rnd.tmin, rnd.tmax))
+        return [_with_stat(rnd, "sinusoid", p, s_new, edge)]
+    done_f = [p for k, p in rnd.effects if k == "sinusoid"]
+    for ln in rnd.lines:
+        if all(abs(ln["f0"] - f) > 2 * ln["bin_hz"] for f in done_f):
+            s_new = solve(rnd.curve, rnd.start, rnd.effects + [("sinusoid", ln["f0"])])
+            return [Proposal("sinusoid", ln["f0"], s_new, False, ln["psd_ratio"], ln["threshold"], rnd.split, line=ln)]
+    return []
+
+
+def _sin_params(pr: Proposal, rnd: Round) -> tuple:
+    if pr.line is None:
+        return _amplitude_and_profile(pr, rnd)
+    ln = pr.line  # found in the PSD: amplitude and f0 from the samples, with their intervals
+    return {"amplitude": ln["amplitude"], "f0": pr.p}, {"amplitude": ln["amplitude_interval"], "f0": ln["f0_interval"]}
+
+
+#: The curve candidates, in the order their columns enter the bootstrap and their proposals are made.
+CURVE_CANDIDATES: dict[str, CurveCandidate] = {
+    c.name: c
+    for c in (
+        CurveCandidate(
+            "gauss_markov",
+            _gm_family,
+            _gm_propose,
+            _amplitude_and_profile,
+            evidence=_gm_evidence,
+            amplitude=lambda pr: "sigma",
+        ),
+        CurveCandidate("bandwidth", _bw_family, _bw_propose, _bw_params, evidence=_bw_evidence),
+        CurveCandidate("resonance", _res_family, _res_propose, _res_params, amplitude=lambda pr: "sigma"),
+        CurveCandidate(
+            "sinusoid",
+            _sin_family,
+            _sin_propose,
+            _sin_params,
+            amplitude=lambda pr: "amplitude" if pr.line is None else None,
+        ),
+    )
+}
+
+
+def families(sub: Curve, candidates, has_samples: bool) -> np.ndarray:
+    """Every column the curve candidates could add (on the thinned curve), for the bootstrap of the maximum
+    statistic: the look-elsewhere effect over all of them is in the threshold."""
+    fam = [col for name, c in CURVE_CANDIDATES.items() if name in candidates for col in c.family(sub, has_samples)]
+    return np.column_stack(fam) if fam else np.zeros((sub.tau.size, 0))
+
+
+# ---- which proposal a step accepts
+
+
+def _admissible(props: list, sol: Solution) -> list:
+    """Proposals whose test passes, whose parameter is identified and amplitude positive, and that lower
+    χ²/dof — a spectral line first (the most specific evidence: a sinusoid also raises a bump on the curve
+    that a Gauss–Markov term would otherwise take), then by the statistic over its threshold."""
+    ok = [
+        pr
+        for pr in props
+        if pr.stat > pr.thr and not pr.edge and pr.sol.theta[-1] > 0 and pr.sol.chi2_dof < sol.chi2_dof
+    ]
+    ok.sort(key=lambda pr: (pr.line is None, -pr.stat / pr.thr))
+    return ok
+
+
+def _first_heldout_winner(cands: list, rnd: Round):
+    """The first proposal that lowers the held-out error: (proposal, held-out before, after), or None."""
+    for pr in cands:
+        ho_b = ho_a = None
+        if pr.split is not None:
+            ho_b = pr.split.error(rnd.start, rnd.effects)
+            ho_a = pr.split.error(rnd.start, rnd.effects + [(pr.key, pr.p)])
+            if not ho_a < ho_b:
+                pr.record["rejected"] = f"held-out error {ho_b:.3g} → {ho_a:.3g} %"
+                continue
+        return (pr, ho_b, ho_a)
+    return None
+
+
+def _paired_bandwidth(ok: list, rnd: Round, candidates):
+    """An unmistakable roll-off (statistic ≥ :data:`PAIR_FACTOR` × threshold) that alone raised the held-out
+    error, accepted when it lowers it together with a Gauss–Markov term (the next step): a bandwidth alone can
+    lower the held-out fit where a bump sits further up the curve (the five terms bend to the bump once the
+    short τ are right). (proposal, held-out before, after alone), or None."""
+    bw = next((pr for pr in ok if pr.effect == "bandwidth"), None)
+    if bw is None or bw.split is None or not bw.stat >= PAIR_FACTOR * bw.thr or "gauss_markov" not in candidates:
+        return None
+    with_bw = rnd.effects + [(bw.key, bw.p)]
+    p_g, s_pair, edge_g = search(rnd.curve, rnd.start, with_bw, "gauss_markov", _gm_grid(rnd.tmin, rnd.tmax))
+    if edge_g or not s_pair.theta[-1] > 0:
+        return None
+    ho_b = bw.split.error(rnd.start, rnd.effects)
+    ho_alone = bw.split.error(rnd.start, with_bw)
+    ho_pair = bw.split.error(rnd.start, with_bw + [("gauss_markov", p_g)])
+    if not ho_pair < ho_b:
+        return None
+    bw.pair_note = (
+        f"accepted with the Gauss–Markov term of the next step: alone it moved the held-out error "
+        f"{ho_b:.3g} → {ho_alone:.3g} %, with it → {ho_pair:.3g} %"
+    )
+    return (bw, ho_b, ho_alone)
+
+
+def choose(props: list, rnd: Round, candidates):
+    """The proposal a step accepts, with the held-out error before and after it, or None (the loop stops).
+
+    A resonance near the shortest τ can stand in for the sensor's roll-off: while a bandwidth passes its test
+    and is not in the model, the resonance waits until the bandwidth (alone or paired) was tried."""
+    ok = _admissible(props, rnd.sol)
+    deferred = []
+    if any(pr.effect == "bandwidth" for pr in ok):
+        deferred = [pr for pr in ok if pr.effect == "resonance"]
+        ok = [pr for pr in ok if pr.effect != "resonance"]
+    chosen = _first_heldout_winner(ok, rnd)
+    if chosen is None:
+        chosen = _paired_bandwidth(ok, rnd, candidates)
+    if chosen is None and deferred:
+        chosen = _first_heldout_winner(deferred, rnd)
+    return chosen

@@ -1,0 +1,339 @@
+"""The weighted fit of an Allan curve with extra effects: the curve, the IRLS NNLS solution, the grid search
+of an effect's nonlinear parameter with its profile interval, and the NoiseFit it becomes.
+
+Every curve effect enters the model as a non-negative column of Allan variance (its registry signature,
+:mod:`allanite.model.effects`); an effect that ``replaces`` a term (a bandwidth: the filtered white noise is
+the white rate noise N) zeroes that term's column. Weights are the estimates' EDF under the model's own
+noise mix, iterated (IRLS); the covariance of the coefficients counts the dense curve's ~one independent
+estimate per octave.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+from scipy.stats import chi2 as chi2_dist
+
+from .. import fitting
+from ..effects import EFFECTS, filtered_white_avar, resonance_avar
+from ..terms import TERM_ALPHA, design_matrix
+
+__all__ = [
+    "base_name",
+    "column",
+    "Curve",
+    "Solution",
+    "design",
+    "solve",
+    "search",
+    "profile_interval",
+    "PROFILE_RHO",
+    "upper_theta",
+    "theta_terms",
+    "noise_fit",
+]
+
+
+def base_name(key: str) -> str:
+    """The effect of a column key ("bandwidth:single_pole" → "bandwidth")."""
+    return key.split(":", 1)[0]
+
+
+def column(key, p, curve):
+    """Allan variance per unit amplitude² of effect ``key`` with nonlinear parameter ``p`` on ``curve``."""
+    base = base_name(key)
+    tau = curve.tau
+    if base == "bandwidth":
+        return filtered_white_avar(tau, key.split(":", 1)[1], p, curve.fs)
+    if base == "resonance":
+        return resonance_avar(tau, p, float(key.split(":", 1)[1]), curve.fs)
+    sig = EFFECTS[base].signature
+    assert sig is not None
+    return sig(tau, p, curve.fs)
+
+
+def _alpha_of(key, p, tau):
+    """Noise type each effect resembles at τ, for the EDF of the estimates."""
+    alpha = EFFECTS[base_name(key)].alpha
+    if alpha is None:
+        return np.zeros(tau.size, dtype=int)
+    return alpha(tau, p)
+
+
+class Curve:
+    """One Allan curve to fit: τ, m, estimates, record length, estimator (for the EDF)."""
+
+    def __init__(self, tau, m, avar, fs, n_points, estimator):
+        self.tau, self.m, self.avar = tau, m, avar
+        self.fs, self.n_points, self.estimator = fs, n_points, estimator
+        self._edf: dict = {}
+        self.n_eff = max(2.0, math.log2(tau[-1] / tau[0]) + 1.0)
+
+    def edf(self, alpha: int) -> np.ndarray:
+        """EDF of each estimate for noise type ``alpha`` (computed once per α)."""
+        if alpha not in self._edf:
+            self._edf[alpha] = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
+        return self._edf[alpha]
+
+    def subset(self, idx):
+        """The curve at the τ indexed by ``idx``."""
+        est = self.estimator if isinstance(self.estimator, str) else tuple(np.asarray(self.estimator)[idx])
+        return Curve(self.tau[idx], self.m[idx], self.avar[idx], self.fs, self.n_points, est)
+
+
+@dataclass
+class Solution:
+    """A weighted fit of a curve: coefficients ``theta``, the model and EDF per τ, normalised residuals ``z``,
+    χ² and its degrees of freedom, the design matrix ``a`` and the coefficients' covariance."""
+
+    theta: np.ndarray
+    model: np.ndarray
+    nu: np.ndarray
+    z: np.ndarray
+    chi2: float
+    dof: int
+    a: np.ndarray
+    cov: np.ndarray
+
+    @property
+    def chi2_dof(self):
+        """χ² per degree of freedom."""
+        return self.chi2 / max(1, self.dof)
+
+    def chi2_eff(self, curve):
+        """χ² scaled to the curve's effective number of independent points (``curve.n_eff`` of its τ)."""
+        return self.chi2 * curve.n_eff / curve.tau.size
+
+
+def design(curve, terms, effects):
+    """Columns of the terms and the effects [(key, nonlinear parameter)] on ``curve``, and each column's
+    noise type per τ (for the EDF)."""
+    tau = curve.tau
+    a0 = design_matrix(tau, tau * curve.fs, curve.fs, terms)
+    for key, _p in effects:
+        rep = EFFECTS[base_name(key)].replaces
+        if rep in terms:
+            a0[:, list(terms).index(rep)] = 0.0
+    cols = [a0] + [column(key, p, curve)[:, None] for key, p in effects]
+    alphas = [np.full(tau.size, TERM_ALPHA[t]) for t in terms] + [_alpha_of(k, p, tau) for k, p in effects]
+    return np.hstack(cols), alphas
+
+
+def solve(curve: Curve, terms, effects, max_iter: int = 40) -> Solution:
+    """IRLS weighted NNLS of the terms plus effects [(key, nonlinear parameter)]."""
+    a, alphas = design(curve, terms, effects)
+    nu_cols = np.column_stack(
+        [
+            np.where(
+                al == -2,
+                curve.edf(-2),
+                np.where(al == -1, curve.edf(-1), np.where(al == 2, curve.edf(2), curve.edf(0))),
+            )
+            for al in alphas
+        ]
+    )
+    y = curve.avar
+    model = y.copy()
+    nu = nu_cols[:, 1] if len(terms) > 1 else nu_cols[:, 0]
+    theta = np.zeros(a.shape[1])
+    floor = 1e-12 * np.max(y)
+    for it in range(max_iter):
+        w = nu / (2.0 * np.maximum(model, floor) ** 2)
+        sw = np.sqrt(w)
+        new = fitting.nnls(a * sw[:, None], y * sw)
+        parts = a * new
+        new_model = np.maximum(parts.sum(axis=1), floor)
+        done = bool(np.all(np.abs(new - theta) <= 1e-6 * np.abs(theta)))  # np.allclose(rtol=1e-6, atol=0)
+        model = new_model if it == 0 else np.sqrt(model * new_model)
+        theta = new
+        if new.any():
+            tot = parts.sum(axis=1)
+            den = np.sum(parts**2 / nu_cols, axis=1)
+            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
+        if done:
+            break
+    return _finish(curve, a, theta, nu, floor, len(effects))
+
+
+def _finish(curve, a, theta, nu, floor, n_effects) -> Solution:
+    """The solution at ``theta``: model, normalised residual, χ², and the coefficients' covariance."""
+    tau = curve.tau
+    model = np.maximum(a @ theta, floor)
+    w = nu / (2.0 * model**2)
+    z = (curve.avar - model) * np.sqrt(w)
+    active = theta > 0
+    cov = np.full((a.shape[1], a.shape[1]), np.nan)
+    if active.any():
+        idx = np.flatnonzero(active)
+        aw = a[:, idx] * w[:, None]
+        cov[np.ix_(idx, idx)] = np.linalg.pinv(aw.T @ a[:, idx]) * (tau.size / curve.n_eff)
+    dof = max(1, tau.size - int(active.sum()) - n_effects)
+    return Solution(theta, model, nu, z, float(np.sum(z**2)), dof, a, cov)
+
+
+def search(curve, terms, effects, key, grid, continuous=True):
+    """Best nonlinear parameter for effect ``key`` on ``grid`` (then refined), its solution, and whether it
+    sits at the edge of the grid."""
+    # screen the grid with a few reweighting passes (the ranking settles early), then solve fully
+    chis = np.array([solve(curve, terms, effects + [(key, p)], max_iter=6).chi2 for p in grid])
+    k = int(np.argmin(chis))
+    lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
+    p = float(grid[k])
+    if continuous and hi > lo:
+        res = minimize_scalar(
+            lambda lp: solve(curve, terms, effects + [(key, math.exp(lp))]).chi2,
+            bounds=(lo, hi),
+            method="bounded",
+            options={"xatol": 1e-3},
+        )
+        p = math.exp(res.x)
+    sol = solve(curve, terms, effects + [(key, p)])
+    if p != float(grid[k]):
+        at_k = solve(curve, terms, effects + [(key, float(grid[k]))])
+        if sol.chi2 > at_k.chi2:
+            p, sol = float(grid[k]), at_k
+    # a best value at the edge of its range is not identified — except a FIR's shortest length (2 taps):
+    # below it lies "no filter", which is the null model itself
+    at_edge = (k == 0 and continuous) or k == grid.size - 1
+    return p, sol, at_edge
+
+
+#: Octave-to-octave correlation of Allan estimates used for the parameters' effective sample size
+#: (the mid value of fit.OCTAVE_CORRELATION: 0.42 white angle … 0.87 random walk).
+PROFILE_RHO = 0.68
+
+
+def profile_interval(curve, terms, effects, key, p, sol):
+    """Interval of the nonlinear parameter where the effective χ² rises by ≤ 1 over its minimum.
+
+    χ² of the dense, correlated τ points is scaled to n_eff·(1 − ρ)/(1 + ρ) independent ones (n_eff
+    octaves whose estimates correlate by ρ = ``PROFILE_RHO`` from one to the next); the crossings are
+    interpolated on a log grid around the best value."""
+    scale = curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / curve.tau.size
+    local = p * np.exp(np.linspace(-1.5, 1.5, 41))
+    lc = np.array([solve(curve, terms, effects + [(key, q)]).chi2 for q in local])
+    d = (lc - min(sol.chi2, lc.min())) * scale - 1.0
+    i0 = int(np.argmin(d))
+    lo_i, hi_i = i0, i0
+    while lo_i > 0 and d[lo_i - 1] <= 0:
+        lo_i -= 1
+    while hi_i < local.size - 1 and d[hi_i + 1] <= 0:
+        hi_i += 1
+    ll = np.log(local)
+
+    def cross(i, j):  # log-parameter where d crosses 0 between i (≤ 0) and j (> 0)
+        return math.exp(ll[i] + (ll[j] - ll[i]) * (-d[i]) / (d[j] - d[i]))
+
+    lo = cross(lo_i, lo_i - 1) if lo_i > 0 else float(local[0])
+    hi = cross(hi_i, hi_i + 1) if hi_i < local.size - 1 else float(local[-1])
+    return (min(lo, p), max(hi, p))
+
+
+def upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4.0):
+    """``theta`` with each slow term (flicker, random walk of rate) raised to the upper end of what the curve
+    allows: the largest value with the others refitted (weighted NNLS, the fit's weights) whose χ² rises by
+    at most ``delta_chi2`` (≈ 2σ; in effective points). A null model for a time-domain test must not leave
+    out a random walk the curve merely could not pin down: one that is there makes warm-up-like wander in the
+    block means."""
+    out = theta.copy()
+    a, _ = design(curve, terms, effects)
+    w = np.sqrt(sol.nu / (2.0 * sol.model**2))
+    aw, yw = a * w[:, None], curve.avar * w
+    chi_min = float(np.sum((yw - aw @ fitting.nnls(aw, yw)) ** 2))
+    # the dense curve's points are strongly correlated: χ² counts ~n_eff independent ones (as the fit's
+    # covariance does), so the rise allowed on the dense χ² is scaled by points / n_eff
+    delta_chi2 = delta_chi2 * curve.tau.size / curve.n_eff
+    for name in slow:
+        if name not in terms:
+            continue
+        j = list(terms).index(name)
+        col = aw[:, j]
+        others = np.delete(aw, j, axis=1)
+        top = float(np.min(curve.avar / np.maximum(a[:, j], 1e-300)))  # alone it would explain a point
+        best = 0.0
+        for v in top * np.geomspace(1e-4, 1.0, 41):
+            r = yw - v * col
+            chi = float(np.sum((r - others @ fitting.nnls(others, r)) ** 2))
+            if chi - chi_min <= delta_chi2:
+                best = v
+        out[j] = max(out[j], best)
+    return out
+
+
+def theta_terms(sol, terms, effects):
+    """Squared coefficients of the terms (a bandwidth's N in place of the zeroed N column)."""
+    k = len(terms)
+    theta = sol.theta[:k].copy()
+    for j, (key, _p) in enumerate(effects):
+        if EFFECTS[base_name(key)].replaces == "N" and "N" in terms:
+            theta[list(terms).index("N")] = sol.theta[k + j]
+    return theta
+
+
+def _coefficients(sol, terms, effects, unit, zq, inflate) -> tuple[dict, np.ndarray, np.ndarray]:
+    """The terms' coefficients (a bandwidth's N reported as N) and each effect's amplitude, with intervals."""
+    k = len(terms)
+    theta = sol.theta[:k].copy()
+    cov = sol.cov[:k, :k].copy()
+    # a bandwidth carries the white rate noise N (before the filter): report it as N
+    for j, (key, _p) in enumerate(effects):
+        if EFFECTS[base_name(key)].replaces == "N" and "N" in terms:
+            i_n = list(terms).index("N")
+            theta[i_n] = sol.theta[k + j]
+            cov[i_n, :] = cov[:, i_n] = np.nan
+            cov[i_n, i_n] = sol.cov[k + j, k + j]
+    coeffs = fitting.coefficients(terms, theta, cov, zq, inflate, unit)
+    for j, (key, _param) in enumerate(effects):
+        i = k + j
+        name = effect_column_name(key, j, effects)
+        coeffs[name] = fitting.Coefficient(
+            name=name,
+            value=float(math.sqrt(max(sol.theta[i], 0.0))),
+            ci=fitting.interval(sol.theta[i], sol.cov[i, i], zq, inflate),
+            unit=unit,
+        )
+    return coeffs, theta, cov
+
+
+def effect_column_name(key, j, effects) -> str:
+    """The name of effect ``j``'s column among a fit's coefficients and components (numbered when the same
+    effect is in the model more than once)."""
+    name = base_name(key) if base_name(key) != "regression" else key.replace(":", "_")
+    return f"{name}{j + 1}" if sum(base_name(e[0]) == base_name(key) for e in effects) > 1 else name
+
+
+def noise_fit(curve, terms, effects, sol, result, unit, confidence):
+    """A NoiseFit for the solution, with the effects' parameters among the coefficients."""
+    zq = fitting.z_quantile(confidence)
+    k = len(terms)
+    inflate = max(1.0, math.sqrt(sol.chi2_dof))
+    coeffs, theta, cov = _coefficients(sol, terms, effects, unit, zq, inflate)
+    comps = {t: sol.a[:, i] * sol.theta[i] for i, t in enumerate(terms)}
+    for j, (key, _param) in enumerate(effects):
+        comps[effect_column_name(key, j, effects)] = sol.a[:, k + j] * sol.theta[k + j]
+    readoffs = fitting.readoffs(result, np.sqrt(np.atleast_2d(result.avar)[0]))
+    return fitting.NoiseFit(
+        coefficients=coeffs,
+        terms=terms,
+        tau=curve.tau,
+        m=curve.m,
+        avar=curve.avar,
+        edf=sol.nu,
+        model=sol.model,
+        components=comps,
+        z=sol.z,
+        chi2=sol.chi2,
+        dof=sol.dof,
+        chi2_dof=sol.chi2_dof,
+        p_value=float(chi2_dist.sf(sol.chi2, sol.dof)),
+        readoffs=readoffs,
+        fs=curve.fs,
+        confidence=confidence,
+        unit=unit,
+        iterations=0,
+        theta=theta,
+        covariance=cov,
+    )

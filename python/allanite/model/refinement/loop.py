@@ -1,0 +1,514 @@
+"""The loop of :func:`allanite.refine`: fit the starting model, remove what the samples show in time, then
+add curve effects one at a time while a calibrated test asks for one and the held-out error falls; change
+points last; every step scored with its error before and after.
+
+The pieces live in modules of their own, each named for what it decides: the weighted fit with effects
+(:mod:`.curvefit`), the errors in-sample and held out (:mod:`.scoring`), the curve test (:mod:`.calibrated`),
+the false-alarm budget (:mod:`.levels`), the curve candidates and which one a step accepts
+(:mod:`.candidates`), the removals in time (:mod:`.removals`), the change points (:mod:`.changes`), and the
+result with its report (:mod:`.result`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..._progress import StepBar
+from ..._validate import as_rate_columns
+from ...analysis import avar
+from ...errors import InputError, ParameterError
+from ...estimators.grid import tau_grid
+from ...results import AllanResult
+from .. import fitting, tracing
+from ..effects import EFFECTS, describe
+from ..terms import check_terms
+from .calibrated import N_BOOT, curve_test, residual_evidence, tested
+from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families
+from .changes import change_points
+from .curvefit import Curve, base_name, noise_fit, solve
+from .levels import LEVEL, alpha
+from .missing import MissingContext, unexplained
+from .removals import REMOVALS, Removal, RemovalContext
+from .result import Refinement, Step
+from .scoring import HELDOUT_BLOCKS, curve_metrics, heldout_split, informative, removal_metrics, segments_heldout
+
+__all__ = ["refine", "CANDIDATES", "MAX_STEPS", "REFINE_SCALE"]
+
+#: Effects refine can add, from the registry in :mod:`allanite.model.effects`.
+CANDIDATES = tuple(EFFECTS)
+#: Curve effects added at most (time-domain removals and change points come on top).
+MAX_STEPS = 4
+
+
+def _resolve_tau_range(tau_range, result, start):
+    if isinstance(tau_range, str):
+        if tau_range != "auto":
+            raise ParameterError(f"tau_range must be a (low, high) pair of seconds or 'auto', got {tau_range!r}")
+        nf = fitting.fit(result, terms=start, tau_range="auto")
+        return float(nf.tau[0]) * (1 - 1e-9), math.inf
+    return (0.0, math.inf) if tau_range is None else fitting.check_tau_range(tau_range)
+
+
+#: refine's searches square and multiply variances: samples beyond this magnitude range are refused (fit and
+#: avar handle any scale exactly; refine's NNLS searches on 1e-300 variances do not).
+REFINE_SCALE = (1e-100, 1e100)
+
+
+def _check_scale(x_or_result) -> None:
+    values = x_or_result.avar if isinstance(x_or_result, AllanResult) else x_or_result
+    if np.iscomplexobj(values):
+        return  # the samples' own checks refuse complex samples (a float cast would drop the imaginary part)
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        return  # the samples' own checks report it
+    finite = arr[np.isfinite(arr)] if arr.size else arr
+    peak = float(np.max(np.abs(finite))) if finite.size else 0.0
+    if isinstance(x_or_result, AllanResult):
+        peak = peak**0.5
+    if peak > 0 and not REFINE_SCALE[0] < peak < REFINE_SCALE[1]:
+        raise InputError(
+            f"refine needs samples of magnitude within {REFINE_SCALE[0]:g}…{REFINE_SCALE[1]:g}, got {peak:.3g}: "
+            f"express them in another unit (avar and fit take any scale)"
+        )
+
+
+def refine(
+    x_or_result,
+    fs=None,
+    *,
+    start=("Q", "N", "B", "K", "R"),
+    candidates=CANDIDATES,
+    unit=None,
+    input: str = "rate",
+    tau_range=None,
+    truth=None,
+    confidence: float = 0.683,
+    points: int = 300,
+    axis: int = 0,
+    channels=None,
+    level: float = LEVEL,
+    progress=None,
+) -> Refinement:
+    """Fit the starting model, find what it lacks, add it, repeat; report the error before and after.
+
+        Parameters
+        ----------
+        x_or_result : array_like or AllanResult
+            Samples (then ``fs`` is needed; the Allan variance is computed on a dense exponential grid of
+            ``points`` τ so that a sinusoid's nulls are resolved, the PSD and the record along time are
+            searched too, and the held-out error is computed), or a static :class:`~allanite.AllanResult`
+            (curve effects only; no held-out error).
+        fs : float, optional
+            Sampling rate, Hz (samples only).
+        start : tuple of str
+            The starting model's terms (``"Q"``, ``"N"``, ``"B"``, ``"K"``, ``"R"``).
+        candidates : tuple of str
+            Effects to try (:data:`CANDIDATES`, the registry :data:`allanite.model.effects.EFFECTS`), with the
+            parameters each step reports and their units ("rate unit": the samples' rate unit):
+
+    {effects}
+        unit : str, optional
+            Unit of the samples, for IEEE-952 values of the terms.
+        tau_range : (float, float) or "auto", optional
+            τ (s) to use, as in :func:`allanite.fit`. Default: every τ — the shortest τ carry the sensor's
+            bandwidth, which is a candidate effect; ``"auto"`` cuts them as ``fit`` does.
+        channels : dict of str → array_like, optional
+            Other channels of the same log (same length as the samples: temperature, other axes,
+            accelerometers): the rate is regressed on each ("regression" effect; band by band where the
+            coupling differs across frequency, the bands in the step's ``evidence["bands"]``).
+        level : float
+            False-alarm probability per record on a clean record (default 0.05), split between spectral
+            lines, the Allan-curve test and change points.
+        progress : bool, optional
+            A ``tqdm.auto`` bar: None (default) in a notebook or a terminal only, True/False always/never.
+        truth : dict, optional
+            Known parameters per effect (``{"gauss_markov": {"sigma": …, "tc": …}}``, ``{"change_point":
+            {"t": …}}``): each step then records its relative errors.
+        axis : int
+            Which axis of multi-axis input to refine.
+
+        Returns
+        -------
+        Refinement
+
+        Examples
+        --------
+        >>> import allanite
+        >>> y = allanite.simulate(1_000_000, 100.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 10.0)], seed=11)
+        >>> r = allanite.refine(y, 100.0)               # the generator's GM is not in the starting model
+        >>> r.found, round(r.steps[0].params["tc"], 0)
+        (['gauss_markov'], 10.0)
+    """
+    _check_scale(x_or_result)
+    with StepBar(progress, 1, "refine") as bar:
+        bar.step("fit, trace and test the candidates")
+        start = check_terms(start)
+        candidates = _check_candidates(candidates, level)
+        y, result, chans = _inputs(x_or_result, fs, input, points, axis, channels)
+        run = _Run(y, result, start, tau_range, level, truth)
+        run.remove_in_time(candidates, chans)
+        run.add_curve_effects(candidates)
+        cp_steps = run.change_point_steps(candidates)
+        run.rescore_removals()
+        return run.refinement(cp_steps, unit, confidence, run.unexplained(chans))
+
+
+def _check_candidates(candidates, level) -> tuple:
+    if isinstance(candidates, str):
+        candidates = (candidates,)
+    bad = [c for c in candidates if c not in CANDIDATES]
+    if bad:
+        raise ParameterError(f"unknown candidate effect {bad[0]!r}; allowed: {', '.join(CANDIDATES)}")
+    if not (isinstance(level, (int, float)) and 0.0 < level < 1.0):
+        raise ParameterError(f"level must be a probability in (0, 1), got {level!r}")
+    return candidates
+
+
+def _inputs(x_or_result, fs, input, points, axis, channels):
+    """(samples or None, the static one-row AllanResult to refine, the channels by name), checked."""
+    y = None
+    if isinstance(x_or_result, AllanResult):
+        if fs is not None:
+            raise ParameterError("fs is taken from the result; pass fs only with samples")
+        result = x_or_result
+    elif hasattr(x_or_result, "tau") and hasattr(x_or_result, "t"):
+        raise ParameterError(
+            "refine needs samples or a static AllanResult; for a dynamic result pass the samples "
+            "so that change points can be located"
+        )
+    else:
+        if fs is None:
+            raise ParameterError("fs (Hz) is needed with samples")
+        cols, fs, _ = as_rate_columns(x_or_result, fs, input)
+        if not 0 <= axis < len(cols):
+            raise ParameterError(f"axis = {axis} is outside 0..{len(cols) - 1}")
+        y = cols[axis]
+        top = max(1, y.size // 9)
+        grid = tau_grid(y.size, fs, "exp", points=points, m_max=top) if top > 1 else "octave"
+        result = avar(y, fs, taus=grid)
+    chans = _channels(channels, y)
+    if result.avar.ndim == 2:
+        result = AllanResult(
+            tau=result.tau,
+            avar=result.avar[axis],
+            n=result.n,
+            m=result.m,
+            estimator=result.estimator,
+            fs=result.fs,
+            n_samples=result.n_samples,
+            input=result.input,
+            source=result.source,
+        )
+    return y, result, chans
+
+
+def _channels(channels, y) -> dict:
+    chans: dict = {}
+    if channels:
+        if y is None:
+            raise ParameterError("channels need samples (a regression is fitted along time), not an AllanResult")
+        for name, c in channels.items():
+            c = np.asarray(c, dtype=np.float64).ravel()
+            if c.size != y.size:
+                raise ParameterError(f"channel {name!r} has {c.size} samples; the rate has {y.size}")
+            if not np.all(np.isfinite(c)):
+                raise ParameterError(f"channel {name!r} has non-finite samples")
+            chans[str(name)] = c
+    return chans
+
+
+def _heldout_note(y, heldout) -> str:
+    if y is None:
+        return "curve-only input (an AllanResult without samples): no held-out error; steps rest on the calibrated test"
+    if heldout is None:
+        return "record too short to hold out alternate blocks: no held-out error"
+    return (
+        f"alternate blocks in time ({HELDOUT_BLOCKS}; odd ↔ even, each part's blocks joined): the model fitted "
+        "on one part predicts the other part's Allan curve, both ways, mean RMS ADEV error on the τ whose "
+        "estimate is within ±10 % (4 per octave); a drift is refitted on the held-in part"
+    )
+
+
+class _Run:
+    """One refinement under way: the samples and their curve as removals change them, the model so far, the
+    steps, and what was considered and turned down."""
+
+    def __init__(self, y, result, start, tau_range, level, truth):
+        self.y, self.result, self.start, self.level, self.truth = y, result, start, level, truth
+        self.lo, self.hi = _resolve_tau_range(tau_range, result, start)
+        keep = (result.tau >= self.lo) & (result.tau <= self.hi) & (result.avar > 0)
+        if keep.sum() < len(start) + 3:
+            raise ParameterError(
+                f"{int(keep.sum())} usable τ points; refining {len(start)} terms needs at least {len(start) + 3}"
+            )
+        self.keep = keep
+        self.est = result.estimator if result.source is None else tuple(np.asarray(result.source)[keep])
+        self.fs = result.fs
+        self.curve, self.heldout = self.build(result, y)
+        self.note = _heldout_note(y, self.heldout)
+        self.sol = self.start_sol = solve(self.curve, start, [])
+        # in-sample RMS ADEV error: on the τ whose estimate is informative under the five-term fit (fixed for
+        # the whole refinement, so every before/after compares the same τ)
+        self.scored = informative(self.curve.tau, self.sol.nu)
+        self.start_heldout = self.heldout.error(start, []) if self.heldout is not None else None
+        self.effects: list = []  # curve effects [(key, nonlinear parameter)], steps[j] ↔ effects[j]
+        self.steps: list = []
+        self.amplitudes: list = []  # per curve step: its parameter that is the column's amplitude, or None
+        self.first_steps: list = []  # time effects removed before the curve effects
+        self.removed: list = []  # (step, removal) of each
+        self.considered: dict[str, list] = {}
+
+    def build(self, res, samples):
+        """The curve (and, with samples, the held-out split) of ``res``'s estimates in the τ range."""
+        keep = self.keep
+        c = Curve(res.tau[keep], res.m[keep].astype(np.float64), res.avar[keep], self.fs, res.n_samples + 1, self.est)
+        if samples is None:
+            return c, None
+        m_all = np.asarray(res.m, dtype=np.int64)
+        return c, heldout_split(samples, self.fs, m_all, self.lo, self.hi, self.start)
+
+    def metrics(self, c, s, ho) -> dict:
+        return curve_metrics(c, s, ho, self.scored)
+
+    def consider(self, effect: str, entry: dict) -> None:
+        self.considered.setdefault(effect, []).append(entry)
+
+    def truth_error(self, effect: str, params: dict) -> dict | None:
+        """Relative errors of the numeric parameters ``truth`` gives for ``effect``."""
+        if not self.truth or effect not in self.truth:
+            return None
+        return {
+            k: params[k] / v - 1
+            for k, v in self.truth[effect].items()
+            if k in params and not isinstance(params[k], str) and v
+        }
+
+    # ---- time-domain removals, before the curve effects
+
+    def remove_in_time(self, candidates, chans) -> None:
+        """Every removal of :data:`REMOVALS` among ``candidates``, in order, each on the samples the ones
+        before it left."""
+        if self.y is None:
+            return
+        ctx = RemovalContext(self.y, self.fs, self.curve, self.sol, self.start, chans, self.level, self.consider)
+        for name, remover in REMOVALS.items():
+            if name not in candidates:
+                continue
+            for rem in remover(ctx):
+                st = self.remove(rem)
+                if st is not None:
+                    self.first_steps.append(st)
+                    self.removed.append((st, rem))
+                    ctx.y, ctx.curve, ctx.sol = self.y, self.curve, self.sol
+
+    def remove(self, rem: Removal) -> Step | None:
+        """Remove ``rem.component`` if the held-out error falls (or its held-out test in time passes); the step,
+        or None (recorded among the considered)."""
+        y, start, effects, heldout = self.y, self.start, self.effects, self.heldout
+        assert y is not None
+        y_new = y - rem.component
+        res_new = avar(y_new, self.fs, taus=self.result.tau)
+        c_new, h_new = self.build(res_new, y_new)
+        ho_b = heldout.error(start, effects) if heldout is not None else None
+        ho_a = heldout.error(start, effects, remove=rem.refit, on_raw=rem.on_raw) if heldout is not None else None
+        s_new = solve(c_new, start, effects)
+        if rem.heldout_in_time is not None:
+            rem.evidence["heldout_variance_ratio"] = rem.heldout_in_time
+            rejected = not rem.heldout_in_time < 1.0
+        else:
+            rejected = ho_b is not None and ho_a is not None and not ho_a < ho_b
+        if rejected:
+            why = f"held-out error {ho_b} → {ho_a} %, variance ratio {rem.heldout_in_time}"
+            self.consider(rem.effect, rem.params | {"rejected": why, "test": rem.evidence["test"]})
+            return None
+        keep = self.keep
+        st = Step(
+            effect=rem.effect,
+            params=rem.params,
+            intervals=rem.intervals,
+            evidence=rem.evidence,
+            before=self.metrics(self.curve, self.sol, ho_b),
+            # on the same curve as "before": the new noise model plus what the removal changed in the curve
+            after=removal_metrics(
+                self.curve, s_new, self.result.avar[keep] - res_new.avar[keep], rem.n_fitted, ho_a, self.scored
+            ),
+            delta_chi2_eff=float(self.sol.chi2_eff(self.curve) - s_new.chi2_eff(c_new)),
+            truth_error=self.truth_error(rem.effect, rem.params),
+        )
+        self.y, self.result, self.curve, self.heldout, self.sol = y_new, res_new, c_new, h_new, s_new
+        return st
+
+    # ---- curve effects
+
+    def add_curve_effects(self, candidates) -> None:
+        """Curve effects one per step (at most :data:`MAX_STEPS`) while one is accepted; then an effect whose
+        amplitude a later one took over entirely is dropped, and the amplitudes come from the joint fit."""
+        y = self.y
+        exact = y is not None or (isinstance(self.est, str) and self.est == "oavar")
+        thin = tracing.thin_indices(self.curve.tau)
+        lines = []
+        if y is not None and "sinusoid" in candidates:
+            lines = tracing.spectral_lines(y, self.fs, alpha("lines", self.level))
+        for n_step in range(MAX_STEPS):
+            if not self.curve_step(n_step, candidates, thin, exact, lines):
+                break
+        self.drop_absorbed()
+
+    def curve_step(self, n_step, candidates, thin, exact, lines) -> bool:
+        """One step: every candidate's proposal, the one :func:`choose` accepts added; False if none."""
+        sub = self.curve.subset(thin)
+        test = curve_test(self.curve, thin, self.sol, self.start, self.effects, exact)
+        fam = families(sub, candidates, self.y is not None)
+        thr = test.threshold(fam, alpha("curve", self.level), N_BOOT, seed=n_step)
+        rnd = Round(self.curve, sub, self.start, self.effects, self.sol, test, thr, self.heldout, self.y, lines)
+        props = [pr for name, c in CURVE_CANDIDATES.items() if name in candidates for pr in c.propose(rnd)]
+        for pr in props:
+            pr.record = {"param": float(pr.p), "statistic": float(pr.stat), "threshold": float(pr.thr)}
+            self.consider(pr.effect, pr.record)
+        chosen = choose(props, rnd, candidates)
+        if chosen is None:
+            return False
+        pr, ho_b, ho_a = chosen
+        self.steps.append(self.curve_effect_step(pr, rnd, ho_b, ho_a))
+        self.amplitudes.append(CURVE_CANDIDATES[pr.effect].amplitude(pr))
+        self.effects, self.sol = self.effects + [(pr.key, pr.p)], pr.sol
+        return True
+
+    def curve_effect_step(self, pr: Proposal, rnd: Round, ho_b, ho_a) -> Step:
+        cand = CURVE_CANDIDATES[pr.effect]
+        params, intervals = cand.params(pr, rnd)
+        evidence = residual_evidence(self.curve, self.sol)
+        evidence["domain"] = EFFECTS[pr.effect].domain
+        if pr.line is not None:
+            evidence["test"] = tested("psd_ratio", pr.stat, pr.thr, alpha("lines", self.level))
+        else:
+            evidence["test"] = tested("gls_score", pr.stat, pr.thr, alpha("curve", self.level))
+        evidence.update(cand.evidence(pr, rnd))
+        if pr.pair_note is not None:
+            evidence["held_out"] = pr.pair_note
+        return Step(
+            effect=pr.effect,
+            params=params,
+            intervals=intervals,
+            evidence=evidence,
+            before=self.metrics(self.curve, self.sol, ho_b),
+            after=self.metrics(self.curve, pr.sol, ho_a),
+            delta_chi2_eff=float(self.sol.chi2_eff(self.curve) - pr.sol.chi2_eff(self.curve)),
+            truth_error=self.truth_error(pr.effect, params),
+        )
+
+    def drop_absorbed(self) -> None:
+        """Drop an effect whose amplitude a later one took over entirely (refit without it); take each curve
+        step's amplitude from the final joint solution."""
+        k = len(self.start)
+        dead = [j for j in range(len(self.effects)) if self.sol.theta[k + j] <= 0]
+        if dead:
+            for j in reversed(dead):
+                key, p = self.effects[j]
+                self.consider(base_name(key), {"param": float(p), "absorbed": True})
+                del self.effects[j], self.steps[j], self.amplitudes[j]
+            self.sol = solve(self.curve, self.start, self.effects)
+        for j, (st, name) in enumerate(zip(self.steps, self.amplitudes)):
+            if name is not None:
+                st.params[name] = math.sqrt(max(self.sol.theta[k + j], 0.0))
+                if st.truth_error is not None:
+                    st.truth_error = self.truth_error(st.effect, st.params)
+
+    # ---- change points, and the removals scored against the final model
+
+    def change_point_steps(self, candidates) -> list:
+        """Steps of the change points the held-out error confirms (their statistic: the windows' levels)."""
+        y = self.y
+        if y is None or "change_point" not in candidates:
+            self.change_points = []
+            return []
+        cps = change_points(y, self.fs, self.start)
+        ho_cp = None
+        if cps and self.heldout is not None:
+            m_all = np.asarray(self.result.m, dtype=np.int64)
+            times = [c["t"] for c in cps]
+            ho_cp = segments_heldout(self.heldout, y, self.fs, m_all, self.lo, self.hi, self.start, self.effects, times)
+        if ho_cp is not None and not ho_cp[1] < ho_cp[0]:
+            for c in cps:
+                why = f"held-out error {ho_cp[0]:.3g} → {ho_cp[1]:.3g} %"
+                self.consider("change_point", {"t": c["t"], "gain_chi2": c["gain"], "rejected": why})
+            cps = []
+        self.change_points = cps
+        return [self.change_point_step(c, ho_cp) for c in cps]
+
+    def change_point_step(self, c: dict, ho_cp) -> Step:
+        assert self.y is not None
+        terr = None
+        if self.truth and "change_point" in self.truth:
+            ts = np.atleast_1d(self.truth["change_point"]["t"])
+            terr = {"t": float(np.min(np.abs(ts - c["t"])) / (self.y.size / self.fs))}
+        c["before"]["heldout_rms_adev_pct"] = None if ho_cp is None else ho_cp[0]
+        c["after"]["heldout_rms_adev_pct"] = None if ho_cp is None else ho_cp[1]
+        evidence = {
+            "domain": "time",
+            "tau": c["tau"],
+            "window_s": c["window_s"],
+            "coarse_split_s": c["coarse_split_s"],
+            "gain_chi2": c["gain"],
+        }
+        return Step(
+            effect="change_point",
+            params={"t": c["t"]},
+            intervals={"t": c["interval"]},
+            evidence=evidence,
+            before=c["before"],
+            after=c["after"],
+            delta_chi2_eff=c["gain"],
+            truth_error=terr,
+        )
+
+    def rescore_removals(self) -> None:
+        """A time effect went before the curve effects (on the five terms alone); its before/after are scored
+        against the final model — the same curve effects with and without it in the samples (the other
+        removals stay removed)."""
+        start, effects, sol = self.start, self.effects, self.sol
+        for st, rem in self.removed:
+            y_raw = self.y + rem.component
+            c_raw, h_raw = self.build(avar(y_raw, self.fs, taus=self.result.tau), y_raw)
+            s_raw = solve(c_raw, start, effects)
+            st.before = self.metrics(c_raw, s_raw, h_raw.error(start, effects) if h_raw is not None else None)
+            # after: on the raw curve too — the final model plus what removing it changed in the curve
+            # (y_raw − comp is the final samples, whose curve the final model was fitted to)
+            ho_after = h_raw.error(start, effects, remove=rem.refit, on_raw=rem.on_raw) if h_raw is not None else None
+            st.after = removal_metrics(c_raw, sol, c_raw.avar - self.curve.avar, rem.n_fitted, ho_after, self.scored)
+            st.delta_chi2_eff = float(s_raw.chi2_eff(c_raw) - sol.chi2_eff(self.curve))
+            st.evidence["scored_with"] = [base_name(k) for k, _p in effects] or "the five terms"
+
+    def unexplained(self, chans) -> list:
+        """What the final model still misses, every domain's check at its own share of ``level``."""
+        exact = self.y is not None or (isinstance(self.est, str) and self.est == "oavar")
+        thin = tracing.thin_indices(self.curve.tau)
+        ctx = MissingContext(
+            self.curve, thin, self.sol, self.start, self.effects, self.y, self.fs, self.level, exact, chans
+        )
+        return unexplained(ctx)
+
+    def refinement(self, cp_steps, unit, confidence, missing) -> Refinement:
+        start_fit = noise_fit(self.curve, self.start, [], self.start_sol, self.result, unit, confidence)
+        final_fit = noise_fit(self.curve, self.start, self.effects, self.sol, self.result, unit, confidence)
+        return Refinement(
+            steps=self.first_steps + self.steps + cp_steps,
+            fit=final_fit,
+            start=start_fit,
+            result=self.result,
+            terms=self.start,
+            effects=self.effects,
+            change_points=self.change_points,
+            considered=self.considered,
+            heldout_note=self.note,
+            start_heldout_rms_adev_pct=self.start_heldout,
+            scored_tau=self.curve.tau[self.scored],
+            tau_range=(self.lo, self.hi),
+            unexplained=missing,
+        )
+
+
+refine.__doc__ = (refine.__doc__ or "").replace("{effects}", describe())

@@ -1,0 +1,220 @@
+"""What the final model still misses — ``Refinement.unexplained``, domain by domain, each at its share of ``level``.
+
+After the last step every domain's calibrated test is run once more against the final model, whether or not its
+candidate was allowed: what a test still finds is reported, not added. Each check spends its own share of
+``level`` (:data:`.levels.SHARES`, the ``"unexplained:…"`` entries), so on a complete model the list is empty but
+at that rate. Entries are dicts (largest misfit first) with ``"domain"``, ``"tau"`` (lo, hi) s, ``"band_hz"``
+(lo, hi) or None (curve-only input), ``"chi2_dof"`` over that τ range of the dense curve (None where the evidence
+is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"threshold"`` and ``"alpha"``.
+
+- ``"allan"`` — the acceptance test itself (:class:`allanite.model.tracing.ScoreTest`: GLS score of one more
+  non-negative column, the maximum over every curve candidate's family — sinusoids' nulls included — and the
+  start terms' own columns, bootstrapped under the final model); the region is where the winning column, with
+  the model's fitted directions projected out, carries its weight, and further regions follow with the winner
+  added to the model, at the same threshold (reported where the dense curve's χ²/dof there exceeds 1). With samples the frequency band is refined on the PSD of the
+  final residual samples: the part of ≈ 1/(2τ_hi) … 1/(2τ_lo) (widened ×2) that stands above the spectrum's
+  running median.
+- ``"psd"`` — spectral lines of the final samples (:func:`allanite.model.tracing.spectral_lines`) that no
+  sinusoid of the model accounts for.
+- ``"time"`` — a warm-up drift left in the final samples (:func:`allanite.model.tracing.drift_fit` against its
+  bootstrap threshold under the final model's slow terms).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import signal
+from scipy.linalg import solve_triangular
+
+from .. import tracing
+from ..terms import design_matrix
+from .calibrated import N_BOOT, curve_test
+from .candidates import CURVE_CANDIDATES, families
+from .curvefit import Curve, Solution, base_name, theta_terms, upper_theta
+from .levels import alpha
+
+__all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS"]
+
+#: Regions the curve check reports at most.
+MAX_REGIONS = 3
+#: A column's projected weight counts towards its region where it is at least this share of its peak.
+REGION_SHARE = 0.3
+
+
+@dataclass
+class MissingContext:
+    """The final state a check looks at: the curve and its fitted solution (terms ``start`` + ``effects``), the
+    thinned τ, the final samples (None for curve-only input) and their rate, the channels, ``level``, and
+    whether the five terms' covariance across τ is exact."""
+
+    curve: Curve
+    thin: np.ndarray
+    sol: Solution
+    start: tuple
+    effects: list
+    y: np.ndarray | None
+    fs: float
+    level: float
+    exact: bool
+    channels: dict = field(default_factory=dict)
+
+
+def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
+    """Indices (i, j) of the thinned τ run where column ``col``, the model's directions projected out, carries
+    its weight (≥ REGION_SHARE of its peak, contiguous around the peak, in units of each estimate's SD)."""
+    cw = solve_triangular(test.chol, col, lower=True)
+    if test.q.shape[1]:
+        cw = cw - test.q @ (test.q.T @ cw)
+    back = np.abs(test.chol @ cw) / np.sqrt(np.maximum(np.sum(test.chol**2, axis=1), 1e-300))
+    k = int(np.argmax(back))
+    keep = back >= REGION_SHARE * back[k]
+    i = k
+    while i > 0 and keep[i - 1]:
+        i -= 1
+    j = k
+    while j + 1 < back.size and keep[j + 1]:
+        j += 1
+    return i, j
+
+
+def _chi2_dof(ctx: MissingContext, lo: float, hi: float) -> float:
+    sel = (ctx.curve.tau >= lo * (1 - 1e-9)) & (ctx.curve.tau <= hi * (1 + 1e-9))
+    z = ctx.sol.z[sel]
+    return float(np.mean(z**2)) if z.size else float("nan")
+
+
+def _curve(ctx: MissingContext, a: float) -> list[dict]:
+    sub = ctx.curve.subset(ctx.thin)
+    fam = families(sub, tuple(CURVE_CANDIDATES), False)
+    terms = design_matrix(sub.tau, sub.m, ctx.fs, ctx.start)
+    fam = np.column_stack([fam, terms]) if fam.size else terms
+    test = curve_test(ctx.curve, ctx.thin, ctx.sol, ctx.start, ctx.effects, ctx.exact)
+    thr = test.threshold(fam, a, N_BOOT, seed=7919)
+    out: list[dict] = []
+    for _ in range(MAX_REGIONS):
+        stats = _statistics(test, fam, sub.avar - test.model)
+        c = int(np.argmax(stats))
+        if not stats[c] > thr:
+            break
+        i, j = _region_of(test, fam[:, c])
+        lo, hi = float(sub.tau[i]), float(sub.tau[j])
+        test = _with_column(test, fam[:, c])
+        if out and not _chi2_dof(ctx, lo, hi) > 1.0:
+            continue  # a further column the residual leans on, where the curve itself is within its scatter
+        out.append(
+            {
+                "domain": "allan",
+                "tau": (lo, hi),
+                "band_hz": None if ctx.y is None else _band(ctx.y, ctx.fs, lo, hi),
+                "chi2_dof": _chi2_dof(ctx, lo, hi),
+                "what": "the Allan curve departs from the model",
+                "statistic": float(stats[c]),
+                "threshold": thr,
+                "alpha": a,
+            }
+        )
+    return out
+
+
+def _statistics(test: tracing.ScoreTest, fam: np.ndarray, resid: np.ndarray) -> np.ndarray:
+    """:meth:`ScoreTest.statistic` of every column of ``fam`` at once (0 for a column the model already spans)."""
+    cw = solve_triangular(test.chol, fam, lower=True)
+    rw = solve_triangular(test.chol, resid, lower=True)
+    if test.q.shape[1]:
+        cw = cw - test.q @ (test.q.T @ cw)
+        rw = rw - test.q @ (test.q.T @ rw)
+    nrm = np.linalg.norm(cw, axis=0)
+    ok = nrm > 1e-3 * np.maximum(np.linalg.norm(solve_triangular(test.chol, fam, lower=True), axis=0), 1e-300)
+    return np.where(ok, np.maximum(cw.T @ rw, 0.0) / np.maximum(nrm, 1e-300), 0.0) ** 2
+
+
+def _with_column(test: tracing.ScoreTest, col: np.ndarray) -> tracing.ScoreTest:
+    """``test`` with ``col`` among the model's fitted directions (a found region is not found again)."""
+    cw = solve_triangular(test.chol, col[:, None], lower=True)
+    basis = np.hstack([test.q, cw]) if test.q.shape[1] else cw
+    test.q = np.linalg.qr(basis)[0]
+    return test
+
+
+def _band(y: np.ndarray, fs: float, tau_lo: float, tau_hi: float) -> tuple[float, float]:
+    """≈ 1/(2τ_hi) … 1/(2τ_lo), narrowed to the part of it (widened ×2) where the final samples' Welch PSD
+    stands above its running median by more than its own scatter; the nominal band where nothing does."""
+    f_lo, f_hi = 0.5 / tau_hi, min(0.5 / tau_lo, 0.5 * fs)
+    nper = int(min(2**14, 2 ** int(math.log2(max(y.size // 16, 256)))))
+    f, p = signal.welch(y - y.mean(), fs=fs, nperseg=nper, detrend="linear")
+    nseg = max(1, (y.size - nper) // (nper // 2) + 1)
+    sel = (f >= f_lo / 2) & (f <= min(2 * f_hi, 0.5 * fs)) & (f > 0)
+    if np.count_nonzero(sel) < 8:
+        return (f_lo, f_hi)
+    lp = np.log(p[sel])
+    width = max(5, int(lp.size // 8) | 1)
+    med = signal.medfilt(lp, width)
+    up = np.flatnonzero(lp - med > 3.0 / math.sqrt(nseg) + 0.5)
+    if up.size == 0:
+        return (f_lo, f_hi)
+    fsel = f[sel]
+    return (float(fsel[up[0]]), float(fsel[up[-1]]))
+
+
+def _lines(ctx: MissingContext, a: float) -> list[dict]:
+    if ctx.y is None:
+        return []
+    have = [p for k, p in ctx.effects if base_name(k) == "sinusoid"]
+    out = []
+    for ln in tracing.spectral_lines(ctx.y, ctx.fs, a, max_lines=len(have) + 4):
+        if any(abs(ln["f0"] - f) <= 2 * ln["bin_hz"] for f in have):
+            continue
+        f0 = float(ln["f0"])
+        lo, hi = max(0.2 / f0, float(ctx.curve.tau[0])), min(1.0 / f0, float(ctx.curve.tau[-1]))
+        out.append(
+            {
+                "domain": "psd",
+                "tau": (lo, hi),
+                "band_hz": (f0 - ln["bin_hz"], f0 + ln["bin_hz"]),
+                "chi2_dof": _chi2_dof(ctx, lo, hi) if hi >= lo else None,
+                "what": f"a spectral line at {f0:.4g} Hz (amplitude {ln['amplitude']:.3g})",
+                "statistic": float(ln["psd_ratio"]),
+                "threshold": float(ln["threshold"]),
+                "alpha": a,
+            }
+        )
+    return out
+
+
+def _drift(ctx: MissingContext, a: float) -> list[dict]:
+    if ctx.y is None:
+        return []
+    y, fs = ctx.y, ctx.fs
+    dr = tracing.drift_fit(y, fs)
+    theta_null = upper_theta(ctx.curve, ctx.sol, ctx.start, ctx.effects, theta_terms(ctx.sol, ctx.start, ctx.effects))
+    thr = tracing.drift_threshold(y.size, fs, ctx.start, theta_null, a, seed=7919)
+    if not (dr["statistic"] > thr and not dr["at_edge"]):
+        return []
+    lo, hi = min(dr["T"] / 2, float(ctx.curve.tau[-1])), float(ctx.curve.tau[-1])
+    return [
+        {
+            "domain": "time",
+            "tau": (lo, hi),
+            "band_hz": (0.0, 1.0 / dr["T"]),
+            "chi2_dof": _chi2_dof(ctx, lo, hi),
+            "what": f"a warm-up-like drift along the record (T ≈ {dr['T']:.3g} s)",
+            "statistic": float(dr["statistic"]),
+            "threshold": float(thr),
+            "alpha": a,
+        }
+    ]
+
+
+#: The checks, by the name of their share in :data:`.levels.SHARES` (``"unexplained:<name>"``).
+CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {"allan": _curve, "psd": _lines, "time": _drift}
+
+
+def unexplained(ctx: MissingContext) -> list[dict]:
+    """Every check's regions, the largest misfit (statistic over threshold) first."""
+    out = [reg for name, check in CHECKS.items() for reg in check(ctx, alpha(f"unexplained:{name}", ctx.level))]
+    out.sort(key=lambda r: -r["statistic"] / max(r["threshold"], 1e-300))
+    return out

@@ -1,0 +1,182 @@
+"""Effects removed from the samples in time — one registry entry each, all through one protocol.
+
+A remover looks at the current samples (after the removals before it) and yields a :class:`Removal` for each
+component its calibrated test finds: the component itself (removed from the samples), how to refit it on
+the held-in part's samples (for the held-out error), its parameters and intervals, its evidence with the
+test's statistic, threshold and α (its share of ``level``, :mod:`.levels`), and how many numbers it fitted.
+The loop accepts a removal when the held-out error falls (or, for a white-like component, the held-out test
+in time), and scores it on the original record's curve: the model after the removal plus what the removal
+changed in the Allan curve, AVAR(y) − AVAR(y − component), cross terms included.
+
+- ``"drift"`` — a warm-up a·e^{−t/T} on block means, tested against block means drawn from the five-term fit
+  with its slow terms at the upper end of what the curve allows (:func:`allanite.model.tracing.drift_fit`);
+  a and T and their intervals by generalised least squares against the block means' covariance under the
+  record's own noise terms (:mod:`allanite.model.warmup`: flicker and random walk tie the block means together,
+  and an ordinary fit's intervals then miss the truth);
+- ``"regression"`` — the rate regressed on each channel of ``channels=`` within blocks in time (t test with the
+  blocks' effective dof), band by band where the coupling differs across frequency.
+
+Removals run before the curve effects (a component left in the samples bends the curve every curve effect is
+fitted against), in the order of :data:`REMOVALS`. A new one (line families removed in time, spikes replaced,
+a richer regression on slow channels) is one entry here and one share in :data:`.levels.TIME_SHARES`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.stats import t as t_dist
+
+from .. import tracing, warmup
+from .calibrated import tested
+from .curvefit import Curve, Solution, theta_terms, upper_theta
+from .levels import alpha
+from .scoring import HELDOUT_BLOCKS
+
+__all__ = ["Removal", "RemovalContext", "REMOVALS", "REGRESSION_BLOCKS"]
+
+#: Blocks in time of a regression (each de-meaned; SE from the blocks' scores, t with at most blocks − 1 dof).
+REGRESSION_BLOCKS = 8
+
+
+@dataclass
+class Removal:
+    """A component to remove from the samples.
+
+    Attributes
+    ----------
+    effect : str
+        The effect's name (a key of :data:`allanite.model.effects.EFFECTS`).
+    component : ndarray
+        What is removed: the samples become ``y - component``.
+    refit : callable
+        ``refit(samples, indices)`` fits the component on the held-in part's samples (at those sample indices
+        of the record) and returns it as a function of sample indices, for the held-out error.
+    params, intervals : dict
+        The step's parameters and the intervals of the numeric ones.
+    evidence : dict
+        Where it was found, with ``"test"``: the statistic, its threshold and α.
+    n_fitted : int
+        Numbers fitted (for the degrees of freedom of χ²/dof after the removal).
+    on_raw : bool
+        Held out: predict the other part's *raw* curve (a component the two parts share, e.g. a multi-position
+        profile's steps, would otherwise change the scale the relative error is taken on).
+    heldout_in_time : float, optional
+        A held-out test in time that decides instead of the held-out Allan curve (accepted when < 1): for a
+        white-like component, which changes the curve's level, not how well one part predicts the other's.
+    """
+
+    effect: str
+    component: np.ndarray
+    refit: Callable
+    params: dict
+    intervals: dict
+    evidence: dict
+    n_fitted: int
+    on_raw: bool = False
+    heldout_in_time: float | None = None
+
+
+@dataclass
+class RemovalContext:
+    """What a remover sees: the current samples ``y`` (updated by the loop after each accepted removal),
+    their curve and noise fit, the starting terms, the channels, ``level``, and ``consider(effect, entry)``
+    to record a candidate its test turned down."""
+
+    y: np.ndarray
+    fs: float
+    curve: Curve
+    sol: Solution
+    start: tuple
+    channels: dict
+    level: float
+    consider: Callable[[str, dict], None]
+    effects: list = field(default_factory=list)
+
+
+def _drift(ctx: RemovalContext) -> Iterator[Removal]:
+    """A warm-up drift: its time-domain evidence is unambiguous, and left in the samples it bends the long-τ
+    curve that every curve effect is fitted against (its threshold comes from the five-term fit, which the
+    drift itself inflates: conservative)."""
+    y, fs = ctx.y, ctx.fs
+    dr = tracing.drift_fit(y, fs)
+    theta_null = upper_theta(ctx.curve, ctx.sol, ctx.start, ctx.effects, theta_terms(ctx.sol, ctx.start, ctx.effects))
+    a = alpha("drift", ctx.level)
+    thr_d = tracing.drift_threshold(y.size, fs, ctx.start, theta_null, a)
+    if not (dr["statistic"] > thr_d and not dr["at_edge"]):
+        ctx.consider("drift", {"T": dr["T"], "statistic": dr["statistic"], "threshold": thr_d})
+        return
+    t_s = np.arange(y.size) / fs
+    span = y.size / fs
+    pieces = HELDOUT_BLOCKS // 2
+    w = warmup.warmup_fit(y, fs, warmup.noise_terms(y, fs), refit_noise=lambda z: warmup.noise_terms(z, fs))
+    if w["at_edge"]:
+        ctx.consider("drift", {"T": w["T"], "statistic": dr["statistic"], "threshold": thr_d, "at_edge": True})
+        return
+
+    def refit(z, idx):
+        g = warmup.warmup_component(z, idx / fs, w["noise"], span, pieces)
+        return lambda i: g(i / fs)
+
+    yield Removal(
+        "drift",
+        w["amplitude"] * np.exp(-t_s / w["T"]),
+        refit,
+        {"amplitude": w["amplitude"], "T": w["T"]},
+        {"amplitude": w["amplitude_interval"], "T": w["T_interval"]},
+        {
+            "domain": "time",
+            "test": tested("statistic", dr["statistic"], thr_d, a),
+            "noise": w["noise"],  # the noise terms the block means were weighed against (base form)
+        },
+        2,
+    )
+
+
+def _regression(ctx: RemovalContext) -> Iterator[Removal]:
+    """Each channel in turn, on the samples with the channels before it removed: a component a channel
+    explains (a multi-position profile's steps, a temperature's swing) bends the curve as a Gauss–Markov term
+    or a random walk would, and fitted first those would take it; its test is in time (within blocks),
+    independent of the curve."""
+    fs, a = ctx.fs, alpha("regression", ctx.level)
+    for name, ch in ctx.channels.items():
+        rg = tracing.regression_fit(ctx.y, ch, REGRESSION_BLOCKS)
+        # t with the blocks' effective number − 1 degrees of freedom (≤ REGRESSION_BLOCKS − 1)
+        t_thr = t_dist.isf(a / (2 * len(ctx.channels)), rg["dof"])
+        t_stat = abs(rg["coefficient"]) / rg["se"] if rg["se"] > 0 else 0.0
+        ev = {"domain": "channels", "test": tested("t", t_stat, float(t_thr), a)}
+        if not t_stat > t_thr:
+            ctx.consider("regression", {"channel": name, "t": t_stat, "threshold": t_thr})
+            continue
+        # band by band where the coupling differs across frequency (the whole-record coefficient elsewhere)
+        br = tracing.band_regression(ctx.y, ch, fs, a)
+        own = [b for b in br["bands"] if b["own"]]
+        if own:
+            ev["bands"] = own
+
+        def refit(z, idx, ch=ch, banded=bool(own)):
+            if banded:
+                used = tracing.band_regression(z, ch[idx], fs, a)["used"]
+                return lambda i: tracing.band_component(ch[i] - ch.mean(), used)
+            cf = tracing.regression_fit(z, ch[idx], 2)["coefficient"]
+            return lambda i: cf * (ch[i] - ch.mean())
+
+        # the held-out test in time: the residual variance of each half with the other half's coefficient
+        held = tracing.regression_heldout(ctx.y, ch, fs, a) if own else tracing.regression_heldout(ctx.y, ch)
+        yield Removal(
+            "regression",
+            tracing.band_component(ch - ch.mean(), br["used"]),
+            refit,
+            {"channel": name, "coefficient": rg["coefficient"]},
+            {"coefficient": (rg["coefficient"] - rg["se"], rg["coefficient"] + rg["se"])},
+            ev,
+            1 + len(own),
+            on_raw=True,
+            heldout_in_time=held,
+        )
+
+
+#: The time-domain removals, in the order they run (each before the curve effects).
+REMOVALS: dict[str, Callable[[RemovalContext], Iterator[Removal]]] = {"drift": _drift, "regression": _regression}

@@ -1,0 +1,188 @@
+"""Errors of a model on an Allan curve: in-sample (χ²/dof, RMS z, RMS ADEV error) and held out.
+
+RMS ADEV errors (in-sample and held out) are scored on 4 τ per octave whose estimate is informative (EDF ≥ 50
+under the five-term fit: ±10 %); beyond, the estimate's own scatter, not the model, would decide the score.
+
+The held-out error: the record is cut into :data:`HELDOUT_BLOCKS` blocks, the odd and the even ones joined end
+to end; the model fitted on one part's Allan curve predicts the other's (both ways, RMS ADEV error averaged).
+A time-domain removal is refitted on the held-in part's samples; change points are held out per segment.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.stats import chi2 as chi2_dist
+
+from ...analysis import avar
+from .. import tracing
+from .curvefit import Curve, Solution, design, solve
+
+__all__ = [
+    "HELDOUT_BLOCKS",
+    "HELDOUT_MIN_EDF",
+    "HELDOUT_AGREE",
+    "rms_adev_pct",
+    "informative",
+    "curve_metrics",
+    "removal_metrics",
+    "Split",
+    "heldout_split",
+    "segments_heldout",
+]
+
+#: Blocks for the held-out error (odd blocks predict even ones and back).
+HELDOUT_BLOCKS = 8
+#: RMS ADEV errors: only τ whose ADEV estimate is within ±10 % (EDF ≥ 50 under the five-term fit).
+HELDOUT_MIN_EDF = 50.0
+#: Held-out error: only τ where the two parts' own ADEV agree within this fraction.
+HELDOUT_AGREE = 0.2
+
+
+def rms_adev_pct(obs, model) -> float:
+    """RMS relative error (%) of the Allan deviation ``sqrt(model)`` against ``sqrt(obs)``."""
+    return float(100 * np.sqrt(np.mean((np.sqrt(obs / model) - 1) ** 2)))
+
+
+def informative(tau, nu) -> np.ndarray:
+    """The τ an RMS ADEV error is scored on: 4 per octave (each octave weighs alike, not the dense grid's
+    points) whose estimate is itself within ±10 % — EDF ≥ 50 under the five-term fit's own noise mix (white
+    at short τ; far fewer for flicker and random walk at long τ). Beyond, the estimate's own scatter would
+    decide the score. Falls back to every thinned τ if fewer than 4 qualify."""
+    thin = tracing.thin_indices(tau)
+    mask = np.zeros(tau.size, dtype=bool)
+    mask[thin] = True
+    good = mask & (nu >= HELDOUT_MIN_EDF)
+    return good if np.count_nonzero(good) >= 4 else mask
+
+
+def removal_metrics(curve: Curve, sol: Solution, change, n_params: int, heldout, scored) -> dict:
+    """In-sample errors of a time-domain removal on the curve it was removed *from*: the noise model
+    fitted after the removal plus the change the removal made to the Allan curve, against the same
+    estimates the "before" model was scored on (apples to apples). ``change`` = AVAR(y) − AVAR(y − c):
+    the component's own Allan variance and its cross terms with the rest of the record, exactly — a
+    regression's component is *not* independent of the noise (a channel's coupling varies across
+    frequency, so the residual keeps a band-by-band cross term that the component's own variance misses)."""
+    model = np.maximum(sol.model + change, 1e-300)
+    z = (curve.avar - model) * np.sqrt(sol.nu / (2.0 * model**2))
+    chi2 = float(np.sum(z**2))
+    dof = max(1, sol.dof - n_params)
+    return {
+        "chi2_dof": chi2 / dof,
+        "rms_z": float(np.sqrt(np.mean(z**2))),
+        "rms_adev_pct": rms_adev_pct(curve.avar[scored], model[scored]),
+        "p_value": float(chi2_dist.sf(chi2 * curve.n_eff / curve.tau.size, max(1.0, curve.n_eff - 1))),
+        "heldout_rms_adev_pct": heldout,
+    }
+
+
+def curve_metrics(curve: Curve, sol: Solution, heldout, scored=None) -> dict:
+    """In-sample errors of a solution on its own curve (RMS ADEV error on ``scored``), with ``heldout``."""
+    sc = slice(None) if scored is None else scored
+    return {
+        "chi2_dof": sol.chi2_dof,
+        "rms_z": float(np.sqrt(np.mean(sol.z**2))),
+        "rms_adev_pct": rms_adev_pct(curve.avar[sc], sol.model[sc]),
+        "p_value": float(chi2_dist.sf(sol.chi2_eff(curve), max(1.0, curve.n_eff - 1))),
+        "heldout_rms_adev_pct": heldout,
+    }
+
+
+class Split:
+    """Alternate blocks in time (odd ↔ even) for the held-out error.
+
+    Each part's blocks are joined end to end (samples keep their true times); the model fitted on one part's
+    Allan curve predicts the other part's, both ways. Interleaved parts share the record's slow changes (a
+    noise level that steps, a warm-up), so the score asks whether the model carries over, not whether the
+    two halves of a non-stationary record agree at long τ. A time effect is fitted on one part's samples
+    and removed from both. Joining keeps τ up to part/9 (a warm-up's time scale) where an Allan curve per
+    block would stop at block/9; the seams affect the model with and without an effect alike."""
+
+    def __init__(self, y, fs, grid_m, lo, hi, estimator, n_blocks, terms):
+        self.y = y
+        n = y.size
+        per = n // n_blocks
+        self.fs, self.estimator = fs, estimator
+        self.idx = [
+            np.concatenate([np.arange(j * per, (j + 1) * per) for j in range(n_blocks) if j % 2 == parity])
+            for parity in (0, 1)
+        ]
+        size = min(i.size for i in self.idx)
+        self.idx = [i[:size] for i in self.idx]
+        m = grid_m[grid_m <= size // 9]
+        tau = m / fs
+        keep = (tau >= lo) & (tau <= hi)
+        if np.count_nonzero(keep) < 8:
+            raise ValueError("too few τ in range for held-out blocks")
+        self.m, self.size = m[keep], size
+        self.curves = [self.curve(y[i]) for i in self.idx]
+        self.scored = informative(self.curves[0].tau, solve(self.curves[0], terms, []).nu)
+        # ... and where the record reproduces itself: the two parts' own ADEV agree within ±20 % (twice the
+        # ±10 % of EDF 50). Beyond, the parts differ more than their estimates scatter (a non-stationary
+        # record, an under-estimated EDF at long τ), no model predicts both, and the score would be decided
+        # by which model happens to sit nearer the other part's values there.
+        agree = np.abs(np.sqrt(self.curves[0].avar / self.curves[1].avar) - 1.0) <= HELDOUT_AGREE
+        if np.count_nonzero(self.scored & agree) >= 4:
+            self.scored &= agree
+
+    def curve(self, z):
+        """The Allan curve of one part's samples ``z`` on the split's τ."""
+        av = np.maximum(avar(z, self.fs, taus=self.m / self.fs).avar, 1e-300)
+        return Curve(self.m / self.fs, self.m.astype(np.float64), av, self.fs, self.size + 1, self.estimator)
+
+    def error(self, terms, effects, remove=None, on_raw=False) -> float:
+        """RMS ADEV error (%) of one part's model predicting the other's curve, both ways; ``remove(samples,
+        indices)`` fits a component on the held-in part and returns it as a function of sample indices.
+
+        ``on_raw``: with ``remove``, predict the other part's *raw* curve — the model fitted on the held-in
+        part's corrected curve plus what the correction changed in the held-in part's curve — so that "before"
+        and "after" are scored on the same curve. Removing a large component the two parts share (a
+        multi-position profile's steps) otherwise changes the scale the relative error is taken on."""
+        errs = []
+        for f, h in ((0, 1), (1, 0)):
+            extra = 0.0
+            if remove is None:
+                cf, ch = self.curves[f], self.curves[h]
+            else:
+                yf, yh = self.y[self.idx[f]], self.y[self.idx[h]]
+                g = remove(yf, self.idx[f])
+                cf = self.curve(yf - g(self.idx[f]))
+                if on_raw:
+                    ch, extra = self.curves[h], self.curves[f].avar - cf.avar
+                else:
+                    ch = self.curve(yh - g(self.idx[h]))
+            sol = solve(cf, terms, effects)
+            a_h, _ = design(ch, terms, effects)
+            pred = np.maximum(a_h @ sol.theta + extra, 1e-300)
+            errs.append(rms_adev_pct(ch.avar[self.scored], pred[self.scored]))
+        return float(np.mean(errs))
+
+
+def heldout_split(y, fs, m_all, lo, hi, terms):
+    """Alternate blocks of the record for the held-out error, or None if the record is too short."""
+    try:
+        return Split(y, fs, m_all, lo, hi, "oavar", HELDOUT_BLOCKS, terms)
+    except ValueError:
+        return None
+
+
+def segments_heldout(whole: Split, y, fs, m_all, lo, hi, terms, effects, times):
+    """Held-out error of change points at ``times`` (s): (without, with), or None if a segment is too short.
+
+    Each segment between change points gets its own alternate blocks; its held-out part's Allan curve is
+    predicted once by the model fitted on the held-in part of the whole record (no change point) and once by
+    the model fitted on the segment's own held-in part (the noise level changes there). Mean over both ways,
+    segments weighted by their length. A change point that is not real leaves the segments alike, and the
+    segment's model, fitted on less data, predicts no better."""
+    edges = [0] + sorted(int(round(t * fs)) for t in times) + [y.size]
+    out = np.zeros(2)
+    for a, b in zip(edges[:-1], edges[1:]):
+        seg = heldout_split(y[a:b], fs, m_all, lo, hi, terms)
+        if seg is None:
+            return None
+        for f, h in ((0, 1), (1, 0)):
+            a_h, _ = design(seg.curves[h], terms, effects)
+            obs = seg.curves[h].avar[seg.scored]
+            for k, part in enumerate((whole.curves[f], seg.curves[f])):
+                pred = np.maximum(a_h @ solve(part, terms, effects).theta, 1e-300)[seg.scored]
+                out[k] += 0.5 * (b - a) / y.size * rms_adev_pct(obs, pred)
+    return float(out[0]), float(out[1])

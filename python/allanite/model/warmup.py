@@ -1,0 +1,180 @@
+"""A warm-up's parameters, estimated against the record's own noise: generalised least squares on block means.
+
+The block means of a gyro's rate are not independent: flicker (B) and random walk of rate (K) tie them over the
+whole record, and a rate ramp (R) tilts them. An ordinary least-squares fit of a·e^{−t/T} treats them as
+independent and trades T against the wander — its intervals then exclude the truth (issue 29: T = 2837 s,
+[2567, 3136], for a 1500 s warm-up in ADIS16405 noise). Here the block means' covariance under the fitted noise
+terms is written out (:func:`block_covariance`) and the warm-up c + a·e^{−t/T} is fitted by GLS, T profiled on a
+fine grid; the intervals are where the GLS χ² rises by ≤ 1 over its minimum (68.3 % for one parameter), for T
+directly and for a as the profile over T of its conditional interval. The noise terms come from a five-term fit of
+the record with the warm-up removed, and the fit is repeated once with them (:func:`warmup_fit`).
+
+Covariance of the means b_i of blocks [s_i, e_i) of w_i = e_i − s_i seconds (two-sided PSDs of IEEE Std 952):
+
+- white rate N (S = N²): N²/w_i on the diagonal;
+- random walk of rate K from the record's start (Brownian, K²·min(s, t)): K²·(s_i + w_i/3) on the diagonal,
+  K²·(s_i + e_i)/2 off it (i < j);
+- flicker B (S = B²/(2πf)): a sum of Gauss–Markov processes with correlation times spaced by e^{1/2} from a
+  twentieth of a block to 10 record lengths, each of variance B²·ln(e^{1/2})/π (their Lorentzians add up to
+  B²/(2πf) across the band); a GM of time constant T adds σ²·T²(1 − e^{−w_i/T})(1 − e^{−w_j/T})·
+  e^{−(s_j − e_i)/T}/(w_i w_j) off the diagonal and σ²·2T(w − T(1 − e^{−w/T}))/w² on it;
+- a ramp R·t of unknown sign: a random slope of variance R², R²·(t_i − t̄)(t_j − t̄) — not a free column, which
+  a long T would trade against.
+
+Constant parts of the covariance (the slowest processes' common level) do not move a GLS fit with an intercept.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.linalg import solve_triangular
+
+from ..analysis import avar
+from .fitting import fit
+
+__all__ = ["block_covariance", "gls_warmup", "warmup_fit", "warmup_component", "noise_terms", "BLOCKS", "T_GRID_POINTS"]
+
+#: Block means the warm-up is fitted to (as the drift test's).
+BLOCKS = 500
+#: Points of the log-T grid the GLS χ² is profiled on (from L/200 to L/2).
+T_GRID_POINTS = 241
+#: Ratio of successive Gauss–Markov time constants in the flicker sum, as a log.
+_FLICKER_STEP = 0.5
+
+
+def block_covariance(edges: np.ndarray, N: float = 0.0, B: float = 0.0, K: float = 0.0, R: float = 0.0) -> np.ndarray:
+    """Covariance of the rate's means over blocks [edges[i], edges[i+1]) (s) for the noise terms N, B, K, R
+    (the rate unit's base form: unit/√s, unit, unit/s^1.5, unit/s²)."""
+    e = np.asarray(edges, dtype=np.float64)
+    return _cov_of_blocks(np.column_stack([e[:-1], e[1:]]), {"N": N, "B": B, "K": K, "R": R})
+
+
+def _flicker(s0, s1, w, length) -> np.ndarray:
+    """Block-mean covariance of unit flicker (two-sided PSD 1/(2πf)) as a sum of Gauss–Markov processes."""
+    var = _FLICKER_STEP / math.pi
+    out = np.zeros((w.size, w.size))
+    gap = s0[None, :] - s1[:, None]  # s_j − e_i: ≥ 0 above the diagonal
+    gap = np.where(gap >= 0, gap, gap.T)
+    for lt in np.arange(math.log(0.05 * w.min()), math.log(10.0 * length), _FLICKER_STEP):
+        t = math.exp(lt)
+        f = t * -np.expm1(-w / t) / w
+        blk = np.outer(f, f) * np.exp(-gap / t)
+        blk[np.diag_indices(w.size)] = 2.0 * t * (w - t * -np.expm1(-w / t)) / (w * w)
+        out += var * blk
+    return out
+
+
+def gls_warmup(b: np.ndarray, tb: np.ndarray, cov: np.ndarray, length: float) -> dict:
+    """GLS fit of c + a·e^{−t/T} to block means ``b`` at times ``tb`` with covariance ``cov``, T profiled on a
+    log grid over [L/200, L/2]; 68.3 % profile intervals for T and a."""
+    chol = _cholesky(cov)
+    wb = solve_triangular(chol, b, lower=True)
+    one = solve_triangular(chol, np.ones_like(tb), lower=True)
+    grid = np.linspace(math.log(length / 200.0), math.log(length / 2.0), T_GRID_POINTS)
+    chi2 = np.empty(grid.size)
+    amp = np.empty(grid.size)
+    se = np.empty(grid.size)
+    for k, lt in enumerate(grid):
+        x = np.column_stack([one, solve_triangular(chol, np.exp(-tb / math.exp(lt)), lower=True)])
+        coef, *_ = np.linalg.lstsq(x, wb, rcond=None)
+        r = wb - x @ coef
+        chi2[k] = float(r @ r)
+        amp[k] = coef[1]
+        se[k] = math.sqrt(max(np.linalg.inv(x.T @ x)[1, 1], 0.0))
+    j = int(np.argmin(chi2))
+    room = chi2[j] + 1.0 - chi2
+    inside = room >= 0
+    half = se[inside] * np.sqrt(room[inside])
+    return {
+        "T": math.exp(grid[j]),
+        "amplitude": float(amp[j]),
+        "T_interval": (math.exp(grid[inside].min()), math.exp(grid[inside].max())),
+        "amplitude_interval": (float(np.min(amp[inside] - half)), float(np.max(amp[inside] + half))),
+        "chi2": float(chi2[j]),
+        "at_edge": j in (0, grid.size - 1),
+    }
+
+
+def _cholesky(cov: np.ndarray) -> np.ndarray:
+    """Cholesky factor of ``cov``; where rounding of its slow (nearly constant) parts leaves it indefinite, of
+    the nearest positive definite matrix (eigenvalues clipped at 1e-10 of the largest)."""
+    try:
+        return np.linalg.cholesky(cov)
+    except np.linalg.LinAlgError:
+        w, v = np.linalg.eigh(0.5 * (cov + cov.T))
+        w = np.maximum(w, 1e-10 * float(w.max()))
+        return np.linalg.cholesky((v * w) @ v.T)
+
+
+def _blocks(y: np.ndarray, fs: float, n_blocks: int):
+    nb = max(3, min(n_blocks, y.size // 2))
+    per = y.size // nb
+    b = y[: nb * per].reshape(nb, per).mean(axis=1)
+    edges = np.arange(nb + 1) * per / fs
+    return b, edges
+
+
+def warmup_fit(y: np.ndarray, fs: float, noise, refit_noise=None, n_blocks: int = BLOCKS) -> dict:
+    """(a, T) of a warm-up in ``y`` with intervals, by GLS against ``noise`` ({"N", "B", "K", "R"}, base form).
+
+    ``refit_noise(z)``, if given, returns the noise terms of the record ``z`` (the warm-up removed): the fit is
+    then repeated once with them, so that the warm-up no longer inflates the noise it is weighed against. The
+    result also holds the noise terms used (``"noise"``)."""
+    b, edges = _blocks(y, fs, n_blocks)
+    tb = 0.5 * (edges[:-1] + edges[1:])
+    length = y.size / fs
+    out = gls_warmup(b, tb, block_covariance(edges, **noise), length)
+    if refit_noise is not None:
+        t = np.arange(y.size) / fs
+        noise = refit_noise(y - out["amplitude"] * np.exp(-t / out["T"]))
+        out = gls_warmup(b, tb, block_covariance(edges, **noise), length)
+    out["noise"] = dict(noise)
+    return out
+
+
+def noise_terms(z: np.ndarray, fs: float) -> dict:
+    """N, B, K, R (base form) of a five-term fit to the octave Allan curve of ``z``, the shortest τ cut where a
+    sensor's bandwidth bends them (``tau_range="auto"``): what the block means are weighed against."""
+    f = fit(avar(z, fs, taus="octave"), tau_range="auto")
+    return {k: float(f.coefficients[k].value) for k in ("N", "B", "K", "R")}
+
+
+def warmup_component(
+    z: np.ndarray, t: np.ndarray, noise: dict, length: float, pieces: int = 1, n_blocks: int = BLOCKS // 2
+):
+    """The warm-up fitted as :func:`warmup_fit` does on samples ``z`` taken at times ``t`` (s) — a part of
+    alternate blocks: its ``pieces`` runs of consecutive samples are each cut into block means, so no block
+    straddles a seam, and the blocks' covariance follows their real times. Returns the component as a function
+    of time (s), for the held-out error."""
+    fs = (t.size - 1) / max(t[-1] - t[0], 1e-300) if t.size > 1 else 1.0
+    run = z.size // pieces
+    per = max(1, run // max(1, n_blocks // pieces))
+    use = (run // per) * per
+    zb = z[: pieces * run].reshape(pieces, run)[:, :use].reshape(-1, per).mean(axis=1)
+    starts = t[: pieces * run].reshape(pieces, run)[:, :use].reshape(-1, per)[:, 0]
+    edges = np.column_stack([starts, starts + per / fs])
+    cov = _cov_of_blocks(edges, noise)
+    d = gls_warmup(zb, edges.mean(axis=1), cov, length)
+    a, t_c = d["amplitude"], d["T"]
+    return lambda tt: a * np.exp(-np.asarray(tt) / t_c)
+
+
+def _cov_of_blocks(edges: np.ndarray, noise: dict) -> np.ndarray:
+    """:func:`block_covariance` for blocks [edges[i, 0], edges[i, 1]) that need not touch (a held-in part)."""
+    s0, s1 = edges[:, 0], edges[:, 1]
+    w = s1 - s0
+    cov = np.diag(noise.get("N", 0.0) ** 2 / w)
+    k, b, r = noise.get("K", 0.0), noise.get("B", 0.0), noise.get("R", 0.0)
+    if k > 0:
+        rw = np.minimum.outer(0.5 * (s0 + s1), 0.5 * (s0 + s1))
+        rw[np.diag_indices(w.size)] = s0 + w / 3.0
+        cov += k * k * rw
+    if b > 0:
+        cov += b * b * _flicker(s0, s1, w, s1[-1] - s0[0])
+    if r > 0:
+        tc = 0.5 * (s0 + s1)
+        tc = tc - tc.mean()
+        cov += r * r * np.outer(tc, tc)
+    return cov
