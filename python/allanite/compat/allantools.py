@@ -47,6 +47,7 @@ from ._tools import (
     trim_data,
 )
 
+#: The allantools release whose API this module follows, then allanite's own version.
 __version__ = "2024.06+allanite." + _core.__version__
 
 __all__ = [
