@@ -26,6 +26,7 @@ Gauss–Markov terms scale their driving noise sample by sample; the ramp integr
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 from typing import Any
@@ -50,12 +51,27 @@ def power_law_filter(w: np.ndarray, alpha: float) -> np.ndarray:
     low-frequency content is lost to circular wrap-around. alpha = 1: flicker, 2: random walk,
     −2: first difference; the output PSD is the input's times |2 sin(π f τ0)|^(−alpha)."""
     n = w.size
+    response = _cached_response(n, float(alpha)) if n <= _CACHED_MAX_N else _response(n, float(alpha))
+    return np.fft.irfft(response * np.fft.rfft(w, 2 * n), 2 * n)[:n]
+
+
+#: longest record whose filter transform is kept for the next call (16 MB at most per entry)
+_CACHED_MAX_N = 2**20
+
+
+def _response(n: int, alpha: float) -> np.ndarray:
+    """The transform (length-2n rfft) of the first n Kasdin & Walter filter coefficients."""
     h = np.empty(n)
     h[0] = 1.0
     k = np.arange(1, n)
     h[1:] = np.cumprod((k - 1 + alpha / 2.0) / k)
-    size = 2 * n
-    return np.fft.irfft(np.fft.rfft(h, size) * np.fft.rfft(w, size), size)[:n]
+    out = np.fft.rfft(h, 2 * n)
+    out.flags.writeable = False
+    return out
+
+
+#: repeated draws of one size and exponent (allantools' Noise, Monte Carlo loops) reuse the transform
+_cached_response = functools.lru_cache(maxsize=4)(_response)
 
 
 def _profile(value, t: np.ndarray, name: str) -> Any:
