@@ -80,12 +80,20 @@ def markdown(rep: dict) -> str:
         lines.append(
             f"| {f} | {_cell(runs['allantools']['per_file'].get(f, {}))} | {_cell(runs['compat']['per_file'].get(f, {}))} |"
         )
-    lines += ["", "Slow cases left out of CI (outcome and seconds, per run):", ""]
+    lines += ["", "Slow cases left out of CI (outcomes and seconds, per run; parametrized cases together):", ""]
+    groups: dict[str, list[str]] = {}
     for n in allantools_sdist.DESELECTED:
-        a, c = runs["allantools"]["deselected_in_ci"][n], runs["compat"]["deselected_in_ci"][n]
-        lines.append(
-            f"- `{n}`: allantools {a['outcome']} {a['duration']:.1f} s, compat {c['outcome']} {c['duration']:.1f} s"
-        )
+        groups.setdefault(n.split("[")[0], []).append(n)
+    for base, nodes in groups.items():
+        cells = []
+        for t in TARGETS:
+            recs = [runs[t]["deselected_in_ci"][n] for n in nodes]
+            counts: dict[str, int] = {}
+            for r in recs:
+                counts[r["outcome"]] = counts.get(r["outcome"], 0) + 1
+            cells.append(f"{t} {_cell(counts)} {sum(r['duration'] for r in recs):.1f} s")
+        what = f"`{base}` ({len(nodes)} cases)" if len(nodes) > 1 else f"`{base}`"
+        lines.append(f"- {what}: {', '.join(cells)}")
     for t in TARGETS:
         bad = runs[t]["not_passed"]
         lines += ["", f"Not passed under {t}: {', '.join(f'`{k}`' for k in bad) if bad else 'none'}."]

@@ -73,5 +73,5 @@ def test_the_blocker_refuses_the_real_allantools():
 def test_deselected_cases_and_exceptions_are_documented():
     text = (Path(__file__).resolve().parents[1] / "docs" / "compat.md").read_text(encoding="utf-8")
     for node in [*DESELECTED, *EXCEPTIONS]:
-        assert node.split("::")[-1] in text, node
+        assert node.split("::")[-1].split("[")[0] in text, node  # parametrized: the test's name
     assert sdist.SHA256 in text
