@@ -2,7 +2,8 @@
 largest difference between their results; then allanite alone on a long record.
 
 Run: ``python benches/compat_bench.py`` (a few minutes) → ``benches/results/compat.json`` and
-``benches/results/compat.md``. Sizes: each allantools function at the largest N it finishes in about a
+``benches/results/compat.md``; ``--datasets``: every deviation on the records of allantools' own test suite
+(benches/_compat_datasets.py) → ``benches/results/compat_datasets.{json,md}``. Sizes: each allantools function at the largest N it finishes in about a
 minute or less (its MTOTDEV/TTOTDEV/HTOTDEV/Theo1 are pure-Python O(N²) loops, so they get small N to keep
 the run bounded); allanite alone at 10^7 where its own cost allows (MTOTDEV/TTOTDEV/HTOTDEV cost O(N·m) per τ,
 Theo1 O(N²): 10^5). Frequency data, white + random-walk FM. Times are wall seconds, best of ``REPEATS``
@@ -140,6 +141,15 @@ def markdown(rep: dict) -> str:
 
 
 if __name__ == "__main__":
+    if "--datasets" in sys.argv:
+        import _compat_datasets
+
+        rep = _compat_datasets.run()
+        out = _common.HERE / "results"
+        (out / "compat_datasets.json").write_text(json.dumps(rep, indent=1) + "\n", encoding="utf-8")
+        (out / "compat_datasets.md").write_text(_compat_datasets.markdown(rep), encoding="utf-8")
+        print(_compat_datasets.markdown(rep))
+        sys.exit(0)
     quick = "--quick" in sys.argv
     rep = main(quick)
     if not quick:

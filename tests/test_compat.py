@@ -15,8 +15,10 @@ from allanite.errors import InputError, ParameterError
 
 allantools = pytest.importorskip("allantools")
 
-#: allantools' pure-Python O(N²)…O(N³) loops (MTOTDEV, TTOTDEV, HTOTDEV, Theo1) get short records
-SLOW = {"mtotdev", "ttotdev", "htotdev", "theo1"}
+#: allantools' pure-Python O(N²)…O(N³) loops (MTOTDEV, TTOTDEV, HTOTDEV, Theo1, PDEV) get short records
+SLOW = {"mtotdev", "ttotdev", "htotdev", "theo1", "pdev"}
+#: every (data, rate, data_type, taus) → (taus, devs, errs, ns) deviation of allantools
+DEVIATIONS = [*compat.ESTIMATORS, "pdev", "mtie_phase_fast"]
 TAUS = [None, "all", "octave", "decade", "log10", "array"]
 
 
@@ -43,12 +45,13 @@ def _allantools(name, *args, **kw):
 @pytest.mark.parametrize("seed", [0, 1])
 @pytest.mark.parametrize("form", TAUS, ids=str)
 @pytest.mark.parametrize("data_type", ["phase", "freq"])
-@pytest.mark.parametrize("name", compat.__all__)
+@pytest.mark.parametrize("name", DEVIATIONS)
 def test_equals_allantools(name, data_type, form, seed):
     data = _record(seed, name, data_type)
     rate = 4.0 if seed else 1.0
     taus = _taus(form, data.size, rate)
-    want = _allantools(name, data, rate=rate, data_type=data_type, taus=taus)
+    # allantools' own mtie_phase_fast is unfinished (its test expects it to fail): compat's is mtie
+    want = _allantools("mtie" if name == "mtie_phase_fast" else name, data, rate=rate, data_type=data_type, taus=taus)
     got = getattr(compat, name)(data, rate=rate, data_type=data_type, taus=taus)
     for what, w, g in zip(("taus", "devs", "errs", "ns"), want, got):
         w = np.asarray(w, dtype=np.float64)

@@ -183,3 +183,31 @@ def tierms_phase(
     workers: int,
 ) -> npt.NDArray[np.float64]:
     """TIE rms of each phase record (1 ≤ m ≤ N − 1): shape (axes, len(ms))."""
+
+def pvar_phase(
+    phase: npt.NDArray[np.float64], ms: Sequence[int], workers: int
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+    """Parabolic-variance term sums Σ u_i² and counts N − 2m of a phase record at every m ≥ 2."""
+
+def allan_covariance_phase(
+    phase1: npt.NDArray[np.float64], phase2: npt.NDArray[np.float64], ms: Sequence[int], workers: int
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+    """Σ Δ²x1·Δ²x2 over the N − 2m overlapping second differences of two phase records, and counts."""
+
+def oavar_phase_gaps(
+    phase: npt.NDArray[np.float64], ms: Sequence[int], workers: int
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+    """Σ (Δ²x)² over the overlapping second differences with no NaN point, and their counts."""
+
+class StreamingVariance:
+    """Streaming "oavar", "ohvar" or "tvar" of a growing phase record (values for τ0 = 1)."""
+
+    def __init__(self, kind: str, ms: Sequence[int], pending: Sequence[int]) -> None: ...
+    def push(self, x: float) -> None: ...
+    def extend(self, xs: npt.NDArray[np.float64]) -> None: ...
+    def add_factor(self, m: int) -> None: ...
+    def factors(self) -> list[int]: ...
+    def counts(self) -> list[int]: ...
+    def values(self) -> npt.NDArray[np.float64]: ...
+    def phase(self) -> npt.NDArray[np.float64]: ...
+    def __len__(self) -> int: ...

@@ -26,6 +26,7 @@ Gauss–Markov terms scale their driving noise sample by sample; the ramp integr
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 from typing import Any
@@ -35,24 +36,42 @@ import numpy as np
 from ._validate import check_count, check_fs
 from .errors import ParameterError
 
-__all__ = ["simulate", "kasdin_walter"]
+__all__ = ["simulate", "kasdin_walter", "power_law_filter"]
 
 
 def kasdin_walter(n: int, alpha: float, rng: np.random.Generator, variance: float = 1.0) -> np.ndarray:
-    """Power-law noise with one-sided PSD ≈ 2·variance·τ0 / (2π f τ0)^alpha (Kasdin & Walter 1992).
+    """Power-law noise with one-sided PSD ≈ 2·variance·τ0 / (2π f τ0)^alpha (Kasdin & Walter 1992):
+    :func:`power_law_filter` applied to n white samples of the given variance drawn from ``rng``."""
+    return power_law_filter(rng.normal(scale=np.sqrt(variance), size=n), alpha)
 
-    Fractional integration of white noise of the given variance with the filter
+
+def power_law_filter(w: np.ndarray, alpha: float) -> np.ndarray:
+    """Kasdin & Walter's (1992) fractional integration of the white samples ``w``: the filter
     h_0 = 1, h_k = h_{k−1}·(k − 1 + alpha/2)/k, applied by FFT convolution over 2n points so that no
-    low-frequency content is lost to circular wrap-around. alpha = 1: flicker, alpha = 2: random walk.
-    """
+    low-frequency content is lost to circular wrap-around. alpha = 1: flicker, 2: random walk,
+    −2: first difference; the output PSD is the input's times |2 sin(π f τ0)|^(−alpha)."""
+    n = w.size
+    response = _cached_response(n, float(alpha)) if n <= _CACHED_MAX_N else _response(n, float(alpha))
+    return np.fft.irfft(response * np.fft.rfft(w, 2 * n), 2 * n)[:n]
+
+
+#: longest record whose filter transform is kept for the next call (16 MB at most per entry)
+_CACHED_MAX_N = 2**20
+
+
+def _response(n: int, alpha: float) -> np.ndarray:
+    """The transform (length-2n rfft) of the first n Kasdin & Walter filter coefficients."""
     h = np.empty(n)
     h[0] = 1.0
     k = np.arange(1, n)
     h[1:] = np.cumprod((k - 1 + alpha / 2.0) / k)
-    w = rng.normal(scale=np.sqrt(variance), size=n)
-    size = 2 * n
-    out = np.fft.irfft(np.fft.rfft(h, size) * np.fft.rfft(w, size), size)[:n]
+    out = np.fft.rfft(h, 2 * n)
+    out.flags.writeable = False
     return out
+
+
+#: repeated draws of one size and exponent (allantools' Noise, Monte Carlo loops) reuse the transform
+_cached_response = functools.lru_cache(maxsize=4)(_response)
 
 
 def _profile(value, t: np.ndarray, name: str) -> Any:

@@ -129,15 +129,15 @@ fn check_values(cols: &[&[f64]], allow_nan: bool) -> Result<()> {
 }
 
 /// Neumaier-compensated accumulator.
-#[derive(Default, Clone, Copy)]
-struct Acc {
+#[derive(Default, Clone, Copy, Debug)]
+pub(crate) struct Acc {
     s: f64,
     c: f64,
 }
 
 impl Acc {
     #[inline]
-    fn add(&mut self, v: f64) {
+    pub(crate) fn add(&mut self, v: f64) {
         let t = self.s + v;
         if self.s.abs() >= v.abs() {
             self.c += (self.s - t) + v;
@@ -146,7 +146,7 @@ impl Acc {
         }
         self.s = t;
     }
-    fn get(self) -> f64 {
+    pub(crate) fn get(self) -> f64 {
         self.s + self.c
     }
 }

@@ -11,7 +11,9 @@ pub mod error;
 pub mod fit;
 mod gather;
 mod oavar;
+pub mod phase_terms;
 pub mod range;
+pub mod streaming;
 pub mod taper;
 pub mod theo;
 

@@ -8,6 +8,8 @@
 //! `run_interruptible(py, workers, |cancel| kernel_cancellable(..., cancel))`.
 
 use allanite_core::dynamic_hann_cancellable;
+use allanite_core::phase_terms::{self, TermSum};
+use allanite_core::streaming::{Stream, StreamKind};
 use allanite_core::{angle_term_sums_cancellable, AngleChunk};
 use allanite_core::{
     compensated_sum_from, dynamic_avar_part_cancellable, dynamic_avar_ranged_cancellable,
@@ -18,7 +20,8 @@ use allanite_core::{
 };
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
-    IntoPyArray, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2,
+    PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 use std::time::Duration;
@@ -739,6 +742,139 @@ fn tierms_phase<'py>(
     to_2d(py, slices.len(), ms.len(), values)
 }
 
+/// (sums, counts) of a phase-domain term kernel as two float64/int64 arrays.
+fn term_sums<'py>(
+    py: Python<'py>,
+    sums: Vec<TermSum>,
+) -> (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<i64>>) {
+    let s: Vec<f64> = sums.iter().map(|t| t.sum).collect();
+    let c: Vec<i64> = sums.iter().map(|t| t.count as i64).collect();
+    (s.into_pyarray(py), c.into_pyarray(py))
+}
+
+/// Parabolic-variance term sums Σ u_i² and counts N − 2m of a *phase* record at every m ≥ 2.
+#[pyfunction]
+#[pyo3(signature = (phase, ms, workers))]
+#[allow(clippy::type_complexity)]
+fn pvar_phase<'py>(
+    py: Python<'py>,
+    phase: PyReadonlyArray1<'py, f64>,
+    ms: Vec<usize>,
+    workers: usize,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<i64>>)> {
+    let x = contiguous(py, std::slice::from_ref(&phase))?[0];
+    let sums = run_interruptible(py, workers, |_c| phase_terms::pvar_sums(x, &ms))?;
+    Ok(term_sums(py, sums))
+}
+
+/// Σ of products of the overlapping second differences of two *phase* records, and counts.
+#[pyfunction]
+#[pyo3(signature = (phase1, phase2, ms, workers))]
+#[allow(clippy::type_complexity)]
+fn allan_covariance_phase<'py>(
+    py: Python<'py>,
+    phase1: PyReadonlyArray1<'py, f64>,
+    phase2: PyReadonlyArray1<'py, f64>,
+    ms: Vec<usize>,
+    workers: usize,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<i64>>)> {
+    let cols = [phase1, phase2];
+    let xs = contiguous(py, &cols)?;
+    let sums = run_interruptible(py, workers, |_c| {
+        phase_terms::allan_covariance_sums(xs[0], xs[1], &ms)
+    })?;
+    Ok(term_sums(py, sums))
+}
+
+/// Σ (Δ²x)² over the overlapping second differences of a *phase* record whose three points are not
+/// NaN, and their counts (allantools' gradev rule).
+#[pyfunction]
+#[pyo3(signature = (phase, ms, workers))]
+#[allow(clippy::type_complexity)]
+fn oavar_phase_gaps<'py>(
+    py: Python<'py>,
+    phase: PyReadonlyArray1<'py, f64>,
+    ms: Vec<usize>,
+    workers: usize,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<i64>>)> {
+    let x = contiguous(py, std::slice::from_ref(&phase))?[0];
+    let sums = run_interruptible(py, workers, |_c| phase_terms::oavar_phase_gap_sums(x, &ms))?;
+    Ok(term_sums(py, sums))
+}
+
+/// A streaming overlapping Allan ("oavar"), overlapping Hadamard ("ohvar") or time ("tvar")
+/// variance of a growing phase record: push points, read the values (τ0 = 1) at every averaging
+/// factor. `pending`: factors added automatically (each at 2m + 1 points), increasing.
+#[pyclass(module = "allanite._core")]
+struct StreamingVariance {
+    inner: Stream,
+}
+
+#[pymethods]
+impl StreamingVariance {
+    #[new]
+    #[pyo3(signature = (kind, ms, pending))]
+    fn new(py: Python<'_>, kind: &str, ms: Vec<usize>, pending: Vec<usize>) -> PyResult<Self> {
+        let kind = match kind {
+            "oavar" => StreamKind::Oavar,
+            "ohvar" => StreamKind::Ohvar,
+            "tvar" => StreamKind::Tvar,
+            other => {
+                return Err(allanite_error_of(
+                    py,
+                    "ParameterError",
+                    format!(
+                        "unknown streaming variance {other:?}; allowed: 'oavar', 'ohvar', 'tvar'"
+                    ),
+                ))
+            }
+        };
+        let inner = Stream::new(kind, &ms, &pending).map_err(|e| core_error(py, e))?;
+        Ok(StreamingVariance { inner })
+    }
+
+    /// Appends one phase point.
+    fn push(&mut self, py: Python<'_>, x: f64) -> PyResult<()> {
+        self.inner.push(x).map_err(|e| core_error(py, e))
+    }
+
+    /// Appends phase points in order (those before a non-finite one are kept).
+    fn extend(&mut self, py: Python<'_>, xs: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        let cols = [xs];
+        let x = contiguous(py, &cols)?[0];
+        self.inner.extend(x).map_err(|e| core_error(py, e))
+    }
+
+    /// Adds an averaging factor, exact over the points already held.
+    fn add_factor(&mut self, py: Python<'_>, m: usize) -> PyResult<()> {
+        self.inner.add_factor(m).map_err(|e| core_error(py, e))
+    }
+
+    /// The averaging factors, in the order they were added.
+    fn factors(&self) -> Vec<usize> {
+        self.inner.factors()
+    }
+
+    /// Terms closed at each averaging factor.
+    fn counts(&self) -> Vec<u64> {
+        self.inner.counts()
+    }
+
+    /// The variance at each averaging factor for τ0 = 1 (NaN before its first term).
+    fn values<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.values().into_pyarray(py)
+    }
+
+    /// The phase points held (a copy).
+    fn phase<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.phase().to_vec().into_pyarray(py)
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.phase().len()
+    }
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
@@ -759,6 +895,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tie_gaps, m)?)?;
     m.add_function(wrap_pyfunction!(mtie_phase, m)?)?;
     m.add_function(wrap_pyfunction!(tierms_phase, m)?)?;
+    m.add_function(wrap_pyfunction!(pvar_phase, m)?)?;
+    m.add_function(wrap_pyfunction!(allan_covariance_phase, m)?)?;
+    m.add_function(wrap_pyfunction!(oavar_phase_gaps, m)?)?;
+    m.add_class::<StreamingVariance>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }
