@@ -231,7 +231,6 @@ CASES = [
         [("temperature", {"coefficient": 4.5e-4, "profile": "cycle"})],
         unit="rad/s",
         seed=1,
-        ci=True,
     ),
     Case(
         "temperature swinging once, 1 Hz × 25 h",
@@ -276,7 +275,6 @@ CASES = [
         {"N": 4e-3, "B": 1e-3, "K": 2e-5},
         [("square", {"amplitude": 0.018, "f0": 0.37})],
         seed=5,
-        ci=True,
     ),
     Case(
         "sawtooth 2.3 Hz, 400 Hz × 10⁶, moving-average filter, quantised",

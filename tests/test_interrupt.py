@@ -2,8 +2,9 @@
 
 Each call below would run for tens of seconds (38-57 s on one worker, about half on two: scaled
 from timed shorter runs of the same calls); a SIGINT sent 0.3 s in must end it promptly. The bound
-on the time after the signal (2 s) is generous: it tells "cancelled" from "ran to the end", it is
-not a benchmark.
+on the time after the signal (5 s; well under a second on an idle machine, up to ≈ 3 s while another
+test process competes for the two cores) is generous: it tells "cancelled" from "ran to the end", it
+is not a benchmark.
 """
 
 from __future__ import annotations
@@ -107,8 +108,8 @@ def _interrupt_after(call, delay: float) -> tuple[float, float]:
 def test_ctrl_c_interrupts_the_kernel(kernel):
     call = LONG_CALLS[kernel]()
     before, after = _interrupt_after(call, 0.3)
-    assert before == pytest.approx(0.3, abs=0.25)
-    assert after < 2.0, f"{kernel}: KeyboardInterrupt {after:.2f} s after SIGINT"
+    assert 0.25 <= before < 2.0  # the signal went out while the call ran (late only under a loaded machine)
+    assert after < 5.0, f"{kernel}: KeyboardInterrupt {after:.2f} s after SIGINT"
 
 
 def test_the_module_still_works_after_an_interrupt():

@@ -1,6 +1,7 @@
 """``refine`` with default arguments on simulated sensors unlike the ADIS16405 (issue 29): the CI subset of
-``tests/sensors.py`` — a 25-hour 1 Hz log whose bias follows its temperature channel, a square wave's line
-family, sparse spikes. Each must be named with its parameters (20 %, frequencies 1 %), lower the errors in sample
+``tests/sensors.py`` — a 25-hour 1 Hz log whose bias follows a temperature that swings once, sparse spikes
+(the issue's cycling temperature and a square wave's line family are tests/test_channels.py's and
+tests/test_refine_lines.py's). Each must be named with its parameters (20 %, frequencies 1 %), lower the errors in sample
 and held out, and leave nothing unexplained; refined without its effect's candidate, the model cannot be
 complete, and ``unexplained`` must say so. The whole suite (17 cases) is ``benches/refine_sensors.py``."""
 
