@@ -157,7 +157,17 @@ def _inject(kind: str, kw: dict, t: np.ndarray, fs: float, rng: np.random.Genera
         return (
             comp,
             {},
-            Injected("periodic", {"fundamentals": [f0, f1, f2], "rms": math.sqrt(power)}, ("fundamentals",)),
+            # the sidebands' lattice has more than one basis ((f1, f2) or (f1 + f2, f2), …): judged by the lines
+            Injected(
+                "periodic",
+                {
+                    "fundamentals": [f0, f2],
+                    "line_frequencies": [k * f0 for k in range(1, 4)]
+                    + [k * f1 + s * f2 for k in range(1, 4) for s in (-1, 1)],
+                    "rms": math.sqrt(power),
+                },
+                ("fundamentals", "line_frequencies"),
+            ),
             None,
         )
     if kind == "warmup":
@@ -383,8 +393,37 @@ def _close(found, true, tol) -> bool:
     return found is not None and not isinstance(found, str) and true != 0 and abs(found / true - 1) <= tol
 
 
-def _step_params(step) -> dict:
-    return getattr(step, "final_params", None) or step.params
+def _step_params(steps) -> dict:
+    """The parameters of an effect's steps, merged: lists joined (a record's line families, one step each), RMS
+    amplitudes in quadrature, counts summed; a periodic effect's line frequencies from its evidence."""
+    out: dict = {}
+    for step in steps:
+        params = dict(getattr(step, "final_params", None) or step.params)
+        if "frequencies_hz" in step.evidence:
+            params["line_frequencies"] = list(step.evidence["frequencies_hz"])
+        for k, v in params.items():
+            if k not in out:
+                out[k] = list(v) if isinstance(v, (list, tuple)) else v
+            elif isinstance(v, (list, tuple)):
+                out[k] = list(out[k]) + list(v)
+            elif k == "rms":
+                out[k] = math.hypot(out[k], v)
+            elif k == "lines":
+                out[k] = out[k] + v
+    return out
+
+
+def _param_error(got, true) -> float | None:
+    """Relative error of a found parameter; for a list, the largest over the true entries of the nearest found
+    entry's (None where nothing numeric was found)."""
+    if got is None or isinstance(got, str):
+        return None
+    if isinstance(true, (list, tuple)):
+        found = list(got) if isinstance(got, (list, tuple)) else [got]
+        if not found:
+            return None
+        return float(max(min(abs(g / f - 1) for g in found) for f in true))
+    return float(got / true - 1)
 
 
 def judge(r, case: Case) -> dict:
@@ -396,23 +435,13 @@ def judge(r, case: Case) -> dict:
         if not steps:
             out["named"] = out["params"] = False
             continue
-        params = _step_params(steps[0])
+        params = _step_params(steps)
         for k, v in inj.truth.items():
             tol = FREQ_TOL if k in inj.frequencies else PARAM_TOL
             ok = _close(params.get(k), v, tol)
             out["params"] &= ok
             got = params.get(k)
-            out["param_errors"][f"{inj.effect}.{k}"] = (
-                None
-                if got is None or isinstance(got, str)
-                else (
-                    [float(g) for g in got]
-                    if isinstance(got, (list, tuple))
-                    else float(got / v - 1)
-                    if not isinstance(v, (list, tuple))
-                    else float(got)
-                )
-            )
+            out["param_errors"][f"{inj.effect}.{k}"] = _param_error(got, v)
     first, last = (r.steps[0], r.steps[-1]) if r.steps else (None, None)
     if first is not None:
         b, a = first.before, last.after
