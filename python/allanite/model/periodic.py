@@ -73,6 +73,7 @@ class LineFamily:
 
     @property
     def amplitudes(self) -> np.ndarray:
+        """Each line's amplitude, √(a² + b²) of its sine and cosine coefficients (rate unit)."""
         return np.hypot(self.a, self.b)
 
     @property
@@ -95,6 +96,7 @@ class LineFamily:
 
     @property
     def gens_sd(self) -> np.ndarray:
+        """SD of each generator (Hz), from the diagonal of :attr:`gens_cov`."""
         return np.sqrt(np.maximum(np.diag(self.gens_cov), 0.0))
 
     def component(self, idx: np.ndarray | None = None) -> np.ndarray:

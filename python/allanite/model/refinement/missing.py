@@ -11,8 +11,8 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   non-negative column, the maximum over every curve candidate's family — sinusoids' nulls included — and the
   start terms' own columns, bootstrapped under the final model); the region is where the winning column, with
   the model's fitted directions projected out, carries its weight, and further regions follow with the winner
-  added to the model, at the same threshold (reported where the dense curve's χ²/dof there exceeds 1). With
-  samples the frequency band is refined on the PSD of the final residual samples: the part of
+  added to the model, at the same threshold; a region is reported only where the dense curve's χ²/dof there
+  exceeds 1. With samples the frequency band is refined on the PSD of the final residual samples: the part of
   ≈ 1/(2τ_hi) … 1/(2τ_lo) (widened ×2) that stands above the spectrum's running median.
 - ``"psd"`` — spectral lines of the final samples (:func:`allanite.model.lines.find_lines`: the line search of
   the periodic effect, afresh) that no sinusoid of the model accounts for.
@@ -108,8 +108,8 @@ def _curve(ctx: MissingContext, a: float) -> list[dict]:
         i, j = _region_of(test, fam[:, c])
         lo, hi = float(sub.tau[i]), float(sub.tau[j])
         test = _with_column(test, fam[:, c])
-        if out and not _chi2_dof(ctx, lo, hi) > 1.0:
-            continue  # a further column the residual leans on, where the curve itself is within its scatter
+        if not _chi2_dof(ctx, lo, hi) > 1.0:
+            continue  # a column the residual leans on where the curve itself is within its scatter
         out.append(
             {
                 "domain": "allan",
