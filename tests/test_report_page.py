@@ -18,9 +18,9 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import allanite  # noqa: E402
-from allanite.model.effects import EFFECTS  # noqa: E402
+from allanite.model.effects import EFFECTS, format_param  # noqa: E402
 from allanite.report import build_report  # noqa: E402
-from allanite.report.fmt import clock, num, param_text, step_params  # noqa: E402
+from allanite.report.fmt import clock, num, step_params  # noqa: E402
 from allanite.report.settings import NOTHING_ADDED  # noqa: E402
 
 FS = 100.0
@@ -126,7 +126,7 @@ def test_parameters_that_are_strings_lists_or_ints_render():
         "bands = 1.5, 3, x"
     )
     assert num(1234.6, 3) == "1235" and num(0.5) == "0.5" and num(3.7e-5) == "3.7e-05"
-    assert param_text(None) == "—" and param_text(np.int64(4)) == "4"
+    assert format_param("p", None) == "p = —" and format_param("taps", np.int64(4)) == "taps = 4"
 
 
 # ------------------------------------------------------------------------------------------------

@@ -18,7 +18,6 @@ __all__ = [
     "duration",
     "clock",
     "time_decimals",
-    "param_text",
     "step_params",
     "LONG_RECORD_S",
     "count",
@@ -148,22 +147,6 @@ def step_params(st: dict, fs, duration_s, *, units: bool = False, intervals: boo
         else:
             parts.append(format_param(p, v, iv, unit, 3))
     return "; ".join(parts)
-
-
-def param_text(v, d: int = 3) -> str:
-    """An effect's parameter value as text: strings as they are, ints exactly, floats to ``d``
-    significant digits, lists and tuples element by element."""
-    if v is None:
-        return "—"
-    if isinstance(v, str):
-        return v
-    if isinstance(v, (bool, np.bool_)):
-        return str(bool(v))
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    if isinstance(v, (list, tuple, np.ndarray)):
-        return "[" + ", ".join(param_text(e, d) for e in v) + "]"
-    return num(v, d)
 
 
 def count(n: int, one: str, many: str) -> str:
