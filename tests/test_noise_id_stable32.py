@@ -110,7 +110,7 @@ def test_octave_grid_nu_falls_unless_alpha_changes(estimator):
 
 
 def test_prudent_rule_leaves_dense_grids_and_dips_alone():
-    from allanite.estimators.confidence import _level_weak_peaks
+    from allanite.estimators.noise_id import _level_weak_peaks
 
     m = 2 ** np.arange(8)
     few = np.array([100, 50, 40, 29, 20, 15, 9, 8])

@@ -15,7 +15,8 @@ classic), the record length, the averaging factor m and the dominant power-law n
 −2     random-walk freq. (RWFM)   rate random walk, K              τ⁺¹
 =====  =========================  ===============================  =========================
 
-The pieces, usable on their own:
+The pieces, usable on their own (they live in :mod:`~allanite.estimators.edf` and
+:mod:`~allanite.estimators.noise_id` and are re-exported here):
 
 * :func:`edf_greenhall` — Greenhall & Riley's EDF algorithm ("Uncertainty of stability variances
   based on finite differences", PTTI 2003), the one Stable32 uses for ADEV and OADEV;
@@ -39,16 +40,17 @@ For ν > 100 Stable32 also replaces the χ² quantile by an approximation (``chi
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from .._dist import chi2_ppf
-from .._validate import as_rate_columns, check_choice, check_count, check_probability
+from .._validate import as_rate_columns, check_choice, check_probability
 from ..errors import ParameterError
 from . import _registry
+from .edf import ALPHAS, check_alpha, edf_greenhall, edf_sp1065, edf_theo1
+from .noise_id import ACF_MIN_POINTS, ESTIMATORS, FALLBACKS, ID_MIN_POINTS, identify_alpha
 
 __all__ = [
     "edf_theo1",
@@ -59,15 +61,14 @@ __all__ = [
     "edf_sp1065",
     "chi2_interval",
     "identify_alpha",
+    "ACF_MIN_POINTS",
+    "ID_MIN_POINTS",
     "confidence_intervals",
     "ConfidenceIntervals",
 ]
 
 #: The probability of a normal variable falling within one standard deviation, erf(1/√2).
 ONE_SIGMA = math.erf(1.0 / math.sqrt(2.0))
-
-#: Noise types of the Allan family (α of S_y(f) ∝ f^α) that the Allan variance can distinguish.
-ALPHAS = (2, 1, 0, -1, -2)
 
 #: Short names of the noise types, clock and gyro vocabulary.
 NOISE_NAMES = {
@@ -78,355 +79,12 @@ NOISE_NAMES = {
     -2: "random-walk frequency / rate random walk (RWFM)",
 }
 
-#: Stable32 switches from the lag-1 ACF to the B1 ratio below this many points at a given τ.
-ACF_MIN_POINTS = 30
-
-#: Fewest τ-intervals (⌊samples/m⌋) at which Stable32 identifies the noise type from that τ's own
-#: samples, per estimator; at longer τ it prints the α of the previous τ. Read off its tables (all 34
-#: ADEV/OADEV tables of the shared data: docs/confidence.md): OADEV identifies at 8 intervals and
-#: carries over at 7, ADEV identifies at 10 and carries over at 9.
-ID_MIN_POINTS = {"oavar": 8, "avar": 10}
-
-_FALLBACKS = ("prudent", "previous", "none")
-
 _EDF_METHODS = ("greenhall", "sp1065")
 _CHI2_METHODS = ("exact", "stable32")
-_INPUTS = ("angle", "rate", "increment")
-_ESTIMATORS = ("oavar", "avar")
-
-
-# --------------------------------------------------------------------------------------------
-# argument checks
-
-
-def _check_alpha(alpha, allowed=ALPHAS, what="alpha") -> np.ndarray:
-    a = np.asarray(alpha)
-    if a.dtype.kind not in "iuf" or a.size == 0:
-        raise ParameterError(f"{what} must be integer noise exponents in {sorted(allowed)}, got {alpha!r}")
-    af = a.astype(np.float64)
-    bad = ~np.isin(af, np.asarray(allowed, dtype=np.float64))
-    if bad.any():
-        raise ParameterError(
-            f"{what} must be integers in {sorted(allowed)} (2 WPM, 1 FPM, 0 WFM, −1 FFM, −2 RWFM), "
-            f"got {af[bad].ravel()[0]!r}"
-        )
-    return af.astype(np.int64)
-
-
-# --------------------------------------------------------------------------------------------
-# Greenhall's EDF algorithm
-#
-# The phase is modelled as the first difference of a continuous-time pure power-law process w(t);
-# sw is its generalized autocovariance (Greenhall & Riley eq. 7), sx the one of the phase seen
-# through the estimator's averaging filter (eq. 8), sz the one of the d-th difference (eq. 9).
-# Constant factors of sw cancel in every ratio below, only the sign pattern in α matters.
-
-
-def _sw(t: np.ndarray, alpha: int) -> np.ndarray:
-    """|t|^(3−α) for even α, |t|^(3−α)·ln|t| for odd α (0 at t = 0), with eq. 7's alternating signs."""
-    t = np.abs(np.asarray(t, dtype=np.float64))
-    p = 3 - alpha
-    sign = {2: -1.0, 1: 1.0, 0: 1.0, -1: -1.0, -2: -1.0, -3: 1.0, -4: 1.0}[alpha]
-    if alpha % 2 == 0:
-        return sign * t**p
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = sign * t**p * np.log(t)
-    return np.where(t == 0.0, 0.0, out)
-
-
-def _sx(t, F: float, alpha: int) -> np.ndarray:
-    if math.isinf(F):  # the F → ∞ limit: a pure sample of w with exponent α + 2
-        return _sw(t, alpha + 2)
-    t = np.asarray(t, dtype=np.float64)
-    return F * F * (2.0 * _sw(t, alpha) - _sw(t - 1.0 / F, alpha) - _sw(t + 1.0 / F, alpha))
-
-
-def _sz(t, F: float, alpha: int, d: int) -> np.ndarray:
-    t = np.asarray(t, dtype=np.float64)
-    out = np.zeros_like(t)
-    for k in range(-d, d + 1):
-        out = out + (-1) ** k * math.comb(2 * d, d + k) * _sx(t + k, F, alpha)
-    return out
-
-
-def _basic_sum(J: int, M: float, S: float, F: float, alpha: int, d: int) -> float:
-    """Greenhall & Riley eq. 10."""
-    j = np.arange(1, int(J), dtype=np.float64)
-    total = float(_sz(0.0, F, alpha, d)) ** 2
-    total += (1.0 - J / M) * float(_sz(J / S, F, alpha, d)) ** 2
-    total += 2.0 * float(np.sum((1.0 - j / M) * _sz(j / S, F, alpha, d) ** 2))
-    return total
-
-
-# Tables 1–3 of Greenhall & Riley (2003): 1/ν ≈ (a0 − a1/r)/r for long records.
-# Keys: alpha → {d: (a0, a1)}.
-_TABLE1 = {  # modified variances (F = 1)
-    2: {1: (2 / 3, 1 / 3), 2: (7 / 9, 1 / 2), 3: (22 / 25, 2 / 3)},
-    1: {1: (0.840, 0.345), 2: (0.997, 0.616), 3: (1.141, 0.843)},
-    0: {1: (1.079, 0.368), 2: (1.033, 0.607), 3: (1.184, 0.848)},
-    -1: {2: (1.048, 0.534), 3: (1.180, 0.816)},
-    -2: {2: (1.302, 0.535), 3: (1.175, 0.777)},
-    -3: {3: (1.194, 0.703)},
-    -4: {3: (1.489, 0.702)},
-}
-_TABLE2 = {  # unmodified variances (F = m)
-    2: {1: (3 / 2, 1 / 2), 2: (35 / 18, 1.0), 3: (231 / 100, 3 / 2)},
-    1: {1: (78.6, 25.2), 2: (790.0, 410.0), 3: (9950.0, 6520.0)},
-    0: {1: (2 / 3, 1 / 6), 2: (2 / 3, 1 / 3), 3: (7 / 9, 1 / 2)},
-    -1: {2: (0.852, 0.375), 3: (0.997, 0.617)},
-    -2: {2: (1.079, 0.368), 3: (1.033, 0.607)},
-    -3: {3: (1.053, 0.553)},
-    -4: {3: (1.302, 0.535)},
-}
-_TABLE3 = {1: (6.0, 4.0), 2: (15.23, 12.0), 3: (47.8, 40.0)}  # α = 1: (b0, b1)
-_J_MAX = 100
-
-
-@functools.lru_cache(maxsize=4096)  # the fits ask for the same (α, m, N) once per candidate model
-def _edf_greenhall_one(alpha: int, d: int, m: int, N: int, overlapping: bool, modified: bool) -> float:
-    F = 1 if modified else m  # filter factor
-    S = m if overlapping else 1  # stride factor
-    L = (m // F) + m * d  # span of the estimator's filter, in phase samples
-    if N < L:
-        raise ParameterError(
-            f"N = {N} phase points is too short for m = {m} with d = {d} "
-            f"({'modified' if modified else 'unmodified'} estimator): at least {L} are needed"
-        )
-    M = 1 + math.floor(S * (N - L) / m)  # number of summands
-    J = min(M, (d + 1) * S)
-    r = M / S
-
-    if F == 1:  # case 1: modified variances, and unmodified ones at m = 1
-        if J <= _J_MAX:
-            inv = _basic_sum(J, M, S, 1, alpha, d) / (M * float(_sz(0.0, 1, alpha, d)) ** 2)
-        elif r >= d + 1:
-            a0, a1 = _TABLE1[alpha][d]
-            inv = (a0 - a1 / r) / r
-        else:
-            mp = _J_MAX / r
-            inv = _basic_sum(_J_MAX, _J_MAX, mp, 1, alpha, d) / (_J_MAX * float(_sz(0.0, 1, alpha, d)) ** 2)
-    elif alpha <= 0:  # case 2: unmodified, WFM and redder
-        if J <= _J_MAX:
-            mp = m if m * (d + 1) <= _J_MAX else math.inf
-            inv = _basic_sum(J, M, S, mp, alpha, d) / (M * float(_sz(0.0, mp, alpha, d)) ** 2)
-        elif r >= d + 1:
-            a0, a1 = _TABLE2[alpha][d]
-            inv = (a0 - a1 / r) / r
-        else:
-            mp = _J_MAX / r
-            inv = _basic_sum(_J_MAX, _J_MAX, mp, math.inf, alpha, d) / (
-                _J_MAX * float(_sz(0.0, math.inf, alpha, d)) ** 2
-            )
-    elif alpha == 1:  # case 3: unmodified, FPM
-        b0, b1 = _TABLE3[d]
-        if J <= _J_MAX:
-            inv = _basic_sum(J, M, S, m, 1, d) / (M * float(_sz(0.0, m, 1, d)) ** 2)
-        elif r >= d + 1:
-            a0, a1 = _TABLE2[1][d]
-            inv = (a0 - a1 / r) / (r * (b0 + b1 * math.log(m)) ** 2)
-        else:
-            mp = _J_MAX / r
-            inv = _basic_sum(_J_MAX, _J_MAX, mp, mp, 1, d) / (_J_MAX * (b0 + b1 * math.log(m)) ** 2)
-    else:  # case 4: unmodified, WPM
-        K = math.ceil(r)
-        c = math.comb(2 * d, d)
-        if K <= d:
-            s = sum((1.0 - k / r) * math.comb(2 * d, d - k) ** 2 for k in range(1, K))
-            inv = (1.0 + 2.0 * s / c**2) / M
-        else:
-            a0, a1 = math.comb(4 * d, 2 * d) / c**2, d / 2.0
-            inv = (a0 - a1 / r) / M
-    return 1.0 / inv
-
-
-def edf_greenhall(alpha, d, m, N, overlapping=True, modified=False):
-    """Equivalent χ² degrees of freedom of a finite-difference stability variance (Greenhall & Riley).
-
-    The "combined EDF" algorithm of C. Greenhall and W. Riley, *Uncertainty of stability variances
-    based on finite differences*, Proc. 35th PTTI (2003): exact sums of the estimator's
-    autocovariance for short filters, the paper's fitted tables (1–3) for long records. Stable32
-    uses it for ADEV, OADEV, MDEV, TDEV, HDEV and OHDEV.
-
-    Parameters
-    ----------
-    alpha : int or array_like of int
-        Noise type, the exponent of the rate PSD S_y(f) ∝ f^α: 2 WPM, 1 FPM, 0 WFM, −1 FFM, −2 RWFM
-        (−3 and −4 only with d = 3). Must satisfy α + 2d > 1.
-    d : {1, 2, 3}
-        Order of the phase difference: 2 for the Allan family, 3 for the Hadamard family.
-    m : int or array_like of int
-        Averaging factor, τ = m·τ0.
-    N : int or array_like of int
-        Number of phase (angle) points, M + 1 for M rate samples.
-    overlapping : bool
-        True for the overlapping estimator (stride τ0, ``"oavar"``), False for the classic one
-        (stride τ, ``"avar"``).
-    modified : bool
-        True for the modified Allan (MVAR/TVAR) family.
-
-    Returns
-    -------
-    float or ndarray
-        ν, broadcast over ``alpha``, ``m`` and ``N``.
-
-    Raises
-    ------
-    ParameterError
-        α outside what the d-th difference can handle, d not in {1, 2, 3}, m < 1, or N too short.
-
-    Examples
-    --------
-    The values of docs/FORMULAS.md §7.2 (overlapping ADEV of 1001 phase points):
-
-    >>> from allanite.estimators.confidence import edf_greenhall
-    >>> [round(float(edf_greenhall(a, 2, 1, 1001)), 1) for a in (2, 0, -2)]
-    [514.0, 782.0, 762.3]
-    >>> [round(float(edf_greenhall(a, 2, 100, 1001)), 2) for a in (2, 0, -2)]
-    [440.21, 12.81, 7.75]
-    """
-    d = check_count(d, "d", 1)
-    if d > 3:
-        raise ParameterError(f"d must be 1 (first difference), 2 (Allan) or 3 (Hadamard), got {d!r}")
-    allowed = tuple(a for a in range(2, -5, -1) if a + 2 * d > 1)
-    a_arr = _check_alpha(alpha, allowed)
-    m_arr = np.asarray(m)
-    n_arr = np.asarray(N)
-    for name, arr, lo in (("m", m_arr, 1), ("N", n_arr, 2)):
-        if (
-            arr.dtype.kind not in "iuf"
-            or arr.size == 0
-            or not np.all(np.isfinite(arr))
-            or np.any(arr < lo)
-            or np.any(np.asarray(arr, dtype=np.float64) % 1 != 0)
-        ):
-            raise ParameterError(f"{name} must be integers ≥ {lo}, got {arr if arr.ndim else arr.item()!r}")
-    a_b, m_b, n_b = np.broadcast_arrays(a_arr, m_arr.astype(np.int64), n_arr.astype(np.int64))
-    out = np.empty(a_b.shape, dtype=np.float64)
-    cache: dict = {}
-    for idx in np.ndindex(a_b.shape):
-        key = (int(a_b[idx]), int(m_b[idx]), int(n_b[idx]))
-        if key not in cache:
-            cache[key] = _edf_greenhall_one(key[0], d, key[1], key[2], bool(overlapping), bool(modified))
-        out[idx] = cache[key]
-    return float(out) if out.ndim == 0 else out
-
-
-def edf_sp1065(alpha, m, N, estimator="oavar"):
-    """EDF of the overlapping Allan variance by the simple formulas of NIST SP 1065, Table 5.
-
-    The approximations of Howe, Allan & Barnes (1981), as tabulated in W. Riley, *Handbook of
-    Frequency Stability Analysis* (NIST SP 1065, 2008), for comparison with :func:`edf_greenhall`
-    (which Stable32 uses, and which this package uses by default). They are within ~25 % of
-    Greenhall's values for the Allan family but not interchangeable with them.
-
-    Parameters
-    ----------
-    alpha : int or array_like of int
-        Noise type, 2 (WPM) … −2 (RWFM).
-    m : int or array_like of int
-        Averaging factor.
-    N : int or array_like of int
-        Number of phase points.
-    estimator : {"oavar"}
-        The formulas exist for the overlapping estimator only; use :func:`edf_greenhall` with
-        ``overlapping=False`` for the classic one.
-
-    Returns
-    -------
-    float or ndarray
-
-    Examples
-    --------
-    >>> from allanite.estimators.confidence import edf_sp1065
-    >>> round(float(edf_sp1065(0, 100, 1001)), 2)     # Greenhall: 12.81
-    13.0
-    """
-    if estimator != "oavar":
-        if estimator == "avar":
-            raise ParameterError(
-                "SP 1065 Table 5 gives EDF formulas for the overlapping estimator only (estimator='oavar'); "
-                "for the classic estimator use edf_greenhall(alpha, 2, m, N, overlapping=False)"
-            )
-        raise ParameterError(f"unknown estimator {estimator!r}; allowed: 'oavar'")
-    a = _check_alpha(alpha)
-    m_arr = np.asarray(m, dtype=np.float64)
-    n_arr = np.asarray(N, dtype=np.float64)
-    if np.any(~np.isfinite(m_arr)) or np.any(m_arr < 1) or np.any(~np.isfinite(n_arr)) or np.any(n_arr < 2 * m_arr + 1):
-        raise ParameterError(f"need m ≥ 1 and N ≥ 2m + 1 phase points, got m={m!r}, N={N!r}")
-    a, m_f, n_f = np.broadcast_arrays(a, m_arr, n_arr)
-    out = np.empty(a.shape)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        wpm = (n_f + 1) * (n_f - 2 * m_f) / (2 * (n_f - m_f))
-        fpm = np.exp(np.sqrt(np.log((n_f - 1) / (2 * m_f)) * np.log((2 * m_f + 1) * (n_f - 1) / 4)))
-        wfm = (3 * (n_f - 1) / (2 * m_f) - 2 * (n_f - 2) / n_f) * 4 * m_f**2 / (4 * m_f**2 + 5)
-        ffm = np.where(m_f == 1, 2 * (n_f - 2) ** 2 / (2.3 * n_f - 4.9), 5 * n_f**2 / (4 * m_f * (n_f + 3 * m_f)))
-        rwfm = (n_f - 2) / (m_f * (n_f - 3) ** 2) * ((n_f - 1) ** 2 - 3 * m_f * (n_f - 1) + 4 * m_f**2)
-    for val, arr in ((2, wpm), (1, fpm), (0, wfm), (-1, ffm), (-2, rwfm)):
-        sel = a == val
-        out[sel] = arr[sel]
-    return float(out) if out.ndim == 0 else out
 
 
 # --------------------------------------------------------------------------------------------
 # χ² intervals
-
-
-def edf_theo1(alpha, m, N):
-    """Equivalent degrees of freedom of Theo1 (and TheoBR) at even averaging factor ``m``.
-
-    Howe & Peppler's empirical fits (NIST SP 1065 §5.5.7 / Table 11; Riley's *Handbook* CI notes),
-    with r = 0.75·m (τ/τ0) and N phase points::
-
-        α =  2 (WPM):  [0.86 (N+1)(N − 4r/3) / (N − r)] · [r / (r + 1.14)]
-        α =  1 (FPM):  [(4.798 N² − 6.374 N r + 12.387 r) / (√(r + 36.6) (N − r))] · [r / (r + 0.3)]
-        α =  0 (WFM):  [(4.1 N + 0.8)/r − (3.1 N + 6.5)/N] · [r^1.5 / (r^1.5 + 5.2)]
-        α = −1 (FFM):  [(2 N² − 1.3 N r − 3.5 r) / (N r)] · [r³ / (r³ + 2.3)]
-        α = −2 (RWFM): [(4.4 N − 2) / (2.9 r)] · [((4.4 N − 1)² − 8.6 r (4.4 N − 1) + 11.4 r²) / (4.4 N − 3)²]
-
-    With these and χ² intervals, Stable32's Thêo1 and ThêoH bounds on the Sr87 clock data are
-    reproduced (``tests/test_theo_reference.py``). TheoBR uses the same ν (kf treated as exact).
-
-    Parameters
-    ----------
-    alpha : int or array_like of int
-        Noise type(s), 2 … −2 (α of S_y ∝ f^α; gyro terms: Q 2, N 0, B −1, K −2).
-    m : int or array_like of int
-        Theo1 averaging factors (τ = 0.75·m·τ0).
-    N : int
-        Number of phase (angle) points: rate samples + 1.
-
-    Returns
-    -------
-    float or ndarray
-
-    Examples
-    --------
-    >>> from allanite.estimators.confidence import edf_theo1
-    >>> round(float(edf_theo1(0, 10, 1001)), 1)          # white rate, m = 10 (τ = 7.5 τ0)
-    434.3
-    """
-    a = _check_alpha(alpha)
-    m_arr = np.asarray(m, dtype=np.float64)
-    if np.any(~np.isfinite(m_arr)) or np.any(m_arr < 2):
-        raise ParameterError(f"m must be Theo1 averaging factors ≥ 2, got {m!r}")
-    n = float(check_count(N, "N", 3))
-    a, r = np.broadcast_arrays(a, 0.75 * m_arr)
-    out = np.empty(a.shape, dtype=np.float64)
-    for idx in np.ndindex(a.shape):
-        al, rr = int(a[idx]), float(r[idx])
-        if al == 2:
-            v = 0.86 * (n + 1) * (n - 4 * rr / 3) / (n - rr) * (rr / (rr + 1.14))
-        elif al == 1:
-            v = (4.798 * n * n - 6.374 * n * rr + 12.387 * rr) / (math.sqrt(rr + 36.6) * (n - rr)) * (rr / (rr + 0.3))
-        elif al == 0:
-            v = ((4.1 * n + 0.8) / rr - (3.1 * n + 6.5) / n) * (rr**1.5 / (rr**1.5 + 5.2))
-        elif al == -1:
-            v = (2 * n * n - 1.3 * n * rr - 3.5 * rr) / (n * rr) * (rr**3 / (rr**3 + 2.3))
-        else:
-            q = 4.4 * n
-            v = (q - 2) / (2.9 * rr) * (((q - 1) ** 2 - 8.6 * rr * (q - 1) + 11.4 * rr * rr) / (q - 3) ** 2)
-        out[idx] = max(v, 1.0)  # the fits go below 1 only far outside their range; ν ≥ 1 keeps χ² defined
-    return float(out) if out.ndim == 0 else out
 
 
 def _norm_ppf_stable32(p: np.ndarray) -> np.ndarray:
@@ -508,290 +166,6 @@ def chi2_interval(variance, edf, confidence=0.683, *, method="exact"):
 
 
 # --------------------------------------------------------------------------------------------
-# noise identification
-
-
-def _lag1_acf(z: np.ndarray) -> float:
-    """Lag-1 autocorrelation with Stable32's (n − 1)/n factor (Riley, Handbook §5.5.3)."""
-    z = z - z.mean()
-    den = float(np.dot(z, z))
-    if den == 0.0:
-        return 0.0
-    return float(np.dot(z[:-1], z[1:])) / den * (z.size - 1) / z.size
-
-
-def _acf_alpha(z: np.ndarray, phase: bool, dmax: int = 2) -> float:
-    """Riley & Greenhall's lag-1 ACF algorithm on data already decimated/averaged to τ: difference
-    until δ = r1/(1 + r1) < 0.25 (at most dmax times); p = −2(δ + d); α = p + 2 for phase data,
-    p for frequency data. Returns the fractional estimate."""
-    d = 0
-    while True:
-        r1 = _lag1_acf(z)
-        delta = r1 / (1.0 + r1) if r1 > -1.0 else -1e9  # r1 → −1: as white as it gets
-        if delta < 0.25 or d >= dmax or z.size < 4:
-            p = -2.0 * (delta + d)
-            return p + 2.0 if phase else p
-        z = np.diff(z)
-        d += 1
-
-
-def _b1_expected(N: float, mu: int) -> float:
-    """Barnes' B1(N, r = 1, μ): expected N-sample over 2-sample variance for the phase exponent μ."""
-    if mu == 0:
-        return N * math.log(N) / (2.0 * (N - 1.0) * math.log(2.0))
-    return N * (1.0 - N**mu) / (2.0 * (N - 1.0) * (1.0 - 2.0**mu))
-
-
-def _b1_rn_alpha(x: np.ndarray, y: np.ndarray, m: int, n_ref: int) -> int:
-    """B1 ratio, then R(n) = MVAR/AVAR to split WPM from FPM (Howe, Beard, Greenhall & Riley 2000)."""
-    k = y.size // m
-    if k < 2:
-        return 0
-    ya = y[: k * m].reshape(k, m).mean(axis=1)
-    avar_classic = 0.5 * float(np.mean(np.diff(ya) ** 2))
-    if avar_classic == 0.0:
-        return 0
-    b1 = float(np.var(ya, ddof=1)) / avar_classic
-    # N at which the expected B1 is evaluated: the number of averages (Barnes), or what the caller
-    # chose (Stable32: the estimator's number of terms).
-    N = max(int(n_ref), 2)
-    mus = (1, 0, -1, -2)  # RWFM, FFM, WFM, WPM/FPM
-    mu = -2
-    for hi, lo in zip(mus[:-1], mus[1:]):
-        if b1 > math.sqrt(_b1_expected(N, hi) * _b1_expected(N, lo)):
-            mu = hi
-            break
-    if mu != -2:
-        return {1: -2, 0: -1, -1: 0}[mu]
-    n = x.size
-    if n - 3 * m + 1 < 1:
-        return 1  # R(n) needs 3m + 1 points; FPM is the conservative (smaller-ν) choice
-    dd = x[2 * m :] - 2.0 * x[m : n - m] + x[: n - 2 * m]
-    oav = float(np.mean(dd * dd))
-    if oav == 0.0:
-        return 2
-    c = np.concatenate(([0.0], np.cumsum(dd)))
-    mv = float(np.mean(((c[m:] - c[:-m]) / m) ** 2))
-    rn = mv / oav
-    rn_wpm = 1.0 / m
-    rn_fpm = 3.37 / (1.04 + 3.0 * math.log(math.pi * m))  # f_h = 1/(2τ0)
-    return 1 if rn > math.sqrt(rn_wpm * rn_fpm) else 2
-
-
-def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_n="terms", fallback="prudent"):
-    """Dominant power-law noise type α at each averaging factor, by Stable32's method.
-
-    At each m the data are brought to τ = m·τ0 — phase (angle) data decimated (every m-th point),
-    rate (frequency) data averaged in non-overlapping blocks of m — and then:
-
-    * ``"acf"``: the lag-1 autocorrelation method of Riley & Greenhall (EFTF 2004): difference the
-      series d times (d ≤ 2) until δ = r1/(1 + r1) < 0.25; α = −2(δ + d) (+2 for phase data),
-      rounded. Reliable from about 30 points.
-    * ``"b1"``: the B1 ratio (sample variance of the m-averages over their Allan variance) against
-      Barnes' expectation for each noise type, and where that says WPM-or-FPM, the ratio
-      R(n) = MVAR/AVAR against 1/m (WPM) and 3.37/(1.04 + 3 ln(πm)) (FPM).
-    * ``"auto"`` (default, Stable32's rule): ACF where the record holds at least 30 intervals of
-      length τ (⌊M/m⌋ ≥ 30 for M samples), B1/R(n) below.
-
-    Where too few samples remain — fewer than 8 τ-intervals for ``"oavar"``, 10 for ``"avar"``
-    (:data:`ID_MIN_POINTS`) — α is not identified from that τ's samples but taken from the nearest
-    shorter τ of ``m`` (``fallback="previous"``): Stable32's rule, which its Alpha columns follow
-    row by row (``docs/confidence.md``). The default, ``fallback="prudent"``, adds one more rule on
-    octave-spaced (or sparser) grids: α may rise above both neighbours' only on ≥ 30 τ-intervals
-    (:data:`ACF_MIN_POINTS`) at every τ of the rise; a rise read on fewer falls back to the α before it.
-
-    Parameters
-    ----------
-    x : array_like, 1-D
-        Samples of one axis: cumulative angle (phase) points, or rate / increment samples, per
-        ``input``. Offsets and scale do not matter.
-    m : int or array_like of int
-        Averaging factors (τ = m/fs).
-    input : {"angle", "rate", "increment"}
-        What ``x`` holds. ``"angle"`` follows Stable32's phase-data path (decimation), ``"rate"`` and
-        ``"increment"`` its frequency-data path (block averages).
-    estimator : {"oavar", "avar"}
-        The estimator the α is for: its number of terms (``b1_n="terms"``) and its minimum of
-        τ-intervals (``fallback``) depend on it.
-    method : {"auto", "acf", "b1"}
-    b1_n : {"terms", "averages"}
-        The N at which Barnes' expected B1(N, μ) is evaluated. ``"terms"`` (default, Stable32's):
-        the estimator's number of terms, N − 2m (overlapping) or ⌊(N − 1)/m⌋ − 1 (classic), the
-        "#" column — with ``fallback="previous"`` it reproduces every Alpha of the Stable32
-        ADEV/OADEV octave and decade tables in ``docs/confidence.md``. ``"averages"``: the number
-        of τ-averages the measured ratio is made of — Barnes' definition. For the overlapping
-        estimator the number of terms is far larger than the number of averages, so with
-        ``"terms"`` the RWFM expectation (N/2) is out of reach and random-walk noise comes out as
-        FFM: in simulation it identifies RWFM 0 % and FFM 24 % of the time at 7–26 averages,
-        against 67 % and 59 % for ``"averages"``. Prefer ``"averages"`` to tell rate random walk
-        from bias instability at long τ of an overlapping curve.
-    fallback : {"prudent", "previous", "none"}
-        ``"previous"``: where too few samples remain (see above), α is that of the
-        nearest shorter τ of ``m`` identified on its own samples; if ``m`` holds none, α is
-        identified at the longest averaging factor that still has enough τ-intervals.
-        ``"prudent"`` (default): the same, and on a grid whose neighbouring m are ≥ 2× apart a *peak*
-        — consecutive τ whose α is above the α on both sides — stands only if each of its τ was
-        identified on ≥ 30 τ-intervals; otherwise it takes the α before it. A sum of power-law noises
-        has α fall as τ grows, and a higher α means a larger ν: a chance rise read on few points would
-        give an interval too narrow where data are scarce (e.g. 2¹⁷ white-rate samples read as flicker
-        phase at m = 4096 and 8192, ν 94 → 511). On the Stable32 tables of ``docs/confidence.md`` it
-        changes no α. ``"none"``: every τ on its own samples, however few (with 2 averages B1 is
-        exactly 1, "white FM", whatever the noise).
-
-    Returns
-    -------
-    int or ndarray of int
-        α ∈ {2, 1, 0, −1, −2} per m (values beyond are clipped to that range).
-
-    Notes
-    -----
-    The lag-1 ACF is exact on average for the white and random-walk types, but on averaged
-    flicker noise its fractional estimate drifts towards the neighbouring type (≈ ±1.45 instead
-    of ±1 from m ≈ 16 on), so flicker is sometimes reported as its neighbour at long τ — in
-    Stable32 as here. With few averages (the B1 branch) any identification is uncertain: in
-    simulation 55–80 % of the calls are right.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from allanite.estimators.confidence import identify_alpha
-    >>> rng = np.random.default_rng(0)
-    >>> identify_alpha(rng.normal(size=10_000), [1, 10, 100], input="rate")      # white rate
-    array([0, 0, 0])
-    >>> identify_alpha(np.cumsum(rng.normal(size=10_000)), [1, 10, 100], input="rate")  # rate random walk
-    array([-2, -2, -2])
-    """
-    check_choice(input, "input", _INPUTS)
-    check_choice(estimator, "estimator", _ESTIMATORS)
-    check_choice(method, "method", ("auto", "acf", "b1"))
-    check_choice(b1_n, "b1_n", ("averages", "terms"))
-    check_choice(fallback, "fallback", _FALLBACKS)
-    arr = np.asarray(x)
-    if arr.ndim != 1 or arr.dtype.kind not in "iuf":
-        raise ParameterError(
-            f"x must be a 1-D array of real numbers (one axis), got shape {arr.shape} dtype {arr.dtype}"
-        )
-    arr = arr.astype(np.float64)
-    if not np.all(np.isfinite(arr)):
-        raise ParameterError("x contains NaN or infinite values; noise identification needs finite samples")
-    if input == "angle":
-        if arr.size < 3:
-            raise ParameterError(f"x has {arr.size} angle points; at least 3 are needed")
-        phase = arr - arr[0]
-        rate = np.diff(arr)
-    else:
-        if arr.size < 2:
-            raise ParameterError(f"x has {arr.size} samples; at least 2 are needed")
-        rate = arr - arr.mean()
-        phase = np.concatenate(([0.0], np.cumsum(rate)))
-    n_phase = phase.size
-    m_arr = np.atleast_1d(np.asarray(m))
-    if m_arr.dtype.kind not in "iuf" or np.any(m_arr % 1 != 0) or np.any(m_arr < 1):
-        raise ParameterError(f"m must be integer averaging factors ≥ 1, got {m!r}")
-    m_arr = m_arr.astype(np.int64)
-    too_big = m_arr > (n_phase - 1) // 2
-    if too_big.any():
-        raise ParameterError(
-            f"m = {int(m_arr[too_big][0])} is too large for {n_phase - 1} samples (largest: {(n_phase - 1) // 2})"
-        )
-    each = functools.partial(
-        _identify_each, phase, rate, phase_input=input == "angle", estimator=estimator, method=method, b1_n=b1_n
-    )
-    own = each(m_arr)
-    out = own
-    if fallback != "none":
-        out = _fall_back(own, m_arr, n_phase - 1, ID_MIN_POINTS[estimator], each)
-    if fallback == "prudent":
-        out = _level_weak_peaks(out, m_arr, (n_phase - 1) // m_arr)
-    return int(out[0]) if np.ndim(m) == 0 else out
-
-
-def _level_weak_peaks(alpha: np.ndarray, m: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """A peak — a run of consecutive τ (in order of m) whose α is above the α on both sides of it —
-    stands only if every τ of the run was identified on at least :data:`ACF_MIN_POINTS` τ-intervals;
-    otherwise the run takes the α before it. A sum of power-law noises has its α fall, never rise, as τ
-    grows; a rise that falls back is a chance reading of few points, and a higher α gives a larger ν —
-    an interval too narrow exactly where the data are scarce. Dips (a lower α, a wider interval) stay.
-
-    Only on a grid whose neighbouring m are at least a factor 2 apart (octave, decade): on a denser
-    grid neighbouring τ re-read nearly the same averages, so a neighbour is no second reading."""
-    steps = np.diff(np.unique(m).astype(np.float64))
-    if steps.size and np.min(steps / np.unique(m)[:-1]) < 0.99:
-        return alpha
-    order = np.argsort(m, kind="stable")
-    a = alpha[order].copy()
-    weak = points[order] < ACF_MIN_POINTS
-    i = 1
-    while i < a.size:
-        j = i
-        while j + 1 < a.size and a[j + 1] == a[i]:
-            j += 1
-        # run i..j; a peak needs a neighbour on both sides, both below it
-        if j + 1 < a.size and a[i] > a[i - 1] and a[i] > a[j + 1] and weak[i : j + 1].any():
-            a[i : j + 1] = a[i - 1]
-            i = max(1, i - 1)  # the run joined its left neighbour's: look at that run again
-            while i > 1 and a[i - 1] == a[i]:
-                i -= 1
-            continue
-        i = j + 1
-    out = np.empty_like(alpha)
-    out[order] = a
-    return out
-
-
-def _fall_back(own: np.ndarray, m: np.ndarray, n_intervals: int, min_points: int, identify) -> np.ndarray:
-    """Stable32's rule for τ with too few samples (see :func:`identify_alpha`): every τ with fewer than
-    ``min_points`` τ-intervals takes the α of the nearest shorter τ of ``m`` identified on its own; with
-    none, the α identified at the longest averaging factor that still has ``min_points`` intervals."""
-    needs = n_intervals // m < min_points
-    if not needs.any():
-        return own
-    out = own.copy()
-    donors = np.flatnonzero(~needs)
-    if donors.size:
-        # m need not be sorted: for each τ, the donor with the largest m below it
-        order = donors[np.argsort(m[donors], kind="stable")]
-        pos = np.searchsorted(m[order], m[needs], side="left") - 1
-    else:
-        pos = np.full(int(needs.sum()), -1)
-    ref = None
-    for i, p in zip(np.flatnonzero(needs), pos):
-        if p >= 0:
-            out[i] = own[order[p]]
-        else:
-            if ref is None:
-                ref = int(identify(np.array([max(1, n_intervals // min_points)]))[0])
-            out[i] = ref
-    return out
-
-
-def _identify_each(phase, rate, m_arr, *, phase_input, estimator, method, b1_n) -> np.ndarray:
-    """α at each m on that τ's own samples (no fallback)."""
-    n_phase = phase.size
-    out = np.empty(m_arr.shape, dtype=np.int64)
-    for i, mi in enumerate(m_arr.tolist()):
-        if phase_input:
-            z = phase[::mi]
-        else:
-            k = rate.size // mi
-            z = rate[: k * mi].reshape(k, mi).mean(axis=1)
-        points = (n_phase - 1) // mi  # τ-intervals in the record, for either kind of data
-        use_acf = method == "acf" or (method == "auto" and points >= ACF_MIN_POINTS)
-        if use_acf:
-            a = int(np.clip(round(_acf_alpha(z, phase=phase_input)), -2, 2))
-        else:
-            if b1_n == "averages":
-                n_ref = points
-            elif estimator == "oavar":
-                n_ref = n_phase - 2 * mi
-            else:
-                n_ref = (n_phase - 1) // mi - 1
-            a = _b1_rn_alpha(phase, rate, mi, n_ref)
-        out[i] = a
-    return out
-
-
-# --------------------------------------------------------------------------------------------
 # intervals for results
 
 
@@ -840,7 +214,7 @@ class ConfidenceIntervals:
 
 def _alpha_for_result(result, x, alpha, shape_edf, b1_n, fallback) -> np.ndarray:
     if alpha is not None:
-        a = _check_alpha(alpha)
+        a = check_alpha(alpha)
         try:
             return np.broadcast_to(a, shape_edf).copy()
         except ValueError:
@@ -1039,13 +413,13 @@ def confidence_intervals(
             "Theo-family results use Greenhall's EDF (Allan τ) and Howe's Theo1 EDF (Theo τ); "
             f"edf_method={edf_method!r} is for plain Allan results"
         )
-    if edf_method == "sp1065" and result.estimator not in _ESTIMATORS:
-        raise ParameterError(f"edf_method='sp1065' has formulas for {_ESTIMATORS}, not {result.estimator!r}")
+    if edf_method == "sp1065" and result.estimator not in ESTIMATORS:
+        raise ParameterError(f"edf_method='sp1065' has formulas for {ESTIMATORS}, not {result.estimator!r}")
     dynamic = _is_dynamic(result)
     n_axes = result.n_axes
     shape_edf = (result.m.size,) if n_axes is None else (n_axes, result.m.size)
     check_choice(b1_n, "b1_n", ("averages", "terms"))
-    check_choice(fallback, "fallback", _FALLBACKS)
+    check_choice(fallback, "fallback", FALLBACKS)
     a = _alpha_for_result(result, x, alpha, shape_edf, b1_n, fallback)
     n_phase = _window_length(result) + 1
     m_b = np.broadcast_to(result.m, shape_edf)
