@@ -74,3 +74,20 @@ def test_warmup_fit_at_10_hz_holds_the_truth():
     assert abs(w["amplitude"] / a - 1) < 3 * bound["amplitude_rel"]
     a_lo, a_hi = w["amplitude_interval"]
     assert a_lo < w["amplitude"] < a_hi
+
+
+def test_a_rate_ramp_is_a_free_column():
+    # a deterministic ramp as large as the warm-up over the record (the ADIS run 4 x final model's R): the noise
+    # terms hold R, the fit takes the ramp as a free column and T comes out unbiased, its spread the bound with
+    # the ramp's column (larger than without it)
+    length, a, t_c, r = 1e4, 0.2, 1500.0, 6.7e-6
+    noise = {"N": 0.0415, "B": 0.00714}
+    edges = np.linspace(0.0, length, 101)
+    tb = 0.5 * (edges[:-1] + edges[1:])
+    draws = _draws(edges, noise, a, t_c, 40, seed=4) + r * tb
+    fits = [warmup_fit(np.repeat(b, 10), 10 / 100.0, {**noise, "R": r}, n_blocks=100) for b in draws]
+    t_hat = np.array([f["T"] for f in fits])
+    with_ramp = warmup_crlb(length, a, t_c, {**noise, "R": r}, n_blocks=100)["T_rel"]
+    assert with_ramp > 1.2 * warmup_crlb(length, a, t_c, noise, n_blocks=100)["T_rel"]
+    assert abs(np.median(t_hat) / t_c - 1) < 0.5 * with_ramp
+    assert np.std(t_hat / t_c) == pytest.approx(with_ramp, rel=0.35)
