@@ -142,6 +142,8 @@ def _drift(ctx: RemovalContext) -> Iterator[Removal]:
             "domain": "time",
             "test": tested("statistic", dr["statistic"], thr_d, a),
             "noise": w["noise"],  # the noise terms the block means were weighed against (base form)
+            # the Cramér–Rao bound of T and a under those terms (relative sd): what any unbiased estimate can do
+            "bound": warmup.warmup_crlb(span, w["amplitude"], w["T"], w["noise"]),
         },
         2,
     )
