@@ -9,9 +9,10 @@ their running sums. On a record of 10⁸ samples each of those is 800 MB, and se
 :class:`LongRate` forms the same quantities a chunk at a time from the caller's samples: the block averages
 and the phase bit for bit as the whole-array code forms them (the same elements, a sequential cumulative
 sum continued across chunks); the sums and means over the record (ACF, AVAR, MVAR) are added chunk by
-chunk, so they differ from NumPy's whole-array sums by rounding only (a few units in the last place — α is
-rounded to an integer from them). The phase is held (8 bytes a sample) only where an R(n) is needed, and
-then once for every m.
+chunk, and the block averages at a multiple of the last m are averages of its averages (one pass over the
+record for a whole octave grid), so they differ from the whole-array code's by rounding only (a few units in
+the last place — α is rounded to an integer from them). The phase is held (8 bytes a sample) only where an
+R(n) is needed, and then once for every m.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ class LongRate:
         self.arr, self.mu, self.chunk = arr, mu, int(CHUNK if chunk is None else chunk)
         self.n = int(arr.size)
         self._phase: np.ndarray | None = None
+        self._coarse: tuple[int, np.ndarray] | None = None  # (m, block averages at m): see all_means
 
     def means(self, m: int, k0: int, k1: int) -> np.ndarray:
         """Averages of the blocks k0 … k1 − 1 of m samples: the rows of ``rate[:k·m].reshape(k, m).mean(1)``."""
@@ -42,10 +44,19 @@ class LongRate:
         return rows.mean(axis=1)
 
     def all_means(self, m: int) -> np.ndarray:
-        """Every block average at m (k = n // m of them)."""
+        """Every block average at m (k = n // m of them). From the record the first time; after that, where
+        m is a multiple of the last m asked for, as averages of its averages (one pass over the record for a
+        whole octave grid instead of one per τ; the same averages to rounding)."""
         k = self.n // m
-        per = max(1, self.chunk // m)
-        return np.concatenate([self.means(m, a, min(k, a + per)) for a in range(0, k, per)] or [np.empty(0)])
+        if self._coarse is not None and m % self._coarse[0] == 0 and m > self._coarse[0]:
+            j = m // self._coarse[0]
+            z = self._coarse[1][: k * j].reshape(k, j).mean(axis=1)
+        else:
+            per = max(1, self.chunk // m)
+            z = np.concatenate([self.means(m, a, min(k, a + per)) for a in range(0, k, per)] or [np.empty(0)])
+        if z.size <= self.chunk:  # held: at most a chunk
+            self._coarse = (m, z)
+        return z
 
     def lag1_acfs(self, m: int, dmax: int = 2) -> list[tuple[float, int]]:
         """[(lag-1 autocorrelation with Stable32's (L − 1)/L factor, L) of the d-th difference of the block
