@@ -515,10 +515,12 @@ def chi2_interval(variance, edf, confidence=0.683, *, method="exact"):
 def _lag1_acf(z: np.ndarray) -> float:
     """Lag-1 autocorrelation with Stable32's (n − 1)/n factor (Riley, Handbook §5.5.3)."""
     z = z - z.mean()
-    den = float(np.dot(z, z))
+    # einsum, not np.dot: OpenBLAS's threaded dot took 8.8 ms of CPU for 2^20 elements on two busy cores,
+    # einsum 0.8 ms (the same sum to rounding)
+    den = float(np.einsum("i,i->", z, z))
     if den == 0.0:
         return 0.0
-    return float(np.dot(z[:-1], z[1:])) / den * (z.size - 1) / z.size
+    return float(np.einsum("i,i->", z[:-1], z[1:])) / den * (z.size - 1) / z.size
 
 
 def _acf_alpha(z: np.ndarray, phase: bool, dmax: int = 2) -> float:
