@@ -462,8 +462,8 @@ def write_md(res: dict, path: Path) -> None:
     bc = rep.get("before", {}).get("cpu_s")
     a, ac = rep["after"]["best_s"], rep["after"]["cpu_s"]
     L.append(
-        f"| ADIS report (3 axes, fresh process) | {b and f'{b:.2f} s (CPU {bc:.2f} s)'} | {a:.2f} s (CPU {ac:.2f} s) | "
-        f"{b and f'{b / a:.2f}× (CPU {bc / ac:.2f}×)'} | "
+        f"| ADIS report (3 axes, fresh process) | {f'{b:.2f} s (CPU {bc:.2f} s)' if b else '— (no baseline run)'} | "
+        f"{a:.2f} s (CPU {ac:.2f} s) | {f'{b / a:.2f}× (CPU {bc / ac:.2f}×)' if b else '—'} | "
         f"read {rep['read_s']:.2f} s, engine (avar+davar) {rep['engine_s']:.3f} s, build {rep['build_s']:.2f} s |"
     )
     fcpu = rep.get("figures_serial_cpu_s")
@@ -530,8 +530,8 @@ def write_md(res: dict, path: Path) -> None:
     heavy_a = ", ".join(im["after"]["heavy_modules_imported"]) or "no scipy/matplotlib"
     ratio = im.get("ratio")
     L.append(
-        f"| `import allanite` (median) | {ib and f'{ib:.2f} s'} ({heavy_b}) | "
-        f"{im['after']['median_s']:.2f} s ({heavy_a}) | {ratio and f'{ratio:.2f}×'} | |"
+        f"| `import allanite` (median) | {f'{ib:.2f} s ({heavy_b})' if ib else '— (no baseline run)'} | "
+        f"{im['after']['median_s']:.2f} s ({heavy_a}) | {f'{ratio:.2f}×' if ratio else '—'} | |"
     )
     L.append("")
     L.append(
