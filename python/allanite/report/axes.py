@@ -27,7 +27,8 @@ from ..estimators.confidence import LONG_SAMPLES
 __all__ = ["record_bytes", "wants_by_axis", "analyse_by_axis", "stack", "axis_column"]
 
 #: Samples × axes beyond which the core streams its sums: below, a static or DAVAR call builds a double-word
-#: phase (16 bytes a sample) of every axis it is given (rust/core; allanite.dask's docstring).
+#: phase (16 bytes a sample) of every axis it is given (rust/core; allanite.dask's docstring); beyond, the static
+#: call still held ≈ 8 bytes a sample (measured: +775 MB for one axis of 10⁸ samples).
 CORE_STREAMS = 1 << 26
 
 
@@ -40,11 +41,11 @@ _PER_AXIS = ("avar", "edf", "ci_low", "ci_high", "alpha")
 
 def record_bytes(n: int, n_axes: int, by_axis: bool) -> int:
     """Bytes the analysis of a record of ``n`` samples × ``n_axes`` holds at its peak: the axes it copies
-    (all of them, or one at a time), and the larger of the core's phase (short records) and the noise
+    (all of them, or one at a time), and the larger of the core's working arrays and the noise
     identification's working arrays (:func:`~allanite.estimators.confidence.identify_alpha`: the samples
     less their mean and the phase; on a record over ``LONG_SAMPLES`` the phase alone, where R(n) needs it)."""
     n, k = int(n), 1 if by_axis else int(n_axes)
-    core = 16 * n * k if n * k <= CORE_STREAMS else 0
+    core = (16 if n * k <= CORE_STREAMS else 8) * n * k
     noise_id = 8 * n * (1 if n > LONG_SAMPLES else 2)
     return 8 * n * k + max(core, noise_id)
 
