@@ -19,13 +19,24 @@ Rows
 6. ``import allanite``: wall time of a fresh interpreter's import (median of 5), after and baseline, and
    the top of ``python -X importtime``.
 
-Not measured here (issue 30 items 4 and 5, not done on this branch): the 10⁸ × 3 memory-mapped ``.npy``
-report, and DAVAR's hop-1 case against its write floor.
+7. ``allanite report <ADIS run 1> ... --refine``: its wall and CPU time against the refine calls alone (the
+   report's own cost beyond them), and against the report without ``--refine``.
+8. Scale (issue 30 item 4): ``allanite report`` of a 10⁸-sample × 3-axis float64 ``.npy`` (2.4 GB, written to
+   ``--scratch`` and deleted after; memory-mapped by the reader) in a fresh process — wall, CPU, peak RSS
+   (ru_maxrss of the process and its children, file pages included) against the target of the file's size
+   + 1 GiB. ``--scale-samples`` for another length.
+
+Not measured here (issue 30 item 5): DAVAR's hop-1 case against its write floor.
+
+``--rows report,scale`` reruns only those rows (names: import, report, refine, fit_adis, combine, hop1, scale)
+and keeps the other rows of the ``pipeline.json`` already in ``--out``; the page says which rows were measured
+when, at which load.
 
 Usage::
 
     python benches/bench_pipeline.py --baseline /path/to/main/python   # -> benches/results/pipeline.{md,json}
     python benches/bench_pipeline.py --quick --out /tmp/p              # a few minutes: fewer windows, 1 repeat
+    python benches/bench_pipeline.py --rows report,refine,scale --scratch /tmp   # these rows only
 
 Timing lives here, never in a pass/fail test. The machine's load is noted at the start and the end.
 """
@@ -157,7 +168,9 @@ def row_report(data: Path, cfg: dict, baseline: Path | None, tmp: Path) -> dict:
     best_build, _, _ = _common.timed(lambda: from_log(log), cfg["repeats"])
     specs = rep.figure_specs()
     render_pngs(specs[:1], 100, lambda s: None, processes=1)  # matplotlib's set-up outside the timing
-    best_serial, _, serial = _common.timed(lambda: render_pngs(specs, 100, lambda s: None, processes=1), cfg["repeats"])
+    best_serial, cpu_serial, serial = cpu_timed(
+        lambda: render_pngs(specs, 100, lambda s: None, processes=1), cfg["repeats"]
+    )
     best_two, _, two = _common.timed(lambda: render_pngs(specs, 100, lambda s: None, processes=2), cfg["repeats"])
     row.update(
         read_s=best_read,
@@ -165,10 +178,99 @@ def row_report(data: Path, cfg: dict, baseline: Path | None, tmp: Path) -> dict:
         build_s=best_build,
         figures=len(specs),
         figures_serial_s=best_serial,
+        figures_serial_cpu_s=cpu_serial,
         figures_two_processes_s=best_two,
         figures_identical=all(serial[k] == two[k] for k in serial),
     )
     return row
+
+
+def row_refine(data: Path, cfg: dict, tmp: Path) -> dict:
+    """The report with ``--refine`` against the refine calls it makes (in this process) and the plain report."""
+    import allanite
+
+    plain = run_timed(_report_cmd(data, tmp / "rep_plain", REPORT_ARGS), _env(REPO / "python"), 900)
+    with_refine = run_timed(
+        _report_cmd(data, tmp / "rep_refine", REPORT_ARGS + ["--refine"]), _env(REPO / "python"), 1800
+    )
+    log = allanite.read_log(data, fs=100, columns=["gyro_x", "gyro_y", "gyro_z"], unit="deg/s")
+    static_tau0 = allanite.avar(log.data, 100.0).tau[0]
+    t0 = 0.1 if static_tau0 < 0.1 else None  # as the report calls it (report/build.py)
+    wall, cpu, _ = cpu_timed(
+        lambda: [
+            allanite.refine(
+                np.ascontiguousarray(log.data[:, k]), 100.0, unit="deg/s", tau_range=None if t0 is None else (t0, None)
+            )
+            for k in range(log.data.shape[1])
+        ],
+        1,
+    )
+    return {
+        "plain": {k: plain[k] for k in ("wall_s", "cpu_s", "peak_rss_mb", "status")},
+        "refine": {k: with_refine[k] for k in ("wall_s", "cpu_s", "peak_rss_mb", "status")},
+        "refine_calls_wall_s": wall,
+        "refine_calls_cpu_s": cpu,
+        "beyond_refine_wall_s": with_refine["wall_s"] - wall,
+        "beyond_refine_cpu_s": with_refine["cpu_s"] - cpu,
+    }
+
+
+def _write_scale_record(path: Path, n: int) -> None:
+    """A (n, 3) float64 .npy: white rate noise, a small rate random walk and a bias per axis, in 2^22-row slabs."""
+    mm = np.lib.format.open_memmap(path, mode="w+", dtype=np.float64, shape=(n, 3))
+    rng = np.random.default_rng(0)
+    walk = np.zeros(3)
+    step = 1 << 22
+    for a in range(0, n, step):
+        b = min(n, a + step)
+        rw = np.cumsum(rng.normal(size=(b - a, 3)) * 1e-6, axis=0) + walk
+        walk = rw[-1]
+        mm[a:b] = 0.01 * rng.normal(size=(b - a, 3)) + rw + np.array([0.1, -0.2, 0.05])
+    mm.flush()
+    del mm
+
+
+def row_scale(n: int, scratch: Path, tmp: Path) -> dict:
+    """``allanite report`` of an (n, 3) float64 .npy in a fresh process: wall, CPU, peak RSS against the target."""
+    path = scratch / f"allanite_scale_{os.getpid()}.npy"
+    try:
+        _write_scale_record(path, n)
+        size = path.stat().st_size
+        out = tmp / "scale"
+        r = run_timed(
+            [
+                sys.executable,
+                "-m",
+                "allanite",
+                "report",
+                str(path),
+                "--fs",
+                "100",
+                "--unit",
+                "deg/s",
+                "--out",
+                str(out),
+            ],
+            _env(REPO / "python"),
+            3600,
+        )
+    finally:
+        path.unlink(missing_ok=True)
+    summ = out / "summary.json"
+    record = json.loads(summ.read_text())["record"] if summ.exists() else {}
+    return {
+        "samples": n,
+        "axes": 3,
+        "file_gb": size / 1e9,
+        "status": r["status"],
+        "wall_s": r["wall_s"],
+        "cpu_s": r["cpu_s"],
+        "peak_rss_mb": r["peak_rss_mb"],
+        "target_rss_mb": (size + 2**30) / 2**20,
+        "by_axis": record.get("analysed_axis_by_axis"),
+        "memory_estimate_mb": (record.get("memory_estimate_bytes") or 0) / 2**20,
+        "log_tail": r["stderr_tail"],
+    }
 
 
 def _per_window_reference(result, rows_avar, k_windows: int):
@@ -360,12 +462,15 @@ def write_md(res: dict, path: Path) -> None:
     bc = rep.get("before", {}).get("cpu_s")
     a, ac = rep["after"]["best_s"], rep["after"]["cpu_s"]
     L.append(
-        f"| ADIS report (3 axes, fresh process) | {b and f'{b:.2f} s (CPU {bc:.2f} s)'} | {a:.2f} s (CPU {ac:.2f} s) | "
-        f"{b and f'{b / a:.2f}× (CPU {bc / ac:.2f}×)'} | "
+        f"| ADIS report (3 axes, fresh process) | {f'{b:.2f} s (CPU {bc:.2f} s)' if b else '— (no baseline run)'} | "
+        f"{a:.2f} s (CPU {ac:.2f} s) | {f'{b / a:.2f}× (CPU {bc / ac:.2f}×)' if b else '—'} | "
         f"read {rep['read_s']:.2f} s, engine (avar+davar) {rep['engine_s']:.3f} s, build {rep['build_s']:.2f} s |"
     )
+    fcpu = rep.get("figures_serial_cpu_s")
     L.append(
-        f"| its {rep['figures']} figures | serial {rep['figures_serial_s']:.2f} s | two processes "
+        f"| its {rep['figures']} figures | serial {rep['figures_serial_s']:.2f} s"
+        + (f" (CPU {fcpu:.2f} s)" if fcpu is not None else "")
+        + " | two processes "
         f"{rep['figures_two_processes_s']:.2f} s | {rep['figures_serial_s'] / rep['figures_two_processes_s']:.2f}× | "
         f"PNG bytes identical: {rep['figures_identical']} |"
     )
@@ -401,14 +506,32 @@ def write_md(res: dict, path: Path) -> None:
         + (f", summary.json {h['summary_json_mb']:.2f} MB" if h["summary_json_mb"] is not None else "")
         + f" | {593 / h['wall_s']:.0f}× | files: {', '.join(h['files'])} |"
     )
+    rf = r.get("refine")
+    if rf:
+        L.append(
+            f"| ADIS report `--refine` (fresh process) | without: {rf['plain']['wall_s']:.2f} s (CPU "
+            f"{rf['plain']['cpu_s']:.2f} s) | {rf['refine']['wall_s']:.2f} s (CPU {rf['refine']['cpu_s']:.2f} s) | "
+            f"beyond the refine calls: {rf['beyond_refine_wall_s']:.2f} s (CPU {rf['beyond_refine_cpu_s']:.2f} s) | "
+            f"the refine calls alone {rf['refine_calls_wall_s']:.2f} s (CPU {rf['refine_calls_cpu_s']:.2f} s) |"
+        )
+    sc = r.get("scale")
+    if sc:
+        L.append(
+            f"| scale: `allanite report` of a {sc['samples']:.0e} × {sc['axes']} float64 .npy ({sc['file_gb']:.1f} GB, "
+            f"memory-mapped) | before this branch: every axis copied at once (10⁷ × 3, 240 MB: peak RSS 997 MB, 4.2×; "
+            f"not run at 10⁸) | "
+            f"{'done' if sc['status'] == 0 else sc['status']} in {sc['wall_s']:.0f} s (CPU {sc['cpu_s']:.0f} s), "
+            f"peak RSS {sc['peak_rss_mb']:.0f} MB | target ≤ 60 s, RSS ≤ {sc['target_rss_mb']:.0f} MB | "
+            f"axis by axis: {sc['by_axis']}; the report's estimate {sc['memory_estimate_mb']:.0f} MB |"
+        )
     im = r["import"]
     ib = im.get("before", {}).get("median_s")
     heavy_b = ", ".join(im.get("before", {}).get("heavy_modules_imported", []))
     heavy_a = ", ".join(im["after"]["heavy_modules_imported"]) or "no scipy/matplotlib"
     ratio = im.get("ratio")
     L.append(
-        f"| `import allanite` (median) | {ib and f'{ib:.2f} s'} ({heavy_b}) | "
-        f"{im['after']['median_s']:.2f} s ({heavy_a}) | {ratio and f'{ratio:.2f}×'} | |"
+        f"| `import allanite` (median) | {f'{ib:.2f} s ({heavy_b})' if ib else '— (no baseline run)'} | "
+        f"{im['after']['median_s']:.2f} s ({heavy_a}) | {f'{ratio:.2f}×' if ratio else '—'} | |"
     )
     L.append("")
     L.append(
@@ -420,11 +543,31 @@ def write_md(res: dict, path: Path) -> None:
         "did before the batched core), timed on windows spread over the record, per window × the number of windows."
     )
     L.append("")
+    stamps = res.get("row_runs", {})
+    if stamps:
+        L.append("")
+        L.append("Rows measured in other runs than the header's (`--rows`), with that run's load:")
+        L.append("")
+        for name, st in stamps.items():
+            L.append(
+                f"- {name}: {st['date']}, commit {st['commit']}, load {st['load']['loadavg']} "
+                f"(busy {st['load']['cpu_busy']:.2f})" + (" — `--quick`: one repeat" if st.get("quick") else "")
+            )
+    L.append("")
     L.append(
-        "Not measured (issue 30 items 4 and 5 were not done on this branch): the 10⁸ × 3 memory-mapped `.npy` "
-        "report, and DAVAR's hop-1 case against its write floor (case 1's old target in engine.md stands)."
+        "Not measured (issue 30 item 5): DAVAR's hop-1 case against its write floor (case 1's old target in "
+        "engine.md stands)."
     )
     path.write_text("\n".join(L) + "\n", encoding="utf-8")
+
+
+ROWS = ("import", "report", "refine", "fit_adis", "combine", "hop1", "scale")
+
+
+def _commit() -> str:
+    return subprocess.run(
+        ["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
+    ).stdout.strip()
 
 
 def main() -> int:
@@ -432,7 +575,16 @@ def main() -> int:
     ap.add_argument("--quick", action="store_true", help="fewer windows and one repeat: a few minutes")
     ap.add_argument("--baseline", type=Path, default=None, help="python/ folder of the checkout to compare with")
     ap.add_argument("--out", type=Path, default=HERE / "results", help="folder for pipeline.md and pipeline.json")
+    ap.add_argument("--rows", default=None, help=f"comma-separated rows to rerun ({', '.join(ROWS)}); default all")
+    ap.add_argument(
+        "--scratch", type=Path, default=None, help="folder for the scale row's record (default: a temp dir)"
+    )
+    ap.add_argument("--scale-samples", type=int, default=100_000_000, help="samples of the scale row's record")
     args = ap.parse_args()
+    rows = ROWS if args.rows is None else tuple(r.strip() for r in args.rows.split(","))
+    unknown = sorted(set(rows) - set(ROWS))
+    if unknown:
+        ap.error(f"unknown rows {unknown}; rows are {', '.join(ROWS)}")
     cfg = CONFIGS["quick" if args.quick else "full"]
     data = _common.shared_data_dir() / ADIS
     if not data.exists():
@@ -444,25 +596,52 @@ def main() -> int:
         "machine": _common.machine_info(),
         "baseline": str(args.baseline) if args.baseline else None,
         "load_start": load_note(),
-        "commit": subprocess.run(
-            ["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
-        ).stdout.strip(),
+        "commit": _commit(),
         "parallel_capacity": parallel_capacity(),
         "rows": {},
     }
+    previous = args.out / "pipeline.json"
+    if args.rows is not None and not previous.exists():
+        ap.error(f"--rows keeps the other rows of {previous}, which does not exist: run every row first")
+    if args.rows is not None and previous.exists():  # keep the rows not rerun, and when they were measured
+        old = json.loads(previous.read_text(encoding="utf-8"))
+        stamp = {k: old[k] for k in ("date", "commit")} | {"load": old["load_start"]}
+        res["rows"] = old["rows"]
+        res["row_runs"] = old.get("row_runs", {})
+        for name in old["rows"]:
+            res["row_runs"].setdefault(name, stamp)
+        for k in ("date", "commit", "load_start", "parallel_capacity", "quick", "baseline", "machine"):
+            res[k] = old.get(k, res[k])
+        res["load_end"] = old.get("load_end")
     with tempfile.TemporaryDirectory() as tmp:
         t = Path(tmp)
-        _common.log("import")
-        res["rows"]["import"] = row_import(cfg, args.baseline)
-        _common.log("report")
-        res["rows"]["report"] = row_report(data, cfg, args.baseline, t)
-        _common.log("fit of the ADIS windows")
-        res["rows"]["fit_adis"] = row_fit_adis(data, cfg)
-        _common.log("combine and fit of many windows")
-        res["rows"]["combine"], res["rows"]["fit_many"] = row_combine_and_fit(cfg, args.baseline)
-        _common.log("hop-1 request")
-        res["rows"]["hop1"] = row_hop1(data, t)
-    res["load_end"] = load_note()
+        for name in rows:
+            _common.log(name)
+            if name == "import":
+                res["rows"]["import"] = row_import(cfg, args.baseline)
+            elif name == "report":
+                res["rows"]["report"] = row_report(data, cfg, args.baseline, t)
+            elif name == "refine":
+                res["rows"]["refine"] = row_refine(data, cfg, t)
+            elif name == "fit_adis":
+                res["rows"]["fit_adis"] = row_fit_adis(data, cfg)
+            elif name == "combine":
+                res["rows"]["combine"], res["rows"]["fit_many"] = row_combine_and_fit(cfg, args.baseline)
+            elif name == "hop1":
+                res["rows"]["hop1"] = row_hop1(data, t)
+            elif name == "scale":
+                res["rows"]["scale"] = row_scale(args.scale_samples, args.scratch or t, t)
+            if args.rows is not None:
+                now = {
+                    "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+                    "commit": _commit(),
+                    "load": load_note(),
+                    "quick": args.quick,
+                }
+                for key in ("combine", "fit_many") if name == "combine" else (name,):
+                    res.setdefault("row_runs", {})[key] = now
+    if args.rows is None:
+        res["load_end"] = load_note()
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "pipeline.json").write_text(json.dumps(res, indent=1, default=str), encoding="utf-8")
     write_md(res, args.out / "pipeline.md")

@@ -4,7 +4,8 @@ Read from the source (AST), so a violation fails here before anyone meets it as 
 a tangle. The layers, bottom up (a module may import only from its own layer or below):
 
     0  errors, _core                       the exceptions; the Rust extension
-    1  units, _validate, _progress         shared checks and units; progress bars of long calls
+    1  units, _validate, _progress,        shared checks and units; progress bars of long calls; reading a
+       _mapped                             memory-mapped record through its file
     2  estimators.*, io.*                  the registry and its entries, EDF; the readers
     3  plot, results, _display             figures; result objects (EDF sits below them); notebook HTML
     4  analysis, simulation, datasets, _reference
@@ -32,6 +33,7 @@ LAYERS = {
     "units": 1,
     "_validate": 1,
     "_progress": 1,
+    "_mapped": 1,
     "_dist": 1,
     "estimators": 2,
     "io": 2,

@@ -21,11 +21,27 @@ def test_import_allanite_loads_no_scipy_stats_signal_optimize_or_matplotlib():
     assert out.stdout.strip() == "[]"
 
 
+def test_the_command_line_and_the_report_load_no_scipy_stats_signal_optimize_or_matplotlib():
+    """What ``allanite report`` imports before it computes: the refinement's loop (scipy.signal, stats,
+    optimize) only with ``--refine``, matplotlib only when the figures are drawn."""
+    code = (
+        "import sys, allanite.cli, allanite.report; "
+        "print(sorted(m for m in ('scipy.stats', 'scipy.signal', 'scipy.optimize', 'matplotlib') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
 def test_refine_names_load_on_first_use():
     from allanite.model.refinement import Refinement, Step, refine
 
     assert allanite.refine is refine and allanite.Refinement is Refinement
     assert allanite.model.Step is Step
+    from allanite.model import refinement
+
+    assert refinement.LEVEL == refinement.levels.LEVEL and refinement.CANDIDATES == refinement.loop.CANDIDATES
+    with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
+        refinement.no_such_name  # noqa: B018
     with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
         allanite.no_such_name  # noqa: B018
     with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):

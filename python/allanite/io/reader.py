@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._mapped import read_rows
 from .._validate import INPUTS, check_choice, check_fs
 from ..errors import AllaniteError, DataGapError, InputError, MissingDependencyError, ParameterError
 from ..units import Unit, parse_unit
@@ -565,7 +566,9 @@ def _finish(path, fmt, rec: _Record, fs, unit, input, gaps) -> Log:
         arr2 = data if data.ndim == 2 else data[:, None]
         chunk = max(1, 4_000_000 // max(1, arr2.shape[1]))
         for s in range(0, n, chunk):
-            hit = _first_nonfinite(np.asarray(arr2[s : s + chunk], dtype=np.float64))
+            # a memory-mapped .npy is read from its file: its pages are not mapped in (allanite._mapped)
+            block = read_rows(data, s, s + chunk)
+            hit = _first_nonfinite(np.asarray(block if block.ndim == 2 else block[:, None], dtype=np.float64))
             if hit is not None:
                 r, c = hit
                 v = arr2[s + r, c]

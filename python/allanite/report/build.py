@@ -40,13 +40,14 @@ import numpy as np
 from .._progress import StepBar
 from .._validate import check_choice, check_count, check_positive
 from ..analysis import avar, davar
-from ..errors import AllaniteError, ParameterError
+from ..errors import AllaniteError, MemoryBudgetError, ParameterError
 from ..estimators import get as get_estimator
 from ..estimators.theo import resolve_decimation
 from ..model import fit as fit_model
 from ..model.terms import TERMS
 from ..results import AllanResult, DynamicAllanResult
 from ..units import adev_unit_label, parse_unit
+from .axes import analyse_by_axis, axis_column, record_bytes, wants_by_axis
 from .budget import check_report_memory
 from .figures import figure_specs
 from .fmt import count, json_number
@@ -330,23 +331,30 @@ def build_report(
     assert resolve_m is not None  # every dynamic estimator of the report resolves its grid
     dyn_ms = resolve_m(dynamic_grid, window, check_positive(fs, "fs"))
     n_fit = _octaves(dyn_ms) if estimator == "oavar" else dyn_ms.size  # DHVAR's short windows: every τ
-    cost = check_report_memory(n, n_axes, window, hop, dyn_ms.size, n_fit, len(TERMS), fit, max_memory)
-    progress.step("static Allan deviation")
+    by_axis, cost = _memory_plan(x, n, n_axes, window, hop, dyn_ms.size, n_fit, fit, max_memory)
     extra = {"decimate": "auto"} if static_est == "theoh" else {}
-    static = avar(x, fs, input=input, taus=taus, estimator=static_est, **extra)
-    progress.step("confidence intervals")
-    static = static.with_confidence(x, confidence=confidence)
-
-    progress.step("dynamic Allan variance")
-    dynamic = davar(
-        x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est, max_memory=max_memory
-    )
+    if by_axis:  # one axis in memory at a time (report/axes.py): a long or memory-mapped record
+        static, dynamic = analyse_by_axis(
+            x, fs, input=input, taus=taus, static_est=static_est, static_extra=extra, confidence=confidence,
+            window=window, hop=hop, grid=dynamic_grid, dynamic_est=dynamic_est, max_memory=max_memory,
+            progress=progress,
+        )  # fmt: skip
+    else:
+        progress.step("static Allan deviation")
+        static = avar(x, fs, input=input, taus=taus, estimator=static_est, **extra)
+        progress.step("confidence intervals")
+        static = static.with_confidence(x, confidence=confidence)
+        progress.step("dynamic Allan variance")
+        dynamic = davar(
+            x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est, max_memory=max_memory
+        )
     settings.update(
         taus=taus if isinstance(taus, str) else "explicit",
         estimator=estimator,
         dynamic_grid=dynamic_grid,
         theo_decimation=(resolve_decimation("auto", n, taus) if static_est == "theoh" else None),
         memory_estimate_bytes=int(cost["total"]),
+        by_axis=by_axis,
     )
 
     fits = series = None
@@ -398,7 +406,7 @@ def build_report(
             try:
                 refinements.append(
                     refine_axis(
-                        np.asarray(x[:, k], dtype=np.float64),
+                        axis_column(x, k),
                         fs,
                         input=input,
                         unit=unit_name,
@@ -503,6 +511,25 @@ def _window_and_hop(n, window, hop, estimator):
         "hop_rule": hop_rule,
     }
     return window, hop, settings
+
+
+def _memory_plan(x, n, n_axes, window, hop, n_tau, n_fit, fit, max_memory) -> tuple[bool, dict]:
+    """(analyse axis by axis?, the cost by part): a memory-mapped record always axis by axis; one in memory
+    axis by axis where all its axes at once would exceed the budget and one at a time fits."""
+    by_axis = wants_by_axis(x)
+    try:
+        cost = check_report_memory(
+            n, n_axes, window, hop, n_tau, n_fit, len(TERMS), fit, max_memory,
+            record=record_bytes(n, n_axes, by_axis),
+        )  # fmt: skip
+    except MemoryBudgetError:
+        if by_axis or n_axes == 1:
+            raise
+        by_axis = True
+        cost = check_report_memory(
+            n, n_axes, window, hop, n_tau, n_fit, len(TERMS), fit, max_memory, record=record_bytes(n, n_axes, True)
+        )
+    return by_axis, cost
 
 
 def _octaves(ms) -> int:

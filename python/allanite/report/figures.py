@@ -177,7 +177,9 @@ def _refinement_specs(rep) -> list:
                 fig.axes[0].set_ylabel(f"Allan deviation ({label})")
             found = ", ".join(st.effect for st in r.steps) or NOTHING_ADDED
             fig.suptitle(f"{name}: model refinement — {found}", fontsize="medium")
-            fig.tight_layout()
+            # room for the title above the panels ``plot`` laid out (a second tight_layout would lay out
+            # every text again)
+            fig.subplots_adjust(top=min(fig.subplotpars.top, 1 - 0.45 / fig.get_figheight()))
 
         specs.append(
             (

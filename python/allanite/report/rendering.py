@@ -26,6 +26,10 @@ __all__ = ["render_pngs", "figure_processes"]
 #: matplotlib's font set-up again).
 MIN_FIGURES_TO_SPLIT = 4
 
+#: zlib level of the PNGs (measured on the ADIS16405 report's 14 figures: level 6, PIL's default, 6.3 s of CPU
+#: and 1316 kB; level 1, 4.1 s and 1439 kB).
+PNG_COMPRESSION = 1
+
 
 def figure_processes() -> int:
     """Processes that draw the figures: 2 where ``fork`` exists, two cores are available, the last minute's
@@ -51,7 +55,8 @@ def png(spec, dpi: int) -> bytes:
     fig = Figure(figsize=size, dpi=dpi)
     draw(fig)
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
+    # zlib level 1: a third of the drawing's CPU time less than the default 6, for PNGs ~10 % larger
+    fig.savefig(buf, format="png", dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESSION})
     return buf.getvalue()
 
 

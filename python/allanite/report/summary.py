@@ -258,6 +258,9 @@ def summarize(rep) -> dict:
         "adev_unit": au,
         "input": rep.input,
         "source": rep.source,
+        # how the analysis held the record (report/axes.py) and the report's memory estimate (report/budget.py)
+        "analysed_axis_by_axis": bool(rep.settings.get("by_axis", False)),
+        "memory_estimate_bytes": rep.settings.get("memory_estimate_bytes"),
     }
     static = {
         "estimator": st.estimator,

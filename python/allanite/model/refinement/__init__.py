@@ -47,8 +47,19 @@ in time and change points do not count).
 """
 
 from ..effects import gm_avar, sinusoid_avar
-from .levels import LEVEL
-from .loop import CANDIDATES, refine
 from .result import Refinement, Step
+
+#: Names whose modules load SciPy's signal, stats and optimize (the loop, its levels): on first use, so that
+#: what only shows a refinement (the report's summary, :mod:`.result`) does not pay for them.
+_LAZY = {"refine": "loop", "CANDIDATES": "loop", "LEVEL": "levels"}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = ["refine", "Refinement", "Step", "gm_avar", "sinusoid_avar", "CANDIDATES", "LEVEL"]

@@ -14,7 +14,6 @@ from ...units import ieee952
 from .. import fitting
 from ..effects import EFFECTS, format_params
 from ..terms import TERM_NAMES
-from .scoring import rms_adev_pct
 
 __all__ = ["Step", "Refinement", "term_moves", "term_move_text", "describe_region"]
 
@@ -149,6 +148,8 @@ class Refinement(RichDisplay):
         """RMS ADEV error (%) of a fit (``start`` or ``fit``) on the τ the steps' errors are scored on
         (``scored_tau``: 4 per octave, each estimate within ±10 %, EDF ≥ 50 under the five-term fit)."""
         sel = np.isin(fit.tau, self.scored_tau) if self.scored_tau is not None else slice(None)
+        from .scoring import rms_adev_pct  # scoring loads scipy.stats and the tracing: not for a summary
+
         return rms_adev_pct(fit.avar[sel], fit.model[sel])
 
     @property
