@@ -83,9 +83,10 @@ CONFIGS = {
     },
 }
 
-#: Issue 17's targets.
+#: Issue 17's targets. Case 1's "≥ 10× davar_prefix" is retired (issue 30, item 5): its 55 MB output bounds any
+#: implementation, the twin included, so it is judged against writing that output once — ≤ 2× the floor,
+#: benches/bench_davar_floor.py → benches/results/davar_floor.md.
 TARGETS = {
-    "case1_speedup_vs_prefix": 10.0,
     "case2_speedup_vs_prefix": 15.0,
     "case3_speedup_vs_prefix": 30.0,
     "case4_speedup_vs_allantools": 25.0,
@@ -394,7 +395,9 @@ def evaluate_targets(cases: dict) -> None:
             )
         ]
         for key in DYNAMIC_CASES
+        if key + "_speedup_vs_prefix" in TARGETS
     }
+    checks["case1"] = []
     checks["case4"] = [
         (
             "speed-up vs allantools.oadev ≥ 25×",
@@ -458,7 +461,6 @@ def write_markdown(report: dict, path: Path) -> None:
         "|---|---|---|---|---|---|---|---|",
     ]
     targets_for = {
-        ("case1", "davar_prefix"): [0],
         ("case2", "davar_prefix"): [0],
         ("case3", "davar_prefix"): [0],
         ("case4", "allantools_oadev"): [0, 1],
@@ -700,6 +702,11 @@ def write_speed_table(report: dict, page: Path) -> None:
     def met(key):
         return "met" if all(bool(t["met"]) for t in cases[key]["targets"]) else "**not met**"
 
+    def target(key):
+        if key + "_speedup_vs_prefix" not in TARGETS:
+            return "— (judged against its output floor: benches/results/davar_floor.md)"
+        return f"≥ {TARGETS[key + '_speedup_vs_prefix']:g}× — {met(key)}"
+
     rows = [
         f"| case (2 cores; run {m['date_utc'][:10]} on {m['cpu_model']}, other load "
         + ", ".join(_pct(cases[k].get("other_processes_cpu_fraction")) for k in CASES)
@@ -715,15 +722,14 @@ def write_speed_table(report: dict, page: Path) -> None:
         ).replace("e+0", "e")
         floor = cases[key].get("output_floor")
         why = ""
-        if floor is not None and floor["twin_over_floor"] < TARGETS[key + "_speedup_vs_prefix"]:
+        if floor is not None and floor["twin_over_floor"] < TARGETS.get(key + "_speedup_vs_prefix", 0):
             why = (
                 f" (writing the output alone takes {_fmt_s(floor['seconds'])} s: the twin is "
                 f"{floor['twin_over_floor']:.1f}× that, the most any implementation could gain)"
             )
         rows.append(
             f"| {label} | {_fmt_s(cases[key]['allanite']['seconds'])} s | NumPy prefix-sum twin "
-            f"{_fmt_s(c['seconds'])} s | {_fmt_ratio(c['ratio'])} | ≥ {TARGETS[key + '_speedup_vs_prefix']:g}× — "
-            f"{met(key)}{why} |"
+            f"{_fmt_s(c['seconds'])} s | {_fmt_ratio(c['ratio'])} | {target(key)}{why} |"
         )
     at = (
         comp("case1", "allantools_per_window")

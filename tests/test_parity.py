@@ -760,3 +760,15 @@ def test_property_tests_run_on_fixed_inputs_by_default():
     exploring = os.environ.get("ALLANITE_EXPLORE", "").strip() not in ("", "0")
     assert current.default.derandomize is not exploring
     assert (current.default.database is None) is not exploring
+
+
+@pytest.mark.parametrize("n, window", [(3_000, 40), (3_001, 41), (2_500, 1_000), (700, 233)])
+def test_hop1_surface_matches_the_per_window_recomputation(rng, n, window):
+    """The hop-1 rows (terms formed segment by segment, two lanes of segments, each window written once:
+    rust/core/src/window_sums.rs) against every window recomputed from its own samples, to 1e-12 — rows of
+    one to ~100 segments, even and odd counts, on an offset record."""
+    y = rng.normal(size=n) * 0.3 + 2.0
+    ms = np.unique(np.linspace(1, window // 2, 9).astype(int))
+    fast = allanite.davar(y, 10.0, window=window, hop=1, taus=ms / 10.0, method="fast")
+    naive = allanite.davar(y, 10.0, window=window, hop=1, taus=ms / 10.0, method="naive")
+    assert max_rel(fast.avar, naive.avar) <= 1e-12

@@ -16,6 +16,7 @@ pub mod range;
 pub mod streaming;
 pub mod taper;
 pub mod theo;
+mod window_sums;
 
 pub use allan::{
     compensated_mean, compensated_sum_from, dynamic_avar, dynamic_avar_cancellable,

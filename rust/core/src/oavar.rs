@@ -597,12 +597,34 @@ unsafe fn terms_into_avx2(
     terms_into(hi, lo, m, k0, scale, out)
 }
 
+/// [`terms_into`] compiled for AVX2 where the CPU has it (`avx2`: checked by the caller, once per row).
+#[inline(always)]
+pub(crate) fn terms_dispatch(
+    avx2: bool,
+    hi: &[f64],
+    lo: &[f64],
+    m: usize,
+    k0: usize,
+    scale: f64,
+    out: &mut [f64],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 {
+        // SAFETY: the caller checked that the CPU has AVX2.
+        unsafe { terms_into_avx2(hi, lo, m, k0, scale, out) };
+        return;
+    }
+    let _ = avx2;
+    terms_into(hi, lo, m, k0, scale, out)
+}
+
 /// Scratch of one worker of [`overlapping_dynamic`].
 #[derive(Default)]
 pub(crate) struct DynScratch {
     terms: Vec<f64>,
     full: Vec<f64>,
     part: Vec<f64>,
+    sums: Vec<f64>,
 }
 
 /// Hops below this keep every term and cut blocks afterwards; longer hops sum each block directly.
@@ -638,7 +660,16 @@ pub(crate) fn overlapping_dynamic_row(
     let k_end = (n_win - 1) * hop + l;
     let nblocks = n_win + q;
     let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
-    let DynScratch { terms, full, part } = sc;
+    let DynScratch {
+        terms,
+        full,
+        part,
+        sums,
+    } = sc;
+    if hop == 1 {
+        // terms formed segment by segment, each window written once (`crate::window_sums`)
+        return crate::window_sums::hop1_row(hi, lo, m, q, norm, avx2, out, sums);
+    }
     if hop < SMALL_HOP {
         // every term is written below: the buffer is only sized (no fill of what it already holds)
         terms.resize(k_end, 0.0);
@@ -684,16 +715,13 @@ pub(crate) fn overlapping_dynamic_row(
     }
     if q == 0 {
         out.copy_from_slice(&part[..n_win]);
+        // noted while the row is in cache: the caller's range check then reads nothing again
+        Range::of(out)
     } else {
-        crate::allan::sliding_sums(full, q, out);
-        if r != 0 {
-            for (o, p) in out.iter_mut().zip(&part[q..]) {
-                *o += p;
-            }
-        }
+        // each window written once, its range noted as it is written
+        let head = (r != 0).then(|| &part[q..]);
+        crate::window_sums::sliding_sums_ranged(full, q, head, out, sums)
     }
-    // noted while the row is in cache: the caller's range check then reads nothing again
-    Range::of(out)
 }
 
 /// [`overlapping_dynamic_row`] for every m of `ms` at once, for hops ≥ `SMALL_HOP`: the block sums
