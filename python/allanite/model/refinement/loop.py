@@ -275,6 +275,7 @@ class _Run:
         self.change_points: list = []
         self.considered: dict[str, list] = {}
         self.line_search: dict | None = None  # the periodic removal's line search, for the sinusoid candidate
+        self.declined_families: list = []  # line families the removal in time turned down: their lines stay
 
     def build(self, res, samples):
         """The curve (and, with samples, the held-out split) of ``res``'s estimates in the τ range."""
@@ -331,6 +332,8 @@ class _Run:
             for rem in remover(ctx):
                 if self.remove(rem):
                     ctx.y, ctx.curve, ctx.sol = self.y, self.curve, self.sol
+                elif rem.family is not None:
+                    self.declined_families.append(rem.family)
         self.line_search = ctx.lines
 
     def remove(self, rem: Removal) -> bool:
@@ -395,7 +398,11 @@ class _Run:
             search = self.line_search
             if search is None:
                 search = periodic.periodic_search(y, self.fs, alpha("lines", self.level))
-            lines = periodic.sinusoid_lines(search, families="periodic" not in candidates)
+            # every line a family removal did not take: all of them without the periodic candidate, else the
+            # lines of the families it turned down (their phase does not carry across the record's parts, their
+            # power is still on the curve)
+            fams = True if "periodic" not in candidates else self.declined_families
+            lines = periodic.sinusoid_lines(search, families=fams)
         for n_step in range(MAX_STEPS):
             if not self.curve_step(n_step, candidates, thin, exact, lines):
                 break
