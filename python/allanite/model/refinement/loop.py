@@ -33,7 +33,15 @@ from .levels import LEVEL, alpha
 from .missing import MissingContext, unexplained
 from .removals import REMOVALS, Removal, RemovalContext
 from .result import Refinement, Step, term_moves
-from .scoring import HELDOUT_BLOCKS, chain_metrics, heldout_split, informative, segments_heldout
+from .scoring import (
+    HELDOUT_BLOCKS,
+    MATERIAL_Z,
+    chain_metrics,
+    curve_change_z,
+    heldout_split,
+    informative,
+    segments_heldout,
+)
 
 __all__ = ["refine", "CANDIDATES", "MAX_STEPS", "REFINE_SCALE"]
 
@@ -359,6 +367,8 @@ class _Run:
             rem.evidence["heldout_test"] = {"before": ho_b, "after": ho_a}
         params = dict(rem.params)
         s_new = solve(c_new, start, effects)
+        if rem.on_curve and not self.moves_curve(rem, c_new):
+            return False
         # the noise terms fitted with the component in the samples and without it, side by side: what the
         # start model had taken of it (a temperature swing into B, K and R)
         rem.evidence["terms_before_after"] = terms_before_after(
@@ -383,6 +393,21 @@ class _Run:
         self.y, self.result, self.curve, self.heldout = y_new, res_new, c_new, h_new
         self.sol = s_new
         return True
+
+    def moves_curve(self, rem: Removal, c_new: Curve) -> bool:
+        """Whether removing ``rem`` moves an estimate of the record's Allan curve by at least
+        :data:`.scoring.MATERIAL_Z` of its standard errors (:func:`.scoring.curve_change_z`, under the model so
+        far). A removal whose test is in time alone (impulsive noise: a tail beyond the Gaussian's) may be real
+        yet immaterial to the curve — one sample of 10⁶ beyond 7 σ on an ADIS16405 accelerometer moves τ₀'s
+        estimate by 0.04 of its standard error — and then is no step of the model. Not the curve's error: the
+        model's white term takes white-like spikes, and removing true spikes can raise it (scoring's note)."""
+        z, tau = curve_change_z(self.curve, self.sol, self.curve.avar - c_new.avar)
+        if z >= MATERIAL_Z:
+            rem.evidence["curve_change"] = {"z": z, "tau": tau, "material_z": MATERIAL_Z}
+            return True
+        why = f"moves the Allan curve by {z:.2g} standard errors at most (τ {tau:.3g} s), < {MATERIAL_Z:g}"
+        self.consider(rem.effect, rem.params | {"rejected": why, "test": rem.evidence["test"]})
+        return False
 
     # ---- curve effects
 

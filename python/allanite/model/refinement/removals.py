@@ -77,6 +77,10 @@ class Removal:
     heldout_in_time : float, optional
         A held-out test in time that decides instead of the held-out Allan curve (accepted when < 1): for a
         white-like component, which changes the curve's level, not how well one part predicts the other's.
+    on_curve : bool
+        Judged on the record's Allan curve as well: accepted only when it moves an estimate there by at least
+        :data:`.scoring.MATERIAL_Z` standard errors (a component found by a test in time alone — impulsive
+        noise — may not matter to the curve at all).
     family : LineFamily, optional
         The periodic removal's family; if the removal is turned down, its lines stay for the ``"sinusoid"``
         curve candidate.
@@ -91,6 +95,7 @@ class Removal:
     n_fitted: int
     on_raw: bool = False
     heldout_in_time: float | None = None
+    on_curve: bool = False
     family: periodic.LineFamily | None = None
 
 
@@ -278,6 +283,7 @@ def _outliers(ctx: RemovalContext) -> Iterator[Removal]:
         evidence,
         2,
         heldout_in_time=lam / max(count, 1e-12),
+        on_curve=True,
     )
 
 
