@@ -427,6 +427,11 @@ class _Run:
             # lines of the families it turned down (their phase does not carry across the record's parts, their
             # power is still on the curve)
             fams = True if "periodic" not in candidates else self.declined_families
+            if any(rem.effect == "periodic" for _st, rem, *_rest in self.removed):
+                # a family removed in time takes the part of its lines whose phase carries across the record;
+                # what power they keep (a wandering phase) is searched again on the samples the removals left,
+                # every line there offered (conditional on a family found: no share of level under the null)
+                search, fams = periodic.periodic_search(y, self.fs, alpha("lines", self.level)), True
             lines = periodic.sinusoid_lines(search, families=fams)
         for n_step in range(MAX_STEPS):
             if not self.curve_step(n_step, candidates, thin, exact, lines):
