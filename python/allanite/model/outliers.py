@@ -22,18 +22,22 @@ only beyond :data:`TAIL_FACTOR` (2) times the Gaussian count — real sensors' n
 5.2 σ: no spikes, yet an exact Gaussian null rejects on two of them) — so
 P(Poisson(2λ) ≥ count) ≤ ``alpha``/len(CUTS) accepts (Bonferroni over the cuts).
 
-The samples then flagged are those off both neighbours at a cut c*: the differences into and out of the
-sample both beyond c*·σ_d (the lattice's next step on quantised samples) and of opposite signs — Gaussian
-samples are flagged at most as often as one difference exceeds the cut, λ(c*), for any spectrum (the lattice
-model holds for the differences; a low-passed record's differences move together, so opposite signs are rarer
-still) — c* the lowest of :data:`FLAG_CUTS` at which λ is at most 5 % of the flags (the flagged share is the
-outliers', not the Gaussian tail's). A spike's neighbours (one large difference each) and a step of the mean
-(one) are not flagged. :func:`replace_outliers` replaces each flagged sample by a draw from what Gaussian
-noise would have put there (the local level plus white noise where the noise is white at the shortest lag;
-the line between its neighbours plus the second difference's noise elsewhere): how :func:`allanite.refine`
-refits the noise after removing them. Sparse spikes are replaced cleanly. Heavy tails are not separable from
-the Gaussian core by any cut: the contaminated samples inside it stay (N falls toward the core's, not to it),
-and removing those outside it by their distance from their neighbours bends the shortest τ.
+The samples then flagged are those off both neighbours at a cut c*: the differences into and out of the sample both
+beyond c*·σ_d (the lattice's next step on quantised samples) and of opposite signs — Gaussian samples are flagged
+at most as often as one difference exceeds the cut, λ(c*), for any spectrum (the lattice model holds for the
+differences; a low-passed record's differences move together, so opposite signs are rarer still) — c* the lowest of
+:data:`FLAG_CUTS` at which λ is at most 5 % of the flags (the flagged share is the outliers', not the Gaussian
+tail's) and the flagged count is itself beyond Poisson(2λ) at the test's α per cut (one sample flagged where λ =
+0.009, as on an ADIS16405 accelerometer's heavy tail, is a count twice the Gaussian's gives 1.7 % of the time).
+:func:`allanite.refine` then removes them only where that moves an estimate of the record's Allan curve by two of
+its standard errors or more — real impulsive samples too few to move the curve are no step of it. A spike's
+neighbours (one large difference each) and a step of the mean (one) are not flagged. :func:`replace_outliers`
+replaces each flagged sample by a draw from what Gaussian noise would have put there (the local level plus white
+noise where the noise is white at the shortest lag; the line between its neighbours plus the second difference's
+noise elsewhere): how :func:`allanite.refine` refits the noise after removing them. Sparse spikes are replaced
+cleanly. Heavy tails are not separable from the Gaussian core by any cut: the contaminated samples inside it stay
+(N falls toward the core's, not to it), and removing those outside it by their distance from their neighbours bends
+the shortest τ.
 """
 
 from __future__ import annotations
@@ -197,13 +201,21 @@ def outlier_test(y: np.ndarray, fs: float, alpha: float) -> dict:
     for c in FLAG_CUTS:
         flags, lam = _flags(d, blocks, sig, step, c)
         k = int(np.count_nonzero(flags))
-        # Gaussian samples flagged: at most the differences beyond the cut, λ (exact for the lattice too)
-        if k and lam <= EXCESS_SHARE * k:
+        # Gaussian samples flagged: at most the differences beyond the cut, λ (exact for the lattice too); the
+        # flagged count itself beyond what twice that gives, at the test's own α per cut (one sample where
+        # λ = 0.009 is not: 1 − e^{−0.017} = 1.7 %)
+        if k and lam <= EXCESS_SHARE * k and _flag_p(k, lam) <= out["alpha_per_cut"]:
             cut = float(np.median([_tail(c, s_b, step)[0] for s_b in sig]))
             out.update(accepted=True, cut=c, flags=flags, rate=k / y.size, threshold=cut, expected_gaussian_flags=lam)
             return out
     out["note"] = "the differences' tail exceeds twice the Gaussian's, but too few samples stand off both neighbours"
     return out
+
+
+def _flag_p(k: int, lam: float) -> float:
+    """P(Poisson(TAIL_FACTOR·λ) ≥ k): the flagged count ``k`` against twice the Gaussian count of flags λ, as
+    the clusters are tested."""
+    return float(poisson.sf(k - 1, TAIL_FACTOR * lam))
 
 
 def flag_at(y: np.ndarray, c: float) -> tuple[np.ndarray, float]:

@@ -265,14 +265,18 @@ def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
     }
 
 
-def sinusoid_lines(search: dict, families: bool = False) -> list[dict]:
+def sinusoid_lines(search: dict, families=False) -> list[dict]:
     """The lines of a :func:`periodic_search` as the ``"sinusoid"`` candidate takes them, strongest first: each
     ``f0`` (Hz, refined), ``amplitude`` and ``phase`` (least squares), ``f0_interval`` and
     ``amplitude_interval`` (±1σ), ``psd_ratio``, ``threshold`` and ``bin_hz`` of the search. The lone lines;
-    with ``families``, every family's lines too (when families are not removed as a whole)."""
+    with ``families`` True, every family's lines too (when families are not removed as a whole); given a list
+    of the search's families, those families' lines (the ones a removal in time turned down: a line whose
+    phase does not carry from one part of the record to the other — a site's sway, narrowband rather than
+    coherent — is still power at its frequency, which the curve's sinusoid term describes)."""
     out: list[dict] = []
     found = np.array([d["f"] for d in search["lines"]])
-    sources = list(search["sinusoids"]) + (list(search["families"]) if families else [])
+    chosen = list(search["families"]) if families is True else list(families or [])
+    sources = list(search["sinusoids"]) + chosen
     for fam in sources:
         freqs, amps, amp_sd = fam.frequencies, fam.amplitudes, fam.amplitude_sd
         lone = freqs.size == 1 and np.all(np.isfinite(fam.gens_sd))

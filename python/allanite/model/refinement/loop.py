@@ -33,7 +33,15 @@ from .levels import LEVEL, alpha
 from .missing import MissingContext, unexplained
 from .removals import REMOVALS, Removal, RemovalContext
 from .result import Refinement, Step, term_moves
-from .scoring import HELDOUT_BLOCKS, chain_metrics, heldout_split, informative, segments_heldout
+from .scoring import (
+    HELDOUT_BLOCKS,
+    MATERIAL_Z,
+    chain_metrics,
+    curve_change_z,
+    heldout_split,
+    informative,
+    segments_heldout,
+)
 
 __all__ = ["refine", "CANDIDATES", "MAX_STEPS", "REFINE_SCALE"]
 
@@ -275,6 +283,7 @@ class _Run:
         self.change_points: list = []
         self.considered: dict[str, list] = {}
         self.line_search: dict | None = None  # the periodic removal's line search, for the sinusoid candidate
+        self.declined_families: list = []  # line families the removal in time turned down: their lines stay
 
     def build(self, res, samples):
         """The curve (and, with samples, the held-out split) of ``res``'s estimates in the τ range."""
@@ -331,6 +340,8 @@ class _Run:
             for rem in remover(ctx):
                 if self.remove(rem):
                     ctx.y, ctx.curve, ctx.sol = self.y, self.curve, self.sol
+                elif rem.family is not None:
+                    self.declined_families.append(rem.family)
         self.line_search = ctx.lines
 
     def remove(self, rem: Removal) -> bool:
@@ -356,6 +367,8 @@ class _Run:
             rem.evidence["heldout_test"] = {"before": ho_b, "after": ho_a}
         params = dict(rem.params)
         s_new = solve(c_new, start, effects)
+        if rem.on_curve and not self.moves_curve(rem, c_new):
+            return False
         # the noise terms fitted with the component in the samples and without it, side by side: what the
         # start model had taken of it (a temperature swing into B, K and R)
         rem.evidence["terms_before_after"] = terms_before_after(
@@ -381,6 +394,21 @@ class _Run:
         self.sol = s_new
         return True
 
+    def moves_curve(self, rem: Removal, c_new: Curve) -> bool:
+        """Whether removing ``rem`` moves an estimate of the record's Allan curve by at least
+        :data:`.scoring.MATERIAL_Z` of its standard errors (:func:`.scoring.curve_change_z`, under the model so
+        far). A removal whose test is in time alone (impulsive noise: a tail beyond the Gaussian's) may be real
+        yet immaterial to the curve — one sample of 10⁶ beyond 7 σ on an ADIS16405 accelerometer moves τ₀'s
+        estimate by 0.04 of its standard error — and then is no step of the model. Not the curve's error: the
+        model's white term takes white-like spikes, and removing true spikes can raise it (scoring's note)."""
+        z, tau = curve_change_z(self.curve, self.sol, self.curve.avar - c_new.avar)
+        if z >= MATERIAL_Z:
+            rem.evidence["curve_change"] = {"z": z, "tau": tau, "material_z": MATERIAL_Z}
+            return True
+        why = f"moves the Allan curve by {z:.2g} standard errors at most (τ {tau:.3g} s), < {MATERIAL_Z:g}"
+        self.consider(rem.effect, rem.params | {"rejected": why, "test": rem.evidence["test"]})
+        return False
+
     # ---- curve effects
 
     def add_curve_effects(self, candidates) -> None:
@@ -395,7 +423,16 @@ class _Run:
             search = self.line_search
             if search is None:
                 search = periodic.periodic_search(y, self.fs, alpha("lines", self.level))
-            lines = periodic.sinusoid_lines(search, families="periodic" not in candidates)
+            # every line a family removal did not take: all of them without the periodic candidate, else the
+            # lines of the families it turned down (their phase does not carry across the record's parts, their
+            # power is still on the curve)
+            fams = True if "periodic" not in candidates else self.declined_families
+            if any(rem.effect == "periodic" for _st, rem, *_rest in self.removed):
+                # a family removed in time takes the part of its lines whose phase carries across the record;
+                # what power they keep (a wandering phase) is searched again on the samples the removals left,
+                # every line there offered (conditional on a family found: no share of level under the null)
+                search, fams = periodic.periodic_search(y, self.fs, alpha("lines", self.level)), True
+            lines = periodic.sinusoid_lines(search, families=fams)
         for n_step in range(MAX_STEPS):
             if not self.curve_step(n_step, candidates, thin, exact, lines):
                 break

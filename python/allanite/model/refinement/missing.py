@@ -34,12 +34,14 @@ from scipy import signal
 from scipy.linalg import solve_triangular
 from scipy.stats import t as t_dist
 
+from ...analysis import avar
 from .. import channels, lines, outliers, tracing
 from ..terms import design_matrix
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
 from .curvefit import Curve, Solution, base_name, theta_terms, upper_theta
 from .levels import alpha
+from .scoring import MATERIAL_Z, curve_change_z
 
 __all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS"]
 
@@ -244,11 +246,13 @@ def _channels(ctx: MissingContext, a: float) -> list[dict]:
 
 def _outliers(ctx: MissingContext, a: float) -> list[dict]:
     """Samples beyond the Gaussian noise left in the final samples (:func:`allanite.model.outliers.outlier_test`
-    on them): impulsive noise the model's Gaussian terms cannot describe."""
+    on them): impulsive noise the model's Gaussian terms cannot describe — where removing it would move the
+    final curve beyond its estimates' scatter, as refine asks of the removal itself; impulsive samples too
+    few to move the curve are not something the model misses."""
     if ctx.y is None:
         return []
     r = outliers.outlier_test(ctx.y, ctx.fs, a)
-    if not r["accepted"]:
+    if not r["accepted"] or not _moves_curve(ctx, outliers.replace_outliers(ctx.y, r["flags"])):
         return []
     best = min(r["cuts"], key=lambda c: c["p_value"])
     tau = float(ctx.curve.tau[0])
@@ -258,6 +262,14 @@ def _outliers(ctx: MissingContext, a: float) -> list[dict]:
     )
     reg = {"domain": "outliers", "tau": (tau, tau), "band_hz": None, "chi2_dof": _chi2_dof(ctx, tau, tau)}
     return [reg | {"what": what, "statistic": float(best["count"]), "threshold": 2.0 * best["expected"], "alpha": a}]
+
+
+def _moves_curve(ctx: MissingContext, clean: np.ndarray) -> bool:
+    """Whether replacing the final samples by ``clean`` moves an estimate of the final curve by at least
+    :data:`.scoring.MATERIAL_Z` standard errors under the final model (refine's own rule for the removal)."""
+    cur = ctx.curve
+    change = cur.avar - avar(clean, ctx.fs, taus=cur.tau).avar
+    return curve_change_z(cur, ctx.sol, change)[0] >= MATERIAL_Z
 
 
 #: The checks, by the name of their share in :data:`.levels.SHARES` (``"unexplained:<name>"``).

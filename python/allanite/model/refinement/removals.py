@@ -22,7 +22,8 @@ changed in the Allan curve, AVAR(y) − AVAR(y − component), cross terms inclu
 - ``"periodic"`` — each family of spectral lines (harmonics, sidebands) removed by least squares at its
   frequencies (:mod:`allanite.model.periodic`); last, on the samples the others left: a channel that cycles
   (a temperature) is its regression, not a line. The search's lone lines go to the ``"sinusoid"`` curve
-  candidate (:attr:`RemovalContext.lines`): one search, one share of ``level``.
+  candidate (:attr:`RemovalContext.lines`): one search, one share of ``level``; so do the lines of a family
+  whose removal is turned down (its phase does not carry across the record: narrowband power, not a line).
 
 Removals run before the curve effects (a component left in the samples bends the curve every curve effect is
 fitted against), in the order of :data:`REMOVALS`. A new one is one entry here and one share in
@@ -76,6 +77,13 @@ class Removal:
     heldout_in_time : float, optional
         A held-out test in time that decides instead of the held-out Allan curve (accepted when < 1): for a
         white-like component, which changes the curve's level, not how well one part predicts the other's.
+    on_curve : bool
+        Judged on the record's Allan curve as well: accepted only when it moves an estimate there by at least
+        :data:`.scoring.MATERIAL_Z` standard errors (a component found by a test in time alone — impulsive
+        noise — may not matter to the curve at all).
+    family : LineFamily, optional
+        The periodic removal's family; if the removal is turned down, its lines stay for the ``"sinusoid"``
+        curve candidate.
     """
 
     effect: str
@@ -87,6 +95,8 @@ class Removal:
     n_fitted: int
     on_raw: bool = False
     heldout_in_time: float | None = None
+    on_curve: bool = False
+    family: periodic.LineFamily | None = None
 
 
 @dataclass
@@ -275,13 +285,14 @@ def _outliers(ctx: RemovalContext) -> Iterator[Removal]:
         evidence,
         2,
         heldout_in_time=lam / max(count, 1e-12),
+        on_curve=True,
     )
 
 
 def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
     """Every family of spectral lines, strongest first, each removed by least squares at its lattice's
     frequencies (refitted on the held-in blocks with the frequencies fixed for the held-out error); the lone
-    lines are left to the ``"sinusoid"`` curve candidate."""
+    lines are left to the ``"sinusoid"`` curve candidate, and so are a turned-down family's (``family``)."""
     a = alpha("lines", ctx.level)
     search = periodic.periodic_search(ctx.y, ctx.fs, a)
     ctx.lines = search
@@ -312,6 +323,7 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
             evidence,
             2 * fam.coefs.shape[0] + 2,
             heldout_in_time=heldout_variance_ratio(ctx.y, fam.refit),
+            family=fam,
         )
 
 

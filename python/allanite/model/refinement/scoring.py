@@ -24,6 +24,8 @@ __all__ = [
     "rms_adev_pct",
     "informative",
     "chain_metrics",
+    "MATERIAL_Z",
+    "curve_change_z",
     "Split",
     "heldout_split",
     "segments_heldout",
@@ -52,6 +54,25 @@ def informative(tau, nu) -> np.ndarray:
     mask[thin] = True
     good = mask & (nu >= HELDOUT_MIN_EDF)
     return good if np.count_nonzero(good) >= 4 else mask
+
+
+#: A removal judged by a test in time alone (impulsive noise) is a step of the model only if it moves an estimate of
+#: the record's Allan curve by at least this many of its standard errors (:func:`curve_change_z`).
+MATERIAL_Z = 2.0
+
+
+def curve_change_z(curve: Curve, sol: Solution, change) -> tuple[float, float]:
+    """How far a removal moves the Allan curve, in the estimates' own scatter: the largest |Δ(τ)|/SE(τ), Δ =
+    ``change`` = AVAR(y) − AVAR(y − component), SE = model·√(2/ν) under the fit ``sol`` of ``curve`` (the
+    samples as they were); returns (that z, its τ). Impulsive noise is white-like: the model's white term takes
+    it, so the record's curve error does not tell whether it matters — on 2·10⁵ samples with 30 spikes of 10 σ
+    the five terms fit the spiky curve *better* (χ²/dof 1.25, held-out 3.5 %) than the cleaned one (1.41, 4.0 %;
+    the record without spikes 1.45, 3.9 %), while N is 1.1 % too high with them (z = 4 at τ₀). One sample beyond
+    7 σ of 10⁶ moves τ₀'s estimate by 0.04 of its standard error."""
+    se = np.maximum(sol.model, 1e-300) * np.sqrt(2.0 / np.maximum(sol.nu, 1e-12))
+    z = np.abs(np.asarray(change, dtype=np.float64)) / se
+    i = int(np.argmax(z))
+    return float(z[i]), float(curve.tau[i])
 
 
 def chain_metrics(curve0: Curve, sol: Solution, change, n_removed: int, heldout, scored) -> tuple[dict, float]:
