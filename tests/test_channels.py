@@ -327,3 +327,31 @@ def test_refine_finds_the_issue_temperature_and_says_what_the_terms_had_taken():
     # a constant channel is refused by name
     with pytest.raises(ParameterError, match="channel 'temp' is constant"):
         allanite.refine(y, 1.0, channels={"temp": np.full(y.size, 20.0)})
+
+
+def test_the_low_bands_noise_is_fitted_to_the_residual_not_to_the_channels_swing():
+    # a slow channel far above the noise (three cycles over the record): once the coupling is fitted, the noise
+    # level of the lowest bands is the noise-only record's, not raised by the channel's own swing (it was fitted to
+    # the raw record's power: 5× the residual's in a 300 s lag case, and the coupling's tests lost their power)
+    n = 30_000
+    t = np.arange(n, dtype=np.float64)
+    noise = allanite.simulate(n, 1.0, N=1e-3, B=2e-4, K=1e-5, seed=5)
+    ch = 7.5 * np.sin(2 * np.pi * 3 * t / n)
+    coupled = wh.spectra(noise + 1e-3 * ch, [ch], 1.0)
+    alone = wh.spectra(noise, [ch], 1.0)
+    s_fit = wh.joint_fit(coupled, wh.Design([0], [np.ones(coupled.m.size)]))["s"]
+    s_true = wh.joint_fit(alone, wh.Design([], []))["s"]
+    low = slice(0, 8)
+    np.testing.assert_allclose(s_fit[low], s_true[low], rtol=0.25)
+
+
+def test_the_lag_threshold_with_few_degrees_of_freedom_is_large_or_infinite_never_an_error():
+    # the upcrossing bound's tail is slow when ν is small: a warm-up at 100 Hz with a real coupling left ν = 2.6
+    # and V = 2.5, whose threshold lies beyond the 10⁴ the root search was bracketed by (it raised ValueError)
+    from allanite.model.channels import _upcrossing_p, _upcrossing_threshold
+
+    thr = _upcrossing_threshold(1e-3, 2.6, 2.5)
+    assert 1e4 < thr < math.inf and _upcrossing_p(thr, 2.6, 2.5) == pytest.approx(1e-3, rel=1e-6)
+    assert _upcrossing_threshold(1e-3, 1.0, 2.5) == math.inf  # (1 + u/ν)^0: the bound never falls below V/π
+    thr = _upcrossing_threshold(1e-3, 40.0, 1.0)
+    assert 10.0 < thr < 30.0 and _upcrossing_p(thr, 40.0, 1.0) == pytest.approx(1e-3, rel=1e-6)

@@ -226,3 +226,53 @@ def test_lines_are_searched_down_to_twenty_cycles_per_record():
 
 def test_fold_frequency_aliases_into_half_a_cycle():
     np.testing.assert_allclose(lines.fold_frequency([0.1, 0.6, 1.2, -0.3, 2.5]), [0.1, 0.4, 0.2, 0.3, 0.5])
+
+
+def _comb(fs, f0, orders, bin_hz):
+    """Line dicts (as find_lines gives them) at the folded frequencies of the harmonics ``orders`` of f0,
+    weaker with the order (a sawtooth's 1/k)."""
+    return [
+        {
+            "f": float(lines.fold_frequency(k * f0 / fs) * fs),
+            "psd_ratio": 1e4 / k,
+            "bin_hz": bin_hz,
+            "amplitude": 1.0 / k,
+            "threshold": 2.0,
+        }
+        for k in orders
+    ]
+
+
+def test_a_sampled_sawtooths_folded_harmonics_are_one_family_at_the_lowest_fundamental():
+    # a 2.3 Hz sawtooth at 400 Hz, sampled with its jump: every harmonic folds into the band, and beside a moving
+    # average's noise nulls (100, 200 Hz) orders up to ≈ 2000 stand out. The harmonic lattice used to stop at
+    # 4·(fs/2) (order 347); a sideband lattice (103.5, 96.6 Hz) took every line, reduced to (103.5, 6.9 Hz)
+    fs, f0 = 400.0, 2.3
+    bin_hz = fs / 2**15
+    direct = list(range(1, 87))
+    folded = [
+        k for k in range(87, 2000) if min(abs(lines.fold_frequency(k * f0 / fs) * fs - c) for c in (100.0, 200.0)) < 4.0
+    ]
+    fams = lines.group_lines(_comb(fs, f0, direct + folded, bin_hz), fs)
+    assert len(fams) == 1 and fams[0]["gens"].size == 1
+    assert fams[0]["gens"][0] * fs == pytest.approx(f0, rel=1e-6)
+    assert len(fams[0]["members"]) >= 0.99 * (len(direct) + len(folded))
+
+
+def test_the_lowest_fundamental_is_preferred_only_where_its_own_lines_stand():
+    fs = 400.0
+    bin_hz = fs / 2**15
+    lt = _comb(fs, 2.3, range(1, 40), bin_hz)
+    nu = np.array([d["f"] / fs for d in lt])
+    tol = np.full(nu.size, 0.5 * bin_hz / fs)
+
+    def grown(g):
+        gens, coefs, m, gen_sd, chance = lines._grow(nu, tol, 1 / tol**2, np.array([g / fs]), tol[:1], 4096, 0)
+        return (m.size - chance, gens, coefs, m, gen_sd, chance)
+
+    high, true, sub, half = grown(6.9), grown(2.3), grown(1.15), grown(3.45)
+    best = max((high, true, sub, half), key=lambda c: c[0])
+    # 6.9 Hz (and 3.45 Hz) take only some of the lines at their own frequency, 1.15 Hz the same lines as
+    # 2.3 Hz at even orders only: 2.3 Hz is the fundamental whichever scored best
+    for first in (best, high, sub, half):
+        assert lines._lowest_fundamental(first[:5], [sub, true, high, half], nu, tol)[1][0] * fs == pytest.approx(2.3)

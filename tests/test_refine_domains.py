@@ -439,3 +439,26 @@ def test_adis_z_gyro_hump_is_a_resonance(shared_data):
     st = next(s for s in r.steps if s.effect == "resonance")
     assert 18.0 < st.params["f0"] < 23.0 and st.params["q"] >= 4
     _falls(st)
+
+
+def test_leftover_lines_are_reported_as_bands_not_one_entry_per_line():
+    # a comb of five weak lines 0.2 Hz apart near 10 Hz and a lone line at 31 Hz left in the final samples: two
+    # entries (the comb's band with its count and rms, the lone line), not six
+    from types import SimpleNamespace
+
+    from allanite.model.refinement import missing
+
+    fs, n = 100.0, 2**17
+    t = np.arange(n) / fs
+    rng = np.random.default_rng(3)
+    comb = [9.6 + 0.2 * i for i in range(5)]
+    y = rng.normal(size=n) + sum(0.1 * np.sin(2 * np.pi * f * t + i) for i, f in enumerate(comb))
+    y = y + 0.1 * np.sin(2 * np.pi * 31.0 * t)
+    tau = np.geomspace(0.01, 100.0, 40)
+    ctx = SimpleNamespace(y=y, fs=fs, effects=[], curve=SimpleNamespace(tau=tau), sol=SimpleNamespace(z=np.ones(40)))
+    out = missing._lines(ctx, 1e-3)
+    assert len(out) == 2
+    band, lone = sorted(out, key=lambda r: r["band_hz"][0])
+    assert band["lines"] == 5 and band["band_hz"][0] < 9.6 < 10.4 < band["band_hz"][1] < 10.5
+    assert band["rms"] == pytest.approx(0.1 * np.sqrt(5 / 2), rel=0.2) and "5 spectral lines" in band["what"]
+    assert lone["lines"] == 1 and lone["band_hz"][0] < 31.0 < lone["band_hz"][1] and "a spectral line" in lone["what"]

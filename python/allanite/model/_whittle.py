@@ -250,7 +250,8 @@ def noise_psd(bands: Bands, resid: np.ndarray, start=None):
     s = bands.q / bands.m
     amounts = None
     if bands.par.any():
-        amounts, s_par = fit_noise(s[bands.par], bands.m[bands.par], bands.basis, start)
+        par_power = resid[bands.par] / bands.m[bands.par]
+        amounts, s_par = fit_noise(par_power, bands.m[bands.par], bands.basis, start)
         s = s.copy()
         s[bands.par] = s_par
     return s, amounts

@@ -20,6 +20,10 @@ differences of strong lines, a strong line as carrier with a difference as spaci
 lines within their tolerance and refitting the generators by weighted least squares; the family kept is the
 one that explains most lines beyond what chance would match (lines × lattice points × window), needing at
 least one line more than it has generators; two generators in a small ratio (p/q, q ≤ 4) are one (g1/q).
+Harmonics reach order 4096 (folded: a waveform with a jump, sampled without an anti-alias filter, has lines at
+every multiple of f_s/P, P its period in samples, and any fundamental whose orders reach far enough explains
+them all); of the one-generator families that score alike, the one taking most lines at their own frequency
+(below f_s/2, unfolded) is the fundamental, the higher of equals (a subharmonic takes the same lines).
 A two-generator basis is reduced to the larger generator and the other modulo it (the sidebands' offset).
 A line no family takes stays a ``"sinusoid"``.
 """
@@ -52,6 +56,10 @@ SUBHARMONICS = 6
 CARRIERS = 6
 #: Largest |s| of a sideband lattice (a sample-rate beat's sawtooth phase modulation spreads over the band).
 MAX_SIDEBAND = 256
+#: Largest harmonic order of a one-generator lattice: a waveform with a jump, sampled without an anti-alias
+#: filter, has harmonics of every order folded into the band (a 2.3 Hz sawtooth at 400 Hz: lines to order ≈ 2000
+#: stand above a moving average's noise nulls).
+MAX_HARMONIC = 4096
 
 
 def fold_frequency(nu: np.ndarray) -> np.ndarray:
@@ -282,11 +290,16 @@ def _lattice(gens: np.ndarray, k_max: int, s_max: int) -> tuple[np.ndarray, np.n
 
 def _match(nu, tol, gens, gen_sd, k_max, s_max):
     """For each line the lattice row nearest to it within its tolerance plus twice the row's uncertainty
-    (|k|·σ_g1 + |s|·σ_g2), or −1; a lattice point takes only its nearest line. Returns (rows, match, slack):
+    (|k|·σ_g1 + |s|·σ_g2), or −1 (of rows folding onto one frequency, the first); a lattice point takes only its
+    nearest line. Returns (rows, match, slack):
     slack the rows' uncertainty, for the chance count."""
     coefs, pos = _lattice(gens, k_max, s_max)
     slack = 2.0 * (np.abs(coefs) @ gen_sd)
-    order = np.argsort(pos)
+    order = np.argsort(pos, kind="stable")
+    # rows that fold onto one frequency (orders k and P − k of a waveform P samples long): the lowest row only,
+    # so that a line is not credited to a far order and the lattice does not grow past its lines
+    first = np.concatenate([[True], np.diff(pos[order]) > 1e-12]) if order.size else np.zeros(0, dtype=bool)
+    order = order[first]
     ps = pos[order]
     j = np.searchsorted(ps, nu)
     lo, hi = np.clip(j - 1, 0, ps.size - 1), np.clip(j, 0, ps.size - 1)
@@ -303,7 +316,7 @@ def _match(nu, tol, gens, gen_sd, k_max, s_max):
     return coefs, row, slack
 
 
-def _grow(nu, tol, w, gens, gen_sd, k_max, s_max, iters: int = 10):
+def _grow(nu, tol, w, gens, gen_sd, k_max, s_max, iters: int = 16):
     """Match lines to the lattice of ``gens`` and refit the generators on the matched lines (weighted least
     squares in the unfolded frequency). The lattice starts at its lowest rows (k ≤ 4 for harmonics; k ≤ 1,
     |s| ≤ 2 for sidebands) and grows only as far as lines are matched (to twice the extents in use, or two
@@ -417,6 +430,30 @@ def _reduce(gens: np.ndarray, coefs: np.ndarray, gen_sd: np.ndarray, strength: n
     return np.array([g1, g2]), coefs, np.array([gen_sd[0], sd2])
 
 
+def _direct(nu: np.ndarray, tol: np.ndarray, gen: float, gen_sd: float) -> int:
+    """How many of the lines ``nu`` sit at their own frequency on the harmonics of ``gen`` (a multiple k·g below
+    f_s/2 within the line's tolerance plus 2k·σ_g) — whatever folded row the lattice matched them to (orders k
+    and P − k of a waveform P samples long fold onto the same frequency)."""
+    k = np.maximum(np.round(nu / gen), 1.0)
+    return int(np.count_nonzero((k * gen < 0.5) & (np.abs(nu - k * gen) <= tol + 2.0 * k * gen_sd)))
+
+
+def _lowest_fundamental(best: tuple, ones: list, nu: np.ndarray, tol: np.ndarray) -> tuple:
+    """The fundamental that explains the lines: among the one-generator families whose score is as good as the
+    best's within the chance count's own scatter (2√chance), the one that takes most lines at their own
+    frequency (k·g below f_s/2, not folded); of those, the highest generator. A waveform with a jump sampled
+    without an anti-alias filter puts a line at every multiple of f_s/P (P its period in samples), so any
+    lattice whose orders reach far enough explains them all folded (a 2.3 Hz sawtooth at 400 Hz: 3.45 Hz and
+    6.9 Hz as well as 2.3 Hz) — only the true fundamental puts its strongest lines at their own frequency. A
+    subharmonic (g/2) takes the same lines directly at even orders only, and loses to g: missing harmonics are
+    allowed, but no lower fundamental than the lines need."""
+    near = [c for c in ones if c[0] >= best[0] - 2.0 * math.sqrt(max(c[5], 1.0))]
+    if not near:
+        return best
+    pick = max(near, key=lambda c: (_direct(nu[c[3]], tol[c[3]], float(c[1][0]), float(c[4][0])), float(c[1][0])))
+    return pick[:5]
+
+
 def group_lines(lines: list[dict], fs: float) -> list[dict]:
     """Families of ``lines`` (:func:`find_lines`' dicts): each ``gens`` (normalised generators), ``coefs``
     (integer rows, one per member), ``members`` (indices into ``lines``), ``gen_sd``; lines no family takes
@@ -432,22 +469,25 @@ def group_lines(lines: list[dict], fs: float) -> list[dict]:
     fams: list[dict] = []
     while left.size >= 2:
         best: dict = {1: None, 2: None}
+        ones: list = []
         sub_nu, sub_tol, sub_w = nu[left], tol[left], w[left]
         for g, g_sd in _seeds(sub_nu, sub_tol, strength[left]):
             if np.any(g <= 2.0 * np.mean(sub_tol)):
                 continue
-            k_max = int(min(4096, math.floor(2.0 / g[0])))  # up to 4·(f_s/2): aliases of a sampled waveform
-            if g.size == 2:
-                k_max = int(min(k_max, 64))
-            gens, coefs, m, gen_sd, chance = _grow(sub_nu, sub_tol, sub_w, g, g_sd, max(1, k_max), MAX_SIDEBAND)
+            k_max = MAX_HARMONIC if g.size == 1 else 64  # the lattice grows only as far as lines match it
+            gens, coefs, m, gen_sd, chance = _grow(sub_nu, sub_tol, sub_w, g, g_sd, k_max, MAX_SIDEBAND)
             if m.size < gens.size + 1:
                 continue
             score = m.size - chance
             if score < gens.size + 0.5:
                 continue
+            if gens.size == 1:
+                ones.append((score, gens, coefs, m, gen_sd, chance))
             if best[gens.size] is None or score > best[gens.size][0]:
                 best[gens.size] = (score, gens, coefs, m, gen_sd)
         one, two = best[1], best[2]
+        if one is not None:
+            one = _lowest_fundamental(one, ones, sub_nu, sub_tol)
         if two is not None and _commensurate(two[1], 2.0 * float(np.mean(sub_tol))):
             two = None  # (2f0, 425f0) is the harmonics of f0 in another basis: the one-generator family says it
         pick = two if two is not None and (one is None or two[0] > one[0]) else one

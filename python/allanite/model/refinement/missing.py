@@ -15,7 +15,8 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   exceeds 1. With samples the frequency band is refined on the PSD of the final residual samples: the part of
   ≈ 1/(2τ_hi) … 1/(2τ_lo) (widened ×2) that stands above the spectrum's running median.
 - ``"psd"`` — spectral lines of the final samples (:func:`allanite.model.lines.find_lines`: the line search of
-  the periodic effect, afresh) that no sinusoid of the model accounts for.
+  the periodic effect, afresh) that no sinusoid of the model accounts for; neighbouring lines (gaps ≤ f/16 or
+  8 bins) are one entry, with its band, ``lines`` (how many), ``rms`` and the largest ``amplitude``.
 - ``"time"`` — a warm-up drift left in the final samples (:func:`allanite.model.tracing.drift_fit` against its
   bootstrap threshold under the final model's slow terms).
 - ``"channels"`` — a coupling to a channel of ``channels=`` left in the final samples (the regression's tests:
@@ -49,6 +50,9 @@ __all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS"]
 MAX_REGIONS = 3
 #: A column's projected weight counts towards its region where it is at least this share of its peak.
 REGION_SHARE = 0.3
+#: Leftover lines closer than 1/LINE_GAP of their frequency, or LINE_GAP_BINS bins, are reported as one band.
+LINE_GAP = 16
+LINE_GAP_BINS = 8
 
 
 @dataclass
@@ -167,25 +171,54 @@ def _band(y: np.ndarray, fs: float, tau_lo: float, tau_hi: float) -> tuple[float
     return (float(fsel[up[0]]), float(fsel[up[-1]]))
 
 
+def _line_groups(found: list[dict]) -> list[list[dict]]:
+    """Lines sorted by frequency, in groups of neighbours: a line joins the group before it when the gap is at
+    most 1/:data:`LINE_GAP` of its frequency or :data:`LINE_GAP_BINS` bins (a comb of leftover lines is one
+    band to report, not one entry per line)."""
+    groups: list[list[dict]] = []
+    for ln in sorted(found, key=lambda d: d["f"]):
+        if groups and ln["f"] - groups[-1][-1]["f"] <= max(ln["f"] / LINE_GAP, LINE_GAP_BINS * ln["bin_hz"]):
+            groups[-1].append(ln)
+        else:
+            groups.append([ln])
+    return groups
+
+
 def _lines(ctx: MissingContext, a: float) -> list[dict]:
+    """Lines of the final samples that no sinusoid of the model accounts for, one entry per group of neighbours
+    (:func:`_line_groups`): its band, its number of ``lines``, their ``rms`` (√(Σ A²/2), rate unit) and largest
+    ``amplitude``; the statistic and threshold of its strongest line."""
     if ctx.y is None:
         return []
     have = [p for k, p in ctx.effects if base_name(k) == "sinusoid"]
+    left = [
+        ln
+        for ln in lines.find_lines(ctx.y, ctx.fs, a)["lines"]
+        if not any(abs(ln["f"] - f) <= 2 * ln["bin_hz"] for f in have)
+    ]
     out = []
-    for ln in lines.find_lines(ctx.y, ctx.fs, a)["lines"]:
-        if any(abs(ln["f"] - f) <= 2 * ln["bin_hz"] for f in have):
-            continue
-        f0 = float(ln["f"])
-        lo, hi = max(0.2 / f0, float(ctx.curve.tau[0])), min(1.0 / f0, float(ctx.curve.tau[-1]))
+    for grp in _line_groups(left):
+        f_lo, f_hi = float(grp[0]["f"]), float(grp[-1]["f"])
+        top = max(grp, key=lambda d: d["psd_ratio"])
+        amps = np.array([d["amplitude"] for d in grp])
+        rms = float(math.sqrt(np.sum(amps**2) / 2.0))
+        lo, hi = max(0.2 / f_hi, float(ctx.curve.tau[0])), min(1.0 / f_lo, float(ctx.curve.tau[-1]))
+        if len(grp) == 1:
+            what = f"a spectral line at {f_lo:.4g} Hz (amplitude {amps[0]:.3g})"
+        else:
+            what = f"{len(grp)} spectral lines at {f_lo:.4g}–{f_hi:.4g} Hz (rms {rms:.3g}, largest {amps.max():.3g})"
         out.append(
             {
                 "domain": "psd",
                 "tau": (lo, hi),
-                "band_hz": (f0 - ln["bin_hz"], f0 + ln["bin_hz"]),
+                "band_hz": (f_lo - grp[0]["bin_hz"], f_hi + grp[-1]["bin_hz"]),
                 "chi2_dof": _chi2_dof(ctx, lo, hi) if hi >= lo else None,
-                "what": f"a spectral line at {f0:.4g} Hz (amplitude {ln['amplitude']:.3g})",
-                "statistic": float(ln["psd_ratio"]),
-                "threshold": float(ln["threshold"]),
+                "what": what,
+                "lines": len(grp),
+                "rms": rms,
+                "amplitude": float(amps.max()),
+                "statistic": float(top["psd_ratio"]),
+                "threshold": float(top["threshold"]),
                 "alpha": a,
             }
         )
