@@ -145,6 +145,7 @@ MODEL_RANKS = {
     "model.timeframes": 2,
     "model.warmup": 2,
     "model.refinement.levels": 2,
+    "model.refinement.words": 3,
     "model.refinement.curvefit": 3,
     "model.refinement.scoring": 4,
     "model.refinement.calibrated": 5,

@@ -566,6 +566,7 @@ class _Run:
             unexplained=missing,
             corrected=self.result if self.removed else None,
             term_moves=term_moves(start_fit, final_fit, steps, [s[2] for s in self.states]),
+            level=self.level,
         )
 
 
