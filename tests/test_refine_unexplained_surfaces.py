@@ -95,6 +95,10 @@ def test_cli_console_page_and_json_say_the_region(tmp_path, capsys):
         assert f"    {s}" in printed  # the console, under the axis
         assert s in section  # the page's section
     assert "passes every calibrated check" not in printed + page
+    # a fleet's table (allanite batch --refine) takes the same words from summary.json
+    fleet = pytest.importorskip("allanite.dask.fleet")
+    (row,) = fleet._rows({"path": str(log), "out": str(out), "status": "ok", "error": None})
+    assert row["effects"] == "" and row["still_missing"] == "; ".join(e["text"] for e in ax["unexplained"])
 
 
 def test_cli_refine_candidates_unknown_name_is_a_usage_error(tmp_path, capsys):
