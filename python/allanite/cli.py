@@ -74,7 +74,7 @@ examples:
   allanite report gyro.npy --fs 200 --window 60000 --hop 2000 --taus exp --quiet
   allanite report flight.bag                      # ROS 1 bag: sensor_msgs/Imu, rad/s
   allanite report imu.npy --fs 500 --frames 20 --forecast 60:30   # paper 004: GM(1,1) forecasts
-  allanite report acc.csv --fs 100 --refine-candidates bandwidth,gauss_markov,drift   # refine, fewer effects
+  allanite report acc.npy --fs 100 --refine-candidates bandwidth,drift   # refine trying 2 effects
 
 files written to DIR:
   report.html              the report, one self-contained page
@@ -216,7 +216,8 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="also look for what the noise model lacks ("
         + ", ".join(e.label for e in EFFECTS.values() if e.domain != "channels")
-        + ") and add a model-refinement section; a few seconds per axis and million samples",
+        + ") and add a model-refinement section, with what the final model still misses (or that it passes "
+        "every calibrated check); a few seconds per axis and million samples",
     )
     ana.add_argument(
         "--refine-candidates",
