@@ -70,6 +70,17 @@ def max_rel_diff(a, b) -> float:
     return float(np.max(rel))
 
 
+def clopper_pearson(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
+    """Exact (Clopper–Pearson) interval of a binomial rate k/n at ``level``: the benches' false-alarm and
+    coverage rates."""
+    from scipy.stats import beta
+
+    a = (1 - level) / 2
+    lo = float(beta.ppf(a, k, n - k + 1)) if k > 0 else 0.0
+    hi = float(beta.isf(a, k + 1, n - k)) if k < n else 1.0
+    return lo, hi
+
+
 def bit_identical(a, b) -> bool:
     a = np.ascontiguousarray(a, dtype=np.float64)
     b = np.ascontiguousarray(b, dtype=np.float64)

@@ -37,7 +37,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import beta, chi2
+from scipy.stats import chi2
 from scipy.stats import t as t_dist
 
 import _common
@@ -57,13 +57,6 @@ NOISES = (
     {"N": 1.5e-3, "B": 1e-4, "K": 3e-6, "gauss_markov": [(5e-4, 300.0)]},
 )
 SETUPS = ((1.0, 90_000), (100.0, 200_000))
-
-
-def clopper_pearson(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
-    a = (1 - level) / 2
-    lo = beta.ppf(a, k, n - k + 1) if k > 0 else 0.0
-    hi = beta.isf(a, k + 1, n - k) if k < n else 1.0
-    return float(lo), float(hi)
 
 
 def temperature(kind: str, n: int, fs: float, rng) -> np.ndarray:
@@ -306,7 +299,7 @@ def cost():
 def _rate(rows, key, sel=lambda r: True):
     use = [r for r in rows if sel(r)]
     k = sum(bool(r.get(key, False)) for r in use)
-    lo, hi = clopper_pearson(k, len(use))
+    lo, hi = _common.clopper_pearson(k, len(use))
     return {"records": len(use), "alarms": k, "rate": k / max(1, len(use)), "ci95": (lo, hi)}
 
 

@@ -38,7 +38,6 @@ from pathlib import Path
 
 import numpy as np
 from scipy import signal
-from scipy.stats import beta
 
 import _common
 import allanite
@@ -48,13 +47,6 @@ HERE = Path(__file__).resolve().parent
 LEVEL = 0.05
 LINE_SHARE = 0.2
 OUTLIER_SHARE = 0.05
-
-
-def clopper_pearson(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
-    a = (1 - level) / 2
-    lo = beta.ppf(a, k, n - k + 1) if k > 0 else 0.0
-    hi = beta.isf(a, k + 1, n - k) if k < n else 1.0
-    return float(lo), float(hi)
 
 
 def record(i: int):
@@ -145,7 +137,7 @@ def run(records: int, out: Path) -> dict:
 
 
 def _rate(k, n):
-    lo, hi = clopper_pearson(k, n)
+    lo, hi = _common.clopper_pearson(k, n)
     return {"alarms": k, "records": n, "rate": k / n if n else float("nan"), "ci95": [lo, hi]}
 
 

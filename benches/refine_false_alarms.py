@@ -34,7 +34,6 @@ from pathlib import Path
 
 import numpy as np
 from scipy import signal
-from scipy.stats import beta
 
 import _common
 import allanite
@@ -84,14 +83,6 @@ def record(mix: str, seed: int):
 MIXES = ("white", "flicker", "quantized", "with_K", "issue16", "slow_1hz", "fast_2khz", "channels_100hz")
 
 
-def clopper_pearson(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
-    """Exact binomial interval of a rate k/n."""
-    a = (1 - level) / 2
-    lo = beta.ppf(a, k, n - k + 1) if k > 0 else 0.0
-    hi = beta.isf(a, k + 1, n - k) if k < n else 1.0
-    return float(lo), float(hi)
-
-
 def run(per_mix: int, out: Path) -> dict:
     rows = {}
     t_all = time.perf_counter()
@@ -128,7 +119,7 @@ def run(per_mix: int, out: Path) -> dict:
         "records": total,
         "records_with_alarm": alarms,
         "rate": alarms / total,
-        "rate_interval_95": clopper_pearson(alarms, total),
+        "rate_interval_95": _common.clopper_pearson(alarms, total),
         "seconds": time.perf_counter() - t_all,
         "other_load": load.fraction,
         "machine": _common.machine_info(),
@@ -151,7 +142,7 @@ def run(per_mix: int, out: Path) -> dict:
             f"| {mix} | {r['records']} | {r['records_with_alarm']} | {100 * r['rate']:.1f} % | {eff} | {une} | "
             f"{r['mean_s']:.2f} s |"
         )
-    lo, hi = clopper_pearson(alarms, total)
+    lo, hi = _common.clopper_pearson(alarms, total)
     lines += [
         "",
         f"All: {alarms} of {total} records = {100 * alarms / total:.1f} % "

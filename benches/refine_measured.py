@@ -33,6 +33,7 @@ import _common
 import allanite
 from _common import load_avar_curve
 from allanite.model.effects import format_param
+from allanite.model.refinement.words import describe_region
 
 HERE = Path(__file__).resolve().parent
 
@@ -50,6 +51,8 @@ def summarize(name, r) -> dict:
         "final_chi2_dof": r.fit.chi2_dof,
         "final_rms_adev_pct": r.rms_adev_pct(r.fit),
         "steps": [],
+        "unexplained": [_jsonable(u) | {"text": describe_region(u)} for u in r.unexplained],
+        "still_missing": r.missing_sentences(),
     }
     for st in r.steps:
         step = {
@@ -174,9 +177,8 @@ def write_md(rows, path: Path) -> None:
             if not row["steps"]:
                 L.append(
                     f"| {row['record']} | {row['start_chi2_dof']:.2f} | {row['start_rms_adev_pct']:.1f} % "
-                    f"({_ho({'heldout_rms_adev_pct': row['start_heldout_rms_adev_pct']})}) | nothing found | | | | |"
+                    f"({_ho({'heldout_rms_adev_pct': row['start_heldout_rms_adev_pct']})}) | nothing added | | | | |"
                 )
-                continue
             for i, st in enumerate(row["steps"]):
                 head = (
                     f"| {row['record']} | {row['start_chi2_dof']:.2f} | {row['start_rms_adev_pct']:.1f} % "
@@ -189,6 +191,8 @@ def write_md(rows, path: Path) -> None:
                     f"{st['after']['chi2_dof']:.2f} | {st['before']['rms_adev_pct']:.1f} → "
                     f"{st['after']['rms_adev_pct']:.1f} % | {_ho(st['before'])} → {_ho(st['after'])} |"
                 )
+            if row.get("unexplained"):  # what the final model still misses, in the report's words
+                L.append(f"| | | | still missing | {'; '.join(u['text'] for u in row['unexplained'])} | | | |")
     n_adis = len(rows["adis"])
     found = {}
     for row in rows["adis"] + rows["curves"]:

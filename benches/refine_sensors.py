@@ -26,6 +26,7 @@ from pathlib import Path
 
 import _common
 import allanite
+from allanite.model.refinement.words import describe_region
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "tests"))
@@ -62,7 +63,7 @@ def _row(v) -> str:
         f"{k} {e:+.1%}" if isinstance(e, float) else f"{k} {e}" for k, e in v["param_errors"].items() if e is not None
     )
     left = v["unexplained"]
-    left_s = "—" if left is None else ("none" if not left else "; ".join(str(u.get("tau")) for u in left))
+    left_s = "—" if left is None else ("none" if not left else _regions(left))
     blind = v["without_candidate"]["unexplained"]
     blind_s = "—" if blind is None else ("**none**" if not blind else f"{len(blind)} region(s)")
     return (
@@ -70,6 +71,12 @@ def _row(v) -> str:
         f"{_fmt_pair(v.get('rms_adev_pct'))} | {_fmt_pair(v.get('heldout_rms_adev_pct'))} | {left_s} | {blind_s} | "
         f"{'✓' if v['passed'] else '✗'} | {v['seconds']:.1f} |"
     )
+
+
+def _regions(left: list, most: int = 3) -> str:
+    """The first regions of ``unexplained`` in the report's words (τ in s, band in Hz), and how many more."""
+    words = "; ".join(describe_region(u) for u in left[:most])
+    return words + (f"; and {len(left) - most} more" if len(left) > most else "")
 
 
 def _machine() -> str:

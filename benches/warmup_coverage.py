@@ -26,7 +26,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import beta
 
 import _common
 import allanite
@@ -54,13 +53,6 @@ NOISES = {
 }
 
 
-def clopper_pearson(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
-    a = 1 - level
-    lo = 0.0 if k == 0 else float(beta.ppf(a / 2, k, n - k + 1))
-    hi = 1.0 if k == n else float(beta.ppf(1 - a / 2, k + 1, n - k))
-    return lo, hi
-
-
 def run(noise: dict, records: int) -> dict:
     t = np.arange(N_SAMPLES) / FS
     rows: dict = {"gls": [], "oracle": [], "ols": []}
@@ -77,7 +69,7 @@ def run(noise: dict, records: int) -> dict:
         err = np.array([r["T"] / T0 - 1 for r in rs])
         out[key] = {
             "coverage": k / len(rs),
-            "coverage_95": clopper_pearson(k, len(rs)),
+            "coverage_95": _common.clopper_pearson(k, len(rs)),
             "median_abs_T_error": float(np.median(np.abs(err))),
             "mean_T_error": float(np.mean(err)),
             "median_T_error": float(np.median(err)),

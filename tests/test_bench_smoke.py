@@ -75,3 +75,19 @@ def test_bench_davar_floor_quick(tmp_path):
     assert len(report["times"]["call"]) == len(report["times"]["floor"]) == report["repeats"] >= 11
     assert math.isfinite(report["ratio"]) and report["ratio"] > 0
     assert report["max_rel_diff_vs_naive"] <= 1e-12
+
+
+def test_clopper_pearson_matches_its_closed_forms():
+    """The benches' one binomial interval (``benches/_common.py``): at k = 0 and k = n the exact bounds are
+    1 − (α/2)^(1/n) and (α/2)^(1/n); inside, the interval holds k/n and the bounds are beta quantiles."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
+    try:
+        import _common
+    finally:
+        sys.path.pop(0)
+    assert _common.clopper_pearson(0, 600) == (0.0, pytest.approx(1 - 0.025 ** (1 / 600), rel=1e-10))
+    assert _common.clopper_pearson(10, 10) == (pytest.approx(0.025 ** (1 / 10), rel=1e-10), 1.0)
+    lo, hi = _common.clopper_pearson(5, 76)
+    assert lo < 5 / 76 < hi and (round(lo, 4), round(hi, 4)) == (0.0217, 0.1469)
+    lo90, hi90 = _common.clopper_pearson(5, 76, level=0.9)
+    assert lo < lo90 and hi90 < hi

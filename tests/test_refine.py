@@ -297,3 +297,15 @@ def test_complex_samples_are_refused_without_a_cast_warning():
         warnings.simplefilter("error")
         with pytest.raises(allanite.InputError, match="complex"):
             allanite.refine(y, 100.0)
+
+
+def test_one_axis_of_a_multi_axis_curve_is_refined_as_that_axis_alone():
+    y = np.column_stack(
+        [allanite.simulate(20_000, FS, N=2e-3, seed=5), allanite.simulate(20_000, FS, N=4e-3, K=1e-4, seed=6)]
+    )
+    both, one = allanite.avar(y, FS), allanite.avar(y[:, 1], FS)
+    r = allanite.refine(both, axis=1, progress=False)
+    assert r.result.n_axes is None and r.result.n_samples == 20_000 and r.result.estimator == one.estimator
+    for field in ("tau", "avar", "n", "m"):
+        np.testing.assert_array_equal(getattr(r.result, field), getattr(one, field))
+    assert r.start.coefficients["N"].value == pytest.approx(4e-3, rel=0.05)  # axis 1's white noise, not axis 0's

@@ -95,6 +95,31 @@ class _ResultBase(RichDisplay):
         """The estimator in words (from the estimator registry)."""
         return get_estimator(self.estimator).label
 
+    def static_row(self, avar, *, n_samples: int | None = None) -> AllanResult:
+        """A static :class:`AllanResult` holding the one row ``avar`` on this result's τ grid: its ``tau``,
+        ``n``, ``m``, estimator, rate, input and ``source``, without intervals — one axis of a multi-axis
+        result, or a row that sums up a dynamic one (its windows' medians; ``n_samples`` then the window).
+
+        Examples
+        --------
+        >>> import numpy as np, allanite
+        >>> r = allanite.avar(np.random.default_rng(1).normal(size=(2, 1_000)).T, fs=10.0, taus=[0.1, 1.0])
+        >>> one = r.static_row(r.avar[1])
+        >>> one.n_axes, one.avar.shape, one.n_samples, float(one.tau[1])
+        (None, (2,), 1000, 1.0)
+        """
+        return AllanResult(
+            tau=self.tau,
+            avar=np.asarray(avar),
+            n=self.n,
+            m=self.m,
+            estimator=self.estimator,
+            fs=self.fs,
+            n_samples=self.n_samples if n_samples is None else int(n_samples),
+            input=self.input,
+            source=self.source,
+        )
+
     def with_confidence(
         self,
         x=None,

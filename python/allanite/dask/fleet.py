@@ -6,8 +6,9 @@ Dask task — a LocalCluster by default, any scheduler given by its address — 
 
 * ``out/<path relative to the glob's root, extensions stripped>/`` — the file's report;
 * ``out/fleet.csv`` (and ``fleet.parquet`` when pyarrow is installed) — one row per file and axis: the
-  fitted N, B, K with their intervals (IEEE-952 units), the effects ``refine`` found, robust z-scores
-  of N, B, K against the fleet and a flag when one is beyond :data:`Z_FLAG`, or the file's error;
+  fitted N, B, K with their intervals (IEEE-952 units), the effects ``refine`` found and what the refined
+  model still misses (``still_missing``), robust z-scores of N, B, K against the fleet and a flag when one is
+  beyond :data:`Z_FLAG`, or the file's error;
 * ``out/fleet.html`` — the fleet's distributions.
 
 Reliability: a file that fails (malformed, gaps, …) becomes a row with its error and does not stop the
@@ -137,10 +138,19 @@ def _rows(status: dict) -> list:
             ci = None if c is None else c.get("ieee_ci")
             row[f"{t}_low"], row[f"{t}_high"] = (None, None) if ci is None else (ci[0], ci[1])
             row[f"{t}_unit"] = None if c is None else c.get("ieee_unit")
-        steps = ref_axes.get(ax.get("axis"), {}).get("steps") or []
-        row["effects"] = ";".join(s["effect"] for s in steps) if ref else None
+        ref_ax = ref_axes.get(ax.get("axis"), {})
+        row["effects"] = ";".join(s["effect"] for s in ref_ax.get("steps") or []) if ref else None
+        row["still_missing"] = _still_missing(ref_ax) if ref else None
         rows.append(row)
     return rows
+
+
+def _still_missing(ref_ax: dict) -> str | None:
+    """What the refined model of an axis still misses (summary.json's ``unexplained``, each entry's words,
+    "; "-joined), "none" when it passes every calibrated check; None for an axis that was not refined."""
+    if "unexplained" not in ref_ax:
+        return None
+    return "; ".join(u["text"] for u in ref_ax["unexplained"]) or "none"
 
 
 def robust_z(values) -> np.ndarray:
@@ -171,7 +181,7 @@ def _flag(rows: list) -> None:
 COLUMNS = (
     ["file", "axis", "status", "error"]
     + [f"{t}{s}" for t in TERMS for s in ("", "_low", "_high", "_unit")]
-    + ["effects"]
+    + ["effects", "still_missing"]
     + [f"z_{t}" for t in TERMS]
     + ["flag", "out"]
 )

@@ -47,6 +47,7 @@ from scipy.stats import t as t_dist
 from .._validate import check_fs, check_probability
 from ..errors import InputError, ParameterError
 from . import _whittle as wh
+from ._shares import TERM_SHARE
 
 __all__ = [
     "regress_channel",
@@ -63,9 +64,6 @@ __all__ = [
 
 #: Optional terms of a channel regression, in the order they are tried.
 SUBTERMS = ("quadratic", "rate_coefficient", "lag_s")
-#: Share of the per-record level spent on each optional term's test (a test run only once the coupling itself
-#: is accepted).
-TERM_SHARE = {"quadratic": 0.02, "rate_coefficient": 0.02, "lag_s": 0.02}
 #: Default per-record level and the default share of it for the coupling's test (refine's time-domain share).
 LEVEL = 0.05
 ALPHA = 0.075 * LEVEL

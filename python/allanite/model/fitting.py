@@ -827,17 +827,7 @@ def _fit_dynamic_auto(result, terms, unit, confidence, zq, thin, max_iter, progr
     out = []
     for rows_avar in rows:
         med = row_medians(rows_avar)
-        stat = AllanResult(
-            tau=result.tau,
-            avar=med,
-            n=result.n,
-            m=result.m,
-            estimator=result.estimator,
-            fs=result.fs,
-            n_samples=result.window,
-            input=result.input,
-            source=result.source,
-        )
+        stat = result.static_row(med, n_samples=result.window)
         cuts, tau0 = _auto_cuts(stat, med, thin, len(terms))
 
         def fit_at(cut, stat=stat, med=med):

@@ -44,6 +44,7 @@ from ..errors import AllaniteError, MemoryBudgetError, ParameterError
 from ..estimators import get as get_estimator
 from ..estimators.theo import resolve_decimation
 from ..model import fit as fit_model
+from ..model.effects import EFFECTS
 from ..model.terms import TERMS
 from ..results import AllanResult, DynamicAllanResult
 from ..units import adev_unit_label, parse_unit
@@ -237,7 +238,7 @@ def build_report(
     notes=(),
     progress=None,
     estimator: str = "oavar",
-    refine: bool = False,
+    refine: bool | tuple = False,
     frames=None,
     forecast=None,
     taper: str | None = None,
@@ -265,10 +266,13 @@ def build_report(
     taus : str or array_like
         τ of the static analysis: a grid name (default ``"octave"``) or τ in seconds. The DAVAR
         uses paper 000's exponential grid on the window (DHVAR: the octave grid).
-    refine : bool
+    refine : bool or sequence of str
         Also run :func:`allanite.refine` on every axis (a few seconds per 10⁶ samples): the page gains a
         "Model refinement" section — the effects the five-term model lacks, their parameters and the
-        error before and after.
+        error before and after, and what the final model still misses (or that it passes every calibrated
+        check). True tries every candidate effect; a sequence of effect names (keys of
+        :data:`allanite.model.effects.EFFECTS`) tries only those — e.g. without ``"outliers"`` on quantised
+        accelerometers (docs/refinement.md); an empty one only says what the five-term model misses.
     estimator : {"oavar", "theoh"}
         ``"oavar"`` (default): overlapping Allan deviation and DAVAR. ``"theoh"``: TheoH for the
         whole record and paper 001's DHVAR over time (overlapping Allan up to 10 % of the record or
@@ -305,7 +309,8 @@ def build_report(
     if frame_s is not None or fc_split is not None:
         # before anything is computed: a frame or split that does not fit the record is the caller's option
         plan = plan_forecast(int(x.shape[0]), float(fs), frame_s, fc_split)
-    progress, own_bar = _steps(progress, 5 + bool(refine) + (plan is not None), "report")
+    candidates = _refine_candidates(refine)
+    progress, own_bar = _steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
     if x.ndim == 1:
         x = x[:, None]
     unit_name = None if unit is None else parse_unit(unit, kind="rate" if input == "rate" else "angle").name
@@ -394,28 +399,10 @@ def build_report(
         progress.add(2)
 
     refinements: list[Refinement | None] | None = None
-    if refine:
+    if candidates is not None:
         progress.step("model refinement")
-        from ..model import refine as refine_axis  # the refinement package (scipy.signal) only when asked
-
-        refinements = []
-        # the same τ range the whole-record fit used (none unless given): start at 0.1 s when the
-        # shortest τ are below it, as real gyros' anti-alias filters colour them
-        t0 = 0.1 if static.tau[0] < 0.1 else None
-        for k in range(n_axes):
-            try:
-                refinements.append(
-                    refine_axis(
-                        axis_column(x, k),
-                        fs,
-                        input=input,
-                        unit=unit_name,
-                        tau_range=None if t0 is None else (t0, None),
-                    )
-                )
-            except AllaniteError as exc:
-                refinements.append(None)
-                notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")
+        refinements = _refine_axes(x, fs, input, unit_name, static, axis_names, candidates, notes)
+        settings["refine_candidates"] = list(candidates)
     frame_fits = forecasts = forecast_settings = forecast_error = None
     if plan is not None:
         progress.step("time frames and coefficient forecast")
@@ -467,6 +454,45 @@ def build_report(
         series_error=series_error,
         created=created,
     )
+
+
+def _refine_candidates(refine) -> tuple | None:
+    """The candidate effects of ``refine=`` (True: all of them; False/None: no refinement), checked."""
+    if refine is None or refine is False:
+        return None
+    if refine is True:
+        return tuple(EFFECTS)
+    names = (refine,) if isinstance(refine, str) else tuple(refine)
+    bad = [n for n in names if n not in EFFECTS]
+    if bad:
+        raise ParameterError(f"refine: unknown candidate effect {bad[0]!r}; allowed: {', '.join(EFFECTS)}")
+    return names
+
+
+def _refine_axes(x, fs, input, unit_name, static, axis_names, candidates, notes) -> list:
+    """:func:`allanite.refine` on every axis (None for an axis it fails on, with a note why)."""
+    from ..model import refine as refine_axis  # the refinement package (scipy.signal) only when asked
+
+    refinements: list = []
+    # the same τ range the whole-record fit used (none unless given): start at 0.1 s when the
+    # shortest τ are below it, as real gyros' anti-alias filters colour them
+    t0 = 0.1 if static.tau[0] < 0.1 else None
+    for k in range(x.shape[1]):
+        try:
+            refinements.append(
+                refine_axis(
+                    axis_column(x, k),
+                    fs,
+                    input=input,
+                    unit=unit_name,
+                    tau_range=None if t0 is None else (t0, None),
+                    candidates=candidates,
+                )
+            )
+        except AllaniteError as exc:
+            refinements.append(None)
+            notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")
+    return refinements
 
 
 def _window_and_hop(n, window, hop, estimator):

@@ -254,11 +254,12 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
     if ref is None:
         return None
     fs, duration_s = rec["fs_hz"], rec["duration_s"]
-    curve_rows, change_rows, summary_rows, move_rows = [], [], [], []
+    curve_rows, change_rows, summary_rows, move_rows, missing = [], [], [], [], []
     for ax in ref["axes"]:
         if ax.get("error"):
             summary_rows.append([ax["name"], "failed (see the notes)", "—", "—", "—"])
             continue
+        missing.append({"name": ax["name"], "sentences": ax["still_missing"], "found": bool(ax["unexplained"])})
         summary_rows.append(
             [
                 ax["name"],
@@ -335,6 +336,7 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
         "candidates": ref["candidates"],
         "units": ref["units"],
         "tables": tables,
+        "missing": missing,
         "chi2_note": (
             "Every step is scored on the record's own Allan curve, a component removed in time part of the model "
             "through what it changed in the curve, so each step's before is the previous step's after (χ²/dof "

@@ -11,6 +11,7 @@ from ..estimators import get as get_estimator
 from ..model.effects import EFFECTS, param_units
 from ..model.fitting import row_medians
 from ..model.refinement.result import term_move_text
+from ..model.refinement.words import describe_region
 from ..model.terms import TERM_NAMES
 from ..units import coefficient_unit, ieee952
 from .fmt import count, duration, g, json_list, json_number, json_value, pct, step_params
@@ -67,17 +68,21 @@ def refinement_dict(rep) -> dict | None:
                     for m in r.term_moves
                 ],
                 "steps": [_step_dict(st, rate) for st in r.steps],
+                "level": json_number(r.level),
+                "unexplained": [_region_dict(reg) for reg in r.unexplained],
+                "still_missing": r.missing_sentences(),
             }
         )
-    curve = [e for e in EFFECTS.values() if e.kind == "curve"]
-    timed = [e for e in EFFECTS.values() if e.kind != "curve"]
+    tried = rep.settings.get("refine_candidates", list(EFFECTS))
+    curve = [e for e in EFFECTS.values() if e.kind == "curve" and e.name in tried]
+    timed = [e for e in EFFECTS.values() if e.kind != "curve" and e.name in tried]
     return {
         "method": "allanite.refine: the residual traced on the Allan curve, in the PSD, along time and in other "
         "channels; an effect is added only if a calibrated test asks for it (GLS score with a bootstrap threshold, "
         "a χ² line test on the Welch PSD, a t test of a regression, a bootstrap of the drift statistic) and it "
         "lowers the held-out error (fit on the odd blocks of the record, predict the even ones, and back)",
-        "candidates": f"{' / '.join(e.label for e in curve)} signatures in the Allan curve, or "
-        + " or ".join(f"{e.label} along the record" for e in timed),
+        "candidates": _candidates_words(curve, timed),
+        "tried": list(tried),
         "units": "; ".join(
             f"{e.name}: " + ", ".join(_param_words(p, u, m, rate) for p, u, m in e.params) for e in EFFECTS.values()
         ),
@@ -93,7 +98,37 @@ def refinement_dict(rep) -> dict | None:
             "levels (split at every change found) of the log Allan variances of 16 windows along the record; held "
             "out per segment (each segment's alternate blocks predicted by its own model vs the one-level model)",
         },
+        "unexplained": "per axis, what the final model still misses, largest misfit first (empty when the final "
+        "model passes every calibrated check of what it may still miss, each at its share of the axis's level): "
+        "domain (allan, psd, time, channels, outliers), tau_s [lo, hi] in s, band_hz [lo, hi] in Hz (null where "
+        "it has no band, or for curve-only input), chi2_dof of the dense Allan curve over that τ range (null "
+        "where the evidence is not on the curve), what (in words), the check's statistic, threshold and alpha, "
+        "and text (the entry in words); still_missing: the sentences the page and the console print",
         "axes": axes,
+    }
+
+
+def _candidates_words(curve: list, timed: list) -> str:
+    """The candidate effects tried, in words (the page's "traced the residual to …")."""
+    words = ", or ".join(
+        ([f"{' / '.join(e.label for e in curve)} signatures in the Allan curve"] if curve else [])
+        + ([" or ".join(f"{e.label} along the record" for e in timed)] if timed else [])
+    )
+    return words or "no candidate effect (only what the five-term model still misses is checked)"
+
+
+def _region_dict(reg: dict) -> dict:
+    """One entry of ``Refinement.unexplained`` as JSON, units in the keys (τ in s, the band in Hz), in words."""
+    return {
+        "domain": reg.get("domain"),
+        "tau_s": json_value(reg["tau"]),
+        "band_hz": json_value(reg.get("band_hz")),
+        "chi2_dof": json_number(reg.get("chi2_dof")),
+        "what": reg.get("what"),
+        "statistic": json_number(reg.get("statistic")),
+        "threshold": json_number(reg.get("threshold")),
+        "alpha": json_number(reg.get("alpha")),
+        "text": describe_region(reg),
     }
 
 
@@ -509,6 +544,7 @@ def text_summary(s: dict) -> str:
                     f"    {st['effect']}: {step_params(st, rec['fs_hz'], rec['duration_s'], units=True, final=True)}"
                 )
             lines += [f"    {m['text']}" for m in ax.get("term_moves", [])]
+            lines += [f"    {t}" for t in ax.get("still_missing", [])]
     lines += forecast_text(s.get("forecast"))
     lines += paper002_text(s.get("paper002"))
     return "\n".join(lines)

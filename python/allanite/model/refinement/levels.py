@@ -8,7 +8,7 @@ calibrated with the rest on clean records (``benches/refine_false_alarms.py``).
 
 from __future__ import annotations
 
-from ..channels import TERM_SHARE
+from .._shares import TERM_SHARE
 
 __all__ = [
     "LEVEL",

@@ -200,17 +200,7 @@ def _inputs(x_or_result, fs, input, points, axis, channels):
         result = avar(y, fs, taus=grid)
     chans = _channels(channels, y)
     if result.avar.ndim == 2:
-        result = AllanResult(
-            tau=result.tau,
-            avar=result.avar[axis],
-            n=result.n,
-            m=result.m,
-            estimator=result.estimator,
-            fs=result.fs,
-            n_samples=result.n_samples,
-            input=result.input,
-            source=result.source,
-        )
+        result = result.static_row(result.avar[axis])
     return y, result, chans
 
 
@@ -603,6 +593,7 @@ class _Run:
             unexplained=missing,
             corrected=self.result if self.removed else None,
             term_moves=term_moves(start_fit, final_fit, steps, [s[2] for s in self.states]),
+            level=self.level,
         )
 
 

@@ -14,8 +14,10 @@ from ...units import ieee952
 from .. import fitting
 from ..effects import EFFECTS, format_params
 from ..terms import TERM_NAMES
+from .levels import LEVEL
+from .words import missing_sentences
 
-__all__ = ["Step", "Refinement", "term_moves", "term_move_text", "describe_region"]
+__all__ = ["Step", "Refinement", "term_moves", "term_move_text"]
 
 #: The errors each step reports before and after it.
 ERRORS = ("chi2_dof", "rms_z", "rms_adev_pct", "heldout_rms_adev_pct")
@@ -122,11 +124,11 @@ class Refinement(RichDisplay):
     time (None when nothing was removed). ``heldout_note`` says how (or why not) the held-out error was
     computed; ``scored_tau`` the τ the RMS ADEV errors are scored on (:meth:`rms_adev_pct` gives a fit's);
     ``term_moves`` the terms whose refined interval no longer overlaps the plain fit's, and the steps that
-    moved them. ``unexplained`` lists what the final model still misses — empty when every
-    domain's calibrated check passes (at its share of ``level``), else one dict per region, largest misfit first:
-    ``"domain"``, ``"tau"`` (lo, hi) s, ``"band_hz"`` (lo, hi) or None, ``"chi2_dof"`` over that τ range,
-    ``"what"``, and the test's ``"statistic"``, ``"threshold"``, ``"alpha"``
-    (:mod:`allanite.model.refinement.missing`)."""
+    moved them; ``level`` the false-alarm level the tests spent. ``unexplained`` lists what the final model
+    still misses — empty when every domain's calibrated check passes (at its share of ``level``), else one dict
+    per region, largest misfit first: ``"domain"``, ``"tau"`` (lo, hi) s, ``"band_hz"`` (lo, hi) or None,
+    ``"chi2_dof"`` over that τ range, ``"what"``, and the test's ``"statistic"``, ``"threshold"``, ``"alpha"``
+    (:mod:`allanite.model.refinement.missing`); :meth:`missing_sentences` says it in words."""
 
     steps: list
     fit: fitting.NoiseFit
@@ -143,6 +145,7 @@ class Refinement(RichDisplay):
     unexplained: list = field(default_factory=list)
     corrected: AllanResult | None = None
     term_moves: list = field(default_factory=list)
+    level: float = LEVEL
 
     def rms_adev_pct(self, fit) -> float:
         """RMS ADEV error (%) of a fit (``start`` or ``fit``) on the τ the steps' errors are scored on
@@ -197,21 +200,28 @@ class Refinement(RichDisplay):
             "",
         ]
         if not self.steps:
-            lines.append(
-                "Nothing added: the starting model passes every calibrated check."
-                if not self.unexplained
-                else "Nothing added: no candidate earned its parameters — but the model still misses something (below)."
-            )
+            lines.append(self._nothing_added().capitalize() + ".")
         for i, st in enumerate(self.steps, 1):
             lines += self._step_lines(i, st)
         return "\n".join(lines + self._final_lines() + self._missing_lines())
 
+    def missing_sentences(self) -> list[str]:
+        """What the final model still misses, one sentence per entry of ``unexplained`` — or the one sentence
+        saying that it passes every calibrated check, at the level they spent (the same words as the report
+        page and the console: :mod:`allanite.model.refinement.words`)."""
+        return missing_sentences(self.unexplained, self.level)
+
+    def _nothing_added(self) -> str:
+        """What to say when no effect was added: that the start passes — only when nothing is missing."""
+        if not self.unexplained:
+            return "nothing added: the starting model passes every calibrated check"
+        return "nothing added: no candidate earned its parameters — but the model still misses something"
+
     def _missing_lines(self) -> list:
         lines = ["", "## What the model still misses", ""]
-        return lines + (
-            [f"- {describe_region(r)}" for r in self.unexplained]
-            or ["Nothing: every domain's calibrated check passes against the final model."]
-        )
+        if not self.unexplained:
+            return lines + self.missing_sentences()
+        return lines + [f"- {t}" for t in self.missing_sentences()]
 
     def _step_lines(self, i: int, st: Step) -> list:
         lines = [
@@ -296,7 +306,7 @@ class Refinement(RichDisplay):
         s0, s1 = self.start, self.fit
         facts: list = [
             ("starting model", "+".join(self.terms)),
-            ("found", ", ".join(self.found) if self.steps else "nothing: the starting model fits"),
+            ("found", ", ".join(self.found) if self.steps else self._nothing_added()),
             ("χ²/dof", f"{s0.chi2_dof:.3g} → {s1.chi2_dof:.3g}"),
             ("RMS z", f"{np.sqrt(np.mean(s0.z**2)):.3g} → {np.sqrt(np.mean(s1.z**2)):.3g}"),
             ("RMS ADEV error %", f"{self.rms_adev_pct(s0):.3g} → {self.rms_adev_pct(s1):.3g}"),
@@ -306,14 +316,7 @@ class Refinement(RichDisplay):
                 f"{self.result.n_samples} samples at {self.result.fs:g} Hz, τ {s0.tau[0]:.4g}–{s0.tau[-1]:.4g} s",
             ),
         ]
-        facts.append(
-            (
-                "still missing",
-                "; ".join(describe_region(r) for r in self.unexplained)
-                if self.unexplained
-                else "nothing: every calibrated check passes",
-            )
-        )
+        facts.append(("still missing", " ".join(self.missing_sentences())))
         if self.change_points:
             facts.append(("change points", ", ".join(f"t = {float(c['t']):.4g} s" for c in self.change_points)))
         tables = [self._steps_table()] if self.steps else []
@@ -368,40 +371,6 @@ class Refinement(RichDisplay):
 
 def _fmt(v) -> str:
     return "n/a" if v is None else f"{v:.3g}"
-
-
-def describe_region(reg: dict) -> str:
-    """One entry of ``Refinement.unexplained`` in words: "the model still misses τ 0.2–3 s (≈ 0.17–2.5 Hz): …"."""
-    lo, hi = reg["tau"]
-    text = f"τ {_span(lo, hi)} s"
-    band = reg.get("band_hz")
-    if band is not None:
-        text += f" (≈ {_span(band[0], band[1])} Hz)"
-    if reg.get("what"):
-        text += f": {reg['what']}"
-    if reg.get("chi2_dof") is not None and math.isfinite(reg["chi2_dof"]):
-        text += f", χ²/dof {_num(reg['chi2_dof'])} there"
-    return text
-
-
-def _span(lo: float, hi: float) -> str:
-    """``lo–hi`` with as many digits as it takes to tell them apart (one value if they are equal)."""
-    if not hi > lo:
-        return _num(lo)
-    for extra in range(4):
-        a, b = _num(lo, extra), _num(hi, extra)
-        if a != b:
-            return f"{a}–{b}"
-    return f"{a}–{b}"
-
-
-def _num(v: float, extra: int = 0) -> str:
-    if v == 0 or not math.isfinite(v):
-        return f"{v:g}"
-    if abs(v) >= 1000:
-        return f"{v:.0f}"
-    digits = max(0, 1 - int(math.floor(math.log10(abs(v))))) + extra
-    return f"{v:.{min(digits, 6)}f}"
 
 
 def _terms_values(tba: dict, when: str) -> dict:

@@ -1,0 +1,14 @@
+"""Shares of the per-record false-alarm level that more than one module needs, without their heavy imports.
+
+:mod:`allanite.model.channels` (scipy) spends :data:`TERM_SHARE` on a slow channel's optional terms, and
+:mod:`allanite.model.refinement.levels` lists it in the record's budget; both take it from here, so that
+reading the budget (as the report's summary does) loads no scipy.
+"""
+
+from __future__ import annotations
+
+__all__ = ["TERM_SHARE"]
+
+#: Share of the per-record level spent on each optional term's test of a channel regression (a test run only
+#: once the coupling itself is accepted).
+TERM_SHARE = {"quadratic": 0.02, "rate_coefficient": 0.02, "lag_s": 0.02}

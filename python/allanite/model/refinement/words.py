@@ -1,0 +1,87 @@
+"""What the final model still misses, in words — the one place that says ``Refinement.unexplained`` to a reader.
+
+:meth:`allanite.Refinement.report`, the notebook display, ``summary.json`` (each entry's ``"text"``), the HTML
+report page and the console all take their sentences from here, so they say the same thing: where in τ (and
+frequency) the model still misses something, or that the final model passes every calibrated check — never the
+latter when a check found something.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .levels import UNEXPLAINED_SHARES
+
+__all__ = ["describe_region", "missing_sentences", "passes_sentence", "checks_alpha"]
+
+
+def checks_alpha(level: float) -> float:
+    """The false-alarm probability per record that the checks of what is still missing spend together."""
+    return level * sum(UNEXPLAINED_SHARES.values())
+
+
+def describe_region(reg: dict) -> str:
+    """One entry of ``Refinement.unexplained`` in words: "τ 0.2–3 s, ≈ 0.17–2.5 Hz: …, χ²/dof 4.1 there".
+
+    Examples
+    --------
+    >>> describe_region({"tau": (0.2, 3.0), "band_hz": (0.17, 2.5), "chi2_dof": 4.12,
+    ...                  "what": "the Allan curve departs from the model"})
+    'τ 0.20–3.0 s, ≈ 0.17–2.5 Hz: the Allan curve departs from the model, χ²/dof 4.1 there'
+    """
+    lo, hi = reg["tau"]
+    text = f"τ {_span(lo, hi)} s"
+    band = reg.get("band_hz")
+    if band is not None:
+        text += f", ≈ {_span(band[0], band[1])} Hz"
+    if reg.get("what"):
+        text += f": {reg['what']}"
+    chi2 = reg.get("chi2_dof")
+    if chi2 is not None and math.isfinite(chi2):
+        text += f", χ²/dof {_num(chi2)} there"
+    return text
+
+
+def passes_sentence(level: float) -> str:
+    """What is said when ``unexplained`` is empty: the final model passes the checks, at their level."""
+    return (
+        "The final model passes every calibrated check of what it may still miss (the Allan-curve score test "
+        "and, with samples, lines in the PSD, a drift, the channels and outliers) at a false-alarm probability "
+        f"of {100 * checks_alpha(level):.3g} % per record together (their share of level {level:g})."
+    )
+
+
+def missing_sentences(unexplained: list, level: float) -> list[str]:
+    """One sentence per entry of ``unexplained`` ("The model still misses something at τ …"), or the one
+    sentence saying that the final model passes (:func:`passes_sentence`) when it is empty.
+
+    Examples
+    --------
+    >>> missing_sentences([{"tau": (0.2, 3.0), "band_hz": None, "chi2_dof": 4.1, "what": ""}], 0.05)
+    ['The model still misses something at τ 0.20–3.0 s, χ²/dof 4.1 there.']
+    >>> missing_sentences([], 0.05)[0][:32]
+    'The final model passes every cal'
+    """
+    if not unexplained:
+        return [passes_sentence(level)]
+    return [f"The model still misses something at {describe_region(r)}." for r in unexplained]
+
+
+def _span(lo: float, hi: float) -> str:
+    """``lo–hi`` with as many digits as it takes to tell them apart (one value if they are equal)."""
+    if not hi > lo:
+        return _num(lo)
+    for extra in range(4):
+        a, b = _num(lo, extra), _num(hi, extra)
+        if a != b:
+            return f"{a}–{b}"
+    return f"{a}–{b}"
+
+
+def _num(v: float, extra: int = 0) -> str:
+    if v == 0 or not math.isfinite(v):
+        return f"{v:g}"
+    if abs(v) >= 1000:
+        return f"{v:.0f}"
+    digits = max(0, 1 - int(math.floor(math.log10(abs(v))))) + extra
+    return f"{v:.{min(digits, 6)}f}"
