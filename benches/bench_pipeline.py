@@ -26,7 +26,7 @@ Rows
    (ru_maxrss of the process and its children, file pages included) against the target of the file's size
    + 1 GiB. ``--scale-samples`` for another length.
 
-Not measured here (issue 30 item 5): DAVAR's hop-1 case against its write floor.
+Not measured here (issue 30 item 5): DAVAR's hop-1 case against its write floor — ``benches/bench_davar_floor.py``.
 
 ``--rows report,scale`` reruns only those rows (names: import, report, refine, fit_adis, combine, hop1, scale)
 and keeps the other rows of the ``pipeline.json`` already in ``--out``; the page says which rows were measured
@@ -555,8 +555,8 @@ def write_md(res: dict, path: Path) -> None:
             )
     L.append("")
     L.append(
-        "Not measured (issue 30 item 5): DAVAR's hop-1 case against its write floor (case 1's old target in "
-        "engine.md stands)."
+        "Not measured here (issue 30 item 5): DAVAR's hop-1 case against its write floor — "
+        "benches/bench_davar_floor.py, results in davar_floor.md (case 1's old target in engine.md is retired)."
     )
     path.write_text("\n".join(L) + "\n", encoding="utf-8")
 
