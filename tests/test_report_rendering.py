@@ -54,3 +54,40 @@ def test_a_report_drawn_in_a_worker_thread_forks_nothing():
     t.start()
     t.join()
     assert seen == [1]
+
+
+def test_idle_cores_reads_the_run_queue_less_this_process(monkeypatch):
+    import io
+
+    from allanite.report import rendering
+
+    queue = iter(["0.9 0.5 0.4 3/200 1\n", "0.9 0.5 0.4 1/200 1\n", "0.9 0.5 0.4 3/200 1\n"] * 3)
+    monkeypatch.setattr(rendering, "open", lambda *a, **k: io.StringIO(next(queue)), raising=False)
+    monkeypatch.setattr(rendering, "RUN_QUEUE_PAUSE", 0.0)
+    monkeypatch.setattr(rendering, "RUN_QUEUE_SAMPLES", 3)
+    # median of 3, 1, 3 runnable tasks = 3, one of them this process: 2 others on 4 cores leave 2 idle
+    assert rendering.idle_cores(4) == 2
+
+
+def test_idle_cores_without_the_run_queue_uses_the_load_average(monkeypatch):
+    from allanite.report import rendering
+
+    def unreadable(*args, **kwargs):
+        raise OSError("no /proc")
+
+    monkeypatch.setattr(rendering, "open", unreadable, raising=False)
+    monkeypatch.setattr(rendering.os, "getloadavg", lambda: (1.5, 1.0, 1.0))
+    assert rendering.idle_cores(2) == 0.5
+
+
+def test_the_child_gets_half_of_the_drawing_by_area():
+    from allanite.report.rendering import child_share
+
+    def sized(k, w, h):
+        return (f"f{k}.png", "", "", (w, h), None)
+
+    # one large figure (area 8) and four small ones (area 2 each): the parent draws the large one, the child the rest
+    specs = [sized(0, 2, 1), sized(1, 4, 2), sized(2, 2, 1), sized(3, 2, 1), sized(4, 2, 1)]
+    assert child_share(specs) == [0, 2, 3, 4]
+    # equal figures alternate, the parent first
+    assert child_share([sized(k, 2, 1) for k in range(5)]) == [1, 3]
