@@ -85,11 +85,11 @@ def _lean_log_axis(ax, axis) -> None:
     from matplotlib.ticker import FuncFormatter, LogFormatterSciNotation, NullLocator
 
     rcParams = cast("Mapping[str, Any]", _rc)  # indexed by composed names ("xtick.minor.size")
-    lo, hi = sorted(float(v) for v in axis.get_view_interval())
+    x = axis is ax.xaxis
+    lo, hi = sorted(float(v) for v in (ax.get_xlim() if x else ax.get_ylim()))  # autoscaled where pending
     if not (lo > 0 and math.isfinite(hi) and math.log10(hi / lo) > MIN_DECADES):
         return
     params = axis.get_tick_params(which="minor")
-    x = axis is ax.xaxis
     letter = "x" if x else "y"
     direction = params.get("direction", rcParams[f"{letter}tick.direction"])
     if direction not in ("in", "out"):
