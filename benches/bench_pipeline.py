@@ -135,6 +135,43 @@ def _report_cmd(path: Path, out: Path, extra: list) -> list:
     return [sys.executable, "-m", "allanite", "report", str(path), *extra, "--out", str(out)]
 
 
+#: The baseline's figures drawn one after another, CPU time of the best of ``repeats`` (run in a subprocess with
+#: the baseline's ``python/``; a checkout before report/rendering.py draws them serially in ``render_figures``).
+_FIGURES_BEFORE = """
+import json, sys, time
+import allanite
+from allanite.report.build import from_log
+log = allanite.read_log(sys.argv[1], fs=100, columns=["gyro_x", "gyro_y", "gyro_z"], unit="deg/s")
+rep = from_log(log, progress=False)
+try:
+    from allanite.report.rendering import render_pngs
+    def draw():
+        return render_pngs(rep.figure_specs(), 100, lambda s: None, processes=1)
+except ImportError:
+    def draw():
+        return rep.render_figures(progress=False)
+draw()
+best = min(
+    (lambda c0: (draw(), time.process_time() - c0)[1])(time.process_time()) for _ in range(int(sys.argv[2]))
+)
+print(json.dumps({"figures_serial_cpu_s": best}))
+"""
+
+
+def figures_before(data: Path, baseline: Path, repeats: int) -> float | None:
+    """CPU seconds of the baseline's figures drawn one after another (None when that run fails)."""
+    p = subprocess.run(
+        [sys.executable, "-c", _FIGURES_BEFORE, str(data), str(repeats)],
+        env=_env(baseline),
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
+    if p.returncode != 0:
+        return None
+    return json.loads(p.stdout.strip().splitlines()[-1])["figures_serial_cpu_s"]
+
+
 def row_report(data: Path, cfg: dict, baseline: Path | None, tmp: Path) -> dict:
     row: dict = {"command": "allanite report <run1> " + " ".join(REPORT_ARGS)}
     for label, pdir in (("after", REPO / "python"), ("before", baseline)):
@@ -172,6 +209,8 @@ def row_report(data: Path, cfg: dict, baseline: Path | None, tmp: Path) -> dict:
         lambda: render_pngs(specs, 100, lambda s: None, processes=1), cfg["repeats"]
     )
     best_two, _, two = _common.timed(lambda: render_pngs(specs, 100, lambda s: None, processes=2), cfg["repeats"])
+    if baseline is not None:
+        row["figures_before_serial_cpu_s"] = figures_before(data, baseline, cfg["repeats"])
     row.update(
         read_s=best_read,
         engine_s=best_engine,
@@ -474,6 +513,12 @@ def write_md(res: dict, path: Path) -> None:
         f"{rep['figures_two_processes_s']:.2f} s | {rep['figures_serial_s'] / rep['figures_two_processes_s']:.2f}× | "
         f"PNG bytes identical: {rep['figures_identical']} |"
     )
+    fb = rep.get("figures_before_serial_cpu_s")
+    if fb and fcpu:
+        L.append(
+            f"| its {rep['figures']} figures drawn one after another (CPU) | baseline {fb:.2f} s | {fcpu:.2f} s "
+            f"(fewer artists: report/_lean.py) | {fb / fcpu:.2f}× | the same report, this run |"
+        )
     f = r["fit_adis"]
     L.append(
         f"| {f['call']} | per-window {f['per_window_ref_total_s']:.2f} s ({f['per_window_ref_us']:.0f} µs/window) | "
@@ -511,7 +556,9 @@ def write_md(res: dict, path: Path) -> None:
         L.append(
             f"| ADIS report `--refine` (fresh process) | without: {rf['plain']['wall_s']:.2f} s (CPU "
             f"{rf['plain']['cpu_s']:.2f} s) | {rf['refine']['wall_s']:.2f} s (CPU {rf['refine']['cpu_s']:.2f} s) | "
-            f"beyond the refine calls: {rf['beyond_refine_wall_s']:.2f} s (CPU {rf['beyond_refine_cpu_s']:.2f} s) | "
+            f"beyond the refine calls: {rf['beyond_refine_wall_s']:.2f} s (CPU {rf['beyond_refine_cpu_s']:.2f} s); "
+            f"beyond them and the plain report: {rf['beyond_refine_wall_s'] - rf['plain']['wall_s']:.2f} s (CPU "
+            f"{rf['beyond_refine_cpu_s'] - rf['plain']['cpu_s']:.2f} s) | "
             f"the refine calls alone {rf['refine_calls_wall_s']:.2f} s (CPU {rf['refine_calls_cpu_s']:.2f} s) |"
         )
     sc = r.get("scale")

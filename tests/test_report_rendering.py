@@ -54,3 +54,73 @@ def test_a_report_drawn_in_a_worker_thread_forks_nothing():
     t.start()
     t.join()
     assert seen == [1]
+
+
+def test_idle_cores_reads_the_run_queue_less_this_process(monkeypatch):
+    import io
+
+    from allanite.report import rendering
+
+    queue = iter(["0.9 0.5 0.4 3/200 1\n", "0.9 0.5 0.4 1/200 1\n", "0.9 0.5 0.4 3/200 1\n"] * 3)
+    monkeypatch.setattr(rendering, "open", lambda *a, **k: io.StringIO(next(queue)), raising=False)
+    monkeypatch.setattr(rendering, "RUN_QUEUE_PAUSE", 0.0)
+    monkeypatch.setattr(rendering, "RUN_QUEUE_SAMPLES", 3)
+    # median of 3, 1, 3 runnable tasks = 3, one of them this process: 2 others on 4 cores leave 2 idle
+    assert rendering.idle_cores(4) == 2
+
+
+def test_idle_cores_without_the_run_queue_uses_the_load_average(monkeypatch):
+    from allanite.report import rendering
+
+    def unreadable(*args, **kwargs):
+        raise OSError("no /proc")
+
+    monkeypatch.setattr(rendering, "open", unreadable, raising=False)
+    monkeypatch.setattr(rendering.os, "getloadavg", lambda: (1.5, 1.0, 1.0))
+    assert rendering.idle_cores(2) == 0.5
+
+
+def test_the_child_gets_half_of_the_drawing_by_area():
+    from allanite.report.rendering import child_share
+
+    def sized(k, w, h):
+        return (f"f{k}.png", "", "", (w, h), None)
+
+    # one large figure (area 8) and four small ones (area 2 each): the parent draws the large one, the child the rest
+    specs = [sized(0, 2, 1), sized(1, 4, 2), sized(2, 2, 1), sized(3, 2, 1), sized(4, 2, 1)]
+    assert child_share(specs) == [0, 2, 3, 4]
+    # equal figures alternate, the parent first
+    assert child_share([sized(k, 2, 1) for k in range(5)]) == [1, 3]
+
+
+def test_lean_figure_draws_the_minor_ticks_where_matplotlib_puts_them():
+    import io
+
+    import numpy as np
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import NullLocator
+
+    from allanite.report._lean import lean_figure
+
+    fig = Figure(figsize=(12, 4))
+    wide, narrow = fig.subplots(1, 2)
+    wide.loglog([1e-2, 1e3], [1e-3, 1.0])  # five decades on x, three on y
+    wide.grid(True, which="both", alpha=0.3)
+    wide.set_title("wide")
+    narrow.semilogy([0, 1], [2.0, 5.0])  # less than a decade: matplotlib labels its minor ticks, left as it is
+    lo, hi = wide.get_xlim()
+    expected = wide.xaxis.get_minorticklocs()
+    expected = expected[(expected >= lo) & (expected <= hi)]
+    lean_figure(fig)
+    assert isinstance(wide.xaxis.get_minor_locator(), NullLocator)
+    assert not isinstance(narrow.yaxis.get_minor_locator(), NullLocator)
+    marks = [a for a in wide.lines if a.get_marker() == 3]  # TICKDOWN: the x axis' marks, outward
+    assert len(marks) == 1 and np.allclose(marks[0].get_xdata(), expected)
+    grids = list(wide.collections)
+    assert len(grids) == 2  # minor grid lines of x and y
+    assert sorted(len(g.get_segments()) for g in grids)[-1] == expected.size
+    assert wide.xaxis.get_major_formatter()(1e-2) == "10⁻²"  # plain text, no mathtext
+    assert wide.title.get_position()[1] == 1.0
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    assert buf.getvalue().startswith(b"\x89PNG")

@@ -378,10 +378,11 @@ def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None
                 ms=4,
                 label="not resolved (upper bound)",
             )
-            ax.legend(fontsize="x-small", loc="upper left")
-        if reference is not None and name in reference.coefficients:
+        whole = reference is not None and name in reference.coefficients
+        if whole:
             ax.axhline(reference.coefficients[name].value * scale, color="k", ls=":", lw=1, label="whole record")
-            ax.legend(fontsize="x-small", loc="upper right")
+        if whole or not resolved.all():  # one legend per panel (a second call would replace the first)
+            ax.legend(fontsize="x-small", loc="upper right" if whole else "upper left")
         finite_hi = series.ci_high[name][np.isfinite(series.ci_high[name])]
         vmax = float(np.max(series.values[name]))
         top = float(finite_hi.max()) if finite_hi.size else vmax

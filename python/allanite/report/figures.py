@@ -177,9 +177,10 @@ def _refinement_specs(rep) -> list:
                 fig.axes[0].set_ylabel(f"Allan deviation ({label})")
             found = ", ".join(st.effect for st in r.steps) or NOTHING_ADDED
             fig.suptitle(f"{name}: model refinement — {found}", fontsize="medium")
-            # room for the title above the panels ``plot`` laid out (a second tight_layout would lay out
-            # every text again)
-            fig.subplots_adjust(top=min(fig.subplotpars.top, 1 - 0.45 / fig.get_figheight()))
+            # fixed margins, room for the title above the panels: the report's figures do no tight layout
+            # (report/rendering.py), which would measure every text of the figure before drawing it
+            h = fig.get_figheight()
+            fig.subplots_adjust(left=0.075, right=0.985, bottom=0.5 / h, top=1 - 0.45 / h, wspace=0.2)
 
         specs.append(
             (

@@ -2,12 +2,12 @@
 
 Drawing and rasterising a figure is matplotlib's Python (ticks, text layout) under one interpreter lock; the
 report's 14 figures of a three-axis log are most of its wall time. Where ``os.fork`` exists, at least two cores
-are available, one of them idle (the load average) and the report is drawn from the main thread, a forked child
-draws every other figure (``fork``: the figures' drawing closures need no pickling, the child holds the report
-already) and hands its PNGs back through a pipe; the parent draws the rest meanwhile. The PNGs are the same
-bytes as drawn one after another. A child that fails or is killed leaves its figures to the parent, which then
-draws them itself (so an error in a figure is raised here, with its traceback); Ctrl-C ends the child with the
-parent.
+are available, one of them idle now (the run queue) and the report is drawn from the main thread, a forked child
+draws about half of the figures by size (``fork``: the figures' drawing closures need no pickling, the child holds
+the report already) and hands its PNGs back through a pipe; the parent draws the rest meanwhile. The PNGs are the
+same bytes as drawn one after another. A child that fails or is killed leaves its figures to the parent, which
+then draws them itself (so an error in a figure is raised here, with its traceback); Ctrl-C ends the child with
+the parent.
 """
 
 from __future__ import annotations
@@ -18,9 +18,13 @@ import pickle
 import signal
 import sys
 import threading
+import time
 import warnings
+from functools import cache
 
-__all__ = ["render_pngs", "figure_processes"]
+from ._lean import lean_figure
+
+__all__ = ["render_pngs", "figure_processes", "idle_cores", "child_share"]
 
 #: Fewer figures than this are drawn in this process (forking costs ~10 ms and a child's first figure pays
 #: matplotlib's font set-up again).
@@ -32,28 +36,67 @@ PNG_COMPRESSION = 1
 
 
 def figure_processes() -> int:
-    """Processes that draw the figures: 2 where ``fork`` exists, two cores are available, the last minute's
-    load average leaves one of them idle and this is the main thread, else 1 (a report built in a worker
-    thread — Dask's ``allanite batch`` — gets its parallelism from its workers, and a fork beside running
-    threads could copy a lock one of them holds)."""
+    """Processes that draw the figures: 2 where ``fork`` exists, two cores are available, one of them is idle
+    now (:func:`idle_cores`) and this is the main thread, else 1 (a report built in a worker thread — Dask's
+    ``allanite batch`` — gets its parallelism from its workers, and a fork beside running threads could copy
+    a lock one of them holds)."""
     if not hasattr(os, "fork") or sys.platform != "linux" or threading.current_thread() is not threading.main_thread():
         return 1
     try:
         cores = len(os.sched_getaffinity(0))
     except (AttributeError, OSError):
         cores = os.cpu_count() or 1
-    # a second process pays off only on a core left idle: on a machine busy with other work it adds the
-    # child's share (~15 % more CPU in all) and gains no core (measured: benches/results/pipeline.md)
-    return 2 if cores >= 2 and os.getloadavg()[0] <= cores - 1 else 1
+    # a second process pays off only on an idle core: on a machine busy with other work it adds the child's
+    # share (~15 % more CPU in all) and gains no core (measured: benches/results/pipeline.md)
+    return 2 if cores >= 2 and idle_cores(cores) >= 1 else 1
+
+
+#: Samples of the run queue :func:`idle_cores` takes, and the pause between them (s).
+RUN_QUEUE_SAMPLES = 7
+RUN_QUEUE_PAUSE = 0.002
+
+
+def idle_cores(cores: int) -> float:
+    """Cores no other task uses now: ``cores`` less the runnable tasks besides this one (the median of a few
+    samples of ``/proc/loadavg``'s run queue, over ~15 ms); where that cannot be read, ``cores`` less the last
+    minute's load average. The load average alone misjudges a report that has just computed on every core
+    itself (``--refine``): its own past work would keep the figures on one process."""
+    counts = []
+    try:
+        for i in range(RUN_QUEUE_SAMPLES):
+            if i:
+                time.sleep(RUN_QUEUE_PAUSE)
+            with open("/proc/loadavg", encoding="ascii") as f:
+                counts.append(int(f.read().split()[3].split("/")[0]))
+    except (OSError, ValueError, IndexError):
+        return cores - os.getloadavg()[0]
+    counts.sort()
+    return cores - (counts[len(counts) // 2] - 1)  # the run queue holds this process's thread too
+
+
+@cache
+def _report_figure():
+    """The Figure class of the report: a ``tight_layout`` call of a drawing function does nothing.
+
+    The report lays out its figures with fixed margins (``subplots_adjust``, in the drawing functions); a
+    tight layout measures every text of the figure once more before it is drawn — most of the time of
+    :meth:`allanite.Refinement.plot`'s figure, whose margins the report sets itself."""
+    from matplotlib.figure import Figure  # matplotlib only when figures are drawn
+
+    class ReportFigure(Figure):
+        def tight_layout(self, *, pad=1.08, h_pad=None, w_pad=None, rect=None):
+            """Nothing: the report's figures have fixed margins."""
+
+    return ReportFigure
 
 
 def png(spec, dpi: int) -> bytes:
-    """One figure of :func:`allanite.report.figures.figure_specs` drawn and encoded as PNG."""
-    from matplotlib.figure import Figure  # matplotlib only when figures are drawn
-
+    """One figure of :func:`allanite.report.figures.figure_specs` drawn and encoded as PNG (with the fewer
+    artists of :func:`allanite.report._lean.lean_figure`)."""
     _name, _title, _caption, size, draw = spec
-    fig = Figure(figsize=size, dpi=dpi)
+    fig = _report_figure()(figsize=size, dpi=dpi)
     draw(fig)
+    lean_figure(fig)
     buf = io.BytesIO()
     # zlib level 1: a third of the drawing's CPU time less than the default 6, for PNGs ~10 % larger
     fig.savefig(buf, format="png", dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESSION})
@@ -65,7 +108,7 @@ def render_pngs(specs: list, dpi: int, step, processes: int | None = None) -> di
     ``processes``: 1 draws them here one after another; None chooses (:func:`figure_processes`)."""
     processes = figure_processes() if processes is None else processes
     pngs: list[bytes | None] = [None] * len(specs)
-    theirs = list(range(1, len(specs), 2)) if processes > 1 and len(specs) >= MIN_FIGURES_TO_SPLIT else []
+    theirs = child_share(specs) if processes > 1 and len(specs) >= MIN_FIGURES_TO_SPLIT else []
     child = _fork_child(specs, theirs, dpi) if theirs else None
     try:
         for i, spec in enumerate(specs):
@@ -80,6 +123,21 @@ def render_pngs(specs: list, dpi: int, step, processes: int | None = None) -> di
         step(f"figure {specs[i][0]}")
         pngs[i] = got[j] if got is not None else png(specs[i], dpi)
     return {spec[0]: data for spec, data in zip(specs, pngs)}
+
+
+def child_share(specs: list) -> list:
+    """Indices of the figures the child draws: the figures, largest first, each to the process with less
+    drawing so far — a figure's area (inches²) standing for its cost (panels, ticks, pixels: the ADIS report's
+    five-panel coefficient figures cost about three single-panel ones). Equal figures alternate, the parent
+    first; the child's indices are returned in the specs' order."""
+    load = [0.0, 0.0]  # parent, child
+    theirs = []
+    for i in sorted(range(len(specs)), key=lambda i: -specs[i][3][0] * specs[i][3][1]):
+        who = int(load[1] < load[0])
+        load[who] += specs[i][3][0] * specs[i][3][1]
+        if who:
+            theirs.append(i)
+    return sorted(theirs)
 
 
 def _fork_child(specs: list, indices: list, dpi: int):
