@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import signal
+from scipy.stats import f as f_dist
 
 import allanite
 from allanite.model.effects import EFFECTS
@@ -428,9 +429,40 @@ def _param_error(got, true) -> float | None:
     return float(got / true - 1)
 
 
+#: A channel regression's optional terms (:data:`allanite.model.channels.SUBTERMS`): each is demanded only where
+#: the record carries it at its own test's level (:func:`_optional_term_carried`).
+OPTIONAL_TERMS = ("quadratic", "rate_coefficient", "lag_s")
+
+
+def _optional_term_carried(steps, key: str) -> bool:
+    """Whether the record carries a channel's optional term ``key`` at its test's level: its nested test's
+    statistic beyond the F(1, ν) quantile at its α — for the lag, the plain quantile, without the penalty of
+    the search over the lag grid (as if the lag were known). The issue keeps such a term "only by a nested test
+    at its own share of ``level``"; where even the known lag's test would turn it down the record cannot show
+    it, and demanding it would demand a false-alarm rate above the share (the 300 s lag case: statistic 14.6,
+    F(1, 15.3) quantile 16.5 at α = 0.001, p = 0.0017 — the lag found at 296 s but not kept)."""
+    for step in steps:
+        t = step.evidence.get("terms", {}).get(key)
+        if t is None:
+            continue
+        if t.get("kept"):
+            return True
+        if float(f_dist.sf(max(float(t["statistic"]), 0.0), 1, float(t["dof"]))) < float(t["alpha"]):
+            return True
+    return False
+
+
 def judge(r, case: Case) -> dict:
     """What the default call got right on ``case``: per injected effect named / parameters within tolerance,
-    and for the whole chain: errors falling in sample and held out, nothing left unexplained."""
+    and for the whole chain: errors falling in sample and held out, nothing left unexplained.
+
+    A channel's optional term (a lag, a d(ch)/dt term) is judged only where the record carries it at its
+    test's level (:func:`_optional_term_carried`; else its error reads "not carried"). The in-sample error
+    "falls" when the RMS ADEV error falls, or, where the starting model already fits the curve within its
+    estimates' scatter (χ²/dof ≤ 1), when χ²/dof does not rise: an effect the five terms absorb (a warm-up
+    into R, a temperature into B, K and R) leaves nothing on the curve to fall, and removing it changes the
+    RMS error on the informative τ by the noise of the refit alone — the injected components removed exactly
+    (the truth) score 1.41 → 1.78 % on the 1500 s warm-up and 0.70 → 0.91 % on the 300 s lag."""
     out: dict = {"named": True, "params": True, "param_errors": {}}
     for inj in case.injected:
         steps = [s for s in r.steps if s.effect == inj.effect]
@@ -439,10 +471,14 @@ def judge(r, case: Case) -> dict:
             continue
         params = _step_params(steps)
         for k, v in inj.truth.items():
-            tol = FREQ_TOL if k in inj.frequencies else PARAM_TOL
-            ok = _close(params.get(k), v, tol)
-            out["params"] &= ok
             got = params.get(k)
+            if inj.effect == "regression" and k in OPTIONAL_TERMS and got is None:
+                if not _optional_term_carried(steps, k):
+                    out["param_errors"][f"{inj.effect}.{k}"] = "not carried"
+                    continue
+            tol = FREQ_TOL if k in inj.frequencies else PARAM_TOL
+            ok = _close(got, v, tol)
+            out["params"] &= ok
             out["param_errors"][f"{inj.effect}.{k}"] = _param_error(got, v)
     first, last = (r.steps[0], r.steps[-1]) if r.steps else (None, None)
     if first is not None:
@@ -450,7 +486,8 @@ def judge(r, case: Case) -> dict:
         out["chi2_dof"] = (b.get("chi2_dof"), a.get("chi2_dof"))
         out["rms_adev_pct"] = (b.get("rms_adev_pct"), a.get("rms_adev_pct"))
         out["heldout_rms_adev_pct"] = (b.get("heldout_rms_adev_pct"), a.get("heldout_rms_adev_pct"))
-        out["falling"] = bool(a["rms_adev_pct"] < b["rms_adev_pct"])
+        within = b["chi2_dof"] <= 1.0 and a["chi2_dof"] <= b["chi2_dof"]
+        out["falling"] = bool(a["rms_adev_pct"] < b["rms_adev_pct"] or within)
         hb, ha = out["heldout_rms_adev_pct"]
         out["heldout_falling"] = hb is None or ha is None or ha < hb
     else:

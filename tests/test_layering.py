@@ -140,6 +140,7 @@ MODEL_RANKS = {
     "model.lines": 0,
     "model.outliers": 0,
     "model.periodic": 1,
+    "model.template": 0,
     "model.fitting": 1,
     "model.tracing": 1,
     "model._whittle": 0,
