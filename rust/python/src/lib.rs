@@ -20,7 +20,7 @@ use allanite_core::{
 };
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2,
+    Element, IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2,
     PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
@@ -45,6 +45,16 @@ fn allanite_error_of(py: Python<'_>, class_name: &str, msg: String) -> PyErr {
 /// Raises `allanite.errors.AllaniteError(msg)`; falls back to ValueError if the package is absent.
 fn allanite_error(py: Python<'_>, msg: String) -> PyErr {
     allanite_error_of(py, "AllaniteError", msg)
+}
+
+/// `allanite.errors.ParameterError(msg)`: a bad argument.
+fn parameter_error(py: Python<'_>, msg: String) -> PyErr {
+    allanite_error_of(py, "ParameterError", msg)
+}
+
+/// `allanite.errors.InputError(msg)`: bad samples.
+fn input_error(py: Python<'_>, msg: String) -> PyErr {
+    allanite_error_of(py, "InputError", msg)
 }
 
 /// Each core error as its `allanite.errors` class, message unchanged.
@@ -82,13 +92,40 @@ fn run_interruptible<R: Send>(
     outcome.map_err(|e| core_error(py, e))
 }
 
+/// `values` (row-major) as a (rows, cols) numpy array.
+fn to_2d<'py, T: Element>(
+    py: Python<'py>,
+    rows: usize,
+    cols: usize,
+    values: Vec<T>,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let arr = Array2::from_shape_vec((rows, cols), values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// `values` (row-major) as a numpy array of `shape`.
+fn to_3d<'py, T: Element>(
+    py: Python<'py>,
+    shape: (usize, usize, usize),
+    values: Vec<T>,
+) -> PyResult<Bound<'py, PyArray3<T>>> {
+    let arr = Array3::from_shape_vec(shape, values)
+        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// Term counts as int64, numpy's index type.
+fn as_i64(counts: Vec<u64>) -> Vec<i64> {
+    counts.into_iter().map(|c| c as i64).collect()
+}
+
 fn parse_estimator(py: Python<'_>, s: &str) -> PyResult<Estimator> {
     match s {
         "oavar" => Ok(Estimator::Overlapping),
         "avar" => Ok(Estimator::Classic),
-        other => Err(allanite_error_of(
+        other => Err(parameter_error(
             py,
-            "ParameterError",
             format!("unknown estimator {other:?}; allowed: 'oavar', 'avar'"),
         )),
     }
@@ -98,11 +135,42 @@ fn parse_method(py: Python<'_>, s: &str) -> PyResult<Method> {
     match s {
         "fast" => Ok(Method::Fast),
         "naive" => Ok(Method::Naive),
-        other => Err(allanite_error_of(
+        other => Err(parameter_error(
             py,
-            "ParameterError",
             format!("unknown method {other:?}; allowed: 'fast', 'naive'"),
         )),
+    }
+}
+
+/// The arguments every dynamic Allan call shares, checked in this order: the estimator, the method,
+/// then every axis contiguous.
+fn dynamic_args<'a>(
+    py: Python<'_>,
+    columns: &'a [PyReadonlyArray1<'_, f64>],
+    estimator: &str,
+    method: &str,
+) -> PyResult<(Vec<&'a [f64]>, Estimator, Method)> {
+    let estimator = parse_estimator(py, estimator)?;
+    let method = parse_method(py, method)?;
+    Ok((contiguous(py, columns)?, estimator, method))
+}
+
+/// The core's request of a dynamic call.
+fn request<'a>(
+    columns: &'a [&'a [f64]],
+    window: usize,
+    hop: usize,
+    ms: &'a [usize],
+    estimator: Estimator,
+    method: Method,
+) -> Request<'a> {
+    Request {
+        columns,
+        window,
+        hop,
+        ms,
+        estimator,
+        method,
     }
 }
 
@@ -123,22 +191,11 @@ fn davar<'py>(
     method: &str,
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let estimator = parse_estimator(py, estimator)?;
-    let method = parse_method(py, method)?;
-    let slices = contiguous(py, &columns)?;
-    let req = Request {
-        columns: &slices,
-        window,
-        hop,
-        ms: &ms,
-        estimator,
-        method,
-    };
+    let (slices, estimator, method) = dynamic_args(py, &columns, estimator, method)?;
+    let req = request(&slices, window, hop, &ms, estimator, method);
     let (values, n_win) =
         run_interruptible(py, workers, |cancel| dynamic_avar_cancellable(&req, cancel))?;
-    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok(arr.into_pyarray(py))
+    to_3d(py, (slices.len(), ms.len(), n_win), values)
 }
 
 /// [`davar`] and the range of every (axis, m) row of the result: (values, ranges), ranges of shape
@@ -158,29 +215,19 @@ fn davar_ranged<'py>(
     method: &str,
     workers: usize,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
-    let estimator = parse_estimator(py, estimator)?;
-    let method = parse_method(py, method)?;
-    let slices = contiguous(py, &columns)?;
-    let req = Request {
-        columns: &slices,
-        window,
-        hop,
-        ms: &ms,
-        estimator,
-        method,
-    };
+    let (slices, estimator, method) = dynamic_args(py, &columns, estimator, method)?;
+    let req = request(&slices, window, hop, &ms, estimator, method);
     let (values, n_win, ranges) = run_interruptible(py, workers, |cancel| {
         dynamic_avar_ranged_cancellable(&req, cancel)
     })?;
-    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     let flat: Vec<f64> = ranges
         .iter()
         .flat_map(|r| [r.max, r.min, if r.non_finite { 1.0 } else { 0.0 }])
         .collect();
-    let rng = Array3::from_shape_vec((slices.len(), ms.len(), 3), flat)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok((arr.into_pyarray(py), rng.into_pyarray(py)))
+    Ok((
+        to_3d(py, (slices.len(), ms.len(), n_win), values)?,
+        to_3d(py, (slices.len(), ms.len(), 3), flat)?,
+    ))
 }
 
 /// [`davar`] of the windows `first_window ..` of a record of `n_windows` windows, from a part of it
@@ -204,23 +251,12 @@ fn davar_part<'py>(
     first_window: usize,
     n_windows: usize,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let estimator = parse_estimator(py, estimator)?;
-    let method = parse_method(py, method)?;
-    let slices = contiguous(py, &columns)?;
-    let req = Request {
-        columns: &slices,
-        window,
-        hop,
-        ms: &ms,
-        estimator,
-        method,
-    };
+    let (slices, estimator, method) = dynamic_args(py, &columns, estimator, method)?;
+    let req = request(&slices, window, hop, &ms, estimator, method);
     let (values, n_win) = run_interruptible(py, workers, |cancel| {
         dynamic_avar_part_cancellable(&req, &mus, first_window, n_windows, cancel)
     })?;
-    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok(arr.into_pyarray(py))
+    to_3d(py, (slices.len(), ms.len(), n_win), values)
 }
 
 /// Samples between the places a record of `n` samples × `n_axes` may be cut into [`davar_part`] parts
@@ -240,9 +276,8 @@ fn part_grid(
     let estimator = parse_estimator(py, estimator)?;
     let method = parse_method(py, method)?;
     allanite_core::part_grid(n, n_axes, window, hop, estimator, method).ok_or_else(|| {
-        allanite_error_of(
+        parameter_error(
             py,
-            "ParameterError",
             format!(
                 "no dynamic call of window {window} and hop {hop} on {n} samples × {n_axes} axes: \
                  2 ≤ window ≤ samples, hop ≥ 1 and at least one axis are needed"
@@ -263,9 +298,8 @@ fn compensated_sums(
 ) -> PyResult<Vec<(f64, f64)>> {
     let slices = contiguous(py, &columns)?;
     if state.len() != slices.len() {
-        return Err(allanite_error_of(
+        return Err(parameter_error(
             py,
-            "ParameterError",
             format!(
                 "{} states given for {} axes: one (sum, compensation) per axis is needed",
                 state.len(),
@@ -302,9 +336,8 @@ fn angle_term_sums<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let n = blocks.len();
     if starts.len() != n || off_w.len() != n || off_r.len() != n || n == 0 {
-        return Err(allanite_error_of(
+        return Err(parameter_error(
             py,
-            "ParameterError",
             format!(
                 "{n} blocks, {} starts, {} and {} offsets: one of each per block is needed",
                 starts.len(),
@@ -317,16 +350,14 @@ fn angle_term_sums<'py>(
     let mut chunks = Vec::with_capacity(n);
     for (j, b) in blocks.iter().enumerate() {
         let y = b.as_slice().map_err(|_| {
-            allanite_error_of(
+            input_error(
                 py,
-                "InputError",
                 format!("block {j} is not a C-contiguous float64 (samples, axes) array"),
             )
         })?;
         if b.as_array().ncols() != n_axes {
-            return Err(allanite_error_of(
+            return Err(input_error(
                 py,
-                "InputError",
                 format!(
                     "block {j} has {} axes, block 0 has {n_axes}",
                     b.as_array().ncols()
@@ -343,9 +374,7 @@ fn angle_term_sums<'py>(
     let values = run_interruptible(py, workers, |cancel| {
         angle_term_sums_cancellable(&chunks, n_axes, q_exp, &plan, classic, cancel)
     })?;
-    let arr = Array2::from_shape_vec((plan.len(), n_axes), values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok(arr.into_pyarray(py))
+    to_2d(py, plan.len(), n_axes, values)
 }
 
 /// Hann-weighted overlapping Allan variance of every window at every averaging factor, for every
@@ -364,19 +393,10 @@ fn davar_hann<'py>(
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let method = parse_method(py, method)?;
     let slices = contiguous(py, &columns)?;
-    let req = Request {
-        columns: &slices,
-        window,
-        hop,
-        ms: &ms,
-        estimator: Estimator::Overlapping,
-        method,
-    };
+    let req = request(&slices, window, hop, &ms, Estimator::Overlapping, method);
     let (values, n_win) =
         run_interruptible(py, workers, |cancel| dynamic_hann_cancellable(&req, cancel))?;
-    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok(arr.into_pyarray(py))
+    to_3d(py, (slices.len(), ms.len(), n_win), values)
 }
 
 /// The noise-model fit of every window (allanite-core `fit::fit_windows`): `avar` (windows, n_tau) at
@@ -437,9 +457,7 @@ fn fit_windows<'py>(
         allanite_core::fit::fit_windows(&problem, y, cancel)
     })?;
     let width = allanite_core::fit::record_width(n_terms);
-    let arr = Array2::from_shape_vec((n_windows, width), values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok(arr.into_pyarray(py))
+    to_2d(py, n_windows, width, values)
 }
 
 fn c_slice<'a>(
@@ -447,13 +465,8 @@ fn c_slice<'a>(
     a: &'a PyReadonlyArray2<'_, f64>,
     what: &str,
 ) -> PyResult<&'a [f64]> {
-    a.as_slice().map_err(|_| {
-        allanite_error_of(
-            py,
-            "ParameterError",
-            format!("{what} must be a C-contiguous float64 array"),
-        )
-    })
+    a.as_slice()
+        .map_err(|_| parameter_error(py, format!("{what} must be a C-contiguous float64 array")))
 }
 
 fn contiguous<'a>(
@@ -462,16 +475,17 @@ fn contiguous<'a>(
 ) -> PyResult<Vec<&'a [f64]>> {
     let mut slices: Vec<&[f64]> = Vec::with_capacity(columns.len());
     for (a, c) in columns.iter().enumerate() {
-        let s = c.as_slice().map_err(|_| {
-            allanite_error_of(
-                py,
-                "InputError",
-                format!("axis {a} is not a contiguous float64 array"),
-            )
-        })?;
+        let s = c
+            .as_slice()
+            .map_err(|_| input_error(py, format!("axis {a} is not a contiguous float64 array")))?;
         slices.push(s);
     }
     Ok(slices)
+}
+
+/// [`contiguous`] of one array (named axis 0 in the error).
+fn contiguous_one<'a>(py: Python<'_>, a: &'a PyReadonlyArray1<'_, f64>) -> PyResult<&'a [f64]> {
+    Ok(contiguous(py, std::slice::from_ref(a))?[0])
 }
 
 /// Theo1 of each whole rate record at every (even) averaging factor: shape (axes, len(ms)).
@@ -487,9 +501,7 @@ fn theo1_static<'py>(
     let values = run_interruptible(py, workers, |cancel| {
         static_theo1_cancellable(&slices, &ms, cancel)
     })?;
-    let arr = Array2::from_shape_vec((slices.len(), ms.len()), values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok(arr.into_pyarray(py))
+    to_2d(py, slices.len(), ms.len(), values)
 }
 
 /// Theo1 of every sliding window at every (even) averaging factor: shape (axes, len(ms), windows).
@@ -507,9 +519,7 @@ fn theo1_dynamic<'py>(
     let (values, n_win) = run_interruptible(py, workers, |cancel| {
         dynamic_theo1_cancellable(&slices, window, hop, &ms, cancel)
     })?;
-    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok(arr.into_pyarray(py))
+    to_3d(py, (slices.len(), ms.len(), n_win), values)
 }
 
 fn parse_kind(py: Python<'_>, s: &str, allowed: &[&str]) -> PyResult<deviations::Kind> {
@@ -531,17 +541,6 @@ fn parse_kind(py: Python<'_>, s: &str, allowed: &[&str]) -> PyResult<deviations:
             format!("unknown estimator {s:?}; allowed: {}", allowed.join(", ")),
         )),
     }
-}
-
-fn to_2d<'py>(
-    py: Python<'py>,
-    rows: usize,
-    cols: usize,
-    values: Vec<f64>,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let arr = Array2::from_shape_vec((rows, cols), values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok(arr.into_pyarray(py))
 }
 
 /// One deviation of each whole rate record at every averaging factor: shape (axes, len(ms)).
@@ -613,12 +612,9 @@ fn deviation_gaps<'py>(
     let (values, counts) = run_interruptible(py, workers, |cancel| {
         deviations::gap_deviation_cancellable(&slices, &ms, kind, classic, cancel)
     })?;
-    let counts: Vec<i64> = counts.into_iter().map(|c| c as i64).collect();
-    let c = Array2::from_shape_vec((slices.len(), ms.len()), counts)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok((
         to_2d(py, slices.len(), ms.len(), values)?,
-        c.into_pyarray(py),
+        to_2d(py, slices.len(), ms.len(), as_i64(counts))?,
     ))
 }
 
@@ -637,9 +633,7 @@ fn ohvar_dynamic<'py>(
     let (values, n_win) = run_interruptible(py, workers, |_cancel| {
         deviations::dynamic_ohvar(&slices, window, hop, &ms)
     })?;
-    let arr = Array3::from_shape_vec((slices.len(), ms.len(), n_win), values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok(arr.into_pyarray(py))
+    to_3d(py, (slices.len(), ms.len(), n_win), values)
 }
 
 /// (values, counts) of a gap-aware whole-record estimate.
@@ -667,11 +661,7 @@ fn deviation_gaps_dynamic<'py>(
         deviations::gap_dynamic(&slices, window, hop, &ms, kind, cancel)
     })?;
     let shape = (slices.len(), ms.len(), n_win);
-    let v = Array3::from_shape_vec(shape, values)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    let c = Array3::from_shape_vec(shape, counts.into_iter().map(|c| c as i64).collect())
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
-    Ok((v.into_pyarray(py), c.into_pyarray(py)))
+    Ok((to_3d(py, shape, values)?, to_3d(py, shape, as_i64(counts))?))
 }
 
 /// Gap-aware MTIE or TIE rms of phase records with the prefix counts of missing rate samples:
@@ -705,12 +695,9 @@ fn tie_gaps<'py>(
     let (values, counts) = run_interruptible(py, workers, |_cancel| {
         deviations::tie_gaps(&slices, &g, &ms, mtie)
     })?;
-    let counts: Vec<i64> = counts.into_iter().map(|c| c as i64).collect();
-    let c = Array2::from_shape_vec((slices.len(), ms.len()), counts)
-        .map_err(|e| allanite_error(py, format!("internal shape error: {e}")))?;
     Ok((
         to_2d(py, slices.len(), ms.len(), values)?,
-        c.into_pyarray(py),
+        to_2d(py, slices.len(), ms.len(), as_i64(counts))?,
     ))
 }
 
@@ -762,7 +749,7 @@ fn pvar_phase<'py>(
     ms: Vec<usize>,
     workers: usize,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<i64>>)> {
-    let x = contiguous(py, std::slice::from_ref(&phase))?[0];
+    let x = contiguous_one(py, &phase)?;
     let sums = run_interruptible(py, workers, |_c| phase_terms::pvar_sums(x, &ms))?;
     Ok(term_sums(py, sums))
 }
@@ -797,7 +784,7 @@ fn oavar_phase_gaps<'py>(
     ms: Vec<usize>,
     workers: usize,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<i64>>)> {
-    let x = contiguous(py, std::slice::from_ref(&phase))?[0];
+    let x = contiguous_one(py, &phase)?;
     let sums = run_interruptible(py, workers, |_c| phase_terms::oavar_phase_gap_sums(x, &ms))?;
     Ok(term_sums(py, sums))
 }
@@ -820,9 +807,8 @@ impl StreamingVariance {
             "ohvar" => StreamKind::Ohvar,
             "tvar" => StreamKind::Tvar,
             other => {
-                return Err(allanite_error_of(
+                return Err(parameter_error(
                     py,
-                    "ParameterError",
                     format!(
                         "unknown streaming variance {other:?}; allowed: 'oavar', 'ohvar', 'tvar'"
                     ),
@@ -840,8 +826,7 @@ impl StreamingVariance {
 
     /// Appends phase points in order (those before a non-finite one are kept).
     fn extend(&mut self, py: Python<'_>, xs: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
-        let cols = [xs];
-        let x = contiguous(py, &cols)?[0];
+        let x = contiguous_one(py, &xs)?;
         self.inner.extend(x).map_err(|e| core_error(py, e))
     }
 

@@ -1,0 +1,140 @@
+"""Shared by every format reader: the record a reader hands on, and choosing the sample and time columns."""
+
+from __future__ import annotations
+
+import numbers
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError, ParameterError
+
+#: Names shown in the message when no time column is recognised.
+KNOWN_TIME_SHOWN = ("time", "t", "timestamp", "stamp", "sec", "seconds", "header.stamp")
+TIME_NAMES = {
+    "t",
+    "time",
+    "times",
+    "timestamp",
+    "timestamps",
+    "stamp",
+    "time_s",
+    "t_s",
+    "sec",
+    "seconds",
+    "time[s]",
+    "time(s)",
+    "time_ns",
+    "timestamp_ns",
+    "time_us",
+    "time_ms",
+    "epoch",
+    "header.stamp",
+    "header_stamp",
+    "header.stamp.sec",
+    "%time",
+    "field.header.stamp",
+}
+
+
+@dataclass
+class Record:
+    """What a format reader hands to :func:`finish`."""
+
+    data: np.ndarray  # (n, k) or (n,)
+    names: list
+    time: np.ndarray | None  # float seconds (or time_unit units when time_is_seconds is False)
+    time_name: str | None
+    where: Callable[[int], str]  # sample index → "line 12" / "row 11" / "message 11"
+    time_is_seconds: bool = False
+    t_first: float = 0.0  # absolute time of sample 0 when `time` is relative (bags)
+    checked_finite: bool = False
+
+
+def check_column_spec(spec, name, single=False):
+    def ok(c):
+        return isinstance(c, str) or (isinstance(c, (numbers.Integral, np.integer)) and not isinstance(c, bool))
+
+    if ok(spec):
+        return
+    if not single and isinstance(spec, (list, tuple)) and len(spec) > 0 and all(ok(c) for c in spec):
+        return
+    what = "a column name or 0-based index" if single else "a column name or index, or a non-empty list of them"
+    raise ParameterError(f"{name} must be {what}, got {spec!r}")
+
+
+def resolve_column(spec, names, path, what="column"):
+    """Index of one column spec among `names`."""
+    n = len(names)
+    if isinstance(spec, str):
+        if spec in names:
+            return names.index(spec)
+        folded = [i for i, c in enumerate(names) if c.strip().lower() == spec.strip().lower()]
+        if len(folded) == 1:
+            return folded[0]
+        raise InputError(f"{path}: no {what} named {spec!r}; available: {', '.join(map(repr, names))}")
+    k = int(spec)
+    if not -n <= k < n:
+        raise InputError(
+            f"{path}: {what} index {k} is out of range: the file has {n} columns "
+            f"(indices 0–{n - 1}: {', '.join(names)})"
+        )
+    return k % n
+
+
+#: Passed as ``time_column`` when neither fs nor a time column was given: recognise the time column by name.
+AUTO_TIME = "<recognise by name>"
+
+
+def recognise_time(names, path) -> int:
+    """Index of the column whose name says it is time (``TIME_NAMES``), or the error that fs is needed."""
+    hits = [i for i, c in enumerate(names) if c.strip().lower() in TIME_NAMES]
+    if not hits:
+        raise ParameterError(
+            f"{path}: give the sampling rate (fs=… in Hz) or the time column (time_column=…) — neither was passed, "
+            f"and no column is named like a time column ({', '.join(sorted(KNOWN_TIME_SHOWN))}, …); "
+            f"columns: {', '.join(map(repr, names[:12]))}"
+        )
+    return hits[0]
+
+
+def select_columns(columns, time_column, names, path, default=None):
+    """(data column indices, time column index or None, squeeze to 1-D)."""
+    if time_column is AUTO_TIME:
+        t_idx: int | None = recognise_time(names, path)
+    else:
+        t_idx = None if time_column is None else resolve_column(time_column, names, path, "time column")
+    if columns is None:
+        if default is not None:
+            idx = [names.index(d) for d in default]
+        else:
+            idx = [i for i in range(len(names)) if i != t_idx]
+            if t_idx is None:
+                timeish = [names[i] for i in idx if names[i].strip().lower() in TIME_NAMES]
+                if timeish and len(idx) > 1:
+                    raise ParameterError(
+                        f"{path}: column {timeish[0]!r} looks like a time column; pass time_column="
+                        f"{timeish[0]!r} (to use it) or columns=[…] (to choose the sample columns)"
+                    )
+        if not idx:
+            raise InputError(f"{path}: no sample columns besides the time column {names[t_idx]!r}")
+        return idx, t_idx, len(idx) == 1
+    single = not isinstance(columns, (list, tuple))
+    specs = [columns] if single else list(columns)
+    idx = [resolve_column(c, names, path) for c in specs]
+    if t_idx is not None and t_idx in idx:
+        raise ParameterError(f"{path}: column {names[t_idx]!r} is both the time column and a sample column")
+    if len(set(idx)) != len(idx):
+        raise ParameterError(f"{path}: columns {specs!r} name the same column twice")
+    return idx, t_idx, single
+
+
+def first_nonfinite(block):
+    """(row, column) of the first non-finite value of a 2-D block, or None."""
+    bad = ~np.isfinite(block)
+    if not bad.any():
+        return None
+    r = int(np.argmax(bad.any(axis=1)))
+    c = int(np.argmax(bad[r]))
+    return r, c

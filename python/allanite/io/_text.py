@@ -1,0 +1,185 @@
+"""The text reader: CSV, TSV and whitespace-separated logs, optionally gzipped."""
+
+from __future__ import annotations
+
+import gzip
+import zlib
+
+import numpy as np
+
+from ..errors import InputError, ParameterError
+from ._columns import Record, first_nonfinite, select_columns
+
+
+def _is_number(s: str) -> bool:
+    """What NumPy's text parser accepts: Python's float() also takes "1_0" and non-ASCII digits."""
+    if not s.isascii() or "_" in s:
+        return False
+    try:
+        float(s)
+    except ValueError:
+        return False
+    return True
+
+
+def _split(line: str, delim):
+    fields = line.split(delim) if delim is not None else line.split()
+    return [f.strip() for f in fields]
+
+
+def _strip_comment(line: str) -> str:
+    k = line.find("#")
+    return line if k < 0 else line[:k]
+
+
+def _guess_delimiter(line: str):
+    for d in (",", "\t", ";"):
+        if d in line:
+            return d
+    return None
+
+
+def _decode(path, gz):
+    """(text, lines) of the file: gunzipped when ``gz``, UTF-8 (else Latin-1), without a byte-order mark."""
+    try:
+        with open(path, "rb") as f:
+            raw = f.read()
+        if gz:
+            raw = zlib.decompress(raw, 16 + zlib.MAX_WBITS) if raw else raw
+    except (OSError, zlib.error, EOFError, gzip.BadGzipFile) as exc:
+        raise InputError(f"{path}: cannot be read{' as gzip' if gz else ''} ({exc})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        text = raw.decode("latin-1")
+    del raw
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    return text, text.splitlines()
+
+
+def _layout(path, lines, delimiter):
+    """(first content line, first data line, delimiter, number of fields, column names) of a text log."""
+    # first content line: the header or the first data row
+    i0 = next((i for i, ln in enumerate(lines) if _strip_comment(ln).strip()), None)
+    if i0 is None:
+        what = "only comment lines" if any(ln.strip() for ln in lines) else "nothing"
+        raise InputError(f"{path}: empty file — it holds {what}, no data rows")
+    if delimiter is None:
+        delim = _guess_delimiter(_strip_comment(lines[i0]))
+    else:
+        if not isinstance(delimiter, str) or len(delimiter) != 1 and delimiter.strip() != "":
+            raise ParameterError(
+                f"delimiter must be one character (',', '\\t', ';', …) or ' ' for whitespace, got {delimiter!r}"
+            )
+        delim = None if delimiter.strip() == "" else delimiter
+    first = _split(_strip_comment(lines[i0]), delim)
+    header = None
+    # a header has no numeric field; a line mixing numbers and text is a (bad) data row
+    if not any(_is_number(f) for f in first):
+        header = [f.strip().strip('"').strip("'").strip() for f in first]
+        start = i0 + 1
+        i1 = next((i for i in range(start, len(lines)) if _strip_comment(lines[i]).strip()), None)
+        if i1 is None:
+            raise InputError(f"{path}: line {i0 + 1} is a header ({', '.join(header)}) but no data rows follow")
+        ncols = len(_split(_strip_comment(lines[i1]), delim))
+        if len(header) != ncols:
+            raise InputError(
+                f"{path}: the header on line {i0 + 1} names {len(header)} columns but line {i1 + 1} has {ncols} fields"
+            )
+    else:
+        start = i0
+        ncols = len(first)
+        # a header written as a comment (np.savetxt's "# a,b,c") right before the data
+        if i0 > 0 and lines[i0 - 1].lstrip().startswith("#"):
+            cand = [f.strip().strip('"').strip("'") for f in _split(lines[i0 - 1].lstrip()[1:], delim)]
+            if len(cand) == ncols and all(c and not _is_number(c) for c in cand):
+                header = cand
+    names = [h if h else f"col{k}" for k, h in enumerate(header)] if header else [f"col{k}" for k in range(ncols)]
+    return i0, start, delim, ncols, names
+
+
+def read_text(path, columns, time_column, delimiter, gz):
+    """The record of a text log: the header (or ``col0``, ``col1``, …), the chosen columns parsed by NumPy, and
+    on a parse error the first bad line found and named."""
+    text, lines = _decode(path, gz)
+    i0, start, delim, ncols, names = _layout(path, lines, delimiter)
+    idx, t_idx, squeeze = select_columns(columns, time_column, names, path)
+    need = sorted(set(idx + ([t_idx] if t_idx is not None else [])))
+    # parse only the needed columns when a one-character delimiter makes skipping safe
+    usecols = need if (delim is not None and len(need) < ncols) else None
+    body = lines[start:]
+
+    def where(r):
+        return f"line {_line_of_row(lines, start, r)}"
+
+    try:
+        arr = np.loadtxt(body, delimiter=delim, comments="#", usecols=usecols, ndmin=2, dtype=np.float64)
+    except (ValueError, IndexError) as exc:
+        _diagnose(path, lines, start, delim, ncols, need, names, first_line=start + 1)
+        raise InputError(f"{path}: cannot parse the numeric data ({exc})") from None
+    if arr.shape[0] == 0:
+        raise InputError(f"{path}: no data rows after the header on line {i0 + 1}")
+    if usecols is not None:
+        # loadtxt skips unused fields, so it cannot see ragged rows: compare the number of delimiters
+        # with what `rows × (columns − 1)` needs, and look closer only when they differ.
+        found = text.count(delim) - sum(ln.count(delim) for ln in lines[:start])
+        if found != arr.shape[0] * (ncols - 1):
+            _diagnose(path, lines, start, delim, ncols, [], names, first_line=start + 1)
+    elif arr.shape[1] != ncols:  # pragma: no cover - loadtxt raises on ragged rows
+        _diagnose(path, lines, start, delim, ncols, need, names, first_line=start + 1)
+    pos = {c: j for j, c in enumerate(need if usecols is not None else range(ncols))}
+    cols = [pos[c] for c in idx]
+    if len(cols) == arr.shape[1] and cols == list(range(arr.shape[1])):
+        data = arr
+    else:
+        data = np.ascontiguousarray(arr[:, cols])
+    hit = first_nonfinite(data)
+    if hit is not None:
+        r, c = hit
+        raise InputError(
+            f"{path}: {where(r)}, column {idx[c] + 1} ({names[idx[c]]!r}): non-finite value "
+            f"{data[r, c]} (NaN or inf); only finite numbers are allowed"
+        )
+    time = arr[:, pos[t_idx]].copy() if t_idx is not None else None
+    del arr
+    if squeeze:
+        data = data[:, 0].copy()
+    return Record(
+        data=data,
+        names=[names[i] for i in idx],
+        time=time,
+        time_name=names[t_idx] if t_idx is not None else None,
+        where=where,
+        checked_finite=True,
+    )
+
+
+def _line_of_row(lines, start, r):
+    """1-based line number of data row r (comments and blank lines skipped) — only on error paths."""
+    k = -1
+    for i in range(start, len(lines)):
+        if _strip_comment(lines[i]).strip():
+            k += 1
+            if k == r:
+                return i + 1
+    return len(lines)
+
+
+def _diagnose(path, lines, start, delim, ncols, need, names, first_line):
+    """Find the first bad line the slow, precise way and raise an InputError naming it."""
+    sep = "whitespace" if delim is None else repr(delim)
+    for i in range(start, len(lines)):
+        content = _strip_comment(lines[i])
+        if not content.strip():
+            continue
+        fields = _split(content, delim)
+        if len(fields) != ncols:
+            raise InputError(
+                f"{path}: line {i + 1}: ragged row — {len(fields)} fields (separated by {sep}) where line "
+                f"{first_line} and the header have {ncols}"
+            )
+        for c in need:
+            if not _is_number(fields[c]):
+                shown = fields[c] if fields[c] else "(empty)"
+                raise InputError(f"{path}: line {i + 1}, column {c + 1} ({names[c]!r}): {shown!r} is not a number")
