@@ -20,6 +20,7 @@ from scipy.stats import chi2 as chi2_dist
 from .. import fitting
 from ..effects import EFFECTS, filtered_white_avar, resonance_avar
 from ..terms import TERM_ALPHA, design_matrix
+from ._irls import chi2_at, irls
 
 __all__ = [
     "base_name",
@@ -28,6 +29,7 @@ __all__ = [
     "Solution",
     "design",
     "solve",
+    "chi2s",
     "search",
     "profile_interval",
     "PROFILE_RHO",
@@ -43,7 +45,15 @@ def base_name(key: str) -> str:
 
 
 def column(key, p, curve):
-    """Allan variance per unit amplitude² of effect ``key`` with nonlinear parameter ``p`` on ``curve``."""
+    """Allan variance per unit amplitude² of effect ``key`` with nonlinear parameter ``p`` on ``curve`` (read-only:
+    remembered by the curve, which every step's searches ask for the same grids)."""
+    got = curve.cached(("column", key, float(p)))
+    if got is None:
+        got = curve.remember(("column", key, float(p)), _column(key, p, curve))
+    return got
+
+
+def _column(key, p, curve):
     base = base_name(key)
     tau = curve.tau
     if base == "bandwidth":
@@ -70,6 +80,7 @@ class Curve:
         self.tau, self.m, self.avar = tau, m, avar
         self.fs, self.n_points, self.estimator = fs, n_points, estimator
         self._edf: dict = {}
+        self._memo: dict = {}
         self.n_eff = max(2.0, math.log2(tau[-1] / tau[0]) + 1.0)
 
     def edf(self, alpha: int) -> np.ndarray:
@@ -79,9 +90,25 @@ class Curve:
         return self._edf[alpha]
 
     def subset(self, idx):
-        """The curve at the τ indexed by ``idx``."""
-        est = self.estimator if isinstance(self.estimator, str) else tuple(np.asarray(self.estimator)[idx])
-        return Curve(self.tau[idx], self.m[idx], self.avar[idx], self.fs, self.n_points, est)
+        """The curve at the τ indexed by ``idx`` (the same object for the same ``idx``: its columns are
+        remembered)."""
+        key = ("subset", np.asarray(idx).tobytes())
+        got = self.cached(key)
+        if got is None:
+            est = self.estimator if isinstance(self.estimator, str) else tuple(np.asarray(self.estimator)[idx])
+            got = self.remember(key, Curve(self.tau[idx], self.m[idx], self.avar[idx], self.fs, self.n_points, est))
+        return got
+
+    def cached(self, key):
+        """What :meth:`remember` kept under ``key``, or None (the curve's τ and estimates never change)."""
+        return self._memo.get(key)
+
+    def remember(self, key, value):
+        """Keep ``value`` (an array is made read-only) for this curve under ``key``; returns it."""
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+        self._memo[key] = value
+        return value
 
 
 @dataclass
@@ -112,7 +139,7 @@ def design(curve, terms, effects):
     """Columns of the terms and the effects [(key, nonlinear parameter)] on ``curve``, and each column's
     noise type per τ (for the EDF)."""
     tau = curve.tau
-    a0 = design_matrix(tau, tau * curve.fs, curve.fs, terms)
+    a0 = _term_columns(curve, terms).copy()
     for key, _p in effects:
         rep = EFFECTS[base_name(key)].replaces
         if rep in terms:
@@ -122,10 +149,18 @@ def design(curve, terms, effects):
     return np.hstack(cols), alphas
 
 
-def solve(curve: Curve, terms, effects, max_iter: int = 40) -> Solution:
-    """IRLS weighted NNLS of the terms plus effects [(key, nonlinear parameter)]."""
-    a, alphas = design(curve, terms, effects)
-    nu_cols = np.column_stack(
+def _term_columns(curve, terms):
+    """The terms' columns on ``curve`` (read-only, remembered by the curve)."""
+    got = curve.cached(("terms", tuple(terms)))
+    if got is None:
+        tau = curve.tau
+        got = curve.remember(("terms", tuple(terms)), design_matrix(tau, tau * curve.fs, curve.fs, terms))
+    return got
+
+
+def _edf_columns(curve, alphas):
+    """Each column's EDF per τ under its noise type per τ (``alphas``, as :func:`design` gives them)."""
+    return np.column_stack(
         [
             np.where(
                 al == -2,
@@ -135,27 +170,31 @@ def solve(curve: Curve, terms, effects, max_iter: int = 40) -> Solution:
             for al in alphas
         ]
     )
+
+
+def solve(curve: Curve, terms, effects, max_iter: int = 40) -> Solution:
+    """IRLS weighted NNLS of the terms plus effects [(key, nonlinear parameter)] (:func:`._irls.irls`)."""
+    a, alphas = design(curve, terms, effects)
+    nu_cols = _edf_columns(curve, alphas)
     y = curve.avar
-    model = y.copy()
     nu = nu_cols[:, 1] if len(terms) > 1 else nu_cols[:, 0]
-    theta = np.zeros(a.shape[1])
     floor = 1e-12 * np.max(y)
-    for it in range(max_iter):
-        w = nu / (2.0 * np.maximum(model, floor) ** 2)
-        sw = np.sqrt(w)
-        new = fitting.nnls(a * sw[:, None], y * sw)
-        parts = a * new
-        new_model = np.maximum(parts.sum(axis=1), floor)
-        done = bool(np.all(np.abs(new - theta) <= 1e-6 * np.abs(theta)))  # np.allclose(rtol=1e-6, atol=0)
-        model = new_model if it == 0 else np.sqrt(model * new_model)
-        theta = new
-        if new.any():
-            tot = parts.sum(axis=1)
-            den = np.sum(parts**2 / nu_cols, axis=1)
-            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
-        if done:
-            break
-    return _finish(curve, a, theta, nu, floor, len(effects))
+    theta, nu_end = irls(a[None], nu_cols[None], y, nu, max_iter, floor)
+    return _finish(curve, a, theta[0], nu_end[0], floor, len(effects))
+
+
+def chi2s(curve: Curve, terms, effects, key, ps, max_iter: int = 40) -> np.ndarray:
+    """χ² of :func:`solve` with ``effects`` plus effect ``key`` at each parameter of ``ps`` — the same numbers,
+    the fits run together (:func:`._irls.irls`)."""
+    ps = [float(p) for p in np.atleast_1d(ps)]
+    designs = [design(curve, terms, effects + [(key, p)]) for p in ps]
+    a = np.stack([d[0] for d in designs])
+    nu_cols = np.stack([_edf_columns(curve, d[1]) for d in designs])
+    y = curve.avar
+    nu = nu_cols[0][:, 1] if len(terms) > 1 else nu_cols[0][:, 0]
+    floor = 1e-12 * np.max(y)
+    theta, nu_end = irls(a, nu_cols, y, nu, max_iter, floor)
+    return np.array([chi2_at(y, a[g], theta[g], nu_end[g], floor) for g in range(len(ps))])
 
 
 def _finish(curve, a, theta, nu, floor, n_effects) -> Solution:
@@ -178,13 +217,13 @@ def search(curve, terms, effects, key, grid, continuous=True):
     """Best nonlinear parameter for effect ``key`` on ``grid`` (then refined), its solution, and whether it
     sits at the edge of the grid."""
     # screen the grid with a few reweighting passes (the ranking settles early), then solve fully
-    chis = np.array([solve(curve, terms, effects + [(key, p)], max_iter=6).chi2 for p in grid])
+    chis = chi2s(curve, terms, effects, key, grid, max_iter=6)
     k = int(np.argmin(chis))
     lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
     p = float(grid[k])
     if continuous and hi > lo:
         res = minimize_scalar(
-            lambda lp: solve(curve, terms, effects + [(key, math.exp(lp))]).chi2,
+            lambda lp: float(chi2s(curve, terms, effects, key, [math.exp(lp)])[0]),
             bounds=(lo, hi),
             method="bounded",
             options={"xatol": 1e-3},
@@ -214,7 +253,7 @@ def profile_interval(curve, terms, effects, key, p, sol):
     interpolated on a log grid around the best value."""
     scale = curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / curve.tau.size
     local = p * np.exp(np.linspace(-1.5, 1.5, 41))
-    lc = np.array([solve(curve, terms, effects + [(key, q)]).chi2 for q in local])
+    lc = chi2s(curve, terms, effects, key, local)
     d = (lc - min(sol.chi2, lc.min())) * scale - 1.0
     i0 = int(np.argmin(d))
     lo_i, hi_i = i0, i0
