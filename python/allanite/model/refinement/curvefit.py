@@ -160,16 +160,22 @@ def _term_columns(curve, terms):
 
 def _edf_columns(curve, alphas):
     """Each column's EDF per τ under its noise type per τ (``alphas``, as :func:`design` gives them)."""
-    return np.column_stack(
-        [
-            np.where(
-                al == -2,
-                curve.edf(-2),
-                np.where(al == -1, curve.edf(-1), np.where(al == 2, curve.edf(2), curve.edf(0))),
-            )
-            for al in alphas
-        ]
-    )
+    return np.column_stack([_edf_column(curve, al) for al in alphas])
+
+
+def _edf_column(curve, al):
+    """EDF per τ of a column whose noise type per τ is ``al`` (remembered by the curve)."""
+    al = np.asarray(al)
+    key = ("edf", al.dtype.str, al.tobytes())
+    got = curve.cached(key)
+    if got is None:
+        nu = np.where(
+            al == -2,
+            curve.edf(-2),
+            np.where(al == -1, curve.edf(-1), np.where(al == 2, curve.edf(2), curve.edf(0))),
+        )
+        got = curve.remember(key, nu)
+    return got
 
 
 def solve(curve: Curve, terms, effects, max_iter: int = 40) -> Solution:
