@@ -123,23 +123,22 @@ def _nodes(mi: int, mj: int, big_m_i: int, big_m_j: int, long_tail: bool):
     else:
         a_lo, a_hi = s_lo, s_hi
     pts = np.array(sorted(b for b in bps if a_lo <= b <= a_hi), dtype=np.float64)
-    nodes = [pts]
-    weights = [np.ones(pts.size)]
-    for a, b in zip(pts[:-1], pts[1:]):
-        n_in = int(b - a) - 1
-        if n_in <= 0:
-            continue
-        if n_in <= _EXACT_RUN:
-            x = np.arange(a + 1, b)
-            nodes.append(x)
-            weights.append(np.ones(x.size))
-        else:
-            lo_x, hi_x = a + 0.5, b - 0.5
-            half = 0.5 * (hi_x - lo_x)
-            nodes.append(0.5 * (hi_x + lo_x) + half * _GL_X)
-            weights.append(half * _GL_W)
-    d = np.concatenate(nodes)
-    w = np.concatenate(weights)
+    # between breakpoints: every integer of a short stretch, Gauss–Legendre nodes on a long one
+    a, b = pts[:-1], pts[1:]
+    n_in = (b - a).astype(np.int64) - 1
+    exact = (n_in > 0) & (n_in <= _EXACT_RUN)
+    counts = np.where(exact, n_in, np.where(n_in > _EXACT_RUN, _GL_X.size, 0))
+    piece = np.repeat(np.arange(a.size), counts)
+    at = np.arange(piece.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    gl_at = np.minimum(at, _GL_X.size - 1)
+    lo_x, hi_x = a + 0.5, b - 0.5
+    half = 0.5 * (hi_x - lo_x)
+    mid = 0.5 * (hi_x + lo_x)
+    on_int = exact[piece]
+    x = np.where(on_int, a[piece] + 1 + at, mid[piece] + half[piece] * _GL_X[gl_at])
+    wx = np.where(on_int, 1.0, half[piece] * _GL_W[gl_at])
+    d = np.concatenate([pts, x])
+    w = np.concatenate([np.ones(pts.size), wx])
     count = np.minimum(big_m_i, big_m_j - d) - np.maximum(0.0, -d)
     return d, w * np.clip(count, 0.0, None)
 

@@ -26,6 +26,9 @@ def irls(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max
     ``nu_cols[g]`` (ν starts at ``nu0``); a design stops once no coefficient moved by more than :data:`RTOL`.
     Returns the coefficients (G × k) and the EDF per τ (G × n) each design stopped at."""
     g_n, n, k = a.shape
+    if g_n == 1:
+        theta1, nu1 = _irls_one(a[0], nu_cols[0], y, nu0, max_iter, floor)
+        return theta1[None], nu1[None]
     theta = np.zeros((g_n, k))
     model = np.tile(np.asarray(y, dtype=np.float64), (g_n, 1))
     nu = np.tile(np.asarray(nu0, dtype=np.float64), (g_n, 1))
@@ -48,6 +51,28 @@ def irls(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max
             nu[live] = np.where(moved[:, None], upd, nu_l)
         live = live[~done]
         if live.size == 0:
+            break
+    return theta, nu
+
+
+def _irls_one(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu: np.ndarray, max_iter: int, floor: float):
+    """:func:`irls` of one design (n × k): the same arithmetic in fewer array operations."""
+    y = np.asarray(y, dtype=np.float64)
+    theta = np.zeros(a.shape[1])
+    model = y.copy()
+    for it in range(max_iter):
+        sw = np.sqrt(nu / (2.0 * np.maximum(model, floor) ** 2))
+        new = nnls_rows((a * sw[:, None])[None], (y * sw)[None])[0]
+        parts = a * new
+        tot = parts.sum(axis=1)
+        new_model = np.maximum(tot, floor)
+        done = bool(np.all(np.abs(new - theta) <= RTOL * np.abs(theta)))
+        model = new_model if it == 0 else np.sqrt(model * new_model)
+        theta = new
+        if new.any():
+            den = np.sum(parts**2 / nu_cols, axis=1)
+            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
+        if done:
             break
     return theta, nu
 
