@@ -43,7 +43,7 @@ def irls(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max
         done = np.all(np.abs(new - th_l) <= RTOL * np.abs(th_l), axis=1)
         model[live] = new_model if it == 0 else np.sqrt(m_l * new_model)
         theta[live] = new
-        moved = new.any(axis=1)
+        moved = np.asarray(new.any(axis=1))
         if moved.any():
             tot = parts.sum(axis=2)
             den = np.sum(parts**2 / (nu_cols if whole else nu_cols[live]), axis=2)
