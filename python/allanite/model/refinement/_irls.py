@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._nnls import nnls_rows
+from .._nnls import nnls_rows, raw_solver
 
 __all__ = ["irls", "chi2_at"]
 
@@ -58,11 +58,19 @@ def irls(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max
 def _irls_one(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu: np.ndarray, max_iter: int, floor: float):
     """:func:`irls` of one design (n × k): the same arithmetic in fewer array operations."""
     y = np.asarray(y, dtype=np.float64)
+    if not (np.isfinite(a).all() and np.isfinite(y).all()):
+        raise ValueError("array must not contain infs or NaNs")
+    solver, maxiter = raw_solver(), 50 * a.shape[1]
     theta = np.zeros(a.shape[1])
     model = y.copy()
     for it in range(max_iter):
         sw = np.sqrt(nu / (2.0 * np.maximum(model, floor) ** 2))
-        new = nnls_rows((a * sw[:, None])[None], (y * sw)[None])[0]
+        if not np.isfinite(sw).all():
+            raise ValueError("array must not contain infs or NaNs")
+        aw = a * sw[:, None]
+        scale = np.sqrt(np.add.reduce(aw * aw, axis=0))
+        scale[scale == 0] = 1.0
+        new = solver(aw / scale, y * sw, maxiter) / scale
         parts = a * new
         tot = parts.sum(axis=1)
         new_model = np.maximum(tot, floor)
