@@ -112,6 +112,7 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--out", type=Path)
     ap.add_argument("--baseline", type=Path, help="python/ folder of the baseline checkout (with its core)")
+    ap.add_argument("--after", type=Path, default=REPO / "python", help="python/ folder to time (default: this one)")
     ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.worker:
@@ -127,7 +128,7 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for spec in specs:
             before = _run(spec, base, Path(tmp))
-            after = _run(spec, REPO / "python", Path(tmp))
+            after = _run(spec, a.after, Path(tmp))
             diff = _differences(before["row"], after["row"])
             rows.append({"record": after["row"]["record"], "before": before, "after": after, "differences": diff})
             print(f"{rows[-1]['record']}: {before['seconds']:.1f} → {after['seconds']:.1f} s, {len(diff)} differences")
@@ -136,6 +137,7 @@ def main(argv=None) -> int:
     if busy0 is not None and busy1 is not None:  # CPU time of processes other than this run's, of all CPUs' time
         others = max(0.0, (busy1 - busy0) - (_own_and_children() - own0)) / (wall * (os.cpu_count() or 1))
     _write(rows, out, base, load0, os.getloadavg(), others)
+    (out / "refine_cost.json").write_text(json.dumps({"after": str(a.after), "rows": rows}, indent=1, default=float))
     print(f"wrote {out / 'refine_cost.md'}")
     return 0
 
@@ -172,7 +174,6 @@ def _write(rows, out: Path, base: Path, load0, load1, others) -> None:
         )
     out.mkdir(parents=True, exist_ok=True)
     (out / "refine_cost.md").write_text("\n".join(lines) + "\n")
-    (out / "refine_cost.json").write_text(json.dumps(rows, indent=1, default=float))
 
 
 if __name__ == "__main__":
