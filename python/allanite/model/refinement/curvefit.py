@@ -180,27 +180,37 @@ def _edf_column(curve, al):
 
 def solve(curve: Curve, terms, effects, max_iter: int = 40) -> Solution:
     """IRLS weighted NNLS of the terms plus effects [(key, nonlinear parameter)] (:func:`._irls.irls`)."""
-    a, alphas = design(curve, terms, effects)
-    nu_cols = _edf_columns(curve, alphas)
-    y = curve.avar
-    nu = nu_cols[:, 1] if len(terms) > 1 else nu_cols[:, 0]
-    floor = 1e-12 * np.max(y)
-    theta, nu_end = irls(a[None], nu_cols[None], y, nu, max_iter, floor)
-    return _finish(curve, a, theta[0], nu_end[0], floor, len(effects))
+    a, theta, nu, floor = _fits(curve, terms, [effects], max_iter)[0]
+    return _finish(curve, a, theta, nu, floor, len(effects))
 
 
 def chi2s(curve: Curve, terms, effects, key, ps, max_iter: int = 40) -> np.ndarray:
     """χ² of :func:`solve` with ``effects`` plus effect ``key`` at each parameter of ``ps`` — the same numbers,
     the fits run together (:func:`._irls.irls`)."""
-    ps = [float(p) for p in np.atleast_1d(ps)]
-    designs = [design(curve, terms, effects + [(key, p)]) for p in ps]
-    a = np.stack([d[0] for d in designs])
-    nu_cols = np.stack([_edf_columns(curve, d[1]) for d in designs])
-    y = curve.avar
-    nu = nu_cols[0][:, 1] if len(terms) > 1 else nu_cols[0][:, 0]
-    floor = 1e-12 * np.max(y)
-    theta, nu_end = irls(a, nu_cols, y, nu, max_iter, floor)
-    return np.array([chi2_at(y, a[g], theta[g], nu_end[g], floor) for g in range(len(ps))])
+    fits = _fits(curve, terms, [effects + [(key, float(p))] for p in np.atleast_1d(ps)], max_iter)
+    return np.array([chi2_at(curve.avar, a, theta, nu, floor) for a, theta, nu, floor in fits])
+
+
+def _fits(curve: Curve, terms, models: list, max_iter: int) -> list:
+    """(design, coefficients, EDF per τ, floor) of the IRLS of each model (a list of effects, all of one size)
+    on ``curve``; the fits not done before on this curve run together, and are remembered (a search's best
+    parameter is solved again, a profile's centre is the best parameter)."""
+    keys = [("fit", tuple(terms), tuple((k, float(p)) for k, p in eff), max_iter) for eff in models]
+    designs = [design(curve, terms, eff) for eff in models]
+    done = [curve.cached(key) for key in keys]
+    todo = [g for g, got in enumerate(done) if got is None]
+    if todo:
+        y = curve.avar
+        a = np.stack([designs[g][0] for g in todo])
+        nu_cols = np.stack([_edf_columns(curve, designs[g][1]) for g in todo])
+        nu0 = nu_cols[0][:, 1] if len(terms) > 1 else nu_cols[0][:, 0]
+        floor = 1e-12 * np.max(y)
+        theta, nu_end = irls(a, nu_cols, y, nu0, max_iter, floor)
+        for i, g in enumerate(todo):
+            th, nu = theta[i].copy(), nu_end[i].copy()
+            th.flags.writeable = nu.flags.writeable = False
+            done[g] = curve.remember(keys[g], (th, nu, floor))
+    return [(d[0], *got) for d, got in zip(designs, done)]
 
 
 def _finish(curve, a, theta, nu, floor, n_effects) -> Solution:
@@ -228,6 +238,8 @@ def search(curve, terms, effects, key, grid, continuous=True):
     lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
     p = float(grid[k])
     if continuous and hi > lo:
+        # the bounded search's first point (golden section of the bracket) fitted with the grid's best value
+        chi2s(curve, terms, effects, key, [math.exp(lo + 0.5 * (3.0 - math.sqrt(5.0)) * (hi - lo)), grid[k]])
         res = minimize_scalar(
             lambda lp: float(chi2s(curve, terms, effects, key, [math.exp(lp)])[0]),
             bounds=(lo, hi),
