@@ -74,4 +74,7 @@ def nnls_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def nnls(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Non-negative least squares of ``a @ x ≈ b``, with the columns scaled to unit norm first."""
-    return nnls_rows(np.asarray(a)[None], np.asarray(b)[None])[0]
+    b = np.asarray(b)
+    if b.ndim == 2 and b.shape[1] == 1:  # a column, as scipy.optimize.nnls takes it
+        b = b.ravel()
+    return nnls_rows(np.asarray(a)[None], b[None])[0]
