@@ -134,6 +134,7 @@ def test_imports_run_one_way(module):
 MODEL_RANKS = {
     "model._batched": 0,
     "model._covariance": 0,
+    "model._nnls": 0,
     "model.terms": 0,
     "model.effects": 0,
     "model.linefit": 0,
@@ -149,6 +150,7 @@ MODEL_RANKS = {
     "model.timeframes": 2,
     "model.warmup": 2,
     "model.refinement.levels": 2,
+    "model.refinement._irls": 2,
     "model.refinement.words": 3,
     "model.refinement.curvefit": 3,
     "model.refinement.scoring": 4,

@@ -52,22 +52,28 @@ def _kernels(h: np.ndarray, tau0: float) -> np.ndarray:
     return out
 
 
-def _cross(d: np.ndarray, mi: int, mj: int, tau0: float) -> np.ndarray:
-    """r_ij(d) per unit squared coefficient of each kernel term: shape (4, d.size).
+def _cross(d: np.ndarray, mi, mj, tau0: float) -> np.ndarray:
+    """r_ij(d) per unit squared coefficient of each kernel term: shape (4, d.size); ``mi``, ``mj`` the pair's
+    averaging factors, integers or integer arrays like ``d`` (many pairs' lags at once, each with its own).
 
     Outside [−2m_j, 2m_i] the two second differences share no sample: the Q, N and K kernels (δ, |h|,
     |h|³) give exactly zero there — set so, rather than computed as a difference of huge numbers. The
     flicker kernel has a tail; far out (|d| ≥ 4 × the offsets' span) it is summed as its Taylor series
     Σ_k G⁽ᵏ⁾(d)·S_k/k! with S_k = Σλ_aλ_b·o_ab^k (S_k = 0 for k < 4), which keeps full precision where
     the nine-term sum of h²·ln|h| would cancel catastrophically (10⁸-sample records)."""
+    mi = np.broadcast_to(np.asarray(mi, dtype=np.int64), d.shape)
+    mj = np.broadcast_to(np.asarray(mj, dtype=np.int64), d.shape)
     lam = (1.0, -2.0, 1.0)
-    offsets = [(lam[a] * lam[b], float(b * mj - a * mi)) for a in range(3) for b in range(3)]
+    weights = [lam[a] * lam[b] for a in range(3) for b in range(3)]
+    offsets = [(b * mj - a * mi).astype(np.float64) for a in range(3) for b in range(3)]
     acc = np.zeros((4, d.size))
     far = np.abs(d) >= 4.0 * (2 * mi + 2 * mj)
     near = ~far
     dn = d[near]
-    for w, o in offsets:
-        acc[:, near] += w * _kernels(dn + o, tau0)
+    acc_near = np.zeros((4, dn.size))
+    for w, o in zip(weights, offsets):
+        acc_near += w * _kernels(dn + o[near], tau0)
+    acc[:, near] = acc_near
     outside = (d > 2 * mi) | (d < -2 * mj)
     acc[0, outside] = acc[1, outside] = acc[3, outside] = 0.0
     if far.any():
@@ -75,15 +81,25 @@ def _cross(d: np.ndarray, mi: int, mj: int, tau0: float) -> np.ndarray:
         df = d[far]
         ad = np.abs(df)
         sgn = np.sign(df)
+        # S_k per pair of averaging factors, then per lag
+        mi_f, mj_f = mi[far], mj[far]
+        span = int(mj_f.max()) + 1
+        if (int(mi_f.max()) + 1) * span < 2**62:  # one integer per pair of averaging factors
+            _u, first, back = np.unique(mi_f * span + mj_f, return_index=True, return_inverse=True)
+        else:
+            _u, first, back = np.unique(np.stack([mi_f, mj_f]), axis=1, return_index=True, return_inverse=True)
+            back = back.ravel()
+        of = [(b * mj_f[first] - a * mi_f[first]).astype(np.float64) for a in range(3) for b in range(3)]
         total = np.zeros(df.size)
         for k in range(4, 17):
-            s_k = sum(w * o**k for w, o in offsets)
-            if s_k == 0.0:
-                continue
+            s_k = weights[0] * of[0] ** k
+            for w, o in zip(weights[1:], of[1:]):
+                s_k = s_k + w * o**k
+            s_k = s_k[back]
             g_k = 2.0 * (-1.0) ** (k - 1) * math.factorial(k - 3) / ad ** (k - 2) * sgn**k
-            total += g_k * (s_k / math.factorial(k))
+            total += np.where(s_k == 0.0, 0.0, g_k * (s_k / math.factorial(k)))
         acc[2, far] = total * (tau0 * tau0 / (2.0 * math.pi))
-    return acc / (mi * mj * tau0 * tau0)
+    return acc / ((mi * mj) * tau0 * tau0)
 
 
 def _nodes(mi: int, mj: int, big_m_i: int, big_m_j: int, long_tail: bool):
@@ -107,23 +123,22 @@ def _nodes(mi: int, mj: int, big_m_i: int, big_m_j: int, long_tail: bool):
     else:
         a_lo, a_hi = s_lo, s_hi
     pts = np.array(sorted(b for b in bps if a_lo <= b <= a_hi), dtype=np.float64)
-    nodes = [pts]
-    weights = [np.ones(pts.size)]
-    for a, b in zip(pts[:-1], pts[1:]):
-        n_in = int(b - a) - 1
-        if n_in <= 0:
-            continue
-        if n_in <= _EXACT_RUN:
-            x = np.arange(a + 1, b)
-            nodes.append(x)
-            weights.append(np.ones(x.size))
-        else:
-            lo_x, hi_x = a + 0.5, b - 0.5
-            half = 0.5 * (hi_x - lo_x)
-            nodes.append(0.5 * (hi_x + lo_x) + half * _GL_X)
-            weights.append(half * _GL_W)
-    d = np.concatenate(nodes)
-    w = np.concatenate(weights)
+    # between breakpoints: every integer of a short stretch, Gauss–Legendre nodes on a long one
+    a, b = pts[:-1], pts[1:]
+    n_in = (b - a).astype(np.int64) - 1
+    exact = (n_in > 0) & (n_in <= _EXACT_RUN)
+    counts = np.where(exact, n_in, np.where(n_in > _EXACT_RUN, _GL_X.size, 0))
+    piece = np.repeat(np.arange(a.size), counts)
+    at = np.arange(piece.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    gl_at = np.minimum(at, _GL_X.size - 1)
+    lo_x, hi_x = a + 0.5, b - 0.5
+    half = 0.5 * (hi_x - lo_x)
+    mid = 0.5 * (hi_x + lo_x)
+    on_int = exact[piece]
+    x = np.where(on_int, a[piece] + 1 + at, mid[piece] + half[piece] * _GL_X[gl_at])
+    wx = np.where(on_int, 1.0, half[piece] * _GL_W[gl_at])
+    d = np.concatenate([pts, x])
+    w = np.concatenate([np.ones(pts.size), wx])
     count = np.minimum(big_m_i, big_m_j - d) - np.maximum(0.0, -d)
     return d, w * np.clip(count, 0.0, None)
 
@@ -161,10 +176,15 @@ def _blocks(m: np.ndarray, n_samples: int, fs: float, terms) -> tuple[np.ndarray
     tau = m * tau0
     s_blk = np.zeros((n_s, n_s, n_tau, n_tau))
     t_blk = np.zeros((n_s, n_tau, n_tau))
-    for i in range(n_tau):
-        for j in range(i, n_tau):
-            d, wc = _nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), has_b)
-            r = _cross(d, int(m[i]), int(m[j]), tau0)[sel]
+    for chunk in _pair_chunks(n_tau):
+        nodes = [_nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), has_b) for i, j in chunk]
+        sizes = [d.size for d, _wc in nodes]
+        ii = np.repeat([i for i, _j in chunk], sizes)
+        jj = np.repeat([j for _i, j in chunk], sizes)
+        r_all = _cross(np.concatenate([d for d, _wc in nodes]), m[ii], m[jj], tau0)[sel]
+        ends = np.cumsum(sizes)
+        for (i, j), (_d, wc), hi, size in zip(chunk, nodes, ends, sizes):
+            r = np.ascontiguousarray(r_all[:, hi - size : hi])
             norm = 1.0 / (float(big_m[i]) * float(big_m[j]))
             rw = r * wc
             s = 0.5 * norm * (rw @ r.T)
@@ -172,6 +192,13 @@ def _blocks(m: np.ndarray, n_samples: int, fs: float, terms) -> tuple[np.ndarray
             s_blk[:, :, i, j] = s_blk[:, :, j, i] = s
             t_blk[:, i, j] = t_blk[:, j, i] = t
     return s_blk, t_blk
+
+
+def _pair_chunks(n_tau: int, size: int = 256):
+    """The pairs (i ≤ j) of ``n_tau`` estimates, ``size`` at a time (their lags' kernels evaluated together)."""
+    pairs = [(i, j) for i in range(n_tau) for j in range(i, n_tau)]
+    for a in range(0, len(pairs), size):
+        yield pairs[a : a + size]
 
 
 def assemble(s_blk: np.ndarray, t_blk: np.ndarray, theta: np.ndarray, terms) -> np.ndarray:

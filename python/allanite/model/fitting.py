@@ -36,7 +36,7 @@ from ..estimators.confidence import edf_of
 from ..plot import plot_coefficient_series, plot_fit  # matplotlib only when a figure is drawn
 from ..results import AllanResult, DynamicAllanResult
 from ..units import coefficient_unit, ieee952, rate_unit
-from . import _batched, _covariance
+from . import _batched, _covariance, _nnls
 from .terms import TERM_ALPHA, TERM_NAMES, TERMS, check_terms, design_matrix
 
 __all__ = [
@@ -342,14 +342,8 @@ def edf_per_tau(alpha: np.ndarray, m: np.ndarray, n_points: int, estimator) -> n
 
 
 def nnls(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Non-negative least squares of ``a @ x ≈ b``, with the columns scaled first."""
-    # Column scaling keeps the problem well conditioned (columns span many decades in τ).
-    scale = np.linalg.norm(a, axis=0)
-    scale[scale == 0] = 1.0
-    from scipy.optimize import nnls as scipy_nnls  # scipy.optimize when a fit runs, not at import
-
-    x, _ = scipy_nnls(a / scale, b, maxiter=50 * a.shape[1])
-    return x / scale
+    """Non-negative least squares of ``a @ x ≈ b``, with the columns scaled first (:func:`._nnls.nnls`)."""
+    return _nnls.nnls(a, b)
 
 
 def _fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=50, edf_cache=None):

@@ -112,17 +112,21 @@ def drift_component(y: np.ndarray, t: np.ndarray, length: float, pieces: int = 1
 
 
 def _grid_stats(b: np.ndarray, tb: np.ndarray, length: float) -> np.ndarray:
-    """The drift statistic on the T grid only, for many records at once (columns of ``b``)."""
+    """The drift statistic on the T grid only, for many records at once (columns of ``b``): per T the exponential
+    made orthogonal to the ramp (twice, for round-off), so that RSS(T) = RSS_ramp − (eᵀr)² for every record in
+    one product."""
     nb = b.shape[0]
     base = np.column_stack([np.ones(nb), tb])
     q0 = np.linalg.qr(base)[0]
     r0 = b - q0 @ (q0.T @ b)
     rss0 = np.sum(r0 * r0, axis=0)
-    best = np.full(b.shape[1], np.inf)
-    for lt in np.linspace(math.log(length / 200), math.log(length / 2), 24):
-        q = np.linalg.qr(np.column_stack([base, np.exp(-tb / math.exp(lt))]))[0]
-        r = b - q @ (q.T @ b)
-        best = np.minimum(best, np.sum(r * r, axis=0))
+    grid = np.linspace(math.log(length / 200), math.log(length / 2), 24)
+    e = np.exp(-tb[:, None] / np.exp(grid)[None, :])
+    for _ in range(2):
+        e = e - q0 @ (q0.T @ e)
+    e = e / np.linalg.norm(e, axis=0)
+    c = e.T @ r0
+    best = np.min(rss0[None, :] - c * c, axis=0)
     return nb * np.log(rss0 / np.maximum(best, 1e-300))
 
 

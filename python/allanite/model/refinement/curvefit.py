@@ -20,6 +20,7 @@ from scipy.stats import chi2 as chi2_dist
 from .. import fitting
 from ..effects import EFFECTS, filtered_white_avar, resonance_avar
 from ..terms import TERM_ALPHA, design_matrix
+from ._irls import chi2_at, irls
 
 __all__ = [
     "base_name",
@@ -28,6 +29,7 @@ __all__ = [
     "Solution",
     "design",
     "solve",
+    "chi2s",
     "search",
     "profile_interval",
     "PROFILE_RHO",
@@ -43,7 +45,15 @@ def base_name(key: str) -> str:
 
 
 def column(key, p, curve):
-    """Allan variance per unit amplitude² of effect ``key`` with nonlinear parameter ``p`` on ``curve``."""
+    """Allan variance per unit amplitude² of effect ``key`` with nonlinear parameter ``p`` on ``curve`` (read-only:
+    remembered by the curve, which every step's searches ask for the same grids)."""
+    got = curve.cached(("column", key, float(p)))
+    if got is None:
+        got = curve.remember(("column", key, float(p)), _column(key, p, curve))
+    return got
+
+
+def _column(key, p, curve):
     base = base_name(key)
     tau = curve.tau
     if base == "bandwidth":
@@ -70,6 +80,7 @@ class Curve:
         self.tau, self.m, self.avar = tau, m, avar
         self.fs, self.n_points, self.estimator = fs, n_points, estimator
         self._edf: dict = {}
+        self._memo: dict = {}
         self.n_eff = max(2.0, math.log2(tau[-1] / tau[0]) + 1.0)
 
     def edf(self, alpha: int) -> np.ndarray:
@@ -79,9 +90,25 @@ class Curve:
         return self._edf[alpha]
 
     def subset(self, idx):
-        """The curve at the τ indexed by ``idx``."""
-        est = self.estimator if isinstance(self.estimator, str) else tuple(np.asarray(self.estimator)[idx])
-        return Curve(self.tau[idx], self.m[idx], self.avar[idx], self.fs, self.n_points, est)
+        """The curve at the τ indexed by ``idx`` (the same object for the same ``idx``: its columns are
+        remembered)."""
+        key = ("subset", np.asarray(idx).tobytes())
+        got = self.cached(key)
+        if got is None:
+            est = self.estimator if isinstance(self.estimator, str) else tuple(np.asarray(self.estimator)[idx])
+            got = self.remember(key, Curve(self.tau[idx], self.m[idx], self.avar[idx], self.fs, self.n_points, est))
+        return got
+
+    def cached(self, key):
+        """What :meth:`remember` kept under ``key``, or None (the curve's τ and estimates never change)."""
+        return self._memo.get(key)
+
+    def remember(self, key, value):
+        """Keep ``value`` (an array is made read-only) for this curve under ``key``; returns it."""
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+        self._memo[key] = value
+        return value
 
 
 @dataclass
@@ -112,7 +139,7 @@ def design(curve, terms, effects):
     """Columns of the terms and the effects [(key, nonlinear parameter)] on ``curve``, and each column's
     noise type per τ (for the EDF)."""
     tau = curve.tau
-    a0 = design_matrix(tau, tau * curve.fs, curve.fs, terms)
+    a0 = _term_columns(curve, terms).copy()
     for key, _p in effects:
         rep = EFFECTS[base_name(key)].replaces
         if rep in terms:
@@ -122,40 +149,68 @@ def design(curve, terms, effects):
     return np.hstack(cols), alphas
 
 
+def _term_columns(curve, terms):
+    """The terms' columns on ``curve`` (read-only, remembered by the curve)."""
+    got = curve.cached(("terms", tuple(terms)))
+    if got is None:
+        tau = curve.tau
+        got = curve.remember(("terms", tuple(terms)), design_matrix(tau, tau * curve.fs, curve.fs, terms))
+    return got
+
+
+def _edf_columns(curve, alphas):
+    """Each column's EDF per τ under its noise type per τ (``alphas``, as :func:`design` gives them)."""
+    return np.column_stack([_edf_column(curve, al) for al in alphas])
+
+
+def _edf_column(curve, al):
+    """EDF per τ of a column whose noise type per τ is ``al`` (remembered by the curve)."""
+    al = np.asarray(al)
+    key = ("edf", al.dtype.str, al.tobytes())
+    got = curve.cached(key)
+    if got is None:
+        nu = np.where(
+            al == -2,
+            curve.edf(-2),
+            np.where(al == -1, curve.edf(-1), np.where(al == 2, curve.edf(2), curve.edf(0))),
+        )
+        got = curve.remember(key, nu)
+    return got
+
+
 def solve(curve: Curve, terms, effects, max_iter: int = 40) -> Solution:
-    """IRLS weighted NNLS of the terms plus effects [(key, nonlinear parameter)]."""
-    a, alphas = design(curve, terms, effects)
-    nu_cols = np.column_stack(
-        [
-            np.where(
-                al == -2,
-                curve.edf(-2),
-                np.where(al == -1, curve.edf(-1), np.where(al == 2, curve.edf(2), curve.edf(0))),
-            )
-            for al in alphas
-        ]
-    )
-    y = curve.avar
-    model = y.copy()
-    nu = nu_cols[:, 1] if len(terms) > 1 else nu_cols[:, 0]
-    theta = np.zeros(a.shape[1])
-    floor = 1e-12 * np.max(y)
-    for it in range(max_iter):
-        w = nu / (2.0 * np.maximum(model, floor) ** 2)
-        sw = np.sqrt(w)
-        new = fitting.nnls(a * sw[:, None], y * sw)
-        parts = a * new
-        new_model = np.maximum(parts.sum(axis=1), floor)
-        done = bool(np.all(np.abs(new - theta) <= 1e-6 * np.abs(theta)))  # np.allclose(rtol=1e-6, atol=0)
-        model = new_model if it == 0 else np.sqrt(model * new_model)
-        theta = new
-        if new.any():
-            tot = parts.sum(axis=1)
-            den = np.sum(parts**2 / nu_cols, axis=1)
-            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
-        if done:
-            break
+    """IRLS weighted NNLS of the terms plus effects [(key, nonlinear parameter)] (:func:`._irls.irls`)."""
+    a, theta, nu, floor = _fits(curve, terms, [effects], max_iter)[0]
     return _finish(curve, a, theta, nu, floor, len(effects))
+
+
+def chi2s(curve: Curve, terms, effects, key, ps, max_iter: int = 40) -> np.ndarray:
+    """χ² of :func:`solve` with ``effects`` plus effect ``key`` at each parameter of ``ps`` — the same numbers,
+    the fits run together (:func:`._irls.irls`)."""
+    fits = _fits(curve, terms, [effects + [(key, float(p))] for p in np.atleast_1d(ps)], max_iter)
+    return np.array([chi2_at(curve.avar, a, theta, nu, floor) for a, theta, nu, floor in fits])
+
+
+def _fits(curve: Curve, terms, models: list, max_iter: int) -> list:
+    """(design, coefficients, EDF per τ, floor) of the IRLS of each model (a list of effects, all of one size)
+    on ``curve``; the fits not done before on this curve run together, and are remembered (a search's best
+    parameter is solved again, a profile's centre is the best parameter)."""
+    keys = [("fit", tuple(terms), tuple((k, float(p)) for k, p in eff), max_iter) for eff in models]
+    designs = [design(curve, terms, eff) for eff in models]
+    done = [curve.cached(key) for key in keys]
+    todo = [g for g, got in enumerate(done) if got is None]
+    if todo:
+        y = curve.avar
+        a = np.stack([designs[g][0] for g in todo])
+        nu_cols = np.stack([_edf_columns(curve, designs[g][1]) for g in todo])
+        nu0 = nu_cols[0][:, 1] if len(terms) > 1 else nu_cols[0][:, 0]
+        floor = 1e-12 * np.max(y)
+        theta, nu_end = irls(a, nu_cols, y, nu0, max_iter, floor)
+        for i, g in enumerate(todo):
+            th, nu = theta[i].copy(), nu_end[i].copy()
+            th.flags.writeable = nu.flags.writeable = False
+            done[g] = curve.remember(keys[g], (th, nu, floor))
+    return [(d[0], *got) for d, got in zip(designs, done)]
 
 
 def _finish(curve, a, theta, nu, floor, n_effects) -> Solution:
@@ -178,13 +233,15 @@ def search(curve, terms, effects, key, grid, continuous=True):
     """Best nonlinear parameter for effect ``key`` on ``grid`` (then refined), its solution, and whether it
     sits at the edge of the grid."""
     # screen the grid with a few reweighting passes (the ranking settles early), then solve fully
-    chis = np.array([solve(curve, terms, effects + [(key, p)], max_iter=6).chi2 for p in grid])
+    chis = chi2s(curve, terms, effects, key, grid, max_iter=6)
     k = int(np.argmin(chis))
     lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
     p = float(grid[k])
     if continuous and hi > lo:
+        # the bounded search's first point (golden section of the bracket) fitted with the grid's best value
+        chi2s(curve, terms, effects, key, [math.exp(lo + 0.5 * (3.0 - math.sqrt(5.0)) * (hi - lo)), grid[k]])
         res = minimize_scalar(
-            lambda lp: solve(curve, terms, effects + [(key, math.exp(lp))]).chi2,
+            lambda lp: float(chi2s(curve, terms, effects, key, [math.exp(lp)])[0]),
             bounds=(lo, hi),
             method="bounded",
             options={"xatol": 1e-3},
@@ -214,7 +271,7 @@ def profile_interval(curve, terms, effects, key, p, sol):
     interpolated on a log grid around the best value."""
     scale = curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / curve.tau.size
     local = p * np.exp(np.linspace(-1.5, 1.5, 41))
-    lc = np.array([solve(curve, terms, effects + [(key, q)]).chi2 for q in local])
+    lc = chi2s(curve, terms, effects, key, local)
     d = (lc - min(sol.chi2, lc.min())) * scale - 1.0
     i0 = int(np.argmin(d))
     lo_i, hi_i = i0, i0

@@ -74,6 +74,8 @@ class MissingContext:
     exact: bool
     channels: dict = field(default_factory=dict)
     unit: str | None = None
+    #: what the checks computed once from the final samples (the Welch PSD of :func:`_band`)
+    memo: dict = field(default_factory=dict)
 
 
 def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
@@ -122,7 +124,7 @@ def _curve(ctx: MissingContext, a: float) -> list[dict]:
             {
                 "domain": "allan",
                 "tau": (lo, hi),
-                "band_hz": None if ctx.y is None else _band(ctx.y, ctx.fs, lo, hi),
+                "band_hz": None if ctx.y is None else _band(ctx, lo, hi),
                 "chi2_dof": _chi2_dof(ctx, lo, hi),
                 "what": "the Allan curve departs from the model",
                 "statistic": float(stats[c]),
@@ -153,12 +155,16 @@ def _with_column(test: tracing.ScoreTest, col: np.ndarray) -> tracing.ScoreTest:
     return test
 
 
-def _band(y: np.ndarray, fs: float, tau_lo: float, tau_hi: float) -> tuple[float, float]:
+def _band(ctx: MissingContext, tau_lo: float, tau_hi: float) -> tuple[float, float]:
     """≈ 1/(2τ_hi) … 1/(2τ_lo), narrowed to the part of it (widened ×2) where the final samples' Welch PSD
     stands above its running median by more than its own scatter; the nominal band where nothing does."""
+    y, fs = ctx.y, ctx.fs
+    assert y is not None
     f_lo, f_hi = 0.5 / tau_hi, min(0.5 / tau_lo, 0.5 * fs)
     nper = int(min(2**14, 2 ** int(math.log2(max(y.size // 16, 256)))))
-    f, p = signal.welch(y - y.mean(), fs=fs, nperseg=nper, detrend="linear")
+    if "welch" not in ctx.memo:  # one spectrum for every region
+        ctx.memo["welch"] = signal.welch(y - y.mean(), fs=fs, nperseg=nper, detrend="linear")
+    f, p = ctx.memo["welch"]
     nseg = max(1, (y.size - nper) // (nper // 2) + 1)
     sel = (f >= f_lo / 2) & (f <= min(2 * f_hi, 0.5 * fs)) & (f > 0)
     if np.count_nonzero(sel) < 8:

@@ -1,0 +1,180 @@
+#!/usr/bin/env python3
+"""The cost of one default ``allanite.refine`` (issue 29: ≤ 5 s per 10⁶ samples), before and after, as ratios.
+
+Records: ADIS16405 run 1 gyro_z, gyro_x and acc_x (10⁶ samples at 100 Hz, from the shared data) and three
+simulated sensors of ``tests/sensors.py`` (10⁶ samples at 100 Hz with a temperature channel, line families at
+100 Hz × 10⁶, a sawtooth at 1 kHz × 10⁷). Each record is refined with the default call in a fresh process
+(imports paid by a small refine first, untimed), once with this checkout and once with the baseline — a
+``python/`` folder of an earlier checkout (``--baseline``; by default a worktree of main at
+:data:`BASELINE` made under the temporary folder, with this checkout's compiled core copied in) — the two
+alternating record by record so that they share the machine's load. Both results are compared: the effects
+found, their parameters and intervals, each step's χ²/dof and errors before and after, and what is still
+missing must be the same (the speed-ups are exact but for the drift bootstrap's statistics, within 1e-11).
+
+Usage::
+
+    python benches/bench_refine_cost.py                 # -> benches/results/refine_cost.md
+    python benches/bench_refine_cost.py --quick         # ADIS run 1 gyro_z only, to a temporary folder
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+#: main before refine's speed-ups (issue 29, refine's cost).
+BASELINE = "9165947"
+ADIS = [("adis", 1, "gyro_z"), ("adis", 1, "gyro_x"), ("adis", 1, "acc_x")]
+SENSORS = [
+    ("sensor", "temperature random walk, 100 Hz"),
+    ("sensor", "consumer IMU line families"),
+    ("sensor", "sawtooth 0.05 Hz, 1 kHz"),
+]
+
+
+def _record(spec):
+    """(samples, fs, keyword arguments of the default call, name, samples) of a record spec."""
+    import numpy as np
+
+    import _common
+    import allanite
+
+    if spec[0] == "adis":
+        _kind, run, ax = spec
+        path = _common.shared_data_dir() / "adis16405" / f"adis16405_run{run}_100Hz.csv.gz"
+        x = np.asarray(allanite.read_log(path, fs=100.0, columns=[ax]).data, dtype=np.float64).ravel()
+        return x, 100.0, {}, f"ADIS16405 run {run} {ax}"
+    sys.path.insert(0, str(REPO / "tests"))
+    import sensors
+
+    case = next(c for c in sensors.CASES if spec[1] in c.name)
+    y, fs, channels = sensors.make(case)
+    kw = {"unit": case.unit} | ({"channels": channels} if channels else {})
+    return y, fs, kw, case.name
+
+
+def worker(spec, out: Path) -> None:
+    """Refine one record with the default call (in the process's own allanite) and write its row."""
+    import numpy as np
+
+    import allanite
+    from refine_measured import _jsonable, summarize
+
+    x, fs, kw, name = _record(spec)
+    allanite.refine(np.random.default_rng(0).standard_normal(20_000), 10.0, progress=False)  # imports, untimed
+    load = os.getloadavg()[0]
+    t0 = time.perf_counter()
+    r = allanite.refine(x, fs, progress=False, **kw)
+    seconds = time.perf_counter() - t0
+    row = _jsonable(summarize(name, r)) | {"fit_chi2": float(r.fit.chi2), "unexplained_all": _jsonable(r.unexplained)}
+    out.write_text(json.dumps({"row": row, "seconds": seconds, "samples": int(x.size), "load": load}, default=float))
+
+
+def _baseline_python(ref: str) -> Path:
+    """``python/`` of ``ref`` (exported once under the temporary folder), this checkout's compiled core copied in."""
+    root = Path(tempfile.gettempdir()) / f"allanite-baseline-{ref}"
+    if not (root / "python" / "allanite").exists():
+        root.mkdir(parents=True, exist_ok=True)
+        archive = subprocess.run(["git", "-C", str(REPO), "archive", ref, "python"], check=True, capture_output=True)
+        subprocess.run(["tar", "-x", "-C", str(root)], input=archive.stdout, check=True)
+    core = next((REPO / "python" / "allanite").glob("_core*.so"))
+    if not any((root / "python" / "allanite").glob("_core*.so")):
+        shutil.copy(core, root / "python" / "allanite" / core.name)
+    return root / "python"
+
+
+def _run(spec, python_dir: Path, tmp: Path) -> dict:
+    out = tmp / f"{abs(hash((spec, str(python_dir))))}.json"
+    env = os.environ | {"PYTHONPATH": str(python_dir)}
+    subprocess.run([sys.executable, __file__, "--worker", json.dumps(spec), str(out)], check=True, env=env, cwd=HERE)
+    return json.loads(out.read_text())
+
+
+def _differences(a, b, path="") -> list[str]:
+    if isinstance(a, dict) and isinstance(b, dict):
+        return [d for k in sorted(set(a) | set(b), key=str) for d in _differences(a.get(k), b.get(k), f"{path}/{k}")]
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        return [d for i, (u, v) in enumerate(zip(a, b)) for d in _differences(u, v, f"{path}[{i}]")]
+    return [] if a == b else [f"{path}: {a!r} → {b!r}"]
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--out", type=Path)
+    ap.add_argument("--baseline", type=Path, help="python/ folder of the baseline checkout (with its core)")
+    ap.add_argument("--after", type=Path, default=REPO / "python", help="python/ folder to time (default: this one)")
+    ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
+    a = ap.parse_args(argv)
+    if a.worker:
+        worker(tuple(json.loads(a.worker[0])), Path(a.worker[1]))
+        return 0
+    import _common
+
+    out = a.out or (Path(tempfile.mkdtemp()) if a.quick else HERE / "results")
+    base = a.baseline or _baseline_python(BASELINE)
+    specs = ADIS[:1] if a.quick else ADIS + SENSORS
+    rows, load0 = [], os.getloadavg()
+    busy0, own0, wall0 = _common.OtherLoad._busy(), _own_and_children(), time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        for spec in specs:
+            before = _run(spec, base, Path(tmp))
+            after = _run(spec, a.after, Path(tmp))
+            diff = _differences(before["row"], after["row"])
+            rows.append({"record": after["row"]["record"], "before": before, "after": after, "differences": diff})
+            print(f"{rows[-1]['record']}: {before['seconds']:.1f} → {after['seconds']:.1f} s, {len(diff)} differences")
+    others = None
+    busy1, wall = _common.OtherLoad._busy(), time.perf_counter() - wall0
+    if busy0 is not None and busy1 is not None:  # CPU time of processes other than this run's, of all CPUs' time
+        others = max(0.0, (busy1 - busy0) - (_own_and_children() - own0)) / (wall * (os.cpu_count() or 1))
+    _write(rows, out, base, load0, os.getloadavg(), others)
+    (out / "refine_cost.json").write_text(json.dumps({"after": str(a.after), "rows": rows}, indent=1, default=float))
+    print(f"wrote {out / 'refine_cost.md'}")
+    return 0
+
+
+def _own_and_children() -> float:
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+def _write(rows, out: Path, base: Path, load0, load1, others) -> None:
+    import _common
+
+    m = _common.machine_info()
+    lines = [
+        "# The cost of one default `refine` (issue 29)",
+        "",
+        f"Written by `benches/bench_refine_cost.py`: {m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at "
+        f"{m['git_commit']} against the baseline `{base}`, {m['date_utc'][:16]} UTC. 1-minute load average "
+        f"{load0[0]:.1f} at the start, {load1[0]:.1f} at the end (2 cores shared with other work"
+        + (f"; other processes used {others:.0%} of the CPUs" if others is not None else "")
+        + "). Each record refined with the default call in a fresh process, before and after alternating; "
+        "the result compared field by field (effects, parameters, intervals, χ²/dof and errors of every step, "
+        "what is still missing).",
+        "",
+        "| record | samples | before (s) | after (s) | after per 10⁶ samples (s) | ratio | results |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        b, a = r["before"], r["after"]
+        same = "identical" if not r["differences"] else f"{len(r['differences'])} differ: {r['differences'][:3]}"
+        lines.append(
+            f"| {r['record']} | {a['samples']:,} | {b['seconds']:.1f} | {a['seconds']:.1f} | "
+            f"{a['seconds'] / a['samples'] * 1e6:.1f} | {b['seconds'] / a['seconds']:.2f}× | {same} |"
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "refine_cost.md").write_text("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,93 @@
+"""The reweighted NNLS of an Allan curve's model, for one design or many at once.
+
+:func:`allanite.refine` fits a curve thousands of times: per step, every grid point of every candidate's
+nonlinear parameter, its refinement and its profile interval, each fit some thirty reweighting passes. The fits
+of one grid differ in one column only; run together, the passes share their array work and only the small NNLS
+solves stay one per design. Each design's arithmetic is the one it would get alone (element by element, the
+same reductions in the same order), so the batch gives the same numbers bit for bit as fitting the designs one
+at a time — ``tests/test_refine_cost.py`` checks it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._nnls import nnls_rows, raw_solver
+
+__all__ = ["irls", "chi2_at"]
+
+#: Relative change of every coefficient below which the reweighting stops (np.allclose(rtol=1e-6, atol=0)).
+RTOL = 1e-6
+
+
+def irls(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max_iter: int, floor: float):
+    """Reweighted NNLS of the curve ``y`` (n τ) on each design ``a[g]`` (G × n × k): weights ν/(2·model²), the
+    model damped geometrically between passes, ν per τ from the columns' shares of the model and their EDF
+    ``nu_cols[g]`` (ν starts at ``nu0``); a design stops once no coefficient moved by more than :data:`RTOL`.
+    Returns the coefficients (G × k) and the EDF per τ (G × n) each design stopped at."""
+    g_n, n, k = a.shape
+    if g_n == 1:
+        theta1, nu1 = _irls_one(a[0], nu_cols[0], y, nu0, max_iter, floor)
+        return theta1[None], nu1[None]
+    theta = np.zeros((g_n, k))
+    model = np.tile(np.asarray(y, dtype=np.float64), (g_n, 1))
+    nu = np.tile(np.asarray(nu0, dtype=np.float64), (g_n, 1))
+    live = np.arange(g_n)
+    for it in range(max_iter):
+        whole = live.size == g_n
+        a_l, m_l, nu_l, th_l = (a, model, nu, theta) if whole else (a[live], model[live], nu[live], theta[live])
+        sw = np.sqrt(nu_l / (2.0 * np.maximum(m_l, floor) ** 2))
+        new = nnls_rows(a_l * sw[:, :, None], y * sw)
+        parts = a_l * new[:, None, :]
+        new_model = np.maximum(parts.sum(axis=2), floor)
+        done = np.all(np.abs(new - th_l) <= RTOL * np.abs(th_l), axis=1)
+        model[live] = new_model if it == 0 else np.sqrt(m_l * new_model)
+        theta[live] = new
+        moved = np.asarray(new.any(axis=1))
+        if moved.any():
+            tot = parts.sum(axis=2)
+            den = np.sum(parts**2 / (nu_cols if whole else nu_cols[live]), axis=2)
+            upd = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu_l)
+            nu[live] = np.where(moved[:, None], upd, nu_l)
+        live = live[~done]
+        if live.size == 0:
+            break
+    return theta, nu
+
+
+def _irls_one(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu: np.ndarray, max_iter: int, floor: float):
+    """:func:`irls` of one design (n × k): the same arithmetic in fewer array operations."""
+    y = np.asarray(y, dtype=np.float64)
+    if not (np.isfinite(a).all() and np.isfinite(y).all()):
+        raise ValueError("array must not contain infs or NaNs")
+    solver, maxiter = raw_solver(), 50 * a.shape[1]
+    theta = np.zeros(a.shape[1])
+    model = y.copy()
+    for it in range(max_iter):
+        sw = np.sqrt(nu / (2.0 * np.maximum(model, floor) ** 2))
+        if not np.isfinite(sw).all():
+            raise ValueError("array must not contain infs or NaNs")
+        aw = a * sw[:, None]
+        scale = np.sqrt(np.add.reduce(aw * aw, axis=0))
+        scale[scale == 0] = 1.0
+        new = solver(aw / scale, y * sw, maxiter) / scale
+        parts = a * new
+        tot = parts.sum(axis=1)
+        new_model = np.maximum(tot, floor)
+        done = bool(np.all(np.abs(new - theta) <= RTOL * np.abs(theta)))
+        model = new_model if it == 0 else np.sqrt(model * new_model)
+        theta = new
+        if new.any():
+            den = np.sum(parts**2 / nu_cols, axis=1)
+            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
+        if done:
+            break
+    return theta, nu
+
+
+def chi2_at(y: np.ndarray, a: np.ndarray, theta: np.ndarray, nu: np.ndarray, floor: float) -> float:
+    """χ² of the normalised residuals of the model ``a @ theta`` (floored) with EDF ``nu``, as the solution's."""
+    model = np.maximum(a @ theta, floor)
+    w = nu / (2.0 * model**2)
+    z = (y - model) * np.sqrt(w)
+    return float(np.sum(z**2))

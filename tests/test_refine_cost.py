@@ -1,0 +1,206 @@
+"""refine's speed-ups give the numbers of the plain computations they replace (issue 29, refine's cost).
+
+Each shortcut is checked against the plain path, bit for bit where it claims so: the fits of a grid run together
+against one fit at a time (the IRLS of the pre-batching code, written out here), the NNLS without scipy's wrapper
+against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of many pairs at once against one pair
+at a time, the drift bootstrap's one-product statistics against a QR per grid point, and a whole default ``refine``
+with the remembered columns against one that recomputes them. No timings here: ``benches/bench_refine_cost.py``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import nnls as scipy_nnls
+
+import allanite
+from allanite.model import _covariance, _nnls, tracing
+from allanite.model.refinement import curvefit
+from allanite.model.refinement.candidates import bandwidth_grids
+
+START = ("Q", "N", "B", "K", "R")
+
+
+@pytest.fixture(scope="module")
+def curve():
+    y = allanite.simulate(200_000, 100.0, N=2e-3, B=3e-4, K=2e-5, gauss_markov=[(4e-3, 3.0)], seed=3)
+    res = allanite.avar(y, 100.0, taus=allanite.tau_grid(y.size, 100.0, "exp", points=200, m_max=y.size // 9))
+    keep = res.avar > 0
+    return curvefit.Curve(res.tau[keep], res.m[keep].astype(float), res.avar[keep], 100.0, y.size + 1, "oavar")
+
+
+def _plain_solve(curve, terms, effects, max_iter=40):
+    """The IRLS as it was before the batch (one design, scipy's NNLS on unit-norm columns)."""
+    a, alphas = curvefit.design(curve, terms, effects)
+    nu_cols = np.column_stack(
+        [
+            np.where(
+                al == -2,
+                curve.edf(-2),
+                np.where(al == -1, curve.edf(-1), np.where(al == 2, curve.edf(2), curve.edf(0))),
+            )
+            for al in alphas
+        ]
+    )
+    y = curve.avar
+    model, theta = y.copy(), np.zeros(a.shape[1])
+    nu = nu_cols[:, 1] if len(terms) > 1 else nu_cols[:, 0]
+    floor = 1e-12 * np.max(y)
+    for it in range(max_iter):
+        sw = np.sqrt(nu / (2.0 * np.maximum(model, floor) ** 2))
+        aw = a * sw[:, None]
+        scale = np.linalg.norm(aw, axis=0)
+        scale[scale == 0] = 1.0
+        new = scipy_nnls(aw / scale, y * sw, maxiter=50 * a.shape[1])[0] / scale
+        parts = a * new
+        new_model = np.maximum(parts.sum(axis=1), floor)
+        done = bool(np.all(np.abs(new - theta) <= 1e-6 * np.abs(theta)))
+        model = new_model if it == 0 else np.sqrt(model * new_model)
+        theta = new
+        if new.any():
+            tot, den = parts.sum(axis=1), np.sum(parts**2 / nu_cols, axis=1)
+            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
+        if done:
+            break
+    model = np.maximum(a @ theta, floor)
+    z = (y - model) * np.sqrt(nu / (2.0 * model**2))
+    return theta, nu, float(np.sum(z**2))
+
+
+@pytest.mark.parametrize("effects", [[], [("sinusoid", 7.0)], [("gauss_markov", 3.0), ("bandwidth:single_pole", 20.0)]])
+@pytest.mark.parametrize("max_iter", [6, 40])
+def test_grid_fits_together_equal_one_at_a_time(curve, effects, max_iter):
+    for key, grid in [("resonance:16", np.geomspace(5.0, 40.0, 9)), ("gauss_markov", np.geomspace(0.5, 200.0, 7))]:
+        together = curvefit.chi2s(curve, START, effects, key, grid, max_iter=max_iter)
+        plain = [_plain_solve(curve, START, effects + [(key, float(p))], max_iter)[2] for p in grid]
+        np.testing.assert_array_equal(together, plain)
+    kind, grid = next(iter(bandwidth_grids(curve).items()))
+    together = curvefit.chi2s(curve, START, effects, f"bandwidth:{kind}", grid[:6], max_iter=max_iter)
+    plain = [_plain_solve(curve, START, effects + [(f"bandwidth:{kind}", float(p))], max_iter)[2] for p in grid[:6]]
+    np.testing.assert_array_equal(together, plain)
+
+
+def test_solve_equals_the_plain_irls(curve):
+    effects = [("gauss_markov", 3.0)]
+    theta, nu, chi2 = _plain_solve(curve, START, effects)
+    sol = curvefit.solve(curve, START, effects)
+    np.testing.assert_array_equal(sol.theta, theta)
+    np.testing.assert_array_equal(sol.nu, nu)
+    assert sol.chi2 == chi2
+    # a second solve on the same curve reads its columns from the curve's memory: the same numbers
+    again = curvefit.solve(curve, START, effects)
+    np.testing.assert_array_equal(again.theta, sol.theta)
+    np.testing.assert_array_equal(again.cov, sol.cov)
+
+
+def test_nnls_equals_scipy_and_keeps_its_errors():
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        a = np.abs(rng.standard_normal((60, 5))) * np.geomspace(1e-6, 1e3, 5)
+        b = rng.standard_normal(60) + 2.0
+        scale = np.linalg.norm(a, axis=0)
+        ref = scipy_nnls(a / scale, b, maxiter=250)[0] / scale
+        np.testing.assert_array_equal(_nnls.nnls(a, b), ref)
+    a[3, 2] = np.nan
+    with pytest.raises(ValueError, match="infs or NaNs"):
+        _nnls.nnls(a, b)
+
+
+def _plain_cross(d, mi, mj, tau0):
+    """The lag kernels of one pair of averaging factors, as before the pairs were evaluated together."""
+    lam = (1.0, -2.0, 1.0)
+    offsets = [(lam[a] * lam[b], float(b * mj - a * mi)) for a in range(3) for b in range(3)]
+    acc = np.zeros((4, d.size))
+    far = np.abs(d) >= 4.0 * (2 * mi + 2 * mj)
+    near = ~far
+    for w, o in offsets:
+        acc[:, near] += w * _covariance._kernels(d[near] + o, tau0)
+    outside = (d > 2 * mi) | (d < -2 * mj)
+    acc[0, outside] = acc[1, outside] = acc[3, outside] = 0.0
+    if far.any():
+        ad, sgn, total = np.abs(d[far]), np.sign(d[far]), np.zeros(int(far.sum()))
+        for k in range(4, 17):
+            s_k = sum(w * o**k for w, o in offsets)
+            if s_k == 0.0:
+                continue
+            g_k = 2.0 * (-1.0) ** (k - 1) * math.factorial(k - 3) / ad ** (k - 2) * sgn**k
+            total += g_k * (s_k / math.factorial(k))
+        acc[2, far] = total * (tau0 * tau0 / (2.0 * math.pi))
+    return acc / (mi * mj * tau0 * tau0)
+
+
+def _plain_nodes(mi, mj, big_m_i, big_m_j, long_tail):
+    """The quadrature nodes built piece by piece, as before."""
+    lo, hi = -(big_m_i - 1), big_m_j - 1
+    s_lo, s_hi = max(lo, -2 * mj), min(hi, 2 * mi)
+    bps = {s_lo, s_hi, 0, big_m_j - big_m_i} | {a * mi - b * mj for a in range(3) for b in range(3)}
+    a_lo, a_hi = s_lo, s_hi
+    if long_tail:
+        bps |= {lo, hi} | {2 * mi * 2**k for k in range(64) if 2 * mi * 2**k < hi}
+        bps |= {-2 * mj * 2**k for k in range(64) if 2 * mj * 2**k < -lo}
+        a_lo, a_hi = lo, hi
+    pts = np.array(sorted(b for b in bps if a_lo <= b <= a_hi), dtype=np.float64)
+    nodes, weights = [pts], [np.ones(pts.size)]
+    for a, b in zip(pts[:-1], pts[1:]):
+        n_in = int(b - a) - 1
+        if 0 < n_in <= _covariance._EXACT_RUN:
+            nodes.append(np.arange(a + 1, b))
+            weights.append(np.ones(n_in))
+        elif n_in > 0:
+            half = 0.5 * ((b - 0.5) - (a + 0.5))
+            nodes.append(0.5 * ((b - 0.5) + (a + 0.5)) + half * _covariance._GL_X)
+            weights.append(half * _covariance._GL_W)
+    d, w = np.concatenate(nodes), np.concatenate(weights)
+    return d, w * np.clip(np.minimum(big_m_i, big_m_j - d) - np.maximum(0.0, -d), 0.0, None)
+
+
+@pytest.mark.parametrize("n", [5_000, 100_000_000])
+@pytest.mark.parametrize("terms", [START, ("N", "K")])
+def test_covariance_blocks_equal_pair_by_pair(n, terms):
+    m = np.unique(np.geomspace(1, n // 9, 9).astype(np.int64))
+    s_blk, t_blk = _covariance._blocks(m, n, 100.0, terms)
+    stoch = [t for t in terms if t in _covariance.KERNEL_TERMS]
+    sel = [_covariance.KERNEL_TERMS.index(t) for t in stoch]
+    big_m, tau = n + 1 - 2 * m, m * 0.01
+    for i in range(m.size):
+        for j in range(i, m.size):
+            d, wc = _plain_nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), "B" in stoch)
+            d_new, wc_new = _covariance._nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), "B" in stoch)
+            np.testing.assert_array_equal(d_new, d)
+            np.testing.assert_array_equal(wc_new, wc)
+            r = _plain_cross(d, int(m[i]), int(m[j]), 0.01)[sel]
+            norm = 1.0 / (float(big_m[i]) * float(big_m[j]))
+            rw = r * wc
+            np.testing.assert_array_equal(s_blk[:, :, i, j], 0.5 * norm * (rw @ r.T))
+            np.testing.assert_array_equal(t_blk[:, i, j], norm * tau[i] * tau[j] * rw.sum(axis=1))
+
+
+def test_drift_bootstrap_statistics_equal_a_qr_per_grid_point():
+    rng = np.random.default_rng(2)
+    nb = 300
+    b = np.cumsum(rng.standard_normal((nb, 200)), axis=0) * 0.02 + rng.standard_normal((nb, 200))
+    tb = (np.arange(nb) * 1000 + 499.5) / 100.0
+    length = nb * 1000 / 100.0
+    base = np.column_stack([np.ones(nb), tb])
+    q0 = np.linalg.qr(base)[0]
+    rss0 = np.sum((b - q0 @ (q0.T @ b)) ** 2, axis=0)
+    best = np.full(b.shape[1], np.inf)
+    for lt in np.linspace(math.log(length / 200), math.log(length / 2), 24):
+        q = np.linalg.qr(np.column_stack([base, np.exp(-tb / math.exp(lt))]))[0]
+        best = np.minimum(best, np.sum((b - q @ (q.T @ b)) ** 2, axis=0))
+    np.testing.assert_allclose(tracing._grid_stats(b, tb, length), nb * np.log(rss0 / best), rtol=1e-9, atol=1e-9)
+
+
+def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
+    y = allanite.simulate(100_000, 50.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 4.0)], seed=8)
+    cached = allanite.refine(y, 50.0, progress=False)
+    monkeypatch.setattr(curvefit.Curve, "cached", lambda self, key: None)  # every column, EDF and subset afresh
+    plain = allanite.refine(y, 50.0, progress=False)
+    assert cached.found == plain.found
+    for a, b in zip(cached.steps, plain.steps):
+        assert a.params == b.params and a.intervals == b.intervals
+        assert a.before == b.before and a.after == b.after
+    assert cached.fit.chi2 == plain.fit.chi2
+    assert cached.unexplained == plain.unexplained
