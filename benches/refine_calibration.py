@@ -10,8 +10,11 @@ hundred records resolve a rate:
   the maximum GLS score over every curve candidate's columns (Gauss–Markov, bandwidth, resonance; the sinusoid
   is found in the PSD when there are samples) against its parametric bootstrap under the fitted five terms, α =
   its share of ``level`` (0.0138). A resonance is added only when this test rejects with it.
-- ``unexplained:allan`` — the same test after the last step with the sinusoids' nulls and the start terms'
-  own columns in the family (``Refinement.unexplained``, domain ``"allan"``), α = 0.0025.
+- ``unexplained:allan`` — the same test after the last step with the start terms' own columns in the family
+  (``Refinement.unexplained``, domain ``"allan"``; :func:`allanite.model.refinement.missing.allan_family`),
+  α = 0.0025; and ``allan, curve-only family`` — the same with the sinusoids' nulls, as for an AllanResult
+  without samples (read at the same α: it was the family of the samples' check too, until it flagged 22 % of
+  clean records at 5 %).
 - ``unexplained:psd`` — spectral lines left in the samples (:func:`allanite.model.lines.find_lines`), α = 0.00125.
 - ``outliers`` — the impulsive-noise test (:func:`allanite.model.outliers.outlier_test`), α = 0.0025.
 
@@ -45,7 +48,7 @@ from allanite.model.refinement.calibrated import curve_test
 from allanite.model.refinement.candidates import CURVE_CANDIDATES, families
 from allanite.model.refinement.curvefit import Curve, solve
 from allanite.model.refinement.levels import LEVEL, alpha
-from allanite.model.terms import design_matrix
+from allanite.model.refinement.missing import allan_family
 
 HERE = Path(__file__).resolve().parent
 START = ("Q", "N", "B", "K", "R")
@@ -56,6 +59,7 @@ LEVELS = (0.01, 0.05, 0.1)
 TESTS = {
     "curve": alpha("curve", LEVEL),
     "unexplained:allan": alpha("unexplained:allan", LEVEL),
+    "allan, curve-only family": alpha("unexplained:allan", LEVEL),
     "unexplained:psd": alpha("unexplained:psd", LEVEL),
     "outliers": alpha("outliers", LEVEL),
 }
@@ -71,10 +75,13 @@ def _curve_p_values(y: np.ndarray, fs: float) -> dict:
     thin = tracing.thin_indices(cur.tau)
     sub = cur.subset(thin)
     test = curve_test(cur, thin, sol, START, [], True)
-    step = families(sub, tuple(CURVE_CANDIDATES), True)
-    final = np.column_stack([families(sub, tuple(CURVE_CANDIDATES), False), design_matrix(sub.tau, sub.m, fs, START)])
+    fams = {
+        "curve": families(sub, tuple(CURVE_CANDIDATES), True),
+        "unexplained:allan": allan_family(sub, START, True),
+        "allan, curve-only family": allan_family(sub, START, False),
+    }
     out = {}
-    for name, fam in (("curve", step), ("unexplained:allan", final)):
+    for name, fam in fams.items():
         s = test.max_statistic(sub.avar, fam)
         draws = test.null_maxima(fam, N_BOOT, seed=7919)
         out[name] = float((1 + np.count_nonzero(draws >= s)) / (1 + draws.size))
@@ -105,7 +112,7 @@ def run(per_mix: int, out: Path) -> dict:
     rows = {}
     for t, a in TESTS.items():
         allp = np.concatenate([np.asarray(v) for v in p[t].values()])
-        levels = (a, *LEVELS) if t.startswith(("curve", "unexplained:allan")) else (a,)
+        levels = (a, *LEVELS) if t.startswith(("curve", "unexplained:allan", "allan")) else (a,)
         rows[t] = {
             "alpha": a,
             "records": int(allp.size),

@@ -377,6 +377,7 @@ class ScoreTest:
         self.chol = self.corr_chol * sd[:, None]  # Σ = D R D
         xw = solve_triangular(self.chol, columns, lower=True) if columns.size else np.zeros((tau.size, 0))
         self.q = np.linalg.qr(xw)[0] if xw.shape[1] else np.zeros((tau.size, 0))
+        self._draws: dict[tuple[int, int], np.ndarray] = {}
 
     def _perp(self, v):
         vw = solve_triangular(self.chol, v, lower=True)
@@ -413,11 +414,12 @@ class ScoreTest:
         u = self.directions(family)
         if u.size == 0:
             return np.zeros(0)
-        rng = np.random.default_rng(seed)
-        z = self.corr_chol @ rng.standard_normal((self.model.size, n_boot))
-        pr = norm.cdf(z)
-        ystar = self.model[:, None] * chi2_dist.ppf(pr, self.nu[:, None]) / self.nu[:, None]
-        rp = self._perp(ystar - self.model[:, None])
+        if (n_boot, seed) not in self._draws:  # the curves drawn once per (n_boot, seed), for every family
+            rng = np.random.default_rng(seed)
+            z = self.corr_chol @ rng.standard_normal((self.model.size, n_boot))
+            ystar = self.model[:, None] * chi2_dist.ppf(norm.cdf(z), self.nu[:, None]) / self.nu[:, None]
+            self._draws[(n_boot, seed)] = ystar - self.model[:, None]
+        rp = self._perp(self._draws[(n_boot, seed)])
         return np.max(np.maximum(u @ rp, 0.0) ** 2, axis=0)
 
     def threshold(self, family: np.ndarray, alpha: float, n_boot: int = 1000, seed: int = 0) -> float:
