@@ -9,10 +9,11 @@ Used by :func:`allanite.refine`:
 - :class:`ScoreTest` — a generalised-least-squares score (likelihood-ratio in the linearised model)
   statistic for adding one non-negative column to the fitted Allan-variance model, with the covariance of
   the estimates across τ (exact for the five terms and the overlapping estimator, docs/FORMULAS.md §5 via
-  :mod:`allanite.model._covariance`; effects enter by scaling it with the model's level), and its null
-  distribution by a parametric bootstrap: Allan curves drawn from the fitted model with χ² marginals of
-  the estimates' EDF tied by a Gaussian copula of their correlation. The maximum of the statistic over
-  every candidate family's columns is bootstrapped, so the look-elsewhere effect is in the threshold.
+  :mod:`allanite.model._covariance`, variances included; effects enter by scaling it with the model's level),
+  and its null distribution by a parametric bootstrap: Allan curves drawn from the fitted model with χ²
+  marginals of the estimates' variances tied by a Gaussian copula of their correlation. The maximum of the
+  statistic over every candidate family's columns is bootstrapped, so the look-elsewhere effect is in the
+  threshold.
 """
 
 from __future__ import annotations
