@@ -9,10 +9,11 @@ Used by :func:`allanite.refine`:
 - :class:`ScoreTest` — a generalised-least-squares score (likelihood-ratio in the linearised model)
   statistic for adding one non-negative column to the fitted Allan-variance model, with the covariance of
   the estimates across τ (exact for the five terms and the overlapping estimator, docs/FORMULAS.md §5 via
-  :mod:`allanite.model._covariance`; effects enter by scaling it with the model's level), and its null
-  distribution by a parametric bootstrap: Allan curves drawn from the fitted model with χ² marginals of
-  the estimates' EDF tied by a Gaussian copula of their correlation. The maximum of the statistic over
-  every candidate family's columns is bootstrapped, so the look-elsewhere effect is in the threshold.
+  :mod:`allanite.model._covariance`, variances included; effects enter by scaling it with the model's level),
+  and its null distribution by a parametric bootstrap: Allan curves drawn from the fitted model with χ²
+  marginals of the estimates' variances tied by a Gaussian copula of their correlation. The maximum of the
+  statistic over every candidate family's columns is bootstrapped, so the look-elsewhere effect is in the
+  threshold.
 """
 
 from __future__ import annotations
@@ -352,27 +353,36 @@ class ScoreTest:
     tau : the thinned τ (s)
     model : the current model on those τ
     model_terms : the current model's five-term part (its covariance is exact; effects scale it)
-    nu : EDF of each estimate
+    nu : EDF of each estimate (used where no exact covariance is given)
     columns : (n_tau, k) active columns of the current model (projected out: the refit absorbs them)
     cov_terms : (n_tau, n_tau) exact covariance of the five-term part, or None (octave-correlation model)
+
+    With ``cov_terms`` the estimates' variances are the exact ones too, not 2·model²/ν: the EDF of a mixture
+    combined per term leaves out the cross terms between the noise types, and under-states the variance of
+    a mid-τ estimate of white + flicker + random walk up to 2.4× (simulated N + B + K, 2·10⁵ samples) — a
+    statistic whitened by it is inflated against its own bootstrap, which then rejects far above its α
+    (``benches/results/refine_calibration.md``). The bootstrap's χ² marginals take the EDF of the exact
+    variance, 2·model²/var.
     """
 
     def __init__(self, model, model_terms, nu, tau, columns, cov_terms=None):
         self.model = model
-        sd = model * np.sqrt(2.0 / nu)
         if cov_terms is not None:
             s = model / np.maximum(model_terms, 1e-300)
             c = cov_terms * np.outer(s, s)
             d = np.sqrt(np.maximum(np.diag(c), 1e-300))
             corr = c / np.outer(d, d)
+            nu = 2.0 * (np.maximum(model, 1e-300) / d) ** 2
         else:
             lt = np.log2(tau)
             corr = OCTAVE_RHO ** np.abs(lt[:, None] - lt[None, :])
+        sd = model * np.sqrt(2.0 / nu)
         self.corr_chol = _psd_cholesky(0.5 * (corr + corr.T))
         self.nu = nu
         self.chol = self.corr_chol * sd[:, None]  # Σ = D R D
         xw = solve_triangular(self.chol, columns, lower=True) if columns.size else np.zeros((tau.size, 0))
         self.q = np.linalg.qr(xw)[0] if xw.shape[1] else np.zeros((tau.size, 0))
+        self._draws: dict[tuple[int, int], np.ndarray] = {}
 
     def _perp(self, v):
         vw = solve_triangular(self.chol, v, lower=True)
@@ -394,19 +404,39 @@ class ScoreTest:
         rp = self._perp((y - self.model)[:, None])[:, 0]
         return float(max(0.0, float(u[0] @ rp)) ** 2)
 
-    def threshold(self, family: np.ndarray, alpha: float, n_boot: int = 1000, seed: int = 0) -> float:
-        """(1 − α) quantile of the maximum statistic over ``family`` (n_tau, n_cols) on curves drawn from
-        the model: χ²_ν/ν marginals, Gaussian copula with the estimates' correlation."""
+    def max_statistic(self, y: np.ndarray, family: np.ndarray) -> float:
+        """The largest :meth:`statistic` over the columns of ``family`` (n_tau, n_cols); 0 if the model spans
+        them all."""
         u = self.directions(family)
         if u.size == 0:
+            return 0.0
+        rp = self._perp((y - self.model)[:, None])[:, 0]
+        return float(np.max(np.maximum(u @ rp, 0.0) ** 2))
+
+    def null_maxima(self, family: np.ndarray, n_boot: int = 1000, seed: int = 0) -> np.ndarray:
+        """The maximum statistic over ``family`` (n_tau, n_cols) on ``n_boot`` curves drawn from the model:
+        χ²_ν/ν marginals, Gaussian copula with the estimates' correlation (empty if the model spans them)."""
+        u = self.directions(family)
+        if u.size == 0:
+            return np.zeros(0)
+        if (n_boot, seed) not in self._draws:  # the curves drawn once per (n_boot, seed), for every family
+            rng = np.random.default_rng(seed)
+            z = self.corr_chol @ rng.standard_normal((self.model.size, n_boot))
+            ystar = self.model[:, None] * chi2_dist.ppf(norm.cdf(z), self.nu[:, None]) / self.nu[:, None]
+            self._draws[(n_boot, seed)] = ystar - self.model[:, None]
+        rp = self._perp(self._draws[(n_boot, seed)])
+        return np.max(np.maximum(u @ rp, 0.0) ** 2, axis=0)
+
+    def threshold(self, family: np.ndarray, alpha: float, n_boot: int = 1000, seed: int = 0) -> float:
+        """(1 − α) quantile of the maximum statistic over ``family`` (n_tau, n_cols) on curves drawn from
+        the model (:meth:`null_maxima`): the ⌈(n_boot + 1)(1 − α)⌉-th smallest draw, the Monte-Carlo test's
+        critical value — a statistic exchangeable with the draws exceeds it with probability at most α (an
+        interpolated quantile of 1000 draws at α = 0.25 % is exceeded with probability ≈ 0.35 %)."""
+        stat = np.sort(self.null_maxima(family, n_boot, seed))
+        if not stat.size:
             return math.inf
-        rng = np.random.default_rng(seed)
-        z = self.corr_chol @ rng.standard_normal((self.model.size, n_boot))
-        pr = norm.cdf(z)
-        ystar = self.model[:, None] * chi2_dist.ppf(pr, self.nu[:, None]) / self.nu[:, None]
-        rp = self._perp(ystar - self.model[:, None])
-        stat = np.max(np.maximum(u @ rp, 0.0) ** 2, axis=0)
-        return float(np.quantile(stat, 1.0 - alpha))
+        k = math.ceil((stat.size + 1) * (1.0 - alpha) - 1e-9)
+        return float(stat[min(k, stat.size) - 1])
 
 
 def exact_covariance(m, n_samples, fs, terms, theta) -> np.ndarray:

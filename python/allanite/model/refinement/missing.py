@@ -8,8 +8,9 @@ at that rate. Entries are dicts (largest misfit first) with ``"domain"``, ``"tau
 is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"threshold"`` and ``"alpha"``.
 
 - ``"allan"`` — the acceptance test itself (:class:`allanite.model.tracing.ScoreTest`: GLS score of one more
-  non-negative column, the maximum over every curve candidate's family — sinusoids' nulls included — and the
-  start terms' own columns, bootstrapped under the final model); the region is where the winning column, with
+  non-negative column, the maximum over every curve candidate's family — sinusoids' nulls for curve-only input;
+  with samples a line is the ``"psd"`` check's — and the start terms' own columns, bootstrapped under the final
+  model, :func:`allan_family`); the region is where the winning column, with
   the model's fitted directions projected out, carries its weight, and further regions follow with the winner
   added to the model, at the same threshold; a region is reported only where the dense curve's χ²/dof there
   exceeds 1. With samples the frequency band is refined on the PSD of the final residual samples: the part of
@@ -46,7 +47,7 @@ from .curvefit import Curve, Solution, base_name, theta_terms, upper_theta
 from .levels import alpha
 from .scoring import MATERIAL_Z, curve_change_z
 
-__all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS"]
+__all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS", "allan_family"]
 
 #: Regions the curve check reports at most.
 MAX_REGIONS = 3
@@ -102,11 +103,24 @@ def _chi2_dof(ctx: MissingContext, lo: float, hi: float) -> float:
     return float(np.mean(z**2)) if z.size else float("nan")
 
 
+def allan_family(sub: Curve, start: tuple, has_samples: bool) -> np.ndarray:
+    """The columns the ``"allan"`` check maximises its score over on the thinned curve ``sub``: every curve
+    candidate's family as the steps bootstrap it (a sinusoid by its nulls for curve-only input only) and the
+    start terms' own columns.
+
+    With samples a line is the ``"psd"`` check's, in the spectrum, as at the steps: on the thinned curve the
+    sinusoids' nulls are contrasts between neighbouring τ, whose null distribution hangs on the estimates'
+    correlation from one τ to the next — which the bootstrap takes from the *fitted* terms. A clean white
+    record whose fit took a little flicker gets a correlation above its own, and the nulls alone gave p ≤ 0.05
+    on 15 of 200 clean records (benches/results/refine_calibration.md)."""
+    fam = families(sub, tuple(CURVE_CANDIDATES), has_samples)
+    terms = design_matrix(sub.tau, sub.m, sub.fs, start)
+    return np.column_stack([fam, terms]) if fam.size else terms
+
+
 def _curve(ctx: MissingContext, a: float) -> list[dict]:
     sub = ctx.curve.subset(ctx.thin)
-    fam = families(sub, tuple(CURVE_CANDIDATES), False)
-    terms = design_matrix(sub.tau, sub.m, ctx.fs, ctx.start)
-    fam = np.column_stack([fam, terms]) if fam.size else terms
+    fam = allan_family(sub, ctx.start, ctx.y is not None)
     test = curve_test(ctx.curve, ctx.thin, ctx.sol, ctx.start, ctx.effects, ctx.exact)
     thr = test.threshold(fam, a, N_BOOT, seed=7919)
     out: list[dict] = []
