@@ -65,10 +65,6 @@ def summarize(name, r) -> dict:
             "after": st.after,
             "evidence": _jsonable(st.evidence),
         }
-        if "window_levels" in st.evidence:  # a change point: what found it, on the windows' levels
-            w, ho = st.evidence["window_levels"], st.evidence.get("heldout_test") or {}
-            step["before"] = w["before"] | {"heldout_rms_adev_pct": ho.get("before")}
-            step["after"] = w["after"] | {"heldout_rms_adev_pct": ho.get("after")}
         row["steps"].append(step)
     return row
 
@@ -142,6 +138,14 @@ def _fmt_params(st):
     changed = [k for k, v in fp.items() if v != st["params"].get(k) or fi.get(k) != st["intervals"].get(k)]
     if changed:
         out += " → final: " + "; ".join(format_param(k, fp[k], fi.get(k), "", 3) for k in changed)
+    w = (st.get("evidence") or {}).get("window_levels")
+    if w:  # a change point: what found it (its before = after on the record's curve), without → with it
+        ho = st["evidence"].get("heldout_test") or {}
+        out += (
+            f" (windows' levels: χ²/dof {w['before']['chi2_dof']:.2f} → {w['after']['chi2_dof']:.2f}, RMS ADEV "
+            f"{w['before']['rms_adev_pct']:.1f} → {w['after']['rms_adev_pct']:.1f} %; held out per segment "
+            f"{_ho({'heldout_rms_adev_pct': ho.get('before')})} → {_ho({'heldout_rms_adev_pct': ho.get('after')})} %)"
+        )
     return out
 
 
@@ -161,9 +165,11 @@ def write_md(rows, path: Path) -> None:
         "is the previous step's after): χ²/dof of the normalised residuals, RMS of the ADEV error in % (4 τ per "
         "octave whose estimate is within ±10 %) in-sample and held out (8 alternate blocks: fit on the odd ones, "
         "predict the even ones' curve and back; n/a for curves without samples). Default call `refine(x, 100.0)` "
-        "/ `refine(curve)`: all τ. Change points are tested on 16 non-overlapping windows (ADIS only); they leave "
-        "the record's curve as it is, and their rows show what found them: the windows' Allan variance against "
-        "one level vs piecewise levels, held out per segment.",
+        "/ `refine(curve)`: all τ. Change points are tested on 16 non-overlapping windows (ADIS only); a change "
+        "of noise level leaves the record's curve model as it is (the curve of a record whose level steps is the "
+        "length-weighted mean of its segments' curves, a model of the same terms), so on the chain its before and "
+        "after are the same numbers; in brackets what found it, each change point without → with it (the earlier "
+        "ones in both): the windows' Allan variances about piecewise levels, and held out per segment.",
         "",
         "| record | five-term χ²/dof | RMS ADEV err (held out) | traced to | parameters | χ²/dof before → after "
         "| RMS ADEV err before → after | held-out err before → after |",

@@ -156,6 +156,37 @@ def test_a_removal_chains_and_its_curve_is_part_of_the_final_model():
 
 
 @pytest.fixture(scope="module")
+def line_and_steps():
+    """A sinusoid (6e-3 at 3.3 Hz, a tenth of the white noise's SD) and the white level stepping up 2.5× at
+    2000 s and back at 3000 s: the default call."""
+    n = 400_000
+    y = allanite.simulate(n, FS, N=2e-3, K=2e-5, seed=3)
+    y[n // 2 : 3 * n // 4] = 2.5 * allanite.simulate(n, FS, N=2e-3, K=2e-5, seed=4)[n // 2 : 3 * n // 4]
+    y += 6e-3 * np.sin(2 * np.pi * 3.3 * np.arange(n) / FS)
+    return allanite.refine(y, FS)
+
+
+def test_change_points_chain_on_the_curve_and_each_has_its_own_numbers(line_and_steps):
+    r = line_and_steps
+    assert r.found == ["sinusoid", "change_point", "change_point"]
+    _assert_chain(r)
+    cps = [s for s in r.steps if s.effect == "change_point"]
+    assert [round(float(c.params["t"])) for c in cps] == [2000, 3000]
+    for c in cps:  # on the record's curve a change of noise level changes nothing: before = after, said so
+        assert c.before == c.after and "before = after" in c.evidence["on_the_curve"]
+    # what found them, a chain of its own: the first one's before is one level, each next before the previous
+    # after — the windows' levels and the held-out error per segment alike, each falling
+    w0, w1 = cps[0].evidence["window_levels"], cps[1].evidence["window_levels"]
+    assert w0["after"] == w1["before"] and w0["before"] != w1["before"]
+    h0, h1 = cps[0].evidence["heldout_test"], cps[1].evidence["heldout_test"]
+    assert h0["after"] == h1["before"] == w0["after"]["heldout_rms_adev_pct"]
+    for w, h in ((w0, h0), (w1, h1)):
+        assert w["after"]["chi2_dof"] < w["before"]["chi2_dof"] and h["after"] < h["before"]
+    # the summary and the notebook carry the same numbers
+    assert "before = after" in r.report() and "held out per segment" in " ".join(r.notes())
+
+
+@pytest.fixture(scope="module")
 def adis_run1_z(shared_data):
     path = shared_data / "adis16405" / "adis16405_run1_100Hz.csv.gz"
     if not path.is_file():

@@ -93,10 +93,12 @@ def refinement_dict(rep) -> dict | None:
             "τ of the dense curve weighted independently), RMS ADEV error (%) on 4 τ per octave whose estimate is "
             "within ±10 %; heldout_rms_adev_pct: the model fitted on alternate blocks (8, joined; removals refitted "
             "on them) predicting the other blocks' curve, both ways (null for curve-only input). A change of noise "
-            "level leaves the curve as it is (before = after)",
-            "window_levels": "what accepted a change point (its step's window_levels): one level vs piecewise "
-            "levels (split at every change found) of the log Allan variances of 16 windows along the record; held "
-            "out per segment (each segment's alternate blocks predicted by its own model vs the one-level model)",
+            "level leaves the curve's model as it is (before = after)",
+            "window_levels": "what found a change point (its step's window_levels): the log Allan variances of "
+            "16 windows along the record about piecewise-constant levels without → with this change point (the "
+            "earlier ones in both: the first one's before is one level, each next one's before the previous one's "
+            "after); heldout_rms_adev_pct in it: held out per segment (each segment's alternate blocks predicted "
+            "by its own held-in part's model), without → with it",
         },
         "unexplained": "per axis, what the final model still misses, largest misfit first (empty when the final "
         "model passes every calibrated check of what it may still miss, each at its share of the axis's level): "

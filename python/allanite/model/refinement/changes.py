@@ -4,8 +4,11 @@ The Allan variances of 16 non-overlapping windows (octave τ), in logs, are spli
 within-segment scatter falls most (binary segmentation, at most two changes); a split is kept when its gain
 beats a penalty calibrated on clean records (``MIN_GAIN``), then located to the sample by a two-segment
 likelihood of the squared m-sample differences at the τ of the largest gain. Its statistic is on the
-windows' levels, not on the Allan curve: a change point's before/after says how one constant level and
-piecewise-constant levels describe the windows.
+windows' levels, not on the Allan curve: a change point's before/after says how the windows' piecewise-
+constant levels without and with it (the earlier change points in both) describe them. On the record's own
+Allan curve a change of noise level changes nothing: the curve of a record whose level steps is the
+length-weighted mean of its segments' curves, a model of the same terms with pooled coefficients, which
+the fit of the whole curve already is.
 """
 
 from __future__ import annotations
@@ -16,8 +19,9 @@ import numpy as np
 
 from ...analysis import davar
 from .. import fitting
+from .result import Step
 
-__all__ = ["MIN_GAIN", "N_WINDOWS", "change_points", "locate"]
+__all__ = ["MIN_GAIN", "N_WINDOWS", "change_points", "change_point_step", "locate"]
 
 #: Kept for the change-point test's penalty (calibrated with it on clean records).
 MIN_GAIN = 6.0
@@ -114,21 +118,26 @@ def _segment(lv: _Levels, y, fs, window, max_points) -> list:
 
 def change_points(y, fs, terms, max_points=2):
     """Level steps of the Allan variance along the record: [{t, interval, gain, tau, window_s, coarse_split_s,
-    before, after}], ``before``/``after`` the windows' levels against one constant level and against
-    piecewise-constant levels (windows that straddle a change belong to neither: left out of both)."""
+    before, after}] by time, ``before``/``after`` the windows' levels about piecewise-constant levels without
+    and with this change point, the earlier ones in both — a chain of its own: the first change point's before
+    is one constant level, each next one's before the previous one's after (windows that straddle any change
+    belong to no segment: left out of all)."""
     window = y.size // N_WINDOWS
     if window < 64:
         return []
     lv = _Levels(y, fs, window)
     out = _segment(lv, y, fs, window, max_points)
-    straddle = sorted({int(c["t"] * fs // window) for c in out})
+    cut = [int(c["t"] * fs // window) for c in out]
     keep = np.ones(N_WINDOWS, dtype=bool)
-    keep[[j for j in straddle if j < N_WINDOWS]] = False
-    edges = [0] + [j for j in straddle] + [N_WINDOWS]
-    before = lv.stats([(0, N_WINDOWS)], keep)
-    after = lv.stats([(a, b) for a, b in zip(edges[:-1], edges[1:])], keep)
-    for c in out:
-        c["before"], c["after"] = before, after
+    keep[[j for j in cut if j < N_WINDOWS]] = False
+
+    def levels(n: int) -> dict:  # the windows about one level per segment between the first n changes
+        edges = [0] + sorted(cut[:n]) + [N_WINDOWS]
+        return lv.stats([(a, b) for a, b in zip(edges[:-1], edges[1:])], keep)
+
+    chain = [levels(n) for n in range(len(out) + 1)]
+    for n, c in enumerate(out):
+        c["before"], c["after"] = chain[n], chain[n + 1]
     return out
 
 
@@ -150,3 +159,44 @@ def locate(y, m, fs):
         return (idx + 1) * m / fs
 
     return to_t(j[i]), (to_t(ok.min()) - m / fs, to_t(ok.max()) + m / fs)
+
+
+def change_point_step(c: dict, heldout: list | None, truth: dict | None, duration_s: float) -> Step:
+    """The step of change point ``c`` (:func:`change_points`), its before/after on the chain left to the loop.
+
+    On the record's Allan curve a change of noise level changes nothing: the curve of the whole record is the
+    length-weighted mean of its segments', a model of the same terms with pooled coefficients — the fit of the
+    whole curve already —, so its before and after there are both the model so far, the same numbers by
+    construction (``evidence["on_the_curve"]``). What found it is in its evidence, a chain of its own:
+    ``window_levels`` (the windows' levels about piecewise levels without → with it, the earlier change points
+    in both) and ``heldout_test`` (``heldout`` = [without, with]: the final segments' held-out parts predicted
+    without → with it, :func:`.scoring.segments_heldout`). ``truth``: the true ``{"t": …}`` (s), for the error
+    as a fraction of the record (``duration_s``)."""
+    terr = None
+    if truth is not None:
+        terr = {"t": float(np.min(np.abs(np.atleast_1d(truth["t"]) - c["t"])) / duration_s)}
+    c["before"]["heldout_rms_adev_pct"] = None if heldout is None else heldout[0]
+    c["after"]["heldout_rms_adev_pct"] = None if heldout is None else heldout[1]
+    evidence = {
+        "domain": "time",
+        "tau": c["tau"],
+        "window_s": c["window_s"],
+        "coarse_split_s": c["coarse_split_s"],
+        "gain_chi2": c["gain"],
+        "window_levels": {"before": dict(c["before"]), "after": dict(c["after"])},
+        "on_the_curve": "a change of noise level leaves the record's Allan curve model as it is: before = after",
+    }
+    if heldout is not None:
+        evidence["heldout_test"] = {"before": heldout[0], "after": heldout[1], "per": "segment"}
+    params, intervals = {"t": c["t"]}, {"t": c["interval"]}
+    return Step(
+        effect="change_point",
+        params=params,
+        intervals=intervals,
+        evidence=evidence,
+        before={},
+        after={},
+        truth_error=terr,
+        final_params=dict(params),
+        final_intervals=dict(intervals),
+    )

@@ -27,7 +27,7 @@ from ..effects import EFFECTS, describe
 from ..terms import check_terms
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families, final_params
-from .changes import change_points
+from .changes import change_point_step, change_points
 from .curvefit import Curve, base_name, noise_fit, solve, theta_terms
 from .levels import LEVEL, alpha
 from .missing import MissingContext, unexplained
@@ -501,59 +501,31 @@ class _Run:
     # ---- change points
 
     def change_point_steps(self, candidates) -> list:
-        """Steps of the change points the held-out error per segment confirms. A change of level leaves the
-        record's Allan curve as it is (one model of the five terms fits the whole curve as well as the
-        segments' models together): on the chain its before and after are the final model's; its own
-        statistic, on the windows' levels along the record, is in its evidence."""
+        """Steps of the change points the held-out error per segment confirms (:func:`.changes.change_point_step`:
+        on the record's curve its before and after are the model so far, the same numbers by construction; what
+        found it, a chain of its own, in its evidence)."""
         y = self.y
         if y is None or "change_point" not in candidates:
             return []
         cps = change_points(y, self.fs, self.start)
-        ho_cp = None
+        chain = None  # the held-out error per segment without any change point, with the first, …, with all
         if cps and self.heldout is not None:
             m_all = np.asarray(self.result.m, dtype=np.int64)
             times = [c["t"] for c in cps]
-            ho_cp = segments_heldout(self.heldout, y, self.fs, m_all, self.lo, self.hi, self.start, self.effects, times)
-        if ho_cp is not None and not ho_cp[1] < ho_cp[0]:
+            chain = segments_heldout(self.heldout, y, self.fs, m_all, self.lo, self.hi, self.start, self.effects, times)
+        if chain is not None and not chain[-1] < chain[0]:
             for c in cps:
-                why = f"held-out error {ho_cp[0]:.3g} → {ho_cp[1]:.3g} %"
+                why = f"held-out error {chain[0]:.3g} → {chain[-1]:.3g} %"
                 self.consider("change_point", {"t": c["t"], "gain_chi2": c["gain"], "rejected": why})
             cps = []
         self.change_points = cps
-        return [self.change_point_step(c, ho_cp) for c in cps]
-
-    def change_point_step(self, c: dict, ho_cp) -> Step:
-        assert self.y is not None
-        terr = None
-        if self.truth and "change_point" in self.truth:
-            ts = np.atleast_1d(self.truth["change_point"]["t"])
-            terr = {"t": float(np.min(np.abs(ts - c["t"])) / (self.y.size / self.fs))}
-        c["before"]["heldout_rms_adev_pct"] = None if ho_cp is None else ho_cp[0]
-        c["after"]["heldout_rms_adev_pct"] = None if ho_cp is None else ho_cp[1]
-        evidence = {
-            "domain": "time",
-            "tau": c["tau"],
-            "window_s": c["window_s"],
-            "coarse_split_s": c["coarse_split_s"],
-            "gain_chi2": c["gain"],
-            "window_levels": {"before": dict(c["before"]), "after": dict(c["after"])},
-        }
-        if ho_cp is not None:
-            evidence["heldout_test"] = {"before": ho_cp[0], "after": ho_cp[1], "per": "segment"}
-        params, intervals = {"t": c["t"]}, {"t": c["interval"]}
-        st = Step(
-            effect="change_point",
-            params=params,
-            intervals=intervals,
-            evidence=evidence,
-            before={},
-            after={},
-            truth_error=terr,
-            final_params=dict(params),
-            final_intervals=dict(intervals),
-        )
-        self.advance(st, self.state)
-        return st
+        steps = []
+        for n, c in enumerate(cps):
+            truth = self.truth.get("change_point") if self.truth else None
+            st = change_point_step(c, None if chain is None else chain[n : n + 2], truth, y.size / self.fs)
+            self.advance(st, self.state)
+            steps.append(st)
+        return steps
 
     # ---- the result
 

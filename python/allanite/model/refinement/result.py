@@ -39,8 +39,11 @@ class Step:
     original record's Allan curve — each step's ``before`` is the previous step's ``after`` (the steps in the
     chain's order: curve effects, then the removals in time, which were searched first, then change points);
     ``evidence``: where in τ, f or t the residual was and the test that accepted it (``heldout_test``: the held-out
-    comparison that accepted it, where that is not the chain's; a change point's statistic on the windows'
-    levels in ``window_levels``); ``truth_error``: relative parameter errors when ``truth`` was given.
+    comparison that accepted it, where that is not the chain's; a change point — whose before and after on the
+    record's curve are the same numbers: a change of noise level leaves the curve's model as it is — has its
+    statistic on the windows' levels in ``window_levels`` and held out per segment in ``heldout_test``, each
+    without → with it, the earlier change points in both); ``truth_error``: relative parameter errors when
+    ``truth`` was given.
     """
 
     effect: str
@@ -179,8 +182,11 @@ class Refinement(RichDisplay):
             "Every step is scored on the original record's Allan curve: each step's before is the previous step's "
             "after. Curve effects come first; then the components removed in time (removed before the curve "
             "effects were searched), each with every curve effect in the model and its exact Allan variance, "
-            "AVAR(y) − AVAR(y − component), part of it. A change of noise level leaves the record's curve as it "
-            "is; its own statistic is on the windows' levels along the record (evidence['window_levels'])."
+            "AVAR(y) − AVAR(y − component), part of it. A change of noise level leaves the record's curve model as "
+            "it is (the curve of a record whose level steps is the length-weighted mean of its segments' curves: a "
+            "model of the same terms), so its before and after there are the same numbers; what found it is on the "
+            "windows' levels along the record (evidence['window_levels'], each change point without → with it) and "
+            "held out per segment (evidence['heldout_test'])."
         ]
         return out + [term_move_text(m, self.fit.unit) for m in self.term_moves]
 

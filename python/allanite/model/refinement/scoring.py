@@ -5,7 +5,8 @@ under the five-term fit: ±10 %); beyond, the estimate's own scatter, not the mo
 
 The held-out error: the record is cut into :data:`HELDOUT_BLOCKS` blocks, the odd and the even ones joined end
 to end; the model fitted on one part's Allan curve predicts the other's (both ways, RMS ADEV error averaged).
-A time-domain removal is refitted on the held-in part's samples; change points are held out per segment.
+A time-domain removal is refitted on the held-in part's samples; change points are held out per segment, one
+after another on the same targets (:func:`segments_heldout`).
 """
 
 from __future__ import annotations
@@ -228,23 +229,45 @@ def heldout_split(y, fs, m_all, lo, hi, terms):
 
 
 def segments_heldout(whole: Split, y, fs, m_all, lo, hi, terms, effects, times):
-    """Held-out error of change points at ``times`` (s): (without, with), or None if a segment is too short.
+    """Held-out error of change points at ``times`` (s), one after another: [without any, with the first, …,
+    with all], or None if a segment is too short.
 
-    Each segment between change points gets its own alternate blocks; its held-out part's Allan curve is
-    predicted once by the model fitted on the held-in part of the whole record (no change point) and once by
-    the model fitted on the segment's own held-in part (the noise level changes there). Mean over both ways,
-    segments weighted by their length. A change point that is not real leaves the segments alike, and the
-    segment's model, fitted on less data, predicts no better."""
-    edges = [0] + sorted(int(round(t * fs)) for t in times) + [y.size]
-    out = np.zeros(2)
-    for a, b in zip(edges[:-1], edges[1:]):
-        seg = heldout_split(y[a:b], fs, m_all, lo, hi, terms)
-        if seg is None:
+    The targets stay the same along the list: each final segment (between all the change points) gets its own
+    alternate blocks, and its held-out part's Allan curve is predicted by the model fitted on the held-in part
+    of the segment that contains it when only the first n change points cut the record (n = 0: the whole
+    record's held-in part; n = all: the segment's own). Mean over both ways, segments weighted by their
+    length. So the first value and the last compare the model without and with every change point (a change
+    point that is not real leaves the segments alike, and the segment's model, fitted on less data, predicts no
+    better), and change point n's before and after are entries n and n + 1 — a chain, each one's before the
+    previous one's after."""
+    cuts = sorted(int(round(t * fs)) for t in times)
+    splits: dict = {(0, y.size): whole}
+    fits: dict = {}
+
+    def held_in(a: int, b: int, f: int):  # the model fitted on segment a..b's held-in part f
+        if (a, b) not in splits:
+            splits[(a, b)] = heldout_split(y[a:b], fs, m_all, lo, hi, terms)
+        if splits[(a, b)] is None:
             return None
+        if (a, b, f) not in fits:
+            fits[(a, b, f)] = solve(splits[(a, b)].curves[f], terms, effects).theta
+        return fits[(a, b, f)]
+
+    edges = [0] + cuts + [y.size]
+    out = np.zeros(len(cuts) + 1)
+    for a, b in zip(edges[:-1], edges[1:]):
+        if held_in(a, b, 0) is None:
+            return None
+        seg = splits[(a, b)]
         for f, h in ((0, 1), (1, 0)):
             a_h, _ = design(seg.curves[h], terms, effects)
             obs = seg.curves[h].avar[seg.scored]
-            for k, part in enumerate((whole.curves[f], seg.curves[f])):
-                pred = np.maximum(a_h @ solve(part, terms, effects).theta, 1e-300)[seg.scored]
-                out[k] += 0.5 * (b - a) / y.size * rms_adev_pct(obs, pred)
-    return float(out[0]), float(out[1])
+            for n in range(len(cuts) + 1):
+                cut_n = [0] + cuts[:n] + [y.size]
+                j = max(i for i, e in enumerate(cut_n) if e <= a)
+                theta = held_in(cut_n[j], cut_n[j + 1], f)
+                if theta is None:
+                    return None
+                pred = np.maximum(a_h @ theta, 1e-300)[seg.scored]
+                out[n] += 0.5 * (b - a) / y.size * rms_adev_pct(obs, pred)
+    return [float(v) for v in out]
