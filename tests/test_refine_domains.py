@@ -459,9 +459,12 @@ def test_leftover_lines_are_reported_as_bands_not_one_entry_per_line():
     rng = np.random.default_rng(3)
     comb = [9.6 + 0.2 * i for i in range(5)]
     y = rng.normal(size=n) + sum(0.1 * np.sin(2 * np.pi * f * t + i) for i, f in enumerate(comb))
-    y = y + 0.1 * np.sin(2 * np.pi * 31.0 * t)
+    y = y + 0.2 * np.sin(2 * np.pi * 31.0 * t)  # at 0.1 it would move τ₀'s estimate by 1.8 SE only: immaterial
     tau = np.geomspace(0.01, 100.0, 40)
-    ctx = SimpleNamespace(y=y, fs=fs, effects=[], curve=SimpleNamespace(tau=tau), sol=SimpleNamespace(z=np.ones(40)))
+    m = np.maximum(np.round(tau * fs), 1.0)
+    # the final model: the unit white noise (AVAR 1/m, EDF ≈ n/m); the lines move its curve by far more than 2 SE
+    sol = SimpleNamespace(z=np.ones(40), model=1.0 / m, nu=n / m)
+    ctx = SimpleNamespace(y=y, fs=fs, effects=[], curve=SimpleNamespace(tau=tau), sol=sol)
     out = missing._lines(ctx, 1e-3)
     assert len(out) == 2
     band, lone = sorted(out, key=lambda r: r["band_hz"][0])
