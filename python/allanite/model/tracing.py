@@ -348,6 +348,13 @@ def _psd_cholesky(corr: np.ndarray) -> np.ndarray:
 class ScoreTest:
     """GLS score statistic for one more non-negative column, and its bootstrap threshold.
 
+    With ``cov_terms`` the estimates' variances are the exact ones too, not 2·model²/ν: the EDF of a mixture
+    combined per term leaves out the cross terms between the noise types, and under-states the variance of
+    a mid-τ estimate of white + flicker + random walk up to 2.4× (simulated N + B + K, 2·10⁵ samples) — a
+    statistic whitened by it is inflated against its own bootstrap, which then rejects far above its α
+    (``benches/results/refine_calibration.md``). The bootstrap's χ² marginals take the EDF of the exact
+    variance, 2·model²/var.
+
     Parameters
     ----------
     tau : the thinned τ (s)
@@ -356,13 +363,6 @@ class ScoreTest:
     nu : EDF of each estimate (used where no exact covariance is given)
     columns : (n_tau, k) active columns of the current model (projected out: the refit absorbs them)
     cov_terms : (n_tau, n_tau) exact covariance of the five-term part, or None (octave-correlation model)
-
-    With ``cov_terms`` the estimates' variances are the exact ones too, not 2·model²/ν: the EDF of a mixture
-    combined per term leaves out the cross terms between the noise types, and under-states the variance of
-    a mid-τ estimate of white + flicker + random walk up to 2.4× (simulated N + B + K, 2·10⁵ samples) — a
-    statistic whitened by it is inflated against its own bootstrap, which then rejects far above its α
-    (``benches/results/refine_calibration.md``). The bootstrap's χ² marginals take the EDF of the exact
-    variance, 2·model²/var.
     """
 
     def __init__(self, model, model_terms, nu, tau, columns, cov_terms=None):
