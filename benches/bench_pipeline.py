@@ -315,9 +315,11 @@ def row_scale(n: int, scratch: Path, tmp: Path) -> dict:
 def _per_window_reference(result, rows_avar, k_windows: int):
     """Seconds per window of the per-window fit (``_fit_core`` on each), on ``k_windows`` windows spread over
     one axis (``rows_avar``, τ × windows) of ``result``, at the τ the fit selects."""
-    from allanite.model import fitting
+    from allanite.model import _tauselect, fitting
 
-    idx = fitting._select(result.tau, fitting.row_medians(rows_avar), True, len(fitting.TERMS), "x", (0.0, np.inf))
+    idx = _tauselect.select_taus(
+        result.tau, fitting.row_medians(rows_avar), True, len(fitting.TERMS), "x", (0.0, np.inf)
+    )
     cols = _common.sample_starts(rows_avar.shape[1], min(k_windows, rows_avar.shape[1]))
     y = np.ascontiguousarray(rows_avar[idx][:, cols].T)
     t0, c0 = time.perf_counter(), time.process_time()

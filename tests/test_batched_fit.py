@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import allanite
-from allanite.model import _batched, fitting
+from allanite.model import _batched, _tauselect, fitting
 from allanite.model.terms import design_matrix
 
 TOL = 10 * fitting.GLS_TOL
@@ -20,7 +20,7 @@ TOL = 10 * fitting.GLS_TOL
 
 def _both(result, terms=fitting.TERMS, thin=True, tau_range=(0.0, np.inf)):
     """(batched, reference) θ, variance of θ, χ² of every window of a one-axis dynamic result."""
-    idx = fitting._select(result.tau, np.median(result.avar, axis=1), thin, len(terms), "x", tau_range)
+    idx = _tauselect.select_taus(result.tau, np.median(result.avar, axis=1), thin, len(terms), "x", tau_range)
     y = np.maximum(np.ascontiguousarray(result.avar[idx].T), 1e-300)
     got = fitting._window_fits(result, idx, y, terms, 0.683, 50, False)
     th, cov, chi2 = fitting._window_fits_reference(result, idx, y, terms, 0.683, 50)

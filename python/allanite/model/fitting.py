@@ -48,6 +48,7 @@ from ._fitcore import (
     fit_core,
     nnls,
 )
+from ._tauselect import check_tau_range, estimator_key, row_medians, select_taus
 from .terms import TERM_ALPHA, TERM_NAMES, TERMS, check_terms, design_matrix
 
 __all__ = [
@@ -316,15 +317,6 @@ class CoefficientSeries(RichDisplay):
         ax.legend(fontsize="small", frameon=False, ncol=len(self.terms))
 
 
-def _octave_thin(tau: np.ndarray) -> np.ndarray:
-    """Indices of τ at least a factor 2 apart, starting from the shortest."""
-    keep = [0]
-    for i in range(1, tau.size):
-        if tau[i] >= 2.0 * tau[keep[-1]] * (1 - 1e-12):
-            keep.append(i)
-    return np.asarray(keep)
-
-
 def interval(theta_k, var_k, zq, inflate):
     """(low, high) of a coefficient from θ_k = coefficient² and its variance: θ ± z·SE·inflate,
     clipped at 0, square-rooted."""
@@ -511,7 +503,7 @@ AUTO_MAX_CUT_M = 64
 def _auto_cuts(result, avar_row, thin, n_terms):
     """Lower τ cuts to try: none, then each fitted τ in turn (an octave at a time) up to AUTO_MAX_CUT_M samples,
     keeping at least n_terms + 3 τ."""
-    idx = _select(result.tau, avar_row, thin, n_terms, "the result")
+    idx = select_taus(result.tau, avar_row, thin, n_terms, "the result")
     tau, m = result.tau[idx], result.m[idx]
     cuts = [0.0]
     for k in range(1, tau.size):
@@ -605,54 +597,12 @@ def fit_estimators() -> tuple[str, ...]:
     return tuple(n for n in estimator_names() if get_estimator(n).estimates_allan)
 
 
-def _est_key(result, idx):
-    """The estimator argument of fit_core: a name, or a tuple of per-τ sources for Theo-family results."""
-    return result.estimator if result.source is None else tuple(np.asarray(result.source)[idx])
-
-
-def check_tau_range(tau_range):
-    """A (low, high) τ range in seconds (None for an open end) as floats, or a ParameterError."""
-    if tau_range is None:
-        return (0.0, np.inf)
-    try:
-        lo, hi = tau_range
-    except (TypeError, ValueError):
-        raise ParameterError(f"tau_range must be a (low, high) pair of seconds, got {tau_range!r}") from None
-    lo = 0.0 if lo is None else float(lo)
-    hi = np.inf if hi is None else float(hi)
-    if not (lo >= 0 and hi > lo) or np.isnan(lo) or np.isnan(hi):
-        raise ParameterError(f"tau_range must satisfy 0 ≤ low < high, got {tau_range!r}")
-    return (lo, hi)
-
-
-def _select(tau, avar, thin, n_terms, what, tau_range=(0.0, np.inf)):
-    if not np.all(np.isfinite(avar)):
-        i = int(np.flatnonzero(~np.isfinite(avar))[0])
-        raise ParameterError(f"{what} has a non-finite Allan variance ({avar[i]}) at τ = {tau[i]:g} s")
-    inside = np.flatnonzero((tau >= tau_range[0]) & (tau <= tau_range[1]))
-    if inside.size == 0:
-        raise ParameterError(f"no τ of {what} lies in tau_range {tau_range} s (τ spans {tau[0]:g}–{tau[-1]:g} s)")
-    if not np.any(avar[inside] > 0):
-        raise ParameterError(
-            f"{what} has an Allan variance of zero at every τ in range (a constant record?): there is no noise to fit"
-        )
-    idx = inside[_octave_thin(tau[inside])] if thin else inside
-    idx = idx[avar[idx] > 0]
-    if idx.size <= n_terms:
-        raise ParameterError(
-            f"{what} has {idx.size} usable τ{' (octave-spaced)' if thin else ''} for {n_terms} terms; "
-            f"at least {n_terms + 1} are needed — use a wider τ grid or fewer terms"
-            + (", or fit every τ (thin=False)" if thin else "")
-        )
-    return idx
-
-
 def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_iter, tau_range):
     avar_row = np.asarray(avar_row, dtype=np.float64)
-    idx = _select(result.tau, avar_row, thin, len(terms), "the result", tau_range)
+    idx = select_taus(result.tau, avar_row, thin, len(terms), "the result", tau_range)
     tau, m, y = result.tau[idx], result.m[idx].astype(np.float64), avar_row[idx]
     theta, cov, model, nu, z, it, a, chi2 = fit_core(
-        tau, m, y, result.fs, result.n_samples + 1, _est_key(result, idx), terms, confidence, max_iter
+        tau, m, y, result.fs, result.n_samples + 1, estimator_key(result, idx), terms, confidence, max_iter
     )
     n_active = int(np.count_nonzero(theta > 0))
     dof = max(1, tau.size - n_active)
@@ -689,7 +639,7 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
         covariance=cov,
         notes=notes,
         method="gls"
-        if exact_covariance_applies(tau, m, result.fs, result.n_samples + 1, _est_key(result, idx))
+        if exact_covariance_applies(tau, m, result.fs, result.n_samples + 1, estimator_key(result, idx))
         else "wls",
     )
 
@@ -704,7 +654,7 @@ def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range,
     series = []
     for rows_avar in rows:
         # τ chosen on the windows' median curve: one flat window must not decide for all of them
-        idx = _select(result.tau, row_medians(rows_avar), thin, len(terms), "the dynamic result", tau_range)
+        idx = select_taus(result.tau, row_medians(rows_avar), thin, len(terms), "the dynamic result", tau_range)
         y = np.ascontiguousarray(rows_avar[idx].T)  # windows × fitted τ
         bad = ~np.isfinite(y).all(axis=1)
         if bad.any():
@@ -748,12 +698,6 @@ def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range,
     return series[0] if result.avar.ndim == 2 else series
 
 
-def row_medians(a) -> np.ndarray:
-    """The median of every row of a 2-D array, one row at a time: ``np.median(a, axis=1)`` partitions a copy
-    of the whole array (a hop-1 DAVAR surface: gigabytes)."""
-    return np.array([np.median(r) for r in a])
-
-
 def intervals(theta, var, zq, inflate):
     """:func:`interval` of many coefficients at once: arrays (low, high)."""
     se = np.where(np.isfinite(var), np.sqrt(np.maximum(var, 0.0)) * inflate, np.inf)
@@ -767,7 +711,7 @@ def _window_fits(result, idx, y, terms, confidence, max_iter, progress):
     per-window fit of :func:`fit_core`, run for all windows at once in the core; a window it hands back
     is refitted here."""
     tau, m, fs = result.tau[idx], result.m[idx].astype(np.float64), result.fs
-    n_points, est = result.window + 1, _est_key(result, idx)
+    n_points, est = result.window + 1, estimator_key(result, idx)
     check_gls_size(est, m)
     gls = exact_covariance_applies(tau, m, fs, n_points, est)
     nu_terms = np.column_stack([edf_per_tau(np.full(m.size, TERM_ALPHA[t]), m, n_points, est) for t in terms])
@@ -797,7 +741,7 @@ def _window_fits_reference(result, idx, y, terms, confidence, max_iter):
     """θ, covariance and χ² of each row of ``y`` by :func:`fit_core`, one window at a time (the reference
     of the batched fit, and the fit of the windows it hands back)."""
     tau, m = result.tau[idx], result.m[idx].astype(np.float64)
-    est, cache = _est_key(result, idx), {}
+    est, cache = estimator_key(result, idx), {}
     theta = np.empty((y.shape[0], len(terms)))
     cov = np.empty((y.shape[0], len(terms), len(terms)))
     chi2 = np.empty(y.shape[0])
