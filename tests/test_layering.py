@@ -145,6 +145,7 @@ MODEL_RANKS = {
     # fit's parts, between the registries and fit itself: the one-curve solver, the result objects, the windows
     "model._fitcore": 0.5,
     "model._tauselect": 0,
+    "model._fitresult": 0.7,
     "model.fitting": 1,
     "model.tracing": 1,
     "model._whittle": 0,
