@@ -146,6 +146,7 @@ MODEL_RANKS = {
     "model._fitcore": 0.5,
     "model._tauselect": 0,
     "model._fitresult": 0.7,
+    "model._dynamicfit": 0.9,
     "model.fitting": 1,
     "model.tracing": 1,
     "model._whittle": 0,

@@ -30,34 +30,20 @@ from ..errors import ParameterError
 from ..estimators import get as get_estimator
 from ..estimators import names as estimator_names
 from ..results import AllanResult, DynamicAllanResult
-from ..units import ieee952, rate_unit
-from . import _batched, _covariance
-from ._fitcore import (
-    GLS_START_ITER,
-    GLS_TOL,
-    IRLS_RTOL,
-    MAX_GLS_TAU,
-    OCTAVE_CORRELATION,
-    check_gls_size,
-    edf_per_tau,
-    exact_covariance_applies,
-    fit_core,
-    nnls,
-)
+from ..units import rate_unit
+from ._dynamicfit import FLAT_FLOOR as FLAT_FLOOR
+from ._dynamicfit import fit_dynamic
+from ._fitcore import GLS_START_ITER as GLS_START_ITER
+from ._fitcore import GLS_TOL as GLS_TOL
+from ._fitcore import IRLS_RTOL as IRLS_RTOL
+from ._fitcore import MAX_GLS_TAU, edf_per_tau, exact_covariance_applies, fit_core, nnls
+from ._fitcore import OCTAVE_CORRELATION as OCTAVE_CORRELATION
 from ._fitresult import READOFF_MIN_EDF as READOFF_MIN_EDF
-from ._fitresult import (
-    Coefficient,
-    CoefficientSeries,
-    NoiseFit,
-    coefficients,
-    interval,
-    intervals,
-    readoffs,
-    z_quantile,
-)
+from ._fitresult import Coefficient, CoefficientSeries, NoiseFit, coefficients, interval, readoffs, z_quantile
 from ._fitresult import coefficient_table as coefficient_table
+from ._fitresult import intervals as intervals
 from ._tauselect import check_tau_range, estimator_key, row_medians, select_taus
-from .terms import TERM_ALPHA, TERMS, check_terms, design_matrix
+from .terms import TERMS, check_terms
 
 __all__ = [
     "fit",
@@ -167,7 +153,7 @@ def fit(
         _check_fit_estimator(result)
         if auto:
             return _fit_dynamic_auto(result, terms, unit, float(confidence), zq, thin, max_iter, progress)
-        return _fit_dynamic(result, terms, unit, float(confidence), zq, thin, max_iter, tau_range, progress)
+        return fit_dynamic(result, terms, unit, float(confidence), zq, thin, max_iter, tau_range, progress)
     if not isinstance(result, AllanResult):
         raise ParameterError(f"fit needs an AllanResult or DynamicAllanResult, got {type(result).__name__}")
     _check_fit_estimator(result)
@@ -263,7 +249,7 @@ def _fit_dynamic_auto(result, terms, unit, confidence, zq, thin, max_iter, progr
 
         cut, (_, chi), (_, chi0), ok = _auto_choose(cuts, fit_at)
         single = dataclasses.replace(result, avar=rows_avar)
-        s = _fit_dynamic(single, terms, unit, confidence, zq, thin, max_iter, (cut, np.inf), progress)
+        s = fit_dynamic(single, terms, unit, confidence, zq, thin, max_iter, (cut, np.inf), progress)
         out.append(dataclasses.replace(s, notes=_auto_note(cut, chi, chi0, tau0, ok)))
     return out[0] if result.avar.ndim == 2 else out
 
@@ -330,105 +316,6 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
         if exact_covariance_applies(tau, m, result.fs, result.n_samples + 1, estimator_key(result, idx))
         else "wls",
     )
-
-
-#: A dynamic result's window is flat when every Allan variance in it is at most this share of the result's
-#: largest (its rounding residue is ~1e-38 of it; a real noise level 10⁶ lower in amplitude is 1e-12).
-FLAT_FLOOR = 1e-24
-
-
-def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range, progress=None):
-    rows = [result.avar] if result.avar.ndim == 2 else list(result.avar)
-    series = []
-    for rows_avar in rows:
-        # τ chosen on the windows' median curve: one flat window must not decide for all of them
-        idx = select_taus(result.tau, row_medians(rows_avar), thin, len(terms), "the dynamic result", tau_range)
-        y = np.ascontiguousarray(rows_avar[idx].T)  # windows × fitted τ
-        bad = ~np.isfinite(y).all(axis=1)
-        if bad.any():
-            raise ParameterError(
-                f"the dynamic result has a non-finite Allan variance in window {int(np.flatnonzero(bad)[0])}"
-            )
-        # a window whose samples are all equal (a sensor not yet streaming) has Allan variance 0; the core
-        # returns its rounding residue, ~ε²·offset² (≈ 1e-38 of the record's largest value), not always an
-        # exact 0: such a window is flat, not a fit (coefficients and intervals 0)
-        finite = rows_avar[np.isfinite(rows_avar)]
-        flat_floor = FLAT_FLOOR * (float(finite.max()) if finite.size else 0.0)
-        fitted = ~np.all(y <= flat_floor, axis=1)
-        theta, var, chi2 = np.zeros((y.shape[0], len(terms))), np.zeros((y.shape[0], len(terms))), np.zeros(y.shape[0])
-        if fitted.any():
-            fits = _window_fits(result, idx, np.maximum(y[fitted], 1e-300), terms, confidence, max_iter, progress)
-            theta[fitted], var[fitted], chi2[fitted] = fits
-        chi = chi2 / np.maximum(1, idx.size - np.count_nonzero(theta > 0, axis=1))
-        inflate = np.maximum(1.0, np.sqrt(chi))
-        vals, lo, hi = {}, {}, {}
-        for k, t in enumerate(terms):
-            vals[t] = np.sqrt(theta[:, k])
-            lo[t], hi[t] = intervals(theta[:, k], var[:, k], zq, inflate)
-        ieee = ieee_units = None
-        if unit is not None:
-            ieee = {t: ieee952(t, vals[t], unit).value for t in terms}
-            ieee_units = {t: ieee952(t, 1.0, unit).unit for t in terms}
-        series.append(
-            CoefficientSeries(
-                t=result.t,
-                terms=terms,
-                values=vals,
-                ci_low=lo,
-                ci_high=hi,
-                chi2_dof=chi,
-                confidence=confidence,
-                unit=unit,
-                ieee=ieee,
-                ieee_units=ieee_units,
-            )
-        )
-    return series[0] if result.avar.ndim == 2 else series
-
-
-def _window_fits(result, idx, y, terms, confidence, max_iter, progress):
-    """θ, the variance of each θ_k and χ² of every window (rows of ``y``, the estimates at τ[idx]): the
-    per-window fit of :func:`fit_core`, run for all windows at once in the core; a window it hands back
-    is refitted here."""
-    tau, m, fs = result.tau[idx], result.m[idx].astype(np.float64), result.fs
-    n_points, est = result.window + 1, estimator_key(result, idx)
-    check_gls_size(est, m)
-    gls = exact_covariance_applies(tau, m, fs, n_points, est)
-    nu_terms = np.column_stack([edf_per_tau(np.full(m.size, TERM_ALPHA[t]), m, n_points, est) for t in terms])
-    theta, cov, chi2, _, status = _batched.fit_windows(
-        y,
-        design_matrix(tau, tau * fs, fs, terms),
-        nu_terms,
-        start_col=terms.index("N") if "N" in terms else 0,
-        irls_iter=GLS_START_ITER,
-        max_iter=max_iter,
-        gls_tol=GLS_TOL,
-        irls_rtol=IRLS_RTOL,
-        rho=[OCTAVE_CORRELATION[t] for t in terms],
-        log2_tau=np.log2(tau),
-        blocks=_covariance.covariance_blocks(m, n_points - 1, fs, terms) if gls else None,
-        stoch=[k for k, t in enumerate(terms) if t in _covariance.KERNEL_TERMS],
-        ramp=terms.index("R") if "R" in terms else None,
-        progress=progress,
-    )
-    back = np.flatnonzero(status)
-    if back.size:
-        theta[back], cov[back], chi2[back] = _window_fits_reference(result, idx, y[back], terms, confidence, max_iter)
-    return theta, np.diagonal(cov, axis1=1, axis2=2), chi2
-
-
-def _window_fits_reference(result, idx, y, terms, confidence, max_iter):
-    """θ, covariance and χ² of each row of ``y`` by :func:`fit_core`, one window at a time (the reference
-    of the batched fit, and the fit of the windows it hands back)."""
-    tau, m = result.tau[idx], result.m[idx].astype(np.float64)
-    est, cache = estimator_key(result, idx), {}
-    theta = np.empty((y.shape[0], len(terms)))
-    cov = np.empty((y.shape[0], len(terms), len(terms)))
-    chi2 = np.empty(y.shape[0])
-    for j in range(y.shape[0]):
-        out = fit_core(tau, m, y[j], result.fs, result.window + 1, est, terms, confidence, max_iter, edf_cache=cache)
-        theta[j], cov[j], chi2[j] = out[0], out[1], out[7]
-    return theta, cov, chi2
 
 
 def information_bound(n: int, fs: float, *, Q: float = 0.0, N: float = 0.0, B: float = 0.0, K: float = 0.0) -> dict:
