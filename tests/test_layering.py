@@ -147,6 +147,7 @@ MODEL_RANKS = {
     "model._tauselect": 0,
     "model._fitresult": 0.7,
     "model._dynamicfit": 0.9,
+    "model._bound": 0,
     "model.fitting": 1,
     "model.tracing": 1,
     "model._whittle": 0,
