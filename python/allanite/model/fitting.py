@@ -14,6 +14,11 @@ coefficient covariance is then (AᵀΣ⁻¹A)⁻¹ and χ² is that of the white
 Theo-family estimates are weighted by ν/(2σ⁴_model) (ν the equivalent degrees of freedom for the
 noise type that dominates the model at that τ), with an octave-correlation model in the intervals.
 By default only τ at least an octave apart enter either fit.
+
+Here: :func:`fit`, the fit of a static curve and ``tau_range="auto"``. Its parts, each a module of its own (their
+public names are importable from here too): the one-curve solver (``_fitcore``), which τ enter a fit
+(``_tauselect``), what a fit returns (``_fitresult``: :class:`NoiseFit`, :class:`CoefficientSeries`), the windows
+of a dynamic result (``_dynamicfit``) and the Cramér–Rao bound (``_bound``: :func:`information_bound`).
 """
 
 from __future__ import annotations
