@@ -9,7 +9,7 @@ Rows
    ``python/`` folder of an earlier checkout (e.g. main) holding its compiled core — the same command on it.
    Inside the report: its figures drawn one after another against two processes (the same PNG bytes).
 2. ``fit(davar(...))`` of the ADIS run (3 axes × its windows), batched against the per-window reference
-   (``_fit_core`` on each window, what the fit did before).
+   (``fit_core`` on each window, what the fit did before).
 3. ``allanite.combine(y, 100, window=401, hop=10)`` of 10⁶ simulated samples (10⁵ windows), against the
    per-window fits of the same windows (timed on a slice of them, per window) — and with ``--baseline``,
    the baseline's ``combine`` on a fifth of the record (per window).
@@ -313,15 +313,17 @@ def row_scale(n: int, scratch: Path, tmp: Path) -> dict:
 
 
 def _per_window_reference(result, rows_avar, k_windows: int):
-    """Seconds per window of the per-window fit (``_fit_core`` on each), on ``k_windows`` windows spread over
+    """Seconds per window of the per-window fit (``fit_core`` on each), on ``k_windows`` windows spread over
     one axis (``rows_avar``, τ × windows) of ``result``, at the τ the fit selects."""
-    from allanite.model import fitting
+    from allanite.model import _dynamicfit, _tauselect, fitting
 
-    idx = fitting._select(result.tau, fitting.row_medians(rows_avar), True, len(fitting.TERMS), "x", (0.0, np.inf))
+    idx = _tauselect.select_taus(
+        result.tau, fitting.row_medians(rows_avar), True, len(fitting.TERMS), "x", (0.0, np.inf)
+    )
     cols = _common.sample_starts(rows_avar.shape[1], min(k_windows, rows_avar.shape[1]))
     y = np.ascontiguousarray(rows_avar[idx][:, cols].T)
     t0, c0 = time.perf_counter(), time.process_time()
-    fitting._window_fits_reference(result, idx, y, fitting.TERMS, 0.683, 50)
+    _dynamicfit.window_fits_reference(result, idx, y, fitting.TERMS, 0.683, 50)
     return (time.perf_counter() - t0) / y.shape[0], (time.process_time() - c0) / y.shape[0]
 
 
@@ -586,7 +588,7 @@ def write_md(res: dict, path: Path) -> None:
         "times (this process's, and a report's figure process's) are less sensitive to that load. "
     )
     L.append(
-        "Per-window reference: `_fit_core` on each window in turn (today's reference path, what `fit(dynamic)` "
+        "Per-window reference: `fit_core` on each window in turn (today's reference path, what `fit(dynamic)` "
         "did before the batched core), timed on windows spread over the record, per window × the number of windows."
     )
     L.append("")

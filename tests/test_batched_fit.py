@@ -1,7 +1,7 @@
 """The batched per-window fit (the Rust core's ``fit_windows``) gives today's per-window fit.
 
 ``allanite.fit(dynamic_result)`` fits all windows at once in the core; the reference is the per-window
-path, ``_fit_core`` on each window in turn. They must agree within 10 × GLS_TOL on the model values and on
+path, ``fit_core`` on each window in turn. They must agree within 10 × GLS_TOL on the model values and on
 every coefficient both resolve, and leave exactly the same coefficients at zero — on simulated and measured
 windows, for the GLS fit (overlapping estimates) and the independent-weights fit (classic, DHVAR).
 """
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import allanite
-from allanite.model import _batched, fitting
+from allanite.model import _batched, _dynamicfit, _tauselect, fitting
 from allanite.model.terms import design_matrix
 
 TOL = 10 * fitting.GLS_TOL
@@ -20,10 +20,10 @@ TOL = 10 * fitting.GLS_TOL
 
 def _both(result, terms=fitting.TERMS, thin=True, tau_range=(0.0, np.inf)):
     """(batched, reference) θ, variance of θ, χ² of every window of a one-axis dynamic result."""
-    idx = fitting._select(result.tau, np.median(result.avar, axis=1), thin, len(terms), "x", tau_range)
+    idx = _tauselect.select_taus(result.tau, np.median(result.avar, axis=1), thin, len(terms), "x", tau_range)
     y = np.maximum(np.ascontiguousarray(result.avar[idx].T), 1e-300)
-    got = fitting._window_fits(result, idx, y, terms, 0.683, 50, False)
-    th, cov, chi2 = fitting._window_fits_reference(result, idx, y, terms, 0.683, 50)
+    got = _dynamicfit.window_fits(result, idx, y, terms, 0.683, 50, False)
+    th, cov, chi2 = _dynamicfit.window_fits_reference(result, idx, y, terms, 0.683, 50)
     return idx, got, (th, np.diagonal(cov, axis1=1, axis2=2), chi2)
 
 

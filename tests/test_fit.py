@@ -102,10 +102,10 @@ def test_curve_matches_the_closed_forms():
 
 
 def test_rate_random_walk_column_is_the_sampled_walk():
-    import allanite.model.fitting as fit_mod
+    from allanite.model.terms import design_matrix
 
     m = np.array([1.0, 2.0, 100.0])
-    col = fit_mod.design_matrix(m / FS, m, FS, ("K",))[:, 0]
+    col = design_matrix(m / FS, m, FS, ("K",))[:, 0]
     # exact sampled-walk AVAR: K²τ0(2m²+1)/(6m) — 1.5× K²τ/3 at m = 1, → K²τ/3 for large m
     assert col[0] == pytest.approx(1.5 * (1 / FS) / 3)
     assert col[2] == pytest.approx((100 / FS) / 3, rel=1e-4)

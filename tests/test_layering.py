@@ -142,6 +142,12 @@ MODEL_RANKS = {
     "model.outliers": 0,
     "model.periodic": 1,
     "model.template": 0,
+    # fit's parts, between the registries and fit itself: the one-curve solver, the result objects, the windows
+    "model._fitcore": 0.5,
+    "model._tauselect": 0,
+    "model._fitresult": 0.7,
+    "model._dynamicfit": 0.9,
+    "model._bound": 0,
     "model.fitting": 1,
     "model.tracing": 1,
     "model._whittle": 0,

@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import textwrap
+from typing import Any
 
 import numpy as np
 
@@ -383,71 +384,31 @@ def davar(
     options = entry.check_options({"kf_rule": kf_rule})
     peaks: list[float] | None
     if gaps == "skip":
-        if taper != "rect" or method != "fast":
-            raise ParameterError(
-                f"gaps='skip' works with taper='rect' and method='fast' only, got taper={taper!r}, method={method!r}"
-            )
-        if estimator not in GAP_DYNAMIC_ESTIMATORS:
-            raise ParameterError(
-                f'davar(gaps="skip") is supported by the estimators {", ".join(GAP_DYNAMIC_ESTIMATORS)}; got '
-                f"estimator={estimator!r}"
-            )
+        _check_gap_davar(estimator, method, taper)
         cols, fs, is_multi = _gap_columns(x, fs, input)
         peaks = None
     else:
         peaks = []
         cols, fs, is_multi = as_rate_columns(x, fs, input, peaks=peaks)
     n = cols[0].size
-    window = check_count(window, "window", 2)
-    hop = check_count(hop, "hop", 1)
-    if window > n:
-        raise ParameterError(f"window ({window} samples) is longer than the record ({n} samples)")
-    if method not in entry.methods:
-        raise ParameterError(
-            f"estimator {estimator!r} is computed with method={entry.methods[0]!r} only, got method={method!r}"
-        )
+    window, hop = _check_window(entry, tapered, estimator, taper, method, window, hop, n)
     assert entry.dynamic is not None and entry.resolve_m is not None
-    if method not in tapered.methods:
-        raise ParameterError(f"taper {taper!r} is computed with method in {tapered.methods}, got method={method!r}")
     ms = entry.resolve_m(taus, window, fs)
     n_win = (n - window) // hop + 1
-    n_axes = len(cols)
-    nbytes = n_axes * ms.size * n_win * (16 if gaps == "skip" else 8)  # with gaps: values and counts
-    budget = resolve_max_memory(max_memory)
-    if nbytes > budget:
-        per_window = n_axes * ms.size * (16 if gaps == "skip" else 8)
-        size = (
-            f"the output would take {nbytes / 2**30:.2f} GiB ({n_axes} axes × {ms.size} τ × {n_win} windows "
-            f"× 8 bytes), over the memory budget of {budget / 2**30:.2f} GiB"
-        )
-        if per_window > budget:
-            raise MemoryBudgetError(
-                f"{size}; even one window ({per_window} bytes) does not fit: use fewer τ or raise "
-                f"max_memory / ALLANITE_MAX_MEMORY"
-            )
-        # windows = (n − window)//hop + 1 ≤ budget/per_window: the smallest hop that fits.
-        max_windows = budget // per_window
-        suggest = n if max_windows <= 1 else max(hop + 1, -(-(n - window) // (max_windows - 1)))
-        raise MemoryBudgetError(f"{size}; use hop ≥ {suggest}, fewer τ, or raise max_memory / ALLANITE_MAX_MEMORY")
+    value_bytes = 16 if gaps == "skip" else 8  # with gaps: values and counts
+    _check_output_budget(len(cols), ms.size, n_win, value_bytes, max_memory, n, window, hop)
     # A hop beyond the record gives one window, as does the record length itself.
     hop_core = min(hop, n)
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
+    common: dict[str, Any] = dict(
+        t=t, window=window, hop=hop, method=method, estimator=estimator, fs=fs, n_samples=n, input=input
+    )
     if gaps == "skip":
         out = gap_dynamic(cols, fs, window, hop_core, ms, workers, estimator)
         counts = np.asarray(out.n, dtype=np.int64)
+        n_terms = counts[0] if np.all(counts == counts[0]) else counts
         return DynamicAllanResult(
-            tau=out.tau,
-            t=t,
-            avar=out.values if is_multi else out.values[0],
-            n=counts[0] if np.all(counts == counts[0]) else counts,
-            m=out.m,
-            window=window,
-            hop=hop,
-            method=method,
-            estimator=estimator,
-            fs=fs,
-            n_samples=n,
-            input=input,
+            tau=out.tau, avar=out.values if is_multi else out.values[0], n=n_terms, m=out.m, **common
         )
     scaled, exps = _scale_columns(cols, peaks)
     big = n_win * window >= DHVAR_BAR_SAMPLES
@@ -462,21 +423,65 @@ def davar(
     kf = out.kf
     return DynamicAllanResult(
         tau=out.tau,
-        t=t,
         avar=out.values if is_multi else out.values[0],
         n=out.n,
         m=out.m,
-        window=window,
-        hop=hop,
-        method=method,
-        estimator=estimator,
-        fs=fs,
-        n_samples=n,
-        input=input,
         source=out.source,
         kf=kf if (kf is None or is_multi) else kf[0],
         taper=taper,
+        **common,
     )
+
+
+def _check_window(entry, tapered, estimator, taper, method, window, hop, n) -> tuple[int, int]:
+    """``window`` and ``hop`` as sample counts, the window within the record's ``n`` samples; ``method`` one
+    that both the estimator and the taper compute."""
+    window = check_count(window, "window", 2)
+    hop = check_count(hop, "hop", 1)
+    if window > n:
+        raise ParameterError(f"window ({window} samples) is longer than the record ({n} samples)")
+    if method not in entry.methods:
+        raise ParameterError(
+            f"estimator {estimator!r} is computed with method={entry.methods[0]!r} only, got method={method!r}"
+        )
+    if method not in tapered.methods:
+        raise ParameterError(f"taper {taper!r} is computed with method in {tapered.methods}, got method={method!r}")
+    return window, hop
+
+
+def _check_gap_davar(estimator: str, method: str, taper: str) -> None:
+    """davar(gaps="skip") needs the plain fast path of an estimator with a gap-skipping dynamic form."""
+    if taper != "rect" or method != "fast":
+        raise ParameterError(
+            f"gaps='skip' works with taper='rect' and method='fast' only, got taper={taper!r}, method={method!r}"
+        )
+    if estimator not in GAP_DYNAMIC_ESTIMATORS:
+        raise ParameterError(
+            f'davar(gaps="skip") is supported by the estimators {", ".join(GAP_DYNAMIC_ESTIMATORS)}; got '
+            f"estimator={estimator!r}"
+        )
+
+
+def _check_output_budget(n_axes, n_tau, n_win, value_bytes, max_memory, n, window, hop) -> None:
+    """A MemoryBudgetError, with the smallest hop that fits, when a DAVAR output of ``n_axes`` × ``n_tau`` ×
+    ``n_win`` values of ``value_bytes`` each would exceed ``max_memory``."""
+    nbytes = n_axes * n_tau * n_win * value_bytes
+    budget = resolve_max_memory(max_memory)
+    if nbytes > budget:
+        per_window = n_axes * n_tau * value_bytes
+        size = (
+            f"the output would take {nbytes / 2**30:.2f} GiB ({n_axes} axes × {n_tau} τ × {n_win} windows "
+            f"× 8 bytes), over the memory budget of {budget / 2**30:.2f} GiB"
+        )
+        if per_window > budget:
+            raise MemoryBudgetError(
+                f"{size}; even one window ({per_window} bytes) does not fit: use fewer τ or raise "
+                f"max_memory / ALLANITE_MAX_MEMORY"
+            )
+        # windows = (n − window)//hop + 1 ≤ budget/per_window: the smallest hop that fits.
+        max_windows = budget // per_window
+        suggest = n if max_windows <= 1 else max(hop + 1, -(-(n - window) // (max_windows - 1)))
+        raise MemoryBudgetError(f"{size}; use hop ≥ {suggest}, fewer τ, or raise max_memory / ALLANITE_MAX_MEMORY")
 
 
 #: DHVAR work (windows × window length) from which ``progress=None`` shows a bar (some seconds).

@@ -204,6 +204,50 @@ def periodic_trend(y: np.ndarray, fs: float, freq: float | None = None, harmonic
     return a @ coef, float(freq)
 
 
+def _check_wavelet(pywt, wavelet) -> None:
+    """A ParameterError unless ``wavelet`` names a discrete PyWavelets wavelet."""
+    discrete = pywt.wavelist(kind="discrete")
+    if not isinstance(wavelet, str) or wavelet not in discrete:
+        raise ParameterError(
+            f"unknown wavelet {wavelet!r}; allowed: a discrete PyWavelets wavelet such as 'db1' … 'db38', "
+            f"'sym2' … 'sym20', 'coif1' … 'coif17' (pywt.wavelist(kind='discrete'))"
+        )
+
+
+def _parts(pywt, w, y, rest, level, groups, trend, trend_part):
+    """(trend, low, high) of the record ``y``: ``rest`` (``y`` less a periodic trend) decomposed to ``level``,
+    each part rebuilt from its levels in ``groups``; ``high`` is the remainder, so the three sum to ``y``."""
+    n = y.shape[0]
+    coeffs = pywt.wavedec(rest, w, mode="symmetric", level=level, axis=0)
+    names = [f"a{level}"] + [f"d{j}" for j in range(level, 0, -1)]
+
+    def reconstruct(keep: tuple[str, ...]) -> np.ndarray:
+        if not keep:
+            return np.zeros_like(y)
+        parts = [c if name in keep else np.zeros_like(c) for name, c in zip(names, coeffs)]
+        return pywt.waverec(parts, w, mode="symmetric", axis=0)[:n]
+
+    if trend == "a5":
+        trend_part = reconstruct(groups["trend"])
+    low = reconstruct(groups["low"])
+    return trend_part, low, y - trend_part - low
+
+
+def _part_bands(groups, trend, freq, fs, level) -> dict[str, dict]:
+    """Each part's levels and the frequency range they cover (:attr:`Split.bands`)."""
+    ranges = level_bands(fs, level)
+    out_bands: dict[str, dict] = {}
+    for key in ("trend", "low", "high"):
+        lv = groups[key]
+        if key == "trend" and trend == "periodic":
+            out_bands[key] = {"levels": ("periodic",), "hz": (float(freq or 0.0), float(HARMONICS * (freq or 0.0)))}
+        elif lv:
+            out_bands[key] = {"levels": lv, "hz": (min(ranges[v][0] for v in lv), max(ranges[v][1] for v in lv))}
+        else:
+            out_bands[key] = {"levels": (), "hz": (0.0, 0.0)}
+    return out_bands
+
+
 def wavelet_split(
     x,
     fs,
@@ -255,12 +299,7 @@ def wavelet_split(
     """
     pywt = _pywt()
     check_choice(trend, "trend", TRENDS)
-    discrete = pywt.wavelist(kind="discrete")
-    if not isinstance(wavelet, str) or wavelet not in discrete:
-        raise ParameterError(
-            f"unknown wavelet {wavelet!r}; allowed: a discrete PyWavelets wavelet such as 'db1' … 'db38', "
-            f"'sym2' … 'sym20', 'coif1' … 'coif17' (pywt.wavelist(kind='discrete'))"
-        )
+    _check_wavelet(pywt, wavelet)
     level = check_count(level, "level", 1)
     cols, fs, is_multi = as_rate_columns(x, fs, "rate")
     y = np.stack(cols, axis=1)
@@ -280,32 +319,8 @@ def wavelet_split(
     else:
         trend_part = np.zeros_like(y)
         rest = y
-    coeffs = pywt.wavedec(rest, w, mode="symmetric", level=level, axis=0)
-    names = [f"a{level}"] + [f"d{j}" for j in range(level, 0, -1)]
-
-    def reconstruct(keep: tuple[str, ...]) -> np.ndarray:
-        if not keep:
-            return np.zeros_like(y)
-        parts = [c if name in keep else np.zeros_like(c) for name, c in zip(names, coeffs)]
-        return pywt.waverec(parts, w, mode="symmetric", axis=0)[:n]
-
-    if trend == "a5":
-        trend_part = reconstruct(groups["trend"])
-        low = reconstruct(groups["low"])
-        high = y - trend_part - low
-    else:
-        low = reconstruct(groups["low"])
-        high = y - trend_part - low
-    ranges = level_bands(fs, level)
-    out_bands: dict[str, dict] = {}
-    for key in ("trend", "low", "high"):
-        lv = groups[key]
-        if key == "trend" and trend == "periodic":
-            out_bands[key] = {"levels": ("periodic",), "hz": (float(freq or 0.0), float(HARMONICS * (freq or 0.0)))}
-        elif lv:
-            out_bands[key] = {"levels": lv, "hz": (min(ranges[v][0] for v in lv), max(ranges[v][1] for v in lv))}
-        else:
-            out_bands[key] = {"levels": (), "hz": (0.0, 0.0)}
+    trend_part, low, high = _parts(pywt, w, y, rest, level, groups, trend, trend_part)
+    out_bands = _part_bands(groups, trend, freq, fs, level)
 
     def shape(a: np.ndarray) -> np.ndarray:
         return a if is_multi else a[:, 0]

@@ -312,19 +312,10 @@ def batch(
     retries : int
         Dask retries of a task whose worker died.
     """
-    from distributed import Client, LocalCluster, as_completed
+    import distributed  # noqa: F401  (missing: this fails at once, before any folder is made)
 
     out = Path(out)
-    root = glob_root(pattern)
-    paths = sorted(Path(p) for p in glob.glob(pattern, recursive=True) if Path(p).is_file())
-    if not paths:
-        raise ParameterError(f"no file matches {pattern!r}")
-    folders: dict[Path, Path] = {}
-    for p in paths:
-        f = out_folder(p, root, out)
-        if f in folders:
-            raise ParameterError(f"{folders[f]} and {p} would share the report folder {f}: rename one")
-        folders[f] = p
+    paths, folders = _report_folders(pattern, out)
     out.mkdir(parents=True, exist_ok=True)
     read_opts = {"fs": fs, "columns": columns, "time_column": time_column, "unit": unit, "input": input}
     read_opts = {k: v for k, v in read_opts.items() if v is not None}
@@ -340,37 +331,9 @@ def batch(
 
     own = []
     if client is None:
-        if scheduler is not None:
-            client = Client(scheduler, timeout="30s")
-        else:
-            cluster = LocalCluster(
-                n_workers=dask_workers or 2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None
-            )
-            own.append(cluster)
-            client = Client(cluster)
-        own.insert(0, client)
+        client, own = _start_client(scheduler, dask_workers)
     try:
-        from tqdm import tqdm
-
-        # disable=None: no bar when stderr is no terminal (a pipe, a log file)
-        bar = tqdm(
-            total=len(todo), disable=True if quiet else None, unit="file", file=sys.stderr, desc="allanite batch"
-        )
-        futures = [
-            client.submit(
-                run_one, p, f, read_opts, report_opts, key=f"allanite-report-{uuid.uuid4().hex}", retries=retries
-            )
-            for p, f in todo
-        ]
-        for fut in as_completed(futures):
-            try:
-                st = fut.result()
-            except Exception as exc:  # the task itself died (e.g. its worker, beyond the retries)
-                i = futures.index(fut)
-                st = {"path": todo[i][0], "out": todo[i][1], "status": "error", "error": f"{type(exc).__name__}: {exc}"}
-            statuses[st["path"]] = st
-            bar.update(1)
-        bar.close()
+        statuses.update(_run_reports(client, todo, read_opts, report_opts, retries, quiet))
     finally:
         for o in own:
             o.close()
@@ -389,6 +352,65 @@ def batch(
     written = _write_table(rows, out)
     written["html"] = _write_html(rows, files, out)
     return FleetResult(rows=rows, files=files, paths=written)
+
+
+def _report_folders(pattern: str, out: Path) -> tuple[list[Path], dict[Path, Path]]:
+    """The files matching ``pattern`` in order, and each one's report folder under ``out`` (folder → file); a
+    ParameterError when none matches or two would share a folder."""
+    root = glob_root(pattern)
+    paths = sorted(Path(p) for p in glob.glob(pattern, recursive=True) if Path(p).is_file())
+    if not paths:
+        raise ParameterError(f"no file matches {pattern!r}")
+    folders: dict[Path, Path] = {}
+    for p in paths:
+        f = out_folder(p, root, out)
+        if f in folders:
+            raise ParameterError(f"{folders[f]} and {p} would share the report folder {f}: rename one")
+        folders[f] = p
+    return paths, folders
+
+
+def _start_client(scheduler, dask_workers):
+    """A client of the scheduler at ``scheduler``, else of a LocalCluster of ``dask_workers`` workers (default 2),
+    and what to close afterwards (the client first)."""
+    from distributed import Client, LocalCluster
+
+    own = []
+    if scheduler is not None:
+        client = Client(scheduler, timeout="30s")
+    else:
+        cluster = LocalCluster(
+            n_workers=dask_workers or 2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None
+        )
+        own.append(cluster)
+        client = Client(cluster)
+    own.insert(0, client)
+    return client, own
+
+
+def _run_reports(client, todo, read_opts, report_opts, retries, quiet) -> dict[str, dict]:
+    """Each (file, folder) of ``todo`` reported as a Dask task: file path → its status (a task that died is an
+    error row, not a stop)."""
+    from distributed import as_completed
+    from tqdm import tqdm
+
+    statuses: dict[str, dict] = {}
+    # disable=None: no bar when stderr is no terminal (a pipe, a log file)
+    bar = tqdm(total=len(todo), disable=True if quiet else None, unit="file", file=sys.stderr, desc="allanite batch")
+    futures = [
+        client.submit(run_one, p, f, read_opts, report_opts, key=f"allanite-report-{uuid.uuid4().hex}", retries=retries)
+        for p, f in todo
+    ]
+    for fut in as_completed(futures):
+        try:
+            st = fut.result()
+        except Exception as exc:  # the task itself died (e.g. its worker, beyond the retries)
+            i = futures.index(fut)
+            st = {"path": todo[i][0], "out": todo[i][1], "status": "error", "error": f"{type(exc).__name__}: {exc}"}
+        statuses[st["path"]] = st
+        bar.update(1)
+    bar.close()
+    return statuses
 
 
 def build_parser() -> argparse.ArgumentParser:

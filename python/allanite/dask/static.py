@@ -148,39 +148,36 @@ def avar(
     threads = resolve_workers(None)
     classic = estimator == "avar"
     where = _plans(ms, bounds, int(arr.chunks[0][0]), n)
-    tasks = []
-    for plan in where:
-        ks = sorted({kk for _j, m, a, b in plan for s in (0, m, 2 * m) for kk in _needed(bounds, a + s, b + s)})
-        tasks.append(
-            dask.delayed(_sum_block)(
-                [blocks[kk] for kk in ks],
-                ks,
-                bounds,
-                [offsets[kk] for kk in ks],
-                fs=fs,
-                input=input,
-                q_exp=q_exp,
-                plan=plan,
-                classic=classic,
-                threads=threads,
-            )
-        )
-    partial = run(tasks)
+    options = dict(fs=fs, input=input, q_exp=q_exp, classic=classic, threads=threads)
+    partial = run([_sum_task(plan, blocks, bounds, offsets, options) for plan in where])
+    values = _avar_values(where, partial, ms, n_axes, n_terms(estimator, n, ms), q_exp)
+    if not np.all(np.isfinite(values)):
+        raise InputError(f"the Allan variance of samples of magnitude up to {peak:.3g} exceeds float64's range")
+    return _static_result(values, ms, estimator, fs, n, input, arr.ndim == 2)
+
+
+def _sum_task(plan, blocks, bounds, offsets, options: dict):
+    """The delayed :func:`_sum_block` of one plan: the chunks its terms' three slices fall into."""
+    ks = sorted({kk for _j, m, a, b in plan for s in (0, m, 2 * m) for kk in _needed(bounds, a + s, b + s)})
+    return dask.delayed(_sum_block)(
+        [blocks[kk] for kk in ks], ks, bounds, [offsets[kk] for kk in ks], plan=plan, **options
+    )
+
+
+def _avar_values(where, partial, ms, n_axes: int, counts, q_exp: int) -> np.ndarray:
+    """The Allan variance per (axis, τ) from every task's partial sums (in quanta²), each τ's summed exactly."""
     sums: list[list[list[float]]] = [[[] for _ in range(ms.size)] for _ in range(n_axes)]
     for plan, part in zip(where, partial):
         for p, (j, *_rest) in enumerate(plan):
             for a in range(n_axes):
                 sums[a][j].append(float(part[p, a]))
-    counts = n_terms(estimator, n, ms)
     values = np.empty((n_axes, ms.size))
     for a in range(n_axes):
         for j, m in enumerate(ms):
             s = math.fsum(sums[a][j])
             # Σ (q·d)² / (2 m² n): scaled back by q² = 2^(2·q_exp) last, so no intermediate overflows
             values[a, j] = math.ldexp(s / (2.0 * float(m) * float(m) * float(counts[j])), 2 * q_exp)
-    if not np.all(np.isfinite(values)):
-        raise InputError(f"the Allan variance of samples of magnitude up to {peak:.3g} exceeds float64's range")
-    return _static_result(values, ms, estimator, fs, n, input, arr.ndim == 2)
+    return values
 
 
 def _peak(peaks: np.ndarray, bounds: np.ndarray, n_axes: int) -> float:

@@ -324,6 +324,54 @@ def _allan_m_for_id(result) -> np.ndarray:
     return np.clip(m_id, 1, max(1, n // 2))
 
 
+def _check_edf_method(result, edf_method: str) -> None:
+    """A ParameterError unless the result's estimator has an EDF model and ``edf_method`` has formulas for it."""
+    if result.source is None and _registry.get(result.estimator).edf is None:
+        with_edf = [n for n in _registry.names() if _registry.get(n).edf is not None]
+        raise ParameterError(
+            f"confidence intervals are implemented for {', '.join(map(repr, with_edf))}, not {result.estimator!r}"
+        )
+    if result.source is not None and edf_method != "greenhall":
+        raise ParameterError(
+            "Theo-family results use Greenhall's EDF (Allan τ) and Howe's Theo1 EDF (Theo τ); "
+            f"edf_method={edf_method!r} is for plain Allan results"
+        )
+    if edf_method == "sp1065" and result.estimator not in ESTIMATORS:
+        raise ParameterError(f"edf_method='sp1065' has formulas for {ESTIMATORS}, not {result.estimator!r}")
+
+
+def _edf_per_tau(result, a, m_b, n_phase, shape_edf, edf_method, dynamic, per_window) -> np.ndarray:
+    """ν of the result's estimates for noise types ``a``: per τ (and axis), or per window for a
+    ``davar(gaps="skip")`` result, whose windows hold their own counts of complete terms."""
+    if per_window and edf_method == "sp1065":
+        raise ParameterError(
+            "results of davar(gaps='skip') use Greenhall's EDF per window; edf_method='sp1065' has none"
+        )
+    if edf_method == "sp1065":
+        nu = edf_sp1065(a, m_b, n_phase, estimator=result.estimator)
+    elif per_window:
+        # davar(gaps="skip"): every window's own count of complete terms → one EDF per window
+        full = np.shape(result.avar)
+        nu = _edf_from_terms(result, np.broadcast_to(a[..., None], full), np.broadcast_to(m_b[..., None], full), full)
+        shape_edf = full
+    elif not dynamic and result.source is None and (result.estimator in _GAP_SPAN or result.estimator in _GAP_CLUSTERS):
+        nu = _edf_from_terms(result, a, m_b, shape_edf)
+    else:
+        nu = edf_of(result.estimator if result.source is None else result.source, a, m_b, n_phase)
+    return np.asarray(nu, dtype=np.float64).reshape(shape_edf)
+
+
+def _chi2_bounds(avar, nu_b, c, chi2):
+    """(low, high) of every variance; NaN where a τ has no EDF (gaps="skip": no complete term)."""
+    if np.all(np.isfinite(nu_b)):
+        return chi2_interval(avar, nu_b, c, method=chi2)
+    ok = np.isfinite(nu_b) & np.isfinite(avar)
+    low, high = np.full(avar.shape, np.nan), np.full(avar.shape, np.nan)
+    if ok.any():
+        low[ok], high[ok] = chi2_interval(avar[ok], nu_b[ok], c, method=chi2)
+    return low, high
+
+
 def confidence_intervals(
     result,
     x=None,
@@ -403,18 +451,7 @@ def confidence_intervals(
     c = check_probability(confidence)
     check_choice(edf_method, "edf_method", _EDF_METHODS)
     check_choice(chi2, "chi2", _CHI2_METHODS)
-    if result.source is None and _registry.get(result.estimator).edf is None:
-        with_edf = [n for n in _registry.names() if _registry.get(n).edf is not None]
-        raise ParameterError(
-            f"confidence intervals are implemented for {', '.join(map(repr, with_edf))}, not {result.estimator!r}"
-        )
-    if result.source is not None and edf_method != "greenhall":
-        raise ParameterError(
-            "Theo-family results use Greenhall's EDF (Allan τ) and Howe's Theo1 EDF (Theo τ); "
-            f"edf_method={edf_method!r} is for plain Allan results"
-        )
-    if edf_method == "sp1065" and result.estimator not in ESTIMATORS:
-        raise ParameterError(f"edf_method='sp1065' has formulas for {ESTIMATORS}, not {result.estimator!r}")
+    _check_edf_method(result, edf_method)
     dynamic = _is_dynamic(result)
     n_axes = result.n_axes
     shape_edf = (result.m.size,) if n_axes is None else (n_axes, result.m.size)
@@ -424,22 +461,7 @@ def confidence_intervals(
     n_phase = _window_length(result) + 1
     m_b = np.broadcast_to(result.m, shape_edf)
     per_window = dynamic and np.ndim(result.n) >= 2
-    if per_window and edf_method == "sp1065":
-        raise ParameterError(
-            "results of davar(gaps='skip') use Greenhall's EDF per window; edf_method='sp1065' has none"
-        )
-    if edf_method == "sp1065":
-        nu = edf_sp1065(a, m_b, n_phase, estimator=result.estimator)
-    elif per_window:
-        # davar(gaps="skip"): every window's own count of complete terms → one EDF per window
-        full = np.shape(result.avar)
-        nu = _edf_from_terms(result, np.broadcast_to(a[..., None], full), np.broadcast_to(m_b[..., None], full), full)
-        shape_edf = full
-    elif not dynamic and result.source is None and (result.estimator in _GAP_SPAN or result.estimator in _GAP_CLUSTERS):
-        nu = _edf_from_terms(result, a, m_b, shape_edf)
-    else:
-        nu = edf_of(result.estimator if result.source is None else result.source, a, m_b, n_phase)
-    nu = np.asarray(nu, dtype=np.float64).reshape(shape_edf)
+    nu = _edf_per_tau(result, a, m_b, n_phase, shape_edf, edf_method, dynamic, per_window)
     taper = _registry.TAPERS[getattr(result, "taper", "rect")]
     if taper.edf_factor is None:
         raise ParameterError(f"taper {taper.name!r} has no model of its equivalent degrees of freedom")
@@ -447,13 +469,7 @@ def confidence_intervals(
         # the tapered estimate keeps the share (Σw)²/(M·Σw²) of the rectangular window's ν
         nu = nu * taper.edf_factor(m_b, n_phase - 1)
     nu_b = nu[..., None] if dynamic and not per_window else nu
-    if np.all(np.isfinite(nu)):
-        low, high = chi2_interval(result.avar, nu_b, c, method=chi2)
-    else:  # gaps="skip": a τ without a complete term has no EDF and no interval (NaN)
-        ok = np.isfinite(nu_b) & np.isfinite(result.avar)
-        low, high = np.full(result.avar.shape, np.nan), np.full(result.avar.shape, np.nan)
-        if ok.any():
-            low[ok], high[ok] = chi2_interval(result.avar[ok], nu_b[ok], c, method=chi2)
+    low, high = _chi2_bounds(result.avar, nu_b, c, chi2)
     return ConfidenceIntervals(
         edf=nu,
         ci_low=np.asarray(low),

@@ -13,7 +13,24 @@ from ._columns import Record, first_nonfinite
 from .log import GAP_FACTOR, JITTER_WARN, Gap, Log
 
 
-def _filled_with_nan(path, fmt, rec, data, t, fs, unit, input, t0, gap_list, jitter, names) -> Log:
+def _log_fields(path, fmt, rec: Record, fs, unit, input, t0, gap_list, jitter) -> dict:
+    """The :class:`Log` fields that every way of keeping a record shares (columns, rate, unit, origin, source,
+    gaps, jitter, the record's length); the data kept, their span and times are each way's own."""
+    return dict(
+        fs=float(fs),
+        columns=list(rec.names),
+        unit=unit,
+        input=input,
+        t0=t0,
+        path=path,
+        format=fmt,
+        gaps=gap_list,
+        jitter=jitter,
+        n_record=int(rec.data.shape[0]),
+    )
+
+
+def _filled_with_nan(path, fmt, rec, data, t, fs, unit, input, t0, gap_list, jitter) -> Log:
     """The record with every gap filled by ``Gap.missing`` NaN rows (times on the nominal grid)."""
     dt = 1.0 / fs
     pieces, times, start = [], [], 0
@@ -27,22 +44,8 @@ def _filled_with_nan(path, fmt, rec, data, t, fs, unit, input, t0, gap_list, jit
     times.append(t[start:])
     filled = np.concatenate(pieces)
     tt = np.concatenate(times)
-    return Log(
-        data=filled,
-        fs=float(fs),
-        columns=list(names),
-        unit=unit,
-        input=input,
-        t0=t0,
-        path=path,
-        format=fmt,
-        gaps=gap_list,
-        span=(0, int(data.shape[0])),
-        time=tt - tt[0],
-        jitter=jitter,
-        n_record=int(data.shape[0]),
-        time_column=rec.time_name,
-    )
+    shared = _log_fields(path, fmt, rec, fs, unit, input, t0, gap_list, jitter)
+    return Log(data=filled, span=(0, int(data.shape[0])), time=tt - tt[0], time_column=rec.time_name, **shared)
 
 
 def finish(path, fmt, rec: Record, fs, unit, input, gaps) -> Log:
@@ -52,7 +55,6 @@ def finish(path, fmt, rec: Record, fs, unit, input, gaps) -> Log:
     n = int(data.shape[0])
     if n == 0:
         raise InputError(f"{path}: no samples (the file holds no data rows)")
-    names = rec.names
     if not rec.checked_finite:
         _check_finite(path, rec, n)
     t = rec.time
@@ -77,7 +79,7 @@ def finish(path, fmt, rec: Record, fs, unit, input, gaps) -> Log:
             f"stretch, or gaps='split' for every stretch"
         )
     if gaps == "nan" and gap_list:
-        return _filled_with_nan(path, fmt, rec, data, t, fs, unit, input, t0, gap_list, jitter, names)
+        return _filled_with_nan(path, fmt, rec, data, t, fs, unit, input, t0, gap_list, jitter)
     longest = max(range(len(spans)), key=lambda j: spans[j][1] - spans[j][0])
     span = spans[longest]
     segments = segment_spans = None
@@ -91,21 +93,12 @@ def finish(path, fmt, rec: Record, fs, unit, input, gaps) -> Log:
         t0 = float(t[span[0]]) + rec.t_first
     return Log(
         data=kept,
-        fs=float(fs),
-        columns=list(names),
-        unit=unit,
-        input=input,
-        t0=t0,
-        path=path,
-        format=fmt,
-        gaps=gap_list,
         span=span,
         segments=segments,
         segment_spans=segment_spans,
         time=time_rel,
-        jitter=jitter,
-        n_record=n,
         time_column=rec.time_name if t is not None else None,
+        **_log_fields(path, fmt, rec, fs, unit, input, t0, gap_list, jitter),
     )
 
 

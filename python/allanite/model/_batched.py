@@ -3,7 +3,7 @@
 :func:`allanite.fit` on a dynamic result fits the same model, on the same τ, with the same design matrix,
 EDF and covariance blocks, to every window; only the estimates differ. :func:`fit_windows` hands the shared
 parts and all the windows' estimates to ``allanite._core.fit_windows``, which runs the per-window fit of
-:mod:`allanite.model.fitting` (``_fit_core``: the IRLS start, the GLS iteration with SQUAREM steps, the
+:mod:`allanite.model._fitcore` (``fit_core``: the IRLS start, the GLS iteration with SQUAREM steps, the
 coefficient covariance) step for step on the core's threads, without the GIL. A window whose fit takes a
 branch only the Python path has (an indefinite covariance, a fit that ends at zero, an NNLS that does
 not settle) comes back flagged; the caller refits it there.

@@ -14,30 +14,41 @@ coefficient covariance is then (AᵀΣ⁻¹A)⁻¹ and χ² is that of the white
 Theo-family estimates are weighted by ν/(2σ⁴_model) (ν the equivalent degrees of freedom for the
 noise type that dominates the model at that τ), with an octave-correlation model in the intervals.
 By default only τ at least an octave apart enter either fit.
+
+Here: :func:`fit`, the fit of a static curve and ``tau_range="auto"``. Its parts, each a module of its own (their
+public names are importable from here too): the one-curve solver (``_fitcore``), which τ enter a fit
+(``_tauselect``), what a fit returns (``_fitresult``: :class:`NoiseFit`, :class:`CoefficientSeries`), the windows
+of a dynamic result (``_dynamicfit``) and the Cramér–Rao bound (``_bound``: :func:`information_bound`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
-from .._display import RichDisplay, Summary, Table, fmt_ci, fmt_range, thin
-from .._dist import chi2_sf, norm_ppf
+from .._dist import chi2_sf
 from .._progress import show_progress
-from .._validate import check_count, check_nonnegative, check_positive
 from ..errors import ParameterError
 from ..estimators import get as get_estimator
 from ..estimators import names as estimator_names
-from ..estimators.confidence import edf_of
-from ..plot import plot_coefficient_series, plot_fit  # matplotlib only when a figure is drawn
 from ..results import AllanResult, DynamicAllanResult
-from ..units import coefficient_unit, ieee952, rate_unit
-from . import _batched, _covariance, _nnls
-from .terms import TERM_ALPHA, TERM_NAMES, TERMS, check_terms, design_matrix
+from ..units import rate_unit
+from ._bound import information_bound
+from ._dynamicfit import FLAT_FLOOR as FLAT_FLOOR
+from ._dynamicfit import fit_dynamic
+from ._fitcore import GLS_START_ITER as GLS_START_ITER
+from ._fitcore import GLS_TOL as GLS_TOL
+from ._fitcore import IRLS_RTOL as IRLS_RTOL
+from ._fitcore import MAX_GLS_TAU, edf_per_tau, exact_covariance_applies, fit_core, nnls
+from ._fitcore import OCTAVE_CORRELATION as OCTAVE_CORRELATION
+from ._fitresult import READOFF_MIN_EDF as READOFF_MIN_EDF
+from ._fitresult import Coefficient, CoefficientSeries, NoiseFit, coefficients, interval, readoffs, z_quantile
+from ._fitresult import coefficient_table as coefficient_table
+from ._fitresult import intervals as intervals
+from ._tauselect import check_tau_range, estimator_key, row_medians, select_taus
+from .terms import TERMS, check_terms
 
 __all__ = [
     "fit",
@@ -56,593 +67,6 @@ __all__ = [
     "MAX_GLS_TAU",
     "row_medians",
 ]
-
-
-@dataclass(frozen=True)
-class Coefficient:
-    """One fitted coefficient.
-
-    ``value`` and ``ci`` are in the input unit's base form (for °/s samples: Q in °, N in °/√s,
-    B in °/s, K in °/s^1.5, R in °/s²); ``ieee`` and ``ieee_ci`` in IEEE-952 units
-    (``ieee_unit``: °, °/√h, °/h, °/h^1.5, °/h²) when the input unit is known.
-    """
-
-    name: str
-    value: float
-    ci: tuple
-    unit: str | None = None
-    ieee: float | None = None
-    ieee_ci: tuple | None = None
-    ieee_unit: str | None = None
-
-    def __repr__(self) -> str:
-        u = f" {self.unit}" if self.unit else ""
-        s = f"{self.name} = {self.value:.4g}{u} [{self.ci[0]:.4g}, {self.ci[1]:.4g}]"
-        if self.ieee is not None and self.ieee_ci is not None:
-            s += f" = {self.ieee:.4g} {self.ieee_unit} [{self.ieee_ci[0]:.4g}, {self.ieee_ci[1]:.4g}]"
-        return s
-
-
-def coefficient_table(coefficients: dict, caption: str) -> Table:
-    """The coefficients as a display table: value [interval] in base form and in IEEE-952 units."""
-    rows = []
-    for c in coefficients.values():
-        ieee = "—" if c.ieee is None or c.ieee_ci is None else fmt_ci(c.ieee, *c.ieee_ci)
-        rows.append(
-            [
-                c.name,
-                TERM_NAMES.get(c.name, ""),
-                fmt_ci(c.value, *c.ci),
-                c.unit or "base form",
-                ieee,
-                c.ieee_unit or "—",
-            ]
-        )
-    return Table(("term", "", "value [interval]", "unit", "IEEE-952 [interval]", "IEEE unit"), rows, caption)
-
-
-@dataclass(frozen=True, repr=False, eq=False)
-class NoiseFit(RichDisplay):
-    """The fitted model: coefficients with intervals, the fitted curve and the residuals.
-
-    Attributes
-    ----------
-    coefficients : dict
-        Term name → :class:`Coefficient`.
-    tau, avar, edf : ndarray
-        The τ used in the fit, the estimates there and their equivalent degrees of freedom.
-    model : ndarray
-        Fitted Allan variance at ``tau``; ``components`` maps each term to its share.
-    z : ndarray
-        Residual per τ in units of the estimate's standard deviation: (σ̂² − σ²_model)/(σ²_model·√(2/ν)).
-    chi2, dof, chi2_dof, p_value : float
-        Goodness of fit: χ² of the residuals (whitened by the estimates' covariance across τ for
-        overlapping results — neighbouring z are correlated, so this is not Σz² —, Σz² otherwise),
-        degrees of freedom = points − active terms, its p-value.
-    readoffs : dict
-        Datasheet read-offs from the full curve: ``adev_at_1s`` (ARW read-off, °/√s for °/s input:
-        σ(1 s)·√1 s), ``adev_min``, ``tau_at_min`` and ``bias_instability_readoff`` = min/0.664.
-    confidence : float
-        Level of the intervals.
-    notes : tuple of str
-        What the fit decided on its own (e.g. the τ range chosen by ``tau_range="auto"``).
-    method : str
-        ``"gls"`` — generalized least squares with the estimates' exact covariance across τ (overlapping
-        results); ``"wls"`` — independent weights with the octave-correlation sandwich (classic, Theo).
-    """
-
-    coefficients: dict
-    terms: tuple
-    tau: np.ndarray
-    m: np.ndarray
-    avar: np.ndarray
-    edf: np.ndarray
-    model: np.ndarray
-    components: dict
-    z: np.ndarray
-    chi2: float
-    dof: int
-    chi2_dof: float
-    p_value: float
-    readoffs: dict
-    fs: float
-    confidence: float
-    unit: str | None = None
-    iterations: int = 0
-    method: str = "wls"
-    notes: tuple = ()
-    theta: np.ndarray = field(default=None)  # type: ignore[arg-type]  # always set by fit
-    covariance: np.ndarray = field(default=None)  # type: ignore[arg-type]
-
-    def curve(self, tau) -> np.ndarray:
-        """The fitted Allan variance at any τ (s)."""
-        tau = np.asarray(tau, dtype=np.float64)
-        m = np.maximum(1.0, tau * self.fs)  # real m: a smooth curve between the integer points
-        return design_matrix(tau, m, self.fs, self.terms) @ self.theta
-
-    def component(self, name: str, tau) -> np.ndarray:
-        """One term's Allan variance at τ (s)."""
-        tau = np.asarray(tau, dtype=np.float64)
-        m = np.maximum(1.0, tau * self.fs)  # real m: a smooth curve between the integer points
-        k = self.terms.index(name)
-        return design_matrix(tau, m, self.fs, (name,))[:, 0] * self.theta[k]
-
-    def __repr__(self) -> str:
-        lines = [
-            f"NoiseFit({len(self.tau)} τ, {self.method.upper()}, χ²/dof = {self.chi2_dof:.3g}, p = {self.p_value:.3g}, "
-            f"{self.confidence:.1%} intervals)"
-        ]
-        lines += [f"  {c!r}" for c in self.coefficients.values()]
-        lines += [f"  note: {n}" for n in self.notes]
-        return "\n".join(lines)
-
-    def plot(self, ax=None, **kwargs):
-        """ADEV estimates with the fitted model and each term as its own line."""
-        return plot_fit(self, ax=ax, **kwargs)
-
-    def _summary(self) -> Summary:
-        ro = self.readoffs or {}
-        u = f" {self.unit}" if self.unit else ""
-        facts: list = [
-            ("fitted", f"{len(self.tau)} τ, {fmt_range(self.tau, 's')} ({self.method.upper()})"),
-            ("goodness", f"χ²/dof = {self.chi2_dof:.3g} (dof {self.dof}), p = {self.p_value:.3g}"),
-            ("intervals", f"{self.confidence:.1%}"),
-        ]
-        if ro.get("adev_at_1s") is not None:
-            facts.append(("σ(1 s) read-off", f"{ro['adev_at_1s']:.4g}{u}"))
-        if ro.get("adev_min") is not None:
-            facts.append(
-                (
-                    "σ minimum read-off",
-                    f"{ro['adev_min']:.4g}{u} at τ = {ro['tau_at_min']:.4g} s; "
-                    f"÷ 0.664 = {ro['bias_instability_readoff']:.4g}{u}",
-                )
-            )
-        return Summary(
-            title="NoiseFit",
-            what="IEEE-952 noise model fitted to the Allan variance" + ("" if self.unit else " (unit unknown)"),
-            facts=facts,
-            tables=[coefficient_table(self.coefficients, "coefficients")],
-            notes=list(self.notes),  # what the fit decided itself, e.g. "fitted from τ ≥ 0.16 s (tau_range='auto')"
-            figure=self._draw_small,
-        )
-
-    def _draw_small(self, ax) -> None:
-        """The inline figure: the estimates and the fitted model (≤ MAX_POINTS points each)."""
-        i = thin(len(self.tau))
-        ax.loglog(self.tau[i], np.sqrt(self.avar[i]), "k.", ms=3, label="estimate")
-        grid = np.geomspace(self.tau[0], self.tau[-1], 120)
-        ax.loglog(grid, np.sqrt(np.maximum(self.curve(grid), 0.0)), "C3-", lw=1, label="model")
-        ax.set_xlabel("τ (s)")
-        ax.set_ylabel("ADEV")
-        ax.legend(fontsize="small", frameon=False)
-
-
-@dataclass(frozen=True, repr=False, eq=False)
-class CoefficientSeries(RichDisplay):
-    """Coefficients fitted in every window of a dynamic result (paper 002's 2-D representation).
-
-    ``values``, ``ci_low``, ``ci_high`` map term → array over ``t`` (input unit's base form);
-    ``ieee`` maps term → array in IEEE-952 units (``ieee_units``) when the unit is known;
-    ``notes`` says what the fit decided on its own (the τ cut of ``tau_range="auto"``).
-    """
-
-    t: np.ndarray
-    terms: tuple
-    values: dict
-    ci_low: dict
-    ci_high: dict
-    chi2_dof: np.ndarray
-    confidence: float
-    unit: str | None = None
-    ieee: dict | None = None
-    ieee_units: dict | None = None
-    notes: tuple = ()
-
-    def __repr__(self) -> str:
-        parts = ", ".join(f"{k} median {np.median(v):.3g}" for k, v in self.values.items())
-        return f"CoefficientSeries({self.t.size} windows: {parts})"
-
-    def plot(self, axes=None, ieee: bool = True):
-        """Each coefficient against time, with its interval band."""
-        return plot_coefficient_series(self, axes=axes, ieee=ieee)
-
-    def _summary(self) -> Summary:
-        values, units = (
-            self.values,
-            {k: coefficient_unit(k, self.unit) if self.unit else "base form" for k in self.terms},
-        )
-        ieee = self.ieee is not None and self.ieee_units is not None
-        if self.ieee is not None and self.ieee_units is not None:
-            values, units = self.ieee, self.ieee_units
-        rows: list = []
-        for k in self.terms:
-            unit = units[k]
-            v: np.ndarray = np.asarray(values[k], dtype=np.float64)
-            # a window whose non-negative fit put the term at 0 has not resolved it (only an upper bound)
-            ok = v[np.asarray(self.values[k]) > 0]
-            resolved = f"{ok.size} of {v.size}"
-            if ok.size == 0:
-                rows.append([k, TERM_NAMES.get(k, ""), resolved, None, None, None, None, unit])
-                continue
-            lo, hi = float(ok.min()), float(ok.max())
-            rows.append([k, TERM_NAMES.get(k, ""), resolved, float(np.median(ok)), lo, hi, hi / lo, unit])
-        chi = np.asarray(self.chi2_dof, dtype=float)
-        facts: list = [
-            ("windows", f"{self.t.size}, centred {fmt_range(self.t, 's')}"),
-            ("terms", "+".join(self.terms)),
-            ("intervals", f"{self.confidence:.1%} per window"),
-            ("χ²/dof", f"median {np.nanmedian(chi):.3g}, max {np.nanmax(chi):.3g}" if chi.size else "—"),
-        ]
-        return Summary(
-            title="CoefficientSeries",
-            what="noise coefficients fitted in every window of a dynamic result",
-            facts=facts,
-            tables=[
-                Table(
-                    ("term", "", "resolved in", "median", "min over t", "max over t", "max/min", "unit"),
-                    rows,
-                    "over the windows that resolved the term; "
-                    + ("IEEE-952 units" if ieee else "base form of the samples' unit"),
-                )
-            ],
-            notes=list(self.notes)
-            + ["a window that did not resolve a term has only an upper bound (ci_high), left out of the table"],
-            figure=self._draw_small,
-        )
-
-    def _draw_small(self, ax) -> None:
-        """The inline figure: each coefficient over time relative to its median (≤ MAX_POINTS points)."""
-        j = thin(self.t.size)
-        for n, k in enumerate(self.terms):
-            v = np.asarray(self.values[k], dtype=float)
-            ok = v > 0  # resolved windows only
-            if ok.sum() >= max(2, v.size // 2):
-                shown = np.where(ok, v, np.nan)[j]
-                ax.semilogy(self.t[j], shown / np.median(v[ok]), f"C{n}-", lw=1, label=k)
-        ax.set_xlabel("t (s)")
-        ax.set_ylabel("coefficient / median")
-        ax.legend(fontsize="small", frameon=False, ncol=len(self.terms))
-
-
-#: Correlation of overlapping Allan variance estimates one octave apart, by noise type, measured on
-#: 150 simulated records of 2^18 samples (log-AVAR at octave τ): white angle 0.42, white rate 0.53,
-#: flicker rate 0.68, random-walk rate 0.87 (ramp: taken as random walk). Two estimates a factor r
-#: apart are given ρ^|log2 r|. Classic estimates are less correlated; the same values are used
-#: for them (conservative).
-OCTAVE_CORRELATION = {"Q": 0.42, "N": 0.53, "B": 0.68, "K": 0.87, "R": 0.87}
-
-
-def _estimate_correlation(tau, parts, terms, estimator) -> np.ndarray:
-    """Correlation matrix of the Allan variance estimates at ``tau`` under the model mixture."""
-    share = parts / np.maximum(parts.sum(axis=1, keepdims=True), 1e-300)
-    rho = np.array([OCTAVE_CORRELATION[t] for t in terms])
-    rho_tau = np.clip(share @ rho, 0.0, 0.99)  # per-τ octave correlation of the mixture
-    lt = np.log2(tau)
-    dist = np.abs(lt[:, None] - lt[None, :])
-    # geometric mean of the two ends' octave correlations, to the power of the octave distance
-    base = np.sqrt(np.outer(rho_tau, rho_tau))
-    return np.where(dist == 0, 1.0, base**dist)
-
-
-def _octave_thin(tau: np.ndarray) -> np.ndarray:
-    """Indices of τ at least a factor 2 apart, starting from the shortest."""
-    keep = [0]
-    for i in range(1, tau.size):
-        if tau[i] >= 2.0 * tau[keep[-1]] * (1 - 1e-12):
-            keep.append(i)
-    return np.asarray(keep)
-
-
-def edf_per_tau(alpha: np.ndarray, m: np.ndarray, n_points: int, estimator) -> np.ndarray:
-    """ν per τ for one noise type. ``estimator``: a registry name, or a tuple naming the estimator of
-    every τ (Theo-family results: Greenhall's EDF for Allan τ, Howe's Theo1 EDF for Theo τ)."""
-    est = estimator if isinstance(estimator, str) else np.asarray(estimator)
-    return np.asarray(edf_of(est, np.asarray(alpha), np.asarray(m, dtype=np.int64), int(n_points)), dtype=np.float64)
-
-
-def nnls(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Non-negative least squares of ``a @ x ≈ b``, with the columns scaled first (:func:`._nnls.nnls`)."""
-    return _nnls.nnls(a, b)
-
-
-def _fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=50, edf_cache=None):
-    """Fit one curve. Returns theta, covariance, model, edf, z, iterations, design, χ².
-
-    Overlapping estimates on integer m ≤ n/2 get the generalized least-squares fit with their exact
-    model covariance across τ (:func:`_fit_gls`); other estimators (classic, Theo family) the
-    independent-weights fit with the octave-correlation sandwich (:func:`_fit_irls`)."""
-    _check_gls_size(estimator, m)
-    # The fit is linear in the variance: fitted on estimates scaled by a power of two near their peak (exact),
-    # so that variances of 1e-300 or 1e300 (samples in extreme units) neither underflow nor overflow in the
-    # squares and products of the weights; θ, its covariance and the model are scaled back.
-    peak = float(np.max(avar))
-    scale = math.ldexp(1.0, math.frexp(peak)[1]) if peak > 0 and math.isfinite(peak) else 1.0
-    y = np.asarray(avar, dtype=np.float64) / scale
-    if _exact_covariance_applies(tau, m, fs, n_points, estimator):
-        # a few independent-weights passes are enough for a start (and its EDF for a bare ramp)
-        n_start = min(max_iter, GLS_START_ITER)
-        start = _fit_irls(tau, m, y, fs, n_points, estimator, terms, confidence, n_start, edf_cache)
-        out = _fit_gls(tau, m, y, fs, n_points, terms, start, max_iter)
-    else:
-        out = _fit_irls(tau, m, y, fs, n_points, estimator, terms, confidence, max_iter, edf_cache)
-    theta, cov, model, nu, z, it, a, chi2 = out
-    return theta * scale, cov * (scale * scale), model * scale, nu, z, it, a, chi2
-
-
-def _check_gls_size(estimator, m) -> None:
-    if isinstance(estimator, str) and estimator == "oavar" and m.size > MAX_GLS_TAU:
-        raise ParameterError(
-            f"{m.size} τ of an overlapping estimate would be fitted with their full covariance; at most "
-            f"{MAX_GLS_TAU} are supported (the covariance costs ~n_τ² lag sums) — use thin=True, or a sparser "
-            f"grid such as taus='exp'"
-        )
-
-
-def _exact_covariance_applies(tau, m, fs, n_points, estimator) -> bool:
-    return bool(
-        isinstance(estimator, str)
-        and estimator == "oavar"
-        and np.allclose(tau * fs, m, rtol=1e-9)
-        and np.all(m == np.round(m))
-        and np.all(2 * m <= n_points - 1)
-    )
-
-
-#: The generalized least-squares iteration stops when no fitted value moves by more than this (relative).
-GLS_TOL = 1e-7
-#: The independent-weights iteration stops when no coefficient moves by more than this (relative) ...
-IRLS_RTOL = 1e-7
-#: ... and, as the start of the generalized least squares, after at most this many passes.
-GLS_START_ITER = 8
-
-#: At most this many τ are fitted with their full covariance (it costs ~n_τ² lag sums); more raise an
-#: error with thin=False (the octave-thinned default never comes near it).
-MAX_GLS_TAU = 160
-
-
-def _chol(cov: np.ndarray) -> np.ndarray:
-    """Cholesky factor of a model covariance, with a growing ridge if rounding made it indefinite."""
-    d = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
-    corr = cov / np.outer(d, d)
-    for ridge in (0.0, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4):
-        try:
-            return np.linalg.cholesky(corr + ridge * np.eye(d.size)) * d[:, None]
-        except np.linalg.LinAlgError:
-            continue
-    w, v = np.linalg.eigh(corr)
-    return (v * np.sqrt(np.clip(w, 1e-4 * w.max(), None))) * d[:, None]
-
-
-def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
-    """Generalized least squares with the estimates' exact covariance, iterated from the model.
-
-    Σ(θ) = Cov(σ̂²(τ_i), σ̂²(τ_j)) under the fitted model (:mod:`allanite.model._covariance`: the
-    overlapping estimator's second differences, each term's generalized covariance, summed over all
-    lags), so correlated neighbours are neither overcounted nor thrown away. Each pass solves the
-    non-negative least squares of the whitened problem L⁻¹Aθ ≈ L⁻¹σ̂² (Σ = LLᵀ) with Σ from the
-    previous pass's coefficients — the quasi-likelihood estimating equation Aᵀ Σ⁻¹ (σ̂² − Aθ) = 0,
-    which needs no independence and no thinning. Coefficient covariance: (AᵀΣ⁻¹A)⁻¹."""
-    assemble, covariance_blocks = _covariance.assemble, _covariance.covariance_blocks
-
-    theta0, _, _, nu0, _, _, a, _ = start
-    s_blk, t_blk = covariance_blocks(m, int(n_points) - 1, fs, terms)
-    floor = 1e-12 * np.max(avar)
-
-    def factor(theta):
-        model = np.maximum(a @ theta, floor)
-        cov = assemble(s_blk, t_blk, theta, terms)
-        # a model without stochastic terms (a bare ramp) has no sampling variance: fall back to the
-        # independent EDF variance there, so the problem stays well posed
-        indep = 2.0 * model**2 / nu0
-        bad = ~(np.diag(cov) > 1e-6 * indep)
-        if bad.any():
-            cov = cov + np.diag(np.where(bad, indep, 0.0))
-        return _chol(cov), cov, model
-
-    def step(theta):
-        chol = factor(theta)[0]
-        return nnls(np.linalg.solve(chol, a), np.linalg.solve(chol, avar))
-
-    # convergence in model space: no τ's fitted value moves by more than GLS_TOL of itself (terms too
-    # small to matter anywhere may still wander; they do not change the fit)
-    def change(new, old):
-        return float(np.max(np.abs(a @ (new - old)) / np.maximum(a @ new, floor)))
-
-    theta = theta0.copy()
-    if not theta.any():
-        return start
-    # The fixed-point map θ → step(θ) converges linearly, slowly where the model misfits (0.7–0.9 per
-    # pass on real-sensor windows). SQUAREM (Varadhan & Roland 2008) extrapolates along the last two
-    # steps: each cycle costs three passes and usually ends within a few cycles. Steps are measured in
-    # model space (each θ_k scaled by its largest share of the curve) so no term dominates the norms.
-    scale = np.max(a / np.maximum(avar, floor)[:, None], axis=0)
-    it = 0
-    while it < max_iter:
-        t1 = step(theta)
-        it += 1
-        if not t1.any() or change(t1, theta) < GLS_TOL:
-            theta = t1
-            break
-        t2 = step(t1)
-        it += 1
-        r = (t1 - theta) * scale
-        v = (t2 - t1) * scale - r
-        nv = float(np.linalg.norm(v))
-        alpha = -1.0 if nv == 0.0 else min(-1.0, -float(np.linalg.norm(r)) / nv)
-        jump = np.maximum(theta - 2.0 * alpha * (t1 - theta) + alpha**2 * (t2 - 2.0 * t1 + theta), 0.0)
-        t3 = step(jump) if np.all(np.isfinite(jump)) and jump.any() else t2
-        it += 1
-        done = change(t3, t2) < GLS_TOL and change(t2, t1) < GLS_TOL
-        theta = t3
-        if done or not theta.any():
-            break
-    if not theta.any():
-        return start
-    chol, cov_y, model = factor(theta)
-    aw = np.linalg.solve(chol, a)
-    resid = np.linalg.solve(chol, avar - a @ theta)
-    chi2 = float(resid @ resid)
-    sd = np.sqrt(np.diag(cov_y))
-    z = (avar - model) / sd
-    nu = 2.0 * model**2 / sd**2  # equivalent degrees of freedom of each estimate under the model
-    active = theta > 0
-    cov = np.full((len(terms), len(terms)), np.nan)
-    idx = np.flatnonzero(active)
-    cov[np.ix_(idx, idx)] = np.linalg.pinv(aw[:, idx].T @ aw[:, idx])
-    for k in np.flatnonzero(~active):  # the variance each inactive term would have if freed alone
-        j = np.append(idx, k)
-        cov[k, k] = np.linalg.pinv(aw[:, j].T @ aw[:, j])[-1, -1]
-    return theta, cov, model, nu, z, it, a, chi2
-
-
-def _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=50, edf_cache=None):
-    """IRLS with independent weights for one curve. Returns theta, covariance, model, edf, z, iterations,
-    design, χ².
-
-    ``m`` are the estimator's averaging factors (for the EDF); the closed forms are evaluated at
-    τ·fs, which is m for the Allan estimators and 0.75·m for Theo1-based points."""
-    a = design_matrix(tau, tau * fs, fs, terms)
-    cache = {} if edf_cache is None else edf_cache
-    # EDF of each term's noise type at every τ (Greenhall), cached across windows of a dynamic fit.
-    nu_terms = []
-    for t in terms:
-        key = (TERM_ALPHA[t], tuple(m), n_points, estimator)
-        if key not in cache:
-            cache[key] = edf_per_tau(np.full(m.size, TERM_ALPHA[t]), m, n_points, estimator)
-        nu_terms.append(cache[key])
-    nu_terms = np.column_stack(nu_terms)
-
-    def edf_of(parts):
-        # Mixture of independent noises: Var(σ̂²) ≈ Σ_k 2 s_k²/ν_k, so ν = (Σ s_k)² / Σ s_k²/ν_k —
-        # continuous in the coefficients (an arg-max noise type would make the weights jump and the
-        # iteration cycle between neighbouring solutions).
-        tot = parts.sum(axis=1)
-        den = np.sum(parts**2 / nu_terms, axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            nu = np.where(den > 0, tot**2 / den, nu_terms[:, 0])
-        return nu
-
-    # Start: weights from the estimates themselves, white-rate EDF.
-    model = avar.copy()
-    nu = nu_terms[:, terms.index("N")] if "N" in terms else nu_terms[:, 0]
-    theta = np.zeros(len(terms))
-    it = 0
-    for it in range(1, max_iter + 1):
-        w = nu / (2.0 * np.maximum(model, 1e-300) ** 2)
-        sw = np.sqrt(w)
-        new = nnls(a * sw[:, None], avar * sw)
-        parts = a * new
-        floor = 1e-12 * np.max(avar)
-        new_model = np.maximum(parts.sum(axis=1), floor)
-        done = np.allclose(new, theta, rtol=IRLS_RTOL, atol=0.0)
-        # Damped reweighting: weights from the geometric mean of the last two models. Undamped,
-        # a term on the edge of significance can flip in and out every other iteration.
-        model = new_model if it == 1 else np.sqrt(model * new_model)
-        theta = new
-        if new.any():
-            nu = edf_of(parts)
-        if done:
-            break
-    model = np.maximum((a * theta).sum(axis=1), 1e-12 * np.max(avar))
-    w = nu / (2.0 * model**2)
-    z = (avar - model) * np.sqrt(w)
-    active = theta > 0
-    cov = np.full((len(terms), len(terms)), np.nan)
-    # Covariance of the estimates: variances 2σ⁴/ν, correlated across τ (overlapping estimates share
-    # data). The weighted fit treats them as independent, so its covariance is the sandwich
-    # (AᵀWA)⁻¹ AᵀW Σ W A (AᵀWA)⁻¹ with Σ = D R D — R from the octave correlations per noise type.
-    parts = a * theta
-    corr = _estimate_correlation(tau, parts if theta.any() else a, terms, estimator)
-    sd = np.sqrt(2.0 / nu) * model
-    sigma = corr * np.outer(sd, sd)
-
-    def sandwich(idx):
-        aw = a[:, idx] * w[:, None]
-        bread = np.linalg.pinv(aw.T @ a[:, idx])
-        return bread @ (aw.T @ sigma @ aw) @ bread
-
-    if active.any():
-        idx = np.flatnonzero(active)
-        cov[np.ix_(idx, idx)] = sandwich(idx)
-    # Inactive terms: the variance each would have if freed alone with the active ones.
-    for k in np.flatnonzero(~active):
-        idx = np.append(np.flatnonzero(active), k)
-        cov[k, k] = sandwich(idx)[-1, -1]
-    return theta, cov, model, nu, z, it, a, float(np.sum(z**2))
-
-
-def interval(theta_k, var_k, zq, inflate):
-    """(low, high) of a coefficient from θ_k = coefficient² and its variance: θ ± z·SE·inflate,
-    clipped at 0, square-rooted."""
-    se = math.sqrt(max(var_k, 0.0)) * inflate if np.isfinite(var_k) else math.inf
-    lo = max(0.0, theta_k - zq * se)
-    hi = theta_k + zq * se
-    return math.sqrt(lo), math.sqrt(hi) if np.isfinite(hi) else math.inf
-
-
-#: σ_min is read off only where the estimate has at least this many equivalent degrees of freedom for
-#: flicker rate noise (the bias-instability floor where σ_min sits): the ADEV is then known to ≈ ±22 %.
-#: The last τ of a curve (a few clusters; Theo points reaching 75 % of the record) have ν ≈ 1–5: their
-#: scatter, not the sensor, would set the minimum.
-READOFF_MIN_EDF = 10.0
-
-
-def readoffs(result: AllanResult, adev_row: np.ndarray) -> dict:
-    """Datasheet read-offs of one ADEV curve: σ(1 s), σ_min and where, σ_min/0.664.
-
-    σ_min is searched over the τ whose estimate has ν ≥ :data:`READOFF_MIN_EDF` for flicker rate noise
-    (``readoff_tau_max`` is the longest such τ): a minimum at a τ with ν ≈ 1 is the estimate's scatter.
-    """
-    tau = result.tau
-    out: dict[str, Any] = {}
-    if tau[0] <= 1.0 <= tau[-1]:
-        # log-log interpolation between the neighbours of 1 s (exact when 1 s is on the grid)
-        out["adev_at_1s"] = float(np.exp(np.interp(0.0, np.log(tau), np.log(adev_row))))
-        out["adev_at_1s_interpolated"] = not np.any(np.isclose(tau, 1.0))
-    else:
-        out["adev_at_1s"] = None
-        out["adev_at_1s_interpolated"] = None
-    src = result.estimator if result.source is None else np.asarray(result.source)
-    window = getattr(result, "window", None) or result.n_samples
-    nu = edf_per_tau(np.full(tau.size, -1), np.asarray(result.m), window + 1, src)
-    usable = np.flatnonzero(nu >= READOFF_MIN_EDF)
-    if usable.size == 0:
-        usable = np.arange(tau.size)
-    i = int(usable[np.argmin(np.asarray(adev_row)[usable])])
-    out["readoff_tau_max"] = float(tau[usable[-1]])
-    out["adev_min"] = float(adev_row[i])
-    out["tau_at_min"] = float(tau[i])
-    out["bias_instability_readoff"] = float(adev_row[i] / 0.664)
-    return out
-
-
-def z_quantile(confidence) -> float:
-    """The two-sided normal quantile of a confidence level (1.0 for 68.3 %)."""
-    if (
-        isinstance(confidence, bool)
-        or not isinstance(confidence, (int, float, np.floating))
-        or not 0.0 < float(confidence) < 1.0
-    ):
-        raise ParameterError(f"confidence must be a level strictly between 0 and 1, got {confidence!r}")
-    return float(norm_ppf(0.5 + float(confidence) / 2.0))
-
-
-def coefficients(terms, theta, cov, zq, inflate, unit) -> dict:
-    """Term → :class:`Coefficient` from θ = coefficient² and its covariance (intervals θ ± z·SE,
-    widened by ``inflate``, clipped at 0, square-rooted); IEEE-952 values when ``unit`` is known."""
-    coeffs = {}
-    for k, name in enumerate(terms):
-        value = math.sqrt(theta[k])
-        ci = interval(theta[k], cov[k, k], zq, inflate)
-        if unit is not None:
-            q = ieee952(name, value, unit)
-            lo = ieee952(name, ci[0], unit).value
-            hi = ieee952(name, ci[1], unit).value if np.isfinite(ci[1]) else math.inf
-            coeffs[name] = Coefficient(name, value, ci, coefficient_unit(name, unit), q.value, (lo, hi), q.unit)
-        else:
-            coeffs[name] = Coefficient(name, value, ci)
-    return coeffs
 
 
 def fit(
@@ -734,7 +158,7 @@ def fit(
         _check_fit_estimator(result)
         if auto:
             return _fit_dynamic_auto(result, terms, unit, float(confidence), zq, thin, max_iter, progress)
-        return _fit_dynamic(result, terms, unit, float(confidence), zq, thin, max_iter, tau_range, progress)
+        return fit_dynamic(result, terms, unit, float(confidence), zq, thin, max_iter, tau_range, progress)
     if not isinstance(result, AllanResult):
         raise ParameterError(f"fit needs an AllanResult or DynamicAllanResult, got {type(result).__name__}")
     _check_fit_estimator(result)
@@ -758,7 +182,7 @@ AUTO_MAX_CUT_M = 64
 def _auto_cuts(result, avar_row, thin, n_terms):
     """Lower τ cuts to try: none, then each fitted τ in turn (an octave at a time) up to AUTO_MAX_CUT_M samples,
     keeping at least n_terms + 3 τ."""
-    idx = _select(result.tau, avar_row, thin, n_terms, "the result")
+    idx = select_taus(result.tau, avar_row, thin, n_terms, "the result")
     tau, m = result.tau[idx], result.m[idx]
     cuts = [0.0]
     for k in range(1, tau.size):
@@ -830,7 +254,7 @@ def _fit_dynamic_auto(result, terms, unit, confidence, zq, thin, max_iter, progr
 
         cut, (_, chi), (_, chi0), ok = _auto_choose(cuts, fit_at)
         single = dataclasses.replace(result, avar=rows_avar)
-        s = _fit_dynamic(single, terms, unit, confidence, zq, thin, max_iter, (cut, np.inf), progress)
+        s = fit_dynamic(single, terms, unit, confidence, zq, thin, max_iter, (cut, np.inf), progress)
         out.append(dataclasses.replace(s, notes=_auto_note(cut, chi, chi0, tau0, ok)))
     return out[0] if result.avar.ndim == 2 else out
 
@@ -852,54 +276,12 @@ def fit_estimators() -> tuple[str, ...]:
     return tuple(n for n in estimator_names() if get_estimator(n).estimates_allan)
 
 
-def _est_key(result, idx):
-    """The estimator argument of _fit_core: a name, or a tuple of per-τ sources for Theo-family results."""
-    return result.estimator if result.source is None else tuple(np.asarray(result.source)[idx])
-
-
-def check_tau_range(tau_range):
-    """A (low, high) τ range in seconds (None for an open end) as floats, or a ParameterError."""
-    if tau_range is None:
-        return (0.0, np.inf)
-    try:
-        lo, hi = tau_range
-    except (TypeError, ValueError):
-        raise ParameterError(f"tau_range must be a (low, high) pair of seconds, got {tau_range!r}") from None
-    lo = 0.0 if lo is None else float(lo)
-    hi = np.inf if hi is None else float(hi)
-    if not (lo >= 0 and hi > lo) or np.isnan(lo) or np.isnan(hi):
-        raise ParameterError(f"tau_range must satisfy 0 ≤ low < high, got {tau_range!r}")
-    return (lo, hi)
-
-
-def _select(tau, avar, thin, n_terms, what, tau_range=(0.0, np.inf)):
-    if not np.all(np.isfinite(avar)):
-        i = int(np.flatnonzero(~np.isfinite(avar))[0])
-        raise ParameterError(f"{what} has a non-finite Allan variance ({avar[i]}) at τ = {tau[i]:g} s")
-    inside = np.flatnonzero((tau >= tau_range[0]) & (tau <= tau_range[1]))
-    if inside.size == 0:
-        raise ParameterError(f"no τ of {what} lies in tau_range {tau_range} s (τ spans {tau[0]:g}–{tau[-1]:g} s)")
-    if not np.any(avar[inside] > 0):
-        raise ParameterError(
-            f"{what} has an Allan variance of zero at every τ in range (a constant record?): there is no noise to fit"
-        )
-    idx = inside[_octave_thin(tau[inside])] if thin else inside
-    idx = idx[avar[idx] > 0]
-    if idx.size <= n_terms:
-        raise ParameterError(
-            f"{what} has {idx.size} usable τ{' (octave-spaced)' if thin else ''} for {n_terms} terms; "
-            f"at least {n_terms + 1} are needed — use a wider τ grid or fewer terms"
-            + (", or fit every τ (thin=False)" if thin else "")
-        )
-    return idx
-
-
 def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_iter, tau_range):
     avar_row = np.asarray(avar_row, dtype=np.float64)
-    idx = _select(result.tau, avar_row, thin, len(terms), "the result", tau_range)
+    idx = select_taus(result.tau, avar_row, thin, len(terms), "the result", tau_range)
     tau, m, y = result.tau[idx], result.m[idx].astype(np.float64), avar_row[idx]
-    theta, cov, model, nu, z, it, a, chi2 = _fit_core(
-        tau, m, y, result.fs, result.n_samples + 1, _est_key(result, idx), terms, confidence, max_iter
+    theta, cov, model, nu, z, it, a, chi2 = fit_core(
+        tau, m, y, result.fs, result.n_samples + 1, estimator_key(result, idx), terms, confidence, max_iter
     )
     n_active = int(np.count_nonzero(theta > 0))
     dof = max(1, tau.size - n_active)
@@ -936,176 +318,6 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
         covariance=cov,
         notes=notes,
         method="gls"
-        if _exact_covariance_applies(tau, m, result.fs, result.n_samples + 1, _est_key(result, idx))
+        if exact_covariance_applies(tau, m, result.fs, result.n_samples + 1, estimator_key(result, idx))
         else "wls",
     )
-
-
-#: A dynamic result's window is flat when every Allan variance in it is at most this share of the result's
-#: largest (its rounding residue is ~1e-38 of it; a real noise level 10⁶ lower in amplitude is 1e-12).
-FLAT_FLOOR = 1e-24
-
-
-def _fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range, progress=None):
-    rows = [result.avar] if result.avar.ndim == 2 else list(result.avar)
-    series = []
-    for rows_avar in rows:
-        # τ chosen on the windows' median curve: one flat window must not decide for all of them
-        idx = _select(result.tau, row_medians(rows_avar), thin, len(terms), "the dynamic result", tau_range)
-        y = np.ascontiguousarray(rows_avar[idx].T)  # windows × fitted τ
-        bad = ~np.isfinite(y).all(axis=1)
-        if bad.any():
-            raise ParameterError(
-                f"the dynamic result has a non-finite Allan variance in window {int(np.flatnonzero(bad)[0])}"
-            )
-        # a window whose samples are all equal (a sensor not yet streaming) has Allan variance 0; the core
-        # returns its rounding residue, ~ε²·offset² (≈ 1e-38 of the record's largest value), not always an
-        # exact 0: such a window is flat, not a fit (coefficients and intervals 0)
-        finite = rows_avar[np.isfinite(rows_avar)]
-        flat_floor = FLAT_FLOOR * (float(finite.max()) if finite.size else 0.0)
-        fitted = ~np.all(y <= flat_floor, axis=1)
-        theta, var, chi2 = np.zeros((y.shape[0], len(terms))), np.zeros((y.shape[0], len(terms))), np.zeros(y.shape[0])
-        if fitted.any():
-            fits = _window_fits(result, idx, np.maximum(y[fitted], 1e-300), terms, confidence, max_iter, progress)
-            theta[fitted], var[fitted], chi2[fitted] = fits
-        chi = chi2 / np.maximum(1, idx.size - np.count_nonzero(theta > 0, axis=1))
-        inflate = np.maximum(1.0, np.sqrt(chi))
-        vals, lo, hi = {}, {}, {}
-        for k, t in enumerate(terms):
-            vals[t] = np.sqrt(theta[:, k])
-            lo[t], hi[t] = intervals(theta[:, k], var[:, k], zq, inflate)
-        ieee = ieee_units = None
-        if unit is not None:
-            ieee = {t: ieee952(t, vals[t], unit).value for t in terms}
-            ieee_units = {t: ieee952(t, 1.0, unit).unit for t in terms}
-        series.append(
-            CoefficientSeries(
-                t=result.t,
-                terms=terms,
-                values=vals,
-                ci_low=lo,
-                ci_high=hi,
-                chi2_dof=chi,
-                confidence=confidence,
-                unit=unit,
-                ieee=ieee,
-                ieee_units=ieee_units,
-            )
-        )
-    return series[0] if result.avar.ndim == 2 else series
-
-
-def row_medians(a) -> np.ndarray:
-    """The median of every row of a 2-D array, one row at a time: ``np.median(a, axis=1)`` partitions a copy
-    of the whole array (a hop-1 DAVAR surface: gigabytes)."""
-    return np.array([np.median(r) for r in a])
-
-
-def intervals(theta, var, zq, inflate):
-    """:func:`interval` of many coefficients at once: arrays (low, high)."""
-    se = np.where(np.isfinite(var), np.sqrt(np.maximum(var, 0.0)) * inflate, np.inf)
-    with np.errstate(invalid="ignore"):
-        hi = theta + zq * se
-        return np.sqrt(np.maximum(0.0, theta - zq * se)), np.where(np.isfinite(hi), np.sqrt(hi), np.inf)
-
-
-def _window_fits(result, idx, y, terms, confidence, max_iter, progress):
-    """θ, the variance of each θ_k and χ² of every window (rows of ``y``, the estimates at τ[idx]): the
-    per-window fit of :func:`_fit_core`, run for all windows at once in the core; a window it hands back
-    is refitted here."""
-    tau, m, fs = result.tau[idx], result.m[idx].astype(np.float64), result.fs
-    n_points, est = result.window + 1, _est_key(result, idx)
-    _check_gls_size(est, m)
-    gls = _exact_covariance_applies(tau, m, fs, n_points, est)
-    nu_terms = np.column_stack([edf_per_tau(np.full(m.size, TERM_ALPHA[t]), m, n_points, est) for t in terms])
-    theta, cov, chi2, _, status = _batched.fit_windows(
-        y,
-        design_matrix(tau, tau * fs, fs, terms),
-        nu_terms,
-        start_col=terms.index("N") if "N" in terms else 0,
-        irls_iter=GLS_START_ITER,
-        max_iter=max_iter,
-        gls_tol=GLS_TOL,
-        irls_rtol=IRLS_RTOL,
-        rho=[OCTAVE_CORRELATION[t] for t in terms],
-        log2_tau=np.log2(tau),
-        blocks=_covariance.covariance_blocks(m, n_points - 1, fs, terms) if gls else None,
-        stoch=[k for k, t in enumerate(terms) if t in _covariance.KERNEL_TERMS],
-        ramp=terms.index("R") if "R" in terms else None,
-        progress=progress,
-    )
-    back = np.flatnonzero(status)
-    if back.size:
-        theta[back], cov[back], chi2[back] = _window_fits_reference(result, idx, y[back], terms, confidence, max_iter)
-    return theta, np.diagonal(cov, axis1=1, axis2=2), chi2
-
-
-def _window_fits_reference(result, idx, y, terms, confidence, max_iter):
-    """θ, covariance and χ² of each row of ``y`` by :func:`_fit_core`, one window at a time (the reference
-    of the batched fit, and the fit of the windows it hands back)."""
-    tau, m = result.tau[idx], result.m[idx].astype(np.float64)
-    est, cache = _est_key(result, idx), {}
-    theta = np.empty((y.shape[0], len(terms)))
-    cov = np.empty((y.shape[0], len(terms), len(terms)))
-    chi2 = np.empty(y.shape[0])
-    for j in range(y.shape[0]):
-        out = _fit_core(tau, m, y[j], result.fs, result.window + 1, est, terms, confidence, max_iter, edf_cache=cache)
-        theta[j], cov[j], chi2[j] = out[0], out[1], out[7]
-    return theta, cov, chi2
-
-
-def information_bound(n: int, fs: float, *, Q: float = 0.0, N: float = 0.0, B: float = 0.0, K: float = 0.0) -> dict:
-    """How precisely a record of ``n`` rate samples at ``fs`` Hz can determine each noise coefficient at all.
-
-    The Cramér–Rao bound, in the Whittle (periodogram) approximation of the Gaussian likelihood, on the
-    relative standard deviation of each nonzero coefficient — Q, N, B, K in the input unit's base form,
-    as :func:`fit` and :func:`~allanite.simulate` use them — that any unbiased estimator, from the Allan
-    variance or otherwise, can reach. Use it to plan a logging campaign (how long until K is known to
-    10 %?) and to judge a fit's intervals: ``fit``'s standard errors should not be far above it.
-
-    The spectra are those of the sampled processes :func:`~allanite.simulate` makes (one-sided, rate
-    samples, f_k = k·fs/n, k = 1 … n/2): Q: 8Q²sin²(πfτ0)/τ0; N: 2N²; B: B²/(πf); K:
-    K²τ0²/(2sin²(πfτ0)). The Fisher information is I_pq = Σ_k ∂_pS·∂_qS/S² for θ = coefficient²,
-    and the bound on a coefficient's relative SD is √(I⁻¹)_pp/(2θ_p). For a roughly normal estimate
-    the median |relative error| is ≈ 0.674 times that. The rate ramp R is a deterministic trend, not a
-    spectral term, and has no bound here.
-
-    Returns a dict term → relative standard deviation (only the nonzero terms).
-
-    Examples
-    --------
-    >>> import allanite
-    >>> b = allanite.information_bound(1_000_000, 100.0, N=2e-3)   # white noise alone: 1/√(2n)
-    >>> round(b["N"] * (2 * 1_000_000) ** 0.5, 6)
-    1.0
-    >>> b = allanite.information_bound(1_000_000, 100.0, Q=3.5e-4, N=2e-3, B=1e-3, K=6e-5)
-    >>> round(100 * 0.674 * b["K"], 1)   # median |error| of K no unbiased estimator beats: 16 %
-    16.4
-    """
-    n = int(check_count(n, "n", 4))
-    tau0 = 1.0 / check_positive(fs, "fs")
-    given = {"Q": Q, "N": N, "B": B, "K": K}
-    terms = []
-    theta = []
-    for name, v in given.items():
-        v = check_nonnegative(v, name)
-        if v > 0:
-            terms.append(name)
-            theta.append(v * v)
-    if not terms:
-        raise ParameterError("information_bound needs at least one nonzero coefficient among Q, N, B, K")
-    theta_arr = np.array(theta)
-    info = np.zeros((len(terms), len(terms)))
-    n_freq = n // 2
-    chunk = 1 << 20
-    for start in range(1, n_freq + 1, chunk):
-        k = np.arange(start, min(n_freq, start + chunk - 1) + 1, dtype=np.float64)
-        f = k * (fs / n)
-        s2 = np.sin(np.pi * f * tau0) ** 2
-        cols = {"Q": 8.0 * s2 / tau0, "N": np.full_like(f, 2.0), "B": 1.0 / (np.pi * f), "K": tau0 * tau0 / (2.0 * s2)}
-        d = np.array([cols[t] for t in terms])
-        spec = theta_arr @ d
-        dw = d / spec
-        info += dw @ dw.T
-    cov = np.linalg.inv(info)
-    return {t: float(math.sqrt(cov[i, i]) / (2.0 * theta_arr[i])) for i, t in enumerate(terms)}
