@@ -3,21 +3,26 @@
 Each shortcut is checked against the plain path, bit for bit where it claims so: the fits of a grid run together
 against one fit at a time (the IRLS of the pre-batching code, written out here), the NNLS without scipy's wrapper
 against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of many pairs at once against one pair
-at a time, the drift bootstrap's one-product statistics against a QR per grid point, and a whole default ``refine``
-with the remembered columns against one that recomputes them. No timings here: ``benches/bench_refine_cost.py``.
+at a time, the drift bootstrap's one-product statistics against a QR per grid point, Brent's bounded search as a
+coroutine against scipy's, a step's searches run in lockstep against one search after another (scipy's bounded
+search, one fit per call), and a whole default ``refine`` with the remembered columns and the searches run in
+lockstep against one that recomputes them one at a time. No timings here: ``benches/bench_refine_cost.py``.
 """
 
 from __future__ import annotations
 
+import importlib
 import math
 
 import numpy as np
 import pytest
+from scipy.optimize import minimize_scalar
 from scipy.optimize import nnls as scipy_nnls
 
 import allanite
 from allanite.model import _covariance, _nnls, tracing
-from allanite.model.refinement import curvefit
+from allanite.model.refinement import _brent, curvefit
+from allanite.model.refinement import candidates as cands
 from allanite.model.refinement.candidates import bandwidth_grids
 
 START = ("Q", "N", "B", "K", "R")
@@ -193,10 +198,32 @@ def test_drift_bootstrap_statistics_equal_a_qr_per_grid_point():
     np.testing.assert_allclose(tracing._grid_stats(b, tb, length), nb * np.log(rss0 / best), rtol=1e-9, atol=1e-9)
 
 
+def _one_at_a_time(curve, terms, effects, specs):
+    """The searches one after another, each on its own, with scipy's bounded search (the code before the lockstep)."""
+    out = []
+    for key, grid, cont in specs:
+        chis = curvefit.chi2s(curve, terms, effects, key, grid, max_iter=6)
+        k = int(np.argmin(chis))
+        lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
+        p = float(grid[k])
+        if cont and hi > lo:
+            res = minimize_scalar(
+                lambda lp, key=key: float(curvefit.chi2s(curve, terms, effects, key, [math.exp(lp)])[0]),
+                bounds=(lo, hi),
+                method="bounded",
+                options={"xatol": 1e-3},
+            )
+            p = math.exp(res.x)
+        out.append(curvefit._searched(curve, terms, effects, key, grid, cont, p, k))
+    return out
+
+
 def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
     y = allanite.simulate(100_000, 50.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 4.0)], seed=8)
     cached = allanite.refine(y, 50.0, progress=False)
     monkeypatch.setattr(curvefit.Curve, "cached", lambda self, key: None)  # every column, EDF and subset afresh
+    monkeypatch.setattr(importlib.import_module("allanite.model.refinement.loop"), "prefetch", lambda rnd, c: None)
+    monkeypatch.setattr(curvefit, "searches", _one_at_a_time)  # each search alone, when proposed
     plain = allanite.refine(y, 50.0, progress=False)
     assert cached.found == plain.found
     for a, b in zip(cached.steps, plain.steps):
@@ -204,3 +231,63 @@ def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
         assert a.before == b.before and a.after == b.after
     assert cached.fit.chi2 == plain.fit.chi2
     assert cached.unexplained == plain.unexplained
+
+
+def test_brent_coroutine_visits_scipys_points():
+    rng = np.random.default_rng(4)
+    for i in range(300):
+        c = rng.uniform(-3.0, 3.0, 4)
+        lo, hi = sorted(rng.uniform(-2.0, 2.0, 2))
+
+        def f(x, c=c, step=i % 3 == 0):  # smooth, and with steps (parabolas rejected, golden sections)
+            return float(c[0] * np.sin(c[1] * x) + c[2] * (x - c[3]) ** 2 + (np.floor(5 * x) if step else 0.0))
+
+        seen: list = []
+        ours: list = []
+        ref = minimize_scalar(
+            lambda x, seen=seen: seen.append(x) or f(x), bounds=(lo, hi), method="bounded", options={"xatol": 1e-3}
+        )
+        got = _brent.minimize(lambda x, ours=ours: ours.append(x) or f(x), lo, hi, xatol=1e-3)
+        assert got == ref.x and ours == seen and len(seen) == ref.nfev
+
+
+def _plain_search(curve, terms, effects, key, grid, continuous=True):
+    """One search as before the lockstep: the grid screened, scipy's bounded search one fit per call."""
+    chis = [_plain_solve(curve, terms, effects + [(key, float(p))], 6)[2] for p in grid]
+    k = int(np.argmin(chis))
+    lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
+    p = float(grid[k])
+    if continuous and hi > lo:
+        res = minimize_scalar(
+            lambda lp: _plain_solve(curve, terms, effects + [(key, math.exp(lp))])[2],
+            bounds=(lo, hi),
+            method="bounded",
+            options={"xatol": 1e-3},
+        )
+        p = math.exp(res.x)
+    theta, _nu, chi2 = _plain_solve(curve, terms, effects + [(key, p)])
+    if p != float(grid[k]):
+        theta_k, _nu_k, chi2_k = _plain_solve(curve, terms, effects + [(key, float(grid[k]))])
+        if chi2 > chi2_k:
+            p, theta, chi2 = float(grid[k]), theta_k, chi2_k
+    return p, theta, chi2, (k == 0 and continuous) or k == grid.size - 1
+
+
+@pytest.mark.parametrize("effects", [[], [("bandwidth:single_pole", 20.0)]])
+def test_searches_in_lockstep_equal_one_after_another(curve, effects):
+    rnd = cands.Round(curve, START, effects, curvefit.solve(curve, START, effects))
+    specs = [
+        s for name in ("gauss_markov", "bandwidth", "resonance") for s in cands.CURVE_CANDIDATES[name].searches(rnd)
+    ]
+    assert len(specs) >= 5
+    fresh = curvefit.Curve(curve.tau, curve.m, curve.avar, curve.fs, curve.n_points, curve.estimator)
+    together = curvefit.searches(fresh, START, effects, specs)
+    for (key, grid, cont), (p, sol, edge) in zip(specs, together):
+        p_ref, theta_ref, chi2_ref, edge_ref = _plain_search(curve, START, effects, key, grid, cont)
+        assert (p, edge) == (p_ref, edge_ref), key
+        np.testing.assert_array_equal(sol.theta, theta_ref)
+        assert sol.chi2 == chi2_ref
+    # a proposal's search afterwards is read from the curve's memory: the same numbers, its own Solution
+    again = curvefit.search(fresh, START, effects, *specs[0])
+    assert again[0] == together[0][0] and again[1] is not together[0][1]
+    np.testing.assert_array_equal(again[1].theta, together[0][1].theta)
