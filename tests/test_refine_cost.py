@@ -6,11 +6,13 @@ against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of m
 at a time, the drift bootstrap's one-product statistics against a QR per grid point, Brent's bounded search as a
 coroutine against scipy's, a step's searches run in lockstep against one search after another (scipy's bounded
 search, one fit per call), and a whole default ``refine`` with the remembered columns and the searches run in
-lockstep against one that recomputes them one at a time. No timings here: ``benches/bench_refine_cost.py``.
+lockstep against one that recomputes them one at a time, the line spectra remembered within a refine against fresh
+ones, the phase gridding of the line-family fits against its plain form. No timings here: ``benches/bench_refine_cost.py``.
 """
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import math
 
@@ -20,7 +22,7 @@ from scipy.optimize import minimize_scalar
 from scipy.optimize import nnls as scipy_nnls
 
 import allanite
-from allanite.model import _covariance, _nnls, tracing
+from allanite.model import _covariance, _nnls, linefit, lines, tracing
 from allanite.model.refinement import _brent, curvefit
 from allanite.model.refinement import candidates as cands
 from allanite.model.refinement.candidates import bandwidth_grids
@@ -222,7 +224,9 @@ def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
     y = allanite.simulate(100_000, 50.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 4.0)], seed=8)
     cached = allanite.refine(y, 50.0, progress=False)
     monkeypatch.setattr(curvefit.Curve, "cached", lambda self, key: None)  # every column, EDF and subset afresh
-    monkeypatch.setattr(importlib.import_module("allanite.model.refinement.loop"), "prefetch", lambda rnd, c: None)
+    loop = importlib.import_module("allanite.model.refinement.loop")
+    monkeypatch.setattr(loop, "prefetch", lambda rnd, c: None)
+    monkeypatch.setattr(loop, "remembering_spectra", contextlib.nullcontext)  # every line spectrum afresh
     monkeypatch.setattr(curvefit, "searches", _one_at_a_time)  # each search alone, when proposed
     plain = allanite.refine(y, 50.0, progress=False)
     assert cached.found == plain.found
@@ -291,3 +295,77 @@ def test_searches_in_lockstep_equal_one_after_another(curve, effects):
     again = curvefit.search(fresh, START, effects, *specs[0])
     assert again[0] == together[0][0] and again[1] is not together[0][1]
     np.testing.assert_array_equal(again[1].theta, together[0][1].theta)
+
+
+def _plain_fold(z, u, m_bins, seg, n_seg):
+    """The gridding + FFT of :func:`allanite.model.linefit._fold` as it was (offsets added per part, the
+    kernel's transform computed per call)."""
+    x = u * m_bins
+    j = x.astype(np.int64)
+    w = x - j
+    j1 = np.where(j + 1 >= m_bins, 0, j + 1)
+    off = 0 if seg is None else seg * m_bins
+    size = m_bins * n_seg
+    parts = []
+    for part in (z.real, z.imag) if np.iscomplexobj(z) else (z,):
+        hi = part * w
+        parts.append(np.bincount(j + off, part - hi, minlength=size) + np.bincount(j1 + off, hi, minlength=size))
+    g = parts[0] + 1j * parts[1] if len(parts) == 2 else parts[0]
+    out = np.fft.fft(g.reshape(n_seg, m_bins), axis=1)
+    k = np.arange(m_bins)
+    ks = np.where(k > m_bins // 2, k - m_bins, k)
+    return out / np.sinc(ks / m_bins) ** 2
+
+
+@pytest.mark.parametrize("n_seg", [1, 32])
+@pytest.mark.parametrize("kind", [np.float64, np.complex128])
+def test_fold_equals_the_plain_gridding(n_seg, kind):
+    rng = np.random.default_rng(6)
+    n = 50_000
+    z = rng.standard_normal(n) + (1j * rng.standard_normal(n) if kind is np.complex128 else 0.0)
+    u = np.mod(np.arange(n) * 0.1234567, 1.0)
+    u[:3] = [0.0, np.nextafter(1.0, 0.0), 0.5]  # the last phase bin wraps to the first
+    seg = None if n_seg == 1 else np.minimum(np.arange(n) * n_seg // n, n_seg - 1)
+    for m_bins in (4096, 2**14):
+        np.testing.assert_array_equal(linefit._fold(z, u, m_bins, seg, n_seg), _plain_fold(z, u, m_bins, seg, n_seg))
+
+
+def _same_search(a, b):
+    assert a["bins"] == b["bins"] and a["p_value"] == b["p_value"] and a["lines"] == b["lines"]
+    for pa, pb in zip(a["passes"], b["passes"], strict=True):
+        assert pa.keys() == pb.keys()
+        for key in pa:
+            if isinstance(pa[key], np.ndarray):
+                np.testing.assert_array_equal(pa[key], pb[key])
+
+
+def test_remembered_line_spectra_equal_fresh_ones():
+    t = np.arange(200_000) / 100.0
+    y = allanite.simulate(t.size, 100.0, N=2e-3, K=2e-5, seed=9) + 0.02 * np.sin(2 * np.pi * 1.3 * t)
+    other = y + 0.02 * np.sin(2 * np.pi * 7.1 * t)
+    fresh = [lines.find_lines(v, 100.0, a) for v, a in ((y, 0.01), (y, 0.2), (other, 0.01))]
+    with lines.remembering_spectra():
+        # the same samples at two levels (the masks of the first search must not leak into the second), a copy
+        # of them, other samples: each the fresh search's numbers
+        got = [lines.find_lines(v, 100.0, a) for v, a in ((y, 0.01), (y, 0.2), (other, 0.01))]
+        again = lines.find_lines(y.copy(), 100.0, 0.01)
+        assert len(lines._SPECTRA[-1]) == 2  # two records' spectra computed, not four
+    assert lines._SPECTRA == []  # forgotten on leaving
+    for g, f in zip(got, fresh):
+        _same_search(g, f)
+    _same_search(again, fresh[0])
+    assert len(fresh[0]["lines"]) >= 1 and len(fresh[2]["lines"]) >= 2
+
+
+def test_remembered_edf_equals_computed(curve):
+    from allanite.model import fitting
+
+    twin = curvefit.Curve(curve.tau, curve.m.copy(), curve.avar * 1.1, curve.fs, curve.n_points, curve.estimator)
+    half = curvefit.Curve(curve.tau, curve.m, curve.avar, curve.fs, curve.n_points // 2, curve.estimator)
+    for alpha in (-2, -1, 0, 2):
+        plain = fitting.edf_per_tau(np.full(curve.m.size, alpha), curve.m, curve.n_points, curve.estimator)
+        np.testing.assert_array_equal(curve.edf(alpha), plain)
+        assert twin.edf(alpha) is curve.edf(alpha)  # the same factors and length: read from memory
+        plain_half = fitting.edf_per_tau(np.full(curve.m.size, alpha), curve.m, curve.n_points // 2, curve.estimator)
+        np.testing.assert_array_equal(half.edf(alpha), plain_half)
+        assert not np.array_equal(plain_half, plain)

@@ -24,6 +24,7 @@ lines:
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -120,19 +121,31 @@ def _fold(z: np.ndarray, u: np.ndarray, m_bins: int, seg: np.ndarray | None, n_s
     x = u * m_bins
     j = x.astype(np.int64)
     w = x - j
-    j1 = np.where(j + 1 >= m_bins, 0, j + 1)
-    off = 0 if seg is None else seg * m_bins
+    j1 = j + 1
+    j1[j1 >= m_bins] = 0
+    if seg is not None:  # each segment its own M bins
+        off = seg * m_bins
+        j += off
+        j1 += off
     size = m_bins * n_seg
     parts = []
     for part in (z.real, z.imag) if np.iscomplexobj(z) else (z,):
         hi = part * w
-        g = np.bincount(j + off, part - hi, minlength=size) + np.bincount(j1 + off, hi, minlength=size)
+        g = np.bincount(j, part - hi, minlength=size) + np.bincount(j1, hi, minlength=size)
         parts.append(g)
     g = parts[0] + 1j * parts[1] if len(parts) == 2 else parts[0]
     out = np.fft.fft(g.reshape(n_seg, m_bins), axis=1)
+    return out / _kernel_transform(m_bins)
+
+
+@lru_cache(maxsize=8)
+def _kernel_transform(m_bins: int) -> np.ndarray:
+    """sinc²(k/M) at the FFT's bins k (signed): the linear interpolation kernel's transform (read-only)."""
     k = np.arange(m_bins)
     ks = np.where(k > m_bins // 2, k - m_bins, k)
-    return out / np.sinc(ks / m_bins) ** 2
+    out = np.sinc(ks / m_bins) ** 2
+    out.flags.writeable = False
+    return out
 
 
 def dtft(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray, n_seg: int = 1) -> np.ndarray:

@@ -75,6 +75,11 @@ def _alpha_of(key, p, tau):
     return alpha(tau, p)
 
 
+#: EDF per τ by (α, averaging factors, record length, estimator): the last :data:`_EDF_KEPT` computed.
+_EDF: dict = {}
+_EDF_KEPT = 64
+
+
 class Curve:
     """One Allan curve to fit: τ, m, estimates, record length, estimator (for the EDF)."""
 
@@ -86,9 +91,20 @@ class Curve:
         self.n_eff = max(2.0, math.log2(tau[-1] / tau[0]) + 1.0)
 
     def edf(self, alpha: int) -> np.ndarray:
-        """EDF of each estimate for noise type ``alpha`` (computed once per α)."""
+        """EDF of each estimate for noise type ``alpha`` (computed once per α — and once per averaging factors,
+        record length and estimator: the curve of the samples a removal left, or of its held-out parts, has
+        the same EDF as the curve before it)."""
         if alpha not in self._edf:
-            self._edf[alpha] = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
+            est = self.estimator if isinstance(self.estimator, str) else tuple(self.estimator)
+            key = (int(alpha), self.m.tobytes(), int(self.n_points), est)
+            got = _EDF.get(key)
+            if got is None:
+                got = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
+                got.flags.writeable = False
+                while len(_EDF) >= _EDF_KEPT:
+                    del _EDF[next(iter(_EDF))]
+                _EDF[key] = got
+            self._edf[alpha] = got
         return self._edf[alpha]
 
     def subset(self, idx):

@@ -24,6 +24,7 @@ from ...results import AllanResult
 from .. import fitting, periodic, tracing
 from ..channels import check_channel, terms_before_after
 from ..effects import EFFECTS, describe
+from ..lines import remembering_spectra
 from ..terms import check_terms
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families, final_params, prefetch
@@ -153,7 +154,7 @@ def refine(
         (['gauss_markov'], 10.0)
     """
     _check_scale(x_or_result)
-    with StepBar(progress, 1, "refine") as bar:
+    with StepBar(progress, 1, "refine") as bar, remembering_spectra():  # each line spectrum once
         bar.step("fit, trace and test the candidates")
         start = check_terms(start)
         candidates = _check_candidates(candidates, level)
