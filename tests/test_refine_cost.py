@@ -369,3 +369,16 @@ def test_remembered_edf_equals_computed(curve):
         plain_half = fitting.edf_per_tau(np.full(curve.m.size, alpha), curve.m, curve.n_points // 2, curve.estimator)
         np.testing.assert_array_equal(half.edf(alpha), plain_half)
         assert not np.array_equal(plain_half, plain)
+
+
+def test_stacked_designs_equal_one_per_model(curve):
+    prefix = [("gauss_markov", 3.0)]
+    grids = [("resonance:4", [6.0, 9.0]), ("bandwidth:boxcar", [1.5, 3.0])]
+    models = [prefix + [(key, p)] for key, grid in grids for p in grid]
+    models += [prefix + [("gauss_markov", 40.0)], prefix + [("resonance:4", 12.0)]]  # groups interleaved
+    a, nu = curvefit._stacked(curve, START, models)
+    for g, eff in enumerate(models):
+        d, alphas = curvefit.design(curve, START, eff)
+        np.testing.assert_array_equal(a[g], d)
+        np.testing.assert_array_equal(nu[g], curvefit._edf_columns(curve, alphas))
+    assert not np.array_equal(a[2][:, 1], a[0][:, 1])  # a bandwidth's design has N zeroed, a resonance's not

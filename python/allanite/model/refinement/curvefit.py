@@ -219,13 +219,13 @@ def _fits(curve: Curve, terms, models: list, max_iter: int) -> list:
     on ``curve``; the fits not done before on this curve run together, and are remembered (a search's best
     parameter is solved again, a profile's centre is the best parameter)."""
     keys = [("fit", tuple(terms), tuple((k, float(p)) for k, p in eff), max_iter) for eff in models]
-    designs = [design(curve, terms, eff) for eff in models]
+    a_all, nu_all = _stacked(curve, terms, models)
     done = [curve.cached(key) for key in keys]
     todo = [g for g, got in enumerate(done) if got is None]
     if todo:
         y = curve.avar
-        a = np.stack([designs[g][0] for g in todo])
-        nu_cols = np.stack([_edf_columns(curve, designs[g][1]) for g in todo])
+        whole = len(todo) == len(models)
+        a, nu_cols = (a_all, nu_all) if whole else (a_all[todo], nu_all[todo])
         nu0 = nu_cols[0][:, 1] if len(terms) > 1 else nu_cols[0][:, 0]
         floor = 1e-12 * np.max(y)
         theta, nu_end = irls(a, nu_cols, y, nu0, max_iter, floor)
@@ -233,7 +233,33 @@ def _fits(curve: Curve, terms, models: list, max_iter: int) -> list:
             th, nu = theta[i].copy(), nu_end[i].copy()
             th.flags.writeable = nu.flags.writeable = False
             done[g] = curve.remember(keys[g], (th, nu, floor))
-    return [(d[0], *got) for d, got in zip(designs, done)]
+    return [(a_all[g], *got) for g, got in enumerate(done)]
+
+
+def _stacked(curve: Curve, terms, models: list) -> tuple[np.ndarray, np.ndarray]:
+    """The designs of ``models`` (:func:`design`, all of one size) and their EDF columns, stacked (G × n × k):
+    the models of a grid differ in their last effect's parameter only, so each (earlier effects, last effect)
+    group's other columns are built once and copied — the same numbers as one design per model."""
+    if len(models) == 1 or not all(models):
+        designs = [design(curve, terms, eff) for eff in models]
+        return np.stack([d for d, _al in designs]), np.stack([_edf_columns(curve, al) for _d, al in designs])
+    a0, al0 = design(curve, terms, models[0])
+    a = np.empty((len(models),) + a0.shape)
+    nu = np.empty_like(a)
+    first: dict = {}
+    for g, eff in enumerate(models):
+        key, p = eff[-1]
+        group = (tuple((k, float(q)) for k, q in eff[:-1]), key)
+        if group not in first:
+            d, al = (a0, al0) if g == 0 else design(curve, terms, eff)
+            a[g], nu[g] = d, _edf_columns(curve, al)
+            first[group] = g
+            continue
+        g0 = first[group]
+        a[g, :, :-1], nu[g, :, :-1] = a[g0, :, :-1], nu[g0, :, :-1]
+        a[g, :, -1] = column(key, p, curve)
+        nu[g, :, -1] = _edf_column(curve, _alpha_of(key, p, curve.tau))
+    return a, nu
 
 
 def _finish(curve, a, theta, nu, floor, n_effects) -> Solution:
