@@ -382,3 +382,39 @@ def test_stacked_designs_equal_one_per_model(curve):
         np.testing.assert_array_equal(a[g], d)
         np.testing.assert_array_equal(nu[g], curvefit._edf_columns(curve, alphas))
     assert not np.array_equal(a[2][:, 1], a[0][:, 1])  # a bandwidth's design has N zeroed, a resonance's not
+
+
+def _plain_evaluate(idx, gens, coefs, a, b):
+    """:func:`allanite.model.linefit.evaluate` as it was: every waveform interpolated as a complex array."""
+    gens, coefs = linefit._oriented(np.atleast_1d(np.asarray(gens, float)), np.atleast_2d(np.asarray(coefs)))
+    out = np.zeros(idx.size)
+    u = np.mod(idx * gens[0], 1.0)
+    nu2 = float(gens[1]) if gens.size > 1 else 0.0
+    for _s, rows, ph in linefit._groups(coefs, nu2, idx):
+        k = coefs[rows, 0]
+        m_bins = linefit._grid(int(np.max(np.abs(k))))
+        spec = np.zeros(m_bins, dtype=np.complex128)
+        np.add.at(spec, np.mod(k, m_bins), (a[rows] - 1j * b[rows]) / np.sinc(k / m_bins) ** 2)
+        wave = np.fft.ifft(spec) * m_bins
+        wave = np.append(wave, wave[0])
+        x = u * m_bins
+        j = x.astype(np.int64)
+        f = x - j
+        val = wave[j] * (1.0 - f) + wave[j + 1] * f
+        if ph is not None:
+            val = val * ph
+        out += val.real
+    return out
+
+
+def test_evaluate_equals_the_complex_interpolation():
+    rng = np.random.default_rng(7)
+    idx = np.arange(100_000)
+    for gens, coefs in [
+        (np.array([0.0123]), np.arange(1, 40)[:, None]),  # harmonics: the real path
+        (np.array([0.031, 0.0047]), np.array([[k, s] for k in (1, 2, 3) for s in (-2, -1, 0, 1, 2)])),  # sidebands
+    ]:
+        a, b = rng.standard_normal(coefs.shape[0]), rng.standard_normal(coefs.shape[0])
+        got = linefit.evaluate(idx, gens, coefs, a, b)
+        np.testing.assert_array_equal(got, _plain_evaluate(idx, gens, coefs, a, b))
+        assert np.std(got) > 1.0

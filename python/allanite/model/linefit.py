@@ -227,10 +227,12 @@ def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndar
         x = u * m_bins
         j = x.astype(np.int64)
         f = x - j
+        if ph is None:  # the real part alone: a complex times a real scales both parts, each as a real product
+            wr = wave.real
+            out += wr[j] * (1.0 - f) + wr[j + 1] * f
+            continue
         val = wave[j] * (1.0 - f) + wave[j + 1] * f
-        if ph is not None:
-            val = val * ph
-        out += val.real
+        out += (val * ph).real
     return out
 
 
