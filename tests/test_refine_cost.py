@@ -418,3 +418,30 @@ def test_evaluate_equals_the_complex_interpolation():
         got = linefit.evaluate(idx, gens, coefs, a, b)
         np.testing.assert_array_equal(got, _plain_evaluate(idx, gens, coefs, a, b))
         assert np.std(got) > 1.0
+
+
+def _plain_dtft(y, idx, gens, coefs, n_seg=1):
+    """:func:`allanite.model.linefit.dtft` as it was: the heterodyned samples complex, each group gridded anew."""
+    gens, coefs = linefit._oriented(np.atleast_1d(np.asarray(gens, float)), np.atleast_2d(np.asarray(coefs)))
+    out = np.zeros((n_seg, coefs.shape[0]), dtype=np.complex128)
+    seg = None if n_seg == 1 else np.minimum(np.arange(idx.size) * n_seg // max(1, idx.size), n_seg - 1)
+    u = np.mod(idx * gens[0], 1.0)
+    nu2 = float(gens[1]) if gens.size > 1 else 0.0
+    for _s, rows, ph in linefit._groups(coefs, nu2, idx):
+        k = coefs[rows, 0]
+        m_bins = linefit._grid(int(np.max(np.abs(k))))
+        z = y if ph is None else y * np.conj(ph)
+        out[:, rows] = _plain_fold(z, u, m_bins, seg, n_seg)[:, np.mod(k, m_bins)]
+    return out if n_seg > 1 else out[0]
+
+
+@pytest.mark.parametrize("n_seg", [1, 32])
+def test_dtft_equals_the_plain_heterodyne(n_seg):
+    rng = np.random.default_rng(8)
+    y = rng.standard_normal(60_000)
+    idx = np.arange(y.size)
+    for gens, coefs in [
+        (np.array([0.0123]), np.arange(1, 40)[:, None]),
+        (np.array([0.031, 0.0047]), np.array([[k, s] for k in (1, 2, 30) for s in (-2, -1, 0, 1, 2)])),
+    ]:
+        np.testing.assert_array_equal(linefit.dtft(y, idx, gens, coefs, n_seg), _plain_dtft(y, idx, gens, coefs, n_seg))
