@@ -230,6 +230,7 @@ def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndar
     out = np.zeros(idx.size)
     u = np.mod(idx * gens[0], 1.0)
     nu2 = float(gens[1]) if gens.size > 1 else 0.0
+    grids: dict = {}
     for _s, rows, ph in _groups(coefs, nu2, idx):
         k = coefs[rows, 0]
         m_bins = _grid(int(np.max(np.abs(k))))
@@ -238,14 +239,17 @@ def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndar
         np.add.at(spec, np.mod(k, m_bins), (a[rows] - 1j * b[rows]) / np.sinc(k / m_bins) ** 2)
         wave = np.fft.ifft(spec) * m_bins
         wave = np.append(wave, wave[0])
-        x = u * m_bins
-        j = x.astype(np.int64)
-        f = x - j
+        if m_bins not in grids:  # each sample's phase bin and weights, once per grid size
+            x = u * m_bins
+            j = x.astype(np.int64)
+            f = x - j
+            grids[m_bins] = (j, j + 1, 1.0 - f, f)
+        j, j1, g, f = grids[m_bins]
         if ph is None:  # the real part alone: a complex times a real scales both parts, each as a real product
             wr = wave.real
-            out += wr[j] * (1.0 - f) + wr[j + 1] * f
+            out += wr[j] * g + wr[j1] * f
             continue
-        val = wave[j] * (1.0 - f) + wave[j + 1] * f
+        val = wave[j] * g + wave[j1] * f
         out += (val * ph).real
     return out
 
