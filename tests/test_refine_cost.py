@@ -1,13 +1,14 @@
 """refine's speed-ups give the numbers of the plain computations they replace (issue 29, refine's cost).
 
-Each shortcut is checked against the plain path, bit for bit where it claims so: the fits of a grid run together
-against one fit at a time (the IRLS of the pre-batching code, written out here), the NNLS without scipy's wrapper
-against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of many pairs at once against one pair
-at a time, the drift bootstrap's one-product statistics against a QR per grid point, Brent's bounded search as a
-coroutine against scipy's, a step's searches run in lockstep against one search after another (scipy's bounded
-search, one fit per call), and a whole default ``refine`` with the remembered columns and the searches run in
-lockstep against one that recomputes them one at a time, the line spectra remembered within a refine against fresh
-ones, the phase gridding of the line-family fits against its plain form. No timings here: ``benches/bench_refine_cost.py``.
+Each shortcut is checked against the plain path, bit for bit: the fits of a grid run together against one fit at a
+time (the IRLS of the pre-batching code, written out here) and their designs stacked against one per model, the NNLS
+without scipy's wrapper against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of many pairs at
+once against one pair at a time, the drift bootstrap's one-product statistics against a QR per grid point (within
+1e-9), Brent's bounded search as a coroutine against scipy's, a step's searches run in lockstep against one search
+after another (scipy's bounded search, one fit per call), the line spectra remembered within a refine and the EDF
+remembered per averaging factors against fresh ones, the line families' phase gridding, DTFT and waveforms against
+their plain forms, and a whole default ``refine`` with every memory and the lockstep against one that recomputes
+everything one search at a time. No timings here: ``benches/bench_refine_cost.py``.
 """
 
 from __future__ import annotations
