@@ -101,8 +101,11 @@ class Curve:
             if got is None:
                 got = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
                 got.flags.writeable = False
-                while len(_EDF) >= _EDF_KEPT:
-                    del _EDF[next(iter(_EDF))]
+                while len(_EDF) >= _EDF_KEPT:  # the oldest out (another thread may be at it too)
+                    try:
+                        del _EDF[next(iter(_EDF))]
+                    except (KeyError, RuntimeError, StopIteration):
+                        break
                 _EDF[key] = got
             self._edf[alpha] = got
         return self._edf[alpha]
