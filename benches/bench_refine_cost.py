@@ -1,15 +1,16 @@
 #!/usr/bin/env python3
 """The cost of one default ``allanite.refine`` (issue 29: ≤ 5 s per 10⁶ samples), before and after, as ratios.
 
-Records: ADIS16405 run 1 gyro_z, gyro_x and acc_x (10⁶ samples at 100 Hz, from the shared data) and three
-simulated sensors of ``tests/sensors.py`` (10⁶ samples at 100 Hz with a temperature channel, line families at
+Records: seven ADIS16405 channels (10⁶ samples at 100 Hz, from the shared data: the slowest of
+``benches/results/refine.json`` — the accelerometers of runs 3 and 6 — and gyros) and three simulated sensors of ``tests/sensors.py`` (10⁶ samples at 100 Hz with a temperature channel, line families at
 100 Hz × 10⁶, a sawtooth at 1 kHz × 10⁷). Each record is refined with the default call in a fresh process
 (imports paid by a small refine first, untimed), once with this checkout and once with the baseline — a
 ``python/`` folder of an earlier checkout (``--baseline``; by default a worktree of main at
 :data:`BASELINE` made under the temporary folder, with this checkout's compiled core copied in) — the two
-alternating record by record so that they share the machine's load. Both results are compared: the effects
+alternating record by record so that they share the machine's load; each call's CPU time (the process's own,
+what the load changes least) and wall time are recorded. Both results are compared: the effects
 found, their parameters and intervals, each step's χ²/dof and errors before and after, and what is still
-missing must be the same (the speed-ups are exact but for the drift bootstrap's statistics, within 1e-11).
+missing must be the same (the speed-ups are exact).
 
 Usage::
 
@@ -23,6 +24,7 @@ import argparse
 import json
 import os
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -31,9 +33,17 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-#: main before refine's speed-ups (issue 29, refine's cost).
-BASELINE = "9165947"
-ADIS = [("adis", 1, "gyro_z"), ("adis", 1, "gyro_x"), ("adis", 1, "acc_x")]
+#: main before this round of refine's speed-ups (issue 29, refine's cost; the first round's baseline was 9165947).
+BASELINE = "313a76b"
+ADIS = [
+    ("adis", 1, "gyro_z"),
+    ("adis", 4, "gyro_x"),
+    ("adis", 3, "gyro_z"),
+    ("adis", 1, "acc_x"),
+    ("adis", 3, "acc_x"),
+    ("adis", 6, "acc_x"),
+    ("adis", 6, "acc_y"),
+]
 SENSORS = [
     ("sensor", "temperature random walk, 100 Hz"),
     ("sensor", "consumer IMU line families"),
@@ -72,11 +82,12 @@ def worker(spec, out: Path) -> None:
     x, fs, kw, name = _record(spec)
     allanite.refine(np.random.default_rng(0).standard_normal(20_000), 10.0, progress=False)  # imports, untimed
     load = os.getloadavg()[0]
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     r = allanite.refine(x, fs, progress=False, **kw)
-    seconds = time.perf_counter() - t0
+    seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
     row = _jsonable(summarize(name, r)) | {"fit_chi2": float(r.fit.chi2), "unexplained_all": _jsonable(r.unexplained)}
-    out.write_text(json.dumps({"row": row, "seconds": seconds, "samples": int(x.size), "load": load}, default=float))
+    info = {"row": row, "seconds": seconds, "cpu": cpu, "samples": int(x.size), "load": load}
+    out.write_text(json.dumps(info, default=float))
 
 
 def _baseline_python(ref: str) -> Path:
@@ -131,7 +142,11 @@ def main(argv=None) -> int:
             after = _run(spec, a.after, Path(tmp))
             diff = _differences(before["row"], after["row"])
             rows.append({"record": after["row"]["record"], "before": before, "after": after, "differences": diff})
-            print(f"{rows[-1]['record']}: {before['seconds']:.1f} → {after['seconds']:.1f} s, {len(diff)} differences")
+            print(
+                f"{rows[-1]['record']}: CPU {before['cpu']:.1f} → {after['cpu']:.1f} s, wall "
+                f"{before['seconds']:.1f} → {after['seconds']:.1f} s, {len(diff)} differences",
+                flush=True,
+            )
     others = None
     busy1, wall = _common.OtherLoad._busy(), time.perf_counter() - wall0
     if busy0 is not None and busy1 is not None:  # CPU time of processes other than this run's, of all CPUs' time
@@ -159,19 +174,25 @@ def _write(rows, out: Path, base: Path, load0, load1, others) -> None:
         f"{load0[0]:.1f} at the start, {load1[0]:.1f} at the end (2 cores shared with other work"
         + (f"; other processes used {others:.0%} of the CPUs" if others is not None else "")
         + "). Each record refined with the default call in a fresh process, before and after alternating; "
-        "the result compared field by field (effects, parameters, intervals, χ²/dof and errors of every step, "
-        "what is still missing).",
+        "CPU: the refine call's own process time (one thread), wall: its elapsed time; the result compared field "
+        "by field (effects, parameters, intervals, χ²/dof and errors of every step, what is still missing).",
         "",
-        "| record | samples | before (s) | after (s) | after per 10⁶ samples (s) | ratio | results |",
-        "|---|---|---|---|---|---|---|",
+        "| record | samples | CPU before (s) | CPU after (s) | CPU after per 10⁶ samples (s) | CPU ratio "
+        "| wall before → after (s) | results |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         b, a = r["before"], r["after"]
         same = "identical" if not r["differences"] else f"{len(r['differences'])} differ: {r['differences'][:3]}"
         lines.append(
-            f"| {r['record']} | {a['samples']:,} | {b['seconds']:.1f} | {a['seconds']:.1f} | "
-            f"{a['seconds'] / a['samples'] * 1e6:.1f} | {b['seconds'] / a['seconds']:.2f}× | {same} |"
+            f"| {r['record']} | {a['samples']:,} | {b['cpu']:.1f} | {a['cpu']:.1f} | "
+            f"{a['cpu'] / a['samples'] * 1e6:.1f} | {b['cpu'] / a['cpu']:.2f}× | "
+            f"{b['seconds']:.1f} → {a['seconds']:.1f} | {same} |"
         )
+    adis = [r for r in rows if r["record"].startswith("ADIS")]
+    if adis:
+        med = [statistics.median(r[w]["cpu"] / r[w]["samples"] * 1e6 for r in adis) for w in ("before", "after")]
+        lines += ["", f"Median CPU per 10⁶ samples over the {len(adis)} ADIS records: {med[0]:.1f} → {med[1]:.1f} s."]
     out.mkdir(parents=True, exist_ok=True)
     (out / "refine_cost.md").write_text("\n".join(lines) + "\n")
 

@@ -1,23 +1,31 @@
 """refine's speed-ups give the numbers of the plain computations they replace (issue 29, refine's cost).
 
-Each shortcut is checked against the plain path, bit for bit where it claims so: the fits of a grid run together
-against one fit at a time (the IRLS of the pre-batching code, written out here), the NNLS without scipy's wrapper
-against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of many pairs at once against one pair
-at a time, the drift bootstrap's one-product statistics against a QR per grid point, and a whole default ``refine``
-with the remembered columns against one that recomputes them. No timings here: ``benches/bench_refine_cost.py``.
+Each shortcut is checked against the plain path, bit for bit: the fits of a grid run together against one fit at a
+time (the IRLS of the pre-batching code, written out here) and their designs stacked against one per model, the NNLS
+without scipy's wrapper against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of many pairs at
+once against one pair at a time, the drift bootstrap's one-product statistics against a QR per grid point (within
+1e-9), Brent's bounded search as a coroutine against scipy's, a step's searches run in lockstep against one search
+after another (scipy's bounded search, one fit per call), the line spectra remembered within a refine and the EDF
+remembered per averaging factors against fresh ones, the line families' phase gridding, DTFT and waveforms against
+their plain forms, and a whole default ``refine`` with every memory and the lockstep against one that recomputes
+everything one search at a time. No timings here: ``benches/bench_refine_cost.py``.
 """
 
 from __future__ import annotations
 
+import contextlib
+import importlib
 import math
 
 import numpy as np
 import pytest
+from scipy.optimize import minimize_scalar
 from scipy.optimize import nnls as scipy_nnls
 
 import allanite
-from allanite.model import _covariance, _nnls, tracing
-from allanite.model.refinement import curvefit
+from allanite.model import _covariance, _nnls, linefit, lines, tracing
+from allanite.model.refinement import _brent, curvefit
+from allanite.model.refinement import candidates as cands
 from allanite.model.refinement.candidates import bandwidth_grids
 
 START = ("Q", "N", "B", "K", "R")
@@ -193,10 +201,34 @@ def test_drift_bootstrap_statistics_equal_a_qr_per_grid_point():
     np.testing.assert_allclose(tracing._grid_stats(b, tb, length), nb * np.log(rss0 / best), rtol=1e-9, atol=1e-9)
 
 
+def _one_at_a_time(curve, terms, effects, specs):
+    """The searches one after another, each on its own, with scipy's bounded search (the code before the lockstep)."""
+    out = []
+    for key, grid, cont in specs:
+        chis = curvefit.chi2s(curve, terms, effects, key, grid, max_iter=6)
+        k = int(np.argmin(chis))
+        lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
+        p = float(grid[k])
+        if cont and hi > lo:
+            res = minimize_scalar(
+                lambda lp, key=key: float(curvefit.chi2s(curve, terms, effects, key, [math.exp(lp)])[0]),
+                bounds=(lo, hi),
+                method="bounded",
+                options={"xatol": 1e-3},
+            )
+            p = math.exp(res.x)
+        out.append(curvefit._searched(curve, terms, effects, key, grid, cont, p, k))
+    return out
+
+
 def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
     y = allanite.simulate(100_000, 50.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 4.0)], seed=8)
     cached = allanite.refine(y, 50.0, progress=False)
     monkeypatch.setattr(curvefit.Curve, "cached", lambda self, key: None)  # every column, EDF and subset afresh
+    loop = importlib.import_module("allanite.model.refinement.loop")
+    monkeypatch.setattr(loop, "prefetch", lambda rnd, c: None)
+    monkeypatch.setattr(loop, "remembering_spectra", contextlib.nullcontext)  # every line spectrum afresh
+    monkeypatch.setattr(curvefit, "searches", _one_at_a_time)  # each search alone, when proposed
     plain = allanite.refine(y, 50.0, progress=False)
     assert cached.found == plain.found
     for a, b in zip(cached.steps, plain.steps):
@@ -204,3 +236,213 @@ def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
         assert a.before == b.before and a.after == b.after
     assert cached.fit.chi2 == plain.fit.chi2
     assert cached.unexplained == plain.unexplained
+
+
+def test_brent_coroutine_visits_scipys_points():
+    rng = np.random.default_rng(4)
+    for i in range(300):
+        c = rng.uniform(-3.0, 3.0, 4)
+        lo, hi = sorted(rng.uniform(-2.0, 2.0, 2))
+
+        def f(x, c=c, step=i % 3 == 0):  # smooth, and with steps (parabolas rejected, golden sections)
+            return float(c[0] * np.sin(c[1] * x) + c[2] * (x - c[3]) ** 2 + (np.floor(5 * x) if step else 0.0))
+
+        seen: list = []
+        ours: list = []
+        ref = minimize_scalar(
+            lambda x, seen=seen: seen.append(x) or f(x), bounds=(lo, hi), method="bounded", options={"xatol": 1e-3}
+        )
+        got = _brent.minimize(lambda x, ours=ours: ours.append(x) or f(x), lo, hi, xatol=1e-3)
+        assert got == ref.x and ours == seen and len(seen) == ref.nfev
+
+
+def _plain_search(curve, terms, effects, key, grid, continuous=True):
+    """One search as before the lockstep: the grid screened, scipy's bounded search one fit per call."""
+    chis = [_plain_solve(curve, terms, effects + [(key, float(p))], 6)[2] for p in grid]
+    k = int(np.argmin(chis))
+    lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
+    p = float(grid[k])
+    if continuous and hi > lo:
+        res = minimize_scalar(
+            lambda lp: _plain_solve(curve, terms, effects + [(key, math.exp(lp))])[2],
+            bounds=(lo, hi),
+            method="bounded",
+            options={"xatol": 1e-3},
+        )
+        p = math.exp(res.x)
+    theta, _nu, chi2 = _plain_solve(curve, terms, effects + [(key, p)])
+    if p != float(grid[k]):
+        theta_k, _nu_k, chi2_k = _plain_solve(curve, terms, effects + [(key, float(grid[k]))])
+        if chi2 > chi2_k:
+            p, theta, chi2 = float(grid[k]), theta_k, chi2_k
+    return p, theta, chi2, (k == 0 and continuous) or k == grid.size - 1
+
+
+@pytest.mark.parametrize("effects", [[], [("bandwidth:single_pole", 20.0)]])
+def test_searches_in_lockstep_equal_one_after_another(curve, effects):
+    rnd = cands.Round(curve, START, effects, curvefit.solve(curve, START, effects))
+    specs = [
+        s for name in ("gauss_markov", "bandwidth", "resonance") for s in cands.CURVE_CANDIDATES[name].searches(rnd)
+    ]
+    assert len(specs) >= 5
+    fresh = curvefit.Curve(curve.tau, curve.m, curve.avar, curve.fs, curve.n_points, curve.estimator)
+    together = curvefit.searches(fresh, START, effects, specs)
+    for (key, grid, cont), (p, sol, edge) in zip(specs, together):
+        p_ref, theta_ref, chi2_ref, edge_ref = _plain_search(curve, START, effects, key, grid, cont)
+        assert (p, edge) == (p_ref, edge_ref), key
+        np.testing.assert_array_equal(sol.theta, theta_ref)
+        assert sol.chi2 == chi2_ref
+    # a proposal's search afterwards is read from the curve's memory: the same numbers, its own Solution
+    again = curvefit.search(fresh, START, effects, *specs[0])
+    assert again[0] == together[0][0] and again[1] is not together[0][1]
+    np.testing.assert_array_equal(again[1].theta, together[0][1].theta)
+
+
+def _plain_fold(z, u, m_bins, seg, n_seg):
+    """The gridding + FFT of :func:`allanite.model.linefit._fold` as it was (offsets added per part, the
+    kernel's transform computed per call)."""
+    x = u * m_bins
+    j = x.astype(np.int64)
+    w = x - j
+    j1 = np.where(j + 1 >= m_bins, 0, j + 1)
+    off = 0 if seg is None else seg * m_bins
+    size = m_bins * n_seg
+    parts = []
+    for part in (z.real, z.imag) if np.iscomplexobj(z) else (z,):
+        hi = part * w
+        parts.append(np.bincount(j + off, part - hi, minlength=size) + np.bincount(j1 + off, hi, minlength=size))
+    g = parts[0] + 1j * parts[1] if len(parts) == 2 else parts[0]
+    out = np.fft.fft(g.reshape(n_seg, m_bins), axis=1)
+    k = np.arange(m_bins)
+    ks = np.where(k > m_bins // 2, k - m_bins, k)
+    return out / np.sinc(ks / m_bins) ** 2
+
+
+@pytest.mark.parametrize("n_seg", [1, 32])
+@pytest.mark.parametrize("kind", [np.float64, np.complex128])
+def test_fold_equals_the_plain_gridding(n_seg, kind):
+    rng = np.random.default_rng(6)
+    n = 50_000
+    z = rng.standard_normal(n) + (1j * rng.standard_normal(n) if kind is np.complex128 else 0.0)
+    u = np.mod(np.arange(n) * 0.1234567, 1.0)
+    u[:3] = [0.0, np.nextafter(1.0, 0.0), 0.5]  # the last phase bin wraps to the first
+    seg = None if n_seg == 1 else np.minimum(np.arange(n) * n_seg // n, n_seg - 1)
+    for m_bins in (4096, 2**14):
+        np.testing.assert_array_equal(linefit._fold(z, u, m_bins, seg, n_seg), _plain_fold(z, u, m_bins, seg, n_seg))
+
+
+def _same_search(a, b):
+    assert a["bins"] == b["bins"] and a["p_value"] == b["p_value"] and a["lines"] == b["lines"]
+    for pa, pb in zip(a["passes"], b["passes"], strict=True):
+        assert pa.keys() == pb.keys()
+        for key in pa:
+            if isinstance(pa[key], np.ndarray):
+                np.testing.assert_array_equal(pa[key], pb[key])
+
+
+def test_remembered_line_spectra_equal_fresh_ones():
+    t = np.arange(200_000) / 100.0
+    y = allanite.simulate(t.size, 100.0, N=2e-3, K=2e-5, seed=9) + 0.02 * np.sin(2 * np.pi * 1.3 * t)
+    other = y + 0.02 * np.sin(2 * np.pi * 7.1 * t)
+    fresh = [lines.find_lines(v, 100.0, a) for v, a in ((y, 0.01), (y, 0.2), (other, 0.01))]
+    with lines.remembering_spectra():
+        # the same samples at two levels (the masks of the first search must not leak into the second), a copy
+        # of them, other samples: each the fresh search's numbers
+        got = [lines.find_lines(v, 100.0, a) for v, a in ((y, 0.01), (y, 0.2), (other, 0.01))]
+        again = lines.find_lines(y.copy(), 100.0, 0.01)
+        assert len(lines._SPECTRA[-1]) == 2  # two records' spectra computed, not four
+    assert lines._SPECTRA == []  # forgotten on leaving
+    for g, f in zip(got, fresh):
+        _same_search(g, f)
+    _same_search(again, fresh[0])
+    assert len(fresh[0]["lines"]) >= 1 and len(fresh[2]["lines"]) >= 2
+
+
+def test_remembered_edf_equals_computed(curve):
+    from allanite.model import fitting
+
+    twin = curvefit.Curve(curve.tau, curve.m.copy(), curve.avar * 1.1, curve.fs, curve.n_points, curve.estimator)
+    half = curvefit.Curve(curve.tau, curve.m, curve.avar, curve.fs, curve.n_points // 2, curve.estimator)
+    for alpha in (-2, -1, 0, 2):
+        plain = fitting.edf_per_tau(np.full(curve.m.size, alpha), curve.m, curve.n_points, curve.estimator)
+        np.testing.assert_array_equal(curve.edf(alpha), plain)
+        assert twin.edf(alpha) is curve.edf(alpha)  # the same factors and length: read from memory
+        plain_half = fitting.edf_per_tau(np.full(curve.m.size, alpha), curve.m, curve.n_points // 2, curve.estimator)
+        np.testing.assert_array_equal(half.edf(alpha), plain_half)
+        assert not np.array_equal(plain_half, plain)
+
+
+def test_stacked_designs_equal_one_per_model(curve):
+    prefix = [("gauss_markov", 3.0)]
+    grids = [("resonance:4", [6.0, 9.0]), ("bandwidth:boxcar", [1.5, 3.0])]
+    models = [prefix + [(key, p)] for key, grid in grids for p in grid]
+    models += [prefix + [("gauss_markov", 40.0)], prefix + [("resonance:4", 12.0)]]  # groups interleaved
+    a, nu = curvefit._stacked(curve, START, models)
+    for g, eff in enumerate(models):
+        d, alphas = curvefit.design(curve, START, eff)
+        np.testing.assert_array_equal(a[g], d)
+        np.testing.assert_array_equal(nu[g], curvefit._edf_columns(curve, alphas))
+    assert not np.array_equal(a[2][:, 1], a[0][:, 1])  # a bandwidth's design has N zeroed, a resonance's not
+
+
+def _plain_evaluate(idx, gens, coefs, a, b):
+    """:func:`allanite.model.linefit.evaluate` as it was: every waveform interpolated as a complex array."""
+    gens, coefs = linefit._oriented(np.atleast_1d(np.asarray(gens, float)), np.atleast_2d(np.asarray(coefs)))
+    out = np.zeros(idx.size)
+    u = np.mod(idx * gens[0], 1.0)
+    nu2 = float(gens[1]) if gens.size > 1 else 0.0
+    for _s, rows, ph in linefit._groups(coefs, nu2, idx):
+        k = coefs[rows, 0]
+        m_bins = linefit._grid(int(np.max(np.abs(k))))
+        spec = np.zeros(m_bins, dtype=np.complex128)
+        np.add.at(spec, np.mod(k, m_bins), (a[rows] - 1j * b[rows]) / np.sinc(k / m_bins) ** 2)
+        wave = np.fft.ifft(spec) * m_bins
+        wave = np.append(wave, wave[0])
+        x = u * m_bins
+        j = x.astype(np.int64)
+        f = x - j
+        val = wave[j] * (1.0 - f) + wave[j + 1] * f
+        if ph is not None:
+            val = val * ph
+        out += val.real
+    return out
+
+
+def test_evaluate_equals_the_complex_interpolation():
+    rng = np.random.default_rng(7)
+    idx = np.arange(100_000)
+    for gens, coefs in [
+        (np.array([0.0123]), np.arange(1, 40)[:, None]),  # harmonics: the real path
+        (np.array([0.031, 0.0047]), np.array([[k, s] for k in (1, 2, 3) for s in (-2, -1, 0, 1, 2)])),  # sidebands
+    ]:
+        a, b = rng.standard_normal(coefs.shape[0]), rng.standard_normal(coefs.shape[0])
+        got = linefit.evaluate(idx, gens, coefs, a, b)
+        np.testing.assert_array_equal(got, _plain_evaluate(idx, gens, coefs, a, b))
+        assert np.std(got) > 1.0
+
+
+def _plain_dtft(y, idx, gens, coefs, n_seg=1):
+    """:func:`allanite.model.linefit.dtft` as it was: the heterodyned samples complex, each group gridded anew."""
+    gens, coefs = linefit._oriented(np.atleast_1d(np.asarray(gens, float)), np.atleast_2d(np.asarray(coefs)))
+    out = np.zeros((n_seg, coefs.shape[0]), dtype=np.complex128)
+    seg = None if n_seg == 1 else np.minimum(np.arange(idx.size) * n_seg // max(1, idx.size), n_seg - 1)
+    u = np.mod(idx * gens[0], 1.0)
+    nu2 = float(gens[1]) if gens.size > 1 else 0.0
+    for _s, rows, ph in linefit._groups(coefs, nu2, idx):
+        k = coefs[rows, 0]
+        m_bins = linefit._grid(int(np.max(np.abs(k))))
+        z = y if ph is None else y * np.conj(ph)
+        out[:, rows] = _plain_fold(z, u, m_bins, seg, n_seg)[:, np.mod(k, m_bins)]
+    return out if n_seg > 1 else out[0]
+
+
+@pytest.mark.parametrize("n_seg", [1, 32])
+def test_dtft_equals_the_plain_heterodyne(n_seg):
+    rng = np.random.default_rng(8)
+    y = rng.standard_normal(60_000)
+    idx = np.arange(y.size)
+    for gens, coefs in [
+        (np.array([0.0123]), np.arange(1, 40)[:, None]),
+        (np.array([0.031, 0.0047]), np.array([[k, s] for k in (1, 2, 30) for s in (-2, -1, 0, 1, 2)])),
+    ]:
+        np.testing.assert_array_equal(linefit.dtft(y, idx, gens, coefs, n_seg), _plain_dtft(y, idx, gens, coefs, n_seg))

@@ -24,6 +24,7 @@ lines:
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -117,22 +118,44 @@ def _groups(coefs: np.ndarray, nu2: float, idx: np.ndarray):
 
 def _fold(z: np.ndarray, u: np.ndarray, m_bins: int, seg: np.ndarray | None, n_seg: int) -> np.ndarray:
     """Σ z_n e^{−i2πk u_n} for k = 0 … M − 1 (per segment: shape (n_seg, M)), by linear gridding + FFT."""
+    parts = (z.real, z.imag) if np.iscomplexobj(z) else (z,)
+    return _gridded_fft(parts, _gridding(u, m_bins, seg), m_bins, n_seg)
+
+
+def _gridding(u: np.ndarray, m_bins: int, seg: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each sample's two phase bins (j, j + 1 mod M; each segment its own M bins) and the weight w of the second."""
     x = u * m_bins
     j = x.astype(np.int64)
     w = x - j
-    j1 = np.where(j + 1 >= m_bins, 0, j + 1)
-    off = 0 if seg is None else seg * m_bins
+    j1 = j + 1
+    j1[j1 >= m_bins] = 0
+    if seg is not None:  # each segment its own M bins
+        off = seg * m_bins
+        j += off
+        j1 += off
+    return j, j1, w
+
+
+def _gridded_fft(parts, grid, m_bins: int, n_seg: int) -> np.ndarray:
+    """:func:`_fold` of the samples whose real (and imaginary) part are ``parts``, on the bins ``grid``."""
+    j, j1, w = grid
     size = m_bins * n_seg
-    parts = []
-    for part in (z.real, z.imag) if np.iscomplexobj(z) else (z,):
+    out = []
+    for part in parts:
         hi = part * w
-        g = np.bincount(j + off, part - hi, minlength=size) + np.bincount(j1 + off, hi, minlength=size)
-        parts.append(g)
-    g = parts[0] + 1j * parts[1] if len(parts) == 2 else parts[0]
-    out = np.fft.fft(g.reshape(n_seg, m_bins), axis=1)
+        out.append(np.bincount(j, part - hi, minlength=size) + np.bincount(j1, hi, minlength=size))
+    g = out[0] + 1j * out[1] if len(out) == 2 else out[0]
+    return np.fft.fft(g.reshape(n_seg, m_bins), axis=1) / _kernel_transform(m_bins)
+
+
+@lru_cache(maxsize=8)
+def _kernel_transform(m_bins: int) -> np.ndarray:
+    """sinc²(k/M) at the FFT's bins k (signed): the linear interpolation kernel's transform (read-only)."""
     k = np.arange(m_bins)
     ks = np.where(k > m_bins // 2, k - m_bins, k)
-    return out / np.sinc(ks / m_bins) ** 2
+    out = np.sinc(ks / m_bins) ** 2
+    out.flags.writeable = False
+    return out
 
 
 def dtft(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray, n_seg: int = 1) -> np.ndarray:
@@ -147,11 +170,15 @@ def dtft(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray, n_seg: int = 1
     seg = None if n_seg == 1 else np.minimum(np.arange(idx.size) * n_seg // max(1, idx.size), n_seg - 1)
     u = np.mod(idx * gens[0], 1.0)
     nu2 = float(gens[1]) if gens.size > 1 else 0.0
+    grids: dict = {}  # the phase bins per grid size, for every second coefficient
     for _s, rows, ph in _groups(coefs, nu2, idx):
         k = coefs[rows, 0]
         m_bins = _grid(int(np.max(np.abs(k))))
-        z = y if ph is None else y * np.conj(ph)
-        g = _fold(z, u, m_bins, seg, n_seg)
+        if m_bins not in grids:
+            grids[m_bins] = _gridding(u, m_bins, seg)
+        # y·conj(e^{iθ}) part by part (a real times a complex scales each part: the complex product's numbers)
+        parts = (y,) if ph is None else (y * ph.real, y * -ph.imag)
+        g = _gridded_fft(parts, grids[m_bins], m_bins, n_seg)
         out[:, rows] = g[:, np.mod(k, m_bins)]
     return out if n_seg > 1 else out[0]
 
@@ -203,6 +230,7 @@ def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndar
     out = np.zeros(idx.size)
     u = np.mod(idx * gens[0], 1.0)
     nu2 = float(gens[1]) if gens.size > 1 else 0.0
+    grids: dict = {}
     for _s, rows, ph in _groups(coefs, nu2, idx):
         k = coefs[rows, 0]
         m_bins = _grid(int(np.max(np.abs(k))))
@@ -211,13 +239,18 @@ def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndar
         np.add.at(spec, np.mod(k, m_bins), (a[rows] - 1j * b[rows]) / np.sinc(k / m_bins) ** 2)
         wave = np.fft.ifft(spec) * m_bins
         wave = np.append(wave, wave[0])
-        x = u * m_bins
-        j = x.astype(np.int64)
-        f = x - j
-        val = wave[j] * (1.0 - f) + wave[j + 1] * f
-        if ph is not None:
-            val = val * ph
-        out += val.real
+        if m_bins not in grids:  # each sample's phase bin and weights, once per grid size
+            x = u * m_bins
+            j = x.astype(np.int64)
+            f = x - j
+            grids[m_bins] = (j, j + 1, 1.0 - f, f)
+        j, j1, g, f = grids[m_bins]
+        if ph is None:  # the real part alone: a complex times a real scales both parts, each as a real product
+            wr = wave.real
+            out += wr[j] * g + wr[j1] * f
+            continue
+        val = wave[j] * g + wave[j1] * f
+        out += (val * ph).real
     return out
 
 

@@ -30,7 +30,9 @@ A line no family takes stays a ``"sinusoid"``.
 
 from __future__ import annotations
 
+import hashlib
 import math
+from contextlib import contextmanager
 from functools import lru_cache
 
 import numpy as np
@@ -38,7 +40,7 @@ from scipy import signal
 from scipy.stats import chi2 as chi2_dist
 from scipy.stats import f as f_dist
 
-__all__ = ["find_lines", "line_spectrum", "group_lines", "LOBE", "MAX_SEGMENT", "fold_frequency"]
+__all__ = ["find_lines", "line_spectrum", "remembering_spectra", "group_lines", "LOBE", "MAX_SEGMENT", "fold_frequency"]
 
 #: Main-lobe half width of the Blackman–Harris window, bins (to its first null; −92 dB beyond).
 LOBE = 4
@@ -164,10 +166,47 @@ def _noise(ps: dict, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return noise, dof_med
 
 
+#: :func:`line_spectrum`'s results by the samples' digest, while :func:`remembering_spectra` is on (refine searches
+#: the same samples for lines up to three times: the periodic removal, the sinusoid candidate, the final check of
+#: what is still missing); None when off.
+_SPECTRA: list[dict] = []
+
+
+@contextmanager
+def remembering_spectra():
+    """Within it, :func:`line_spectrum` remembers its results (forgotten on leaving: a 10⁸-sample record's
+    spectra are large)."""
+    _SPECTRA.append({})
+    try:
+        yield
+    finally:
+        _SPECTRA.pop()
+
+
 def line_spectrum(y: np.ndarray, fs: float) -> list[dict]:
     """The passes :func:`find_lines` searches: per pass the Welch PSD (``f``, ``p``), the noise level under
-    each searched bin (``noise``, NaN elsewhere), the degrees of freedom (``dof``, ``dof_med``) and ``df``."""
-    x = np.asarray(y, dtype=np.float64)
+    each searched bin (``noise``, NaN elsewhere), the degrees of freedom (``dof``, ``dof_med``) and ``df``.
+
+    Within :func:`remembering_spectra`, the passes of samples searched before (the same values, by a digest of
+    their bytes) are read from memory: each call gets its own dicts (their arrays shared and read-only), the
+    same numbers as computed afresh."""
+    x = np.ascontiguousarray(y, dtype=np.float64)
+    if not _SPECTRA:
+        return _line_spectrum(x, fs)
+    memo = _SPECTRA[-1]
+    key = (hashlib.blake2b(x.data, digest_size=20).digest(), x.size, float(fs))
+    if key not in memo:
+        passes = _line_spectrum(x, fs)
+        for ps in passes:
+            for v in ps.values():
+                if isinstance(v, np.ndarray):
+                    v.flags.writeable = False
+        memo[key] = passes
+    return [dict(ps) for ps in memo[key]]
+
+
+def _line_spectrum(x: np.ndarray, fs: float) -> list[dict]:
+    """:func:`line_spectrum` computed."""
     x = x - x.mean()
     n = x.size
     if n < 2048:

@@ -26,7 +26,7 @@ import numpy as np
 
 from .. import tracing
 from ..effects import CASCADE_SPANS, EFFECTS, RESONANCE_Q, filter_autocorrelation, filter_cutoff
-from .curvefit import Curve, Solution, base_name, column, profile_interval, search, solve
+from .curvefit import Curve, Solution, base_name, column, profile_interval, search, searches, solve
 from .scoring import Split
 
 __all__ = [
@@ -36,6 +36,7 @@ __all__ = [
     "CURVE_CANDIDATES",
     "PAIR_FACTOR",
     "families",
+    "prefetch",
     "choose",
     "final_params",
 ]
@@ -106,7 +107,8 @@ class CurveCandidate:
     bootstrap of the maximum statistic; ``propose(round)`` its proposals at a step; ``params(pr, round)``
     the step's parameters and intervals; ``evidence(pr, round)`` what another domain says (or {});
     ``amplitude`` the parameter that is the column's amplitude, updated from the final joint fit (None:
-    none, or it came from the samples)."""
+    none, or it came from the samples); ``searches(round)`` the bounded searches ``propose`` will ask for,
+    ``(key, grid, continuous)`` each, run beforehand with every other candidate's (:func:`prefetch`)."""
 
     name: str
     family: Callable[[Curve, bool], list]
@@ -114,6 +116,16 @@ class CurveCandidate:
     params: Callable[[Proposal, Round], tuple]
     evidence: Callable[[Proposal, Round], dict] = lambda pr, rnd: {}
     amplitude: Callable[[Proposal], str | None] = lambda pr: None
+    searches: Callable[[Round], list] = lambda rnd: []
+
+
+def prefetch(rnd: Round, candidates) -> None:
+    """Run the bounded searches every curve candidate among ``candidates`` will ask for at this step, together
+    (:func:`.curvefit.searches`: one batch of fits per round of every search; the same numbers as one search
+    after another); the proposals read them from the curve's memory."""
+    specs = [s for name, c in CURVE_CANDIDATES.items() if name in candidates for s in c.searches(rnd)]
+    if specs:
+        searches(rnd.curve, rnd.start, rnd.effects, specs)
 
 
 def _amplitude(sol: Solution, i: int) -> tuple[float, float, tuple[float, float]]:
@@ -142,6 +154,10 @@ def _gm_grid(tmin, tmax):
 
 def _gm_family(sub: Curve, has_samples: bool) -> list:
     return [column("gauss_markov", p, sub) for p in _gm_grid(sub.tau[0], sub.tau[-1])]
+
+
+def _gm_searches(rnd: Round) -> list:
+    return [("gauss_markov", _gm_grid(rnd.tmin, rnd.tmax), True)]
 
 
 def _gm_propose(rnd: Round) -> list:
@@ -214,14 +230,19 @@ def _bw_better(new, best, tie) -> bool:
     )
 
 
-def _bw_propose(rnd: Round) -> list:
+def _bw_searches(rnd: Round) -> list:
     if any(base_name(k) == "bandwidth" for k, _p in rnd.effects) or "N" not in rnd.start:
         return []
+    return [
+        (f"bandwidth:{kind}", grid, kind in ("single_pole", "boxcar") or kind.startswith("single_pole+"))
+        for kind, grid in bandwidth_grids(rnd.curve).items()
+    ]
+
+
+def _bw_propose(rnd: Round) -> list:
     best = None
     tie = rnd.curve.tau.size / rnd.curve.n_eff
-    for kind, grid in bandwidth_grids(rnd.curve).items():
-        key = f"bandwidth:{kind}"
-        cont = kind in ("single_pole", "boxcar") or kind.startswith("single_pole+")
+    for key, grid, cont in _bw_searches(rnd):
         p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, key, grid, continuous=cont)
         if _bw_better((key, p, s_new, edge), best, tie):
             best = (key, p, s_new, edge)
@@ -281,11 +302,14 @@ def _res_family(sub: Curve, has_samples: bool) -> list:
     return [column(f"resonance:{q:g}", p, sub) for q in RESONANCE_Q for p in grid]
 
 
+def _res_searches(rnd: Round) -> list:
+    return [(f"resonance:{q:g}", _res_grid(rnd.tmin, rnd.tmax), True) for q in RESONANCE_Q]
+
+
 def _res_propose(rnd: Round) -> list:
     best_r = None
-    for q in RESONANCE_Q:
-        key = f"resonance:{q:g}"
-        p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, key, _res_grid(rnd.tmin, rnd.tmax))
+    for key, grid, _cont in _res_searches(rnd):
+        p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, key, grid)
         if best_r is None or s_new.chi2 < best_r[2].chi2:
             best_r = (key, p, s_new, edge)
     assert best_r is not None
@@ -311,6 +335,10 @@ def _sin_grid(tmin, tmax):
 def _sin_family(sub: Curve, has_samples: bool) -> list:
     # with samples a sinusoid is found in the PSD (its own test), not on the curve
     return [] if has_samples else [column("sinusoid", p, sub) for p in _sin_grid(sub.tau[0], sub.tau[-1])]
+
+
+def _sin_searches(rnd: Round) -> list:
+    return [("sinusoid", _sin_grid(rnd.tmin, rnd.tmax), True)] if rnd.y is None else []
 
 
 def _sin_propose(rnd: Round) -> list:
@@ -343,15 +371,19 @@ CURVE_CANDIDATES: dict[str, CurveCandidate] = {
             _amplitude_and_profile,
             evidence=_gm_evidence,
             amplitude=lambda pr: "sigma",
+            searches=_gm_searches,
         ),
-        CurveCandidate("bandwidth", _bw_family, _bw_propose, _bw_params, evidence=_bw_evidence),
-        CurveCandidate("resonance", _res_family, _res_propose, _res_params, amplitude=lambda pr: "sigma"),
+        CurveCandidate("bandwidth", _bw_family, _bw_propose, _bw_params, evidence=_bw_evidence, searches=_bw_searches),
+        CurveCandidate(
+            "resonance", _res_family, _res_propose, _res_params, amplitude=lambda pr: "sigma", searches=_res_searches
+        ),
         CurveCandidate(
             "sinusoid",
             _sin_family,
             _sin_propose,
             _sin_params,
             amplitude=lambda pr: "amplitude" if pr.line is None else None,
+            searches=_sin_searches,
         ),
     )
 }

@@ -11,15 +11,15 @@ estimate per octave.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 from scipy.stats import chi2 as chi2_dist
 
 from .. import fitting
 from ..effects import EFFECTS, filtered_white_avar, resonance_avar
 from ..terms import TERM_ALPHA, design_matrix
+from . import _brent
 from ._irls import chi2_at, irls
 
 __all__ = [
@@ -31,6 +31,8 @@ __all__ = [
     "solve",
     "chi2s",
     "search",
+    "searches",
+    "chi2s_of",
     "profile_interval",
     "PROFILE_RHO",
     "upper_theta",
@@ -73,6 +75,11 @@ def _alpha_of(key, p, tau):
     return alpha(tau, p)
 
 
+#: EDF per τ by (α, averaging factors, record length, estimator): the last :data:`_EDF_KEPT` computed.
+_EDF: dict = {}
+_EDF_KEPT = 64
+
+
 class Curve:
     """One Allan curve to fit: τ, m, estimates, record length, estimator (for the EDF)."""
 
@@ -84,9 +91,23 @@ class Curve:
         self.n_eff = max(2.0, math.log2(tau[-1] / tau[0]) + 1.0)
 
     def edf(self, alpha: int) -> np.ndarray:
-        """EDF of each estimate for noise type ``alpha`` (computed once per α)."""
+        """EDF of each estimate for noise type ``alpha`` (computed once per α — and once per averaging factors,
+        record length and estimator: the curve of the samples a removal left, or of its held-out parts, has
+        the same EDF as the curve before it)."""
         if alpha not in self._edf:
-            self._edf[alpha] = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
+            est = self.estimator if isinstance(self.estimator, str) else tuple(self.estimator)
+            key = (int(alpha), self.m.tobytes(), int(self.n_points), est)
+            got = _EDF.get(key)
+            if got is None:
+                got = fitting.edf_per_tau(np.full(self.m.size, alpha), self.m, self.n_points, self.estimator)
+                got.flags.writeable = False
+                while len(_EDF) >= _EDF_KEPT:  # the oldest out (another thread may be at it too)
+                    try:
+                        del _EDF[next(iter(_EDF))]
+                    except (KeyError, RuntimeError, StopIteration):
+                        break
+                _EDF[key] = got
+            self._edf[alpha] = got
         return self._edf[alpha]
 
     def subset(self, idx):
@@ -187,7 +208,12 @@ def solve(curve: Curve, terms, effects, max_iter: int = 40) -> Solution:
 def chi2s(curve: Curve, terms, effects, key, ps, max_iter: int = 40) -> np.ndarray:
     """χ² of :func:`solve` with ``effects`` plus effect ``key`` at each parameter of ``ps`` — the same numbers,
     the fits run together (:func:`._irls.irls`)."""
-    fits = _fits(curve, terms, [effects + [(key, float(p))] for p in np.atleast_1d(ps)], max_iter)
+    return chi2s_of(curve, terms, [effects + [(key, float(p))] for p in np.atleast_1d(ps)], max_iter)
+
+
+def chi2s_of(curve: Curve, terms, models: list, max_iter: int = 40) -> np.ndarray:
+    """χ² of :func:`solve` of each model of ``models`` (lists of effects, all of one size), fitted together."""
+    fits = _fits(curve, terms, models, max_iter)
     return np.array([chi2_at(curve.avar, a, theta, nu, floor) for a, theta, nu, floor in fits])
 
 
@@ -196,13 +222,13 @@ def _fits(curve: Curve, terms, models: list, max_iter: int) -> list:
     on ``curve``; the fits not done before on this curve run together, and are remembered (a search's best
     parameter is solved again, a profile's centre is the best parameter)."""
     keys = [("fit", tuple(terms), tuple((k, float(p)) for k, p in eff), max_iter) for eff in models]
-    designs = [design(curve, terms, eff) for eff in models]
+    a_all, nu_all = _stacked(curve, terms, models)
     done = [curve.cached(key) for key in keys]
     todo = [g for g, got in enumerate(done) if got is None]
     if todo:
         y = curve.avar
-        a = np.stack([designs[g][0] for g in todo])
-        nu_cols = np.stack([_edf_columns(curve, designs[g][1]) for g in todo])
+        whole = len(todo) == len(models)
+        a, nu_cols = (a_all, nu_all) if whole else (a_all[todo], nu_all[todo])
         nu0 = nu_cols[0][:, 1] if len(terms) > 1 else nu_cols[0][:, 0]
         floor = 1e-12 * np.max(y)
         theta, nu_end = irls(a, nu_cols, y, nu0, max_iter, floor)
@@ -210,7 +236,33 @@ def _fits(curve: Curve, terms, models: list, max_iter: int) -> list:
             th, nu = theta[i].copy(), nu_end[i].copy()
             th.flags.writeable = nu.flags.writeable = False
             done[g] = curve.remember(keys[g], (th, nu, floor))
-    return [(d[0], *got) for d, got in zip(designs, done)]
+    return [(a_all[g], *got) for g, got in enumerate(done)]
+
+
+def _stacked(curve: Curve, terms, models: list) -> tuple[np.ndarray, np.ndarray]:
+    """The designs of ``models`` (:func:`design`, all of one size) and their EDF columns, stacked (G × n × k):
+    the models of a grid differ in their last effect's parameter only, so each (earlier effects, last effect)
+    group's other columns are built once and copied — the same numbers as one design per model."""
+    if len(models) == 1 or not all(models):
+        designs = [design(curve, terms, eff) for eff in models]
+        return np.stack([d for d, _al in designs]), np.stack([_edf_columns(curve, al) for _d, al in designs])
+    a0, al0 = design(curve, terms, models[0])
+    a = np.empty((len(models),) + a0.shape)
+    nu = np.empty_like(a)
+    first: dict = {}
+    for g, eff in enumerate(models):
+        key, p = eff[-1]
+        group = (tuple((k, float(q)) for k, q in eff[:-1]), key)
+        if group not in first:
+            d, al = (a0, al0) if g == 0 else design(curve, terms, eff)
+            a[g], nu[g] = d, _edf_columns(curve, al)
+            first[group] = g
+            continue
+        g0 = first[group]
+        a[g, :, :-1], nu[g, :, :-1] = a[g0, :, :-1], nu[g0, :, :-1]
+        a[g, :, -1] = column(key, p, curve)
+        nu[g, :, -1] = _edf_column(curve, _alpha_of(key, p, curve.tau))
+    return a, nu
 
 
 def _finish(curve, a, theta, nu, floor, n_effects) -> Solution:
@@ -231,22 +283,62 @@ def _finish(curve, a, theta, nu, floor, n_effects) -> Solution:
 
 def search(curve, terms, effects, key, grid, continuous=True):
     """Best nonlinear parameter for effect ``key`` on ``grid`` (then refined), its solution, and whether it
-    sits at the edge of the grid."""
-    # screen the grid with a few reweighting passes (the ranking settles early), then solve fully
-    chis = chi2s(curve, terms, effects, key, grid, max_iter=6)
-    k = int(np.argmin(chis))
-    lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
-    p = float(grid[k])
-    if continuous and hi > lo:
-        # the bounded search's first point (golden section of the bracket) fitted with the grid's best value
-        chi2s(curve, terms, effects, key, [math.exp(lo + 0.5 * (3.0 - math.sqrt(5.0)) * (hi - lo)), grid[k]])
-        res = minimize_scalar(
-            lambda lp: float(chi2s(curve, terms, effects, key, [math.exp(lp)])[0]),
-            bounds=(lo, hi),
-            method="bounded",
-            options={"xatol": 1e-3},
-        )
-        p = math.exp(res.x)
+    sits at the edge of the grid (:func:`searches` of one; a search :func:`searches` ran before on this curve
+    is read from its memory)."""
+    return searches(curve, terms, effects, [(key, grid, continuous)])[0]
+
+
+def searches(curve, terms, effects, specs) -> list:
+    """:func:`search` of each ``(key, grid, continuous)`` of ``specs`` with ``effects`` — the same numbers, the
+    searches run together: their grids screened in one batch of fits, their bounded refinements (Brent's
+    method, :mod:`._brent`) advanced in lockstep, each round's points fitted in one batch. Each result
+    ``(p, solution, at_edge)`` is remembered by the curve (a step's proposals ask for searches declared
+    beforehand, :func:`.candidates.prefetch`)."""
+    eff = tuple((k, float(p)) for k, p in effects)
+    keys = [("search", tuple(terms), eff, key, np.asarray(g, dtype=np.float64).tobytes(), c) for key, g, c in specs]
+    out = [curve.cached(k) for k in keys]
+    todo = [i for i, got in enumerate(out) if got is None]
+    if todo:
+        best = _refined(curve, terms, effects, [specs[i] for i in todo])
+        for i, (p, k) in zip(todo, best):
+            key, grid, continuous = specs[i]
+            out[i] = curve.remember(keys[i], _searched(curve, terms, effects, key, grid, continuous, p, k))
+    # each caller its own Solution (its arrays shared, read-only where the fits' memory keeps them)
+    return [(p, replace(sol), at_edge) for p, sol, at_edge in out]
+
+
+def _refined(curve, terms, effects, specs) -> list:
+    """(refined parameter, index of the best grid point) of each search of ``specs``: the grids screened with a
+    few reweighting passes (the ranking settles early), then Brent's bounded search on the log-parameter
+    between the best point's neighbours, every search's next point fitted together."""
+    sizes = [np.asarray(grid).size for _key, grid, _c in specs]
+    screen = chi2s_of(curve, terms, [effects + [(key, float(p))] for key, grid, _c in specs for p in grid], 6)
+    ks = [int(np.argmin(part)) for part in np.split(screen, np.cumsum(sizes)[:-1])]
+    out: list = [(float(grid[k]), k) for (_key, grid, _c), k in zip(specs, ks)]
+    gens = {}
+    for i, ((_key, grid, continuous), k) in enumerate(zip(specs, ks)):
+        lo, hi = math.log(grid[max(0, k - 1)]), math.log(grid[min(grid.size - 1, k + 1)])
+        if continuous and hi > lo:
+            gens[i] = _brent.bounded(lo, hi, xatol=1e-3)
+    # the bounded searches' first points (golden sections of the brackets) fitted with the grids' best values
+    pending = {i: next(g) for i, g in gens.items()}
+    first = [effects + [(specs[i][0], p)] for i, x in pending.items() for p in (math.exp(x), float(specs[i][1][ks[i]]))]
+    chi2s_of(curve, terms, first, 40)
+    while pending:
+        values = chi2s_of(curve, terms, [effects + [(specs[i][0], math.exp(x))] for i, x in pending.items()], 40)
+        nxt = {}
+        for (i, _x), v in zip(pending.items(), values):
+            try:
+                nxt[i] = gens[i].send(float(v))
+            except StopIteration as stop:
+                out[i] = (math.exp(stop.value), ks[i])
+        pending = nxt
+    return out
+
+
+def _searched(curve, terms, effects, key, grid, continuous, p, k) -> tuple:
+    """(p, solution, at_edge) of a search whose refined parameter is ``p`` and best grid point ``grid[k]``:
+    the grid point kept where the refinement did not lower χ²."""
     sol = solve(curve, terms, effects + [(key, p)])
     if p != float(grid[k]):
         at_k = solve(curve, terms, effects + [(key, float(grid[k]))])
@@ -254,7 +346,7 @@ def search(curve, terms, effects, key, grid, continuous=True):
             p, sol = float(grid[k]), at_k
     # a best value at the edge of its range is not identified — except a FIR's shortest length (2 taps):
     # below it lies "no filter", which is the null model itself
-    at_edge = (k == 0 and continuous) or k == grid.size - 1
+    at_edge = (k == 0 and continuous) or k == np.asarray(grid).size - 1
     return p, sol, at_edge
 
 

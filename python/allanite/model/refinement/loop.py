@@ -24,9 +24,10 @@ from ...results import AllanResult
 from .. import fitting, periodic, tracing
 from ..channels import check_channel, terms_before_after
 from ..effects import EFFECTS, describe
+from ..lines import remembering_spectra
 from ..terms import check_terms
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
-from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families, final_params
+from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families, final_params, prefetch
 from .changes import change_point_step, change_points
 from .curvefit import Curve, base_name, noise_fit, solve, theta_terms
 from .levels import LEVEL, alpha
@@ -153,7 +154,7 @@ def refine(
         (['gauss_markov'], 10.0)
     """
     _check_scale(x_or_result)
-    with StepBar(progress, 1, "refine") as bar:
+    with StepBar(progress, 1, "refine") as bar, remembering_spectra():  # each line spectrum once
         bar.step("fit, trace and test the candidates")
         start = check_terms(start)
         candidates = _check_candidates(candidates, level)
@@ -436,6 +437,7 @@ class _Run:
         fam = families(sub, candidates, self.y is not None)
         thr = test.threshold(fam, alpha("curve", self.level), N_BOOT, seed=n_step)
         rnd = Round(self.curve, self.start, self.effects, self.sol, sub, test, thr, self.heldout, self.y, lines)
+        prefetch(rnd, candidates)  # every candidate's bounded searches, run together
         props = [pr for name, c in CURVE_CANDIDATES.items() if name in candidates for pr in c.propose(rnd)]
         for pr in props:
             pr.record = {"param": float(pr.p), "statistic": float(pr.stat), "threshold": float(pr.thr)}
