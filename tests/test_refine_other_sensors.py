@@ -94,6 +94,22 @@ def test_unexplained_regions_do_not_overlap_and_a_model_above_the_curve_is_named
         assert reg["chi2_dof"] > 4
 
 
+def test_a_misfit_found_by_two_columns_is_one_region():
+    # two Gauss–Markov humps on a curve-only record refined with the bandwidth only: at 313a76b the check said
+    # τ 0.08–1.28 s and 0.64–5.12 s — the same misfit reported by two columns, overlapping
+    fs, n = 200.0, 1_000_000
+    rng = np.random.default_rng(0)
+    gm = [
+        (float(rng.uniform(5e-3, 3e-2)), float(rng.uniform(0.05, 1.0))),
+        (float(rng.uniform(1e-3, 4e-3)), float(rng.uniform(10, 80))),
+    ]
+    y = allanite.simulate(n, fs, N=1e-3, B=2e-4, gauss_markov=gm, seed=rng)
+    r = allanite.refine(_curve_only(y, fs), candidates=("bandwidth",), progress=False)
+    spans = sorted(u["tau"] for u in r.unexplained)
+    assert spans and any(lo <= 0.3 <= hi for lo, hi in spans)  # the faster hump (T_c 0.31 s) is named
+    assert all(b0 <= a1 * (1 + 1e-9) for (_a0, b0), (a1, _b1) in zip(spans, spans[1:])), spans  # touching at most
+
+
 def test_other_sensors_curves_get_one_region_per_misfit(shared_data, load_avar_curve):
     # IMAR gyro y: two columns found the same misfit (τ 0.005–0.08 and 0.005–0.64 s); LN200 accelerometer y: the
     # model 2–5× above the curve at τ 1.3–655 s (z −68 … −4) went unnamed beside a region at 655–2621 s
