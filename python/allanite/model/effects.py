@@ -55,10 +55,19 @@ def gm_avar(tau: np.ndarray | float, tc: float) -> np.ndarray:
     return np.where(x < 1e-2, small, big)
 
 
-def sinusoid_avar(tau: np.ndarray | float, f0: float) -> np.ndarray:
-    """Allan variance of a unit-amplitude rate sinusoid of frequency ``f0``: sin⁴(πf0τ)/(πf0τ)²."""
-    u = np.pi * f0 * np.asarray(tau, dtype=np.float64)
-    return np.sin(u) ** 4 / u**2
+def sinusoid_avar(tau: np.ndarray | float, f0: float, fs: float | None = None) -> np.ndarray:
+    """Allan variance of a unit-amplitude rate sinusoid of frequency ``f0``: sin⁴(πf0τ)/(πf0τ)² in continuous
+    time; with ``fs``, exact for samples at that rate (averages of m = τ·f_s samples, ν = f0/f_s):
+    sin⁴(πνm)/(m·sin πν)², the same to O(ν²) for f0 ≪ f_s and right up to f_s/2, where the continuous form
+    is off by (πν/sin πν)² (1.23× at f_s/4) — a line above a quarter of the rate is then seen at the
+    shortest τ of a curve that starts at m = 2 (nulls at even m for a line at f_s/2)."""
+    tau = np.asarray(tau, dtype=np.float64)
+    if fs is None:
+        u = np.pi * f0 * tau
+        return np.sin(u) ** 4 / u**2
+    nu = f0 / fs
+    m = np.maximum(1.0, np.round(tau * fs))
+    return np.sin(np.pi * nu * m) ** 4 / (m * np.sin(np.pi * nu)) ** 2
 
 
 def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
@@ -250,7 +259,7 @@ EFFECTS: dict[str, Effect] = {
             "line of the Welch PSD (a bin above its neighbours' median beyond the χ² quantile of the Welch "
             "average, Bonferroni over the bins), f0 refined on the periodogram, A and phase by least squares; "
             "on a curve only, f0 ≥ 2/τ_max so that two nulls fall inside it",
-            signature=lambda tau, f0, fs: sinusoid_avar(tau, f0),
+            signature=lambda tau, f0, fs: sinusoid_avar(tau, f0, fs),
             alpha=lambda tau, f0: np.zeros(np.asarray(tau).size, dtype=int),
             search=lambda tmin, tmax: np.geomspace(2.0 / tmax, 0.5 / tmin, 120),
             domain="psd",

@@ -21,6 +21,9 @@ __all__ = ["N_BOOT", "curve_test", "residual_evidence", "tested"]
 
 #: Bootstrap draws of the Allan-curve test's null distribution.
 N_BOOT = 1000
+#: The exact five-term covariance is scaled to the whole model only where the terms are at least this share of
+#: it at every τ of the test (:func:`curve_test`).
+TERMS_FLOOR = 1e-6
 
 
 def curve_test(curve: Curve, thin: np.ndarray, sol: Solution, start, effects, exact: bool) -> tracing.ScoreTest:
@@ -31,7 +34,10 @@ def curve_test(curve: Curve, thin: np.ndarray, sol: Solution, start, effects, ex
     theta_t = theta_terms(sol, start, effects)
     model_t = np.maximum(design_matrix(sub.tau, sub.m, curve.fs, start) @ theta_t, 1e-300)
     cov_t = None
-    if exact:
+    # the effects' variance is the five terms' covariance scaled by model/terms: where the terms carry (next to)
+    # nothing of the model (a curve-only fit whose effects took every τ: LN200 accelerometer z) the scaling
+    # blows up (EDF ~1e298, overflow); there the octave-correlation model with each estimate's EDF is used
+    if exact and np.all(model_t >= TERMS_FLOOR * sol.model[thin]):
         cov_t = tracing.exact_covariance(sub.m.astype(np.int64), curve.n_points - 1, curve.fs, start, theta_t)
     a_thin, _ = design(sub, start, effects)
     return tracing.ScoreTest(sol.model[thin], model_t, sol.nu[thin], sub.tau, a_thin[:, sol.theta > 0], cov_t)

@@ -403,13 +403,28 @@ def _admissible(props: list, sol: Solution) -> list:
     """Proposals whose test passes, whose parameter is identified and amplitude positive, and that lower
     χ²/dof — a spectral line first (the most specific evidence: a sinusoid also raises a bump on the curve
     that a Gauss–Markov term would otherwise take), then by the statistic over its threshold."""
-    ok = [
-        pr
-        for pr in props
-        if pr.stat > pr.thr and not pr.edge and pr.sol.theta[-1] > 0 and pr.sol.chi2_dof < sol.chi2_dof
-    ]
+    ok = []
+    for pr in props:
+        why = _inadmissible(pr, sol)
+        if why is None:
+            ok.append(pr)
+        elif pr.stat > pr.thr:  # a test that passed: say why it was not taken
+            pr.record["rejected"] = why
     ok.sort(key=lambda pr: (pr.line is None, -pr.stat / pr.thr))
     return ok
+
+
+def _inadmissible(pr: Proposal, sol: Solution) -> str | None:
+    """Why proposal ``pr`` cannot be accepted against the model ``sol`` (None: it can)."""
+    if not pr.stat > pr.thr:
+        return "test not passed"
+    if pr.edge:
+        return f"its parameter ({pr.p:.4g}) sits at the edge of its search range: not identified"
+    if not pr.sol.theta[-1] > 0:
+        return "amplitude 0"
+    if not pr.sol.chi2_dof < sol.chi2_dof:
+        return f"χ²/dof does not fall ({sol.chi2_dof:.4g} → {pr.sol.chi2_dof:.4g})"
+    return None
 
 
 def _first_heldout_winner(cands: list, rnd: Round):

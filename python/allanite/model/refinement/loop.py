@@ -443,6 +443,10 @@ class _Run:
             pr.record = {"param": float(pr.p), "statistic": float(pr.stat), "threshold": float(pr.thr)}
             self.consider(pr.effect, pr.record)
         chosen = choose(props, rnd, candidates)
+        for other in props:  # a test that passed says why it was not taken (choose says it where it can)
+            if other.stat > other.thr and "rejected" not in other.record and (chosen is None or other is not chosen[0]):
+                other.record["rejected"] = "not taken: " + (f"{chosen[0].effect} was" if chosen else "nothing")
+                other.record["rejected"] += " taken at this step"
         if chosen is None:
             return False
         pr, ho_b, ho_a = chosen

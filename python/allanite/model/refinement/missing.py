@@ -13,8 +13,12 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   model, :func:`allan_family`); the region is where the winning column, with
   the model's fitted directions projected out, carries its weight, and further regions follow with the winner
   added to the model, at the same threshold; a region is reported only where the dense curve's χ²/dof there
-  exceeds 1. With samples the frequency band is refined on the PSD of the final residual samples: the part of
-  ≈ 1/(2τ_hi) … 1/(2τ_lo) (widened ×2) that stands above the spectrum's running median.
+  exceeds 1, and a region that overlaps one already found widens it (one region per misfit). The test adds
+  non-negative columns, so it sees where the curve stands above the model: once it has fired, the runs of
+  same-signed |z| > 2 on the dense curve that no region covers are reported too ("the model lies above the
+  Allan curve" / "the Allan curve lies above the model"; no share of ``level`` spent). With samples the
+  frequency band is refined on the PSD of the final residual samples: the part of ≈ 1/(2τ_hi) … 1/(2τ_lo)
+  (widened ×2) that stands above the spectrum's running median.
 - ``"psd"`` — spectral lines of the final samples (:func:`allanite.model.lines.find_lines`: the line search of
   the periodic effect, afresh) that no sinusoid of the model accounts for; neighbouring lines (gaps ≤ f/16 or
   8 bins) are one entry, with its band, ``lines`` (how many), ``rms`` and the largest ``amplitude`` — where
@@ -134,6 +138,8 @@ def _curve(ctx: MissingContext, a: float) -> list[dict]:
         test = _with_column(test, fam[:, c])
         if not _chi2_dof(ctx, lo, hi) > 1.0:
             continue  # a column the residual leans on where the curve itself is within its scatter
+        if _merged(ctx, out, lo, hi, float(stats[c])):
+            continue
         out.append(
             {
                 "domain": "allan",
@@ -146,7 +152,63 @@ def _curve(ctx: MissingContext, a: float) -> list[dict]:
                 "alpha": a,
             }
         )
+    if out:  # the test rejected the model: say too where the curve's largest misfits are
+        _misfit_runs(ctx, out, thr, a)
     return out
+
+
+def _misfit_runs(ctx: MissingContext, out: list[dict], thr: float, a: float) -> None:
+    """Once the curve test has rejected the final model, add (up to :data:`MAX_REGIONS` regions in all) the runs
+    of same-signed normalised residuals beyond 2 on the dense curve that no region covers, the largest Σz²
+    first, as regions of their own (statistic Σz², the test's threshold). The test adds one *non-negative*
+    column at a time, so it sees where the curve stands above the model; a model held above the curve over a
+    range (its terms pinned by the short τ: LN200 accelerometer y, z ≈ −68 … −4 at τ 1.3–655 s, χ²/dof 1785
+    overall) would otherwise go unnamed while a small region elsewhere is reported. No share of ``level`` is
+    spent: nothing is added unless the calibrated test already fired."""
+    z, tau = ctx.sol.z, ctx.curve.tau
+    runs, i = [], 0
+    while i < z.size:
+        j = i
+        while j + 1 < z.size and abs(z[j + 1]) > 2 and np.sign(z[j + 1]) == np.sign(z[i]):
+            j += 1
+        if abs(z[i]) > 2:
+            runs.append((float(np.sum(z[i : j + 1] ** 2)), i, j))
+        i = j + 1
+    for chi2, i, j in sorted(runs, reverse=True):
+        lo, hi = float(tau[i]), float(tau[j])
+        if len(out) >= MAX_REGIONS or chi2 <= thr:
+            break
+        if any(lo < reg["tau"][1] and reg["tau"][0] < hi for reg in out):
+            continue
+        above = z[i] < 0
+        out.append(
+            {
+                "domain": "allan",
+                "tau": (lo, hi),
+                "band_hz": None if ctx.y is None else _band(ctx, lo, hi),
+                "chi2_dof": _chi2_dof(ctx, lo, hi),
+                "what": "the model lies above the Allan curve" if above else "the Allan curve lies above the model",
+                "statistic": chi2,
+                "threshold": thr,
+                "alpha": a,
+            }
+        )
+
+
+def _merged(ctx: MissingContext, out: list[dict], lo: float, hi: float, stat: float) -> bool:
+    """Whether τ (lo, hi) overlaps a region already in ``out``; if so that region becomes the union (its χ²/dof
+    and band over the union, its statistic the larger). A later column that finds the same misfit again is
+    one region, not two overlapping ones (IMAR gyro y: τ 0.005–0.08 s and 0.005–1.28 s)."""
+    for reg in out:
+        a, b = reg["tau"]
+        if lo <= b * (1 + 1e-9) and a <= hi * (1 + 1e-9):
+            a, b = min(a, lo), max(b, hi)
+            reg["tau"] = (a, b)
+            reg["chi2_dof"] = _chi2_dof(ctx, a, b)
+            reg["band_hz"] = None if ctx.y is None else _band(ctx, a, b)
+            reg["statistic"] = max(reg["statistic"], stat)
+            return True
+    return False
 
 
 def _statistics(test: tracing.ScoreTest, fam: np.ndarray, resid: np.ndarray) -> np.ndarray:

@@ -131,7 +131,10 @@ class Refinement(RichDisplay):
     still misses — empty when every domain's calibrated check passes (at its share of ``level``), else one dict
     per region, largest misfit first: ``"domain"``, ``"tau"`` (lo, hi) s, ``"band_hz"`` (lo, hi) or None,
     ``"chi2_dof"`` over that τ range, ``"what"``, and the test's ``"statistic"``, ``"threshold"``, ``"alpha"``
-    (:mod:`allanite.model.refinement.missing`); :meth:`missing_sentences` says it in words."""
+    (:mod:`allanite.model.refinement.missing`); :meth:`missing_sentences` says it in words. ``considered``: per
+    effect, every proposal tried (its parameter, statistic and threshold); one whose test passed but that was not
+    taken says why under ``"rejected"`` (χ²/dof not falling, a parameter at the edge of its range, the held-out
+    error, another candidate taken at that step)."""
 
     steps: list
     fit: fitting.NoiseFit
