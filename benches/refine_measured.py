@@ -176,7 +176,9 @@ def write_md(rows, path: Path) -> None:
         "of noise level leaves the record's curve model as it is (the curve of a record whose level steps is the "
         "length-weighted mean of its segments' curves, a model of the same terms), so on the chain its before and "
         "after are the same numbers; in brackets what found it, each change point without → with it (the earlier "
-        "ones in both): the windows' Allan variances about piecewise levels, and held out per segment.",
+        "ones in both): the windows' Allan variances about piecewise levels, and held out per segment. A spectral "
+        "line's amplitude (its power in the spectrum) and f0 are measured in the samples and held in every fit "
+        "of the curve, the final joint refit included.",
         "",
         "| record | five-term χ²/dof | RMS ADEV err (held out) | traced to | parameters | χ²/dof before → after "
         "| RMS ADEV err before → after | held-out err before → after |",
