@@ -14,6 +14,7 @@ Usage::
     python benches/refine_measured.py            # -> benches/results/refine.{json,md}
     python benches/refine_measured.py --quick    # one ADIS axis and one curve, to a temporary folder
     python benches/refine_measured.py --processes 4   # the ADIS channels in 4 processes (same rows)
+    python benches/refine_measured.py --only "run 3 acc_x" --only "run 4 acc_z" --out /tmp/r   # some records
 """
 
 from __future__ import annotations
@@ -98,11 +99,15 @@ def _adis_row(k: int, ax: str) -> dict:
     return _jsonable(row)
 
 
-def run(quick: bool, out: Path, processes: int = 1) -> dict:
+def run(quick: bool, out: Path, processes: int = 1, only=None) -> dict:
+    """Refine every record (``only``: the records whose name contains one of these texts) and write the
+    results to ``out``."""
     rows: dict = {"adis": [], "curves": []}
     data = _common.shared_data_dir()
     runs = [1] if quick else range(1, 7)
     jobs = [(k, ax) for k in runs for ax in (AXES[:1] if quick else AXES)]
+    if only:
+        jobs = [(k, ax) for k, ax in jobs if any(t in f"ADIS16405 run {k} {ax}" for t in only)]
     if processes > 1:  # the records are independent: in that many processes, rows kept in order
         with ProcessPoolExecutor(processes) as pool:
             rows["adis"] = list(pool.map(_adis_row, *zip(*jobs)))
@@ -112,6 +117,8 @@ def run(quick: bool, out: Path, processes: int = 1) -> dict:
     for f in files[:1] if quick else files:
         cur = load_avar_curve(f)
         for ch, res in cur["channels"].items():
+            if only and not any(t in f"{cur['sensor']} {ch}" for t in only):
+                continue
             try:
                 r = allanite.refine(res)
             except allanite.AllaniteError as exc:
@@ -169,7 +176,9 @@ def write_md(rows, path: Path) -> None:
         "of noise level leaves the record's curve model as it is (the curve of a record whose level steps is the "
         "length-weighted mean of its segments' curves, a model of the same terms), so on the chain its before and "
         "after are the same numbers; in brackets what found it, each change point without → with it (the earlier "
-        "ones in both): the windows' Allan variances about piecewise levels, and held out per segment.",
+        "ones in both): the windows' Allan variances about piecewise levels, and held out per segment. A spectral "
+        "line's amplitude (its power in the spectrum) and f0 are measured in the samples and held in every fit "
+        "of the curve, the final joint refit included.",
         "",
         "| record | five-term χ²/dof | RMS ADEV err (held out) | traced to | parameters | χ²/dof before → after "
         "| RMS ADEV err before → after | held-out err before → after |",
@@ -227,9 +236,15 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--out", type=Path)
     ap.add_argument("--processes", type=int, default=1, help="refine the ADIS channels in this many processes")
+    ap.add_argument(
+        "--only",
+        action="append",
+        metavar="TEXT",
+        help='only the records whose name contains TEXT (repeatable; e.g. "run 3 acc_x", "acc_", "KVH")',
+    )
     a = ap.parse_args(argv)
-    out = a.out or (Path(tempfile.mkdtemp()) if a.quick else HERE / "results")
-    run(a.quick, out, a.processes)
+    out = a.out or (Path(tempfile.mkdtemp()) if a.quick or a.only else HERE / "results")
+    run(a.quick, out, a.processes, a.only)
     print(f"wrote {out / 'refine.md'}")
     return 0
 

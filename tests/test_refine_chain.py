@@ -218,15 +218,20 @@ def test_adis_run1_z_final_params_beside_acceptance(adis_run1_z):
     r = adis_run1_z
     curve = [s for s in r.steps if s.effect in ("sinusoid", "bandwidth", "resonance", "gauss_markov")]
     assert len(curve) == len(r.effects)
-    names = [n for n in r.fit.coefficients if n not in r.terms]  # "sinusoid1", "sinusoid2", "bandwidth", …
+    names = [n for n in r.fit.coefficients if n not in r.terms]  # "resonance1", "bandwidth", …
     for key, st in zip(names, curve):  # steps[j] ↔ effects[j]
         assert set(st.final_params) == set(st.params)
         amp = {"sinusoid": "amplitude", "resonance": "sigma", "gauss_markov": "sigma"}.get(st.effect)
         if amp:  # the final joint fit's amplitude: its column's √θ in the final model
             assert st.final_params[amp] == pytest.approx(r.fit.coefficients[key].value, rel=1e-12)
-    sn = next(s for s in r.steps if s.effect == "sinusoid")
-    # at acceptance from the samples (least squares at the line), after the joint refit from the curve
-    assert sn.params["amplitude"] != sn.final_params["amplitude"] and sn.final_params["f0"] == sn.params["f0"]
+        if st.effect == "sinusoid":  # a line's amplitude is measured in the samples and held: as accepted
+            lo, hi = st.intervals["amplitude"]
+            assert st.final_params == st.params and lo <= st.final_params["amplitude"] <= hi
+    # the lines at 18.8 and 21.8 Hz (0.0045 °/s by least squares) sit in the 20.4 Hz resonance's hump: a free
+    # joint refit drifted them to 0.063 and 0.11 °/s; held at their power in the spectrum they no longer stand
+    # in for the hump, and the resonances and the bandwidth describe it
+    assert {"bandwidth", "resonance"} <= set(r.found)
+    assert all(st.final_params.get("amplitude", 0.0) < 0.02 for st in r.steps if st.effect == "sinusoid")
 
 
 def test_adis_run1_z_renders_every_param_everywhere(adis_run1_z):
@@ -245,10 +250,10 @@ def test_adis_run1_z_renders_every_param_everywhere(adis_run1_z):
         for k, v in st.final_params.items():
             assert format_param(k, v, st.final_intervals.get(k), units.get(k, ""), 3) in page
     # the final-model table lists each effect once, with the registry's units (N is not repeated under the
-    # bandwidth, a sinusoid's f0 is in Hz)
+    # bandwidth, a resonance's f0 is in Hz)
     final = text.split("## Final model", 1)[1]
-    assert final.count("- bandwidth:") == 1 and "filter = boxcar" in final.split("- bandwidth:", 1)[1].split("\n")[0]
-    assert "f0 = " in final and " Hz" in final.split("- sinusoid 1:", 1)[1].split("\n")[0]
+    assert final.count("- bandwidth:") == 1 and "filter = " in final.split("- bandwidth:", 1)[1].split("\n")[0]
+    assert "f0 = " in final and " Hz" in final.split("- resonance 1:", 1)[1].split("\n")[0]
     assert "deg/s" not in final.split("- bandwidth:", 1)[1].split("\n")[0]
     # a term the refinement moved outside the plain fit's interval: which steps moved it, in words, everywhere
     assert r.term_moves and all(m["moves"] for m in r.term_moves)

@@ -89,7 +89,13 @@ def test_a_family_whose_phase_wanders_is_left_to_the_sinusoid_term():
     r = allanite.refine(y, FS, progress=False)
     assert any("rejected" in e for e in r.considered["periodic"])
     assert r.found[0] == "sinusoid" and abs(r.steps[0].params["f0"] / 0.56 - 1) < 0.02
-    assert r.start.chi2_dof > 300 and r.fit.chi2_dof < 30  # nothing found: 347 (the lines were lost)
+    # nothing found: 347 (the lines were lost). The line's power is held in the curve's fits (0.0191 by its power
+    # in the spectrum; the free curve column had said 0.0194): the misfit left is the column's shape, a
+    # sinusoid's, which a line whose phase wanders follows only up to its coherence time (10 s) — a short-τ term
+    # takes part of it (before, a Gauss–Markov term of T_c 0.09 s, χ²/dof 10; held, a 7 Hz pole, 47), and the
+    # report says the model still misses something there
+    assert r.start.chi2_dof > 300 and r.fit.chi2_dof < 60
+    assert r.steps[0].final_params == r.steps[0].params and r.unexplained
 
 
 def test_sparse_spikes_are_one_outliers_step():

@@ -246,7 +246,9 @@ def find_lines(y: np.ndarray, fs: float, alpha: float, rounds: int = 4) -> dict:
     search is repeated (up to ``rounds`` times) with the main lobes of the lines found left out of every median;
     with no line in the first round nothing changes (the null is the first round's).
 
-    Returns ``lines`` (strongest first; each ``f`` Hz, ``amplitude`` (from the PSD), ``psd_ratio`` (bin over
+    Returns ``lines`` (strongest first; each ``f`` Hz, ``amplitude`` and ``amplitude_sd`` (from the PSD: the
+    line's power over its width ``width_hz`` — the main lobe, or more where its phase wanders —, A²/2, whether or
+    not its phase carries across the record), ``psd_ratio`` (bin over
     the noise level), ``threshold``, ``noise`` (one-sided PSD under it, unit²/Hz), ``bin_hz``, ``pass``),
     ``bins`` (the number searched: the Bonferroni factor), ``p_value`` (the smallest bin's in the first round,
     times ``bins``: the record's Bonferroni p-value) and ``passes`` (:func:`line_spectrum`)."""
@@ -287,17 +289,37 @@ def find_lines(y: np.ndarray, fs: float, alpha: float, rounds: int = 4) -> dict:
 
 def _describe(ps: dict, k: int, ratio: float, thr: float, j: int) -> dict:
     """A peak's frequency (log-parabola through the bin and its neighbours), amplitude from the power above
-    the noise over the main lobe (A²/2 = Σ (p − noise)·df), and the test."""
+    the noise over the line's width (A²/2 = Σ (p − noise)·df; the main lobe, wider where the bins beside it
+    stand out: ``width_hz``), and the test."""
     p, df = ps["p"], ps["df"]
     lp = np.log(np.maximum(p[k - 1 : k + 2], 1e-300))
     den = lp[0] - 2 * lp[1] + lp[2]
     delta = 0.5 * (lp[0] - lp[2]) / den if den < 0 else 0.0
     delta = float(np.clip(delta, -0.5, 0.5))
     noise = float(ps["noise"][k])
-    power = float(np.sum(np.maximum(p[k - LOBE : k + LOBE + 1] - noise, 0.0)) * df)
+    # the line's width: its main lobe, widened while the next bin stands 2 SD above the noise (a line whose
+    # phase wanders spreads over more bins than the window's lobe), at most to the neighbourhood its noise level
+    # came from
+    lo, hi, reach = k - LOBE, k + LOBE, LOBE + int(np.clip(k // 2, *NEIGHBOURS))
+    above = noise * (1.0 + 2.0 * math.sqrt(2.0 / ps["dof"]))
+    while lo - 1 >= max(1, k - reach) and p[lo - 1] > above:
+        lo -= 1
+    while hi + 1 <= min(p.size - 2, k + reach) and p[hi + 1] > above:
+        hi += 1
+    lobe = p[lo : hi + 1]
+    power = float(np.sum(np.maximum(lobe - noise, 0.0)) * df)
+    # its SD: each Welch bin scatters by p·√(2/dof) (a line whose phase wanders scatters like the noise; the
+    # bins of one lobe correlate: κ), the noise level under it by noise·√(2/dof_med)
+    var_p = ps["kappa"] * float(np.sum(lobe**2)) * 2.0 / ps["dof"] + (lobe.size * noise) ** 2 * 2.0 / float(
+        ps["dof_med"][k]
+    )
+    amp = math.sqrt(2.0 * power)
     return {
         "f": (k + delta) * df,
-        "amplitude": math.sqrt(2.0 * power),
+        "amplitude": amp,
+        "width_hz": (lo * df, hi * df),
+        # A²/2 = power: σ_A = σ_power/A (a line at the noise level: the SD of √(2·power) at power's SD)
+        "amplitude_sd": math.sqrt(var_p) * df / amp if amp > 0 else math.sqrt(2.0 * math.sqrt(var_p) * df),
         "psd_ratio": ratio,
         "threshold": thr,
         "noise": noise,

@@ -266,13 +266,15 @@ def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
 
 
 def sinusoid_lines(search: dict, families=False) -> list[dict]:
-    """The lines of a :func:`periodic_search` as the ``"sinusoid"`` candidate takes them, strongest first: each
-    ``f0`` (Hz, refined), ``amplitude`` and ``phase`` (least squares), ``f0_interval`` and
-    ``amplitude_interval`` (±1σ), ``psd_ratio``, ``threshold`` and ``bin_hz`` of the search. The lone lines;
-    with ``families`` True, every family's lines too (when families are not removed as a whole); given a list
-    of the search's families, those families' lines (the ones a removal in time turned down: a line whose
-    phase does not carry from one part of the record to the other — a site's sway, narrowband rather than
-    coherent — is still power at its frequency, which the curve's sinusoid term describes)."""
+    """The lines of a :func:`periodic_search` as the ``"sinusoid"`` candidate takes them, strongest first: each ``f0``
+    (Hz, refined), ``amplitude`` and ``phase`` (least squares: the part whose phase carries across the record),
+    ``f0_interval`` and ``amplitude_interval`` (±1σ), ``power_amplitude`` and its ``power_amplitude_interval``
+    (√(2·power) of the line in the search's spectrum over its ``width_hz``: all its power, a wandering phase too —
+    what the Allan curve sees), ``psd_ratio``, ``threshold`` and ``bin_hz`` of the search. The lone lines; with
+    ``families`` True, every family's lines too (when families are not removed as a whole); given a list of the
+    search's families, those families' lines (the ones a removal in time turned down: a line whose phase does not
+    carry from one part of the record to the other — a site's sway, narrowband rather than coherent — is still power
+    at its frequency, which the curve's sinusoid term describes)."""
     out: list[dict] = []
     found = np.array([d["f"] for d in search["lines"]])
     chosen = list(search["families"]) if families is True else list(families or [])
@@ -294,6 +296,12 @@ def sinusoid_lines(search: dict, families=False) -> list[dict]:
                     "phase": float(math.atan2(fam.a[i], fam.b[i])),
                     "f0_interval": (float(freqs[i] - f_sd[i]), float(freqs[i] + f_sd[i])),
                     "amplitude_interval": (max(0.0, float(amps[i] - amp_sd[i])), float(amps[i] + amp_sd[i])),
+                    "power_amplitude": float(near["amplitude"]),
+                    "width_hz": near["width_hz"],
+                    "power_amplitude_interval": (
+                        max(0.0, float(near["amplitude"] - near["amplitude_sd"])),
+                        float(near["amplitude"] + near["amplitude_sd"]),
+                    ),
                     "psd_ratio": float(near["psd_ratio"]),
                     "threshold": float(near["threshold"]),
                     "bin_hz": float(near["bin_hz"]),

@@ -93,7 +93,8 @@ def refinement_dict(rep) -> dict | None:
             "τ of the dense curve weighted independently), RMS ADEV error (%) on 4 τ per octave whose estimate is "
             "within ±10 %; heldout_rms_adev_pct: the model fitted on alternate blocks (8, joined; removals refitted "
             "on them) predicting the other blocks' curve, both ways (null for curve-only input). A change of noise "
-            "level leaves the curve's model as it is (before = after)",
+            "level leaves the curve's model as it is (before = after); a spectral line's amplitude and f0, measured "
+            "in the samples, are held in every fit of the curve",
             "window_levels": "what found a change point (its step's window_levels): the log Allan variances of "
             "16 windows along the record about piecewise-constant levels without → with this change point (the "
             "earlier ones in both: the first one's before is one level, each next one's before the previous one's "

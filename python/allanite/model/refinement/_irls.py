@@ -20,12 +20,17 @@ __all__ = ["irls", "chi2_at"]
 RTOL = 1e-6
 
 
-def irls(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max_iter: int, floor: float):
+def irls(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max_iter: int, floor: float, held=None):
     """Reweighted NNLS of the curve ``y`` (n τ) on each design ``a[g]`` (G × n × k): weights ν/(2·model²), the
     model damped geometrically between passes, ν per τ from the columns' shares of the model and their EDF
     ``nu_cols[g]`` (ν starts at ``nu0``); a design stops once no coefficient moved by more than :data:`RTOL`.
-    Returns the coefficients (G × k) and the EDF per τ (G × n) each design stopped at."""
+    ``held`` {column: (coefficient, variance)}: columns at a coefficient measured elsewhere (a spectral line's
+    power), part of the model and of ν, not fitted (:func:`_irls_held`). Returns the coefficients (G × k) and
+    the EDF per τ (G × n) each design stopped at."""
     g_n, n, k = a.shape
+    if held:
+        out = [_irls_held(a[g], nu_cols[g], y, nu0, max_iter, floor, held) for g in range(g_n)]
+        return np.stack([t for t, _nu in out]), np.stack([v for _t, v in out])
     if g_n == 1:
         theta1, nu1 = _irls_one(a[0], nu_cols[0], y, nu0, max_iter, floor)
         return theta1[None], nu1[None]
@@ -76,6 +81,39 @@ def _irls_one(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu: np.ndarray,
         new_model = np.maximum(tot, floor)
         done = bool(np.all(np.abs(new - theta) <= RTOL * np.abs(theta)))
         model = new_model if it == 0 else np.sqrt(model * new_model)
+        theta = new
+        if new.any():
+            den = np.sum(parts**2 / nu_cols, axis=1)
+            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
+        if done:
+            break
+    return theta, nu
+
+
+def _irls_held(a, nu_cols, y, nu, max_iter, floor, held):
+    """:func:`irls` of one design whose ``held`` columns stay at their coefficients: the others fitted to the
+    curve less the held columns' part, the weights and ν from the whole model."""
+    y = np.asarray(y, dtype=np.float64)
+    fixed = np.zeros(a.shape[1])
+    for i, (th, _var) in held.items():
+        fixed[i] = th
+    free = np.ones(a.shape[1], dtype=bool)
+    free[list(held)] = False
+    y_free = y - a @ fixed
+    solver, maxiter = raw_solver(), 50 * int(free.sum())
+    theta, model = fixed.copy(), y.copy()
+    for it in range(max_iter):
+        sw = np.sqrt(nu / (2.0 * np.maximum(model, floor) ** 2))
+        aw = a[:, free] * sw[:, None]
+        scale = np.sqrt(np.add.reduce(aw * aw, axis=0))
+        scale[scale == 0] = 1.0
+        new = fixed.copy()
+        if free.any():
+            new[free] = solver(aw / scale, y_free * sw, maxiter) / scale
+        parts = a * new
+        tot = parts.sum(axis=1)
+        done = bool(np.all(np.abs(new - theta) <= RTOL * np.abs(theta)))
+        model = np.maximum(tot, floor) if it == 0 else np.sqrt(model * np.maximum(tot, floor))
         theta = new
         if new.any():
             den = np.sum(parts**2 / nu_cols, axis=1)

@@ -3,9 +3,12 @@ of an effect's nonlinear parameter with its profile interval, and the NoiseFit i
 
 Every curve effect enters the model as a non-negative column of Allan variance (its registry signature,
 :mod:`allanite.model.effects`); an effect that ``replaces`` a term (a bandwidth: the filtered white noise is
-the white rate noise N) zeroes that term's column. Weights are the estimates' EDF under the model's own
-noise mix, iterated (IRLS); the covariance of the coefficients counts the dense curve's ~one independent
-estimate per octave.
+the white rate noise N) zeroes that term's column. An effect measured in the time domain (a spectral line's
+amplitude, from its power in the samples' spectrum) is *held*: its key carries the coefficient and its
+variance (:func:`held_key`), its column enters every fit at that value and the curve fits only the others —
+the Allan curve, where a line's column aliases with a bandwidth's or a resonance's, does not move it.
+Weights are the estimates' EDF under the model's own noise mix, iterated (IRLS); the covariance of the
+coefficients counts the dense curve's ~one independent estimate per octave.
 """
 
 from __future__ import annotations
@@ -24,6 +27,8 @@ from ._irls import chi2_at, irls
 
 __all__ = [
     "base_name",
+    "held_key",
+    "held_theta",
     "column",
     "Curve",
     "Solution",
@@ -44,6 +49,20 @@ __all__ = [
 def base_name(key: str) -> str:
     """The effect of a column key ("bandwidth:single_pole" → "bandwidth")."""
     return key.split(":", 1)[0]
+
+
+def held_key(effect: str, theta: float, var: float) -> str:
+    """The key of ``effect`` held at coefficient ``theta`` (amplitude², measured in the time domain) with
+    variance ``var`` in every fit of the curve."""
+    return f"{effect}:held:{theta!r}:{var!r}"
+
+
+def held_theta(key: str) -> tuple[float, float] | None:
+    """(coefficient, its variance) of a held effect's key (:func:`held_key`), else None."""
+    parts = key.split(":")
+    if len(parts) == 4 and parts[1] == "held":
+        return float(parts[2]), float(parts[3])
+    return None
 
 
 def column(key, p, curve):
@@ -200,9 +219,10 @@ def _edf_column(curve, al):
 
 
 def solve(curve: Curve, terms, effects, max_iter: int = 40) -> Solution:
-    """IRLS weighted NNLS of the terms plus effects [(key, nonlinear parameter)] (:func:`._irls.irls`)."""
+    """IRLS weighted NNLS of the terms plus effects [(key, nonlinear parameter)] (:func:`._irls.irls`); a held
+    effect's column (:func:`held_key`) at its coefficient, the others fitted."""
     a, theta, nu, floor = _fits(curve, terms, [effects], max_iter)[0]
-    return _finish(curve, a, theta, nu, floor, len(effects))
+    return _finish(curve, a, theta, nu, floor, len(effects), _held(terms, effects))
 
 
 def chi2s(curve: Curve, terms, effects, key, ps, max_iter: int = 40) -> np.ndarray:
@@ -231,7 +251,8 @@ def _fits(curve: Curve, terms, models: list, max_iter: int) -> list:
         a, nu_cols = (a_all, nu_all) if whole else (a_all[todo], nu_all[todo])
         nu0 = nu_cols[0][:, 1] if len(terms) > 1 else nu_cols[0][:, 0]
         floor = 1e-12 * np.max(y)
-        theta, nu_end = irls(a, nu_cols, y, nu0, max_iter, floor)
+        held = _held(terms, models[todo[0]])  # the models of one call differ in their last column only
+        theta, nu_end = irls(a, nu_cols, y, nu0, max_iter, floor, held=held or None)
         for i, g in enumerate(todo):
             th, nu = theta[i].copy(), nu_end[i].copy()
             th.flags.writeable = nu.flags.writeable = False
@@ -265,18 +286,32 @@ def _stacked(curve: Curve, terms, models: list) -> tuple[np.ndarray, np.ndarray]
     return a, nu
 
 
-def _finish(curve, a, theta, nu, floor, n_effects) -> Solution:
-    """The solution at ``theta``: model, normalised residual, χ², and the coefficients' covariance."""
+def _held(terms, effects) -> dict:
+    """The held columns of a model: {column index: (coefficient, its variance)} (:func:`held_key`)."""
+    k = len(terms)
+    return {k + j: h for j, (key, _p) in enumerate(effects) if (h := held_theta(key)) is not None}
+
+
+def _finish(curve, a, theta, nu, floor, n_effects, held=None) -> Solution:
+    """The solution at ``theta``: model, normalised residual, χ², and the coefficients' covariance (a held
+    column's its time-domain variance, uncorrelated with the others). A held column counts among the numbers
+    fitted (in the time domain) for the degrees of freedom."""
     tau = curve.tau
     model = np.maximum(a @ theta, floor)
     w = nu / (2.0 * model**2)
     z = (curve.avar - model) * np.sqrt(w)
     active = theta > 0
+    is_held = np.zeros(theta.size, dtype=bool)
+    held = held or {}
+    is_held[list(held)] = True
     cov = np.full((a.shape[1], a.shape[1]), np.nan)
-    if active.any():
-        idx = np.flatnonzero(active)
-        aw = a[:, idx] * w[:, None]
-        cov[np.ix_(idx, idx)] = np.linalg.pinv(aw.T @ a[:, idx]) * (tau.size / curve.n_eff)
+    fit_idx = np.flatnonzero(active & ~is_held)
+    if fit_idx.size:
+        aw = a[:, fit_idx] * w[:, None]
+        cov[np.ix_(fit_idx, fit_idx)] = np.linalg.pinv(aw.T @ a[:, fit_idx]) * (tau.size / curve.n_eff)
+    for i, (_th, var) in held.items():
+        cov[i, :] = cov[:, i] = 0.0
+        cov[i, i] = var
     dof = max(1, tau.size - int(active.sum()) - n_effects)
     return Solution(theta, model, nu, z, float(np.sum(z**2)), dof, a, cov)
 
@@ -390,7 +425,11 @@ def upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4
     out = theta.copy()
     a, _ = design(curve, terms, effects)
     w = np.sqrt(sol.nu / (2.0 * sol.model**2))
-    aw, yw = a * w[:, None], curve.avar * w
+    # a held effect's column (a line measured in the time domain) stays at its coefficient
+    held = [len(terms) + j for j, (key, _p) in enumerate(effects) if held_theta(key) is not None]
+    y = curve.avar - a[:, held] @ sol.theta[held] if held else curve.avar
+    a = np.delete(a, held, axis=1) if held else a
+    aw, yw = a * w[:, None], y * w
     chi_min = float(np.sum((yw - aw @ fitting.nnls(aw, yw)) ** 2))
     # the dense curve's points are strongly correlated: χ² counts ~n_eff independent ones (as the fit's
     # covariance does), so the rise allowed on the dense χ² is scaled by points / n_eff

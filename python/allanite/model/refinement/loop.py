@@ -29,7 +29,7 @@ from ..terms import check_terms
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families, final_params, prefetch
 from .changes import change_point_step, change_points
-from .curvefit import Curve, base_name, noise_fit, solve, theta_terms
+from .curvefit import Curve, base_name, held_theta, noise_fit, solve, theta_terms
 from .levels import LEVEL, alpha
 from .missing import MissingContext, unexplained
 from .removals import REMOVALS, Removal, RemovalContext
@@ -48,8 +48,9 @@ __all__ = ["refine", "CANDIDATES", "MAX_STEPS", "REFINE_SCALE"]
 
 #: Effects refine can add, from the registry in :mod:`allanite.model.effects`.
 CANDIDATES = tuple(EFFECTS)
-#: Curve effects added at most (time-domain removals and change points come on top): two injected curve effects,
-#: the bandwidth and a resonance beside it (ADIS16405 run 1 z takes four) with room for one more.
+#: Curve effects added at most (time-domain removals, spectral lines — their amplitude measured in the samples,
+#: held in the curve's fits — and change points come on top): two injected curve effects, the bandwidth and a
+#: resonance beside it (ADIS16405 run 1 z takes four) with room for one more.
 MAX_STEPS = 6
 
 
@@ -424,9 +425,11 @@ class _Run:
                 # every line there offered (conditional on a family found: no share of level under the null)
                 search, fams = periodic.periodic_search(y, self.fs, alpha("lines", self.level)), True
             lines = periodic.sinusoid_lines(search, families=fams)
-        for n_step in range(MAX_STEPS):
+        n_step = 0
+        while sum(held_theta(k) is None for k, _p in self.effects) < MAX_STEPS:
             if not self.curve_step(n_step, candidates, thin, exact, lines):
                 break
+            n_step += 1
         self.drop_absorbed()
         self.score()
 

@@ -33,7 +33,8 @@ class Step:
     ``T`` s; regression ``channel``, ``coefficient`` rate unit per channel unit; change point ``t`` s);
     ``intervals`` the numeric keys → (low, high); ``final_params``/``final_intervals`` the same after the final
     joint refit (a curve effect's amplitude refitted beside every other effect, its nonlinear parameter's
-    interval profiled again; a removal in time or a change point as accepted). ``before``/``after``:
+    interval profiled again; what was measured in the time domain as accepted: a spectral line's amplitude and
+    f0 — held in every fit of the curve —, a removal in time, a change point). ``before``/``after``:
     ``chi2_dof``, ``rms_z``, ``rms_adev_pct`` (on ``Refinement.scored_tau``), ``p_value`` and
     ``heldout_rms_adev_pct`` (None for curve-only input) of the model before and after the step, all on the
     original record's Allan curve — each step's ``before`` is the previous step's ``after`` (the steps in the
@@ -134,7 +135,10 @@ class Refinement(RichDisplay):
     (:mod:`allanite.model.refinement.missing`); :meth:`missing_sentences` says it in words. ``considered``: per
     effect, every proposal tried (its parameter, statistic and threshold); one whose test passed but that was not
     taken says why under ``"rejected"`` (χ²/dof not falling, a parameter at the edge of its range, the held-out
-    error, another candidate taken at that step)."""
+    error, another candidate taken at that step). ``effects`` the final model's curve columns [(key, nonlinear
+    parameter)], steps[j] ↔ effects[j] (a spectral line's key, ``"sinusoid:held:<A²>:<its variance>"``, carries
+    the amplitude it is held at:
+    :func:`allanite.model.refinement.curvefit.held_key`)."""
 
     steps: list
     fit: fitting.NoiseFit
@@ -189,7 +193,13 @@ class Refinement(RichDisplay):
             "it is (the curve of a record whose level steps is the length-weighted mean of its segments' curves: a "
             "model of the same terms), so its before and after there are the same numbers; what found it is on the "
             "windows' levels along the record (evidence['window_levels'], each change point without → with it) and "
-            "held out per segment (evidence['heldout_test'])."
+            "held out per segment (evidence['heldout_test']).",
+            "Parameters measured in the time domain keep their time-domain values in the final joint refit: a "
+            "spectral line's amplitude (its power in the samples' spectrum; the part whose phase carries across "
+            "the record in evidence['coherent_amplitude']) and f0 are held in every fit of the curve, and the "
+            "components removed in time (drift, regressions, line families, outliers) and change points are as "
+            "accepted; the joint refit moves the amplitudes only the curve measures (σ of a Gauss–Markov term "
+            "or a resonance, the noise terms).",
         ]
         return out + [term_move_text(m, self.fit.unit) for m in self.term_moves]
 
