@@ -178,3 +178,20 @@ def test_an_unused_worker_is_ended():
     assert not _worker._WORKER
     with pytest.raises(ChildProcessError):
         os.waitpid(pid, os.WNOHANG)  # reaped
+
+
+def test_the_worker_draws_the_davar_figures_from_the_offered_analysis(monkeypatch):
+    import allanite
+    from allanite.report import _worker, build_report
+
+    y = allanite.simulate(6_000, 100.0, N=0.01, K=1e-3, seed=4)[:, None]
+    offered = []
+    real_offer = _worker.offer
+    monkeypatch.setattr(_worker, "offer", lambda partial: offered.append(partial) or real_offer(partial))
+    assert _worker.start(when_idle=False)
+    rep = build_report(y, 100.0, unit="deg/s", window=1_500, hop=500, progress=False)
+    assert len(offered) == 1 and offered[0].fits is None and offered[0].dynamic is rep.dynamic
+    images = rep.render_figures(False)  # the offered figures were drawn at the default 100 dpi
+    serial = render_pngs(rep.figure_specs(), 100, lambda text: None, processes=1)
+    assert list(images) == list(serial) and all(images[k] == serial[k] for k in serial)
+    assert not _worker.waiting()

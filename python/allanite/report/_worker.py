@@ -2,10 +2,13 @@
 
 Importing matplotlib and setting up its fonts takes about half a second, and the report's figures cannot be
 drawn before the report exists. :func:`start` forks a process right away that imports matplotlib and draws a
-small figure (fonts, the Agg canvas, the 3-D axes) while this process reads the log and computes; handed the
-report (pickled: arrays and the fits, a few hundred kB), it draws the figures — on two processes where a core
-is idle then (:func:`allanite.report.rendering.render_pngs`) — and hands the PNGs back. This process then never
-imports matplotlib. The PNGs are the same bytes as drawn here.
+small figure (fonts, the Agg canvas, the 3-D axes) while this process reads the log and computes. Offered the
+analysis as soon as it exists (:func:`offer`: the static and dynamic results, before the noise model is fitted),
+it draws the figures that need nothing more (:func:`allanite.report.figures.from_analysis_alone`: the DAVAR heat
+maps and surfaces, about half of the drawing) while this process fits; handed the whole report (pickled: arrays
+and the fits, a few hundred kB), it draws the rest — on two processes where a core is idle then
+(:func:`allanite.report.rendering.render_pngs`) — and hands the PNGs back. This process then never imports
+matplotlib. The PNGs are the same bytes as drawn here.
 
 The worker is started only where the figures would be drawn on two processes
 (:func:`~allanite.report.rendering.figure_processes`: ``fork``, two cores and one of them idle, the main
@@ -21,7 +24,10 @@ import pickle
 import signal
 import warnings
 
-__all__ = ["start", "close", "take"]
+__all__ = ["start", "waiting", "offer", "take", "close"]
+
+#: Capacity asked for the pipe to the worker (Linux allows up to 1 MiB unprivileged).
+PIPE_BYTES = 1 << 20
 
 _WORKER: list = []  # the one waiting worker: (pid, write end, read end)
 
@@ -53,6 +59,12 @@ def start(when_idle: bool = True) -> bool:
             status = _serve(to_child, from_child)
         finally:
             os._exit(status)
+    try:  # room in the pipe for the offered analysis (a few hundred kB) while the worker still sets up (Linux)
+        import fcntl
+
+        fcntl.fcntl(from_parent, fcntl.F_SETPIPE_SZ, PIPE_BYTES)
+    except (ImportError, AttributeError, OSError):
+        pass
     try:
         os.setpgid(pid, pid)  # as the worker does itself: its group exists whichever of the two runs first
     except OSError:
@@ -63,33 +75,64 @@ def start(when_idle: bool = True) -> bool:
     return True
 
 
+#: Resolution of the figures drawn from the analysis before the report is complete (Report.write's default);
+#: a report written at another resolution has them drawn again.
+EARLY_DPI = 100
+
+
+def waiting() -> bool:
+    """Whether a worker waits for this process's report."""
+    return bool(_WORKER)
+
+
+def offer(partial) -> None:
+    """Hand the waiting worker (if any) the report as far as it is computed — static and dynamic results, no
+    fits — so that it draws the figures that need nothing more now; nothing when no worker waits or the
+    report cannot be pickled."""
+    if _WORKER:
+        _send(("analysis", partial, EARLY_DPI))
+
+
 def take(rep, dpi: int) -> dict | None:
     """File name → PNG bytes of the report's figures drawn by the waiting worker, or None when no worker waits,
     the report cannot be pickled or the worker fails (the caller draws them)."""
     if not _WORKER:
         return None
-    pid, w, r = _WORKER.pop()
     try:
-        try:
-            data = pickle.dumps((rep, dpi), protocol=pickle.HIGHEST_PROTOCOL)
-        except Exception:  # something in the report that pickle cannot carry: drawn here
+        if not _send(("report", rep, dpi)):
             return None
-        with os.fdopen(w, "wb", closefd=False) as f:
-            f.write(data)
+        pid, w, r = _WORKER[0]
         os.close(w)
-        w = -1
+        _WORKER[0] = (pid, -1, r)
         chunks = []
         while chunk := os.read(r, 1 << 20):
             chunks.append(chunk)
         _, status = os.waitpid(pid, 0)
-        pid = -1
+        _WORKER[0] = (-1, -1, r)
         if status != 0 or not chunks:
             return None
         return pickle.loads(b"".join(chunks))
     except (OSError, pickle.UnpicklingError, EOFError):
         return None
     finally:
-        _end(pid, w, r)
+        close()
+
+
+def _send(message) -> bool:
+    """Write one message (its length, then its pickle) to the worker; False when it cannot be pickled or
+    written (the worker is then ended)."""
+    try:
+        data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception:  # something in the report that pickle cannot carry: drawn here
+        close()
+        return False
+    try:
+        with os.fdopen(_WORKER[0][1], "wb", closefd=False) as f:
+            f.write(len(data).to_bytes(8, "little") + data)
+    except OSError:
+        close()
+        return False
+    return True
 
 
 def close() -> None:
@@ -121,23 +164,57 @@ def _end(pid: int, w: int, r: int) -> None:
 
 
 def _serve(r: int, w: int) -> int:  # pragma: no cover - runs in the forked worker
-    """The worker: set up matplotlib, wait for (report, dpi), draw, hand the PNGs back; 0 when done."""
+    """The worker: set up matplotlib, draw the figures of the analysis when it is offered, the rest when the
+    report comes, hand all the PNGs back; 0 when done."""
+    import select
+
+    from .figures import figure_specs, from_analysis_alone
+    from .rendering import png, render_pngs
+
     os.setpgid(0, 0)  # its own group: killed with the drawing process it forks; Ctrl-C reaches the parent only
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _warm_up()
-    chunks = []
-    while chunk := os.read(r, 1 << 20):
-        chunks.append(chunk)
-    os.close(r)
-    if not chunks:  # the parent closed the pipe without a report: nothing to draw
+    message = _receive(r)
+    early: dict = {}
+    if message is not None and message[0] == "analysis":
+        _, partial, dpi = message
+        todo = [sp for sp in figure_specs(partial) if from_analysis_alone(sp[0])]
+        message = None
+        for spec in todo:  # one at a time, until the whole report comes
+            early[spec[0]] = (png(spec, dpi), dpi)
+            if select.select([r], [], [], 0)[0]:
+                break
+        message = _receive(r)
+    if message is None:  # the parent closed the pipe without a report: nothing to draw
         return 0
-    from .rendering import render_pngs
-
-    rep, dpi = pickle.loads(b"".join(chunks))
-    images = render_pngs(rep.figure_specs(), dpi, lambda text: None)
+    _, rep, dpi = message
+    specs = figure_specs(rep)
+    rest = [sp for sp in specs if early.get(sp[0], (None, None))[1] != dpi]
+    drawn = render_pngs(rest, dpi, lambda text: None)
+    images = {sp[0]: drawn[sp[0]] if sp[0] in drawn else early[sp[0]][0] for sp in specs}
     with os.fdopen(w, "wb") as f:
         f.write(pickle.dumps(images, protocol=pickle.HIGHEST_PROTOCOL))
     return 0
+
+
+def _receive(r: int):
+    """The next message from the parent, None at end-of-file."""
+    head = _read_exactly(r, 8)
+    if head is None:
+        return None
+    data = _read_exactly(r, int.from_bytes(head, "little"))
+    return None if data is None else pickle.loads(data)
+
+
+def _read_exactly(r: int, n: int) -> bytes | None:
+    parts, got = [], 0
+    while got < n:
+        chunk = os.read(r, min(n - got, 1 << 20))
+        if not chunk:
+            return None
+        parts.append(chunk)
+        got += len(chunk)
+    return b"".join(parts)
 
 
 def _warm_up() -> None:  # pragma: no cover - runs in the forked worker

@@ -43,6 +43,7 @@ from ..model import fit as fit_model
 from ..model.effects import EFFECTS
 from ..model.terms import TERMS
 from ..units import parse_unit
+from . import _worker
 from .axes import analyse_by_axis, axis_column, record_bytes, wants_by_axis
 from .budget import check_report_memory
 from .fmt import json_number
@@ -210,6 +211,21 @@ def build_report(
         memory_estimate_bytes=int(cost["total"]),
         by_axis=by_axis,
     )
+    if _worker.waiting():  # a figure process draws the DAVAR figures while the model is fitted
+        _worker.offer(
+            Report(
+                static=static,
+                dynamic=dynamic,
+                fits=None,
+                series=None,
+                fs=float(static.fs),
+                unit=unit_name,
+                input=input,
+                axis_names=axis_names,
+                source={},
+                settings={},
+            )  # fmt: skip
+        )
 
     fits = series = None
     fit_error = series_error = None
