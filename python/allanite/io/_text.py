@@ -154,7 +154,9 @@ def read_text(path, columns, time_column, delimiter, gz):
     # parse only the needed columns when a one-character delimiter makes skipping safe
     usecols = need if (delim is not None and len(need) < ncols) else None
     parsed = usecols if usecols is not None else list(range(ncols))
-    arr = _core.parse_decimal_table(doc.raw, doc.byte_offset(start), delim, ncols, parsed)
+    # (a core extension built before the fast parser existed reads the NumPy way)
+    fast = getattr(_core, "parse_decimal_table", None)
+    arr = fast(doc.raw, doc.byte_offset(start), delim, ncols, parsed) if fast is not None else None
     if arr is None:  # not plain decimal rows: NumPy reads them, and a bad line is found and named
         arr = _parse_lines(path, doc, start, delim, ncols, need, names, usecols)
     if arr.shape[0] == 0:
