@@ -112,14 +112,14 @@ def test_ctrl_c_leaves_no_out_folder(tmp_path, monkeypatch, capsys):
 
 
 def test_ctrl_c_while_writing_removes_the_half_written_folder(tmp_path, monkeypatch):
-    from allanite.report import build as build_module
+    from allanite.report import result as result_module  # Report.write
 
     def interrupted_dumps(*args, **kwargs):
         raise KeyboardInterrupt
 
     x, fs, _ = allanite.default_record()
     rep = allanite.report.build_report(x[:20_000], fs, unit="deg/s", fit=False, window=5_000, hop=2_500)
-    monkeypatch.setattr(build_module.json, "dumps", interrupted_dumps)
+    monkeypatch.setattr(result_module.json, "dumps", interrupted_dumps)
     monkeypatch.setattr(cli, "build_report", lambda *a, **k: rep)
     out = tmp_path / "out"
     assert cli.main(["report", "--out", str(out), "-q"]) == 130

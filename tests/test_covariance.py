@@ -138,3 +138,20 @@ def test_flicker_variance_scales_as_one_over_n_up_to_1e8():
 
     scaled = [n * _blocks(np.array([1, 2, 4]), n, 1.0, ("B",))[0][0, 0, 0, 0] for n in (10**4, 10**6, 10**8)]
     assert scaled[1] == pytest.approx(scaled[0], rel=1e-3) and scaled[2] == pytest.approx(scaled[0], rel=1e-3)
+
+
+def test_a_suffix_of_remembered_blocks_is_sliced_bit_for_bit():
+    from allanite.model import _covariance
+
+    m = np.array([1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048])
+    terms = ("Q", "N", "B", "K", "R")
+    full = covariance_blocks(m, 20_000, 100.0, terms)
+    for k in (1, 3, 6):
+        s, t = covariance_blocks(m[k:], 20_000, 100.0, terms)
+        fresh_s, fresh_t = _covariance._blocks(m[k:], 20_000, 100.0, terms)
+        assert np.array_equal(s.view(np.int64), fresh_s.view(np.int64))
+        assert np.array_equal(t.view(np.int64), fresh_t.view(np.int64))
+        assert not s.flags.writeable and s.shape[2:] == (m.size - k, m.size - k) and full[0].shape[2] == m.size
+    # another record length is not a slice of this one
+    other = covariance_blocks(m[2:], 20_001, 100.0, terms)
+    assert not np.array_equal(other[0], covariance_blocks(m[2:], 20_000, 100.0, terms)[0])

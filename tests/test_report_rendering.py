@@ -124,3 +124,74 @@ def test_lean_figure_draws_the_minor_ticks_where_matplotlib_puts_them():
     buf = io.BytesIO()
     fig.savefig(buf, format="png")
     assert buf.getvalue().startswith(b"\x89PNG")
+
+
+@pytest.fixture
+def small_report():
+    import allanite
+    from allanite.report import build_report
+
+    y = allanite.simulate(6_000, 100.0, N=0.01, K=1e-3, seed=3)[:, None]
+    return build_report(y, 100.0, unit="deg/s", window=1_500, hop=500, progress=False)
+
+
+def test_the_early_worker_draws_the_same_bytes(small_report, monkeypatch):
+    from allanite.report import _worker, result
+
+    serial = render_pngs(small_report.figure_specs(), 60, lambda text: None, processes=1)
+    assert _worker.start(when_idle=False)
+
+    def here(*args, **kwargs):
+        raise AssertionError("drawn in this process although a worker waited")
+
+    monkeypatch.setattr(result, "render_pngs", here)
+    steps = []
+
+    class Bar:
+        def step(self, text):
+            steps.append(text)
+
+    images = small_report.render_figures(Bar(), dpi=60)
+    assert list(images) == list(serial) and all(images[k] == serial[k] for k in serial)
+    assert steps == [f"figure {k}" for k in serial]
+    assert not _worker._WORKER  # used once
+
+
+def test_a_dead_worker_leaves_the_figures_to_this_process(small_report):
+    import signal
+
+    from allanite.report import _worker
+
+    serial = render_pngs(small_report.figure_specs(), 60, lambda text: None, processes=1)
+    assert _worker.start(when_idle=False)
+    os.kill(_worker._WORKER[0][0], signal.SIGKILL)
+    images = small_report.render_figures(False, dpi=60)
+    assert list(images) == list(serial) and all(images[k] == serial[k] for k in serial)
+
+
+def test_an_unused_worker_is_ended():
+    from allanite.report import _worker
+
+    assert _worker.start(when_idle=False)
+    pid = _worker._WORKER[0][0]
+    _worker.close()
+    assert not _worker._WORKER
+    with pytest.raises(ChildProcessError):
+        os.waitpid(pid, os.WNOHANG)  # reaped
+
+
+def test_the_worker_draws_the_davar_figures_from_the_offered_analysis(monkeypatch):
+    import allanite
+    from allanite.report import _worker, build_report
+
+    y = allanite.simulate(6_000, 100.0, N=0.01, K=1e-3, seed=4)[:, None]
+    offered = []
+    real_offer = _worker.offer
+    monkeypatch.setattr(_worker, "offer", lambda partial: offered.append(partial) or real_offer(partial))
+    assert _worker.start(when_idle=False)
+    rep = build_report(y, 100.0, unit="deg/s", window=1_500, hop=500, progress=False)
+    assert len(offered) == 1 and offered[0].fits is None and offered[0].dynamic is rep.dynamic
+    images = rep.render_figures(False)  # the offered figures were drawn at the default 100 dpi
+    serial = render_pngs(rep.figure_specs(), 100, lambda text: None, processes=1)
+    assert list(images) == list(serial) and all(images[k] == serial[k] for k in serial)
+    assert not _worker.waiting()

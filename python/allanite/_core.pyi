@@ -74,6 +74,15 @@ def compensated_sums(
 ) -> list[tuple[float, float]]:
     """Neumaier's compensated sum of each column continued from state[(sum, compensation) per axis]."""
 
+def parse_decimal_table(
+    text: bytes,
+    offset: int,
+    delimiter: str | None,
+    ncols: int,
+    cols: Sequence[int],
+) -> npt.NDArray[np.float64] | None:
+    """Columns cols (sorted) of the data lines of text[offset:], (rows, len(cols)); None off the fast path."""
+
 def angle_term_sums(
     blocks: Sequence[npt.NDArray[np.float64]],
     starts: Sequence[int],

@@ -29,6 +29,8 @@ from .kalibr import to_kalibr
 from .model import fit as fit_model
 from .model.effects import EFFECTS
 from .report import build_report, from_log
+from .report._worker import close as close_figure_worker
+from .report._worker import start as start_figure_worker
 from .units import ACCEL_UNITS
 
 EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
@@ -495,6 +497,8 @@ def _report(args) -> int:
     out_existed = out.exists()
     t0 = time.perf_counter()
     progress = _Progress(quiet)
+    # matplotlib's import and font set-up in a process of its own while the log is read and analysed
+    start_figure_worker()
     try:
         with warnings.catch_warnings():
             if quiet:
@@ -538,6 +542,7 @@ def _report(args) -> int:
             shutil.rmtree(out, ignore_errors=True)
         raise
     finally:
+        close_figure_worker()
         progress.close()
     if not quiet:
         print(rep.text())

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import gzip
 import zlib
+from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
+from .. import _core
 from ..errors import InputError, ParameterError
 from ._columns import Record, first_nonfinite, select_columns
 
@@ -39,8 +42,45 @@ def _guess_delimiter(line: str):
     return None
 
 
-def _decode(path, gz):
-    """(text, lines) of the file: gunzipped when ``gz``, UTF-8 (else Latin-1), without a byte-order mark."""
+#: Characters of a text log's beginning split into lines to find its header and first data row (the fast path
+#: reads the rest as bytes; a log whose header is not found within them is split whole).
+HEAD_CHARS = 1 << 16
+
+
+@dataclass
+class _Text:
+    """A text log decoded: its bytes (gunzipped), text (UTF-8, else Latin-1, without a byte-order mark), the
+    codec and whether a mark was dropped; its lines split on first use (a large log's body is read from
+    ``raw`` by the core's parser, and only an error message needs its lines)."""
+
+    raw: bytes
+    text: str
+    codec: str
+    bom: bool
+
+    @cached_property
+    def lines(self) -> list[str]:
+        return self.text.splitlines()
+
+    def head(self) -> tuple[list[str], bool]:
+        """(the first lines — all of them when the text is short, else those in its first ``HEAD_CHARS``
+        characters, complete lines only —, whether that is every line)."""
+        if len(self.text) <= HEAD_CHARS:
+            return self.lines, True
+        k = self.text.rfind("\n", 0, HEAD_CHARS) + 1
+        return self.text[:k].splitlines(), False
+
+    def byte_offset(self, start: int) -> int:
+        """Where line ``start`` begins in ``raw``."""
+        kept = self.text[: HEAD_CHARS + 1].splitlines(keepends=True)[:start]
+        chars = sum(map(len, kept))
+        if len(kept) < start or chars > HEAD_CHARS:  # line `start` begins beyond the head
+            chars = sum(map(len, self.text.splitlines(keepends=True)[:start]))
+        return len(self.text[:chars].encode(self.codec)) + (3 if self.bom else 0)
+
+
+def _decode(path, gz) -> _Text:
+    """The file gunzipped when ``gz``, decoded as UTF-8 (else Latin-1), without a byte-order mark."""
     try:
         with open(path, "rb") as f:
             raw = f.read()
@@ -49,13 +89,11 @@ def _decode(path, gz):
     except (OSError, zlib.error, EOFError, gzip.BadGzipFile) as exc:
         raise InputError(f"{path}: cannot be read{' as gzip' if gz else ''} ({exc})") from None
     try:
-        text = raw.decode("utf-8")
+        text, codec = raw.decode("utf-8"), "utf-8"
     except UnicodeDecodeError:
-        text = raw.decode("latin-1")
-    del raw
-    if text.startswith("\ufeff"):
-        text = text[1:]
-    return text, text.splitlines()
+        text, codec = raw.decode("latin-1"), "latin-1"
+    bom = text.startswith("\ufeff")
+    return _Text(raw, text[1:] if bom else text, codec, bom)
 
 
 def _layout(path, lines, delimiter):
@@ -100,35 +138,34 @@ def _layout(path, lines, delimiter):
 
 
 def read_text(path, columns, time_column, delimiter, gz):
-    """The record of a text log: the header (or ``col0``, ``col1``, …), the chosen columns parsed by NumPy, and
-    on a parse error the first bad line found and named."""
-    text, lines = _decode(path, gz)
-    i0, start, delim, ncols, names = _layout(path, lines, delimiter)
+    """The record of a text log: the header (or ``col0``, ``col1``, …), the chosen columns parsed (by the core's
+    decimal parser, else by NumPy), and on a parse error the first bad line found and named."""
+    doc = _decode(path, gz)
+    head, whole = doc.head()
+    try:
+        i0, start, delim, ncols, names = _layout(path, head, delimiter)
+    except InputError:
+        if whole:
+            raise
+        head, whole = doc.lines, True  # the header or the first data row lies beyond the head
+        i0, start, delim, ncols, names = _layout(path, head, delimiter)
     idx, t_idx, squeeze = select_columns(columns, time_column, names, path)
     need = sorted(set(idx + ([t_idx] if t_idx is not None else [])))
     # parse only the needed columns when a one-character delimiter makes skipping safe
     usecols = need if (delim is not None and len(need) < ncols) else None
-    body = lines[start:]
-
-    def where(r):
-        return f"line {_line_of_row(lines, start, r)}"
-
-    try:
-        arr = np.loadtxt(body, delimiter=delim, comments="#", usecols=usecols, ndmin=2, dtype=np.float64)
-    except (ValueError, IndexError) as exc:
-        _diagnose(path, lines, start, delim, ncols, need, names, first_line=start + 1)
-        raise InputError(f"{path}: cannot parse the numeric data ({exc})") from None
+    parsed = usecols if usecols is not None else list(range(ncols))
+    # (a core extension built before the fast parser existed reads the NumPy way)
+    fast = getattr(_core, "parse_decimal_table", None)
+    arr = fast(doc.raw, doc.byte_offset(start), delim, ncols, parsed) if fast is not None else None
+    if arr is None:  # not plain decimal rows: NumPy reads them, and a bad line is found and named
+        arr = _parse_lines(path, doc, start, delim, ncols, need, names, usecols)
     if arr.shape[0] == 0:
         raise InputError(f"{path}: no data rows after the header on line {i0 + 1}")
-    if usecols is not None:
-        # loadtxt skips unused fields, so it cannot see ragged rows: compare the number of delimiters
-        # with what `rows × (columns − 1)` needs, and look closer only when they differ.
-        found = text.count(delim) - sum(ln.count(delim) for ln in lines[:start])
-        if found != arr.shape[0] * (ncols - 1):
-            _diagnose(path, lines, start, delim, ncols, [], names, first_line=start + 1)
-    elif arr.shape[1] != ncols:  # pragma: no cover - loadtxt raises on ragged rows
-        _diagnose(path, lines, start, delim, ncols, need, names, first_line=start + 1)
-    pos = {c: j for j, c in enumerate(need if usecols is not None else range(ncols))}
+
+    def where(r):
+        return f"line {_line_of_row(doc.lines, start, r)}"
+
+    pos = {c: j for j, c in enumerate(parsed)}
     cols = [pos[c] for c in idx]
     if len(cols) == arr.shape[1] and cols == list(range(arr.shape[1])):
         data = arr
@@ -153,6 +190,26 @@ def read_text(path, columns, time_column, delimiter, gz):
         where=where,
         checked_finite=True,
     )
+
+
+def _parse_lines(path, doc, start, delim, ncols, need, names, usecols):
+    """The data rows parsed by ``np.loadtxt`` (what the core's fast parser leaves: NaN, inf, other number
+    forms, bad rows), the first bad line found and named."""
+    lines = doc.lines
+    try:
+        arr = np.loadtxt(lines[start:], delimiter=delim, comments="#", usecols=usecols, ndmin=2, dtype=np.float64)
+    except (ValueError, IndexError) as exc:
+        _diagnose(path, lines, start, delim, ncols, need, names, first_line=start + 1)
+        raise InputError(f"{path}: cannot parse the numeric data ({exc})") from None
+    if usecols is not None:
+        # loadtxt skips unused fields, so it cannot see ragged rows: compare the number of delimiters
+        # with what `rows × (columns − 1)` needs, and look closer only when they differ.
+        found = doc.text.count(delim) - sum(ln.count(delim) for ln in lines[:start])
+        if found != arr.shape[0] * (ncols - 1):
+            _diagnose(path, lines, start, delim, ncols, [], names, first_line=start + 1)
+    elif arr.shape[1] != ncols:  # pragma: no cover - loadtxt raises on ragged rows
+        _diagnose(path, lines, start, delim, ncols, need, names, first_line=start + 1)
+    return arr
 
 
 def _line_of_row(lines, start, r):

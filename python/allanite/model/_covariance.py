@@ -145,8 +145,31 @@ def _nodes(mi: int, mj: int, big_m_i: int, big_m_j: int, long_tail: bool):
 
 def covariance_blocks(m, n_samples: int, fs: float, terms) -> tuple[np.ndarray, np.ndarray]:
     """:func:`_blocks`, remembered for the last few (m, n, fs, terms) — a dynamic fit asks for the same
-    blocks in every window, and repeated fits of same-length records share them. Read-only arrays."""
-    return _blocks_cached(tuple(int(v) for v in np.asarray(m).ravel()), int(n_samples), float(fs), tuple(terms))
+    blocks in every window, and repeated fits of same-length records share them. A request whose ``m`` ends a
+    remembered one (``tau_range="auto"`` cuts the shortest τ one at a time) is its trailing sub-blocks, bit for
+    bit: each block entry depends on its own pair of τ only. Read-only arrays."""
+    key = tuple(int(v) for v in np.asarray(m).ravel())
+    rest = (int(n_samples), float(fs), tuple(terms))
+    for (full, *others), (s_blk, t_blk) in reversed(_RECENT.items()):
+        k = len(full) - len(key)
+        if k > 0 and others == list(rest) and full[k:] == key:
+            return _read_only(s_blk[:, :, k:, k:]), _read_only(t_blk[:, k:, k:])
+    blocks = _blocks_cached(key, *rest)
+    _RECENT[(key, *rest)] = blocks
+    while len(_RECENT) > _RECENT_SIZE:
+        _RECENT.pop(next(iter(_RECENT)))
+    return blocks
+
+
+#: The blocks last computed, by (m, n, fs, terms): where a request's m is a suffix of one, it is sliced from it.
+_RECENT: dict = {}
+_RECENT_SIZE = 8
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a)
+    a.flags.writeable = False
+    return a
 
 
 @functools.lru_cache(maxsize=32)

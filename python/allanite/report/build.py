@@ -30,14 +30,10 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
-import json
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._progress import StepBar
 from .._validate import check_choice, check_count, check_positive
 from ..analysis import avar, davar
 from ..errors import AllaniteError, MemoryBudgetError, ParameterError
@@ -46,16 +42,14 @@ from ..estimators.theo import resolve_decimation
 from ..model import fit as fit_model
 from ..model.effects import EFFECTS
 from ..model.terms import TERMS
-from ..results import AllanResult, DynamicAllanResult
-from ..units import adev_unit_label, parse_unit
+from ..units import parse_unit
+from . import _worker
 from .axes import analyse_by_axis, axis_column, record_bytes, wants_by_axis
 from .budget import check_report_memory
-from .figures import figure_specs
-from .fmt import count, json_number
+from .fmt import json_number
 from .forecasting import check_forecast_options, plan_forecast, run_forecast
-from .page import html_page
 from .paper002 import compute as paper002_sections
-from .rendering import render_pngs
+from .result import Report, steps
 from .settings import (
     DHVAR_MAX_DEFAULT_WINDOW,
     DHVAR_MAX_WINDOWS,
@@ -65,155 +59,11 @@ from .settings import (
     default_hop,
     default_window,
 )
-from .sidefiles import write_side_files
-from .summary import summarize, text_summary
 
 if TYPE_CHECKING:
     from ..model import Refinement
 
 __all__ = ["Report", "build_report", "from_log", "log_source"]
-
-
-def _steps(progress, total: int, desc: str):
-    """(step object, made here?): the caller's (the CLI's bar), or a :class:`StepBar` for ``progress``
-    None/True/False — None shows one only in a notebook or a terminal (see :mod:`allanite._progress`)."""
-    if progress is None or isinstance(progress, bool):
-        return StepBar(progress, total, desc), True
-    return progress, False
-
-
-@dataclass
-class Report:
-    """Everything the report shows. Build it with :func:`build_report` or :func:`from_log`.
-
-    Attributes
-    ----------
-    static : AllanResult
-        Overlapping Allan variance of the whole record, with confidence intervals, (axes, τ).
-    dynamic : DynamicAllanResult
-        DAVAR, (axes, τ, t).
-    fits : list of NoiseFit or None
-        Whole-record noise-model fit per axis (None with ``fit=False`` or when it failed: ``fit_error``).
-    series : list of CoefficientSeries or None
-        The coefficients fitted in every DAVAR window, per axis (``series_error`` when it failed).
-    unit : str or None
-        Unit of the samples (canonical name, e.g. ``"deg/s"``); None when unknown.
-    axis_names : list of str
-    source : dict
-        Where the record came from (JSON-able): path, format, columns, gaps, …
-    notes : list of str
-        Things the reader must know (unit unknown, gaps, warnings while reading).
-    """
-
-    static: AllanResult
-    dynamic: DynamicAllanResult
-    fits: list | None
-    series: list | None
-    fs: float
-    unit: str | None
-    input: str
-    axis_names: list
-    source: dict
-    settings: dict
-    notes: list = field(default_factory=list)
-    fit_requested: bool = True
-    fit_error: str | None = None
-    series_error: str | None = None
-    created: str = ""
-    #: per axis :class:`~allanite.Refinement` (``refine=True``), else None
-    refinements: list[Refinement | None] | None = None
-    #: per axis :class:`~allanite.TimeFrames` and :func:`allanite.forecast.compare` table (``frames=`` or
-    #: ``forecast=`` given), else None; ``forecast_error`` when they could not be computed
-    frames: list | None = None
-    forecasts: list | None = None
-    forecast_settings: dict | None = None
-    forecast_error: str | None = None
-    #: the paper-002 sections (``taper=`` / ``split=``; :mod:`allanite.report.paper002`), else None
-    paper002: dict | None = None
-    _summary: dict | None = field(default=None, repr=False)
-
-    # ---------------------------------------------------------------------------- properties
-    @property
-    def n_axes(self) -> int:
-        """Number of axes the report analyses."""
-        return len(self.axis_names)
-
-    @property
-    def adev_unit(self) -> str | None:
-        """Label of the Allan deviation's unit (e.g. ``"°/s"``), None when the unit is unknown."""
-        if self.unit is None:
-            return None
-        return adev_unit_label(self.unit)
-
-    def __repr__(self) -> str:
-        fit = "not fitted" if self.fits is None else f"{len(self.fits)} noise fits"
-        return (
-            f"Report({self.source.get('name', 'record')!r}: {self.static.n_samples} samples × "
-            f"{count(self.n_axes, 'axis', 'axes')} at {self.fs:g} Hz, unit {self.unit or 'unknown'}; "
-            f"{self.static.tau.size} τ, "
-            f"{self.dynamic.t.size} DAVAR windows; {fit})"
-        )
-
-    # ---------------------------------------------------------------------------- summary
-    def summary(self) -> dict:
-        """Every number of the report, JSON-able (what ``summary.json`` holds)."""
-        if self._summary is None:
-            self._summary = summarize(self)
-        return self._summary
-
-    def text(self) -> str:
-        """The terminal summary: ADEV table with intervals, fitted coefficients, DAVAR summary."""
-        return text_summary(self.summary())
-
-    # ---------------------------------------------------------------------------- figures
-    def figure_specs(self) -> list:
-        """(file name, title, caption, draw) for every figure; ``draw(fig)`` fills a matplotlib Figure."""
-        return figure_specs(self)
-
-    def render_figures(self, progress=None, dpi: int = 100) -> dict:
-        """File name → PNG bytes of every figure (drawn on two processes where two cores are available:
-        :mod:`allanite.report.rendering`)."""
-        specs = self.figure_specs()
-        progress, own = _steps(progress, len(specs), "figures")
-        images = render_pngs(specs, dpi, progress.step)
-        if own:
-            progress.close()
-        return images
-
-    def html(self, images: dict) -> str:
-        """The self-contained HTML page, with ``images`` (file name → PNG bytes) embedded as data URIs."""
-        return html_page(self, images)
-
-    def write(self, out, progress=None, dpi: int = 100) -> list:
-        """Write ``report.html``, ``summary.json`` and the PNG figures into folder ``out`` (created if
-        needed), and the side files of a report of more than ``SIDE_FILE_WINDOWS`` windows
-        (:mod:`allanite.report.sidefiles`). Returns the paths written, report.html and summary.json first,
-        the side files last."""
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        progress, own = _steps(progress, len(self.figure_specs()) + 1, "report files")
-        images = self.render_figures(progress, dpi=dpi)
-        progress.step("writing report.html, summary.json")
-        pngs = []
-        for name, data in images.items():
-            p = out / name
-            p.write_bytes(data)
-            pngs.append(p)
-        summary = self.summary()
-        side = write_side_files(self, out) if summary.get("side_files") else []
-        summary["files"] = {
-            "html": "report.html",
-            "summary": "summary.json",
-            "figures": list(images),
-            "side_files": [p.name for p in side],
-        }
-        (out / "summary.json").write_text(
-            json.dumps(summary, indent=1, ensure_ascii=False, allow_nan=False), encoding="utf-8"
-        )
-        (out / "report.html").write_text(self.html(images), encoding="utf-8")
-        if own:
-            progress.close()
-        return [out / "report.html", out / "summary.json"] + pngs + side
 
 
 def _check_taus(taus):
@@ -310,7 +160,7 @@ def build_report(
         # before anything is computed: a frame or split that does not fit the record is the caller's option
         plan = plan_forecast(int(x.shape[0]), float(fs), frame_s, fc_split)
     candidates = _refine_candidates(refine)
-    progress, own_bar = _steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
+    progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
     if x.ndim == 1:
         x = x[:, None]
     unit_name = None if unit is None else parse_unit(unit, kind="rate" if input == "rate" else "angle").name
@@ -361,6 +211,21 @@ def build_report(
         memory_estimate_bytes=int(cost["total"]),
         by_axis=by_axis,
     )
+    if _worker.waiting():  # a figure process draws the DAVAR figures while the model is fitted
+        _worker.offer(
+            Report(
+                static=static,
+                dynamic=dynamic,
+                fits=None,
+                series=None,
+                fs=float(static.fs),
+                unit=unit_name,
+                input=input,
+                axis_names=axis_names,
+                source={},
+                settings={},
+            )  # fmt: skip
+        )
 
     fits = series = None
     fit_error = series_error = None

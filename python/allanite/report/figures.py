@@ -9,7 +9,16 @@ from ..units import adev_unit_label
 from .forecasting import forecast_specs
 from .settings import NOTHING_ADDED
 
-__all__ = ["figure_specs"]
+__all__ = ["figure_specs", "from_analysis_alone"]
+
+#: Figures drawn from the static and dynamic analysis alone — the same with or without the fits (file names
+#: or their prefixes): a figure process can draw them while the noise model is being fitted.
+ANALYSIS_FIGURES = ("davar.png", "davar_axis", "davar3d_axis")
+
+
+def from_analysis_alone(name: str) -> bool:
+    """Whether figure ``name`` is drawn from the static and dynamic analysis alone (``ANALYSIS_FIGURES``)."""
+    return name.startswith(ANALYSIS_FIGURES)
 
 
 def figure_specs(rep) -> list:

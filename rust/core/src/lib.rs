@@ -15,6 +15,7 @@ pub mod phase_terms;
 pub mod range;
 pub mod streaming;
 pub mod taper;
+pub mod text;
 pub mod theo;
 mod window_sums;
 

@@ -10,6 +10,7 @@
 use allanite_core::dynamic_hann_cancellable;
 use allanite_core::phase_terms::{self, TermSum};
 use allanite_core::streaming::{Stream, StreamKind};
+use allanite_core::text;
 use allanite_core::{angle_term_sums_cancellable, AngleChunk};
 use allanite_core::{
     compensated_sum_from, dynamic_avar_part_cancellable, dynamic_avar_ranged_cancellable,
@@ -860,6 +861,35 @@ impl StreamingVariance {
     }
 }
 
+/// The columns `cols` (sorted) of the data lines of `text[offset:]` as a (rows, len(cols)) array, or
+/// None where a line is outside the fast path's grammar (allanite-core `text::parse_decimal_table`:
+/// plain decimal numbers, `delimiter` one ASCII character or None for whitespace). The caller then
+/// reads the text the slow way, which names the problem.
+#[pyfunction]
+#[pyo3(signature = (text, offset, delimiter, ncols, cols))]
+fn parse_decimal_table<'py>(
+    py: Python<'py>,
+    text: &[u8],
+    offset: usize,
+    delimiter: Option<char>,
+    ncols: usize,
+    cols: Vec<usize>,
+) -> PyResult<Option<Bound<'py, PyArray2<f64>>>> {
+    let delim = match delimiter {
+        None => None,
+        Some(c) if c.is_ascii() => Some(c as u8),
+        Some(_) => return Ok(None),
+    };
+    let body = text.get(offset..).unwrap_or(&[]);
+    let parsed = py.detach(|| text::parse_decimal_table(body, delim, ncols, &cols));
+    let Some((values, rows)) = parsed else {
+        return Ok(None);
+    };
+    let arr = Array2::from_shape_vec((rows, cols.len()), values)
+        .map_err(|e| allanite_error(py, format!("parse_decimal_table: {e}")))?;
+    Ok(Some(arr.into_pyarray(py)))
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar, m)?)?;
@@ -869,6 +899,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;
     m.add_function(wrap_pyfunction!(part_grid, m)?)?;
     m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;
+    m.add_function(wrap_pyfunction!(parse_decimal_table, m)?)?;
     m.add_function(wrap_pyfunction!(angle_term_sums, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_static, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_dynamic, m)?)?;
