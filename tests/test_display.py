@@ -121,7 +121,7 @@ def _results(record, static, dynamic):
                 f"{int(np.sum(series.values['N'] > 0))} of {series.t.size}",
             ],
         ),
-        "Refinement": (ref, ["Q+N+B+K+R", f"{ref.fit.chi2_dof:.3g}", "final model", "°/√h"]),
+        "Refinement": (ref, ["Q+N+B+K+R", f"{ref.curve_errors(ref.fit)['chi2_dof']:.3g}", "final model", "°/√h"]),
     }
     return out
 

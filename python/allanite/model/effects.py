@@ -365,15 +365,17 @@ EFFECTS: dict[str, Effect] = {
                 (
                     "threshold",
                     "rate unit",
-                    "a sample is flagged when the differences into and out of it both exceed this, with opposite signs",
+                    "a sample is flagged when its distance from the slow level exceeds this (noise white at the "
+                    "shortest lag), else when the differences into and out of it both do, with opposite signs",
                 ),
             ),
             "samples beyond what Gaussian noise predicts: clusters of first differences beyond 4–7 robust σ (per "
             "block; lattice-aware on quantised samples) against more than twice their Gaussian expectation "
             "(Poisson, Bonferroni over the cuts, at the outlier share of level); the flagged samples replaced by a "
-            "draw from what Gaussian noise puts there (the local level plus white noise of the block's σ where "
-            "the noise is white at the shortest lag, else the line between the neighbours plus the second "
-            "difference's noise) and the noise refitted (allanite.model.outliers). Never applied by avar",
+            "draw from what Gaussian noise puts there (the slow level plus white noise as wide as the samples "
+            "left where the noise is white at the shortest lag, else the line between the neighbours plus the "
+            "second difference's noise), tested again on what is left (up to 4 passes: a heavy tail's scale "
+            "shrinks as it is cut) and the noise refitted (allanite.model.outliers). Never applied by avar",
             domain="time",
         ),
         Effect(

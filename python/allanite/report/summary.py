@@ -24,12 +24,9 @@ __all__ = ["summarize", "text_summary", "refinement_dict"]
 
 
 def _fit_errors(f, r) -> dict:
-    """χ²/dof, RMS z and RMS ADEV error (%, on the refinement's scored τ) of a NoiseFit against its estimates."""
-    return {
-        "chi2_dof": json_number(f.chi2_dof),
-        "rms_z": json_number(np.sqrt(np.mean(f.z**2))),
-        "rms_adev_pct": json_number(r.rms_adev_pct(f)),
-    }
+    """χ²/dof, RMS z and RMS ADEV error (%, on the refinement's scored τ) of the start or final model on the
+    record's curve: the chain's numbers (:meth:`Refinement.curve_errors`, the steps' first before / last after)."""
+    return {k: json_number(v) for k, v in r.curve_errors(f).items()}
 
 
 def refinement_dict(rep) -> dict | None:

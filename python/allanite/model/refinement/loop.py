@@ -42,6 +42,7 @@ from .scoring import (
     heldout_split,
     informative,
     segments_heldout,
+    settle_chi2,
 )
 
 __all__ = ["refine", "CANDIDATES", "MAX_STEPS", "REFINE_SCALE"]
@@ -257,13 +258,16 @@ class _Run:
         self.curve, self.heldout = self.build(result, y)
         self.note = _heldout_note(y, self.heldout)
         self.sol = self.start_sol = solve(self.curve, start, [])
+        # the chain's χ² on the tests' thinned τ and covariance (exact for samples or overlapping estimates)
+        self.thin = tracing.thin_indices(self.curve.tau)
+        self.exact = y is not None or (isinstance(self.est, str) and self.est == "oavar")
         # in-sample RMS ADEV error: on the τ whose estimate is informative under the five-term fit (fixed for
         # the whole refinement, so every before/after compares the same τ)
         self.scored = informative(self.curve.tau, self.sol.nu)
         # the original record: what every step is scored on
         self.result0, self.curve0, self.split0 = result, self.curve, self.heldout
         self.raw = self.split0.raw_parts() if self.split0 is not None else None
-        self.state = self.chain(self.sol, [])  # (metrics, effective χ², terms' coefficients) of the model so far
+        self.state = self.chain(self.sol, [])  # (metrics, GLS χ², terms' coefficients) of the model so far
         self.start_heldout = self.state[0]["heldout_rms_adev_pct"]
         self.effects: list = []  # curve effects [(key, nonlinear parameter)], steps[j] ↔ effects[j]
         self.steps: list = []
@@ -289,14 +293,17 @@ class _Run:
     def chain(self, sol, effects, curve=None, n_removed=0, parts=None) -> tuple:
         """The model ``sol`` (terms plus ``effects``, fitted on ``curve``: the record's, or the one the removals
         left, with ``n_removed`` numbers fitted by them) scored on the record's curve, held out with ``parts``
-        (the raw parts when None): (metrics, effective χ², the terms' coefficients √θ)."""
+        (the raw parts when None): (metrics, GLS χ², the terms' coefficients √θ)."""
         curve = self.curve0 if curve is None else curve
         ho = None
         if self.split0 is not None:
             ho = self.split0.predict(self.raw if parts is None else parts, self.start, effects)
         change = self.curve0.avar - curve.avar
-        metrics, chi2_eff = chain_metrics(self.curve0, sol, change, n_removed, ho, self.scored)
-        return metrics, chi2_eff, np.sqrt(np.maximum(theta_terms(sol, self.start, effects), 0.0))
+        metrics, pending = chain_metrics(self.curve0, sol, change, n_removed, ho, self.scored, self.thin)
+        # χ² under the model's own covariance, as the calibrated test at that stage takes it (the removals'
+        # components are fitted, not drawn: the residual on the record's curve is the corrected curve's)
+        chi2 = settle_chi2(metrics, pending, curve_test(curve, self.thin, sol, self.start, effects, self.exact))
+        return metrics, chi2, np.sqrt(np.maximum(theta_terms(sol, self.start, effects), 0.0))
 
     def advance(self, st: Step, state: tuple) -> None:
         """Score ``st`` from the chain's last state to ``state``."""
@@ -575,6 +582,8 @@ class _Run:
             corrected=self.result if self.removed else None,
             term_moves=term_moves(start_fit, final_fit, steps, [s[2] for s in self.states]),
             level=self.level,
+            start_errors=dict(self.states[0][0]),
+            final_errors=dict(self.state[0]),
         )
 
 

@@ -254,8 +254,8 @@ def _outliers(ctx: RemovalContext) -> Iterator[Removal]:
         entry = {"cuts": r["cuts"], "test": test} | ({"note": r["note"]} if "note" in r else {})
         ctx.consider("outliers", entry)
         return
+    r, clean, passes = _flag_passes(y, ctx.fs, a, r)
     flags, cut = r["flags"], r["cut"]
-    clean = outliers.replace_outliers(y, flags)
     per = y.size // HELDOUT_BLOCKS
     lam = count = 0.0
     for parity in (0, 1):
@@ -273,6 +273,8 @@ def _outliers(ctx: RemovalContext) -> Iterator[Removal]:
         "domain": "time",
         "test": test,
         "cut_sigma": cut,
+        "rule": r["rule"],
+        "passes": passes,
         "flagged": k,
         "flagged_s": [float(i / ctx.fs) for i in np.flatnonzero(flags)[:50]],
         "expected_gaussian_flags": r["expected_gaussian_flags"],
@@ -293,6 +295,32 @@ def _outliers(ctx: RemovalContext) -> Iterator[Removal]:
         heldout_in_time=lam / max(count, 1e-12),
         on_curve=True,
     )
+
+
+#: Passes of the outlier test at most: each on the samples the ones before left.
+OUTLIER_PASSES = 4
+
+
+def _flag_passes(y, fs, a, r) -> tuple[dict, np.ndarray, int]:
+    """The accepted test ``r`` of the samples ``y`` carried on while the samples left still fail it: each pass
+    tests the record with every sample flagged so far replaced, its flags join them, and the replacement is
+    made again from ``y`` (at most :data:`OUTLIER_PASSES`). Sparse spikes are one pass. A continuous heavy
+    tail is not: cut at c* σ of its own robust scale, what is left has a smaller scale and still a tail beyond
+    the Gaussian's (white, 20 % of samples 6× wider: 10.8 % flagged at 3 σ, then 122 samples beyond 4.5 σ of
+    the new scale, enough to move τ₀'s estimate by 2 standard errors). Returns the last pass's test with the
+    union of the flags and its rate, the replaced samples and the number of passes."""
+    flags = r["flags"].copy()
+    clean = outliers.replace_outliers(y, flags)
+    passes = 1
+    while passes < OUTLIER_PASSES:
+        again = outliers.outlier_test(clean, fs, a)
+        if not again["accepted"] or not np.any(again["flags"] & ~flags):
+            break
+        flags |= again["flags"]
+        r = again
+        clean = outliers.replace_outliers(y, flags)
+        passes += 1
+    return r | {"flags": flags, "rate": float(np.count_nonzero(flags)) / y.size}, clean, passes
 
 
 def _periodic(ctx: RemovalContext) -> Iterator[Removal]:

@@ -137,8 +137,11 @@ class Refinement(RichDisplay):
     taken says why under ``"rejected"`` (χ²/dof not falling, a parameter at the edge of its range, the held-out
     error, another candidate taken at that step). ``effects`` the final model's curve columns [(key, nonlinear
     parameter)], steps[j] ↔ effects[j] (a spectral line's key, ``"sinusoid:held:<A²>:<its variance>"``, carries
-    the amplitude it is held at:
-    :func:`allanite.model.refinement.curvefit.held_key`)."""
+    the amplitude it is held at: :func:`allanite.model.refinement.curvefit.held_key`). ``start_errors`` and
+    ``final_errors``: the chain's errors of the starting and the final model (the first step's ``before`` and the
+    last one's ``after``: χ²/dof on the tests' covariance, :func:`allanite.model.refinement.scoring.settle_chi2`)
+    — what :meth:`report`, the summary and the report page say; ``fit.chi2_dof`` stays the weighted fit's own
+    (EDF variances, the one its intervals are inflated by)."""
 
     steps: list
     fit: fitting.NoiseFit
@@ -156,6 +159,20 @@ class Refinement(RichDisplay):
     corrected: AllanResult | None = None
     term_moves: list = field(default_factory=list)
     level: float = LEVEL
+    start_errors: dict | None = None
+    final_errors: dict | None = None
+
+    def curve_errors(self, fit) -> dict:
+        """χ²/dof, RMS z and RMS ADEV error (%) of ``start`` or ``fit`` on the record's curve: the chain's
+        (``start_errors``/``final_errors``, the numbers every step's before/after carry), else the fit's own."""
+        errs = self.start_errors if fit is self.start else self.final_errors if fit is self.fit else None
+        if errs is not None:
+            return {k: errs[k] for k in ("chi2_dof", "rms_z", "rms_adev_pct")}
+        return {
+            "chi2_dof": fit.chi2_dof,
+            "rms_z": float(np.sqrt(np.mean(fit.z**2))),
+            "rms_adev_pct": self.rms_adev_pct(fit),
+        }
 
     def rms_adev_pct(self, fit) -> float:
         """RMS ADEV error (%) of a fit (``start`` or ``fit``) on the τ the steps' errors are scored on
@@ -205,15 +222,14 @@ class Refinement(RichDisplay):
 
     def report(self) -> str:
         """Markdown: the starting residual, each step with its parameters, evidence and errors, the final model."""
-        s0 = self.start
+        e0 = self.curve_errors(self.start)
         ho = self.start_heldout_rms_adev_pct
         lines = [
             "# Model refinement",
             "",
-            f"Starting model {'+'.join(self.terms)}: χ²/dof = {s0.chi2_dof:.3g}, "
-            f"RMS z = {np.sqrt(np.mean(s0.z**2)):.3g}, RMS ADEV error = "
-            f"{self.rms_adev_pct(s0):.3g} %, held-out RMS ADEV error = "
-            + (f"{ho:.3g} %." if ho is not None else "n/a."),
+            f"Starting model {'+'.join(self.terms)}: χ²/dof = {e0['chi2_dof']:.3g}, "
+            f"RMS z = {e0['rms_z']:.3g}, RMS ADEV error = "
+            f"{e0['rms_adev_pct']:.3g} %, held-out RMS ADEV error = " + (f"{ho:.3g} %." if ho is not None else "n/a."),
             "",
             f"Held-out error: {self.heldout_note}",
             "",
@@ -264,13 +280,13 @@ class Refinement(RichDisplay):
 
     def _final_lines(self) -> list:
         s1 = self.fit
+        e1 = self.curve_errors(s1)
         ho = self.final_heldout_rms_adev_pct
         lines = [
             "## Final model",
             "",
-            f"χ²/dof = {s1.chi2_dof:.3g}, RMS z = {np.sqrt(np.mean(s1.z**2)):.3g}, RMS ADEV error = "
-            f"{self.rms_adev_pct(s1):.3g} %, held-out RMS ADEV error = "
-            + (f"{ho:.3g} %." if ho is not None else "n/a."),
+            f"χ²/dof = {e1['chi2_dof']:.3g}, RMS z = {e1['rms_z']:.3g}, RMS ADEV error = "
+            f"{e1['rms_adev_pct']:.3g} %, held-out RMS ADEV error = " + (f"{ho:.3g} %." if ho is not None else "n/a."),
             "",
         ]
         lines += [f"- {c!r}" for t, c in s1.coefficients.items() if t in self.terms]
@@ -322,13 +338,14 @@ class Refinement(RichDisplay):
         return Table(header, rows, "final model")
 
     def _summary(self) -> Summary:
-        s0, s1 = self.start, self.fit
+        s0 = self.start
+        e0, e1 = self.curve_errors(s0), self.curve_errors(self.fit)
         facts: list = [
             ("starting model", "+".join(self.terms)),
             ("found", ", ".join(self.found) if self.steps else self._nothing_added()),
-            ("χ²/dof", f"{s0.chi2_dof:.3g} → {s1.chi2_dof:.3g}"),
-            ("RMS z", f"{np.sqrt(np.mean(s0.z**2)):.3g} → {np.sqrt(np.mean(s1.z**2)):.3g}"),
-            ("RMS ADEV error %", f"{self.rms_adev_pct(s0):.3g} → {self.rms_adev_pct(s1):.3g}"),
+            ("χ²/dof", f"{e0['chi2_dof']:.3g} → {e1['chi2_dof']:.3g}"),
+            ("RMS z", f"{e0['rms_z']:.3g} → {e1['rms_z']:.3g}"),
+            ("RMS ADEV error %", f"{e0['rms_adev_pct']:.3g} → {e1['rms_adev_pct']:.3g}"),
             ("held-out %", f"{_fmt(self.start_heldout_rms_adev_pct)} → {_fmt(self.final_heldout_rms_adev_pct)}"),
             (
                 "record",
@@ -351,7 +368,7 @@ class Refinement(RichDisplay):
             what="what the starting noise model lacked, found and fitted by allanite.refine",
             facts=facts,
             tables=tables,
-            notes=list(s1.notes) + self.notes(),
+            notes=list(self.fit.notes) + self.notes(),
             figure=self._draw_small,
         )
 
