@@ -244,6 +244,18 @@ pub(crate) fn overlapping_rows(
     if cancel.is_cancelled() {
         return Vec::new();
     }
+    window_sums(&blocks, &geo, part, out)
+}
+
+/// Every window of the part from its rows' block sums (`blocks`: (full, head) per m): the Van Herk sum
+/// of its q whole blocks plus the next block's head, as the streaming rows form it; each row's range.
+fn window_sums(
+    blocks: &[(Vec<f64>, Vec<f64>)],
+    geo: &[Geo],
+    part: Part,
+    out: &mut [f64],
+) -> Vec<Range> {
+    let n_win = out.len() / geo.len();
     out.par_chunks_mut(n_win)
         .zip(blocks.par_iter())
         .zip(geo.par_iter())
@@ -323,6 +335,21 @@ fn static_rows(
             cs = ce;
         }
     }
+    finish_static(y, mu, ms, window, &sums, out, cancel)
+}
+
+/// The static values from the chunked m's sums (`sums`, in the order of the chunked m of `ms`), the
+/// other m streamed; each value's range.
+fn finish_static(
+    y: &[f64],
+    mu: f64,
+    ms: &[usize],
+    window: usize,
+    sums: &[f64],
+    out: &mut [f64],
+    cancel: &Cancel,
+) -> Vec<Range> {
+    let short = |m: usize| 2 * m <= CHUNK_TERMS;
     let mut chunked = sums.iter();
     let sums: Vec<f64> = ms
         .iter()
