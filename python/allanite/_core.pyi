@@ -66,7 +66,9 @@ def davar_part(
     record's call streams, and from a part_grid start on its phase path; to a few ε elsewhere)."""
 
 def part_grid(n: int, n_axes: int, window: int, hop: int, estimator: str, method: str) -> int:
-    """Samples between the cuts of a record into davar_part parts that give the whole call bit for bit."""
+    """Samples between the cuts of a record into davar_part parts that give the whole call bit for bit: the
+    hop where the call streams, a phase segment on its phase path, a chunk of terms on its chunked path
+    (windows over 2^21 samples on records over 2^26 samples × axes, hops ≥ 64)."""
 
 def compensated_sums(
     columns: Sequence[npt.NDArray[np.float64]],

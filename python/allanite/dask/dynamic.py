@@ -199,7 +199,9 @@ def davar(
     the first non-finite sample; then every block hands the core its part of the record with that
     centring value and its first window, and the core forms the same terms and sums in the same order
     as for the whole record. Memory per task: one chunk plus ``window − 1`` samples plus its output, and on the
-    phase path one segment's phase (16 B per sample of max(2^22, 4 · window) on records over 2^26 samples).
+    phase path one segment's phase (16 B per sample of max(2^22, 4 · window) on records over 2^26 samples; with
+    windows over 2^21 samples on such records, at hops ≥ 64, one chunk's phase: 16 B per sample of ≤ 2 · max(2^22,
+    window) + hop).
     """
     fs = check_inputs(estimator, input, fs)
     arr = as_dask(x)

@@ -545,7 +545,7 @@ const PHASE_M_MAX: usize = 8192;
 
 /// Reusable buffers of one worker, so that rows do not pay fresh allocations (page faults).
 #[derive(Default)]
-struct RowScratch {
+pub(crate) struct RowScratch {
     terms: Vec<f64>,
     full: Vec<f64>,
     part: Vec<f64>,
@@ -555,8 +555,8 @@ struct RowScratch {
 /// record's `total`, from samples that start at the record's sample `first · hop`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Part {
-    first: usize,
-    total: usize,
+    pub(crate) first: usize,
+    pub(crate) total: usize,
 }
 
 impl Part {
@@ -619,7 +619,7 @@ pub(crate) fn sliding_sums_at(f: &[f64], q: usize, g0: usize, n_total: usize, ou
 /// [`for_each_term_chunk_at`] and [`sliding_sums_at`]). Once `cancel` is set, `out` holds garbage
 /// (the caller returns `Cancelled` instead).
 #[allow(clippy::too_many_arguments)]
-fn overlapping_row_at(
+pub(crate) fn overlapping_row_at(
     y: &[f64],
     part: Part,
     mu: f64,
@@ -952,8 +952,8 @@ fn dynamic_avar_rows(req: &Request, cancel: &Cancel) -> Result<Rows> {
                 .collect();
             // samples any window reads
             let n_used = ((n_win - 1) * req.hop + req.window).min(req.columns[0].len());
-            let phase = takes_phase_path(req.estimator, n_used, n_axes, req.window);
-            ranges = part_rows(req, &mus, Part::whole(n_win), phase, &mut out, cancel);
+            let path = row_path(req, n_used, n_axes, n_win);
+            ranges = part_rows(req, &mus, Part::whole(n_win), path, &mut out, cancel);
         }
         Method::Naive => {
             for (a, y) in req.columns.iter().enumerate() {
@@ -1000,8 +1000,13 @@ fn dynamic_avar_rows(req: &Request, cancel: &Cancel) -> Result<Rows> {
 /// [`compensated_sum_from`]; a record of one window is centred from the window itself, as the
 /// whole-record call does, and `mus` is only checked). The path is the record's: [`dynamic_avar`] takes the phase path for the
 /// overlapping estimator when the samples its windows read, times the axes, are at most 2^26 or its
-/// window is at most 2^21 samples (see `takes_phase_path`), and streams otherwise (and for the
-/// classic estimator, and for rows of m > `PHASE_M_MAX` at hops below 64).
+/// window is at most 2^21 samples (see `takes_phase_path`); longer windows on a long record take
+/// chunked phases at hops ≥ 64 ([`RowPath::Chunked`], `crate::chunked`); the rest streams (the classic
+/// estimator, longer windows at hops below 64, rows of m > `PHASE_M_MAX` at hops below 64).
+///
+/// * Chunked phases: the record's terms in chunks of `crate::chunked::chunk_len` (a multiple of the
+///   hop), each chunk's phase from its own first term: a part that starts on that grid has the
+///   record's chunks: **bit for bit**; one that starts inside a chunk, to a few ε (as the phase path).
 ///
 /// * Streaming: the part centres on `mus`, cuts the terms and block sums at the record's boundaries
 ///   (multiples of m, of the hop, of the window sums' segments) and sizes the edge segments as the
@@ -1060,8 +1065,8 @@ pub fn dynamic_avar_part_cancellable(
     check_finite(req.columns)?;
     // the samples the record's windows read
     let n_used_record = (n_windows_total - 1) * req.hop + req.window;
-    let phase = takes_phase_path(req.estimator, n_used_record, n_axes, req.window);
-    part_rows(req, mus, part, phase, &mut out, cancel);
+    let path = row_path(req, n_used_record, n_axes, n_windows_total);
+    part_rows(req, mus, part, path, &mut out, cancel);
     cancel.check()?;
     Ok((out, n_win))
 }
@@ -1119,13 +1124,37 @@ fn long_record(n_used: usize, n_axes: usize) -> bool {
 /// Whether the fast dynamic estimator of a record of several windows takes the double-word phase
 /// path: the overlapping estimator on a short record (≤ 2^26 samples × axes) at any window, on a long
 /// one while its segments span at most `PHASE_SPAN_MAX` (2^23) samples — windows up to 2^21. The phase
-/// it holds is one segment's either way. Longer windows on long records stream their sums (which a
-/// record cut into parts gives bit for bit at any cut on the hop grid, see
-/// [`dynamic_avar_part_cancellable`]).
+/// it holds is one segment's either way. Longer windows on long records take chunked phases
+/// ([`RowPath::Chunked`]) or stream their sums (hops below 64), see [`dynamic_avar_part_cancellable`].
 fn takes_phase_path(estimator: Estimator, n_used: usize, n_axes: usize, window: usize) -> bool {
     let long = long_record(n_used, n_axes);
     estimator == Estimator::Overlapping
         && (!long || crate::oavar::segment_span(window, true) <= crate::oavar::PHASE_SPAN_MAX)
+}
+
+/// How the fast path forms a record's rows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum RowPath {
+    /// The double-word phase of each segment of whole windows (`takes_phase_path`).
+    Phase,
+    /// Terms from the phase built chunk by chunk (`crate::chunked`): the overlapping estimator on a
+    /// long record with long windows at hops ≥ 64, and its static estimator beyond `GATHER_MAX`.
+    Chunked,
+    /// Streaming block sums per m (the classic estimator; overlapping hops below 64 on long windows).
+    Stream,
+}
+
+/// The path of a record of `n_win` windows whose windows read `n_used` samples × `n_axes`.
+pub(crate) fn row_path(req: &Request, n_used: usize, n_axes: usize, n_win: usize) -> RowPath {
+    if takes_phase_path(req.estimator, n_used, n_axes, req.window) {
+        RowPath::Phase
+    } else if req.estimator == Estimator::Overlapping
+        && (n_win == 1 || req.hop >= crate::oavar::SMALL_HOP)
+    {
+        RowPath::Chunked
+    } else {
+        RowPath::Stream
+    }
 }
 
 /// Samples between the places a record of `n` samples × `n_axes` can be cut into parts whose
@@ -1145,11 +1174,24 @@ pub fn part_grid(
     }
     let n_win = n_windows(n, window, hop);
     let n_used = (n_win - 1) * hop + window;
-    if method == Method::Fast && n_win >= 2 && takes_phase_path(estimator, n_used, n_axes, window) {
-        Some(crate::oavar::segment_windows(window, hop, long_record(n_used, n_axes)) * hop)
-    } else {
-        Some(hop)
+    if method != Method::Fast || n_win < 2 {
+        return Some(hop);
     }
+    let req = Request {
+        columns: &[],
+        window,
+        hop,
+        ms: &[],
+        estimator,
+        method,
+    };
+    Some(match row_path(&req, n_used, n_axes, n_win) {
+        RowPath::Phase => {
+            crate::oavar::segment_windows(window, hop, long_record(n_used, n_axes)) * hop
+        }
+        RowPath::Chunked => crate::chunked::chunk_len(window, hop),
+        RowPath::Stream => hop,
+    })
 }
 
 /// The fast path of [`dynamic_avar_part_cancellable`] (and of [`dynamic_avar`], as the part that is
@@ -1165,13 +1207,25 @@ fn part_rows(
     req: &Request,
     mus: &[f64],
     part: Part,
-    phase: bool,
+    path: RowPath,
     out: &mut [f64],
     cancel: &Cancel,
 ) -> Option<Vec<Range>> {
     let n_m = req.ms.len();
     let n_win = out.len() / (req.columns.len() * n_m);
     let n_m_win = n_m * n_win;
+    if path == RowPath::Chunked {
+        let mut ranges = Vec::with_capacity(req.columns.len() * n_m);
+        for (a, y) in req.columns.iter().enumerate() {
+            let dst_axis = &mut out[a * n_m_win..(a + 1) * n_m_win];
+            let (w, h) = (req.window, req.hop);
+            ranges.extend(crate::chunked::overlapping_rows(
+                y, part, mus[a], req.ms, w, h, dst_axis, cancel,
+            ));
+        }
+        return (ranges.len() == req.columns.len() * n_m).then_some(ranges);
+    }
+    let phase = path == RowPath::Phase;
     // each row's range, noted right after the row is formed (in cache); the tiled path leaves it open
     let mut ranges = vec![Range::default(); req.columns.len() * n_m];
     let mut noted = true;
@@ -1443,7 +1497,7 @@ mod tests {
         let n_win = validate(req).unwrap().min(total - first);
         let mut out = vec![0.0; req.columns.len() * req.ms.len() * n_win];
         let part = Part { first, total };
-        part_rows(req, mus, part, false, &mut out, &Cancel::new());
+        part_rows(req, mus, part, RowPath::Stream, &mut out, &Cancel::new());
         out
     }
 
@@ -1604,17 +1658,24 @@ mod tests {
                 method: Method::Fast,
             };
             let (record, n_win) = dynamic_avar(&req).unwrap();
-            // (the unit tests' span limit for a long record is 2^13: window 2500 streams, the others
-            // keep the phase path; a short record keeps it at any window)
+            // (the unit tests' span limit for a long record is 2^13: window 2500 takes chunked phases
+            // (`crate::chunked`), the others keep the phase path; a short record keeps it at any window)
             let phase = !long || window * 4 <= 1 << 13;
             assert!(
                 n_win > seg || hop > 4096 || !phase,
                 "window {window} hop {hop}: one segment only"
             );
+            let grid = if phase {
+                seg * hop
+            } else {
+                crate::chunked::chunk_len(window, hop)
+            };
             assert_eq!(
                 part_grid(n, n_axes, window, hop, Estimator::Overlapping, Method::Fast),
-                Some(if phase { seg * hop } else { hop })
+                Some(grid)
             );
+            // the parts' own grid in windows
+            let seg = grid / hop;
             // every value against the window's own plain recomputation
             for (a, y) in cols.iter().enumerate() {
                 for (t, &m) in ms.iter().enumerate() {
@@ -1659,7 +1720,7 @@ mod tests {
                     for row in 0..cols.len() * ms.len() {
                         for j in 0..count {
                             let (g, r) = (got[row * count + j], record[row * n_win + first + j]);
-                            if first % seg == 0 || !phase {
+                            if first % seg == 0 {
                                 assert_eq!(
                                     g.to_bits(),
                                     r.to_bits(),

@@ -6,6 +6,7 @@
 pub mod allan;
 pub mod angle;
 pub mod cancel;
+mod chunked;
 pub mod deviations;
 pub mod error;
 pub mod fit;

@@ -409,7 +409,7 @@ unsafe fn chunk_sum_avx2<const LO: bool>(
 /// Σ d² of one (chunk, m) (double words with `LO`, hi alone without), with the AVX2 term loop where
 /// the CPU has it.
 #[inline(always)]
-fn chunk_sum_dispatch<const LO: bool>(
+pub(crate) fn chunk_sum_dispatch<const LO: bool>(
     avx2: bool,
     hi: &[f64],
     lo: &[f64],
@@ -833,8 +833,8 @@ pub(crate) const PHASE_RECORD_MAX: usize = 1 << 14;
 
 /// A long record's segments span 4 windows' worth (≤ 1/3 rebuilt), so that a Dask task that holds whole
 /// segments stays small, and it takes the phase path while a segment spans at most this many samples:
-/// 2^23 (128 MiB of phase; windows up to 2^21 samples). Longer windows stream their sums in O(window)
-/// per worker.
+/// 2^23 (128 MiB of phase; windows up to 2^21 samples). Longer windows build the phase chunk by chunk
+/// of their terms (`crate::chunked`, hops ≥ 64) or stream their sums in O(window) per worker.
 #[cfg(not(test))]
 pub(crate) const PHASE_SPAN_MAX: usize = 1 << 23;
 #[cfg(test)]
@@ -869,6 +869,19 @@ impl Phase {
         let mut lo = PhaseBuf::new(n + 1);
         phase_prefix(y, mu, hi.slice(), lo.slice());
         Phase { hi, lo }
+    }
+
+    /// The phase of another `y` in the same buffers where they are long enough (no fresh pages).
+    pub(crate) fn refill(&mut self, y: &[f64], mu: f64) {
+        let n = y.len();
+        let fits = |b: &PhaseBuf| b.off + n < b.v.len();
+        if !(fits(&self.hi) && fits(&self.lo)) {
+            *self = Phase::new(y, mu);
+            return;
+        }
+        self.hi.len = n + 1;
+        self.lo.len = n + 1;
+        phase_prefix(y, mu, self.hi.slice(), self.lo.slice());
     }
 
     pub(crate) fn parts(&self) -> (&[f64], &[f64]) {
