@@ -161,6 +161,87 @@ def build_report(
         plan = plan_forecast(int(x.shape[0]), float(fs), frame_s, fc_split)
     candidates = _refine_candidates(refine)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
+    x, unit_name, axis_names = _axes_and_unit(x, unit, input, axis_names, notes)
+    taus = _check_taus(taus)
+    check_choice(estimator, "estimator", tuple(REPORT_ESTIMATORS))
+    static, dynamic, settings = _analyse(
+        x, fs, input=input, taus=taus, estimator=estimator, window=window, hop=hop, fit=fit, confidence=confidence,
+        max_memory=max_memory, progress=progress,
+    )  # fmt: skip
+    if _worker.waiting():  # a figure process draws the DAVAR figures while the model is fitted
+        _worker.offer(
+            Report(
+                static=static,
+                dynamic=dynamic,
+                fits=None,
+                series=None,
+                fs=float(static.fs),
+                unit=unit_name,
+                input=input,
+                axis_names=axis_names,
+                source={},
+                settings={},
+            )  # fmt: skip
+        )
+    fits = series = fit_error = series_error = None
+    if fit:
+        fits, series, fit_error, series_error = _fit_record_and_windows(
+            static, dynamic, unit_name, confidence, axis_names, notes, progress
+        )
+    else:
+        progress.add(2)
+    refinements: list[Refinement | None] | None = None
+    if candidates is not None:
+        progress.step("model refinement")
+        refinements = _refine_axes(x, fs, input, unit_name, static, axis_names, candidates, notes)
+        settings["refine_candidates"] = list(candidates)
+    frame_fits = forecasts = forecast_settings = forecast_error = None
+    if plan is not None:
+        progress.step("time frames and coefficient forecast")
+        forecast_settings = plan
+        try:
+            frame_fits, forecasts = run_forecast(x, fs, plan, unit=unit_name, input=input, confidence=confidence)
+        except AllaniteError as exc:
+            forecast_error = str(exc)
+            notes.append(f"The coefficient forecast could not be computed: {exc}")
+    paper002 = None
+    if taper or split:
+        progress.step("paper 002 sections")
+        paper002 = paper002_sections(
+            x, fs, input=input, window=dynamic.window, hop=dynamic.hop, taus=dynamic.tau, unit=unit_name,
+            axis_names=axis_names, taper=taper, split=split, notes=notes,
+        )  # fmt: skip
+    created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
+    if own_bar:
+        progress.close()
+    return Report(
+        frames=frame_fits,
+        forecasts=forecasts,
+        forecast_settings=forecast_settings,
+        forecast_error=forecast_error,
+        paper002=paper002,
+        refinements=refinements,
+        static=static,
+        dynamic=dynamic,
+        fits=fits,
+        series=series,
+        fs=float(static.fs),
+        unit=unit_name,
+        input=input,
+        axis_names=axis_names,
+        source=dict(source or {}),
+        settings=settings,
+        notes=notes,
+        fit_requested=bool(fit),
+        fit_error=fit_error,
+        series_error=series_error,
+        created=created,
+    )
+
+
+def _axes_and_unit(x, unit, input, axis_names, notes) -> tuple:
+    """(samples as (samples, axes), the unit's name or None, one name per axis), checked; a note when the unit
+    is unknown."""
     if x.ndim == 1:
         x = x[:, None]
     unit_name = None if unit is None else parse_unit(unit, kind="rate" if input == "rate" else "angle").name
@@ -175,11 +256,14 @@ def build_report(
     axis_names = [str(a) for a in axis_names]
     if len(axis_names) != n_axes:
         raise ParameterError(f"axis_names has {len(axis_names)} names for {n_axes} axes")
-    taus = _check_taus(taus)
-    check_choice(estimator, "estimator", tuple(REPORT_ESTIMATORS))
-    static_est, dynamic_est, dynamic_grid = REPORT_ESTIMATORS[estimator][:3]
+    return x, unit_name, axis_names
 
-    # the request's size before any heavy work: over the memory budget, it is refused here
+
+def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max_memory, progress) -> tuple:
+    """(static result with intervals, dynamic result, settings): the request's size first — over the memory
+    budget it is refused before any heavy work — then every axis at once, or one at a time (report/axes.py)."""
+    static_est, dynamic_est, dynamic_grid = REPORT_ESTIMATORS[estimator][:3]
+    n_axes = x.shape[1]
     n = int(x.shape[0]) - (input == "angle")  # rate samples (angle input: differenced)
     window, hop, settings = _window_and_hop(n, window, hop, estimator)
     resolve_m = get_estimator(dynamic_est).resolve_m
@@ -211,114 +295,44 @@ def build_report(
         memory_estimate_bytes=int(cost["total"]),
         by_axis=by_axis,
     )
-    if _worker.waiting():  # a figure process draws the DAVAR figures while the model is fitted
-        _worker.offer(
-            Report(
-                static=static,
-                dynamic=dynamic,
-                fits=None,
-                series=None,
-                fs=float(static.fs),
-                unit=unit_name,
-                input=input,
-                axis_names=axis_names,
-                source={},
-                settings={},
-            )  # fmt: skip
-        )
+    return static, dynamic, settings
 
-    fits = series = None
-    fit_error = series_error = None
-    if fit:
-        progress.step("noise-model fit")
-        try:
-            # tau_range="auto": a real sensor's shortest τ (anti-alias filter, vibration lines) are often not
-            # the model's; they would dominate the fit and give wrong coefficients. The cut is stated.
-            fits = fit_model(static, unit=unit_name, confidence=confidence, tau_range="auto")
-            if not isinstance(fits, list):
-                fits = [fits]
-            for k, f in enumerate(fits):
-                notes.extend(f"{axis_names[k]}: {note}." for note in f.notes)
-        except AllaniteError as exc:
-            fit_error = str(exc)
-            notes.append(f"The noise model could not be fitted to the whole record: {exc}")
-        progress.step("noise-model fit over time")
-        try:
-            # the windows use the same τ range as the whole-record fit of their axis
-            if fits is not None:
-                per_axis = [dynamic.avar] if dynamic.avar.ndim == 2 else list(dynamic.avar)
-                series = [
-                    _fit_windows(dataclasses.replace(dynamic, avar=row), unit_name, confidence, float(f.tau[0]))
-                    for row, f in zip(per_axis, fits)
-                ]
-                if dynamic.avar.ndim == 2:
-                    series = series[0]
-            else:
-                series = fit_model(dynamic, unit=unit_name, confidence=confidence, tau_range="auto")
-        except AllaniteError as exc:
-            series_error = str(exc)
-            notes.append(
-                f"The coefficients over time could not be fitted (DAVAR window of {dynamic.window} samples): {exc}"
-            )
-    else:
-        progress.add(2)
 
-    refinements: list[Refinement | None] | None = None
-    if candidates is not None:
-        progress.step("model refinement")
-        refinements = _refine_axes(x, fs, input, unit_name, static, axis_names, candidates, notes)
-        settings["refine_candidates"] = list(candidates)
-    frame_fits = forecasts = forecast_settings = forecast_error = None
-    if plan is not None:
-        progress.step("time frames and coefficient forecast")
-        forecast_settings = plan
-        try:
-            frame_fits, forecasts = run_forecast(x, fs, plan, unit=unit_name, input=input, confidence=confidence)
-        except AllaniteError as exc:
-            forecast_error = str(exc)
-            notes.append(f"The coefficient forecast could not be computed: {exc}")
-    paper002 = None
-    if taper or split:
-        progress.step("paper 002 sections")
-        paper002 = paper002_sections(
-            x,
-            fs,
-            input=input,
-            window=dynamic.window,
-            hop=dynamic.hop,
-            taus=dynamic.tau,
-            unit=unit_name,
-            axis_names=axis_names,
-            taper=taper,
-            split=split,
-            notes=notes,
+def _fit_record_and_windows(static, dynamic, unit_name, confidence, axis_names, notes, progress) -> tuple:
+    """(whole-record fits, per-window series, their errors or None): the noise model of the whole record, then
+    of every window on the same τ range as its axis's whole-record fit; a failure becomes a note."""
+    fits = series = fit_error = series_error = None
+    progress.step("noise-model fit")
+    try:
+        # tau_range="auto": a real sensor's shortest τ (anti-alias filter, vibration lines) are often not
+        # the model's; they would dominate the fit and give wrong coefficients. The cut is stated.
+        fits = fit_model(static, unit=unit_name, confidence=confidence, tau_range="auto")
+        if not isinstance(fits, list):
+            fits = [fits]
+        for k, f in enumerate(fits):
+            notes.extend(f"{axis_names[k]}: {note}." for note in f.notes)
+    except AllaniteError as exc:
+        fit_error = str(exc)
+        notes.append(f"The noise model could not be fitted to the whole record: {exc}")
+    progress.step("noise-model fit over time")
+    try:
+        # the windows use the same τ range as the whole-record fit of their axis
+        if fits is not None:
+            per_axis = [dynamic.avar] if dynamic.avar.ndim == 2 else list(dynamic.avar)
+            series = [
+                _fit_windows(dataclasses.replace(dynamic, avar=row), unit_name, confidence, float(f.tau[0]))
+                for row, f in zip(per_axis, fits)
+            ]
+            if dynamic.avar.ndim == 2:
+                series = series[0]
+        else:
+            series = fit_model(dynamic, unit=unit_name, confidence=confidence, tau_range="auto")
+    except AllaniteError as exc:
+        series_error = str(exc)
+        notes.append(
+            f"The coefficients over time could not be fitted (DAVAR window of {dynamic.window} samples): {exc}"
         )
-    created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
-    if own_bar:
-        progress.close()
-    return Report(
-        frames=frame_fits,
-        forecasts=forecasts,
-        forecast_settings=forecast_settings,
-        forecast_error=forecast_error,
-        paper002=paper002,
-        refinements=refinements,
-        static=static,
-        dynamic=dynamic,
-        fits=fits,
-        series=series,
-        fs=float(static.fs),
-        unit=unit_name,
-        input=input,
-        axis_names=axis_names,
-        source=dict(source or {}),
-        settings=settings,
-        notes=notes,
-        fit_requested=bool(fit),
-        fit_error=fit_error,
-        series_error=series_error,
-        created=created,
-    )
+    return fits, series, fit_error, series_error
 
 
 def _refine_candidates(refine) -> tuple | None:
