@@ -169,7 +169,7 @@ def write_md(rows, path: Path) -> None:
         "the parameters added (input unit's base form: σ and amplitude in the rate unit — °/s for gyros, g for "
         'accelerometers —, T_c and t in s, f0 and cutoff in Hz; at acceptance, and after "→ final:" what the '
         "final joint refit changed) and the error before → after on the record's Allan curve (each step's before "
-        "is the previous step's after): χ²/dof of the normalised residuals, RMS of the ADEV error in % (4 τ per "
+        "is the previous step's after): χ²/dof on the calibrated tests' covariance (generalised least squares on their thinned τ, `Refinement.start_errors`/`final_errors`; the five-term column is the plain fit's own, EDF-weighted), RMS of the ADEV error in % (4 τ per "
         "octave whose estimate is within ±10 %) in-sample and held out (8 alternate blocks: fit on the odd ones, "
         "predict the even ones' curve and back; n/a for curves without samples). Default call `refine(x, 100.0)` "
         "/ `refine(curve)`: all τ. Change points are tested on 16 non-overlapping windows (ADIS only); a change "
