@@ -446,3 +446,13 @@ def test_dtft_equals_the_plain_heterodyne(n_seg):
         (np.array([0.031, 0.0047]), np.array([[k, s] for k in (1, 2, 30) for s in (-2, -1, 0, 1, 2)])),
     ]:
         np.testing.assert_array_equal(linefit.dtft(y, idx, gens, coefs, n_seg), _plain_dtft(y, idx, gens, coefs, n_seg))
+
+
+def test_no_models_fit_to_nothing(curve):
+    # a step whose searches are all on fixed grids has no bounded search to start: fitting an empty list of
+    # models gives an empty answer (it had raised IndexError from the stacked designs: test_fuzz's short record)
+    assert curvefit.chi2s_of(curve, START, []).shape == (0,)
+    grid = np.geomspace(0.5, 50, 8)
+    got = curvefit.searches(curve, START, [], [("gauss_markov", grid, False)])
+    want = int(np.argmin(curvefit.chi2s(curve, START, [], "gauss_markov", grid, 6)))
+    assert len(got) == 1 and float(got[0][0]) == float(grid[want]), got

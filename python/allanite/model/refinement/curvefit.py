@@ -241,6 +241,8 @@ def _fits(curve: Curve, terms, models: list, max_iter: int) -> list:
     """(design, coefficients, EDF per τ, floor) of the IRLS of each model (a list of effects, all of one size)
     on ``curve``; the fits not done before on this curve run together, and are remembered (a search's best
     parameter is solved again, a profile's centre is the best parameter)."""
+    if not models:  # a step whose searches are all on fixed grids has no bounded search's first points
+        return []
     keys = [("fit", tuple(terms), tuple((k, float(p)) for k, p in eff), max_iter) for eff in models]
     a_all, nu_all = _stacked(curve, terms, models)
     done = [curve.cached(key) for key in keys]
