@@ -50,9 +50,7 @@ def irls(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max
         theta[live] = new
         moved = np.asarray(new.any(axis=1))
         if moved.any():
-            tot = parts.sum(axis=2)
-            den = np.sum(parts**2 / (nu_cols if whole else nu_cols[live]), axis=2)
-            upd = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu_l)
+            upd = _combined_edf(parts, nu_cols if whole else nu_cols[live], parts.sum(axis=2), nu_l)
             nu[live] = np.where(moved[:, None], upd, nu_l)
         live = live[~done]
         if live.size == 0:
@@ -83,8 +81,7 @@ def _irls_one(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu: np.ndarray,
         model = new_model if it == 0 else np.sqrt(model * new_model)
         theta = new
         if new.any():
-            den = np.sum(parts**2 / nu_cols, axis=1)
-            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
+            nu = _combined_edf(parts, nu_cols, tot, nu)
         if done:
             break
     return theta, nu
@@ -116,8 +113,7 @@ def _irls_held(a, nu_cols, y, nu, max_iter, floor, held):
         model = np.maximum(tot, floor) if it == 0 else np.sqrt(model * np.maximum(tot, floor))
         theta = new
         if new.any():
-            den = np.sum(parts**2 / nu_cols, axis=1)
-            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
+            nu = _combined_edf(parts, nu_cols, tot, nu)
         if done:
             break
     return theta, nu
@@ -129,3 +125,10 @@ def chi2_at(y: np.ndarray, a: np.ndarray, theta: np.ndarray, nu: np.ndarray, flo
     w = nu / (2.0 * model**2)
     z = (y - model) * np.sqrt(w)
     return float(np.sum(z**2))
+
+
+def _combined_edf(parts, nu_cols, tot, nu):
+    """The model's EDF per τ from its terms' parts (last axis) and each term's EDF: tot² / Σ part²/ν_term
+    (Satterthwaite), ``nu`` kept where no term contributes."""
+    den = np.sum(parts**2 / nu_cols, axis=-1)
+    return np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
