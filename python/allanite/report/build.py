@@ -168,21 +168,8 @@ def build_report(
         x, fs, input=input, taus=taus, estimator=estimator, window=window, hop=hop, fit=fit, confidence=confidence,
         max_memory=max_memory, progress=progress,
     )  # fmt: skip
-    if _worker.waiting():  # a figure process draws the DAVAR figures while the model is fitted
-        _worker.offer(
-            Report(
-                static=static,
-                dynamic=dynamic,
-                fits=None,
-                series=None,
-                fs=float(static.fs),
-                unit=unit_name,
-                input=input,
-                axis_names=axis_names,
-                source={},
-                settings={},
-            )  # fmt: skip
-        )
+    # a figure process draws the DAVAR figures while the model is fitted
+    _offer(static, dynamic, None, None, unit_name, input, axis_names, complete=False)
     fits = series = fit_error = series_error = None
     if fit:
         fits, series, fit_error, series_error = _fit_record_and_windows(
@@ -190,6 +177,8 @@ def build_report(
         )
     else:
         progress.add(2)
+    if candidates is not None or plan is not None or taper or split:  # and the rest while more is computed
+        _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete=True)
     refinements: list[Refinement | None] | None = None
     if candidates is not None:
         progress.step("model refinement")
@@ -237,6 +226,18 @@ def build_report(
         series_error=series_error,
         created=created,
     )
+
+
+def _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete: bool) -> None:
+    """Offer the figure process (if one waits: :mod:`allanite.report._worker`) the report as far as it is
+    computed; ``complete``: every figure it has is final (the fits are in; refinement, frames and forecast
+    figures come with the whole report)."""
+    if _worker.waiting():
+        partial = Report(
+            static=static, dynamic=dynamic, fits=fits, series=series, fs=float(static.fs), unit=unit_name,
+            input=input, axis_names=axis_names, source={}, settings={},
+        )  # fmt: skip
+        _worker.offer(partial, complete=complete)
 
 
 def _axes_and_unit(x, unit, input, axis_names, notes) -> tuple:
