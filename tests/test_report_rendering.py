@@ -222,3 +222,21 @@ def test_a_report_computing_more_after_its_fits_offers_them_too(monkeypatch):
     serial = render_pngs(rep.figure_specs(), 100, lambda text: None, processes=1)
     assert list(images) == list(serial) and all(images[k] == serial[k] for k in serial)
     assert not _worker.waiting()
+
+
+def test_two_figures_are_split_where_matplotlib_is_set_up(monkeypatch):
+    """The figure process has drawn before it is handed the report: a --refine report's three refinement
+    figures left then are split; a process that has not drawn yet keeps fewer than four."""
+    from allanite.report import rendering
+
+    monkeypatch.setitem(rendering._STATE, "drawn", False)
+    assert rendering.min_figures_to_split() == rendering.MIN_FIGURES_TO_SPLIT == 4
+    specs = [_spec(k) for k in range(2)]
+    serial = render_pngs(specs, 60, lambda text: None, processes=1)  # sets up the Agg canvas here
+    assert rendering.min_figures_to_split() == 2
+    forked = []
+    real_fork = rendering._fork_child
+    monkeypatch.setattr(rendering, "_fork_child", lambda *a: forked.append(a[1]) or real_fork(*a))
+    split = render_pngs(specs, 60, lambda text: None, processes=2)
+    assert forked == [[1]]  # the child drew the second figure
+    assert list(split) == list(serial) and all(split[k] == serial[k] for k in serial)
