@@ -167,9 +167,9 @@ def build_report(
     static, dynamic, settings = _analyse(
         x, fs, input=input, taus=taus, estimator=estimator, window=window, hop=hop, fit=fit, confidence=confidence,
         max_memory=max_memory, progress=progress,
+        # a figure process draws the DAVAR figures while the intervals and the model are computed
+        on_dynamic=lambda st, dy: _offer(st, dy, None, None, unit_name, input, axis_names, complete=False),
     )  # fmt: skip
-    # a figure process draws the DAVAR figures while the model is fitted
-    _offer(static, dynamic, None, None, unit_name, input, axis_names, complete=False)
     fits = series = fit_error = series_error = None
     if fit:
         fits, series, fit_error, series_error = _fit_record_and_windows(
@@ -260,9 +260,10 @@ def _axes_and_unit(x, unit, input, axis_names, notes) -> tuple:
     return x, unit_name, axis_names
 
 
-def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max_memory, progress) -> tuple:
+def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max_memory, progress, on_dynamic) -> tuple:
     """(static result with intervals, dynamic result, settings): the request's size first — over the memory
-    budget it is refused before any heavy work — then every axis at once, or one at a time (report/axes.py)."""
+    budget it is refused before any heavy work — then every axis at once, or one at a time (report/axes.py).
+    ``on_dynamic(static, dynamic)`` is called once both exist (with every axis at once: before the intervals)."""
     static_est, dynamic_est, dynamic_grid = REPORT_ESTIMATORS[estimator][:3]
     n_axes = x.shape[1]
     n = int(x.shape[0]) - (input == "angle")  # rate samples (angle input: differenced)
@@ -279,15 +280,17 @@ def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max
             window=window, hop=hop, grid=dynamic_grid, dynamic_est=dynamic_est, max_memory=max_memory,
             progress=progress,
         )  # fmt: skip
+        on_dynamic(static, dynamic)
     else:
         progress.step("static Allan deviation")
         static = avar(x, fs, input=input, taus=taus, estimator=static_est, **extra)
-        progress.step("confidence intervals")
-        static = static.with_confidence(x, confidence=confidence)
         progress.step("dynamic Allan variance")
         dynamic = davar(
             x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est, max_memory=max_memory
         )
+        on_dynamic(static, dynamic)  # before the intervals: the DAVAR figures need nothing more
+        progress.step("confidence intervals")
+        static = static.with_confidence(x, confidence=confidence)
     settings.update(
         taus=taus if isinstance(taus, str) else "explicit",
         estimator=estimator,

@@ -46,7 +46,8 @@ def _words(rep) -> dict:
     """The names of what the figures show: TheoH or Allan deviation, the confidence level."""
     theoh = rep.static.source is not None
     return {
-        "conf": f"{rep.static.confidence:.1%}",
+        # none yet in the partial report offered before the intervals (its figures do not show them)
+        "conf": "" if rep.static.confidence is None else f"{rep.static.confidence:.1%}",
         "static": "TheoH deviation" if theoh else "Overlapping Allan deviation",
         "static_lower": "TheoH deviation" if theoh else "Allan deviation",
         "dynamic": "Dynamic TheoH deviation (DHVAR)" if theoh else "Dynamic Allan deviation",
