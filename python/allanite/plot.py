@@ -396,17 +396,25 @@ def plot_coefficient_series(
             ax.axhline(reference.coefficients[name].value * scale, color=ref_colour, ls=":", lw=1, label="whole record")
         if legend and (whole or not resolved.all()):  # one legend per panel (a second call would replace the first)
             ax.legend(fontsize="x-small", loc="upper right" if whole else "upper left")
-        finite_hi = series.ci_high[name][np.isfinite(series.ci_high[name])]
-        vmax = float(np.max(series.values[name]))
-        top = float(finite_hi.max()) if finite_hi.size else vmax
-        if vmax > 0:
-            top = min(top, 3.0 * vmax)  # a few windows with huge intervals must not flatten the curve
-        top = max(top, vmax)
-        if reference is not None and name in reference.coefficients:
-            top = max(top, reference.coefficients[name].value)
+        top = _coefficient_top(series, name, reference)
         if top > 0:
             ax.set_ylim(0.0, top * scale * 1.05)
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel("window centre t (s)")
     return axes
+
+
+def _coefficient_top(series, name: str, reference) -> float:
+    """Top of coefficient ``name``'s panel (its base unit): the highest finite interval bound, at most 3× the
+    highest value (a few windows with huge intervals must not flatten the curve), and at least the highest value
+    and the whole-record value."""
+    finite_hi = series.ci_high[name][np.isfinite(series.ci_high[name])]
+    vmax = float(np.max(series.values[name]))
+    top = float(finite_hi.max()) if finite_hi.size else vmax
+    if vmax > 0:
+        top = min(top, 3.0 * vmax)
+    top = max(top, vmax)
+    if reference is not None and name in reference.coefficients:
+        top = max(top, reference.coefficients[name].value)
+    return top
