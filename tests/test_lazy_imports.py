@@ -21,6 +21,14 @@ def test_import_allanite_loads_no_scipy_stats_signal_optimize_or_matplotlib():
     assert out.stdout.strip() == "[]"
 
 
+def test_import_allanite_loads_no_jinja2_or_pywavelets():
+    """The HTML templates (jinja2, ~0.1 s) load where a page or a notebook display is made, PyWavelets
+    (~0.08 s) where paper 004's improved GM(1,1) uses a wavelet."""
+    code = "import sys, allanite; print(sorted(m for m in ('jinja2', 'pywt') if m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
+
+
 def test_the_command_line_and_the_report_load_no_scipy_stats_signal_optimize_or_matplotlib():
     """What ``allanite report`` imports before it computes: the refinement's loop (scipy.signal, stats,
     optimize) only with ``--refine``, matplotlib only when the figures are drawn."""

@@ -187,7 +187,9 @@ def test_the_worker_draws_the_davar_figures_from_the_offered_analysis(monkeypatc
     y = allanite.simulate(6_000, 100.0, N=0.01, K=1e-3, seed=4)[:, None]
     offered = []
     real_offer = _worker.offer
-    monkeypatch.setattr(_worker, "offer", lambda partial: offered.append(partial) or real_offer(partial))
+    monkeypatch.setattr(
+        _worker, "offer", lambda partial, complete=False: offered.append(partial) or real_offer(partial, complete)
+    )
     assert _worker.start(when_idle=False)
     rep = build_report(y, 100.0, unit="deg/s", window=1_500, hop=500, progress=False)
     assert len(offered) == 1 and offered[0].fits is None and offered[0].dynamic is rep.dynamic
@@ -195,3 +197,46 @@ def test_the_worker_draws_the_davar_figures_from_the_offered_analysis(monkeypatc
     serial = render_pngs(rep.figure_specs(), 100, lambda text: None, processes=1)
     assert list(images) == list(serial) and all(images[k] == serial[k] for k in serial)
     assert not _worker.waiting()
+
+
+def test_a_report_computing_more_after_its_fits_offers_them_too(monkeypatch):
+    """With paper 002's sections (or ``refine``, frames) computed after the fits, the worker is offered the
+    report with its fits before them and draws every figure it has meanwhile: the same bytes."""
+    import allanite
+    from allanite.report import _worker, build_report
+
+    y = allanite.simulate(6_000, 100.0, N=0.01, K=1e-3, seed=4)[:, None]
+    offered = []
+    real_offer = _worker.offer
+
+    def offer(partial, complete=False):
+        offered.append((partial, complete))
+        real_offer(partial, complete=complete)
+
+    monkeypatch.setattr(_worker, "offer", offer)
+    assert _worker.start(when_idle=False)
+    rep = build_report(y, 100.0, unit="deg/s", window=1_500, hop=500, taper="hann", progress=False)
+    assert [(p.fits is None, c) for p, c in offered] == [(True, False), (False, True)]
+    assert offered[1][0].fits is rep.fits and offered[1][0].series is rep.series
+    images = rep.render_figures(False)
+    serial = render_pngs(rep.figure_specs(), 100, lambda text: None, processes=1)
+    assert list(images) == list(serial) and all(images[k] == serial[k] for k in serial)
+    assert not _worker.waiting()
+
+
+def test_two_figures_are_split_where_matplotlib_is_set_up(monkeypatch):
+    """The figure process has drawn before it is handed the report: a --refine report's three refinement
+    figures left then are split; a process that has not drawn yet keeps fewer than four."""
+    from allanite.report import rendering
+
+    monkeypatch.setitem(rendering._STATE, "drawn", False)
+    assert rendering.min_figures_to_split() == rendering.MIN_FIGURES_TO_SPLIT == 4
+    specs = [_spec(k) for k in range(2)]
+    serial = render_pngs(specs, 60, lambda text: None, processes=1)  # sets up the Agg canvas here
+    assert rendering.min_figures_to_split() == 2
+    forked = []
+    real_fork = rendering._fork_child
+    monkeypatch.setattr(rendering, "_fork_child", lambda *a: forked.append(a[1]) or real_fork(*a))
+    split = render_pngs(specs, 60, lambda text: None, processes=2)
+    assert forked == [[1]]  # the child drew the second figure
+    assert list(split) == list(serial) and all(split[k] == serial[k] for k in serial)

@@ -38,10 +38,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
 from importlib import resources
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import jinja2
 import numpy as np
+
+if TYPE_CHECKING:
+    import jinja2
 
 __all__ = ["MAX_POINTS", "MAX_ROWS", "RichDisplay", "Summary", "Table", "fmt", "fmt_ci", "fmt_range", "thin"]
 
@@ -116,6 +118,8 @@ def thin(n: int, cap: int = MAX_POINTS) -> np.ndarray:
 
 @lru_cache(maxsize=1)
 def _template() -> jinja2.Template:
+    import jinja2  # where a result is shown as HTML: not on ``import allanite`` (~0.1 s)
+
     text = resources.files(__package__).joinpath("_display.html.j2").read_text(encoding="utf-8")
     env = jinja2.Environment(autoescape=True, undefined=jinja2.StrictUndefined)
     return env.from_string(text)

@@ -81,11 +81,11 @@ examples:
 files written to DIR:
   report.html              the report, one self-contained page
   summary.json             every number of the page, with units (schema allanite-report/1)
-  adev.png, davar.png      all axes: Allan deviation with fits; DAVAR heat maps stacked
+  adev.png                 all axes: Allan deviation with confidence bands and fits
+  davar.png                all axes: DAVAR heat maps (time x tau, log colour), one panel per axis
+  coefficients.png         all axes: noise coefficients per DAVAR window with intervals
   adev_axisK.png           axis K: ADEV with confidence band, fitted model and each term
-  davar_axisK.png          axis K: DAVAR heat map (time x tau, log colour)
   davar3d_axisK.png        axis K: DAVAR surface (t, log10 tau, log10 ADEV)
-  coefficients_axisK.png   axis K: noise coefficients per DAVAR window with intervals
   refinement_axisK.png     axis K (--refine): starting and refined model, residuals before/after
   frames_axisK.png         axis K (--frames/--forecast): coefficients per frame with intervals
   forecast_axisK.png       axis K (--frames/--forecast): forecasts of the resolved coefficients

@@ -323,7 +323,9 @@ def _shade_unfitted(ax, lo: float, hi: float, fit_lo: float, fit_hi: float) -> N
             label = None
 
 
-def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None):
+def plot_coefficient_series(
+    series, axes=None, ieee: bool = True, reference=None, *, color=None, label=None, legend: bool = True
+):
     """One panel per coefficient against window centre time, with the interval band.
 
     Parameters
@@ -334,9 +336,17 @@ def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None
     ieee : bool
         IEEE-952 units (°/√h, °/h, …) when the series' unit is known, else the base form.
     reference : NoiseFit, optional
-        Whole-record fit: its value of each coefficient is drawn as a dotted line.
+        Whole-record fit: its value of each coefficient is drawn as a dotted line (in ``color`` where given).
+    color : matplotlib colour, optional
+        Colour of every panel's curve, band and markers (default: one colour per coefficient) — several
+        series (axes of one sensor) drawn into the same panels.
+    label : str, optional
+        Legend label of the curves (default: none).
+    legend : bool
+        Whether each panel gets its legend (whole-record line, unresolved windows).
     """
     names = [t for t in series.terms if np.any(series.values[t] > 0)] or list(series.terms)
+    curve_label = label  # ``label`` below: each panel's axis label
     if axes is None:
         import matplotlib.pyplot as plt
 
@@ -352,7 +362,7 @@ def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None
                 scale, label = q.value, f"{name} ({q.unit})"
             else:
                 label = f"{name} ({coefficient_unit(name, series.unit)})"
-        colour = _TERM_STYLE.get(name, "C0")
+        colour = color if color is not None else _TERM_STYLE.get(name, "C0")
         values = np.asarray(series.values[name], dtype=np.float64)
         # A window whose fit put the term at zero (non-negative least squares) has not resolved it: the
         # value is "at most the upper bound", not 0. Draw those windows as gaps in the line, with an
@@ -360,7 +370,9 @@ def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None
         resolved = values > 0
         shown = np.where(resolved, values, np.nan)
         t, line = _envelope(series.t, shown, shown)
-        ax.plot(t, line * scale, color=colour, lw=1.2, marker="." if resolved.sum() < 60 else None, ms=3)
+        ax.plot(
+            t, line * scale, color=colour, lw=1.2, marker="." if resolved.sum() < 60 else None, ms=3, label=curve_label
+        )
         low = np.where(resolved, series.ci_low[name], np.nan)
         high = np.where(resolved, np.minimum(series.ci_high[name], 1e300), np.nan)
         t, band = _envelope(series.t, low, high)
@@ -380,20 +392,29 @@ def plot_coefficient_series(series, axes=None, ieee: bool = True, reference=None
             )
         whole = reference is not None and name in reference.coefficients
         if whole:
-            ax.axhline(reference.coefficients[name].value * scale, color="k", ls=":", lw=1, label="whole record")
-        if whole or not resolved.all():  # one legend per panel (a second call would replace the first)
+            ref_colour = "k" if color is None else color
+            ax.axhline(reference.coefficients[name].value * scale, color=ref_colour, ls=":", lw=1, label="whole record")
+        if legend and (whole or not resolved.all()):  # one legend per panel (a second call would replace the first)
             ax.legend(fontsize="x-small", loc="upper right" if whole else "upper left")
-        finite_hi = series.ci_high[name][np.isfinite(series.ci_high[name])]
-        vmax = float(np.max(series.values[name]))
-        top = float(finite_hi.max()) if finite_hi.size else vmax
-        if vmax > 0:
-            top = min(top, 3.0 * vmax)  # a few windows with huge intervals must not flatten the curve
-        top = max(top, vmax)
-        if reference is not None and name in reference.coefficients:
-            top = max(top, reference.coefficients[name].value)
+        top = _coefficient_top(series, name, reference)
         if top > 0:
             ax.set_ylim(0.0, top * scale * 1.05)
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel("window centre t (s)")
     return axes
+
+
+def _coefficient_top(series, name: str, reference) -> float:
+    """Top of coefficient ``name``'s panel (its base unit): the highest finite interval bound, at most 3× the
+    highest value (a few windows with huge intervals must not flatten the curve), and at least the highest value
+    and the whole-record value."""
+    finite_hi = series.ci_high[name][np.isfinite(series.ci_high[name])]
+    vmax = float(np.max(series.values[name]))
+    top = float(finite_hi.max()) if finite_hi.size else vmax
+    if vmax > 0:
+        top = min(top, 3.0 * vmax)
+    top = max(top, vmax)
+    if reference is not None and name in reference.coefficients:
+        top = max(top, reference.coefficients[name].value)
+    return top

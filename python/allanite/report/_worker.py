@@ -5,8 +5,9 @@ drawn before the report exists. :func:`start` forks a process right away that im
 small figure (fonts, the Agg canvas, the 3-D axes) while this process reads the log and computes. Offered the
 analysis as soon as it exists (:func:`offer`: the static and dynamic results, before the noise model is fitted),
 it draws the figures that need nothing more (:func:`allanite.report.figures.from_analysis_alone`: the DAVAR heat
-maps and surfaces, about half of the drawing) while this process fits; handed the whole report (pickled: arrays
-and the fits, a few hundred kB), it draws the rest — on two processes where a core is idle then
+maps and surfaces) while this process fits; offered it again with the fits where more is computed after them
+(``refine``, frames, paper 002's sections), it draws every figure but theirs meanwhile; handed the whole report
+(pickled: arrays and the fits, a few hundred kB), it draws the rest — on two processes where a core is idle then
 (:func:`allanite.report.rendering.render_pngs`) — and hands the PNGs back. This process then never imports
 matplotlib. The PNGs are the same bytes as drawn here.
 
@@ -85,12 +86,15 @@ def waiting() -> bool:
     return bool(_WORKER)
 
 
-def offer(partial) -> None:
-    """Hand the waiting worker (if any) the report as far as it is computed — static and dynamic results, no
-    fits — so that it draws the figures that need nothing more now; nothing when no worker waits or the
-    report cannot be pickled."""
+def offer(partial, complete: bool = False) -> None:
+    """Hand the waiting worker (if any) the report as far as it is computed, so that it draws the figures
+    that need nothing more now: the static and dynamic results, no fits — the figures of the analysis alone
+    (:func:`~allanite.report.figures.from_analysis_alone`); ``complete``: with the fits, every figure the
+    partial report has is final (a report with ``refine``, frames or paper 002's sections offers it before
+    computing them: their figures come with the whole report). Nothing when no worker waits or the report
+    cannot be pickled."""
     if _WORKER:
-        _send(("analysis", partial, EARLY_DPI))
+        _send(("analysis", partial, EARLY_DPI, complete))
 
 
 def take(rep, dpi: int) -> dict | None:
@@ -175,15 +179,14 @@ def _serve(r: int, w: int) -> int:  # pragma: no cover - runs in the forked work
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _warm_up()
     message = _receive(r)
-    early: dict = {}
-    if message is not None and message[0] == "analysis":
-        _, partial, dpi = message
-        todo = [sp for sp in figure_specs(partial) if from_analysis_alone(sp[0])]
-        message = None
-        for spec in todo:  # one at a time, until the whole report comes
-            early[spec[0]] = (png(spec, dpi), dpi)
-            if select.select([r], [], [], 0)[0]:
-                break
+    early: dict = {}  # file name -> (PNG, dpi) drawn from an offered partial report
+    while message is not None and message[0] == "analysis":
+        _, partial, dpi, complete = message
+        for spec in figure_specs(partial):  # one at a time, until the next message comes
+            if (complete or from_analysis_alone(spec[0])) and early.get(spec[0], (None, None))[1] != dpi:
+                early[spec[0]] = (png(spec, dpi), dpi)
+                if select.select([r], [], [], 0)[0]:
+                    break
         message = _receive(r)
     if message is None:  # the parent closed the pipe without a report: nothing to draw
         return 0

@@ -167,22 +167,9 @@ def build_report(
     static, dynamic, settings = _analyse(
         x, fs, input=input, taus=taus, estimator=estimator, window=window, hop=hop, fit=fit, confidence=confidence,
         max_memory=max_memory, progress=progress,
+        # a figure process draws the DAVAR figures while the intervals and the model are computed
+        on_dynamic=lambda st, dy: _offer(st, dy, None, None, unit_name, input, axis_names, complete=False),
     )  # fmt: skip
-    if _worker.waiting():  # a figure process draws the DAVAR figures while the model is fitted
-        _worker.offer(
-            Report(
-                static=static,
-                dynamic=dynamic,
-                fits=None,
-                series=None,
-                fs=float(static.fs),
-                unit=unit_name,
-                input=input,
-                axis_names=axis_names,
-                source={},
-                settings={},
-            )  # fmt: skip
-        )
     fits = series = fit_error = series_error = None
     if fit:
         fits, series, fit_error, series_error = _fit_record_and_windows(
@@ -190,6 +177,8 @@ def build_report(
         )
     else:
         progress.add(2)
+    if candidates is not None or plan is not None or taper or split:  # and the rest while more is computed
+        _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete=True)
     refinements: list[Refinement | None] | None = None
     if candidates is not None:
         progress.step("model refinement")
@@ -239,6 +228,18 @@ def build_report(
     )
 
 
+def _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete: bool) -> None:
+    """Offer the figure process (if one waits: :mod:`allanite.report._worker`) the report as far as it is
+    computed; ``complete``: every figure it has is final (the fits are in; refinement, frames and forecast
+    figures come with the whole report)."""
+    if _worker.waiting():
+        partial = Report(
+            static=static, dynamic=dynamic, fits=fits, series=series, fs=float(static.fs), unit=unit_name,
+            input=input, axis_names=axis_names, source={}, settings={},
+        )  # fmt: skip
+        _worker.offer(partial, complete=complete)
+
+
 def _axes_and_unit(x, unit, input, axis_names, notes) -> tuple:
     """(samples as (samples, axes), the unit's name or None, one name per axis), checked; a note when the unit
     is unknown."""
@@ -259,9 +260,10 @@ def _axes_and_unit(x, unit, input, axis_names, notes) -> tuple:
     return x, unit_name, axis_names
 
 
-def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max_memory, progress) -> tuple:
+def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max_memory, progress, on_dynamic) -> tuple:
     """(static result with intervals, dynamic result, settings): the request's size first — over the memory
-    budget it is refused before any heavy work — then every axis at once, or one at a time (report/axes.py)."""
+    budget it is refused before any heavy work — then every axis at once, or one at a time (report/axes.py).
+    ``on_dynamic(static, dynamic)`` is called once both exist (with every axis at once: before the intervals)."""
     static_est, dynamic_est, dynamic_grid = REPORT_ESTIMATORS[estimator][:3]
     n_axes = x.shape[1]
     n = int(x.shape[0]) - (input == "angle")  # rate samples (angle input: differenced)
@@ -278,15 +280,17 @@ def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max
             window=window, hop=hop, grid=dynamic_grid, dynamic_est=dynamic_est, max_memory=max_memory,
             progress=progress,
         )  # fmt: skip
+        on_dynamic(static, dynamic)
     else:
         progress.step("static Allan deviation")
         static = avar(x, fs, input=input, taus=taus, estimator=static_est, **extra)
-        progress.step("confidence intervals")
-        static = static.with_confidence(x, confidence=confidence)
         progress.step("dynamic Allan variance")
         dynamic = davar(
             x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est, max_memory=max_memory
         )
+        on_dynamic(static, dynamic)  # before the intervals: the DAVAR figures need nothing more
+        progress.step("confidence intervals")
+        static = static.with_confidence(x, confidence=confidence)
     settings.update(
         taus=taus if isinstance(taus, str) else "explicit",
         estimator=estimator,

@@ -10,9 +10,7 @@ import base64
 import math
 from functools import lru_cache
 from importlib import resources
-from typing import Any
-
-import jinja2
+from typing import TYPE_CHECKING, Any
 
 from .._core import __version__
 from .fmt import LONG_RECORD_S, clock, duration, g, num, step_params
@@ -20,11 +18,16 @@ from .forecasting import forecast_page
 from .paper002 import page_context as paper002_page
 from .settings import NOTHING_ADDED, REPORT_ESTIMATORS
 
+if TYPE_CHECKING:
+    import jinja2
+
 __all__ = ["html_page"]
 
 
 @lru_cache(maxsize=1)
 def _template() -> jinja2.Template:
+    import jinja2  # where a page is written: not on ``import allanite`` (~0.1 s)
+
     here = resources.files(__package__)
     env = jinja2.Environment(autoescape=True, trim_blocks=False, lstrip_blocks=False, undefined=jinja2.StrictUndefined)
     return env.from_string(here.joinpath("template.html.j2").read_text(encoding="utf-8"))

@@ -1,7 +1,7 @@
 """The report's figures as PNG bytes, drawn on two processes where the machine gives this one two cores.
 
 Drawing and rasterising a figure is matplotlib's Python (ticks, text layout) under one interpreter lock; the
-report's 14 figures of a three-axis log are most of its wall time. Where ``os.fork`` exists, at least two cores
+report's 9 figures of a three-axis log are most of its wall time. Where ``os.fork`` exists, at least two cores
 are available, one of them idle now (the run queue) and the report is drawn from the main thread, a forked child
 draws about half of the figures by size (``fork``: the figures' drawing closures need no pickling, the child holds
 the report already) and hands its PNGs back through a pipe; the parent draws the rest meanwhile. The PNGs are the
@@ -24,11 +24,25 @@ from functools import cache
 
 from ._lean import lean_figure
 
-__all__ = ["render_pngs", "figure_processes", "idle_cores", "child_share"]
+__all__ = ["render_pngs", "figure_processes", "idle_cores", "child_share", "min_figures_to_split"]
 
-#: Fewer figures than this are drawn in this process (forking costs ~10 ms and a child's first figure pays
-#: matplotlib's font set-up again).
+#: Fewer figures than this are drawn in this process where it has not drawn a figure yet (forking costs ~10 ms
+#: and a child forked before matplotlib's font set-up pays it again); where it has (the figure process of
+#: :mod:`allanite.report._worker`, set up before it is handed the report: a ``--refine`` report's three
+#: refinement figures are what is left then), two figures are split (:func:`min_figures_to_split`).
 MIN_FIGURES_TO_SPLIT = 4
+
+
+#: Whether this process has drawn a figure (:func:`png`): matplotlib and its fonts are set up, and a child
+#: forked now inherits them.
+_STATE = {"drawn": False}
+
+
+def min_figures_to_split() -> int:
+    """Fewest figures drawn on two processes: 2 where this process has drawn a figure already (a forked child
+    inherits matplotlib's set-up), else ``MIN_FIGURES_TO_SPLIT``."""
+    return 2 if _STATE["drawn"] else MIN_FIGURES_TO_SPLIT
+
 
 #: zlib level of the PNGs (measured on the ADIS16405 report's 14 figures: level 6, PIL's default, 6.3 s of CPU
 #: and 1316 kB; level 1, 4.1 s and 1439 kB).
@@ -100,6 +114,7 @@ def png(spec, dpi: int) -> bytes:
     buf = io.BytesIO()
     # zlib level 1: a third of the drawing's CPU time less than the default 6, for PNGs ~10 % larger
     fig.savefig(buf, format="png", dpi=dpi, pil_kwargs={"compress_level": PNG_COMPRESSION})
+    _STATE["drawn"] = True
     return buf.getvalue()
 
 
@@ -108,7 +123,7 @@ def render_pngs(specs: list, dpi: int, step, processes: int | None = None) -> di
     ``processes``: 1 draws them here one after another; None chooses (:func:`figure_processes`)."""
     processes = figure_processes() if processes is None else processes
     pngs: list[bytes | None] = [None] * len(specs)
-    theirs = child_share(specs) if processes > 1 and len(specs) >= MIN_FIGURES_TO_SPLIT else []
+    theirs = child_share(specs) if processes > 1 and len(specs) >= min_figures_to_split() else []
     child = _fork_child(specs, theirs, dpi) if theirs else None
     try:
         for i, spec in enumerate(specs):
