@@ -54,3 +54,53 @@ impl Shared {
         Shared { design_cm, blocks }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::Gls;
+
+    #[test]
+    fn blocks_are_packed_lower_triangles_in_assembly_order() {
+        // 2 τ, 3 terms (two stochastic, the ramp last): S[a, b] entry (i, j) = 1000a + 100b + 10i + j,
+        // T[a] entry (i, j) = 5000 + 1000a + 10i + j; the upper triangle must be left out
+        let (nt, ns) = (2, 2);
+        let mut s = vec![0.0; ns * ns * nt * nt];
+        for (n, v) in s.iter_mut().enumerate() {
+            let (ab, ij) = (n / (nt * nt), n % (nt * nt));
+            *v = (1000 * (ab / ns) + 100 * (ab % ns) + 10 * (ij / nt) + ij % nt) as f64;
+        }
+        let t: Vec<f64> = (0..ns * nt * nt)
+            .map(|n| (5000 + 1000 * (n / 4) + 10 * (n % 4 / 2) + n % 2) as f64)
+            .collect();
+        let design = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let (nu, rho, l2) = ([1.0; 6], [0.0; 3], [0.0, 1.0]);
+        let p = Problem {
+            n_tau: nt,
+            n_terms: 3,
+            design: &design,
+            nu_terms: &nu,
+            start_col: 0,
+            irls_iter: 1,
+            max_iter: 1,
+            gls_tol: 1e-7,
+            irls_rtol: 1e-7,
+            rho: &rho,
+            log2_tau: &l2,
+            gls: Some(Gls {
+                s_blk: &s,
+                t_blk: &t,
+                stoch: &[0, 1],
+                ramp: Some(2),
+            }),
+        };
+        let sh = Shared::new(&p);
+        assert_eq!(sh.design_cm, [1.0, 4.0, 2.0, 5.0, 3.0, 6.0]);
+        let want = [
+            0.0, 10.0, 11.0, 100.0, 110.0, 111.0, 1000.0, 1010.0, 1011.0, 1100.0, 1110.0, 1111.0,
+            5000.0, 5010.0, 5011.0, 6000.0, 6010.0, 6011.0,
+        ];
+        assert_eq!(sh.blocks, want);
+        assert_eq!((tri_len(nt), tri_row(1)), (3, 1));
+    }
+}
