@@ -97,47 +97,42 @@ fn lstsq_cols(
     r: &mut [f64],
 ) -> bool {
     let p = cols.len();
+    let q = &mut q[..p * m];
     for (k, &c) in cols.iter().enumerate() {
         q[k * m..(k + 1) * m].copy_from_slice(&a[c * m..(c + 1) * m]);
     }
-    r[..m].copy_from_slice(&b[..m]);
+    let r = &mut r[..m];
+    r.copy_from_slice(&b[..m]);
     for k in 0..p {
-        let col = k * m;
-        let norm = q[col + k..col + m]
-            .iter()
-            .map(|v| v * v)
-            .sum::<f64>()
-            .sqrt();
+        // column k from row k on (the reflector), and the columns after it
+        let (head, tail) = q.split_at_mut((k + 1) * m);
+        let v = &mut head[k * m + k..];
+        let norm = v.iter().map(|v| v * v).sum::<f64>().sqrt();
         if norm == 0.0 || !norm.is_finite() {
             return false;
         }
         // reflect column k onto ∓norm·e_k (sign chosen against cancellation)
-        let alpha = if q[col + k] > 0.0 { -norm } else { norm };
-        let v0 = q[col + k] - alpha;
-        q[col + k] = v0;
-        let vnorm2 = v0 * v0 + q[col + k + 1..col + m].iter().map(|v| v * v).sum::<f64>();
+        let alpha = if v[0] > 0.0 { -norm } else { norm };
+        let v0 = v[0] - alpha;
+        v[0] = v0;
+        let vnorm2 = v0 * v0 + v[1..].iter().map(|v| v * v).sum::<f64>();
         if vnorm2 > 0.0 {
-            for j in k + 1..p {
-                let cj = j * m;
+            let reflect = |x: &mut [f64]| {
                 let mut s = 0.0;
-                for i in k..m {
-                    s += q[col + i] * q[cj + i];
+                for (vi, xi) in v.iter().zip(x.iter()) {
+                    s += vi * xi;
                 }
                 let f = 2.0 * s / vnorm2;
-                for i in k..m {
-                    q[cj + i] -= f * q[col + i];
+                for (xi, vi) in x.iter_mut().zip(v.iter()) {
+                    *xi -= f * vi;
                 }
+            };
+            for col in tail.chunks_exact_mut(m) {
+                reflect(&mut col[k..]);
             }
-            let mut s = 0.0;
-            for i in k..m {
-                s += q[col + i] * r[i];
-            }
-            let f = 2.0 * s / vnorm2;
-            for i in k..m {
-                r[i] -= f * q[col + i];
-            }
+            reflect(&mut r[k..]);
         }
-        q[col + k] = alpha; // R's diagonal; the reflector below it is no longer needed
+        v[0] = alpha; // R's diagonal; the reflector below it is no longer needed
     }
     for k in (0..p).rev() {
         let mut s = r[k];
@@ -198,18 +193,19 @@ fn nnls_from(
     let mut iterations = 0;
     loop {
         // dual w = aᵀ(b − a·x)
-        ws.resid[..m].copy_from_slice(&b[..m]);
-        for c in 0..n {
-            if x[c] != 0.0 {
-                for i in 0..m {
-                    ws.resid[i] -= a[c * m + i] * x[c];
+        let resid = &mut ws.resid[..m];
+        resid.copy_from_slice(&b[..m]);
+        for (col, &xc) in a.chunks_exact(m).zip(&x[..n]) {
+            if xc != 0.0 {
+                for (ri, &ai) in resid.iter_mut().zip(col) {
+                    *ri -= ai * xc;
                 }
             }
         }
         let mut best = None;
         let mut wmax = 0.0;
-        for c in 0..n {
-            ws.w[c] = (0..m).map(|i| a[c * m + i] * ws.resid[i]).sum();
+        for (c, col) in a.chunks_exact(m).take(n).enumerate() {
+            ws.w[c] = col.iter().zip(resid.iter()).map(|(ai, ri)| ai * ri).sum();
             if !ws.passive[c] && !ws.skip[c] && ws.w[c] > wmax {
                 wmax = ws.w[c];
                 best = Some(c);
@@ -301,21 +297,22 @@ pub(crate) fn pinv_sym(a: &mut [f64], p: usize, v: &mut [f64], out: &mut [f64]) 
                 let t = if theta == 0.0 { 1.0 } else { t };
                 let c = 1.0 / (t * t + 1.0).sqrt();
                 let s = t * c;
-                for k in 0..p {
-                    let (aki, akj) = (a[k * p + i], a[k * p + j]);
-                    a[k * p + i] = c * aki - s * akj;
-                    a[k * p + j] = s * aki + c * akj;
+                let rotate_cols = |m: &mut [f64]| {
+                    for row in m[..p * p].chunks_exact_mut(p) {
+                        let (ri, rj) = (row[i], row[j]);
+                        row[i] = c * ri - s * rj;
+                        row[j] = s * ri + c * rj;
+                    }
+                };
+                rotate_cols(a);
+                let (upper, lower) = a[..p * p].split_at_mut(j * p);
+                let row_i = &mut upper[i * p..(i + 1) * p];
+                for (aik, ajk) in row_i.iter_mut().zip(&mut lower[..p]) {
+                    let (x, y) = (*aik, *ajk);
+                    *aik = c * x - s * y;
+                    *ajk = s * x + c * y;
                 }
-                for k in 0..p {
-                    let (aik, ajk) = (a[i * p + k], a[j * p + k]);
-                    a[i * p + k] = c * aik - s * ajk;
-                    a[j * p + k] = s * aik + c * ajk;
-                }
-                for k in 0..p {
-                    let (vki, vkj) = (v[k * p + i], v[k * p + j]);
-                    v[k * p + i] = c * vki - s * vkj;
-                    v[k * p + j] = s * vki + c * vkj;
-                }
+                rotate_cols(v);
             }
         }
     }

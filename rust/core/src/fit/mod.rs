@@ -8,6 +8,7 @@
 //! flagged and refitted there, so every window gets the reference's answer.
 
 mod dense;
+mod shared;
 mod window;
 
 use crate::cancel::Cancel;
@@ -113,7 +114,7 @@ pub fn fit_windows(problem: &Problem, avar: &[f64], cancel: &Cancel) -> Result<V
     out.par_chunks_mut(CHUNK * width)
         .zip(avar.par_chunks(CHUNK * nt))
         .for_each_init(
-            || window::Window::new(nt, k),
+            || window::Window::new(problem),
             |w, (rec, ys)| {
                 if cancel.is_cancelled() {
                     return;

@@ -3,7 +3,10 @@
 //! reference; each step here names the one it mirrors, and `tests/test_batched_fit.py` checks the two
 //! agree on measured and simulated windows.
 
-use super::dense::{cholesky, forward_solve, nnls, pinv_sym, NnlsWork};
+use super::dense::{cholesky, forward_solve, nnls, NnlsWork};
+use super::shared::{tri_len, tri_row, Shared};
+
+mod covariance;
 use super::{Gls, Problem};
 use std::cmp::Ordering;
 
@@ -30,6 +33,7 @@ pub enum Handback {
 pub(crate) struct Window {
     nt: usize,
     k: usize,
+    sh: Shared,
     y: Vec<f64>,
     model: Vec<f64>,
     nu: Vec<f64>,
@@ -67,11 +71,13 @@ pub(crate) struct Out<'o> {
 }
 
 impl Window {
-    pub(crate) fn new(nt: usize, k: usize) -> Self {
+    pub(crate) fn new(p: &Problem) -> Self {
+        let (nt, k) = (p.n_tau, p.n_terms);
         let z = |n: usize| vec![0.0; n];
         Window {
             nt,
             k,
+            sh: Shared::new(p),
             y: z(nt),
             model: z(nt),
             nu: z(nt),
@@ -197,18 +203,23 @@ impl Window {
             it = pass;
             for i in 0..nt {
                 let m = self.model[i].max(1e-300);
-                let sw = (self.nu[i] / (2.0 * m * m)).sqrt();
-                for c in 0..k {
-                    self.aw[c * nt + i] = a[i * k + c] * sw;
+                self.tmp[i] = (self.nu[i] / (2.0 * m * m)).sqrt();
+                self.bw[i] = self.y[i] * self.tmp[i];
+            }
+            for (aw, col) in self
+                .aw
+                .chunks_exact_mut(nt)
+                .zip(self.sh.design_cm.chunks_exact(nt))
+            {
+                for ((v, &d), &sw) in aw.iter_mut().zip(col).zip(&self.tmp[..nt]) {
+                    *v = d * sw;
                 }
-                self.bw[i] = self.y[i] * sw;
             }
             self.scaled_nnls()?;
             let done = (0..k)
                 .all(|c| (self.new[c] - self.theta[c]).abs() <= p.irls_rtol * self.theta[c].abs());
-            for i in 0..nt {
-                let s: f64 = (0..k).map(|c| a[i * k + c] * self.new[c]).sum();
-                let new_model = s.max(floor);
+            for (i, row) in a.chunks_exact(k).enumerate() {
+                let new_model = row_dot(row, &self.new).max(floor);
                 self.model[i] = if pass == 1 {
                     new_model
                 } else {
@@ -231,61 +242,57 @@ impl Window {
     /// (`_fit_gls.factor` and `_chol`: the correlation matrix, with a growing ridge when rounding made
     /// it indefinite, scaled back).
     fn factor(&mut self, p: &Problem, g: &Gls, theta: &[f64]) -> Result<(), Handback> {
-        let (nt, k, nn) = (self.nt, self.k, self.nt * self.nt);
+        let (nt, k) = (self.nt, self.k);
         let floor = self.floor();
-        for i in 0..nt {
-            let s: f64 = (0..k).map(|c| p.design[i * k + c] * theta[c]).sum();
-            self.model[i] = s.max(floor);
+        for (m, row) in self.model.iter_mut().zip(p.design.chunks_exact(k)) {
+            *m = row_dot(row, theta).max(floor);
         }
         let ns = g.stoch.len();
         for (q, &c) in g.stoch.iter().enumerate() {
             self.th_s[q] = theta[c];
         }
-        // Σ is symmetric and only its lower triangle is read below (Cholesky): only that is formed
-        self.cov.fill(0.0);
-        let mut add = |w: f64, blk: &[f64]| {
+        // Σ is symmetric and only its lower triangle is read below (Cholesky): only that is formed,
+        // packed, from the blocks' packed lower triangles in `sh.blocks` (their order: S[a, b], T[a])
+        let ntri = tri_len(nt);
+        let tri = &mut self.cov[..ntri];
+        tri.fill(0.0);
+        let mut blocks = self.sh.blocks.chunks_exact(ntri);
+        let mut add = |w: f64| {
+            let blk = blocks.next().expect("one packed block per weight");
             if w != 0.0 {
-                for i in 0..nt {
-                    let (c, b) = (
-                        &mut self.cov[i * nt..i * nt + i + 1],
-                        &blk[i * nt..i * nt + i + 1],
-                    );
-                    c.iter_mut().zip(b).for_each(|(c, s)| *c += w * s);
-                }
+                tri.iter_mut().zip(blk).for_each(|(c, s)| *c += w * s);
             }
         };
         for a in 0..ns {
             for b in 0..ns {
-                add(
-                    self.th_s[a] * self.th_s[b],
-                    &g.s_blk[(a * ns + b) * nn..(a * ns + b + 1) * nn],
-                );
+                add(self.th_s[a] * self.th_s[b]);
             }
         }
         if let Some(r) = g.ramp {
             for a in 0..ns {
-                add(theta[r] * self.th_s[a], &g.t_blk[a * nn..(a + 1) * nn]);
+                add(theta[r] * self.th_s[a]);
             }
         }
         for i in 0..nt {
+            let d = tri_row(i) + i;
             let indep = 2.0 * self.model[i] * self.model[i] / self.nu0[i];
             // NumPy's `~(diag > 1e-6 · indep)`: a NaN diagonal counts as too small too
-            let big =
-                self.cov[i * nt + i].partial_cmp(&(BARE_SHARE * indep)) == Some(Ordering::Greater);
+            let big = self.cov[d].partial_cmp(&(BARE_SHARE * indep)) == Some(Ordering::Greater);
             if !big {
-                self.cov[i * nt + i] += indep;
+                self.cov[d] += indep;
             }
         }
         for i in 0..nt {
-            let c = self.cov[i * nt + i];
+            let c = self.cov[tri_row(i) + i];
             if !c.is_finite() {
                 return Err(Handback::Numerical);
             }
             self.tmp[i] = c.max(1e-300).sqrt();
         }
         for i in 0..nt {
-            for j in 0..=i {
-                self.corr[i * nt + j] = self.cov[i * nt + j] / (self.tmp[i] * self.tmp[j]);
+            let row = &self.cov[tri_row(i)..tri_row(i) + i + 1];
+            for (j, &c) in row.iter().enumerate() {
+                self.corr[i * nt + j] = c / (self.tmp[i] * self.tmp[j]);
             }
         }
         for ridge in RIDGES {
@@ -304,19 +311,20 @@ impl Window {
     /// L⁻¹·A into `self.aw` (column-major) and L⁻¹·`rhs` into `self.bw`, L = `self.l`.
     fn whiten(&mut self, p: &Problem, rhs_is_residual: bool) {
         let (nt, k) = (self.nt, self.k);
-        for c in 0..k {
-            let col = &mut self.aw[c * nt..(c + 1) * nt];
-            for (i, v) in col.iter_mut().enumerate() {
-                *v = p.design[i * k + c];
-            }
+        self.aw[..nt * k].copy_from_slice(&self.sh.design_cm);
+        for col in self.aw[..nt * k].chunks_exact_mut(nt) {
             forward_solve(&self.l, nt, col);
         }
-        for i in 0..nt {
-            self.bw[i] = if rhs_is_residual {
-                let s: f64 = (0..k).map(|c| p.design[i * k + c] * self.theta[c]).sum();
-                self.y[i] - s
+        for ((b, &y), row) in self
+            .bw
+            .iter_mut()
+            .zip(&self.y)
+            .zip(p.design.chunks_exact(k))
+        {
+            *b = if rhs_is_residual {
+                y - row_dot(row, &self.theta)
             } else {
-                self.y[i]
+                y
             };
         }
         forward_solve(&self.l, nt, &mut self.bw);
@@ -332,11 +340,17 @@ impl Window {
     /// The largest move of the model between `old` and `new`, relative to the new model (`_fit_gls.change`).
     fn change(&self, p: &Problem, new: &[f64], old: &[f64], floor: f64) -> f64 {
         let k = self.k;
-        (0..self.nt)
-            .map(|i| {
-                let row = &p.design[i * k..(i + 1) * k];
-                let d: f64 = (0..k).map(|c| row[c] * (new[c] - old[c])).sum();
-                let m: f64 = (0..k).map(|c| row[c] * new[c]).sum();
+        let (new, old) = (&new[..k], &old[..k]);
+        p.design
+            .chunks_exact(k)
+            .map(|row| {
+                let d: f64 = row
+                    .iter()
+                    .zip(new)
+                    .zip(old)
+                    .map(|((r, n), o)| r * (n - o))
+                    .sum();
+                let m = row_dot(row, new);
                 d.abs() / m.max(floor)
             })
             .fold(f64::NEG_INFINITY, f64::max)
@@ -415,172 +429,30 @@ impl Window {
         Ok(it)
     }
 
-    /// χ² of the whitened residuals and the coefficient covariance (AᵀΣ⁻¹A)⁻¹ over the active terms;
-    /// each inactive term's variance as if freed alone (the end of `_fit_gls`).
-    fn gls_covariance(&mut self, p: &Problem, g: &Gls, cov: &mut [f64]) -> Result<f64, Handback> {
-        let theta = std::mem::take(&mut self.theta);
-        let factored = self.factor(p, g, &theta);
-        self.theta = theta;
-        factored?;
-        self.whiten(p, true);
-        let chi2 = self.bw.iter().map(|v| v * v).sum();
-        self.covariance_over_active(cov, |w| {
-            let (nt, q) = (w.nt, w.idx.len());
-            for a in 0..q {
-                for b in 0..q {
-                    let (ca, cb) = (w.idx[a] * nt, w.idx[b] * nt);
-                    w.gram[a * q + b] = (0..nt).map(|i| w.aw[ca + i] * w.aw[cb + i]).sum();
-                }
-            }
-            pinv_sym(&mut w.gram, q, &mut w.gv, &mut w.ginv);
-        });
-        Ok(chi2)
-    }
-
-    /// `cov[idx, idx] = B(idx)` for the active terms idx, and for each inactive k `cov[k, k] =
-    /// B(idx ∪ k)[k, k]` — B the block `block` leaves in `self.ginv` for the terms in `self.idx`;
-    /// NaN elsewhere (the reference's layout).
-    fn covariance_over_active(&mut self, cov: &mut [f64], block: impl Fn(&mut Self)) {
-        let k = self.k;
-        cov.fill(f64::NAN);
-        self.idx.clear();
-        self.idx.extend((0..k).filter(|&c| self.theta[c] > 0.0));
-        let n_active = self.idx.len();
-        for e in 0..=k {
-            // e = 0: the active block; e = c + 1: inactive term c freed alone
-            let extra = match e.checked_sub(1) {
-                None => None,
-                Some(c) if self.theta[c] > 0.0 => continue,
-                Some(c) => Some(c),
-            };
-            self.idx.truncate(n_active);
-            if let Some(c) = extra {
-                self.idx.push(c);
-            }
-            let q = self.idx.len();
-            if q == 0 {
-                continue;
-            }
-            block(self);
-            match extra {
-                None => {
-                    for a in 0..q {
-                        for b in 0..q {
-                            cov[self.idx[a] * k + self.idx[b]] = self.ginv[a * q + b];
-                        }
-                    }
-                }
-                Some(c) => cov[c * k + c] = self.ginv[q * q - 1],
-            }
-        }
-    }
-
-    /// The end of `_fit_irls`: z and χ² under independent weights, and the sandwich covariance
-    /// (AᵀWA)⁻¹ AᵀWΣWA (AᵀWA)⁻¹ with Σ from the octave-correlation model (`_estimate_correlation`).
-    fn irls_covariance(&mut self, p: &Problem, cov: &mut [f64]) -> f64 {
-        let (nt, k) = (self.nt, self.k);
-        let floor = self.floor();
-        let any = self.theta.iter().any(|&v| v != 0.0);
-        let mut chi2 = 0.0;
-        for i in 0..nt {
-            let row = &p.design[i * k..(i + 1) * k];
-            let m = (0..k)
-                .map(|c| row[c] * self.theta[c])
-                .sum::<f64>()
-                .max(floor);
-            self.model[i] = m;
-            let w = self.nu[i] / (2.0 * m * m);
-            self.bw[i] = w; // the weights, kept for the sandwich
-            let z = (self.y[i] - m) * w.sqrt();
-            chi2 += z * z;
-            // the mixture's octave correlation at this τ: the terms' shares of the model (of A when θ = 0)
-            let part = |c: usize| if any { row[c] * self.theta[c] } else { row[c] };
-            let total = (0..k).map(part).sum::<f64>().max(1e-300);
-            let rho = (0..k).map(|c| part(c) / total * p.rho[c]).sum::<f64>();
-            self.tmp[i] = rho.clamp(0.0, 0.99);
-        }
-        for i in 0..nt {
-            let sd_i = (2.0 / self.nu[i]).sqrt() * self.model[i];
-            for j in 0..nt {
-                let dist = (p.log2_tau[i] - p.log2_tau[j]).abs();
-                let corr = if dist == 0.0 {
-                    1.0
-                } else {
-                    (self.tmp[i] * self.tmp[j]).sqrt().powf(dist)
-                };
-                let sd_j = (2.0 / self.nu[j]).sqrt() * self.model[j];
-                self.corr[i * nt + j] = corr * (sd_i * sd_j);
-            }
-        }
-        self.covariance_over_active(cov, |w| w.sandwich(p));
-        chi2
-    }
-
-    /// The sandwich for the terms in `self.idx` into `self.ginv` (weights in `self.bw`, Σ in `self.corr`).
-    fn sandwich(&mut self, p: &Problem) {
-        let (nt, k, q) = (self.nt, self.k, self.idx.len());
-        for (b, &c) in self.idx.iter().enumerate() {
-            for i in 0..nt {
-                self.aw[b * nt + i] = p.design[i * k + c] * self.bw[i];
-            }
-        }
-        for a in 0..q {
-            for b in 0..q {
-                let cb = self.idx[b];
-                self.gram[a * q + b] = (0..nt)
-                    .map(|i| self.aw[a * nt + i] * p.design[i * k + cb])
-                    .sum();
-            }
-        }
-        pinv_sym(&mut self.gram, q, &mut self.gv, &mut self.bread);
-        // meat = awᵀ Σ aw
-        for b in 0..q {
-            for i in 0..nt {
-                self.l[b * nt + i] = (0..nt)
-                    .map(|j| self.corr[i * nt + j] * self.aw[b * nt + j])
-                    .sum();
-            }
-        }
-        for a in 0..q {
-            for b in 0..q {
-                self.meat[a * q + b] = (0..nt)
-                    .map(|i| self.aw[a * nt + i] * self.l[b * nt + i])
-                    .sum();
-            }
-        }
-        for a in 0..q {
-            for b in 0..q {
-                self.gram[a * q + b] = (0..q)
-                    .map(|c| self.bread[a * q + c] * self.meat[c * q + b])
-                    .sum();
-            }
-        }
-        for a in 0..q {
-            for b in 0..q {
-                self.ginv[a * q + b] = (0..q)
-                    .map(|c| self.gram[a * q + c] * self.bread[c * q + b])
-                    .sum();
-            }
-        }
-    }
-
     /// ν of the model mixture at every τ: (Σ s_k)² / Σ s_k²/ν_k (`_fit_irls.edf_of`).
     fn mixture_edf(&mut self, p: &Problem) {
         let k = self.k;
-        for i in 0..self.nt {
+        let rows = p.design.chunks_exact(k).zip(p.nu_terms.chunks_exact(k));
+        for (nu, (row, nu_row)) in self.nu.iter_mut().zip(rows) {
             let (mut tot, mut den) = (0.0, 0.0);
-            for c in 0..k {
-                let s = p.design[i * k + c] * self.theta[c];
+            for ((&a, &t), &n) in row.iter().zip(&self.theta[..k]).zip(nu_row) {
+                let s = a * t;
                 tot += s;
-                den += s * s / p.nu_terms[i * k + c];
+                den += s * s / n;
             }
-            self.nu[i] = if den > 0.0 {
+            *nu = if den > 0.0 {
                 tot * tot / den
             } else {
-                p.nu_terms[i * k]
+                nu_row[0]
             };
         }
     }
+}
+
+/// Σ row[c]·v[c] in order (one row of the design matrix times a coefficient vector).
+#[inline]
+fn row_dot(row: &[f64], v: &[f64]) -> f64 {
+    row.iter().zip(v).map(|(a, b)| a * b).sum()
 }
 
 /// The exponent e of `math.frexp(x)` (x = f·2^e, 0.5 ≤ f < 1) for a positive finite x.
