@@ -279,30 +279,23 @@ _READ_ONCE = (
 )
 
 
-def row_scale(n: int, scratch: Path, tmp: Path) -> dict:
-    """``allanite report`` of an (n, 3) float64 .npy in a fresh process: wall, CPU, peak RSS against the target."""
+def _report_cmd(path: Path, out: Path) -> list:
+    return [sys.executable, "-m", "allanite", "report", str(path), "--fs", "100", "--unit", "deg/s", "--out", str(out)]
+
+
+def row_scale(n: int, scratch: Path, tmp: Path, baseline: Path | None = None) -> dict:
+    """``allanite report`` of an (n, 3) float64 .npy in a fresh process: wall, CPU, peak RSS against the target;
+    with ``baseline``, the baseline checkout's report of the same file in the same run."""
     path = scratch / f"allanite_scale_{os.getpid()}.npy"
+    before = None
     try:
         _write_scale_record(path, n)
         size = path.stat().st_size
         out = tmp / "scale"
-        r = run_timed(
-            [
-                sys.executable,
-                "-m",
-                "allanite",
-                "report",
-                str(path),
-                "--fs",
-                "100",
-                "--unit",
-                "deg/s",
-                "--out",
-                str(out),
-            ],
-            _env(REPO / "python"),
-            3600,
-        )
+        r = run_timed(_report_cmd(path, out), _env(REPO / "python"), 3600)
+        if baseline is not None:
+            b = run_timed(_report_cmd(path, tmp / "scale_before"), _env(baseline), 3600)
+            before = {k: b[k] for k in ("wall_s", "cpu_s", "peak_rss_mb", "status")}
         # the same run's reference: one read of the whole file (one axis's column through the file, as the
         # report reads each axis), in a fresh process
         read_once = run_timed([sys.executable, "-c", _READ_ONCE, str(path)], _env(REPO / "python"), 900)
@@ -324,6 +317,7 @@ def row_scale(n: int, scratch: Path, tmp: Path) -> dict:
         "by_axis": record.get("analysed_axis_by_axis"),
         "memory_estimate_mb": (record.get("memory_estimate_bytes") or 0) / 2**20,
         "log_tail": r["stderr_tail"],
+        "before": before,
     }
 
 
@@ -585,9 +579,15 @@ def write_md(res: dict, path: Path) -> None:
     if sc:
         L.append(
             f"| scale: `allanite report` of a {sc['samples']:.0e} × {sc['axes']} float64 .npy ({sc['file_gb']:.1f} GB, "
-            f"memory-mapped) | before the chunked-phase core (27f2226, load 19): 779 s (CPU 152 s), peak RSS 2578 MB; "
-            f"before the by-axis report: every axis copied at once (10⁷ × 3: peak RSS 997 MB) | "
-            f"{'done' if sc['status'] == 0 else sc['status']} in {sc['wall_s']:.0f} s (CPU {sc['cpu_s']:.0f} s), "
+            f"memory-mapped) | "
+            + (
+                f"same run, the baseline: {sb['wall_s']:.0f} s (CPU {sb['cpu_s']:.0f} s), peak RSS "
+                f"{sb['peak_rss_mb']:.0f} MB — CPU {sb['cpu_s'] / max(sc['cpu_s'], 1e-9):.2f}× the report's | "
+                if (sb := sc.get("before"))
+                else "before the chunked-phase core (27f2226, load 19): 779 s (CPU 152 s), peak RSS 2578 MB; "
+                "before the by-axis report: every axis copied at once (10⁷ × 3: peak RSS 997 MB) | "
+            )
+            + f"{'done' if sc['status'] == 0 else sc['status']} in {sc['wall_s']:.0f} s (CPU {sc['cpu_s']:.0f} s), "
             f"peak RSS {sc['peak_rss_mb']:.0f} MB | target ≤ 60 s, RSS ≤ {sc['target_rss_mb']:.0f} MB; "
             + (
                 f"same run, one read of the file: {sc['read_once_wall_s']:.1f} s (CPU {sc['read_once_cpu_s']:.1f} s) — "
@@ -703,7 +703,7 @@ def main() -> int:
             elif name == "hop1":
                 res["rows"]["hop1"] = row_hop1(data, t)
             elif name == "scale":
-                res["rows"]["scale"] = row_scale(args.scale_samples, args.scratch or t, t)
+                res["rows"]["scale"] = row_scale(args.scale_samples, args.scratch or t, t, args.baseline)
             if args.rows is not None:
                 now = {
                     "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),

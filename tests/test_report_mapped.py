@@ -19,9 +19,10 @@ import pytest
 
 import allanite
 from allanite import _mapped
-from allanite._mapped import column, file_layout, read_rows
+from allanite._mapped import column, columns, file_layout, read_rows
 from allanite.estimators import _long_id, confidence, noise_id
 from allanite.report import axes, budget, build_report
+from allanite.report import build as report_build
 from allanite.report.build import from_log
 
 N = 120_000
@@ -73,6 +74,42 @@ def test_rows_and_columns_of_a_mapped_npy_come_from_the_file(npy):
         assert _mapped_rss_kb(npy) == 0  # the checks above compared against `full`, never touching `x`
 
 
+def test_one_pass_over_the_file_gives_each_axis_exactly(npy):
+    x = np.load(npy, mmap_mode="r")
+    for view in (x, x[7:, 1:], x[3:999:4]):
+        for chunk in (1001, 4096, None):
+            got = columns(view, list(range(view.shape[1]))[::-1], chunk=chunk)
+            for k, c in zip(list(range(view.shape[1]))[::-1], got):
+                assert c.flags.c_contiguous and np.array_equal(c, column(view, k, chunk=777))
+    assert np.array_equal(columns(x[:, 2], [None])[0], column(x, 2))
+    if sys.platform.startswith("linux"):
+        assert _mapped_rss_kb(npy) == 0
+
+
+def test_axes_read_in_one_pass_where_the_budget_holds_them(npy, monkeypatch):
+    """The report reads as many axes per pass as the budget holds beside one axis's analysis, with the same
+    numbers as one pass per axis."""
+    n = N
+    cost = budget.check_report_memory(n, 3, 12_000, 3_000, 10, 10, 5, False, record=axes.record_bytes(n, 3, True))
+    one = cost["total"]
+    assert axes.axes_per_read(n, 3, one, one) == 1
+    assert axes.axes_per_read(n, 3, one, one + 8 * n) == 2
+    assert axes.axes_per_read(n, 3, one, 10 * one) == 3
+    passes: list[list] = []
+    monkeypatch.setattr(axes, "columns", lambda x, ks: passes.append(ks) or columns(x, ks))
+    x = np.load(npy, mmap_mode="r")
+    kw = dict(window=12_000, hop=3_000, progress=False, fit=False)
+    together = build_report(x, 100.0, **kw)
+    assert passes == [[0, 1, 2]]
+    monkeypatch.setattr(report_build, "axes_per_read", lambda *a: 1)
+    apart = build_report(x, 100.0, **kw)
+    assert passes[1:] == [[0], [1], [2]]
+    for a, b in ((together.static, apart.static), (together.dynamic, apart.dynamic)):
+        for name in ("avar", "edf", "ci_low", "ci_high", "alpha"):
+            va, vb = getattr(a, name), getattr(b, name)
+            assert (va is None and vb is None) or np.array_equal(va, vb), name
+
+
 @pytest.fixture(scope="module")
 def reports(npy):
     log = allanite.read_log(npy, fs=100.0, unit="deg/s")
@@ -104,7 +141,9 @@ def test_axis_by_axis_gives_the_all_axes_numbers(reports):
 
 def test_the_report_of_a_mapped_record_never_holds_all_its_axes(npy, monkeypatch):
     """Traced allocations (NumPy's) stay below one copy of every axis, which the all-axes path makes: one
-    axis at a time, read in small chunks, identified in chunks (what a long record gets)."""
+    axis at a time, read in small chunks, identified in chunks (what a long record gets, whose axes the
+    budget does not hold together: one axis per pass)."""
+    monkeypatch.setattr(report_build, "axes_per_read", lambda *a: 1)
     monkeypatch.setattr(_mapped, "CHUNK_BYTES", 1 << 16)
     monkeypatch.setattr(noise_id, "LONG_SAMPLES", 1000)
     monkeypatch.setattr(_long_id, "CHUNK", 4096)
@@ -167,3 +206,12 @@ def test_the_chunked_noise_identification_agrees_with_the_whole_array(kind, monk
             assert got[d] == (pytest.approx(noise_id._lag1_acf(w), abs=1e-12), w.size)
     for m in (5, 1000, 9000, 19_000):
         assert lr.rn(m) == pytest.approx(noise_id._rn(phase, m), rel=1e-11)
+
+
+def test_the_cores_block_acf_sums_refuse_a_factor_longer_than_the_record():
+    from allanite import _core
+
+    with pytest.raises(allanite.AllaniteError, match=r"averaging factor 4 for 3 samples: 1 ≤ m ≤ samples"):
+        _core.block_lag1_sums(np.arange(3.0), 0.0, [4], 2, 1)
+    with pytest.raises(allanite.AllaniteError, match=r"averaging factor 0 for 3 samples"):
+        _core.block_lag1_sums(np.arange(3.0), 0.0, [1, 0], 2, 1)

@@ -76,6 +76,16 @@ def compensated_sums(
 ) -> list[tuple[float, float]]:
     """Neumaier's compensated sum of each column continued from state[(sum, compensation) per axis]."""
 
+def block_lag1_sums(
+    x: npt.NDArray[np.float64],
+    mu: float,
+    ms: Sequence[int],
+    dmax: int,
+    workers: int,
+) -> npt.NDArray[np.float64]:
+    """(len(ms), dmax + 1, 5): Σw, Σw², Σ w_j w_(j+1), first and last w of the block averages of x − mu
+    at each m and their differences up to dmax (NaN where empty)."""
+
 def parse_decimal_table(
     text: bytes,
     offset: int,

@@ -26,10 +26,11 @@ array([ 1.,  4.,  7., 10.])
 from __future__ import annotations
 
 import mmap
+from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["CHUNK_BYTES", "file_layout", "read_rows", "column"]
+__all__ = ["CHUNK_BYTES", "file_layout", "read_rows", "column", "columns"]
 
 #: Bytes read from the file at a time (rows × row stride).
 CHUNK_BYTES = 1 << 23
@@ -55,9 +56,11 @@ def file_layout(x) -> tuple[str, int] | None:
     return str(filename), int(offset) + int(start)
 
 
-def _file_rows(x, a: int, b: int) -> np.ndarray | None:
-    """Rows ``a:b`` of the mapped ``x`` (``0 <= a < b <= len(x)``) read from its file into a fresh buffer, as a
-    view of it with ``x``'s strides; None where ``x`` is not a mapped ``.npy`` or the file is shorter."""
+def _file_rows(x, a: int, b: int, buf: np.ndarray | None = None) -> np.ndarray | None:
+    """Rows ``a:b`` of the mapped ``x`` (``0 <= a < b <= len(x)``) read from its file into a fresh buffer (or
+    into ``buf``, a 1-D array of ``x``'s dtype, where it is long enough: a reader of many chunks reuses one
+    buffer instead of faulting in fresh pages for each), as a view of it with ``x``'s strides; None where ``x``
+    is not a mapped ``.npy`` or the file is shorter."""
     lay = file_layout(x)
     if lay is None:
         return None
@@ -66,7 +69,9 @@ def _file_rows(x, a: int, b: int) -> np.ndarray | None:
     # the bytes from row a's first element to row b − 1's last: whole row strides but the last row's
     last = (x.shape[1] - 1) * x.strides[1] + x.itemsize if x.ndim == 2 else x.itemsize
     nbytes = (b - a - 1) * stride + last
-    buf = np.empty(-(-nbytes // x.itemsize), dtype=x.dtype)
+    size = -(-nbytes // x.itemsize)
+    if buf is None or buf.size < size or buf.dtype != x.dtype:
+        buf = np.empty(size, dtype=x.dtype)
     with open(name, "rb") as f:
         f.seek(off + a * stride)
         got = f.readinto(buf.view(np.uint8)[:nbytes].data)
@@ -87,16 +92,24 @@ def column(x, k: int | None = None, *, chunk: int | None = None, dtype=np.float6
     """Column ``k`` of a 2-D ``x`` (``k`` None: the 1-D ``x`` itself) as a contiguous array of ``dtype``,
     read ``chunk`` rows at a time (default: :data:`CHUNK_BYTES` of file) — for a mapped ``.npy`` from the
     file, never touching the map; for any other array a plain copy."""
+    return columns(x, [k], chunk=chunk, dtype=dtype)[0]
+
+
+def columns(x, ks: Sequence[int | None], *, chunk: int | None = None, dtype=np.float64) -> list[np.ndarray]:
+    """:func:`column` of each of ``ks`` in one pass over the file: each chunk of rows is read once and every
+    column asked for copied out of it — the same values as one :func:`column` call per axis, with one read
+    of the file instead of one per axis."""
     n = int(x.shape[0])
     if file_layout(x) is None or n == 0:
-        src = x if k is None else x[:, k]
-        return np.array(src, dtype=dtype, order="C")
+        return [np.array(x if k is None else x[:, k], dtype=dtype, order="C") for k in ks]
     rows = chunk if chunk is not None else max(1, CHUNK_BYTES // max(1, x.strides[0]))
-    out = np.empty(n, dtype=dtype)
+    outs = [np.empty(n, dtype=dtype) for _ in ks]
+    buf = np.empty(-(-min(n, rows) * x.strides[0] // x.itemsize) + 1, dtype=x.dtype)
     for a in range(0, n, rows):
         b = min(n, a + rows)
-        block = _file_rows(x, a, b)
+        block = _file_rows(x, a, b, buf)
         if block is None:
             block = x[a:b]
-        out[a:b] = block if k is None else block[:, k]
-    return out
+        for out, k in zip(outs, ks):
+            out[a:b] = block if k is None else block[:, k]
+    return outs

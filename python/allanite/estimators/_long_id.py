@@ -8,9 +8,11 @@ their running sums. On a record of 10⁸ samples each of those is 800 MB, and se
 
 :class:`LongRate` forms the same quantities a chunk at a time from the caller's samples: the block averages
 and the phase bit for bit as the whole-array code forms them (the same elements, a sequential cumulative
-sum continued across chunks); the sums and means over the record (ACF, AVAR, MVAR) are added chunk by
-chunk, and the block averages at a multiple of the last m are averages of its averages (one pass over the
-record for a whole octave grid), so they differ from the whole-array code's by rounding only (a few units in
+sum continued across chunks); the sums and means over the record (AVAR, MVAR) are added chunk by chunk,
+the lag-1 autocorrelation's sums are formed in the Rust core in one pass per m without holding the block
+averages (``rust/core/src/block_acf.rs``; every m of a call at once, in parallel), and the block averages
+at a multiple of the last m are averages of its averages (one pass over the record for a whole octave
+grid), so they differ from the whole-array code's by rounding only (a few units in
 the last place — α is rounded to an integer from them). The phase is held (8 bytes a sample) only where an
 R(n) is needed, and then once for every m.
 """
@@ -18,6 +20,9 @@ R(n) is needed, and then once for every m.
 from __future__ import annotations
 
 import numpy as np
+
+from .. import _core
+from .._validate import resolve_workers
 
 __all__ = ["LONG_SAMPLES", "CHUNK", "LongRate"]
 
@@ -35,6 +40,7 @@ class LongRate:
         self.n = int(arr.size)
         self._phase: np.ndarray | None = None
         self._coarse: tuple[int, np.ndarray] | None = None  # (m, block averages at m): see all_means
+        self._sums: dict[tuple[int, int], np.ndarray] = {}  # (m, dmax): the core's sums, see lag1_acfs
 
     def means(self, m: int, k0: int, k1: int) -> np.ndarray:
         """Averages of the blocks k0 … k1 − 1 of m samples: the rows of ``rate[:k·m].reshape(k, m).mean(1)``."""
@@ -58,44 +64,36 @@ class LongRate:
             self._coarse = (m, z)
         return z
 
+    def prefetch(self, ms, dmax: int = 2) -> None:
+        """Form the sums :meth:`lag1_acfs` needs at every m of ``ms`` in one core call (the factors in
+        parallel on the core's threads, ``ALLANITE_NUM_THREADS``); :meth:`lag1_acfs` then reads them."""
+        todo = sorted({int(m) for m in ms} - {m for m, d in self._sums if d == dmax})
+        if not todo:
+            return
+        sums = _core.block_lag1_sums(self.arr, self.mu, todo, dmax, resolve_workers(None))
+        for m, row in zip(todo, sums):
+            self._sums[(m, dmax)] = row
+
     def lag1_acfs(self, m: int, dmax: int = 2) -> list[tuple[float, int]]:
         """[(lag-1 autocorrelation with Stable32's (L − 1)/L factor, L) of the d-th difference of the block
         averages at m, for d = 0 … dmax] — :func:`allanite.estimators.confidence._lag1_acf` in one pass
-        over the record: each difference's sum, sum of squares and lag-1 products, a chunk at a time
-        (``einsum``, not a threaded BLAS dot: on a busy machine the threads cost ten times the work).
+        over the record in the core (``rust/core/src/block_acf.rs``): each difference's sum, sum of squares,
+        lag-1 products and end values, without holding the block averages (the record's length at m = 1).
         Sum of squares about the mean = Σw² − Lμ², which loses nothing here: the block averages of a
         record less its mean, and their differences, average to ≈ 0."""
+        self.prefetch([m], dmax)
+        stats = self._sums[(int(m), dmax)]
         k = self.n // m
-        per = max(dmax + 2, self.chunk // m)
-        stats = np.zeros((dmax + 1, 3))  # Σw, Σw², Σ w_i w_(i+1)
-        ends: list[list[float | None]] = [[None, None] for _ in range(dmax + 1)]  # first, last w of each
-        tail = np.empty(0)  # the last dmax + 1 block averages of the chunk before: continuity
-        for a in range(0, k, per):
-            z = np.concatenate((tail, self.means(m, a, min(k, a + per))))
-            w = z
-            for d in range(dmax + 1):
-                if d:
-                    w = np.diff(w)
-                # the first len(tail) − d elements of w were counted with the chunk before (w spans it)
-                own = w[max(0, tail.size - d) :] if a else w
-                if own.size == 0:
-                    continue
-                if ends[d][0] is None:
-                    ends[d][0] = float(own[0])
-                ends[d][1] = float(own[-1])
-                pairs = w[max(0, tail.size - d - 1) :] if a else w  # the pair across the chunk's start too
-                stats[d] += (own.sum(), np.einsum("i,i->", own, own), np.einsum("i,i->", pairs[:-1], pairs[1:]))
-            tail = z[-(dmax + 1) :]
         out = []
         for d in range(dmax + 1):
             length = k - d
-            if length < 1 or ends[d][0] is None:
+            if length < 1:
                 out.append((0.0, max(length, 0)))
                 continue
-            s1, s2, c = stats[d]
+            s1, s2, c, first, last = (float(v) for v in stats[d])
             mu = s1 / length
             den = s2 - length * mu * mu
-            num = c - mu * (2.0 * s1 - ends[d][0] - ends[d][1]) + (length - 1) * mu * mu
+            num = c - mu * (2.0 * s1 - first - last) + (length - 1) * mu * mu
             out.append((0.0 if den <= 0.0 else num / den * (length - 1) / length, length))
         return out
 

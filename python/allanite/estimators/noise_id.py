@@ -322,6 +322,8 @@ def _identify_each(phase, rate, m_arr, *, phase_input, estimator, method, b1_n, 
     (:class:`~allanite.estimators._long_id.LongRate`; ``phase`` and ``rate`` unused)."""
     n_phase = phase.size if long is None else long.n + 1
     out = np.empty(m_arr.shape, dtype=np.int64)
+    if long is not None and method != "b1":  # the ACF sums of every long m in one parallel core call
+        long.prefetch([mi for mi in m_arr.tolist() if long.n // mi > max(long.chunk, ACF_MIN_POINTS - 1)])
     for i, mi in enumerate(m_arr.tolist()):
         points = (n_phase - 1) // mi  # τ-intervals in the record, for either kind of data
         use_acf = method == "acf" or (method == "auto" and points >= ACF_MIN_POINTS)

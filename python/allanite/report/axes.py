@@ -20,11 +20,12 @@ import dataclasses
 
 import numpy as np
 
-from .._mapped import column, file_layout
+from .._mapped import column, columns, file_layout
+from .._validate import resolve_max_memory
 from ..analysis import avar, davar
 from ..estimators.noise_id import LONG_SAMPLES
 
-__all__ = ["record_bytes", "wants_by_axis", "analyse_by_axis", "stack", "axis_column"]
+__all__ = ["record_bytes", "wants_by_axis", "axes_per_read", "analyse_by_axis", "stack", "axis_column"]
 
 #: Samples × axes beyond which the core streams its sums: below, a static or DAVAR call builds a double-word
 #: phase (16 bytes a sample) of every axis it is given (rust/core; allanite.dask's docstring); beyond, the static
@@ -55,6 +56,13 @@ def wants_by_axis(x) -> bool:
     return file_layout(x) is not None
 
 
+def axes_per_read(n: int, n_axes: int, total: int, max_memory) -> int:
+    """Axes read from the record in one pass: as many as the memory budget holds beside the report's
+    ``total`` (its cost with one axis in memory) — each further axis held costs its 8 bytes a sample."""
+    spare = resolve_max_memory(max_memory) - int(total)
+    return int(max(1, min(n_axes, 1 + spare // max(1, 8 * int(n)))))
+
+
 def axis_column(x, k: int) -> np.ndarray:
     """Axis ``k`` of the (samples, axes) record ``x`` as a contiguous float64 array (from the file for a
     mapped ``.npy``)."""
@@ -77,16 +85,21 @@ def stack(results: list):
 
 
 def analyse_by_axis(x, fs, *, input, taus, static_est, static_extra, confidence, window, hop, grid, dynamic_est,
-                    max_memory, progress):  # fmt: skip
-    """(static result with intervals, DAVAR) of every axis of ``x``, one axis in memory at a time.
-    ``progress``: told of three steps (``step(text)``, ``add(n)``), one per axis for the first three."""
+                    max_memory, progress, group=1):  # fmt: skip
+    """(static result with intervals, DAVAR) of every axis of ``x``, one axis analysed at a time; the axes
+    read ``group`` at a time in one pass over the record (:func:`axes_per_read`; each axis dropped once
+    analysed). ``progress``: told of three steps (``step(text)``, ``add(n)``), one per axis for the first
+    three."""
     statics, dynamics = [], []
     n_axes = x.shape[1]
+    held: list[np.ndarray] = []  # the axes read in this pass and not analysed yet
     for k in range(n_axes):
         if k < STEPS:
             which = f"axis {k + 1}" if k < STEPS - 1 or n_axes == STEPS else f"axes {k + 1}–{n_axes}"
             progress.step(f"{which} of {n_axes}: static Allan deviation, intervals, dynamic Allan variance")
-        y = axis_column(x, k)
+        if not held:  # one pass over the record for the next `group` axes
+            held = columns(x, list(range(k, min(n_axes, k + max(1, group)))))
+        y = held.pop(0)
         s = avar(y, fs, input=input, taus=taus, estimator=static_est, **static_extra)
         statics.append(s.with_confidence(y, confidence=confidence))
         dynamics.append(

@@ -44,7 +44,7 @@ from ..model.effects import EFFECTS
 from ..model.terms import TERMS
 from ..units import parse_unit
 from . import _worker
-from .axes import analyse_by_axis, axis_column, record_bytes, wants_by_axis
+from .axes import analyse_by_axis, axes_per_read, axis_column, record_bytes, wants_by_axis
 from .budget import check_report_memory
 from .fmt import json_number
 from .forecasting import check_forecast_options, plan_forecast, run_forecast
@@ -278,7 +278,7 @@ def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max
         static, dynamic = analyse_by_axis(
             x, fs, input=input, taus=taus, static_est=static_est, static_extra=extra, confidence=confidence,
             window=window, hop=hop, grid=dynamic_grid, dynamic_est=dynamic_est, max_memory=max_memory,
-            progress=progress,
+            progress=progress, group=axes_per_read(n, n_axes, cost["total"], max_memory),
         )  # fmt: skip
         on_dynamic(static, dynamic)
     else:

@@ -5,6 +5,7 @@
 
 pub mod allan;
 pub mod angle;
+pub mod block_acf;
 pub mod cancel;
 mod chunked;
 pub mod deviations;

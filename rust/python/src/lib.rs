@@ -317,6 +317,30 @@ fn compensated_sums(
     }))
 }
 
+/// Sums of the lag-1 autocorrelation of the block averages of `x` less `mu` at each of `ms` and of
+/// their differences up to `dmax` (allanite-core `block_acf`): shape (len(ms), dmax + 1, 5) — Σw, Σw²,
+/// Σ w_j w_(j+1), first and last w (NaN where empty).
+#[pyfunction]
+#[pyo3(signature = (x, mu, ms, dmax, workers))]
+fn block_lag1_sums<'py>(
+    py: Python<'py>,
+    x: PyReadonlyArray1<'py, f64>,
+    mu: f64,
+    ms: Vec<usize>,
+    dmax: usize,
+    workers: usize,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let s = contiguous_one(py, &x)?;
+    let values = run_interruptible(py, workers, |cancel| {
+        allanite_core::block_acf::block_lag1_sums(s, mu, &ms, dmax, cancel)
+    })?;
+    to_3d(
+        py,
+        (ms.len(), dmax + 1, allanite_core::block_acf::STATS),
+        values,
+    )
+}
+
 /// Σ (X[i+2m] − 2X[i+m] + X[i])² in quanta² per plan item (m, i0, i1) and axis, X the exact angle of
 /// the chunks given (rate samples (samples, axes) C-contiguous, each with its record start and exact
 /// angle offset per axis: whole quanta and remainder), q = 2^q_exp: shape (items, axes). The kernel
@@ -899,6 +923,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;
     m.add_function(wrap_pyfunction!(part_grid, m)?)?;
     m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;
+    m.add_function(wrap_pyfunction!(block_lag1_sums, m)?)?;
     m.add_function(wrap_pyfunction!(parse_decimal_table, m)?)?;
     m.add_function(wrap_pyfunction!(angle_term_sums, m)?)?;
     m.add_function(wrap_pyfunction!(theo1_static, m)?)?;
