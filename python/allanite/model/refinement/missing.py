@@ -43,13 +43,15 @@ from scipy.linalg import solve_triangular
 from scipy.stats import t as t_dist
 
 from ...analysis import avar
-from .. import channels, lines, outliers, tracing
+from .. import channels, lines, noise_level, outliers, tracing
 from ..terms import design_matrix
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
+from .changes import locate
 from .curvefit import Curve, Solution, base_name, theta_terms, upper_theta
 from .levels import alpha
 from .scoring import MATERIAL_Z, curve_change_z
+from .words import span_text
 
 __all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS", "allan_family"]
 
@@ -81,6 +83,8 @@ class MissingContext:
     unit: str | None = None
     #: what the checks computed once from the final samples (the Welch PSD of :func:`_band`)
     memo: dict = field(default_factory=dict)
+    #: times (s) of the change points refine accepted: the noise level is checked between them
+    change_times: list = field(default_factory=list)
 
 
 def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
@@ -326,6 +330,66 @@ def _lines_move_curve(ctx: MissingContext, freqs: np.ndarray, amps: np.ndarray) 
     return curve_change_z(ctx.curve, ctx.sol, change)[0] >= MATERIAL_Z
 
 
+def _fit(ctx: MissingContext, a: float) -> list[dict]:
+    """Curve-only input: the GLS χ² of the whole thinned curve once the model's fitted directions are refitted
+    (:meth:`allanite.model.tracing.ScoreTest.gls_chi2`, two-sided), against its bootstrap under the final
+    model (the draws of the ``"allan"`` check). Where it rejects, the runs of same-signed |z| > 2 on the curve
+    are the regions (the largest Σz² first; the whole τ range where the misfit is spread thin), whichever side
+    of the model the curve lies. With samples its share goes to the checks that need them
+    (:data:`.levels.SAMPLE_CHECKS`): the dense curve's neighbouring τ are contrasts whose null distribution the
+    bootstrap does not reproduce (see :func:`allan_family`)."""
+    if ctx.y is not None:
+        return []
+    test = curve_test(ctx.curve, ctx.thin, ctx.sol, ctx.start, ctx.effects, ctx.exact)
+    stat = test.gls_chi2(ctx.curve.subset(ctx.thin).avar)
+    null = np.sort(test.null_chi2(N_BOOT, seed=7919))
+    thr = float(null[min(math.ceil((null.size + 1) * (1.0 - a) - 1e-9), null.size) - 1])
+    if not stat > thr:
+        return []
+    base = {"domain": "allan", "band_hz": None, "statistic": stat, "threshold": thr, "alpha": a}
+    out: list[dict] = []
+    _misfit_runs(ctx, out, 0.0, a)
+    for reg in out:
+        reg |= base | {"what": reg["what"] + " (two-sided test of the whole curve)"}
+    if not out:
+        lo, hi = float(ctx.curve.tau[0]), float(ctx.curve.tau[-1])
+        what = "the Allan curve departs from the model over its whole range (two-sided test of the whole curve)"
+        out.append(base | {"tau": (lo, hi), "chi2_dof": _chi2_dof(ctx, lo, hi), "what": what})
+    return out
+
+
+def _level(ctx: MissingContext, a: float) -> list[dict]:
+    """The noise level along the final samples (:func:`allanite.model.noise_level.level_test`: the Allan
+    variance at τ₀ in blocks, a studentised CUSUM against its simulated null), between the change points refine
+    accepted (``a`` split over the segments). Where it rejects: one entry with ``"t"`` the side of the largest
+    change where the level is higher (s; the split located to the sample by
+    :func:`.changes.locate` within its two blocks), and the ratio of the Allan deviations at τ₀."""
+    if ctx.y is None:
+        return []
+    fs, y = ctx.fs, ctx.y
+    cuts = [0] + sorted(int(round(t * fs)) for t in ctx.change_times if 0 < t * fs < y.size) + [y.size]
+    a_seg, out = a / (len(cuts) - 1), []
+    for i0, i1 in zip(cuts[:-1], cuts[1:]):
+        r = noise_level.level_test(y[i0:i1], fs, a_seg, t0=i0 / fs)
+        if r is None or not r["rejected"]:
+            continue
+        block = (r["right_s"][1] - r["left_s"][0]) / r["blocks"]
+        lo_i = max(i0, int((r["split_s"] - block) * fs))
+        split = lo_i / fs + locate(y[lo_i : min(i1, int((r["split_s"] + block) * fs))], 1, fs)[0]
+        left, right = (r["left_s"][0], split), (split, r["right_s"][1])
+        hi_side, lo_side, ratio = (right, left, r["ratio"]) if r["ratio"] >= 1 else (left, right, 1 / r["ratio"])
+        tau = float(ctx.curve.tau[0])
+        what = (
+            f"the noise level changes along the record: {ratio:.2f}× the Allan deviation at τ₀ of "
+            f"t {span_text(*lo_side)} s"
+        )
+        out.append(
+            {"domain": "level", "tau": (tau, tau), "t": hi_side, "band_hz": None, "chi2_dof": None}
+            | {"what": what, "ratio": ratio, "statistic": r["statistic"], "threshold": r["threshold"], "alpha": a_seg}
+        )
+    return out
+
+
 def _drift(ctx: MissingContext, a: float) -> list[dict]:
     if ctx.y is None:
         return []
@@ -409,8 +473,10 @@ def _moves_curve(ctx: MissingContext, clean: np.ndarray) -> bool:
 #: The checks, by the name of their share in :data:`.levels.SHARES` (``"unexplained:<name>"``).
 CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "allan": _curve,
+    "fit": _fit,
     "psd": _lines,
     "time": _drift,
+    "level": _level,
     "channels": _channels,
     "outliers": _outliers,
 }
@@ -418,6 +484,13 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
 
 def unexplained(ctx: MissingContext) -> list[dict]:
     """Every check's regions, the largest misfit (statistic over threshold) first."""
-    out = [reg for name, check in CHECKS.items() for reg in check(ctx, alpha(f"unexplained:{name}", ctx.level))]
+    found = {name: check(ctx, alpha(f"unexplained:{name}", ctx.level)) for name, check in CHECKS.items()}
+    if found["allan"]:  # the score test's regions and misfit runs already say where the curve departs
+        found["fit"] = [r for r in found["fit"] if not any(_overlap(r, q) for q in found["allan"])]
+    out = [reg for regs in found.values() for reg in regs]
     out.sort(key=lambda r: -r["statistic"] / max(r["threshold"], 1e-300))
     return out
+
+
+def _overlap(r: dict, q: dict) -> bool:
+    return bool(r["tau"][0] <= q["tau"][1] * (1 + 1e-9) and q["tau"][0] <= r["tau"][1] * (1 + 1e-9))
