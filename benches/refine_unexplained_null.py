@@ -32,6 +32,7 @@ import json
 import math
 import tempfile
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -118,33 +119,47 @@ def _rates(p: np.ndarray, a: float) -> dict:
     }
 
 
-def run(n_curves: int, per_mix: int, n_refine: int, out: Path) -> dict:
+def _curve_task(k: int, refine: bool) -> tuple[dict, dict | None]:
+    res, _desc = clean_curve(20_000 + 7919 * k)
+    got = curve_p_values(res)
+    if not refine:
+        return got, None
+    r = allanite.refine(res, progress=False)
+    return got, {
+        "alarm": bool(r.steps or r.unexplained),
+        "found": r.found,
+        "flagged": [u["domain"] for u in r.unexplained],
+    }
+
+
+def _level_task(mix: str, k: int) -> float | None:
+    y, fs = level_record(mix, 90_000 + 1_000_003 * LEVEL_MIXES.index(mix) + 97 * k)
+    r = level_test(y, fs, TESTS["unexplained:level"])
+    return None if r is None else r["p_value"]
+
+
+def run(n_curves: int, per_mix: int, n_refine: int, out: Path, processes: int = 1) -> dict:
     t0 = time.perf_counter()
     load = _common.OtherLoad().__enter__()
     p: dict[str, list] = {t: [] for t in TESTS}
     both, refined = 0, {"records": 0, "with_alarm": 0, "found": [], "flagged": []}
-    for k in range(n_curves):
-        res, _desc = clean_curve(20_000 + 7919 * k)
-        got = curve_p_values(res)
-        for t, v in got.items():
-            p[t].append(v)
-        both += any(v <= TESTS[t] for t, v in got.items())
-        if k < n_refine:
-            r = allanite.refine(res, progress=False)
-            refined["records"] += 1
-            refined["with_alarm"] += bool(r.steps or r.unexplained)
-            refined["found"] += r.found
-            refined["flagged"] += [u["domain"] for u in r.unexplained]
-        if k % 50 == 49:
-            print("curves", k + 1, flush=True)
-    by_mix: dict[str, int] = {}
-    for mix in LEVEL_MIXES:
-        for k in range(per_mix):
-            y, fs = level_record(mix, 90_000 + 1_000_003 * LEVEL_MIXES.index(mix) + 97 * k)
-            r = level_test(y, fs, TESTS["unexplained:level"])
-            p["unexplained:level"].append(1.0 if r is None else r["p_value"])
-            by_mix[mix] = by_mix.get(mix, 0) + int(r is not None and r["rejected"])
-        print(mix, by_mix[mix], flush=True)
+    with ProcessPoolExecutor(processes) as pool:
+        curves = pool.map(_curve_task, range(n_curves), [k < n_refine for k in range(n_curves)])
+        jobs = [(mix, k) for mix in LEVEL_MIXES for k in range(per_mix)]
+        levels = pool.map(_level_task, [j[0] for j in jobs], [j[1] for j in jobs])
+        for got, ref in curves:
+            for t, v in got.items():
+                p[t].append(v)
+            both += any(v <= TESTS[t] for t, v in got.items())
+            if ref is not None:
+                refined["records"] += 1
+                refined["with_alarm"] += ref["alarm"]
+                refined["found"] += ref["found"]
+                refined["flagged"] += ref["flagged"]
+        by_mix: dict[str, int] = {}
+        for (mix, _k), pv in zip(jobs, levels):
+            p["unexplained:level"].append(1.0 if pv is None else pv)
+            by_mix[mix] = by_mix.get(mix, 0) + int(pv is not None and pv <= TESTS["unexplained:level"])
     load.__exit__(None, None, None)
     tests = {t: {"alpha": TESTS[t], "records": len(v), "rates": _rates(np.array(v), TESTS[t])} for t, v in p.items()}
     tests["unexplained:level"]["by_mixture"] = by_mix
@@ -220,12 +235,13 @@ def main(argv=None) -> int:
     ap.add_argument("--records", type=int, default=640, help="clean curves (default 640)")
     ap.add_argument("--level-records", type=int, default=80, help="level-check records per mixture (default 80)")
     ap.add_argument("--refine", type=int, default=100, help="curves also given to the default refine")
+    ap.add_argument("--processes", type=int, default=1, help="records in this many processes (same results)")
     ap.add_argument("--quick", action="store_true")
     args = ap.parse_args(argv)
     if args.quick:
-        run(8, 2, 2, Path(tempfile.mkdtemp()))
+        run(8, 2, 2, Path(tempfile.mkdtemp()), args.processes)
         return 0
-    rep = run(args.records, args.level_records, args.refine, HERE / "results")
+    rep = run(args.records, args.level_records, args.refine, HERE / "results", args.processes)
     print(markdown(rep))
     return 0
 

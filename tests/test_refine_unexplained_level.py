@@ -73,6 +73,8 @@ def test_refine_says_where_the_noise_level_changes_unless_a_change_point_explain
     (lv,) = [u for u in r.unexplained if u["domain"] == "level"]
     assert lv["t"][0] == pytest.approx(200.0, abs=10.0) and lv["t"][1] == pytest.approx(400.0, abs=0.1)
     assert lv["ratio"] == pytest.approx(2.0, rel=0.05) and lv["alpha"] == alpha("unexplained:level", 0.05)
+    # halves at 1 and 4 in AVAR: the record's level 2.5, the sides √(4/2.5) − 1 = 26 % and 1 − √(1/2.5) = 37 % off
+    assert lv["departure_pct"] == pytest.approx(37.0, abs=3.0) and lv["departure_pct"] > lv["heldout_pct"] > 0
     text = describe_region(lv)
     assert re.match(
         r"t (19\d|20\d)–400 s, τ 0\.010 s: the noise level changes along the record: (1\.9\d|2\.0\d)× ", text

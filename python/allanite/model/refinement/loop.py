@@ -554,6 +554,7 @@ class _Run:
             self.curve, thin, self.sol, self.start, self.effects, self.y, self.fs, self.level, exact, chans, self.unit
         )
         ctx.change_times = [st.params["t"] for st in cp_steps]
+        ctx.heldout_pct = self.state[0].get("heldout_rms_adev_pct")
         return unexplained(ctx)
 
     def refinement(self, cp_steps, unit, confidence, missing) -> Refinement:
