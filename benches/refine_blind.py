@@ -355,10 +355,12 @@ NOTES: list = [
     "- *Gauss–Markov with T_c = 4000 s in a 20 000 s record*: below τ ≈ T_c the process is rate random walk of "
     "K = σ√(2/T_c), and the five terms take it (χ²/dof 0.41); the Gauss–Markov grid ends at τ_max/4, so T_c near "
     "the record's end is not identifiable from this record — nothing added, nothing flagged.",
-    "- *Without the candidate*, 4 of 7 leave something unexplained. The noise level doubling halfway leaves "
-    "nothing unexplained without the `change_point` candidate: the record's curve is one of white noise at the "
-    "length-weighted level, and `unexplained` has no check of the level along time — a gap (it would need its own "
-    "share of `level` and a false-alarm calibration). The temperature and the slow Gauss–Markov cases: as above.",
+    "- *Without the candidate*, 5 of 7 leave something unexplained (was 4). The noise level doubling halfway: the "
+    "record's curve is one of white noise at the length-weighted level, so no check of the curve sees it; the "
+    '`"level"` check of `unexplained` (the Allan variance at τ₀ in blocks along the record, its own share of '
+    '`level`, 0 of 720 clean records at its α: benches/results/refine_unexplained_null.md) now says "t 5000–10000 s: '
+    'the noise level changes along the record: 2.00× the Allan deviation at τ₀ of t 0–5000 s". The temperature '
+    "and the slow Gauss–Markov cases: as above.",
     "- Clean cases (the 2 kHz FOG with B dominating at 5·10⁻⁸ rad/s/√Hz white noise, the clean axes): nothing "
     "added, nothing flagged; the float32 record on a 500 °/s bias is refined as its float64 copy would be.",
 ]

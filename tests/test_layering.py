@@ -140,6 +140,7 @@ MODEL_RANKS = {
     "model.linefit": 0,
     "model.lines": 0,
     "model.outliers": 0,
+    "model.noise_level": 0,
     "model.periodic": 1,
     "model.template": 0,
     # fit's parts, between the registries and fit itself: the one-curve solver, the result objects, the windows

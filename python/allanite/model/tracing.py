@@ -419,13 +419,29 @@ class ScoreTest:
         u = self.directions(family)
         if u.size == 0:
             return np.zeros(0)
-        if (n_boot, seed) not in self._draws:  # the curves drawn once per (n_boot, seed), for every family
+        rp = self._perp(self._drawn(n_boot, seed))
+        return np.max(np.maximum(u @ rp, 0.0) ** 2, axis=0)
+
+    def _drawn(self, n_boot: int, seed: int) -> np.ndarray:
+        """``n_boot`` curves drawn from the model, minus the model (drawn once per (n_boot, seed), for every
+        family and for :meth:`null_chi2`)."""
+        if (n_boot, seed) not in self._draws:
             rng = np.random.default_rng(seed)
             z = self.corr_chol @ rng.standard_normal((self.model.size, n_boot))
             ystar = self.model[:, None] * chi2_dist.ppf(norm.cdf(z), self.nu[:, None]) / self.nu[:, None]
             self._draws[(n_boot, seed)] = ystar - self.model[:, None]
-        rp = self._perp(self._draws[(n_boot, seed)])
-        return np.max(np.maximum(u @ rp, 0.0) ** 2, axis=0)
+        return self._draws[(n_boot, seed)]
+
+    def gls_chi2(self, y: np.ndarray) -> float:
+        """The GLS χ² of the residual y − model once the model's fitted directions are refitted (projected out):
+        a two-sided measure of the whole curve's misfit, beside the one-sided score of one more column."""
+        rp = self._perp((y - self.model)[:, None])[:, 0]
+        return float(rp @ rp)
+
+    def null_chi2(self, n_boot: int = 1000, seed: int = 0) -> np.ndarray:
+        """:meth:`gls_chi2` of ``n_boot`` curves drawn from the model (the same draws as :meth:`null_maxima`)."""
+        rp = self._perp(self._drawn(n_boot, seed))
+        return np.sum(rp**2, axis=0)
 
     def threshold(self, family: np.ndarray, alpha: float, n_boot: int = 1000, seed: int = 0) -> float:
         """(1 − α) quantile of the maximum statistic over ``family`` (n_tau, n_cols) on curves drawn from

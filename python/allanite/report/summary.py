@@ -100,7 +100,8 @@ def refinement_dict(rep) -> dict | None:
         },
         "unexplained": "per axis, what the final model still misses, largest misfit first (empty when the final "
         "model passes every calibrated check of what it may still miss, each at its share of the axis's level): "
-        "domain (allan, psd, time, channels, outliers), tau_s [lo, hi] in s, band_hz [lo, hi] in Hz (null where "
+        "domain (allan, psd, time, level, channels, outliers), tau_s [lo, hi] in s, t_s [lo, hi] in s (the time "
+        "region along the record, null where the entry has none), band_hz [lo, hi] in Hz (null where "
         "it has no band, or for curve-only input), chi2_dof of the dense Allan curve over that τ range (null "
         "where the evidence is not on the curve), what (in words), the check's statistic, threshold and alpha, "
         "and text (the entry in words); still_missing: the sentences the page and the console print",
@@ -122,6 +123,7 @@ def _region_dict(reg: dict) -> dict:
     return {
         "domain": reg.get("domain"),
         "tau_s": json_value(reg["tau"]),
+        "t_s": json_value(reg.get("t")),
         "band_hz": json_value(reg.get("band_hz")),
         "chi2_dof": json_number(reg.get("chi2_dof")),
         "what": reg.get("what"),

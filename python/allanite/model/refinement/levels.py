@@ -17,6 +17,7 @@ __all__ = [
     "TIME_SHARE",
     "OUTLIER_SHARE",
     "UNEXPLAINED_SHARES",
+    "SAMPLE_CHECKS",
     "SHARES",
     "TIME_SHARES",
     "CONDITIONAL_SHARES",
@@ -41,9 +42,20 @@ TIME_SHARE = 0.075
 OUTLIER_SHARE = 0.05
 
 #: Share of ``level`` spent on saying what the final model still misses (``Refinement.unexplained``), split
-#: between its checks: the Allan curve, lines in the PSD, a drift in time, a coupling to a channel left in the
-#: samples, impulsive noise left in them (:data:`allanite.model.refinement.missing.CHECKS`).
-UNEXPLAINED_SHARES = {"allan": 0.05, "psd": 0.025, "time": 0.025, "channels": 0.0125, "outliers": 0.0125}
+#: between its checks: the Allan curve, lines in the PSD, a drift in time, the noise level along the record, a
+#: coupling to a channel left in the samples, impulsive noise left in them
+#: (:data:`allanite.model.refinement.missing.CHECKS`).
+UNEXPLAINED_SHARES = {
+    "allan": 0.05,
+    "psd": 0.025,
+    "time": 0.0125,
+    "level": 0.0125,
+    "channels": 0.0125,
+    "outliers": 0.0125,
+}
+#: The checks that need the samples; on curve-only input their shares go to the ``"fit"`` check (the GLS χ²
+#: of the whole curve, two-sided), so that curve-only input spends the same share on ``unexplained``.
+SAMPLE_CHECKS = ("psd", "time", "level", "channels", "outliers")
 
 #: Tests with a share of their own, by name (the Allan-curve test, ``"curve"``, takes the rest).
 SHARES = {
@@ -64,13 +76,17 @@ CONDITIONAL_SHARES = {f"regression:{k}": v for k, v in TERM_SHARE.items()}
 
 def share(test: str) -> float:
     """The share of ``level`` spent on ``test`` (a key of :data:`SHARES`, :data:`TIME_SHARES` or
-    :data:`CONDITIONAL_SHARES`, or ``"curve"``: what the others leave — the conditional ones take nothing)."""
+    :data:`CONDITIONAL_SHARES`, ``"unexplained:fit"`` — curve-only input's share of the checks that need the
+    samples, :data:`SAMPLE_CHECKS` —, or ``"curve"``: what the others leave — the conditional ones take
+    nothing)."""
     if test in SHARES:
         return SHARES[test]
     if test in TIME_SHARES:
         return TIME_SHARES[test]
     if test in CONDITIONAL_SHARES:
         return CONDITIONAL_SHARES[test]
+    if test == "unexplained:fit":  # curve-only input: the shares of the checks it cannot run
+        return sum(UNEXPLAINED_SHARES[k] for k in SAMPLE_CHECKS)
     if test != "curve":
         raise KeyError(test)
     rest = 1.0

@@ -165,7 +165,7 @@ def refine(
         run.remove_in_time(candidates, chans)
         run.add_curve_effects(candidates)
         cp_steps = run.change_point_steps(candidates)
-        return run.refinement(cp_steps, unit, confidence, run.unexplained(chans))
+        return run.refinement(cp_steps, unit, confidence, run.unexplained(chans, cp_steps))
 
 
 def _check_candidates(candidates, level) -> tuple:
@@ -545,13 +545,16 @@ class _Run:
 
     # ---- the result
 
-    def unexplained(self, chans) -> list:
-        """What the final model still misses, every domain's check at its own share of ``level``."""
+    def unexplained(self, chans, cp_steps=()) -> list:
+        """What the final model still misses, every domain's check at its own share of ``level`` (the noise
+        level's between the change points ``cp_steps``)."""
         exact = self.y is not None or (isinstance(self.est, str) and self.est == "oavar")
         thin = tracing.thin_indices(self.curve.tau)
         ctx = MissingContext(
             self.curve, thin, self.sol, self.start, self.effects, self.y, self.fs, self.level, exact, chans, self.unit
         )
+        ctx.change_times = [st.params["t"] for st in cp_steps]
+        ctx.heldout_pct = self.state[0].get("heldout_rms_adev_pct")
         return unexplained(ctx)
 
     def refinement(self, cp_steps, unit, confidence, missing) -> Refinement:

@@ -3,7 +3,8 @@
 After the last step every domain's calibrated test is run once more against the final model, whether or not its
 candidate was allowed: what a test still finds is reported, not added. Each check spends its own share of
 ``level`` (:data:`.levels.SHARES`, the ``"unexplained:…"`` entries), so on a complete model the list is empty but
-at that rate. Entries are dicts (largest misfit first) with ``"domain"``, ``"tau"`` (lo, hi) s, ``"band_hz"``
+at that rate. Entries are dicts (largest misfit first) with ``"domain"``, ``"tau"`` (lo, hi) s, ``"t"`` (lo, hi) s
+for a region along the record (the ``"level"`` check's; absent elsewhere), ``"band_hz"``
 (lo, hi) or None (curve-only input), ``"chi2_dof"`` over that τ range of the dense curve (None where the evidence
 is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"threshold"`` and ``"alpha"``.
 
@@ -19,6 +20,10 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   Allan curve" / "the Allan curve lies above the model"; no share of ``level`` spent). With samples the
   frequency band is refined on the PSD of the final residual samples: the part of ≈ 1/(2τ_hi) … 1/(2τ_lo)
   (widened ×2) that stands above the spectrum's running median.
+- ``"fit"`` — curve-only input: the whole curve's GLS χ² once the model's fitted directions are refitted,
+  two-sided (a model *above* the curve too), against the same bootstrap; it spends the shares of the checks
+  that need samples (:data:`.levels.SAMPLE_CHECKS`). Its regions are the runs of same-signed |z| > 2 (domain
+  ``"allan"``); a region the ``"allan"`` check already named is not repeated.
 - ``"psd"`` — spectral lines of the final samples (:func:`allanite.model.lines.find_lines`: the line search of
   the periodic effect, afresh) that no sinusoid of the model accounts for; neighbouring lines (gaps ≤ f/16 or
   8 bins) are one entry, with its band, ``lines`` (how many), ``rms`` and the largest ``amplitude`` — where
@@ -26,6 +31,9 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   standard errors (as impulsive noise below; a line visible only in a filter's noise null moves none).
 - ``"time"`` — a warm-up drift left in the final samples (:func:`allanite.model.tracing.drift_fit` against its
   bootstrap threshold under the final model's slow terms).
+- ``"level"`` — the noise level along the final samples (:func:`allanite.model.noise_level.level_test`, between
+  the change points refine accepted): an entry with the time region ``"t"`` (lo, hi) s where the level is
+  higher, where the change exceeds the final model's held-out error.
 - ``"channels"`` — a coupling to a channel of ``channels=`` left in the final samples (the regression's tests:
   the Whittle GLS for a slow channel, within blocks for a fast one).
 - ``"outliers"`` — impulsive noise left in the final samples (:func:`allanite.model.outliers.outlier_test`).
@@ -43,13 +51,15 @@ from scipy.linalg import solve_triangular
 from scipy.stats import t as t_dist
 
 from ...analysis import avar
-from .. import channels, lines, outliers, tracing
+from .. import channels, lines, noise_level, outliers, tracing
 from ..terms import design_matrix
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
+from .changes import locate
 from .curvefit import Curve, Solution, base_name, theta_terms, upper_theta
 from .levels import alpha
 from .scoring import MATERIAL_Z, curve_change_z
+from .words import span_text
 
 __all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS", "allan_family"]
 
@@ -81,6 +91,10 @@ class MissingContext:
     unit: str | None = None
     #: what the checks computed once from the final samples (the Welch PSD of :func:`_band`)
     memo: dict = field(default_factory=dict)
+    #: times (s) of the change points refine accepted: the noise level is checked between them
+    change_times: list = field(default_factory=list)
+    #: the final model's held-out RMS ADEV error (%), the yardstick of a level change's size (None: not known)
+    heldout_pct: float | None = None
 
 
 def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
@@ -326,6 +340,85 @@ def _lines_move_curve(ctx: MissingContext, freqs: np.ndarray, amps: np.ndarray) 
     return curve_change_z(ctx.curve, ctx.sol, change)[0] >= MATERIAL_Z
 
 
+def _fit(ctx: MissingContext, a: float) -> list[dict]:
+    """Curve-only input: the GLS χ² of the whole thinned curve once the model's fitted directions are refitted
+    (:meth:`allanite.model.tracing.ScoreTest.gls_chi2`, two-sided), against its bootstrap under the final
+    model (the draws of the ``"allan"`` check). Where it rejects, the runs of same-signed |z| > 2 on the curve
+    are the regions (the largest Σz² first; the whole τ range where the misfit is spread thin), whichever side
+    of the model the curve lies. With samples its share goes to the checks that need them
+    (:data:`.levels.SAMPLE_CHECKS`): the dense curve's neighbouring τ are contrasts whose null distribution the
+    bootstrap does not reproduce (see :func:`allan_family`)."""
+    if ctx.y is not None:
+        return []
+    test = curve_test(ctx.curve, ctx.thin, ctx.sol, ctx.start, ctx.effects, ctx.exact)
+    stat = test.gls_chi2(ctx.curve.subset(ctx.thin).avar)
+    null = np.sort(test.null_chi2(N_BOOT, seed=7919))
+    thr = float(null[min(math.ceil((null.size + 1) * (1.0 - a) - 1e-9), null.size) - 1])
+    if not stat > thr:
+        return []
+    base = {"domain": "allan", "band_hz": None, "statistic": stat, "threshold": thr, "alpha": a}
+    out: list[dict] = []
+    _misfit_runs(ctx, out, 0.0, a)
+    for reg in out:
+        reg |= base | {"what": reg["what"] + " (two-sided test of the whole curve)"}
+    if not out:  # spread thin: no run beyond 2 — its size is the GLS χ², not the diagonal χ²/dof over τ
+        lo, hi = float(ctx.curve.tau[0]), float(ctx.curve.tau[-1])
+        dof = ctx.thin.size - test.q.shape[1]
+        what = (
+            f"the Allan curve departs from the model over its whole range, no τ by more than 2 SE: GLS χ² "
+            f"{stat:.3g} on {dof} dof under the estimates' covariance (threshold {thr:.3g}; two-sided test of the "
+            "whole curve)"
+        )
+        out.append(base | {"tau": (lo, hi), "chi2_dof": None, "what": what})
+    return out
+
+
+def _level(ctx: MissingContext, a: float) -> list[dict]:
+    """The noise level along the final samples (:func:`allanite.model.noise_level.level_test`: the Allan
+    variance at τ₀ in blocks, a studentised CUSUM against its simulated null), between the change points refine
+    accepted (``a`` split over the segments). Where it rejects: one entry with ``"t"`` the side of the largest
+    change where the level is higher (s; the split located to the sample by
+    :func:`.changes.locate` within its two blocks), the ratio of the Allan deviations at τ₀ and
+    ``"departure_pct"``, how far the side further from the record's level (the length-weighted mean) departs
+    from it in Allan deviation at τ₀.
+
+    A change is said only where that departure exceeds the final model's held-out RMS ADEV error
+    (``heldout_pct``): on 10⁶ samples the test resolves level changes of 1–2 % (the ADIS16405 gyros'), real
+    but smaller than what the model already misses on held-out data — not the thing to tell first."""
+    if ctx.y is None:
+        return []
+    fs, y = ctx.fs, ctx.y
+    cuts = [0] + sorted(int(round(t * fs)) for t in ctx.change_times if 0 < t * fs < y.size) + [y.size]
+    a_seg, out = a / (len(cuts) - 1), []
+    for i0, i1 in zip(cuts[:-1], cuts[1:]):
+        r = noise_level.level_test(y[i0:i1], fs, a_seg, t0=i0 / fs)
+        if r is None or not r["rejected"]:
+            continue
+        block = (r["right_s"][1] - r["left_s"][0]) / r["blocks"]
+        lo_i = max(i0, int((r["split_s"] - block) * fs))
+        split = lo_i / fs + locate(y[lo_i : min(i1, int((r["split_s"] + block) * fs))], 1, fs)[0]
+        left, right = (r["left_s"][0], split), (split, r["right_s"][1])
+        hi_side, lo_side, ratio = (right, left, r["ratio"]) if r["ratio"] >= 1 else (left, right, 1 / r["ratio"])
+        share_hi = (hi_side[1] - hi_side[0]) / max(r["right_s"][1] - r["left_s"][0], 1e-300)
+        mean = share_hi * ratio**2 + (1 - share_hi)  # the record's AVAR at τ₀ in units of the lower side's
+        departure = 100 * max(ratio / math.sqrt(mean) - 1, 1 - 1 / math.sqrt(mean))
+        if ctx.heldout_pct is not None and not departure > ctx.heldout_pct:
+            continue
+        tau = float(ctx.curve.tau[0])
+        what = (
+            f"the noise level changes along the record: {ratio:.2f}× the Allan deviation at τ₀ of "
+            f"t {span_text(*lo_side)} s ({departure:.2g} % off the record's level"
+            + ("" if ctx.heldout_pct is None else f"; held-out error {ctx.heldout_pct:.2g} %")
+            + ")"
+        )
+        out.append(
+            {"domain": "level", "tau": (tau, tau), "t": hi_side, "band_hz": None, "chi2_dof": None}
+            | {"what": what, "ratio": ratio, "departure_pct": departure, "heldout_pct": ctx.heldout_pct}
+            | {"statistic": r["statistic"], "threshold": r["threshold"], "alpha": a_seg}
+        )
+    return out
+
+
 def _drift(ctx: MissingContext, a: float) -> list[dict]:
     if ctx.y is None:
         return []
@@ -409,8 +502,10 @@ def _moves_curve(ctx: MissingContext, clean: np.ndarray) -> bool:
 #: The checks, by the name of their share in :data:`.levels.SHARES` (``"unexplained:<name>"``).
 CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "allan": _curve,
+    "fit": _fit,
     "psd": _lines,
     "time": _drift,
+    "level": _level,
     "channels": _channels,
     "outliers": _outliers,
 }
@@ -418,6 +513,13 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
 
 def unexplained(ctx: MissingContext) -> list[dict]:
     """Every check's regions, the largest misfit (statistic over threshold) first."""
-    out = [reg for name, check in CHECKS.items() for reg in check(ctx, alpha(f"unexplained:{name}", ctx.level))]
+    found = {name: check(ctx, alpha(f"unexplained:{name}", ctx.level)) for name, check in CHECKS.items()}
+    if found["allan"]:  # the score test's regions and misfit runs already say where the curve departs
+        found["fit"] = [r for r in found["fit"] if not any(_overlap(r, q) for q in found["allan"])]
+    out = [reg for regs in found.values() for reg in regs]
     out.sort(key=lambda r: -r["statistic"] / max(r["threshold"], 1e-300))
     return out
+
+
+def _overlap(r: dict, q: dict) -> bool:
+    return bool(r["tau"][0] <= q["tau"][1] * (1 + 1e-9) and q["tau"][0] <= r["tau"][1] * (1 + 1e-9))

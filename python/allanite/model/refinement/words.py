@@ -12,7 +12,7 @@ import math
 
 from .levels import UNEXPLAINED_SHARES
 
-__all__ = ["describe_region", "missing_sentences", "passes_sentence", "checks_alpha"]
+__all__ = ["describe_region", "missing_sentences", "passes_sentence", "checks_alpha", "span_text"]
 
 
 def checks_alpha(level: float) -> float:
@@ -21,16 +21,22 @@ def checks_alpha(level: float) -> float:
 
 
 def describe_region(reg: dict) -> str:
-    """One entry of ``Refinement.unexplained`` in words: "τ 0.2–3 s, ≈ 0.17–2.5 Hz: …, χ²/dof 4.1 there".
+    """One entry of ``Refinement.unexplained`` in words: "τ 0.2–3 s, ≈ 0.17–2.5 Hz: …, χ²/dof 4.1 there" (with
+    its time region first where it has one, key ``"t"``, s: "t 0–5000 s, τ 0.01 s: …").
 
     Examples
     --------
     >>> describe_region({"tau": (0.2, 3.0), "band_hz": (0.17, 2.5), "chi2_dof": 4.12,
     ...                  "what": "the Allan curve departs from the model"})
     'τ 0.20–3.0 s, ≈ 0.17–2.5 Hz: the Allan curve departs from the model, χ²/dof 4.1 there'
+    >>> describe_region({"tau": (0.01, 0.01), "t": (5000.0, 10000.0), "band_hz": None, "chi2_dof": None,
+    ...                  "what": "the noise level changes along the record"})
+    't 5000–10000 s, τ 0.010 s: the noise level changes along the record'
     """
     lo, hi = reg["tau"]
     text = f"τ {_span(lo, hi)} s"
+    if reg.get("t") is not None:  # a time region along the record (s)
+        text = f"t {_span(*reg['t'])} s, {text}"
     band = reg.get("band_hz")
     if band is not None:
         text += f", ≈ {_span(band[0], band[1])} Hz"
@@ -46,7 +52,8 @@ def passes_sentence(level: float) -> str:
     """What is said when ``unexplained`` is empty: the final model passes the checks, at their level."""
     return (
         "The final model passes every calibrated check of what it may still miss (the Allan-curve score test "
-        "and, with samples, lines in the PSD, a drift, the channels and outliers) at a false-alarm probability "
+        "and, with samples, lines in the PSD, a drift, the noise level along the record, the channels and "
+        "outliers; without, the whole curve's two-sided GLS χ²) at a false-alarm probability "
         f"of {100 * checks_alpha(level):.3g} % per record together (their share of level {level:g})."
     )
 
@@ -65,6 +72,17 @@ def missing_sentences(unexplained: list, level: float) -> list[str]:
     if not unexplained:
         return [passes_sentence(level)]
     return [f"The model still misses something at {describe_region(r)}." for r in unexplained]
+
+
+def span_text(lo: float, hi: float) -> str:
+    """``lo–hi`` as the sentences write a range (one value if they are equal).
+
+    Examples
+    --------
+    >>> span_text(0.0, 5000.0), span_text(4992.5, 10000.0)
+    ('0–5000', '4992–10000')
+    """
+    return _span(lo, hi)
 
 
 def _span(lo: float, hi: float) -> str:
