@@ -456,3 +456,60 @@ def test_no_models_fit_to_nothing(curve):
     got = curvefit.searches(curve, START, [], [("gauss_markov", grid, False)])
     want = int(np.argmin(curvefit.chi2s(curve, START, [], "gauss_markov", grid, 6)))
     assert len(got) == 1 and float(got[0][0]) == float(grid[want]), got
+
+
+def _plain_held(a, nu_cols, y, nu, max_iter, floor, held):
+    """The IRLS of one design with ``held`` columns, as it was before the batch (one design at a time)."""
+    fixed = np.zeros(a.shape[1])
+    for i, (th, _var) in held.items():
+        fixed[i] = th
+    free = np.ones(a.shape[1], dtype=bool)
+    free[list(held)] = False
+    y_free = y - a @ fixed
+    theta, model = fixed.copy(), y.copy()
+    for it in range(max_iter):
+        sw = np.sqrt(nu / (2.0 * np.maximum(model, floor) ** 2))
+        aw = a[:, free] * sw[:, None]
+        scale = np.linalg.norm(aw, axis=0)
+        scale[scale == 0] = 1.0
+        new = fixed.copy()
+        new[free] = scipy_nnls(aw / scale, y_free * sw, maxiter=50 * int(free.sum()))[0] / scale
+        parts = a * new
+        tot = parts.sum(axis=1)
+        done = bool(np.all(np.abs(new - theta) <= 1e-6 * np.abs(theta)))
+        model = np.maximum(tot, floor) if it == 0 else np.sqrt(model * np.maximum(tot, floor))
+        theta = new
+        if new.any():
+            den = np.sum(parts**2 / nu_cols, axis=1)
+            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
+        if done:
+            break
+    return theta, nu
+
+
+@pytest.mark.parametrize("max_iter", [6, 40])
+def test_held_fits_together_equal_one_at_a_time(curve, max_iter):
+    # a line measured in the time domain held at its power (one or two of them) while a grid is searched: the
+    # designs reweighted together give each design's own numbers, bit for bit
+    from allanite.model.refinement import _irls
+
+    line = float(np.median(curve.avar)) * 0.3
+    for held in (
+        [(curvefit.held_key("sinusoid", line, 0.01 * line**2), 7.0)],
+        [(curvefit.held_key("sinusoid", line, 1e-4), 7.0), (curvefit.held_key("sinusoid", 0.1 * line, 1e-6), 0.9)],
+    ):
+        grid = np.geomspace(0.5, 200.0, 9)
+        models = [held + [("gauss_markov", float(p))] for p in grid]
+        a, nu_cols = curvefit._stacked(curve, START, models)
+        hold = curvefit._held(START, models[0])
+        nu0, floor = nu_cols[0][:, 1], 1e-12 * np.max(curve.avar)
+        theta, nu = _irls.irls(a, nu_cols, curve.avar, nu0, max_iter, floor, held=hold)
+        for g in range(len(models)):
+            want = _plain_held(a[g], nu_cols[g], curve.avar, nu0, max_iter, floor, hold)
+            np.testing.assert_array_equal(theta[g], want[0])
+            np.testing.assert_array_equal(nu[g], want[1])
+        # the held columns stay at their power, the grid's fits differ from one another
+        assert all(theta[:, i].tolist() == [v[0]] * len(models) for i, v in hold.items())
+        assert np.unique(theta[:, -1]).size > 3
+        chi2 = curvefit.chi2s(curve, START, held, "gauss_markov", grid, max_iter=max_iter)
+        np.testing.assert_array_equal(chi2, [_irls.chi2_at(curve.avar, a[g], theta[g], nu[g], floor) for g in range(9)])
