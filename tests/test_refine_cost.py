@@ -175,7 +175,8 @@ def test_covariance_blocks_equal_pair_by_pair(n, terms):
     for i in range(m.size):
         for j in range(i, m.size):
             d, wc = _plain_nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), "B" in stoch)
-            d_new, wc_new = _covariance._nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), "B" in stoch)
+            d_new, wc_new, size = _covariance._nodes([m[i]], [m[j]], [big_m[i]], [big_m[j]], "B" in stoch)
+            assert size.tolist() == [d.size]
             np.testing.assert_array_equal(d_new, d)
             np.testing.assert_array_equal(wc_new, wc)
             r = _plain_cross(d, int(m[i]), int(m[j]), 0.01)[sel]
@@ -183,6 +184,13 @@ def test_covariance_blocks_equal_pair_by_pair(n, terms):
             rw = r * wc
             np.testing.assert_array_equal(s_blk[:, :, i, j], 0.5 * norm * (rw @ r.T))
             np.testing.assert_array_equal(t_blk[:, i, j], norm * tau[i] * tau[j] * rw.sum(axis=1))
+    # every pair's nodes at once: each pair's own, one after another
+    ii, jj = np.triu_indices(m.size)
+    d_all, wc_all, sizes = _covariance._nodes(m[ii], m[jj], big_m[ii], big_m[jj], "B" in stoch)
+    plain = [_plain_nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), "B" in stoch) for i, j in zip(ii, jj)]
+    assert sizes.tolist() == [d.size for d, _wc in plain]
+    np.testing.assert_array_equal(d_all, np.concatenate([d for d, _wc in plain]))
+    np.testing.assert_array_equal(wc_all, np.concatenate([wc for _d, wc in plain]))
 
 
 def test_drift_bootstrap_statistics_equal_a_qr_per_grid_point():
