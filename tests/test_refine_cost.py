@@ -521,3 +521,48 @@ def test_held_fits_together_equal_one_at_a_time(curve, max_iter):
         assert np.unique(theta[:, -1]).size > 3
         chi2 = curvefit.chi2s(curve, START, held, "gauss_markov", grid, max_iter=max_iter)
         np.testing.assert_array_equal(chi2, [_irls.chi2_at(curve.avar, a[g], theta[g], nu[g], floor) for g in range(9)])
+
+
+def _plain_sz(t, F, alpha, d):
+    """Greenhall & Riley's sz (eqs. 7–9) as it was: one sw per shift, each shift's sx on its own."""
+    from allanite.estimators.edf import _sw
+
+    def sx(t):
+        if math.isinf(F):
+            return _sw(t, alpha + 2)
+        return F * F * (2.0 * _sw(t, alpha) - _sw(t - 1.0 / F, alpha) - _sw(t + 1.0 / F, alpha))
+
+    t = np.asarray(t, dtype=np.float64)
+    out = np.zeros_like(t)
+    for k in range(-d, d + 1):
+        out = out + (-1) ** k * math.comb(2 * d, d + k) * sx(t + k)
+    return out
+
+
+def test_greenhall_sums_in_one_call_equal_shift_by_shift(monkeypatch):
+    # the EDF every fit of refine asks for (first time per α, m, N): sw of every shift and every lag at once
+    from allanite.estimators import edf
+
+    def plain_basic_sum(J, M, S, F, alpha, d):
+        j = np.arange(1, int(J), dtype=np.float64)
+        total = float(_plain_sz(0.0, F, alpha, d)) ** 2
+        total += (1.0 - J / M) * float(_plain_sz(J / S, F, alpha, d)) ** 2
+        return total + 2.0 * float(np.sum((1.0 - j / M) * _plain_sz(j / S, F, alpha, d) ** 2))
+
+    cases = [
+        (a, d, m, n, ov, mod)
+        for d in (1, 2, 3)
+        for a in range(2, -5, -1)
+        if a + 2 * d > 1
+        for m in (1, 2, 7, 33, 34, 500)
+        for n in (2001, 1_000_001)
+        for ov, mod in ((True, False), (False, False), (True, True))
+    ]
+    new = [edf._edf_greenhall_one.__wrapped__(*c) for c in cases]
+    for args in [(0.0, 1, 0, 2), (np.arange(5) / 3.0, 7, -1, 2), (np.arange(9) / 2.0, math.inf, -2, 3)]:
+        np.testing.assert_array_equal(edf._sz(*args), _plain_sz(*args))
+    monkeypatch.setattr(edf, "_sz", _plain_sz)
+    monkeypatch.setattr(edf, "_basic_sum", plain_basic_sum)
+    plain = [edf._edf_greenhall_one.__wrapped__(*c) for c in cases]
+    assert new == plain
+    assert len(set(new)) > len(cases) // 2
