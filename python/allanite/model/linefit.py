@@ -78,11 +78,32 @@ def _wrap(x: np.ndarray) -> np.ndarray:
 
 
 def _phasor(nu: float, idx: np.ndarray) -> np.ndarray:
-    """e^{i2πν n} at the indices (table lookup, linear interpolation)."""
+    """e^{i2πν n} at the indices (table lookup, linear interpolation; read-only). The last few of at most
+    :data:`_KEEP_SAMPLES` indices are remembered: a family's sidebands are fitted on one half of a record and
+    evaluated on the other, family after family, at the same spacing ν."""
+    for nu0, idx0, ph in list(_RECENT):
+        if nu0 == nu and idx0.shape == idx.shape and np.array_equal(idx0, idx):
+            return ph
     u = np.mod(idx * nu, 1.0) * 2**TABLE_BITS
     j = u.astype(np.int64)
     f = u - j
-    return _TABLE[j] * (1.0 - f) + _TABLE[j + 1] * f
+    out = _TABLE[j] * (1.0 - f) + _TABLE[j + 1] * f
+    out.flags.writeable = False
+    if idx.size <= _KEEP_SAMPLES:
+        _RECENT.append((nu, np.array(idx, dtype=np.int64), out))
+        while len(_RECENT) > _KEEP:  # the oldest out (another thread may be at it too)
+            try:
+                _RECENT.pop(0)
+            except IndexError:
+                break
+    return out
+
+
+#: Phasors remembered by :func:`_phasor`: the last :data:`_KEEP`, of records up to :data:`_KEEP_SAMPLES` samples
+#: (16 bytes per sample each).
+_RECENT: list = []
+_KEEP = 4
+_KEEP_SAMPLES = 4_000_000
 
 
 def _grid(kmax: int) -> int:
