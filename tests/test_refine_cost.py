@@ -24,6 +24,7 @@ from scipy.optimize import nnls as scipy_nnls
 
 import allanite
 from allanite.model import _covariance, _nnls, linefit, lines, tracing
+from allanite.model._recent import Recent
 from allanite.model.refinement import _brent, curvefit
 from allanite.model.refinement import candidates as cands
 from allanite.model.refinement.candidates import bandwidth_grids
@@ -237,6 +238,7 @@ def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
     monkeypatch.setattr(loop, "prefetch", lambda rnd, c: None)
     monkeypatch.setattr(loop, "remembering_spectra", contextlib.nullcontext)  # every line spectrum afresh
     monkeypatch.setattr(curvefit, "searches", _one_at_a_time)  # each search alone, when proposed
+    monkeypatch.setattr(Recent, "get", lambda self, arr, key=(): None)  # held-out curves, phasors, … afresh
     plain = allanite.refine(y, 50.0, progress=False)
     assert cached.found == plain.found
     for a, b in zip(cached.steps, plain.steps):
@@ -566,25 +568,3 @@ def test_greenhall_sums_in_one_call_equal_shift_by_shift(monkeypatch):
     plain = [edf._edf_greenhall_one.__wrapped__(*c) for c in cases]
     assert new == plain
     assert len(set(new)) > len(cases) // 2
-
-
-def test_remembered_phasors_equal_fresh_ones(monkeypatch):
-    def fresh(nu, idx):
-        u = np.mod(idx * nu, 1.0) * 2**linefit.TABLE_BITS
-        j = u.astype(np.int64)
-        return linefit._TABLE[j] * (1.0 - (u - j)) + linefit._TABLE[j + 1] * (u - j)
-
-    idx = np.arange(3, 40_000, 2)
-    first = linefit._phasor(0.0123, idx)
-    again = linefit._phasor(0.0123, idx.copy())  # equal indices in another array: remembered
-    assert again is first and not again.flags.writeable
-    np.testing.assert_array_equal(again, fresh(0.0123, idx))
-    other = linefit._phasor(0.0123, idx + 1)  # other indices, other spacing: computed
-    np.testing.assert_array_equal(other, fresh(0.0123, idx + 1))
-    np.testing.assert_array_equal(linefit._phasor(0.0124, idx), fresh(0.0124, idx))
-    for k in range(6):
-        linefit._phasor(0.001 * (k + 1), idx)
-    assert len(linefit._RECENT) == linefit._KEEP
-    monkeypatch.setattr(linefit, "_KEEP_SAMPLES", 100)  # a long record's phasors are not kept
-    linefit._phasor(0.5, idx)
-    assert all(nu != 0.5 for nu, _i, _p in linefit._RECENT)

@@ -28,6 +28,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from ._recent import Recent
+
 __all__ = ["runs", "dirichlet", "dtft", "solve", "evaluate", "refine_generators", "frequency_sd", "TABLE_BITS"]
 
 #: Phasors e^{i2πu} are read from a table of 2^TABLE_BITS + 1 points, linearly interpolated (error ≈ 1e-9).
@@ -78,32 +80,22 @@ def _wrap(x: np.ndarray) -> np.ndarray:
 
 
 def _phasor(nu: float, idx: np.ndarray) -> np.ndarray:
-    """e^{i2πν n} at the indices (table lookup, linear interpolation; read-only). The last few of at most
-    :data:`_KEEP_SAMPLES` indices are remembered: a family's sidebands are fitted on one half of a record and
-    evaluated on the other, family after family, at the same spacing ν."""
-    for nu0, idx0, ph in list(_RECENT):
-        if nu0 == nu and idx0.shape == idx.shape and np.array_equal(idx0, idx):
-            return ph
+    """e^{i2πν n} at the indices (table lookup, linear interpolation; read-only). The last few are remembered
+    (:data:`_PHASORS`): a family's sidebands are fitted on one half of a record and evaluated on the other,
+    family after family, at the same spacing ν."""
+    got = _PHASORS.get(idx, (nu,))
+    if got is not None:
+        return got
     u = np.mod(idx * nu, 1.0) * 2**TABLE_BITS
     j = u.astype(np.int64)
     f = u - j
     out = _TABLE[j] * (1.0 - f) + _TABLE[j + 1] * f
     out.flags.writeable = False
-    if idx.size <= _KEEP_SAMPLES:
-        _RECENT.append((nu, np.array(idx, dtype=np.int64), out))
-        while len(_RECENT) > _KEEP:  # the oldest out (another thread may be at it too)
-            try:
-                _RECENT.pop(0)
-            except IndexError:
-                break
-    return out
+    return _PHASORS.put(idx, (nu,), out)
 
 
-#: Phasors remembered by :func:`_phasor`: the last :data:`_KEEP`, of records up to :data:`_KEEP_SAMPLES` samples
-#: (16 bytes per sample each).
-_RECENT: list = []
-_KEEP = 4
-_KEEP_SAMPLES = 4_000_000
+#: Phasors remembered by :func:`_phasor`: the last four, of records up to 4·10⁶ samples (16 bytes per sample each).
+_PHASORS = Recent(4, 4_000_000)
 
 
 def _grid(kmax: int) -> int:
