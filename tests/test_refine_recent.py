@@ -6,9 +6,16 @@ noise scales. (A whole refine with every memory off: ``test_refine_cost.py``.)""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from allanite.model import linefit, outliers
-from allanite.model._recent import Recent
+from allanite.model._recent import Recent, remembering
+
+
+@pytest.fixture(autouse=True)
+def _remembering():
+    with remembering():  # as within a refine call
+        yield
 
 
 def test_remembered_phasors_equal_fresh_ones(monkeypatch):
@@ -65,3 +72,31 @@ def test_remembered_outlier_scales_equal_fresh_ones():
         assert not loc[k].flags.writeable
     assert outliers._local(y.copy(), 0.05) is loc  # the same samples: remembered
     assert outliers._local(y, 0.1) is not loc  # another step: computed
+
+
+def test_nothing_remembered_outside_a_refine_call():
+    memo = Recent(2, 1000)
+    memo.put(np.arange(3.0), (), "kept")
+    assert memo.get(np.arange(3.0)) == "kept"
+    with remembering():  # a nested call leaves the outer one's memory alone
+        pass
+    assert memo.get(np.arange(3.0)) == "kept"
+
+
+def test_memories_forget_when_the_call_returns():
+    # (outside the autouse fixture's context: a plain function would see nothing remembered)
+    import allanite.model._recent as recent
+
+    memo = Recent(2, 1000)
+    depth = len(recent._OPEN)
+    for _ in range(depth):  # leave this test's own context for a moment
+        recent._OPEN.pop()
+    try:
+        memo.put(np.arange(3.0), (), "kept")
+        assert memo.get(np.arange(3.0)) is None and memo._items == []
+        with remembering():
+            memo.put(np.arange(3.0), (), "kept")
+            assert memo.get(np.arange(3.0)) == "kept"
+        assert memo._items == [] and memo.get(np.arange(3.0)) is None
+    finally:
+        recent._OPEN.extend([True] * depth)
