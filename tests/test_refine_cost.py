@@ -1,9 +1,11 @@
 """refine's speed-ups give the numbers of the plain computations they replace (issue 29, refine's cost).
 
 Each shortcut is checked against the plain path, bit for bit: the fits of a grid run together against one fit at a
-time (the IRLS of the pre-batching code, written out here) and their designs stacked against one per model, the NNLS
+time (the IRLS of the pre-batching code, written out here; with spectral lines held at their power too) and their
+designs stacked against one per model, the NNLS
 without scipy's wrapper against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of many pairs at
-once against one pair at a time, the drift bootstrap's one-product statistics against a QR per grid point (within
+once (and their nodes built for all pairs at once) against one pair at a time, Greenhall's EDF sums in one call
+against shift by shift, the drift bootstrap's one-product statistics against a QR per grid point (within
 1e-9), Brent's bounded search as a coroutine against scipy's, a step's searches run in lockstep against one search
 after another (scipy's bounded search, one fit per call), the line spectra remembered within a refine and the EDF
 remembered per averaging factors against fresh ones, the line families' phase gridding, DTFT and waveforms against
