@@ -33,8 +33,8 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-#: main before this round of refine's speed-ups (issue 29, refine's cost; the first round's baseline was 9165947).
-BASELINE = "313a76b"
+#: main before this round of refine's speed-ups (issue 29, refine's cost; earlier rounds' baselines: 9165947, 313a76b).
+BASELINE = "f836703"
 ADIS = [
     ("adis", 1, "gyro_z"),
     ("adis", 4, "gyro_x"),

@@ -132,6 +132,7 @@ def test_imports_run_one_way(module):
 #: budget, the weighted fit with effects, the errors in-sample and held out, the curve test and the result,
 #: the proposals per domain (curve candidates, removals in time, change points), the loop, the package.
 MODEL_RANKS = {
+    "model._recent": -1,
     "model._batched": 0,
     "model._covariance": 0,
     "model._nnls": 0,

@@ -1,9 +1,11 @@
 """refine's speed-ups give the numbers of the plain computations they replace (issue 29, refine's cost).
 
 Each shortcut is checked against the plain path, bit for bit: the fits of a grid run together against one fit at a
-time (the IRLS of the pre-batching code, written out here) and their designs stacked against one per model, the NNLS
+time (the IRLS of the pre-batching code, written out here; with spectral lines held at their power too) and their
+designs stacked against one per model, the NNLS
 without scipy's wrapper against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of many pairs at
-once against one pair at a time, the drift bootstrap's one-product statistics against a QR per grid point (within
+once (and their nodes built for all pairs at once) against one pair at a time, Greenhall's EDF sums in one call
+against shift by shift, the drift bootstrap's one-product statistics against a QR per grid point (within
 1e-9), Brent's bounded search as a coroutine against scipy's, a step's searches run in lockstep against one search
 after another (scipy's bounded search, one fit per call), the line spectra remembered within a refine and the EDF
 remembered per averaging factors against fresh ones, the line families' phase gridding, DTFT and waveforms against
@@ -24,6 +26,7 @@ from scipy.optimize import nnls as scipy_nnls
 
 import allanite
 from allanite.model import _covariance, _nnls, linefit, lines, tracing
+from allanite.model._recent import Recent
 from allanite.model.refinement import _brent, curvefit
 from allanite.model.refinement import candidates as cands
 from allanite.model.refinement.candidates import bandwidth_grids
@@ -175,7 +178,8 @@ def test_covariance_blocks_equal_pair_by_pair(n, terms):
     for i in range(m.size):
         for j in range(i, m.size):
             d, wc = _plain_nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), "B" in stoch)
-            d_new, wc_new = _covariance._nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), "B" in stoch)
+            d_new, wc_new, size = _covariance._nodes([m[i]], [m[j]], [big_m[i]], [big_m[j]], "B" in stoch)
+            assert size.tolist() == [d.size]
             np.testing.assert_array_equal(d_new, d)
             np.testing.assert_array_equal(wc_new, wc)
             r = _plain_cross(d, int(m[i]), int(m[j]), 0.01)[sel]
@@ -183,6 +187,13 @@ def test_covariance_blocks_equal_pair_by_pair(n, terms):
             rw = r * wc
             np.testing.assert_array_equal(s_blk[:, :, i, j], 0.5 * norm * (rw @ r.T))
             np.testing.assert_array_equal(t_blk[:, i, j], norm * tau[i] * tau[j] * rw.sum(axis=1))
+    # every pair's nodes at once: each pair's own, one after another
+    ii, jj = np.triu_indices(m.size)
+    d_all, wc_all, sizes = _covariance._nodes(m[ii], m[jj], big_m[ii], big_m[jj], "B" in stoch)
+    plain = [_plain_nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), "B" in stoch) for i, j in zip(ii, jj)]
+    assert sizes.tolist() == [d.size for d, _wc in plain]
+    np.testing.assert_array_equal(d_all, np.concatenate([d for d, _wc in plain]))
+    np.testing.assert_array_equal(wc_all, np.concatenate([wc for _d, wc in plain]))
 
 
 def test_drift_bootstrap_statistics_equal_a_qr_per_grid_point():
@@ -229,6 +240,7 @@ def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
     monkeypatch.setattr(loop, "prefetch", lambda rnd, c: None)
     monkeypatch.setattr(loop, "remembering_spectra", contextlib.nullcontext)  # every line spectrum afresh
     monkeypatch.setattr(curvefit, "searches", _one_at_a_time)  # each search alone, when proposed
+    monkeypatch.setattr(Recent, "get", lambda self, arr, key=(): None)  # held-out curves, phasors, … afresh
     plain = allanite.refine(y, 50.0, progress=False)
     assert cached.found == plain.found
     for a, b in zip(cached.steps, plain.steps):
@@ -456,3 +468,105 @@ def test_no_models_fit_to_nothing(curve):
     got = curvefit.searches(curve, START, [], [("gauss_markov", grid, False)])
     want = int(np.argmin(curvefit.chi2s(curve, START, [], "gauss_markov", grid, 6)))
     assert len(got) == 1 and float(got[0][0]) == float(grid[want]), got
+
+
+def _plain_held(a, nu_cols, y, nu, max_iter, floor, held):
+    """The IRLS of one design with ``held`` columns, as it was before the batch (one design at a time)."""
+    fixed = np.zeros(a.shape[1])
+    for i, (th, _var) in held.items():
+        fixed[i] = th
+    free = np.ones(a.shape[1], dtype=bool)
+    free[list(held)] = False
+    y_free = y - a @ fixed
+    theta, model = fixed.copy(), y.copy()
+    for it in range(max_iter):
+        sw = np.sqrt(nu / (2.0 * np.maximum(model, floor) ** 2))
+        aw = a[:, free] * sw[:, None]
+        scale = np.linalg.norm(aw, axis=0)
+        scale[scale == 0] = 1.0
+        new = fixed.copy()
+        new[free] = scipy_nnls(aw / scale, y_free * sw, maxiter=50 * int(free.sum()))[0] / scale
+        parts = a * new
+        tot = parts.sum(axis=1)
+        done = bool(np.all(np.abs(new - theta) <= 1e-6 * np.abs(theta)))
+        model = np.maximum(tot, floor) if it == 0 else np.sqrt(model * np.maximum(tot, floor))
+        theta = new
+        if new.any():
+            den = np.sum(parts**2 / nu_cols, axis=1)
+            nu = np.where(den > 0, tot**2 / np.maximum(den, 1e-300), nu)
+        if done:
+            break
+    return theta, nu
+
+
+@pytest.mark.parametrize("max_iter", [6, 40])
+def test_held_fits_together_equal_one_at_a_time(curve, max_iter):
+    # a line measured in the time domain held at its power (one or two of them) while a grid is searched: the
+    # designs reweighted together give each design's own numbers, bit for bit
+    from allanite.model.refinement import _irls
+
+    line = float(np.median(curve.avar)) * 0.3
+    for held in (
+        [(curvefit.held_key("sinusoid", line, 0.01 * line**2), 7.0)],
+        [(curvefit.held_key("sinusoid", line, 1e-4), 7.0), (curvefit.held_key("sinusoid", 0.1 * line, 1e-6), 0.9)],
+    ):
+        grid = np.geomspace(0.5, 200.0, 9)
+        models = [held + [("gauss_markov", float(p))] for p in grid]
+        a, nu_cols = curvefit._stacked(curve, START, models)
+        hold = curvefit._held(START, models[0])
+        nu0, floor = nu_cols[0][:, 1], 1e-12 * np.max(curve.avar)
+        theta, nu = _irls.irls(a, nu_cols, curve.avar, nu0, max_iter, floor, held=hold)
+        for g in range(len(models)):
+            want = _plain_held(a[g], nu_cols[g], curve.avar, nu0, max_iter, floor, hold)
+            np.testing.assert_array_equal(theta[g], want[0])
+            np.testing.assert_array_equal(nu[g], want[1])
+        # the held columns stay at their power, the grid's fits differ from one another
+        assert all(theta[:, i].tolist() == [v[0]] * len(models) for i, v in hold.items())
+        assert np.unique(theta[:, -1]).size > 3
+        chi2 = curvefit.chi2s(curve, START, held, "gauss_markov", grid, max_iter=max_iter)
+        np.testing.assert_array_equal(chi2, [_irls.chi2_at(curve.avar, a[g], theta[g], nu[g], floor) for g in range(9)])
+
+
+def _plain_sz(t, F, alpha, d):
+    """Greenhall & Riley's sz (eqs. 7–9) as it was: one sw per shift, each shift's sx on its own."""
+    from allanite.estimators.edf import _sw
+
+    def sx(t):
+        if math.isinf(F):
+            return _sw(t, alpha + 2)
+        return F * F * (2.0 * _sw(t, alpha) - _sw(t - 1.0 / F, alpha) - _sw(t + 1.0 / F, alpha))
+
+    t = np.asarray(t, dtype=np.float64)
+    out = np.zeros_like(t)
+    for k in range(-d, d + 1):
+        out = out + (-1) ** k * math.comb(2 * d, d + k) * sx(t + k)
+    return out
+
+
+def test_greenhall_sums_in_one_call_equal_shift_by_shift(monkeypatch):
+    # the EDF every fit of refine asks for (first time per α, m, N): sw of every shift and every lag at once
+    from allanite.estimators import edf
+
+    def plain_basic_sum(J, M, S, F, alpha, d):
+        j = np.arange(1, int(J), dtype=np.float64)
+        total = float(_plain_sz(0.0, F, alpha, d)) ** 2
+        total += (1.0 - J / M) * float(_plain_sz(J / S, F, alpha, d)) ** 2
+        return total + 2.0 * float(np.sum((1.0 - j / M) * _plain_sz(j / S, F, alpha, d) ** 2))
+
+    cases = [
+        (a, d, m, n, ov, mod)
+        for d in (1, 2, 3)
+        for a in range(2, -5, -1)
+        if a + 2 * d > 1
+        for m in (1, 2, 7, 33, 34, 500)
+        for n in (2001, 1_000_001)
+        for ov, mod in ((True, False), (False, False), (True, True))
+    ]
+    new = [edf._edf_greenhall_one.__wrapped__(*c) for c in cases]
+    for args in [(0.0, 1, 0, 2), (np.arange(5) / 3.0, 7, -1, 2), (np.arange(9) / 2.0, math.inf, -2, 3)]:
+        np.testing.assert_array_equal(edf._sz(*args), _plain_sz(*args))
+    monkeypatch.setattr(edf, "_sz", _plain_sz)
+    monkeypatch.setattr(edf, "_basic_sum", plain_basic_sum)
+    plain = [edf._edf_greenhall_one.__wrapped__(*c) for c in cases]
+    assert new == plain
+    assert len(set(new)) > len(cases) // 2

@@ -68,27 +68,31 @@ def _sw(t: np.ndarray, alpha: int) -> np.ndarray:
     return np.where(t == 0.0, 0.0, out)
 
 
-def _sx(t, F: float, alpha: int) -> np.ndarray:
-    if math.isinf(F):  # the F → ∞ limit: a pure sample of w with exponent α + 2
-        return _sw(t, alpha + 2)
-    t = np.asarray(t, dtype=np.float64)
-    return F * F * (2.0 * _sw(t, alpha) - _sw(t - 1.0 / F, alpha) - _sw(t + 1.0 / F, alpha))
-
-
 def _sz(t, F: float, alpha: int, d: int) -> np.ndarray:
+    """Σ_k (−1)^k C(2d, d + k)·sx(t + k) (eq. 9) with sx(t) = F²·(2sw(t) − sw(t − 1/F) − sw(t + 1/F)) (eq. 8; the
+    F → ∞ limit: sw with exponent α + 2, a pure sample of w): every sw of every shift in one call, the sum over
+    k in order."""
     t = np.asarray(t, dtype=np.float64)
+    ks = range(-d, d + 1)
+    shifted = np.stack([t + k for k in ks])
+    if math.isinf(F):
+        sx = _sw(shifted, alpha + 2)
+    else:
+        w = _sw(np.stack([shifted, shifted - 1.0 / F, shifted + 1.0 / F]), alpha)
+        sx = F * F * (2.0 * w[0] - w[1] - w[2])
     out = np.zeros_like(t)
-    for k in range(-d, d + 1):
-        out = out + (-1) ** k * math.comb(2 * d, d + k) * _sx(t + k, F, alpha)
+    for i, k in enumerate(ks):
+        out = out + (-1) ** k * math.comb(2 * d, d + k) * sx[i]
     return out
 
 
 def _basic_sum(J: int, M: float, S: float, F: float, alpha: int, d: int) -> float:
-    """Greenhall & Riley eq. 10."""
+    """Greenhall & Riley eq. 10 (sz at 0, J/S and every j/S, 0 < j < J, in one call)."""
     j = np.arange(1, int(J), dtype=np.float64)
-    total = float(_sz(0.0, F, alpha, d)) ** 2
-    total += (1.0 - J / M) * float(_sz(J / S, F, alpha, d)) ** 2
-    total += 2.0 * float(np.sum((1.0 - j / M) * _sz(j / S, F, alpha, d) ** 2))
+    sz = _sz(np.concatenate([[0.0, J / S], j / S]), F, alpha, d)
+    total = float(sz[0]) ** 2
+    total += (1.0 - J / M) * float(sz[1]) ** 2
+    total += 2.0 * float(np.sum((1.0 - j / M) * sz[2:] ** 2))
     return total
 
 

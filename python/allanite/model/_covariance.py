@@ -102,29 +102,17 @@ def _cross(d: np.ndarray, mi, mj, tau0: float) -> np.ndarray:
     return acc / ((mi * mj) * tau0 * tau0)
 
 
-def _nodes(mi: int, mj: int, big_m_i: int, big_m_j: int, long_tail: bool):
-    """Quadrature nodes and weights for Σ_d c(d)·f(d) over d ∈ [−(M_i − 1), M_j − 1] (f smooth between
-    breakpoints; zero outside (−2m_j, 2m_i) unless ``long_tail``). Returns (d, weight·c(d))."""
-    lo, hi = -(big_m_i - 1), big_m_j - 1
-    s_lo, s_hi = max(lo, -2 * mj), min(hi, 2 * mi)
-    bps = {s_lo, s_hi, 0, big_m_j - big_m_i}
-    bps.update(a * mi - b * mj for a in range(3) for b in range(3))
-    if long_tail:
-        bps.update((lo, hi))
-        step = 2 * mi
-        while step < hi:
-            bps.add(step)
-            step *= 2
-        step = 2 * mj
-        while step < -lo:
-            bps.add(-step)
-            step *= 2
-        a_lo, a_hi = lo, hi
-    else:
-        a_lo, a_hi = s_lo, s_hi
-    pts = np.array(sorted(b for b in bps if a_lo <= b <= a_hi), dtype=np.float64)
-    # between breakpoints: every integer of a short stretch, Gauss–Legendre nodes on a long one
-    a, b = pts[:-1], pts[1:]
+def _nodes(mi, mj, big_m_i, big_m_j, long_tail: bool):
+    """Quadrature nodes and weights for Σ_d c(d)·f(d) over d ∈ [−(M_i − 1), M_j − 1] of each pair of averaging
+    factors (integer arrays ``mi``, ``mj``, ``big_m_i``, ``big_m_j``; f smooth between breakpoints; zero outside
+    (−2m_j, 2m_i) unless ``long_tail``), all pairs at once. Returns (d, weight·c(d), nodes per pair): each pair's
+    breakpoints in increasing order, then the nodes between them (every integer of a short stretch,
+    Gauss–Legendre nodes on a long one), the pairs one after another."""
+    mi, mj, big_m_i, big_m_j = (np.asarray(v, dtype=np.int64) for v in (mi, mj, big_m_i, big_m_j))
+    pts, pair = _breakpoints(mi, mj, big_m_i, big_m_j, long_tail)
+    # between consecutive breakpoints of a pair
+    same = pair[1:] == pair[:-1]
+    a, b, p_of = pts[:-1][same], pts[1:][same], pair[:-1][same]
     n_in = (b - a).astype(np.int64) - 1
     exact = (n_in > 0) & (n_in <= _EXACT_RUN)
     counts = np.where(exact, n_in, np.where(n_in > _EXACT_RUN, _GL_X.size, 0))
@@ -137,10 +125,43 @@ def _nodes(mi: int, mj: int, big_m_i: int, big_m_j: int, long_tail: bool):
     on_int = exact[piece]
     x = np.where(on_int, a[piece] + 1 + at, mid[piece] + half[piece] * _GL_X[gl_at])
     wx = np.where(on_int, 1.0, half[piece] * _GL_W[gl_at])
-    d = np.concatenate([pts, x])
-    w = np.concatenate([np.ones(pts.size), wx])
-    count = np.minimum(big_m_i, big_m_j - d) - np.maximum(0.0, -d)
-    return d, w * np.clip(count, 0.0, None)
+    # each pair's breakpoints, then its nodes
+    n_p = mi.size
+    n_pts = np.bincount(pair, minlength=n_p)
+    n_x = np.bincount(p_of, weights=counts, minlength=n_p).astype(np.int64)
+    sizes = n_pts + n_x
+    start = np.cumsum(sizes) - sizes
+    order = np.empty(pts.size + x.size, dtype=np.int64)
+    order[: pts.size] = start[pair] + np.arange(pts.size) - np.repeat(np.cumsum(n_pts) - n_pts, n_pts)
+    x_pair = p_of[piece]
+    order[pts.size :] = start[x_pair] + n_pts[x_pair] + np.arange(x.size) - np.repeat(np.cumsum(n_x) - n_x, n_x)
+    d, w = np.empty(order.size), np.empty(order.size)
+    d[order] = np.concatenate([pts, x])
+    w[order] = np.concatenate([np.ones(pts.size), wx])
+    who = np.repeat(np.arange(n_p), sizes)
+    count = np.minimum(big_m_i[who], big_m_j[who] - d) - np.maximum(0.0, -d)
+    return d, w * np.clip(count, 0.0, None), sizes
+
+
+def _breakpoints(mi, mj, big_m_i, big_m_j, long_tail: bool):
+    """Each pair's breakpoints of the lag sum (sorted, each once; as float) and the pair each belongs to."""
+    lo, hi = -(big_m_i - 1), big_m_j - 1
+    s_lo, s_hi = np.maximum(lo, -2 * mj), np.minimum(hi, 2 * mi)
+    cands = [s_lo, s_hi, np.zeros_like(mi), big_m_j - big_m_i] + [a * mi - b * mj for a in range(3) for b in range(3)]
+    a_lo, a_hi = s_lo, s_hi
+    if long_tail:
+        cands += [lo, hi]
+        top = int(np.max(np.maximum(hi, -lo))) + 1
+        up, down = np.minimum(2 * mi, top), np.minimum(2 * mj, top)
+        for _k in range(top.bit_length() + 1):  # 2m·2^k below the far end, on either side (saturating at top)
+            cands += [np.where(up < hi, up, lo - 1), np.where(down < -lo, -down, lo - 1)]
+            up, down = np.minimum(2 * up, top), np.minimum(2 * down, top)
+        a_lo, a_hi = lo, hi
+    c = np.sort(np.stack(cands, axis=1), axis=1)
+    keep = (c >= a_lo[:, None]) & (c <= a_hi[:, None])
+    keep[:, 1:] &= c[:, 1:] != c[:, :-1]
+    pair = np.broadcast_to(np.arange(mi.size)[:, None], c.shape)[keep]
+    return c[keep].astype(np.float64), pair
 
 
 def covariance_blocks(m, n_samples: int, fs: float, terms) -> tuple[np.ndarray, np.ndarray]:
@@ -200,14 +221,13 @@ def _blocks(m: np.ndarray, n_samples: int, fs: float, terms) -> tuple[np.ndarray
     s_blk = np.zeros((n_s, n_s, n_tau, n_tau))
     t_blk = np.zeros((n_s, n_tau, n_tau))
     for chunk in _pair_chunks(n_tau):
-        nodes = [_nodes(int(m[i]), int(m[j]), int(big_m[i]), int(big_m[j]), has_b) for i, j in chunk]
-        sizes = [d.size for d, _wc in nodes]
-        ii = np.repeat([i for i, _j in chunk], sizes)
-        jj = np.repeat([j for _i, j in chunk], sizes)
-        r_all = _cross(np.concatenate([d for d, _wc in nodes]), m[ii], m[jj], tau0)[sel]
+        ci, cj = np.array(chunk, dtype=np.int64).T
+        d_all, wc_all, sizes = _nodes(m[ci], m[cj], big_m[ci], big_m[cj], has_b)
+        r_all = _cross(d_all, m[np.repeat(ci, sizes)], m[np.repeat(cj, sizes)], tau0)[sel]
         ends = np.cumsum(sizes)
-        for (i, j), (_d, wc), hi, size in zip(chunk, nodes, ends, sizes):
+        for (i, j), hi, size in zip(chunk, ends, sizes):
             r = np.ascontiguousarray(r_all[:, hi - size : hi])
+            wc = wc_all[hi - size : hi]
             norm = 1.0 / (float(big_m[i]) * float(big_m[j]))
             rw = r * wc
             s = 0.5 * norm * (rw @ r.T)

@@ -28,6 +28,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from ._recent import Recent
+
 __all__ = ["runs", "dirichlet", "dtft", "solve", "evaluate", "refine_generators", "frequency_sd", "TABLE_BITS"]
 
 #: Phasors e^{i2πu} are read from a table of 2^TABLE_BITS + 1 points, linearly interpolated (error ≈ 1e-9).
@@ -78,11 +80,22 @@ def _wrap(x: np.ndarray) -> np.ndarray:
 
 
 def _phasor(nu: float, idx: np.ndarray) -> np.ndarray:
-    """e^{i2πν n} at the indices (table lookup, linear interpolation)."""
+    """e^{i2πν n} at the indices (table lookup, linear interpolation; read-only). The last few are remembered
+    (:data:`_PHASORS`): a family's sidebands are fitted on one half of a record and evaluated on the other,
+    family after family, at the same spacing ν."""
+    got = _PHASORS.get(idx, (nu,))
+    if got is not None:
+        return got
     u = np.mod(idx * nu, 1.0) * 2**TABLE_BITS
     j = u.astype(np.int64)
     f = u - j
-    return _TABLE[j] * (1.0 - f) + _TABLE[j + 1] * f
+    out = _TABLE[j] * (1.0 - f) + _TABLE[j + 1] * f
+    out.flags.writeable = False
+    return _PHASORS.put(idx, (nu,), out)
+
+
+#: Phasors remembered by :func:`_phasor`: the last four, of records up to 4·10⁶ samples (16 bytes per sample each).
+_PHASORS = Recent(4, 4_000_000)
 
 
 def _grid(kmax: int) -> int:

@@ -57,6 +57,8 @@ from scipy.optimize import brentq
 from scipy.special import ndtr
 from scipy.stats import poisson
 
+from ._recent import Recent
+
 __all__ = [
     "outlier_test",
     "flag_at",
@@ -101,8 +103,20 @@ WHITE_RATIO = 0.65
 def lattice_step(x: np.ndarray) -> float:
     """The quantisation step L of ``x``: the smallest nonzero |x| that recurs, if at least 99 % of the nonzero
     |x| are whole multiples of it (to 1e-6) — a few off-lattice values (the outliers themselves, added to a
-    quantised record) do not hide the lattice; else 0 (continuous)."""
-    a = np.abs(np.asarray(x, dtype=np.float64))
+    quantised record) do not hide the lattice; else 0 (continuous). The last few are remembered (the test and
+    the replacement ask for the same record's)."""
+    x = np.asarray(x, dtype=np.float64)
+    got = _STEPS.get(x)
+    return got if got is not None else _STEPS.put(x, (), _lattice_step(x))
+
+
+#: What :func:`lattice_step` and :func:`_local` last found, by the samples' content (records up to 2·10⁶ samples).
+_STEPS = Recent(2, 2_000_000)
+_LOCALS = Recent(2, 2_000_000)
+
+
+def _lattice_step(x: np.ndarray) -> float:
+    a = np.abs(x)
     nz = a[a > 0]
     if nz.size == 0:
         return 0.0
@@ -317,7 +331,15 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
 
 def _local(y: np.ndarray, step: float) -> dict:
     """Per sample: the robust σ of the second difference e_t = y_t − (y_{t−1} + y_{t+1})/2 (``sigma_e``) and of
-    the first differences (``sigma_d``) in its block (for the replacement)."""
+    the first differences (``sigma_d``) in its block (for the replacement; read-only arrays, the last few
+    remembered: the test and the replacement ask for the same record's)."""
+    got = _LOCALS.get(y, (float(step),))
+    if got is None:
+        got = _LOCALS.put(y, (float(step),), _local_sigmas(y, step))
+    return got
+
+
+def _local_sigmas(y: np.ndarray, step: float) -> dict:
     e = np.zeros(y.size)
     e[1:-1] = y[1:-1] - 0.5 * (y[:-2] + y[2:])
     d = np.concatenate([[0.0], np.diff(y)])
@@ -329,6 +351,7 @@ def _local(y: np.ndarray, step: float) -> dict:
             sig_e[b] = se
         if np.isfinite(sd) and sd > 0:
             sig_d[b] = sd
+    sig_e.flags.writeable = sig_d.flags.writeable = False
     return {"sigma_e": sig_e, "sigma_d": sig_d}
 
 

@@ -29,8 +29,7 @@ def irls(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max
     the EDF per τ (G × n) each design stopped at."""
     g_n, n, k = a.shape
     if held:
-        out = [_irls_held(a[g], nu_cols[g], y, nu0, max_iter, floor, held) for g in range(g_n)]
-        return np.stack([t for t, _nu in out]), np.stack([v for _t, v in out])
+        return _irls_held(a, nu_cols, y, nu0, max_iter, floor, held)
     if g_n == 1:
         theta1, nu1 = _irls_one(a[0], nu_cols[0], y, nu0, max_iter, floor)
         return theta1[None], nu1[None]
@@ -87,34 +86,45 @@ def _irls_one(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu: np.ndarray,
     return theta, nu
 
 
-def _irls_held(a, nu_cols, y, nu, max_iter, floor, held):
-    """:func:`irls` of one design whose ``held`` columns stay at their coefficients: the others fitted to the
-    curve less the held columns' part, the weights and ν from the whole model."""
+def _irls_held(a, nu_cols, y, nu0, max_iter, floor, held):
+    """:func:`irls` of designs (G × n × k) whose ``held`` columns stay at their coefficients: the others fitted
+    to the curve less the held columns' part, the weights and ν from the whole model. The designs run together
+    as in :func:`irls` (each one's arithmetic the one it would get alone: the same numbers bit for bit)."""
+    g_n, _n, k = a.shape
     y = np.asarray(y, dtype=np.float64)
-    fixed = np.zeros(a.shape[1])
+    fixed = np.zeros(k)
     for i, (th, _var) in held.items():
         fixed[i] = th
-    free = np.ones(a.shape[1], dtype=bool)
+    free = np.ones(k, dtype=bool)
     free[list(held)] = False
-    y_free = y - a @ fixed
+    a_free = a[:, :, free]
+    y_free = np.stack([y - a[g] @ fixed for g in range(g_n)])
     solver, maxiter = raw_solver(), 50 * int(free.sum())
-    theta, model = fixed.copy(), y.copy()
+    theta = np.tile(fixed, (g_n, 1))
+    model = np.tile(y, (g_n, 1))
+    nu = np.tile(np.asarray(nu0, dtype=np.float64), (g_n, 1))
+    live = np.arange(g_n)
     for it in range(max_iter):
-        sw = np.sqrt(nu / (2.0 * np.maximum(model, floor) ** 2))
-        aw = a[:, free] * sw[:, None]
-        scale = np.sqrt(np.add.reduce(aw * aw, axis=0))
-        scale[scale == 0] = 1.0
-        new = fixed.copy()
+        rows = slice(None) if live.size == g_n else live  # the designs still reweighting
+        m_l, nu_l, th_l = model[rows], nu[rows], theta[rows]
+        sw = np.sqrt(nu_l / (2.0 * np.maximum(m_l, floor) ** 2))
+        new = np.tile(fixed, (live.size, 1))
         if free.any():
-            new[free] = solver(aw / scale, y_free * sw, maxiter) / scale
-        parts = a * new
-        tot = parts.sum(axis=1)
-        done = bool(np.all(np.abs(new - theta) <= RTOL * np.abs(theta)))
-        model = np.maximum(tot, floor) if it == 0 else np.sqrt(model * np.maximum(tot, floor))
-        theta = new
-        if new.any():
-            nu = _combined_edf(parts, nu_cols, tot, nu)
-        if done:
+            aw = a_free[rows] * sw[:, :, None]
+            scale = np.sqrt(np.add.reduce(aw * aw, axis=1))
+            scale[scale == 0] = 1.0
+            an, b = aw / scale[:, None, :], y_free[rows] * sw
+            new[:, free] = np.stack([solver(an[g], b[g], maxiter) for g in range(live.size)]) / scale
+        parts = a[rows] * new[:, None, :]
+        tot = parts.sum(axis=2)
+        done = np.all(np.abs(new - th_l) <= RTOL * np.abs(th_l), axis=1)
+        model[rows] = np.maximum(tot, floor) if it == 0 else np.sqrt(m_l * np.maximum(tot, floor))
+        theta[rows] = new
+        moved = np.asarray(new.any(axis=1))
+        if moved.any():
+            nu[rows] = np.where(moved[:, None], _combined_edf(parts, nu_cols[rows], tot, nu_l), nu_l)
+        live = live[~done]
+        if live.size == 0:
             break
     return theta, nu
 

@@ -22,6 +22,7 @@ from ...errors import InputError, ParameterError
 from ...estimators.grid import tau_grid
 from ...results import AllanResult
 from .. import fitting, periodic, tracing
+from .._recent import remembering
 from ..channels import check_channel, terms_before_after
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
@@ -156,7 +157,8 @@ def refine(
         (['gauss_markov'], 10.0)
     """
     _check_scale(x_or_result)
-    with StepBar(progress, 1, "refine") as bar, remembering_spectra():  # each line spectrum once
+    # each line spectrum once; curves, phasors and outlier scales of the same samples once
+    with StepBar(progress, 1, "refine") as bar, remembering_spectra(), remembering():
         bar.step("fit, trace and test the candidates")
         start = check_terms(start)
         candidates = _check_candidates(candidates, level)

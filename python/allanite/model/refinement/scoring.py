@@ -17,6 +17,7 @@ from scipy.stats import chi2 as chi2_dist
 
 from ...analysis import avar
 from .. import tracing
+from .._recent import Recent
 from .curvefit import Curve, Solution, design, solve
 
 __all__ = [
@@ -164,9 +165,17 @@ class Split:
             self.scored &= agree
 
     def curve(self, z):
-        """The Allan curve of one part's samples ``z`` on the split's τ."""
-        av = np.maximum(avar(z, self.fs, taus=self.m / self.fs).avar, 1e-300)
-        return Curve(self.m / self.fs, self.m.astype(np.float64), av, self.fs, self.size + 1, self.estimator)
+        """The Allan curve of one part's samples ``z`` on the split's τ (the last few remembered, with the fits
+        on them: a removal leaves most parts' samples as they were, and the split is made again after it)."""
+        z = np.asarray(z)
+        key = (self.m.tobytes(), float(self.fs), int(self.size), str(self.estimator))
+        got = _CURVES.get(z, key)
+        if got is None:
+            av = np.maximum(avar(z, self.fs, taus=self.m / self.fs).avar, 1e-300)
+            av.flags.writeable = False  # shared by every split that asks for these samples' curve
+            curve = Curve(self.m / self.fs, self.m.astype(np.float64), av, self.fs, self.size + 1, self.estimator)
+            got = _CURVES.put(z, key, curve)
+        return got
 
     def raw_parts(self) -> list:
         """Per direction (held-in part f → held-out part h), nothing removed yet: the held-in samples and their
@@ -242,6 +251,10 @@ class Split:
             pred = np.maximum(a_h @ sol.theta + extra, 1e-300)
             errs.append(rms_adev_pct(ch.avar[self.scored], pred[self.scored]))
         return float(np.mean(errs))
+
+
+#: The held-out parts' curves last made (:meth:`Split.curve`), of parts up to 4·10⁶ samples.
+_CURVES = Recent(4, 4_000_000)
 
 
 def heldout_split(y, fs, m_all, lo, hi, terms):

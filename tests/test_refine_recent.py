@@ -1,0 +1,102 @@
+"""Results remembered by their arrays' content within a refine (issue 29, refine's cost): each found again only
+for equal samples and the same key, and equal to a fresh computation — the memory itself
+(:class:`allanite.model._recent.Recent`), a line family's phasors, the outlier test's quantisation step and local
+noise scales. (A whole refine with every memory off: ``test_refine_cost.py``.)"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from allanite.model import linefit, outliers
+from allanite.model._recent import Recent, remembering
+
+
+@pytest.fixture(autouse=True)
+def _remembering():
+    with remembering():  # as within a refine call
+        yield
+
+
+def test_remembered_phasors_equal_fresh_ones(monkeypatch):
+    def fresh(nu, idx):
+        u = np.mod(idx * nu, 1.0) * 2**linefit.TABLE_BITS
+        j = u.astype(np.int64)
+        return linefit._TABLE[j] * (1.0 - (u - j)) + linefit._TABLE[j + 1] * (u - j)
+
+    idx = np.arange(3, 40_000, 2)
+    first = linefit._phasor(0.0123, idx)
+    again = linefit._phasor(0.0123, idx.copy())  # equal indices in another array: remembered
+    assert again is first and not again.flags.writeable
+    np.testing.assert_array_equal(again, fresh(0.0123, idx))
+    other = linefit._phasor(0.0123, idx + 1)  # other indices, other spacing: computed
+    np.testing.assert_array_equal(other, fresh(0.0123, idx + 1))
+    np.testing.assert_array_equal(linefit._phasor(0.0124, idx), fresh(0.0124, idx))
+    for k in range(6):
+        linefit._phasor(0.001 * (k + 1), idx)
+    assert len(linefit._PHASORS._items) == linefit._PHASORS.keep
+    monkeypatch.setattr(linefit._PHASORS, "max_size", 100)  # a long record's phasors are not kept
+    linefit._phasor(0.5, idx)
+    assert linefit._PHASORS.get(idx, (0.5,)) is None
+
+
+def test_recent_finds_equal_arrays_only():
+    memo = Recent(2, 1000)
+    a = np.arange(10.0)
+    memo.put(a, ("k",), "first")
+    assert memo.get(a.copy(), ("k",)) == "first"
+    assert memo.get(a, ("other",)) is None
+    assert memo.get(a.astype(np.float32), ("k",)) is None  # another dtype
+    assert memo.get(a.reshape(2, 5), ("k",)) is None  # another shape
+    b = a.copy()
+    b[3] = 0.5
+    assert memo.get(b, ("k",)) is None  # another element
+    a[0] = 7.0  # the memory keeps a copy: changing the array afterwards does not change what it finds
+    assert memo.get(np.arange(10.0), ("k",)) == "first" and memo.get(a, ("k",)) is None
+    memo.put(b, (), 1)
+    memo.put(a, (), 2)
+    assert memo.get(np.arange(10.0), ("k",)) is None and len(memo._items) == 2  # the oldest out
+    memo.put(np.zeros(1001), (), 3)  # too long to keep
+    assert memo.get(np.zeros(1001)) is None
+
+
+def test_remembered_outlier_scales_equal_fresh_ones():
+    rng = np.random.default_rng(4)
+    y = np.round(rng.standard_normal(50_000) / 0.05) * 0.05
+    y[::997] += 3.0
+    step, loc = outliers.lattice_step(np.diff(y)), outliers._local(y, 0.05)
+    assert step == outliers._lattice_step(np.diff(y)) and step > 0
+    fresh = outliers._local_sigmas(y, 0.05)
+    for k in ("sigma_e", "sigma_d"):
+        np.testing.assert_array_equal(loc[k], fresh[k])
+        assert not loc[k].flags.writeable
+    assert outliers._local(y.copy(), 0.05) is loc  # the same samples: remembered
+    assert outliers._local(y, 0.1) is not loc  # another step: computed
+
+
+def test_nothing_remembered_outside_a_refine_call():
+    memo = Recent(2, 1000)
+    memo.put(np.arange(3.0), (), "kept")
+    assert memo.get(np.arange(3.0)) == "kept"
+    with remembering():  # a nested call leaves the outer one's memory alone
+        pass
+    assert memo.get(np.arange(3.0)) == "kept"
+
+
+def test_memories_forget_when_the_call_returns():
+    # (outside the autouse fixture's context: a plain function would see nothing remembered)
+    import allanite.model._recent as recent
+
+    memo = Recent(2, 1000)
+    depth = len(recent._OPEN)
+    for _ in range(depth):  # leave this test's own context for a moment
+        recent._OPEN.pop()
+    try:
+        memo.put(np.arange(3.0), (), "kept")
+        assert memo.get(np.arange(3.0)) is None and memo._items == []
+        with remembering():
+            memo.put(np.arange(3.0), (), "kept")
+            assert memo.get(np.arange(3.0)) == "kept"
+        assert memo._items == [] and memo.get(np.arange(3.0)) is None
+    finally:
+        recent._OPEN.extend([True] * depth)
