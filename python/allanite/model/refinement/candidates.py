@@ -4,8 +4,8 @@ parameters and intervals a step reports, and what a second domain says about it.
 
 - ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4];
 - ``"bandwidth"`` — the sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett
-  FIR, a boxcar of any span, a single pole after a short boxcar), replacing the N column; the kind with the
-  lowest χ² (ties: the one needing fewer other terms);
+  FIR, a boxcar of any span, a single pole after a short boxcar, a 2nd-order Butterworth), replacing the N
+  column; the kind with the lowest χ² (ties: the one needing fewer other terms);
 - ``"resonance"`` — narrowband noise near the shortest τ, at quality factors :data:`RESONANCE_Q`;
 - ``"sinusoid"`` — with samples, the strongest spectral line of the Welch PSD not yet in the model (its own χ²
   test), its amplitude held at the line's power in the spectrum in every fit of the curve (:func:`line_key`);
@@ -195,7 +195,8 @@ def _amplitude_and_profile(pr: Proposal, rnd: Round) -> tuple:
 
 
 def bandwidth_grids(curve: Curve) -> dict:
-    """Search grids per filter kind: single-pole cutoffs whose roll-off falls inside the curve, FIR lengths."""
+    """Search grids per filter kind: single-pole and Butterworth cutoffs whose roll-off falls inside the curve,
+    FIR lengths."""
     # the roll-off must reach into the curve: a time constant (or FIR span) of at least a third of the
     # shortest τ — a faster filter leaves no mark on it
     fs = curve.fs
@@ -203,7 +204,7 @@ def bandwidth_grids(curve: Curve) -> dict:
     f_hi = min(0.45 * fs, 3.0 / (2 * math.pi * curve.tau[0]))
     grids = {}
     if f_lo < f_hi:
-        grids["single_pole"] = np.geomspace(f_lo, f_hi, 24)
+        grids["single_pole"] = grids["butterworth2"] = np.geomspace(f_lo, f_hi, 24)
     l_min = max(2, int(math.ceil(curve.tau[0] * fs / 3)))
     l_max = int(max(2, min(64, 0.1 * curve.tau[-1] * fs)))
     if l_max > l_min:
@@ -247,7 +248,7 @@ def _bw_searches(rnd: Round) -> list:
     if any(base_name(k) == "bandwidth" for k, _p in rnd.effects) or "N" not in rnd.start:
         return []
     return [
-        (f"bandwidth:{kind}", grid, kind in ("single_pole", "boxcar") or kind.startswith("single_pole+"))
+        (f"bandwidth:{kind}", grid, kind not in ("moving_average", "bartlett"))
         for kind, grid in bandwidth_grids(rnd.curve).items()
     ]
 
@@ -273,8 +274,9 @@ def _bw_params(pr: Proposal, rnd: Round) -> tuple:
     def profile():
         return profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, p, pr.sol)
 
-    if kind == "single_pole":
-        return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": profile()}
+    if kind in ("single_pole", "butterworth2"):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
+        c_int = profile() if kind == "single_pole" else tuple(min(c, fs / 2.0) for c in profile())
+        return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": c_int}
     if kind.startswith("single_pole+boxcar:"):
         p_lo, p_hi = profile()
         span = float(kind.split(":", 1)[1])

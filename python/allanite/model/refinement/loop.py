@@ -26,6 +26,7 @@ from ..channels import check_channel, terms_before_after
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
 from ..terms import check_terms
+from ._rolloff import research_rolloff
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families, final_params, prefetch
 from .changes import change_point_step, change_points
@@ -438,6 +439,7 @@ class _Run:
                 break
             n_step += 1
         self.drop_absorbed()
+        self.effects, self.sol = research_rolloff(self.curve, self.start, self.effects, self.sol)
         self.score()
 
     def curve_step(self, n_step, candidates, thin, exact, lines) -> bool:
