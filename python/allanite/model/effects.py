@@ -333,13 +333,15 @@ EFFECTS: dict[str, Effect] = {
                     "taps",
                     "samples",
                     "FIR length (moving average L, Bartlett 2L − 1; a boxcar's span D·f_s, any real); "
-                    "0 for a single pole",
+                    "0 for a single pole or a Butterworth",
                 ),
             ),
             "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
-            "decimating MEMS part, or a boxcar of any span read at the output rate): "
+            "decimating MEMS part, a boxcar of any span read at the output rate, or the 2nd-order Butterworth "
+            "anti-alias stage of a tactical gyro, ``butterworth2``): "
             "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, replacing N²/τ — a "
-            "roll-off of the shortest τ; the N it reports is the white noise before the filter",
+            "roll-off of the shortest τ; the N it reports is the white noise before the filter. Accepted first, "
+            "its parameter is searched again beside the terms later steps add",
             signature=None,
             alpha=lambda tau, p: np.zeros(np.asarray(tau).size, dtype=int),
             search=None,

@@ -587,8 +587,8 @@ def choose(props: list, rnd: Round, candidates):
 
 def final_params(key: str, p: float, line: dict | None, intervals: dict, j: int, rnd: Round) -> tuple[dict, dict]:
     """Parameters and intervals of effect ``j`` of the final model ``rnd.sol`` (terms ``rnd.start`` plus
-    ``rnd.effects``): its amplitude from the final joint fit, its nonlinear parameter as accepted (the joint fit
-    refits amplitudes only) with the interval profiled again beside the other effects. A spectral line keeps
+    ``rnd.effects``): its amplitude from the final joint fit, its nonlinear parameter as accepted (a roll-off's
+    searched again beside the others, :mod:`._rolloff`) with the interval profiled again beside them. A line keeps
     its f0 interval from the samples (``intervals``, at acceptance)."""
     others = rnd.effects[:j] + rnd.effects[j + 1 :]
     column_j = len(rnd.start) + j
