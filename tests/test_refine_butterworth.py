@@ -12,6 +12,7 @@ from scipy import signal
 import allanite
 from allanite.errors import ParameterError
 from allanite.model.effects import filter_autocorrelation, filter_cutoff, filtered_white_avar, two_pole_terms
+from allanite.model.refinement._rolloff import SPECTRUM_FACTOR, needs_spectrum, spectrum_agrees
 
 #: (f_s, f_c): the blind suite's, another rate, near Nyquist, and a slow filter (a long impulse response)
 CASES = [(400.0, 100.0), (1000.0, 200.0), (100.0, 45.0), (100.0, 49.0), (100.0, 1.5)]
@@ -78,6 +79,20 @@ def test_cutoff_at_or_beyond_nyquist():
     np.testing.assert_allclose(filtered_white_avar(tau, "butterworth2", 60.0, fs), 1.0 / tau)
     np.testing.assert_allclose(filtered_white_avar(tau, "butterworth2", 0.4999 * fs, fs), 1.0 / tau, rtol=1e-3)
     assert filter_autocorrelation("butterworth2", 50.0, fs).tolist() == [1.0]
+
+
+def test_a_butterworth_is_named_only_where_the_spectrum_shows_it():
+    fs = 100.0
+    rng = np.random.default_rng(3)
+    w = rng.normal(size=400_000)
+    through = signal.lfilter(*signal.butter(2, 23.0, fs=fs), w)
+    # a boxcar of 1.2 samples (an ADIS16405 gyro's): lag-1 correlation 1/6, nothing beyond
+    box = w[1:] + (3.0 - np.sqrt(8.0)) * w[:-1]  # a/(1 + a²) = 1/6
+    assert needs_spectrum("butterworth2") and not needs_spectrum("boxcar") and SPECTRUM_FACTOR == 2.0
+    assert spectrum_agrees(through, fs, "butterworth2", 23.0)
+    assert not spectrum_agrees(box, fs, "butterworth2", 23.0)  # its 40–48 Hz band holds half the 2–10 Hz power
+    assert spectrum_agrees(box, fs, "boxcar", 1.2)
+    assert not spectrum_agrees(None, fs, "butterworth2", 23.0)  # a curve alone shows no spectrum
 
 
 def test_refine_names_a_butterworth_at_1khz():
