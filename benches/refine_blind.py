@@ -50,12 +50,15 @@ Injected = sensors.Injected
 @dataclass
 class Blind:
     """One blind case: ``build(rng)`` → (samples, fs, channels, keyword arguments of the call); ``injected`` what
-    refine should name (empty: a clean record); ``allowed`` what it may add besides (a filter's bandwidth)."""
+    refine should name (empty: a clean record); ``allowed`` what it may add besides (a filter's bandwidth);
+    ``filter`` the bandwidth's kind it must name, ``forbidden`` effects it must not add (a stand-in)."""
 
     name: str
     build: object
     injected: list = field(default_factory=list)
     allowed: tuple = ()
+    filter: str | None = None
+    forbidden: tuple = ()
     unit: str = "deg/s"
     seed: int = 0
 
@@ -143,8 +146,9 @@ CASES = [
     Blind(
         "tactical gyro, 400 Hz × 10⁶, 2nd-order Butterworth at 100 Hz, Gauss–Markov 5·10⁻³ °/s, T_c 3 s",
         _butterworth_gm,
-        [Injected("gauss_markov", {"sigma": 5e-3, "tc": 3.0})],
-        allowed=("bandwidth",),
+        [Injected("bandwidth", {"cutoff": 100.0}), Injected("gauss_markov", {"sigma": 5e-3, "tc": 3.0})],
+        filter="butterworth2",
+        forbidden=("resonance",),
         seed=102,
     ),
     Blind(
@@ -234,6 +238,16 @@ def _judge_change_points(r, v: dict) -> None:
         v["passed"] = bool(v["named"] and v["params"] and v["falling"] and v["explained"])
 
 
+def _judge_kind(r, case: Blind, v: dict) -> None:
+    """The bandwidth's kind named where the case says which (after the final refit), no stand-in added."""
+    if case.filter is None and not case.forbidden:
+        return
+    kinds = [(s.final_params or s.params).get("filter") for s in r.steps if s.effect == "bandwidth"]
+    v["filter"], v["forbidden_found"] = kinds, [f for f in case.forbidden if f in r.found]
+    if (case.filter is not None and case.filter not in kinds) or v["forbidden_found"]:
+        v["named"] = v["passed"] = False
+
+
 def _fell(pair: dict, key: str) -> bool:
     """Whether ``pair``'s (a before/after dict of metrics) ``key`` fell."""
     b, a = (pair.get("before") or {}).get(key), (pair.get("after") or {}).get(key)
@@ -250,6 +264,7 @@ def run_case(case: Blind) -> dict:
     cpu = time.process_time() - t0
     v = sensors.judge(r, case) if case.injected else _judge_clean(r, case)
     _judge_change_points(r, v)
+    _judge_kind(r, case, v)
     v["start_chi2_dof"] = r.start.chi2_dof
     v["final_chi2_dof"] = r.fit.chi2_dof
     if case.injected:
