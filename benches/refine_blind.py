@@ -352,15 +352,17 @@ NOTES: list = [
     "the real curves (`benches/results/refine_curves.md`) moved the 10 Hz logger's line amplitude error "
     "+3.8 % → −1.0 % (a sampled line's exact Allan variance at ν = 0.17) and merged overlapping regions.",
     "",
+    "The *2nd-order Butterworth at 100 Hz (400 Hz)* passes since the `butterworth2` bandwidth kind (the digital "
+    "`scipy.signal.butter(2, f_c, fs)`, its Allan variance exact) and the roll-off's parameter searched again "
+    "beside the terms accepted after it: named butterworth2 at 101.3 Hz at acceptance, 100.1 Hz beside the "
+    "Gauss–Markov term, no resonance, nothing unexplained. Before, the family had no two-pole low-pass and refine "
+    "read the filter as a boxcar of 2.1 samples plus a 48.9 Hz resonance standing in for the knee (χ²/dof 397 "
+    "on the tests' GLS covariance, τ 2.5–68 ms flagged). Its judge was made stricter with the kind: the "
+    "bandwidth is an injected effect (cutoff 100 Hz within 20 %, kind butterworth2) and a resonance counts "
+    "against it; before, only the Gauss–Markov term was judged and a bandwidth of any kind allowed.",
+    "",
     "Why the other cases fail — and whether the library should change:",
     "",
-    "- *2nd-order Butterworth at 100 Hz (400 Hz)*: the bandwidth family has a single pole, moving averages, a "
-    "boxcar and a pole after a boxcar — no two-pole low-pass. refine reads the filter as a boxcar of 2.1 samples "
-    "plus a 48.9 Hz resonance standing in for the Butterworth's knee, finds the Gauss–Markov term right (σ −4 %, "
-    "T_c +8 %) and ends at χ²/dof 37 (the fit's own; 397 on the tests' GLS covariance), the region τ 2.5–68 ms (≈ 7–200 Hz) flagged: honest, but a filter kind "
-    "is missing. Not fixed here: a new kind changes which kind wins on every record with a roll-off (the "
-    "ADIS16405 among them) and needs the measured and false-alarm benches rerun; a two-pole (Butterworth / "
-    "critically damped) kind with its exact discrete autocorrelation is the next step.",
     "- *48 h at 1 Hz, temperature through an 1800 s lag*: not of detectable size as written (the suite was not "
     "retuned after the run): the coupling's Allan deviation is at most ≈ 1.7× the five terms' (rate random walk "
     "5·10⁻⁶ rad/s^1.5 over two daily cycles), where issue 29's suite asks ≥ 3×; the Whittle regression's "
