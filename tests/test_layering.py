@@ -169,6 +169,7 @@ MODEL_RANKS = {
     "model.refinement.removals": 6,
     "model.refinement.changes": 6,
     "model.refinement.missing": 7,
+    "model.refinement._rolloff": 5.5,
     "model.refinement.loop": 8,
     "model.refinement": 9,
     "model": 10,

@@ -14,6 +14,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy import signal
+
+from ..errors import ParameterError
 
 __all__ = [
     "Effect",
@@ -23,6 +26,7 @@ __all__ = [
     "filtered_white_avar",
     "filter_autocorrelation",
     "filter_cutoff",
+    "two_pole_terms",
     "drift_avar",
     "describe",
     "param_units",
@@ -38,8 +42,10 @@ __all__ = [
 #: a = e^{−2πf_c/f_s}), a moving average of L taps (the boxcar decimation filter of MEMS parts), a Bartlett
 #: (triangular, two cascaded moving averages: 2L − 1 taps), and a boxcar of any span D (a moving average a
 #: part computes at its internal rate and the host reads at the output rate, so D·f_s need not be whole:
-#: the samples' autocorrelation is the triangle (1 − l/(D·f_s))₊; −3 dB at 0.443/D).
-FILTERS = ("single_pole", "moving_average", "bartlett", "boxcar", "single_pole+boxcar")
+#: the samples' autocorrelation is the triangle (1 − l/(D·f_s))₊; −3 dB at 0.443/D), and a two-pole Butterworth
+#: (Q = 1/√2, the digital filter ``scipy.signal.butter(2, f_c, fs=f_s)``: bilinear, prewarped, −3 dB at f_c
+#: exactly — the 2nd-order anti-alias stage of tactical and navigation gyros; one parameter, f_c).
+FILTERS = ("single_pole", "moving_average", "bartlett", "boxcar", "single_pole+boxcar", "butterworth2")
 #: Spans (samples) of the boxcar a single pole may follow ("single_pole+boxcar:<span>": a filter added after
 #: a part's own averaging, e.g. an anti-alias stage or a user's low-pass on the logged rate).
 CASCADE_SPANS = (1.2, 1.5, 2.0)
@@ -70,15 +76,58 @@ def sinusoid_avar(tau: np.ndarray | float, f0: float, fs: float | None = None) -
     return np.sin(np.pi * nu * m) ** 4 / (m * np.sin(np.pi * nu)) ** 2
 
 
+def two_pole_terms(fc: float, fs: float) -> tuple[float, np.ndarray, np.ndarray]:
+    """The autocorrelation of unit-DC-gain 2nd-order Butterworth filtered unit white noise in closed form:
+    (r(0), C, p) with r(l) = Σ_j C_j·p_j^l for l ≥ 1 (``p`` the two poles, ``C`` complex conjugates when the
+    poles are).
+
+    The filter is ``scipy.signal.butter(2, fc, fs=fs)``; in partial fractions H(z) = K + Σ_i R_i/(1 − p_i z⁻¹),
+    so h(0) = K + Σ R_i, h(n) = Σ R_i p_i^n (n ≥ 1), and Σ_n h(n)h(n + l) sums geometric series:
+    r(0) = K² + 2K·Σ R_i + Σ_ij R_i R_j/(1 − p_i p_j), C_j = R_j·(K + Σ_i R_i/(1 − p_i p_j)). Divided by
+    H(1)² (= 1 up to rounding) so that Σ_l r(|l|) = 1."""
+    if not 0.0 < fc < fs / 2.0:
+        raise ParameterError(f"two-pole cutoff {fc!r} Hz: must lie in (0, fs/2 = {fs / 2.0!r})")
+    b, a = signal.butter(2, fc, fs=fs)
+    res, poles, k = signal.residuez(b, a)
+    kk = complex(k[0]) if len(k) else 0.0j
+    cross = 1.0 / (1.0 - np.outer(poles, poles))  # 1/(1 − p_i p_j)
+    r0 = kk * kk + 2.0 * kk * res.sum() + res @ cross @ res
+    c = res * (kk + res @ cross)
+    dc2 = (b.sum() / a.sum()) ** 2
+    return float(r0.real / dc2), c / dc2, poles
+
+
+def _geometric_avar(rho: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """σ²(m) of samples with autocorrelation ρ^|l| (complex ρ, |ρ| < 1: the real part taken by the caller), per
+    ρ (rows) and m (columns): (Var S_m − Cov(S_m, next S_m))/m², closed geometric sums (see
+    :func:`resonance_avar`)."""
+    rho = np.asarray(rho, dtype=np.complex128)[:, None]
+    rm = np.exp(m[None, :] * np.log(rho))
+    one = 1.0 - rho
+    var = m * (1.0 + rho) / one - 2.0 * rho * (1.0 - rm) / one**2
+    cov = rho * (1.0 - rm) ** 2 / one**2
+    return (var - cov) / (m * m)
+
+
 def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
     """Normalised autocorrelation r(l), l = 0, 1, …, of unit-DC-gain filtered white noise: Σ_l r(|l|) = 1.
 
-    ``kind`` one of :data:`FILTERS`; ``p`` the cutoff (Hz) for ``"single_pole"``, the length L (taps of one
-    moving average) for the FIRs, the span D·f_s (samples, ≥ 1, any real) for ``"boxcar"``."""
+    ``kind`` one of :data:`FILTERS`; ``p`` the cutoff (Hz) for ``"single_pole"`` and ``"butterworth2"``, the
+    length L (taps of one moving average) for the FIRs, the span D·f_s (samples, ≥ 1, any real) for
+    ``"boxcar"``."""
     if kind == "single_pole":
         a = math.exp(-2.0 * math.pi * p / fs)
         n = int(min(200_000, math.ceil(40.0 / max(1.0 - a, 1e-9)))) + 1
         return (1.0 - a) / (1.0 + a) * a ** np.arange(n, dtype=np.float64)
+    if kind == "butterworth2" and p >= fs / 2.0:  # its limit there: H → 1, no filter
+        return np.ones(1)
+    if kind == "butterworth2":  # to where the poles' terms fall below 1e-17 of r(0)
+        r0, c, poles = two_pole_terms(p, fs)
+        decay = max(float(np.max(np.abs(poles))), 1e-300)
+        n = int(min(200_000, math.ceil(math.log(1e-17) / math.log(decay)) if decay < 1.0 else 200_000)) + 1
+        lags = np.arange(1, n, dtype=np.float64)
+        tail = (c[None, :] * np.exp(lags[:, None] * np.log(poles.astype(np.complex128))[None, :])).sum(axis=1)
+        return np.concatenate([[r0], tail.real])
     if kind == "boxcar":
         span = max(1.0, float(p))
         tri = 1.0 - np.arange(int(math.ceil(span)), dtype=np.float64) / span
@@ -100,7 +149,7 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
 def filter_cutoff(kind: str, p: float, fs: float) -> float:
     """−3 dB frequency (Hz) of a filter of :data:`FILTERS` (``p`` as in :func:`filter_autocorrelation`); for a
     boxcar the continuous filter's, 0.4430/D (sinc² = ½), before the output sampling aliases it."""
-    if kind == "single_pole":
+    if kind in ("single_pole", "butterworth2"):  # the Butterworth's prewarped cutoff: −3 dB at f_c exactly
         return float(p)
     if kind == "boxcar":
         return float(0.44295 * fs / max(1.0, float(p)))
@@ -126,9 +175,18 @@ def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float)
     σ²(m) = (1/2m²)·Σ_l A_m(l)·R(l) with A_m(l) = 2·tri_m(l) − tri_m(l − m) − tri_m(l + m) (tri_m(l) =
     max(0, m − |l|): the autocorrelation of the Allan kernel of m ones then m minus ones) and R the
     autocorrelation of the filtered samples; N² = σ²_w·τ0 of the white input. Unity DC gain, so the curve
-    tends to N²/τ for τ well above 1/f_c (the filter only reshapes the shortest τ)."""
+    tends to N²/τ for τ well above 1/f_c (the filter only reshapes the shortest τ). For ``"butterworth2"``
+    R(l) = Σ_j C_j·p_j^|l| beyond lag 0 (:func:`two_pole_terms`), so the sum is closed: (r(0) − Σ C_j)/m plus
+    Σ_j C_j times the geometric sums of :func:`resonance_avar` at ρ = p_j; at f_c ≥ f_s/2 its limit (the poles
+    meet the double zero at z = −1: no filter), N²/τ."""
     tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
     m = np.maximum(1.0, np.round(tau * fs))
+    if kind == "butterworth2" and p >= fs / 2.0:  # its limit there: H → 1, white noise
+        return fs / m
+    if kind == "butterworth2":  # geometric autocorrelation: closed sums, white part r(0) − Σ C_j at lag 0
+        r0, c, poles = two_pole_terms(p, fs)
+        s2 = (r0 - c.sum().real) / m + (c[:, None] * _geometric_avar(poles, m)).sum(axis=0).real
+        return s2 * fs
     r = filter_autocorrelation(kind, p, fs)
     lag = np.arange(r.size, dtype=np.float64)
 
@@ -275,13 +333,15 @@ EFFECTS: dict[str, Effect] = {
                     "taps",
                     "samples",
                     "FIR length (moving average L, Bartlett 2L − 1; a boxcar's span D·f_s, any real); "
-                    "0 for a single pole",
+                    "0 for a single pole or a Butterworth",
                 ),
             ),
             "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
-            "decimating MEMS part, or a boxcar of any span read at the output rate): "
+            "decimating MEMS part, a boxcar of any span read at the output rate, or the 2nd-order Butterworth "
+            "anti-alias stage of a tactical gyro, ``butterworth2``): "
             "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, replacing N²/τ — a "
-            "roll-off of the shortest τ; the N it reports is the white noise before the filter",
+            "roll-off of the shortest τ; the N it reports is the white noise before the filter. Accepted first, "
+            "its parameter is searched again beside the terms later steps add",
             signature=None,
             alpha=lambda tau, p: np.zeros(np.asarray(tau).size, dtype=int),
             search=None,

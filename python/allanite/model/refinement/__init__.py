@@ -5,11 +5,11 @@
 of the registry :data:`allanite.model.effects.EFFECTS`:
 
 - on the **Allan curve**, by signature (closed forms, ``docs/FORMULAS.md`` §5): ``"bandwidth"`` — the
-  sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett FIR, or a boxcar of
-  any span), exact in discrete time, replacing the N column; ``"gauss_markov"`` — a bump, T_c in
-  [5·τ_min, τ_max/4]; ``"resonance"`` — narrowband noise, a PSD hump at f_r with quality factor Q (near the
-  shortest τ, tried after the bandwidth); and, for curve-only input, ``"sinusoid"`` (nulls at τ = k/f0,
-  f0 ≥ 2/τ_max);
+  sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett FIR, a boxcar of
+  any span, or a 2nd-order Butterworth), exact in discrete time, replacing the N column; ``"gauss_markov"``
+  — a bump, T_c in [5·τ_min, τ_max/4]; ``"resonance"`` — narrowband noise, a PSD hump at f_r with quality
+  factor Q (near the shortest τ, tried after the bandwidth); and, for curve-only input, ``"sinusoid"`` (nulls
+  at τ = k/f0, f0 ≥ 2/τ_max);
 - in the **PSD** (Welch) for spectral lines: ``"sinusoid"`` with f0 from the periodogram peak, refined;
 - in **time**: ``"drift"`` (warm-up a·e^{−t/T} on block means) and ``"change_point"`` (steps of the noise
   level along the record);

@@ -4,8 +4,9 @@ parameters and intervals a step reports, and what a second domain says about it.
 
 - ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4];
 - ``"bandwidth"`` — the sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett
-  FIR, a boxcar of any span, a single pole after a short boxcar), replacing the N column; the kind with the
-  lowest χ² (ties: the one needing fewer other terms);
+  FIR, a boxcar of any span, a single pole after a short boxcar, a 2nd-order Butterworth), replacing the N
+  column; the kind with the lowest χ² (ties: the one needing fewer other terms; a Butterworth only where
+  the samples' spectrum shows its roll-off);
 - ``"resonance"`` — narrowband noise near the shortest τ, at quality factors :data:`RESONANCE_Q`;
 - ``"sinusoid"`` — with samples, the strongest spectral line of the Welch PSD not yet in the model (its own χ²
   test), its amplitude held at the line's power in the spectrum in every fit of the curve (:func:`line_key`);
@@ -27,6 +28,7 @@ import numpy as np
 
 from .. import tracing
 from ..effects import CASCADE_SPANS, EFFECTS, RESONANCE_Q, filter_autocorrelation, filter_cutoff
+from ._rolloff import better_kind, needs_spectrum, spectrum_agrees
 from .curvefit import (
     Curve,
     Solution,
@@ -195,7 +197,8 @@ def _amplitude_and_profile(pr: Proposal, rnd: Round) -> tuple:
 
 
 def bandwidth_grids(curve: Curve) -> dict:
-    """Search grids per filter kind: single-pole cutoffs whose roll-off falls inside the curve, FIR lengths."""
+    """Search grids per filter kind: single-pole and Butterworth cutoffs whose roll-off falls inside the curve,
+    FIR lengths."""
     # the roll-off must reach into the curve: a time constant (or FIR span) of at least a third of the
     # shortest τ — a faster filter leaves no mark on it
     fs = curve.fs
@@ -203,7 +206,7 @@ def bandwidth_grids(curve: Curve) -> dict:
     f_hi = min(0.45 * fs, 3.0 / (2 * math.pi * curve.tau[0]))
     grids = {}
     if f_lo < f_hi:
-        grids["single_pole"] = np.geomspace(f_lo, f_hi, 24)
+        grids["single_pole"] = grids["butterworth2"] = np.geomspace(f_lo, f_hi, 24)
     l_min = max(2, int(math.ceil(curve.tau[0] * fs / 3)))
     l_max = int(max(2, min(64, 0.1 * curve.tau[-1] * fs)))
     if l_max > l_min:
@@ -219,35 +222,18 @@ def bandwidth_grids(curve: Curve) -> dict:
 
 def _bw_family(sub: Curve, has_samples: bool) -> list:
     return [
-        column(f"bandwidth:{kind}", p, sub) - 1.0 / sub.tau for kind, grid in bandwidth_grids(sub).items() for p in grid
+        column(f"bandwidth:{kind}", p, sub) - 1.0 / sub.tau
+        for kind, grid in bandwidth_grids(sub).items()
+        if has_samples or not needs_spectrum(kind)  # proposed only where a spectrum can show it
+        for p in grid
     ]
-
-
-def _bw_better(new, best, tie) -> bool:
-    """Whether the bandwidth kind ``new`` = (key, p, sol, edge) beats ``best``: a kind whose best parameter sits
-    at the edge of its range is not identified (any kind that is comes first); then the lowest χ², and within
-    one effective point of it the one that needs fewer other terms (a 2-tap average plus white angle noise and
-    a boxcar of 1.2 samples are the same MA(1) process: the single filter is the physical reading; a cascade
-    counts one parameter more, its boxcar span)."""
-    if best is None or (best[3] and not new[3]):
-        return True
-    if best[3] != new[3]:
-        return False
-
-    def n_par(key, sol):
-        return np.count_nonzero(sol.theta > 0) + ("+" in key)
-
-    s_new, s_best = new[2], best[2]
-    return s_new.chi2 < s_best.chi2 - tie or (
-        s_new.chi2 < s_best.chi2 + tie and (n_par(new[0], s_new), s_new.chi2) < (n_par(best[0], s_best), s_best.chi2)
-    )
 
 
 def _bw_searches(rnd: Round) -> list:
     if any(base_name(k) == "bandwidth" for k, _p in rnd.effects) or "N" not in rnd.start:
         return []
     return [
-        (f"bandwidth:{kind}", grid, kind in ("single_pole", "boxcar") or kind.startswith("single_pole+"))
+        (f"bandwidth:{kind}", grid, kind not in ("moving_average", "bartlett"))
         for kind, grid in bandwidth_grids(rnd.curve).items()
     ]
 
@@ -257,7 +243,10 @@ def _bw_propose(rnd: Round) -> list:
     tie = rnd.curve.tau.size / rnd.curve.n_eff
     for key, grid, cont in _bw_searches(rnd):
         p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, key, grid, continuous=cont)
-        if _bw_better((key, p, s_new, edge), best, tie):
+        kind = key.split(":", 1)[1]  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)
+        if needs_spectrum(kind) and not spectrum_agrees(rnd.y, rnd.curve.fs, kind, p):
+            continue
+        if better_kind((key, p, s_new, edge), best, tie):
             best = (key, p, s_new, edge)
     if best is None:
         return []
@@ -273,8 +262,9 @@ def _bw_params(pr: Proposal, rnd: Round) -> tuple:
     def profile():
         return profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, p, pr.sol)
 
-    if kind == "single_pole":
-        return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": profile()}
+    if kind in ("single_pole", "butterworth2"):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
+        c_int = profile() if kind == "single_pole" else tuple(min(c, fs / 2.0) for c in profile())
+        return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": c_int}
     if kind.startswith("single_pole+boxcar:"):
         p_lo, p_hi = profile()
         span = float(kind.split(":", 1)[1])
@@ -585,8 +575,8 @@ def choose(props: list, rnd: Round, candidates):
 
 def final_params(key: str, p: float, line: dict | None, intervals: dict, j: int, rnd: Round) -> tuple[dict, dict]:
     """Parameters and intervals of effect ``j`` of the final model ``rnd.sol`` (terms ``rnd.start`` plus
-    ``rnd.effects``): its amplitude from the final joint fit, its nonlinear parameter as accepted (the joint fit
-    refits amplitudes only) with the interval profiled again beside the other effects. A spectral line keeps
+    ``rnd.effects``): its amplitude from the final joint fit, its nonlinear parameter as accepted (a roll-off's
+    searched again beside the others, :mod:`._rolloff`) with the interval profiled again beside them. A line keeps
     its f0 interval from the samples (``intervals``, at acceptance)."""
     others = rnd.effects[:j] + rnd.effects[j + 1 :]
     column_j = len(rnd.start) + j

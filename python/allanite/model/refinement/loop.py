@@ -27,8 +27,9 @@ from ..channels import check_channel, terms_before_after
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
 from ..terms import check_terms
+from ._rolloff import research_rolloff
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
-from .candidates import CURVE_CANDIDATES, Proposal, Round, choose, families, final_params, prefetch
+from .candidates import CURVE_CANDIDATES, Proposal, Round, bandwidth_grids, choose, families, final_params, prefetch
 from .changes import change_point_step, change_points
 from .curvefit import Curve, base_name, held_theta, noise_fit, solve, theta_terms
 from .levels import LEVEL, alpha
@@ -440,6 +441,8 @@ class _Run:
                 break
             n_step += 1
         self.drop_absorbed()
+        grids = bandwidth_grids(self.curve)
+        self.effects, self.sol = research_rolloff(self.curve, self.start, self.effects, self.sol, grids)
         self.score()
 
     def curve_step(self, n_step, candidates, thin, exact, lines) -> bool:

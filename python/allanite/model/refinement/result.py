@@ -32,9 +32,10 @@ class Step:
     rate unit, ``f0`` Hz; bandwidth ``cutoff`` Hz, ``taps``, ``filter``; drift ``amplitude`` rate unit,
     ``T`` s; regression ``channel``, ``coefficient`` rate unit per channel unit; change point ``t`` s);
     ``intervals`` the numeric keys → (low, high); ``final_params``/``final_intervals`` the same after the final
-    joint refit (a curve effect's amplitude refitted beside every other effect, its nonlinear parameter's
-    interval profiled again; what was measured in the time domain as accepted: a spectral line's amplitude and
-    f0 — held in every fit of the curve —, a removal in time, a change point). ``before``/``after``:
+    joint refit (a curve effect's amplitude refitted beside every other effect — a bandwidth's cutoff searched
+    again beside them —, its nonlinear parameter's interval profiled again; what was measured in the time
+    domain as accepted: a spectral line's amplitude and f0 — held in every fit of the curve —, a removal in
+    time, a change point). ``before``/``after``:
     ``chi2_dof``, ``rms_z``, ``rms_adev_pct`` (on ``Refinement.scored_tau``), ``p_value`` and
     ``heldout_rms_adev_pct`` (None for curve-only input) of the model before and after the step, all on the
     original record's Allan curve — each step's ``before`` is the previous step's ``after`` (the steps in the

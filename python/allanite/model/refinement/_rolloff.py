@@ -1,0 +1,97 @@
+"""The sensor's roll-off: which filter kind is named, and its parameter re-searched beside the terms that came
+after it.
+
+Kinds compete on χ² (:func:`better_kind`). A 2nd-order Butterworth bends the shortest τ broadly enough to stand
+in for a hump beside a milder filter (ADIS16405 run 1 acc_x beside its 10 Hz hump: a Butterworth at 23 Hz where
+the spectrum's 40–48 Hz band holds half the power of its 2–10 Hz band, as a boxcar of 1.2 samples predicts and
+the Butterworth predicts a twentieth; run 1 gyro_z's 20 Hz resonance: a Butterworth at 36 Hz); so it is named
+only where the samples' spectrum shows its roll-off (:func:`spectrum_agrees`), and never on a curve alone.
+
+The roll-off is accepted first (:func:`.candidates.choose`: the white noise every other column is judged
+against), so its parameter is searched without the terms later steps add; a Gauss–Markov term's short-τ slope
+or a resonance beside it then leaves the cutoff biased, and the final joint fit refits amplitudes only
+(a 2nd-order Butterworth at 100 Hz with a Gauss–Markov term: 101.3 Hz at acceptance, a 1.8 % misfit at the
+shortest τ that ``unexplained`` flags). Once the loop is done its parameter is searched again on its kind's grid
+with every other effect in the model, and moved where the value at acceptance lies outside the new value's
+profile interval. Not beside a resonance: near the bandwidth the two trade (ADIS16405 run 3 acc_z's single pole
+beside three resonances near 10 Hz would move 19.9 → 14.3 Hz, run 1 gyro_z's beside two at 20 Hz 23.9 → 28.4 Hz,
+where the same sensor's other runs agree at acceptance); there the accepted value stays.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import tracing
+from ..effects import filter_autocorrelation
+from .curvefit import PROFILE_RHO, Curve, Solution, base_name, search, solve
+
+__all__ = ["better_kind", "needs_spectrum", "spectrum_agrees", "research_rolloff", "SPECTRUM_FACTOR"]
+
+#: The kinds named only where the samples' spectrum shows their roll-off.
+_SPECTRUM_KINDS = ("butterworth2",)
+#: How far (a factor either way) the filter's predicted high-band/low-band power ratio may lie from the one
+#: measured in the Welch PSD (:func:`allanite.model.tracing.rolloff_psd`) for a kind of ``needs_spectrum``.
+SPECTRUM_FACTOR = 2.0
+
+
+def needs_spectrum(kind: str) -> bool:
+    """Whether a bandwidth kind is named only where the samples' spectrum shows its roll-off."""
+    return kind in _SPECTRUM_KINDS
+
+
+def spectrum_agrees(y: np.ndarray | None, fs: float, kind: str, p: float) -> bool:
+    """Whether the roll-off filter ``kind`` at ``p`` predicts the Welch PSD's power at 0.40–0.48·f_s over its
+    power at 0.02–0.10·f_s within a factor :data:`SPECTRUM_FACTOR` of the samples' (``y``; False without)."""
+    if y is None:
+        return False
+    psd = tracing.rolloff_psd(y, fs, filter_autocorrelation(kind, p, fs))
+    meas, pred = psd["measured"], psd["predicted"]
+    return meas > 0 and pred > 0 and abs(math.log(pred / meas)) <= math.log(SPECTRUM_FACTOR)
+
+
+def better_kind(new, best, tie) -> bool:
+    """Whether the bandwidth kind ``new`` = (key, p, sol, edge) beats ``best``: a kind whose best parameter sits
+    at the edge of its range is not identified (any kind that is comes first); then the lowest χ², and within
+    one effective point of it the one that needs fewer other terms (a 2-tap average plus white angle noise and
+    a boxcar of 1.2 samples are the same MA(1) process: the single filter is the physical reading; a cascade
+    counts one parameter more, its boxcar span)."""
+    if best is None or (best[3] and not new[3]):
+        return True
+    if best[3] != new[3]:
+        return False
+
+    def n_par(key, sol):
+        return np.count_nonzero(sol.theta > 0) + ("+" in key)
+
+    s_new, s_best = new[2], best[2]
+    return s_new.chi2 < s_best.chi2 - tie or (
+        s_new.chi2 < s_best.chi2 + tie and (n_par(new[0], s_new), s_new.chi2) < (n_par(best[0], s_best), s_best.chi2)
+    )
+
+
+def research_rolloff(curve: Curve, start: tuple, effects: list, sol: Solution, grids: dict) -> tuple[list, Solution]:
+    """(effects, solution) with the bandwidth's parameter re-searched beside the others on its kind's grid
+    (``grids``: :func:`.candidates.bandwidth_grids`); the same when there is none, when its best value sits at
+    the edge of its grid, when the value at acceptance lies inside the new value's profile interval, or beside a
+    resonance."""
+    j = next((i for i, (k, _p) in enumerate(effects) if base_name(k) == "bandwidth"), None)
+    if j is None or len(effects) < 2 or any(base_name(k) == "resonance" for k, _p in effects):
+        return effects, sol  # beside a resonance near the bandwidth the cutoff trades with it: left as accepted
+    key = effects[j][0]
+    kind = key.split(":", 1)[1]
+    grid = grids.get(kind)
+    if grid is None:
+        return effects, sol
+    others = effects[:j] + effects[j + 1 :]
+    p, _s, edge = search(curve, start, others, key, grid, continuous=kind not in ("moving_average", "bartlett"))
+    if edge:
+        return effects, sol
+    new = effects[:j] + [(key, p)] + effects[j + 1 :]
+    s_new = solve(curve, start, new)  # in the model's own column order
+    # moved only where the value at acceptance lies outside the new one's profile interval (effective χ², as
+    # :func:`.curvefit.profile_interval` counts it, more than 1 above): a flat profile keeps the accepted value
+    scale = curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / curve.tau.size
+    return (new, s_new) if (sol.chi2 - s_new.chi2) * scale > 1.0 else (effects, sol)
