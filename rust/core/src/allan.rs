@@ -44,8 +44,8 @@ mod tests;
 pub(crate) use naive::{centred_angle, naive_rows};
 pub use paths::part_grid;
 pub(crate) use rows::{overlapping_row_at, Part, RowScratch};
+pub(crate) use sums::{block_window_sums, sliding_sums, sliding_sums_at, sum4};
 pub use sums::{compensated_mean, compensated_sum_from};
-pub(crate) use sums::{sliding_sums, sliding_sums_at, sum4};
 pub(crate) use terms::{for_each_term_chunk, for_each_term_chunk_at, TermScratch};
 
 use crate::cancel::Cancel;
@@ -120,6 +120,25 @@ pub struct Request<'a> {
     pub method: Method,
 }
 
+impl<'a> Request<'a> {
+    /// The usual request: the overlapping estimator by the fast method, with these windows and factors.
+    pub fn overlapping(
+        columns: &'a [&'a [f64]],
+        window: usize,
+        hop: usize,
+        ms: &'a [usize],
+    ) -> Self {
+        Request {
+            columns,
+            window,
+            hop,
+            ms,
+            estimator: Estimator::Overlapping,
+            method: Method::Fast,
+        }
+    }
+}
+
 /// At least one axis, all the same length, at least 2 samples: the record length.
 pub(crate) fn check_shape(cols: &[&[f64]]) -> Result<usize> {
     if cols.is_empty() {
@@ -158,6 +177,22 @@ pub(crate) fn check_finite(cols: &[&[f64]]) -> Result<()> {
     Ok(())
 }
 
+/// A window of `min ..= n` samples (`n`: the record length) and a hop of at least 1 sample, or the
+/// error naming the value and what is allowed.
+pub(crate) fn check_window_hop(window: usize, hop: usize, n: usize, min: usize) -> Result<()> {
+    if window < min || window > n {
+        return Err(CoreError::InvalidParameter(format!(
+            "window ({window} samples) must be between {min} and the record length ({n} samples)"
+        )));
+    }
+    if hop == 0 {
+        return Err(CoreError::InvalidParameter(
+            "hop (0) must be at least 1 sample".into(),
+        ));
+    }
+    Ok(())
+}
+
 /// Checks a request; the messages name the value and what is allowed.
 pub fn validate(req: &Request) -> Result<usize> {
     let n_win = validate_shape(req)?;
@@ -168,17 +203,7 @@ pub fn validate(req: &Request) -> Result<usize> {
 /// [`validate`] without the finite check (for a path that checks while it reads the samples).
 fn validate_shape(req: &Request) -> Result<usize> {
     let n = check_shape(req.columns)?;
-    if req.window < 2 || req.window > n {
-        return Err(CoreError::InvalidParameter(format!(
-            "window ({} samples) must be between 2 and the record length ({n} samples)",
-            req.window
-        )));
-    }
-    if req.hop == 0 {
-        return Err(CoreError::InvalidParameter(
-            "hop (0) must be at least 1 sample".into(),
-        ));
-    }
+    check_window_hop(req.window, req.hop, n, 2)?;
     if req.ms.is_empty() {
         return Err(CoreError::InvalidParameter(
             "no averaging factors given".into(),

@@ -24,7 +24,9 @@
 //! results are bit-identical for any number of worker threads (as everywhere in the core: every
 //! (axis, τ) value is one deterministic computation).
 
-use crate::allan::{check_shape, compensated_mean, sliding_sums, sum4};
+use crate::allan::{
+    block_window_sums, check_shape, check_window_hop, compensated_mean, sliding_sums, sum4,
+};
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use rayon::prelude::*;
@@ -858,16 +860,7 @@ pub fn dynamic_ohvar(
     ms: &[usize],
 ) -> Result<(Vec<f64>, usize)> {
     let n = check_shape(columns)?;
-    if window < 3 || window > n {
-        return Err(CoreError::InvalidParameter(format!(
-            "window ({window} samples) must be between 3 and the record length ({n} samples)"
-        )));
-    }
-    if hop == 0 {
-        return Err(CoreError::InvalidParameter(
-            "hop (0) must be at least 1 sample".into(),
-        ));
-    }
+    check_window_hop(window, hop, n, 3)?;
     check_ms(Kind::Ohvar, window, ms, "window")?;
     check_values(columns, false)?;
     let n_win = (n - window) / hop + 1;
@@ -909,16 +902,7 @@ pub fn dynamic_ohvar(
                 full[b] = acc.get();
                 part[b] = pacc.get();
             }
-            if q == 0 {
-                dst.copy_from_slice(&part[..n_win]);
-            } else {
-                sliding_sums(&full, q, dst);
-                if r != 0 {
-                    for (o, p) in dst.iter_mut().zip(&part[q..]) {
-                        *o += p;
-                    }
-                }
-            }
+            block_window_sums(&full, &part, (q, r), (0, n_win), dst);
         });
     Ok((out, n_win))
 }
@@ -949,16 +933,7 @@ pub fn gap_dynamic(
         )));
     }
     let n = check_shape(columns)?;
-    if window < 2 || window > n {
-        return Err(CoreError::InvalidParameter(format!(
-            "window ({window} samples) must be between 2 and the record length ({n} samples)"
-        )));
-    }
-    if hop == 0 {
-        return Err(CoreError::InvalidParameter(
-            "hop (0) must be at least 1 sample".into(),
-        ));
-    }
+    check_window_hop(window, hop, n, 2)?;
     check_ms(kind, window, ms, "window")?;
     check_values(columns, true)?;
     let n_win = (n - window) / hop + 1;
@@ -1024,16 +999,7 @@ pub fn gap_dynamic(
                 full[b] = acc.get();
                 part[b] = pacc.get();
             }
-            if q == 0 {
-                dst.copy_from_slice(&part[..n_win]);
-            } else {
-                sliding_sums(&full, q, dst);
-                if r != 0 {
-                    for (o, p) in dst.iter_mut().zip(&part[q..]) {
-                        *o += p;
-                    }
-                }
-            }
+            block_window_sums(&full, &part, (q, r), (0, n_win), dst);
             for (o, &c) in dst.iter_mut().zip(dcnt.iter()) {
                 *o = if c == 0 {
                     f64::NAN

@@ -540,14 +540,7 @@ mod tests {
     fn too_few_terms_is_an_error() {
         let y = noise(100, 1);
         let cols = [&y[..]];
-        let req = Request {
-            columns: &cols,
-            window: 10,
-            hop: 1,
-            ms: &[4],
-            estimator: Estimator::Overlapping,
-            method: Method::Fast,
-        };
+        let req = Request::overlapping(&cols, 10, 1, &[4]);
         assert!(dynamic_hann(&req).is_ok()); // M = 3: the fewest allowed
         let req = Request { ms: &[5], ..req };
         let e = dynamic_hann(&req).unwrap_err().to_string();

@@ -2,7 +2,7 @@
 //! windows of a part of a record (the record's values, bit for bit), and one window recomputed from
 //! scratch (the naive method, paper 000's DAVAR step).
 
-use super::{for_each_term_chunk_at, sliding_sums, sliding_sums_at, sum4, RUN, SMALL_HOP};
+use super::{block_window_sums, for_each_term_chunk_at, sum4, RUN, SMALL_HOP};
 use crate::cancel::Cancel;
 
 /// Short-hop DAVAR rows take their terms from the double-word phase up to this m; beyond, the three
@@ -116,20 +116,7 @@ pub(crate) fn overlapping_row_at(
         return;
     }
     // The terms already carry the normalisation, so the window sums are the variances.
-    if q == 0 {
-        out.copy_from_slice(&head[..n_win]);
-    } else {
-        if part.first == 0 && n_win == part.total {
-            sliding_sums(full, q, out);
-        } else {
-            sliding_sums_at(full, q, part.first, part.total, out);
-        }
-        if r != 0 {
-            for (o, p) in out.iter_mut().zip(&head[q..]) {
-                *o += p;
-            }
-        }
-    }
+    block_window_sums(full, head, (q, r), (part.first, part.total), out);
 }
 
 /// Classic (non-overlapping) Allan variance of the windows `part` of a record, for one m: clusters

@@ -175,3 +175,31 @@ pub(crate) fn sliding_sums_at(f: &[f64], q: usize, g0: usize, n_total: usize, ou
         s0 += q;
     }
 }
+
+/// Window sums from hop-aligned block sums, for windows of q·hop + r terms: window j's sum is the
+/// full blocks j .. j + q (the Van Herk sliding sums, [`sliding_sums_at`] for the windows `g0 ..` of a
+/// record of `n_total` windows, `place` = (g0, n_total)) plus the first r terms of block j + q
+/// (`part`); with q = 0, only those. `full` and `part` hold `out.len() + q` blocks.
+pub(crate) fn block_window_sums(
+    full: &[f64],
+    part: &[f64],
+    (q, r): (usize, usize),
+    place: (usize, usize),
+    out: &mut [f64],
+) {
+    if q == 0 {
+        out.copy_from_slice(&part[..out.len()]);
+        return;
+    }
+    let (g0, n_total) = place;
+    if g0 == 0 && out.len() == n_total {
+        sliding_sums(full, q, out);
+    } else {
+        sliding_sums_at(full, q, g0, n_total, out);
+    }
+    if r != 0 {
+        for (o, p) in out.iter_mut().zip(&part[q..]) {
+            *o += p;
+        }
+    }
+}

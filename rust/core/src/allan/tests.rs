@@ -269,14 +269,7 @@ fn segments_case(n: usize, n_axes: usize, long: bool, cases: &[(usize, usize)]) 
             .into_iter()
             .filter(|&m| m <= window / 2)
             .collect();
-        let req = Request {
-            columns: &cols,
-            window,
-            hop,
-            ms: &ms,
-            estimator: Estimator::Overlapping,
-            method: Method::Fast,
-        };
+        let req = Request::overlapping(&cols, window, hop, &ms);
         let (record, n_win) = dynamic_avar(&req).unwrap();
         // (the unit tests' span limit for a long record is 2^13: window 2500 takes chunked phases
         // (`crate::chunked`), the others keep the phase path; a short record keeps it at any window)
