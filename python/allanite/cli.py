@@ -176,6 +176,14 @@ def _cli_words(message: str) -> str:
     return " ".join(message.split())
 
 
+def _time_column(args):
+    """--time-column as read_log takes it: a 0-based index or a name; None without it."""
+    if args.time_column is None:
+        return None
+    tc = args.time_column.strip()
+    return int(tc) if tc.isdigit() else tc
+
+
 def _read(args, progress):
     path = Path(args.log)
     if not path.exists():
@@ -185,17 +193,13 @@ def _read(args, progress):
     if args.time_unit is not None:
         kwargs["time_unit"] = args.time_unit
     columns = None if args.columns is None else _spec_list(args.columns, "--columns")
-    time_column = None
-    if args.time_column is not None:
-        tc = args.time_column.strip()
-        time_column = int(tc) if tc.isdigit() else tc
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         log = read_log(
             path,
             fs=args.fs,
             columns=columns,
-            time_column=time_column,
+            time_column=_time_column(args),
             unit=args.unit,
             input=args.input or "rate",
             gaps=args.gaps or "error",
@@ -250,10 +254,6 @@ def _kalibr(args, rep, progress) -> Path:
     accel = None
     if args.accel_columns is not None:
         progress.step("accelerometer fit")
-        time_column = None
-        if args.time_column is not None:
-            tc = args.time_column.strip()
-            time_column = int(tc) if tc.isdigit() else tc
         kwargs = {} if args.time_unit is None else {"time_unit": args.time_unit}
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the gyro read already reported the timing
@@ -261,7 +261,7 @@ def _kalibr(args, rep, progress) -> Path:
                 Path(args.log),
                 fs=args.fs,
                 columns=_spec_list(args.accel_columns, "--accel-columns"),
-                time_column=time_column,
+                time_column=_time_column(args),
                 gaps=args.gaps or "error",
                 **kwargs,
             )
