@@ -52,6 +52,7 @@ LAYERS = {
     "combination": 5,
     "report": 6,
     "cli": 7,
+    "_cli_options": 7,
     "dask": 7,
     "__main__": 7,
     "__init__": 7,

@@ -20,6 +20,18 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from ._cli_options import (
+    DESCRIPTION,
+    EPILOG,
+    REPORT_DESCRIPTION,
+    REPORT_EPILOG,
+    Parser,
+    UsageError,
+    add_analysis_options,
+    add_input_options,
+    add_output_options,
+    formatter,
+)
 from ._core import __version__
 from .analysis import avar
 from .datasets import default_record
@@ -27,77 +39,11 @@ from .errors import AllaniteError
 from .io import read_log
 from .kalibr import to_kalibr
 from .model import fit as fit_model
-from .model.effects import EFFECTS
 from .report import build_report, from_log
 from .report._worker import close as close_figure_worker
 from .report._worker import start as start_figure_worker
-from .units import ACCEL_UNITS
 
 EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
-
-#: ``allanite --help``: what the command line does.
-DESCRIPTION = """\
-allanite: static and dynamic Allan variance for gyroscopes, IMUs and clocks.
-
-commands:
-  report    Allan deviation with intervals, IEEE-952 noise fit and dynamic Allan variance of a
-            log, as an HTML page, a JSON summary and PNG figures
-  batch     one report per log of a fleet, as Dask tasks, and a fleet summary (fleet.csv,
-            fleet.parquet, fleet.html); needs allanite[dask]"""
-
-#: ``allanite --help``, after the options: the exit statuses.
-EPILOG = """\
-Run 'allanite report --help' for the report's options; 'allanite report' alone analyses the
-bundled record (a simulated 3-axis gyro) and writes the report to ./allanite-report/.
-
-exit status:
-  0    success
-  1    internal error (a bug: please report it with the traceback)
-  2    usage or input error (one line on stderr: 'allanite: error: ...')
-  130  interrupted"""
-
-#: ``allanite report --help``: what the report holds and the bundled record it runs on by default.
-REPORT_DESCRIPTION = """\
-Analyse a gyro/IMU/clock log: the overlapping Allan deviation with confidence intervals, the
-IEEE-952 noise model (quantization Q, angle random walk N, bias instability B, rate random walk K,
-rate ramp R) with intervals and datasheet read-offs, the dynamic Allan variance (DAVAR) and the
-noise coefficients over time. Prints a summary and writes, into DIR, one self-contained HTML page
-(figures embedded, no network), a JSON file with every number of the page and the figures as PNG.
-
-Without LOG it analyses the bundled record: a deterministic simulated 3-axis gyro, 1 h at 100 Hz
-in deg/s, whose angle random walk is 4x larger from 20 to 30 min."""
-
-#: ``allanite report --help``, after the options.
-REPORT_EPILOG = """\
-examples:
-  allanite report                                 # the bundled record -> ./allanite-report/
-  allanite report imu.csv.gz --fs 100 --columns gyro_x,gyro_y,gyro_z --unit deg/s
-  allanite report gyro.csv --time-column t --unit rad/s --gaps longest --out results/
-  allanite report gyro.npy --fs 200 --window 60000 --hop 2000 --taus exp --quiet
-  allanite report flight.bag                      # ROS 1 bag: sensor_msgs/Imu, rad/s
-  allanite report imu.npy --fs 500 --frames 20 --forecast 60:30   # paper 004: GM(1,1) forecasts
-  allanite report acc.npy --fs 100 --refine-candidates bandwidth,drift   # refine trying 2 effects
-
-files written to DIR:
-  report.html              the report, one self-contained page
-  summary.json             every number of the page, with units (schema allanite-report/1)
-  adev.png                 all axes: Allan deviation with confidence bands and fits
-  davar.png                all axes: DAVAR heat maps (time x tau, log colour), one panel per axis
-  coefficients.png         all axes: noise coefficients per DAVAR window with intervals
-  adev_axisK.png           axis K: ADEV with confidence band, fitted model and each term
-  davar3d_axisK.png        axis K: DAVAR surface (t, log10 tau, log10 ADEV)
-  refinement_axisK.png     axis K (--refine): starting and refined model, residuals before/after
-  frames_axisK.png         axis K (--frames/--forecast): coefficients per frame with intervals
-  forecast_axisK.png       axis K (--frames/--forecast): forecasts of the resolved coefficients
-
-A progress bar goes to stderr when it is a terminal; when stdout is not one (a pipe, a log file),
-each step is also printed there as it starts. --quiet prints nothing but errors.
-
-exit status:
-  0    success
-  1    internal error (a bug: please report it with the traceback)
-  2    usage or input error (one line on stderr: 'allanite: error: ...')
-  130  interrupted"""
 
 _KALIBR_NEEDS_UNIT = (
     "--kalibr needs the gyro's unit to write SI values: give --unit (e.g. --unit deg/s or --unit rad/s)"
@@ -107,39 +53,26 @@ _KALIBR_NEEDS_UNIT = (
 _LOG_OPTIONS = ("fs", "columns", "time_column", "time_unit", "unit", "input", "gaps", "accel_columns", "accel_unit")
 
 
-class _UsageError(Exception):
-    """A bad command line: reported as one line, exit status 2."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line instead of argparse's usage block
-        raise _UsageError(f"{message} (see '{self.prog} --help')")
-
-
-def _formatter(prog):
-    return argparse.RawDescriptionHelpFormatter(prog, max_help_position=30, width=100)
-
-
 def build_parser() -> argparse.ArgumentParser:
     """The ``allanite`` argument parser: the ``report`` and ``batch`` subcommands and their options."""
-    parser = _Parser(
+    parser = Parser(
         prog="allanite",
         usage="%(prog)s [-h] [--version] COMMAND [ARGS ...]",
         description=DESCRIPTION,
         epilog=EPILOG,
-        formatter_class=_formatter,
+        formatter_class=formatter,
     )
     parser.add_argument(
         "--version", action="version", version=f"allanite {__version__}", help="show the version and exit"
     )
     # the commands are listed in DESCRIPTION (argparse's own listing adds a stray "COMMAND" line)
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", help=argparse.SUPPRESS, parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", help=argparse.SUPPRESS, parser_class=Parser)
     rep = sub.add_parser(
         "report",
         prog="allanite report",
         description=REPORT_DESCRIPTION,
         epilog=REPORT_EPILOG,
-        formatter_class=_formatter,
+        formatter_class=formatter,
     )
     rep.add_argument(
         "log",
@@ -149,139 +82,9 @@ def build_parser() -> argparse.ArgumentParser:
         "bag; default: the bundled record",
     )
 
-    inp = rep.add_argument_group("input (LOG only)")
-    inp.add_argument(
-        "--fs", type=float, metavar="HZ", help="sampling rate in Hz (or give --time-column; ROS bags use their stamps)"
-    )
-    inp.add_argument(
-        "--columns",
-        metavar="C1,C2,...",
-        help="columns that are the samples, by name or 0-based index, comma-separated; one per "
-        "axis (default: every column but the time column — or, when the header also names "
-        "accelerometer columns (acc_x, ...), the ones it names as gyro (gyro_x, ...))",
-    )
-    inp.add_argument("--time-column", metavar="C", help="column of sample times: derives --fs, finds gaps")
-    inp.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), help="unit of the time column (default: s)")
-    inp.add_argument(
-        "--unit",
-        metavar="U",
-        help="unit of the samples: deg/s, rad/s, deg/h, mrad/s, urad/s, ... (rate input) or deg, rad, "
-        "arcsec, ... (increment/angle input); without it the report says the unit is unknown "
-        "and gives the noise coefficients in base form",
-    )
-    inp.add_argument(
-        "--input",
-        choices=("rate", "increment", "angle"),
-        help="what the samples are: rate (default), angle increments per sample, cumulative angle",
-    )
-    inp.add_argument(
-        "--gaps",
-        choices=("error", "longest", "split"),
-        help="when the time column shows gaps: stop with the list of gaps (default), analyse the "
-        "longest gap-free stretch, or the same and list every stretch (split)",
-    )
-
-    inp.add_argument(
-        "--accel-columns",
-        metavar="C1,C2,...",
-        help="accelerometer columns of the same log, for --kalibr (fitted like the gyro, written as "
-        "accelerometer_noise_density and accelerometer_random_walk)",
-    )
-    inp.add_argument(
-        "--accel-unit",
-        choices=ACCEL_UNITS,
-        help="unit of the accelerometer columns (default: m/s^2; g = 9.80665 m/s^2)",
-    )
-
-    ana = rep.add_argument_group("analysis")
-    ana.add_argument(
-        "--taus",
-        metavar="GRID",
-        default="octave",
-        help="tau of the static analysis: octave (default), decade, exp, all, or seconds "
-        "comma-separated (0.01,0.1,1,10)",
-    )
-    ana.add_argument("--window", type=int, metavar="N", help="DAVAR window in samples (default: 1/12 of the record)")
-    ana.add_argument(
-        "--hop", type=int, metavar="N", help="DAVAR hop between windows in samples (default: 1/25 of the window)"
-    )
-    ana.add_argument(
-        "--estimator",
-        choices=("oavar", "theoh"),
-        default="oavar",
-        help="oavar: overlapping Allan deviation and DAVAR (default); theoh: TheoH for the record and "
-        "paper 001's dynamic TheoH (DHVAR) over time, reaching 75%% of the record or window "
-        "(default window then at most 2001 samples)",
-    )
-    ana.add_argument(
-        "--refine",
-        action="store_true",
-        help="also look for what the noise model lacks ("
-        + ", ".join(e.label for e in EFFECTS.values() if e.domain != "channels")
-        + ") and add a model-refinement section, with what the final model still misses (or that it passes "
-        "every calibrated check); a few seconds per axis and million samples",
-    )
-    ana.add_argument(
-        "--refine-candidates",
-        metavar="NAMES",
-        help="refine (as --refine) trying only these effects, comma-separated ("
-        + ", ".join(e.name for e in EFFECTS.values() if e.domain != "channels")
-        + "; e.g. without outliers on quantised accelerometers); 'none': only say what the five-term model "
-        "still misses",
-    )
-    ana.add_argument("--no-fit", action="store_true", help="skip the noise-model fit (whole record and per window)")
-    ana.add_argument(
-        "--max-memory",
-        type=float,
-        metavar="BYTES",
-        help="memory budget of the report (default: ALLANITE_MAX_MEMORY or 2 GiB); a request over it is "
-        "refused at once with a --hop that fits",
-    )
-    ana.add_argument(
-        "--frames",
-        type=float,
-        metavar="SEC",
-        help="time-frame DAVAR (paper 004): fit the noise model in consecutive frames of SEC seconds and add a "
-        "coefficient-forecast section (GM(1,1), improved GM(1,1) and baselines)",
-    )
-    ana.add_argument(
-        "--forecast",
-        metavar="BUILD:CHECK",
-        help="frames that build / check the forecast (e.g. 60:30; default 2/3 : 1/3 of the frames); without "
-        "--frames the record is cut into BUILD+CHECK frames",
-    )
-    ana.add_argument(
-        "--taper",
-        choices=("hann", "hann_signal"),
-        help="add a section: the DAVAR with this taper beside the rectangular one, coefficients per window (paper 002)",
-    )
-    ana.add_argument(
-        "--split",
-        metavar="WAVELET",
-        help="add a section: wavelet split (e.g. db5, 5 levels) and the window-function combination "
-        "(low band rect, high band Hann), coefficients per window (paper 002)",
-    )
-
-    out = rep.add_argument_group("output")
-    out.add_argument(
-        "--out",
-        default="allanite-report",
-        metavar="DIR",
-        help="folder for the report, created if needed (default: %(default)s)",
-    )
-    out.add_argument(
-        "--kalibr",
-        metavar="YAML",
-        help="also write a Kalibr / ROS imu.yaml (noise densities and random walks in SI, the worst axis; "
-        "needs --unit for a LOG)",
-    )
-    out.add_argument(
-        "--kalibr-aggregate",
-        choices=("worst", "mean"),
-        default="worst",
-        help="one value from the axes: the largest (default, as allan_variance_ros) or the mean (as imu_utils)",
-    )
-    out.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+    add_input_options(rep)
+    add_analysis_options(rep)
+    add_output_options(rep)
     return parser
 
 
@@ -344,7 +147,7 @@ def _isatty(stream) -> bool:
 def _spec_list(text: str, what: str):
     items = [c.strip() for c in text.split(",")]
     if not all(items):
-        raise _UsageError(f"{what} {text!r}: empty name in the comma-separated list")
+        raise UsageError(f"{what} {text!r}: empty name in the comma-separated list")
     return [int(c) if c.isdigit() else c for c in items]
 
 
@@ -354,7 +157,7 @@ def _taus(text: str):
     try:
         return [float(t) for t in text.split(",")]
     except ValueError:
-        raise _UsageError(
+        raise UsageError(
             f"argument --taus: {text!r} is neither a grid name (octave, decade, exp, all) nor comma-separated seconds"
         ) from None
 
@@ -373,6 +176,14 @@ def _cli_words(message: str) -> str:
     return " ".join(message.split())
 
 
+def _time_column(args):
+    """--time-column as read_log takes it: a 0-based index or a name; None without it."""
+    if args.time_column is None:
+        return None
+    tc = args.time_column.strip()
+    return int(tc) if tc.isdigit() else tc
+
+
 def _read(args, progress):
     path = Path(args.log)
     if not path.exists():
@@ -382,17 +193,13 @@ def _read(args, progress):
     if args.time_unit is not None:
         kwargs["time_unit"] = args.time_unit
     columns = None if args.columns is None else _spec_list(args.columns, "--columns")
-    time_column = None
-    if args.time_column is not None:
-        tc = args.time_column.strip()
-        time_column = int(tc) if tc.isdigit() else tc
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         log = read_log(
             path,
             fs=args.fs,
             columns=columns,
-            time_column=time_column,
+            time_column=_time_column(args),
             unit=args.unit,
             input=args.input or "rate",
             gaps=args.gaps or "error",
@@ -421,7 +228,7 @@ def _gyro_columns(log):
         return log, None
     gyro = [i for i, n in enumerate(names) if _GYRO_NAME.search(n) and not _ACCEL_NAME.search(n)]
     if not gyro:
-        raise _UsageError(
+        raise UsageError(
             f"{log.path.name} has accelerometer columns ({', '.join(accel)}) beside others, and its header names "
             f"none as a gyro: give the gyro's with --columns (the columns are: {', '.join(names)})"
         )
@@ -439,18 +246,14 @@ def _gyro_columns(log):
 def _kalibr(args, rep, progress) -> Path:
     """imu.yaml from the report's gyro fits and, with --accel-columns, the accelerometer's."""
     if rep.unit is None:
-        raise _UsageError(_KALIBR_NEEDS_UNIT)
+        raise UsageError(_KALIBR_NEEDS_UNIT)
     if rep.fits is None:
         raise AllaniteError(f"--kalibr needs the noise-model fit: {rep.fit_error or 'drop --no-fit'}")
     if args.accel_columns is not None and args.log is None:
-        raise _UsageError("--accel-columns describes a LOG file; the bundled record has no accelerometer")
+        raise UsageError("--accel-columns describes a LOG file; the bundled record has no accelerometer")
     accel = None
     if args.accel_columns is not None:
         progress.step("accelerometer fit")
-        time_column = None
-        if args.time_column is not None:
-            tc = args.time_column.strip()
-            time_column = int(tc) if tc.isdigit() else tc
         kwargs = {} if args.time_unit is None else {"time_unit": args.time_unit}
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the gyro read already reported the timing
@@ -458,7 +261,7 @@ def _kalibr(args, rep, progress) -> Path:
                 Path(args.log),
                 fs=args.fs,
                 columns=_spec_list(args.accel_columns, "--accel-columns"),
-                time_column=time_column,
+                time_column=_time_column(args),
                 gaps=args.gaps or "error",
                 **kwargs,
             )
@@ -486,7 +289,7 @@ def _report(args) -> int:
     if args.log is None:
         given = [f"--{o.replace('_', '-')}" for o in _LOG_OPTIONS if getattr(args, o) is not None]
         if given:
-            raise _UsageError(
+            raise UsageError(
                 f"{', '.join(given)} describe{'s' if len(given) == 1 else ''} a LOG file; without LOG "
                 f"the bundled record (100 Hz, 3 axes, deg/s) is analysed"
             )
@@ -528,7 +331,7 @@ def _report(args) -> int:
             else:
                 log, notes = _read(args, progress)
                 if args.kalibr and log.unit is None:
-                    raise _UsageError(_KALIBR_NEEDS_UNIT)
+                    raise UsageError(_KALIBR_NEEDS_UNIT)
                 if not quiet:
                     for note in notes:
                         progress.bar.write(f"allanite: warning: {note}", file=sys.stderr)
@@ -576,7 +379,7 @@ def main(argv=None) -> int:
             parser.print_help()
             return EXIT_USAGE
         return _report(args)
-    except _UsageError as exc:
+    except UsageError as exc:
         return _error(str(exc))
     except AllaniteError as exc:
         return _error(str(exc))

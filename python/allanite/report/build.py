@@ -179,27 +179,11 @@ def build_report(
         progress.add(2)
     if candidates is not None or plan is not None or taper or split:  # and the rest while more is computed
         _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete=True)
-    refinements: list[Refinement | None] | None = None
-    if candidates is not None:
-        progress.step("model refinement")
-        refinements = _refine_axes(x, fs, input, unit_name, static, axis_names, candidates, notes)
-        settings["refine_candidates"] = list(candidates)
-    frame_fits = forecasts = forecast_settings = forecast_error = None
-    if plan is not None:
-        progress.step("time frames and coefficient forecast")
-        forecast_settings = plan
-        try:
-            frame_fits, forecasts = run_forecast(x, fs, plan, unit=unit_name, input=input, confidence=confidence)
-        except AllaniteError as exc:
-            forecast_error = str(exc)
-            notes.append(f"The coefficient forecast could not be computed: {exc}")
-    paper002 = None
-    if taper or split:
-        progress.step("paper 002 sections")
-        paper002 = paper002_sections(
-            x, fs, input=input, window=dynamic.window, hop=dynamic.hop, taus=dynamic.tau, unit=unit_name,
-            axis_names=axis_names, taper=taper, split=split, notes=notes,
-        )  # fmt: skip
+    refinements = _refinement(x, fs, input, unit_name, static, axis_names, candidates, notes, settings, progress)
+    frame_fits, forecasts, forecast_settings, forecast_error = _forecast(
+        x, fs, plan, unit_name, input, confidence, notes, progress
+    )
+    paper002 = _paper002(x, fs, input, dynamic, unit_name, axis_names, taper, split, notes, progress)
     created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
     if own_bar:
         progress.close()
@@ -238,6 +222,43 @@ def _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete
             input=input, axis_names=axis_names, source={}, settings={},
         )  # fmt: skip
         _worker.offer(partial, complete=complete)
+
+
+def _refinement(x, fs, input, unit_name, static, axis_names, candidates, notes, settings, progress):
+    """Every axis's refinement (None where it failed), or None when not asked for; the effects tried go
+    into ``settings``."""
+    refinements: list[Refinement | None] | None = None
+    if candidates is not None:
+        progress.step("model refinement")
+        refinements = _refine_axes(x, fs, input, unit_name, static, axis_names, candidates, notes)
+        settings["refine_candidates"] = list(candidates)
+    return refinements
+
+
+def _forecast(x, fs, plan, unit_name, input, confidence, notes, progress) -> tuple:
+    """(frame fits, forecasts, the plan, error or None) of the time-frame section, all None without a plan;
+    a forecast that cannot be computed is a note, not a failed report."""
+    frame_fits = forecasts = forecast_error = None
+    if plan is None:
+        return None, None, None, None
+    progress.step("time frames and coefficient forecast")
+    try:
+        frame_fits, forecasts = run_forecast(x, fs, plan, unit=unit_name, input=input, confidence=confidence)
+    except AllaniteError as exc:
+        forecast_error = str(exc)
+        notes.append(f"The coefficient forecast could not be computed: {exc}")
+    return frame_fits, forecasts, plan, forecast_error
+
+
+def _paper002(x, fs, input, dynamic, unit_name, axis_names, taper, split, notes, progress) -> dict | None:
+    """Paper 002's sections (tapered DAVAR, wavelet split) on the DAVAR's windows and τ, or None unasked."""
+    if not (taper or split):
+        return None
+    progress.step("paper 002 sections")
+    return paper002_sections(
+        x, fs, input=input, window=dynamic.window, hop=dynamic.hop, taus=dynamic.tau, unit=unit_name,
+        axis_names=axis_names, taper=taper, split=split, notes=notes,
+    )  # fmt: skip
 
 
 def _axes_and_unit(x, unit, input, axis_names, notes) -> tuple:

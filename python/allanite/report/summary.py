@@ -12,12 +12,11 @@ from ..model.effects import EFFECTS, param_units
 from ..model.fitting import row_medians
 from ..model.refinement.result import term_move_text
 from ..model.refinement.words import describe_region
-from ..model.terms import TERM_NAMES
-from ..units import coefficient_unit, ieee952
+from ._fitsummary import fit_dict
 from .fmt import count, duration, g, json_list, json_number, json_value, pct, step_params
 from .forecasting import forecast_dict, forecast_text
 from .paper002 import text_lines as paper002_text
-from .settings import FIT_MODEL, NOTHING_ADDED
+from .settings import NOTHING_ADDED
 from .sidefiles import side_files_entry, uses_side_files
 
 __all__ = ["summarize", "text_summary", "refinement_dict"]
@@ -172,98 +171,6 @@ def _jsonable_test(t):
     return {k: json_number(v) for k, v in t.items()}
 
 
-def _coef_dict(c, unit, name) -> dict:
-    d = {
-        "name": TERM_NAMES[name],
-        "value": json_number(c.value),
-        "ci": [json_number(c.ci[0]), json_number(c.ci[1])],
-        "unit": c.unit,
-        "ieee": json_number(c.ieee),
-        "ieee_ci": None if c.ieee_ci is None else [json_number(c.ieee_ci[0]), json_number(c.ieee_ci[1])],
-        "ieee_unit": c.ieee_unit,
-    }
-    if name == "Q" and unit is not None:
-        q = ieee952("Q", c.value, unit, to="urad")
-        d["also"] = {
-            "value": json_number(q.value),
-            "ci": [
-                json_number(ieee952("Q", c.ci[0], unit, to="urad").value),
-                json_number(ieee952("Q", c.ci[1], unit, to="urad").value),
-            ],
-            "unit": q.unit,
-        }
-    return d
-
-
-def _readoffs(f, unit, adev_unit) -> dict:
-    r = f.readoffs
-    out = {
-        "adev_at_1s": json_number(r["adev_at_1s"]),
-        "adev_at_1s_interpolated": r["adev_at_1s_interpolated"],
-        "adev_min": json_number(r["adev_min"]),
-        "tau_at_min_s": json_number(r["tau_at_min"]),
-        "bias_instability_readoff": json_number(r["bias_instability_readoff"]),
-        "readoff_tau_max_s": json_number(r.get("readoff_tau_max")),
-        "adev_unit": adev_unit,
-    }
-    if unit is not None:
-        n_ro = ieee952("N", r["adev_at_1s"], unit) if r["adev_at_1s"] is not None else None
-        b_ro = ieee952("B", r["bias_instability_readoff"], unit)
-        out["arw_readoff_ieee"] = None if n_ro is None else json_number(n_ro.value)
-        out["arw_readoff_ieee_unit"] = ieee952("N", 1.0, unit).unit
-        out["bias_instability_readoff_ieee"] = json_number(b_ro.value)
-        out["bias_instability_readoff_ieee_unit"] = b_ro.unit
-    return out
-
-
-def _series_dict(s, unit, inline: bool = True) -> dict:
-    """One axis's coefficient series; ``inline`` False: statistics only (the per-window lists are in the
-    side files, :mod:`allanite.report.sidefiles`)."""
-    coeffs = {}
-    for t in s.terms:
-        v, lo, hi = s.values[t], s.ci_low[t], s.ci_high[t]
-        d = {
-            "name": TERM_NAMES[t],
-            "unit": coefficient_unit(t, unit) if unit is not None else None,
-            "value": json_list(v) if inline else None,
-            "ci_low": json_list(lo) if inline else None,
-            "ci_high": json_list(hi) if inline else None,
-        }
-        show, show_unit = v, d["unit"]
-        if unit is not None:
-            ie = ieee952(t, v, unit)
-            show, show_unit = np.asarray(ie.value), ie.unit
-            d.update(
-                ieee_unit=ie.unit,
-                ieee=json_list(show) if inline else None,
-                ieee_ci_low=json_list(ieee952(t, lo, unit).value) if inline else None,
-                ieee_ci_high=json_list(ieee952(t, hi, unit).value) if inline else None,
-            )
-        d["stats"] = _resolved_stats(np.asarray(show, dtype=np.float64), v, s.t, show_unit)
-        coeffs[t] = d
-    if not inline:
-        return {"t_s": None, "chi2_dof": None, "per_window": "side_files", "coefficients": coeffs}
-    return {"t_s": json_list(s.t), "chi2_dof": json_list(s.chi2_dof), "coefficients": coeffs}
-
-
-def _resolved_stats(show: np.ndarray, value: np.ndarray, t: np.ndarray, unit) -> dict:
-    """Median, minimum and maximum of a coefficient over the windows that resolve it (value > 0): a
-    window whose fit leaves the term at 0 says "at most its upper bound", not 0. None when none does."""
-    resolved = np.flatnonzero(np.asarray(value) > 0)
-    out = {"unit": unit, "windows_nonzero": int(resolved.size), "windows": int(np.size(value))}
-    if resolved.size == 0:
-        return out | {"median": None, "min": None, "t_of_min_s": None, "max": None, "t_of_max_s": None}
-    shown = show[resolved]
-    j_min, j_max = resolved[int(np.argmin(shown))], resolved[int(np.argmax(shown))]
-    return out | {
-        "median": json_number(np.median(shown)),
-        "min": json_number(show[j_min]),
-        "t_of_min_s": json_number(t[j_min]),
-        "max": json_number(show[j_max]),
-        "t_of_max_s": json_number(t[j_max]),
-    }
-
-
 def _positions(st) -> np.ndarray:
     """Terms per estimate that the reader can compare with the record: Allan τ as counted by the estimator,
     Theo τ as the N − m positions of the Theo1 sum (the double sum's (N − m)·m/2 terms exceed the record)."""
@@ -276,30 +183,57 @@ def _positions(st) -> np.ndarray:
 
 def summarize(rep) -> dict:
     """Every number of the report, JSON-able (``summary.json``)."""
-    st, dy = rep.static, rep.dynamic
     inline = not uses_side_files(rep)  # per-window lists in the JSON, or in the side files
-    adev = np.atleast_2d(st.adev)
-    lo, hi = (np.atleast_2d(a) for a in st.adev_ci)
-    fs = rep.fs
-    n = st.n_samples
-    au = rep.adev_unit
-    record = {
+    return {
+        "schema": "allanite-report/1",
+        "allanite_version": __version__,
+        "created": rep.created,
+        "unit": rep.unit,
+        "fs_hz": rep.fs,
+        "samples": rep.static.n_samples,
+        "axes": rep.n_axes,
+        "record": _record_dict(rep),
+        "notes": list(rep.notes),
+        "static": _static_dict(rep),
+        "dynamic": _dynamic_dict(rep, inline),
+        "fit": fit_dict(rep, inline),
+        "refinement": refinement_dict(rep),
+        "forecast": forecast_dict(rep),
+        "paper002": getattr(rep, "paper002", None),
+        "side_files": None if inline else side_files_entry(rep),
+        "conventions": "times and τ in s (keys ending _s), fs in Hz; Allan deviations in adev_unit (the samples' "
+        "rate unit); coefficients: value/ci in base form ('unit'), ieee/ieee_ci in IEEE-952 units "
+        "('ieee_unit'); intervals at 'confidence'; null = does not exist (unknown unit, unbounded "
+        "interval, read-off outside the τ range)",
+    }
+
+
+def _record_dict(rep) -> dict:
+    """The record: its name, samples, axes, rate, unit and source, and how the analysis held it."""
+    n = rep.static.n_samples
+    return {
         "name": rep.source.get("name", "record"),
         "samples": n,
         "axes": rep.n_axes,
         "axis_names": rep.axis_names,
-        "fs_hz": fs,
-        "duration_s": n / fs,
+        "fs_hz": rep.fs,
+        "duration_s": n / rep.fs,
         "unit": rep.unit,
         "unit_known": rep.unit is not None,
-        "adev_unit": au,
+        "adev_unit": rep.adev_unit,
         "input": rep.input,
         "source": rep.source,
         # how the analysis held the record (report/axes.py) and the report's memory estimate (report/budget.py)
         "analysed_axis_by_axis": bool(rep.settings.get("by_axis", False)),
         "memory_estimate_bytes": rep.settings.get("memory_estimate_bytes"),
     }
-    static = {
+
+
+def _static_dict(rep) -> dict:
+    """The static analysis: the Allan deviation per τ and axis with its interval, EDF and noise type."""
+    st = rep.static
+    lo, hi = (np.atleast_2d(a) for a in st.adev_ci)
+    return {
         "estimator": st.estimator,
         "grid": rep.settings["taus"],
         "confidence": st.confidence,
@@ -313,36 +247,42 @@ def summarize(rep) -> dict:
         "source": None if st.source is None else [str(v) for v in st.source],
         "kf": None if st.kf is None else json_list(np.atleast_1d(st.kf)),
         "theo_decimation": rep.settings.get("theo_decimation"),
-        "adev_unit": au,
-        "adev": json_list(adev),
+        "adev_unit": rep.adev_unit,
+        "adev": json_list(np.atleast_2d(st.adev)),
         "adev_ci_low": json_list(lo),
         "adev_ci_high": json_list(hi),
         "edf": json_list(np.atleast_2d(st.edf)),
         "alpha": json_list(np.atleast_2d(st.alpha)),
     }
-    d_axes = []
-    for k in range(rep.n_axes):
-        av = dy.avar[k]
-        row = np.sqrt(av[0])
-        med = float(np.median(row))
-        j_max, j_min = int(np.argmax(row)), int(np.argmin(row))
-        d_axes.append(
-            {
-                "axis": k,
-                "name": rep.axis_names[k],
-                "tau_s": json_number(dy.tau[0]),
-                "adev_shortest_tau_median": med,
-                "adev_shortest_tau_max": float(row[j_max]),
-                "t_of_max_s": float(dy.t[j_max]),
-                "adev_shortest_tau_min": float(row[j_min]),
-                "t_of_min_s": float(dy.t[j_min]),
-                "max_over_min": json_number(row[j_max] / row[j_min]) if row[j_min] > 0 else None,
-                "adev_median_over_time": json_list(np.sqrt(row_medians(av))),
-                "adev_min_over_time": json_list(np.sqrt(av.min(axis=1))),
-                "adev_max_over_time": json_list(np.sqrt(av.max(axis=1))),
-            }
-        )
-    dynamic = {
+
+
+def _dynamic_axis(rep, k: int) -> dict:
+    """One axis of the dynamic analysis: its ADEV at the shortest τ over time, and per τ over the windows."""
+    dy = rep.dynamic
+    av = dy.avar[k]
+    row = np.sqrt(av[0])
+    med = float(np.median(row))
+    j_max, j_min = int(np.argmax(row)), int(np.argmin(row))
+    return {
+        "axis": k,
+        "name": rep.axis_names[k],
+        "tau_s": json_number(dy.tau[0]),
+        "adev_shortest_tau_median": med,
+        "adev_shortest_tau_max": float(row[j_max]),
+        "t_of_max_s": float(dy.t[j_max]),
+        "adev_shortest_tau_min": float(row[j_min]),
+        "t_of_min_s": float(dy.t[j_min]),
+        "max_over_min": json_number(row[j_max] / row[j_min]) if row[j_min] > 0 else None,
+        "adev_median_over_time": json_list(np.sqrt(row_medians(av))),
+        "adev_min_over_time": json_list(np.sqrt(av.min(axis=1))),
+        "adev_max_over_time": json_list(np.sqrt(av.max(axis=1))),
+    }
+
+
+def _dynamic_dict(rep, inline: bool) -> dict:
+    """The dynamic analysis: the windows, their τ and times (``inline``, else in the side files), and per axis."""
+    dy, fs, n = rep.dynamic, rep.fs, rep.static.n_samples
+    return {
         "method": dy.method,
         "estimator": dy.estimator,
         "grid": rep.settings.get("dynamic_grid", "exp"),
@@ -358,73 +298,8 @@ def summarize(rep) -> dict:
         "windows": int(dy.t.size),
         "tau_s": json_list(dy.tau),
         "t_s": json_list(dy.t) if inline else None,
-        "adev_unit": au,
-        "axes": d_axes,
-    }
-    fit = {
-        "requested": rep.fit_requested,
-        "model": FIT_MODEL,
-        "unit": rep.unit,
-        "unit_known": rep.unit is not None,
-        "confidence": st.confidence if rep.fit_requested else None,
-        "error": rep.fit_error,
-        "axes": None,
-        "series": None,
-    }
-    if rep.fits is not None:
-        f0 = rep.fits[0]
-        fit["terms"] = list(f0.terms)
-        fit["confidence"] = f0.confidence
-        fit["axes"] = [
-            {
-                "axis": k,
-                "name": rep.axis_names[k],
-                "coefficients": {t: _coef_dict(f.coefficients[t], rep.unit, t) for t in f.terms},
-                "chi2": json_number(f.chi2),
-                "dof": int(f.dof),
-                "chi2_dof": json_number(f.chi2_dof),
-                "p_value": json_number(f.p_value),
-                "tau_s": json_list(f.tau),
-                "iterations": int(f.iterations),
-                "method": f.method,
-                "notes": list(f.notes),
-                "readoffs": _readoffs(f, rep.unit, au),
-            }
-            for k, f in enumerate(rep.fits)
-        ]
-    if rep.fit_requested:
-        ser = {"error": rep.series_error, "axes": None}
-        if rep.series is not None:
-            ser["terms"] = list(rep.series[0].terms)
-            ser["confidence"] = rep.series[0].confidence
-            ser["window_samples"] = int(dy.window)
-            ser["hop_samples"] = int(dy.hop)
-            ser["axes"] = [
-                dict(axis=k, name=rep.axis_names[k], **_series_dict(s, rep.unit, inline))
-                for k, s in enumerate(rep.series)
-            ]
-        fit["series"] = ser
-    return {
-        "schema": "allanite-report/1",
-        "allanite_version": __version__,
-        "created": rep.created,
-        "unit": rep.unit,
-        "fs_hz": fs,
-        "samples": n,
-        "axes": rep.n_axes,
-        "record": record,
-        "notes": list(rep.notes),
-        "static": static,
-        "dynamic": dynamic,
-        "fit": fit,
-        "refinement": refinement_dict(rep),
-        "forecast": forecast_dict(rep),
-        "paper002": getattr(rep, "paper002", None),
-        "side_files": None if inline else side_files_entry(rep),
-        "conventions": "times and τ in s (keys ending _s), fs in Hz; Allan deviations in adev_unit (the samples' "
-        "rate unit); coefficients: value/ci in base form ('unit'), ieee/ieee_ci in IEEE-952 units "
-        "('ieee_unit'); intervals at 'confidence'; null = does not exist (unknown unit, unbounded "
-        "interval, read-off outside the τ range)",
+        "adev_unit": rep.adev_unit,
+        "axes": [_dynamic_axis(rep, k) for k in range(rep.n_axes)],
     }
 
 
@@ -434,19 +309,31 @@ def summarize(rep) -> dict:
 
 def text_summary(s: dict) -> str:
     """The terminal summary of a report's :func:`summarize` output."""
-    rec, st, dy, fit = s["record"], s["static"], s["dynamic"], s["fit"]
-    names = rec["axis_names"]
-    au = rec["adev_unit"] or "samples' unit"
+    rec = s["record"]
     lines = [
         f"allanite report: {rec['name']}",
-        f"  {rec['samples']} samples × {count(rec['axes'], 'axis', 'axes')} ({', '.join(names)}) at "
+        f"  {rec['samples']} samples × {count(rec['axes'], 'axis', 'axes')} ({', '.join(rec['axis_names'])}) at "
         f"{rec['fs_hz']:g} Hz = "
         f"{duration(rec['duration_s'])}; unit {rec['unit'] or 'unknown (give --unit)'}, {rec['input']} input",
     ]
     for note in s["notes"]:
         lines.append(f"  note: {note}")
+    lines += _adev_text(s)
+    lines += _fit_text(s)
+    lines += _dynamic_text(s)
+    lines += _refinement_text(s)
+    lines += forecast_text(s.get("forecast"))
+    lines += paper002_text(s.get("paper002"))
+    return "\n".join(lines)
+
+
+def _adev_text(s: dict) -> list[str]:
+    """The static Allan deviation: a table of τ, n and each axis's value with its interval."""
+    rec, st = s["record"], s["static"]
+    names = rec["axis_names"]
+    au = rec["adev_unit"] or "samples' unit"
     conf = st["confidence"]
-    lines += ["", f"Overlapping Allan deviation ({au}), {conf:.1%} interval as −/+ % of the value"]
+    lines = ["", f"Overlapping Allan deviation ({au}), {conf:.1%} interval as −/+ % of the value"]
     w = 27
     lines.append(f"  {'tau (s)':>9} {'n':>10}  " + "".join(f"{nm[: w - 1]:<{w}}" for nm in names).rstrip())
     for i, tau in enumerate(st["tau_s"]):
@@ -455,47 +342,55 @@ def text_summary(s: dict) -> str:
             v, lo, hi = st["adev"][k][i], st["adev_ci_low"][k][i], st["adev_ci_high"][k][i]
             cells.append(f"{g(v):>10} (−{pct(v, lo)}/+{pct(v, hi)} %)".ljust(w))
         lines.append(f"  {tau:>9.4g} {st['n'][i]:>10}  " + "".join(cells).rstrip())
+    return lines
 
-    if fit["axes"] is not None:
-        ieee = fit["unit_known"]
-        lines += [
-            "",
-            f"Noise model (IEEE 952) {'in IEEE-952 units' if ieee else 'in base form (unit unknown)'}, "
-            f"{fit['confidence']:.1%} intervals",
-            f"  {fit['model']}",
-        ]
-        w2 = 26
-        lines.append(f"  {'term':<25}{'unit':<10}" + "".join(f"{nm[: w2 - 1]:<{w2}}" for nm in names).rstrip())
-        for t in fit["terms"]:
-            c0 = fit["axes"][0]["coefficients"][t]
-            unit = (c0["ieee_unit"] if ieee else c0["unit"]) or ""
-            cells = []
-            for ax in fit["axes"]:
-                c = ax["coefficients"][t]
-                v, ci = (c["ieee"], c["ieee_ci"]) if ieee else (c["value"], c["ci"])
-                cells.append(f"{g(v, 3)} [{g(ci[0], 3)}, {g(ci[1] if ci[1] is not None else math.inf, 3)}]".ljust(w2))
-            lines.append(f"  {t + ' ' + c0['name']:<25}{unit:<10}" + "".join(cells).rstrip())
-        lines.append(
-            f"  {'χ²/dof':<25}{'':<10}" + "".join(f"{g(ax['chi2_dof'], 3):<{w2}}" for ax in fit["axes"]).rstrip()
-        )
-        ro = [ax["readoffs"] for ax in fit["axes"]]
-        if ieee:
-            lines.append(
-                f"  {'read-off N = σ(1 s)':<25}{ro[0]['arw_readoff_ieee_unit']:<10}"
-                + "".join(f"{g(r['arw_readoff_ieee'], 3):<{w2}}" for r in ro).rstrip()
-            )
-            lines.append(
-                f"  {'read-off B = σmin/0.664':<25}{ro[0]['bias_instability_readoff_ieee_unit']:<10}"
-                + "".join(f"{g(r['bias_instability_readoff_ieee'], 3):<{w2}}" for r in ro).rstrip()
-            )
-        lines.append(
-            f"  {'σmin (at τ)':<25}{rec['adev_unit'] or '':<10}"
-            + "".join(f"{g(r['adev_min'], 3) + ' (' + g(r['tau_at_min_s'], 3) + ' s)':<{w2}}" for r in ro).rstrip()
-        )
-    elif fit["requested"] and fit["error"]:
-        lines += ["", f"Noise model: not fitted ({fit['error']})"]
 
-    lines += [
+def _fit_text(s: dict) -> list[str]:
+    """The noise model: a table of terms × axes with intervals, χ²/dof and the read-offs (or why not fitted)."""
+    rec, fit = s["record"], s["fit"]
+    names = rec["axis_names"]
+    if fit["axes"] is None:
+        return ["", f"Noise model: not fitted ({fit['error']})"] if fit["requested"] and fit["error"] else []
+    ieee = fit["unit_known"]
+    lines = [
+        "",
+        f"Noise model (IEEE 952) {'in IEEE-952 units' if ieee else 'in base form (unit unknown)'}, "
+        f"{fit['confidence']:.1%} intervals",
+        f"  {fit['model']}",
+    ]
+    w2 = 26
+    lines.append(f"  {'term':<25}{'unit':<10}" + "".join(f"{nm[: w2 - 1]:<{w2}}" for nm in names).rstrip())
+    for t in fit["terms"]:
+        c0 = fit["axes"][0]["coefficients"][t]
+        unit = (c0["ieee_unit"] if ieee else c0["unit"]) or ""
+        cells = []
+        for ax in fit["axes"]:
+            c = ax["coefficients"][t]
+            v, ci = (c["ieee"], c["ieee_ci"]) if ieee else (c["value"], c["ci"])
+            cells.append(f"{g(v, 3)} [{g(ci[0], 3)}, {g(ci[1] if ci[1] is not None else math.inf, 3)}]".ljust(w2))
+        lines.append(f"  {t + ' ' + c0['name']:<25}{unit:<10}" + "".join(cells).rstrip())
+    lines.append(f"  {'χ²/dof':<25}{'':<10}" + "".join(f"{g(ax['chi2_dof'], 3):<{w2}}" for ax in fit["axes"]).rstrip())
+    ro = [ax["readoffs"] for ax in fit["axes"]]
+    if ieee:
+        lines.append(
+            f"  {'read-off N = σ(1 s)':<25}{ro[0]['arw_readoff_ieee_unit']:<10}"
+            + "".join(f"{g(r['arw_readoff_ieee'], 3):<{w2}}" for r in ro).rstrip()
+        )
+        lines.append(
+            f"  {'read-off B = σmin/0.664':<25}{ro[0]['bias_instability_readoff_ieee_unit']:<10}"
+            + "".join(f"{g(r['bias_instability_readoff_ieee'], 3):<{w2}}" for r in ro).rstrip()
+        )
+    lines.append(
+        f"  {'σmin (at τ)':<25}{rec['adev_unit'] or '':<10}"
+        + "".join(f"{g(r['adev_min'], 3) + ' (' + g(r['tau_at_min_s'], 3) + ' s)':<{w2}}" for r in ro).rstrip()
+    )
+    return lines
+
+
+def _dynamic_text(s: dict) -> list[str]:
+    """The dynamic Allan deviation: the windows, each axis's ADEV over time, the coefficients over the windows."""
+    dy, fit = s["dynamic"], s["fit"]
+    lines = [
         "",
         f"Dynamic Allan deviation: window {dy['window_samples']} samples ({g(dy['window_s'])} s, "
         f"{dy['window_rule']}), hop {dy['hop_samples']} ({g(dy['hop_s'])} s, {dy['hop_rule']}); "
@@ -528,25 +423,30 @@ def text_summary(s: dict) -> str:
             lines.append(f"    {ax['name']}: " + ("; ".join(parts) or "all zero"))
     elif ser and ser["error"]:
         lines.append(f"  noise coefficients over time: not fitted ({ser['error']})")
-    ref = s.get("refinement")
-    if ref is not None:
-        lines += ["", "Model refinement (what the five-term model lacks; allanite.refine)"]
-        for ax in ref["axes"]:
-            if ax.get("error"):
-                lines.append(f"  {ax['name']}: failed (see the notes)")
-                continue
-            found = ", ".join(st["effect"] for st in ax["steps"]) or NOTHING_ADDED
-            a, b = ax["start"], ax["final"]
+    return lines
+
+
+def _refinement_text(s: dict) -> list[str]:
+    """The model refinement per axis: the effects found, the curve's errors start → final, each step's
+    parameters, the coefficients that moved, and what the final model still misses."""
+    rec, ref = s["record"], s.get("refinement")
+    if ref is None:
+        return []
+    lines = ["", "Model refinement (what the five-term model lacks; allanite.refine)"]
+    for ax in ref["axes"]:
+        if ax.get("error"):
+            lines.append(f"  {ax['name']}: failed (see the notes)")
+            continue
+        found = ", ".join(st["effect"] for st in ax["steps"]) or NOTHING_ADDED
+        a, b = ax["start"], ax["final"]
+        lines.append(
+            f"  {ax['name']}: {found}; curve χ²/dof {g(a['chi2_dof'], 3)} → {g(b['chi2_dof'], 3)}, "
+            f"RMS ADEV error {g(a['rms_adev_pct'], 3)} → {g(b['rms_adev_pct'], 3)} %"
+        )
+        for st in ax["steps"]:
             lines.append(
-                f"  {ax['name']}: {found}; curve χ²/dof {g(a['chi2_dof'], 3)} → {g(b['chi2_dof'], 3)}, "
-                f"RMS ADEV error {g(a['rms_adev_pct'], 3)} → {g(b['rms_adev_pct'], 3)} %"
+                f"    {st['effect']}: {step_params(st, rec['fs_hz'], rec['duration_s'], units=True, final=True)}"
             )
-            for st in ax["steps"]:
-                lines.append(
-                    f"    {st['effect']}: {step_params(st, rec['fs_hz'], rec['duration_s'], units=True, final=True)}"
-                )
-            lines += [f"    {m['text']}" for m in ax.get("term_moves", [])]
-            lines += [f"    {t}" for t in ax.get("still_missing", [])]
-    lines += forecast_text(s.get("forecast"))
-    lines += paper002_text(s.get("paper002"))
-    return "\n".join(lines)
+        lines += [f"    {m['text']}" for m in ax.get("term_moves", [])]
+        lines += [f"    {t}" for t in ax.get("still_missing", [])]
+    return lines

@@ -1,5 +1,5 @@
 //! Times the core on the large case without Python: `cargo run --release --example profile`.
-use allanite_core::{dynamic_avar, run_in_pool, Estimator, Method, Request};
+use allanite_core::{dynamic_avar, run_in_pool, Request};
 use std::time::Instant;
 
 fn main() {
@@ -35,14 +35,7 @@ fn main() {
     }
     let cols = [&y[..]];
     for workers in [1, 2] {
-        let req = Request {
-            columns: &cols,
-            window,
-            hop,
-            ms: &ms,
-            estimator: Estimator::Overlapping,
-            method: Method::Fast,
-        };
+        let req = Request::overlapping(&cols, window, hop, &ms);
         let t = Instant::now();
         let (out, nw) = run_in_pool(workers, || dynamic_avar(&req))
             .unwrap()
@@ -56,14 +49,7 @@ pub fn per_m(y: &[f64], window: usize, hop: usize) {
     let cols = [y];
     for m in [1usize, 4, 8, 9, 16, 32, 64, 100, 1000, 10000, 100000] {
         let ms = [m; 8];
-        let req = Request {
-            columns: &cols,
-            window,
-            hop,
-            ms: &ms,
-            estimator: Estimator::Overlapping,
-            method: Method::Fast,
-        };
+        let req = Request::overlapping(&cols, window, hop, &ms);
         let t = Instant::now();
         run_in_pool(1, || dynamic_avar(&req)).unwrap().unwrap();
         println!(

@@ -495,14 +495,7 @@ mod tests {
         let (window, hop) = (2600, 130);
         let ms = [1, 4, 33, 500, 1300];
         let cols = [y.as_slice()];
-        let req = Request {
-            columns: &cols,
-            window,
-            hop,
-            ms: &ms,
-            estimator: Estimator::Overlapping,
-            method: Method::Fast,
-        };
+        let req = Request::overlapping(&cols, window, hop, &ms);
         let (got, n_win) = dynamic_avar(&req).unwrap();
         assert_eq!(
             crate::allan::part_grid(n, 1, window, hop, Estimator::Overlapping, Method::Fast),

@@ -33,7 +33,7 @@ pub(crate) const GATHER_MAX: usize = 1 << 26;
 
 /// Error-free sum: a + b = s + e exactly (Knuth).
 #[inline(always)]
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
     let s = a + b;
     let bb = s - a;
     let e = (a - (s - bb)) + (b - bb);

@@ -43,7 +43,9 @@
 //! formed by one sequential routine (whose single- or double-word choice depends on the data and
 //! that grid only), and the partials are added in chunk order.
 
+use crate::allan::block_window_sums;
 use crate::cancel::Cancel;
+use crate::gather::two_sum;
 use crate::range::Range;
 use rayon::prelude::*;
 
@@ -57,15 +59,6 @@ const SUPER: usize = 16;
 const SHORT_M: usize = CHUNK / 2;
 /// Independent partial sums per chunk and m (the vector width the term loop is written for).
 const LANES: usize = 8;
-
-/// Error-free sum: a + b = s + e exactly (Knuth).
-#[inline(always)]
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let s = a + b;
-    let bb = s - a;
-    let e = (a - (s - bb)) + (b - bb);
-    (s, e)
-}
 
 /// The double-word total of `src − μ` (each fl(v − μ) as the prefix pass rounds it), in `LANES`
 /// independent TwoSum accumulators so that it vectorises; their exact errors are kept and the lanes
@@ -803,16 +796,7 @@ pub(crate) fn overlapping_dynamic_tiled(
         let block = |b: usize| sums[((b / tile_blocks) * n_m + t) * tile_blocks + b % tile_blocks];
         let part: Vec<f64> = (0..nb).map(|b| block(b).0 * norm).collect();
         let full: Vec<f64> = (0..nb).map(|b| block(b).1 * norm).collect();
-        if q == 0 {
-            row.copy_from_slice(&part[..n_win]);
-        } else {
-            crate::allan::sliding_sums(&full, q, row);
-            if r != 0 {
-                for (o, p) in row.iter_mut().zip(&part[q..]) {
-                    *o += p;
-                }
-            }
-        }
+        block_window_sums(&full, &part, (q, r), (0, n_win), row);
     });
 }
 

@@ -31,7 +31,8 @@
 //! any number of worker threads.
 
 use crate::allan::{
-    compensated_mean, for_each_term_chunk, sum4, validate, Estimator, Method, Request,
+    centred_angle, compensated_mean, for_each_term_chunk, naive_rows, sum4, validate, Estimator,
+    Method, Request,
 };
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
@@ -373,14 +374,7 @@ fn hann_row(
 /// the squared second differences (the definition; the reference for the fast path).
 fn naive_window(yw: &[f64], ms: &[usize], angle: &mut Vec<f64>, out: &mut [f64]) {
     let n = yw.len();
-    let mu = yw.iter().sum::<f64>() / n as f64;
-    angle.clear();
-    angle.push(0.0);
-    let mut x = 0.0;
-    for &v in yw {
-        x += v - mu;
-        angle.push(x);
-    }
+    centred_angle(yw, angle);
     let xs = &angle[..];
     for (o, &m) in out.iter_mut().zip(ms) {
         let mt = n + 1 - 2 * m;
@@ -434,27 +428,9 @@ pub fn dynamic_hann_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
             );
         }
         Method::Naive => {
-            for (a, y) in req.columns.iter().enumerate() {
-                let cols: Vec<Vec<f64>> = (0..n_win)
-                    .into_par_iter()
-                    .map_init(Vec::new, |angle, j| {
-                        let s = j * req.hop;
-                        let mut col = vec![0.0; n_m];
-                        if cancel.is_cancelled() {
-                            return col;
-                        }
-                        naive_window(&y[s..s + req.window], req.ms, angle, &mut col);
-                        col
-                    })
-                    .collect();
-                cancel.check()?;
-                let block = &mut out[a * n_m * n_win..(a + 1) * n_m * n_win];
-                for (j, col) in cols.iter().enumerate() {
-                    for (t, v) in col.iter().enumerate() {
-                        block[t * n_win + j] = *v;
-                    }
-                }
-            }
+            naive_rows(req, n_win, &mut out, cancel, |yw, angle, col| {
+                naive_window(yw, req.ms, angle, col)
+            })?;
         }
     }
     cancel.check()?;
@@ -564,14 +540,7 @@ mod tests {
     fn too_few_terms_is_an_error() {
         let y = noise(100, 1);
         let cols = [&y[..]];
-        let req = Request {
-            columns: &cols,
-            window: 10,
-            hop: 1,
-            ms: &[4],
-            estimator: Estimator::Overlapping,
-            method: Method::Fast,
-        };
+        let req = Request::overlapping(&cols, 10, 1, &[4]);
         assert!(dynamic_hann(&req).is_ok()); // M = 3: the fewest allowed
         let req = Request { ms: &[5], ..req };
         let e = dynamic_hann(&req).unwrap_err().to_string();

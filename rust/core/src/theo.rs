@@ -32,7 +32,8 @@
 //! mean and slope, so one record-wide mean serves every window.
 
 use crate::allan::{
-    check_finite, check_shape, compensated_mean, sliding_sums, sum4, TermScratch, DIRECT_M,
+    check_finite, check_shape, check_window_hop, compensated_mean, sliding_sums, sum4, TermScratch,
+    DIRECT_M,
 };
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
@@ -563,16 +564,7 @@ pub fn dynamic_theo1_cancellable(
     cancel: &Cancel,
 ) -> Result<(Vec<f64>, usize)> {
     let n = check_columns(columns)?;
-    if window < 2 || window > n {
-        return Err(CoreError::InvalidParameter(format!(
-            "window ({window} samples) must be between 2 and the record length ({n} samples)"
-        )));
-    }
-    if hop == 0 {
-        return Err(CoreError::InvalidParameter(
-            "hop (0) must be at least 1 sample".into(),
-        ));
-    }
+    check_window_hop(window, hop, n, 2)?;
     check_ms(window, ms, "window")?;
     let n_win = crate::allan::n_windows(n, window, hop);
     let (u, pos) = sorted_unique(ms);

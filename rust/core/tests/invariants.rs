@@ -148,14 +148,7 @@ fn errors_name_the_value() {
     let y = [0.0; 10];
     let cols = [&y[..]];
     let bad = |window, hop, ms: &[usize]| {
-        let req = Request {
-            columns: &cols,
-            window,
-            hop,
-            ms,
-            estimator: Estimator::Overlapping,
-            method: Method::Fast,
-        };
+        let req = Request::overlapping(&cols, window, hop, ms);
         dynamic_avar(&req).unwrap_err().to_string()
     };
     assert!(bad(11, 1, &[1]).contains("window (11 samples)"));
