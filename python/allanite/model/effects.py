@@ -14,7 +14,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy import signal
 
 from ..errors import ParameterError
 
@@ -87,6 +86,8 @@ def two_pole_terms(fc: float, fs: float) -> tuple[float, np.ndarray, np.ndarray]
     H(1)² (= 1 up to rounding) so that Σ_l r(|l|) = 1."""
     if not 0.0 < fc < fs / 2.0:
         raise ParameterError(f"two-pole cutoff {fc!r} Hz: must lie in (0, fs/2 = {fs / 2.0!r})")
+    from scipy import signal  # here, not at import: `import allanite` stays free of scipy.signal
+
     b, a = signal.butter(2, fc, fs=fs)
     res, poles, k = signal.residuez(b, a)
     kk = complex(k[0]) if len(k) else 0.0j
