@@ -279,7 +279,7 @@ _READ_ONCE = (
 )
 
 
-def _report_cmd(path: Path, out: Path) -> list:
+def _scale_report_cmd(path: Path, out: Path) -> list:
     return [sys.executable, "-m", "allanite", "report", str(path), "--fs", "100", "--unit", "deg/s", "--out", str(out)]
 
 
@@ -292,9 +292,9 @@ def row_scale(n: int, scratch: Path, tmp: Path, baseline: Path | None = None) ->
         _write_scale_record(path, n)
         size = path.stat().st_size
         out = tmp / "scale"
-        r = run_timed(_report_cmd(path, out), _env(REPO / "python"), 3600)
+        r = run_timed(_scale_report_cmd(path, out), _env(REPO / "python"), 3600)
         if baseline is not None:
-            b = run_timed(_report_cmd(path, tmp / "scale_before"), _env(baseline), 3600)
+            b = run_timed(_scale_report_cmd(path, tmp / "scale_before"), _env(baseline), 3600)
             before = {k: b[k] for k in ("wall_s", "cpu_s", "peak_rss_mb", "status")}
         # the same run's reference: one read of the whole file (one axis's column through the file, as the
         # report reads each axis), in a fresh process
