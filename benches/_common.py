@@ -1,5 +1,6 @@
 """Helpers shared by the bench scripts: where the shared data live, timing, machine facts, the
-load of other processes, and the reader of the ``avar`` package's Allan curves.
+load of other processes, the cells and files of the refine benches' results pages, and the reader of the
+``avar`` package's Allan curves.
 
 The scripts in this folder are run as ``python benches/<script>.py``; Python puts the script's own folder
 first on ``sys.path``, so they take these helpers with a plain ``import _common`` (no path editing, and
@@ -9,6 +10,7 @@ first on ``sys.path``, so they take these helpers with a plain ``import _common`
 from __future__ import annotations
 
 import datetime as _dt
+import json
 import os
 import platform
 import re
@@ -227,6 +229,78 @@ def wait_idle(max_wait: float, threshold: float = 0.10) -> dict:
 
 def log(msg: str) -> None:
     print(msg, flush=True)
+
+
+# ----------------------------------------------------------------------------------------------
+# results pages: the cells and the files the refine benches' tables share
+
+
+def machine_line(m: dict | None = None) -> str:
+    """Where a results page was written: ``cpu, N CPUs, allanite at <commit>, <date>`` (``m``: a
+    :func:`machine_info`, this machine's by default)."""
+    m = machine_info() if m is None else m
+    return f"{m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at {m['git_commit']}, {m['date_utc'][:10]}"
+
+
+def rejection_rates(p, levels) -> dict:
+    """For each level (keyed ``f"{level:g}"``): how many of the p-values ``p`` are ≤ it, their share, and
+    the share's 95 % Clopper–Pearson interval — a calibration table's row."""
+    p = np.asarray(p)
+    rates = {}
+    for lv in levels:
+        k = int(np.sum(p <= lv))
+        rates[f"{lv:g}"] = {
+            "rejections": k,
+            "rate": float(np.mean(p <= lv)),
+            "interval_95": clopper_pearson(k, int(p.size)),
+        }
+    return rates
+
+
+def rate_cell(r: dict, count: bool = False) -> str:
+    """One of :func:`rejection_rates`' entries as ``1.25 % (0.40–2.90)`` (rate and interval in percent);
+    with ``count``, the rejections first: ``3 = 1.25 % (0.40–2.90)``."""
+    lo, hi = r["interval_95"]
+    text = f"{100 * r['rate']:.2f} % ({100 * lo:.2f}–{100 * hi:.2f})"
+    return f"{r['rejections']} = {text}" if count else text
+
+
+def arrow_cell(p) -> str:
+    """A (before, after) pair as ``a → b`` to 3 digits; ``—`` without a before, ``a → —`` without an after."""
+    if not p or p[0] is None:
+        return "—"
+    return f"{p[0]:.3g} → {p[1]:.3g}" if p[1] is not None else f"{p[0]:.3g} → —"
+
+
+def param_errors_cell(errors: dict) -> str:
+    """A verdict's parameter errors as ``name +1.2%`` (a float: relative error) or ``name text``, the
+    parameters without one left out ("" when none has one)."""
+    return ", ".join(
+        f"{k} {e:+.1%}" if isinstance(e, float) else f"{k} {e}" for k, e in errors.items() if e is not None
+    )
+
+
+def steps_cell(steps: list, digits: int) -> str:
+    """refine's steps as ``effect (parameter value, …)`` joined by ``; `` (floats to ``digits`` significant
+    digits), or ``nothing``."""
+    out = []
+    for s in steps:
+        ps = ", ".join(f"{k} {x:.{digits}g}" if isinstance(x, float) else f"{k} {x}" for k, x in s["params"].items())
+        out.append(f"{s['effect']} ({ps})")
+    return "; ".join(out) or "nothing"
+
+
+def without_candidate_cell(left) -> str:
+    """What ``unexplained`` said when the effect's candidate was left out: ``—`` (not run), ``**none**``
+    or how many regions."""
+    return "—" if left is None else ("**none**" if not left else f"{len(left)} region(s)")
+
+
+def write_results(out: Path, stem: str, lines: list, results, end: str = "\n") -> None:
+    """A bench's page ``<stem>.md`` (``lines`` joined by newlines, then ``end``) and its ``<stem>.json``
+    (``results``; NumPy scalars as floats)."""
+    (out / f"{stem}.md").write_text("\n".join(lines) + end)
+    (out / f"{stem}.json").write_text(json.dumps(results, indent=1, default=float))
 
 
 # ----------------------------------------------------------------------------------------------

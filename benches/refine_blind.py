@@ -24,7 +24,6 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import tempfile
@@ -280,47 +279,30 @@ def run_case(case: Blind) -> dict:
     return v
 
 
-def _pair(p) -> str:
-    if not p or p[0] is None:
-        return "—"
-    return f"{p[0]:.3g} → {p[1]:.3g}" if p[1] is not None else f"{p[0]:.3g} → —"
-
-
-def _params(v) -> str:
-    out = []
-    for s in v["steps"]:
-        ps = ", ".join(f"{k} {x:.4g}" if isinstance(x, float) else f"{k} {x}" for k, x in s["params"].items())
-        out.append(f"{s['effect']} ({ps})")
-    return "; ".join(out) or "nothing"
-
-
 def _row(v) -> str:
     injected = ", ".join(i["effect"] for i in v["injected"]) or "— (clean)"
-    errs = ", ".join(
-        f"{k} {e:+.1%}" if isinstance(e, float) else f"{k} {e}" for k, e in v["param_errors"].items() if e is not None
-    )
+    errs = _common.param_errors_cell(v["param_errors"])
     left = v["unexplained"]
     left_s = "none" if not left else "; ".join(describe_region(u) for u in left[:3])
     wc = v.get("without_candidate")
-    blind_s = "—" if wc is None else ("**none**" if not wc["unexplained"] else f"{len(wc['unexplained'])} region(s)")
-    chi = _pair(v.get("chi2_dof")) if v.get("chi2_dof") else f"{v['start_chi2_dof']:.3g} (nothing added)"
+    blind_s = _common.without_candidate_cell(None if wc is None else wc["unexplained"])
+    chi = _common.arrow_cell(v.get("chi2_dof")) if v.get("chi2_dof") else f"{v['start_chi2_dof']:.3g} (nothing added)"
     return (
-        f"| {v['name']} | {injected} | {_params(v)} | {errs or '—'} | {chi} | {_pair(v.get('rms_adev_pct'))} | "
-        f"{_pair(v.get('heldout_rms_adev_pct'))} | {left_s} | {blind_s} | {'✓' if v['passed'] else '✗'} | "
+        f"| {v['name']} | {injected} | {_common.steps_cell(v['steps'], 4)} | {errs or '—'} | {chi} | "
+        f"{_common.arrow_cell(v.get('rms_adev_pct'))} | {_common.arrow_cell(v.get('heldout_rms_adev_pct'))} | {left_s} | {blind_s} | {'✓' if v['passed'] else '✗'} | "
         f"{v['cpu_seconds']:.0f} |"
     )
 
 
 def write(results, out: Path, load, notes: list) -> None:
-    m = _common.machine_info()
     passed = sum(v["passed"] for v in results)
     with_inj = [v for v in results if v["injected"]]
     flagged = sum(v.get("without_candidate_flags", False) for v in with_inj)
     lines = [
         "# refine on a blind suite of simulated sensors (issue 29)",
         "",
-        f"Default call, `python benches/refine_blind.py`, {m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at "
-        f"{m['git_commit']}, {m['date_utc'][:10]}; other processes used {load:.0%} of the CPUs during the run "
+        f"Default call, `python benches/refine_blind.py`, {_common.machine_line()}; other processes used {load:.0%} "
+        "of the CPUs during the run "
         "(the last column is this process's CPU seconds for the default call).",
         "",
         f"**Passed: {passed} of {len(results)}** (named, parameters within 20 %, frequencies within 1 %, χ²/dof "
@@ -336,8 +318,7 @@ def write(results, out: Path, load, notes: list) -> None:
         "",
         *notes,
     ]
-    (out / "refine_blind.md").write_text("\n".join(lines) + "\n")
-    (out / "refine_blind.json").write_text(json.dumps(results, indent=1, default=float))
+    _common.write_results(out, "refine_blind", lines, results)
 
 
 #: What the table shows and why (kept true to the recorded run).

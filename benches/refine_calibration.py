@@ -118,14 +118,7 @@ def run(per_mix: int, out: Path) -> dict:
             "alpha": a,
             "records": int(allp.size),
             "by_mixture": {m: int(np.sum(np.asarray(v) <= a)) for m, v in p[t].items()},
-            "rates": {
-                f"{lv:g}": {
-                    "rejections": int(np.sum(allp <= lv)),
-                    "rate": float(np.mean(allp <= lv)),
-                    "interval_95": _common.clopper_pearson(int(np.sum(allp <= lv)), int(allp.size)),
-                }
-                for lv in levels
-            },
+            "rates": _common.rejection_rates(allp, levels),
         }
     report = {
         "level": LEVEL,
@@ -170,17 +163,13 @@ def _markdown(report: dict) -> str:
         "|---|---|---|---|---|---|---|---|",
     ]
 
-    def cell(r):
-        lo, hi = r["interval_95"]
-        return f"{100 * r['rate']:.2f} % ({100 * lo:.2f}–{100 * hi:.2f})"
-
     for t, r in report["tests"].items():
         at = r["rates"]
         own = at[f"{r['alpha']:g}"]
         by = ", ".join(f"{m} {c}" for m, c in r["by_mixture"].items())
-        more = [cell(at[f"{lv:g}"]) if f"{lv:g}" in at else "—" for lv in LEVELS]
+        more = [_common.rate_cell(at[f"{lv:g}"]) if f"{lv:g}" in at else "—" for lv in LEVELS]
         md.append(
-            f"| {t} | {r['alpha']:.4g} | {r['records']} | {own['rejections']} ({by}) | {cell(own)} | "
+            f"| {t} | {r['alpha']:.4g} | {r['records']} | {own['rejections']} ({by}) | {_common.rate_cell(own)} | "
             + " | ".join(more)
             + " |"
         )

@@ -21,7 +21,6 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import time
 import warnings
@@ -94,14 +93,6 @@ def run_channel(sensor: str, channel: str, res) -> dict:
     return row
 
 
-def _steps(row) -> str:
-    out = []
-    for s in row["steps"]:
-        ps = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in s["params"].items())
-        out.append(f"{s['effect']} ({ps})")
-    return "; ".join(out) or "nothing"
-
-
 def _sane(s: dict) -> str:
     if "N_ieee" not in s:
         return f"N/vignette {s['N_over_vignette']:.2f}" if "N_over_vignette" in s else "—"
@@ -122,21 +113,20 @@ def _row(row) -> str:
     warn = f" ⚠ {len(row['warnings'])} warning(s)" if row["warnings"] else ""
     return (
         f"| {name} | {row['plain_chi2_dof']:.3g} | {row['start_chi2_dof']:.3g} → {row['final_chi2_dof']:.3g} | "
-        f"{_steps(row)}{warn} | {left} | {_sane(row['sanity_plain'])} | {_sane(row['sanity_refined'])} | "
+        f"{_common.steps_cell(row['steps'], 3)}{warn} | {left} | {_sane(row['sanity_plain'])} | {_sane(row['sanity_refined'])} | "
         f"{row['cpu_seconds']:.1f} |"
     )
 
 
 def write(rows, out: Path, load: float, notes: list) -> None:
-    m = _common.machine_info()
     crashes = sum("error" in r for r in rows)
     silent = sum(r.get("silent_misfit", False) for r in rows)
     warned = sum(bool(r.get("warnings")) for r in rows)
     lines = [
         "# refine on the Allan curves of five real IMUs (curves only)",
         "",
-        f"`python benches/refine_curves.py`, {m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at "
-        f"{m['git_commit']}, {m['date_utc'][:10]}; other processes used {load:.0%} of the CPUs during the run. "
+        f"`python benches/refine_curves.py`, {_common.machine_line()}; other processes used {load:.0%} of the CPUs "
+        "during the run. "
         "Default calls `allanite.fit(curve)` and `allanite.refine(curve)` on every channel of "
         "`../shared/data/avar-curves` (one τ per octave, from m = 2; raw units). χ²/dof: the plain fit's, then "
         "refine's start → final model. Found: the steps at acceptance (raw units; f0, cutoff in Hz, T_c in s). "
@@ -154,8 +144,7 @@ def write(rows, out: Path, load: float, notes: list) -> None:
         "",
         *notes,
     ]
-    (out / "refine_curves.md").write_text("\n".join(lines) + "\n")
-    (out / "refine_curves.json").write_text(json.dumps(rows, indent=1, default=float))
+    _common.write_results(out, "refine_curves", lines, rows)
 
 
 #: What the run showed and what was changed because of it (kept true to the recorded run).

@@ -19,7 +19,6 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import tempfile
 import time
@@ -32,13 +31,6 @@ from allanite.model.refinement.words import describe_region
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "tests"))
 import sensors  # noqa: E402
-
-
-def _fmt_pair(p) -> str:
-    if not p or p[0] is None:
-        return "—"
-    a, b = p
-    return f"{a:.3g} → {b:.3g}" if b is not None else f"{a:.3g} → —"
 
 
 def run_case(case) -> dict:
@@ -60,16 +52,13 @@ def run_case(case) -> dict:
 
 def _row(v) -> str:
     injected = ", ".join(i["effect"] for i in v["injected"])
-    errs = ", ".join(
-        f"{k} {e:+.1%}" if isinstance(e, float) else f"{k} {e}" for k, e in v["param_errors"].items() if e is not None
-    )
+    errs = _common.param_errors_cell(v["param_errors"])
     left = v["unexplained"]
     left_s = "—" if left is None else ("none" if not left else _regions(left))
-    blind = v["without_candidate"]["unexplained"]
-    blind_s = "—" if blind is None else ("**none**" if not blind else f"{len(blind)} region(s)")
+    blind_s = _common.without_candidate_cell(v["without_candidate"]["unexplained"])
     return (
-        f"| {v['name']} | {injected} | {', '.join(v['found']) or '—'} | {errs or '—'} | {_fmt_pair(v.get('chi2_dof'))} | "
-        f"{_fmt_pair(v.get('rms_adev_pct'))} | {_fmt_pair(v.get('heldout_rms_adev_pct'))} | {left_s} | {blind_s} | "
+        f"| {v['name']} | {injected} | {', '.join(v['found']) or '—'} | {errs or '—'} | {_common.arrow_cell(v.get('chi2_dof'))} | "
+        f"{_common.arrow_cell(v.get('rms_adev_pct'))} | {_common.arrow_cell(v.get('heldout_rms_adev_pct'))} | {left_s} | {blind_s} | "
         f"{'✓' if v['passed'] else '✗'} | {v['seconds']:.1f} |"
     )
 
@@ -78,11 +67,6 @@ def _regions(left: list, most: int = 3) -> str:
     """The first regions of ``unexplained`` in the report's words (τ in s, band in Hz), and how many more."""
     words = "; ".join(describe_region(u) for u in left[:most])
     return words + (f"; and {len(left) - most} more" if len(left) > most else "")
-
-
-def _machine() -> str:
-    m = _common.machine_info()
-    return f"{m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at {m['git_commit']}, {m['date_utc'][:10]}"
 
 
 #: What made the two cases that failed at 2399841 fail (15 of 17 then; i29gm), and the five at 7951666 (i29suite).
@@ -151,7 +135,7 @@ def write(results, out: Path, load) -> None:
     lines = [
         "# refine on simulated sensors unlike the ADIS16405 (issue 29)",
         "",
-        f"Default call, `python benches/refine_sensors.py`, {_machine()}; other processes used {load:.0%} of the CPUs "
+        f"Default call, `python benches/refine_sensors.py`, {_common.machine_line()}; other processes used {load:.0%} of the CPUs "
         "during the run.",
         "",
         f"**Passed: {passed} of {len(results)}** (named, parameters within 20 %, frequencies within 1 %, χ²/dof or the "
@@ -171,8 +155,7 @@ def write(results, out: Path, load) -> None:
         "",
         *NOTES,
     ]
-    (out / "refine_sensors.md").write_text("\n".join(lines))
-    (out / "refine_sensors.json").write_text(json.dumps(results, indent=1, default=float))
+    _common.write_results(out, "refine_sensors", lines, results, end="")
 
 
 def main(argv=None) -> None:

@@ -108,17 +108,6 @@ def level_record(mix: str, seed: int):
     return y, fs
 
 
-def _rates(p: np.ndarray, a: float) -> dict:
-    return {
-        f"{lv:g}": {
-            "rejections": int(np.sum(p <= lv)),
-            "rate": float(np.mean(p <= lv)),
-            "interval_95": _common.clopper_pearson(int(np.sum(p <= lv)), int(p.size)),
-        }
-        for lv in (a, *LEVELS)
-    }
-
-
 def _curve_task(k: int, refine: bool) -> tuple[dict, dict | None]:
     res, _desc = clean_curve(20_000 + 7919 * k)
     got = curve_p_values(res)
@@ -161,7 +150,10 @@ def run(n_curves: int, per_mix: int, n_refine: int, out: Path, processes: int = 
             p["unexplained:level"].append(1.0 if pv is None else pv)
             by_mix[mix] = by_mix.get(mix, 0) + int(pv is not None and pv <= TESTS["unexplained:level"])
     load.__exit__(None, None, None)
-    tests = {t: {"alpha": TESTS[t], "records": len(v), "rates": _rates(np.array(v), TESTS[t])} for t, v in p.items()}
+    tests = {
+        t: {"alpha": TESTS[t], "records": len(v), "rates": _common.rejection_rates(v, (TESTS[t], *LEVELS))}
+        for t, v in p.items()
+    }
     tests["unexplained:level"]["by_mixture"] = by_mix
     report = {
         "level": LEVEL,
@@ -182,18 +174,11 @@ def run(n_curves: int, per_mix: int, n_refine: int, out: Path, processes: int = 
     return report
 
 
-def _cell(r: dict) -> str:
-    lo, hi = r["interval_95"]
-    return f"{r['rejections']} = {100 * r['rate']:.2f} % ({100 * lo:.2f}–{100 * hi:.2f})"
-
-
 def markdown(report: dict) -> str:
-    m = report["machine"]
     lines = [
         "# Two checks of `Refinement.unexplained` on clean records",
         "",
-        f"Written by `benches/refine_unexplained_null.py` ({m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at "
-        f"{m['git_commit']}, {m['date_utc'][:10]}; other processes used {100 * (report['other_load'] or 0):.0f} % "
+        f"Written by `benches/refine_unexplained_null.py` ({_common.machine_line(report['machine'])}; other processes used {100 * (report['other_load'] or 0):.0f} % "
         f"of the CPUs; {report['seconds']:.0f} s). Curve-only checks on {report['curves']} clean octave curves "
         "(random five-term mixtures, 10⁴–10⁶ samples at 1/100/400 Hz, the checks on the five-term fit, "
         f"{N_BOOT} bootstrap draws); the level check on {report['level_records_per_mixture']} clean records of "
@@ -204,7 +189,7 @@ def markdown(report: dict) -> str:
     ]
     for t, row in report["tests"].items():
         rates = row["rates"]
-        cells = [_cell(rates[f"{row['alpha']:g}"])] + [_cell(rates[f"{lv:g}"]) for lv in LEVELS]
+        cells = [_common.rate_cell(rates[f"{lv:g}"], count=True) for lv in (row["alpha"], *LEVELS)]
         lines.append(f"| {t} | {row['alpha']:g} | {row['records']} | " + " | ".join(cells) + " |")
     lo, hi = report["curves_either_interval_95"]
     lines += [

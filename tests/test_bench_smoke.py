@@ -91,3 +91,49 @@ def test_clopper_pearson_matches_its_closed_forms():
     assert lo < 5 / 76 < hi and (round(lo, 4), round(hi, 4)) == (0.0217, 0.1469)
     lo90, hi90 = _common.clopper_pearson(5, 76, level=0.9)
     assert lo < lo90 and hi90 < hi
+
+
+def _bench_common():
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
+    try:
+        import _common
+    finally:
+        sys.path.pop(0)
+    return _common
+
+
+def test_rejection_rates_and_their_cells():
+    """The calibration tables' rows (``refine_calibration.py``, ``refine_unexplained_null.py``): per level the
+    count of p ≤ level, its share and the share's Clopper–Pearson interval, and the cells that print them."""
+    c = _bench_common()
+    p = [0.001, 0.004, 0.02, 0.3, 0.5, 0.7, 0.9, 0.05]
+    rates = c.rejection_rates(p, (0.0025, 0.01, 0.05, 0.1))
+    assert list(rates) == ["0.0025", "0.01", "0.05", "0.1"]
+    assert [r["rejections"] for r in rates.values()] == [1, 2, 4, 4]
+    assert rates["0.05"]["rate"] == 0.5 and rates["0.05"]["interval_95"] == c.clopper_pearson(4, 8)
+    r = {"rejections": 3, "rate": 0.0125, "interval_95": (0.004, 0.029)}
+    assert c.rate_cell(r) == "1.25 % (0.40–2.90)"
+    assert c.rate_cell(r, count=True) == "3 = 1.25 % (0.40–2.90)"
+
+
+def test_refine_bench_cells():
+    """The cells refine_blind.py, refine_curves.py and refine_sensors.py share."""
+    c = _bench_common()
+    assert c.arrow_cell((12.04, 1.291)) == "12 → 1.29"
+    assert c.arrow_cell((2.5, None)) == "2.5 → —" and c.arrow_cell(None) == c.arrow_cell((None, 1.0)) == "—"
+    assert c.param_errors_cell({"f0": 0.0123, "kind": "too wide", "tau": None}) == "f0 +1.2%, kind too wide"
+    steps = [{"effect": "sinusoid", "params": {"f0": 1.70123, "harmonics": 2}}, {"effect": "white", "params": {}}]
+    assert c.steps_cell(steps, 3) == "sinusoid (f0 1.7, harmonics 2); white ()"
+    assert c.steps_cell(steps, 4) == "sinusoid (f0 1.701, harmonics 2); white ()"
+    assert c.steps_cell([], 3) == "nothing"
+    assert [c.without_candidate_cell(x) for x in (None, [], [{}, {}])] == ["—", "**none**", "2 region(s)"]
+    m = {"cpu_model": "CPU X", "cpus_usable": 2, "git_commit": "abc1234", "date_utc": "2026-11-26T17:00:00"}
+    assert c.machine_line(m) == "CPU X, 2 CPUs, allanite at abc1234, 2026-11-26"
+
+
+def test_write_results_writes_the_page_and_its_json(tmp_path):
+    c = _bench_common()
+    c.write_results(tmp_path, "x", ["# t", "", "| a |"], [{"v": 1.5}])
+    c.write_results(tmp_path, "y", ["# t"], [], end="")
+    assert (tmp_path / "x.md").read_text() == "# t\n\n| a |\n" and (tmp_path / "y.md").read_text() == "# t"
+    assert json.loads((tmp_path / "x.json").read_text()) == [{"v": 1.5}]

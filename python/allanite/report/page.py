@@ -253,56 +253,68 @@ def _heldout(st: dict) -> str:
     return f"{g(a, 3)} → {g(b, 3)} %"
 
 
-def _refinement(ref: dict | None, rec: dict) -> dict | None:
-    if ref is None:
-        return None
-    fs, duration_s = rec["fs_hz"], rec["duration_s"]
-    curve_rows, change_rows, summary_rows, move_rows, missing = [], [], [], [], []
-    for ax in ref["axes"]:
+def _axis_summary(ax: dict) -> list:
+    """The summary row of one refined axis: effects added, χ²/dof and RMS error start → final, τ fitted from."""
+    return [
+        ax["name"],
+        ", ".join(st["effect"] for st in ax["steps"]) or NOTHING_ADDED,
+        f"{g(ax['start']['chi2_dof'], 3)} → {g(ax['final']['chi2_dof'], 3)}",
+        f"{g(ax['start']['rms_adev_pct'], 3)} → {g(ax['final']['rms_adev_pct'], 3)} %",
+        f"{g(ax['tau_from_s'])} s" if ax["tau_from_s"] is not None else "—",
+    ]
+
+
+def _step_rows(name: str, st: dict, fs: float, duration_s: float) -> tuple[list, list | None]:
+    """One step's row of the steps table and, for a change of noise level, its row of the changes table."""
+    curve = [
+        name,
+        st["effect"],
+        step_params(st, fs, duration_s, units=True, intervals=True),
+        step_params(st, fs, duration_s, units=True, intervals=True, final=True),
+        f"{g(st['before']['chi2_dof'], 3)} → {g(st['after']['chi2_dof'], 3)}",
+        f"{g(st['before']['rms_adev_pct'], 3)} → {g(st['after']['rms_adev_pct'], 3)} %",
+        _heldout(st),
+    ]
+    if "window_levels" not in st:
+        return curve, None
+    w = st["window_levels"]
+    change = [
+        name,
+        step_params(st, fs, duration_s, units=True, intervals=True),
+        f"{g(w['before']['chi2_dof'], 3)} → {g(w['after']['chi2_dof'], 3)}",
+        _heldout({"before": w["before"], "after": w["after"]}),
+    ]
+    return curve, change
+
+
+def _refinement_rows(axes: list, fs: float, duration_s: float) -> dict[str, list]:
+    """The rows of the refinement's tables (summary, curve, change, move) and each axis's still-missing sentences."""
+    rows: dict[str, list] = {"summary": [], "curve": [], "change": [], "move": [], "missing": []}
+    for ax in axes:
         if ax.get("error"):
-            summary_rows.append([ax["name"], "failed (see the notes)", "—", "—", "—"])
+            rows["summary"].append([ax["name"], "failed (see the notes)", "—", "—", "—"])
             continue
-        missing.append({"name": ax["name"], "sentences": ax["still_missing"], "found": bool(ax["unexplained"])})
-        summary_rows.append(
-            [
-                ax["name"],
-                ", ".join(st["effect"] for st in ax["steps"]) or NOTHING_ADDED,
-                f"{g(ax['start']['chi2_dof'], 3)} → {g(ax['final']['chi2_dof'], 3)}",
-                f"{g(ax['start']['rms_adev_pct'], 3)} → {g(ax['final']['rms_adev_pct'], 3)} %",
-                f"{g(ax['tau_from_s'])} s" if ax["tau_from_s"] is not None else "—",
-            ]
-        )
-        move_rows += [[ax["name"], m["text"]] for m in ax.get("term_moves", [])]
+        rows["missing"].append({"name": ax["name"], "sentences": ax["still_missing"], "found": bool(ax["unexplained"])})
+        rows["summary"].append(_axis_summary(ax))
+        rows["move"] += [[ax["name"], m["text"]] for m in ax.get("term_moves", [])]
         for st in ax["steps"]:
-            curve_rows.append(
-                [
-                    ax["name"],
-                    st["effect"],
-                    step_params(st, fs, duration_s, units=True, intervals=True),
-                    step_params(st, fs, duration_s, units=True, intervals=True, final=True),
-                    f"{g(st['before']['chi2_dof'], 3)} → {g(st['after']['chi2_dof'], 3)}",
-                    f"{g(st['before']['rms_adev_pct'], 3)} → {g(st['after']['rms_adev_pct'], 3)} %",
-                    _heldout(st),
-                ]
-            )
-            if "window_levels" in st:
-                w = st["window_levels"]
-                change_rows.append(
-                    [
-                        ax["name"],
-                        step_params(st, fs, duration_s, units=True, intervals=True),
-                        f"{g(w['before']['chi2_dof'], 3)} → {g(w['after']['chi2_dof'], 3)}",
-                        _heldout({"before": w["before"], "after": w["after"]}),
-                    ]
-                )
+            curve, change = _step_rows(ax["name"], st, fs, duration_s)
+            rows["curve"].append(curve)
+            if change is not None:
+                rows["change"].append(change)
+    return rows
+
+
+def _refinement_tables(rows: dict[str, list]) -> list[dict[str, Any]]:
+    """The refinement's tables for the template: the summary always, the others where they have rows."""
     tables = [
         _table(
             ["axis", "effects added", "curve χ²/dof start → final", "RMS ADEV error start → final", "fitted from τ"],
-            summary_rows,
+            rows["summary"],
             left=2,
         )
     ]
-    if curve_rows:
+    if rows["curve"]:
         tables.append(
             _table(
                 [
@@ -314,11 +326,11 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
                     "RMS ADEV error before → after",
                     "held-out RMS ADEV error before → after",
                 ],
-                curve_rows,
+                rows["curve"],
                 left=4,
             )
         )
-    if change_rows:
+    if rows["change"]:
         tables.append(
             _table(
                 [
@@ -327,19 +339,26 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
                     "window-level χ²/dof: one level → levels split at every change found",
                     "held out per segment: one-level model → each segment's own",
                 ],
-                change_rows,
+                rows["change"],
                 left=2,
             )
         )
-    if move_rows:
+    if rows["move"]:
         tables.append(
-            _table(["axis", "a term the refinement moved outside the plain fit's interval"], move_rows, left=2)
+            _table(["axis", "a term the refinement moved outside the plain fit's interval"], rows["move"], left=2)
         )
+    return tables
+
+
+def _refinement(ref: dict | None, rec: dict) -> dict | None:
+    if ref is None:
+        return None
+    rows = _refinement_rows(ref["axes"], rec["fs_hz"], rec["duration_s"])
     return {
         "candidates": ref["candidates"],
         "units": ref["units"],
-        "tables": tables,
-        "missing": missing,
+        "tables": _refinement_tables(rows),
+        "missing": rows["missing"],
         "chi2_note": (
             "Every step is scored on the record's own Allan curve, a component removed in time part of the model "
             "through what it changed in the curve, so each step's before is the previous step's after (χ²/dof "

@@ -184,6 +184,40 @@ fn centred(y: &[f64]) -> Vec<f64> {
         .collect()
 }
 
+/// Prefix count of the NaN samples (gaps) of `column`: cnt[0] = 0, cnt[k + 1] = cnt[k] + (y_k is NaN),
+/// so a span [a, a + s) holds no gap iff cnt[a + s] == cnt[a]. The count is kept modulo 2³² (4 bytes a
+/// sample): a count that wrapped still differs across a span holding a NaN unless that span holds a
+/// multiple of 2³² of them, which a span of fewer than 2³² samples cannot — [`check_gap_span`] refuses
+/// longer spans, so the test is exact.
+fn nan_prefix_counts(column: &[f64]) -> Vec<u32> {
+    nan_prefix_counts_from(column, 0)
+}
+
+/// [`nan_prefix_counts`] starting at `start` instead of 0 (the tests' way to reach the wrap-around).
+fn nan_prefix_counts_from(column: &[f64], start: u32) -> Vec<u32> {
+    let mut cnt = Vec::with_capacity(column.len() + 1);
+    cnt.push(start);
+    let mut k = start;
+    for v in column {
+        k = k.wrapping_add(v.is_nan() as u32);
+        cnt.push(k);
+    }
+    cnt
+}
+
+/// The longest span a gap-aware estimate tests with [`nan_prefix_counts`] (samples of a `what`), as an
+/// error when it reaches 2³² samples and the 32-bit count could no longer tell a gap from none.
+fn check_gap_span(longest: usize, what: &str) -> Result<()> {
+    if longest as u64 > u32::MAX as u64 {
+        return Err(CoreError::InvalidInput(format!(
+            "gap-aware estimation takes a {what} of at most {} samples (its gap count is 32-bit), \
+             got {longest}",
+            u32::MAX
+        )));
+    }
+    Ok(())
+}
+
 /// Terms per chunk at least; a chunk also spans ≥ 4m terms so the O(m) edge work stays ≤ ¼ of it.
 /// Memory per (axis, m) task is O(chunk + m), not O(M): a 10⁸-sample record stays cheap.
 const TERM_CHUNK: usize = 1 << 16;
@@ -384,19 +418,10 @@ pub fn gap_deviation_cancellable(
     let n = check_shape(columns)?;
     check_ms(kind, n, ms, "record")?;
     check_values(columns, true)?;
+    check_gap_span(n, "record")?; // a term's span is at most the record
     let prepared: Vec<(Vec<f64>, Vec<u32>)> = columns
         .par_iter()
-        .map(|c| {
-            // Prefix count of gaps: a span [a, a+s) is complete iff cnt[a+s] == cnt[a] (exact).
-            let mut cnt = Vec::with_capacity(c.len() + 1);
-            cnt.push(0u32);
-            let mut k = 0u32;
-            for v in c.iter() {
-                k += v.is_nan() as u32;
-                cnt.push(k);
-            }
-            (centred(c), cnt)
-        })
+        .map(|c| (centred(c), nan_prefix_counts(c)))
         .collect();
     let n_m = ms.len();
     let res: Vec<(f64, u64)> = (0..columns.len() * n_m)
@@ -447,5 +472,41 @@ fn overlapping_gap(kind: Kind, f: &[f64], cnt: &[u32], m: usize, classic: bool) 
         (f64::NAN, 0)
     } else {
         (acc.get() * scale / kept as f64, kept as u64)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The span test stays exact where the 32-bit count wraps around (a record with 2³² NaN before
+    /// this stretch would reach it; starting the count just below 2³² reaches it cheaply).
+    #[test]
+    fn nan_prefix_counts_wrap_around() {
+        let y = [1.0, f64::NAN, 2.0, f64::NAN, f64::NAN, 3.0, 4.0];
+        let plain = nan_prefix_counts(&y);
+        assert_eq!(plain, vec![0, 0, 1, 1, 2, 3, 3, 3]);
+        for start in [u32::MAX - 2, u32::MAX - 1, u32::MAX] {
+            let cnt = nan_prefix_counts_from(&y, start);
+            assert!(cnt.iter().any(|&c| c < start), "the count must wrap");
+            for a in 0..=y.len() {
+                for b in a..=y.len() {
+                    let clean = y[a..b].iter().all(|v| !v.is_nan());
+                    assert_eq!(cnt[b] == cnt[a], clean, "span [{a}, {b}) from {start}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    #[cfg(target_pointer_width = "64")]
+    fn gap_span_limit() {
+        assert!(check_gap_span(u32::MAX as usize, "record").is_ok());
+        let err = check_gap_span(u32::MAX as usize + 1, "window").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "gap-aware estimation takes a window of at most 4294967295 samples (its gap count is \
+             32-bit), got 4294967296"
+        );
     }
 }

@@ -3,7 +3,8 @@
 //! blocks and one partial block (as `allan`'s DAVAR).
 
 use super::{
-    centred, check_ms, check_values, for_each_term_chunk, span_scale, Acc, Kind, TermBuf, RUN,
+    centred, check_gap_span, check_ms, check_values, for_each_term_chunk, nan_prefix_counts,
+    span_scale, Acc, Kind, TermBuf, RUN,
 };
 use crate::allan::{block_window_sums, check_shape, check_window_hop, sum4};
 use crate::cancel::Cancel;
@@ -101,20 +102,12 @@ pub fn gap_dynamic(
     check_window_hop(window, hop, n, 2)?;
     check_ms(kind, window, ms, "window")?;
     check_values(columns, true)?;
+    check_gap_span(window, "window")?; // a term's span is at most the window
     let n_win = (n - window) / hop + 1;
     let n_m = ms.len();
     let prepared: Vec<(Vec<f64>, Vec<u32>)> = columns
         .par_iter()
-        .map(|c| {
-            let mut cnt = Vec::with_capacity(c.len() + 1);
-            cnt.push(0u32);
-            let mut k = 0u32;
-            for v in c.iter() {
-                k = k.wrapping_add(v.is_nan() as u32);
-                cnt.push(k);
-            }
-            (centred(c), cnt)
-        })
+        .map(|c| (centred(c), nan_prefix_counts(c)))
         .collect();
     let mut out = vec![0.0; columns.len() * n_m * n_win];
     let mut counts = vec![0u64; columns.len() * n_m * n_win];
@@ -129,9 +122,8 @@ pub fn gap_dynamic(
             let (span, scale) = span_scale(kind, m);
             let l = window + 1 - span; // terms per window
             let k_end = (n_win - 1) * hop + l; // terms used by some window
-                                               // squares of the complete terms (0 otherwise) and the prefix count of complete terms;
-                                               // a gap count that wrapped (≥ 2³² NaN) still differs across a span holding a NaN unless
-                                               // the span holds exactly 2³² of them, which a span of < 2³² samples cannot
+                                               // squares of the complete terms (0 otherwise) and the prefix count of complete terms
+                                               // (the gap count's wrap-around: see `nan_prefix_counts`)
             let mut t = Vec::with_capacity(k_end);
             let mut done = vec![0u64; k_end + 1];
             let mut tb = TermBuf::default();
