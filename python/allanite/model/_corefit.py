@@ -102,15 +102,15 @@ def _nu_terms(m, n_points, estimator, terms, edf_cache) -> np.ndarray:
 def _recent_edf(key) -> np.ndarray:
     alpha, m, n_points, estimator = key
     if isinstance(estimator, str):
-        for (a, full, n, est), nu in reversed(_RECENT_EDF.items()):
+        for (a, full, n, est), nu in reversed(list(_RECENT_EDF.items())):  # a copy: reports run in threads too
             k = len(full) - len(m)
             if k >= 0 and (a, n, est) == (alpha, n_points, estimator) and full[k:] == m:
                 return nu[k:]
     nu = edf_per_tau(np.full(len(m), alpha), np.asarray(m, dtype=np.float64), n_points, estimator)
     nu.flags.writeable = False
     _RECENT_EDF[key] = nu
-    while len(_RECENT_EDF) > _RECENT_SIZE:
-        _RECENT_EDF.pop(next(iter(_RECENT_EDF)))
+    for old in list(_RECENT_EDF)[:-_RECENT_SIZE]:
+        _RECENT_EDF.pop(old, None)
     return nu
 
 
