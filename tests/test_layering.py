@@ -145,9 +145,11 @@ MODEL_RANKS = {
     "model.noise_level": 0,
     "model.periodic": 1,
     "model.template": 0,
-    # fit's parts, between the registries and fit itself: the one-curve solver, the result objects, the windows
+    # fit's parts, between the registries and fit itself: the one-curve solver (and it in the core), the result
+    # objects, the windows
     "model._fitcore": 0.5,
     "model._tauselect": 0,
+    "model._corefit": 0.6,
     "model._fitresult": 0.7,
     "model._dynamicfit": 0.9,
     "model._bound": 0,

@@ -76,12 +76,15 @@ def fit_windows(
         int(workers),
     )
     pieces = max(1, math.ceil(n_windows / PIECE))
-    out = np.empty((n_windows, k + k * k + 3))
-    with StepBar(progress if pieces > 1 else False, n_windows, "noise fit per window", unit="window") as bar:
-        for p in range(pieces):
-            lo, hi = p * PIECE, min(n_windows, (p + 1) * PIECE)
-            out[lo:hi] = _core.fit_windows(avar[lo:hi], *args)
-            bar.add(hi - lo)
+    if pieces == 1:  # no bar (a static curve's fit is one window: even a disabled bar costs as much as its fit)
+        out = np.asarray(_core.fit_windows(avar, *args)).reshape(n_windows, k + k * k + 3)
+    else:
+        out = np.empty((n_windows, k + k * k + 3))
+        with StepBar(progress, n_windows, "noise fit per window", unit="window") as bar:
+            for p in range(pieces):
+                lo, hi = p * PIECE, min(n_windows, (p + 1) * PIECE)
+                out[lo:hi] = _core.fit_windows(avar[lo:hi], *args)
+                bar.add(hi - lo)
     theta = out[:, :k]
     cov = out[:, k : k + k * k].reshape(n_windows, k, k)
     chi2, iterations, status = out[:, -3], out[:, -2].astype(np.int64), out[:, -1].astype(np.int64)

@@ -16,7 +16,8 @@ noise type that dominates the model at that τ), with an octave-correlation mode
 By default only τ at least an octave apart enter either fit.
 
 Here: :func:`fit`, the fit of a static curve and ``tau_range="auto"``. Its parts, each a module of its own (their
-public names are importable from here too): the one-curve solver (``_fitcore``), which τ enter a fit
+public names are importable from here too): the one-curve solver (``_fitcore``; run in the Rust core by ``_corefit``,
+``fit_core``'s iteration step for step), which τ enter a fit
 (``_tauselect``), what a fit returns (``_fitresult``: :class:`NoiseFit`, :class:`CoefficientSeries`), the windows
 of a dynamic result (``_dynamicfit``) and the Cramér–Rao bound (``_bound``: :func:`information_bound`).
 """
@@ -36,12 +37,13 @@ from ..estimators import names as estimator_names
 from ..results import AllanResult, DynamicAllanResult
 from ..units import rate_unit
 from ._bound import information_bound
+from ._corefit import fit_curve
 from ._dynamicfit import FLAT_FLOOR as FLAT_FLOOR
 from ._dynamicfit import fit_dynamic
 from ._fitcore import GLS_START_ITER as GLS_START_ITER
 from ._fitcore import GLS_TOL as GLS_TOL
 from ._fitcore import IRLS_RTOL as IRLS_RTOL
-from ._fitcore import MAX_GLS_TAU, edf_per_tau, exact_covariance_applies, fit_core, nnls
+from ._fitcore import MAX_GLS_TAU, edf_per_tau, exact_covariance_applies, nnls
 from ._fitcore import OCTAVE_CORRELATION as OCTAVE_CORRELATION
 from ._fitresult import READOFF_MIN_EDF as READOFF_MIN_EDF
 from ._fitresult import Coefficient, CoefficientSeries, NoiseFit, coefficients, interval, readoffs, z_quantile
@@ -135,7 +137,9 @@ def fit(
 
     A dynamic result's windows are fitted all at once in the Rust core, on all its threads (the same
     iteration as a static fit, step for step; ≈ 3–10 µs per window for five terms on the octave τ of
-    a window); Ctrl-C stops it.
+    a window); Ctrl-C stops it. A static curve is fitted by the same kernel (≈ 1 ms per curve with its
+    Python around it; ``tau_range="auto"`` fits up to seven), the Python iteration only for what the
+    kernel hands back.
 
     Examples
     --------
@@ -280,7 +284,7 @@ def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_ite
     avar_row = np.asarray(avar_row, dtype=np.float64)
     idx = select_taus(result.tau, avar_row, thin, len(terms), "the result", tau_range)
     tau, m, y = result.tau[idx], result.m[idx].astype(np.float64), avar_row[idx]
-    theta, cov, model, nu, z, it, a, chi2 = fit_core(
+    theta, cov, model, nu, z, it, a, chi2 = fit_curve(
         tau, m, y, result.fs, result.n_samples + 1, estimator_key(result, idx), terms, confidence, max_iter
     )
     n_active = int(np.count_nonzero(theta > 0))
