@@ -1,6 +1,7 @@
-"""The command line's exit: ``main()`` of the process's own arguments freezes the garbage collector's objects
-before the interpreter exits (so that its exit does not walk them all again); ``main(argv)`` — a caller that
-goes on — leaves the collector alone. The files of a report run the command's way are complete."""
+"""The command line's exit and what it imports. ``main()`` of the process's own arguments freezes the garbage
+collector's objects before the interpreter exits (so that its exit does not walk them all again); ``main(argv)``
+— a caller that goes on — leaves the collector alone. The files of a report run the command's way are complete.
+Without a terminal to draw a bar on, tqdm is not imported."""
 
 from __future__ import annotations
 
@@ -61,3 +62,19 @@ def test_report_files_complete_after_the_command_exits(tmp_path):
     for name in summary["files"]["figures"]:
         data = (out / name).read_bytes()
         assert data.startswith(b"\x89PNG") and data.endswith(b"IEND\xaeB`\x82")
+
+
+def test_no_progress_bar_no_tqdm_import(tmp_path):
+    """A report whose stderr is no terminal draws no bar: tqdm (whose import reads the installed packages'
+    metadata) is not imported."""
+    log = tmp_path / "gyro.csv"
+    np.savetxt(log, np.random.default_rng(4).normal(size=(3000, 1)) * 0.01, header="g", comments="")
+    code = (
+        "import sys; from allanite import cli; "
+        f"rc = cli.main(['report', {str(log)!r}, '--fs', '50', '--no-fit', '--out', {str(tmp_path / 'o')!r}]); "
+        "print('TQDM', 'tqdm' in sys.modules, rc)"
+    )
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
+    assert "TQDM False 0" in proc.stdout, proc.stdout + proc.stderr
+    assert "static Allan deviation" in proc.stdout  # the steps are printed as lines instead (stdout no terminal)

@@ -17,9 +17,9 @@ import sys
 import time
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-from tqdm import tqdm
 
 from ._cli_options import (
     DESCRIPTION,
@@ -101,15 +101,8 @@ class _Progress:
     def __init__(self, quiet: bool):
         self.lines = not quiet and not _isatty(sys.stdout)
         self.t0 = time.perf_counter()
-        self.bar = tqdm(
-            total=8,
-            file=sys.stderr,
-            disable=True if quiet else None,
-            leave=False,
-            unit="step",
-            bar_format="{desc:<38.38}|{bar}| {n_fmt}/{total_fmt} [{elapsed}]",
-            dynamic_ncols=True,
-        )
+        # tqdm (and the package metadata its import reads, ~0.1 s) only where a bar is drawn
+        self.bar: Any = _NoBar() if quiet or not _isatty(sys.stderr) else _bar()
         self.started = False
 
     def step(self, name: str) -> None:
@@ -132,6 +125,43 @@ class _Progress:
         if self.started and self.bar.total is not None:
             self.bar.update(max(0, self.bar.total - self.bar.n))
         self.bar.close()
+
+
+def _bar():
+    """The tqdm bar on stderr (a terminal)."""
+    from tqdm import tqdm
+
+    return tqdm(
+        total=8,
+        file=sys.stderr,
+        leave=False,
+        unit="step",
+        bar_format="{desc:<38.38}|{bar}| {n_fmt}/{total_fmt} [{elapsed}]",
+        dynamic_ncols=True,
+    )
+
+
+class _NoBar:
+    """What ``_Progress`` keeps of a bar that is not drawn (--quiet, stderr no terminal): the count; ``write``
+    prints, as tqdm's does."""
+
+    def __init__(self):
+        self.n, self.total = 0, 8
+
+    def update(self, n: int = 1) -> None:
+        self.n += n
+
+    def set_description_str(self, desc: str) -> None:
+        pass
+
+    def refresh(self) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+    def write(self, text: str, file=None) -> None:
+        print(text, file=file if file is not None else sys.stdout, flush=True)
 
 
 def _isatty(stream) -> bool:
