@@ -78,3 +78,16 @@ def test_no_progress_bar_no_tqdm_import(tmp_path):
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
     assert "TQDM False 0" in proc.stdout, proc.stdout + proc.stderr
     assert "static Allan deviation" in proc.stdout  # the steps are printed as lines instead (stdout no terminal)
+
+
+def test_import_allanite_leaves_the_optional_modules_for_their_first_use():
+    code = (
+        "import sys, allanite; "
+        "lazy = ('combination', 'wavelet', 'simulation', 'datasets', 'kalibr', 'model.refinement'); "
+        "print(sorted(m for m in lazy if 'allanite.' + m in sys.modules)); "
+        "from allanite.combination import combine; from allanite.wavelet import Split; "
+        "print(allanite.combine is combine, allanite.Split is Split, 'to_kalibr' in dir(allanite))"
+    )
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
+    assert proc.stdout.split("\n")[:2] == ["[]", "True True True"], proc.stdout + proc.stderr
