@@ -84,3 +84,22 @@ def test_a_latin1_body_goes_to_numpy_and_names_nothing_wrong(tmp_path):
     assert _text.HEAD_CHARS < len(CASES["ascii head, latin-1 body"])
     log = allanite.read_log(path, fs=100.0)
     assert log.data.shape == (20_000, 2) and log.columns == ["a", "b"]
+
+
+def test_a_text_parsed_in_pieces_is_numpys_and_a_bad_line_is_named(tmp_path):
+    """Over 1 MiB the core parses line-aligned pieces on several threads: NumPy's values bit for bit, and a bad
+    line in a late piece is still found and named."""
+    rng = np.random.default_rng(8)
+    x = rng.normal(size=(60_000, 3)) * np.array([1e-3, 1.0, 1e5])
+    lines = ["t,a,b,c"] + [f"{i / 100:.2f},{float(a)!r},{b:.9g},{c:.6e}" for i, (a, b, c) in enumerate(x)]
+    text = "\n".join(lines) + "\n"
+    assert len(text) > 2 << 20
+    path = tmp_path / "big.csv"
+    path.write_text(text, encoding="ascii")
+    log = allanite.read_log(path, time_column="t", columns=["a", "c"])
+    ref = np.loadtxt(lines[1:], delimiter=",")
+    assert np.array_equal(log.data.view(np.uint64), ref[:, [1, 3]].view(np.uint64))
+    lines[50_001] = lines[50_001].replace(",", ",x", 1)
+    path.write_text("\n".join(lines) + "\n", encoding="ascii")
+    with pytest.raises(allanite.InputError, match=r"line 50002, column 2 \('a'\): 'x"):
+        allanite.read_log(path, time_column="t", columns=["a", "c"])
