@@ -240,3 +240,34 @@ def test_two_figures_are_split_where_matplotlib_is_set_up(monkeypatch):
     split = render_pngs(specs, 60, lambda text: None, processes=2)
     assert forked == [[1]]  # the child drew the second figure
     assert list(split) == list(serial) and all(split[k] == serial[k] for k in serial)
+
+
+def test_write_hands_the_report_over_before_making_the_json_and_page(small_report, tmp_path, monkeypatch):
+    """With a figure process waiting, ``Report.write`` hands it the report first and makes the summary, the
+    JSON text and the page's context while it draws; the files are those of a write without it."""
+    import json
+
+    from allanite.report import _worker, result
+
+    order = []
+    real_hand_over, real_context = _worker.hand_over, result.page_context
+    monkeypatch.setattr(_worker, "hand_over", lambda rep, dpi: order.append("hand over") or real_hand_over(rep, dpi))
+    monkeypatch.setattr(result, "page_context", lambda rep: order.append("page") or real_context(rep))
+    here = small_report.write(tmp_path / "here", progress=False, dpi=60)
+    small_report._summary = None
+    assert _worker.start(when_idle=False)
+    there = small_report.write(tmp_path / "worker", progress=False, dpi=60)
+    # (the last: take's, which finds the report handed over already and only collects)
+    assert order == ["hand over", "page", "hand over", "page", "hand over"]
+    assert not _worker._WORKER  # used and reaped
+    assert [p.name for p in here] == [p.name for p in there]
+    for a, b in zip(here, there):
+        if a.suffix == ".png":
+            assert a.read_bytes() == b.read_bytes()
+    one, two = (
+        json.loads((d / "summary.json").read_text(encoding="utf-8")) for d in (tmp_path / "here", tmp_path / "worker")
+    )
+    one.pop("created", None), two.pop("created", None)
+    assert one["files"] == two["files"] and one["files"]["figures"] == [p.name for p in here if p.suffix == ".png"]
+    page = (tmp_path / "worker" / "report.html").read_text(encoding="utf-8")
+    assert page.count("data:image/png;base64,") == len(one["files"]["figures"])

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import gzip
 import zlib
-from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
@@ -47,40 +46,70 @@ def _guess_delimiter(line: str):
 HEAD_CHARS = 1 << 16
 
 
-@dataclass
 class _Text:
-    """A text log decoded: its bytes (gunzipped), text (UTF-8, else Latin-1, without a byte-order mark), the
-    codec and whether a mark was dropped; its lines split on first use (a large log's body is read from
-    ``raw`` by the core's parser, and only an error message needs its lines)."""
+    """A text log's bytes (gunzipped) and, decoded on first use, its text (UTF-8, else Latin-1, without a
+    byte-order mark), the codec and whether a mark was dropped; its lines split on first use. A large log's body
+    is read from ``raw`` by the core's parser: where the head is ASCII, only the head is decoded (the whole text
+    only for a log the core's parser leaves to NumPy, or an error message)."""
 
-    raw: bytes
-    text: str
-    codec: str
-    bom: bool
+    def __init__(self, raw: bytes):
+        self.raw = raw
+        # the first HEAD_CHARS + 1 bytes, where ASCII: the text's first HEAD_CHARS + 1 characters in either codec
+        prefix = raw[: HEAD_CHARS + 1]
+        self._ascii_head = prefix.decode("ascii") if prefix.isascii() else None
+
+    @cached_property
+    def _decoded(self) -> tuple[str, str, bool]:
+        try:
+            text, codec = self.raw.decode("utf-8"), "utf-8"
+        except UnicodeDecodeError:
+            text, codec = self.raw.decode("latin-1"), "latin-1"
+        bom = text.startswith("\ufeff")
+        return (text[1:] if bom else text), codec, bom
+
+    @property
+    def text(self) -> str:
+        return self._decoded[0]
+
+    @property
+    def codec(self) -> str:
+        return self._decoded[1]
+
+    @property
+    def bom(self) -> bool:
+        return self._decoded[2]
 
     @cached_property
     def lines(self) -> list[str]:
         return self.text.splitlines()
 
+    def _head_text(self) -> str:
+        """The text's first HEAD_CHARS + 1 characters (all of a shorter text)."""
+        return self._ascii_head if self._ascii_head is not None else self.text[: HEAD_CHARS + 1]
+
     def head(self) -> tuple[list[str], bool]:
         """(the first lines — all of them when the text is short, else those in its first ``HEAD_CHARS``
         characters, complete lines only —, whether that is every line)."""
-        if len(self.text) <= HEAD_CHARS:
+        head = self._head_text()
+        if len(head) <= HEAD_CHARS:
             return self.lines, True
-        k = self.text.rfind("\n", 0, HEAD_CHARS) + 1
-        return self.text[:k].splitlines(), False
+        k = head.rfind("\n", 0, HEAD_CHARS) + 1
+        return head[:k].splitlines(), False
 
     def byte_offset(self, start: int) -> int:
         """Where line ``start`` begins in ``raw``."""
-        kept = self.text[: HEAD_CHARS + 1].splitlines(keepends=True)[:start]
+        head = self._head_text()
+        kept = head.splitlines(keepends=True)[:start]
         chars = sum(map(len, kept))
         if len(kept) < start or chars > HEAD_CHARS:  # line `start` begins beyond the head
             chars = sum(map(len, self.text.splitlines(keepends=True)[:start]))
+        if self._ascii_head is not None and chars <= HEAD_CHARS:
+            return chars  # ASCII: a character is a byte, and there is no byte-order mark
         return len(self.text[:chars].encode(self.codec)) + (3 if self.bom else 0)
 
 
 def _decode(path, gz) -> _Text:
-    """The file gunzipped when ``gz``, decoded as UTF-8 (else Latin-1), without a byte-order mark."""
+    """The file, gunzipped when ``gz`` (decoded on use: :class:`_Text`)."""
     try:
         with open(path, "rb") as f:
             raw = f.read()
@@ -88,12 +117,7 @@ def _decode(path, gz) -> _Text:
             raw = zlib.decompress(raw, 16 + zlib.MAX_WBITS) if raw else raw
     except (OSError, zlib.error, EOFError, gzip.BadGzipFile) as exc:
         raise InputError(f"{path}: cannot be read{' as gzip' if gz else ''} ({exc})") from None
-    try:
-        text, codec = raw.decode("utf-8"), "utf-8"
-    except UnicodeDecodeError:
-        text, codec = raw.decode("latin-1"), "latin-1"
-    bom = text.startswith("\ufeff")
-    return _Text(raw, text[1:] if bom else text, codec, bom)
+    return _Text(raw)
 
 
 def _layout(path, lines, delimiter):

@@ -25,7 +25,7 @@ import pickle
 import signal
 import warnings
 
-__all__ = ["start", "waiting", "offer", "take", "close"]
+__all__ = ["start", "waiting", "offer", "hand_over", "take", "close"]
 
 #: Capacity asked for the pipe to the worker (Linux allows up to 1 MiB unprivileged).
 PIPE_BYTES = 1 << 20
@@ -97,17 +97,30 @@ def offer(partial, complete: bool = False) -> None:
         _send(("analysis", partial, EARLY_DPI, complete))
 
 
+def hand_over(rep, dpi: int) -> bool:
+    """Hand the waiting worker the whole report (it then draws what it has not drawn yet) and return at once,
+    so that this process can prepare the files meanwhile; :func:`take` collects the PNGs. False when no worker
+    waits or the report cannot be pickled (the worker is then ended; the caller draws the figures)."""
+    if not _WORKER or _WORKER[0][1] < 0:
+        return bool(_WORKER)  # none waits, or it has the report already
+    if not _send(("report", rep, dpi)):
+        return False
+    pid, w, r = _WORKER[0]
+    os.close(w)
+    _WORKER[0] = (pid, -1, r)
+    return True
+
+
 def take(rep, dpi: int) -> dict | None:
-    """File name → PNG bytes of the report's figures drawn by the waiting worker, or None when no worker waits,
-    the report cannot be pickled or the worker fails (the caller draws them)."""
+    """File name → PNG bytes of the report's figures drawn by the waiting worker (handed the report here unless
+    :func:`hand_over` did), or None when no worker waits, the report cannot be pickled or the worker fails (the
+    caller draws them)."""
     if not _WORKER:
         return None
     try:
-        if not _send(("report", rep, dpi)):
+        if not hand_over(rep, dpi):
             return None
-        pid, w, r = _WORKER[0]
-        os.close(w)
-        _WORKER[0] = (pid, -1, r)
+        pid, _, r = _WORKER[0]
         chunks = []
         while chunk := os.read(r, 1 << 20):
             chunks.append(chunk)

@@ -21,7 +21,7 @@ from .settings import NOTHING_ADDED, REPORT_ESTIMATORS
 if TYPE_CHECKING:
     import jinja2
 
-__all__ = ["html_page"]
+__all__ = ["html_page", "page_context"]
 
 
 @lru_cache(maxsize=1)
@@ -369,18 +369,27 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
     }
 
 
-def html_page(rep: Any, images: dict) -> str:
-    """The self-contained HTML page of a report, figures embedded as data URIs."""
-    s = rep.summary()
-    rec, st, dy, fit = s["record"], s["static"], s["dynamic"], s["fit"]
-    names = rec["axis_names"]
-    au = rec["adev_unit"] or "samples' unit"
+def html_page(rep: Any, images: dict, context: dict | None = None) -> str:
+    """The self-contained HTML page of a report, figures embedded as data URIs; ``context``: the page's
+    context made beforehand (:func:`page_context`, while the figures were drawn elsewhere)."""
     specs = {sp[0]: sp for sp in rep.figure_specs()}
     figures = {
         name: {"data": base64.b64encode(data).decode("ascii"), "title": specs[name][1], "caption": specs[name][2]}
         for name, data in images.items()
     }
-    context = {
+    context = page_context(rep) if context is None else context
+    return _template().render(**context, figures=figures).rstrip() + "\n"
+
+
+def page_context(rep: Any) -> dict:
+    """Everything the page shows but its figures, from the report's summary; the template compiled (Jinja2
+    imported) on the first call."""
+    _template()
+    s = rep.summary()
+    rec, st, dy, fit = s["record"], s["static"], s["dynamic"], s["fit"]
+    names = rec["axis_names"]
+    au = rec["adev_unit"] or "samples' unit"
+    return {
         "name": rec["name"],
         "version": __version__,
         "created": s["created"],
@@ -397,6 +406,4 @@ def html_page(rep: Any, images: dict) -> str:
         "refinement": _refinement(s.get("refinement"), rec),
         "forecast": forecast_page(s.get("forecast")),
         "paper002": paper002_page(s.get("paper002")),
-        "figures": figures,
     }
-    return _template().render(**context).rstrip() + "\n"

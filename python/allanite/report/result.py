@@ -14,7 +14,7 @@ from ..units import adev_unit_label
 from . import _worker
 from .figures import figure_specs
 from .fmt import count
-from .page import html_page
+from .page import html_page, page_context
 from .rendering import render_pngs
 from .sidefiles import write_side_files
 from .summary import summarize, text_summary
@@ -148,7 +148,21 @@ class Report:
         the side files last."""
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
-        progress, own = steps(progress, len(self.figure_specs()) + 1, "report files")
+        specs = self.figure_specs()
+        progress, own = steps(progress, len(specs) + 1, "report files")
+        # while a figure process draws (handed the report now), the JSON and the page's template are made here
+        _worker.hand_over(self, dpi)
+        summary = self.summary()
+        entry = (summary.get("side_files") or {}).get("series") or {}
+        side = [name for name in (entry.get("npz"), entry.get("parquet")) if name]
+        summary["files"] = {
+            "html": "report.html",
+            "summary": "summary.json",
+            "figures": [spec[0] for spec in specs],
+            "side_files": list(side),
+        }
+        text = json.dumps(summary, indent=1, ensure_ascii=False, allow_nan=False)
+        page = page_context(self)
         images = self.render_figures(progress, dpi=dpi)
         progress.step("writing report.html, summary.json")
         pngs = []
@@ -156,18 +170,9 @@ class Report:
             p = out / name
             p.write_bytes(data)
             pngs.append(p)
-        summary = self.summary()
-        side = write_side_files(self, out) if summary.get("side_files") else []
-        summary["files"] = {
-            "html": "report.html",
-            "summary": "summary.json",
-            "figures": list(images),
-            "side_files": [p.name for p in side],
-        }
-        (out / "summary.json").write_text(
-            json.dumps(summary, indent=1, ensure_ascii=False, allow_nan=False), encoding="utf-8"
-        )
-        (out / "report.html").write_text(self.html(images), encoding="utf-8")
+        written = write_side_files(self, out) if side else []
+        (out / "summary.json").write_text(text, encoding="utf-8")
+        (out / "report.html").write_text(html_page(self, images, page), encoding="utf-8")
         if own:
             progress.close()
-        return [out / "report.html", out / "summary.json"] + pngs + side
+        return [out / "report.html", out / "summary.json"] + pngs + written

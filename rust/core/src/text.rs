@@ -9,6 +9,8 @@
 //! makes it return `None`, and the caller reads the file the slow way, which finds and names the
 //! problem.
 
+use rayon::prelude::*;
+
 /// The values of columns `cols` (sorted, each < `ncols`) of every data line of `buf`, row-major,
 /// and the number of rows; `None` when any line is outside the fast path's grammar (see the
 /// module's documentation).
@@ -36,13 +38,69 @@ pub fn parse_decimal_table(
     for &c in cols {
         wanted[c] = true;
     }
-    let mut values = Vec::with_capacity(cols.len() * (buf.len() / (8 * ncols) + 1));
+    let pieces = line_aligned_pieces(buf);
+    if pieces.len() == 1 {
+        return parse_piece(buf, delim, &wanted, cols.len());
+    }
+    // the pieces end at line ends: each line is parsed as it would be in one pass, so the values are the same
+    let parsed: Vec<Option<(Vec<f64>, usize)>> = pieces
+        .par_iter()
+        .map(|&(a, b)| parse_piece(&buf[a..b], delim, &wanted, cols.len()))
+        .collect();
+    let mut values = Vec::with_capacity(parsed.iter().flatten().map(|(v, _)| v.len()).sum());
+    let mut rows = 0usize;
+    for piece in parsed {
+        let (v, r) = piece?;
+        values.extend_from_slice(&v);
+        rows += r;
+    }
+    Some((values, rows))
+}
+
+/// Bytes of text from which [`parse_decimal_table`] parses pieces of it on several threads.
+pub const PARALLEL_BYTES: usize = 1 << 20;
+
+/// `buf` cut into pieces of about `PARALLEL_BYTES / 2` or more, each ending just after a `\n` (the last at
+/// `buf`'s end), as (start, end) — one piece for a short text or one thread.
+fn line_aligned_pieces(buf: &[u8]) -> Vec<(usize, usize)> {
+    let threads = rayon::current_num_threads();
+    if buf.len() < PARALLEL_BYTES || threads < 2 {
+        return vec![(0, buf.len())];
+    }
+    let n = (threads * 4).min(buf.len() / (PARALLEL_BYTES / 2)).max(2);
+    let mut pieces = Vec::with_capacity(n);
+    let mut start = 0usize;
+    for k in 1..n {
+        let guess = (buf.len() / n * k).max(start);
+        let Some(nl) = buf[guess..].iter().position(|&b| b == b'\n') else {
+            break;
+        };
+        let end = guess + nl + 1;
+        if end > start {
+            pieces.push((start, end));
+            start = end;
+        }
+    }
+    if start < buf.len() {
+        pieces.push((start, buf.len()));
+    }
+    pieces
+}
+
+/// The rows of `piece` (whole lines): the values of the `wanted` fields and the number of data rows.
+fn parse_piece(
+    piece: &[u8],
+    delim: Option<u8>,
+    wanted: &[bool],
+    n_wanted: usize,
+) -> Option<(Vec<f64>, usize)> {
+    let mut values = Vec::with_capacity(n_wanted * (piece.len() / (8 * wanted.len()) + 1));
     let mut rows = 0usize;
     let mut pos = 0usize;
-    while pos < buf.len() {
+    while pos < piece.len() {
         let (row, next) = match delim {
-            Some(d) => delimited_line(buf, pos, d, &wanted, &mut values)?,
-            None => blank_separated_line(buf, pos, &wanted, &mut values)?,
+            Some(d) => delimited_line(piece, pos, d, wanted, &mut values)?,
+            None => blank_separated_line(piece, pos, wanted, &mut values)?,
         };
         rows += usize::from(row);
         pos = next;
@@ -313,6 +371,48 @@ mod tests {
         let got = parse("1\t 2 \n3\t4\r\n", Some(b'\t'), 2, &[0, 1]);
         assert_eq!(got, Some((vec![1.0, 2.0, 3.0, 4.0], 2)));
         assert_eq!(parse("1\t\t2\n", Some(b'\t'), 2, &[0, 1]), None);
+    }
+
+    /// A text long enough to be parsed in pieces on several threads: the values of one pass, bit for bit;
+    /// a bad line in any piece sends the whole text to the slow path.
+    #[test]
+    fn pieces_give_the_values_of_one_pass() {
+        let mut s = String::from("# head\r\n");
+        let mut x = 0.123_456_789_f64;
+        let mut k = 0usize;
+        while s.len() < 3 * PARALLEL_BYTES {
+            x = (x * 3.7 + 0.31).fract();
+            match k % 5 {
+                0 => s.push_str(&format!("{x:.9},{},{:e}\r\n", k, -x * 1e-7)),
+                1 => s.push_str(&format!("{x},  {} ,{:.3} # c\n", k, x - 0.5)),
+                2 => s.push_str("\n# comment, 1,2\n"),
+                _ => s.push_str(&format!("{:.17e},{},{x}\n", x * 1e300, k)),
+            }
+            k += 1;
+        }
+        let buf = s.as_bytes();
+        assert!(line_aligned_pieces(buf).len() > 1 || rayon::current_num_threads() < 2);
+        for cols in [&[0usize, 1, 2][..], &[0, 2], &[1]] {
+            let mut wanted = vec![false; 3];
+            cols.iter().for_each(|&c| wanted[c] = true);
+            let one = parse_piece(buf, Some(b','), &wanted, cols.len()).unwrap();
+            let got = parse_decimal_table(buf, Some(b','), 3, cols).unwrap();
+            assert_eq!(got.1, one.1);
+            assert!(got
+                .0
+                .iter()
+                .zip(&one.0)
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
+            assert_eq!(got.0.len(), one.0.len());
+        }
+        let pieces = line_aligned_pieces(buf);
+        let (a, b) = pieces[pieces.len() / 2];
+        assert!(b > a && buf[b - 1] == b'\n' && (a == 0 || buf[a - 1] == b'\n'));
+        let mut bad = s.clone().into_bytes();
+        let at = bad.len() * 2 / 3;
+        let nl = at + bad[at..].iter().position(|&c| c == b'\n').unwrap() + 1;
+        bad.splice(nl..nl, b"1,nan,2\n".iter().copied());
+        assert_eq!(parse_decimal_table(&bad, Some(b','), 3, &[0, 1, 2]), None);
     }
 
     #[test]
