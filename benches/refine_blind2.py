@@ -382,6 +382,7 @@ def main(argv=None) -> None:
             print(f"{case.name}: {effect_size(y, comp, fs)}", flush=True)
         return
     out = Path(args.out) if args.out else (Path(tempfile.mkdtemp()) if args.case else HERE / "results")
+    out.mkdir(parents=True, exist_ok=True)
     results = []
     with _common.OtherLoad() as load:
         for case in chosen:

@@ -355,3 +355,22 @@ def test_the_lag_threshold_with_few_degrees_of_freedom_is_large_or_infinite_neve
     assert _upcrossing_threshold(1e-3, 1.0, 2.5) == math.inf  # (1 + u/ν)^0: the bound never falls below V/π
     thr = _upcrossing_threshold(1e-3, 40.0, 1.0)
     assert 10.0 < thr < 30.0 and _upcrossing_p(thr, 40.0, 1.0) == pytest.approx(1e-3, rel=1e-6)
+
+
+def test_heldout_of_a_channel_cycling_a_whole_number_of_times():
+    # a temperature cycling exactly 3 times puts its power in one DFT bin, so into one side of the even/odd split:
+    # that way's held-out ratio was the other side's noise (1.05, 0.46, 0.60 for these seeds — the first a
+    # coupling at LR 50 rejected); the record's two halves both carry it, and that split is taken
+    n, fs = 200_000, 10.0
+    t = np.arange(n) / fs
+    temp = 25 + 10 * np.sin(2 * np.pi * 3 * t / (n / fs))
+    for seed in (1, 2, 3):
+        rng = np.random.default_rng(seed)
+        logged = temp + 0.01 * rng.standard_normal(n)
+        noise = allanite.simulate(n, fs, N=2e-3, B=5e-4, K=1e-5, seed=seed + 7)
+        y = noise + 3e-4 * (temp - temp.mean())
+        r = regress_channel(y, logged, fs, name="temp")
+        assert r.accepted and r.params["coefficient"] == pytest.approx(3e-4, rel=0.2)
+        assert heldout_ratio(y, logged, fs, r) < 0.6
+        r0 = regress_channel(noise, logged, fs, name="temp")
+        assert heldout_ratio(noise, logged, fs, r0) > 0.9
