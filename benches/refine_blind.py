@@ -398,6 +398,7 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     chosen = [c for c in CASES if args.case is None or args.case in c.name]
     out = Path(args.out) if args.out else (Path(tempfile.mkdtemp()) if args.case else HERE / "results")
+    out.mkdir(parents=True, exist_ok=True)
     results = []
     with _common.OtherLoad() as load:
         for case in chosen:
