@@ -62,7 +62,7 @@ class Blind:
     seed: int = 0
 
 
-def _noise(n, fs, rng, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:
+def noise(n, fs, rng, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:
     """N, K, R from ``allanite.simulate``, stationary flicker B (Kasdin–Walter over 4× the record, its tail)."""
     y = allanite.simulate(n, fs, N=N, K=K, R=R, seed=rng) if (N or K or R) else np.zeros(n)
     if B:
@@ -72,12 +72,12 @@ def _noise(n, fs, rng, N=0.0, B=0.0, K=0.0, R=0.0) -> np.ndarray:
 
 def _fog(rng):
     fs, n = 2000.0, 2_000_000
-    return _noise(n, fs, rng, N=5e-8, B=2e-8, K=2e-10), fs, {}, {}
+    return noise(n, fs, rng, N=5e-8, B=2e-8, K=2e-10), fs, {}, {}
 
 
 def _butterworth_gm(rng):
     fs, n = 400.0, 1_000_000
-    y = _noise(n, fs, rng, N=1.7e-3, B=2.8e-4, K=2e-6)
+    y = noise(n, fs, rng, N=1.7e-3, B=2.8e-4, K=2e-6)
     y = y + allanite.simulate(n, fs, gauss_markov=[(5e-3, 3.0)], seed=rng)
     b, a = signal.butter(2, 100.0, fs=fs)
     return signal.lfilter(b, a, y), fs, {}, {}
@@ -85,7 +85,7 @@ def _butterworth_gm(rng):
 
 def _logger(rng):
     fs, n = 10.0, 300_000
-    y = _noise(n, fs, rng, N=0.01, B=2e-3, K=2e-5)
+    y = noise(n, fs, rng, N=0.01, B=2e-3, K=2e-5)
     t = np.arange(n) / fs
     y = y + 0.03 * np.sin(2 * np.pi * 1.7 * t + 0.4)
     lsb = 2 * 0.01 * math.sqrt(fs)  # twice the white noise per sample
@@ -94,7 +94,7 @@ def _logger(rng):
 
 def _float32(rng):
     fs, n = 200.0, 1_000_000
-    y = _noise(n, fs, rng, N=1e-4, B=5e-5, K=2e-7)
+    y = noise(n, fs, rng, N=1e-4, B=5e-5, K=2e-7)
     y = y + allanite.simulate(n, fs, gauss_markov=[(5e-4, 10.0)], seed=rng) + 500.0
     return y.astype(np.float32), fs, {}, {}
 
@@ -102,7 +102,7 @@ def _float32(rng):
 def _three_axes(axis):
     def build(rng):
         fs, n = 100.0, 500_000
-        x = np.column_stack([_noise(n, fs, rng, N=4e-3, B=8e-4, K=1e-5) for _ in range(3)])
+        x = np.column_stack([noise(n, fs, rng, N=4e-3, B=8e-4, K=1e-5) for _ in range(3)])
         x[:, 1] += 0.004 * np.sin(2 * np.pi * 3.3 * np.arange(n) / fs + 1.0)
         return x, fs, {}, {"axis": axis}
 
@@ -112,7 +112,7 @@ def _three_axes(axis):
 def _temperature_lag(rng):
     fs, n = 1.0, 172_800  # 48 h
     t = np.arange(n) / fs
-    y = _noise(n, fs, rng, N=5e-4, B=5e-5, K=5e-6)
+    y = noise(n, fs, rng, N=5e-4, B=5e-5, K=5e-6)
     wander = np.cumsum(rng.standard_normal(n))
     air = 22.5 + 6.0 * np.sin(2 * np.pi * t / 86_400.0 - 1.0) + 1.5 * wander / np.ptp(wander)
     sensor = sensors.first_order_lag(air, fs, 1800.0)
@@ -123,7 +123,7 @@ def _temperature_lag(rng):
 
 def _noise_doubles(rng):
     fs, n = 100.0, 1_000_000
-    y = _noise(n, fs, rng, B=5e-4, K=1e-5)
+    y = noise(n, fs, rng, B=5e-4, K=1e-5)
     white = rng.standard_normal(n) * 3e-3 * math.sqrt(fs)
     white[n // 2 :] *= 2.0
     return y + white, fs, {}, {}
@@ -131,7 +131,7 @@ def _noise_doubles(rng):
 
 def _slow_gm(rng):
     fs, n = 20.0, 400_000  # 20 000 s; T_c = 4000 s
-    y = _noise(n, fs, rng, N=2e-3, B=2e-4, K=1e-6)
+    y = noise(n, fs, rng, N=2e-3, B=2e-4, K=1e-6)
     return y + allanite.simulate(n, fs, gauss_markov=[(1e-3, 4000.0)], seed=rng), fs, {}, {}
 
 
@@ -253,6 +253,16 @@ def _fell(pair: dict, key: str) -> bool:
     return b is not None and a is not None and a < b
 
 
+def judge(r, case: Blind) -> dict:
+    """The verdict on refinement ``r`` of ``case`` (also ``benches/refine_blind2.py``'s): ``sensors.judge`` where
+    something was injected, else nothing added but what the case allows; a change point's own errors; the
+    bandwidth's kind."""
+    v = sensors.judge(r, case) if case.injected else _judge_clean(r, case)
+    _judge_change_points(r, v)
+    _judge_kind(r, case, v)
+    return v
+
+
 def run_case(case: Blind) -> dict:
     rng = np.random.default_rng(case.seed)
     y, fs, channels, kw = case.build(rng)
@@ -261,9 +271,7 @@ def run_case(case: Blind) -> dict:
     t0 = time.process_time()
     r = allanite.refine(y, fs, unit=case.unit, progress=False, **kw)
     cpu = time.process_time() - t0
-    v = sensors.judge(r, case) if case.injected else _judge_clean(r, case)
-    _judge_change_points(r, v)
-    _judge_kind(r, case, v)
+    v = judge(r, case)
     v["start_chi2_dof"] = r.start.chi2_dof
     v["final_chi2_dof"] = r.fit.chi2_dof
     if case.injected:
@@ -371,6 +379,7 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     chosen = [c for c in CASES if args.case is None or args.case in c.name]
     out = Path(args.out) if args.out else (Path(tempfile.mkdtemp()) if args.case else HERE / "results")
+    out.mkdir(parents=True, exist_ok=True)
     results = []
     with _common.OtherLoad() as load:
         for case in chosen:

@@ -1,0 +1,431 @@
+#!/usr/bin/env python3
+"""``allanite.refine`` on a second blind suite of simulated sensors, unlike ``tests/sensors.py``, the first blind
+suite (``benches/refine_blind.py``) and the ADIS16405.
+
+**Written and committed before it was first run.** The first run's verdicts are recorded as they came out (the
+notes below the table); any later change is judged against them, and the cases are not retuned after the run. The
+effects' sizes were fixed beforehand by their Allan deviation alone (the column "size": the largest ratio, over the
+τ refine scores, of the injected component's Allan deviation to that of the rest of the record — the suite asks
+≥ 3× for curve effects; impulsive noise is sized by its count instead), never by refine's answer.
+
+The cases: a 2 kHz MEMS gyro × 4·10⁶ with two extra channels — a temperature it follows with a quadratic term, and
+a supply voltage (a random walk) it does not follow, which must not be taken; a 1 Hz × 10⁵ log in a thermal
+chamber ramping between plateaus, the gyro following the temperature and dT/dt; bursts of spikes (clustered
+impulsive noise, not iid); a square wave at 0.7 Hz on a 200 Hz quantised gyro (a period of 285.7 samples); an
+amplitude-modulated 47.5 Hz carrier on a 1 kHz sensor; a 50 s record (10⁵ samples at 2 kHz) with a line; a 300 s
+warm-up on a 400 Hz gyro with strong flicker; a clean 10⁷-sample 1 kHz record with strong flicker and rate random
+walk (nothing may be added) — and three effects **outside refine's family**: a chirp (a line whose frequency drifts
+along the record), a bias step (a jump of the mean, not of the noise level) and a sinusoid switched on halfway.
+
+Judged as ``benches/refine_blind.py`` judges (its :func:`refine_blind.judge`, i.e. ``tests/sensors.py``'s
+``judge`` plus the change-point and filter-kind rules; a clean case: nothing added, nothing unexplained). An effect
+outside the family passes when ``unexplained`` is non-empty (refine may name its nearest effect, but must not call
+the model complete). A case with a named channel passes only if every regression is on that channel. Every case
+with an effect in the family is refined again without its effect's candidate, which must leave something
+unexplained.
+
+Usage::
+
+    python benches/refine_blind2.py               # -> benches/results/refine_blind2.{json,md}
+    python benches/refine_blind2.py --case chirp  # the cases whose name contains "chirp", to a temporary folder
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy import signal
+
+import _common
+import allanite
+import refine_blind as rb
+from allanite.model.refinement.words import describe_region
+
+sensors = rb.sensors
+Injected = sensors.Injected
+HERE = Path(__file__).resolve().parent
+
+
+@dataclass
+class Blind2(rb.Blind):
+    """A blind case (``refine_blind.Blind``) whose ``build(rng)`` returns (samples, fs, channels, keyword arguments,
+    the injected component or None); ``outside``: its effect is outside refine's family (passes when something is
+    left unexplained); ``channel``: the only channel a regression may be on."""
+
+    outside: bool = False
+    channel: str | None = None
+    sizes: dict = field(default_factory=dict)
+
+
+def _white(n, fs, rng, N) -> np.ndarray:
+    return rng.standard_normal(n) * (N * math.sqrt(fs))
+
+
+def _chamber(t: np.ndarray, lo: float, hi: float, hold: float, ramp: float) -> np.ndarray:
+    """A thermal chamber's profile: plateaus at ``lo`` and ``hi`` held ``hold`` s, joined by ramps of ``ramp`` s."""
+    period = 2 * (hold + ramp)
+    p = np.mod(t, period)
+    up = np.clip((p - hold) / ramp, 0.0, 1.0)
+    down = np.clip((p - 2 * hold - ramp) / ramp, 0.0, 1.0)
+    return lo + (hi - lo) * (up - down)
+
+
+def _mems_two_channels(rng):
+    fs, n = 2000.0, 4_000_000  # 2000 s
+    t = np.arange(n) / fs
+    y = rb.noise(n, fs, rng, N=3e-3, B=1e-3, K=3e-5)
+    temp = sensors.temperature_profile(t, "cycle", rng, lo=15.0, hi=35.0)
+    d = temp - temp.mean()
+    comp = 8e-4 * d + 1.2e-4 * (d * d - np.mean(d * d))
+    walk = np.cumsum(rng.standard_normal(n))
+    vdd = 5.0 + 0.05 * (walk - walk.mean()) / np.ptp(walk) + 1e-3 * rng.standard_normal(n)
+    logged = temp + 0.01 * rng.standard_normal(n)
+    return y + comp, fs, {"temp": logged, "vdd": vdd}, {}, comp
+
+
+def _chamber_rate(rng):
+    fs, n = 1.0, 100_000
+    t = np.arange(n) / fs
+    y = rb.noise(n, fs, rng, N=1e-3, B=2e-4, K=2e-6)
+    temp = _chamber(t + 1500.0, 10.0, 30.0, 6000.0, 1200.0)  # 1 °C/min ramps
+    comp = 1e-4 * (temp - temp.mean()) + 0.12 * np.gradient(temp, 1.0 / fs)
+    logged = temp + 0.01 * rng.standard_normal(n)
+    return y + comp, fs, {"temp": logged}, {}, comp
+
+
+def _bursts(rng):
+    fs, n = 500.0, 1_000_000
+    y = rb.noise(n, fs, rng, B=5e-4, K=1e-5)
+    sigma = 2e-3 * math.sqrt(fs)
+    white = sigma * rng.standard_normal(n)
+    comp = np.zeros(n)
+    starts = np.sort(rng.choice(np.arange(100, n // 50 - 1), 100, replace=False)) * 50  # 100 bursts of 0.1 s
+    for s in starts:
+        hit = s + rng.choice(50, 15, replace=False)  # 15 of its 50 samples spiked: 1500 in all, rate 1.5·10⁻³
+        comp[hit] = sigma * 10.0 * (1.0 + rng.random(15)) * rng.choice([-1.0, 1.0], 15)
+    return y + white + comp, fs, {}, {}, comp
+
+
+def _square_quantised(rng):
+    fs, n = 200.0, 1_000_000
+    t = np.arange(n) / fs
+    y = rb.noise(n, fs, rng, N=2e-3, B=5e-4, K=1e-5)
+    comp = 0.012 * signal.square(2 * np.pi * 0.7 * t + 0.9)
+    lsb = 1.5 * 2e-3 * math.sqrt(fs)
+    return np.round((y + comp) / lsb) * lsb, fs, {}, {}, comp
+
+
+def _am_1khz(rng):
+    fs, n = 1000.0, 2_000_000
+    t = np.arange(n) / fs
+    y = rb.noise(n, fs, rng, N=2e-3, B=5e-4, K=1e-5)
+    comp = 0.1 * (1.0 + 0.6 * np.cos(2 * np.pi * 1.9 * t)) * np.sin(2 * np.pi * 47.5 * t + 0.2)
+    return y + comp, fs, {}, {}, comp
+
+
+def _short_line(rng):
+    fs, n = 2000.0, 100_000  # 50 s
+    t = np.arange(n) / fs
+    y = rb.noise(n, fs, rng, N=3e-3, B=1e-3, K=2e-5)
+    comp = 0.05 * np.sin(2 * np.pi * 3.7 * t + 2.0)
+    return y + comp, fs, {}, {}, comp
+
+
+def _warmup_flicker(rng):
+    fs, n = 400.0, 1_000_000  # 2500 s
+    t = np.arange(n) / fs
+    y = rb.noise(n, fs, rng, N=2e-3, B=1e-3, K=1e-5)
+    comp = 0.04 * np.exp(-t / 300.0)
+    return y + comp, fs, {}, {}, comp
+
+
+def _clean_long(rng):
+    fs, n = 1000.0, 10_000_000
+    return rb.noise(n, fs, rng, N=1e-3, B=1e-3, K=5e-5), fs, {}, {}, None
+
+
+def _chirp(rng):
+    fs, n = 100.0, 1_000_000
+    t = np.arange(n) / fs
+    y = rb.noise(n, fs, rng, N=3e-3, B=1e-3, K=2e-5)
+    f_a, f_b, span = 2.0, 2.6, n / fs  # the line's frequency drifts 2.0 → 2.6 Hz along the record
+    comp = 0.04 * np.sin(2 * np.pi * (f_a * t + 0.5 * (f_b - f_a) * t * t / span) + 0.5)
+    return y + comp, fs, {}, {}, comp
+
+
+def _bias_step(rng):
+    fs, n = 50.0, 1_000_000  # 20 000 s
+    y = rb.noise(n, fs, rng, N=2e-3, B=3e-4, K=2e-6)
+    comp = np.zeros(n)
+    comp[int(0.55 * n) :] = 3e-3
+    return y + comp, fs, {}, {}, comp
+
+
+def _switch_on(rng):
+    fs, n = 200.0, 1_000_000
+    t = np.arange(n) / fs
+    y = rb.noise(n, fs, rng, N=2e-3, B=5e-4, K=1e-5)
+    comp = np.where(t >= 0.5 * n / fs, 0.05 * np.sin(2 * np.pi * 4.3 * t + 1.3), 0.0)
+    return y + comp, fs, {}, {}, comp
+
+
+def _periodic(fundamentals, rms) -> Injected:
+    return Injected("periodic", {"fundamentals": list(fundamentals), "rms": rms}, ("fundamentals",))
+
+
+CASES = [
+    Blind2(
+        "2 kHz MEMS × 4·10⁶, temperature with a quadratic term, an irrelevant supply voltage (random walk)",
+        _mems_two_channels,
+        [Injected("regression", {"coefficient": 8e-4, "quadratic": 1.2e-4})],
+        channel="temp",
+        seed=201,
+    ),
+    Blind2(
+        "1 Hz × 10⁵, thermal chamber ramping 1 °C/min between 10 and 30 °C, gyro on T and dT/dt",
+        _chamber_rate,
+        [Injected("regression", {"coefficient": 1e-4, "rate_coefficient": 0.12})],
+        channel="temp",
+        unit="rad/s",
+        seed=202,
+    ),
+    Blind2(
+        "bursts of spikes (100 bursts of 0.1 s, 30 % of their samples at 10–20 σ), 500 Hz × 10⁶",
+        _bursts,
+        [Injected("outliers", {"rate": 1.5e-3})],
+        seed=203,
+    ),
+    Blind2(
+        "square wave 0.012 °/s at 0.7 Hz, 200 Hz × 10⁶, quantised to 1.5 σ of its white noise",
+        _square_quantised,
+        [_periodic([0.7], 0.012)],
+        seed=204,
+    ),
+    Blind2(
+        "AM carrier 47.5 Hz × 1.9 Hz (depth 0.6), 1 kHz × 2·10⁶",
+        _am_1khz,
+        [_periodic([47.5, 1.9], 0.1 * math.sqrt(0.5 * (1 + 0.5 * 0.36)))],
+        seed=205,
+    ),
+    Blind2(
+        "short record: 50 s at 2 kHz, line 0.05 °/s at 3.7 Hz",
+        _short_line,
+        [Injected("sinusoid", {"amplitude": 0.05, "f0": 3.7}, ("f0",))],
+        seed=206,
+    ),
+    Blind2(
+        "warm-up 0.04·e^{−t/300 s}, 400 Hz × 10⁶, strong flicker",
+        _warmup_flicker,
+        [Injected("drift", {"amplitude": 0.04, "T": 300.0})],
+        seed=207,
+    ),
+    Blind2("clean 1 kHz × 10⁷, strong flicker and rate random walk", _clean_long, seed=208),
+    Blind2(
+        "outside the family: chirp 0.04 °/s drifting 2.0 → 2.6 Hz, 100 Hz × 10⁶",
+        _chirp,
+        outside=True,
+        seed=209,
+    ),
+    Blind2(
+        "outside the family: bias step 3·10⁻³ °/s at 0.55 T, 50 Hz × 10⁶",
+        _bias_step,
+        outside=True,
+        seed=210,
+    ),
+    Blind2(
+        "outside the family: line 0.05 °/s at 4.3 Hz switched on halfway, 200 Hz × 10⁶",
+        _switch_on,
+        outside=True,
+        seed=211,
+    ),
+]
+
+
+def effect_size(y: np.ndarray, comp, fs: float) -> float | None:
+    """The largest ratio, over octave τ up to a quarter of the record, of the component's Allan deviation to that of
+    the rest of the record (None for a clean case)."""
+    if comp is None:
+        return None
+    a = allanite.avar(comp, fs)
+    b = allanite.avar(np.asarray(y, dtype=np.float64) - comp, fs)
+    keep = (a.tau <= 0.25 * y.shape[0] / fs) & (b.avar > 0)
+    return float(np.sqrt(np.max(a.avar[keep] / b.avar[keep])))
+
+
+def _judge_outside(r) -> dict:
+    left = r.unexplained
+    first, last = (r.steps[0], r.steps[-1]) if r.steps else (None, None)
+    out = {"named": True, "params": True, "param_errors": {}, "found": list(r.found), "unexplained": left}
+    out |= {"explained": not left, "passed": bool(left), "falling": True, "heldout_falling": True}
+    if first is not None:
+        out["chi2_dof"] = (first.before.get("chi2_dof"), last.after.get("chi2_dof"))
+        out["rms_adev_pct"] = (first.before.get("rms_adev_pct"), last.after.get("rms_adev_pct"))
+        out["heldout_rms_adev_pct"] = (first.before.get("heldout_rms_adev_pct"), last.after.get("heldout_rms_adev_pct"))
+    return out
+
+
+def _judge_channel(r, case: Blind2, v: dict) -> None:
+    """Every regression on the case's channel (an irrelevant channel taken fails the case)."""
+    if case.channel is None:
+        return
+    chans = [s.params.get("channel") for s in r.steps if s.effect == "regression"]
+    v["regression_channels"] = chans
+    if any(c != case.channel for c in chans):
+        v["named"] = v["passed"] = False
+
+
+def run_case(case: Blind2) -> dict:
+    rng = np.random.default_rng(case.seed)
+    y, fs, channels, kw, comp = case.build(rng)
+    size = effect_size(y, comp, fs)
+    if channels:
+        kw = kw | {"channels": channels}
+    t0 = time.process_time()
+    r = allanite.refine(y, fs, unit=case.unit, progress=False, **kw)
+    cpu = time.process_time() - t0
+    v = _judge_outside(r) if case.outside else rb.judge(r, case)
+    _judge_channel(r, case, v)
+    v |= {"start_chi2_dof": r.start.chi2_dof, "final_chi2_dof": r.fit.chi2_dof, "size": size}
+    if case.injected:
+        blind = allanite.refine(
+            y, fs, unit=case.unit, candidates=sensors.candidates_without(case), progress=False, **kw
+        )
+        v["without_candidate"] = {"found": list(blind.found), "unexplained": blind.unexplained}
+        v["without_candidate_flags"] = bool(blind.unexplained)
+    v |= {"cpu_seconds": cpu, "name": case.name, "outside": case.outside}
+    v["injected"] = [{"effect": i.effect, "truth": i.truth} for i in case.injected]
+    v["steps"] = [{"effect": s.effect, "params": s.params} for s in r.steps]
+    return v
+
+
+def _row(v) -> str:
+    injected = ", ".join(i["effect"] for i in v["injected"]) or ("outside" if v["outside"] else "— (clean)")
+    errs = _common.param_errors_cell(v["param_errors"])
+    left = v["unexplained"]
+    left_s = "none" if not left else "; ".join(describe_region(u) for u in left[:3])
+    wc = v.get("without_candidate")
+    blind_s = _common.without_candidate_cell(None if wc is None else wc["unexplained"])
+    chi = _common.arrow_cell(v.get("chi2_dof")) if v.get("chi2_dof") else f"{v['start_chi2_dof']:.3g} (nothing added)"
+    size = "—" if v["size"] is None else f"{v['size']:.3g}×"
+    return (
+        f"| {v['name']} | {size} | {injected} | {_common.steps_cell(v['steps'], 4)} | {errs or '—'} | {chi} | "
+        f"{_common.arrow_cell(v.get('rms_adev_pct'))} | {_common.arrow_cell(v.get('heldout_rms_adev_pct'))} | {left_s} | {blind_s} | "
+        f"{'✓' if v['passed'] else '✗'} | {v['cpu_seconds']:.0f} |"
+    )
+
+
+def write(results, out: Path, load, notes: list) -> None:
+    m = _common.machine_info()
+    passed = sum(v["passed"] for v in results)
+    with_inj = [v for v in results if v["injected"]]
+    flagged = sum(v.get("without_candidate_flags", False) for v in with_inj)
+    lines = [
+        "# refine on a second blind suite of simulated sensors (issue 29)",
+        "",
+        f"Default call, `python benches/refine_blind2.py`, {m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at "
+        f"{m['git_commit']}, {m['date_utc'][:10]}; other processes used {load:.0%} of the CPUs during the run "
+        "(the last column is this process's CPU seconds for the default call).",
+        "",
+        f"**Passed: {passed} of {len(results)}** (as `benches/refine_blind.py`: named, parameters within 20 %, "
+        "frequencies within 1 %, χ²/dof (the tests' GLS) or the RMS ADEV error falling in sample, the RMS ADEV "
+        "error held out, nothing unexplained; a clean case: nothing added, nothing unexplained; an effect outside "
+        "refine's family: something left unexplained; a named channel: no regression on another). **Without the "
+        f"effect's candidate, `unexplained` is non-empty in {flagged} of {len(with_inj)}.** The suite was written "
+        "and committed before its first run; size: the injected component's Allan deviation over the rest's, "
+        "largest over τ ≤ T/4.",
+        "",
+        "| case | size | injected | found (at acceptance, input unit) | parameter errors | χ²/dof start → final | "
+        "RMS ADEV % | held-out % | unexplained | unexplained without the candidate | pass | CPU s |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        *(_row(v) for v in results),
+        "",
+        *notes,
+    ]
+    (out / "refine_blind2.md").write_text("\n".join(lines) + "\n")
+    (out / "refine_blind2.json").write_text(json.dumps(results, indent=1, default=float))
+
+
+#: What the table shows and why (kept true to the recorded run).
+NOTES: list = [
+    "**First run** (at 270d294, the suite as committed, before any change; load 89 % from other processes): "
+    "**6 of 11 passed**, without the candidate 7 of 7 flagged. Failed: the 2 kHz two-channel MEMS (the "
+    "temperature's Whittle test accepts — LR 17.8 against 9.8, coefficient −3.6 %, quadratic +4.9 % — but the "
+    "held-out ratio across frequency 3.17 rejects it; the voltage was not taken, the coupling said as unexplained); "
+    "the thermal chamber (the channel classed fast — 7 cycles, its variance within the 8 blocks — so no dT/dt term "
+    "is tried; a sinusoid at 0.003 Hz and lines at 0.0012–0.0013 Hz left standing in for it); the spike bursts "
+    "(outliers named, rate −11.9 %, but a 167 Hz single pole and a 139.8 Hz resonance added before them, χ²/dof "
+    "3.55 → 5.77); the bias step (nothing added, nothing said: a silent complete model); the line switched on "
+    "halfway (a sinusoid at 0.0353 = A/√2 plus a change point of the noise level at 2500 s, nothing unexplained). "
+    "The chirp passed (three sinusoids and two change points, the curve's misfit at 2.0–2.6 Hz said).",
+    "",
+    "**Changed since** (the table is the rerun after it, at 915142b; the first run's table and JSON are in commit 8a4201a): the channel regression's held-out test "
+    "across frequency (`channels.heldout_ratio`) now splits where the channel's information is shared more "
+    "evenly — the even/odd DFT bins as before, or the record's two halves in time. A temperature cycling a whole "
+    "number of times puts its power in one DFT bin, so on one side of the even/odd split: in the two-channel MEMS "
+    "99.7 % of the information was on the odd bins, the way fitted there read 0.89, the other way 5.4 (that "
+    "side's noise). Now the MEMS passes: regression on `temp` only, coefficient −3.6 %, quadratic +4.9 %, "
+    "χ²/dof 6.44 → 0.99, held out 5.09 → 2.76 %, nothing unexplained; the voltage not taken "
+    "(tests/test_channels.py: a 3-cycle temperature at LR 50 had been rejected at 1.05, now < 0.6; null ≈ 1). "
+    "Unchanged by it: the six temperature cases of `benches/refine_sensors.py` (the same numbers as "
+    "refine_sensors.md), the first blind suite's 48 h case, and 40 null records of `refine_false_alarms.py`'s "
+    "channel mixtures (slow_1hz, channels_100hz: the Whittle test accepted none, so the held-out gate never "
+    "came into play); the ADIS16405 rows (no channels) do not reach the changed code.",
+    "",
+    "Why the other four still fail — each a general gap, none fixed in this session:",
+    "",
+    "- *Thermal chamber, T and dT/dt*: the channel is classed fast (7 cycles over the record, most of its "
+    "variance within the 8 blocks: `channels.is_slow`), and only the slow path (Whittle GLS) tries the optional "
+    "terms. On the slow path the dT/dt term is kept at 1356 against 11 and the coefficients come out at −8 % and "
+    "−0.3 %. A rule that sends this channel there but keeps a multi-position tumble (flips every 200–600 s, "
+    "tests/test_channels.py) on the within-block test was not found without a threshold set between the two; the "
+    "general way is the optional terms on the fast path too (or the Whittle path for every channel whose fast "
+    "test accepts).",
+    "- *Bursts of spikes*: with clustered spikes the record is not white over a level's span, so the rule off "
+    "both neighbours flags; it misses a spike beside another of the same sign — 372 of the 1500 missed, 371 of "
+    "them in same-sign runs (2 samples: 286, 3: 69, 4: 16) — and flags 160 good samples lying between spikes. "
+    "The runs left behind read as a 167 Hz single pole and a 139.8 Hz resonance (χ²/dof 3.55 → 5.77). Needed: short "
+    "runs flagged off their outer neighbours, with the Gaussian count bounded per run length.",
+    "- *Bias step* (outside the family): nothing added and nothing said — the curve fits (χ²/dof 0.55) and no "
+    "check tests the mean along the record (the level check is on the first differences, which a step of the "
+    "mean does not change). Needed: a mean-shift check in `unexplained` (block means under the fitted noise's "
+    "covariance), with its own share of `level`.",
+    "- *Line switched on halfway* (outside the family): refine names a sinusoid at 0.0353 (A/√2, the power "
+    "averaged over the record) and a change of the noise level at 2500 s — the line's power in the first "
+    "differences reads as a level change — and says nothing else. Needed: a check that a removed line's "
+    "amplitude is the same along the record (its least-squares amplitude in blocks at the fixed frequency).",
+]
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--case", default=None, help="only cases whose name contains this text")
+    ap.add_argument("--out", default=None, help="results folder (default benches/results)")
+    ap.add_argument("--sizes", action="store_true", help="print each case's effect size only (no refine)")
+    args = ap.parse_args(argv)
+    chosen = [c for c in CASES if args.case is None or args.case in c.name]
+    if args.sizes:
+        for case in chosen:
+            y, fs, _ch, _kw, comp = case.build(np.random.default_rng(case.seed))
+            print(f"{case.name}: {effect_size(y, comp, fs)}", flush=True)
+        return
+    out = Path(args.out) if args.out else (Path(tempfile.mkdtemp()) if args.case else HERE / "results")
+    out.mkdir(parents=True, exist_ok=True)
+    results = []
+    with _common.OtherLoad() as load:
+        for case in chosen:
+            v = run_case(case)
+            print(_row(v), flush=True)
+            results.append(v)
+    write(results, out, load.fraction or 0.0, NOTES)
+    print(f"wrote {out / 'refine_blind2.md'}")
+
+
+if __name__ == "__main__":
+    main()
