@@ -56,6 +56,22 @@ def test_robust_sigma_and_the_tail_model_hold_on_quantised_filtered_noise(step_o
     assert emp == pytest.approx(p, rel=0.1)
 
 
+def test_lattice_sigma_remembered_equals_a_fresh_solve():
+    # blocks of equal length with the same count at the median step ask for the same σ: found again, the same number
+    rng = np.random.default_rng(4)
+    d = np.round(rng.standard_normal(4000) * 1.7) * 0.05
+    outliers._lattice_sigma.cache_clear()
+    first = outliers.robust_sigma(d, 0.05)
+    again = outliers.robust_sigma(rng.permutation(d), 0.05)
+    assert outliers._lattice_sigma.cache_info().hits == 1
+    j = np.round(np.abs(d) / 0.05).astype(int)
+    share = np.cumsum(np.bincount(j)) / d.size
+    k = int(np.argmin(np.abs(share - 0.5)))
+    fresh = outliers._lattice_sigma.__wrapped__((k + 0.5) * 0.05, float(share[k]), 0.05)
+    assert first == again == fresh
+    assert 1.6 * 0.05 < first < 1.8 * 0.05
+
+
 @pytest.mark.parametrize(
     "make",
     [

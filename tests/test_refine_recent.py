@@ -19,19 +19,20 @@ def _remembering():
 
 
 def test_remembered_phasors_equal_fresh_ones(monkeypatch):
-    def fresh(nu, idx):
-        u = np.mod(idx * nu, 1.0) * 2**linefit.TABLE_BITS
-        j = u.astype(np.int64)
-        return linefit._TABLE[j] * (1.0 - (u - j)) + linefit._TABLE[j + 1] * (u - j)
+    def fresh(nu, idx):  # the same block × offset products, one index at a time
+        b = linefit._BLOCK
+        return np.array(
+            [np.exp(2j * np.pi * ((n // b * b * nu) % 1.0)) * np.exp(2j * np.pi * ((n % b * nu) % 1.0)) for n in idx]
+        )
 
     idx = np.arange(3, 40_000, 2)
     first = linefit._phasor(0.0123, idx)
     again = linefit._phasor(0.0123, idx.copy())  # equal indices in another array: remembered
     assert again is first and not again.flags.writeable
-    np.testing.assert_array_equal(again, fresh(0.0123, idx))
+    np.testing.assert_allclose(again, fresh(0.0123, idx), rtol=0, atol=1e-14)
     other = linefit._phasor(0.0123, idx + 1)  # other indices, other spacing: computed
-    np.testing.assert_array_equal(other, fresh(0.0123, idx + 1))
-    np.testing.assert_array_equal(linefit._phasor(0.0124, idx), fresh(0.0124, idx))
+    np.testing.assert_allclose(other, fresh(0.0123, idx + 1), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(linefit._phasor(0.0124, idx), fresh(0.0124, idx), rtol=0, atol=1e-14)
     for k in range(6):
         linefit._phasor(0.001 * (k + 1), idx)
     assert len(linefit._PHASORS._items) == linefit._PHASORS.keep
@@ -100,3 +101,19 @@ def test_memories_forget_when_the_call_returns():
         assert memo._items == [] and memo.get(np.arange(3.0)) is None
     finally:
         recent._OPEN.extend([True] * depth)
+
+
+def test_phasors_of_a_long_record_are_exact_to_rounding():
+    # the block × offset products against e^{i2π frac(νn)} with frac(νn) taken exactly (ν as its binary fraction):
+    # within the rounding of ν·B·⌊n/B⌋ (≈ 2e4 here, half an ulp 1.8e-12, × 2π); the former table was off by 1e-9
+    import math
+    from fractions import Fraction
+
+    nu = 0.0101286
+    idx = np.arange(2_000_000)
+    got = linefit._phasor(nu, idx)
+    for n in (0, 1, 1023, 1024, 777_777, 1_999_999):
+        ph = float((Fraction(nu) * n) % 1)
+        assert abs(got[n] - complex(math.cos(2 * math.pi * ph), math.sin(2 * math.pi * ph))) < 2e-11
+    sparse = np.array([5, 4096, 1_234_567])
+    np.testing.assert_array_equal(linefit._phasor(nu, sparse), got[sparse])

@@ -30,11 +30,11 @@ import numpy as np
 
 from ._recent import Recent
 
-__all__ = ["runs", "dirichlet", "dtft", "solve", "evaluate", "refine_generators", "frequency_sd", "TABLE_BITS"]
+__all__ = ["runs", "dirichlet", "dtft", "solve", "evaluate", "refine_generators", "frequency_sd"]
 
-#: Phasors e^{i2πu} are read from a table of 2^TABLE_BITS + 1 points, linearly interpolated (error ≈ 1e-9).
-TABLE_BITS = 16
-_TABLE = np.exp(2j * np.pi * np.arange(2**TABLE_BITS + 1) / 2**TABLE_BITS)
+#: Phasors e^{i2πνn} are products e^{i2πν·B·⌊n/B⌋}·e^{i2πν·(n mod B)} of two exact short tables, B = _BLOCK
+#: (error ≈ 1e-15, one complex product per sample).
+_BLOCK = 1024
 
 
 def runs(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -80,18 +80,39 @@ def _wrap(x: np.ndarray) -> np.ndarray:
 
 
 def _phasor(nu: float, idx: np.ndarray) -> np.ndarray:
-    """e^{i2πν n} at the indices (table lookup, linear interpolation; read-only). The last few are remembered
+    """e^{i2πν n} at the indices (read-only): per sample, the product of its block's phasor and its offset's within
+    the block, each from ``np.exp`` — one complex product per sample. The last few are remembered
     (:data:`_PHASORS`): a family's sidebands are fitted on one half of a record and evaluated on the other,
     family after family, at the same spacing ν."""
     got = _PHASORS.get(idx, (nu,))
     if got is not None:
         return got
-    u = np.mod(idx * nu, 1.0) * 2**TABLE_BITS
-    j = u.astype(np.int64)
-    f = u - j
-    out = _TABLE[j] * (1.0 - f) + _TABLE[j + 1] * f
+    if idx.size == 0:
+        out = np.ones(0, dtype=np.complex128)
+    else:
+        lo, hi = int(idx.min()), int(idx.max())
+        k0 = lo // _BLOCK
+        blocks = np.exp(2j * np.pi * _frac(np.arange(k0, hi // _BLOCK + 1, dtype=np.int64) * _BLOCK * nu))
+        offsets = np.exp(2j * np.pi * _frac(np.arange(_BLOCK) * nu))
+        if hi - lo + 1 == idx.size and idx[0] == lo:  # one run: the outer product, sliced
+            out = np.multiply.outer(blocks, offsets).ravel()[lo - k0 * _BLOCK : hi - k0 * _BLOCK + 1]
+        else:
+            out = blocks[idx // _BLOCK - k0] * offsets[idx % _BLOCK]
     out.flags.writeable = False
     return _PHASORS.put(idx, (nu,), out)
+
+
+def _unit_phase(idx: np.ndarray, nu: float) -> np.ndarray:
+    """frac(ν·n) at the indices, in [0, 1): the same numbers as ``np.mod(idx * nu, 1.0)``, faster where ν·n ≥ 0."""
+    x = idx * nu
+    if nu >= 0 and (idx.size == 0 or idx.min() >= 0):
+        return _frac(x)
+    return np.mod(x, 1.0)
+
+
+def _frac(x: np.ndarray) -> np.ndarray:
+    """x − ⌊x⌋ (= x mod 1, exactly, for x ≥ 0; one pass fewer than ``np.mod``)."""
+    return x - np.floor(x)
 
 
 #: Phasors remembered by :func:`_phasor`: the last four, of records up to 4·10⁶ samples (16 bytes per sample each).
@@ -114,7 +135,7 @@ def _oriented(gens: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 def _groups(coefs: np.ndarray, nu2: float, idx: np.ndarray):
     """(s, rows, e^{i2πsν2 n} or None for s = 0) for each distinct second coefficient s (0 for one-generator
-    lattices); the phasors as powers of one table lookup, by increasing |s| (one complex product each)."""
+    lattices); the phasors as powers of one :func:`_phasor`, by increasing |s| (one complex product each)."""
     s_all = coefs[:, 1] if coefs.shape[1] > 1 else np.zeros(coefs.shape[0], dtype=np.int64)
     present = set(np.unique(s_all).tolist())
     if 0 in present:
@@ -151,12 +172,18 @@ def _gridding(u: np.ndarray, m_bins: int, seg: np.ndarray | None) -> tuple[np.nd
 
 def _gridded_fft(parts, grid, m_bins: int, n_seg: int) -> np.ndarray:
     """:func:`_fold` of the samples whose real (and imaginary) part are ``parts``, on the bins ``grid``."""
+    return _binned_fft([_binned(part, grid, m_bins * n_seg) for part in parts], m_bins, n_seg)
+
+
+def _binned(part: np.ndarray, grid, size: int) -> np.ndarray:
+    """One real part spread onto the phase bins ``grid`` (linear interpolation: two ``bincount``)."""
     j, j1, w = grid
-    size = m_bins * n_seg
-    out = []
-    for part in parts:
-        hi = part * w
-        out.append(np.bincount(j, part - hi, minlength=size) + np.bincount(j1, hi, minlength=size))
+    hi = part * w
+    return np.bincount(j, part - hi, minlength=size) + np.bincount(j1, hi, minlength=size)
+
+
+def _binned_fft(out: list, m_bins: int, n_seg: int) -> np.ndarray:
+    """The FFT of the bins (real, or real and imaginary parts), the kernel's transform divided out."""
     g = out[0] + 1j * out[1] if len(out) == 2 else out[0]
     return np.fft.fft(g.reshape(n_seg, m_bins), axis=1) / _kernel_transform(m_bins)
 
@@ -181,17 +208,26 @@ def dtft(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray, n_seg: int = 1
     y = np.asarray(y, dtype=np.float64)
     out = np.zeros((n_seg, coefs.shape[0]), dtype=np.complex128)
     seg = None if n_seg == 1 else np.minimum(np.arange(idx.size) * n_seg // max(1, idx.size), n_seg - 1)
-    u = np.mod(idx * gens[0], 1.0)
+    u = _unit_phase(idx, float(gens[0]))
     nu2 = float(gens[1]) if gens.size > 1 else 0.0
     grids: dict = {}  # the phase bins per grid size, for every second coefficient
-    for _s, rows, ph in _groups(coefs, nu2, idx):
+    bins: dict = {}  # (|s|, grid size): the bins of y·cos θ and y·sin θ, shared by s and −s
+    for s, rows, ph in _groups(coefs, nu2, idx):
         k = coefs[rows, 0]
         m_bins = _grid(int(np.max(np.abs(k))))
         if m_bins not in grids:
             grids[m_bins] = _gridding(u, m_bins, seg)
-        # y·conj(e^{iθ}) part by part (a real times a complex scales each part: the complex product's numbers)
-        parts = (y,) if ph is None else (y * ph.real, y * -ph.imag)
-        g = _gridded_fft(parts, grids[m_bins], m_bins, n_seg)
+        size = m_bins * n_seg
+        if ph is None:
+            g = _binned_fft([_binned(y, grids[m_bins], size)], m_bins, n_seg)
+        else:
+            # y·conj(e^{iθ}) part by part (a real times a complex scales each part: the complex product's
+            # numbers); −s's phasor is s's conjugate: its imaginary part's bins are s's negated, exactly
+            key = (abs(s), m_bins)
+            if key not in bins:
+                bins[key] = (_binned(y * ph.real, grids[m_bins], size), _binned(y * -ph.imag, grids[m_bins], size), s)
+            re, im, s_done = bins[key]
+            g = _binned_fft([re, im if s == s_done else -im], m_bins, n_seg)
         out[:, rows] = g[:, np.mod(k, m_bins)]
     return out if n_seg > 1 else out[0]
 
@@ -241,7 +277,7 @@ def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndar
     )
     idx = np.asarray(idx, dtype=np.int64)
     out = np.zeros(idx.size)
-    u = np.mod(idx * gens[0], 1.0)
+    u = _unit_phase(idx, float(gens[0]))
     nu2 = float(gens[1]) if gens.size > 1 else 0.0
     grids: dict = {}
     for _s, rows, ph in _groups(coefs, nu2, idx):

@@ -50,6 +50,7 @@ with 20 % of its samples 6× wider) that the shortest τ read as a low-pass.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 from scipy.ndimage import median_filter
@@ -131,13 +132,16 @@ def _lattice_step(x: np.ndarray) -> float:
     return step if np.mean(on) >= 0.99 else 0.0
 
 
+_SQRT2, _SQRT_2PI = math.sqrt(2.0), math.sqrt(2.0 * math.pi)
+
+
 def _inner(a: float, sigma: float, step: float) -> float:
     """P(|d + U| < a), d ~ N(0, σ²), U uniform on (−L/2, L/2): (1/L)∫ [Φ((a−u)/σ) − Φ((−a−u)/σ)] du, closed
     form with ∫Φ(x/σ)dx = xΦ(x/σ) + σφ(x/σ)."""
 
     def psi(x: float) -> float:
         z = x / sigma
-        return x * 0.5 * math.erfc(-z / math.sqrt(2.0)) + sigma * math.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
+        return x * 0.5 * math.erfc(-z / _SQRT2) + sigma * math.exp(-0.5 * z * z) / _SQRT_2PI
 
     h = step / 2.0
     return float((psi(a + h) - psi(a - h) - psi(-a + h) + psi(-a - h)) / step)
@@ -158,7 +162,13 @@ def robust_sigma(d: np.ndarray, step: float) -> float:
     target = float(share[j])
     if target >= 1.0:
         return float("nan")
-    a = (j + 0.5) * step
+    return _lattice_sigma((j + 0.5) * step, target, step)
+
+
+@lru_cache(maxsize=4096)
+def _lattice_sigma(a: float, target: float, step: float) -> float:
+    """The σ with P(|d + U| < a) = ``target`` on the lattice ``step`` (NaN if none in 1e-6 … 1e6 steps): the same
+    share at the same count is asked again — blocks of equal length, the record tested again after a removal."""
     lo, hi = 1e-6 * step, 1e6 * step
     f_lo, f_hi = _inner(a, lo, step) - target, _inner(a, hi, step) - target
     if f_lo * f_hi > 0:

@@ -142,15 +142,27 @@ def change_points(y, fs, terms, max_points=2):
 
 
 def locate(y, m, fs):
-    """Change in the mean of the squared m-sample second differences: MLE split and 2-unit support."""
+    """Change in the mean of the squared m-sample second differences: MLE split and 2-unit support.
+
+    Each segment's mean square is floored at q²/6, the variance of the difference of two samples' rounding
+    errors (Sheppard), when the terms are quantized (some exactly zero; q² their smallest non-zero value): a
+    short segment of equal samples would otherwise read as zero noise, an unbounded likelihood that puts the
+    split at an end of the span. The tail sums are summed from the end, not as total − head (which cancels to
+    zero once the tail falls below the total's last digit)."""
     k = y.size // m
     b = y[: k * m].reshape(k, m).mean(axis=1)
-    d = np.diff(b) ** 2 + 1e-300  # independent-ish terms at stride m
+    d0 = np.diff(b) ** 2
+    d = d0 + 1e-300  # independent-ish terms at stride m
     n = d.size
     c = np.cumsum(d)
+    tail = np.cumsum(d[::-1])[::-1]  # tail[i] = sum of d[i:]
     j = np.arange(2, n - 1)
     mu1 = c[j - 1] / j
-    mu2 = (c[-1] - c[j - 1]) / (n - j)
+    mu2 = tail[j] / (n - j)
+    nonzero = d0[d0 > 0]
+    if 0 < nonzero.size < n:  # quantized: no segment's mean square below the rounding's own
+        floor = float(nonzero.min()) / 6.0
+        mu1, mu2 = np.maximum(mu1, floor), np.maximum(mu2, floor)
     ll = -0.5 * (j * np.log(mu1) + (n - j) * np.log(mu2))  # exponential-family profile (χ²₁ terms)
     i = int(np.argmax(ll))
     ok = j[ll >= ll[i] - 2.0]
