@@ -8,9 +8,11 @@ Records: seven ADIS16405 channels (10⁶ samples at 100 Hz, from the shared data
 ``python/`` folder of an earlier checkout (``--baseline``; by default a worktree of main at
 :data:`BASELINE` made under the temporary folder, with this checkout's compiled core copied in) — the two
 alternating record by record so that they share the machine's load; each call's CPU time (the process's own,
-what the load changes least) and wall time are recorded. Both results are compared: the effects
-found, their parameters and intervals, each step's χ²/dof and errors before and after, and what is still
-missing must be the same (the speed-ups are exact).
+all its threads: what the load changes least) and wall time are recorded. Both results are compared: the
+effects found, their parameters and intervals, each step's χ²/dof and errors before and after, and what is
+still missing — field by field, and where numbers differ in their last digits (the compiled reweighting loop,
+the χ² quantile table) with the largest relative difference of the parameters, of the χ²/dof and of the rest
+(:mod:`compare_refine`).
 
 Usage::
 
@@ -33,8 +35,9 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-#: main before this round of refine's speed-ups (issue 29, refine's cost; earlier rounds' baselines: 9165947, 313a76b).
-BASELINE = "f836703"
+#: main before this round of refine's speed-ups (issue 29, refine's cost; earlier rounds' baselines: 9165947, 313a76b,
+#: f836703).
+BASELINE = "a0e3816"
 ADIS = [
     ("adis", 1, "gyro_z"),
     ("adis", 4, "gyro_x"),
@@ -130,6 +133,7 @@ def main(argv=None) -> int:
         worker(tuple(json.loads(a.worker[0])), Path(a.worker[1]))
         return 0
     import _common
+    import compare_refine
 
     out = a.out or (Path(tempfile.mkdtemp()) if a.quick else HERE / "results")
     base = a.baseline or _baseline_python(BASELINE)
@@ -141,7 +145,16 @@ def main(argv=None) -> int:
             before = _run(spec, base, Path(tmp))
             after = _run(spec, a.after, Path(tmp))
             diff = _differences(before["row"], after["row"])
-            rows.append({"record": after["row"]["record"], "before": before, "after": after, "differences": diff})
+            close = compare_refine.compare(before["row"], after["row"])
+            rows.append(
+                {
+                    "record": after["row"]["record"],
+                    "before": before,
+                    "after": after,
+                    "differences": diff,
+                    "close": close,
+                }
+            )
             print(
                 f"{rows[-1]['record']}: CPU {before['cpu']:.1f} → {after['cpu']:.1f} s, wall "
                 f"{before['seconds']:.1f} → {after['seconds']:.1f} s, {len(diff)} differences",
@@ -162,6 +175,17 @@ def _own_and_children() -> float:
     return t.user + t.system + t.children_user + t.children_system
 
 
+def _differing(r) -> str:
+    """The differences of a row in words: fields not equal, the largest relative differences of numbers."""
+    close = r["close"]
+    words = [f"{len(r['differences'])} fields differ"]
+    words += [f"{say} ≤ {close[k][0]:.1e}" for k, say in (("params", "params"), ("chi2", "χ²/dof")) if close[k][0]]
+    words += [f"rest ≤ {close['other'][0]:.1e}"] if close["other"][0] else []
+    if close["mismatch"]:
+        words.append(f"not equal: {close['mismatch'][:3]}")
+    return ", ".join(words)
+
+
 def _write(rows, out: Path, base: Path, load0, load1, others) -> None:
     import _common
 
@@ -174,7 +198,7 @@ def _write(rows, out: Path, base: Path, load0, load1, others) -> None:
         f"{load0[0]:.1f} at the start, {load1[0]:.1f} at the end (2 cores shared with other work"
         + (f"; other processes used {others:.0%} of the CPUs" if others is not None else "")
         + "). Each record refined with the default call in a fresh process, before and after alternating; "
-        "CPU: the refine call's own process time (one thread), wall: its elapsed time; the result compared field "
+        "CPU: the refine call's own process time (all its threads), wall: its elapsed time; the result compared field "
         "by field (effects, parameters, intervals, χ²/dof and errors of every step, what is still missing).",
         "",
         "| record | samples | CPU before (s) | CPU after (s) | CPU after per 10⁶ samples (s) | CPU ratio "
@@ -183,7 +207,7 @@ def _write(rows, out: Path, base: Path, load0, load1, others) -> None:
     ]
     for r in rows:
         b, a = r["before"], r["after"]
-        same = "identical" if not r["differences"] else f"{len(r['differences'])} differ: {r['differences'][:3]}"
+        same = "identical" if not r["differences"] else _differing(r)
         lines.append(
             f"| {r['record']} | {a['samples']:,} | {b['cpu']:.1f} | {a['cpu']:.1f} | "
             f"{a['cpu'] / a['samples'] * 1e6:.1f} | {b['cpu'] / a['cpu']:.2f}× | "

@@ -135,6 +135,7 @@ def test_imports_run_one_way(module):
 MODEL_RANKS = {
     "model._recent": -1,
     "model._batched": 0,
+    "model._chi2_draws": 0,
     "model._covariance": 0,
     "model._nnls": 0,
     "model.terms": 0,

@@ -10,7 +10,9 @@ against shift by shift, the drift bootstrap's one-product statistics against a Q
 after another (scipy's bounded search, one fit per call), the line spectra remembered within a refine and the EDF
 remembered per averaging factors against fresh ones, the line families' phase gridding, DTFT and waveforms against
 their plain forms, and a whole default ``refine`` with every memory and the lockstep against one that recomputes
-everything one search at a time. No timings here: ``benches/bench_refine_cost.py``.
+everything one search at a time. The fits here run the Python loop (``_irls.irls_python``; the Rust core's
+loop, which agrees with it to rounding, is checked in ``tests/test_refine_irls.py``), but for the whole default
+``refine``, which runs the core's loop both ways. No timings here: ``benches/bench_refine_cost.py``.
 """
 
 from __future__ import annotations
@@ -27,11 +29,18 @@ from scipy.optimize import nnls as scipy_nnls
 import allanite
 from allanite.model import _covariance, _nnls, linefit, lines, tracing
 from allanite.model._recent import Recent
-from allanite.model.refinement import _brent, curvefit
+from allanite.model.refinement import _brent, _irls, curvefit
 from allanite.model.refinement import candidates as cands
 from allanite.model.refinement.candidates import bandwidth_grids
 
 START = ("Q", "N", "B", "K", "R")
+COMPILED = _irls.COMPILED
+
+
+@pytest.fixture(autouse=True)
+def python_irls(monkeypatch):
+    """The fits of this module in the Python loop, whose arithmetic the plain paths below write out."""
+    monkeypatch.setattr(_irls, "COMPILED", None)
 
 
 @pytest.fixture(scope="module")
@@ -233,6 +242,7 @@ def _one_at_a_time(curve, terms, effects, specs):
 
 
 def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
+    monkeypatch.setattr(_irls, "COMPILED", COMPILED)  # the default path: the core's loop where it is built
     y = allanite.simulate(100_000, 50.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 4.0)], seed=8)
     cached = allanite.refine(y, 50.0, progress=False)
     monkeypatch.setattr(curvefit.Curve, "cached", lambda self, key: None)  # every column, EDF and subset afresh
@@ -503,8 +513,6 @@ def _plain_held(a, nu_cols, y, nu, max_iter, floor, held):
 def test_held_fits_together_equal_one_at_a_time(curve, max_iter):
     # a line measured in the time domain held at its power (one or two of them) while a grid is searched: the
     # designs reweighted together give each design's own numbers, bit for bit
-    from allanite.model.refinement import _irls
-
     line = float(np.median(curve.avar)) * 0.3
     for held in (
         [(curvefit.held_key("sinusoid", line, 0.01 * line**2), 7.0)],

@@ -24,11 +24,9 @@ import numpy as np
 from scipy import signal
 from scipy.linalg import solve_triangular
 from scipy.optimize import minimize_scalar
-from scipy.stats import chi2 as chi2_dist
-from scipy.stats import norm
 
 from ..simulation import simulate
-from . import _covariance
+from . import _chi2_draws, _covariance
 
 __all__ = [
     "drift_fit",
@@ -428,7 +426,7 @@ class ScoreTest:
         if (n_boot, seed) not in self._draws:
             rng = np.random.default_rng(seed)
             z = self.corr_chol @ rng.standard_normal((self.model.size, n_boot))
-            ystar = self.model[:, None] * chi2_dist.ppf(norm.cdf(z), self.nu[:, None]) / self.nu[:, None]
+            ystar = self.model[:, None] * _chi2_draws.scaled_quantiles(z, self.nu)
             self._draws[(n_boot, seed)] = ystar - self.model[:, None]
         return self._draws[(n_boot, seed)]
 

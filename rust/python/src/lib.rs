@@ -22,7 +22,7 @@ use allanite_core::{
 use numpy::ndarray::{Array2, Array3};
 use numpy::{
     Element, IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2,
-    PyUntypedArrayMethods,
+    PyReadonlyArray3, PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 use std::time::Duration;
@@ -485,6 +485,69 @@ fn fit_windows<'py>(
     to_2d(py, n_windows, width, values)
 }
 
+/// `refine`'s reweighted NNLS of one curve on many designs (allanite-core `fit::curves`): `design` and
+/// `nu_cols` (designs, n_tau, n_cols), `y` and `nu0` (n_tau), `fixed` (n_cols: a held column's
+/// coefficient, NaN for a fitted one). Returns θ (designs, n_cols) and ν (designs, n_tau). Errors as
+/// `scipy.optimize.nnls`'s: ValueError for a non-finite weighted problem, RuntimeError when the NNLS
+/// does not settle.
+#[pyfunction]
+#[pyo3(signature = (design, nu_cols, y, nu0, fixed, max_iter, floor, rtol))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn irls_curves<'py>(
+    py: Python<'py>,
+    design: PyReadonlyArray3<'py, f64>,
+    nu_cols: PyReadonlyArray3<'py, f64>,
+    y: PyReadonlyArray1<'py, f64>,
+    nu0: PyReadonlyArray1<'py, f64>,
+    fixed: PyReadonlyArray1<'py, f64>,
+    max_iter: usize,
+    floor: f64,
+    rtol: f64,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    use allanite_core::fit::curves::{irls_curves as run, CurveDesigns, CurveFitError};
+    let shape = design.shape().to_vec();
+    let (g_n, n, k) = (shape[0], shape[1], shape[2]);
+    let contiguous =
+        |what: &str| parameter_error(py, format!("{what} must be a C-contiguous float64 array"));
+    let (a, nc) = (
+        design.as_slice().map_err(|_| contiguous("design"))?,
+        nu_cols.as_slice().map_err(|_| contiguous("nu_cols"))?,
+    );
+    let (yv, nv, fv) = (
+        y.as_slice().map_err(|_| contiguous("y"))?,
+        nu0.as_slice().map_err(|_| contiguous("nu0"))?,
+        fixed.as_slice().map_err(|_| contiguous("fixed"))?,
+    );
+    if nu_cols.shape() != shape.as_slice() || yv.len() != n || nv.len() != n || fv.len() != k {
+        return Err(parameter_error(
+            py,
+            format!("irls_curves: nu_cols must be shaped as design {shape:?}, y and nu0 of {n} τ, fixed of {k} columns"),
+        ));
+    }
+    let p = CurveDesigns {
+        n_designs: g_n,
+        n_tau: n,
+        n_cols: k,
+        design: a,
+        nu_cols: nc,
+        y: yv,
+        nu0: nv,
+        fixed: fv,
+        max_iter,
+        floor,
+        rtol,
+    };
+    let (theta, nu) = py.detach(|| run(&p)).map_err(|e| match e {
+        CurveFitError::NonFinite => {
+            pyo3::exceptions::PyValueError::new_err("array must not contain infs or NaNs")
+        }
+        CurveFitError::MaxIter => {
+            pyo3::exceptions::PyRuntimeError::new_err("Maximum number of iterations reached.")
+        }
+    })?;
+    Ok((to_2d(py, g_n, k, theta)?, to_2d(py, g_n, n, nu)?))
+}
+
 fn c_slice<'a>(
     py: Python<'_>,
     a: &'a PyReadonlyArray2<'_, f64>,
@@ -920,6 +983,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar_ranged, m)?)?;
     m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
     m.add_function(wrap_pyfunction!(fit_windows, m)?)?;
+    m.add_function(wrap_pyfunction!(irls_curves, m)?)?;
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;
     m.add_function(wrap_pyfunction!(part_grid, m)?)?;
     m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;

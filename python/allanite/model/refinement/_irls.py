@@ -6,21 +6,54 @@ of one grid differ in one column only; run together, the passes share their arra
 solves stay one per design. Each design's arithmetic is the one it would get alone (element by element, the
 same reductions in the same order), so the batch gives the same numbers bit for bit as fitting the designs one
 at a time — ``tests/test_refine_cost.py`` checks it.
+
+The Rust core runs the same loop (``allanite._core.irls_curves``: each design alone, the designs on its
+threads, without the GIL) some ten times faster; :func:`irls` uses it when the core has it. Its NNLS is the
+core's Lawson–Hanson routine, not SciPy's, so its numbers agree with this module's loop to rounding (a design
+may stop a pass earlier or later where a coefficient's change sits at :data:`RTOL`): ``tests/test_refine_irls.py``
+bounds the difference, ``benches/results/refine.json`` records refine's answers with it.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ... import _core
 from .._nnls import nnls_rows, raw_solver
 
-__all__ = ["irls", "chi2_at"]
+__all__ = ["irls", "irls_python", "chi2_at", "COMPILED"]
 
 #: Relative change of every coefficient below which the reweighting stops (np.allclose(rtol=1e-6, atol=0)).
 RTOL = 1e-6
+#: The Rust core's loop, or None where the core lacks it (then :func:`irls` is :func:`irls_python`).
+COMPILED = getattr(_core, "irls_curves", None)
 
 
 def irls(a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max_iter: int, floor: float, held=None):
+    """:func:`irls_python` in the Rust core where it has it (the same loop; the numbers to rounding)."""
+    compiled = COMPILED
+    if compiled is None:
+        return irls_python(a, nu_cols, y, nu0, max_iter, floor, held)
+    k = a.shape[2]
+    fixed = np.full(k, np.nan)
+    for i, (th, _var) in (held or {}).items():
+        fixed[i] = th
+    f64 = np.float64
+    return compiled(
+        np.ascontiguousarray(a, dtype=f64),
+        np.ascontiguousarray(nu_cols, dtype=f64),
+        np.ascontiguousarray(y, dtype=f64),
+        np.ascontiguousarray(nu0, dtype=f64),
+        fixed,
+        int(max_iter),
+        float(floor),
+        RTOL,
+    )
+
+
+def irls_python(
+    a: np.ndarray, nu_cols: np.ndarray, y: np.ndarray, nu0: np.ndarray, max_iter: int, floor: float, held=None
+):
     """Reweighted NNLS of the curve ``y`` (n τ) on each design ``a[g]`` (G × n × k): weights ν/(2·model²), the
     model damped geometrically between passes, ν per τ from the columns' shares of the model and their EDF
     ``nu_cols[g]`` (ν starts at ``nu0``); a design stops once no coefficient moved by more than :data:`RTOL`.

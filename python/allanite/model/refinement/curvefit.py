@@ -284,8 +284,17 @@ def _stacked(curve: Curve, terms, models: list) -> tuple[np.ndarray, np.ndarray]
         g0 = first[group]
         a[g, :, :-1], nu[g, :, :-1] = a[g0, :, :-1], nu[g0, :, :-1]
         a[g, :, -1] = column(key, p, curve)
-        nu[g, :, -1] = _edf_column(curve, _alpha_of(key, p, curve.tau))
+        nu[g, :, -1] = _edf_of(curve, key, p)
     return a, nu
+
+
+def _edf_of(curve, key, p):
+    """EDF per τ of effect ``key``'s column at parameter ``p`` (:func:`_edf_column` of its noise types per τ;
+    remembered by the curve under the effect and parameter, as its column is)."""
+    got = curve.cached(("edf_of", key, float(p)))
+    if got is None:
+        got = curve.remember(("edf_of", key, float(p)), _edf_column(curve, _alpha_of(key, p, curve.tau)))
+    return got
 
 
 def _held(terms, effects) -> dict:

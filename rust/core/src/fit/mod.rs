@@ -7,6 +7,7 @@
 //! takes a branch kept in Python only (an indefinite covariance, a fit at θ = 0, a failed NNLS) is
 //! flagged and refitted there, so every window gets the reference's answer.
 
+pub mod curves;
 mod dense;
 mod shared;
 mod window;
