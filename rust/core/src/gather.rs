@@ -277,17 +277,7 @@ mod tests {
         s / (2.0 * (k - 1) as f64)
     }
 
-    fn noise(n: usize, seed: u64) -> Vec<f64> {
-        let mut s = seed;
-        (0..n)
-            .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-            })
-            .collect()
-    }
+    use crate::test_noise::uniform as noise;
 
     #[test]
     fn matches_the_definition() {

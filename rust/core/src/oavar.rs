@@ -71,16 +71,5 @@ const SHORT_M: usize = CHUNK / 2;
 /// Independent partial sums per chunk and m (the vector width the term loop is written for).
 const LANES: usize = 8;
 
-/// Deterministic uniform noise in [−½, ½) for the unit tests (a 64-bit LCG).
 #[cfg(test)]
-fn noise(n: usize, seed: u64) -> Vec<f64> {
-    let mut s = seed;
-    (0..n)
-        .map(|_| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        })
-        .collect()
-}
+use crate::test_noise::uniform as noise;

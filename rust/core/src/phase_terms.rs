@@ -165,17 +165,7 @@ pub fn oavar_phase_gap_sums(x: &[f64], ms: &[usize]) -> Result<Vec<TermSum>> {
 mod tests {
     use super::*;
 
-    fn lcg(n: usize, seed: u64) -> Vec<f64> {
-        let mut s = seed;
-        (0..n)
-            .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-            })
-            .collect()
-    }
+    use crate::test_noise::uniform as lcg;
 
     /// PVAR's sum straight from its definition (O(N·m)).
     fn pvar_direct(x: &[f64], m: usize) -> f64 {

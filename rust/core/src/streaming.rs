@@ -193,17 +193,7 @@ fn close_term(kind: StreamKind, x: &[f64], lane: &mut Lane) {
 mod tests {
     use super::*;
 
-    fn lcg(n: usize, seed: u64) -> Vec<f64> {
-        let mut s = seed;
-        (0..n)
-            .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-            })
-            .collect()
-    }
+    use crate::test_noise::uniform as lcg;
 
     /// The batch value from the definitions, for comparison.
     fn batch(kind: StreamKind, x: &[f64], m: usize) -> f64 {

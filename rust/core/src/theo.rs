@@ -144,17 +144,7 @@ fn sorted_unique(ms: &[usize]) -> (Vec<usize>, Vec<usize>) {
 mod tests {
     use super::*;
 
-    pub(super) fn lcg(n: usize, seed: u64) -> Vec<f64> {
-        let mut s = seed;
-        (0..n)
-            .map(|_| {
-                s = s
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-            })
-            .collect()
-    }
+    pub(super) use crate::test_noise::uniform as lcg;
 
     pub(super) fn rel(a: f64, b: f64) -> f64 {
         (a - b).abs() / b.abs()
