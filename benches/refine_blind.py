@@ -263,15 +263,16 @@ def judge(r, case: Blind) -> dict:
     return v
 
 
-def run_case(case: Blind) -> dict:
-    rng = np.random.default_rng(case.seed)
-    y, fs, channels, kw = case.build(rng)
+def refined(case, y, fs: float, channels, kw: dict, judged=judge) -> dict:
+    """refine's default call on a case's record, its verdict (``judged(r, case)``), the call without the effect's
+    candidate where something was injected, and the fields every table row reads (also
+    ``benches/refine_blind2.py``'s)."""
     if channels:
         kw = kw | {"channels": channels}
     t0 = time.process_time()
     r = allanite.refine(y, fs, unit=case.unit, progress=False, **kw)
     cpu = time.process_time() - t0
-    v = judge(r, case)
+    v = judged(r, case)
     v["start_chi2_dof"] = r.start.chi2_dof
     v["final_chi2_dof"] = r.fit.chi2_dof
     if case.injected:
@@ -285,6 +286,11 @@ def run_case(case: Blind) -> dict:
     v["injected"] = [{"effect": i.effect, "truth": i.truth} for i in case.injected]
     v["steps"] = [{"effect": s.effect, "params": s.params} for s in r.steps]
     return v
+
+
+def run_case(case: Blind) -> dict:
+    y, fs, channels, kw = case.build(np.random.default_rng(case.seed))
+    return refined(case, y, fs, channels, kw)
 
 
 def _row(v) -> str:
@@ -378,16 +384,22 @@ def main(argv=None) -> None:
     ap.add_argument("--out", default=None, help="results folder (default benches/results)")
     args = ap.parse_args(argv)
     chosen = [c for c in CASES if args.case is None or args.case in c.name]
+    run_suite(chosen, args, run_case, _row, lambda res, out, load: write(res, out, load, NOTES), "refine_blind")
+
+
+def run_suite(chosen, args, run_case, row, write, stem: str) -> None:
+    """Refine each chosen case in turn (a row printed as each ends), then ``write(results, out, load)``: to
+    ``--out``, a temporary folder for a ``--case`` subset, else benches/results (also refine_blind2's)."""
     out = Path(args.out) if args.out else (Path(tempfile.mkdtemp()) if args.case else HERE / "results")
     out.mkdir(parents=True, exist_ok=True)
     results = []
     with _common.OtherLoad() as load:
         for case in chosen:
             v = run_case(case)
-            print(_row(v), flush=True)
+            print(row(v), flush=True)
             results.append(v)
-    write(results, out, load.fraction or 0.0, NOTES)
-    print(f"wrote {out / 'refine_blind.md'}")
+    write(results, out, load.fraction or 0.0)
+    print(f"wrote {out / (stem + '.md')}")
 
 
 if __name__ == "__main__":

@@ -35,8 +35,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import tempfile
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -281,28 +279,18 @@ def _judge_channel(r, case: Blind2, v: dict) -> None:
         v["named"] = v["passed"] = False
 
 
-def run_case(case: Blind2) -> dict:
-    rng = np.random.default_rng(case.seed)
-    y, fs, channels, kw, comp = case.build(rng)
-    size = effect_size(y, comp, fs)
-    if channels:
-        kw = kw | {"channels": channels}
-    t0 = time.process_time()
-    r = allanite.refine(y, fs, unit=case.unit, progress=False, **kw)
-    cpu = time.process_time() - t0
+def _judged(r, case: Blind2) -> dict:
+    """The verdict: something left unexplained for an effect outside the family, else refine_blind's; an
+    irrelevant channel taken fails either."""
     v = _judge_outside(r) if case.outside else rb.judge(r, case)
     _judge_channel(r, case, v)
-    v |= {"start_chi2_dof": r.start.chi2_dof, "final_chi2_dof": r.fit.chi2_dof, "size": size}
-    if case.injected:
-        blind = allanite.refine(
-            y, fs, unit=case.unit, candidates=sensors.candidates_without(case), progress=False, **kw
-        )
-        v["without_candidate"] = {"found": list(blind.found), "unexplained": blind.unexplained}
-        v["without_candidate_flags"] = bool(blind.unexplained)
-    v |= {"cpu_seconds": cpu, "name": case.name, "outside": case.outside}
-    v["injected"] = [{"effect": i.effect, "truth": i.truth} for i in case.injected]
-    v["steps"] = [{"effect": s.effect, "params": s.params} for s in r.steps]
     return v
+
+
+def run_case(case: Blind2) -> dict:
+    y, fs, channels, kw, comp = case.build(np.random.default_rng(case.seed))
+    size = effect_size(y, comp, fs)
+    return rb.refined(case, y, fs, channels, kw, _judged) | {"size": size, "outside": case.outside}
 
 
 def _row(v) -> str:
@@ -415,16 +403,7 @@ def main(argv=None) -> None:
             y, fs, _ch, _kw, comp = case.build(np.random.default_rng(case.seed))
             print(f"{case.name}: {effect_size(y, comp, fs)}", flush=True)
         return
-    out = Path(args.out) if args.out else (Path(tempfile.mkdtemp()) if args.case else HERE / "results")
-    out.mkdir(parents=True, exist_ok=True)
-    results = []
-    with _common.OtherLoad() as load:
-        for case in chosen:
-            v = run_case(case)
-            print(_row(v), flush=True)
-            results.append(v)
-    write(results, out, load.fraction or 0.0, NOTES)
-    print(f"wrote {out / 'refine_blind2.md'}")
+    rb.run_suite(chosen, args, run_case, _row, lambda res, out, load: write(res, out, load, NOTES), "refine_blind2")
 
 
 if __name__ == "__main__":
