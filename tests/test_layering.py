@@ -131,7 +131,7 @@ def test_imports_run_one_way(module):
 #: Inside ``model``, bottom up: a model module imports only model modules of a lower rank. The registries of
 #: terms and effects and the covariance; the fit and the tracing tools; then refine's house — its false-alarm
 #: budget, the weighted fit with effects, the errors in-sample and held out, the curve test and the result,
-#: the proposals per domain (curve candidates, removals in time, change points), the loop, the package.
+#: refine's inputs checked, the proposals per domain (curve candidates, removals in time, change points), the loop, the package.
 MODEL_RANKS = {
     "model._recent": -1,
     "model._batched": 0,
@@ -174,6 +174,7 @@ MODEL_RANKS = {
     "model.refinement.changes": 6,
     "model.refinement.missing": 7,
     "model.refinement._rolloff": 5.5,
+    "model.refinement._inputs": 4.5,
     "model.refinement.loop": 8,
     "model.refinement": 9,
     "model": 10,

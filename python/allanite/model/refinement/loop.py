@@ -5,28 +5,24 @@ points last; every step scored with its error before and after.
 The pieces live in modules of their own, each named for what it decides: the weighted fit with effects
 (:mod:`.curvefit`), the errors in-sample and held out (:mod:`.scoring`), the curve test (:mod:`.calibrated`),
 the false-alarm budget (:mod:`.levels`), the curve candidates and which one a step accepts
-(:mod:`.candidates`), the removals in time (:mod:`.removals`), the change points (:mod:`.changes`), and the
-result with its report (:mod:`.result`).
+(:mod:`.candidates`), the removals in time (:mod:`.removals`), the change points (:mod:`.changes`), the
+result with its report (:mod:`.result`), and the inputs checked (:mod:`._inputs`).
 """
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..._progress import StepBar
-from ..._validate import as_rate_columns
 from ...analysis import avar
-from ...errors import InputError, ParameterError
-from ...estimators.grid import tau_grid
-from ...results import AllanResult
-from .. import fitting, periodic, tracing
+from ...errors import ParameterError
+from .. import periodic, tracing
 from .._recent import remembering
-from ..channels import check_channel, terms_before_after
+from ..channels import terms_before_after
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
 from ..terms import check_terms
+from ._inputs import REFINE_SCALE, check_scale, heldout_note, inputs, resolve_tau_range
 from ._rolloff import research_rolloff
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, bandwidth_grids, choose, families, final_params, prefetch
@@ -37,7 +33,6 @@ from .missing import MissingContext, unexplained
 from .removals import REMOVALS, Removal, RemovalContext
 from .result import Refinement, Step, term_moves
 from .scoring import (
-    HELDOUT_BLOCKS,
     MATERIAL_Z,
     chain_metrics,
     curve_change_z,
@@ -55,39 +50,6 @@ CANDIDATES = tuple(EFFECTS)
 #: held in the curve's fits — and change points come on top): two injected curve effects, the bandwidth and a
 #: resonance beside it (ADIS16405 run 1 z takes four) with room for one more.
 MAX_STEPS = 6
-
-
-def _resolve_tau_range(tau_range, result, start):
-    if isinstance(tau_range, str):
-        if tau_range != "auto":
-            raise ParameterError(f"tau_range must be a (low, high) pair of seconds or 'auto', got {tau_range!r}")
-        nf = fitting.fit(result, terms=start, tau_range="auto")
-        return float(nf.tau[0]) * (1 - 1e-9), math.inf
-    return (0.0, math.inf) if tau_range is None else fitting.check_tau_range(tau_range)
-
-
-#: refine's searches square and multiply variances: samples beyond this magnitude range are refused (fit and
-#: avar handle any scale exactly; refine's NNLS searches on 1e-300 variances do not).
-REFINE_SCALE = (1e-100, 1e100)
-
-
-def _check_scale(x_or_result) -> None:
-    values = x_or_result.avar if isinstance(x_or_result, AllanResult) else x_or_result
-    if np.iscomplexobj(values):
-        return  # the samples' own checks refuse complex samples (a float cast would drop the imaginary part)
-    try:
-        arr = np.asarray(values, dtype=np.float64)
-    except (TypeError, ValueError):
-        return  # the samples' own checks report it
-    finite = arr[np.isfinite(arr)] if arr.size else arr
-    peak = float(np.max(np.abs(finite))) if finite.size else 0.0
-    if isinstance(x_or_result, AllanResult):
-        peak = peak**0.5
-    if peak > 0 and not REFINE_SCALE[0] < peak < REFINE_SCALE[1]:
-        raise InputError(
-            f"refine needs samples of magnitude within {REFINE_SCALE[0]:g}…{REFINE_SCALE[1]:g}, got {peak:.3g}: "
-            f"express them in another unit (avar and fit take any scale)"
-        )
 
 
 def refine(
@@ -157,13 +119,13 @@ def refine(
         >>> r.found, round(r.steps[0].params["tc"], 0)
         (['gauss_markov'], 10.0)
     """
-    _check_scale(x_or_result)
+    check_scale(x_or_result)
     # each line spectrum once; curves, phasors and outlier scales of the same samples once
     with StepBar(progress, 1, "refine") as bar, remembering_spectra(), remembering():
         bar.step("fit, trace and test the candidates")
         start = check_terms(start)
         candidates = _check_candidates(candidates, level)
-        y, result, chans = _inputs(x_or_result, fs, input, points, axis, channels)
+        y, result, chans = inputs(x_or_result, fs, input, points, axis, channels)
         run = _Run(y, result, start, tau_range, level, truth, unit)
         run.remove_in_time(candidates, chans)
         run.add_curve_effects(candidates)
@@ -180,56 +142,6 @@ def _check_candidates(candidates, level) -> tuple:
     if not (isinstance(level, (int, float)) and 0.0 < level < 1.0):
         raise ParameterError(f"level must be a probability in (0, 1), got {level!r}")
     return candidates
-
-
-def _inputs(x_or_result, fs, input, points, axis, channels):
-    """(samples or None, the static one-row AllanResult to refine, the channels by name), checked."""
-    y = None
-    if isinstance(x_or_result, AllanResult):
-        if fs is not None:
-            raise ParameterError("fs is taken from the result; pass fs only with samples")
-        result = x_or_result
-    elif hasattr(x_or_result, "tau") and hasattr(x_or_result, "t"):
-        raise ParameterError(
-            "refine needs samples or a static AllanResult; for a dynamic result pass the samples "
-            "so that change points can be located"
-        )
-    else:
-        if fs is None:
-            raise ParameterError("fs (Hz) is needed with samples")
-        cols, fs, _ = as_rate_columns(x_or_result, fs, input)
-        if not 0 <= axis < len(cols):
-            raise ParameterError(f"axis = {axis} is outside 0..{len(cols) - 1}")
-        y = cols[axis]
-        top = max(1, y.size // 9)
-        grid = tau_grid(y.size, fs, "exp", points=points, m_max=top) if top > 1 else "octave"
-        result = avar(y, fs, taus=grid)
-    chans = _channels(channels, y)
-    if result.avar.ndim == 2:
-        result = result.static_row(result.avar[axis])
-    return y, result, chans
-
-
-def _channels(channels, y) -> dict:
-    chans: dict = {}
-    if channels:
-        if y is None:
-            raise ParameterError("channels need samples (a regression is fitted along time), not an AllanResult")
-        for name, c in channels.items():
-            chans[str(name)] = check_channel(str(name), c, y.size)
-    return chans
-
-
-def _heldout_note(y, heldout) -> str:
-    if y is None:
-        return "curve-only input (an AllanResult without samples): no held-out error; steps rest on the calibrated test"
-    if heldout is None:
-        return "record too short to hold out alternate blocks: no held-out error"
-    return (
-        f"alternate blocks in time ({HELDOUT_BLOCKS}; odd ↔ even, each part's blocks joined): the model fitted "
-        "on one part predicts the other part's Allan curve, both ways, mean RMS ADEV error on the τ whose "
-        "estimate is within ±10 % (4 per octave); a drift is refitted on the held-in part"
-    )
 
 
 class _Run:
@@ -249,7 +161,7 @@ class _Run:
     def __init__(self, y, result, start, tau_range, level, truth, unit=None):
         self.y, self.result, self.start, self.level, self.truth = y, result, start, level, truth
         self.unit = unit
-        self.lo, self.hi = _resolve_tau_range(tau_range, result, start)
+        self.lo, self.hi = resolve_tau_range(tau_range, result, start)
         keep = (result.tau >= self.lo) & (result.tau <= self.hi) & (result.avar > 0)
         if keep.sum() < len(start) + 3:
             raise ParameterError(
@@ -259,7 +171,7 @@ class _Run:
         self.est = result.estimator if result.source is None else tuple(np.asarray(result.source)[keep])
         self.fs = result.fs
         self.curve, self.heldout = self.build(result, y)
-        self.note = _heldout_note(y, self.heldout)
+        self.note = heldout_note(y, self.heldout)
         self.sol = self.start_sol = solve(self.curve, start, [])
         # the chain's χ² on the tests' thinned τ and covariance (exact for samples or overlapping estimates)
         self.thin = tracing.thin_indices(self.curve.tau)

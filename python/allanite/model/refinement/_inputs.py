@@ -1,0 +1,107 @@
+"""What :func:`allanite.refine` is given, checked and put in the form its loop takes: the samples' magnitude,
+the samples or a static result (the Allan curve on a dense exponential τ grid), the other channels, the τ range,
+and the note saying how the held-out error is computed."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..._validate import as_rate_columns
+from ...analysis import avar
+from ...errors import InputError, ParameterError
+from ...estimators.grid import tau_grid
+from ...results import AllanResult
+from .. import fitting
+from ..channels import check_channel
+from .scoring import HELDOUT_BLOCKS
+
+__all__ = ["REFINE_SCALE", "check_channels", "check_scale", "heldout_note", "inputs", "resolve_tau_range"]
+
+
+def resolve_tau_range(tau_range, result, start):
+    """(low, high) τ in seconds: every τ for None, ``fit``'s cut for ``"auto"``, else the pair checked."""
+    if isinstance(tau_range, str):
+        if tau_range != "auto":
+            raise ParameterError(f"tau_range must be a (low, high) pair of seconds or 'auto', got {tau_range!r}")
+        nf = fitting.fit(result, terms=start, tau_range="auto")
+        return float(nf.tau[0]) * (1 - 1e-9), math.inf
+    return (0.0, math.inf) if tau_range is None else fitting.check_tau_range(tau_range)
+
+
+#: refine's searches square and multiply variances: samples beyond this magnitude range are refused (fit and
+#: avar handle any scale exactly; refine's NNLS searches on 1e-300 variances do not).
+REFINE_SCALE = (1e-100, 1e100)
+
+
+def check_scale(x_or_result) -> None:
+    """Refuse samples (or a result's ADEV) whose largest finite magnitude is outside :data:`REFINE_SCALE`."""
+    values = x_or_result.avar if isinstance(x_or_result, AllanResult) else x_or_result
+    if np.iscomplexobj(values):
+        return  # the samples' own checks refuse complex samples (a float cast would drop the imaginary part)
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        return  # the samples' own checks report it
+    finite = arr[np.isfinite(arr)] if arr.size else arr
+    peak = float(np.max(np.abs(finite))) if finite.size else 0.0
+    if isinstance(x_or_result, AllanResult):
+        peak = peak**0.5
+    if peak > 0 and not REFINE_SCALE[0] < peak < REFINE_SCALE[1]:
+        raise InputError(
+            f"refine needs samples of magnitude within {REFINE_SCALE[0]:g}…{REFINE_SCALE[1]:g}, got {peak:.3g}: "
+            f"express them in another unit (avar and fit take any scale)"
+        )
+
+
+def inputs(x_or_result, fs, input, points, axis, channels):
+    """(samples or None, the static one-row AllanResult to refine, the channels by name), checked."""
+    y = None
+    if isinstance(x_or_result, AllanResult):
+        if fs is not None:
+            raise ParameterError("fs is taken from the result; pass fs only with samples")
+        result = x_or_result
+    elif hasattr(x_or_result, "tau") and hasattr(x_or_result, "t"):
+        raise ParameterError(
+            "refine needs samples or a static AllanResult; for a dynamic result pass the samples "
+            "so that change points can be located"
+        )
+    else:
+        if fs is None:
+            raise ParameterError("fs (Hz) is needed with samples")
+        cols, fs, _ = as_rate_columns(x_or_result, fs, input)
+        if not 0 <= axis < len(cols):
+            raise ParameterError(f"axis = {axis} is outside 0..{len(cols) - 1}")
+        y = cols[axis]
+        top = max(1, y.size // 9)
+        grid = tau_grid(y.size, fs, "exp", points=points, m_max=top) if top > 1 else "octave"
+        result = avar(y, fs, taus=grid)
+    chans = check_channels(channels, y)
+    if result.avar.ndim == 2:
+        result = result.static_row(result.avar[axis])
+    return y, result, chans
+
+
+def check_channels(channels, y) -> dict:
+    """The other channels by name, each checked against the samples ``y`` (None: an AllanResult, refused)."""
+    chans: dict = {}
+    if channels:
+        if y is None:
+            raise ParameterError("channels need samples (a regression is fitted along time), not an AllanResult")
+        for name, c in channels.items():
+            chans[str(name)] = check_channel(str(name), c, y.size)
+    return chans
+
+
+def heldout_note(y, heldout) -> str:
+    """How the held-out error was computed, or why there is none."""
+    if y is None:
+        return "curve-only input (an AllanResult without samples): no held-out error; steps rest on the calibrated test"
+    if heldout is None:
+        return "record too short to hold out alternate blocks: no held-out error"
+    return (
+        f"alternate blocks in time ({HELDOUT_BLOCKS}; odd ↔ even, each part's blocks joined): the model fitted "
+        "on one part predicts the other part's Allan curve, both ways, mean RMS ADEV error on the τ whose "
+        "estimate is within ±10 % (4 per octave); a drift is refitted on the held-in part"
+    )
