@@ -28,6 +28,7 @@ from ._fitcore import (
     exact_covariance_applies,
     fit_core,
 )
+from ._recent import Suffixes
 from .terms import TERM_ALPHA, design_matrix
 
 __all__ = ["fit_curve"]
@@ -101,22 +102,18 @@ def _nu_terms(m, n_points, estimator, terms, edf_cache) -> np.ndarray:
 
 def _recent_edf(key) -> np.ndarray:
     alpha, m, n_points, estimator = key
-    if isinstance(estimator, str):
-        for (a, full, n, est), nu in reversed(list(_RECENT_EDF.items())):  # a copy: reports run in threads too
-            k = len(full) - len(m)
-            if k >= 0 and (a, n, est) == (alpha, n_points, estimator) and full[k:] == m:
-                return nu[k:]
+    rest = (alpha, n_points, estimator)
+    hit = _RECENT_EDF.find(m, rest) if isinstance(estimator, str) else None
+    if hit is not None:
+        nu, k = hit
+        return nu[k:]
     nu = edf_per_tau(np.full(len(m), alpha), np.asarray(m, dtype=np.float64), n_points, estimator)
     nu.flags.writeable = False
-    _RECENT_EDF[key] = nu
-    for old in list(_RECENT_EDF)[:-_RECENT_SIZE]:
-        _RECENT_EDF.pop(old, None)
-    return nu
+    return _RECENT_EDF.put(m, rest, nu)
 
 
 #: The EDF columns last computed, by (α, m, n, estimator); where a request's m ends one, it is sliced from it.
-_RECENT_EDF: dict = {}
-_RECENT_SIZE = 16
+_RECENT_EDF = Suffixes(16)
 
 
 def _mixture_edf(parts: np.ndarray, nu_terms: np.ndarray) -> np.ndarray:

@@ -34,6 +34,8 @@ import math
 
 import numpy as np
 
+from ._recent import Suffixes
+
 #: Stochastic terms with a kernel, in the order of the returned blocks.
 KERNEL_TERMS = ("Q", "N", "B", "K")
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
@@ -171,20 +173,15 @@ def covariance_blocks(m, n_samples: int, fs: float, terms) -> tuple[np.ndarray, 
     bit: each block entry depends on its own pair of τ only. Read-only arrays."""
     key = tuple(int(v) for v in np.asarray(m).ravel())
     rest = (int(n_samples), float(fs), tuple(terms))
-    for (full, *others), (s_blk, t_blk) in reversed(_RECENT.items()):
-        k = len(full) - len(key)
-        if k > 0 and others == list(rest) and full[k:] == key:
-            return _read_only(s_blk[:, :, k:, k:]), _read_only(t_blk[:, k:, k:])
-    blocks = _blocks_cached(key, *rest)
-    _RECENT[(key, *rest)] = blocks
-    while len(_RECENT) > _RECENT_SIZE:
-        _RECENT.pop(next(iter(_RECENT)))
-    return blocks
+    hit = _RECENT.find(key, rest, strict=True)
+    if hit is not None:
+        (s_blk, t_blk), k = hit
+        return _read_only(s_blk[:, :, k:, k:]), _read_only(t_blk[:, k:, k:])
+    return _RECENT.put(key, rest, _blocks_cached(key, *rest))
 
 
 #: The blocks last computed, by (m, n, fs, terms): where a request's m is a suffix of one, it is sliced from it.
-_RECENT: dict = {}
-_RECENT_SIZE = 8
+_RECENT = Suffixes(8)
 
 
 def _read_only(a: np.ndarray) -> np.ndarray:
