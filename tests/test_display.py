@@ -8,6 +8,7 @@ none when it is not, and it stays small (a DAVAR of 10⁴ windows renders as sma
 from __future__ import annotations
 
 import dataclasses
+import math
 import sys
 from html.parser import HTMLParser
 
@@ -262,3 +263,26 @@ def test_forecast_models_and_scores_render():
     sc = forecast.score(forecast.GM11, build, check)
     text = " ".join(" ".join(parse(sc._repr_html_()).text).split())
     assert f"{sc.rmse:.4g}" in text and f"{sc.honest.C:.4g}" in text and f"{sc.paper_rule.C:.4g}" in text
+
+
+def test_one_number_format_for_tables_and_parameters():
+    """``_display.fmt`` formats table cells and every refine step's parameters (``effects.format_param``)."""
+    from fractions import Fraction
+
+    from allanite.model.effects import format_param
+
+    fmt = _display.fmt
+    assert fmt(None) == "—" and fmt("boxcar") == "boxcar" and fmt(True) == "True" and fmt(np.bool_(False)) == "False"
+    assert fmt(12) == "12" and fmt(np.int64(-3)) == "-3" and fmt(10**20) == str(10**20)
+    assert fmt(0.123456789) == "0.1235" and fmt(0.123456789, 2) == "0.12" and fmt(2.5e-7) == "2.5e-07"
+    assert fmt(np.float32(0.25)) == "0.25" and fmt(np.float64(1234567.0)) == "1.235e+06"
+    assert fmt(np.array(0.123456789)) == "0.1235" and fmt(np.array(7)) == "7"  # 0-d arrays as their number
+    assert fmt(math.inf) == "∞" and fmt(-np.inf) == "−∞" and fmt(np.float32("nan")) == "NaN"
+    assert fmt(Fraction(1, 3)) == "0.3333"  # any real
+    assert fmt([0.123456, 2, None]) == "0.1235, 2, —" and fmt((1.5,)) == "1.5" and fmt([]) == ""
+    assert fmt(np.array([1e-3, 2.0 / 3.0])) == "0.001, 0.6667"
+    assert fmt({"a": 1}) == "{'a': 1}"  # anything else as str
+    # a parameter's value and interval go through the same function
+    assert format_param("x", np.float32(0.123456), (np.float64(0.1), 1), "s") == "x = 0.1235 [0.1, 1] s"
+    assert format_param("x", None) == "x = —" and format_param("x", np.bool_(True)) == "x = True"
+    assert format_param("x", [np.int64(2), 0.5]) == "x = 2, 0.5"

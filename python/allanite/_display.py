@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import io
 import math
+import numbers
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -78,14 +79,22 @@ class Summary:
 
 
 def fmt(v: Any, digits: int = 4) -> str:
-    """A table cell: numbers to ``digits`` significant digits, ∞ and NaN spelled, strings as they are."""
+    """A table cell or a parameter's value: numbers (Python's, NumPy's scalars and 0-d arrays, any real) to
+    ``digits`` significant digits, ∞ and NaN spelled, None as "—", strings as they are, a list, tuple or array
+    as its entries so formatted, ``", "``-separated; anything else as ``str``."""
     if v is None:
         return "—"
+    if isinstance(v, str):
+        return v
+    if isinstance(v, np.ndarray) and v.ndim == 0:
+        v = v.item()
     if isinstance(v, (bool, np.bool_)):
         return str(bool(v))
     if isinstance(v, (int, np.integer)):
         return str(int(v))
-    if isinstance(v, (float, np.floating)):
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return ", ".join(fmt(x, digits) for x in v)
+    if isinstance(v, (numbers.Real, np.floating)):
         f = float(v)
         if math.isnan(f):
             return "NaN"

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from .._display import fmt, fmt_ci
 from ..errors import ParameterError
 
 __all__ = [
@@ -480,23 +481,6 @@ def param_units(name: str, rate_unit: str | None = None) -> dict:
     return {p: u.replace("rate unit", rate) for p, u, _ in EFFECTS[name].params}
 
 
-def _number(v: Any, digits: int) -> str:
-    if v is None:
-        return "—"
-    if isinstance(v, str):
-        return v
-    if isinstance(v, (bool, np.bool_)):
-        return str(bool(v))
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    f = float(v)
-    if math.isnan(f):
-        return "NaN"
-    if math.isinf(f):
-        return "∞" if f > 0 else "−∞"
-    return f"{f:.{digits}g}"
-
-
 def _is_pair(iv: Any) -> bool:
     return (
         isinstance(iv, (tuple, list, np.ndarray))
@@ -506,8 +490,7 @@ def _is_pair(iv: Any) -> bool:
 
 
 def _with_interval(v: Any, iv: Any, digits: int) -> str:
-    text = _number(v, digits)
-    return f"{text} [{_number(iv[0], digits)}, {_number(iv[1], digits)}]" if _is_pair(iv) else text
+    return fmt_ci(v, iv[0], iv[1], digits) if _is_pair(iv) else fmt(v, digits)
 
 
 def format_param(name: str, value: Any, interval: Any = None, unit: str = "", digits: int = 4) -> str:
@@ -524,7 +507,7 @@ def format_param(name: str, value: Any, interval: Any = None, unit: str = "", di
         text = ", ".join(_with_interval(v, ivs[i] if ivs else None, digits) for i, v in enumerate(values))
         return f"{name} = {text or 'none'}{u}"
     if value is None or isinstance(value, (bool, np.bool_)):
-        return f"{name} = {_number(value, digits)}"
+        return f"{name} = {fmt(value, digits)}"
     return f"{name} = {_with_interval(value, interval, digits)}{u}"
 
 
