@@ -128,6 +128,26 @@ fn streamed(req: &Request, mus: &[f64], first: usize, total: usize) -> Vec<f64> 
     out
 }
 
+/// The columns of windows `first .. first + count` (the samples they span, the record's end at most).
+fn part_columns<'a>(
+    cols: &[&'a [f64]],
+    first: usize,
+    count: usize,
+    window: usize,
+    hop: usize,
+) -> Vec<&'a [f64]> {
+    let s0 = first * hop;
+    let len = ((count - 1) * hop + window).min(cols[0].len() - s0);
+    cols.iter().map(|c| &c[s0..s0 + len]).collect()
+}
+
+/// The part call's values for `preq` (windows `first ..` of `n_win`), checked to hold `count` windows.
+fn part_values(preq: &Request, mus: &[f64], first: usize, n_win: usize, count: usize) -> Vec<f64> {
+    let (got, k) = dynamic_avar_part_cancellable(preq, mus, first, n_win, &Cancel::new()).unwrap();
+    assert_eq!(k, count);
+    got
+}
+
 #[test]
 fn a_part_of_the_record_gives_the_records_windows() {
     let n = 3001;
@@ -178,17 +198,12 @@ fn a_part_of_the_record_gives_the_records_windows() {
             for &first in &starts {
                 for count in [1, 2, 3, n_win] {
                     let count = count.min(n_win - first);
-                    let s0 = first * hop;
-                    let len = ((count - 1) * hop + window).min(n - s0);
-                    let part_cols: Vec<&[f64]> = cols.iter().map(|c| &c[s0..s0 + len]).collect();
+                    let part_cols = part_columns(&cols, first, count, window, hop);
                     let preq = Request {
                         columns: &part_cols,
                         ..req
                     };
-                    let (got, k) =
-                        dynamic_avar_part_cancellable(&preq, &mus, first, n_win, &Cancel::new())
-                            .unwrap();
-                    assert_eq!(k, count);
+                    let got = part_values(&preq, &mus, first, n_win, count);
                     let part = streamed(&preq, &mus, first, n_win);
                     // the part on its own (its own mean and alignment) rounds differently
                     let (alone, _) = dynamic_avar(&preq).unwrap();
@@ -256,6 +271,20 @@ fn phase_segments_cut_where_parts_can() {
     }
 }
 
+/// The overlapping Allan variance of one window at factor `m`, the plain way (phase by a running sum).
+fn plain_overlapping(w: &[f64], m: usize) -> f64 {
+    let mut x = vec![0.0f64; w.len() + 1];
+    let mu = compensated_mean(w);
+    for (i, v) in w.iter().enumerate() {
+        x[i + 1] = x[i] + (v - mu);
+    }
+    let l = w.len() + 1 - 2 * m;
+    let s: f64 = (0..l)
+        .map(|k| (x[k + 2 * m] - 2.0 * x[k + m] + x[k]).powi(2))
+        .sum();
+    s / (2.0 * (m * m) as f64 * l as f64)
+}
+
 fn segments_case(n: usize, n_axes: usize, long: bool, cases: &[(usize, usize)]) {
     let cols_owned: Vec<Vec<f64>> = (0..n_axes)
         .map(|a| biased_record(n, 7 + a as u64))
@@ -293,17 +322,7 @@ fn segments_case(n: usize, n_axes: usize, long: bool, cases: &[(usize, usize)]) 
         for (a, y) in cols.iter().enumerate() {
             for (t, &m) in ms.iter().enumerate() {
                 for j in (0..n_win).step_by(1 + n_win / 40) {
-                    let w = &y[j * hop..j * hop + window];
-                    let mut x = vec![0.0f64; window + 1];
-                    let mu = compensated_mean(w);
-                    for (i, v) in w.iter().enumerate() {
-                        x[i + 1] = x[i] + (v - mu);
-                    }
-                    let l = window + 1 - 2 * m;
-                    let s: f64 = (0..l)
-                        .map(|k| (x[k + 2 * m] - 2.0 * x[k + m] + x[k]).powi(2))
-                        .sum();
-                    let plain = s / (2.0 * (m * m) as f64 * l as f64);
+                    let plain = plain_overlapping(&y[j * hop..j * hop + window], m);
                     let got = record[(a * ms.len() + t) * n_win + j];
                     assert!(
                         (got / plain - 1.0).abs() < 1e-9,
@@ -319,17 +338,12 @@ fn segments_case(n: usize, n_axes: usize, long: bool, cases: &[(usize, usize)]) 
             }
             for count in [1, seg, seg + 1, n_win] {
                 let count = count.min(n_win - first);
-                let s0 = first * hop;
-                let len = ((count - 1) * hop + window).min(n - s0);
-                let part_cols: Vec<&[f64]> = cols.iter().map(|c| &c[s0..s0 + len]).collect();
+                let part_cols = part_columns(&cols, first, count, window, hop);
                 let preq = Request {
                     columns: &part_cols,
                     ..req
                 };
-                let (got, k) =
-                    dynamic_avar_part_cancellable(&preq, &mus, first, n_win, &Cancel::new())
-                        .unwrap();
-                assert_eq!(k, count);
+                let got = part_values(&preq, &mus, first, n_win, count);
                 for row in 0..cols.len() * ms.len() {
                     for j in 0..count {
                         let (g, r) = (got[row * count + j], record[row * n_win + first + j]);
