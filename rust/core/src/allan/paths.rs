@@ -156,114 +156,170 @@ pub(super) fn part_rows(
     out: &mut [f64],
     cancel: &Cancel,
 ) -> Option<Vec<Range>> {
+    match path {
+        RowPath::Chunked => chunked_rows(req, mus, part, out, cancel),
+        RowPath::Phase => phase_rows(req, mus, part, out, cancel),
+        RowPath::Stream => Some(stream_rows(req, mus, part, out, cancel)),
+    }
+}
+
+/// [`part_rows`] on chunked phases (`crate::chunked`), axis by axis.
+fn chunked_rows(
+    req: &Request,
+    mus: &[f64],
+    part: Part,
+    out: &mut [f64],
+    cancel: &Cancel,
+) -> Option<Vec<Range>> {
+    let n_m = req.ms.len();
+    let n_m_win = out.len() / req.columns.len();
+    let mut ranges = Vec::with_capacity(req.columns.len() * n_m);
+    for (a, y) in req.columns.iter().enumerate() {
+        let dst_axis = &mut out[a * n_m_win..(a + 1) * n_m_win];
+        let (w, h) = (req.window, req.hop);
+        ranges.extend(crate::chunked::overlapping_rows(
+            y, part, mus[a], req.ms, w, h, dst_axis, cancel,
+        ));
+    }
+    (ranges.len() == req.columns.len() * n_m).then_some(ranges)
+}
+
+/// [`part_rows`] on the double-word phase, segment by segment: a segment's rows tiled for hops ≥ 64,
+/// else row by row ([`phase_segment_rows`]). Each row's range is noted right after the row is formed
+/// (in cache); the tiled path leaves it open (`None`).
+fn phase_rows(
+    req: &Request,
+    mus: &[f64],
+    part: Part,
+    out: &mut [f64],
+    cancel: &Cancel,
+) -> Option<Vec<Range>> {
     let n_m = req.ms.len();
     let n_win = out.len() / (req.columns.len() * n_m);
     let n_m_win = n_m * n_win;
-    if path == RowPath::Chunked {
-        let mut ranges = Vec::with_capacity(req.columns.len() * n_m);
-        for (a, y) in req.columns.iter().enumerate() {
-            let dst_axis = &mut out[a * n_m_win..(a + 1) * n_m_win];
-            let (w, h) = (req.window, req.hop);
-            ranges.extend(crate::chunked::overlapping_rows(
-                y, part, mus[a], req.ms, w, h, dst_axis, cancel,
-            ));
-        }
-        return (ranges.len() == req.columns.len() * n_m).then_some(ranges);
-    }
-    let phase = path == RowPath::Phase;
-    // each row's range, noted right after the row is formed (in cache); the tiled path leaves it open
     let mut ranges = vec![Range::default(); req.columns.len() * n_m];
     let mut noted = true;
-    if phase {
-        let n_used_record = (part.total - 1) * req.hop + req.window;
-        let long = long_record(n_used_record, req.columns.len());
-        let seg = crate::oavar::segment_windows(req.window, req.hop, long);
-        for (a, y) in req.columns.iter().enumerate() {
-            let dst_axis = &mut out[a * n_m_win..(a + 1) * n_m_win];
-            // the part's windows j0 .. j1 (its own index), cut where the record's segments start
-            let mut j0 = 0;
-            while j0 < n_win {
-                if cancel.is_cancelled() {
-                    return None;
+    let n_used_record = (part.total - 1) * req.hop + req.window;
+    let long = long_record(n_used_record, req.columns.len());
+    let seg = crate::oavar::segment_windows(req.window, req.hop, long);
+    for (a, y) in req.columns.iter().enumerate() {
+        let dst_axis = &mut out[a * n_m_win..(a + 1) * n_m_win];
+        // the part's windows j0 .. j1 (its own index), cut where the record's segments start
+        let mut j0 = 0;
+        while j0 < n_win {
+            if cancel.is_cancelled() {
+                return None;
+            }
+            let g = part.first + j0; // the record's window index
+            let j1 = ((g / seg + 1) * seg - part.first).min(n_win);
+            let nw = j1 - j0;
+            let s0 = j0 * req.hop;
+            let ys = &y[s0..s0 + (nw - 1) * req.hop + req.window];
+            let ph = crate::oavar::Phase::new(ys, mus[a]);
+            let (hi, lo) = ph.parts();
+            if part.total >= 2 && nw >= 2 && req.hop >= crate::oavar::SMALL_HOP {
+                noted = false;
+                crate::oavar::overlapping_dynamic_tiled(
+                    hi,
+                    lo,
+                    req.ms,
+                    req.window,
+                    req.hop,
+                    dst_axis,
+                    (n_win, j0, nw),
+                    cancel,
+                );
+            } else {
+                let sub = Part {
+                    first: g,
+                    total: part.total,
+                };
+                let seg_part = Segment {
+                    hi,
+                    lo,
+                    y: &y[s0..],
+                    mu: mus[a],
+                    sub,
+                    cols: j0..j1,
+                };
+                let rows = phase_segment_rows(req, &seg_part, dst_axis, n_win, cancel);
+                for (t, r) in rows.into_iter().enumerate() {
+                    ranges[a * n_m + t] = ranges[a * n_m + t].merge(r);
                 }
-                let g = part.first + j0; // the record's window index
-                let j1 = ((g / seg + 1) * seg - part.first).min(n_win);
-                let nw = j1 - j0;
-                let s0 = j0 * req.hop;
-                let ys = &y[s0..s0 + (nw - 1) * req.hop + req.window];
-                let ph = crate::oavar::Phase::new(ys, mus[a]);
-                let (hi, lo) = ph.parts();
-                if part.total >= 2 && nw >= 2 && req.hop >= crate::oavar::SMALL_HOP {
-                    noted = false;
-                    crate::oavar::overlapping_dynamic_tiled(
-                        hi,
-                        lo,
-                        req.ms,
+            }
+            j0 = j1;
+        }
+    }
+    noted.then_some(ranges)
+}
+
+/// One phase segment of one axis: its phase (`hi`, `lo`), the axis's samples from its first window on
+/// (`y`), the axis mean, the segment as a part of the record, and its windows in the part's rows.
+struct Segment<'a> {
+    hi: &'a [f64],
+    lo: &'a [f64],
+    y: &'a [f64],
+    mu: f64,
+    sub: Part,
+    cols: std::ops::Range<usize>,
+}
+
+/// The rows of one phase segment (`dst_axis`: one axis's rows of `n_win` windows), m by m in parallel:
+/// from the phase for m ≤ `PHASE_M_MAX` (and a one-window record, and hops ≥ 64), else streaming the
+/// segment's samples. Each row's range.
+fn phase_segment_rows(
+    req: &Request,
+    sp: &Segment,
+    dst_axis: &mut [f64],
+    n_win: usize,
+    cancel: &Cancel,
+) -> Vec<Range> {
+    let total = sp.sub.total;
+    dst_axis
+        .par_chunks_mut(n_win)
+        .enumerate()
+        .map_init(
+            || (crate::oavar::DynScratch::default(), RowScratch::default()),
+            |(sc, rs), (t, row)| {
+                if cancel.is_cancelled() {
+                    return Range::default();
+                }
+                let dst = &mut row[sp.cols.clone()];
+                let m = req.ms[t];
+                // (a one-window run at a hop ≥ 64 is the tiled path's blocks)
+                if m <= PHASE_M_MAX || total == 1 || req.hop >= crate::oavar::SMALL_HOP {
+                    crate::oavar::overlapping_dynamic_row(
+                        sp.hi,
+                        sp.lo,
+                        m,
                         req.window,
                         req.hop,
-                        dst_axis,
-                        (n_win, j0, nw),
-                        cancel,
-                    );
+                        total == 1,
+                        dst,
+                        sc,
+                    )
                 } else {
-                    let sub = Part {
-                        first: g,
-                        total: part.total,
-                    };
-                    let rows: Vec<Range> = dst_axis
-                        .par_chunks_mut(n_win)
-                        .enumerate()
-                        .map_init(
-                            || (crate::oavar::DynScratch::default(), RowScratch::default()),
-                            |(sc, rs), (t, row)| {
-                                if cancel.is_cancelled() {
-                                    return Range::default();
-                                }
-                                let dst = &mut row[j0..j1];
-                                let m = req.ms[t];
-                                // (a one-window run at a hop ≥ 64 is the tiled path's blocks)
-                                if m <= PHASE_M_MAX
-                                    || part.total == 1
-                                    || req.hop >= crate::oavar::SMALL_HOP
-                                {
-                                    crate::oavar::overlapping_dynamic_row(
-                                        hi,
-                                        lo,
-                                        m,
-                                        req.window,
-                                        req.hop,
-                                        part.total == 1,
-                                        dst,
-                                        sc,
-                                    )
-                                } else {
-                                    overlapping_row_at(
-                                        &y[s0..],
-                                        sub,
-                                        mus[a],
-                                        m,
-                                        req.window,
-                                        req.hop,
-                                        dst,
-                                        rs,
-                                        cancel,
-                                    );
-                                    Range::of(dst)
-                                }
-                            },
-                        )
-                        .collect();
-                    for (t, r) in rows.into_iter().enumerate() {
-                        ranges[a * n_m + t] = ranges[a * n_m + t].merge(r);
-                    }
+                    overlapping_row_at(
+                        sp.y, sp.sub, sp.mu, m, req.window, req.hop, dst, rs, cancel,
+                    );
+                    Range::of(dst)
                 }
-                j0 = j1;
-            }
-        }
-        return noted.then_some(ranges);
-    }
-    let rows: Vec<Range> = out
-        .par_chunks_mut(n_win)
+            },
+        )
+        .collect()
+}
+
+/// [`part_rows`] streaming every (axis, m) row in parallel.
+fn stream_rows(
+    req: &Request,
+    mus: &[f64],
+    part: Part,
+    out: &mut [f64],
+    cancel: &Cancel,
+) -> Vec<Range> {
+    let n_m = req.ms.len();
+    let n_win = out.len() / (req.columns.len() * n_m);
+    out.par_chunks_mut(n_win)
         .enumerate()
         .map_init(RowScratch::default, |sc, (row, dst)| {
             if cancel.is_cancelled() {
@@ -281,6 +337,5 @@ pub(super) fn part_rows(
             }
             Range::of(dst)
         })
-        .collect();
-    Some(rows)
+        .collect()
 }
