@@ -170,74 +170,8 @@ fn a_part_of_the_record_gives_the_records_windows() {
     let (mut differ, mut compared, mut worst) = (0usize, 0usize, 0.0f64);
     for estimator in [Estimator::Overlapping, Estimator::Classic] {
         for (window, hop) in cases {
-            let mut ms: Vec<usize> = vec![1, 2, 3, 8, 9, 10, 17, 64, 100, 149, window / 2];
-            ms.retain(|&m| m <= window / 2);
-            ms.dedup();
-            let req = Request {
-                columns: &cols,
-                window,
-                hop,
-                ms: &ms,
-                estimator,
-                method: Method::Fast,
-            };
-            let (record, n_win) = dynamic_avar(&req).unwrap();
-            let whole = streamed(&req, &mus, 0, n_win);
-            // this record is small: the record's call streams only the classic estimator
-            let phase = estimator == Estimator::Overlapping;
-            if !phase && n_win >= 2 {
-                assert!(whole
-                    .iter()
-                    .zip(&record)
-                    .all(|(a, b)| a.to_bits() == b.to_bits()));
-            }
-            let starts: Vec<usize> = (0..n_win)
-                .step_by(1 + n_win / 7)
-                .chain([n_win - 1])
-                .collect();
-            for &first in &starts {
-                for count in [1, 2, 3, n_win] {
-                    let count = count.min(n_win - first);
-                    let part_cols = part_columns(&cols, first, count, window, hop);
-                    let preq = Request {
-                        columns: &part_cols,
-                        ..req
-                    };
-                    let got = part_values(&preq, &mus, first, n_win, count);
-                    let part = streamed(&preq, &mus, first, n_win);
-                    // the part on its own (its own mean and alignment) rounds differently
-                    let (alone, _) = dynamic_avar(&preq).unwrap();
-                    let per_row = alone.len() / (cols.len() * ms.len());
-                    for row in 0..cols.len() * ms.len() {
-                        for j in 0..count {
-                            let w = whole[row * n_win + first + j];
-                            differ += usize::from(alone[row * per_row + j] != w);
-                            compared += 1;
-                            // streaming: the same additions in the same order
-                            assert_eq!(
-                                part[row * count + j].to_bits(),
-                                w.to_bits(),
-                                "{estimator:?} window {window} hop {hop} first {first} \
-                                 count {count} row {row} j {j}"
-                            );
-                            // the part entry against the record's call (its path)
-                            let (g, r) = (got[row * count + j], record[row * n_win + first + j]);
-                            // (the phase path: bit for bit from a segment's start)
-                            let seg = crate::oavar::segment_windows(window, hop, false);
-                            let exact = !phase || first % seg == 0;
-                            if exact {
-                                assert_eq!(
-                                    g.to_bits(),
-                                    r.to_bits(),
-                                    "{estimator:?} {window} {hop}"
-                                );
-                            } else {
-                                worst = worst.max((g / r - 1.0).abs());
-                            }
-                        }
-                    }
-                }
-            }
+            let (d, c, w) = part_case(&cols, &mus, estimator, window, hop);
+            (differ, compared, worst) = (differ + d, compared + c, worst.max(w));
         }
     }
     // the phase path of a part: the record's terms from differently rounded phase values
@@ -245,6 +179,84 @@ fn a_part_of_the_record_gives_the_records_windows() {
     // the streaming equality is not a property of any part: computed on their own (their own
     // mean, their own alignment) a quarter of these values differ in the last bits
     assert!(differ * 10 > compared, "{differ} of {compared} differ");
+}
+
+/// One (estimator, window, hop) of [`a_part_of_the_record_gives_the_records_windows`]: every part
+/// checked against the record's call and its streaming path; (parts' values computed on their own
+/// that differ from the record's, values compared, the phase path's worst relative difference).
+fn part_case(
+    cols: &[&[f64]],
+    mus: &[f64],
+    estimator: Estimator,
+    window: usize,
+    hop: usize,
+) -> (usize, usize, f64) {
+    let (mut differ, mut compared, mut worst) = (0usize, 0usize, 0.0f64);
+    let mut ms: Vec<usize> = vec![1, 2, 3, 8, 9, 10, 17, 64, 100, 149, window / 2];
+    ms.retain(|&m| m <= window / 2);
+    ms.dedup();
+    let req = Request {
+        columns: cols,
+        window,
+        hop,
+        ms: &ms,
+        estimator,
+        method: Method::Fast,
+    };
+    let (record, n_win) = dynamic_avar(&req).unwrap();
+    let whole = streamed(&req, mus, 0, n_win);
+    // this record is small: the record's call streams only the classic estimator
+    let phase = estimator == Estimator::Overlapping;
+    if !phase && n_win >= 2 {
+        assert!(whole
+            .iter()
+            .zip(&record)
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+    let starts: Vec<usize> = (0..n_win)
+        .step_by(1 + n_win / 7)
+        .chain([n_win - 1])
+        .collect();
+    for &first in &starts {
+        for count in [1, 2, 3, n_win] {
+            let count = count.min(n_win - first);
+            let part_cols = part_columns(cols, first, count, window, hop);
+            let preq = Request {
+                columns: &part_cols,
+                ..req
+            };
+            let got = part_values(&preq, mus, first, n_win, count);
+            let part = streamed(&preq, mus, first, n_win);
+            // the part on its own (its own mean and alignment) rounds differently
+            let (alone, _) = dynamic_avar(&preq).unwrap();
+            let per_row = alone.len() / (cols.len() * ms.len());
+            for row in 0..cols.len() * ms.len() {
+                for j in 0..count {
+                    let w = whole[row * n_win + first + j];
+                    differ += usize::from(alone[row * per_row + j] != w);
+                    compared += 1;
+                    // streaming: the same additions in the same order
+                    assert_eq!(
+                        part[row * count + j].to_bits(),
+                        w.to_bits(),
+                        "{estimator:?} window {window} hop {hop} first {first} \
+                         count {count} row {row} j {j}"
+                    );
+                    // the part entry against the record's call (its path)
+                    let (g, r) = (got[row * count + j], record[row * n_win + first + j]);
+                    // (the phase path: bit for bit from a segment's start)
+                    let seg = crate::oavar::segment_windows(window, hop, false);
+                    let exact = !phase || first % seg == 0;
+                    if exact {
+                        assert_eq!(g.to_bits(), r.to_bits(), "{estimator:?} {window} {hop}");
+                    } else {
+                        worst = worst.max((g / r - 1.0).abs());
+                    }
+                }
+            }
+        }
+    }
+    (differ, compared, worst)
 }
 
 /// The phase path in segments (the unit tests' segments span 2^12 samples): parts that start on
