@@ -166,7 +166,7 @@ def test_bursts_of_spikes_are_flagged_as_runs_and_refine_adds_no_filter():
     assert r["accepted"] and r["rule"] == "neighbours"
     spikes, flags = comp != 0, r["flags"]
     assert np.count_nonzero(flags & spikes) >= 0.99 * spikes.sum() and np.count_nonzero(flags & ~spikes) <= 3
-    # the Gaussian bound counts every run length (1 + 2 + 3 + 4 times λ) and stays below 5 % of the flags
+    # the Gaussian bound counts each run length that flags a sample (here 1 + 2 + 3 + 4 times λ): below 5 %
     assert r["expected_gaussian_flags"] <= 0.05 * flags.sum()
     ref = allanite.refine(y, 500.0, progress=False)
     assert ref.found == ["outliers"]

@@ -31,8 +31,10 @@ span) the runs of 1 … :data:`MAX_RUN` samples off both outer neighbours at a c
 of the run both beyond c*·σ_d (the lattice's next step on quantised samples) and of opposite signs, and each of
 its samples beyond the cut from both — a lone spike, or spikes beside spikes of the same sign (a burst). Gaussian
 samples are flagged in runs of L at most as often as the difference into the run exceeds the cut, so at most
-L·λ(c*) samples per run length and λ = Σ_L L·λ(c*) in all, for any spectrum (the lattice model holds for the
-differences; a low-passed record's differences move together, so opposite signs are rarer still) — c* the lowest of
+L·λ(c*) samples per run length, for any spectrum (the lattice model holds for the differences; a low-passed
+record's differences move together, so opposite signs are rarer still); λ sums that over the lone samples and
+each longer length that flags a sample (a length that flags none puts no Gaussian sample among the flags) — c*
+the lowest of
 :data:`FLAG_CUTS` at which λ is at most 5 % of the flags (the flagged share is the outliers', not the Gaussian
 tail's) and the flagged count is itself beyond Poisson(2λ) at the test's α per cut (one sample flagged where λ =
 0.009, as on an ADIS16405 accelerometer's heavy tail, is a count twice the Gaussian's gives 1.7 % of the time).
@@ -321,9 +323,10 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
 
     Any other record: runs of 1 … :data:`MAX_RUN` samples off both outer neighbours (:func:`_off_neighbours`),
     the differences into and out of the run beyond the cut (c·σ_d of its block) and of opposite signs. Gaussian
-    samples are flagged in runs of L at most as often as a difference exceeds the cut, so λ is Σ_L L × that
-    count — for any spectrum (a low-passed record's differences move together: opposite signs are rarer still);
-    a spike's neighbours (one large difference each) and a step of the mean (one) are not flagged."""
+    samples are flagged in runs of L at most as often as a difference exceeds the cut, so λ is that count × the
+    sum of the lone samples' 1 and each longer length that flags a sample — for any spectrum (a low-passed
+    record's differences move together: opposite signs are rarer still); a spike's neighbours (one large
+    difference each) and a step of the mean (one) are not flagged."""
     if level is not None:
         r, s_blocks, s_sig = level
         flags = np.zeros(r.size, dtype=bool)
@@ -340,23 +343,28 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
         cut, p = _tail(c, s_b, step)
         cut_d[b] = cut
         lam += (b.stop - b.start) * p
-    # a run of L samples is flagged at most once per difference into it beyond the cut: L·λ samples per length
-    lam *= sum(range(1, MAX_RUN + 1))
-    return _off_neighbours(d, cut_d), lam, float(np.median([_tail(c, s_b, step)[0] for s_b in sig]))
+    # a run of L samples is flagged at most once per difference into it beyond the cut: L·λ samples per length,
+    # charged for the lone samples and for each longer length that flags a sample (one that flags none has put
+    # no Gaussian sample among the flags)
+    flags, lengths = _off_neighbours(d, cut_d)
+    lam *= 1 + sum(lengths - {1})
+    return flags, lam, float(np.median([_tail(c, s_b, step)[0] for s_b in sig]))
 
 
-def _off_neighbours(d: np.ndarray, cut_d: np.ndarray) -> np.ndarray:
+def _off_neighbours(d: np.ndarray, cut_d: np.ndarray) -> tuple[np.ndarray, set]:
     """Flags of the runs of 1 … :data:`MAX_RUN` samples that stand off both outer neighbours: the differences
     into and out of the run beyond the cut (``cut_d``, per difference) and of opposite signs, and every sample
     of the run beyond the cut from both outer neighbours on the run's side. A run of one is a lone spike (the
     rule off both neighbours); longer runs are spikes beside spikes of the same sign (a burst: 371 of the 372
     spikes the lone rule missed in ``benches/refine_blind2.py``'s bursts). Then, in each stretch of flagged
     samples, those not beyond the cut from both of the stretch's outer neighbours are unflagged: a good sample
-    between two spikes of the same sign stands off both of its own neighbours, not off the stretch's."""
+    between two spikes of the same sign stands off both of its own neighbours, not off the stretch's. Returns the
+    flags and the run lengths that flagged a sample no shorter run had."""
     n = d.size + 1
     y = np.concatenate([[0.0], np.cumsum(d)])  # the samples less the first
     big = np.abs(d) > cut_d
     flags = np.zeros(n, dtype=bool)
+    shortest = np.zeros(n, dtype=np.int8)  # the shortest run length that flagged each sample
     for run in range(1, MAX_RUN + 1):
         t = np.arange(1, n - run)  # the run's first sample; d[t − 1] into it, d[t + run − 1] out of it
         if t.size == 0:
@@ -367,8 +375,11 @@ def _off_neighbours(d: np.ndarray, cut_d: np.ndarray) -> np.ndarray:
         for j in range(run):
             ok &= (s * (y[t + j] - y[t - 1]) > c) & (s * (y[t + j] - y[t + run]) > c)
         for j in range(run):
-            flags[t[ok] + j] = True
-    return _stretch_check(y, flags, cut_d)
+            at = t[ok] + j
+            shortest[at[~flags[at]]] = run
+            flags[at] = True
+    flags = _stretch_check(y, flags, cut_d)
+    return flags, {int(v) for v in np.unique(shortest[flags])}
 
 
 def _stretch_check(y: np.ndarray, flags: np.ndarray, cut_d: np.ndarray) -> np.ndarray:
