@@ -366,20 +366,23 @@ NOTES: list = [
     "channel mixtures (slow_1hz, channels_100hz: the Whittle test accepted none, so the held-out gate never "
     "came into play); the ADIS16405 rows (no channels) do not reach the changed code.",
     "",
-    "Why the other four still fail — each a general gap, none fixed in this session:",
+    "Why the other four failed — each a general gap:",
     "",
-    "- *Thermal chamber, T and dT/dt*: the channel is classed fast (7 cycles over the record, most of its "
-    "variance within the 8 blocks: `channels.is_slow`), and only the slow path (Whittle GLS) tries the optional "
-    "terms. On the slow path the dT/dt term is kept at 1356 against 11 and the coefficients come out at −8 % and "
-    "−0.3 %. A rule that sends this channel there but keeps a multi-position tumble (flips every 200–600 s, "
-    "tests/test_channels.py) on the within-block test was not found without a threshold set between the two; the "
-    "general way is the optional terms on the fast path too (or the Whittle path for every channel whose fast "
-    "test accepts).",
-    "- *Bursts of spikes*: with clustered spikes the record is not white over a level's span, so the rule off "
-    "both neighbours flags; it misses a spike beside another of the same sign — 372 of the 1500 missed, 371 of "
-    "them in same-sign runs (2 samples: 286, 3: 69, 4: 16) — and flags 160 good samples lying between spikes. "
-    "The runs left behind read as a 167 Hz single pole and a 139.8 Hz resonance (χ²/dof 3.55 → 5.77). Needed: short "
-    "runs flagged off their outer neighbours, with the Gaussian count bounded per run length.",
+    "- *Thermal chamber, T and dT/dt* — **fixed since** (i29blind3): the channel is still classed fast (7 "
+    "cycles, its variance within the 8 blocks), but once the within-block test accepts, the Whittle GLS's optional "
+    "terms are tried, each by its own nested test at its own share of `level`; its fit replaces the block "
+    "coefficient when its coupling test accepts too, a term is kept, and its component regressed within the "
+    "blocks on the channel gives the rate's own block coefficient within the t threshold × its standard error "
+    "(a coupling that differs across frequency fails that: ADIS16405 run 2 gyro_x on acc_z, 9.6 SE off). Now "
+    "regression with coefficient −8.0 % and rate_coefficient −0.3 %, χ²/dof 2.93 → 1.6, held out 7.58 → 2.32 %, "
+    "nothing unexplained (tests/test_channels.py: a 7-cycle chamber at 0.8 °C/min, both within 10 %).",
+    "- *Bursts of spikes* — **fixed since** (i29blind3): the rule off both neighbours now flags runs of up to 4 "
+    "samples off both outer neighbours (the differences into and out of the run beyond the cut with opposite "
+    "signs, each sample beyond the cut from both), the Gaussian count bounded by L·λ for each run length that "
+    "flags a sample, and a good sample between two same-sign spikes is unflagged (off its own neighbours, not off "
+    "those of the flagged stretch). 1500 of the 1500 spikes flagged, no good sample; outliers alone (rate −0.1 %), "
+    "χ²/dof 3.55 → 1.06, held out 4.97 → 3.26 %. The pole and the resonance had been the runs left behind: the "
+    "outlier removal already runs before every curve effect (removals first, outliers first among them).",
     "- *Bias step* (outside the family): nothing added and nothing said — the curve fits (χ²/dof 0.55) and no "
     "check tests the mean along the record (the level check is on the first differences, which a step of the "
     "mean does not change). Needed: a mean-shift check in `unexplained` (block means under the fitted noise's "

@@ -391,3 +391,33 @@ def test_refine_takes_a_temperature_cycling_a_whole_number_of_times():
     assert step.params["coefficient"] == pytest.approx(3e-4, rel=0.2)
     assert step.evidence["heldout_variance_ratio"] < 0.6
     assert not [u for u in r.unexplained if u["domain"] == "channels"]
+
+
+def _chamber(t, lo, hi, hold, ramp):
+    """A thermal chamber's profile: plateaus at ``lo`` and ``hi`` held ``hold`` s, joined by ramps of ``ramp`` s."""
+    p = np.mod(t, 2 * (hold + ramp))
+    return lo + (hi - lo) * (np.clip((p - hold) / ramp, 0, 1) - np.clip((p - 2 * hold - ramp) / ramp, 0, 1))
+
+
+def test_refine_keeps_a_rate_term_on_a_fast_channel():
+    # a chamber cycling 7 times (0.8 °C/min ramps between 15 and 35 °C) is a fast channel — its variance lies
+    # within the 8 blocks — and the within-block test has no d(ch)/dt term: a boxcar, a sinusoid and a
+    # Gauss–Markov term stood in for it, and the Allan and PSD misfit was said. The Whittle GLS's optional terms
+    # are tried once the within-block test accepts (benches/results/refine_blind2.md)
+    n = 80_000
+    t = np.arange(n, dtype=np.float64)
+    temp = _chamber(t + 700.0, 15.0, 35.0, 4000.0, 1500.0)
+    logged = temp + 0.01 * np.random.default_rng(3).standard_normal(n)
+    assert not is_slow(logged)
+    y = (
+        allanite.simulate(n, 1.0, N=1e-3, B=2e-4, K=2e-6, seed=3)
+        + 2e-4 * (temp - temp.mean())
+        + 0.1 * np.gradient(temp)
+    )
+    r = allanite.refine(y, 1.0, channels={"temp": logged}, progress=False)
+    assert r.found == ["regression"] and not r.unexplained
+    (st,) = r.steps
+    assert st.params["coefficient"] == pytest.approx(2e-4, rel=0.1)
+    assert st.params["rate_coefficient"] == pytest.approx(0.1, rel=0.1)
+    assert st.evidence["terms"]["rate_coefficient"]["kept"] and "lag_s" not in st.params
+    assert st.evidence["method"].startswith("fast channel with optional terms")

@@ -144,6 +144,47 @@ def test_spikes_on_a_low_passed_record_are_flagged_and_replaced_without_a_trace(
     np.testing.assert_allclose(a1.adev, a0.adev, rtol=0.01)
 
 
+def _bursts(seed, n=400_000, fs=500.0, k=40):
+    """(samples, spikes) at ``fs``: N + B + K noise and ``k`` bursts of 0.1 s, 15 of each burst's 50 samples
+    spiked at 10–20 σ of the white noise, either sign — spikes beside spikes of the same sign."""
+    rng = np.random.default_rng(seed)
+    sigma = 2e-3 * np.sqrt(fs)
+    y = allanite.simulate(n, fs, N=2e-3, B=5e-4, K=1e-5, seed=seed)
+    comp = np.zeros(n)
+    for s in np.sort(rng.choice(np.arange(10, n // 50 - 1), k, replace=False)) * 50:
+        hit = s + rng.choice(50, 15, replace=False)
+        comp[hit] = sigma * 10.0 * (1.0 + rng.random(15)) * rng.choice([-1.0, 1.0], 15)
+    return y + comp, comp
+
+
+def test_bursts_of_spikes_are_flagged_as_runs_and_refine_adds_no_filter():
+    # off both neighbours alone, a spike beside one of the same sign was missed (127 of 600 here) and a good
+    # sample between two such was flagged (54); the runs left read as a low-pass ("bandwidth" added, the rate
+    # −17 %). Runs of up to MAX_RUN samples off their outer neighbours take them (benches/results/refine_blind2.md)
+    y, comp = _bursts(4)
+    r = outliers.outlier_test(y, 500.0, ALPHA)
+    assert r["accepted"] and r["rule"] == "neighbours"
+    spikes, flags = comp != 0, r["flags"]
+    assert np.count_nonzero(flags & spikes) >= 0.99 * spikes.sum() and np.count_nonzero(flags & ~spikes) <= 3
+    # the Gaussian bound counts each run length that flags a sample (here 1 + 2 + 3 + 4 times λ): below 5 %
+    assert r["expected_gaussian_flags"] <= 0.05 * flags.sum()
+    ref = allanite.refine(y, 500.0, progress=False)
+    assert ref.found == ["outliers"]
+    (st,) = ref.steps
+    assert st.params["rate"] == pytest.approx(spikes.mean(), rel=0.1)
+
+
+def test_a_good_sample_between_two_spikes_of_one_sign_is_kept():
+    y = _gauss(100_000, 12)
+    at = np.arange(5_000, 95_000, 3_000)
+    for a in at:  # spike, good sample, spike (both up), and a run of three down 1000 samples later
+        y[[a, a + 2]] += 1.5
+        y[a + 1000 : a + 1003] -= 1.2
+    r = outliers.outlier_test(y, FS, ALPHA)
+    want = np.concatenate([at, at + 2, at + 1000, at + 1001, at + 1002])
+    assert sorted(np.flatnonzero(r["flags"]).tolist()) == sorted(want.tolist())
+
+
 def test_a_step_of_the_mean_is_not_an_outlier():
     y = _gauss(200_000, 8)
     y[100_000:] += 2.0  # 20 σ

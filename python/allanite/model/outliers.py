@@ -27,24 +27,29 @@ The samples then flagged, where the record is white from the shortest lag up to 
 are those whose distance from the slow level (the mean over that span, on the sample's side of a step) is
 beyond c*·σ of that distance — each sample on its own, as white noise's samples are independent, so that what
 is left stays white; elsewhere (a low-pass, a random walk at the shortest lag, a roll-off or a line within the
-span) those off both neighbours at a cut c*: the differences into and out of the sample both
-beyond c*·σ_d (the lattice's next step on quantised samples) and of opposite signs — Gaussian samples are flagged
-at most as often as one difference exceeds the cut, λ(c*), for any spectrum (the lattice model holds for the
-differences; a low-passed record's differences move together, so opposite signs are rarer still) — c* the lowest of
+span) the runs of 1 … :data:`MAX_RUN` samples off both outer neighbours at a cut c*: the differences into and out
+of the run both beyond c*·σ_d (the lattice's next step on quantised samples) and of opposite signs, and each of
+its samples beyond the cut from both — a lone spike, or spikes beside spikes of the same sign (a burst). Gaussian
+samples are flagged in runs of L at most as often as the difference into the run exceeds the cut, so at most
+L·λ(c*) samples per run length, for any spectrum (the lattice model holds for the differences; a low-passed
+record's differences move together, so opposite signs are rarer still); λ sums that over the lone samples and
+each longer length that flags a sample (a length that flags none puts no Gaussian sample among the flags) — c*
+the lowest of
 :data:`FLAG_CUTS` at which λ is at most 5 % of the flags (the flagged share is the outliers', not the Gaussian
 tail's) and the flagged count is itself beyond Poisson(2λ) at the test's α per cut (one sample flagged where λ =
 0.009, as on an ADIS16405 accelerometer's heavy tail, is a count twice the Gaussian's gives 1.7 % of the time).
 :func:`allanite.refine` then removes them only where that moves an estimate of the record's Allan curve by two of
 its standard errors or more — real impulsive samples too few to move the curve are no step of it. A spike's
-neighbours (one large difference each) and a step of the mean (one) are not flagged. :func:`replace_outliers`
-replaces each flagged sample by a draw from what Gaussian noise would have put there (the slow level plus white
-noise as wide as the samples left where the noise is white at the shortest lag; the line between its neighbours
-plus the second difference's noise elsewhere): how :func:`allanite.refine` refits the noise after removing them.
-Sparse spikes are replaced cleanly. Heavy tails are not separable from the Gaussian core by any cut: the
-contaminated samples inside it stay (N falls toward the core's, not to it); refine tests the samples left again
-and flags on (``refinement.removals``). Flagging a heavy tail's samples off both neighbours would keep the wide
-samples that sit beside one of the same sign — what is left then has a lag-1 correlation (0.084 for white noise
-with 20 % of its samples 6× wider) that the shortest τ read as a low-pass.
+neighbours (one large difference each), a step of the mean (one) and a good sample between two spikes of one sign
+(off its own neighbours, not off those of the stretch of flagged samples around it) are not flagged.
+:func:`replace_outliers` replaces each flagged sample by a draw from what Gaussian noise would have put there (the slow
+level plus white noise as wide as the samples left where the noise is white at the shortest lag; the line between its
+neighbours plus the second difference's noise elsewhere): how :func:`allanite.refine` refits the noise after removing
+them. Sparse spikes are replaced cleanly. Heavy tails are not separable from the Gaussian core by any cut: the
+contaminated samples inside it stay (N falls toward the core's, not to it); refine tests the samples left again and
+flags on (``refinement.removals``). Flagging a heavy tail's samples off both neighbours would keep the wide samples that
+sit beside one of the same sign — what is left then has a lag-1 correlation (0.084 for white noise with 20 % of its
+samples 6× wider) that the shortest τ read as a low-pass.
 """
 
 from __future__ import annotations
@@ -89,6 +94,9 @@ COARSE = 0.7
 #: most EXCESS_SHARE of the flags.
 FLAG_CUTS = (3.0, 3.5, 4.0, 4.5, 5.0, 6.0, 7.0, 8.0)
 EXCESS_SHARE = 0.05
+#: Longest run of samples flagged off its outer neighbours (spikes beside spikes of the same sign, a burst;
+#: :func:`_off_neighbours`): the Gaussian samples so flagged are at most L·λ per run length L.
+MAX_RUN = 4
 #: Fewest samples of the slow level a white record's samples are flagged against and replaced around (the span
 #: is as far as the record stays white, :func:`_white_span`; shorter, the rule off both neighbours).
 LEVEL_SPAN = 65
@@ -313,10 +321,12 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
     record left had a lag-1 correlation of 0.084 (white 20 % of samples 6× wider), which the Allan curve's
     shortest τ read as a 38 Hz low-pass at 100 Hz.
 
-    Any other record: samples off both neighbours, the differences into and out of the sample both beyond the cut
-    (c·σ_d of its block) and of opposite signs. Gaussian samples are flagged at most as often as a difference
-    exceeds the cut (λ) — for any spectrum (a low-passed record's differences move together: opposite signs are
-    rarer still); a spike's neighbours (one large difference each) and a step of the mean (one) are not flagged."""
+    Any other record: runs of 1 … :data:`MAX_RUN` samples off both outer neighbours (:func:`_off_neighbours`),
+    the differences into and out of the run beyond the cut (c·σ_d of its block) and of opposite signs. Gaussian
+    samples are flagged in runs of L at most as often as a difference exceeds the cut, so λ is that count × the
+    sum of the lone samples' 1 and each longer length that flags a sample — for any spectrum (a low-passed
+    record's differences move together: opposite signs are rarer still); a spike's neighbours (one large
+    difference each) and a step of the mean (one) are not flagged."""
     if level is not None:
         r, s_blocks, s_sig = level
         flags = np.zeros(r.size, dtype=bool)
@@ -327,16 +337,66 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
             lam += (b.stop - b.start) * p
             cuts.append(cut)
         return flags, lam, float(np.median(cuts))
-    big = np.zeros(d.size, dtype=bool)
+    cut_d = np.zeros(d.size)
     lam = 0.0
     for b, s_b in zip(blocks, sig):
         cut, p = _tail(c, s_b, step)
-        big[b] = np.abs(d[b]) > cut
+        cut_d[b] = cut
         lam += (b.stop - b.start) * p
-    both = big[:-1] & big[1:] & (np.sign(d[:-1]) != np.sign(d[1:]))
-    flags = np.zeros(d.size + 1, dtype=bool)
-    flags[1:-1] = both  # d[t-1] = y_t − y_{t−1} and d[t] = y_{t+1} − y_t flag sample t
+    # a run of L samples is flagged at most once per difference into it beyond the cut: L·λ samples per length,
+    # charged for the lone samples and for each longer length that flags a sample (one that flags none has put
+    # no Gaussian sample among the flags)
+    flags, lengths = _off_neighbours(d, cut_d)
+    lam *= 1 + sum(lengths - {1})
     return flags, lam, float(np.median([_tail(c, s_b, step)[0] for s_b in sig]))
+
+
+def _off_neighbours(d: np.ndarray, cut_d: np.ndarray) -> tuple[np.ndarray, set]:
+    """Flags of the runs of 1 … :data:`MAX_RUN` samples that stand off both outer neighbours: the differences
+    into and out of the run beyond the cut (``cut_d``, per difference) and of opposite signs, and every sample
+    of the run beyond the cut from both outer neighbours on the run's side. A run of one is a lone spike (the
+    rule off both neighbours); longer runs are spikes beside spikes of the same sign (a burst: 371 of the 372
+    spikes the lone rule missed in ``benches/refine_blind2.py``'s bursts). Then, in each stretch of flagged
+    samples, those not beyond the cut from both of the stretch's outer neighbours are unflagged: a good sample
+    between two spikes of the same sign stands off both of its own neighbours, not off the stretch's. Returns the
+    flags and the run lengths that flagged a sample no shorter run had."""
+    n = d.size + 1
+    y = np.concatenate([[0.0], np.cumsum(d)])  # the samples less the first
+    big = np.abs(d) > cut_d
+    flags = np.zeros(n, dtype=bool)
+    shortest = np.zeros(n, dtype=np.int8)  # the shortest run length that flagged each sample
+    for run in range(1, MAX_RUN + 1):
+        t = np.arange(1, n - run)  # the run's first sample; d[t − 1] into it, d[t + run − 1] out of it
+        if t.size == 0:
+            break
+        d_in, d_out, c = d[t - 1], d[t + run - 1], cut_d[t - 1]
+        s = np.sign(d_in)
+        ok = big[t - 1] & big[t + run - 1] & (np.sign(d_out) == -s)
+        for j in range(run):
+            ok &= (s * (y[t + j] - y[t - 1]) > c) & (s * (y[t + j] - y[t + run]) > c)
+        for j in range(run):
+            at = t[ok] + j
+            shortest[at[~flags[at]]] = run
+            flags[at] = True
+    flags = _stretch_check(y, flags, cut_d)
+    return flags, {int(v) for v in np.unique(shortest[flags])}
+
+
+def _stretch_check(y: np.ndarray, flags: np.ndarray, cut_d: np.ndarray) -> np.ndarray:
+    """``flags`` less the samples of each flagged stretch that are not beyond the cut from both of the
+    stretch's outer (unflagged) neighbours on one side (:func:`_off_neighbours`)."""
+    edge = np.diff(np.concatenate([[0], flags.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edge == 1), np.flatnonzero(edge == -1)
+    long = stops - starts > 1
+    out = flags.copy()
+    for a, b in zip(starts[long], stops[long]):
+        if a == 0 or b >= y.size:
+            continue
+        c = cut_d[a - 1]
+        lo, hi = sorted((y[a - 1], y[b]))
+        seg = y[a:b]
+        out[a:b] = (seg > hi + c) | (seg < lo - c)
+    return out
 
 
 def _local(y: np.ndarray, step: float) -> dict:
