@@ -4,6 +4,10 @@
   Python loop (``_irls.irls_python``, itself checked bit for bit against the plain one-design IRLS in
   ``tests/test_refine_cost.py``): grids of every curve effect, with and without lines held at their power;
   its errors are SciPy's (a non-finite problem, an NNLS that does not settle).
+- The line families' two passes over the samples in the Rust core (``allanite._core.phase_bins``,
+  ``add_waveform``, used by :mod:`allanite.model.linefit`) against NumPy's: the folding, the DTFT (one and
+  two generators, in segments) and the waveform, bit for bit (a sideband waveform to 1e-13: NumPy's complex
+  product may fuse a multiply-add); their bad input is refused by name.
 - The χ² marginals of :class:`allanite.model.tracing.ScoreTest`'s draws from a table per ν
   (:mod:`allanite.model._chi2_draws`) against the quantile computed value by value.
 
@@ -18,7 +22,9 @@ import pytest
 from scipy.special import gammaincinv, ndtr
 
 import allanite
-from allanite.model import _chi2_draws
+from allanite import _core
+from allanite.errors import AllaniteError
+from allanite.model import _chi2_draws, linefit
 from allanite.model.refinement import _irls, curvefit
 from allanite.model.refinement.candidates import bandwidth_grids
 
@@ -127,3 +133,66 @@ def test_chi2_draws_from_the_table_agree_with_the_quantile(nu_lo, nu_hi):
     np.testing.assert_allclose(got, want, rtol=1e-6, atol=0)
     # too few draws per row for a table: the values one by one, bit for bit
     np.testing.assert_array_equal(_chi2_draws.scaled_quantiles(z[:, :100], nu), want[:, :100])
+
+
+needs_grid = pytest.mark.skipif(linefit._BINS is None, reason="the compiled core has no phase_bins")
+
+_FAMILIES = [
+    (np.array([0.0123]), np.arange(1, 40)[:, None]),  # harmonics: the real path
+    (np.array([0.031, 0.0047]), np.array([[k, s] for k in (1, 2, 30) for s in (-2, -1, 0, 1, 2)])),  # sidebands
+]
+
+
+def _numpy_path(monkeypatch):
+    monkeypatch.setattr(linefit, "_BINS", None)
+    monkeypatch.setattr(linefit, "_WAVE", None)
+
+
+@needs_grid
+@pytest.mark.parametrize("n_seg", [1, 32])
+def test_compiled_line_passes_equal_numpys(monkeypatch, n_seg):
+    rng = np.random.default_rng(12)
+    n = 70_001
+    y = rng.standard_normal(n)
+    idx = np.flatnonzero(rng.random(n) > 0.1)  # held-in samples: runs with gaps
+    u = np.mod(np.arange(n) * 0.1234567, 1.0)
+    u[:3] = [0.0, np.nextafter(1.0, 0.0), 0.5]  # the last phase bin wraps to the first
+    seg = None if n_seg == 1 else np.minimum(np.arange(n) * n_seg // n, n_seg - 1)
+    z = y + 1j * rng.standard_normal(n)
+    got = [linefit._fold(z, u, 4096, seg, n_seg), linefit._fold(y, u, 2**14, seg, n_seg)]
+    for gens, coefs in _FAMILIES:
+        a, b = rng.standard_normal(coefs.shape[0]), rng.standard_normal(coefs.shape[0])
+        got += [linefit.dtft(y[idx], idx, gens, coefs, n_seg), linefit.evaluate(idx, gens, coefs, a, b)]
+    rng = np.random.default_rng(12)  # the same draws again, NumPy's passes
+    rng.standard_normal(n), rng.random(n), rng.standard_normal(n)
+    with monkeypatch.context() as mp:
+        _numpy_path(mp)
+        want = [linefit._fold(z, u, 4096, seg, n_seg), linefit._fold(y, u, 2**14, seg, n_seg)]
+        for gens, coefs in _FAMILIES:
+            a, b = rng.standard_normal(coefs.shape[0]), rng.standard_normal(coefs.shape[0])
+            want += [linefit.dtft(y[idx], idx, gens, coefs, n_seg), linefit.evaluate(idx, gens, coefs, a, b)]
+    for i, (g, w) in enumerate(zip(got, want, strict=True)):
+        if i in (5,):  # a sideband waveform: NumPy's complex product may fuse a multiply-add (x86 SIMD), the core's not
+            np.testing.assert_allclose(g, w, rtol=0, atol=1e-13 * np.max(np.abs(w)))
+        else:  # the gridding, the DTFT and a real waveform: the same operations in the same order
+            np.testing.assert_array_equal(g, w)
+    assert np.std(got[-1]) > 1.0 and np.max(np.abs(got[2])) > 10.0  # real waveforms and sums, not zeros
+
+
+@needs_grid
+def test_compiled_line_passes_refuse_bad_input():
+    u = np.array([0.1, 0.5])
+    with pytest.raises(AllaniteError, match=r"phase_bins: every part must be as long as u \(2\), u in \[0, 1\)"):
+        _core.phase_bins([np.ones(3)], u, 8, None, 1)
+    with pytest.raises(AllaniteError, match=r"seg in \[0, 2\)"):
+        _core.phase_bins([np.ones(2)], u, 8, np.array([0, 2]), 2)
+    with pytest.raises(AllaniteError, match="u in"):
+        _core.phase_bins([np.ones(2)], np.array([0.1, 1.0]), 8, None, 1)
+    with pytest.raises(AllaniteError, match="with ph one part and 2·2 phasor values"):
+        _core.phase_bins([np.ones(2), np.ones(2)], u, 8, None, 1, np.ones(4))
+    with pytest.raises(AllaniteError, match=r"add_waveform: u must be 2 phases in \[0, 1\), wave 2\(m \+ 1\)"):
+        _core.add_waveform(np.zeros(2), u, np.ones(3), None)
+    with pytest.raises(AllaniteError, match="ph 2·2 values"):
+        _core.add_waveform(np.zeros(2), u, np.ones(4), np.ones(2))
+    with pytest.raises(AllaniteError, match="u must be a C-contiguous float64 array"):
+        _core.phase_bins([np.ones(2)], np.linspace(0, 0.9, 4)[::2], 8, None, 1)

@@ -220,6 +220,24 @@ def oavar_phase_gaps(
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     """Σ (Δ²x)² over the overlapping second differences with no NaN point, and their counts."""
 
+def phase_bins(
+    parts: Sequence[npt.NDArray[np.float64]],
+    u: npt.NDArray[np.float64],
+    m_bins: int,
+    seg: npt.NDArray[np.int64] | None,
+    n_seg: int,
+    ph: npt.NDArray[np.float64] | None = None,
+) -> list[npt.NDArray[np.float64]]:
+    """Each part (or y·Re ph, y·(−Im ph) of the one part y with ph) spread linearly onto n_seg × m_bins phase bins."""
+
+def add_waveform(
+    out: npt.NDArray[np.float64],
+    u: npt.NDArray[np.float64],
+    wave: npt.NDArray[np.float64],
+    ph: npt.NDArray[np.float64] | None,
+) -> None:
+    """out += Re[wave interpolated at the phases u (× the phasors ph)]; complex arrays as interleaved float64."""
+
 class StreamingVariance:
     """Streaming "oavar", "ohvar" or "tvar" of a growing phase record (values for τ0 = 1)."""
 

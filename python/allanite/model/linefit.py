@@ -19,6 +19,11 @@ lines:
   line), and the generators are their weighted least-squares combination (weights: the inverse Cramér–Rao
   variances, A²N³/(12·S₁f_s) per line — Kay's bound var(ω̂) = 24σ²/(A²N³) for a real sinusoid in white
   noise σ² = S₁f_s/2 locally).
+
+The two passes over the samples — the folding's gridding and the waveform's interpolation — run in the Rust
+core where it has them (``allanite._core.phase_bins``, ``add_waveform``: one pass each instead of NumPy's
+eight, the same operations in the same order, so the same numbers; ``tests/test_refine_irls.py`` holds the
+two paths equal); NumPy's path stays the reference.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from .. import _core
 from ._recent import Recent
 
 __all__ = ["runs", "dirichlet", "dtft", "solve", "evaluate", "refine_generators", "frequency_sd"]
@@ -35,6 +41,9 @@ __all__ = ["runs", "dirichlet", "dtft", "solve", "evaluate", "refine_generators"
 #: Phasors e^{i2πνn} are products e^{i2πν·B·⌊n/B⌋}·e^{i2πν·(n mod B)} of two exact short tables, B = _BLOCK
 #: (error ≈ 1e-15, one complex product per sample).
 _BLOCK = 1024
+#: The Rust core's gridding and waveform passes, or None where the core lacks them (then NumPy's, below).
+_BINS = getattr(_core, "phase_bins", None)
+_WAVE = getattr(_core, "add_waveform", None)
 
 
 def runs(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -152,8 +161,25 @@ def _groups(coefs: np.ndarray, nu2: float, idx: np.ndarray):
 
 def _fold(z: np.ndarray, u: np.ndarray, m_bins: int, seg: np.ndarray | None, n_seg: int) -> np.ndarray:
     """Σ z_n e^{−i2πk u_n} for k = 0 … M − 1 (per segment: shape (n_seg, M)), by linear gridding + FFT."""
-    parts = (z.real, z.imag) if np.iscomplexobj(z) else (z,)
-    return _gridded_fft(parts, _gridding(u, m_bins, seg), m_bins, n_seg)
+    parts = [z.real, z.imag] if np.iscomplexobj(z) else [z]
+    return _binned_fft(_bins_of(parts, u, m_bins, seg, n_seg, {}), m_bins, n_seg)
+
+
+def _bins_of(parts: list, u: np.ndarray, m_bins: int, seg: np.ndarray | None, n_seg: int, grids: dict, ph=None) -> list:
+    """Each real part spread onto the phase bins of ``u`` (:func:`_binned` on :func:`_gridding`; in the Rust
+    core where it has it, else the grid remembered in ``grids`` per grid size). With the phasors ``ph``, the
+    parts are y·Re ph and y·(−Im ph) of the one series ``parts[0]`` (the core forms them sample by sample)."""
+    if _BINS is not None:
+        f64 = np.float64
+        parts = [np.ascontiguousarray(part, dtype=f64) for part in parts]
+        seg_c = None if seg is None else np.ascontiguousarray(seg, dtype=np.int64)
+        ph_f = None if ph is None else np.ascontiguousarray(ph, dtype=np.complex128).view(f64)
+        return _BINS(parts, np.ascontiguousarray(u, dtype=f64), m_bins, seg_c, n_seg, ph_f)
+    if ph is not None:
+        parts = [parts[0] * ph.real, parts[0] * -ph.imag]
+    if m_bins not in grids:
+        grids[m_bins] = _gridding(u, m_bins, seg)
+    return [_binned(part, grids[m_bins], m_bins * n_seg) for part in parts]
 
 
 def _gridding(u: np.ndarray, m_bins: int, seg: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -168,11 +194,6 @@ def _gridding(u: np.ndarray, m_bins: int, seg: np.ndarray | None) -> tuple[np.nd
         j += off
         j1 += off
     return j, j1, w
-
-
-def _gridded_fft(parts, grid, m_bins: int, n_seg: int) -> np.ndarray:
-    """:func:`_fold` of the samples whose real (and imaginary) part are ``parts``, on the bins ``grid``."""
-    return _binned_fft([_binned(part, grid, m_bins * n_seg) for part in parts], m_bins, n_seg)
 
 
 def _binned(part: np.ndarray, grid, size: int) -> np.ndarray:
@@ -215,17 +236,14 @@ def dtft(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray, n_seg: int = 1
     for s, rows, ph in _groups(coefs, nu2, idx):
         k = coefs[rows, 0]
         m_bins = _grid(int(np.max(np.abs(k))))
-        if m_bins not in grids:
-            grids[m_bins] = _gridding(u, m_bins, seg)
-        size = m_bins * n_seg
         if ph is None:
-            g = _binned_fft([_binned(y, grids[m_bins], size)], m_bins, n_seg)
+            g = _binned_fft(_bins_of([y], u, m_bins, seg, n_seg, grids), m_bins, n_seg)
         else:
             # y·conj(e^{iθ}) part by part (a real times a complex scales each part: the complex product's
             # numbers); −s's phasor is s's conjugate: its imaginary part's bins are s's negated, exactly
             key = (abs(s), m_bins)
             if key not in bins:
-                bins[key] = (_binned(y * ph.real, grids[m_bins], size), _binned(y * -ph.imag, grids[m_bins], size), s)
+                bins[key] = (*_bins_of([y], u, m_bins, seg, n_seg, grids, ph), s)
             re, im, s_done = bins[key]
             g = _binned_fft([re, im if s == s_done else -im], m_bins, n_seg)
         out[:, rows] = g[:, np.mod(k, m_bins)]
@@ -288,6 +306,9 @@ def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndar
         np.add.at(spec, np.mod(k, m_bins), (a[rows] - 1j * b[rows]) / np.sinc(k / m_bins) ** 2)
         wave = np.fft.ifft(spec) * m_bins
         wave = np.append(wave, wave[0])
+        if _WAVE is not None:  # the same sums in the Rust core, one pass
+            _WAVE(out, u, wave.view(np.float64), None if ph is None else np.ascontiguousarray(ph).view(np.float64))
+            continue
         if m_bins not in grids:  # each sample's phase bin and weights, once per grid size
             x = u * m_bins
             j = x.astype(np.int64)

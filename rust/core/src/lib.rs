@@ -13,6 +13,7 @@ pub mod error;
 pub mod fit;
 mod gather;
 mod oavar;
+pub mod phase_grid;
 pub mod phase_terms;
 pub mod range;
 pub mod streaming;

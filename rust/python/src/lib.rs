@@ -27,6 +27,8 @@ use numpy::{
 use pyo3::prelude::*;
 use std::time::Duration;
 
+mod phase_grid;
+
 /// How often the calling thread looks for a pending signal while the workers run: often enough
 /// for Ctrl-C to land well within a second, rarely enough that taking the GIL costs nothing.
 const SIGNAL_POLL: Duration = Duration::from_millis(50);
@@ -984,6 +986,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
     m.add_function(wrap_pyfunction!(fit_windows, m)?)?;
     m.add_function(wrap_pyfunction!(irls_curves, m)?)?;
+    m.add_function(wrap_pyfunction!(phase_grid::phase_bins, m)?)?;
+    m.add_function(wrap_pyfunction!(phase_grid::add_waveform, m)?)?;
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;
     m.add_function(wrap_pyfunction!(part_grid, m)?)?;
     m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;

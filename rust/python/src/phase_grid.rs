@@ -1,0 +1,102 @@
+//! Bindings of allanite-core's `phase_grid` (the line families' time-domain passes, used by
+//! `allanite.model.linefit` where the core has them): numpy in, numpy out, GIL released.
+
+use crate::parameter_error;
+use allanite_core::phase_grid;
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadwriteArray1};
+use pyo3::prelude::*;
+
+fn slice<'a>(py: Python<'_>, a: &'a PyReadonlyArray1<'_, f64>, what: &str) -> PyResult<&'a [f64]> {
+    a.as_slice()
+        .map_err(|_| parameter_error(py, format!("{what} must be a C-contiguous float64 array")))
+}
+
+/// `linefit._binned` of each part on `linefit._gridding(u, m_bins, seg)`: the parts (each as long as
+/// `u`, the unit phases in [0, 1)) spread onto `n_seg` × `m_bins` bins by linear interpolation; `seg`
+/// (int64 per sample, < n_seg) or None for one segment. With `ph` (the phasors, complex as interleaved
+/// float64), `parts` is the one series y and the parts are y·Re ph and y·(−Im ph). Returns one float64
+/// array per part.
+#[pyfunction]
+#[pyo3(signature = (parts, u, m_bins, seg, n_seg, ph=None))]
+pub(crate) fn phase_bins<'py>(
+    py: Python<'py>,
+    parts: Vec<PyReadonlyArray1<'py, f64>>,
+    u: PyReadonlyArray1<'py, f64>,
+    m_bins: usize,
+    seg: Option<PyReadonlyArray1<'py, i64>>,
+    n_seg: usize,
+    ph: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Vec<Bound<'py, PyArray1<f64>>>> {
+    let uv = slice(py, &u, "u")?;
+    let ps = parts
+        .iter()
+        .map(|p| slice(py, p, "parts"))
+        .collect::<PyResult<Vec<_>>>()?;
+    let pv = match &ph {
+        None => None,
+        Some(p) => Some(slice(py, p, "ph")?),
+    };
+    let segs: Option<Vec<usize>> = match &seg {
+        None => None,
+        Some(s) => {
+            let sv = s.as_slice().map_err(|_| {
+                parameter_error(py, "seg must be a C-contiguous int64 array".to_string())
+            })?;
+            Some(
+                sv.iter()
+                    .map(|&k| usize::try_from(k).unwrap_or(usize::MAX))
+                    .collect(),
+            )
+        }
+    };
+    let sg = segs.as_deref();
+    let out = py
+        .detach(|| match (pv, ps.as_slice()) {
+            (None, _) => phase_grid::phase_bins(&ps, uv, m_bins, sg, n_seg),
+            (Some(p), [y]) => phase_grid::phase_bins_heterodyned(y, p, uv, m_bins, sg, n_seg)
+                .map(|b| b.to_vec()),
+            (Some(_), _) => None,
+        })
+        .ok_or_else(|| {
+            parameter_error(
+                py,
+                format!(
+                    "phase_bins: every part must be as long as u ({}), u in [0, 1), seg in [0, {n_seg}), m_bins ≥ 1, with ph one part and 2·{} phasor values",
+                    uv.len(), uv.len()
+                ),
+            )
+        })?;
+    Ok(out.into_iter().map(|v| v.into_pyarray(py)).collect())
+}
+
+/// `linefit.evaluate`'s pass: adds to `out` the waveform `wave` (m + 1 complex bins as interleaved
+/// float64, the last the first again) interpolated at the unit phases `u`, times the phasors `ph`
+/// (interleaved complex per sample) or its real part alone when `ph` is None.
+#[pyfunction]
+#[pyo3(signature = (out, u, wave, ph))]
+pub(crate) fn add_waveform<'py>(
+    py: Python<'py>,
+    mut out: PyReadwriteArray1<'py, f64>,
+    u: PyReadonlyArray1<'py, f64>,
+    wave: PyReadonlyArray1<'py, f64>,
+    ph: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<()> {
+    let (uv, wv) = (slice(py, &u, "u")?, slice(py, &wave, "wave")?);
+    let pv = match &ph {
+        None => None,
+        Some(p) => Some(slice(py, p, "ph")?),
+    };
+    let ov = out
+        .as_slice_mut()
+        .map_err(|_| parameter_error(py, "out must be a C-contiguous float64 array".to_string()))?;
+    let n = ov.len();
+    if !py.detach(|| phase_grid::add_waveform(ov, uv, wv, pv)) {
+        return Err(parameter_error(
+            py,
+            format!(
+                "add_waveform: u must be {n} phases in [0, 1), wave 2(m + 1) ≥ 4 values, ph 2·{n} values"
+            ),
+        ));
+    }
+    Ok(())
+}
