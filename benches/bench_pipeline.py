@@ -20,7 +20,8 @@ Rows
    the top of ``python -X importtime``.
 
 7. ``allanite report <ADIS run 1> ... --refine``: its wall and CPU time against the refine calls alone (the
-   report's own cost beyond them), and against the report without ``--refine``.
+   report's own cost beyond them), and against the report without ``--refine`` — five rounds of the three
+   (one with ``--quick``), medians, and each round's cost beyond both.
 8. Scale (issue 30 item 4): ``allanite report`` of a 10⁸-sample × 3-axis float64 ``.npy`` (2.4 GB, written to
    ``--scratch`` and deleted after; memory-mapped by the reader) in a fresh process — wall, CPU, peak RSS
    (ru_maxrss of the process and its children, file pages included) against the target of the file's size
@@ -68,6 +69,7 @@ CONFIGS = {
         "n_baseline_combine": 50_000,
         "ref_windows": 400,
         "import_repeats": 5,
+        "refine_repeats": 5,
     },
     "quick": {
         "repeats": 1,
@@ -75,6 +77,7 @@ CONFIGS = {
         "n_baseline_combine": 20_000,
         "ref_windows": 100,
         "import_repeats": 3,
+        "refine_repeats": 1,
     },
 }
 
@@ -228,33 +231,61 @@ def row_report(data: Path, cfg: dict, baseline: Path | None, tmp: Path) -> dict:
     return row
 
 
-def row_refine(data: Path, cfg: dict, tmp: Path) -> dict:
-    """The report with ``--refine`` against the refine calls it makes (in this process) and the plain report."""
-    import allanite
+#: The refine calls the report makes, timed in a fresh process of their own (imports and first-call set-up
+#: included, as in the report's process): [wall s, CPU s] of the calls alone.
+_REFINE_CALLS = """
+import json, sys, time
+import numpy as np, allanite
+log = allanite.read_log(sys.argv[1], fs=100, columns=["gyro_x", "gyro_y", "gyro_z"], unit="deg/s")
+t0 = 0.1 if allanite.avar(log.data, 100.0).tau[0] < 0.1 else None  # as the report calls it (report/build.py)
+w, c = time.perf_counter(), time.process_time()
+for k in range(log.data.shape[1]):
+    x = np.ascontiguousarray(log.data[:, k])
+    allanite.refine(x, 100.0, unit="deg/s", tau_range=None if t0 is None else (t0, None))
+print(json.dumps([time.perf_counter() - w, time.process_time() - c]))
+"""
 
-    plain = run_timed(_report_cmd(data, tmp / "rep_plain", REPORT_ARGS), _env(REPO / "python"), 900)
-    with_refine = run_timed(
-        _report_cmd(data, tmp / "rep_refine", REPORT_ARGS + ["--refine"]), _env(REPO / "python"), 1800
+
+def _refine_calls(data: Path) -> tuple[float, float]:
+    p = subprocess.run(
+        [sys.executable, "-c", _REFINE_CALLS, str(data)],
+        env=_env(REPO / "python"),
+        capture_output=True,
+        text=True,
+        timeout=1800,
+        check=True,
     )
-    log = allanite.read_log(data, fs=100, columns=["gyro_x", "gyro_y", "gyro_z"], unit="deg/s")
-    static_tau0 = allanite.avar(log.data, 100.0).tau[0]
-    t0 = 0.1 if static_tau0 < 0.1 else None  # as the report calls it (report/build.py)
-    wall, cpu, _ = cpu_timed(
-        lambda: [
-            allanite.refine(
-                np.ascontiguousarray(log.data[:, k]), 100.0, unit="deg/s", tau_range=None if t0 is None else (t0, None)
-            )
-            for k in range(log.data.shape[1])
-        ],
-        1,
-    )
+    wall, cpu = json.loads(p.stdout.strip().splitlines()[-1])
+    return wall, cpu
+
+
+def row_refine(data: Path, cfg: dict, tmp: Path) -> dict:
+    """The report with ``--refine`` against the refine calls it makes (:data:`_REFINE_CALLS`, a fresh process)
+    and the plain report: ``cfg["refine_repeats"]`` rounds of the three, medians of each and of each round's
+    differences."""
+    import statistics
+
+    runs = []
+    for i in range(cfg["refine_repeats"]):
+        plain = run_timed(_report_cmd(data, tmp / f"rep_plain_{i}", REPORT_ARGS), _env(REPO / "python"), 900)
+        with_refine = run_timed(
+            _report_cmd(data, tmp / f"rep_refine_{i}", REPORT_ARGS + ["--refine"]), _env(REPO / "python"), 1800
+        )
+        wall, cpu = _refine_calls(data)
+        runs.append({"plain": plain, "refine": with_refine, "calls_wall_s": wall, "calls_cpu_s": cpu})
+    med = statistics.median
+    keys = ("wall_s", "cpu_s", "peak_rss_mb")
     return {
-        "plain": {k: plain[k] for k in ("wall_s", "cpu_s", "peak_rss_mb", "status")},
-        "refine": {k: with_refine[k] for k in ("wall_s", "cpu_s", "peak_rss_mb", "status")},
-        "refine_calls_wall_s": wall,
-        "refine_calls_cpu_s": cpu,
-        "beyond_refine_wall_s": with_refine["wall_s"] - wall,
-        "beyond_refine_cpu_s": with_refine["cpu_s"] - cpu,
+        "repeats": len(runs),
+        "plain": {k: med(r["plain"][k] for r in runs) for k in keys} | {"status": runs[-1]["plain"]["status"]},
+        "refine": {k: med(r["refine"][k] for r in runs) for k in keys} | {"status": runs[-1]["refine"]["status"]},
+        "refine_calls_wall_s": med(r["calls_wall_s"] for r in runs),
+        "refine_calls_cpu_s": med(r["calls_cpu_s"] for r in runs),
+        "beyond_refine_wall_s": med(r["refine"]["wall_s"] - r["calls_wall_s"] for r in runs),
+        "beyond_refine_cpu_s": med(r["refine"]["cpu_s"] - r["calls_cpu_s"] for r in runs),
+        # each round's report with --refine less its refine calls and its plain report
+        "beyond_both_cpu_runs_s": [r["refine"]["cpu_s"] - r["calls_cpu_s"] - r["plain"]["cpu_s"] for r in runs],
+        "beyond_both_wall_runs_s": [r["refine"]["wall_s"] - r["calls_wall_s"] - r["plain"]["wall_s"] for r in runs],
     }
 
 
@@ -493,6 +524,22 @@ def load_note() -> dict:
     return {"loadavg": Path("/proc/loadavg").read_text().split()[:3], "cpu_busy": _common.cpu_busy_fraction()}
 
 
+def _beyond_both(rf: dict) -> str:
+    """The refine row's cost beyond the refine calls and the plain report: the median of each round's (and the
+    rounds) where the row has rounds, else the difference of its single run."""
+    import statistics
+
+    if "beyond_both_cpu_runs_s" not in rf:  # a row recorded before the rounds
+        wall = rf["beyond_refine_wall_s"] - rf["plain"]["wall_s"]
+        return f"{wall:.2f} s (CPU {rf['beyond_refine_cpu_s'] - rf['plain']['cpu_s']:.2f} s)"
+    cpu, wall = rf["beyond_both_cpu_runs_s"], rf["beyond_both_wall_runs_s"]
+    runs = ", ".join(f"{c:.2f}" for c in cpu)
+    return (
+        f"median of {len(cpu)} rounds {statistics.median(wall):.2f} s (CPU {statistics.median(cpu):.2f} s; "
+        f"each round's CPU: {runs} s)"
+    )
+
+
 def write_md(res: dict, path: Path) -> None:
     r, L = res["rows"], []
     L.append("# Pipeline benchmark (issue 30): the report and the per-window fits at engine speed\n")
@@ -571,8 +618,7 @@ def write_md(res: dict, path: Path) -> None:
             f"| ADIS report `--refine` (fresh process) | without: {rf['plain']['wall_s']:.2f} s (CPU "
             f"{rf['plain']['cpu_s']:.2f} s) | {rf['refine']['wall_s']:.2f} s (CPU {rf['refine']['cpu_s']:.2f} s) | "
             f"beyond the refine calls: {rf['beyond_refine_wall_s']:.2f} s (CPU {rf['beyond_refine_cpu_s']:.2f} s); "
-            f"beyond them and the plain report: {rf['beyond_refine_wall_s'] - rf['plain']['wall_s']:.2f} s (CPU "
-            f"{rf['beyond_refine_cpu_s'] - rf['plain']['cpu_s']:.2f} s) | "
+            f"beyond them and the plain report: {_beyond_both(rf)} | "
             f"the refine calls alone {rf['refine_calls_wall_s']:.2f} s (CPU {rf['refine_calls_cpu_s']:.2f} s) |"
         )
     sc = r.get("scale")

@@ -42,6 +42,33 @@ def test_a_figure_failing_in_the_child_fails_in_the_parent():
         render_pngs(specs, 60, lambda text: None, processes=2)
 
 
+def test_figures_are_drawn_with_fewer_collections_and_the_thresholds_come_back():
+    import gc
+
+    from allanite.report import rendering
+
+    old = gc.get_threshold()
+    seen = []
+
+    def draw(fig):
+        seen.append(gc.get_threshold())
+        fig.add_subplot().plot([0, 1])
+
+    try:
+        gc.set_threshold(700, 10, 10)
+        got = render_pngs([("g.png", "g", "c", (1.0, 1.0), draw)], 40, lambda text: None, processes=1)
+        assert seen == [(rendering.GC_THRESHOLD, 10, 10)]  # the older generations keep their ratios
+        assert gc.get_threshold() == (700, 10, 10)
+        assert got["g.png"].startswith(b"\x89PNG")
+        gc.set_threshold(50_000, 10, 10)  # a higher threshold set by the user is kept
+        with pytest.raises(ValueError, match="boom"), rendering.fewer_collections():
+            assert gc.get_threshold() == (50_000, 10, 10)
+            raise ValueError("boom")
+        assert gc.get_threshold() == (50_000, 10, 10)
+    finally:
+        gc.set_threshold(*old)
+
+
 def test_figure_processes_is_one_or_two():
     assert figure_processes() in (1, 2)
 

@@ -20,6 +20,7 @@ process, which draws them itself (an error in a figure is then raised here, with
 
 from __future__ import annotations
 
+import gc
 import os
 import pickle
 import signal
@@ -186,10 +187,12 @@ def _serve(r: int, w: int) -> int:  # pragma: no cover - runs in the forked work
     import select
 
     from .figures import figure_specs, from_analysis_alone
-    from .rendering import png, render_pngs
+    from .rendering import GC_THRESHOLD, png, render_pngs
 
     os.setpgid(0, 0)  # its own group: killed with the drawing process it forks; Ctrl-C reaches the parent only
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # a process of its own that only draws: fewer collections for all its figures (rendering.fewer_collections)
+    gc.set_threshold(max(gc.get_threshold()[0], GC_THRESHOLD), *gc.get_threshold()[1:])
     _warm_up()
     message = _receive(r)
     early: dict = {}  # file name -> (PNG, dpi) drawn from an offered partial report
