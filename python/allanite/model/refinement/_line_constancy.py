@@ -1,6 +1,6 @@
 """A removed line's amplitude along the record: is it the same in every block?
 
-The test behind the planned ``"line"`` check of :mod:`.missing` (not yet registered in ``CHECKS``): the
+The test behind the ``"line"`` check of :mod:`.missing` (:mod:`._line_check`): the
 least-squares phasor of a fixed-frequency line in ``B`` blocks along the record (each ≥ ``MIN_PERIODS``
 periods), compared with their mean by an F test whose noise variance comes from phasors at off-line
 frequencies of the same blocks (the residual's local PSD at f0). The complex phasor, not |A|, is tested, so
@@ -39,12 +39,13 @@ def _phasors(y: np.ndarray, t: np.ndarray, freqs: np.ndarray) -> np.ndarray:
     return a - 1j * b
 
 
-def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float) -> dict | None:
+def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float, phasors: bool = False) -> dict | None:
     """Test that the line at ``f0`` Hz has the same complex amplitude in every block of ``y`` (rate ``fs``).
 
     Returns None where fewer than 4 blocks of ``MIN_PERIODS`` periods fit, else a dict: ``statistic`` (the F
     ratio), ``threshold`` (its 1 − ``alpha`` quantile, F(2(B − 1), 4·OFF_BINS·B)), ``rejected``, ``blocks``,
-    ``edges_s`` (block edges, s), ``amplitude`` (|A| per block) and ``amplitude_mean`` (|mean phasor|).
+    ``edges_s`` (block edges, s), ``amplitude`` (|A| per block) and ``amplitude_mean`` (|mean phasor|); with
+    ``phasors`` also ``"phasors"``, the complex amplitude per block.
 
     Examples
     --------
@@ -79,7 +80,7 @@ def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float) -> dict | 
     num = float(np.sum(np.abs(ph - mean) ** 2 * lengths) / pooled) / (blocks - 1)  # each |c − A|²/v is χ²₂/2
     d2 = 4 * OFF_BINS * blocks
     thr = float(stats.f.ppf(1 - alpha, 2 * (blocks - 1), d2))
-    return {
+    out = {
         "statistic": num,
         "threshold": thr,
         "rejected": bool(num > thr),
@@ -92,3 +93,6 @@ def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float) -> dict | 
         "f0": f0,
         "periods_per_block": float(math.floor(n / blocks * f0 / fs)),
     }
+    if phasors:
+        out["phasors"] = ph.tolist()
+    return out
