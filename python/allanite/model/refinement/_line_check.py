@@ -49,7 +49,9 @@ def _departure_pct(ctx: Any, f0: float, amps: tuple[float, float], shares: tuple
 def line_check(ctx: Any, a: float) -> list[dict]:
     """One entry per accepted ``"sinusoid"`` whose complex amplitude changes along the final samples (each
     tested at ``a`` over the number of lines tested): ``"t"`` the later side of the best split of the block
-    phasors (s), ``"band_hz"`` (f0 ± one block's resolution), ``"amplitudes"`` (|A| of each side, rate unit),
+    phasors (s), ``"band_hz"`` (f0 ± one block's resolution), ``"amplitudes"`` (each side's |A|, rate unit:
+    the root of its blocks' mean |c|² less their noise variance, so that a wandering phase is not read as a
+    smaller amplitude),
     ``"departure_pct"`` as in the module docstring; nothing without an accepted line."""
     if ctx.y is None:
         return []
@@ -63,7 +65,8 @@ def line_check(ctx: Any, a: float) -> list[dict]:
         ph, lengths = np.asarray(r["phasors"]), np.diff(edges)
         k = _split(ph, lengths)
         sides = ((edges[0], edges[k]), (edges[k], edges[-1]))
-        amps = (abs(complex(np.mean(ph[:k]))), abs(complex(np.mean(ph[k:]))))
+        power = np.abs(ph) ** 2 - np.asarray(r["phasor_var"])  # unbiased |A|² per block, whatever its phase
+        amps = (math.sqrt(max(float(np.mean(power[:k])), 0.0)), math.sqrt(max(float(np.mean(power[k:])), 0.0)))
         w = (lengths[:k].sum() / lengths.sum(), lengths[k:].sum() / lengths.sum())
         dep, tau = _departure_pct(ctx, f0, amps, (float(w[0]), float(w[1])))
         if ctx.heldout_pct is not None and not dep > ctx.heldout_pct:

@@ -45,7 +45,8 @@ def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float, phasors: b
     Returns None where fewer than 4 blocks of ``MIN_PERIODS`` periods fit, else a dict: ``statistic`` (the F
     ratio), ``threshold`` (its 1 − ``alpha`` quantile, F(2(B − 1), 4·OFF_BINS·B)), ``rejected``, ``blocks``,
     ``edges_s`` (block edges, s), ``amplitude`` (|A| per block) and ``amplitude_mean`` (|mean phasor|); with
-    ``phasors`` also ``"phasors"``, the complex amplitude per block.
+    ``phasors`` also ``"phasors"``, the complex amplitude per block, and ``"phasor_var"``, each one's noise
+    variance E|c − A|².
 
     Examples
     --------
@@ -94,5 +95,5 @@ def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float, phasors: b
         "periods_per_block": float(math.floor(n / blocks * f0 / fs)),
     }
     if phasors:
-        out["phasors"] = ph.tolist()
+        out["phasors"], out["phasor_var"] = ph.tolist(), var.tolist()
     return out
