@@ -164,6 +164,8 @@ MODEL_RANKS = {
     "model.refinement.levels": 2,
     "model.refinement._irls": 2,
     "model.refinement._brent": 0,
+    "model.refinement._line_constancy": 0,
+    "model.refinement._line_check": 4,
     "model.refinement.words": 3,
     "model.refinement.curvefit": 3,
     "model.refinement.scoring": 4,

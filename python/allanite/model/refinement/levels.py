@@ -46,7 +46,10 @@ OUTLIER_SHARE = 0.05
 #: coupling to a channel left in the samples, impulsive noise left in them
 #: (:data:`allanite.model.refinement.missing.CHECKS`).
 UNEXPLAINED_SHARES = {
-    "allan": 0.05,
+    # "line" takes 0.0125 of "allan": a line whose amplitude changes shows in the curve's misfit too, but the
+    # dedicated phasor test is far stronger; it spends nothing without an accepted line.
+    "allan": 0.0375,
+    "line": 0.0125,
     "psd": 0.025,
     "time": 0.0125,
     "level": 0.0125,
@@ -55,7 +58,7 @@ UNEXPLAINED_SHARES = {
 }
 #: The checks that need the samples; on curve-only input their shares go to the ``"fit"`` check (the GLS χ²
 #: of the whole curve, two-sided), so that curve-only input spends the same share on ``unexplained``.
-SAMPLE_CHECKS = ("psd", "time", "level", "channels", "outliers")
+SAMPLE_CHECKS = ("psd", "time", "level", "channels", "outliers", "line")
 
 #: Tests with a share of their own, by name (the Allan-curve test, ``"curve"``, takes the rest).
 SHARES = {

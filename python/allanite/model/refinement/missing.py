@@ -53,6 +53,7 @@ from scipy.stats import t as t_dist
 from ...analysis import avar
 from .. import channels, lines, noise_level, outliers, tracing
 from ..terms import design_matrix
+from ._line_check import line_check
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
 from .changes import locate
@@ -506,6 +507,7 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "psd": _lines,
     "time": _drift,
     "level": _level,
+    "line": line_check,
     "channels": _channels,
     "outliers": _outliers,
 }
