@@ -385,12 +385,18 @@ NOTES: list = [
     "outlier removal already runs before every curve effect (removals first, outliers first among them).",
     "- *Bias step* (outside the family): nothing added and nothing said — the curve fits (χ²/dof 0.55) and no "
     "check tests the mean along the record (the level check is on the first differences, which a step of the "
-    "mean does not change). Needed: a mean-shift check in `unexplained` (block means under the fitted noise's "
-    "covariance), with its own share of `level`.",
-    "- *Line switched on halfway* (outside the family): refine names a sinusoid at 0.0353 (A/√2, the power "
-    "averaged over the record) and a change of the noise level at 2500 s — the line's power in the first "
-    "differences reads as a level change — and says nothing else. Needed: a check that a removed line's "
-    "amplitude is the same along the record (its least-squares amplitude in blocks at the fixed frequency).",
+    "mean does not change). Still open: a one-step test of 48 block means against a null simulated from the final "
+    "model was built (branch r2step, not merged) and stays silent here, because the final fit has absorbed the "
+    "step into rate random walk (K 2.8e-5 against the true 2e-6), and a null drawn from that model covers the step "
+    "(CUSUM 0.0113 against 0.031); with the located step removed and the terms refitted (K 1.6e-6) the same test "
+    "rejects it (threshold 0.0038–0.0061) and locates it at 11000.1 s (true 11000 s). Needed: the null from a refit "
+    "without the located step, or a mean-step removal among refine's candidates, calibrated on ≥ 300 null records.",
+    "- *Line switched on halfway* (outside the family) — **said since** (r2line): refine still names a sinusoid at "
+    "A/√2 and a change of the noise level at 2500 s, and now `unexplained` says the line's amplitude changes along "
+    "the record (the `\"line\"` check: each accepted sinusoid's complex amplitude in blocks of ≥ 20 periods tested "
+    "for constancy against the off-line noise of the same blocks, at its own share of `level` taken from the Allan "
+    "check's; said only where the change exceeds the held-out error): ≈ 0 deg/s in t 0–2500 s, 0.050 deg/s in "
+    "t 2500–5000 s. The model is not right, but it no longer reads as complete.",
 ]
 
 
