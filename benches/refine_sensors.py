@@ -166,6 +166,7 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     chosen = [c for c in sensors.CASES if (not args.ci or c.ci) and (args.case is None or args.case in c.name)]
     out = Path(args.out) if args.out else (Path(tempfile.mkdtemp()) if args.ci or args.case else HERE / "results")
+    out.mkdir(parents=True, exist_ok=True)
     results = []
     with _common.OtherLoad() as load:
         for case in chosen:
