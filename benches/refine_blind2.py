@@ -353,7 +353,7 @@ NOTES: list = [
     "halfway (a sinusoid at 0.0353 = A/√2 plus a change point of the noise level at 2500 s, nothing unexplained). "
     "The chirp passed (three sinusoids and two change points, the curve's misfit at 2.0–2.6 Hz said).",
     "",
-    "**Changed since** (the table is the rerun after it, at 915142b; the first run's table and JSON are in commit 8a4201a): the channel regression's held-out test "
+    "**Changed since** (the first run's table and JSON are in commit 8a4201a, the rerun after this change at 915142b; the table above is the latest rerun, its commit in the header): the channel regression's held-out test "
     "across frequency (`channels.heldout_ratio`) now splits where the channel's information is shared more "
     "evenly — the even/odd DFT bins as before, or the record's two halves in time. A temperature cycling a whole "
     "number of times puts its power in one DFT bin, so on one side of the even/odd split: in the two-channel MEMS "
