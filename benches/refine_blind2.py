@@ -393,7 +393,7 @@ NOTES: list = [
     "without the located step, or a mean-step removal among refine's candidates, calibrated on ≥ 300 null records.",
     "- *Line switched on halfway* (outside the family) — **said since** (r2line): refine still names a sinusoid at "
     "A/√2 and a change of the noise level at 2500 s, and now `unexplained` says the line's amplitude changes along "
-    "the record (the `\"line\"` check: each accepted sinusoid's complex amplitude in blocks of ≥ 20 periods tested "
+    'the record (the `"line"` check: each accepted sinusoid\'s complex amplitude in blocks of ≥ 20 periods tested '
     "for constancy against the off-line noise of the same blocks, at its own share of `level` taken from the Allan "
     "check's; said only where the change exceeds the held-out error): ≈ 0 deg/s in t 0–2500 s, 0.050 deg/s in "
     "t 2500–5000 s. The model is not right, but it no longer reads as complete.",
