@@ -365,8 +365,11 @@ def _off_neighbours(d: np.ndarray, cut_d: np.ndarray) -> tuple[np.ndarray, set]:
     big = np.abs(d) > cut_d
     flags = np.zeros(n, dtype=bool)
     shortest = np.zeros(n, dtype=np.int8)  # the shortest run length that flagged each sample
+    # a run starts only after a difference beyond the cut: its first samples t are taken from those alone (the
+    # same runs as every t in 1 … n − run − 1, without passes over the whole record per run length)
+    after_big = np.flatnonzero(big) + 1
     for run in range(1, MAX_RUN + 1):
-        t = np.arange(1, n - run)  # the run's first sample; d[t − 1] into it, d[t + run − 1] out of it
+        t = after_big[after_big < n - run]  # the run's first sample; d[t − 1] into it, d[t + run − 1] out of it
         if t.size == 0:
             break
         d_in, d_out, c = d[t - 1], d[t + run - 1], cut_d[t - 1]
