@@ -32,3 +32,20 @@ def test_constant_line_not_flagged() -> None:
 
 def test_too_short_is_none() -> None:
     assert line_constancy(np.zeros(1000), FS, 4.3, 0.05) is None
+
+
+def test_block_phasors_equal_the_direct_least_squares_at_global_time():
+    # each block's phasor is fitted on one basis per block length in block-local time, then rotated by its start
+    # time: the same complex amplitude as the least squares on the block's own absolute times
+    from allanite.model.refinement._line_constancy import _phasors
+
+    rng = np.random.default_rng(3)
+    for fs, n, f0 in ((100.0, 123_457, 0.55), (200.0, 200_001, 4.3), (1000.0, 300_000, 47.5)):
+        t = np.arange(n) / fs
+        y = rng.standard_normal(n) + 0.3 * np.sin(2 * np.pi * f0 * t + 1) * (t > 0.6 * t[-1])
+        r = line_constancy(y, fs, f0, 0.01, phasors=True)
+        edges = np.round(np.asarray(r["edges_s"]) * fs).astype(int)
+        for b in range(r["blocks"]):
+            yb = y[edges[b] : edges[b + 1]]
+            direct = _phasors(yb, np.arange(edges[b], edges[b + 1]) / fs, np.array([f0]))[0]
+            assert abs(r["phasors"][b] - direct) <= 1e-8 * abs(direct)

@@ -39,6 +39,27 @@ def _phasors(y: np.ndarray, t: np.ndarray, freqs: np.ndarray) -> np.ndarray:
     return a - 1j * b
 
 
+def _basis(t: np.ndarray, freqs: np.ndarray) -> tuple:
+    """The mean-removed cosines and sines of :func:`_phasors` at block-local times ``t``, with their Gram terms."""
+    w = 2.0 * np.pi * freqs[:, None] * t[None, :]
+    c, s = np.cos(w), np.sin(w)
+    c -= c.mean(axis=1, keepdims=True)
+    s -= s.mean(axis=1, keepdims=True)
+    cc, ss, cs = np.sum(c * c, 1), np.sum(s * s, 1), np.sum(c * s, 1)
+    return c, s, cc, ss, cs, cc * ss - cs**2
+
+
+def _local_phasors(y: np.ndarray, basis: tuple) -> np.ndarray:
+    """:func:`_phasors` of ``y`` on a :func:`_basis` in block-local time; a block starting at t₀ has its
+    phasors times e^{−2πi·f·t₀} (a cos + b sin of f(t₀ + τ) is the same line; the fit's span does not change)."""
+    c, s, cc, ss, cs, det = basis
+    yc = y - y.mean()
+    yc_c, yc_s = c @ yc, s @ yc
+    a = (ss * yc_c - cs * yc_s) / det
+    b = (cc * yc_s - cs * yc_c) / det
+    return a - 1j * b
+
+
 def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float, phasors: bool = False) -> dict | None:
     """Test that the line at ``f0`` Hz has the same complex amplitude in every block of ``y`` (rate ``fs``).
 
@@ -65,13 +86,17 @@ def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float, phasors: b
     edges = np.linspace(0, n, blocks + 1).astype(int)
     k = np.arange(2, OFF_BINS + 2, dtype=float)
     ph, noise = np.empty(blocks, complex), np.empty(blocks)
+    bases: dict[int, tuple] = {}  # the blocks have at most two lengths: one basis each
     for b in range(blocks):
         yb = np.asarray(y[edges[b] : edges[b + 1]], dtype=float)
-        tb = np.arange(yb.size) / fs
-        df = fs / yb.size
-        off = np.concatenate([f0 - k * df, f0 + k * df])
-        off = off[(off > 0) & (off < fs / 2)]
-        z = _phasors(yb, tb + edges[b] / fs, np.concatenate([[f0], off]))
+        if yb.size not in bases:
+            df = fs / yb.size
+            off = np.concatenate([f0 - k * df, f0 + k * df])
+            off = off[(off > 0) & (off < fs / 2)]
+            freqs = np.concatenate([[f0], off])
+            bases[yb.size] = (freqs, _basis(np.arange(yb.size) / fs, freqs))
+        freqs, basis = bases[yb.size]
+        z = _local_phasors(yb, basis) * np.exp(-2j * np.pi * freqs * (edges[b] / fs))
         ph[b] = z[0]
         noise[b] = float(np.mean(np.abs(z[1:]) ** 2)) * yb.size  # |A|² var × block length: per-sample scale
     lengths = np.diff(edges).astype(float)
