@@ -25,18 +25,9 @@ OFF_BINS = 4
 
 
 def _phasors(y: np.ndarray, t: np.ndarray, freqs: np.ndarray) -> np.ndarray:
-    """Least-squares complex amplitudes (a·cos + b·sin → a − ib) of ``y`` at each of ``freqs``, mean removed."""
-    yc = y - y.mean()
-    w = 2.0 * np.pi * freqs[:, None] * t[None, :]
-    c, s = np.cos(w), np.sin(w)
-    c -= c.mean(axis=1, keepdims=True)
-    s -= s.mean(axis=1, keepdims=True)
-    cc, ss, cs = np.sum(c * c, 1), np.sum(s * s, 1), np.sum(c * s, 1)
-    yc_c, yc_s = c @ yc, s @ yc
-    det = cc * ss - cs**2
-    a = (ss * yc_c - cs * yc_s) / det
-    b = (cc * yc_s - cs * yc_c) / det
-    return a - 1j * b
+    """Least-squares complex amplitudes (a·cos + b·sin → a − ib) of ``y`` at each of ``freqs``, mean removed, at
+    the times ``t`` themselves (the reference the block-local fits of :func:`line_constancy` are checked against)."""
+    return _local_phasors(y, _basis(t, freqs))
 
 
 def _basis(t: np.ndarray, freqs: np.ndarray) -> tuple:
