@@ -49,6 +49,20 @@ def fit_windows(
     """The noise fit of every window (rows of ``avar``): (windows, terms + terms² + 3) — θ, covariance,
     χ², iterations, status (0 fitted; else refit the window in Python)."""
 
+def irls_curves(
+    design: npt.NDArray[np.float64],
+    nu_cols: npt.NDArray[np.float64],
+    y: npt.NDArray[np.float64],
+    nu0: npt.NDArray[np.float64],
+    fixed: npt.NDArray[np.float64],
+    max_iter: int,
+    floor: float,
+    rtol: float,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """refine's reweighted NNLS of the curve y (n τ) on every design (designs, n, k) with the EDF columns
+    nu_cols, ν from nu0; fixed[k] a held coefficient or NaN: (θ (designs, k), ν (designs, n)). ValueError
+    for a non-finite weighted problem, RuntimeError when the NNLS does not settle (as scipy's nnls)."""
+
 def davar_part(
     columns: Sequence[npt.NDArray[np.float64]],
     window: int,

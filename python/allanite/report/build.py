@@ -153,12 +153,7 @@ def build_report(
         :class:`~allanite.errors.MemoryBudgetError` before any heavy work, with a hop that fits.
     """
     notes = list(notes)
-    frame_s, fc_split = check_forecast_options(frames, forecast)
-    x = np.asarray(x) if not isinstance(x, np.ndarray) else x
-    plan = None
-    if frame_s is not None or fc_split is not None:
-        # before anything is computed: a frame or split that does not fit the record is the caller's option
-        plan = plan_forecast(int(x.shape[0]), float(fs), frame_s, fc_split)
+    x, plan = _record_and_plan(x, fs, frames, forecast)
     candidates = _refine_candidates(refine)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
     x, unit_name, axis_names = _axes_and_unit(x, unit, input, axis_names, notes)
@@ -210,6 +205,17 @@ def build_report(
         series_error=series_error,
         created=created,
     )
+
+
+def _record_and_plan(x, fs, frames, forecast):
+    """The samples as an array and the time-frame forecast's plan (None without frames or a split): the
+    options checked first, the plan made before anything is computed — a frame or split that does not fit
+    the record is the caller's option."""
+    frame_s, fc_split = check_forecast_options(frames, forecast)
+    x = np.asarray(x) if not isinstance(x, np.ndarray) else x
+    if frame_s is None and fc_split is None:
+        return x, None
+    return x, plan_forecast(int(x.shape[0]), float(fs), frame_s, fc_split)
 
 
 def _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete: bool) -> None:

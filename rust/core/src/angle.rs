@@ -59,6 +59,9 @@ pub struct AngleChunk<'a> {
 /// multiples of m among them).
 pub type PlanItem = (usize, usize, usize);
 
+/// A plan item as the sums read it: (m, first term, one past the last term, step, terms).
+type Item = (usize, usize, usize, usize, usize);
+
 /// For every plan item and axis, Σ (X[i+2m] − 2X[i+m] + X[i])² in quanta² over the item's terms, X the
 /// exact angle of the chunks (see the module notes): [item][axis]. `chunks` in record order; those that
 /// follow each other form runs, and each of a term range's three slices must lie in one run.
@@ -70,6 +73,44 @@ pub fn angle_term_sums_cancellable(
     classic: bool,
     cancel: &Cancel,
 ) -> Result<Vec<f64>> {
+    check_chunks(chunks, n_axes, q_exp)?;
+    let groups = runs_of(chunks, n_axes);
+    let items = plan_items(plan, classic)?;
+    let needed = needed_lengths(&groups, &items, n_axes);
+    #[cfg(target_arch = "x86_64")]
+    let avx2 = std::arch::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    let avx2 = false;
+    let angle = Angle {
+        groups: &groups,
+        n_axes,
+        q_exp,
+        avx2,
+    };
+    let mut out = vec![0.0f64; plan.len() * n_axes];
+    let busy: Vec<usize> = (0..items.len()).filter(|&p| items[p].4 > 0).collect();
+    if busy.len() == 1 {
+        // One factor (a long one: its slices lie far apart): stream the three slices, store nothing.
+        let sums = angle.streamed(items[busy[0]], cancel)?;
+        for (axis, s) in sums.into_iter().enumerate() {
+            out[busy[0] * n_axes + axis] = s?;
+        }
+        cancel.check()?;
+        return Ok(out);
+    }
+    for axis in 0..n_axes {
+        cancel.check()?;
+        let sums = angle.stored(axis, &needed, &items, cancel)?;
+        for (p, s) in sums.into_iter().enumerate() {
+            out[p * n_axes + axis] = s?;
+        }
+    }
+    cancel.check()?;
+    Ok(out)
+}
+
+/// The chunks' shapes, values and order and the quantum's exponent, checked before any work.
+fn check_chunks(chunks: &[AngleChunk], n_axes: usize, q_exp: i32) -> Result<()> {
     if n_axes == 0 || chunks.is_empty() {
         return Err(CoreError::InvalidParameter(
             "no chunks or no axes given".into(),
@@ -103,7 +144,11 @@ pub fn angle_term_sums_cancellable(
             )));
         }
     }
-    // runs of consecutive chunks
+    Ok(())
+}
+
+/// The runs of consecutive chunks.
+fn runs_of<'c, 'a>(chunks: &'c [AngleChunk<'a>], n_axes: usize) -> Vec<&'c [AngleChunk<'a>]> {
     let mut groups: Vec<&[AngleChunk]> = Vec::new();
     let mut g0 = 0;
     for j in 1..=chunks.len() {
@@ -113,7 +158,11 @@ pub fn angle_term_sums_cancellable(
             g0 = j;
         }
     }
-    // every item's terms and slices, checked before any work
+    groups
+}
+
+/// Every item's terms and slices, checked before any work.
+fn plan_items(plan: &[PlanItem], classic: bool) -> Result<Vec<Item>> {
     let mut items = Vec::with_capacity(plan.len());
     for &(m, i0, i1) in plan {
         if m == 0 {
@@ -127,9 +176,13 @@ pub fn angle_term_sums_cancellable(
         let last = i0 + count.saturating_sub(1) * step + 1; // one past the item's last term
         items.push((m, i0, last, step, count));
     }
-    // samples of each run that some slice reaches (its angle points up to that one)
+    Ok(items)
+}
+
+/// Samples of each run that some slice reaches (its angle points up to that one).
+fn needed_lengths(groups: &[&[AngleChunk]], items: &[Item], n_axes: usize) -> Vec<usize> {
     let mut needed = vec![0usize; groups.len()];
-    for &(m, i0, last, _step, count) in &items {
+    for &(m, i0, last, _step, count) in items {
         if count == 0 {
             continue;
         }
@@ -144,15 +197,22 @@ pub fn angle_term_sums_cancellable(
             }
         }
     }
-    #[cfg(target_arch = "x86_64")]
-    let avx2 = std::arch::is_x86_feature_detected!("avx2");
-    #[cfg(not(target_arch = "x86_64"))]
-    let avx2 = false;
-    let mut out = vec![0.0f64; plan.len() * n_axes];
-    let busy: Vec<usize> = (0..items.len()).filter(|&p| items[p].4 > 0).collect();
-    if busy.len() == 1 {
-        // One factor (a long one: its slices lie far apart): stream the three slices, store nothing.
-        let (m, i0, last, step, count) = items[busy[0]];
+    needed
+}
+
+/// The runs of chunks and how their angle is read.
+struct Angle<'g, 'c, 'a> {
+    groups: &'g [&'c [AngleChunk<'a>]],
+    n_axes: usize,
+    q_exp: i32,
+    avx2: bool,
+}
+
+impl Angle<'_, '_, '_> {
+    /// The sums of one item, the three slices streamed from the chunks and nothing stored: one per axis.
+    fn streamed(&self, item: Item, cancel: &Cancel) -> Result<Vec<Result<f64>>> {
+        let (m, i0, last, step, count) = item;
+        let (groups, n_axes, q_exp, avx2) = (self.groups, self.n_axes, self.q_exp, self.avx2);
         let mut at = [(0usize, 0usize); 3]; // (group, first point's offset in it)
         for (j, s) in [0, m, 2 * m].into_iter().enumerate() {
             let (lo, hi) = (i0 + s, last + s);
@@ -170,7 +230,7 @@ pub fn angle_term_sums_cancellable(
                     ))
                 })?;
         }
-        let sums: Vec<Result<f64>> = (0..n_axes)
+        Ok((0..n_axes)
             .into_par_iter()
             .map(|axis| {
                 if cancel.is_cancelled() {
@@ -179,21 +239,26 @@ pub fn angle_term_sums_cancellable(
                 let mut cur = at.map(|(g, _)| Cursor::new(groups[g], axis, n_axes, q_exp));
                 stream_sum(avx2, &mut cur, at.map(|(_, o)| o), count, step)
             })
-            .collect();
-        for (axis, s) in sums.into_iter().enumerate() {
-            out[busy[0] * n_axes + axis] = s?;
-        }
-        cancel.check()?;
-        return Ok(out);
+            .collect())
     }
-    for axis in 0..n_axes {
-        cancel.check()?;
-        let runs: Vec<Run> = groups
+
+    /// Every item's sum on one axis from the runs' angles, stored as far as some slice reaches
+    /// (`needed`).
+    fn stored(
+        &self,
+        axis: usize,
+        needed: &[usize],
+        items: &[Item],
+        cancel: &Cancel,
+    ) -> Result<Vec<Result<f64>>> {
+        let (n_axes, q_exp, avx2) = (self.n_axes, self.q_exp, self.avx2);
+        let runs: Vec<Run> = self
+            .groups
             .par_iter()
-            .zip(&needed)
+            .zip(needed)
             .map(|(g, &len)| build_run(g, axis, n_axes, q_exp, len))
             .collect::<Result<_>>()?;
-        let sums: Vec<Result<f64>> = items
+        Ok(items
             .par_iter()
             .map(|&(m, i0, last, step, count)| {
                 if count == 0 || cancel.is_cancelled() {
@@ -217,11 +282,6 @@ pub fn angle_term_sums_cancellable(
                     step,
                 ))
             })
-            .collect();
-        for (p, s) in sums.into_iter().enumerate() {
-            out[p * n_axes + axis] = s?;
-        }
+            .collect())
     }
-    cancel.check()?;
-    Ok(out)
 }

@@ -250,21 +250,85 @@ fn hann_row(
         return;
     }
     phase_table(mt, cos_t, sin_t);
-    let ratio = fallback_ratio(mt);
-    let period = mt + 1;
     suf.clear();
     suf.resize(mt, [0.0; 3]);
     pre.clear();
     pre.resize(mt + 1, [0.0; 3]);
-    let mut base = 0usize; // term index of terms[0]: always a multiple of M
-    let mut next = 0usize; // next window to emit
-    let mut received = 0usize;
-    // Emits every window that starts in the block [base, base + M): needs terms up to base + 2M − 1
-    // (or the end of the record).
-    let mut emit_block = |terms: &[f64], base: usize, next: &mut usize, out: &mut [f64]| {
-        let first = *next;
+    let mut em = HannEmitter {
+        mt,
+        hop,
+        ratio: fallback_ratio(mt),
+        sw,
+        cos_t,
+        sin_t,
+        suf,
+        pre,
+        w,
+        prod,
+        next: 0,
+    };
+    em.run(terms, (y, mu, m), (k_end, scale), cancel, out);
+}
+
+/// The windows of a [`hann_row`] of M = `mt` terms per window, emitted block by block.
+struct HannEmitter<'s> {
+    mt: usize,
+    hop: usize,
+    /// Below `ratio` × the window's plain sum, the window is recomputed directly.
+    ratio: f64,
+    /// The Hann weights' sum.
+    sw: f64,
+    cos_t: &'s [f64],
+    sin_t: &'s [f64],
+    suf: &'s mut [[f64; 3]],
+    pre: &'s mut [[f64; 3]],
+    w: &'s mut Vec<f64>,
+    prod: &'s mut Vec<f64>,
+    /// The next window to emit.
+    next: usize,
+}
+
+impl HannEmitter<'_> {
+    /// Every window of the row: the record's (y, mu, m) `k_end` terms (times `scale`) streamed through
+    /// `terms`, each block's windows emitted once the next block is in.
+    fn run(
+        &mut self,
+        terms: &mut Vec<f64>,
+        (y, mu, m): (&[f64], f64, usize),
+        (k_end, scale): (usize, f64),
+        cancel: &Cancel,
+        out: &mut [f64],
+    ) {
+        let mt = self.mt;
+        let mut base = 0usize; // term index of terms[0]: always a multiple of M
+        let mut received = 0usize;
+        for_each_term_chunk(y, mu, m, k_end, scale, cancel, |chunk| {
+            terms.extend_from_slice(chunk);
+            received += chunk.len();
+            while terms.len() >= 2 * mt {
+                self.emit(terms, base, out);
+                terms.drain(..mt);
+                base += mt;
+            }
+        });
+        if cancel.is_cancelled() {
+            return;
+        }
+        debug_assert_eq!(received, k_end);
+        while self.next < out.len() {
+            self.emit(terms, base, out);
+            let cut = mt.min(terms.len());
+            terms.drain(..cut);
+            base += mt;
+        }
+    }
+
+    /// Emits every window that starts in the block [base, base + M) (`terms[0]` is term `base`): needs
+    /// terms up to base + 2M − 1 (or the end of the record).
+    fn emit(&mut self, terms: &[f64], base: usize, out: &mut [f64]) {
+        let (first, hop) = (self.next, self.hop);
         let mut last = first;
-        while last < n_win && last * hop < base + mt {
+        while last < out.len() && last * hop < base + self.mt {
             last += 1;
         }
         if last == first {
@@ -273,100 +337,106 @@ fn hann_row(
         let r_min = first * hop - base;
         let r_max = (last - 1) * hop - base;
         if hop < SEGMENT_HOP {
-            // Suffix sums of block b from r (terms [base + r, base + M)), for r ≥ r_min.
-            let mut acc = [0.0f64; 3];
-            let mut p = (base + mt - 1) % period;
-            for r in (r_min..mt).rev() {
-                let a = terms[r];
-                acc[0] += a;
-                acc[1] += a * cos_t[p];
-                acc[2] += a * sin_t[p];
-                suf[r] = acc;
-                p = if p == 0 { period - 1 } else { p - 1 };
-            }
-            // Prefix sums of block b + 1 over its first r terms, r ≤ r_max.
-            let mut acc = [0.0f64; 3];
-            let mut p = (base + mt) % period;
-            pre[0] = acc;
-            for r in 0..r_max {
-                let a = terms[mt + r];
-                acc[0] += a;
-                acc[1] += a * cos_t[p];
-                acc[2] += a * sin_t[p];
-                pre[r + 1] = acc;
-                p += 1;
-                if p == period {
-                    p = 0;
-                }
-            }
+            self.dense_sums(terms, base, r_min, r_max);
         } else {
-            // Sparse window starts: sums over the stretches between consecutive starts (independent
-            // accumulators, vectorisable), then cumulated — still only terms inside each window.
-            let seg = |i0: usize, i1: usize| dot3(&terms[i0..i1], base + i0, cos_t, sin_t);
-            let mut acc = seg(r_max, mt);
-            suf[r_max] = acc;
-            let mut r = r_max;
-            while r > r_min {
-                let lo = r - hop;
-                let v = seg(lo, r);
-                for (x, y) in acc.iter_mut().zip(v) {
-                    *x += y;
-                }
-                suf[lo] = acc;
-                r = lo;
-            }
-            let mut acc = seg(mt, mt + r_min);
-            pre[r_min] = acc;
-            let mut r = r_min;
-            while r < r_max {
-                let v = seg(mt + r, mt + r + hop);
-                for (x, y) in acc.iter_mut().zip(v) {
-                    *x += y;
-                }
-                r += hop;
-                pre[r] = acc;
+            self.sparse_sums(terms, base, r_min, r_max);
+        }
+        self.windows(terms, base, first..last, out);
+        self.next = last;
+    }
+
+    /// Suffix sums of the block from r (terms [base + r, base + M)), r ≥ r_min, and prefix sums of the
+    /// next block over its first r terms, r ≤ r_max: every r.
+    fn dense_sums(&mut self, terms: &[f64], base: usize, r_min: usize, r_max: usize) {
+        let (mt, cos_t, sin_t) = (self.mt, self.cos_t, self.sin_t);
+        let period = mt + 1;
+        let mut acc = [0.0f64; 3];
+        let mut p = (base + mt - 1) % period;
+        for r in (r_min..mt).rev() {
+            let a = terms[r];
+            acc[0] += a;
+            acc[1] += a * cos_t[p];
+            acc[2] += a * sin_t[p];
+            self.suf[r] = acc;
+            p = if p == 0 { period - 1 } else { p - 1 };
+        }
+        let mut acc = [0.0f64; 3];
+        let mut p = (base + mt) % period;
+        self.pre[0] = acc;
+        for r in 0..r_max {
+            let a = terms[mt + r];
+            acc[0] += a;
+            acc[1] += a * cos_t[p];
+            acc[2] += a * sin_t[p];
+            self.pre[r + 1] = acc;
+            p += 1;
+            if p == period {
+                p = 0;
             }
         }
-        for (j, o) in out.iter_mut().enumerate().take(last).skip(first) {
-            let s = j * hop;
+    }
+
+    /// [`Self::dense_sums`] at the window starts only (sparse starts): sums over the stretches between
+    /// consecutive starts (independent accumulators, vectorisable), then cumulated — still only terms
+    /// inside each window.
+    fn sparse_sums(&mut self, terms: &[f64], base: usize, r_min: usize, r_max: usize) {
+        let (mt, hop, cos_t, sin_t) = (self.mt, self.hop, self.cos_t, self.sin_t);
+        let seg = |i0: usize, i1: usize| dot3(&terms[i0..i1], base + i0, cos_t, sin_t);
+        let mut acc = seg(r_max, mt);
+        self.suf[r_max] = acc;
+        let mut r = r_max;
+        while r > r_min {
+            let lo = r - hop;
+            let v = seg(lo, r);
+            for (x, y) in acc.iter_mut().zip(v) {
+                *x += y;
+            }
+            self.suf[lo] = acc;
+            r = lo;
+        }
+        let mut acc = seg(mt, mt + r_min);
+        self.pre[r_min] = acc;
+        let mut r = r_min;
+        while r < r_max {
+            let v = seg(mt + r, mt + r + hop);
+            for (x, y) in acc.iter_mut().zip(v) {
+                *x += y;
+            }
+            r += hop;
+            self.pre[r] = acc;
+        }
+    }
+
+    /// The windows `range` from the suffix and prefix sums of their two blocks.
+    fn windows(
+        &mut self,
+        terms: &[f64],
+        base: usize,
+        range: std::ops::Range<usize>,
+        out: &mut [f64],
+    ) {
+        let (mt, cos_t, sin_t) = (self.mt, self.cos_t, self.sin_t);
+        let period = mt + 1;
+        for (j, o) in out.iter_mut().enumerate().take(range.end).skip(range.start) {
+            let s = j * self.hop;
             let r = s - base;
-            let (sf, pr) = (suf[r], pre[r]);
+            let (sf, pr) = (self.suf[r], self.pre[r]);
             let s0 = sf[0] + pr[0];
             let (re, im) = (sf[1] + pr[1], sf[2] + pr[2]);
             // e^{iθ(1 − s)}: index (1 − s) mod (M + 1).
             let q = (period + 1 - s % period) % period;
             let v = 0.5 * s0 - 0.5 * (cos_t[q] * re - sin_t[q] * im);
-            let v = if v < ratio * s0 {
+            let v = if v < self.ratio * s0 {
                 // Terms piled up at the window's edges: the difference lost digits; recompute.
-                if w.is_empty() {
-                    *w = hann_weights(mt);
+                if self.w.is_empty() {
+                    *self.w = hann_weights(mt);
                 }
-                weighted_direct(&terms[r..r + mt], w, prod)
+                weighted_direct(&terms[r..r + mt], self.w, self.prod)
             } else {
                 v
             };
-            *o = v / sw;
+            *o = v / self.sw;
         }
-        *next = last;
-    };
-    for_each_term_chunk(y, mu, m, k_end, scale, cancel, |chunk| {
-        terms.extend_from_slice(chunk);
-        received += chunk.len();
-        while terms.len() >= 2 * mt {
-            emit_block(terms, base, &mut next, out);
-            terms.drain(..mt);
-            base += mt;
-        }
-    });
-    if cancel.is_cancelled() {
-        return;
-    }
-    debug_assert_eq!(received, k_end);
-    while next < n_win {
-        emit_block(terms, base, &mut next, out);
-        let cut = mt.min(terms.len());
-        terms.drain(..cut);
-        base += mt;
     }
 }
 
@@ -452,128 +522,4 @@ pub fn static_hann(columns: &[&[f64]], ms: &[usize]) -> Result<Vec<f64>> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A small deterministic generator (xorshift), uniform in [−1, 1).
-    fn noise(n: usize, seed: u64) -> Vec<f64> {
-        let mut s = seed.max(1);
-        (0..n)
-            .map(|_| {
-                s ^= s << 13;
-                s ^= s >> 7;
-                s ^= s << 17;
-                (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-            })
-            .collect()
-    }
-
-    fn run(y: &[f64], window: usize, hop: usize, ms: &[usize], method: Method) -> Vec<f64> {
-        let cols = [y];
-        let req = Request {
-            columns: &cols,
-            window,
-            hop,
-            ms,
-            estimator: Estimator::Overlapping,
-            method,
-        };
-        dynamic_hann(&req).unwrap().0
-    }
-
-    #[test]
-    fn weights_sum_as_stated() {
-        for mt in [3, 4, 17, 400, 1001] {
-            let w = hann_weights(mt);
-            let s: f64 = w.iter().sum();
-            let s2: f64 = w.iter().map(|v| v * v).sum();
-            assert!((s - weight_sum(mt)).abs() < 1e-12 * s);
-            assert!((s2 - 3.0 * (mt + 1) as f64 / 8.0).abs() < 1e-12 * s2);
-        }
-    }
-
-    #[test]
-    fn fast_matches_naive() {
-        let mut y = noise(3000, 7);
-        for v in y[1500..].iter_mut() {
-            *v *= 1e3;
-        }
-        for (window, hop) in [
-            (40, 1),
-            (41, 3),
-            (401, 1),
-            (401, 7),
-            (401, 8),
-            (401, 33),
-            (401, 450),
-            (1000, 999),
-        ] {
-            let ms: Vec<usize> = [1, 2, 5, 9, 20, 100, 190]
-                .into_iter()
-                .filter(|&m| window + 1 >= 2 * m + MIN_TERMS)
-                .collect();
-            let f = run(&y, window, hop, &ms, Method::Fast);
-            let n = run(&y, window, hop, &ms, Method::Naive);
-            for (a, b) in f.iter().zip(&n) {
-                assert!(
-                    (a - b).abs() <= 1e-10 * b.abs(),
-                    "{window} {hop}: {a} vs {b}"
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn one_window_matches_sliding() {
-        let y = noise(2001, 3);
-        let ms = [1, 3, 50, 700];
-        let one = run(&y, 2001, 1, &ms, Method::Fast);
-        let two = run(&y[..2001], 2000, 1, &ms, Method::Fast);
-        let naive = run(&y, 2001, 1, &ms, Method::Naive);
-        for (a, b) in one.iter().zip(&naive) {
-            assert!((a - b).abs() <= 1e-12 * b, "{a} vs {b}");
-        }
-        assert_eq!(two.len(), 2 * ms.len());
-    }
-
-    #[test]
-    fn too_few_terms_is_an_error() {
-        let y = noise(100, 1);
-        let cols = [&y[..]];
-        let req = Request::overlapping(&cols, 10, 1, &[4]);
-        assert!(dynamic_hann(&req).is_ok()); // M = 3: the fewest allowed
-        let req = Request { ms: &[5], ..req };
-        let e = dynamic_hann(&req).unwrap_err().to_string();
-        assert!(
-            e.contains("M = window + 1 − 2m = 1 at m = 5") && e.contains("m ≤ 4"),
-            "{e}"
-        );
-        let req = Request {
-            ms: &[2],
-            estimator: Estimator::Classic,
-            ..req
-        };
-        assert!(dynamic_hann(&req).is_err());
-    }
-
-    #[test]
-    fn thread_count_does_not_change_bits() {
-        let y = noise(5000, 11);
-        let cols = [&y[..]];
-        let req = Request {
-            columns: &cols,
-            window: 777,
-            hop: 5,
-            ms: &[1, 4, 33, 200],
-            estimator: Estimator::Overlapping,
-            method: Method::Fast,
-        };
-        let one = crate::run_in_pool(1, || dynamic_hann(&req))
-            .unwrap()
-            .unwrap();
-        let two = crate::run_in_pool(2, || dynamic_hann(&req))
-            .unwrap()
-            .unwrap();
-        assert_eq!(one, two);
-    }
-}
+mod tests;

@@ -253,34 +253,7 @@ pub(crate) fn for_each_term_chunk_at(
     let (k_lo, k_hi) = range;
     debug_assert!(off <= k_lo && k_lo < k_hi && k_hi <= k_end && k_hi + 2 * m <= off + y.len() + 1);
     if m <= DIRECT_M {
-        // Short blocks: sum each B(k) directly over its own m samples (exactly local too), in
-        // chunks of k so the per-call bookkeeping of the segment scheme is not paid per sample.
-        let mut bbuf = vec![0.0; DIRECT_CHUNK + m];
-        let mut a = vec![0.0; DIRECT_CHUNK];
-        let mut k0 = k_lo;
-        while k0 < k_hi {
-            if cancel.is_cancelled() {
-                return;
-            }
-            // chunks end at the record's multiples of DIRECT_CHUNK
-            let c = ((k0 / DIRECT_CHUNK + 1) * DIRECT_CHUNK).min(k_hi) - k0;
-            let b = &mut bbuf[..c + m];
-            b.fill(0.0);
-            let i0 = k0 - off;
-            for j in 0..m {
-                let src = &y[i0 + j..i0 + j + c + m];
-                for (bt, v) in b.iter_mut().zip(src) {
-                    *bt += v - mu;
-                }
-            }
-            for (t, at) in a[..c].iter_mut().enumerate() {
-                let d = b[t + m] - b[t];
-                *at = d * d * scale;
-            }
-            f(&a[..c]);
-            k0 += c;
-        }
-        return;
+        return direct_term_chunks((y, off), mu, m, range, scale, cancel, f);
     }
     // The record's segment at p (a multiple of m) is formed with this many block sums.
     let seg_len = |p: usize| {
@@ -320,5 +293,44 @@ pub(crate) fn for_each_term_chunk_at(
         let (a, b) = (k_lo.max(start) - start, k_hi.min(start + len) - start);
         f(&sc.suf[a..b]);
         start += m;
+    }
+}
+
+/// [`for_each_term_chunk_at`] for short blocks (m ≤ `DIRECT_M`; `part`: (y, off) as there): each B(k)
+/// summed directly over its own m samples (exactly local too), in chunks of k so the per-call
+/// bookkeeping of the segment scheme is not paid per sample.
+fn direct_term_chunks(
+    (y, off): (&[f64], usize),
+    mu: f64,
+    m: usize,
+    (k_lo, k_hi): (usize, usize),
+    scale: f64,
+    cancel: &Cancel,
+    mut f: impl FnMut(&[f64]),
+) {
+    let mut bbuf = vec![0.0; DIRECT_CHUNK + m];
+    let mut a = vec![0.0; DIRECT_CHUNK];
+    let mut k0 = k_lo;
+    while k0 < k_hi {
+        if cancel.is_cancelled() {
+            return;
+        }
+        // chunks end at the record's multiples of DIRECT_CHUNK
+        let c = ((k0 / DIRECT_CHUNK + 1) * DIRECT_CHUNK).min(k_hi) - k0;
+        let b = &mut bbuf[..c + m];
+        b.fill(0.0);
+        let i0 = k0 - off;
+        for j in 0..m {
+            let src = &y[i0 + j..i0 + j + c + m];
+            for (bt, v) in b.iter_mut().zip(src) {
+                *bt += v - mu;
+            }
+        }
+        for (t, at) in a[..c].iter_mut().enumerate() {
+            let d = b[t + m] - b[t];
+            *at = d * d * scale;
+        }
+        f(&a[..c]);
+        k0 += c;
     }
 }

@@ -119,52 +119,71 @@ pub fn gap_dynamic(
                 return;
             }
             let ((f, gap), m) = (&prepared[row / n_m], ms[row % n_m]);
-            let (span, scale) = span_scale(kind, m);
-            let l = window + 1 - span; // terms per window
-            let k_end = (n_win - 1) * hop + l; // terms used by some window
-                                               // squares of the complete terms (0 otherwise) and the prefix count of complete terms
-                                               // (the gap count's wrap-around: see `nan_prefix_counts`)
-            let mut t = Vec::with_capacity(k_end);
-            let mut done = vec![0u64; k_end + 1];
-            let mut tb = TermBuf::default();
-            for_each_term_chunk(kind, &f[..k_end + span - 1], m, &mut tb, |k0, c| {
-                for (i, v) in c.iter().enumerate() {
-                    let k = k0 + i;
-                    let ok = gap[k + span] == gap[k];
-                    t.push(if ok { v * v } else { 0.0 });
-                    done[k + 1] = done[k] + ok as u64;
-                }
-            });
-            for (j, o) in dcnt.iter_mut().enumerate() {
-                *o = done[j * hop + l] - done[j * hop];
-            }
-            let hop_b = if n_win == 1 { l } else { hop };
-            let (q, r) = (l / hop_b, l % hop_b);
-            let nblocks = n_win + q;
-            let mut full = vec![0.0; nblocks];
-            let mut part = vec![0.0; nblocks];
-            for (b, blk) in t[..k_end].chunks(hop_b).enumerate() {
-                let mut acc = Acc::default();
-                let mut pacc = Acc::default();
-                for (c, sub) in blk.chunks(RUN).enumerate() {
-                    acc.add(sum4(sub));
-                    let lo = c * RUN;
-                    if lo < r {
-                        pacc.add(sum4(&sub[..(r - lo).min(sub.len())]));
-                    }
-                }
-                full[b] = acc.get();
-                part[b] = pacc.get();
-            }
-            block_window_sums(&full, &part, (q, r), (0, n_win), dst);
-            for (o, &c) in dst.iter_mut().zip(dcnt.iter()) {
-                *o = if c == 0 {
-                    f64::NAN
-                } else {
-                    *o * scale / c as f64
-                };
-            }
+            gap_dynamic_row(kind, (f, gap), m, (window, hop, n_win), dst, dcnt);
         });
     cancel.check()?;
     Ok((out, counts, n_win))
+}
+
+/// One (axis, m) row of [`gap_dynamic`] on the centred record `f` and its NaN prefix counts `gap`: every
+/// window's value into `dst`, its complete terms into `dcnt`.
+fn gap_dynamic_row(
+    kind: Kind,
+    (f, gap): (&[f64], &[u32]),
+    m: usize,
+    (window, hop, n_win): (usize, usize, usize),
+    dst: &mut [f64],
+    dcnt: &mut [u64],
+) {
+    let (span, scale) = span_scale(kind, m);
+    let l = window + 1 - span; // terms per window
+    let k_end = (n_win - 1) * hop + l; // terms used by some window
+                                       // squares of the complete terms (0 otherwise) and the prefix count of complete terms
+                                       // (the gap count's wrap-around: see `nan_prefix_counts`)
+    let mut t = Vec::with_capacity(k_end);
+    let mut done = vec![0u64; k_end + 1];
+    let mut tb = TermBuf::default();
+    for_each_term_chunk(kind, &f[..k_end + span - 1], m, &mut tb, |k0, c| {
+        for (i, v) in c.iter().enumerate() {
+            let k = k0 + i;
+            let ok = gap[k + span] == gap[k];
+            t.push(if ok { v * v } else { 0.0 });
+            done[k + 1] = done[k] + ok as u64;
+        }
+    });
+    for (j, o) in dcnt.iter_mut().enumerate() {
+        *o = done[j * hop + l] - done[j * hop];
+    }
+    let hop_b = if n_win == 1 { l } else { hop };
+    let (q, r) = (l / hop_b, l % hop_b);
+    let (full, part) = block_sums(&t[..k_end], hop_b, r, n_win + q);
+    block_window_sums(&full, &part, (q, r), (0, n_win), dst);
+    for (o, &c) in dst.iter_mut().zip(dcnt.iter()) {
+        *o = if c == 0 {
+            f64::NAN
+        } else {
+            *o * scale / c as f64
+        };
+    }
+}
+
+/// The compensated sums of `t` per block of `hop_b` terms (`nblocks` of them), and of each block's
+/// first `r` terms: (full, part).
+fn block_sums(t: &[f64], hop_b: usize, r: usize, nblocks: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut full = vec![0.0; nblocks];
+    let mut part = vec![0.0; nblocks];
+    for (b, blk) in t.chunks(hop_b).enumerate() {
+        let mut acc = Acc::default();
+        let mut pacc = Acc::default();
+        for (c, sub) in blk.chunks(RUN).enumerate() {
+            acc.add(sum4(sub));
+            let lo = c * RUN;
+            if lo < r {
+                pacc.add(sum4(&sub[..(r - lo).min(sub.len())]));
+            }
+        }
+        full[b] = acc.get();
+        part[b] = pacc.get();
+    }
+    (full, part)
 }

@@ -192,26 +192,9 @@ fn nnls_from(
 ) -> bool {
     let mut iterations = 0;
     loop {
-        // dual w = aᵀ(b − a·x)
-        let resid = &mut ws.resid[..m];
-        resid.copy_from_slice(&b[..m]);
-        for (col, &xc) in a.chunks_exact(m).zip(&x[..n]) {
-            if xc != 0.0 {
-                for (ri, &ai) in resid.iter_mut().zip(col) {
-                    *ri -= ai * xc;
-                }
-            }
-        }
-        let mut best = None;
-        let mut wmax = 0.0;
-        for (c, col) in a.chunks_exact(m).take(n).enumerate() {
-            ws.w[c] = col.iter().zip(resid.iter()).map(|(ai, ri)| ai * ri).sum();
-            if !ws.passive[c] && !ws.skip[c] && ws.w[c] > wmax {
-                wmax = ws.w[c];
-                best = Some(c);
-            }
-        }
-        let Some(t) = best else { return true };
+        let Some(t) = most_useful_column(a, m, n, b, x, ws) else {
+            return true;
+        };
         ws.passive[t] = true;
         let mut first = true;
         loop {
@@ -239,28 +222,64 @@ fn nnls_from(
                 }
                 break;
             }
-            // step from x towards z until the first passive coefficient reaches zero
-            let mut alpha = f64::INFINITY;
-            let mut hit = usize::MAX;
-            for &c in &ws.cols {
-                if ws.z[c] <= 0.0 {
-                    let s = x[c] / (x[c] - ws.z[c]);
-                    if s < alpha {
-                        alpha = s;
-                        hit = c;
-                    }
-                }
+            step_towards_z(x, n, ws);
+        }
+    }
+}
+
+/// The dual w = aᵀ(b − a·x) into `ws.w`, and the active column (neither passive nor skipped) of the
+/// largest positive w, if any.
+fn most_useful_column(
+    a: &[f64],
+    m: usize,
+    n: usize,
+    b: &[f64],
+    x: &[f64],
+    ws: &mut NnlsWork,
+) -> Option<usize> {
+    let resid = &mut ws.resid[..m];
+    resid.copy_from_slice(&b[..m]);
+    for (col, &xc) in a.chunks_exact(m).zip(&x[..n]) {
+        if xc != 0.0 {
+            for (ri, &ai) in resid.iter_mut().zip(col) {
+                *ri -= ai * xc;
             }
-            for &c in &ws.cols {
-                x[c] += alpha * (ws.z[c] - x[c]);
+        }
+    }
+    let mut best = None;
+    let mut wmax = 0.0;
+    for (c, col) in a.chunks_exact(m).take(n).enumerate() {
+        ws.w[c] = col.iter().zip(resid.iter()).map(|(ai, ri)| ai * ri).sum();
+        if !ws.passive[c] && !ws.skip[c] && ws.w[c] > wmax {
+            wmax = ws.w[c];
+            best = Some(c);
+        }
+    }
+    best
+}
+
+/// Steps x from itself towards the passive solution `ws.z` until the first passive coefficient reaches
+/// zero; the coefficients at zero leave the passive set.
+fn step_towards_z(x: &mut [f64], n: usize, ws: &mut NnlsWork) {
+    let mut alpha = f64::INFINITY;
+    let mut hit = usize::MAX;
+    for &c in &ws.cols {
+        if ws.z[c] <= 0.0 {
+            let s = x[c] / (x[c] - ws.z[c]);
+            if s < alpha {
+                alpha = s;
+                hit = c;
             }
-            x[hit] = 0.0;
-            for (c, xc) in x[..n].iter_mut().enumerate() {
-                if ws.passive[c] && *xc <= 0.0 {
-                    *xc = 0.0;
-                    ws.passive[c] = false;
-                }
-            }
+        }
+    }
+    for &c in &ws.cols {
+        x[c] += alpha * (ws.z[c] - x[c]);
+    }
+    x[hit] = 0.0;
+    for (c, xc) in x[..n].iter_mut().enumerate() {
+        if ws.passive[c] && *xc <= 0.0 {
+            *xc = 0.0;
+            ws.passive[c] = false;
         }
     }
 }

@@ -105,59 +105,21 @@ pub(crate) fn overlapping_dynamic_row(
     let k_end = (n_win - 1) * hop + l;
     let nblocks = n_win + q;
     let norm = 1.0 / (2.0 * (m as f64) * (m as f64) * l as f64);
-    let DynScratch {
-        terms,
-        full,
-        part,
-        sums,
-    } = sc;
     if hop == 1 {
         // terms formed segment by segment, each window written once (`crate::window_sums`)
-        return crate::window_sums::hop1_row(hi, lo, m, q, norm, avx2, out, sums);
+        return crate::window_sums::hop1_row(hi, lo, m, q, norm, avx2, out, &mut sc.sums);
     }
-    if hop < SMALL_HOP {
-        // every term is written below: the buffer is only sized (no fill of what it already holds)
-        terms.resize(k_end, 0.0);
-        #[cfg(target_arch = "x86_64")]
-        if avx2 {
-            // SAFETY: the CPU has AVX2 (checked above).
-            unsafe { terms_into_avx2(hi, lo, m, 0, norm, terms) };
-        } else {
-            terms_into(hi, lo, m, 0, norm, terms);
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        terms_into(hi, lo, m, 0, norm, terms);
-        if hop == 1 {
-            // the terms are the one-term blocks (k_end = n_win + q − 1 of them: all sliding_sums reads)
-            std::mem::swap(terms, full);
-        } else {
-            full.clear();
-            full.resize(nblocks, 0.0);
-            part.clear();
-            part.resize(nblocks, 0.0);
-            for (b, blk) in terms.chunks(hop).enumerate() {
-                full[b] = crate::allan::sum4(blk);
-                part[b] = crate::allan::sum4(&blk[..r.min(blk.len())]);
-            }
-        }
-    } else {
-        full.clear();
-        full.resize(nblocks, 0.0);
-        part.clear();
-        part.resize(nblocks, 0.0);
-        for b in 0..nblocks {
-            let k0 = b * hop;
-            if k0 >= k_end {
-                break;
-            }
-            let len = hop.min(k_end - k0);
-            let rr = r.min(len);
-            let p = chunk_sum_dispatch::<true>(avx2, hi, lo, m, k0, rr);
-            let rest = chunk_sum_dispatch::<true>(avx2, hi, lo, m, k0 + rr, len - rr);
-            part[b] = p * norm;
-            full[b] = (p + rest) * norm;
-        }
-    }
+    let blocks = RowBlocks {
+        hop,
+        r,
+        k_end,
+        nblocks,
+        norm,
+    };
+    blocks.form(hi, lo, m, avx2, sc);
+    let DynScratch {
+        full, part, sums, ..
+    } = sc;
     if q == 0 {
         out.copy_from_slice(&part[..n_win]);
         // noted while the row is in cache: the caller's range check then reads nothing again
@@ -166,6 +128,67 @@ pub(crate) fn overlapping_dynamic_row(
         // each window written once, its range noted as it is written
         let head = (r != 0).then(|| &part[q..]);
         crate::window_sums::sliding_sums_ranged(full, q, head, out, sums)
+    }
+}
+
+/// How the terms of an [`overlapping_dynamic_row`] fall into blocks: `hop` (≥ 2) terms per block,
+/// `k_end` terms in all, `nblocks` blocks, each window's terms L = q·hop + r, each term scaled by `norm`.
+struct RowBlocks {
+    hop: usize,
+    r: usize,
+    k_end: usize,
+    nblocks: usize,
+    norm: f64,
+}
+
+impl RowBlocks {
+    /// The block sums into `sc.full` (a block's terms) and `sc.part` (its first r terms): below
+    /// `SMALL_HOP` from every term formed first, else each block summed directly from the phase.
+    fn form(&self, hi: &[f64], lo: &[f64], m: usize, avx2: bool, sc: &mut DynScratch) {
+        let RowBlocks {
+            hop,
+            r,
+            k_end,
+            nblocks,
+            norm,
+        } = *self;
+        let DynScratch {
+            terms, full, part, ..
+        } = sc;
+        full.clear();
+        full.resize(nblocks, 0.0);
+        part.clear();
+        part.resize(nblocks, 0.0);
+        if hop < SMALL_HOP {
+            // every term is written below: the buffer is only sized (no fill of what it already holds)
+            terms.resize(k_end, 0.0);
+            #[cfg(target_arch = "x86_64")]
+            if avx2 {
+                // SAFETY: the CPU has AVX2 (checked by the caller).
+                unsafe { terms_into_avx2(hi, lo, m, 0, norm, terms) };
+            } else {
+                terms_into(hi, lo, m, 0, norm, terms);
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            terms_into(hi, lo, m, 0, norm, terms);
+            for (b, blk) in terms.chunks(hop).enumerate() {
+                full[b] = crate::allan::sum4(blk);
+                part[b] = crate::allan::sum4(&blk[..r.min(blk.len())]);
+            }
+        } else {
+            for b in 0..nblocks {
+                let k0 = b * hop;
+                if k0 >= k_end {
+                    break;
+                }
+                let len = hop.min(k_end - k0);
+                let rr = r.min(len);
+                let p = chunk_sum_dispatch::<true>(avx2, hi, lo, m, k0, rr);
+                let rest = chunk_sum_dispatch::<true>(avx2, hi, lo, m, k0 + rr, len - rr);
+                part[b] = p * norm;
+                full[b] = (p + rest) * norm;
+            }
+        }
     }
 }
 

@@ -117,14 +117,7 @@ fn head_pass(
     let inv: Vec<f64> = (0..=mmax)
         .map(|d| if d == 0 { 0.0 } else { 1.0 / d as f64 })
         .collect();
-    // −W_m(d) − W_m(m−d), d = 1..=m/2, once the pairs inside [0, m) are in h.
-    let full_deposit = |h: &[f64], m: usize| -> f64 {
-        let mut acc = 0.0;
-        for d in 1..=m / 2 {
-            acc += inv[d] * (h[d] + h[m - d]);
-        }
-        acc
-    };
+    let deposits = Deposits { ms, inv: &inv };
     let mut p = 1;
     while p <= last {
         // Each step adds p pairs: one load of the flag per step is lost in that work.
@@ -149,40 +142,13 @@ fn head_pass(
             (k.add_pairs)(&mut h[1..=p], z[p], &zr[n - p..n]);
         }
         if s <= mmax {
-            if !fuse {
-                if let Ok(idx) = ms.binary_search(&s) {
-                    part[idx] -= full_deposit(&h, s);
-                }
-            }
-            // +W_{m−d}(m−2d) at stage s = m − d, for every m with s < m < 2s (d = m − s ≤ m/2).
-            let lo = ms.partition_point(|&m| m <= s);
-            for (idx, &m) in ms.iter().enumerate().skip(lo) {
-                if m >= 2 * s {
-                    break;
-                }
-                let l = 2 * s - m;
-                let mut v = h[l];
-                if fuse && l >= 1 {
-                    // h already holds point p + 1's pairs: take its pair at lag l back out.
-                    let e = z[p + 1] - z[p + 1 - l];
-                    v -= e * e;
-                }
-                part[idx] += inv[m - s] * v;
-            }
+            // fused, h already holds point p + 1's pairs: they are taken back out
+            deposits.stage(&h, s, &mut part, !fuse, fuse.then_some((z, p + 1)));
         }
         if fuse {
             let s2 = p + 2;
             if s2 <= mmax {
-                if let Ok(idx) = ms.binary_search(&s2) {
-                    part[idx] -= full_deposit(&h, s2);
-                }
-                let lo = ms.partition_point(|&m| m <= s2);
-                for (idx, &m) in ms.iter().enumerate().skip(lo) {
-                    if m >= 2 * s2 {
-                        break;
-                    }
-                    part[idx] += inv[m - s2] * h[2 * s2 - m];
-                }
+                deposits.stage(&h, s2, &mut part, true, None);
             }
             p += 2;
         } else {
@@ -190,6 +156,57 @@ fn head_pass(
         }
     }
     (part, if want_f { Some(h) } else { None })
+}
+
+/// The W-part's deposits of [`head_pass`] on the factors `ms`; `inv[d]` = 1/d.
+struct Deposits<'a> {
+    ms: &'a [usize],
+    inv: &'a [f64],
+}
+
+impl Deposits<'_> {
+    /// −W_m(d) − W_m(m−d), d = 1..=m/2, once the pairs inside [0, m) are in h.
+    fn full(&self, h: &[f64], m: usize) -> f64 {
+        let mut acc = 0.0;
+        for d in 1..=m / 2 {
+            acc += self.inv[d] * (h[d] + h[m - d]);
+        }
+        acc
+    }
+
+    /// The deposits of stage s (the pairs inside [0, s) in h) into `part`: with `full`, the full
+    /// deposit of m = s; +W_{m−d}(m−2d) at stage s = m − d, for every m with s < m < 2s (d = m − s ≤
+    /// m/2). `ahead`: (z, q) when h also holds point q's pairs, each taken back out at its lag.
+    fn stage(
+        &self,
+        h: &[f64],
+        s: usize,
+        part: &mut [f64],
+        full: bool,
+        ahead: Option<(&[f64], usize)>,
+    ) {
+        let (ms, inv) = (self.ms, self.inv);
+        if full {
+            if let Ok(idx) = ms.binary_search(&s) {
+                part[idx] -= self.full(h, s);
+            }
+        }
+        let lo = ms.partition_point(|&m| m <= s);
+        for (idx, &m) in ms.iter().enumerate().skip(lo) {
+            if m >= 2 * s {
+                break;
+            }
+            let l = 2 * s - m;
+            let mut v = h[l];
+            if let Some((z, q)) = ahead {
+                if l >= 1 {
+                    let e = z[q] - z[q - l];
+                    v -= e * e;
+                }
+            }
+            part[idx] += inv[m - s] * v;
+        }
+    }
 }
 
 /// Theo1 of one whole record of phase points `x` (detrended) at each m of `ms` (sorted, distinct).
