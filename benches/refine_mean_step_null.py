@@ -16,10 +16,15 @@ bandwidth effect, as refine's would), a tenth with a rate ramp; fs 1, 50, 100, 4
 A p-value is (1 + #{draws ≥ statistic}) / (1 + draws) over :data:`N_BOOT` draws of the refitted null; a rate at
 α is the share of records with p ≤ α, with its 95 % Clopper–Pearson interval.
 
+``--power K``: the check's power instead, on K records per cell of blind2's bias-step noise (white 2·10⁻³, flicker
+3·10⁻⁴, random walk 2·10⁻⁶; 50 Hz × 2·10⁵ samples = 4000 s) with a step of d at 0.2 or 0.55 of the record: the
+test alone at its α, and with the gate at a held-out error of 3 % (a typical final model's); the split's error.
+
 Usage::
 
     python benches/refine_mean_step_null.py                  # 300 records -> benches/results/refine_mean_step_null.{json,md}
     python benches/refine_mean_step_null.py --records 40 --out /tmp/x
+    python benches/refine_mean_step_null.py --power 15       # -> benches/results/refine_mean_step_power.{json,md}
 """
 
 from __future__ import annotations
@@ -184,13 +189,81 @@ def markdown(report: dict) -> list[str]:
     return lines
 
 
+POWER_STEPS = (1e-3, 2e-3, 3e-3, 5e-3)
+POWER_AT = (0.2, 0.55)
+POWER_N, POWER_FS = 200_000, 50.0
+
+
+def power_task(job: tuple) -> dict:
+    d, at, k = job
+    rng = np.random.default_rng(50_000 + 1009 * k + int(1e6 * d) + int(100 * at))
+    y = allanite.simulate(POWER_N, POWER_FS, N=2e-3, K=2e-6, seed=rng)
+    y = y + 3e-4 * kasdin_walter(4 * POWER_N, 1.0, rng)[-POWER_N:]
+    y[int(at * POWER_N) :] += d
+    ctx = context(y, POWER_FS, [])
+    loc, _sol, dep = ms.located(ctx)
+    thr = ms.mean_step_threshold(POWER_N, POWER_FS, START, loc["theta"], ALPHA)
+    rejected = loc["statistic"] > thr
+    return {
+        "d": d,
+        "at": at,
+        "rejected": bool(rejected),
+        "said_at_3pct": bool(rejected and float(dep.max()) > 3.0),
+        "t_error_frac": abs(loc["index"] / POWER_N - at),
+        "d_est": loc["d"],
+    }
+
+
+def run_power(per_cell: int, out: Path, processes: int) -> dict:
+    t0 = time.perf_counter()
+    jobs = [(d, at, k) for d in POWER_STEPS for at in POWER_AT for k in range(per_cell)]
+    load = _common.OtherLoad().__enter__()
+    with ProcessPoolExecutor(processes) as pool:
+        rows = list(pool.map(power_task, jobs))
+    load.__exit__(None, None, None)
+    report = {"alpha": ALPHA, "per_cell": per_cell, "rows": rows, "seconds": time.perf_counter() - t0}
+    report |= {"other_load": load.fraction, "machine": _common.machine_info()}
+    lines = [
+        '# The `"mean"` check\'s power on a bias step',
+        "",
+        f"Written by `benches/refine_mean_step_null.py --power {per_cell}` ({_common.machine_line(report['machine'])}; "
+        f"other processes used {100 * (report['other_load'] or 0):.0f} % of the CPUs; {report['seconds']:.0f} s). "
+        "blind2's bias-step noise (white 2·10⁻³ °/s/√Hz, stationary flicker 3·10⁻⁴, random walk 2·10⁻⁶) at 50 Hz × "
+        f"2·10⁵ samples (4000 s), a step of d at a share of the record; {per_cell} records per cell (fixed seeds). "
+        f"Rejected: the test alone at its α ({ALPHA:g}); said: rejected and the step moving the Allan deviation by "
+        "more than 3 % (a typical final model's held-out error); split error: median |located − true| as a share "
+        "of the record, over the rejected records.",
+        "",
+        "| d (°/s) | at | rejected | 95 % CP | said (3 %) | split error (median) |",
+        "|---|---|---|---|---|---|",
+    ]
+    for d in POWER_STEPS:
+        for at in POWER_AT:
+            cell = [r for r in rows if r["d"] == d and r["at"] == at]
+            k = sum(r["rejected"] for r in cell)
+            lo, hi = _common.clopper_pearson(k, len(cell))
+            said = sum(r["said_at_3pct"] for r in cell)
+            errs = [r["t_error_frac"] for r in cell if r["rejected"]]
+            err = f"{100 * float(np.median(errs)):.2f} %" if errs else "—"
+            lines.append(f"| {d:g} | {at:g} | {k} of {len(cell)} | {100 * lo:.0f}–{100 * hi:.0f} % | {said} | {err} |")
+    out.mkdir(parents=True, exist_ok=True)
+    _common.write_results(out, "refine_mean_step_power", lines, report)
+    return report
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--records", type=int, default=300)
     ap.add_argument("--processes", type=int, default=1)
+    ap.add_argument("--power", type=int, default=0, help="the power table instead, this many records per cell")
     ap.add_argument("--out", default=None, help="results folder (default benches/results)")
     args = ap.parse_args(argv)
-    rep = run(args.records, Path(args.out) if args.out else HERE / "results", args.processes)
+    out = Path(args.out) if args.out else HERE / "results"
+    if args.power:
+        run_power(args.power, out, args.processes)
+        print((out / "refine_mean_step_power.md").read_text())
+        return
+    rep = run(args.records, out, args.processes)
     print("\n".join(markdown(rep)))
 
 
