@@ -387,11 +387,11 @@ NOTES: list = [
     'χ²/dof 0.55), and now `unexplained` says the step (the `"mean"` check: the best single split of 48 block '
     "means against a null simulated from the final model refitted without the located step, its slow terms raised "
     "to the upper end the curve allows, at its own share of `level` taken from the drift check's): 0.0033 deg/s "
-    "at t ≈ 11001.9 s (true 3·10⁻³ at 11000 s), statistic 1.62·10⁻³ against 8.5·10⁻⁴, said because the step moves "
+    "at t ≈ 11001.9 s (true 3·10⁻³ at 11000 s), statistic 1.62·10⁻³ against 8.7·10⁻⁴, said because the step moves "
     "the Allan deviation by up to 264 % against a held-out error of 2.3 %. The final fit had absorbed the step "
     "into rate random walk (K 2.6·10⁻⁵ against the true 2·10⁻⁶) and a null drawn from that model covered it; the "
     "refit without it gives K 1.65·10⁻⁶ (the null's, raised, 4.3·10⁻⁶). False alarms of the check over 300 clean "
-    "records: benches/results/refine_mean_step_null.md. Rerun at 2437093: this row changed, the other ten rows' "
+    "records: benches/results/refine_mean_step_null.md. Rerun at 92b277f: this row changed, the other ten rows' "
     "effects, numbers and words as before (CPU column aside).",
     "- *Line switched on halfway* (outside the family) — **said since** (r2line): refine still names a sinusoid at "
     "A/√2 and a change of the noise level at 2500 s, and now `unexplained` says the line's amplitude changes along "
