@@ -383,14 +383,16 @@ NOTES: list = [
     "those of the flagged stretch). 1500 of the 1500 spikes flagged, no good sample; outliers alone (rate −0.1 %), "
     "χ²/dof 3.55 → 1.06, held out 4.97 → 3.26 %. The pole and the resonance had been the runs left behind: the "
     "outlier removal already runs before every curve effect (removals first, outliers first among them).",
-    "- *Bias step* (outside the family): nothing added and nothing said — the curve fits (χ²/dof 0.55) and no "
-    "check tests the mean along the record (the level check is on the first differences, which a step of the "
-    "mean does not change). Still open: a one-step test of 48 block means against a null simulated from the final "
-    "model was built (branch r2step, not merged) and stays silent here, because the final fit has absorbed the "
-    "step into rate random walk (K 2.8e-5 against the true 2e-6), and a null drawn from that model covers the step "
-    "(CUSUM 0.0113 against 0.031); with the located step removed and the terms refitted (K 1.6e-6) the same test "
-    "rejects it (threshold 0.0038–0.0061) and locates it at 11000.1 s (true 11000 s). Needed: the null from a refit "
-    "without the located step, or a mean-step removal among refine's candidates, calibrated on ≥ 300 null records.",
+    "- *Bias step* (outside the family) — **said since** (r3step): refine still adds nothing (the curve fits, "
+    'χ²/dof 0.55), and now `unexplained` says the step (the `"mean"` check: the best single split of 48 block '
+    "means against a null simulated from the final model refitted without the located step, its slow terms raised "
+    "to the upper end the curve allows, at its own share of `level` taken from the drift check's): 0.0033 deg/s "
+    "at t ≈ 11001.9 s (true 3·10⁻³ at 11000 s), statistic 1.62·10⁻³ against 8.7·10⁻⁴, said because the step moves "
+    "the Allan deviation by up to 264 % against a held-out error of 2.3 %. The final fit had absorbed the step "
+    "into rate random walk (K 2.6·10⁻⁵ against the true 2·10⁻⁶) and a null drawn from that model covered it; the "
+    "refit without it gives K 1.65·10⁻⁶ (the null's, raised, 4.3·10⁻⁶). False alarms of the check over 300 clean "
+    "records: benches/results/refine_mean_step_null.md. Rerun at 92b277f: this row changed, the other ten rows' "
+    "effects, numbers and words as before (CPU column aside).",
     "- *Line switched on halfway* (outside the family) — **said since** (r2line): refine still names a sinusoid at "
     "A/√2 and a change of the noise level at 2500 s, and now `unexplained` says the line's amplitude changes along "
     'the record (the `"line"` check: each accepted sinusoid\'s complex amplitude in blocks of ≥ 20 periods tested '

@@ -31,6 +31,9 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   standard errors (as impulsive noise below; a line visible only in a filter's noise null moves none).
 - ``"time"`` — a warm-up drift left in the final samples (:func:`allanite.model.tracing.drift_fit` against its
   bootstrap threshold under the final model's slow terms).
+- ``"mean"`` — one step of the mean along the final samples (:mod:`._mean_step`: the best split of its block
+  means against a null from the final model refitted without the located step), said where the step moves the
+  Allan deviation beyond the final model's held-out error; ``"t"`` the side after the step.
 - ``"level"`` — the noise level along the final samples (:func:`allanite.model.noise_level.level_test`, between
   the change points refine accepted): an entry with the time region ``"t"`` (lo, hi) s where the level is
   higher, where the change exceeds the final model's held-out error.
@@ -54,6 +57,7 @@ from ...analysis import avar
 from .. import channels, lines, noise_level, outliers, tracing
 from ..terms import design_matrix
 from ._line_check import line_check
+from ._mean_step import mean_step_check
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
 from .changes import locate
@@ -506,6 +510,7 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "fit": _fit,
     "psd": _lines,
     "time": _drift,
+    "mean": mean_step_check,
     "level": _level,
     "line": line_check,
     "channels": _channels,

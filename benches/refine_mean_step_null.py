@@ -1,0 +1,271 @@
+#!/usr/bin/env python3
+"""Calibration of the ``"mean"`` check of ``Refinement.unexplained`` (one step of the mean; issue 29, item 4).
+
+The check's test alone — the best single split of 48 block means against its null simulated from the model
+refitted without the located step (:mod:`allanite.model.refinement._mean_step`) — on clean records, where
+refitting without a step that is not there lowers K: the place false alarms would hide. The gate that follows it
+in refine (the step must move the Allan deviation by more than the final model's held-out error) is left off,
+so these rates bound the check's from above.
+
+Clean records (a fixed seed each): white noise always, flicker (stationary: Kasdin–Walter over 4× the record,
+its tail) and rate random walk always, their corners placed log-uniformly along the record; a quarter with
+quantisation, a fifth through a 2nd-order Butterworth low-pass at fs/8…fs/40 (the final model then holds its
+bandwidth effect, as refine's would), a tenth with a rate ramp; fs 1, 50, 100, 400 or 1000 Hz, 10⁵, 3·10⁵ or
+10⁶ samples. The final model is the five-term fit of refine's dense curve (300 τ) plus that bandwidth.
+
+A p-value is (1 + #{draws ≥ statistic}) / (1 + draws) over :data:`N_BOOT` draws of the refitted null; a rate at
+α is the share of records with p ≤ α, with its 95 % Clopper–Pearson interval.
+
+``--power K``: the check's power instead, on K records per cell of blind2's bias-step noise (white 2·10⁻³, flicker
+3·10⁻⁴, random walk 2·10⁻⁶; 50 Hz × 2·10⁵ samples = 4000 s) with a step of d at 0.2 or 0.55 of the record: the
+test alone at its α, and with the gate at a held-out error of 3 % (a typical final model's); the split's error.
+
+Usage::
+
+    python benches/refine_mean_step_null.py                  # 300 records -> benches/results/refine_mean_step_null.{json,md}
+    python benches/refine_mean_step_null.py --records 40 --out /tmp/x
+    python benches/refine_mean_step_null.py --power 15       # -> benches/results/refine_mean_step_power.{json,md}
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+from scipy import signal
+
+import _common
+import allanite
+from allanite.estimators.grid import tau_grid
+from allanite.model.refinement import _mean_step as ms
+from allanite.model.refinement.curvefit import Curve, solve, theta_terms
+from allanite.model.refinement.levels import LEVEL, alpha
+from allanite.model.refinement.missing import MissingContext
+from allanite.simulation import kasdin_walter
+
+HERE = Path(__file__).resolve().parent
+START = ("Q", "N", "B", "K", "R")
+N_BOOT = 4000
+ALPHA = alpha("unexplained:mean", LEVEL)
+LEVELS = (ALPHA, 0.01, 0.05)
+
+
+def clean_record(seed: int) -> tuple[np.ndarray, float, list, dict]:
+    """A clean record, its rate, the final model's effects (a low-pass's bandwidth) and its description."""
+    rng = np.random.default_rng(seed)
+    fs = float(rng.choice([1.0, 50.0, 100.0, 400.0, 1000.0]))
+    n = int(rng.choice([100_000, 300_000, 1_000_000]))
+    span, nw = n / fs, 1e-3
+    terms = {"N": nw}
+    # flicker floor meeting white noise at 10⁻⁴…10⁻¹ of the record; random walk at 10⁻³…1 of it
+    b = nw / math.sqrt(0.4413 * span * 10 ** rng.uniform(-4, -1))
+    terms["K"] = nw * math.sqrt(3) / (span * 10 ** rng.uniform(-3, 0))
+    if rng.random() < 0.25:
+        terms["Q"] = nw * math.sqrt(rng.uniform(1, 4) / fs / 3)
+    if rng.random() < 0.1:
+        terms["R"] = nw * math.sqrt(2 / (span * 10 ** rng.uniform(-1, 0)) ** 3)
+    y = allanite.simulate(n, fs, seed=rng, **terms)
+    y = y + b * kasdin_walter(4 * n, 1.0, rng)[-n:]  # allanite.simulate's flicker, stationary
+    effects: list = []
+    desc = {"fs": fs, "n": n, "terms": sorted([*terms, "B"])}
+    if rng.random() < 0.2:
+        frac = float(rng.uniform(1 / 40, 1 / 8))
+        bb, aa = signal.butter(2, 2 * frac)
+        y = signal.lfilter(bb, aa, y)
+        effects = [("bandwidth:butterworth2", frac * fs)]
+        desc["lowpass_hz"] = frac * fs
+    return y, fs, effects, desc
+
+
+def context(y: np.ndarray, fs: float, effects: list) -> MissingContext:
+    """The final state refine's check would see: its dense curve, the five terms (+ effects) fitted."""
+    grid = tau_grid(y.size, fs, "exp", points=300, m_max=max(1, y.size // 9))
+    res = allanite.avar(y, fs, taus=grid)
+    keep = res.avar > 0
+    cur = Curve(res.tau[keep], res.m[keep].astype(np.float64), res.avar[keep], fs, res.n_samples + 1, res.estimator)
+    sol = solve(cur, START, effects)
+    return MissingContext(cur, np.arange(cur.tau.size), sol, START, effects, y, fs, LEVEL, True)
+
+
+def task(k: int) -> dict:
+    y, fs, effects, desc = clean_record(70_000 + 7919 * k)
+    ctx = context(y, fs, effects)
+    loc, sol, dep = ms.located(ctx)
+    draws = ms.null_statistics(y.size, fs, START, loc["theta"], N_BOOT)
+    p = float((1 + np.count_nonzero(draws >= loc["statistic"])) / (1 + draws.size))
+    # the same null with the refitted terms as they are (slow terms not raised): the variant not taken
+    bare = ms.null_statistics(y.size, fs, START, theta_terms(sol, START, effects), N_BOOT)
+    p_bare = float((1 + np.count_nonzero(bare >= loc["statistic"])) / (1 + bare.size))
+    k_true = float(ctx.sol.theta[START.index("K")])
+    return desc | {
+        "p": p,
+        "p_refit_not_raised": p_bare,
+        "statistic": loc["statistic"],
+        "t_step_frac": loc["index"] / y.size,
+        "K_fit": math.sqrt(max(k_true, 0.0)),
+        "K_null": math.sqrt(max(float(loc["theta"][START.index("K")]), 0.0)),
+        "departure_pct": float(dep.max()),
+    }
+
+
+def run(records: int, out: Path, processes: int) -> dict:
+    t0 = time.perf_counter()
+    load = _common.OtherLoad().__enter__()
+    with ProcessPoolExecutor(processes) as pool:
+        rows = list(pool.map(task, range(records)))
+    load.__exit__(None, None, None)
+    p = [r["p"] for r in rows]
+    report = {
+        "level": LEVEL,
+        "alpha": ALPHA,
+        "records": records,
+        "n_boot": N_BOOT,
+        "rates": _common.rejection_rates(p, LEVELS),
+        "rates_refit_not_raised": _common.rejection_rates([r["p_refit_not_raised"] for r in rows], LEVELS),
+        "by_group": _groups(rows),
+        "rows": rows,
+        "seconds": time.perf_counter() - t0,
+        "other_load": load.fraction,
+        "machine": _common.machine_info(),
+    }
+    out.mkdir(parents=True, exist_ok=True)
+    _common.write_results(out, "refine_mean_step_null", markdown(report), report)
+    return report
+
+
+def _groups(rows: list) -> dict:
+    """Rejections at 5 % by record kind (a low-pass, quantisation, a ramp, the rest) and by length."""
+    kinds = {
+        "low-pass": lambda r: "lowpass_hz" in r,
+        "quantisation": lambda r: "Q" in r["terms"],
+        "ramp": lambda r: "R" in r["terms"],
+        "N + B + K only": lambda r: r["terms"] == ["B", "K", "N"] and "lowpass_hz" not in r,
+        **{f"{n:g} samples": (lambda r, n=n: r["n"] == n) for n in (100_000, 300_000, 1_000_000)},
+    }
+    out = {}
+    for name, sel in kinds.items():
+        ps = [r["p"] for r in rows if sel(r)]
+        out[name] = {"records": len(ps), "at_5pct": int(sum(v <= 0.05 for v in ps))}
+    return out
+
+
+def markdown(report: dict) -> list[str]:
+    lines = [
+        '# The `"mean"` check of `Refinement.unexplained` on clean records',
+        "",
+        f"Written by `benches/refine_mean_step_null.py` ({_common.machine_line(report['machine'])}; other processes "
+        f"used {100 * (report['other_load'] or 0):.0f} % of the CPUs; {report['seconds']:.0f} s). The check's test "
+        f"alone (its gate — the step moving the Allan deviation beyond the held-out error — off) on "
+        f"{report['records']} clean records: white + stationary flicker + rate random walk, a quarter with "
+        "quantisation, a fifth through a 2nd-order low-pass (the final model holding its bandwidth), a tenth with a "
+        "ramp; 1–1000 Hz, 10⁵–10⁶ samples. The null from the five-term model refitted without the located step, "
+        f"its slow terms at the upper end the curve allows; p over {report['n_boot']} draws. Rate: records with "
+        "p ≤ the level, 95 % Clopper–Pearson interval.",
+        "",
+        "| check | α (its share of 5 %) | records | at α | at 1 % | at 5 % |",
+        "|---|---|---|---|---|---|",
+    ]
+    cells = [_common.rate_cell(report["rates"][f"{lv:g}"], count=True) for lv in LEVELS]
+    lines.append(f"| unexplained:mean | {report['alpha']:g} | {report['records']} | " + " | ".join(cells) + " |")
+    cells = [_common.rate_cell(report["rates_refit_not_raised"][f"{lv:g}"], count=True) for lv in LEVELS]
+    lines.append(
+        f"| the same, null's slow terms as refitted (not raised; not used) | {report['alpha']:g} | "
+        f"{report['records']} | " + " | ".join(cells) + " |"
+    )
+    lines += ["", "At 5 %, by kind of record:", "", "| records | n | rejections at 5 % |", "|---|---|---|"]
+    for name, g in report["by_group"].items():
+        lines.append(f"| {name} | {g['records']} | {g['at_5pct']} |")
+    ratio = np.array([r["K_null"] / max(r["K_fit"], 1e-300) for r in report["rows"] if r["K_fit"] > 0])
+    if ratio.size:
+        lines += [
+            "",
+            f"The null's K over the five-term fit's K (records where the fit has K): median {np.median(ratio):.3g}, "
+            f"5th percentile {np.quantile(ratio, 0.05):.3g}.",
+        ]
+    return lines
+
+
+POWER_STEPS = (1e-3, 2e-3, 3e-3, 5e-3)
+POWER_AT = (0.2, 0.55)
+POWER_N, POWER_FS = 200_000, 50.0
+
+
+def power_task(job: tuple) -> dict:
+    d, at, k = job
+    rng = np.random.default_rng(50_000 + 1009 * k + int(1e6 * d) + int(100 * at))
+    y = allanite.simulate(POWER_N, POWER_FS, N=2e-3, K=2e-6, seed=rng)
+    y = y + 3e-4 * kasdin_walter(4 * POWER_N, 1.0, rng)[-POWER_N:]
+    y[int(at * POWER_N) :] += d
+    ctx = context(y, POWER_FS, [])
+    loc, _sol, dep = ms.located(ctx)
+    thr = ms.mean_step_threshold(POWER_N, POWER_FS, START, loc["theta"], ALPHA)
+    rejected = loc["statistic"] > thr
+    return {
+        "d": d,
+        "at": at,
+        "rejected": bool(rejected),
+        "said_at_3pct": bool(rejected and float(dep.max()) > 3.0),
+        "t_error_frac": abs(loc["index"] / POWER_N - at),
+        "d_est": loc["d"],
+    }
+
+
+def run_power(per_cell: int, out: Path, processes: int) -> dict:
+    t0 = time.perf_counter()
+    jobs = [(d, at, k) for d in POWER_STEPS for at in POWER_AT for k in range(per_cell)]
+    load = _common.OtherLoad().__enter__()
+    with ProcessPoolExecutor(processes) as pool:
+        rows = list(pool.map(power_task, jobs))
+    load.__exit__(None, None, None)
+    report = {"alpha": ALPHA, "per_cell": per_cell, "rows": rows, "seconds": time.perf_counter() - t0}
+    report |= {"other_load": load.fraction, "machine": _common.machine_info()}
+    lines = [
+        '# The `"mean"` check\'s power on a bias step',
+        "",
+        f"Written by `benches/refine_mean_step_null.py --power {per_cell}` ({_common.machine_line(report['machine'])}; "
+        f"other processes used {100 * (report['other_load'] or 0):.0f} % of the CPUs; {report['seconds']:.0f} s). "
+        "blind2's bias-step noise (white 2·10⁻³ °/s/√Hz, stationary flicker 3·10⁻⁴, random walk 2·10⁻⁶) at 50 Hz × "
+        f"2·10⁵ samples (4000 s), a step of d at a share of the record; {per_cell} records per cell (fixed seeds). "
+        f"Rejected: the test alone at its α ({ALPHA:g}); said: rejected and the step moving the Allan deviation by "
+        "more than 3 % (a typical final model's held-out error); split error: median |located − true| as a share "
+        "of the record, over the rejected records.",
+        "",
+        "| d (°/s) | at | rejected | 95 % CP | said (3 %) | split error (median) |",
+        "|---|---|---|---|---|---|",
+    ]
+    for d in POWER_STEPS:
+        for at in POWER_AT:
+            cell = [r for r in rows if r["d"] == d and r["at"] == at]
+            k = sum(r["rejected"] for r in cell)
+            lo, hi = _common.clopper_pearson(k, len(cell))
+            said = sum(r["said_at_3pct"] for r in cell)
+            errs = [r["t_error_frac"] for r in cell if r["rejected"]]
+            err = f"{100 * float(np.median(errs)):.2f} %" if errs else "—"
+            lines.append(f"| {d:g} | {at:g} | {k} of {len(cell)} | {100 * lo:.0f}–{100 * hi:.0f} % | {said} | {err} |")
+    out.mkdir(parents=True, exist_ok=True)
+    _common.write_results(out, "refine_mean_step_power", lines, report)
+    return report
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--records", type=int, default=300)
+    ap.add_argument("--processes", type=int, default=1)
+    ap.add_argument("--power", type=int, default=0, help="the power table instead, this many records per cell")
+    ap.add_argument("--out", default=None, help="results folder (default benches/results)")
+    args = ap.parse_args(argv)
+    out = Path(args.out) if args.out else HERE / "results"
+    if args.power:
+        run_power(args.power, out, args.processes)
+        print((out / "refine_mean_step_power.md").read_text())
+        return
+    rep = run(args.records, out, args.processes)
+    print("\n".join(markdown(rep)))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,106 @@
+"""The ``"mean"`` check of ``Refinement.unexplained``: one step of the mean along the record (issue 29, item 4).
+
+A bias step leaves the first differences alone and looks like rate random walk on the Allan curve, so the final
+fit absorbs it; the check's null comes from the model refitted without the located step. Records of 10⁵–2·10⁵
+samples keep each test to a second or two (the check on a context built as refine builds its own; one default
+``refine`` call); the false-alarm rate over 300 clean records is in ``benches/results/refine_mean_step_null.md``.
+"""
+
+from __future__ import annotations
+
+import html as html_mod
+import re
+
+import numpy as np
+import pytest
+
+import allanite
+from allanite.estimators.grid import tau_grid
+from allanite.model.refinement import _mean_step as ms
+from allanite.model.refinement.curvefit import Curve, solve
+from allanite.model.refinement.levels import alpha
+from allanite.model.refinement.missing import CHECKS, MissingContext
+from allanite.model.refinement.words import describe_region
+
+FS = 50.0
+START = ("Q", "N", "B", "K", "R")
+A = alpha("unexplained:mean", 0.05)
+
+
+def _record(n: int, step: float, seed: int, at: float = 0.55) -> np.ndarray:
+    """White + flicker + a little rate random walk (blind2's bias-step noise), the mean stepping by ``step`` at
+    ``at`` of the record."""
+    y = allanite.simulate(n, FS, N=2e-3, B=3e-4, K=2e-6, seed=seed)
+    y[int(at * n) :] += step
+    return y
+
+
+def _context(y: np.ndarray, heldout_pct: float | None = 2.5) -> MissingContext:
+    """The state the check sees after refine: its dense curve of ``y`` and the five terms fitted to it."""
+    res = allanite.avar(y, FS, taus=tau_grid(y.size, FS, "exp", points=300, m_max=y.size // 9))
+    cur = Curve(res.tau, res.m.astype(np.float64), res.avar, FS, res.n_samples + 1, res.estimator)
+    ctx = MissingContext(cur, np.arange(cur.tau.size), solve(cur, START, []), START, [], y, FS, 0.05, True)
+    ctx.unit, ctx.heldout_pct = "deg/s", heldout_pct
+    return ctx
+
+
+def test_the_step_avar_is_the_allan_variance_of_a_step_exactly():
+    n = 20_000
+    for index in (11_000, 300, 19_950):
+        y = np.zeros(n)
+        y[index:] = 0.3
+        res = allanite.avar(y, FS)
+        got = ms.step_avar(n, index, 0.3, res.m)
+        assert np.allclose(got, res.avar, rtol=1e-12, atol=0)
+
+
+def test_the_split_statistic_is_the_two_segment_mean_change():
+    b = np.r_[np.zeros(30), np.ones(18)]
+    stat, k = ms.split_statistic(b)
+    assert k[0] == 30 and stat[0] == pytest.approx(np.sqrt(30 * 18) / 48)
+
+
+def test_a_step_of_the_mean_is_said_and_located():
+    n = 200_000  # 4000 s; the step at 2200 s
+    ctx = _context(_record(n, 5e-3, seed=3))
+    assert ctx.sol.theta[START.index("K")] > 10 * (2e-6) ** 2  # the plain fit took the step as random walk
+    out = ms.mean_step_check(ctx, A)
+    assert len(out) == 1
+    e = out[0]
+    assert e["domain"] == "mean" and e["alpha"] == A
+    assert e["statistic"] > e["threshold"] > 0
+    assert abs(e["t_step"] - 2200.0) <= 0.02 * 4000.0  # within 2 % of the record
+    assert e["step"] == pytest.approx(5e-3, rel=0.2)
+    assert e["t"] == (e["t_step"], 4000.0) and e["departure_pct"] > 2.5
+    assert e["tau"][0] < e["tau"][1] and e["band_hz"] == pytest.approx((0.5 / e["tau"][1], 0.5 / e["tau"][0]))
+    text = describe_region(e)
+    assert "the mean steps by 0.005 deg/s at t ≈ 22" in text and "held-out error 2.5 %" in text
+
+
+def test_a_clean_flicker_and_random_walk_record_is_silent():
+    # the gate off (no held-out error): the test alone, and at 5 % rather than its own α
+    ctx = _context(_record(200_000, 0.0, seed=11), heldout_pct=None)
+    assert ms.mean_step_check(ctx, 0.05) == []
+
+
+def test_a_step_smaller_than_the_held_out_error_is_not_said():
+    ctx = _context(_record(200_000, 5e-3, seed=3), heldout_pct=None)
+    assert ms.mean_step_check(ctx, A)  # the test rejects
+    ctx.heldout_pct = 1e4  # but nothing it moves exceeds an error this large
+    assert ms.mean_step_check(ctx, A) == []
+
+
+def test_the_check_is_registered_and_needs_the_samples():
+    assert CHECKS["mean"] is ms.mean_step_check
+    ctx = _context(_record(100_000, 0.0, seed=1))
+    ctx.y = None
+    assert ms.mean_step_check(ctx, A) == []
+
+
+def test_refine_says_the_step_in_every_surface():
+    y = _record(100_000, 8e-3, seed=4)  # 2000 s, the step at 1100 s
+    r = allanite.refine(y, FS, unit="deg/s", progress=False)
+    got = [u for u in r.unexplained if u["domain"] == "mean"]
+    assert len(got) == 1 and abs(got[0]["t_step"] - 1100.0) <= 40.0
+    said = re.compile(r"the mean steps by 0\.00[78]\d* deg/s at t ≈ 1(09\d|10\d|11\d)")
+    assert said.search(r.report()) and said.search(html_mod.unescape(r._repr_html_()))
