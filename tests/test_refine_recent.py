@@ -1,14 +1,14 @@
 """Results remembered by their arrays' content within a refine (issue 29, refine's cost): each found again only
 for equal samples and the same key, and equal to a fresh computation — the memory itself
 (:class:`allanite.model._recent.Recent`), a line family's phasors, the outlier test's quantisation step and local
-noise scales. (A whole refine with every memory off: ``test_refine_cost.py``.)"""
+noise scales, the bandwidth check's Welch spectrum. (A whole refine with every memory off: ``test_refine_cost.py``.)"""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from allanite.model import linefit, outliers
+from allanite.model import linefit, outliers, tracing
 from allanite.model._recent import Recent, remembering
 
 
@@ -117,3 +117,23 @@ def test_phasors_of_a_long_record_are_exact_to_rounding():
         assert abs(got[n] - complex(math.cos(2 * math.pi * ph), math.sin(2 * math.pi * ph))) < 2e-11
     sparse = np.array([5, 4096, 1_234_567])
     np.testing.assert_array_equal(linefit._phasor(nu, sparse), got[sparse])
+
+
+def test_remembered_rolloff_spectrum_equals_a_fresh_one():
+    from scipy import signal
+
+    y = np.random.default_rng(8).standard_normal(60_000).cumsum() * 1e-3 + 0.2
+    r1, r2 = np.array([1.0, 0.5]), np.array([1.0, 0.25, 0.05])
+    first = tracing.rolloff_psd(y, 50.0, r1)
+    f, p = signal.welch(y - y.mean(), fs=50.0, nperseg=4096)  # the spectrum computed afresh
+    hi, lo = (f >= 20.0) & (f <= 24.0), (f >= 1.0) & (f <= 5.0)
+    assert first["measured"] == float(p[hi].mean() / p[lo].mean())
+    got = tracing._WELCH.get(y, (50.0, 4096))
+    assert got is not None and not got[1].flags.writeable
+    again = tracing.rolloff_psd(y.copy(), 50.0, r2)  # equal samples, another filter: the spectrum found again
+    assert again["measured"] == first["measured"] and again["predicted"] != first["predicted"]
+    assert tracing._WELCH.get(y, (50.0, 4096)) is got
+    z = y.copy()
+    z[100] += 1.0  # other samples: computed
+    f2, p2 = signal.welch(z - z.mean(), fs=50.0, nperseg=4096)
+    assert tracing.rolloff_psd(z, 50.0, r1)["measured"] == float(p2[hi].mean() / p2[lo].mean())
