@@ -1,7 +1,7 @@
 """Results remembered by their arrays' content within a refine (issue 29, refine's cost): each found again only
 for equal samples and the same key, and equal to a fresh computation — the memory itself
 (:class:`allanite.model._recent.Recent`), a line family's phasors, the outlier test's quantisation step and local
-noise scales, the bandwidth check's Welch spectrum. (A whole refine with every memory off: ``test_refine_cost.py``.)"""
+noise scales and flags per cut, the bandwidth check's Welch spectrum. (A whole refine with every memory off: ``test_refine_cost.py``.)"""
 
 from __future__ import annotations
 
@@ -137,3 +137,22 @@ def test_remembered_rolloff_spectrum_equals_a_fresh_one():
     z[100] += 1.0  # other samples: computed
     f2, p2 = signal.welch(z - z.mean(), fs=50.0, nperseg=4096)
     assert tracing.rolloff_psd(z, 50.0, r1)["measured"] == float(p2[hi].mean() / p2[lo].mean())
+
+
+def test_remembered_outlier_flags_equal_fresh_ones(monkeypatch):
+    rng = np.random.default_rng(12)
+    y = rng.standard_normal(40_000)
+    y[rng.choice(y.size, 40, replace=False)] += rng.choice([-1, 1], 40) * rng.uniform(6, 12, 40)
+    first = outliers.outlier_test(y, 100.0, 0.01)
+    assert first["accepted"] and np.count_nonzero(first["flags"]) >= 30
+    first["flags"][:] = False  # the caller's copy: the memory keeps its own
+    per_cut = outliers._FLAGGED.get(y)
+    assert per_cut is not None and first["cut"] in per_cut
+    again = outliers.outlier_test(y.copy(), 100.0, 0.001)  # another level, the same samples: found again
+    flags_at, lam_at = outliers.flag_at(y, again["cut"])
+    monkeypatch.setattr(Recent, "get", lambda self, arr, key=(): None)  # everything afresh
+    fresh = outliers.outlier_test(y, 100.0, 0.001)
+    assert again["cut"] == fresh["cut"] and again["expected_gaussian_flags"] == fresh["expected_gaussian_flags"]
+    np.testing.assert_array_equal(again["flags"], fresh["flags"])
+    np.testing.assert_array_equal(flags_at, fresh["flags"])
+    assert lam_at == fresh["expected_gaussian_flags"] and again["cuts"] == fresh["cuts"]

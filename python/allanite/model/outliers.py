@@ -255,7 +255,7 @@ def outlier_test(y: np.ndarray, fs: float, alpha: float) -> dict:
     level = _level_residual(y, step)
     out["rule"] = "neighbours" if level is None else "level"
     for c in FLAG_CUTS:
-        flags, lam, cut = _flags(d, blocks, sig, step, c, level)
+        flags, lam, cut = _flags_of(y, d, blocks, sig, step, c, level)
         k = int(np.count_nonzero(flags))
         # Gaussian samples flagged: at most the differences beyond the cut, λ (exact for the lattice too); the
         # flagged count itself beyond what twice that gives, at the test's own α per cut (one sample where
@@ -283,7 +283,7 @@ def flag_at(y: np.ndarray, c: float) -> tuple[np.ndarray, float]:
     sig = np.array([robust_sigma(d[b], step) for b in blocks])
     if not np.isfinite(sig).all():
         return np.zeros(y.size, dtype=bool), 0.0
-    flags, lam, _cut = _flags(d, blocks, sig, step, c, _level_residual(y, step))
+    flags, lam, _cut = _flags_of(y, d, blocks, sig, step, c, _level_residual(y, step))
     return flags, lam
 
 
@@ -307,6 +307,23 @@ def _level_residual(y: np.ndarray, step: float) -> tuple[np.ndarray, list, np.nd
     blocks = _blocks(y.size)
     sig = np.array([robust_sigma(r[b], step) for b in blocks])
     return (r, blocks, sig) if np.isfinite(sig).all() and np.all(sig > 0) else None
+
+
+#: What :func:`_flags` found per cut, by the samples' content (records up to 2·10⁶ samples): refine tests the same
+#: record at two levels (the removal's and the final check's share), and each level tries the same cuts in turn.
+_FLAGGED = Recent(2, 2_000_000)
+
+
+def _flags_of(y: np.ndarray, d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, level) -> tuple:
+    """:func:`_flags` of the samples ``y`` (``d``, ``blocks``, ``sig``, ``step`` and ``level`` are ``y``'s, as
+    :func:`outlier_test` derives them), remembered per cut; the flags a fresh copy each time."""
+    per_cut = _FLAGGED.get(y)
+    if per_cut is None:
+        per_cut = _FLAGGED.put(y, (), {})
+    if c not in per_cut:
+        per_cut[c] = _flags(d, blocks, sig, step, c, level)
+    flags, lam, cut = per_cut[c]
+    return flags.copy(), lam, cut
 
 
 def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, level) -> tuple:
