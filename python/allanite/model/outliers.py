@@ -533,7 +533,19 @@ def replace_outliers(y: np.ndarray, flags: np.ndarray, seed: int = 0) -> np.ndar
         slow = _slow_level(y, flags, span, near)
         level = slow[idx] + _kept_sigma(y - slow, flags)[idx] * z
     else:
-        level = median_filter(y, size=LEVEL_SPAN, mode="nearest")[idx] + se[idx] / math.sqrt(1.5) * z
+        level = _running_median_at(y, idx, LEVEL_SPAN) + se[idx] / math.sqrt(1.5) * z
     line = (np.interp(idx, good, y[good]) if good.size else y[idx]) + se[idx] * z
     out[idx] = np.where(white[idx], level, line)
     return out
+
+
+def _running_median_at(y: np.ndarray, idx: np.ndarray, size: int) -> np.ndarray:
+    """``median_filter(y, size, mode="nearest")[idx]`` (odd ``size``): the median of the ``size`` samples around
+    each of ``idx``, the record's end samples repeated beyond it — the same numbers (a middle order statistic
+    either way), taken at the flagged samples alone where they are few instead of at every sample."""
+    if idx.size * 8 > y.size or not np.isfinite(y).all():
+        return median_filter(y, size=size, mode="nearest")[idx]
+    half = size // 2
+    padded = np.concatenate([np.full(half, y[0]), y, np.full(half, y[-1])])
+    windows = np.lib.stride_tricks.sliding_window_view(padded, size)
+    return np.median(windows[idx], axis=1)
