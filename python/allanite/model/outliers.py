@@ -309,21 +309,25 @@ def _level_residual(y: np.ndarray, step: float) -> tuple[np.ndarray, list, np.nd
     return (r, blocks, sig) if np.isfinite(sig).all() and np.all(sig > 0) else None
 
 
-#: What :func:`_flags` found per cut, by the samples' content (records up to 2·10⁶ samples): refine tests the same
-#: record at two levels (the removal's and the final check's share), and each level tries the same cuts in turn.
-_FLAGGED = Recent(2, 2_000_000)
+#: What :func:`_flags` found per cut, by the samples' content (records up to 2·10⁶ samples): refine tests the raw
+#: record at two levels (the removal's and the final check's share), each trying the same cuts in turn, with the
+#: removal's passes and flaggings of other samples between them (four records kept; the flags as indices).
+_FLAGGED = Recent(4, 2_000_000)
 
 
 def _flags_of(y: np.ndarray, d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, level) -> tuple:
     """:func:`_flags` of the samples ``y`` (``d``, ``blocks``, ``sig``, ``step`` and ``level`` are ``y``'s, as
-    :func:`outlier_test` derives them), remembered per cut; the flags a fresh copy each time."""
+    :func:`outlier_test` derives them), remembered per cut; the flags a fresh array each time."""
     per_cut = _FLAGGED.get(y)
     if per_cut is None:
         per_cut = _FLAGGED.put(y, (), {})
     if c not in per_cut:
-        per_cut[c] = _flags(d, blocks, sig, step, c, level)
-    flags, lam, cut = per_cut[c]
-    return flags.copy(), lam, cut
+        flags, lam, cut = _flags(d, blocks, sig, step, c, level)
+        per_cut[c] = (np.flatnonzero(flags), lam, cut)
+    at, lam, cut = per_cut[c]
+    flags = np.zeros(y.size, dtype=bool)
+    flags[at] = True
+    return flags, lam, cut
 
 
 def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, level) -> tuple:
