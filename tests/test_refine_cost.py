@@ -2,17 +2,18 @@
 
 Each shortcut is checked against the plain path, bit for bit: the fits of a grid run together against one fit at a
 time (the IRLS of the pre-batching code, written out here; with spectral lines held at their power too) and their
-designs stacked against one per model, the NNLS without scipy's wrapper against ``scipy.optimize.nnls``, the
-covariance blocks with the lag kernels of many pairs at once (and their nodes built for all pairs at once) against
-one pair at a time, Greenhall's EDF sums in one call against shift by shift, the replacement's running median at
-the flagged samples against the filter's, the drift bootstrap's one-product statistics against a QR per grid point
-(within 1e-9), Brent's bounded search as a coroutine against scipy's, a step's searches run in lockstep against one
-search after another (scipy's bounded search, one fit per call), the line spectra remembered within a refine and
-the EDF remembered per averaging factors against fresh ones, the line families' phase gridding, DTFT and waveforms
-against their plain forms, and a whole default ``refine`` with every memory and the lockstep against one that
-recomputes everything one search at a time. The fits here run the Python loop (``_irls.irls_python``; the Rust
-core's loop, which agrees with it to rounding, is checked in ``tests/test_refine_irls.py``), but for the whole
-default ``refine``, which runs the core's loop both ways. No timings here: ``benches/bench_refine_cost.py``.
+designs stacked against one per model, the NNLS
+without scipy's wrapper against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of many pairs at
+once (and their nodes built for all pairs at once) against one pair at a time, Greenhall's EDF sums in one call
+against shift by shift, the replacement's running median at the flagged samples against the filter's, the drift
+bootstrap's one-product statistics against a QR per grid point (within
+1e-9), Brent's bounded search as a coroutine against scipy's, a step's searches run in lockstep against one search
+after another (scipy's bounded search, one fit per call), the line spectra remembered within a refine and the EDF
+remembered per averaging factors against fresh ones, the line families' phase gridding, DTFT and waveforms against
+their plain forms, and a whole default ``refine`` with every memory and the lockstep against one that recomputes
+everything one search at a time. The fits here run the Python loop (``_irls.irls_python``; the Rust core's
+loop, which agrees with it to rounding, is checked in ``tests/test_refine_irls.py``), but for the whole default
+``refine``, which runs the core's loop both ways. No timings here: ``benches/bench_refine_cost.py``.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""Results remembered by their arrays' content within a refine (issue 29, refine's cost): each found again only for
-equal samples and the same key, and equal to a fresh computation — the memory itself
+"""Results remembered by their arrays' content within a refine (issue 29, refine's cost): each found again only
+for equal samples and the same key, and equal to a fresh computation — the memory itself
 (:class:`allanite.model._recent.Recent`), a line family's phasors, the outlier test's quantisation step and local
 noise scales and flags per cut, the bandwidth check's Welch spectrum. (A whole refine with every memory off:
 ``test_refine_cost.py``.)"""

@@ -5,13 +5,14 @@ solves with 1000 right-hand sides) and long thin ones (a line's 9 × 62 500 bloc
 thousands of times. OpenBLAS splits each over its threads, whose wake-up and spin-wait cost more than the
 product itself at these sizes, and far more when the cores are busy: on 2 cores at load 7, 544 products of
 9 × 62 500 by a vector and 200 of 63 × 63 by 63 × 1000 (with as many triangular solves) took 20.6 s wall, 9.4 s
-CPU on OpenBLAS's two threads against 0.43 s wall, 0.19 s CPU on one — the same numbers to the bit (each output
-element is summed by one thread either way). :func:`one_thread` sets every OpenBLAS the process has loaded
-(NumPy's and SciPy's wheels each bring one) to one thread (``openblas_set_num_threads_local``, OpenBLAS ≥
-0.3.27, which returns the count it replaces) and puts the count back when the last call inside one leaves it.
-The count is the library's, not the thread's: other threads of the process doing BLAS at the same time run on
-one thread too. Where there is no such OpenBLAS, or the platform does not list its loaded libraries
-(``/proc/self/maps``, Linux), it does nothing.
+CPU on OpenBLAS's two threads against 0.43 s wall, 0.19 s CPU on one, the same numbers to the bit. (A sum that
+OpenBLAS splits between its threads, a long dot product, moves in its last bits: refine's results are now a
+one-thread OpenBLAS's on any machine.) :func:`one_thread` sets every OpenBLAS the process has loaded (NumPy's and
+SciPy's wheels each bring one) to one thread (``openblas_set_num_threads_local``, OpenBLAS ≥ 0.3.27, which
+returns the count it replaces) and puts the count back when the last call inside one leaves it. The count is the
+library's, not the thread's: other threads of the process doing BLAS at the same time run on one thread too, and
+a count set meanwhile is overwritten on leaving. Where there is no such OpenBLAS, or the platform does not list
+its loaded libraries (``/proc/self/maps``, Linux), it does nothing.
 """
 
 from __future__ import annotations
