@@ -1,6 +1,6 @@
 """Results remembered by their arrays' content within a refine (issue 29, refine's cost): each found again only
 for equal samples and the same key, and equal to a fresh computation — the memory itself
-(:class:`allanite.model._recent.Recent`), a line family's phasors, the outlier test's quantisation step and local
+(:class:`allanite.model._recent.Recent`), a line family's phasors and refits, the outlier test's quantisation step and local
 noise scales and flags per cut, the bandwidth check's Welch spectrum. (A whole refine with every memory off:
 ``test_refine_cost.py``.)"""
 
@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from allanite.model import linefit, outliers, tracing
+from allanite.model import linefit, outliers, periodic, tracing
 from allanite.model._recent import Recent, remembering
 
 
@@ -157,3 +157,33 @@ def test_remembered_outlier_flags_equal_fresh_ones(monkeypatch):
     np.testing.assert_array_equal(again["flags"], fresh["flags"])
     np.testing.assert_array_equal(flags_at, fresh["flags"])
     assert lam_at == fresh["expected_gaussian_flags"] and again["cuts"] == fresh["cuts"]
+
+
+def test_remembered_family_refits_equal_fresh_ones(monkeypatch):
+    n, fs = 80_000, 100.0
+    t = np.arange(n)
+    y = np.random.default_rng(5).standard_normal(n) + 0.8 * np.sin(2 * np.pi * 0.0731 * t + 0.3)
+    y += 0.3 * np.cos(2 * np.pi * 2 * 0.0731 * t)
+    fam = periodic.LineFamily(
+        fs=fs,
+        gens=np.array([7.31]),
+        gens_cov=np.eye(1),
+        coefs=np.array([[1], [2]]),
+        a=np.zeros(2),
+        b=np.zeros(2),
+        noise=np.ones(2),
+        found=np.ones(2, dtype=bool),
+        n=n,
+    )
+    half = np.concatenate([np.arange(j * 10_000, (j + 1) * 10_000) for j in range(0, 8, 2)])
+    other = np.setdiff1d(t, half)
+    first = fam.refit(y[half], half)(other)
+    a, b = linefit.solve(y[half], half, fam.gens / fs, fam.coefs)  # afresh
+    np.testing.assert_array_equal(first, linefit.evaluate(other, fam.gens / fs, fam.coefs, a, b))
+    calls = []
+    monkeypatch.setattr(linefit, "solve", lambda *args: calls.append(1) or (a, b))
+    np.testing.assert_array_equal(fam.refit(y[half].copy(), half.copy())(other), first)  # found again
+    assert calls == []
+    fam.refit(y[half], half + 1)  # other indices: solved
+    fam.refit(y[half] + 1e-9, half)  # other samples: solved
+    assert len(calls) == 2
