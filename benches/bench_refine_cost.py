@@ -18,6 +18,9 @@ Usage::
 
     python benches/bench_refine_cost.py                 # -> benches/results/refine_cost.md
     python benches/bench_refine_cost.py --quick         # ADIS run 1 gyro_z only, to a temporary folder
+    python benches/bench_refine_cost.py --records 1:acc_x 1:gyro_z --rounds 3 --out /tmp/x
+                                                        # chosen ADIS records, each round alternating which
+                                                        # checkout runs first
 """
 
 from __future__ import annotations
@@ -127,6 +130,8 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path)
     ap.add_argument("--baseline", type=Path, help="python/ folder of the baseline checkout (with its core)")
     ap.add_argument("--after", type=Path, default=REPO / "python", help="python/ folder to time (default: this one)")
+    ap.add_argument("--records", nargs="+", metavar="RUN:AXIS", help="ADIS16405 records (default: the list above)")
+    ap.add_argument("--rounds", type=int, default=1, help="times each record is refined by each checkout")
     ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.worker:
@@ -138,17 +143,23 @@ def main(argv=None) -> int:
     out = a.out or (Path(tempfile.mkdtemp()) if a.quick else HERE / "results")
     base = a.baseline or _baseline_python(BASELINE)
     specs = ADIS[:1] if a.quick else ADIS + SENSORS
+    if a.records:
+        specs = [("adis", int(r.split(":")[0]), r.split(":")[1]) for r in a.records]
     rows, load0 = [], os.getloadavg()
     busy0, own0, wall0 = _common.OtherLoad._busy(), _own_and_children(), time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
-        for spec in specs:
-            before = _run(spec, base, Path(tmp))
-            after = _run(spec, a.after, Path(tmp))
+        for rnd, spec in ((r, sp) for r in range(a.rounds) for sp in specs):
+            if rnd % 2:  # odd rounds: this checkout first, so that neither always meets the load first
+                after = _run(spec, a.after, Path(tmp))
+                before = _run(spec, base, Path(tmp))
+            else:
+                before = _run(spec, base, Path(tmp))
+                after = _run(spec, a.after, Path(tmp))
             diff = _differences(before["row"], after["row"])
             close = compare_refine.compare(before["row"], after["row"])
             rows.append(
                 {
-                    "record": after["row"]["record"],
+                    "record": after["row"]["record"] + (f" (round {rnd + 1})" if a.rounds > 1 else ""),
                     "before": before,
                     "after": after,
                     "differences": diff,
@@ -216,7 +227,7 @@ def _write(rows, out: Path, base: Path, load0, load1, others) -> None:
     adis = [r for r in rows if r["record"].startswith("ADIS")]
     if adis:
         med = [statistics.median(r[w]["cpu"] / r[w]["samples"] * 1e6 for r in adis) for w in ("before", "after")]
-        lines += ["", f"Median CPU per 10⁶ samples over the {len(adis)} ADIS records: {med[0]:.1f} → {med[1]:.1f} s."]
+        lines += ["", f"Median CPU per 10⁶ samples over the {len(adis)} ADIS rows: {med[0]:.1f} → {med[1]:.1f} s."]
     out.mkdir(parents=True, exist_ok=True)
     (out / "refine_cost.md").write_text("\n".join(lines) + "\n")
 

@@ -5,7 +5,8 @@ time (the IRLS of the pre-batching code, written out here; with spectral lines h
 designs stacked against one per model, the NNLS
 without scipy's wrapper against ``scipy.optimize.nnls``, the covariance blocks with the lag kernels of many pairs at
 once (and their nodes built for all pairs at once) against one pair at a time, Greenhall's EDF sums in one call
-against shift by shift, the drift bootstrap's one-product statistics against a QR per grid point (within
+against shift by shift, the replacement's running median at the flagged samples against the filter's, the drift
+bootstrap's one-product statistics against a QR per grid point (within
 1e-9), Brent's bounded search as a coroutine against scipy's, a step's searches run in lockstep against one search
 after another (scipy's bounded search, one fit per call), the line spectra remembered within a refine and the EDF
 remembered per averaging factors against fresh ones, the line families' phase gridding, DTFT and waveforms against
@@ -584,3 +585,20 @@ def test_greenhall_sums_in_one_call_equal_shift_by_shift(monkeypatch):
     # one np.sum over every shift against a sum per shift: the same terms, NumPy's summation order aside
     np.testing.assert_allclose(new, plain, rtol=1e-12, atol=0)
     assert len(set(new)) > len(cases) // 2
+
+
+@pytest.mark.parametrize("n", [10, 64, 65, 1_000, 200_000])
+def test_running_median_at_flags_equals_the_filter(n):
+    from scipy.ndimage import median_filter
+
+    from allanite.model import outliers
+
+    rng = np.random.default_rng(n)
+    y = np.round(rng.standard_normal(n).cumsum(), 1)  # ties too
+    full = median_filter(y, size=outliers.LEVEL_SPAN, mode="nearest")
+    for k in (1, 2, max(1, n // 50), n // 3):
+        idx = np.sort(rng.choice(n, size=k, replace=False))
+        idx[0] = 0  # the record's ends, where the window runs past them
+        idx[-1] = n - 1 if k > 1 else idx[-1]
+        idx = np.unique(idx)
+        np.testing.assert_array_equal(outliers._running_median_at(y, idx, outliers.LEVEL_SPAN), full[idx])

@@ -1,14 +1,15 @@
 """Results remembered by their arrays' content within a refine (issue 29, refine's cost): each found again only
 for equal samples and the same key, and equal to a fresh computation — the memory itself
-(:class:`allanite.model._recent.Recent`), a line family's phasors, the outlier test's quantisation step and local
-noise scales. (A whole refine with every memory off: ``test_refine_cost.py``.)"""
+(:class:`allanite.model._recent.Recent`), a line family's phasors and refits, the outlier test's quantisation step and local
+noise scales and flags per cut, the bandwidth check's Welch spectrum. (A whole refine with every memory off:
+``test_refine_cost.py``.)"""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from allanite.model import linefit, outliers
+from allanite.model import linefit, outliers, periodic, tracing
 from allanite.model._recent import Recent, remembering
 
 
@@ -117,3 +118,72 @@ def test_phasors_of_a_long_record_are_exact_to_rounding():
         assert abs(got[n] - complex(math.cos(2 * math.pi * ph), math.sin(2 * math.pi * ph))) < 2e-11
     sparse = np.array([5, 4096, 1_234_567])
     np.testing.assert_array_equal(linefit._phasor(nu, sparse), got[sparse])
+
+
+def test_remembered_rolloff_spectrum_equals_a_fresh_one():
+    from scipy import signal
+
+    y = np.random.default_rng(8).standard_normal(60_000).cumsum() * 1e-3 + 0.2
+    r1, r2 = np.array([1.0, 0.5]), np.array([1.0, 0.25, 0.05])
+    first = tracing.rolloff_psd(y, 50.0, r1)
+    f, p = signal.welch(y - y.mean(), fs=50.0, nperseg=4096)  # the spectrum computed afresh
+    hi, lo = (f >= 20.0) & (f <= 24.0), (f >= 1.0) & (f <= 5.0)
+    assert first["measured"] == float(p[hi].mean() / p[lo].mean())
+    got = tracing._WELCH.get(y, (50.0, 4096))
+    assert got is not None and not got[1].flags.writeable
+    again = tracing.rolloff_psd(y.copy(), 50.0, r2)  # equal samples, another filter: the spectrum found again
+    assert again["measured"] == first["measured"] and again["predicted"] != first["predicted"]
+    assert tracing._WELCH.get(y, (50.0, 4096)) is got
+    z = y.copy()
+    z[100] += 1.0  # other samples: computed
+    f2, p2 = signal.welch(z - z.mean(), fs=50.0, nperseg=4096)
+    assert tracing.rolloff_psd(z, 50.0, r1)["measured"] == float(p2[hi].mean() / p2[lo].mean())
+
+
+def test_remembered_outlier_flags_equal_fresh_ones(monkeypatch):
+    rng = np.random.default_rng(12)
+    y = rng.standard_normal(40_000)
+    y[rng.choice(y.size, 40, replace=False)] += rng.choice([-1, 1], 40) * rng.uniform(6, 12, 40)
+    first = outliers.outlier_test(y, 100.0, 0.01)
+    assert first["accepted"] and np.count_nonzero(first["flags"]) >= 30
+    first["flags"][:] = False  # the caller's copy: the memory keeps its own
+    per_cut = outliers._FLAGGED.get(y)
+    assert per_cut is not None and first["cut"] in per_cut
+    again = outliers.outlier_test(y.copy(), 100.0, 0.001)  # another level, the same samples: found again
+    flags_at, lam_at = outliers.flag_at(y, again["cut"])
+    monkeypatch.setattr(Recent, "get", lambda self, arr, key=(): None)  # everything afresh
+    fresh = outliers.outlier_test(y, 100.0, 0.001)
+    assert again["cut"] == fresh["cut"] and again["expected_gaussian_flags"] == fresh["expected_gaussian_flags"]
+    np.testing.assert_array_equal(again["flags"], fresh["flags"])
+    np.testing.assert_array_equal(flags_at, fresh["flags"])
+    assert lam_at == fresh["expected_gaussian_flags"] and again["cuts"] == fresh["cuts"]
+
+
+def test_remembered_family_refits_equal_fresh_ones(monkeypatch):
+    n, fs = 80_000, 100.0
+    t = np.arange(n)
+    y = np.random.default_rng(5).standard_normal(n) + 0.8 * np.sin(2 * np.pi * 0.0731 * t + 0.3)
+    y += 0.3 * np.cos(2 * np.pi * 2 * 0.0731 * t)
+    fam = periodic.LineFamily(
+        fs=fs,
+        gens=np.array([7.31]),
+        gens_cov=np.eye(1),
+        coefs=np.array([[1], [2]]),
+        a=np.zeros(2),
+        b=np.zeros(2),
+        noise=np.ones(2),
+        found=np.ones(2, dtype=bool),
+        n=n,
+    )
+    half = np.concatenate([np.arange(j * 10_000, (j + 1) * 10_000) for j in range(0, 8, 2)])
+    other = np.setdiff1d(t, half)
+    first = fam.refit(y[half], half)(other)
+    a, b = linefit.solve(y[half], half, fam.gens / fs, fam.coefs)  # afresh
+    np.testing.assert_array_equal(first, linefit.evaluate(other, fam.gens / fs, fam.coefs, a, b))
+    calls = []
+    monkeypatch.setattr(linefit, "solve", lambda *args: calls.append(1) or (a, b))
+    np.testing.assert_array_equal(fam.refit(y[half].copy(), half.copy())(other), first)  # found again
+    assert calls == []
+    fam.refit(y[half], half + 1)  # other indices: solved
+    fam.refit(y[half] + 1e-9, half)  # other samples: solved
+    assert len(calls) == 2

@@ -255,7 +255,7 @@ def outlier_test(y: np.ndarray, fs: float, alpha: float) -> dict:
     level = _level_residual(y, step)
     out["rule"] = "neighbours" if level is None else "level"
     for c in FLAG_CUTS:
-        flags, lam, cut = _flags(d, blocks, sig, step, c, level)
+        flags, lam, cut = _flags_of(y, d, blocks, sig, step, c, level)
         k = int(np.count_nonzero(flags))
         # Gaussian samples flagged: at most the differences beyond the cut, λ (exact for the lattice too); the
         # flagged count itself beyond what twice that gives, at the test's own α per cut (one sample where
@@ -283,7 +283,7 @@ def flag_at(y: np.ndarray, c: float) -> tuple[np.ndarray, float]:
     sig = np.array([robust_sigma(d[b], step) for b in blocks])
     if not np.isfinite(sig).all():
         return np.zeros(y.size, dtype=bool), 0.0
-    flags, lam, _cut = _flags(d, blocks, sig, step, c, _level_residual(y, step))
+    flags, lam, _cut = _flags_of(y, d, blocks, sig, step, c, _level_residual(y, step))
     return flags, lam
 
 
@@ -307,6 +307,27 @@ def _level_residual(y: np.ndarray, step: float) -> tuple[np.ndarray, list, np.nd
     blocks = _blocks(y.size)
     sig = np.array([robust_sigma(r[b], step) for b in blocks])
     return (r, blocks, sig) if np.isfinite(sig).all() and np.all(sig > 0) else None
+
+
+#: What :func:`_flags` found per cut, by the samples' content (records up to 2·10⁶ samples): refine tests the raw
+#: record at two levels (the removal's and the final check's share), each trying the same cuts in turn, with the
+#: removal's passes and flaggings of other samples between them (four records kept; the flags as indices).
+_FLAGGED = Recent(4, 2_000_000)
+
+
+def _flags_of(y: np.ndarray, d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, level) -> tuple:
+    """:func:`_flags` of the samples ``y`` (``d``, ``blocks``, ``sig``, ``step`` and ``level`` are ``y``'s, as
+    :func:`outlier_test` derives them), remembered per cut; the flags a fresh array each time."""
+    per_cut = _FLAGGED.get(y)
+    if per_cut is None:
+        per_cut = _FLAGGED.put(y, (), {})
+    if c not in per_cut:
+        flags, lam, cut = _flags(d, blocks, sig, step, c, level)
+        per_cut[c] = (np.flatnonzero(flags), lam, cut)
+    at, lam, cut = per_cut[c]
+    flags = np.zeros(y.size, dtype=bool)
+    flags[at] = True
+    return flags, lam, cut
 
 
 def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, level) -> tuple:
@@ -516,7 +537,19 @@ def replace_outliers(y: np.ndarray, flags: np.ndarray, seed: int = 0) -> np.ndar
         slow = _slow_level(y, flags, span, near)
         level = slow[idx] + _kept_sigma(y - slow, flags)[idx] * z
     else:
-        level = median_filter(y, size=LEVEL_SPAN, mode="nearest")[idx] + se[idx] / math.sqrt(1.5) * z
+        level = _running_median_at(y, idx, LEVEL_SPAN) + se[idx] / math.sqrt(1.5) * z
     line = (np.interp(idx, good, y[good]) if good.size else y[idx]) + se[idx] * z
     out[idx] = np.where(white[idx], level, line)
     return out
+
+
+def _running_median_at(y: np.ndarray, idx: np.ndarray, size: int) -> np.ndarray:
+    """``median_filter(y, size, mode="nearest")[idx]`` (odd ``size``): the median of the ``size`` samples around
+    each of ``idx``, the record's end samples repeated beyond it — the same numbers (a middle order statistic
+    either way), taken at the flagged samples alone where they are few instead of at every sample."""
+    if idx.size * 8 > y.size or not np.isfinite(y).all():
+        return median_filter(y, size=size, mode="nearest")[idx]
+    half = size // 2
+    padded = np.concatenate([np.full(half, y[0]), y, np.full(half, y[-1])])
+    windows = np.lib.stride_tricks.sliding_window_view(padded, size)
+    return np.median(windows[idx], axis=1)

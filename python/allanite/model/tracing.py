@@ -27,6 +27,7 @@ from scipy.optimize import minimize_scalar
 
 from ..simulation import simulate
 from . import _chi2_draws, _covariance
+from ._recent import Recent
 
 __all__ = [
     "drift_fit",
@@ -180,7 +181,7 @@ def rolloff_psd(y: np.ndarray, fs: float, r: np.ndarray) -> dict:
     Allan curve): the Welch PSD's power at 0.40–0.48·f_s over its power at 0.02–0.10·f_s, measured and as the
     filter with normalised autocorrelation ``r`` predicts for white input (r₀ + 2Σ r_l cos 2πfl/f_s)."""
     nper = int(min(4096, 2 ** int(math.log2(max(y.size // 8, 256)))))
-    f, p = signal.welch(y - y.mean(), fs=fs, nperseg=nper)
+    f, p = _rolloff_welch(np.asarray(y, dtype=np.float64), float(fs), nper)
     hi, lo = (f >= 0.40 * fs) & (f <= 0.48 * fs), (f >= 0.02 * fs) & (f <= 0.10 * fs)
     lags = np.arange(1, r.size)
 
@@ -192,6 +193,21 @@ def rolloff_psd(y: np.ndarray, fs: float, r: np.ndarray) -> dict:
         "predicted": float(model(f[hi]).mean() / model(f[lo]).mean()),
         "bands_hz": (0.02 * fs, 0.10 * fs, 0.40 * fs, 0.48 * fs),
     }
+
+
+#: The Welch PSDs of :func:`rolloff_psd`, of records up to 4·10⁶ samples: each curve step's bandwidth candidates
+#: and the accepted bandwidth's evidence ask for the same samples' spectrum, each with another filter's prediction.
+_WELCH = Recent(2, 4_000_000)
+
+
+def _rolloff_welch(y: np.ndarray, fs: float, nper: int) -> tuple[np.ndarray, np.ndarray]:
+    """``signal.welch`` of the de-meaned ``y`` (remembered by content within a refine call; read-only)."""
+    got = _WELCH.get(y, (fs, nper))
+    if got is None:
+        f, p = signal.welch(y - y.mean(), fs=fs, nperseg=nper)
+        f.flags.writeable = p.flags.writeable = False
+        got = _WELCH.put(y, (fs, nper), (f, p))
+    return got
 
 
 def regression_fit(y: np.ndarray, ch: np.ndarray, n_blocks: int = 8) -> dict:

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..._blas import one_thread
 from ..._progress import StepBar
 from ...analysis import avar
 from ...errors import ParameterError
@@ -120,8 +121,9 @@ def refine(
         (['gauss_markov'], 10.0)
     """
     check_scale(x_or_result)
-    # each line spectrum once; curves, phasors and outlier scales of the same samples once
-    with StepBar(progress, 1, "refine") as bar, remembering_spectra(), remembering():
+    # each line spectrum once; curves, phasors and outlier scales of the same samples once; OpenBLAS on one
+    # thread (its products here are small or thin: its threads cost more than they save, :mod:`allanite._blas`)
+    with StepBar(progress, 1, "refine") as bar, remembering_spectra(), remembering(), one_thread():
         bar.step("fit, trace and test the candidates")
         start = check_terms(start)
         candidates = _check_candidates(candidates, level)
