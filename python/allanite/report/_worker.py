@@ -186,6 +186,7 @@ def _serve(r: int, w: int) -> int:  # pragma: no cover - runs in the forked work
     report comes, hand all the PNGs back; 0 when done."""
     import select
 
+    _skip_setter_docs()
     from .figures import figure_specs, from_analysis_alone
     from .rendering import GC_THRESHOLD, png, render_pngs
 
@@ -234,6 +235,27 @@ def _read_exactly(r: int, n: int) -> bytes | None:
         parts.append(chunk)
         got += len(chunk)
     return b"".join(parts)
+
+
+def _skip_setter_docs() -> None:  # pragma: no cover - runs in the forked worker
+    """Let matplotlib's import skip writing the signature and docstring of each Artist class's ``set``.
+
+    Every Artist subclass matplotlib defines lists its settable properties in its ``set`` method's docstring at
+    import (``Artist.__init_subclass__``: an introspection of all its setters) — a third of the ~0.5 s of CPU that
+    importing what the figures need costs here (``benches/bench_figure_worker.py``). This process only draws and
+    shows no help text: ``set`` itself is unchanged (each class's ``set`` still calls ``Artist.set``, which
+    normalises the keyword aliases as before), only its ``__doc__`` and ``__signature__`` are not filled in, and
+    the PNGs are the same bytes. Nothing is done where matplotlib is imported already or no longer has the hook."""
+    import sys
+
+    if "matplotlib.figure" in sys.modules:
+        return
+    try:
+        from matplotlib.artist import Artist
+    except ImportError:
+        return
+    if callable(getattr(Artist, "_update_set_signature_and_docstring", None)):
+        Artist._update_set_signature_and_docstring = classmethod(lambda cls: None)  # type: ignore[attr-defined]
 
 
 def _warm_up() -> None:  # pragma: no cover - runs in the forked worker
