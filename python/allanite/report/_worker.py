@@ -241,8 +241,8 @@ def _skip_setter_docs() -> None:  # pragma: no cover - runs in the forked worker
     """Let matplotlib's import skip writing the signature and docstring of each Artist class's ``set``.
 
     Every Artist subclass matplotlib defines lists its settable properties in its ``set`` method's docstring at
-    import (``Artist.__init_subclass__``: an introspection of all its setters) — a third of the ~0.5 s of CPU that
-    importing what the figures need costs here (``benches/bench_figure_worker.py``). This process only draws and
+    import (``Artist.__init_subclass__``: an introspection of all its setters) — about a third of the CPU that
+    importing what the figures need costs (``benches/bench_figure_worker.py``). This process only draws and
     shows no help text: ``set`` itself is unchanged (each class's ``set`` still calls ``Artist.set``, which
     normalises the keyword aliases as before), only its ``__doc__`` and ``__signature__`` are not filled in, and
     the PNGs are the same bytes. Nothing is done where matplotlib is imported already or no longer has the hook."""
