@@ -397,3 +397,18 @@ def test_skipping_the_setter_docstrings_leaves_an_imported_matplotlib_alone():
         pass
 
     assert Later.set.__doc__ and "linewidth" in Later.set.__doc__
+
+
+def test_a_task_about_to_wait_counts_as_an_idle_core(monkeypatch):
+    """The figure process, handed the report, counts the command's process (runnable while it writes the JSON,
+    then waiting for the PNGs) as leaving its core: two processes draw even where the run queue shows none idle."""
+    from allanite.report import _worker, rendering
+
+    monkeypatch.setattr(rendering, "idle_cores", lambda cores: 0.0)
+    monkeypatch.setattr(rendering.os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
+    assert rendering.figure_processes() == 1
+    assert rendering.figure_processes(leaving=1) == 2
+    monkeypatch.setattr(rendering, "idle_cores", lambda cores: -1.0)  # one more task than cores: still busy
+    assert rendering.figure_processes(leaving=1) == 1
+    assert _worker._runnable(os.getpid())  # this process, running this line
+    assert not _worker._runnable(-5)  # no such process: unknown counts as not runnable

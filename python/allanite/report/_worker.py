@@ -188,7 +188,7 @@ def _serve(r: int, w: int) -> int:  # pragma: no cover - runs in the forked work
 
     _skip_setter_docs()
     from .figures import figure_specs, from_analysis_alone
-    from .rendering import GC_THRESHOLD, png, render_pngs
+    from .rendering import GC_THRESHOLD, figure_processes, png, render_pngs
 
     os.setpgid(0, 0)  # its own group: killed with the drawing process it forks; Ctrl-C reaches the parent only
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -210,11 +210,22 @@ def _serve(r: int, w: int) -> int:  # pragma: no cover - runs in the forked work
     _, rep, dpi = message
     specs = figure_specs(rep)
     rest = [sp for sp in specs if early.get(sp[0], (None, None))[1] != dpi]
-    drawn = render_pngs(rest, dpi, lambda text: None)
+    # the command's process, where runnable now, waits for the PNGs once it has written the JSON: its core frees
+    leaving = int(_runnable(os.getppid()))
+    drawn = render_pngs(rest, dpi, lambda text: None, processes=figure_processes(leaving=leaving))
     images = {sp[0]: drawn[sp[0]] if sp[0] in drawn else early[sp[0]][0] for sp in specs}
     with os.fdopen(w, "wb") as f:
         f.write(pickle.dumps(images, protocol=pickle.HIGHEST_PROTOCOL))
     return 0
+
+
+def _runnable(pid: int) -> bool:
+    """Whether process ``pid`` is running or runnable now (``R`` in ``/proc/PID/stat``); False where unknown."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] == "R"
+    except (OSError, IndexError):
+        return False
 
 
 def _receive(r: int):

@@ -80,11 +80,13 @@ def fewer_collections():
         gc.set_threshold(*old)
 
 
-def figure_processes() -> int:
+def figure_processes(leaving: int = 0) -> int:
     """Processes that draw the figures: 2 where ``fork`` exists, two cores are available, one of them is idle
     now (:func:`idle_cores`) and this is the main thread, else 1 (a report built in a worker thread — Dask's
     ``allanite batch`` — gets its parallelism from its workers, and a fork beside running threads could copy
-    a lock one of them holds)."""
+    a lock one of them holds). ``leaving``: runnable tasks counted now that are about to wait — the figure
+    process of :mod:`allanite.report._worker` counts the command's process, which hands it the report and then
+    only writes the JSON before it waits for the PNGs."""
     if not hasattr(os, "fork") or sys.platform != "linux" or threading.current_thread() is not threading.main_thread():
         return 1
     try:
@@ -93,7 +95,7 @@ def figure_processes() -> int:
         cores = os.cpu_count() or 1
     # a second process pays off only on an idle core: on a machine busy with other work it adds the child's
     # share (~15 % more CPU in all) and gains no core (measured: benches/results/pipeline.md)
-    return 2 if cores >= 2 and idle_cores(cores) >= 1 else 1
+    return 2 if cores >= 2 and idle_cores(cores) + leaving >= 1 else 1
 
 
 #: Samples of the run queue :func:`idle_cores` takes, and the pause between them (s).
