@@ -7,8 +7,9 @@ analysis as soon as it exists (:func:`offer`: the static and dynamic results, be
 it draws the figures that need nothing more (:func:`allanite.report.figures.from_analysis_alone`: the DAVAR heat
 maps and surfaces) while this process fits; offered it again with the fits where more is computed after them
 (``refine``, frames, paper 002's sections), it draws every figure but theirs meanwhile; handed the whole report
-(pickled: arrays and the fits, a few hundred kB), it draws the rest — on two processes where a core is idle then
-(:func:`allanite.report.rendering.render_pngs`) — and hands the PNGs back. This process then never imports
+(pickled: arrays and the fits, a few hundred kB), it draws the rest — on two processes where a core is idle then,
+this process's counted as free (it only writes the JSON before it waits; :func:`allanite.report.rendering.render_pngs`)
+— and hands the PNGs back. This process then never imports
 matplotlib. The PNGs are the same bytes as drawn here.
 
 The worker is started only where the figures would be drawn on two processes
