@@ -30,13 +30,12 @@ def special():
 
 
 def _kernels_module():
-    import sys
     import threading
 
-    if "scipy.special" not in sys.modules and threading.active_count() == 1:
+    if threading.active_count() == 1:
         try:
             return _ufuncs_alone()
-        except Exception:  # another SciPy layout: the package as usual
+        except Exception:  # scipy.special imported already, or another SciPy layout: the package as usual
             pass
     from scipy import special as package
 
@@ -46,11 +45,14 @@ def _kernels_module():
 def _ufuncs_alone():
     """``scipy.special._ufuncs`` loaded from its file without running ``scipy/special/__init__.py``.
 
-    The extension imports its compiled siblings (``_ufuncs_cxx``, ``_special_ufuncs``, …) as submodules of
-    ``scipy.special``, so a bare package module stands in for it while it loads (only this thread runs Python:
-    :func:`_kernels_module`). Afterwards every ``scipy.special`` entry is taken out of ``sys.modules`` again —
-    a later ``import scipy.special`` (``refine``, a user's code) runs the package's ``__init__`` and loads its
-    submodules as if this had not happened, with all its attributes; this module keeps its own instance."""
+    The one place allanite writes ``sys.modules`` besides :mod:`allanite.compat`'s opt-in alias
+    (``tests/test_layering.py``). The extension imports its compiled siblings (``_ufuncs_cxx``,
+    ``_special_ufuncs``, …) as submodules of ``scipy.special``, so a bare package module stands in for it while
+    it loads (only this thread runs Python: :func:`_kernels_module`); where ``scipy.special`` is imported
+    already, ImportError (its ufuncs are taken from it). Afterwards every ``scipy.special`` entry is taken out of
+    ``sys.modules`` again — a later ``import scipy.special`` (``refine``, a user's code) runs the package's
+    ``__init__`` and loads its submodules as if this had not happened, with all its attributes; this module
+    keeps its own instance."""
     import importlib.machinery
     import importlib.util
     import os
@@ -59,6 +61,8 @@ def _ufuncs_alone():
 
     import scipy
 
+    if "scipy.special" in sys.modules:
+        raise ImportError("scipy.special is imported already: its ufuncs are taken from it")
     base = os.path.join(scipy.__path__[0], "special")
     paths = [os.path.join(base, "_ufuncs" + s) for s in importlib.machinery.EXTENSION_SUFFIXES]
     path = next(p for p in paths if os.path.exists(p))  # StopIteration: another layout, the package is used

@@ -258,14 +258,13 @@ def _skip_setter_docs() -> None:  # pragma: no cover - runs in the forked worker
     shows no help text: ``set`` itself is unchanged (each class's ``set`` still calls ``Artist.set``, which
     normalises the keyword aliases as before), only its ``__doc__`` and ``__signature__`` are not filled in, and
     the PNGs are the same bytes. Nothing is done where matplotlib is imported already or no longer has the hook."""
-    import sys
-
-    if "matplotlib.figure" in sys.modules:
-        return
     try:
+        import matplotlib
         from matplotlib.artist import Artist
     except ImportError:
         return
+    if any(hasattr(matplotlib, m) for m in ("lines", "text", "patches", "figure")):
+        return  # its artists are defined already: imported before the fork
     if callable(getattr(Artist, "_update_set_signature_and_docstring", None)):
         Artist._update_set_signature_and_docstring = classmethod(lambda cls: None)  # type: ignore[attr-defined]
 
