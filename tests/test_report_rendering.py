@@ -37,7 +37,7 @@ def test_two_processes_give_the_serial_bytes_in_order():
 
 
 def test_a_figure_failing_in_the_child_fails_in_the_parent():
-    specs = [_spec(0), _spec(1, fail=True), _spec(2), _spec(3)]  # odd indices go to the child
+    specs = [_spec(0), _spec(1, fail=True), _spec(2), _spec(3)]  # whichever process takes it, it fails here
     with pytest.raises(ValueError, match="figure 1 cannot be drawn"):
         render_pngs(specs, 60, lambda text: None, processes=2)
 
@@ -107,17 +107,15 @@ def test_idle_cores_without_the_run_queue_uses_the_load_average(monkeypatch):
     assert rendering.idle_cores(2) == 0.5
 
 
-def test_the_child_gets_half_of_the_drawing_by_area():
-    from allanite.report.rendering import child_share
+def test_the_figures_are_queued_largest_first():
+    from allanite.report.rendering import draw_order
 
     def sized(k, w, h):
         return (f"f{k}.png", "", "", (w, h), None)
 
-    # one large figure (area 8) and four small ones (area 2 each): the parent draws the large one, the child the rest
-    specs = [sized(0, 2, 1), sized(1, 4, 2), sized(2, 2, 1), sized(3, 2, 1), sized(4, 2, 1)]
-    assert child_share(specs) == [0, 2, 3, 4]
-    # equal figures alternate, the parent first
-    assert child_share([sized(k, 2, 1) for k in range(5)]) == [1, 3]
+    # one large figure (area 8), one middling (4) and three small ones (2 each, kept in the specs' order)
+    specs = [sized(0, 2, 1), sized(1, 4, 2), sized(2, 2, 1), sized(3, 2, 2), sized(4, 2, 1)]
+    assert draw_order(specs) == [1, 3, 0, 2, 4]
 
 
 def _marking(k, folder, size=(2.4, 1.8)):
@@ -130,7 +128,7 @@ def _marking(k, folder, size=(2.4, 1.8)):
     return (f"f{k}.png", f"figure {k}", "caption", size, draw)
 
 
-def test_each_figure_is_drawn_once_by_one_of_the_two_processes(tmp_path):
+def test_each_queued_figure_is_drawn_once_by_one_of_the_two_processes(tmp_path):
     specs = [_marking(k, tmp_path, (2.0 + 0.1 * (k % 3), 1.5)) for k in range(8)]
     split = render_pngs(specs, 40, lambda text: None, processes=2)
     marks = sorted(p.name for p in tmp_path.iterdir())
@@ -143,9 +141,9 @@ def test_each_figure_is_drawn_once_by_one_of_the_two_processes(tmp_path):
     assert list(split) == list(serial) and all(split[k] == serial[k] for k in serial)
 
 
-def test_the_figures_of_a_dead_child_are_drawn_by_the_parent(tmp_path):
-    """A child that dies while drawing its share (killed, out of memory) hands nothing back: the parent draws
-    the child's figures itself, and its own as before."""
+def test_figures_a_dead_child_took_are_drawn_by_the_parent(tmp_path):
+    """A child that dies after taking a figure from the queue (killed, out of memory) hands nothing back: the
+    parent draws the figure it took, and the other figures as before."""
     import time
 
     parent, died = os.getpid(), tmp_path / "child died"
@@ -154,9 +152,9 @@ def test_the_figures_of_a_dead_child_are_drawn_by_the_parent(tmp_path):
         def draw(fig):
             if os.getpid() != parent:
                 died.touch()
-                os._exit(3)  # the child dies on its first figure
+                os._exit(3)  # the child dies on the first figure it takes
             deadline = time.monotonic() + 30
-            while not died.exists() and time.monotonic() < deadline:  # the child has started drawing
+            while not died.exists() and time.monotonic() < deadline:  # leave the child a figure to take
                 time.sleep(0.005)
             fig.add_subplot().plot([0, k + 1])
 
@@ -316,7 +314,7 @@ def test_two_figures_are_split_where_matplotlib_is_set_up(monkeypatch):
     real_fork = rendering._fork_child
     monkeypatch.setattr(rendering, "_fork_child", lambda *a: forked.append(a[1]) or real_fork(*a))
     split = render_pngs(specs, 60, lambda text: None, processes=2)
-    assert forked == [[1]]  # the child drew the second figure
+    assert len(forked) == 1  # a child took figures from the queue
     assert list(split) == list(serial) and all(split[k] == serial[k] for k in serial)
 
 
