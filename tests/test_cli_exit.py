@@ -91,3 +91,19 @@ def test_import_allanite_leaves_the_optional_modules_for_their_first_use():
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
     assert proc.stdout.split("\n")[:2] == ["[]", "True True True"], proc.stdout + proc.stderr
+
+
+def test_the_report_loads_the_quantile_kernels_alone_even_with_a_progress_bar(tmp_path):
+    """With a bar on a terminal (tqdm starts a monitor thread), the command still loads the intervals' χ²
+    kernels without the whole scipy.special package: it loads them before the bar exists."""
+    log = tmp_path / "gyro.csv"
+    np.savetxt(log, np.random.default_rng(5).normal(size=(4000, 1)) * 0.01, header="g", comments="")
+    code = (
+        "import sys, threading; from allanite import cli, _dist; "
+        "cli._isatty = lambda stream: True; "
+        f"rc = cli.main(['report', {str(log)!r}, '--fs', '50', '--out', {str(tmp_path / 'o')!r}]); "
+        "print('KERNELS', _dist.special().__name__, 'scipy.special' in sys.modules, 'tqdm' in sys.modules, rc)"
+    )
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
+    assert "KERNELS scipy.special._ufuncs False True 0" in proc.stdout, proc.stdout + proc.stderr[-3000:]

@@ -1,6 +1,7 @@
 """``import allanite`` leaves the heavy SciPy modules for their first use, and the quantiles it computes
 without scipy.stats are scipy.stats' own numbers."""
 
+import math
 import subprocess
 import sys
 
@@ -68,3 +69,54 @@ def test_quantiles_are_scipy_stats_numbers_bit_for_bit():
     np.testing.assert_array_equal(norm_ppf(p), stats.norm.ppf(p))
     assert isinstance(chi2_sf(5.0, 3), float) and chi2_sf(5.0, 3) == stats.chi2.sf(5.0, 3)
     assert np.isnan(chi2_ppf(0.5, 0.0)) and np.isnan(chi2_sf(1.0, 0.0))  # no χ² with ν ≤ 0
+
+
+_KERNELS_FIRST = r"""
+import json, sys
+import numpy as np
+from allanite import _dist
+rng = np.random.default_rng(30)
+nu = np.concatenate([rng.random(2000) * 1e4 + 0.01, rng.integers(1, 300, 2000).astype(float), [1e6, 0.0, -1.0]])
+p = np.concatenate([rng.random(4000), [0.5, 0.0, 1.0]])
+x = np.concatenate([rng.random(4000) * 300, [1e6, 0.0, -1.0]])
+ours = [_dist.chi2_ppf(0.975, nu), _dist.chi2_ppf(p, nu), _dist.chi2_sf(x, nu), _dist.norm_ppf(p)]
+alone = "scipy.special" not in sys.modules  # the kernels' extension was loaded without the package
+kernels = _dist.special().__name__
+import scipy.special, scipy.stats  # the package, imported afterwards as usual
+theirs = [scipy.stats.chi2.ppf(0.975, nu), scipy.stats.chi2.ppf(p, nu), scipy.stats.chi2.sf(x, nu), scipy.stats.norm.ppf(p)]
+same = all(np.array_equal(a, b, equal_nan=True) for a, b in zip(ours, theirs))
+print(json.dumps({"alone": alone, "kernels": kernels, "same": same, "names": sorted(dir(scipy.special)),
+                  "gammaln": float(scipy.special.gammaln(3.3))}))
+"""
+
+
+def test_the_kernels_load_without_scipy_special_and_leave_it_whole():
+    """``allanite._dist`` loads scipy.special's compiled ufuncs alone where the package is not imported yet
+    (``import scipy.special`` costs ~0.4 s of CPU): the same numbers as scipy.stats, bit for bit, and a later
+    ``import scipy.special`` has every name it has in a process that never took that path."""
+    import json
+
+    got = json.loads(subprocess.run([sys.executable, "-c", _KERNELS_FIRST], capture_output=True, text=True,
+                                    check=True).stdout)  # fmt: skip
+    clean = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import json, scipy.special, scipy.stats; print(json.dumps(sorted(dir(scipy.special))))",
+        ],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert got["alone"] and got["kernels"] == "scipy.special._ufuncs"
+    assert got["same"]
+    assert got["names"] == json.loads(clean.stdout)
+    assert got["gammaln"] == pytest.approx(math.lgamma(3.3), rel=1e-14)  # the package works as usual
+
+
+def test_with_scipy_special_imported_the_kernels_come_from_it():
+    import scipy.special
+
+    from allanite import _dist
+
+    assert _dist._kernels_module() is scipy.special

@@ -37,7 +37,7 @@ def test_two_processes_give_the_serial_bytes_in_order():
 
 
 def test_a_figure_failing_in_the_child_fails_in_the_parent():
-    specs = [_spec(0), _spec(1, fail=True), _spec(2), _spec(3)]  # odd indices go to the child
+    specs = [_spec(0), _spec(1, fail=True), _spec(2), _spec(3)]  # whichever process takes it, it fails here
     with pytest.raises(ValueError, match="figure 1 cannot be drawn"):
         render_pngs(specs, 60, lambda text: None, processes=2)
 
@@ -107,17 +107,66 @@ def test_idle_cores_without_the_run_queue_uses_the_load_average(monkeypatch):
     assert rendering.idle_cores(2) == 0.5
 
 
-def test_the_child_gets_half_of_the_drawing_by_area():
-    from allanite.report.rendering import child_share
+def test_the_figures_are_queued_largest_first():
+    from allanite.report.rendering import draw_order
 
     def sized(k, w, h):
         return (f"f{k}.png", "", "", (w, h), None)
 
-    # one large figure (area 8) and four small ones (area 2 each): the parent draws the large one, the child the rest
-    specs = [sized(0, 2, 1), sized(1, 4, 2), sized(2, 2, 1), sized(3, 2, 1), sized(4, 2, 1)]
-    assert child_share(specs) == [0, 2, 3, 4]
-    # equal figures alternate, the parent first
-    assert child_share([sized(k, 2, 1) for k in range(5)]) == [1, 3]
+    # one large figure (area 8), one middling (4) and three small ones (2 each, kept in the specs' order)
+    specs = [sized(0, 2, 1), sized(1, 4, 2), sized(2, 2, 1), sized(3, 2, 2), sized(4, 2, 1)]
+    assert draw_order(specs) == [1, 3, 0, 2, 4]
+
+
+def _marking(k, folder, size=(2.4, 1.8)):
+    """A figure whose drawing leaves a file named after it and the drawing process's id."""
+
+    def draw(fig):
+        (folder / f"f{k}.{os.getpid()}").touch()
+        fig.add_subplot().plot([0, k + 1])
+
+    return (f"f{k}.png", f"figure {k}", "caption", size, draw)
+
+
+def test_each_queued_figure_is_drawn_once_by_one_of_the_two_processes(tmp_path):
+    specs = [_marking(k, tmp_path, (2.0 + 0.1 * (k % 3), 1.5)) for k in range(8)]
+    split = render_pngs(specs, 40, lambda text: None, processes=2)
+    marks = sorted(p.name for p in tmp_path.iterdir())
+    assert [m.split(".")[0] for m in marks] == [f"f{k}" for k in range(8)]  # each figure drawn exactly once
+    drawers = {m.split(".")[1] for m in marks}
+    assert len(drawers) <= 2 and (len(drawers) == 1 or str(os.getpid()) in drawers)  # this process and its child
+    for p in tmp_path.iterdir():
+        p.unlink()
+    serial = render_pngs(specs, 40, lambda text: None, processes=1)
+    assert list(split) == list(serial) and all(split[k] == serial[k] for k in serial)
+
+
+def test_figures_a_dead_child_took_are_drawn_by_the_parent(tmp_path):
+    """A child that dies after taking a figure from the queue (killed, out of memory) hands nothing back: the
+    parent draws the figure it took, and the other figures as before."""
+    import time
+
+    parent, died = os.getpid(), tmp_path / "child died"
+
+    def dying(k):
+        def draw(fig):
+            if os.getpid() != parent:
+                died.touch()
+                os._exit(3)  # the child dies on the first figure it takes
+            deadline = time.monotonic() + 30
+            while not died.exists() and time.monotonic() < deadline:  # leave the child a figure to take
+                time.sleep(0.005)
+            fig.add_subplot().plot([0, k + 1])
+
+        return (f"f{k}.png", f"figure {k}", "caption", (2.4, 1.8), draw)
+
+    specs = [dying(k) for k in range(5)]
+    steps = []
+    split = render_pngs(specs, 40, steps.append, processes=2)
+    assert died.exists()
+    serial = render_pngs(specs, 40, lambda text: None, processes=1)
+    assert list(split) == list(serial) and all(split[k] == serial[k] for k in serial)
+    assert sorted(steps) == sorted(f"figure f{k}.png" for k in range(5))
 
 
 def test_lean_figure_draws_the_minor_ticks_where_matplotlib_puts_them():
@@ -265,7 +314,7 @@ def test_two_figures_are_split_where_matplotlib_is_set_up(monkeypatch):
     real_fork = rendering._fork_child
     monkeypatch.setattr(rendering, "_fork_child", lambda *a: forked.append(a[1]) or real_fork(*a))
     split = render_pngs(specs, 60, lambda text: None, processes=2)
-    assert forked == [[1]]  # the child drew the second figure
+    assert len(forked) == 1  # a child took figures from the queue
     assert list(split) == list(serial) and all(split[k] == serial[k] for k in serial)
 
 
@@ -298,3 +347,68 @@ def test_write_hands_the_report_over_before_making_the_json_and_page(small_repor
     assert one["files"] == two["files"] and one["files"]["figures"] == [p.name for p in here if p.suffix == ".png"]
     page = (tmp_path / "worker" / "report.html").read_text(encoding="utf-8")
     assert page.count("data:image/png;base64,") == len(one["files"]["figures"])
+
+
+_DRAW_IN_A_FRESH_PROCESS = r"""
+import hashlib, io, sys
+from allanite.report import _worker
+if sys.argv[1] == "skip":
+    _worker._skip_setter_docs()
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from allanite.report.rendering import png
+def draw(fig):
+    ax = fig.add_subplot()
+    (line,) = ax.loglog([1e-2, 1e3], [1.0, 1e-3], label="a")
+    line.set(lw=2.5, c="C3", ls="--")  # set's keyword aliases, normalised by Artist.set
+    assert line.get_linewidth() == 2.5 and line.get_linestyle() == "--"
+    ax.set_title("τ"); ax.legend()
+data = png(("f.png", "", "", (3.0, 2.0), draw), 60)
+print(hashlib.sha256(data).hexdigest(), bool(Line2D.set.__doc__))
+"""
+
+
+def test_the_figure_process_skips_the_setter_docstrings_and_draws_the_same_bytes():
+    """``_worker._skip_setter_docs`` (the figure process's, before matplotlib is imported): the Artist classes'
+    ``set`` keeps working, with its aliases; only its docstring is left out; the PNG is the same bytes."""
+    import subprocess
+    import sys
+
+    def run(mode):
+        p = subprocess.run([sys.executable, "-c", _DRAW_IN_A_FRESH_PROCESS, mode], capture_output=True, text=True)
+        assert p.returncode == 0, p.stderr
+        digest, documented = p.stdout.split()
+        return digest, documented
+
+    plain, skip = run("plain"), run("skip")
+    assert plain[1] == "True" and skip[1] == "False"  # the docstring was skipped where asked, and only there
+    assert skip[0] == plain[0]
+
+
+def test_skipping_the_setter_docstrings_leaves_an_imported_matplotlib_alone():
+    import matplotlib.figure  # noqa: F401 - imported before, as in a process that has drawn already
+    from matplotlib.lines import Line2D
+
+    from allanite.report import _worker
+
+    _worker._skip_setter_docs()
+
+    class Later(Line2D):  # a class defined afterwards still gets its docstring: nothing was patched
+        pass
+
+    assert Later.set.__doc__ and "linewidth" in Later.set.__doc__
+
+
+def test_a_task_about_to_wait_counts_as_an_idle_core(monkeypatch):
+    """The figure process, handed the report, counts the command's process (runnable while it writes the JSON,
+    then waiting for the PNGs) as leaving its core: two processes draw even where the run queue shows none idle."""
+    from allanite.report import _worker, rendering
+
+    monkeypatch.setattr(rendering, "idle_cores", lambda cores: 0.0)
+    monkeypatch.setattr(rendering.os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
+    assert rendering.figure_processes() == 1
+    assert rendering.figure_processes(leaving=1) == 2
+    monkeypatch.setattr(rendering, "idle_cores", lambda cores: -1.0)  # one more task than cores: still busy
+    assert rendering.figure_processes(leaving=1) == 1
+    assert _worker._runnable(os.getpid())  # this process, running this line
+    assert not _worker._runnable(-5)  # no such process: unknown counts as not runnable

@@ -7,8 +7,9 @@ analysis as soon as it exists (:func:`offer`: the static and dynamic results, be
 it draws the figures that need nothing more (:func:`allanite.report.figures.from_analysis_alone`: the DAVAR heat
 maps and surfaces) while this process fits; offered it again with the fits where more is computed after them
 (``refine``, frames, paper 002's sections), it draws every figure but theirs meanwhile; handed the whole report
-(pickled: arrays and the fits, a few hundred kB), it draws the rest — on two processes where a core is idle then
-(:func:`allanite.report.rendering.render_pngs`) — and hands the PNGs back. This process then never imports
+(pickled: arrays and the fits, a few hundred kB), it draws the rest — on two processes where a core is idle then,
+this process's counted as free (it only writes the JSON before it waits; :func:`allanite.report.rendering.render_pngs`)
+— and hands the PNGs back. This process then never imports
 matplotlib. The PNGs are the same bytes as drawn here.
 
 The worker is started only where the figures would be drawn on two processes
@@ -186,8 +187,9 @@ def _serve(r: int, w: int) -> int:  # pragma: no cover - runs in the forked work
     report comes, hand all the PNGs back; 0 when done."""
     import select
 
+    _skip_setter_docs()
     from .figures import figure_specs, from_analysis_alone
-    from .rendering import GC_THRESHOLD, png, render_pngs
+    from .rendering import GC_THRESHOLD, figure_processes, png, render_pngs
 
     os.setpgid(0, 0)  # its own group: killed with the drawing process it forks; Ctrl-C reaches the parent only
     signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -209,11 +211,22 @@ def _serve(r: int, w: int) -> int:  # pragma: no cover - runs in the forked work
     _, rep, dpi = message
     specs = figure_specs(rep)
     rest = [sp for sp in specs if early.get(sp[0], (None, None))[1] != dpi]
-    drawn = render_pngs(rest, dpi, lambda text: None)
+    # the command's process, where runnable now, waits for the PNGs once it has written the JSON: its core frees
+    leaving = int(_runnable(os.getppid()))
+    drawn = render_pngs(rest, dpi, lambda text: None, processes=figure_processes(leaving=leaving))
     images = {sp[0]: drawn[sp[0]] if sp[0] in drawn else early[sp[0]][0] for sp in specs}
     with os.fdopen(w, "wb") as f:
         f.write(pickle.dumps(images, protocol=pickle.HIGHEST_PROTOCOL))
     return 0
+
+
+def _runnable(pid: int) -> bool:
+    """Whether process ``pid`` is running or runnable now (``R`` in ``/proc/PID/stat``); False where unknown."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] == "R"
+    except (OSError, IndexError):
+        return False
 
 
 def _receive(r: int):
@@ -234,6 +247,26 @@ def _read_exactly(r: int, n: int) -> bytes | None:
         parts.append(chunk)
         got += len(chunk)
     return b"".join(parts)
+
+
+def _skip_setter_docs() -> None:  # pragma: no cover - runs in the forked worker
+    """Let matplotlib's import skip writing the signature and docstring of each Artist class's ``set``.
+
+    Every Artist subclass matplotlib defines lists its settable properties in its ``set`` method's docstring at
+    import (``Artist.__init_subclass__``: an introspection of all its setters) — about a third of the CPU that
+    importing what the figures need costs (``benches/bench_figure_worker.py``). This process only draws and
+    shows no help text: ``set`` itself is unchanged (each class's ``set`` still calls ``Artist.set``, which
+    normalises the keyword aliases as before), only its ``__doc__`` and ``__signature__`` are not filled in, and
+    the PNGs are the same bytes. Nothing is done where matplotlib is imported already or no longer has the hook."""
+    try:
+        import matplotlib
+        from matplotlib.artist import Artist
+    except ImportError:
+        return
+    if any(hasattr(matplotlib, m) for m in ("lines", "text", "patches", "figure")):
+        return  # its artists are defined already: imported before the fork
+    if callable(getattr(Artist, "_update_set_signature_and_docstring", None)):
+        Artist._update_set_signature_and_docstring = classmethod(lambda cls: None)  # type: ignore[attr-defined]
 
 
 def _warm_up() -> None:  # pragma: no cover - runs in the forked worker

@@ -3,11 +3,12 @@
 Drawing and rasterising a figure is matplotlib's Python (ticks, text layout) under one interpreter lock; the
 report's 9 figures of a three-axis log are most of its wall time. Where ``os.fork`` exists, at least two cores
 are available, one of them idle now (the run queue) and the report is drawn from the main thread, a forked child
-draws about half of the figures by size (``fork``: the figures' drawing closures need no pickling, the child holds
-the report already) and hands its PNGs back through a pipe; the parent draws the rest meanwhile. The PNGs are the
-same bytes as drawn one after another. A child that fails or is killed leaves its figures to the parent, which
-then draws them itself (so an error in a figure is raised here, with its traceback); Ctrl-C ends the child with
-the parent.
+(``fork``: the figures' drawing closures need no pickling, the child holds the report already) and this process
+take the figures from one queue, largest first (:func:`draw_order`), each the next one left when it is done with
+its last — so the two finish within about one figure of each other whatever each figure costs — and the child
+hands its PNGs back through a pipe. The PNGs are the same bytes as drawn one after another. A child that fails or
+is killed leaves the figures it took to the parent, which then draws them itself (so an error in a figure is
+raised here, with its traceback); Ctrl-C ends the child with the parent.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import sys
 import threading
 import time
 import warnings
+from collections.abc import Iterable
 from contextlib import contextmanager
 from functools import cache
 
@@ -30,7 +32,7 @@ __all__ = [
     "render_pngs",
     "figure_processes",
     "idle_cores",
-    "child_share",
+    "draw_order",
     "min_figures_to_split",
     "fewer_collections",
 ]
@@ -78,11 +80,13 @@ def fewer_collections():
         gc.set_threshold(*old)
 
 
-def figure_processes() -> int:
+def figure_processes(leaving: int = 0) -> int:
     """Processes that draw the figures: 2 where ``fork`` exists, two cores are available, one of them is idle
     now (:func:`idle_cores`) and this is the main thread, else 1 (a report built in a worker thread — Dask's
     ``allanite batch`` — gets its parallelism from its workers, and a fork beside running threads could copy
-    a lock one of them holds)."""
+    a lock one of them holds). ``leaving``: runnable tasks counted now that are about to wait — the figure
+    process of :mod:`allanite.report._worker` counts the command's process, which hands it the report and then
+    only writes the JSON before it waits for the PNGs."""
     if not hasattr(os, "fork") or sys.platform != "linux" or threading.current_thread() is not threading.main_thread():
         return 1
     try:
@@ -91,7 +95,7 @@ def figure_processes() -> int:
         cores = os.cpu_count() or 1
     # a second process pays off only on an idle core: on a machine busy with other work it adds the child's
     # share (~15 % more CPU in all) and gains no core (measured: benches/results/pipeline.md)
-    return 2 if cores >= 2 and idle_cores(cores) >= 1 else 1
+    return 2 if cores >= 2 and idle_cores(cores) + leaving >= 1 else 1
 
 
 #: Samples of the run queue :func:`idle_cores` takes, and the pause between them (s).
@@ -152,41 +156,66 @@ def render_pngs(specs: list, dpi: int, step, processes: int | None = None) -> di
     ``processes``: 1 draws them here one after another; None chooses (:func:`figure_processes`)."""
     processes = figure_processes() if processes is None else processes
     pngs: list[bytes | None] = [None] * len(specs)
-    theirs = child_share(specs) if processes > 1 and len(specs) >= min_figures_to_split() else []
+    split = processes > 1 and min_figures_to_split() <= len(specs) <= MAX_QUEUED
     with fewer_collections():  # the child forked here inherits the thresholds
-        child = _fork_child(specs, theirs, dpi) if theirs else None
+        queue = _Queue(draw_order(specs)) if split else None
+        child = _fork_child(specs, queue, dpi) if queue is not None else None
+        mine: Iterable[int] = queue if queue is not None and child is not None else range(len(specs))
         try:
-            for i, spec in enumerate(specs):
-                if child is None or i not in theirs:
-                    step(f"figure {spec[0]}")
-                    pngs[i] = png(spec, dpi)
+            for i in mine:
+                step(f"figure {specs[i][0]}")
+                pngs[i] = png(specs[i], dpi)
             got = _collect(child) if child is not None else None
         finally:
             if child is not None:
                 _end(child)
-        for j, i in enumerate(theirs):
-            step(f"figure {specs[i][0]}")
-            pngs[i] = got[j] if got is not None else png(specs[i], dpi)
+            if queue is not None:
+                queue.close()
+        for i, spec in enumerate(specs):  # the child's figures, or those a failed child took: drawn here
+            if pngs[i] is None:
+                step(f"figure {spec[0]}")
+                pngs[i] = got[i] if got is not None and i in got else png(spec, dpi)
     return {spec[0]: data for spec, data in zip(specs, pngs)}
 
 
-def child_share(specs: list) -> list:
-    """Indices of the figures the child draws: the figures, largest first, each to the process with less
-    drawing so far — a figure's area (inches²) standing for its cost (panels, ticks, pixels: the ADIS report's
-    five-panel coefficient figures cost about three single-panel ones). Equal figures alternate, the parent
-    first; the child's indices are returned in the specs' order."""
-    load = [0.0, 0.0]  # parent, child
-    theirs = []
-    for i in sorted(range(len(specs)), key=lambda i: -specs[i][3][0] * specs[i][3][1]):
-        who = int(load[1] < load[0])
-        load[who] += specs[i][3][0] * specs[i][3][1]
-        if who:
-            theirs.append(i)
-    return sorted(theirs)
+def draw_order(specs: list) -> list:
+    """Indices of the specs, the largest figure first — a figure's area (inches²) standing for its cost (panels,
+    ticks, pixels: the ADIS report's five-panel coefficient figure costs about two and a half single-panel
+    ones); equal figures in the specs' order. Taken from one queue by two processes, the costly figures are
+    drawn first and the small ones fill the end, so neither waits long for the other."""
+    return sorted(range(len(specs)), key=lambda i: -specs[i][3][0] * specs[i][3][1])
 
 
-def _fork_child(specs: list, indices: list, dpi: int):
-    """(pid, read end) of a child drawing ``specs[indices]``; None where fork fails."""
+#: Most figures drawn from one queue (4 bytes each in a pipe, written whole before the child is forked: within
+#: Linux's smallest pipe buffer, 4 kB); a report with more is drawn in one process.
+MAX_QUEUED = 1024
+
+
+class _Queue:
+    """Figure indices in a pipe, 4 bytes each, the write end closed: either process takes the next one with one
+    read (a pipe read of whole records is atomic under the pipe's lock) until the pipe is empty (end-of-file)."""
+
+    def __init__(self, order: list):
+        self.r, w = os.pipe()
+        try:
+            data = b"".join(int(i).to_bytes(4, "little") for i in order)
+            while data:
+                data = data[os.write(w, data) :]
+        finally:
+            os.close(w)
+
+    def __iter__(self):
+        while len(head := os.read(self.r, 4)) == 4:
+            yield int.from_bytes(head, "little")
+
+    def close(self) -> None:
+        if self.r >= 0:
+            os.close(self.r)
+            self.r = -1
+
+
+def _fork_child(specs: list, queue: _Queue, dpi: int):
+    """(pid, read end) of a child drawing the figures it takes from ``queue``; None where fork fails."""
     r, w = os.pipe()
     try:
         with warnings.catch_warnings():
@@ -201,9 +230,9 @@ def _fork_child(specs: list, indices: list, dpi: int):
         try:
             os.close(r)
             signal.signal(signal.SIGINT, signal.SIG_DFL)
-            data = pickle.dumps([png(specs[i], dpi) for i in indices], protocol=pickle.HIGHEST_PROTOCOL)
+            drawn = {i: png(specs[i], dpi) for i in queue}
             with os.fdopen(w, "wb") as f:
-                f.write(data)
+                f.write(pickle.dumps(drawn, protocol=pickle.HIGHEST_PROTOCOL))
             status = 0
         finally:
             os._exit(status)
@@ -211,8 +240,8 @@ def _fork_child(specs: list, indices: list, dpi: int):
     return pid, r
 
 
-def _collect(child) -> list | None:
-    """The child's PNGs, or None where it failed (its figures are then drawn by the caller)."""
+def _collect(child) -> dict | None:
+    """The child's PNGs by figure index, or None where it failed (its figures are then drawn by the caller)."""
     pid, r = child
     chunks = []
     while chunk := os.read(r, 1 << 20):
