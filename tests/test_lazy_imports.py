@@ -120,3 +120,20 @@ def test_with_scipy_special_imported_the_kernels_come_from_it():
     from allanite import _dist
 
     assert _dist._kernels_module() is scipy.special
+
+
+def test_invalid_arguments_are_nan_as_in_scipy_stats_whatever_scipy_special_seterr_says():
+    """scipy.stats checks a distribution's arguments before it calls the kernel, so a user's
+    ``scipy.special.seterr(all="raise")`` (process-wide, and it applies to the kernels allanite loads alone too:
+    they are the same compiled ufuncs) never turns ν ≤ 0 or p outside [0, 1] into an exception there; a NaN
+    χ² is a NaN p-value, not 1 (a failed fit does not pass)."""
+    import scipy.special
+
+    nu = np.array([-1.0, 0.0, 3.0, np.nan])
+    with scipy.special.errstate(all="raise"):
+        for p in (0.5, 1.5, -0.5):
+            np.testing.assert_array_equal(chi2_ppf(p, nu), stats.chi2.ppf(p, nu))
+        np.testing.assert_array_equal(chi2_sf(1.0, nu), stats.chi2.sf(1.0, nu))
+        np.testing.assert_array_equal(norm_ppf([2.0, -1.0, 0.3]), stats.norm.ppf([2.0, -1.0, 0.3]))
+    assert np.isnan(chi2_sf(np.nan, 3.0)) and np.isnan(stats.chi2.sf(np.nan, 3.0))
+    assert chi2_sf(-np.inf, 3.0) == stats.chi2.sf(-np.inf, 3.0) == 1.0

@@ -90,21 +90,30 @@ def _out(v):
 
 
 def chi2_ppf(p, nu):
-    """``scipy.stats.chi2.ppf(p, nu)``: 2·P⁻¹(ν/2, p); NaN for ν ≤ 0 or p outside [0, 1]."""
+    """``scipy.stats.chi2.ppf(p, nu)``: 2·P⁻¹(ν/2, p); NaN for ν ≤ 0 or p outside [0, 1]. The kernel sees valid
+    arguments only (as scipy.stats's argument check does), so a user's ``scipy.special.seterr`` cannot turn
+    an invalid one into an exception."""
     p, nu = np.broadcast_arrays(np.asarray(p, dtype=np.float64), np.asarray(nu, dtype=np.float64))
+    ok = (nu > 0) & (p >= 0) & (p <= 1)
     with np.errstate(invalid="ignore"):
-        q = 2.0 * special().gammaincinv(nu / 2.0, p)  # loaded at the first interval, not at import allanite
-    return _out(np.where((nu > 0) & (p >= 0) & (p <= 1), q, np.nan))
+        # loaded at the first interval, not at import allanite
+        q = 2.0 * special().gammaincinv(np.where(ok, nu, 2.0) / 2.0, np.where(ok, p, 0.5))
+    return _out(np.where(ok, q, np.nan))
 
 
 def chi2_sf(x, nu):
-    """``scipy.stats.chi2.sf(x, nu)``: Q(ν/2, x/2), 1 for x ≤ 0; NaN for ν ≤ 0."""
+    """``scipy.stats.chi2.sf(x, nu)``: Q(ν/2, x/2), 1 for x ≤ 0; NaN for ν ≤ 0 or x NaN (the kernel sees ν > 0
+    only)."""
     x, nu = np.broadcast_arrays(np.asarray(x, dtype=np.float64), np.asarray(nu, dtype=np.float64))
+    ok = nu > 0
     with np.errstate(invalid="ignore"):
-        q = special().chdtrc(nu, np.maximum(x, 0.0))
-    return _out(np.where(nu > 0, np.where(x > 0, q, 1.0), np.nan))
+        q = special().chdtrc(np.where(ok, nu, 1.0), np.maximum(x, 0.0))
+    return _out(np.where(ok, np.where(x <= 0, 1.0, q), np.nan))
 
 
 def norm_ppf(p):
-    """``scipy.stats.norm.ppf(p)``: the inverse of the standard normal CDF."""
-    return _out(special().ndtri(np.asarray(p, dtype=np.float64)))
+    """``scipy.stats.norm.ppf(p)``: the inverse of the standard normal CDF; NaN for p outside [0, 1] (the
+    kernel sees p in [0, 1] only)."""
+    p = np.asarray(p, dtype=np.float64)
+    ok = (p >= 0) & (p <= 1)
+    return _out(np.where(ok, special().ndtri(np.where(ok, p, 0.5)), np.nan))
