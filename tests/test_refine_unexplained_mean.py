@@ -9,6 +9,7 @@ samples keep each test to a second or two (the check on a context built as refin
 from __future__ import annotations
 
 import html as html_mod
+import math
 import re
 
 import numpy as np
@@ -104,3 +105,24 @@ def test_refine_says_the_step_in_every_surface():
     assert len(got) == 1 and abs(got[0]["t_step"] - 1100.0) <= 40.0
     said = re.compile(r"the mean steps by 0\.00[78]\d* deg/s at t ≈ 1(09\d|10\d|11\d)")
     assert said.search(r.report()) and said.search(html_mod.unescape(r._repr_html_()))
+
+
+def test_a_small_level_does_not_simulate_a_record_beyond_the_cap(monkeypatch):
+    """refine accepts any level in (0, 1); at level 10⁻⁴ the check's α is 6.25·10⁻⁷ and 5/α null records would
+    be 3.8·10⁸ block-rate samples (gigabytes). The draws stop at :data:`MAX_BOOT`; below what they resolve the
+    threshold is their largest statistic (the rank rule's last index)."""
+    asked = []
+    real = ms.simulate
+
+    def counted(n, *args, **kw):
+        asked.append(n)
+        assert n <= 2**20, f"{n} block-rate samples asked for"
+        return real(n, *args, **kw)
+
+    monkeypatch.setattr(ms, "simulate", counted)
+    theta = [0.0, 4e-6, 9e-8, 4e-12, 0.0]
+    thr = ms.mean_step_threshold(200_000, FS, START, theta, alpha("unexplained:mean", 1e-4))
+    assert asked == [ms.MEAN_BLOCKS * ms.MAX_BOOT]
+    assert thr == ms.null_statistics(200_000, FS, START, theta, ms.MAX_BOOT)[-1] > 0
+    # at the default level the number of draws is unchanged (5/α)
+    assert ms.MAX_BOOT >= math.ceil(ms.BOOT_PER_ALPHA / A)

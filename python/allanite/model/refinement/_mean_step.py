@@ -34,6 +34,7 @@ from .curvefit import Curve, solve, theta_terms, upper_theta
 __all__ = [
     "MEAN_BLOCKS",
     "FINE",
+    "MAX_BOOT",
     "split_statistic",
     "locate_step",
     "null_statistics",
@@ -52,6 +53,11 @@ FINE = 32
 #: block-rate record under 2²⁰ samples, where the flicker filter's transform is kept between calls.
 BOOT_PER_ALPHA = 5
 MIN_BOOT = 2000
+#: Most simulated records (2²⁰ block-rate samples in all, 8 MB): refine accepts any level in (0, 1), and 5/α records
+#: at level 10⁻⁴ (α 6.25·10⁻⁷) would be 3.8·10⁸ samples, gigabytes. From level ≈ 0.037 down (α < 5/MAX_BOOT) fewer
+#: than 5/α are drawn; below α = 1/(MAX_BOOT + 1) (level ≈ 0.0073) the threshold is the largest null statistic,
+#: whose false-alarm probability is 1/(MAX_BOOT + 1) ≈ 4.6·10⁻⁵ rather than α (as the drift check's 1000 draws).
+MAX_BOOT = 2**20 // MEAN_BLOCKS
 
 
 def split_statistic(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -106,8 +112,9 @@ def null_statistics(n: int, fs: float, terms, theta, n_boot: int, seed: int = 79
 
 
 def mean_step_threshold(n: int, fs: float, terms, theta, alpha: float, seed: int = 7919) -> float:
-    """(1 − α) quantile of :func:`null_statistics`, max(:data:`MIN_BOOT`, :data:`BOOT_PER_ALPHA`/α) records."""
-    n_boot = max(MIN_BOOT, math.ceil(BOOT_PER_ALPHA / alpha))
+    """(1 − α) quantile of :func:`null_statistics`, max(:data:`MIN_BOOT`, :data:`BOOT_PER_ALPHA`/α) records, at
+    most :data:`MAX_BOOT` (then the rank rule's index is capped at the largest statistic)."""
+    n_boot = min(MAX_BOOT, max(MIN_BOOT, math.ceil(BOOT_PER_ALPHA / alpha)))
     stats = null_statistics(n, fs, terms, theta, n_boot, seed)
     return float(stats[min(math.ceil((n_boot + 1) * (1.0 - alpha)), n_boot) - 1])
 
