@@ -123,3 +123,26 @@ def test_two_refines_in_threads_equal_sequential_calls():
         assert [(s.before, s.after) for s in a.steps] == [(s.before, s.after) for s in b.steps]
         assert a.fit.chi2 == b.fit.chi2 and a.unexplained == b.unexplained
     assert alone[0].found  # the first record's Gauss–Markov term is found
+
+
+def test_a_put_as_the_last_refine_leaves_keeps_nothing(monkeypatch):
+    """A put from a thread outside refine (a user's direct call) that passed the ``remembering`` check just as
+    the last refine call left must not keep its copy after that call's clearing (up to ``keep`` records of
+    4·10⁶ samples, 32 MB each, held until some later refine returns): the interleaving made deterministic by
+    leaving inside the copy that ``put`` makes between its check and its insert."""
+    from allanite.model import _recent
+
+    memo = Recent(2, 100)
+    ctx = remembering()
+    ctx.__enter__()
+
+    class LeavesWhileCopying:
+        @staticmethod
+        def array(a, copy):
+            ctx.__exit__(None, None, None)  # the last refine leaves here, in another thread
+            return np.array(a, copy=copy)
+
+    monkeypatch.setattr(_recent, "np", LeavesWhileCopying)
+    memo.put(np.arange(3.0), (), "value")
+    monkeypatch.undo()
+    assert memo._items == []

@@ -74,8 +74,11 @@ class Recent:
         if _OPEN and arr.size <= self.max_size:
             item = (key, np.array(arr, copy=True), value)
             with self._lock:
-                self._items.append(item)
-                del self._items[: max(0, len(self._items) - self.keep)]  # the oldest out
+                # checked again under the lock the last leaving refine clears under: a copy made as it left is
+                # dropped, not kept until some later call returns
+                if _OPEN:
+                    self._items.append(item)
+                    del self._items[: max(0, len(self._items) - self.keep)]  # the oldest out
         return value
 
 
