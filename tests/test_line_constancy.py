@@ -2,6 +2,8 @@
 constant line on white + random-walk noise is not, and its false-alarm rate is near alpha."""
 
 import numpy as np
+import pytest
+from scipy import stats
 
 from allanite.model.refinement._line_constancy import line_constancy
 
@@ -49,3 +51,27 @@ def test_block_phasors_equal_the_direct_least_squares_at_global_time():
             yb = y[edges[b] : edges[b + 1]]
             direct = _phasors(yb, np.arange(edges[b], edges[b + 1]) / fs, np.array([f0]))[0]
             assert abs(r["phasors"][b] - direct) <= 1e-8 * abs(direct)
+
+
+def test_off_line_noise_is_the_local_psd_under_a_random_walk():
+    # a random walk's in-block trend leaked through a rectangular block's sidelobes into every phasor: on white
+    # noise plus a unit-step walk at 4.3 Hz of 100 Hz the off-line noise read 28× the white noise's where the
+    # walk's own PSD there is 1/(2 sin(π f0/fs))² = 13.8 white-noise levels (the untapered test, 3637a85); the
+    # Hann-tapered blocks read the local PSD itself
+    fs, n, f0 = 100.0, 100_000, 4.3
+    rng = np.random.default_rng(5)
+    white, walk = rng.normal(size=n), np.cumsum(rng.normal(size=n))
+    base = np.mean(line_constancy(white, fs, f0, 0.01, phasors=True)["phasor_var"])
+    for k in (0.1, 1.0):
+        local = 1 + k**2 / (2 * np.sin(np.pi * f0 / fs)) ** 2
+        got = np.mean(line_constancy(white + k * walk, fs, f0, 0.01, phasors=True)["phasor_var"]) / base
+        assert got == pytest.approx(local, rel=0.1)
+
+
+def test_threshold_counts_the_correlated_off_line_phasors():
+    # the tapered off-line phasors at f0 ± 2…5 bins are correlated (Hann: 2/3 at one bin, 1/6 at two): their
+    # Satterthwaite degrees of freedom are 2·8²/(8 + 2·(3·4/9 + 2/36)·2) ≈ 9.44 per block, not 16
+    r = line_constancy(np.random.default_rng(2).normal(size=200_000), FS, 4.3, 0.01)
+    d2 = 16 * 2 * 64 / (8 + 4 * (3 * 4 / 9 + 2 / 36))
+    assert r["blocks"] == 16
+    assert r["threshold"] == pytest.approx(stats.f.ppf(0.99, 30, d2), rel=2e-3)

@@ -5,6 +5,15 @@ Fundamentals of ``"periodic"`` families are not tested (not wired yet). A change
 material, by the level check's rule: the larger of the two sides' departure from the record's line, in Allan
 deviation at the τ where the line's Allan variance peaks (≈ 0.371/f0), must exceed the final model's held-out
 RMS ADEV error (``heldout_pct``).
+
+Known gap (measured, not yet fixed): the departure compares the sides' amplitudes |A|, not their phasors. A
+family switched on halfway is removed from the samples at one amplitude, so each of its lines is left in the
+final samples with about half its amplitude on both sides and its phase flipped between them; refine then names
+the family plus sinusoids at its first lines, and the test rejects them at once (2.3 Hz harmonics 0.3/k, k = 1…4,
+on unit white noise, 100 Hz × 10⁵: p ≈ 10⁻⁴²) while the two sides' amplitudes are equal: nothing is said.
+Wiring the families in needs their generators in :class:`.missing.MissingContext` and a departure that counts a
+change of phase (which might then also say the ADIS16405 lines whose phase wanders, held at their power
+today — not measured).
 """
 
 from __future__ import annotations
