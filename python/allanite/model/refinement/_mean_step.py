@@ -119,11 +119,15 @@ def mean_step_threshold(n: int, fs: float, terms, theta, alpha: float, seed: int
     return float(stats[min(math.ceil((n_boot + 1) * (1.0 - alpha)), n_boot) - 1])
 
 
-def refit_without(ctx: Any, step: np.ndarray) -> tuple[Curve, Any]:
+def refit_without(ctx: Any, index: int, d: float) -> tuple[Curve, Any]:
     """The final model's terms and effects refitted (:func:`.curvefit.solve`) on the exact Allan curve of the
-    final samples less ``step``, at the curve's τ."""
+    final samples less a step of ``d`` from sample ``index`` on, at the curve's τ (one copy of the record:
+    8 bytes a sample, not a step array beside the difference)."""
     cur = ctx.curve
-    av = avar(ctx.y - step, ctx.fs, taus=cur.tau).avar
+    less = np.array(ctx.y, dtype=np.float64)
+    less[index:] -= d
+    av = avar(less, ctx.fs, taus=cur.tau).avar
+    del less
     curve = Curve(cur.tau, cur.m, np.asarray(av, dtype=np.float64), cur.fs, cur.n_points, cur.estimator)
     return curve, solve(curve, ctx.start, ctx.effects)
 
@@ -157,9 +161,7 @@ def located(ctx: Any) -> tuple[dict, Any, np.ndarray]:
     Allan deviation at each τ of the curve."""
     y = ctx.y
     loc = locate_step(y)
-    step = np.zeros(y.size)
-    step[loc["index"] :] = loc["d"]
-    curve, sol = refit_without(ctx, step)
+    curve, sol = refit_without(ctx, loc["index"], loc["d"])
     loc["theta"] = upper_theta(curve, sol, ctx.start, ctx.effects, theta_terms(sol, ctx.start, ctx.effects))
     s_av = step_avar(y.size, loc["index"], loc["d"], ctx.curve.m)
     return loc, sol, 100.0 * (np.sqrt(1.0 + s_av / np.maximum(sol.model, 1e-300)) - 1.0)
