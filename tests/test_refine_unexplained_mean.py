@@ -17,6 +17,7 @@ import pytest
 
 import allanite
 from allanite.estimators.grid import tau_grid
+from allanite.model import tracing
 from allanite.model.refinement import _mean_step as ms
 from allanite.model.refinement.curvefit import Curve, solve
 from allanite.model.refinement.levels import alpha
@@ -112,14 +113,14 @@ def test_a_small_level_does_not_simulate_a_record_beyond_the_cap(monkeypatch):
     be 3.8·10⁸ block-rate samples (gigabytes). The draws stop at :data:`MAX_BOOT`; below what they resolve the
     threshold is their largest statistic (the rank rule's last index)."""
     asked = []
-    real = ms.simulate
+    real = tracing.simulate
 
     def counted(n, *args, **kw):
         asked.append(n)
         assert n <= 2**20, f"{n} block-rate samples asked for"
         return real(n, *args, **kw)
 
-    monkeypatch.setattr(ms, "simulate", counted)
+    monkeypatch.setattr(tracing, "simulate", counted)
     theta = [0.0, 4e-6, 9e-8, 4e-12, 0.0]
     thr = ms.mean_step_threshold(200_000, FS, START, theta, alpha("unexplained:mean", 1e-4))
     assert asked == [ms.MEAN_BLOCKS * ms.MAX_BOOT]

@@ -33,6 +33,7 @@ __all__ = [
     "drift_fit",
     "drift_component",
     "drift_threshold",
+    "simulated_block_means",
     "regression_fit",
     "gm_autocorrelation",
     "rolloff_psd",
@@ -139,20 +140,27 @@ def drift_threshold(n: int, fs: float, terms, theta, alpha: float, n_boot: int =
     between grid points, so the test errs on the safe side by at most that refinement)."""
     nb = min(DRIFT_BLOCKS, n)
     per = n // nb
-    fs_b = fs / per
-    coef = {t: math.sqrt(max(float(v), 0.0)) for t, v in zip(terms, theta)}
     tb = (np.arange(nb) * per + 0.5 * (per - 1)) / fs
+    b = simulated_block_means(nb, per, fs, terms, theta, n_boot, seed)
+    return float(np.quantile(_grid_stats(b, tb, n / fs), 1.0 - alpha))
+
+
+def simulated_block_means(nb: int, per: int, fs: float, terms, theta, n_boot: int, seed: int) -> np.ndarray:
+    """Block means (``nb`` blocks of ``per`` samples at ``fs``) of ``n_boot`` records of the five-term model
+    ``theta`` (squared coefficients of ``terms``), shape (nb, n_boot): simulated at the block rate fs/per (white
+    rate, flicker and random walk of rate keep their coefficients; white angle noise averages out), all at once
+    as the consecutive pieces of one long record — the nulls of the drift and mean-step checks."""
+    coef = {t: math.sqrt(max(float(v), 0.0)) for t, v in zip(terms, theta)}
     long = simulate(
         nb * n_boot,
-        fs_b,
+        fs / per,
         N=coef.get("N", 0.0),
         B=coef.get("B", 0.0),
         K=coef.get("K", 0.0),
         R=coef.get("R", 0.0),
         seed=seed,
     )
-    b = np.asarray(long, dtype=np.float64).ravel().reshape(n_boot, nb).T
-    return float(np.quantile(_grid_stats(b, tb, n / fs), 1.0 - alpha))
+    return np.asarray(long, dtype=np.float64).ravel().reshape(n_boot, nb).T
 
 
 def gm_autocorrelation(y: np.ndarray, fs: float, tc: float) -> dict | None:

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from ...analysis import avar
-from ...simulation import simulate
+from ..tracing import simulated_block_means
 from .curvefit import Curve, solve, theta_terms, upper_theta
 
 __all__ = [
@@ -102,12 +102,8 @@ def null_statistics(n: int, fs: float, terms, theta, n_boot: int, seed: int = 79
     """:func:`split_statistic` (sorted) on the :data:`MEAN_BLOCKS` block means of ``n_boot`` records of ``n``
     samples of the five-term model ``theta`` (squared coefficients of ``terms``): simulated at the block rate
     (white, flicker and random walk of rate keep their coefficients; quantisation averages out), as consecutive
-    pieces of one long record (:func:`allanite.model.tracing.drift_threshold`'s way)."""
-    per = n // MEAN_BLOCKS
-    coef = {t: math.sqrt(max(float(v), 0.0)) for t, v in zip(terms, theta)}
-    kw = {k: coef.get(k, 0.0) for k in ("N", "B", "K", "R")}
-    long = simulate(MEAN_BLOCKS * n_boot, fs / per, seed=seed, **kw)
-    b = np.asarray(long, dtype=np.float64).reshape(n_boot, MEAN_BLOCKS).T
+    pieces of one long record (:func:`allanite.model.tracing.simulated_block_means`, as the drift check's null)."""
+    b = simulated_block_means(MEAN_BLOCKS, n // MEAN_BLOCKS, fs, terms, theta, n_boot, seed)
     return np.sort(split_statistic(b)[0])
 
 
