@@ -187,3 +187,27 @@ def test_remembered_family_refits_equal_fresh_ones(monkeypatch):
     fam.refit(y[half], half + 1)  # other indices: solved
     fam.refit(y[half] + 1e-9, half)  # other samples: solved
     assert len(calls) == 2
+
+
+def test_memories_keep_one_copy_of_the_same_samples():
+    # the outlier test's scales and flags, a family's phasors at each frequency, the held-out curves and the line
+    # refits are asked for on the same samples: one read-only copy between the memories, found by content
+    first, second = Recent(2, 1000), Recent(2, 1000)
+    a = np.linspace(0.0, 1.0, 500)
+    first.put(a, ("x",), 1)
+    first.put(a.copy(), ("y",), 2)
+    second.put(a.copy(), (), 3)
+    kept = [item[1] for item in first._items + second._items]
+    assert kept[0] is kept[1] is kept[2] and kept[0] is not a
+    assert not kept[0].flags.writeable and np.array_equal(kept[0], a)
+    a[7] = -1.0  # the caller's array changed afterwards: the kept copy did not
+    assert first.get(np.linspace(0.0, 1.0, 500), ("y",)) == 2 and first.get(a, ("y",)) is None
+    b = np.linspace(0.0, 1.0, 500)
+    b[250] += 1e-9  # between the fingerprint's samples: equal fingerprints, another content
+    second.put(b, ("b",), 4)
+    assert second._items[-1][1] is not kept[0] and np.array_equal(second._items[-1][1], b)
+    assert second.get(b, ("b",)) == 4 and second.get(np.linspace(0.0, 1.0, 500)) == 3
+    strided = np.arange(40.0)[::2]  # a view: kept as its elements
+    first.put(strided, (), 5)
+    assert first.get(np.arange(0.0, 40.0, 2.0)) == 5 and first._items[-1][1].flags.c_contiguous
+    assert second._items[0][1] is kept[0]  # still kept by the second memory after the first let it go

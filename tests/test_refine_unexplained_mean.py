@@ -127,3 +127,54 @@ def test_a_small_level_does_not_simulate_a_record_beyond_the_cap(monkeypatch):
     assert thr == ms.null_statistics(200_000, FS, START, theta, ms.MAX_BOOT)[-1] > 0
     # at the default level the number of draws is unchanged (5/α)
     assert ms.MAX_BOOT >= math.ceil(ms.BOOT_PER_ALPHA / A)
+
+
+def _plain_locate(y: np.ndarray) -> dict:
+    """:func:`ms.locate_step` written out: exactly rounded block means (``math.fsum``), every split's statistic
+    by its definition, the fine split searched within ±1 block of the best block split, the step from the sums."""
+    n, nb = y.size, ms.MEAN_BLOCKS
+    nf, per, per_f = nb * ms.FINE, y.size // nb, y.size // (nb * ms.FINE)
+    b = [math.fsum(y[i * per : (i + 1) * per]) / per for i in range(nb)]
+    gains = [
+        math.sqrt(k * (nb - k)) / nb * abs(math.fsum(b[:k]) / k - math.fsum(b[k:]) / (nb - k)) for k in range(1, nb)
+    ]
+    k = 1 + max(range(nb - 1), key=lambda i: gains[i])
+    f = [math.fsum(y[i * per_f : (i + 1) * per_f]) / per_f for i in range(nf)]
+    fine = {
+        kk: math.sqrt(kk * (nf - kk)) * abs(math.fsum(f[:kk]) / kk - math.fsum(f[kk:]) / (nf - kk))
+        for kk in range(max(1, (k - 1) * ms.FINE), min(nf - 1, (k + 1) * ms.FINE) + 1)
+    }
+    index = max(fine, key=lambda kk: (fine[kk], -kk)) * per_f  # the first of equal maxima, as argmax
+    d = math.fsum(y[index:]) / (n - index) - math.fsum(y[:index]) / index
+    return {"statistic": max(gains), "index": index, "d": d, "block": per}
+
+
+@pytest.mark.parametrize(
+    "n, step, at, seed",
+    [(200_000, 0.01, 0.55, 1), (200_017, 0.0, 0.5, 2), (123_457, 0.004, 0.03, 3), (300_001, -0.02, 0.97, 4)],
+)
+def test_the_block_sum_location_equals_a_plain_reference(n, step, at, seed):
+    # a step, none, one in the first and one in the last block; lengths not a multiple of the 1536 fine blocks
+    y = _record(n, step, seed, at)
+    got, ref = ms.locate_step(y), _plain_locate(y)
+    assert got["index"] == ref["index"] and got["block"] == ref["block"]
+    assert got["statistic"] == pytest.approx(ref["statistic"], rel=1e-12)
+    assert got["d"] == pytest.approx(ref["d"], rel=1e-12, abs=1e-12 * float(np.std(y)))
+    if step:
+        assert abs(got["index"] - int(at * n)) <= 2 * (n // (ms.MEAN_BLOCKS * ms.FINE))
+
+
+def test_locating_the_step_holds_no_copy_of_the_record():
+    # the block means are reductions of views (strided too): memory O(blocks), not O(samples) — at 10⁸ samples
+    # a record-length temporary is 0.8 GB
+    import tracemalloc
+
+    y = _record(2_000_000, 0.01, 5)
+    for samples in (y, y[::2]):
+        tracemalloc.start()
+        try:
+            ms.locate_step(samples)
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        assert peak < 200_000, peak  # the record is 16 MB (the strided view 8 MB)

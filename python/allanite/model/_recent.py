@@ -6,7 +6,10 @@ family; a record's local noise scale and quantisation step for the outlier test 
 the held-out parts' Allan curves of samples a removal left as they were. Comparing an array with the few
 remembered ones costs one pass over it, the computations many. Arrays longer than the memory's limit are never
 kept (copies of a 10⁸-sample record would cost gigabytes), and nothing is remembered outside
-:func:`remembering` (a refine call): on leaving it every memory is emptied.
+:func:`remembering` (a refine call): on leaving it every memory is emptied. The memories keep one read-only copy
+of each content between them (:func:`_shared_copy`): the outlier test's local scales and flags, a family's phasors
+for each frequency, the held-out curves and the line refits are asked for on the same samples, and each memory's
+own copy was 213 MB of copies for 122 MB of distinct samples in one refine of a 10⁶-sample ADIS channel.
 
 :class:`Suffixes` remembers the last few results computed per τ (covariance blocks, EDF columns) for a fit that
 cuts its shortest τ one at a time. Both are used from threads (Dask workers, a user's threads, the report's):
@@ -27,6 +30,37 @@ __all__ = ["Recent", "Suffixes", "remembering"]
 _OPEN: list = []
 _ALL: weakref.WeakSet = weakref.WeakSet()
 _LOCK = threading.Lock()  # guards _OPEN and _ALL
+#: The copies the memories keep, by (shape, dtype, a few samples' bytes): weak references, so a copy lives as long
+#: as some memory keeps it and no longer.
+_COPIES: dict = {}
+_COPIES_LOCK = threading.Lock()
+
+
+def _fingerprint(arr: np.ndarray) -> tuple:
+    """(shape, dtype, the bytes of at most 16 evenly spaced elements): arrays equal to the bit have equal
+    fingerprints (equal ones differing in a zero's sign may not, and are then kept apart, as before)."""
+    picks = arr.flat[np.linspace(0, arr.size - 1, min(arr.size, 16), dtype=np.intp)]  # no copy of the rest
+    return arr.shape, arr.dtype.str, np.ascontiguousarray(picks).tobytes()
+
+
+def _shared_copy(arr: np.ndarray) -> np.ndarray:
+    """A read-only copy of ``arr``: the one some memory already keeps of equal content (shape, dtype, elements),
+    else a new one, registered for the next memory asking."""
+    fp = _fingerprint(arr)
+    with _COPIES_LOCK:
+        refs = [r for r in _COPIES.get(fp, []) if r() is not None]
+    for ref in refs:
+        kept = ref()
+        if kept is not None and np.array_equal(kept, arr):
+            return kept
+    kept = np.array(arr, copy=True)
+    kept.setflags(write=False)
+    with _COPIES_LOCK:
+        live = [r for r in _COPIES.get(fp, []) if r() is not None]
+        _COPIES[fp] = live + [weakref.ref(kept)]
+        for key in [k for k, v in _COPIES.items() if not any(r() is not None for r in v)]:
+            del _COPIES[key]  # the fingerprints of copies no memory keeps any more
+    return kept
 
 
 @contextlib.contextmanager
@@ -70,9 +104,10 @@ class Recent:
 
     def put(self, arr: np.ndarray, key: tuple, value):
         """Remember ``value`` for (a copy of) ``arr`` and ``key`` if ``arr`` is short enough (and within
-        :func:`remembering`); returns ``value``."""
+        :func:`remembering`); returns ``value``. The copy is shared with every memory keeping the same content
+        (:func:`_shared_copy`)."""
         if _OPEN and arr.size <= self.max_size:
-            item = (key, np.array(arr, copy=True), value)
+            item = (key, _shared_copy(arr), value)
             with self._lock:
                 # checked again under the lock the last leaving refine clears under: a copy made as it left is
                 # dropped, not kept until some later call returns

@@ -83,7 +83,9 @@ def _means(y: np.ndarray, blocks: int) -> tuple[np.ndarray, int]:
 def locate_step(y: np.ndarray) -> dict:
     """The one-step statistic of ``y``'s block means, the split located to 1/:data:`FINE` of a block around the
     best block split (the same two-segment criterion on the fine block means), and the step ``d`` (the mean
-    of the samples after the split less the mean before). ``index``: the first sample after the split."""
+    of the samples after the split less the mean before). ``index``: the first sample after the split. Memory
+    O(blocks): the block means and the step are reductions of views of ``y`` (no record-length temporary, which
+    would be 0.8 GB at 10⁸ samples)."""
     b, per = _means(y, MEAN_BLOCKS)
     stat, k = split_statistic(b)
     fine, per_f = _means(y, MEAN_BLOCKS * FINE)
