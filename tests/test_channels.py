@@ -262,9 +262,40 @@ def test_bad_input_is_named():
         regress_channel(y, x, -1.0)
     with pytest.raises(ParameterError, match="alpha"):
         regress_channel(y, x, 1.0, alpha=2.0)
-    with pytest.raises(ParameterError, match="channel 'acc' must be an array of numbers"):
+    with pytest.raises(ParameterError, match="channel 'acc' must be one real number per sample"):
         check_channel("acc", object(), 1000)
     assert issubclass(ParameterError, AllaniteError)
+
+
+def test_refines_bad_channels_are_named_never_crash_or_convert():
+    # refine's channels path: each bad channel a ValueError subclass naming it and what is allowed. Before, a list
+    # or tuple of channels crashed (AttributeError: no .items()), an array of them raised numpy's "truth value of an
+    # array is ambiguous", and a complex channel lost its imaginary part silently (a ComplexWarning at most).
+    rng = np.random.default_rng(5)
+    y = rng.normal(size=4000)
+    t = np.linspace(20.0, 30.0, y.size)
+    nan, n2 = t.copy(), np.column_stack([t, t])
+    nan[11] = np.nan
+    cases = [
+        (InputError, r"channel 'temp' has non-finite samples \(1; the first at index 11: nan\)", {"temp": nan}),
+        (ParameterError, "channel 'temp' has 3999 samples; the rate has 4000", {"temp": t[:-1]}),
+        (ParameterError, r"channel 'temp' is constant \(every sample 20.0\)", {"temp": np.full(y.size, 20.0)}),
+        (ParameterError, "channels must be a dict of name → samples .* got list", [t]),
+        (ParameterError, "channels must be a dict of name → samples .* got tuple", (t,)),
+        (ParameterError, "channels must be a dict of name → samples .* got ndarray", n2.T),
+        (ParameterError, r"channel 'temp' must be one real number per sample .* got shape \(4000, 2\)", {"temp": n2}),
+        (ParameterError, "channel 'temp' must be one real number per sample .* dtype complex128", {"temp": t + 1j}),
+        (ParameterError, "channel 'temp' must be one real number per sample .* got NoneType", {"temp": None}),
+        (ParameterError, r"channel 'temp' must be one real number per sample .* got shape \(\)", {"temp": 21.0}),
+    ]
+    for cls, match, channels in cases:
+        with pytest.raises(cls, match=match):
+            allanite.refine(y, 10.0, channels=channels, candidates=("regression",), progress=False)
+    # a list of numbers, or a single column, is the same channel as its 1-D array (array_like, as documented)
+    x = check_channel("temp", t, y.size)
+    assert np.array_equal(check_channel("temp", list(t), y.size), x)
+    assert np.array_equal(check_channel("temp", t[:, None], y.size), x)
+    assert allanite.refine(y, 10.0, channels={}, candidates=(), progress=False).found == []
 
 
 def test_result_component_of_a_plain_coupling():

@@ -83,21 +83,34 @@ MIN_SAMPLES = 64
 
 
 def check_channel(name: str, ch, n: int) -> np.ndarray:
-    """The channel as float64 of the rate's length ``n``, finite and not constant, or an AllaniteError naming it."""
+    """The channel as float64 of the rate's length ``n``, finite and not constant, or an AllaniteError naming it.
+
+    One sample per rate sample: a 1-D array or list of real numbers (a single column or row of a 2-D array too);
+    a scalar, a string, None, a complex or multi-column array are refused, not converted."""
+    what = f"channel {name!r} must be one real number per sample of the rate (a 1-D array of {n})"
     try:
-        x = np.asarray(ch, dtype=np.float64).ravel()
+        a = np.asarray(ch)
+        x = a.astype(np.float64) if a.dtype.kind in "biuf" else None
     except (TypeError, ValueError):
-        raise ParameterError(f"channel {name!r} must be an array of numbers, got {type(ch).__name__}") from None
+        x = None
+    if x is None:
+        kind = type(ch).__name__ if not isinstance(ch, np.ndarray) else f"an array of dtype {ch.dtype}"
+        raise ParameterError(f"{what}, got {kind}")
+    if x.ndim == 0 or (x.ndim > 1 and sorted(x.shape)[-2] > 1):
+        raise ParameterError(f"{what}, got shape {x.shape}")
+    x = x.ravel()
     if x.size != n:
         raise ParameterError(f"channel {name!r} has {x.size} samples; the rate has {n}")
     bad = np.flatnonzero(~np.isfinite(x))
     if bad.size:
         raise InputError(
-            f"channel {name!r} has non-finite samples ({bad.size}; the first at index {bad[0]}: {x[bad[0]]!r}); "
+            f"channel {name!r} has non-finite samples ({bad.size}; the first at index {bad[0]}: {float(x[bad[0]])!r}); "
             "every sample must be finite"
         )
     if not np.ptp(x) > 0:
-        raise ParameterError(f"channel {name!r} is constant (every sample {x[0]!r}): there is nothing to regress on")
+        raise ParameterError(
+            f"channel {name!r} is constant (every sample {float(x[0])!r}): there is nothing to regress on"
+        )
     return x
 
 

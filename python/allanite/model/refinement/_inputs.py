@@ -5,6 +5,7 @@ and the note saying how the held-out error is computed."""
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -86,6 +87,12 @@ def inputs(x_or_result, fs, input, points, axis, channels):
 def check_channels(channels, y) -> dict:
     """The other channels by name, each checked against the samples ``y`` (None: an AllanResult, refused)."""
     chans: dict = {}
+    if channels is None:
+        return chans
+    if not isinstance(channels, Mapping):
+        raise ParameterError(
+            f"channels must be a dict of name → samples (e.g. {{'temp': T}}), got {type(channels).__name__}"
+        )
     if channels:
         if y is None:
             raise ParameterError("channels need samples (a regression is fitted along time), not an AllanResult")
