@@ -287,6 +287,7 @@ def test_refines_bad_channels_are_named_never_crash_or_convert():
         (ParameterError, "channel 'temp' must be one real number per sample .* dtype complex128", {"temp": t + 1j}),
         (ParameterError, "channel 'temp' must be one real number per sample .* got NoneType", {"temp": None}),
         (ParameterError, r"channel 'temp' must be one real number per sample .* got shape \(\)", {"temp": 21.0}),
+        (ParameterError, "two channels are named '1'; each channel needs its own name", {1: t, "1": t[::-1]}),
     ]
     for cls, match, channels in cases:
         with pytest.raises(cls, match=match):

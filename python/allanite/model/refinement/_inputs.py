@@ -97,6 +97,8 @@ def check_channels(channels, y) -> dict:
         if y is None:
             raise ParameterError("channels need samples (a regression is fitted along time), not an AllanResult")
         for name, c in channels.items():
+            if str(name) in chans:  # 1 and "1": one would replace the other silently
+                raise ParameterError(f"two channels are named {str(name)!r}; each channel needs its own name")
             chans[str(name)] = check_channel(str(name), c, y.size)
     return chans
 
