@@ -130,3 +130,63 @@ def test_memory_beyond_the_input_is_a_chunk_or_a_segment():
     # so far — ≈ 2.5 × a segment; the three-segment group was ≈ 6 × a segment's worth of copies
     assert peak_welch < 2.6 * nper * 8 + 4 * 8 * _chunked.CHUNK  # and a few chunks' temporaries
     assert peak_overlap < 16 * _chunked.CHUNK  # a few sixteenth-chunks of complex exponentials
+
+
+@pytest.mark.parametrize(("n", "nper"), [(100_000, 4096), (3 * _chunked.CHUNK + 5, 4096), (10_001, 1024), (5000, 256)])
+def test_rolloff_welch_equals_scipys(n, nper):
+    rng = np.random.default_rng(n)
+    x = 5.0 + np.cumsum(rng.normal(size=n)) * 1e-2 + rng.normal(size=n)
+    f0, p0 = signal.welch(x - x.mean(), fs=50.0, nperseg=nper)  # tracing._rolloff_welch before the chunked form
+    f1, p1 = _chunked.welch_mean(x, 50.0, nper, float(x.mean()))
+    assert np.array_equal(f0, f1)
+    np.testing.assert_allclose(p1, p0, rtol=1e-12, atol=0)
+
+
+def _lines_before():
+    """lines.py as it was before the chunked Welch and the long pass cut to its searched bins (git: 478e6dd)."""
+    import importlib.util
+    import subprocess
+    from pathlib import Path
+
+    repo = Path(__file__).resolve().parents[1]
+    try:
+        src = subprocess.run(
+            ["git", "-C", str(repo), "show", "478e6dd:python/allanite/model/lines.py"], capture_output=True, check=True
+        ).stdout.decode()
+    except (OSError, subprocess.CalledProcessError):
+        pytest.skip("needs the repository's history (git) for the earlier lines.py")
+    spec = importlib.util.spec_from_loader("allanite.model._lines_before", loader=None)
+    mod = importlib.util.module_from_spec(spec)
+    mod.__package__ = "allanite.model"
+    exec(compile(src, "lines_before.py", "exec"), mod.__dict__)
+    return mod
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_find_lines_as_before(seed):
+    """The lines found, their amplitudes and tests, the Bonferroni count and the p-value as before, on records
+    with lines low (the long pass's bins) and high, on flicker and random walk; the long pass's arrays now end
+    where its search reaches."""
+    old = _lines_before()
+    rng = np.random.default_rng(seed)
+    n, fs = 400_000 + 1237 * seed, 100.0
+    t = np.arange(n) / fs
+    y = rng.normal(size=n) + np.cumsum(rng.normal(size=n)) * 0.01 * seed
+    y += 0.3 * np.sin(2 * np.pi * 0.02 * seed * t) + 0.3 * np.sin(2 * np.pi * 0.011 * t + 1.0)  # low: long pass
+    y += 0.03 * np.sin(2 * np.pi * 7.3 * t) + 0.02 * np.sin(2 * np.pi * 14.6 * t) + 0.05 * np.sin(2 * np.pi * 31.0 * t)
+    got, want = lines.find_lines(y, fs, 0.05), old.find_lines(y, fs, 0.05)
+    assert got["bins"] == want["bins"] and got["p_value"] == pytest.approx(want["p_value"], rel=1e-9, abs=1e-300)
+    assert len(got["lines"]) == len(want["lines"]) >= 4
+    for a, b in zip(got["lines"], want["lines"]):
+        assert a["pass"] == b["pass"] and a["bin_hz"] == b["bin_hz"]
+        for key in ("f", "amplitude", "amplitude_sd", "psd_ratio", "threshold", "noise"):
+            assert a[key] == pytest.approx(b[key], rel=1e-10), key
+    long_new, long_old = got["passes"][0], want["passes"][0]
+    assert long_new["p"].size < long_old["p"].size / 20  # the long pass cut to the bins its search reaches
+    k = long_new["p"].size
+    np.testing.assert_allclose(long_new["p"], long_old["p"][:k], rtol=1e-12, atol=0)
+    assert np.array_equal(
+        np.isfinite(long_old["noise"]),
+        np.concatenate([np.isfinite(long_new["noise"]), np.zeros(long_old["noise"].size - k, bool)]),
+    )
+    assert np.isnan(long_new["noise"][-1])

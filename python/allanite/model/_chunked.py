@@ -151,3 +151,27 @@ def window_overlap(win: np.ndarray, nper: int, lags: int) -> tuple[float, list[f
     half = nper // 2
     rho = sum(float(win[s] @ win[s.start + half : s.stop + half]) for s in chunks(nper - half))
     return ww, [rho / ww], np.abs(acc / ww) ** 2
+
+
+def welch_mean(x: np.ndarray, fs: float, nper: int, mean: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """``scipy.signal.welch(x − mean, fs, nperseg=nper)`` (Hann window, half-overlapping segments, each less its
+    mean, density scaling, their mean) a group of segments at a time within :data:`CHUNK` samples: the grouped
+    segments' copies, windowed copies and transforms of the whole call were ≈ 6 record-size arrays. Within 1e-12
+    of scipy's (its per-segment scaling before the mean reassociated)."""
+    from scipy import signal
+
+    win = signal.get_window("hann", nper)
+    step = nper // 2
+    k = (x.size - nper) // step + 1
+    rows = max(1, CHUNK // nper)
+    acc = np.zeros(nper // 2 + 1)
+    for a in range(0, k, rows):
+        idx = (np.arange(a, min(k, a + rows)) * step)[:, None] + np.arange(nper)[None, :]
+        seg = x[idx] - mean
+        seg -= seg.mean(axis=1, keepdims=True)
+        seg *= win
+        spec = np.fft.rfft(seg, axis=1)
+        acc += np.sum((np.conjugate(spec) * spec).real, axis=0)
+    acc *= 1.0 / (fs * float(win @ win))
+    acc[1 : (nper + 1) // 2] *= 2.0  # one-sided: every bin but DC and, for an even nper, Nyquist
+    return np.fft.rfftfreq(nper, 1.0 / fs), acc / k

@@ -101,8 +101,8 @@ def _welch(x: np.ndarray, fs: float, win: np.ndarray, nper: int, mean: float = 0
 
 
 def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int, mean: float = 0.0) -> dict:
-    """Welch PSD of one segment length, the bins k_lo ≤ k < k_hi it searches (grouped by their neighbourhood
-    w) and, unmasked, the noise level under each (:func:`_noise`)."""
+    """Welch PSD of one segment length up to the bins its search reaches, the bins k_lo ≤ k < k_hi it searches
+    (grouped by their neighbourhood w) and, unmasked, the noise level under each (:func:`_noise`)."""
     win = signal.get_window(WINDOW, nper)
     f, p = _welch(x, fs, win, nper, mean)
     dof, kappa, k_seg = _edof(win, x.size, nper)
@@ -115,6 +115,12 @@ def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int, mean: f
         ks = ks[ks + LOBE + w < p.size - 1]
         if ks.size:
             groups.append((w, ks))
+    # the bins a searched bin's neighbourhood can reach (±(LOBE + 2w) with its mirror, the line's width) and one
+    # unsearched bin beyond: the long pass searches its lowest few thousand bins of n/4, and its whole PSD, noise
+    # and dof arrays, remembered through a refine, were the record's size again; every bin beyond has NaN noise, as
+    # the kept last one does, so a frequency beyond reads as unsearched as before
+    top = min(p.size, k_hi + LOBE + 2 * NEIGHBOURS[1] + 2)
+    f, p = f[:top].copy(), p[:top].copy()
     ps = {"f": f, "p": p, "dof": dof, "kappa": kappa, "df": fs / nper, "segments": k_seg, "groups": groups}
     ps["noise"], ps["dof_med"] = _noise(ps, np.zeros(p.size, dtype=bool))
     return ps
