@@ -190,3 +190,35 @@ def test_find_lines_as_before(seed):
         np.concatenate([np.isfinite(long_new["noise"]), np.zeros(long_old["noise"].size - k, bool)]),
     )
     assert np.isnan(long_new["noise"][-1])
+
+
+@pytest.mark.parametrize(
+    "values",
+    [
+        np.array([1.0, np.inf, -3.0, np.nan]),
+        np.zeros((5, 3)),
+        (np.random.default_rng(1).normal(size=(_chunked.CHUNK + 5, 3)) * 1e3).astype(np.float32),
+        np.random.default_rng(2).normal(size=2 * _chunked.CHUNK + 3)[::2],  # a strided view
+        np.arange(10),
+        [1, 2, -7.5],
+        np.array([np.nan, np.inf]),
+    ],
+)
+def test_refine_scale_check_peak_as_before(values):
+    from allanite.model.refinement import _inputs
+
+    a = np.asarray(values, dtype=np.float64)  # check_scale before: the float64 copy, its finite values, |…|
+    finite = a[np.isfinite(a)] if a.size else a
+    want = float(np.max(np.abs(finite))) if finite.size else 0.0
+    assert _inputs._finite_peak(np.asarray(values)) == want
+
+
+def test_refine_scale_check_still_refuses():
+    from allanite.errors import InputError
+    from allanite.model.refinement import _inputs
+
+    with pytest.raises(InputError, match="1e\\+101"):
+        _inputs.check_scale(np.array([1.0, -1e101, np.nan], dtype=np.float64))
+    with pytest.raises(InputError, match="1e-101"):
+        _inputs.check_scale(np.full(10, 1e-101))
+    _inputs.check_scale(np.ones(10, dtype=np.float32))  # within the range: nothing said

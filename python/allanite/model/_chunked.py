@@ -100,27 +100,33 @@ def welch_detrended(x: np.ndarray, win: np.ndarray, nper: int, mean: float = 0.0
             p += np.sum(np.abs(np.fft.rfft(seg * win, axis=1)) ** 2, axis=0)
         return p
     tt = _sum_squares_centred(nper)
-    p = None  # the first group's sum is the total so far (no zeros beside it)
+    total: np.ndarray | None = None  # the first group's sum is the total so far (no zeros beside it)
     for a in range(0, k, rows):
-        acc = None
-        for i in range(a, min(k, a + rows)):
-            w = x[i * step : i * step + nper] - mean
-            trend = sum(float(w[s] @ (np.arange(s.start, s.stop, dtype=np.float64) - c)) for s in chunks(nper)) / tt
-            w -= w.mean()
-            for s in chunks(nper):
-                w[s] -= trend * (np.arange(s.start, s.stop, dtype=np.float64) - c)
-                w[s] *= win[s]
-            spec = np.fft.rfft(w)
-            del w
-            power = np.abs(spec)
-            del spec
-            power **= 2
-            if acc is None:
-                acc = power
-            else:
-                acc += power
-        p = acc if p is None else p + acc
-    return p
+        acc = _segment_power(x[a * step : a * step + nper], win, mean, tt)
+        for i in range(a + 1, min(k, a + rows)):
+            acc += _segment_power(x[i * step : i * step + nper], win, mean, tt)
+        total = acc if total is None else total + acc
+    assert total is not None
+    return total
+
+
+def _segment_power(seg: np.ndarray, win: np.ndarray, mean: float, tt: float) -> np.ndarray:
+    """|rfft(window × (seg − mean) less its least-squares line)|² of one long segment: one detrended copy, its
+    transform, then its power (the line's slope and the line itself a chunk at a time)."""
+    nper = seg.size
+    c = (nper - 1) / 2.0
+    w = seg - mean
+    trend = sum(float(w[s] @ (np.arange(s.start, s.stop, dtype=np.float64) - c)) for s in chunks(nper)) / tt
+    w -= w.mean()
+    for s in chunks(nper):
+        w[s] -= trend * (np.arange(s.start, s.stop, dtype=np.float64) - c)
+        w[s] *= win[s]
+    spec = np.fft.rfft(w)
+    del w
+    power = np.abs(spec)
+    del spec
+    power **= 2
+    return power
 
 
 def _sum_squares_centred(nper: int) -> float:
