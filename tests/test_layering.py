@@ -135,6 +135,7 @@ def test_imports_run_one_way(module):
 #: refine's inputs checked, the proposals per domain (curve candidates, removals in time, change points), the loop, the package.
 MODEL_RANKS = {
     "model._recent": -1,
+    "model._chunked": -1,  # record-length passes a chunk at a time (numpy, scipy only)
     "model._batched": 0,
     "model._chi2_draws": 0,
     "model._covariance": 0,

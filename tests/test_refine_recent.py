@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from allanite.model import linefit, outliers, periodic, tracing
+from allanite.model import _chunked, linefit, outliers, periodic, tracing
 from allanite.model._recent import Recent, remembering
 
 
@@ -126,9 +126,11 @@ def test_remembered_rolloff_spectrum_equals_a_fresh_one():
     y = np.random.default_rng(8).standard_normal(60_000).cumsum() * 1e-3 + 0.2
     r1, r2 = np.array([1.0, 0.5]), np.array([1.0, 0.25, 0.05])
     first = tracing.rolloff_psd(y, 50.0, r1)
-    f, p = signal.welch(y - y.mean(), fs=50.0, nperseg=4096)  # the spectrum computed afresh
+    f, p = _chunked.welch_mean(y, 50.0, 4096, float(y.mean()))  # the spectrum computed afresh (chunked)
     hi, lo = (f >= 20.0) & (f <= 24.0), (f >= 1.0) & (f <= 5.0)
     assert first["measured"] == float(p[hi].mean() / p[lo].mean())
+    f0, p0 = signal.welch(y - y.mean(), fs=50.0, nperseg=4096)  # scipy's, as it was computed before
+    assert np.array_equal(f, f0) and np.allclose(p, p0, rtol=1e-12, atol=0)
     got = tracing._WELCH.get(y, (50.0, 4096))
     assert got is not None and not got[1].flags.writeable
     again = tracing.rolloff_psd(y.copy(), 50.0, r2)  # equal samples, another filter: the spectrum found again
@@ -136,7 +138,7 @@ def test_remembered_rolloff_spectrum_equals_a_fresh_one():
     assert tracing._WELCH.get(y, (50.0, 4096)) is got
     z = y.copy()
     z[100] += 1.0  # other samples: computed
-    f2, p2 = signal.welch(z - z.mean(), fs=50.0, nperseg=4096)
+    f2, p2 = _chunked.welch_mean(z, 50.0, 4096, float(z.mean()))
     assert tracing.rolloff_psd(z, 50.0, r1)["measured"] == float(p2[hi].mean() / p2[lo].mean())
 
 

@@ -40,6 +40,8 @@ from scipy import signal
 from scipy.stats import chi2 as chi2_dist
 from scipy.stats import f as f_dist
 
+from ._chunked import CHUNK, welch_detrended, window_overlap
+
 __all__ = ["find_lines", "line_spectrum", "remembering_spectra", "group_lines", "LOBE", "MAX_SEGMENT", "fold_frequency"]
 
 #: Main-lobe half width of the Blackman–Harris window, bins (to its first null; −92 dB beyond).
@@ -71,41 +73,38 @@ def fold_frequency(nu: np.ndarray) -> np.ndarray:
 
 
 def _edof(win: np.ndarray, n: int, nper: int) -> tuple[float, float, int]:
-    """Welch's equivalent degrees of freedom, the bins' correlation factor 1 + 2Σρ_j², and the segments."""
-    h = win / math.sqrt(float(win @ win))
+    """Welch's equivalent degrees of freedom, the bins' correlation factor 1 + 2Σρ_j², and the segments (for the
+    long pass's three segments, whose window is half the record, summed over chunks: :mod:`._chunked`)."""
     step = nper // 2
     k = (n - nper) // step + 1
-    rho = [float(h[: nper - m * step] @ h[m * step :]) for m in range(1, min(k, nper // step))]
+    if 16 * nper > CHUNK and k <= 3:
+        _ww, rho, corr = window_overlap(win, nper, 2 * LOBE - 1)
+        rho = rho[: max(0, min(k, nper // step) - 1)]
+    else:
+        h = win / math.sqrt(float(win @ win))
+        rho = [float(h[: nper - m * step] @ h[m * step :]) for m in range(1, min(k, nper // step))]
+        # white noise's periodogram bins j apart correlate by |Σ h_t² e^{−i2πjt/n}|² (Σ h² = 1)
+        corr = np.abs(np.fft.rfft(h * h)[1 : 2 * LOBE]) ** 2
     dof = 2.0 * k / (1.0 + 2.0 * sum((1 - (m + 1) / k) * r * r for m, r in enumerate(rho)))
-    # white noise's periodogram bins j apart correlate by |Σ h_t² e^{−i2πjt/n}|² (Σ h² = 1)
-    corr = np.abs(np.fft.rfft(h * h)[1 : 2 * LOBE]) ** 2
     return dof, 1.0 + 2.0 * float(np.sum(corr)), k
 
 
-def _welch(x: np.ndarray, fs: float, win: np.ndarray, nper: int) -> tuple[np.ndarray, np.ndarray]:
+def _welch(x: np.ndarray, fs: float, win: np.ndarray, nper: int, mean: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """One-sided Welch PSD (unit²/Hz) of 50 %-overlapping segments, each with its least-squares line removed
-    (as ``scipy.signal.welch(detrend="linear")``, without a least-squares solve per segment)."""
-    step = nper // 2
-    k = (x.size - nper) // step + 1
-    t = np.arange(nper) - (nper - 1) / 2.0
-    tt = float(t @ t)
-    scale = 1.0 / (fs * float(win @ win))
-    p = np.zeros(nper // 2 + 1)
-    for a in range(0, k, 16):  # a few segments at a time: bounded memory for long records
-        idx = (np.arange(a, min(k, a + 16)) * step)[:, None] + np.arange(nper)[None, :]
-        seg = x[idx]
-        seg = seg - seg.mean(axis=1, keepdims=True) - np.outer(seg @ t / tt, t)
-        p += np.sum(np.abs(np.fft.rfft(seg * win, axis=1)) ** 2, axis=0)
-    p *= scale / k
+    (as ``scipy.signal.welch(detrend="linear")``, without a least-squares solve per segment) of ``x − mean``; a few
+    segments at a time, or one, so that the memory beyond ``x`` stays a chunk's or a segment's (:mod:`._chunked`)."""
+    k = (x.size - nper) // (nper // 2) + 1
+    p = welch_detrended(x, win, nper, mean)
+    p *= 1.0 / (fs * float(win @ win)) / k
     p[1:-1] *= 2.0  # one-sided (the Nyquist bin of an even nper once)
     return np.arange(p.size) * fs / nper, p
 
 
-def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int) -> dict:
-    """Welch PSD of one segment length, the bins k_lo ≤ k < k_hi it searches (grouped by their neighbourhood
-    w) and, unmasked, the noise level under each (:func:`_noise`)."""
+def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int, mean: float = 0.0) -> dict:
+    """Welch PSD of one segment length up to the bins its search reaches, the bins k_lo ≤ k < k_hi it searches
+    (grouped by their neighbourhood w) and, unmasked, the noise level under each (:func:`_noise`)."""
     win = signal.get_window(WINDOW, nper)
-    f, p = _welch(x, fs, win, nper)
+    f, p = _welch(x, fs, win, nper, mean)
     dof, kappa, k_seg = _edof(win, x.size, nper)
     ks_all = np.arange(p.size)
     width = np.clip(ks_all // 2, *NEIGHBOURS)
@@ -116,6 +115,12 @@ def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int) -> dict
         ks = ks[ks + LOBE + w < p.size - 1]
         if ks.size:
             groups.append((w, ks))
+    # the bins a searched bin's neighbourhood can reach (±(LOBE + 2w) with its mirror, the line's width) and one
+    # unsearched bin beyond: the long pass searches its lowest few thousand bins of n/4, and its whole PSD, noise
+    # and dof arrays, remembered through a refine, were the record's size again; every bin beyond has NaN noise, as
+    # the kept last one does, so a frequency beyond reads as unsearched as before
+    top = min(p.size, k_hi + LOBE + 2 * NEIGHBOURS[1] + 2)
+    f, p = f[:top].copy(), p[:top].copy()
     ps = {"f": f, "p": p, "dof": dof, "kappa": kappa, "df": fs / nper, "segments": k_seg, "groups": groups}
     ps["noise"], ps["dof_med"] = _noise(ps, np.zeros(p.size, dtype=bool))
     return ps
@@ -207,7 +212,7 @@ def line_spectrum(y: np.ndarray, fs: float) -> list[dict]:
 
 def _line_spectrum(x: np.ndarray, fs: float) -> list[dict]:
     """:func:`line_spectrum` computed."""
-    x = x - x.mean()
+    mean = float(x.mean())  # subtracted per segment (each taken as a copy): no de-meaned copy of the record
     n = x.size
     if n < 2048:
         return []
@@ -215,12 +220,12 @@ def _line_spectrum(x: np.ndarray, fs: float) -> list[dict]:
     first = LOBE + NEIGHBOURS[0] + 1
     long = 2 * (n // 4)  # three half-overlapping segments (any length: the FFT needs no power of two)
     if long < 2 * nper:
-        return [_one_pass(x, fs, nper, first, nper // 2)]
+        return [_one_pass(x, fs, nper, first, nper // 2, mean)]
     # the long segments take the lowest SWITCH bins of the band-wide pass, where a steep 1/f² floor and a
     # line's neighbours crowd its short neighbourhoods
     return [
-        _one_pass(x, fs, long, first, int(math.ceil(SWITCH * long / nper))),
-        _one_pass(x, fs, nper, SWITCH, nper // 2),
+        _one_pass(x, fs, long, first, int(math.ceil(SWITCH * long / nper)), mean),
+        _one_pass(x, fs, nper, SWITCH, nper // 2, mean),
     ]
 
 

@@ -127,6 +127,22 @@ def settle_chi2(metrics: dict, pending: tuple, test) -> float:
     return chi2
 
 
+class _PartIndex:
+    """The sample indices of a :class:`Split`'s two parts (``idx[parity]``), made when asked: held through a refine
+    as arrays they were the record's size again in int64 (0.8 GB at 10⁸ samples), and only a removal's refit on
+    the parts asks for them."""
+
+    def __init__(self, per: int, n_blocks: int, size: int):
+        self.per, self.n_blocks, self.size = per, n_blocks, size
+
+    def blocks(self, parity: int) -> range:
+        return range(parity, self.n_blocks, 2)
+
+    def __getitem__(self, parity: int) -> np.ndarray:
+        per = self.per
+        return np.concatenate([np.arange(j * per, (j + 1) * per) for j in self.blocks(parity)])[: self.size]
+
+
 class Split:
     """Alternate blocks in time (odd ↔ even) for the held-out error.
 
@@ -139,22 +155,17 @@ class Split:
 
     def __init__(self, y, fs, grid_m, lo, hi, estimator, n_blocks, terms):
         self.y = y
-        n = y.size
-        per = n // n_blocks
+        per = y.size // n_blocks
         self.fs, self.estimator = fs, estimator
-        self.idx = [
-            np.concatenate([np.arange(j * per, (j + 1) * per) for j in range(n_blocks) if j % 2 == parity])
-            for parity in (0, 1)
-        ]
-        size = min(i.size for i in self.idx)
-        self.idx = [i[:size] for i in self.idx]
+        size = per * (n_blocks // 2)  # the shorter part's (odd blocks'), the longer cut to it
+        self.idx = _PartIndex(per, n_blocks, size)
         m = grid_m[grid_m <= size // 9]
         tau = m / fs
         keep = (tau >= lo) & (tau <= hi)
         if np.count_nonzero(keep) < 8:
             raise ValueError("too few τ in range for held-out blocks")
         self.m, self.size = m[keep], size
-        self.curves = [self.curve(y[i]) for i in self.idx]
+        self.curves = [self.curve(self.part(f)) for f in (0, 1)]
         self.scored = informative(self.curves[0].tau, solve(self.curves[0], terms, []).nu)
         # ... and where the record reproduces itself: the two parts' own ADEV agree within ±20 % (twice the
         # ±10 % of EDF 50). Beyond, the parts differ more than their estimates scatter (a non-stationary
@@ -177,18 +188,18 @@ class Split:
             got = _CURVES.put(z, key, curve)
         return got
 
+    def part(self, parity: int) -> np.ndarray:
+        """The samples of part ``parity`` (its blocks joined), made when asked: held through a refine, the two
+        parts were the record's size again, and only the removals' held-out refits read them."""
+        per = self.idx.per
+        return np.concatenate([self.y[j * per : (j + 1) * per] for j in self.idx.blocks(parity)])[: self.size]
+
     def raw_parts(self) -> list:
         """Per direction (held-in part f → held-out part h), nothing removed yet: the held-in samples and their
         curve, the held-out samples and their curve, and no change of the curve to add back — the start of
         :meth:`corrected`."""
         return [
-            {
-                "zf": self.y[self.idx[f]],
-                "cf": self.curves[f],
-                "zh": self.y[self.idx[h]],
-                "ch": self.curves[h],
-                "extra": 0.0,
-            }
+            {"zf": None, "cf": self.curves[f], "zh": None, "ch": self.curves[h], "extra": 0.0}
             for f, h in ((0, 1), (1, 0))
         ]
 
@@ -201,14 +212,17 @@ class Split:
         both parts share, whose held-out change the held-in part's own does not carry over to)."""
         out = []
         for (f, h), p in zip(((0, 1), (1, 0)), parts):
-            g = refit(p["zf"], self.idx[f])
-            zf, zh = p["zf"] - g(self.idx[f]), p["zh"] - g(self.idx[h])
+            zf0 = p["zf"] if p["zf"] is not None else self.part(f)  # None: the raw part's samples
+            zh0 = p["zh"] if p["zh"] is not None else self.part(h)
+            g = refit(zf0, self.idx[f])
+            zf, zh = zf0 - g(self.idx[f]), zh0 - g(self.idx[h])
+            del zf0
             cf = self.curve(zf)
             if on_raw:
                 ch, change = None, p["cf"].avar - cf.avar
             else:
                 ch = self.curve(zh)
-                change = (p["ch"] if p["ch"] is not None else self.curve(p["zh"])).avar - ch.avar
+                change = (p["ch"] if p["ch"] is not None else self.curve(zh0)).avar - ch.avar
             out.append({"zf": zf, "cf": cf, "zh": zh, "ch": ch, "extra": p["extra"] + change})
         return out
 
@@ -239,7 +253,7 @@ class Split:
             if remove is None:
                 cf, ch = self.curves[f], self.curves[h]
             else:
-                yf, yh = self.y[self.idx[f]], self.y[self.idx[h]]
+                yf, yh = self.part(f), self.part(h)
                 g = remove(yf, self.idx[f])
                 cf = self.curve(yf - g(self.idx[f]))
                 if on_raw:
