@@ -44,3 +44,43 @@ def test_a_constant_line_is_not_said(seed):
     r = allanite.refine(_record(seed, False), FS, progress=False)
     assert "sinusoid" in r.found
     assert not any(u["domain"] == "line" for u in r.unexplained)
+
+
+# ---- the families removed in time: a change of phase counts
+
+
+def _square(seed: int, switched: bool) -> np.ndarray:
+    """Unit white noise + a little random walk + a 2.3 Hz square wave of 0.3 (harmonics 0.38/k), switched on at
+    the record's middle or on throughout."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(N) / FS
+    wave = 0.3 * np.sign(np.sin(2 * np.pi * 2.3 * t + 0.4)) * ((t >= t[-1] / 2) if switched else 1.0)
+    return rng.normal(size=N) + 1e-3 * np.cumsum(rng.normal(size=N)) + wave
+
+
+def test_a_family_switched_on_halfway_is_said_though_what_its_removal_left_has_one_amplitude():
+    # removed at one complex amplitude — about half its own — the fundamental is left in the final samples at
+    # ≈ 0.19 on both sides with its phase flipped: the sides' amplitudes agree, their phasors differ by the
+    # whole line (4/π·0.3); the words give the line in the record: ≈ 0 before the switch, 0.38 after
+    r = allanite.refine(_square(1, True), FS, unit="deg/s", progress=False)
+    assert "periodic" in r.found
+    (ln,) = [u for u in r.unexplained if u["domain"] == "line"]
+    assert ln["family"] == [pytest.approx(2.3, abs=1e-4)] and ln["f0"] == pytest.approx(2.3, abs=1e-4)
+    assert ln["t"][0] == pytest.approx(500.0, abs=0.07 * N / FS) and ln["t"][1] == pytest.approx(N / FS, rel=1e-3)
+    a1, a2 = ln["amplitudes"]
+    assert a1 < 0.05 * 4 / np.pi * 0.3 and a2 == pytest.approx(4 / np.pi * 0.3, rel=0.1)
+    assert ln["change"] == pytest.approx(4 / np.pi * 0.3, rel=0.1)
+    assert ln["departure_pct"] > ln["heldout_pct"] and ln["alpha"] <= alpha("unexplained:line", 0.05)
+    text = describe_region(ln)
+    assert re.search(
+        r"the 2\.30 Hz family's lines change along the record: its 2\.30 Hz line .* deg/s in t 0–5\d\d s", text
+    )
+    assert "phase turned" not in text  # no phase to speak of where the line was off
+    assert any(text in s for s in r.missing_sentences())
+
+
+@pytest.mark.parametrize("seed", [1, 2, 4])
+def test_a_constant_family_is_not_said(seed):
+    r = allanite.refine(_square(seed, False), FS, progress=False)
+    assert "periodic" in r.found
+    assert not any(u["domain"] == "line" for u in r.unexplained)
