@@ -84,3 +84,22 @@ def test_a_constant_family_is_not_said(seed):
     r = allanite.refine(_square(seed, False), FS, progress=False)
     assert "periodic" in r.found
     assert not any(u["domain"] == "line" for u in r.unexplained)
+
+
+def test_the_lines_tested_are_each_familys_strongest_testable_line_and_the_sinusoids_apart_from_them():
+    from types import SimpleNamespace
+
+    from allanite.model.refinement._line_check import tested_lines
+
+    # 10⁵ samples at 100 Hz: the test takes lines from 4·20 periods in 1000 s = 0.08 Hz; half the finest block
+    # resolution is 16·100/(2·10⁵) = 0.008 Hz
+    fams = [
+        ([0.05], [0.05, 0.15, 0.25], [1.0, 0.5, 0.6], None),  # its strongest line too slow: the next, 0.25 Hz
+        ([2.3], [2.3, 6.9], [0.4, 0.1], None),
+        ([60.0], [60.0], [1.0], None),  # above fs/2: nothing testable
+    ]
+    effects = [("sinusoid", 2.305), ("sinusoid", 4.3), ("bandwidth:single_pole", 20.0), ("sinusoid:held:1.0:0.1", 0.2)]
+    ctx = SimpleNamespace(y=np.zeros(N), fs=FS, families=fams, effects=effects)
+    assert tested_lines(ctx) == [(4.3, None, True), (0.2, None, True), (0.25, 0, False), (2.3, 1, True)]
+    ctx.effects = []
+    assert tested_lines(ctx) == [(0.25, 0, False), (2.3, 1, False)]
