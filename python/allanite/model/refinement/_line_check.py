@@ -5,11 +5,11 @@ Two kinds of line are tested: each ``"sinusoid"`` the model holds, and the stron
 ``"periodic"`` family removed in time (:attr:`.missing.MissingContext.families`; a sinusoid within half a
 block's resolution of that line — the part of it the removal left, taken as a sinusoid — is that line, tested
 once: said as the family's line where that is material, else as the sinusoid). The test compares complex
-amplitudes, so a change of phase counts as surely as one of amplitude: a family is removed at one complex
-amplitude per line, and one switched on halfway is removed at about half its amplitude, each of its lines left
-in the final samples with that half on both sides and its phase flipped between them (2.3 Hz harmonics 0.3/k,
-k = 1…4, on unit white noise, 100 Hz × 10⁵: p ≈ 10⁻⁴²) — equal amplitudes, which a rule on the final samples'
-amplitudes never said.
+amplitudes, so a change of phase counts as surely as one of amplitude: a family is removed as one set of lines
+(or one waveform) along the whole record, and one switched on halfway is removed at about half its amplitude,
+each of its lines left in the final samples with that half on both sides and its phase flipped between them
+(2.3 Hz harmonics 0.3/k, k = 1…4, on unit white noise, 100 Hz × 10⁵: p ≈ 10⁻⁴²) — equal amplitudes, which a
+rule on the final samples' amplitudes never said.
 
 A change is said only where it is material, by the level check's rule: the side further from the record's
 line, in Allan deviation at the τ where the line's Allan variance peaks (≈ 0.371/f0), must depart by more than
@@ -97,7 +97,8 @@ def line_check(ctx: Any, a: float) -> list[dict]:
     less their noise variance, so that a wandering phase is not read as a smaller amplitude; for a family's line
     the |mean phasor| of the line in the record — left plus removed — less its noise variance),
     ``"departure_pct"`` as in the module docstring; a family's line also ``"family"`` (its fundamentals, Hz),
-    ``"change"`` (|Δ|) and ``"phase_change_deg"`` (the turn of the line's phase between the sides). Nothing
+    ``"change"`` (|Δ|, the sides' mean phasors of the line in the record) and ``"phase_change_deg"`` (the
+    turn of its phase between the sides). Nothing
     without an accepted line."""
     if ctx.y is None:
         return []
@@ -130,7 +131,8 @@ def line_check(ctx: Any, a: float) -> list[dict]:
 
 def _tail(ctx: Any, dep: float, tau: float) -> str:
     held = "" if ctx.heldout_pct is None else f"; held-out error {ctx.heldout_pct:.2g} %"
-    return f"{dep:.2g} % of the Allan deviation at τ {tau:.3g} s{held})"
+    size = f"{dep:.2g}" if dep < 100 else f"{dep:.0f}"
+    return f"{size} % of the Allan deviation at τ {tau:.3g} s{held})"
 
 
 def _material(ctx: Any, dep: float) -> bool:
@@ -159,26 +161,24 @@ def _family_entry(ctx: Any, r: dict, k: int, sides: tuple, w: tuple, family: tup
     """A removed family's line, as it is in the record: the final samples' block phasors plus the removed
     component's own. Each side's |A| from its blocks' mean power less their noise variance (whatever the
     phase), judged as a sinusoid's against the record's mean power on the record's curve (the final one plus
-    the removed line's A²·g); the change Δ = m₂ − m₁ of the sides' mean phasors the removal left (|Δ|² less
-    its noise variance) and the turn of the line's phase between the sides for the words. None where the
-    change is not material."""
+    the removed line's A²·g); for the entry, the change of the sides' mean phasors (|Δ|² less its noise
+    variance) and the turn of the line's phase between them. None where the change is not material."""
     gens, _freqs, _amps, comp = family
     ph, var = np.asarray(r["phasors"]), np.asarray(r["phasor_var"])
     f0 = float(r["f0"])
     removed = block_phasors(np.asarray(comp, dtype=float), ctx.fs, f0, int(r["blocks"]))
     own = ph + removed
     lengths = np.diff(np.asarray(r["edges_s"]))
-    m, rec, v, power = [], [], [], []
+    rec, v, power = [], [], []
     for sl in (slice(0, k), slice(k, None)):
         ln = lengths[sl]
-        m.append(complex(np.sum(ph[sl] * ln) / ln.sum()))
         rec.append(complex(np.sum(own[sl] * ln) / ln.sum()))
         v.append(float(np.sum(var[sl] * ln**2) / ln.sum() ** 2))
         power.append(max(float(np.mean(np.abs(own[sl]) ** 2 - var[sl])), 0.0))
-    change = math.sqrt(max(abs(m[1] - m[0]) ** 2 - v[0] - v[1], 0.0))
+    change = math.sqrt(max(abs(rec[1] - rec[0]) ** 2 - v[0] - v[1], 0.0))
     amps = (math.sqrt(power[0]), math.sqrt(power[1]))
     turn = math.degrees(abs(np.angle(rec[1] * rec[0].conjugate())))
-    dep, tau = _departure_pct(ctx, f0, amps, w, extra=float(np.mean(np.abs(removed)) ** 2))
+    dep, tau = _departure_pct(ctx, f0, amps, w, extra=float(np.mean(np.abs(removed) ** 2)))
     if not _material(ctx, dep):
         return None
     unit = f" {ctx.unit}" if ctx.unit else ""
@@ -186,8 +186,7 @@ def _family_entry(ctx: Any, r: dict, k: int, sides: tuple, w: tuple, family: tup
     phase = f"its phase turned {turn:.0f}°; " if min(abs(rec[0]) ** 2, abs(rec[1]) ** 2) > 9 * max(v) else ""
     what = (
         f"the {name} Hz family's lines change along the record: its {f0:.2f} Hz line {amps[0]:.3g}{unit} in t "
-        f"{span_text(*sides[0])} s, {amps[1]:.3g}{unit} in t {span_text(*sides[1])} s ({phase}removed at one "
-        f"complex amplitude, it leaves a change of {change:.3g}{unit}; " + _tail(ctx, dep, tau)
+        f"{span_text(*sides[0])} s, {amps[1]:.3g}{unit} in t {span_text(*sides[1])} s ({phase}" + _tail(ctx, dep, tau)
     )
     return {"what": what, "amplitudes": amps, "departure_pct": dep, "tau_peak": tau} | {
         "family": [float(g) for g in gens],
