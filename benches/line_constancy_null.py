@@ -231,7 +231,8 @@ def write(results: dict, before: dict | None, out: Path) -> None:
         "",
     ]
     head = "| mixture | blocks (median) | at 5 % | at 1 % | at 6.25·10⁻⁴ | p quantiles 1 / 5 / 10 / 50 % |"
-    if before:
+    kept = results.get("before_cells") if not before else None  # the before columns as an earlier page wrote them
+    if before or kept:
         head += " before: at 5 % | before: at 1 % |"
     lines += [head, "|" + "---|" * (head.count("|") - 1)]
     for mix, v in results["null"].items():
@@ -239,7 +240,9 @@ def write(results: dict, before: dict | None, out: Path) -> None:
         cells = [_common.rate_cell(r, True) for r in v["rates"].values()]
         row = f"| {mix} | {v['blocks_median']:.0f} | " + " | ".join(cells)
         row += f" | {q['0.01']:.4f} / {q['0.05']:.3f} / {q['0.1']:.3f} / {q['0.5']:.2f} |"
-        if before:
+        if kept:
+            row += " " + " | ".join(kept.get(mix, ["—", "—"])) + " |"
+        elif before:
             b = before["null"].get(mix)
             if b is None:
                 row += " — | — |"
