@@ -103,3 +103,37 @@ def test_the_lines_tested_are_each_familys_strongest_testable_line_and_the_sinus
     assert tested_lines(ctx) == [(4.3, None, True), (0.2, None, True), (0.25, 0, False), (2.3, 1, True)]
     ctx.effects = []
     assert tested_lines(ctx) == [(0.25, 0, False), (2.3, 1, False)]
+
+
+@pytest.mark.parametrize("case", ["switched_on", "phase_flip"])
+def test_a_familys_line_is_said_by_its_power_along_the_record_not_its_phase_alone(case):
+    # the check on a final state built by hand: a 2.3 Hz line of 0.4 removed as one constant line (least
+    # squares over the record). Switched on halfway it is removed at ≈ 0.2 and said (0 → 0.4 in the record);
+    # flipped in phase halfway at one amplitude the removal takes ≈ 0, the test rejects the flip, and nothing
+    # is said: each side's power is the record's, the curve's share of the line unchanged.
+    from types import SimpleNamespace
+
+    from allanite.analysis import avar
+    from allanite.model.refinement._line_check import line_check
+    from allanite.model.refinement._line_constancy import line_constancy
+
+    rng = np.random.default_rng(5)
+    t = np.arange(N) / FS
+    wave = np.sin(2 * np.pi * 2.3 * t + 0.4)
+    half = t >= t[-1] / 2
+    line = 0.4 * wave * (half if case == "switched_on" else np.where(half, -1.0, 1.0))
+    x = np.column_stack([wave, np.cos(2 * np.pi * 2.3 * t + 0.4)])
+    comp = x @ np.linalg.lstsq(x, line, rcond=None)[0]  # the family's removal: one complex amplitude
+    y = rng.normal(size=N) + line - comp
+    curve = avar(y, FS)
+    ctx = SimpleNamespace(
+        y=y, fs=FS, curve=curve, effects=[], families=[([2.3], [2.3], [0.4], comp)], heldout_pct=2.0, unit="deg/s"
+    )
+    assert line_constancy(y, FS, 2.3, 1e-6)["rejected"]
+    said = line_check(ctx, alpha("unexplained:line", 0.05))
+    if case == "phase_flip":
+        assert said == []
+        return
+    (ln,) = said
+    assert ln["amplitudes"][0] < 0.03 and ln["amplitudes"][1] == pytest.approx(0.4, rel=0.05)
+    assert ln["change"] == pytest.approx(0.4, rel=0.05) and ln["t"][0] == pytest.approx(500.0, abs=70.0)
