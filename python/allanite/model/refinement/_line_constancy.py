@@ -23,7 +23,7 @@ import math
 import numpy as np
 from scipy import stats
 
-__all__ = ["line_constancy", "MAX_BLOCKS", "MIN_PERIODS", "OFF_BINS"]
+__all__ = ["line_constancy", "block_phasors", "MAX_BLOCKS", "MIN_PERIODS", "OFF_BINS"]
 
 #: Blocks along the record at most.
 MAX_BLOCKS = 16
@@ -98,6 +98,14 @@ def _block_terms(y: np.ndarray, fs: float, f0: float, edges: np.ndarray) -> tupl
         ph[b], unit[b], dof[b] = z[0], d[0], nu
         level[b] = float(np.mean(np.abs(z[1:]) ** 2 / d[1:]))
     return ph, unit, level, dof
+
+
+def block_phasors(y: np.ndarray, fs: float, f0: float, blocks: int) -> np.ndarray:
+    """The line's complex amplitude at ``f0`` in each of ``blocks`` blocks of ``y``, as :func:`line_constancy`
+    fits it (its blocks, its taper, record time): phasors are linear in the samples, so those of a removed
+    component added to the final samples' give the record's own."""
+    edges = np.linspace(0, y.size, blocks + 1).astype(int)
+    return _block_terms(y, fs, f0, edges)[0]
 
 
 def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float, phasors: bool = False) -> dict | None:

@@ -474,6 +474,11 @@ class _Run:
         )
         ctx.change_times = [st.params["t"] for st in cp_steps]
         ctx.heldout_pct = self.state[0].get("heldout_rms_adev_pct")
+        ctx.families = [
+            (st.params["fundamentals"], st.evidence["frequencies_hz"], st.evidence["amplitudes"], rem.component)
+            for st, rem, *_rest in self.removed
+            if rem.effect == "periodic"
+        ]
         return unexplained(ctx)
 
     def refinement(self, cp_steps, unit, confidence, missing) -> Refinement:

@@ -37,6 +37,9 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
 - ``"level"`` — the noise level along the final samples (:func:`allanite.model.noise_level.level_test`, between
   the change points refine accepted): an entry with the time region ``"t"`` (lo, hi) s where the level is
   higher, where the change exceeds the final model's held-out error.
+- ``"line"`` — an accepted line whose complex amplitude changes along the final samples (:mod:`._line_check`:
+  each sinusoid, and the strongest line of each family removed in time), said where the change moves the
+  Allan deviation beyond the final model's held-out error; ``"t"`` the side after the change.
 - ``"channels"`` — a coupling to a channel of ``channels=`` left in the final samples (the regression's tests:
   the Whittle GLS for a slow channel, within blocks for a fast one).
 - ``"outliers"`` — impulsive noise left in the final samples (:func:`allanite.model.outliers.outlier_test`).
@@ -100,6 +103,9 @@ class MissingContext:
     change_times: list = field(default_factory=list)
     #: the final model's held-out RMS ADEV error (%), the yardstick of a level change's size (None: not known)
     heldout_pct: float | None = None
+    #: the ``"periodic"`` families removed in time, as (fundamentals, line frequencies, line amplitudes, the
+    #: removed component's samples): the ``"line"`` check tests each one's strongest line (:mod:`._line_check`)
+    families: list = field(default_factory=list)
 
 
 def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
