@@ -165,7 +165,7 @@ pub fn oavar_phase_gap_sums(x: &[f64], ms: &[usize]) -> Result<Vec<TermSum>> {
 mod tests {
     use super::*;
 
-    use crate::test_noise::uniform as lcg;
+    use allanite_testutil::lcg_uniform as lcg;
 
     /// PVAR's sum straight from its definition (O(N·m)).
     fn pvar_direct(x: &[f64], m: usize) -> f64 {

@@ -193,7 +193,7 @@ fn close_term(kind: StreamKind, x: &[f64], lane: &mut Lane) {
 mod tests {
     use super::*;
 
-    use crate::test_noise::uniform as lcg;
+    use allanite_testutil::lcg_uniform as lcg;
 
     /// The batch value from the definitions, for comparison.
     fn batch(kind: StreamKind, x: &[f64], m: usize) -> f64 {

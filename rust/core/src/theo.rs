@@ -144,7 +144,7 @@ fn sorted_unique(ms: &[usize]) -> (Vec<usize>, Vec<usize>) {
 mod tests {
     use super::*;
 
-    pub(super) use crate::test_noise::uniform as lcg;
+    pub(super) use allanite_testutil::lcg_uniform as lcg;
 
     pub(super) fn rel(a: f64, b: f64) -> f64 {
         (a - b).abs() / b.abs()
