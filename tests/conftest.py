@@ -20,7 +20,7 @@ from allanite.results import AllanResult
 # The property tests run on fixed inputs wherever the test command runs (the same examples on every run,
 # no example database written), so a red run is a change, never a draw. Exploring new inputs is a separate,
 # explicit run: ALLANITE_EXPLORE=1 python -m pytest (or --hypothesis-profile=explore), which draws at random
-# and keeps failures in .hypothesis/. The Rust property tests follow the same switch (rust/core/tests/common).
+# and keeps failures in .hypothesis/. The Rust property tests follow the same switch (rust/testutil/src/proptest_config.rs).
 settings.register_profile("fixed", derandomize=True, database=None)
 settings.register_profile("explore", derandomize=False)
 settings.load_profile("explore" if os.environ.get("ALLANITE_EXPLORE", "").strip() not in ("", "0") else "fixed")

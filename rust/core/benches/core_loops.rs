@@ -2,18 +2,11 @@
 //! `cargo bench -p allanite-core`. Sizes are small enough to run in a minute or two.
 
 use allanite_core::{dynamic_avar, run_in_pool, Estimator, Method, Request};
+use allanite_testutil::xorshift_uniform;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 
 fn noise(n: usize) -> Vec<f64> {
-    let mut s = 0x2545F4914F6CDD1Du64;
-    (0..n)
-        .map(|_| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        })
-        .collect()
+    xorshift_uniform(n, 0x2545F4914F6CDD1D)
 }
 
 /// Paper 000 §4.2 grid: m = round(g^i), duplicates removed, up to window/9.

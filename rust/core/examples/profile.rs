@@ -1,5 +1,6 @@
 //! Times the core on the large case without Python: `cargo run --release --example profile`.
 use allanite_core::{dynamic_avar, run_in_pool, Request};
+use allanite_testutil::xorshift_uniform;
 use std::time::Instant;
 
 fn main() {
@@ -12,16 +13,7 @@ fn main() {
     let hop = std::env::args()
         .nth(3)
         .map_or((n / 1000).max(1), |s| s.parse().unwrap());
-    // xorshift noise: no rand dependency needed
-    let mut s = 0x9E3779B97F4A7C15u64;
-    let y: Vec<f64> = (0..n)
-        .map(|_| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        })
-        .collect();
+    let y = xorshift_uniform(n, 0x9E3779B97F4A7C15);
     let top = window / 9;
     let g = (top as f64).powf(1.0 / 149.0);
     let mut ms: Vec<usize> = (0..150)

@@ -1,6 +1,7 @@
 //! Times the static overlapping Allan variance without Python, with a STREAM-like roofline measured
 //! in the same run: `cargo run --release --example static_profile -- [N] [workers]`.
 use allanite_core::{run_in_pool, static_avar, Estimator};
+use allanite_testutil::xorshift_uniform;
 use std::time::Instant;
 
 fn best<R>(reps: usize, mut f: impl FnMut() -> R) -> (f64, R) {
@@ -20,15 +21,7 @@ fn main() {
         .nth(1)
         .map_or(10_000_000, |s| s.parse().unwrap());
     let workers: usize = std::env::args().nth(2).map_or(1, |s| s.parse().unwrap());
-    let mut s = 0x9E3779B97F4A7C15u64;
-    let y: Vec<f64> = (0..n)
-        .map(|_| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        })
-        .collect();
+    let y = xorshift_uniform(n, 0x9E3779B97F4A7C15);
     let mut ms: Vec<usize> = (0..200)
         .map(|k| 1.2f64.powi(k).round() as usize)
         .filter(|&m| m <= n / 10)

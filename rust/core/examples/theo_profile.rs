@@ -1,18 +1,7 @@
 //! Timing of the Theo1 paths without Python: `cargo run --release --example theo_profile -p allanite-core`.
 use allanite_core::{dynamic_theo1, static_theo1};
+use allanite_testutil::lcg_uniform as lcg;
 use std::time::Instant;
-
-fn lcg(n: usize, seed: u64) -> Vec<f64> {
-    let mut s = seed;
-    (0..n)
-        .map(|_| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        })
-        .collect()
-}
 
 /// TheoH's Theo1 factors: the bias-ratio set 12 + 4i and a log grid beyond 10 % of the span.
 fn theoh_ms(n_rate: usize) -> Vec<usize> {

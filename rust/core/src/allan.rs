@@ -44,7 +44,9 @@ mod tests;
 pub(crate) use naive::{centred_angle, naive_rows};
 pub use paths::part_grid;
 pub(crate) use rows::{overlapping_row_at, Part, RowScratch};
-pub(crate) use sums::{block_window_sums, sliding_sums, sliding_sums_at, sum4};
+pub(crate) use sums::{
+    block_window_sums, compensated_means, sliding_sums, sliding_sums_at, sum4, Compensated,
+};
 pub use sums::{compensated_mean, compensated_sum_from};
 pub(crate) use terms::{for_each_term_chunk, for_each_term_chunk_at, TermScratch};
 
@@ -270,11 +272,7 @@ fn dynamic_avar_rows(req: &Request, cancel: &Cancel) -> Result<Rows> {
     let mut ranges = None;
     match req.method {
         Method::Fast => {
-            let mus: Vec<f64> = req
-                .columns
-                .par_iter()
-                .map(|c| compensated_mean(c))
-                .collect();
+            let mus = compensated_means(req.columns);
             // samples any window reads
             let n_used = ((n_win - 1) * req.hop + req.window).min(req.columns[0].len());
             let path = row_path(req, n_used, n_axes, n_win);

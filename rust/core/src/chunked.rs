@@ -394,18 +394,16 @@ fn finish_static(
 mod tests {
     use super::*;
     use crate::allan::{compensated_mean, dynamic_avar, Estimator, Method, Request};
+    use allanite_testutil::Lcg;
 
     /// White noise on a large offset whose level drops ×10⁴ after the first third (a loud stretch
     /// then a quiet one: what a global running sum would lose), and a slow random walk.
     fn record(n: usize, seed: u64) -> Vec<f64> {
-        let mut x = seed.wrapping_mul(6364136223846793005).wrapping_add(7);
+        let mut g = Lcg::new(seed.wrapping_mul(Lcg::MUL).wrapping_add(7));
         let mut walk = 0.0;
         (0..n)
             .map(|i| {
-                x = x
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let u = (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                let u = g.next_centered();
                 walk += 1e-6 * u;
                 7000.0 + walk + u * if i < n / 3 { 1.0 } else { 1e-4 }
             })

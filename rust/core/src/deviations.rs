@@ -32,7 +32,7 @@ pub use sliding::{dynamic_ohvar, gap_dynamic};
 pub use tie::{mtie, tie_gaps, tie_rms};
 use total::{htotvar_gap, htotvar_value, mtotvar_gap, mtotvar_value, totvar_sum, totvar_value};
 
-use crate::allan::{check_shape, compensated_mean, sliding_sums, sum4};
+use crate::allan::{check_shape, compensated_mean, sliding_sums, sum4, Compensated};
 use crate::cancel::Cancel;
 use crate::error::{CoreError, Result};
 use rayon::prelude::*;
@@ -136,34 +136,11 @@ fn check_values(cols: &[&[f64]], allow_nan: bool) -> Result<()> {
     Ok(())
 }
 
-/// Neumaier-compensated accumulator.
-#[derive(Default, Clone, Copy, Debug)]
-pub(crate) struct Acc {
-    s: f64,
-    c: f64,
-}
-
-impl Acc {
-    #[inline]
-    pub(crate) fn add(&mut self, v: f64) {
-        let t = self.s + v;
-        if self.s.abs() >= v.abs() {
-            self.c += (self.s - t) + v;
-        } else {
-            self.c += (v - t) + self.s;
-        }
-        self.s = t;
-    }
-    pub(crate) fn get(self) -> f64 {
-        self.s + self.c
-    }
-}
-
 const RUN: usize = 512;
 
 /// Σ v² in runs of `RUN` (four accumulators each), runs combined with compensation.
 fn sum_sq(v: &[f64]) -> f64 {
-    let mut acc = Acc::default();
+    let mut acc = Compensated::default();
     let mut buf = [0.0f64; RUN];
     for chunk in v.chunks(RUN) {
         for (b, x) in buf.iter_mut().zip(chunk) {
@@ -171,7 +148,7 @@ fn sum_sq(v: &[f64]) -> f64 {
         }
         acc.add(sum4(&buf[..chunk.len()]));
     }
-    acc.get()
+    acc.value()
 }
 
 /// The rate minus its mean, NaN (gaps) replaced by 0 so that sums over gap-free ranges are exact
@@ -293,11 +270,11 @@ fn for_each_term_chunk(
 /// OAVAR (SP 1065 eq. 11), for the gap-aware path.
 fn overlapping_value(kind: Kind, f: &[f64], m: usize) -> f64 {
     let (span, scale) = span_scale(kind, m);
-    let mut acc = Acc::default();
+    let mut acc = Compensated::default();
     for_each_term_chunk(kind, f, m, &mut TermBuf::default(), |_, t| {
         acc.add(sum_sq(t))
     });
-    acc.get() * scale / (f.len() + 1 - span) as f64
+    acc.value() * scale / (f.len() + 1 - span) as f64
 }
 
 /// HVAR (SP 1065 eq. 17, frequency form): with ȳ_j the non-overlapping m-sample averages, K = ⌊M/m⌋,
@@ -453,7 +430,7 @@ pub fn gap_deviation_cancellable(
 /// One gap-aware overlapping (or, `classic`, non-overlapping) estimate and its count of terms.
 fn overlapping_gap(kind: Kind, f: &[f64], cnt: &[u32], m: usize, classic: bool) -> (f64, u64) {
     let (span, scale) = span_scale(kind, m);
-    let (mut acc, mut kept) = (Acc::default(), 0usize);
+    let (mut acc, mut kept) = (Compensated::default(), 0usize);
     let mut keep = Vec::new();
     for_each_term_chunk(kind, f, m, &mut TermBuf::default(), |k0, t| {
         keep.clear();
@@ -471,7 +448,7 @@ fn overlapping_gap(kind: Kind, f: &[f64], cnt: &[u32], m: usize, classic: bool) 
     if kept == 0 {
         (f64::NAN, 0)
     } else {
-        (acc.get() * scale / kept as f64, kept as u64)
+        (acc.value() * scale / kept as f64, kept as u64)
     }
 }
 

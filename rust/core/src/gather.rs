@@ -277,7 +277,7 @@ mod tests {
         s / (2.0 * (k - 1) as f64)
     }
 
-    use crate::test_noise::uniform as noise;
+    use allanite_testutil::lcg_uniform as noise;
 
     #[test]
     fn matches_the_definition() {

@@ -18,8 +18,6 @@ pub mod phase_terms;
 pub mod range;
 pub mod streaming;
 pub mod taper;
-#[cfg(test)]
-mod test_noise;
 pub mod text;
 pub mod theo;
 mod window_sums;

@@ -72,4 +72,4 @@ const SHORT_M: usize = CHUNK / 2;
 const LANES: usize = 8;
 
 #[cfg(test)]
-use crate::test_noise::uniform as noise;
+use allanite_testutil::lcg_uniform as noise;

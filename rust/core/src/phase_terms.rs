@@ -23,7 +23,7 @@
 //! d is centred on its mean first (u is unchanged) and a frequency offset costs no digits.
 
 use crate::allan::compensated_mean;
-use crate::deviations::Acc;
+use crate::allan::Compensated;
 use crate::error::{CoreError, Result};
 use rayon::prelude::*;
 
@@ -83,7 +83,7 @@ fn pvar_one(x: &[f64], m: usize) -> TermSum {
     let c0 = (m as f64 - 1.0) / 2.0;
     let cm = c0 - m as f64;
     let (mut u, mut w) = (0.0f64, 0.0f64);
-    let mut acc = Acc::default();
+    let mut acc = Compensated::default();
     for i in 0..count {
         if i % m == 0 {
             let win = &d[i..i + m];
@@ -101,7 +101,7 @@ fn pvar_one(x: &[f64], m: usize) -> TermSum {
         acc.add(u * u);
     }
     TermSum {
-        sum: acc.get(),
+        sum: acc.value(),
         count,
     }
 }
@@ -122,14 +122,14 @@ pub fn allan_covariance_sums(x1: &[f64], x2: &[f64], ms: &[usize]) -> Result<Vec
         .par_iter()
         .map(|&m| {
             let count = x1.len() - 2 * m;
-            let mut acc = Acc::default();
+            let mut acc = Compensated::default();
             for i in 0..count {
                 let a = x1[i + 2 * m] - 2.0 * x1[i + m] + x1[i];
                 let b = x2[i + 2 * m] - 2.0 * x2[i + m] + x2[i];
                 acc.add(a * b);
             }
             TermSum {
-                sum: acc.get(),
+                sum: acc.value(),
                 count,
             }
         })
@@ -144,7 +144,7 @@ pub fn oavar_phase_gap_sums(x: &[f64], ms: &[usize]) -> Result<Vec<TermSum>> {
     Ok(ms
         .par_iter()
         .map(|&m| {
-            let mut acc = Acc::default();
+            let mut acc = Compensated::default();
             let mut count = 0;
             for i in 0..x.len() - 2 * m {
                 let v = x[i + 2 * m] - 2.0 * x[i + m] + x[i];
@@ -154,7 +154,7 @@ pub fn oavar_phase_gap_sums(x: &[f64], ms: &[usize]) -> Result<Vec<TermSum>> {
                 }
             }
             TermSum {
-                sum: acc.get(),
+                sum: acc.value(),
                 count,
             }
         })
@@ -165,7 +165,7 @@ pub fn oavar_phase_gap_sums(x: &[f64], ms: &[usize]) -> Result<Vec<TermSum>> {
 mod tests {
     use super::*;
 
-    use crate::test_noise::uniform as lcg;
+    use allanite_testutil::lcg_uniform as lcg;
 
     /// PVAR's sum straight from its definition (O(N·m)).
     fn pvar_direct(x: &[f64], m: usize) -> f64 {

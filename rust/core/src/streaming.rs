@@ -20,7 +20,7 @@
 //! points close (O(points) once), so its values are exact from the start. With an automatic
 //! schedule (`pending`), the next factor m is added as soon as the stream holds 2m + 1 points.
 
-use crate::deviations::Acc;
+use crate::allan::Compensated;
 use crate::error::{CoreError, Result};
 
 /// Which streaming variance.
@@ -37,7 +37,7 @@ pub enum StreamKind {
 #[derive(Clone, Debug)]
 struct Lane {
     m: usize,
-    sq: Acc,
+    sq: Compensated,
     n: u64,
     /// TVAR: the latest inner sum W_j
     w: f64,
@@ -88,7 +88,7 @@ impl Stream {
         }
         let mut lane = Lane {
             m,
-            sq: Acc::default(),
+            sq: Compensated::default(),
             n: 0,
             w: 0.0,
         };
@@ -151,7 +151,7 @@ impl Stream {
                 if l.n == 0 {
                     f64::NAN
                 } else {
-                    l.sq.get() / (k * m * m * l.n as f64)
+                    l.sq.value() / (k * m * m * l.n as f64)
                 }
             })
             .collect()
@@ -193,7 +193,7 @@ fn close_term(kind: StreamKind, x: &[f64], lane: &mut Lane) {
 mod tests {
     use super::*;
 
-    use crate::test_noise::uniform as lcg;
+    use allanite_testutil::lcg_uniform as lcg;
 
     /// The batch value from the definitions, for comparison.
     fn batch(kind: StreamKind, x: &[f64], m: usize) -> f64 {

@@ -31,7 +31,7 @@
 //! any number of worker threads.
 
 use crate::allan::{
-    centred_angle, compensated_mean, for_each_term_chunk, naive_rows, sum4, validate, Estimator,
+    centred_angle, compensated_means, for_each_term_chunk, naive_rows, sum4, validate, Estimator,
     Method, Request,
 };
 use crate::cancel::Cancel;
@@ -472,11 +472,7 @@ pub fn dynamic_hann_cancellable(req: &Request, cancel: &Cancel) -> Result<(Vec<f
     let mut out = vec![0.0f64; n_axes * n_m * n_win];
     match req.method {
         Method::Fast => {
-            let mus: Vec<f64> = req
-                .columns
-                .par_iter()
-                .map(|c| compensated_mean(c))
-                .collect();
+            let mus = compensated_means(req.columns);
             out.par_chunks_mut(n_win).enumerate().for_each_init(
                 HannScratch::default,
                 |sc, (row, dst)| {

@@ -40,7 +40,7 @@ mod whole;
 pub use sliding::{dynamic_theo1, dynamic_theo1_cancellable};
 pub use whole::{static_theo1, static_theo1_cancellable};
 
-use crate::allan::{check_finite, check_shape, compensated_mean};
+use crate::allan::{check_finite, check_shape, compensated_mean, Compensated};
 use crate::error::{CoreError, Result};
 
 /// Checks Theo1 averaging factors for a record (or window) of `n_rate` rate samples.
@@ -63,30 +63,6 @@ fn check_columns(columns: &[&[f64]]) -> Result<usize> {
     let n = check_shape(columns)?;
     check_finite(columns)?;
     Ok(n)
-}
-
-/// Neumaier-compensated running sum.
-#[derive(Default, Clone, Copy)]
-struct Compensated {
-    s: f64,
-    c: f64,
-}
-
-impl Compensated {
-    #[inline]
-    fn add(&mut self, v: f64) {
-        let t = self.s + v;
-        if self.s.abs() >= v.abs() {
-            self.c += (self.s - t) + v;
-        } else {
-            self.c += (v - t) + self.s;
-        }
-        self.s = t;
-    }
-    #[inline]
-    fn value(&self) -> f64 {
-        self.s + self.c
-    }
 }
 
 /// Phase of the mean-removed rate (compensated cumulative sum), with its least-squares line removed.
@@ -144,7 +120,7 @@ fn sorted_unique(ms: &[usize]) -> (Vec<usize>, Vec<usize>) {
 mod tests {
     use super::*;
 
-    pub(super) use crate::test_noise::uniform as lcg;
+    pub(super) use allanite_testutil::lcg_uniform as lcg;
 
     pub(super) fn rel(a: f64, b: f64) -> f64 {
         (a - b).abs() / b.abs()

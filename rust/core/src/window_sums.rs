@@ -434,12 +434,9 @@ pub(crate) fn hop1_row(
 mod tests {
     use super::*;
     use crate::allan::sliding_sums;
+    use allanite_testutil::Lcg;
 
-    fn blocks(n: usize) -> Vec<f64> {
-        (0..n as u64)
-            .map(|i| ((i.wrapping_mul(2654435761) % 1000) as f64 / 7.0).sqrt() * 1e-3)
-            .collect()
-    }
+    use allanite_testutil::hashed_levels as blocks;
 
     /// The two-pass form and the head's addition, as the rows formed them before.
     fn two_pass(f: &[f64], q: usize, head: Option<&[f64]>, n: usize) -> Vec<f64> {
@@ -503,13 +500,10 @@ mod tests {
 
     /// The record's phase, as the dynamic phase path builds it.
     fn phase(n: usize, seed: u64) -> crate::oavar::Phase {
-        let mut x = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+        let mut g = Lcg::new(seed.wrapping_mul(Lcg::MUL).wrapping_add(1));
         let y: Vec<f64> = (0..n)
             .map(|i| {
-                x = x
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let u = (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+                let u = g.next_centered();
                 // a loud first half, a quiet second one, on a large offset
                 7000.0 + if i < n / 2 { u * 1e3 } else { u * 1e-3 }
             })

@@ -5,19 +5,8 @@ use allanite_core::{
     run_in_pool_interruptible, static_theo1, static_theo1_cancellable, Cancel, CoreError,
     Estimator, Method, Request,
 };
+use allanite_testutil::xorshift_uniform as noise;
 use std::time::{Duration, Instant};
-
-fn noise(n: usize, seed: u64) -> Vec<f64> {
-    let mut s = seed;
-    (0..n)
-        .map(|_| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        })
-        .collect()
-}
 
 #[test]
 fn a_set_flag_returns_cancelled_from_every_kernel() {

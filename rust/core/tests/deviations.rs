@@ -10,7 +10,7 @@ use allanite_core::deviations::{
 use allanite_core::{run_in_pool, Cancel};
 use proptest::prelude::*;
 
-mod common;
+use allanite_testutil::proptest_config;
 
 const ALL: [Kind; 6] = [
     Kind::Mvar,
@@ -43,7 +43,7 @@ fn all_ms(kind: Kind, n: usize) -> Vec<usize> {
 }
 
 proptest! {
-    #![proptest_config(common::config(60))]
+    #![proptest_config(proptest_config::config(60))]
 
     #[test]
     fn hadamard_family_is_zero_for_constant_and_ramp(n in 9usize..200, c in -1e3f64..1e3, slope in -10f64..10.0) {

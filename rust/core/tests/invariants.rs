@@ -3,7 +3,7 @@
 use allanite_core::{dynamic_avar, run_in_pool, static_avar, Estimator, Method, Request};
 use proptest::prelude::*;
 
-mod common;
+use allanite_testutil::proptest_config;
 
 /// Plain definition: remove the mean, integrate, sum squared second differences.
 fn reference(y: &[f64], m: usize, estimator: Estimator) -> f64 {
@@ -45,7 +45,7 @@ fn estimator() -> impl Strategy<Value = Estimator> {
 }
 
 proptest! {
-    #![proptest_config(common::config(200))]
+    #![proptest_config(proptest_config::config(200))]
 
     #[test]
     fn every_window_equals_the_plain_recomputation(
@@ -155,23 +155,4 @@ fn errors_name_the_value() {
     assert!(bad(4, 0, &[1]).contains("hop (0)"));
     assert!(bad(4, 1, &[3]).contains("m = 3"));
     assert!(bad(4, 1, &[]).contains("no averaging factors"));
-}
-
-/// A default run replays the committed failures but records none (`common::config`); exploring records.
-#[test]
-fn a_default_run_records_no_failure() {
-    let dir = std::env::temp_dir().join(format!("allanite-proptest-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let src = dir.join("probe.rs").to_string_lossy().into_owned();
-    let mut cfg = common::config(8);
-    cfg.source_file = Some(Box::leak(src.into_boxed_str()));
-    let mut runner = proptest::test_runner::TestRunner::new(cfg);
-    let failed = runner.run(&(0u32..100), |v| {
-        prop_assert!(v > 1000);
-        Ok(())
-    });
-    assert!(failed.is_err(), "the probe property must fail");
-    let written = dir.join("probe.proptest-regressions").exists();
-    std::fs::remove_dir_all(&dir).ok();
-    assert_eq!(written, common::exploring());
 }

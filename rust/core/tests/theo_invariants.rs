@@ -3,7 +3,7 @@
 use allanite_core::{detrended_phase, dynamic_theo1, run_in_pool, static_theo1, theo1_direct};
 use proptest::prelude::*;
 
-mod common;
+use allanite_testutil::proptest_config;
 
 fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()) + 1e-300
@@ -14,7 +14,7 @@ fn record() -> impl Strategy<Value = Vec<f64>> {
 }
 
 proptest! {
-    #![proptest_config(common::config(120))]
+    #![proptest_config(proptest_config::config(120))]
 
     #[test]
     fn every_window_equals_the_direct_double_sum(y in record(), wfrac in 0.1f64..1.0, hop in 1usize..40) {

@@ -1,7 +1,7 @@
 //! The (dynamic) Allan variance: `davar` and its ranged, part-wise and Hann-weighted forms, and the
 //! grid on which a record may be cut into parts (allanite-core `allan`, `oavar`, `taper`).
 
-use crate::{contiguous, parameter_error, run_interruptible, to_3d};
+use crate::{parameter_error, per_axis_m_and_window, run_interruptible, to_3d};
 use allanite_core::dynamic_hann_cancellable;
 use allanite_core::{dynamic_avar_cancellable, Estimator, Method, Request};
 use allanite_core::{dynamic_avar_part_cancellable, dynamic_avar_ranged_cancellable};
@@ -30,17 +30,13 @@ pub(crate) fn parse_method(py: Python<'_>, s: &str) -> PyResult<Method> {
     }
 }
 
-/// The arguments every dynamic Allan call shares, checked in this order: the estimator, the method,
-/// then every axis contiguous.
-pub(crate) fn dynamic_args<'a>(
+/// The estimator and method every dynamic Allan call takes, checked in this order (the axes after them).
+pub(crate) fn dynamic_args(
     py: Python<'_>,
-    columns: &'a [PyReadonlyArray1<'_, f64>],
     estimator: &str,
     method: &str,
-) -> PyResult<(Vec<&'a [f64]>, Estimator, Method)> {
-    let estimator = parse_estimator(py, estimator)?;
-    let method = parse_method(py, method)?;
-    Ok((contiguous(py, columns)?, estimator, method))
+) -> PyResult<(Estimator, Method)> {
+    Ok((parse_estimator(py, estimator)?, parse_method(py, method)?))
 }
 
 /// The core's request of a dynamic call.
@@ -79,11 +75,10 @@ pub(crate) fn davar<'py>(
     method: &str,
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let (slices, estimator, method) = dynamic_args(py, &columns, estimator, method)?;
-    let req = request(&slices, window, hop, &ms, estimator, method);
-    let (values, n_win) =
-        run_interruptible(py, workers, |cancel| dynamic_avar_cancellable(&req, cancel))?;
-    to_3d(py, (slices.len(), ms.len(), n_win), values)
+    let (estimator, method) = dynamic_args(py, estimator, method)?;
+    per_axis_m_and_window(py, &columns, ms.len(), workers, |cols, cancel| {
+        dynamic_avar_cancellable(&request(cols, window, hop, &ms, estimator, method), cancel)
+    })
 }
 
 /// [`davar`] and the range of every (axis, m) row of the result: (values, ranges), ranges of shape
@@ -103,7 +98,8 @@ pub(crate) fn davar_ranged<'py>(
     method: &str,
     workers: usize,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray3<f64>>)> {
-    let (slices, estimator, method) = dynamic_args(py, &columns, estimator, method)?;
+    let (estimator, method) = dynamic_args(py, estimator, method)?;
+    let slices = crate::contiguous(py, &columns)?;
     let req = request(&slices, window, hop, &ms, estimator, method);
     let (values, n_win, ranges) = run_interruptible(py, workers, |cancel| {
         dynamic_avar_ranged_cancellable(&req, cancel)
@@ -139,12 +135,11 @@ pub(crate) fn davar_part<'py>(
     first_window: usize,
     n_windows: usize,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let (slices, estimator, method) = dynamic_args(py, &columns, estimator, method)?;
-    let req = request(&slices, window, hop, &ms, estimator, method);
-    let (values, n_win) = run_interruptible(py, workers, |cancel| {
+    let (estimator, method) = dynamic_args(py, estimator, method)?;
+    per_axis_m_and_window(py, &columns, ms.len(), workers, |cols, cancel| {
+        let req = request(cols, window, hop, &ms, estimator, method);
         dynamic_avar_part_cancellable(&req, &mus, first_window, n_windows, cancel)
-    })?;
-    to_3d(py, (slices.len(), ms.len(), n_win), values)
+    })
 }
 
 /// Samples between the places a record of `n` samples × `n_axes` may be cut into [`davar_part`] parts
@@ -161,8 +156,7 @@ pub(crate) fn part_grid(
     estimator: &str,
     method: &str,
 ) -> PyResult<usize> {
-    let estimator = parse_estimator(py, estimator)?;
-    let method = parse_method(py, method)?;
+    let (estimator, method) = dynamic_args(py, estimator, method)?;
     allanite_core::part_grid(n, n_axes, window, hop, estimator, method).ok_or_else(|| {
         parameter_error(
             py,
@@ -189,9 +183,8 @@ pub(crate) fn davar_hann<'py>(
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     let method = parse_method(py, method)?;
-    let slices = contiguous(py, &columns)?;
-    let req = request(&slices, window, hop, &ms, Estimator::Overlapping, method);
-    let (values, n_win) =
-        run_interruptible(py, workers, |cancel| dynamic_hann_cancellable(&req, cancel))?;
-    to_3d(py, (slices.len(), ms.len(), n_win), values)
+    per_axis_m_and_window(py, &columns, ms.len(), workers, |cols, cancel| {
+        let req = request(cols, window, hop, &ms, Estimator::Overlapping, method);
+        dynamic_hann_cancellable(&req, cancel)
+    })
 }

@@ -2,6 +2,7 @@
 //! and sliding-window forms, MTIE and TIE rms.
 
 use crate::{allanite_error, as_i64, contiguous, run_interruptible, to_2d, to_3d};
+use crate::{per_axis_and_m, per_axis_m_and_window};
 use allanite_core::deviations;
 use numpy::{PyArray2, PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -45,11 +46,9 @@ pub(crate) fn deviation_static<'py>(
         estimator,
         &["mvar", "hvar", "ohvar", "totvar", "mtotvar", "htotvar"],
     )?;
-    let slices = contiguous(py, &columns)?;
-    let values = run_interruptible(py, workers, |cancel| {
-        deviations::static_deviation_cancellable(&slices, &ms, kind, cancel)
-    })?;
-    to_2d(py, slices.len(), ms.len(), values)
+    per_axis_and_m(py, &columns, ms.len(), workers, |cols, cancel| {
+        deviations::static_deviation_cancellable(cols, &ms, kind, cancel)
+    })
 }
 
 /// Time total variance (τ²/3)·MTOTVAR, τ = m·tau0, of each rate record: shape (axes, len(ms)).
@@ -62,11 +61,9 @@ pub(crate) fn ttotvar_static<'py>(
     tau0: f64,
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let slices = contiguous(py, &columns)?;
-    let values = run_interruptible(py, workers, |cancel| {
-        deviations::static_ttotvar_cancellable(&slices, &ms, tau0, cancel)
-    })?;
-    to_2d(py, slices.len(), ms.len(), values)
+    per_axis_and_m(py, &columns, ms.len(), workers, |cols, cancel| {
+        deviations::static_ttotvar_cancellable(cols, &ms, tau0, cancel)
+    })
 }
 
 /// Gap-aware OAVAR/MVAR/OHVAR (and classic AVAR/HVAR: "avar", "hvar") of rate records with NaN-marked gaps: (values, counts), each of
@@ -113,11 +110,9 @@ pub(crate) fn ohvar_dynamic<'py>(
     ms: Vec<usize>,
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let slices = contiguous(py, &columns)?;
-    let (values, n_win) = run_interruptible(py, workers, |_cancel| {
-        deviations::dynamic_ohvar(&slices, window, hop, &ms)
-    })?;
-    to_3d(py, (slices.len(), ms.len(), n_win), values)
+    per_axis_m_and_window(py, &columns, ms.len(), workers, |cols, _cancel| {
+        deviations::dynamic_ohvar(cols, window, hop, &ms)
+    })
 }
 
 /// (values, counts) of a gap-aware whole-record estimate.
@@ -194,9 +189,9 @@ pub(crate) fn mtie_phase<'py>(
     ms: Vec<usize>,
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let slices = contiguous(py, &columns)?;
-    let values = run_interruptible(py, workers, |_cancel| deviations::mtie(&slices, &ms))?;
-    to_2d(py, slices.len(), ms.len(), values)
+    per_axis_and_m(py, &columns, ms.len(), workers, |cols, _cancel| {
+        deviations::mtie(cols, &ms)
+    })
 }
 
 /// TIE rms of each *phase* record: shape (axes, len(ms)).
@@ -208,7 +203,7 @@ pub(crate) fn tierms_phase<'py>(
     ms: Vec<usize>,
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let slices = contiguous(py, &columns)?;
-    let values = run_interruptible(py, workers, |_cancel| deviations::tie_rms(&slices, &ms))?;
-    to_2d(py, slices.len(), ms.len(), values)
+    per_axis_and_m(py, &columns, ms.len(), workers, |cols, _cancel| {
+        deviations::tie_rms(cols, &ms)
+    })
 }

@@ -1,7 +1,7 @@
 //! The noise-model fits in the core: every window's fit and `refine`'s reweighted NNLS of one curve on
 //! many designs (allanite-core `fit`).
 
-use crate::{parameter_error, run_interruptible, to_2d};
+use crate::{c_slice, parameter_error, run_interruptible, to_2d};
 use numpy::{
     PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods,
 };
@@ -90,16 +90,14 @@ pub(crate) fn irls_curves<'py>(
     use allanite_core::fit::curves::{irls_curves as run, CurveDesigns, CurveFitError};
     let shape = design.shape().to_vec();
     let (g_n, n, k) = (shape[0], shape[1], shape[2]);
-    let contiguous =
-        |what: &str| parameter_error(py, format!("{what} must be a C-contiguous float64 array"));
     let (a, nc) = (
-        design.as_slice().map_err(|_| contiguous("design"))?,
-        nu_cols.as_slice().map_err(|_| contiguous("nu_cols"))?,
+        c_slice(py, &design, "design")?,
+        c_slice(py, &nu_cols, "nu_cols")?,
     );
     let (yv, nv, fv) = (
-        y.as_slice().map_err(|_| contiguous("y"))?,
-        nu0.as_slice().map_err(|_| contiguous("nu0"))?,
-        fixed.as_slice().map_err(|_| contiguous("fixed"))?,
+        c_slice(py, &y, "y")?,
+        c_slice(py, &nu0, "nu0")?,
+        c_slice(py, &fixed, "fixed")?,
     );
     if nu_cols.shape() != shape.as_slice() || yv.len() != n || nv.len() != n || fv.len() != k {
         return Err(parameter_error(
@@ -129,13 +127,4 @@ pub(crate) fn irls_curves<'py>(
         }
     })?;
     Ok((to_2d(py, g_n, k, theta)?, to_2d(py, g_n, n, nu)?))
-}
-
-pub(crate) fn c_slice<'a>(
-    py: Python<'_>,
-    a: &'a PyReadonlyArray2<'_, f64>,
-    what: &str,
-) -> PyResult<&'a [f64]> {
-    a.as_slice()
-        .map_err(|_| parameter_error(py, format!("{what} must be a C-contiguous float64 array")))
 }

@@ -5,7 +5,10 @@
 //!
 //! Every long call goes through [`run_interruptible`], so Ctrl-C stops it: a kernel takes a
 //! `&Cancel` (see allanite_core::cancel) and the binding calls it as
-//! `run_interruptible(py, workers, |cancel| kernel_cancellable(..., cancel))`.
+//! `run_interruptible(py, workers, |cancel| kernel_cancellable(..., cancel))` — or, for a kernel of
+//! contiguous axes giving an (axes, len(ms)[, windows]) array, as
+//! `per_axis_and_m(py, &columns, ms.len(), workers, |cols, cancel| kernel(cols, ..., cancel))`
+//! ([`arrays`]), which checks the axes, runs it so and shapes the result.
 //!
 //! This file is the module definition alone: one binding module per concern (a new binding goes in a
 //! file of its own, registered below), the shared helpers ([`errors`], [`arrays`]) re-exported here so
@@ -23,7 +26,8 @@ mod sums;
 mod text;
 mod theo;
 
-pub(crate) use arrays::{as_i64, contiguous, contiguous_one, to_2d, to_3d};
+pub(crate) use arrays::{as_i64, c_slice, contiguous, contiguous_one, to_2d, to_3d};
+pub(crate) use arrays::{per_axis_and_m, per_axis_m_and_window};
 pub(crate) use errors::{
     allanite_error, core_error, input_error, parameter_error, run_interruptible,
 };

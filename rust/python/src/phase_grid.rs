@@ -1,15 +1,10 @@
 //! Bindings of allanite-core's `phase_grid` (the line families' time-domain passes, used by
 //! `allanite.model.linefit` where the core has them): numpy in, numpy out, GIL released.
 
-use crate::parameter_error;
+use crate::{c_slice, parameter_error};
 use allanite_core::phase_grid;
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1, PyReadwriteArray1};
 use pyo3::prelude::*;
-
-fn slice<'a>(py: Python<'_>, a: &'a PyReadonlyArray1<'_, f64>, what: &str) -> PyResult<&'a [f64]> {
-    a.as_slice()
-        .map_err(|_| parameter_error(py, format!("{what} must be a C-contiguous float64 array")))
-}
 
 /// `linefit._binned` of each part on `linefit._gridding(u, m_bins, seg)`: the parts (each as long as
 /// `u`, the unit phases in [0, 1)) spread onto `n_seg` × `m_bins` bins by linear interpolation; `seg`
@@ -27,27 +22,20 @@ pub(crate) fn phase_bins<'py>(
     n_seg: usize,
     ph: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<Vec<Bound<'py, PyArray1<f64>>>> {
-    let uv = slice(py, &u, "u")?;
+    let uv = c_slice(py, &u, "u")?;
     let ps = parts
         .iter()
-        .map(|p| slice(py, p, "parts"))
+        .map(|p| c_slice(py, p, "parts"))
         .collect::<PyResult<Vec<_>>>()?;
-    let pv = match &ph {
-        None => None,
-        Some(p) => Some(slice(py, p, "ph")?),
-    };
+    let pv = ph.as_ref().map(|p| c_slice(py, p, "ph")).transpose()?;
     let segs: Option<Vec<usize>> = match &seg {
         None => None,
-        Some(s) => {
-            let sv = s.as_slice().map_err(|_| {
-                parameter_error(py, "seg must be a C-contiguous int64 array".to_string())
-            })?;
-            Some(
-                sv.iter()
-                    .map(|&k| usize::try_from(k).unwrap_or(usize::MAX))
-                    .collect(),
-            )
-        }
+        Some(s) => Some(
+            c_slice(py, s, "seg")?
+                .iter()
+                .map(|&k| usize::try_from(k).unwrap_or(usize::MAX))
+                .collect(),
+        ),
     };
     let sg = segs.as_deref();
     let out = py
@@ -81,11 +69,8 @@ pub(crate) fn add_waveform<'py>(
     wave: PyReadonlyArray1<'py, f64>,
     ph: Option<PyReadonlyArray1<'py, f64>>,
 ) -> PyResult<()> {
-    let (uv, wv) = (slice(py, &u, "u")?, slice(py, &wave, "wave")?);
-    let pv = match &ph {
-        None => None,
-        Some(p) => Some(slice(py, p, "ph")?),
-    };
+    let (uv, wv) = (c_slice(py, &u, "u")?, c_slice(py, &wave, "wave")?);
+    let pv = ph.as_ref().map(|p| c_slice(py, p, "ph")).transpose()?;
     let ov = out
         .as_slice_mut()
         .map_err(|_| parameter_error(py, "out must be a C-contiguous float64 array".to_string()))?;

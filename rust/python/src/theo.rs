@@ -1,6 +1,6 @@
 //! Theo1 of whole records and of sliding windows (allanite-core `theo`).
 
-use crate::{contiguous, run_interruptible, to_2d, to_3d};
+use crate::{per_axis_and_m, per_axis_m_and_window};
 use allanite_core::{dynamic_theo1_cancellable, static_theo1_cancellable};
 use numpy::{PyArray2, PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -14,11 +14,9 @@ pub(crate) fn theo1_static<'py>(
     ms: Vec<usize>,
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let slices = contiguous(py, &columns)?;
-    let values = run_interruptible(py, workers, |cancel| {
-        static_theo1_cancellable(&slices, &ms, cancel)
-    })?;
-    to_2d(py, slices.len(), ms.len(), values)
+    per_axis_and_m(py, &columns, ms.len(), workers, |cols, cancel| {
+        static_theo1_cancellable(cols, &ms, cancel)
+    })
 }
 
 /// Theo1 of every sliding window at every (even) averaging factor: shape (axes, len(ms), windows).
@@ -32,9 +30,7 @@ pub(crate) fn theo1_dynamic<'py>(
     ms: Vec<usize>,
     workers: usize,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let slices = contiguous(py, &columns)?;
-    let (values, n_win) = run_interruptible(py, workers, |cancel| {
-        dynamic_theo1_cancellable(&slices, window, hop, &ms, cancel)
-    })?;
-    to_3d(py, (slices.len(), ms.len(), n_win), values)
+    per_axis_m_and_window(py, &columns, ms.len(), workers, |cols, cancel| {
+        dynamic_theo1_cancellable(cols, window, hop, &ms, cancel)
+    })
 }

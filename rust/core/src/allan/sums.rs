@@ -3,6 +3,7 @@
 //! record ([`sliding_sums`]) or a part of one, bit for bit the record's ([`sliding_sums_at`]).
 
 use super::terms::CHAINS;
+use rayon::prelude::*;
 
 /// Mean by Neumaier's compensated sum, so that a long record's mean is right to ~ε.
 pub fn compensated_mean(y: &[f64]) -> f64 {
@@ -19,17 +20,56 @@ pub fn compensated_mean(y: &[f64]) -> f64 {
 /// `(s + c) / n` its [`compensated_mean`]. This is how a record held in pieces (a Dask array)
 /// gets the centring value the whole-record call uses.
 pub fn compensated_sum_from(y: &[f64], state: (f64, f64)) -> (f64, f64) {
-    let (mut s, mut c) = state;
+    let mut acc = Compensated::from_state(state);
     for &v in y {
-        let t = s + v;
-        if s.abs() >= v.abs() {
-            c += (s - t) + v;
-        } else {
-            c += (v - t) + s;
-        }
-        s = t;
+        acc.add(v);
     }
-    (s, c)
+    acc.state()
+}
+
+/// The per-column [`compensated_mean`]s, the columns in parallel (each one sequential, so the
+/// same bits for any number of threads): every path's centring values.
+pub(crate) fn compensated_means(columns: &[&[f64]]) -> Vec<f64> {
+    columns.par_iter().map(|c| compensated_mean(c)).collect()
+}
+
+/// Neumaier's compensated running sum (sum s, compensation c; the value s + c): the one
+/// implementation of the step behind [`compensated_sum_from`] and the kernels that add their
+/// terms or blocks of terms one at a time.
+#[derive(Default, Clone, Copy, Debug)]
+pub(crate) struct Compensated {
+    s: f64,
+    c: f64,
+}
+
+impl Compensated {
+    /// The sum continued from the state (s, c).
+    pub(crate) fn from_state((s, c): (f64, f64)) -> Self {
+        Self { s, c }
+    }
+
+    /// Adds `v`; the rounding error of s + v goes to the compensation.
+    #[inline]
+    pub(crate) fn add(&mut self, v: f64) {
+        let t = self.s + v;
+        if self.s.abs() >= v.abs() {
+            self.c += (self.s - t) + v;
+        } else {
+            self.c += (v - t) + self.s;
+        }
+        self.s = t;
+    }
+
+    /// The compensated value s + c.
+    #[inline]
+    pub(crate) fn value(self) -> f64 {
+        self.s + self.c
+    }
+
+    /// The state (s, c), to continue from.
+    pub(crate) fn state(self) -> (f64, f64) {
+        (self.s, self.c)
+    }
 }
 
 /// Sum with four partial accumulators: shorter dependency chains and ~¼ the rounding growth.

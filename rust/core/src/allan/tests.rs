@@ -1,5 +1,6 @@
 use super::paths::RowPath;
 use super::*;
+use allanite_testutil::{hashed_levels, Lcg};
 
 #[test]
 fn sliding_sums_match_direct() {
@@ -42,9 +43,7 @@ fn sliding_sums_serial(f: &[f64], q: usize, out: &mut [f64]) {
 
 #[test]
 fn interleaved_sliding_sums_are_bit_identical_to_serial() {
-    let f: Vec<f64> = (0..5000u64)
-        .map(|i| ((i.wrapping_mul(2654435761) % 1000) as f64 / 7.0).sqrt() * 1e-3)
-        .collect();
+    let f = hashed_levels(5000);
     for q in [2, 3, 7, 64, 100, 333, 1000, 1249, 1250, 1251, 2500, 4999] {
         for n_out in [
             1,
@@ -74,9 +73,7 @@ fn interleaved_sliding_sums_are_bit_identical_to_serial() {
 
 #[test]
 fn sliding_sums_at_is_the_records_arithmetic() {
-    let f: Vec<f64> = (0..300u64)
-        .map(|i| ((i.wrapping_mul(2654435761) % 1000) as f64 / 7.0).sqrt() * 1e-3)
-        .collect();
+    let f = hashed_levels(300);
     for q in [1, 2, 3, 7, 16, 33, 100] {
         for n_total in [1, 2, q, q + 1, 3 * q + 2, f.len() + 1 - q] {
             if n_total + q - 1 > f.len() {
@@ -105,15 +102,10 @@ fn sliding_sums_at_is_the_records_arithmetic() {
 /// A record whose mean is far above its noise (7000 σ) and whose noise level changes: centring
 /// and block alignment matter in the last bits.
 fn biased_record(n: usize, seed: u64) -> Vec<f64> {
-    let mut x = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
+    let mut g = Lcg::new(seed.wrapping_mul(Lcg::MUL).wrapping_add(Lcg::INC));
     (0..n)
         .map(|i| {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let u = (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            let u = g.next_centered();
             7000.0 + u * if i < n / 3 { 3.0 } else { 1.0 }
         })
         .collect()

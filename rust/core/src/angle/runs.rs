@@ -2,6 +2,7 @@
 //! axis), and the vectorised sum of a plan item's squared second differences over them.
 
 use super::{AngleChunk, LANES, RUN};
+use crate::allan::Compensated;
 use crate::error::{CoreError, Result};
 use crate::oavar::PhaseBuf;
 
@@ -163,7 +164,7 @@ pub(super) fn term_sum(
         .wrapping_add(ra.base) as f64;
     let (ha, hb, hc) = (ra.hi.get(), rb.hi.get(), rc.hi.get());
     let (la, lb, lc) = (ra.lo.get(), rb.lo.get(), rc.lo.get());
-    let (mut s, mut comp) = (0.0f64, 0.0f64);
+    let mut sum = Compensated::default();
     let mut done = 0;
     while done < count {
         let n = RUN.min(count - done);
@@ -190,17 +191,10 @@ pub(super) fn term_sum(
             }
             ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
         };
-        // Neumaier
-        let t = s + run;
-        if s.abs() >= run.abs() {
-            comp += (s - t) + run;
-        } else {
-            comp += (run - t) + s;
-        }
-        s = t;
+        sum.add(run);
         done += n;
     }
-    s + comp
+    sum.value()
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 
 use super::runs::{rint, run_sum_dispatch, scale, MAX_LOCAL, MAX_WHOLE};
 use super::{AngleChunk, LANES, RUN};
+use crate::allan::Compensated;
 use crate::error::{CoreError, Result};
 
 /// The angle of one axis of a run of consecutive chunks, produced point by point without storing it:
@@ -157,7 +158,7 @@ pub(super) fn stream_sum(
         .base
         .wrapping_sub(cur[1].base.wrapping_mul(2))
         .wrapping_add(cur[0].base) as f64;
-    let (mut s, mut comp) = (0.0f64, 0.0f64);
+    let mut sum = Compensated::default();
     let mut done = 0;
     let mut buf = vec![0.0f64; 6 * RUN];
     while done < count {
@@ -195,17 +196,11 @@ pub(super) fn stream_sum(
             }
             ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]))
         };
-        let t = s + run;
-        if s.abs() >= run.abs() {
-            comp += (s - t) + run;
-        } else {
-            comp += (run - t) + s;
-        }
-        s = t;
+        sum.add(run);
         done += n;
     }
     for c in cur.iter() {
         c.check()?;
     }
-    Ok(s + comp)
+    Ok(sum.value())
 }

@@ -1,4 +1,5 @@
 use super::*;
+use allanite_testutil::Lcg;
 
 /// Integer-valued samples on a quantum of 1: every sum is exact, so the kernel must match the
 /// plain definition exactly.
@@ -71,15 +72,9 @@ fn streaming_one_factor_gives_the_stored_paths_bits() {
     // noisy, biased, three axes; chunks of uneven length in two runs
     let n = 5000;
     let na = 3;
-    let mut x = 0x9E3779B97F4A7C15u64;
+    let mut g = Lcg::new(0x9E3779B97F4A7C15);
     let y: Vec<f64> = (0..n * na)
-        .map(|i| {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * [1.0, 3e-3, 40.0][i % na]
-                + [0.0, 7.0, -900.0][i % na]
-        })
+        .map(|i| g.next_centered() * [1.0, 3e-3, 40.0][i % na] + [0.0, 7.0, -900.0][i % na])
         .collect();
     let q_exp = -16; // |y/q| ≤ 2^26
     let cut = [0, 700, 1900, 2600, 5000];

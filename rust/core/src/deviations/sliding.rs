@@ -4,7 +4,7 @@
 
 use super::{
     centred, check_gap_span, check_ms, check_values, for_each_term_chunk, nan_prefix_counts,
-    span_scale, Acc, Kind, TermBuf, RUN,
+    span_scale, Compensated, Kind, TermBuf, RUN,
 };
 use crate::allan::{block_window_sums, check_shape, check_window_hop, sum4};
 use crate::cancel::Cancel;
@@ -53,8 +53,8 @@ pub fn dynamic_ohvar(
             let mut part = vec![0.0; nblocks];
             let mut buf = Vec::with_capacity(hop_b.min(RUN));
             for (b, blk) in t[..k_end].chunks(hop_b).enumerate() {
-                let mut acc = Acc::default();
-                let mut pacc = Acc::default();
+                let mut acc = Compensated::default();
+                let mut pacc = Compensated::default();
                 for (c, sub) in blk.chunks(RUN).enumerate() {
                     buf.clear();
                     buf.extend(sub.iter().map(|v| v * v * norm));
@@ -65,8 +65,8 @@ pub fn dynamic_ohvar(
                         pacc.add(sum4(&buf[..(r - lo).min(buf.len())]));
                     }
                 }
-                full[b] = acc.get();
-                part[b] = pacc.get();
+                full[b] = acc.value();
+                part[b] = pacc.value();
             }
             block_window_sums(&full, &part, (q, r), (0, n_win), dst);
         });
@@ -173,8 +173,8 @@ fn block_sums(t: &[f64], hop_b: usize, r: usize, nblocks: usize) -> (Vec<f64>, V
     let mut full = vec![0.0; nblocks];
     let mut part = vec![0.0; nblocks];
     for (b, blk) in t.chunks(hop_b).enumerate() {
-        let mut acc = Acc::default();
-        let mut pacc = Acc::default();
+        let mut acc = Compensated::default();
+        let mut pacc = Compensated::default();
         for (c, sub) in blk.chunks(RUN).enumerate() {
             acc.add(sum4(sub));
             let lo = c * RUN;
@@ -182,8 +182,8 @@ fn block_sums(t: &[f64], hop_b: usize, r: usize, nblocks: usize) -> (Vec<f64>, V
                 pacc.add(sum4(&sub[..(r - lo).min(sub.len())]));
             }
         }
-        full[b] = acc.get();
-        part[b] = pacc.get();
+        full[b] = acc.value();
+        part[b] = pacc.value();
     }
     (full, part)
 }

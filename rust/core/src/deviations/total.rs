@@ -3,7 +3,7 @@
 //! subsequences whose sums are combined in order (bit-identical for any number of threads); with a
 //! gap count, only the complete terms or subsequences.
 
-use super::{overlapping_value, sum_sq, Acc, Kind, RUN, TERM_CHUNK};
+use super::{overlapping_value, sum_sq, Compensated, Kind, RUN, TERM_CHUNK};
 use crate::allan::{sliding_sums, sum4};
 use crate::cancel::Cancel;
 use rayon::prelude::*;
@@ -37,7 +37,7 @@ pub(super) fn totvar_sum(f: &[f64], m: usize, cnt: Option<&[u32]>) -> (f64, usiz
     };
     let chunk = TERM_CHUNK.max(4 * m);
     let (mut z, mut b) = (Vec::new(), Vec::new());
-    let mut acc = Acc::default();
+    let mut acc = Compensated::default();
     let mut kept = 0usize;
     let mut p0 = 1;
     while p0 < mm {
@@ -63,7 +63,7 @@ pub(super) fn totvar_sum(f: &[f64], m: usize, cnt: Option<&[u32]>) -> (f64, usiz
         acc.add(sum_sq(&t));
         p0 += c;
     }
-    (acc.get(), kept)
+    (acc.value(), kept)
 }
 
 /// Subsequences per parallel chunk in MTOTVAR/HTOTVAR (fixed: results independent of threads).
@@ -137,7 +137,7 @@ impl TotScratch {
         }
         // z_j·m = Q(j+3m) − 3Q(j+2m) + 3Q(j+m) − Q(j), j < 6m; squares summed in runs of RUN with
         // four accumulators (independent chains), the runs with compensation.
-        let mut acc = Acc::default();
+        let mut acc = Compensated::default();
         let mut buf = [0.0f64; RUN];
         let mut j0 = 0;
         while j0 < 2 * n3 {
@@ -163,7 +163,7 @@ impl TotScratch {
             acc.add(sum4(&buf[..c]));
             j0 += c;
         }
-        acc.get()
+        acc.value()
     }
 }
 
@@ -251,7 +251,7 @@ pub(super) fn chunked_sum(
                 if cancel.is_cancelled() {
                     return (0.0, 0); // the caller checks the flag and discards the value
                 }
-                let mut acc = Acc::default();
+                let mut acc = Compensated::default();
                 let mut kept = 0;
                 for n in c * SUB_CHUNK..((c + 1) * SUB_CHUNK).min(l) {
                     if let Some(v) = g(sc, n) {
@@ -259,15 +259,15 @@ pub(super) fn chunked_sum(
                         kept += 1;
                     }
                 }
-                (acc.get(), kept)
+                (acc.value(), kept)
             },
         )
         .collect();
-    let mut acc = Acc::default();
+    let mut acc = Compensated::default();
     let mut kept = 0;
     for (p, k) in parts {
         acc.add(p);
         kept += k;
     }
-    (acc.get(), kept)
+    (acc.value(), kept)
 }

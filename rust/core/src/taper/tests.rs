@@ -1,16 +1,10 @@
 use super::*;
+use allanite_testutil::Xorshift;
 
-/// A small deterministic generator (xorshift), uniform in [−1, 1).
+/// Xorshift noise uniform in [−1, 1) (twice the [−½, ½) values: exact, multiples of 2⁻⁵²).
 fn noise(n: usize, seed: u64) -> Vec<f64> {
-    let mut s = seed.max(1);
-    (0..n)
-        .map(|_| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        })
-        .collect()
+    let mut g = Xorshift::new(seed.max(1));
+    (0..n).map(|_| 2.0 * g.next_centered()).collect()
 }
 
 fn run(y: &[f64], window: usize, hop: usize, ms: &[usize], method: Method) -> Vec<f64> {

@@ -2,7 +2,9 @@
 //! hop-aligned blocks (see the parent module).
 
 use super::{check_columns, check_ms, sorted_unique};
-use crate::allan::{check_window_hop, compensated_mean, sliding_sums, sum4, TermScratch, DIRECT_M};
+use crate::allan::{
+    check_window_hop, compensated_means, sliding_sums, sum4, TermScratch, DIRECT_M,
+};
 use crate::cancel::Cancel;
 use crate::error::Result;
 use rayon::prelude::*;
@@ -182,7 +184,7 @@ pub fn dynamic_theo1_cancellable(
     check_ms(window, ms, "window")?;
     let n_win = crate::allan::n_windows(n, window, hop);
     let (u, pos) = sorted_unique(ms);
-    let mus: Vec<f64> = columns.par_iter().map(|c| compensated_mean(c)).collect();
+    let mus = compensated_means(columns);
     // A fixed number of groups (not the thread count), so grouping never depends on the machine.
     let groups = work_groups(&u, 8);
     let mut sorted = vec![0.0f64; columns.len() * u.len() * n_win];

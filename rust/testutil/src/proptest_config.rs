@@ -1,5 +1,7 @@
 //! The property tests' configuration: fixed inputs by default, exploration on request.
 //!
+//! Every property test of the workspace takes its config here: `#![proptest_config(proptest_config::config(n))]`.
+//!
 //! A default `cargo test` draws the same cases on every run (seed [`FIXED_SEED`], or `PROPTEST_RNG_SEED`
 //! when set), replays the failures kept in the committed `*.proptest-regressions` files and never writes
 //! to them — a red run is a change, never a draw. `ALLANITE_EXPLORE=1 cargo test` draws at random and
@@ -60,5 +62,30 @@ impl FailurePersistence for ReadOnly {
 
     fn as_any(&self) -> &dyn Any {
         self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A default run replays the committed failures but records none ([`config`]); exploring records.
+    #[test]
+    fn a_default_run_records_no_failure() {
+        let dir = std::env::temp_dir().join(format!("allanite-proptest-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let src = dir.join("probe.rs").to_string_lossy().into_owned();
+        let mut cfg = config(8);
+        cfg.source_file = Some(Box::leak(src.into_boxed_str()));
+        let mut runner = proptest::test_runner::TestRunner::new(cfg);
+        let failed = runner.run(&(0u32..100), |v| {
+            prop_assert!(v > 1000);
+            Ok(())
+        });
+        assert!(failed.is_err(), "the probe property must fail");
+        let written = dir.join("probe.proptest-regressions").exists();
+        std::fs::remove_dir_all(&dir).ok();
+        assert_eq!(written, exploring());
     }
 }
