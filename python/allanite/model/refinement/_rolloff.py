@@ -25,31 +25,61 @@ import math
 import numpy as np
 
 from .. import tracing
-from ..effects import filter_autocorrelation
+from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation
 from .curvefit import PROFILE_RHO, Curve, Solution, base_name, search, solve
 
-__all__ = ["better_kind", "needs_spectrum", "spectrum_agrees", "research_rolloff", "SPECTRUM_FACTOR"]
-
-#: The kinds named only where the samples' spectrum shows their roll-off.
-_SPECTRUM_KINDS = ("butterworth2",)
+__all__ = [
+    "better_kind",
+    "needs_spectrum",
+    "spectrum_agrees",
+    "research_rolloff",
+    "higher_butterworths",
+    "SPECTRUM_FACTOR",
+    "SPECTRUM_FLOOR",
+]
 #: How far (a factor either way) the filter's predicted high-band/low-band power ratio may lie from the one
 #: measured in the Welch PSD (:func:`allanite.model.tracing.rolloff_psd`) for a kind of ``needs_spectrum``.
 SPECTRUM_FACTOR = 2.0
+#: The white floor a roll-off may sit on in that band, as a fraction of the passband's power: white noise added
+#: after the filter — the quantisation of a digital part's output (a step Δ adds (Δ/σ)²/12 of the white noise's
+#: σ² per sample: up to a step of √2·σ), or a readout's noise after its anti-alias stage. Far below the half a
+#: boxcar of 1.2 samples leaves there (ADIS16405), which a Butterworth must not stand in for.
+SPECTRUM_FLOOR = 1.0 / 6.0
 
 
 def needs_spectrum(kind: str) -> bool:
     """Whether a bandwidth kind is named only where the samples' spectrum shows its roll-off."""
-    return kind in _SPECTRUM_KINDS
+    return butterworth_order(kind) > 0  # every Butterworth order
 
 
 def spectrum_agrees(y: np.ndarray | None, fs: float, kind: str, p: float) -> bool:
     """Whether the roll-off filter ``kind`` at ``p`` predicts the Welch PSD's power at 0.40–0.48·f_s over its
-    power at 0.02–0.10·f_s within a factor :data:`SPECTRUM_FACTOR` of the samples' (``y``; False without)."""
+    power at 0.02–0.10·f_s within a factor :data:`SPECTRUM_FACTOR` of the samples' (``y``; False without), or
+    below it where the samples' is a white floor after the filter (at most :data:`SPECTRUM_FLOOR`: a steep
+    filter's stop band is the quantisation's, 1/12 of the passband for a step of one σ)."""
     if y is None:
         return False
     psd = tracing.rolloff_psd(y, fs, filter_autocorrelation(kind, p, fs))
     meas, pred = psd["measured"], psd["predicted"]
-    return meas > 0 and pred > 0 and abs(math.log(pred / meas)) <= math.log(SPECTRUM_FACTOR)
+    if not (meas > 0 and pred > 0):
+        return False
+    return abs(math.log(pred / meas)) <= math.log(SPECTRUM_FACTOR) or pred < meas <= SPECTRUM_FLOOR
+
+
+def higher_butterworths(curve: Curve, start: tuple, effects: list, grid: np.ndarray, second, tie: float) -> list:
+    """The Butterworths of order 3 and up as (key, p, sol, edge), searched on the 2nd order's ``grid`` one order
+    after another while each lowers χ² by more than ``tie`` below the order before (``second``: the 2nd order's
+    (key, p, sol, edge)). A steeper roll-off is tried only where the 2nd order was, and only as far as the curve
+    asks for it: a record whose 2nd order no 3rd beats costs one search more."""
+    prev, out = second, []
+    for order in BUTTERWORTH_ORDERS[1:]:
+        key = f"bandwidth:butterworth{order}"
+        p, sol, edge = search(curve, start, effects, key, grid)
+        out.append((key, p, sol, edge))
+        if not sol.chi2 < prev[2].chi2 - tie:
+            break
+        prev = out[-1]
+    return out
 
 
 def better_kind(new, best, tie) -> bool:
