@@ -20,7 +20,13 @@ from allanite.model.effects import (
     filter_cutoff,
     filtered_white_avar,
 )
-from allanite.model.refinement._rolloff import SPECTRUM_FACTOR, needs_spectrum, spectrum_agrees
+from allanite.model.refinement._rolloff import (
+    SPECTRUM_FACTOR,
+    SPECTRUM_FLOOR,
+    STEEPER,
+    needs_spectrum,
+    spectrum_agrees,
+)
 
 #: (f_s, f_c): the blind suites' (400 Hz, 2 kHz), another rate, near Nyquist, a slow filter (a long impulse
 #: response; the grid's lowest cutoff is f_s/63), and f_s/4 exactly and just off it (an odd order's real pole at
@@ -137,6 +143,38 @@ def test_a_butterworth_is_named_only_where_the_spectrum_shows_it():
     assert not spectrum_agrees(box, fs, "butterworth2", 23.0)  # its 40–48 Hz band holds half the 2–10 Hz power
     assert spectrum_agrees(box, fs, "boxcar", 1.2)
     assert not spectrum_agrees(None, fs, "butterworth2", 23.0)  # a curve alone shows no spectrum
+
+
+def test_a_steep_butterworth_on_a_quantisation_floor():
+    # a 4th-order filter at f_s/5, its output quantised with a step of one white-noise σ: the 40–48 % band holds
+    # the quantisation's flat (1/12)/(passband) ≈ 0.08 where the filter alone predicts 1e-6 — a white floor after
+    # the filter, which a steep Butterworth may sit on; a boxcar of 1.2 samples leaves half there, which it may not
+    fs = 100.0
+    w = np.random.default_rng(5).normal(size=400_000)
+    y = np.round(signal.sosfilt(signal.butter(4, 20.0, fs=fs, output="sos"), w))
+    assert SPECTRUM_FLOOR == pytest.approx(1 / 6) and STEEPER == tuple(f"butterworth{n}" for n in (3, 4, 5, 6))
+    assert all(needs_spectrum(f"butterworth{n}") for n in BUTTERWORTH_ORDERS)
+    assert spectrum_agrees(y, fs, "butterworth4", 20.0)
+    box = w[1:] + (3.0 - np.sqrt(8.0)) * w[:-1]
+    assert not spectrum_agrees(box, fs, "butterworth4", 20.0)
+    assert not spectrum_agrees(np.round(4.0 * box), fs, "butterworth4", 20.0)  # a finer step: the same half
+
+
+def test_refine_names_a_4th_order_butterworth_at_500hz():
+    # 500 Hz, a 4th-order Butterworth at 90 Hz on white noise and a rate random walk, a 6.5 Hz line beside: the
+    # 4th order named (not the 2nd, a cascade or a stand-in resonance for its knee), its cutoff within 5 %
+    fs, n = 500.0, 600_000
+    rng = np.random.default_rng(11)
+    y = allanite.simulate(n, fs, N=1e-3, K=1e-6, seed=rng) + 0.02 * np.sin(2 * np.pi * 6.5 * np.arange(n) / fs)
+    y = signal.sosfilt(signal.butter(4, 90.0, fs=fs, output="sos"), y)
+    r = allanite.refine(y, fs, unit="deg/s", progress=False)
+    assert "resonance" not in r.found, r.found
+    bw = next(st for st in r.steps if st.effect == "bandwidth")
+    assert bw.final_params["filter"] == "butterworth4"
+    assert bw.final_params["cutoff"] == pytest.approx(90.0, rel=0.05)
+    lo, hi = bw.final_intervals["cutoff"]
+    assert lo <= bw.final_params["cutoff"] <= hi <= fs / 2
+    assert r.unexplained == []
 
 
 def test_refine_names_a_butterworth_at_1khz():

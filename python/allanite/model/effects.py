@@ -373,8 +373,8 @@ EFFECTS: dict[str, Effect] = {
                 ),
             ),
             "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
-            "decimating MEMS part, a boxcar of any span read at the output rate, or the 2nd-order Butterworth "
-            "anti-alias stage of a tactical gyro, ``butterworth2``): "
+            "decimating MEMS part, a boxcar of any span read at the output rate, or the Butterworth anti-alias "
+            "stage of a MEMS or tactical gyro, orders 2 to 6, ``butterworth2`` … ``butterworth6``): "
             "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, replacing N²/τ — a "
             "roll-off of the shortest τ; the N it reports is the white noise before the filter. Accepted first, "
             "its parameter is searched again beside the terms later steps add",

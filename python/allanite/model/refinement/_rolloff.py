@@ -1,11 +1,15 @@
 """The sensor's roll-off: which filter kind is named, and its parameter re-searched beside the terms that came
 after it.
 
-Kinds compete on χ² (:func:`better_kind`). A 2nd-order Butterworth bends the shortest τ broadly enough to stand
+Kinds compete on χ² (:func:`better_kind`); the Butterworths above the 2nd order only where the 2nd order was
+searched, one order after another while each beats the one before (:func:`higher_butterworths`). A 2nd-order
+Butterworth bends the shortest τ broadly enough to stand
 in for a hump beside a milder filter (ADIS16405 run 1 acc_x beside its 10 Hz hump: a Butterworth at 23 Hz where
 the spectrum's 40–48 Hz band holds half the power of its 2–10 Hz band, as a boxcar of 1.2 samples predicts and
 the Butterworth predicts a twentieth; run 1 gyro_z's 20 Hz resonance: a Butterworth at 36 Hz); so it is named
-only where the samples' spectrum shows its roll-off (:func:`spectrum_agrees`), and never on a curve alone.
+only where the samples' spectrum shows its roll-off (:func:`spectrum_agrees`), and never on a curve alone —
+every order so (a steeper one stands in for a hump no less); the spectrum may show a white floor after the
+filter there, up to :data:`SPECTRUM_FLOOR` (a steep filter's output quantised).
 
 The roll-off is accepted first (:func:`.candidates.choose`: the white noise every other column is judged
 against), so its parameter is searched without the terms later steps add; a Gauss–Markov term's short-τ slope
@@ -36,7 +40,11 @@ __all__ = [
     "higher_butterworths",
     "SPECTRUM_FACTOR",
     "SPECTRUM_FLOOR",
+    "STEEPER",
 ]
+
+#: The Butterworths above the 2nd order: searched only where the 2nd order was (:func:`higher_butterworths`).
+STEEPER = tuple(f"butterworth{n}" for n in BUTTERWORTH_ORDERS[1:])
 #: How far (a factor either way) the filter's predicted high-band/low-band power ratio may lie from the one
 #: measured in the Welch PSD (:func:`allanite.model.tracing.rolloff_psd`) for a kind of ``needs_spectrum``.
 SPECTRUM_FACTOR = 2.0
@@ -72,8 +80,8 @@ def higher_butterworths(curve: Curve, start: tuple, effects: list, grid: np.ndar
     (key, p, sol, edge)). A steeper roll-off is tried only where the 2nd order was, and only as far as the curve
     asks for it: a record whose 2nd order no 3rd beats costs one search more."""
     prev, out = second, []
-    for order in BUTTERWORTH_ORDERS[1:]:
-        key = f"bandwidth:butterworth{order}"
+    for kind in STEEPER:
+        key = f"bandwidth:{kind}"
         p, sol, edge = search(curve, start, effects, key, grid)
         out.append((key, p, sol, edge))
         if not sol.chi2 < prev[2].chi2 - tie:

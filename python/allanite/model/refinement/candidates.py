@@ -4,7 +4,7 @@ parameters and intervals a step reports, and what a second domain says about it.
 
 - ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4];
 - ``"bandwidth"`` — the sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett
-  FIR, a boxcar of any span, a single pole after a short boxcar, a 2nd-order Butterworth), replacing the N
+  FIR, a boxcar of any span, a single pole after a short boxcar, a Butterworth of order 2–6), replacing the N
   column; the kind with the lowest χ² (ties: the one needing fewer other terms; a Butterworth only where
   the samples' spectrum shows its roll-off);
 - ``"resonance"`` — narrowband noise near the shortest τ, at quality factors :data:`RESONANCE_Q`;
@@ -27,16 +27,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import tracing
-from ..effects import (
-    BUTTERWORTH_ORDERS,
-    CASCADE_SPANS,
-    EFFECTS,
-    RESONANCE_Q,
-    butterworth_order,
-    filter_autocorrelation,
-    filter_cutoff,
-)
-from ._rolloff import better_kind, higher_butterworths, needs_spectrum, spectrum_agrees
+from ..effects import CASCADE_SPANS, EFFECTS, RESONANCE_Q, filter_autocorrelation, filter_cutoff
+from ._rolloff import STEEPER, better_kind, higher_butterworths, needs_spectrum, spectrum_agrees
 from .curvefit import (
     Curve,
     Solution,
@@ -215,7 +207,7 @@ def bandwidth_grids(curve: Curve) -> dict:
     grids = {}
     if f_lo < f_hi:
         grids["single_pole"] = np.geomspace(f_lo, f_hi, 24)
-        grids.update({f"butterworth{n}": grids["single_pole"] for n in BUTTERWORTH_ORDERS})
+        grids.update({kind: grids["single_pole"] for kind in ("butterworth2",) + STEEPER})
     l_min = max(2, int(math.ceil(curve.tau[0] * fs / 3)))
     l_max = int(max(2, min(64, 0.1 * curve.tau[-1] * fs)))
     if l_max > l_min:
@@ -244,7 +236,7 @@ def _bw_searches(rnd: Round) -> list:
     return [  # the Butterworths above the 2nd order only where it was searched (:func:`_bw_propose`)
         (f"bandwidth:{kind}", grid, kind not in ("moving_average", "bartlett"))
         for kind, grid in bandwidth_grids(rnd.curve).items()
-        if butterworth_order(kind) <= 2
+        if kind not in STEEPER
     ]
 
 
@@ -278,7 +270,7 @@ def _bw_params(pr: Proposal, rnd: Round) -> tuple:
     def profile():
         return profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, p, pr.sol)
 
-    if kind == "single_pole" or butterworth_order(kind):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
+    if kind == "single_pole" or needs_spectrum(kind):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
         c_int = profile() if kind == "single_pole" else tuple(min(c, fs / 2.0) for c in profile())
         return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": c_int}
     if kind.startswith("single_pole+boxcar:"):
