@@ -19,14 +19,18 @@ from allanite.model.effects import (
     filter_autocorrelation,
     filter_cutoff,
     filtered_white_avar,
+    gm_avar,
 )
 from allanite.model.refinement._rolloff import (
     SPECTRUM_FACTOR,
     SPECTRUM_FLOOR,
     STEEPER,
     needs_spectrum,
+    research_rolloff,
     spectrum_agrees,
 )
+from allanite.model.refinement.candidates import bandwidth_grids
+from allanite.model.refinement.curvefit import Curve, solve
 
 #: (f_s, f_c): the blind suites' (400 Hz, 2 kHz), another rate, near Nyquist, a slow filter (a long impulse
 #: response; the grid's lowest cutoff is f_s/63), and f_s/4 exactly and just off it (an odd order's real pole at
@@ -197,3 +201,25 @@ def test_refine_names_a_butterworth_at_1khz():
     assert gm.final_params["sigma"] == pytest.approx(3e-3, rel=0.2)
     assert gm.final_params["tc"] == pytest.approx(2.0, rel=0.2)
     assert r.unexplained == []
+
+
+def test_the_order_is_chosen_again_beside_the_later_terms():
+    # blind suite 1's tactical gyro: a 2nd-order filter at 100 Hz of 400 Hz beside a Gauss–Markov term, read as a
+    # 3rd order at acceptance (the Gauss–Markov term not yet in the model); beside it the 2nd order is chosen
+    # again, at its cutoff, on the exact curve — and the 3rd order is kept where it is the truth
+    fs, n, start = 400.0, 1_000_000, ("Q", "N", "B", "K", "R")
+    m = np.unique(np.round(np.geomspace(1, n / 8, 60)))
+    tau = m / fs
+    rng = np.random.default_rng(2)
+    for order, wrong in ((2, 3), (3, 2)):
+        kind = f"butterworth{order}"
+        avar = 1.7e-3**2 * filtered_white_avar(tau, kind, 100.0, fs) + 5e-3**2 * gm_avar(tau, 3.0)
+        curve = Curve(tau, m, avar, fs, n + 1, "oavar")
+        y = signal.sosfilt(signal.butter(order, 100.0, fs=fs, output="sos"), rng.normal(size=400_000))
+        effects = [(f"bandwidth:butterworth{wrong}", 98.0), ("gauss_markov", 3.0)]
+        got, sol = research_rolloff(curve, start, effects, solve(curve, start, effects), bandwidth_grids(curve), y)
+        assert got[0][0] == f"bandwidth:{kind}" and got[0][1] == pytest.approx(100.0, rel=1e-3), got
+        assert got[1] == ("gauss_markov", 3.0)
+        # without samples no other order is named (its roll-off unseen): the accepted one's cutoff re-searched
+        got, _sol = research_rolloff(curve, start, effects, solve(curve, start, effects), bandwidth_grids(curve))
+        assert got[0][0] == f"bandwidth:butterworth{wrong}"
