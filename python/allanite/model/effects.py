@@ -49,10 +49,11 @@ __all__ = [
 #: 2 to 6 ("butterworth2" … "butterworth6": the digital filter ``scipy.signal.butter(n, f_c, fs=f_s)``: bilinear,
 #: prewarped, −3 dB at f_c exactly — the 2nd- to 6th-order anti-alias low-passes of MEMS, tactical and
 #: navigation gyros; one parameter, f_c; the order is in the kind's name, as every other kind's shape is).
-BUTTERWORTH_ORDERS = (2, 3, 4, 5, 6)
 FILTERS = ("single_pole", "moving_average", "bartlett", "boxcar", "single_pole+boxcar") + tuple(
-    f"butterworth{n}" for n in BUTTERWORTH_ORDERS
+    f"butterworth{n}" for n in (2, 3, 4, 5, 6)
 )
+#: Orders of the Butterworth kinds of :data:`FILTERS` ("butterworth2" … "butterworth6").
+BUTTERWORTH_ORDERS = (2, 3, 4, 5, 6)
 #: Spans (samples) of the boxcar a single pole may follow ("single_pole+boxcar:<span>": a filter added after
 #: a part's own averaging, e.g. an anti-alias stage or a user's low-pass on the logged rate).
 CASCADE_SPANS = (1.2, 1.5, 2.0)
