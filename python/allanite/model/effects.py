@@ -27,13 +27,15 @@ __all__ = [
     "filtered_white_avar",
     "filter_autocorrelation",
     "filter_cutoff",
-    "two_pole_terms",
+    "butterworth_terms",
+    "butterworth_order",
     "drift_avar",
     "describe",
     "param_units",
     "format_param",
     "format_params",
     "FILTERS",
+    "BUTTERWORTH_ORDERS",
     "CASCADE_SPANS",
     "RESONANCE_Q",
     "resonance_avar",
@@ -43,10 +45,15 @@ __all__ = [
 #: a = e^{−2πf_c/f_s}), a moving average of L taps (the boxcar decimation filter of MEMS parts), a Bartlett
 #: (triangular, two cascaded moving averages: 2L − 1 taps), and a boxcar of any span D (a moving average a
 #: part computes at its internal rate and the host reads at the output rate, so D·f_s need not be whole:
-#: the samples' autocorrelation is the triangle (1 − l/(D·f_s))₊; −3 dB at 0.443/D), and a two-pole Butterworth
-#: (Q = 1/√2, the digital filter ``scipy.signal.butter(2, f_c, fs=f_s)``: bilinear, prewarped, −3 dB at f_c
-#: exactly — the 2nd-order anti-alias stage of tactical and navigation gyros; one parameter, f_c).
-FILTERS = ("single_pole", "moving_average", "bartlett", "boxcar", "single_pole+boxcar", "butterworth2")
+#: the samples' autocorrelation is the triangle (1 − l/(D·f_s))₊; −3 dB at 0.443/D), and Butterworths of order
+#: 2 to 6 ("butterworth2" … "butterworth6": the digital filter ``scipy.signal.butter(n, f_c, fs=f_s)``: bilinear,
+#: prewarped, −3 dB at f_c exactly — the 2nd- to 6th-order anti-alias low-passes of MEMS, tactical and
+#: navigation gyros; one parameter, f_c; the order is in the kind's name, as every other kind's shape is).
+FILTERS = ("single_pole", "moving_average", "bartlett", "boxcar", "single_pole+boxcar") + tuple(
+    f"butterworth{n}" for n in (2, 3, 4, 5, 6)
+)
+#: Orders of the Butterworth kinds of :data:`FILTERS` ("butterworth2" … "butterworth6").
+BUTTERWORTH_ORDERS = (2, 3, 4, 5, 6)
 #: Spans (samples) of the boxcar a single pole may follow ("single_pole+boxcar:<span>": a filter added after
 #: a part's own averaging, e.g. an anti-alias stage or a user's low-pass on the logged rate).
 CASCADE_SPANS = (1.2, 1.5, 2.0)
@@ -77,36 +84,51 @@ def sinusoid_avar(tau: np.ndarray | float, f0: float, fs: float | None = None) -
     return np.sin(np.pi * nu * m) ** 4 / (m * np.sin(np.pi * nu)) ** 2
 
 
-def two_pole_terms(fc: float, fs: float) -> tuple[float, np.ndarray, np.ndarray]:
-    """The autocorrelation of unit-DC-gain 2nd-order Butterworth filtered unit white noise in closed form:
-    (r(0), C, p) with r(l) = Σ_j C_j·p_j^l for l ≥ 1 (``p`` the two poles, ``C`` complex conjugates when the
-    poles are).
+def butterworth_order(kind: str) -> int:
+    """The order of a Butterworth kind of :data:`FILTERS` ("butterworth4" → 4); 0 for any other kind."""
+    tail = kind[len("butterworth") :] if kind.startswith("butterworth") else ""
+    return int(tail) if tail.isdigit() and int(tail) in BUTTERWORTH_ORDERS else 0
 
-    The filter is ``scipy.signal.butter(2, fc, fs=fs)``; in partial fractions H(z) = K + Σ_i R_i/(1 − p_i z⁻¹),
-    so h(0) = K + Σ R_i, h(n) = Σ R_i p_i^n (n ≥ 1), and Σ_n h(n)h(n + l) sums geometric series:
-    r(0) = K² + 2K·Σ R_i + Σ_ij R_i R_j/(1 − p_i p_j), C_j = R_j·(K + Σ_i R_i/(1 − p_i p_j)). Divided by
+
+def butterworth_terms(order: int, fc: float, fs: float) -> tuple[float, np.ndarray, np.ndarray, float]:
+    """The autocorrelation of unit-DC-gain Butterworth filtered unit white noise in closed form:
+    (r(0), C, p, d) with r(l) = Σ_j C_j·p_j^l + d·[l = 1] for l ≥ 1 (``p`` the filter's nonzero poles, distinct;
+    ``C`` complex conjugates where the poles are; ``d`` the lag-1 term of a pole at z = 0, which an odd order
+    has at f_c = f_s/4, else 0).
+
+    The filter is ``scipy.signal.butter(order, fc, fs=fs)``, H(z) = k·Π(z − z_i)/Π(z − p_i). For l ≥ 1,
+    r(l) = Σ_n h(n)h(n + l) is the sum of the residues of H(z)·H(1/z)·z^{l−1} inside the unit circle, at the
+    poles: r(l) = Σ_j D_j·p_j^{l−1}, D_j = A_j·H(1/p_j), A_j = k·Π_i(p_j − z_i)/Π_{i≠j}(p_j − p_i); so
+    C_j = D_j/p_j, and a pole at 0 (|p| < 1e-8) gives d = D_j. r(0) = H(1)² − 2Σ_{l≥1} r(l). All divided by
     H(1)² (= 1 up to rounding) so that Σ_l r(|l|) = 1."""
+    if order not in BUTTERWORTH_ORDERS:
+        raise ParameterError(f"Butterworth order {order!r}: must be one of {BUTTERWORTH_ORDERS}")
     if not 0.0 < fc < fs / 2.0:
-        raise ParameterError(f"two-pole cutoff {fc!r} Hz: must lie in (0, fs/2 = {fs / 2.0!r})")
-    return _two_pole_terms(float(fc), float(fs))
+        raise ParameterError(f"Butterworth cutoff {fc!r} Hz: must lie in (0, fs/2 = {fs / 2.0!r})")
+    return _butterworth_terms(int(order), float(fc), float(fs))
 
 
-@functools.lru_cache(maxsize=256)
-def _two_pole_terms(fc: float, fs: float) -> tuple[float, np.ndarray, np.ndarray]:
-    """:func:`two_pole_terms`, remembered (a bandwidth search asks for the same cutoffs on every curve it fits:
+@functools.lru_cache(maxsize=1024)
+def _butterworth_terms(order: int, fc: float, fs: float) -> tuple[float, np.ndarray, np.ndarray, float]:
+    """:func:`butterworth_terms`, remembered (a bandwidth search asks for the same cutoffs on every curve it fits:
     the record's, the held-out parts', a removal's; SciPy's filter design costs ~2 ms a call). Read-only arrays."""
     from scipy import signal  # here, not at import: `import allanite` stays free of scipy.signal
 
-    b, a = signal.butter(2, fc, fs=fs)
-    res, poles, k = signal.residuez(b, a)
-    kk = complex(k[0]) if len(k) else 0.0j
-    cross = 1.0 / (1.0 - np.outer(poles, poles))  # 1/(1 − p_i p_j)
-    r0 = kk * kk + 2.0 * kk * res.sum() + res @ cross @ res
-    c = res * (kk + res @ cross)
-    dc2 = (b.sum() / a.sum()) ** 2
-    c = c / dc2
+    zeros, poles, k = signal.butter(order, fc, fs=fs, output="zpk")
+    b, a = signal.zpk2tf(zeros, poles, k)
+    dc2 = float((b.sum() / a.sum()) ** 2)
+    # H at z = 1/p_j: b and a as polynomials in z⁻¹, evaluated at z⁻¹ = p_j
+    h_inv = np.polyval(b[::-1], poles) / np.polyval(a[::-1], poles)
+    others = poles[:, None] - poles[None, :]  # [j, i]: p_j − p_i
+    np.fill_diagonal(others, 1.0)
+    d = k * np.prod(poles[:, None] - zeros[None, :], axis=1) / np.prod(others, axis=1) * h_inv / dc2
+    at_zero = np.abs(poles) < 1e-8
+    lag1 = float(d[at_zero].sum().real)
+    poles, d = poles[~at_zero], d[~at_zero]
+    c = d / poles
+    r0 = 1.0 - 2.0 * (lag1 + float((d / (1.0 - poles)).sum().real))
     c.flags.writeable = poles.flags.writeable = False
-    return float(r0.real / dc2), c, poles
+    return r0, c, poles, lag1
 
 
 def _geometric_avar(rho: np.ndarray, m: np.ndarray) -> np.ndarray:
@@ -124,22 +146,24 @@ def _geometric_avar(rho: np.ndarray, m: np.ndarray) -> np.ndarray:
 def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
     """Normalised autocorrelation r(l), l = 0, 1, …, of unit-DC-gain filtered white noise: Σ_l r(|l|) = 1.
 
-    ``kind`` one of :data:`FILTERS`; ``p`` the cutoff (Hz) for ``"single_pole"`` and ``"butterworth2"``, the
+    ``kind`` one of :data:`FILTERS`; ``p`` the cutoff (Hz) for ``"single_pole"`` and the Butterworths, the
     length L (taps of one moving average) for the FIRs, the span D·f_s (samples, ≥ 1, any real) for
     ``"boxcar"``."""
     if kind == "single_pole":
         a = math.exp(-2.0 * math.pi * p / fs)
         n = int(min(200_000, math.ceil(40.0 / max(1.0 - a, 1e-9)))) + 1
         return (1.0 - a) / (1.0 + a) * a ** np.arange(n, dtype=np.float64)
-    if kind == "butterworth2" and p >= fs / 2.0:  # its limit there: H → 1, no filter
+    order = butterworth_order(kind)
+    if order and p >= fs / 2.0:  # its limit there: H → 1, no filter
         return np.ones(1)
-    if kind == "butterworth2":  # to where the poles' terms fall below 1e-17 of r(0)
-        r0, c, poles = two_pole_terms(p, fs)
+    if order:  # to where the poles' terms fall below 1e-17 of r(0)
+        r0, c, poles, lag1 = butterworth_terms(order, p, fs)
         decay = max(float(np.max(np.abs(poles))), 1e-300)
-        n = int(min(200_000, math.ceil(math.log(1e-17) / math.log(decay)) if decay < 1.0 else 200_000)) + 1
+        n = int(min(200_000, math.ceil(math.log(1e-17) / math.log(decay)) if decay < 1.0 else 200_000)) + 2
         lags = np.arange(1, n, dtype=np.float64)
-        tail = (c[None, :] * np.exp(lags[:, None] * np.log(poles.astype(np.complex128))[None, :])).sum(axis=1)
-        return np.concatenate([[r0], tail.real])
+        tail = (c[None, :] * np.exp(lags[:, None] * np.log(poles.astype(np.complex128))[None, :])).sum(axis=1).real
+        tail[0] += lag1
+        return np.concatenate([[r0], tail])
     if kind == "boxcar":
         span = max(1.0, float(p))
         tri = 1.0 - np.arange(int(math.ceil(span)), dtype=np.float64) / span
@@ -161,7 +185,7 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
 def filter_cutoff(kind: str, p: float, fs: float) -> float:
     """−3 dB frequency (Hz) of a filter of :data:`FILTERS` (``p`` as in :func:`filter_autocorrelation`); for a
     boxcar the continuous filter's, 0.4430/D (sinc² = ½), before the output sampling aliases it."""
-    if kind in ("single_pole", "butterworth2"):  # the Butterworth's prewarped cutoff: −3 dB at f_c exactly
+    if kind == "single_pole" or butterworth_order(kind):  # a Butterworth's prewarped cutoff: −3 dB at f_c exactly
         return float(p)
     if kind == "boxcar":
         return float(0.44295 * fs / max(1.0, float(p)))
@@ -187,18 +211,19 @@ def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float)
     σ²(m) = (1/2m²)·Σ_l A_m(l)·R(l) with A_m(l) = 2·tri_m(l) − tri_m(l − m) − tri_m(l + m) (tri_m(l) =
     max(0, m − |l|): the autocorrelation of the Allan kernel of m ones then m minus ones) and R the
     autocorrelation of the filtered samples; N² = σ²_w·τ0 of the white input. Unity DC gain, so the curve
-    tends to N²/τ for τ well above 1/f_c (the filter only reshapes the shortest τ). For ``"butterworth2"``
-    R(l) = Σ_j C_j·p_j^|l| beyond lag 0 (:func:`two_pole_terms`), so the sum is closed: (r(0) − Σ C_j)/m plus
+    tends to N²/τ for τ well above 1/f_c (the filter only reshapes the shortest τ). For a Butterworth
+    R(l) = Σ_j C_j·p_j^|l| beyond lag 0 (:func:`butterworth_terms`), so the sum is closed: (r(0) − Σ C_j)/m plus
     Σ_j C_j times the geometric sums of :func:`resonance_avar` at ρ = p_j; at f_c ≥ f_s/2 its limit (the poles
-    meet the double zero at z = −1: no filter), N²/τ."""
+    meet the n-fold zero at z = −1: no filter), N²/τ."""
     tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
     m = np.maximum(1.0, np.round(tau * fs))
-    if kind == "butterworth2" and p >= fs / 2.0:  # its limit there: H → 1, white noise
+    order = butterworth_order(kind)
+    if order and p >= fs / 2.0:  # its limit there: H → 1, white noise
         return fs / m
-    if kind == "butterworth2":  # geometric autocorrelation: closed sums, white part r(0) − Σ C_j at lag 0
-        r0, c, poles = two_pole_terms(p, fs)
+    if order:  # geometric autocorrelation: closed sums, white part r(0) − Σ C_j at lag 0
+        r0, c, poles, lag1 = butterworth_terms(order, p, fs)
         s2 = (r0 - c.sum().real) / m + (c[:, None] * _geometric_avar(poles, m)).sum(axis=0).real
-        return s2 * fs
+        return (s2 + (2.0 * m - 3.0) * lag1 / (m * m)) * fs  # a lag-1 term d: A_m(±1) = 2m − 3
     r = filter_autocorrelation(kind, p, fs)
     lag = np.arange(r.size, dtype=np.float64)
 
@@ -349,8 +374,8 @@ EFFECTS: dict[str, Effect] = {
                 ),
             ),
             "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
-            "decimating MEMS part, a boxcar of any span read at the output rate, or the 2nd-order Butterworth "
-            "anti-alias stage of a tactical gyro, ``butterworth2``): "
+            "decimating MEMS part, a boxcar of any span read at the output rate, or the Butterworth anti-alias "
+            "stage of a MEMS or tactical gyro, orders 2 to 6, ``butterworth2`` … ``butterworth6``): "
             "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, replacing N²/τ — a "
             "roll-off of the shortest τ; the N it reports is the white noise before the filter. Accepted first, "
             "its parameter is searched again beside the terms later steps add",

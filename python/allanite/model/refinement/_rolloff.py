@@ -1,11 +1,15 @@
 """The sensor's roll-off: which filter kind is named, and its parameter re-searched beside the terms that came
 after it.
 
-Kinds compete on χ² (:func:`better_kind`). A 2nd-order Butterworth bends the shortest τ broadly enough to stand
-in for a hump beside a milder filter (ADIS16405 run 1 acc_x beside its 10 Hz hump: a Butterworth at 23 Hz where
+Kinds compete on χ² (:func:`better_kind`); the Butterworths above the 2nd order only where the 2nd order was
+searched, one order after another while each beats the one before (:func:`higher_butterworths`). A 2nd-order
+Butterworth bends the shortest τ broadly enough to stand in for a hump beside a milder filter (ADIS16405 run 1
+acc_x beside its 10 Hz hump: a Butterworth at 23 Hz where
 the spectrum's 40–48 Hz band holds half the power of its 2–10 Hz band, as a boxcar of 1.2 samples predicts and
 the Butterworth predicts a twentieth; run 1 gyro_z's 20 Hz resonance: a Butterworth at 36 Hz); so it is named
-only where the samples' spectrum shows its roll-off (:func:`spectrum_agrees`), and never on a curve alone.
+only where the samples' spectrum shows its roll-off (:func:`spectrum_agrees`), and never on a curve alone —
+every order so (a steeper one stands in for a hump no less); the spectrum may show a white floor after the
+filter there, up to :data:`SPECTRUM_FLOOR` (a steep filter's output quantised).
 
 The roll-off is accepted first (:func:`.candidates.choose`: the white noise every other column is judged
 against), so its parameter is searched without the terms later steps add; a Gauss–Markov term's short-τ slope
@@ -25,31 +29,65 @@ import math
 import numpy as np
 
 from .. import tracing
-from ..effects import filter_autocorrelation
+from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation
 from .curvefit import PROFILE_RHO, Curve, Solution, base_name, search, solve
 
-__all__ = ["better_kind", "needs_spectrum", "spectrum_agrees", "research_rolloff", "SPECTRUM_FACTOR"]
+__all__ = [
+    "better_kind",
+    "needs_spectrum",
+    "spectrum_agrees",
+    "research_rolloff",
+    "higher_butterworths",
+    "SPECTRUM_FACTOR",
+    "SPECTRUM_FLOOR",
+    "STEEPER",
+]
 
-#: The kinds named only where the samples' spectrum shows their roll-off.
-_SPECTRUM_KINDS = ("butterworth2",)
+#: The Butterworths above the 2nd order: searched only where the 2nd order was (:func:`higher_butterworths`).
+STEEPER = tuple(f"butterworth{n}" for n in BUTTERWORTH_ORDERS[1:])
 #: How far (a factor either way) the filter's predicted high-band/low-band power ratio may lie from the one
 #: measured in the Welch PSD (:func:`allanite.model.tracing.rolloff_psd`) for a kind of ``needs_spectrum``.
 SPECTRUM_FACTOR = 2.0
+#: The white floor a roll-off may sit on in that band, as a fraction of the passband's power: white noise added
+#: after the filter — the quantisation of a digital part's output (a step Δ adds (Δ/σ)²/12 of the white noise's
+#: σ² per sample: up to a step of √2·σ), or a readout's noise after its anti-alias stage. Far below the half a
+#: boxcar of 1.2 samples leaves there (ADIS16405), which a Butterworth must not stand in for.
+SPECTRUM_FLOOR = 1.0 / 6.0
 
 
 def needs_spectrum(kind: str) -> bool:
     """Whether a bandwidth kind is named only where the samples' spectrum shows its roll-off."""
-    return kind in _SPECTRUM_KINDS
+    return butterworth_order(kind) > 0  # every Butterworth order
 
 
 def spectrum_agrees(y: np.ndarray | None, fs: float, kind: str, p: float) -> bool:
     """Whether the roll-off filter ``kind`` at ``p`` predicts the Welch PSD's power at 0.40–0.48·f_s over its
-    power at 0.02–0.10·f_s within a factor :data:`SPECTRUM_FACTOR` of the samples' (``y``; False without)."""
+    power at 0.02–0.10·f_s within a factor :data:`SPECTRUM_FACTOR` of the samples' (``y``; False without), or
+    below it where the samples' is a white floor after the filter (at most :data:`SPECTRUM_FLOOR`: a steep
+    filter's stop band is the quantisation's, 1/12 of the passband for a step of one σ)."""
     if y is None:
         return False
     psd = tracing.rolloff_psd(y, fs, filter_autocorrelation(kind, p, fs))
     meas, pred = psd["measured"], psd["predicted"]
-    return meas > 0 and pred > 0 and abs(math.log(pred / meas)) <= math.log(SPECTRUM_FACTOR)
+    if not (meas > 0 and pred > 0):
+        return False
+    return abs(math.log(pred / meas)) <= math.log(SPECTRUM_FACTOR) or pred < meas <= SPECTRUM_FLOOR
+
+
+def higher_butterworths(curve: Curve, start: tuple, effects: list, grid: np.ndarray, second, tie: float) -> list:
+    """The Butterworths of order 3 and up as (key, p, sol, edge), searched on the 2nd order's ``grid`` one order
+    after another while each lowers χ² by more than ``tie`` below the order before (``second``: the 2nd order's
+    (key, p, sol, edge)). A steeper roll-off is tried only where the 2nd order was, and only as far as the curve
+    asks for it: a record whose 2nd order no 3rd beats costs one search more."""
+    prev, out = second, []
+    for kind in STEEPER:
+        key = f"bandwidth:{kind}"
+        p, sol, edge = search(curve, start, effects, key, grid)
+        out.append((key, p, sol, edge))
+        if not sol.chi2 < prev[2].chi2 - tie:
+            break
+        prev = out[-1]
+    return out
 
 
 def better_kind(new, best, tie) -> bool:
@@ -72,11 +110,14 @@ def better_kind(new, best, tie) -> bool:
     )
 
 
-def research_rolloff(curve: Curve, start: tuple, effects: list, sol: Solution, grids: dict) -> tuple[list, Solution]:
+def research_rolloff(
+    curve: Curve, start: tuple, effects: list, sol: Solution, grids: dict, y: np.ndarray | None = None
+) -> tuple[list, Solution]:
     """(effects, solution) with the bandwidth's parameter re-searched beside the others on its kind's grid
-    (``grids``: :func:`.candidates.bandwidth_grids`); the same when there is none, when its best value sits at
-    the edge of its grid, when the value at acceptance lies inside the new value's profile interval, or beside a
-    resonance."""
+    (``grids``: :func:`.candidates.bandwidth_grids`) — a Butterworth's order chosen again too, among the orders
+    whose roll-off the samples ``y`` show (:func:`_butterworth_beside`); the same when there is none, when its
+    best value sits at the edge of its grid, when the value at acceptance lies inside the new value's profile
+    interval, or beside a resonance."""
     j = next((i for i, (k, _p) in enumerate(effects) if base_name(k) == "bandwidth"), None)
     if j is None or len(effects) < 2 or any(base_name(k) == "resonance" for k, _p in effects):
         return effects, sol  # beside a resonance near the bandwidth the cutoff trades with it: left as accepted
@@ -86,12 +127,39 @@ def research_rolloff(curve: Curve, start: tuple, effects: list, sol: Solution, g
     if grid is None:
         return effects, sol
     others = effects[:j] + effects[j + 1 :]
-    p, _s, edge = search(curve, start, others, key, grid, continuous=kind not in ("moving_average", "bartlett"))
-    if edge:
-        return effects, sol
+    if needs_spectrum(kind):
+        found = _butterworth_beside(curve, start, others, grids, y, kind)
+        if found is None:
+            return effects, sol
+        key, p = found
+    else:
+        p, _s, edge = search(curve, start, others, key, grid, continuous=kind not in ("moving_average", "bartlett"))
+        if edge:
+            return effects, sol
     new = effects[:j] + [(key, p)] + effects[j + 1 :]
     s_new = solve(curve, start, new)  # in the model's own column order
     # moved only where the value at acceptance lies outside the new one's profile interval (effective χ², as
     # :func:`.curvefit.profile_interval` counts it, more than 1 above): a flat profile keeps the accepted value
     scale = curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / curve.tau.size
     return (new, s_new) if (sol.chi2 - s_new.chi2) * scale > 1.0 else (effects, sol)
+
+
+def _butterworth_beside(curve: Curve, start: tuple, others: list, grids: dict, y, kind: str) -> tuple | None:
+    """(key, f_c) of the Butterworth order that fits best beside ``others`` — the accepted ``kind`` and every other
+    order whose roll-off the spectrum of ``y`` shows, a higher order only where it lowers χ² by more than one
+    effective point — or None where the best one's cutoff sits at the edge of its grid. At acceptance the order
+    is chosen without the terms later steps add: a Gauss–Markov term's short-τ slope beside a 2nd-order filter at
+    100 Hz of 400 Hz read as a 3rd order, its final χ²/dof 20.4 where the 2nd order's is 2.34 (blind suite 1)."""
+    tie = curve.tau.size / curve.n_eff
+    best = None
+    for k in ("butterworth2",) + STEEPER:
+        if k not in grids:
+            continue
+        p, s_k, edge = search(curve, start, others, f"bandwidth:{k}", grids[k])
+        if k != kind and (edge or not spectrum_agrees(y, curve.fs, k, p)):
+            continue
+        if best is None or s_k.chi2 < best[2].chi2 - tie:
+            best = (f"bandwidth:{k}", p, s_k, edge)
+    if best is None or best[3]:
+        return None
+    return best[0], best[1]

@@ -4,7 +4,7 @@ parameters and intervals a step reports, and what a second domain says about it.
 
 - ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4];
 - ``"bandwidth"`` — the sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett
-  FIR, a boxcar of any span, a single pole after a short boxcar, a 2nd-order Butterworth), replacing the N
+  FIR, a boxcar of any span, a single pole after a short boxcar, a Butterworth of order 2–6), replacing the N
   column; the kind with the lowest χ² (ties: the one needing fewer other terms; a Butterworth only where
   the samples' spectrum shows its roll-off);
 - ``"resonance"`` — narrowband noise near the shortest τ, at quality factors :data:`RESONANCE_Q`;
@@ -28,7 +28,7 @@ import numpy as np
 
 from .. import tracing
 from ..effects import CASCADE_SPANS, EFFECTS, RESONANCE_Q, filter_autocorrelation, filter_cutoff
-from ._rolloff import better_kind, needs_spectrum, spectrum_agrees
+from ._rolloff import STEEPER, better_kind, higher_butterworths, needs_spectrum, spectrum_agrees
 from .curvefit import (
     Curve,
     Solution,
@@ -197,8 +197,8 @@ def _amplitude_and_profile(pr: Proposal, rnd: Round) -> tuple:
 
 
 def bandwidth_grids(curve: Curve) -> dict:
-    """Search grids per filter kind: single-pole and Butterworth cutoffs whose roll-off falls inside the curve,
-    FIR lengths."""
+    """Search grids per filter kind: single-pole and Butterworth cutoffs (every order's the same) whose roll-off
+    falls inside the curve, FIR lengths."""
     # the roll-off must reach into the curve: a time constant (or FIR span) of at least a third of the
     # shortest τ — a faster filter leaves no mark on it
     fs = curve.fs
@@ -206,7 +206,8 @@ def bandwidth_grids(curve: Curve) -> dict:
     f_hi = min(0.45 * fs, 3.0 / (2 * math.pi * curve.tau[0]))
     grids = {}
     if f_lo < f_hi:
-        grids["single_pole"] = grids["butterworth2"] = np.geomspace(f_lo, f_hi, 24)
+        grids["single_pole"] = np.geomspace(f_lo, f_hi, 24)
+        grids.update({kind: grids["single_pole"] for kind in ("butterworth2",) + STEEPER})
     l_min = max(2, int(math.ceil(curve.tau[0] * fs / 3)))
     l_max = int(max(2, min(64, 0.1 * curve.tau[-1] * fs)))
     if l_max > l_min:
@@ -232,17 +233,24 @@ def _bw_family(sub: Curve, has_samples: bool) -> list:
 def _bw_searches(rnd: Round) -> list:
     if any(base_name(k) == "bandwidth" for k, _p in rnd.effects) or "N" not in rnd.start:
         return []
-    return [
+    return [  # the Butterworths above the 2nd order only where it was searched (:func:`_bw_propose`)
         (f"bandwidth:{kind}", grid, kind not in ("moving_average", "bartlett"))
         for kind, grid in bandwidth_grids(rnd.curve).items()
+        if kind not in STEEPER
     ]
 
 
 def _bw_propose(rnd: Round) -> list:
     best = None
     tie = rnd.curve.tau.size / rnd.curve.n_eff
+    found, grids = [], {}
     for key, grid, cont in _bw_searches(rnd):
-        p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, key, grid, continuous=cont)
+        found.append((key, *search(rnd.curve, rnd.start, rnd.effects, key, grid, continuous=cont)))
+        grids[key] = grid
+    two = "bandwidth:butterworth2"
+    if two in grids and rnd.y is not None:  # steeper Butterworths, named only with a spectrum as the 2nd order
+        found += higher_butterworths(rnd.curve, rnd.start, rnd.effects, grids[two], found[list(grids).index(two)], tie)
+    for key, p, s_new, edge in found:
         kind = key.split(":", 1)[1]  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)
         if needs_spectrum(kind) and not spectrum_agrees(rnd.y, rnd.curve.fs, kind, p):
             continue
@@ -262,7 +270,7 @@ def _bw_params(pr: Proposal, rnd: Round) -> tuple:
     def profile():
         return profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, p, pr.sol)
 
-    if kind in ("single_pole", "butterworth2"):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
+    if kind == "single_pole" or needs_spectrum(kind):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
         c_int = profile() if kind == "single_pole" else tuple(min(c, fs / 2.0) for c in profile())
         return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": c_int}
     if kind.startswith("single_pole+boxcar:"):

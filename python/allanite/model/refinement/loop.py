@@ -356,7 +356,7 @@ class _Run:
             n_step += 1
         self.drop_absorbed()
         grids = bandwidth_grids(self.curve)
-        self.effects, self.sol = research_rolloff(self.curve, self.start, self.effects, self.sol, grids)
+        self.effects, self.sol = research_rolloff(self.curve, self.start, self.effects, self.sol, grids, self.y)
         self.score()
 
     def curve_step(self, n_step, candidates, thin, exact, lines) -> bool:
