@@ -18,7 +18,8 @@ What is achievable: :func:`warmup_crlb`, the Cramér–Rao bound of (a, T) under
 read mostly against the flicker and random walk at its own time scale, so the bound falls with the amplitude
 (∝ 1/a) and hardly with the record's length: for 0.08 °/s·e^{−t/1500 s} in ADIS16405 run 4 x noise it is
 sd(T)/T ≥ 46–66 % on 10⁶ samples at 100 Hz; the GLS against the true noise terms has a median |T error| of
-22–37 % there, this fit against the record's own 28–45 % (benches/results/warmup_coverage.md).
+22–37 % there, this fit against the record's own 26–52 % (13 % at twice the amplitude on the first noise;
+benches/results/warmup_coverage.md).
 
 Covariance of the means b_i of blocks [s_i, e_i) of w_i = e_i − s_i seconds (two-sided PSDs of IEEE Std 952):
 
