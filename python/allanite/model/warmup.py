@@ -9,13 +9,17 @@ ramp R·t (when the noise terms hold one) a free column: it is a deterministic s
 intervals are where the GLS χ² rises over its minimum by at most a threshold from a parametric bootstrap of the
 profile's likelihood ratio (1 for a model linear in T; more where T is poorly determined), for T directly and for
 a as the profile over T of its conditional interval. The noise terms come from a five-term fit of the record
-with the warm-up removed, and the fit is repeated once with them (:func:`warmup_fit`).
+with the warm-up removed, and the fit is repeated once with them (:func:`warmup_fit`); whether a rate ramp is a
+free column then is decided by the block means' likelihood (:func:`ramp_choice`), not by the fitted R alone —
+on one record a five-term fit tells a ramp from a random walk of rate poorly, and a real ramp left out is taken
+by the warm-up.
 
 What is achievable: :func:`warmup_crlb`, the Cramér–Rao bound of (a, T) under given noise terms. A warm-up is
 read mostly against the flicker and random walk at its own time scale, so the bound falls with the amplitude
 (∝ 1/a) and hardly with the record's length: for 0.08 °/s·e^{−t/1500 s} in ADIS16405 run 4 x noise it is
 sd(T)/T ≥ 46–66 % on 10⁶ samples at 100 Hz; the GLS against the true noise terms has a median |T error| of
-22–37 % there, this fit against the record's own 28–45 % (benches/results/warmup_coverage.md).
+22–37 % there, this fit against the record's own 26–52 % (13 % at twice the amplitude on the first noise;
+benches/results/warmup_coverage.md).
 
 Covariance of the means b_i of blocks [s_i, e_i) of w_i = e_i − s_i seconds (two-sided PSDs of IEEE Std 952):
 
@@ -50,6 +54,7 @@ __all__ = [
     "warmup_component",
     "warmup_crlb",
     "noise_terms",
+    "ramp_choice",
     "BLOCKS",
     "T_GRID_POINTS",
 ]
@@ -62,6 +67,10 @@ T_GRID_POINTS = 241
 BOOTSTRAP = 400
 #: The intervals' coverage (one standard deviation of a normal).
 LEVEL_68 = 0.6827
+#: Log-likelihood gain a free rate ramp must bring to be fitted (:func:`ramp_choice`; Akaike: one parameter).
+RAMP_GAIN = 1.0
+#: Random walks of rate the ramp's choice weighs each design at, × the block means' spread over √(length).
+_K_GRID = np.geomspace(1e-3, 10.0, 25)
 #: Ratio of successive Gauss–Markov time constants in the flicker sum, as a log.
 _FLICKER_STEP = 0.5
 
@@ -94,17 +103,7 @@ def gls_warmup(b: np.ndarray, tb: np.ndarray, cov: np.ndarray, length: float, ra
     χ² rises over its minimum by at most the threshold a parametric bootstrap of the profile's likelihood
     ratio at the fitted T gives (:func:`_lr_threshold`; 1 for a linear model, more where T is poorly
     determined and the profile is far from parabolic)."""
-    chol = _cholesky(cov)
-    wb = solve_triangular(chol, b, lower=True)
-    base = [np.ones_like(tb)] + ([tb - tb.mean()] if ramp else [])
-    q0 = np.linalg.qr(solve_triangular(chol, np.column_stack(base), lower=True))[0]
-    grid = np.linspace(math.log(length / 200.0), math.log(length / 2.0), T_GRID_POINTS)
-    cols = solve_triangular(chol, np.exp(-tb[:, None] / np.exp(grid)[None, :]), lower=True)
-    cols -= q0 @ (q0.T @ cols)  # the warm-up's columns with the constant (and ramp) projected out
-    norm2 = np.maximum(np.sum(cols * cols, axis=0), 1e-300)
-    r0 = wb - q0 @ (q0.T @ wb)
-    u = cols.T @ r0
-    chi2 = float(r0 @ r0) - u * u / norm2
+    chi2, cols, norm2, q0, u, grid = _profile(_cholesky(cov), b, tb, length, ramp)
     amp, se = u / norm2, 1.0 / np.sqrt(norm2)
     j = int(np.argmin(chi2))
     thr = _lr_threshold(cols, norm2, q0, amp[j] * cols[:, j], j)
@@ -120,6 +119,28 @@ def gls_warmup(b: np.ndarray, tb: np.ndarray, cov: np.ndarray, length: float, ra
         "threshold": thr,
         "at_edge": j in (0, grid.size - 1),
     }
+
+
+def _profile(chol: np.ndarray, b: np.ndarray, tb: np.ndarray, length: float, ramp: bool, white=None):
+    """The GLS χ² of c + a·e^{−t/T} (+ r·t) over the log-T grid, whitened by the Cholesky factor ``chol``:
+    (χ², the warm-up's whitened columns with the constant (and ramp) projected out, their squared norms, the
+    projector's basis, the columns' products with the residual, the grid of ln T). ``white``: the whitened
+    (block means, warm-up columns) from :func:`_whitened`, where several designs share one factor."""
+    grid = np.linspace(math.log(length / 200.0), math.log(length / 2.0), T_GRID_POINTS)
+    wb, cols = _whitened(chol, b, tb, grid) if white is None else white
+    base = [np.ones_like(tb)] + ([tb - tb.mean()] if ramp else [])
+    q0 = np.linalg.qr(solve_triangular(chol, np.column_stack(base), lower=True))[0]
+    cols = cols - q0 @ (q0.T @ cols)  # the warm-up's columns with the constant (and ramp) projected out
+    norm2 = np.maximum(np.sum(cols * cols, axis=0), 1e-300)
+    r0 = wb - q0 @ (q0.T @ wb)
+    u = cols.T @ r0
+    return float(r0 @ r0) - u * u / norm2, cols, norm2, q0, u, grid
+
+
+def _whitened(chol: np.ndarray, b: np.ndarray, tb: np.ndarray, grid: np.ndarray):
+    """The block means and the warm-up's columns e^{−t/T} (T = e^grid) whitened by the Cholesky factor."""
+    cols = np.exp(-tb[:, None] / np.exp(grid)[None, :])
+    return solve_triangular(chol, b, lower=True), solve_triangular(chol, cols, lower=True)
 
 
 def _lr_threshold(cols: np.ndarray, norm2: np.ndarray, q0: np.ndarray, signal: np.ndarray, j: int) -> float:
@@ -154,22 +175,64 @@ def _blocks(y: np.ndarray, fs: float, n_blocks: int):
     return b, edges
 
 
-def warmup_fit(y: np.ndarray, fs: float, noise, refit_noise=None, n_blocks: int = BLOCKS) -> dict:
+def warmup_fit(
+    y: np.ndarray, fs: float, noise, refit_noise=None, n_blocks: int = BLOCKS, ramp: bool | None = None
+) -> dict:
     """(a, T) of a warm-up in ``y`` with intervals, by GLS against ``noise`` ({"N", "B", "K", "R"}, base form).
 
     ``refit_noise(z)``, if given, returns the noise terms of the record ``z`` (the warm-up removed): the fit is
-    then repeated once with them, so that the warm-up no longer inflates the noise it is weighed against. The
-    result also holds the noise terms used (``"noise"``)."""
+    then repeated once with them, so that the warm-up no longer inflates the noise it is weighed against, and
+    whether a free rate ramp is fitted is decided by the block means' likelihood (:func:`ramp_choice`) instead
+    of by the fitted R alone. ``ramp`` forces the free ramp column on or off; by default it follows
+    ``noise["R"] > 0`` for noise terms given as known. The result also holds the noise terms used
+    (``"noise"``) and whether the ramp was fitted (``"ramp"``)."""
     b, edges = _blocks(y, fs, n_blocks)
     tb = 0.5 * (edges[:-1] + edges[1:])
     length = y.size / fs
-    out = gls_warmup(b, tb, _cov_of_blocks(_pairs(edges), _slow_free(noise)), length, ramp=_has_ramp(noise))
+    use_ramp = _has_ramp(noise) if ramp is None else ramp
+    out = gls_warmup(b, tb, _cov_of_blocks(_pairs(edges), _slow_free(noise)), length, ramp=use_ramp)
     if refit_noise is not None:
         t = np.arange(y.size) / fs
         noise = refit_noise(y - out["amplitude"] * np.exp(-t / out["T"]))
-        out = gls_warmup(b, tb, _cov_of_blocks(_pairs(edges), _slow_free(noise)), length, ramp=_has_ramp(noise))
+        if ramp is None:
+            use_ramp, gain = ramp_choice(b, edges, noise)
+        out = gls_warmup(b, tb, _cov_of_blocks(_pairs(edges), _slow_free(noise)), length, ramp=use_ramp)
+        if ramp is None:
+            out["ramp_gain"] = gain
     out["noise"] = dict(noise)
+    out["ramp"] = bool(use_ramp)
     return out
+
+
+def ramp_choice(b: np.ndarray, edges: np.ndarray, noise: dict) -> tuple[bool, float]:
+    """Whether the block means ``b`` (blocks between ``edges``, s) hold a rate ramp r·t beside the warm-up:
+    (the choice, the log-likelihood gain of the ramp's column).
+
+    A deterministic ramp and a random walk of rate both rise as the longest τ of the Allan curve, and on one
+    record a five-term fit takes one for the other (it sets R = 0 on a fifth of records of the ADIS run 4 x
+    final model, whose slow part is a ramp; R > 0 on two in five of its five-term fit's, a random walk).
+    Without the column a real ramp is taken by the warm-up (T's median error −56 % there); with it where
+    there is none, T loses its information to the column. So both designs are weighed by the block means'
+    Gaussian likelihood, each at its best random walk K (a grid, :data:`_K_GRID` × the block means' spread
+    over √L; K = 0 included) and T (profiled), N and B from ``noise``; the ramp is kept when it raises the
+    log-likelihood by more than :data:`RAMP_GAIN` (Akaike: one more parameter)."""
+    pairs = _pairs(edges)
+    length = float(edges[-1] - edges[0])
+    tb = 0.5 * (pairs[:, 0] + pairs[:, 1])
+    base = _cov_of_blocks(pairs, {"N": noise.get("N", 0.0), "B": noise.get("B", 0.0)})
+    unit_rw = _cov_of_blocks(pairs, {"K": 1.0})
+    scale = float(np.std(b)) / math.sqrt(length)
+    grid = np.linspace(math.log(length / 200.0), math.log(length / 2.0), T_GRID_POINTS)
+    best = {False: -math.inf, True: -math.inf}
+    for k in np.concatenate([[0.0], scale * _K_GRID]):
+        chol = _cholesky(base + k * k * unit_rw)
+        logdet = 2.0 * float(np.sum(np.log(np.diag(chol))))
+        white = _whitened(chol, b, tb, grid)
+        for r in best:
+            chi2 = _profile(chol, b, tb, length, r, white)[0]
+            best[r] = max(best[r], -0.5 * (logdet + float(chi2.min())))
+    gain = best[True] - best[False]
+    return gain > RAMP_GAIN, gain
 
 
 def noise_terms(z: np.ndarray, fs: float) -> dict:
@@ -180,12 +243,19 @@ def noise_terms(z: np.ndarray, fs: float) -> dict:
 
 
 def warmup_component(
-    z: np.ndarray, t: np.ndarray, noise: dict, length: float, pieces: int = 1, n_blocks: int = BLOCKS // 2
+    z: np.ndarray,
+    t: np.ndarray,
+    noise: dict,
+    length: float,
+    pieces: int = 1,
+    n_blocks: int = BLOCKS // 2,
+    ramp: bool | None = None,
 ):
     """The warm-up fitted as :func:`warmup_fit` does on samples ``z`` taken at times ``t`` (s) — a part of
     alternate blocks: its ``pieces`` runs of consecutive samples are each cut into block means, so no block
     straddles a seam, and the blocks' covariance follows their real times. Returns the component as a function
-    of time (s), for the held-out error."""
+    of time (s), for the held-out error. ``ramp``: fit a free rate ramp (by default where ``noise["R"] > 0``;
+    pass :func:`warmup_fit`'s ``"ramp"``)."""
     fs = (t.size - 1) / max(t[-1] - t[0], 1e-300) if t.size > 1 else 1.0
     run = z.size // pieces
     per = max(1, run // max(1, n_blocks // pieces))
@@ -194,7 +264,7 @@ def warmup_component(
     starts = t[: pieces * run].reshape(pieces, run)[:, :use].reshape(-1, per)[:, 0]
     edges = np.column_stack([starts, starts + per / fs])
     cov = _cov_of_blocks(edges, _slow_free(noise))
-    d = gls_warmup(zb, edges.mean(axis=1), cov, length, ramp=_has_ramp(noise))
+    d = gls_warmup(zb, edges.mean(axis=1), cov, length, ramp=_has_ramp(noise) if ramp is None else ramp)
     a, t_c = d["amplitude"], d["T"]
     return lambda tt: a * np.exp(-np.asarray(tt) / t_c)
 

@@ -141,7 +141,7 @@ def _drift(ctx: RemovalContext) -> Iterator[Removal]:
         return
 
     def refit(z, idx):
-        g = warmup.warmup_component(z, idx / fs, w["noise"], span, pieces)
+        g = warmup.warmup_component(z, idx / fs, w["noise"], span, pieces, ramp=w["ramp"])
         return lambda i: g(i / fs)
 
     yield Removal(
@@ -155,7 +155,7 @@ def _drift(ctx: RemovalContext) -> Iterator[Removal]:
             "test": tested("statistic", dr["statistic"], thr_d, a),
             "noise": w["noise"],  # the noise terms the block means were weighed against (base form)
             # the Cramér–Rao bound of T and a under those terms (relative sd): what any unbiased estimate can do
-            "bound": warmup.warmup_crlb(span, w["amplitude"], w["T"], w["noise"]),
+            "bound": warmup.warmup_crlb(span, w["amplitude"], w["T"], w["noise"], ramp=w["ramp"]),
         },
         2,
     )
