@@ -216,13 +216,43 @@ def _orient(gens: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return gens, coefs
 
 
+def _weight_amplitudes(y: np.ndarray, gens: np.ndarray, coefs: np.ndarray, found_lines: list[dict]) -> np.ndarray:
+    """Each line's amplitude for the generators' weights: the least-squares amplitudes of the lattice at the search's
+    generators when the family has two lines or more, else the search's own.
+
+    The search's amplitude is the power in the line's width of the Welch PSD: a weak line beside a strong one reads
+    the strong one's leakage. A square wave near f_s/60 puts its aliased 59th and 61st harmonics 0.06 Hz either side
+    of its fundamental: they read the fundamental's amplitude (59× their own), took 59²·3500× their weight in the
+    generator's least squares, and their leakage-biased offsets moved the fundamental by 8000 of its standard errors
+    (``benches/results/line_constancy_null.md``). The joint least squares (:func:`allanite.model.linefit.solve`)
+    separates neighbouring lines exactly; at the search's generators a high harmonic's amplitude may read low (its
+    phase turns along the record): its weight then errs on the small side."""
+    if coefs.shape[0] < 2:
+        return np.array([d["amplitude"] for d in found_lines])
+    a, b = linefit.solve(y, np.arange(y.size), gens, coefs)
+    return np.hypot(a, b)
+
+
+def _refined(y, fs, gens, coefs, found_lines, noise) -> tuple[np.ndarray, np.ndarray]:
+    """The generators refined (:func:`allanite.model.linefit.refine_generators`) with the lines' weights of
+    :func:`_weight_amplitudes`; a family refined again with the weights at its refined generators, where its high
+    harmonics' amplitudes read true (a square wave's 29 lines at 400 Hz: the standard error 4.3× the Cramér–Rao bound
+    with the first weights, at it with the second)."""
+    gens, cov = linefit.refine_generators(
+        y, gens, coefs, _line_var(_weight_amplitudes(y, gens, coefs, found_lines), noise, fs, y.size)
+    )
+    if coefs.shape[0] < 2:
+        return gens, cov
+    amp = _weight_amplitudes(y, gens, coefs, found_lines)
+    return linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, y.size))
+
+
 def _fit_family(y, fs, fam, found_lines, passes, alpha, taken_f) -> LineFamily:
     """Refine the generators, add the lattice points the targeted test accepts, fit amplitudes."""
     n = y.size
     gens, coefs = _orient(np.asarray(fam["gens"], dtype=np.float64), np.asarray(fam["coefs"], dtype=np.int64))
-    amp = np.array([d["amplitude"] for d in found_lines])
     noise = np.array([d["noise"] for d in found_lines])
-    gens, cov = linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, n))
+    gens, cov = _refined(y, fs, gens, coefs, found_lines, noise)
     found = np.ones(coefs.shape[0], dtype=bool)
     rows, f_t = _targets({"coefs": coefs}, gens, passes, taken_f, fs)
     added = 0
