@@ -8,7 +8,8 @@
 2. :func:`allanite.model.lines.group_lines` — the lines into families on a lattice (harmonics k·f0,
    sidebands k·f1 + s·f2); a line no family takes is a sinusoid of its own;
 3. per family, the generators refined on the samples (Gauss–Newton on the lines' frequency offsets,
-   :func:`allanite.model.linefit.refine_generators`), then the lattice points the family predicts but the
+   :func:`allanite.model.linefit.refine_generators`, each line weighted by its least-squares amplitude at the
+   lattice: :func:`_weight_amplitudes`), then the lattice points the family predicts but the
    search did not flag are tested one by one (the F test of the PSD ratio at the point's bin, Bonferroni
    over the points tried, at the same ``alpha``: a family's weak harmonics and sidebands, known in advance,
    need far less than a line found anywhere among all bins); under the null nothing reaches this stage, so
@@ -247,11 +248,53 @@ def _refined(y, fs, gens, coefs, found_lines, noise) -> tuple[np.ndarray, np.nda
     return linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, y.size))
 
 
+def _unaliased(y, fs, gens, coefs, found_lines, noise) -> tuple[np.ndarray, np.ndarray]:
+    """A harmonic family's orders and its fundamental to start from: each line's order, among the orders folding
+    within a search bin of it, the one of most power at the record's full resolution.
+
+    Where P·f0 nears a multiple of f_s, orders k and mP ± k fold within a Welch bin of each other: the search's
+    lattice cannot tell them apart and may give a line the far order (a square wave at 2.04106 Hz, 100 Hz: its
+    9th–27th harmonics taken as the 40th–22nd, the fundamental refined 1400 of its standard errors off). At the
+    record's resolution the candidates stand ≈ 10 bins apart: the orders are decided by increasing lowest candidate
+    (up to 4, 8, 16, …), each at the fundamental refined on the lines decided before (:func:`_refined`), the
+    candidate whose DTFT holds the most power; the fundamental the last refined. Unchanged where no line is
+    ambiguous."""
+    if gens.size != 1 or coefs.shape[0] < 2:
+        return coefs, gens
+    k = coefs[:, 0]
+    orders = np.arange(1, int(np.max(k)) + 1)
+    pos = np.abs(lines.fold_frequency(orders * gens[0]))
+    tol = min(d["bin_hz"] for d in found_lines) / fs
+    near = np.abs(pos[k - 1][:, None] - pos[None, :]) < tol  # (lines, orders): the orders each line could be
+    if not np.any(near.sum(axis=1) > 1):
+        return coefs, gens
+    lowest = np.array([orders[row][0] for row in near])
+    out, g, limit = k.copy(), gens, 4
+    yd, idx = y - y.mean(), np.arange(y.size)
+    while True:
+        now = np.flatnonzero(lowest <= limit)
+        if now.size >= 2:
+            g, _ = _refined(y, fs, g, out[now][:, None], [found_lines[i] for i in now], noise[now])
+        stage = (
+            np.flatnonzero((lowest > limit) & (lowest <= 2 * limit)) if now.size else np.flatnonzero(lowest <= limit)
+        )
+        power = np.abs(linefit.dtft(yd, idx, g, orders[:, None]))
+        for i in stage:
+            cand = orders[near[i]]
+            best = int(cand[np.argmax(power[cand - 1])])
+            if best != out[i] and best not in out:
+                out[i] = best
+        if limit >= orders.size:
+            return out[:, None], g
+        limit *= 2
+
+
 def _fit_family(y, fs, fam, found_lines, passes, alpha, taken_f) -> LineFamily:
     """Refine the generators, add the lattice points the targeted test accepts, fit amplitudes."""
     n = y.size
     gens, coefs = _orient(np.asarray(fam["gens"], dtype=np.float64), np.asarray(fam["coefs"], dtype=np.int64))
     noise = np.array([d["noise"] for d in found_lines])
+    coefs, gens = _unaliased(y, fs, gens, coefs, found_lines, noise)
     gens, cov = _refined(y, fs, gens, coefs, found_lines, noise)
     found = np.ones(coefs.shape[0], dtype=bool)
     rows, f_t = _targets({"coefs": coefs}, gens, passes, taken_f, fs)
