@@ -8,11 +8,12 @@
 2. :func:`allanite.model.lines.group_lines` — the lines into families on a lattice (harmonics k·f0,
    sidebands k·f1 + s·f2); a line no family takes is a sinusoid of its own;
 3. per family, the generators refined on the samples (Gauss–Newton on the lines' frequency offsets,
-   :func:`allanite.model.linefit.refine_generators`, each line weighted by its least-squares amplitude at the
-   lattice: :func:`_weight_amplitudes`), then the lattice points the family predicts but the
-   search did not flag are tested one by one (the F test of the PSD ratio at the point's bin, Bonferroni
-   over the points tried, at the same ``alpha``: a family's weak harmonics and sidebands, known in advance,
-   need far less than a line found anywhere among all bins); under the null nothing reaches this stage, so
+   :func:`allanite.model.linefit.refine_generators`; a line whose Welch width takes in another of the family's
+   lines weighted by its least-squares amplitude at the lattice: :func:`_weight_amplitudes`; a harmonic family's
+   orders that fold within a bin of each other told apart: :func:`_unaliased`), then the lattice points the
+   family predicts but the search did not flag are tested one by one (the F test of the PSD ratio at the point's
+   bin, Bonferroni over the points tried, at the same ``alpha``: a family's weak harmonics and sidebands, known in
+   advance, need far less than a line found anywhere among all bins); under the null nothing reaches this stage, so
    it adds nothing to the record's false-alarm probability;
 4. amplitudes and phases by least squares at the lattice frequencies (:func:`allanite.model.linefit.solve`)
    — on the whole record, or, for a held-out test, on the held-in samples with the frequencies fixed
@@ -217,34 +218,41 @@ def _orient(gens: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return gens, coefs
 
 
-def _weight_amplitudes(y: np.ndarray, gens: np.ndarray, coefs: np.ndarray, found_lines: list[dict]) -> np.ndarray:
-    """Each line's amplitude for the generators' weights: the least-squares amplitudes of the lattice at the search's
-    generators when the family has two lines or more, else the search's own.
+def _weight_amplitudes(y, gens, coefs, found_lines, everywhere=False) -> tuple[np.ndarray, bool]:
+    """Each line's amplitude for the generators' weights, and whether any was replaced: the search's own (√(2·power)
+    in the line's width of the Welch PSD), or, where that width holds another of the family's lines, the lattice's
+    joint least-squares amplitude (:func:`allanite.model.linefit.solve`, which separates neighbouring lines exactly).
 
-    The search's amplitude is the power in the line's width of the Welch PSD: a weak line beside a strong one reads
-    the strong one's leakage. A square wave near f_s/60 puts its aliased 59th and 61st harmonics 0.06 Hz either side
-    of its fundamental: they read the fundamental's amplitude (59× their own), took 59²·3500× their weight in the
-    generator's least squares, and their leakage-biased offsets moved the fundamental by 8000 of its standard errors
-    (``benches/results/line_constancy_null.md``). The joint least squares (:func:`allanite.model.linefit.solve`)
-    separates neighbouring lines exactly; at the search's generators a high harmonic's amplitude may read low (its
-    phase turns along the record): its weight then errs on the small side."""
-    if coefs.shape[0] < 2:
-        return np.array([d["amplitude"] for d in found_lines])
+    A weak line whose width takes in a strong one reads the strong one's power. A square wave near f_s/60 puts its
+    aliased 59th and 61st harmonics 0.06 Hz either side of its fundamental, inside their 0.13–0.2 Hz widths: they
+    read the fundamental's amplitude (59× their own), took 59²·3500× their weight in the generator's least squares,
+    and their offsets moved the fundamental by 8000 of its standard errors (``benches/results/line_constancy_null.md``).
+    With ``everywhere``, every line's (a line given a wrong order reads none). Otherwise only those lines: a line that
+    wanders (a site's sway) reads less coherent amplitude than power, and its PSD weight
+    is the one the family's removal has been tuned with."""
+    amp = np.array([d["amplitude"] for d in found_lines])
+    f = np.array([d["f"] for d in found_lines])
+    lo = np.array([d["width_hz"][0] for d in found_lines])
+    hi = np.array([d["width_hz"][1] for d in found_lines])
+    inside = (f[None, :] >= lo[:, None]) & (f[None, :] <= hi[:, None])
+    np.fill_diagonal(inside, False)
+    shared = inside.any(axis=1) | everywhere
+    if not shared.any():
+        return amp, False
     a, b = linefit.solve(y, np.arange(y.size), gens, coefs)
-    return np.hypot(a, b)
+    return np.where(shared, np.hypot(a, b), amp), True
 
 
-def _refined(y, fs, gens, coefs, found_lines, noise) -> tuple[np.ndarray, np.ndarray]:
+def _refined(y, fs, gens, coefs, found_lines, noise, everywhere=False) -> tuple[np.ndarray, np.ndarray]:
     """The generators refined (:func:`allanite.model.linefit.refine_generators`) with the lines' weights of
-    :func:`_weight_amplitudes`; a family refined again with the weights at its refined generators, where its high
-    harmonics' amplitudes read true (a square wave's 29 lines at 400 Hz: the standard error 4.3× the Cramér–Rao bound
-    with the first weights, at it with the second)."""
-    gens, cov = linefit.refine_generators(
-        y, gens, coefs, _line_var(_weight_amplitudes(y, gens, coefs, found_lines), noise, fs, y.size)
-    )
-    if coefs.shape[0] < 2:
+    :func:`_weight_amplitudes`; where some line's weight came from the least squares, refined again with the weights
+    at the refined generators (at the search's, a high harmonic's phase may turn along the record and its
+    least-squares amplitude read low)."""
+    amp, leaked = _weight_amplitudes(y, gens, coefs, found_lines, everywhere)
+    gens, cov = linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, y.size))
+    if not leaked:
         return gens, cov
-    amp = _weight_amplitudes(y, gens, coefs, found_lines)
+    amp, _ = _weight_amplitudes(y, gens, coefs, found_lines, everywhere)
     return linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, y.size))
 
 
@@ -274,7 +282,7 @@ def _unaliased(y, fs, gens, coefs, found_lines, noise) -> tuple[np.ndarray, np.n
     while True:
         now = np.flatnonzero(lowest <= limit)
         if now.size >= 2:
-            g, _ = _refined(y, fs, g, out[now][:, None], [found_lines[i] for i in now], noise[now])
+            g, _ = _refined(y, fs, g, out[now][:, None], [found_lines[i] for i in now], noise[now], True)
         stage = (
             np.flatnonzero((lowest > limit) & (lowest <= 2 * limit)) if now.size else np.flatnonzero(lowest <= limit)
         )
