@@ -276,3 +276,46 @@ def test_the_lowest_fundamental_is_preferred_only_where_its_own_lines_stand():
     # 2.3 Hz at even orders only: 2.3 Hz is the fundamental whichever scored best
     for first in (best, high, sub, half):
         assert lines._lowest_fundamental(first[:5], [sub, true, high, half], nu, tol)[1][0] * fs == pytest.approx(2.3)
+
+
+@pytest.mark.parametrize(
+    ("fs", "n", "f0", "seed"),
+    [(100.0, 100_000, 1.665678, 4), (100.0, 100_000, 1.6657, 5), (400.0, 200_000, 6.6651, 6)],
+)
+def test_a_square_waves_fundamental_beside_its_aliased_harmonics_is_within_three_standard_errors(fs, n, f0, seed):
+    """Near f_s/60 a sampled square wave's 59th and 61st harmonics fold to f0 ± (f_s − 60·f0), a few bins from the
+    fundamental: the Welch PSD read them at the fundamental's amplitude, and the generator's least squares weighted
+    them 3500× too much — the fundamental came out 10⁴ standard errors off (1.66560 for 1.66568 Hz). The error
+    against the Cramér–Rao bound of the lines the family holds (white noise: each harmonic 4A/(πk) adds its
+    information), and the family's own standard error near that bound."""
+    sigma, amp = 0.5, 1.0
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / fs
+    y = sigma * rng.normal(size=n) + amp * np.sign(np.sin(2 * np.pi * f0 * t + rng.uniform(0, 2 * np.pi)))
+    r = periodic.periodic_search(y, fs, 0.01)
+    fam = r["families"][0]
+    k = np.abs(fam.coefs[:, 0])
+    assert fam.gens.size == 1 and np.any(k > 55)  # the aliased harmonics are in the family
+    sd_line = linefit.frequency_sd(4 * amp / (np.pi * k), 2 * sigma**2 / fs, fs, n)  # Hz, each line's own
+    se = 1.0 / np.sqrt(np.sum((k / sd_line) ** 2))  # the fundamental's, the lines' information added
+    assert abs(fam.gens[0] - f0) < 3 * se, (fam.gens[0] - f0) / se
+    assert 0.5 < fam.gens_sd[0] / se < 2.0, fam.gens_sd[0] / se
+
+
+def test_a_square_waves_orders_that_fold_within_a_bin_of_each_other_are_told_apart():
+    """At 2.041057 Hz of 100 Hz, 49·f0 is 0.012 Hz past f_s: orders k and 49 − k (and 98 − k) fold within a Welch bin
+    of each other, and the search's lattice gave the 9th–27th harmonics the orders 40–22 (the fundamental refined
+    1400 standard errors off). At the record's resolution they are 12 bins apart: every line an odd order, the
+    fundamental within 3 standard errors of the bound."""
+    fs, n, f0, sigma, amp = 100.0, 100_000, 2.041057, 0.5, 1.0
+    rng = np.random.default_rng(8)
+    t = np.arange(n) / fs
+    y = sigma * rng.normal(size=n) + amp * np.sign(np.sin(2 * np.pi * f0 * t + 1.0))
+    fam = periodic.periodic_search(y, fs, 0.01)["families"][0]
+    assert fam.gens.size == 1 and abs(fam.gens[0] / f0 - 1) < 1e-3
+    k = np.abs(fam.coefs[:, 0])
+    assert np.all(k % 2 == 1), sorted(k.tolist())  # a square wave's harmonics are odd
+    assert np.any(k > 24)  # orders past the fold at 49/2 are in the family
+    sd_line = linefit.frequency_sd(4 * amp / (np.pi * k), 2 * sigma**2 / fs, fs, n)
+    se = 1.0 / np.sqrt(np.sum((k / sd_line) ** 2))
+    assert abs(fam.gens[0] - f0) < 3 * se, (fam.gens[0] - f0) / se

@@ -8,10 +8,12 @@
 2. :func:`allanite.model.lines.group_lines` — the lines into families on a lattice (harmonics k·f0,
    sidebands k·f1 + s·f2); a line no family takes is a sinusoid of its own;
 3. per family, the generators refined on the samples (Gauss–Newton on the lines' frequency offsets,
-   :func:`allanite.model.linefit.refine_generators`), then the lattice points the family predicts but the
-   search did not flag are tested one by one (the F test of the PSD ratio at the point's bin, Bonferroni
-   over the points tried, at the same ``alpha``: a family's weak harmonics and sidebands, known in advance,
-   need far less than a line found anywhere among all bins); under the null nothing reaches this stage, so
+   :func:`allanite.model.linefit.refine_generators`; a line whose Welch width takes in another of the family's
+   lines weighted by its least-squares amplitude at the lattice: :func:`_weight_amplitudes`; a harmonic family's
+   orders that fold within a bin of each other told apart: :func:`_unaliased`), then the lattice points the
+   family predicts but the search did not flag are tested one by one (the F test of the PSD ratio at the point's
+   bin, Bonferroni over the points tried, at the same ``alpha``: a family's weak harmonics and sidebands, known in
+   advance, need far less than a line found anywhere among all bins); under the null nothing reaches this stage, so
    it adds nothing to the record's false-alarm probability;
 4. amplitudes and phases by least squares at the lattice frequencies (:func:`allanite.model.linefit.solve`)
    — on the whole record, or, for a held-out test, on the held-in samples with the frequencies fixed
@@ -216,13 +218,92 @@ def _orient(gens: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return gens, coefs
 
 
+def _weight_amplitudes(y, gens, coefs, found_lines, everywhere=False) -> tuple[np.ndarray, bool]:
+    """Each line's amplitude for the generators' weights, and whether any was replaced: the search's own (√(2·power)
+    in the line's width of the Welch PSD), or, where that width holds another of the family's lines, the lattice's
+    joint least-squares amplitude (:func:`allanite.model.linefit.solve`, which separates neighbouring lines exactly).
+
+    A weak line whose width takes in a strong one reads the strong one's power. A square wave near f_s/60 puts its
+    aliased 59th and 61st harmonics 0.06 Hz either side of its fundamental, inside their 0.13–0.2 Hz widths: they
+    read the fundamental's amplitude (59× their own), took 59²·3500× their weight in the generator's least squares,
+    and their offsets moved the fundamental by 8000 of its standard errors (``benches/results/line_constancy_null.md``).
+    With ``everywhere``, every line's (a line given a wrong order reads none). Otherwise only those lines: a line that
+    wanders (a site's sway) reads less coherent amplitude than power, and its PSD weight
+    is the one the family's removal has been tuned with."""
+    amp = np.array([d["amplitude"] for d in found_lines])
+    f = np.array([d["f"] for d in found_lines])
+    lo = np.array([d["width_hz"][0] for d in found_lines])
+    hi = np.array([d["width_hz"][1] for d in found_lines])
+    inside = (f[None, :] >= lo[:, None]) & (f[None, :] <= hi[:, None])
+    np.fill_diagonal(inside, False)
+    shared = inside.any(axis=1) | everywhere
+    if not shared.any():
+        return amp, False
+    a, b = linefit.solve(y, np.arange(y.size), gens, coefs)
+    return np.where(shared, np.hypot(a, b), amp), True
+
+
+def _refined(y, fs, gens, coefs, found_lines, noise, everywhere=False) -> tuple[np.ndarray, np.ndarray]:
+    """The generators refined (:func:`allanite.model.linefit.refine_generators`) with the lines' weights of
+    :func:`_weight_amplitudes`; where some line's weight came from the least squares, refined again with the weights
+    at the refined generators (at the search's, a high harmonic's phase may turn along the record and its
+    least-squares amplitude read low)."""
+    amp, leaked = _weight_amplitudes(y, gens, coefs, found_lines, everywhere)
+    gens, cov = linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, y.size))
+    if not leaked:
+        return gens, cov
+    amp, _ = _weight_amplitudes(y, gens, coefs, found_lines, everywhere)
+    return linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, y.size))
+
+
+def _unaliased(y, fs, gens, coefs, found_lines, noise) -> tuple[np.ndarray, np.ndarray]:
+    """A harmonic family's orders and its fundamental to start from: each line's order, among the orders folding
+    within a search bin of it, the one of most power at the record's full resolution.
+
+    Where P·f0 nears a multiple of f_s, orders k and mP ± k fold within a Welch bin of each other: the search's
+    lattice cannot tell them apart and may give a line the far order (a square wave at 2.04106 Hz, 100 Hz: its
+    9th–27th harmonics taken as the 40th–22nd, the fundamental refined 1400 of its standard errors off). At the
+    record's resolution the candidates stand ≈ 10 bins apart: the orders are decided by increasing lowest candidate
+    (up to 4, 8, 16, …), each at the fundamental refined on the lines decided before (:func:`_refined`), the
+    candidate whose DTFT holds the most power; the fundamental the last refined. Unchanged where no line is
+    ambiguous."""
+    if gens.size != 1 or coefs.shape[0] < 2:
+        return coefs, gens
+    k = coefs[:, 0]
+    orders = np.arange(1, int(np.max(k)) + 1)
+    pos = np.abs(lines.fold_frequency(orders * gens[0]))
+    tol = min(d["bin_hz"] for d in found_lines) / fs
+    near = np.abs(pos[k - 1][:, None] - pos[None, :]) < tol  # (lines, orders): the orders each line could be
+    if not np.any(near.sum(axis=1) > 1):
+        return coefs, gens
+    lowest = np.array([orders[row][0] for row in near])
+    out, g, limit = k.copy(), gens, 4
+    yd, idx = y - y.mean(), np.arange(y.size)
+    while True:
+        now = np.flatnonzero(lowest <= limit)
+        if now.size >= 2:
+            g, _ = _refined(y, fs, g, out[now][:, None], [found_lines[i] for i in now], noise[now], True)
+        stage = (
+            np.flatnonzero((lowest > limit) & (lowest <= 2 * limit)) if now.size else np.flatnonzero(lowest <= limit)
+        )
+        power = np.abs(linefit.dtft(yd, idx, g, orders[:, None]))
+        for i in stage:
+            cand = orders[near[i]]
+            best = int(cand[np.argmax(power[cand - 1])])
+            if best != out[i] and best not in out:
+                out[i] = best
+        if limit >= orders.size:
+            return out[:, None], g
+        limit *= 2
+
+
 def _fit_family(y, fs, fam, found_lines, passes, alpha, taken_f) -> LineFamily:
     """Refine the generators, add the lattice points the targeted test accepts, fit amplitudes."""
     n = y.size
     gens, coefs = _orient(np.asarray(fam["gens"], dtype=np.float64), np.asarray(fam["coefs"], dtype=np.int64))
-    amp = np.array([d["amplitude"] for d in found_lines])
     noise = np.array([d["noise"] for d in found_lines])
-    gens, cov = linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, n))
+    coefs, gens = _unaliased(y, fs, gens, coefs, found_lines, noise)
+    gens, cov = _refined(y, fs, gens, coefs, found_lines, noise)
     found = np.ones(coefs.shape[0], dtype=bool)
     rows, f_t = _targets({"coefs": coefs}, gens, passes, taken_f, fs)
     added = 0
