@@ -32,8 +32,11 @@ def test_a_wandering_line_has_one_amplitude_its_power(wandering_line):
     # least-squares amplitude at f0 over the whole record, 3.5e-4, a tenth of it (the phase wanders), and the
     # final model its free curve column's, 4.1e-3
     assert abs(st.params["amplitude"] / 4e-3 - 1) < 0.2
-    # the part whose phase carries across the record is still reported, as evidence
-    assert st.evidence["coherent_amplitude"] < 0.1 * st.params["amplitude"]
+    # the part whose phase carries across the record is still reported, as evidence: well below the power's.
+    # It is the least-squares amplitude at f0, so it depends on where f0 lands inside the line's 0.02 Hz width:
+    # 0.02 of the power at 2.6905 Hz, 0.24 at 2.6931 Hz, where f0 lands since the family fit was changed for
+    # lines inside each other's Welch width (r5f0): nearer the truth (2.7 Hz), and where the phase holds longer
+    assert st.evidence["coherent_amplitude"] < 0.3 * st.params["amplitude"]
     # held in every fit of the curve: the final joint refit leaves it where it was accepted
     assert st.final_params == st.params and st.final_intervals == st.intervals
     name = [n for n in r.fit.coefficients if n.startswith("sinusoid")][0]
