@@ -264,7 +264,7 @@ def _unaliased(y, fs, gens, coefs, found_lines, noise) -> tuple[np.ndarray, np.n
     lattice cannot tell them apart and may give a line the far order (a square wave at 2.04106 Hz, 100 Hz: its
     9th–27th harmonics taken as the 40th–22nd, the fundamental refined 1400 of its standard errors off). At the
     record's resolution the candidates stand ≈ 10 bins apart: the orders are decided by increasing lowest candidate
-    (up to 4, 8, 16, …), each at the fundamental refined on the lines decided before (:func:`_refined`), the
+    (up to 4, 16, 64, …), each at the fundamental refined on the lines decided before (:func:`_refined`), the
     candidate whose DTFT holds the most power; the fundamental the last refined (one refit per stage, and none for
     a stage with no ambiguous line: a refit at every stage, weights taken twice, made refine 5× slower on a 325-line
     sawtooth). Unchanged where no line is ambiguous."""
