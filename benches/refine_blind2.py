@@ -33,7 +33,6 @@ Usage::
 from __future__ import annotations
 
 import argparse
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -309,19 +308,22 @@ def _row(v) -> str:
     )
 
 
-def write(results, out: Path, load, notes: list) -> None:
+def write(results, out: Path, load, notes: list, stem: str = "refine_blind2", which: str = "second") -> None:
+    """The suite's page and JSON, ``<stem>.{md,json}`` in ``out`` (blind suite 3 writes through this too: its
+    ``which`` "third", judged as this suite judges)."""
     m = _common.machine_info()
     passed = sum(v["passed"] for v in results)
     with_inj = [v for v in results if v["injected"]]
     flagged = sum(v.get("without_candidate_flags", False) for v in with_inj)
+    judged_as = "refine_blind.py" if stem == "refine_blind2" else "refine_blind2.py"
     lines = [
-        "# refine on a second blind suite of simulated sensors (issue 29)",
+        f"# refine on a {which} blind suite of simulated sensors (issue 29)",
         "",
-        f"Default call, `python benches/refine_blind2.py`, {m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at "
+        f"Default call, `python benches/{stem}.py`, {m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at "
         f"{m['git_commit']}, {m['date_utc'][:10]}; other processes used {load:.0%} of the CPUs during the run "
         "(the last column is this process's CPU seconds for the default call).",
         "",
-        f"**Passed: {passed} of {len(results)}** (as `benches/refine_blind.py`: named, parameters within 20 %, "
+        f"**Passed: {passed} of {len(results)}** (as `benches/{judged_as}`: named, parameters within 20 %, "
         "frequencies within 1 %, χ²/dof (the tests' GLS) or the RMS ADEV error falling in sample, the RMS ADEV "
         "error held out, nothing unexplained; a clean case: nothing added, nothing unexplained; an effect outside "
         "refine's family: something left unexplained; a named channel: no regression on another). **Without the "
@@ -336,8 +338,7 @@ def write(results, out: Path, load, notes: list) -> None:
         "",
         *notes,
     ]
-    (out / "refine_blind2.md").write_text("\n".join(lines) + "\n")
-    (out / "refine_blind2.json").write_text(json.dumps(results, indent=1, default=float))
+    _common.write_results(out, stem, lines, results)
 
 
 #: What the table shows and why (kept true to the recorded run).
@@ -402,19 +403,26 @@ NOTES: list = [
 ]
 
 
-def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+def suite_main(argv, doc: str, cases, run, size, notes: list, stem: str, which: str) -> None:
+    """The command line of a blind suite (this one's and blind suite 3's): ``--case``, ``--out``, ``--sizes``
+    (``size(y, comp, fs, kw)`` printed per case, no refine)."""
+    ap = argparse.ArgumentParser(description=doc.split("\n")[0])
     ap.add_argument("--case", default=None, help="only cases whose name contains this text")
     ap.add_argument("--out", default=None, help="results folder (default benches/results)")
     ap.add_argument("--sizes", action="store_true", help="print each case's effect size only (no refine)")
     args = ap.parse_args(argv)
-    chosen = [c for c in CASES if args.case is None or args.case in c.name]
+    chosen = [c for c in cases if args.case is None or args.case in c.name]
     if args.sizes:
         for case in chosen:
-            y, fs, _ch, _kw, comp = case.build(np.random.default_rng(case.seed))
-            print(f"{case.name}: {effect_size(y, comp, fs)}", flush=True)
+            y, fs, _ch, kw, comp = case.build(np.random.default_rng(case.seed))
+            print(f"{case.name}: {size(y, comp, fs, kw)}", flush=True)
         return
-    rb.run_suite(chosen, args, run_case, _row, lambda res, out, load: write(res, out, load, NOTES), "refine_blind2")
+    rb.run_suite(chosen, args, run, _row, lambda res, out, load: write(res, out, load, notes, stem, which), stem)
+
+
+def main(argv=None) -> None:
+    size = lambda y, comp, fs, _kw: effect_size(y, comp, fs)  # noqa: E731
+    suite_main(argv, __doc__, CASES, run_case, size, NOTES, "refine_blind2", "second")
 
 
 if __name__ == "__main__":

@@ -35,13 +35,11 @@ Usage::
 
 from __future__ import annotations
 
-import argparse
 import math
 
 import numpy as np
 from scipy import signal
 
-import _common
 import refine_blind as rb
 import refine_blind2 as rb2
 
@@ -180,8 +178,7 @@ def _three_axes(axis):
     return build
 
 
-def _periodic(fundamentals, rms) -> Injected:
-    return Injected("periodic", {"fundamentals": list(fundamentals), "rms": rms}, ("fundamentals",))
+_periodic = rb2._periodic
 
 
 CASES = [
@@ -280,36 +277,6 @@ def run_case(case) -> dict:
     return rb.refined(case, y, fs, channels, kw, rb2._judged) | {"size": size, "outside": case.outside}
 
 
-def write(results, out, load, notes: list) -> None:
-    m = _common.machine_info()
-    passed = sum(v["passed"] for v in results)
-    with_inj = [v for v in results if v["injected"]]
-    flagged = sum(v.get("without_candidate_flags", False) for v in with_inj)
-    lines = [
-        "# refine on a third blind suite of simulated sensors (issue 29)",
-        "",
-        f"Default call, `python benches/refine_blind3.py`, {m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at "
-        f"{m['git_commit']}, {m['date_utc'][:10]}; other processes used {load:.0%} of the CPUs during the run "
-        "(the last column is this process's CPU seconds for the default call).",
-        "",
-        f"**Passed: {passed} of {len(results)}** (as `benches/refine_blind2.py`: named, parameters within 20 %, "
-        "frequencies within 1 %, χ²/dof (the tests' GLS) or the RMS ADEV error falling in sample, the RMS ADEV "
-        "error held out, nothing unexplained; a clean case: nothing added, nothing unexplained; an effect outside "
-        "refine's family: something left unexplained; a named channel: no regression on another). **Without the "
-        f"effect's candidate, `unexplained` is non-empty in {flagged} of {len(with_inj)}.** The suite was written "
-        "and committed before its first run; size: the injected component's Allan deviation over the rest's, "
-        "largest over τ ≤ T/4.",
-        "",
-        "| case | size | injected | found (at acceptance, input unit) | parameter errors | χ²/dof start → final | "
-        "RMS ADEV % | held-out % | unexplained | unexplained without the candidate | pass | CPU s |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
-        *(rb2._row(v) for v in results),
-        "",
-        *notes,
-    ]
-    _common.write_results(out, "refine_blind3", lines, results)
-
-
 #: What the table shows and why (kept true to the recorded run).
 NOTES: list = [
     "**First run** (at 4001644, the suite as committed, before any change; load 81 % from other processes; its "
@@ -372,18 +339,7 @@ NOTES: list = [
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--case", default=None, help="only cases whose name contains this text")
-    ap.add_argument("--out", default=None, help="results folder (default benches/results)")
-    ap.add_argument("--sizes", action="store_true", help="print each case's effect size only (no refine)")
-    args = ap.parse_args(argv)
-    chosen = [c for c in CASES if args.case is None or args.case in c.name]
-    if args.sizes:
-        for case in chosen:
-            y, fs, _ch, kw, comp = case.build(np.random.default_rng(case.seed))
-            print(f"{case.name}: {_size(y, comp, fs, kw)}", flush=True)
-        return
-    rb.run_suite(chosen, args, run_case, rb2._row, lambda res, out, load: write(res, out, load, NOTES), "refine_blind3")
+    rb2.suite_main(argv, __doc__, CASES, run_case, _size, NOTES, "refine_blind3", "third")
 
 
 if __name__ == "__main__":
