@@ -243,14 +243,14 @@ def _weight_amplitudes(y, gens, coefs, found_lines, everywhere=False) -> tuple[n
     return np.where(shared, np.hypot(a, b), amp), True
 
 
-def _refined(y, fs, gens, coefs, found_lines, noise, everywhere=False) -> tuple[np.ndarray, np.ndarray]:
+def _refined(y, fs, gens, coefs, found_lines, noise, everywhere=False, again=True) -> tuple[np.ndarray, np.ndarray]:
     """The generators refined (:func:`allanite.model.linefit.refine_generators`) with the lines' weights of
-    :func:`_weight_amplitudes`; where some line's weight came from the least squares, refined again with the weights
-    at the refined generators (at the search's, a high harmonic's phase may turn along the record and its
-    least-squares amplitude read low)."""
+    :func:`_weight_amplitudes`; where some line's weight came from the least squares (and ``again``), refined again
+    with the weights at the refined generators (at the search's, a high harmonic's phase may turn along the record
+    and its least-squares amplitude read low)."""
     amp, leaked = _weight_amplitudes(y, gens, coefs, found_lines, everywhere)
     gens, cov = linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, y.size))
-    if not leaked:
+    if not (leaked and again):
         return gens, cov
     amp, _ = _weight_amplitudes(y, gens, coefs, found_lines, everywhere)
     return linefit.refine_generators(y, gens, coefs, _line_var(amp, noise, fs, y.size))
@@ -288,8 +288,7 @@ def _unaliased(y, fs, gens, coefs, found_lines, noise) -> tuple[np.ndarray, np.n
         )
         stage = stage[ambiguous[stage]]  # a stage with no ambiguous line decides nothing: no refit for it
         if stage.size and now.size >= 2:
-            amp, _ = _weight_amplitudes(y, g, out[now][:, None], [found_lines[i] for i in now], True)
-            g, _ = linefit.refine_generators(y, g, out[now][:, None], _line_var(amp, noise[now], fs, y.size))
+            g, _ = _refined(y, fs, g, out[now][:, None], [found_lines[i] for i in now], noise[now], True, False)
         if stage.size:
             power = np.abs(linefit.dtft(yd, idx, g, orders[:, None]))
         for i in stage:
