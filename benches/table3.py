@@ -832,6 +832,16 @@ def ratios(row):
 
 def write_markdown(report, path: Path):
     rows = report["table"]
+    lines = _md_table(report) + _md_grids(rows) + _md_growth(rows) + _md_instead(rows) + _md_agreement(report)
+    lines += _md_how(report) + _md_scaling(report)
+    if report["mode"] == "quick":
+        lines += ["_Quick mode: tiny sizes — a correctness smoke test of the script, not a timing result._", ""]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def _md_table(report) -> list[str]:
+    """The page's head and the table itself: ours against paper 000 per N and method."""
+    rows = report["table"]
     m = report["machine"]
     lines = [
         "# Paper 000, Table 3 — DAVAR vs fast DAVAR vs improved fast DAVAR",
@@ -863,6 +873,12 @@ def write_markdown(report, path: Path):
             f"{fmt_ratio(q['naive_over_fast'])} | {fmt_ratio(q['paper_naive_over_fast'])} | "
             f"{fmt_ratio(q['fast_over_improved'])} | {fmt_ratio(q['paper_fast_over_improved'])} |"
         )
+    return lines
+
+
+def _md_grids(rows) -> list[str]:
+    """The other processes' CPU share per N, and the grids and window used."""
+    lines: list[str] = []
     loads = [
         f"{fmt_n(r['n'])}: {r['other_processes_cpu_fraction']:.0%}"
         for r in rows
@@ -881,6 +897,12 @@ def write_markdown(report, path: Path):
         "as the record, and at N = 1e3 W/9 = 11 still leaves the exponential grid 11 τ.",
         "",
     ]
+    return lines
+
+
+def _md_growth(rows) -> list[str]:
+    """Growth per decade of N against each method's work model (only where N grows by 10×)."""
+    lines: list[str] = []
     decades = [(a, b) for a, b in zip(rows, rows[1:]) if b["n"] == 10 * a["n"]]
     if decades:
         head, rule = "| method |", "|---|"
@@ -909,7 +931,12 @@ def write_markdown(report, path: Path):
             if b["n"] in PAPER and a["n"] in PAPER:
                 cells.append(fmt_ratio(PAPER[b["n"]][k] / PAPER[a["n"]][k]))
         lines.append(f"| {k} | " + " | ".join(cells) + f" | {models[k]} |")
-    lines += [
+    return lines
+
+
+def _md_instead(rows) -> list[str]:
+    """What users would do instead: NumPy prefix sums and allantools on the same grids."""
+    lines = [
         "",
         "## What users would do instead (same grids, same run, seconds)",
         "",
@@ -933,9 +960,13 @@ def write_markdown(report, path: Path):
             f"{cell('prefix_exp', 'prefix_exp_over_improved')} | "
             f"{cell('allantools_exp', 'allantools_exp_over_improved')} |"
         )
-    lines += [
-        "",
-        "(× = that method's time over allanite's on the same grid.)",
+    return lines + ["", "(× = that method's time over allanite's on the same grid.)"]
+
+
+def _md_agreement(report) -> list[str]:
+    """The agreement of every pair of methods, and which differences the 1e-9 check covers."""
+    rows = report["table"]
+    lines = [
         "",
         "## Agreement (max relative difference |a − b| / |b| at every shared m and window kept)",
         "",
@@ -974,6 +1005,14 @@ def write_markdown(report, path: Path):
         'the "all" grid\'s m (or the timed sample), at evenly strided windows, and every computed m at the '
         "naive and allantools sample windows.",
         "",
+    ]
+    return lines
+
+
+def _md_how(report) -> list[str]:
+    """How each number was obtained: per N and method, the timing rule and the memory note."""
+    rows = report["table"]
+    lines = [
         "## How each number was obtained",
         "",
         "| N | method | seconds | extrapolated | how |",
@@ -1011,6 +1050,12 @@ def write_markdown(report, path: Path):
                 f"chunks (the table)."
             )
     lines.append("")
+    return lines
+
+
+def _md_scaling(report) -> list[str]:
+    """The scaling rows (fresh process per row), when the report has them."""
+    lines: list[str] = []
     sc = report.get("scaling")
     if sc:
         sr = report.get("scaling_run")
@@ -1052,9 +1097,7 @@ def write_markdown(report, path: Path):
             ),
             "",
         ]
-    if report["mode"] == "quick":
-        lines += ["_Quick mode: tiny sizes — a correctness smoke test of the script, not a timing result._", ""]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return lines
 
 
 def plot(report, out: Path):
