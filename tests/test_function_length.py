@@ -1,10 +1,11 @@
-"""The library's functions stay short: no body over 80 lines, read from the source (AST).
+"""Functions stay short: no body over 80 lines in the package or the benches, read from the source (AST).
 
 The brief: "Functions stay short (≲ 80 lines) and modules small — split as you go." A function's
 length here is its body without the docstring: from the first statement after the docstring to the
 function's last line (comments and blank lines inside count; the signature and the docstring do not).
 Nested functions and methods are measured on their own and also count inside their parent.
-Every module under ``python/allanite`` is walked; nothing is allowed over the limit.
+Every module under ``python/allanite`` is walked and nothing there is allowed over the limit; the
+benchmark scripts under ``benches/`` are held to the same limit, with the one exception listed below.
 """
 
 from __future__ import annotations
@@ -13,10 +14,19 @@ import ast
 import textwrap
 from pathlib import Path
 
+import pytest
+
 import allanite
 
 PACKAGE = Path(allanite.__file__).parent
+BENCHES = Path(__file__).resolve().parents[1] / "benches"
 LIMIT = 80
+#: benchmark functions still over the limit, each with the reason it was not split
+BENCH_ALLOWED = {
+    # 95 lines; left whole on 2026-11-27 while the regression on slow channels (issue 29, item 1) is reworked
+    # with this bench as its null check — split it (null records, power, summary, page) once that has landed
+    "regression_null.py:main",
+}
 
 
 def _body_lines(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
@@ -77,3 +87,18 @@ def test_no_library_function_is_over_80_lines() -> None:
         for name, line, n in _long_functions(path.read_text(encoding="utf-8"))
     ]
     assert offenders == [], "split these into well-named helpers:\n" + "\n".join(offenders)
+
+
+def test_no_bench_function_is_over_80_lines_but_the_allowed() -> None:
+    scripts = sorted(BENCHES.glob("*.py"))
+    if not scripts:
+        pytest.skip(f"no benchmark scripts beside the tests ({BENCHES}): an installed package's tests")
+    found = {
+        f"{path.name}:{name}": n
+        for path in scripts
+        for name, _line, n in _long_functions(path.read_text(encoding="utf-8"))
+    }
+    over = sorted(f"{k} ({n} lines)" for k, n in found.items() if k not in BENCH_ALLOWED)
+    assert over == [], "split these into well-named helpers:\n" + "\n".join(over)
+    # an allowance that is no longer needed is dropped, so the list says only what is true
+    assert sorted(BENCH_ALLOWED - set(found)) == []
