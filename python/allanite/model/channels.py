@@ -196,6 +196,19 @@ class ChannelRegression:
         keep = [0] + [i for i, k in ((1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
         return np.array([cols[i] for i in keep])
 
+    def lag_note(self) -> str | None:
+        """In words, where the removal's lag is not a kept term: the lag profiled for the removal, or None."""
+        prof = self.terms.get("lag_s", {}).get("profiled")
+        if self.removal_lag_s is None or "lag_s" in self.params or prof is None:
+            return None
+        t = self.terms["lag_s"]
+        lo, hi = prof["interval"]
+        return (
+            f"a lag not resolved at its test's level (statistic {t['statistic']:.3g} against {t['threshold']:.3g}); "
+            f"the removal takes the channel through the profile's {prof['lag_s']:.4g} s (interval {lo:.4g}–{hi:.4g} s, "
+            f"2Δℓ {prof['gain']:.3g} over no lag) — not claimed as a term"
+        )
+
     def coefficients(self) -> np.ndarray:
         """The kept terms' coefficients, in the order of :meth:`columns`."""
         return np.array([self.params[k] for k in ("coefficient", "quadratic", "rate_coefficient") if k in self.params])
