@@ -13,6 +13,7 @@ from scipy.signal.windows import tukey
 import allanite
 from allanite.errors import AllaniteError, InputError, ParameterError
 from allanite.model import _whittle as wh
+from allanite.model import channels as channels_module
 from allanite.model.channels import (
     ChannelRegression,
     band_limited,
@@ -470,7 +471,7 @@ def _fog_lagged(seed: int, lag_s: float = 900.0):
     return y + comp, temp + 0.01 * rng.standard_normal(n), comp
 
 
-def test_a_lag_its_test_cannot_resolve_is_profiled_for_the_removal_and_the_heldout_error_falls():
+def test_a_lag_its_test_cannot_resolve_is_profiled_for_the_removal_and_the_heldout_error_falls(monkeypatch):
     # the temperature reaches the rate through 900 s, but with rate random walk dominating 10⁵ s the lag's test
     # cannot claim it (its statistic far below its threshold); removed at lag 0, the coupling left c·(L_T[T] − T)
     # in the residual and the chain's held-out error *rose* (7.07 → 10.45 % on this record; blind3's FOG row
@@ -492,7 +493,14 @@ def test_a_lag_its_test_cannot_resolve_is_profiled_for_the_removal_and_the_heldo
     ref = allanite.refine(y, 1.0, unit="rad/s", channels={"temp": logged}, progress=False)
     st = next(s for s in ref.steps if s.effect == "regression")
     assert st.after["heldout_rms_adev_pct"] < 0.7 * st.before["heldout_rms_adev_pct"]
-    assert st.evidence["terms"]["lag_s"]["profiled"]["used"]
+    assert st.evidence["terms"]["lag_s"]["profiled"]["used"] and "heldout_note" not in st.evidence
+    assert "not resolved" in st.evidence["lag"] and st.evidence["removal_lag_s"] == pytest.approx(r.removal_lag_s)
+    # the removal at lag 0 (as before): the held-out error rises, and the step says so instead of staying silent
+    monkeypatch.setattr(channels_module, "_removal_lag", lambda *a, **k: None)
+    ref0 = allanite.refine(y, 1.0, unit="rad/s", channels={"temp": logged}, progress=False)
+    st0 = next(s for s in ref0.steps if s.effect == "regression")
+    assert st0.after["heldout_rms_adev_pct"] > 1.2 * st0.before["heldout_rms_adev_pct"]
+    assert "rose" in st0.evidence["heldout_note"] and "lag" not in st0.evidence
 
 
 def test_no_lag_is_profiled_into_a_coupling_without_one():
