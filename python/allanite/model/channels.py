@@ -470,7 +470,7 @@ def _removal_lag(bands, fit, keys, tests, grid, z2) -> float | None:
     Why: a coefficient fitted at lag 0 on a channel that reaches the rate through a lag leaves c·(L_T[ch] − ch)
     in the residual. On a 1 Hz × 10⁵ FOG-like record (rate random walk dominating) with the temperature through
     900 s, the lag's test reads 2.27 against 16.5 (it cannot claim the lag), and the removal at lag 0 raised
-    the chain's held-out error 2.13 → 2.76 %; at the profiled 389 s it is 1.56 %, at the true 900 s 0.79 %
+    the chain's held-out error 2.13 → 2.76 %; with the profiled 498 s 1.28 %, at the true 900 s 0.79 %
     (docs/channels.md, "A lag not resolved")."""
     if "lag_s" not in tests or "rate_coefficient" in keys:
         return None
