@@ -464,8 +464,9 @@ def regress_channel(
 
 def _removal_lag(bands, fit, keys, tests, grid, z2) -> float | None:
     """The lag the removal takes when the lag's test did not keep one (and no d(ch)/dt term stands in for it):
-    the profile's best T where it beats no lag by more than the intervals' 2Δℓ (:func:`allanite.model._lag.
-    unresolved_lag`), recorded under ``tests["lag_s"]["profiled"]``; else None (the channel as it is).
+    the profile's best T where it beats no lag by more than the intervals' 2Δℓ
+    (:func:`allanite.model._lag.unresolved_lag`), recorded under ``tests["lag_s"]["profiled"]``; else None (the
+    channel as it is).
 
     Why: a coefficient fitted at lag 0 on a channel that reaches the rate through a lag leaves c·(L_T[ch] − ch)
     in the residual. On a 1 Hz × 10⁵ FOG-like record (rate random walk dominating) with the temperature through
