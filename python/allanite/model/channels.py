@@ -427,10 +427,7 @@ def regress_channel(
     alpha = check_probability(alpha, "alpha")
     level = check_probability(level, "level")
     confidence = check_probability(confidence)
-    terms = (terms,) if isinstance(terms, str) else tuple(terms)
-    bad = [t for t in terms if t not in SUBTERMS]
-    if bad:
-        raise ParameterError(f"unknown channel regression term {bad[0]!r}; allowed: {', '.join(SUBTERMS)}")
+    terms = _check_subterms(terms)
     n_use = wh.usable_length(y.size)
     y, x = y[:n_use], x[:n_use]
     floor, sig = channel_signal(x, fs)
@@ -446,8 +443,7 @@ def regress_channel(
         z2 = float(t_dist.isf((1.0 - confidence) / 2.0, test["dof"])) ** 2
         keys, fit, lag_s, tests = _optional_terms(bands, fit, terms, level, lag_grid(y.size, fs), z2)
         removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, lag_grid(y.size, fs), z2)
-        if lag_s is not None:
-            lag = (lag_s, tests["lag_s"]["interval"])
+        lag = (lag_s, tests["lag_s"]["interval"]) if lag_s is not None else None
         if removal_lag is not None:
             exact = wh.spectra(y, _columns(xs, mean, quad_mean, fs, removal_lag), fs)
             fit = wh.joint_fit(exact, _design(keys, exact.m.size))
@@ -460,6 +456,16 @@ def regress_channel(
     return ChannelRegression(
         name, bool(accepted), params, intervals, test, tests, fs, mean, quad_mean, noise, sig, removal_lag
     )
+
+
+def _check_subterms(terms) -> tuple:
+    """``terms`` as a tuple of names of :data:`SUBTERMS` (one name alone too), or a ParameterError naming the
+    first unknown one."""
+    terms = (terms,) if isinstance(terms, str) else tuple(terms)
+    bad = [t for t in terms if t not in SUBTERMS]
+    if bad:
+        raise ParameterError(f"unknown channel regression term {bad[0]!r}; allowed: {', '.join(SUBTERMS)}")
+    return terms
 
 
 def _removal_lag(bands, fit, keys, tests, grid, z2) -> float | None:
