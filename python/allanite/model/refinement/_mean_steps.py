@@ -61,9 +61,8 @@ MIN_BOOT = 2000
 #: Share of the increments (the smallest in size) their scale is taken from.
 KEEP = 0.75
 #: The SD of a standard normal truncated to its central KEEP (the scale's constant: E[Z²; |Z| < z₀]/KEEP).
-_KEEP_SD = math.sqrt(
-    1.0 - 2.0 * 1.1503493803760079 * math.exp(-(1.1503493803760079**2) / 2) / math.sqrt(2 * math.pi) / KEEP
-)
+_Z0 = 1.1503493803760079  # the normal's (1 + KEEP)/2 quantile
+_KEEP_SD = math.sqrt(1.0 - 2.0 * _Z0 * math.exp(-(_Z0**2) / 2) / math.sqrt(2 * math.pi) / KEEP)
 #: Most steps located (the step-down's rounds stop there).
 MOST_STEPS = 6
 #: Most simulated records (2²² half-block means in all, 32 MB): below α ≈ 1/(MAX_BOOT + 1) the threshold is the
@@ -89,7 +88,7 @@ def increment_z(half: np.ndarray, blocks: tuple[int, ...]) -> tuple[np.ndarray, 
     if g.ndim == 1:
         g = g[:, None]
     zs, incs = [], []
-    for n in sorted(blocks, reverse=True):
+    for _ in blocks:  # finest first
         b = 0.5 * (g[:-1] + g[1:])
         d = b[2:] - b[:-2]
         d = d - np.median(d, axis=0)
