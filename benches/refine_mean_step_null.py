@@ -1,24 +1,29 @@
 #!/usr/bin/env python3
-"""Calibration of the ``"mean"`` check of ``Refinement.unexplained`` (one step of the mean; issue 29, item 4).
+"""Calibration of the ``"mean"`` and ``"steps"`` checks of ``Refinement.unexplained`` (steps of the mean; issue 29).
 
-The check's test alone — the best single split of 48 block means against its null simulated from the model
+``"mean"``: its test alone — the best single split of 48 block means against its null simulated from the model
 refitted without the located step (:mod:`allanite.model.refinement._mean_step`) — on clean records, where
-refitting without a step that is not there lowers K: the place false alarms would hide. The gate that follows it
-in refine (the step must move the Allan deviation by more than the final model's held-out error) is left off,
-so these rates bound the check's from above.
+refitting without a step that is not there lowers K: the place false alarms would hide. ``"steps"``: its test
+alone — the block means' largest increment over their robust scale at three lengths
+(:mod:`allanite.model.refinement._mean_steps`), its null under the final model with its slow terms at the upper
+end. The gate that follows each in refine (the step moving the Allan deviation by more than the final model's
+held-out error) is left off, so these rates bound the checks' from above.
 
 Clean records (a fixed seed each): white noise always, flicker (stationary: Kasdin–Walter over 4× the record,
 its tail) and rate random walk always, their corners placed log-uniformly along the record; a quarter with
 quantisation, a fifth through a 2nd-order Butterworth low-pass at fs/8…fs/40 (the final model then holds its
-bandwidth effect, as refine's would), a tenth with a rate ramp; fs 1, 50, 100, 400 or 1000 Hz, 10⁵, 3·10⁵ or
-10⁶ samples. The final model is the five-term fit of refine's dense curve (300 τ) plus that bandwidth.
+bandwidth effect, as refine's would), a tenth with a rate ramp, a fifth with a Gauss–Markov term (not in the final
+model); fs 1, 50, 100, 400 or 1000 Hz, 10⁵, 3·10⁵ or 10⁶ samples. The final model is the five-term fit of refine's
+dense curve (300 τ) plus that bandwidth.
 
-A p-value is (1 + #{draws ≥ statistic}) / (1 + draws) over :data:`N_BOOT` draws of the refitted null; a rate at
-α is the share of records with p ≤ α, with its 95 % Clopper–Pearson interval.
+A p-value is (1 + #{draws ≥ statistic}) / (1 + draws) over :data:`N_BOOT` draws of the mean check's refitted null
+and 2/α draws of the steps check's; a rate at α is the share of records with p ≤ α, with its 95 % Clopper–Pearson
+interval.
 
-``--power K``: the check's power instead, on K records per cell of blind2's bias-step noise (white 2·10⁻³, flicker
-3·10⁻⁴, random walk 2·10⁻⁶; 50 Hz × 2·10⁵ samples = 4000 s) with a step of d at 0.2 or 0.55 of the record: the
-test alone at its α, and with the gate at a held-out error of 3 % (a typical final model's); the split's error.
+``--power K``: the checks' power instead, on K records per cell of blind2's bias-step noise (white 2·10⁻³, flicker
+3·10⁻⁴, random walk 2·10⁻⁶; 50 Hz × 2·10⁵ samples = 4000 s) with a step of d at 0.2 or 0.55 of the record: each
+test alone at its α, and the mean check with the gate at a held-out error of 3 % (a typical final model's); the
+split's error.
 
 Usage::
 
@@ -220,7 +225,11 @@ def power_task(job: tuple) -> dict:
     loc, _sol, dep = ms.located(ctx)
     thr = ms.mean_step_threshold(POWER_N, POWER_FS, START, loc["theta"], ALPHA)
     rejected = loc["statistic"] > thr
+    theta = upper_theta(ctx.curve, ctx.sol, START, [], theta_terms(ctx.sol, START, []))
+    null = mss.null_ratios(POWER_N, POWER_FS, START, theta, STEPS_ALPHA)
+    steps = mss.step_down(np.asarray(y, dtype=np.float64), null)[1]["statistic"] > null["threshold"]
     return {
+        "steps_rejected": bool(steps),
         "d": d,
         "at": at,
         "rejected": bool(rejected),
@@ -240,7 +249,7 @@ def run_power(per_cell: int, out: Path, processes: int) -> dict:
     report = {"alpha": ALPHA, "per_cell": per_cell, "rows": rows, "seconds": time.perf_counter() - t0}
     report |= {"other_load": load.fraction, "machine": _common.machine_info()}
     lines = [
-        '# The `"mean"` check\'s power on a bias step',
+        '# The `"mean"` and `"steps"` checks\' power on a bias step',
         "",
         f"Written by `benches/refine_mean_step_null.py --power {per_cell}` ({_common.machine_line(report['machine'])}; "
         f"other processes used {100 * (report['other_load'] or 0):.0f} % of the CPUs; {report['seconds']:.0f} s). "
@@ -248,10 +257,11 @@ def run_power(per_cell: int, out: Path, processes: int) -> dict:
         f"2·10⁵ samples (4000 s), a step of d at a share of the record; {per_cell} records per cell (fixed seeds). "
         f"Rejected: the test alone at its α ({ALPHA:g}); said: rejected and the step moving the Allan deviation by "
         "more than 3 % (a typical final model's held-out error); split error: median |located − true| as a share "
-        "of the record, over the rejected records.",
+        "of the record, over the rejected records. `steps` rejected: the several-step check's test alone at its "
+        f"α ({STEPS_ALPHA:g}), its null under the five-term fit with its slow terms at the upper end.",
         "",
-        "| d (°/s) | at | rejected | 95 % CP | said (3 %) | split error (median) |",
-        "|---|---|---|---|---|---|",
+        "| d (°/s) | at | rejected | 95 % CP | said (3 %) | split error (median) | `steps` rejected |",
+        "|---|---|---|---|---|---|---|",
     ]
     for d in POWER_STEPS:
         for at in POWER_AT:
@@ -261,7 +271,10 @@ def run_power(per_cell: int, out: Path, processes: int) -> dict:
             said = sum(r["said_at_3pct"] for r in cell)
             errs = [r["t_error_frac"] for r in cell if r["rejected"]]
             err = f"{100 * float(np.median(errs)):.2f} %" if errs else "—"
-            lines.append(f"| {d:g} | {at:g} | {k} of {len(cell)} | {100 * lo:.0f}–{100 * hi:.0f} % | {said} | {err} |")
+            st = sum(r["steps_rejected"] for r in cell)
+            lines.append(
+                f"| {d:g} | {at:g} | {k} of {len(cell)} | {100 * lo:.0f}–{100 * hi:.0f} % | {said} | {err} | {st} |"
+            )
     out.mkdir(parents=True, exist_ok=True)
     _common.write_results(out, "refine_mean_step_power", lines, report)
     return report
