@@ -185,7 +185,9 @@ def step_down(y: np.ndarray, null: dict) -> tuple[list[tuple[int, float]], dict]
     The first round is the test; later rounds face the same threshold, which holds for every position of the
     record and so for those that remain (a step-down maximum test: removing a found step lowers the robust scale
     that the steps left had shared with it)."""
-    blocks, steps, first = null["blocks"], [], {}
+    blocks = null["blocks"]
+    steps: list[tuple[int, float]] = []
+    first: dict[str, Any] = {}
     comp = np.zeros(y.size)
     while len(steps) < MOST_STEPS:
         z, incs = increment_z(_half_means(y - comp, blocks[-1])[0], blocks)
