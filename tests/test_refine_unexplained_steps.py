@@ -140,3 +140,19 @@ def test_refine_says_the_steps_in_every_surface():
     assert len(got) == 1 and len(got[0]["steps"]) >= 2
     said = re.compile(r"the mean steps by 0\.00\d+ deg/s at t ≈ [23]\d{3}.*; by -0\.00[34]\d* deg/s at t ≈ 7[45]\d\d")
     assert said.search(r.report()) and said.search(html_mod.unescape(r._repr_html_()))
+
+
+def test_degenerate_records_and_models_say_nothing_rather_than_divide_by_zero():
+    # most increments exactly zero (a record stuck between rounding levels): no scale, no evidence
+    stuck = np.zeros(100_000)
+    stuck[::5000] = 1.0
+    z, _ = mss.increment_z(mss._half_means(stuck, 128)[0], mss.STEP_BLOCKS)
+    assert np.all(np.isfinite(z))
+    # a model with nothing at the block rate: the null is drawn as white noise (the statistic is free of scale)
+    null = mss.null_ratios(100_000, FS, ("Q", "N"), [1e-6, 0.0], 0.01)
+    assert np.all(null["q"] > 1.0) and 1.2 < null["threshold"] < 4.0  # at α 1 %: 1.69
+
+
+def test_a_small_level_does_not_simulate_beyond_the_cap():
+    null = mss.null_ratios(100_000, FS, ("N",), [1e-6], alpha("unexplained:steps", 1e-4))
+    assert null["n_boot"] == mss.MAX_BOOT and null["threshold"] == null["draws"][-1]

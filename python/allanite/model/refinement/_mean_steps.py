@@ -93,7 +93,8 @@ def increment_z(half: np.ndarray, blocks: tuple[int, ...]) -> tuple[np.ndarray, 
         d = b[2:] - b[:-2]
         d = d - np.median(d, axis=0)
         s = _scale(d)
-        z = np.abs(d) / np.maximum(s, 1e-300)
+        # no scale (most increments exactly zero: a record stuck between rounding levels): no evidence either way
+        z = np.where(s > 0, np.abs(d) / np.where(s > 0, s, 1.0), 0.0)
         zs.append(np.max(z, axis=0))
         incs.append(z)
         g = 0.5 * (g[0::2] + g[1::2])
@@ -102,7 +103,7 @@ def increment_z(half: np.ndarray, blocks: tuple[int, ...]) -> tuple[np.ndarray, 
 
 def steps_statistic(z: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """max over lengths of ``z_n / q_n`` (``z``: lengths × records) and the length's index where it is reached."""
-    r = np.asarray(z) / np.asarray(q)[:, None]
+    r = np.asarray(z) / np.maximum(np.asarray(q), 1e-300)[:, None]
     j = np.argmax(r, axis=0)
     return r[j, np.arange(r.shape[1])], j
 
@@ -113,6 +114,8 @@ def null_ratios(size: int, fs: float, terms, theta, alpha: float, seed: int = 79
     number of records drawn, the lengths and the statistic's ``draws`` (sorted)."""
     blocks = _blocks(size)
     half = size // (2 * blocks[-1])
+    if not any(float(v) > 0 for t, v in zip(terms, theta) if t in ("N", "B", "K", "R")):
+        terms, theta = ("N",), [1.0]  # nothing at the block rate (a model of lines or a Gauss–Markov term): white
     n_boot = min(MAX_BOOT, max(MIN_BOOT, math.ceil(BOOT_PER_ALPHA / alpha)))
     sims = simulated_block_means(2 * blocks[-1], half, fs, terms, theta, n_boot, seed)
     z, _ = increment_z(sims, blocks)
