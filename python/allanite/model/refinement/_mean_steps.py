@@ -78,7 +78,8 @@ def _blocks(size: int) -> tuple[int, ...]:
 def _scale(d: np.ndarray) -> np.ndarray:
     """The increments' SD (columns) from the :data:`KEEP` smallest in size: a few steps beyond them move it not
     at all, and it scatters far less than a median absolute deviation (its null's tail is lighter)."""
-    a = np.sort(np.abs(d), axis=0)[: max(2, int(KEEP * d.shape[0]))]
+    k = max(2, int(KEEP * d.shape[0]))
+    a = np.partition(np.abs(d), k - 1, axis=0)[:k]
     return np.sqrt(np.mean(a * a, axis=0)) / _KEEP_SD
 
 
