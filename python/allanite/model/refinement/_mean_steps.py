@@ -11,8 +11,8 @@ noise, flicker, random walk or a Gauss–Markov term are Gaussian, and their sca
 
 - For each of :data:`STEP_BLOCKS` block lengths L = T/n: the means of blocks of L at a stride of L/2, their
   increments Δⱼ = B_{j+2} − Bⱼ (adjacent blocks; a step anywhere in the record sits within L/4 of a block
-  boundary, so one increment carries ≥ 3/4 of it), ``z_n`` = max |Δⱼ − med Δ| / (1.4826·MAD Δ) — the median
-  removes a ramp, the MAD is not moved by a few steps.
+  boundary, so one increment carries ≥ 3/4 of it), ``z_n`` = max |Δⱼ − med Δ| / s, s the SD of Δ taken from
+  its :data:`KEEP` smallest in size — the median removes a ramp, and a few steps move the scale not at all.
 - The statistic: the largest ``z_n / q_n`` over the lengths, ``q_n`` the median of ``z_n`` in the null (one
   scale for several lengths, which differ in how many increments they hold).
 - Its null: the statistic of records simulated at the half-block rate under the final model, its slow terms at
@@ -21,9 +21,11 @@ noise, flicker, random walk or a Gauss–Markov term are Gaussian, and their sca
   is nearly pivotal (a ratio of the record's own increments): at 3·10⁵ samples and α 1.6·10⁻⁴ its threshold reads
   2.25 under white noise alone, 2.25 under flicker alone, 2.47 under random walk alone and 2.28 under a mix (each
   length's median within 1.5 %), so the steps a fit has absorbed into K barely move it.
-- The steps: at the length of the largest ratio, every run of increments beyond the threshold is one step, placed
-  where the difference of the means over L after and before it is largest (to L/:data:`FINE`), its size that
-  difference.
+- The steps, step-down: at the length of the largest ratio, every run of increments beyond the threshold is one
+  step, placed where the difference of the means over L after and before it is largest (to L/:data:`FINE`), its
+  size that difference; the steps removed, the statistic again against the same threshold, until it holds.
+  Block means of the samples less the steps are the samples' block means less the steps' (closed form): no
+  record-length array until the steps are said (:func:`_departure`, one copy of the record).
 - Said only where the steps matter: their exact Allan variance (of the located steps together, at the curve's
   τ) must move the model refitted without them beyond the final model's held-out error at some τ (the mean
   check's rule); the entry's τ range is where it does.
@@ -32,6 +34,7 @@ noise, flicker, random walk or a Gauss–Markov term are Gaussian, and their sca
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -132,10 +135,12 @@ def _half_means(y: np.ndarray, n: int) -> tuple[np.ndarray, int]:
     return y[: 2 * n * per].reshape(2 * n, per).mean(axis=1), per
 
 
-def locate_steps(y: np.ndarray, n: int, z: np.ndarray, cut: float) -> list[tuple[int, float]]:
+def locate_steps(
+    y: np.ndarray, n: int, z: np.ndarray, cut: float, found: Sequence[tuple[int, float]] = ()
+) -> list[tuple[int, float]]:
     """(first sample after the step, size) of each run of increments ``z`` (of length T/n at stride L/2) beyond
     ``cut``: placed within ±L/2 of the run's largest increment's block boundary where the mean over L after less
-    the mean over L before is largest in size (on means of L/:data:`FINE`)."""
+    the mean over L before is largest in size (on means of L/:data:`FINE` of ``y`` less the steps ``found``)."""
     hot = np.flatnonzero(z > cut)
     if hot.size == 0:
         return []
@@ -143,7 +148,7 @@ def locate_steps(y: np.ndarray, n: int, z: np.ndarray, cut: float) -> list[tuple
     per = y.size // (2 * n)  # samples per half block
     fper = max(1, 2 * per // FINE)  # samples per fine mean
     nf = y.size // fper
-    fm = np.cumsum(np.r_[0.0, y[: nf * fper].reshape(nf, fper).mean(axis=1)])
+    fm = np.cumsum(np.r_[0.0, y[: nf * fper].reshape(nf, fper).mean(axis=1) - _step_means(found, fper, nf)])
     span = round(2 * per / fper)  # fine means per block of L
     out = []
     for run in runs:
@@ -158,20 +163,27 @@ def locate_steps(y: np.ndarray, n: int, z: np.ndarray, cut: float) -> list[tuple
     return out
 
 
-def _component(size: int, steps: list[tuple[int, float]]) -> np.ndarray:
-    comp = np.zeros(size)
+def _step_means(steps: Sequence[tuple[int, float]], per: int, count: int) -> np.ndarray:
+    """The means of ``count`` consecutive blocks of ``per`` samples of the steps' component (d from sample
+    ``index`` on, summed over the steps): each block holds the share of its samples at or after each index."""
+    edges = np.arange(count, dtype=np.float64)[:, None] * per
+    out = np.zeros(count)
     for index, d in steps:
-        comp[index:] += d
-    return comp
+        out += d * np.clip((edges[:, 0] + per - index) / per, 0.0, 1.0)
+    return out
 
 
 def _departure(ctx: Any, steps: list[tuple[int, float]]) -> np.ndarray:
     """How far (%) the located steps' own Allan variance (together, cross terms included) moves the final model
     refitted without them (refine's fit on the exact curve of the samples less the steps), at each τ."""
     cur = ctx.curve
-    comp = _component(ctx.y.size, steps)
+    comp = np.zeros(ctx.y.size)  # the one record-length array: the steps, then the samples less them
+    for index, d in steps:
+        comp[index:] += d
     s_av = np.asarray(avar(comp, ctx.fs, taus=cur.tau).avar, dtype=np.float64)
-    av = np.asarray(avar(np.asarray(ctx.y, dtype=np.float64) - comp, ctx.fs, taus=cur.tau).avar, dtype=np.float64)
+    np.negative(comp, out=comp)
+    comp += ctx.y
+    av = np.asarray(avar(comp, ctx.fs, taus=cur.tau).avar, dtype=np.float64)
     del comp
     sol = solve(Curve(cur.tau, cur.m, av, cur.fs, cur.n_points, cur.estimator), ctx.start, ctx.effects)
     return 100.0 * (np.sqrt(1.0 + s_av / np.maximum(sol.model, 1e-300)) - 1.0)
@@ -193,9 +205,9 @@ def step_down(y: np.ndarray, null: dict) -> tuple[list[tuple[int, float]], dict]
     blocks = null["blocks"]
     steps: list[tuple[int, float]] = []
     first: dict[str, Any] = {}
-    comp = np.zeros(y.size)
+    half, per = _half_means(y, blocks[-1])
     while len(steps) < MOST_STEPS:
-        z, incs = increment_z(_half_means(y - comp, blocks[-1])[0], blocks)
+        z, incs = increment_z(half - _step_means(steps, per, half.size), blocks)
         stat, j = steps_statistic(z, null["q"])
         if not first:
             first = {"statistic": float(stat[0]), "block": 0}
@@ -205,15 +217,13 @@ def step_down(y: np.ndarray, null: dict) -> tuple[list[tuple[int, float]], dict]
         block = y.size // blocks[i]
         new = [
             (k, d)
-            for k, d in locate_steps(y - comp, blocks[i], incs[i][:, 0], null["threshold"] * float(null["q"][i]))
+            for k, d in locate_steps(y, blocks[i], incs[i][:, 0], null["threshold"] * float(null["q"][i]), steps)
             if all(abs(k - k0) > block for k0, _ in steps)
         ][: MOST_STEPS - len(steps)]
         if not new:
             break
         first["block"] = first["block"] or block
         steps += new
-        for k, d in new:
-            comp[k:] += d
     return sorted(steps), first
 
 
