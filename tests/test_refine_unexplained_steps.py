@@ -156,3 +156,14 @@ def test_degenerate_records_and_models_say_nothing_rather_than_divide_by_zero():
 def test_a_small_level_does_not_simulate_beyond_the_cap():
     null = mss.null_ratios(100_000, FS, ("N",), [1e-6], alpha("unexplained:steps", 1e-4))
     assert null["n_boot"] == mss.MAX_BOOT and null["threshold"] == null["draws"][-1]
+
+
+def test_the_steps_block_means_are_the_component_s_exactly():
+    steps = [(1000, 0.5), (2503, -1.25), (7999, 2.0)]
+    comp = np.zeros(8192)
+    for index, d in steps:
+        comp[index:] += d
+    for per in (1, 64, 100, 512):
+        count = comp.size // per
+        want = comp[: count * per].reshape(count, per).mean(axis=1)
+        assert np.allclose(mss._step_means(steps, per, count), want, rtol=0, atol=1e-13)
