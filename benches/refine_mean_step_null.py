@@ -30,6 +30,7 @@ Usage::
     python benches/refine_mean_step_null.py                  # 300 records -> benches/results/refine_mean_step_null.{json,md}
     python benches/refine_mean_step_null.py --records 40 --out /tmp/x
     python benches/refine_mean_step_null.py --power 15       # -> benches/results/refine_mean_step_power.{json,md}
+    python benches/refine_mean_step_null.py --blind3 6       # -> benches/results/refine_mean_steps_blind3.{json,md}
 """
 
 from __future__ import annotations
@@ -280,14 +281,63 @@ def run_power(per_cell: int, out: Path, processes: int) -> dict:
     return report
 
 
+def blind3_task(seed: int) -> dict:
+    """blind3's bias-steps record (its generator, seeded ``seed``), refined with the default call."""
+    import refine_blind3  # noqa: PLC0415 — only this mode needs the suite
+
+    y, fs, *_ = refine_blind3._bias_steps(np.random.default_rng(seed))
+    r = allanite.refine(y, fs, unit="deg/s", progress=False)
+    said = [u for u in r.unexplained if u["domain"] == "steps"]
+    row: dict = {"seed": seed, "added": [s.effect for s in r.steps], "domains": [u["domain"] for u in r.unexplained]}
+    if said:
+        row |= {k: said[0][k] for k in ("steps", "statistic", "threshold", "what")}
+    return row
+
+
+def run_blind3(records: int, out: Path, processes: int) -> dict:
+    t0 = time.perf_counter()
+    with ProcessPoolExecutor(processes) as pool:
+        rows = list(pool.map(blind3_task, [1001 + k for k in range(records)]))
+    report = {"rows": rows, "seconds": time.perf_counter() - t0, "machine": _common.machine_info()}
+    lines = [
+        '# The `"steps"` check on blind3\'s bias-steps configuration, more records',
+        "",
+        f"Written by `benches/refine_mean_step_null.py --blind3 {records}` ({_common.machine_line(report['machine'])}; "
+        f"{report['seconds']:.0f} s). `benches/refine_blind3.py`'s bias-steps record (its noise N 3·10⁻³, B 3·10⁻⁴, "
+        "K 10⁻⁶ at 20 Hz × 6·10⁵; +2.5, −4, +3·10⁻³ °/s at 6000, 15000, 24000 s) with other "
+        "seeds, default `refine`: what `unexplained` says, the check's statistic over its threshold and the steps it "
+        "located (t s, size °/s).",
+        "",
+        "| seed | added | unexplained | statistic / threshold | steps located |",
+        "|---|---|---|---|---|",
+    ]
+    for r in rows:
+        ratio = f"{r['statistic']:.3g} / {r['threshold']:.3g}" if "statistic" in r else "—"
+        steps = "; ".join(f"{t:.6g} s, {d:.2g}" for t, d in r.get("steps", [])) or "—"
+        lines.append(
+            f"| {r['seed']} | {', '.join(r['added']) or 'nothing'} | {', '.join(r['domains']) or 'none'} | {ratio} "
+            f"| {steps} |"
+        )
+    said = sum("statistic" in r for r in rows)
+    lines += ["", f"Said in {said} of {len(rows)}."]
+    out.mkdir(parents=True, exist_ok=True)
+    _common.write_results(out, "refine_mean_steps_blind3", lines, report)
+    return report
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--records", type=int, default=300)
     ap.add_argument("--processes", type=int, default=1)
     ap.add_argument("--power", type=int, default=0, help="the power table instead, this many records per cell")
+    ap.add_argument("--blind3", type=int, default=0, help="blind3's bias-steps record with this many other seeds")
     ap.add_argument("--out", default=None, help="results folder (default benches/results)")
     args = ap.parse_args(argv)
     out = Path(args.out) if args.out else HERE / "results"
+    if args.blind3:
+        run_blind3(args.blind3, out, args.processes)
+        print((out / "refine_mean_steps_blind3.md").read_text())
+        return
     if args.power:
         run_power(args.power, out, args.processes)
         print((out / "refine_mean_step_power.md").read_text())
