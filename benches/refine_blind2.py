@@ -391,7 +391,8 @@ NOTES: list = [
     'χ²/dof 0.55), and now `unexplained` says the step (the `"mean"` check: the best single split of 48 block '
     "means against a null simulated from the final model refitted without the located step, its slow terms raised "
     "to the upper end the curve allows, at its own share of `level` taken from the drift check's): 0.0033 deg/s "
-    "at t ≈ 11001.9 s (true 3·10⁻³ at 11000 s), statistic 1.62·10⁻³ against 8.7·10⁻⁴, said because the step moves "
+    "at t ≈ 11001.9 s (true 3·10⁻³ at 11000 s), statistic 1.62·10⁻³ against 8.8·10⁻⁴ (8.7·10⁻⁴ before its α "
+    "was halved for the `steps` check), said because the step moves "
     "the Allan deviation by up to 264 % against a held-out error of 2.3 %. The final fit had absorbed the step "
     "into rate random walk (K 2.6·10⁻⁵ against the true 2·10⁻⁶) and a null drawn from that model covered it; the "
     "refit without it gives K 1.65·10⁻⁶ (the null's, raised, 4.3·10⁻⁶). False alarms of the check over 300 clean "

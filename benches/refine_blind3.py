@@ -287,8 +287,10 @@ NOTES: list = [
     "above is the rerun after the Butterworth orders 2–6 joined the bandwidth family (at 21e7e2d): **10 of 12** — the 2 kHz row now "
     "passes; the float32 row's without-candidate entry found 3 regions (2 before); every other row the same. "
     "The six channel rows (`--case temp`) rerun at 2b6cb2a, a lag its test cannot resolve now profiled for the "
-    "removal, the other rows as recorded at 21e7e2d: **11 of 12** — the FOG row passes; the thermistor's "
-    "coefficient −1.3 → −0.8 % (held out 2.35 → 2.33 %); every other channel row the same.",
+    "removal; the thermistor's coefficient −1.3 → −0.8 % (held out 2.35 → 2.33 %), every other channel row the "
+    "same; the bias-steps row rerun alone (`--case steps`, at 4c0e450 with lint-only edits) once the `\"steps\"` "
+    "check of `unexplained` joined; the other rows as recorded at 21e7e2d: **12 of 12** — the FOG row and the "
+    "bias-steps row pass.",
     "",
     "Passed as a user would want: the temperature read once a second, held and quantised to 1/16 °C "
     "(coefficient +0.5 %); the thermistor with 0.2 °C of its own white noise (−0.8 %: the Whittle regression "
@@ -301,7 +303,7 @@ NOTES: list = [
     "6 s clipped at the rail passes as an effect outside the family on what is said (a change point at 1184 s "
     "and the curve departing at τ 7.5–278 s), not because clipping is named.",
     "",
-    "Why three failed at the first run — the first two since fixed, the third a general gap still open:",
+    "Why three failed at the first run — all three since fixed:",
     "",
     "- *2 kHz, 4th-order Butterworth at 400 Hz, mains 50 Hz and harmonics* — at the first run the roll-off was "
     "not in the bandwidth family (single pole, moving average, Bartlett, boxcar, pole + boxcar, 2nd-order "
@@ -327,23 +329,21 @@ NOTES: list = [
     'removal takes the channel through it, reported as not resolved (`evidence["lag"]`): 498 s (153–910 s), '
     "coefficient −3.8 %, χ²/dof 2.50 → 0.76, held out 2.13 → 1.28 %. Over 34 lagged and unlagged records "
     "(`benches/results/refine_channel_lag.md`) the step's held-out error rose on 1 before, on none now.",
-    "- *Bias steps +2.5, −4, +3·10⁻³ °/s at 0.2, 0.5, 0.8 T* (outside the family) — silent: nothing added, "
-    'nothing unexplained. The `"mean"` check tests one split against a null from the model refitted without '
-    "the located step; the other two steps stay in that record, its K is refitted at 2.7·10⁻⁵ (true 10⁻⁶; the "
-    "plain fit's 3.5·10⁻⁵) and the threshold is 5.1·10⁻³ against a statistic of 1.05·10⁻³ (one split's two "
-    "sides mix steps of opposite signs). Tried and not merged: the null refitted without up to 4 steps located "
-    "in turn (their sizes fitted jointly as segment means, each further step kept where it moves the Allan "
-    "deviation beyond the held-out error) and a several-step statistic (each split's jointly fitted step as "
-    "if alone, the largest; the same procedure in the null). It said this record (1.92·10⁻³ against "
-    "9.8·10⁻⁴, the three steps located within 14 s, sizes within 14 %), 6 of 6 seeds of this configuration "
-    "(1.8–2.3× the threshold); blind2's single step unchanged (1.62·10⁻³ against 8.66·10⁻⁴) and "
-    "`benches/refine_sensors.py` 17 of 17 with every row's effects and words the same — but on the 300 clean "
-    "records of `benches/refine_mean_step_null.py` (gate off) it rejected 3 at its α = 3.1·10⁻⁴ (1.00 %, "
-    "Clopper–Pearson 0.21–2.89 %), 8 at 1 % and 29 at 5 % (main: 0, 0, 2): removing steps that are not there "
-    "lowers the refitted K (null K / fit K median 0.90, 5th percentile 0.39; main 1.05, 0.82) more than raising "
-    "the slow terms to their upper end makes up for. What might: a statistic whose null does not hang on K — "
-    "e.g. the block means' largest first differences over their robust scale (steps are a few outlying "
-    "increments, a random walk's are Gaussian) — untried.",
+    "- *Bias steps +2.5, −4, +3·10⁻³ °/s at 0.2, 0.5, 0.8 T* (outside the family) — **said since** (r6steps): "
+    'refine adds nothing (the curve fits, χ²/dof 0.64) and the `"steps"` check of `unexplained` says "the mean '
+    "steps by 0.0025 deg/s at t ≈ 5972.1 s; by -0.0043 deg/s at t ≈ 14988.8 s; and by 0.0027 deg/s at t ≈ "
+    '24005.5 s" (statistic 4.73 against 2.58; the three steps within 28 s, sizes within 10 %). Before, the '
+    '`"mean"` check tested one split against a null from the model refitted without the located step; the other '
+    "two steps stayed in that record, its K refitted at 2.7·10⁻⁵ (true 10⁻⁶) and the threshold was 5.1·10⁻³ "
+    "against a statistic of 1.05·10⁻³ (one split's two sides mix steps of opposite signs); a null refitted "
+    "without several located steps (an experiment) rejected 1.0 % of clean records at its α, removing steps that "
+    'are not there lowering K. The `"steps"` check does not hang on K: the block means\' largest increment over '
+    "their own robust scale (T/32, T/64, T/128; steps are a few outlying increments, flicker's and a random "
+    "walk's are Gaussian), its null simulated under the final model with its slow terms at the upper end, "
+    "steps located step-down. Six more records of this configuration: said in 6 of 6 (1.3–1.7× the threshold), "
+    "the −4·10⁻³ step located in all, the others in 1–3 (each alone is 5–8 of the increments' SDs, the "
+    "threshold ≈ 6.6). On 300 clean records (`benches/results/refine_mean_step_null.md`, gate off): 0 at its α, "
+    "2.0 % at 1 %, 5.7 % at 5 %.",
 ]
 
 

@@ -109,15 +109,15 @@ def test_refine_says_the_step_in_every_surface():
 
 
 def test_a_small_level_does_not_simulate_a_record_beyond_the_cap(monkeypatch):
-    """refine accepts any level in (0, 1); at level 10⁻⁴ the check's α is 6.25·10⁻⁷ and 5/α null records would
-    be 3.8·10⁸ block-rate samples (gigabytes). The draws stop at :data:`MAX_BOOT`; below what they resolve the
+    """refine accepts any level in (0, 1); at level 10⁻⁴ the check's α is 3.1·10⁻⁷ and 5/α null records would
+    be 7.7·10⁸ block-rate samples (gigabytes). The draws stop at :data:`MAX_BOOT`; below what they resolve the
     threshold is their largest statistic (the rank rule's last index)."""
     asked = []
     real = tracing.simulate
 
     def counted(n, *args, **kw):
         asked.append(n)
-        assert n <= 2**20, f"{n} block-rate samples asked for"
+        assert n <= 2**21, f"{n} block-rate samples asked for"
         return real(n, *args, **kw)
 
     monkeypatch.setattr(tracing, "simulate", counted)

@@ -49,15 +49,16 @@ MEAN_BLOCKS = 48
 #: Finer blocks per block for locating the split once the statistic is taken.
 FINE = 32
 #: Simulated records per unit of 1/α for the null's quantile (at least :data:`MIN_BOOT`): a Monte Carlo test's
-#: rank rule holds α for any number of draws, more only sharpen its power; 5/α at the default level keeps the
-#: block-rate record under 2²⁰ samples, where the flicker filter's transform is kept between calls.
+#: rank rule holds α for any number of draws, more only sharpen its power; 5/α at the default level (32 000
+#: records) keeps the block-rate record under 2²¹ samples.
 BOOT_PER_ALPHA = 5
 MIN_BOOT = 2000
-#: Most simulated records (2²⁰ block-rate samples in all, 8 MB): refine accepts any level in (0, 1), and 5/α records
-#: at level 10⁻⁴ (α 6.25·10⁻⁷) would be 3.8·10⁸ samples, gigabytes. From level ≈ 0.037 down (α < 5/MAX_BOOT) fewer
-#: than 5/α are drawn; below α = 1/(MAX_BOOT + 1) (level ≈ 0.0073) the threshold is the largest null statistic,
-#: whose false-alarm probability is 1/(MAX_BOOT + 1) ≈ 4.6·10⁻⁵ rather than α (as the drift check's 1000 draws).
-MAX_BOOT = 2**20 // MEAN_BLOCKS
+#: Most simulated records (2²¹ block-rate samples in all, 16 MB): refine accepts any level in (0, 1), and 5/α
+#: records at level 10⁻⁴ (α 3.1·10⁻⁷) would be 7.7·10⁸ samples, gigabytes. From level ≈ 0.037 down
+#: (α < 5/MAX_BOOT) fewer than 5/α are drawn; below α = 1/(MAX_BOOT + 1) (level ≈ 0.0073) the threshold is the
+#: largest null statistic, whose false-alarm probability is 1/(MAX_BOOT + 1) ≈ 2.3·10⁻⁵ rather than α (as the
+#: drift check's 1000 draws).
+MAX_BOOT = 2**21 // MEAN_BLOCKS
 
 
 def split_statistic(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

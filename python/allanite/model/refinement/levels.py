@@ -42,7 +42,8 @@ TIME_SHARE = 0.075
 OUTLIER_SHARE = 0.05
 
 #: Share of ``level`` spent on saying what the final model still misses (``Refinement.unexplained``), split
-#: between its checks: the Allan curve, lines in the PSD, a drift in time, a step of the mean, the noise level
+#: between its checks: the Allan curve, lines in the PSD, a drift in time, a step of the mean, steps of the mean
+#: at several times, the noise level
 #: along the record, a coupling to a channel left in the samples, impulsive noise left in them
 #: (:data:`allanite.model.refinement.missing.CHECKS`).
 UNEXPLAINED_SHARES = {
@@ -54,15 +55,17 @@ UNEXPLAINED_SHARES = {
     # "mean" (one step of the mean) takes half of "time" (a warm-up drift): both test the record's block means
     # for a deterministic change of the mean, so on a clean record they look at the same wander (flicker, rate
     # random walk) and their false alarms come together — the pair spends what the drift check alone did.
+    # "steps" (steps at several times: outlying increments of the block means) takes half of "mean"'s.
     "time": 0.00625,
-    "mean": 0.00625,
+    "mean": 0.003125,
+    "steps": 0.003125,
     "level": 0.0125,
     "channels": 0.0125,
     "outliers": 0.0125,
 }
 #: The checks that need the samples; on curve-only input their shares go to the ``"fit"`` check (the GLS χ²
 #: of the whole curve, two-sided), so that curve-only input spends the same share on ``unexplained``.
-SAMPLE_CHECKS = ("psd", "time", "mean", "level", "channels", "outliers", "line")
+SAMPLE_CHECKS = ("psd", "time", "mean", "steps", "level", "channels", "outliers", "line")
 
 #: Tests with a share of their own, by name (the Allan-curve test, ``"curve"``, takes the rest).
 SHARES = {

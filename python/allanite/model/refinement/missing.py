@@ -34,6 +34,11 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
 - ``"mean"`` — one step of the mean along the final samples (:mod:`._mean_step`: the best split of its block
   means against a null from the final model refitted without the located step), said where the step moves the
   Allan deviation beyond the final model's held-out error; ``"t"`` the side after the step.
+- ``"steps"`` — steps of the mean at one or several times (:mod:`._mean_steps`: outlying increments of the block
+  means over their robust scale, several block lengths, a step-down; its null simulated under the final model,
+  its slow terms at the upper end, and nearly pivotal — it does not hang on K), said where the located steps
+  together move the Allan deviation beyond the held-out error; ``"steps"`` [(t, size)]. Not repeated where the
+  ``"mean"`` check already said the one step it found.
 - ``"level"`` — the noise level along the final samples (:func:`allanite.model.noise_level.level_test`, between
   the change points refine accepted): an entry with the time region ``"t"`` (lo, hi) s where the level is
   higher, where the change exceeds the final model's held-out error.
@@ -61,6 +66,7 @@ from .. import channels, lines, noise_level, outliers, tracing
 from ..terms import design_matrix
 from ._line_check import line_check
 from ._mean_step import mean_step_check
+from ._mean_steps import steps_check
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
 from .changes import locate
@@ -517,6 +523,7 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "psd": _lines,
     "time": _drift,
     "mean": mean_step_check,
+    "steps": steps_check,
     "level": _level,
     "line": line_check,
     "channels": _channels,
@@ -529,9 +536,16 @@ def unexplained(ctx: MissingContext) -> list[dict]:
     found = {name: check(ctx, alpha(f"unexplained:{name}", ctx.level)) for name, check in CHECKS.items()}
     if found["allan"]:  # the score test's regions and misfit runs already say where the curve departs
         found["fit"] = [r for r in found["fit"] if not any(_overlap(r, q) for q in found["allan"])]
+    if found["mean"]:  # one step already said: the steps check repeats it unless it found others
+        found["steps"] = [r for r in found["steps"] if not _same_step(r, found["mean"][0])]
     out = [reg for regs in found.values() for reg in regs]
     out.sort(key=lambda r: -r["statistic"] / max(r["threshold"], 1e-300))
     return out
+
+
+def _same_step(steps: dict, mean: dict) -> bool:
+    """Whether the ``"steps"`` entry ``steps`` holds only the ``"mean"`` entry's step (within one of its blocks)."""
+    return all(abs(t - mean["t_step"]) <= steps["block_s"] for t, _d in steps["steps"])
 
 
 def _overlap(r: dict, q: dict) -> bool:
