@@ -1,17 +1,23 @@
-"""refine's content memories of round r6cost give the numbers of the computations they stand for, bit for bit.
+"""refine's speed-ups of round r6cost give the numbers of the computations they stand for, bit for bit.
 
 The channel regression's transforms (:mod:`allanite.model._rfft`: a real FFT and a band-limited channel, each
 remembered by its input's content) against fresh ones, and a whole ``refine`` with a temperature channel with
-every memory against one that recomputes everything. No timings here: ``benches/bench_refine_cost.py``.
+every memory against one that recomputes everything; the waveform template's choice of bins with its alternate
+blocks gathered once against the plain gathering per number of bins. No timings here:
+``benches/bench_refine_cost.py``.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+import pytest
 from scipy import fft as sfft
+from scipy import signal
 
 import allanite
-from allanite.model import _rfft, channels
+from allanite.model import _rfft, channels, template
 from allanite.model._recent import Recent, remembering
 
 
@@ -54,3 +60,49 @@ def test_refine_with_a_channel_and_its_memories_equals_recomputing(monkeypatch):
         assert a.before == b.before and a.after == b.after
     assert kept.fit.chi2 == plain.fit.chi2
     assert kept.unexplained == plain.unexplained
+
+
+def _plain_choice(y, fs, f0):
+    """The held-out power and filled bins per number of bins as fit_template chose them before: every part's
+    indices gathered again for each number of bins, the filled bins counted on every sample."""
+    n, nu = y.size, f0 / fs
+    per = n // template.HELDOUT_BLOCKS
+    blocks = [np.arange(j * per, (j + 1) * per) for j in range(template.HELDOUT_BLOCKS)]
+    parts = [
+        tuple(np.concatenate([b for j, b in enumerate(blocks) if (j % 2 == parity) == side]) for side in (True, False))
+        for parity in (0, 1)
+    ]
+    u = np.arange(n, dtype=np.float64) * nu
+    u = (u - np.floor(u)).astype(np.float32)
+    heldout, filled, b = {}, {}, template.MIN_BINS
+    while b <= min(template.MAX_BINS, max(template.MIN_BINS, (n // 2) // template.MIN_PER_BIN)):
+        k = np.minimum((u * b).astype(np.int64), b - 1)
+        num = den = 0.0
+        for held_in, held_out in parts:
+            count = np.bincount(k[held_in], minlength=b).astype(np.float64)
+            total = np.bincount(k[held_in], weights=y[held_in], minlength=b)
+            mean = np.where(count > 0, total / np.maximum(count, 1.0), 0.0)
+            if not (count > 0).all():
+                have = np.flatnonzero(count > 0)
+                mean = np.interp(np.arange(b, dtype=np.float64), have.astype(np.float64), mean[have], period=b)
+            comp = mean[k[held_out]]
+            z = y[held_out] - y[held_out].mean()
+            r = z - (comp - comp.mean())
+            num, den = num + float(r @ r), den + float(z @ z)
+        heldout[b] = num / den if den > 0 else math.inf
+        filled[b] = int(np.count_nonzero(np.bincount(k, minlength=b)))
+        b *= 2
+    return heldout, filled
+
+
+@pytest.mark.parametrize(("n", "fs", "f0"), [(200_003, 400.0, 2.3), (100_000, 100.0, 0.19), (4_000, 100.0, 25.0)])
+def test_template_choice_equals_the_plain_gathering(n, fs, f0):
+    t = np.arange(n) / fs
+    y = 0.05 * signal.sawtooth(2 * np.pi * f0 * t) + np.random.default_rng(1).normal(0.0, 0.01, n)
+    heldout, filled = _plain_choice(y, fs, f0)
+    got = template.fit_template(y, fs, f0)
+    assert got.heldout == heldout  # every number of bins' held-out power, bit for bit
+    u = np.arange(n, dtype=np.float64) * (f0 / fs)
+    sides, tail = template._sides(y, (u - np.floor(u)).astype(np.float32))
+    assert {b: template._heldout_power(sides, tail, b)[1] for b in filled} == filled
+    assert got.bins in heldout and 0.0 < min(heldout.values()) < 1.0  # the waveform predicts held-out samples
