@@ -2,7 +2,8 @@
 
 The channel regression's transforms (:mod:`allanite.model._rfft`: a real FFT and a band-limited channel, each
 remembered by its input's content) against fresh ones, and a whole ``refine`` with a temperature channel with
-every memory against one that recomputes everything; the waveform template's choice of bins with its alternate
+every memory against one that recomputes everything; the outlier replacement and the span a record is white for
+remembered against fresh ones; the waveform template's choice of bins with its alternate
 blocks gathered once against the plain gathering per number of bins. No timings here:
 ``benches/bench_refine_cost.py``.
 """
@@ -17,7 +18,7 @@ from scipy import fft as sfft
 from scipy import signal
 
 import allanite
-from allanite.model import _rfft, channels, template
+from allanite.model import _rfft, channels, outliers, template
 from allanite.model._recent import Recent, remembering
 
 
@@ -106,3 +107,26 @@ def test_template_choice_equals_the_plain_gathering(n, fs, f0):
     sides, tail = template._sides(y, (u - np.floor(u)).astype(np.float32))
     assert {b: template._heldout_power(sides, tail, b)[1] for b in filled} == filled
     assert got.bins in heldout and 0.0 < min(heldout.values()) < 1.0  # the waveform predicts held-out samples
+
+
+def test_remembered_replacement_equals_a_fresh_one(monkeypatch):
+    rng = np.random.default_rng(4)
+    y = rng.standard_normal(60_000) + np.cumsum(rng.standard_normal(60_000)) * 1e-3
+    y[rng.choice(y.size, 40, replace=False)] += 12.0
+    flags = outliers.outlier_test(y, 100.0, 0.01)["flags"]
+    fewer = flags.copy()
+    fewer[np.flatnonzero(flags)[0]] = False
+    fresh = [outliers.replace_outliers(y, f) for f in (flags, fewer)]
+    spans, plain_span = [], outliers._white_span_of
+    monkeypatch.setattr(outliers, "_white_span_of", lambda v: spans.append(v.size) or plain_span(v))
+    with remembering():
+        got = [outliers.replace_outliers(y, f) for f in (flags, fewer)]
+        again = outliers.replace_outliers(y.copy(), flags.copy())  # found by content
+        again[0] += 1.0  # each caller its own array: the remembered samples stay as they were
+        later = outliers.replace_outliers(y, flags)
+    assert spans == [y.size]  # the span once for the record, not once per replacement
+    assert 30 <= flags.sum() <= 60 and not np.array_equal(fresh[0], fresh[1])
+    for g, f in zip(got, fresh):
+        np.testing.assert_array_equal(g, f)
+    np.testing.assert_array_equal(later, fresh[0])
+    assert again[0] == fresh[0][0] + 1.0 and got[0].flags.writeable
