@@ -19,7 +19,7 @@ from ._recent import Recent
 __all__ = ["rfft", "band_limited"]
 
 #: The transforms last computed, by their input's content (16 bytes per input sample with the kept copy).
-_RFFT = Recent(6, 2_100_000)
+_RFFT = Recent(5, 2_100_000)
 #: :func:`band_limited`'s last results, by the channel's content and the bands.
 _LIMITED = Recent(2, 2_100_000)
 
