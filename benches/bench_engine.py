@@ -203,19 +203,8 @@ def case_dynamic(name, title, y, cfg, repeats_fast, allantools, prefix_repeats, 
             f"[{name}] allantools.oadev: {at['mean_per_window_seconds']:.4f} s/window over "
             f"{at['sample_count']} windows -> {at['seconds']:.1f} s extrapolated"
         )
-
-    # The output floor: a fresh array of the result's size written once (page faults included) — what any
-    # implementation pays to hand the surface back, allanite and the twin alike.
-    shape = np.shape(res.avar)
-    fbest, freps, _f = timed(lambda: np.full(shape, 1.0), repeats_fast)
-    log(f"[{name}] output floor (np.full of {np.prod(shape)} values): best {fbest:.4f} s")
     out = {
-        "output_floor": {
-            "what": f"np.full of the result's shape {tuple(int(v) for v in shape)} (fresh pages, written once)",
-            "seconds": fbest,
-            "repeats": freps,
-            "twin_over_floor": pbest / fbest,
-        },
+        "output_floor": output_floor(name, np.shape(res.avar), pbest, repeats_fast),
         "name": name,
         "title": title,
         "params": {
@@ -241,34 +230,50 @@ def case_dynamic(name, title, y, cfg, repeats_fast, allantools, prefix_repeats, 
     del pref
 
     if with_workers:
-        # Interleaved (w1, w2, w1, w2, ...) after one warm-up of each, so that slow drifts of the
-        # machine hit both alike.
-        f1, f2 = run(1), run(2)
-        f1(), f2()
-        r1, r2 = [], []
-        for _ in range(repeats_fast):
-            _b, (t1,), res1 = timed(f1, 1)
-            _b, (t2,), res2 = timed(f2, 1)
-            r1.append(t1)
-            r2.append(t2)
-        b1, b2 = min(r1), min(r2)
-        log(f"[{name}] workers=1 {b1:.4f} s, workers=2 {b2:.4f} s")
-        comps.append(
-            {
-                "baseline": "allanite workers=1 (vs workers=2)",
-                "key": "workers",
-                "seconds": b1,
-                "repeats": r1,
-                "allanite_workers2_seconds": b2,
-                "allanite_workers2_repeats": r2,
-                "extrapolated": False,
-                "ratio": b1 / b2,
-                "max_rel_diff": max_rel_diff(res2.avar, res1.avar),
-                "bit_identical": bit_identical(res1.avar, res2.avar) and bit_identical(res.avar, res1.avar),
-                "n_compared": int(res1.avar.size),
-            }
-        )
+        comps.append(workers_comparison(name, run(1), run(2), res, repeats_fast))
     return out
+
+
+def output_floor(name, shape, pbest, repeats_fast) -> dict:
+    """The output floor: a fresh array of the result's size written once (page faults included) — what any
+    implementation pays to hand the surface back, allanite and the twin alike."""
+    fbest, freps, _f = timed(lambda: np.full(shape, 1.0), repeats_fast)
+    log(f"[{name}] output floor (np.full of {np.prod(shape)} values): best {fbest:.4f} s")
+    return {
+        "what": f"np.full of the result's shape {tuple(int(v) for v in shape)} (fresh pages, written once)",
+        "seconds": fbest,
+        "repeats": freps,
+        "twin_over_floor": pbest / fbest,
+    }
+
+
+def workers_comparison(name, f1, f2, res, repeats_fast) -> dict:
+    """allanite with workers=1 against workers=2: the parallel speed-up, and whether the results are
+    bit-identical (to each other and to the default's ``res``)."""
+    # Interleaved (w1, w2, w1, w2, ...) after one warm-up of each, so that slow drifts of the
+    # machine hit both alike.
+    f1(), f2()
+    r1, r2 = [], []
+    for _ in range(repeats_fast):
+        _b, (t1,), res1 = timed(f1, 1)
+        _b, (t2,), res2 = timed(f2, 1)
+        r1.append(t1)
+        r2.append(t2)
+    b1, b2 = min(r1), min(r2)
+    log(f"[{name}] workers=1 {b1:.4f} s, workers=2 {b2:.4f} s")
+    return {
+        "baseline": "allanite workers=1 (vs workers=2)",
+        "key": "workers",
+        "seconds": b1,
+        "repeats": r1,
+        "allanite_workers2_seconds": b2,
+        "allanite_workers2_repeats": r2,
+        "extrapolated": False,
+        "ratio": b1 / b2,
+        "max_rel_diff": max_rel_diff(res2.avar, res1.avar),
+        "bit_identical": bit_identical(res1.avar, res2.avar) and bit_identical(res.avar, res1.avar),
+        "n_compared": int(res1.avar.size),
+    }
 
 
 def exp_ms(window: int, growth: float) -> np.ndarray:
@@ -442,8 +447,25 @@ def _pct(x) -> str:
 
 
 def write_markdown(report: dict, path: Path) -> None:
-    m = report["machine"]
     cases = report["cases"]
+    lines = _md_table(report) + ["", "## Details", ""]
+    for key in CASES:
+        lines += _md_details(cases[key], cases)
+    lines += _md_machine(report)
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+#: which of a case's targets each comparison is judged by (indices into the case's "targets")
+_TARGETS_FOR = {
+    ("case2", "davar_prefix"): [0],
+    ("case3", "davar_prefix"): [0],
+    ("case4", "allantools_oadev"): [0, 1],
+}
+
+
+def _md_table(report: dict) -> list[str]:
+    """The page's head and the table: per case and comparison, seconds, ratio, target and agreement."""
+    m = report["machine"]
     lines = [
         f"# Engine benchmark ({report['mode']} run)",
         "",
@@ -460,122 +482,139 @@ def write_markdown(report: dict, path: Path) -> None:
         "| case | allanite s | baseline | baseline s | ratio | target | met? | max rel. diff |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    targets_for = {
-        ("case2", "davar_prefix"): [0],
-        ("case3", "davar_prefix"): [0],
-        ("case4", "allantools_oadev"): [0, 1],
-    }
     for key in CASES:
-        c = cases[key]
-        p = c["params"]
-        if "window" in p:
-            label = (
-                f"{key[-1]}. DAVAR N={p['n']:.0e}, window={p['window']:.0e}, hop={p['hop']:g}, "
-                f"{p['n_taus']} τ, {p['n_windows']} windows"
-            )
-        else:
-            label = f"{key[-1]}. static OAVAR N={p['n']:.0e}, {p['n_taus']} τ (growth 1.2)"
-        label = label.replace("e+0", "e")
-        for comp in c["comparisons"]:
-            idx = targets_for.get((key, comp["key"]), [])
-            tg = [c["targets"][i] for i in idx]
-            target = "; ".join(t["target"] for t in tg) or "—"
-            met = None if not tg else all(bool(t["met"]) for t in tg)
-            a_s = c["allanite"]["seconds"]
-            base = comp["baseline"]
-            b_s = _fmt_s(comp["seconds"])
-            if comp.get("extrapolated"):
-                base += f" ({comp['sample_count']} windows sampled)"
-                b_s += " (extrap.)"
-            if comp["key"] == "workers":
-                a_s = comp["allanite_workers2_seconds"]
-                base = "allanite workers=1 → ratio = parallel speed-up of workers=2"
-                target = "bit-identical"
-                met = comp["bit_identical"]
-            lines.append(
-                f"| {label} | {_fmt_s(a_s)} | {base} | {b_s} | {_fmt_ratio(comp['ratio'])} | "
-                f"{target} | {_fmt_met(met)} | {comp['max_rel_diff']:.2g} |"
-            )
-    lines += ["", "## Details", ""]
-    for key in CASES:
-        c = cases[key]
-        lines.append(f"**{c['title']}** — params: " + ", ".join(f"{k}={v}" for k, v in c["params"].items()))
-        lines.append("")
-        lines.append(
-            f"- allanite `{c['allanite']['call']}`: repeats "
-            + ", ".join(f"{t:.4f}" for t in c["allanite"]["repeats"])
-            + " s (after one warm-up call)"
+        lines += _md_case_rows(key, report["cases"][key])
+    return lines
+
+
+def _md_case_rows(key: str, c: dict) -> list[str]:
+    """One case's rows of the table, one per comparison."""
+    p = c["params"]
+    if "window" in p:
+        label = (
+            f"{key[-1]}. DAVAR N={p['n']:.0e}, window={p['window']:.0e}, hop={p['hop']:g}, "
+            f"{p['n_taus']} τ, {p['n_windows']} windows"
         )
-        for comp in c["comparisons"]:
-            if comp["key"] == "workers":
-                lines.append(
-                    "- workers=1: "
-                    + ", ".join(f"{t:.4f}" for t in comp["repeats"])
-                    + " s; workers=2: "
-                    + ", ".join(f"{t:.4f}" for t in comp["allanite_workers2_repeats"])
-                    + f" s; speed-up {comp['ratio']:.2f}×; bit-identical: {comp['bit_identical']}"
-                )
-            elif comp.get("extrapolated"):
-                extra = ""
-                if "davar_prefix_vs_allantools_max_rel_diff" in comp:
-                    extra = (
-                        f"; on the same windows davar_prefix differs from allantools by up to "
-                        f"{comp['davar_prefix_vs_allantools_max_rel_diff']:.2g}"
-                    )
-                lines.append(
-                    f"- {comp['baseline']}: {comp['sample_count']} windows sampled evenly over the record "
-                    f"(indices {comp['sample_windows'][0]} … {comp['sample_windows'][-1]}), "
-                    f"{comp['mean_per_window_seconds'] * 1e3:.3g} ms/window mean → "
-                    f"{comp['seconds']:.4g} s for all windows (extrapolated); "
-                    f"τ match exactly: {comp['taus_match_exactly']}, τ missing: "
-                    f"{comp['taus_missing_from_baseline']}{extra}"
-                )
-            else:
-                lines.append(
-                    f"- {comp['baseline']}: repeats "
-                    + ", ".join(f"{t:.4f}" for t in comp["repeats"])
-                    + f" s; compared {comp['n_compared']} values"
-                    + (
-                        f"; τ match exactly: {comp['taus_match_exactly']}, τ missing: "
-                        f"{comp['taus_missing_from_baseline']}"
-                        if "taus_match_exactly" in comp
-                        else ""
-                    )
-                )
-        if "output_floor" in c and c["output_floor"]["twin_over_floor"] < 100:  # where the output matters
-            f = c["output_floor"]
-            lines.append(
-                f"- output floor: {f['what']}: {f['seconds']:.4f} s — the NumPy twin takes "
-                f"{f['twin_over_floor']:.1f}× this, the largest ratio any implementation that returns the "
-                "surface could reach here"
+    else:
+        label = f"{key[-1]}. static OAVAR N={p['n']:.0e}, {p['n_taus']} τ (growth 1.2)"
+    label = label.replace("e+0", "e")
+    lines = []
+    for comp in c["comparisons"]:
+        idx = _TARGETS_FOR.get((key, comp["key"]), [])
+        tg = [c["targets"][i] for i in idx]
+        target = "; ".join(t["target"] for t in tg) or "—"
+        met = None if not tg else all(bool(t["met"]) for t in tg)
+        a_s = c["allanite"]["seconds"]
+        base = comp["baseline"]
+        b_s = _fmt_s(comp["seconds"])
+        if comp.get("extrapolated"):
+            base += f" ({comp['sample_count']} windows sampled)"
+            b_s += " (extrap.)"
+        if comp["key"] == "workers":
+            a_s = comp["allanite_workers2_seconds"]
+            base = "allanite workers=1 → ratio = parallel speed-up of workers=2"
+            target = "bit-identical"
+            met = comp["bit_identical"]
+        lines.append(
+            f"| {label} | {_fmt_s(a_s)} | {base} | {b_s} | {_fmt_ratio(comp['ratio'])} | "
+            f"{target} | {_fmt_met(met)} | {comp['max_rel_diff']:.2g} |"
+        )
+    return lines
+
+
+def _md_details(c: dict, cases: dict) -> list[str]:
+    """One case's details: allanite's call and repeats, each comparison, the output floor, the cost per sample."""
+    lines = [f"**{c['title']}** — params: " + ", ".join(f"{k}={v}" for k, v in c["params"].items()), ""]
+    lines.append(
+        f"- allanite `{c['allanite']['call']}`: repeats "
+        + ", ".join(f"{t:.4f}" for t in c["allanite"]["repeats"])
+        + " s (after one warm-up call)"
+    )
+    lines += [_md_comparison(comp) for comp in c["comparisons"]]
+    if "output_floor" in c and c["output_floor"]["twin_over_floor"] < 100:  # where the output matters
+        f = c["output_floor"]
+        lines.append(
+            f"- output floor: {f['what']}: {f['seconds']:.4f} s — the NumPy twin takes "
+            f"{f['twin_over_floor']:.1f}× this, the largest ratio any implementation that returns the "
+            "surface could reach here"
+        )
+    lines += _md_per_sample(c, cases.get("case4", {}).get("roofline"))
+    lines.append("")
+    return lines
+
+
+def _md_comparison(comp: dict) -> str:
+    """The detail line of one comparison: its repeats, or its sampled windows and extrapolation."""
+    if comp["key"] == "workers":
+        return (
+            "- workers=1: "
+            + ", ".join(f"{t:.4f}" for t in comp["repeats"])
+            + " s; workers=2: "
+            + ", ".join(f"{t:.4f}" for t in comp["allanite_workers2_repeats"])
+            + f" s; speed-up {comp['ratio']:.2f}×; bit-identical: {comp['bit_identical']}"
+        )
+    if comp.get("extrapolated"):
+        extra = ""
+        if "davar_prefix_vs_allantools_max_rel_diff" in comp:
+            extra = (
+                f"; on the same windows davar_prefix differs from allantools by up to "
+                f"{comp['davar_prefix_vs_allantools_max_rel_diff']:.2g}"
             )
-        roof = cases.get("case4", {}).get("roofline")
-        if "roofline" not in c and roof and "n_windows" in c["params"]:
-            # the DAVAR cases: every τ reads the record's N samples once (their terms), so the same
-            # measure as case 4, against case 4's copy of a 10⁷-sample record (memory, not cache)
-            prm = c["params"]
-            ns = c["allanite"]["seconds"] / (prm["n"] * prm["n_taus"]) * 1e9
-            lines.append(
-                f"- per sample and τ: {ns:.3f} ns on the default workers = {ns / roof['ns_per_sample']:.2f} copies "
-                f"of the record ({roof['what']}, {roof['ns_per_sample']:.3f} ns/sample, measured in case 4); "
-                f"{c['allanite']['seconds'] / (prm['n_taus'] * prm['n_windows']) * 1e9:.2f} ns per output value"
-            )
-        if "roofline" in c:
-            a, r = c["allanite"], c["roofline"]
-            lines.append(
-                f"- per sample and τ: {a['ns_per_sample_per_tau']:.3f} ns (default workers), "
-                f"{a['workers1_ns_per_sample_per_tau']:.3f} ns with workers=1 (repeats "
-                + ", ".join(f"{t:.4f}" for t in a["workers1_repeats"])
-                + f" s; bit-identical to the default: {a['bit_identical_workers1']}); roofline in the same run: "
-                f"{r['what']} {r['ns_per_sample']:.3f} ns/sample ({r['gb_per_s']:.1f} GB/s) — each τ costs "
-                f"{a['workers1_ns_per_sample_per_tau'] / r['ns_per_sample']:.2f} copies of the record on one worker"
-            )
-            lines.append(
-                f"- every value against an extended-precision (np.longdouble) recomputation: max rel. diff "
-                f"{a['max_rel_diff_longdouble']:.2g}"
-            )
-        lines.append("")
-    lines += [
+        return (
+            f"- {comp['baseline']}: {comp['sample_count']} windows sampled evenly over the record "
+            f"(indices {comp['sample_windows'][0]} … {comp['sample_windows'][-1]}), "
+            f"{comp['mean_per_window_seconds'] * 1e3:.3g} ms/window mean → "
+            f"{comp['seconds']:.4g} s for all windows (extrapolated); "
+            f"τ match exactly: {comp['taus_match_exactly']}, τ missing: "
+            f"{comp['taus_missing_from_baseline']}{extra}"
+        )
+    return (
+        f"- {comp['baseline']}: repeats "
+        + ", ".join(f"{t:.4f}" for t in comp["repeats"])
+        + f" s; compared {comp['n_compared']} values"
+        + (
+            f"; τ match exactly: {comp['taus_match_exactly']}, τ missing: {comp['taus_missing_from_baseline']}"
+            if "taus_match_exactly" in comp
+            else ""
+        )
+    )
+
+
+def _md_per_sample(c: dict, roof: dict | None) -> list[str]:
+    """The cost per sample and τ: of a DAVAR case against case 4's roofline, or case 4's own with its roofline."""
+    lines = []
+    if "roofline" not in c and roof and "n_windows" in c["params"]:
+        # the DAVAR cases: every τ reads the record's N samples once (their terms), so the same
+        # measure as case 4, against case 4's copy of a 10⁷-sample record (memory, not cache)
+        prm = c["params"]
+        ns = c["allanite"]["seconds"] / (prm["n"] * prm["n_taus"]) * 1e9
+        lines.append(
+            f"- per sample and τ: {ns:.3f} ns on the default workers = {ns / roof['ns_per_sample']:.2f} copies "
+            f"of the record ({roof['what']}, {roof['ns_per_sample']:.3f} ns/sample, measured in case 4); "
+            f"{c['allanite']['seconds'] / (prm['n_taus'] * prm['n_windows']) * 1e9:.2f} ns per output value"
+        )
+    if "roofline" in c:
+        a, r = c["allanite"], c["roofline"]
+        lines.append(
+            f"- per sample and τ: {a['ns_per_sample_per_tau']:.3f} ns (default workers), "
+            f"{a['workers1_ns_per_sample_per_tau']:.3f} ns with workers=1 (repeats "
+            + ", ".join(f"{t:.4f}" for t in a["workers1_repeats"])
+            + f" s; bit-identical to the default: {a['bit_identical_workers1']}); roofline in the same run: "
+            f"{r['what']} {r['ns_per_sample']:.3f} ns/sample ({r['gb_per_s']:.1f} GB/s) — each τ costs "
+            f"{a['workers1_ns_per_sample_per_tau'] / r['ns_per_sample']:.2f} copies of the record on one worker"
+        )
+        lines.append(
+            f"- every value against an extended-precision (np.longdouble) recomputation: max rel. diff "
+            f"{a['max_rel_diff_longdouble']:.2g}"
+        )
+    return lines
+
+
+def _md_machine(report: dict) -> list[str]:
+    """The machine, its load during each case, and how the timings were taken."""
+    m = report["machine"]
+    cases = report["cases"]
+    lines = [
         "## Machine",
         "",
         f"- CPU: {m['cpu_model']}, {m['cpu_count']} logical CPUs ({m['cpus_usable']} usable)",
@@ -599,7 +638,7 @@ def write_markdown(report: dict, path: Path) -> None:
             "_Quick mode: sizes are far smaller than the targets refer to; a correctness smoke test, "
             "not a timing check._",
         ]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return lines
 
 
 def run(quick: bool = False, out: Path | None = None, wait: float = 0.0) -> dict:
@@ -621,6 +660,41 @@ def run(quick: bool = False, out: Path | None = None, wait: float = 0.0) -> dict
     machine["idle_check"] = idle
     n_max = max(cfg[k]["n"] for k in CASES)
     y = np.random.default_rng(SEED).standard_normal(n_max)
+    rf = cfg["repeats_fast"]
+    cases = run_cases(y, cfg, allantools, quick, wait)
+    evaluate_targets(cases)
+    machine["loadavg_end"] = list(os.getloadavg()) if hasattr(os, "getloadavg") else None
+    report = {
+        "benchmark": "engine",
+        "mode": mode,
+        "machine": machine,
+        "data": {
+            "kind": "white noise, standard normal",
+            "seed": SEED,
+            "generator": "numpy.random.default_rng",
+            "fs": FS,
+            "n_generated": n_max,
+        },
+        "repeats_fast": rf,
+        "timing": "time.perf_counter; allanite: warm-up + best of repeats_fast; davar_prefix: best of repeats_fast "
+        "(case 1) or 1 (case 2, full mode); allantools: 1 run (per sampled window, extrapolated)",
+        "targets": TARGETS,
+        "cases": cases,
+        "total_seconds": time.perf_counter() - t_start,
+    }
+    (out / "engine.json").write_text(json.dumps(report, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+    write_markdown(report, out / "engine.md")
+    log("")
+    log((out / "engine.md").read_text(encoding="utf-8"))
+    log(f"wrote {out / 'engine.json'} and {out / 'engine.md'} ({report['total_seconds']:.1f} s)")
+    if not quick and out.resolve() == (HERE / "results").resolve():
+        write_speed_table(report, REPO / "docs" / "performance.md")
+        log(f"rewrote the speed table in {REPO / 'docs' / 'performance.md'}")
+    return report
+
+
+def run_cases(y, cfg, allantools, quick: bool, wait: float) -> dict:
+    """The four cases, each with the other processes' CPU share while it ran (and its idle wait)."""
     rf = cfg["repeats_fast"]
     cases = {}
     loads = {}
@@ -661,35 +735,7 @@ def run(quick: bool = False, out: Path | None = None, wait: float = 0.0) -> dict
             cases[key]["idle_wait"] = waits[key]
         if frac is not None and frac > 0.05:
             log(f"warning: other processes used {frac:.0%} of the CPUs during {key}; its timings are suspect")
-    evaluate_targets(cases)
-    machine["loadavg_end"] = list(os.getloadavg()) if hasattr(os, "getloadavg") else None
-    report = {
-        "benchmark": "engine",
-        "mode": mode,
-        "machine": machine,
-        "data": {
-            "kind": "white noise, standard normal",
-            "seed": SEED,
-            "generator": "numpy.random.default_rng",
-            "fs": FS,
-            "n_generated": n_max,
-        },
-        "repeats_fast": rf,
-        "timing": "time.perf_counter; allanite: warm-up + best of repeats_fast; davar_prefix: best of repeats_fast "
-        "(case 1) or 1 (case 2, full mode); allantools: 1 run (per sampled window, extrapolated)",
-        "targets": TARGETS,
-        "cases": cases,
-        "total_seconds": time.perf_counter() - t_start,
-    }
-    (out / "engine.json").write_text(json.dumps(report, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
-    write_markdown(report, out / "engine.md")
-    log("")
-    log((out / "engine.md").read_text(encoding="utf-8"))
-    log(f"wrote {out / 'engine.json'} and {out / 'engine.md'} ({report['total_seconds']:.1f} s)")
-    if not quick and out.resolve() == (HERE / "results").resolve():
-        write_speed_table(report, REPO / "docs" / "performance.md")
-        log(f"rewrote the speed table in {REPO / 'docs' / 'performance.md'}")
-    return report
+    return cases
 
 
 def write_speed_table(report: dict, page: Path) -> None:

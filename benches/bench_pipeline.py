@@ -552,9 +552,22 @@ def write_md(res: dict, path: Path) -> None:
     L.append(
         f"Load at start: {res['load_start']}; at end: {res['load_end']}. Baseline: {res['baseline'] or 'none given'}.\n"
     )
-    rep = r["report"]
     L.append("| row | before | after | ratio | same run's reference |")
     L.append("|---|---|---|---|---|")
+    L += _md_report_rows(r["report"])
+    L += [_md_fit_adis(r["fit_adis"]), _md_combine(r["combine"]), _md_fit_many(r["fit_many"]), _md_hop1(r["hop1"])]
+    if r.get("refine"):
+        L.append(_md_refine(r["refine"]))
+    if r.get("scale"):
+        L.append(_md_scale(r["scale"]))
+    L.append(_md_import(r["import"]))
+    L += _md_notes(res)
+    path.write_text("\n".join(L) + "\n", encoding="utf-8")
+
+
+def _md_report_rows(rep: dict) -> list[str]:
+    """The ADIS report's rows: its wall and CPU time, its figures in one and two processes, against a baseline."""
+    L = []
     b = rep.get("before", {}).get("best_s")
     bc = rep.get("before", {}).get("cpu_s")
     a, ac = rep["after"]["best_s"], rep["after"]["cpu_s"]
@@ -580,12 +593,17 @@ def write_md(res: dict, path: Path) -> None:
             + f" | {fcpu:.2f} s ({rep['figures']} figures: per-axis figures merged, fewer artists) | {fb / fcpu:.2f}× "
             "| the same report, this run |"
         )
-    f = r["fit_adis"]
-    L.append(
+    return L
+
+
+def _md_fit_adis(f: dict) -> str:
+    return (
         f"| {f['call']} | per-window {f['per_window_ref_total_s']:.2f} s ({f['per_window_ref_us']:.0f} µs/window) | "
         f"{f['batched_s']:.3f} s ({f['batched_us_per_window']:.1f} µs/window; CPU {f['batched_cpu_us_per_window']:.1f} µs) | {f['ratio']:.0f}× | |"
     )
-    c = r["combine"]
+
+
+def _md_combine(c: dict) -> str:
     bl = (
         (
             f"baseline {c['baseline_s']:.1f} s on {c['baseline_samples']:,} samples = {c['baseline_us_per_window']:.0f} µs/window; "
@@ -594,65 +612,77 @@ def write_md(res: dict, path: Path) -> None:
         if "baseline_s" in c
         else "no baseline run"
     )
-    L.append(
+    return (
         f"| {c['call']} | per-window fits alone ≈ {c['per_window_fits_estimate_s']:.1f} s | {c['after_s']:.2f} s "
         f"(CPU {c['after_cpu_s']:.2f} s) | "
         f"{c['ratio_vs_per_window_fits']:.0f}× | {bl} |"
     )
-    g = r["fit_many"]
-    L.append(
+
+
+def _md_fit_many(g: dict) -> str:
+    return (
         f"| {g['call']} | per-window ≈ {g['per_window_ref_total_s']:.1f} s ({g['per_window_ref_us']:.0f} µs/window) | "
         f"{g['batched_s']:.2f} s ({g['batched_us_per_window']:.1f} µs/window; CPU {g['batched_cpu_us_per_window']:.1f} µs) | "
         f"{g['ratio']:.0f}× (CPU {g['cpu_ratio']:.0f}×) | per-window CPU {g['per_window_ref_cpu_us']:.0f} µs; davar {g['davar_s']:.2f} s |"
     )
-    h = r["hop1"]
-    L.append(
+
+
+def _md_hop1(h: dict) -> str:
+    return (
         f"| hop-1 `--window 500000 --hop 1` | 593 s, 4.4 GB, 376 MB JSON (issue; not rerun) | {h['answer']} in "
         f"{h['wall_s']:.1f} s, peak RSS {h['peak_rss_mb']:.0f} MB"
         + (f", summary.json {h['summary_json_mb']:.2f} MB" if h["summary_json_mb"] is not None else "")
         + f" | {593 / h['wall_s']:.0f}× | files: {', '.join(h['files'])} |"
     )
-    rf = r.get("refine")
-    if rf:
-        L.append(
-            f"| ADIS report `--refine` (fresh process) | without: {rf['plain']['wall_s']:.2f} s (CPU "
-            f"{rf['plain']['cpu_s']:.2f} s) | {rf['refine']['wall_s']:.2f} s (CPU {rf['refine']['cpu_s']:.2f} s) | "
-            f"beyond the refine calls: {rf['beyond_refine_wall_s']:.2f} s (CPU {rf['beyond_refine_cpu_s']:.2f} s); "
-            f"beyond them and the plain report: {_beyond_both(rf)} | "
-            f"the refine calls alone {rf['refine_calls_wall_s']:.2f} s (CPU {rf['refine_calls_cpu_s']:.2f} s) |"
+
+
+def _md_refine(rf: dict) -> str:
+    return (
+        f"| ADIS report `--refine` (fresh process) | without: {rf['plain']['wall_s']:.2f} s (CPU "
+        f"{rf['plain']['cpu_s']:.2f} s) | {rf['refine']['wall_s']:.2f} s (CPU {rf['refine']['cpu_s']:.2f} s) | "
+        f"beyond the refine calls: {rf['beyond_refine_wall_s']:.2f} s (CPU {rf['beyond_refine_cpu_s']:.2f} s); "
+        f"beyond them and the plain report: {_beyond_both(rf)} | "
+        f"the refine calls alone {rf['refine_calls_wall_s']:.2f} s (CPU {rf['refine_calls_cpu_s']:.2f} s) |"
+    )
+
+
+def _md_scale(sc: dict) -> str:
+    return (
+        f"| scale: `allanite report` of a {sc['samples']:.0e} × {sc['axes']} float64 .npy ({sc['file_gb']:.1f} GB, "
+        f"memory-mapped) | "
+        + (
+            f"same run, the baseline: {sb['wall_s']:.0f} s (CPU {sb['cpu_s']:.0f} s), peak RSS "
+            f"{sb['peak_rss_mb']:.0f} MB — CPU {sb['cpu_s'] / max(sc['cpu_s'], 1e-9):.2f}× the report's | "
+            if (sb := sc.get("before"))
+            else "before the chunked-phase core (27f2226, load 19): 779 s (CPU 152 s), peak RSS 2578 MB; "
+            "before the by-axis report: every axis copied at once (10⁷ × 3: peak RSS 997 MB) | "
         )
-    sc = r.get("scale")
-    if sc:
-        L.append(
-            f"| scale: `allanite report` of a {sc['samples']:.0e} × {sc['axes']} float64 .npy ({sc['file_gb']:.1f} GB, "
-            f"memory-mapped) | "
-            + (
-                f"same run, the baseline: {sb['wall_s']:.0f} s (CPU {sb['cpu_s']:.0f} s), peak RSS "
-                f"{sb['peak_rss_mb']:.0f} MB — CPU {sb['cpu_s'] / max(sc['cpu_s'], 1e-9):.2f}× the report's | "
-                if (sb := sc.get("before"))
-                else "before the chunked-phase core (27f2226, load 19): 779 s (CPU 152 s), peak RSS 2578 MB; "
-                "before the by-axis report: every axis copied at once (10⁷ × 3: peak RSS 997 MB) | "
-            )
-            + f"{'done' if sc['status'] == 0 else sc['status']} in {sc['wall_s']:.0f} s (CPU {sc['cpu_s']:.0f} s), "
-            f"peak RSS {sc['peak_rss_mb']:.0f} MB | target ≤ 60 s, RSS ≤ {sc['target_rss_mb']:.0f} MB; "
-            + (
-                f"same run, one read of the file: {sc['read_once_wall_s']:.1f} s (CPU {sc['read_once_cpu_s']:.1f} s) — "
-                f"the report {sc['cpu_s'] / max(sc['read_once_cpu_s'], 1e-9):.0f}× its CPU | "
-                if "read_once_cpu_s" in sc
-                else "| "
-            )
-            + f"axis by axis: {sc['by_axis']}; the report's estimate {sc['memory_estimate_mb']:.0f} MB |"
+        + f"{'done' if sc['status'] == 0 else sc['status']} in {sc['wall_s']:.0f} s (CPU {sc['cpu_s']:.0f} s), "
+        f"peak RSS {sc['peak_rss_mb']:.0f} MB | target ≤ 60 s, RSS ≤ {sc['target_rss_mb']:.0f} MB; "
+        + (
+            f"same run, one read of the file: {sc['read_once_wall_s']:.1f} s (CPU {sc['read_once_cpu_s']:.1f} s) — "
+            f"the report {sc['cpu_s'] / max(sc['read_once_cpu_s'], 1e-9):.0f}× its CPU | "
+            if "read_once_cpu_s" in sc
+            else "| "
         )
-    im = r["import"]
+        + f"axis by axis: {sc['by_axis']}; the report's estimate {sc['memory_estimate_mb']:.0f} MB |"
+    )
+
+
+def _md_import(im: dict) -> str:
     ib = im.get("before", {}).get("median_s")
     heavy_b = ", ".join(im.get("before", {}).get("heavy_modules_imported", []))
     heavy_a = ", ".join(im["after"]["heavy_modules_imported"]) or "no scipy/matplotlib"
     ratio = im.get("ratio")
-    L.append(
+    return (
         f"| `import allanite` (median) | {f'{ib:.2f} s ({heavy_b})' if ib else '— (no baseline run)'} | "
         f"{im['after']['median_s']:.2f} s ({heavy_a}) | {f'{ratio:.2f}×' if ratio else '—'} | |"
     )
-    L.append("")
+
+
+def _md_notes(res: dict) -> list[str]:
+    """Below the table: how the times were taken, the rows measured in other runs, what is measured elsewhere."""
+    L = [""]
     L.append(
         "Wall times are the best of the repeats on a machine shared with other workers (its load above); CPU "
         "times (this process's, and a report's figure process's) are less sensitive to that load. "
@@ -677,7 +707,7 @@ def write_md(res: dict, path: Path) -> None:
         "Not measured here (issue 30 item 5): DAVAR's hop-1 case against its write floor — "
         "benches/bench_davar_floor.py, results in davar_floor.md (case 1's old target in engine.md is retired)."
     )
-    path.write_text("\n".join(L) + "\n", encoding="utf-8")
+    return L
 
 
 ROWS = ("import", "report", "refine", "fit_adis", "combine", "hop1", "scale")

@@ -783,6 +783,10 @@ def _ci(c, key="ieee_ci", digits=3):
     return f"[{_fmt(c[key][0], digits)}, {_fmt(c[key][1], digits)}]"
 
 
+#: the issue's targets for the median |relative error| of a recovery set's fit, per term
+RECOVERY_TARGETS = {"Q": 0.03, "N": 0.02, "B": 0.10, "K": 0.15}
+
+
 def write_markdown(rep: dict, path: Path) -> None:
     L = []
     w = L.append
@@ -796,224 +800,256 @@ def write_markdown(rep: dict, path: Path) -> None:
         f"docstring and `docs/noise-model.md`."
     )
     w("")
-    targets = {"Q": 0.03, "N": 0.02, "B": 0.10, "K": 0.15}
     for set_name, rec in rep.get("recovery", {}).items():
-        s = rec["summary"]
-        terms = rec["terms"]
-        truth = rec["truth"]
-        w(
-            f"## 1{set_name.lower()}. Recovery, set {set_name}: "
-            + ", ".join(f"{t} = {truth[t]:g}" for t in terms)
-            + f" (°/s base units); {s['n_seeds']} seeds, {rec['n_samples']:.0e} samples at {rec['fs']:g} Hz"
-        )
-        w("")
-        w(f"Dominant ranges: {rec['ranges']}. Median |relative error| (median signed error in brackets):")
-        w("")
-        w("| estimator | " + " | ".join(terms) + " |")
-        w("|---|" + "---|" * len(terms))
-        for est in ESTIMATORS:
-            e = s[est]
-            w(
-                f"| {EST_LABEL[est]} | "
-                + " | ".join(
-                    f"{_pct(e['median_abs_rel_error'][t])} ({100 * e['median_rel_error'][t]:+.1f} %)" for t in terms
-                )
-                + " |"
-            )
-        b = s["allanite"]["median_abs_rel_error_bootstrap95"]
-        bp = s["peer"]["median_abs_rel_error_bootstrap95"]
-        w(
-            "| allanite, 95 % bootstrap range of the median | "
-            + " | ".join(f"{_pct(b[t][0])}–{_pct(b[t][1])}" for t in terms)
-            + " |"
-        )
-        w(
-            "| peer (as shipped), 95 % bootstrap range | "
-            + " | ".join(f"{_pct(bp[t][0])}–{_pct(bp[t][1])}" for t in terms)
-            + " |"
-        )
-        bm = s.get("bound_median_abs_rel_error", {})
-        if bm:
-            w(
-                "| information bound (≈ median error of an efficient unbiased estimator) | "
-                + " | ".join(_pct(bm.get(t)) for t in terms)
-                + " |"
-            )
-        w("| issue target (median) | " + " | ".join(_pct(targets[t]) if t in targets else "—" for t in terms) + " |")
-        w("")
-        if bm:
-            w(
-                "RMS relative error over seeds / the bound's relative SD (1 = as precise as the record allows for "
-                "an unbiased estimator; the RMS counts bias as well as scatter):"
-            )
-            w("")
-            w("| estimator | " + " | ".join(t for t in terms if t in bm) + " |")
-            w("|---|" + "---|" * len(bm))
-            for est in ESTIMATORS:
-                w(
-                    f"| {EST_LABEL[est]} | "
-                    + " | ".join(_fmt(s["rms_over_bound"][est][t], 3) for t in terms if t in bm)
-                    + " |"
-                )
-            w("")
-        verdict = []
-        for t in terms:
-            a = s["allanite"]["median_abs_rel_error"][t]
-            ok_target = a <= targets[t] if t in targets else None
-            if ok_target is False and bm.get(t, 0) > targets[t]:
-                ok_target = "beyond"
-            cmp_peer = [_paired(rec["rows"], rec["truth"], t, other) for other in ("peer", "peer_octave")]
-            cmp_slope = _paired(rec["rows"], rec["truth"], t, "slope")
-            tgt_txt = (
-                "no target"
-                if ok_target is None
-                else f"target **not met** — and not reachable: the record's information bound is {_pct(bm[t])}"
-                if ok_target == "beyond"
-                else "target met"
-                if ok_target
-                else "target **not met**"
-            )
-            verdict.append(
-                f"{t}: {tgt_txt}; against the peer as shipped / on our curve: {cmp_peer[0]} / "
-                f"{cmp_peer[1]}; against the slope read-off: {cmp_slope}"
-            )
-        w(
-            "Verdict (allanite.fit with the set's terms; comparisons are paired over the same seeds — 'better' or "
-            "'worse' only when the 95 % bootstrap interval of the difference of median |error| excludes zero): "
-            + "; ".join(verdict)
-            + "."
-        )
-        w("")
-        lo, hi = s["coverage_expected_range_95"]
-        w(
-            f"Coverage of allanite's 68.3 % intervals (share of seeds whose interval holds the truth; with "
-            f"{s['n_seeds']} seeds a correct 68.3 % interval gives {lo:.0%}–{hi:.0%} in 95 % of benchmark runs), "
-            f"and SD of the estimates / median reported standard error (1 = calibrated, > 1 = intervals too narrow):"
-        )
-        w("")
-        w("| | " + " | ".join(terms) + " |")
-        w("|---|" + "---|" * len(terms))
-        w("| coverage, set's terms | " + " | ".join(_pct(s["coverage_68"][t]) for t in terms) + " |")
-        w("| coverage, all five terms | " + " | ".join(_pct(s["coverage_68_5terms"][t]) for t in terms) + " |")
-        w("| SD / reported SE | " + " | ".join(_fmt(s["sd_over_reported_se"][t], 3) for t in terms) + " |")
-        w("")
-        unc = s.get("time_allanite_uncached_s")
-        unc_txt = f", {1e3 * unc:.0f} ms for the first fit on a grid (covariance blocks computed)" if unc else ""
-        cc = s.get("covariance_check")
-        if cc:
-            sdr = np.array(cc["sd_ratio_mc_over_model"])
-            dc = np.abs(np.array(cc["octave_corr_mc"]) - np.array(cc["octave_corr_model"]))
-            w(
-                f"The covariance the fit uses, against the scatter of the {cc['n_records']} octave curves: SD over "
-                f"the seeds / model SD {sdr.min():.2f}–{sdr.max():.2f} (median {np.median(sdr):.2f}) across the "
-                f"{sdr.size} τ; correlation one octave apart, seeds vs model: median difference {np.median(dc):.3f}, "
-                f"largest {dc.max():.3f} (sampling error of a correlation from {cc['n_records']} records ≈ "
-                f"{1 / math.sqrt(cc['n_records']):.2f})."
-            )
-            w("")
-        w(
-            f"Median χ²/dof {s['median_chi2_dof']:.2f}; median fit time {1e3 * s['median_time_allanite_s']:.0f} ms "
-            f"(allanite.fit on the octave curve{unc_txt}) vs {1e3 * s['median_time_peer_s']:.0f} ms (allan-variance's "
-            f"compute_avar + estimate_parameters, {rec['rows'][0]['peer_tau_range'][2]} τ from "
-            f"{rec['rows'][0]['peer_tau_range'][0]:g} to {rec['rows'][0]['peer_tau_range'][1]:g} s)."
-        )
-        w("")
+        _write_recovery(w, set_name, rec)
     t2 = rep.get("table2")
     if t2:
-        w(
-            f"## 2. Paper 000 Table 2: exponential vs full linear τ grid ({len(t2['rows'])} seeds, "
-            f"{t2['n_samples']:.0e} samples at {t2['fs']:g} Hz, m ≤ N/9 = {t2['m_max']})"
-        )
-        w("")
-        w(
-            "Truth "
-            + ", ".join(f"{k} = {v:g}" for k, v in t2["truth"].items())
-            + f". Linear grid: every m = 1…{t2['m_max']} ({t2['rows'][0]['n_tau_all']} τ); exponential grid "
-            f'`"exp"` ({t2["rows"][0]["n_tau_exp"]} τ). "Mutually inside": share of seeds where each grid\'s value '
-            f"lies in the other's 68.3 % interval; \"diff/half-width\": |difference| over the exp grid's interval half-width."
-        )
-        w("")
-        w("| comparison | " + " | ".join(t2["truth"]) + " |")
-        w("|---|" + "---|" * len(t2["truth"]))
-        for pair, s in t2["agreement"].items():
-            w(
-                f"| {pair.replace('_vs_', ' vs ')}: mutually inside | "
-                + " | ".join(_pct(s[t]["mutually_inside"]) for t in t2["truth"])
-                + " |"
-            )
-            w(
-                f"| {pair.replace('_vs_', ' vs ')}: median (max) diff/half-width | "
-                + " | ".join(
-                    f"{s[t]['median_diff_over_halfwidth']:.2f} ({s[t]['max_diff_over_halfwidth']:.2f})"
-                    for t in t2["truth"]
-                )
-                + " |"
-            )
-        for label in ("all_thin", "exp_thin", "exp_full"):
-            e = t2["median_abs_rel_error"][label]
-            c = t2["median_abs_rel_error"][label + "_coverage"]
-            w(
-                f"| {label}: median abs. error vs truth (coverage) | "
-                + " | ".join(f"{_pct(e[t])} ({_pct(c[t])})" for t in t2["truth"])
-                + " |"
-            )
-        w("")
-        w(
-            "`*_thin`: the default fit (τ at least an octave apart, so the linear grid reduces to m = 1, 2, 4, …); "
-            "`exp_full`: `thin=False`, every τ of the exp grid in the generalized least-squares fit with their full "
-            "covariance. The full linear grid cannot be fitted that way (its covariance would need ~5.5 million τ "
-            f"pairs; `fit` allows at most {MAX_GLS_TAU} τ with thin=False and says so)."
-        )
-        w("")
-        w(
-            "Reading: the two grids give the same coefficients well inside their intervals — paper 000's point "
-            "holds — and so does the exp grid fitted on all its τ at once: with the estimates' covariance in the fit, "
-            "dense correlated τ add no spurious weight."
-        )
-        w("")
+        _write_table2(w, t2)
     p1 = rep.get("paper001")
     if p1:
-        pr = p1["params"]
-        w("## 3. Paper 001: bias-instability variance 0.001 → 0.01 (400–800 s) → 0.001 through DAVAR")
-        w("")
-        w(
-            f"{pr['n']} samples at {pr['fs']:g} Hz ({pr['n'] / pr['fs']:g} s); first-order Gauss–Markov bias, "
-            f"T_c = {pr['tc']} s, σ² = {pr['var_out']} (°/h)² outside and {pr['var_in']} inside 400–800 s; white noise "
-            f"{pr['white_per_sample']} °/h per sample (N = {pr['N_coefficient']:.4g} (°/h)·√s). The paper gives "
-            f"neither T_c nor the white level: these are our choices. `davar(window={pr['window']}, "
-            f"hop={pr['hop']})` (exp grid, τ {p1['runs'][0]['tau'][0]:g}–{p1['runs'][0]['tau'][-1]:g} s) → "
-            f'`fit(terms={tuple(pr["terms"])}, unit="deg/h")` per window. Windows overlapping a switch '
-            f"(±{pr['window'] / pr['fs'] / 2:.1f} s) are left out of the medians."
-        )
-        w("")
-        w(
-            "| seed | B inside, °/h | B outside, °/h | ratio | B change points (step fit), s | "
-            "inside windows with B lower bound > outside median | K ratio | N ratio | whole-record B, °/h | "
-            "outside: SD(B)/SE(B), SD(N)/SE(N) |"
-        )
-        w("|---|---|---|---|---|---|---|---|---|---|")
-        for r in p1["runs"]:
-            b = r["B"]
-            w(
-                f"| {r['seed']} | {b['median_inside']:.4f} | {b['median_outside']:.4f} | {b['ratio']:.2f} | "
-                f"{b['change_points_s'][0]:.0f}, {b['change_points_s'][1]:.0f} | "
-                f"{_pct(b['share_inside_windows_lower_bound_above_outside_median'])} | "
-                f"{_fmt(r['K']['ratio'], 3)} | {_fmt(r['N']['ratio'], 3)} | {r['static_fit']['B']:.4f} | "
-                f"{b['outside_sd_over_median_se']:.2f}, {r['N']['outside_sd_over_median_se']:.2f} |"
-            )
-        w("")
-        w(
-            f"Median B ratio inside/outside {p1['B_ratio_median']:.2f} (√10 = 3.16 would be B scaling with σ; the "
-            f"window sees τ ≤ {p1['runs'][0]['tau'][-1]:g} s, where the Gauss–Markov curve is only partly flat, "
-            f"and the white noise does not change, so the fitted B moves by less). Figure: `{p1['figure']}`."
-        )
-        w("")
+        _write_paper001(w, p1)
     real = rep.get("real")
     if real and real.get("adis"):
         _write_adis(w, real["adis"])
     if real and real.get("curves"):
         _write_curves(w, real["curves"], real.get("adis"))
     path.write_text("\n".join(L) + "\n", encoding="utf-8")
+
+
+def _write_recovery(w, set_name: str, rec: dict) -> None:
+    """Section 1 for one recovery set: errors against the peers and the bound, verdict, coverage, covariance."""
+    s = rec["summary"]
+    terms = rec["terms"]
+    truth = rec["truth"]
+    w(
+        f"## 1{set_name.lower()}. Recovery, set {set_name}: "
+        + ", ".join(f"{t} = {truth[t]:g}" for t in terms)
+        + f" (°/s base units); {s['n_seeds']} seeds, {rec['n_samples']:.0e} samples at {rec['fs']:g} Hz"
+    )
+    w("")
+    w(f"Dominant ranges: {rec['ranges']}. Median |relative error| (median signed error in brackets):")
+    w("")
+    bm = s.get("bound_median_abs_rel_error", {})
+    _write_recovery_errors(w, s, terms, bm)
+    _write_recovery_verdict(w, rec, terms, bm)
+    _write_recovery_coverage(w, rec, terms)
+
+
+def _write_recovery_errors(w, s: dict, terms: list, bm: dict) -> None:
+    """The median-error table (each estimator, bootstrap ranges, bound, target) and the RMS-over-bound table."""
+    w("| estimator | " + " | ".join(terms) + " |")
+    w("|---|" + "---|" * len(terms))
+    for est in ESTIMATORS:
+        e = s[est]
+        w(
+            f"| {EST_LABEL[est]} | "
+            + " | ".join(
+                f"{_pct(e['median_abs_rel_error'][t])} ({100 * e['median_rel_error'][t]:+.1f} %)" for t in terms
+            )
+            + " |"
+        )
+    b = s["allanite"]["median_abs_rel_error_bootstrap95"]
+    bp = s["peer"]["median_abs_rel_error_bootstrap95"]
+    w(
+        "| allanite, 95 % bootstrap range of the median | "
+        + " | ".join(f"{_pct(b[t][0])}–{_pct(b[t][1])}" for t in terms)
+        + " |"
+    )
+    w(
+        "| peer (as shipped), 95 % bootstrap range | "
+        + " | ".join(f"{_pct(bp[t][0])}–{_pct(bp[t][1])}" for t in terms)
+        + " |"
+    )
+    if bm:
+        w(
+            "| information bound (≈ median error of an efficient unbiased estimator) | "
+            + " | ".join(_pct(bm.get(t)) for t in terms)
+            + " |"
+        )
+    targets = RECOVERY_TARGETS
+    w("| issue target (median) | " + " | ".join(_pct(targets[t]) if t in targets else "—" for t in terms) + " |")
+    w("")
+    if bm:
+        w(
+            "RMS relative error over seeds / the bound's relative SD (1 = as precise as the record allows for "
+            "an unbiased estimator; the RMS counts bias as well as scatter):"
+        )
+        w("")
+        w("| estimator | " + " | ".join(t for t in terms if t in bm) + " |")
+        w("|---|" + "---|" * len(bm))
+        for est in ESTIMATORS:
+            w(
+                f"| {EST_LABEL[est]} | "
+                + " | ".join(_fmt(s["rms_over_bound"][est][t], 3) for t in terms if t in bm)
+                + " |"
+            )
+        w("")
+
+
+def _write_recovery_verdict(w, rec: dict, terms: list, bm: dict) -> None:
+    """Per term: the target met or not (or beyond the information bound), and the paired comparisons."""
+    s = rec["summary"]
+    targets = RECOVERY_TARGETS
+    verdict = []
+    for t in terms:
+        a = s["allanite"]["median_abs_rel_error"][t]
+        ok_target = a <= targets[t] if t in targets else None
+        if ok_target is False and bm.get(t, 0) > targets[t]:
+            ok_target = "beyond"
+        cmp_peer = [_paired(rec["rows"], rec["truth"], t, other) for other in ("peer", "peer_octave")]
+        cmp_slope = _paired(rec["rows"], rec["truth"], t, "slope")
+        tgt_txt = (
+            "no target"
+            if ok_target is None
+            else f"target **not met** — and not reachable: the record's information bound is {_pct(bm[t])}"
+            if ok_target == "beyond"
+            else "target met"
+            if ok_target
+            else "target **not met**"
+        )
+        verdict.append(
+            f"{t}: {tgt_txt}; against the peer as shipped / on our curve: {cmp_peer[0]} / "
+            f"{cmp_peer[1]}; against the slope read-off: {cmp_slope}"
+        )
+    w(
+        "Verdict (allanite.fit with the set's terms; comparisons are paired over the same seeds — 'better' or "
+        "'worse' only when the 95 % bootstrap interval of the difference of median |error| excludes zero): "
+        + "; ".join(verdict)
+        + "."
+    )
+    w("")
+
+
+def _write_recovery_coverage(w, rec: dict, terms: list) -> None:
+    """Coverage and calibration of the intervals, the covariance check, χ²/dof and the fit times."""
+    s = rec["summary"]
+    lo, hi = s["coverage_expected_range_95"]
+    w(
+        f"Coverage of allanite's 68.3 % intervals (share of seeds whose interval holds the truth; with "
+        f"{s['n_seeds']} seeds a correct 68.3 % interval gives {lo:.0%}–{hi:.0%} in 95 % of benchmark runs), "
+        f"and SD of the estimates / median reported standard error (1 = calibrated, > 1 = intervals too narrow):"
+    )
+    w("")
+    w("| | " + " | ".join(terms) + " |")
+    w("|---|" + "---|" * len(terms))
+    w("| coverage, set's terms | " + " | ".join(_pct(s["coverage_68"][t]) for t in terms) + " |")
+    w("| coverage, all five terms | " + " | ".join(_pct(s["coverage_68_5terms"][t]) for t in terms) + " |")
+    w("| SD / reported SE | " + " | ".join(_fmt(s["sd_over_reported_se"][t], 3) for t in terms) + " |")
+    w("")
+    unc = s.get("time_allanite_uncached_s")
+    unc_txt = f", {1e3 * unc:.0f} ms for the first fit on a grid (covariance blocks computed)" if unc else ""
+    cc = s.get("covariance_check")
+    if cc:
+        sdr = np.array(cc["sd_ratio_mc_over_model"])
+        dc = np.abs(np.array(cc["octave_corr_mc"]) - np.array(cc["octave_corr_model"]))
+        w(
+            f"The covariance the fit uses, against the scatter of the {cc['n_records']} octave curves: SD over "
+            f"the seeds / model SD {sdr.min():.2f}–{sdr.max():.2f} (median {np.median(sdr):.2f}) across the "
+            f"{sdr.size} τ; correlation one octave apart, seeds vs model: median difference {np.median(dc):.3f}, "
+            f"largest {dc.max():.3f} (sampling error of a correlation from {cc['n_records']} records ≈ "
+            f"{1 / math.sqrt(cc['n_records']):.2f})."
+        )
+        w("")
+    w(
+        f"Median χ²/dof {s['median_chi2_dof']:.2f}; median fit time {1e3 * s['median_time_allanite_s']:.0f} ms "
+        f"(allanite.fit on the octave curve{unc_txt}) vs {1e3 * s['median_time_peer_s']:.0f} ms (allan-variance's "
+        f"compute_avar + estimate_parameters, {rec['rows'][0]['peer_tau_range'][2]} τ from "
+        f"{rec['rows'][0]['peer_tau_range'][0]:g} to {rec['rows'][0]['peer_tau_range'][1]:g} s)."
+    )
+    w("")
+
+
+def _write_table2(w, t2: dict) -> None:
+    """Section 2: paper 000 Table 2, the exponential against the full linear τ grid."""
+    w(
+        f"## 2. Paper 000 Table 2: exponential vs full linear τ grid ({len(t2['rows'])} seeds, "
+        f"{t2['n_samples']:.0e} samples at {t2['fs']:g} Hz, m ≤ N/9 = {t2['m_max']})"
+    )
+    w("")
+    w(
+        "Truth "
+        + ", ".join(f"{k} = {v:g}" for k, v in t2["truth"].items())
+        + f". Linear grid: every m = 1…{t2['m_max']} ({t2['rows'][0]['n_tau_all']} τ); exponential grid "
+        f'`"exp"` ({t2["rows"][0]["n_tau_exp"]} τ). "Mutually inside": share of seeds where each grid\'s value '
+        f"lies in the other's 68.3 % interval; \"diff/half-width\": |difference| over the exp grid's interval half-width."
+    )
+    w("")
+    w("| comparison | " + " | ".join(t2["truth"]) + " |")
+    w("|---|" + "---|" * len(t2["truth"]))
+    for pair, s in t2["agreement"].items():
+        w(
+            f"| {pair.replace('_vs_', ' vs ')}: mutually inside | "
+            + " | ".join(_pct(s[t]["mutually_inside"]) for t in t2["truth"])
+            + " |"
+        )
+        w(
+            f"| {pair.replace('_vs_', ' vs ')}: median (max) diff/half-width | "
+            + " | ".join(
+                f"{s[t]['median_diff_over_halfwidth']:.2f} ({s[t]['max_diff_over_halfwidth']:.2f})" for t in t2["truth"]
+            )
+            + " |"
+        )
+    for label in ("all_thin", "exp_thin", "exp_full"):
+        e = t2["median_abs_rel_error"][label]
+        c = t2["median_abs_rel_error"][label + "_coverage"]
+        w(
+            f"| {label}: median abs. error vs truth (coverage) | "
+            + " | ".join(f"{_pct(e[t])} ({_pct(c[t])})" for t in t2["truth"])
+            + " |"
+        )
+    w("")
+    w(
+        "`*_thin`: the default fit (τ at least an octave apart, so the linear grid reduces to m = 1, 2, 4, …); "
+        "`exp_full`: `thin=False`, every τ of the exp grid in the generalized least-squares fit with their full "
+        "covariance. The full linear grid cannot be fitted that way (its covariance would need ~5.5 million τ "
+        f"pairs; `fit` allows at most {MAX_GLS_TAU} τ with thin=False and says so)."
+    )
+    w("")
+    w(
+        "Reading: the two grids give the same coefficients well inside their intervals — paper 000's point "
+        "holds — and so does the exp grid fitted on all its τ at once: with the estimates' covariance in the fit, "
+        "dense correlated τ add no spurious weight."
+    )
+    w("")
+
+
+def _write_paper001(w, p1: dict) -> None:
+    """Section 3: paper 001's bias-instability step seen through DAVAR, per seed."""
+    pr = p1["params"]
+    w("## 3. Paper 001: bias-instability variance 0.001 → 0.01 (400–800 s) → 0.001 through DAVAR")
+    w("")
+    w(
+        f"{pr['n']} samples at {pr['fs']:g} Hz ({pr['n'] / pr['fs']:g} s); first-order Gauss–Markov bias, "
+        f"T_c = {pr['tc']} s, σ² = {pr['var_out']} (°/h)² outside and {pr['var_in']} inside 400–800 s; white noise "
+        f"{pr['white_per_sample']} °/h per sample (N = {pr['N_coefficient']:.4g} (°/h)·√s). The paper gives "
+        f"neither T_c nor the white level: these are our choices. `davar(window={pr['window']}, "
+        f"hop={pr['hop']})` (exp grid, τ {p1['runs'][0]['tau'][0]:g}–{p1['runs'][0]['tau'][-1]:g} s) → "
+        f'`fit(terms={tuple(pr["terms"])}, unit="deg/h")` per window. Windows overlapping a switch '
+        f"(±{pr['window'] / pr['fs'] / 2:.1f} s) are left out of the medians."
+    )
+    w("")
+    w(
+        "| seed | B inside, °/h | B outside, °/h | ratio | B change points (step fit), s | "
+        "inside windows with B lower bound > outside median | K ratio | N ratio | whole-record B, °/h | "
+        "outside: SD(B)/SE(B), SD(N)/SE(N) |"
+    )
+    w("|---|---|---|---|---|---|---|---|---|---|")
+    for r in p1["runs"]:
+        b = r["B"]
+        w(
+            f"| {r['seed']} | {b['median_inside']:.4f} | {b['median_outside']:.4f} | {b['ratio']:.2f} | "
+            f"{b['change_points_s'][0]:.0f}, {b['change_points_s'][1]:.0f} | "
+            f"{_pct(b['share_inside_windows_lower_bound_above_outside_median'])} | "
+            f"{_fmt(r['K']['ratio'], 3)} | {_fmt(r['N']['ratio'], 3)} | {r['static_fit']['B']:.4f} | "
+            f"{b['outside_sd_over_median_se']:.2f}, {r['N']['outside_sd_over_median_se']:.2f} |"
+        )
+    w("")
+    w(
+        f"Median B ratio inside/outside {p1['B_ratio_median']:.2f} (√10 = 3.16 would be B scaling with σ; the "
+        f"window sees τ ≤ {p1['runs'][0]['tau'][-1]:g} s, where the Gauss–Markov curve is only partly flat, "
+        f"and the white noise does not change, so the fitted B moves by less). Figure: `{p1['figure']}`."
+    )
+    w("")
 
 
 def _auto_cell(f) -> str:
@@ -1129,79 +1165,95 @@ def _write_curves(w, curves, adis):
             )
     w("")
     if "adis_av" in curves and adis:
-        w(
-            "ADIS16405 run 1: the avar curve against allanite's own Allan variance of the raw run (τ ≥ 0.16 s fit, IEEE "
-            "units):"
-        )
-        w("")
-        w("| axis | N from curve | N from raw | B from curve | B from raw | K from curve | K from raw |")
-        w("|---|---|---|---|---|---|---|")
-        for ax, ch in zip("xyz", ("Gyro. X", "Gyro. Y", "Gyro. Z")):
-            cc = curves["adis_av"]["gyro"][ch]["tau_ge_0.16"]["coefficients"]
-            rc = adis["runs"][0]["axes"][ax]["tau_ge_0.16"]["coefficients"]
-            w(
-                f"| {ax} | {cc['N']['ieee']:.4f} | {rc['N']['ieee']:.4f} | {cc['B']['ieee']:.2f} | {rc['B']['ieee']:.2f} | "
-                f"{cc['K']['ieee']:.1f} | {rc['K']['ieee']:.1f} |"
-            )
-        w("")
+        _write_adis_curve(w, curves["adis_av"], adis)
     nav = curves.get("navchip_av")
     if nav:
-        rep_ = nav["avlr_reproduced"]
-        pr = nav["avlr_printed"]
-        rad = 180.0 / math.pi
+        _write_navchip_table(w, nav)
+        _write_navchip_reading(w, nav)
+
+
+def _write_adis_curve(w, adis_av: dict, adis: dict) -> None:
+    """ADIS16405 run 1: the avar package's curve against allanite's fit of the raw run."""
+    w(
+        "ADIS16405 run 1: the avar curve against allanite's own Allan variance of the raw run (τ ≥ 0.16 s fit, IEEE "
+        "units):"
+    )
+    w("")
+    w("| axis | N from curve | N from raw | B from curve | B from raw | K from curve | K from raw |")
+    w("|---|---|---|---|---|---|---|")
+    for ax, ch in zip("xyz", ("Gyro. X", "Gyro. Y", "Gyro. Z")):
+        cc = adis_av["gyro"][ch]["tau_ge_0.16"]["coefficients"]
+        rc = adis["runs"][0]["axes"][ax]["tau_ge_0.16"]["coefficients"]
         w(
-            "NavChip. The avar vignette fits `avlr(navchip_av, qn_gyro = 1:4, wn_gyro = 6:8, rw_gyro = 10:13)`: the "
-            "slope read-offs σ·√τ (WN), σ·τ/√3 (QN) and √3·σ/√τ (RW) at those rows, geometric mean pooled over the "
-            "three gyro axes. Recomputed here from the CSV:"
+            f"| {ax} | {cc['N']['ieee']:.4f} | {rc['N']['ieee']:.4f} | {cc['B']['ieee']:.2f} | {rc['B']['ieee']:.2f} | "
+            f"{cc['K']['ieee']:.1f} | {rc['K']['ieee']:.1f} |"
         )
-        w("")
-        w(
-            "| | printed (vignette) | recomputed | allanite.fit, X / Y / Z (68.3 % interval) | allanite, IEEE units if rad/s |"
-        )
-        w("|---|---|---|---|---|")
-        for t, lab in (("N", "WN"), ("Q", "QN"), ("K", "RW"), ("B", "—")):
-            fits = [nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"][t] for a in "XYZ"]
-            conv = {"N": 60 * rad, "Q": rad, "K": 216000 * rad, "B": 3600 * rad}[t]
-            unit = {"N": "°/√h", "Q": "°", "K": "°/h^1.5", "B": "°/h"}[t]
-            if t == "B":
-                ieee = " / ".join(f"{conv * c['value']:.3g}" for c in fits)
-                w(
-                    "| bias instability (B) | — | — | "
-                    + " / ".join(f"{c['value']:.3g} [{_fmt(c['ci'][0], 2)}, {_fmt(c['ci'][1], 2)}]" for c in fits)
-                    + f" | {ieee} {unit} |"
-                )
-                continue
+    w("")
+
+
+def _write_navchip_table(w, nav: dict) -> None:
+    """NavChip: the avar vignette's slope read-offs, printed and recomputed, beside allanite's fits."""
+    rep_ = nav["avlr_reproduced"]
+    pr = nav["avlr_printed"]
+    rad = 180.0 / math.pi
+    w(
+        "NavChip. The avar vignette fits `avlr(navchip_av, qn_gyro = 1:4, wn_gyro = 6:8, rw_gyro = 10:13)`: the "
+        "slope read-offs σ·√τ (WN), σ·τ/√3 (QN) and √3·σ/√τ (RW) at those rows, geometric mean pooled over the "
+        "three gyro axes. Recomputed here from the CSV:"
+    )
+    w("")
+    w(
+        "| | printed (vignette) | recomputed | allanite.fit, X / Y / Z (68.3 % interval) | allanite, IEEE units if rad/s |"
+    )
+    w("|---|---|---|---|---|")
+    for t, lab in (("N", "WN"), ("Q", "QN"), ("K", "RW"), ("B", "—")):
+        fits = [nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"][t] for a in "XYZ"]
+        conv = {"N": 60 * rad, "Q": rad, "K": 216000 * rad, "B": 3600 * rad}[t]
+        unit = {"N": "°/√h", "Q": "°", "K": "°/h^1.5", "B": "°/h"}[t]
+        if t == "B":
             ieee = " / ".join(f"{conv * c['value']:.3g}" for c in fits)
             w(
-                f"| {lab} ({t}) | {pr[t]:.6e} | {rep_[t]:.6e} | "
+                "| bias instability (B) | — | — | "
                 + " / ".join(f"{c['value']:.3g} [{_fmt(c['ci'][0], 2)}, {_fmt(c['ci'][1], 2)}]" for c in fits)
                 + f" | {ieee} {unit} |"
             )
-        w("")
-        per = nav["wn_readoff_per_axis"]
-        dev = [abs(per[a]["fitted_curve"] / per[a]["readoff"] - 1) for a in "XYZ"]
-        low = [1 - per[a]["N"] / per[a]["readoff"] for a in "XYZ"]
-        kr = [
-            pr["K"] / nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"]["K"]["value"]
-            for a in "XYZ"
-            if nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"]["K"]["value"] > 0
-        ]
-        chis = [nav["gyro"][f"Gyro. {a}"]["all_tau"]["chi2_dof"] for a in "XYZ"]
+            continue
+        ieee = " / ".join(f"{conv * c['value']:.3g}" for c in fits)
         w(
-            "The vignette's WN is read at τ = 0.26–1 s, where bias instability still adds to the curve: allanite's "
-            f"fitted curve reproduces each axis's read-off σ·√τ there to {100 * max(dev):.1f} %, while N alone is "
-            f"{100 * min(low):.0f}–{100 * max(low):.0f} % lower (checked in tests/test_fit_real.py). Its RW is read at "
-            "τ = 4–33 s, the flat bottom of the curve, so it is mostly bias instability too; allanite's K is "
-            + (f"{min(kr):.1f}–{max(kr):.1f} × smaller" if kr else "0")
-            + f" and poorly determined. The fits' χ²/dof ({min(chis):.0f}–{max(chis):.0f}) say the five-term model is "
-            "only an approximation of this sensor's curve."
+            f"| {lab} ({t}) | {pr[t]:.6e} | {rep_[t]:.6e} | "
+            + " / ".join(f"{c['value']:.3g} [{_fmt(c['ci'][0], 2)}, {_fmt(c['ci'][1], 2)}]" for c in fits)
+            + f" | {ieee} {unit} |"
         )
-        w("")
-        w(
-            "Units: the package does not state them; rad/s is inferred (WN 5.95e-5 → 0.204 °/√h and an ADEV minimum "
-            "of ≈ 5.8e-5 → 12 °/h are MEMS-chip values; in °/s they would be 100 × too good)."
-        )
-        w("")
+    w("")
+
+
+def _write_navchip_reading(w, nav: dict) -> None:
+    """NavChip: why the vignette's read-offs differ from the fitted terms, and the inferred units."""
+    pr = nav["avlr_printed"]
+    per = nav["wn_readoff_per_axis"]
+    dev = [abs(per[a]["fitted_curve"] / per[a]["readoff"] - 1) for a in "XYZ"]
+    low = [1 - per[a]["N"] / per[a]["readoff"] for a in "XYZ"]
+    kr = [
+        pr["K"] / nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"]["K"]["value"]
+        for a in "XYZ"
+        if nav["gyro"][f"Gyro. {a}"]["all_tau"]["coefficients"]["K"]["value"] > 0
+    ]
+    chis = [nav["gyro"][f"Gyro. {a}"]["all_tau"]["chi2_dof"] for a in "XYZ"]
+    w(
+        "The vignette's WN is read at τ = 0.26–1 s, where bias instability still adds to the curve: allanite's "
+        f"fitted curve reproduces each axis's read-off σ·√τ there to {100 * max(dev):.1f} %, while N alone is "
+        f"{100 * min(low):.0f}–{100 * max(low):.0f} % lower (checked in tests/test_fit_real.py). Its RW is read at "
+        "τ = 4–33 s, the flat bottom of the curve, so it is mostly bias instability too; allanite's K is "
+        + (f"{min(kr):.1f}–{max(kr):.1f} × smaller" if kr else "0")
+        + f" and poorly determined. The fits' χ²/dof ({min(chis):.0f}–{max(chis):.0f}) say the five-term model is "
+        "only an approximation of this sensor's curve."
+    )
+    w("")
+    w(
+        "Units: the package does not state them; rad/s is inferred (WN 5.95e-5 → 0.204 °/√h and an ADEV minimum "
+        "of ≈ 5.8e-5 → 12 °/h are MEMS-chip values; in °/s they would be 100 × too good)."
+    )
+    w("")
 
 
 # ----------------------------------------------------------------------------------------------

@@ -207,7 +207,7 @@ def findings(runs, rows, sims, cal) -> list[str]:
     ]
 
 
-def main(argv: list[str] | None = None) -> int:
+def _arguments(argv: list[str] | None) -> argparse.Namespace:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", default=str(_common.HERE / "results"), help="folder for paper004.md and the figures")
     ap.add_argument("--runs", default="1,2,3,4,5,6", help="ADIS16405 runs (comma-separated)")
@@ -216,16 +216,11 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="smoke run (a few seconds, for the tests): run 1 only, one seed of 270 000 samples per scenario",
     )
-    args = ap.parse_args(argv)
-    runs_arg = "1" if args.quick else args.runs
-    n_seeds, n_sim = (1, 270_000) if args.quick else (SIM_SEEDS, 1_000_000)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    data = _common.shared_data_dir() / "adis16405"
-    if not data.is_dir():
-        print(f"no ADIS16405 data in {data} (set ALLANITE_SHARED_DATA)", file=sys.stderr)
-        return 1
-    methods = list(default_methods())
+    return ap.parse_args(argv)
+
+
+def _measure(runs_arg: str, n_seeds: int, n_sim: int) -> tuple[dict, dict, dict, float]:
+    """(runs, runs at paper 004's 20 s frames, simulations, seconds): every frame fit and forecast."""
     t0 = time.perf_counter()
     runs, runs20 = {}, {}
     for k in (int(r) for r in runs_arg.split(",")):
@@ -240,8 +235,11 @@ def main(argv: list[str] | None = None) -> int:
         for seed in range(n_seeds)
     }
     print(f"simulations done ({time.perf_counter() - t0:.1f} s)", file=sys.stderr)
-    elapsed = time.perf_counter() - t0
+    return runs, runs20, sims, time.perf_counter() - t0
 
+
+def _head(runs, elapsed: float) -> list[str]:
+    """The page's title, rerun line and method paragraph, and the table of terms the frames resolve."""
     md = [
         "# Paper 004 on real data — time-frame DAVAR and GM(1,1) forecasts of the ADIS16405 noise coefficients",
         "",
@@ -269,8 +267,12 @@ def main(argv: list[str] | None = None) -> int:
             + " | ".join(str(int(np.count_nonzero(f.series.values[t] <= 0))) for f, _ in res for t in TERMS)
             + " |"
         )
-    md += ["", "## Run 1 in the layout of paper 004's Tables 1 and 3: C (grade) per axis and term", ""]
-    r1 = runs.get("run 1") or next(iter(runs.values()))
+    return md
+
+
+def _paper_tables(r1, methods) -> list[str]:
+    """Run 1 beside paper 004's Tables 1 and 3, and every run's honest C in that layout."""
+    md = ["", "## Run 1 in the layout of paper 004's Tables 1 and 3: C (grade) per axis and term", ""]
     md += ["**Paper 004 Table 1 (traditional GM(1,1), its laser gyro)**", ""]
     md += ["| axis | " + " | ".join(TERMS) + " |", "|---|" + "---|" * 5]
     md += [f"| {a} | " + " | ".join(f"{v:.2f}" for v in PAPER_T1[a]) + " |" for a in "XYZ"]
@@ -280,8 +282,11 @@ def main(argv: list[str] | None = None) -> int:
     for m in methods:
         md += ["", f"**ours, {m} — honest**", ""] + paper_layout(r1, m)
         md += ["", f"**ours, {m} — paper rule**", ""] + paper_layout(r1, m, _cp)
+    return md
 
-    md += [
+
+def _all_runs_layout(runs) -> list[str]:
+    md = [
         "",
         "## All runs in the layout of paper 004's Tables 1 and 3",
         "",
@@ -304,7 +309,12 @@ def main(argv: list[str] | None = None) -> int:
                     )
                 )
             md.append(f"| {name} | {a} | " + " | ".join(cells) + " |")
-    md += [
+    return md
+
+
+def _every_method(runs, methods) -> tuple[list[str], dict[str, list]]:
+    """The table of every run, axis, forecastable term and method; and per method its cells (with rmse_rel)."""
+    md = [
         "",
         "## All six runs: the resolved terms, every method",
         "",
@@ -313,7 +323,7 @@ def main(argv: list[str] | None = None) -> int:
         "(rmse/SE).",
         "",
     ]
-    rows = {m: [] for m in methods}
+    rows: dict[str, list] = {m: [] for m in methods}
     table = ["| run | axis | term | " + " | ".join(methods) + " |", "|---|---|---|" + "---|" * len(methods)]
     for name, res in runs.items():
         for (f, tab), a in zip(res, "XYZ"):
@@ -331,8 +341,11 @@ def main(argv: list[str] | None = None) -> int:
                     )
                     rows[m].append(c | {"rmse_rel": c["rmse"] / per})
                 table.append(f"| {name} | {a} | {t} | " + " | ".join(cells) + " |")
-    md += table
-    md += [
+    return md + table, rows
+
+
+def _summary(rows, methods) -> list[str]:
+    md = [
         "",
         "## Summary over the real runs (every forecastable series of every run and axis)",
         "",
@@ -352,7 +365,12 @@ def main(argv: list[str] | None = None) -> int:
             f"| {m} | {len(r)} | {np.median(C):.2f} [{C.min():.2f}, {C.max():.2f}] | {np.sum(C < 0.5)} | "
             f"{np.median(Cp):.2f} | {np.median(rel):.2f} | {np.median(ose):.2f} | {np.sum(rel < 1)} of {len(r)} |"
         )
-    md += [
+    return md
+
+
+def _variant20(runs20, methods) -> list[str]:
+    """The summary of paper 004's own frame length (20 s frames, the first 90 of each run)."""
+    md = [
         "",
         f"## Variant: paper 004's frame length ({PAPER_FRAME_S:g} s frames, the first 90 of each run = 30 min)",
         "",
@@ -379,20 +397,28 @@ def main(argv: list[str] | None = None) -> int:
         )
     terms20 = sorted({(t) for res in runs20.values() for _, tab in res for t in tab["terms"]})
     md += ["", f"Terms resolved in all 90 frames of some axis: {', '.join(terms20) or 'none'}."]
-    # interval calibration: robust frame-to-frame scatter against the fits' SE
+    return md
+
+
+def _calibration(runs) -> tuple[list[str], list[float]]:
+    """Interval calibration: robust frame-to-frame scatter against the fits' SE, per forecastable series."""
     cal = []
     for name, res in runs.items():
         for (f, tab), a in zip(res, "XYZ"):
             for t in tab["terms"]:
                 se = f.standard_errors()[t]
                 cal.append(tab["scatter"][t] / float(np.sqrt(np.mean(se**2))))
-    md += [
+    md = [
         "",
         f"Frame-to-frame scatter (robust SD of successive differences / √2) over the fits' RMS standard error, "
         f"per forecastable series: median {np.median(cal):.2f}, range {min(cal):.2f}–{max(cal):.2f} "
         "(≈ 1: the fit intervals describe how much a coefficient moves from frame to frame).",
     ]
-    md += [
+    return md, cal
+
+
+def _simulated(sims, methods, n_seeds: int, n_sim: int) -> list[str]:
+    md = [
         "",
         f"## Simulated drifting records ({n_seeds} seeds per scenario, {n_sim} samples each)",
         "",
@@ -417,11 +443,15 @@ def main(argv: list[str] | None = None) -> int:
                     f" · {np.median([c['rmse_over_se'] for c in cs]):.2f}"
                 )
             md.append(f"| {scen} | {t} | {len(tabs)} | " + " | ".join(cells) + " |")
+    return md
+
+
+def _figures(r1, sims, out: Path) -> list[str]:
+    """Run 1's per-frame coefficients and forecasts per axis, and each scenario's seed-0 forecast; the names."""
     figs = []
-    f1 = r1
     from matplotlib.figure import Figure
 
-    for k, ((f, tab), a) in enumerate(zip(f1, "XYZ")):
+    for k, ((f, tab), a) in enumerate(zip(r1, "XYZ")):
         shown = [t for t in f.terms if np.any(f.series.values[t] > 0)]
         fig = Figure(figsize=(7.5, 1.2 + 1.5 * len(shown)), dpi=100)
         axs = fig.subplots(len(shown), 1, sharex=True, squeeze=False)[:, 0]
@@ -450,6 +480,28 @@ def main(argv: list[str] | None = None) -> int:
         name = f"paper004_simulated_{scen.replace('-', '')}.png"
         fig.savefig(out / name)
         figs.append(name)
+    return figs
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _arguments(argv)
+    runs_arg = "1" if args.quick else args.runs
+    n_seeds, n_sim = (1, 270_000) if args.quick else (SIM_SEEDS, 1_000_000)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    data = _common.shared_data_dir() / "adis16405"
+    if not data.is_dir():
+        print(f"no ADIS16405 data in {data} (set ALLANITE_SHARED_DATA)", file=sys.stderr)
+        return 1
+    methods = list(default_methods())
+    runs, runs20, sims, elapsed = _measure(runs_arg, n_seeds, n_sim)
+    r1 = runs.get("run 1") or next(iter(runs.values()))
+    md = _head(runs, elapsed) + _paper_tables(r1, methods) + _all_runs_layout(runs)
+    every, rows = _every_method(runs, methods)
+    md += every + _summary(rows, methods) + _variant20(runs20, methods)
+    cal_md, cal = _calibration(runs)
+    md += cal_md + _simulated(sims, methods, n_seeds, n_sim)
+    figs = _figures(r1, sims, out)
     md += ["", "## Figures", ""] + [f"![{p}]({p})" for p in figs]
     at = md.index("## Which terms the frames resolve (frames with the term at 0, of 90)")
     md[at:at] = findings(runs, rows, sims, cal) + [""]

@@ -57,6 +57,39 @@ def _narrowband(n, f_r, q, sigma, seed):
 
 def cases(quick: bool):
     """(name, samples or None, truth, kwargs) — simulated first, then real ADIS noise."""
+    out = _simulated_cases()
+    if quick:
+        return out
+    y5 = _adis(5, ["gyro_y"])
+    g2 = _adis(2, ["gyro_x", "acc_z"])
+    y6 = _adis(6, ["gyro_x"])
+    y3 = _adis(3, ["gyro_x"])
+    if y5 is None or g2 is None or y6 is None or y3 is None:
+        print("ADIS16405 logs not found: the real-noise rows are left out (set ALLANITE_SHARED_DATA)")
+        return out
+    (y5,), (gx, az), (y6,), (y3,) = y5, g2, y6, y3
+    t = np.arange(y5.size) / FS
+    out += _adis_filter_cases(y5, t) + _adis_channel_cases(gx, az)
+    white = np.random.default_rng(3).normal(size=y6.size) * np.where(t >= 6000.0, 2 * np.std(np.diff(y6)), 0.0)
+    out += [
+        (
+            "ADIS run 6 x + white noise ×3 from 6000 s",
+            y6 + white,
+            {"change_point": {"t": 6000.0}},
+            {},
+        ),
+        (
+            "ADIS run 3 x + warm-up 0.2 °/s·e^{−t/600 s}",
+            y3 + 0.2 * np.exp(-t / 600.0),
+            {"drift": {"amplitude": 0.2, "T": 600.0}},
+            {},
+        ),
+    ]
+    return out
+
+
+def _simulated_cases() -> list:
+    """The simulated records: each effect alone on N + K, and a GM with a sinusoid at once."""
     t4 = np.arange(400_000) / FS
     out = [
         (
@@ -108,31 +141,12 @@ def cases(quick: bool):
             {},
         ),
     ]
-    if quick:
-        return out
-    y5 = _adis(5, ["gyro_y"])
-    g2 = _adis(2, ["gyro_x", "acc_z"])
-    y6 = _adis(6, ["gyro_x"])
-    y3 = _adis(3, ["gyro_x"])
-    if y5 is None or g2 is None or y6 is None or y3 is None:
-        print("ADIS16405 logs not found: the real-noise rows are left out (set ALLANITE_SHARED_DATA)")
-        return out
-    (y5,), (gx, az), (y6,), (y3,) = y5, g2, y6, y3
-    t = np.arange(y5.size) / FS
-    gm = allanite.simulate(gx.size, FS, gauss_markov=[(0.05, 20.0)], seed=8)
-    base = regression_fit(gx, az)["coefficient"]
-    # a multi-position test: acc_z turned between +1 g and −1 g every 200–600 s (the log's own acc_z noise kept);
-    # the gyro responds to the true acceleration at 0.01 °/s/g. The regression's expected coefficient is the
-    # least-squares value of that response plus gyro_x's own coupling to acc_z's noise (`base`), within the
-    # regression's 8 blocks as `regression_fit` forms it.
-    edges = np.cumsum(np.random.default_rng(5).uniform(200, 600, size=400) * FS).astype(int)
-    tumble = np.where(np.searchsorted(edges, np.arange(gx.size), side="right") % 2 == 0, 1.0, -1.0)
-    tumble -= tumble.mean()
-    ch_t = az - az.mean() + tumble
-    tumble_truth = _within(0.01 * tumble + base * az, ch_t) / _within(ch_t, ch_t)
-    tumble_truth3 = _within(0.03 * tumble + base * az, ch_t) / _within(ch_t, ch_t)
-    white = np.random.default_rng(3).normal(size=y6.size) * np.where(t >= 6000.0, 2 * np.std(np.diff(y6)), 0.0)
-    out += [
+    return out
+
+
+def _adis_filter_cases(y5, t) -> list:
+    """ADIS run 5 y with a sinusoid added, and through a moving average and a single pole."""
+    return [
         (
             "ADIS run 5 y + 0.03 °/s at 0.02 Hz (issue 16)",
             y5 + 0.03 * np.sin(2 * np.pi * 0.02 * t + 0.3),
@@ -151,6 +165,24 @@ def cases(quick: bool):
             {"bandwidth": {"cutoff": 5.0}},
             {},
         ),
+    ]
+
+
+def _adis_channel_cases(gx, az) -> list:
+    """ADIS run 2 x with a Gauss–Markov process and/or a g-sensitivity to acc_z (`channels=`)."""
+    gm = allanite.simulate(gx.size, FS, gauss_markov=[(0.05, 20.0)], seed=8)
+    base = regression_fit(gx, az)["coefficient"]
+    # a multi-position test: acc_z turned between +1 g and −1 g every 200–600 s (the log's own acc_z noise kept);
+    # the gyro responds to the true acceleration at 0.01 °/s/g. The regression's expected coefficient is the
+    # least-squares value of that response plus gyro_x's own coupling to acc_z's noise (`base`), within the
+    # regression's 8 blocks as `regression_fit` forms it.
+    edges = np.cumsum(np.random.default_rng(5).uniform(200, 600, size=400) * FS).astype(int)
+    tumble = np.where(np.searchsorted(edges, np.arange(gx.size), side="right") % 2 == 0, 1.0, -1.0)
+    tumble -= tumble.mean()
+    ch_t = az - az.mean() + tumble
+    tumble_truth = _within(0.01 * tumble + base * az, ch_t) / _within(ch_t, ch_t)
+    tumble_truth3 = _within(0.03 * tumble + base * az, ch_t) / _within(ch_t, ch_t)
+    return [
         (
             "ADIS run 2 x + GM (0.05 °/s, 20 s)",
             gx + gm,
@@ -175,20 +207,7 @@ def cases(quick: bool):
             {"gauss_markov": {"sigma": 0.05, "tc": 20.0}, "regression": {"coefficient": tumble_truth3}},
             {"channels": {"acc_z": az - az.mean() + tumble}},
         ),
-        (
-            "ADIS run 6 x + white noise ×3 from 6000 s",
-            y6 + white,
-            {"change_point": {"t": 6000.0}},
-            {},
-        ),
-        (
-            "ADIS run 3 x + warm-up 0.2 °/s·e^{−t/600 s}",
-            y3 + 0.2 * np.exp(-t / 600.0),
-            {"drift": {"amplitude": 0.2, "T": 600.0}},
-            {},
-        ),
     ]
-    return out
 
 
 def _pct(v):

@@ -373,50 +373,63 @@ def run_rows(name, fn, ms_timed, n_win, chunk_bytes, probe: Probe, fixed: float)
     return total, {"chunks": details, "prewarm_seconds": warm, "chunk_rows": rows_per_chunk}, blocks
 
 
+class Grids:
+    """One N's window, averaging factors and sampled windows, and what every method keeps (``probe``)."""
+
+    def __init__(self, n, cfg, allanite, probe_rows, probe_windows):
+        self.window = window = n // 10
+        self.n_win = n_win = n - window + 1
+        self.m_all = m_all = np.arange(1, window // 2 + 1, dtype=np.int64)
+        self.m_exp = m_exp = np.round(allanite.tau_grid(window, FS, "exp") * FS).astype(np.int64)
+        self.s_m = s_m = evenly(m_all, cfg["fast_m"]) if cfg["fast_m"] else None
+        probe_m = np.union1d(m_exp, s_m if s_m is not None else evenly(m_all, probe_rows))
+
+        # Sampled windows: naive uses a hop (windows 0, h, 2h, …); allantools evenly spread windows.
+        if cfg["naive_windows"] is None:
+            naive_hop = 1
+        else:
+            naive_hop = max(1, math.ceil((n_win - 1) / max(1, cfg["naive_windows"] - 1)))
+        self.naive_hop = naive_hop
+        self.naive_n = naive_n = (n - window) // naive_hop + 1
+        self.j_naive = j_naive = np.arange(naive_n) * naive_hop
+        j_at_all = sample_starts(n_win, cfg["at_all_windows"] or n_win)
+        j_at_exp = sample_starts(n_win, cfg["at_exp_windows"] or n_win)
+        stride = max(1, math.ceil(n_win / probe_windows))
+        self.probe = Probe(
+            probe_m,
+            np.arange(0, n_win, stride),
+            np.concatenate(
+                [
+                    j_naive if naive_hop > 1 else [],
+                    j_at_all if cfg["at_all_windows"] else [],
+                    j_at_exp if cfg["at_exp_windows"] else [],
+                ]
+            ).astype(np.int64),
+        )
+
+    def info(self, n) -> dict:
+        m_all, m_exp, n_win = self.m_all, self.m_exp, self.n_win
+        return {
+            "n": n,
+            "window": self.window,
+            "hop": 1,
+            "n_windows": n_win,
+            "n_m_all": int(m_all.size),
+            "n_m_exp": int(m_exp.size),
+            "m_exp": [int(m) for m in m_exp],
+            "all_grid_output_gib": m_all.size * n_win * 8 / GiB,
+            "exp_grid_output_gib": m_exp.size * n_win * 8 / GiB,
+        }
+
+
 def measure_n(
     n, cfg, y_all, allanite, reference, allantools, chunk_bytes, probe_rows, probe_windows, single_call=False
 ):
     """Every method at one N. Returns (dict of measurements, dict of blocks)."""
     y = y_all[:n]
-    window = n // 10
-    n_win = n - window + 1
-    m_all = np.arange(1, window // 2 + 1, dtype=np.int64)
-    m_exp = np.round(allanite.tau_grid(window, FS, "exp") * FS).astype(np.int64)
-    s_m = evenly(m_all, cfg["fast_m"]) if cfg["fast_m"] else None
-    probe_m = np.union1d(m_exp, s_m if s_m is not None else evenly(m_all, probe_rows))
-
-    # Sampled windows: naive uses a hop (windows 0, h, 2h, …); allantools evenly spread windows.
-    if cfg["naive_windows"] is None:
-        naive_hop = 1
-    else:
-        naive_hop = max(1, math.ceil((n_win - 1) / max(1, cfg["naive_windows"] - 1)))
-    naive_n = (n - window) // naive_hop + 1
-    j_naive = np.arange(naive_n) * naive_hop
-    j_at_all = sample_starts(n_win, cfg["at_all_windows"] or n_win)
-    j_at_exp = sample_starts(n_win, cfg["at_exp_windows"] or n_win)
-    stride = max(1, math.ceil(n_win / probe_windows))
-    probe = Probe(
-        probe_m,
-        np.arange(0, n_win, stride),
-        np.concatenate(
-            [
-                j_naive if naive_hop > 1 else [],
-                j_at_all if cfg["at_all_windows"] else [],
-                j_at_exp if cfg["at_exp_windows"] else [],
-            ]
-        ).astype(np.int64),
-    )
-    info = {
-        "n": n,
-        "window": window,
-        "hop": 1,
-        "n_windows": n_win,
-        "n_m_all": int(m_all.size),
-        "n_m_exp": int(m_exp.size),
-        "m_exp": [int(m) for m in m_exp],
-        "all_grid_output_gib": m_all.size * n_win * 8 / GiB,
-        "exp_grid_output_gib": m_exp.size * n_win * 8 / GiB,
-    }
+    g = Grids(n, cfg, allanite, probe_rows, probe_windows)
+    window, n_win, m_all, m_exp, s_m, probe = g.window, g.n_win, g.m_all, g.m_exp, g.s_m, g.probe
+    info = g.info(n)
     log(
         f"N = {n}: window {window}, {n_win} windows, all grid {m_all.size} m "
         f"({info['all_grid_output_gib']:.2f} GiB at hop 1), exp grid {m_exp.size} m"
@@ -442,25 +455,7 @@ def measure_n(
         t, fixed_fast, ms_t.size, m_all.size, chunks, "allanite.davar(method='fast', hop=1, workers=1)"
     )
     if single_call and s_m is None:
-        # Diagnostic: the whole "all" surface from one call, as a user would make it — once as it comes,
-        # once right after touching that much memory (see prewarm). Not used in the table.
-        nbytes = m_all.size * n_win * 8
-        diag = {"output_gib": nbytes / GiB}
-        for label in ("as_is", "after_prewarm"):
-            if label == "after_prewarm":
-                diag["prewarm_seconds"] = prewarm(nbytes + 64 * 2**20)
-            gc.collect()
-            t0 = time.perf_counter()
-            out = allanite.davar(
-                y, FS, window=window, hop=1, taus="all", method="fast", workers=WORKERS, max_memory=nbytes + 1
-            ).avar
-            diag[f"seconds_{label}"] = time.perf_counter() - t0
-            del out
-        info["single_call_diagnostic"] = diag
-        log(
-            f"    fast, one call ({diag['output_gib']:.2f} GiB output): {diag['seconds_as_is']:.3g} s as is, "
-            f"{diag['seconds_after_prewarm']:.3g} s after touching that memory ({diag['prewarm_seconds']:.3g} s)"
-        )
+        info["single_call_diagnostic"] = single_call_diagnostic(allanite, y, window, m_all.size * n_win * 8)
     # improved fast DAVAR, exp grid, always in full
     t, chunks, blocks["improved"] = run_rows(
         "improved", lambda ms: dav(ms, "fast"), m_exp, n_win, chunk_bytes, probe, fixed_fast
@@ -469,8 +464,7 @@ def measure_n(
         t, fixed_fast, m_exp.size, m_exp.size, chunks, "allanite.davar(method='fast', taus=exp grid, hop=1, workers=1)"
     )
     # DAVAR (naive), windows 0, h, 2h, …, m all or sampled
-    ms_n = m_all if cfg["naive_m"] is None else evenly(m_all, cfg["naive_m"])
-    if naive_hop == 1 and cfg["naive_m"] is None:
+    if g.naive_hop == 1 and cfg["naive_m"] is None:
         t, chunks, blocks["naive"] = run_rows(
             "naive", lambda ms: dav(ms, "naive"), m_all, n_win, chunk_bytes, probe, fixed_naive
         )
@@ -478,82 +472,8 @@ def measure_n(
             t, fixed_naive, m_all.size, m_all.size, chunks, "allanite.davar(method='naive', hop=1, workers=1)"
         )
     else:
-        best, reps, out = timed(lambda: dav(ms_n, "naive", naive_hop))
-        blocks["naive"] = [Block(ms_n, j_naive, out)]
-        del out
-        rec = {
-            "how": "",
-            "measured_seconds": best,
-            "repeats": reps,
-            "fixed_seconds": fixed_naive,
-            "windows_timed": int(naive_n),
-            "windows_total": int(n_win),
-            "m_timed": int(ms_n.size),
-            "m_total": int(m_all.size),
-            "extrapolated": True,
-            "call": f"allanite.davar(method='naive', hop={naive_hop}, workers=1)",
-        }
-        fixed_naive = min(fixed_naive, 0.5 * best)  # never let a noisy fixed cost swallow the work
-        rec["fixed_seconds_used"] = fixed_naive
-        if ms_n.size < m_all.size:
-            # The per-window angle (O(W)) and the call's overhead do not grow with the number of m: time the
-            # same windows with m = W/2 alone (one term per window); the difference is the sampled m's
-            # work, scaled by the number of terms.
-            a_best, a_reps, _ = timed(lambda: dav(np.array([window // 2]), "naive", naive_hop))
-            a_best = min(a_best, best)
-            angle = max(0.0, (a_best - fixed_naive) / naive_n)
-            work = (best - a_best) / naive_n
-            term_scale = (n_terms(window, m_all).sum() - 1) / max(1, n_terms(window, ms_n).sum() - 1)
-            per_window_all = angle + work * term_scale
-            rec.update(
-                angle_call_seconds=a_best,
-                angle_call_repeats=a_reps,
-                angle_per_window_seconds=angle,
-                term_scale=float(term_scale),
-            )
-            rec["how"] = (
-                f"{naive_n} windows (hop {naive_hop}) × {ms_n.size} evenly spread m timed "
-                f"({best:.3g} s), and the same windows at m = W/2 alone ({a_best:.3g} s: window angles "
-                f"+ overhead); per window: angle + (difference / {naive_n}) × "
-                f"Σ_all(W+1−2m)/Σ_sample(W+1−2m)"
-                f" = {term_scale:.4g}; × {n_win} windows; + fixed {fixed_naive:.2g} s"
-            )
-        else:
-            per_window_all = (best - fixed_naive) / naive_n
-            rec["how"] = (
-                f"{naive_n} windows (hop {naive_hop}) at every m timed ({best:.3g} s); "
-                f"(time − fixed {fixed_naive:.2g} s) / {naive_n} × {n_win} windows + fixed"
-            )
-        rec["seconds"] = fixed_naive + per_window_all * n_win
-        res["naive"] = rec
-
-    # NumPy prefix-sum twin
-    t0 = time.perf_counter()
-    for _ in range(3):
-        reference.angle_from_rate(y, FS)
-    fixed_prefix = (time.perf_counter() - t0) / 3
-    info["prefix_fixed_seconds"] = fixed_prefix
-
-    def pref(ms):
-        return reference.davar_prefix(y, FS, window, 1, ms)
-
-    for key, grid, count in (("prefix_all", m_all, cfg["prefix_all_m"]), ("prefix_exp", m_exp, cfg["prefix_exp_m"])):
-        if count is None:
-            ms_t = grid
-        elif key == "prefix_all" and s_m is not None and count == s_m.size:
-            ms_t = s_m
-        else:
-            ms_t = evenly(grid, count)
-        t, chunks, blocks[key] = run_rows(key, pref, ms_t, n_win, chunk_bytes, probe, fixed_prefix)
-        res[key] = scaled_rows(
-            t,
-            fixed_prefix,
-            ms_t.size,
-            grid.size,
-            chunks,
-            "allanite._reference.davar_prefix(hop=1)",
-            fixed_name="cumulative angle",
-        )
+        res["naive"], blocks["naive"] = naive_sampled(dav, g, cfg["naive_m"], fixed_naive)
+    prefix_rows(reference, y, g, cfg, chunk_bytes, info, res, blocks)
 
     # allantools per window
     if allantools is not None:
@@ -567,6 +487,116 @@ def measure_n(
     for key, r in res.items():
         log(f"    {key:15s} {r['seconds']:12.4g} s{'  (extrapolated)' if r['extrapolated'] else ''}")
     return info, res, blocks
+
+
+def single_call_diagnostic(allanite, y, window, nbytes) -> dict:
+    """The whole "all" surface from one call, as a user would make it — once as it comes, once right after
+    touching that much memory (see prewarm). A diagnostic, not used in the table."""
+    diag = {"output_gib": nbytes / GiB}
+    for label in ("as_is", "after_prewarm"):
+        if label == "after_prewarm":
+            diag["prewarm_seconds"] = prewarm(nbytes + 64 * 2**20)
+        gc.collect()
+        t0 = time.perf_counter()
+        out = allanite.davar(
+            y, FS, window=window, hop=1, taus="all", method="fast", workers=WORKERS, max_memory=nbytes + 1
+        ).avar
+        diag[f"seconds_{label}"] = time.perf_counter() - t0
+        del out
+    log(
+        f"    fast, one call ({diag['output_gib']:.2f} GiB output): {diag['seconds_as_is']:.3g} s as is, "
+        f"{diag['seconds_after_prewarm']:.3g} s after touching that memory ({diag['prewarm_seconds']:.3g} s)"
+    )
+    return diag
+
+
+def naive_sampled(dav, g: Grids, naive_m, fixed_naive):
+    """DAVAR (naive) timed on the windows 0, h, 2h, … (and a sample of m) and extrapolated to every window
+    and m. Returns (its row, its kept block)."""
+    window, n_win, m_all, naive_hop, naive_n = g.window, g.n_win, g.m_all, g.naive_hop, g.naive_n
+    ms_n = m_all if naive_m is None else evenly(m_all, naive_m)
+    best, reps, out = timed(lambda: dav(ms_n, "naive", naive_hop))
+    blocks = [Block(ms_n, g.j_naive, out)]
+    del out
+    rec = {
+        "how": "",
+        "measured_seconds": best,
+        "repeats": reps,
+        "fixed_seconds": fixed_naive,
+        "windows_timed": int(naive_n),
+        "windows_total": int(n_win),
+        "m_timed": int(ms_n.size),
+        "m_total": int(m_all.size),
+        "extrapolated": True,
+        "call": f"allanite.davar(method='naive', hop={naive_hop}, workers=1)",
+    }
+    fixed_naive = min(fixed_naive, 0.5 * best)  # never let a noisy fixed cost swallow the work
+    rec["fixed_seconds_used"] = fixed_naive
+    if ms_n.size < m_all.size:
+        # The per-window angle (O(W)) and the call's overhead do not grow with the number of m: time the
+        # same windows with m = W/2 alone (one term per window); the difference is the sampled m's
+        # work, scaled by the number of terms.
+        a_best, a_reps, _ = timed(lambda: dav(np.array([window // 2]), "naive", naive_hop))
+        a_best = min(a_best, best)
+        angle = max(0.0, (a_best - fixed_naive) / naive_n)
+        work = (best - a_best) / naive_n
+        term_scale = (n_terms(window, m_all).sum() - 1) / max(1, n_terms(window, ms_n).sum() - 1)
+        per_window_all = angle + work * term_scale
+        rec.update(
+            angle_call_seconds=a_best,
+            angle_call_repeats=a_reps,
+            angle_per_window_seconds=angle,
+            term_scale=float(term_scale),
+        )
+        rec["how"] = (
+            f"{naive_n} windows (hop {naive_hop}) × {ms_n.size} evenly spread m timed "
+            f"({best:.3g} s), and the same windows at m = W/2 alone ({a_best:.3g} s: window angles "
+            f"+ overhead); per window: angle + (difference / {naive_n}) × "
+            f"Σ_all(W+1−2m)/Σ_sample(W+1−2m)"
+            f" = {term_scale:.4g}; × {n_win} windows; + fixed {fixed_naive:.2g} s"
+        )
+    else:
+        per_window_all = (best - fixed_naive) / naive_n
+        rec["how"] = (
+            f"{naive_n} windows (hop {naive_hop}) at every m timed ({best:.3g} s); "
+            f"(time − fixed {fixed_naive:.2g} s) / {naive_n} × {n_win} windows + fixed"
+        )
+    rec["seconds"] = fixed_naive + per_window_all * n_win
+    return rec, blocks
+
+
+def prefix_rows(reference, y, g: Grids, cfg, chunk_bytes, info, res, blocks) -> None:
+    """The NumPy prefix-sum twin on the all and exp grids, into ``res`` and ``blocks``."""
+    window, n_win, s_m = g.window, g.n_win, g.s_m
+    t0 = time.perf_counter()
+    for _ in range(3):
+        reference.angle_from_rate(y, FS)
+    fixed_prefix = (time.perf_counter() - t0) / 3
+    info["prefix_fixed_seconds"] = fixed_prefix
+
+    def pref(ms):
+        return reference.davar_prefix(y, FS, window, 1, ms)
+
+    for key, grid, count in (
+        ("prefix_all", g.m_all, cfg["prefix_all_m"]),
+        ("prefix_exp", g.m_exp, cfg["prefix_exp_m"]),
+    ):
+        if count is None:
+            ms_t = grid
+        elif key == "prefix_all" and s_m is not None and count == s_m.size:
+            ms_t = s_m
+        else:
+            ms_t = evenly(grid, count)
+        t, chunks, blocks[key] = run_rows(key, pref, ms_t, n_win, chunk_bytes, g.probe, fixed_prefix)
+        res[key] = scaled_rows(
+            t,
+            fixed_prefix,
+            ms_t.size,
+            grid.size,
+            chunks,
+            "allanite._reference.davar_prefix(hop=1)",
+            fixed_name="cumulative angle",
+        )
 
 
 def scaled_rows(t, fixed, n_timed, n_total, det, call, fixed_name="input checks and mean"):
@@ -832,6 +862,16 @@ def ratios(row):
 
 def write_markdown(report, path: Path):
     rows = report["table"]
+    lines = _md_table(report) + _md_grids(rows) + _md_growth(rows) + _md_instead(rows) + _md_agreement(report)
+    lines += _md_how(report) + _md_scaling(report)
+    if report["mode"] == "quick":
+        lines += ["_Quick mode: tiny sizes — a correctness smoke test of the script, not a timing result._", ""]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+
+
+def _md_table(report) -> list[str]:
+    """The page's head and the table itself: ours against paper 000 per N and method."""
+    rows = report["table"]
     m = report["machine"]
     lines = [
         "# Paper 000, Table 3 — DAVAR vs fast DAVAR vs improved fast DAVAR",
@@ -863,6 +903,12 @@ def write_markdown(report, path: Path):
             f"{fmt_ratio(q['naive_over_fast'])} | {fmt_ratio(q['paper_naive_over_fast'])} | "
             f"{fmt_ratio(q['fast_over_improved'])} | {fmt_ratio(q['paper_fast_over_improved'])} |"
         )
+    return lines
+
+
+def _md_grids(rows) -> list[str]:
+    """The other processes' CPU share per N, and the grids and window used."""
+    lines: list[str] = []
     loads = [
         f"{fmt_n(r['n'])}: {r['other_processes_cpu_fraction']:.0%}"
         for r in rows
@@ -881,6 +927,12 @@ def write_markdown(report, path: Path):
         "as the record, and at N = 1e3 W/9 = 11 still leaves the exponential grid 11 τ.",
         "",
     ]
+    return lines
+
+
+def _md_growth(rows) -> list[str]:
+    """Growth per decade of N against each method's work model (only where N grows by 10×)."""
+    lines: list[str] = []
     decades = [(a, b) for a, b in zip(rows, rows[1:]) if b["n"] == 10 * a["n"]]
     if decades:
         head, rule = "| method |", "|---|"
@@ -909,7 +961,12 @@ def write_markdown(report, path: Path):
             if b["n"] in PAPER and a["n"] in PAPER:
                 cells.append(fmt_ratio(PAPER[b["n"]][k] / PAPER[a["n"]][k]))
         lines.append(f"| {k} | " + " | ".join(cells) + f" | {models[k]} |")
-    lines += [
+    return lines
+
+
+def _md_instead(rows) -> list[str]:
+    """What users would do instead: NumPy prefix sums and allantools on the same grids."""
+    lines = [
         "",
         "## What users would do instead (same grids, same run, seconds)",
         "",
@@ -933,9 +990,13 @@ def write_markdown(report, path: Path):
             f"{cell('prefix_exp', 'prefix_exp_over_improved')} | "
             f"{cell('allantools_exp', 'allantools_exp_over_improved')} |"
         )
-    lines += [
-        "",
-        "(× = that method's time over allanite's on the same grid.)",
+    return lines + ["", "(× = that method's time over allanite's on the same grid.)"]
+
+
+def _md_agreement(report) -> list[str]:
+    """The agreement of every pair of methods, and which differences the 1e-9 check covers."""
+    rows = report["table"]
+    lines = [
         "",
         "## Agreement (max relative difference |a − b| / |b| at every shared m and window kept)",
         "",
@@ -974,6 +1035,14 @@ def write_markdown(report, path: Path):
         'the "all" grid\'s m (or the timed sample), at evenly strided windows, and every computed m at the '
         "naive and allantools sample windows.",
         "",
+    ]
+    return lines
+
+
+def _md_how(report) -> list[str]:
+    """How each number was obtained: per N and method, the timing rule and the memory note."""
+    rows = report["table"]
+    lines = [
         "## How each number was obtained",
         "",
         "| N | method | seconds | extrapolated | how |",
@@ -1011,6 +1080,12 @@ def write_markdown(report, path: Path):
                 f"chunks (the table)."
             )
     lines.append("")
+    return lines
+
+
+def _md_scaling(report) -> list[str]:
+    """The scaling rows (fresh process per row), when the report has them."""
+    lines: list[str] = []
     sc = report.get("scaling")
     if sc:
         sr = report.get("scaling_run")
@@ -1052,9 +1127,7 @@ def write_markdown(report, path: Path):
             ),
             "",
         ]
-    if report["mode"] == "quick":
-        lines += ["_Quick mode: tiny sizes — a correctness smoke test of the script, not a timing result._", ""]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return lines
 
 
 def plot(report, out: Path):
@@ -1063,6 +1136,14 @@ def plot(report, out: Path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    _plot_table(report, out, plt)
+    sc = report.get("scaling")
+    if sc:
+        _plot_scaling(sc, out, plt)
+
+
+def _plot_table(report, out: Path, plt) -> None:
+    """table3.png: every method's seconds against N, beside paper 000 Table 3."""
     rows = report["table"]
     fig, ax = plt.subplots(figsize=(11, 6))
     styles = {
@@ -1112,43 +1193,44 @@ def plot(report, out: Path):
     fig.savefig(out / "table3.png", dpi=120)
     plt.close(fig)
 
-    sc = report.get("scaling")
-    if sc:
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.5))
-        for w, c in ((1, "C0"), (2, "C2")):
-            pts = [s for s in sc if s["workers"] == w]
-            a1.plot([s["n"] for s in pts], [s["seconds"] for s in pts], "o-", color=c, label=f"{w} worker(s)")
-            a2.plot(
-                [s["n"] for s in pts],
-                [s["peak_rss_bytes"] / 2**20 for s in pts],
-                "o-",
-                color=c,
-                label=f"peak RSS, {w} worker(s)",
-            )
-            a2.plot(
-                [s["n"] for s in pts],
-                [s["call_extra_peak_bytes"] / 2**20 for s in pts],
-                "x:",
-                color=c,
-                label=f"added by the call, {w} worker(s)",
-            )
-        big = max(sc, key=lambda s: (s["n"], -s["workers"]))
-        ns = np.array(sorted({s["n"] for s in sc}), dtype=float)
-        a1.plot(ns, big["seconds"] * ns / big["n"], "k--", lw=0.8, alpha=0.6, label="∝ N")
-        a2.plot(ns, ns * 8 / 2**20, "k--", lw=0.8, alpha=0.6, label="input record (8 B × N)")
-        for a in (a1, a2):
-            a.set_xscale("log")
-            a.set_yscale("log")
-            a.grid(True, which="both", alpha=0.3)
-            a.set_xlabel("N (samples); window N/10, hop N/1000, exp grid")
-            a.legend(fontsize=7)
-        a1.set_ylabel("seconds")
-        a2.set_ylabel("MiB")
-        a1.set_title("improved fast DAVAR: time", fontsize=9)
-        a2.set_title("peak resident memory of a fresh process", fontsize=9)
-        fig.tight_layout()
-        fig.savefig(out / "scaling.png", dpi=120)
-        plt.close(fig)
+
+def _plot_scaling(sc, out: Path, plt) -> None:
+    """scaling.png: the improved fast DAVAR's time and peak memory against N, 1 and 2 workers."""
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.5))
+    for w, c in ((1, "C0"), (2, "C2")):
+        pts = [s for s in sc if s["workers"] == w]
+        a1.plot([s["n"] for s in pts], [s["seconds"] for s in pts], "o-", color=c, label=f"{w} worker(s)")
+        a2.plot(
+            [s["n"] for s in pts],
+            [s["peak_rss_bytes"] / 2**20 for s in pts],
+            "o-",
+            color=c,
+            label=f"peak RSS, {w} worker(s)",
+        )
+        a2.plot(
+            [s["n"] for s in pts],
+            [s["call_extra_peak_bytes"] / 2**20 for s in pts],
+            "x:",
+            color=c,
+            label=f"added by the call, {w} worker(s)",
+        )
+    big = max(sc, key=lambda s: (s["n"], -s["workers"]))
+    ns = np.array(sorted({s["n"] for s in sc}), dtype=float)
+    a1.plot(ns, big["seconds"] * ns / big["n"], "k--", lw=0.8, alpha=0.6, label="∝ N")
+    a2.plot(ns, ns * 8 / 2**20, "k--", lw=0.8, alpha=0.6, label="input record (8 B × N)")
+    for a in (a1, a2):
+        a.set_xscale("log")
+        a.set_yscale("log")
+        a.grid(True, which="both", alpha=0.3)
+        a.set_xlabel("N (samples); window N/10, hop N/1000, exp grid")
+        a.legend(fontsize=7)
+    a1.set_ylabel("seconds")
+    a2.set_ylabel("MiB")
+    a1.set_title("improved fast DAVAR: time", fontsize=9)
+    a2.set_title("peak resident memory of a fresh process", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(out / "scaling.png", dpi=120)
+    plt.close(fig)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -1259,46 +1341,7 @@ def run(quick: bool, out: Path | None, wait: float, skip_scaling: bool = False) 
     table = []
     for n in sizes:
         idle_n = wait_idle(min(wait, 60.0)) if wait > 0 and n != sizes[0] else None
-        with Load() as ld:
-            info, res, blocks = measure_n(
-                n,
-                cfg["table"][n],
-                y,
-                allanite,
-                _reference,
-                allantools,
-                cfg["chunk_bytes"],
-                cfg["probe_rows"],
-                cfg["probe_windows"],
-                single_call=n in cfg.get("single_call_diagnostic", ()),
-            )
-        agreement = {}
-        keys = list(res)
-        for i, a in enumerate(keys):
-            for b in keys[i + 1 :]:
-                pair = (a, b) if (a, b) in PAIRS else (b, a)
-                name = f"{pair[0]} vs {pair[1]}"
-                c = compare(blocks[pair[0]], blocks[pair[1]], info["window"] // 9)
-                c["checked"] = checked_diff(name, c)
-                c["check_applies_to"] = "m ≤ W/9" if "prefix" in name else "every shared value"
-                agreement[name] = c
-        del blocks
-        gc.collect()
-        row = {
-            **info,
-            "methods": res,
-            "agreement": agreement,
-            "other_processes_cpu_fraction": ld.fraction,
-            "idle_wait": idle_n,
-            "paper_seconds": PAPER.get(n),
-        }
-        row["ratios"] = ratios(row)
-        table.append(row)
-        if ld.fraction is not None and ld.fraction > 0.05:
-            log(f"  warning: other processes used {ld.fraction:.0%} of the CPUs during N = {n}")
-        bad = {k: v for k, v in agreement.items() if v["checked"] is not None and not v["checked"] <= 1e-9}
-        if bad:
-            log(f"  DISAGREEMENT at N = {n}: {bad}")
+        table.append(table_row(n, cfg, y, allanite, _reference, allantools, idle_n))
     diffs = [v["checked"] for r in table for v in r["agreement"].values() if v["checked"] is not None]
     sc = None
     if not skip_scaling:
@@ -1315,18 +1358,7 @@ def run(quick: bool, out: Path | None, wait: float, skip_scaling: bool = False) 
             "generator": "numpy.random.default_rng",
             "fs": FS,
         },
-        "setup": {
-            "window": "N/10",
-            "hop": 1,
-            "workers": WORKERS,
-            "estimator": "oavar (overlapping)",
-            "grids": {
-                "all": "m = 1 … W/2 (paper 000: 1 … W/2 − 1)",
-                "exp": "paper 000 §4.2: 100 points m0·g^(i−1) up to W/9, rounded, duplicates dropped",
-            },
-            "sampling": {str(n): c for n, c in cfg["table"].items()},
-            "chunk_bytes": cfg["chunk_bytes"],
-        },
+        "setup": setup_record(cfg),
         "methods": METHODS,
         "paper": {
             "source": "paper 000 Table 3, Matlab 7.11, 3 GHz Core 2 Duo",
@@ -1347,6 +1379,66 @@ def run(quick: bool, out: Path | None, wait: float, skip_scaling: bool = False) 
         f"({report['total_seconds']:.1f} s)"
     )
     return report
+
+
+def table_row(n, cfg, y, allanite, reference, allantools, idle_n) -> dict:
+    """One N of the table: every method measured (with the other processes' load) and every pair compared."""
+    with Load() as ld:
+        info, res, blocks = measure_n(
+            n,
+            cfg["table"][n],
+            y,
+            allanite,
+            reference,
+            allantools,
+            cfg["chunk_bytes"],
+            cfg["probe_rows"],
+            cfg["probe_windows"],
+            single_call=n in cfg.get("single_call_diagnostic", ()),
+        )
+    agreement = {}
+    keys = list(res)
+    for i, a in enumerate(keys):
+        for b in keys[i + 1 :]:
+            pair = (a, b) if (a, b) in PAIRS else (b, a)
+            name = f"{pair[0]} vs {pair[1]}"
+            c = compare(blocks[pair[0]], blocks[pair[1]], info["window"] // 9)
+            c["checked"] = checked_diff(name, c)
+            c["check_applies_to"] = "m ≤ W/9" if "prefix" in name else "every shared value"
+            agreement[name] = c
+    del blocks
+    gc.collect()
+    row = {
+        **info,
+        "methods": res,
+        "agreement": agreement,
+        "other_processes_cpu_fraction": ld.fraction,
+        "idle_wait": idle_n,
+        "paper_seconds": PAPER.get(n),
+    }
+    row["ratios"] = ratios(row)
+    if ld.fraction is not None and ld.fraction > 0.05:
+        log(f"  warning: other processes used {ld.fraction:.0%} of the CPUs during N = {n}")
+    bad = {k: v for k, v in agreement.items() if v["checked"] is not None and not v["checked"] <= 1e-9}
+    if bad:
+        log(f"  DISAGREEMENT at N = {n}: {bad}")
+    return row
+
+
+def setup_record(cfg) -> dict:
+    """The report's "setup": window, hop, workers, estimator, grids and the sampling per N."""
+    return {
+        "window": "N/10",
+        "hop": 1,
+        "workers": WORKERS,
+        "estimator": "oavar (overlapping)",
+        "grids": {
+            "all": "m = 1 … W/2 (paper 000: 1 … W/2 − 1)",
+            "exp": "paper 000 §4.2: 100 points m0·g^(i−1) up to W/9, rounded, duplicates dropped",
+        },
+        "sampling": {str(n): c for n, c in cfg["table"].items()},
+        "chunk_bytes": cfg["chunk_bytes"],
+    }
 
 
 def main(argv=None) -> int:

@@ -78,18 +78,25 @@ QUANT = 1e-4  # °
 
 
 def part_timings(cfg: dict) -> dict:
-    import allanite
-
-    out = {}
     rng = np.random.default_rng(SEED)
     reps = cfg["repeats"]
+    # one generator, drawn in this order: TheoH's record, then Theo1's, then DHVAR's
+    return {
+        "theoh": _time_theoh(rng.normal(size=cfg["theoh_n"]), reps),
+        "theo1": _time_theo1(rng.normal(size=cfg["theo1_n"]), reps),
+        "dhvar": _time_dhvar(rng.normal(size=cfg["dhvar_n"]), cfg["dhvar_window"], reps),
+    }
 
-    # 1. TheoH, N = 1e5, exp grid
-    y = rng.normal(size=cfg["theoh_n"])
+
+def _time_theoh(y, reps) -> dict:
+    """1. TheoH, N = 1e5, exp grid, against OAVAR on the same grid."""
+    import allanite
+
     with _common.OtherLoad() as load:
         best, times, r = _common.timed(lambda: allanite.avar(y, 1.0, estimator="theoh", taus="exp"), reps, warmup=True)
         a_best, a_times, _ = _common.timed(lambda: allanite.avar(y, 1.0, taus="exp"), reps, warmup=True)
-    out["theoh"] = {
+    _common.log(f"TheoH N={y.size}: {best:.3f} s ({r.tau.size} τ; OAVAR same grid {a_best:.3f} s)")
+    return {
         "n": y.size,
         "grid": "exp",
         "tau_points": int(r.tau.size),
@@ -101,10 +108,12 @@ def part_timings(cfg: dict) -> dict:
         "theobr_points": int(np.sum(r.source == "theobr")),
         "other_processes_cpu_fraction": load.fraction,
     }
-    _common.log(f"TheoH N={y.size}: {best:.3f} s ({r.tau.size} τ; OAVAR same grid {a_best:.3f} s)")
 
-    # 2. Theo1 vs allantools, N = 1e4, octave grid of even m
-    y = rng.normal(size=cfg["theo1_n"])
+
+def _time_theo1(y, reps) -> dict:
+    """2. Theo1 vs allantools, N = 1e4, octave grid of even m."""
+    import allanite
+
     ms = [m for m in (10, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 8192) if m <= y.size]
     with _common.OtherLoad() as load:
         best, times, r = _common.timed(
@@ -115,37 +124,39 @@ def part_timings(cfg: dict) -> dict:
         import allantools
     except ImportError:
         entry["allantools"] = "not installed"
-    else:
-        with _common.OtherLoad() as load:
-            t_at, _, res = _common.timed(
-                lambda: allantools.theo1(y, rate=1.0, data_type="freq", taus=np.array(ms, dtype=float)), 1
-            )
-        taus_at, dev_at = np.asarray(res[0]), np.asarray(res[1])
-        m_at = np.round(taus_at).astype(int)
-        ours = {int(m): v for m, v in zip(r.m, r.avar)}
-        common = [i for i, m in enumerate(m_at) if m in ours]
-        diff = max(abs(dev_at[i] ** 2 / ours[m_at[i]] - 1) for i in common) if common else None
-        entry.update(
-            {
-                "allantools_seconds": t_at,
-                "speedup": t_at / best,
-                "allantools_version": allantools.__version__,
-                "allantools_m": m_at.tolist(),
-                "allantools_tau_label": taus_at.tolist(),
-                "compared_points": len(common),
-                "max_rel_diff_variance": diff,
-                "allantools_other_processes_cpu_fraction": load.fraction,
-            }
+        return entry
+    with _common.OtherLoad() as load:
+        t_at, _, res = _common.timed(
+            lambda: allantools.theo1(y, rate=1.0, data_type="freq", taus=np.array(ms, dtype=float)), 1
         )
-        _common.log(
-            f"Theo1 N={y.size}: allanite {best * 1e3:.2f} ms, allantools {t_at:.1f} s → {t_at / best:.0f}×, "
-            f"max rel diff {diff:.2e} at corrected τ"
-        )
-    out["theo1"] = entry
+    taus_at, dev_at = np.asarray(res[0]), np.asarray(res[1])
+    m_at = np.round(taus_at).astype(int)
+    ours = {int(m): v for m, v in zip(r.m, r.avar)}
+    common = [i for i, m in enumerate(m_at) if m in ours]
+    diff = max(abs(dev_at[i] ** 2 / ours[m_at[i]] - 1) for i in common) if common else None
+    entry.update(
+        {
+            "allantools_seconds": t_at,
+            "speedup": t_at / best,
+            "allantools_version": allantools.__version__,
+            "allantools_m": m_at.tolist(),
+            "allantools_tau_label": taus_at.tolist(),
+            "compared_points": len(common),
+            "max_rel_diff_variance": diff,
+            "allantools_other_processes_cpu_fraction": load.fraction,
+        }
+    )
+    _common.log(
+        f"Theo1 N={y.size}: allanite {best * 1e3:.2f} ms, allantools {t_at:.1f} s → {t_at / best:.0f}×, "
+        f"max rel diff {diff:.2e} at corrected τ"
+    )
+    return entry
 
-    # 3. DHVAR, N = 4e4, window 401, hop 1
-    y = rng.normal(size=cfg["dhvar_n"])
-    w = cfg["dhvar_window"]
+
+def _time_dhvar(y, w, reps) -> dict:
+    """3. DHVAR, N = 4e4, window 401, hop 1, against DAVAR on the same windows."""
+    import allanite
+
     with _common.OtherLoad() as load:
         best, times, d = _common.timed(
             lambda: allanite.davar(y, 25.0, window=w, hop=1, estimator="theoh", taus="exp"), reps, warmup=True
@@ -153,7 +164,8 @@ def part_timings(cfg: dict) -> dict:
         a_best, a_times, da = _common.timed(
             lambda: allanite.davar(y, 25.0, window=w, hop=1, taus="exp"), reps, warmup=True
         )
-    out["dhvar"] = {
+    _common.log(f"DHVAR N={y.size} W={w}: {best:.3f} s ({d.tau.size} τ × {d.t.size} windows); DAVAR {a_best:.3f} s")
+    return {
         "n": y.size,
         "window": w,
         "hop": 1,
@@ -166,8 +178,6 @@ def part_timings(cfg: dict) -> dict:
         "davar_tau_points": int(da.tau.size),
         "other_processes_cpu_fraction": load.fraction,
     }
-    _common.log(f"DHVAR N={y.size} W={w}: {best:.3f} s ({d.tau.size} τ × {d.t.size} windows); DAVAR {a_best:.3f} s")
-    return out
 
 
 def simulate_paper001(seconds: float, seed: int = SEED):
@@ -191,13 +201,7 @@ def true_avar(tau):
 
 
 def part_paper001(cfg: dict, out_dir: Path) -> dict:
-    import matplotlib
-
     import allanite
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     import allanite.model.fitting as fit_mod
 
     y, (t1, t2) = simulate_paper001(cfg["paper_seconds"])
@@ -221,7 +225,33 @@ def part_paper001(cfg: dict, out_dir: Path) -> dict:
         if hasattr(next(iter(expected.coefficients.values())), "ieee_unit")
         else {}
     )
+    quiet, scatter = _quiet_scatter(res, window, t1)
+    narrowing = []
+    for row in scatter:
+        if "DAVAR" in row and "DHVAR" in row:
+            narrowing.append(1 - row["DHVAR"]["rms_rel_error"] / row["DAVAR"]["rms_rel_error"])
+    _paper001_figures(res, series, table, scatter, window, (t1, t2), out_dir)
+    return {
+        "seconds": cfg["paper_seconds"],
+        "fs": FS,
+        "window": window,
+        "hop": hop,
+        "gm_tc": GM_TC,
+        "gm_var": [GM_VAR_QUIET, GM_VAR_LOUD],
+        "white_N": WHITE_N,
+        "quantization": QUANT,
+        "loud_interval_s": [t1, t2],
+        "quiet_windows": int(quiet.sum()),
+        "table": table,
+        "ieee_units": ieee_units,
+        "scatter": scatter,
+        "median_rms_error_reduction_dhvar_vs_davar": float(np.median(narrowing)) if narrowing else None,
+        "kf_median": {n: float(np.median(d.kf)) for n, d in res.items() if d.kf is not None},
+    }
 
+
+def _quiet_scatter(res, window, t1):
+    """(the quiet windows' mask, per picked τ each surface's scatter there against the closed form)."""
     # Scatter inside the stationary stretch (windows entirely before the loud part), at matched τ:
     # Theo τ = 0.75·m/fs; DAVAR evaluated at the same τ where it exists (m ≤ window/2).
     d0 = res["DAVAR"]
@@ -243,10 +273,15 @@ def part_paper001(cfg: dict, out_dir: Path) -> dict:
                 "mean_rel_bias": float(np.mean(v) / row["true_avar"] - 1),
             }
         scatter.append(row)
-    narrowing = []
-    for row in scatter:
-        if "DAVAR" in row and "DHVAR" in row:
-            narrowing.append(1 - row["DHVAR"]["rms_rel_error"] / row["DAVAR"]["rms_rel_error"])
+    return quiet, scatter
+
+
+def _paper001_figures(res, series, table, scatter, window, loud, out_dir: Path) -> None:
+    """theo_paper001_surfaces.png (the three surfaces) and theo_paper001_series.png (B per window, scatter)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
 
     # Figure: the three surfaces side by side (log10 ADEV over t × τ).
     fig = plt.figure(figsize=(15, 4.6))
@@ -267,7 +302,7 @@ def part_paper001(cfg: dict, out_dir: Path) -> dict:
     for name, s in series.items():
         ax[0].plot(s.t, s.ieee["B"], label=name, lw=1)
     ax[0].axhline(table["expected"]["B"], color="k", ls="--", label="whole record")
-    ax[0].axvspan(t1, t2, color="0.9")
+    ax[0].axvspan(*loud, color="0.9")
     ax[0].set_xlabel("t (s)")
     ax[0].set_ylabel("B (°/h)")
     ax[0].legend()
@@ -286,23 +321,6 @@ def part_paper001(cfg: dict, out_dir: Path) -> dict:
     fig.tight_layout()
     fig.savefig(out_dir / "theo_paper001_series.png", dpi=90)
     plt.close(fig)
-    return {
-        "seconds": cfg["paper_seconds"],
-        "fs": FS,
-        "window": window,
-        "hop": hop,
-        "gm_tc": GM_TC,
-        "gm_var": [GM_VAR_QUIET, GM_VAR_LOUD],
-        "white_N": WHITE_N,
-        "quantization": QUANT,
-        "loud_interval_s": [t1, t2],
-        "quiet_windows": int(quiet.sum()),
-        "table": table,
-        "ieee_units": ieee_units,
-        "scatter": scatter,
-        "median_rms_error_reduction_dhvar_vs_davar": float(np.median(narrowing)) if narrowing else None,
-        "kf_median": {n: float(np.median(d.kf)) for n, d in res.items() if d.kf is not None},
-    }
 
 
 def _fmt(v, digits=4):
@@ -310,6 +328,12 @@ def _fmt(v, digits=4):
 
 
 def write_markdown(report: dict, path: Path) -> None:
+    lines = _md_timings(report) + _md_paper001(report["paper001"])
+    path.write_text("\n".join(lines))
+
+
+def _md_timings(report: dict) -> list[str]:
+    """The page's head and the timing table (TheoH, Theo1 against allantools, DHVAR) with its notes."""
     t = report["timings"]
     lines = [
         "# TheoH / DHVAR benchmark",
@@ -354,9 +378,12 @@ def write_markdown(report: dict, path: Path) -> None:
         + ", ".join(f"{k} {_fmt(100 * v, 2) if v is not None else '?'} %" for k, v in loads.items()),
         "",
     ]
+    return lines
 
-    p = report["paper001"]
-    lines += [
+
+def _md_paper001(p: dict) -> list[str]:
+    """Paper 001 rebuilt: the mean coefficients per surface, the quiet windows' scatter, the figures."""
+    lines = [
         "## Paper 001 rebuilt: DAVAR vs DHVAR-A vs DHVAR",
         "",
         f"{p['seconds']:.0f} s at {p['fs']:g} Hz; Gauss–Markov bias (T_c = {p['gm_tc']} s) of variance "
@@ -398,7 +425,7 @@ def write_markdown(report: dict, path: Path) -> None:
         "![series](theo_paper001_series.png)",
         "",
     ]
-    path.write_text("\n".join(lines))
+    return lines
 
 
 def run(quick: bool = False, out: Path | None = None, wait: float = 0.0) -> dict:

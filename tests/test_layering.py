@@ -160,6 +160,7 @@ MODEL_RANKS = {
     "model.fitting": 1,
     "model.tracing": 1,
     "model._whittle": 0,
+    "model._lag": 0.5,  # a channel's first-order lag: its test and profile (on _whittle)
     "model._shares": 0,
     "model.channels": 1,
     "model.timeframes": 2,

@@ -26,7 +26,11 @@ Optional terms, each kept only by its own nested test at its own share of the le
   statistic against the t-process upcrossing bound (Davies 1987; Worsley 1994: P(F(1, ν) > u) +
   (V/π)·(1 + u/ν)^{−(ν−1)/2}, V the arc length of the whitened family over the grid). A lag and a d(ch)/dt
   term are nearly collinear: when both pass, the lag is kept only if the pure lag model c·L_T[ch] beats the
-  rate model by :data:`LAG_MARGIN` in 2Δℓ; otherwise the rate term is kept — never both.
+  rate model by :data:`LAG_MARGIN` in 2Δℓ; otherwise the rate term is kept — never both. A lag its test does
+  not keep (and no d(ch)/dt term in its place) is still profiled: where the profile prefers a lag to none at the
+  intervals' level, the removal takes the channel through it (:attr:`ChannelRegression.removal_lag_s`; the lag
+  itself is reported as not resolved, under ``terms["lag_s"]["profiled"]``, not as a param) — at lag 0 the
+  coupling's phase error stays in the residual (:mod:`allanite.model._lag`).
 
 Intervals: the coefficients ±t_ν quantile × the inverse Fisher information's standard error; the lag from the
 profile likelihood.
@@ -38,14 +42,13 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import signal
-from scipy.optimize import brentq
 from scipy.stats import f as f_dist
 from scipy.stats import t as t_dist
 
 from .._validate import check_fs, check_probability
 from ..errors import InputError, ParameterError
 from . import _whittle as wh
+from ._lag import lag_grid, lag_profile, lag_response, lag_test, lagged, unresolved_lag
 from ._rfft import band_limited, rfft
 from ._shares import TERM_SHARE
 
@@ -60,6 +63,7 @@ __all__ = [
     "SUBTERMS",
     "TERM_SHARE",
     "SLOW_SHARE",
+    "lagged",
 ]
 
 #: Optional terms of a channel regression, in the order they are tried.
@@ -69,8 +73,6 @@ LEVEL = 0.05
 ALPHA = 0.075 * LEVEL
 #: The pure lag replaces a kept rate term only if it fits better by this much in 2Δℓ ("positive" evidence).
 LAG_MARGIN = 4.0
-#: Lag grid: points per octave, from 2 samples to a quarter of the record.
-LAG_PER_OCTAVE = 8
 #: Share of the channel's information (Σ_b |Z_b|²/S_b) whose bands the held-out ratio is summed over.
 HELDOUT_INFO = 0.99
 #: A band of the channel takes part only where its power is this many times its measurement noise's.
@@ -167,6 +169,8 @@ class ChannelRegression:
     ``test``: the coupling's likelihood ratio (``statistic``, 2Δℓ), ``threshold``, ``alpha``, ``dof`` (ν),
     ``p_value``; ``terms``: each optional term's test (``statistic``, ``threshold``, ``alpha``, ``dof``,
     ``kept``, and why not); ``accepted``: the coupling passed its test (optional terms are tried only then).
+    ``removal_lag_s``: the lag the component runs the channel through — the kept ``lag_s``, or a lag its test
+    did not resolve but the profile prefers to none (``terms["lag_s"]["profiled"]``, not a param), or None.
     """
 
     name: str
@@ -180,6 +184,7 @@ class ChannelRegression:
     quad_mean: float
     noise: dict = field(default_factory=dict)
     signal_bands: list | None = None
+    removal_lag_s: float | None = None
 
     def columns(self, ch) -> np.ndarray:
         """The regressors of the kept terms, (k, n), for the channel samples ``ch`` (the whole record: a lag
@@ -187,9 +192,22 @@ class ChannelRegression:
         kept; the fit's means."""
         x = np.asarray(ch, dtype=np.float64)
         xs = band_limited(x, self.fs, self.signal_bands)
-        cols = _columns(xs, self.mean, self.quad_mean, self.fs, self.params.get("lag_s"))
+        cols = _columns(xs, self.mean, self.quad_mean, self.fs, self.removal_lag_s)
         keep = [0] + [i for i, k in ((1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
         return np.array([cols[i] for i in keep])
+
+    def lag_note(self) -> str | None:
+        """In words, where the removal's lag is not a kept term: the lag profiled for the removal, or None."""
+        prof = self.terms.get("lag_s", {}).get("profiled")
+        if self.removal_lag_s is None or "lag_s" in self.params or prof is None:
+            return None
+        t = self.terms["lag_s"]
+        lo, hi = prof["interval"]
+        return (
+            f"a lag not resolved at its test's level (statistic {t['statistic']:.3g} against {t['threshold']:.3g}); "
+            f"the removal takes the channel through the profile's {prof['lag_s']:.4g} s (interval {lo:.4g}–{hi:.4g} s, "
+            f"2Δℓ {prof['gain']:.3g} over no lag) — not claimed as a term"
+        )
 
     def coefficients(self) -> np.ndarray:
         """The kept terms' coefficients, in the order of :meth:`columns`."""
@@ -212,13 +230,6 @@ class ChannelRegression:
         c = wh.joint_fit(bands, wh.Design(list(range(len(cols))), [one] * len(cols)))["c"]
         comp = c @ cols
         return lambda i: comp[np.asarray(i)]
-
-
-def lagged(x: np.ndarray, lag_s: float, fs: float) -> np.ndarray:
-    """``x`` through a first-order lag of time constant ``lag_s`` (impulse invariant, a = 1 − e^{−1/(fs·T)}),
-    starting in equilibrium with the first sample."""
-    a = -math.expm1(-1.0 / (fs * lag_s))
-    return signal.lfilter([a], [1.0, a - 1.0], x - x[0]) + x[0]
 
 
 def channel_signal(x: np.ndarray, fs: float) -> tuple[float, list | None]:
@@ -251,11 +262,6 @@ def channel_signal(x: np.ndarray, fs: float) -> tuple[float, list | None]:
     return floor, out or [(0.0, 0.0)]
 
 
-def _lag_response(f: np.ndarray, lag_s: float, fs: float) -> np.ndarray:
-    a = -math.expm1(-1.0 / (fs * lag_s))
-    return a / (1.0 - (1.0 - a) * np.exp(-2j * np.pi * f / fs))
-
-
 def _f_test(stat: float, dof: float, alpha: float) -> dict:
     return {
         "statistic": float(stat),
@@ -282,101 +288,6 @@ def _nested(bands, design, fit_small, alpha) -> tuple[dict, dict]:
     v = _new_direction(bands, design, big["s"])
     dof = wh.noise_dof(bands, big, wh.band_info(bands, design, v))
     return _f_test(2.0 * (big["loglik"] - fit_small["loglik"]), dof, alpha), big
-
-
-def _lag_grid(n: int, fs: float) -> np.ndarray:
-    lo, hi = 2.0 / fs, n / fs / 4.0
-    k = max(2, int(round(LAG_PER_OCTAVE * math.log2(hi / lo))) + 1)
-    return np.geomspace(lo, hi, k)
-
-
-def _lag_test(bands, design, fit, alpha, grid) -> dict:
-    """The largest score statistic of (L_T[ch] − ch) added to ``design`` over the lag grid, against the
-    upcrossing bound of its t process (module docstring)."""
-    w = 1.0 / fit["s"]
-    src = design.src[0]
-    mult = np.array([_lag_response(bands.f, t, bands.fs) - 1.0 for t in grid])  # (n_T, nb)
-    gw = bands.G[:, src, src].real * w
-    # the family's Gram matrix is needed only on its diagonal and first off-diagonal (the arc length)
-    c_diag = 2.0 * np.sum(np.abs(mult) ** 2 * gw, axis=1)
-    c_next = 2.0 * np.sum((np.conj(mult[:-1]) * mult[1:]).real * gw, axis=1)
-    c_fd = np.column_stack(
-        [2.0 * ((np.conj(mult) * (m * bands.G[:, src, k])).real @ w) for k, m in zip(design.src, design.mult)]
-    )
-    i_dd = 2.0 * wh.cross(bands, design, design, w)
-    sol = np.linalg.solve(i_dd, c_fd.T)
-    var = np.maximum(c_diag - np.sum(c_fd * sol.T, axis=1), 1e-300)
-    cov_next = c_next - np.sum(c_fd[:-1] * sol.T[1:], axis=1)
-    sc = 2.0 * ((np.conj(mult) * bands.g[:, src]).real @ w) - c_fd @ fit["c"]
-    stat = sc**2 / var
-    j = int(np.argmax(stat))
-    cos = np.abs(cov_next) / np.sqrt(var[:-1] * var[1:])
-    arc = float(np.sum(np.arccos(np.clip(cos, 0.0, 1.0))))
-    v = np.append(-np.linalg.solve(i_dd, c_fd[j]), 1.0)
-    full = design.plus(src, mult[j])
-    dof = wh.noise_dof(bands, fit, wh.band_info(bands, full, v))
-
-    thr = _upcrossing_threshold(alpha, dof, arc)
-    return {
-        "statistic": float(stat[j]),
-        "threshold": float(thr),
-        "alpha": float(alpha),
-        "dof": float(dof),
-        "p_value": min(1.0, _upcrossing_p(float(stat[j]), dof, arc)),
-        "arc_length": arc,
-        "at_lag_s": float(grid[j]),
-    }
-
-
-def _upcrossing_p(u: float, dof: float, arc: float) -> float:
-    """P(max over the lag grid > u): P(F(1, ν) > u) + (V/π)·(1 + u/ν)^{−(ν−1)/2} (module docstring)."""
-    return float(f_dist.sf(u, 1, dof) + arc / math.pi * (1.0 + u / dof) ** (-(dof - 1.0) / 2.0))
-
-
-def _upcrossing_threshold(alpha: float, dof: float, arc: float) -> float:
-    """The u where :func:`_upcrossing_p` falls to ``alpha``; with few degrees of freedom the bound's tail is slow
-    (ν = 2.6, V = 2.5: beyond 10⁴), and where it never gets there (ν ≤ 1) no statistic can pass: ∞."""
-    if _upcrossing_p(1e-6, dof, arc) <= alpha:
-        return 0.0
-    hi = 1e4
-    while _upcrossing_p(hi, dof, arc) > alpha and hi < 1e12:
-        hi *= 100.0
-    if _upcrossing_p(hi, dof, arc) > alpha:
-        return math.inf
-    return float(brentq(lambda u: _upcrossing_p(u, dof, arc) - alpha, 1e-6, hi))
-
-
-def _lag_objective(bands, design, s, lag_s) -> float:
-    """Σ ĉᵀ·score with the noise fixed (the likelihood up to a constant) for the pure lag model: the channel
-    column of ``design`` (its first) through the lag ``lag_s``."""
-    d = wh.Design(design.src, [_lag_response(bands.f, lag_s, bands.fs)] + design.mult[1:])
-    info, sc = d.gram(bands, 1.0 / s)
-    return float(sc @ np.linalg.solve(info, sc))
-
-
-def _lag_profile(bands, design, s, grid, z2) -> tuple[float, tuple]:
-    """The pure lag model's T (profile likelihood, noise fixed) and its interval where 2Δℓ ≤ ``z2``."""
-    prof = np.array([_lag_objective(bands, design, s, t) for t in grid])
-    j = int(np.argmax(prof))
-    lo, hi = math.log(grid[max(0, j - 1)]), math.log(grid[min(grid.size - 1, j + 1)])
-    from scipy.optimize import minimize_scalar
-
-    res = minimize_scalar(lambda lt: -_lag_objective(bands, design, s, math.exp(lt)), bounds=(lo, hi), method="bounded")
-    best, top = math.exp(float(res.x)), -float(res.fun)
-
-    def gap(lt):
-        return 2.0 * (top - _lag_objective(bands, design, s, math.exp(lt))) - z2
-
-    ends = []
-    for side in (range(j, -1, -1), range(j, grid.size)):
-        inner, end = math.log(best), None
-        for k in side:
-            if gap(math.log(grid[k])) > 0:
-                end = math.exp(brentq(gap, *sorted((inner, math.log(grid[k])))))
-                break
-            inner = math.log(grid[k])
-        ends.append(end if end is not None else float(grid[side[-1]] if len(side) else best))
-    return best, (min(ends[0], best), max(ends[1], best))
 
 
 def _columns(xs: np.ndarray, mean: float, quad_mean: float, fs: float, lag_s: float | None) -> list:
@@ -420,11 +331,11 @@ def _optional_terms(bands, fit, terms, level, grid, z2):
         tests["rate_coefficient"] = t_r | {"kept": rate_ok}
     lag_s = None
     if "lag_s" in terms:
-        t_l = _lag_test(bands, design, fit, TERM_SHARE["lag_s"] * level, grid)
+        t_l = lag_test(bands, design, fit, TERM_SHARE["lag_s"] * level, grid)
         tests["lag_s"] = t_l | {"kept": False}
         if t_l["statistic"] > t_l["threshold"]:
-            best, interval = _lag_profile(bands, design, fit["s"], grid, z2)
-            lag_design = wh.Design(design.src, [_lag_response(bands.f, best, bands.fs)] + design.mult[1:])
+            best, interval = lag_profile(bands, design, fit["s"], grid, z2)
+            lag_design = wh.Design(design.src, [lag_response(bands.f, best, bands.fs)] + design.mult[1:])
             fit_l = wh.joint_fit(bands, lag_design)
             margin = 2.0 * (fit_l["loglik"] - fit_r["loglik"]) if rate_ok and fit_r is not None else math.inf
             tests["lag_s"] |= {"lag_s": best, "interval": interval, "against_rate": margin}
@@ -502,10 +413,7 @@ def regress_channel(
     alpha = check_probability(alpha, "alpha")
     level = check_probability(level, "level")
     confidence = check_probability(confidence)
-    terms = (terms,) if isinstance(terms, str) else tuple(terms)
-    bad = [t for t in terms if t not in SUBTERMS]
-    if bad:
-        raise ParameterError(f"unknown channel regression term {bad[0]!r}; allowed: {', '.join(SUBTERMS)}")
+    terms = _check_subterms(terms)
     n_use = wh.usable_length(y.size)
     y, x = y[:n_use], x[:n_use]
     floor, sig = channel_signal(x, fs)
@@ -516,13 +424,14 @@ def regress_channel(
     null = wh.joint_fit(bands, wh.Design([], []))
     test, fit = _nested(bands, _design([], bands.m.size), null, alpha)
     accepted = test["statistic"] > test["threshold"]
-    keys, lag, tests = [], None, {}
+    keys, lag, tests, removal_lag = [], None, {}, None
     if accepted:
         z2 = float(t_dist.isf((1.0 - confidence) / 2.0, test["dof"])) ** 2
-        keys, fit, lag_s, tests = _optional_terms(bands, fit, terms, level, _lag_grid(y.size, fs), z2)
-        if lag_s is not None:
-            lag = (lag_s, tests["lag_s"]["interval"])
-            exact = wh.spectra(y, _columns(xs, mean, quad_mean, fs, lag_s), fs)
+        keys, fit, lag_s, tests = _optional_terms(bands, fit, terms, level, lag_grid(y.size, fs), z2)
+        removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, lag_grid(y.size, fs), z2)
+        lag = (lag_s, tests["lag_s"]["interval"]) if lag_s is not None else None
+        if removal_lag is not None:
+            exact = wh.spectra(y, _columns(xs, mean, quad_mean, fs, removal_lag), fs)
             fit = wh.joint_fit(exact, _design(keys, exact.m.size))
     dofs = {"coefficient": test["dof"]} | {k: tests[k]["dof"] for k in keys}
     params, intervals = _params(fit, keys, dofs, confidence, lag)
@@ -530,7 +439,37 @@ def regress_channel(
     # K, B and the Gauss–Markov shapes trade against each other (the level they add up to is what is used);
     # the terms before and after a removal come from the Allan fits (terms_before_after)
     noise = {"channel_noise": math.sqrt(floor), "whittle_loglik_gain": float(fit["loglik"] - null["loglik"])}
-    return ChannelRegression(name, bool(accepted), params, intervals, test, tests, fs, mean, quad_mean, noise, sig)
+    return ChannelRegression(
+        name, bool(accepted), params, intervals, test, tests, fs, mean, quad_mean, noise, sig, removal_lag
+    )
+
+
+def _check_subterms(terms) -> tuple:
+    """``terms`` as a tuple of names of :data:`SUBTERMS` (one name alone too), or a ParameterError naming the
+    first unknown one."""
+    terms = (terms,) if isinstance(terms, str) else tuple(terms)
+    bad = [t for t in terms if t not in SUBTERMS]
+    if bad:
+        raise ParameterError(f"unknown channel regression term {bad[0]!r}; allowed: {', '.join(SUBTERMS)}")
+    return terms
+
+
+def _removal_lag(bands, fit, keys, tests, grid, z2) -> float | None:
+    """The lag the removal takes when the lag's test did not keep one (and no d(ch)/dt term stands in for it):
+    the profile's best T where it beats no lag by more than the intervals' 2Δℓ
+    (:func:`allanite.model._lag.unresolved_lag`), recorded under ``tests["lag_s"]["profiled"]``; else None (the
+    channel as it is).
+
+    Why: a coefficient fitted at lag 0 on a channel that reaches the rate through a lag leaves c·(L_T[ch] − ch)
+    in the residual. On a 1 Hz × 10⁵ FOG-like record (rate random walk dominating) with the temperature through
+    900 s, the lag's test reads 2.27 against 16.5 (it cannot claim the lag), and the removal at lag 0 raised
+    the chain's held-out error 2.13 → 2.76 %; with the profiled 498 s 1.28 %, at the true 900 s 0.79 %
+    (docs/channels.md, "A lag not resolved")."""
+    if "lag_s" not in tests or "rate_coefficient" in keys:
+        return None
+    prof = unresolved_lag(bands, _design(keys, bands.m.size), fit["s"], grid, z2)
+    tests["lag_s"]["profiled"] = prof
+    return float(prof["lag_s"]) if prof["used"] else None
 
 
 def _informative(info: np.ndarray) -> np.ndarray:
@@ -565,7 +504,7 @@ def heldout_ratio(y, ch, fs: float, reg: ChannelRegression) -> float:
     n_use = wh.usable_length(y.size)
     y, x = y[:n_use], check_channel(reg.name, ch, y.size)[:n_use]
     xs = band_limited(x, fs, reg.signal_bands)
-    cols = _columns(xs, reg.mean, reg.quad_mean, fs, reg.params.get("lag_s"))
+    cols = _columns(xs, reg.mean, reg.quad_mean, fs, reg.removal_lag_s)
     split = [wh.spectra(y, cols, fs, parity) for parity in (0, 1)]
     half = wh.usable_length(n_use // 2)
     halves = [wh.spectra(y[a : a + half], [c[a : a + half] for c in cols], fs) for a in (0, n_use - half)]

@@ -256,6 +256,8 @@ def _slow_regression(
         "signal_bands_hz": r.signal_bands,
         "heldout": "even ↔ odd DFT bins",
     }
+    if r.lag_note():  # a lag its test cannot claim, profiled for the removal (docs/channels.md)
+        ev |= {"lag": r.lag_note(), "removal_lag_s": r.removal_lag_s}
     yield Removal(
         "regression",
         r.component(ch),
