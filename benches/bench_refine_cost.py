@@ -21,6 +21,8 @@ Usage::
     python benches/bench_refine_cost.py --records 1:acc_x 1:gyro_z --rounds 3 --out /tmp/x
                                                         # chosen ADIS records, each round alternating which
                                                         # checkout runs first
+    python benches/bench_refine_cost.py --records sensor:temperature "sensor:line families" --out /tmp/x
+                                                        # simulated sensors, by a part of their name
 """
 
 from __future__ import annotations
@@ -38,9 +40,9 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-#: main before this round of refine's speed-ups (issue 29, refine's cost; earlier rounds' baselines: 9165947, 313a76b,
-#: f836703).
-BASELINE = "a0e3816"
+#: main before this round of refine's speed-ups (issue 29, refine's cost, round r6cost; earlier rounds' baselines:
+#: 9165947, 313a76b, f836703, a0e3816, 3637a85).
+BASELINE = "904c152"
 ADIS = [
     ("adis", 1, "gyro_z"),
     ("adis", 4, "gyro_x"),
@@ -76,6 +78,12 @@ def _record(spec):
     y, fs, channels = sensors.make(case)
     kw = {"unit": case.unit} | ({"channels": channels} if channels else {})
     return y, fs, kw, case.name
+
+
+def _spec(text: str) -> tuple:
+    """A record of ``--records``: ``RUN:AXIS`` (ADIS16405) or ``sensor:NAME`` (a part of a sensor's name)."""
+    kind, rest = text.split(":", 1)
+    return ("sensor", rest) if kind == "sensor" else ("adis", int(kind), rest)
 
 
 def worker(spec, out: Path) -> None:
@@ -130,7 +138,9 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=Path)
     ap.add_argument("--baseline", type=Path, help="python/ folder of the baseline checkout (with its core)")
     ap.add_argument("--after", type=Path, default=REPO / "python", help="python/ folder to time (default: this one)")
-    ap.add_argument("--records", nargs="+", metavar="RUN:AXIS", help="ADIS16405 records (default: the list above)")
+    ap.add_argument(
+        "--records", nargs="+", metavar="RUN:AXIS", help="ADIS16405 records or sensor:NAME (default: the list above)"
+    )
     ap.add_argument("--rounds", type=int, default=1, help="times each record is refined by each checkout")
     ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
@@ -144,7 +154,7 @@ def main(argv=None) -> int:
     base = a.baseline or _baseline_python(BASELINE)
     specs = ADIS[:1] if a.quick else ADIS + SENSORS
     if a.records:
-        specs = [("adis", int(r.split(":")[0]), r.split(":")[1]) for r in a.records]
+        specs = [_spec(r) for r in a.records]
     rows, load0 = [], os.getloadavg()
     busy0, own0, wall0 = _common.OtherLoad._busy(), _own_and_children(), time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:

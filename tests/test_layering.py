@@ -136,6 +136,7 @@ def test_imports_run_one_way(module):
 MODEL_RANKS = {
     "model._recent": -1,
     "model._chunked": -1,  # record-length passes a chunk at a time (numpy, scipy only)
+    "model._rfft": -0.5,  # the channel regression's transforms, remembered by content
     "model._batched": 0,
     "model._chi2_draws": 0,
     "model._covariance": 0,

@@ -418,7 +418,7 @@ def _plain_evaluate(idx, gens, coefs, a, b):
     out = np.zeros(idx.size)
     u = np.mod(idx * gens[0], 1.0)
     nu2 = float(gens[1]) if gens.size > 1 else 0.0
-    for _s, rows, ph in linefit._groups(coefs, nu2, idx):
+    for s, rows, ph in linefit._groups(coefs, nu2, idx):  # ph: |s|'s phasor, conjugated for a negative s
         k = coefs[rows, 0]
         m_bins = linefit._grid(int(np.max(np.abs(k))))
         spec = np.zeros(m_bins, dtype=np.complex128)
@@ -430,7 +430,7 @@ def _plain_evaluate(idx, gens, coefs, a, b):
         f = x - j
         val = wave[j] * (1.0 - f) + wave[j + 1] * f
         if ph is not None:
-            val = val * ph
+            val = val * (np.conj(ph) if s < 0 else ph)
         out += val.real
     return out
 
@@ -456,10 +456,10 @@ def _plain_dtft(y, idx, gens, coefs, n_seg=1):
     seg = None if n_seg == 1 else np.minimum(np.arange(idx.size) * n_seg // max(1, idx.size), n_seg - 1)
     u = np.mod(idx * gens[0], 1.0)
     nu2 = float(gens[1]) if gens.size > 1 else 0.0
-    for _s, rows, ph in linefit._groups(coefs, nu2, idx):
+    for s, rows, ph in linefit._groups(coefs, nu2, idx):  # ph: |s|'s phasor, the conjugate of −|s|'s
         k = coefs[rows, 0]
         m_bins = linefit._grid(int(np.max(np.abs(k))))
-        z = y if ph is None else y * np.conj(ph)
+        z = y if ph is None else y * (ph if s < 0 else np.conj(ph))
         out[:, rows] = _plain_fold(z, u, m_bins, seg, n_seg)[:, np.mod(k, m_bins)]
     return out if n_seg > 1 else out[0]
 

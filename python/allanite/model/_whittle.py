@@ -31,6 +31,8 @@ from scipy import fft as sfft
 from scipy.optimize import nnls as scipy_nnls
 from scipy.signal.windows import tukey
 
+from . import _rfft
+
 __all__ = [
     "Bands",
     "spectra",
@@ -97,7 +99,7 @@ def _taper(n: int) -> np.ndarray:
 
 
 def _dft(x: np.ndarray, w: np.ndarray, n_bins: int) -> np.ndarray:
-    return sfft.rfft(np.diff(x) * w)[1 : n_bins + 1]
+    return _rfft.rfft(np.diff(x) * w)[1 : n_bins + 1]  # remembered: refine transforms the same samples again
 
 
 def _basis(k: np.ndarray, n_diff: int, fs: float) -> tuple[np.ndarray, tuple]:

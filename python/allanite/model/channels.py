@@ -42,7 +42,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import fft as sfft
 from scipy.stats import f as f_dist
 from scipy.stats import t as t_dist
 
@@ -50,6 +49,7 @@ from .._validate import check_fs, check_probability
 from ..errors import InputError, ParameterError
 from . import _whittle as wh
 from ._lag import lag_grid, lag_profile, lag_response, lag_test, lagged, unresolved_lag
+from ._rfft import band_limited, rfft
 from ._shares import TERM_SHARE
 
 __all__ = [
@@ -242,7 +242,7 @@ def channel_signal(x: np.ndarray, fs: float) -> tuple[float, list | None]:
     when that is every band (no noise to keep out)."""
     d = np.diff(x)
     n_bins = d.size // 2
-    p = np.abs(sfft.rfft(d)[1 : n_bins + 1]) ** 2 / d.size
+    p = np.abs(rfft(d)[1 : n_bins + 1]) ** 2 / d.size  # remembered: band_limited transforms it again
     k = np.arange(1, n_bins + 1)
     s2 = 4.0 * np.sin(np.pi * k / d.size) ** 2
     top = k >= d.size // 4
@@ -260,20 +260,6 @@ def channel_signal(x: np.ndarray, fs: float) -> tuple[float, list | None]:
         else:
             out.append((lo, hi))
     return floor, out or [(0.0, 0.0)]
-
-
-def band_limited(x: np.ndarray, fs: float, bands: list | None) -> np.ndarray:
-    """``x`` with only the frequency intervals ``bands`` (Hz) of its differences kept (None: all), integrated
-    back from the first sample (filtered as differences, so the record's two ends need not meet)."""
-    if bands is None:
-        return x
-    d = np.diff(x)
-    f = np.fft.rfftfreq(d.size, 1.0 / fs)
-    mask = np.zeros(f.size, dtype=bool)
-    mask[0] = True
-    for lo, hi in bands:
-        mask |= (f >= lo) & (f <= hi)
-    return x[0] + np.concatenate([[0.0], np.cumsum(sfft.irfft(sfft.rfft(d) * mask, d.size))])
 
 
 def _f_test(stat: float, dof: float, alpha: float) -> dict:

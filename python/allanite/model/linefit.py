@@ -143,8 +143,9 @@ def _oriented(gens: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 
 def _groups(coefs: np.ndarray, nu2: float, idx: np.ndarray):
-    """(s, rows, e^{i2πsν2 n} or None for s = 0) for each distinct second coefficient s (0 for one-generator
-    lattices); the phasors as powers of one :func:`_phasor`, by increasing |s| (one complex product each)."""
+    """(s, rows, e^{i2π|s|ν2 n} or None for s = 0) for each distinct second coefficient s (0 for one-generator
+    lattices; a negative s's phasor is the conjugate, taken by the caller where it needs it); the phasors as
+    powers of one :func:`_phasor`, by increasing |s| (one complex product each)."""
     s_all = coefs[:, 1] if coefs.shape[1] > 1 else np.zeros(coefs.shape[0], dtype=np.int64)
     present = set(np.unique(s_all).tolist())
     if 0 in present:
@@ -156,7 +157,7 @@ def _groups(coefs: np.ndarray, nu2: float, idx: np.ndarray):
         cur = base if a == 1 else cur * base
         for s in (a, -a):
             if s in present:
-                yield s, np.flatnonzero(s_all == s), (cur if s > 0 else np.conj(cur))
+                yield s, np.flatnonzero(s_all == s), cur
 
 
 def _fold(z: np.ndarray, u: np.ndarray, m_bins: int, seg: np.ndarray | None, n_seg: int) -> np.ndarray:
@@ -236,14 +237,14 @@ def dtft(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray, n_seg: int = 1
     for s, rows, ph in _groups(coefs, nu2, idx):
         k = coefs[rows, 0]
         m_bins = _grid(int(np.max(np.abs(k))))
-        if ph is None:
+        if s == 0:
             g = _binned_fft(_bins_of([y], u, m_bins, seg, n_seg, grids), m_bins, n_seg)
         else:
             # y·conj(e^{iθ}) part by part (a real times a complex scales each part: the complex product's
             # numbers); −s's phasor is s's conjugate: its imaginary part's bins are s's negated, exactly
             key = (abs(s), m_bins)
-            if key not in bins:
-                bins[key] = (*_bins_of([y], u, m_bins, seg, n_seg, grids, ph), s)
+            if key not in bins:  # s's phasor (conjugated for a negative s: only where s itself is absent)
+                bins[key] = (*_bins_of([y], u, m_bins, seg, n_seg, grids, ph if s > 0 else np.conj(ph)), s)
             re, im, s_done = bins[key]
             g = _binned_fft([re, im if s == s_done else -im], m_bins, n_seg)
         out[:, rows] = g[:, np.mod(k, m_bins)]
@@ -298,7 +299,8 @@ def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndar
     u = _unit_phase(idx, float(gens[0]))
     nu2 = float(gens[1]) if gens.size > 1 else 0.0
     grids: dict = {}
-    for _s, rows, ph in _groups(coefs, nu2, idx):
+    for s, rows, ph in _groups(coefs, nu2, idx):
+        ph = np.conj(ph) if s < 0 else ph
         k = coefs[rows, 0]
         m_bins = _grid(int(np.max(np.abs(k))))
         spec = np.zeros(m_bins, dtype=np.complex128)

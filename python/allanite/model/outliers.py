@@ -440,6 +440,12 @@ def _local_sigmas(y: np.ndarray, step: float) -> dict:
 
 
 def _white_span(y: np.ndarray) -> int:
+    """:func:`_white_span_of` ``y``, remembered (the test and the replacement ask for the same record's)."""
+    got = _SPANS.get(y)
+    return got if got is not None else _SPANS.put(y, (), _white_span_of(y))
+
+
+def _white_span_of(y: np.ndarray) -> int:
     """The largest octave m (≤ 1/8 of the record) up to which ``y`` is white: τ·AVAR(m) (overlapping) within
     :data:`WHITE_Z` standard errors of white Gaussian noise's estimate (√(2/ν), ν ≈ 1.5·n/m) of m = 1's, at m
     and at every octave below it. The slow level a white record's samples are flagged against and replaced
@@ -510,9 +516,26 @@ def replace_outliers(y: np.ndarray, flags: np.ndarray, seed: int = 0) -> np.ndar
     smoother than the samples around it, which the Allan curve's shortest τ read as a low-pass."""
     y = np.asarray(y, dtype=np.float64)
     flags = np.asarray(flags, dtype=bool)
-    out = y.copy()
     if not flags.any():
-        return out
+        return y.copy()
+    if not isinstance(seed, (int, np.integer)):
+        return _replaced(y, flags, seed)
+    key = (int(seed), np.flatnonzero(flags).tobytes())  # the removal's last pass and the final check ask again
+    got = _REPLACED.get(y, key)
+    if got is None:
+        got = _REPLACED.put(y, key, _replaced(y, flags, seed))
+        got.flags.writeable = False
+    return got.copy()
+
+
+#: :func:`replace_outliers`' and :func:`_white_span`'s last results, by the samples' content (records up to 2·10⁶).
+_REPLACED = Recent(2, 2_000_000)
+_SPANS = Recent(4, 2_000_000)
+
+
+def _replaced(y: np.ndarray, flags: np.ndarray, seed) -> np.ndarray:
+    """:func:`replace_outliers`' samples, computed."""
+    out = y.copy()
     step = lattice_step(np.diff(y)) if y.size > 1 else 0.0
     loc = _local(y, step)
     se = np.where(np.isfinite(loc["sigma_e"]), loc["sigma_e"], 0.0)

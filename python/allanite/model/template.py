@@ -116,23 +116,39 @@ class Template:
         return math.sqrt(var_ms) / (2.0 * r)
 
 
-def _heldout_power(y: np.ndarray, u: np.ndarray, bins: int, parts: list) -> float:
-    """Residual power of each part of alternate blocks with the template folded on the other part subtracted,
-    both ways, over their power without it (``u`` every sample's phase)."""
+def _sides(y: np.ndarray, u: np.ndarray) -> tuple[list, np.ndarray]:
+    """The record's alternate blocks (:data:`HELDOUT_BLOCKS`; the even ones, then the odd ones, each joined end to
+    end): per side its samples' phases, its samples and them less their mean; and the phases of the samples after
+    the last whole block. Gathered once for every number of bins tried."""
+    per = y.size // HELDOUT_BLOCKS
+    sides = []
+    for parity in (0, 1):
+        at = np.concatenate([np.arange(j * per, (j + 1) * per) for j in range(HELDOUT_BLOCKS) if j % 2 == parity])
+        v = y[at]
+        sides.append((u[at], v, v - v.mean()))
+    return sides, u[HELDOUT_BLOCKS * per :]
+
+
+def _heldout_power(sides: list, tail: np.ndarray, bins: int) -> tuple[float, int]:
+    """Residual power of each side (:func:`_sides`) with the template folded on the other side subtracted, both
+    ways, over their power without it; and how many of the ``bins`` phase bins the record's samples fill."""
+    k = [np.minimum((u * bins).astype(np.int64), bins - 1) for u, _v, _z in sides]
+    counts = [np.bincount(kk, minlength=bins) for kk in k]
     num = den = 0.0
-    k = np.minimum((u * bins).astype(np.int64), bins - 1)
-    for held_in, held_out in parts:
-        count = np.bincount(k[held_in], minlength=bins).astype(np.float64)
-        total = np.bincount(k[held_in], weights=y[held_in], minlength=bins)
+    for held_in, held_out in ((0, 1), (1, 0)):
+        count = counts[held_in].astype(np.float64)
+        total = np.bincount(k[held_in], weights=sides[held_in][1], minlength=bins)
         mean = np.where(count > 0, total / np.maximum(count, 1.0), 0.0)
         if not (count > 0).all():
             have = np.flatnonzero(count > 0)
             mean = np.interp(np.arange(bins, dtype=np.float64), have.astype(np.float64), mean[have], period=bins)
         comp = mean[k[held_out]]
-        z = y[held_out] - y[held_out].mean()
+        z = sides[held_out][2]
         r = z - (comp - comp.mean())
         num, den = num + float(r @ r), den + float(z @ z)
-    return num / den if den > 0 else math.inf
+    in_tail = np.bincount(np.minimum((tail * bins).astype(np.int64), bins - 1), minlength=bins)
+    filled = int(np.count_nonzero(counts[0] + counts[1] + in_tail))
+    return (num / den if den > 0 else math.inf), filled
 
 
 def _exact_bins(filled: dict) -> int | None:
@@ -170,20 +186,13 @@ def fit_template(y, fs: float, f0: float, bins=None) -> Template:
     nu = float(f0) / float(fs)
     heldout: dict = {}
     if bins is None:
-        per = n // HELDOUT_BLOCKS
-        blocks = [np.arange(j * per, (j + 1) * per) for j in range(HELDOUT_BLOCKS)]
-        parts = []
-        for parity in (0, 1):
-            held_in = np.concatenate([b for j, b in enumerate(blocks) if j % 2 == parity])
-            held_out = np.concatenate([b for j, b in enumerate(blocks) if j % 2 != parity])
-            parts.append((held_in, held_out))
         u = np.arange(n, dtype=np.float64) * nu
         u = (u - np.floor(u)).astype(np.float32)
+        sides, tail = _sides(y, u)
         top = min(MAX_BINS, max(MIN_BINS, (n // 2) // MIN_PER_BIN))
         b, filled = MIN_BINS, {}
         while b <= top:
-            heldout[b] = _heldout_power(y, u, b, parts)
-            filled[b] = int(np.count_nonzero(np.bincount(np.minimum((u * b).astype(np.int64), b - 1), minlength=b)))
+            heldout[b], filled[b] = _heldout_power(sides, tail, b)
             b *= 2
         bins = _exact_bins(filled)
         if bins is None:
