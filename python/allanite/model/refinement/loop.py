@@ -17,6 +17,7 @@ from ..._blas import one_thread
 from ..._progress import StepBar
 from ...analysis import avar
 from ...errors import ParameterError
+from ...units import rate_unit
 from .. import periodic, tracing
 from .._recent import remembering
 from ..channels import terms_before_after
@@ -89,7 +90,9 @@ def refine(
 
     {effects}
         unit : str, optional
-            Unit of the samples, for IEEE-952 values of the terms.
+            Unit of the samples, for IEEE-952 values of the terms: a gyro's rate or angle unit
+            (:func:`allanite.units.parse_unit`), checked before any work. For an accelerometer, a magnetometer
+            or another sensor give none: the terms are then in the samples' own unit and seconds.
         tau_range : (float, float) or "auto", optional
             τ (s) to use, as in :func:`allanite.fit`. Default: every τ — the shortest τ carry the sensor's
             bandwidth, which is a candidate effect; ``"auto"`` cuts them as ``fit`` does.
@@ -121,6 +124,8 @@ def refine(
         (['gauss_markov'], 10.0)
     """
     check_scale(x_or_result)
+    if unit is not None:
+        rate_unit(unit)  # a unit refine does not know fails before any work (it was read only by the final fit)
     # each line spectrum once; curves, phasors and outlier scales of the same samples once; OpenBLAS on one
     # thread (its products here are small or thin: its threads cost more than they save, :mod:`allanite._blas`)
     with StepBar(progress, 1, "refine") as bar, remembering_spectra(), remembering(), one_thread():

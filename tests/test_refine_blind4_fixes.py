@@ -1,0 +1,71 @@
+"""Fixes from the fourth blind suite (benches/refine_blind4.py): a cold start's temperature swing is its coupling,
+not a warm-up in time; a unit refine does not know fails before any work, saying what to give instead."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+import allanite
+from allanite.errors import ParameterError
+from allanite.model import channels, tracing
+from allanite.model.refinement import loop
+from allanite.units import parse_unit
+
+
+def _cold_start(seed: int, t_temp: float, warmup: tuple | None, coupling: float):
+    """10 Hz × 10⁵: white noise and a random walk, a temperature swinging −10 → 40 °C with time constant
+    ``t_temp`` (within the first of 8 blocks), the rate coupled to it by ``coupling`` °/s per °C, plus a warm-up
+    (amplitude, T) of its own."""
+    fs, n = 10.0, 100_000
+    t = np.arange(n) / fs
+    rng = np.random.default_rng(seed)
+    y = allanite.simulate(n, fs, N=2e-3, K=1e-5, seed=rng)
+    temp = 40.0 - 50.0 * np.exp(-t / t_temp)
+    y = y + coupling * (temp - temp.mean())
+    if warmup is not None:
+        y = y + warmup[0] * np.exp(-t / warmup[1])
+    return y, fs, temp + 0.05 * rng.standard_normal(n)
+
+
+def test_a_cold_start_temperature_is_its_regression_not_a_drift():
+    y, fs, temp = _cold_start(1, 300.0, None, 3e-4)
+    # the swing sits within one block: fast by its share, a within-block t test of ≈ 1 dof (threshold 170)
+    assert not channels.is_slow(temp)
+    assert tracing.regression_fit(y, temp, 8)["dof"] < 2
+    r = allanite.refine(y, fs, unit="deg/s", channels={"temp": temp}, progress=False)
+    # before: a drift (T ≈ 281 s) took the swing and the temperature was turned down (t 1.6 against 170)
+    assert r.found == ["regression"], (r.found, r.considered.get("drift"))
+    assert r.steps[0].params["coefficient"] == pytest.approx(3e-4, rel=0.15)
+    drift = r.considered["drift"][0]
+    assert drift["explained_by"] == "temp" and drift["statistic_without_channel"] < drift["threshold"]
+
+
+def test_a_warm_up_the_temperature_does_not_explain_stays_a_drift():
+    # the rate does not follow the temperature; its warm-up (T 1500 s) is slower than the swing (300 s): a
+    # regression on the temperature takes part of it, but the drift test still accepts on what it leaves
+    y, fs, temp = _cold_start(1, 300.0, (0.02, 1500.0), 0.0)
+    r = allanite.refine(y, fs, unit="deg/s", channels={"temp": temp}, progress=False)
+    assert r.found == ["drift"], r.found
+    assert r.steps[0].params["T"] == pytest.approx(1500.0, rel=0.2)
+
+
+def test_refine_refuses_an_unknown_unit_before_any_work(monkeypatch):
+    # the unit was read only by the final fit: a 10⁷-sample record was refined for minutes, then refused
+    def no_work(*_a, **_k):
+        raise AssertionError("refine started work before checking its unit")
+
+    monkeypatch.setattr(loop, "inputs", no_work)
+    y = np.zeros(1000)
+    with pytest.raises(ParameterError, match=r"unknown unit 'm/s\^2'; allowed rate units: .*give no unit"):
+        allanite.refine(y, 100.0, unit="m/s^2", progress=False)
+
+
+@pytest.mark.parametrize("bad", ["uT", "g", "m/s^2", "gauss"])
+def test_an_unknown_unit_says_what_other_sensors_give(bad):
+    with pytest.raises(
+        ParameterError, match=rf"unknown unit {re.escape(repr(bad))}.*for an accelerometer, a magnetometer"
+    ):
+        parse_unit(bad)
