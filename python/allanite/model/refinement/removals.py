@@ -19,8 +19,8 @@ changed in the Allan curve, AVAR(y) − AVAR(y − component), cross terms inclu
   (:func:`allanite.model.channels.is_slow`: a temperature), or a fast one whose within-block test has fewer
   than :data:`COLLAPSED_DOF` dof (its changes within one or two blocks), against the record's own noise by a
   Whittle GLS, with its optional terms (:func:`allanite.model.channels.regress_channel`); so is a fast channel
-  whose within-block
-  test accepts when that fit keeps an optional term (d(ch)/dt, a lag, a square: a chamber cycling many times).
+  whose within-block test accepts when that fit keeps an optional term (d(ch)/dt, a lag, a square: a chamber
+  cycling many times).
 - ``"outliers"`` — samples beyond what Gaussian noise predicts, replaced (:mod:`allanite.model.outliers`); first,
   since a spike reaches every other test;
 - ``"periodic"`` — each family of spectral lines (harmonics, sidebands) removed by least squares at its frequencies
