@@ -69,3 +69,25 @@ def test_an_unknown_unit_says_what_other_sensors_give(bad):
         ParameterError, match=rf"unknown unit {re.escape(repr(bad))}.*for an accelerometer, a magnetometer"
     ):
         parse_unit(bad)
+
+
+def test_refine_refuses_a_unit_of_the_other_kind_than_its_samples():
+    y = allanite.simulate(20_000, 100.0, N=1e-3, seed=1)
+    # an angle unit with rate samples: increments whose ``input`` was left at "rate" were taken as °/s, silently
+    with pytest.raises(ParameterError, match=r"unit 'deg' is an angle unit.*input='rate'.*input='increment'"):
+        allanite.refine(y, 100.0, unit="deg", progress=False)
+    with pytest.raises(ParameterError, match=r"unit 'deg/s' is a rate unit.*input='increment'"):
+        allanite.refine(np.cumsum(y) / 100.0, 100.0, input="increment", unit="deg/s", progress=False)
+
+
+@pytest.mark.parametrize(
+    ("truth", "match"),
+    [
+        ({"gm": {"tc": 10.0}}, r"truth names an unknown effect 'gm'; allowed: gauss_markov, "),
+        ([("gauss_markov", 10.0)], r"truth must be a dict of effect → \{parameter: value\}.*got list"),
+        ({"gauss_markov": 10.0}, r"truth\['gauss_markov'\] must be a dict of parameter → value, got float"),
+    ],
+)
+def test_refine_refuses_a_truth_it_would_have_ignored(truth, match):
+    with pytest.raises(ParameterError, match=match):
+        allanite.refine(np.zeros(1000), 100.0, truth=truth, progress=False)

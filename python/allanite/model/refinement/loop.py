@@ -17,14 +17,13 @@ from ..._blas import one_thread
 from ..._progress import StepBar
 from ...analysis import avar
 from ...errors import ParameterError
-from ...units import rate_unit
 from .. import periodic, tracing
 from .._recent import remembering
 from ..channels import terms_before_after
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
 from ..terms import check_terms
-from ._inputs import REFINE_SCALE, check_scale, heldout_note, inputs, resolve_tau_range
+from ._inputs import REFINE_SCALE, check_scale, check_truth, check_unit, heldout_note, inputs, resolve_tau_range
 from ._rolloff import research_rolloff
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, bandwidth_grids, choose, families, final_params, prefetch
@@ -124,8 +123,8 @@ def refine(
         (['gauss_markov'], 10.0)
     """
     check_scale(x_or_result)
-    if unit is not None:
-        rate_unit(unit)  # a unit refine does not know fails before any work (it was read only by the final fit)
+    check_unit(unit, input, x_or_result)  # before any work: it was read only by the final fit
+    check_truth(truth, tuple(EFFECTS))
     # each line spectrum once; curves, phasors and outlier scales of the same samples once; OpenBLAS on one
     # thread (its products here are small or thin: its threads cost more than they save, :mod:`allanite._blas`)
     with StepBar(progress, 1, "refine") as bar, remembering_spectra(), remembering(), one_thread():
