@@ -253,6 +253,8 @@ class _Run:
         before it left."""
         if self.y is None:
             return
+        # the channels only where their regression may be taken (a drift is left to a channel that would take it)
+        chans = chans if "regression" in candidates else {}
         ctx = RemovalContext(self.y, self.fs, self.curve, self.sol, self.start, chans, self.level, self.consider)
         for name, remover in REMOVALS.items():
             if name not in candidates:
