@@ -7,8 +7,8 @@ user brings with default arguments.
 deviation alone (``--sizes``: the largest ratio over τ ≤ T/4 of the injected component's Allan deviation to that of
 the rest of the record, ≥ 3× for every effect a case asks refine to find; with two effects, the smaller of the
 two; a filter, which lowers the curve, by the unfiltered record's Allan deviation over the record's — the sinc³
-decimator's own 1.73×, as the ADIS16405's 2-tap moving average's √2), never by refine's answer; the first run's verdicts are recorded as they came out (the notes below the table)
-and the cases are not retuned after it.
+decimator's own 1.73×, where a 2-tap moving average's is 2×), never by refine's answer; the first run's verdicts
+are recorded as they came out (the notes below the table) and the cases are not retuned after it.
 
 The cases: a gyro's g-sensitivity to an accelerometer channel under 20–80 Hz vibration (a fast channel, 400 Hz);
 a MEMS behind a sinc³ (CIC) decimation filter, 3200 Hz → 200 Hz (not a moving average); a 400 Hz automotive gyro

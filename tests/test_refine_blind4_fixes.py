@@ -4,6 +4,9 @@ not a warm-up in time; a unit refine does not know fails before any work, saying
 from __future__ import annotations
 
 import re
+import sys
+from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -96,3 +99,56 @@ def test_refine_refuses_a_unit_of_the_other_kind_than_its_samples():
 def test_refine_refuses_a_truth_it_would_have_ignored(truth, match):
     with pytest.raises(ParameterError, match=match):
         allanite.refine(np.zeros(1000), 100.0, truth=truth, progress=False)
+
+
+def _blind4():
+    """benches/refine_blind4.py (its judge and its sizes)."""
+    root = Path(__file__).resolve().parents[1]
+    sys.path.insert(0, str(root / "benches"))
+    try:
+        import refine_blind4
+    finally:
+        sys.path.pop(0)
+    return refine_blind4
+
+
+def _refinement(*ts):
+    """A stand-in for a Refinement whose steps are change points at the times ``ts``: the chain's errors falling,
+    nothing unexplained."""
+    metrics = ({"chi2_dof": 2.0, "rms_adev_pct": 3.0, "heldout_rms_adev_pct": 4.0},)
+    metrics += ({"chi2_dof": 1.0, "rms_adev_pct": 2.0, "heldout_rms_adev_pct": 3.0},)
+    steps = [
+        SimpleNamespace(effect="change_point", params={"t": t}, final_params=None, evidence={}, before=metrics[0])
+        for t in ts
+    ]
+    for st in steps:
+        st.after = metrics[1]
+    return SimpleNamespace(steps=steps, unexplained=[], found=["change_point"] * len(ts))
+
+
+@pytest.mark.parametrize(
+    ("found", "passed", "error"),
+    [((6010.0, 10_900.0), True, 0.0091), ((6010.0,), False, 0.4536), ((6010.0, 14_000.0), False, 0.2727)],
+)
+def test_the_heater_judge_asks_for_every_change_time(found, passed, error):
+    # sensors.judge keeps one t per effect (the first step's): the second change of the heater went unjudged
+    b4 = _blind4()
+    case = next(c for c in b4.CASES if "heater" in c.name)
+    v = b4._judged(_refinement(*found), case)
+    assert v["passed"] is passed
+    assert v["param_errors"]["change_point.t"] == pytest.approx(error, abs=1e-4)
+
+
+def test_the_size_of_two_effects_is_the_smaller_and_of_a_filter_what_it_lowers():
+    b4 = _blind4()
+    rng = np.random.default_rng(3)
+    fs, n = 100.0, 200_000
+    rest = rng.standard_normal(n)
+    big, small = 0.5 * np.sin(2 * np.pi * 0.3 * np.arange(n) / fs), 0.05 * rng.standard_normal(n)
+    both = b4._size(rest + big + small, [big, small], fs, {})
+    assert both == pytest.approx(b4.rb2.effect_size(rest + small, small, fs), rel=1e-9)
+    assert both < 1.0 < b4.rb2.effect_size(rest + big, big, fs)
+    # a 2-tap moving average halves white noise's Allan deviation at τ₀: (w₊ − w₋)/2 has variance ½, AVAR ¼
+    white = rng.standard_normal(n)
+    filtered = 0.5 * (white + np.roll(white, 1))
+    assert b4._size(filtered, {"without": white}, fs, {}) == pytest.approx(2.0, rel=0.02)
