@@ -140,6 +140,14 @@ for _name, (_kind, _f, _label, _aliases) in _TABLE.items():
         _ALIASES[_normalise(_a)] = _name
 
 
+#: Said after the allowed units: the units are a gyro's; an accelerometer's or any other sensor's samples are
+#: analysed as they are, with no unit, the terms then in the samples' own unit and seconds.
+_OTHER_SENSORS = (
+    " (a gyro's; for an accelerometer, a magnetometer or another sensor give no unit: the terms are then in the "
+    "samples' own unit and seconds)"
+)
+
+
 def _allowed(kind=None) -> str:
     rates = ", ".join(RATE_UNITS)
     angles = ", ".join(ANGLE_UNITS)
@@ -183,7 +191,7 @@ def parse_unit(s, kind=None) -> Unit:
     elif isinstance(s, str):
         name = _ALIASES.get(_normalise(s))
         if name is None:
-            raise ParameterError(f"unknown unit {s!r}; allowed {_allowed(kind)}")
+            raise ParameterError(f"unknown unit {s!r}; allowed {_allowed(kind)}{_OTHER_SENSORS}")
         unit = _UNITS[name]
     else:
         raise ParameterError(f"a unit must be a string such as 'deg/s', got {s!r}; allowed {_allowed(kind)}")

@@ -14,12 +14,22 @@ from ...analysis import avar
 from ...errors import InputError, ParameterError
 from ...estimators.grid import tau_grid
 from ...results import AllanResult
+from ...units import parse_unit, rate_unit
 from .. import fitting
 from .._chunked import CHUNK, chunks
 from ..channels import check_channel
 from .scoring import HELDOUT_BLOCKS
 
-__all__ = ["REFINE_SCALE", "check_channels", "check_scale", "heldout_note", "inputs", "resolve_tau_range"]
+__all__ = [
+    "REFINE_SCALE",
+    "check_channels",
+    "check_scale",
+    "check_truth",
+    "check_unit",
+    "heldout_note",
+    "inputs",
+    "resolve_tau_range",
+]
 
 
 def resolve_tau_range(tau_range, result, start):
@@ -118,6 +128,44 @@ def check_channels(channels, y) -> dict:
                 raise ParameterError(f"two channels are named {str(name)!r}; each channel needs its own name")
             chans[str(name)] = check_channel(str(name), c, y.size)
     return chans
+
+
+def check_unit(unit, input: str, x_or_result) -> None:
+    """Refuse, before any work, a unit refine does not know, or one of the other kind than the samples: a rate
+    unit for rates, an angle unit for increments or a cumulative angle (an AllanResult: either, as ``fit``
+    takes it). It was read only by the final fit, after the whole refinement; and an angle unit given with rate
+    samples (increments whose ``input`` was left at "rate") was taken as that angle per second, silently."""
+    if unit is None:
+        return
+    if isinstance(x_or_result, AllanResult) or input not in ("rate", "increment", "angle"):
+        rate_unit(unit)  # a bad ``input`` is reported by the samples' own check
+        return
+    kind = "rate" if input == "rate" else "angle"
+    try:
+        parse_unit(unit, kind=kind)
+    except ParameterError as e:
+        if "unknown unit" in str(e) or "must be a string" in str(e):
+            raise
+        other = "angle increments: input='increment'" if kind == "rate" else "rates: input='rate'"
+        what = "rates" if kind == "rate" else "angles"
+        raise ParameterError(f"{e} (input={input!r}: the samples are {what}; {other})") from None
+
+
+def check_truth(truth, effects) -> None:
+    """``truth`` is None or a dict of effect name (one of ``effects``) → dict of parameter name → value; an unknown
+    effect or another shape was ignored silently (no step reported an error against it)."""
+    if truth is None:
+        return
+    if not isinstance(truth, Mapping):
+        raise ParameterError(
+            f"truth must be a dict of effect → {{parameter: value}} (e.g. {{'gauss_markov': {{'tc': 10.0}}}}), "
+            f"got {type(truth).__name__}"
+        )
+    for effect, params in truth.items():
+        if effect not in effects:
+            raise ParameterError(f"truth names an unknown effect {effect!r}; allowed: {', '.join(effects)}")
+        if not isinstance(params, Mapping):
+            raise ParameterError(f"truth[{effect!r}] must be a dict of parameter → value, got {type(params).__name__}")
 
 
 def heldout_note(y, heldout) -> str:

@@ -23,7 +23,7 @@ from ..channels import terms_before_after
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
 from ..terms import check_terms
-from ._inputs import REFINE_SCALE, check_scale, heldout_note, inputs, resolve_tau_range
+from ._inputs import REFINE_SCALE, check_scale, check_truth, check_unit, heldout_note, inputs, resolve_tau_range
 from ._rolloff import research_rolloff
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, bandwidth_grids, choose, families, final_params, prefetch
@@ -89,7 +89,9 @@ def refine(
 
     {effects}
         unit : str, optional
-            Unit of the samples, for IEEE-952 values of the terms.
+            Unit of the samples, for IEEE-952 values of the terms: a gyro's rate or angle unit
+            (:func:`allanite.units.parse_unit`), checked before any work. For an accelerometer, a magnetometer
+            or another sensor give none: the terms are then in the samples' own unit and seconds.
         tau_range : (float, float) or "auto", optional
             τ (s) to use, as in :func:`allanite.fit`. Default: every τ — the shortest τ carry the sensor's
             bandwidth, which is a candidate effect; ``"auto"`` cuts them as ``fit`` does.
@@ -121,6 +123,8 @@ def refine(
         (['gauss_markov'], 10.0)
     """
     check_scale(x_or_result)
+    check_unit(unit, input, x_or_result)  # before any work: it was read only by the final fit
+    check_truth(truth, tuple(EFFECTS))
     # each line spectrum once; curves, phasors and outlier scales of the same samples once; OpenBLAS on one
     # thread (its products here are small or thin: its threads cost more than they save, :mod:`allanite._blas`)
     with StepBar(progress, 1, "refine") as bar, remembering_spectra(), remembering(), one_thread():
@@ -249,6 +253,8 @@ class _Run:
         before it left."""
         if self.y is None:
             return
+        # the channels only where their regression may be taken (a drift is left to a channel that would take it)
+        chans = chans if "regression" in candidates else {}
         ctx = RemovalContext(self.y, self.fs, self.curve, self.sol, self.start, chans, self.level, self.consider)
         for name, remover in REMOVALS.items():
             if name not in candidates:

@@ -12,12 +12,15 @@ changed in the Allan curve, AVAR(y) − AVAR(y − component), cross terms inclu
   with its slow terms at the upper end of what the curve allows (:func:`allanite.model.tracing.drift_fit`);
   a and T and their intervals by generalised least squares against the block means' covariance under the
   record's own noise terms (:mod:`allanite.model.warmup`: flicker and random walk tie the block means together,
-  and an ordinary fit's intervals then miss the truth);
+  and an ordinary fit's intervals then miss the truth); left to a channel whose regression, accepted on the
+  samples as they are, leaves a record the drift test no longer accepts (a cold start's temperature swing);
 - ``"regression"`` — the rate regressed on each channel of ``channels=``: a fast channel within blocks in time
   (t test with the blocks' effective dof), band by band where the coupling differs across frequency; a slow one
-  (:func:`allanite.model.channels.is_slow`: a temperature) against the record's own noise by a Whittle GLS, with
-  its optional terms (:func:`allanite.model.channels.regress_channel`); so is a fast channel whose within-block
-  test accepts when that fit keeps an optional term (d(ch)/dt, a lag, a square: a chamber cycling many times).
+  (:func:`allanite.model.channels.is_slow`: a temperature), or a fast one whose within-block test has fewer
+  than :data:`COLLAPSED_DOF` dof (its changes within one or two blocks), against the record's own noise by a
+  Whittle GLS, with its optional terms (:func:`allanite.model.channels.regress_channel`); so is a fast channel
+  whose within-block test accepts when that fit keeps an optional term (d(ch)/dt, a lag, a square: a chamber
+  cycling many times).
 - ``"outliers"`` — samples beyond what Gaussian noise predicts, replaced (:mod:`allanite.model.outliers`); first,
   since a spike reaches every other test;
 - ``"periodic"`` — each family of spectral lines (harmonics, sidebands) removed by least squares at its frequencies
@@ -34,6 +37,7 @@ fitted against), in the order of :data:`REMOVALS`. A new one is one entry here a
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -139,6 +143,10 @@ def _drift(ctx: RemovalContext) -> Iterator[Removal]:
     if w["at_edge"]:
         ctx.consider("drift", {"T": w["T"], "statistic": dr["statistic"], "threshold": thr_d, "at_edge": True})
         return
+    channel = _channel_explaining(ctx, thr_d)
+    if channel is not None:
+        ctx.consider("drift", {"T": w["T"], "statistic": dr["statistic"], "threshold": thr_d} | channel)
+        return
 
     def refit(z, idx):
         g = warmup.warmup_component(z, idx / fs, w["noise"], span, pieces, ramp=w["ramp"])
@@ -161,6 +169,28 @@ def _drift(ctx: RemovalContext) -> Iterator[Removal]:
     )
 
 
+#: Below this many degrees of freedom (the blocks' effective number − 1) the within-block t test of a channel is
+#: powerless — its changes sit within one or two of the blocks (a temperature swinging at a cold start), the t
+#: threshold 20–170 — and the channel is tested as a slow one, by the Whittle GLS, in its stead.
+COLLAPSED_DOF = 2.0
+
+
+def _channel_explaining(ctx: RemovalContext, thr_d: float) -> dict | None:
+    """The channel that explains a warm-up the drift test found, or None: a regression on it accepted by its own
+    test on the samples as they are, after whose removal the drift test no longer accepts (a gyro's warm-up is
+    its temperature settling; given the temperature, a cold start's swing is its coupling, not a drift in time —
+    and a warm-up the channel does not carry stays a drift: tested first, as before, the regression then on
+    what the drift left)."""
+    if not ctx.channels:
+        return None
+    quiet = dataclasses.replace(ctx, consider=lambda _effect, _entry: None)
+    for rem in _regression(quiet):
+        after = tracing.drift_fit(ctx.y - rem.component, ctx.fs)
+        if not after["statistic"] > thr_d:
+            return {"explained_by": rem.params["channel"], "statistic_without_channel": after["statistic"]}
+    return None
+
+
 def _regression(ctx: RemovalContext) -> Iterator[Removal]:
     """Each channel in turn, on the samples with the channels before it removed: a component a channel
     explains (a multi-position profile's steps, a temperature's swing) bends the curve as a Gauss–Markov term
@@ -168,10 +198,10 @@ def _regression(ctx: RemovalContext) -> Iterator[Removal]:
     independent of the curve."""
     fs, a = ctx.fs, alpha("regression", ctx.level)
     for name, ch in ctx.channels.items():
-        if channels.is_slow(ch):
+        rg = None if channels.is_slow(ch) else tracing.regression_fit(ctx.y, ch, REGRESSION_BLOCKS)
+        if rg is None or rg["dof"] < COLLAPSED_DOF:
             yield from _slow_regression(ctx, name, ch, a / len(ctx.channels))
             continue
-        rg = tracing.regression_fit(ctx.y, ch, REGRESSION_BLOCKS)
         # t with the blocks' effective number − 1 degrees of freedom (≤ REGRESSION_BLOCKS − 1)
         t_thr = t_dist.isf(a / (2 * len(ctx.channels)), rg["dof"])
         t_stat = abs(rg["coefficient"]) / rg["se"] if rg["se"] > 0 else 0.0
