@@ -180,11 +180,16 @@ def _channel_explaining(ctx: RemovalContext, thr_d: float) -> dict | None:
     test on the samples as they are, after whose removal the drift test no longer accepts (a gyro's warm-up is
     its temperature settling; given the temperature, a cold start's swing is its coupling, not a drift in time —
     and a warm-up the channel does not carry stays a drift: tested first, as before, the regression then on
-    what the drift left)."""
+    what the drift left). Only through the terms the regression claims: a lag profiled for the removal but not
+    resolved by its test does not count."""
     if not ctx.channels:
         return None
     quiet = dataclasses.replace(ctx, consider=lambda _effect, _entry: None)
     for rem in _regression(quiet):
+        if "lag" in rem.evidence:
+            # through a lag its test did not resolve, a cold start's temperature is itself a warm-up of the lag's
+            # time constant: what the record cannot tell apart is no reason to give the drift up
+            continue
         after = tracing.drift_fit(ctx.y - rem.component, ctx.fs)
         if not after["statistic"] > thr_d:
             return {"explained_by": rem.params["channel"], "statistic_without_channel": after["statistic"]}
