@@ -249,7 +249,10 @@ def _bw_propose(rnd: Round) -> list:
         grids[key] = grid
     two = "bandwidth:butterworth2"
     if two in grids and rnd.y is not None:  # steeper Butterworths, named only with a spectrum as the 2nd order
-        found += higher_butterworths(rnd.curve, rnd.start, rnd.effects, grids[two], found[list(grids).index(two)], tie)
+        steeper, superseded = higher_butterworths(
+            rnd.curve, rnd.start, rnd.effects, grids[two], found[list(grids).index(two)], tie, rnd.y
+        )
+        found = [f for f in found if f[0] not in superseded] + steeper
     for key, p, s_new, edge in found:
         kind = key.split(":", 1)[1]  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)
         if needs_spectrum(kind) and not spectrum_agrees(rnd.y, rnd.curve.fs, kind, p):
@@ -264,6 +267,14 @@ def _bw_propose(rnd: Round) -> list:
 
 
 def _bw_params(pr: Proposal, rnd: Round) -> tuple:
+    params, intervals = _bw_filter_params(pr, rnd)
+    if "N" in rnd.start:  # the N column beside the filtered one: white noise added after the filter
+        floor, _sd, floor_int = _amplitude(pr.sol, list(rnd.start).index("N"))
+        params["floor"], intervals["floor"] = floor, floor_int
+    return params, intervals
+
+
+def _bw_filter_params(pr: Proposal, rnd: Round) -> tuple:
     kind, p, fs = pr.key.split(":", 1)[1], pr.p, rnd.curve.fs
     cut = filter_cutoff(kind, p, fs)
 

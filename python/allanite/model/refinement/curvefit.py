@@ -3,7 +3,8 @@ of an effect's nonlinear parameter with its profile interval, and the NoiseFit i
 
 Every curve effect enters the model as a non-negative column of Allan variance (its registry signature,
 :mod:`allanite.model.effects`); an effect that ``replaces`` a term (a bandwidth: the filtered white noise is
-the white rate noise N) zeroes that term's column. An effect measured in the time domain (a spectral line's
+the white rate noise N, reported as N) leaves that term's column beside it — for a bandwidth the white noise
+added after the filter (a quantised output's floor), non-negative, so 0 where there is none. An effect measured in the time domain (a spectral line's
 amplitude, from its power in the samples' spectrum) is *held*: its key carries the coefficient and its
 variance (:func:`held_key`), its column enters every fit at that value and the curve fits only the others —
 the Allan curve, where a line's column aliases with a bandwidth's or a resonance's, does not move it.
@@ -179,11 +180,9 @@ def design(curve, terms, effects):
     """Columns of the terms and the effects [(key, nonlinear parameter)] on ``curve``, and each column's
     noise type per τ (for the EDF)."""
     tau = curve.tau
-    a0 = _term_columns(curve, terms).copy()
-    for key, _p in effects:
-        rep = EFFECTS[base_name(key)].replaces
-        if rep in terms:
-            a0[:, list(terms).index(rep)] = 0.0
+    # a bandwidth's column is the white noise through the filter; the N column stays beside it as white noise
+    # added after the filter (the output's quantisation, a readout's noise): non-negative, 0 where there is none
+    a0 = _term_columns(curve, terms)
     cols = [a0] + [column(key, p, curve)[:, None] for key, p in effects]
     alphas = [np.full(tau.size, TERM_ALPHA[t]) for t in terms] + [_alpha_of(k, p, tau) for k, p in effects]
     return np.hstack(cols), alphas
@@ -463,7 +462,8 @@ def upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4
 
 
 def theta_terms(sol, terms, effects):
-    """Squared coefficients of the terms (a bandwidth's N in place of the zeroed N column)."""
+    """Squared coefficients of the terms (a bandwidth's N — the white noise before its filter — in place of the N
+    column's, which is the floor after it)."""
     k = len(terms)
     theta = sol.theta[:k].copy()
     for j, (key, _p) in enumerate(effects):
