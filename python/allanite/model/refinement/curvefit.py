@@ -4,10 +4,11 @@ of an effect's nonlinear parameter with its profile interval, and the NoiseFit i
 Every curve effect enters the model as a non-negative column of Allan variance (its registry signature,
 :mod:`allanite.model.effects`); an effect that ``replaces`` a term (a bandwidth: the filtered white noise is
 the white rate noise N, reported as N) leaves that term's column beside it — for a bandwidth the white noise
-added after the filter (a quantised output's floor), non-negative, so 0 where there is none. An effect measured in the time domain (a spectral line's
-amplitude, from its power in the samples' spectrum) is *held*: its key carries the coefficient and its
-variance (:func:`held_key`), its column enters every fit at that value and the curve fits only the others —
-the Allan curve, where a line's column aliases with a bandwidth's or a resonance's, does not move it.
+added after the filter (a quantised output's floor), non-negative, so 0 where there is none. An effect
+measured in the time domain (a spectral line's amplitude, from its power in the samples' spectrum) is *held*:
+its key carries the coefficient and its variance (:func:`held_key`), its column enters every fit at that value
+and the curve fits only the others — the Allan curve, where a line's column aliases with a bandwidth's or a
+resonance's, does not move it.
 Weights are the estimates' EDF under the model's own noise mix, iterated (IRLS); the covariance of the
 coefficients counts the dense curve's ~one independent estimate per octave.
 """
