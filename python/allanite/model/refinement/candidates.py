@@ -34,6 +34,7 @@ from .curvefit import (
     Solution,
     base_name,
     column,
+    has_floor,
     held_key,
     held_theta,
     profile_interval,
@@ -268,9 +269,11 @@ def _bw_propose(rnd: Round) -> list:
 
 def _bw_params(pr: Proposal, rnd: Round) -> tuple:
     params, intervals = _bw_filter_params(pr, rnd)
-    if "N" in rnd.start:  # the N column beside the filtered one: white noise added after the filter
-        floor, _sd, floor_int = _amplitude(pr.sol, list(rnd.start).index("N"))
-        params["floor"], intervals["floor"] = floor, floor_int
+    if "N" in rnd.start and has_floor(pr.key):  # the N column beside a Butterworth: white noise after it
+        floor, sd, floor_int = _amplitude(pr.sol, list(rnd.start).index("N"))
+        params["floor"] = floor
+        if math.isfinite(sd):  # none where the floor is 0 (a bound, not an estimate)
+            intervals["floor"] = floor_int
     return params, intervals
 
 
