@@ -9,7 +9,11 @@ the spectrum's 40–48 Hz band holds half the power of its 2–10 Hz band, as a 
 the Butterworth predicts a twentieth; run 1 gyro_z's 20 Hz resonance: a Butterworth at 36 Hz); so it is named
 only where the samples' spectrum shows its roll-off (:func:`spectrum_agrees`), and never on a curve alone —
 every order so (a steeper one stands in for a hump no less); the spectrum may show a white floor after the
-filter there, up to :data:`SPECTRUM_FLOOR` (a steep filter's output quantised).
+filter there, up to :data:`SPECTRUM_FLOOR` (a steep filter's output quantised). Beside a Butterworth that floor is
+in the model (the N column kept: :func:`.curvefit.has_floor`, the bandwidth's ``floor``), and an order less plus
+white angle noise stands in for the order plus the floor on the Allan curve; where the two are within one
+effective χ² point the spectrum above f_s/4 chooses (:func:`white_psd_misfit`: a floor is flat, white angle
+noise rises to f_s/2).
 
 The roll-off is accepted first (:func:`.candidates.choose`: the white noise every other column is judged
 against), so its parameter is searched without the terms later steps add; a Gauss–Markov term's short-τ slope
@@ -30,11 +34,12 @@ import numpy as np
 from scipy.optimize import nnls
 
 from .. import tracing
-from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation
+from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation, filter_cutoff
 from .curvefit import PROFILE_RHO, Curve, Solution, base_name, search, solve
 
 __all__ = [
     "better_kind",
+    "filter_params",
     "needs_spectrum",
     "spectrum_agrees",
     "research_rolloff",
@@ -217,3 +222,29 @@ def _butterworth_beside(curve: Curve, start: tuple, others: list, grids: dict, y
     if best is None or best[3]:
         return None
     return best[0], best[1]
+
+
+def filter_params(kind: str, p: float, fs: float, profile) -> tuple[dict, dict]:
+    """A bandwidth's reported parameters and intervals: ``cutoff`` (−3 dB, Hz), ``taps``, ``filter`` (and a
+    cascade's ``pole_cutoff``) of the kind ``kind`` at its searched parameter ``p``; ``profile()`` gives the
+    parameter's profile interval (called only where the kind's intervals come from it)."""
+    cut = filter_cutoff(kind, p, fs)
+    if kind == "single_pole" or needs_spectrum(kind):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
+        c_int = profile() if kind == "single_pole" else tuple(min(c, fs / 2.0) for c in profile())
+        return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": c_int}
+    if kind.startswith("single_pole+boxcar:"):
+        p_lo, p_hi = profile()
+        span = float(kind.split(":", 1)[1])
+        return {"cutoff": cut, "taps": span, "filter": "single_pole+boxcar", "pole_cutoff": float(p)}, {
+            "cutoff": (filter_cutoff(kind, p_lo, fs), filter_cutoff(kind, p_hi, fs)),
+            "pole_cutoff": (p_lo, p_hi),
+        }
+    if kind == "boxcar":
+        s_lo, s_hi = profile()
+        return {"cutoff": cut, "taps": float(p), "filter": kind}, {
+            "cutoff": (filter_cutoff(kind, s_hi, fs), filter_cutoff(kind, s_lo, fs)),
+            "taps": (s_lo, s_hi),
+        }
+    taps = int(p) if kind == "moving_average" else 2 * int(p) - 1
+    c_int = (filter_cutoff(kind, p + 1, fs), filter_cutoff(kind, max(1.0, p - 1), fs))
+    return {"cutoff": cut, "taps": taps, "filter": kind}, {"cutoff": c_int}
