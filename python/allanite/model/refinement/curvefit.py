@@ -481,7 +481,7 @@ def upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4
 
 def theta_terms(sol, terms, effects):
     """Squared coefficients of the terms (a bandwidth's N — the white noise before its filter — in place of the N
-    column's, which is the floor after it)."""
+    column's: zeroed, or beside a Butterworth the floor after the filter, the bandwidth's ``floor``)."""
     k = len(terms)
     theta = sol.theta[:k].copy()
     for j, (key, _p) in enumerate(effects):
