@@ -55,6 +55,10 @@ def test_a_quantised_4th_order_butterworth_keeps_its_order_and_finds_the_floor()
     lo, hi = r.steps[0].final_intervals["floor"]
     assert lo < p["floor"] < hi
     assert r.fit.coefficients["N"].value == pytest.approx(N, rel=0.03)  # the white noise before the filter
+    # the spectrum above f_s/4 splits the white part after the filter: all floor, no white angle noise
+    white = r.steps[0].evidence["psd_white"]
+    assert white["floor"] == pytest.approx(_floor(1.0), rel=0.03) and white["q"] < 1e-3 * _floor(1.0)
+    assert white["misfit"] < 0.03
     assert r.fit.chi2_dof < 1.5 and not r.unexplained
 
 
@@ -84,7 +88,7 @@ def test_no_floor_without_quantisation_and_no_bandwidth_without_a_filter():
     clean = allanite.refine(_record(1, fs, 4, 0.0), fs)
     p = clean.steps[0].final_params
     assert p["filter"] == "butterworth4" and p["cutoff"] == pytest.approx(400.0, rel=0.01)
-    assert p["floor"] < 0.1 * _floor(1.0)
+    assert p["floor"] < 0.1 * _floor(1.0) and clean.steps[0].evidence["psd_white"]["floor"] < 0.1 * _floor(1.0)
     # quantised white noise without a filter is white noise: nothing to add
     plain = allanite.refine(_record(1, fs, None, 1.0), fs)
     assert plain.steps == [] and not plain.unexplained

@@ -40,6 +40,8 @@ from .curvefit import PROFILE_RHO, Curve, Solution, base_name, search, solve
 __all__ = [
     "better_kind",
     "filter_params",
+    "psd_white",
+    "white_psd_misfit",
     "needs_spectrum",
     "spectrum_agrees",
     "research_rolloff",
@@ -88,6 +90,24 @@ def white_psd_misfit(y: np.ndarray, fs: float, kind: str, p: float, sol: Solutio
     f_s/2: on the Allan curve a Butterworth of one order less plus Q stands in for the order plus a floor (4th
     order at 400 Hz of 2 kHz with a floor: the 3rd at 404.5 Hz plus Q within 0.08 % at every τ), and the curve
     splits the two white kinds loosely — the spectrum tells the orders apart."""
+    return _white_parts(y, fs, kind, p, float(sol.theta[-1]))[0]
+
+
+def psd_white(y: np.ndarray, fs: float, kind: str, p: float, n2: float) -> dict:
+    """What the spectrum above f_s/4 says of the white noise after the filter ``kind`` at ``p`` (filtered white
+    noise N² = ``n2``): ``floor`` (white rate noise, as N: rate unit·√s) and ``q`` (white angle noise, as Q),
+    the non-negative mix of :func:`white_psd_misfit`, and its ``misfit`` — the step's evidence beside the floor
+    the Allan curve gave, which splits the two loosely."""
+    misfit, mix = _white_parts(y, fs, kind, p, n2)
+    return {
+        "floor": math.sqrt(mix[0] / 2.0),
+        "q": math.sqrt(mix[1] / (8.0 * fs)),
+        "misfit": misfit if math.isfinite(misfit) else None,
+    }
+
+
+def _white_parts(y: np.ndarray, fs: float, kind: str, p: float, n2: float) -> tuple[float, np.ndarray]:
+    """(:func:`white_psd_misfit`, the mix (2N_floor², 8Q²f_s) of its best prediction)."""
     nper = int(min(4096, 2 ** int(math.log2(max(y.size // 8, 256)))))
     f, meas = tracing._rolloff_welch(np.asarray(y, dtype=np.float64), float(fs), nper)
     band = (f >= 0.25 * fs) & (f <= 0.49 * fs)
@@ -97,15 +117,15 @@ def white_psd_misfit(y: np.ndarray, fs: float, kind: str, p: float, sol: Solutio
     # the band in 12 parts, each part's mean power: the Welch estimate's scatter averaged out, the shape kept
     parts = np.array_split(np.arange(int(band.sum())), 12)
     m = np.array([meas[band][ix].mean() for ix in parts])
-    filt = np.array([2.0 * sol.theta[-1] * max(float(h2[ix].mean()), 0.0) for ix in parts])
+    filt = np.array([2.0 * n2 * max(float(h2[ix].mean()), 0.0) for ix in parts])
     white = np.array([[1.0, float(np.mean(np.sin(np.pi * f[band][ix] / fs) ** 2))] for ix in parts])
     if not np.all(m > 0):
-        return math.inf
+        return math.inf, np.zeros(2)
     mix, _res = nnls(white / m[:, None], 1.0 - filt / m)  # relative least squares, non-negative
     pred = filt + white @ mix
     if not np.all(pred > 0):
-        return math.inf
-    return float(np.sqrt(np.mean(np.log(m / pred) ** 2)))
+        return math.inf, mix
+    return float(np.sqrt(np.mean(np.log(m / pred) ** 2))), mix
 
 
 #: How much better (a factor on :func:`white_psd_misfit`) the steeper order's white parts must predict the

@@ -28,7 +28,15 @@ import numpy as np
 
 from .. import tracing
 from ..effects import CASCADE_SPANS, EFFECTS, RESONANCE_Q, filter_autocorrelation
-from ._rolloff import STEEPER, better_kind, filter_params, higher_butterworths, needs_spectrum, spectrum_agrees
+from ._rolloff import (
+    STEEPER,
+    better_kind,
+    filter_params,
+    higher_butterworths,
+    needs_spectrum,
+    psd_white,
+    spectrum_agrees,
+)
 from .curvefit import (
     Curve,
     Solution,
@@ -287,6 +295,8 @@ def _bw_evidence(pr: Proposal, rnd: Round) -> dict:
     if rnd.y is not None:  # a second domain: the roll-off the filter predicts in the spectrum, and the data's
         r = filter_autocorrelation(pr.key.split(":", 1)[1], pr.p, rnd.curve.fs)
         ev["psd"] = tracing.rolloff_psd(rnd.y, rnd.curve.fs, r)
+        if has_floor(pr.key):  # the white noise after it, as the spectrum above f_s/4 splits it (floor, Q)
+            ev["psd_white"] = psd_white(rnd.y, rnd.curve.fs, pr.key.split(":", 1)[1], pr.p, ev["N"] ** 2)
     return ev
 
 
