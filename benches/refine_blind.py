@@ -357,7 +357,9 @@ NOTES: list = [
     "read the filter as a boxcar of 2.1 samples plus a 48.9 Hz resonance standing in for the knee (χ²/dof 397 "
     "on the tests' GLS covariance, τ 2.5–68 ms flagged). Its judge was made stricter with the kind: the "
     "bandwidth is an injected effect (cutoff 100 Hz within 20 %, kind butterworth2) and a resonance counts "
-    "against it; before, only the Gauss–Markov term was judged and a bandwidth of any kind allowed.",
+    "against it; before, only the Gauss–Markov term was judged and a bandwidth of any kind allowed. Rerun alone "
+    "with the white floor beside a Butterworth (branch r6quant): floor 0 (none injected), the same kinds and "
+    "cutoffs, T_c +8.1 % (+8.3 %), χ²/dof 2.31.",
     "",
     "Why the other cases fail — and whether the library should change:",
     "",

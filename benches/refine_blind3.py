@@ -311,9 +311,12 @@ NOTES: list = [
     "4.7·10⁴ → 515, `unexplained` τ 0.5 ms–0.26 s. **Fixed since**: Butterworth orders 2–6 "
     "(`butterworth2` … `butterworth6`, the autocorrelation from the poles): now `butterworth4` at 402.5 Hz "
     "(+0.6 %), χ²/dof → 4.23, nothing unexplained, the mains family as before — but a broad 704 Hz resonance "
-    "(Q 2) stands in for the quantisation's white noise added after the filter (the bandwidth effect replaces "
-    "the N column; the same record unquantised gives `butterworth4` at 399.8 Hz and no resonance). The judge "
-    "passes the row; a white term beside a filter is left (docs/refinement.md).",
+    "(Q 2) stood in for the quantisation's white noise added after the filter (the bandwidth effect replaced "
+    "the N column; the same record unquantised gave `butterworth4` at 399.8 Hz and no resonance). **Fixed "
+    "since** (this row alone rerun, at the branch r6quant): beside a Butterworth the N column stays as white "
+    "noise after the filter, the bandwidth's `floor` — `butterworth4` at 400.8 Hz (+0.2 %), floor 0.00102 "
+    "°/s·√s (the step's Δ·√(τ0/12) = 0.00115: −12 %), no resonance, χ²/dof → 0.816, held-out 2.35 % "
+    "(docs/refinement.md).",
     "- *FOG-like 1 Hz × 10⁵, temperature through a 900 s lag* — the regression is named (coefficient −5.5 %) "
     "and the lag is not carried by the record at its test's level (statistic 2.27 at ν 39.3 against 16.5, "
     "p 0.36, best at 389 s), χ²/dof 2.50 → 0.78; but the held-out error rises 2.13 → 2.76 %. The truth does "

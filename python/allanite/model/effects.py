@@ -305,8 +305,9 @@ class Effect:
         Where it is traced: "allan" (the curve's residual), "psd" (Welch periodogram), "time" (the samples
         along time), "channels" (other channels of the log).
     replaces : str, optional
-        The term whose column the effect's column replaces ("N" for a bandwidth: the filtered white noise
-        *is* the white rate noise).
+        The term whose noise the effect's column carries ("N" for a bandwidth: the filtered white noise *is* the
+        white rate noise, reported as N); the term's own column is zeroed — beside a Butterworth it stays, as
+        white noise added after the filter (its ``floor``; :func:`allanite.model.refinement.curvefit.has_floor`).
     """
 
     name: str
@@ -372,13 +373,22 @@ EFFECTS: dict[str, Effect] = {
                     "FIR length (moving average L, Bartlett 2L − 1; a boxcar's span D·f_s, any real); "
                     "0 for a single pole or a Butterworth",
                 ),
+                (
+                    "floor",
+                    "rate unit·√s",
+                    "white rate noise added after a Butterworth (the output's quantisation, a readout's noise), "
+                    "as N: the N column beside the filtered one, 0 where there is none; not with other kinds",
+                ),
             ),
             "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
             "decimating MEMS part, a boxcar of any span read at the output rate, or the Butterworth anti-alias "
             "stage of a MEMS or tactical gyro, orders 2 to 6, ``butterworth2`` … ``butterworth6``): "
-            "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, replacing N²/τ — a "
-            "roll-off of the shortest τ; the N it reports is the white noise before the filter. Accepted first, "
-            "its parameter is searched again beside the terms later steps add",
+            "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, in place of N²/τ — a "
+            "roll-off of the shortest τ; the N it reports is the white noise before the filter. Beside a Butterworth "
+            "the N²/τ column stays, non-negative, as white noise added after the filter (``floor``: a digital "
+            "part's quantised output adds a step Δ's Δ²/12 per sample, floor = Δ·√(τ0/12); a readout's noise): a "
+            "steep filter's stop band is then flat, not a resonance. Accepted first, its parameter is searched "
+            "again beside the terms later steps add",
             signature=None,
             alpha=lambda tau, p: np.zeros(np.asarray(tau).size, dtype=int),
             search=None,

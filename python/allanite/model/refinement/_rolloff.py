@@ -9,7 +9,11 @@ the spectrum's 40–48 Hz band holds half the power of its 2–10 Hz band, as a 
 the Butterworth predicts a twentieth; run 1 gyro_z's 20 Hz resonance: a Butterworth at 36 Hz); so it is named
 only where the samples' spectrum shows its roll-off (:func:`spectrum_agrees`), and never on a curve alone —
 every order so (a steeper one stands in for a hump no less); the spectrum may show a white floor after the
-filter there, up to :data:`SPECTRUM_FLOOR` (a steep filter's output quantised).
+filter there, up to :data:`SPECTRUM_FLOOR` (a steep filter's output quantised). Beside a Butterworth that floor is
+in the model (the N column kept: :func:`.curvefit.has_floor`, the bandwidth's ``floor``), and an order less plus
+white angle noise stands in for the order plus the floor on the Allan curve; where the two are within one
+effective χ² point the spectrum above f_s/4 chooses (:func:`white_psd_misfit`: a floor is flat, white angle
+noise rises to f_s/2).
 
 The roll-off is accepted first (:func:`.candidates.choose`: the white noise every other column is judged
 against), so its parameter is searched without the terms later steps add; a Gauss–Markov term's short-τ slope
@@ -27,13 +31,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import nnls
 
 from .. import tracing
-from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation
+from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation, filter_cutoff
 from .curvefit import PROFILE_RHO, Curve, Solution, base_name, search, solve
 
 __all__ = [
     "better_kind",
+    "filter_params",
+    "psd_white",
+    "white_psd_misfit",
     "needs_spectrum",
     "spectrum_agrees",
     "research_rolloff",
@@ -74,20 +82,90 @@ def spectrum_agrees(y: np.ndarray | None, fs: float, kind: str, p: float) -> boo
     return abs(math.log(pred / meas)) <= math.log(SPECTRUM_FACTOR) or pred < meas <= SPECTRUM_FLOOR
 
 
-def higher_butterworths(curve: Curve, start: tuple, effects: list, grid: np.ndarray, second, tie: float) -> list:
+def white_psd_misfit(y: np.ndarray, fs: float, kind: str, p: float, sol: Solution) -> float:
+    """RMS of log(measured/predicted) of the Welch PSD's power in 12 parts of 0.25–0.49·f_s, predicted as the
+    filtered white noise of the solution ``sol`` (the bandwidth ``kind`` at ``p`` in its last column: 2N²·|H(f)|²,
+    one-sided per Hz) plus the non-negative mix of a white floor (flat) and white angle noise (∝ sin²(πf/f_s))
+    that fits the parts best. Where a steep filter has fallen, a floor is flat and white angle noise rises to
+    f_s/2: on the Allan curve a Butterworth of one order less plus Q stands in for the order plus a floor (4th
+    order at 400 Hz of 2 kHz with a floor: the 3rd at 404.5 Hz plus Q within 0.08 % at every τ), and the curve
+    splits the two white kinds loosely — the spectrum tells the orders apart."""
+    return _white_parts(y, fs, kind, p, float(sol.theta[-1]))[0]
+
+
+def psd_white(y: np.ndarray, fs: float, kind: str, p: float, n2: float) -> dict:
+    """What the spectrum above f_s/4 says of the white noise after the filter ``kind`` at ``p`` (filtered white
+    noise N² = ``n2``): ``floor`` (white rate noise, as N: rate unit·√s) and ``q`` (white angle noise, as Q),
+    the non-negative mix of :func:`white_psd_misfit`, and its ``misfit`` — the step's evidence beside the floor
+    the Allan curve gave, which splits the two loosely."""
+    misfit, mix = _white_parts(y, fs, kind, p, n2)
+    return {
+        "floor": math.sqrt(mix[0] / 2.0),
+        "q": math.sqrt(mix[1] / (8.0 * fs)),
+        "misfit": misfit if math.isfinite(misfit) else None,
+    }
+
+
+def _white_parts(y: np.ndarray, fs: float, kind: str, p: float, n2: float) -> tuple[float, np.ndarray]:
+    """(:func:`white_psd_misfit`, the mix (2N_floor², 8Q²f_s) of its best prediction)."""
+    nper = int(min(4096, 2 ** int(math.log2(max(y.size // 8, 256)))))
+    f, meas = tracing._rolloff_welch(np.asarray(y, dtype=np.float64), float(fs), nper)
+    band = (f >= 0.25 * fs) & (f <= 0.49 * fs)
+    r = filter_autocorrelation(kind, p, fs)
+    lags = np.arange(1, r.size)
+    h2 = r[0] + 2.0 * np.cos(2.0 * np.pi * np.outer(f[band] / fs, lags)) @ r[1:]
+    # the band in 12 parts, each part's mean power: the Welch estimate's scatter averaged out, the shape kept
+    parts = np.array_split(np.arange(int(band.sum())), 12)
+    m = np.array([meas[band][ix].mean() for ix in parts])
+    filt = np.array([2.0 * n2 * max(float(h2[ix].mean()), 0.0) for ix in parts])
+    white = np.array([[1.0, float(np.mean(np.sin(np.pi * f[band][ix] / fs) ** 2))] for ix in parts])
+    if not np.all(m > 0):
+        return math.inf, np.zeros(2)
+    mix, _res = nnls(white / m[:, None], 1.0 - filt / m)  # relative least squares, non-negative
+    pred = filt + white @ mix
+    if not np.all(pred > 0):
+        return math.inf, mix
+    return float(np.sqrt(np.mean(np.log(m / pred) ** 2))), mix
+
+
+#: How much better (a factor on :func:`white_psd_misfit`) the steeper order's white parts must predict the
+#: spectrum's upper half band to be taken where the Allan curve cannot tell the two apart (within ``tie``).
+PSD_MISFIT_FACTOR = 0.5
+
+
+def higher_butterworths(
+    curve: Curve, start: tuple, effects: list, grid: np.ndarray, second, tie: float, y: np.ndarray | None = None
+) -> tuple[list, set]:
     """The Butterworths of order 3 and up as (key, p, sol, edge), searched on the 2nd order's ``grid`` one order
     after another while each lowers χ² by more than ``tie`` below the order before (``second``: the 2nd order's
-    (key, p, sol, edge)). A steeper roll-off is tried only where the 2nd order was, and only as far as the curve
-    asks for it: a record whose 2nd order no 3rd beats costs one search more."""
-    prev, out = second, []
+    (key, p, sol, edge)) — or, within ``tie`` of it, predicts the spectrum of ``y`` above f_s/4 better by
+    :data:`PSD_MISFIT_FACTOR` (:func:`white_psd_misfit`: a floor after the filter, not white angle noise beside
+    an order less). A steeper roll-off is tried only where the 2nd order was, and only as far as the curve asks
+    for it: a record whose 2nd order no 3rd beats costs one search more. An order the spectrum took a steeper one
+    over is left out of the list and its key returned in ``superseded`` (the 2nd order's too), so that the choice
+    between kinds on χ² does not take it back."""
+    prev, out, superseded = second, [], set()
     for kind in STEEPER:
         key = f"bandwidth:{kind}"
         p, sol, edge = search(curve, start, effects, key, grid)
         out.append((key, p, sol, edge))
-        if not sol.chi2 < prev[2].chi2 - tie:
+        if sol.chi2 < prev[2].chi2 - tie:
+            prev = out[-1]
+        elif _spectrum_prefers(y, curve.fs, out[-1], prev, tie):
+            superseded.add(prev[0])
+            prev = out[-1]
+        else:
             break
-        prev = out[-1]
-    return out
+    return [o for o in out if o[0] not in superseded], superseded
+
+
+def _spectrum_prefers(y, fs: float, new: tuple, prev: tuple, tie: float) -> bool:
+    """Whether the steeper order ``new`` = (key, p, sol, edge), within ``tie`` of ``prev`` on χ², predicts the
+    spectrum's upper half band better by :data:`PSD_MISFIT_FACTOR` (False without samples)."""
+    if y is None or new[3] or not new[2].chi2 < prev[2].chi2 + tie:
+        return False
+    mis = [white_psd_misfit(y, fs, k.split(":", 1)[1], p, s) for k, p, s, _e in (new, prev)]
+    return mis[0] < PSD_MISFIT_FACTOR * mis[1]
 
 
 def better_kind(new, best, tie) -> bool:
@@ -158,8 +236,35 @@ def _butterworth_beside(curve: Curve, start: tuple, others: list, grids: dict, y
         p, s_k, edge = search(curve, start, others, f"bandwidth:{k}", grids[k])
         if k != kind and (edge or not spectrum_agrees(y, curve.fs, k, p)):
             continue
-        if best is None or s_k.chi2 < best[2].chi2 - tie:
-            best = (f"bandwidth:{k}", p, s_k, edge)
+        new = (f"bandwidth:{k}", p, s_k, edge)
+        if best is None or s_k.chi2 < best[2].chi2 - tie or _spectrum_prefers(y, curve.fs, new, best, tie):
+            best = new
     if best is None or best[3]:
         return None
     return best[0], best[1]
+
+
+def filter_params(kind: str, p: float, fs: float, profile) -> tuple[dict, dict]:
+    """A bandwidth's reported parameters and intervals: ``cutoff`` (−3 dB, Hz), ``taps``, ``filter`` (and a
+    cascade's ``pole_cutoff``) of the kind ``kind`` at its searched parameter ``p``; ``profile()`` gives the
+    parameter's profile interval (called only where the kind's intervals come from it)."""
+    cut = filter_cutoff(kind, p, fs)
+    if kind == "single_pole" or needs_spectrum(kind):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
+        c_int = profile() if kind == "single_pole" else tuple(min(c, fs / 2.0) for c in profile())
+        return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": c_int}
+    if kind.startswith("single_pole+boxcar:"):
+        p_lo, p_hi = profile()
+        span = float(kind.split(":", 1)[1])
+        return {"cutoff": cut, "taps": span, "filter": "single_pole+boxcar", "pole_cutoff": float(p)}, {
+            "cutoff": (filter_cutoff(kind, p_lo, fs), filter_cutoff(kind, p_hi, fs)),
+            "pole_cutoff": (p_lo, p_hi),
+        }
+    if kind == "boxcar":
+        s_lo, s_hi = profile()
+        return {"cutoff": cut, "taps": float(p), "filter": kind}, {
+            "cutoff": (filter_cutoff(kind, s_hi, fs), filter_cutoff(kind, s_lo, fs)),
+            "taps": (s_lo, s_hi),
+        }
+    taps = int(p) if kind == "moving_average" else 2 * int(p) - 1
+    c_int = (filter_cutoff(kind, p + 1, fs), filter_cutoff(kind, max(1.0, p - 1), fs))
+    return {"cutoff": cut, "taps": taps, "filter": kind}, {"cutoff": c_int}

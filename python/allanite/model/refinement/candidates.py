@@ -27,13 +27,22 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import tracing
-from ..effects import CASCADE_SPANS, EFFECTS, RESONANCE_Q, filter_autocorrelation, filter_cutoff
-from ._rolloff import STEEPER, better_kind, higher_butterworths, needs_spectrum, spectrum_agrees
+from ..effects import CASCADE_SPANS, EFFECTS, RESONANCE_Q, filter_autocorrelation
+from ._rolloff import (
+    STEEPER,
+    better_kind,
+    filter_params,
+    higher_butterworths,
+    needs_spectrum,
+    psd_white,
+    spectrum_agrees,
+)
 from .curvefit import (
     Curve,
     Solution,
     base_name,
     column,
+    has_floor,
     held_key,
     held_theta,
     profile_interval,
@@ -249,7 +258,10 @@ def _bw_propose(rnd: Round) -> list:
         grids[key] = grid
     two = "bandwidth:butterworth2"
     if two in grids and rnd.y is not None:  # steeper Butterworths, named only with a spectrum as the 2nd order
-        found += higher_butterworths(rnd.curve, rnd.start, rnd.effects, grids[two], found[list(grids).index(two)], tie)
+        steeper, superseded = higher_butterworths(
+            rnd.curve, rnd.start, rnd.effects, grids[two], found[list(grids).index(two)], tie, rnd.y
+        )
+        found = [f for f in found if f[0] not in superseded] + steeper
     for key, p, s_new, edge in found:
         kind = key.split(":", 1)[1]  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)
         if needs_spectrum(kind) and not spectrum_agrees(rnd.y, rnd.curve.fs, kind, p):
@@ -264,31 +276,18 @@ def _bw_propose(rnd: Round) -> list:
 
 
 def _bw_params(pr: Proposal, rnd: Round) -> tuple:
-    kind, p, fs = pr.key.split(":", 1)[1], pr.p, rnd.curve.fs
-    cut = filter_cutoff(kind, p, fs)
-
-    def profile():
-        return profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, p, pr.sol)
-
-    if kind == "single_pole" or needs_spectrum(kind):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
-        c_int = profile() if kind == "single_pole" else tuple(min(c, fs / 2.0) for c in profile())
-        return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": c_int}
-    if kind.startswith("single_pole+boxcar:"):
-        p_lo, p_hi = profile()
-        span = float(kind.split(":", 1)[1])
-        return {"cutoff": cut, "taps": span, "filter": "single_pole+boxcar", "pole_cutoff": float(p)}, {
-            "cutoff": (filter_cutoff(kind, p_lo, fs), filter_cutoff(kind, p_hi, fs)),
-            "pole_cutoff": (p_lo, p_hi),
-        }
-    if kind == "boxcar":
-        s_lo, s_hi = profile()
-        return {"cutoff": cut, "taps": float(p), "filter": kind}, {
-            "cutoff": (filter_cutoff(kind, s_hi, fs), filter_cutoff(kind, s_lo, fs)),
-            "taps": (s_lo, s_hi),
-        }
-    taps = int(p) if kind == "moving_average" else 2 * int(p) - 1
-    c_int = (filter_cutoff(kind, p + 1, fs), filter_cutoff(kind, max(1.0, p - 1), fs))
-    return {"cutoff": cut, "taps": taps, "filter": kind}, {"cutoff": c_int}
+    params, intervals = filter_params(
+        pr.key.split(":", 1)[1],
+        pr.p,
+        rnd.curve.fs,
+        lambda: profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol),
+    )
+    if "N" in rnd.start and has_floor(pr.key):  # the N column beside a Butterworth: white noise after it
+        floor, sd, floor_int = _amplitude(pr.sol, list(rnd.start).index("N"))
+        params["floor"] = floor
+        if math.isfinite(sd):  # none where the floor is 0 (a bound, not an estimate)
+            intervals["floor"] = floor_int
+    return params, intervals
 
 
 def _bw_evidence(pr: Proposal, rnd: Round) -> dict:
@@ -296,6 +295,8 @@ def _bw_evidence(pr: Proposal, rnd: Round) -> dict:
     if rnd.y is not None:  # a second domain: the roll-off the filter predicts in the spectrum, and the data's
         r = filter_autocorrelation(pr.key.split(":", 1)[1], pr.p, rnd.curve.fs)
         ev["psd"] = tracing.rolloff_psd(rnd.y, rnd.curve.fs, r)
+        if has_floor(pr.key):  # the white noise after it, as the spectrum above f_s/4 splits it (floor, Q)
+            ev["psd_white"] = psd_white(rnd.y, rnd.curve.fs, pr.key.split(":", 1)[1], pr.p, ev["N"] ** 2)
     return ev
 
 

@@ -3,10 +3,12 @@ of an effect's nonlinear parameter with its profile interval, and the NoiseFit i
 
 Every curve effect enters the model as a non-negative column of Allan variance (its registry signature,
 :mod:`allanite.model.effects`); an effect that ``replaces`` a term (a bandwidth: the filtered white noise is
-the white rate noise N) zeroes that term's column. An effect measured in the time domain (a spectral line's
-amplitude, from its power in the samples' spectrum) is *held*: its key carries the coefficient and its
-variance (:func:`held_key`), its column enters every fit at that value and the curve fits only the others —
-the Allan curve, where a line's column aliases with a bandwidth's or a resonance's, does not move it.
+the white rate noise N, reported as N) zeroes that term's column — but beside a Butterworth the N column stays,
+as white noise added after the filter (a quantised output's floor), non-negative, so 0 where there is none
+(:func:`has_floor`). An effect measured in the time domain (a spectral line's amplitude, from its power in the
+samples' spectrum) is *held*: its key carries the coefficient and its variance (:func:`held_key`), its column
+enters every fit at that value and the curve fits only the others — the Allan curve, where a line's column
+aliases with a bandwidth's or a resonance's, does not move it.
 Weights are the estimates' EDF under the model's own noise mix, iterated (IRLS); the covariance of the
 coefficients counts the dense curve's ~one independent estimate per octave.
 """
@@ -20,13 +22,14 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from .. import fitting
-from ..effects import EFFECTS, filtered_white_avar, resonance_avar
+from ..effects import EFFECTS, butterworth_order, filtered_white_avar, resonance_avar
 from ..terms import TERM_ALPHA, design_matrix
 from . import _brent
 from ._irls import chi2_at, irls
 
 __all__ = [
     "base_name",
+    "has_floor",
     "held_key",
     "held_theta",
     "column",
@@ -179,14 +182,28 @@ def design(curve, terms, effects):
     """Columns of the terms and the effects [(key, nonlinear parameter)] on ``curve``, and each column's
     noise type per τ (for the EDF)."""
     tau = curve.tau
-    a0 = _term_columns(curve, terms).copy()
-    for key, _p in effects:
-        rep = EFFECTS[base_name(key)].replaces
-        if rep in terms:
-            a0[:, list(terms).index(rep)] = 0.0
+    a0 = _term_columns(curve, terms)
+    zeroed = [EFFECTS[base_name(key)].replaces for key, _p in effects if not has_floor(key)]
+    if any(rep in terms for rep in zeroed):
+        a0 = a0.copy()
+        for rep in zeroed:
+            if rep in terms:
+                a0[:, list(terms).index(rep)] = 0.0
     cols = [a0] + [column(key, p, curve)[:, None] for key, p in effects]
     alphas = [np.full(tau.size, TERM_ALPHA[t]) for t in terms] + [_alpha_of(k, p, tau) for k, p in effects]
     return np.hstack(cols), alphas
+
+
+def has_floor(key: str) -> bool:
+    """Whether the term a bandwidth ``key`` carries keeps its own column beside it — white noise added after the
+    filter (a quantised output's floor; the bandwidth's ``floor``): beside a Butterworth, whose stop band the
+    samples' spectrum shows and a floor is flat in. Beside a single pole or a boxcar the term is replaced: there
+    a floor trades with the pole's cutoff, the boxcar's span and white angle noise on the Allan curve (ADIS16405
+    run 5 gyro_y's boxcar read 1.41 → 1.61 samples with a floor of 0 and white angle noise in its place, run 1
+    gyro_z's single pole beside a second resonance at 24.5 Hz)."""
+    if base_name(key) != "bandwidth":
+        return False
+    return butterworth_order(key.split(":", 1)[1]) > 0
 
 
 def _term_columns(curve, terms):
@@ -463,7 +480,8 @@ def upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4
 
 
 def theta_terms(sol, terms, effects):
-    """Squared coefficients of the terms (a bandwidth's N in place of the zeroed N column)."""
+    """Squared coefficients of the terms (a bandwidth's N — the white noise before its filter — in place of the N
+    column's: zeroed, or beside a Butterworth the floor after the filter, the bandwidth's ``floor``)."""
     k = len(terms)
     theta = sol.theta[:k].copy()
     for j, (key, _p) in enumerate(effects):
