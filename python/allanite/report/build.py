@@ -253,6 +253,11 @@ def _refinement(x, fs, input, unit_name, static, axis_names, asked, notes, setti
         settings["refine_candidates"] = list(candidates)
         if channels:
             settings["channels"] = list(channels)
+            notes.append(
+                f"Channel{'s' if len(channels) > 1 else ''} {', '.join(channels)} passed to every axis's model "
+                "refinement (its regression on other channels); a channel's unit is not known to allanite: its "
+                "coefficients are per unit of the channel."
+            )
     return refinements
 
 
