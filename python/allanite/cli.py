@@ -243,7 +243,7 @@ def _read(args, progress):
         log = read_log(
             path,
             fs=args.fs,
-            columns=None if columns is None or not chans else columns + chans,
+            columns=columns + chans if columns is not None else None,
             time_column=_time_column(args),
             unit=args.unit,
             input=args.input or "rate",
@@ -259,16 +259,12 @@ def _read(args, progress):
 
 
 def _channel_specs(args, columns) -> list:
-    """--channels as column specs ([] without it); refused without a refinement that uses them, by index without
-    --columns (the file's indices are only known with it), and where a spec is also one of --columns."""
+    """--channels as column specs ([] without it); refused with --refine-candidates that leave the regression out,
+    by index without --columns (the file's indices are only known with it), and where a spec is also one of
+    --columns. Without --refine / --refine-candidates it implies --refine (:func:`_refine_option`)."""
     if args.channels is None:
         return []
     specs = _spec_list(args.channels, "--channels")
-    if not (args.refine or args.refine_candidates is not None):
-        raise UsageError(
-            f"--channels {args.channels} is used by the model refinement's regression on other channels: add "
-            "--refine (or --refine-candidates with regression)"
-        )
     tried = _refine_option(args)
     if isinstance(tried, tuple) and "regression" not in tried:
         raise UsageError(
@@ -283,13 +279,14 @@ def _channel_specs(args, columns) -> list:
     both = [c for c in specs if c in (columns or [])]
     if both or len(set(specs)) < len(specs):
         twice = both[0] if both else next(c for c in specs if specs.count(c) > 1)
-        raise ParameterError(_twice_message(twice, "both --columns and --channels" if both else "twice in --channels"))
+        where = "in both --columns and --channels" if both else "twice in --channels"
+        raise ParameterError(_twice_message(twice, where))
     return specs
 
 
 def _twice_message(column, where: str) -> str:
     return (
-        f"column {column!r} is given in {where}: a column is either analysed as an axis (--columns) or "
+        f"column {column!r} is given {where}: a column is either analysed as an axis (--columns) or "
         "a channel the axes are regressed on (--channels), once"
     )
 
@@ -307,7 +304,7 @@ def _split_channels(log, specs: list, n_axes: int | None):
             n for n in names[n_axes:] if names[n_axes:].count(n) > 1
         ]
         if twice:  # a name and an index of the same column
-            raise ParameterError(_twice_message(twice[0], "both --columns and --channels"))
+            raise ParameterError(_twice_message(twice[0], "in both --columns and --channels"))
     else:
         idx = [resolve_column(c, names, log.path, "column") for c in specs]
     keep = [i for i in range(len(names)) if i not in idx]
@@ -388,9 +385,11 @@ def _kalibr(args, rep, progress) -> Path:
 
 
 def _refine_option(args) -> bool | tuple:
-    """``build_report``'s ``refine=``: False, True (--refine), or the effects of --refine-candidates."""
+    """``build_report``'s ``refine=``: False, True (--refine, or --channels alone), or the effects of
+    --refine-candidates."""
     if args.refine_candidates is None:
-        return bool(args.refine)
+        # --channels implies --refine: a channel has no other use than the refinement's regression on it
+        return bool(args.refine or args.channels)
     names = [n.strip() for n in args.refine_candidates.split(",") if n.strip()]
     return () if names == ["none"] else tuple(names)
 

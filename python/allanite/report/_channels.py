@@ -10,7 +10,8 @@ from ..errors import ParameterError
 
 def check_channels(channels, candidates, n: int) -> dict | None:
     """``channels=`` checked: None or empty → None; else name → float64 samples (n of them, finite, not
-    constant), refused without a refinement that tries the regression on them."""
+    constant), refused when ``refine=`` names effects without the regression on them. ``candidates`` None (no
+    refinement asked for) is checked by the caller, which then refines with every effect."""
     if channels is None or (isinstance(channels, Mapping) and not channels):
         return None
     if not isinstance(channels, Mapping):
@@ -18,12 +19,7 @@ def check_channels(channels, candidates, n: int) -> dict | None:
             f"channels must be a dict of name → samples (e.g. {{'temp': T}}), got {type(channels).__name__}"
         )
     names = ", ".join(map(repr, map(str, channels)))
-    if candidates is None:
-        raise ParameterError(
-            f"channels={{{names}}} are only used by the model refinement's regression: give refine=True "
-            "(or refine= a list of effects with 'regression'), or drop channels="
-        )
-    if "regression" not in candidates:
+    if candidates is not None and "regression" not in candidates:
         raise ParameterError(
             f"channels={{{names}}} are only used by the 'regression' effect, which refine={list(candidates)!r} "
             "leaves out: add 'regression' to the effects, or drop channels="

@@ -128,8 +128,9 @@ def build_report(
     channels : dict of str → array_like, optional
         Other channels of the same record (a temperature, a supply voltage, an accelerometer), one sample per
         sample of ``x``, passed to :func:`allanite.refine` on every axis as ``channels=`` for its ``"regression"``
-        effect. Needs ``refine`` with that effect among the candidates (a :class:`~allanite.errors.ParameterError`
-        otherwise: the channels would be read and never used). Their unit is not known to the report: a
+        effect. They imply ``refine=True`` (their only use is that regression); ``refine`` naming effects without
+        ``"regression"`` is a :class:`~allanite.errors.ParameterError` (the channels would never be used).
+        Their unit is not known to the report: a
         coefficient is in the rate unit per unit of the channel (e.g. "deg/s per unit of temp").
     estimator : {"oavar", "theoh"}
         ``"oavar"`` (default): overlapping Allan deviation and DAVAR. ``"theoh"``: TheoH for the
@@ -164,6 +165,8 @@ def build_report(
     x, plan = _record_and_plan(x, fs, frames, forecast)
     candidates = _refine_candidates(refine)
     channels = check_channels(channels, candidates, np.shape(x)[0])
+    if channels and candidates is None:  # channels imply refine=True: the regression is their only use
+        candidates = _refine_candidates(True)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
     x, unit_name, axis_names = _axes_and_unit(x, unit, input, axis_names, notes)
     taus = _check_taus(taus)
@@ -255,8 +258,8 @@ def _refinement(x, fs, input, unit_name, static, axis_names, asked, notes, setti
             settings["channels"] = list(channels)
             notes.append(
                 f"Channel{'s' if len(channels) > 1 else ''} {', '.join(channels)} passed to every axis's model "
-                "refinement (its regression on other channels); a channel's unit is not known to allanite: its "
-                "coefficients are per unit of the channel."
+                "refinement (its regression on other channels, which the channels imply); a channel's unit is "
+                "not known to allanite: its coefficients are per unit of the channel."
             )
     return refinements
 
