@@ -32,3 +32,11 @@ def check_channels(channels, candidates, n: int) -> dict | None:
             raise ParameterError(f"two channels are named {str(name)!r}; each channel needs its own name")
         checked[str(name)] = check_channel(str(name), c, n)
     return checked
+
+
+def rate_aligned(channels: dict | None, input: str) -> dict | None:
+    """The channels one per rate sample: a cumulative angle's n samples give n − 1 rates (θ[i+1] − θ[i])·fs, each
+    between two samples, so each channel is averaged over the same two samples; rates and increments as they are."""
+    if not channels or input != "angle":
+        return channels
+    return {name: 0.5 * (c[:-1] + c[1:]) for name, c in channels.items()}

@@ -44,7 +44,7 @@ from ..model.effects import EFFECTS
 from ..model.terms import TERMS
 from ..units import parse_unit
 from . import _worker
-from ._channels import check_channels
+from ._channels import check_channels, rate_aligned
 from .axes import analyse_by_axis, axes_per_read, axis_column, record_bytes, wants_by_axis
 from .budget import check_report_memory
 from .fmt import json_number
@@ -127,11 +127,12 @@ def build_report(
         accelerometers (docs/refinement.md); an empty one only says what the five-term model misses.
     channels : dict of str → array_like, optional
         Other channels of the same record (a temperature, a supply voltage, an accelerometer), one sample per
-        sample of ``x``, passed to :func:`allanite.refine` on every axis as ``channels=`` for its ``"regression"``
-        effect. They imply ``refine=True`` (their only use is that regression); ``refine`` naming effects without
-        ``"regression"`` is a :class:`~allanite.errors.ParameterError` (the channels would never be used).
-        Their unit is not known to the report: a
-        coefficient is in the rate unit per unit of the channel (e.g. "deg/s per unit of temp").
+        sample of ``x`` (with ``input="angle"`` each is averaged over the two samples of each rate), passed to
+        :func:`allanite.refine` on every axis as ``channels=`` for its ``"regression"`` effect. They imply
+        ``refine=True`` (their only use is that regression); ``refine`` naming effects without ``"regression"``
+        is a :class:`~allanite.errors.ParameterError` (the channels would never be used). Their unit is not
+        known to the report: a coefficient is in the rate unit per unit of the channel (e.g. "deg/s per unit of
+        temp").
     estimator : {"oavar", "theoh"}
         ``"oavar"`` (default): overlapping Allan deviation and DAVAR. ``"theoh"``: TheoH for the
         whole record and paper 001's DHVAR over time (overlapping Allan up to 10 % of the record or
@@ -167,6 +168,7 @@ def build_report(
     channels = check_channels(channels, candidates, np.shape(x)[0])
     if channels and candidates is None:  # channels imply refine=True: the regression is their only use
         candidates = _refine_candidates(True)
+    channels = rate_aligned(channels, input)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
     x, unit_name, axis_names = _axes_and_unit(x, unit, input, axis_names, notes)
     taus = _check_taus(taus)
