@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 import re
 
+import markupsafe
 import matplotlib
 
 matplotlib.use("Agg")
@@ -190,3 +191,26 @@ def test_whittle_bands_parametric_ones_are_the_lowest(n):
         b = wh.spectra(y, [_temperature(n, 1)], FS, parity=parity)
         assert b.par.sum() > 0 and not np.any(np.diff(b.par.astype(int)) > 0)  # True… then False…
         assert b.basis.shape[0] == int(b.par.sum())
+
+
+def test_an_unresolved_lag_and_a_heldout_rise_are_said_everywhere(tmp_path):
+    """8000 samples: the lag's test does not keep it but the profile is used for the removal (evidence["lag"]),
+    and the chain's held-out error rose (evidence["heldout_note"]): summary.json, the console, the page and
+    Refinement.report() all say both, the coefficient per unit of temp."""
+    n = 8_000
+    temp = _temperature(n, 3)
+    y = allanite.simulate(n, FS, N=0.01, seed=2) + COEF * (temp - temp.mean())
+    rep = build_report(y, FS, unit="deg/s", window=1600, hop=400, channels={"temp": temp}, progress=False)
+    (r,) = rep.refinements
+    (st,) = [st for st in r.steps if st.effect == "regression"]
+    said = {k: st.evidence[k] for k in ("lag", "heldout_note") if st.evidence.get(k)}
+    assert said  # the case exercises the notes (both, at these seeds)
+    (js,) = [s for s in rep.summary()["refinement"]["axes"][0]["steps"] if s["effect"] == "regression"]
+    text = rep.text()
+    paths = rep.write(tmp_path / "out")
+    html = next(p for p in paths if p.name == "report.html").read_text()
+    for key, words in said.items():
+        assert js["regression"][key] == words
+        assert words in text
+        assert str(markupsafe.escape(words)) in html  # as Jinja2 escapes it
+    assert "°/s per unit of temp" in text and "deg/s per unit of temp" in r.report()

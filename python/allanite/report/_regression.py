@@ -27,18 +27,6 @@ REGRESSION_COLUMNS = (
 )
 
 
-def channel_units(units: dict, params: dict) -> dict:
-    """The step's parameter units with "channel unit" spelled as the unit of the named channel, which the report
-    does not know: "deg/s per unit of temp" (the coefficient is per whatever unit the channel's column is in)."""
-    name = params.get("channel")
-    if not isinstance(name, str):
-        return units
-    return {
-        p: u.replace("channel unit²", f"(unit of {name})²").replace("channel unit", f"unit of {name}")
-        for p, u in units.items()
-    }
-
-
 def _tree(v: Any) -> Any:
     """Evidence made JSON-able: dicts and sequences element by element, numbers by :func:`json_number`."""
     if isinstance(v, dict):

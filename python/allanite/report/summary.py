@@ -8,12 +8,12 @@ import numpy as np
 
 from .._core import __version__
 from ..estimators import get as get_estimator
-from ..model.effects import EFFECTS, param_units
+from ..model.effects import EFFECTS, channel_units, param_units
 from ..model.fitting import row_medians
 from ..model.refinement.result import term_move_text
 from ..model.refinement.words import describe_region
 from ._fitsummary import fit_dict
-from ._regression import channel_units, regression_dict, regression_lines
+from ._regression import regression_dict, regression_lines
 from .fmt import count, duration, g, json_list, json_number, json_value, pct, step_params
 from .forecasting import forecast_dict, forecast_text
 from .paper002 import text_lines as paper002_text
