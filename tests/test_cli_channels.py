@@ -20,8 +20,8 @@ from allanite import cli  # noqa: E402
 from allanite.errors import InputError, ParameterError  # noqa: E402
 from allanite.report import build_report  # noqa: E402
 
-FS, N, COEF = 10.0, 20_000, 0.02  # 10 Hz, 2000 s; deg/s per unit of temp on g_x only
-SMALL = ["--window", "2000", "--hop", "500"]
+FS, N, COEF = 10.0, 10_000, 0.02  # 10 Hz, 1000 s; deg/s per unit of temp on g_x only
+SMALL = ["--window", "1000", "--hop", "250"]
 
 
 def _temperature(n: int, seed: int) -> np.ndarray:
@@ -83,7 +83,7 @@ def test_cli_channels_finds_the_coupling_on_the_coupled_axis_only(cli_run, capsy
 def test_build_report_channels_imply_refine_and_match_the_cli(coupled_log):
     d = np.loadtxt(coupled_log, delimiter=",", skiprows=1)
     rep = build_report(
-        d[:, :1], FS, unit="deg/s", axis_names=["g_x"], window=2000, hop=500, channels={"temp": d[:, 2]}, progress=False
+        d[:, :1], FS, unit="deg/s", axis_names=["g_x"], window=1000, hop=250, channels={"temp": d[:, 2]}, progress=False
     )
     assert rep.settings["channels"] == ["temp"] and rep.refinements is not None
     (r,) = rep.refinements
