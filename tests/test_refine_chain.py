@@ -12,7 +12,7 @@ import pytest
 from markupsafe import escape
 
 import allanite
-from allanite.model.effects import format_param, format_params, param_units
+from allanite.model.effects import channel_units, format_param, format_params, param_units
 from allanite.model.refinement import Step
 from allanite.model.refinement.result import term_move_text
 from allanite.model.terms import TERM_NAMES
@@ -47,7 +47,7 @@ def _assert_chain(r):
 
 def _rendered(st, rate):
     """Every parameter of a step as the displays write it (at acceptance and after the final joint refit)."""
-    units = param_units(st.effect, rate)
+    units = channel_units(param_units(st.effect, rate), st.params)  # a regression's: per unit of its channel
     out = [format_param(k, v, st.intervals.get(k), units.get(k, ""), 4) for k, v in st.params.items()]
     fp, fi = (st.final_params, st.final_intervals) if st.final_params else (st.params, st.intervals)
     return out + [format_param(k, v, fi.get(k), units.get(k, ""), 4) for k, v in fp.items()]

@@ -51,6 +51,8 @@ examples:
   allanite report flight.bag                      # ROS 1 bag: sensor_msgs/Imu, rad/s
   allanite report imu.npy --fs 500 --frames 20 --forecast 60:30   # paper 004: GM(1,1) forecasts
   allanite report acc.npy --fs 100 --refine-candidates bandwidth,drift   # refine trying 2 effects
+  allanite report log.csv --fs 10 --columns g_x,g_y --unit deg/s --channels temp
+                                                  # refine (implied), regressing on the temp column
 
 files written to DIR:
   report.html              the report, one self-contained page
@@ -122,6 +124,15 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
         choices=("error", "longest", "split"),
         help="when the time column shows gaps: stop with the list of gaps (default), analyse the "
         "longest gap-free stretch, or the same and list every stretch (split)",
+    )
+    inp.add_argument(
+        "--channels",
+        metavar="C1,C2,...",
+        help="other columns of the same log (a temperature, a supply voltage, an accelerometer), by name or "
+        "(with --columns) 0-based index, read at the same rate and cut at the same gaps as the samples: every "
+        "axis's model refinement regresses the rate on them (implies --refine; with --refine-candidates, "
+        "regression must be among them; a channel is not also an axis). Their unit is unknown: a coefficient "
+        "is per unit of the channel (deg/s per unit of temp)",
     )
     inp.add_argument(
         "--accel-columns",

@@ -155,6 +155,9 @@ def spectra(y: np.ndarray, regressors: list[np.ndarray], fs: float, parity: int 
     f = np.add.reduceat(k_all.astype(np.float64), idx) / m * fs / n_diff
     # the band's width in bins of the whole spectrum decides its noise model (a split keeps the full record's)
     par = np.diff(np.append(starts, n_bins + 1))[band_of[idx]] < OWN_BINS
+    # the parametric bands are the lowest ones: a last band cut short by the Nyquist bin is narrow too, yet above
+    # bands that carry their own level (n = 3999: it indexed past the parametric bins' shapes)
+    par = np.logical_and.accumulate(par)
     n_par_bins = int(m[par].sum())
     shapes, names = _basis(k_all[:n_par_bins].astype(np.float64), n_diff, fs)
     basis = np.add.reduceat(shapes, idx[par], axis=0) / m[par][:, None] if n_par_bins else np.zeros((0, 4))

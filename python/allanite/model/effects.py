@@ -32,6 +32,7 @@ __all__ = [
     "drift_avar",
     "describe",
     "param_units",
+    "channel_units",
     "format_param",
     "format_params",
     "FILTERS",
@@ -516,6 +517,18 @@ def param_units(name: str, rate_unit: str | None = None) -> dict:
     return {p: u.replace("rate unit", rate) for p, u, _ in EFFECTS[name].params}
 
 
+def channel_units(units: dict, params: dict) -> dict:
+    """A step's parameter units with "channel unit" spelled as the unit of the channel ``params["channel"]``
+    names, which allanite does not know: "deg/s per unit of temp" (per whatever unit the channel's samples are in)."""
+    name = params.get("channel")
+    if not isinstance(name, str):
+        return units
+    return {
+        p: u.replace("channel unit²", f"(unit of {name})²").replace("channel unit", f"unit of {name}")
+        for p, u in units.items()
+    }
+
+
 def _is_pair(iv: Any) -> bool:
     return (
         isinstance(iv, (tuple, list, np.ndarray))
@@ -549,5 +562,5 @@ def format_param(name: str, value: Any, interval: Any = None, unit: str = "", di
 def format_params(name: str, params: dict, intervals: dict, rate_unit: str | None = None, digits: int = 4) -> str:
     """Every parameter of a step of effect ``name``, with its interval where it has one and its unit from the
     registry, ``"; "``-separated."""
-    units = param_units(name, rate_unit)
+    units = channel_units(param_units(name, rate_unit), params)
     return "; ".join(format_param(k, v, (intervals or {}).get(k), units.get(k, ""), digits) for k, v in params.items())

@@ -44,6 +44,7 @@ from ..model.effects import EFFECTS
 from ..model.terms import TERMS
 from ..units import parse_unit
 from . import _worker
+from ._channels import check_channels, rate_aligned
 from .axes import analyse_by_axis, axes_per_read, axis_column, record_bytes, wants_by_axis
 from .budget import check_report_memory
 from .fmt import json_number
@@ -89,6 +90,7 @@ def build_report(
     progress=None,
     estimator: str = "oavar",
     refine: bool | tuple = False,
+    channels=None,
     frames=None,
     forecast=None,
     taper: str | None = None,
@@ -123,6 +125,14 @@ def build_report(
         check). True tries every candidate effect; a sequence of effect names (keys of
         :data:`allanite.model.effects.EFFECTS`) tries only those — e.g. without ``"outliers"`` on quantised
         accelerometers (docs/refinement.md); an empty one only says what the five-term model misses.
+    channels : dict of str → array_like, optional
+        Other channels of the same record (a temperature, a supply voltage, an accelerometer), one sample per
+        sample of ``x`` (with ``input="angle"`` each is averaged over the two samples of each rate), passed to
+        :func:`allanite.refine` on every axis as ``channels=`` for its ``"regression"`` effect. They imply
+        ``refine=True`` (their only use is that regression); ``refine`` naming effects without ``"regression"``
+        is a :class:`~allanite.errors.ParameterError` (the channels would never be used). Their unit is not
+        known to the report: a coefficient is in the rate unit per unit of the channel (e.g. "deg/s per unit of
+        temp").
     estimator : {"oavar", "theoh"}
         ``"oavar"`` (default): overlapping Allan deviation and DAVAR. ``"theoh"``: TheoH for the
         whole record and paper 001's DHVAR over time (overlapping Allan up to 10 % of the record or
@@ -155,6 +165,10 @@ def build_report(
     notes = list(notes)
     x, plan = _record_and_plan(x, fs, frames, forecast)
     candidates = _refine_candidates(refine)
+    channels = check_channels(channels, candidates, np.shape(x)[0])
+    if channels and candidates is None:  # channels imply refine=True: the regression is their only use
+        candidates = _refine_candidates(True)
+    channels = rate_aligned(channels, input)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
     x, unit_name, axis_names = _axes_and_unit(x, unit, input, axis_names, notes)
     taus = _check_taus(taus)
@@ -174,7 +188,9 @@ def build_report(
         progress.add(2)
     if candidates is not None or plan is not None or taper or split:  # and the rest while more is computed
         _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete=True)
-    refinements = _refinement(x, fs, input, unit_name, static, axis_names, candidates, notes, settings, progress)
+    refinements = _refinement(
+        x, fs, input, unit_name, static, axis_names, (candidates, channels), notes, settings, progress
+    )
     frame_fits, forecasts, forecast_settings, forecast_error = _forecast(
         x, fs, plan, unit_name, input, confidence, notes, progress
     )
@@ -230,14 +246,23 @@ def _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete
         _worker.offer(partial, complete=complete)
 
 
-def _refinement(x, fs, input, unit_name, static, axis_names, candidates, notes, settings, progress):
-    """Every axis's refinement (None where it failed), or None when not asked for; the effects tried go
+def _refinement(x, fs, input, unit_name, static, axis_names, asked, notes, settings, progress):
+    """Every axis's refinement (None where it failed), or None when not asked for; ``asked``: the candidate
+    effects and the other channels. The effects tried and the channels' names go
     into ``settings``."""
+    candidates, channels = asked
     refinements: list[Refinement | None] | None = None
     if candidates is not None:
         progress.step("model refinement")
-        refinements = _refine_axes(x, fs, input, unit_name, static, axis_names, candidates, notes)
+        refinements = _refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes)
         settings["refine_candidates"] = list(candidates)
+        if channels:
+            settings["channels"] = list(channels)
+            notes.append(
+                f"Channel{'s' if len(channels) > 1 else ''} {', '.join(channels)} passed to every axis's model "
+                "refinement (its regression on other channels, which the channels imply); a channel's unit is "
+                "not known to allanite: its coefficients are per unit of the channel."
+            )
     return refinements
 
 
@@ -379,9 +404,12 @@ def _refine_candidates(refine) -> tuple | None:
     return names
 
 
-def _refine_axes(x, fs, input, unit_name, static, axis_names, candidates, notes) -> list:
-    """:func:`allanite.refine` on every axis (None for an axis it fails on, with a note why)."""
+def _refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes) -> list:
+    """:func:`allanite.refine` on every axis (None for an axis it fails on, with a note why); ``asked``: the
+    candidate effects and the other channels (None: none)."""
     from ..model import refine as refine_axis  # the refinement package (scipy.signal) only when asked
+
+    candidates, channels = asked
 
     refinements: list = []
     # the same τ range the whole-record fit used (none unless given): start at 0.1 s when the
@@ -397,6 +425,7 @@ def _refine_axes(x, fs, input, unit_name, static, axis_names, candidates, notes)
                     unit=unit_name,
                     tau_range=None if t0 is None else (t0, None),
                     candidates=candidates,
+                    channels=channels,
                 )
             )
         except AllaniteError as exc:

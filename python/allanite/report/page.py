@@ -13,6 +13,7 @@ from importlib import resources
 from typing import TYPE_CHECKING, Any
 
 from .._core import __version__
+from ._regression import REGRESSION_COLUMNS, regression_row
 from .fmt import LONG_RECORD_S, clock, duration, g, num, step_params
 from .forecasting import forecast_page
 from .paper002 import page_context as paper002_page
@@ -289,7 +290,7 @@ def _step_rows(name: str, st: dict, fs: float, duration_s: float) -> tuple[list,
 
 def _refinement_rows(axes: list, fs: float, duration_s: float) -> dict[str, list]:
     """The rows of the refinement's tables (summary, curve, change, move) and each axis's still-missing sentences."""
-    rows: dict[str, list] = {"summary": [], "curve": [], "change": [], "move": [], "missing": []}
+    rows: dict[str, list] = {"summary": [], "curve": [], "change": [], "regression": [], "move": [], "missing": []}
     for ax in axes:
         if ax.get("error"):
             rows["summary"].append([ax["name"], "failed (see the notes)", "—", "—", "—"])
@@ -302,6 +303,9 @@ def _refinement_rows(axes: list, fs: float, duration_s: float) -> dict[str, list
             rows["curve"].append(curve)
             if change is not None:
                 rows["change"].append(change)
+            reg = regression_row(ax["name"], st)
+            if reg is not None:
+                rows["regression"].append(reg)
     return rows
 
 
@@ -343,6 +347,8 @@ def _refinement_tables(rows: dict[str, list]) -> list[dict[str, Any]]:
                 left=2,
             )
         )
+    if rows["regression"]:
+        tables.append(_table(list(REGRESSION_COLUMNS), rows["regression"], left=7))
     if rows["move"]:
         tables.append(
             _table(["axis", "a term the refinement moved outside the plain fit's interval"], rows["move"], left=2)

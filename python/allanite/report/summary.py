@@ -8,11 +8,12 @@ import numpy as np
 
 from .._core import __version__
 from ..estimators import get as get_estimator
-from ..model.effects import EFFECTS, param_units
+from ..model.effects import EFFECTS, channel_units, param_units
 from ..model.fitting import row_medians
 from ..model.refinement.result import term_move_text
 from ..model.refinement.words import describe_region
 from ._fitsummary import fit_dict
+from ._regression import regression_dict, regression_lines
 from .fmt import count, duration, g, json_list, json_number, json_value, pct, step_params
 from .forecasting import forecast_dict, forecast_text
 from .paper002 import text_lines as paper002_text
@@ -151,13 +152,16 @@ def _step_dict(st, rate) -> dict:
         "domain": EFFECTS[st.effect].domain if st.effect in EFFECTS else None,
         "params": {p: json_value(v) for p, v in st.params.items()},
         "final_params": {p: json_value(v) for p, v in fp.items()},
-        "units": param_units(st.effect, rate),
+        "units": channel_units(param_units(st.effect, rate), st.params),
         "intervals": {p: json_value(iv) for p, iv in st.intervals.items()},
         "final_intervals": {p: json_value(iv) for p, iv in fi.items()},
         "before": {q: json_number(v) for q, v in st.before.items()},
         "after": {q: json_number(v) for q, v in st.after.items()},
         "test": _jsonable_test(st.evidence.get("test")),
     }
+    reg = regression_dict(st.evidence) if st.effect == "regression" else None
+    if reg is not None:
+        out["regression"] = reg
     if "window_levels" in st.evidence:
         out["window_levels"] = {
             k: {q: json_number(v) for q, v in d.items()} for k, d in st.evidence["window_levels"].items()
@@ -447,6 +451,7 @@ def _refinement_text(s: dict) -> list[str]:
             lines.append(
                 f"    {st['effect']}: {step_params(st, rec['fs_hz'], rec['duration_s'], units=True, final=True)}"
             )
+            lines += [f"      {t}" for t in regression_lines(st.get("regression"))]
         lines += [f"    {m['text']}" for m in ax.get("term_moves", [])]
         lines += [f"    {t}" for t in ax.get("still_missing", [])]
     return lines

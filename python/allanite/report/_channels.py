@@ -1,0 +1,42 @@
+"""The report's ``channels=``: other channels of the record (a temperature, a supply voltage, an accelerometer)
+for the model refinement's regression, checked before any heavy work."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from ..errors import ParameterError
+
+
+def check_channels(channels, candidates, n: int) -> dict | None:
+    """``channels=`` checked: None or empty → None; else name → float64 samples (n of them, finite, not
+    constant), refused when ``refine=`` names effects without the regression on them. ``candidates`` None (no
+    refinement asked for) is checked by the caller, which then refines with every effect."""
+    if channels is None or (isinstance(channels, Mapping) and not channels):
+        return None
+    if not isinstance(channels, Mapping):
+        raise ParameterError(
+            f"channels must be a dict of name → samples (e.g. {{'temp': T}}), got {type(channels).__name__}"
+        )
+    names = ", ".join(map(repr, map(str, channels)))
+    if candidates is not None and "regression" not in candidates:
+        raise ParameterError(
+            f"channels={{{names}}} are only used by the 'regression' effect, which refine={list(candidates)!r} "
+            "leaves out: add 'regression' to the effects, or drop channels="
+        )
+    from ..model.channels import check_channel  # scipy.stats: only when channels are given
+
+    checked: dict = {}
+    for name, c in channels.items():
+        if str(name) in checked:  # 1 and "1": one would replace the other silently
+            raise ParameterError(f"two channels are named {str(name)!r}; each channel needs its own name")
+        checked[str(name)] = check_channel(str(name), c, n)
+    return checked
+
+
+def rate_aligned(channels: dict | None, input: str) -> dict | None:
+    """The channels one per rate sample: a cumulative angle's n samples give n − 1 rates (θ[i+1] − θ[i])·fs, each
+    between two samples, so each channel is averaged over the same two samples; rates and increments as they are."""
+    if not channels or input != "angle":
+        return channels
+    return {name: 0.5 * (c[:-1] + c[1:]) for name, c in channels.items()}
