@@ -7,12 +7,16 @@ surface. The ADIS16405 logs (quantised: 0.05 °/s and 1/300 g steps) must raise 
 
 from __future__ import annotations
 
+import html as html_mod
+import json
+import re
 import types
 
 import numpy as np
 import pytest
 
 import allanite
+from allanite import cli
 from allanite.model.refinement import _quality as qc
 from allanite.model.refinement.levels import alpha
 from allanite.model.refinement.missing import CHECKS
@@ -130,3 +134,23 @@ def test_the_adis16405_logs_are_neither_clipped_nor_held(shared_data):
     data = np.asarray(log.data, dtype=np.float64)
     for k in range(data.shape[1]):
         assert _both(data[:, k]) == [], k
+
+
+def test_cli_console_page_and_json_say_a_clipped_record(tmp_path, capsys):
+    """``allanite report --refine-candidates none`` (only the checks): the console, the page and summary.json."""
+    rng = np.random.default_rng(2)
+    t = np.arange(60_000) / 100.0
+    x = 0.02 * rng.standard_normal(t.size) + 0.1 * np.exp(-(((t - 300.0) / 3.0) ** 2))
+    log, out = tmp_path / "clipped.npy", tmp_path / "out"
+    np.save(log, np.minimum(x, 0.08))
+    args = ["report", str(log), "--fs", "100", "--unit", "deg/s", "--window", "6000", "--hop", "3000", "--no-fit"]
+    assert cli.main([*args, "--refine-candidates", "none", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text(encoding="utf-8"))
+    json.dumps(summary, allow_nan=False)
+    (clip,) = [e for e in summary["refinement"]["axes"][0]["unexplained"] if e["domain"] == "clipped"]
+    assert 290.0 < clip["t_s"][0] < clip["t_s"][1] < 310.0
+    assert "clipped at 0.08 deg/s" in clip["text"]
+    page = html_mod.unescape(re.sub(r"<[^>]+>", "", (out / "report.html").read_text(encoding="utf-8")))
+    assert clip["text"] in page[page.index("What the model still misses") :]
+    assert clip["text"] in printed

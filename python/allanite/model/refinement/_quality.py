@@ -149,6 +149,16 @@ def quality_flags(y: np.ndarray, a: float) -> tuple[list[dict], dict | None]:
     return rails, _stuck(y, a / 2)
 
 
+def _flags(ctx: MissingContext, y: np.ndarray, a: float) -> tuple[list[dict], dict | None]:
+    """:func:`quality_flags` once per context (the held check leaves the clipped check's samples out)."""
+    memo = getattr(ctx, "memo", None)
+    if memo is None:
+        return quality_flags(y, a)
+    if ("quality", a) not in memo:
+        memo[("quality", a)] = quality_flags(y, a)
+    return memo[("quality", a)]
+
+
 def _stretches(ctx: MissingContext, spans: list[tuple[int, int]]) -> str:
     """ ", in 3 stretches: t a–b, c–d, e–f s" (the first :data:`MAX_SPANS`); nothing for one stretch — the
     entry's ``"t"``, said before its words, is that stretch."""
@@ -168,7 +178,7 @@ def clipped_check(ctx: MissingContext, a: float) -> list[dict]:
     y = ctx.samples
     if y is None or y.size < 3:
         return []
-    rails, stuck = quality_flags(y, a)
+    rails, stuck = _flags(ctx, y, a)
     out = [_rail_entry(ctx, r, a / 4) for r in rails]
     at_rail = np.zeros(y.size, dtype=bool)
     for r in rails:
@@ -239,21 +249,29 @@ def tie_counts(y: np.ndarray, skip: np.ndarray | None = None) -> dict:
     """
     y = np.asarray(y, dtype=np.float64)
     d = np.diff(y)
-    keep = np.ones(d.size, dtype=bool) if skip is None else ~(skip[1:] | skip[:-1])
-    d = d[keep]
-    ad = np.abs(d)
+    if skip is not None and skip.any():
+        idx = np.flatnonzero(~(skip[1:] | skip[:-1]))
+        ad = np.abs(d[idx])
+    else:  # every pair (no fancy indexing: a copy of the record less)
+        idx = np.arange(d.size)
+        ad = np.abs(d)
+    ties = idx[ad == 0] + 1
     nz = ad[ad > 0]
-    ties = np.flatnonzero(keep)[d == 0] + 1
     if not nz.size:
         return {"n0": int(ties.size), "n1": 0.0, "n2": 0.0, "ties": ties, "step": 0.0}
     q = float(nz.min())
+    f32 = bool(np.all(y.astype(np.float32) == y))  # float32 samples: the spacing grows with the magnitude
+    # only the differences within 2.5 steps of 0 can count (the largest step the record's magnitudes give)
+    top = max(q, float(np.spacing(np.float32(np.max(np.abs(y)))))) if f32 else q
+    near = (ad > 0) & (ad <= 2.5 * top)
+    sel, a_near = idx[near], ad[near]
     step: float | np.ndarray = q
-    if np.all(y.astype(np.float32) == y):  # float32 samples: the spacing grows with the magnitude
-        big = np.maximum(np.abs(y[1:]), np.abs(y[:-1]))[keep]
+    if f32:
+        big = np.maximum(np.abs(y[sel + 1]), np.abs(y[sel]))
         step = np.maximum(q, np.spacing(big.astype(np.float32)).astype(np.float64))
-    k = ad / step
-    on = np.abs(k - np.round(k)) < 1e-6
+    k = a_near / step
     kr = np.round(k)
+    on = np.abs(k - kr) < 1e-6
     return {
         "n0": int(ties.size),
         "n1": float(np.count_nonzero(on & (kr == 1))) / 2,
@@ -287,7 +305,7 @@ def held_check(ctx: MissingContext, a: float) -> list[dict]:
     if y is None or y.size < 3:
         return []
     skip = np.zeros(y.size, dtype=bool)  # the clipped check's samples are its own
-    rails, stuck = quality_flags(y, alpha("unexplained:clipped", ctx.level))
+    rails, stuck = _flags(ctx, y, alpha("unexplained:clipped", ctx.level))
     for r in rails:
         skip |= r["at"]
     for i, j in [] if stuck is None else stuck["runs"]:
