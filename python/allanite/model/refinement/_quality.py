@@ -11,8 +11,10 @@ cause; a held sample is one innovation lost, its effect on the Allan variance at
   with probability 0; quantised ones do, but beyond the distribution's mode the density falls towards the
   extreme, so the extreme value holds no more samples than the next value inward (for a lattice the next
   lattice point) but by chance: the count at the extreme, given the two counts, is at most Binomial(n, ½).
-  Samples piled at a rail exceed that by far. Tested at each rail with half the share (one-sided binomial),
-  and said only where the samples at the rail come in runs (two or more in a row: a rail holds).
+  Samples piled at a rail exceed that by far, in runs where the signal stays beyond the rail, scattered where
+  white noise crosses it (a continuous record clipped at 3σ: 1364 samples at the rail, one next to it). Each
+  rail is tested at a quarter of the share (one-sided binomial); the other half goes to runs of one value
+  longer than the record's own ties give, wherever they sit (:func:`longest_null_run`).
 - ``"held"`` — consecutive samples exactly equal (a sample repeated by a driver that missed an output).
   Continuous samples never repeat; quantised ones do at a rate their step and noise give: on the lattice of
   the differences (step q, the smallest non-zero difference, or the float32 spacing for float32-exact samples)
@@ -95,9 +97,9 @@ def _rail(y: np.ndarray, top: bool, a: float) -> dict | None:
     w = float(inner.max() if top else inner.min())
     n_next = int(np.count_nonzero(inner == w))
     p = float(binom.sf(n_ext - 1, n_ext + n_next, 0.5))
-    runs = [r for r in rail_runs(at) if r[1] - r[0] >= 2]
-    if not (p <= a and runs):
+    if not p <= a:
         return None
+    runs = rail_runs(at)
     return {"value": v, "count": n_ext, "next": n_next, "p": p, "runs": runs, "at": at, "top": top}
 
 
@@ -198,17 +200,18 @@ def _entry(ctx: MissingContext, t: tuple[float, float], what: str) -> dict:
 def _rail_entry(ctx: MissingContext, r: dict, a: float) -> dict:
     """A clipped rail (:func:`_rail`) as an entry of ``unexplained``; its statistic −log₁₀ p against −log₁₀ a."""
     spans = _spans(r["runs"])
-    in_runs = sum(j - i for i, j in r["runs"])
+    long = [(i, j) for i, j in r["runs"] if j - i >= 2]
+    in_runs = sum(j - i for i, j in long)
     what = (
         f"the record is clipped at {r['value']:.6g}{_unit(ctx)}: {r['count']} samples at its "
-        f"{'largest' if r['top'] else 'smallest'} value ({in_runs} in {len(r['runs'])} run"
-        f"{'s' if len(r['runs']) > 1 else ''} of two or more; {r['next']} at the next value inward)"
+        f"{'largest' if r['top'] else 'smallest'} value ({in_runs} in {len(long)} run"
+        f"{'' if len(long) == 1 else 's'} of two or more; {r['next']} at the next value inward)"
         f"{_stretches(ctx, spans)} — left in the record"
     )
     return _entry(ctx, (spans[0][0] / ctx.fs, spans[-1][1] / ctx.fs), what) | {
         "value": r["value"],
         "samples": r["count"],
-        "runs": len(r["runs"]),
+        "runs": len(long),
         "statistic": -math.log10(max(r["p"], 1e-300)),
         "threshold": -math.log10(a),
         "alpha": a,
