@@ -46,7 +46,7 @@ def test_a_record_saturated_at_its_rail_is_said_clipped_with_the_value_and_times
     rng = np.random.default_rng(1)
     fs = 400.0
     t = np.arange(400_000) / fs
-    x = 0.02 * rng.standard_normal(t.size) + 0.1 * np.exp(-(((t - 300.0) / 3.0) ** 2))  # a bump past 0.08
+    x = 0.015 * rng.standard_normal(t.size) + 0.1 * np.exp(-(((t - 300.0) / 3.0) ** 2))  # a bump past 0.08 (5σ)
     out = _both(np.minimum(x, 0.08), fs)
     assert [e["domain"] for e in out] == ["clipped"]
     e = out[0]
@@ -140,7 +140,7 @@ def test_cli_console_page_and_json_say_a_clipped_record(tmp_path, capsys):
     """``allanite report --refine-candidates none`` (only the checks): the console, the page and summary.json."""
     rng = np.random.default_rng(2)
     t = np.arange(60_000) / 100.0
-    x = 0.02 * rng.standard_normal(t.size) + 0.1 * np.exp(-(((t - 300.0) / 3.0) ** 2))
+    x = 0.015 * rng.standard_normal(t.size) + 0.1 * np.exp(-(((t - 300.0) / 3.0) ** 2))
     log, out = tmp_path / "clipped.npy", tmp_path / "out"
     np.save(log, np.minimum(x, 0.08))
     args = ["report", str(log), "--fs", "100", "--unit", "deg/s", "--window", "6000", "--hop", "3000", "--no-fit"]
