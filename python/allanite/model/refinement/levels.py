@@ -60,9 +60,9 @@ UNEXPLAINED_SHARES = {
     "channels": 0.0125,
     "outliers": 0.0125,
     # clipped and held samples (:mod:`._quality`): exact-count tests on the samples as given, far from their
-    # thresholds on clean records (neither fired on the 613 records of benches/refine_false_alarms.py, its own
-    # seeds, nor on the 36 ADIS16405 channels); their 0.005 comes from the Allan-curve test's rest, whose
-    # bootstrap critical value (the 988th of 1001 draws at level 0.05) does not move.
+    # thresholds on clean records (0 of 889: the 613 of benches/refine_false_alarms.py, quantised and float32
+    # records, the 36 ADIS16405 channels; benches/results/refine_quality_null.md); their 0.005 comes from the
+    # Allan-curve test's rest, whose bootstrap critical value (the 988th of 1001 draws at level 0.05) does not move.
     "clipped": 0.0025,
     "held": 0.0025,
 }
