@@ -299,9 +299,12 @@ NOTES: list = [
     "turned from phase (unit None, 10⁻¹² scale); the three axes (axis 0 takes nothing, axis 2 the temperature "
     "at +0.1 %). The popcorn noise is read as a Gauss–Markov term (σ −0.1 %, T_c −4.3 %): random telegraph "
     "noise's second-order statistics are exactly a Gauss–Markov term's, so that is the right Allan model — but "
-    "nothing says the rate sits at two levels (no check looks at the distribution of a slow component). The "
-    "6 s clipped at the rail passes as an effect outside the family on what is said (a change point at 1184 s "
-    "and the curve departing at τ 7.5–278 s), not because clipping is named.",
+    "nothing says the rate sits at two levels (no check looks at the distribution of a slow component). "
+    "The 6 s clipped at the rail was at first said only by its consequences (a change point at 1184 s and the "
+    "curve departing at τ 7.5–278 s); rerun alone at the `clipped` check's commit (r6clip), it is now named "
+    'first, the rest of its row unchanged: "t 1200–1206 s: the record holds one value for 2400 samples in a row '
+    'at 0.08 deg/s … clipped or stuck" (not "clipped at its largest value": the simulated noise elsewhere reaches'
+    " beyond the 0.08 rail, so the run is said as a run of one value too long for the record's quantisation).",
     "",
     "Why three failed at the first run — all three since fixed:",
     "",

@@ -172,6 +172,7 @@ MODEL_RANKS = {
     "model.refinement._line_check": 4,
     "model.refinement._mean_step": 4,
     "model.refinement._mean_steps": 4,
+    "model.refinement._quality": 4,
     "model.refinement.words": 3,
     "model.refinement.curvefit": 3,
     "model.refinement.scoring": 4,

@@ -54,8 +54,8 @@ def test_words_of_a_region_and_of_a_pass():
     bare = {"tau": (1.5, 1.5), "band_hz": None, "chi2_dof": float("nan"), "what": ""}
     assert describe_region(bare) == "τ 1.5 s"
     assert missing_sentences([], 0.05) == [passes_sentence(0.05)]
-    assert "0.625 %" in passes_sentence(0.05) and "level 0.05" in passes_sentence(0.05)
-    assert "0.125 %" in passes_sentence(0.01)
+    assert "0.65 %" in passes_sentence(0.05) and "level 0.05" in passes_sentence(0.05)
+    assert "0.13 %" in passes_sentence(0.01)
 
 
 def test_report_and_notebook_say_what_a_refinement_misses():

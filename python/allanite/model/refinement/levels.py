@@ -43,8 +43,8 @@ OUTLIER_SHARE = 0.05
 
 #: Share of ``level`` spent on saying what the final model still misses (``Refinement.unexplained``), split
 #: between its checks: the Allan curve, lines in the PSD, a drift in time, a step of the mean, steps of the mean
-#: at several times, the noise level
-#: along the record, a coupling to a channel left in the samples, impulsive noise left in them
+#: at several times, the noise level along the record, a coupling to a channel left in the samples, impulsive
+#: noise left in them, clipped and held samples in the record as given
 #: (:data:`allanite.model.refinement.missing.CHECKS`).
 UNEXPLAINED_SHARES = {
     # "line" takes 0.0125 of "allan": a line whose amplitude changes shows in the curve's misfit too, but the
@@ -62,10 +62,16 @@ UNEXPLAINED_SHARES = {
     "level": 0.0125,
     "channels": 0.0125,
     "outliers": 0.0125,
+    # clipped and held samples (:mod:`._quality`): exact-count tests on the samples as given, far from their
+    # thresholds on clean records (0 of 889: the 613 of benches/refine_false_alarms.py, quantised and float32
+    # records, the 36 ADIS16405 channels; benches/results/refine_quality_null.md); their 0.005 comes from the
+    # Allan-curve test's rest, whose bootstrap critical value (the 988th of 1001 draws at level 0.05) does not move.
+    "clipped": 0.0025,
+    "held": 0.0025,
 }
 #: The checks that need the samples; on curve-only input their shares go to the ``"fit"`` check (the GLS χ²
 #: of the whole curve, two-sided), so that curve-only input spends the same share on ``unexplained``.
-SAMPLE_CHECKS = ("psd", "time", "mean", "steps", "level", "channels", "outliers", "line")
+SAMPLE_CHECKS = ("psd", "time", "mean", "steps", "level", "channels", "outliers", "line", "clipped", "held")
 
 #: Tests with a share of their own, by name (the Allan-curve test, ``"curve"``, takes the rest).
 SHARES = {

@@ -166,6 +166,7 @@ class _Run:
 
     def __init__(self, y, result, start, tau_range, level, truth, unit=None):
         self.y, self.result, self.start, self.level, self.truth = y, result, start, level, truth
+        self.y0 = y  # the samples as given: removals replace self.y, never change it in place
         self.unit = unit
         self.lo, self.hi = resolve_tau_range(tau_range, result, start)
         keep = (result.tau >= self.lo) & (result.tau <= self.hi) & (result.avar > 0)
@@ -481,6 +482,7 @@ class _Run:
         )
         ctx.change_times = [st.params["t"] for st in cp_steps]
         ctx.heldout_pct = self.state[0].get("heldout_rms_adev_pct")
+        ctx.samples = self.y0
         ctx.families = [
             (st.params["fundamentals"], st.evidence["frequencies_hz"], st.evidence["amplitudes"], rem.component)
             for st, rem, *_rest in self.removed

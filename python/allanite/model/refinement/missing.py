@@ -48,6 +48,11 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
 - ``"channels"`` — a coupling to a channel of ``channels=`` left in the final samples (the regression's tests:
   the Whittle GLS for a slow channel, within blocks for a fast one).
 - ``"outliers"`` — impulsive noise left in the final samples (:func:`allanite.model.outliers.outlier_test`).
+- ``"clipped"`` — samples piled at the record's largest or smallest value, or held at one value longer than
+  the record's quantisation gives, in the samples as given (:mod:`._quality`); ``"t"`` their first and last
+  time, ``"value"``, ``"samples"``, ``"runs"``. Left in the record: said, not removed.
+- ``"held"`` — consecutive equal samples beyond the ties the quantisation step predicts (:mod:`._quality`):
+  a driver that repeats an output; ``"repeats"``, ``"expected"``, ``"fraction"``.
 """
 
 from __future__ import annotations
@@ -67,6 +72,7 @@ from ..terms import design_matrix
 from ._line_check import line_check
 from ._mean_step import mean_step_check
 from ._mean_steps import steps_check
+from ._quality import clipped_check, held_check
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
 from .changes import locate
@@ -112,6 +118,9 @@ class MissingContext:
     #: the ``"periodic"`` families removed in time, as (fundamentals, line frequencies, line amplitudes, the
     #: removed component's samples): the ``"line"`` check tests each one's strongest line (:mod:`._line_check`)
     families: list = field(default_factory=list)
+    #: the samples as refine was given them, before any removal in time (None for curve-only input): the
+    #: clipped and held samples are looked for there (:mod:`._quality`)
+    samples: np.ndarray | None = None
 
 
 def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
@@ -528,6 +537,8 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "line": line_check,
     "channels": _channels,
     "outliers": _outliers,
+    "clipped": clipped_check,
+    "held": held_check,
 }
 
 

@@ -53,7 +53,8 @@ def passes_sentence(level: float) -> str:
     return (
         "The final model passes every calibrated check of what it may still miss (the Allan-curve score test "
         "and, with samples, lines in the PSD, a drift, a step of the mean, the noise level along the record, the "
-        "channels and outliers; without, the whole curve's two-sided GLS χ²) at a false-alarm probability "
+        "channels, outliers, and clipped or repeated samples; without, the whole curve's two-sided GLS χ²) at a "
+        "false-alarm probability "
         f"of {100 * checks_alpha(level):.3g} % per record together (their share of level {level:g})."
     )
 
