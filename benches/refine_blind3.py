@@ -288,9 +288,11 @@ NOTES: list = [
     "passes; the float32 row's without-candidate entry found 3 regions (2 before); every other row the same. "
     "The six channel rows (`--case temp`) rerun at 2b6cb2a, a lag its test cannot resolve now profiled for the "
     "removal; the thermistor's coefficient −1.3 → −0.8 % (held out 2.35 → 2.33 %), every other channel row the "
-    "same; the bias-steps row rerun alone (`--case steps`, at 4c0e450 with lint-only edits) once the `\"steps\"` "
+    'same; the bias-steps row rerun alone (`--case steps`, at 4c0e450 with lint-only edits) once the `"steps"` '
     "check of `unexplained` joined; the other rows as recorded at 21e7e2d: **12 of 12** — the FOG row and the "
-    "bias-steps row pass.",
+    "bias-steps row pass. The table above is the whole suite rerun once every branch of the session had merged "
+    "(f97e098; its header's \"+dirty\" is the other suites' pages written before it): **12 of 12**, every row as "
+    "the partial reruns recorded but the clipped row, which now also says the step of the mean at the rail.",
     "",
     "Passed as a user would want: the temperature read once a second, held and quantised to 1/16 °C "
     "(coefficient +0.5 %); the thermistor with 0.2 °C of its own white noise (−0.8 %: the Whittle regression "

@@ -314,7 +314,8 @@ def run_case(case) -> dict:
 NOTES: list = [
     "**First run** (at 5b4c9e3, the suite as committed, before any change; load 70 % from other processes; its "
     "table and JSON are in commit 44120db): **8 of 11 passed**, without the candidate 8 of 9 flagged. The table "
-    'above is the rerun after the fixes below (at 5229dd3; its header\'s "+dirty" is these notes): **8 of 11**, without the '
+    "above is the suite rerun once every branch of the session had merged (f97e098, after the fixes below; its "
+    "header's \"+dirty\" is the other suites' pages written before it), as the rerun at 5229dd3: **8 of 11**, without the "
     "candidate 8 of 9 (the cold start's drift stands in for its temperature, as before) — the cold start now names its temperature (regression, coefficient +30.3 %, quadratic +5.9 %) but still fails "
     "on the coefficient's 20 %; every other row's effects, parameters and words as at the first run. Passed as a user would want: the g-sensitivity "
     "on the accelerometer channel (+0.1 %); the 24 h log's temperature (−3.0 %) and its 900 s cycle (+1.8 %, a "
