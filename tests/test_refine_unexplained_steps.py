@@ -21,6 +21,7 @@ from allanite.model.refinement import _mean_steps as mss
 from allanite.model.refinement.curvefit import Curve, solve
 from allanite.model.refinement.levels import SAMPLE_CHECKS, UNEXPLAINED_SHARES, alpha
 from allanite.model.refinement.missing import CHECKS, MissingContext, unexplained
+from allanite.model.tracing import block_means
 from allanite.simulation import kasdin_walter
 
 FS = 20.0
@@ -86,7 +87,7 @@ def test_noiseless_steps_are_located_to_the_fine_block_and_sized_exactly():
     for index, d in ((20_000, 1.0), (70_001, -2.0), (110_000, 0.5)):
         y[index:] += d
     y += 1e-3 * np.random.default_rng(0).normal(size=n)
-    half, _ = mss._half_means(y, 64)
+    half, _ = block_means(y, 2 * 64)
     z, incs = mss.increment_z(half, (32, 64))
     got = mss.locate_steps(y, 32, incs[0][:, 0], 50.0)
     fine = 2 * (n // 64) // mss.FINE
@@ -146,7 +147,7 @@ def test_degenerate_records_and_models_say_nothing_rather_than_divide_by_zero():
     # most increments exactly zero (a record stuck between rounding levels): no scale, no evidence
     stuck = np.zeros(100_000)
     stuck[::5000] = 1.0
-    z, _ = mss.increment_z(mss._half_means(stuck, 128)[0], mss.STEP_BLOCKS)
+    z, _ = mss.increment_z(block_means(stuck, 2 * 128)[0], mss.STEP_BLOCKS)
     assert np.all(np.isfinite(z))
     # a model with nothing at the block rate: the null is drawn as white noise (the statistic is free of scale)
     null = mss.null_ratios(100_000, FS, ("Q", "N"), [1e-6, 0.0], 0.01)

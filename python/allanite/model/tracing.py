@@ -35,6 +35,7 @@ __all__ = [
     "drift_component",
     "drift_threshold",
     "simulated_block_means",
+    "block_means",
     "regression_fit",
     "gm_autocorrelation",
     "rolloff_psd",
@@ -84,7 +85,9 @@ def _drift_stat(b, tb, length, with_interval=False):
     return out
 
 
-def _block_means(y, n_blocks):
+def block_means(y: np.ndarray, n_blocks: int) -> tuple[np.ndarray, int]:
+    """The means of ``n_blocks`` consecutive blocks of ``y`` (at most one sample each) and the samples per block;
+    the samples past the last whole block are left out."""
     nb = min(n_blocks, y.size)
     per = y.size // nb
     return y[: nb * per].reshape(nb, per).mean(axis=1), per
@@ -93,7 +96,7 @@ def _block_means(y, n_blocks):
 def drift_fit(y: np.ndarray, fs: float, n_blocks: int = DRIFT_BLOCKS) -> dict:
     """Least-squares warm-up c + r·t + a·e^{−t/T} on block means (T from L/200 to L/2, L the record), with
     the statistic nb·ln(RSS_ramp/RSS_warm-up) against a ramp (a constant slope is the R term, not a drift)."""
-    b, per = _block_means(y, n_blocks)
+    b, per = block_means(y, n_blocks)
     tb = (np.arange(b.size) * per + 0.5 * (per - 1)) / fs
     return _drift_stat(b, tb, y.size / fs, with_interval=True)
 

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from ...analysis import avar
-from ..tracing import simulated_block_means
+from ..tracing import block_means, simulated_block_means
 from .curvefit import Curve, solve, theta_terms, upper_theta
 
 __all__ = [
@@ -76,20 +76,15 @@ def split_statistic(b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return gain[j, np.arange(b.shape[1])], j + 1
 
 
-def _means(y: np.ndarray, blocks: int) -> tuple[np.ndarray, int]:
-    per = y.size // blocks
-    return y[: blocks * per].reshape(blocks, per).mean(axis=1), per
-
-
 def locate_step(y: np.ndarray) -> dict:
     """The one-step statistic of ``y``'s block means, the split located to 1/:data:`FINE` of a block around the
     best block split (the same two-segment criterion on the fine block means), and the step ``d`` (the mean
     of the samples after the split less the mean before). ``index``: the first sample after the split. Memory
     O(blocks): the block means and the step are reductions of views of ``y`` (no record-length temporary, which
     would be 0.8 GB at 10⁸ samples)."""
-    b, per = _means(y, MEAN_BLOCKS)
+    b, per = block_means(y, MEAN_BLOCKS)
     stat, k = split_statistic(b)
-    fine, per_f = _means(y, MEAN_BLOCKS * FINE)
+    fine, per_f = block_means(y, MEAN_BLOCKS * FINE)
     nf = fine.size
     c = np.cumsum(fine)
     lo, hi = max(1, (int(k[0]) - 1) * FINE), min(nf - 1, (int(k[0]) + 1) * FINE)

@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from ...analysis import avar
-from ..tracing import simulated_block_means
+from ..tracing import block_means, simulated_block_means
 from .curvefit import Curve, solve, theta_terms, upper_theta
 
 __all__ = [
@@ -130,11 +130,6 @@ def null_ratios(size: int, fs: float, terms, theta, alpha: float, seed: int = 79
     return {"q": q, "threshold": thr, "n_boot": n_boot, "blocks": blocks, "draws": stats}
 
 
-def _half_means(y: np.ndarray, n: int) -> tuple[np.ndarray, int]:
-    per = y.size // (2 * n)
-    return y[: 2 * n * per].reshape(2 * n, per).mean(axis=1), per
-
-
 def locate_steps(
     y: np.ndarray, n: int, z: np.ndarray, cut: float, found: Sequence[tuple[int, float]] = ()
 ) -> list[tuple[int, float]]:
@@ -205,7 +200,7 @@ def step_down(y: np.ndarray, null: dict) -> tuple[list[tuple[int, float]], dict]
     blocks = null["blocks"]
     steps: list[tuple[int, float]] = []
     first: dict[str, Any] = {}
-    half, per = _half_means(y, blocks[-1])
+    half, per = block_means(y, 2 * blocks[-1])  # half blocks of the finest length
     while len(steps) < MOST_STEPS:
         z, incs = increment_z(half - _step_means(steps, per, half.size), blocks)
         stat, j = steps_statistic(z, null["q"])
