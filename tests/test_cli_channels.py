@@ -129,11 +129,11 @@ def test_channel_is_cut_at_the_same_gaps_as_the_samples(tmp_path):
         (["--columns", "g_x", "--channels", "tmp"], r"log\.csv: no column named 'tmp'; available: 'g_x', 'g_y', "),
         (["--channels", "tmp"], r"log\.csv.*'label'"),  # without --columns every column is read: 'label' is text
         (["--columns", "g_x,g_y", "--channels", "g_x"], r"column 'g_x' is given in both --columns and --channels"),
-        (["--columns", "g_x,g_y", "--channels", "0"], r"name the same column twice"),
-        (["--channels", "2"], r"a channel by index needs --columns"),
+        (["--columns", "g_x,g_y", "--channels", "0"], r"column 'g_x' is both a sample column and a channel"),
+        (["--channels", "4"], r"log\.csv.*'label'"),  # by index without --columns: the file's column 4, 'hot'
         (["--columns", "g_x,g_y", "--channels", "temp,temp"], r"column 'temp' is given twice in --channels"),
         (["--columns", "g_x,g_y", "--channels", "label"], r"log\.csv.*'label'"),  # a text column
-        (["--columns", "g_x,g_y", "--channels", "hot"], r"log\.csv.*(NaN|nan|finite)"),  # a NaN in the channel
+        (["--columns", "g_x,g_y", "--channels", "hot"], r"log\.csv: line 52, channel column 'hot': infinite value inf"),
         (["--refine-candidates", "drift", "--channels", "temp"], r"regression effect, which --refine-candidates drift"),
     ],
 )
@@ -141,7 +141,7 @@ def test_bad_channel_columns_are_one_line_errors_exit_2(tmp_path, capsys, extra,
     n = 200
     rng = np.random.default_rng(3)
     rows = ["g_x,g_y,temp,label,hot"] + [
-        f"{a:.5f},{b:.5f},{20 + i / n:.4f},{'ab'[i % 2]},{'nan' if i == 50 else f'{i / n:.3f}'}"
+        f"{a:.5f},{b:.5f},{20 + i / n:.4f},{'ab'[i % 2]},{'inf' if i == 50 else f'{i / n:.3f}'}"
         for i, (a, b) in enumerate(rng.normal(size=(n, 2)))
     ]
     path = tmp_path / "log.csv"

@@ -53,6 +53,7 @@ examples:
   allanite report acc.npy --fs 100 --refine-candidates bandwidth,drift   # refine trying 2 effects
   allanite report log.csv --fs 10 --columns g_x,g_y --unit deg/s --channels temp
                                                   # refine (implied), regressing on the temp column
+  allanite report log.csv --fs 10 --unit deg/s --refine   # a 'temp' column: a channel, not an axis
 
 files written to DIR:
   report.html              the report, one self-contained page
@@ -129,10 +130,13 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
         "--channels",
         metavar="C1,C2,...",
         help="other columns of the same log (a temperature, a supply voltage, an accelerometer), by name or "
-        "(with --columns) 0-based index, read at the same rate and cut at the same gaps as the samples: every "
-        "axis's model refinement regresses the rate on them (implies --refine; with --refine-candidates, "
-        "regression must be among them; a channel is not also an axis). Their unit is unknown: a coefficient "
-        "is per unit of the channel (deg/s per unit of temp)",
+        "0-based index, read at the same rate and cut at the same gaps as the samples: every axis's model "
+        "refinement regresses the rate on them (implies --refine; with --refine-candidates, regression must be "
+        "among them; a channel is not also an axis). Their unit is unknown: a coefficient is per unit of the "
+        "channel (deg/s per unit of temp). Default: the columns whose names say temperature (temp, temperature, "
+        "imu_temp, TEMP_OUT, 'T [degC]', ...: a word temp/temperature or a temperature unit in brackets, any "
+        "case) — never an axis, and a channel when the report refines (--refine; they do not imply it); "
+        "'none': no channel. A channel's missing values (nan) are interpolated linearly, with a warning",
     )
     inp.add_argument(
         "--accel-columns",

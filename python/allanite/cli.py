@@ -39,7 +39,6 @@ from .analysis import avar
 from .datasets import default_record
 from .errors import AllaniteError, ParameterError
 from .io import read_log
-from .io._columns import resolve_column
 from .kalibr import to_kalibr
 from .model import fit as fit_model
 from .report import build_report, from_log
@@ -211,7 +210,11 @@ def _cli_words(message: str) -> str:
     message = re.sub(
         r"\b(gaps|input|time_unit)='([a-z]+)'", lambda m: f"--{m.group(1).replace('_', '-')} {m.group(2)}", message
     )
-    message = message.replace("drop fs=,", "drop --fs,").replace("time_unit=", "--time-unit")
+    message = (
+        message.replace("drop fs=,", "drop --fs,")
+        .replace("channels=None", "--channels none")
+        .replace("time_unit=", "--time-unit")
+    )
     message = re.sub(r"\bhop=(\d+)", r"--hop \1", message).replace(
         "max_memory / ALLANITE_MAX_MEMORY", "--max-memory / ALLANITE_MAX_MEMORY"
     )
@@ -229,6 +232,8 @@ def _time_column(args):
 
 
 def _read(args, progress):
+    """The log, the reading's notes and its channels (``Log.channels``: those --channels names, else the columns
+    recognised as a temperature by their names; None without any)."""
     path = Path(args.log)
     if not path.exists():
         raise AllaniteError(f"{path}: no such file")
@@ -237,33 +242,34 @@ def _read(args, progress):
     if args.time_unit is not None:
         kwargs["time_unit"] = args.time_unit
     columns = None if args.columns is None else _spec_list(args.columns, "--columns")
-    chans = _channel_specs(args, columns)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         log = read_log(
             path,
             fs=args.fs,
-            columns=columns + chans if columns is not None else None,
+            columns=columns,
             time_column=_time_column(args),
             unit=args.unit,
             input=args.input or "rate",
             gaps=args.gaps or "error",
+            channels=_channel_specs(args, columns),
             **kwargs,
         )
     notes = [" ".join(str(w.message).split()) for w in caught]
-    log, channels = _split_channels(log, chans, None if columns is None else len(columns))
     if columns is None:
         log, note = _gyro_columns(log)
         notes += [note] if note else []
-    return log, notes, channels
+    return log, notes, log.channels or None
 
 
-def _channel_specs(args, columns) -> list:
-    """--channels as column specs ([] without it); refused with --refine-candidates that leave the regression out,
-    by index without --columns (the file's indices are only known with it), and where a spec is also one of
-    --columns. Without --refine / --refine-candidates it implies --refine (:func:`_refine_option`)."""
+def _channel_specs(args, columns):
+    """--channels as read_log's ``channels=``: "auto" without it (the columns named as a temperature), None for
+    ``none``, else the column specs — refused with --refine-candidates that leave the regression out, and where a
+    spec is also one of --columns. Named channels imply --refine (:func:`_refine_option`)."""
     if args.channels is None:
-        return []
+        return "auto"
+    if args.channels.strip().lower() == "none":
+        return None
     specs = _spec_list(args.channels, "--channels")
     tried = _refine_option(args)
     if isinstance(tried, tuple) and "regression" not in tried:
@@ -271,53 +277,15 @@ def _channel_specs(args, columns) -> list:
             f"--channels {args.channels} is only used by the regression effect, which --refine-candidates "
             f"{args.refine_candidates} leaves out: add regression to it, or drop --channels"
         )
-    if columns is None and any(isinstance(c, int) for c in specs):
-        raise ParameterError(
-            f"--channels {args.channels}: a channel by index needs --columns (then an index counts the file's "
-            "columns, as there); without --columns give the channel's name"
-        )
     both = [c for c in specs if c in (columns or [])]
     if both or len(set(specs)) < len(specs):
         twice = both[0] if both else next(c for c in specs if specs.count(c) > 1)
         where = "in both --columns and --channels" if both else "twice in --channels"
-        raise ParameterError(_twice_message(twice, where))
-    return specs
-
-
-def _twice_message(column, where: str) -> str:
-    return (
-        f"column {column!r} is given {where}: a column is either analysed as an axis (--columns) or "
-        "a channel the axes are regressed on (--channels), once"
-    )
-
-
-def _split_channels(log, specs: list, n_axes: int | None):
-    """The log without its channel columns, and the channels as {header name: samples} (cut as the samples are:
-    read in the same call, so the same rate, span and gap handling). ``n_axes``: the sample columns come first
-    (read with --columns), else the channels are found among the log's columns by name."""
-    if not specs:
-        return log, None
-    names = [str(c) for c in log.columns]
-    if n_axes is not None:
-        idx = list(range(n_axes, len(names)))
-        twice = [names[i] for i in idx if names[i] in names[:n_axes]] or [
-            n for n in names[n_axes:] if names[n_axes:].count(n) > 1
-        ]
-        if twice:  # a name and an index of the same column
-            raise ParameterError(_twice_message(twice[0], "in both --columns and --channels"))
-    else:
-        idx = [resolve_column(c, names, log.path, "column") for c in specs]
-    keep = [i for i in range(len(names)) if i not in idx]
-    if not keep:
         raise ParameterError(
-            f"--channels {','.join(map(str, specs))} leaves no column to analyse "
-            f"(the log's columns: {', '.join(names)})"
+            f"column {twice!r} is given {where}: a column is either analysed as an axis (--columns) or "
+            "a channel the axes are regressed on (--channels), once"
         )
-    data = log.data if log.data.ndim == 2 else log.data[:, None]
-    channels = {names[i]: np.asarray(data[:, i], dtype=np.float64) for i in idx}
-    segments = None if log.segments is None else [np.asarray(seg)[:, keep] for seg in log.segments]
-    picked = dataclasses.replace(log, data=data[:, keep], columns=[names[i] for i in keep], segments=segments)
-    return picked, channels
+    return specs
 
 
 #: Column names that say "gyro" and "accelerometer" (case-insensitive): gyro_x, omega_y, angular_velocity.z,
@@ -385,13 +353,18 @@ def _kalibr(args, rep, progress) -> Path:
 
 
 def _refine_option(args) -> bool | tuple:
-    """``build_report``'s ``refine=``: False, True (--refine, or --channels alone), or the effects of
+    """``build_report``'s ``refine=``: False, True (--refine, or --channels C1,… alone), or the effects of
     --refine-candidates."""
     if args.refine_candidates is None:
-        # --channels implies --refine: a channel has no other use than the refinement's regression on it
-        return bool(args.refine or args.channels)
+        # --channels C1,… implies --refine: a channel has no other use than the refinement's regression on it
+        return bool(args.refine or _named_channels(args))
     names = [n.strip() for n in args.refine_candidates.split(",") if n.strip()]
     return () if names == ["none"] else tuple(names)
+
+
+def _named_channels(args) -> bool:
+    """Whether --channels names channels (not ``none``, not left to the recognition of temperature names)."""
+    return args.channels is not None and args.channels.strip().lower() != "none"
 
 
 def _report(args) -> int:
@@ -442,13 +415,13 @@ def _report(args) -> int:
                 }
                 rep = build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common)
             else:
-                log, notes, channels = _read(args, progress)
+                log, notes, _ = _read(args, progress)
                 if args.kalibr and log.unit is None:
                     raise UsageError(_KALIBR_NEEDS_UNIT)
                 if not quiet:
                     for note in notes:
                         progress.bar.write(f"allanite: warning: {note}", file=sys.stderr)
-                rep = from_log(log, notes=notes, channels=channels, **common)
+                rep = from_log(log, notes=notes, **common)  # with the log's channels (report._channels)
             kalibr_path = _kalibr(args, rep, progress) if args.kalibr else None
             specs = rep.figure_specs()
             progress.expect(len(specs) + 1)

@@ -273,6 +273,7 @@ def batch(
     unit=None,
     input: str = "rate",
     gaps: str = "error",
+    channels="auto",
     window=None,
     hop=None,
     taus="octave",
@@ -294,8 +295,10 @@ def batch(
         Glob of the logs; outputs are named relative to the folder before its first wildcard.
     out : path
         Output folder.
-    fs, columns, time_column, unit, input, gaps
-        As for :func:`allanite.read_log` (the same for every file).
+    fs, columns, time_column, unit, input, gaps, channels
+        As for :func:`allanite.read_log` (the same for every file): by default a column named as a temperature
+        is no axis, and a channel of the refinement when ``refine`` (:func:`allanite.report.from_log`); channels
+        named here imply the refinement (``allanite report --channels``).
     window, hop, taus, estimator, refine, fit
         As for ``allanite report``.
     scheduler : str, optional
@@ -319,7 +322,7 @@ def batch(
     out.mkdir(parents=True, exist_ok=True)
     read_opts = {"fs": fs, "columns": columns, "time_column": time_column, "unit": unit, "input": input}
     read_opts = {k: v for k, v in read_opts.items() if v is not None}
-    read_opts["gaps"] = gaps
+    read_opts.update(gaps=gaps, channels=channels)
     report_opts = {"window": window, "hop": hop, "taus": taus, "estimator": estimator, "refine": refine, "fit": fit}
     statuses: dict[str, dict] = {}
     todo = []
@@ -426,6 +429,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--unit", metavar="U")
     p.add_argument("--input", choices=("rate", "increment", "angle"), default="rate")
     p.add_argument("--gaps", choices=("error", "longest", "split"), default="error")
+    p.add_argument(
+        "--channels",
+        metavar="C1,C2,...",
+        help="as allanite report's: other columns every axis is regressed on (implies --refine); default: the "
+        "columns named as a temperature (never an axis; a channel with --refine); 'none': no channel",
+    )
     p.add_argument("--taus", default="octave")
     p.add_argument("--window", type=int)
     p.add_argument("--hop", type=int)
@@ -448,6 +457,13 @@ def _spec(text):
     return [int(c) if c.isdigit() else c for c in items]
 
 
+def _channels(text):
+    """--channels as read_log's ``channels=``: "auto" without it, None for ``none``, else the column specs."""
+    if text is None:
+        return "auto"
+    return None if text.strip().lower() == "none" else _spec(text)
+
+
 def main(argv=None) -> int:
     """``allanite batch``: exit 0 when every file succeeded, 3 when some failed, 2 on a usage error."""
     args = build_parser().parse_args(argv)
@@ -464,6 +480,7 @@ def main(argv=None) -> int:
             unit=args.unit,
             input=args.input,
             gaps=args.gaps,
+            channels=_channels(args.channels),
             window=args.window,
             hop=args.hop,
             taus=taus,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numbers
+import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -50,6 +51,9 @@ class Record:
     time_is_seconds: bool = False
     t_first: float = 0.0  # absolute time of sample 0 when `time` is relative (bags)
     checked_finite: bool = False
+    #: Other channels (``read_log(channels=…)``): column name → float64 samples, NaN where a value is missing.
+    channels: dict | None = None
+    channels_recognised: bool = False  # found by their names (channels="auto")
 
 
 def check_column_spec(spec, name, single=False):
@@ -83,6 +87,47 @@ def resolve_column(spec, names, path, what="column"):
     return k % n
 
 
+#: ``read_log(channels=…)``'s default: the columns whose names say they are a temperature (:func:`is_temperature`).
+AUTO_CHANNELS = "auto"
+
+#: Words that make a column a temperature (a word of its name: ``temp``, ``imu_temp``, ``TEMP_OUT``,
+#: ``boardTemperature``, ``temperature.x``), and the units in brackets that do so on any name (``T [degC]``,
+#: ``die (°C)``, ``t[K]``) — the unit alone, since ``t`` or ``T`` without one is a time column.
+TEMPERATURE_WORDS = ("temp", "temperature")
+TEMPERATURE_UNITS = ("c", "°c", "degc", "deg c", "deg_c", "celsius", "k", "kelvin", "f", "°f", "degf", "deg f")
+_BRACKETED = re.compile(r"[\[(]\s*([^\])]*?)\s*[\])]\s*$")
+
+
+def is_temperature(name) -> bool:
+    """Whether a column's name says it is a temperature: a word of it (case-insensitive; camelCase, ``_``, ``.``,
+    spaces and digits split words) is one of :data:`TEMPERATURE_WORDS`, or it ends in one of
+    :data:`TEMPERATURE_UNITS` in brackets or parentheses."""
+    name = str(name)
+    unit = _BRACKETED.search(name)
+    if unit is not None and unit.group(1).lower() in TEMPERATURE_UNITS:
+        return True
+    words = re.findall(r"[a-z]+", re.sub(r"([a-z])([A-Z])", r"\1_\2", name).lower())
+    return any(w in TEMPERATURE_WORDS for w in words)
+
+
+def channel_indices(channels, names, path, t_idx=None) -> list:
+    """Indices of ``read_log``'s ``channels=`` among ``names``: none for None, the temperature-named columns but the
+    time column for ``"auto"``, else the columns named (names or 0-based indices; never the time column, nor one
+    twice)."""
+    if channels is None:
+        return []
+    if isinstance(channels, str) and channels == AUTO_CHANNELS:
+        return [i for i, c in enumerate(names) if i != t_idx and is_temperature(c)]
+    check_column_spec(channels, "channels")
+    specs = [channels] if not isinstance(channels, (list, tuple)) else list(channels)
+    idx = [resolve_column(c, names, path, "column") for c in specs]
+    if t_idx is not None and t_idx in idx:
+        raise ParameterError(f"{path}: column {names[t_idx]!r} is both the time column and a channel")
+    if len(set(idx)) != len(idx):
+        raise ParameterError(f"{path}: channels {specs!r} name the same column twice")
+    return idx
+
+
 #: Passed as ``time_column`` when neither fs nor a time column was given: recognise the time column by name.
 AUTO_TIME = "<recognise by name>"
 
@@ -99,17 +144,22 @@ def recognise_time(names, path) -> int:
     return hits[0]
 
 
-def select_columns(columns, time_column, names, path, default=None):
-    """(data column indices, time column index or None, squeeze to 1-D)."""
+def select_columns(columns, time_column, names, path, default=None, channels=None):
+    """(data column indices, time column index or None, squeeze to 1-D). Without ``columns`` (and ``default``):
+    every column but the time column, the ``channels`` and the temperature-named ones (:func:`is_temperature`)."""
     if time_column is AUTO_TIME:
         t_idx: int | None = recognise_time(names, path)
     else:
         t_idx = None if time_column is None else resolve_column(time_column, names, path, "time column")
     if columns is None:
+        apart: set = set()
         if default is not None:
             idx = [names.index(d) for d in default]
         else:
-            idx = [i for i in range(len(names)) if i != t_idx]
+            apart |= set(channel_indices(channels, names, path, t_idx)) | {
+                i for i, c in enumerate(names) if is_temperature(c)
+            }
+            idx = [i for i in range(len(names)) if i != t_idx and i not in apart]
             if t_idx is None:
                 timeish = [names[i] for i in idx if names[i].strip().lower() in TIME_NAMES]
                 if timeish and len(idx) > 1:
@@ -118,7 +168,11 @@ def select_columns(columns, time_column, names, path, default=None):
                         f"{timeish[0]!r} (to use it) or columns=[…] (to choose the sample columns)"
                     )
         if not idx:
-            raise InputError(f"{path}: no sample columns besides the time column {names[t_idx]!r}")
+            besides = [repr(names[i]) for i in sorted(apart | ({t_idx} if t_idx is not None else set()))]
+            raise InputError(
+                f"{path}: no sample columns besides {', '.join(besides)} (the time column, the channels and the "
+                "columns named as a temperature); name the sample columns with columns=[…]"
+            )
         return idx, t_idx, len(idx) == 1
     single = not isinstance(columns, (list, tuple))
     specs = [columns] if single else list(columns)
@@ -128,6 +182,21 @@ def select_columns(columns, time_column, names, path, default=None):
     if len(set(idx)) != len(idx):
         raise ParameterError(f"{path}: columns {specs!r} name the same column twice")
     return idx, t_idx, single
+
+
+def pick_channels(channels, idx, t_idx, names, path) -> list:
+    """The channel columns' indices (:func:`channel_indices`), none of them a sample column: ``"auto"`` leaves the
+    sample columns out, a column named in both ``columns`` and ``channels`` is refused."""
+    ch = channel_indices(channels, names, path, t_idx)
+    if isinstance(channels, str) and channels == AUTO_CHANNELS:
+        return [i for i in ch if i not in idx]
+    both = [names[i] for i in ch if i in idx]
+    if both:
+        raise ParameterError(
+            f"{path}: column {both[0]!r} is both a sample column and a channel: a column is either analysed "
+            "(columns=) or a channel the samples are regressed on (channels=), once"
+        )
+    return ch
 
 
 def first_nonfinite(block):

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError, MissingDependencyError, ParameterError
-from ._columns import Record, select_columns
+from ._columns import AUTO_CHANNELS, Record, pick_channels, select_columns
 
 _IMU_TYPES = ("sensor_msgs/msg/Imu", "sensor_msgs/Imu")
 _BAG_FIELDS = (
@@ -29,7 +29,7 @@ def _need(module: str, extra: str, what: str):
         ) from None
 
 
-def read_parquet(path, columns, time_column):
+def read_parquet(path, columns, time_column, channels=None):
     pq = _need("pyarrow.parquet", "parquet", "Parquet files")
     pa = _need("pyarrow", "parquet", "Parquet files")
     try:
@@ -39,16 +39,20 @@ def read_parquet(path, columns, time_column):
     names = list(schema.names)
     if not names:
         raise InputError(f"{path}: the Parquet file has no columns")
-    idx, t_idx, squeeze = select_columns(columns, time_column, names, path)
-    want = [names[i] for i in idx] + ([names[t_idx]] if t_idx is not None else [])
+    idx, t_idx, squeeze = select_columns(columns, time_column, names, path, channels=channels)
+    ch = pick_channels(channels, idx, t_idx, names, path)
+    want = [names[i] for i in idx + ch] + ([names[t_idx]] if t_idx is not None else [])
     try:
         table = pq.read_table(path, columns=want)
     except Exception as exc:
         raise InputError(f"{path}: cannot read columns {want} ({exc})") from None
 
-    def column(name, is_time):
+    def column(name, is_time, nulls=False):
         col = table.column(name)
         typ = col.type
+        if nulls and col.null_count and (pa.types.is_integer(typ) or pa.types.is_floating(typ)):
+            # a channel's missing values (nulls) are NaN, filled where the log is finished (io._timing)
+            return np.asarray(col.cast(pa.float64()).fill_null(float("nan")).to_numpy(), dtype=np.float64), None
         if col.null_count:
             mask = np.asarray(col.is_null().to_numpy(zero_copy_only=False))
             raise InputError(
@@ -81,6 +85,8 @@ def read_parquet(path, columns, time_column):
         where=lambda r: f"row {r}",
         time_is_seconds=secs,
         t_first=t_first,
+        channels={names[i]: column(names[i], False, nulls=True)[0] for i in ch},
+        channels_recognised=isinstance(channels, str) and channels == AUTO_CHANNELS,
     )
 
 

@@ -9,7 +9,7 @@ import zlib
 import numpy as np
 
 from ..errors import AllaniteError, InputError, ParameterError
-from ._columns import AUTO_TIME, Record, recognise_time, select_columns
+from ._columns import AUTO_CHANNELS, AUTO_TIME, Record, pick_channels, recognise_time, select_columns
 
 
 def _numeric_check(path, arr, what):
@@ -26,14 +26,16 @@ def _columns_of(mm, idx):
     return np.asarray(mm[:, idx])
 
 
-def _array_record(path, arr, columns, time_column, label, extra_time=None):
-    """A record from a 1-D, 2-D or structured array (the .npy/.npz common path)."""
+def _array_record(path, arr, columns, time_column, label, extra_time=None, channels=None):
+    """A record from a 1-D, 2-D or structured array (the .npy/.npz common path); ``channels`` only from a structured
+    one's fields (an unstructured array's columns have no names to recognise)."""
     if arr.dtype.names:
         names = list(arr.dtype.names)
         if arr.ndim != 1:
             raise InputError(f"{path}: {label} is a structured array of shape {arr.shape}; 1-D is expected")
-        idx, t_idx, squeeze = select_columns(columns, time_column, names, path)
-        for i in idx + ([t_idx] if t_idx is not None else []):
+        idx, t_idx, squeeze = select_columns(columns, time_column, names, path, channels=channels)
+        ch = pick_channels(channels, idx, t_idx, names, path)
+        for i in idx + ch + ([t_idx] if t_idx is not None else []):
             _numeric_check(path, arr[names[i]], f"field {names[i]!r}")
         data = np.column_stack([np.asarray(arr[names[i]], dtype=np.float64) for i in idx])
         time = np.asarray(arr[names[t_idx]], dtype=np.float64) if t_idx is not None else None
@@ -45,9 +47,13 @@ def _array_record(path, arr, columns, time_column, label, extra_time=None):
             time=time,
             time_name=names[t_idx] if t_idx is not None else None,
             where=lambda r: f"row {r}",
+            channels={names[i]: np.asarray(arr[names[i]], dtype=np.float64) for i in ch},
+            channels_recognised=isinstance(channels, str) and channels == AUTO_CHANNELS,
         )
     _numeric_check(path, arr, label)
-    tname = None
+    if arr.ndim != 2 and channels is not None and not (isinstance(channels, str) and channels == AUTO_CHANNELS):
+        raise ParameterError(f"{path}: channels={channels!r}: {label} is one column, so it holds no other channel")
+    tname, chans = None, {}
     if arr.ndim == 1:
         names = ["col0"]
         if time_column is AUTO_TIME:
@@ -66,10 +72,13 @@ def _array_record(path, arr, columns, time_column, label, extra_time=None):
     elif arr.ndim == 2:
         names = [f"col{k}" for k in range(arr.shape[1])]
         if extra_time is not None:
-            idx, _, squeeze = select_columns(columns, None, names, path)
+            idx, _, squeeze = select_columns(columns, None, names, path, channels=channels)
             t_idx = None
         else:
-            idx, t_idx, squeeze = select_columns(columns, time_column, names, path)
+            idx, t_idx, squeeze = select_columns(columns, time_column, names, path, channels=channels)
+        chans = {
+            names[i]: np.asarray(arr[:, i], dtype=np.float64) for i in pick_channels(channels, idx, t_idx, names, path)
+        }
         data = _columns_of(arr, idx)
         if squeeze:
             data = data[:, 0]
@@ -88,7 +97,9 @@ def _array_record(path, arr, columns, time_column, label, extra_time=None):
             )
     elif arr.ndim == 2 and time_column is not None:
         tname = names[t_idx]
-    return Record(data=data, names=out_names, time=time, time_name=tname, where=lambda r: f"row {r}")
+    return Record(
+        data=data, names=out_names, time=time, time_name=tname, where=lambda r: f"row {r}", channels=chans or None
+    )
 
 
 #: What NumPy's readers raise on damaged .npy/.npz bytes (header parser, zip layer, decompression).
@@ -110,15 +121,15 @@ _DAMAGED = (
 )
 
 
-def read_npy(path, columns, time_column):
+def read_npy(path, columns, time_column, channels=None):
     try:
         arr = np.load(path, mmap_mode="r", allow_pickle=False)
     except _DAMAGED as exc:  # a damaged header fails in NumPy's header parser with many exception types
         raise InputError(f"{path}: not a readable .npy file ({type(exc).__name__}: {exc})") from None
-    return _array_record(path, arr, columns, time_column, "the array")
+    return _array_record(path, arr, columns, time_column, "the array", channels=channels)
 
 
-def read_npz(path, columns, time_column, array):
+def read_npz(path, columns, time_column, array, channels=None):
     try:
         z = np.load(path, allow_pickle=False)
     except _DAMAGED as exc:
@@ -147,7 +158,8 @@ def read_npz(path, columns, time_column, array):
                 arr = z[array]
             except _DAMAGED as exc:
                 raise InputError(f"{path}: array {array!r} cannot be read ({type(exc).__name__}: {exc})") from None
-            return _array_record(path, arr, columns, time_column, f"array {array!r}", extra_time=time_arr)
+            label = f"array {array!r}"
+            return _array_record(path, arr, columns, time_column, label, extra_time=time_arr, channels=channels)
     except AllaniteError:
         raise
     except _DAMAGED as exc:  # damaged members: bad CRC, truncated streams, broken member headers

@@ -10,7 +10,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import InputError, ParameterError
-from ._columns import Record, first_nonfinite, select_columns
+from ._columns import AUTO_CHANNELS, Record, first_nonfinite, pick_channels, select_columns
 
 
 def _is_number(s: str) -> bool:
@@ -161,9 +161,9 @@ def _layout(path, lines, delimiter):
     return i0, start, delim, ncols, names
 
 
-def read_text(path, columns, time_column, delimiter, gz):
-    """The record of a text log: the header (or ``col0``, ``col1``, …), the chosen columns parsed (by the core's
-    decimal parser, else by NumPy), and on a parse error the first bad line found and named."""
+def read_text(path, columns, time_column, delimiter, gz, channels=None):
+    """The record of a text log: the header (or ``col0``, ``col1``, …), the chosen columns and ``channels`` parsed
+    (by the core's decimal parser, else by NumPy), and on a parse error the first bad line found and named."""
     doc = _decode(path, gz)
     head, whole = doc.head()
     try:
@@ -173,8 +173,9 @@ def read_text(path, columns, time_column, delimiter, gz):
             raise
         head, whole = doc.lines, True  # the header or the first data row lies beyond the head
         i0, start, delim, ncols, names = _layout(path, head, delimiter)
-    idx, t_idx, squeeze = select_columns(columns, time_column, names, path)
-    need = sorted(set(idx + ([t_idx] if t_idx is not None else [])))
+    idx, t_idx, squeeze = select_columns(columns, time_column, names, path, channels=channels)
+    ch = pick_channels(channels, idx, t_idx, names, path)
+    need = sorted(set(idx + ch + ([t_idx] if t_idx is not None else [])))
     # parse only the needed columns when a one-character delimiter makes skipping safe
     usecols = need if (delim is not None and len(need) < ncols) else None
     parsed = usecols if usecols is not None else list(range(ncols))
@@ -182,7 +183,10 @@ def read_text(path, columns, time_column, delimiter, gz):
     fast = getattr(_core, "parse_decimal_table", None)
     arr = fast(doc.raw, doc.byte_offset(start), delim, ncols, parsed) if fast is not None else None
     if arr is None:  # not plain decimal rows: NumPy reads them, and a bad line is found and named
-        arr = _parse_lines(path, doc, start, delim, ncols, need, names, usecols)
+        try:
+            arr = _parse_lines(path, doc, start, delim, ncols, need, names, usecols)
+        except InputError as exc:
+            raise _as_channel(exc, [names[i] for i in ch], channels) from None
     if arr.shape[0] == 0:
         raise InputError(f"{path}: no data rows after the header on line {i0 + 1}")
 
@@ -203,6 +207,7 @@ def read_text(path, columns, time_column, delimiter, gz):
             f"{data[r, c]} (NaN or inf); only finite numbers are allowed"
         )
     time = arr[:, pos[t_idx]].copy() if t_idx is not None else None
+    chans = {names[i]: arr[:, pos[i]].copy() for i in ch}
     del arr
     if squeeze:
         data = data[:, 0].copy()
@@ -213,7 +218,18 @@ def read_text(path, columns, time_column, delimiter, gz):
         time_name=names[t_idx] if t_idx is not None else None,
         where=where,
         checked_finite=True,
+        channels=chans,
+        channels_recognised=isinstance(channels, str) and channels == AUTO_CHANNELS,
     )
+
+
+def _as_channel(exc: InputError, chans: list, channels) -> InputError:
+    """A parse error that names a channel column, with how to leave the channel out."""
+    hit = next((c for c in chans if f"({c!r})" in str(exc)), None)
+    if hit is None:
+        return exc
+    why = " (recognised as a temperature by its name)" if channels == AUTO_CHANNELS else ""
+    return InputError(f"{exc} — column {hit!r} is read as a channel{why}; channels=None leaves it out")
 
 
 def _parse_lines(path, doc, start, delim, ncols, need, names, usecols):

@@ -9,6 +9,7 @@ import numpy as np
 
 from .._mapped import read_rows
 from ..errors import DataGapError, InputError, ParameterError
+from ._channels import finish_channels
 from ._columns import Record, first_nonfinite
 from .log import GAP_FACTOR, JITTER_WARN, Gap, Log
 
@@ -27,6 +28,7 @@ def _log_fields(path, fmt, rec: Record, fs, unit, input, t0, gap_list, jitter) -
         gaps=gap_list,
         jitter=jitter,
         n_record=int(rec.data.shape[0]),
+        channels_recognised=rec.channels_recognised,
     )
 
 
@@ -45,7 +47,19 @@ def _filled_with_nan(path, fmt, rec, data, t, fs, unit, input, t0, gap_list, jit
     filled = np.concatenate(pieces)
     tt = np.concatenate(times)
     shared = _log_fields(path, fmt, rec, fs, unit, input, t0, gap_list, jitter)
-    return Log(data=filled, span=(0, int(data.shape[0])), time=tt - tt[0], time_column=rec.time_name, **shared)
+    # the channels' own missing values filled, then NaN where the samples are (a gap misses both)
+    channels = {k: _nan_rows(c, gap_list) for k, c in finish_channels(path, rec, 0, int(data.shape[0])).items()}
+    span = (0, int(data.shape[0]))
+    return Log(data=filled, span=span, time=tt - tt[0], time_column=rec.time_name, channels=channels, **shared)
+
+
+def _nan_rows(c: np.ndarray, gap_list: list) -> np.ndarray:
+    """A channel with ``Gap.missing`` NaN at each gap, as ``gaps="nan"`` fills the samples."""
+    bounds = [0] + [g.index for g in gap_list]
+    pieces = []
+    for g, a in zip(gap_list, bounds):
+        pieces += [c[a : g.index], np.full(g.missing, np.nan)]
+    return np.concatenate(pieces + [c[bounds[-1] :]])
 
 
 def finish(path, fmt, rec: Record, fs, unit, input, gaps) -> Log:
@@ -94,6 +108,7 @@ def finish(path, fmt, rec: Record, fs, unit, input, gaps) -> Log:
     return Log(
         data=kept,
         span=span,
+        channels=finish_channels(path, rec, *span),
         segments=segments,
         segment_spans=segment_spans,
         time=time_rel,

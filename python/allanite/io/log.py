@@ -89,6 +89,12 @@ class Log:
         Largest deviation of a (non-gap) time step from the nominal step, as a fraction of it.
     n_record : int
         Samples in the full record, before any gap handling.
+    channels : dict of str → ndarray
+        Other channels of the log (``read_log(channels=…)``: by default the columns whose names say they are a
+        temperature), column name → float64 samples of ``data``'s rows (the same span; missing values filled,
+        see :mod:`allanite.io._channels`); empty without any. Not among ``columns``.
+    channels_recognised : bool
+        Whether the channels were found by their names (``channels="auto"``) rather than named.
     """
 
     data: np.ndarray
@@ -110,6 +116,8 @@ class Log:
     #: by its name because neither ``fs`` nor ``time_column`` was given.
     time_column: str | None = None
     time_column_recognised: bool = False
+    channels: dict = field(default_factory=dict)
+    channels_recognised: bool = False
 
     @property
     def n_samples(self) -> int:
@@ -136,6 +144,11 @@ class Log:
             f"{kind}{self.data.dtype}, "
             f"fs = {self.fs:g} Hz ({dur_s})",
             f"  columns: {', '.join(self.columns)}",
+            *(
+                [f"  channels: {', '.join(self.channels)}{' (recognised by name)' if self.channels_recognised else ''}"]
+                if self.channels
+                else []
+            ),
             f"  unit: {self.unit.name + ' (' + self.unit.kind + ')' if self.unit else 'not given'}, "
             f"input: {self.input}",
         ]

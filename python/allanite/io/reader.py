@@ -18,8 +18,8 @@ from pathlib import Path
 from .._validate import INPUTS, check_choice, check_fs
 from ..errors import InputError, ParameterError
 from ..units import parse_unit
+from ._columns import AUTO_CHANNELS, check_column_spec
 from ._columns import AUTO_TIME as AUTO_TIME
-from ._columns import check_column_spec
 from ._external import read_bag, read_parquet
 from ._numpy import read_npy, read_npz
 from ._text import read_text
@@ -45,6 +45,7 @@ def read_log(
     time_unit="s",
     array=None,
     topic=None,
+    channels=AUTO_CHANNELS,
 ) -> Log:
     """Read a gyro log.
 
@@ -87,6 +88,20 @@ def read_log(
         For ``.npz``: which array holds the samples (default: the only one).
     topic : str, optional
         For ROS bags: the ``sensor_msgs/Imu`` topic (default: the only one).
+    channels : "auto", str, int, list or None
+        Other columns to read beside the samples, into ``Log.channels`` (not ``data``): what
+        :func:`allanite.refine` regresses the rate on. ``"auto"`` (default): the columns whose names say they
+        are a temperature (a word ``temp`` or ``temperature`` — ``temp``, ``imu_temp``, ``TEMP_OUT``,
+        ``boardTemperature`` —, or a temperature unit in brackets — ``T [degC]``, ``die (°C)``, ``T[K]``;
+        case-insensitive; :func:`allanite.io._columns.is_temperature`), except the time column and ``columns``;
+        a name, index or list of them: those columns (never also a sample or the time column); None: none. A
+        temperature-named column is never a sample column by default, with or without ``channels`` — name it in
+        ``columns`` to analyse it. A channel's missing values (NaN) are filled by linear interpolation, with a
+        warning; an infinite value, fewer than two finite ones or a run of NaN over 1 % of the samples is an
+        InputError naming the column (a recognised channel is then left out with a warning instead). Read from
+        text, Parquet, a structured ``.npy``/``.npz`` (by field name) or a plain 2-D array (by index); cut with
+        the samples (the same span with ``gaps="longest"``/``"split"``, NaN at the gaps with ``gaps="nan"``).
+        Not read from ROS bags yet (``Log.channels`` stays empty).
 
     Returns
     -------
@@ -123,11 +138,18 @@ def read_log(
         check_column_spec(columns, "columns")
     if time_column is not None:
         check_column_spec(time_column, "time_column", single=True)
+    if channels is not None and not (isinstance(channels, str) and channels == AUTO_CHANNELS):
+        check_column_spec(channels, "channels")
     if not path.exists():
         raise InputError(f"{path}: no such file")
 
     fmt = sniff_format(path)
     if fmt in ("ros1", "ros2"):
+        if channels is not None and not (isinstance(channels, str) and channels == AUTO_CHANNELS):
+            raise ParameterError(
+                f"{path}: channels={channels!r}: channels are not read from ROS bags yet (a sensor_msgs/Temperature "
+                "topic neither); read it yourself and pass build_report(channels=…)"
+            )
         rec = read_bag(path, fmt, columns, time_column, topic)
         if u is None and input == "rate":
             u = parse_unit("rad/s")  # REP 103: ROS angular velocity is in rad/s
@@ -136,13 +158,13 @@ def read_log(
             # neither given: a column named like a time column (time, t, timestamp, …) is the time column
             time_column = AUTO_TIME
         if fmt == "npy":
-            rec = read_npy(path, columns, time_column)
+            rec = read_npy(path, columns, time_column, channels)
         elif fmt == "npz":
-            rec = read_npz(path, columns, time_column, array)
+            rec = read_npz(path, columns, time_column, array, channels)
         elif fmt == "parquet":
-            rec = read_parquet(path, columns, time_column)
+            rec = read_parquet(path, columns, time_column, channels)
         else:
-            rec = read_text(path, columns, time_column, delimiter, gz=(fmt == "text.gz"))
+            rec = read_text(path, columns, time_column, delimiter, gz=(fmt == "text.gz"), channels=channels)
         if rec.time is not None and rec.time_is_seconds is False:
             rec.time = rec.time * TIME_UNITS[time_unit]
     fmt = "text" if fmt == "text.gz" else fmt

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+import numpy as np
+
 from ..errors import ParameterError
 
 
@@ -40,3 +42,34 @@ def rate_aligned(channels: dict | None, input: str) -> dict | None:
     if not channels or input != "angle":
         return channels
     return {name: 0.5 * (c[:-1] + c[1:]) for name, c in channels.items()}
+
+
+def log_channels(log, refine, notes: list) -> dict | None:
+    """The channels :func:`~allanite.report.from_log` hands on from ``log.channels``: named ones (read_log's
+    ``channels=[…]``) as they are — they imply the refinement, as ``channels=`` does; recognised ones (temperature
+    names) only when the refinement asked for tries the regression, and then not a constant one. ``notes`` gains
+    a line on each recognised channel: that it is not an axis, whether it was used, and how to choose otherwise."""
+    if not log.channels:
+        return None
+    if not log.channels_recognised:
+        return dict(log.channels)
+    names = ", ".join(map(repr, log.channels))
+    one = len(log.channels) == 1
+    found = (
+        f"Column{'' if one else 's'} {names} {'was' if one else 'were'} recognised as a temperature by "
+        f"{'its name' if one else 'their names'}: not analysed as {'an axis' if one else 'axes'}"
+    )
+    how = "--channels none (read_log(channels=None)) leaves it out, --channels C1,… chooses the channels."
+    tried = () if refine is None or refine is False else ("regression",) if refine is True else refine
+    if "regression" not in ((tried,) if isinstance(tried, str) else tuple(tried)):
+        asked = refine is not None and refine is not False
+        why = "the refinement's effects leave out the regression" if asked else "no refinement was asked for (--refine)"
+        notes.append(f"{found}, and not used: {why}, and a channel's only use is its regression. {how}")
+        return None
+    used = {k: c for k, c in log.channels.items() if np.ptp(c) > 0}
+    for k in log.channels:
+        if k not in used:
+            notes.append(f"Column {k!r} (recognised as a temperature) is constant: not used as a channel.")
+    if used:
+        notes.append(f"{found}; every axis's model refinement regresses on {'it' if one else 'them'}. {how}")
+    return used or None

@@ -44,7 +44,7 @@ from ..model.effects import EFFECTS
 from ..model.terms import TERMS
 from ..units import parse_unit
 from . import _worker
-from ._channels import check_channels, rate_aligned
+from ._channels import check_channels, log_channels, rate_aligned
 from .axes import analyse_by_axis, axes_per_read, axis_column, record_bytes, wants_by_axis
 from .budget import check_report_memory
 from .fmt import json_number
@@ -548,7 +548,10 @@ def log_source(log) -> dict:
 
 def from_log(log, **kwargs) -> Report:
     """:func:`build_report` on a :class:`~allanite.Log` from :func:`allanite.read_log` (its unit,
-    input kind, column names and reading notes)."""
+    input kind, column names and reading notes) and, without ``channels=``, its channels (``Log.channels``):
+    those named in ``read_log(channels=[…])`` imply the refinement, as ``channels=`` does; those recognised as a
+    temperature by their names are handed to the refinement only when ``refine=`` asks for one that tries the
+    regression — a report without ``refine`` stays the same, and says in a note that the column is no axis."""
     notes = list(kwargs.pop("notes", ()))
     if log.time_column_recognised:
         notes.append(
@@ -566,6 +569,8 @@ def from_log(log, **kwargs) -> Report:
             )
         )
     unit = kwargs.pop("unit", None) or (log.unit.name if log.unit is not None else None)
+    if "channels" not in kwargs:  # the log's own: a temperature column recognised by its name, or those named
+        kwargs["channels"] = log_channels(log, kwargs.get("refine", False), notes)
     return build_report(
         log.data,
         log.fs,
