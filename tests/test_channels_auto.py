@@ -255,3 +255,14 @@ def test_batch_cli_has_channels(tmp_path, capsys):
 
     assert "--channels C1,C2,..." in build_parser().format_help()
     assert _channels(None) == "auto" and _channels("none") is None and _channels("temp,2") == ["temp", 2]
+
+
+def test_what_is_not_read_is_said(tmp_path):
+    """A log of nothing but time and temperature has no sample column; a plain 1-D array holds no channel."""
+    np.savetxt(tmp_path / "only.csv", np.c_[np.arange(10.0), np.arange(10.0)], delimiter=",", header="t,temp",
+               comments="")  # fmt: skip
+    with pytest.raises(InputError, match=r"no sample columns besides 't', 'temp' \(the time column, the channels"):
+        allanite.read_log(tmp_path / "only.csv")
+    np.save(tmp_path / "one.npy", np.zeros(10))
+    with pytest.raises(ParameterError, match="is one column, so it holds no other channel"):
+        allanite.read_log(tmp_path / "one.npy", fs=FS, channels=[0])

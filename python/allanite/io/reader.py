@@ -126,6 +126,14 @@ def read_log(
     >>> log = allanite.read_log(path, time_column="t", unit="deg/s")
     >>> log.data.shape, log.fs, log.columns
     ((500, 3), 100.0, ['gx', 'gy', 'gz'])
+
+    A column named as a temperature is a channel (what :func:`allanite.refine` regresses on), not an axis:
+
+    >>> temp = 20.0 + 0.01 * np.arange(500)
+    >>> np.savetxt(path, np.c_[t, np.full((500, 2), 0.05), temp], delimiter=",", header="t,gx,gy,T [degC]", comments="")
+    >>> log = allanite.read_log(path, time_column="t", unit="deg/s")
+    >>> log.columns, list(log.channels), log.channels_recognised
+    (['gx', 'gy'], ['T [degC]'], True)
     """
     path = Path(os.fspath(path))
     check_choice(input, "input", INPUTS)
