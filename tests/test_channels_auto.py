@@ -128,7 +128,7 @@ def test_a_bad_channel_column_is_named(tmp_path, values, message):
         with pytest.raises(InputError, match="recognised as a temperature by its name"):
             allanite.read_log(tmp_path / "b.csv", time_column="t")
         return
-    with pytest.warns(UserWarning, match=message + ".*recognised as a temperature by its name, is not used"):
+    with pytest.warns(UserWarning, match=message + ".*recognised as a temperature, is not used as a channel"):
         log = allanite.read_log(tmp_path / "b.csv", time_column="t")
     assert log.columns == ["gx"] and log.channels == {}
 
@@ -266,3 +266,79 @@ def test_what_is_not_read_is_said(tmp_path):
     np.save(tmp_path / "one.npy", np.zeros(10))
     with pytest.raises(ParameterError, match="is one column, so it holds no other channel"):
         allanite.read_log(tmp_path / "one.npy", fs=FS, channels=[0])
+
+
+def _imu_and_temperature_bag(path, ros, n, temp_stamps, temps):
+    """Imu messages at 200 Hz from t = 1 s (angular velocity: noise) and sensor_msgs/Temperature on /imu/temp."""
+    import inspect
+
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS1_NOETIC if ros == 1 else Stores.ROS2_HUMBLE)
+    T = ts.types
+    Imu, Temp, Header, Time = (T[k] for k in ("sensor_msgs/msg/Imu", "sensor_msgs/msg/Temperature",
+                                              "std_msgs/msg/Header", "builtin_interfaces/msg/Time"))  # fmt: skip
+    V, Q = T["geometry_msgs/msg/Vector3"], T["geometry_msgs/msg/Quaternion"]
+    if ros == 1:
+        from rosbags.rosbag1 import Writer
+
+        writer, ser = Writer(path), ts.serialize_ros1
+    else:
+        from rosbags.rosbag2 import Writer
+
+        kw = {"version": 8} if "version" in inspect.signature(Writer.__init__).parameters else {}
+        writer, ser = Writer(path, **kw), ts.serialize_cdr
+
+    def header(i, ns):
+        stamp = Time(sec=ns // 10**9, nanosec=ns % 10**9)
+        return Header(seq=i, stamp=stamp, frame_id="imu") if ros == 1 else Header(stamp=stamp, frame_id="imu")
+
+    w = np.random.default_rng(5).normal(scale=0.01, size=(n, 3))
+    cov = np.zeros(9)
+    with writer:
+        imu = writer.add_connection("/imu/data", Imu.__msgtype__, typestore=ts)
+        tc = writer.add_connection("/imu/temp", Temp.__msgtype__, typestore=ts)
+        for i in range(n):
+            ns = 10**9 + i * 5_000_000
+            msg = Imu(header=header(i, ns), orientation=Q(x=0.0, y=0.0, z=0.0, w=1.0), orientation_covariance=cov,
+                      angular_velocity=V(x=w[i, 0], y=w[i, 1], z=w[i, 2]), angular_velocity_covariance=cov,
+                      linear_acceleration=V(x=0.0, y=0.0, z=9.81), linear_acceleration_covariance=cov)  # fmt: skip
+            writer.write(imu, ns, ser(msg, Imu.__msgtype__))
+        for i, (ns, v) in enumerate(zip(temp_stamps, temps)):
+            msg = Temp(header=header(i, int(ns)), temperature=float(v), variance=0.0)
+            writer.write(tc, int(ns), ser(msg, Temp.__msgtype__))
+    return w
+
+
+@pytest.mark.parametrize("ros", [1, 2])
+def test_a_bags_temperature_topic_is_a_channel_at_the_imu_times(tmp_path, ros):
+    pytest.importorskip("rosbags", reason="rosbags is not installed (pip install 'allanite[ros]')")
+    n = 400  # 2 s at 200 Hz from t = 1 s; the temperature at 10 Hz from 0.95 s to 3.05 s, rising 1 °C/s
+    stamps = np.arange(950_000_000, 3_100_000_000, 100_000_000)
+    path = tmp_path / ("imu.bag" if ros == 1 else "imu_bag")
+    w = _imu_and_temperature_bag(path, ros, n, stamps, 20.0 + stamps * 1e-9)
+    log = allanite.read_log(path)
+    np.testing.assert_array_equal(log.data, w)
+    assert list(log.channels) == ["/imu/temp"] and log.channels_recognised
+    np.testing.assert_allclose(log.channels["/imu/temp"], 21.0 + np.arange(n) * 0.005, rtol=1e-12)
+    assert allanite.read_log(path, channels=None).channels == {}
+    with pytest.raises(InputError, match=r"no sensor_msgs/Temperature topic '/t'; .* Temperature topics: /imu/temp"):
+        allanite.read_log(path, channels=["/t"])
+    notes: list = []
+    from allanite.report._channels import log_channels
+
+    assert log_channels(log, False, notes) is None
+    assert notes[0].startswith(
+        "Topic '/imu/temp' was recognised as a temperature by its type (sensor_msgs/Temperature)"
+    )
+
+
+def test_a_bags_temperature_that_stops_early_is_left_out_or_refused(tmp_path):
+    pytest.importorskip("rosbags", reason="rosbags is not installed (pip install 'allanite[ros]')")
+    stamps = np.arange(1_000_000_000, 2_000_000_000, 100_000_000)  # the first of the Imu's 2 s only
+    _imu_and_temperature_bag(tmp_path / "early.bag", 1, 400, stamps, np.full(stamps.size, 30.0))
+    with pytest.warns(UserWarning, match=r"'/imu/temp' misses 219 values in a row from message 181 on /imu/data"):
+        log = allanite.read_log(tmp_path / "early.bag")
+    assert log.channels == {}
+    with pytest.raises(InputError, match=r"channel column '/imu/temp' misses"):
+        allanite.read_log(tmp_path / "early.bag", channels=["/imu/temp"])

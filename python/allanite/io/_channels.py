@@ -35,7 +35,7 @@ def finish_channels(path, rec, a: int, b: int) -> dict:
             if not rec.channels_recognised:
                 raise
             warnings.warn(
-                f"{exc} — so column {name!r}, recognised as a temperature by its name, is not used as a channel",
+                f"{exc} — so {name!r}, recognised as a temperature, is not used as a channel",
                 stacklevel=4,  # the caller of read_log (read_log → finish → finish_channels)
             )
     return out

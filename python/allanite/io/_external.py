@@ -8,6 +8,7 @@ from ..errors import InputError, MissingDependencyError, ParameterError
 from ._columns import AUTO_CHANNELS, Record, pick_channels, select_columns
 
 _IMU_TYPES = ("sensor_msgs/msg/Imu", "sensor_msgs/Imu")
+_TEMPERATURE_TYPES = ("sensor_msgs/msg/Temperature", "sensor_msgs/Temperature")
 _BAG_FIELDS = (
     "angular_velocity_x",
     "angular_velocity_y",
@@ -90,7 +91,7 @@ def read_parquet(path, columns, time_column, channels=None):
     )
 
 
-def read_bag(path, fmt, columns, time_column, topic):
+def read_bag(path, fmt, columns, time_column, topic, channels=AUTO_CHANNELS):
     hl = _need("rosbags.highlevel", "ros", "ROS bags")
     bag = path.parent if (fmt == "ros2" and path.is_file()) else path
     if time_column not in (None, "header", "receive"):
@@ -120,6 +121,7 @@ def read_bag(path, fmt, columns, time_column, topic):
         elif topic not in topics:
             raise InputError(f"{path}: no sensor_msgs/Imu topic {topic!r}; Imu topics: {', '.join(topics) or 'none'}")
         conns = [c for c in imu if c.topic == topic]
+        temps = _temperature_topics(reader, channels, time_column, path)
         vals = []
         stamps = []
         for k, (con, t_recv, raw) in enumerate(reader.messages(connections=conns)):
@@ -149,6 +151,11 @@ def read_bag(path, fmt, columns, time_column, topic):
         )
     time = (ns - ns[0]).astype(np.float64) * 1e-9
     tname = "receive time" if time_column == "receive" else "header.stamp"
+    # each temperature at the Imu messages' times: linear between its own, NaN beyond them (io._channels)
+    t_ch = {
+        k: np.interp((ns - ns[0]) * 1e-9, (t - ns[0]) * 1e-9, v, left=np.nan, right=np.nan)
+        for k, (t, v) in temps.items()
+    }
     return Record(
         data=data,
         names=[names[i] for i in idx],
@@ -157,4 +164,36 @@ def read_bag(path, fmt, columns, time_column, topic):
         where=lambda r: f"message {r} on {topic}",
         time_is_seconds=True,
         t_first=float(ns[0]) * 1e-9,
+        channels=t_ch,
+        channels_recognised=isinstance(channels, str) and channels == AUTO_CHANNELS,
     )
+
+
+def _temperature_topics(reader, channels, time_column, path) -> dict:
+    """The bag's ``sensor_msgs/Temperature`` topics asked for (``"auto"``: every one; else those named; None: none)
+    as topic → (stamps in ns, temperatures), in time order."""
+    if channels is None:
+        return {}
+    found = sorted({c.topic for c in reader.connections if c.msgtype in _TEMPERATURE_TYPES})
+    if isinstance(channels, str) and channels == AUTO_CHANNELS:
+        want = found
+    else:
+        want = [channels] if isinstance(channels, str) else list(channels)
+        bad = [w for w in want if w not in found]
+        if bad:
+            raise InputError(
+                f"{path}: no sensor_msgs/Temperature topic {bad[0]!r}; a bag's channels are its Temperature "
+                f"topics: {', '.join(found) or 'none'}"
+            )
+    out = {}
+    for name in want:
+        stamps, temps = [], []
+        for con, t_recv, raw in reader.messages(connections=[c for c in reader.connections if c.topic == name]):
+            m = reader.deserialize(raw, con.msgtype)
+            st = m.header.stamp
+            sec = int(st.sec) * 1_000_000_000 + int(getattr(st, "nanosec", getattr(st, "nsec", 0)))
+            stamps.append(int(t_recv) if time_column == "receive" else sec)
+            temps.append(float(m.temperature))
+        order = np.argsort(np.asarray(stamps, dtype=np.int64), kind="stable")
+        out[name] = (np.asarray(stamps, dtype=np.int64)[order], np.asarray(temps, dtype=np.float64)[order])
+    return out

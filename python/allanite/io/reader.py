@@ -101,7 +101,10 @@ def read_log(
         InputError naming the column (a recognised channel is then left out with a warning instead). Read from
         text, Parquet, a structured ``.npy``/``.npz`` (by field name) or a plain 2-D array (by index); cut with
         the samples (the same span with ``gaps="longest"``/``"split"``, NaN at the gaps with ``gaps="nan"``).
-        Not read from ROS bags yet (``Log.channels`` stays empty).
+        ROS bags: the ``sensor_msgs/Temperature`` topics (``"auto"``: all; else topic names), each interpolated
+        linearly at the Imu messages' times (by ``header.stamp``, or the receive time with
+        ``time_column="receive"``), named by its topic; Imu messages before its first or after its last message
+        are missing values, as above.
 
     Returns
     -------
@@ -153,12 +156,7 @@ def read_log(
 
     fmt = sniff_format(path)
     if fmt in ("ros1", "ros2"):
-        if channels is not None and not (isinstance(channels, str) and channels == AUTO_CHANNELS):
-            raise ParameterError(
-                f"{path}: channels={channels!r}: channels are not read from ROS bags yet (a sensor_msgs/Temperature "
-                "topic neither); read it yourself and pass build_report(channels=…)"
-            )
-        rec = read_bag(path, fmt, columns, time_column, topic)
+        rec = read_bag(path, fmt, columns, time_column, topic, channels)
         if u is None and input == "rate":
             u = parse_unit("rad/s")  # REP 103: ROS angular velocity is in rad/s
     else:

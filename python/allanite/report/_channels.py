@@ -55,9 +55,13 @@ def log_channels(log, refine, notes: list) -> dict | None:
         return dict(log.channels)
     names = ", ".join(map(repr, log.channels))
     one = len(log.channels) == 1
+    bag = log.format in ("ros1", "ros2")  # a bag's sensor_msgs/Temperature topics, at the Imu messages' times
+    kind = "Topic" if bag else "Column"
+    what = kind if one else f"{kind}s"
+    how_found = "its type (sensor_msgs/Temperature)" if bag else "its name" if one else "their names"
     found = (
-        f"Column{'' if one else 's'} {names} {'was' if one else 'were'} recognised as a temperature by "
-        f"{'its name' if one else 'their names'}: not analysed as {'an axis' if one else 'axes'}"
+        f"{what} {names} {'was' if one else 'were'} recognised as a temperature by {how_found}: not analysed as "
+        f"{'an axis' if one else 'axes'}"
     )
     how = "--channels none (read_log(channels=None)) leaves it out, --channels C1,… chooses the channels."
     tried = () if refine is None or refine is False else ("regression",) if refine is True else refine
@@ -69,7 +73,7 @@ def log_channels(log, refine, notes: list) -> dict | None:
     used = {k: c for k, c in log.channels.items() if np.ptp(c) > 0}
     for k in log.channels:
         if k not in used:
-            notes.append(f"Column {k!r} (recognised as a temperature) is constant: not used as a channel.")
+            notes.append(f"{kind} {k!r} (recognised as a temperature) is constant: not used as a channel.")
     if used:
         notes.append(f"{found}; every axis's model refinement regresses on {'it' if one else 'them'}. {how}")
     return used or None
