@@ -339,6 +339,7 @@ def _kalibr(args, rep, progress) -> Path:
                 columns=_spec_list(args.accel_columns, "--accel-columns"),
                 time_column=_time_column(args),
                 gaps=args.gaps or "error",
+                channels=None,  # the gyro read took the channels
                 **kwargs,
             )
         accel = fit_model(avar(alog.data, alog.fs), tau_range="auto")
