@@ -103,6 +103,20 @@ def test_missing_values_are_interpolated_and_said(tmp_path):
     assert log.channels["temp"][0] == temp[1] and log.channels["temp"][-1] == temp[-2]  # the ends: held
 
 
+def test_empty_fields_of_a_channel_are_missing_values(tmp_path):
+    """A temperature written every 10th row of a CSV, the fields between empty: interpolated; an empty field in a
+    sample column still stops the reader, naming it."""
+    rows = [f"{i % 7 * 0.1:.1f},{20 + i / 100 if i % 10 == 0 else ''}" for i in range(1_000)]
+    (tmp_path / "s.csv").write_text("gx,temp\n" + "\n".join(rows) + "\n")
+    with pytest.warns(UserWarning, match=r"'temp': 900 of 1000 values missing \(NaN; the longest run 9, from line 3\)"):
+        log = allanite.read_log(tmp_path / "s.csv", fs=FS)
+    np.testing.assert_allclose(log.channels["temp"][:991], 20 + np.arange(991) / 100, rtol=1e-12)
+    assert np.all(log.channels["temp"][990:] == 29.9)  # after the last reading: held
+    (tmp_path / "g.csv").write_text("gx,temp\n0.1,20\n,20.5\n0.3,21\n")
+    with pytest.raises(InputError, match=r"line 3, column 1 \('gx'\): '\(empty\)' is not a number"):
+        allanite.read_log(tmp_path / "g.csv", fs=FS)
+
+
 @pytest.mark.parametrize(
     ("values", "message"),
     [

@@ -136,7 +136,7 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
         "channel (deg/s per unit of temp). Default: the columns whose names say temperature (temp, temperature, "
         "imu_temp, TEMP_OUT, 'T [degC]', ...: a word temp/temperature or a temperature unit in brackets, any "
         "case) — never an axis, and a channel when the report refines (--refine; they do not imply it); "
-        "'none': no channel. A channel's missing values (nan) are interpolated linearly, with a warning",
+        "'none': no channel. A channel's missing values (nan or empty) are interpolated linearly, with a warning",
     )
     inp.add_argument(
         "--accel-columns",

@@ -2,8 +2,9 @@
 their missing values filled.
 
 A channel is slow next to the samples it is read with (a temperature logged every second in a 100 Hz log, where a
-text export leaves ``nan`` in the rows between), so a missing value is filled by linear interpolation between its
-finite neighbours (before the first / after the last finite value: that value), with a warning that says how many.
+text export leaves ``nan`` or an empty field in the rows between), so a missing value is filled by linear
+interpolation between its finite neighbours (before the first / after the last finite value: that value), with a
+warning that says how many. A single missing value is always filled.
 Refused (an :class:`~allanite.errors.InputError` naming the column): an infinite value (no reading, but no gap
 either), fewer than two finite values, or a run of missing values longer than :data:`MAX_MISSING_RUN` of the record
 (interpolation would invent the channel there). A channel recognised by its name (``channels="auto"``) is left out
@@ -19,7 +20,7 @@ import numpy as np
 from ..errors import InputError
 
 #: Longest run of missing values a channel may have, as a share of the samples kept: 1 % (a 1 Hz temperature in a
-#: 100 Hz log has runs of 99 samples; at 1 % a record of 10⁴ samples already takes them).
+#: 100 Hz log has runs of 99 samples; at 1 % a record of 10⁴ samples already takes them) — and one value always.
 MAX_MISSING_RUN = 0.01
 
 
@@ -60,7 +61,7 @@ def fill_missing(path, name: str, x: np.ndarray, where) -> np.ndarray:
             "(channels=None leaves it out)"
         )
     start, run = _longest_run(miss)
-    if run > MAX_MISSING_RUN * n:
+    if run > max(1.0, MAX_MISSING_RUN * n):  # one value between two readings is always filled
         raise InputError(
             f"{path}: channel column {name!r} misses {run} values in a row from {where(start)} — more than "
             f"{100 * MAX_MISSING_RUN:g} % of the {n} samples, where interpolation would invent it; fill or cut the "

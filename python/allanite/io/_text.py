@@ -184,7 +184,7 @@ def read_text(path, columns, time_column, delimiter, gz, channels=None):
     arr = fast(doc.raw, doc.byte_offset(start), delim, ncols, parsed) if fast is not None else None
     if arr is None:  # not plain decimal rows: NumPy reads them, and a bad line is found and named
         try:
-            arr = _parse_lines(path, doc, start, delim, ncols, need, names, usecols)
+            arr = _parse_lines(path, doc, start, delim, ncols, need, names, usecols, blank=set(ch))
         except InputError as exc:
             raise _as_channel(exc, [names[i] for i in ch], channels) from None
     if arr.shape[0] == 0:
@@ -232,14 +232,22 @@ def _as_channel(exc: InputError, chans: list, channels) -> InputError:
     return InputError(f"{exc} — column {hit!r} is read as a channel{why}; channels=None leaves it out")
 
 
-def _parse_lines(path, doc, start, delim, ncols, need, names, usecols):
+def _number_or_nan(field: str) -> float:
+    """A channel's field: an empty one is a missing value (NaN), as a sparse temperature leaves in a text export."""
+    return float(field) if field.strip() else float("nan")
+
+
+def _parse_lines(path, doc, start, delim, ncols, need, names, usecols, blank=frozenset()):
     """The data rows parsed by ``np.loadtxt`` (what the core's fast parser leaves: NaN, inf, other number
-    forms, bad rows), the first bad line found and named."""
+    forms, bad rows), the first bad line found and named. An empty field of a ``blank`` column (a channel) is NaN."""
     lines = doc.lines
+    conv = {c: _number_or_nan for c in blank} if blank and delim is not None else None
     try:
-        arr = np.loadtxt(lines[start:], delimiter=delim, comments="#", usecols=usecols, ndmin=2, dtype=np.float64)
+        arr = np.loadtxt(
+            lines[start:], delimiter=delim, comments="#", usecols=usecols, ndmin=2, dtype=np.float64, converters=conv
+        )
     except (ValueError, IndexError) as exc:
-        _diagnose(path, lines, start, delim, ncols, need, names, first_line=start + 1)
+        _diagnose(path, lines, start, delim, ncols, need, names, first_line=start + 1, blank=blank)
         raise InputError(f"{path}: cannot parse the numeric data ({exc})") from None
     if usecols is not None:
         # loadtxt skips unused fields, so it cannot see ragged rows: compare the number of delimiters
@@ -263,8 +271,9 @@ def _line_of_row(lines, start, r):
     return len(lines)
 
 
-def _diagnose(path, lines, start, delim, ncols, need, names, first_line):
-    """Find the first bad line the slow, precise way and raise an InputError naming it."""
+def _diagnose(path, lines, start, delim, ncols, need, names, first_line, blank=frozenset()):
+    """Find the first bad line the slow, precise way and raise an InputError naming it (an empty field of a
+    ``blank`` column is no error)."""
     sep = "whitespace" if delim is None else repr(delim)
     for i in range(start, len(lines)):
         content = _strip_comment(lines[i])
@@ -277,6 +286,6 @@ def _diagnose(path, lines, start, delim, ncols, need, names, first_line):
                 f"{first_line} and the header have {ncols}"
             )
         for c in need:
-            if not _is_number(fields[c]):
+            if not _is_number(fields[c]) and not (c in blank and not fields[c]):
                 shown = fields[c] if fields[c] else "(empty)"
                 raise InputError(f"{path}: line {i + 1}, column {c + 1} ({names[c]!r}): {shown!r} is not a number")

@@ -96,15 +96,15 @@ def read_log(
         case-insensitive; :func:`allanite.io._columns.is_temperature`), except the time column and ``columns``;
         a name, index or list of them: those columns (never also a sample or the time column); None: none. A
         temperature-named column is never a sample column by default, with or without ``channels`` — name it in
-        ``columns`` to analyse it. A channel's missing values (NaN) are filled by linear interpolation, with a
-        warning; an infinite value, fewer than two finite ones or a run of NaN over 1 % of the samples is an
-        InputError naming the column (a recognised channel is then left out with a warning instead). Read from
-        text, Parquet, a structured ``.npy``/``.npz`` (by field name) or a plain 2-D array (by index); cut with
-        the samples (the same span with ``gaps="longest"``/``"split"``, NaN at the gaps with ``gaps="nan"``).
-        ROS bags: the ``sensor_msgs/Temperature`` topics (``"auto"``: all; else topic names), each interpolated
-        linearly at the Imu messages' times (by ``header.stamp``, or the receive time with
-        ``time_column="receive"``), named by its topic; Imu messages before its first or after its last message
-        are missing values, as above.
+        ``columns`` to analyse it. A channel's missing values (NaN, null, an empty text field) are filled by
+        linear interpolation, with a warning; an infinite value, fewer than two finite ones or a run of NaN over
+        1 % of the samples is an InputError naming the column (a recognised channel is then left out with a
+        warning instead). Read from text, Parquet, a structured ``.npy``/``.npz`` (by field name) or a plain 2-D
+        array (by index); cut with the samples (the same span with ``gaps="longest"``/``"split"``, NaN at the
+        gaps with ``gaps="nan"``). ROS bags: the ``sensor_msgs/Temperature`` topics (``"auto"``: all; else topic
+        names), each interpolated linearly at the Imu messages' times (by ``header.stamp``, or the receive time
+        with ``time_column="receive"``), named by its topic; Imu messages before its first or after its last
+        message are missing values, as above.
 
     Returns
     -------
