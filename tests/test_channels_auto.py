@@ -182,6 +182,8 @@ def test_default_report_refines_on_the_recognised_temperature(coupled, tmp_path,
     assert st["params"]["channel"] == "T [degC]"
     assert st["final_params"]["coefficient"] == pytest.approx(COEF, rel=0.2)
     assert not [st for st in gy["steps"] if st["effect"] == "regression"]
+    src = s["record"]["source"]
+    assert (src["channels"], src["channels_recognised"], src["channels_used"]) == (["T [degC]"], True, ["T [degC]"])
     (note,) = [n for n in s["notes"] if "recognised as a temperature" in n]
     assert "Column 'T [degC]' was recognised as a temperature by its name: not analysed as an axis" in note
     assert "--channels none" in note and "regresses on it" in note
@@ -192,6 +194,7 @@ def test_default_report_refines_on_the_recognised_temperature(coupled, tmp_path,
 def test_default_report_without_refine_leaves_the_temperature_out(coupled, tmp_path):
     rc, s = _report(coupled, tmp_path / "o")
     assert rc == 0 and s["record"]["axis_names"] == ["g_x", "g_y"] and s.get("refinement") is None
+    assert s["record"]["source"]["channels"] == ["T [degC]"] and s["record"]["source"]["channels_used"] == []
     assert any("not used: no refinement was asked for (--refine)" in n for n in s["notes"])
 
 
@@ -200,6 +203,7 @@ def test_channels_none_switches_it_off(coupled, tmp_path):
     assert rc == 0 and s["record"]["axis_names"] == ["g_x", "g_y"]
     assert all(st["effect"] != "regression" for ax in s["refinement"]["axes"] for st in ax["steps"])
     assert not any("recognised as a temperature" in n for n in s["notes"])
+    assert s["record"]["source"]["channels"] == [] and s["record"]["source"]["channels_used"] == []
     assert not any("passed to every axis's model refinement" in n for n in s["notes"])  # build_report's channel note
 
 

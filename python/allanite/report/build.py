@@ -540,6 +540,9 @@ def log_source(log) -> dict:
             for g in log.gaps
         ],
         "jitter": json_number(log.jitter),
+        # the log's other channels (from_log adds which ones the refinement used: "channels_used")
+        "channels": list(log.channels),
+        "channels_recognised": bool(log.channels_recognised),
     }
     if log.segment_spans is not None:
         src["segments"] = [[int(a), int(b)] for a, b in log.segment_spans]
@@ -571,13 +574,15 @@ def from_log(log, **kwargs) -> Report:
     unit = kwargs.pop("unit", None) or (log.unit.name if log.unit is not None else None)
     if "channels" not in kwargs:  # the log's own: a temperature column recognised by its name, or those named
         kwargs["channels"] = log_channels(log, kwargs.get("refine", False), notes)
+    used = kwargs["channels"]  # build_report checks it (a mapping of name → samples)
+    source = dict(log_source(log), channels_used=[str(k) for k in used] if isinstance(used, dict) else [])
     return build_report(
         log.data,
         log.fs,
         unit=unit,
         input=log.input,
         axis_names=list(log.columns),
-        source=log_source(log),
+        source=source,
         notes=notes,
         **kwargs,
     )
