@@ -67,6 +67,8 @@ def test_read_log_takes_a_temperature_column_as_a_channel_not_an_axis(tmp_path):
     assert off.columns == ["g_x", "g_y"] and off.channels == {}
     named = allanite.read_log(path, fs=FS, columns=["g_x", "T [degC]"])  # asked for as a sample column: it is one
     assert named.columns == ["g_x", "T [degC]"] and named.channels == {}
+    chosen = allanite.read_log(path, fs=FS, columns=["g_x"])  # sample columns chosen: the temperature still found
+    assert chosen.columns == ["g_x"] and list(chosen.channels) == ["T [degC]"]
     by_index = allanite.read_log(path, fs=FS, columns=[0], channels=[1])  # any column, by index
     assert by_index.columns == ["g_x"] and list(by_index.channels) == ["g_y"] and not by_index.channels_recognised
     with pytest.raises(ParameterError, match="column 'g_x' is both a sample column and a channel"):
