@@ -100,8 +100,10 @@ def refine(
             accelerometers): the rate is regressed on each ("regression" effect; band by band where the
             coupling differs across frequency, the bands in the step's ``evidence["bands"]``).
         level : float
-            False-alarm probability per record on a clean record (default 0.05), split between spectral
-            lines, the Allan-curve test and change points.
+            False-alarm probability per record on a clean record (default 0.05), split between every
+            calibrated test (:mod:`allanite.model.refinement.levels`): spectral lines, change points, the
+            outliers, drift and regression removals, the checks behind ``unexplained`` and the Allan-curve
+            test, which takes what the others leave.
         progress : bool, optional
             A ``tqdm.auto`` bar: None (default) in a notebook or a terminal only, True/False always/never.
         truth : dict, optional
@@ -528,7 +530,8 @@ def _component_name(st: Step) -> str:
     return st.effect if st.effect != "regression" else f"regression_{st.params['channel']}"
 
 
-refine.__doc__ = (refine.__doc__ or "").replace("{effects}", describe())
+# the registry's list under ``candidates``: every item indented as that parameter's description (12 here)
+refine.__doc__ = (refine.__doc__ or "").replace("    {effects}", describe(" " * 12))
 
 
 def _say_heldout_rise(st: Step, rem: Removal) -> None:
