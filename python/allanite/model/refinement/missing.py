@@ -180,21 +180,24 @@ def _curve(ctx: MissingContext, a: float) -> list[dict]:
             continue  # a column the residual leans on where the curve itself is within its scatter
         if _merged(ctx, out, lo, hi, float(stats[c])):
             continue
-        out.append(
-            {
-                "domain": "allan",
-                "tau": (lo, hi),
-                "band_hz": None if ctx.y is None else _band(ctx, lo, hi),
-                "chi2_dof": _chi2_dof(ctx, lo, hi),
-                "what": "the Allan curve departs from the model",
-                "statistic": float(stats[c]),
-                "threshold": thr,
-                "alpha": a,
-            }
-        )
+        out.append(_allan_region(ctx, lo, hi, "the Allan curve departs from the model", float(stats[c]), thr, a))
     if out:  # the test rejected the model: say too where the curve's largest misfits are
         _misfit_runs(ctx, out, thr, a)
     return out
+
+
+def _allan_region(ctx: MissingContext, lo: float, hi: float, what: str, statistic: float, thr: float, a: float) -> dict:
+    """An ``"allan"`` entry of ``unexplained``: the τ region, its band (with samples), χ²/dof there, in words."""
+    return {
+        "domain": "allan",
+        "tau": (lo, hi),
+        "band_hz": None if ctx.y is None else _band(ctx, lo, hi),
+        "chi2_dof": _chi2_dof(ctx, lo, hi),
+        "what": what,
+        "statistic": statistic,
+        "threshold": thr,
+        "alpha": a,
+    }
 
 
 def _misfit_runs(ctx: MissingContext, out: list[dict], thr: float, a: float) -> None:
@@ -220,19 +223,8 @@ def _misfit_runs(ctx: MissingContext, out: list[dict], thr: float, a: float) -> 
             break
         if any(lo < reg["tau"][1] and reg["tau"][0] < hi for reg in out):
             continue
-        above = z[i] < 0
-        out.append(
-            {
-                "domain": "allan",
-                "tau": (lo, hi),
-                "band_hz": None if ctx.y is None else _band(ctx, lo, hi),
-                "chi2_dof": _chi2_dof(ctx, lo, hi),
-                "what": "the model lies above the Allan curve" if above else "the Allan curve lies above the model",
-                "statistic": chi2,
-                "threshold": thr,
-                "alpha": a,
-            }
-        )
+        what = "the model lies above the Allan curve" if z[i] < 0 else "the Allan curve lies above the model"
+        out.append(_allan_region(ctx, lo, hi, what, chi2, thr, a))
 
 
 def _merged(ctx: MissingContext, out: list[dict], lo: float, hi: float, stat: float) -> bool:
