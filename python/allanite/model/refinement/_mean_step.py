@@ -184,10 +184,9 @@ def mean_step_check(ctx: Any, a: float) -> list[dict]:
         + ("" if ctx.heldout_pct is None else f"; held-out error {ctx.heldout_pct:.2g} %")
         + ")"
     )
-    sel = (tau >= lo * (1 - 1e-9)) & (tau <= hi * (1 + 1e-9))
     return [
         {"domain": "mean", "tau": (lo, hi), "t": (t_step, y.size / fs), "band_hz": (0.5 / hi, 0.5 / lo)}
-        | {"chi2_dof": float(np.mean(ctx.sol.z[sel] ** 2)), "what": what, "step": loc["d"], "t_step": t_step}
+        | {"chi2_dof": ctx.sol.chi2_dof_between(tau, lo, hi), "what": what, "step": loc["d"], "t_step": t_step}
         | {"departure_pct": float(dep[i_top]), "heldout_pct": ctx.heldout_pct}
         | {"statistic": loc["statistic"], "threshold": thr, "alpha": a}
     ]

@@ -177,6 +177,12 @@ class Solution:
         """χ² scaled to the curve's effective number of independent points (``curve.n_eff`` of its τ)."""
         return self.chi2 * curve.n_eff / curve.tau.size
 
+    def chi2_dof_between(self, tau: np.ndarray, lo: float, hi: float) -> float:
+        """Mean z² over the τ of the fitted curve (``tau``) in [lo, hi] (ends taken within 10⁻⁹ relative, as
+        regions are given by their τ): an ``unexplained`` region's χ²/dof; NaN where no τ lies there."""
+        z = self.z[(tau >= lo * (1 - 1e-9)) & (tau <= hi * (1 + 1e-9))]
+        return float(np.mean(z**2)) if z.size else float("nan")
+
 
 def design(curve, terms, effects):
     """Columns of the terms and the effects [(key, nonlinear parameter)] on ``curve``, and each column's

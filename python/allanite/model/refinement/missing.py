@@ -142,9 +142,7 @@ def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
 
 
 def _chi2_dof(ctx: MissingContext, lo: float, hi: float) -> float:
-    sel = (ctx.curve.tau >= lo * (1 - 1e-9)) & (ctx.curve.tau <= hi * (1 + 1e-9))
-    z = ctx.sol.z[sel]
-    return float(np.mean(z**2)) if z.size else float("nan")
+    return ctx.sol.chi2_dof_between(ctx.curve.tau, lo, hi)
 
 
 def allan_family(sub: Curve, start: tuple, has_samples: bool) -> np.ndarray:
