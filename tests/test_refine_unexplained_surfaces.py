@@ -139,3 +139,27 @@ def test_a_regions_chi2_dof_is_the_mean_z2_over_its_tau_ends_included():
     assert sol.chi2_dof_between(tau, 0.02 * (1 + 5e-10), 0.08 * (1 - 5e-10)) == pytest.approx((4 + 9 + 16) / 3)
     assert sol.chi2_dof_between(tau, 0.16, 0.16) == pytest.approx(25.0)
     assert np.isnan(sol.chi2_dof_between(tau, 0.05, 0.07))
+
+
+def test_the_passing_sentence_names_every_check_of_unexplained():
+    """ "Passes every calibrated check (…)" lists what was checked: a check with a share of ``level`` and no
+    words here would pass unsaid (the sentence once lacked the line and steps checks)."""
+    from allanite.model.refinement.levels import UNEXPLAINED_SHARES
+
+    words = {
+        "allan": "the Allan-curve score test",
+        "psd": "lines in the PSD",
+        "line": "an accepted line's amplitude along the record",
+        "time": "a drift",
+        "mean": "steps of the mean",
+        "steps": "steps of the mean",
+        "level": "the noise level along the record",
+        "channels": "the channels",
+        "outliers": "outliers",
+        "clipped": "clipped or repeated samples",
+        "held": "clipped or repeated samples",
+    }
+    assert set(words) == set(UNEXPLAINED_SHARES)
+    text = passes_sentence(0.05)
+    assert [k for k, w in words.items() if w not in text] == []
+    assert "two-sided GLS χ²" in text and "0.65 %" in text

@@ -52,9 +52,9 @@ def passes_sentence(level: float) -> str:
     """What is said when ``unexplained`` is empty: the final model passes the checks, at their level."""
     return (
         "The final model passes every calibrated check of what it may still miss (the Allan-curve score test "
-        "and, with samples, lines in the PSD, a drift, a step of the mean, the noise level along the record, the "
-        "channels, outliers, and clipped or repeated samples; without, the whole curve's two-sided GLS χ²) at a "
-        "false-alarm probability "
+        "and, with samples, lines in the PSD, an accepted line's amplitude along the record, a drift, steps of "
+        "the mean, the noise level along the record, the channels, outliers, and clipped or repeated samples; "
+        "without, the whole curve's two-sided GLS χ²) at a false-alarm probability "
         f"of {100 * checks_alpha(level):.3g} % per record together (their share of level {level:g})."
     )
 
