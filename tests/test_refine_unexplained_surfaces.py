@@ -128,17 +128,16 @@ def test_a_clean_record_passes_on_every_surface():
 
 
 def test_a_regions_chi2_dof_is_the_mean_z2_over_its_tau_ends_included():
-    """Every check's entry takes χ²/dof over its τ region from one place (``Solution.chi2_dof_between``): the
+    """Every check's entry takes χ²/dof over its τ region from one place (``curvefit.chi2_dof_between``): the
     region's ends are τ of the curve itself, so they are in, to 10⁻⁹ relative (a τ re-read from a float)."""
-    from allanite.model.refinement.curvefit import Solution
+    from allanite.model.refinement.curvefit import chi2_dof_between
 
     tau = np.array([0.01, 0.02, 0.04, 0.08, 0.16])
     z = np.array([1.0, 2.0, 3.0, 4.0, 5.0])
-    sol = Solution(np.zeros(1), np.ones(5), np.ones(5), z, 55.0, 4, np.ones((5, 1)), np.eye(1))
-    assert sol.chi2_dof_between(tau, 0.02, 0.08) == pytest.approx((4 + 9 + 16) / 3)
-    assert sol.chi2_dof_between(tau, 0.02 * (1 + 5e-10), 0.08 * (1 - 5e-10)) == pytest.approx((4 + 9 + 16) / 3)
-    assert sol.chi2_dof_between(tau, 0.16, 0.16) == pytest.approx(25.0)
-    assert np.isnan(sol.chi2_dof_between(tau, 0.05, 0.07))
+    assert chi2_dof_between(tau, z, 0.02, 0.08) == pytest.approx((4 + 9 + 16) / 3)
+    assert chi2_dof_between(tau, z, 0.02 * (1 + 5e-10), 0.08 * (1 - 5e-10)) == pytest.approx((4 + 9 + 16) / 3)
+    assert chi2_dof_between(tau, z, 0.16, 0.16) == pytest.approx(25.0)
+    assert np.isnan(chi2_dof_between(tau, z, 0.05, 0.07))
 
 
 def test_the_passing_sentence_names_every_check_of_unexplained():

@@ -29,7 +29,7 @@ import numpy as np
 
 from ...analysis import avar
 from ..tracing import block_means, simulated_block_means
-from .curvefit import Curve, solve, theta_terms, upper_theta
+from .curvefit import Curve, chi2_dof_between, solve, theta_terms, upper_theta
 
 __all__ = [
     "MEAN_BLOCKS",
@@ -186,7 +186,7 @@ def mean_step_check(ctx: Any, a: float) -> list[dict]:
     )
     return [
         {"domain": "mean", "tau": (lo, hi), "t": (t_step, y.size / fs), "band_hz": (0.5 / hi, 0.5 / lo)}
-        | {"chi2_dof": ctx.sol.chi2_dof_between(tau, lo, hi), "what": what, "step": loc["d"], "t_step": t_step}
+        | {"chi2_dof": chi2_dof_between(tau, ctx.sol.z, lo, hi), "what": what, "step": loc["d"], "t_step": t_step}
         | {"departure_pct": float(dep[i_top]), "heldout_pct": ctx.heldout_pct}
         | {"statistic": loc["statistic"], "threshold": thr, "alpha": a}
     ]

@@ -35,6 +35,7 @@ __all__ = [
     "column",
     "Curve",
     "Solution",
+    "chi2_dof_between",
     "design",
     "solve",
     "chi2s",
@@ -177,11 +178,13 @@ class Solution:
         """χ² scaled to the curve's effective number of independent points (``curve.n_eff`` of its τ)."""
         return self.chi2 * curve.n_eff / curve.tau.size
 
-    def chi2_dof_between(self, tau: np.ndarray, lo: float, hi: float) -> float:
-        """Mean z² over the τ of the fitted curve (``tau``) in [lo, hi] (ends taken within 10⁻⁹ relative, as
-        regions are given by their τ): an ``unexplained`` region's χ²/dof; NaN where no τ lies there."""
-        z = self.z[(tau >= lo * (1 - 1e-9)) & (tau <= hi * (1 + 1e-9))]
-        return float(np.mean(z**2)) if z.size else float("nan")
+
+def chi2_dof_between(tau: np.ndarray, z: np.ndarray, lo: float, hi: float) -> float:
+    """Mean z² (a fit's normalised residuals ``z`` on the curve's ``tau``) over the τ in [lo, hi], the ends taken
+    within 10⁻⁹ relative (regions are given by their τ): an ``unexplained`` region's χ²/dof; NaN where no τ lies
+    there."""
+    z = z[(tau >= lo * (1 - 1e-9)) & (tau <= hi * (1 + 1e-9))]
+    return float(np.mean(z**2)) if z.size else float("nan")
 
 
 def design(curve, terms, effects):

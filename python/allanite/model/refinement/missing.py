@@ -76,7 +76,7 @@ from ._quality import clipped_check, held_check
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
 from .changes import locate
-from .curvefit import Curve, Solution, base_name, theta_terms, upper_theta
+from .curvefit import Curve, Solution, base_name, chi2_dof_between, theta_terms, upper_theta
 from .levels import alpha
 from .scoring import MATERIAL_Z, curve_change_z
 from .words import span_text
@@ -142,7 +142,7 @@ def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
 
 
 def _chi2_dof(ctx: MissingContext, lo: float, hi: float) -> float:
-    return ctx.sol.chi2_dof_between(ctx.curve.tau, lo, hi)
+    return chi2_dof_between(ctx.curve.tau, ctx.sol.z, lo, hi)
 
 
 def allan_family(sub: Curve, start: tuple, has_samples: bool) -> np.ndarray:
