@@ -515,11 +515,14 @@ def _coefficients(sol, terms, effects, unit, zq, inflate) -> tuple[dict, np.ndar
     for j, (key, _param) in enumerate(effects):
         i = k + j
         name = effect_column_name(key, j, effects)
+        # a column's amplitude is in the rate unit (σ, A), but a bandwidth's is the white noise N before the
+        # filter: N's unit (rate unit·√s), not the rate unit
+        n_unit = EFFECTS[base_name(key)].replaces == "N" and "N" in coeffs
         coeffs[name] = fitting.Coefficient(
             name=name,
             value=float(math.sqrt(max(sol.theta[i], 0.0))),
             ci=fitting.interval(sol.theta[i], sol.cov[i, i], zq, inflate),
-            unit=unit,
+            unit=coeffs["N"].unit if n_unit else unit,
         )
     return coeffs, theta, cov
 
