@@ -30,6 +30,7 @@ import numpy as np
 from ...analysis import avar
 from ..tracing import block_means, simulated_block_means
 from .curvefit import Curve, chi2_dof_between, solve, theta_terms, upper_theta
+from .words import heldout_clause
 
 __all__ = [
     "MEAN_BLOCKS",
@@ -180,9 +181,7 @@ def mean_step_check(ctx: Any, a: float) -> list[dict]:
     unit = f" {ctx.unit}" if ctx.unit else ""
     what = (
         f"the mean steps by {loc['d']:.2g}{unit} at t ≈ {t_step:.6g} s (it raises the Allan deviation by "
-        f"{_pct(float(dep[i_top]))} % at τ {float(tau[i_top]):.4g} s"
-        + ("" if ctx.heldout_pct is None else f"; held-out error {ctx.heldout_pct:.2g} %")
-        + ")"
+        f"{_pct(float(dep[i_top]))} % at τ {float(tau[i_top]):.4g} s" + heldout_clause(ctx.heldout_pct) + ")"
     )
     return [
         {"domain": "mean", "tau": (lo, hi), "t": (t_step, y.size / fs), "band_hz": (0.5 / hi, 0.5 / lo)}

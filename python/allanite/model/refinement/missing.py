@@ -79,7 +79,7 @@ from .changes import locate
 from .curvefit import Curve, Solution, base_name, chi2_dof_between, theta_terms, upper_theta
 from .levels import alpha
 from .scoring import MATERIAL_Z, curve_change_z
-from .words import span_text
+from .words import heldout_clause, span_text
 
 __all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS", "allan_family"]
 
@@ -424,7 +424,7 @@ def _level(ctx: MissingContext, a: float) -> list[dict]:
         what = (
             f"the noise level changes along the record: {ratio:.2f}× the Allan deviation at τ₀ of "
             f"t {span_text(*lo_side)} s ({departure:.2g} % off the record's level"
-            + ("" if ctx.heldout_pct is None else f"; held-out error {ctx.heldout_pct:.2g} %")
+            + heldout_clause(ctx.heldout_pct)
             + ")"
         )
         out.append(

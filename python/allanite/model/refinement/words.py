@@ -12,12 +12,23 @@ import math
 
 from .levels import UNEXPLAINED_SHARES
 
-__all__ = ["describe_region", "missing_sentences", "passes_sentence", "checks_alpha", "span_text"]
+__all__ = ["describe_region", "missing_sentences", "passes_sentence", "checks_alpha", "span_text", "heldout_clause"]
 
 
 def checks_alpha(level: float) -> float:
     """The false-alarm probability per record that the checks of what is still missing spend together."""
     return level * sum(UNEXPLAINED_SHARES.values())
+
+
+def heldout_clause(pct: float | None) -> str:
+    """The closing words of an entry judged against the final model's held-out error (none without one).
+
+    Examples
+    --------
+    >>> heldout_clause(4.567), heldout_clause(None)
+    ('; held-out error 4.6 %', '')
+    """
+    return "" if pct is None else f"; held-out error {pct:.2g} %"
 
 
 def describe_region(reg: dict) -> str:
