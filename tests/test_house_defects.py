@@ -145,6 +145,20 @@ def test_refine_help_lists_every_candidate_with_parameters_and_units():
             assert f"``{name}`` ({unit})" in doc
 
 
+def test_refine_help_lists_every_candidate_under_the_candidates_parameter():
+    """help() and the numpydoc parse see the effects as one list inside ``candidates``'s description: every
+    item indented alike, deeper than the parameter names (the registry's lines were once indented 8 where the
+    docstring's placeholder stood at 4, so all but the first fell out to the parameters' column)."""
+    import inspect
+
+    lines = inspect.getdoc(allanite.refine).splitlines()
+    items = [ln for ln in lines if ln.lstrip().startswith("- ``'")]
+    assert len(items) == len(allanite.model.EFFECTS)
+    assert {len(ln) - len(ln.lstrip()) for ln in items} == {4}
+    start, end = lines.index("candidates : tuple of str"), lines.index("unit : str, optional")
+    assert all(start < lines.index(ln) < end for ln in items)
+
+
 # 7. coefficient series with unresolved windows ----------------------------------------------------
 
 

@@ -264,3 +264,18 @@ def test_adis_run1_z_renders_every_param_everywhere(adis_run1_z):
         said = term_move_text(m, "deg/s")
         assert said in text and str(escape(said)) in html and str(escape(said)) in page
         assert said.startswith(f"{m['term']} ({TERM_NAMES[m['term']]}) is ") and "moved by step" in said
+
+
+def test_the_final_fits_bandwidth_amplitude_is_n_in_ns_unit():
+    """``Refinement.fit`` holds each curve effect's amplitude; a bandwidth's is the white noise N before the
+    filter (the N row's value), so it is in N's unit — issue 29 found it "repeated under 'bandwidth' in deg/s"."""
+    from scipy.signal import lfilter
+
+    y = allanite.simulate(200_000, FS, N=2e-3, K=2e-5, seed=3)
+    a = math.exp(-2 * math.pi * 8.0 / FS)
+    r = allanite.refine(lfilter([1 - a], [1, -a], y), FS, unit="deg/s", candidates=("bandwidth",))
+    assert r.found == ["bandwidth"]
+    bw, n = r.fit.coefficients["bandwidth"], r.fit.coefficients["N"]
+    assert bw.unit == n.unit == "deg/√s" and bw.value == pytest.approx(n.value, rel=1e-12)
+    assert bw.value == pytest.approx(2e-3, rel=0.02)
+    assert "bandwidth = " in repr(r.fit) and "deg/s [" not in repr(bw)

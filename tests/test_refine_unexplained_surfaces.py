@@ -125,3 +125,40 @@ def test_a_clean_record_passes_on_every_surface():
     assert passes_sentence(0.05) in page and passes_sentence(0.05) in r.report()
     assert "The model still misses something" not in text + page + r.report()
     assert "nothing added: the starting model passes every calibrated check" in html_mod.unescape(r._repr_html_())
+
+
+def test_a_regions_chi2_dof_is_the_mean_z2_over_its_tau_ends_included():
+    """Every check's entry takes χ²/dof over its τ region from one place (``curvefit.chi2_dof_between``): the
+    region's ends are τ of the curve itself, so they are in, to 10⁻⁹ relative (a τ re-read from a float)."""
+    from allanite.model.refinement.curvefit import chi2_dof_between
+
+    tau = np.array([0.01, 0.02, 0.04, 0.08, 0.16])
+    z = np.array([1.0, 2.0, 3.0, 4.0, 5.0])
+    assert chi2_dof_between(tau, z, 0.02, 0.08) == pytest.approx((4 + 9 + 16) / 3)
+    assert chi2_dof_between(tau, z, 0.02 * (1 + 5e-10), 0.08 * (1 - 5e-10)) == pytest.approx((4 + 9 + 16) / 3)
+    assert chi2_dof_between(tau, z, 0.16, 0.16) == pytest.approx(25.0)
+    assert np.isnan(chi2_dof_between(tau, z, 0.05, 0.07))
+
+
+def test_the_passing_sentence_names_every_check_of_unexplained():
+    """ "Passes every calibrated check (…)" lists what was checked: a check with a share of ``level`` and no
+    words here would pass unsaid (the sentence once lacked the line and steps checks)."""
+    from allanite.model.refinement.levels import UNEXPLAINED_SHARES
+
+    words = {
+        "allan": "the Allan-curve score test",
+        "psd": "lines in the PSD",
+        "line": "an accepted line's amplitude along the record",
+        "time": "a drift",
+        "mean": "steps of the mean",
+        "steps": "steps of the mean",
+        "level": "the noise level along the record",
+        "channels": "the channels",
+        "outliers": "outliers",
+        "clipped": "clipped or repeated samples",
+        "held": "clipped or repeated samples",
+    }
+    assert set(words) == set(UNEXPLAINED_SHARES)
+    text = passes_sentence(0.05)
+    assert [k for k, w in words.items() if w not in text] == []
+    assert "two-sided GLS χ²" in text and "0.65 %" in text

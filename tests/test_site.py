@@ -170,6 +170,38 @@ def test_docstring_citations_link_to_the_formula_sheet(site):
         assert f'id="{anchor}"' in html, anchor
 
 
+def test_refines_entry_lists_every_effect_under_candidates(site):
+    """refine's docstring lists the effects registry at import time; the reference reads the source, so its
+    extension fills the same list in (``docs/_site/griffe_roles.fill_effects``) — once a literal ``{effects}``
+    line, whose lower indentation also turned the whole parameter list into a code block."""
+    import allanite
+
+    html = (site / "api" / "allanite.model.refinement.loop.html").read_text(encoding="utf-8")
+    assert "{effects}" not in html
+    for name in allanite.model.EFFECTS:
+        assert f"&#39;{name}&#39;" in html or f"'{name}'" in html, name
+    # the parameters after the list are parsed as parameters (a table row each), not shown as text
+    for param in ("x_or_result", "candidates", "unit", "level", "progress"):
+        assert re.search(rf"<code>{param}</code>", html), param
+
+
+def test_fill_effects_puts_the_registry_at_the_placeholders_indentation():
+    sys.path.insert(0, str(SITE_TOOLS))
+    try:
+        from griffe_roles import fill_effects
+    finally:
+        sys.path.remove(str(SITE_TOOLS))
+    import allanite
+
+    filled = fill_effects(
+        "Parameters\n----------\ncandidates : tuple\n    Effects:\n\n    {effects}\nunit : str\n    Unit."
+    )
+    items = [ln for ln in filled.splitlines() if ln.lstrip().startswith("- ``'")]
+    assert len(items) == len(allanite.model.EFFECTS) and all(ln.startswith("    - ") for ln in items)
+    assert filled.splitlines()[-2:] == ["unit : str", "    Unit."]
+    assert fill_effects("no placeholder") == "no placeholder"
+
+
 def test_the_site_links_are_relative(site):
     for page in (site / "index.html", site / "docs" / "guide.html", site / "api" / "allanite.analysis.html"):
         html = page.read_text(encoding="utf-8")

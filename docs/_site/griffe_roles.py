@@ -29,6 +29,18 @@ def sheet_anchors(text: str) -> dict[str, str]:
     return {m.group(2): slugify(m.group(1).strip(), "-") for m in _HEADING.finditer(text)}
 
 
+def fill_effects(text: str) -> str:
+    """A docstring's ``{effects}`` line (``refine``'s ``candidates``) as the effects registry's list, indented as
+    that line: the list ``help(refine)`` shows, filled at import time (``model/refinement/loop.py``), which a
+    static read of the source does not see. Reads the registry from the installed package."""
+    line = next((ln for ln in text.splitlines() if ln.strip() == "{effects}"), None)
+    if line is None:
+        return text
+    from allanite.model.effects import describe  # the registry: what refine tries, at run time
+
+    return text.replace(line, describe(line[: len(line) - len(line.lstrip())]))
+
+
 class SphinxRoles(griffe.Extension):
     """Rewrite roles and formula-sheet citations in every docstring, once the package is loaded."""
 
@@ -42,7 +54,7 @@ class SphinxRoles(griffe.Extension):
 
     def _walk(self, obj: griffe.Object, loader: griffe.GriffeLoader) -> None:
         if obj.docstring is not None:
-            obj.docstring.value = self.rewrite(obj.docstring.value, obj, loader)
+            obj.docstring.value = self.rewrite(fill_effects(obj.docstring.value), obj, loader)
         for member in obj.members.values():
             if not member.is_alias:
                 self._walk(member, loader)

@@ -353,9 +353,10 @@ EFFECTS: dict[str, Effect] = {
             "curve",
             (("amplitude", "rate unit", "amplitude A of the rate sinusoid"), ("f0", "Hz", "frequency f0")),
             "rate sinusoid A·sin(2πf0t): A²·sin⁴(πf0τ)/(πf0τ)², nulls at τ = k/f0. With samples it is found as a "
-            "line of the Welch PSD (a bin above its neighbours' median beyond the χ² quantile of the Welch "
-            "average, Bonferroni over the bins), f0 refined on the periodogram, A from the line's power over its "
-            "width (held in every fit of the curve; the least-squares A at f0 in evidence['coherent_amplitude']); "
+            "line of the Welch PSD (a bin above its neighbours' median beyond the F quantile of the Welch "
+            "average against that median, Bonferroni over the bins), f0 refined on the periodogram, A from the "
+            "line's power over its width (held in every fit of the curve; the least-squares A at f0 in "
+            "evidence['coherent_amplitude']); "
             "on a curve only, f0 ≥ 2/τ_max so that two nulls fall inside it",
             signature=lambda tau, f0, fs: sinusoid_avar(tau, f0, fs),
             alpha=lambda tau, f0: np.zeros(np.asarray(tau).size, dtype=int),
@@ -499,12 +500,13 @@ EFFECTS: dict[str, Effect] = {
 }
 
 
-def describe() -> str:
-    """The candidates as a numpydoc-style list: name, parameters with units, what each is."""
+def describe(indent: str = "        ") -> str:
+    """The candidates as a numpydoc-style list: name, parameters with units, what each is; every item
+    ``indent``-ed alike (in a docstring, the list under its parameter's description)."""
     lines = []
     for e in EFFECTS.values():
         params = ", ".join(f"``{n}`` ({u})" for n, u, _ in e.params)
-        lines.append(f"        - ``{e.name!r}`` — {params}: {e.description}.")
+        lines.append(f"{indent}- ``{e.name!r}`` — {params}: {e.description}.")
     return "\n".join(lines)
 
 

@@ -31,7 +31,7 @@ import numpy as np
 
 from ._line_constancy import MAX_BLOCKS, MIN_PERIODS, block_phasors, line_constancy
 from .curvefit import base_name
-from .words import span_text
+from .words import heldout_clause, span_text
 
 __all__ = ["line_check", "tested_lines"]
 
@@ -130,7 +130,7 @@ def line_check(ctx: Any, a: float) -> list[dict]:
 
 
 def _tail(ctx: Any, dep: float, tau: float) -> str:
-    held = "" if ctx.heldout_pct is None else f"; held-out error {ctx.heldout_pct:.2g} %"
+    held = heldout_clause(ctx.heldout_pct)
     size = f"{dep:.2g}" if dep < 100 else f"{dep:.0f}"
     return f"{size} % of the Allan deviation at τ {tau:.3g} s{held})"
 

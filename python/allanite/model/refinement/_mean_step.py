@@ -29,7 +29,8 @@ import numpy as np
 
 from ...analysis import avar
 from ..tracing import block_means, simulated_block_means
-from .curvefit import Curve, solve, theta_terms, upper_theta
+from .curvefit import Curve, chi2_dof_between, solve, theta_terms, upper_theta
+from .words import heldout_clause
 
 __all__ = [
     "MEAN_BLOCKS",
@@ -180,14 +181,11 @@ def mean_step_check(ctx: Any, a: float) -> list[dict]:
     unit = f" {ctx.unit}" if ctx.unit else ""
     what = (
         f"the mean steps by {loc['d']:.2g}{unit} at t ≈ {t_step:.6g} s (it raises the Allan deviation by "
-        f"{_pct(float(dep[i_top]))} % at τ {float(tau[i_top]):.4g} s"
-        + ("" if ctx.heldout_pct is None else f"; held-out error {ctx.heldout_pct:.2g} %")
-        + ")"
+        f"{_pct(float(dep[i_top]))} % at τ {float(tau[i_top]):.4g} s" + heldout_clause(ctx.heldout_pct) + ")"
     )
-    sel = (tau >= lo * (1 - 1e-9)) & (tau <= hi * (1 + 1e-9))
     return [
         {"domain": "mean", "tau": (lo, hi), "t": (t_step, y.size / fs), "band_hz": (0.5 / hi, 0.5 / lo)}
-        | {"chi2_dof": float(np.mean(ctx.sol.z[sel] ** 2)), "what": what, "step": loc["d"], "t_step": t_step}
+        | {"chi2_dof": chi2_dof_between(tau, ctx.sol.z, lo, hi), "what": what, "step": loc["d"], "t_step": t_step}
         | {"departure_pct": float(dep[i_top]), "heldout_pct": ctx.heldout_pct}
         | {"statistic": loc["statistic"], "threshold": thr, "alpha": a}
     ]

@@ -170,22 +170,25 @@ def _with_stat(rnd: Round, key: str, p: float, sol: Solution, edge: bool, bump: 
 # ---- Gauss–Markov
 
 
-def _gm_grid(tmin, tmax):
-    grid = EFFECTS["gauss_markov"].search
+def _grid(effect: str, tmin, tmax):
+    """The registry's search grid of a curve effect's nonlinear parameter over the τ range [tmin, tmax]."""
+    grid = EFFECTS[effect].search
     assert grid is not None
     return grid(tmin, tmax)
 
 
 def _gm_family(sub: Curve, has_samples: bool) -> list:
-    return [column("gauss_markov", p, sub) for p in _gm_grid(sub.tau[0], sub.tau[-1])]
+    return [column("gauss_markov", p, sub) for p in _grid("gauss_markov", sub.tau[0], sub.tau[-1])]
 
 
 def _gm_searches(rnd: Round) -> list:
-    return [("gauss_markov", _gm_grid(rnd.tmin, rnd.tmax), True)]
+    return [("gauss_markov", _grid("gauss_markov", rnd.tmin, rnd.tmax), True)]
 
 
 def _gm_propose(rnd: Round) -> list:
-    p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, "gauss_markov", _gm_grid(rnd.tmin, rnd.tmax))
+    p, s_new, edge = search(
+        rnd.curve, rnd.start, rnd.effects, "gauss_markov", _grid("gauss_markov", rnd.tmin, rnd.tmax)
+    )
     return [_with_stat(rnd, "gauss_markov", p, s_new, edge)]
 
 
@@ -303,19 +306,13 @@ def _bw_evidence(pr: Proposal, rnd: Round) -> dict:
 # ---- resonance
 
 
-def _res_grid(tmin, tmax):
-    grid = EFFECTS["resonance"].search
-    assert grid is not None
-    return grid(tmin, tmax)
-
-
 def _res_family(sub: Curve, has_samples: bool) -> list:
-    grid = _res_grid(sub.tau[0], sub.tau[-1])
+    grid = _grid("resonance", sub.tau[0], sub.tau[-1])
     return [column(f"resonance:{q:g}", p, sub) for q in RESONANCE_Q for p in grid]
 
 
 def _res_searches(rnd: Round) -> list:
-    return [(f"resonance:{q:g}", _res_grid(rnd.tmin, rnd.tmax), True) for q in RESONANCE_Q]
+    return [(f"resonance:{q:g}", _grid("resonance", rnd.tmin, rnd.tmax), True) for q in RESONANCE_Q]
 
 
 def _res_propose(rnd: Round) -> list:
@@ -338,24 +335,18 @@ def _res_params(pr: Proposal, rnd: Round) -> tuple:
 # ---- sinusoid
 
 
-def _sin_grid(tmin, tmax):
-    grid = EFFECTS["sinusoid"].search
-    assert grid is not None
-    return grid(tmin, tmax)
-
-
 def _sin_family(sub: Curve, has_samples: bool) -> list:
     # with samples a sinusoid is found in the PSD (its own test), not on the curve
-    return [] if has_samples else [column("sinusoid", p, sub) for p in _sin_grid(sub.tau[0], sub.tau[-1])]
+    return [] if has_samples else [column("sinusoid", p, sub) for p in _grid("sinusoid", sub.tau[0], sub.tau[-1])]
 
 
 def _sin_searches(rnd: Round) -> list:
-    return [("sinusoid", _sin_grid(rnd.tmin, rnd.tmax), True)] if rnd.y is None else []
+    return [("sinusoid", _grid("sinusoid", rnd.tmin, rnd.tmax), True)] if rnd.y is None else []
 
 
 def _sin_propose(rnd: Round) -> list:
     if rnd.y is None:
-        p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, "sinusoid", _sin_grid(rnd.tmin, rnd.tmax))
+        p, s_new, edge = search(rnd.curve, rnd.start, rnd.effects, "sinusoid", _grid("sinusoid", rnd.tmin, rnd.tmax))
         return [_with_stat(rnd, "sinusoid", p, s_new, edge)]
     done_f = [p for k, p in rnd.effects if base_name(k) == "sinusoid"]
     # a line's power is taken over its width: a line inside a taken one's width is part of it
@@ -527,12 +518,12 @@ def _partners(rnd: Round, with_bw: list, candidates) -> list:
     of each quality factor at their best parameters with the bandwidth in the model, where identified."""
     out = []
     if "gauss_markov" in candidates:
-        p, s, edge = search(rnd.curve, rnd.start, with_bw, "gauss_markov", _gm_grid(rnd.tmin, rnd.tmax))
+        p, s, edge = search(rnd.curve, rnd.start, with_bw, "gauss_markov", _grid("gauss_markov", rnd.tmin, rnd.tmax))
         out.append(("gauss_markov", p, s, edge))
     if "resonance" in candidates:
         for q in RESONANCE_Q:
             key = f"resonance:{q:g}"
-            p, s, edge = search(rnd.curve, rnd.start, with_bw, key, _res_grid(rnd.tmin, rnd.tmax))
+            p, s, edge = search(rnd.curve, rnd.start, with_bw, key, _grid("resonance", rnd.tmin, rnd.tmax))
             out.append((key, p, s, edge))
     return [(key, p) for key, p, s, edge in out if not edge and s.theta[-1] > 0]
 

@@ -35,6 +35,7 @@ __all__ = [
     "column",
     "Curve",
     "Solution",
+    "chi2_dof_between",
     "design",
     "solve",
     "chi2s",
@@ -176,6 +177,14 @@ class Solution:
     def chi2_eff(self, curve):
         """χ² scaled to the curve's effective number of independent points (``curve.n_eff`` of its τ)."""
         return self.chi2 * curve.n_eff / curve.tau.size
+
+
+def chi2_dof_between(tau: np.ndarray, z: np.ndarray, lo: float, hi: float) -> float:
+    """Mean z² (a fit's normalised residuals ``z`` on the curve's ``tau``) over the τ in [lo, hi], the ends taken
+    within 10⁻⁹ relative (regions are given by their τ): an ``unexplained`` region's χ²/dof; NaN where no τ lies
+    there."""
+    z = z[(tau >= lo * (1 - 1e-9)) & (tau <= hi * (1 + 1e-9))]
+    return float(np.mean(z**2)) if z.size else float("nan")
 
 
 def design(curve, terms, effects):
@@ -506,11 +515,14 @@ def _coefficients(sol, terms, effects, unit, zq, inflate) -> tuple[dict, np.ndar
     for j, (key, _param) in enumerate(effects):
         i = k + j
         name = effect_column_name(key, j, effects)
+        # a column's amplitude is in the rate unit (σ, A), but a bandwidth's is the white noise N before the
+        # filter: N's unit (rate unit·√s), not the rate unit
+        n_unit = EFFECTS[base_name(key)].replaces == "N" and "N" in coeffs
         coeffs[name] = fitting.Coefficient(
             name=name,
             value=float(math.sqrt(max(sol.theta[i], 0.0))),
             ci=fitting.interval(sol.theta[i], sol.cov[i, i], zq, inflate),
-            unit=unit,
+            unit=coeffs["N"].unit if n_unit else unit,
         )
     return coeffs, theta, cov
 

@@ -72,55 +72,57 @@ def refine(
 ) -> Refinement:
     """Fit the starting model, find what it lacks, add it, repeat; report the error before and after.
 
-        Parameters
-        ----------
-        x_or_result : array_like or AllanResult
-            Samples (then ``fs`` is needed; the Allan variance is computed on a dense exponential grid of
-            ``points`` τ so that a sinusoid's nulls are resolved, the PSD and the record along time are
-            searched too, and the held-out error is computed), or a static :class:`~allanite.AllanResult`
-            (curve effects only; no held-out error).
-        fs : float, optional
-            Sampling rate, Hz (samples only).
-        start : tuple of str
-            The starting model's terms (``"Q"``, ``"N"``, ``"B"``, ``"K"``, ``"R"``).
-        candidates : tuple of str
-            Effects to try (:data:`CANDIDATES`, the registry :data:`allanite.model.effects.EFFECTS`), with the
-            parameters each step reports and their units ("rate unit": the samples' rate unit):
+    Parameters
+    ----------
+    x_or_result : array_like or AllanResult
+        Samples (then ``fs`` is needed; the Allan variance is computed on a dense exponential grid of
+        ``points`` τ so that a sinusoid's nulls are resolved, the PSD and the record along time are
+        searched too, and the held-out error is computed), or a static :class:`~allanite.AllanResult`
+        (curve effects only; no held-out error).
+    fs : float, optional
+        Sampling rate, Hz (samples only).
+    start : tuple of str
+        The starting model's terms (``"Q"``, ``"N"``, ``"B"``, ``"K"``, ``"R"``).
+    candidates : tuple of str
+        Effects to try (:data:`CANDIDATES`, the registry :data:`allanite.model.effects.EFFECTS`), with the
+        parameters each step reports and their units ("rate unit": the samples' rate unit):
 
-    {effects}
-        unit : str, optional
-            Unit of the samples, for IEEE-952 values of the terms: a gyro's rate or angle unit
-            (:func:`allanite.units.parse_unit`), checked before any work. For an accelerometer, a magnetometer
-            or another sensor give none: the terms are then in the samples' own unit and seconds.
-        tau_range : (float, float) or "auto", optional
-            τ (s) to use, as in :func:`allanite.fit`. Default: every τ — the shortest τ carry the sensor's
-            bandwidth, which is a candidate effect; ``"auto"`` cuts them as ``fit`` does.
-        channels : dict of str → array_like, optional
-            Other channels of the same log (same length as the samples: temperature, other axes,
-            accelerometers): the rate is regressed on each ("regression" effect; band by band where the
-            coupling differs across frequency, the bands in the step's ``evidence["bands"]``).
-        level : float
-            False-alarm probability per record on a clean record (default 0.05), split between spectral
-            lines, the Allan-curve test and change points.
-        progress : bool, optional
-            A ``tqdm.auto`` bar: None (default) in a notebook or a terminal only, True/False always/never.
-        truth : dict, optional
-            Known parameters per effect (``{"gauss_markov": {"sigma": …, "tc": …}}``, ``{"change_point":
-            {"t": …}}``): each step then records its relative errors.
-        axis : int
-            Which axis of multi-axis input to refine.
+        {effects}
+    unit : str, optional
+        Unit of the samples, for IEEE-952 values of the terms: a gyro's rate or angle unit
+        (:func:`allanite.units.parse_unit`), checked before any work. For an accelerometer, a magnetometer
+        or another sensor give none: the terms are then in the samples' own unit and seconds.
+    tau_range : (float, float) or "auto", optional
+        τ (s) to use, as in :func:`allanite.fit`. Default: every τ — the shortest τ carry the sensor's
+        bandwidth, which is a candidate effect; ``"auto"`` cuts them as ``fit`` does.
+    channels : dict of str → array_like, optional
+        Other channels of the same log (same length as the samples: temperature, other axes,
+        accelerometers): the rate is regressed on each ("regression" effect; band by band where the
+        coupling differs across frequency, the bands in the step's ``evidence["bands"]``).
+    level : float
+        False-alarm probability per record on a clean record (default 0.05), split between every
+        calibrated test (:mod:`allanite.model.refinement.levels`): spectral lines, change points, the
+        outliers, drift and regression removals, the checks behind ``unexplained`` and the Allan-curve
+        test, which takes what the others leave.
+    progress : bool, optional
+        A ``tqdm.auto`` bar: None (default) in a notebook or a terminal only, True/False always/never.
+    truth : dict, optional
+        Known parameters per effect (``{"gauss_markov": {"sigma": …, "tc": …}}``, ``{"change_point":
+        {"t": …}}``): each step then records its relative errors.
+    axis : int
+        Which axis of multi-axis input to refine.
 
-        Returns
-        -------
-        Refinement
+    Returns
+    -------
+    Refinement
 
-        Examples
-        --------
-        >>> import allanite
-        >>> y = allanite.simulate(1_000_000, 100.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 10.0)], seed=11)
-        >>> r = allanite.refine(y, 100.0)               # the generator's GM is not in the starting model
-        >>> r.found, round(r.steps[0].params["tc"], 0)
-        (['gauss_markov'], 10.0)
+    Examples
+    --------
+    >>> import allanite
+    >>> y = allanite.simulate(1_000_000, 100.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 10.0)], seed=11)
+    >>> r = allanite.refine(y, 100.0)               # the generator's GM is not in the starting model
+    >>> r.found, round(r.steps[0].params["tc"], 0)
+    (['gauss_markov'], 10.0)
     """
     check_scale(x_or_result)
     check_unit(unit, input, x_or_result)  # before any work: it was read only by the final fit
@@ -528,7 +530,9 @@ def _component_name(st: Step) -> str:
     return st.effect if st.effect != "regression" else f"regression_{st.params['channel']}"
 
 
-refine.__doc__ = (refine.__doc__ or "").replace("{effects}", describe())
+# the registry's list under ``candidates``, every item indented as that parameter's description (the site's
+# API reference fills the same list in: docs/_site/griffe_roles.py)
+refine.__doc__ = (refine.__doc__ or "").replace("        {effects}", describe(" " * 8))
 
 
 def _say_heldout_rise(st: Step, rem: Removal) -> None:

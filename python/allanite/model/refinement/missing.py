@@ -76,10 +76,10 @@ from ._quality import clipped_check, held_check
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
 from .changes import locate
-from .curvefit import Curve, Solution, base_name, theta_terms, upper_theta
+from .curvefit import Curve, Solution, base_name, chi2_dof_between, theta_terms, upper_theta
 from .levels import alpha
 from .scoring import MATERIAL_Z, curve_change_z
-from .words import span_text
+from .words import heldout_clause, span_text
 
 __all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS", "allan_family"]
 
@@ -142,9 +142,7 @@ def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
 
 
 def _chi2_dof(ctx: MissingContext, lo: float, hi: float) -> float:
-    sel = (ctx.curve.tau >= lo * (1 - 1e-9)) & (ctx.curve.tau <= hi * (1 + 1e-9))
-    z = ctx.sol.z[sel]
-    return float(np.mean(z**2)) if z.size else float("nan")
+    return chi2_dof_between(ctx.curve.tau, ctx.sol.z, lo, hi)
 
 
 def allan_family(sub: Curve, start: tuple, has_samples: bool) -> np.ndarray:
@@ -180,21 +178,24 @@ def _curve(ctx: MissingContext, a: float) -> list[dict]:
             continue  # a column the residual leans on where the curve itself is within its scatter
         if _merged(ctx, out, lo, hi, float(stats[c])):
             continue
-        out.append(
-            {
-                "domain": "allan",
-                "tau": (lo, hi),
-                "band_hz": None if ctx.y is None else _band(ctx, lo, hi),
-                "chi2_dof": _chi2_dof(ctx, lo, hi),
-                "what": "the Allan curve departs from the model",
-                "statistic": float(stats[c]),
-                "threshold": thr,
-                "alpha": a,
-            }
-        )
+        out.append(_allan_region(ctx, lo, hi, "the Allan curve departs from the model", float(stats[c]), thr, a))
     if out:  # the test rejected the model: say too where the curve's largest misfits are
         _misfit_runs(ctx, out, thr, a)
     return out
+
+
+def _allan_region(ctx: MissingContext, lo: float, hi: float, what: str, statistic: float, thr: float, a: float) -> dict:
+    """An ``"allan"`` entry of ``unexplained``: the τ region, its band (with samples), χ²/dof there, in words."""
+    return {
+        "domain": "allan",
+        "tau": (lo, hi),
+        "band_hz": None if ctx.y is None else _band(ctx, lo, hi),
+        "chi2_dof": _chi2_dof(ctx, lo, hi),
+        "what": what,
+        "statistic": statistic,
+        "threshold": thr,
+        "alpha": a,
+    }
 
 
 def _misfit_runs(ctx: MissingContext, out: list[dict], thr: float, a: float) -> None:
@@ -220,19 +221,8 @@ def _misfit_runs(ctx: MissingContext, out: list[dict], thr: float, a: float) -> 
             break
         if any(lo < reg["tau"][1] and reg["tau"][0] < hi for reg in out):
             continue
-        above = z[i] < 0
-        out.append(
-            {
-                "domain": "allan",
-                "tau": (lo, hi),
-                "band_hz": None if ctx.y is None else _band(ctx, lo, hi),
-                "chi2_dof": _chi2_dof(ctx, lo, hi),
-                "what": "the model lies above the Allan curve" if above else "the Allan curve lies above the model",
-                "statistic": chi2,
-                "threshold": thr,
-                "alpha": a,
-            }
-        )
+        what = "the model lies above the Allan curve" if z[i] < 0 else "the Allan curve lies above the model"
+        out.append(_allan_region(ctx, lo, hi, what, chi2, thr, a))
 
 
 def _merged(ctx: MissingContext, out: list[dict], lo: float, hi: float, stat: float) -> bool:
@@ -434,7 +424,7 @@ def _level(ctx: MissingContext, a: float) -> list[dict]:
         what = (
             f"the noise level changes along the record: {ratio:.2f}× the Allan deviation at τ₀ of "
             f"t {span_text(*lo_side)} s ({departure:.2g} % off the record's level"
-            + ("" if ctx.heldout_pct is None else f"; held-out error {ctx.heldout_pct:.2g} %")
+            + heldout_clause(ctx.heldout_pct)
             + ")"
         )
         out.append(

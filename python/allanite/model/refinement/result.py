@@ -29,8 +29,11 @@ class Step:
 
     ``params`` in the input unit's base form, at acceptance (see :data:`allanite.model.effects.EFFECTS` for
     each effect's parameters and units: Gauss–Markov ``sigma`` rate unit, ``tc`` s; sinusoid ``amplitude``
-    rate unit, ``f0`` Hz; bandwidth ``cutoff`` Hz, ``taps``, ``filter``; drift ``amplitude`` rate unit,
-    ``T`` s; regression ``channel``, ``coefficient`` rate unit per channel unit; change point ``t`` s);
+    rate unit, ``f0`` Hz; bandwidth ``cutoff`` Hz, ``taps``, ``filter``, beside a Butterworth ``floor`` rate
+    unit·√s; resonance ``sigma`` rate unit, ``f0`` Hz, ``q``; periodic ``fundamentals`` (a list, Hz),
+    ``lines``, ``rms`` rate unit; outliers ``rate`` (share of the samples), ``threshold`` rate unit; drift
+    ``amplitude`` rate unit, ``T`` s; regression ``channel``, ``coefficient`` rate unit per channel unit and,
+    where their tests keep them, ``quadratic``, ``rate_coefficient``, ``lag_s``; change point ``t`` s);
     ``intervals`` the numeric keys → (low, high); ``final_params``/``final_intervals`` the same after the final
     joint refit (a curve effect's amplitude refitted beside every other effect — a bandwidth's cutoff searched
     again beside them —, its nonlinear parameter's interval profiled again; what was measured in the time
@@ -131,8 +134,9 @@ class Refinement(RichDisplay):
     ``term_moves`` the terms whose refined interval no longer overlaps the plain fit's, and the steps that
     moved them; ``level`` the false-alarm level the tests spent. ``unexplained`` lists what the final model
     still misses — empty when every domain's calibrated check passes (at its share of ``level``), else one dict
-    per region, largest misfit first: ``"domain"``, ``"tau"`` (lo, hi) s, ``"band_hz"`` (lo, hi) or None,
-    ``"chi2_dof"`` over that τ range, ``"what"``, and the test's ``"statistic"``, ``"threshold"``, ``"alpha"``
+    per region, largest misfit first: ``"domain"``, ``"tau"`` (lo, hi) s, ``"t"`` (lo, hi) s where the region
+    is one along the record (the mean, steps, level, line, clipped and held checks), ``"band_hz"`` (lo, hi) or
+    None, ``"chi2_dof"`` over that τ range, ``"what"``, and the test's ``"statistic"``, ``"threshold"``, ``"alpha"``
     (:mod:`allanite.model.refinement.missing`); :meth:`missing_sentences` says it in words. ``considered``: per
     effect, every proposal tried (its parameter, statistic and threshold); one whose test passed but that was not
     taken says why under ``"rejected"`` (χ²/dof not falling, a parameter at the edge of its range, the held-out

@@ -12,12 +12,23 @@ import math
 
 from .levels import UNEXPLAINED_SHARES
 
-__all__ = ["describe_region", "missing_sentences", "passes_sentence", "checks_alpha", "span_text"]
+__all__ = ["describe_region", "missing_sentences", "passes_sentence", "checks_alpha", "span_text", "heldout_clause"]
 
 
 def checks_alpha(level: float) -> float:
     """The false-alarm probability per record that the checks of what is still missing spend together."""
     return level * sum(UNEXPLAINED_SHARES.values())
+
+
+def heldout_clause(pct: float | None) -> str:
+    """The closing words of an entry judged against the final model's held-out error (none without one).
+
+    Examples
+    --------
+    >>> heldout_clause(4.567), heldout_clause(None)
+    ('; held-out error 4.6 %', '')
+    """
+    return "" if pct is None else f"; held-out error {pct:.2g} %"
 
 
 def describe_region(reg: dict) -> str:
@@ -52,9 +63,9 @@ def passes_sentence(level: float) -> str:
     """What is said when ``unexplained`` is empty: the final model passes the checks, at their level."""
     return (
         "The final model passes every calibrated check of what it may still miss (the Allan-curve score test "
-        "and, with samples, lines in the PSD, a drift, a step of the mean, the noise level along the record, the "
-        "channels, outliers, and clipped or repeated samples; without, the whole curve's two-sided GLS χ²) at a "
-        "false-alarm probability "
+        "and, with samples, lines in the PSD, an accepted line's amplitude along the record, a drift, steps of "
+        "the mean, the noise level along the record, the channels, outliers, and clipped or repeated samples; "
+        "without, the whole curve's two-sided GLS χ²) at a false-alarm probability "
         f"of {100 * checks_alpha(level):.3g} % per record together (their share of level {level:g})."
     )
 
