@@ -186,8 +186,8 @@ def add_analysis_options(rep: argparse.ArgumentParser) -> None:
         metavar="NAMES",
         help="refine (as --refine) trying only these effects, comma-separated ("
         + ", ".join(e.name for e in EFFECTS.values() if e.domain != "channels")
-        + "; e.g. without outliers on quantised accelerometers); 'none': only say what the five-term model "
-        "still misses",
+        + "; regression as well where a channel is given; e.g. without outliers on quantised accelerometers); "
+        "'none': only say what the five-term model still misses",
     )
     ana.add_argument("--no-fit", action="store_true", help="skip the noise-model fit (whole record and per window)")
     ana.add_argument(

@@ -423,25 +423,47 @@ def build_parser() -> argparse.ArgumentParser:
         "(out/fleet.csv, fleet.parquet, fleet.html).",
     )
     p.add_argument("pattern", metavar="PATTERN", help="glob of the logs, quoted ('logs/**/*.csv.gz')")
-    p.add_argument("--fs", type=float, metavar="HZ")
-    p.add_argument("--columns", metavar="C1,C2,...")
-    p.add_argument("--time-column", metavar="C")
-    p.add_argument("--unit", metavar="U")
-    p.add_argument("--input", choices=("rate", "increment", "angle"), default="rate")
-    p.add_argument("--gaps", choices=("error", "longest", "split"), default="error")
+    p.add_argument(
+        "--fs", type=float, metavar="HZ", help="sampling rate in Hz (or give --time-column; ROS bags use their stamps)"
+    )
+    p.add_argument(
+        "--columns",
+        metavar="C1,C2,...",
+        help="the sample columns, as allanite report's (default: every column but time and channels)",
+    )
+    p.add_argument("--time-column", metavar="C", help="column of sample times: derives --fs, finds gaps")
+    p.add_argument(
+        "--unit",
+        metavar="U",
+        help="unit of the samples, as allanite report's (without it the coefficients are in base form)",
+    )
+    p.add_argument(
+        "--input", choices=("rate", "increment", "angle"), default="rate", help="what a sample is (default rate)"
+    )
+    p.add_argument(
+        "--gaps",
+        choices=("error", "longest", "split"),
+        default="error",
+        help="as allanite report's: stop on gaps (default), analyse the longest gap-free stretch, "
+        "or the same and list every stretch (split)",
+    )
     p.add_argument(
         "--channels",
         metavar="C1,C2,...",
         help="as allanite report's: other columns every axis is regressed on (implies --refine); default: the "
         "columns named as a temperature (never an axis; a channel with --refine); 'none': no channel",
     )
-    p.add_argument("--taus", default="octave")
-    p.add_argument("--window", type=int)
-    p.add_argument("--hop", type=int)
-    p.add_argument("--estimator", choices=("oavar", "theoh"), default="oavar")
-    p.add_argument("--refine", action="store_true")
-    p.add_argument("--no-fit", action="store_true")
-    p.add_argument("--out", required=True, metavar="DIR")
+    p.add_argument("--taus", default="octave", help="the τ grid, as allanite report's (default octave)")
+    p.add_argument("--window", type=int, metavar="N", help="DAVAR window in samples (default: 1/12 of the record)")
+    p.add_argument(
+        "--hop", type=int, metavar="N", help="DAVAR hop between windows in samples (default: 1/25 of the window)"
+    )
+    p.add_argument(
+        "--estimator", choices=("oavar", "theoh"), default="oavar", help="as allanite report's (default oavar)"
+    )
+    p.add_argument("--refine", action="store_true", help="add the model refinement to every report")
+    p.add_argument("--no-fit", action="store_true", help="skip the noise-model fit")
+    p.add_argument("--out", required=True, metavar="DIR", help="folder for the reports and the fleet summary")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--scheduler", metavar="ADDRESS", help="a running Dask scheduler, e.g. tcp://host:8786")
     where.add_argument("--dask-workers", type=int, metavar="N", help="LocalCluster workers (default 2)")
