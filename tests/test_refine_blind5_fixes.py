@@ -1,0 +1,56 @@
+"""Fixes from the fifth blind suite (benches/refine_blind5.py): a channel's lag read on the channel lagged in time,
+not on the grid's circular response (which reads T short over a record a few lags long)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import signal
+
+import allanite
+from allanite.model import _lag
+from allanite.model.channels import regress_channel
+
+
+def _lagged_coupling(seed: int, lag_s: float, coefficient: float):
+    """10 Hz × 5·10⁴ (5000 s): white noise and a random walk of rate; a temperature cycling three times (19.5 → 45.5 °C,
+    two frequencies); the rate follows it through a first-order lag of ``lag_s`` started in equilibrium."""
+    fs, n = 10.0, 50_000
+    t = np.arange(n) / fs
+    rng = np.random.default_rng(seed)
+    y = allanite.simulate(n, fs, N=8e-4, K=2e-6, seed=rng)
+    w = 2 * np.pi * t / (n / fs / 3)
+    temp = 32.5 - 10.0 * np.cos(w) - 3.0 * np.cos(2.6 * w + 0.5)  # not one sinusoid: a lag, not a rate term
+    a = -math.expm1(-1.0 / (fs * lag_s))
+    sensor = signal.lfilter([a], [1.0, a - 1.0], temp - temp[0]) + temp[0]
+    return y + coefficient * (sensor - sensor.mean()), temp + 0.01 * rng.standard_normal(n), fs
+
+
+def test_lag_over_a_few_lags_is_not_read_short():
+    # the grid's circular profile read 525 s (coefficient −10 %) here, 603 s (+0.0 %) in time; over 8 records of
+    # one sinusoid plus wander its median was 473 s, 545 s started in steady state, in time 590 and 602 s
+    # (refine_blind5's 10⁷-sample FOG: 420 s for 600 s)
+    y, temp, fs = _lagged_coupling(1000, 600.0, 1e-3)
+    r = regress_channel(y, temp, fs, name="temp")
+    assert r.accepted and "lag_s" in r.params
+    assert abs(r.params["lag_s"] / 600.0 - 1.0) < 0.05
+    assert abs(r.params["coefficient"] / 1e-3 - 1.0) < 0.03
+    lo, hi = r.intervals["lag_s"]
+    assert lo < 600.0 < hi
+    grid_t = r.terms["lag_s"]["grid_lag_s"]
+    assert grid_t < 0.9 * 600.0  # the grid's profile, kept beside it, reads short
+
+
+def test_exact_lag_maximum_and_interval():
+    # 2Δℓ = ((ln T − ln 600)/0.2)²: the maximum at 600 s, the interval where 2Δℓ ≤ 1 at 600·e^{±0.2}
+    def objective(t):
+        return 5.0 - 0.5 * ((math.log(t) - math.log(600.0)) / 0.2) ** 2
+
+    best, (lo, hi) = _lag.exact_lag(objective, 450.0, (300.0, 700.0), 1.0, (0.2, 1250.0))
+    assert abs(best / 600.0 - 1.0) < 0.01
+    assert abs(lo / (600.0 * math.exp(-0.2)) - 1.0) < 0.01
+    assert abs(hi / (600.0 * math.exp(0.2)) - 1.0) < 0.01
+    # an interval reaching the grid's end stops there
+    best, (lo, hi) = _lag.exact_lag(objective, 600.0, (500.0, 700.0), 1.0, (0.2, 650.0))
+    assert abs(hi / 650.0 - 1.0) < 1e-9 and abs(best / 600.0 - 1.0) < 0.01
