@@ -42,15 +42,15 @@ def test_lag_over_a_few_lags_is_not_read_short():
     assert grid_t < 0.9 * 600.0  # the grid's profile, kept beside it, reads short
 
 
-def test_exact_lag_maximum_and_interval():
-    # 2Δℓ = ((ln T − ln 600)/0.2)²: the maximum at 600 s, the interval where 2Δℓ ≤ 1 at 600·e^{±0.2}
+def test_exact_lag_moves_the_grid_interval_with_the_maximum():
+    # 2Δℓ = ((ln T − ln 600)/0.2)²: the maximum at 600 s; from the grid's 450 s (interval 300–700 s) the interval
+    # moves by 600/450
     def objective(t):
         return 5.0 - 0.5 * ((math.log(t) - math.log(600.0)) / 0.2) ** 2
 
-    best, (lo, hi) = _lag.exact_lag(objective, 450.0, (300.0, 700.0), 1.0, (0.2, 1250.0))
-    assert abs(best / 600.0 - 1.0) < 0.01
-    assert abs(lo / (600.0 * math.exp(-0.2)) - 1.0) < 0.01
-    assert abs(hi / (600.0 * math.exp(0.2)) - 1.0) < 0.01
-    # an interval reaching the grid's end stops there
-    best, (lo, hi) = _lag.exact_lag(objective, 600.0, (500.0, 700.0), 1.0, (0.2, 650.0))
-    assert abs(hi / 650.0 - 1.0) < 1e-9 and abs(best / 600.0 - 1.0) < 0.01
+    best, (lo, hi) = _lag.exact_lag(objective, 450.0, (300.0, 700.0), (0.2, 1250.0))
+    assert abs(best / 600.0 - 1.0) < 0.02
+    assert abs(lo / (300.0 * best / 450.0) - 1.0) < 1e-9 and abs(hi / (700.0 * best / 450.0) - 1.0) < 1e-9
+    # within the grid's ends: the search and the interval stop there
+    best, (lo, hi) = _lag.exact_lag(objective, 400.0, (300.0, 500.0), (0.2, 550.0))
+    assert abs(best / 550.0 - 1.0) < 0.02 and hi == 550.0 and lo < best

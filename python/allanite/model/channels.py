@@ -429,7 +429,7 @@ def regress_channel(
         keys, fit, lag_s, tests = _optional_terms(bands, fit, terms, level, lag_grid(y.size, fs), z2)
         removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, lag_grid(y.size, fs), z2)
         if removal_lag is not None:
-            removal_lag = _lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"], z2)
+            removal_lag = _lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"])
             exact = wh.spectra(y, _columns(xs, mean, quad_mean, fs, removal_lag), fs)
             fit = wh.joint_fit(exact, _design(keys, exact.m.size))
     lag = (removal_lag, tests["lag_s"]["interval"]) if lag_s is not None else None
@@ -471,10 +471,10 @@ def _removal_lag(bands, fit, keys, tests, grid, z2) -> float | None:
     return float(prof["lag_s"]) if prof["used"] else None
 
 
-def _lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict, z2: float) -> float:
-    """The lag the removal takes (kept, or profiled: ``t_lag["profiled"]``) and its interval refined on the band sums
-    of the channel lagged in time (:func:`allanite.model._lag.exact_lag`; the grid's profile lags circularly and
-    reads T short over a record a few lags long), written back into ``t_lag`` (the grid's T under
+def _lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict) -> float:
+    """The lag the removal takes (kept, or profiled: ``t_lag["profiled"]``) refined on the band sums of the channel
+    lagged in time, its interval moved with it (:func:`allanite.model._lag.exact_lag`; the grid's profile lags
+    circularly and reads T short over a record a few lags long), written back into ``t_lag`` (the grid's T under
     ``"grid_lag_s"``). Returns the refined T."""
     rec = t_lag if t_lag.get("kept") else t_lag["profiled"]
     n_cols = 2 if "quadratic" in keys else 1  # a lag is never beside the d(ch)/dt term
@@ -485,7 +485,7 @@ def _lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict, z2: float) -> fl
         return float(sc @ np.linalg.solve(info, sc))
 
     grid = lag_grid(y.size, fs)
-    best, interval = exact_lag(objective, float(rec["lag_s"]), rec["interval"], z2, (grid[0], grid[-1]))
+    best, interval = exact_lag(objective, float(rec["lag_s"]), rec["interval"], (grid[0], grid[-1]))
     rec |= {"grid_lag_s": float(rec["lag_s"]), "lag_s": best, "interval": interval}
     return best
 
