@@ -13,6 +13,7 @@ import pytest
 from scipy import signal
 
 import allanite
+from allanite.errors import ParameterError
 from allanite.model import _lag
 from allanite.model.channels import regress_channel
 
@@ -90,3 +91,11 @@ def test_student_flag_rate_closed_forms():
     # beyond the cut from the level: both tails of Student-t(3), 2·S(2) = 0.1393 at twice the scale
     assert b5.student_flag_rate(2 * b5.T_SCALE, rule="level") == pytest.approx(0.139326, rel=1e-4)
     assert b5.student_flag_rate(4 * b5.T_SCALE, rule="level") < b5.student_flag_rate(2 * b5.T_SCALE, rule="level")
+
+
+@pytest.mark.parametrize("name", ["", "  "])
+def test_a_channel_without_a_name_is_refused(name):
+    # accepted before, the regression then named by a blank in the report, the HTML page and summary.json
+    y = np.zeros(1000)
+    with pytest.raises(ParameterError, match="a channel's name must not be empty"):
+        allanite.refine(y, 10.0, channels={name: np.arange(1000.0)}, progress=False)
