@@ -48,7 +48,7 @@ from scipy.stats import t as t_dist
 from .._validate import check_fs, check_probability
 from ..errors import InputError, ParameterError
 from . import _whittle as wh
-from ._lag import lag_grid, lag_profile, lag_response, lag_test, lagged, unresolved_lag
+from ._lag import exact_lag, lag_grid, lag_profile, lag_response, lag_test, lagged, unresolved_lag
 from ._rfft import band_limited, rfft
 from ._shares import TERM_SHARE
 
@@ -410,8 +410,7 @@ def regress_channel(
     """
     y, fs = _check_rate(y, fs)
     x = check_channel(name, ch, y.size)
-    alpha = check_probability(alpha, "alpha")
-    level = check_probability(level, "level")
+    alpha, level = check_probability(alpha, "alpha"), check_probability(level, "level")
     confidence = check_probability(confidence)
     terms = _check_subterms(terms)
     n_use = wh.usable_length(y.size)
@@ -424,20 +423,20 @@ def regress_channel(
     null = wh.joint_fit(bands, wh.Design([], []))
     test, fit = _nested(bands, _design([], bands.m.size), null, alpha)
     accepted = test["statistic"] > test["threshold"]
-    keys, lag, tests, removal_lag = [], None, {}, None
+    keys, lag_s, tests, removal_lag = [], None, {}, None
     if accepted:
         z2 = float(t_dist.isf((1.0 - confidence) / 2.0, test["dof"])) ** 2
         keys, fit, lag_s, tests = _optional_terms(bands, fit, terms, level, lag_grid(y.size, fs), z2)
         removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, lag_grid(y.size, fs), z2)
-        lag = (lag_s, tests["lag_s"]["interval"]) if lag_s is not None else None
         if removal_lag is not None:
+            removal_lag = _lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"])
             exact = wh.spectra(y, _columns(xs, mean, quad_mean, fs, removal_lag), fs)
             fit = wh.joint_fit(exact, _design(keys, exact.m.size))
+    lag = (removal_lag, tests["lag_s"]["interval"]) if lag_s is not None else None
     dofs = {"coefficient": test["dof"]} | {k: tests[k]["dof"] for k in keys}
     params, intervals = _params(fit, keys, dofs, confidence, lag)
-    # the noise model's amounts are not read as IEEE-952 terms: over the few octaves of the parametric bands
-    # K, B and the Gauss–Markov shapes trade against each other (the level they add up to is what is used);
-    # the terms before and after a removal come from the Allan fits (terms_before_after)
+    # the noise amounts are not read as IEEE-952 terms: over the parametric bands' few octaves K, B and the GM shapes
+    # trade against each other (their sum is what is used); the terms before/after come from the Allan fits
     noise = {"channel_noise": math.sqrt(floor), "whittle_loglik_gain": float(fit["loglik"] - null["loglik"])}
     return ChannelRegression(
         name, bool(accepted), params, intervals, test, tests, fs, mean, quad_mean, noise, sig, removal_lag
@@ -470,6 +469,25 @@ def _removal_lag(bands, fit, keys, tests, grid, z2) -> float | None:
     prof = unresolved_lag(bands, _design(keys, bands.m.size), fit["s"], grid, z2)
     tests["lag_s"]["profiled"] = prof
     return float(prof["lag_s"]) if prof["used"] else None
+
+
+def _lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict) -> float:
+    """The lag the removal takes (kept, or profiled: ``t_lag["profiled"]``) refined on the band sums of the channel
+    lagged in time, its interval moved with it (:func:`allanite.model._lag.exact_lag`; the grid's profile lags
+    circularly and reads T short over a record a few lags long), written back into ``t_lag`` (the grid's T under
+    ``"grid_lag_s"``). Returns the refined T."""
+    rec = t_lag if t_lag.get("kept") else t_lag["profiled"]
+    n_cols = 2 if "quadratic" in keys else 1  # a lag is never beside the d(ch)/dt term
+
+    def objective(lag_s: float) -> float:
+        b = wh.spectra(y, _columns(xs, means[0], means[1], fs, lag_s)[:n_cols], fs)
+        info, sc = _design(keys, b.m.size).gram(b, 1.0 / s)
+        return float(sc @ np.linalg.solve(info, sc))
+
+    grid = lag_grid(y.size, fs)
+    best, interval = exact_lag(objective, float(rec["lag_s"]), rec["interval"], (grid[0], grid[-1]))
+    rec |= {"grid_lag_s": float(rec["lag_s"]), "lag_s": best, "interval": interval}
+    return best
 
 
 def _informative(info: np.ndarray) -> np.ndarray:

@@ -124,6 +124,8 @@ def check_channels(channels, y) -> dict:
         if y is None:
             raise ParameterError("channels need samples (a regression is fitted along time), not an AllanResult")
         for name, c in channels.items():
+            if not str(name).strip():  # the report names the regression by it: "regression on " read as a blank
+                raise ParameterError(f"a channel's name must not be empty, got {str(name)!r}; e.g. {{'temp': T}}")
             if str(name) in chans:  # 1 and "1": one would replace the other silently
                 raise ParameterError(f"two channels are named {str(name)!r}; each channel needs its own name")
             chans[str(name)] = check_channel(str(name), c, y.size)
