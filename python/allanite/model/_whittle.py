@@ -24,6 +24,7 @@ cannot be taken into the noise: it stands above the level the higher bins set. T
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -126,9 +127,10 @@ def usable_length(n: int) -> int:
     return m + 1
 
 
-def spectra(y: np.ndarray, regressors: list[np.ndarray], fs: float, parity: int | None = None) -> Bands:
-    """Band sums of the differenced, tapered record ``y`` and ``regressors`` (each the record's length); with
-    ``parity`` 0 or 1 over the even or the odd bins only (a held-out split across frequency)."""
+def spectra(y: np.ndarray, regressors: Iterable[np.ndarray], fs: float, parity: int | None = None) -> Bands:
+    """Band sums of the differenced, tapered record ``y`` and ``regressors`` (each the record's length; an
+    iterator is taken one regressor at a time, each let go once transformed); with ``parity`` 0 or 1 over the
+    even or the odd bins only (a held-out split across frequency)."""
     n_diff = y.size - 1
     n_bins = (n_diff - 1) // 2  # strictly between 0 and the Nyquist frequency
     w = _taper(n_diff)
