@@ -102,7 +102,8 @@ def test_the_chunked_steps_null_matches_the_one_long_records():
 def test_a_channel_regression_holds_one_column_at_a_time():
     # a slow temperature's Whittle regression (refine's removal and its channels check): its three columns
     # (the channel, its square, its derivative) were built at once beside their transforms — 13.0× the rate
-    # record traced at 10⁶ samples; made and transformed one at a time, 10.0× (r7mem)
+    # record traced at 10⁶ samples; made and transformed one at a time, 10.0×; the bins' numbers and bands let
+    # go before the transforms and each difference tapered in place, 9.0× (r7mem)
     from allanite.model.channels import regress_channel
 
     n = 1_000_000
@@ -115,4 +116,4 @@ def test_a_channel_regression_holds_one_column_at_a_time():
     finally:
         tracemalloc.stop()
     assert not r.accepted  # independent of the rate
-    assert peak < 11.5 * y.nbytes, f"traced peak {peak / y.nbytes:.1f}× the record"
+    assert peak < 9.5 * y.nbytes, f"traced peak {peak / y.nbytes:.2f}× the record"
