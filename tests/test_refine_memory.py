@@ -15,9 +15,9 @@ def test_refine_traced_peak_stays_a_few_records():
     # was 14.7× a 4·10⁶ record at 478e6dd — the lattice step's ≈ 5 copies, whole-record Welch passes, the held-out
     # parts twice with their indices — and 5.6× with them chunked or made when asked. The "steps" check (r6steps)
     # added a cost that did not grow with the record: its null's 2²² half-block means simulated at once (≈ 240 MB
-    # at their peak), 5.8× of 8·10⁶. Drawn a chunk at a time (r7mem) the peak is 4.57× (the outlier test's
-    # lattice step and what the content memories keep of the 4·10⁶-sample held-out parts): the bound fails on
-    # one record-size copy more.
+    # at their peak), 5.8× of 8·10⁶. Drawn a chunk at a time (r7mem) the peak is 4.57× (by stage: the outliers
+    # check's transient, 2.5× the record, over ≈ 1.3× held through the final checks): the bound fails on one
+    # record-size copy more.
     y = np.asarray(allanite.simulate(8_000_000, 100.0, seed=3, N=0.01, B=0.002, K=1e-4))
     tracemalloc.start(1)
     try:
