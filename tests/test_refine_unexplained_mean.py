@@ -117,13 +117,16 @@ def test_a_small_level_does_not_simulate_a_record_beyond_the_cap(monkeypatch):
 
     def counted(n, *args, **kw):
         asked.append(n)
-        assert n <= 2**21, f"{n} block-rate samples asked for"
+        assert n <= tracing.SIM_CHUNK, f"{n} block-rate samples asked for at once"
         return real(n, *args, **kw)
 
     monkeypatch.setattr(tracing, "simulate", counted)
     theta = [0.0, 4e-6, 9e-8, 4e-12, 0.0]
     thr = ms.mean_step_threshold(200_000, FS, START, theta, alpha("unexplained:mean", 1e-4))
-    assert asked == [ms.MEAN_BLOCKS * ms.MAX_BOOT]
+    # MAX_BOOT records, a chunk of records at a time (each chunk a whole long record: the last one's spare pieces
+    # are simulated too)
+    each = tracing.SIM_CHUNK // ms.MEAN_BLOCKS
+    assert asked == [ms.MEAN_BLOCKS * each] * math.ceil(ms.MAX_BOOT / each)
     assert thr == ms.null_statistics(200_000, FS, START, theta, ms.MAX_BOOT)[-1] > 0
     # at the default level the number of draws is unchanged (5/α)
     assert ms.MAX_BOOT >= math.ceil(ms.BOOT_PER_ALPHA / A)

@@ -24,6 +24,7 @@ cannot be taken into the noise: it stands above the level the higher bins set. T
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -99,7 +100,9 @@ def _taper(n: int) -> np.ndarray:
 
 
 def _dft(x: np.ndarray, w: np.ndarray, n_bins: int) -> np.ndarray:
-    return _rfft.rfft(np.diff(x) * w)[1 : n_bins + 1]  # remembered: refine transforms the same samples again
+    d = np.diff(x)
+    d = np.multiply(d, w, out=d) if d.dtype == np.float64 else d * w  # tapered in place: one copy, not two
+    return _rfft.rfft(d)[1 : n_bins + 1]  # remembered: refine transforms the same samples again
 
 
 def _basis(k: np.ndarray, n_diff: int, fs: float) -> tuple[np.ndarray, tuple]:
@@ -126,9 +129,10 @@ def usable_length(n: int) -> int:
     return m + 1
 
 
-def spectra(y: np.ndarray, regressors: list[np.ndarray], fs: float, parity: int | None = None) -> Bands:
-    """Band sums of the differenced, tapered record ``y`` and ``regressors`` (each the record's length); with
-    ``parity`` 0 or 1 over the even or the odd bins only (a held-out split across frequency)."""
+def spectra(y: np.ndarray, regressors: Iterable[np.ndarray], fs: float, parity: int | None = None) -> Bands:
+    """Band sums of the differenced, tapered record ``y`` and ``regressors`` (each the record's length; an
+    iterator is taken one regressor at a time, each let go once transformed); with ``parity`` 0 or 1 over the
+    even or the odd bins only (a held-out split across frequency)."""
     n_diff = y.size - 1
     n_bins = (n_diff - 1) // 2  # strictly between 0 and the Nyquist frequency
     w = _taper(n_diff)
@@ -140,6 +144,15 @@ def spectra(y: np.ndarray, regressors: list[np.ndarray], fs: float, parity: int 
     k_all, band_of = k_all[sel], band_of[sel]
     idx = np.flatnonzero(np.diff(band_of, prepend=-1))
     m = np.diff(np.append(idx, k_all.size))
+    f = np.add.reduceat(k_all.astype(np.float64), idx) / m * fs / n_diff
+    # the band's width in bins of the whole spectrum decides its noise model (a split keeps the full record's)
+    par = np.diff(np.append(starts, n_bins + 1))[band_of[idx]] < OWN_BINS
+    # the parametric bands are the lowest ones: a last band cut short by the Nyquist bin is narrow too, yet above
+    # bands that carry their own level (n = 3999: it indexed past the parametric bins' shapes)
+    par = np.logical_and.accumulate(par)
+    n_par_bins = int(m[par].sum())
+    k_par = k_all[:n_par_bins].astype(np.float64)
+    del k_all, band_of  # the bins' numbers and bands (half the record's length each): not held beside the transforms
     d = _dft(y, w, n_bins)[sel] / norm
     zs = [_dft(np.asarray(r, dtype=np.float64), w, n_bins)[sel] / norm for r in regressors]
     p = len(zs)
@@ -152,14 +165,7 @@ def spectra(y: np.ndarray, regressors: list[np.ndarray], fs: float, parity: int 
         for j in range(i, p):
             big[:, i, j] = np.add.reduceat(zc * zs[j], idx)
             big[:, j, i] = np.conj(big[:, i, j])
-    f = np.add.reduceat(k_all.astype(np.float64), idx) / m * fs / n_diff
-    # the band's width in bins of the whole spectrum decides its noise model (a split keeps the full record's)
-    par = np.diff(np.append(starts, n_bins + 1))[band_of[idx]] < OWN_BINS
-    # the parametric bands are the lowest ones: a last band cut short by the Nyquist bin is narrow too, yet above
-    # bands that carry their own level (n = 3999: it indexed past the parametric bins' shapes)
-    par = np.logical_and.accumulate(par)
-    n_par_bins = int(m[par].sum())
-    shapes, names = _basis(k_all[:n_par_bins].astype(np.float64), n_diff, fs)
+    shapes, names = _basis(k_par, n_diff, fs)
     basis = np.add.reduceat(shapes, idx[par], axis=0) / m[par][:, None] if n_par_bins else np.zeros((0, 4))
     return Bands(m, f, q, g, big, par, basis, names, float(fs), n_diff)
 

@@ -35,6 +35,7 @@ __all__ = [
     "drift_component",
     "drift_threshold",
     "simulated_block_means",
+    "simulated_block_mean_chunks",
     "block_means",
     "regression_fit",
     "gm_autocorrelation",
@@ -149,11 +150,36 @@ def drift_threshold(n: int, fs: float, terms, theta, alpha: float, n_boot: int =
     return float(np.quantile(_grid_stats(b, tb, n / fs), 1.0 - alpha))
 
 
+#: Most block-rate samples simulated at once for a null (2 MB each; the simulation's transient, the flicker's
+#: transforms over twice that length, ≈ 10× it). Larger nulls are drawn as chunks of records of this many samples.
+SIM_CHUNK = 2**18
+
+
+def simulated_block_mean_chunks(nb: int, per: int, fs: float, terms, theta, n_boot: int, seed: int):
+    """:func:`simulated_block_means` a chunk of records at a time (the mean and steps checks' nulls): arrays
+    (nb, k), k records each, ``n_boot`` in all. Up to :data:`SIM_CHUNK` samples (nb · n_boot) one chunk, exactly
+    :func:`simulated_block_means`; beyond, each chunk the consecutive pieces of its own long record of
+    ``SIM_CHUNK // nb`` records (the last chunk its first pieces only), chunk i drawn from the seed (``seed``,
+    i). A null's memory no longer grows with its records (2²² samples at once were ≈ 240 MB with the flicker's
+    transforms); each record is, as before, a piece of a record ≥ 2¹⁸ block-rate samples long."""
+    coef = {t: math.sqrt(max(float(v), 0.0)) for t, v in zip(terms, theta)}
+    terms5 = {t: coef.get(t, 0.0) for t in ("N", "B", "K", "R")}
+    if nb * n_boot <= SIM_CHUNK:
+        yield np.asarray(simulate(nb * n_boot, fs / per, **terms5, seed=seed), dtype=np.float64).reshape(n_boot, nb).T
+        return
+    each = max(1, SIM_CHUNK // nb)
+    for i, first in enumerate(range(0, n_boot, each)):
+        long = simulate(nb * each, fs / per, **terms5, seed=np.random.default_rng([seed, i]))
+        k = min(each, n_boot - first)
+        yield np.asarray(long[: nb * k], dtype=np.float64).reshape(k, nb).T
+
+
 def simulated_block_means(nb: int, per: int, fs: float, terms, theta, n_boot: int, seed: int) -> np.ndarray:
     """Block means (``nb`` blocks of ``per`` samples at ``fs``) of ``n_boot`` records of the five-term model
     ``theta`` (squared coefficients of ``terms``), shape (nb, n_boot): simulated at the block rate fs/per (white
     rate, flicker and random walk of rate keep their coefficients; white angle noise averages out), all at once
-    as the consecutive pieces of one long record — the nulls of the drift and mean-step checks."""
+    as the consecutive pieces of one long record — the drift check's null (5·10⁵ samples; the mean and steps
+    checks' larger nulls are drawn a chunk at a time, :func:`simulated_block_mean_chunks`)."""
     coef = {t: math.sqrt(max(float(v), 0.0)) for t, v in zip(terms, theta)}
     long = simulate(
         nb * n_boot,

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from ...analysis import avar
-from ..tracing import block_means, simulated_block_means
+from ..tracing import block_means, simulated_block_mean_chunks
 from .curvefit import Curve, chi2_dof_between, solve, theta_terms, upper_theta
 from .words import heldout_clause
 
@@ -54,8 +54,8 @@ FINE = 32
 #: records) keeps the block-rate record under 2²¹ samples.
 BOOT_PER_ALPHA = 5
 MIN_BOOT = 2000
-#: Most simulated records (2²¹ block-rate samples in all, 16 MB): refine accepts any level in (0, 1), and 5/α
-#: records at level 10⁻⁴ (α 3.1·10⁻⁷) would be 7.7·10⁸ samples, gigabytes. From level ≈ 0.037 down
+#: Most simulated records (2²¹ block-rate samples in all, drawn 2¹⁸ at a time): refine accepts any level in
+#: (0, 1), and 5/α records at level 10⁻⁴ (α 3.1·10⁻⁷) would be 7.7·10⁸ samples, gigabytes. From level ≈ 0.037 down
 #: (α < 5/MAX_BOOT) fewer than 5/α are drawn; below α = 1/(MAX_BOOT + 1) (level ≈ 0.0073) the threshold is the
 #: largest null statistic, whose false-alarm probability is 1/(MAX_BOOT + 1) ≈ 2.3·10⁻⁵ rather than α (as the
 #: drift check's 1000 draws).
@@ -101,9 +101,10 @@ def null_statistics(n: int, fs: float, terms, theta, n_boot: int, seed: int = 79
     """:func:`split_statistic` (sorted) on the :data:`MEAN_BLOCKS` block means of ``n_boot`` records of ``n``
     samples of the five-term model ``theta`` (squared coefficients of ``terms``): simulated at the block rate
     (white, flicker and random walk of rate keep their coefficients; quantisation averages out), as consecutive
-    pieces of one long record (:func:`allanite.model.tracing.simulated_block_means`, as the drift check's null)."""
-    b = simulated_block_means(MEAN_BLOCKS, n // MEAN_BLOCKS, fs, terms, theta, n_boot, seed)
-    return np.sort(split_statistic(b)[0])
+    pieces of long records, a chunk of records at a time (:func:`allanite.model.tracing.simulated_block_mean_chunks`:
+    the statistic per chunk, not the 2²¹ block means and their sums at once)."""
+    chunks = simulated_block_mean_chunks(MEAN_BLOCKS, n // MEAN_BLOCKS, fs, terms, theta, n_boot, seed)
+    return np.sort(np.concatenate([split_statistic(b)[0] for b in chunks]))
 
 
 def mean_step_threshold(n: int, fs: float, terms, theta, alpha: float, seed: int = 7919) -> float:

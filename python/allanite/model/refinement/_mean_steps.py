@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from ...analysis import avar
-from ..tracing import block_means, simulated_block_means
+from ..tracing import block_means, simulated_block_mean_chunks
 from .curvefit import Curve, solve, theta_terms, upper_theta
 
 __all__ = [
@@ -69,8 +69,8 @@ _Z0 = 1.1503493803760079  # the normal's (1 + KEEP)/2 quantile
 _KEEP_SD = math.sqrt(1.0 - 2.0 * _Z0 * math.exp(-(_Z0**2) / 2) / math.sqrt(2 * math.pi) / KEEP)
 #: Most steps located (the step-down's rounds stop there).
 MOST_STEPS = 6
-#: Most simulated records (2²² half-block means in all, 32 MB): below α ≈ 1/(MAX_BOOT + 1) the threshold is the
-#: largest null statistic.
+#: Most simulated records (2²² half-block means in all, drawn :data:`.tracing.SIM_CHUNK` at a time): below
+#: α ≈ 1/(MAX_BOOT + 1) the threshold is the largest null statistic.
 MAX_BOOT = 2**22 // (2 * STEP_BLOCKS[-1])
 
 
@@ -122,8 +122,10 @@ def null_ratios(size: int, fs: float, terms, theta, alpha: float, seed: int = 79
     if not any(float(v) > 0 for t, v in zip(terms, theta) if t in ("N", "B", "K", "R")):
         terms, theta = ("N",), [1.0]  # nothing at the block rate (a model of lines or a Gauss–Markov term): white
     n_boot = min(MAX_BOOT, max(MIN_BOOT, math.ceil(BOOT_PER_ALPHA / alpha)))
-    sims = simulated_block_means(2 * blocks[-1], half, fs, terms, theta, n_boot, seed)
-    z, _ = increment_z(sims, blocks)
+    # a chunk of records at a time: their z (3 numbers a record) kept, not their means and increments (2²² of
+    # each at the cap, ≈ 240 MB with the simulation's transforms at once)
+    chunks = simulated_block_mean_chunks(2 * blocks[-1], half, fs, terms, theta, n_boot, seed)
+    z = np.concatenate([increment_z(sims, blocks)[0] for sims in chunks], axis=1)
     q = np.median(z, axis=1)
     stats = np.sort(steps_statistic(z, q)[0])
     thr = float(stats[min(math.ceil((n_boot + 1) * (1.0 - alpha)), n_boot) - 1])
