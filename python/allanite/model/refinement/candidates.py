@@ -35,6 +35,8 @@ from ._rolloff import (
     higher_butterworths,
     needs_spectrum,
     psd_white,
+    sinc_choice,
+    sinc_grids,
     spectrum_agrees,
 )
 from .curvefit import (
@@ -223,6 +225,7 @@ def bandwidth_grids(curve: Curve) -> dict:
         grids["moving_average"] = np.arange(l_min, l_max + 1, dtype=np.float64)
         grids["bartlett"] = np.arange(max(2, l_min // 2), max(3, l_max // 2) + 1, dtype=np.float64)
         grids["boxcar"] = np.geomspace(max(1.02, curve.tau[0] * fs / 3), l_max, 32)
+        grids.update(sinc_grids(grids["boxcar"]))  # sinc² … sinc⁵ (CIC): the boxcar's cutoffs
     if "single_pole" in grids and curve.tau[0] * fs <= 1.0:
         # a single pole after the part's own short averaging (only where the curve starts at one sample)
         for span in CASCADE_SPANS:
@@ -262,6 +265,7 @@ def _bw_propose(rnd: Round) -> list:
             rnd.curve, rnd.start, rnd.effects, grids[two], found[list(grids).index(two)], tie, rnd.y
         )
         found = [f for f in found if f[0] not in superseded] + steeper
+    found = sinc_choice(found, tie)  # one sinc^k order at most, where it beats the boxcar and the orders below
     for key, p, s_new, edge in found:
         kind = key.split(":", 1)[1]  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)
         if needs_spectrum(kind) and not spectrum_agrees(rnd.y, rnd.curve.fs, kind, p):
