@@ -84,7 +84,7 @@ def sinc_choice(found: list, tie: float) -> list:
     ``tie`` of the best sinc^k's, the one whose span lies nearest one output sample — a CIC read at its own
     output rate, whose boxcars are as long as its decimation. Kept where it lowers χ² by more than ``tie`` below
     the boxcar's (order 1), or where the two tie, the boxcar is more than two samples long and the sinc^k's span
-    within a factor :data:`CIC_SPAN` of one sample: a boxcar of 2.1 samples and a sinc⁴ of one have the same
+    within a factor :data:`CIC_SPAN` of one sample (the boxcar then left out, as the same process): a boxcar of 2.1 samples and a sinc⁴ of one have the same
     autocorrelation at the output's lags (0.52, 0.05 against 0.49, 0.05) but −3 dB points 8 % apart before the
     sampling aliases them, and a span of one is what a CIC has. Neighbouring orders trade span for order on the
     Allan curve (a sinc³ CIC 3200 → 200 Hz: sinc² at 1.24 samples, sinc³ at 1.00, sinc⁴ at 0.87, χ² 83–85, the
@@ -99,7 +99,9 @@ def sinc_choice(found: list, tie: float) -> list:
     pick = min((f for f in sincs if f[2].chi2 < best + tie), key=lambda f: abs(math.log(f[1])))
     beats = pick[2].chi2 < box[2].chi2 - tie
     cic = box[1] > 2.0 and pick[2].chi2 < box[2].chi2 + tie and abs(math.log(pick[1])) <= math.log(CIC_SPAN)
-    return rest + [pick] if beats or cic else rest
+    if beats:
+        return rest + [pick]
+    return [f for f in rest if f is not box] + [pick] if cic else rest  # the CIC reading in the boxcar's place
 
 
 #: How far (a factor either way) the filter's predicted high-band/low-band power ratio may lie from the one
