@@ -85,7 +85,12 @@ def test_allan_variance_matches_a_simulated_cic(order):
     span = filter_cutoff("boxcar", 1.0, FS) / filter_cutoff(f"sinc{order}", 1.0, FS)
     box = filtered_white_avar(tau, "boxcar", span, FS)
     # (sinc³: 2.6 % off at m = 1 where the spline's form is 0.2 % off; the others 6–9 %)
-    assert abs(sim[0] / box[0] - 1.0) > 0.02 > 0.01 > abs(sim[0] / filtered_white_avar(tau[0], f"sinc{order}", 1.0, FS)[0] - 1)
+    assert (
+        abs(sim[0] / box[0] - 1.0)
+        > 0.02
+        > 0.01
+        > abs(sim[0] / filtered_white_avar(tau[0], f"sinc{order}", 1.0, FS)[0] - 1)
+    )
 
 
 def test_sinc_grids_follow_the_boxcar_cutoffs():

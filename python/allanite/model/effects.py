@@ -55,8 +55,12 @@ __all__ = [
 #: navigation gyros; one parameter, f_c; the order is in the kind's name, as every other kind's shape is), and
 #: sinc^k of order 2 to 5 ("sinc2" … "sinc5": a CIC decimator read at its output rate, k boxcars of span D,
 #: the samples' autocorrelation the B-spline M_2k(l/D); :mod:`allanite.model._sinc`).
-FILTERS: tuple[str, ...] = ("single_pole", "moving_average", "bartlett", "boxcar") + tuple(f"sinc{k}" for k in SINC_ORDERS)
-FILTERS += ("single_pole+boxcar",) + tuple(f"butterworth{n}" for n in (2, 3, 4, 5, 6))
+FILTERS: tuple[str, ...] = (
+    ("single_pole", "moving_average", "bartlett", "boxcar")
+    + tuple(f"sinc{k}" for k in SINC_ORDERS)
+    + ("single_pole+boxcar",)
+    + tuple(f"butterworth{n}" for n in (2, 3, 4, 5, 6))
+)
 #: Orders of the Butterworth kinds of :data:`FILTERS` ("butterworth2" … "butterworth6").
 BUTTERWORTH_ORDERS = (2, 3, 4, 5, 6)
 #: Spans (samples) of the boxcar a single pole may follow ("single_pole+boxcar:<span>": a filter added after

@@ -84,12 +84,13 @@ def sinc_choice(found: list, tie: float) -> list:
     ``tie`` of the best sinc^k's, the one whose span lies nearest one output sample — a CIC read at its own
     output rate, whose boxcars are as long as its decimation. Kept where it lowers χ² by more than ``tie`` below
     the boxcar's (order 1), or where the two tie, the boxcar is more than two samples long and the sinc^k's span
-    within a factor :data:`CIC_SPAN` of one sample (the boxcar then left out, as the same process): a boxcar of 2.1 samples and a sinc⁴ of one have the same
-    autocorrelation at the output's lags (0.52, 0.05 against 0.49, 0.05) but −3 dB points 8 % apart before the
-    sampling aliases them, and a span of one is what a CIC has. Neighbouring orders trade span for order on the
-    Allan curve (a sinc³ CIC 3200 → 200 Hz: sinc² at 1.24 samples, sinc³ at 1.00, sinc⁴ at 0.87, χ² 83–85, the
-    boxcar's 156, one effective point 14). Where the roll-off is one lag long (a boxcar of 1–2 samples, an MA(1)
-    process: the ADIS16405's) every order is the boxcar's process and none is kept."""
+    within a factor :data:`CIC_SPAN` of one sample (the boxcar then left out, as the same process): a boxcar of
+    2.1 samples and a sinc⁴ of one have the same autocorrelation at the output's lags (0.52, 0.05 against 0.49,
+    0.05) but −3 dB points 8 % apart before the sampling aliases them, and a span of one is what a CIC has.
+    Neighbouring orders trade span for order on the Allan curve (a sinc³ CIC 3200 → 200 Hz: sinc² at 1.24
+    samples, sinc³ at 1.00, sinc⁴ at 0.87, χ² 83–85, the boxcar's 156, one effective point 14). Where the
+    roll-off is one lag long (a boxcar of 1–2 samples, an MA(1) process: the ADIS16405's) every order is the
+    boxcar's process and none is kept."""
     sincs = [f for f in found if sinc_order(f[0].split(":", 1)[1]) and not f[3]]
     rest = [f for f in found if not sinc_order(f[0].split(":", 1)[1])]
     box = next((f for f in rest if f[0] == "bandwidth:boxcar" and not f[3]), None)
