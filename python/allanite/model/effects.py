@@ -383,8 +383,8 @@ EFFECTS: dict[str, Effect] = {
                 (
                     "taps",
                     "samples",
-                    "FIR length (moving average L, Bartlett 2L − 1; a boxcar's span D·f_s, any real); "
-                    "0 for a single pole or a Butterworth",
+                    "FIR length (moving average L, Bartlett 2L − 1; a boxcar's span D·f_s, any real; a sinc^k's "
+                    "span per boxcar, 1 for a CIC read at its output rate); 0 for a single pole or a Butterworth",
                 ),
                 (
                     "floor",
@@ -394,7 +394,8 @@ EFFECTS: dict[str, Effect] = {
                 ),
             ),
             "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
-            "decimating MEMS part, a boxcar of any span read at the output rate, or the Butterworth anti-alias "
+            "decimating MEMS part, a boxcar of any span read at the output rate, a CIC decimator's sinc^k of "
+            "order 2 to 5, ``sinc2`` … ``sinc5``, or the Butterworth anti-alias "
             "stage of a MEMS or tactical gyro, orders 2 to 6, ``butterworth2`` … ``butterworth6``): "
             "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, in place of N²/τ — a "
             "roll-off of the shortest τ; the N it reports is the white noise before the filter. Beside a Butterworth "

@@ -15,6 +15,10 @@ white angle noise stands in for the order plus the floor on the Allan curve; whe
 effective χ² point the spectrum above f_s/4 chooses (:func:`white_psd_misfit`: a floor is flat, white angle
 noise rises to f_s/2).
 
+A CIC decimator's sinc^k (orders 2–5; the boxcar is order 1) is named where it fits better than the boxcar, or
+ties with a boxcar of more than two samples at a span of one output sample; of the orders that tie, the one whose
+span lies nearest one sample (:func:`sinc_choice`).
+
 The roll-off is accepted first (:func:`.candidates.choose`: the white noise every other column is judged
 against), so its parameter is searched without the terms later steps add; a Gauss–Markov term's short-τ slope
 or a resonance beside it then leaves the cutoff biased, and the final joint fit refits amplitudes only

@@ -4,7 +4,7 @@ parameters and intervals a step reports, and what a second domain says about it.
 
 - ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4];
 - ``"bandwidth"`` — the sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett
-  FIR, a boxcar of any span, a single pole after a short boxcar, a Butterworth of order 2–6), replacing the N
+  FIR, a boxcar of any span, a CIC's sinc^k, a single pole after a short boxcar, a Butterworth), replacing the N
   column; the kind with the lowest χ² (ties: the one needing fewer other terms; a Butterworth only where
   the samples' spectrum shows its roll-off);
 - ``"resonance"`` — narrowband noise near the shortest τ, at quality factors :data:`RESONANCE_Q`;
