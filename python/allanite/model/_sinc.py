@@ -13,7 +13,7 @@ boxcar kind's triangle (1 − l/D)₊. The discrete filter's ρ(1) lies below th
 a few % shorter). Its Allan variance follows exactly from ρ (:func:`allanite.model.effects.filtered_white_avar`).
 
 The −3 dB frequency is the continuous filter's, sinc^{2k}(πf·D/f_s) = ½: x_k·f_s/(π·D), x_k solving
-sinc²(x) = 2^{−1/k} (0.4430·f_s/D at k = 1, 0.2625·f_s at k = 3, D = 1) — before the output sampling aliases it.
+sinc²(x) = 2^{−1/k} (0.4430·f_s/D at k = 1, 0.2619·f_s at k = 3, D = 1) — before the output sampling aliases it.
 """
 
 from __future__ import annotations
