@@ -12,7 +12,9 @@ from scipy import optimize, signal
 import allanite
 from allanite.model._sinc import SINC_ORDERS, sinc_autocorrelation, sinc_cutoff, sinc_order
 from allanite.model.effects import FILTERS, filter_autocorrelation, filter_cutoff, filtered_white_avar
-from allanite.model.refinement._rolloff import CIC_SPAN, sinc_choice, sinc_grids
+from allanite.model.refinement._rolloff import CIC_SPAN, needs_samples, needs_spectrum, sinc_choice, sinc_grids
+from allanite.model.refinement.candidates import CURVE_CANDIDATES, bandwidth_grids
+from allanite.model.refinement.curvefit import Curve
 
 FS = 200.0
 
@@ -140,3 +142,17 @@ def test_refine_names_a_cic_and_its_cutoff():
     assert st.params["filter"] == "sinc4" and st.params["taps"] == pytest.approx(1.0, abs=0.05)
     assert st.params["cutoff"] == pytest.approx(_cic_cutoff(order, dec, FS), rel=0.03)
     assert r.curve_errors(r.fit)["chi2_dof"] < 1.6 and not r.unexplained
+
+
+def test_sinc_kinds_only_with_samples():
+    # a steep shape the Allan curve alone does not pin (as a Butterworth's): not proposed on a curve alone
+    assert all(needs_samples(f"sinc{k}") and not needs_spectrum(f"sinc{k}") for k in SINC_ORDERS)
+    assert not needs_samples("boxcar") and needs_samples("butterworth2")
+    m = np.unique(np.geomspace(1, 20_000, 40).astype(int)).astype(float)
+    curve = Curve(m / FS, m, FS / m, FS, 1_000_000, "oavar")
+    grids = bandwidth_grids(curve)
+    assert {f"sinc{k}" for k in SINC_ORDERS} <= set(grids)
+    family = CURVE_CANDIDATES["bandwidth"].family
+    with_samples, curve_only = family(curve, True), family(curve, False)
+    steep = sum(grids[k].size for k in grids if needs_samples(k))
+    assert len(with_samples) - len(curve_only) == steep > sum(grids[f"sinc{k}"].size for k in SINC_ORDERS)

@@ -48,6 +48,7 @@ __all__ = [
     "psd_white",
     "white_psd_misfit",
     "needs_spectrum",
+    "needs_samples",
     "spectrum_agrees",
     "research_rolloff",
     "higher_butterworths",
@@ -122,6 +123,13 @@ SPECTRUM_FLOOR = 1.0 / 6.0
 def needs_spectrum(kind: str) -> bool:
     """Whether a bandwidth kind is named only where the samples' spectrum shows its roll-off."""
     return butterworth_order(kind) > 0  # every Butterworth order
+
+
+def needs_samples(kind: str) -> bool:
+    """Whether a bandwidth kind is proposed only with samples: the Butterworths (named where the spectrum shows
+    their roll-off) and the sinc^k, steep shapes the Allan curve alone does not pin (the IMAR gyro y curve, whose
+    main reading is a boxcar of 1.09 samples beside a misfit at τ 5–80 ms, read as a sinc⁵ of 1.24 samples)."""
+    return needs_spectrum(kind) or sinc_order(kind) > 0
 
 
 def spectrum_agrees(y: np.ndarray | None, fs: float, kind: str, p: float) -> bool:

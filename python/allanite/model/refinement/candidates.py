@@ -3,10 +3,9 @@ bootstrap of the curve test (its family), how its best parameter is found at a s
 parameters and intervals a step reports, and what a second domain says about it.
 
 - ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4];
-- ``"bandwidth"`` — the sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett
-  FIR, a boxcar of any span, a CIC's sinc^k, a single pole after a short boxcar, a Butterworth), replacing the N
-  column; the kind with the lowest χ² (ties: the one needing fewer other terms; a Butterworth only where
-  the samples' spectrum shows its roll-off);
+- ``"bandwidth"`` — the sensor's low-pass on its white rate noise (single pole, moving average, Bartlett, boxcar,
+  a CIC's sinc^k, pole + boxcar, Butterworth), replacing the N column; the kind with the lowest χ² (ties: the one
+  needing fewer other terms; a Butterworth only where the samples' spectrum shows its roll-off);
 - ``"resonance"`` — narrowband noise near the shortest τ, at quality factors :data:`RESONANCE_Q`;
 - ``"sinusoid"`` — with samples, the strongest spectral line of the Welch PSD not yet in the model (its own χ²
   test), its amplitude held at the line's power in the spectrum in every fit of the curve (:func:`line_key`);
@@ -33,6 +32,7 @@ from ._rolloff import (
     better_kind,
     filter_params,
     higher_butterworths,
+    needs_samples,
     needs_spectrum,
     psd_white,
     sinc_choice,
@@ -237,7 +237,7 @@ def _bw_family(sub: Curve, has_samples: bool) -> list:
     return [
         column(f"bandwidth:{kind}", p, sub) - 1.0 / sub.tau
         for kind, grid in bandwidth_grids(sub).items()
-        if has_samples or not needs_spectrum(kind)  # proposed only where a spectrum can show it
+        if has_samples or not needs_samples(kind)  # a Butterworth, a sinc^k: proposed only with samples
         for p in grid
     ]
 
@@ -248,7 +248,7 @@ def _bw_searches(rnd: Round) -> list:
     return [  # the Butterworths above the 2nd order only where it was searched (:func:`_bw_propose`)
         (f"bandwidth:{kind}", grid, kind not in ("moving_average", "bartlett"))
         for kind, grid in bandwidth_grids(rnd.curve).items()
-        if kind not in STEEPER
+        if kind not in STEEPER and (rnd.y is not None or not needs_samples(kind))
     ]
 
 
