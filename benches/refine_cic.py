@@ -185,6 +185,16 @@ NOTES = [
     "the curve test's threshold is bit-identical on 12 and 0.15, 0.69, 0.73 % higher on the three flicker "
     "records; nothing found or unexplained on either side. `refine_false_alarms.py --quick` (16 records): 0 "
     "alarms before and after.",
+    "",
+    "**Unchanged by the kinds** (run on this branch, compared with main's runs): ADIS16405 run 1 gyro_z, run 4 "
+    "gyro_x, run 3 acc_x, run 5 gyro_y (`refine_measured.py --only …`: every line of their rows identical to "
+    "`benches/results/refine.md` — boxcars of 1.23–1.41 samples, run 1 z's single pole beside its resonances: "
+    "an MA(1) roll-off is every sinc order's process, so the boxcar stays); the four filtered rows of "
+    "`refine_sensors.py` and blind suite 1's Butterworth + Gauss–Markov and blind suite 3's quantised "
+    "4th-order Butterworth rows (every number but the CPU seconds); `refine_white_floor.py --quick` (24 "
+    "records: Butterworths 2–6, single pole, 4-tap average, none at 2 kHz, steps 0–1 σ) table identical to "
+    "main's. Curve-only input proposes no sinc^k (as no Butterworth): the IMAR gyro y curve would read as a "
+    "sinc⁵ of 1.24 samples.",
 ]
 
 
