@@ -18,6 +18,7 @@ import numpy as np
 
 from .._display import fmt, fmt_ci
 from ..errors import ParameterError
+from ._sinc import SINC_ORDERS, sinc_autocorrelation, sinc_cutoff, sinc_order
 
 __all__ = [
     "Effect",
@@ -37,6 +38,8 @@ __all__ = [
     "format_params",
     "FILTERS",
     "BUTTERWORTH_ORDERS",
+    "SINC_ORDERS",
+    "sinc_order",
     "CASCADE_SPANS",
     "RESONANCE_Q",
     "resonance_avar",
@@ -49,9 +52,14 @@ __all__ = [
 #: the samples' autocorrelation is the triangle (1 − l/(D·f_s))₊; −3 dB at 0.443/D), and Butterworths of order
 #: 2 to 6 ("butterworth2" … "butterworth6": the digital filter ``scipy.signal.butter(n, f_c, fs=f_s)``: bilinear,
 #: prewarped, −3 dB at f_c exactly — the 2nd- to 6th-order anti-alias low-passes of MEMS, tactical and
-#: navigation gyros; one parameter, f_c; the order is in the kind's name, as every other kind's shape is).
-FILTERS = ("single_pole", "moving_average", "bartlett", "boxcar", "single_pole+boxcar") + tuple(
-    f"butterworth{n}" for n in (2, 3, 4, 5, 6)
+#: navigation gyros; one parameter, f_c; the order is in the kind's name, as every other kind's shape is), and
+#: sinc^k of order 2 to 5 ("sinc2" … "sinc5": a CIC decimator read at its output rate, k boxcars of span D,
+#: the samples' autocorrelation the B-spline M_2k(l/D); :mod:`allanite.model._sinc`).
+FILTERS: tuple[str, ...] = (
+    ("single_pole", "moving_average", "bartlett", "boxcar")
+    + tuple(f"sinc{k}" for k in SINC_ORDERS)
+    + ("single_pole+boxcar",)
+    + tuple(f"butterworth{n}" for n in (2, 3, 4, 5, 6))
 )
 #: Orders of the Butterworth kinds of :data:`FILTERS` ("butterworth2" … "butterworth6").
 BUTTERWORTH_ORDERS = (2, 3, 4, 5, 6)
@@ -149,7 +157,7 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
 
     ``kind`` one of :data:`FILTERS`; ``p`` the cutoff (Hz) for ``"single_pole"`` and the Butterworths, the
     length L (taps of one moving average) for the FIRs, the span D·f_s (samples, ≥ 1, any real) for
-    ``"boxcar"``."""
+    ``"boxcar"``, each boxcar's span in output samples (≥ 1/k, any real) for a sinc^k (``"sinc2"`` …)."""
     if kind == "single_pole":
         a = math.exp(-2.0 * math.pi * p / fs)
         n = int(min(200_000, math.ceil(40.0 / max(1.0 - a, 1e-9)))) + 1
@@ -165,6 +173,8 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
         tail = (c[None, :] * np.exp(lags[:, None] * np.log(poles.astype(np.complex128))[None, :])).sum(axis=1).real
         tail[0] += lag1
         return np.concatenate([[r0], tail])
+    if sinc_order(kind):
+        return sinc_autocorrelation(sinc_order(kind), p)
     if kind == "boxcar":
         span = max(1.0, float(p))
         tri = 1.0 - np.arange(int(math.ceil(span)), dtype=np.float64) / span
@@ -185,7 +195,9 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
 
 def filter_cutoff(kind: str, p: float, fs: float) -> float:
     """−3 dB frequency (Hz) of a filter of :data:`FILTERS` (``p`` as in :func:`filter_autocorrelation`); for a
-    boxcar the continuous filter's, 0.4430/D (sinc² = ½), before the output sampling aliases it."""
+    boxcar the continuous filter's, 0.4430/D (sinc² = ½), and a sinc^k's, before the output sampling aliases it."""
+    if sinc_order(kind):
+        return sinc_cutoff(sinc_order(kind), p, fs)
     if kind == "single_pole" or butterworth_order(kind):  # a Butterworth's prewarped cutoff: −3 dB at f_c exactly
         return float(p)
     if kind == "boxcar":
@@ -372,8 +384,8 @@ EFFECTS: dict[str, Effect] = {
                 (
                     "taps",
                     "samples",
-                    "FIR length (moving average L, Bartlett 2L − 1; a boxcar's span D·f_s, any real); "
-                    "0 for a single pole or a Butterworth",
+                    "FIR length (moving average L, Bartlett 2L − 1; a boxcar's span D·f_s, any real; a sinc^k's "
+                    "span per boxcar, 1 for a CIC read at its output rate); 0 for a single pole or a Butterworth",
                 ),
                 (
                     "floor",
@@ -383,7 +395,8 @@ EFFECTS: dict[str, Effect] = {
                 ),
             ),
             "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
-            "decimating MEMS part, a boxcar of any span read at the output rate, or the Butterworth anti-alias "
+            "decimating MEMS part, a boxcar of any span read at the output rate, a CIC decimator's sinc^k of "
+            "order 2 to 5, ``sinc2`` … ``sinc5``, or the Butterworth anti-alias "
             "stage of a MEMS or tactical gyro, orders 2 to 6, ``butterworth2`` … ``butterworth6``): "
             "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, in place of N²/τ — a "
             "roll-off of the shortest τ; the N it reports is the white noise before the filter. Beside a Butterworth "

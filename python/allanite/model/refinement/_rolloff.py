@@ -15,6 +15,10 @@ white angle noise stands in for the order plus the floor on the Allan curve; whe
 effective χ² point the spectrum above f_s/4 chooses (:func:`white_psd_misfit`: a floor is flat, white angle
 noise rises to f_s/2).
 
+A CIC decimator's sinc^k (orders 2–5; the boxcar is order 1) is named where it fits better than the boxcar, or
+ties with a boxcar of more than two samples at a span of one output sample; of the orders that tie, the one whose
+span lies nearest one sample (:func:`sinc_choice`).
+
 The roll-off is accepted first (:func:`.candidates.choose`: the white noise every other column is judged
 against), so its parameter is searched without the terms later steps add; a Gauss–Markov term's short-τ slope
 or a resonance beside it then leaves the cutoff biased, and the final joint fit refits amplitudes only
@@ -34,6 +38,7 @@ import numpy as np
 from scipy.optimize import nnls
 
 from .. import tracing
+from .._sinc import SINC_ORDERS, sinc_order
 from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation, filter_cutoff
 from .curvefit import PROFILE_RHO, Curve, Solution, base_name, search, solve
 
@@ -43,16 +48,68 @@ __all__ = [
     "psd_white",
     "white_psd_misfit",
     "needs_spectrum",
+    "needs_samples",
     "spectrum_agrees",
     "research_rolloff",
     "higher_butterworths",
     "SPECTRUM_FACTOR",
     "SPECTRUM_FLOOR",
     "STEEPER",
+    "SINCS",
+    "sinc_grids",
+    "sinc_choice",
+    "CIC_SPAN",
 ]
 
 #: The Butterworths above the 2nd order: searched only where the 2nd order was (:func:`higher_butterworths`).
 STEEPER = tuple(f"butterworth{n}" for n in BUTTERWORTH_ORDERS[1:])
+#: The sinc^k (CIC) kinds, order 2 up: the boxcar is order 1 (:func:`sinc_choice`).
+SINCS = tuple(f"sinc{k}" for k in SINC_ORDERS)
+
+
+def sinc_grids(boxcar: np.ndarray) -> dict:
+    """Each sinc^k kind's grid of spans (output samples per boxcar): the boxcar's grid at the same −3 dB
+    frequencies (a span D·x_k/x_1, :func:`allanite.model.filter_cutoff`), none below 1.02/k (white there)."""
+    grids = {}
+    for kind in SINCS:
+        k, ref = sinc_order(kind), filter_cutoff("boxcar", 1.0, 1.0)
+        spans = np.asarray(boxcar, dtype=np.float64) * filter_cutoff(kind, 1.0, 1.0) / ref
+        grids[kind] = np.geomspace(max(1.02 / k, float(spans[0])), float(spans[-1]), spans.size)
+    return grids
+
+
+#: How near one output sample (a factor either way) a sinc^k's span must lie to be read as a CIC at its own output
+#: rate where the boxcar fits as well: the discrete CIC's ρ lies below the spline's by O(1/R²) — spans 0.97–1.0 at
+#: decimations 4–64 (``benches/refine_cic.py``).
+CIC_SPAN = 1.1
+
+
+def sinc_choice(found: list, tie: float) -> list:
+    """``found`` (key, p, sol, edge) with the sinc^k kinds left out but one: among the orders whose χ² lies within
+    ``tie`` of the best sinc^k's, the one whose span lies nearest one output sample — a CIC read at its own
+    output rate, whose boxcars are as long as its decimation. Kept where it lowers χ² by more than ``tie`` below
+    the boxcar's (order 1), or where the two tie, the boxcar is more than two samples long and the sinc^k's span
+    within a factor :data:`CIC_SPAN` of one sample (the boxcar then left out, as the same process): a boxcar of
+    2.1 samples and a sinc⁴ of one have the same autocorrelation at the output's lags (0.52, 0.05 against 0.49,
+    0.05) but −3 dB points 8 % apart before the sampling aliases them, and a span of one is what a CIC has.
+    Neighbouring orders trade span for order on the Allan curve (a sinc³ CIC 3200 → 200 Hz: sinc² at 1.24
+    samples, sinc³ at 1.00, sinc⁴ at 0.87, χ² 83–85, the boxcar's 156, one effective point 14). Where the
+    roll-off is one lag long (a boxcar of 1–2 samples, an MA(1) process: the ADIS16405's) every order is the
+    boxcar's process and none is kept."""
+    sincs = [f for f in found if sinc_order(f[0].split(":", 1)[1]) and not f[3]]
+    rest = [f for f in found if not sinc_order(f[0].split(":", 1)[1])]
+    box = next((f for f in rest if f[0] == "bandwidth:boxcar" and not f[3]), None)
+    if not sincs or box is None:
+        return rest
+    best = min(f[2].chi2 for f in sincs)
+    pick = min((f for f in sincs if f[2].chi2 < best + tie), key=lambda f: abs(math.log(f[1])))
+    beats = pick[2].chi2 < box[2].chi2 - tie
+    cic = box[1] > 2.0 and pick[2].chi2 < box[2].chi2 + tie and abs(math.log(pick[1])) <= math.log(CIC_SPAN)
+    if beats:
+        return rest + [pick]
+    return [f for f in rest if f is not box] + [pick] if cic else rest  # the CIC reading in the boxcar's place
+
+
 #: How far (a factor either way) the filter's predicted high-band/low-band power ratio may lie from the one
 #: measured in the Welch PSD (:func:`allanite.model.tracing.rolloff_psd`) for a kind of ``needs_spectrum``.
 SPECTRUM_FACTOR = 2.0
@@ -66,6 +123,13 @@ SPECTRUM_FLOOR = 1.0 / 6.0
 def needs_spectrum(kind: str) -> bool:
     """Whether a bandwidth kind is named only where the samples' spectrum shows its roll-off."""
     return butterworth_order(kind) > 0  # every Butterworth order
+
+
+def needs_samples(kind: str) -> bool:
+    """Whether a bandwidth kind is proposed only with samples: the Butterworths (named where the spectrum shows
+    their roll-off) and the sinc^k, steep shapes the Allan curve alone does not pin (the IMAR gyro y curve, whose
+    main reading is a boxcar of 1.09 samples beside a misfit at τ 5–80 ms, read as a sinc⁵ of 1.24 samples)."""
+    return needs_spectrum(kind) or sinc_order(kind) > 0
 
 
 def spectrum_agrees(y: np.ndarray | None, fs: float, kind: str, p: float) -> bool:
@@ -259,7 +323,7 @@ def filter_params(kind: str, p: float, fs: float, profile) -> tuple[dict, dict]:
             "cutoff": (filter_cutoff(kind, p_lo, fs), filter_cutoff(kind, p_hi, fs)),
             "pole_cutoff": (p_lo, p_hi),
         }
-    if kind == "boxcar":
+    if kind == "boxcar" or sinc_order(kind):
         s_lo, s_hi = profile()
         return {"cutoff": cut, "taps": float(p), "filter": kind}, {
             "cutoff": (filter_cutoff(kind, s_hi, fs), filter_cutoff(kind, s_lo, fs)),

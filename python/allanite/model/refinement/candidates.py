@@ -3,10 +3,9 @@ bootstrap of the curve test (its family), how its best parameter is found at a s
 parameters and intervals a step reports, and what a second domain says about it.
 
 - ``"gauss_markov"`` — a bump, T_c in [5·τ_min, τ_max/4];
-- ``"bandwidth"`` — the sensor's low-pass on its white rate noise (single pole, moving-average or Bartlett
-  FIR, a boxcar of any span, a single pole after a short boxcar, a Butterworth of order 2–6), replacing the N
-  column; the kind with the lowest χ² (ties: the one needing fewer other terms; a Butterworth only where
-  the samples' spectrum shows its roll-off);
+- ``"bandwidth"`` — the sensor's low-pass on its white rate noise (single pole, moving average, Bartlett, boxcar,
+  a CIC's sinc^k, pole + boxcar, Butterworth), replacing the N column; the kind with the lowest χ² (ties: the one
+  needing fewer other terms; a Butterworth only where the samples' spectrum shows its roll-off);
 - ``"resonance"`` — narrowband noise near the shortest τ, at quality factors :data:`RESONANCE_Q`;
 - ``"sinusoid"`` — with samples, the strongest spectral line of the Welch PSD not yet in the model (its own χ²
   test), its amplitude held at the line's power in the spectrum in every fit of the curve (:func:`line_key`);
@@ -33,8 +32,11 @@ from ._rolloff import (
     better_kind,
     filter_params,
     higher_butterworths,
+    needs_samples,
     needs_spectrum,
     psd_white,
+    sinc_choice,
+    sinc_grids,
     spectrum_agrees,
 )
 from .curvefit import (
@@ -226,6 +228,7 @@ def bandwidth_grids(curve: Curve) -> dict:
         grids["moving_average"] = np.arange(l_min, l_max + 1, dtype=np.float64)
         grids["bartlett"] = np.arange(max(2, l_min // 2), max(3, l_max // 2) + 1, dtype=np.float64)
         grids["boxcar"] = np.geomspace(max(1.02, curve.tau[0] * fs / 3), l_max, 32)
+        grids.update(sinc_grids(grids["boxcar"]))  # sinc² … sinc⁵ (CIC): the boxcar's cutoffs
     if "single_pole" in grids and curve.tau[0] * fs <= 1.0:
         # a single pole after the part's own short averaging (only where the curve starts at one sample)
         for span in CASCADE_SPANS:
@@ -237,7 +240,7 @@ def _bw_family(sub: Curve, has_samples: bool) -> list:
     return [
         column(f"bandwidth:{kind}", p, sub) - 1.0 / sub.tau
         for kind, grid in bandwidth_grids(sub).items()
-        if has_samples or not needs_spectrum(kind)  # proposed only where a spectrum can show it
+        if has_samples or not needs_samples(kind)  # a Butterworth, a sinc^k: proposed only with samples
         for p in grid
     ]
 
@@ -248,7 +251,7 @@ def _bw_searches(rnd: Round) -> list:
     return [  # the Butterworths above the 2nd order only where it was searched (:func:`_bw_propose`)
         (f"bandwidth:{kind}", grid, kind not in ("moving_average", "bartlett"))
         for kind, grid in bandwidth_grids(rnd.curve).items()
-        if kind not in STEEPER
+        if kind not in STEEPER and (rnd.y is not None or not needs_samples(kind))
     ]
 
 
@@ -265,6 +268,7 @@ def _bw_propose(rnd: Round) -> list:
             rnd.curve, rnd.start, rnd.effects, grids[two], found[list(grids).index(two)], tie, rnd.y
         )
         found = [f for f in found if f[0] not in superseded] + steeper
+    found = sinc_choice(found, tie)  # one sinc^k order at most, where it beats the boxcar and the orders below
     for key, p, s_new, edge in found:
         kind = key.split(":", 1)[1]  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)
         if needs_spectrum(kind) and not spectrum_agrees(rnd.y, rnd.curve.fs, kind, p):
