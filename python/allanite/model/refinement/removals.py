@@ -148,6 +148,15 @@ def _drift(ctx: RemovalContext) -> Iterator[Removal]:
         ctx.consider("drift", {"T": w["T"], "statistic": dr["statistic"], "threshold": thr_d} | channel)
         return
 
+    # held out in time on the warm-up's own time scale (the Allan curve's alternate eighths put a warm-up shorter
+    # than one into one part alone: tests/test_warmup_heldout.py)
+    held = warmup.warmup_heldout(y, fs, w["noise"], w["T"], w["ramp"])
+    held_ev = {k: held[k] for k in ("ratio", "z", "group_s", "fits")} | {"z_min": warmup.HELDOUT_Z}
+    if not held["z"] >= warmup.HELDOUT_Z:
+        why = f"held out in time: z {held['z']:.3g} < {warmup.HELDOUT_Z:g} (ratio {held['ratio']:.3g})"
+        ctx.consider("drift", {"T": w["T"], "statistic": dr["statistic"], "threshold": thr_d, "rejected": why})
+        return
+
     def refit(z, idx):
         g = warmup.warmup_component(z, idx / fs, w["noise"], span, pieces, ramp=w["ramp"])
         return lambda i: g(i / fs)
@@ -164,8 +173,10 @@ def _drift(ctx: RemovalContext) -> Iterator[Removal]:
             "noise": w["noise"],  # the noise terms the block means were weighed against (base form)
             # the Cramér–Rao bound of T and a under those terms (relative sd): what any unbiased estimate can do
             "bound": warmup.warmup_crlb(span, w["amplitude"], w["T"], w["noise"], ramp=w["ramp"]),
+            "heldout_in_time": held_ev,
         },
         2,
+        heldout_in_time=held["ratio"],
     )
 
 
