@@ -5,8 +5,9 @@ component its calibrated test finds: the component itself (removed from the samp
 the held-in part's samples (for the held-out error), its parameters and intervals, its evidence with the
 test's statistic, threshold and α (its share of ``level``, :mod:`.levels`), and how many numbers it fitted.
 The loop accepts a removal when the held-out error falls (or its own held-out test in time passes: a white-like
-component's, a warm-up's, a slow channel's, a line family's), and scores it on the original record's curve: the model after the removal plus what the removal
-changed in the Allan curve, AVAR(y) − AVAR(y − component), cross terms included.
+component's, a warm-up's, a slow channel's, a line family's), and scores it on the original record's curve: the
+model after the removal plus what the removal changed in the Allan curve, AVAR(y) − AVAR(y − component), cross
+terms included.
 
 - ``"drift"`` — a warm-up a·e^{−t/T} on block means, tested against block means drawn from the five-term fit
   with its slow terms at the upper end of what the curve allows (:func:`allanite.model.tracing.drift_fit`);
@@ -14,8 +15,9 @@ changed in the Allan curve, AVAR(y) − AVAR(y − component), cross terms inclu
   record's own noise terms (:mod:`allanite.model.warmup`: flicker and random walk tie the block means together,
   and an ordinary fit's intervals then miss the truth); held out in time on its own time scale
   (:func:`allanite.model.warmup.warmup_heldout`: groups of block means no longer than T/2 interleaved, the
-  held-out part's conditional χ² under that noise with and without the held-in part's fit); left to a channel whose regression, accepted on the
-  samples as they are, leaves a record the drift test no longer accepts (a cold start's temperature swing);
+  held-out part's conditional χ² under that noise with and without the held-in part's fit); left to a channel
+  whose regression, accepted on the samples as they are, leaves a record the drift test no longer accepts (a cold
+  start's temperature swing);
 - ``"regression"`` — the rate regressed on each channel of ``channels=``: a fast channel within blocks in time
   (t test with the blocks' effective dof), band by band where the coupling differs across frequency; a slow one
   (:func:`allanite.model.channels.is_slow`: a temperature), or a fast one whose within-block test has fewer
