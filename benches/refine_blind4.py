@@ -324,7 +324,8 @@ NOTES: list = [
     "Gauss–Markov term of T_c 388 s beside them); the pulse-counted RLG's dither line at its alias, 388 Hz "
     "(+0.0 %); the flicker-dominated clean gyro (nothing added); the heater's two change points (6000 and "
     "11 000 s); the 0.01 Hz line in 10⁷ samples (−1.1 %); the magnetometer's 50 Hz family of 4 odd harmonics "
-    "(rms +0.1 %); the warm-up of a sixth of the detectable size (nothing added, nothing said).",
+    "(rms +0.1 %); the warm-up of a sixth of the detectable size (nothing added, nothing said)."
+    + " The accelerometer's row (warm-up and line) was rerun alone since, once the drift's held-out test moved into time (r7heldout): **9 of 11**.",
     "",
     "Why three failed at the first run:",
     "",
@@ -353,19 +354,28 @@ NOTES: list = [
     "and T² are nearly collinear and their errors tied (the quadratic +5.9 %, its interval ±3.5 %). The judge's 20 % is tighter than this record allows; not retuned. Unchanged by the fix: the six "
     "temperature rows of `benches/refine_sensors.py`, blind2's two channel rows, blind3's six and blind1's "
     "48 h row (effects, parameters and words as recorded).",
-    "- *accelerometer (m/s²) on 1 g, warm-up and a 6.2 Hz line* — the line is named (−0.1 %), the warm-up's "
-    "test accepts (statistic 1516 against 126; a 0.0128, +6 %, T 445 s, +11 %) but its held-out Allan-curve "
-    "error rose 42.36 → 42.52 %, the line (a curve effect, added after the removals) then 42 % of that "
-    "error. The warm-up is said in `unexplained` (τ 223–556 s, T ≈ 447 s). Tried and not kept: the warm-up "
-    "offered again once the curve effects are in — with the line in the model its held-out error still rises, "
-    "3.53 → 3.94 %, so the line is not the whole cause. The held-in parts' own warm-up fits are poor (on the "
-    "even blocks T ≈ 80 s, on the odd ones, which miss the first 625 s, a 0.004 and T ≈ 3500 s; the same with "
-    "the line removed exactly), but T kept from the whole record and the amplitude alone refitted (as every "
-    "curve effect's nonlinear parameter is held out) does not make it fall either: 42.36 → 42.85 %, and with the "
-    "line in the model 3.53 → 3.59 %. Left open: at τ where the two parts agree the warm-up may move the "
-    "held-out score by less than its scatter. Not tried: the held-out test in "
-    "time of the periodic removal (`removals.heldout_variance_ratio`), which for a drift would not guard "
-    "against its main false alarm (a random walk's wander, which the interleaved blocks share).",
+    "- *accelerometer (m/s²) on 1 g, warm-up and a 6.2 Hz line* — at the first run the line was named "
+    "(−0.1 %) and the warm-up's test accepted (statistic 1516 against 126; a 0.0128, +6 %, T 445 s, +11 "
+    "%) but its held-out Allan-curve error rose 42.36 → 42.52 %, and the warm-up was only said in "
+    "`unexplained` (τ 223–556 s, T ≈ 447 s). Why: the held-out split's alternate eighths (625 s) are "
+    "longer than the warm-up (T 400 s), so one part holds the whole warm-up and the other almost none; "
+    "the held-in parts' fits are poor (the odd blocks' a 0.0086, T 528 s here; on other seeds and rates T"
+    " from 25 to 5000 s, one amplitude 10⁷), no τ where the two parts' own curves agree holds the warm-"
+    "up, and the scored τ (EDF ≥ 50: up to 30 s) are decided by the line's misfit, which the five terms "
+    "do not model (without the line: 3.68 → 3.69 %). Over 20 such warm-ups (T 40–1500 s, 100 Hz–1 kHz × "
+    "10⁵–10⁶, with and without the line) that test kept 9. **Kept since** (r7heldout): a drift is held "
+    "out in time on its own time scale (`allanite.model.warmup.warmup_heldout`: block means interleaved "
+    "in groups ≤ T/2, here 220 s, each part with a block at the record's start; the held-in parts' fits a"
+    " 0.0127, T 436 s and a 0.0130, T 445 s; the held-out block means' conditional χ² under the record's "
+    "noise 0.45 of that without the warm-up, z 16.5 against 4) — 18 of those 20 kept (the two at 1 kHz "
+    "with T 100 s and the line read z 3.0 and 3.6), while on 20 random-walk and flicker records at 10 "
+    "Hz–1 kHz the warm-up fitted to their wander reached z ≤ 2.1; `refine_injected`'s two warm-up rows "
+    "and `refine_sensors`' three, blind2's one as recorded. The row above is this case rerun alone "
+    "(`--case accelerometer`, its neighbour the vibration row unchanged): drift (a +6.4 %, T +11.1 %) and"
+    " sinusoid, χ²/dof 4.29·10⁴ → 1.56, RMS ADEV 39.6 → 0.881 %, nothing unexplained. The chain's held-"
+    "out Allan-curve error rises at the drift step, 3.53 → 3.85 % (said in the step's `heldout_note`): on"
+    " that split's eighths the warm-up is still refitted on a part that holds it alone; the final 3.85 % "
+    "where the first run ended at 3.53 %.",
 ]
 
 

@@ -4,16 +4,20 @@ A remover looks at the current samples (after the removals before it) and yields
 component its calibrated test finds: the component itself (removed from the samples), how to refit it on
 the held-in part's samples (for the held-out error), its parameters and intervals, its evidence with the
 test's statistic, threshold and α (its share of ``level``, :mod:`.levels`), and how many numbers it fitted.
-The loop accepts a removal when the held-out error falls (or, for a white-like component, the held-out test
-in time), and scores it on the original record's curve: the model after the removal plus what the removal
-changed in the Allan curve, AVAR(y) − AVAR(y − component), cross terms included.
+The loop accepts a removal when the held-out error falls (or its own held-out test in time passes: a white-like
+component's, a warm-up's, a slow channel's, a line family's), and scores it on the original record's curve: the
+model after the removal plus what the removal changed in the Allan curve, AVAR(y) − AVAR(y − component), cross
+terms included.
 
 - ``"drift"`` — a warm-up a·e^{−t/T} on block means, tested against block means drawn from the five-term fit
   with its slow terms at the upper end of what the curve allows (:func:`allanite.model.tracing.drift_fit`);
   a and T and their intervals by generalised least squares against the block means' covariance under the
   record's own noise terms (:mod:`allanite.model.warmup`: flicker and random walk tie the block means together,
-  and an ordinary fit's intervals then miss the truth); left to a channel whose regression, accepted on the
-  samples as they are, leaves a record the drift test no longer accepts (a cold start's temperature swing);
+  and an ordinary fit's intervals then miss the truth); held out in time on its own time scale
+  (:func:`allanite.model.warmup.warmup_heldout`: groups of block means no longer than T/2 interleaved, the
+  held-out part's conditional χ² under that noise with and without the held-in part's fit); left to a channel
+  whose regression, accepted on the samples as they are, leaves a record the drift test no longer accepts (a cold
+  start's temperature swing);
 - ``"regression"`` — the rate regressed on each channel of ``channels=``: a fast channel within blocks in time
   (t test with the blocks' effective dof), band by band where the coupling differs across frequency; a slow one
   (:func:`allanite.model.channels.is_slow`: a temperature), or a fast one whose within-block test has fewer
@@ -148,6 +152,21 @@ def _drift(ctx: RemovalContext) -> Iterator[Removal]:
         ctx.consider("drift", {"T": w["T"], "statistic": dr["statistic"], "threshold": thr_d} | channel)
         return
 
+    # held out in time on the warm-up's own time scale (the Allan curve's alternate eighths put a warm-up shorter
+    # than one into one part alone: tests/test_warmup_heldout.py)
+    held = warmup.warmup_heldout(y, fs, w["noise"], w["T"], w["ramp"])
+    held_ev = {
+        "ratio": float(held["ratio"]),
+        "z": float(held["z"]),
+        "z_min": warmup.HELDOUT_Z,
+        "group_s": float(held["group_s"]),
+        "fits": [(float(a), float(t_c)) for a, t_c in held["fits"]],
+    }
+    if not held["z"] >= warmup.HELDOUT_Z:
+        why = f"held out in time: z {held['z']:.3g} < {warmup.HELDOUT_Z:g} (ratio {held['ratio']:.3g})"
+        ctx.consider("drift", {"T": w["T"], "statistic": dr["statistic"], "threshold": thr_d, "rejected": why})
+        return
+
     def refit(z, idx):
         g = warmup.warmup_component(z, idx / fs, w["noise"], span, pieces, ramp=w["ramp"])
         return lambda i: g(i / fs)
@@ -164,8 +183,10 @@ def _drift(ctx: RemovalContext) -> Iterator[Removal]:
             "noise": w["noise"],  # the noise terms the block means were weighed against (base form)
             # the Cramér–Rao bound of T and a under those terms (relative sd): what any unbiased estimate can do
             "bound": warmup.warmup_crlb(span, w["amplitude"], w["T"], w["noise"], ramp=w["ramp"]),
+            "heldout_in_time": held_ev,
         },
         2,
+        heldout_in_time=held["ratio"],
     )
 
 
