@@ -3,7 +3,8 @@
 
 A digital sensor quantises its rate output after its filter: a step Δ adds white rate noise of Δ²/12 per sample
 (Allan variance Δ²·τ0/(12τ), floor = Δ·√(τ0/12) in N's units). Beside a Butterworth the bandwidth effect keeps
-N's column as that floor (``floor``); beside a single pole or a moving average it does not (docs/refinement.md).
+N's column as that floor (``floor``); beside a single pole or a moving average only where the spectrum above
+f_s/4 shows a floor the fit agrees with (docs/refinement.md).
 Cases: Butterworths of order 2–6 at f_s/5, a single pole at f_s/10, a 4-tap moving average, and no filter; at
 f_s = 200, 1000 and 2000 Hz; quantised at none, ½ and 1 σ of the white noise before the filter (Δ = step·N·√f_s);
 white noise N = 4·10⁻³ °/√s plus rate random walk K = 2·10⁻⁵, 4·10⁵ samples, one seed per case. Default call

@@ -13,7 +13,9 @@ filter there, up to :data:`SPECTRUM_FLOOR` (a steep filter's output quantised). 
 in the model (the N column kept: :func:`.curvefit.has_floor`, the bandwidth's ``floor``), and an order less plus
 white angle noise stands in for the order plus the floor on the Allan curve; where the two are within one
 effective χ² point the spectrum above f_s/4 chooses (:func:`white_psd_misfit`: a floor is flat, white angle
-noise rises to f_s/2).
+noise rises to f_s/2). Beside a single pole, a boxcar or another kind the floor is in the model only where the
+spectrum shows one and the Allan curve's fit agrees with it (:func:`floor_choice`): offered everywhere, it moved
+the ADIS16405's boxcars and resonances where the spectrum has none.
 
 A CIC decimator's sinc^k (orders 2–5; the boxcar is order 1) is named where it fits better than the boxcar, or
 ties with a boxcar of more than two samples at a span of one output sample; of the orders that tie, the one whose
@@ -275,11 +277,14 @@ def floor_choice(curve: Curve, start: tuple, effects: list, best: tuple, specs: 
 
 def _floor_agrees(y: np.ndarray, fs: float, n_col: int, found: tuple) -> bool:
     """Whether the floor of the fit ``found`` = (key, p, sol, edge) (its N column, ``n_col``) lies within
-    :data:`FLOOR_AGREE` of the one the spectrum above f_s/4 shows beside its filter (:func:`psd_white`)."""
+    :data:`FLOOR_AGREE` of the one the spectrum above f_s/4 shows beside its filter (:func:`psd_white`), and
+    below the filtered white noise N: a "filter" whose white part is mostly after it is none (ADIS16405 run 1
+    gyro_z before its resonance: a 3-tap average carrying N = 0 beside a floor of 0.040, the spectrum's 0.029)."""
     key, p, sol, _edge = found
-    fit = math.sqrt(max(float(sol.theta[n_col]), 0.0))
-    spec = psd_white(y, fs, bw_kind(key), p, max(float(sol.theta[-1]), 0.0))["floor"]
-    return fit > 0.0 and spec > 0.0 and abs(math.log(fit / spec)) <= math.log(FLOOR_AGREE)
+    fit, n2 = math.sqrt(max(float(sol.theta[n_col]), 0.0)), max(float(sol.theta[-1]), 0.0)
+    spec = psd_white(y, fs, bw_kind(key), p, n2)["floor"]
+    agree = fit > 0.0 and spec > 0.0 and abs(math.log(fit / spec)) <= math.log(FLOOR_AGREE)
+    return agree and fit < math.sqrt(n2)
 
 
 def better_kind(new, best, tie) -> bool:
