@@ -138,5 +138,7 @@ def test_a_quantised_4_tap_average_names_no_resonance():
     r = allanite.refine(_record(2058, fs, "ma4", 0.5), fs)
     assert [s.effect for s in r.steps] == ["bandwidth"]
     p = r.steps[0].final_params
-    assert p["filter"] in ("boxcar", "moving_average") and p["cutoff"] == pytest.approx(filter_cutoff("moving_average", 4, fs), rel=0.03)
+    assert p["filter"] in ("boxcar", "moving_average") and p["cutoff"] == pytest.approx(
+        filter_cutoff("moving_average", 4, fs), rel=0.03
+    )
     assert p["floor"] == pytest.approx(_floor(0.5), rel=0.20)
