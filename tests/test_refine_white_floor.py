@@ -12,6 +12,7 @@ cutoff 7–10 % high and a quantised 4-tap average took a resonance for the floo
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -20,7 +21,7 @@ from scipy import signal
 import allanite
 from allanite.estimators.grid import tau_grid
 from allanite.model.effects import filter_cutoff
-from allanite.model.refinement._rolloff import PSD_MISFIT_FACTOR, white_psd_misfit
+from allanite.model.refinement._rolloff import PSD_MISFIT_FACTOR, _floor_agrees, psd_white, white_psd_misfit
 from allanite.model.refinement.candidates import bandwidth_grids
 from allanite.model.refinement.curvefit import FLOOR_TAG, Curve, has_floor, search
 
@@ -142,3 +143,25 @@ def test_a_quantised_4_tap_average_names_no_resonance():
         filter_cutoff("moving_average", 4, fs), rel=0.03
     )
     assert p["floor"] == pytest.approx(_floor(0.5), rel=0.20)
+
+
+def test_a_floor_beside_a_single_pole_is_kept_only_where_the_spectrum_agrees_and_it_is_no_filter_by_itself():
+    fs = 2000.0
+    y = _record(2053, fs, "pole", 1.0)
+    spec = psd_white(y, fs, "single_pole", 200.0, N**2)["floor"]
+    assert spec == pytest.approx(_floor(1.0), rel=0.10)
+
+    def found(floor: float, n: float) -> tuple:  # (key, p, a stand-in solution: Q, N (the floor), B, K, R, filter)
+        return (
+            "bandwidth:single_pole" + FLOOR_TAG,
+            200.0,
+            SimpleNamespace(theta=np.array([0, floor**2, 0, 0, 0, n**2])),
+            False,
+        )
+
+    assert _floor_agrees(y, fs, 1, found(spec, N))
+    assert _floor_agrees(y, fs, 1, found(1.4 * spec, N)) and not _floor_agrees(y, fs, 1, found(1.6 * spec, N))
+    assert not _floor_agrees(y, fs, 1, found(0.0, N))  # white angle noise took it on the curve: no floor
+    # a "filter" carrying almost none of the white noise, the floor all of it (the spectrum then agrees): refused
+    lone = psd_white(y, fs, "single_pole", 200.0, (0.01 * N) ** 2)["floor"]
+    assert not _floor_agrees(y, fs, 1, found(lone, 0.01 * N))
