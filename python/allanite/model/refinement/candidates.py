@@ -291,7 +291,7 @@ def _bw_params(pr: Proposal, rnd: Round) -> tuple:
         rnd.curve.fs,
         lambda: profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol),
     )
-    if "N" in rnd.start and has_floor(pr.key):  # the N column beside a Butterworth: white noise after it
+    if "N" in rnd.start and has_floor(pr.key):  # the N column kept (has_floor): white noise after the filter
         floor, sd, floor_int = _amplitude(pr.sol, list(rnd.start).index("N"))
         params["floor"] = floor
         if math.isfinite(sd):  # none where the floor is 0 (a bound, not an estimate)

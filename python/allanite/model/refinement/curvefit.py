@@ -3,12 +3,13 @@ of an effect's nonlinear parameter with its profile interval, and the NoiseFit i
 
 Every curve effect enters the model as a non-negative column of Allan variance (its registry signature,
 :mod:`allanite.model.effects`); an effect that ``replaces`` a term (a bandwidth: the filtered white noise is
-the white rate noise N, reported as N) zeroes that term's column — but beside a Butterworth the N column stays,
-as white noise added after the filter (a quantised output's floor), non-negative, so 0 where there is none
-(:func:`has_floor`). An effect measured in the time domain (a spectral line's amplitude, from its power in the
-samples' spectrum) is *held*: its key carries the coefficient and its variance (:func:`held_key`), its column
-enters every fit at that value and the curve fits only the others — the Allan curve, where a line's column
-aliases with a bandwidth's or a resonance's, does not move it.
+the white rate noise N, reported as N) zeroes that term's column — but beside a Butterworth (and beside another
+kind whose key carries :data:`FLOOR_TAG`) the N column stays, as white noise added after the filter (a quantised
+output's floor), non-negative, so 0 where there is none (:func:`has_floor`). An effect measured in the time
+domain (a spectral line's amplitude, from its power in the samples' spectrum) is *held*: its key carries the
+coefficient and its variance (:func:`held_key`), its column enters every fit at that value and the curve fits
+only the others — the Allan curve, where a line's column aliases with a bandwidth's or a resonance's, does not
+move it.
 Weights are the estimates' EDF under the model's own noise mix, iterated (IRLS); the covariance of the
 coefficients counts the dense curve's ~one independent estimate per octave.
 """
@@ -504,7 +505,7 @@ def upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4
 
 def theta_terms(sol, terms, effects):
     """Squared coefficients of the terms (a bandwidth's N — the white noise before its filter — in place of the N
-    column's: zeroed, or beside a Butterworth the floor after the filter, the bandwidth's ``floor``)."""
+    column's: zeroed, or where :func:`has_floor` keeps it the floor after the filter, the bandwidth's ``floor``)."""
     k = len(terms)
     theta = sol.theta[:k].copy()
     for j, (key, _p) in enumerate(effects):
