@@ -298,7 +298,8 @@ def without_candidate_cell(left) -> str:
 
 def write_results(out: Path, stem: str, lines: list, results, end: str = "\n") -> None:
     """A bench's page ``<stem>.md`` (``lines`` joined by newlines, then ``end``) and its ``<stem>.json``
-    (``results``; NumPy scalars as floats)."""
+    (``results``; NumPy scalars as floats), in ``out`` (made if missing)."""
+    out.mkdir(parents=True, exist_ok=True)
     (out / f"{stem}.md").write_text("\n".join(lines) + end)
     (out / f"{stem}.json").write_text(json.dumps(results, indent=1, default=float))
 

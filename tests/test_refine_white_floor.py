@@ -4,12 +4,15 @@ A digital part quantises its output after its decimation filter: a step Δ adds 
 sample — Allan variance Δ²·τ0/(12τ), N's τ⁻¹ slope, not Q's τ⁻² — so floor = Δ·√(τ0/12). Before the floor was
 modelled, blind suite 3's quantised 4th-order filter at 400 Hz of 2 kHz was read with a 704 Hz resonance (Q 2)
 that is not there, and a 3rd order plus white angle noise stood in for the 4th plus the floor (the two within
-0.08 % on the Allan curve; the spectrum above f_s/4 tells them apart: :func:`white_psd_misfit`). Only beside a
-Butterworth (:func:`has_floor`)."""
+0.08 % on the Allan curve; the spectrum above f_s/4 tells them apart: :func:`white_psd_misfit`). Beside a
+Butterworth always (:func:`has_floor`); beside a single pole or a moving average only where the spectrum shows a
+floor and the Allan curve's fit agrees with it (:func:`floor_choice`) — before, a quantised single pole read its
+cutoff 7–10 % high and a quantised 4-tap average took a resonance for the floor."""
 
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -17,19 +20,23 @@ from scipy import signal
 
 import allanite
 from allanite.estimators.grid import tau_grid
-from allanite.model.refinement._rolloff import PSD_MISFIT_FACTOR, white_psd_misfit
+from allanite.model.effects import filter_cutoff
+from allanite.model.refinement._rolloff import PSD_MISFIT_FACTOR, _floor_agrees, psd_white, white_psd_misfit
 from allanite.model.refinement.candidates import bandwidth_grids
-from allanite.model.refinement.curvefit import Curve, has_floor, search
+from allanite.model.refinement.curvefit import FLOOR_TAG, Curve, has_floor, search
 
 N = 4e-3  # °/√s of white rate noise before the filter
 
 
 def _record(seed: int, fs: float, filt, step: float, n: int = 400_000) -> np.ndarray:
-    """White rate noise N plus a little rate random walk, through ``filt`` ("pole" at f_s/10, an int: the
+    """White rate noise N plus a little rate random walk, through ``filt`` ("pole" at f_s/10, "ma4" a 4-tap moving
+    average, an int: the
     Butterworth of that order at f_s/5, None: no filter), rounded to ``step`` white-noise σ (N·√f_s)."""
     rng = np.random.default_rng(seed)
     y = allanite.simulate(n, fs, N=N, K=2e-5, seed=rng)
-    if filt == "pole":
+    if filt == "ma4":
+        y = signal.lfilter(np.full(4, 0.25), [1.0], y)
+    elif filt == "pole":
         a = math.exp(-2.0 * math.pi * 0.1)
         y = signal.lfilter([1.0 - a], [1.0, -a], y)
     elif filt:
@@ -71,10 +78,11 @@ def test_a_quantised_2nd_order_butterworth_at_200hz_finds_the_floor():
     assert p["floor"] == pytest.approx(_floor(1.0), rel=0.10)
 
 
-def test_a_single_pole_has_no_floor_column():
+def test_an_unquantised_single_pole_has_no_floor_column():
     # beside a single pole (or a boxcar) a floor trades with the cutoff (the span) and white angle noise on the
-    # Allan curve: N stays replaced, as before (curvefit.has_floor)
+    # Allan curve: N stays replaced unless the spectrum shows a floor (curvefit.has_floor, _rolloff.floor_choice)
     assert not has_floor("bandwidth:single_pole") and not has_floor("bandwidth:boxcar")
+    assert has_floor("bandwidth:single_pole" + FLOOR_TAG) and has_floor("bandwidth:boxcar" + FLOOR_TAG)
     assert has_floor("bandwidth:butterworth2") and not has_floor("resonance:2")
     fs = 500.0
     r = allanite.refine(_record(1, fs, "pole", 0.0), fs)
@@ -110,3 +118,50 @@ def test_the_spectrum_tells_the_order_plus_floor_from_an_order_less_plus_white_a
     # … the spectrum above f_s/4 is flat, as a floor is, not rising as white angle noise does
     mis = {k: white_psd_misfit(y, fs, f"butterworth{k}", p, sol) for k, (p, sol) in fits.items()}
     assert mis[4] < 0.03 and mis[4] < PSD_MISFIT_FACTOR * mis[3]
+
+
+def test_a_quantised_single_pole_reads_its_cutoff_with_the_floor_beside_it():
+    # a step of one σ after a single pole at f_s/10: without the floor the pole's cutoff stood in for it, +6.9 %
+    # (benches/refine_white_floor.py's row, this record)
+    fs = 2000.0
+    r = allanite.refine(_record(2053, fs, "pole", 1.0), fs)
+    assert [s.effect for s in r.steps] == ["bandwidth"]
+    p = r.steps[0].final_params
+    assert p["filter"] == "single_pole" and p["cutoff"] == pytest.approx(200.0, rel=0.03)
+    assert p["floor"] == pytest.approx(_floor(1.0), rel=0.20)
+    assert r.steps[0].evidence["psd_white"]["floor"] == pytest.approx(_floor(1.0), rel=0.20)
+    assert r.fit.coefficients["N"].value == pytest.approx(N, rel=0.03)
+
+
+def test_a_quantised_4_tap_average_names_no_resonance():
+    # a step of ½ σ after a 4-tap moving average at 1 kHz: without the floor a resonance stood in for it
+    fs = 1000.0
+    r = allanite.refine(_record(2058, fs, "ma4", 0.5), fs)
+    assert [s.effect for s in r.steps] == ["bandwidth"]
+    p = r.steps[0].final_params
+    assert p["filter"] in ("boxcar", "moving_average") and p["cutoff"] == pytest.approx(
+        filter_cutoff("moving_average", 4, fs), rel=0.03
+    )
+    assert p["floor"] == pytest.approx(_floor(0.5), rel=0.20)
+
+
+def test_a_floor_beside_a_single_pole_is_kept_only_where_the_spectrum_agrees_and_it_is_no_filter_by_itself():
+    fs = 2000.0
+    y = _record(2053, fs, "pole", 1.0)
+    spec = psd_white(y, fs, "single_pole", 200.0, N**2)["floor"]
+    assert spec == pytest.approx(_floor(1.0), rel=0.10)
+
+    def found(floor: float, n: float) -> tuple:  # (key, p, a stand-in solution: Q, N (the floor), B, K, R, filter)
+        return (
+            "bandwidth:single_pole" + FLOOR_TAG,
+            200.0,
+            SimpleNamespace(theta=np.array([0, floor**2, 0, 0, 0, n**2])),
+            False,
+        )
+
+    assert _floor_agrees(y, fs, 1, found(spec, N))
+    assert _floor_agrees(y, fs, 1, found(1.4 * spec, N)) and not _floor_agrees(y, fs, 1, found(1.6 * spec, N))
+    assert not _floor_agrees(y, fs, 1, found(0.0, N))  # white angle noise took it on the curve: no floor
+    # a "filter" carrying almost none of the white noise, the floor all of it (the spectrum then agrees): refused
+    lone = psd_white(y, fs, "single_pole", 200.0, (0.01 * N) ** 2)["floor"]
+    assert not _floor_agrees(y, fs, 1, found(lone, 0.01 * N))

@@ -320,7 +320,8 @@ class Effect:
     replaces : str, optional
         The term whose noise the effect's column carries ("N" for a bandwidth: the filtered white noise *is* the
         white rate noise, reported as N); the term's own column is zeroed — beside a Butterworth it stays, as
-        white noise added after the filter (its ``floor``; :func:`allanite.model.refinement.curvefit.has_floor`).
+        white noise added after the filter (its ``floor``; :func:`allanite.model.refinement.curvefit.has_floor`),
+        and beside another kind where the samples' spectrum shows a floor (:func:`.refinement._rolloff.floor_choice`).
     """
 
     name: str
@@ -390,8 +391,9 @@ EFFECTS: dict[str, Effect] = {
                 (
                     "floor",
                     "rate unit·√s",
-                    "white rate noise added after a Butterworth (the output's quantisation, a readout's noise), "
-                    "as N: the N column beside the filtered one, 0 where there is none; not with other kinds",
+                    "white rate noise added after the filter (the output's quantisation, a readout's noise), as N: "
+                    "the N column beside the filtered one, 0 where there is none; beside a Butterworth always, beside "
+                    "another kind only where the spectrum above f_s/4 shows one and the fit agrees with it",
                 ),
             ),
             "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
@@ -400,6 +402,7 @@ EFFECTS: dict[str, Effect] = {
             "stage of a MEMS or tactical gyro, orders 2 to 6, ``butterworth2`` … ``butterworth6``): "
             "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, in place of N²/τ — a "
             "roll-off of the shortest τ; the N it reports is the white noise before the filter. Beside a Butterworth "
+            "(and beside another kind where the spectrum above f_s/4 shows a floor the fit agrees with) "
             "the N²/τ column stays, non-negative, as white noise added after the filter (``floor``: a digital "
             "part's quantised output adds a step Δ's Δ²/12 per sample, floor = Δ·√(τ0/12); a readout's noise): a "
             "steep filter's stop band is then flat, not a resonance. Accepted first, its parameter is searched "

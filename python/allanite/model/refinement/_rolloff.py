@@ -13,7 +13,9 @@ filter there, up to :data:`SPECTRUM_FLOOR` (a steep filter's output quantised). 
 in the model (the N column kept: :func:`.curvefit.has_floor`, the bandwidth's ``floor``), and an order less plus
 white angle noise stands in for the order plus the floor on the Allan curve; where the two are within one
 effective χ² point the spectrum above f_s/4 chooses (:func:`white_psd_misfit`: a floor is flat, white angle
-noise rises to f_s/2).
+noise rises to f_s/2). Beside a single pole, a boxcar or another kind the floor is in the model only where the
+spectrum shows one and the Allan curve's fit agrees with it (:func:`floor_choice`): offered everywhere, it moved
+the ADIS16405's boxcars and resonances where the spectrum has none.
 
 A CIC decimator's sinc^k (orders 2–5; the boxcar is order 1) is named where it fits better than the boxcar, or
 ties with a boxcar of more than two samples at a span of one output sample; of the orders that tie, the one whose
@@ -40,7 +42,7 @@ from scipy.optimize import nnls
 from .. import tracing
 from .._sinc import SINC_ORDERS, sinc_order
 from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation, filter_cutoff
-from .curvefit import PROFILE_RHO, Curve, Solution, base_name, search, solve
+from .curvefit import FLOOR_TAG, PROFILE_RHO, Curve, Solution, base_name, bw_kind, search, searches, solve
 
 __all__ = [
     "better_kind",
@@ -59,6 +61,9 @@ __all__ = [
     "sinc_grids",
     "sinc_choice",
     "CIC_SPAN",
+    "floor_choice",
+    "FLOOR_MIN",
+    "FLOOR_AGREE",
 ]
 
 #: The Butterworths above the 2nd order: searched only where the 2nd order was (:func:`higher_butterworths`).
@@ -96,9 +101,9 @@ def sinc_choice(found: list, tie: float) -> list:
     samples, sinc³ at 1.00, sinc⁴ at 0.87, χ² 83–85, the boxcar's 156, one effective point 14). Where the
     roll-off is one lag long (a boxcar of 1–2 samples, an MA(1) process: the ADIS16405's) every order is the
     boxcar's process and none is kept."""
-    sincs = [f for f in found if sinc_order(f[0].split(":", 1)[1]) and not f[3]]
-    rest = [f for f in found if not sinc_order(f[0].split(":", 1)[1])]
-    box = next((f for f in rest if f[0] == "bandwidth:boxcar" and not f[3]), None)
+    sincs = [f for f in found if sinc_order(bw_kind(f[0])) and not f[3]]
+    rest = [f for f in found if not sinc_order(bw_kind(f[0]))]
+    box = next((f for f in rest if bw_kind(f[0]) == "boxcar" and not f[3]), None)
     if not sincs or box is None:
         return rest
     best = min(f[2].chi2 for f in sincs)
@@ -228,8 +233,58 @@ def _spectrum_prefers(y, fs: float, new: tuple, prev: tuple, tie: float) -> bool
     spectrum's upper half band better by :data:`PSD_MISFIT_FACTOR` (False without samples)."""
     if y is None or new[3] or not new[2].chi2 < prev[2].chi2 + tie:
         return False
-    mis = [white_psd_misfit(y, fs, k.split(":", 1)[1], p, s) for k, p, s, _e in (new, prev)]
+    mis = [white_psd_misfit(y, fs, bw_kind(k), p, s) for k, p, s, _e in (new, prev)]
     return mis[0] < PSD_MISFIT_FACTOR * mis[1]
+
+
+#: The least white floor, as a fraction of N, that the spectrum above f_s/4 must show beside a kind other than a
+#: Butterworth (:func:`psd_white` at the kind found without one) for a floor to be tried there: a quantisation
+#: step of ≈ 0.17 σ of the white noise, whose Δ²/12 is 1/400 of its power — below that the floor moves nothing.
+FLOOR_MIN = 0.05
+#: How far (a factor either way) the floor the Allan curve's fit gives may lie from the spectrum's at that fit
+#: (:func:`psd_white`) for the floor to be kept beside a kind other than a Butterworth.
+FLOOR_AGREE = 1.5
+
+
+def floor_choice(curve: Curve, start: tuple, effects: list, best: tuple, specs: list, y, tie: float) -> tuple:
+    """The bandwidth (key, p, sol, edge) with a white floor after the filter where the samples show one beside a
+    kind other than a Butterworth (a Butterworth keeps its floor always: :func:`.curvefit.has_floor`), else
+    ``best`` as found without one. Tried where the spectrum above f_s/4 beside ``best`` flattens at a floor of
+    at least :data:`FLOOR_MIN` of N (:func:`psd_white`): every kind of ``specs`` ((key, grid, continuous), the
+    Butterworths left out) searched again with the floor (:data:`.curvefit.FLOOR_TAG`), the kind chosen as
+    without it (:func:`sinc_choice`, :func:`better_kind`), and kept only where the floor its fit gives agrees
+    with the spectrum's at that fit within :data:`FLOOR_AGREE` — on the Allan curve a floor trades with the
+    cutoff and white angle noise, so a floor the fit leaves at 0, or puts where the spectrum has none, is not
+    one (ADIS16405 run 4 gyro_x: the spectrum's 0.07·N beside a boxcar of 1.25 samples, the fit's 0 and a span
+    of 1.58 with white angle noise; run 1 gyro_z's single pole beside its 20 Hz resonances)."""
+    key, p, sol, _edge = best
+    kind = bw_kind(key)
+    if y is None or "N" not in start or butterworth_order(kind) or key.endswith(FLOOR_TAG):
+        return best
+    n2 = float(sol.theta[-1])
+    if not n2 > 0 or psd_white(y, curve.fs, kind, p, n2)["floor"] < FLOOR_MIN * math.sqrt(n2):
+        return best
+    tagged = [(k + FLOOR_TAG, g, c) for k, g, c in specs if not butterworth_order(bw_kind(k))]
+    found = [(spec[0], *res) for spec, res in zip(tagged, searches(curve, start, effects, tagged))]
+    pick = None
+    for f in sinc_choice(found, tie):
+        if better_kind(f, pick, tie):
+            pick = f
+    if pick is None or pick[3] or not _floor_agrees(y, curve.fs, list(start).index("N"), pick):
+        return best
+    return pick
+
+
+def _floor_agrees(y: np.ndarray, fs: float, n_col: int, found: tuple) -> bool:
+    """Whether the floor of the fit ``found`` = (key, p, sol, edge) (its N column, ``n_col``) lies within
+    :data:`FLOOR_AGREE` of the one the spectrum above f_s/4 shows beside its filter (:func:`psd_white`), and
+    below the filtered white noise N: a "filter" whose white part is mostly after it is none (ADIS16405 run 1
+    gyro_z before its resonance: a 3-tap average carrying N = 0 beside a floor of 0.040, the spectrum's 0.029)."""
+    key, p, sol, _edge = found
+    fit, n2 = math.sqrt(max(float(sol.theta[n_col]), 0.0)), max(float(sol.theta[-1]), 0.0)
+    spec = psd_white(y, fs, bw_kind(key), p, n2)["floor"]
+    agree = fit > 0.0 and spec > 0.0 and abs(math.log(fit / spec)) <= math.log(FLOOR_AGREE)
+    return agree and fit < math.sqrt(n2)
 
 
 def better_kind(new, best, tie) -> bool:
@@ -264,7 +319,7 @@ def research_rolloff(
     if j is None or len(effects) < 2 or any(base_name(k) == "resonance" for k, _p in effects):
         return effects, sol  # beside a resonance near the bandwidth the cutoff trades with it: left as accepted
     key = effects[j][0]
-    kind = key.split(":", 1)[1]
+    kind = bw_kind(key)
     grid = grids.get(kind)
     if grid is None:
         return effects, sol

@@ -31,6 +31,7 @@ from ._rolloff import (
     STEEPER,
     better_kind,
     filter_params,
+    floor_choice,
     higher_butterworths,
     needs_samples,
     needs_spectrum,
@@ -43,6 +44,7 @@ from .curvefit import (
     Curve,
     Solution,
     base_name,
+    bw_kind,
     column,
     has_floor,
     held_key,
@@ -270,26 +272,26 @@ def _bw_propose(rnd: Round) -> list:
         found = [f for f in found if f[0] not in superseded] + steeper
     found = sinc_choice(found, tie)  # one sinc^k order at most, where it beats the boxcar and the orders below
     for key, p, s_new, edge in found:
-        kind = key.split(":", 1)[1]  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)
+        kind = bw_kind(key)  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)
         if needs_spectrum(kind) and not spectrum_agrees(rnd.y, rnd.curve.fs, kind, p):
             continue
         if better_kind((key, p, s_new, edge), best, tie):
             best = (key, p, s_new, edge)
     if best is None:
         return []
-    key, p, s_new, edge = best
+    key, p, s_new, edge = floor_choice(rnd.curve, rnd.start, rnd.effects, best, _bw_searches(rnd), rnd.y, tie)
     assert rnd.sub is not None
     return [_with_stat(rnd, key, p, s_new, edge, bump=1.0 / rnd.sub.tau)]
 
 
 def _bw_params(pr: Proposal, rnd: Round) -> tuple:
     params, intervals = filter_params(
-        pr.key.split(":", 1)[1],
+        bw_kind(pr.key),
         pr.p,
         rnd.curve.fs,
         lambda: profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol),
     )
-    if "N" in rnd.start and has_floor(pr.key):  # the N column beside a Butterworth: white noise after it
+    if "N" in rnd.start and has_floor(pr.key):  # the N column kept (has_floor): white noise after the filter
         floor, sd, floor_int = _amplitude(pr.sol, list(rnd.start).index("N"))
         params["floor"] = floor
         if math.isfinite(sd):  # none where the floor is 0 (a bound, not an estimate)
@@ -300,10 +302,10 @@ def _bw_params(pr: Proposal, rnd: Round) -> tuple:
 def _bw_evidence(pr: Proposal, rnd: Round) -> dict:
     ev: dict = {"N": math.sqrt(max(pr.sol.theta[-1], 0.0))}
     if rnd.y is not None:  # a second domain: the roll-off the filter predicts in the spectrum, and the data's
-        r = filter_autocorrelation(pr.key.split(":", 1)[1], pr.p, rnd.curve.fs)
+        r = filter_autocorrelation(bw_kind(pr.key), pr.p, rnd.curve.fs)
         ev["psd"] = tracing.rolloff_psd(rnd.y, rnd.curve.fs, r)
         if has_floor(pr.key):  # the white noise after it, as the spectrum above f_s/4 splits it (floor, Q)
-            ev["psd_white"] = psd_white(rnd.y, rnd.curve.fs, pr.key.split(":", 1)[1], pr.p, ev["N"] ** 2)
+            ev["psd_white"] = psd_white(rnd.y, rnd.curve.fs, bw_kind(pr.key), pr.p, ev["N"] ** 2)
     return ev
 
 

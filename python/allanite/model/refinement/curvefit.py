@@ -3,12 +3,13 @@ of an effect's nonlinear parameter with its profile interval, and the NoiseFit i
 
 Every curve effect enters the model as a non-negative column of Allan variance (its registry signature,
 :mod:`allanite.model.effects`); an effect that ``replaces`` a term (a bandwidth: the filtered white noise is
-the white rate noise N, reported as N) zeroes that term's column — but beside a Butterworth the N column stays,
-as white noise added after the filter (a quantised output's floor), non-negative, so 0 where there is none
-(:func:`has_floor`). An effect measured in the time domain (a spectral line's amplitude, from its power in the
-samples' spectrum) is *held*: its key carries the coefficient and its variance (:func:`held_key`), its column
-enters every fit at that value and the curve fits only the others — the Allan curve, where a line's column
-aliases with a bandwidth's or a resonance's, does not move it.
+the white rate noise N, reported as N) zeroes that term's column — but beside a Butterworth (and beside another
+kind whose key carries :data:`FLOOR_TAG`) the N column stays, as white noise added after the filter (a quantised
+output's floor), non-negative, so 0 where there is none (:func:`has_floor`). An effect measured in the time
+domain (a spectral line's amplitude, from its power in the samples' spectrum) is *held*: its key carries the
+coefficient and its variance (:func:`held_key`), its column enters every fit at that value and the curve fits
+only the others — the Allan curve, where a line's column aliases with a bandwidth's or a resonance's, does not
+move it.
 Weights are the estimates' EDF under the model's own noise mix, iterated (IRLS); the covariance of the
 coefficients counts the dense curve's ~one independent estimate per octave.
 """
@@ -30,6 +31,8 @@ from ._irls import chi2_at, irls
 __all__ = [
     "base_name",
     "has_floor",
+    "bw_kind",
+    "FLOOR_TAG",
     "held_key",
     "held_theta",
     "column",
@@ -53,6 +56,16 @@ __all__ = [
 def base_name(key: str) -> str:
     """The effect of a column key ("bandwidth:single_pole" → "bandwidth")."""
     return key.split(":", 1)[0]
+
+
+#: The tail of a bandwidth key whose N column stays beside a kind other than a Butterworth: a white floor after
+#: the filter that the samples' spectrum shows and the Allan curve's fit agrees with (:func:`._rolloff.floor_choice`).
+FLOOR_TAG = "|floor"
+
+
+def bw_kind(key: str) -> str:
+    """The filter kind of a bandwidth key ("bandwidth:boxcar|floor" → "boxcar")."""
+    return key.split(":", 1)[1].removesuffix(FLOOR_TAG)
 
 
 def held_key(effect: str, theta: float, var: float) -> str:
@@ -82,7 +95,7 @@ def _column(key, p, curve):
     base = base_name(key)
     tau = curve.tau
     if base == "bandwidth":
-        return filtered_white_avar(tau, key.split(":", 1)[1], p, curve.fs)
+        return filtered_white_avar(tau, bw_kind(key), p, curve.fs)
     if base == "resonance":
         return resonance_avar(tau, p, float(key.split(":", 1)[1]), curve.fs)
     sig = EFFECTS[base].signature
@@ -206,13 +219,15 @@ def design(curve, terms, effects):
 def has_floor(key: str) -> bool:
     """Whether the term a bandwidth ``key`` carries keeps its own column beside it — white noise added after the
     filter (a quantised output's floor; the bandwidth's ``floor``): beside a Butterworth, whose stop band the
-    samples' spectrum shows and a floor is flat in. Beside a single pole or a boxcar the term is replaced: there
-    a floor trades with the pole's cutoff, the boxcar's span and white angle noise on the Allan curve (ADIS16405
+    samples' spectrum shows and a floor is flat in, and beside any other kind whose key carries
+    :data:`FLOOR_TAG` — only where the spectrum above the roll-off shows a floor and the fit's floor agrees with
+    it (:func:`._rolloff.floor_choice`). Untagged, beside a single pole or a boxcar the term is replaced: there a
+    floor trades with the pole's cutoff, the boxcar's span and white angle noise on the Allan curve (ADIS16405
     run 5 gyro_y's boxcar read 1.41 → 1.61 samples with a floor of 0 and white angle noise in its place, run 1
     gyro_z's single pole beside a second resonance at 24.5 Hz)."""
     if base_name(key) != "bandwidth":
         return False
-    return butterworth_order(key.split(":", 1)[1]) > 0
+    return key.endswith(FLOOR_TAG) or butterworth_order(bw_kind(key)) > 0
 
 
 def _term_columns(curve, terms):
@@ -490,7 +505,7 @@ def upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4
 
 def theta_terms(sol, terms, effects):
     """Squared coefficients of the terms (a bandwidth's N — the white noise before its filter — in place of the N
-    column's: zeroed, or beside a Butterworth the floor after the filter, the bandwidth's ``floor``)."""
+    column's: zeroed, or where :func:`has_floor` keeps it the floor after the filter, the bandwidth's ``floor``)."""
     k = len(terms)
     theta = sol.theta[:k].copy()
     for j, (key, _p) in enumerate(effects):

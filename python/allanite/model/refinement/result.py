@@ -27,13 +27,14 @@ ERRORS = ("chi2_dof", "rms_z", "rms_adev_pct", "heldout_rms_adev_pct")
 class Step:
     """One effect added by :func:`refine`.
 
-    ``params`` in the input unit's base form, at acceptance (see :data:`allanite.model.effects.EFFECTS` for
-    each effect's parameters and units: Gauss–Markov ``sigma`` rate unit, ``tc`` s; sinusoid ``amplitude``
-    rate unit, ``f0`` Hz; bandwidth ``cutoff`` Hz, ``taps``, ``filter``, beside a Butterworth ``floor`` rate
-    unit·√s; resonance ``sigma`` rate unit, ``f0`` Hz, ``q``; periodic ``fundamentals`` (a list, Hz),
-    ``lines``, ``rms`` rate unit; outliers ``rate`` (share of the samples), ``threshold`` rate unit; drift
-    ``amplitude`` rate unit, ``T`` s; regression ``channel``, ``coefficient`` rate unit per channel unit and,
-    where their tests keep them, ``quadratic``, ``rate_coefficient``, ``lag_s``; change point ``t`` s);
+    ``params`` in the input unit's base form, at acceptance (see :data:`allanite.model.effects.EFFECTS` for each
+    effect's parameters and units: Gauss–Markov ``sigma`` rate unit, ``tc`` s; sinusoid ``amplitude`` rate unit,
+    ``f0`` Hz; bandwidth ``cutoff`` Hz, ``taps``, ``filter``, where a floor is modelled (beside a Butterworth;
+    another kind where the spectrum shows one) ``floor`` rate unit·√s; resonance ``sigma`` rate unit, ``f0`` Hz,
+    ``q``; periodic ``fundamentals`` (a list, Hz), ``lines``, ``rms`` rate unit; outliers ``rate`` (share of the
+    samples), ``threshold`` rate unit; drift ``amplitude`` rate unit, ``T`` s; regression ``channel``,
+    ``coefficient`` rate unit per channel unit and, where their tests keep them, ``quadratic``,
+    ``rate_coefficient``, ``lag_s``; change point ``t`` s);
     ``intervals`` the numeric keys → (low, high); ``final_params``/``final_intervals`` the same after the final
     joint refit (a curve effect's amplitude refitted beside every other effect — a bandwidth's cutoff searched
     again beside them —, its nonlinear parameter's interval profiled again; what was measured in the time
