@@ -187,8 +187,8 @@ def write(res: dict, out: Path) -> None:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", type=int, default=12)
-    ap.add_argument("--null", type=int, default=600)
-    ap.add_argument("--null-suite", type=int, default=1000)
+    ap.add_argument("--null", type=int, default=2000)
+    ap.add_argument("--null-suite", type=int, default=2000)
     ap.add_argument("--out", type=Path, default=HERE / "results")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
