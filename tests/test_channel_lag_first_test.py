@@ -5,6 +5,8 @@ the coupling. Power and false alarms at scale: benches/channel_lag_first_test.py
 from __future__ import annotations
 
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -63,3 +65,20 @@ def test_a_null_record_with_the_same_channel_is_not_accepted(seed):
     y, temp = _record(seed, 0.0, 0.0)
     r = regress_channel(y, temp, FS, name="temp", alpha=alpha("regression", LEVEL), level=LEVEL)
     assert not r.accepted and r.test["statistic"] < r.test["threshold"] and r.test["p_value"] > 0.01
+
+
+def test_a_diurnal_coupling_with_few_dof_keeps_the_channels_own_count():
+    # benches/refine_blind4.py's 24 h log: one diurnal cycle, ν ≈ 3. The pair's test takes the in-phase fit's ν
+    # (its threshold 99.8 against 2Δℓ 165); counted at the pair's own noise fit ν fell to 2.2 and the threshold
+    # rose to 379 — the coupling, found before the quadrature was added, was lost
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benches"))
+    try:
+        import refine_blind4
+    finally:
+        sys.path.pop(0)
+    case = next(c for c in refine_blind4.CASES if c.name.startswith("24 h at 10 Hz"))
+    y, fs, chans, _, _ = case.build(np.random.default_rng(case.seed))
+    r = regress_channel(y, chans["temp"], fs, name="temp", alpha=alpha("regression", LEVEL), level=LEVEL)
+    assert r.test["dof"] == r.test["in_phase"]["dof"] < 5.0
+    assert r.accepted and r.test["in_phase"]["statistic"] > r.test["in_phase"]["threshold"]
+    assert abs(r.test["phase_deg"]) < 15.0
