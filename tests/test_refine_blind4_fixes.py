@@ -44,11 +44,14 @@ def test_a_cold_start_temperature_is_its_regression_not_a_drift():
     assert r.steps[0].params["coefficient"] == pytest.approx(3e-4, rel=0.15)
     drift = r.considered["drift"][0]
     assert drift["explained_by"] == "temp" and drift["statistic_without_channel"] < drift["threshold"]
-    # without the regression candidate the channel takes nothing, so the drift is not left to it
+    # without the regression candidate the channel still explains the swing: the drift is not kept as its stand-in
+    # (it was, until a drift was held out in time and kept on a 25 h swing the same way) — the swing is said instead
     without = allanite.refine(
         y, fs, unit="deg/s", channels={"temp": temp}, candidates=("drift", "gauss_markov"), progress=False
     )
-    assert without.found == ["drift"], (without.found, without.considered.get("drift"))
+    assert without.found == [], (without.found, without.considered.get("drift"))
+    assert without.considered["drift"][0]["explained_by"] == "temp"
+    assert any(u["domain"] == "time" and "warm-up-like drift" in u["what"] for u in without.unexplained)
 
 
 def test_a_warm_up_the_temperature_does_not_explain_stays_a_drift():

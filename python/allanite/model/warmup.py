@@ -269,7 +269,16 @@ def warmup_component(
     cov = _cov_of_blocks(edges, _slow_free(noise))
     d = gls_warmup(zb, edges.mean(axis=1), cov, length, ramp=_has_ramp(noise) if ramp is None else ramp)
     a, t_c = d["amplitude"], d["T"]
+    if not math.exp(-float(edges[0, 0]) / t_c) >= SEEN_MIN:
+        # the part starts after the warm-up it fits has decayed: its amplitude is an extrapolation the part cannot
+        # determine (a part of late blocks once read 10¹⁴⁷ on a 25 h swing) — it predicts no warm-up
+        return lambda tt: np.zeros(np.shape(tt))
     return lambda tt: a * np.exp(-np.asarray(tt) / t_c)
+
+
+#: The least share of its amplitude a warm-up fitted on a part of the record must show within that part
+#: (:func:`warmup_component`): below it the part only extrapolates.
+SEEN_MIN = 1e-3
 
 
 #: The held-out test's interleave: at least this many groups of block means (half held in, half held out).

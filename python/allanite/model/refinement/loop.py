@@ -256,8 +256,8 @@ class _Run:
         before it left."""
         if self.y is None:
             return
-        # the channels only where their regression may be taken (a drift is left to a channel that would take it)
-        chans = chans if "regression" in candidates else {}
+        # the channels even where their regression may not be taken: a drift a channel explains is no drift (with
+        # the regression a candidate the channel takes it; without, it is left to be said in ``unexplained``)
         ctx = RemovalContext(self.y, self.fs, self.curve, self.sol, self.start, chans, self.level, self.consider)
         for name, remover in REMOVALS.items():
             if name not in candidates:
