@@ -46,7 +46,8 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   each sinusoid, and the strongest line of each family removed in time), said where the change moves the
   Allan deviation beyond the final model's held-out error; ``"t"`` the side after the change.
 - ``"channels"`` — a coupling to a channel of ``channels=`` left in the final samples (the regression's tests:
-  the Whittle GLS for a slow channel, within blocks for a fast one).
+  the Whittle GLS for a slow channel — the pair of any phase and the in-phase test, each at half the share —,
+  within blocks for a fast one).
 - ``"outliers"`` — impulsive noise left in the final samples (:func:`allanite.model.outliers.outlier_test`).
 - ``"clipped"`` — samples piled at the record's largest or smallest value, or held at one value longer than
   the record's quantisation gives, in the samples as given (:mod:`._quality`); ``"t"`` their first and last
@@ -469,8 +470,13 @@ def _channels(ctx: MissingContext, a: float) -> list[dict]:
     t_lo, t_hi = float(ctx.curve.tau[0]), float(ctx.curve.tau[-1])
     for name, ch in ctx.channels.items():
         if channels.is_slow(ch):
-            r = channels.regress_channel(ctx.y, ch, ctx.fs, name=name, alpha=a_ch, level=ctx.level, terms=())
+            # the coupling's test (channel and quadrature, 2 dof: any phase) and the in-phase test alone (1 dof: more
+            # power on a coupling without lag), each at half the share — one of them may take a left coupling
+            r = channels.regress_channel(ctx.y, ch, ctx.fs, name=name, alpha=a_ch / 2, level=ctx.level, terms=())
             hit, stat, thr = r.accepted, float(r.test["statistic"]), float(r.test["threshold"])
+            one = r.test["in_phase"]
+            if not hit and one["statistic"] > one["threshold"]:
+                hit, stat, thr = True, float(one["statistic"]), float(one["threshold"])
             coef = float(r.params.get("coefficient", float("nan")))
             lo = max(t_lo, min(t_hi, 0.1 * ctx.y.size / ctx.fs))  # a slow channel moves the longest τ
         else:
