@@ -41,7 +41,8 @@ import numpy as np
 
 from ...analysis import avar
 from ..tracing import block_means, simulated_block_mean_chunks
-from .curvefit import Curve, solve, theta_terms, upper_theta
+from .curvefit import Curve, chi2_dof_between, solve, theta_terms, upper_theta
+from .words import heldout_clause
 
 __all__ = [
     "STEP_BLOCKS",
@@ -248,10 +249,9 @@ def steps_check(ctx: Any, a: float) -> list[dict]:
     what = (
         _words(steps, ctx.fs, ctx.unit)
         + f" (together they raise the Allan deviation by {pct:.0f} % at τ {float(tau[i_top]):.4g} s"
-        + ("" if ctx.heldout_pct is None else f"; held-out error {ctx.heldout_pct:.2g} %")
+        + heldout_clause(ctx.heldout_pct)
         + ")"
     )
-    sel = (tau >= lo * (1 - 1e-9)) & (tau <= hi * (1 + 1e-9))
     return [
         {
             "domain": "steps",
@@ -259,7 +259,7 @@ def steps_check(ctx: Any, a: float) -> list[dict]:
             "t": (steps[0][0] / ctx.fs, y.size / ctx.fs),
             "band_hz": (0.5 / hi, 0.5 / lo),
         }
-        | {"chi2_dof": float(np.mean(ctx.sol.z[sel] ** 2)), "what": what}
+        | {"chi2_dof": chi2_dof_between(tau, ctx.sol.z, lo, hi), "what": what}
         | {"steps": [(index / ctx.fs, d) for index, d in steps], "block_s": test["block"] / ctx.fs}
         | {"departure_pct": pct, "heldout_pct": ctx.heldout_pct}
         | {"statistic": test["statistic"], "threshold": null["threshold"], "alpha": a}
