@@ -235,7 +235,10 @@ def _peaks(ps: dict, alpha_bin: float) -> tuple[list[int], np.ndarray, np.ndarra
     ratio = np.full(ps["p"].size, -np.inf)
     ratio[ok] = ps["p"][ok] / ps["noise"][ok]
     thr = np.full(ps["p"].size, np.inf)
-    thr[ok] = f_dist.isf(alpha_bin, ps["dof"], ps["dof_med"][ok])
+    # the bins' median dof take a few values (one per neighbourhood width and count of bins used): the F quantile
+    # of each value once, the same numbers as per bin (≈ 7 ms a pass per 10⁴ bins otherwise)
+    dfd, at = np.unique(ps["dof_med"][ok], return_inverse=True)
+    thr[ok] = f_dist.isf(alpha_bin, ps["dof"], dfd)[at]
     hits = np.flatnonzero(ratio > thr)
     peaks: list[int] = []
     for k in hits[np.argsort(-ratio[hits])]:
