@@ -1,6 +1,8 @@
 """refine's speed-ups of round r8cost give the numbers of the computations they stand for, bit for bit.
 
-The line search's F thresholds (one quantile per distinct median dof, not per bin) against the per-bin quantiles.
+The line search's F thresholds (one quantile per distinct median dof, not per bin) against the per-bin quantiles;
+the outlier flags off both neighbours with the record summed once for every cut and the flagged stretches found
+from their indices, against the per-cut sums and the passes over the record.
 No timings here: ``benches/bench_refine_cost.py``.
 """
 
@@ -10,7 +12,7 @@ import numpy as np
 from scipy.stats import f as f_dist
 
 import allanite
-from allanite.model import lines
+from allanite.model import lines, outliers
 
 
 def test_line_thresholds_equal_the_per_bin_quantiles():
@@ -27,3 +29,40 @@ def test_line_thresholds_equal_the_per_bin_quantiles():
                 want = np.full(ps["p"].size, np.inf)
                 want[ok] = f_dist.isf(a, ps["dof"], dof_med[ok])
                 np.testing.assert_array_equal(lines._peaks(got, a)[2], want)
+
+
+def _stretch_check_by_passes(y, flags, cut_d):  # outliers._stretch_check before round r8cost
+    edge = np.diff(np.concatenate([[0], flags.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edge == 1), np.flatnonzero(edge == -1)
+    long = stops - starts > 1
+    out = flags.copy()
+    for a, b in zip(starts[long], stops[long]):
+        if a == 0 or b >= y.size:
+            continue
+        lo, hi = sorted((y[a - 1], y[b]))
+        out[a:b] = (y[a:b] > hi + cut_d[a - 1]) | (y[a:b] < lo - cut_d[a - 1])
+    return out
+
+
+def test_flags_off_both_neighbours_equal_the_passes_over_the_record():
+    rng = np.random.default_rng(8)
+    y = np.cumsum(rng.standard_normal(40_000)) * 0.05 + rng.standard_normal(40_000)
+    spikes = rng.integers(1, y.size - 5, 120)
+    for k, at in enumerate(spikes):  # lone spikes, bursts of 2–4 of one sign, spikes at the ends
+        y[at : at + 1 + k % 4] += (8 + k % 5) * (1 if k % 2 else -1)
+    y[0] += 9
+    y[-2:] -= 9
+    d = np.diff(y)
+    cut_d = np.full(d.size, 4.0)
+    for flags in (rng.random(y.size) < 0.3, np.zeros(y.size, dtype=bool), np.ones(y.size, dtype=bool)):
+        np.testing.assert_array_equal(
+            outliers._stretch_check(y, flags, cut_d), _stretch_check_by_passes(y, flags, cut_d)
+        )
+    step, blocks = outliers.lattice_step(d), outliers._blocks(d.size)
+    sig = np.array([outliers.robust_sigma(d[b], step) for b in blocks])
+    for c in outliers.FLAG_CUTS:
+        plain = outliers._flags(d, blocks, sig, step, c, None)
+        summed = outliers._flags(d, blocks, sig, step, c, None, outliers._summed(d))
+        np.testing.assert_array_equal(summed[0], plain[0])
+        assert summed[1:] == plain[1:]
+    assert outliers._flags(d, blocks, sig, step, 4.0, None)[0].sum() >= 100

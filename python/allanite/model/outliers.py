@@ -312,7 +312,9 @@ def _flags_of(y: np.ndarray, d: np.ndarray, blocks: list, sig: np.ndarray, step:
     if per_cut is None:
         per_cut = _FLAGGED.put(y, (), {})
     if c not in per_cut:
-        flags, lam, cut = _flags(d, blocks, sig, step, c, level)
+        if level is None and "summed" not in per_cut:  # the rule off both neighbours sums d once for every cut
+            per_cut["summed"] = _summed(d)
+        flags, lam, cut = _flags(d, blocks, sig, step, c, level, per_cut.get("summed"))
         per_cut[c] = (np.flatnonzero(flags), lam, cut)
     at, lam, cut = per_cut[c]
     flags = np.zeros(y.size, dtype=bool)
@@ -320,7 +322,12 @@ def _flags_of(y: np.ndarray, d: np.ndarray, blocks: list, sig: np.ndarray, step:
     return flags, lam, cut
 
 
-def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, level) -> tuple:
+def _summed(d: np.ndarray) -> np.ndarray:
+    """The samples less the first from their differences ``d`` (what :func:`_off_neighbours` compares)."""
+    return np.concatenate([[0.0], np.cumsum(d)])
+
+
+def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, level, summed=None) -> tuple:
     """(flags, λ, cut) at the cut c: the samples flagged, the Gaussian samples expected among them and the cut
     in the data's unit (median over blocks).
 
@@ -357,12 +364,12 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
     # a run of L samples is flagged at most once per difference into it beyond the cut: L·λ samples per length,
     # charged for the lone samples and for each longer length that flags a sample (one that flags none has put
     # no Gaussian sample among the flags)
-    flags, lengths = _off_neighbours(d, cut_d)
+    flags, lengths = _off_neighbours(d, cut_d, summed)
     lam *= 1 + sum(lengths - {1})
     return flags, lam, float(np.median([_tail(c, s_b, step)[0] for s_b in sig]))
 
 
-def _off_neighbours(d: np.ndarray, cut_d: np.ndarray) -> tuple[np.ndarray, set]:
+def _off_neighbours(d: np.ndarray, cut_d: np.ndarray, summed: np.ndarray | None = None) -> tuple[np.ndarray, set]:
     """Flags of the runs of 1 … :data:`MAX_RUN` samples that stand off both outer neighbours: the differences
     into and out of the run beyond the cut (``cut_d``, per difference) and of opposite signs, and every sample
     of the run beyond the cut from both outer neighbours on the run's side. A run of one is a lone spike (the
@@ -370,9 +377,10 @@ def _off_neighbours(d: np.ndarray, cut_d: np.ndarray) -> tuple[np.ndarray, set]:
     spikes the lone rule missed in ``benches/refine_blind2.py``'s bursts). Then, in each stretch of flagged
     samples, those not beyond the cut from both of the stretch's outer neighbours are unflagged: a good sample
     between two spikes of the same sign stands off both of its own neighbours, not off the stretch's. Returns the
-    flags and the run lengths that flagged a sample no shorter run had."""
+    flags and the run lengths that flagged a sample no shorter run had. ``summed``: :func:`_summed` of ``d``, when
+    the caller has it (the same for every cut)."""
     n = d.size + 1
-    y = np.concatenate([[0.0], np.cumsum(d)])  # the samples less the first
+    y = _summed(d) if summed is None else summed  # the samples less the first
     big = np.abs(d) > cut_d
     flags = np.zeros(n, dtype=bool)
     shortest = np.zeros(n, dtype=np.int8)  # the shortest run length that flagged each sample
@@ -398,9 +406,12 @@ def _off_neighbours(d: np.ndarray, cut_d: np.ndarray) -> tuple[np.ndarray, set]:
 
 def _stretch_check(y: np.ndarray, flags: np.ndarray, cut_d: np.ndarray) -> np.ndarray:
     """``flags`` less the samples of each flagged stretch that are not beyond the cut from both of the
-    stretch's outer (unflagged) neighbours on one side (:func:`_off_neighbours`)."""
-    edge = np.diff(np.concatenate([[0], flags.astype(np.int8), [0]]))
-    starts, stops = np.flatnonzero(edge == 1), np.flatnonzero(edge == -1)
+    stretch's outer (unflagged) neighbours on one side (:func:`_off_neighbours`). The stretches from the flagged
+    samples' indices (a few thousand), not from passes over the record."""
+    at = np.flatnonzero(flags)
+    gap = np.flatnonzero(np.diff(at) != 1)  # a stretch ends after at[gap], the next starts at at[gap + 1]
+    starts = at[np.concatenate([[0], gap + 1])] if at.size else at
+    stops = at[np.concatenate([gap, [at.size - 1]])] + 1 if at.size else at
     long = stops - starts > 1
     out = flags.copy()
     for a, b in zip(starts[long], stops[long]):
