@@ -2,17 +2,19 @@
 
 The line search's F thresholds (one quantile per distinct median dof, not per bin) against the per-bin quantiles;
 the outlier flags off both neighbours with the record summed once for every cut and the flagged stretches found
-from their indices, against the per-cut sums and the passes over the record.
+from their indices, against the per-cut sums and the passes over the record; a filtered white noise's Allan
+variance with its lag weights 2m − 3l where m reaches every lag, against the three triangles everywhere.
 No timings here: ``benches/bench_refine_cost.py``.
 """
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.stats import f as f_dist
 
 import allanite
-from allanite.model import lines, outliers
+from allanite.model import effects, lines, outliers
 
 
 def test_line_thresholds_equal_the_per_bin_quantiles():
@@ -66,3 +68,28 @@ def test_flags_off_both_neighbours_equal_the_passes_over_the_record():
         np.testing.assert_array_equal(summed[0], plain[0])
         assert summed[1:] == plain[1:]
     assert outliers._flags(d, blocks, sig, step, 4.0, None)[0].sum() >= 100
+
+
+def _filtered_white_avar_triangles(tau, kind, p, fs):  # effects.filtered_white_avar's FIR form before r8cost
+    m = np.maximum(1.0, np.round(np.atleast_1d(tau) * fs))
+    r = effects.filter_autocorrelation(kind, p, fs)
+    lag = np.arange(r.size, dtype=np.float64)
+
+    def tri(x):
+        return np.maximum(0.0, m[:, None] - np.abs(x))
+
+    a = 2.0 * tri(lag[None, :]) - tri(lag[None, :] - m[:, None]) - tri(lag[None, :] + m[:, None])
+    w = np.full(r.size, 2.0)
+    w[0] = 1.0
+    return a @ (w * r) / (2.0 * m * m) * fs
+
+
+@pytest.mark.parametrize("fs", [100.0, 2000.0])
+def test_filtered_white_columns_equal_the_triangle_sums(fs):
+    tau = np.geomspace(0.5 / fs, 2e4 / fs, 241)
+    kinds = [("single_pole", 0.016 * fs), ("boxcar", 1.33), ("boxcar", 40.3), ("sinc3", 0.69), ("bartlett", 7.0)]
+    kinds += [("moving_average", 3.0), ("single_pole+boxcar:1.5", 0.016 * fs)]
+    for kind, p in kinds:
+        for t in (tau, tau[:3], tau[-2:]):
+            want = _filtered_white_avar_triangles(t, kind, p, fs)
+            np.testing.assert_array_equal(effects.filtered_white_avar(t, kind, p, fs), want)

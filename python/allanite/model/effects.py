@@ -239,11 +239,13 @@ def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float)
         return (s2 + (2.0 * m - 3.0) * lag1 / (m * m)) * fs  # a lag-1 term d: A_m(±1) = 2m − 3
     r = filter_autocorrelation(kind, p, fs)
     lag = np.arange(r.size, dtype=np.float64)
-
-    def tri(x: np.ndarray) -> np.ndarray:
-        return np.maximum(0.0, m[:, None] - np.abs(x))
-
-    a = 2.0 * tri(lag[None, :]) - tri(lag[None, :] - m[:, None]) - tri(lag[None, :] + m[:, None])
+    # A_m(l) at the lags l ≥ 0 (tri_m(l + m) = 0 there): 2m − 3l wherever m reaches the last lag, the triangles
+    # only on the rows of shorter m — the same whole numbers, so the same sum
+    a = np.subtract.outer(2.0 * m, 3.0 * lag)
+    short = np.flatnonzero(m < lag[-1])
+    if short.size:
+        ms = m[short, None]
+        a[short] = 2.0 * np.maximum(0.0, ms - lag) - np.maximum(0.0, ms - np.abs(lag - ms))
     w = np.full(r.size, 2.0)
     w[0] = 1.0
     s = a @ (w * r)
