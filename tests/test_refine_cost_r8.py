@@ -3,7 +3,8 @@
 The line search's F thresholds (one quantile per distinct median dof, not per bin) against the per-bin quantiles;
 the outlier flags off both neighbours with the record summed once for every cut and the flagged stretches found
 from their indices, against the per-cut sums and the passes over the record; a filtered white noise's Allan
-variance with its lag weights 2m − 3l where m reaches every lag, against the three triangles everywhere.
+variance with its lag weights 2m − 3l where m reaches every lag, against the three triangles everywhere; the
+line search's row medians of the bins left unmasked against ``np.nanmedian``.
 No timings here: ``benches/bench_refine_cost.py``.
 """
 
@@ -93,3 +94,15 @@ def test_filtered_white_columns_equal_the_triangle_sums(fs):
         for t in (tau, tau[:3], tau[-2:]):
             want = _filtered_white_avar_triangles(t, kind, p, fs)
             np.testing.assert_array_equal(effects.filtered_white_avar(t, kind, p, fs), want)
+
+
+def test_row_nanmedian_equals_numpys():
+    rng = np.random.default_rng(4)
+    for shape in [(3000, 16), (500, 7), (200, 64), (1, 2)]:
+        v = rng.lognormal(size=shape)
+        v[rng.random(shape) < 0.4] = np.nan
+        v[:, 0] = 1.5  # a number in every row
+        v[0, 1:] = np.nan  # one number alone
+        if shape[1] > 3:
+            v[-1] = np.where(np.isnan(v[-1]), np.nan, 2.0)  # ties
+        np.testing.assert_array_equal(lines._row_nanmedian(v), np.nanmedian(v, axis=1))

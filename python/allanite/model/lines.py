@@ -158,7 +158,7 @@ def _noise(ps: dict, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             vals = np.where(np.concatenate([keep, keep], axis=1), np.concatenate([p[lo_c], p[hi_c]], axis=1), np.nan)
             sel = todo[enough]
             if sel.size:
-                med[sel] = np.nanmedian(vals[enough], axis=1)
+                med[sel] = _row_nanmedian(vals[enough])
                 used[sel] = 2 * count[enough]
         # a bin whose neighbourhood is all lines keeps its unmasked reference
         lost = ~np.isfinite(med)
@@ -169,6 +169,18 @@ def _noise(ps: dict, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         noise[ks] = med / bias
         dof_med[ks] = dof * (used / ps["kappa"]) * (2.0 / math.pi)
     return noise, dof_med
+
+
+def _row_nanmedian(v: np.ndarray) -> np.ndarray:
+    """``np.nanmedian(v, axis=1)`` of rows holding at least one number: each row sorted (NaN last), its middle
+    value or the mean of its two middle values — the numbers ``np.nanmedian`` gives (its masked-array median for
+    rows this short, ≈ 10× slower: ≈ 0.15 s of a default refine's line searches)."""
+    a = np.sort(v, axis=1)
+    count = np.count_nonzero(~np.isnan(v), axis=1)
+    hi = count // 2
+    lo = np.where(count % 2 == 1, hi, hi - 1)
+    rows = np.arange(v.shape[0])
+    return (a[rows, lo] + a[rows, hi]) / 2.0
 
 
 #: :func:`line_spectrum`'s results by the samples' digest, while :func:`remembering_spectra` is on (refine searches
