@@ -4,7 +4,8 @@ The line search's F thresholds (one quantile per distinct median dof, not per bi
 the outlier flags off both neighbours with the record summed once for every cut and the flagged stretches found
 from their indices, against the per-cut sums and the passes over the record; a filtered white noise's Allan
 variance with its lag weights 2m − 3l where m reaches every lag, against the three triangles everywhere; the
-line search's row medians of the bins left unmasked against ``np.nanmedian``.
+line search's row medians (of every neighbour, and of those left unmasked) and the steps check's medians of its
+increments by one sort, against ``np.median`` and ``np.nanmedian``.
 No timings here: ``benches/bench_refine_cost.py``.
 """
 
@@ -15,7 +16,7 @@ import pytest
 from scipy.stats import f as f_dist
 
 import allanite
-from allanite.model import effects, lines, outliers
+from allanite.model import _medians, effects, lines, outliers
 
 
 def test_line_thresholds_equal_the_per_bin_quantiles():
@@ -105,4 +106,17 @@ def test_row_nanmedian_equals_numpys():
         v[0, 1:] = np.nan  # one number alone
         if shape[1] > 3:
             v[-1] = np.where(np.isnan(v[-1]), np.nan, 2.0)  # ties
-        np.testing.assert_array_equal(lines._row_nanmedian(v), np.nanmedian(v, axis=1))
+        np.testing.assert_array_equal(_medians.nanmedian_rows(v), np.nanmedian(v, axis=1))
+
+
+def test_median_by_sort_equals_numpys():
+    rng = np.random.default_rng(6)
+    for shape in [(254, 64), (253, 40), (1, 9), (40, 16), (7, 1)]:
+        a = rng.standard_normal(shape)
+        a[: min(3, shape[0]), 0] = 0.25  # ties
+        for axis in (0, 1):
+            np.testing.assert_array_equal(_medians.median_by_sort(a, axis), np.median(a, axis=axis))
+        a[min(3, shape[0] - 1), 0] = np.nan  # NaN where np.median gives NaN
+        with np.errstate(invalid="ignore"):
+            for axis in (0, 1):
+                np.testing.assert_array_equal(_medians.median_by_sort(a, axis), np.median(a, axis=axis))

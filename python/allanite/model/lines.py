@@ -41,6 +41,7 @@ from scipy.stats import chi2 as chi2_dist
 from scipy.stats import f as f_dist
 
 from ._chunked import CHUNK, welch_detrended, window_overlap
+from ._medians import median_by_sort, nanmedian_rows
 
 __all__ = ["find_lines", "line_spectrum", "remembering_spectra", "group_lines", "LOBE", "MAX_SEGMENT", "fold_frequency"]
 
@@ -140,7 +141,7 @@ def _noise(ps: dict, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         near = np.arange(LOBE + 1, LOBE + w + 1)
         if not mask.any():
             both = np.concatenate([-near[::-1], near])
-            noise[ks] = np.median(p[ks[:, None] + both[None, :]], axis=1) / bias
+            noise[ks] = median_by_sort(p[ks[:, None] + both[None, :]], axis=1) / bias
             dof_med[ks] = dof * (2.0 * w / ps["kappa"]) * (2.0 / math.pi)
             continue
         med = np.full(ks.size, np.nan)
@@ -158,29 +159,17 @@ def _noise(ps: dict, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             vals = np.where(np.concatenate([keep, keep], axis=1), np.concatenate([p[lo_c], p[hi_c]], axis=1), np.nan)
             sel = todo[enough]
             if sel.size:
-                med[sel] = _row_nanmedian(vals[enough])
+                med[sel] = nanmedian_rows(vals[enough])
                 used[sel] = 2 * count[enough]
         # a bin whose neighbourhood is all lines keeps its unmasked reference
         lost = ~np.isfinite(med)
         if lost.any():
             both = np.concatenate([-near[::-1], near])
-            med[lost] = np.median(p[ks[lost, None] + both[None, :]], axis=1)
+            med[lost] = median_by_sort(p[ks[lost, None] + both[None, :]], axis=1)
             used[lost] = 2 * w
         noise[ks] = med / bias
         dof_med[ks] = dof * (used / ps["kappa"]) * (2.0 / math.pi)
     return noise, dof_med
-
-
-def _row_nanmedian(v: np.ndarray) -> np.ndarray:
-    """``np.nanmedian(v, axis=1)`` of rows holding at least one number: each row sorted (NaN last), its middle
-    value or the mean of its two middle values — the numbers ``np.nanmedian`` gives (its masked-array median for
-    rows this short, ≈ 10× slower: ≈ 0.15 s of a default refine's line searches)."""
-    a = np.sort(v, axis=1)
-    count = np.count_nonzero(~np.isnan(v), axis=1)
-    hi = count // 2
-    lo = np.where(count % 2 == 1, hi, hi - 1)
-    rows = np.arange(v.shape[0])
-    return (a[rows, lo] + a[rows, hi]) / 2.0
 
 
 #: :func:`line_spectrum`'s results by the samples' digest, while :func:`remembering_spectra` is on (refine searches

@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from ...analysis import avar
+from .._medians import median_by_sort
 from ..tracing import block_means, simulated_block_mean_chunks
 from .curvefit import Curve, chi2_dof_between, solve, theta_terms, upper_theta
 from .words import heldout_clause
@@ -97,7 +98,7 @@ def increment_z(half: np.ndarray, blocks: tuple[int, ...]) -> tuple[np.ndarray, 
     for _ in blocks:  # finest first
         b = 0.5 * (g[:-1] + g[1:])
         d = b[2:] - b[:-2]
-        d = d - np.median(d, axis=0)
+        d = d - median_by_sort(d, axis=0)  # np.median's numbers, one sort (its partition: 5× slower)
         s = _scale(d)
         # no scale (most increments exactly zero: a record stuck between rounding levels): no evidence either way
         z = np.where(s > 0, np.abs(d) / np.where(s > 0, s, 1.0), 0.0)
