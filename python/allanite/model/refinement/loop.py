@@ -274,9 +274,6 @@ class _Run:
         record it among the considered. Its step is scored once the curve effects are in (:meth:`score`)."""
         y, start, effects, heldout = self.y, self.start, self.effects, self.heldout
         assert y is not None
-        y_new = y - rem.component
-        res_new = avar(y_new, self.fs, taus=self.result.tau)
-        c_new, h_new = self.build(res_new, y_new)
         ho_b = heldout.error(start, effects) if heldout is not None else None
         ho_a = heldout.error(start, effects, remove=rem.refit, on_raw=rem.on_raw) if heldout is not None else None
         if rem.heldout_in_time is not None:
@@ -290,6 +287,11 @@ class _Run:
             return False
         if ho_b is not None:  # on the samples as they were, the five terms alone
             rem.evidence["heldout_test"] = {"before": ho_b, "after": ho_a}
+        # the corrected samples' curve and split only for a removal the held-out test kept (one Allan curve of the
+        # record and two of its halves saved per removal turned down)
+        y_new = y - rem.component
+        res_new = avar(y_new, self.fs, taus=self.result.tau)
+        c_new, h_new = self.build(res_new, y_new)
         params = dict(rem.params)
         s_new = solve(c_new, start, effects)
         if rem.on_curve and not self.moves_curve(rem, c_new):
