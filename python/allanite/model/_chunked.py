@@ -28,13 +28,21 @@ def lattice_step(x: np.ndarray) -> float:
     """The quantisation step of ``x`` (:func:`allanite.model.outliers.lattice_step`'s rule): the smallest nonzero
     |x| that recurs (its value over max|x|, rounded to 12 digits, three times or more), if at least 99 % of the
     nonzero |x| are whole multiples of it (to 1e-6), else 0. One sorted copy of the rounded quotients (the record's
-    size) is the only record-length array; everything else is chunked. The same result as the whole-array form
+    size) is the only record-length array; everything else is chunked (a record of one chunk has its nonzero |x|
+    taken once for the four passes). The same result as the whole-array form
     (the same quotients, the same first value with three equal in the sorted order that ``np.unique`` counts)."""
     n = x.size
+    one = None
+    if n <= CHUNK:  # one chunk: its nonzero |x| once, for the four passes (the same values; a chunk's memory)
+        a = np.abs(x)
+        one = [a[a > 0]]
+        del a
+
+    def passes():
+        return one if one is not None else _nonzero_abs(x)
+
     n_nz, scale = 0, 0.0
-    for s in chunks(n):
-        a = np.abs(x[s])
-        nz = a[a > 0]
+    for nz in passes():
         if nz.size:
             n_nz += nz.size
             scale = max(scale, float(nz.max()))
@@ -42,9 +50,7 @@ def lattice_step(x: np.ndarray) -> float:
         return 0.0
     r = np.empty(n_nz)
     pos = 0
-    for s in chunks(n):
-        a = np.abs(x[s])
-        nz = a[a > 0]
+    for nz in passes():
         r[pos : pos + nz.size] = np.round(nz / scale, 12)
         pos += nz.size
     r.sort()
@@ -53,18 +59,22 @@ def lattice_step(x: np.ndarray) -> float:
     if first is None:
         return 0.0
     step = np.inf
-    for s in chunks(n):
-        a = np.abs(x[s])
-        nz = a[a > 0]
+    for nz in passes():
         near = nz[np.abs(nz / scale - first) <= 1e-12]
         if near.size:
             step = min(step, float(near.min()))
     on = 0
-    for s in chunks(n):
-        a = np.abs(x[s])
-        q = a[a > 0] / step
+    for nz in passes():
+        q = nz / step
         on += int(np.count_nonzero(np.abs(q - np.round(q)) <= 1e-6 * np.maximum(1.0, q)))
     return step if on / n_nz >= 0.99 else 0.0
+
+
+def _nonzero_abs(x: np.ndarray):
+    """The nonzero |x| of each chunk, in order (a fresh pass over ``x``)."""
+    for s in chunks(x.size):
+        a = np.abs(x[s])
+        yield a[a > 0]
 
 
 def _first_recurring(r: np.ndarray) -> float | None:
