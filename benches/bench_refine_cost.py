@@ -40,9 +40,9 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-#: main before this round of refine's speed-ups (issue 29, refine's cost, round r6cost; earlier rounds' baselines:
-#: 9165947, 313a76b, f836703, a0e3816, 3637a85).
-BASELINE = "904c152"
+#: main before this round of refine's speed-ups (issue 29, refine's cost, round r8cost; earlier rounds' baselines:
+#: 9165947, 313a76b, f836703, a0e3816, 3637a85, 904c152).
+BASELINE = "80c1a7b"
 ADIS = [
     ("adis", 1, "gyro_z"),
     ("adis", 4, "gyro_x"),
