@@ -24,7 +24,7 @@ from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
 from ..terms import check_terms
 from ._inputs import REFINE_SCALE, check_scale, check_truth, check_unit, heldout_note, inputs, resolve_tau_range
-from ._rolloff import research_rolloff
+from ._rolloff import research_rolloff, sinc_chain_kept, sinc_named, without_sincs
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, bandwidth_grids, choose, families, final_params, prefetch
 from .changes import change_point_step, change_points
@@ -358,6 +358,18 @@ class _Run:
                 # every line there offered (conditional on a family found: no share of level under the null)
                 search, fams = periodic.periodic_search(y, self.fs, alpha("lines", self.level)), True
             lines = periodic.sinusoid_lines(search, families=fams)
+        fork = self.fork()
+        self.curve_loop(candidates, thin, exact, lines)
+        if sinc_named(self.effects):  # the kinds without the sinc^k carried too: the whole chain decides
+            with_sinc = self.fork()
+            self.effects, self.steps, self.lines, self.sol, self.considered = fork
+            with without_sincs():
+                self.curve_loop(candidates, thin, exact, lines)
+            self.keep_chain(with_sinc)
+        self.score()
+
+    def curve_loop(self, candidates, thin, exact, lines) -> None:
+        """The curve steps while one is accepted, the absorbed dropped, the roll-off searched again."""
         n_step = 0
         while sum(held_theta(k) is None for k, _p in self.effects) < MAX_STEPS:
             if not self.curve_step(n_step, candidates, thin, exact, lines):
@@ -366,7 +378,27 @@ class _Run:
         self.drop_absorbed()
         grids = bandwidth_grids(self.curve)
         self.effects, self.sol = research_rolloff(self.curve, self.start, self.effects, self.sol, grids, self.y)
-        self.score()
+
+    def fork(self) -> tuple:
+        """The curve steps' state so far (effects, steps, lines, solution, considered), copied."""
+        considered = {k: list(v) for k, v in self.considered.items()}
+        return list(self.effects), list(self.steps), list(self.lines), self.sol, considered
+
+    def keep_chain(self, with_sinc: tuple) -> None:
+        """The chain that named a sinc^k (``with_sinc``, :meth:`fork`) or the one just run without the sinc^k
+        kinds, whichever :func:`._rolloff.sinc_chain_kept` prefers; the other's final χ²/dof and effects in the
+        kept bandwidth step's ``evidence["kind_chains"]``."""
+        tie = self.curve.tau.size / self.curve.n_eff
+        without = self.fork()
+        chains = {
+            name: {"chi2_dof": float(fk[3].chi2_dof), "effects": [base_name(k) for k, _p in fk[0]]}
+            for name, fk in (("with_sinc", with_sinc), ("without_sinc", without))
+        }
+        if sinc_chain_kept(with_sinc[3], without[3], tie):
+            self.effects, self.steps, self.lines, self.sol, self.considered = with_sinc
+        for st in self.steps:
+            if st.effect == "bandwidth":
+                st.evidence["kind_chains"] = chains
 
     def curve_step(self, n_step, candidates, thin, exact, lines) -> bool:
         """One step: every candidate's proposal, the one :func:`choose` accepts added; False if none."""
