@@ -144,15 +144,15 @@ def sinc_named(effects: list) -> bool:
 
 def sinc_chain_kept(with_sinc, without, tie: float) -> bool:
     """Whether the chain that named a sinc^k is kept over the one the kinds without it took (each a
-    :class:`.curvefit.Solution` of its final model, fitted on the same curve): where its final χ² lies more than
-    ``tie`` (one effective point) below the other's. The kind is chosen where it is accepted, before the terms
-    later steps add, and a sinc^k's lag-2 correlation is also what a resonance or a line beside a one-lag roll-off
-    makes: ADIS16405 run 6 acc_z read a sinc³ of 0.99 samples over a boxcar of 1.19 by one point at that step,
-    and its 10 Hz resonance (GLS score 210 → 3.4) and 0.46 Hz line were then no longer taken — χ²/dof 2.22 at the
-    end where the boxcar's chain ends at 1.09. Judged on the whole chain the sinc^k stays where it is the
-    better reading with everything else in (run 1 acc_z: 2.36 against 2.52; a CIC, whose boxcar chain takes a
-    resonance as a stand-in and still fits worse)."""
-    return with_sinc.chi2 < without.chi2 - tie
+    :class:`.curvefit.Solution` of its final model, fitted on the same curve): unless the other's final χ² lies
+    more than ``tie`` (one effective point) below its own. The kind is chosen where it is accepted, before the
+    terms later steps add, and a sinc^k's lag-2 correlation is also what a resonance or a line beside a one-lag
+    roll-off makes: ADIS16405 run 6 acc_z read a sinc³ of 0.99 samples over a boxcar of 1.19 by one point at
+    that step, and its 10 Hz resonance (GLS score 210 → 3.4) and 0.46 Hz line were then no longer taken —
+    χ²/dof 2.22 at the end where the boxcar's chain ends at 1.09. Judged on the whole chain the sinc^k stays
+    where it is the better reading with everything else in (run 1 acc_z: 2.36 against 2.52), and where the two
+    chains tie, as a CIC read at its output rate ties with a boxcar of two samples (:func:`sinc_choice`)."""
+    return not without.chi2 < with_sinc.chi2 - tie
 
 
 #: How far (a factor either way) the filter's predicted high-band/low-band power ratio may lie from the one
