@@ -19,7 +19,10 @@ the ADIS16405's boxcars and resonances where the spectrum has none.
 
 A CIC decimator's sinc^k (orders 2–5; the boxcar is order 1) is named where it fits better than the boxcar, or
 ties with a boxcar of more than two samples at a span of one output sample; of the orders that tie, the one whose
-span lies nearest one sample (:func:`sinc_choice`).
+span lies nearest one sample (:func:`sinc_choice`). That choice is made before the terms later steps add, and a
+sinc^k's lag-2 correlation is also what a resonance beside a one-lag roll-off makes: where one is named the curve
+steps run again without the sinc^k kinds, and the sinc^k's chain is kept unless the other ends better by more
+than one effective point (:func:`sinc_chain_kept`).
 
 The roll-off is accepted first (:func:`.candidates.choose`: the white noise every other column is judged
 against), so its parameter is searched without the terms later steps add; a Gauss–Markov term's short-τ slope
