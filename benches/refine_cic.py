@@ -205,7 +205,10 @@ NOTES = [
     "steps), 2.0, 2.4, 3.0 samples named boxcars (cutoffs −1.5 … +1.1 %; one of 1.0 sample is white: nothing), "
     "no chain run again; CICs k = 4 at R = 4 and 16, k = 5 at R = 8 keep their order, k = 5 at R = 2 its sinc⁴ "
     "(its chain ties with the boxcar's); k = 2 at R = 2, 8, 16 and k = 3 at R = 2 read as boxcars of 1.19–1.43 "
-    "samples (+1.9 … +4.8 %) with no sinc^k named at the step, so as on main.",
+    "samples (+1.9 … +4.8 %) with no sinc^k named at the step, so as on main. The false-alarm side: "
+    "`refine_false_alarms.py --quick` 0 of 16 records with an alarm, no sinc^k named on any (no chain run again: "
+    "main's path); `refine_white_floor.py --quick` 22 of 24 as before (the single pole and the 4-tap average at "
+    "σ/2 steps, +4.2 and −3.8 %, fail as they did), no sinc^k named.",
 ]
 
 
