@@ -338,7 +338,9 @@ class _Run:
 
     def add_curve_effects(self, candidates) -> None:
         """Curve effects one per step (at most :data:`MAX_STEPS`) while one is accepted; then an effect whose
-        amplitude a later one took over entirely is dropped, and the steps are scored along the chain."""
+        amplitude a later one took over entirely is dropped, and the steps are scored along the chain. Where the
+        bandwidth named a sinc^k the steps run again without the sinc^k kinds, and the chain
+        :func:`._rolloff.sinc_chain_kept` prefers is kept."""
         y = self.y
         exact = y is not None or (isinstance(self.est, str) and self.est == "oavar")
         thin = tracing.thin_indices(self.curve.tau)
