@@ -519,6 +519,7 @@ class _Run:
         ctx.change_times = [st.params["t"] for st in cp_steps]
         ctx.heldout_pct = self.state[0].get("heldout_rms_adev_pct")
         ctx.samples = self.y0
+        ctx.replaced = _replaced([rem for _st, rem, *_rest in self.removed], self.y0.size if self.y0 is not None else 0)
         ctx.families = [
             (st.params["fundamentals"], st.evidence["frequencies_hz"], st.evidence["amplitudes"], rem.component)
             for st, rem, *_rest in self.removed
@@ -557,6 +558,16 @@ class _Run:
             start_errors=dict(self.states[0][0]),
             final_errors=dict(self.state[0]),
         )
+
+
+def _replaced(removals: list[Removal], n: int) -> np.ndarray | None:
+    """True at the samples the accepted ``"outliers"`` removals replaced (their component is non-zero only
+    there), None where none did: the clipped and held checks of ``unexplained`` leave them out."""
+    out = None
+    for rem in removals:
+        if rem.effect == "outliers" and rem.component.size == n:
+            out = (rem.component != 0) if out is None else out | (rem.component != 0)
+    return out
 
 
 def _component_name(st: Step) -> str:

@@ -122,6 +122,9 @@ class MissingContext:
     #: the samples as refine was given them, before any removal in time (None for curve-only input): the
     #: clipped and held samples are looked for there (:mod:`._quality`)
     samples: np.ndarray | None = None
+    #: True at the samples an accepted removal replaced (the ``"outliers"`` step's; None: none): the clipped
+    #: and held checks leave them out
+    replaced: np.ndarray | None = None
 
 
 def _region_of(test: tracing.ScoreTest, col: np.ndarray) -> tuple[int, int]:
