@@ -183,6 +183,11 @@ MODEL_RANKS = {
     "model.refinement.scoring": 4,
     "model.refinement.calibrated": 5,
     "model.refinement.result": 5,
+    "model.refinement._proposal": 5.2,  # a curve candidate's round, proposal and entry, and their shared helpers
+    "model.refinement._bumps": 5.7,  # the curve candidates per domain (Gauss–Markov and resonance; bandwidth;
+    "model.refinement._bandwidth": 5.7,  # sinusoid) and which proposal a step accepts: none imports another
+    "model.refinement._sinusoid": 5.7,
+    "model.refinement._choose": 5.7,
     "model.refinement.candidates": 6,
     "model.refinement.removals": 6,
     "model.refinement.changes": 6,
