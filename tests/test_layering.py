@@ -217,6 +217,21 @@ def test_model_imports_run_one_way(module):
     assert up == [], f"{module} imports model modules of its own rank or above: {up}"
 
 
+#: report.build's parts, below it: the plan of window, hop and memory, and the optional sections. Neither imports
+#: build (nor the report package, which assembles build), nor the other.
+REPORT_BUILD_PARTS = ("report._plan", "report._sections")
+
+
+@pytest.mark.parametrize("module", REPORT_BUILD_PARTS)
+def test_report_build_parts_sit_below_it(module):
+    up = [
+        (t, line)
+        for t, _, line, _ in _imports(module)
+        if t in ("report", "report.build") or (t in REPORT_BUILD_PARTS and t != module)
+    ]
+    assert up == [], f"{module} imports report.build, the report package or its sibling part: {up}"
+
+
 @pytest.mark.parametrize("module", sorted(MODULES))
 def test_no_private_names_across_modules(module):
     bad = [
