@@ -13,12 +13,15 @@ re-raised with that context.
 from __future__ import annotations
 
 import os
+import warnings
 from pathlib import Path
+
+import numpy as np
 
 from .._validate import INPUTS, check_choice, check_fs
 from ..errors import InputError, ParameterError
 from ..units import parse_unit
-from ._columns import AUTO_CHANNELS, check_column_spec
+from ._columns import AUTO_CHANNELS, check_column_spec, time_unit_of
 from ._columns import AUTO_TIME as AUTO_TIME
 from ._external import read_bag, read_parquet
 from ._numpy import read_npy, read_npz
@@ -42,7 +45,7 @@ def read_log(
     input="rate",
     gaps="error",
     delimiter=None,
-    time_unit="s",
+    time_unit=None,
     array=None,
     topic=None,
     channels=AUTO_CHANNELS,
@@ -56,7 +59,8 @@ def read_log(
         ``.txt``, …; ``.gz`` is decompressed), ``.npy`` (memory-mapped), ``.npz``, ``.parquet``
         (needs pyarrow), a ROS 1 ``.bag`` or a ROS 2 bag folder / ``.db3`` / ``.mcap`` (needs rosbags).
     fs : float, optional
-        Sampling rate, Hz. Without it, derived from the time column (1 / median step).
+        Sampling rate, Hz. Without it, derived from the time column: 1 / its median step (or, where float64
+        rounds large time stamps — epoch seconds at hundreds of Hz — 1 / the mean of its regular steps).
     columns : str, int or list, optional
         Which columns are the samples, by name or 0-based index. A single name or index gives 1-D
         data; a list gives (samples, axes). Default: every column except the time column (ROS bags:
@@ -66,8 +70,9 @@ def read_log(
         and to find gaps and irregular sampling. For ``.npz`` it may also name a separate array. ROS
         bags always use ``header.stamp`` (``time_column="receive"``: the bag's receive time). When
         neither ``fs`` nor ``time_column`` is given, a column named like a time column (``time``,
-        ``t``, ``timestamp``, ``stamp``, ``sec``, ``seconds``, ``header.stamp``, …) is taken as the
-        time column; ``Log.time_column`` says which (``Log.time_column_recognised`` is then True).
+        ``t``, ``timestamp``, ``stamp``, ``sec``, ``seconds``, ``header.stamp``, …, or one of them ending in
+        a unit: ``time_ns``, ``timestamp_us``, ``t [ms]``) is taken as the time column; ``Log.time_column``
+        says which (``Log.time_column_recognised`` is then True).
     unit : str, optional
         Unit of the samples (:func:`allanite.units.parse_unit`): a rate unit for ``input="rate"``, an
         angle unit for ``"increment"`` and ``"angle"``. ROS bags default to ``"rad/s"``.
@@ -82,8 +87,10 @@ def read_log(
     delimiter : str, optional
         Text field separator; default: guessed from the first data line (``,``, tab, ``;`` or
         whitespace).
-    time_unit : {"s", "ms", "us", "ns"}
-        Unit of a text/array time column.
+    time_unit : {"s", "ms", "us", "ns"}, optional
+        Unit of a text/array time column. Default: the unit its name ends in (``time_ns``, ``timestamp_us``,
+        ``t [ms]``, ``Time (nsec)``; ``rostopic echo -p``'s ``%time``: ns), else seconds; ``Log.time_unit`` says
+        which was used.
     array : str, optional
         For ``.npz``: which array holds the samples (default: the only one).
     topic : str, optional
@@ -141,7 +148,8 @@ def read_log(
     path = Path(os.fspath(path))
     check_choice(input, "input", INPUTS)
     check_choice(gaps, "gaps", GAP_MODES)
-    check_choice(time_unit, "time_unit", tuple(TIME_UNITS))
+    if time_unit is not None:
+        check_choice(time_unit, "time_unit", tuple(TIME_UNITS))
     if fs is not None:
         fs = check_fs(fs)
     u = None if unit is None else _sample_unit(unit, input)
@@ -155,6 +163,7 @@ def read_log(
         raise InputError(f"{path}: no such file")
 
     fmt = sniff_format(path)
+    named = None
     if fmt in ("ros1", "ros2"):
         rec = read_bag(path, fmt, columns, time_column, topic, channels)
         if u is None and input == "rate":
@@ -172,11 +181,30 @@ def read_log(
         else:
             rec = read_text(path, columns, time_column, delimiter, gz=(fmt == "text.gz"), channels=channels)
         if rec.time is not None and rec.time_is_seconds is False:
+            named = time_unit_of(rec.time_name) if time_unit is None else None
+            if time_unit is None and named is None:
+                _check_seconds(path, rec)
+            time_unit = time_unit or named or "s"
             rec.time = rec.time * TIME_UNITS[time_unit]
     fmt = "text" if fmt == "text.gz" else fmt
     log = finish(path, fmt, rec, fs, u, input, gaps)
+    if rec.time is not None:
+        log.time_unit = time_unit or "s"
+        log.time_unit_from_name = named is not None
     log.time_column_recognised = time_column is AUTO_TIME and rec.time_name is not None
     return log
+
+
+def _check_seconds(path, rec) -> None:
+    """A warning when a time column taken as seconds by default reads over 10¹¹ s (3000 years): epoch ms, µs or ns
+    read as seconds would make fs 10³–10⁹ times too small."""
+    t = rec.time
+    if t.size and float(np.max(np.abs(t[[0, -1]]))) > 1e11:
+        warnings.warn(
+            f"{path}: time column {rec.time_name!r} reads {float(t[-1]):.6g} s (over 3000 years) as seconds; "
+            "if it is in ms, us or ns, give time_unit= (--time-unit)",
+            stacklevel=3,
+        )
 
 
 def _sample_unit(unit, input):

@@ -75,7 +75,8 @@ def _record(rec: dict) -> dict:
             if src.get("time_column_recognised")
             else ""
         )
-        rows.append(("time column", f"{src['time_column']}{how}"))
+        unit = f", in {src['time_unit']}" if src.get("time_unit") not in (None, "s") else ""
+        rows.append(("time column", f"{src['time_column']}{unit}{how}"))
     if src.get("gaps"):
         shown = "; ".join(f"{gap['duration_s']:.6g} s after sample {gap['after_sample']}" for gap in src["gaps"][:10])
         rows.append(("gaps", shown + (" …" if len(src["gaps"]) > 10 else "")))

@@ -1,0 +1,53 @@
+"""Logs of sensors unlike the ADIS16405, as a new user reads them (issue 29; r8review): a time column in ns named
+so, epoch time stamps whose float rounding biased fs, … — each test a small file that failed before its fix."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from allanite import read_log
+
+
+def _csv(path, header, cols, fmt="%.10g"):
+    np.savetxt(path, np.column_stack(cols), delimiter=",", header=header, comments="", fmt=fmt)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("name", "scale", "unit"), [("time_ns", 1e9, "ns"), ("timestamp_us", 1e6, "us"), ("t [ms]", 1e3, "ms")]
+)
+def test_time_column_unit_from_its_name(tmp_path, name, scale, unit):
+    # 200 Hz epoch stamps: read as seconds, time_ns gave fs = 2e-7 Hz and a record of 5e8 h
+    t = (1.7e9 + np.arange(400) / 200.0) * scale
+    p = _csv(tmp_path / "g.csv", f"{name},gx", [t, np.ones(400)], fmt=["%d", "%g"])
+    log = read_log(p)
+    assert log.fs == 200.0 and log.time_unit == unit and log.time_unit_from_name
+    assert log.time[1] == pytest.approx(0.005, rel=1e-4)  # float64 keeps 256 ns of 1.7e18 ns
+    assert f"in {unit} (its name says so)" in repr(log)
+    over = read_log(p, time_unit="s")  # given: the name does not override it
+    assert over.fs == pytest.approx(200.0 / scale) and over.time_unit == "s" and not over.time_unit_from_name
+
+
+def test_plain_time_name_stays_seconds_and_warns_when_implausible(tmp_path):
+    t = np.arange(100) / 50.0
+    log = read_log(_csv(tmp_path / "s.csv", "time,gx", [t, np.ones(100)]))
+    assert log.fs == 50.0 and log.time_unit == "s" and not log.time_unit_from_name
+    p = _csv(tmp_path / "ns.csv", "time,gx", [(1.7e9 + t) * 1e9, np.ones(100)], fmt=["%d", "%g"])
+    with pytest.warns(UserWarning, match=r"'time' reads 1\.7e\+18 s \(over 3000 years\) as seconds"):
+        read_log(p)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert read_log(p, time_unit="ns").fs == 50.0
+
+
+@pytest.mark.parametrize("fs", [400.0, 1000.0])
+def test_epoch_seconds_give_the_nominal_rate(tmp_path, fs):
+    # float64 rounds 1.7e9 s + k/fs to 2.4e-7 s: the median step read 399.991 Hz at 400 Hz
+    t = 1.7e9 + np.arange(20_000) / fs
+    p = tmp_path / "e.npy"
+    np.save(p, np.c_[t, np.ones(t.size)])
+    log = read_log(p, time_column=0)
+    assert log.fs == fs and log.gaps == []
