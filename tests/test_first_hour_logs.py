@@ -51,3 +51,18 @@ def test_epoch_seconds_give_the_nominal_rate(tmp_path, fs):
     np.save(p, np.c_[t, np.ones(t.size)])
     log = read_log(p, time_column=0)
     assert log.fs == fs and log.gaps == []
+
+
+def test_console_tables_keep_their_columns_apart():
+    # an unknown unit's base-form values with tight intervals ("2.37e-05 [2.37e-05, 2.37e-05]", 29 characters)
+    # ran into the next axis's column in the noise-model table
+    from allanite import simulate
+    from allanite.report import build_report
+
+    y = np.c_[simulate(20_000, 200.0, N=2.4e-5, B=3e-6, seed=1), simulate(20_000, 200.0, N=2.4e-5, B=3e-6, seed=2)]
+    text = build_report(y, 200.0, window=4000, hop=2000).text()
+    table = [r for r in text[text.index("Noise model") : text.index("Dynamic Allan")].splitlines()[3:] if r.strip()]
+    for row in table:
+        cells = [c for c in row[37:].split("  ") if c.strip()]
+        assert len(cells) == 2, row  # two axes: two cells, each kept apart by ≥ 2 spaces
+    assert not any("][" in row or "]0" in row or "]1" in row for row in table)
