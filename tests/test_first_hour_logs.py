@@ -66,3 +66,15 @@ def test_console_tables_keep_their_columns_apart():
         cells = [c for c in row[37:].split("  ") if c.strip()]
         assert len(cells) == 2, row  # two axes: two cells, each kept apart by ≥ 2 spaces
     assert not any("][" in row or "]0" in row or "]1" in row for row in table)
+
+
+def test_decimal_comma_is_named(tmp_path):
+    from allanite.errors import InputError
+
+    p = tmp_path / "eu.csv"
+    p.write_text("# logger export\ntime;gx\n0,00;0,0125\n0,02;-0,0031\n", encoding="utf-8")
+    with pytest.raises(InputError, match=r"line 3, column 1 \('time'\): '0,00' is not a number; a decimal comma"):
+        read_log(p)
+    p.write_text("time;gx\n0;abc\n", encoding="utf-8")
+    with pytest.raises(InputError, match=r"'abc' is not a number$"):
+        read_log(p)

@@ -288,4 +288,8 @@ def _diagnose(path, lines, start, delim, ncols, need, names, first_line, blank=f
         for c in need:
             if not _is_number(fields[c]) and not (c in blank and not fields[c]):
                 shown = fields[c] if fields[c] else "(empty)"
-                raise InputError(f"{path}: line {i + 1}, column {c + 1} ({names[c]!r}): {shown!r} is not a number")
+                comma = _is_number(fields[c].replace(",", ".", 1)) and fields[c].count(",") == 1
+                raise InputError(
+                    f"{path}: line {i + 1}, column {c + 1} ({names[c]!r}): {shown!r} is not a number"
+                    + ("; a decimal comma is not read: write the file with decimal points" if comma else "")
+                )

@@ -86,7 +86,7 @@ def read_log(
         :func:`allanite.avar` with ``gaps="skip"``.
     delimiter : str, optional
         Text field separator; default: guessed from the first data line (``,``, tab, ``;`` or
-        whitespace).
+        whitespace). Numbers take a decimal point: a decimal comma (``0,0125``) is an InputError that says so.
     time_unit : {"s", "ms", "us", "ns"}, optional
         Unit of a text/array time column. Default: the unit its name ends in (``time_ns``, ``timestamp_us``,
         ``t [ms]``, ``Time (nsec)``; ``rostopic echo -p``'s ``%time``: ns), else seconds; ``Log.time_unit`` says
