@@ -78,3 +78,22 @@ def test_decimal_comma_is_named(tmp_path):
     p.write_text("time;gx\n0;abc\n", encoding="utf-8")
     with pytest.raises(InputError, match=r"'abc' is not a number$"):
         read_log(p)
+
+
+def test_refinement_repr_and_console_line_are_short_and_say_the_heldout_error():
+    # the default dataclass repr printed every field (arrays, the proposals tried): ~10⁴ characters in a terminal;
+    # the console's axis line left out the held-out error, the one refine decides by
+    import allanite
+    from allanite.report import build_report
+
+    n, fs = 20_000, 100.0
+    y = allanite.simulate(n, fs, N=2e-3, K=2e-5, seed=3) + 3e-3 * np.sin(2 * np.pi * 1.3 * np.arange(n) / fs)
+    rep = build_report(y[:, None], fs, unit="deg/s", refine=("bandwidth",), fit=False, window=4000, hop=4000)
+    r = rep.refinements[0]
+    text = repr(r)
+    assert text.startswith("Refinement(20000 samples at 100 Hz, start Q+N+B+K+R; nothing added")
+    assert len(text.splitlines()) == 3 + len(r.unexplained) and len(text) < 1500
+    assert f"held-out {r.start_heldout_rms_adev_pct:.3g} → {r.final_heldout_rms_adev_pct:.3g} %" in text
+    axis_line = next(ln for ln in rep.text().splitlines() if ln.startswith("  axis 0: nothing added"))
+    assert axis_line.endswith(f", held-out {r.start_heldout_rms_adev_pct:.3g} → {r.final_heldout_rms_adev_pct:.3g} %")
+    assert rep.summary()["refinement"]["axes"][0]["final_heldout_rms_adev_pct"] == r.final_heldout_rms_adev_pct

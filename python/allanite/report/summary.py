@@ -52,6 +52,7 @@ def refinement_dict(rep) -> dict | None:
                 "start_heldout_rms_adev_pct": json_number(r.start_heldout_rms_adev_pct),
                 "heldout_note": r.heldout_note,
                 "final": _fit_errors(r.fit, r),
+                "final_heldout_rms_adev_pct": json_number(r.final_heldout_rms_adev_pct),
                 "term_moves": [
                     {
                         "term": m["term"],
@@ -455,7 +456,7 @@ def _refinement_text(s: dict) -> list[str]:
         a, b = ax["start"], ax["final"]
         lines.append(
             f"  {ax['name']}: {found}; curve χ²/dof {g(a['chi2_dof'], 3)} → {g(b['chi2_dof'], 3)}, "
-            f"RMS ADEV error {g(a['rms_adev_pct'], 3)} → {g(b['rms_adev_pct'], 3)} %"
+            f"RMS ADEV error {g(a['rms_adev_pct'], 3)} → {g(b['rms_adev_pct'], 3)} %" + _heldout_words(ax)
         )
         for st in ax["steps"]:
             lines.append(
@@ -465,3 +466,10 @@ def _refinement_text(s: dict) -> list[str]:
         lines += [f"    {m['text']}" for m in ax.get("term_moves", [])]
         lines += [f"    {t}" for t in ax.get("still_missing", [])]
     return lines
+
+
+def _heldout_words(ax: dict) -> str:
+    """ ", held-out a → b %" — the error refine decides by (the in-sample one can rise as it falls: a regression
+    on a temperature 2.17 → 2.43 % in sample, 7.59 → 2.96 % held out); nothing for curve-only input."""
+    a, b = ax.get("start_heldout_rms_adev_pct"), ax.get("final_heldout_rms_adev_pct")
+    return "" if a is None or b is None else f", held-out {g(a, 3)} → {g(b, 3)} %"
