@@ -117,7 +117,7 @@ class Log:
     time_column: str | None = None
     time_column_recognised: bool = False
     #: Unit the time column was read in (``time_unit=``, else the unit its name ends in, else "s"; None without
-    #: one), and whether it came from the column's name (``time_ns`` → "ns").
+    #: one), and whether its name gave a unit other than seconds (``time_ns`` → "ns").
     time_unit: str | None = None
     time_unit_from_name: bool = False
     channels: dict = field(default_factory=dict)

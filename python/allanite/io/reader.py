@@ -190,7 +190,7 @@ def read_log(
     log = finish(path, fmt, rec, fs, u, input, gaps)
     if rec.time is not None:
         log.time_unit = time_unit or "s"
-        log.time_unit_from_name = named is not None
+        log.time_unit_from_name = named not in (None, "s")
     log.time_column_recognised = time_column is AUTO_TIME and rec.time_name is not None
     return log
 
