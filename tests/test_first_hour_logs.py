@@ -99,3 +99,33 @@ def test_refinement_repr_and_console_line_are_short_and_say_the_heldout_error():
     axis_line = next(ln for ln in rep.text().splitlines() if ln.startswith("  axis 0: nothing added"))
     assert axis_line.endswith(f", held-out {r.start_heldout_rms_adev_pct:.3g} → {r.final_heldout_rms_adev_pct:.3g} %")
     assert rep.summary()["refinement"]["axes"][0]["final_heldout_rms_adev_pct"] == r.final_heldout_rms_adev_pct
+
+
+def test_batch_takes_the_gyro_columns_and_fills_the_fleet_rows_without_a_unit(tmp_path):
+    # allanite batch analysed an IMU log's accelerometer columns as gyro axes (allanite report chose the gyro
+    # ones by name), and without --unit every N, B, K of fleet.csv was empty
+    pytest.importorskip("distributed")
+    import json
+
+    from allanite.dask.fleet import _flag, _rows, run_one
+
+    rng = np.random.default_rng(5)
+    n = 4000
+    p = _csv(tmp_path / "imu.csv", "t,gyro_x,gyro_y,acc_x,acc_y", [np.arange(n) / 50.0, *rng.normal(size=(4, n))])
+    st = run_one(str(p), str(tmp_path / "out"), {}, {"window": 2000, "hop": 1000})
+    assert st["status"] == "ok", st
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text(encoding="utf-8"))
+    assert summary["record"]["axis_names"] == ["gyro_x", "gyro_y"]
+    assert any("chosen by their names (gyro)" in note for note in summary["notes"])
+    rows = _rows(st)
+    _flag(rows)
+    n_fit = summary["fit"]["axes"][0]["coefficients"]["N"]
+    assert [r["axis"] for r in rows] == ["gyro_x", "gyro_y"]
+    assert rows[0]["N"] == n_fit["value"] and rows[0]["N_unit"] == "base form" and rows[0]["N_low"] is not None
+    st2 = run_one(
+        str(_csv(tmp_path / "acc.csv", "t,acc_x,w", [np.arange(50) / 50.0, np.ones(50), np.ones(50)])),
+        str(tmp_path / "out2"),
+        {},
+        {},
+    )
+    assert st2["status"] == "error" and "names none as a gyro" in st2["error"]  # a row, not a failed task
