@@ -129,3 +129,10 @@ def test_batch_takes_the_gyro_columns_and_fills_the_fleet_rows_without_a_unit(tm
         {},
     )
     assert st2["status"] == "error" and "names none as a gyro" in st2["error"]  # a row, not a failed task
+
+
+def test_a_tight_interval_is_not_printed_as_zero_percent():
+    from allanite.report.fmt import pct
+
+    assert pct(0.3162, 0.3162 * (1 + 3.2e-4)) == "0.03"  # 10⁷ samples at τ0: "0.0" read as no interval at all
+    assert pct(1.0, 1.0012) == "0.1" and pct(1.0, 1.05) == "5.0" and pct(1.0, 1.3) == "30" and pct(1.0, 1.0) == "0.0"

@@ -71,6 +71,8 @@ def pct(v, b) -> str:
     if v is None or b is None or v == 0:
         return "?"
     p = abs(b / v - 1.0) * 100.0
+    if 0 < p < 0.095:  # one significant digit: "0.0" read as an interval of no width (10⁷ samples: ±0.03 %)
+        return f"{p:.1g}"
     return f"{p:.1f}" if p < 9.95 else f"{p:.0f}"
 
 
