@@ -99,6 +99,14 @@ def test_refinement_repr_and_console_line_are_short_and_say_the_heldout_error():
     axis_line = next(ln for ln in rep.text().splitlines() if ln.startswith("  axis 0: nothing added"))
     assert axis_line.endswith(f", held-out {r.start_heldout_rms_adev_pct:.3g} → {r.final_heldout_rms_adev_pct:.3g} %")
     assert rep.summary()["refinement"]["axes"][0]["final_heldout_rms_adev_pct"] == r.final_heldout_rms_adev_pct
+    # the page and summary.json said the chain's χ²/dof weighted each τ independently: it is the tests' GLS χ²
+    import html as html_mod
+
+    page = html_mod.unescape(rep.html({}))
+    words = rep.summary()["refinement"]["statistics"]["allan_curve"]
+    assert "χ²/dof is the calibrated tests' own: the generalised least-squares χ²" in page
+    assert "generalised least-squares χ² of the residual on ~4 τ per octave" in words
+    assert "independently" not in page + words
 
 
 def test_batch_takes_the_gyro_columns_and_fills_the_fleet_rows_without_a_unit(tmp_path):

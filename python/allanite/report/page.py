@@ -369,9 +369,10 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
         "chi2_note": (
             "Every step is scored on the record's own Allan curve, a component removed in time part of the model "
             "through what it changed in the curve, so each step's before is the previous step's after (χ²/dof "
-            "weights each τ of a dense curve independently — not the fit table's χ²/dof, which accounts for the "
-            "correlation between τ). A change of noise level leaves the record's curve as it is: it was found "
-            "and is judged on the Allan variances of 16 windows along the record (their own χ² scale)."
+            "is the calibrated tests' own: the generalised least-squares χ² of the residual on ~4 τ per octave "
+            "under the exact covariance of the estimates across τ, per degree of freedom — not the noise-model "
+            "table's, a fit on its own τ grid). A change of noise level leaves the record's curve as it is: it was "
+            "found and is judged on the Allan variances of 16 windows along the record (their own χ² scale)."
         ),
     }
 

@@ -87,8 +87,10 @@ def refinement_dict(rep) -> dict | None:
         "statistics": {
             "allan_curve": "every step's before/after, on the record's own Allan curve (a component removed in "
             "time is part of the model through what it changed in the curve, AVAR(y) − AVAR(y − component)), so "
-            "that each step's before is the previous step's after: χ²/dof and RMS z of the Allan-curve fit (each "
-            "τ of the dense curve weighted independently), RMS ADEV error (%) on 4 τ per octave whose estimate is "
+            "that each step's before is the previous step's after: χ²/dof and RMS z of the Allan-curve fit by the "
+            "calibrated tests' standard (the generalised least-squares χ² of the residual on ~4 τ per octave under "
+            "the exact covariance of the estimates across τ; not the fit section's χ²/dof), RMS ADEV error (%) "
+            "on 4 τ per octave whose estimate is "
             "within ±10 %; heldout_rms_adev_pct: the model fitted on alternate blocks (8, joined; removals refitted "
             "on them) predicting the other blocks' curve, both ways (null for curve-only input). A change of noise "
             "level leaves the curve's model as it is (before = after); a spectral line's amplitude and f0, measured "
