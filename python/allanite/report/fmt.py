@@ -21,7 +21,16 @@ __all__ = [
     "step_params",
     "LONG_RECORD_S",
     "count",
+    "CLOCK_TERMS",
 ]
+
+#: Said beside a fit whose unit is unknown (a clock's fractional frequency among such logs): the IEEE-952 terms'
+#: names are a gyro's, their τ laws those of the frequency-stability noise types (Riley, NIST SP 1065) — R²τ²/2
+#: is a linear frequency drift's Allan variance exactly.
+CLOCK_TERMS = (
+    "for a clock's fractional frequency the same terms are Q ↔ white/flicker PM, N ↔ white FM, B ↔ flicker FM, "
+    "K ↔ random-walk FM, R ↔ linear frequency drift"
+)
 
 
 def json_number(v):

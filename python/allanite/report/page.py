@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from .._core import __version__
 from ._regression import REGRESSION_COLUMNS, regression_row
-from .fmt import LONG_RECORD_S, clock, duration, g, num, step_params
+from .fmt import CLOCK_TERMS, LONG_RECORD_S, clock, duration, g, num, step_params
 from .forecasting import forecast_page
 from .paper002 import page_context as paper002_page
 from .settings import NOTHING_ADDED, REPORT_ESTIMATORS
@@ -180,7 +180,9 @@ def _model(fit: dict, names: list, au: str) -> dict:
         "units_note": (
             "Coefficients in IEEE-952 units; base form in the second table."
             if ieee
-            else "The unit is unknown, so coefficients are in base form (the samples' unit and seconds)."
+            else "The unit is unknown, so coefficients are in base form (the samples' unit and seconds); "
+            + CLOCK_TERMS
+            + "."
         ),
     }
 

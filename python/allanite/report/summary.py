@@ -14,7 +14,7 @@ from ..model.refinement.result import term_move_text
 from ..model.refinement.words import describe_region
 from ._fitsummary import fit_dict
 from ._regression import regression_dict, regression_lines
-from .fmt import count, duration, g, json_list, json_number, json_value, pct, step_params
+from .fmt import CLOCK_TERMS, count, duration, g, json_list, json_number, json_value, pct, step_params
 from .forecasting import forecast_dict, forecast_text
 from .paper002 import text_lines as paper002_text
 from .settings import NOTHING_ADDED
@@ -367,6 +367,7 @@ def _fit_text(s: dict) -> list[str]:
         f"Noise model (IEEE 952) {'in IEEE-952 units' if ieee else 'in base form (unit unknown)'}, "
         f"{fit['confidence']:.1%} intervals",
         f"  {fit['model']}",
+        *([] if ieee else [f"  ({CLOCK_TERMS})"]),
     ]
     rows = []
     for t in fit["terms"]:
