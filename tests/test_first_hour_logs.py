@@ -146,3 +146,20 @@ def test_a_tight_interval_is_not_printed_as_zero_percent():
 
     assert pct(0.3162, 0.3162 * (1 + 3.2e-4)) == "0.03"  # 10⁷ samples at τ0: "0.0" read as no interval at all
     assert pct(1.0, 1.0012) == "0.1" and pct(1.0, 1.05) == "5.0" and pct(1.0, 1.3) == "30" and pct(1.0, 1.0) == "0.0"
+
+
+def test_refine_on_several_columns_says_it_took_one():
+    # refine(log.data, log.fs) on a 6-column IMU log refined column 0 alone and said nothing
+    import allanite
+
+    y = np.c_[allanite.simulate(4000, 100.0, N=0.01, seed=1), allanite.simulate(4000, 100.0, N=0.02, seed=2)]
+    with pytest.warns(UserWarning, match=r"refine refines one axis: axis 0 of 2; pass axis= for another"):
+        r = allanite.refine(y, 100.0, candidates=(), progress=False)
+    assert r.start.coefficients["N"].value == pytest.approx(0.01, rel=0.1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r1 = allanite.refine(y, 100.0, axis=1, candidates=(), progress=False)  # asked: nothing to say
+        allanite.refine(y[:, 0], 100.0, candidates=(), progress=False)
+    assert r1.start.coefficients["N"].value == pytest.approx(0.02, rel=0.1)
+    with pytest.warns(UserWarning, match="axis 0 of 2"):
+        allanite.refine(allanite.avar(y, 100.0), candidates=(), progress=False)
