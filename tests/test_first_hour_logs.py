@@ -163,3 +163,26 @@ def test_refine_on_several_columns_says_it_took_one():
     assert r1.start.coefficients["N"].value == pytest.approx(0.02, rel=0.1)
     with pytest.warns(UserWarning, match="axis 0 of 2"):
         allanite.refine(allanite.avar(y, 100.0), candidates=(), progress=False)
+
+
+def test_a_row_counter_is_no_axis(tmp_path):
+    # pandas' to_csv writes its unnamed index first: it was analysed as a gyro axis 'col0' (0, 1, 2, …)
+    rng = np.random.default_rng(3)
+    p = tmp_path / "pd.csv"
+    t = np.arange(3000) / 100.0
+    rows = np.c_[np.arange(3000), t, rng.normal(size=(3000, 2))]
+    np.savetxt(p, rows, delimiter=",", header=",time,gx,gy", comments="", fmt=["%d", "%.2f", "%.6g", "%.6g"])
+    with pytest.warns(UserWarning, match=r"column\(s\) 'col0' count the rows \(0, 1, 2, …"):
+        log = read_log(p)
+    assert log.columns == ["gx", "gy"] and log.data.shape == (3000, 2) and log.fs == 100.0
+    assert read_log(p, columns=["col0", "gx"]).columns == ["col0", "gx"]  # asked for: analysed
+    seq = tmp_path / "seq.npy"
+    np.save(seq, np.c_[np.arange(5, 3005), rng.normal(size=3000)])  # a sequence counter from 5, then one axis
+    with pytest.warns(UserWarning, match="'col0' count the rows"):
+        one = read_log(seq, fs=100.0)
+    assert one.data.shape == (3000,) and one.columns == ["col1"]
+    late = np.c_[np.r_[np.arange(1500), np.arange(1500) + 2000], rng.normal(size=3000)]  # counts, then jumps
+    np.save(seq, late)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert read_log(seq, fs=100.0).data.shape == (3000, 2)

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._mapped import column, read_rows
 from .._validate import INPUTS, check_choice, check_fs
 from ..errors import InputError, ParameterError
 from ..units import parse_unit
@@ -63,8 +64,9 @@ def read_log(
         rounds large time stamps — epoch seconds at hundreds of Hz — 1 / the mean of its regular steps).
     columns : str, int or list, optional
         Which columns are the samples, by name or 0-based index. A single name or index gives 1-D
-        data; a list gives (samples, axes). Default: every column except the time column (ROS bags:
-        the three ``angular_velocity_*`` components).
+        data; a list gives (samples, axes). Default: every column except the time column, the channels and a
+        column that counts the rows (each value the previous + 1: pandas' unnamed index, a sequence counter;
+        left out with a warning) (ROS bags: the three ``angular_velocity_*`` components).
     time_column : str or int, optional
         Column of sample times (seconds unless ``time_unit`` says otherwise). Used to derive ``fs``
         and to find gaps and irregular sampling. For ``.npz`` it may also name a separate array. ROS
@@ -180,6 +182,8 @@ def read_log(
             rec = read_parquet(path, columns, time_column, channels)
         else:
             rec = read_text(path, columns, time_column, delimiter, gz=(fmt == "text.gz"), channels=channels)
+        if columns is None:
+            _drop_counters(path, rec)
         if rec.time is not None and rec.time_is_seconds is False:
             named = time_unit_of(rec.time_name) if time_unit is None else None
             if time_unit is None and named is None:
@@ -193,6 +197,32 @@ def read_log(
         log.time_unit_from_name = named not in (None, "s")
     log.time_column_recognised = time_column is AUTO_TIME and rec.time_name is not None
     return log
+
+
+def _drop_counters(path, rec) -> None:
+    """Without ``columns=``: a column that counts rows (each value the previous + 1 — pandas' unnamed index,
+    a sequence or packet counter) is no axis; left out, with a warning (its Allan deviation was reported as
+    a gyro's). Checked on the first 1000 rows, then on the whole column when they count."""
+    data = rec.data
+    if data.ndim != 2 or data.shape[1] < 2 or data.shape[0] < 3:
+        return
+    head = np.asarray(read_rows(data, 0, 1000), dtype=np.float64)  # a mapped .npy: from its file, pages unmapped
+    counters = [k for k in range(data.shape[1]) if np.all(np.diff(head[:, k]) == 1.0) and _counts(data, k)]
+    if not counters or len(counters) == data.shape[1]:
+        return
+    keep = [k for k in range(data.shape[1]) if k not in counters]
+    warnings.warn(
+        f"{path}: column(s) {', '.join(repr(rec.names[k]) for k in counters)} count the rows (0, 1, 2, …: an index "
+        "or a sequence counter): not analysed as an axis; name the columns to analyse with columns= (--columns)",
+        stacklevel=3,
+    )
+    rec.data = data[:, keep] if len(keep) > 1 else data[:, keep[0]]
+    rec.names = [rec.names[k] for k in keep]
+
+
+def _counts(data, k: int) -> bool:
+    """Whether column ``k``, whose first 1000 rows count, rises by exactly 1 from row to row throughout."""
+    return data.shape[0] <= 1000 or bool(np.all(np.diff(column(data, k)) == 1.0))
 
 
 def _check_seconds(path, rec) -> None:
