@@ -186,3 +186,21 @@ def test_a_row_counter_is_no_axis(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert read_log(seq, fs=100.0).data.shape == (3000, 2)
+
+
+def test_an_iso_8601_time_column_is_read(tmp_path):
+    # a logger's date-time stamps were "not a number" (and 'datetime' no time column by its name)
+    from allanite.errors import InputError
+
+    t = np.datetime64("2026-11-27T10:00:00", "ns") + (np.arange(2000) * 20_000_000).astype("timedelta64[ns]")
+    t[1000:] += np.timedelta64(2, "s")  # a 2 s gap
+    stamps = [str(s)[:23] + "Z" for s in t]
+    p = tmp_path / "iso.csv"
+    p.write_text("datetime,gx\n" + "".join(f"{s},{v:.5f}\n" for s, v in zip(stamps, np.sin(np.arange(2000)))))
+    log = read_log(p, gaps="longest")
+    assert log.fs == 50.0 and log.time_column == "datetime" and len(log.gaps) == 1
+    assert log.gaps[0].duration == pytest.approx(2.0) and log.t0 == pytest.approx(1795773600.0)
+    np.testing.assert_allclose(log.time[:3], [0.0, 0.02, 0.04])
+    p.write_text("time;gx\n2026-11-27 10:00:00.00;1\n2026-11-27 10:00:00.02;2\n10:00:00.04;3\n")
+    with pytest.raises(InputError, match=r"line 4, time column: '10:00:00.04' is not an ISO 8601 date-time"):
+        read_log(p)

@@ -68,13 +68,15 @@ def read_log(
         column that counts the rows (each value the previous + 1: pandas' unnamed index, a sequence counter;
         left out with a warning) (ROS bags: the three ``angular_velocity_*`` components).
     time_column : str or int, optional
-        Column of sample times (seconds unless ``time_unit`` says otherwise). Used to derive ``fs``
-        and to find gaps and irregular sampling. For ``.npz`` it may also name a separate array. ROS
-        bags always use ``header.stamp`` (``time_column="receive"``: the bag's receive time). When
-        neither ``fs`` nor ``time_column`` is given, a column named like a time column (``time``,
-        ``t``, ``timestamp``, ``stamp``, ``sec``, ``seconds``, ``header.stamp``, …, or one of them ending in
-        a unit: ``time_ns``, ``timestamp_us``, ``t [ms]``) is taken as the time column; ``Log.time_column``
-        says which (``Log.time_column_recognised`` is then True).
+        Column of sample times (seconds unless ``time_unit`` says otherwise; in a text log also ISO 8601
+        date-times, ``2026-11-27T10:00:00.005`` with an optional ``Z`` or offset: 1.8 s of CPU per 10⁶ rows
+        against ≈ 0.4 s for numbers). Used to derive ``fs`` and to find gaps and irregular sampling. For
+        ``.npz`` it may also name a separate array. ROS bags always use ``header.stamp``
+        (``time_column="receive"``: the bag's receive time). When neither ``fs`` nor ``time_column`` is given,
+        a column named like a time column (``time``, ``t``, ``timestamp``, ``stamp``, ``sec``, ``seconds``,
+        ``datetime``, ``header.stamp``, …, or one of them ending in a unit: ``time_ns``, ``timestamp_us``,
+        ``t [ms]``) is taken as the time column; ``Log.time_column`` says which
+        (``Log.time_column_recognised`` is then True).
     unit : str, optional
         Unit of the samples (:func:`allanite.units.parse_unit`): a rate unit for ``input="rate"``, an
         angle unit for ``"increment"`` and ``"angle"``. ROS bags default to ``"rad/s"``.
