@@ -204,3 +204,15 @@ def test_an_iso_8601_time_column_is_read(tmp_path):
     p.write_text("time;gx\n2026-11-27 10:00:00.00;1\n2026-11-27 10:00:00.02;2\n10:00:00.04;3\n")
     with pytest.raises(InputError, match=r"line 4, time column: '10:00:00.04' is not an ISO 8601 date-time"):
         read_log(p)
+
+
+def test_batch_prints_a_files_error_in_the_commands_words(monkeypatch, capsys):
+    # allanite batch printed "Pass gaps='longest'" where its option is --gaps longest
+    pytest.importorskip("distributed")
+    from allanite.dask import fleet
+
+    err = "DataGapError: g.csv: 1 gap(s) … Pass gaps='longest' to keep the longest gap-free stretch"
+    files = [{"path": "g.csv", "out": "o/g", "status": "error", "error": err}]
+    monkeypatch.setattr(fleet, "batch", lambda *a, **k: fleet.FleetResult(rows=[], files=files, paths={}))
+    assert fleet.main(["g.csv", "--out", "o"]) == 3
+    assert "  failed: g.csv: DataGapError: g.csv: 1 gap(s) … Pass --gaps longest to keep" in capsys.readouterr().out

@@ -205,7 +205,7 @@ def _taus(text: str):
         ) from None
 
 
-def _cli_words(message: str) -> str:
+def cli_words(message: str) -> str:
     """Library messages speak Python (gaps='longest'); say it as options, on one line."""
     message = re.sub(
         r"\b(gaps|input|time_unit)='([a-z]+)'", lambda m: f"--{m.group(1).replace('_', '-')} {m.group(2)}", message
@@ -449,7 +449,7 @@ def _report(args) -> int:
 
 
 def _error(message: str) -> int:
-    print(f"allanite: error: {_cli_words(message)}", file=sys.stderr)
+    print(f"allanite: error: {cli_words(message)}", file=sys.stderr)
     return EXIT_USAGE
 
 

@@ -543,8 +543,10 @@ def main(argv=None) -> int:
         n_ok = sum(f["status"] == "ok" for f in res.files)
         n_skip = sum(f["status"] == "skipped" for f in res.files)
         print(f"{len(res.files)} files: {n_ok} reported, {n_skip} skipped (resume), {len(res.failed)} failed")
+        from ..cli import cli_words  # a file's error in the command's words (--gaps longest, not gaps='longest')
+
         for f in res.failed:
-            print(f"  failed: {f['path']}: {f['error']}")
+            print(f"  failed: {f['path']}: {cli_words(f['error'])}")
         flagged = [r for r in res.rows if r.get("flag")]
         for r in flagged:
             print(f"  flagged: {r['file']} axis {r['axis']}: {r['flag']}")
