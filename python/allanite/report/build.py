@@ -355,6 +355,7 @@ def log_source(log) -> dict:
         "fs_from": "time column" if log.time is not None else "given",
         "time_column": log.time_column,
         "time_column_recognised": bool(log.time_column_recognised),
+        "time_unit": log.time_unit,
         "unit": log.unit.name if log.unit is not None else None,
         "input": log.input,
         "t0_s": json_number(log.t0),
@@ -384,7 +385,12 @@ def from_log(log, **kwargs) -> Report:
     if log.time_column_recognised:
         notes.append(
             f"Neither fs nor a time column was given: column {log.time_column!r} was taken as the time "
-            f"column by its name; fs = {log.fs:g} Hz from its median step."
+            f"column by its name; fs = {log.fs:g} Hz from its steps."
+        )
+    if log.time_unit_from_name:
+        notes.append(
+            f"Time column {log.time_column!r} was read in {log.time_unit}, the unit its name ends in "
+            "(--time-unit / read_log(time_unit=…) overrides it)."
         )
     if log.gaps:
         notes.append(

@@ -65,7 +65,7 @@ def refine(
     truth=None,
     confidence: float = 0.683,
     points: int = 300,
-    axis: int = 0,
+    axis: int | None = None,
     channels=None,
     level: float = LEVEL,
     progress=None,
@@ -109,8 +109,9 @@ def refine(
     truth : dict, optional
         Known parameters per effect (``{"gauss_markov": {"sigma": …, "tc": …}}``, ``{"change_point":
         {"t": …}}``): each step then records its relative errors.
-    axis : int
-        Which axis of multi-axis input to refine.
+    axis : int, optional
+        Which axis of multi-axis input to refine; without it the first (a warning says so when there are
+        others).
 
     Returns
     -------
