@@ -194,10 +194,11 @@ def markdown(report: dict) -> list[str]:
         "quantisation, a fifth through a 2nd-order low-pass (the final model holding its bandwidth), a tenth with a "
         "ramp, a fifth with a Gauss–Markov term (correlation time 10⁻³–10⁻¹ of the record, 1–10× the white "
         "noise's Allan deviation there; not in the final model); 1–1000 Hz, 10⁵–10⁶ samples. `mean`: one split, "
-        "its null from the five-term model refitted without the located step, its slow terms at the upper end the "
-        f"curve allows, p over {report['n_boot']} draws. `steps`: the block means' largest increment over their "
-        "robust scale (3 block lengths), its null under the final model with its slow terms at the upper end, p "
-        "over 2/α draws. Rate: records with p ≤ the level, 95 % Clopper–Pearson interval.",
+        "its null from the five-term model refitted without the located step, profiled over what the curve allows "
+        "(each slow term at its upper end, the others refitted there; p the largest over those models; before "
+        f"2026-11-27 both slow terms at their upper ends at once, its row below), p over {report['n_boot']} draws. "
+        "`steps`: the block means' largest increment over their robust scale (3 block lengths), its null under "
+        "the final model with its slow terms at the upper end, p over 2/α draws. Rate: records with p ≤ the level, 95 % Clopper–Pearson interval.",
         "",
         "| check | α (its share of 5 %) | records | at α | at 1 % | at 5 % |",
         "|---|---|---|---|---|---|",
