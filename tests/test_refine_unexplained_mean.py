@@ -241,3 +241,16 @@ def test_a_clocks_frequency_step_is_said():
     e = out[0]
     assert e["statistic"] == pytest.approx(4.99e-14, rel=0.01) and e["threshold"] < 0.95 * e["statistic"]
     assert abs(e["t_step"] - 40_000.0) <= 100.0 and e["step"] == pytest.approx(1e-13, rel=0.05)
+
+
+def test_the_profile_threshold_is_the_largest_and_stops_once_the_statistic_is_covered(monkeypatch):
+    thetas = [np.array([0.0, 4e-6, 9e-8, 0.0, 0.0]), np.array([0.0, 4e-6, 0.0, 1e-9, 0.0])]
+    each = [ms.mean_step_threshold(100_000, FS, START, t, 0.01) for t in thetas]
+    assert each[1] > each[0] > 0  # the random walk's end the larger here
+    assert ms.profile_threshold(100_000, FS, START, thetas, 0.01) == max(each)
+    asked = []
+    real = ms.mean_step_threshold
+    monkeypatch.setattr(ms, "mean_step_threshold", lambda *a, **k: asked.append(a[3]) or real(*a, **k))
+    # a statistic the last model's threshold already covers: the test holds, the other null is not drawn
+    assert ms.profile_threshold(100_000, FS, START, thetas, 0.01, stop_at=each[1]) == each[1]
+    assert len(asked) == 1 and asked[0] is thetas[1]

@@ -122,9 +122,18 @@ def mean_step_threshold(n: int, fs: float, terms, theta, alpha: float, seed: int
     return float(stats[min(math.ceil((n_boot + 1) * (1.0 - alpha)), n_boot) - 1])
 
 
-def profile_threshold(n: int, fs: float, terms, thetas, alpha: float, seed: int = 7919) -> float:
-    """The largest :func:`mean_step_threshold` over the null models ``thetas`` (:func:`located`'s profile)."""
-    return max(mean_step_threshold(n, fs, terms, theta, alpha, seed) for theta in thetas)
+def profile_threshold(
+    n: int, fs: float, terms, thetas, alpha: float, seed: int = 7919, stop_at: float = math.inf
+) -> float:
+    """The largest :func:`mean_step_threshold` over the null models ``thetas`` (:func:`located`'s profile), the
+    last model first (the random walk's end, most often the largest); once one reaches ``stop_at`` (the
+    statistic: the test then holds whatever the others give) that one's."""
+    out = -math.inf
+    for theta in reversed(thetas):
+        out = max(out, mean_step_threshold(n, fs, terms, theta, alpha, seed))
+        if out >= stop_at:
+            break
+    return out
 
 
 def refit_without(ctx: Any, index: int, d: float) -> tuple[Curve, Any]:
@@ -187,7 +196,7 @@ def mean_step_check(ctx: Any, a: float) -> list[dict]:
     big = np.flatnonzero(dep > float(ctx.heldout_pct or 0.0))
     if big.size == 0:  # checked before the null, which costs more
         return []
-    thr = profile_threshold(y.size, fs, ctx.start, loc["thetas"], a)
+    thr = profile_threshold(y.size, fs, ctx.start, loc["thetas"], a, stop_at=loc["statistic"])
     if not loc["statistic"] > thr:
         return []
     lo, hi = float(tau[big[0]]), float(tau[big[-1]])
