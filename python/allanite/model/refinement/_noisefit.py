@@ -15,27 +15,25 @@ from .. import fitting
 from ..effects import EFFECTS
 from ._columns import base_name, design, held_theta
 
-__all__ = ["upper_theta", "theta_terms", "effect_column_name", "noise_fit"]
+__all__ = ["upper_theta", "upper_models", "theta_terms", "effect_column_name", "noise_fit"]
 
 
-def upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4.0):
-    """``theta`` with each slow term (flicker, random walk of rate) raised to the upper end of what the curve
-    allows: the largest value with the others refitted (weighted NNLS, the fit's weights) whose χ² rises by
-    at most ``delta_chi2`` (≈ 2σ; in effective points). A null model for a time-domain test must not leave
-    out a random walk the curve merely could not pin down: one that is there makes warm-up-like wander in the
-    block means."""
-    out = theta.copy()
+def _upper_ends(curve, sol, terms, effects, slow, delta_chi2):
+    """For each slow term of ``slow`` in ``terms``: (its index, its upper end v, the other columns' coefficients
+    refitted at v — None where no v is allowed). The upper end is the largest v on a log grid below what alone
+    would explain a point, with the others refitted (weighted NNLS, the fit's weights), whose χ² rises by at most
+    ``delta_chi2`` (in effective points: the dense curve's points are strongly correlated, so the rise allowed
+    on its χ² is scaled by points / n_eff, as the fit's covariance counts them). A held effect's column (a
+    line measured in the time domain) stays at its coefficient and is left out of the columns returned."""
     a, _ = design(curve, terms, effects)
     w = np.sqrt(sol.nu / (2.0 * sol.model**2))
-    # a held effect's column (a line measured in the time domain) stays at its coefficient
     held = [len(terms) + j for j, (key, _p) in enumerate(effects) if held_theta(key) is not None]
     y = curve.avar - a[:, held] @ sol.theta[held] if held else curve.avar
     a = np.delete(a, held, axis=1) if held else a
     aw, yw = a * w[:, None], y * w
     chi_min = float(np.sum((yw - aw @ fitting.nnls(aw, yw)) ** 2))
-    # the dense curve's points are strongly correlated: χ² counts ~n_eff independent ones (as the fit's
-    # covariance does), so the rise allowed on the dense χ² is scaled by points / n_eff
     delta_chi2 = delta_chi2 * curve.tau.size / curve.n_eff
+    out = []
     for name in slow:
         if name not in terms:
             continue
@@ -43,24 +41,62 @@ def upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4
         col = aw[:, j]
         others = np.delete(aw, j, axis=1)
         top = float(np.min(curve.avar / np.maximum(a[:, j], 1e-300)))  # alone it would explain a point
-        best = 0.0
+        best: tuple[float, np.ndarray | None] = (0.0, None)
         for v in top * np.geomspace(1e-4, 1.0, 41):
             r = yw - v * col
-            chi = float(np.sum((r - others @ fitting.nnls(others, r)) ** 2))
-            if chi - chi_min <= delta_chi2:
-                best = v
-        out[j] = max(out[j], best)
+            c = fitting.nnls(others, r)
+            if float(np.sum((r - others @ c) ** 2)) - chi_min <= delta_chi2:
+                best = (float(v), c)
+        out.append((j, best[0], best[1]))
     return out
+
+
+def upper_theta(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4.0):
+    """``theta`` with each slow term (flicker, random walk of rate) raised to the upper end of what the curve
+    allows: the largest value with the others refitted (weighted NNLS, the fit's weights) whose χ² rises by
+    at most ``delta_chi2`` (≈ 2σ; in effective points). A null model for a time-domain test must not leave
+    out a random walk the curve merely could not pin down: one that is there makes warm-up-like wander in the
+    block means. Every slow term is raised at once (a corner the curve need not allow together: see
+    :func:`upper_models` for the models it does allow)."""
+    out = theta.copy()
+    for j, v, _c in _upper_ends(curve, sol, terms, effects, slow, delta_chi2):
+        out[j] = max(out[j], v)
+    return out
+
+
+def upper_models(curve, sol, terms, effects, theta, slow=("B", "K"), delta_chi2=4.0):
+    """The profile of the slow terms' upper ends: for each slow term in ``terms``, the terms' squared
+    coefficients with that term at its upper end (as :func:`upper_theta`) and the *others refitted there* — a
+    model the curve allows (χ² within ``delta_chi2`` effective points of its minimum), where
+    :func:`upper_theta` raises every slow term at once. ``theta`` (the fit's) is the model where no slow term
+    is in ``terms``. A test whose threshold rises with each slow term holds its level at the largest
+    threshold over these models, as at any one of them."""
+    k = len(terms)
+    held = {k + j for j, (key, _p) in enumerate(effects) if held_theta(key) is not None}
+    free = [i for i in range(sol.theta.size) if i not in held]
+    out = []
+    for j, v, c in _upper_ends(curve, sol, terms, effects, slow, delta_chi2):
+        if c is None:
+            continue
+        full = np.asarray(sol.theta, dtype=np.float64).copy()
+        full[free] = np.insert(c, j, v)
+        out.append(_terms_of(full, terms, effects))
+    return out or [np.asarray(theta, dtype=np.float64)[:k].copy()]
 
 
 def theta_terms(sol, terms, effects):
     """Squared coefficients of the terms (a bandwidth's N — the white noise before its filter — in place of the N
     column's: zeroed, or where :func:`has_floor` keeps it the floor after the filter, the bandwidth's ``floor``)."""
+    return _terms_of(sol.theta, terms, effects)
+
+
+def _terms_of(coef, terms, effects):
+    """:func:`theta_terms` of the solution's coefficient vector ``coef`` (terms, then one per effect)."""
     k = len(terms)
-    theta = sol.theta[:k].copy()
+    theta = np.array(coef[:k], dtype=np.float64)
     for j, (key, _p) in enumerate(effects):
         if EFFECTS[base_name(key)].replaces == "N" and "N" in terms:
-            theta[list(terms).index("N")] = sol.theta[k + j]
+            theta[list(terms).index("N")] = coef[k + j]
     return theta
 
 
