@@ -191,9 +191,19 @@ MODEL_RANKS = {
     "model.refinement.candidates": 6,
     "model.refinement.removals": 6,
     "model.refinement.changes": 6,
+    # unexplained's parts, below missing (its spectral-line and channel checks, CHECKS): what a check is given;
+    # the Allan curve's checks; the final samples' checks along the record (neither imports the other)
+    "model.refinement._missing_context": 3.5,
+    "model.refinement._curve_checks": 6.5,
+    "model.refinement._time_checks": 6.5,
     "model.refinement.missing": 7,
     "model.refinement._rolloff": 5.5,
     "model.refinement._inputs": 4.5,
+    # refine's parts, below loop (its curve steps): the refinement under way and its chain; the removals in time
+    # on it; the chain scored, the change points and the result on it (with what is missing: above missing)
+    "model.refinement._run": 6.5,
+    "model.refinement._in_time": 6.7,
+    "model.refinement._final": 7.5,
     "model.refinement.loop": 8,
     "model.refinement": 9,
     "model": 10,
