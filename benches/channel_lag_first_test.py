@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A lagged channel's coupling and the coupling's first test: the channel alone (lag 0, F(1, ν), the test before)
-against the channel and its quadrature (2·F(2, ν), :func:`allanite.model.channels._coupling_test`) — power on
+against the channel and its quadrature (2·F(2, ν), :func:`allanite.model._coupling.coupling_test`) — power on
 lagged couplings, false alarms on null records.
 
 Power: 10 Hz × 5·10⁴ records (5000 s), FOG-like noise (white 8·10⁻⁴, flicker 1.4·10⁻⁴, rate random walk

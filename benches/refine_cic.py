@@ -195,6 +195,20 @@ NOTES = [
     "records: Butterworths 2–6, single pole, 4-tap average, none at 2 kHz, steps 0–1 σ) table identical to "
     "main's. Curve-only input proposes no sinc^k (as no Butterworth): the IMAR gyro y curve would read as a "
     "sinc⁵ of 1.24 samples.",
+    "",
+    "**The whole chain decides** (r8acc6): where a sinc^k is named the curve steps run again without the sinc^k "
+    "kinds, and the sinc^k's chain is kept unless the other ends more than one effective χ² point better "
+    "(`_rolloff.sinc_chain_kept`; ADIS16405 run 6 acc_z's sinc³ of 0.99 samples stood in for its 10 Hz resonance: "
+    "χ²/dof 2.22 against the boxcar chain's 1.09). Every row above is as before (each row's JSON but the seconds "
+    "identical). Read the other way round (the sinc^k kept only where its chain ends better), the two sinc⁴ "
+    "CICs, tied with a boxcar of 2.1 samples, went back to it (−7.9, −7.3 %). 14 more records (`refine_cic.record`, seeds 7000–7013, not in the page): boxcars of 1.2, 1.6 (σ/2 "
+    "steps), 2.0, 2.4, 3.0 samples named boxcars (cutoffs −1.5 … +1.1 %; one of 1.0 sample is white: nothing), "
+    "no chain run again; CICs k = 4 at R = 4 and 16, k = 5 at R = 8 keep their order, k = 5 at R = 2 its sinc⁴ "
+    "(its chain ties with the boxcar's); k = 2 at R = 2, 8, 16 and k = 3 at R = 2 read as boxcars of 1.19–1.43 "
+    "samples (+1.9 … +4.8 %) with no sinc^k named at the step, so as on main. The false-alarm side: "
+    "`refine_false_alarms.py --quick` 0 of 16 records with an alarm, no sinc^k named on any (no chain run again: "
+    "main's path); `refine_white_floor.py --quick` 22 of 24 as before (the single pole and the 4-tap average at "
+    "σ/2 steps, +4.2 and −3.8 %, fail as they did), no sinc^k named.",
 ]
 
 

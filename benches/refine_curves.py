@@ -154,7 +154,7 @@ NOTES: list = [
     "- **One misfit reported as two overlapping regions**: IMAR gyro y said τ 0.005–0.080 s *and* 0.005–0.64 s, "
     "LN200 accelerometer y τ 655–2621 s twice, LN200 accelerometer x τ 1.3–20 s and 2.6–1311 s (the ADIS16405 "
     "run 2 gyro z record, with samples, also τ 0.09–1.83 s twice). A column that finds a region already reported "
-    "now widens it (`missing._merged`): one region per misfit.",
+    "now widens it (`_curve_checks._merged`): one region per misfit.",
     "- **The largest misfit unnamed**: LN200 accelerometer y ends at χ²/dof 1785 with the model 2–5× *above* the "
     "curve over τ 1.3–655 s (z −68 … −4), yet the only region said was τ 655–2621 s (χ²/dof 7.9): the score test "
     "adds non-negative columns and cannot see a model held above the curve. Once the test has fired, the runs of "

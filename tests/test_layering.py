@@ -164,6 +164,8 @@ MODEL_RANKS = {
     "model._whittle": 0,
     "model._lag": 0.5,  # a channel's first-order lag: its test and profile (on _whittle)
     "model._shares": 0,
+    "model._regressors": 0.7,  # a channel regression's signal bands and regressors (on _whittle, _lag)
+    "model._coupling": 0.8,  # a channel regression's coupling test and optional terms
     "model.channels": 1,
     "model.timeframes": 2,
     "model.warmup": 2,
@@ -176,16 +178,33 @@ MODEL_RANKS = {
     "model.refinement._mean_steps": 4,
     "model.refinement._quality": 4,
     "model.refinement.words": 3,
+    "model.refinement._columns": 2.5,  # the curve and its columns (curvefit's lower half)
+    "model.refinement._noisefit": 2.7,  # what a solution says of the terms; the NoiseFit it becomes
     "model.refinement.curvefit": 3,
     "model.refinement.scoring": 4,
     "model.refinement.calibrated": 5,
     "model.refinement.result": 5,
+    "model.refinement._proposal": 5.2,  # a curve candidate's round, proposal and entry, and their shared helpers
+    "model.refinement._bumps": 5.7,  # the curve candidates per domain (Gauss–Markov and resonance; bandwidth;
+    "model.refinement._bandwidth": 5.7,  # sinusoid) and which proposal a step accepts: none imports another
+    "model.refinement._sinusoid": 5.7,
+    "model.refinement._choose": 5.7,
     "model.refinement.candidates": 6,
     "model.refinement.removals": 6,
     "model.refinement.changes": 6,
+    # unexplained's parts, below missing (its spectral-line and channel checks, CHECKS): what a check is given;
+    # the Allan curve's checks; the final samples' checks along the record (neither imports the other)
+    "model.refinement._missing_context": 3.5,
+    "model.refinement._curve_checks": 6.5,
+    "model.refinement._time_checks": 6.5,
     "model.refinement.missing": 7,
     "model.refinement._rolloff": 5.5,
     "model.refinement._inputs": 4.5,
+    # refine's parts, below loop (its curve steps): the refinement under way and its chain; the removals in time
+    # on it; the chain scored, the change points and the result on it (with what is missing: above missing)
+    "model.refinement._run": 6.5,
+    "model.refinement._in_time": 6.7,
+    "model.refinement._final": 7.5,
     "model.refinement.loop": 8,
     "model.refinement": 9,
     "model": 10,
@@ -207,6 +226,21 @@ def test_model_imports_run_one_way(module):
         if t.split(".")[0] == "model" and not t.startswith(module + ".") and MODEL_RANKS.get(t, own + 1) >= own
     ]
     assert up == [], f"{module} imports model modules of its own rank or above: {up}"
+
+
+#: report.build's parts, below it: the plan of window, hop and memory, and the optional sections. Neither imports
+#: build (nor the report package, which assembles build), nor the other.
+REPORT_BUILD_PARTS = ("report._plan", "report._sections")
+
+
+@pytest.mark.parametrize("module", REPORT_BUILD_PARTS)
+def test_report_build_parts_sit_below_it(module):
+    up = [
+        (t, line)
+        for t, _, line, _ in _imports(module)
+        if t in ("report", "report.build") or (t in REPORT_BUILD_PARTS and t != module)
+    ]
+    assert up == [], f"{module} imports report.build, the report package or its sibling part: {up}"
 
 
 @pytest.mark.parametrize("module", sorted(MODULES))

@@ -408,7 +408,7 @@ def test_stacked_designs_equal_one_per_model(curve):
     for g, eff in enumerate(models):
         d, alphas = curvefit.design(curve, START, eff)
         np.testing.assert_array_equal(a[g], d)
-        np.testing.assert_array_equal(nu[g], curvefit._edf_columns(curve, alphas))
+        np.testing.assert_array_equal(nu[g], curvefit.edf_columns(curve, alphas))
     assert not np.array_equal(a[2][:, 1], a[0][:, 1])  # a bandwidth's design has N zeroed, a resonance's not
 
 

@@ -20,7 +20,7 @@ from allanite.estimators.grid import tau_grid
 from allanite.model import tracing
 from allanite.model.refinement import _mean_step as ms
 from allanite.model.refinement.curvefit import Curve, solve
-from allanite.model.refinement.levels import alpha
+from allanite.model.refinement.levels import LEVEL, alpha
 from allanite.model.refinement.missing import CHECKS, MissingContext
 from allanite.model.refinement.words import describe_region
 
@@ -181,3 +181,76 @@ def test_locating_the_step_holds_no_copy_of_the_record():
         finally:
             tracemalloc.stop()
         assert peak < 200_000, peak  # the record is 16 MB (the strided view 8 MB)
+
+
+def _clock_record() -> np.ndarray:
+    """refine_blind6's clock (1 Hz × 10⁵ of fractional frequency: white 10⁻¹², flicker 10⁻¹⁴, random walk
+    10⁻¹⁷) whose frequency steps by 10⁻¹³ at 0.4 T, drawn as that suite draws it (seed 611)."""
+    from allanite.simulation import kasdin_walter
+
+    n, rng = 100_000, np.random.default_rng(611)
+    y = allanite.simulate(n, 1.0, N=1e-12, K=1e-17, seed=rng) + 1e-14 * kasdin_walter(4 * n, 1.0, rng)[-n:]
+    y[40_000:] += 1e-13
+    return y
+
+
+def _clock_context() -> MissingContext:
+    y = _clock_record()
+    res = allanite.avar(y, 1.0, taus=tau_grid(y.size, 1.0, "exp", points=300, m_max=y.size // 9))
+    cur = Curve(res.tau, res.m.astype(np.float64), res.avar, 1.0, res.n_samples + 1, res.estimator)
+    ctx = MissingContext(cur, np.arange(cur.tau.size), solve(cur, START, []), START, [], y, 1.0, 0.05, True)
+    ctx.heldout_pct = 5.9  # the final model's in that suite
+    return ctx
+
+
+def _chi2_rise(curve: Curve, sol, theta: np.ndarray) -> float:
+    """χ² of the five terms ``theta`` on ``curve`` (the fit's weights) over its minimum, in effective points."""
+    from allanite.model import fitting
+    from allanite.model.refinement._columns import design
+
+    a, _ = design(curve, START, [])
+    w = np.sqrt(sol.nu / (2.0 * sol.model**2))
+    aw, yw = a * w[:, None], curve.avar * w
+    best = float(np.sum((yw - aw @ fitting.nnls(aw, yw)) ** 2))
+    return (float(np.sum((yw - aw @ theta) ** 2)) - best) * curve.n_eff / curve.tau.size
+
+
+def test_the_null_is_profiled_over_models_the_curve_allows():
+    """Each null model is one slow term at its upper end with the others refitted there — χ² within its 4
+    effective points — where raising flicker and random walk at once (upper_theta) is a corner the clock's
+    curve does not allow."""
+    from allanite.model.refinement.curvefit import theta_terms, upper_theta
+
+    loc, sol, _dep = ms.located(_clock_context())
+    corner = upper_theta(loc["curve"], sol, START, [], theta_terms(sol, START, []))
+    b, k = START.index("B"), START.index("K")
+    assert len(loc["thetas"]) == 2
+    by_b, by_k = loc["thetas"]
+    assert by_b[b] == corner[b] and by_k[k] == corner[k] > 100 * (1e-17) ** 2  # the same upper ends
+    assert by_b[k] < corner[k] and by_k[b] < corner[b]  # the other slow term refitted below its upper end
+    for theta in loc["thetas"]:
+        assert _chi2_rise(loc["curve"], sol, theta) <= 4.0 + 1e-9
+    assert _chi2_rise(loc["curve"], sol, corner) > 4.0
+
+
+def test_a_clocks_frequency_step_is_said():
+    """refine_blind6's clock row: the corner null's threshold was 1.05× the statistic (5.25·10⁻¹⁴ against
+    4.99·10⁻¹⁴; silent); the profile's largest is 0.93× it."""
+    out = ms.mean_step_check(_clock_context(), alpha("unexplained:mean", LEVEL))
+    assert len(out) == 1
+    e = out[0]
+    assert e["statistic"] == pytest.approx(4.99e-14, rel=0.01) and e["threshold"] < 0.95 * e["statistic"]
+    assert abs(e["t_step"] - 40_000.0) <= 100.0 and e["step"] == pytest.approx(1e-13, rel=0.05)
+
+
+def test_the_profile_threshold_is_the_largest_and_stops_once_the_statistic_is_covered(monkeypatch):
+    thetas = [np.array([0.0, 4e-6, 9e-8, 0.0, 0.0]), np.array([0.0, 4e-6, 0.0, 1e-9, 0.0])]
+    each = [ms.mean_step_threshold(100_000, FS, START, t, 0.01) for t in thetas]
+    assert each[1] > each[0] > 0  # the random walk's end the larger here
+    assert ms.profile_threshold(100_000, FS, START, thetas, 0.01) == max(each)
+    asked = []
+    real = ms.mean_step_threshold
+    monkeypatch.setattr(ms, "mean_step_threshold", lambda *a, **k: asked.append(a[3]) or real(*a, **k))
+    # a statistic the last model's threshold already covers: the test holds, the other null is not drawn
+    assert ms.profile_threshold(100_000, FS, START, thetas, 0.01, stop_at=each[1]) == each[1]
+    assert len(asked) == 1 and asked[0] is thetas[1]

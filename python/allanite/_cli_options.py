@@ -107,7 +107,11 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
         "accelerometer columns (acc_x, ...), the ones it names as gyro (gyro_x, ...))",
     )
     inp.add_argument("--time-column", metavar="C", help="column of sample times: derives --fs, finds gaps")
-    inp.add_argument("--time-unit", choices=("s", "ms", "us", "ns"), help="unit of the time column (default: s)")
+    inp.add_argument(
+        "--time-unit",
+        choices=("s", "ms", "us", "ns"),
+        help="unit of the time column (default: the unit its name ends in — time_ns, t [ms] — else s)",
+    )
     inp.add_argument(
         "--unit",
         metavar="U",

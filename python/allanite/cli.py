@@ -205,7 +205,7 @@ def _taus(text: str):
         ) from None
 
 
-def _cli_words(message: str) -> str:
+def cli_words(message: str) -> str:
     """Library messages speak Python (gaps='longest'); say it as options, on one line."""
     message = re.sub(
         r"\b(gaps|input|time_unit)='([a-z]+)'", lambda m: f"--{m.group(1).replace('_', '-')} {m.group(2)}", message
@@ -257,7 +257,7 @@ def _read(args, progress):
         )
     notes = [" ".join(str(w.message).split()) for w in caught]
     if columns is None:
-        log, note = _gyro_columns(log)
+        log, note = gyro_columns(log)
         notes += [note] if note else []
     return log, notes, log.channels or None
 
@@ -294,10 +294,11 @@ _GYRO_NAME = re.compile(r"gyr|omega|angular|ang_?vel|^[wg]_?[xyz]$", re.IGNORECA
 _ACCEL_NAME = re.compile(r"acc|specific_?force|^a_?[xyz]$", re.IGNORECASE)
 
 
-def _gyro_columns(log):
+def gyro_columns(log):
     """Without --columns: a log with accelerometer columns beside others is analysed on the columns its
     header names as gyro ones (with a note); when it names none, the user is asked (a usage error that
-    lists the columns). A log without accelerometer-named columns is analysed whole, as before."""
+    lists the columns). A log without accelerometer-named columns is analysed whole, as before. ``allanite
+    report`` and ``allanite batch`` (:func:`allanite.dask.fleet.run_one`) both choose so."""
     names = [str(c) for c in log.columns]
     accel = [n for n in names if _ACCEL_NAME.search(n)]
     if not accel or len(accel) == len(names):
@@ -448,7 +449,7 @@ def _report(args) -> int:
 
 
 def _error(message: str) -> int:
-    print(f"allanite: error: {_cli_words(message)}", file=sys.stderr)
+    print(f"allanite: error: {cli_words(message)}", file=sys.stderr)
     return EXIT_USAGE
 
 

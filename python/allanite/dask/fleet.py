@@ -6,9 +6,10 @@ Dask task — a LocalCluster by default, any scheduler given by its address — 
 
 * ``out/<path relative to the glob's root, extensions stripped>/`` — the file's report;
 * ``out/fleet.csv`` (and ``fleet.parquet`` when pyarrow is installed) — one row per file and axis: the
-  fitted N, B, K with their intervals (IEEE-952 units), the effects ``refine`` found and what the refined
-  model still misses (``still_missing``), robust z-scores of N, B, K against the fleet and a flag when one is
-  beyond :data:`Z_FLAG`, or the file's error;
+  fitted N, B, K with their intervals (IEEE-952 units; without a unit, the base form, ``N_unit`` "base form"),
+  the effects ``refine`` found and what the refined
+  model still misses (``still_missing``), robust z-scores of N, B, K against the fleet's rows in the same unit
+  and a flag when one is beyond :data:`Z_FLAG`, or the file's error;
 * ``out/fleet.html`` — the fleet's distributions.
 
 Reliability: a file that fails (malformed, gaps, …) becomes a row with its error and does not stop the
@@ -37,6 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._cli_options import UsageError
 from ..errors import AllaniteError, ParameterError
 from ..io import read_log
 from ..report import from_log
@@ -99,7 +101,13 @@ def run_one(path: str, folder: str, read_opts: dict, report_opts: dict) -> dict:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             log = read_log(src, **read_opts)
-            rep = from_log(log, **report_opts)
+            notes = []
+            if "columns" not in read_opts:  # as allanite report: the gyro columns beside accelerometer ones
+                from ..cli import gyro_columns
+
+                log, note = gyro_columns(log)
+                notes += [note] if note else []
+            rep = from_log(log, notes=notes, **report_opts)
             dst.parent.mkdir(parents=True, exist_ok=True)
             tmp = dst.parent / f".{dst.name}.tmp-{uuid.uuid4().hex[:8]}"
             try:
@@ -115,7 +123,7 @@ def run_one(path: str, folder: str, read_opts: dict, report_opts: dict) -> dict:
                 if tmp.exists():
                     shutil.rmtree(tmp, ignore_errors=True)
         return {"path": path, "out": folder, "status": "ok", "error": None}
-    except (AllaniteError, OSError, ValueError) as exc:
+    except (AllaniteError, OSError, ValueError, UsageError) as exc:
         return {"path": path, "out": folder, "status": "error", "error": f"{type(exc).__name__}: {exc}"}
 
 
@@ -133,11 +141,13 @@ def _rows(status: dict) -> list:
         row = dict(base, axis=ax.get("name"))
         coefs = ax.get("coefficients") or {}
         for t in TERMS:
-            c = coefs.get(t)
-            row[t] = None if c is None else c.get("ieee")
-            ci = None if c is None else c.get("ieee_ci")
+            c = coefs.get(t) or {}
+            # IEEE-952 units; without a unit (none given) the base form — before, an empty row
+            ieee = c.get("ieee") is not None
+            row[t] = c.get("ieee") if ieee else c.get("value")
+            ci = c.get("ieee_ci") if ieee else c.get("ci")
             row[f"{t}_low"], row[f"{t}_high"] = (None, None) if ci is None else (ci[0], ci[1])
-            row[f"{t}_unit"] = None if c is None else c.get("ieee_unit")
+            row[f"{t}_unit"] = c.get("ieee_unit") if ieee else (c.get("unit") or "base form") if c else None
         ref_ax = ref_axes.get(ax.get("axis"), {})
         row["effects"] = ";".join(s["effect"] for s in ref_ax.get("steps") or []) if ref else None
         row["still_missing"] = _still_missing(ref_ax) if ref else None
@@ -169,10 +179,13 @@ def robust_z(values) -> np.ndarray:
 def _flag(rows: list) -> None:
     ok = [r for r in rows if r["status"] != "error"]
     for t in TERMS:
-        # log10: N, B, K spread over decades; a sensor 10× off is as far as one 10× better
-        z = robust_z([None if (r.get(t) is None or r[t] <= 0) else math.log10(r[t]) for r in ok])
-        for r, zi in zip(ok, z):
-            r[f"z_{t}"] = None if not np.isfinite(zi) else round(float(zi), 3)
+        # against the rows in the same unit only: °/√h and a base form (no unit given) do not compare
+        for unit in {r.get(f"{t}_unit") for r in ok}:
+            same = [r for r in ok if r.get(f"{t}_unit") == unit]
+            # log10: N, B, K spread over decades; a sensor 10× off is as far as one 10× better
+            z = robust_z([None if (r.get(t) is None or r[t] <= 0) else math.log10(r[t]) for r in same])
+            for r, zi in zip(same, z):
+                r[f"z_{t}"] = None if not np.isfinite(zi) else round(float(zi), 3)
     for r in rows:
         out = [t for t in TERMS if r.get(f"z_{t}") is not None and abs(r[f"z_{t}"]) > Z_FLAG]
         r["flag"] = ",".join(out) if out else ""
@@ -274,6 +287,7 @@ def batch(
     input: str = "rate",
     gaps: str = "error",
     channels="auto",
+    time_unit=None,
     window=None,
     hop=None,
     taus="octave",
@@ -295,7 +309,7 @@ def batch(
         Glob of the logs; outputs are named relative to the folder before its first wildcard.
     out : path
         Output folder.
-    fs, columns, time_column, unit, input, gaps, channels
+    fs, columns, time_column, unit, input, gaps, channels, time_unit
         As for :func:`allanite.read_log` (the same for every file): by default a column named as a temperature
         is no axis, and a channel of the refinement when ``refine`` (:func:`allanite.report.from_log`); channels
         named here imply the refinement (``allanite report --channels``).
@@ -321,6 +335,7 @@ def batch(
     paths, folders = _report_folders(pattern, out)
     out.mkdir(parents=True, exist_ok=True)
     read_opts = {"fs": fs, "columns": columns, "time_column": time_column, "unit": unit, "input": input}
+    read_opts["time_unit"] = time_unit
     read_opts = {k: v for k, v in read_opts.items() if v is not None}
     read_opts.update(gaps=gaps, channels=channels)
     report_opts = {"window": window, "hop": hop, "taus": taus, "estimator": estimator, "refine": refine, "fit": fit}
@@ -429,9 +444,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--columns",
         metavar="C1,C2,...",
-        help="the sample columns, as allanite report's (default: every column but time and channels)",
+        help="the sample columns, as allanite report's (default: every column but time and channels — or, when "
+        "the header also names accelerometer columns, the ones it names as gyro)",
     )
     p.add_argument("--time-column", metavar="C", help="column of sample times: derives --fs, finds gaps")
+    p.add_argument(
+        "--time-unit",
+        choices=("s", "ms", "us", "ns"),
+        help="unit of the time column, as allanite report's (default: the unit its name ends in, else s)",
+    )
     p.add_argument(
         "--unit",
         metavar="U",
@@ -503,6 +524,7 @@ def main(argv=None) -> int:
             input=args.input,
             gaps=args.gaps,
             channels=_channels(args.channels),
+            time_unit=args.time_unit,
             window=args.window,
             hop=args.hop,
             taus=taus,
@@ -521,8 +543,10 @@ def main(argv=None) -> int:
         n_ok = sum(f["status"] == "ok" for f in res.files)
         n_skip = sum(f["status"] == "skipped" for f in res.files)
         print(f"{len(res.files)} files: {n_ok} reported, {n_skip} skipped (resume), {len(res.failed)} failed")
+        from ..cli import cli_words  # a file's error in the command's words (--gaps longest, not gaps='longest')
+
         for f in res.failed:
-            print(f"  failed: {f['path']}: {f['error']}")
+            print(f"  failed: {f['path']}: {cli_words(f['error'])}")
         flagged = [r for r in res.rows if r.get("flag")]
         for r in flagged:
             print(f"  flagged: {r['file']} axis {r['axis']}: {r['flag']}")

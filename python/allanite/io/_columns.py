@@ -31,12 +31,56 @@ TIME_NAMES = {
     "time_us",
     "time_ms",
     "epoch",
+    "datetime",
+    "date_time",
+    "utc",
     "header.stamp",
     "header_stamp",
     "header.stamp.sec",
     "%time",
     "field.header.stamp",
 }
+
+
+#: A time column's name that ends in its unit (``time_ns``, ``timestamp_us``, ``t [ms]``, ``Time (nsec)``,
+#: ``stamp_millis``; ``rostopic echo -p``'s ``%time``, ``field.header.stamp``: ns): the unit ``read_log`` reads it in
+#: when ``time_unit=`` is not given.
+_TIME_UNIT_SUFFIX = re.compile(
+    r"(?:^|[\s_.\-\[(])(?P<u>ns|nsec|nanos|nanoseconds|us|µs|usec|micros|microseconds|ms|msec|millis|milliseconds|"
+    r"s|sec|secs|seconds)[\])]?\s*$",
+    re.IGNORECASE,
+)
+_UNIT_WORDS = {"n": "ns", "u": "us", "µ": "us", "m": "ms", "s": "s"}
+#: Time columns whose unit is known by convention: ``rostopic echo -p`` writes both in ns.
+_KNOWN_TIME_UNITS = {"%time": "ns", "field.header.stamp": "ns"}
+
+
+def time_unit_of(name) -> str | None:
+    """The unit a time column's name ends in (``"ns"``, ``"us"``, ``"ms"``, ``"s"``), or None when it names none:
+    ``time_ns`` → ``"ns"``, ``t [ms]`` → ``"ms"``, ``stamp_usec`` → ``"us"``, ``time`` → None.
+
+    >>> [time_unit_of(c) for c in ("time_ns", "timestamp_us", "t [ms]", "Time (nsec)", "time_s", "time", "%time")]
+    ['ns', 'us', 'ms', 'ns', 's', None, 'ns']
+    """
+    if not isinstance(name, str):
+        return None
+    if name.strip().lower() in _KNOWN_TIME_UNITS:
+        return _KNOWN_TIME_UNITS[name.strip().lower()]
+    m = _TIME_UNIT_SUFFIX.search(name.strip())
+    if m is None or m.start("u") == 0:  # the whole name a unit word: "sec", "seconds" are seconds, "ms" a column
+        return "s" if m is not None and m.group("u").lower().startswith("s") else None
+    u = m.group("u").lower()
+    return "s" if u.startswith("s") else _UNIT_WORDS[u[0]]
+
+
+def is_time_name(name) -> bool:
+    """Whether a column's name says it is time: one of ``TIME_NAMES``, or one of them followed by a unit
+    (``timestamp_us``, ``t [ms]``, ``Time (nsec)``)."""
+    low = str(name).strip().lower()
+    if low in TIME_NAMES:
+        return True
+    m = _TIME_UNIT_SUFFIX.search(low)
+    return m is not None and m.start("u") > 0 and low[: m.start()].strip() in TIME_NAMES
 
 
 @dataclass
@@ -134,7 +178,7 @@ AUTO_TIME = "<recognise by name>"
 
 def recognise_time(names, path) -> int:
     """Index of the column whose name says it is time (``TIME_NAMES``), or the error that fs is needed."""
-    hits = [i for i, c in enumerate(names) if c.strip().lower() in TIME_NAMES]
+    hits = [i for i, c in enumerate(names) if is_time_name(c)]
     if not hits:
         raise ParameterError(
             f"{path}: give the sampling rate (fs=… in Hz) or the time column (time_column=…) — neither was passed, "
@@ -161,7 +205,7 @@ def select_columns(columns, time_column, names, path, default=None, channels=Non
             }
             idx = [i for i in range(len(names)) if i != t_idx and i not in apart]
             if t_idx is None:
-                timeish = [names[i] for i in idx if names[i].strip().lower() in TIME_NAMES]
+                timeish = [names[i] for i in idx if is_time_name(names[i])]
                 if timeish and len(idx) > 1:
                     raise ParameterError(
                         f"{path}: column {timeish[0]!r} looks like a time column; pass time_column="

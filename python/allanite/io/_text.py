@@ -11,6 +11,7 @@ import numpy as np
 from .. import _core
 from ..errors import InputError, ParameterError
 from ._columns import AUTO_CHANNELS, Record, first_nonfinite, pick_channels, select_columns
+from ._isotime import is_iso_time, iso_seconds
 
 
 def _is_number(s: str) -> bool:
@@ -175,7 +176,8 @@ def read_text(path, columns, time_column, delimiter, gz, channels=None):
         i0, start, delim, ncols, names = _layout(path, head, delimiter)
     idx, t_idx, squeeze = select_columns(columns, time_column, names, path, channels=channels)
     ch = pick_channels(channels, idx, t_idx, names, path)
-    need = sorted(set(idx + ch + ([t_idx] if t_idx is not None else [])))
+    iso = t_idx is not None and delim is not None and _first_field_iso(head, start, delim, t_idx)
+    need = sorted(set(idx + ch + ([t_idx] if t_idx is not None and not iso else [])))
     # parse only the needed columns when a one-character delimiter makes skipping safe
     usecols = need if (delim is not None and len(need) < ncols) else None
     parsed = usecols if usecols is not None else list(range(ncols))
@@ -206,7 +208,12 @@ def read_text(path, columns, time_column, delimiter, gz, channels=None):
             f"{path}: {where(r)}, column {idx[c] + 1} ({names[idx[c]]!r}): non-finite value "
             f"{data[r, c]} (NaN or inf); only finite numbers are allowed"
         )
-    time = arr[:, pos[t_idx]].copy() if t_idx is not None else None
+    t_first, secs = 0.0, False
+    if iso:  # ISO 8601 date-times: seconds from the first, the first kept as POSIX seconds
+        fields = [_split(ln, delim)[t_idx] for ln in doc.lines[start:] if _strip_comment(ln).strip()]
+        (time, t_first), secs = iso_seconds(path, fields, where), True
+    else:
+        time = arr[:, pos[t_idx]].copy() if t_idx is not None else None
     chans = {names[i]: arr[:, pos[i]].copy() for i in ch}
     del arr
     if squeeze:
@@ -217,10 +224,19 @@ def read_text(path, columns, time_column, delimiter, gz, channels=None):
         time=time,
         time_name=names[t_idx] if t_idx is not None else None,
         where=where,
+        time_is_seconds=secs,
+        t_first=t_first,
         checked_finite=True,
         channels=chans,
         channels_recognised=isinstance(channels, str) and channels == AUTO_CHANNELS,
     )
+
+
+def _first_field_iso(lines, start, delim, k) -> bool:
+    """Whether field ``k`` of the first data row is an ISO 8601 date-time (:mod:`._isotime`)."""
+    row = next((ln for ln in lines[start:] if _strip_comment(ln).strip()), None)
+    fields = _split(_strip_comment(row), delim) if row is not None else []
+    return k < len(fields) and is_iso_time(fields[k])
 
 
 def _as_channel(exc: InputError, chans: list, channels) -> InputError:
@@ -288,4 +304,8 @@ def _diagnose(path, lines, start, delim, ncols, need, names, first_line, blank=f
         for c in need:
             if not _is_number(fields[c]) and not (c in blank and not fields[c]):
                 shown = fields[c] if fields[c] else "(empty)"
-                raise InputError(f"{path}: line {i + 1}, column {c + 1} ({names[c]!r}): {shown!r} is not a number")
+                comma = _is_number(fields[c].replace(",", ".", 1)) and fields[c].count(",") == 1
+                raise InputError(
+                    f"{path}: line {i + 1}, column {c + 1} ({names[c]!r}): {shown!r} is not a number"
+                    + ("; a decimal comma is not read: write the file with decimal points" if comma else "")
+                )

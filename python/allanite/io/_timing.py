@@ -135,6 +135,29 @@ def _check_finite(path, rec: Record, n: int) -> None:
             )
 
 
+def _step(t: np.ndarray, d: np.ndarray) -> tuple[float, float]:
+    """(nominal time step, its relative rounding): the median step, or — when the times are so large that float64
+    rounds each step by more than 10⁻⁷ of it (epoch seconds at 400 Hz, epoch nanoseconds read as float) — the mean
+    of the regular steps (within ``GAP_FACTOR`` of the median), whose rounding errors cancel but at the ends:
+    1.7·10⁹ s + k/400 has steps 0.0025 ± 2.4·10⁻⁷, median 399.991 Hz, mean 400.000."""
+    step = float(np.median(d))
+    ulp = float(np.spacing(max(abs(float(t[0])), abs(float(t[-1])))))
+    regular = d[np.abs(d - step) <= (GAP_FACTOR - 1.0) * step]
+    if ulp <= 1e-7 * step or not regular.size:
+        return step, 5e-10
+    return float(np.mean(regular)), 2.0 * ulp / float(np.sum(regular))
+
+
+def _shortest(x: float, rel: float) -> float:
+    """The decimal with the fewest significant digits within ``rel`` of ``x`` (time stamps carry rounding:
+    1/0.010000000000000009 is 100 Hz)."""
+    for digits in range(1, 18):
+        v = float(f"{x:.{digits}g}")
+        if abs(v - x) <= rel * abs(x):
+            return v
+    return x
+
+
 def _time_steps(path, rec: Record, t: np.ndarray, n: int, fs):
     """(fs, gaps, jitter) from the time column ``t`` (seconds): the times checked finite and increasing, fs
     derived from the median step (or checked against it when given), the gaps found, irregular steps warned
@@ -154,10 +177,9 @@ def _time_steps(path, rec: Record, t: np.ndarray, n: int, fs):
             f"{path}: {rec.where(i)}, time column {tn!r}: time {how} ({float(t[i])!r} after {float(t[i - 1])!r}); "
             f"times must increase — is {tn!r} really the time column? ({back.size} such step(s))"
         )
-    step = float(np.median(d))
+    step, rel = _step(t, d)
     if fs is None:
-        # time stamps written in decimal carry rounding: 1/0.010000000000000009 is 100 Hz
-        fs = float(f"{1.0 / step:.9g}")
+        fs = _shortest(1.0 / step, rel)
     elif abs(step * fs - 1.0) > 0.01:
         raise ParameterError(
             f"{path}: fs = {fs:g} Hz, but the median step of time column {tn!r} is {step:g} "

@@ -116,6 +116,10 @@ class Log:
     #: by its name because neither ``fs`` nor ``time_column`` was given.
     time_column: str | None = None
     time_column_recognised: bool = False
+    #: Unit the time column was read in (``time_unit=``, else the unit its name ends in, else "s"; None without
+    #: one), and whether its name gave a unit other than seconds (``time_ns`` → "ns").
+    time_unit: str | None = None
+    time_unit_from_name: bool = False
     channels: dict = field(default_factory=dict)
     channels_recognised: bool = False
 
@@ -160,6 +164,7 @@ class Log:
                 (
                     f"time column {self.time_column!r}"
                     + (" (recognised by its name)" if self.time_column_recognised else "")
+                    + (f" in {self.time_unit} (its name says so)" if self.time_unit_from_name else "")
                     + ", "
                 )
                 if self.time_column

@@ -12,7 +12,7 @@ channel and its quadrature (its Hilbert transform: every phase of each band) aga
 (a Satterthwaite count from the noise fit's own covariance), so a channel that moves only at the lowest
 frequencies, where a random walk's level is known to ±20 %, is tested as such. The quadrature is there for a
 channel that reaches the rate shifted in phase — through a lag, a lead, a d(ch)/dt term — which a test of the
-channel alone sees only as cos φ of its size (:func:`_coupling_test`). O(N log N) (one FFT of the record and
+channel alone sees only as cos φ of its size (:func:`coupling_test`). O(N log N) (one FFT of the record and
 one per regressor).
 
 Why not within time blocks (the test it replaces, :func:`allanite.model.tracing.regression_fit`): de-meaning 8
@@ -45,14 +45,15 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import f as f_dist
 from scipy.stats import t as t_dist
 
 from .._validate import check_fs, check_probability
 from ..errors import InputError, ParameterError
 from . import _whittle as wh
-from ._lag import exact_lag, lag_grid, lag_profile, lag_response, lag_test, lagged, unresolved_lag
-from ._rfft import band_limited, rfft
+from ._coupling import LAG_MARGIN, coupling_test, optional_terms
+from ._lag import exact_lag, lag_grid, lagged, unresolved_lag
+from ._regressors import CHANNEL_SNR, channel_signal, regressor_design, regressor_iter, regressors
+from ._rfft import band_limited
 from ._shares import TERM_SHARE
 
 __all__ = [
@@ -67,6 +68,9 @@ __all__ = [
     "TERM_SHARE",
     "SLOW_SHARE",
     "lagged",
+    "LAG_MARGIN",
+    "CHANNEL_SNR",
+    "channel_signal",
 ]
 
 #: Optional terms of a channel regression, in the order they are tried.
@@ -74,12 +78,8 @@ SUBTERMS = ("quadratic", "rate_coefficient", "lag_s")
 #: Default per-record level and the default share of it for the coupling's test (refine's time-domain share).
 LEVEL = 0.05
 ALPHA = 0.075 * LEVEL
-#: The pure lag replaces a kept rate term only if it fits better by this much in 2Δℓ ("positive" evidence).
-LAG_MARGIN = 4.0
 #: Share of the channel's information (Σ_b |Z_b|²/S_b) whose bands the held-out ratio is summed over.
 HELDOUT_INFO = 0.99
-#: A band of the channel takes part only where its power is this many times its measurement noise's.
-CHANNEL_SNR = 20.0
 #: A channel is slow when at least this share of its variance is between the means of 8 blocks in time (the
 #: block test's blind spot, :func:`allanite.model.tracing.regression_fit`).
 SLOW_SHARE = 0.5
@@ -198,7 +198,7 @@ class ChannelRegression:
         kept; the fit's means."""
         x = np.asarray(ch, dtype=np.float64)
         xs = band_limited(x, self.fs, self.signal_bands)
-        cols = _columns(xs, self.mean, self.quad_mean, self.fs, self.removal_lag_s)
+        cols = regressors(xs, self.mean, self.quad_mean, self.fs, self.removal_lag_s)
         keep = [0] + [i for i, k in ((1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
         return np.array([cols[i] for i in keep])
 
@@ -236,171 +236,6 @@ class ChannelRegression:
         c = wh.joint_fit(bands, wh.Design(list(range(len(cols))), [one] * len(cols)))["c"]
         comp = c @ cols
         return lambda i: comp[np.asarray(i)]
-
-
-def channel_signal(x: np.ndarray, fs: float) -> tuple[float, list | None]:
-    """The channel's white measurement noise per sample (variance) and the frequency intervals (Hz) where it
-    stands above it, from one periodogram of its differences.
-
-    The floor: the median of P_k/s_k² (s_k = 2 sin(πk/M)) over the upper half of the band (f ≥ f_s/4), over
-    ln 2 (an exponential's median is ln 2 × its mean). The intervals: merged runs of the bands of
-    :mod:`allanite.model._whittle` whose power is at least :data:`CHANNEL_SNR` × the floor's (σ²·s²); None
-    when that is every band (no noise to keep out)."""
-    d = np.diff(x)
-    n_bins = d.size // 2
-    p = np.abs(rfft(d)[1 : n_bins + 1]) ** 2 / d.size  # remembered: band_limited transforms it again
-    k = np.arange(1, n_bins + 1)
-    s2 = 4.0 * np.sin(np.pi * k / d.size) ** 2
-    top = k >= d.size // 4
-    floor = float(np.median(p[top] / s2[top]) / math.log(2.0)) if top.any() else 0.0
-    starts = wh.band_starts(n_bins)
-    ok = np.add.reduceat(p, starts - 1) >= CHANNEL_SNR * floor * np.add.reduceat(s2, starts - 1)
-    if ok.all():
-        return floor, None
-    ends = np.append(starts[1:], n_bins + 1)
-    out: list = []
-    for a, b in zip(starts[ok], ends[ok]):
-        lo, hi = (0.0 if a == 1 else float((a - 0.5) * fs / d.size)), float((b - 0.5) * fs / d.size)
-        if out and abs(out[-1][1] - lo) < 1e-12 * fs:
-            out[-1] = (out[-1][0], hi)
-        else:
-            out.append((lo, hi))
-    return floor, out or [(0.0, 0.0)]
-
-
-def _f_test(stat: float, dof: float, alpha: float) -> dict:
-    return {
-        "statistic": float(stat),
-        "threshold": float(f_dist.isf(alpha, 1, dof)),
-        "alpha": float(alpha),
-        "dof": float(dof),
-        "p_value": float(f_dist.sf(max(stat, 0.0), 1, dof)),
-    }
-
-
-def _new_direction(bands, design, s) -> np.ndarray:
-    """The last regressor of ``design`` made orthogonal to the others (GLS metric), as a combination."""
-    info = design.gram(bands, 1.0 / s)[0]
-    v = np.zeros(len(design))
-    v[-1] = 1.0
-    if len(design) > 1:
-        v[:-1] = -np.linalg.solve(info[:-1, :-1], info[:-1, -1])
-    return v
-
-
-def _nested(bands, design, fit_small, alpha) -> tuple[dict, dict]:
-    """Likelihood-ratio test of the last regressor of ``design`` (both models refitted, noise included)."""
-    big = wh.joint_fit(bands, design)
-    v = _new_direction(bands, design, big["s"])
-    dof = wh.noise_dof(bands, big, wh.band_info(bands, design, v))
-    return _f_test(2.0 * (big["loglik"] - fit_small["loglik"]), dof, alpha), big
-
-
-def _coupling_test(bands, null, alpha) -> tuple[dict, dict, dict]:
-    """The coupling's test: the channel and its quadrature (Hilbert transform) jointly against no coupling — the
-    likelihood ratio 2Δℓ (both models' noise refitted) against 2·F(2, ν) at ``alpha``; ν the Satterthwaite count
-    of the channel's information (:func:`allanite.model._whittle.noise_dof`) at the in-phase fit, as the channel's
-    test alone had it — the quadrature's information is the same (in band space it is the channel's DFT times −i,
-    orthogonal to it and of the same power in every band). Not the count at the pair's own fit: where ν is a few
-    (a diurnal temperature, one cycle in the record) the noise refitted beside the quadrature moved it 3.2 → 2.2
-    and the threshold 102 → 379 (blind suite 4's 24 h log, its coupling lost).
-
-    Why two degrees of freedom: a channel that reaches the rate through a lag (a thermistor behind the sensing
-    element) arrives shifted in phase, and only cos φ of it lines up with the channel itself — at a 600 s lag on
-    a 1667 s cycle (66°) the lag-0 test read 6.8 against 12.6 on a coupling 11× its detectable size and
-    accepted 0 of 12 records; the pair spans every phase of each band, so a lag (or a pure d(ch)/dt term, or a
-    lead) is seen at whatever phase it arrives. One fixed threshold (no maximum over a grid of lags), at the
-    same share of ``level`` (docs/channels.md, "The coupling's test").
-
-    Returns (the test, the in-phase 1-dof test — what this test was before, kept for the record and for the
-    coefficient's interval —, the in-phase fit, from which the optional terms are tested)."""
-    nb = bands.m.size
-    one = np.ones(nb)
-    in_phase, fit = _nested(bands, _design([], nb), null, alpha)
-    both = wh.Design([0, 0], [one, -1j * one])
-    big = wh.joint_fit(bands, both)
-    dof = in_phase["dof"]
-    stat = 2.0 * (big["loglik"] - null["loglik"])
-    test = {
-        "statistic": float(stat),
-        "threshold": float(2.0 * f_dist.isf(alpha, 2, dof)),
-        "alpha": float(alpha),
-        "dof": float(dof),
-        "p_value": float(f_dist.sf(max(stat, 0.0) / 2.0, 2, dof)),
-        "phase_deg": float(np.degrees(np.arctan2(big["c"][1], big["c"][0]))),
-        "in_phase": {k: in_phase[k] for k in ("statistic", "threshold", "dof", "p_value")},
-    }
-    return test, in_phase, fit
-
-
-def _columns(xs: np.ndarray, mean: float, quad_mean: float, fs: float, lag_s: float | None) -> list:
-    """The regressors from the channel's signal bands (``xs``, :func:`band_limited`): the channel (through the
-    lag), its square and its derivative. The sensor responds to the true temperature, not to the logging
-    sensor's noise, and that noise — squared, differentiated, or only weighed where the gyro's noise is low —
-    would bias every coefficient toward zero: a d(ch)/dt coupling of 0.1 rad/s per °C/s came out as 0.019
-    through a temperature logged to 0.01 °C with 0.02 °C of noise (0.095–0.102 from its signal bands)."""
-    return list(_column_iter(xs, mean, quad_mean, fs, lag_s))
-
-
-def _column_iter(xs: np.ndarray, mean: float, quad_mean: float, fs: float, lag_s: float | None):
-    """:func:`_columns` one at a time, for :func:`allanite.model._whittle.spectra` to transform each and let it
-    go: the three columns at once were 3× the record beside their transforms (a 10⁷-sample temperature's
-    regression peaked at 13× the rate record)."""
-    xm = xs - mean
-    yield lagged(xm, lag_s, fs) if lag_s else xm
-    yield xm**2 - quad_mean
-    del xm
-    yield np.gradient(xs) * fs
-
-
-def _design(keys, nb: int) -> wh.Design:
-    one = np.ones(nb)
-    d = wh.Design([0], [one])
-    if "quadratic" in keys:
-        d = d.plus(1, one)
-    if "rate_coefficient" in keys:
-        d = d.plus(2, one)
-    return d
-
-
-def _optional_terms(bands, fit, terms, level, grid, z2):
-    """Quadratic first, then d(ch)/dt or a lag (never both). Returns (kept keys, fit, lag_s, tests)."""
-    nb = bands.m.size
-    keys: list = []
-    tests: dict = {}
-    if "quadratic" in terms:
-        t_q, big = _nested(bands, _design(["quadratic"], nb), fit, TERM_SHARE["quadratic"] * level)
-        tests["quadratic"] = t_q | {"kept": t_q["statistic"] > t_q["threshold"]}
-        if tests["quadratic"]["kept"]:
-            keys, fit = ["quadratic"], big
-    design = _design(keys, nb)
-    rate_ok, fit_r = False, None
-    if "rate_coefficient" in terms:
-        t_r, fit_r = _nested(
-            bands, _design(keys + ["rate_coefficient"], nb), fit, TERM_SHARE["rate_coefficient"] * level
-        )
-        rate_ok = t_r["statistic"] > t_r["threshold"]
-        tests["rate_coefficient"] = t_r | {"kept": rate_ok}
-    lag_s = None
-    if "lag_s" in terms:
-        t_l = lag_test(bands, design, fit, TERM_SHARE["lag_s"] * level, grid)
-        tests["lag_s"] = t_l | {"kept": False}
-        if t_l["statistic"] > t_l["threshold"]:
-            best, interval = lag_profile(bands, design, fit["s"], grid, z2)
-            lag_design = wh.Design(design.src, [lag_response(bands.f, best, bands.fs)] + design.mult[1:])
-            fit_l = wh.joint_fit(bands, lag_design)
-            margin = 2.0 * (fit_l["loglik"] - fit_r["loglik"]) if rate_ok and fit_r is not None else math.inf
-            tests["lag_s"] |= {"lag_s": best, "interval": interval, "against_rate": margin}
-            if margin > LAG_MARGIN:
-                tests["lag_s"]["kept"] = True
-                if rate_ok:
-                    tests["rate_coefficient"] |= {"kept": False, "why": "the lag fits better (2Δℓ > LAG_MARGIN)"}
-                rate_ok, lag_s = False, best
-            elif rate_ok:
-                tests["lag_s"]["why"] = "the d(ch)/dt term fits as well (a lag and a rate term are nearly collinear)"
-    if rate_ok:
-        keys, fit = keys + ["rate_coefficient"], fit_r
-    return keys, fit, lag_s, tests
 
 
 def _params(fit, keys, dofs, confidence, lag):
@@ -471,19 +306,19 @@ def regress_channel(
     xs = band_limited(x, fs, sig)
     mean = float(xs.mean())
     quad_mean = float(np.mean((xs - mean) ** 2))
-    bands = wh.spectra(y, _column_iter(xs, mean, quad_mean, fs, None), fs)
+    bands = wh.spectra(y, regressor_iter(xs, mean, quad_mean, fs, None), fs)
     null = wh.joint_fit(bands, wh.Design([], []))
-    test, in_phase, fit = _coupling_test(bands, null, alpha)
+    test, in_phase, fit = coupling_test(bands, null, alpha)
     accepted = test["statistic"] > test["threshold"]
     keys, lag_s, tests, removal_lag = [], None, {}, None
     if accepted:
         z2 = float(t_dist.isf((1.0 - confidence) / 2.0, in_phase["dof"])) ** 2
-        keys, fit, lag_s, tests = _optional_terms(bands, fit, terms, level, lag_grid(y.size, fs), z2)
+        keys, fit, lag_s, tests = optional_terms(bands, fit, terms, level, lag_grid(y.size, fs), z2)
         removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, lag_grid(y.size, fs), z2)
         if removal_lag is not None:
             removal_lag = _lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"])
-            exact = wh.spectra(y, _column_iter(xs, mean, quad_mean, fs, removal_lag), fs)
-            fit = wh.joint_fit(exact, _design(keys, exact.m.size))
+            exact = wh.spectra(y, regressor_iter(xs, mean, quad_mean, fs, removal_lag), fs)
+            fit = wh.joint_fit(exact, regressor_design(keys, exact.m.size))
     lag = (removal_lag, tests["lag_s"]["interval"]) if lag_s is not None else None
     dofs = {"coefficient": in_phase["dof"]} | {k: tests[k]["dof"] for k in keys}
     params, intervals = _params(fit, keys, dofs, confidence, lag)
@@ -518,7 +353,7 @@ def _removal_lag(bands, fit, keys, tests, grid, z2) -> float | None:
     (docs/channels.md, "A lag not resolved")."""
     if "lag_s" not in tests or "rate_coefficient" in keys:
         return None
-    prof = unresolved_lag(bands, _design(keys, bands.m.size), fit["s"], grid, z2)
+    prof = unresolved_lag(bands, regressor_design(keys, bands.m.size), fit["s"], grid, z2)
     tests["lag_s"]["profiled"] = prof
     return float(prof["lag_s"]) if prof["used"] else None
 
@@ -532,8 +367,8 @@ def _lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict) -> float:
     n_cols = 2 if "quadratic" in keys else 1  # a lag is never beside the d(ch)/dt term
 
     def objective(lag_s: float) -> float:
-        b = wh.spectra(y, _columns(xs, means[0], means[1], fs, lag_s)[:n_cols], fs)
-        info, sc = _design(keys, b.m.size).gram(b, 1.0 / s)
+        b = wh.spectra(y, regressors(xs, means[0], means[1], fs, lag_s)[:n_cols], fs)
+        info, sc = regressor_design(keys, b.m.size).gram(b, 1.0 / s)
         return float(sc @ np.linalg.solve(info, sc))
 
     grid = lag_grid(y.size, fs)
@@ -574,7 +409,7 @@ def heldout_ratio(y, ch, fs: float, reg: ChannelRegression) -> float:
     n_use = wh.usable_length(y.size)
     y, x = y[:n_use], check_channel(reg.name, ch, y.size)[:n_use]
     xs = band_limited(x, fs, reg.signal_bands)
-    cols = _columns(xs, reg.mean, reg.quad_mean, fs, reg.removal_lag_s)
+    cols = regressors(xs, reg.mean, reg.quad_mean, fs, reg.removal_lag_s)
     split = [wh.spectra(y, cols, fs, parity) for parity in (0, 1)]
     half = wh.usable_length(n_use // 2)
     halves = [wh.spectra(y[a : a + half], [c[a : a + half] for c in cols], fs) for a in (0, n_use - half)]
@@ -584,12 +419,12 @@ def heldout_ratio(y, ch, fs: float, reg: ChannelRegression) -> float:
 def _two_ways(sides: list, keys: list) -> tuple[float, float]:
     """(mean of the two ways' held-out ratios, the poorer side's share of the channel's information) of a split
     into two sides' band sums (:func:`heldout_ratio`)."""
-    coefs = [wh.joint_fit(b, _design(keys, b.m.size))["c"] for b in sides]
+    coefs = [wh.joint_fit(b, regressor_design(keys, b.m.size))["c"] for b in sides]
     noise = [wh.joint_fit(b, wh.Design([], []))["s"] for b in sides]
     info = [float(np.sum(b.G[:, 0, 0].real / s)) for b, s in zip(sides, noise, strict=True)]
     ratios = []
     for held, s, c_other in ((sides[0], noise[0], coefs[1]), (sides[1], noise[1], coefs[0])):
-        d = _design(keys, held.m.size)
+        d = regressor_design(keys, held.m.size)
         use = _informative(held.G[:, 0, 0].real / s)
         ratios.append(float(np.sum(wh.residual_power(held, d, c_other)[use] / s[use]) / np.sum(held.q[use] / s[use])))
     total = sum(info)

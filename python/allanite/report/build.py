@@ -30,39 +30,25 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._validate import check_choice, check_count, check_positive
+from .._validate import check_choice, check_positive
 from ..analysis import avar, davar
-from ..errors import AllaniteError, MemoryBudgetError, ParameterError
+from ..errors import AllaniteError, ParameterError
 from ..estimators import get as get_estimator
 from ..estimators.theo import resolve_decimation
 from ..model import fit as fit_model
-from ..model.effects import EFFECTS
-from ..model.terms import TERMS
 from ..units import parse_unit
 from . import _worker
 from ._channels import check_channels, log_channels, rate_aligned
-from .axes import analyse_by_axis, axes_per_read, axis_column, record_bytes, wants_by_axis
-from .budget import check_report_memory
+from ._plan import memory_plan, octaves, window_and_hop
+from ._sections import forecast_section, paper002_section, refine_candidates, refinement_section
+from .axes import analyse_by_axis, axes_per_read
 from .fmt import json_number
-from .forecasting import check_forecast_options, plan_forecast, run_forecast
-from .paper002 import compute as paper002_sections
+from .forecasting import check_forecast_options, plan_forecast
 from .result import Report, steps
-from .settings import (
-    DHVAR_MAX_DEFAULT_WINDOW,
-    DHVAR_MAX_WINDOWS,
-    HOP_FRACTION,
-    REPORT_ESTIMATORS,
-    WINDOW_FRACTION,
-    default_hop,
-    default_window,
-)
-
-if TYPE_CHECKING:
-    from ..model import Refinement
+from .settings import REPORT_ESTIMATORS
 
 __all__ = ["Report", "build_report", "from_log", "log_source"]
 
@@ -164,10 +150,10 @@ def build_report(
     """
     notes = list(notes)
     x, plan = _record_and_plan(x, fs, frames, forecast)
-    candidates = _refine_candidates(refine)
+    candidates = refine_candidates(refine)
     channels = check_channels(channels, candidates, np.shape(x)[0])
     if channels and candidates is None:  # channels imply refine=True: the regression is their only use
-        candidates = _refine_candidates(True)
+        candidates = refine_candidates(True)
     channels = rate_aligned(channels, input)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
     x, unit_name, axis_names = _axes_and_unit(x, unit, input, axis_names, notes)
@@ -188,13 +174,13 @@ def build_report(
         progress.add(2)
     if candidates is not None or plan is not None or taper or split:  # and the rest while more is computed
         _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete=True)
-    refinements = _refinement(
+    refinements = refinement_section(
         x, fs, input, unit_name, static, axis_names, (candidates, channels), notes, settings, progress
     )
-    frame_fits, forecasts, forecast_settings, forecast_error = _forecast(
+    frame_fits, forecasts, forecast_settings, forecast_error = forecast_section(
         x, fs, plan, unit_name, input, confidence, notes, progress
     )
-    paper002 = _paper002(x, fs, input, dynamic, unit_name, axis_names, taper, split, notes, progress)
+    paper002 = paper002_section(x, fs, input, dynamic, unit_name, axis_names, taper, split, notes, progress)
     created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
     if own_bar:
         progress.close()
@@ -246,52 +232,6 @@ def _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete
         _worker.offer(partial, complete=complete)
 
 
-def _refinement(x, fs, input, unit_name, static, axis_names, asked, notes, settings, progress):
-    """Every axis's refinement (None where it failed), or None when not asked for; ``asked``: the candidate
-    effects and the other channels. The effects tried and the channels' names go
-    into ``settings``."""
-    candidates, channels = asked
-    refinements: list[Refinement | None] | None = None
-    if candidates is not None:
-        progress.step("model refinement")
-        refinements = _refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes)
-        settings["refine_candidates"] = list(candidates)
-        if channels:
-            settings["channels"] = list(channels)
-            notes.append(
-                f"Channel{'s' if len(channels) > 1 else ''} {', '.join(channels)} passed to every axis's model "
-                "refinement (its regression on other channels, which the channels imply); a channel's unit is "
-                "not known to allanite: its coefficients are per unit of the channel."
-            )
-    return refinements
-
-
-def _forecast(x, fs, plan, unit_name, input, confidence, notes, progress) -> tuple:
-    """(frame fits, forecasts, the plan, error or None) of the time-frame section, all None without a plan;
-    a forecast that cannot be computed is a note, not a failed report."""
-    frame_fits = forecasts = forecast_error = None
-    if plan is None:
-        return None, None, None, None
-    progress.step("time frames and coefficient forecast")
-    try:
-        frame_fits, forecasts = run_forecast(x, fs, plan, unit=unit_name, input=input, confidence=confidence)
-    except AllaniteError as exc:
-        forecast_error = str(exc)
-        notes.append(f"The coefficient forecast could not be computed: {exc}")
-    return frame_fits, forecasts, plan, forecast_error
-
-
-def _paper002(x, fs, input, dynamic, unit_name, axis_names, taper, split, notes, progress) -> dict | None:
-    """Paper 002's sections (tapered DAVAR, wavelet split) on the DAVAR's windows and τ, or None unasked."""
-    if not (taper or split):
-        return None
-    progress.step("paper 002 sections")
-    return paper002_sections(
-        x, fs, input=input, window=dynamic.window, hop=dynamic.hop, taus=dynamic.tau, unit=unit_name,
-        axis_names=axis_names, taper=taper, split=split, notes=notes,
-    )  # fmt: skip
-
-
 def _axes_and_unit(x, unit, input, axis_names, notes) -> tuple:
     """(samples as (samples, axes), the unit's name or None, one name per axis), checked; a note when the unit
     is unknown."""
@@ -319,12 +259,12 @@ def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max
     static_est, dynamic_est, dynamic_grid = REPORT_ESTIMATORS[estimator][:3]
     n_axes = x.shape[1]
     n = int(x.shape[0]) - (input == "angle")  # rate samples (angle input: differenced)
-    window, hop, settings = _window_and_hop(n, window, hop, estimator)
+    window, hop, settings = window_and_hop(n, window, hop, estimator)
     resolve_m = get_estimator(dynamic_est).resolve_m
     assert resolve_m is not None  # every dynamic estimator of the report resolves its grid
     dyn_ms = resolve_m(dynamic_grid, window, check_positive(fs, "fs"))
-    n_fit = _octaves(dyn_ms) if estimator == "oavar" else dyn_ms.size  # DHVAR's short windows: every τ
-    by_axis, cost = _memory_plan(x, n, n_axes, window, hop, dyn_ms.size, n_fit, fit, max_memory)
+    n_fit = octaves(dyn_ms) if estimator == "oavar" else dyn_ms.size  # DHVAR's short windows: every τ
+    by_axis, cost = memory_plan(x, n, n_axes, window, hop, dyn_ms.size, n_fit, fit, max_memory)
     extra = {"decimate": "auto"} if static_est == "theoh" else {}
     if by_axis:  # one axis in memory at a time (report/axes.py): a long or memory-mapped record
         static, dynamic = analyse_by_axis(
@@ -391,121 +331,6 @@ def _fit_record_and_windows(static, dynamic, unit_name, confidence, axis_names, 
     return fits, series, fit_error, series_error
 
 
-def _refine_candidates(refine) -> tuple | None:
-    """The candidate effects of ``refine=`` (True: all of them; False/None: no refinement), checked."""
-    if refine is None or refine is False:
-        return None
-    if refine is True:
-        return tuple(EFFECTS)
-    names = (refine,) if isinstance(refine, str) else tuple(refine)
-    bad = [n for n in names if n not in EFFECTS]
-    if bad:
-        raise ParameterError(f"refine: unknown candidate effect {bad[0]!r}; allowed: {', '.join(EFFECTS)}")
-    return names
-
-
-def _refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes) -> list:
-    """:func:`allanite.refine` on every axis (None for an axis it fails on, with a note why); ``asked``: the
-    candidate effects and the other channels (None: none)."""
-    from ..model import refine as refine_axis  # the refinement package (scipy.signal) only when asked
-
-    candidates, channels = asked
-
-    refinements: list = []
-    # the same τ range the whole-record fit used (none unless given): start at 0.1 s when the
-    # shortest τ are below it, as real gyros' anti-alias filters colour them
-    t0 = 0.1 if static.tau[0] < 0.1 else None
-    for k in range(x.shape[1]):
-        try:
-            refinements.append(
-                refine_axis(
-                    axis_column(x, k),
-                    fs,
-                    input=input,
-                    unit=unit_name,
-                    tau_range=None if t0 is None else (t0, None),
-                    candidates=candidates,
-                    channels=channels,
-                )
-            )
-        except AllaniteError as exc:
-            refinements.append(None)
-            notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")
-    return refinements
-
-
-def _window_and_hop(n, window, hop, estimator):
-    """The DAVAR window and hop (given, or the report's defaults) and how they were chosen."""
-    window_given, hop_given = window is not None, hop is not None
-    window_rule = hop_rule = "given"
-    if window is None:
-        window = default_window(n)
-        window_rule = f"record/{WINDOW_FRACTION}"
-        if estimator == "theoh" and window > DHVAR_MAX_DEFAULT_WINDOW:
-            window = DHVAR_MAX_DEFAULT_WINDOW
-            window_rule = f"record/{WINDOW_FRACTION}, capped at {DHVAR_MAX_DEFAULT_WINDOW} samples for DHVAR"
-    else:
-        window = check_count(window, "window", 2)
-    if window > n:
-        raise ParameterError(f"window ({window} samples) is longer than the record ({n} samples)")
-    if hop is None:
-        hop = default_hop(window)
-        hop_rule = f"window/{HOP_FRACTION}"
-        if estimator == "theoh":
-            # every DHVAR window gets its own fit: keep it to about DHVAR_MAX_WINDOWS of them — but never
-            # hop past a window's end, which would leave samples out of every window
-            fewer = min(window, -(-(n - window) // DHVAR_MAX_WINDOWS))
-            if fewer > hop:
-                hop = fewer
-                hop_rule = f"raised from window/{HOP_FRACTION} to keep about {DHVAR_MAX_WINDOWS} windows" + (
-                    " (at most the window, so that no sample is left out)" if hop == window else ""
-                )
-    else:
-        hop = check_count(hop, "hop", 1)
-        if hop > n:
-            raise ParameterError(
-                f"hop ({hop} samples) is longer than the record ({n} samples): give a hop of at most "
-                f"the window ({window} samples) so that every sample is in a window"
-            )
-    settings = {
-        "window": int(window),
-        "hop": int(hop),
-        "window_default": not window_given,
-        "hop_default": not hop_given,
-        "window_rule": window_rule,
-        "hop_rule": hop_rule,
-    }
-    return window, hop, settings
-
-
-def _memory_plan(x, n, n_axes, window, hop, n_tau, n_fit, fit, max_memory) -> tuple[bool, dict]:
-    """(analyse axis by axis?, the cost by part): a memory-mapped record always axis by axis; one in memory
-    axis by axis where all its axes at once would exceed the budget and one at a time fits."""
-    by_axis = wants_by_axis(x)
-    try:
-        cost = check_report_memory(
-            n, n_axes, window, hop, n_tau, n_fit, len(TERMS), fit, max_memory,
-            record=record_bytes(n, n_axes, by_axis),
-        )  # fmt: skip
-    except MemoryBudgetError:
-        if by_axis or n_axes == 1:
-            raise
-        by_axis = True
-        cost = check_report_memory(
-            n, n_axes, window, hop, n_tau, n_fit, len(TERMS), fit, max_memory, record=record_bytes(n, n_axes, True)
-        )
-    return by_axis, cost
-
-
-def _octaves(ms) -> int:
-    """How many of the averaging factors ``ms`` an octave-thinned fit keeps (each at least twice the last)."""
-    kept, last = 0, 0.0
-    for m in ms:
-        if m >= 2.0 * last * (1 - 1e-12):
-            kept, last = kept + 1, float(m)
-    return kept
-
-
 def _fit_windows(dynamic, unit, confidence, tau_from):
     """The coefficients of every window, on the τ range of the whole-record fit of that axis. A short
     window (DHVAR's ≤ 2001 samples) holds few octaves: when thinning to octaves leaves too few τ for the
@@ -530,6 +355,7 @@ def log_source(log) -> dict:
         "fs_from": "time column" if log.time is not None else "given",
         "time_column": log.time_column,
         "time_column_recognised": bool(log.time_column_recognised),
+        "time_unit": log.time_unit,
         "unit": log.unit.name if log.unit is not None else None,
         "input": log.input,
         "t0_s": json_number(log.t0),
@@ -559,7 +385,12 @@ def from_log(log, **kwargs) -> Report:
     if log.time_column_recognised:
         notes.append(
             f"Neither fs nor a time column was given: column {log.time_column!r} was taken as the time "
-            f"column by its name; fs = {log.fs:g} Hz from its median step."
+            f"column by its name; fs = {log.fs:g} Hz from its steps."
+        )
+    if log.time_unit_from_name:
+        notes.append(
+            f"Time column {log.time_column!r} was read in {log.time_unit}, the unit its name ends in "
+            "(--time-unit / read_log(time_unit=…) overrides it)."
         )
     if log.gaps:
         notes.append(

@@ -21,7 +21,16 @@ __all__ = [
     "step_params",
     "LONG_RECORD_S",
     "count",
+    "CLOCK_TERMS",
 ]
+
+#: Said beside a fit whose unit is unknown (a clock's fractional frequency among such logs): the IEEE-952 terms'
+#: names are a gyro's, their τ laws those of the frequency-stability noise types (Riley, NIST SP 1065) — R²τ²/2
+#: is a linear frequency drift's Allan variance exactly.
+CLOCK_TERMS = (
+    "for a clock's fractional frequency the same terms are Q ↔ white/flicker PM, N ↔ white FM, B ↔ flicker FM, "
+    "K ↔ random-walk FM, R ↔ linear frequency drift"
+)
 
 
 def json_number(v):
@@ -71,6 +80,8 @@ def pct(v, b) -> str:
     if v is None or b is None or v == 0:
         return "?"
     p = abs(b / v - 1.0) * 100.0
+    if 0 < p < 0.095:  # one significant digit: "0.0" read as an interval of no width (10⁷ samples: ±0.03 %)
+        return f"{p:.1g}"
     return f"{p:.1f}" if p < 9.95 else f"{p:.0f}"
 
 

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 from .._core import __version__
 from ._regression import REGRESSION_COLUMNS, regression_row
-from .fmt import LONG_RECORD_S, clock, duration, g, num, step_params
+from .fmt import CLOCK_TERMS, LONG_RECORD_S, clock, duration, g, num, step_params
 from .forecasting import forecast_page
 from .paper002 import page_context as paper002_page
 from .settings import NOTHING_ADDED, REPORT_ESTIMATORS
@@ -75,7 +75,8 @@ def _record(rec: dict) -> dict:
             if src.get("time_column_recognised")
             else ""
         )
-        rows.append(("time column", f"{src['time_column']}{how}"))
+        unit = f", in {src['time_unit']}" if src.get("time_unit") not in (None, "s") else ""
+        rows.append(("time column", f"{src['time_column']}{unit}{how}"))
     if src.get("gaps"):
         shown = "; ".join(f"{gap['duration_s']:.6g} s after sample {gap['after_sample']}" for gap in src["gaps"][:10])
         rows.append(("gaps", shown + (" …" if len(src["gaps"]) > 10 else "")))
@@ -179,7 +180,9 @@ def _model(fit: dict, names: list, au: str) -> dict:
         "units_note": (
             "Coefficients in IEEE-952 units; base form in the second table."
             if ieee
-            else "The unit is unknown, so coefficients are in base form (the samples' unit and seconds)."
+            else "The unit is unknown, so coefficients are in base form (the samples' unit and seconds); "
+            + CLOCK_TERMS
+            + "."
         ),
     }
 
@@ -368,9 +371,10 @@ def _refinement(ref: dict | None, rec: dict) -> dict | None:
         "chi2_note": (
             "Every step is scored on the record's own Allan curve, a component removed in time part of the model "
             "through what it changed in the curve, so each step's before is the previous step's after (χ²/dof "
-            "weights each τ of a dense curve independently — not the fit table's χ²/dof, which accounts for the "
-            "correlation between τ). A change of noise level leaves the record's curve as it is: it was found "
-            "and is judged on the Allan variances of 16 windows along the record (their own χ² scale)."
+            "is the calibrated tests' own: the generalised least-squares χ² of the residual on ~4 τ per octave "
+            "under the exact covariance of the estimates across τ, per degree of freedom — not the noise-model "
+            "table's, a fit on its own τ grid). A change of noise level leaves the record's curve as it is: it was "
+            "found and is judged on the Allan variances of 16 windows along the record (their own χ² scale)."
         ),
     }
 

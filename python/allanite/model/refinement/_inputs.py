@@ -5,6 +5,7 @@ and the note saying how the held-out error is computed."""
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
@@ -99,6 +100,7 @@ def inputs(x_or_result, fs, input, points, axis, channels):
         if fs is None:
             raise ParameterError("fs (Hz) is needed with samples")
         cols, fs, _ = as_rate_columns(x_or_result, fs, input)
+        axis = _one_axis(axis, len(cols))
         if not 0 <= axis < len(cols):
             raise ParameterError(f"axis = {axis} is outside 0..{len(cols) - 1}")
         y = cols[axis]
@@ -107,8 +109,21 @@ def inputs(x_or_result, fs, input, points, axis, channels):
         result = avar(y, fs, taus=grid)
     chans = check_channels(channels, y)
     if result.avar.ndim == 2:
-        result = result.static_row(result.avar[axis])
+        result = result.static_row(result.avar[_one_axis(axis, result.avar.shape[0])])
     return y, result, chans
+
+
+def _one_axis(axis, n_axes: int) -> int:
+    """The axis to refine: ``axis``, or without it the first — with a warning when there are others (a log's
+    ``data`` of six columns was refined on its first alone, and the result said nothing of it)."""
+    if axis is not None:
+        return axis
+    if n_axes > 1:
+        warnings.warn(
+            f"refine refines one axis: axis 0 of {n_axes}; pass axis= for another (or call refine once per axis)",
+            stacklevel=4,  # refine's caller (refine → inputs → _one_axis)
+        )
+    return 0
 
 
 def check_channels(channels, y) -> dict:

@@ -6,6 +6,9 @@ stay as they are, and the entry says what they are. A clipped stretch is not exc
 value to put in its place (the rate beyond the rail is unknown; a model of censored samples is outside the
 Allan model) and because the change point and the curve's misfit it causes are then said too, beside the
 cause; a held sample is one innovation lost, its effect on the Allan variance at τ₀ the held fraction.
+Samples an accepted removal replaced (the ``"outliers"`` step's, ``MissingContext.replaced``) are left out of
+both: they are no longer in the record, and said by that step (a logger's dropped packets written as 0.0 are
+its smallest value, in runs, but replaced as impulsive noise they are neither a rail nor held samples).
 
 - ``"clipped"`` — samples at the record's largest (or smallest) value. Continuous samples tie at an extreme
   with probability 0; quantised ones do, but beyond the distribution's mode the density falls towards the
@@ -86,14 +89,18 @@ def _spans(runs: list[tuple[int, int]]) -> list[tuple[int, int]]:
     return out
 
 
-def _rail(y: np.ndarray, top: bool, a: float) -> dict | None:
-    """The binomial test at one rail (the largest value, or the smallest): None unless it rejects."""
-    v = float(y.max() if top else y.min())
-    at = y == v
-    n_ext = int(np.count_nonzero(at))
-    if n_ext < 2 or n_ext == y.size:
+def _rail(y: np.ndarray, top: bool, a: float, keep: np.ndarray | None = None) -> dict | None:
+    """The binomial test at one rail (the largest value, or the smallest, of the samples ``keep`` holds; all
+    where None): None unless it rejects."""
+    kept = y if keep is None else y[keep]
+    if kept.size < 3:
         return None
-    inner = y[~at]
+    v = float(kept.max() if top else kept.min())
+    at = y == v if keep is None else (y == v) & keep
+    n_ext = int(np.count_nonzero(at))
+    if n_ext < 2 or n_ext == kept.size:
+        return None
+    inner = y[~at] if keep is None else y[keep & ~at]
     w = float(inner.max() if top else inner.min())
     n_next = int(np.count_nonzero(inner == w))
     p = float(binom.sf(n_ext - 1, n_ext + n_next, 0.5))
@@ -132,9 +139,14 @@ def longest_null_run(n: int, ties: int, a: float) -> int:
     return max(3, math.ceil(math.log(a / n) / math.log(p) + 1))
 
 
-def _stuck(y: np.ndarray, a: float) -> dict | None:
-    """Runs of equal samples too long for the record's own tie rate (:func:`longest_null_run` at ``a``)."""
+def _stuck(y: np.ndarray, a: float, replaced: np.ndarray | None = None) -> dict | None:
+    """Runs of equal samples too long for the record's own tie rate (:func:`longest_null_run` at ``a``); a run
+    whose every sample a removal ``replaced`` is not one (nor are its ties counted)."""
     s, t = equal_runs(y)
+    if replaced is not None and s.size:
+        c = np.concatenate([[0], np.cumsum(replaced, dtype=np.int64)])
+        own = (c[t] - c[s]) < (t - s)
+        s, t = s[own], t[own]
     if not s.size:
         return None
     ties = int(np.sum(t - s - 1))
@@ -145,19 +157,25 @@ def _stuck(y: np.ndarray, a: float) -> dict | None:
     return {"runs": list(zip(s[long].tolist(), t[long].tolist())), "min_len": lmin}
 
 
-def quality_flags(y: np.ndarray, a: float) -> tuple[list[dict], dict | None]:
-    """The rails that reject (each at ``a``/4) and the runs too long for the quantisation (at ``a``/2)."""
-    rails = [r for top in (True, False) if (r := _rail(y, top, a / 4)) is not None]
-    return rails, _stuck(y, a / 2)
+def quality_flags(y: np.ndarray, a: float, replaced: np.ndarray | None = None) -> tuple[list[dict], dict | None]:
+    """The rails that reject (each at ``a``/4) and the runs too long for the quantisation (at ``a``/2), among
+    the samples no removal ``replaced`` (True where one did; None: none): a logger's dropped packets written as
+    0.0, once the outliers step has replaced them, are neither a rail nor a stuck run."""
+    if replaced is not None and not replaced.any():
+        replaced = None
+    keep = None if replaced is None else ~replaced
+    rails = [r for top in (True, False) if (r := _rail(y, top, a / 4, keep)) is not None]
+    return rails, _stuck(y, a / 2, replaced)
 
 
 def _flags(ctx: MissingContext, y: np.ndarray, a: float) -> tuple[list[dict], dict | None]:
     """:func:`quality_flags` once per context (the held check leaves the clipped check's samples out)."""
     memo = getattr(ctx, "memo", None)
+    replaced = getattr(ctx, "replaced", None)
     if memo is None:
-        return quality_flags(y, a)
+        return quality_flags(y, a, replaced)
     if ("quality", a) not in memo:
-        memo[("quality", a)] = quality_flags(y, a)
+        memo[("quality", a)] = quality_flags(y, a, replaced)
     return memo[("quality", a)]
 
 
@@ -315,6 +333,9 @@ def held_check(ctx: MissingContext, a: float) -> list[dict]:
         skip |= r["at"]
     for i, j in [] if stuck is None else stuck["runs"]:
         skip[i:j] = True
+    replaced = getattr(ctx, "replaced", None)
+    if replaced is not None:  # samples a removal replaced (the outliers step's) are its own
+        skip |= replaced
     c = tie_counts(y, skip)
     exp = expected_ties(c["n1"], c["n2"])
     if exp is None or c["n0"] < 10:

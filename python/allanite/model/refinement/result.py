@@ -198,6 +198,23 @@ class Refinement(RichDisplay):
         """The held-out error of the final model (the last step's after; the start's if nothing was added)."""
         return self.steps[-1].after.get("heldout_rms_adev_pct") if self.steps else self.start_heldout_rms_adev_pct
 
+    def __repr__(self) -> str:
+        """A few lines (the dataclass's own printed every field, arrays and the proposals tried included — pages
+        in a terminal): what was found, the chain's errors start → final, what is still missing."""
+        e0, e1 = self.curve_errors(self.start), self.curve_errors(self.fit)
+        found = ", ".join(self.found) if self.steps else self._nothing_added()
+        r = self.result
+        lines = [
+            f"Refinement({r.n_samples} samples at {r.fs:g} Hz, start {'+'.join(self.terms)}; {found}",
+            f"  χ²/dof {e0['chi2_dof']:.3g} → {e1['chi2_dof']:.3g}, RMS ADEV error {e0['rms_adev_pct']:.3g} → "
+            f"{e1['rms_adev_pct']:.3g} %, held-out {_fmt(self.start_heldout_rms_adev_pct)} → "
+            f"{_fmt(self.final_heldout_rms_adev_pct)} %",
+            *(f"  {st.effect}: {self.params_text(st, final=True)}" for st in self.steps),
+            *(f"  {t}" for t in (self.missing_sentences() if self.unexplained else [])),
+            "  .report(): the whole account; .fit: the final model; .steps: each effect with its test)",
+        ]
+        return "\n".join(lines)
+
     def _rate_unit(self) -> str | None:
         return self.fit.unit
 

@@ -1,0 +1,126 @@
+"""A channel regression's tests (:mod:`allanite.model.channels`): the coupling's likelihood ratio, the channel and
+its quadrature against no coupling (:func:`coupling_test`), and the optional terms, each by its own nested test at
+its own share of the level — the quadratic, then a d(ch)/dt term or a lag, never both (:func:`optional_terms`).
+Whittle's frequency-domain likelihood (:mod:`allanite.model._whittle`) throughout."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.stats import f as f_dist
+
+from . import _whittle as wh
+from ._lag import lag_profile, lag_response, lag_test
+from ._regressors import regressor_design
+from ._shares import TERM_SHARE
+
+__all__ = ["LAG_MARGIN", "coupling_test", "optional_terms"]
+
+#: The pure lag replaces a kept rate term only if it fits better by this much in 2Δℓ ("positive" evidence).
+LAG_MARGIN = 4.0
+
+
+def _f_test(stat: float, dof: float, alpha: float) -> dict:
+    return {
+        "statistic": float(stat),
+        "threshold": float(f_dist.isf(alpha, 1, dof)),
+        "alpha": float(alpha),
+        "dof": float(dof),
+        "p_value": float(f_dist.sf(max(stat, 0.0), 1, dof)),
+    }
+
+
+def _new_direction(bands, design, s) -> np.ndarray:
+    """The last regressor of ``design`` made orthogonal to the others (GLS metric), as a combination."""
+    info = design.gram(bands, 1.0 / s)[0]
+    v = np.zeros(len(design))
+    v[-1] = 1.0
+    if len(design) > 1:
+        v[:-1] = -np.linalg.solve(info[:-1, :-1], info[:-1, -1])
+    return v
+
+
+def _nested(bands, design, fit_small, alpha) -> tuple[dict, dict]:
+    """Likelihood-ratio test of the last regressor of ``design`` (both models refitted, noise included)."""
+    big = wh.joint_fit(bands, design)
+    v = _new_direction(bands, design, big["s"])
+    dof = wh.noise_dof(bands, big, wh.band_info(bands, design, v))
+    return _f_test(2.0 * (big["loglik"] - fit_small["loglik"]), dof, alpha), big
+
+
+def coupling_test(bands, null, alpha) -> tuple[dict, dict, dict]:
+    """The coupling's test: the channel and its quadrature (Hilbert transform) jointly against no coupling — the
+    likelihood ratio 2Δℓ (both models' noise refitted) against 2·F(2, ν) at ``alpha``; ν the Satterthwaite count
+    of the channel's information (:func:`allanite.model._whittle.noise_dof`) at the in-phase fit, as the channel's
+    test alone had it — the quadrature's information is the same (in band space it is the channel's DFT times −i,
+    orthogonal to it and of the same power in every band). Not the count at the pair's own fit: where ν is a few
+    (a diurnal temperature, one cycle in the record) the noise refitted beside the quadrature moved it 3.2 → 2.2
+    and the threshold 102 → 379 (blind suite 4's 24 h log, its coupling lost).
+
+    Why two degrees of freedom: a channel that reaches the rate through a lag (a thermistor behind the sensing
+    element) arrives shifted in phase, and only cos φ of it lines up with the channel itself — at a 600 s lag on
+    a 1667 s cycle (66°) the lag-0 test read 6.8 against 12.6 on a coupling 11× its detectable size and
+    accepted 0 of 12 records; the pair spans every phase of each band, so a lag (or a pure d(ch)/dt term, or a
+    lead) is seen at whatever phase it arrives. One fixed threshold (no maximum over a grid of lags), at the
+    same share of ``level`` (docs/channels.md, "The coupling's test").
+
+    Returns (the test, the in-phase 1-dof test — what this test was before, kept for the record and for the
+    coefficient's interval —, the in-phase fit, from which the optional terms are tested)."""
+    nb = bands.m.size
+    one = np.ones(nb)
+    in_phase, fit = _nested(bands, regressor_design([], nb), null, alpha)
+    both = wh.Design([0, 0], [one, -1j * one])
+    big = wh.joint_fit(bands, both)
+    dof = in_phase["dof"]
+    stat = 2.0 * (big["loglik"] - null["loglik"])
+    test = {
+        "statistic": float(stat),
+        "threshold": float(2.0 * f_dist.isf(alpha, 2, dof)),
+        "alpha": float(alpha),
+        "dof": float(dof),
+        "p_value": float(f_dist.sf(max(stat, 0.0) / 2.0, 2, dof)),
+        "phase_deg": float(np.degrees(np.arctan2(big["c"][1], big["c"][0]))),
+        "in_phase": {k: in_phase[k] for k in ("statistic", "threshold", "dof", "p_value")},
+    }
+    return test, in_phase, fit
+
+
+def optional_terms(bands, fit, terms, level, grid, z2):
+    """Quadratic first, then d(ch)/dt or a lag (never both). Returns (kept keys, fit, lag_s, tests)."""
+    nb = bands.m.size
+    keys: list = []
+    tests: dict = {}
+    if "quadratic" in terms:
+        t_q, big = _nested(bands, regressor_design(["quadratic"], nb), fit, TERM_SHARE["quadratic"] * level)
+        tests["quadratic"] = t_q | {"kept": t_q["statistic"] > t_q["threshold"]}
+        if tests["quadratic"]["kept"]:
+            keys, fit = ["quadratic"], big
+    design = regressor_design(keys, nb)
+    rate_ok, fit_r = False, None
+    if "rate_coefficient" in terms:
+        t_r, fit_r = _nested(
+            bands, regressor_design(keys + ["rate_coefficient"], nb), fit, TERM_SHARE["rate_coefficient"] * level
+        )
+        rate_ok = t_r["statistic"] > t_r["threshold"]
+        tests["rate_coefficient"] = t_r | {"kept": rate_ok}
+    lag_s = None
+    if "lag_s" in terms:
+        t_l = lag_test(bands, design, fit, TERM_SHARE["lag_s"] * level, grid)
+        tests["lag_s"] = t_l | {"kept": False}
+        if t_l["statistic"] > t_l["threshold"]:
+            best, interval = lag_profile(bands, design, fit["s"], grid, z2)
+            lag_design = wh.Design(design.src, [lag_response(bands.f, best, bands.fs)] + design.mult[1:])
+            fit_l = wh.joint_fit(bands, lag_design)
+            margin = 2.0 * (fit_l["loglik"] - fit_r["loglik"]) if rate_ok and fit_r is not None else math.inf
+            tests["lag_s"] |= {"lag_s": best, "interval": interval, "against_rate": margin}
+            if margin > LAG_MARGIN:
+                tests["lag_s"]["kept"] = True
+                if rate_ok:
+                    tests["rate_coefficient"] |= {"kept": False, "why": "the lag fits better (2Δℓ > LAG_MARGIN)"}
+                rate_ok, lag_s = False, best
+            elif rate_ok:
+                tests["lag_s"]["why"] = "the d(ch)/dt term fits as well (a lag and a rate term are nearly collinear)"
+    if rate_ok:
+        keys, fit = keys + ["rate_coefficient"], fit_r
+    return keys, fit, lag_s, tests

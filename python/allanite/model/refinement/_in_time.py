@@ -1,0 +1,106 @@
+"""The removals in time of a refinement, before its curve effects: every removal of :data:`.removals.REMOVALS`
+among the candidates, in order, each on the samples the ones before it left, kept where the held-out error
+falls (or its own held-out test in time passes) and, for a test in time alone, where it moves the Allan curve.
+Each kept removal's step is scored along the chain once the curve effects are in (:mod:`._final`).
+"""
+
+from __future__ import annotations
+
+from ...analysis import avar
+from ..channels import terms_before_after
+from ._run import RunState
+from .curvefit import Curve, noise_fit, solve
+from .removals import REMOVALS, Removal, RemovalContext
+from .result import Step
+from .scoring import MATERIAL_Z, curve_change_z
+
+__all__ = ["TimeRemovals"]
+
+
+class TimeRemovals(RunState):
+    """A refinement's removals in time (:meth:`remove_in_time`), on :class:`._run.RunState`."""
+
+    def remove_in_time(self, candidates, chans) -> None:
+        """Every removal of :data:`REMOVALS` among ``candidates``, in order, each on the samples the ones
+        before it left."""
+        if self.y is None:
+            return
+        # the channels even where their regression may not be taken: a drift a channel explains is no drift (with
+        # the regression a candidate the channel takes it; without, it is left to be said in ``unexplained``)
+        ctx = RemovalContext(self.y, self.fs, self.curve, self.sol, self.start, chans, self.level, self.consider)
+        for name, remover in REMOVALS.items():
+            if name not in candidates:
+                continue
+            for rem in remover(ctx):
+                if self.remove(rem):
+                    ctx.y, ctx.curve, ctx.sol = self.y, self.curve, self.sol
+                elif rem.family is not None:
+                    self.declined_families.append(rem.family)
+        self.line_search = ctx.lines
+
+    def remove(self, rem: Removal) -> bool:
+        """Remove ``rem.component`` if the held-out error falls (or its held-out test in time passes); else
+        record it among the considered. Its step is scored once the curve effects are in (:meth:`score`)."""
+        y, start, effects, heldout = self.y, self.start, self.effects, self.heldout
+        assert y is not None
+        ho_b = heldout.error(start, effects) if heldout is not None else None
+        ho_a = heldout.error(start, effects, remove=rem.refit, on_raw=rem.on_raw) if heldout is not None else None
+        if rem.heldout_in_time is not None:
+            rem.evidence["heldout_variance_ratio"] = rem.heldout_in_time
+            rejected = not rem.heldout_in_time < 1.0
+        else:
+            rejected = ho_b is not None and ho_a is not None and not ho_a < ho_b
+        if rejected:
+            why = f"held-out error {ho_b} → {ho_a} %, variance ratio {rem.heldout_in_time}"
+            self.consider(rem.effect, rem.params | {"rejected": why, "test": rem.evidence["test"]})
+            return False
+        if ho_b is not None:  # on the samples as they were, the five terms alone
+            rem.evidence["heldout_test"] = {"before": ho_b, "after": ho_a}
+        # the corrected samples' curve and split only for a removal the held-out test kept (one Allan curve of the
+        # record and two of its halves saved per removal turned down)
+        y_new = y - rem.component
+        res_new = avar(y_new, self.fs, taus=self.result.tau)
+        c_new, h_new = self.build(res_new, y_new)
+        params = dict(rem.params)
+        s_new = solve(c_new, start, effects)
+        if rem.on_curve and not self.moves_curve(rem, c_new):
+            return False
+        # the noise terms fitted with the component in the samples and without it, side by side: what the
+        # start model had taken of it (a temperature swing into B, K and R)
+        rem.evidence["terms_before_after"] = terms_before_after(
+            noise_fit(self.curve, start, effects, self.sol, self.result, self.unit, 0.683),
+            noise_fit(c_new, start, effects, s_new, res_new, self.unit, 0.683),
+        )
+        st = Step(
+            effect=rem.effect,
+            params=params,
+            intervals=rem.intervals,
+            evidence=rem.evidence,
+            before={},
+            after={},
+            truth_error=self.truth_error(rem.effect, params),
+            final_params=dict(params),
+            final_intervals=dict(rem.intervals),
+        )
+        parts = None
+        if self.split0 is not None:
+            parts = self.split0.corrected(self.removed[-1][4] if self.removed else self.raw, rem.refit, rem.on_raw)
+        self.removed.append((st, rem, self.curve.avar - c_new.avar, c_new, parts))
+        self.y, self.result, self.curve, self.heldout = y_new, res_new, c_new, h_new
+        self.sol = s_new
+        return True
+
+    def moves_curve(self, rem: Removal, c_new: Curve) -> bool:
+        """Whether removing ``rem`` moves an estimate of the record's Allan curve by at least
+        :data:`.scoring.MATERIAL_Z` of its standard errors (:func:`.scoring.curve_change_z`, under the model so
+        far). A removal whose test is in time alone (impulsive noise: a tail beyond the Gaussian's) may be real
+        yet immaterial to the curve — one sample of 10⁶ beyond 7 σ on an ADIS16405 accelerometer moves τ₀'s
+        estimate by 0.04 of its standard error — and then is no step of the model. Not the curve's error: the
+        model's white term takes white-like spikes, and removing true spikes can raise it (scoring's note)."""
+        z, tau = curve_change_z(self.curve, self.sol, self.curve.avar - c_new.avar)
+        if z >= MATERIAL_Z:
+            rem.evidence["curve_change"] = {"z": z, "tau": tau, "material_z": MATERIAL_Z}
+            return True
+        why = f"moves the Allan curve by {z:.2g} standard errors at most (τ {tau:.3g} s), < {MATERIAL_Z:g}"
+        self.consider(rem.effect, rem.params | {"rejected": why, "test": rem.evidence["test"]})
+        return False
