@@ -23,6 +23,7 @@ from ..channels import terms_before_after
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
 from ..terms import check_terms
+from ._family_fold import fold_wandering
 from ._inputs import REFINE_SCALE, check_scale, check_truth, check_unit, heldout_note, inputs, resolve_tau_range
 from ._rolloff import research_rolloff, sinc_chain_kept, sinc_named, without_sincs
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
@@ -476,6 +477,8 @@ class _Run:
             self.advance(st, self.chain(sol, self.effects, curve, n_removed, parts))
             st.evidence["scored_with"] = [base_name(k) for k, _p in self.effects] or "the five terms"
             _say_heldout_rise(st, rem)
+        fams = [st for st, rem, *_rest in self.removed if rem.effect == "periodic"]
+        fold_wandering(self.steps, self.lines, fams, self.truth_error)  # a family's own lines found again: one effect
 
     # ---- change points
 
