@@ -11,6 +11,7 @@ from scipy import signal
 import allanite
 from allanite.model.refinement._family_fold import fold_wandering, folded
 from allanite.model.refinement.result import Step
+from allanite.report.summary import _step_dict
 
 AMPS = (0.12, 0.072, 0.036)  # harmonics 1, 3, 5 of the mains, °/s
 
@@ -51,6 +52,8 @@ def test_wandering_family_takes_its_own_lines_and_their_power():
     assert sum(n.startswith("periodic") for n in names) == 1
     assert not any(n.startswith("sinusoid") for n in names)
     assert "sinusoid" not in "\n".join(r.report().split("## Final model")[1].splitlines()[:12])
+    # summary.json says which of the history's steps are the family's lines
+    assert [_step_dict(st, "deg/s").get("folded_into") for st in sins if folded(st)] == ["periodic"] * 3
 
 
 def _step(effect, params, intervals=None, evidence=None):
