@@ -136,6 +136,7 @@ def test_a_quantised_single_pole_reads_its_cutoff_with_the_floor_beside_it():
     assert r.fit.coefficients["N"].value == pytest.approx(N, rel=0.03)
 
 
+@pytest.mark.slow  # floor: the quantised single pole; no resonance: the clean records
 def test_a_quantised_4_tap_average_names_no_resonance():
     # a step of ½ σ after a 4-tap moving average at 1 kHz: without the floor a resonance stood in for it
     fs = 1000.0

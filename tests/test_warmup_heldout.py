@@ -39,6 +39,7 @@ def _held(y: np.ndarray, fs: float) -> tuple[float, dict]:
     return d["T"], warmup_heldout(y, fs, noise, d["T"], ramp=False)
 
 
+@pytest.mark.slow  # refine's side: the test below
 def test_a_warmup_shorter_than_a_block_is_fitted_and_held_out_on_both_parts():
     t_c, h = _held(_warmup_record(411), FS)
     assert abs(t_c / 40.0 - 1) < 0.2
