@@ -28,6 +28,25 @@ settings.load_profile("explore" if os.environ.get("ALLANITE_EXPLORE", "").strip(
 DEFAULT_SHARED_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
 
 
+def _slow_wanted(config: pytest.Config) -> bool:
+    """ALLANITE_SLOW=1 (any value but empty or 0), or a -m expression that names ``slow``."""
+    if os.environ.get("ALLANITE_SLOW", "").strip() not in ("", "0"):
+        return True
+    return "slow" in (config.getoption("markexpr", "") or "")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """The default run keeps CI's share small: tests marked ``slow`` — a heavier second record of a case a
+    cheaper default test covers, or a larger sample of a statistic a smaller one checks — are skipped with a
+    reason that says how to run them (docs/development.md lists what each set covers)."""
+    if _slow_wanted(config):
+        return
+    skip = pytest.mark.skip(reason="slow: a heavier twin of a default test; run with ALLANITE_SLOW=1 or -m slow")
+    for item in items:
+        if item.get_closest_marker("slow") is not None:
+            item.add_marker(skip)
+
+
 def shared_data_dir() -> Path:
     """Where the shared reference data are expected (``ALLANITE_SHARED_DATA`` or the default)."""
     env = os.environ.get("ALLANITE_SHARED_DATA", "").strip()

@@ -67,6 +67,7 @@ def test_a_null_record_with_the_same_channel_is_not_accepted(seed):
     assert not r.accepted and r.test["statistic"] < r.test["threshold"] and r.test["p_value"] > 0.01
 
 
+@pytest.mark.slow  # the lag-first test: the 600-s lag above
 def test_a_diurnal_coupling_with_few_dof_keeps_the_channels_own_count():
     # benches/refine_blind4.py's 24 h log: one diurnal cycle, ν ≈ 3. The pair's test takes the in-phase fit's ν
     # (its threshold 99.8 against 2Δℓ 165); counted at the pair's own noise fit ν fell to 2.2 and the threshold

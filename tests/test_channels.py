@@ -390,6 +390,7 @@ def test_the_lag_threshold_with_few_degrees_of_freedom_is_large_or_infinite_neve
     assert 10.0 < thr < 30.0 and upcrossing_p(thr, 40.0, 1.0) == pytest.approx(1e-3, rel=1e-6)
 
 
+@pytest.mark.slow  # its record refined: test_refine_takes_a_temperature_cycling_...
 def test_heldout_of_a_channel_cycling_a_whole_number_of_times():
     # a temperature cycling exactly 3 times puts its power in one DFT bin, so into one side of the even/odd split:
     # that way's held-out ratio was the other side's noise (1.05, 0.46, 0.60 for these seeds — the first a

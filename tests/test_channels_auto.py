@@ -209,6 +209,7 @@ def test_channels_none_switches_it_off(coupled, tmp_path):
     assert not any("passed to every axis's model refinement" in n for n in s["notes"])  # build_report's channel note
 
 
+@pytest.mark.slow  # a third report refine
 def test_refine_candidates_without_regression_leave_it_out_with_a_note(coupled, tmp_path):
     rc, s = _report(coupled, tmp_path / "o", "--refine-candidates", "drift")
     assert rc == 0 and s["record"]["axis_names"] == ["g_x", "g_y"]
@@ -248,24 +249,36 @@ def client():
         yield c
 
 
-def test_batch_takes_the_channels_as_report_does(tmp_path, client):
-    import csv
-
+def _batch(tmp_path, client, **kw):
     from allanite.dask import batch
 
     (tmp_path / "logs").mkdir()
     _coupled_csv(tmp_path / "logs" / "a.csv", "imu_temp", seed=0)
     _coupled_csv(tmp_path / "logs" / "b.csv", "imu_temp", coef=0.0, seed=1)
-    opts = dict(fs=FS, unit="deg/s", window=1000, hop=250, client=client)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = batch(str(tmp_path / "logs" / "*.csv"), out=tmp_path / "r", refine=True, **opts)
-        off = batch(str(tmp_path / "logs" / "*.csv"), out=tmp_path / "s", refine=True, channels=None, **opts)
-    assert not res.failed and not off.failed
+        return batch(
+            str(tmp_path / "logs" / "*.csv"), out=tmp_path / "r", refine=True, fs=FS, unit="deg/s", window=1000,
+            hop=250, client=client, **kw,
+        )  # fmt: skip
+
+
+@pytest.mark.slow  # a dask cluster and eight reports; the channels in the report: the tests above
+def test_batch_takes_the_channels_as_report_does(tmp_path, client):
+    import csv
+
+    res = _batch(tmp_path, client)
+    assert not res.failed
     rows = {(r["file"][-5:], r["axis"]): r for r in csv.DictReader((tmp_path / "r" / "fleet.csv").open())}
     assert set(rows) == {("a.csv", "g_x"), ("a.csv", "g_y"), ("b.csv", "g_x"), ("b.csv", "g_y")}  # no imu_temp axis
     assert "regression" in rows["a.csv", "g_x"]["effects"].split(";")
     assert not any("regression" in rows[k]["effects"] for k in rows if k != ("a.csv", "g_x"))
+
+
+@pytest.mark.slow  # the same four refines again; channels=None is test_channels_none_switches_it_off's in the report
+def test_batch_channels_none_switches_it_off(tmp_path, client):
+    off = _batch(tmp_path, client, channels=None)
+    assert not off.failed
     assert not any("regression" in (r["effects"] or "") for r in off.rows)
     assert {r["axis"] for r in off.rows} == {"g_x", "g_y"}
 

@@ -52,7 +52,7 @@ def test_progress_must_be_a_bool_or_none():
         allanite.refine(y, 100.0, progress="yes")
 
 
-@pytest.mark.parametrize("estimator", ["theoh", "theoh_a"])
+@pytest.mark.parametrize("estimator", ["theoh", pytest.param("theoh_a", marks=pytest.mark.slow)])
 def test_dhvar_in_groups_equals_one_call(estimator, capsys, monkeypatch):
     monkeypatch.setattr(_progress, "DELAY", 0.0)
     rng = np.random.default_rng(5)

@@ -8,6 +8,7 @@ import sys
 import threading
 
 import numpy as np
+import pytest
 
 import allanite
 from allanite.model import _covariance
@@ -110,6 +111,7 @@ def test_recent_from_threads_finds_equal_arrays_only():
     assert memo._items == []  # emptied on leaving
 
 
+@pytest.mark.slow  # two refines twice; the memories from threads: the tests above
 def test_two_refines_in_threads_equal_sequential_calls():
     records = [
         (allanite.simulate(60_000, 50.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 4.0)], seed=8), 50.0),

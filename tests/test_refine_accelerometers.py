@@ -77,6 +77,7 @@ def adis_run1_acc_x(shared_data):
     return allanite.refine(y, 100.0, progress=False)
 
 
+@pytest.mark.slow  # ADIS accelerometers: test_refine_line_amplitude.py
 def test_adis_run1_acc_x_default_call(adis_run1_acc_x):
     r = adis_run1_acc_x
     # the one sample beyond 7 σ is considered and turned down: it moves τ₀'s estimate by 0.04 standard error

@@ -33,6 +33,7 @@ def _cold_start(seed: int, t_temp: float, warmup: tuple | None, coupling: float)
     return y, fs, temp + 0.05 * rng.standard_normal(n)
 
 
+@pytest.mark.slow  # regression vs drift: the test below
 def test_a_cold_start_temperature_is_its_regression_not_a_drift():
     y, fs, temp = _cold_start(1, 300.0, None, 3e-4)
     # the swing sits within one block: fast by its share, a within-block t test of ≈ 1 dof (threshold 170)

@@ -181,6 +181,7 @@ def test_refine_names_a_4th_order_butterworth_at_500hz():
     assert r.unexplained == []
 
 
+@pytest.mark.slow  # a second Butterworth: the 4th order at 500 Hz
 def test_refine_names_a_butterworth_at_1khz():
     # 1 kHz, a 2nd-order Butterworth at 200 Hz on the white noise and a Gauss–Markov rate (both filtered, as a
     # sensor's anti-alias stage filters everything), flicker beside: a two-pole bandwidth, no resonance

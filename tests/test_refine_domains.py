@@ -159,6 +159,7 @@ def test_finds_a_simulated_warm_up_drift():
     _falls(st)
 
 
+@pytest.mark.slow  # simulated: test_finds_a_simulated_warm_up_drift
 def test_finds_a_warm_up_drift_injected_into_adis_noise(shared_data):
     # run 3 gyro x has no warm-up of its own (drift statistic 2 against a threshold of ~650)
     (y,) = _adis(shared_data, 3, ["gyro_x"])
@@ -209,6 +210,7 @@ def test_clean_adis_run_names_its_bandwidth_not_sinusoids(shared_data):
     assert st.before["chi2_dof"] > 100 and st.after["chi2_dof"] < 2
 
 
+@pytest.mark.slow  # ADIS bandwidth: test_clean_adis_run_names_its_bandwidth...
 def test_roll_off_is_kept_where_the_record_reproduces_itself(shared_data):
     # run 1 y: over every informative τ the held-out error rose with the bandwidth (7.24 → 7.83 %), decided by
     # τ ≥ 40 s where the two parts differ by more than ±20 %; scored where they agree, it falls
@@ -221,6 +223,7 @@ def test_roll_off_is_kept_where_the_record_reproduces_itself(shared_data):
     assert r.steps[0].after["chi2_dof"] < 1.5 and not r.unexplained
 
 
+@pytest.mark.slow  # ADIS bandwidth: the clean run and the single pole
 def test_adis_through_an_injected_decimation_filter(shared_data):
     # the ADIS run filtered by a further 8-tap moving average: the cascade (−3 dB at 5.46 Hz) is named a
     # bandwidth with its cutoff (the nearest of the family: a Bartlett FIR)
@@ -256,6 +259,7 @@ def test_cascade_matches_a_simulation():
     np.testing.assert_allclose(sim / sim[-1], exact / exact[-1], rtol=0.03)
 
 
+@pytest.mark.slow  # a line: test_refine.py's test_finds_an_undeclared_sinusoid
 def test_adis_with_injected_sinusoid_at_0p02_hz(shared_data):
     # issue 16: run 5 y + 0.03 °/s at 0.02 Hz was not found with default arguments (f0 reported 1.54 Hz)
     (y,) = _adis(shared_data, 5, ["gyro_y"])
@@ -269,6 +273,7 @@ def test_adis_with_injected_sinusoid_at_0p02_hz(shared_data):
     _falls(st)
 
 
+@pytest.mark.slow  # two effects: test_two_effects_at_once
 def test_adis_with_injected_gauss_markov_and_g_sensitivity(shared_data):
     # two effects at once in real noise: a Gauss–Markov rate and a g-sensitivity through the accelerometer
     gx, az = _adis(shared_data, 2, ["gyro_x", "acc_z"])
@@ -326,6 +331,7 @@ def test_band_regression_keeps_one_coefficient_unless_the_bands_differ():
     assert regression_heldout(y, a, FS, 0.01) < regression_heldout(y, a)
 
 
+@pytest.mark.slow  # simulated: test_simulated_multi_position_g_sensitivity
 def test_adis_multi_position_g_sensitivity(shared_data):
     # a realistic g-sensitivity test: acc_z turned between ±1 g every 200–600 s, the gyro responding to the
     # true acceleration at 0.01 °/s/g (the log's own noise and its coupling to acc_z's noise kept)
@@ -338,6 +344,7 @@ def test_adis_multi_position_g_sensitivity(shared_data):
     _falls(rg)
 
 
+@pytest.mark.slow  # simulated: test_simulated_multi_position_...
 def test_adis_gauss_markov_and_multi_position_g_sensitivity_at_once(shared_data):
     # two effects at once in real noise: a Gauss–Markov rate and a g-sensitivity seen through a ±1 g
     # multi-position profile. The regression goes first (its test is in time): left in, the profile's steps
@@ -441,6 +448,7 @@ def test_finds_a_simulated_resonance():
     _falls(st)
 
 
+@pytest.mark.slow  # simulated: test_finds_a_simulated_resonance
 def test_adis_z_gyro_hump_is_a_resonance(shared_data):
     # the z gyros' broad PSD hump near 20 Hz (5× the floor from ~18 to ~23 Hz): named a resonance there
     (y,) = _adis(shared_data, 1, ["gyro_z"])

@@ -81,6 +81,7 @@ def test_a_heavy_tail_is_flagged_sample_by_sample_and_what_is_left_stays_white()
     np.testing.assert_allclose(flat / flat[0], 1.0, atol=0.05)
 
 
+@pytest.mark.slow  # heavy tails: test_outliers.py
 def test_heavy_tailed_noise_is_outliers_alone_and_nothing_is_left():
     case = _case("heavy-tailed")
     y, fs, _ = sensors.make(case)

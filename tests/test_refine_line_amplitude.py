@@ -58,7 +58,7 @@ def test_a_coherent_line_keeps_its_amplitude_in_the_final_model():
 
 @pytest.mark.parametrize(
     "run, axis, before",
-    [(3, "acc_x", 59.0), (4, "acc_z", 159.0)],
+    [(3, "acc_x", 59.0), pytest.param(4, "acc_z", 159.0, marks=pytest.mark.slow)],
 )
 def test_adis_accelerometers_take_the_roll_off_and_hold_their_lines(shared_data, run, axis, before):
     path = shared_data / "adis16405" / f"adis16405_run{run}_100Hz.csv.gz"

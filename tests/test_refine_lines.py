@@ -58,6 +58,7 @@ def test_list_and_int_params_render_everywhere(square):
     assert format_param("taps", 7) == "taps = 7" and format_param("filter", "boxcar") == "filter = boxcar"
 
 
+@pytest.mark.slow  # a second square wave
 def test_without_the_periodic_candidate_the_lines_come_one_sinusoid_at_a_time():
     t = np.arange(N) / FS
     y = _noise(2) + 0.05 * np.sign(np.sin(2 * np.pi * 0.73 * t + 0.3))
@@ -67,6 +68,7 @@ def test_without_the_periodic_candidate_the_lines_come_one_sinusoid_at_a_time():
     assert abs(r.steps[0].params["f0"] / 0.73 - 1) < 1e-3
 
 
+@pytest.mark.slow  # test_periodic.py's isolated line; test_refine.py's sinusoid
 def test_an_isolated_line_stays_a_sinusoid():
     t = np.arange(N) / FS
     y = _noise(3) + 0.02 * np.sin(2 * np.pi * 3.1 * t)

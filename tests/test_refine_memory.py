@@ -6,10 +6,12 @@ from __future__ import annotations
 import tracemalloc
 
 import numpy as np
+import pytest
 
 import allanite
 
 
+@pytest.mark.slow  # an 8e6-sample refine; chunked nulls: the tests below
 def test_refine_traced_peak_stays_a_few_records():
     # 8·10⁶ samples (64 MB): the traced peak (NumPy's arrays; the compiled core's working arrays are not traced)
     # was 14.7× a 4·10⁶ record at 478e6dd — the lattice step's ≈ 5 copies, whole-record Welch passes, the held-out

@@ -1,6 +1,7 @@
 """``refine`` with default arguments on simulated sensors unlike the ADIS16405 (issue 29): the CI subset of
-``tests/sensors.py`` — a 25-hour 1 Hz log whose bias follows a temperature that swings once, sparse spikes
-(the issue's cycling temperature and a square wave's line family are tests/test_channels.py's and
+``tests/sensors.py`` — a 25-hour 1 Hz log whose bias follows a temperature that swings once, and sparse spikes in
+the slow set only (``ALLANITE_SLOW=1``: outliers are tests/test_refine_lines.py's and tests/test_outliers.py's by
+default; the issue's cycling temperature and a square wave's line family are tests/test_channels.py's and
 tests/test_refine_lines.py's). Each must be named with its parameters (20 %, frequencies 1 %), lower the errors in sample
 and held out, and leave nothing unexplained; refined without its effect's candidate, the model cannot be
 complete, and ``unexplained`` must say so. The whole suite (17 cases) is ``benches/refine_sensors.py``."""
@@ -13,9 +14,14 @@ import allanite
 import sensors
 
 CI_CASES = [c for c in sensors.CASES if c.ci]
+SLOW = {"sparse spikes"}
 
 
-@pytest.fixture(scope="module", params=CI_CASES, ids=lambda c: c.name.split(",")[0])
+@pytest.fixture(
+    scope="module",
+    params=[pytest.param(c, marks=[pytest.mark.slow] if c.name.split(",")[0] in SLOW else []) for c in CI_CASES],
+    ids=lambda c: c.name.split(",")[0],
+)
 def case_record(request):
     case = request.param
     y, fs, channels = sensors.make(case)

@@ -38,6 +38,7 @@ def sawtooth():
     return allanite.refine(y, fs, unit="deg/s", progress=False)
 
 
+@pytest.mark.slow  # test_periodic's sawtooth
 def test_a_sawtooth_through_a_moving_average_is_one_waveform_and_nothing_is_left(sawtooth):
     r = sawtooth
     (st,) = [s for s in r.steps if s.effect == "periodic"]

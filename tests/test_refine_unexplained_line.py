@@ -39,7 +39,7 @@ def test_a_line_switched_on_halfway_is_said_where_it_changes():
     assert any(text in s for s in r.missing_sentences())
 
 
-@pytest.mark.parametrize("seed", [1, 2, 4])
+@pytest.mark.parametrize("seed", [1, pytest.param(2, marks=pytest.mark.slow), pytest.param(4, marks=pytest.mark.slow)])
 def test_a_constant_line_is_not_said(seed):
     r = allanite.refine(_record(seed, False), FS, progress=False)
     assert "sinusoid" in r.found
@@ -79,7 +79,7 @@ def test_a_family_switched_on_halfway_is_said_though_what_its_removal_left_has_o
     assert any(text in s for s in r.missing_sentences())
 
 
-@pytest.mark.parametrize("seed", [1, 2, 4])
+@pytest.mark.parametrize("seed", [1, pytest.param(2, marks=pytest.mark.slow), pytest.param(4, marks=pytest.mark.slow)])
 def test_a_constant_family_is_not_said(seed):
     r = allanite.refine(_square(seed, False), FS, progress=False)
     assert "periodic" in r.found

@@ -124,6 +124,7 @@ def test_clean_flicker_random_walk_and_gauss_markov_records_are_silent(seed):
     assert mss.steps_check(_context(y, heldout_pct=None), A) == []
 
 
+@pytest.mark.slow  # steps said: test_refine_says_the_steps_in_every_surface
 def test_one_step_is_said_once_by_the_mean_check():
     n = 200_000
     y = allanite.simulate(n, 50.0, N=2e-3, B=3e-4, K=2e-6, seed=3)

@@ -75,6 +75,7 @@ def test_report_and_notebook_say_what_a_refinement_misses():
     assert "no candidate earned its parameters — but the model still misses something" in md
 
 
+@pytest.mark.slow  # CLI surfaces: test_refine_unexplained_level.py, test_refine_quality.py
 def test_cli_console_page_and_json_say_the_region(tmp_path, capsys):
     log, out = tmp_path / "line.npy", tmp_path / "out"
     np.save(log, _with_line())

@@ -52,6 +52,7 @@ def _floor(step: float) -> float:
     return step * N / math.sqrt(12.0)
 
 
+@pytest.mark.slow  # floor: single pole, 4-tap
 def test_a_quantised_4th_order_butterworth_keeps_its_order_and_finds_the_floor():
     fs = 2000.0
     r = allanite.refine(_record(1, fs, 4, 1.0), fs)
@@ -69,6 +70,7 @@ def test_a_quantised_4th_order_butterworth_keeps_its_order_and_finds_the_floor()
     assert r.fit.chi2_dof < 1.5 and not r.unexplained
 
 
+@pytest.mark.slow  # floor: single pole, 4-tap
 def test_a_quantised_2nd_order_butterworth_at_200hz_finds_the_floor():
     fs = 200.0
     r = allanite.refine(_record(7, fs, 2, 1.0, n=300_000), fs)
@@ -78,6 +80,7 @@ def test_a_quantised_2nd_order_butterworth_at_200hz_finds_the_floor():
     assert p["floor"] == pytest.approx(_floor(1.0), rel=0.10)
 
 
+@pytest.mark.slow  # no floor unquantised: test_no_floor_without_quantisation...
 def test_an_unquantised_single_pole_has_no_floor_column():
     # beside a single pole (or a boxcar) a floor trades with the cutoff (the span) and white angle noise on the
     # Allan curve: N stays replaced unless the spectrum shows a floor (curvefit.has_floor, _rolloff.floor_choice)
@@ -133,6 +136,7 @@ def test_a_quantised_single_pole_reads_its_cutoff_with_the_floor_beside_it():
     assert r.fit.coefficients["N"].value == pytest.approx(N, rel=0.03)
 
 
+@pytest.mark.slow  # floor: the quantised single pole; no resonance: the clean records
 def test_a_quantised_4_tap_average_names_no_resonance():
     # a step of ½ σ after a 4-tap moving average at 1 kHz: without the floor a resonance stood in for it
     fs = 1000.0

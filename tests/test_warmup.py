@@ -63,6 +63,7 @@ def test_gls_intervals_cover_and_the_spread_meets_the_bound():
     assert abs(np.median(t_hat) / t_c - 1) < 0.5 * rel
 
 
+@pytest.mark.slow  # 2e5 samples; the intervals: test_gls_intervals_cover_...
 def test_warmup_fit_at_10_hz_holds_the_truth():
     # another rate and length than the benchmark's (10 Hz, 2·10⁵ samples, T = 600 s), noise terms fitted to the
     # record itself (the warm-up removed and the noise refitted), as refine fits it. A 68 % interval misses the
@@ -100,22 +101,29 @@ def test_a_rate_ramp_is_a_free_column():
     assert np.std(t_hat / t_c) == pytest.approx(with_ramp, rel=0.35)
 
 
-def test_the_ramp_choice_tells_a_ramp_from_a_random_walk():
+@pytest.mark.parametrize(
+    "records, min_ramps, max_walks",
+    [(12, 10, 8), pytest.param(30, 25, 17, marks=pytest.mark.slow)],
+)
+def test_the_ramp_choice_tells_a_ramp_from_a_random_walk(records, min_ramps, max_walks):
     # block means drawn from exactly their covariance plus a warm-up: white + flicker + a deterministic ramp as
     # large as the warm-up over the record (the ADIS run 4 x final model), and white + flicker + a random walk of
     # rate with no ramp (its five-term fit). The likelihood keeps the ramp on nearly every record of the first
-    # (29 of 30 at these seeds) and on a minority of the second (10 of 30): bounds ±2.5 binomial σ
+    # (30 of 30 at these seeds; 12 of the first 12) and on a minority of the second (9 of 30; 6 of 12): bounds
+    # ±2.5 binomial σ (p ≈ 0.97 and 1/3). The default run draws the first 12 records of the same 30
     length, a, t_c = 1e4, 0.08, 1500.0
     edges = np.linspace(0.0, length, 101)
     tb = 0.5 * (edges[:-1] + edges[1:])
     ramp_noise = {"N": 0.0415, "B": 0.00714}
-    ramps = [ramp_choice(b, edges, ramp_noise)[0] for b in _draws(edges, ramp_noise, a, t_c, 30, seed=3) + 6.68e-6 * tb]
-    assert sum(ramps) >= 25
+    draws = _draws(edges, ramp_noise, a, t_c, records, seed=3) + 6.68e-6 * tb
+    ramps = [ramp_choice(b, edges, ramp_noise)[0] for b in draws]
+    assert sum(ramps) >= min_ramps
     walk_noise = {"N": 0.0414, "B": 0.0101, "K": 3.36e-4}
-    walks = [ramp_choice(b, edges, walk_noise)[0] for b in _draws(edges, walk_noise, a, t_c, 30, seed=3)]
-    assert sum(walks) <= 17
+    walks = [ramp_choice(b, edges, walk_noise)[0] for b in _draws(edges, walk_noise, a, t_c, records, seed=3)]
+    assert sum(walks) <= max_walks
 
 
+@pytest.mark.slow  # 16 full warm-up fits; the choice itself is test_the_ramp_choice_tells_a_ramp_from_a_random_walk's
 def test_the_ramp_chosen_by_likelihood_brings_T_closer_than_the_fitted_R():
     # the warm-up in the ADIS run 4 x final model (its slow part a ramp) at 10 Hz, 100 blocks: where the
     # refit five-term fit sets R = 0 (3 of 16 records here), the former fit dropped the ramp's column and the

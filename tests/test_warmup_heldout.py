@@ -39,6 +39,7 @@ def _held(y: np.ndarray, fs: float) -> tuple[float, dict]:
     return d["T"], warmup_heldout(y, fs, noise, d["T"], ramp=False)
 
 
+@pytest.mark.slow  # refine's side: the test below
 def test_a_warmup_shorter_than_a_block_is_fitted_and_held_out_on_both_parts():
     t_c, h = _held(_warmup_record(411), FS)
     assert abs(t_c / 40.0 - 1) < 0.2
@@ -60,6 +61,7 @@ def test_refine_keeps_a_warmup_shorter_than_a_held_out_block():
     assert held["z"] >= held["z_min"] and held["ratio"] < 1
 
 
+@pytest.mark.slow  # refine's side: test_refine_keeps_no_drift_on_a_random_walk
 def test_a_random_walk_wander_fitted_as_a_warmup_is_not_held_out():
     # the warm-up fitted to a random walk's wander, whatever the drift test says: the held-out part's conditional
     # residual is independent of the held-in part, so the fit gains nothing there beyond its scatter

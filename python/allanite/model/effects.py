@@ -473,7 +473,13 @@ EFFECTS: dict[str, Effect] = {
                     "±s·f2 around the multiples of f1)",
                 ),
                 ("lines", "", "lines in the family"),
-                ("rms", "rate unit", "RMS of the family's component, √(Σ A_i²/2)"),
+                (
+                    "rms",
+                    "rate unit",
+                    "RMS of the family's lines, √(Σ A_i²/2): the component removed in time with the power that "
+                    "sinusoids found again at its own lines hold (a wandering phase; the removed part alone in "
+                    "evidence['coherent_rms'])",
+                ),
             ),
             "every significant line of the Welch PSD (Blackman–Harris, the neighbours' median, Bonferroni over the "
             "bins, at the line share of level) grouped into families on a lattice — harmonics k·f0, sidebands "

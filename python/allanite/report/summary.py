@@ -165,6 +165,8 @@ def _step_dict(st, rate) -> dict:
     reg = regression_dict(st.evidence) if st.effect == "regression" else None
     if reg is not None:
         out["regression"] = reg
+    if "folded_into" in st.evidence:  # a periodic family's own line found again: its power is in the family's rms
+        out["folded_into"] = st.evidence["folded_into"]["effect"]
     if "window_levels" in st.evidence:
         out["window_levels"] = {
             k: {q: json_number(v) for q, v in d.items()} for k, d in st.evidence["window_levels"].items()
@@ -462,8 +464,9 @@ def _refinement_text(s: dict) -> list[str]:
             f"RMS ADEV error {g(a['rms_adev_pct'], 3)} → {g(b['rms_adev_pct'], 3)} %" + _heldout_words(ax)
         )
         for st in ax["steps"]:
+            fold = f" (one of the {st['folded_into']} family's lines)" if st.get("folded_into") else ""
             lines.append(
-                f"    {st['effect']}: {step_params(st, rec['fs_hz'], rec['duration_s'], units=True, final=True)}"
+                f"    {st['effect']}: {step_params(st, rec['fs_hz'], rec['duration_s'], units=True, final=True)}{fold}"
             )
             lines += [f"      {t}" for t in regression_lines(st.get("regression"))]
         lines += [f"    {m['text']}" for m in ax.get("term_moves", [])]

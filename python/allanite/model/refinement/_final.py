@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import tracing
+from ._family_fold import fold_wandering
 from ._run import RunState
 from .candidates import Round, final_params
 from .changes import change_point_step, change_points
@@ -46,6 +47,8 @@ class FinalModel(RunState):
             self.advance(st, self.chain(sol, self.effects, curve, n_removed, parts))
             st.evidence["scored_with"] = [base_name(k) for k, _p in self.effects] or "the five terms"
             _say_heldout_rise(st, rem)
+        fams = [st for st, rem, *_rest in self.removed if rem.effect == "periodic"]
+        fold_wandering(self.steps, self.lines, fams, self.truth_error)  # a family's own lines found again: one effect
 
     def change_point_steps(self, candidates) -> list:
         """Steps of the change points the held-out error per segment confirms (:func:`.changes.change_point_step`:

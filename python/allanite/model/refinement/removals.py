@@ -50,7 +50,7 @@ import numpy as np
 from scipy.stats import t as t_dist
 
 from ...analysis import avar
-from .. import channels, outliers, periodic, template, tracing, warmup
+from .. import channels, linefit, outliers, periodic, template, tracing, warmup
 from .calibrated import tested
 from .curvefit import Curve, Solution, theta_terms, upper_theta
 from .levels import alpha
@@ -422,7 +422,10 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
     a = alpha("lines", ctx.level)
     search = periodic.periodic_search(ctx.y, ctx.fs, a)
     ctx.lines = search
+    searched = ctx.y
     for fam in search["families"]:
+        if ctx.y is not searched:  # a family removed before: this one's amplitudes on what it left
+            fam = _refit_family(fam, ctx.y)
         ratios = fam.evidence["psd_ratio"]
         i = int(np.argmax(ratios))
         sd = fam.gens_sd
@@ -468,6 +471,16 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
             heldout_in_time=ratio,
             family=fam,
         )
+
+
+def _refit_family(fam: periodic.LineFamily, y: np.ndarray) -> periodic.LineFamily:
+    """``fam`` with its amplitudes and phases refitted on ``y`` (the samples an earlier family's removal left), its
+    frequencies as found. Every family is found on the same samples; a line two families share was removed twice
+    when each kept the amplitudes fitted there (a consumer IMU's 35th harmonic of 0.19 Hz, taken by that family's
+    folded waveform, is the 6.65 Hz sideband of the other: the second removal left it at −its amplitude, which a
+    sinusoid then held, ``tests/sensors.py``)."""
+    a, b = linefit.solve(y, np.arange(y.size), fam.gens / fam.fs, fam.coefs)
+    return dataclasses.replace(fam, a=a, b=b)
 
 
 def _waveform(ctx: RemovalContext, fam: periodic.LineFamily, ratio_lines: float):

@@ -14,6 +14,7 @@ from ...units import ieee952
 from .. import fitting
 from ..effects import EFFECTS, format_params
 from ..terms import TERM_NAMES
+from ._family_fold import folded
 from .levels import LEVEL
 from .words import missing_sentences
 
@@ -314,7 +315,9 @@ class Refinement(RichDisplay):
         ]
         lines += [f"- {c!r}" for t, c in s1.coefficients.items() if t in self.terms]
         lines += [
-            f"- {_effect_name(self.steps, i)}: {self.params_text(st, final=True)}" for i, st in enumerate(self.steps)
+            f"- {_effect_name(self.steps, i)}: {self.params_text(st, final=True)}"
+            for i, st in enumerate(self.steps)
+            if not folded(st)  # a family's own line found again: in the family's row
         ]
         return lines + [""] + [f"{n}" for n in self.notes()[1:]]
 
@@ -355,6 +358,8 @@ class Refinement(RichDisplay):
                 [t, TERM_NAMES.get(t, ""), fmt_ci(c.value, *c.ci), c.unit or "base form", ieee, c.ieee_unit or "—"]
             )
         for i, st in enumerate(self.steps):
+            if folded(st):  # a periodic family's own line found again: its power is in the family's rms
+                continue
             label = EFFECTS[st.effect].label if st.effect in EFFECTS else ""
             rows.append([_effect_name(self.steps, i), label, self.params_text(st, final=True), "", "—", "—"])
         header = ("term or effect", "", "value [interval]", "unit", "IEEE-952 [interval]", "IEEE unit")
