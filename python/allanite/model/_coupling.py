@@ -78,18 +78,20 @@ def _null_bands(bands, s, rng):
     return dataclasses.replace(bands, q=s * (np.abs(w) ** 2 + rest), g=g, G=bands.G[:, :1, :1])
 
 
-def bootstrap_scale(bands, null, seed: int = 0) -> float:
-    """Bartlett's factor of the coupling's statistic under the null: the mean of 2Δℓ over :data:`BOOT_DRAWS`
-    records of the null fit's noise beside the same channel (:func:`_null_bands`; the noise refitted in every
-    draw, as on the record), over χ²₂'s mean 2 — at least 1. Seeded: the same record gets the same threshold."""
+def bootstrap_scale(bands, null, seed: int = 0) -> tuple[float, float]:
+    """Bartlett's factors of the coupling's statistic (the pair, 2 dof) and of the in-phase one (1 dof) under the
+    null: their means over :data:`BOOT_DRAWS` records of the null fit's noise beside the same channel
+    (:func:`_null_bands`; the noise refitted in every draw from a cold start, as on the record: the noise fit's
+    optimum depends on where it starts — started at the null fit's amounts, a 3600-sample record's factor read 0.9
+    where 2.5 cold) over χ²'s means 2 and 1 — each at least 1. Seeded: the same record gets the same thresholds."""
     rng = np.random.default_rng(seed)
-    total = 0.0
+    one = regressor_design([], bands.m.size)
+    total = np.zeros(2)
     for _ in range(BOOT_DRAWS):
         b = _null_bands(bands, null["s"], rng)
-        # both fits from a cold start, as on the record: the noise fit's optimum depends on where it starts
-        # (started at the null fit's amounts, a 3600-sample record's factor read 0.9 where 2.5 cold)
-        total += _pair_statistic(b, wh.joint_fit(b, wh.Design([], [])))[0]
-    return max(1.0, total / BOOT_DRAWS / 2.0)
+        fit0 = wh.joint_fit(b, wh.Design([], []))
+        total += (_pair_statistic(b, fit0)[0], 2.0 * (wh.joint_fit(b, one)["loglik"] - fit0["loglik"]))
+    return max(1.0, float(total[0]) / BOOT_DRAWS / 2.0), max(1.0, float(total[1]) / BOOT_DRAWS)
 
 
 def coupling_test(bands, null, alpha) -> tuple[dict, dict, dict]:
@@ -125,10 +127,16 @@ def coupling_test(bands, null, alpha) -> tuple[dict, dict, dict]:
     p_value = float(f_dist.sf(max(stat, 0.0) / 2.0, 2, dof))
     calibration: dict = {"reference": "2·F(2, ν), ν Satterthwaite"}
     if threshold > BOOT_COST * chi2.isf(alpha, 2):
-        scale = bootstrap_scale(bands, null)
+        scale, scale_1 = bootstrap_scale(bands, null)
         threshold, p_value = scale * float(chi2.isf(alpha, 2)), float(chi2.sf(max(stat, 0.0) / scale, 2))
         calibration = {"reference": f"χ²₂ × Bartlett's factor, parametric bootstrap ({BOOT_DRAWS} draws)"}
         calibration["bartlett"] = scale
+        # the in-phase test alone (unexplained's channel check runs it beside the pair) the same way, χ²₁
+        in_phase = in_phase | {
+            "threshold": scale_1 * float(chi2.isf(alpha, 1)),
+            "p_value": float(chi2.sf(max(in_phase["statistic"], 0.0) / scale_1, 1)),
+            "bartlett": scale_1,
+        }
     test = {
         "statistic": float(stat),
         "threshold": threshold,
@@ -136,7 +144,7 @@ def coupling_test(bands, null, alpha) -> tuple[dict, dict, dict]:
         "dof": float(dof),
         "p_value": p_value,
         "phase_deg": float(np.degrees(np.arctan2(big["c"][1], big["c"][0]))),
-        "in_phase": {k: in_phase[k] for k in ("statistic", "threshold", "dof", "p_value")},
+        "in_phase": {k: in_phase[k] for k in ("statistic", "threshold", "dof", "p_value", "bartlett") if k in in_phase},
     } | calibration
     return test, in_phase, fit
 
