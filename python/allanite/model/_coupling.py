@@ -38,7 +38,6 @@ def _f_test(stat: float, dof: float, alpha: float) -> dict:
     }
 
 
-
 def _new_direction(bands, design, s) -> np.ndarray:
     """The last regressor of ``design`` made orthogonal to the others (GLS metric), as a combination."""
     info = design.gram(bands, 1.0 / s)[0]
