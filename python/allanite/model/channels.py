@@ -10,7 +10,10 @@ settles — the noise never takes the channel's share first. The test is the lik
 channel and its quadrature (its Hilbert transform: every phase of each band) against no coupling, referred to
 2·F(2, ν): ν is the effective number of degrees of freedom of the noise level the coupling is weighed against
 (a Satterthwaite count from the noise fit's own covariance), so a channel that moves only at the lowest
-frequencies, where a random walk's level is known to ±20 %, is tested as such. The quadrature is there for a
+frequencies, where a random walk's level is known to ±20 %, is tested as such — and where ν is so small that
+2·F(2, ν) costs power (a temperature rising once within the record: ν ≈ 3, threshold ≈ 100), against χ²₂ times
+Bartlett's factor from a parametric bootstrap of the statistic (:func:`allanite.model._coupling.bootstrap_scale`,
+docs/channels.md). The quadrature is there for a
 channel that reaches the rate shifted in phase — through a lag, a lead, a d(ch)/dt term — which a test of the
 channel alone sees only as cos φ of its size (:func:`coupling_test`). O(N log N) (one FFT of the record and
 one per regressor).
