@@ -404,6 +404,7 @@ NOTES: list = [
     "for constancy against the off-line noise of the same blocks, at its own share of `level` taken from the Allan "
     "check's; said only where the change exceeds the held-out error): ≈ 0 deg/s in t 0–2500 s, 0.050 deg/s in "
     "t 2500–5000 s. The model is not right, but it no longer reads as complete.",
+    "**Rerun at 44eba23** (every branch of the 2026-11-27 afternoon merged: the sinc^k kind chain, the family fold, the mean check's per-term nulls, the coupling test's bootstrap where its dof is small, the cost round, the module splits): the table above, **11 of 11**, without the candidate **7 of 7** — every row's effects, parameters and words as at bfcb29f (only the CPU column moved).",
 ]
 
 

@@ -352,6 +352,7 @@ NOTES: list = [
     "the −4·10⁻³ step located in all, the others in 1–3 (each alone is 5–8 of the increments' SDs, the "
     "threshold ≈ 6.6). On 300 clean records (`benches/results/refine_mean_step_null.md`, gate off): 0 at its α, "
     "2.0 % at 1 %, 5.7 % at 5 %.",
+    "**Rerun at 44eba23** (every branch of the 2026-11-27 afternoon merged: the sinc^k kind chain, the family fold, the mean check's per-term nulls, the coupling test's bootstrap where its dof is small, the cost round, the module splits): the table above, **12 of 12**, without the candidate **9 of 9** — every row's effects, parameters and words as at bfcb29f (only the CPU column moved).",
 ]
 
 

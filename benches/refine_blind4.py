@@ -382,6 +382,7 @@ NOTES: list = [
     "out Allan-curve error rises at the drift step, 3.53 → 3.85 % (said in the step's `heldout_note`): on"
     " that split's eighths the warm-up is still refitted on a part that holds it alone; the final 3.85 % "
     "where the first run ended at 3.53 %.",
+    "**Rerun at 44eba23** (every branch of the 2026-11-27 afternoon merged: the sinc^k kind chain, the family fold, the mean check's per-term nulls, the coupling test's bootstrap where its dof is small, the cost round, the module splits): the table above, **10 of 11**, without the candidate **9 of 9** — every row's effects, parameters and words as at bfcb29f but the 24 h log's: refined without the regression candidate it now leaves 2 regions unexplained (1 before; the coupling test's bootstrap). The cold start still fails on its coefficient (+30.3 %, its interval holding the truth).",
 ]
 
 

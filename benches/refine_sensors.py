@@ -126,6 +126,16 @@ NOTES = [
     "final curve test on this simulated noise (five terms, Kasdin–Walter flicker over 3× the record, 10⁷ "
     "samples), a calibration question for the curve test, not for the periodic removal.",
     "",
+    "",
+    "**The table above** is the whole suite rerun at 44eba23 (every branch of the 2026-11-27 afternoon merged: the "
+    "sinc^k kind chain, the family fold, the mean check's per-term nulls, the coupling test's bootstrap where its dof "
+    "is small, the cost round, the module splits): **17 of 17**, without the candidate **17 of 17**, every row's "
+    "effects, parameters and words as in the rows recorded before it (only the CPU column moved; the machine was "
+    "shared, other processes 79 % of the CPUs). Since the last whole run, the consumer IMU's second family is "
+    "refitted on the samples the first family's removal left (a line both families hold — the 0.19 Hz family's "
+    "35th harmonic at 6.65 Hz is the other's 2·3.1 + 0.45 Hz sideband — was removed twice: χ²/dof 1.73 → 0.903), "
+    "and *temperature and spikes* refined without the regression candidate says the rate still follows 'temp' "
+    "(2 regions, 1 before).",
 ]
 
 
