@@ -163,6 +163,16 @@ def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
     # steps: each cycle costs three passes and usually ends within a few cycles. Steps are measured in
     # model space (each θ_k scaled by its largest share of the curve) so no term dominates the norms.
     scale = np.max(a / np.maximum(avar, floor)[:, None], axis=0)
+    theta, it = _squarem(step, change, theta, scale, max_iter)
+    if not theta.any():
+        return start
+    return _gls_result(factor, theta, a, avar, len(terms), it)
+
+
+def _squarem(step, change, theta, scale, max_iter):
+    """The GLS passes θ → step(θ) from ``theta``, accelerated by SQUAREM, until ``change`` between passes is
+    below GLS_TOL, θ is all zero or ``max_iter`` passes are spent; returns θ and the passes made. ``scale``
+    puts each θ_k in model space for the extrapolation's norms."""
     it = 0
     while it < max_iter:
         t1 = step(theta)
@@ -183,8 +193,12 @@ def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
         theta = t3
         if done or not theta.any():
             break
-    if not theta.any():
-        return start
+    return theta, it
+
+
+def _gls_result(factor, theta, a, avar, n_terms, it):
+    """The fit at the converged ``theta``: theta, coefficient covariance (AᵀΣ⁻¹A)⁻¹ (an inactive term's
+    variance as if it were freed alone), model, EDF, z, iterations, design, χ² under Σ(θ) from ``factor``."""
     chol, cov_y, model = factor(theta)
     aw = np.linalg.solve(chol, a)
     resid = np.linalg.solve(chol, avar - a @ theta)
@@ -193,7 +207,7 @@ def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
     z = (avar - model) / sd
     nu = 2.0 * model**2 / sd**2  # equivalent degrees of freedom of each estimate under the model
     active = theta > 0
-    cov = np.full((len(terms), len(terms)), np.nan)
+    cov = np.full((n_terms, n_terms), np.nan)
     idx = np.flatnonzero(active)
     cov[np.ix_(idx, idx)] = np.linalg.pinv(aw[:, idx].T @ aw[:, idx])
     for k in np.flatnonzero(~active):  # the variance each inactive term would have if freed alone
