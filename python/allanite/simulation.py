@@ -176,28 +176,38 @@ def simulate(
     if not _is_zero(r):
         y += np.cumsum(np.broadcast_to(r, t.shape)) * tau0 if np.ndim(r) else r * t
     for item in gauss_markov:
-        try:
-            sigma, tc = item
-        except (TypeError, ValueError):
-            raise ParameterError(f"gauss_markov entries must be (sigma, tc) pairs, got {item!r}") from None
-        sig = _profile(sigma, t, "gauss_markov sigma")
-        tc = float(tc)
-        if not np.isfinite(tc) or tc <= 0:
-            raise ParameterError(f"gauss_markov correlation time must be a positive number of seconds, got {tc!r}")
-        phi = np.exp(-tau0 / tc)
-        drive = rng.normal(size=n) * np.sqrt(1.0 - phi * phi)
-        unit = ar1(drive, phi, rng.normal())
-        y += unit * sig
+        y += _gauss_markov(item, t, tau0, rng)
     for item in sinusoid:
-        if not isinstance(item, (list, tuple)) or len(item) not in (2, 3):
-            raise ParameterError(f"sinusoid entries must be (amplitude, f0) or (amplitude, f0, phase), got {item!r}")
-        amp = _profile(item[0], t, "sinusoid amplitude")
-        f0 = float(item[1])
-        if not np.isfinite(f0) or f0 <= 0:
-            raise ParameterError(f"sinusoid frequency must be a positive number of Hz, got {item[1]!r}")
-        phase = float(item[2]) if len(item) == 3 else 0.0
-        y += amp * np.sin(2 * np.pi * f0 * t + phase)
+        y += _sinusoid(item, t)
     return y
+
+
+def _gauss_markov(item, t: np.ndarray, tau0: float, rng: np.random.Generator) -> np.ndarray:
+    """One first-order Gauss–Markov process, the (sigma, tc) entry ``item``, at the sample times ``t``."""
+    try:
+        sigma, tc = item
+    except (TypeError, ValueError):
+        raise ParameterError(f"gauss_markov entries must be (sigma, tc) pairs, got {item!r}") from None
+    sig = _profile(sigma, t, "gauss_markov sigma")
+    tc = float(tc)
+    if not np.isfinite(tc) or tc <= 0:
+        raise ParameterError(f"gauss_markov correlation time must be a positive number of seconds, got {tc!r}")
+    phi = np.exp(-tau0 / tc)
+    drive = rng.normal(size=t.size) * np.sqrt(1.0 - phi * phi)
+    unit = ar1(drive, phi, rng.normal())
+    return unit * sig
+
+
+def _sinusoid(item, t: np.ndarray) -> np.ndarray:
+    """One sinusoid, the (amplitude, f0) or (amplitude, f0, phase) entry ``item``, at the sample times ``t``."""
+    if not isinstance(item, (list, tuple)) or len(item) not in (2, 3):
+        raise ParameterError(f"sinusoid entries must be (amplitude, f0) or (amplitude, f0, phase), got {item!r}")
+    amp = _profile(item[0], t, "sinusoid amplitude")
+    f0 = float(item[1])
+    if not np.isfinite(f0) or f0 <= 0:
+        raise ParameterError(f"sinusoid frequency must be a positive number of Hz, got {item[1]!r}")
+    phase = float(item[2]) if len(item) == 3 else 0.0
+    return amp * np.sin(2 * np.pi * f0 * t + phase)
 
 
 def ar1(drive: np.ndarray, phi: float, x0: float, block: int = 1024) -> np.ndarray:
