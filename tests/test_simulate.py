@@ -311,6 +311,15 @@ def test_reproducible_with_seed_and_generator():
         (dict(sinusoid=[1.0]), r"sinusoid entries must be"),
         (dict(sinusoid=[(1.0, -0.5)]), r"sinusoid frequency must be a positive number of Hz"),
         (dict(sinusoid=[(-1.0, 0.5)]), r"sinusoid amplitude must be finite and ≥ 0"),
+        # not numbers at all: named, as the others (they raised a bare ValueError or TypeError of float())
+        (dict(gauss_markov=[(1.0, "a")]), r"gauss_markov correlation time must be a positive .* got 'a'"),
+        (dict(gauss_markov=[(1.0, None)]), r"gauss_markov correlation time must be a positive .* got None"),
+        (dict(gauss_markov=[(1.0, -2)]), r"gauss_markov correlation time must be a positive .* got -2\.0$"),
+        (dict(sinusoid=[(1.0, "a")]), r"sinusoid frequency must be a positive number of Hz, got 'a'"),
+        (dict(sinusoid=[(1.0, None)]), r"sinusoid frequency must be a positive number of Hz, got None"),
+        # a phase that is not a finite number made every sample NaN without a word
+        (dict(sinusoid=[(1.0, 0.5, float("nan"))]), r"sinusoid phase must be a finite number of radians, got nan"),
+        (dict(sinusoid=[(1.0, 0.5, "p")]), r"sinusoid phase must be a finite number of radians, got 'p'"),
     ],
 )
 def test_bad_parameters_raise_parameter_error(kw, message):

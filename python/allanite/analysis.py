@@ -404,20 +404,9 @@ def davar(
         t=t, window=window, hop=hop, method=method, estimator=estimator, fs=fs, n_samples=n, input=input
     )
     if gaps == "skip":
-        out = gap_dynamic(cols, fs, window, hop_core, ms, workers, estimator)
-        counts = np.asarray(out.n, dtype=np.int64)
-        n_terms = counts[0] if np.all(counts == counts[0]) else counts
-        return DynamicAllanResult(
-            tau=out.tau, avar=out.values if is_multi else out.values[0], n=n_terms, m=out.m, **common
-        )
+        return _gap_davar(cols, fs, window, hop_core, ms, workers, estimator, is_multi, common)
     scaled, exps = _scale_columns(cols, peaks)
-    big = n_win * window >= DHVAR_BAR_SAMPLES
-    if tapered.dynamic is not None:
-        out = tapered.dynamic(scaled, fs, window, hop_core, taus, method, workers)
-    elif entry.family == "theo" and n_win >= 2 and show_progress(progress) and (big or progress is True):
-        out = _in_groups(entry, scaled, fs, window, hop_core, taus, method, workers, options, n_win, progress)
-    else:
-        out = entry.dynamic(scaled, fs, window, hop_core, taus, method, workers, **options)
+    out = _dynamic_core(entry, tapered, scaled, fs, window, hop_core, taus, method, workers, options, n_win, progress)
     values = _unscale(out.values, exps, entry.unit_power, cols, entry.label, out.ranges)
     out = dataclasses.replace(out, values=values)
     kf = out.kf
@@ -431,6 +420,26 @@ def davar(
         taper=taper,
         **common,
     )
+
+
+def _gap_davar(cols, fs, window, hop_core, ms, workers, estimator, is_multi, common) -> DynamicAllanResult:
+    """DAVAR of records with NaN-marked gaps (``gaps="skip"``, :func:`gap_dynamic`): ``n`` counts each window's
+    complete terms per τ — one axis's counts where every axis has the same, else every axis's."""
+    out = gap_dynamic(cols, fs, window, hop_core, ms, workers, estimator)
+    counts = np.asarray(out.n, dtype=np.int64)
+    n_terms = counts[0] if np.all(counts == counts[0]) else counts
+    return DynamicAllanResult(tau=out.tau, avar=out.values if is_multi else out.values[0], n=n_terms, m=out.m, **common)
+
+
+def _dynamic_core(entry, tapered, scaled, fs, window, hop_core, taus, method, workers, options, n_win, progress):
+    """The estimator's dynamic values of the scaled columns: the taper's form, DHVAR in groups behind a bar
+    (``progress``; on large or asked-for runs) or the estimator's own call."""
+    big = n_win * window >= DHVAR_BAR_SAMPLES
+    if tapered.dynamic is not None:
+        return tapered.dynamic(scaled, fs, window, hop_core, taus, method, workers)
+    if entry.family == "theo" and n_win >= 2 and show_progress(progress) and (big or progress is True):
+        return _in_groups(entry, scaled, fs, window, hop_core, taus, method, workers, options, n_win, progress)
+    return entry.dynamic(scaled, fs, window, hop_core, taus, method, workers, **options)
 
 
 def _check_window(entry, tapered, estimator, taper, method, window, hop, n) -> tuple[int, int]:

@@ -371,13 +371,7 @@ def _named_channels(args) -> bool:
 
 def _report(args) -> int:
     quiet = args.quiet
-    if args.log is None:
-        given = [f"--{o.replace('_', '-')}" for o in _LOG_OPTIONS if getattr(args, o) is not None]
-        if given:
-            raise UsageError(
-                f"{', '.join(given)} describe{'s' if len(given) == 1 else ''} a LOG file; without LOG "
-                f"the bundled record (100 Hz, 3 axes, deg/s) is analysed"
-            )
+    _check_log_options(args)
     taus = _taus(args.taus)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
@@ -408,22 +402,7 @@ def _report(args) -> int:
                 split=args.split,
                 max_memory=args.max_memory,
             )
-            if args.log is None:
-                progress.step("generating the bundled record")
-                x, fs, info = default_record()
-                source = {
-                    "name": "bundled record",
-                    **{k: (list(v) if isinstance(v, tuple) else v) for k, v in info.items()},
-                }
-                rep = build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common)
-            else:
-                log, notes, _ = _read(args, progress)
-                if args.kalibr and log.unit is None:
-                    raise UsageError(_KALIBR_NEEDS_UNIT)
-                if not quiet:
-                    for note in notes:
-                        progress.bar.write(f"allanite: warning: {note}", file=sys.stderr)
-                rep = from_log(log, notes=notes, **common)  # with the log's channels (report._channels)
+            rep = _analysed_report(args, progress, common)
             kalibr_path = _kalibr(args, rep, progress) if args.kalibr else None
             specs = rep.figure_specs()
             progress.expect(len(specs) + 1)
@@ -436,16 +415,51 @@ def _report(args) -> int:
         close_figure_worker()
         progress.close()
     if not quiet:
-        print(rep.text())
-        pngs = [p.name for p in paths[2:] if p.suffix == ".png"]
-        print(f"\nwrote {paths[0]}\n      {paths[1]}\n      {len(pngs)} figures in {out}/: {', '.join(pngs)}")
-        side = [p.name for p in paths[2:] if p.suffix != ".png"]
-        if side:
-            print(f"      per-window series in {out}/: {', '.join(side)} (named in summary.json)")
-        if kalibr_path is not None:
-            print(f"      {kalibr_path} (Kalibr)")
-        print(f"in {time.perf_counter() - t0:.1f} s")
+        _print_written(rep, paths, out, kalibr_path, t0)
     return EXIT_OK
+
+
+def _check_log_options(args) -> None:
+    """Options that describe a LOG file are refused without one (the bundled record is analysed then)."""
+    if args.log is None:
+        given = [f"--{o.replace('_', '-')}" for o in _LOG_OPTIONS if getattr(args, o) is not None]
+        if given:
+            raise UsageError(
+                f"{', '.join(given)} describe{'s' if len(given) == 1 else ''} a LOG file; without LOG "
+                f"the bundled record (100 Hz, 3 axes, deg/s) is analysed"
+            )
+
+
+def _analysed_report(args, progress, common: dict):
+    """The report of the bundled record, or of LOG read with its notes (warned of unless --quiet)."""
+    if args.log is None:
+        progress.step("generating the bundled record")
+        x, fs, info = default_record()
+        source = {
+            "name": "bundled record",
+            **{k: (list(v) if isinstance(v, tuple) else v) for k, v in info.items()},
+        }
+        return build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common)
+    log, notes, _ = _read(args, progress)
+    if args.kalibr and log.unit is None:
+        raise UsageError(_KALIBR_NEEDS_UNIT)
+    if not args.quiet:
+        for note in notes:
+            progress.bar.write(f"allanite: warning: {note}", file=sys.stderr)
+    return from_log(log, notes=notes, **common)  # with the log's channels (report._channels)
+
+
+def _print_written(rep, paths, out: Path, kalibr_path, t0: float) -> None:
+    """The console's summary of the report and the files written, and the run's time since ``t0``."""
+    print(rep.text())
+    pngs = [p.name for p in paths[2:] if p.suffix == ".png"]
+    print(f"\nwrote {paths[0]}\n      {paths[1]}\n      {len(pngs)} figures in {out}/: {', '.join(pngs)}")
+    side = [p.name for p in paths[2:] if p.suffix != ".png"]
+    if side:
+        print(f"      per-window series in {out}/: {', '.join(side)} (named in summary.json)")
+    if kalibr_path is not None:
+        print(f"      {kalibr_path} (Kalibr)")
+    print(f"in {time.perf_counter() - t0:.1f} s")
 
 
 def _error(message: str) -> int:

@@ -181,33 +181,7 @@ def to_kalibr(
     fields: dict[str, float] = {}
     flagged: set[str] = set()
     for sensor, vals in sensors.items():
-        ax0 = vals["N"]["axes"][0]
-        head.append(
-            f"# {sensor} (samples in {vals['unit']}), {len(vals['N']['axes'])} axes, "
-            f"{ax0['confidence']:.1%} intervals, per axis its value, interval and the tau range fitted:"
-        )
-        for term in ("N", "K", "B"):
-            if term not in vals:
-                continue
-            name, unit = _FIELDS[(sensor, term)] if term != "B" else ("bias instability B (not a Kalibr field)", "")
-            unit = unit or _B_UNIT[sensor]
-            head.append(f"#   {name} [{unit}]:")
-            for a, x in enumerate(vals[term]["axes"]):
-                flag = "  NOT IDENTIFIABLE: upper bound used" if x["flagged"] and term != "B" else ""
-                head.append(
-                    f"#     axis {a}: {x['value']:.6e}  interval [{x['ci'][0]:.6e}, {x['ci'][1]:.6e}]"
-                    f"  tau {x['tau_range'][0]:.4g}..{x['tau_range'][1]:.4g} s{flag}"
-                )
-                if x["flagged"] and term != "B":
-                    warnings.append(
-                        f"# WARNING: {sensor} axis {a}: {term} is not identifiable from this record (its interval "
-                        f"reaches 0); its upper bound {x['ci'][1]:.6e} {unit} is used"
-                        + (" and is the aggregate" if vals[term]["flagged"] else "")
-                    )
-            if term != "B":
-                fields[name] = vals[term]["value"]
-                if vals[term]["flagged"]:
-                    flagged.add(name)
+        _sensor_lines(sensor, vals, head, warnings, fields, flagged)
     if accel is None:
         warnings.append(
             "# NOTE: no accelerometer fits were given: Kalibr also needs accelerometer_noise_density and "
@@ -221,3 +195,38 @@ def to_kalibr(
     p = Path(path)
     p.write_text("\n".join(head + warnings + body) + "\n", encoding="utf-8")
     return p
+
+
+def _sensor_lines(
+    sensor: str, vals: dict, head: list[str], warnings: list[str], fields: dict[str, float], flagged: set[str]
+) -> None:
+    """One sensor's part of the file: its comment lines (each term's value, interval and τ range per axis) onto
+    ``head``, a warning per axis whose N or K is not identifiable onto ``warnings``, its Kalibr fields' values
+    into ``fields`` and the names of those that are upper bounds into ``flagged``."""
+    ax0 = vals["N"]["axes"][0]
+    head.append(
+        f"# {sensor} (samples in {vals['unit']}), {len(vals['N']['axes'])} axes, "
+        f"{ax0['confidence']:.1%} intervals, per axis its value, interval and the tau range fitted:"
+    )
+    for term in ("N", "K", "B"):
+        if term not in vals:
+            continue
+        name, unit = _FIELDS[(sensor, term)] if term != "B" else ("bias instability B (not a Kalibr field)", "")
+        unit = unit or _B_UNIT[sensor]
+        head.append(f"#   {name} [{unit}]:")
+        for a, x in enumerate(vals[term]["axes"]):
+            flag = "  NOT IDENTIFIABLE: upper bound used" if x["flagged"] and term != "B" else ""
+            head.append(
+                f"#     axis {a}: {x['value']:.6e}  interval [{x['ci'][0]:.6e}, {x['ci'][1]:.6e}]"
+                f"  tau {x['tau_range'][0]:.4g}..{x['tau_range'][1]:.4g} s{flag}"
+            )
+            if x["flagged"] and term != "B":
+                warnings.append(
+                    f"# WARNING: {sensor} axis {a}: {term} is not identifiable from this record (its interval "
+                    f"reaches 0); its upper bound {x['ci'][1]:.6e} {unit} is used"
+                    + (" and is the aggregate" if vals[term]["flagged"] else "")
+                )
+        if term != "B":
+            fields[name] = vals[term]["value"]
+            if vals[term]["flagged"]:
+                flagged.add(name)

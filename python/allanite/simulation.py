@@ -134,7 +134,7 @@ def simulate(
         First-order Gauss–Markov processes: stationary std sigma (rate unit, may vary like the
         terms above) and correlation time tc (s).
     sinusoid : sequence of (amplitude, f0) or (amplitude, f0, phase)
-        Sinusoids in the rate, f0 in Hz.
+        Sinusoids in the rate, f0 in Hz (> 0), phase in radians (default 0).
     seed : int or numpy Generator, optional
         For reproducible records.
 
@@ -176,28 +176,49 @@ def simulate(
     if not _is_zero(r):
         y += np.cumsum(np.broadcast_to(r, t.shape)) * tau0 if np.ndim(r) else r * t
     for item in gauss_markov:
-        try:
-            sigma, tc = item
-        except (TypeError, ValueError):
-            raise ParameterError(f"gauss_markov entries must be (sigma, tc) pairs, got {item!r}") from None
-        sig = _profile(sigma, t, "gauss_markov sigma")
-        tc = float(tc)
-        if not np.isfinite(tc) or tc <= 0:
-            raise ParameterError(f"gauss_markov correlation time must be a positive number of seconds, got {tc!r}")
-        phi = np.exp(-tau0 / tc)
-        drive = rng.normal(size=n) * np.sqrt(1.0 - phi * phi)
-        unit = ar1(drive, phi, rng.normal())
-        y += unit * sig
+        y += _gauss_markov(item, t, tau0, rng)
     for item in sinusoid:
-        if not isinstance(item, (list, tuple)) or len(item) not in (2, 3):
-            raise ParameterError(f"sinusoid entries must be (amplitude, f0) or (amplitude, f0, phase), got {item!r}")
-        amp = _profile(item[0], t, "sinusoid amplitude")
-        f0 = float(item[1])
-        if not np.isfinite(f0) or f0 <= 0:
-            raise ParameterError(f"sinusoid frequency must be a positive number of Hz, got {item[1]!r}")
-        phase = float(item[2]) if len(item) == 3 else 0.0
-        y += amp * np.sin(2 * np.pi * f0 * t + phase)
+        y += _sinusoid(item, t)
     return y
+
+
+def _gauss_markov(item, t: np.ndarray, tau0: float, rng: np.random.Generator) -> np.ndarray:
+    """One first-order Gauss–Markov process, the (sigma, tc) entry ``item``, at the sample times ``t``."""
+    try:
+        sigma, tc = item
+    except (TypeError, ValueError):
+        raise ParameterError(f"gauss_markov entries must be (sigma, tc) pairs, got {item!r}") from None
+    sig = _profile(sigma, t, "gauss_markov sigma")
+    value = _float_or_nan(tc)
+    if not np.isfinite(value) or value <= 0:
+        shown = tc if math.isnan(value) else value  # a number as a float (as before), else as given
+        raise ParameterError(f"gauss_markov correlation time must be a positive number of seconds, got {shown!r}")
+    phi = np.exp(-tau0 / value)
+    drive = rng.normal(size=t.size) * np.sqrt(1.0 - phi * phi)
+    unit = ar1(drive, phi, rng.normal())
+    return unit * sig
+
+
+def _sinusoid(item, t: np.ndarray) -> np.ndarray:
+    """One sinusoid, the (amplitude, f0) or (amplitude, f0, phase) entry ``item``, at the sample times ``t``."""
+    if not isinstance(item, (list, tuple)) or len(item) not in (2, 3):
+        raise ParameterError(f"sinusoid entries must be (amplitude, f0) or (amplitude, f0, phase), got {item!r}")
+    amp = _profile(item[0], t, "sinusoid amplitude")
+    f0 = _float_or_nan(item[1])
+    if not np.isfinite(f0) or f0 <= 0:
+        raise ParameterError(f"sinusoid frequency must be a positive number of Hz, got {item[1]!r}")
+    phase = _float_or_nan(item[2]) if len(item) == 3 else 0.0
+    if not np.isfinite(phase):
+        raise ParameterError(f"sinusoid phase must be a finite number of radians, got {item[2]!r}")
+    return amp * np.sin(2 * np.pi * f0 * t + phase)
+
+
+def _float_or_nan(value) -> float:
+    """``value`` as a float, NaN where it is not a number (the caller's check then names it)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
 
 
 def ar1(drive: np.ndarray, phi: float, x0: float, block: int = 1024) -> np.ndarray:

@@ -213,12 +213,7 @@ def davar(
     ms = entry.resolve_m(taus, window, fs)
     n_tau = int(ms.size)
     n_axes = int(arr.shape[1]) if arr.ndim == 2 else 1
-    target = target_chunk(arr, chunk)
-    # cut where the core's parts are the whole call's values bit for bit (its phase segments or the hop)
-    grid = _core.part_grid(n, n_axes, window, min(hop, n), estimator, method)
-    chunks, counts = davar_chunks(n, window, min(hop, n), int(target), grid)
-    arr = arr.rechunk({0: chunks, 1: -1} if arr.ndim == 2 else {0: chunks})
-    bounds = np.concatenate([[0], np.cumsum(chunks)]).astype(np.int64)
+    arr, chunks, counts, bounds = _cut(arr, chunk, n_axes, window, hop, estimator, method)
     n_win = (n - window) // hop + 1
     hop_core = min(hop, n)  # as the single-machine call: a hop beyond the record gives one window
 
@@ -245,11 +240,28 @@ def davar(
     if not compute:
         return values
     result = values.compute()
+    return _result(result if arr.ndim == 2 else result[0], ms, n_win, n, window, hop, method, estimator, fs, input)
+
+
+def _cut(arr, chunk, n_axes: int, window: int, hop: int, estimator: str, method: str):
+    """``arr`` rechunked along the samples where the core's parts are the whole call's values bit for bit (its
+    phase segments or the hop), near ``chunk`` samples; with the chunks, their windows' counts and bounds."""
+    n = int(arr.shape[0])
+    target = target_chunk(arr, chunk)
+    grid = _core.part_grid(n, n_axes, window, min(hop, n), estimator, method)
+    chunks, counts = davar_chunks(n, window, min(hop, n), int(target), grid)
+    arr = arr.rechunk({0: chunks, 1: -1} if arr.ndim == 2 else {0: chunks})
+    bounds = np.concatenate([[0], np.cumsum(chunks)]).astype(np.int64)
+    return arr, chunks, counts, bounds
+
+
+def _result(avar, ms, n_win: int, n: int, window: int, hop: int, method, estimator, fs, input) -> DynamicAllanResult:
+    """The computed surface as the single-machine call's result (window centres in s, τ = m/fs)."""
     t = (np.arange(n_win) * float(hop) + window / 2) / fs
     return DynamicAllanResult(
         tau=ms / fs,
         t=t,
-        avar=result if arr.ndim == 2 else result[0],
+        avar=avar,
         n=n_terms(estimator, window, ms),
         m=ms,
         window=window,

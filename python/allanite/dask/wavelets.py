@@ -133,31 +133,8 @@ def wavelet_split(
     target = target_chunk(arr, chunk)
     chunks = wavelet_chunks(n, level, overlap, int(target))
     arr2 = (arr if arr.ndim == 2 else arr[:, None]).rechunk({0: chunks, 1: -1})
-    starts = [int(v) for v in np.concatenate([[0], np.cumsum(chunks)[:-1]])]
-    kwargs = dict(
-        fs=meta.fs,
-        wavelet=wavelet,
-        level=level,
-        bands=bands,
-        trend=trend,
-        overlap=overlap,
-        n_chunks=len(chunks),
-        starts=starts,
-    )
-    out_chunks = (chunks, (3 * n_axes,))
-    if len(chunks) == 1:
-        out = arr2.map_blocks(_split_block, chunks=out_chunks, dtype=np.float64, **kwargs)
-    else:
-        out = arr2.map_overlap(
-            _split_block,
-            depth={0: overlap, 1: 0},
-            boundary="none",
-            trim=False,
-            allow_rechunk=False,
-            chunks=out_chunks,
-            dtype=np.float64,
-            **kwargs,
-        )
+    kwargs = dict(fs=meta.fs, wavelet=wavelet, level=level, bands=bands, trend=trend)
+    out = _split_blocks(arr2, chunks, overlap, n_axes, kwargs)
     parts = [out[:, p * n_axes : (p + 1) * n_axes] for p in range(3)]
     if arr.ndim == 1:
         parts = [p[:, 0] for p in parts]
@@ -173,4 +150,24 @@ def wavelet_split(
         fs=meta.fs,
         trend_kind=trend,
         trend_freq=None,
+    )
+
+
+def _split_blocks(arr2, chunks, overlap: int, n_axes: int, kwargs: dict):
+    """The lazy (samples, 3 · axes) array of trend, low and high: :func:`_split_block` on every chunk of
+    ``arr2`` (samples, axes) with ``overlap`` samples of each neighbour (none for a single chunk)."""
+    starts = [int(v) for v in np.concatenate([[0], np.cumsum(chunks)[:-1]])]
+    kwargs = dict(kwargs, overlap=overlap, n_chunks=len(chunks), starts=starts)
+    out_chunks = (chunks, (3 * n_axes,))
+    if len(chunks) == 1:
+        return arr2.map_blocks(_split_block, chunks=out_chunks, dtype=np.float64, **kwargs)
+    return arr2.map_overlap(
+        _split_block,
+        depth={0: overlap, 1: 0},
+        boundary="none",
+        trim=False,
+        allow_rechunk=False,
+        chunks=out_chunks,
+        dtype=np.float64,
+        **kwargs,
     )

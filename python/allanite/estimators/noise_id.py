@@ -214,31 +214,9 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
     # min and max are NaN if any sample is, ±inf if any is: no per-sample temporary
     if arr.size and not (np.isfinite(arr.min()) and np.isfinite(arr.max())):
         raise ParameterError("x contains NaN or infinite values; noise identification needs finite samples")
-    long = None
-    if input == "angle":
-        if arr.size < 3:
-            raise ParameterError(f"x has {arr.size} angle points; at least 3 are needed")
-        phase = arr - arr[0]
-        rate = np.diff(arr)
-    else:
-        if arr.size < 2:
-            raise ParameterError(f"x has {arr.size} samples; at least 2 are needed")
-        if arr.size > LONG_SAMPLES:  # chunk by chunk: no copy of the record (estimators/_long_id.py)
-            long = LongRate(arr, arr.mean())
-            rate = phase = arr[:0]
-        else:
-            rate = arr - arr.mean()
-            phase = np.concatenate(([0.0], np.cumsum(rate)))
+    phase, rate, long = _phase_and_rate(arr, input)
     n_phase = phase.size if long is None else arr.size + 1
-    m_arr = np.atleast_1d(np.asarray(m))
-    if m_arr.dtype.kind not in "iuf" or np.any(m_arr % 1 != 0) or np.any(m_arr < 1):
-        raise ParameterError(f"m must be integer averaging factors ≥ 1, got {m!r}")
-    m_arr = m_arr.astype(np.int64)
-    too_big = m_arr > (n_phase - 1) // 2
-    if too_big.any():
-        raise ParameterError(
-            f"m = {int(m_arr[too_big][0])} is too large for {n_phase - 1} samples (largest: {(n_phase - 1) // 2})"
-        )
+    m_arr = _checked_m(m, n_phase)
     each = functools.partial(
         _identify_each,
         phase,
@@ -256,6 +234,41 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
     if fallback == "prudent":
         out = _level_weak_peaks(out, m_arr, (n_phase - 1) // m_arr)
     return int(out[0]) if np.ndim(m) == 0 else out
+
+
+def _phase_and_rate(arr: np.ndarray, input: str):
+    """The phase (from 0) and the centred rate of a checked record, or for a rate record over LONG_SAMPLES
+    empty arrays and a :class:`LongRate` that reads it chunk by chunk (no copy of the record)."""
+    long = None
+    if input == "angle":
+        if arr.size < 3:
+            raise ParameterError(f"x has {arr.size} angle points; at least 3 are needed")
+        phase = arr - arr[0]
+        rate = np.diff(arr)
+    else:
+        if arr.size < 2:
+            raise ParameterError(f"x has {arr.size} samples; at least 2 are needed")
+        if arr.size > LONG_SAMPLES:  # chunk by chunk: no copy of the record (estimators/_long_id.py)
+            long = LongRate(arr, arr.mean())
+            rate = phase = arr[:0]
+        else:
+            rate = arr - arr.mean()
+            phase = np.concatenate(([0.0], np.cumsum(rate)))
+    return phase, rate, long
+
+
+def _checked_m(m, n_phase: int) -> np.ndarray:
+    """``m`` as int64 averaging factors, each ≥ 1 and at most half the record's samples."""
+    m_arr = np.atleast_1d(np.asarray(m))
+    if m_arr.dtype.kind not in "iuf" or np.any(m_arr % 1 != 0) or np.any(m_arr < 1):
+        raise ParameterError(f"m must be integer averaging factors ≥ 1, got {m!r}")
+    m_arr = m_arr.astype(np.int64)
+    too_big = m_arr > (n_phase - 1) // 2
+    if too_big.any():
+        raise ParameterError(
+            f"m = {int(m_arr[too_big][0])} is too large for {n_phase - 1} samples (largest: {(n_phase - 1) // 2})"
+        )
+    return m_arr
 
 
 def _level_weak_peaks(alpha: np.ndarray, m: np.ndarray, points: np.ndarray) -> np.ndarray:

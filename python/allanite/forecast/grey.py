@@ -150,6 +150,30 @@ class GM11(Forecaster):
                 "then adds a constant) or shift=<number>."
             )
         self.level_ratio = level_ratio_test(x)
+        c = self._shift(x, shift, nonpos)
+        self.shift_applied = c
+        y = x + c
+        self._y = y
+        self.level_ratio_shifted = level_ratio_test(y) if c else self.level_ratio
+        x1 = np.cumsum(y)
+        z = 0.5 * (x1[1:] + x1[:-1])
+        B = np.column_stack([-z, np.ones_like(z)])
+        # lstsq (QR/SVD), not the normal equations (BᵀB)⁻¹BᵀY of eq. 6: same solution, better conditioned.
+        sol, *_ = np.linalg.lstsq(B, y[1:], rcond=None)
+        self.a = float(sol[0])
+        self.b = float(sol[1])
+        if not (np.isfinite(self.a) and np.isfinite(self.b)):  # pragma: no cover - guarded by validation
+            raise InputError("GM(1,1) least squares gave non-finite a, b for this series")
+        self.fitted = self._x0hat(np.arange(x.size)) - c
+        if not np.all(np.isfinite(self.fitted)):
+            raise InputError(
+                f"GM(1,1) fitted values overflow for this series (n = {x.size}, a = {self.a:.6g}): "
+                "e^(−a·k) exceeds the float range; use a shorter series"
+            )
+
+    def _shift(self, x: np.ndarray, shift: str | float | None, nonpos: np.ndarray) -> float:
+        """The constant added to ``x`` before the fit, as ``shift`` asks (None, 'auto' or a number), checked
+        against the series; a note says why when one is added or the level-ratio test failed unshifted."""
         if shift is None:
             c = 0.0
             if nonpos.size:
@@ -183,25 +207,7 @@ class GM11(Forecaster):
                 )
             if c:
                 self.notes.append(f"fitted on series + {c:.6g} (shift given)")
-        self.shift_applied = c
-        y = x + c
-        self._y = y
-        self.level_ratio_shifted = level_ratio_test(y) if c else self.level_ratio
-        x1 = np.cumsum(y)
-        z = 0.5 * (x1[1:] + x1[:-1])
-        B = np.column_stack([-z, np.ones_like(z)])
-        # lstsq (QR/SVD), not the normal equations (BᵀB)⁻¹BᵀY of eq. 6: same solution, better conditioned.
-        sol, *_ = np.linalg.lstsq(B, y[1:], rcond=None)
-        self.a = float(sol[0])
-        self.b = float(sol[1])
-        if not (np.isfinite(self.a) and np.isfinite(self.b)):  # pragma: no cover - guarded by validation
-            raise InputError("GM(1,1) least squares gave non-finite a, b for this series")
-        self.fitted = self._x0hat(np.arange(x.size)) - c
-        if not np.all(np.isfinite(self.fitted)):
-            raise InputError(
-                f"GM(1,1) fitted values overflow for this series (n = {x.size}, a = {self.a:.6g}): "
-                "e^(−a·k) exceeds the float range; use a shorter series"
-            )
+        return c
 
     # k below is 0-based: value index k is the paper's x(k+1)
     def _x0hat(self, k: np.ndarray) -> np.ndarray:

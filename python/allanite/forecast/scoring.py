@@ -241,15 +241,10 @@ def compare(
         x = as_series(values, name=f"series[{term!r}]")
         b, c = split(x, build, check)
         used = x[: build + check]
-        d = np.diff(used)
-        # robust frame-to-frame scatter: successive differences of independent noise have SD √2·σ
-        out["scatter"][term] = float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
+        out["scatter"][term] = _scatter(used)
         se = None
         if noise is not None and term in noise:
-            se_all = np.asarray(noise[term], dtype=np.float64)
-            if se_all.shape[0] < build + check:
-                raise InputError(f"noise[{term!r}] has {se_all.shape[0]} values; {build + check} needed")
-            se = float(np.sqrt(np.mean(se_all[build : build + check] ** 2)))
+            se = _check_noise(noise[term], term, build, check)
             out["se_check"][term] = se
         nonpos = np.flatnonzero(used <= 0)
         if nonpos.size:
@@ -267,6 +262,20 @@ def compare(
                 continue
             cells[name][term] = _cell(s, se)
     return out
+
+
+def _scatter(used: np.ndarray) -> float:
+    """Robust frame-to-frame scatter σ of ``used``: successive differences of independent noise have SD √2·σ."""
+    d = np.diff(used)
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / math.sqrt(2.0))
+
+
+def _check_noise(values: Any, term: str, build: int, check: int) -> float:
+    """RMS of a term's own standard errors over the check frames (``values`` has one per frame)."""
+    se_all = np.asarray(values, dtype=np.float64)
+    if se_all.shape[0] < build + check:
+        raise InputError(f"noise[{term!r}] has {se_all.shape[0]} values; {build + check} needed")
+    return float(np.sqrt(np.mean(se_all[build : build + check] ** 2)))
 
 
 def _cell(s: Score, se: float | None) -> dict[str, Any]:

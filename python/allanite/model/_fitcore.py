@@ -163,6 +163,16 @@ def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
     # steps: each cycle costs three passes and usually ends within a few cycles. Steps are measured in
     # model space (each θ_k scaled by its largest share of the curve) so no term dominates the norms.
     scale = np.max(a / np.maximum(avar, floor)[:, None], axis=0)
+    theta, it = _squarem(step, change, theta, scale, max_iter)
+    if not theta.any():
+        return start
+    return _gls_result(factor, theta, a, avar, len(terms), it)
+
+
+def _squarem(step, change, theta, scale, max_iter):
+    """The GLS passes θ → step(θ) from ``theta``, accelerated by SQUAREM, until ``change`` between passes is
+    below GLS_TOL, θ is all zero or ``max_iter`` passes are spent; returns θ and the passes made. ``scale``
+    puts each θ_k in model space for the extrapolation's norms."""
     it = 0
     while it < max_iter:
         t1 = step(theta)
@@ -183,8 +193,12 @@ def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
         theta = t3
         if done or not theta.any():
             break
-    if not theta.any():
-        return start
+    return theta, it
+
+
+def _gls_result(factor, theta, a, avar, n_terms, it):
+    """The fit at the converged ``theta``: theta, coefficient covariance (AᵀΣ⁻¹A)⁻¹ (an inactive term's
+    variance as if it were freed alone), model, EDF, z, iterations, design, χ² under Σ(θ) from ``factor``."""
     chol, cov_y, model = factor(theta)
     aw = np.linalg.solve(chol, a)
     resid = np.linalg.solve(chol, avar - a @ theta)
@@ -193,7 +207,7 @@ def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
     z = (avar - model) / sd
     nu = 2.0 * model**2 / sd**2  # equivalent degrees of freedom of each estimate under the model
     active = theta > 0
-    cov = np.full((len(terms), len(terms)), np.nan)
+    cov = np.full((n_terms, n_terms), np.nan)
     idx = np.flatnonzero(active)
     cov[np.ix_(idx, idx)] = np.linalg.pinv(aw[:, idx].T @ aw[:, idx])
     for k in np.flatnonzero(~active):  # the variance each inactive term would have if freed alone
@@ -209,15 +223,7 @@ def _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
     ``m`` are the estimator's averaging factors (for the EDF); the closed forms are evaluated at
     τ·fs, which is m for the Allan estimators and 0.75·m for Theo1-based points."""
     a = design_matrix(tau, tau * fs, fs, terms)
-    cache = {} if edf_cache is None else edf_cache
-    # EDF of each term's noise type at every τ (Greenhall), cached across windows of a dynamic fit.
-    nu_terms = []
-    for t in terms:
-        key = (TERM_ALPHA[t], tuple(m), n_points, estimator)
-        if key not in cache:
-            cache[key] = edf_per_tau(np.full(m.size, TERM_ALPHA[t]), m, n_points, estimator)
-        nu_terms.append(cache[key])
-    nu_terms = np.column_stack(nu_terms)
+    nu_terms = _term_edfs(terms, m, n_points, estimator, {} if edf_cache is None else edf_cache)
 
     def edf_of(parts):
         # Mixture of independent noises: Var(σ̂²) ≈ Σ_k 2 s_k²/ν_k, so ν = (Σ s_k)² / Σ s_k²/ν_k —
@@ -253,11 +259,31 @@ def _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
     model = np.maximum((a * theta).sum(axis=1), 1e-12 * np.max(avar))
     w = nu / (2.0 * model**2)
     z = (avar - model) * np.sqrt(w)
+    cov = _sandwich_covariance(tau, a, theta, w, nu, model, terms, estimator)
+    return theta, cov, model, nu, z, it, a, float(np.sum(z**2))
+
+
+def _term_edfs(terms, m, n_points, estimator, cache: dict) -> np.ndarray:
+    """(τ, term) EDF of each term's noise type at every τ (Greenhall), kept in ``cache`` across the windows
+    of a dynamic fit."""
+    nu_terms = []
+    for t in terms:
+        key = (TERM_ALPHA[t], tuple(m), n_points, estimator)
+        if key not in cache:
+            cache[key] = edf_per_tau(np.full(m.size, TERM_ALPHA[t]), m, n_points, estimator)
+        nu_terms.append(cache[key])
+    return np.column_stack(nu_terms)
+
+
+def _sandwich_covariance(tau, a, theta, w, nu, model, terms, estimator) -> np.ndarray:
+    """Covariance of the independent-weights fit's coefficients.
+
+    The estimates have variances 2σ⁴/ν and are correlated across τ (overlapping estimates share data).
+    The weighted fit treats them as independent, so its covariance is the sandwich
+    (AᵀWA)⁻¹ AᵀW Σ W A (AᵀWA)⁻¹ with Σ = D R D — R from the octave correlations per noise type. An
+    inactive term gets the variance it would have if freed alone with the active ones."""
     active = theta > 0
     cov = np.full((len(terms), len(terms)), np.nan)
-    # Covariance of the estimates: variances 2σ⁴/ν, correlated across τ (overlapping estimates share
-    # data). The weighted fit treats them as independent, so its covariance is the sandwich
-    # (AᵀWA)⁻¹ AᵀW Σ W A (AᵀWA)⁻¹ with Σ = D R D — R from the octave correlations per noise type.
     parts = a * theta
     corr = _estimate_correlation(tau, parts if theta.any() else a, terms, estimator)
     sd = np.sqrt(2.0 / nu) * model
@@ -271,8 +297,7 @@ def _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
     if active.any():
         idx = np.flatnonzero(active)
         cov[np.ix_(idx, idx)] = sandwich(idx)
-    # Inactive terms: the variance each would have if freed alone with the active ones.
     for k in np.flatnonzero(~active):
         idx = np.append(np.flatnonzero(active), k)
         cov[k, k] = sandwich(idx)[-1, -1]
-    return theta, cov, model, nu, z, it, a, float(np.sum(z**2))
+    return cov

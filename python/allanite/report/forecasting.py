@@ -115,48 +115,7 @@ def forecast_dict(rep) -> dict | None:
     if rep.frames is None:
         return {"error": rep.forecast_error, "axes": None}
     st = rep.forecast_settings
-    axes = []
-    for k, (f, tab) in enumerate(zip(rep.frames, rep.forecasts)):
-        vals, (lo, hi) = f.values(), f.intervals()
-        cells: dict[str, Any] = {}
-        for m in tab["methods"]:
-            cells[m] = {}
-            for t in tab["terms"]:
-                c = tab["cells"][m][t]
-                if "error" in c:
-                    cells[m][t] = {"error": c["error"]}
-                    continue
-                cells[m][t] = {
-                    "C": json_number(c["C"]),
-                    "P": json_number(c["P"]),
-                    "c_grade": c["c_grade"],
-                    "grade": c["grade"],
-                    "C_paper": json_number(c["C_paper"]),
-                    "P_paper": json_number(c["P_paper"]),
-                    "c_grade_paper": c["c_grade_paper"],
-                    "grade_paper": c["grade_paper"],
-                    "rmse": json_number(c["rmse"]),
-                    "bias": json_number(c["bias"]),
-                    "rmse_over_se": json_number(c.get("rmse_over_se")),
-                    "forecast": json_list(c["forecast"]),
-                }
-        axes.append(
-            {
-                "axis": k,
-                "name": rep.axis_names[k],
-                "t_s": json_list(f.t),
-                "values": {t: json_list(vals[t]) for t in f.terms},
-                "ci_low": {t: json_list(lo[t]) for t in f.terms},
-                "ci_high": {t: json_list(hi[t]) for t in f.terms},
-                "forecastable": dict(f.forecastable),
-                "frames_at_zero": {t: int(np.count_nonzero(f.series.values[t] <= 0)) for t in f.terms},
-                "not_forecastable": {t: tab["skipped"].get(t, f.not_forecastable.get(t)) for t in tab["skipped"]},
-                "terms": list(tab["terms"]),
-                "scatter": {t: json_number(v) for t, v in tab["scatter"].items()},
-                "se_check": {t: json_number(v) for t, v in tab["se_check"].items()},
-                "cells": cells,
-            }
-        )
+    axes = [_forecast_axis(k, f, tab, rep) for k, (f, tab) in enumerate(zip(rep.frames, rep.forecasts))]
     first = rep.frames[0]
     return {
         "error": None,
@@ -180,6 +139,48 @@ def forecast_dict(rep) -> dict | None:
             "check part (≈ 1: the forecast is as good as the frames' own estimation noise allows)"
         ),
         "axes": axes,
+    }
+
+
+def _forecast_axis(k: int, f, tab: dict, rep) -> dict:
+    """One axis of :func:`forecast_dict`: its frames' values and intervals, what is forecastable, and every
+    method's cell on every term."""
+    vals, (lo, hi) = f.values(), f.intervals()
+    cells: dict[str, Any] = {m: {t: _cell_dict(tab["cells"][m][t]) for t in tab["terms"]} for m in tab["methods"]}
+    return {
+        "axis": k,
+        "name": rep.axis_names[k],
+        "t_s": json_list(f.t),
+        "values": {t: json_list(vals[t]) for t in f.terms},
+        "ci_low": {t: json_list(lo[t]) for t in f.terms},
+        "ci_high": {t: json_list(hi[t]) for t in f.terms},
+        "forecastable": dict(f.forecastable),
+        "frames_at_zero": {t: int(np.count_nonzero(f.series.values[t] <= 0)) for t in f.terms},
+        "not_forecastable": {t: tab["skipped"].get(t, f.not_forecastable.get(t)) for t in tab["skipped"]},
+        "terms": list(tab["terms"]),
+        "scatter": {t: json_number(v) for t, v in tab["scatter"].items()},
+        "se_check": {t: json_number(v) for t, v in tab["se_check"].items()},
+        "cells": cells,
+    }
+
+
+def _cell_dict(c: dict) -> dict:
+    """One method's score on one term (or its error) for summary.json."""
+    if "error" in c:
+        return {"error": c["error"]}
+    return {
+        "C": json_number(c["C"]),
+        "P": json_number(c["P"]),
+        "c_grade": c["c_grade"],
+        "grade": c["grade"],
+        "C_paper": json_number(c["C_paper"]),
+        "P_paper": json_number(c["P_paper"]),
+        "c_grade_paper": c["c_grade_paper"],
+        "grade_paper": c["grade_paper"],
+        "rmse": json_number(c["rmse"]),
+        "bias": json_number(c["bias"]),
+        "rmse_over_se": json_number(c.get("rmse_over_se")),
+        "forecast": json_list(c["forecast"]),
     }
 
 

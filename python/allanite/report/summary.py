@@ -29,6 +29,37 @@ def _fit_errors(f, r) -> dict:
     return {k: json_number(v) for k, v in r.curve_errors(f).items()}
 
 
+#: What each step's before → after is measured on (summary.json's refinement.statistics).
+_STATISTICS = {
+    "allan_curve": "every step's before/after, on the record's own Allan curve (a component removed in "
+    "time is part of the model through what it changed in the curve, AVAR(y) − AVAR(y − component)), so "
+    "that each step's before is the previous step's after: χ²/dof and RMS z of the Allan-curve fit by the "
+    "calibrated tests' standard (the generalised least-squares χ² of the residual on ~4 τ per octave under "
+    "the exact covariance of the estimates across τ; not the fit section's χ²/dof), RMS ADEV error (%) "
+    "on 4 τ per octave whose estimate is "
+    "within ±10 %; heldout_rms_adev_pct: the model fitted on alternate blocks (8, joined; removals refitted "
+    "on them) predicting the other blocks' curve, both ways (null for curve-only input). A change of noise "
+    "level leaves the curve's model as it is (before = after); a spectral line's amplitude and f0, measured "
+    "in the samples, are held in every fit of the curve",
+    "window_levels": "what found a change point (its step's window_levels): the log Allan variances of "
+    "16 windows along the record about piecewise-constant levels without → with this change point (the "
+    "earlier ones in both: the first one's before is one level, each next one's before the previous one's "
+    "after); heldout_rms_adev_pct in it: held out per segment (each segment's alternate blocks predicted "
+    "by its own held-in part's model), without → with it",
+}
+
+#: What an axis's ``unexplained`` entries hold (summary.json's refinement.unexplained).
+_UNEXPLAINED_WORDS = (
+    "per axis, what the final model still misses, largest misfit first (empty when the final "
+    "model passes every calibrated check of what it may still miss, each at its share of the axis's level): "
+    "domain (allan, psd, time, level, channels, outliers), tau_s [lo, hi] in s, t_s [lo, hi] in s (the time "
+    "region along the record, null where the entry has none), band_hz [lo, hi] in Hz (null where "
+    "it has no band, or for curve-only input), chi2_dof of the dense Allan curve over that τ range (null "
+    "where the evidence is not on the curve), what (in words), the check's statistic, threshold and alpha, "
+    "and text (the entry in words); still_missing: the sentences the page and the console print"
+)
+
+
 def refinement_dict(rep) -> dict | None:
     """The refinement of every axis: the curve fit's errors at the start and at the end, and each step with its
     errors before → after on the record's Allan curve (each step's before is the previous step's after);
@@ -37,40 +68,10 @@ def refinement_dict(rep) -> dict | None:
     if rep.refinements is None:
         return None
     rate = rep.adev_unit or "rate unit"
-    axes = []
-    for k, r in enumerate(rep.refinements):
-        if r is None:
-            axes.append({"axis": k, "name": rep.axis_names[k], "error": True})
-            continue
-        axes.append(
-            {
-                "axis": k,
-                "name": rep.axis_names[k],
-                "terms": list(r.terms),
-                "tau_from_s": json_number(r.start.tau[0]),
-                "start": _fit_errors(r.start, r),
-                "start_heldout_rms_adev_pct": json_number(r.start_heldout_rms_adev_pct),
-                "heldout_note": r.heldout_note,
-                "final": _fit_errors(r.fit, r),
-                "final_heldout_rms_adev_pct": json_number(r.final_heldout_rms_adev_pct),
-                "term_moves": [
-                    {
-                        "term": m["term"],
-                        "start": json_number(m["start"]),
-                        "start_interval": json_value(m["start_interval"]),
-                        "final": json_number(m["final"]),
-                        "final_interval": json_value(m["final_interval"]),
-                        "moved_by": [{k: json_value(v) for k, v in mv.items()} for mv in m["moves"]],
-                        "text": term_move_text(m, r.fit.unit),
-                    }
-                    for m in r.term_moves
-                ],
-                "steps": [_step_dict(st, rate) for st in r.steps],
-                "level": json_number(r.level),
-                "unexplained": [_region_dict(reg) for reg in r.unexplained],
-                "still_missing": r.missing_sentences(),
-            }
-        )
+    axes = [
+        {"axis": k, "name": rep.axis_names[k], "error": True} if r is None else _axis_dict(k, r, rep, rate)
+        for k, r in enumerate(rep.refinements)
+    ]
     tried = rep.settings.get("refine_candidates", list(EFFECTS))
     curve = [e for e in EFFECTS.values() if e.kind == "curve" and e.name in tried]
     timed = [e for e in EFFECTS.values() if e.kind != "curve" and e.name in tried]
@@ -84,31 +85,43 @@ def refinement_dict(rep) -> dict | None:
         "units": "; ".join(
             f"{e.name}: " + ", ".join(_param_words(p, u, m, rate) for p, u, m in e.params) for e in EFFECTS.values()
         ),
-        "statistics": {
-            "allan_curve": "every step's before/after, on the record's own Allan curve (a component removed in "
-            "time is part of the model through what it changed in the curve, AVAR(y) − AVAR(y − component)), so "
-            "that each step's before is the previous step's after: χ²/dof and RMS z of the Allan-curve fit by the "
-            "calibrated tests' standard (the generalised least-squares χ² of the residual on ~4 τ per octave under "
-            "the exact covariance of the estimates across τ; not the fit section's χ²/dof), RMS ADEV error (%) "
-            "on 4 τ per octave whose estimate is "
-            "within ±10 %; heldout_rms_adev_pct: the model fitted on alternate blocks (8, joined; removals refitted "
-            "on them) predicting the other blocks' curve, both ways (null for curve-only input). A change of noise "
-            "level leaves the curve's model as it is (before = after); a spectral line's amplitude and f0, measured "
-            "in the samples, are held in every fit of the curve",
-            "window_levels": "what found a change point (its step's window_levels): the log Allan variances of "
-            "16 windows along the record about piecewise-constant levels without → with this change point (the "
-            "earlier ones in both: the first one's before is one level, each next one's before the previous one's "
-            "after); heldout_rms_adev_pct in it: held out per segment (each segment's alternate blocks predicted "
-            "by its own held-in part's model), without → with it",
-        },
-        "unexplained": "per axis, what the final model still misses, largest misfit first (empty when the final "
-        "model passes every calibrated check of what it may still miss, each at its share of the axis's level): "
-        "domain (allan, psd, time, level, channels, outliers), tau_s [lo, hi] in s, t_s [lo, hi] in s (the time "
-        "region along the record, null where the entry has none), band_hz [lo, hi] in Hz (null where "
-        "it has no band, or for curve-only input), chi2_dof of the dense Allan curve over that τ range (null "
-        "where the evidence is not on the curve), what (in words), the check's statistic, threshold and alpha, "
-        "and text (the entry in words); still_missing: the sentences the page and the console print",
+        "statistics": dict(_STATISTICS),
+        "unexplained": _UNEXPLAINED_WORDS,
         "axes": axes,
+    }
+
+
+def _axis_dict(k: int, r, rep, rate: str) -> dict:
+    """One refined axis of :func:`refinement_dict`: its terms, the start's and the final model's errors, each
+    term's move, each step and what the final model still misses."""
+    return {
+        "axis": k,
+        "name": rep.axis_names[k],
+        "terms": list(r.terms),
+        "tau_from_s": json_number(r.start.tau[0]),
+        "start": _fit_errors(r.start, r),
+        "start_heldout_rms_adev_pct": json_number(r.start_heldout_rms_adev_pct),
+        "heldout_note": r.heldout_note,
+        "final": _fit_errors(r.fit, r),
+        "final_heldout_rms_adev_pct": json_number(r.final_heldout_rms_adev_pct),
+        "term_moves": [_term_move_dict(m, r.fit.unit) for m in r.term_moves],
+        "steps": [_step_dict(st, rate) for st in r.steps],
+        "level": json_number(r.level),
+        "unexplained": [_region_dict(reg) for reg in r.unexplained],
+        "still_missing": r.missing_sentences(),
+    }
+
+
+def _term_move_dict(m: dict, unit) -> dict:
+    """One noise term's start → final value with its intervals, and the steps that moved it."""
+    return {
+        "term": m["term"],
+        "start": json_number(m["start"]),
+        "start_interval": json_value(m["start_interval"]),
+        "final": json_number(m["final"]),
+        "final_interval": json_value(m["final_interval"]),
+        "moved_by": [{k: json_value(v) for k, v in mv.items()} for mv in m["moves"]],
+        "text": term_move_text(m, unit),
     }
 
 
