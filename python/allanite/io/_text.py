@@ -47,7 +47,7 @@ def _guess_delimiter(line: str):
 HEAD_CHARS = 1 << 16
 #: Bytes of a text log's body the core's parser reads at a time (line-aligned pieces streamed from the file into
 #: the preallocated arrays: the file is never held whole, the read peaks near the arrays' size).
-CHUNK_BYTES = 1 << 24
+CHUNK_BYTES = 1 << 22
 
 
 class _Text:
@@ -266,7 +266,8 @@ def read_text(path, columns, time_column, delimiter, gz, channels=None):
     usecols = need if (delim is not None and len(need) < ncols) else None
     parsed = usecols if usecols is not None else list(range(ncols))
     pos = {c: j for j, c in enumerate(parsed)}
-    groups = [[pos[c] for c in idx], *([[pos[t_idx]]] if t_idx is not None and not iso else []), *([pos[i]] for i in ch)]
+    timed = [[pos[t_idx]]] if t_idx is not None and not iso else []
+    groups = [[pos[c] for c in idx], *timed, *([pos[i]] for i in ch)]
     outs = _parse_fast(doc, doc.byte_offset(start), delim, ncols, parsed, groups, squeeze)
     if outs is None:  # not plain decimal rows: NumPy reads them, and a bad line is found and named
         try:

@@ -191,7 +191,8 @@ def _time_steps(path, rec: Record, t: np.ndarray, n: int, fs):
             f"times must increase — is {tn!r} really the time column? ({back.size} such step(s))"
         )
     step, rel = _step(t, d)
-    d = np.diff(t)  # _step's median reordered d
+    del d  # _step's median reordered it: taken again, never two at once
+    d = np.diff(t)
     if fs is None:
         fs = _shortest(1.0 / step, rel)
     elif abs(step * fs - 1.0) > 0.01:
