@@ -160,10 +160,13 @@ def test_slow_or_short_logs_in_seconds_say_nothing(tmp_path):
         assert log.fs == fs and log.time_unit == "s" and log.time_unit_source == "default"
 
 
-@pytest.mark.parametrize("gz", [False, True])
-def test_the_streamed_body_is_numpys_bit_for_bit(tmp_path, monkeypatch, gz):
-    """Pieces of 1 kB (not 4 MiB): lines cut at piece ends, comments and CRLF, the row bound over the rows read."""
+@pytest.mark.parametrize(("gz", "hint"), [(False, None), (True, None), (False, 16), (True, 16)])
+def test_the_streamed_body_is_numpys_bit_for_bit(tmp_path, monkeypatch, gz, hint):
+    """Pieces of 1 kB (not 4 MiB): lines cut at piece ends, comments and CRLF; the arrays cut to the rows read,
+    or grown where the rows outnumber the hint (16)."""
     monkeypatch.setattr(_text, "CHUNK_BYTES", 1000)
+    if hint is not None:
+        monkeypatch.setattr(_text._Text, "rows_hint", lambda self, offset: hint)
     rng = np.random.default_rng(2)
     x = rng.normal(size=(3000, 2)) * [1e-3, 1e4]
     lines = ["t,a,b"] + [f"{i / 50:.2f},{float(a)!r},{b:.9g}" for i, (a, b) in enumerate(x)]
@@ -177,5 +180,6 @@ def test_the_streamed_body_is_numpys_bit_for_bit(tmp_path, monkeypatch, gz):
     ref = np.loadtxt(lines[1:], delimiter=",")
     assert log.data.shape == (3000, 2) and np.array_equal(log.data.view(np.uint64), ref[:, 1:].view(np.uint64))
     assert log.fs == 50.0 and log.t0 == 0.0 and np.array_equal(log.time, ref[:, 0] - ref[0, 0])
+    assert log.data.flags.owndata and log.data.base is None  # exactly the rows: no view of a larger block
     one = read_log(p, time_column="t", columns="b")
     assert one.data.shape == (3000,) and np.array_equal(one.data, ref[:, 2])

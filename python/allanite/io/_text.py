@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gzip
+import os
 import zlib
 from functools import cached_property
 
@@ -46,7 +47,8 @@ def _guess_delimiter(line: str):
 #: reads the rest as bytes; a log whose header is not found within them is split whole).
 HEAD_CHARS = 1 << 16
 #: Bytes of a text log's body the core's parser reads at a time (line-aligned pieces streamed from the file into
-#: the preallocated arrays: the file is never held whole, the read peaks near the arrays' size).
+#: arrays allocated once for the rows the head's line length promises: the file is never held whole, the read
+#: peaks near the arrays' size).
 CHUNK_BYTES = 1 << 22
 
 
@@ -112,10 +114,25 @@ class _Text:
             if rest:
                 yield rest
 
-    def count_lines(self, offset: int) -> int:
-        """An upper bound on the data rows from ``offset`` on: the line ends + 1."""
+    def rows_hint(self, offset: int) -> int:
+        """About how many data rows lie from ``offset`` on: the body's bytes over the bytes per line of the head's
+        complete lines past ``offset`` (+ 5 %); counted for a log read whole, or whose head holds no such line. The
+        body's bytes: the file's size, a gzip file's from its trailer (ISIZE; its size × 4 where that is less)."""
         if "raw" in self.__dict__:
             return self.raw.count(b"\n", offset) + 1
+        seg = self._prefix[offset : self._prefix.rfind(b"\n") + 1]
+        lines = seg.count(b"\n")
+        if not lines:
+            return self._count_lines(offset)
+        size = os.path.getsize(self._path)
+        if self._gz:
+            with open(self._path, "rb") as f:
+                f.seek(-4, os.SEEK_END)
+                size = max(int.from_bytes(f.read(4), "little"), 4 * size)  # ISIZE: the size mod 2³²
+        return int((size - offset) / (len(seg) / lines) * 1.05) + 64
+
+    def _count_lines(self, offset: int) -> int:
+        """The line ends from ``offset`` on + 1: a bound on the data rows (the file read once more)."""
         n, buf = 1, bytearray(CHUNK_BYTES)
         with _open(self._path, self._gz) as f:
             f.seek(offset)
@@ -319,18 +336,24 @@ def _parse_fast(doc, offset, delim, ncols, parsed, groups, squeeze):
     fast = getattr(_core, "parse_decimal_table", None)  # (a core built before the fast parser: the NumPy way)
     if fast is None:
         return None
-    bound = doc.count_lines(offset)  # rows ≤ line ends + 1; pages past the rows read are never touched
-    outs = [np.empty(bound if (squeeze or k) else (bound, len(g))) for k, g in enumerate(groups)]
+    cap = max(16, doc.rows_hint(offset))  # pages past the rows written are never touched
+    outs = [np.empty(cap if (squeeze or k) else (cap, len(g))) for k, g in enumerate(groups)]
     r = 0
     for piece in doc.pieces(offset):
         arr = fast(piece, 0, delim, ncols, parsed)
         if arr is None:
             return None
         m = arr.shape[0]
+        if r + m > cap:  # more rows than the hint: grown in place (realloc), rarely
+            cap = max(r + m, int(cap * 1.25))
+            for out in outs:
+                out.resize((cap, *out.shape[1:]), refcheck=False)
         for out, g in zip(outs, groups):
             out[r : r + m] = arr[:, g[0]] if out.ndim == 1 else arr[:, g]
         r += m
-    return [out[:r] for out in outs]
+    for out in outs:  # cut to the rows read: the arrays own just them
+        out.resize((r, *out.shape[1:]), refcheck=False)
+    return outs
 
 
 def _split_parsed(arr, groups, squeeze) -> list:

@@ -65,17 +65,20 @@ def time_unit(path, rec: Record, given: str | None) -> tuple[str, str]:
     else:
         unit, source = _by_magnitude(path, rec)
     factor = TIME_UNITS[unit]
+    t = rec.time
+    assert t is not None
     if factor != 1.0:
-        if rec.time_owned and rec.time.dtype == np.float64:
-            rec.time *= factor
+        if rec.time_owned and t.dtype == np.float64:
+            t *= factor
         else:
-            rec.time = rec.time * factor
+            rec.time = t * factor
     return unit, source
 
 
 def _by_magnitude(path, rec: Record) -> tuple[str, str]:
     """(unit, source) of a time column whose unit nothing gives: rules 1–3 of the module."""
     t = rec.time
+    assert t is not None
     if t.size < 2:
         return "s", "default"
     t0, step = float(t[0]), _median_step(t)

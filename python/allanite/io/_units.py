@@ -61,7 +61,8 @@ def _as_quotient(text: str) -> str:
     parts = s.split()
     if len(parts) < 2:
         return text
-    num, den = [], []
+    num: list[str] = []
+    den: list[str] = []
     for p in parts:
         m = _POWER.match(p.lower())
         if m is None:
@@ -139,6 +140,7 @@ def units_of(path, names, given, input, ros=False) -> tuple:
         return parse_unit("rad/s"), "ROS convention (REP 103)", cols
     need = "rate" if input == "rate" else "angle"
     found = {cu.name for cu in cols if cu is not None}
-    if cols and len(found) == 1 and all(cu is not None and cu.kind == need for cu in cols):
-        return parse_unit(cols[0].name), f"from the column names: {cols[0].text}", cols
+    first = cols[0] if cols else None
+    if first is not None and len(found) == 1 and all(cu is not None and cu.kind == need for cu in cols):
+        return parse_unit(first.name), f"from the column names: {first.text}", cols
     return None, None, cols

@@ -96,6 +96,13 @@ class Log:
         see :mod:`allanite.io._channels`); empty without any. Not among ``columns``.
     channels_recognised : bool
         Whether the channels were found by their names (``channels="auto"``) rather than named.
+    unit_source : str or None
+        Where ``unit`` came from (``unit=``, the column names, a ROS bag's convention).
+    column_units : list
+        Per column, the unit its name gives (a ``ColumnUnit(name, kind, text)``) or None; :attr:`groups` gathers
+        the columns by it and :meth:`take` keeps one group.
+    time_unit, time_unit_source : str or None
+        The time column's unit and why: ``time_unit=``, its name, an epoch magnitude, or the default (seconds).
     """
 
     data: np.ndarray

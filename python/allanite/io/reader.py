@@ -81,7 +81,12 @@ def read_log(
         (``Log.time_column_recognised`` is then True).
     unit : str, optional
         Unit of the samples (:func:`allanite.units.parse_unit`): a rate unit for ``input="rate"``, an
-        angle unit for ``"increment"`` and ``"angle"``. ROS bags default to ``"rad/s"``.
+        angle unit for ``"increment"`` and ``"angle"``. ROS bags default to ``"rad/s"``. Without it, the unit the
+        sample columns' names give (:mod:`allanite.io._units`: ``w_RS_S_x [rad s^-1]``, ``gx (deg/s)``, ``gz_dps``)
+        when they all give the same one of the kind needed; columns of several units (an IMU's gyro and
+        accelerometer) leave ``Log.unit`` None and are told apart by ``Log.groups`` (``Log.take`` one group).
+        Given, it wins over the header, with a warning where a column's name says another unit.
+        ``Log.unit_source`` says where the unit came from.
     input : {"rate", "increment", "angle"}
         What the samples are, as for :func:`allanite.avar`.
     gaps : {"error", "longest", "split", "nan"}
@@ -95,8 +100,11 @@ def read_log(
         whitespace). Numbers take a decimal point: a decimal comma (``0,0125``) is an InputError that says so.
     time_unit : {"s", "ms", "us", "ns"}, optional
         Unit of a text/array time column. Default: the unit its name ends in (``time_ns``, ``timestamp_us``,
-        ``t [ms]``, ``Time (nsec)``; ``rostopic echo -p``'s ``%time``: ns), else seconds; ``Log.time_unit`` says
-        which was used.
+        ``t [ms]``, ``Time (nsec)``; ``rostopic echo -p``'s ``%time``: ns), else the unit in which its first stamp
+        is an epoch date (≈ 1.7·10⁹ s, 10¹² ms, 10¹⁵ µs, 10¹⁸ ns), else seconds — where seconds are implausible, an
+        InputError (a span over 10 years) or a warning (under 1 Hz over 10⁴ rows) says so, with what the steps
+        read as in ms, µs and ns (:mod:`allanite.io._timeunit`). ``Log.time_unit`` says which unit was used,
+        ``Log.time_unit_source`` why.
     array : str, optional
         For ``.npz``: which array holds the samples (default: the only one).
     topic : str, optional
