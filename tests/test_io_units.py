@@ -129,7 +129,7 @@ def test_ms_relative_time_warns_and_time_unit_fixes_it(tmp_path):
     with pytest.warns(
         UserWarning,
         match=r"'time' names no unit .* step 10 \(integer steps\) gives fs = 0\.1 Hz.*"
-        r"in ms: 100 Hz.*time_unit=",
+        r"in ms: 100 Hz.*time_unit='ms' \(--time-unit ms",
     ):
         log = read_log(p)
     assert log.fs == 0.1 and log.time_unit_source == "default"
@@ -143,7 +143,7 @@ def test_a_span_no_log_has_is_an_error(tmp_path):
     # ns from boot at 100 Hz, 2·10⁴ rows: 2·10¹¹ "s", 6000 years
     p = _csv(tmp_path / "ns.csv", "time,gx", 5e11 + np.arange(20_000) * 1e7, np.zeros(20_000))
     with pytest.raises(
-        InputError, match=r"'time' spans 1\.9999e\+11 .*6\.34e\+03 years read as seconds.*in ns: 100 Hz.*time_unit="
+        InputError, match=r"'time' spans 1\.9999e\+11 .*6\.34e\+03 years read as seconds.*in ns: 100 Hz.*time_unit='ns'"
     ):
         read_log(p)
     assert read_log(p, time_unit="ns").fs == 100.0
@@ -183,3 +183,36 @@ def test_the_streamed_body_is_numpys_bit_for_bit(tmp_path, monkeypatch, gz, hint
     assert log.data.flags.owndata and log.data.base is None  # exactly the rows: no view of a larger block
     one = read_log(p, time_column="t", columns="b")
     assert one.data.shape == (3000,) and np.array_equal(one.data, ref[:, 2])
+
+
+def test_kalibr_takes_the_accelerometer_unit_the_header_gives(tmp_path):
+    """``--kalibr --accel-columns`` without ``--accel-unit``: an accelerometer in g by its names ([g]) is written
+    in SI (×9.80665; taken as m/s² before, 9.8× too small)."""
+    import argparse
+    import re
+    import types
+
+    from allanite import avar, fit
+    from allanite.cli import _kalibr
+
+    rng = np.random.default_rng(11)
+    n = 20_000
+    gyro = 1e-3 * np.sqrt(100.0) * rng.standard_normal((n, 3))  # rad/s, density 1e-3 rad/s/√Hz
+    acc = 2e-3 * np.sqrt(100.0) * rng.standard_normal((n, 3)) / 9.80665  # g, density 2e-3 m/s²/√Hz
+    p = _csv(
+        tmp_path / "imu.csv",
+        "t,gx [rad/s],gy [rad/s],gz [rad/s],ax [g],ay [g],az [g]",
+        np.arange(n) / 100.0,
+        np.c_[gyro, acc],
+        tfmt="%.2f",
+    )
+    log = read_log(p).take(["gx [rad/s]", "gy [rad/s]", "gz [rad/s]"])
+    assert log.unit.name == "rad/s"
+    rep = types.SimpleNamespace(unit="rad/s", fits=fit(avar(log.data, log.fs), unit="rad/s"), fs=log.fs)
+    args = argparse.Namespace(
+        kalibr=str(tmp_path / "imu.yaml"), accel_columns="ax [g],ay [g],az [g]", log=str(p), time_unit=None,
+        fs=None, time_column=None, gaps=None, kalibr_aggregate="worst", accel_unit=None,
+    )  # fmt: skip
+    text = _kalibr(args, rep, types.SimpleNamespace(step=lambda *a: None)).read_text()
+    density = float(re.search(r"accelerometer_noise_density: ([0-9.e+-]+)", text).group(1))
+    assert density == pytest.approx(2e-3, rel=0.1) and "samples in g" in text

@@ -54,6 +54,11 @@ def _readings(step: float) -> str:
     return ", ".join(f"in {u}: {1.0 / (step * TIME_UNITS[u]):.6g} Hz" for u in ("ms", "us", "ns"))
 
 
+def _likely(step: float) -> str:
+    """The first of ms, us, ns in which ``step`` gives 1 Hz to 100 kHz (ms where none does): the unit suggested."""
+    return next((u for u in ("ms", "us", "ns") if 1.0 <= 1.0 / (step * TIME_UNITS[u]) <= 1e5), "ms")
+
+
 def time_unit(path, rec: Record, given: str | None) -> tuple[str, str]:
     """(unit, where it came from) of the record's time column — ``given``, its name, an epoch's magnitude or
     seconds by default (the module's rule, whose warnings and errors name the column, the value and
@@ -90,16 +95,16 @@ def _by_magnitude(path, rec: Record) -> tuple[str, str]:
     if span > MAX_SPAN_S:
         raise InputError(
             f"{path}: time column {name!r} spans {span:.6g} (from {t0:.6g}) — {span / MAX_SPAN_S * 10:.3g} years "
-            f"read as seconds, which no log spans; its median step {step:.6g} reads {_readings(step)}: give its unit "
-            "with time_unit= (--time-unit: s, ms, us or ns)"
+            f"read as seconds, which no log spans; its median step {step:.6g} reads {_readings(step)}: give its unit, "
+            f"time_unit='{_likely(step)}' (or 'ms', 'us', 'ns', 's')"
         )
     if step > 1.0 and t.size > SLOW_ROWS:
         whole = bool(np.all(np.diff(t[: SLOW_ROWS + 1]) % 1.0 == 0.0))
         warnings.warn(
             f"{path}: time column {name!r} names no unit and is read as seconds: its median step "
             f"{step:.6g}{' (integer steps)' if whole else ''} gives fs = {1.0 / step:.6g} Hz over {t.size} rows "
-            f"({span / 3600:.3g} h); {_readings(step)} — give time_unit= (--time-unit) if it is not seconds "
-            "(time_unit='s' keeps seconds without this warning)",
+            f"({span / 3600:.3g} h); {_readings(step)} — give its unit if it is not seconds, time_unit="
+            f"'{_likely(step)}' (--time-unit {_likely(step)}; time_unit='s' keeps seconds without this warning)",
             stacklevel=4,
         )
     return "s", "default"
