@@ -109,6 +109,9 @@ def test_given_unit_wins_over_a_contradicting_header(tmp_path):
         warnings.simplefilter("error")  # agreeing: nothing to say
         same = read_log(p, unit="rad/s", columns=["w_RS_S_x [rad s^-1]"])
     assert same.unit.name == "rad/s" and same.unit_source == "given as unit="
+    kept = log.take("w_RS_S_y [rad s^-1]")  # a given unit stays given
+    assert kept.unit.name == "deg/s" and kept.unit_source.startswith("given as unit=")
+    assert kept.column_units[0].name == "rad/s"
 
 
 @pytest.mark.parametrize(("unit", "scale"), [("s", 1.0), ("ms", 1e3), ("us", 1e6), ("ns", 1e9)])
@@ -216,3 +219,19 @@ def test_kalibr_takes_the_accelerometer_unit_the_header_gives(tmp_path):
     text = _kalibr(args, rep, types.SimpleNamespace(step=lambda *a: None)).read_text()
     density = float(re.search(r"accelerometer_noise_density: ([0-9.e+-]+)", text).group(1))
     assert density == pytest.approx(2e-3, rel=0.1) and "samples in g" in text
+
+
+def test_a_long_log_with_a_utf8_header_is_read_from_its_head(tmp_path):
+    """``[°/s]`` in the header: the head decodes alone (UTF-8), the body streams — the unit and NumPy's values."""
+    rng = np.random.default_rng(4)
+    x = rng.normal(size=(5000, 2))
+    lines = ["t,wx [°/s],wy [°/s]"] + [f"{i / 100:.2f},{a:.6f},{b:.6f}" for i, (a, b) in enumerate(x)]
+    p = tmp_path / "deg.csv"
+    p.write_bytes(("\n".join(lines) + "\n").encode("utf-8"))
+    assert p.stat().st_size > _text.HEAD_CHARS
+    doc = _text._Text.open(p, gz=False)
+    assert doc.head()[0][0] == lines[0] and doc.byte_offset(1) == len(lines[0].encode("utf-8")) + 1
+    assert "raw" not in doc.__dict__ and "_decoded" not in doc.__dict__  # the file was not read whole
+    log = read_log(p)
+    assert log.unit.name == "deg/s" and log.unit_source == "from the column names: [°/s]" and log.fs == 100.0
+    assert np.array_equal(log.data, np.loadtxt(lines[1:], delimiter=",")[:, 1:])

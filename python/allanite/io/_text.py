@@ -63,6 +63,7 @@ class _Text:
 
     def __init__(self, raw: bytes | None = None, *, path=None, gz: bool = False, prefix: bytes | None = None):
         self._path, self._gz = path, gz
+        self._streamed = raw is None  # only the head read: a log longer than HEAD_CHARS bytes
         if raw is not None:
             self.raw = raw
             prefix = raw[: HEAD_CHARS + 1]
@@ -189,9 +190,9 @@ class _Text:
         """(the first lines — all of them when the text is short, else those in its first ``HEAD_CHARS``
         characters, complete lines only —, whether that is every line)."""
         head = self._head_text()
-        if len(head) <= HEAD_CHARS:
+        if len(head) <= HEAD_CHARS and not self._streamed:
             return self.lines, True
-        k = head.rfind("\n", 0, HEAD_CHARS) + 1
+        k = head.rfind("\n", 0, HEAD_CHARS) + 1  # (a streamed log is longer than HEAD_CHARS bytes)
         return head[:k].splitlines(), False
 
     def byte_offset(self, start: int) -> int:

@@ -153,8 +153,8 @@ class Log:
 
     def take(self, columns) -> Log:
         """This log on some of its ``columns`` (names, in the order given; e.g. one of :attr:`groups`): ``data``
-        (and ``segments``) of those columns, 1-D for a single name; without a given ``unit=``, the unit those
-        columns' names give when they give one gyro unit (``unit_source`` says so).
+        (and ``segments``) of those columns, 1-D for a single name; the log's unit where it was given (``unit=``, a
+        ROS bag's), else the unit those columns' names give when they give one gyro unit (``unit_source`` says so).
 
         Raises
         ------
@@ -173,8 +173,10 @@ class Log:
         idx = [self.columns.index(c) for c in names]
         pick = idx[0] if isinstance(columns, str) else idx
         two = self.data if self.data.ndim == 2 else self.data[:, None]
-        given = self.unit if self.unit_source is not None and self.unit_source.startswith("given as unit=") else None
-        unit, source, cols = units_of(self.path, names, given, self.input)
+        cols = [self.column_units[i] if self.column_units else None for i in idx]
+        unit, source = self.unit, self.unit_source
+        if unit is None or (source or "").startswith("from the column names"):  # the names' unit: theirs now
+            unit, source, cols = units_of(self.path, names, None, self.input)
         segments = None
         if self.segments is not None:
             segments = [np.asarray(s).reshape(len(s), -1)[:, pick] for s in self.segments]
