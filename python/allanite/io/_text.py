@@ -339,6 +339,9 @@ def _parse_fast(doc, offset, delim, ncols, parsed, groups, squeeze):
         return None
     cap = max(16, doc.rows_hint(offset))  # pages past the rows written are never touched
     outs = [np.empty(cap if (squeeze or k) else (cap, len(g))) for k, g in enumerate(groups)]
+    # a group of adjacent columns is a view of the parsed block (no copy by fancy indexing); one column a 1-D view
+    takes = [g[0] if out.ndim == 1 else (slice(g[0], g[-1] + 1) if g == list(range(g[0], g[-1] + 1)) else g)
+             for out, g in zip(outs, groups)]  # fmt: skip
     r = 0
     for piece in doc.pieces(offset):
         arr = fast(piece, 0, delim, ncols, parsed)
@@ -349,8 +352,8 @@ def _parse_fast(doc, offset, delim, ncols, parsed, groups, squeeze):
             cap = max(r + m, int(cap * 1.25))
             for out in outs:
                 out.resize((cap, *out.shape[1:]), refcheck=False)
-        for out, g in zip(outs, groups):
-            out[r : r + m] = arr[:, g[0]] if out.ndim == 1 else arr[:, g]
+        for out, take in zip(outs, takes):
+            out[r : r + m] = arr[:, take]
         r += m
     for out in outs:  # cut to the rows read: the arrays own just them
         out.resize((r, *out.shape[1:]), refcheck=False)
