@@ -161,6 +161,7 @@ def test_slow_or_short_logs_in_seconds_say_nothing(tmp_path):
             warnings.simplefilter("error")
             log = read_log(p)
         assert log.fs == fs and log.time_unit == "s" and log.time_unit_source == "default"
+        assert "in s (by default: neither its name nor an epoch magnitude gives one)" in repr(log)
 
 
 @pytest.mark.parametrize(("gz", "hint"), [(False, None), (True, None), (False, 16), (True, 16)])

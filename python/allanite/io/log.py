@@ -210,6 +210,17 @@ class Log:
             return f"none — the column names give {shown} (Log.take(columns) for one group)"
         return "not given"
 
+    def _time_unit_said(self) -> str:
+        """The repr's time unit and where it came from; nothing for seconds named so (``time_s``)."""
+        why = {
+            "epoch magnitude": "read from its epoch magnitude",
+            "time_unit=": "given as time_unit=",
+            "default": "by default: neither its name nor an epoch magnitude gives one",
+        }.get(self.time_unit_source or "")
+        if self.time_unit_from_name:
+            why = "its name says so"
+        return f" in {self.time_unit} ({why})" if why else ""
+
     def __repr__(self) -> str:
         kind = "memory-mapped " if isinstance(self.data, np.memmap) else ""
         dur = self.duration
@@ -232,17 +243,10 @@ class Log:
         else:
             jit = f", max jitter {100 * self.jitter:.3g} % of the step" if self.jitter is not None else ""
             which = (
-                (
-                    f"time column {self.time_column!r}"
-                    + (" (recognised by its name)" if self.time_column_recognised else "")
-                    + (f" in {self.time_unit} (its name says so)" if self.time_unit_from_name else "")
-                    + (
-                        f" in {self.time_unit} (read from its epoch magnitude)"
-                        if self.time_unit_source == "epoch magnitude"
-                        else ""
-                    )
-                    + ", "
-                )
+                f"time column {self.time_column!r}"
+                + (" (recognised by its name)" if self.time_column_recognised else "")
+                + self._time_unit_said()
+                + ", "
                 if self.time_column
                 else ""
             )
