@@ -150,6 +150,14 @@ def test_a_span_no_log_has_is_an_error(tmp_path):
     ):
         read_log(p)
     assert read_log(p, time_unit="ns").fs == 100.0
+    # ns from boot at 10¹² (16 min), 200 Hz: epoch ms by magnitude, but 0.2 Hz so: not taken, an error again
+    q = _csv(tmp_path / "boot.csv", "time,gx", 1e12 + np.arange(20_000) * 5e6, np.zeros(20_000))
+    with pytest.raises(InputError, match=r"in ns: 200 Hz.*time_unit='ns'"):
+        read_log(q)
+    # a few rows of the same: no error (a short span), but the stamps over 10¹¹ s are said
+    r = _csv(tmp_path / "short.csv", "time,gx", 1e12 + np.arange(50) * 5e6, np.zeros(50))
+    with pytest.warns(UserWarning, match=r"reads 1\.00024e\+12 s \(over 3000 years\) as seconds.*time_unit='ns'"):
+        read_log(r)
 
 
 def test_slow_or_short_logs_in_seconds_say_nothing(tmp_path):

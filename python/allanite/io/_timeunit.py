@@ -5,11 +5,13 @@ The rule, applied only when neither ``time_unit=`` nor the column's name gives t
 
 1. **Epoch magnitudes name their unit.** A first time stamp that reads as a date in 2001–2286 in exactly one
    unit — 10⁹–10¹⁰ s (≈ 1.7·10⁹ now), 10¹²–10¹³ ms, 10¹⁵–10¹⁶ µs, 10¹⁸–10¹⁹ ns — is read in that unit, when its
-   median step then gives a rate in :data:`PLAUSIBLE_FS` (``Log.time_unit_source`` says so).
+   median step then gives a rate over 1 Hz and up to 10 MHz (:data:`PLAUSIBLE_FS`; ``Log.time_unit_source`` says
+   so).
 2. Otherwise the times are seconds. **A span over** :data:`MAX_SPAN_S` **(10 years)** read so is implausible for
    any log: an :class:`~allanite.errors.InputError` naming the value, what it reads as in ms, µs and ns, and
    ``time_unit=``.
-3. **A rate below 1 Hz over more than** :data:`SLOW_ROWS` **rows** (over 2.8 h of a slow logger — or a time column
+3. **Stamps over 10¹¹ s** (3000 years) that are no epoch and span less: a warning, as below. **A rate below 1 Hz
+   over more than** :data:`SLOW_ROWS` **rows** (over 2.8 h of a slow logger — or a time column
    in ms, 0, 10, 20 … at 100 Hz, read as 0.1 Hz): a warning naming the step, the rate it gives, what it gives in
    ms and µs, and ``time_unit=`` (``time_unit="s"`` keeps seconds without it).
 """
@@ -24,8 +26,10 @@ from ..errors import InputError
 from ._columns import Record, time_unit_of
 from .log import TIME_UNITS
 
-#: Rates (Hz) an epoch reading must give to be taken: a gyro or IMU log's, from 1 sample a minute to 10 MHz.
-PLAUSIBLE_FS = (1.0 / 60.0, 1e7)
+#: Rates (Hz) an epoch reading must give to be taken: over 1 Hz, at most 10 MHz. A slower reading is more likely
+#: the next smaller unit counted from another origin — ns from boot, 10¹² (16 min) at 200 Hz, read as epoch ms would
+#: give 0.2 Hz — and is left to rules 2–3 (epoch seconds at 1 Hz read as seconds all the same).
+PLAUSIBLE_FS = (1.0, 1e7)
 #: A time column read as seconds may span at most this long (10 years, s).
 MAX_SPAN_S = 10 * 365.25 * 86400.0
 #: More rows than this at under 1 Hz (read as seconds) make the warning of rule 3.
@@ -45,7 +49,7 @@ def _epoch_unit(t0: float, step: float) -> str | None:
     for unit, factor in TIME_UNITS.items():
         if _EPOCH_S[0] <= abs(t0) * factor < _EPOCH_S[1]:
             fs = 1.0 / (step * factor) if step > 0 else 0.0
-            return unit if PLAUSIBLE_FS[0] <= fs <= PLAUSIBLE_FS[1] else None
+            return unit if PLAUSIBLE_FS[0] < fs <= PLAUSIBLE_FS[1] else None
     return None
 
 
@@ -98,7 +102,14 @@ def _by_magnitude(path, rec: Record) -> tuple[str, str]:
             f"read as seconds, which no log spans; its median step {step:.6g} reads {_readings(step)}: give its unit, "
             f"time_unit='{_likely(step)}' (or 'ms', 'us', 'ns', 's')"
         )
-    if step > 1.0 and t.size > SLOW_ROWS:
+    if max(abs(t0), abs(float(t[-1]))) > 1e11:  # a short span of huge stamps: ms, µs or ns from another origin
+        warnings.warn(
+            f"{path}: time column {name!r} reads {float(t[-1]):.6g} s (over 3000 years) as seconds; its median step "
+            f"{step:.6g} reads {_readings(step)} — give its unit, time_unit='{_likely(step)}' (--time-unit "
+            f"{_likely(step)})",
+            stacklevel=4,
+        )
+    elif step > 1.0 and t.size > SLOW_ROWS:
         whole = bool(np.all(np.diff(t[: SLOW_ROWS + 1]) % 1.0 == 0.0))
         warnings.warn(
             f"{path}: time column {name!r} names no unit and is read as seconds: its median step "
