@@ -710,7 +710,7 @@ def test_log_repr_is_readable(tmp_path, record):
     text = repr(read_log(p, time_column="t", unit="dps"))
     assert text.splitlines()[0] == "Log('log.csv', text)"
     assert "400 samples × 3 axes, float64, fs = 100 Hz (4 s)" in text
-    assert "columns: gx, gy, gz" in text and "unit: deg/s (rate), input: rate" in text
+    assert "columns: gx, gy, gz" in text and "unit: deg/s (rate; given as unit=), input: rate" in text
     assert "t0 = 12.5 s, 0 gap(s)" in text
 
 

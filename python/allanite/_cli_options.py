@@ -151,7 +151,8 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
     inp.add_argument(
         "--accel-unit",
         choices=ACCEL_UNITS,
-        help="unit of the accelerometer columns (default: m/s^2; g = 9.80665 m/s^2)",
+        help="unit of the accelerometer columns (default: the one their names give, [g] or [m s^-2], else m/s^2; "
+        "g = 9.80665 m/s^2)",
     )
 
 

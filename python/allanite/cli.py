@@ -8,7 +8,6 @@ stderr (never a traceback); 1 an internal error (a bug: the traceback is shown);
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import gc
 import os
 import re
@@ -18,8 +17,6 @@ import time
 import warnings
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from ._cli_options import (
     DESCRIPTION,
@@ -300,6 +297,9 @@ def gyro_columns(log):
     lists the columns). A log without accelerometer-named columns is analysed whole, as before. ``allanite
     report`` and ``allanite batch`` (:func:`allanite.dask.fleet.run_one`) both choose so."""
     names = [str(c) for c in log.columns]
+    by_unit = _gyro_by_unit(log)
+    if by_unit is not None:
+        return by_unit
     accel = [n for n in names if _ACCEL_NAME.search(n)]
     if not accel or len(accel) == len(names):
         return log, None
@@ -309,15 +309,32 @@ def gyro_columns(log):
             f"{log.path.name} has accelerometer columns ({', '.join(accel)}) beside others, and its header names "
             f"none as a gyro: give the gyro's with --columns (the columns are: {', '.join(names)})"
         )
-    pick = gyro if len(gyro) > 1 else gyro[0]
     chosen = [names[i] for i in gyro]
     left = [n for n in names if n not in chosen]
     note = (
         f"columns {', '.join(chosen)} analysed, chosen by their names (gyro); left out: {', '.join(left)} — "
         "give --columns to choose others (and --accel-columns with --kalibr for the accelerometer)"
     )
-    segments = None if log.segments is None else [np.asarray(seg)[:, pick] for seg in log.segments]
-    return dataclasses.replace(log, data=log.data[:, pick], columns=chosen, segments=segments), note
+    return log.take(chosen if len(gyro) > 1 else chosen[0]), note
+
+
+def _gyro_by_unit(log):
+    """(the log on its gyro columns, the note) where the units the column names give set a gyro's rate columns
+    beside an accelerometer's or others (EuRoC's ``w_RS_S_x [rad s^-1]`` … ``a_RS_S_x [m s^-2]``): the report
+    gives the gyro's in IEEE-952 units; None where the names give no rate unit, or only rate units."""
+    units = log.column_units or [None] * len(log.columns)
+    rate = [str(c) for c, cu in zip(log.columns, units) if cu is not None and cu.kind == "rate"]
+    if not rate or len(rate) == len(log.columns):
+        return None
+    left = [f"{c} ({cu.name if cu is not None else 'no unit'})" for c, cu in zip(log.columns, units) if c not in rate]
+    gyro = log.take(rate if len(rate) > 1 else rate[0])
+    said = gyro.unit.name if gyro.unit is not None else "several units"
+    note = (
+        f"columns {', '.join(rate)} analysed, chosen by the rate unit their names give ({said}); left out: "
+        f"{', '.join(left)} — give --columns to analyse others (an accelerometer's in its own unit; "
+        "--accel-columns with --kalibr writes its noise in SI)"
+    )
+    return gyro, note
 
 
 def _kalibr(args, rep, progress) -> Path:
@@ -344,13 +361,18 @@ def _kalibr(args, rep, progress) -> Path:
                 **kwargs,
             )
         accel = fit_model(avar(alog.data, alog.fs), tau_range="auto")
+        named = {cu.name for cu in alog.column_units if cu is not None and cu.kind == "acceleration"}
+    else:
+        named = set()
+    # --accel-unit, else the one unit the accelerometer columns' names give ("a [g]"), else m/s²
+    header = named.pop() if len(named) == 1 else None
     return to_kalibr(
         Path(args.kalibr),
         gyro=rep.fits,
         accel=accel,
         update_rate=rep.fs,
         aggregate=args.kalibr_aggregate,
-        accel_unit=args.accel_unit or "m/s^2",
+        accel_unit=args.accel_unit or header or "m/s^2",
     )
 
 

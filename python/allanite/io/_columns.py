@@ -98,6 +98,9 @@ class Record:
     #: Other channels (``read_log(channels=…)``): column name → float64 samples, NaN where a value is missing.
     channels: dict | None = None
     channels_recognised: bool = False  # found by their names (channels="auto")
+    #: Whether ``time`` is the reader's own float64 array (no view of a file or of the caller's data): scaled to
+    #: seconds and made relative in place, without a second array of the record's length.
+    time_owned: bool = False
 
 
 def check_column_spec(spec, name, single=False):

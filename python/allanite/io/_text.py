@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import gzip
+import os
 import zlib
 from functools import cached_property
 
@@ -45,19 +46,100 @@ def _guess_delimiter(line: str):
 #: Characters of a text log's beginning split into lines to find its header and first data row (the fast path
 #: reads the rest as bytes; a log whose header is not found within them is split whole).
 HEAD_CHARS = 1 << 16
+#: Bytes of a text log's body the core's parser reads at a time (line-aligned pieces streamed from the file into
+#: arrays allocated once for the rows the head's line length promises: the file is never held whole, the read
+#: peaks near the arrays' size).
+CHUNK_BYTES = 1 << 22
 
 
 class _Text:
     """A text log's bytes (gunzipped) and, decoded on first use, its text (UTF-8, else Latin-1, without a
     byte-order mark), the codec and whether a mark was dropped; its lines split on first use. A large log's body
-    is read from ``raw`` by the core's parser: where the head is ASCII, only the head is decoded (the whole text
-    only for a log the core's parser leaves to NumPy, or an error message)."""
+    is read by the core's parser in line-aligned pieces streamed from the file (:meth:`pieces`): the whole file is
+    read into ``raw`` only for a log the core's parser leaves to NumPy, or an error message. Where the head
+    decodes alone (ASCII, or UTF-8 cut at a character), only the head is decoded.
 
-    def __init__(self, raw: bytes):
-        self.raw = raw
+    ``_Text(raw)`` holds bytes already read; :meth:`open` reads only the head of a file, the rest on use."""
+
+    def __init__(self, raw: bytes | None = None, *, path=None, gz: bool = False, prefix: bytes | None = None):
+        self._path, self._gz = path, gz
+        self._streamed = raw is None  # only the head read: a log longer than HEAD_CHARS bytes
+        if raw is not None:
+            self.raw = raw
+            prefix = raw[: HEAD_CHARS + 1]
+        assert prefix is not None
+        self._prefix = prefix
         # the first HEAD_CHARS + 1 bytes, where ASCII: the text's first HEAD_CHARS + 1 characters in either codec
-        prefix = raw[: HEAD_CHARS + 1]
         self._ascii_head = prefix.decode("ascii") if prefix.isascii() else None
+
+    @classmethod
+    def open(cls, path, gz: bool) -> _Text:
+        """The log at ``path`` (gunzipped when ``gz``), its head read; a short log is read whole."""
+        with _open(path, gz) as f:
+            prefix = f.read(HEAD_CHARS + 1)
+        if len(prefix) <= HEAD_CHARS:
+            return cls(prefix, path=path, gz=gz)
+        return cls(path=path, gz=gz, prefix=prefix)
+
+    @cached_property
+    def raw(self) -> bytes:
+        """The whole file's bytes (gunzipped)."""
+        with _open(self._path, self._gz) as f:
+            return f.read()
+
+    def pieces(self, offset: int):
+        """The bytes from ``offset`` on in pieces of about ``CHUNK_BYTES``, each ending at a line end (the last
+        at the end of the file): what the core's parser reads one at a time."""
+        if "raw" in self.__dict__:
+            raw, a = self.raw, offset
+            while a < len(raw):
+                b = raw.rfind(b"\n", a, a + CHUNK_BYTES) + 1 if a + CHUNK_BYTES < len(raw) else len(raw)
+                b = b if b > a else (raw.find(b"\n", a + CHUNK_BYTES) + 1 or len(raw))
+                yield raw[a:b]
+                a = b
+            return
+        with _open(self._path, self._gz) as f:
+            f.seek(offset)
+            rest = b""
+            while block := f.read(CHUNK_BYTES):
+                k = block.rfind(b"\n") + 1
+                if not self._gz and 0 < k < len(block):  # a file seeks back to the line's start: one copy less
+                    f.seek(k - len(block), 1)
+                    yield block[:k]
+                    continue
+                buf = rest + block if rest else block
+                k = buf.rfind(b"\n") + 1
+                rest = buf[k:]
+                if k:
+                    yield buf if k == len(buf) else buf[:k]
+            if rest:
+                yield rest
+
+    def rows_hint(self, offset: int) -> int:
+        """About how many data rows lie from ``offset`` on: the body's bytes over the bytes per line of the head's
+        complete lines past ``offset`` (+ 5 %); counted for a log read whole, or whose head holds no such line. The
+        body's bytes: the file's size, a gzip file's from its trailer (ISIZE; its size × 4 where that is less)."""
+        if "raw" in self.__dict__:
+            return self.raw.count(b"\n", offset) + 1
+        seg = self._prefix[offset : self._prefix.rfind(b"\n") + 1]
+        lines = seg.count(b"\n")
+        if not lines:
+            return self._count_lines(offset)
+        size = os.path.getsize(self._path)
+        if self._gz:
+            with open(self._path, "rb") as f:
+                f.seek(-4, os.SEEK_END)
+                size = max(int.from_bytes(f.read(4), "little"), 4 * size)  # ISIZE: the size mod 2³²
+        return int((size - offset) / (len(seg) / lines) * 1.05) + 64
+
+    def _count_lines(self, offset: int) -> int:
+        """The line ends from ``offset`` on + 1: a bound on the data rows (the file read once more)."""
+        n, buf = 1, bytearray(CHUNK_BYTES)
+        with _open(self._path, self._gz) as f:
+            f.seek(offset)
+            while got := f.readinto(buf):
+                n += buf.count(b"\n", 0, got)
+        return n
 
     @cached_property
     def _decoded(self) -> tuple[str, str, bool]:
@@ -84,17 +166,33 @@ class _Text:
     def lines(self) -> list[str]:
         return self.text.splitlines()
 
+    @cached_property
+    def _utf8_head(self) -> str | None:
+        """The head decoded alone where it is UTF-8 (a character cut at its end dropped), without a byte-order
+        mark; None where it is not (the whole file's codec then decides)."""
+        for cut in range(4):
+            try:
+                text = self._prefix[: len(self._prefix) - cut].decode("utf-8")
+            except UnicodeDecodeError:
+                continue
+            return text[1:] if text.startswith("\ufeff") else text
+        return None
+
     def _head_text(self) -> str:
-        """The text's first HEAD_CHARS + 1 characters (all of a shorter text)."""
-        return self._ascii_head if self._ascii_head is not None else self.text[: HEAD_CHARS + 1]
+        """The text's first characters: HEAD_CHARS + 1 of them or more (all of a shorter text)."""
+        if self._ascii_head is not None:
+            return self._ascii_head
+        if "raw" not in self.__dict__ and self._utf8_head is not None:
+            return self._utf8_head
+        return self.text[: HEAD_CHARS + 1]
 
     def head(self) -> tuple[list[str], bool]:
         """(the first lines — all of them when the text is short, else those in its first ``HEAD_CHARS``
         characters, complete lines only —, whether that is every line)."""
         head = self._head_text()
-        if len(head) <= HEAD_CHARS:
+        if len(head) <= HEAD_CHARS and not self._streamed:
             return self.lines, True
-        k = head.rfind("\n", 0, HEAD_CHARS) + 1
+        k = head.rfind("\n", 0, HEAD_CHARS) + 1  # (a streamed log is longer than HEAD_CHARS bytes)
         return head[:k].splitlines(), False
 
     def byte_offset(self, start: int) -> int:
@@ -106,19 +204,23 @@ class _Text:
             chars = sum(map(len, self.text.splitlines(keepends=True)[:start]))
         if self._ascii_head is not None and chars <= HEAD_CHARS:
             return chars  # ASCII: a character is a byte, and there is no byte-order mark
+        if "raw" not in self.__dict__ and self._utf8_head is not None and chars <= HEAD_CHARS:
+            bom = self._prefix.startswith(b"\xef\xbb\xbf")
+            return len(self._utf8_head[:chars].encode("utf-8")) + (3 if bom else 0)
         return len(self.text[:chars].encode(self.codec)) + (3 if self.bom else 0)
 
 
+def _open(path, gz):
+    """The file, as a binary stream gunzipped when ``gz``."""
+    return gzip.open(path, "rb") if gz else open(path, "rb")
+
+
 def _decode(path, gz) -> _Text:
-    """The file, gunzipped when ``gz`` (decoded on use: :class:`_Text`)."""
+    """The file, gunzipped when ``gz``, its head read (the rest on use: :class:`_Text`)."""
     try:
-        with open(path, "rb") as f:
-            raw = f.read()
-        if gz:
-            raw = zlib.decompress(raw, 16 + zlib.MAX_WBITS) if raw else raw
+        return _Text.open(path, gz)
     except (OSError, zlib.error, EOFError, gzip.BadGzipFile) as exc:
         raise InputError(f"{path}: cannot be read{' as gzip' if gz else ''} ({exc})") from None
-    return _Text(raw)
 
 
 def _layout(path, lines, delimiter):
@@ -181,43 +283,38 @@ def read_text(path, columns, time_column, delimiter, gz, channels=None):
     # parse only the needed columns when a one-character delimiter makes skipping safe
     usecols = need if (delim is not None and len(need) < ncols) else None
     parsed = usecols if usecols is not None else list(range(ncols))
-    # (a core extension built before the fast parser existed reads the NumPy way)
-    fast = getattr(_core, "parse_decimal_table", None)
-    arr = fast(doc.raw, doc.byte_offset(start), delim, ncols, parsed) if fast is not None else None
-    if arr is None:  # not plain decimal rows: NumPy reads them, and a bad line is found and named
+    pos = {c: j for j, c in enumerate(parsed)}
+    timed = [[pos[t_idx]]] if t_idx is not None and not iso else []
+    groups = [[pos[c] for c in idx], *timed, *([pos[i]] for i in ch)]
+    outs = _parse_fast(doc, doc.byte_offset(start), delim, ncols, parsed, groups, squeeze)
+    if outs is None:  # not plain decimal rows: NumPy reads them, and a bad line is found and named
         try:
             arr = _parse_lines(path, doc, start, delim, ncols, need, names, usecols, blank=set(ch))
         except InputError as exc:
             raise _as_channel(exc, [names[i] for i in ch], channels) from None
-    if arr.shape[0] == 0:
+        outs = _split_parsed(arr, groups, squeeze)
+        del arr
+    data, rest = outs[0], outs[1:]
+    if data.shape[0] == 0:
         raise InputError(f"{path}: no data rows after the header on line {i0 + 1}")
 
     def where(r):
         return f"line {_line_of_row(doc.lines, start, r)}"
 
-    pos = {c: j for j, c in enumerate(parsed)}
-    cols = [pos[c] for c in idx]
-    if len(cols) == arr.shape[1] and cols == list(range(arr.shape[1])):
-        data = arr
-    else:
-        data = np.ascontiguousarray(arr[:, cols])
-    hit = first_nonfinite(data)
+    hit = first_nonfinite(data if data.ndim == 2 else data[:, None])
     if hit is not None:
         r, c = hit
         raise InputError(
             f"{path}: {where(r)}, column {idx[c] + 1} ({names[idx[c]]!r}): non-finite value "
-            f"{data[r, c]} (NaN or inf); only finite numbers are allowed"
+            f"{(data if data.ndim == 2 else data[:, None])[r, c]} (NaN or inf); only finite numbers are allowed"
         )
-    t_first, secs = 0.0, False
+    t_first, secs, time = 0.0, False, None
     if iso:  # ISO 8601 date-times: seconds from the first, the first kept as POSIX seconds
         fields = [_split(ln, delim)[t_idx] for ln in doc.lines[start:] if _strip_comment(ln).strip()]
         (time, t_first), secs = iso_seconds(path, fields, where), True
-    else:
-        time = arr[:, pos[t_idx]].copy() if t_idx is not None else None
-    chans = {names[i]: arr[:, pos[i]].copy() for i in ch}
-    del arr
-    if squeeze:
-        data = data[:, 0].copy()
+    elif t_idx is not None:
+        time = rest.pop(0)
+    chans = {names[i]: c for i, c in zip(ch, rest)}
     return Record(
         data=data,
         names=[names[i] for i in idx],
@@ -229,7 +326,50 @@ def read_text(path, columns, time_column, delimiter, gz, channels=None):
         checked_finite=True,
         channels=chans,
         channels_recognised=isinstance(channels, str) and channels == AUTO_CHANNELS,
+        time_owned=time is not None,
     )
+
+
+def _parse_fast(doc, offset, delim, ncols, parsed, groups, squeeze):
+    """The body parsed by the core's decimal parser, piece by piece (:meth:`_Text.pieces`), into one preallocated
+    array per group of ``parsed``'s positions — the samples' (rows, k), or (rows,) when ``squeeze``; each other
+    group one column, (rows,) —; None when a piece is outside its grammar (or the core has no such parser)."""
+    fast = getattr(_core, "parse_decimal_table", None)  # (a core built before the fast parser: the NumPy way)
+    if fast is None:
+        return None
+    cap = max(16, doc.rows_hint(offset))  # pages past the rows written are never touched
+    outs = [np.empty(cap if (squeeze or k) else (cap, len(g))) for k, g in enumerate(groups)]
+    # a group of adjacent columns is a view of the parsed block (no copy by fancy indexing); one column a 1-D view
+    takes = [g[0] if out.ndim == 1 else (slice(g[0], g[-1] + 1) if g == list(range(g[0], g[-1] + 1)) else g)
+             for out, g in zip(outs, groups)]  # fmt: skip
+    r = 0
+    for piece in doc.pieces(offset):
+        arr = fast(piece, 0, delim, ncols, parsed)
+        if arr is None:
+            return None
+        m = arr.shape[0]
+        if r + m > cap:  # more rows than the hint: grown in place (realloc), rarely
+            cap = max(r + m, int(cap * 1.25))
+            for out in outs:
+                out.resize((cap, *out.shape[1:]), refcheck=False)
+        for out, take in zip(outs, takes):
+            out[r : r + m] = arr[:, take]
+        r += m
+    for out in outs:  # cut to the rows read: the arrays own just them
+        out.resize((r, *out.shape[1:]), refcheck=False)
+    return outs
+
+
+def _split_parsed(arr, groups, squeeze) -> list:
+    """NumPy's parsed columns as :func:`_parse_fast` returns them: the samples' (rows, k) (``arr`` itself where it
+    is just them), or (rows,) when ``squeeze``; each other group's one column (rows,)."""
+    outs = []
+    for k, g in enumerate(groups):
+        if k == 0 and not squeeze:
+            outs.append(arr if g == list(range(arr.shape[1])) else np.ascontiguousarray(arr[:, g]))
+        else:
+            outs.append(arr[:, g[0]].copy())
+    return outs
 
 
 def _first_field_iso(lines, start, delim, k) -> bool:

@@ -103,8 +103,8 @@ def finish(path, fmt, rec: Record, fs, unit, input, gaps) -> Log:
     kept = data[span[0] : span[1]] if span != (0, n) else data
     time_rel = None
     if t is not None:
-        time_rel = t[span[0] : span[1]] - t[span[0]]
         t0 = float(t[span[0]]) + rec.t_first
+        time_rel = _relative(rec, t, span)
     return Log(
         data=kept,
         span=span,
@@ -115,6 +115,16 @@ def finish(path, fmt, rec: Record, fs, unit, input, gaps) -> Log:
         time_column=rec.time_name if t is not None else None,
         **_log_fields(path, fmt, rec, fs, unit, input, t0, gap_list, jitter),
     )
+
+
+def _relative(rec: Record, t: np.ndarray, span) -> np.ndarray:
+    """The times of ``span`` from its first: in place where the record's time column is the reader's own array (a
+    text log's — no second array of the record's length), else a new array."""
+    kept = t[span[0] : span[1]]
+    if rec.time_owned and t is rec.time:
+        kept -= t[span[0]]
+        return kept
+    return kept - t[span[0]]
 
 
 def _check_finite(path, rec: Record, n: int) -> None:
@@ -140,10 +150,13 @@ def _step(t: np.ndarray, d: np.ndarray) -> tuple[float, float]:
     rounds each step by more than 10⁻⁷ of it (epoch seconds at 400 Hz, epoch nanoseconds read as float) — the mean
     of the regular steps (within ``GAP_FACTOR`` of the median), whose rounding errors cancel but at the ends:
     1.7·10⁹ s + k/400 has steps 0.0025 ± 2.4·10⁻⁷, median 399.991 Hz, mean 400.000."""
-    step = float(np.median(d))
+    step = float(np.median(d, overwrite_input=True))  # reorders d (no copy of the record's length)
     ulp = float(np.spacing(max(abs(float(t[0])), abs(float(t[-1])))))
+    if ulp <= 1e-7 * step:
+        return step, 5e-10
+    d = np.diff(t)  # in order again: the mean below sums in the record's order
     regular = d[np.abs(d - step) <= (GAP_FACTOR - 1.0) * step]
-    if ulp <= 1e-7 * step or not regular.size:
+    if not regular.size:
         return step, 5e-10
     return float(np.mean(regular)), 2.0 * ulp / float(np.sum(regular))
 
@@ -178,6 +191,8 @@ def _time_steps(path, rec: Record, t: np.ndarray, n: int, fs):
             f"times must increase — is {tn!r} really the time column? ({back.size} such step(s))"
         )
     step, rel = _step(t, d)
+    del d  # _step's median reordered it: taken again, never two at once
+    d = np.diff(t)
     if fs is None:
         fs = _shortest(1.0 / step, rel)
     elif abs(step * fs - 1.0) > 0.01:
@@ -187,8 +202,9 @@ def _time_steps(path, rec: Record, t: np.ndarray, n: int, fs):
         )
     dt = 1.0 / fs
     is_gap = d > GAP_FACTOR * dt
-    rel = np.abs(d[~is_gap] - dt) / dt
-    jitter = float(rel.max()) if rel.size else 0.0
+    # the largest |step − dt| / dt off the gaps, from the extreme steps (no temporaries of the record's length)
+    kept = d[~is_gap] if is_gap.any() else d
+    jitter = max(float(kept.max()) - dt, dt - float(kept.min())) / dt if kept.size else 0.0
     gap_list = []
     for gi in np.flatnonzero(is_gap):
         i = int(gi)

@@ -3,11 +3,12 @@ timing constants the reader applies."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..units import Unit
 
 __all__ = ["GAP_FACTOR", "GAP_MODES", "JITTER_WARN", "TIME_UNITS", "Gap", "Log"]
@@ -95,6 +96,13 @@ class Log:
         see :mod:`allanite.io._channels`); empty without any. Not among ``columns``.
     channels_recognised : bool
         Whether the channels were found by their names (``channels="auto"``) rather than named.
+    unit_source : str or None
+        Where ``unit`` came from (``unit=``, the column names, a ROS bag's convention).
+    column_units : list
+        Per column, the unit its name gives (a ``ColumnUnit(name, kind, text)``) or None; :attr:`groups` gathers
+        the columns by it and :meth:`take` keeps one group.
+    time_unit, time_unit_source : str or None
+        The time column's unit and why: ``time_unit=``, its name, an epoch magnitude, or the default (seconds).
     """
 
     data: np.ndarray
@@ -122,6 +130,59 @@ class Log:
     time_unit_from_name: bool = False
     channels: dict = field(default_factory=dict)
     channels_recognised: bool = False
+    #: Where ``unit`` came from: ``"given as unit="``, ``"from the column names: [rad s^-1]"``,
+    #: ``"ROS convention (REP 103)"``, …; None without a unit.
+    unit_source: str | None = None
+    #: Per column of ``columns``, the unit its name gives (:func:`allanite.io._units.column_unit`: a
+    #: ``ColumnUnit(name, kind, text)``), or None.
+    column_units: list = field(default_factory=list)
+    #: Where ``time_unit`` came from: ``"time_unit="``, ``"its name"``, ``"epoch magnitude"`` (a first stamp that
+    #: reads as a date in 2001–2286 in that unit) or ``"default"`` (seconds); None without a time column.
+    time_unit_source: str | None = None
+
+    @property
+    def groups(self) -> dict:
+        """The columns by the unit their names give: unit name (``"rad/s"``, ``"m/s^2"``; ``None`` for none) →
+        column names, in order — an IMU log's gyro and accelerometer columns apart. One group for a log whose
+        columns give one unit (or none)."""
+        out: dict = {}
+        units = self.column_units or [None] * len(self.columns)
+        for c, cu in zip(self.columns, units):
+            out.setdefault(None if cu is None else cu.name, []).append(c)
+        return out
+
+    def take(self, columns) -> Log:
+        """This log on some of its ``columns`` (names, in the order given; e.g. one of :attr:`groups`): ``data``
+        (and ``segments``) of those columns, 1-D for a single name; the log's unit where it was given (``unit=``, a
+        ROS bag's), else the unit those columns' names give when they give one gyro unit (``unit_source`` says so).
+
+        Raises
+        ------
+        ParameterError
+            A name that is not one of ``columns``, or none at all.
+        """
+        from ._units import units_of
+
+        names = [columns] if isinstance(columns, str) else list(columns)
+        missing = [c for c in names if c not in self.columns]
+        if not names or missing:
+            raise ParameterError(
+                f"Log.take: {missing[0] if missing else columns!r} is not one of the log's columns: "
+                f"{', '.join(map(repr, self.columns))}"
+            )
+        idx = [self.columns.index(c) for c in names]
+        pick = idx[0] if isinstance(columns, str) else idx
+        two = self.data if self.data.ndim == 2 else self.data[:, None]
+        cols = [self.column_units[i] if self.column_units else None for i in idx]
+        unit, source = self.unit, self.unit_source
+        if unit is None or (source or "").startswith("from the column names"):  # the names' unit: theirs now
+            unit, source, cols = units_of(self.path, names, None, self.input)
+        segments = None
+        if self.segments is not None:
+            segments = [np.asarray(s).reshape(len(s), -1)[:, pick] for s in self.segments]
+        return replace(
+            self, data=two[:, pick], columns=names, segments=segments, unit=unit, unit_source=source, column_units=cols
+        )
 
     @property
     def n_samples(self) -> int:
@@ -138,6 +199,28 @@ class Log:
         """Length of ``data`` in seconds (samples / fs)."""
         return self.n_samples / self.fs
 
+    def _unit_said(self) -> str:
+        """The repr's unit: the unit, its kind and where it came from; the header's groups where its columns give
+        several units; "not given"."""
+        if self.unit is not None:
+            return f"{self.unit.name} ({self.unit.kind}{'; ' + self.unit_source if self.unit_source else ''})"
+        groups = self.groups
+        if len(groups) > 1 or None not in groups:
+            shown = "; ".join(f"{u or 'no unit'}: {', '.join(map(str, cs))}" for u, cs in groups.items())
+            return f"none — the column names give {shown} (Log.take(columns) for one group)"
+        return "not given"
+
+    def _time_unit_said(self) -> str:
+        """The repr's time unit and where it came from; nothing for seconds named so (``time_s``)."""
+        why = {
+            "epoch magnitude": "read from its epoch magnitude",
+            "time_unit=": "given as time_unit=",
+            "default": "by default: neither its name nor an epoch magnitude gives one",
+        }.get(self.time_unit_source or "")
+        if self.time_unit_from_name:
+            why = "its name says so"
+        return f" in {self.time_unit} ({why})" if why else ""
+
     def __repr__(self) -> str:
         kind = "memory-mapped " if isinstance(self.data, np.memmap) else ""
         dur = self.duration
@@ -153,20 +236,17 @@ class Log:
                 if self.channels
                 else []
             ),
-            f"  unit: {self.unit.name + ' (' + self.unit.kind + ')' if self.unit else 'not given'}, "
-            f"input: {self.input}",
+            f"  unit: {self._unit_said()}, input: {self.input}",
         ]
         if self.time is None and not self.gaps:
             lines.append("  timing: no time column (fs given; gaps cannot be detected)")
         else:
             jit = f", max jitter {100 * self.jitter:.3g} % of the step" if self.jitter is not None else ""
             which = (
-                (
-                    f"time column {self.time_column!r}"
-                    + (" (recognised by its name)" if self.time_column_recognised else "")
-                    + (f" in {self.time_unit} (its name says so)" if self.time_unit_from_name else "")
-                    + ", "
-                )
+                f"time column {self.time_column!r}"
+                + (" (recognised by its name)" if self.time_column_recognised else "")
+                + self._time_unit_said()
+                + ", "
                 if self.time_column
                 else ""
             )

@@ -22,12 +22,14 @@ from .._mapped import column, read_rows
 from .._validate import INPUTS, check_choice, check_fs
 from ..errors import InputError, ParameterError
 from ..units import parse_unit
-from ._columns import AUTO_CHANNELS, check_column_spec, time_unit_of
+from ._columns import AUTO_CHANNELS, check_column_spec
 from ._columns import AUTO_TIME as AUTO_TIME
 from ._external import read_bag, read_parquet
 from ._numpy import read_npy, read_npz
 from ._text import read_text
+from ._timeunit import time_unit as time_unit_of_record
 from ._timing import finish
+from ._units import units_of
 from .log import GAP_FACTOR, GAP_MODES, Gap, Log
 from .log import JITTER_WARN as JITTER_WARN
 from .log import TIME_UNITS as TIME_UNITS
@@ -79,7 +81,12 @@ def read_log(
         (``Log.time_column_recognised`` is then True).
     unit : str, optional
         Unit of the samples (:func:`allanite.units.parse_unit`): a rate unit for ``input="rate"``, an
-        angle unit for ``"increment"`` and ``"angle"``. ROS bags default to ``"rad/s"``.
+        angle unit for ``"increment"`` and ``"angle"``. ROS bags default to ``"rad/s"``. Without it, the unit the
+        sample columns' names give (:mod:`allanite.io._units`: ``w_RS_S_x [rad s^-1]``, ``gx (deg/s)``, ``gz_dps``)
+        when they all give the same one of the kind needed; columns of several units (an IMU's gyro and
+        accelerometer) leave ``Log.unit`` None and are told apart by ``Log.groups`` (``Log.take`` one group).
+        Given, it wins over the header, with a warning where a column's name says another unit.
+        ``Log.unit_source`` says where the unit came from.
     input : {"rate", "increment", "angle"}
         What the samples are, as for :func:`allanite.avar`.
     gaps : {"error", "longest", "split", "nan"}
@@ -93,8 +100,11 @@ def read_log(
         whitespace). Numbers take a decimal point: a decimal comma (``0,0125``) is an InputError that says so.
     time_unit : {"s", "ms", "us", "ns"}, optional
         Unit of a text/array time column. Default: the unit its name ends in (``time_ns``, ``timestamp_us``,
-        ``t [ms]``, ``Time (nsec)``; ``rostopic echo -p``'s ``%time``: ns), else seconds; ``Log.time_unit`` says
-        which was used.
+        ``t [ms]``, ``Time (nsec)``; ``rostopic echo -p``'s ``%time``: ns), else the unit in which its first stamp
+        is an epoch date (≈ 1.7·10⁹ s, 10¹² ms, 10¹⁵ µs, 10¹⁸ ns), else seconds — where seconds are implausible, an
+        InputError (a span over 10 years) or a warning (under 1 Hz over 10⁴ rows) says so, with what the steps
+        read as in ms, µs and ns (:mod:`allanite.io._timeunit`). ``Log.time_unit`` says which unit was used,
+        ``Log.time_unit_source`` why.
     array : str, optional
         For ``.npz``: which array holds the samples (default: the only one).
     topic : str, optional
@@ -150,12 +160,37 @@ def read_log(
     (['gx', 'gy'], ['T [degC]'], True)
     """
     path = Path(os.fspath(path))
+    fs = None if fs is None else check_fs(fs)
+    u = _check_arguments(path, columns, time_column, unit, input, gaps, time_unit, channels)
+    fmt = sniff_format(path)
+    if fmt in ("ros1", "ros2"):
+        rec = read_bag(path, fmt, columns, time_column, topic, channels)
+    else:
+        if fs is None and time_column is None:
+            # neither given: a column named like a time column (time, t, timestamp, …) is the time column
+            time_column = AUTO_TIME
+        rec = _read_file(path, fmt, columns, time_column, delimiter, array, channels)
+    t_unit = t_source = None
+    if rec.time is not None and rec.time_is_seconds is False:
+        t_unit, t_source = time_unit_of_record(path, rec, time_unit)
+    fmt = "text" if fmt == "text.gz" else fmt
+    log = finish(path, fmt, rec, fs, u, input, gaps)
+    if rec.time is not None:
+        log.time_unit = t_unit or "s"
+        log.time_unit_source = t_source or "the reader (seconds)"
+        log.time_unit_from_name = t_source == "its name" and t_unit != "s"
+    log.time_column_recognised = time_column is AUTO_TIME and rec.time_name is not None
+    log.unit, log.unit_source, log.column_units = units_of(path, log.columns, u, input, ros=fmt in ("ros1", "ros2"))
+    return log
+
+
+def _check_arguments(path, columns, time_column, unit, input, gaps, time_unit, channels):
+    """``read_log``'s arguments checked (a ParameterError naming a bad one; an InputError for a missing file);
+    the samples' parsed unit, or None."""
     check_choice(input, "input", INPUTS)
     check_choice(gaps, "gaps", GAP_MODES)
     if time_unit is not None:
         check_choice(time_unit, "time_unit", tuple(TIME_UNITS))
-    if fs is not None:
-        fs = check_fs(fs)
     u = None if unit is None else _sample_unit(unit, input)
     if columns is not None:
         check_column_spec(columns, "columns")
@@ -165,40 +200,22 @@ def read_log(
         check_column_spec(channels, "channels")
     if not path.exists():
         raise InputError(f"{path}: no such file")
+    return u
 
-    fmt = sniff_format(path)
-    named = None
-    if fmt in ("ros1", "ros2"):
-        rec = read_bag(path, fmt, columns, time_column, topic, channels)
-        if u is None and input == "rate":
-            u = parse_unit("rad/s")  # REP 103: ROS angular velocity is in rad/s
+
+def _read_file(path, fmt, columns, time_column, delimiter, array, channels):
+    """The record of a .npy, .npz, Parquet or text log, without the columns that count rows (unless named)."""
+    if fmt == "npy":
+        rec = read_npy(path, columns, time_column, channels)
+    elif fmt == "npz":
+        rec = read_npz(path, columns, time_column, array, channels)
+    elif fmt == "parquet":
+        rec = read_parquet(path, columns, time_column, channels)
     else:
-        if fs is None and time_column is None:
-            # neither given: a column named like a time column (time, t, timestamp, …) is the time column
-            time_column = AUTO_TIME
-        if fmt == "npy":
-            rec = read_npy(path, columns, time_column, channels)
-        elif fmt == "npz":
-            rec = read_npz(path, columns, time_column, array, channels)
-        elif fmt == "parquet":
-            rec = read_parquet(path, columns, time_column, channels)
-        else:
-            rec = read_text(path, columns, time_column, delimiter, gz=(fmt == "text.gz"), channels=channels)
-        if columns is None:
-            _drop_counters(path, rec)
-        if rec.time is not None and rec.time_is_seconds is False:
-            named = time_unit_of(rec.time_name) if time_unit is None else None
-            if time_unit is None and named is None:
-                _check_seconds(path, rec)
-            time_unit = time_unit or named or "s"
-            rec.time = rec.time * TIME_UNITS[time_unit]
-    fmt = "text" if fmt == "text.gz" else fmt
-    log = finish(path, fmt, rec, fs, u, input, gaps)
-    if rec.time is not None:
-        log.time_unit = time_unit or "s"
-        log.time_unit_from_name = named not in (None, "s")
-    log.time_column_recognised = time_column is AUTO_TIME and rec.time_name is not None
-    return log
+        rec = read_text(path, columns, time_column, delimiter, gz=(fmt == "text.gz"), channels=channels)
+    if columns is None:
+        _drop_counters(path, rec)
+    return rec
 
 
 def _drop_counters(path, rec) -> None:
@@ -225,18 +242,6 @@ def _drop_counters(path, rec) -> None:
 def _counts(data, k: int) -> bool:
     """Whether column ``k``, whose first 1000 rows count, rises by exactly 1 from row to row throughout."""
     return data.shape[0] <= 1000 or bool(np.all(np.diff(column(data, k)) == 1.0))
-
-
-def _check_seconds(path, rec) -> None:
-    """A warning when a time column taken as seconds by default reads over 10¹¹ s (3000 years): epoch ms, µs or ns
-    read as seconds would make fs 10³–10⁹ times too small."""
-    t = rec.time
-    if t.size and float(np.max(np.abs(t[[0, -1]]))) > 1e11:
-        warnings.warn(
-            f"{path}: time column {rec.time_name!r} reads {float(t[-1]):.6g} s (over 3000 years) as seconds; "
-            "if it is in ms, us or ns, give time_unit= (--time-unit)",
-            stacklevel=3,
-        )
 
 
 def _sample_unit(unit, input):

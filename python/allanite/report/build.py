@@ -356,7 +356,10 @@ def log_source(log) -> dict:
         "time_column": log.time_column,
         "time_column_recognised": bool(log.time_column_recognised),
         "time_unit": log.time_unit,
+        "time_unit_source": log.time_unit_source,
         "unit": log.unit.name if log.unit is not None else None,
+        "unit_source": log.unit_source,
+        "column_units": [None if cu is None else cu.name for cu in log.column_units],
         "input": log.input,
         "t0_s": json_number(log.t0),
         "samples_in_file": int(log.n_record),
@@ -373,6 +376,18 @@ def log_source(log) -> dict:
     if log.segment_spans is not None:
         src["segments"] = [[int(a), int(b)] for a, b in log.segment_spans]
     return src
+
+
+def _unit_notes(log) -> list:
+    """The note on a unit the column names gave (``Log.unit_source``), or on the unit they give that is no gyro's
+    (an accelerometer's m/s²: Allan deviations in it, the coefficients in base form)."""
+    if log.unit is not None and (log.unit_source or "").startswith("from the column names"):
+        return [f"The unit {log.unit.name} is the one the column names give ({log.unit_source[23:]})."]
+    named = {cu.name for cu in log.column_units if cu is not None}
+    if log.unit is None and len(named) == 1:
+        u = named.pop()
+        return [f"The column names give the unit {u}, no gyro unit: the samples' own unit below is {u} (and seconds)."]
+    return []
 
 
 def from_log(log, **kwargs) -> Report:
@@ -402,6 +417,12 @@ def from_log(log, **kwargs) -> Report:
                 else "."
             )
         )
+    if log.time_unit_source == "epoch magnitude":
+        notes.append(
+            f"Time column {log.time_column!r} names no unit: read in {log.time_unit}, the unit in which its first "
+            "stamp is an epoch date (--time-unit / read_log(time_unit=…) overrides it)."
+        )
+    notes += _unit_notes(log) if "unit" not in kwargs else []
     unit = kwargs.pop("unit", None) or (log.unit.name if log.unit is not None else None)
     if "channels" not in kwargs:  # the log's own: a temperature column recognised by its name, or those named
         kwargs["channels"] = log_channels(log, kwargs.get("refine", False), notes)
