@@ -21,6 +21,7 @@ __all__ = [
     "FLOOR_TAG",
     "held_key",
     "held_theta",
+    "held_coherent",
     "column",
     "Curve",
     "design",
@@ -44,18 +45,29 @@ def bw_kind(key: str) -> str:
     return key.split(":", 1)[1].removesuffix(FLOOR_TAG)
 
 
-def held_key(effect: str, theta: float, var: float) -> str:
+def held_key(effect: str, theta: float, var: float, coherent: float | None = None) -> str:
     """The key of ``effect`` held at coefficient ``theta`` (amplitude², measured in the time domain) with
-    variance ``var`` in every fit of the curve."""
-    return f"{effect}:held:{theta!r}:{var!r}"
+    variance ``var`` in every fit of the curve; ``coherent``: the share of ``theta`` whose phase carries across
+    the whole record (a fixed, deterministic line — :func:`held_coherent`), left out when not measured."""
+    tail = "" if coherent is None else f":{coherent!r}"
+    return f"{effect}:held:{theta!r}:{var!r}{tail}"
 
 
 def held_theta(key: str) -> tuple[float, float] | None:
     """(coefficient, its variance) of a held effect's key (:func:`held_key`), else None."""
     parts = key.split(":")
-    if len(parts) == 4 and parts[1] == "held":
+    if len(parts) in (4, 5) and parts[1] == "held":
         return float(parts[2]), float(parts[3])
     return None
+
+
+def held_coherent(key: str) -> float:
+    """The coherent share of a held effect's key (:func:`held_key`) in [0, 1]: 0 where not measured (not held,
+    or held without it) — the whole effect is then treated as noise by the tests' covariance."""
+    parts = key.split(":")
+    if len(parts) == 5 and parts[1] == "held":
+        return min(1.0, max(0.0, float(parts[4])))
+    return 0.0
 
 
 def column(key, p, curve):

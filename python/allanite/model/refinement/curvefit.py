@@ -33,6 +33,7 @@ from ._columns import (
     edf_columns,
     edf_of,
     has_floor,
+    held_coherent,
     held_key,
     held_theta,
 )
@@ -46,6 +47,7 @@ __all__ = [
     "FLOOR_TAG",
     "held_key",
     "held_theta",
+    "held_coherent",
     "column",
     "Curve",
     "Solution",

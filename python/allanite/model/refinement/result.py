@@ -143,11 +143,13 @@ class Refinement(RichDisplay):
     effect, every proposal tried (its parameter, statistic and threshold); one whose test passed but that was not
     taken says why under ``"rejected"`` (χ²/dof not falling, a parameter at the edge of its range, the held-out
     error, another candidate taken at that step). ``effects`` the final model's curve columns [(key, nonlinear
-    parameter)], steps[j] ↔ effects[j] (a spectral line's key, ``"sinusoid:held:<A²>:<its variance>"``, carries
-    the amplitude it is held at: :func:`allanite.model.refinement.curvefit.held_key`). ``start_errors`` and
-    ``final_errors``: the chain's errors of the starting and the final model (the first step's ``before`` and the
-    last one's ``after``: χ²/dof on the tests' covariance, :func:`allanite.model.refinement.scoring.settle_chi2`)
-    — what :meth:`report`, the summary and the report page say; ``fit.chi2_dof`` stays the weighted fit's own
+    parameter)], steps[j] ↔ effects[j] (a spectral line's key,
+    ``"sinusoid:held:<A²>:<its variance>:<coherent share>"``, carries the amplitude it is held at and the share
+    of its power whose phase holds across the record: :func:`allanite.model.refinement.curvefit.held_key`).
+    ``start_errors`` and ``final_errors``: the chain's errors of the starting and the final model (the first
+    step's ``before`` and the last one's ``after``: χ²/dof on the tests' covariance,
+    :func:`allanite.model.refinement.scoring.settle_chi2`) — what :meth:`report`, the summary and the report
+    page say; ``fit.chi2_dof`` stays the weighted fit's own
     (EDF variances, the one its intervals are inflated by)."""
 
     steps: list

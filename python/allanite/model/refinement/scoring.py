@@ -108,8 +108,9 @@ def settle_chi2(metrics: dict, pending: tuple, test) -> float:
     ``pending`` = (residual on the thinned τ, dof) under the covariance ``test`` whitens with — the model's own,
     as the calibrated test at that stage takes it (:func:`.calibrated.curve_test`: the exact covariance of the
     estimates across τ, cross terms of the noise types included, for samples or overlapping estimates; with an
-    effect in the model, the five terms' nearest the model's curve). A goodness of fit of each model by the
-    tests' standard, not an objective the chain minimises: the covariance moves with the model, and a step the
+    effect in the model, the five terms' nearest the model's curve; a line's coherent part by its cross term with
+    the noise). A goodness of fit of each model by the tests' standard, not an objective the chain minimises: the
+    covariance moves with the model, and a step the
     score test and the held-out error accept can raise it (ADIS16405 run 5 y + a 0.02 Hz sinusoid 1300 → 1352,
     held out falling; run 1 z's last, weak resonance 200 → 216). One covariance for the whole chain (the final
     model's) would judge the models before a removal against a noise that lacks the removed component's cross
