@@ -95,7 +95,7 @@ def test_welch_equals_the_whole_array_form(n, nper):
     x = 3.0 + np.cumsum(rng.normal(size=n)) * 1e-3 + rng.normal(size=n) + np.sin(0.01 * np.arange(n))
     win = signal.get_window(lines.WINDOW, nper)
     f0, p0 = _welch_whole(x - x.mean(), 50.0, win, nper)  # line_spectrum de-meaned the record first, as a copy
-    f1, p1 = lines._welch(x, 50.0, win, nper, float(x.mean()))  # now each segment as it is taken
+    f1, p1, _spread = lines._welch(x, 50.0, win, nper, float(x.mean()))  # now each segment as it is taken
     assert np.array_equal(f0, f1)
     if 16 * nper <= _chunked.CHUNK:  # the grouped path: the same bits
         assert np.array_equal(p0, p1)

@@ -106,6 +106,37 @@ def test_clean_quantised_records_say_nothing(sigma):
         assert _both(np.round(x)) == []
 
 
+def _counter_output(seed: int, n: int = 1_000_000, fs: float = 2000.0) -> np.ndarray:
+    """A delta-angle counter's rate: the angle quantised to 3× its white noise's step per sample, differenced."""
+    rng = np.random.default_rng(seed)
+    rate = 1.7e-3 * np.sqrt(fs) * rng.standard_normal(n) + 4.2e-3
+    q = 3.0 * 1.7e-3 / np.sqrt(fs)
+    return np.diff(np.floor(np.cumsum(rate) / fs / q), prepend=0.0) * (q * fs)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_delta_angle_counters_output_is_not_said_held(seed):
+    """Q-dominated, anti-correlated, three levels: 56 % of neighbours tie, the lattice's log-quadratic predicts
+    31 % (it was said held: "25 % of the samples repeat the one before"), the ties at lag 2 are 57 %."""
+    y = _counter_output(seed)
+    c = qc.tie_counts(y)
+    assert c["n0"] > 1.7 * qc.expected_ties(c["n1"], c["n2"])  # the lattice's prediction alone is far off
+    assert qc.held_check(_ctx(y, 2000.0), A_HELD) == []
+    assert 1.0 < qc.lag2_ties(y) / c["n0"] < 1.1  # the ties two samples apart are the null
+
+
+def test_repeats_in_a_continuous_record_outrun_its_ties_at_lag_2():
+    """The lag-2 reference leaves a driver's repeats said: a repeat ties with the sample before only."""
+    y = allanite.simulate(200_000, 100.0, N=2e-3, K=2e-5, seed=6)
+    idx = np.arange(50, y.size, 50)
+    y[idx] = y[idx - 1]
+    y[idx[::2] + 1] = y[idx[::2]]  # every other one repeated twice: those tie at lag 2 too
+    twice = idx[::2].size
+    assert qc.lag2_ties(y) == twice
+    out = qc.held_check(_ctx(y, 100.0), A_HELD)
+    assert [e["domain"] for e in out] == ["held"] and out[0]["repeats"] == idx.size + twice
+
+
 def test_float32_and_continuous_records_say_nothing():
     rng = np.random.default_rng(11)
     on_bias = (250.0 + 0.01 * rng.standard_normal(1_000_000)).astype(np.float32)  # float32 spacing 1.5e-5

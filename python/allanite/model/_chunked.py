@@ -89,13 +89,16 @@ def _first_recurring(r: np.ndarray) -> float | None:
     return None
 
 
-def welch_detrended(x: np.ndarray, win: np.ndarray, nper: int, mean: float = 0.0, rows: int = 16) -> np.ndarray:
+def welch_detrended(
+    x: np.ndarray, win: np.ndarray, nper: int, mean: float = 0.0, rows: int = 16, each=None
+) -> np.ndarray:
     """Σ over the 50 %-overlapping segments of ``x − mean`` of |rfft(window × segment less its least-squares
     line)|², ``rows`` segments at a time while a group stays within :data:`CHUNK` samples — the whole-group form,
     bit for bit —, else one segment at a time, the line's slope summed over chunks (a segment of half a 10⁸-sample
     record is 400 MB: the group of three such and its copies were several GB). Per segment then: its detrended
     copy, its transform and the power so far (≈ 2.5 segments). The groups' sums are added in segment order, as the
-    whole-group sum adds its rows; ``mean`` is subtracted from each segment as it is taken (no copy of ``x``)."""
+    whole-group sum adds its rows; ``mean`` is subtracted from each segment as it is taken (no copy of ``x``).
+    ``each``, when given, is called with every group's (segments × bins) powers, in segment order."""
     step = nper // 2
     k = (x.size - nper) // step + 1
     c = (nper - 1) / 2.0
@@ -107,14 +110,22 @@ def welch_detrended(x: np.ndarray, win: np.ndarray, nper: int, mean: float = 0.0
             idx = (np.arange(a, min(k, a + rows)) * step)[:, None] + np.arange(nper)[None, :]
             seg = x[idx] - mean
             seg = seg - seg.mean(axis=1, keepdims=True) - np.outer(seg @ t / tt, t)
-            p += np.sum(np.abs(np.fft.rfft(seg * win, axis=1)) ** 2, axis=0)
+            pw = np.abs(np.fft.rfft(seg * win, axis=1)) ** 2
+            if each is not None:
+                each(pw)
+            p += np.sum(pw, axis=0)
         return p
     tt = _sum_squares_centred(nper)
     total: np.ndarray | None = None  # the first group's sum is the total so far (no zeros beside it)
     for a in range(0, k, rows):
         acc = _segment_power(x[a * step : a * step + nper], win, mean, tt)
+        if each is not None:
+            each(acc[None, :])
         for i in range(a + 1, min(k, a + rows)):
-            acc += _segment_power(x[i * step : i * step + nper], win, mean, tt)
+            one = _segment_power(x[i * step : i * step + nper], win, mean, tt)
+            if each is not None:
+                each(one[None, :])
+            acc += one
         total = acc if total is None else total + acc
     assert total is not None
     return total

@@ -11,7 +11,8 @@ window's median of a monotone 1/f or 1/f² slope is its value at the centre). Tw
 are searched at the long segments' finer resolution. Degrees of freedom: the Welch average's
 2K/(1 + 2Σ(1 − m/K)ρ_m²) (Percival & Walden 1993, eq. 292b; ρ_m the window's overlap correlation), the
 median's that times its neighbours' effective number (2w/(1 + 2Σρ_j²), ρ_j the correlation of bins j
-apart) times 2/π (a sample median's efficiency). Lines close together raise each other's reference, so the
+apart) times 2/π (a sample median's efficiency); both times K_eff/K in a band where the segments' powers differ
+(a noise on for part of the record: :mod:`._welch_spread`). Lines close together raise each other's reference, so the
 search repeats with the lines found left out of every median (in mirror pairs, keeping it centred).
 
 :func:`group_lines` — lines into families on a lattice: harmonics k·f0 (one generator) or sidebands
@@ -42,6 +43,7 @@ from scipy.stats import f as f_dist
 
 from ._chunked import CHUNK, welch_detrended, window_overlap
 from ._medians import median_by_sort, nanmedian_rows
+from ._welch_spread import SegmentLevels
 
 __all__ = ["find_lines", "line_spectrum", "remembering_spectra", "group_lines", "LOBE", "MAX_SEGMENT", "fold_frequency"]
 
@@ -90,22 +92,24 @@ def _edof(win: np.ndarray, n: int, nper: int) -> tuple[float, float, int]:
     return dof, 1.0 + 2.0 * float(np.sum(corr)), k
 
 
-def _welch(x: np.ndarray, fs: float, win: np.ndarray, nper: int, mean: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+def _welch(x: np.ndarray, fs: float, win: np.ndarray, nper: int, mean: float = 0.0):
     """One-sided Welch PSD (unit²/Hz) of 50 %-overlapping segments, each with its least-squares line removed
     (as ``scipy.signal.welch(detrend="linear")``, without a least-squares solve per segment) of ``x − mean``; a few
-    segments at a time, or one, so that the memory beyond ``x`` stays a chunk's or a segment's (:mod:`._chunked`)."""
+    segments at a time, or one, so that the memory beyond ``x`` stays a chunk's or a segment's (:mod:`._chunked`);
+    and per bin the factor on its dof where the segments' powers differ (:mod:`._welch_spread`)."""
     k = (x.size - nper) // (nper // 2) + 1
-    p = welch_detrended(x, win, nper, mean)
+    levels = SegmentLevels()
+    p = welch_detrended(x, win, nper, mean, each=levels if k >= 4 else None)  # the long pass's 3: none
     p *= 1.0 / (fs * float(win @ win)) / k
     p[1:-1] *= 2.0  # one-sided (the Nyquist bin of an even nper once)
-    return np.arange(p.size) * fs / nper, p
+    return np.arange(p.size) * fs / nper, p, levels.factor(p.size)
 
 
 def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int, mean: float = 0.0) -> dict:
     """Welch PSD of one segment length up to the bins its search reaches, the bins k_lo ≤ k < k_hi it searches
     (grouped by their neighbourhood w) and, unmasked, the noise level under each (:func:`_noise`)."""
     win = signal.get_window(WINDOW, nper)
-    f, p = _welch(x, fs, win, nper, mean)
+    f, p, spread = _welch(x, fs, win, nper, mean)
     dof, kappa, k_seg = _edof(win, x.size, nper)
     ks_all = np.arange(p.size)
     width = np.clip(ks_all // 2, *NEIGHBOURS)
@@ -123,6 +127,7 @@ def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int, mean: f
     top = min(p.size, k_hi + LOBE + 2 * NEIGHBOURS[1] + 2)
     f, p = f[:top].copy(), p[:top].copy()
     ps = {"f": f, "p": p, "dof": dof, "kappa": kappa, "df": fs / nper, "segments": k_seg, "groups": groups}
+    ps["dof_bin"] = dof * spread[:top]  # the Welch dof per bin: fewer where the segments' powers differ
     ps["noise"], ps["dof_med"] = _noise(ps, np.zeros(p.size, dtype=bool))
     return ps
 
@@ -133,7 +138,7 @@ def _noise(ps: dict, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     across k go together, so that the median of a sloped spectrum stays its centre value); where fewer than w/2
     pairs are left, pairs out to ±(LOBE + 2w) join. Degrees of freedom of the median: the Welch average's times
     the bins used over their correlation factor times 2/π."""
-    p, dof = ps["p"], ps["dof"]
+    p, dof = ps["p"], ps["dof_bin"]
     noise = np.full(p.size, np.nan)
     dof_med = np.full(p.size, np.nan)
     bias = chi2_dist.median(dof) / dof
@@ -141,8 +146,8 @@ def _noise(ps: dict, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         near = np.arange(LOBE + 1, LOBE + w + 1)
         if not mask.any():
             both = np.concatenate([-near[::-1], near])
-            noise[ks] = median_by_sort(p[ks[:, None] + both[None, :]], axis=1) / bias
-            dof_med[ks] = dof * (2.0 * w / ps["kappa"]) * (2.0 / math.pi)
+            noise[ks] = median_by_sort(p[ks[:, None] + both[None, :]], axis=1) / bias[ks]
+            dof_med[ks] = dof[ks] * (2.0 * w / ps["kappa"]) * (2.0 / math.pi)
             continue
         med = np.full(ks.size, np.nan)
         used = np.zeros(ks.size)
@@ -167,8 +172,8 @@ def _noise(ps: dict, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             both = np.concatenate([-near[::-1], near])
             med[lost] = median_by_sort(p[ks[lost, None] + both[None, :]], axis=1)
             used[lost] = 2 * w
-        noise[ks] = med / bias
-        dof_med[ks] = dof * (used / ps["kappa"]) * (2.0 / math.pi)
+        noise[ks] = med / bias[ks]
+        dof_med[ks] = dof[ks] * (used / ps["kappa"]) * (2.0 / math.pi)
     return noise, dof_med
 
 
@@ -191,7 +196,8 @@ def remembering_spectra():
 
 def line_spectrum(y: np.ndarray, fs: float) -> list[dict]:
     """The passes :func:`find_lines` searches: per pass the Welch PSD (``f``, ``p``), the noise level under
-    each searched bin (``noise``, NaN elsewhere), the degrees of freedom (``dof``, ``dof_med``) and ``df``.
+    each searched bin (``noise``, NaN elsewhere), the degrees of freedom (``dof``; per bin ``dof_bin``,
+    ``dof_med``) and ``df``.
 
     Within :func:`remembering_spectra`, the passes of samples searched before (the same values, by a digest of
     their bytes) are read from memory: each call gets its own dicts (their arrays shared and read-only), the
@@ -236,10 +242,10 @@ def _peaks(ps: dict, alpha_bin: float) -> tuple[list[int], np.ndarray, np.ndarra
     ratio = np.full(ps["p"].size, -np.inf)
     ratio[ok] = ps["p"][ok] / ps["noise"][ok]
     thr = np.full(ps["p"].size, np.inf)
-    # the bins' median dof take a few values (one per neighbourhood width and count of bins used): the F quantile
-    # of each value once, the same numbers as per bin (≈ 7 ms a pass per 10⁴ bins otherwise)
-    dfd, at = np.unique(ps["dof_med"][ok], return_inverse=True)
-    thr[ok] = f_dist.isf(alpha_bin, ps["dof"], dfd)[at]
+    # the bins' dof pairs take a few values (one per neighbourhood width and count of bins used, per band where the
+    # segments differ): the F quantile of each pair once, the same numbers as per bin (≈ 7 ms a pass per 10⁴ bins)
+    pairs, at = np.unique(np.stack([ps["dof_bin"][ok], ps["dof_med"][ok]], axis=1), axis=0, return_inverse=True)
+    thr[ok] = f_dist.isf(alpha_bin, pairs[:, 0], pairs[:, 1])[at.ravel()]
     hits = np.flatnonzero(ratio > thr)
     peaks: list[int] = []
     for k in hits[np.argsort(-ratio[hits])]:
@@ -271,7 +277,7 @@ def find_lines(y: np.ndarray, fs: float, alpha: float, rounds: int = 4) -> dict:
         ok = np.isfinite(ps["noise"])
         if ok.any():
             r = ps["p"][ok] / ps["noise"][ok]
-            p_min = min(p_min, float(np.min(f_dist.sf(r, ps["dof"], ps["dof_med"][ok]))))
+            p_min = min(p_min, float(np.min(f_dist.sf(r, ps["dof_bin"][ok], ps["dof_med"][ok]))))
     masks = [np.zeros(ps["p"].size, dtype=bool) for ps in passes]
     found: list[list[int]] = [[] for _ in passes]
     for _ in range(rounds):
@@ -310,7 +316,7 @@ def _describe(ps: dict, k: int, ratio: float, thr: float, j: int) -> dict:
     # phase wanders spreads over more bins than the window's lobe), at most to the neighbourhood its noise level
     # came from
     lo, hi, reach = k - LOBE, k + LOBE, LOBE + int(np.clip(k // 2, *NEIGHBOURS))
-    above = noise * (1.0 + 2.0 * math.sqrt(2.0 / ps["dof"]))
+    above = noise * (1.0 + 2.0 * math.sqrt(2.0 / ps["dof_bin"][k]))
     while lo - 1 >= max(1, k - reach) and p[lo - 1] > above:
         lo -= 1
     while hi + 1 <= min(p.size - 2, k + reach) and p[hi + 1] > above:
@@ -319,7 +325,7 @@ def _describe(ps: dict, k: int, ratio: float, thr: float, j: int) -> dict:
     power = float(np.sum(np.maximum(lobe - noise, 0.0)) * df)
     # its SD: each Welch bin scatters by p·√(2/dof) (a line whose phase wanders scatters like the noise; the
     # bins of one lobe correlate: κ), the noise level under it by noise·√(2/dof_med)
-    var_p = ps["kappa"] * float(np.sum(lobe**2)) * 2.0 / ps["dof"] + (lobe.size * noise) ** 2 * 2.0 / float(
+    var_p = ps["kappa"] * float(np.sum(lobe**2)) * 2.0 / ps["dof_bin"][k] + (lobe.size * noise) ** 2 * 2.0 / float(
         ps["dof_med"][k]
     )
     amp = math.sqrt(2.0 * power)

@@ -200,7 +200,7 @@ def _ratio_at(passes: list[dict], f: np.ndarray) -> tuple[np.ndarray, np.ndarray
             r = np.where(ok, ps["p"][kk] / np.where(ok, nz, 1.0), -np.inf)
             better = r > ratio
             ratio = np.where(better, r, ratio)
-            dof = np.where(better, ps["dof"], dof)
+            dof = np.where(better, ps["dof_bin"][kk], dof)
             dof_med = np.where(better, ps["dof_med"][kk], dof_med)
     return ratio, dof, dof_med
 

@@ -26,7 +26,13 @@ its smallest value, in runs, but replaced as impulsive noise they are neither a 
   whose accelerometers have noise of 1.2–1.7 steps). Ties beyond 1.25× that prediction, with a Poisson
   probability at most the check's α, are said. Where the noise is below one step (n₂ < 20 while n₁ is not)
   the quantisation alone makes most ties: nothing can be told and nothing is said. Ties inside a clipped run
-  are the clipping's.
+  are the clipping's. A repeated sample ties with the one before, not with the one before that, while the
+  quantisation ties samples two apart at least as often as neighbours wherever successive samples are not
+  positively correlated: the null is the larger of the prediction and the ties at lag 2
+  (:func:`lag2_ties`). That is what a delta-angle counter's output needs (the angle quantised, the rate its
+  differences: Q-dominated, anti-correlated, a few levels): there the lattice's shape is not a smooth
+  density's (n₂ raised by the −1, +1 pairs the differencing makes), the log-quadratic predicts 0.55× the
+  ties, and the ties at lag 2 are 1.03× those at lag 1.
 """
 
 from __future__ import annotations
@@ -52,6 +58,7 @@ __all__ = [
     "quality_flags",
     "tie_counts",
     "expected_ties",
+    "lag2_ties",
     "MIN_COUNT",
     "HELD_MARGIN",
 ]
@@ -321,9 +328,27 @@ def expected_ties(n1: float, n2: float) -> float | None:
     return n1 * (n1 / n2) ** (1.0 / 3.0)
 
 
+def lag2_ties(y: np.ndarray, skip: np.ndarray | None = None) -> int:
+    """Samples equal to the one two before (y[i] == y[i − 2]), triples with ``skip`` True anywhere left out.
+
+    Examples
+    --------
+    >>> lag2_ties(np.array([0.0, 1.0, 0.0, 1.0, 2.0, 1.0]))
+    3
+    """
+    y = np.asarray(y, dtype=np.float64)
+    if y.size < 3:
+        return 0
+    eq = y[2:] == y[:-2]
+    if skip is not None and skip.any():
+        eq &= ~(skip[2:] | skip[1:-1] | skip[:-2])
+    return int(np.count_nonzero(eq))
+
+
 def held_check(ctx: MissingContext, a: float) -> list[dict]:
-    """Consecutive equal samples beyond what the quantisation predicts (:func:`expected_ties`, ×
-    :data:`HELD_MARGIN`), at a Poisson probability ≤ ``a``; samples at a clipped rail left out."""
+    """Consecutive equal samples beyond what the quantisation predicts (the larger of :func:`expected_ties`
+    and :func:`lag2_ties`, × :data:`HELD_MARGIN`), at a Poisson probability ≤ ``a``; samples at a clipped rail
+    left out."""
     y = ctx.samples
     if y is None or y.size < 3:
         return []
@@ -340,6 +365,7 @@ def held_check(ctx: MissingContext, a: float) -> list[dict]:
     exp = expected_ties(c["n1"], c["n2"])
     if exp is None or c["n0"] < 10:
         return []
+    exp = max(exp, float(lag2_ties(y, skip)))  # quantisation ties at every lag; a repeat at lag 1 only
     null = HELD_MARGIN * max(exp, 0.5)
     thr = float(poisson.isf(a, null)) + 1
     if not c["n0"] >= thr:
