@@ -18,6 +18,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+from ._cli_columns import gyro_columns
 from ._cli_options import (
     DESCRIPTION,
     EPILOG,
@@ -283,58 +284,6 @@ def _channel_specs(args, columns):
             "a channel the axes are regressed on (--channels), once"
         )
     return specs
-
-
-#: Column names that say "gyro" and "accelerometer" (case-insensitive): gyro_x, omega_y, angular_velocity.z,
-#: wx / gx; acc_x, accel_y, specific_force_z, ax.
-_GYRO_NAME = re.compile(r"gyr|omega|angular|ang_?vel|^[wg]_?[xyz]$", re.IGNORECASE)
-_ACCEL_NAME = re.compile(r"acc|specific_?force|^a_?[xyz]$", re.IGNORECASE)
-
-
-def gyro_columns(log):
-    """Without --columns: a log with accelerometer columns beside others is analysed on the columns its
-    header names as gyro ones (with a note); when it names none, the user is asked (a usage error that
-    lists the columns). A log without accelerometer-named columns is analysed whole, as before. ``allanite
-    report`` and ``allanite batch`` (:func:`allanite.dask.fleet.run_one`) both choose so."""
-    names = [str(c) for c in log.columns]
-    by_unit = _gyro_by_unit(log)
-    if by_unit is not None:
-        return by_unit
-    accel = [n for n in names if _ACCEL_NAME.search(n)]
-    if not accel or len(accel) == len(names):
-        return log, None
-    gyro = [i for i, n in enumerate(names) if _GYRO_NAME.search(n) and not _ACCEL_NAME.search(n)]
-    if not gyro:
-        raise UsageError(
-            f"{log.path.name} has accelerometer columns ({', '.join(accel)}) beside others, and its header names "
-            f"none as a gyro: give the gyro's with --columns (the columns are: {', '.join(names)})"
-        )
-    chosen = [names[i] for i in gyro]
-    left = [n for n in names if n not in chosen]
-    note = (
-        f"columns {', '.join(chosen)} analysed, chosen by their names (gyro); left out: {', '.join(left)} — "
-        "give --columns to choose others (and --accel-columns with --kalibr for the accelerometer)"
-    )
-    return log.take(chosen if len(gyro) > 1 else chosen[0]), note
-
-
-def _gyro_by_unit(log):
-    """(the log on its gyro columns, the note) where the units the column names give set a gyro's rate columns
-    beside an accelerometer's or others (EuRoC's ``w_RS_S_x [rad s^-1]`` … ``a_RS_S_x [m s^-2]``): the report
-    gives the gyro's in IEEE-952 units; None where the names give no rate unit, or only rate units."""
-    units = log.column_units or [None] * len(log.columns)
-    rate = [str(c) for c, cu in zip(log.columns, units) if cu is not None and cu.kind == "rate"]
-    if not rate or len(rate) == len(log.columns):
-        return None
-    left = [f"{c} ({cu.name if cu is not None else 'no unit'})" for c, cu in zip(log.columns, units) if c not in rate]
-    gyro = log.take(rate if len(rate) > 1 else rate[0])
-    said = gyro.unit.name if gyro.unit is not None else "several units"
-    note = (
-        f"columns {', '.join(rate)} analysed, chosen by the rate unit their names give ({said}); left out: "
-        f"{', '.join(left)} — give --columns to analyse others (an accelerometer's in its own unit; "
-        "--accel-columns with --kalibr writes its noise in SI)"
-    )
-    return gyro, note
 
 
 def _kalibr(args, rep, progress) -> Path:
