@@ -58,3 +58,39 @@ def _gyro_by_unit(log):
         "--accel-columns with --kalibr writes its noise in SI)"
     )
     return gyro, note
+
+
+#: Where ``allanite report`` writes an accelerometer's report of its own, inside --out.
+ACCEL_FOLDER = "accelerometer"
+
+
+def accel_columns(log):
+    """The log on its accelerometer's columns where their names all give the same accelerometer unit beside a
+    gyro's rate columns (EuRoC and TUM-VI: ``a_RS_S_x [m s^-2]`` beside ``w_RS_S_x [rad s^-1]``), analysed in a
+    report of their own in that unit; else None — names without units (the ADIS16405's ``acc_x``), or
+    accelerometer columns in several units, leave them out as before."""
+    units = log.column_units or [None] * len(log.columns)
+    rate = [c for c, cu in zip(log.columns, units) if cu is not None and cu.kind == "rate"]
+    acc = [str(c) for c, cu in zip(log.columns, units) if cu is not None and cu.kind == "acceleration"]
+    if not rate or not acc or len({cu.name for cu in units if cu is not None and cu.kind == "acceleration"}) > 1:
+        return None
+    return log.take(acc if len(acc) > 1 else acc[0])
+
+
+def sensor_columns(log):
+    """(the gyro's log, the accelerometer's log or None, the note or None) of a log read without --columns: the
+    gyro's columns as :func:`gyro_columns` chooses them and, where the names give a gyro's and an accelerometer's
+    units (:func:`accel_columns`), the accelerometer's for a report of their own in ``ACCEL_FOLDER``."""
+    accel = accel_columns(log)
+    gyro, note = gyro_columns(log)
+    if accel is None:
+        return gyro, None, note
+    taken = {str(c) for c in (*gyro.columns, *accel.columns)}
+    left = [str(c) for c in log.columns if str(c) not in taken]
+    note = (
+        f"columns {', '.join(map(str, gyro.columns))} analysed in {gyro.unit.name if gyro.unit else 'their unit'}, "
+        f"and the accelerometer's {', '.join(map(str, accel.columns))} in {accel.column_units[0].name} in a report "
+        f"of their own ({ACCEL_FOLDER}/report.html), each chosen by the unit its name gives"
+        + (f"; left out: {', '.join(left)} — give --columns to analyse others" if left else "")
+    )
+    return gyro, accel, note

@@ -18,7 +18,8 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-from ._cli_columns import gyro_columns
+from ._cli_columns import ACCEL_FOLDER, sensor_columns
+from ._cli_columns import gyro_columns as gyro_columns  # allanite.cli.gyro_columns, as before the move
 from ._cli_options import (
     DESCRIPTION,
     EPILOG,
@@ -230,8 +231,9 @@ def _time_column(args):
 
 
 def _read(args, progress):
-    """The log, the reading's notes and its channels (``Log.channels``: those --channels names, else the columns
-    recognised as a temperature by their names; None without any)."""
+    """The log, the reading's notes, its channels (``Log.channels``: those --channels names, else the columns
+    recognised as a temperature by their names; None without any) and, without --columns, the log on its
+    accelerometer's columns where their names give its unit beside a gyro's (:func:`sensor_columns`), else None."""
     path = Path(args.log)
     if not path.exists():
         raise AllaniteError(f"{path}: no such file")
@@ -254,10 +256,11 @@ def _read(args, progress):
             **kwargs,
         )
     notes = [" ".join(str(w.message).split()) for w in caught]
+    accel = None
     if columns is None:
-        log, note = gyro_columns(log)
+        log, accel, note = sensor_columns(log)
         notes += [note] if note else []
-    return log, notes, log.channels or None
+    return log, notes, log.channels or None, accel
 
 
 def _channel_specs(args, columns):
@@ -373,11 +376,14 @@ def _report(args) -> int:
                 split=args.split,
                 max_memory=args.max_memory,
             )
-            rep = _analysed_report(args, progress, common)
+            rep, accel = _analysed_report(args, progress, common)
             kalibr_path = _kalibr(args, rep, progress) if args.kalibr else None
             specs = rep.figure_specs()
             progress.expect(len(specs) + 1)
+            if accel is not None:  # the page links it, summary.json names it
+                rep.source["accelerometer_report"] = f"{ACCEL_FOLDER}/report.html"
             paths = rep.write(out, progress)
+            accel_rep, accel_paths = _accel_report(accel, progress, common, out)
     except KeyboardInterrupt:
         if not out_existed and out.is_dir():  # a folder this run made holds a half-written report at most
             shutil.rmtree(out, ignore_errors=True)
@@ -386,8 +392,19 @@ def _report(args) -> int:
         close_figure_worker()
         progress.close()
     if not quiet:
-        _print_written(rep, paths, out, kalibr_path, t0)
+        _print_written(rep, paths, out, kalibr_path, t0, (accel_rep, accel_paths))
     return EXIT_OK
+
+
+def _accel_report(accel, progress, common: dict, out: Path) -> tuple:
+    """(the report, its files) of the accelerometer's columns (``accel``, a Log; None: (None, [])), written in
+    ``out/ACCEL_FOLDER`` with the options of the gyro's report — a figure process of its own where one helps."""
+    if accel is None:
+        return None, []
+    start_figure_worker()
+    arep = from_log(accel, notes=[], **common)
+    progress.expect(len(arep.figure_specs()) + 1)
+    return arep, arep.write(out / ACCEL_FOLDER, progress)
 
 
 def _check_log_options(args) -> None:
@@ -402,7 +419,8 @@ def _check_log_options(args) -> None:
 
 
 def _analysed_report(args, progress, common: dict):
-    """The report of the bundled record, or of LOG read with its notes (warned of unless --quiet)."""
+    """(the report, None) of the bundled record, or (the report of LOG read with its notes (warned of unless
+    --quiet), the log on its accelerometer's columns or None: :func:`_read`)."""
     if args.log is None:
         progress.step("generating the bundled record")
         x, fs, info = default_record()
@@ -410,24 +428,32 @@ def _analysed_report(args, progress, common: dict):
             "name": "bundled record",
             **{k: (list(v) if isinstance(v, tuple) else v) for k, v in info.items()},
         }
-        return build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common)
-    log, notes, _ = _read(args, progress)
+        return build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common), None
+    log, notes, _, accel = _read(args, progress)
     if args.kalibr and log.unit is None:
         raise UsageError(_KALIBR_NEEDS_UNIT)
     if not args.quiet:
         for note in notes:
             progress.bar.write(f"allanite: warning: {note}", file=sys.stderr)
-    return from_log(log, notes=notes, **common)  # with the log's channels (report._channels)
+    return from_log(log, notes=notes, **common), accel  # with the log's channels (report._channels)
 
 
-def _print_written(rep, paths, out: Path, kalibr_path, t0: float) -> None:
-    """The console's summary of the report and the files written, and the run's time since ``t0``."""
+def _print_written(rep, paths, out: Path, kalibr_path, t0: float, accel=(None, [])) -> None:
+    """The console's summary of the report and the files written (and of the accelerometer's report, ``accel``:
+    (report, paths), where one was written), and the run's time since ``t0``."""
     print(rep.text())
+    if accel[0] is not None:
+        print(f"\n{accel[0].text()}")
     pngs = [p.name for p in paths[2:] if p.suffix == ".png"]
     print(f"\nwrote {paths[0]}\n      {paths[1]}\n      {len(pngs)} figures in {out}/: {', '.join(pngs)}")
     side = [p.name for p in paths[2:] if p.suffix != ".png"]
     if side:
         print(f"      per-window series in {out}/: {', '.join(side)} (named in summary.json)")
+    if accel[0] is not None:
+        apaths = accel[1]
+        n_png = sum(p.suffix == ".png" for p in apaths[2:])
+        print(f"      the accelerometer's report: {apaths[0]}\n      {apaths[1]}")
+        print(f"      {n_png} figures in {apaths[0].parent}/")
     if kalibr_path is not None:
         print(f"      {kalibr_path} (Kalibr)")
     print(f"in {time.perf_counter() - t0:.1f} s")
