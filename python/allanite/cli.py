@@ -231,9 +231,14 @@ def _time_column(args):
 
 
 def _read(args, progress):
-    """The log, the reading's notes, its channels (``Log.channels``: those --channels names, else the columns
-    recognised as a temperature by their names; None without any) and, without --columns, the log on its
-    accelerometer's columns where their names give its unit beside a gyro's (:func:`sensor_columns`), else None."""
+    """The log, the reading's notes and its channels (``Log.channels``: those --channels names, else the columns
+    recognised as a temperature by their names; None without any)."""
+    return _read_sensors(args, progress)[:3]
+
+
+def _read_sensors(args, progress):
+    """:func:`_read`'s log, notes and channels and, without --columns, the log on its accelerometer's columns where
+    their names give its unit beside a gyro's (:func:`sensor_columns`), else None."""
     path = Path(args.log)
     if not path.exists():
         raise AllaniteError(f"{path}: no such file")
@@ -429,7 +434,7 @@ def _analysed_report(args, progress, common: dict):
             **{k: (list(v) if isinstance(v, tuple) else v) for k, v in info.items()},
         }
         return build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common), None
-    log, notes, _, accel = _read(args, progress)
+    log, notes, _, accel = _read_sensors(args, progress)
     if args.kalibr and log.unit is None:
         raise UsageError(_KALIBR_NEEDS_UNIT)
     if not args.quiet:
