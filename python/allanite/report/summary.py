@@ -225,7 +225,8 @@ def summarize(rep) -> dict:
         "side_files": None if inline else side_files_entry(rep),
         "conventions": "times and τ in s (keys ending _s), fs in Hz; Allan deviations in adev_unit (the samples' "
         "rate unit); coefficients: value/ci in base form ('unit'), ieee/ieee_ci in IEEE-952 units "
-        "('ieee_unit'); intervals at 'confidence'; null = does not exist (unknown unit, unbounded "
+        "('ieee_unit'; an accelerometer's report, fit.sensor 'accelerometer': its units, m/s/√h, µg, m/s/h^1.5); "
+        "intervals at 'confidence'; null = does not exist (unknown unit, unbounded "
         "interval, read-off outside the τ range)",
     }
 
