@@ -125,11 +125,37 @@ def test_refine_runs_on_both(tmp_path, no_figures):
         assert ref is not None and len(ref["axes"]) == 1
 
 
+def _adis(path, n=4_000, n_acc=1e-4):
+    """The ADIS16405's layout (t, gyro_*, acc_*, no units in the names) at 100 Hz: the accelerometer's white
+    noise ``n_acc`` g·√s."""
+    rng = np.random.default_rng(5)
+    g, a = rng.normal(size=(n, 3)) * 0.01, rng.normal(size=(n, 3)) * n_acc * 10.0 + [0.0, 0.0, 1.0]
+    np.savetxt(path, np.c_[np.arange(n) / 100.0, g, a], delimiter=",", comments="", fmt="%.9g",
+               header="t,gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z")  # fmt: skip
+    return path
+
+
 def test_names_without_units_keep_the_gyro_alone(tmp_path):
-    """The ADIS16405's layout (gyro_*, acc_*, no units in the names): the gyro's columns only, as before."""
-    p = tmp_path / "adis.csv"
-    rows = np.c_[np.arange(400) / 100.0, np.random.default_rng(0).normal(size=(400, 6))]
-    np.savetxt(p, rows, delimiter=",", header="t,gyro_x,gyro_y,gyro_z,acc_x,acc_y,acc_z", comments="", fmt="%.6f")
-    gyro, accel, note = sensor_columns(read_log(p, time_column="t"))
-    assert accel is None and gyro.columns == ["gyro_x", "gyro_y", "gyro_z"]
-    assert note.startswith("columns gyro_x, gyro_y, gyro_z analysed, chosen by their names (gyro); left out: acc_x")
+    """Without a unit for each, the gyro's columns only, as before (an --accel-unit without the gyro's --unit too)."""
+    log = read_log(_adis(tmp_path / "adis.csv", n=400), time_column="t")
+    for accel_unit in (None, "g"):
+        gyro, accel, note = sensor_columns(log, accel_unit)
+        assert accel is None and gyro.columns == ["gyro_x", "gyro_y", "gyro_z"]
+        assert note.startswith("columns gyro_x, gyro_y, gyro_z analysed, chosen by their names (gyro); left out: acc_x")
+
+
+def test_a_unit_given_for_each_reports_both(tmp_path, capsys, no_figures):
+    p, out = _adis(tmp_path / "adis.csv"), tmp_path / "out"
+    argv = ["report", str(p), "--time-column", "t", "--unit", "deg/s", "--window", "1000", "--hop", "500"]
+    assert cli.main([*argv, "--accel-unit", "g", "-q", "--out", str(out)]) == 0
+    acc = json.loads((out / "accelerometer" / "summary.json").read_text())
+    assert acc["record"]["axis_names"] == ["acc_x", "acc_y", "acc_z"] and acc["record"]["accel_unit"] == "g"
+    assert acc["record"]["source"]["unit"] is None  # the gyro's --unit is not the accelerometer's
+    for ax in acc["fit"]["axes"]:
+        assert _inside(ax["coefficients"]["N"], 1e-4 * STANDARD_GRAVITY * 60.0), ax["coefficients"]["N"]
+    gyro = json.loads((out / "summary.json").read_text())
+    assert gyro["record"]["axis_names"] == ["gyro_x", "gyro_y", "gyro_z"] and gyro["unit"] == "deg/s"
+    assert "acc_x, acc_y, acc_z in g in a report of their own (accelerometer/report.html)" in gyro["notes"][0]
+    # the gyro's --unit alone: its report only, as before
+    assert cli.main([*argv, "-q", "--out", str(tmp_path / "one")]) == 0
+    assert not (tmp_path / "one" / "accelerometer").exists()

@@ -5,6 +5,7 @@ batch`` (:func:`allanite.dask.fleet.run_one`) both choose so."""
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 
 from ._cli_options import UsageError
 
@@ -77,20 +78,28 @@ def accel_columns(log):
     return log.take(acc if len(acc) > 1 else acc[0])
 
 
-def sensor_columns(log):
+def sensor_columns(log, accel_unit=None):
     """(the gyro's log, the accelerometer's log or None, the note or None) of a log read without --columns: the
-    gyro's columns as :func:`gyro_columns` chooses them and, where the names give a gyro's and an accelerometer's
-    units (:func:`accel_columns`), the accelerometer's for a report of their own in ``ACCEL_FOLDER``."""
+    gyro's columns as :func:`gyro_columns` chooses them and the accelerometer's for a report of their own in
+    ``ACCEL_FOLDER`` — where the names give a gyro's and an accelerometer's units (:func:`accel_columns`), or where
+    a unit is given for each (``accel_unit``, --accel-unit, beside the gyro's --unit) and the names tell the
+    accelerometer's columns from the gyro's (the ADIS16405's ``gyro_x`` … ``acc_x``: as before without it)."""
     accel = accel_columns(log)
     gyro, note = gyro_columns(log)
+    if accel is None and accel_unit is not None and gyro.unit is not None and gyro is not log:
+        named = [str(c) for c in log.columns if _ACCEL_NAME.search(str(c)) and c not in gyro.columns]
+        if named:  # the gyro's given unit is no accelerometer's: --accel-unit is theirs (from_log(unit=…))
+            accel = replace(log.take(named if len(named) > 1 else named[0]), unit=None, unit_source=None)
     if accel is None:
         return gyro, None, note
     taken = {str(c) for c in (*gyro.columns, *accel.columns)}
     left = [str(c) for c in log.columns if str(c) not in taken]
+    said = accel_unit or accel.column_units[0].name
     note = (
         f"columns {', '.join(map(str, gyro.columns))} analysed in {gyro.unit.name if gyro.unit else 'their unit'}, "
-        f"and the accelerometer's {', '.join(map(str, accel.columns))} in {accel.column_units[0].name} in a report "
-        f"of their own ({ACCEL_FOLDER}/report.html), each chosen by the unit its name gives"
+        f"and the accelerometer's {', '.join(map(str, accel.columns))} in {said} in a report of their own "
+        f"({ACCEL_FOLDER}/report.html), each chosen by "
+        + ("the unit its name gives" if accel_unit is None else "its name and given unit")
         + (f"; left out: {', '.join(left)} — give --columns to analyse others" if left else "")
     )
     return gyro, accel, note

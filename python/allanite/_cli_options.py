@@ -157,7 +157,8 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
         "--accel-unit",
         choices=ACCEL_UNITS,
         help="unit of the accelerometer columns (default: the one their names give, [g] or [m s^-2], else m/s^2; "
-        "g = 9.80665 m/s^2)",
+        "g = 9.80665 m/s^2); with --unit and without --columns, the columns named as an accelerometer's (acc_x, "
+        "...) are also reported in it, in DIR/accelerometer/",
     )
 
 

@@ -263,7 +263,7 @@ def _read_sensors(args, progress):
     notes = [" ".join(str(w.message).split()) for w in caught]
     accel = None
     if columns is None:
-        log, accel, note = sensor_columns(log)
+        log, accel, note = sensor_columns(log, args.accel_unit)
         notes += [note] if note else []
     return log, notes, log.channels or None, accel
 
@@ -388,7 +388,7 @@ def _report(args) -> int:
             if accel is not None:  # the page links it, summary.json names it
                 rep.source["accelerometer_report"] = f"{ACCEL_FOLDER}/report.html"
             paths = rep.write(out, progress)
-            accel_rep, accel_paths = _accel_report(accel, progress, common, out)
+            accel_rep, accel_paths = _accel_report(accel, progress, dict(common, unit=args.accel_unit), out)
     except KeyboardInterrupt:
         if not out_existed and out.is_dir():  # a folder this run made holds a half-written report at most
             shutil.rmtree(out, ignore_errors=True)
@@ -407,6 +407,8 @@ def _accel_report(accel, progress, common: dict, out: Path) -> tuple:
     if accel is None:
         return None, []
     start_figure_worker()
+    if common.get("unit") is None:  # the accelerometer's unit from its columns' names
+        common = {k: v for k, v in common.items() if k != "unit"}
     arep = from_log(accel, notes=[], **common)
     progress.expect(len(arep.figure_specs()) + 1)
     return arep, arep.write(out / ACCEL_FOLDER, progress)
