@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -16,6 +17,7 @@ from allanite._cli_columns import sensor_columns
 from allanite.errors import ParameterError
 from allanite.io import read_log
 from allanite.report import build_report
+from allanite.report.build import log_accel_unit
 from allanite.report.result import Report
 from allanite.units import STANDARD_GRAVITY, accel_report_unit
 
@@ -159,3 +161,12 @@ def test_a_unit_given_for_each_reports_both(tmp_path, capsys, no_figures):
     # the gyro's --unit alone: its report only, as before
     assert cli.main([*argv, "-q", "--out", str(tmp_path / "one")]) == 0
     assert not (tmp_path / "one" / "accelerometer").exists()
+
+
+def test_a_given_gyro_unit_is_not_the_accelerometers(tmp_path):
+    """--unit rad/s on an EuRoC log is the gyro's: the accelerometer's columns keep the m/s² their names give."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the header names m/s^2 for the a_ columns: said by read_log
+        log = read_log(_euroc(tmp_path / "imu0.csv", n=400), unit="rad/s")
+    gyro, accel, _ = sensor_columns(log)
+    assert gyro.unit.name == "rad/s" and accel.unit is None and log_accel_unit(accel) == "m/s^2"

@@ -75,7 +75,8 @@ def accel_columns(log):
     acc = [str(c) for c, cu in zip(log.columns, units) if cu is not None and cu.kind == "acceleration"]
     if not rate or not acc or len({cu.name for cu in units if cu is not None and cu.kind == "acceleration"}) > 1:
         return None
-    return log.take(acc if len(acc) > 1 else acc[0])
+    # a --unit given is the gyro's (Log.take keeps a given unit): the accelerometer's is the one its names give
+    return replace(log.take(acc if len(acc) > 1 else acc[0]), unit=None, unit_source=None)
 
 
 def sensor_columns(log, accel_unit=None):
