@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import warnings
 
 import numpy as np
@@ -170,3 +171,15 @@ def test_a_given_gyro_unit_is_not_the_accelerometers(tmp_path):
         log = read_log(_euroc(tmp_path / "imu0.csv", n=400), unit="rad/s")
     gyro, accel, _ = sensor_columns(log)
     assert gyro.unit.name == "rad/s" and accel.unit is None and log_accel_unit(accel) == "m/s^2"
+
+
+def test_kalibr_takes_the_accelerometer_report_fits(tmp_path, no_figures):
+    """--kalibr on an EuRoC log: imu.yaml's accelerometer noise from the accelerometer's report (no --accel-columns)."""
+    log, out, yml = _euroc(tmp_path / "imu0.csv"), tmp_path / "out", tmp_path / "imu.yaml"
+    argv = ["report", str(log), "--window", "1200", "--hop", "600", "--kalibr", str(yml), "-q", "--out", str(out)]
+    assert cli.main(argv) == 0
+    text = yml.read_text()
+    density = float(re.search(r"accelerometer_noise_density: ([0-9.e+-]+)", text).group(1))  # m/s²/√Hz
+    gyro_density = float(re.search(r"gyroscope_noise_density: ([0-9.e+-]+)", text).group(1))  # rad/s/√Hz
+    assert density == pytest.approx(N_ACC, rel=0.05) and gyro_density == pytest.approx(N_GYRO, rel=0.05)
+    assert (out / "accelerometer" / "summary.json").exists()

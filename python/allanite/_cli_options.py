@@ -151,7 +151,8 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
         "--accel-columns",
         metavar="C1,C2,...",
         help="accelerometer columns of the same log, for --kalibr (fitted like the gyro, written as "
-        "accelerometer_noise_density and accelerometer_random_walk)",
+        "accelerometer_noise_density and accelerometer_random_walk; default: the accelerometer report's fits, "
+        "where one is written in DIR/accelerometer/)",
     )
     inp.add_argument(
         "--accel-unit",

@@ -294,16 +294,25 @@ def _channel_specs(args, columns):
     return specs
 
 
-def _kalibr(args, rep, progress) -> Path:
-    """imu.yaml from the report's gyro fits and, with --accel-columns, the accelerometer's."""
+def _kalibr_ready(args, rep) -> None:
+    """What --kalibr needs of the gyro's report (its unit, its fits) and of the options, checked before any file is
+    written."""
     if rep.unit is None:
         raise UsageError(_KALIBR_NEEDS_UNIT)
     if rep.fits is None:
         raise AllaniteError(f"--kalibr needs the noise-model fit: {rep.fit_error or 'drop --no-fit'}")
     if args.accel_columns is not None and args.log is None:
         raise UsageError("--accel-columns describes a LOG file; the bundled record has no accelerometer")
+
+
+def _kalibr(args, rep, progress, accel_rep=None) -> Path:
+    """imu.yaml from the report's gyro fits and, with --accel-columns, the accelerometer's — else those of the
+    accelerometer's report (``accel_rep``, written beside the gyro's) where there is one."""
+    _kalibr_ready(args, rep)
     accel = None
-    if args.accel_columns is not None:
+    if args.accel_columns is None and accel_rep is not None:
+        accel, named = accel_rep.fits, {accel_rep.accel_unit}
+    elif args.accel_columns is not None:
         progress.step("accelerometer fit")
         kwargs = {} if args.time_unit is None else {"time_unit": args.time_unit}
         with warnings.catch_warnings():
@@ -382,13 +391,17 @@ def _report(args) -> int:
                 max_memory=args.max_memory,
             )
             rep, accel = _analysed_report(args, progress, common)
-            kalibr_path = _kalibr(args, rep, progress) if args.kalibr else None
+            if args.kalibr:  # imu.yaml now, or with the accelerometer's report's fits once it is written
+                _kalibr_ready(args, rep)
+            kalibr_path = _kalibr(args, rep, progress) if args.kalibr and accel is None else None
             specs = rep.figure_specs()
             progress.expect(len(specs) + 1)
             if accel is not None:  # the page links it, summary.json names it
                 rep.source["accelerometer_report"] = f"{ACCEL_FOLDER}/report.html"
             paths = rep.write(out, progress)
             accel_rep, accel_paths = _accel_report(accel, progress, dict(common, unit=args.accel_unit), out)
+            if args.kalibr and accel_rep is not None:
+                kalibr_path = _kalibr(args, rep, progress, accel_rep)
     except KeyboardInterrupt:
         if not out_existed and out.is_dir():  # a folder this run made holds a half-written report at most
             shutil.rmtree(out, ignore_errors=True)
