@@ -111,7 +111,8 @@ def test_report_writes_the_gyro_and_the_accelerometer_each_in_its_unit(tmp_path,
         assert n["ieee_unit"] == "m/s/√h" and _inside(n, N_ACC * 60.0), n
         assert ax["coefficients"]["B"]["ieee_unit"] == "µg"
     assert 'href="accelerometer/report.html"' in (out / "report.html").read_text()
-    assert "m/s^2 (an accelerometer" in (out / "accelerometer" / "report.html").read_text()  # ' escaped
+    page = (out / "accelerometer" / "report.html").read_text()
+    assert "m/s^2 (an accelerometer" in page and 'href="../report.html"' in page  # ' escaped; the gyro's linked
     # the console: both summaries, both reports listed
     assert "unit rad/s, rate input" in console and "unit m/s^2 (an accelerometer's), rate input" in console
     assert f"wrote {out / 'report.html'}" in console

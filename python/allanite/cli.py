@@ -423,6 +423,7 @@ def _accel_report(accel, progress, common: dict, out: Path) -> tuple:
     if common.get("unit") is None:  # the accelerometer's unit from its columns' names
         common = {k: v for k, v in common.items() if k != "unit"}
     arep = from_log(accel, notes=[], **common)
+    arep.source["gyro_report"] = "../report.html"  # its page links the gyro's, as the gyro's links it
     progress.expect(len(arep.figure_specs()) + 1)
     return arep, arep.write(out / ACCEL_FOLDER, progress)
 

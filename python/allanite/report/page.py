@@ -411,6 +411,7 @@ def page_context(rep: Any) -> dict:
         "notes": s["notes"],
         # allanite report's accelerometer report beside this one (cli: its folder, relative to this page)
         "accel_report": rec["source"].get("accelerometer_report"),
+        "gyro_report": rec["source"].get("gyro_report"),  # and on the accelerometer's page, the gyro's
         "adev_unit": au,
         "axes": list(range(len(names))),
         "axis_names": names,
