@@ -13,7 +13,7 @@ a tangle. The layers, bottom up (a module may import only from its own layer or 
                                            the allantools-compatible front door (whose opt-in alias
                                            install_as_allantools alone may write sys.modules)
     6  report.*
-    7  cli, __main__, __init__, dask.*     allanite.dask: arrays larger than memory, fleets (never imported by allanite)
+    7  cli, _cli_*, __main__, __init__, dask.* allanite.dask: arrays larger than memory, fleets (never imported by allanite)
 """
 
 from __future__ import annotations
@@ -54,6 +54,7 @@ LAYERS = {
     "report": 6,
     "cli": 7,
     "_cli_options": 7,
+    "_cli_columns": 7,
     "dask": 7,
     "__main__": 7,
     "__init__": 7,

@@ -49,6 +49,7 @@ examples:
   allanite report gyro.csv --time-column t --unit rad/s --gaps longest --out results/
   allanite report gyro.npy --fs 200 --window 60000 --hop 2000 --taus exp --quiet
   allanite report flight.bag                      # ROS 1 bag: sensor_msgs/Imu, rad/s
+  allanite report imu0.csv                        # EuRoC: the accelerometer in DIR/accelerometer/
   allanite report imu.npy --fs 500 --frames 20 --forecast 60:30   # paper 004: GM(1,1) forecasts
   allanite report acc.npy --fs 100 --refine-candidates bandwidth,drift   # refine trying 2 effects
   allanite report log.csv --fs 10 --columns g_x,g_y --unit deg/s --channels temp
@@ -66,6 +67,8 @@ files written to DIR:
   refinement_axisK.png     axis K (--refine): starting and refined model, residuals before/after
   frames_axisK.png         axis K (--frames/--forecast): coefficients per frame with intervals
   forecast_axisK.png       axis K (--frames/--forecast): forecasts of the resolved coefficients
+  accelerometer/           a log's accelerometer columns, where their names give its unit beside a
+                           gyro's: the same files, VRW in m/s/sqrt(h), bias instability in ug
 
 A progress bar goes to stderr when it is a terminal; when stdout is not one (a pipe, a log file),
 each step is also printed there as it starts. --quiet prints nothing but errors.
@@ -104,7 +107,9 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
         metavar="C1,C2,...",
         help="columns that are the samples, by name or 0-based index, comma-separated; one per "
         "axis (default: every column but the time column — or, when the header also names "
-        "accelerometer columns (acc_x, ...), the ones it names as gyro (gyro_x, ...))",
+        "accelerometer columns (acc_x, ...), the ones it names as gyro (gyro_x, ...); when the names give a gyro's "
+        "and an accelerometer's units (w_RS_S_x [rad s^-1], a_RS_S_x [m s^-2]), each in its own report: the "
+        "accelerometer's in DIR/accelerometer/)",
     )
     inp.add_argument("--time-column", metavar="C", help="column of sample times: derives --fs, finds gaps")
     inp.add_argument(
@@ -146,13 +151,15 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
         "--accel-columns",
         metavar="C1,C2,...",
         help="accelerometer columns of the same log, for --kalibr (fitted like the gyro, written as "
-        "accelerometer_noise_density and accelerometer_random_walk)",
+        "accelerometer_noise_density and accelerometer_random_walk; default: the accelerometer report's fits, "
+        "where one is written in DIR/accelerometer/)",
     )
     inp.add_argument(
         "--accel-unit",
         choices=ACCEL_UNITS,
         help="unit of the accelerometer columns (default: the one their names give, [g] or [m s^-2], else m/s^2; "
-        "g = 9.80665 m/s^2)",
+        "g = 9.80665 m/s^2); with --unit and without --columns, the columns named as an accelerometer's (acc_x, "
+        "...) are also reported in it, in DIR/accelerometer/",
     )
 
 

@@ -18,6 +18,8 @@ import warnings
 from pathlib import Path
 from typing import Any
 
+from ._cli_columns import ACCEL_FOLDER, sensor_columns
+from ._cli_columns import gyro_columns as gyro_columns  # allanite.cli.gyro_columns, as before the move
 from ._cli_options import (
     DESCRIPTION,
     EPILOG,
@@ -231,6 +233,12 @@ def _time_column(args):
 def _read(args, progress):
     """The log, the reading's notes and its channels (``Log.channels``: those --channels names, else the columns
     recognised as a temperature by their names; None without any)."""
+    return _read_sensors(args, progress)[:3]
+
+
+def _read_sensors(args, progress):
+    """:func:`_read`'s log, notes and channels and, without --columns, the log on its accelerometer's columns where
+    their names give its unit beside a gyro's (:func:`sensor_columns`), else None."""
     path = Path(args.log)
     if not path.exists():
         raise AllaniteError(f"{path}: no such file")
@@ -253,10 +261,11 @@ def _read(args, progress):
             **kwargs,
         )
     notes = [" ".join(str(w.message).split()) for w in caught]
+    accel = None
     if columns is None:
-        log, note = gyro_columns(log)
+        log, accel, note = sensor_columns(log, args.accel_unit)
         notes += [note] if note else []
-    return log, notes, log.channels or None
+    return log, notes, log.channels or None, accel
 
 
 def _channel_specs(args, columns):
@@ -285,68 +294,25 @@ def _channel_specs(args, columns):
     return specs
 
 
-#: Column names that say "gyro" and "accelerometer" (case-insensitive): gyro_x, omega_y, angular_velocity.z,
-#: wx / gx; acc_x, accel_y, specific_force_z, ax.
-_GYRO_NAME = re.compile(r"gyr|omega|angular|ang_?vel|^[wg]_?[xyz]$", re.IGNORECASE)
-_ACCEL_NAME = re.compile(r"acc|specific_?force|^a_?[xyz]$", re.IGNORECASE)
-
-
-def gyro_columns(log):
-    """Without --columns: a log with accelerometer columns beside others is analysed on the columns its
-    header names as gyro ones (with a note); when it names none, the user is asked (a usage error that
-    lists the columns). A log without accelerometer-named columns is analysed whole, as before. ``allanite
-    report`` and ``allanite batch`` (:func:`allanite.dask.fleet.run_one`) both choose so."""
-    names = [str(c) for c in log.columns]
-    by_unit = _gyro_by_unit(log)
-    if by_unit is not None:
-        return by_unit
-    accel = [n for n in names if _ACCEL_NAME.search(n)]
-    if not accel or len(accel) == len(names):
-        return log, None
-    gyro = [i for i, n in enumerate(names) if _GYRO_NAME.search(n) and not _ACCEL_NAME.search(n)]
-    if not gyro:
-        raise UsageError(
-            f"{log.path.name} has accelerometer columns ({', '.join(accel)}) beside others, and its header names "
-            f"none as a gyro: give the gyro's with --columns (the columns are: {', '.join(names)})"
-        )
-    chosen = [names[i] for i in gyro]
-    left = [n for n in names if n not in chosen]
-    note = (
-        f"columns {', '.join(chosen)} analysed, chosen by their names (gyro); left out: {', '.join(left)} — "
-        "give --columns to choose others (and --accel-columns with --kalibr for the accelerometer)"
-    )
-    return log.take(chosen if len(gyro) > 1 else chosen[0]), note
-
-
-def _gyro_by_unit(log):
-    """(the log on its gyro columns, the note) where the units the column names give set a gyro's rate columns
-    beside an accelerometer's or others (EuRoC's ``w_RS_S_x [rad s^-1]`` … ``a_RS_S_x [m s^-2]``): the report
-    gives the gyro's in IEEE-952 units; None where the names give no rate unit, or only rate units."""
-    units = log.column_units or [None] * len(log.columns)
-    rate = [str(c) for c, cu in zip(log.columns, units) if cu is not None and cu.kind == "rate"]
-    if not rate or len(rate) == len(log.columns):
-        return None
-    left = [f"{c} ({cu.name if cu is not None else 'no unit'})" for c, cu in zip(log.columns, units) if c not in rate]
-    gyro = log.take(rate if len(rate) > 1 else rate[0])
-    said = gyro.unit.name if gyro.unit is not None else "several units"
-    note = (
-        f"columns {', '.join(rate)} analysed, chosen by the rate unit their names give ({said}); left out: "
-        f"{', '.join(left)} — give --columns to analyse others (an accelerometer's in its own unit; "
-        "--accel-columns with --kalibr writes its noise in SI)"
-    )
-    return gyro, note
-
-
-def _kalibr(args, rep, progress) -> Path:
-    """imu.yaml from the report's gyro fits and, with --accel-columns, the accelerometer's."""
+def _kalibr_ready(args, rep) -> None:
+    """What --kalibr needs of the gyro's report (its unit, its fits) and of the options, checked before any file is
+    written."""
     if rep.unit is None:
         raise UsageError(_KALIBR_NEEDS_UNIT)
     if rep.fits is None:
         raise AllaniteError(f"--kalibr needs the noise-model fit: {rep.fit_error or 'drop --no-fit'}")
     if args.accel_columns is not None and args.log is None:
         raise UsageError("--accel-columns describes a LOG file; the bundled record has no accelerometer")
+
+
+def _kalibr(args, rep, progress, accel_rep=None) -> Path:
+    """imu.yaml from the report's gyro fits and, with --accel-columns, the accelerometer's — else those of the
+    accelerometer's report (``accel_rep``, written beside the gyro's) where there is one."""
+    _kalibr_ready(args, rep)
     accel = None
-    if args.accel_columns is not None:
+    if args.accel_columns is None and accel_rep is not None:
+        accel, named = accel_rep.fits, {accel_rep.accel_unit}
+    elif args.accel_columns is not None:
         progress.step("accelerometer fit")
         kwargs = {} if args.time_unit is None else {"time_unit": args.time_unit}
         with warnings.catch_warnings():
@@ -424,11 +390,18 @@ def _report(args) -> int:
                 split=args.split,
                 max_memory=args.max_memory,
             )
-            rep = _analysed_report(args, progress, common)
-            kalibr_path = _kalibr(args, rep, progress) if args.kalibr else None
+            rep, accel = _analysed_report(args, progress, common)
+            if args.kalibr:  # imu.yaml now, or with the accelerometer's report's fits once it is written
+                _kalibr_ready(args, rep)
+            kalibr_path = _kalibr(args, rep, progress) if args.kalibr and accel is None else None
             specs = rep.figure_specs()
             progress.expect(len(specs) + 1)
+            if accel is not None:  # the page links it, summary.json names it
+                rep.source["accelerometer_report"] = f"{ACCEL_FOLDER}/report.html"
             paths = rep.write(out, progress)
+            accel_rep, accel_paths = _accel_report(accel, progress, dict(common, unit=args.accel_unit), out)
+            if args.kalibr and accel_rep is not None:
+                kalibr_path = _kalibr(args, rep, progress, accel_rep)
     except KeyboardInterrupt:
         if not out_existed and out.is_dir():  # a folder this run made holds a half-written report at most
             shutil.rmtree(out, ignore_errors=True)
@@ -437,8 +410,22 @@ def _report(args) -> int:
         close_figure_worker()
         progress.close()
     if not quiet:
-        _print_written(rep, paths, out, kalibr_path, t0)
+        _print_written(rep, paths, out, kalibr_path, t0, (accel_rep, accel_paths))
     return EXIT_OK
+
+
+def _accel_report(accel, progress, common: dict, out: Path) -> tuple:
+    """(the report, its files) of the accelerometer's columns (``accel``, a Log; None: (None, [])), written in
+    ``out/ACCEL_FOLDER`` with the options of the gyro's report — a figure process of its own where one helps."""
+    if accel is None:
+        return None, []
+    start_figure_worker()
+    if common.get("unit") is None:  # the accelerometer's unit from its columns' names
+        common = {k: v for k, v in common.items() if k != "unit"}
+    arep = from_log(accel, notes=[], **common)
+    arep.source["gyro_report"] = "../report.html"  # its page links the gyro's, as the gyro's links it
+    progress.expect(len(arep.figure_specs()) + 1)
+    return arep, arep.write(out / ACCEL_FOLDER, progress)
 
 
 def _check_log_options(args) -> None:
@@ -453,7 +440,8 @@ def _check_log_options(args) -> None:
 
 
 def _analysed_report(args, progress, common: dict):
-    """The report of the bundled record, or of LOG read with its notes (warned of unless --quiet)."""
+    """(the report, None) of the bundled record, or (the report of LOG read with its notes (warned of unless
+    --quiet), the log on its accelerometer's columns or None: :func:`_read`)."""
     if args.log is None:
         progress.step("generating the bundled record")
         x, fs, info = default_record()
@@ -461,24 +449,32 @@ def _analysed_report(args, progress, common: dict):
             "name": "bundled record",
             **{k: (list(v) if isinstance(v, tuple) else v) for k, v in info.items()},
         }
-        return build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common)
-    log, notes, _ = _read(args, progress)
+        return build_report(x, fs, unit=info["unit"], axis_names=["x", "y", "z"], source=source, **common), None
+    log, notes, _, accel = _read_sensors(args, progress)
     if args.kalibr and log.unit is None:
         raise UsageError(_KALIBR_NEEDS_UNIT)
     if not args.quiet:
         for note in notes:
             progress.bar.write(f"allanite: warning: {note}", file=sys.stderr)
-    return from_log(log, notes=notes, **common)  # with the log's channels (report._channels)
+    return from_log(log, notes=notes, **common), accel  # with the log's channels (report._channels)
 
 
-def _print_written(rep, paths, out: Path, kalibr_path, t0: float) -> None:
-    """The console's summary of the report and the files written, and the run's time since ``t0``."""
+def _print_written(rep, paths, out: Path, kalibr_path, t0: float, accel=(None, [])) -> None:
+    """The console's summary of the report and the files written (and of the accelerometer's report, ``accel``:
+    (report, paths), where one was written), and the run's time since ``t0``."""
     print(rep.text())
+    if accel[0] is not None:
+        print(f"\n{accel[0].text()}")
     pngs = [p.name for p in paths[2:] if p.suffix == ".png"]
     print(f"\nwrote {paths[0]}\n      {paths[1]}\n      {len(pngs)} figures in {out}/: {', '.join(pngs)}")
     side = [p.name for p in paths[2:] if p.suffix != ".png"]
     if side:
         print(f"      per-window series in {out}/: {', '.join(side)} (named in summary.json)")
+    if accel[0] is not None:
+        apaths = accel[1]
+        n_png = sum(p.suffix == ".png" for p in apaths[2:])
+        print(f"      the accelerometer's report: {apaths[0]}\n      {apaths[1]}")
+        print(f"      {n_png} figures in {apaths[0].parent}/")
     if kalibr_path is not None:
         print(f"      {kalibr_path} (Kalibr)")
     print(f"in {time.perf_counter() - t0:.1f} s")

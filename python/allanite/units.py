@@ -49,6 +49,9 @@ __all__ = [
     "STANDARD_GRAVITY",
     "ACCEL_UNITS",
     "accel_factor",
+    "ACCEL_LABELS",
+    "ACCEL_TERMS",
+    "accel_report_unit",
 ]
 
 
@@ -402,6 +405,8 @@ _ACCEL = {
 
 #: Canonical names of the accepted accelerometer units.
 ACCEL_UNITS = tuple(_ACCEL)
+#: Typographic form of each accelerometer unit (plots and reports).
+ACCEL_LABELS = {"m/s^2": "m/s²", "mm/s^2": "mm/s²", "g": "g", "mg": "mg", "ug": "µg"}
 
 
 def accel_factor(unit: str) -> float:
@@ -417,3 +422,77 @@ def accel_factor(unit: str) -> float:
             if key == name or key in aliases:
                 return factor
     raise ParameterError(f"unknown accelerometer unit {unit!r}; allowed: {', '.join(ACCEL_UNITS)} (g = 9.80665 m/s²)")
+
+
+# term: (name, target unit → (label, factor from the base form in m/s² and seconds), default). The
+# accelerometer's names and report units (IEEE Std 1293 and datasheets): N a velocity random walk, B in µg,
+# K an acceleration random walk; the factors are the gyro's (√h = 60 √s) and g = 9.80665 m/s².
+_UG = 1e-6 * STANDARD_GRAVITY
+_ACCEL_TERMS = {
+    "Q": ("velocity quantization", {"m/s": ("m/s", 1.0), "mm/s": ("mm/s", 1e3)}, "m/s"),
+    "N": (
+        "velocity random walk",
+        {
+            "m/s/sqrt(h)": ("m/s/√h", _SQH),
+            "m/s/sqrt(s)": ("m/s/√s", 1.0),
+            "ug/sqrt(Hz)": ("µg/√Hz", 1.0 / _UG),
+        },
+        "m/s/sqrt(h)",
+    ),
+    "B": ("bias instability", {"ug": ("µg", 1.0 / _UG), "mg": ("mg", 1e-3 / _UG), "m/s^2": ("m/s²", 1.0)}, "ug"),
+    "K": (
+        "acceleration random walk",
+        {"m/s/h^1.5": ("m/s/h^1.5", 3600.0 * _SQH), "m/s^2.5": ("m/s^2.5", 1.0)},
+        "m/s/h^1.5",
+    ),
+    "R": ("acceleration ramp", {"m/s/h^2": ("m/s/h²", 3600.0**2), "m/s^3": ("m/s³", 1.0)}, "m/s/h^2"),
+}
+_ACCEL_ALIASES = {
+    **{t.lower(): t for t in _ACCEL_TERMS},
+    **{v[0].replace(" ", "_"): t for t, v in _ACCEL_TERMS.items()},
+    "vrw": "N",
+    "bi": "B",
+}
+#: The accelerometer's noise terms: name and the report units each accepts (first: the default).
+ACCEL_TERMS = {t: (v[0], tuple([v[2]] + [k for k in v[1] if k != v[2]])) for t, v in _ACCEL_TERMS.items()}
+
+
+def accel_report_unit(term, value, unit, *, to=None) -> Quantity:
+    """An accelerometer's noise coefficient converted from its samples' ``unit`` to a report unit: the
+    accelerometer's counterpart of :func:`ieee952`.
+
+    Parameters
+    ----------
+    term : {"Q", "N", "B", "K", "R"}
+        Velocity quantization, velocity random walk, bias instability, acceleration random walk, acceleration
+        ramp (the gyro's letters; also ``"vrw"``, ``"bias_instability"``, ``"acceleration_random_walk"``, …).
+    value : float or array_like
+        The coefficient in base form for samples in ``unit``: Q in unit·s, N in unit·√s, B in unit, K in
+        unit/√s, R in unit/s (τ in seconds) — what a fit of the accelerometer's σ²(τ) returns.
+    unit : str
+        The samples' accelerometer unit (one of :data:`ACCEL_UNITS`: ``"m/s^2"``, ``"g"``, ``"mg"``, …).
+    to : str, optional
+        Report unit; defaults: Q "m/s" (also "mm/s"), N "m/s/sqrt(h)" ("m/s/sqrt(s)", "ug/sqrt(Hz)"), B "ug"
+        ("mg", "m/s^2"), K "m/s/h^1.5" ("m/s^2.5"), R "m/s/h^2" ("m/s^3").
+
+    Examples
+    --------
+    >>> from allanite.units import accel_report_unit
+    >>> accel_report_unit("N", 0.001, "m/s^2")          # VRW 0.001 m/s/√s
+    Quantity(value=0.06, unit='m/s/√h')
+    >>> round(accel_report_unit("B", 2e-5, "g").value, 6)  # 20 µg
+    20.0
+    """
+    t = _ACCEL_ALIASES.get(term.lower()) if isinstance(term, str) else None
+    if t is None:
+        raise ParameterError(
+            f"unknown accelerometer noise term {term!r}; allowed: 'Q' (velocity quantization), 'N' (velocity "
+            "random walk), 'B' (bias instability), 'K' (acceleration random walk), 'R' (acceleration ramp)"
+        )
+    _, targets, default = _ACCEL_TERMS[t]
+    target = default if to is None else to
+    if target not in targets:
+        raise ParameterError(f"unknown report unit {to!r} for term {t}; allowed: {', '.join(ACCEL_TERMS[t][1])}")
+    label, factor = targets[target]
+    v = np.asarray(value, dtype=np.float64) * (accel_factor(unit) * factor)
+    return Quantity(float(v) if v.ndim == 0 else v, label)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.terms import TERM_NAMES
-from ..units import coefficient_unit, ieee952
+from ..units import ACCEL_TERMS, accel_report_unit, coefficient_unit, ieee952
 from .fmt import json_list, json_number
 from .settings import FIT_MODEL
 
@@ -20,7 +20,10 @@ def fit_dict(rep, inline: bool) -> dict:
         "requested": rep.fit_requested,
         "model": FIT_MODEL,
         "unit": rep.unit,
-        "unit_known": rep.unit is not None,
+        # "ieee"/"ieee_ci" hold IEEE-952 units for a gyro, the accelerometer's report units for an accelerometer
+        "unit_known": rep.unit is not None or rep.accel_unit is not None,
+        "sensor": "accelerometer" if rep.accel_unit is not None else "gyro",
+        "accel_unit": rep.accel_unit,
         "confidence": st.confidence if rep.fit_requested else None,
         "error": rep.fit_error,
         "axes": None,
@@ -51,7 +54,12 @@ def _fit_axis(rep, k: int, f) -> dict:
     return {
         "axis": k,
         "name": rep.axis_names[k],
-        "coefficients": {t: _coef_dict(f.coefficients[t], rep.unit, t) for t in f.terms},
+        "coefficients": {
+            t: _coef_dict(f.coefficients[t], rep.unit, t)
+            if rep.accel_unit is None
+            else _accel_coef_dict(f.coefficients[t], rep.accel_unit, t)
+            for t in f.terms
+        },
         "chi2": json_number(f.chi2),
         "dof": int(f.dof),
         "chi2_dof": json_number(f.chi2_dof),
@@ -60,7 +68,7 @@ def _fit_axis(rep, k: int, f) -> dict:
         "iterations": int(f.iterations),
         "method": f.method,
         "notes": list(f.notes),
-        "readoffs": _readoffs(f, rep.unit, rep.adev_unit),
+        "readoffs": _readoffs(f, rep.unit, rep.adev_unit, rep.accel_unit),
     }
 
 
@@ -87,7 +95,24 @@ def _coef_dict(c, unit, name) -> dict:
     return d
 
 
-def _readoffs(f, unit, adev_unit) -> dict:
+def _accel_coef_dict(c, unit: str, name: str) -> dict:
+    """An accelerometer's coefficient: base form in its ``unit`` and seconds, and in the accelerometer's report
+    units (:func:`allanite.units.accel_report_unit`) as ``ieee``/``ieee_ci``/``ieee_unit``."""
+    q = accel_report_unit(name, c.value, unit)
+    lo, hi = (accel_report_unit(name, v, unit).value for v in c.ci)
+    base = {"Q": f"({unit})·s", "N": f"({unit})·√s", "B": unit, "K": f"({unit})/√s", "R": f"({unit})/s"}
+    return {
+        "name": ACCEL_TERMS[name][0],
+        "value": json_number(c.value),
+        "ci": [json_number(c.ci[0]), json_number(c.ci[1])],
+        "unit": base[name],
+        "ieee": json_number(q.value),
+        "ieee_ci": [json_number(lo), json_number(hi)],
+        "ieee_unit": q.unit,
+    }
+
+
+def _readoffs(f, unit, adev_unit, accel_unit=None) -> dict:
     r = f.readoffs
     out = {
         "adev_at_1s": json_number(r["adev_at_1s"]),
@@ -103,6 +128,13 @@ def _readoffs(f, unit, adev_unit) -> dict:
         b_ro = ieee952("B", r["bias_instability_readoff"], unit)
         out["arw_readoff_ieee"] = None if n_ro is None else json_number(n_ro.value)
         out["arw_readoff_ieee_unit"] = ieee952("N", 1.0, unit).unit
+        out["bias_instability_readoff_ieee"] = json_number(b_ro.value)
+        out["bias_instability_readoff_ieee_unit"] = b_ro.unit
+    elif accel_unit is not None:
+        n_ro = accel_report_unit("N", r["adev_at_1s"], accel_unit) if r["adev_at_1s"] is not None else None
+        b_ro = accel_report_unit("B", r["bias_instability_readoff"], accel_unit)
+        out["arw_readoff_ieee"] = None if n_ro is None else json_number(n_ro.value)
+        out["arw_readoff_ieee_unit"] = accel_report_unit("N", 1.0, accel_unit).unit
         out["bias_instability_readoff_ieee"] = json_number(b_ro.value)
         out["bias_instability_readoff_ieee_unit"] = b_ro.unit
     return out

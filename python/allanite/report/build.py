@@ -39,7 +39,7 @@ from ..errors import AllaniteError, ParameterError
 from ..estimators import get as get_estimator
 from ..estimators.theo import resolve_decimation
 from ..model import fit as fit_model
-from ..units import parse_unit
+from ..units import ACCEL_UNITS, accel_factor, parse_unit
 from . import _worker
 from ._channels import check_channels, log_channels, rate_aligned
 from ._plan import memory_plan, octaves, window_and_hop
@@ -93,7 +93,11 @@ def build_report(
         Sampling rate, Hz.
     unit : str, optional
         Unit of the samples (a rate unit, or an angle unit for increments/angle). Without it the
-        numbers are in "the samples' unit" and the coefficients stay in base form.
+        numbers are in "the samples' unit" and the coefficients stay in base form. An accelerometer's unit
+        (:data:`allanite.units.ACCEL_UNITS`: ``"m/s^2"``, ``"g"``, ``"mg"``, …; rate input) makes the report
+        an accelerometer's: Allan deviations in it, the coefficients in base form (that unit and seconds) and in
+        the accelerometer's report units (:func:`allanite.units.accel_report_unit`: velocity random walk in
+        m/s/√h, bias instability in µg, acceleration random walk in m/s/h^1.5) — ``Report.accel_unit``.
     axis_names : list of str, optional
         One per axis (default "axis 0", "axis 1", …).
     source : dict, optional
@@ -156,7 +160,9 @@ def build_report(
         candidates = refine_candidates(True)
     channels = rate_aligned(channels, input)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
-    x, unit_name, axis_names = _axes_and_unit(x, unit, input, axis_names, notes)
+    accel_unit = accelerometer_unit(unit, input, notes)
+    # an accelerometer's unit is no gyro's: none for the gyro's conversions, and its own note (not "unknown")
+    x, unit_name, axis_names = _axes_and_unit(x, None if accel_unit else unit, input, axis_names, notes, accel_unit)
     taus = _check_taus(taus)
     check_choice(estimator, "estimator", tuple(REPORT_ESTIMATORS))
     static, dynamic, settings = _analyse(
@@ -197,6 +203,7 @@ def build_report(
         series=series,
         fs=float(static.fs),
         unit=unit_name,
+        accel_unit=accel_unit,
         input=input,
         axis_names=axis_names,
         source=dict(source or {}),
@@ -232,13 +239,41 @@ def _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete
         _worker.offer(partial, complete=complete)
 
 
-def _axes_and_unit(x, unit, input, axis_names, notes) -> tuple:
+def accelerometer_unit(unit, input, notes) -> str | None:
+    """The canonical name of ``unit`` where it is an accelerometer's (rate input; a note says what the report
+    then holds), else None (no unit, or a gyro's: :func:`_axes_and_unit` checks it)."""
+    if not isinstance(unit, str):
+        return None
+    try:
+        parse_unit(unit)
+        return None
+    except ParameterError:
+        pass
+    try:
+        factor = accel_factor(unit)
+    except ParameterError:
+        return None  # neither: _axes_and_unit's message lists the gyro's units, and says to give none
+    if input != "rate":
+        raise ParameterError(
+            f"unit {unit!r} is an accelerometer's, analysed as rate input only (input={input!r}); allowed "
+            "input: 'rate' (or give a gyro's angle unit)"
+        )
+    name = next(n for n in ACCEL_UNITS if accel_factor(n) == factor)
+    notes.append(
+        f"The samples are an accelerometer's, in {name}: Allan deviations in {name}, the noise coefficients in "
+        f"base form ({name} and seconds) and in the accelerometer's units — velocity random walk in m/s/√h, bias "
+        "instability in µg, acceleration random walk in m/s/h^1.5 (the gyro's terms N, B, K)."
+    )
+    return name
+
+
+def _axes_and_unit(x, unit, input, axis_names, notes, accel_unit=None) -> tuple:
     """(samples as (samples, axes), the unit's name or None, one name per axis), checked; a note when the unit
-    is unknown."""
+    is unknown (neither a gyro's nor ``accel_unit``)."""
     if x.ndim == 1:
         x = x[:, None]
     unit_name = None if unit is None else parse_unit(unit, kind="rate" if input == "rate" else "angle").name
-    if unit_name is None:
+    if unit_name is None and accel_unit is None:
         notes.append(
             "The unit of the samples is unknown (not given): Allan deviations are in the "
             "samples' own unit and the noise coefficients in base form, without IEEE-952 conversion."
@@ -378,12 +413,24 @@ def log_source(log) -> dict:
     return src
 
 
+def log_accel_unit(log) -> str | None:
+    """The accelerometer's unit every column's name gives (``a_RS_S_x [m s^-2]``, …: ``Log.take`` of that group),
+    else None — a log of rate input without a gyro unit whose columns all name the same acceleration unit."""
+    units = log.column_units or [None]
+    if log.unit is not None or log.input != "rate" or any(cu is None or cu.kind != "acceleration" for cu in units):
+        return None
+    names = {cu.name for cu in units}
+    return names.pop() if len(names) == 1 else None
+
+
 def _unit_notes(log) -> list:
     """The note on a unit the column names gave (``Log.unit_source``), or on the unit they give that is no gyro's
     (an accelerometer's m/s²: Allan deviations in it, the coefficients in base form)."""
     if log.unit is not None and (log.unit_source or "").startswith("from the column names"):
         return [f"The unit {log.unit.name} is the one the column names give ({log.unit_source[23:]})."]
     named = {cu.name for cu in log.column_units if cu is not None}
+    if log_accel_unit(log) is not None:
+        return []  # build_report's note says the report is an accelerometer's
     if log.unit is None and len(named) == 1:
         u = named.pop()
         return [f"The column names give the unit {u}, no gyro unit: the samples' own unit below is {u} (and seconds)."]
@@ -391,7 +438,8 @@ def _unit_notes(log) -> list:
 
 
 def from_log(log, **kwargs) -> Report:
-    """:func:`build_report` on a :class:`~allanite.Log` from :func:`allanite.read_log` (its unit,
+    """:func:`build_report` on a :class:`~allanite.Log` from :func:`allanite.read_log` (its unit — a gyro's, or
+    the accelerometer's its columns' names all give, as ``Log.take`` keeps one of ``Log.groups`` —, its
     input kind, column names and reading notes) and, without ``channels=``, its channels (``Log.channels``):
     those named in ``read_log(channels=[…])`` imply the refinement, as ``channels=`` does; those recognised as a
     temperature by their names are handed to the refinement only when ``refine=`` asks for one that tries the
@@ -423,7 +471,7 @@ def from_log(log, **kwargs) -> Report:
             "stamp is an epoch date (--time-unit / read_log(time_unit=…) overrides it)."
         )
     notes += _unit_notes(log) if "unit" not in kwargs else []
-    unit = kwargs.pop("unit", None) or (log.unit.name if log.unit is not None else None)
+    unit = kwargs.pop("unit", None) or (log.unit.name if log.unit is not None else log_accel_unit(log))
     if "channels" not in kwargs:  # the log's own: a temperature column recognised by its name, or those named
         kwargs["channels"] = log_channels(log, kwargs.get("refine", False), notes)
     used = kwargs["channels"]  # build_report checks it (a mapping of name → samples)

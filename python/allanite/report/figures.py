@@ -57,7 +57,7 @@ def _words(rep) -> dict:
 
 def _overview_spec(rep, words) -> tuple:
     """``adev.png``: the Allan deviation of every axis with its interval band and fitted model."""
-    st, unit, names = rep.static, rep.unit, rep.axis_names
+    st, unit, names = rep.static, rep.unit or rep.adev_unit, rep.axis_names  # an accelerometer's: its label
 
     def overview(fig):
         ax = fig.add_subplot()
@@ -92,7 +92,7 @@ def _davar_spec(rep, words) -> tuple:
     def davar_all(fig):
         axs = fig.subplots(rep.n_axes, 1, squeeze=False)
         for k in range(rep.n_axes):
-            plot_davar(dy, ax=axs[k, 0], axis=k, unit=rep.unit)
+            plot_davar(dy, ax=axs[k, 0], axis=k, unit=rep.unit or rep.adev_unit)
             axs[k, 0].set_title(f"{words['dynamic']}, {names[k]} ({window})")
         h = fig.get_figheight()
         fig.subplots_adjust(left=0.1, right=1.0, bottom=0.45 / h, top=1 - 0.35 / h, hspace=0.55)
@@ -106,7 +106,7 @@ def _davar_spec(rep, words) -> tuple:
 
 def _adev_axis_spec(rep, words, k: int) -> tuple:
     """``adev_axisK.png``: axis K's Allan deviation, its fitted model and each term."""
-    st, unit, names = rep.static, rep.unit, rep.axis_names
+    st, unit, names = rep.static, rep.unit or rep.adev_unit, rep.axis_names  # an accelerometer's: its label
 
     def adev_k(fig):
         ax = fig.add_subplot()
@@ -131,7 +131,7 @@ def _davar3d_spec(rep, words, k: int) -> tuple:
 
     def davar3d_k(fig):
         ax = fig.add_subplot(projection="3d")
-        plot_davar3d(rep.dynamic, ax=ax, axis=k, unit=rep.unit)
+        plot_davar3d(rep.dynamic, ax=ax, axis=k, unit=rep.unit or rep.adev_unit)
         ax.set_title(f"{name}: {words['dynamic_lower']}")
         fig.subplots_adjust(left=0.0, right=0.95, bottom=0.05, top=0.95)
 
@@ -209,7 +209,7 @@ def _refinement_specs(rep) -> list:
     on the Allan curve, and the normalised residuals before and after)."""
     if rep.refinements is None:
         return []
-    label = adev_unit_label(rep.unit) if rep.unit is not None else None
+    label = adev_unit_label(rep.unit) if rep.unit is not None else rep.adev_unit  # an accelerometer's, or None
     specs = []
     for k, r in enumerate(rep.refinements):
         if r is None:

@@ -56,7 +56,7 @@ def _record(rec: dict) -> dict:
         ("axes", f"{rec['axes']} ({', '.join(rec['axis_names'])})"),
         ("sampling rate", f"{rec['fs_hz']:g} Hz"),
         ("duration", f"{g(rec['duration_s'], 6)} s ({duration(rec['duration_s'])})"),
-        ("unit", rec["unit"] or "unknown"),
+        ("unit", rec["unit"] or (f"{rec['accel_unit']} (an accelerometer's)" if rec.get("accel_unit") else "unknown")),
         ("input", rec["input"]),
     ]
     for key, label in (
@@ -178,7 +178,10 @@ def _model(fit: dict, names: list, au: str) -> dict:
         "tables": tables,
         "goodness": _table([""] + names, good, left=1),
         "units_note": (
-            "Coefficients in IEEE-952 units; base form in the second table."
+            f"Coefficients in the accelerometer's units (samples in {fit['accel_unit']}: velocity random walk, bias "
+            "instability, acceleration random walk); base form in the second table."
+            if fit.get("sensor") == "accelerometer"
+            else "Coefficients in IEEE-952 units; base form in the second table."
             if ieee
             else "The unit is unknown, so coefficients are in base form (the samples' unit and seconds); "
             + CLOCK_TERMS
@@ -245,7 +248,7 @@ def _series(fit: dict, rec: dict) -> dict:
     return {
         "status": "fitted",
         "confidence": f"{ser['confidence']:.1%}",
-        "units_note": ", in IEEE-952 units" if fit["unit_known"] else " (base form)",
+        "units_note": ", in IEEE-952 units" if fit["unit"] else " (base form)",
         "table": _table(["axis", "term", "unit", "median", "min", "max", "windows resolved (> 0)"], rows, left=3),
     }
 
@@ -406,6 +409,9 @@ def page_context(rep: Any) -> dict:
         "css": _css(),
         "record": _record(rec),
         "notes": s["notes"],
+        # allanite report's accelerometer report beside this one (cli: its folder, relative to this page)
+        "accel_report": rec["source"].get("accelerometer_report"),
+        "gyro_report": rec["source"].get("gyro_report"),  # and on the accelerometer's page, the gyro's
         "adev_unit": au,
         "axes": list(range(len(names))),
         "axis_names": names,

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 from .._progress import StepBar
 from ..results import AllanResult, DynamicAllanResult
-from ..units import adev_unit_label
+from ..units import ACCEL_LABELS, adev_unit_label
 from . import _worker
 from .figures import figure_specs
 from .fmt import count
@@ -48,7 +48,10 @@ class Report:
     series : list of CoefficientSeries or None
         The coefficients fitted in every DAVAR window, per axis (``series_error`` when it failed).
     unit : str or None
-        Unit of the samples (canonical name, e.g. ``"deg/s"``); None when unknown.
+        Unit of the samples (canonical name, e.g. ``"deg/s"``); None when unknown or an accelerometer's.
+    accel_unit : str or None
+        The accelerometer's unit of the samples (e.g. ``"m/s^2"``, ``"g"``) where they are an accelerometer's
+        (``build_report(unit="m/s^2")``), else None.
     axis_names : list of str
     source : dict
         Where the record came from (JSON-able): path, format, columns, gaps, …
@@ -81,6 +84,7 @@ class Report:
     forecast_error: str | None = None
     #: the paper-002 sections (``taper=`` / ``split=``; :mod:`allanite.report.paper002`), else None
     paper002: dict | None = None
+    accel_unit: str | None = None
     _summary: dict | None = field(default=None, repr=False)
 
     # ---------------------------------------------------------------------------- properties
@@ -93,14 +97,15 @@ class Report:
     def adev_unit(self) -> str | None:
         """Label of the Allan deviation's unit (e.g. ``"°/s"``), None when the unit is unknown."""
         if self.unit is None:
-            return None
+            return None if self.accel_unit is None else ACCEL_LABELS[self.accel_unit]
         return adev_unit_label(self.unit)
 
     def __repr__(self) -> str:
         fit = "not fitted" if self.fits is None else f"{len(self.fits)} noise fits"
+        unit = self.unit or self.accel_unit or "unknown"
         return (
             f"Report({self.source.get('name', 'record')!r}: {self.static.n_samples} samples × "
-            f"{count(self.n_axes, 'axis', 'axes')} at {self.fs:g} Hz, unit {self.unit or 'unknown'}; "
+            f"{count(self.n_axes, 'axis', 'axes')} at {self.fs:g} Hz, unit {unit}; "
             f"{self.static.tau.size} τ, "
             f"{self.dynamic.t.size} DAVAR windows; {fit})"
         )

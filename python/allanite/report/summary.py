@@ -225,7 +225,8 @@ def summarize(rep) -> dict:
         "side_files": None if inline else side_files_entry(rep),
         "conventions": "times and τ in s (keys ending _s), fs in Hz; Allan deviations in adev_unit (the samples' "
         "rate unit); coefficients: value/ci in base form ('unit'), ieee/ieee_ci in IEEE-952 units "
-        "('ieee_unit'); intervals at 'confidence'; null = does not exist (unknown unit, unbounded "
+        "('ieee_unit'; an accelerometer's report, fit.sensor 'accelerometer': its units, m/s/√h, µg, m/s/h^1.5); "
+        "intervals at 'confidence'; null = does not exist (unknown unit, unbounded "
         "interval, read-off outside the τ range)",
     }
 
@@ -242,6 +243,7 @@ def _record_dict(rep) -> dict:
         "duration_s": n / rep.fs,
         "unit": rep.unit,
         "unit_known": rep.unit is not None,
+        "accel_unit": rep.accel_unit,
         "adev_unit": rep.adev_unit,
         "input": rep.input,
         "source": rep.source,
@@ -336,7 +338,7 @@ def text_summary(s: dict) -> str:
         f"allanite report: {rec['name']}",
         f"  {rec['samples']} samples × {count(rec['axes'], 'axis', 'axes')} ({', '.join(rec['axis_names'])}) at "
         f"{rec['fs_hz']:g} Hz = "
-        f"{duration(rec['duration_s'])}; unit {rec['unit'] or 'unknown (give --unit)'}, {rec['input']} input",
+        f"{duration(rec['duration_s'])}; unit {_unit_words(rec)}, {rec['input']} input",
     ]
     for note in s["notes"]:
         lines.append(f"  note: {note}")
@@ -347,6 +349,13 @@ def text_summary(s: dict) -> str:
     lines += forecast_text(s.get("forecast"))
     lines += paper002_text(s.get("paper002"))
     return "\n".join(lines)
+
+
+def _unit_words(rec: dict) -> str:
+    """The record's unit as the summary's first lines say it: a gyro's, an accelerometer's, or unknown."""
+    if rec.get("accel_unit"):
+        return f"{rec['accel_unit']} (an accelerometer's)"
+    return rec["unit"] or "unknown (give --unit)"
 
 
 def _adev_text(s: dict) -> list[str]:
@@ -379,8 +388,7 @@ def _fit_text(s: dict) -> list[str]:
     ieee = fit["unit_known"]
     lines = [
         "",
-        f"Noise model (IEEE 952) {'in IEEE-952 units' if ieee else 'in base form (unit unknown)'}, "
-        f"{fit['confidence']:.1%} intervals",
+        f"Noise model (IEEE 952) {_units_words(fit)}, {fit['confidence']:.1%} intervals",
         f"  {fit['model']}",
         *([] if ieee else [f"  ({CLOCK_TERMS})"]),
     ]
@@ -395,25 +403,35 @@ def _fit_text(s: dict) -> list[str]:
         rows.append((f"{t} {c0['name']}", (c0["ieee_unit"] if ieee else c0["unit"]) or "", cells))
     # each column as wide as its widest cell and two spaces: "2.37e-05 [2.37e-05, 2.37e-05]" ran into the next
     w2 = max([26] + [len(c) + 2 for _, _, cells in rows for c in cells])
-    lines.append(f"  {'term':<25}{'unit':<10}" + "".join(f"{nm[: w2 - 1]:<{w2}}" for nm in names).rstrip())
+    w1 = max([25] + [len(label) + 1 for label, _, _ in rows])  # "K acceleration random walk" (26)
+    lines.append(f"  {'term':<{w1}}{'unit':<10}" + "".join(f"{nm[: w2 - 1]:<{w2}}" for nm in names).rstrip())
     for label, unit, cells in rows:
-        lines.append(f"  {label:<25}{unit:<10}" + "".join(c.ljust(w2) for c in cells).rstrip())
-    lines.append(f"  {'χ²/dof':<25}{'':<10}" + "".join(f"{g(ax['chi2_dof'], 3):<{w2}}" for ax in fit["axes"]).rstrip())
+        lines.append(f"  {label:<{w1}}{unit:<10}" + "".join(c.ljust(w2) for c in cells).rstrip())
+    lines.append(
+        f"  {'χ²/dof':<{w1}}{'':<10}" + "".join(f"{g(ax['chi2_dof'], 3):<{w2}}" for ax in fit["axes"]).rstrip()
+    )
     ro = [ax["readoffs"] for ax in fit["axes"]]
     if ieee:
         lines.append(
-            f"  {'read-off N = σ(1 s)':<25}{ro[0]['arw_readoff_ieee_unit']:<10}"
+            f"  {'read-off N = σ(1 s)':<{w1}}{ro[0]['arw_readoff_ieee_unit']:<10}"
             + "".join(f"{g(r['arw_readoff_ieee'], 3):<{w2}}" for r in ro).rstrip()
         )
         lines.append(
-            f"  {'read-off B = σmin/0.664':<25}{ro[0]['bias_instability_readoff_ieee_unit']:<10}"
+            f"  {'read-off B = σmin/0.664':<{w1}}{ro[0]['bias_instability_readoff_ieee_unit']:<10}"
             + "".join(f"{g(r['bias_instability_readoff_ieee'], 3):<{w2}}" for r in ro).rstrip()
         )
     lines.append(
-        f"  {'σmin (at τ)':<25}{rec['adev_unit'] or '':<10}"
+        f"  {'σmin (at τ)':<{w1}}{rec['adev_unit'] or '':<10}"
         + "".join(f"{g(r['adev_min'], 3) + ' (' + g(r['tau_at_min_s'], 3) + ' s)':<{w2}}" for r in ro).rstrip()
     )
     return lines
+
+
+def _units_words(fit: dict) -> str:
+    """The units the noise model's table is in: IEEE-952 (a gyro's), an accelerometer's, or base form."""
+    if fit.get("sensor") == "accelerometer":
+        return f"in the accelerometer's units (samples in {fit['accel_unit']})"
+    return "in IEEE-952 units" if fit["unit_known"] else "in base form (unit unknown)"
 
 
 def _dynamic_text(s: dict) -> list[str]:
@@ -436,7 +454,7 @@ def _dynamic_text(s: dict) -> list[str]:
     ser = fit.get("series")
     if ser and ser["axes"] is not None:
         lines.append(
-            f"  noise coefficients{' in IEEE-952 units' if fit['unit_known'] else ' (base form)'} over the windows "
+            f"  noise coefficients{' in IEEE-952 units' if fit['unit'] else ' (base form)'} over the windows "
             "that resolve them (> 0): median [min, max] (windows resolving / all)"
         )
         for ax in ser["axes"]:
