@@ -55,9 +55,10 @@ from ..errors import InputError, ParameterError
 from . import _whittle as wh
 from ._coupling import LAG_MARGIN, coupling_test, optional_terms
 from ._lag import exact_lag, lag_grid, lagged, unresolved_lag
-from ._regressors import CHANNEL_SNR, channel_signal, regressor_design, regressor_iter, regressors
+from ._regressors import CHANNEL_SNR, channel_signal, form_signal, regressor_design, regressor_iter, regressors
 from ._rfft import band_limited
 from ._shares import TERM_SHARE
+from ._staircase import ChannelForm, channel_form, reconstructed
 
 __all__ = [
     "regress_channel",
@@ -194,12 +195,13 @@ class ChannelRegression:
     noise: dict = field(default_factory=dict)
     signal_bands: list | None = None
     removal_lag_s: float | None = None
+    form: ChannelForm = field(default_factory=ChannelForm)
 
     def columns(self, ch) -> np.ndarray:
         """The regressors of the kept terms, (k, n), for the channel samples ``ch`` (the whole record: a lag
         runs along it): the channel's signal bands (through the lag), then its square and its derivative where
         kept; the fit's means."""
-        x = np.asarray(ch, dtype=np.float64)
+        x = reconstructed(np.asarray(ch, dtype=np.float64), self.form)
         xs = band_limited(x, self.fs, self.signal_bands)
         cols = regressors(xs, self.mean, self.quad_mean, self.fs, self.removal_lag_s)
         keep = [0] + [i for i, k in ((1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
@@ -305,7 +307,9 @@ def regress_channel(
     terms = _check_subterms(terms)
     n_use = wh.usable_length(y.size)
     y, x = y[:n_use], x[:n_use]
-    floor, sig = channel_signal(x, fs)
+    form = channel_form(x)
+    x = reconstructed(x, form)
+    floor, sig = form_signal(x, fs, form)
     xs = band_limited(x, fs, sig)
     mean = float(xs.mean())
     quad_mean = float(np.mean((xs - mean) ** 2))
@@ -329,7 +333,7 @@ def regress_channel(
     # trade against each other (their sum is what is used); the terms before/after come from the Allan fits
     noise = {"channel_noise": math.sqrt(floor), "whittle_loglik_gain": float(fit["loglik"] - null["loglik"])}
     return ChannelRegression(
-        name, bool(accepted), params, intervals, test, tests, fs, mean, quad_mean, noise, sig, removal_lag
+        name, bool(accepted), params, intervals, test, tests, fs, mean, quad_mean, noise, sig, removal_lag, form
     )
 
 
@@ -410,7 +414,7 @@ def heldout_ratio(y, ch, fs: float, reg: ChannelRegression) -> float:
     halves in time (each half's own spectrum and noise fit)."""
     y, fs = _check_rate(y, fs)
     n_use = wh.usable_length(y.size)
-    y, x = y[:n_use], check_channel(reg.name, ch, y.size)[:n_use]
+    y, x = y[:n_use], reconstructed(check_channel(reg.name, ch, y.size)[:n_use], reg.form)
     xs = band_limited(x, fs, reg.signal_bands)
     cols = regressors(xs, reg.mean, reg.quad_mean, fs, reg.removal_lag_s)
     split = [wh.spectra(y, cols, fs, parity) for parity in (0, 1)]
