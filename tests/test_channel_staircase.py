@@ -83,3 +83,16 @@ def test_quantised_channel_keeps_its_rate_term():
     assert set(r.params) == {"coefficient", "rate_coefficient"}
     assert r.params["rate_coefficient"] == pytest.approx(0.3, rel=0.05)
     assert r.params["coefficient"] == pytest.approx(2e-4, rel=0.05)
+
+
+def test_real_steps_are_not_read_back():
+    """A ±1 g multi-position profile turned on a fixed grid of samples looks held (its changes' gcd is the dwell),
+    a heater switched on once looks like a one-step staircase: their steps are what they measure (the rate
+    steps with them), and they stay as they are."""
+    dwell = 3000  # 300 s at 10 Hz
+    profile = np.repeat(np.where(np.arange(40) % 2 == 0, 1.0, -1.0), dwell)
+    assert channel_form(profile).plain and reconstructed(profile, channel_form(profile)) is profile
+    switch = np.where(np.arange(50_000) < 20_000, 0.0, 1.0)
+    assert channel_form(switch).plain
+    ramp_of_levels = np.repeat(np.arange(40) * 0.5, dwell)  # a slow staircase of many steps is read back
+    assert channel_form(ramp_of_levels).staircase

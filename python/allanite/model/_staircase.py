@@ -13,7 +13,9 @@ measurement error that is neither white nor small where it matters:
   sawtooth away, so the lag's test took it for a lag (a 0.5 °C staircase of a slow sine at 10 Hz: a lag of 16 s
   kept at 2Δℓ 57 against 15.5, truth none).
 
-:func:`channel_form` reads the form from the channel alone: the quantum (every step a whole multiple of the
+:func:`channel_form` reads the form from the channel alone — only where its typical step between readings is a
+small share of its range (:data:`FINE_STEP`; a switch or a multi-position profile turned on a fixed grid of
+samples steps by what it measures, and stays as it is): the quantum (every step a whole multiple of the
 smallest), the hold (every change of value on a grid of ``hold`` samples, at least :data:`MIN_CHANGES` of them),
 and whether the channel moves slowly against its quantum (at most :data:`MAX_REVERSALS` of its steps undo the one
 before: a staircase, not a noisy channel dithering across steps). :func:`reconstructed` reads it back: the
@@ -45,6 +47,10 @@ __all__ = [
 MIN_CHANGES = 16
 #: A quantised channel is a slow staircase when at most this share of its steps reverse the one before.
 MAX_REVERSALS = 0.25
+#: A channel is read back only when its typical step between readings is at most this share of its range: a
+#: sampled quantity, not a switch or a multi-position profile whose steps are real (a ±1 g profile turned on a
+#: fixed grid of samples looks held; a heater switched on once, a one-step staircase).
+FINE_STEP = 1.0 / 8.0
 #: Steps are whole multiples of the quantum to this fraction of it.
 LATTICE_TOL = 1e-3
 
@@ -124,7 +130,10 @@ def channel_form(x: np.ndarray) -> ChannelForm:
     hold, phase = _hold(x)
     v = x[reading_index(x.size, hold, phase)]
     d = np.diff(v)
-    q = _quantum(d[d != 0])
+    steps = d[d != 0]
+    if steps.size == 0 or np.median(np.abs(steps)) > FINE_STEP * float(np.ptp(v)):
+        return ChannelForm()  # its steps are what it measures (a switch, a multi-position profile): as it is
+    q = _quantum(steps)
     if q is None:
         return ChannelForm(None, hold, phase)
     rev = _reversal_share(v)
