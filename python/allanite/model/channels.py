@@ -23,6 +23,13 @@ blocks takes out the slow wander the channel and the noise share, and with it th
 temperature that moves within one or two blocks leaves ≈ 1.25 effective degrees of freedom and a t threshold of
 64. Here the wander is not removed but weighed: a random walk's and flicker's power at each frequency is in S.
 
+A channel as loggers write it — quantised in value (0.5, 1/16, 1/340 °C), read at 1 Hz and held on a faster rate
+log — is read back first as the quantity it samples (:mod:`allanite.model._staircase`: the quantum, the hold and
+a slow staircase detected from the channel itself; the readings at their own instants, a staircase's crossings
+between its steps): the hold's half-period delay, its d/dt spike train and a slow staircase's sawtooth are
+measurement error of the regressor, and the optional terms fitted them (:attr:`ChannelRegression.form`,
+docs/channels.md "Quantised and held channels").
+
 Optional terms, each kept only by its own nested test at its own share of the level:
 
 - ``quadratic`` — on (ch − mean)² (per channel unit²): likelihood ratio, F(1, ν);
@@ -181,6 +188,8 @@ class ChannelRegression:
     (optional terms are tried only then).
     ``removal_lag_s``: the lag the component runs the channel through — the kept ``lag_s``, or a lag its test
     did not resolve but the profile prefers to none (``terms["lag_s"]["profiled"]``, not a param), or None.
+    ``form``: how the channel was written (:class:`allanite.model._staircase.ChannelForm`: quantum, hold, a slow
+    staircase); every use of the channel reads it back the same way first.
     """
 
     name: str
