@@ -96,3 +96,17 @@ def test_real_steps_are_not_read_back():
     assert channel_form(switch).plain
     ramp_of_levels = np.repeat(np.arange(40) * 0.5, dwell)  # a slow staircase of many steps is read back
     assert channel_form(ramp_of_levels).staircase
+
+
+def test_chatter_is_one_crossing():
+    """A 0.5 °C staircase with 0.02 °C of noise chatters across each boundary as it passes: its transitions
+    between the same two steps are one crossing, so it is still a slow staircase, read back as well as without
+    the noise; with 0.1 °C of noise the quantisation dithers and the channel is used as it is."""
+    rng = np.random.default_rng(0)
+    truth = _sine(200_000, 10.0, 8000.0)
+    quiet = np.round((truth + 0.02 * rng.standard_normal(truth.size)) / 0.5) * 0.5
+    f = channel_form(quiet)
+    assert f.staircase and f.reversals < 0.1
+    assert np.std(reconstructed(quiet, f) - truth) < 0.03  # 0.023; as logged 0.140
+    noisy = np.round((truth + 0.1 * rng.standard_normal(truth.size)) / 0.5) * 0.5
+    assert not channel_form(noisy).staircase

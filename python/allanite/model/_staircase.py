@@ -17,10 +17,13 @@ measurement error that is neither white nor small where it matters:
 small share of its range (:data:`FINE_STEP`; a switch or a multi-position profile turned on a fixed grid of
 samples steps by what it measures, and stays as it is): the quantum (every step a whole multiple of the
 smallest), the hold (every change of value on a grid of ``hold`` samples, at least :data:`MIN_CHANGES` of them),
-and whether the channel moves slowly against its quantum (at most :data:`MAX_REVERSALS` of its steps undo the one
-before: a staircase, not a noisy channel dithering across steps). :func:`reconstructed` reads it back: the
+and whether the channel moves slowly against its quantum (at most :data:`MAX_REVERSALS` of its crossings between
+steps turn back — a run of transitions between the same two steps, a channel chattering across their boundary
+while it passes, counted as one crossing: a staircase, not a noisy channel dithering across steps).
+:func:`reconstructed` reads it back: the
 readings at their own instants (each hold's first sample), and for a slow staircase the instants where the
-channel crossed between two steps — midway between the last reading at one step and the first at the next,
+channel crossed between two steps — midway between the last reading at one step and the first at the next (the
+mean of those instants over a crossing's chatter),
 at the value midway between the steps (the rounding's threshold; a floor or ceiling quantiser's offset is a
 constant, which the regression's mean absorbs) — with each turning-point step (and the first and last) at its
 own value at the middle of its run; linear in between. A noisy channel's quantisation is dithered (nearly white)
@@ -29,6 +32,7 @@ and stays as it is; so does a channel neither quantised nor held (the same numbe
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,12 +49,15 @@ __all__ = [
 
 #: A hold is read only from at least this many changes of value (a gcd of fewer could be chance: 2⁻¹⁵).
 MIN_CHANGES = 16
-#: A quantised channel is a slow staircase when at most this share of its steps reverse the one before.
+#: A quantised channel is a slow staircase when at most this share of its crossings between steps turn back.
 MAX_REVERSALS = 0.25
 #: A channel is read back only when its typical step between readings is at most this share of its range: a
 #: sampled quantity, not a switch or a multi-position profile whose steps are real (a ±1 g profile turned on a
 #: fixed grid of samples looks held; a heater switched on once, a one-step staircase).
 FINE_STEP = 1.0 / 8.0
+#: Transitions between the same two steps are one crossing (chatter) while each follows the last within this
+#: share of the median time between crossings of different boundaries.
+CHATTER_SHARE = 0.5
 #: Steps are whole multiples of the quantum to this fraction of it.
 LATTICE_TOL = 1e-3
 
@@ -59,7 +66,7 @@ LATTICE_TOL = 1e-3
 class ChannelForm:
     """How a channel was written: ``quantum`` (channel unit; None: not quantised), ``hold`` (samples per reading,
     1: read every sample), ``phase`` (index of a reading), ``staircase`` (quantised and slow against its quantum:
-    its steps' crossings are reconstructed), ``reversals`` (share of steps that undo the one before)."""
+    its steps' crossings are reconstructed), ``reversals`` (share of its crossings between steps that turn back)."""
 
     quantum: float | None = None
     hold: int = 1
@@ -118,10 +125,57 @@ def reading_index(n: int, hold: int, phase: int) -> np.ndarray:
     return idx if phase == 0 else np.concatenate([[0], idx])
 
 
-def _reversal_share(v: np.ndarray) -> float:
-    d = np.diff(v)
-    s = np.sign(d[d != 0])
-    return float(np.mean(s[1:] != s[:-1])) if s.size > 1 else 0.0
+@dataclass(frozen=True)
+class _Crossings:
+    """A staircase's transitions grouped: consecutive transitions between the same two steps are one crossing of
+    their boundary (a channel chattering across it: its noise, a few hundredths of the quantum, flips the step back
+    and forth while it passes); ``time`` the mean instant of a group's transitions, ``value`` the boundary (midway
+    between the two steps), ``sign`` +1 rising, −1 falling, 0 a touch (back on the step it left: a turning point at
+    the boundary); ``level_before``/``level_after`` the steps either side, ``gap_start``/``gap_end`` the instants of
+    its first and last transitions."""
+
+    time: np.ndarray
+    value: np.ndarray
+    sign: np.ndarray
+    level_before: np.ndarray
+    level_after: np.ndarray
+    gap_start: np.ndarray
+    gap_end: np.ndarray
+
+    def turning_share(self) -> float:
+        """Share of the crossings that turn: touches, and crossings the other way from the one before."""
+        n = self.sign.size
+        if n < 2:
+            return 0.0
+        crossing = self.sign[self.sign != 0]
+        turns = int(np.sum(self.sign == 0)) + int(np.sum(crossing[1:] != crossing[:-1]))
+        return turns / n
+
+
+def _crossings(t: np.ndarray, v: np.ndarray) -> _Crossings:
+    change = np.flatnonzero(np.diff(v) != 0)  # transition j: between readings change[j] and change[j] + 1
+    a, b = v[change], v[change + 1]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    tt = 0.5 * (t[change] + t[change + 1])
+    new = np.ones(change.size, dtype=bool)
+    new[1:] = (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1])
+    # chatter is brief against the time between crossings of different boundaries: a longer stay on the other
+    # side (a turning point's dwell on the top step) is two crossings, not one
+    gap = np.diff(tt)
+    spacing = float(np.median(gap[new[1:]])) if new[1:].any() else math.inf
+    new[1:] |= gap > CHATTER_SHARE * spacing
+    first = np.flatnonzero(new)
+    last = np.append(first[1:], change.size) - 1
+    before, after = a[first], b[last]
+    return _Crossings(
+        np.add.reduceat(tt, first) / (last - first + 1) if first.size else tt,
+        0.5 * (lo[first] + hi[first]),
+        np.sign(after - before),
+        before,
+        after,
+        tt[first],
+        tt[last],
+    )
 
 
 def channel_form(x: np.ndarray) -> ChannelForm:
@@ -136,25 +190,25 @@ def channel_form(x: np.ndarray) -> ChannelForm:
     q = _quantum(steps)
     if q is None:
         return ChannelForm(None, hold, phase)
-    rev = _reversal_share(v)
+    rev = _crossings(reading_index(x.size, hold, phase).astype(np.float64), v).turning_share()
     return ChannelForm(q, hold, phase, rev <= MAX_REVERSALS, rev)
 
 
 def _staircase_knots(t: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Knots (instants, values) of a slow staircase read at instants ``t``: each crossing between two steps, and
-    each turning-point step (and the first and last) at the middle of its run (module docstring)."""
-    change = np.flatnonzero(np.diff(v) != 0)  # the last reading of each run but the last
-    if change.size == 0:
+    """Knots (instants, values) of a slow staircase read at instants ``t``: each crossing of a boundary between two
+    steps (:class:`_Crossings`: its transitions' mean instant, the boundary's value), and each step the channel
+    turns on (rises into and falls out of, or the reverse), the first and the last, at its own value in the
+    middle of its stretch (module docstring)."""
+    c = _crossings(t, v)
+    if c.time.size == 0:
         return np.array([t[0], t[-1]], dtype=np.float64), np.array([v[0], v[-1]])
-    first = np.concatenate([[0], change + 1])  # runs' first and last readings
-    last = np.concatenate([change, [v.size - 1]])
-    cross_t = 0.5 * (t[change] + t[change + 1])
-    cross_v = 0.5 * (v[change] + v[change + 1])
-    up = np.sign(np.diff(v[first]))  # the direction into each run after the first
-    turn = np.concatenate([[True], up[1:] != up[:-1], [True]])  # first, turning points, last
-    mid_t = 0.5 * (t[first[turn]] + t[last[turn]])
-    times = np.concatenate([cross_t, mid_t])
-    values = np.concatenate([cross_v, v[first[turn]]])
+    turn = (c.sign[:-1] * c.sign[1:] < 0) & (c.level_after[:-1] == c.level_before[1:])
+    mid_t = np.concatenate([[0.5 * (t[0] + c.gap_start[0])], 0.5 * (c.gap_end[:-1] + c.gap_start[1:])[turn]])
+    mid_v = np.concatenate([[v[0]], c.level_after[:-1][turn]])
+    mid_t = np.append(mid_t, 0.5 * (c.gap_end[-1] + t[-1]))
+    mid_v = np.append(mid_v, v[-1])
+    times = np.concatenate([c.time, mid_t])
+    values = np.concatenate([c.value, mid_v])
     order = np.argsort(times, kind="stable")
     return times[order], values[order]
 
