@@ -125,9 +125,9 @@ def main(argv=None) -> None:
     ap.add_argument("--records", type=int, default=20)
     ap.add_argument("--out", default=str(HERE / "results"))
     args = ap.parse_args(argv)
+    rev = subprocess.run(["git", "describe", "--always", "--dirty"], capture_output=True, text=True, cwd=HERE)
     t0 = time.process_time()
     res = run(args.records)
-    rev = subprocess.run(["git", "describe", "--always", "--dirty"], capture_output=True, text=True, cwd=HERE)
     meta = f"Code at {rev.stdout.strip() or '?'}, {args.records} records per row; CPU {time.process_time() - t0:.0f} s"
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
