@@ -167,6 +167,7 @@ MODEL_RANKS = {
     "model._lag": 0.5,  # a channel's first-order lag: its test and profile (on _whittle)
     "model._shares": 0,
     "model._regressors": 0.7,  # a channel regression's signal bands and regressors (on _whittle, _lag)
+    "model._staircase": -0.5,  # a channel's form (quantum, hold) read from it, and the channel read back (numpy only)
     "model._coupling": 0.8,  # a channel regression's coupling test and optional terms
     "model.channels": 1,
     "model.timeframes": 2,

@@ -12,8 +12,9 @@ import numpy as np
 from . import _whittle as wh
 from ._lag import lagged
 from ._rfft import rfft
+from ._staircase import ChannelForm, reading_index, reading_rate
 
-__all__ = ["CHANNEL_SNR", "channel_signal", "regressors", "regressor_iter", "regressor_design"]
+__all__ = ["CHANNEL_SNR", "channel_signal", "form_signal", "regressors", "regressor_iter", "regressor_design"]
 
 
 #: A band of the channel takes part only where its power is this many times its measurement noise's.
@@ -48,6 +49,18 @@ def channel_signal(x: np.ndarray, fs: float) -> tuple[float, list | None]:
         else:
             out.append((lo, hi))
     return floor, out or [(0.0, 0.0)]
+
+
+def form_signal(xr: np.ndarray, fs: float, form: ChannelForm) -> tuple[float, list | None]:
+    """:func:`channel_signal` of a channel read back from its form (``xr``,
+    :func:`allanite.model._staircase.reconstructed`): a held channel's on its own readings at their own rate —
+    its floor is the readings' noise, not the joining's, and nothing above half the reading rate is signal (only
+    the hold's images are there)."""
+    if form.hold == 1:
+        return channel_signal(xr, fs)
+    rate = reading_rate(fs, form)
+    floor, sig = channel_signal(xr[reading_index(xr.size, form.hold, form.phase)], rate)
+    return floor, sig if sig is not None else [(0.0, 0.5 * rate)]
 
 
 def regressors(xs: np.ndarray, mean: float, quad_mean: float, fs: float, lag_s: float | None) -> list:

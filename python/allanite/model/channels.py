@@ -23,6 +23,13 @@ blocks takes out the slow wander the channel and the noise share, and with it th
 temperature that moves within one or two blocks leaves ≈ 1.25 effective degrees of freedom and a t threshold of
 64. Here the wander is not removed but weighed: a random walk's and flicker's power at each frequency is in S.
 
+A channel as loggers write it — quantised in value (0.5, 1/16, 1/340 °C), read at 1 Hz and held on a faster rate
+log — is read back first as the quantity it samples (:mod:`allanite.model._staircase`: the quantum, the hold and
+a slow staircase detected from the channel itself; the readings at their own instants, a staircase's crossings
+between its steps): the hold's half-period delay, its d/dt spike train and a slow staircase's sawtooth are
+measurement error of the regressor, and the optional terms fitted them (:attr:`ChannelRegression.form`,
+docs/channels.md "Quantised and held channels").
+
 Optional terms, each kept only by its own nested test at its own share of the level:
 
 - ``quadratic`` — on (ch − mean)² (per channel unit²): likelihood ratio, F(1, ν);
@@ -55,9 +62,10 @@ from ..errors import InputError, ParameterError
 from . import _whittle as wh
 from ._coupling import LAG_MARGIN, coupling_test, optional_terms
 from ._lag import exact_lag, lag_grid, lagged, unresolved_lag
-from ._regressors import CHANNEL_SNR, channel_signal, regressor_design, regressor_iter, regressors
+from ._regressors import CHANNEL_SNR, channel_signal, form_signal, regressor_design, regressor_iter, regressors
 from ._rfft import band_limited
 from ._shares import TERM_SHARE
+from ._staircase import ChannelForm, channel_form, reconstructed
 
 __all__ = [
     "regress_channel",
@@ -180,6 +188,8 @@ class ChannelRegression:
     (optional terms are tried only then).
     ``removal_lag_s``: the lag the component runs the channel through — the kept ``lag_s``, or a lag its test
     did not resolve but the profile prefers to none (``terms["lag_s"]["profiled"]``, not a param), or None.
+    ``form``: how the channel was written (:class:`allanite.model._staircase.ChannelForm`: quantum, hold, a slow
+    staircase); every use of the channel reads it back the same way first.
     """
 
     name: str
@@ -194,12 +204,13 @@ class ChannelRegression:
     noise: dict = field(default_factory=dict)
     signal_bands: list | None = None
     removal_lag_s: float | None = None
+    form: ChannelForm = field(default_factory=ChannelForm)
 
     def columns(self, ch) -> np.ndarray:
         """The regressors of the kept terms, (k, n), for the channel samples ``ch`` (the whole record: a lag
         runs along it): the channel's signal bands (through the lag), then its square and its derivative where
         kept; the fit's means."""
-        x = np.asarray(ch, dtype=np.float64)
+        x = reconstructed(np.asarray(ch, dtype=np.float64), self.form)
         xs = band_limited(x, self.fs, self.signal_bands)
         cols = regressors(xs, self.mean, self.quad_mean, self.fs, self.removal_lag_s)
         keep = [0] + [i for i, k in ((1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
@@ -305,7 +316,9 @@ def regress_channel(
     terms = _check_subterms(terms)
     n_use = wh.usable_length(y.size)
     y, x = y[:n_use], x[:n_use]
-    floor, sig = channel_signal(x, fs)
+    form = channel_form(x)
+    x = reconstructed(x, form)
+    floor, sig = form_signal(x, fs, form)
     xs = band_limited(x, fs, sig)
     mean = float(xs.mean())
     quad_mean = float(np.mean((xs - mean) ** 2))
@@ -329,7 +342,7 @@ def regress_channel(
     # trade against each other (their sum is what is used); the terms before/after come from the Allan fits
     noise = {"channel_noise": math.sqrt(floor), "whittle_loglik_gain": float(fit["loglik"] - null["loglik"])}
     return ChannelRegression(
-        name, bool(accepted), params, intervals, test, tests, fs, mean, quad_mean, noise, sig, removal_lag
+        name, bool(accepted), params, intervals, test, tests, fs, mean, quad_mean, noise, sig, removal_lag, form
     )
 
 
@@ -410,7 +423,7 @@ def heldout_ratio(y, ch, fs: float, reg: ChannelRegression) -> float:
     halves in time (each half's own spectrum and noise fit)."""
     y, fs = _check_rate(y, fs)
     n_use = wh.usable_length(y.size)
-    y, x = y[:n_use], check_channel(reg.name, ch, y.size)[:n_use]
+    y, x = y[:n_use], reconstructed(check_channel(reg.name, ch, y.size)[:n_use], reg.form)
     xs = band_limited(x, fs, reg.signal_bands)
     cols = regressors(xs, reg.mean, reg.quad_mean, fs, reg.removal_lag_s)
     split = [wh.spectra(y, cols, fs, parity) for parity in (0, 1)]

@@ -55,7 +55,8 @@ def regression_dict(evidence: dict) -> dict | None:
     """The regression's evidence for ``summary.json`` (None for a step without it): ``method``, ``slow_share``,
     ``optional_terms`` (each term's nested test: kept, statistic, threshold, p_value, alpha, dof; a lag also its
     profile), ``terms_before_after`` (N, B, K, … fitted before and after the removal), ``lag`` (a lag not resolved,
-    in words, or None) and ``heldout_note`` (why the held-out error rose, or None)."""
+    in words, or None), ``heldout_note`` (why the held-out error rose, or None) and ``channel_form`` (how the
+    channel was written and read back — "quantised at 0.5 (…), held for 1 s (…)" — or None: as logged)."""
     tba = evidence.get("terms_before_after")
     if "terms" not in evidence and tba is None:
         return None
@@ -69,6 +70,7 @@ def regression_dict(evidence: dict) -> dict | None:
         else {side: _terms(tba[side], ieee.get(side)) for side in ("before", "after") if side in tba},
         "lag": evidence.get("lag"),
         "heldout_note": evidence.get("heldout_note"),
+        "channel_form": (evidence.get("channel_form") or {}).get("words"),
     }
 
 
@@ -112,6 +114,8 @@ def regression_lines(reg: dict | None) -> list[str]:
         lines.append(f"noise terms before → after the removal: {_moves_words(reg['terms_before_after'])}")
     if reg.get("optional_terms"):
         lines.append(f"optional terms: {_optional_words(reg['optional_terms'])}")
+    if reg.get("channel_form"):
+        lines.append(f"channel: {reg['channel_form']}")
     if reg.get("lag"):
         lines.append(f"lag: {reg['lag']}")
     if reg.get("heldout_note"):
@@ -128,7 +132,8 @@ def regression_row(axis: str, st: dict) -> list | None:
     coef = st["final_params"].get("coefficient", st["params"].get("coefficient"))
     unit = st["units"].get("coefficient", "")
     tba = reg.get("terms_before_after")
-    notes = [x for x in (reg.get("lag"), reg.get("heldout_note")) if x]
+    form = f"channel {reg['channel_form']}" if reg.get("channel_form") else None
+    notes = [x for x in (form, reg.get("lag"), reg.get("heldout_note")) if x]
     return [
         axis,
         str(st["params"].get("channel", "—")),

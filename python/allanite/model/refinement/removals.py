@@ -312,6 +312,8 @@ def _slow_regression(
         "signal_bands_hz": r.signal_bands,
         "heldout": "even ↔ odd DFT bins",
     }
+    if not r.form.plain:  # quantised and slow against its quantum, or held: read back first (docs/channels.md)
+        ev["channel_form"] = r.form.evidence(ctx.fs)
     if r.lag_note():  # a lag its test cannot claim, profiled for the removal (docs/channels.md)
         ev |= {"lag": r.lag_note(), "removal_lag_s": r.removal_lag_s}
     yield Removal(
