@@ -3,7 +3,7 @@
 :func:`robust_sigma` — the σ of the Gaussian behind differences (1.4826·MAD, or the lattice's own law);
 :func:`local_scales` — that σ block by block, each block judged at the larger of its own and its neighbours'
 scale (the outliers test's local scale: a noise level that changes along the record is no heavy tail);
-``_tail`` — the cut at c·σ in the data's unit and the Gaussian probability beyond it. numpy and scipy
+``tail_cut`` — the cut at c·σ in the data's unit and the Gaussian probability beyond it. numpy and scipy
 only (the outliers test, :mod:`.outliers`, is built on them).
 """
 
@@ -16,7 +16,7 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.special import ndtr
 
-__all__ = ["robust_sigma", "local_scales", "LOCAL_BLOCK"]
+__all__ = ["robust_sigma", "lattice_sigma", "local_scales", "tail_cut", "LOCAL_BLOCK", "SCALE_Z"]
 
 #: Samples per block of the local scale (:func:`local_scales`). Long against spikes: the median absolute difference
 #: of 2048 samples scatters by 1.166/√2048 = 2.6 % (which moves the Gaussian count beyond 4 σ by ≈ 1.2×, within the
@@ -58,11 +58,11 @@ def robust_sigma(d: np.ndarray, step: float) -> float:
     target = float(share[j])
     if target >= 1.0:
         return float("nan")
-    return _lattice_sigma((j + 0.5) * step, target, step)
+    return lattice_sigma((j + 0.5) * step, target, step)
 
 
 @lru_cache(maxsize=4096)
-def _lattice_sigma(a: float, target: float, step: float) -> float:
+def lattice_sigma(a: float, target: float, step: float) -> float:
     """The σ with P(|d + U| < a) = ``target`` on the lattice ``step`` (NaN if none in 1e-6 … 1e6 steps): the same
     share at the same count is asked again — blocks of equal length, the record tested again after a removal."""
     lo, hi = 1e-6 * step, 1e6 * step
@@ -72,7 +72,7 @@ def _lattice_sigma(a: float, target: float, step: float) -> float:
     return float(brentq(lambda s: _inner(a, s, step) - target, lo, hi, xtol=1e-9 * step))
 
 
-def _tail(c: float, sigma: float, step: float) -> tuple[float, float]:
+def tail_cut(c: float, sigma: float, step: float) -> tuple[float, float]:
     """(cut in the data's unit, P(|d| beyond it)) at c·σ: continuous 2Φ̄(c); on a lattice the next multiple
     of L above c·σ, k·L, with P(|d_q| ≥ kL) = 2·(1 − P(d + U < (k − ½)L))."""
     if step <= 0:

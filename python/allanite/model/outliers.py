@@ -62,7 +62,9 @@ from scipy.stats import poisson
 
 from . import _chunked
 from ._recent import Recent
-from ._robust_scale import _lattice_sigma, _tail, local_scales, robust_sigma  # noqa: F401 (_lattice_sigma: its cache)
+from ._robust_scale import lattice_sigma as _lattice_sigma  # noqa: F401 (its cache, asked by the tests)
+from ._robust_scale import local_scales, robust_sigma
+from ._robust_scale import tail_cut as _tail
 
 __all__ = [
     "outlier_test",
