@@ -19,11 +19,15 @@ from scipy.special import ndtr
 __all__ = ["robust_sigma", "lattice_sigma", "local_scales", "tail_cut", "LOCAL_BLOCK", "SCALE_Z"]
 
 #: Samples per block of the local scale (:func:`local_scales`). Long against spikes: the median absolute difference
-#: of 2048 samples scatters by 1.166/√2048 = 2.6 % (which moves the Gaussian count beyond 4 σ by ≈ 1.2×, within the
-#: test's factor 2) and moves by ≈ 1.3 % per 1 % of its samples spiked (a burst of 50 samples, 30 % spikes, is 0.7 %
-#: of a block). Short against stretches: a stretch of noise at another level of 2 blocks (4096 samples) or more
-#: holds a whole block, whose scale the blocks it begins and ends in take.
-LOCAL_BLOCK = 2048
+#: of 8192 samples scatters by 1.166/√8192 = 1.3 %, which raises the Gaussian count at c σ by ≈ exp(c⁴·1.3 %²/2)
+#: over the one at the true scale — 1.02× at 4 σ, 1.4× at 8 σ, within the test's factor 2 (2048 samples: 1.15× at
+#: 4.5 σ, 4× at 8 σ, and the flagging's cut fell to where the Gaussian samples flagged were more than their 5 %
+#: share, +44 % rate on ``refine_sensors.py``'s temperature and spikes) — and moves by ≈ 1.3 % per 1 % of its
+#: samples spiked (a burst of 50 samples, 30 % spikes, is 0.2 % of a block). Short against stretches: a stretch of
+#: noise at another level of 2 blocks (16 384 samples, 82 s at 200 Hz) or more holds a whole block, whose scale
+#: the blocks it begins and ends in take. The old blocks (this length, but at most 64 over the record) were 31 250
+#: samples at 2·10⁶, a sixth of a 600 s stretch at 200 Hz.
+LOCAL_BLOCK = 8192
 #: Standard errors of the ratio of two blocks' robust scales beyond which a block takes its neighbour's (louder)
 #: scale (:func:`local_scales`).
 SCALE_Z = 4.0
@@ -84,7 +88,7 @@ def tail_cut(c: float, sigma: float, step: float) -> tuple[float, float]:
 def local_scales(x: np.ndarray, step: float) -> tuple[list[slice], np.ndarray]:
     """Blocks of :data:`LOCAL_BLOCK` samples of ``x`` (one block below two) and the local robust σ of each: its own
     :func:`robust_sigma`, or the larger neighbour's where that is beyond it by :data:`SCALE_Z` standard errors
-    of the ratio of two blocks' scales (√2·1.166/√n: 14.6 % at 2048 samples; NaN only where all three have no
+    of the ratio of two blocks' scales (√2·1.166/√n: 7.3 % at 8192 samples; NaN only where all three have no
     spread — a block without spread takes its neighbours' larger).
 
     A block in which the noise level changes (a stretch of vibration begins or ends in it) has a median between
