@@ -3,10 +3,11 @@
 :func:`outlier_test` — the test behind the ``"outliers"`` effect of :func:`allanite.refine`. The first
 differences d_t = y_t − y_{t−1} of any Gaussian record are Gaussian, whatever its spectrum (white, flicker,
 random walk, a ramp, a low-pass: a linear filter of Gaussian noise stays Gaussian; slow terms barely reach
-the differences, so they hide nothing). Their scale is estimated robustly in blocks of the record (so a noise
-level that changes along the record does not read as a heavy tail): the median absolute difference, or — for
-quantised samples (every difference a multiple of a step L) — the σ of the Gaussian whose differences,
-quantised, put the observed share of |d| ≤ jL (j where that share is nearest ½). With y quantised as y + u
+the differences, so they hide nothing). Their scale is estimated robustly and locally — per block of 8192
+differences, the block's own or its louder neighbour's (:func:`._robust_scale.local_scales`), so a noise level
+that changes along the record (a pump on for stretches) does not read as a heavy tail: the median absolute
+difference, or — for quantised samples (every difference a multiple of a step L) — the σ of the Gaussian whose
+differences, quantised, put the observed share of |d| ≤ jL (j where that share is nearest ½). With y quantised as y + u
 (u uniform on a step, independent of d), P(|d_q| ≤ jL) = P(|d + U| < (j + ½)L), U uniform on (−L/2, L/2):
 exact for the lattice however coarse (a Gaussian σ alone would miss a record whose differences are mostly 0
 or ±1 step). The offsets are uniform when the samples wander over a step or more; a record whose samples'
@@ -83,7 +84,8 @@ CUTS = (4.0, 5.0, 6.0, 7.0)
 #: TAIL_FACTOR × λ", so that a sensor whose noise is only slightly non-Gaussian is not flagged (the
 #: ADIS16405 gyros' differences hold 1.1–1.5× the Gaussian count at 3–4 σ, none beyond 5.2 σ: no spikes).
 TAIL_FACTOR = 2.0
-#: Samples per block of the robust scale (at most MAX_BLOCKS blocks, at least one).
+#: Samples per block of the replacement's scales and of the coarse-lattice check (at most MAX_BLOCKS blocks, at
+#: least one); the test's and the flagging's scale is local (:func:`._robust_scale.local_scales`).
 BLOCK = 8192
 MAX_BLOCKS = 64
 #: Least spread of the samples (standard deviation per block, in quantisation steps) for the lattice model to
@@ -210,7 +212,7 @@ def _flag_p(k: int, lam: float) -> float:
 
 
 def flag_at(y: np.ndarray, c: float) -> tuple[np.ndarray, float]:
-    """Flags of the samples ``y`` at the cut ``c`` (σ of the differences, each block's own) and the number of
+    """Flags of the samples ``y`` at the cut ``c`` (σ of the differences, each block's local scale) and the number of
     Gaussian samples expected among them (λ): the flagging of :func:`outlier_test` at a given cut."""
     y = np.asarray(y, dtype=np.float64)
     d = np.diff(y)
