@@ -139,6 +139,7 @@ MODEL_RANKS = {
     "model._chunked": -1,  # record-length passes a chunk at a time (numpy, scipy only)
     "model._medians": -1,  # medians along an axis by one sort (numpy only)
     "model._welch_spread": -1,  # Welch segments' spread per band: the line search's dof (numpy only)
+    "model._robust_scale": -1,  # the differences' robust scale, on a lattice and local (numpy, scipy only)
     "model._rfft": -0.5,  # the channel regression's transforms, remembered by content
     "model._sinc": -0.5,  # the sinc^k (CIC) roll-off's autocorrelation and cutoff (numpy only)
     "model._batched": 0,

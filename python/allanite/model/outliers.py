@@ -3,10 +3,11 @@
 :func:`outlier_test` — the test behind the ``"outliers"`` effect of :func:`allanite.refine`. The first
 differences d_t = y_t − y_{t−1} of any Gaussian record are Gaussian, whatever its spectrum (white, flicker,
 random walk, a ramp, a low-pass: a linear filter of Gaussian noise stays Gaussian; slow terms barely reach
-the differences, so they hide nothing). Their scale is estimated robustly in blocks of the record (so a noise
-level that changes along the record does not read as a heavy tail): the median absolute difference, or — for
-quantised samples (every difference a multiple of a step L) — the σ of the Gaussian whose differences,
-quantised, put the observed share of |d| ≤ jL (j where that share is nearest ½). With y quantised as y + u
+the differences, so they hide nothing). Their scale is estimated robustly and locally — per block of 8192
+differences, the block's own or its louder neighbour's (:func:`._robust_scale.local_scales`), so a noise level
+that changes along the record (a pump on for stretches) does not read as a heavy tail: the median absolute
+difference, or — for quantised samples (every difference a multiple of a step L) — the σ of the Gaussian whose
+differences, quantised, put the observed share of |d| ≤ jL (j where that share is nearest ½). With y quantised as y + u
 (u uniform on a step, independent of d), P(|d_q| ≤ jL) = P(|d + U| < (j + ½)L), U uniform on (−L/2, L/2):
 exact for the lattice however coarse (a Gaussian σ alone would miss a record whose differences are mostly 0
 or ±1 step). The offsets are uniform when the samples wander over a step or more; a record whose samples'
@@ -55,16 +56,16 @@ samples 6× wider) that the shortest τ read as a low-pass.
 from __future__ import annotations
 
 import math
-from functools import lru_cache
 
 import numpy as np
 from scipy.ndimage import median_filter
-from scipy.optimize import brentq
-from scipy.special import ndtr
 from scipy.stats import poisson
 
 from . import _chunked
 from ._recent import Recent
+from ._robust_scale import lattice_sigma as _lattice_sigma  # noqa: F401 (its cache, asked by the tests)
+from ._robust_scale import local_scales, robust_sigma
+from ._robust_scale import tail_cut as _tail
 
 __all__ = [
     "outlier_test",
@@ -83,7 +84,8 @@ CUTS = (4.0, 5.0, 6.0, 7.0)
 #: TAIL_FACTOR × λ", so that a sensor whose noise is only slightly non-Gaussian is not flagged (the
 #: ADIS16405 gyros' differences hold 1.1–1.5× the Gaussian count at 3–4 σ, none beyond 5.2 σ: no spikes).
 TAIL_FACTOR = 2.0
-#: Samples per block of the robust scale (at most MAX_BLOCKS blocks, at least one).
+#: Samples per block of the replacement's scales and of the coarse-lattice check (at most MAX_BLOCKS blocks, at
+#: least one); the test's and the flagging's scale is local (:func:`._robust_scale.local_scales`).
 BLOCK = 8192
 MAX_BLOCKS = 64
 #: Least spread of the samples (standard deviation per block, in quantisation steps) for the lattice model to
@@ -131,59 +133,6 @@ def _lattice_step(x: np.ndarray) -> float:
     return _chunked.lattice_step(x)
 
 
-_SQRT2, _SQRT_2PI = math.sqrt(2.0), math.sqrt(2.0 * math.pi)
-
-
-def _inner(a: float, sigma: float, step: float) -> float:
-    """P(|d + U| < a), d ~ N(0, σ²), U uniform on (−L/2, L/2): (1/L)∫ [Φ((a−u)/σ) − Φ((−a−u)/σ)] du, closed
-    form with ∫Φ(x/σ)dx = xΦ(x/σ) + σφ(x/σ)."""
-
-    def psi(x: float) -> float:
-        z = x / sigma
-        return x * 0.5 * math.erfc(-z / _SQRT2) + sigma * math.exp(-0.5 * z * z) / _SQRT_2PI
-
-    h = step / 2.0
-    return float((psi(a + h) - psi(a - h) - psi(-a + h) + psi(-a - h)) / step)
-
-
-def robust_sigma(d: np.ndarray, step: float) -> float:
-    """σ of the Gaussian behind differences ``d`` (robust): 1.4826·median|d − median d| when continuous; on a
-    lattice of ``step`` L, the σ at which P(|d + U| < (j + ½)L) matches the share of |d| ≤ jL, j where that
-    share is nearest ½. NaN when the differences carry no scale (all equal)."""
-    d = np.asarray(d, dtype=np.float64)
-    if step <= 0:
-        mad = float(np.median(np.abs(d - np.median(d))))
-        return 1.4826 * mad if mad > 0 else float("nan")
-    j_all = np.round(np.abs(d) / step).astype(np.int64)
-    counts = np.bincount(j_all)
-    share = np.cumsum(counts) / d.size
-    j = int(np.argmin(np.abs(share - 0.5)))
-    target = float(share[j])
-    if target >= 1.0:
-        return float("nan")
-    return _lattice_sigma((j + 0.5) * step, target, step)
-
-
-@lru_cache(maxsize=4096)
-def _lattice_sigma(a: float, target: float, step: float) -> float:
-    """The σ with P(|d + U| < a) = ``target`` on the lattice ``step`` (NaN if none in 1e-6 … 1e6 steps): the same
-    share at the same count is asked again — blocks of equal length, the record tested again after a removal."""
-    lo, hi = 1e-6 * step, 1e6 * step
-    f_lo, f_hi = _inner(a, lo, step) - target, _inner(a, hi, step) - target
-    if f_lo * f_hi > 0:
-        return float("nan")
-    return float(brentq(lambda s: _inner(a, s, step) - target, lo, hi, xtol=1e-9 * step))
-
-
-def _tail(c: float, sigma: float, step: float) -> tuple[float, float]:
-    """(cut in the data's unit, P(|d| beyond it)) at c·σ: continuous 2Φ̄(c); on a lattice the next multiple
-    of L above c·σ, k·L, with P(|d_q| ≥ kL) = 2·(1 − P(d + U < (k − ½)L))."""
-    if step <= 0:
-        return c * sigma, float(2.0 * ndtr(-c))
-    k = math.floor(c * sigma / step) + 1
-    return (k - 0.5) * step, 1.0 - _inner((k - 0.5) * step, sigma, step)
-
-
 def _blocks(n: int) -> list[slice]:
     nb = int(min(MAX_BLOCKS, max(1, n // BLOCK)))
     edges = np.linspace(0, n, nb + 1).astype(np.int64)
@@ -216,14 +165,13 @@ def outlier_test(y: np.ndarray, fs: float, alpha: float) -> dict:
     d = np.diff(y)
     step = lattice_step(d)
     out["step"] = step
-    blocks = _blocks(d.size)
-    sig = np.array([robust_sigma(d[b], step) for b in blocks])
+    blocks, sig = local_scales(d, step)  # each sample judged at its local scale (:mod:`._robust_scale`)
     out["sigma_d"] = float(np.nanmedian(sig)) if np.isfinite(sig).any() else float("nan")
     if not np.isfinite(sig).all():
         out["note"] = "a block of the differenced record has no spread (constant samples)"
         return out
     if step > 0:
-        spread = min(float(np.std(y[b])) for b in blocks)
+        spread = min(float(np.std(y[b])) for b in _blocks(d.size))
         if not spread >= COARSE * step:
             # the quantisation offsets are uniform only when the samples wander over a step or more
             out["note"] = (
@@ -264,13 +212,12 @@ def _flag_p(k: int, lam: float) -> float:
 
 
 def flag_at(y: np.ndarray, c: float) -> tuple[np.ndarray, float]:
-    """Flags of the samples ``y`` at the cut ``c`` (σ of the differences, each block's own) and the number of
+    """Flags of the samples ``y`` at the cut ``c`` (σ of the differences, each block's local scale) and the number of
     Gaussian samples expected among them (λ): the flagging of :func:`outlier_test` at a given cut."""
     y = np.asarray(y, dtype=np.float64)
     d = np.diff(y)
     step = lattice_step(d)
-    blocks = _blocks(d.size)
-    sig = np.array([robust_sigma(d[b], step) for b in blocks])
+    blocks, sig = local_scales(d, step)
     if not np.isfinite(sig).all():
         return np.zeros(y.size, dtype=bool), 0.0
     flags, lam, _cut = _flags_of(y, d, blocks, sig, step, c, _level_residual(y, step))
@@ -294,8 +241,7 @@ def _level_residual(y: np.ndarray, step: float) -> tuple[np.ndarray, list, np.nd
     if span < LEVEL_SPAN:
         return None
     r = y - _slow_level(y, np.zeros(y.size, dtype=bool), span)
-    blocks = _blocks(y.size)
-    sig = np.array([robust_sigma(r[b], step) for b in blocks])
+    blocks, sig = local_scales(r, step)
     return (r, blocks, sig) if np.isfinite(sig).all() and np.all(sig > 0) else None
 
 
