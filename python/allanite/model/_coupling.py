@@ -1,6 +1,7 @@
 """A channel regression's tests (:mod:`allanite.model.channels`): the coupling's likelihood ratio, the channel and
 its quadrature against no coupling (:func:`coupling_test`), and the optional terms, each by its own nested test at
-its own share of the level — the quadratic, then a d(ch)/dt term or a lag, never both (:func:`optional_terms`).
+its own share of the level — the quadratic (run also where the coupling's test fails: :func:`quadratic_test`), then
+a d(ch)/dt term or a lag, never both (:func:`optional_terms`).
 Whittle's frequency-domain likelihood (:mod:`allanite.model._whittle`) throughout."""
 
 from __future__ import annotations

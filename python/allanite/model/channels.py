@@ -32,7 +32,10 @@ docs/channels.md "Quantised and held channels").
 
 Optional terms, each kept only by its own nested test at its own share of the level:
 
-- ``quadratic`` — on (ch − mean)² (per channel unit²): likelihood ratio, F(1, ν);
+- ``quadratic`` — on (ch − mean)² (per channel unit²): likelihood ratio, F(1, ν); run also where the coupling's
+  test fails, and where it passes then the coupling is accepted by it (a turnover temperature: a bias on
+  (T − T₀)² with T₀ inside the swing has no linear part; T₀ = mean − b₁/(2·b₂) with its interval in
+  ``terms["quadratic"]["turnover"]``; docs/channels.md "A turnover temperature");
 - ``rate_coefficient`` — on d(ch)/dt (per channel unit/s, central differences): likelihood ratio, F(1, ν);
 - ``lag_s`` — the rate follows the channel through a first-order lag of that time constant (s): the family
   c·ch + c_L·(L_T[ch] − ch)/T over T on a log grid (T → 0 is the d(ch)/dt direction), its largest score
@@ -183,9 +186,11 @@ class ChannelRegression:
     ``test``: the coupling's likelihood ratio, the channel and its quadrature together (``statistic``, 2Δℓ),
     ``threshold`` (2·F(2, ν)), ``alpha``, ``dof`` (ν), ``p_value``, ``phase_deg`` (the phase by which the
     coupling follows the channel, positive for a lag) and ``in_phase`` (the channel alone: 2Δℓ against F(1, ν),
-    the test before the quadrature was added); ``terms``: each optional term's test (``statistic``,
-    ``threshold``, ``alpha``, ``dof``, ``kept``, and why not); ``accepted``: the coupling passed its test
-    (optional terms are tried only then).
+    the test before the quadrature was added), ``accepted_by`` (``"channel"``, or ``"quadratic"``: the
+    quadratic's own test, under ``quadratic``, where the channel's failed — a turnover); ``terms``: each optional
+    term's test (``statistic``, ``threshold``, ``alpha``, ``dof``, ``kept``, and why not; the quadratic's
+    ``turnover``: T₀, whether inside the channel's range, its interval there); ``accepted``: the coupling passed
+    its test or the quadratic's (optional terms are tried only then).
     ``removal_lag_s``: the lag the component runs the channel through — the kept ``lag_s``, or a lag its test
     did not resolve but the profile prefers to none (``terms["lag_s"]["profiled"]``, not a param), or None.
     ``form``: how the channel was written (:class:`allanite.model._staircase.ChannelForm`: quantum, hold, a slow
