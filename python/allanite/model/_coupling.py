@@ -1,6 +1,7 @@
 """A channel regression's tests (:mod:`allanite.model.channels`): the coupling's likelihood ratio, the channel and
 its quadrature against no coupling (:func:`coupling_test`), and the optional terms, each by its own nested test at
-its own share of the level — the quadratic, then a d(ch)/dt term or a lag, never both (:func:`optional_terms`).
+its own share of the level — the quadratic (run also where the coupling's test fails: :func:`quadratic_test`), then
+a d(ch)/dt term or a lag, never both (:func:`optional_terms`).
 Whittle's frequency-domain likelihood (:mod:`allanite.model._whittle`) throughout."""
 
 from __future__ import annotations
@@ -17,7 +18,15 @@ from ._lag import lag_profile, lag_response, lag_test
 from ._regressors import regressor_design
 from ._shares import TERM_SHARE
 
-__all__ = ["LAG_MARGIN", "BOOT_COST", "BOOT_DRAWS", "coupling_test", "optional_terms", "bootstrap_scale"]
+__all__ = [
+    "LAG_MARGIN",
+    "BOOT_COST",
+    "BOOT_DRAWS",
+    "coupling_test",
+    "quadratic_test",
+    "optional_terms",
+    "bootstrap_scale",
+]
 
 #: The pure lag replaces a kept rate term only if it fits better by this much in 2Δℓ ("positive" evidence).
 LAG_MARGIN = 4.0
@@ -148,14 +157,24 @@ def coupling_test(bands, null, alpha) -> tuple[dict, dict, dict]:
     return test, in_phase, fit
 
 
-def optional_terms(bands, fit, terms, level, grid, z2):
-    """Quadratic first, then d(ch)/dt or a lag (never both). Returns (kept keys, fit, lag_s, tests)."""
+def quadratic_test(bands, fit, level) -> tuple[dict, dict]:
+    """The quadratic's nested test: (ch − mean)² beside the channel against the channel alone (``fit``, the
+    in-phase fit), 2Δℓ against F(1, ν) at its :data:`TERM_SHARE` of ``level``. Returns (the test with ``kept``,
+    the fit with both columns). Run whether or not the coupling's own test accepts (docs/channels.md, "A
+    turnover temperature"): a bias on (T − T₀)² with T₀ inside the swing has almost no linear part."""
+    nb = bands.m.size
+    t_q, big = _nested(bands, regressor_design(["quadratic"], nb), fit, TERM_SHARE["quadratic"] * level)
+    return t_q | {"kept": t_q["statistic"] > t_q["threshold"]}, big
+
+
+def optional_terms(bands, fit, terms, level, grid, z2, quadratic=None):
+    """Quadratic first (``quadratic``: its :func:`quadratic_test` already run), then d(ch)/dt or a lag (never
+    both). Returns (kept keys, fit, lag_s, tests)."""
     nb = bands.m.size
     keys: list = []
     tests: dict = {}
     if "quadratic" in terms:
-        t_q, big = _nested(bands, regressor_design(["quadratic"], nb), fit, TERM_SHARE["quadratic"] * level)
-        tests["quadratic"] = t_q | {"kept": t_q["statistic"] > t_q["threshold"]}
+        tests["quadratic"], big = quadratic if quadratic is not None else quadratic_test(bands, fit, level)
         if tests["quadratic"]["kept"]:
             keys, fit = ["quadratic"], big
     design = regressor_design(keys, nb)

@@ -299,6 +299,10 @@ def _slow_regression(
     if r is None:
         r = channels.regress_channel(ctx.y, ch, ctx.fs, name=name, alpha=a, level=ctx.level)
     test = tested("likelihood_ratio", r.test["statistic"], r.test["threshold"], a) | {"dof": r.test["dof"]}
+    if r.test.get("accepted_by") == "quadratic":  # a turnover: the channel's square, its own share (docs/channels.md)
+        q = r.test["quadratic"]
+        test = tested("likelihood_ratio", q["statistic"], q["threshold"], q["alpha"])
+        test |= {"dof": q["dof"], "accepted_by": "quadratic", "channel_test": r.test["statistic"]}
     if not r.accepted:
         ctx.consider("regression", {"channel": name} | test)
         return
