@@ -136,6 +136,8 @@ NOTES = [
     "35th harmonic at 6.65 Hz is the other's 2·3.1 + 0.45 Hz sideband — was removed twice: χ²/dof 1.73 → 0.903), "
     "and *temperature and spikes* refined without the regression candidate says the rate still follows 'temp' "
     "(2 regions, 1 before).",
+    "",
+    "**Rerun whole at 6909b06** (r9line, r9blind7, r9chan, r9acc, r9pump, r9turn merged; the table above is this run's, beside CI and two helpers — its CPU seconds are not a cost measurement): **17 of 17**, without the candidate **17 of 17**; every row's effects, parameters and words as at 44eba23 but *sparse spikes*' outliers rate (+0.9 → +0.7 %, the outliers test's local scale).",
 ]
 
 
