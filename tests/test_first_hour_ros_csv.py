@@ -1,0 +1,45 @@
+"""A ``rostopic echo -p`` CSV of a sensor_msgs/Imu, as a new user reads it (r9review): its ``field.header.frame_id``
+text column stopped the reader ('imu_link' is not a number) and its rates had no unit though REP 103 fixes them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from allanite import read_log
+from allanite.errors import InputError
+from allanite.io._units import column_unit
+
+
+def _rostopic_csv(path, n=400, fs=100.0, seed=5):
+    rng = np.random.default_rng(seed)
+    t = 1_600_000_000_000_000_000 + np.arange(n) * int(1e9 / fs)
+    w, a = rng.normal(0, 1e-3, (n, 3)), rng.normal((0.0, 0.0, 9.81), 1e-2, (n, 3))
+    head = (
+        "%time,field.header.seq,field.header.stamp,field.header.frame_id,field.angular_velocity.x,"
+        "field.angular_velocity.y,field.angular_velocity.z,field.linear_acceleration.x,"
+        "field.linear_acceleration.y,field.linear_acceleration.z"
+    )
+    rows = [f"{t[i] + 7},{i},{t[i]},imu_link," + ",".join(f"{v:.9g}" for v in (*w[i], *a[i])) for i in range(n)]
+    path.write_text(head + "\n" + "\n".join(rows) + "\n")
+    return path, w
+
+
+def test_a_text_column_is_no_axis_and_rostopic_units_are_read(tmp_path):
+    p, w = _rostopic_csv(tmp_path / "imu.csv")
+    with pytest.warns(UserWarning, match=r"'field.header.frame_id' hold text \('imu_link' on the first data row\)"):
+        log = read_log(p)
+    assert "field.header.frame_id" not in log.columns and log.fs == 100.0
+    assert log.groups["rad/s"] == [f"field.angular_velocity.{c}" for c in "xyz"]
+    assert log.groups["m/s^2"] == [f"field.linear_acceleration.{c}" for c in "xyz"]
+    gyro = log.take(log.groups["rad/s"])
+    assert gyro.unit.name == "rad/s" and "REP 103" in gyro.unit_source
+    np.testing.assert_allclose(gyro.data, w, rtol=1e-8)
+    with pytest.raises(InputError, match=r"'imu_link' is not a number"):  # asked for by name: still refused
+        read_log(p, columns=["field.header.frame_id", "field.angular_velocity.x"])
+
+
+def test_rostopic_field_units():
+    assert column_unit("field.angular_velocity.z").name == "rad/s"
+    assert column_unit("field.linear_acceleration.x").name == "m/s^2"
+    assert column_unit("field.orientation.x") is None and column_unit("field.angular_velocity.w") is None
