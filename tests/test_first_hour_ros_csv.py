@@ -43,3 +43,20 @@ def test_rostopic_field_units():
     assert column_unit("field.angular_velocity.z").name == "rad/s"
     assert column_unit("field.linear_acceleration.x").name == "m/s^2"
     assert column_unit("field.orientation.x") is None and column_unit("field.angular_velocity.w") is None
+
+
+def test_a_stretch_far_shorter_than_the_log_is_said(tmp_path, capsys):
+    # 2 % dropped packets: --gaps longest analysed 0.3 % of a 20-minute ROS log and said only "samples a–b of n"
+    from allanite import cli
+
+    p, _ = _rostopic_csv(tmp_path / "imu.csv", n=3000)
+    lines = p.read_text().splitlines()
+    keep = [ln for k, ln in enumerate(lines) if k == 0 or k % 50 != 7]  # every 50th row dropped: gaps of one sample
+    p.write_text("\n".join(keep) + "\n")
+    args = ["report", str(p), "--columns", "field.angular_velocity.x", "--gaps", "longest", "--no-fit"]
+    assert cli.main([*args, "--out", str(tmp_path / "o")]) == 0
+    printed = capsys.readouterr().out
+    assert "60 gap(s); only the longest gap-free stretch, samples 6–54 of 2940, is analysed" in printed
+    assert "— 1.7 % of the log: its gaps are many or long, each result is of this stretch alone" in printed
+    assert "(--gaps split lists every stretch)" in printed
+    assert "Time column '%time' was read in ns, the unit its name gives" in printed and "ends in" not in printed

@@ -113,7 +113,7 @@ def column_unit(name) -> ColumnUnit | None:
     if ros is not None:  # rostopic echo -p of a sensor_msgs/Imu: its units by REP 103
         hit = _known("rad/s" if ros.group(1) == "angular_velocity" else "m/s^2")
         assert hit is not None
-        return ColumnUnit(hit[0], hit[1], "sensor_msgs/Imu (REP 103)")
+        return ColumnUnit(hit[0], hit[1], "sensor_msgs/Imu, REP 103")
     m = _BRACKETED.search(name)
     if m is not None and m.group(1):
         hit = _known(m.group(1))
