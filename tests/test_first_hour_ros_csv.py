@@ -60,3 +60,25 @@ def test_a_stretch_far_shorter_than_the_log_is_said(tmp_path, capsys):
     assert "— 1.7 % of the log: its gaps are many or long, each result is of this stretch alone" in printed
     assert "(--gaps split lists every stretch)" in printed
     assert "Time column '%time' was read in ns, the unit its name gives" in printed and "ends in" not in printed
+
+
+def test_the_channel_note_says_the_coefficient_is_per_the_channels_unit(monkeypatch):
+    # the note read "its regression on other channels, which the channels imply; a channel's unit is not known to
+    # allanite" beside a column named temp [degC] — as if the coefficient's unit were unknowable
+    from allanite.report import _sections
+
+    class Progress:
+        def step(self, what):
+            pass
+
+    monkeypatch.setattr(_sections, "refine_axes", lambda *a: [None])  # the note, not the refinement, is tested
+    notes: list = []
+    settings: dict = {}
+    asked = (("regression",), ["temp [degC]"])
+    out = _sections.refinement_section(None, 10.0, "rate", "deg/s", None, ["gx"], asked, notes, settings, Progress())
+    assert out == [None] and settings["channels"] == ["temp [degC]"]
+    assert notes == [
+        "Channel temp [degC] passed to every axis's model refinement, for its regression on them (channels imply "
+        "refine); a coefficient is per unit of the channel's samples, as logged (its name's unit, where it gives "
+        "one, e.g. [degC]): allanite converts no channel's unit."
+    ]
