@@ -82,3 +82,22 @@ def test_the_channel_note_says_the_coefficient_is_per_the_channels_unit(monkeypa
         "refine); a coefficient is per unit of the channel's samples, as logged (its name's unit, where it gives "
         "one, e.g. [degC]): allanite converts no channel's unit."
     ]
+
+
+def test_an_imu_logs_two_reports_are_no_warning(tmp_path, capsys):
+    # EuRoC's gyro and accelerometer, every column taken, were also printed as "allanite: warning: columns …"
+    from allanite import cli
+
+    rng = np.random.default_rng(4)
+    t = 1_403_636_579_758_555_392 + np.arange(1000) * 5_000_000
+    p = _csv_rows(tmp_path / "data.csv", "#timestamp [ns],w_RS_S_x [rad s^-1],a_RS_S_x [m s^-2]", t, rng)
+    assert cli.main(["report", str(p), "--no-fit", "--out", str(tmp_path / "o")]) == 0
+    out, err = capsys.readouterr()
+    assert "a_RS_S_x [m s^-2] in m/s^2 in a report of their own (accelerometer/report.html)" in out
+    assert "warning" not in err
+
+
+def _csv_rows(path, header, t, rng):
+    rows = [f"{s}," + ",".join(f"{v:.6g}" for v in rng.normal(size=header.count(","))) for s in t]
+    path.write_text(header + "\n" + "\n".join(rows) + "\n")
+    return path
