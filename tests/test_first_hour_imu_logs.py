@@ -1,5 +1,7 @@
-"""A ``rostopic echo -p`` CSV of a sensor_msgs/Imu, as a new user reads it (r9review): its ``field.header.frame_id``
-text column stopped the reader ('imu_link' is not a number) and its rates had no unit though REP 103 fixes them."""
+"""IMU logs unlike the ADIS16405 as a new user runs them (r9review): a ``rostopic echo -p`` CSV of a sensor_msgs/Imu
+(its ``field.header.frame_id`` text column stopped the reader, its REP 103 units were not taken, dropped packets left
+a sliver analysed without saying its share), a EuRoC log's two reports warned of, the channel note's words, and a
+constant axis's figures — each test a small record that failed before its fix."""
 
 from __future__ import annotations
 
@@ -101,3 +103,20 @@ def _csv_rows(path, header, t, rng):
     rows = [f"{s}," + ",".join(f"{v:.6g}" for v in rng.normal(size=header.count(","))) for s in t]
     path.write_text(header + "\n" + "\n".join(rows) + "\n")
     return path
+
+
+def test_a_constant_axis_draws_its_figures_without_matplotlibs_warnings():
+    # a logged axis that never moves (an unused channel; a simulator's constant accelerometer) printed
+    # matplotlib's "Data has no positive values, and therefore cannot be log-scaled" twice per figure
+    import warnings
+
+    from allanite.report import build_report
+    from allanite.report.rendering import png
+
+    x = np.c_[np.random.default_rng(1).normal(size=1200), np.full(1200, 9.81)]
+    rep = build_report(x, 100.0, window=300, hop=100, progress=False)
+    assert any("Allan variance of zero at every τ" in n for n in rep.summary()["notes"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        drawn = [png(spec, 40) for spec in rep.figure_specs()]
+    assert len(drawn) >= 5 and all(d.startswith(b"\x89PNG") for d in drawn)
