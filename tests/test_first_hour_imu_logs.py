@@ -27,6 +27,7 @@ def _rostopic_csv(path, n=400, fs=100.0, seed=5):
     return path, w
 
 
+@pytest.mark.filterwarnings("ignore:.*count the rows")  # field.header.seq: its own test
 def test_a_text_column_is_no_axis_and_rostopic_units_are_read(tmp_path):
     p, w = _rostopic_csv(tmp_path / "imu.csv")
     with pytest.warns(UserWarning, match=r"'field.header.frame_id' hold text \('imu_link' on the first data row\)"):
