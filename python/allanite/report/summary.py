@@ -371,6 +371,15 @@ def column_heads(names, width: int) -> list[str]:
     return [nm if len(nm) <= width else "…" + nm[len(nm) - width + 1 :] for nm in names]
 
 
+def _instant(t: float) -> str:
+    """A time along the record in whole seconds, and in h from an hour on (a 25-hour log's 52050 s: 14.5 h).
+
+    >>> _instant(1106.4), _instant(52050.0)
+    ('1106 s', '52050 s (14.5 h)')
+    """
+    return f"{t:.0f} s" + (f" ({duration(t)})" if t >= 3600 else "")
+
+
 def _adev_text(s: dict) -> list[str]:
     """The static Allan deviation: a table of τ, n and each axis's value with its interval."""
     rec, st = s["record"], s["static"]
@@ -463,8 +472,8 @@ def _dynamic_text(s: dict) -> list[str]:
         lines.append(
             f"  {ax['name']}: ADEV at τ = {g(ax['tau_s'])} s over time: median "
             f"{g(ax['adev_shortest_tau_median'])}, max {g(ax['adev_shortest_tau_max'])} at t = "
-            f"{ax['t_of_max_s']:.0f} s, min {g(ax['adev_shortest_tau_min'])} at t = "
-            f"{ax['t_of_min_s']:.0f} s, max/min = {ratio}"
+            f"{_instant(ax['t_of_max_s'])}, min {g(ax['adev_shortest_tau_min'])} at t = "
+            f"{_instant(ax['t_of_min_s'])}, max/min = {ratio}"
         )
     ser = fit.get("series")
     if ser and ser["axes"] is not None:
