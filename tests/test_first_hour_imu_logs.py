@@ -121,3 +121,16 @@ def test_a_constant_axis_draws_its_figures_without_matplotlibs_warnings():
         warnings.simplefilter("error")
         drawn = [png(spec, 40) for spec in rep.figure_specs()]
     assert len(drawn) >= 5 and all(d.startswith(b"\x89PNG") for d in drawn)
+
+
+def test_a_dropped_packet_reads_as_one_sample_of_the_step(tmp_path):
+    # a ROS log's dropped packets were listed as "0.00999998 s (≈1 samples) missing" (a ns epoch stamp's rounding)
+    from allanite.errors import DataGapError
+
+    p, _ = _rostopic_csv(tmp_path / "imu.csv", n=400)
+    lines = p.read_text().splitlines()
+    p.write_text("\n".join(lines[:101] + lines[102:]) + "\n")  # data row 100 dropped
+    with pytest.raises(
+        DataGapError, match=r"1 gap\(s\).*: 0\.01 s \(≈1 sample\) missing after sample 99 at t = 0\.99 s"
+    ):
+        read_log(p, columns=["field.angular_velocity.x"])
