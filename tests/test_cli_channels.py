@@ -130,7 +130,8 @@ def test_channel_is_cut_at_the_same_gaps_as_the_samples(tmp_path):
         (["--channels", "tmp"], r"log\.csv.*'label'"),  # without --columns every column is read: 'label' is text
         (["--columns", "g_x,g_y", "--channels", "g_x"], r"column 'g_x' is given in both --columns and --channels"),
         (["--columns", "g_x,g_y", "--channels", "0"], r"column 'g_x' is both a sample column and a channel"),
-        (["--channels", "4"], r"log\.csv.*'label'"),  # by index without --columns: the file's column 4, 'hot'
+        # by index without --columns: the file's column 4, 'hot' (the text column 'label' is no axis, left out)
+        (["--channels", "4"], r"log\.csv: line 52, channel column 'hot': infinite value inf"),
         (["--columns", "g_x,g_y", "--channels", "temp,temp"], r"column 'temp' is given twice in --channels"),
         (["--columns", "g_x,g_y", "--channels", "label"], r"log\.csv.*'label'"),  # a text column
         (["--columns", "g_x,g_y", "--channels", "hot"], r"log\.csv: line 52, channel column 'hot': infinite value inf"),

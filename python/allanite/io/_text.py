@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import gzip
 import os
+import warnings
 import zlib
 from functools import cached_property
 
@@ -277,6 +278,8 @@ def read_text(path, columns, time_column, delimiter, gz, channels=None):
         head, whole = doc.lines, True  # the header or the first data row lies beyond the head
         i0, start, delim, ncols, names = _layout(path, head, delimiter)
     idx, t_idx, squeeze = select_columns(columns, time_column, names, path, channels=channels)
+    if columns is None:
+        idx, squeeze = _without_text(path, head, start, delim, names, idx, squeeze)
     ch = pick_channels(channels, idx, t_idx, names, path)
     iso = t_idx is not None and delim is not None and _first_field_iso(head, start, delim, t_idx)
     need = sorted(set(idx + ch + ([t_idx] if t_idx is not None and not iso else [])))
@@ -370,6 +373,30 @@ def _split_parsed(arr, groups, squeeze) -> list:
         else:
             outs.append(arr[:, g[0]].copy())
     return outs
+
+
+def _without_text(path, lines, start, delim, names, idx, squeeze):
+    """Without ``columns=``: a column that holds text on the first and the last data row of the file's head
+    (``rostopic echo -p``'s ``field.header.frame_id``) is no axis — left out with a warning, as a row counter is;
+    kept (and reported as not a number) when every chosen column holds text, or one damaged row does."""
+    rows = [_split(_strip_comment(ln), delim) for ln in lines[start:] if _strip_comment(ln).strip()]
+    if not rows:
+        return idx, squeeze
+    fields = rows[0]
+
+    def text_in(row, i):
+        return i < len(row) and bool(row[i].strip()) and not _is_number(row[i])
+
+    text = [i for i in idx if text_in(fields, i) and text_in(rows[-1], i)]
+    if not text or len(text) == len(idx):
+        return idx, squeeze
+    warnings.warn(
+        f"{path}: column(s) {', '.join(repr(names[i]) for i in text)} hold text ({fields[text[0]].strip()!r} on "
+        "the first data row): not analysed as an axis; name the columns to analyse with columns= (--columns)",
+        stacklevel=4,
+    )
+    kept = [i for i in idx if i not in text]
+    return kept, len(kept) == 1
 
 
 def _first_field_iso(lines, start, delim, k) -> bool:

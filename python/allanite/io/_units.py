@@ -93,16 +93,27 @@ def _known(text: str) -> tuple[str, str] | None:
     return None
 
 
+#: ``rostopic echo -p``'s columns of a sensor_msgs/Imu, whose units REP 103 fixes (rad/s, m/s²).
+_ROS_FIELD = re.compile(r"field\.(angular_velocity|linear_acceleration)\.[xyz]")
+
+
 def column_unit(name) -> ColumnUnit | None:
     """The unit a column's name gives (the module's grammar), or None.
 
     >>> [column_unit(c).name for c in ("w_RS_S_x [rad s^-1]", "a_RS_S_z [m s^-2]", "gx (deg/s)", "gz_dps", "a [g]")]
     ['rad/s', 'm/s^2', 'deg/s', 'deg/s', 'g']
+    >>> column_unit("field.angular_velocity.x").name, column_unit("field.linear_acceleration.z").name  # rostopic -p
+    ('rad/s', 'm/s^2')
     >>> column_unit("gx") is None, column_unit("T [degC]") is None
     (True, True)
     """
     if not isinstance(name, str):
         return None
+    ros = _ROS_FIELD.fullmatch(name.strip())
+    if ros is not None:  # rostopic echo -p of a sensor_msgs/Imu: its units by REP 103
+        hit = _known("rad/s" if ros.group(1) == "angular_velocity" else "m/s^2")
+        assert hit is not None
+        return ColumnUnit(hit[0], hit[1], "sensor_msgs/Imu, REP 103")
     m = _BRACKETED.search(name)
     if m is not None and m.group(1):
         hit = _known(m.group(1))

@@ -48,7 +48,9 @@ class Gap:
 
     def __str__(self) -> str:
         return (
-            f"{self.duration:.6g} s (≈{self.missing} samples) missing after sample {self.index - 1} "
+            # 4 digits: a ns epoch stamp's float rounding read a 10 ms gap as 0.00999998 s
+            f"{self.duration:.4g} s (≈{self.missing} sample{'' if self.missing == 1 else 's'}) missing after "
+            f"sample {self.index - 1} "
             f"at t = {self.time:.6g} s"
         )
 

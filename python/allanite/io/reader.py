@@ -67,8 +67,10 @@ def read_log(
     columns : str, int or list, optional
         Which columns are the samples, by name or 0-based index. A single name or index gives 1-D
         data; a list gives (samples, axes). Default: every column except the time column, the channels and a
-        column that counts the rows (each value the previous + 1: pandas' unnamed index, a sequence counter;
-        left out with a warning) (ROS bags: the three ``angular_velocity_*`` components).
+        column that counts the rows (each value the previous + 1: pandas' unnamed index, a sequence counter)
+        or, in a text log, holds text on its first and last rows of the head (``rostopic echo -p``'s
+        ``field.header.frame_id``) — each left out with a warning (ROS bags: the three ``angular_velocity_*``
+        components).
     time_column : str or int, optional
         Column of sample times (seconds unless ``time_unit`` says otherwise; in a text log also ISO 8601
         date-times, ``2026-11-27T10:00:00.005`` with an optional ``Z`` or offset: 1.8 s of CPU per 10⁶ rows

@@ -33,8 +33,9 @@ def refinement_section(x, fs, input, unit_name, static, axis_names, asked, notes
             settings["channels"] = list(channels)
             notes.append(
                 f"Channel{'s' if len(channels) > 1 else ''} {', '.join(channels)} passed to every axis's model "
-                "refinement (its regression on other channels, which the channels imply); a channel's unit is "
-                "not known to allanite: its coefficients are per unit of the channel."
+                "refinement, for its regression on them (channels imply refine); a coefficient is per unit of the "
+                "channel's samples, as logged (its name's unit, where it gives one, e.g. [degC]): allanite converts "
+                "no channel's unit."
             )
     return refinements
 

@@ -379,6 +379,16 @@ def _fit_windows(dynamic, unit, confidence, tau_from):
         return fit_model(dynamic, unit=unit, confidence=confidence, tau_range=tau_range, thin=False)
 
 
+def _share(log) -> str:
+    """The analysed stretch's share of a gapped log, said where it is under half of it: many short gaps
+    (dropped samples) leave a stretch far shorter than the log, which the report's numbers are of."""
+    share = (log.span[1] - log.span[0]) / log.n_record
+    if share >= 0.5:
+        return ""
+    listed = "" if log.segment_spans is not None else " (--gaps split lists every stretch)"
+    return f" — {100 * share:.2g} % of the log: its gaps are many or long, each result is of this stretch alone{listed}"
+
+
 def log_source(log) -> dict:
     """JSON-able description of a :class:`~allanite.Log` for the report's Record section."""
     src = {
@@ -452,13 +462,13 @@ def from_log(log, **kwargs) -> Report:
         )
     if log.time_unit_from_name:
         notes.append(
-            f"Time column {log.time_column!r} was read in {log.time_unit}, the unit its name ends in "
-            "(--time-unit / read_log(time_unit=…) overrides it)."
+            f"Time column {log.time_column!r} was read in {log.time_unit}, the unit its name gives (time_ns, "
+            "t [ms]; rostopic echo -p's %time: ns) (--time-unit / read_log(time_unit=…) overrides it)."
         )
     if log.gaps:
         notes.append(
             f"The log has {len(log.gaps)} gap(s); only the longest gap-free stretch, samples "
-            f"{log.span[0]}–{log.span[1] - 1} of {log.n_record}, is analysed"
+            f"{log.span[0]}–{log.span[1] - 1} of {log.n_record}, is analysed{_share(log)}"
             + (
                 f" (all {len(log.segment_spans)} stretches are listed in summary.json)."
                 if log.segment_spans is not None

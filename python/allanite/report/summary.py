@@ -358,6 +358,28 @@ def _unit_words(rec: dict) -> str:
     return rec["unit"] or "unknown (give --unit)"
 
 
+def column_heads(names, width: int) -> list[str]:
+    """Axis names cut to ``width`` characters for a table's heads — from the end, after an ellipsis, where cutting
+    their ends leaves two alike (``field.linear_acceleration.x`` … were three heads ``field.linear_acceleration.``).
+
+    >>> column_heads(["gx [dps]", "field.angular_velocity.x", "field.angular_velocity.y"], 12)
+    ['gx [dps]', '…_velocity.x', '…_velocity.y']
+    """
+    heads = [nm[:width] for nm in names]
+    if len(set(heads)) == len(heads):
+        return heads
+    return [nm if len(nm) <= width else "…" + nm[len(nm) - width + 1 :] for nm in names]
+
+
+def _instant(t: float) -> str:
+    """A time along the record in whole seconds, and in h from an hour on (a 25-hour log's 52050 s: 14.5 h).
+
+    >>> _instant(1106.4), _instant(52050.0)
+    ('1106 s', '52050 s (14.5 h)')
+    """
+    return f"{t:.0f} s" + (f" ({duration(t)})" if t >= 3600 else "")
+
+
 def _adev_text(s: dict) -> list[str]:
     """The static Allan deviation: a table of τ, n and each axis's value with its interval."""
     rec, st = s["record"], s["static"]
@@ -373,7 +395,7 @@ def _adev_text(s: dict) -> list[str]:
             cells.append(f"{g(v):>10} (−{pct(v, lo)}/+{pct(v, hi)} %)")
         rows.append(cells)
     w = max([27] + [len(c) + 2 for cells in rows for c in cells])  # never one column run into the next
-    lines.append(f"  {'tau (s)':>9} {'n':>10}  " + "".join(f"{nm[: w - 1]:<{w}}" for nm in names).rstrip())
+    lines.append(f"  {'tau (s)':>9} {'n':>10}  " + "".join(f"{nm:<{w}}" for nm in column_heads(names, w - 1)).rstrip())
     for tau, n, cells in zip(st["tau_s"], st["n"], rows):
         lines.append(f"  {tau:>9.4g} {n:>10}  " + "".join(c.ljust(w) for c in cells).rstrip())
     return lines
@@ -404,7 +426,9 @@ def _fit_text(s: dict) -> list[str]:
     # each column as wide as its widest cell and two spaces: "2.37e-05 [2.37e-05, 2.37e-05]" ran into the next
     w2 = max([26] + [len(c) + 2 for _, _, cells in rows for c in cells])
     w1 = max([25] + [len(label) + 1 for label, _, _ in rows])  # "K acceleration random walk" (26)
-    lines.append(f"  {'term':<{w1}}{'unit':<10}" + "".join(f"{nm[: w2 - 1]:<{w2}}" for nm in names).rstrip())
+    lines.append(
+        f"  {'term':<{w1}}{'unit':<10}" + "".join(f"{nm:<{w2}}" for nm in column_heads(names, w2 - 1)).rstrip()
+    )
     for label, unit, cells in rows:
         lines.append(f"  {label:<{w1}}{unit:<10}" + "".join(c.ljust(w2) for c in cells).rstrip())
     lines.append(
@@ -448,8 +472,8 @@ def _dynamic_text(s: dict) -> list[str]:
         lines.append(
             f"  {ax['name']}: ADEV at τ = {g(ax['tau_s'])} s over time: median "
             f"{g(ax['adev_shortest_tau_median'])}, max {g(ax['adev_shortest_tau_max'])} at t = "
-            f"{ax['t_of_max_s']:.0f} s, min {g(ax['adev_shortest_tau_min'])} at t = "
-            f"{ax['t_of_min_s']:.0f} s, max/min = {ratio}"
+            f"{_instant(ax['t_of_max_s'])}, min {g(ax['adev_shortest_tau_min'])} at t = "
+            f"{_instant(ax['t_of_min_s'])}, max/min = {ratio}"
         )
     ser = fit.get("series")
     if ser and ser["axes"] is not None:
