@@ -58,8 +58,9 @@ def _new_direction(bands, design, s) -> np.ndarray:
 
 
 def _nested(bands, design, fit_small, alpha) -> tuple[dict, dict]:
-    """Likelihood-ratio test of the last regressor of ``design`` (both models refitted, noise included)."""
-    big = wh.joint_fit(bands, design)
+    """Likelihood-ratio test of the last regressor of ``design`` (both models refitted, noise included; the larger
+    one never below the smaller: :func:`allanite.model._whittle.nested_fit`)."""
+    big = wh.nested_fit(bands, design, fit_small)
     v = _new_direction(bands, design, big["s"])
     dof = wh.noise_dof(bands, big, wh.band_info(bands, design, v))
     return _f_test(2.0 * (big["loglik"] - fit_small["loglik"]), dof, alpha), big
@@ -68,7 +69,7 @@ def _nested(bands, design, fit_small, alpha) -> tuple[dict, dict]:
 def _pair_statistic(bands, null) -> tuple[float, dict]:
     """2Δℓ of the channel and its quadrature against ``null`` (both models' noise refitted), and the pair's fit."""
     one = np.ones(bands.m.size)
-    big = wh.joint_fit(bands, wh.Design([0, 0], [one, -1j * one]))
+    big = wh.nested_fit(bands, wh.Design([0, 0], [one, -1j * one]), null)
     return 2.0 * (big["loglik"] - null["loglik"]), big
 
 
@@ -98,7 +99,7 @@ def bootstrap_scale(bands, null, seed: int = 0) -> tuple[float, float]:
     for _ in range(BOOT_DRAWS):
         b = _null_bands(bands, null["s"], rng)
         fit0 = wh.joint_fit(b, wh.Design([], []))
-        total += (_pair_statistic(b, fit0)[0], 2.0 * (wh.joint_fit(b, one)["loglik"] - fit0["loglik"]))
+        total += (_pair_statistic(b, fit0)[0], 2.0 * (wh.nested_fit(b, one, fit0)["loglik"] - fit0["loglik"]))
     return max(1.0, float(total[0]) / BOOT_DRAWS / 2.0), max(1.0, float(total[1]) / BOOT_DRAWS)
 
 

@@ -39,6 +39,7 @@ __all__ = [
     "spectra",
     "fit_noise",
     "joint_fit",
+    "nested_fit",
     "Design",
     "cross",
     "score",
@@ -273,34 +274,64 @@ def loglik(bands: Bands, resid: np.ndarray, s: np.ndarray) -> float:
     return float(-np.sum(bands.m * np.log(s) + resid / s))
 
 
-def joint_fit(bands: Bands, design: Design, fixed_s: np.ndarray | None = None) -> dict:
+def joint_fit(bands: Bands, design: Design, fixed_s: np.ndarray | None = None, start: dict | None = None) -> dict:
     """Coefficients and noise jointly (alternating: GLS of the coefficients with the noise fixed, the noise
     refitted on the residual — the noise never sees the channel's share). With ``fixed_s`` the noise stays put.
+
+    The alternation is not monotone: the noise refit (IRLS-NNLS, warm-started) is not a maximiser of the Whittle
+    likelihood given the residual, and on a 1 kHz × 10⁶ record it lowered ℓ by more than the GLS step had gained.
+    The best (coefficients, noise) pair visited — after each GLS step and after each noise refit — is returned:
+    each is a point of the model. ``start``, a fit of
+    the first regressors of ``design`` (a nested smaller model), is the alternation's start (its coefficients, the
+    new ones at 0, its noise): its first GLS step is taken at the smaller model's noise, so the result's ℓ is at
+    least the smaller model's — a nested likelihood ratio ≥ 0 (:func:`nested_fit`).
 
     Returns ``c``, ``cov`` ((2·Σ Re Z̄Zᵀ/S)⁻¹, the inverse Fisher information), ``s``, ``loglik``, ``amounts``
     (the parametric noise shapes' amounts, or None)."""
     p = len(design.src)
     c = np.zeros(p)
     amounts = None
+    best: dict | None = None
+    if start is not None:
+        c[: start["c"].size] = start["c"]
+        amounts = start["amounts"]
+        best = {k: start[k] for k in ("s", "loglik", "amounts", "resid")} | {"c": c.copy()}
     prev = -math.inf
-    for _ in range(MAX_ITER):
+    for it in range(MAX_ITER):
         resid = residual_power(bands, design, c)
-        if fixed_s is None:
-            s, amounts = noise_psd(bands, resid, amounts)
+        if start is not None and it == 0:
+            s, ll = start["s"], start["loglik"]  # the first GLS step at the smaller model's noise: ℓ can only rise
         else:
-            s = fixed_s
-        ll = loglik(bands, resid, s)
+            s, amounts = (fixed_s, amounts) if fixed_s is not None else noise_psd(bands, resid, amounts)
+            ll = loglik(bands, resid, s)
+        if best is None or ll > best["loglik"]:
+            best = {"c": c.copy(), "s": s, "loglik": ll, "amounts": amounts, "resid": resid}
         if p == 0 or abs(ll - prev) <= 1e-10 * max(1.0, abs(ll)):
             break
         prev = ll
         info, score = design.gram(bands, 1.0 / s)
         c = np.linalg.solve(info, score)
+        resid = residual_power(bands, design, c)  # the GLS half-step, (new c, this noise): ℓ rose
+        ll = loglik(bands, resid, s)
+        if ll > best["loglik"]:
+            best = {"c": c.copy(), "s": s, "loglik": ll, "amounts": amounts, "resid": resid}
         if fixed_s is not None:
-            resid = residual_power(bands, design, c)
-            ll = loglik(bands, resid, s)
             break
+    assert best is not None
+    s = best["s"]
     cov = np.linalg.inv(2.0 * design.gram(bands, 1.0 / s)[0]) if p else np.zeros((0, 0))
-    return {"c": c, "cov": cov, "s": s, "loglik": ll, "amounts": amounts, "resid": resid}
+    return best | {"cov": cov}
+
+
+def nested_fit(bands: Bands, design: Design, small: dict) -> dict:
+    """:func:`joint_fit` of ``design`` whose first regressors are the model ``small`` was fitted with: from a cold
+    start as always, and where that ends below ``small``'s likelihood (the alternation is not monotone) from
+    ``small`` itself — the better of the two, never below ``small``."""
+    big = joint_fit(bands, design)
+    if big["loglik"] < small["loglik"]:
+        warm = joint_fit(bands, design, start=small)
+        big = warm if warm["loglik"] > big["loglik"] else big
+    return big
 
 
 def noise_dof(bands: Bands, fit: dict, direction: np.ndarray) -> float:
