@@ -193,7 +193,8 @@ class NoiseFit(RichDisplay):
 def _fit_what(unit) -> str:
     acc = accel_unit_name(unit)
     if acc is not None:
-        return f"noise model fitted to an accelerometer's Allan variance ({acc}: velocity random walk, bias instability, …)"
+        what = "velocity random walk, bias instability, …"
+        return f"noise model fitted to an accelerometer's Allan variance ({acc}: {what})"
     return "IEEE-952 noise model fitted to the Allan variance" + ("" if unit else " (unit unknown)")
 
 
@@ -202,7 +203,8 @@ class CoefficientSeries(RichDisplay):
     """Coefficients fitted in every window of a dynamic result (paper 002's 2-D representation).
 
     ``values``, ``ci_low``, ``ci_high`` map term → array over ``t`` (input unit's base form);
-    ``ieee`` maps term → array in IEEE-952 units (``ieee_units``) when the unit is known;
+    ``ieee`` maps term → array in IEEE-952 units (``ieee_units``) when the unit is known (an accelerometer's:
+    its report units, m/s/√h, µg, …);
     ``notes`` says what the fit decided on its own (the τ cut of ``tau_range="auto"``).
     """
 
