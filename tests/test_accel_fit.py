@@ -124,3 +124,22 @@ def test_an_unknown_unit_names_both_sensors_units(monkeypatch):
         allanite.refine(y, FS, unit="uT", progress=False)
     with pytest.raises(ParameterError, match=r"unit 'g' is an accelerometer's.*input='rate'.*got input='increment'"):
         allanite.refine(y, FS, unit="g", input="increment", progress=False)
+
+
+def test_to_kalibr_takes_the_accelerometer_unit_the_fits_carry(tmp_path):
+    yaml = pytest.importorskip("yaml")
+    gyro = allanite.fit(allanite.avar(allanite.simulate(40_000, FS, N=1e-3, K=1e-5, seed=3), FS), unit="deg/s")
+    a = allanite.avar(allanite.simulate(40_000, FS, N=N_ACC, K=1e-4, seed=6) / STANDARD_GRAVITY, FS)  # in g
+    carried, bare = allanite.fit(a, terms=("N", "K"), unit="g"), allanite.fit(a, terms=("N", "K"))
+    # the fits' own "g": before, to_kalibr took m/s² unless told, 9.8× too small
+    p1 = allanite.to_kalibr(tmp_path / "a.yaml", gyro=gyro, accel=carried, update_rate=FS)
+    p2 = allanite.to_kalibr(tmp_path / "b.yaml", gyro=gyro, accel=bare, update_rate=FS, accel_unit="g")
+    y1, y2 = (yaml.safe_load(p.read_text(encoding="utf-8")) for p in (p1, p2))
+    assert y1["accelerometer_noise_density"] == y2["accelerometer_noise_density"]
+    assert y1["accelerometer_noise_density"] == pytest.approx(N_ACC, rel=0.05)
+    with pytest.raises(
+        ParameterError, match=r"accel_unit='m/s\^2', but the accelerometer fits were made with unit='g'"
+    ):
+        allanite.to_kalibr(tmp_path / "c.yaml", gyro=gyro, accel=carried, update_rate=FS, accel_unit="m/s^2")
+    with pytest.raises(ParameterError, match=r"carry the unit 'deg/s', not an accelerometer's"):
+        allanite.to_kalibr(tmp_path / "d.yaml", gyro=gyro, accel=gyro, update_rate=FS)
