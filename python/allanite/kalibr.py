@@ -29,7 +29,7 @@ from typing import Any
 
 from ._core import __version__
 from .errors import ParameterError
-from .units import accel_factor, rate_unit
+from .units import ACCEL_UNITS, accel_factor, accel_unit_name, rate_unit
 
 __all__ = ["to_kalibr", "kalibr_values", "AGGREGATES"]
 
@@ -65,7 +65,17 @@ def _factor(sensor: str, fit, unit) -> tuple[float, str]:
             )
         r = rate_unit(u)
         return r.factor * math.pi / 180.0, r.name
-    u = unit if unit is not None else "m/s^2"
+    own = accel_unit_name(fit.unit)  # fit(..., unit="g") carries the accelerometer's unit
+    if fit.unit is not None and own is None:
+        raise ParameterError(
+            f"the accelerometer fits carry the unit {fit.unit!r}, not an accelerometer's (allowed: "
+            f"{', '.join(ACCEL_UNITS)}): were the gyro's fits passed as accel=?"
+        )
+    if unit is not None and own is not None and accel_factor(unit) != accel_factor(own):
+        raise ParameterError(
+            f"accel_unit={unit!r}, but the accelerometer fits were made with unit={own!r}: give one, or the same"
+        )
+    u = unit if unit is not None else own or "m/s^2"
     return accel_factor(u), u
 
 
@@ -127,7 +137,7 @@ def to_kalibr(
     rostopic: str = "/imu0",
     aggregate: str = "worst",
     gyro_unit=None,
-    accel_unit: str = "m/s^2",
+    accel_unit: str | None = None,
 ) -> Path:
     """Write a Kalibr / ROS ``imu.yaml`` from per-axis noise fits.
 
@@ -149,8 +159,10 @@ def to_kalibr(
         mean (as imu_utils does). Every axis's value is written in the comment block.
     gyro_unit : str, optional
         Unit of the gyro samples when the fits carry none (``fit(..., unit=...)`` sets it).
-    accel_unit : str
-        Unit of the accelerometer samples: ``"m/s^2"`` (default), ``"g"`` (9.80665 m/s²), ``"mg"``, …
+    accel_unit : str, optional
+        Unit of the accelerometer samples: ``"m/s^2"``, ``"g"`` (9.80665 m/s²), ``"mg"``, … Default: the
+        unit the fits carry (``fit(..., unit="g")``), else ``"m/s^2"``; one that differs from the fits' is a
+        ``ParameterError``.
 
     Returns
     -------

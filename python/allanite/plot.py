@@ -15,7 +15,7 @@ import warnings
 import numpy as np
 
 from .errors import AllaniteError
-from .units import adev_unit_label, coefficient_unit, ieee952
+from .units import adev_unit_label, coefficient_unit, report_unit
 
 __all__ = ["plot_adev", "plot_davar", "plot_davar3d", "plot_fit", "plot_coefficient_series"]
 
@@ -358,7 +358,7 @@ def plot_coefficient_series(
         label = name
         if series.unit is not None:
             if ieee:
-                q = ieee952(name, 1.0, series.unit)
+                q = report_unit(name, 1.0, series.unit)
                 scale, label = q.value, f"{name} ({q.unit})"
             else:
                 label = f"{name} ({coefficient_unit(name, series.unit)})"

@@ -52,6 +52,9 @@ __all__ = [
     "ACCEL_LABELS",
     "ACCEL_TERMS",
     "accel_report_unit",
+    "accel_unit_name",
+    "check_sensor_unit",
+    "report_unit",
 ]
 
 
@@ -143,11 +146,12 @@ for _name, (_kind, _f, _label, _aliases) in _TABLE.items():
         _ALIASES[_normalise(_a)] = _name
 
 
-#: Said after the allowed units: the units are a gyro's; an accelerometer's or any other sensor's samples are
-#: analysed as they are, with no unit, the terms then in the samples' own unit and seconds.
+#: Said after the allowed units: the units are a gyro's; an accelerometer's are their own (:data:`ACCEL_UNITS`,
+#: taken by fit, refine and build_report); any other sensor's samples are analysed with no unit, the terms then
+#: in the samples' own unit and seconds.
 _OTHER_SENSORS = (
-    " (a gyro's; for an accelerometer, a magnetometer or another sensor give no unit: the terms are then in the "
-    "samples' own unit and seconds)"
+    " (a gyro's; an accelerometer's m/s^2, g, mg, … are taken by fit, refine and build_report as its own; for a "
+    "magnetometer or another sensor give no unit: the terms are then in the samples' own unit and seconds)"
 )
 
 
@@ -370,17 +374,22 @@ def adev_unit_label(unit) -> str:
     """
     if unit is None:
         return "rate unit"
-    return rate_unit(unit).label
+    acc = accel_unit_name(unit)
+    return ACCEL_LABELS[acc] if acc is not None else rate_unit(unit).label
 
 
 def coefficient_unit(term: str, unit) -> str:
     """Label of a noise coefficient's base form for samples in ``unit``: for °/s, Q in °, N in °/√s,
-    B in °/s, K in °/s^1.5, R in °/s² (what :func:`allanite.fit` returns before IEEE-952 conversion).
+    B in °/s, K in °/s^1.5, R in °/s² (what :func:`allanite.fit` returns before IEEE-952 conversion); for an
+    accelerometer's m/s², Q in m/s, N in m/s^1.5, B in m/s², K in m/s^2.5, R in m/s³ (g: g·s, g·√s, g, …).
 
     >>> from allanite.units import coefficient_unit
-    >>> coefficient_unit("N", "deg/s"), coefficient_unit("K", "rad/s")
-    ('deg/√s', 'rad/s^1.5')
+    >>> coefficient_unit("N", "deg/s"), coefficient_unit("K", "rad/s"), coefficient_unit("N", "m/s^2")
+    ('deg/√s', 'rad/s^1.5', 'm/s^1.5')
     """
+    acc = accel_unit_name(unit)
+    if acc is not None:
+        return _accel_coefficient_unit(term, acc)
     u = str(rate_unit(unit))
     if u.endswith("/s"):
         angle = u[:-2]
@@ -496,3 +505,66 @@ def accel_report_unit(term, value, unit, *, to=None) -> Quantity:
     label, factor = targets[target]
     v = np.asarray(value, dtype=np.float64) * (accel_factor(unit) * factor)
     return Quantity(float(v) if v.ndim == 0 else v, label)
+
+
+def accel_unit_name(unit) -> str | None:
+    """The canonical name (one of :data:`ACCEL_UNITS`) of an accelerometer's ``unit``, else None (a gyro's unit,
+    an unknown one, or not a string) — never raises.
+
+    >>> from allanite.units import accel_unit_name
+    >>> accel_unit_name("m/s²"), accel_unit_name("G"), accel_unit_name("deg/s")
+    ('m/s^2', 'g', None)
+    """
+    if not isinstance(unit, str):
+        return None
+    key = unit.strip().lower().replace(" ", "").replace("\u00b5", "u").replace("\u03bc", "u")
+    for name, (_, aliases) in _ACCEL.items():
+        if key == name or key in aliases:
+            return name
+    return None
+
+
+def _accel_coefficient_unit(term: str, name: str) -> str:
+    """Base-form label of term Q…R for an accelerometer's samples in ``name`` (canonical)."""
+    if name.endswith("/s^2"):
+        v = name[:-4]  # m or mm: the velocity's length
+        return {"Q": f"{v}/s", "N": f"{v}/s^1.5", "B": f"{v}/s²", "K": f"{v}/s^2.5", "R": f"{v}/s³"}[term]
+    u = ACCEL_LABELS[name]
+    return {"Q": f"{u}·s", "N": f"{u}·√s", "B": u, "K": f"{u}/√s", "R": f"{u}/s"}[term]
+
+
+def check_sensor_unit(unit) -> str | None:
+    """Check a unit ``fit`` and ``refine`` take for rate samples: a gyro's (:func:`parse_unit`) or an
+    accelerometer's (:data:`ACCEL_UNITS`). Returns the accelerometer's canonical name, or None for a gyro's.
+
+    Raises
+    ------
+    ParameterError
+        Neither: the message names the value and both sensors' allowed units.
+    """
+    acc = accel_unit_name(unit)
+    if acc is not None:
+        return acc
+    try:
+        rate_unit(unit)
+    except ParameterError:
+        raise ParameterError(
+            f"unknown unit {unit!r}; allowed {_allowed()} (a gyro's), or {', '.join(ACCEL_UNITS)} (an "
+            "accelerometer's; g = 9.80665 m/s²); for another sensor give no unit: the terms are then in the samples' "
+            "own unit and seconds"
+        ) from None
+    return None
+
+
+def report_unit(term, value, unit) -> Quantity:
+    """A noise coefficient in its report unit: IEEE-952's (:func:`ieee952`) for a gyro's ``unit``, the
+    accelerometer's (:func:`accel_report_unit`: velocity random walk in m/s/√h, bias instability in µg, …) for
+    an accelerometer's — what :func:`allanite.fit` gives as ``Coefficient.ieee``.
+
+    >>> from allanite.units import report_unit
+    >>> report_unit("N", 0.0025, "deg/s"), report_unit("N", 0.001, "m/s^2")
+    (Quantity(value=0.15, unit='°/√h'), Quantity(value=0.06, unit='m/s/√h'))
+    """
+    if accel_unit_name(unit) is not None:
+        return accel_report_unit(term, value, unit)
+    return ieee952(term, value, unit)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ParameterError
-from ..units import ieee952
+from ..units import report_unit
 from . import _batched, _covariance
 from ._fitcore import (
     GLS_START_ITER,
@@ -60,8 +60,8 @@ def fit_dynamic(result, terms, unit, confidence, zq, thin, max_iter, tau_range, 
             lo[t], hi[t] = intervals(theta[:, k], var[:, k], zq, inflate)
         ieee = ieee_units = None
         if unit is not None:
-            ieee = {t: ieee952(t, vals[t], unit).value for t in terms}
-            ieee_units = {t: ieee952(t, 1.0, unit).unit for t in terms}
+            ieee = {t: report_unit(t, vals[t], unit).value for t in terms}
+            ieee_units = {t: report_unit(t, 1.0, unit).unit for t in terms}
         series.append(
             CoefficientSeries(
                 t=result.t,

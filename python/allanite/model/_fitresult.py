@@ -16,7 +16,7 @@ from .._dist import norm_ppf
 from ..errors import ParameterError
 from ..plot import plot_coefficient_series, plot_fit  # matplotlib only when a figure is drawn
 from ..results import AllanResult
-from ..units import coefficient_unit, ieee952
+from ..units import accel_unit_name, coefficient_unit, report_unit
 from ._fitcore import edf_per_tau
 from .terms import TERM_NAMES, design_matrix
 
@@ -27,7 +27,8 @@ class Coefficient:
 
     ``value`` and ``ci`` are in the input unit's base form (for °/s samples: Q in °, N in °/√s,
     B in °/s, K in °/s^1.5, R in °/s²); ``ieee`` and ``ieee_ci`` in IEEE-952 units
-    (``ieee_unit``: °, °/√h, °/h, °/h^1.5, °/h²) when the input unit is known.
+    (``ieee_unit``: °, °/√h, °/h, °/h^1.5, °/h²) when the input unit is known — for an accelerometer's unit
+    (m/s², g, …) in its report units (m/s, m/s/√h, µg, m/s/h^1.5, m/s/h²: :func:`allanite.units.accel_report_unit`).
     """
 
     name: str
@@ -46,8 +47,16 @@ class Coefficient:
         return s
 
 
-def coefficient_table(coefficients: dict, caption: str) -> Table:
-    """The coefficients as a display table: value [interval] in base form and in IEEE-952 units."""
+def report_header(unit) -> tuple:
+    """The two report-unit columns' headers: IEEE-952's for a gyro (or no unit), the accelerometer's otherwise."""
+    if accel_unit_name(unit) is not None:
+        return ("accelerometer units [interval]", "accelerometer unit")
+    return ("IEEE-952 [interval]", "IEEE unit")
+
+
+def coefficient_table(coefficients: dict, caption: str, unit=None) -> Table:
+    """The coefficients as a display table: value [interval] in base form and in IEEE-952 units (an
+    accelerometer's ``unit``: in its report units)."""
     rows = []
     for c in coefficients.values():
         ieee = "—" if c.ieee is None or c.ieee_ci is None else fmt_ci(c.ieee, *c.ieee_ci)
@@ -61,7 +70,7 @@ def coefficient_table(coefficients: dict, caption: str) -> Table:
                 c.ieee_unit or "—",
             ]
         )
-    return Table(("term", "", "value [interval]", "unit", "IEEE-952 [interval]", "IEEE unit"), rows, caption)
+    return Table(("term", "", "value [interval]", "unit", *report_header(unit)), rows, caption)
 
 
 @dataclass(frozen=True, repr=False, eq=False)
@@ -163,9 +172,9 @@ class NoiseFit(RichDisplay):
             )
         return Summary(
             title="NoiseFit",
-            what="IEEE-952 noise model fitted to the Allan variance" + ("" if self.unit else " (unit unknown)"),
+            what=_fit_what(self.unit),
             facts=facts,
-            tables=[coefficient_table(self.coefficients, "coefficients")],
+            tables=[coefficient_table(self.coefficients, "coefficients", self.unit)],
             notes=list(self.notes),  # what the fit decided itself, e.g. "fitted from τ ≥ 0.16 s (tau_range='auto')"
             figure=self._draw_small,
         )
@@ -181,12 +190,21 @@ class NoiseFit(RichDisplay):
         ax.legend(fontsize="small", frameon=False)
 
 
+def _fit_what(unit) -> str:
+    acc = accel_unit_name(unit)
+    if acc is not None:
+        what = "velocity random walk, bias instability, …"
+        return f"noise model fitted to an accelerometer's Allan variance ({acc}: {what})"
+    return "IEEE-952 noise model fitted to the Allan variance" + ("" if unit else " (unit unknown)")
+
+
 @dataclass(frozen=True, repr=False, eq=False)
 class CoefficientSeries(RichDisplay):
     """Coefficients fitted in every window of a dynamic result (paper 002's 2-D representation).
 
     ``values``, ``ci_low``, ``ci_high`` map term → array over ``t`` (input unit's base form);
-    ``ieee`` maps term → array in IEEE-952 units (``ieee_units``) when the unit is known;
+    ``ieee`` maps term → array in IEEE-952 units (``ieee_units``) when the unit is known (an accelerometer's:
+    its report units, m/s/√h, µg, …);
     ``notes`` says what the fit decided on its own (the τ cut of ``tau_range="auto"``).
     """
 
@@ -246,7 +264,7 @@ class CoefficientSeries(RichDisplay):
                     ("term", "", "resolved in", "median", "min over t", "max over t", "max/min", "unit"),
                     rows,
                     "over the windows that resolved the term; "
-                    + ("IEEE-952 units" if ieee else "base form of the samples' unit"),
+                    + (_series_units(self.unit) if ieee else "base form of the samples' unit"),
                 )
             ],
             notes=list(self.notes)
@@ -266,6 +284,10 @@ class CoefficientSeries(RichDisplay):
         ax.set_xlabel("t (s)")
         ax.set_ylabel("coefficient / median")
         ax.legend(fontsize="small", frameon=False, ncol=len(self.terms))
+
+
+def _series_units(unit) -> str:
+    return "the accelerometer's report units" if accel_unit_name(unit) is not None else "IEEE-952 units"
 
 
 def interval(theta_k, var_k, zq, inflate):
@@ -332,9 +354,9 @@ def coefficients(terms, theta, cov, zq, inflate, unit) -> dict:
         value = math.sqrt(theta[k])
         ci = interval(theta[k], cov[k, k], zq, inflate)
         if unit is not None:
-            q = ieee952(name, value, unit)
-            lo = ieee952(name, ci[0], unit).value
-            hi = ieee952(name, ci[1], unit).value if np.isfinite(ci[1]) else math.inf
+            q = report_unit(name, value, unit)  # an accelerometer's: its report units (m/s/√h, µg, …)
+            lo = report_unit(name, ci[0], unit).value
+            hi = report_unit(name, ci[1], unit).value if np.isfinite(ci[1]) else math.inf
             coeffs[name] = Coefficient(name, value, ci, coefficient_unit(name, unit), q.value, (lo, hi), q.unit)
         else:
             coeffs[name] = Coefficient(name, value, ci)

@@ -35,7 +35,7 @@ from ..errors import ParameterError
 from ..estimators import get as get_estimator
 from ..estimators import names as estimator_names
 from ..results import AllanResult, DynamicAllanResult
-from ..units import rate_unit
+from ..units import check_sensor_unit
 from ._bound import information_bound
 from ._corefit import fit_curve
 from ._dynamicfit import FLAT_FLOOR as FLAT_FLOOR
@@ -94,7 +94,11 @@ def fit(
         Terms to fit (drop the ones the data cannot support).
     unit : str, optional
         Unit of the rate samples the result was computed from (e.g. "deg/s"); gives each
-        coefficient its IEEE-952 value (``ieee``). Must be a rate unit.
+        coefficient its IEEE-952 value (``ieee``). A gyro's rate unit (an angle unit for increments), or an
+        accelerometer's (``"m/s^2"``, ``"g"``, ``"mg"``, … — :data:`allanite.units.ACCEL_UNITS`): ``ieee`` is
+        then in the accelerometer's report units (:func:`allanite.units.accel_report_unit`: N a velocity
+        random walk in m/s/√h, B in µg, K an acceleration random walk in m/s/h^1.5), ``value`` in base form
+        (that unit and seconds, as for a gyro).
     confidence : float
         Level of the coefficient intervals (default 68.3 %).
     thin : bool
@@ -156,7 +160,7 @@ def fit(
         raise ParameterError(f"tau_range must be a (low, high) pair of seconds or 'auto', got {tau_range!r}")
     tau_range = (0.0, np.inf) if auto else check_tau_range(tau_range)
     if unit is not None:
-        rate_unit(unit)
+        check_sensor_unit(unit)
     show_progress(progress)  # a wrong value fails before any work
     if isinstance(result, DynamicAllanResult):
         _check_fit_estimator(result)

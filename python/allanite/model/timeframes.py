@@ -20,7 +20,7 @@ from ..analysis import davar
 from ..errors import ParameterError
 from ..forecast import compare
 from ..results import DynamicAllanResult
-from ..units import ieee952
+from ..units import report_unit
 from .fitting import CoefficientSeries, fit, z_quantile
 from .terms import TERMS
 
@@ -95,7 +95,7 @@ class TimeFrames:
             # the IEEE value is a fixed multiple of the base value: scale the bounds by the same factor
             lo, hi = {}, {}
             for t in s.terms:
-                f = float(ieee952(t, 1.0, s.unit).value)
+                f = float(report_unit(t, 1.0, s.unit).value)  # an accelerometer's: its report units
                 lo[t], hi[t] = s.ci_low[t] * f, s.ci_high[t] * f
             return lo, hi
         return dict(s.ci_low), dict(s.ci_high)
@@ -245,7 +245,8 @@ def frames(
         Frame length, s (default 20, paper 004's); ``round(frame·fs)`` samples, at least
         ``MIN_FRAME_SAMPLES``. Samples after the last whole frame are left out (``dropped_samples``).
     unit : str, optional
-        Unit of the rate samples (e.g. "deg/s"): the coefficients get IEEE-952 values.
+        Unit of the rate samples (e.g. "deg/s"): the coefficients get IEEE-952 values (an accelerometer's,
+        e.g. "m/s^2" or "g": its report units, as :func:`allanite.fit`).
     input : {"rate", "increment", "angle"}
     terms, confidence, thin, tau_range
         As for :func:`allanite.fit` (``tau_range="auto"`` chooses the cut on the frames' median curve).

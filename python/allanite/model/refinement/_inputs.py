@@ -15,7 +15,7 @@ from ...analysis import avar
 from ...errors import InputError, ParameterError
 from ...estimators.grid import tau_grid
 from ...results import AllanResult
-from ...units import parse_unit, rate_unit
+from ...units import ACCEL_UNITS, accel_unit_name, check_sensor_unit, parse_unit
 from .. import fitting
 from .._chunked import CHUNK, chunks
 from ..channels import check_channel
@@ -155,8 +155,18 @@ def check_unit(unit, input: str, x_or_result) -> None:
     if unit is None:
         return
     if isinstance(x_or_result, AllanResult) or input not in ("rate", "increment", "angle"):
-        rate_unit(unit)  # a bad ``input`` is reported by the samples' own check
+        check_sensor_unit(unit)  # a bad ``input`` is reported by the samples' own check
         return
+    if accel_unit_name(unit) is not None:  # an accelerometer's acceleration samples: rates, as a gyro's °/s
+        if input != "rate":
+            raise ParameterError(
+                f"unit {unit!r} is an accelerometer's, taken for acceleration samples only (input='rate'), got "
+                f"input={input!r}; for velocity increments give no unit (allowed accelerometer units: "
+                f"{', '.join(ACCEL_UNITS)})"
+            )
+        return
+    if input == "rate":
+        check_sensor_unit(unit)  # unknown: the message lists the gyro's and the accelerometer's units
     kind = "rate" if input == "rate" else "angle"
     try:
         parse_unit(unit, kind=kind)

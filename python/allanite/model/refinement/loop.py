@@ -79,8 +79,10 @@ def refine(
         {effects}
     unit : str, optional
         Unit of the samples, for IEEE-952 values of the terms: a gyro's rate or angle unit
-        (:func:`allanite.units.parse_unit`), checked before any work. For an accelerometer, a magnetometer
-        or another sensor give none: the terms are then in the samples' own unit and seconds.
+        (:func:`allanite.units.parse_unit`), checked before any work. An accelerometer's (``"m/s^2"``,
+        ``"g"``, ``"mg"``, … with ``input="rate"``) gives the terms in its report units (velocity random walk
+        in m/s/√h, bias instability in µg, acceleration random walk in m/s/h^1.5). For a magnetometer or
+        another sensor give none: the terms are then in the samples' own unit and seconds.
     tau_range : (float, float) or "auto", optional
         τ (s) to use, as in :func:`allanite.fit`. Default: every τ — the shortest τ carry the sensor's
         bandwidth, which is a candidate effect; ``"auto"`` cuts them as ``fit`` does.

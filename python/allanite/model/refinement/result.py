@@ -10,8 +10,9 @@ import numpy as np
 
 from ..._display import RichDisplay, Summary, Table, fmt_ci, thin
 from ...results import AllanResult
-from ...units import ieee952
+from ...units import report_unit
 from .. import fitting
+from .._fitresult import report_header
 from ..effects import EFFECTS, format_params
 from ..terms import TERM_NAMES
 from ._family_fold import folded
@@ -105,8 +106,8 @@ def term_move_text(m: dict, unit) -> str:
     t = m["term"]
     conv, u = (lambda v: v), m["unit"] or "(base form)"
     if unit is not None:
-        u = ieee952(t, 1.0, unit).unit
-        conv = lambda v: ieee952(t, v, unit).value if np.isfinite(v) else v  # noqa: E731
+        u = report_unit(t, 1.0, unit).unit
+        conv = lambda v: report_unit(t, v, unit).value if np.isfinite(v) else v  # noqa: E731
     s0, (a0, b0) = conv(m["start"]), map(conv, m["start_interval"])
     s1, (a1, b1) = conv(m["final"]), map(conv, m["final_interval"])
     moves = ", ".join(
@@ -364,7 +365,7 @@ class Refinement(RichDisplay):
                 continue
             label = EFFECTS[st.effect].label if st.effect in EFFECTS else ""
             rows.append([_effect_name(self.steps, i), label, self.params_text(st, final=True), "", "—", "—"])
-        header = ("term or effect", "", "value [interval]", "unit", "IEEE-952 [interval]", "IEEE unit")
+        header = ("term or effect", "", "value [interval]", "unit", *report_header(self.fit.unit))
         return Table(header, rows, "final model")
 
     def _summary(self) -> Summary:
