@@ -186,7 +186,8 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
         before it — the smaller ν, the wider interval. E.g. 10⁶ white-rate samples
         (``default_rng(3)``, octave grid) read as flicker phase from 30 intervals on: ν 720 → 44 at
         the first of those τ. In simulation (``benches/results/ci_few_points.md``) it brings the
-        68 % coverage at the longest τ of white, flicker and random-walk FM from 55–67 % to 67–80 %;
+        68 % coverage at 4 and 8 τ-intervals of white, flicker and random-walk FM from 50–68 % to
+        63–80 % (62–74 % with the true α given);
         it departs from Stable32's Alpha column on 15 of its 2774 rows (OCXO octave, Sr87 decade:
         rises at 4–19 intervals), so it is not the default. ``"none"``: every τ on its own samples,
         however few (with 2 averages B1 is exactly 1, "white FM", whatever the noise).
