@@ -150,6 +150,18 @@ def test_prudent_rule_leaves_dense_grids_and_dips_alone():
     assert _level_weak_peaks(fall, m, many, end_rise=True).tolist() == fall.tolist()
     dense = np.arange(1, 9)
     assert _level_weak_peaks(np.array([0, 0, 0, 1, 1, 0, 0, 0]), dense, few).tolist() == [0, 0, 0, 1, 1, 0, 0, 0]
+    # the end-of-grid rule asks for points at one τ, not a second reading: it holds on dense grids too
+    assert _level_weak_peaks(np.array([0, 0, 0, 1, 0, 1, 1, 1]), dense, few, end_rise=True).tolist() == [
+        0,
+        0,
+        0,
+        1,
+        0,
+        0,
+        0,
+        0,
+    ]
+    assert _level_weak_peaks(end, dense, few).tolist() == end.tolist()
 
 
 # ------------------------------------------------------------------------------------------

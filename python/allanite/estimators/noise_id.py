@@ -297,9 +297,11 @@ def _level_weak_peaks(alpha: np.ndarray, m: np.ndarray, points: np.ndarray, end_
     grid neighbouring τ re-read nearly the same averages, so a neighbour is no second reading.
 
     ``end_rise`` (``fallback="conservative"``): a run that rises above the α before it and lasts to the
-    longest τ is levelled too, unless its first τ holds ≥ :data:`END_RISE_MIN_POINTS` τ-intervals."""
+    longest τ is levelled too, unless its first τ holds ≥ :data:`END_RISE_MIN_POINTS` τ-intervals — on
+    any grid: the rule asks for enough points at one τ, not for a second reading at its neighbour."""
     steps = np.diff(np.unique(m).astype(np.float64))
-    if steps.size and np.min(steps / np.unique(m)[:-1]) < 0.99:
+    sparse = not (steps.size and np.min(steps / np.unique(m)[:-1]) < 0.99)
+    if not sparse and not end_rise:
         return alpha
     order = np.argsort(m, kind="stable")
     a = alpha[order].copy()
@@ -311,7 +313,7 @@ def _level_weak_peaks(alpha: np.ndarray, m: np.ndarray, points: np.ndarray, end_
             j += 1
         # run i..j; a peak needs a neighbour on both sides, both below it; a rise to the end of the grid
         # needs its first τ read on ≥ END_RISE_MIN_POINTS (a second ACF reading an octave on)
-        peak = j + 1 < a.size and a[i] > a[i - 1] and a[i] > a[j + 1] and weak[i : j + 1].any()
+        peak = sparse and j + 1 < a.size and a[i] > a[i - 1] and a[i] > a[j + 1] and weak[i : j + 1].any()
         weak_end = end_rise and j + 1 == a.size and a[i] > a[i - 1] and points[order][i] < END_RISE_MIN_POINTS
         if peak or weak_end:
             a[i : j + 1] = a[i - 1]
