@@ -109,6 +109,25 @@ def test_octave_grid_nu_falls_unless_alpha_changes(estimator):
             assert np.all(a <= prev)
 
 
+def test_white_fm_rise_to_the_end_is_levelled():
+    """A new user's record: 10⁶ white-rate samples at 100 Hz, octave grid. The lag-1 ACF reads flicker
+    phase (α = +1) at τ = 327.68 s on 30 τ-intervals, and Stable32's rule carries it to the three longer τ:
+    ν 720 where white FM gives 44, a 68 % ADEV interval of −2.5/+2.7 % for ≈ −9/+13 %. A rise of α to
+    the end of the grid stands with ``fallback="conservative"`` only if its first τ holds ≥ 60
+    intervals; here α stays 0. The default (``"prudent"``) keeps Stable32's reading."""
+    y = np.random.default_rng(3).normal(0, 1, 10**6)
+    r = allanite.avar(y, 100.0, taus="octave")
+    assert r.m[-4:].tolist() == [32768, 65536, 131072, 262144]
+    for fallback in ("previous", "prudent"):
+        assert r.with_confidence(y, fallback=fallback).alpha[-4:].tolist() == [1, 1, 1, 1]
+    ci = r.with_confidence(y, fallback="conservative")
+    assert np.all(ci.alpha == 0)
+    assert 40 < ci.edf[-4] < 48 and np.all(np.diff(ci.edf) < 0)
+    ci = allanite.confidence_intervals(r, y, fallback="conservative")
+    lo, hi = ci.adev_low[-4] / r.adev[-4], ci.adev_high[-4] / r.adev[-4]
+    assert lo < 0.92 and hi > 1.12
+
+
 def test_prudent_rule_leaves_dense_grids_and_dips_alone():
     from allanite.estimators.noise_id import _level_weak_peaks
 
@@ -118,18 +137,31 @@ def test_prudent_rule_leaves_dense_grids_and_dips_alone():
     assert _level_weak_peaks(np.array([0, 0, 1, 2, 1, 0, 0, 0]), m, few).tolist() == [0] * 8  # nested rise
     assert _level_weak_peaks(np.array([0, 0, 0, -1, -1, 0, 0, 0]), m, few).tolist() == [0, 0, 0, -1, -1, 0, 0, 0]
     assert _level_weak_peaks(np.array([0, 1, 0, 0, 0, 0, 0, 0]), m, few).tolist() == [0, 1, 0, 0, 0, 0, 0, 0]  # 50 ≥ 30
-    assert _level_weak_peaks(np.array([0, 0, 0, 0, 0, 0, 1, 1]), m, few).tolist() == [
-        0,
-        0,
-        0,
-        0,
-        0,
-        0,
-        1,
-        1,
-    ]  # no right side
+    end = np.array([0, 0, 0, 0, 0, 0, 1, 1])
+    assert _level_weak_peaks(end, m, few).tolist() == end.tolist()  # no right side
+    # fallback="conservative": a rise to the end stands only if its first τ holds ≥ END_RISE_MIN_POINTS
+    assert _level_weak_peaks(end, m, few, end_rise=True).tolist() == [0] * 8
+    assert _level_weak_peaks(np.array([0, 0, 0, 1, 1, 1, 2, 2]), m, few, end_rise=True).tolist() == [0] * 8
+    many = np.array([800, 400, 200, 100, 60, 30, 15, 8])
+    rise60, rise30 = np.array([0, 0, 0, 0, 1, 1, 1, 1]), np.array([0, 0, 0, 0, 0, 1, 1, 1])
+    assert _level_weak_peaks(rise60, m, many, end_rise=True).tolist() == rise60.tolist()
+    assert _level_weak_peaks(rise30, m, many, end_rise=True).tolist() == [0] * 8
+    fall = np.array([0, 0, 0, 0, 1, 1, 0, -1])
+    assert _level_weak_peaks(fall, m, many, end_rise=True).tolist() == fall.tolist()
     dense = np.arange(1, 9)
     assert _level_weak_peaks(np.array([0, 0, 0, 1, 1, 0, 0, 0]), dense, few).tolist() == [0, 0, 0, 1, 1, 0, 0, 0]
+    # the end-of-grid rule asks for points at one τ, not a second reading: it holds on dense grids too
+    assert _level_weak_peaks(np.array([0, 0, 0, 1, 0, 1, 1, 1]), dense, few, end_rise=True).tolist() == [
+        0,
+        0,
+        0,
+        1,
+        0,
+        0,
+        0,
+        0,
+    ]
+    assert _level_weak_peaks(end, dense, few).tolist() == end.tolist()
 
 
 # ------------------------------------------------------------------------------------------

@@ -414,13 +414,15 @@ def confidence_intervals(
         Convention of the B1 branch of the noise identification, see :func:`identify_alpha`
         (the default ``"terms"`` with ``chi2="stable32"``, ``confidence=ONE_SIGMA`` for Stable32's
         numbers; ``"averages"`` to tell rate random walk from bias instability at long τ).
-    fallback : {"prudent", "previous", "none"}
+    fallback : {"prudent", "previous", "none", "conservative"}
         Where too few samples remain to identify the noise type (fewer than 8 τ-intervals for
         ``"oavar"``, 10 for ``"avar"``), α is the nearest shorter τ's (``"previous"``, Stable32's
         rule, see :func:`identify_alpha`), so the last points get the wide interval their few terms
         warrant instead of one from a guessed "white/flicker phase" type. ``"prudent"`` (default)
         also keeps a rise of α above both neighbours (a larger ν) on an octave grid only where it
-        was read on ≥ 30 τ-intervals; ``"none"`` identifies every τ on its own samples.
+        was read on ≥ 30 τ-intervals; ``"conservative"`` also a rise that lasts to the longest τ
+        only where its first τ holds ≥ 60 (the honest interval where few points read a chance rise;
+        not Stable32's, see :func:`identify_alpha`); ``"none"`` identifies every τ on its own samples.
 
     Returns
     -------

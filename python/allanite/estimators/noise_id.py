@@ -29,8 +29,14 @@ ACF_MIN_POINTS = 30
 #: carries over at 7, ADEV identifies at 10 and carries over at 9.
 ID_MIN_POINTS = {"oavar": 8, "avar": 10}
 
+#: A rise of α that lasts to the longest τ stands (``fallback="conservative"``) only if its first τ holds this
+#: many τ-intervals: two lag-1 ACF readings (≥ 30 intervals each) an octave apart. On a white series
+#: the ACF's r1 scatters by ≈ 1/√n, so it reads a chance rise (r1 < −1/3: δ < −0.25) ≈ 5 % of the time at
+#: 30 intervals and < 1 % from 60 (see :func:`identify_alpha`, ``docs/confidence.md``).
+END_RISE_MIN_POINTS = 2 * ACF_MIN_POINTS
+
 #: What happens at τ with too few intervals for their own identification (see :func:`identify_alpha`).
-FALLBACKS = ("prudent", "previous", "none")
+FALLBACKS = ("prudent", "previous", "none", "conservative")
 
 #: Kinds of input samples: angle (phase) points, rate (frequency) samples, or angle increments.
 INPUTS = ("angle", "rate", "increment")
@@ -164,7 +170,7 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
         FFM: in simulation it identifies RWFM 0 % and FFM 24 % of the time at 7–26 averages,
         against 67 % and 59 % for ``"averages"``. Prefer ``"averages"`` to tell rate random walk
         from bias instability at long τ of an overlapping curve.
-    fallback : {"prudent", "previous", "none"}
+    fallback : {"prudent", "previous", "none", "conservative"}
         ``"previous"``: where too few samples remain (see above), α is that of the
         nearest shorter τ of ``m`` identified on its own samples; if ``m`` holds none, α is
         identified at the longest averaging factor that still has enough τ-intervals.
@@ -174,8 +180,17 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
         has α fall as τ grows, and a higher α means a larger ν: a chance rise read on few points would
         give an interval too narrow where data are scarce (e.g. 2¹⁷ white-rate samples read as flicker
         phase at m = 4096 and 8192, ν 94 → 511). On the Stable32 tables of ``docs/confidence.md`` it
-        changes no α. ``"none"``: every τ on its own samples, however few (with 2 averages B1 is
-        exactly 1, "white FM", whatever the noise).
+        changes no α. ``"conservative"``: ``"prudent"``, and a rise of α that lasts to the longest τ
+        stands only if its first τ holds ≥ 60 τ-intervals (:data:`END_RISE_MIN_POINTS`, two lag-1 ACF
+        readings an octave apart; Riley & Greenhall's ACF method wants ≥ 30). Otherwise it takes the α
+        before it — the smaller ν, the wider interval. E.g. 10⁶ white-rate samples
+        (``default_rng(3)``, octave grid) read as flicker phase from 30 intervals on: ν 720 → 44 at
+        the first of those τ. In simulation (``benches/results/ci_few_points.md``) it brings the
+        68 % coverage at 4 and 8 τ-intervals of white, flicker and random-walk FM from 50–68 % to
+        63–80 % (62–74 % with the true α given);
+        it departs from Stable32's Alpha column on 15 of its 2774 rows (OCXO octave, Sr87 decade:
+        rises at 4–19 intervals), so it is not the default. ``"none"``: every τ on its own samples,
+        however few (with 2 averages B1 is exactly 1, "white FM", whatever the noise).
 
     Returns
     -------
@@ -231,8 +246,8 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
     out = own
     if fallback != "none":
         out = _fall_back(own, m_arr, n_phase - 1, ID_MIN_POINTS[estimator], each)
-    if fallback == "prudent":
-        out = _level_weak_peaks(out, m_arr, (n_phase - 1) // m_arr)
+    if fallback in ("prudent", "conservative"):
+        out = _level_weak_peaks(out, m_arr, (n_phase - 1) // m_arr, end_rise=fallback == "conservative")
     return int(out[0]) if np.ndim(m) == 0 else out
 
 
@@ -271,7 +286,7 @@ def _checked_m(m, n_phase: int) -> np.ndarray:
     return m_arr
 
 
-def _level_weak_peaks(alpha: np.ndarray, m: np.ndarray, points: np.ndarray) -> np.ndarray:
+def _level_weak_peaks(alpha: np.ndarray, m: np.ndarray, points: np.ndarray, end_rise: bool = False) -> np.ndarray:
     """A peak — a run of consecutive τ (in order of m) whose α is above the α on both sides of it —
     stands only if every τ of the run was identified on at least :data:`ACF_MIN_POINTS` τ-intervals;
     otherwise the run takes the α before it. A sum of power-law noises has its α fall, never rise, as τ
@@ -279,9 +294,14 @@ def _level_weak_peaks(alpha: np.ndarray, m: np.ndarray, points: np.ndarray) -> n
     an interval too narrow exactly where the data are scarce. Dips (a lower α, a wider interval) stay.
 
     Only on a grid whose neighbouring m are at least a factor 2 apart (octave, decade): on a denser
-    grid neighbouring τ re-read nearly the same averages, so a neighbour is no second reading."""
+    grid neighbouring τ re-read nearly the same averages, so a neighbour is no second reading.
+
+    ``end_rise`` (``fallback="conservative"``): a run that rises above the α before it and lasts to the
+    longest τ is levelled too, unless its first τ holds ≥ :data:`END_RISE_MIN_POINTS` τ-intervals — on
+    any grid: the rule asks for enough points at one τ, not for a second reading at its neighbour."""
     steps = np.diff(np.unique(m).astype(np.float64))
-    if steps.size and np.min(steps / np.unique(m)[:-1]) < 0.99:
+    sparse = not (steps.size and np.min(steps / np.unique(m)[:-1]) < 0.99)
+    if not sparse and not end_rise:
         return alpha
     order = np.argsort(m, kind="stable")
     a = alpha[order].copy()
@@ -291,8 +311,11 @@ def _level_weak_peaks(alpha: np.ndarray, m: np.ndarray, points: np.ndarray) -> n
         j = i
         while j + 1 < a.size and a[j + 1] == a[i]:
             j += 1
-        # run i..j; a peak needs a neighbour on both sides, both below it
-        if j + 1 < a.size and a[i] > a[i - 1] and a[i] > a[j + 1] and weak[i : j + 1].any():
+        # run i..j; a peak needs a neighbour on both sides, both below it; a rise to the end of the grid
+        # needs its first τ read on ≥ END_RISE_MIN_POINTS (a second ACF reading an octave on)
+        peak = sparse and j + 1 < a.size and a[i] > a[i - 1] and a[i] > a[j + 1] and weak[i : j + 1].any()
+        weak_end = end_rise and j + 1 == a.size and a[i] > a[i - 1] and points[order][i] < END_RISE_MIN_POINTS
+        if peak or weak_end:
             a[i : j + 1] = a[i - 1]
             i = max(1, i - 1)  # the run joined its left neighbour's: look at that run again
             while i > 1 and a[i - 1] == a[i]:
