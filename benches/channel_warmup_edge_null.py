@@ -32,9 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import allanite
 import sensors
 from allanite.model import _whittle as wh
-from allanite.model._regressors import form_signal, regressor_iter
-from allanite.model._rfft import band_limited
-from allanite.model._staircase import channel_form, reconstructed
+from allanite.model.channels import channel_bands
 
 FS, N = 20.0, 8000
 NOISES = {
@@ -47,14 +45,7 @@ CHI2_2_AT_ALPHA = 11.17  # χ²₂'s point at the channel test's 0.375 %
 
 def _bands(y, temp):
     """Band sums as regress_channel forms them (read back, signal bands, the three regressors)."""
-    n_use = wh.usable_length(y.size)
-    y, x = y[:n_use], temp[:n_use]
-    form = channel_form(x)
-    x = reconstructed(x, form)
-    _, sig = form_signal(x, FS, form)
-    xs = band_limited(x, FS, sig)
-    mean = float(xs.mean())
-    return wh.spectra(y, regressor_iter(xs, mean, float(np.mean((xs - mean) ** 2)), FS, None), FS)
+    return channel_bands(y, temp, FS)[-1]
 
 
 def _channel(kind: str, rng) -> np.ndarray:

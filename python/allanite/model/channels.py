@@ -319,15 +319,7 @@ def regress_channel(
     alpha, level = check_probability(alpha, "alpha"), check_probability(level, "level")
     confidence = check_probability(confidence)
     terms = _check_subterms(terms)
-    n_use = wh.usable_length(y.size)
-    y, x = y[:n_use], x[:n_use]
-    form = channel_form(x)
-    x = reconstructed(x, form)
-    floor, sig = form_signal(x, fs, form)
-    xs = band_limited(x, fs, sig)
-    mean = float(xs.mean())
-    quad_mean = float(np.mean((xs - mean) ** 2))
-    bands = wh.spectra(y, regressor_iter(xs, mean, quad_mean, fs, None), fs)
+    y, form, floor, sig, xs, mean, quad_mean, bands = channel_bands(y, x, fs)
     null = wh.joint_fit(bands, wh.Design([], []))
     test, in_phase, fit = coupling_test(bands, null, alpha)
     accepted, quad = _first_test(bands, fit, test, level, terms)
@@ -351,6 +343,23 @@ def regress_channel(
     return ChannelRegression(
         name, bool(accepted), params, intervals, test, tests, fs, mean, quad_mean, noise, sig, removal_lag, form
     )
+
+
+def channel_bands(y: np.ndarray, x: np.ndarray, fs: float) -> tuple:
+    """The record and channel as :func:`regress_channel` tests them: both cut to the usable length, the channel's
+    form detected and read back, its signal bands, the band-limited channel ``xs`` with its mean and mean square
+    about it, and the Whittle band sums of ``y`` with the three regressors. Returns (y, form, floor, sig, xs, mean,
+    quad_mean, bands)."""
+    n_use = wh.usable_length(y.size)
+    y, x = y[:n_use], x[:n_use]
+    form = channel_form(x)
+    x = reconstructed(x, form)
+    floor, sig = form_signal(x, fs, form)
+    xs = band_limited(x, fs, sig)
+    mean = float(xs.mean())
+    quad_mean = float(np.mean((xs - mean) ** 2))
+    bands = wh.spectra(y, regressor_iter(xs, mean, quad_mean, fs, None), fs)
+    return y, form, floor, sig, xs, mean, quad_mean, bands
 
 
 def _first_test(bands, fit, test: dict, level: float, terms) -> tuple[bool, tuple | None]:
