@@ -158,6 +158,7 @@ MODEL_RANKS = {
     # objects, the windows
     "model._fitcore": 0.5,
     "model._tauselect": 0,
+    "model._gapfit": 0,  # a gapped result made ready for fit: its usable τ and each τ's share of terms kept
     "model._corefit": 0.6,
     "model._fitresult": 0.7,
     "model._dynamicfit": 0.9,

@@ -266,6 +266,7 @@ def _avar_skipping_gaps(x, fs, input, taus, estimator, workers) -> AllanResult:
     counts = np.asarray(out.n, dtype=np.int64)
     n = counts[0] if np.all(counts == counts[0]) else counts
     values = out.values if is_multi else out.values[0]
+    lost = np.array([int(np.count_nonzero(np.isnan(c))) for c in out_cols], dtype=np.int64)
     return AllanResult(
         tau=out.tau,
         avar=values,
@@ -275,6 +276,7 @@ def _avar_skipping_gaps(x, fs, input, taus, estimator, workers) -> AllanResult:
         fs=fs,
         n_samples=out_cols[0].size,
         input=input,
+        missing=lost if is_multi else int(lost[0]),
     )
 
 

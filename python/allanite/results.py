@@ -269,6 +269,9 @@ class AllanResult(_ResultBase):
         ``"theobr"``); None for plain Allan results.
     kf : ndarray, optional
         TheoBR's bias ratio per axis (scalar for 1-D input), None when not used.
+    missing : int or ndarray
+        Rate samples marked missing (NaN) per axis, ``avar(..., gaps="skip")``: an int for 1-D input, (axes,)
+        otherwise; 0 for a gapless record. :func:`allanite.fit` scales each τ's EDF by the share of terms kept.
     """
 
     tau: np.ndarray
@@ -292,6 +295,8 @@ class AllanResult(_ResultBase):
     kf: np.ndarray | float | None = None
     #: Weighting of the terms inside the window (``"rect"``, ``"hann"``, ``"hann_signal"``; paper 002).
     taper: str = "rect"
+    #: Rate samples marked missing per axis (``gaps="skip"``), 0 when none.
+    missing: int | np.ndarray = 0
 
     def __repr__(self) -> str:
         axes = f", {self.n_axes} {'axis' if self.n_axes == 1 else 'axes'}" if self.n_axes else ""

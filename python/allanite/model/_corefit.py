@@ -27,6 +27,7 @@ from ._fitcore import (
     edf_per_tau,
     exact_covariance_applies,
     fit_core,
+    scale_for_gaps,
 )
 from ._recent import Suffixes
 from .terms import TERM_ALPHA, design_matrix
@@ -34,18 +35,20 @@ from .terms import TERM_ALPHA, design_matrix
 __all__ = ["fit_curve"]
 
 
-def fit_curve(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=50, edf_cache=None):
+def fit_curve(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=50, edf_cache=None, *, share=None):
     """:func:`~allanite.model._fitcore.fit_core` in the core: theta, covariance, model, edf, z, iterations,
-    design, χ²."""
+    design, χ². ``share``: per τ, the share of a gapless record's terms the estimate averages (a record with
+    gaps), its EDF scaled by it and its covariance by 1/√(share_i·share_j) (:func:`scale_for_gaps`)."""
     check_gls_size(estimator, m)
     y = np.asarray(avar, dtype=np.float64)
     if not (np.all(np.isfinite(y)) and np.all(y >= 1e-300)):
-        return fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter, edf_cache)
+        return fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter, edf_cache, share=share)
     terms = tuple(terms)
     a = design_matrix(tau, tau * fs, fs, terms)
     nu_terms = _nu_terms(m, n_points, estimator, terms, edf_cache)
     gls = exact_covariance_applies(tau, m, fs, n_points, estimator)
     blocks = _covariance.covariance_blocks(m, int(n_points) - 1, fs, terms) if gls else None
+    nu_terms, blocks = scale_for_gaps(share, nu_terms, blocks)
     shared = dict(
         start_col=terms.index("N") if "N" in terms else 0,
         irls_iter=GLS_START_ITER,
@@ -63,7 +66,7 @@ def fit_curve(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
     )
     theta, cov = theta[0], cov[0]
     if status[0] != 0 or not theta.any():
-        return fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter, edf_cache)
+        return fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter, edf_cache, share=share)
     # fit_core's own scaling (a power of two near the peak: exact), so that Σ(θ) neither under- nor overflows
     peak = float(np.max(y))
     scale = math.ldexp(1.0, math.frexp(peak)[1])

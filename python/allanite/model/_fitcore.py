@@ -47,12 +47,13 @@ def nnls(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return _nnls.nnls(a, b)
 
 
-def fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=50, edf_cache=None):
+def fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=50, edf_cache=None, *, share=None):
     """Fit one curve. Returns theta, covariance, model, edf, z, iterations, design, χ².
 
     Overlapping estimates on integer m ≤ n/2 get the generalized least-squares fit with their exact
     model covariance across τ (:func:`_fit_gls`); other estimators (classic, Theo family) the
-    independent-weights fit with the octave-correlation sandwich (:func:`_fit_irls`)."""
+    independent-weights fit with the octave-correlation sandwich (:func:`_fit_irls`). ``share``: a record with
+    gaps, each τ's share of the gapless record's terms (:func:`scale_for_gaps`)."""
     check_gls_size(estimator, m)
     # The fit is linear in the variance: fitted on estimates scaled by a power of two near their peak (exact),
     # so that variances of 1e-300 or 1e300 (samples in extreme units) neither underflow nor overflow in the
@@ -63,12 +64,28 @@ def fit_core(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=
     if exact_covariance_applies(tau, m, fs, n_points, estimator):
         # a few independent-weights passes are enough for a start (and its EDF for a bare ramp)
         n_start = min(max_iter, GLS_START_ITER)
-        start = _fit_irls(tau, m, y, fs, n_points, estimator, terms, confidence, n_start, edf_cache)
-        out = _fit_gls(tau, m, y, fs, n_points, terms, start, max_iter)
+        start = _fit_irls(tau, m, y, fs, n_points, estimator, terms, confidence, n_start, edf_cache, share)
+        out = _fit_gls(tau, m, y, fs, n_points, terms, start, max_iter, share)
     else:
-        out = _fit_irls(tau, m, y, fs, n_points, estimator, terms, confidence, max_iter, edf_cache)
+        out = _fit_irls(tau, m, y, fs, n_points, estimator, terms, confidence, max_iter, edf_cache, share)
     theta, cov, model, nu, z, it, a, chi2 = out
     return theta * scale, cov * (scale * scale), model * scale, nu, z, it, a, chi2
+
+
+def scale_for_gaps(share, nu_terms, blocks):
+    """(EDF per τ and term, covariance blocks) of estimates that average only a ``share`` of a gapless record's
+    terms (a record with gaps, :mod:`allanite.model._gapfit`): an average of fewer terms has its variance times
+    1/share, so the EDF is scaled by the share and each covariance entry (i, j) by 1/√(share_i·share_j). ``share``
+    None: both as they are."""
+    if share is None:
+        return nu_terms, blocks
+    k = np.asarray(share, dtype=np.float64)
+    nu_terms = nu_terms * k[:, None]
+    if blocks is not None:
+        w = 1.0 / np.sqrt(k)
+        ww = np.outer(w, w)
+        blocks = (blocks[0] * ww, blocks[1] * ww)
+    return nu_terms, blocks
 
 
 def check_gls_size(estimator, m) -> None:
@@ -120,7 +137,7 @@ def _chol(cov: np.ndarray) -> np.ndarray:
     return (v * np.sqrt(np.clip(w, 1e-4 * w.max(), None))) * d[:, None]
 
 
-def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
+def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter, share=None):
     """Generalized least squares with the estimates' exact covariance, iterated from the model.
 
     Σ(θ) = Cov(σ̂²(τ_i), σ̂²(τ_j)) under the fitted model (:mod:`allanite.model._covariance`: the
@@ -132,7 +149,7 @@ def _fit_gls(tau, m, avar, fs, n_points, terms, start, max_iter):
     assemble, covariance_blocks = _covariance.assemble, _covariance.covariance_blocks
 
     theta0, _, _, nu0, _, _, a, _ = start
-    s_blk, t_blk = covariance_blocks(m, int(n_points) - 1, fs, terms)
+    s_blk, t_blk = scale_for_gaps(share, np.ones((m.size, 1)), covariance_blocks(m, int(n_points) - 1, fs, terms))[1]
     floor = 1e-12 * np.max(avar)
 
     def factor(theta):
@@ -216,7 +233,7 @@ def _gls_result(factor, theta, a, avar, n_terms, it):
     return theta, cov, model, nu, z, it, a, chi2
 
 
-def _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=50, edf_cache=None):
+def _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter=50, edf_cache=None, share=None):
     """IRLS with independent weights for one curve. Returns theta, covariance, model, edf, z, iterations,
     design, χ².
 
@@ -224,6 +241,7 @@ def _fit_irls(tau, m, avar, fs, n_points, estimator, terms, confidence, max_iter
     τ·fs, which is m for the Allan estimators and 0.75·m for Theo1-based points."""
     a = design_matrix(tau, tau * fs, fs, terms)
     nu_terms = _term_edfs(terms, m, n_points, estimator, {} if edf_cache is None else edf_cache)
+    nu_terms = scale_for_gaps(share, nu_terms, None)[0]
 
     def edf_of(parts):
         # Mixture of independent noises: Var(σ̂²) ≈ Σ_k 2 s_k²/ν_k, so ν = (Σ s_k)² / Σ s_k²/ν_k —

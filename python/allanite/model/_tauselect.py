@@ -43,7 +43,10 @@ def select_taus(tau, avar, thin, n_terms, what, tau_range=(0.0, np.inf)):
     a ParameterError naming ``what`` when the estimates are not finite or too few τ remain for ``n_terms``."""
     if not np.all(np.isfinite(avar)):
         i = int(np.flatnonzero(~np.isfinite(avar))[0])
-        raise ParameterError(f"{what} has a non-finite Allan variance ({avar[i]}) at τ = {tau[i]:g} s")
+        raise ParameterError(
+            f"{what} has a non-finite Allan variance ({avar[i]}) at τ = {tau[i]:g} s (NaN-marked gaps: "
+            f"avar(..., gaps='skip') then fit(..., gaps='skip') leaves out the τ without a complete term)"
+        )
     inside = np.flatnonzero((tau >= tau_range[0]) & (tau <= tau_range[1]))
     if inside.size == 0:
         raise ParameterError(f"no τ of {what} lies in tau_range {tau_range} s (τ spans {tau[0]:g}–{tau[-1]:g} s)")

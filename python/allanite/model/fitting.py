@@ -31,6 +31,7 @@ import numpy as np
 
 from .._dist import chi2_sf
 from .._progress import show_progress
+from .._validate import check_choice
 from ..errors import ParameterError
 from ..estimators import get as get_estimator
 from ..estimators import names as estimator_names
@@ -49,6 +50,7 @@ from ._fitresult import READOFF_MIN_EDF as READOFF_MIN_EDF
 from ._fitresult import Coefficient, CoefficientSeries, NoiseFit, coefficients, interval, readoffs, z_quantile
 from ._fitresult import coefficient_table as coefficient_table
 from ._fitresult import intervals as intervals
+from ._gapfit import GAPS, gap_row
 from ._tauselect import check_tau_range, estimator_key, row_medians, select_taus
 from .terms import TERMS, check_terms
 
@@ -81,6 +83,7 @@ def fit(
     tau_range=None,
     max_iter: int = 50,
     progress=None,
+    gaps: str = "error",
 ):
     """Fit the IEEE-952 noise terms to an Allan variance result.
 
@@ -118,6 +121,13 @@ def fit(
         Dynamic results: a ``tqdm.auto`` bar over the windows when there are more than
         ``allanite.model._batched.PIECE`` of them — None (default) shows it in a notebook or a terminal,
         True always, False never. It appears only after a second.
+    gaps : {"error", "skip"}
+        A static result of a record with NaN-marked gaps (``avar(..., gaps="skip")``, ``result.missing`` > 0)
+        is fitted from the terms its curve kept: each τ's EDF (and its covariance across τ) is the gapless
+        record's scaled by the share of terms kept at that τ, ``n / n_full`` — the variance of an average of
+        fewer terms, exact when the gaps are short against the stretches between them, somewhat optimistic when
+        they are closer than 2τ — and ``notes`` states how many samples were missing. A τ with no complete
+        term (n = 0) is an error by default (``"error"``); ``"skip"`` leaves such τ out (said in ``notes``).
 
     Notes
     -----
@@ -162,6 +172,7 @@ def fit(
     if unit is not None:
         check_sensor_unit(unit)
     show_progress(progress)  # a wrong value fails before any work
+    check_choice(gaps, "gaps", GAPS)
     if isinstance(result, DynamicAllanResult):
         _check_fit_estimator(result)
         if auto:
@@ -172,9 +183,15 @@ def fit(
     _check_fit_estimator(result)
     one = _fit_static_auto if auto else _fit_static_row
     args = (terms, unit, float(confidence), zq, thin, max_iter) + (() if auto else (tau_range,))
+
+    def one_row(row, axis):
+        sub, row, share, notes = gap_row(result, np.asarray(row, dtype=np.float64), axis, gaps)
+        f = one(sub, row, *args, share=share)
+        return dataclasses.replace(f, notes=notes + f.notes) if notes else f
+
     if result.avar.ndim == 2:
-        return [one(result, row, *args) for row in result.avar]
-    return one(result, result.avar, *args)
+        return [one_row(row, a) for a, row in enumerate(result.avar)]
+    return one_row(result.avar, None)
 
 
 #: A fit this much worse than its noise says so in ``NoiseFit.notes``.
@@ -236,12 +253,12 @@ def _auto_note(cut, chi2_dof, first_chi2_dof, tau0, ok):
     )
 
 
-def _fit_static_auto(result, avar_row, terms, unit, confidence, zq, thin, max_iter):
+def _fit_static_auto(result, avar_row, terms, unit, confidence, zq, thin, max_iter, share=None):
     avar_row = np.asarray(avar_row, dtype=np.float64)
     cuts, tau0 = _auto_cuts(result, avar_row, thin, len(terms))
 
     def fit_at(cut):
-        f = _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_iter, (cut, np.inf))
+        f = _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_iter, (cut, np.inf), share)
         return f, f.chi2_dof
 
     cut, (f, chi), (_, chi0), ok = _auto_choose(cuts, fit_at)
@@ -284,12 +301,22 @@ def fit_estimators() -> tuple[str, ...]:
     return tuple(n for n in estimator_names() if get_estimator(n).estimates_allan)
 
 
-def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_iter, tau_range):
+def _fit_static_row(result, avar_row, terms, unit, confidence, zq, thin, max_iter, tau_range, share=None):
+    """One row's fit; ``share``: the share of terms kept per τ of a record with gaps (:mod:`._gapfit`)."""
     avar_row = np.asarray(avar_row, dtype=np.float64)
     idx = select_taus(result.tau, avar_row, thin, len(terms), "the result", tau_range)
     tau, m, y = result.tau[idx], result.m[idx].astype(np.float64), avar_row[idx]
     theta, cov, model, nu, z, it, a, chi2 = fit_curve(
-        tau, m, y, result.fs, result.n_samples + 1, estimator_key(result, idx), terms, confidence, max_iter
+        tau,
+        m,
+        y,
+        result.fs,
+        result.n_samples + 1,
+        estimator_key(result, idx),
+        terms,
+        confidence,
+        max_iter,
+        share=None if share is None else share[idx],
     )
     n_active = int(np.count_nonzero(theta > 0))
     dof = max(1, tau.size - n_active)
