@@ -10,15 +10,18 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from ..._validate import as_rate_columns
-from ...analysis import avar
+from ..._validate import as_rate_columns, check_choice
+from ...analysis import GAPS, avar
+from ...analysis import _gap_columns as gap_columns
 from ...errors import InputError, ParameterError
 from ...estimators.grid import tau_grid
 from ...results import AllanResult
 from ...units import ACCEL_UNITS, accel_unit_name, check_sensor_unit, parse_unit
 from .. import fitting
 from .._chunked import CHUNK, chunks
+from .._gapfit import gapless_terms
 from ..channels import check_channel
+from ._gapfill import MAX_GAP, MAX_MISSING, fill_channel, filled_record
 from .scoring import HELDOUT_BLOCKS
 
 __all__ = [
@@ -84,12 +87,18 @@ def _finite_peak(arr: np.ndarray) -> float:
     return peak
 
 
-def inputs(x_or_result, fs, input, points, axis, channels):
-    """(samples or None, the static one-row AllanResult to refine, the channels by name), checked."""
-    y = None
+def inputs(x_or_result, fs, input, points, axis, channels, gaps="error"):
+    """(samples or None, the static one-row AllanResult to refine, the channels by name, what was filled or None),
+    checked. ``gaps="skip"``: NaN marks missing samples, filled for the searches along time (:mod:`._gapfill`)."""
+    y, filled = None, None
     if isinstance(x_or_result, AllanResult):
         if fs is not None:
             raise ParameterError("fs is taken from the result; pass fs only with samples")
+        if np.any(np.asarray(x_or_result.missing) > 0):
+            raise ParameterError(
+                "refine takes the samples of a record with gaps, not its AllanResult (its curve's EDF would be the "
+                "gapless record's): pass the NaN-marked samples with gaps='skip'"
+            )
         result = x_or_result
     elif hasattr(x_or_result, "tau") and hasattr(x_or_result, "t"):
         raise ParameterError(
@@ -99,18 +108,50 @@ def inputs(x_or_result, fs, input, points, axis, channels):
     else:
         if fs is None:
             raise ParameterError("fs (Hz) is needed with samples")
-        cols, fs, _ = as_rate_columns(x_or_result, fs, input)
+        cols, fs = _columns(x_or_result, fs, input, gaps)
         axis = _one_axis(axis, len(cols))
         if not 0 <= axis < len(cols):
             raise ParameterError(f"axis = {axis} is outside 0..{len(cols) - 1}")
-        y = cols[axis]
+        y, filled = filled_record(cols[axis], fs)
         top = max(1, y.size // 9)
         grid = tau_grid(y.size, fs, "exp", points=points, m_max=top) if top > 1 else "octave"
         result = avar(y, fs, taus=grid)
+        if filled is not None:
+            filled["curve_change_pct"] = _fill_change(cols[axis], result)
+    if filled is not None and channels is not None and isinstance(channels, Mapping):
+        channels = {k: fill_channel(str(k), c, fs) for k, c in channels.items()}
     chans = check_channels(channels, y)
     if result.avar.ndim == 2:
         result = result.static_row(result.avar[_one_axis(axis, result.avar.shape[0])])
-    return y, result, chans
+    return y, result, chans, filled
+
+
+def _columns(x, fs, input, gaps):
+    """The rate columns and fs; NaN an InputError naming gaps='skip', or with it kept as missing samples."""
+    check_choice(gaps, "gaps", GAPS)
+    arr = np.asarray(x)
+    if arr.dtype.kind == "f" and np.isnan(arr).any():
+        if gaps != "skip":
+            i = int(np.flatnonzero(np.isnan(arr).reshape(arr.shape[0], -1).any(axis=1))[0])
+            raise InputError(
+                f"the samples hold NaN (first at sample {i}): refine(..., gaps='skip') takes NaN as missing samples "
+                f"(at most {100 * MAX_MISSING:g} %, no gap over {100 * MAX_GAP:g} % of the record) and fills them "
+                f"for the searches along time"
+            )
+        cols, fs, _ = gap_columns(arr, fs, input)
+        return cols, fs
+    cols, fs, _ = as_rate_columns(x, fs, input)
+    return cols, fs
+
+
+def _fill_change(y_nan, result) -> float:
+    """The largest change (%) the fill made to the Allan curve against the curve that skips the gaps, over the τ
+    where the skipping curve keeps at least 90 % of a gapless record's terms (further out the two average different
+    subsets of the terms, and their difference is mostly the sampling noise of the terms the gaps touch)."""
+    skip = avar(y_nan, result.fs, taus=result.tau, gaps="skip")
+    share = skip.n / np.maximum(gapless_terms("oavar", skip.m, skip.n_samples), 1)
+    ok = (share >= 0.9) & np.isfinite(skip.avar) & (skip.avar > 0)
+    return float(100 * np.max(np.abs(result.avar[ok] / skip.avar[ok] - 1))) if ok.any() else float("nan")
 
 
 def _one_axis(axis, n_axes: int) -> int:

@@ -16,6 +16,7 @@ from .._fitresult import report_header
 from ..effects import EFFECTS, format_params
 from ..terms import TERM_NAMES
 from ._family_fold import folded
+from ._gapfill import filled_words
 from .levels import LEVEL
 from .words import missing_sentences
 
@@ -171,6 +172,11 @@ class Refinement(RichDisplay):
     level: float = LEVEL
     start_errors: dict | None = None
     final_errors: dict | None = None
+    #: ``refine(..., gaps="skip")`` on a record with missing samples: how many (``"samples"``, ``"fraction"``), in
+    #: how many gaps (``"gaps"``, ``"longest_s"``, ``"runs"``: (start, length) each), filled how (``"method"``), and
+    #: the largest change (%) the fill made to the Allan curve against the curve that skips the gaps
+    #: (``"curve_change_pct"``); None for a gapless record.
+    filled: dict | None = None
 
     def curve_errors(self, fit) -> dict:
         """χ²/dof, RMS z and RMS ADEV error (%) of ``start`` or ``fit`` on the record's curve: the chain's
@@ -261,6 +267,8 @@ class Refinement(RichDisplay):
             f"Held-out error: {self.heldout_note}",
             "",
         ]
+        if self.filled:
+            lines += [f"Gaps: {filled_words(self.filled)}.", ""]
         if not self.steps:
             lines.append(self._nothing_added().capitalize() + ".")
         for i, st in enumerate(self.steps, 1):
