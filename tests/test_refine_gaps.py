@@ -1,0 +1,104 @@
+"""refine on a record with NaN-marked gaps (``gaps="skip"``): the fill (the line between the gap's neighbourhood
+medians), the limits it refuses beyond, what ``Refinement.filled`` and the report say, and a sinusoid still found
+through the gaps (benches/refine_gaps.py: the false-alarm side on clean records)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import allanite
+from allanite.errors import DataGapError, InputError, ParameterError
+from allanite.model.refinement._gapfill import check_gaps, fill_gaps, gap_runs
+
+FS = 100.0
+
+
+def dropped(y, seed, n_gaps=20, frac=0.01):
+    z = y.copy()
+    width = max(1, int(frac * y.size / n_gaps))
+    slots = np.random.default_rng(seed).choice(y.size // width - 1, n_gaps, replace=False)
+    for s in slots:
+        z[s * width : (s + 1) * width] = np.nan
+    return z
+
+
+def test_gap_runs_and_the_fill_of_a_line_is_the_line():
+    t = np.arange(200, dtype=np.float64)
+    y = 3.0 + 0.5 * t
+    z = y.copy()
+    z[[0, 1, 50, 51, 52, 120, 199]] = np.nan
+    runs = gap_runs(np.isnan(z))
+    np.testing.assert_array_equal(runs, [[0, 2], [50, 3], [120, 1], [199, 1]])
+    # inside the record: the line through each side's median of a straight line is that line
+    out = fill_gaps(z, runs)
+    np.testing.assert_allclose(out[2:199], y[2:199], rtol=0, atol=1e-12)
+    # at its ends one side only: flat at that side's median (8 samples)
+    np.testing.assert_allclose(out[:2], np.median(y[2:10]))
+    np.testing.assert_allclose(out[199], np.median(y[191:199]))
+
+
+def test_the_fill_is_the_neighbourhood_medians_not_the_single_neighbours():
+    y = np.zeros(100)
+    y[39] = 50.0  # a spike beside the gap: one neighbour; the median of the 8 before it ignores it
+    y[40:44] = np.nan
+    out = fill_gaps(y, gap_runs(np.isnan(y)))
+    np.testing.assert_array_equal(out[40:44], 0.0)
+
+
+def test_too_many_missing_or_a_gap_too_long_is_a_data_gap_error():
+    miss = np.zeros(1_000, dtype=bool)
+    miss[::15] = True  # 6.7 % in gaps of one sample
+    with pytest.raises(DataGapError, match=r"67 of 1000 samples \(6.7 %\) are missing.*at most 5 %"):
+        check_gaps(miss, FS)
+    miss = np.zeros(1_000, dtype=bool)
+    miss[100:112] = True  # 1.2 % of the record in one gap
+    with pytest.raises(DataGapError, match=r"a gap of 12 samples \(0.12 s\) from sample 100 is longer than 1 %"):
+        check_gaps(miss, FS)
+    assert issubclass(DataGapError, ValueError)
+
+
+def test_a_channels_gaps_are_filled_as_the_samples():
+    from allanite.model.refinement._gapfill import fill_channel
+
+    temp = np.linspace(20.0, 25.0, 1_000)
+    gappy = temp.copy()
+    gappy[[10, 11, 500]] = np.nan  # read_log(gaps="nan") marks the channels at the same gaps
+    np.testing.assert_allclose(fill_channel("temp", gappy, FS), temp, atol=1e-12)
+    assert fill_channel("temp", temp, FS) is temp
+    gappy[600:620] = np.nan
+    with pytest.raises(DataGapError, match="channel 'temp': a gap of 20 samples"):
+        fill_channel("temp", gappy, FS)
+
+
+def test_nan_without_gaps_skip_is_an_input_error_naming_it():
+    y = allanite.simulate(4_096, FS, N=0.01, seed=1)
+    y[77] = np.nan
+    with pytest.raises(InputError, match=r"first at sample 77\): refine\(\.\.\., gaps='skip'\)"):
+        allanite.refine(y, FS)
+    with pytest.raises(ParameterError, match="unknown gaps"):
+        allanite.refine(y, FS, gaps="nan")
+    r = allanite.avar(y, FS, gaps="skip")
+    with pytest.raises(ParameterError, match="not its AllanResult"):
+        allanite.refine(r)
+
+
+def test_a_sinusoid_is_found_through_the_gaps_and_the_fill_is_stated():
+    y = allanite.simulate(2**13, FS, N=0.01, sinusoid=[(0.02, 2.3)], seed=3)
+    z = dropped(y, 4)
+    r = allanite.refine(z, FS, gaps="skip", candidates=("sinusoid",))
+    assert r.found == ["sinusoid"]
+    st = r.steps[0]
+    assert st.params["amplitude"] == pytest.approx(0.02, rel=0.2)
+    assert st.params["f0"] == pytest.approx(2.3, rel=0.01)
+    f = r.filled
+    assert f["samples"] == int(np.isnan(z).sum()) == 80 and f["gaps"] == 20 and f["longest_s"] == 0.04
+    assert f["fraction"] == pytest.approx(80 / 2**13)
+    assert [tuple(g) for g in gap_runs(np.isnan(z))] == f["runs"]
+    assert 0.0 < f["curve_change_pct"] < 5.0
+    assert "Gaps: 80 samples missing (0.98 %) in 20 gap(s)" in r.report()
+    # a gapless record says nothing of gaps (refine's inputs: its samples as given, no fill)
+    from allanite.model.refinement._inputs import inputs
+
+    got, _res, _ch, filled = inputs(y, FS, "rate", 300, None, None, "skip")
+    assert filled is None and np.array_equal(got, y)
