@@ -444,7 +444,7 @@ def test_report_help_reads_like_a_unix_tool(capsys):
         "--time-column",
         "--unit U",
         "--input {rate,increment,angle}",
-        "--gaps {error,longest,split}",
+        "--gaps {error,longest,split,nan}",
         "--taus GRID",
         "--window N",
         "--hop N",

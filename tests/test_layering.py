@@ -183,6 +183,7 @@ MODEL_RANKS = {
     "model.refinement._mean_steps": 4,
     "model.refinement._quality": 4,
     "model.refinement.words": 3,
+    "model.refinement._gapfill": 0,  # a record's NaN gaps checked and filled for refine(gaps="skip")
     "model.refinement._family_fold": 3,  # a periodic family and the sinusoids at its own lines: one effect
     "model.refinement._columns": 2.5,  # the curve and its columns (curvefit's lower half)
     "model.refinement._noisefit": 2.7,  # what a solution says of the terms; the NoiseFit it becomes

@@ -102,3 +102,28 @@ def test_a_sinusoid_is_found_through_the_gaps_and_the_fill_is_stated():
 
     got, _res, _ch, filled = inputs(y, FS, "rate", 300, None, None, "skip")
     assert filled is None and np.array_equal(got, y)
+
+
+def test_report_of_a_log_with_gaps_marked_nan(tmp_path, capsys):
+    import json
+
+    from allanite import cli
+
+    n = 4_000
+    t = np.arange(n) / 50.0
+    y = allanite.simulate(n, 50.0, N=0.01, seed=7)
+    keep = np.ones(n, dtype=bool)
+    keep[[700, 701, 702, 2500, 2501]] = False  # two gaps: 3 and 2 rows missing
+    log = tmp_path / "gappy.csv"
+    np.savetxt(log, np.c_[t[keep], y[keep]], delimiter=",", header="t,gx", comments="")
+    out = tmp_path / "out"
+    args = ["report", str(log), "--time-column", "t", "--unit", "deg/s", "--gaps", "nan", "--quiet", "--out", str(out)]
+    assert cli.main(args) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["samples"] == n
+    notes = " ".join(summary["notes"])
+    assert "The log has 2 gap(s): 5 missing rows marked NaN (--gaps nan)" in notes
+    assert "gx: 5 of 4000 samples missing (0.12 %)" in notes
+    assert "could not be fitted" not in notes and summary["fit"]["error"] is None
+    n_coef = summary["fit"]["axes"][0]["coefficients"]["N"]
+    assert n_coef["value"] == pytest.approx(0.01, rel=0.05) and n_coef["ci"][0] < 0.01 < n_coef["ci"][1]

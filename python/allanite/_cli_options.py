@@ -131,9 +131,11 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
     )
     inp.add_argument(
         "--gaps",
-        choices=("error", "longest", "split"),
+        choices=("error", "longest", "split", "nan"),
         help="when the time column shows gaps: stop with the list of gaps (default), analyse the "
-        "longest gap-free stretch, or the same and list every stretch (split)",
+        "longest gap-free stretch, or the same and list every stretch (split), or keep the whole log with the "
+        "missing rows marked NaN (nan): the Allan curves skip the terms that touch one, the refinement fills "
+        "them (at most 5 %% missing)",
     )
     inp.add_argument(
         "--channels",

@@ -238,7 +238,7 @@ def avar(
     )
 
 
-def _gap_columns(x, fs, input):
+def gap_columns(x, fs, input):
     """Rate columns of a record whose NaN marks missing samples (a missing angle point makes the two
     rate samples beside it missing): (columns with NaN at the missing rate samples, fs, is_multi)."""
     arr = np.asarray(x)
@@ -261,7 +261,7 @@ def _avar_skipping_gaps(x, fs, input, taus, estimator, workers) -> AllanResult:
         raise ParameterError(
             f'gaps="skip" is supported by the estimators {", ".join(GAP_ESTIMATORS)}; got estimator={estimator!r}'
         )
-    out_cols, fs, is_multi = _gap_columns(x, fs, input)
+    out_cols, fs, is_multi = gap_columns(x, fs, input)
     out = gap_static(out_cols, fs, taus, workers, estimator)
     counts = np.asarray(out.n, dtype=np.int64)
     n = counts[0] if np.all(counts == counts[0]) else counts
@@ -387,7 +387,7 @@ def davar(
     peaks: list[float] | None
     if gaps == "skip":
         _check_gap_davar(estimator, method, taper)
-        cols, fs, is_multi = _gap_columns(x, fs, input)
+        cols, fs, is_multi = gap_columns(x, fs, input)
         peaks = None
     else:
         peaks = []

@@ -90,7 +90,7 @@ def finish(path, fmt, rec: Record, fs, unit, input, gaps) -> Log:
         raise DataGapError(
             f"{path}: {len(gap_list)} gap(s) in time column {rec.time_name!r} (a step over {GAP_FACTOR}× the "
             f"nominal {1.0 / fs:g} s): {shown}{more}. Pass gaps='longest' to keep the longest gap-free "
-            f"stretch, or gaps='split' for every stretch"
+            f"stretch, gaps='split' for every stretch, or gaps='nan' to keep the whole log with the missing rows NaN"
         )
     if gaps == "nan" and gap_list:
         return _filled_with_nan(path, fmt, rec, data, t, fs, unit, input, t0, gap_list, jitter)

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ..errors import AllaniteError, ParameterError
 from ..model.effects import EFFECTS
 from .axes import axis_column
@@ -83,6 +85,7 @@ def refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes) -> li
     """:func:`allanite.refine` on every axis (None for an axis it fails on, with a note why); ``asked``: the
     candidate effects and the other channels (None: none)."""
     from ..model import refine as refine_axis  # the refinement package (scipy.signal) only when asked
+    from ..model.refinement._gapfill import filled_words
 
     candidates, channels = asked
 
@@ -101,8 +104,11 @@ def refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes) -> li
                     tau_range=None if t0 is None else (t0, None),
                     candidates=candidates,
                     channels=channels,
+                    gaps="skip" if np.any(np.asarray(static.missing) > 0) else "error",
                 )
             )
+            if refinements[-1].filled:  # the one note the page needs: which samples the searches saw filled
+                notes.append(f"Model refinement of {axis_names[k]}: {filled_words(refinements[-1].filled)}.")
         except AllaniteError as exc:
             refinements.append(None)
             notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")

@@ -82,6 +82,7 @@ def build_report(
     taper: str | None = None,
     split: str | None = None,
     max_memory=None,
+    gaps: str = "error",
 ) -> Report:
     """Compute everything the report shows.
 
@@ -151,8 +152,14 @@ def build_report(
         DAVAR surface, the per-window fits and what the report keeps of them
         (:func:`allanite.report.budget.report_memory`). A request over it raises
         :class:`~allanite.errors.MemoryBudgetError` before any heavy work, with a hop that fits.
+    gaps : {"error", "skip"}
+        ``"skip"``: NaN marks missing samples (``read_log(..., gaps="nan")``; :func:`from_log` sets it for such a
+        log) — the Allan deviation and DAVAR skip the terms that touch one (``avar(gaps="skip")``), the fit scales
+        each τ's EDF by the terms kept (``fit(gaps="skip")``), the refinement fills the gaps for its searches along
+        time (``refine(gaps="skip")``, at most 5 % missing). Overlapping Allan only (``estimator="oavar"``).
     """
     notes = list(notes)
+    check_choice(gaps, "gaps", ("error", "skip"))
     x, plan = _record_and_plan(x, fs, frames, forecast)
     candidates = refine_candidates(refine)
     channels = check_channels(channels, candidates, np.shape(x)[0])
@@ -167,7 +174,7 @@ def build_report(
     check_choice(estimator, "estimator", tuple(REPORT_ESTIMATORS))
     static, dynamic, settings = _analyse(
         x, fs, input=input, taus=taus, estimator=estimator, window=window, hop=hop, fit=fit, confidence=confidence,
-        max_memory=max_memory, progress=progress,
+        max_memory=max_memory, progress=progress, gaps=gaps,
         # a figure process draws the DAVAR figures while the intervals and the model are computed
         on_dynamic=lambda st, dy: _offer(st, dy, None, None, unit_name, input, axis_names, complete=False),
     )  # fmt: skip
@@ -287,7 +294,9 @@ def _axes_and_unit(x, unit, input, axis_names, notes, accel_unit=None) -> tuple:
     return x, unit_name, axis_names
 
 
-def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max_memory, progress, on_dynamic) -> tuple:
+def _analyse(
+    x, fs, *, input, taus, estimator, window, hop, fit, confidence, max_memory, progress, on_dynamic, gaps="error"
+) -> tuple:
     """(static result with intervals, dynamic result, settings): the request's size first — over the memory
     budget it is refused before any heavy work — then every axis at once, or one at a time (report/axes.py).
     ``on_dynamic(static, dynamic)`` is called once both exist (with every axis at once: before the intervals)."""
@@ -300,7 +309,9 @@ def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max
     dyn_ms = resolve_m(dynamic_grid, window, check_positive(fs, "fs"))
     n_fit = octaves(dyn_ms) if estimator == "oavar" else dyn_ms.size  # DHVAR's short windows: every τ
     by_axis, cost = memory_plan(x, n, n_axes, window, hop, dyn_ms.size, n_fit, fit, max_memory)
-    extra = {"decimate": "auto"} if static_est == "theoh" else {}
+    extra: dict = {"decimate": "auto"} if static_est == "theoh" else {}
+    if gaps == "skip":  # NaN-marked missing samples (the by-axis path's DAVAR then refuses them: a NaN)
+        extra["gaps"] = "skip"
     if by_axis:  # one axis in memory at a time (report/axes.py): a long or memory-mapped record
         static, dynamic = analyse_by_axis(
             x, fs, input=input, taus=taus, static_est=static_est, static_extra=extra, confidence=confidence,
@@ -313,11 +324,14 @@ def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max
         static = avar(x, fs, input=input, taus=taus, estimator=static_est, **extra)
         progress.step("dynamic Allan variance")
         dynamic = davar(
-            x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est, max_memory=max_memory
-        )
+            x, fs, window=window, hop=hop, taus=dynamic_grid, input=input, estimator=dynamic_est,
+            max_memory=max_memory, gaps=gaps,
+        )  # fmt: skip
         on_dynamic(static, dynamic)  # before the intervals: the DAVAR figures need nothing more
         progress.step("confidence intervals")
-        static = static.with_confidence(x, confidence=confidence)
+        # the noise type behind each interval is identified on the samples (gaps: joined by straight lines for
+        # that alone; the EDF counts the complete terms, ``static.n``)
+        static = static.with_confidence(_bridged(x) if gaps == "skip" else x, confidence=confidence)
     settings.update(
         taus=taus if isinstance(taus, str) else "explicit",
         estimator=estimator,
@@ -329,6 +343,17 @@ def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max
     return static, dynamic, settings
 
 
+def _bridged(x) -> np.ndarray:
+    """A copy of the samples with each NaN replaced by the straight line between the finite samples around it."""
+    out = np.array(x, dtype=np.float64)
+    idx = np.arange(out.shape[0])
+    for col in out.reshape(out.shape[0], -1).T:
+        bad = np.isnan(col)
+        if bad.any() and not bad.all():
+            col[bad] = np.interp(idx[bad], idx[~bad], col[~bad])
+    return out
+
+
 def _fit_record_and_windows(static, dynamic, unit_name, confidence, axis_names, notes, progress) -> tuple:
     """(whole-record fits, per-window series, their errors or None): the noise model of the whole record, then
     of every window on the same τ range as its axis's whole-record fit; a failure becomes a note."""
@@ -337,7 +362,7 @@ def _fit_record_and_windows(static, dynamic, unit_name, confidence, axis_names, 
     try:
         # tau_range="auto": a real sensor's shortest τ (anti-alias filter, vibration lines) are often not
         # the model's; they would dominate the fit and give wrong coefficients. The cut is stated.
-        fits = fit_model(static, unit=unit_name, confidence=confidence, tau_range="auto")
+        fits = fit_model(static, unit=unit_name, confidence=confidence, tau_range="auto", gaps="skip")
         if not isinstance(fits, list):
             fits = [fits]
         for k, f in enumerate(fits):
@@ -447,6 +472,12 @@ def _unit_notes(log) -> list:
     return []
 
 
+def log_has_nan(log) -> bool:
+    """Whether a log's samples hold NaN rows (``read_log(..., gaps="nan")`` marked its gaps)."""
+    data = np.asarray(log.data)
+    return data.dtype.kind == "f" and bool(np.isnan(data).any())
+
+
 def from_log(log, **kwargs) -> Report:
     """:func:`build_report` on a :class:`~allanite.Log` from :func:`allanite.read_log` (its unit — a gyro's, or
     the accelerometer's its columns' names all give, as ``Log.take`` keeps one of ``Log.groups`` —, its
@@ -465,7 +496,15 @@ def from_log(log, **kwargs) -> Report:
             f"Time column {log.time_column!r} was read in {log.time_unit}, the unit its name gives (time_ns, "
             "t [ms]; rostopic echo -p's %time: ns) (--time-unit / read_log(time_unit=…) overrides it)."
         )
-    if log.gaps:
+    if log.gaps and log_has_nan(log):
+        lost = int(np.isnan(np.asarray(log.data)).reshape(len(log.data), -1).any(axis=1).sum())
+        notes.append(
+            f"The log has {len(log.gaps)} gap(s): {lost} missing rows marked NaN (--gaps nan) — the Allan curves skip "
+            "the terms that touch one, the fit scales each τ's EDF by the terms kept, the refinement fills them for "
+            "its searches along time."
+        )
+        kwargs.setdefault("gaps", "skip")
+    elif log.gaps:
         notes.append(
             f"The log has {len(log.gaps)} gap(s); only the longest gap-free stretch, samples "
             f"{log.span[0]}–{log.span[1] - 1} of {log.n_record}, is analysed{_share(log)}"

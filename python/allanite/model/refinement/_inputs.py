@@ -11,8 +11,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ..._validate import as_rate_columns, check_choice
-from ...analysis import GAPS, avar
-from ...analysis import _gap_columns as gap_columns
+from ...analysis import GAPS, avar, gap_columns
 from ...errors import InputError, ParameterError
 from ...estimators.grid import tau_grid
 from ...results import AllanResult
@@ -108,7 +107,7 @@ def inputs(x_or_result, fs, input, points, axis, channels, gaps="error"):
     else:
         if fs is None:
             raise ParameterError("fs (Hz) is needed with samples")
-        cols, fs = _columns(x_or_result, fs, input, gaps)
+        cols, fs = _rate_columns(x_or_result, fs, input, gaps)
         axis = _one_axis(axis, len(cols))
         if not 0 <= axis < len(cols):
             raise ParameterError(f"axis = {axis} is outside 0..{len(cols) - 1}")
@@ -126,7 +125,7 @@ def inputs(x_or_result, fs, input, points, axis, channels, gaps="error"):
     return y, result, chans, filled
 
 
-def _columns(x, fs, input, gaps):
+def _rate_columns(x, fs, input, gaps):
     """The rate columns and fs; NaN an InputError naming gaps='skip', or with it kept as missing samples."""
     check_choice(gaps, "gaps", GAPS)
     arr = np.asarray(x)
