@@ -46,6 +46,19 @@ def test_gapped_fit_agrees_with_the_full_record_within_intervals(pair):
     assert "τ from" in gap.notes[0] and "left out (gaps='skip')" in gap.notes[0]
 
 
+def test_tau_with_too_few_terms_kept_are_left_out(pair):
+    from allanite.model._gapfit import MIN_SHARE
+
+    _y, z, _full, _gap = pair
+    r = allanite.avar(z, FS, gaps="skip")
+    share = r.n / gapless_terms("oavar", r.m, r.n_samples)
+    few = (r.n > 0) & (share < MIN_SHARE)
+    assert MIN_SHARE == 0.1 and few.any()  # this record has τ with a few runs of terms left
+    f = allanite.fit(r, terms=("N", "K"), gaps="skip", thin=False)
+    assert set(f.tau) == set(r.tau[share >= MIN_SHARE])
+    assert f"{int(few.sum())} τ from {r.tau[few][0]:g} s with under 10 % of the terms left out" in f.notes[0]
+
+
 def test_edf_is_the_full_records_times_the_share_of_terms_kept(pair):
     # one term: ν = 2·model²/var does not depend on its coefficient, so the ratio is the share exactly
     y, z, _full, _gap = pair

@@ -125,8 +125,9 @@ def fit(
         A static result of a record with NaN-marked gaps (``avar(..., gaps="skip")``, ``result.missing`` > 0)
         is fitted from the terms its curve kept: each τ's EDF (and its covariance across τ) is the gapless
         record's scaled by the share of terms kept at that τ, ``n / n_full`` — the variance of an average of
-        fewer terms, exact when the gaps are short against the stretches between them, somewhat optimistic when
-        they are closer than 2τ — and ``notes`` states how many samples were missing. A τ with no complete
+        fewer terms, exact when the gaps are short against the stretches between them, optimistic when they are
+        closer than 2τ, so τ that kept under 10 % of the terms are left out (``allanite.model._gapfit.MIN_SHARE``)
+        — and ``notes`` states how many samples were missing and which τ were left out. A τ with no complete
         term (n = 0) is an error by default (``"error"``); ``"skip"`` leaves such τ out (said in ``notes``).
 
     Notes
