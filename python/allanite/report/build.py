@@ -447,6 +447,34 @@ def _unit_notes(log) -> list:
     return []
 
 
+def _time_notes(log) -> list:
+    """The notes on the time column where the reader chose it or its unit: recognised by its name (no time column
+    named, no fs given — with the unit that was given, if one was), its unit from its name or from an epoch
+    magnitude. None where the time column and its unit were both given, or fs was (no time column read)."""
+    notes = []
+    if log.time_column_recognised:
+        given = (
+            f", read in {log.time_unit} as given (--time-unit / time_unit=)"
+            if log.time_unit_source == "time_unit="
+            else ""
+        )
+        notes.append(
+            f"No time column was named (--time-column / time_column=) nor fs given: column {log.time_column!r} was "
+            f"taken as the time column by its name{given}; fs = {log.fs:g} Hz from its steps."
+        )
+    if log.time_unit_from_name:
+        notes.append(
+            f"Time column {log.time_column!r} was read in {log.time_unit}, the unit its name gives (time_ns, "
+            "t [ms]; rostopic echo -p's %time: ns) (--time-unit / read_log(time_unit=…) overrides it)."
+        )
+    if log.time_unit_source == "epoch magnitude":
+        notes.append(
+            f"Time column {log.time_column!r} names no unit: read in {log.time_unit}, the unit in which its first "
+            "stamp is an epoch date (--time-unit / read_log(time_unit=…) overrides it)."
+        )
+    return notes
+
+
 def from_log(log, **kwargs) -> Report:
     """:func:`build_report` on a :class:`~allanite.Log` from :func:`allanite.read_log` (its unit — a gyro's, or
     the accelerometer's its columns' names all give, as ``Log.take`` keeps one of ``Log.groups`` —, its
@@ -454,17 +482,7 @@ def from_log(log, **kwargs) -> Report:
     those named in ``read_log(channels=[…])`` imply the refinement, as ``channels=`` does; those recognised as a
     temperature by their names are handed to the refinement only when ``refine=`` asks for one that tries the
     regression — a report without ``refine`` stays the same, and says in a note that the column is no axis."""
-    notes = list(kwargs.pop("notes", ()))
-    if log.time_column_recognised:
-        notes.append(
-            f"Neither fs nor a time column was given: column {log.time_column!r} was taken as the time "
-            f"column by its name; fs = {log.fs:g} Hz from its steps."
-        )
-    if log.time_unit_from_name:
-        notes.append(
-            f"Time column {log.time_column!r} was read in {log.time_unit}, the unit its name gives (time_ns, "
-            "t [ms]; rostopic echo -p's %time: ns) (--time-unit / read_log(time_unit=…) overrides it)."
-        )
+    notes = list(kwargs.pop("notes", ())) + _time_notes(log)
     if log.gaps:
         notes.append(
             f"The log has {len(log.gaps)} gap(s); only the longest gap-free stretch, samples "
@@ -474,11 +492,6 @@ def from_log(log, **kwargs) -> Report:
                 if log.segment_spans is not None
                 else "."
             )
-        )
-    if log.time_unit_source == "epoch magnitude":
-        notes.append(
-            f"Time column {log.time_column!r} names no unit: read in {log.time_unit}, the unit in which its first "
-            "stamp is an epoch date (--time-unit / read_log(time_unit=…) overrides it)."
         )
     notes += _unit_notes(log) if "unit" not in kwargs else []
     unit = kwargs.pop("unit", None) or (log.unit.name if log.unit is not None else log_accel_unit(log))

@@ -70,11 +70,7 @@ def _record(rec: dict) -> dict:
         if src.get(key) is not None:
             rows.append((label, src[key]))
     if src.get("time_column"):
-        how = (
-            " (recognised by its name: neither fs nor a time column was given)"
-            if src.get("time_column_recognised")
-            else ""
-        )
+        how = " (recognised by its name: none was named, nor fs given)" if src.get("time_column_recognised") else ""
         unit = f", in {src['time_unit']}" if src.get("time_unit") not in (None, "s") else ""
         rows.append(("time column", f"{src['time_column']}{unit}{how}"))
     if src.get("gaps"):
