@@ -53,3 +53,63 @@ def test_the_cli_report_says_how_time_was_read(tmp_path, samples, capsys):
     assert "Neither fs" not in printed and "read in ms as given (--time-unit" in printed
     page = (tmp_path / "o" / "report.html").read_text(encoding="utf-8")
     assert "t, in ms (recognised by its name: none was named, nor fs given)" in page
+
+
+# ------------------------------------------------------------------------------------------------
+# the report in a notebook: Report._repr_html_ (it showed as its repr)
+
+
+def _shown(rep) -> str:
+    from test_display import parse
+
+    p = parse(rep._repr_html_())  # the tags balance
+    return " ".join(" ".join(p.text).split())
+
+
+def test_a_report_shows_its_numbers_units_and_files_in_a_notebook(tmp_path):
+    from allanite.report import build_report
+
+    y = allanite.simulate(6000, 100.0, N=0.01, K=1e-3, seed=2)
+    rep = build_report(np.c_[y, 1.1 * y], 100.0, unit="deg/s", progress=False, axis_names=["gx", "gy"])
+    text = _shown(rep)
+    assert "6000 samples × 2 axes (gx, gy) at 100 Hz = 1 min" in text
+    assert "samples' unit deg/s, rate input" in text and "Allan deviation in °/s" in text
+    assert "noise model in IEEE-952 units" in text
+    n_gx, n_gy = (rep.summary()["fit"]["axes"][k]["coefficients"]["N"]["ieee"] for k in (0, 1))
+    assert f"N angle random walk °/√h {n_gx:.3g} [" in text and f" {n_gy:.3g} [" in text
+    assert "not written yet: rep.write(folder)" in text and "model refinement" not in text
+    assert "<svg" in rep._repr_html_()  # the inline figure
+    unfitted = build_report(y[:1500], 100.0, progress=False, fit=False)
+    text = _shown(unfitted)
+    assert "samples' unit unknown (not given)" in text and "The unit of the samples is unknown" in text
+    unfitted.write(tmp_path / "out", progress=False, dpi=30)
+    assert f"files {tmp_path / 'out' / 'report.html'}, summary.json and the figures beside it" in _shown(unfitted)
+
+
+def test_an_accelerometers_report_shows_its_units_in_a_notebook():
+    from allanite.report import build_report
+
+    y = allanite.simulate(6000, 100.0, N=0.002, K=1e-4, seed=2)
+    text = _shown(build_report(y, 100.0, unit="m/s^2", progress=False, fit=True))
+    assert "samples' unit m/s^2 (an accelerometer's), rate input" in text and "Allan deviation in m/s²" in text
+    assert "noise model in the accelerometer's units (m/s/√h, µg, m/s/h^1.5; samples in m/s^2)" in text
+    assert "N velocity random walk m/s/√h" in text and "B bias instability µg" in text and "°" not in text
+
+
+def test_a_refined_report_shows_the_effects_and_what_is_left_in_a_notebook():
+    # a line, outliers and a drift: refine adds steps of the periodic and outliers effects
+    from allanite.report import build_report
+
+    n, fs = 4000, 100.0
+    rng = np.random.default_rng(5)
+    t = np.arange(n) / fs
+    y = allanite.simulate(n, fs, N=0.01, seed=5) + 0.05 * np.sin(2 * np.pi * 7.3 * t)
+    y += 0.03 * np.sin(2 * np.pi * t / 30.0)
+    y[rng.choice(n, 8, replace=False)] += 1.5
+    rep = build_report(y, fs, unit="deg/s", refine=("periodic", "outliers"), progress=False)
+    (ax,) = rep.summary()["refinement"]["axes"]
+    assert {st["effect"] for st in ax["steps"]} == {"periodic", "outliers"}
+    text = _shown(rep)
+    a, b = ax["start"]["chi2_dof"], ax["final"]["chi2_dof"]
+    assert f"axis 0 {', '.join(st['effect'] for st in ax['steps'])} {a:.3g} → {b:.3g}" in text
+    assert f"axis 0: {' '.join(ax['still_missing'])}" in text
