@@ -113,3 +113,57 @@ def test_a_refined_report_shows_the_effects_and_what_is_left_in_a_notebook():
     a, b = ax["start"]["chi2_dof"], ax["final"]["chi2_dof"]
     assert f"axis 0 {', '.join(st['effect'] for st in ax['steps'])} {a:.3g} → {b:.3g}" in text
     assert f"axis 0: {' '.join(ax['still_missing'])}" in text
+
+
+# ------------------------------------------------------------------------------------------------
+# an accelerometer's coefficients over the windows: its units (they were in base form, m/s^1.5, …)
+
+
+def test_an_accelerometers_coefficients_over_time_are_in_its_units(tmp_path):
+    from matplotlib.figure import Figure
+
+    from allanite.report import build_report
+    from allanite.report.sidefiles import series_columns
+    from allanite.units import accel_report_unit
+
+    y = allanite.simulate(6000, 100.0, N=0.002, K=1e-4, seed=4)
+    rep = build_report(y, 100.0, unit="g", progress=False, window=1500, hop=500)
+    s = rep.summary()
+    (ax,) = s["fit"]["series"]["axes"]
+    n = ax["coefficients"]["N"]
+    assert (n["name"], n["unit"], n["ieee_unit"], n["stats"]["unit"]) == (
+        "velocity random walk",
+        "g·√s",
+        "m/s/√h",
+        "m/s/√h",
+    )
+    assert ax["coefficients"]["B"]["stats"]["unit"] == "µg" and ax["coefficients"]["K"]["ieee_unit"] == "m/s/h^1.5"
+    values = rep.series[0].values["N"]
+    assert n["ieee"] == pytest.approx(accel_report_unit("N", values, "g").value, rel=1e-12)
+    assert np.median(n["ieee"]) == pytest.approx(0.002 * 9.80665 * 60, rel=0.1)  # N's truth, m/s/√h
+    cols = series_columns(rep)
+    assert cols["axis0_N_ieee"] == pytest.approx(n["ieee"], rel=1e-12)
+    assert "noise coefficients in the accelerometer's units over the windows" in rep.text()
+    (spec,) = [sp for sp in rep.figure_specs() if sp[0] == "coefficients.png"]
+    fig = Figure(figsize=spec[3])
+    spec[4](fig)
+    labels = [a.get_ylabel() for a in fig.axes if a.get_ylabel()]
+    assert "N (m/s/√h)" in labels and all("°" not in lb and "g·" not in lb for lb in labels), labels
+
+
+def test_the_cli_takes_an_accelerometers_unit_for_an_accelerometers_log(tmp_path, capsys):
+    from allanite import cli
+
+    y = allanite.simulate(3000, 100.0, N=0.002, seed=6)
+    t = np.arange(y.size) / 100.0
+    log = _csv(tmp_path / "acc.csv", "time,ax,ay", t, np.c_[y, y[::-1]])
+    args = ["report", str(log), "--no-fit", "--out", str(tmp_path / "o")]
+    for given, unit in ((["--unit", "m/s^2"], "m/s^2"), (["--accel-unit", "g"], "g")):  # --unit was refused
+        assert cli.main([*args, *given]) == 0
+        printed = capsys.readouterr().out
+        assert f"unit {unit} (an accelerometer's), rate input" in printed
+    gyro = _csv(tmp_path / "gyro.csv", "time,gx [deg/s],gy [deg/s]", t, np.c_[y, y])
+    assert cli.main(["report", str(gyro), "--unit", "g", "--no-fit", "--out", str(tmp_path / "p")]) == 2
+    assert "--unit g is an accelerometer's, and the names of columns gx [deg/s], gy [deg/s] give a gyro's" in (
+        capsys.readouterr().err
+    )

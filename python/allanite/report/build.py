@@ -174,7 +174,7 @@ def build_report(
     fits = series = fit_error = series_error = None
     if fit:
         fits, series, fit_error, series_error = _fit_record_and_windows(
-            static, dynamic, unit_name, confidence, axis_names, notes, progress
+            static, dynamic, (unit_name, accel_unit), confidence, axis_names, notes, progress
         )
     else:
         progress.add(2)
@@ -329,9 +329,12 @@ def _analyse(x, fs, *, input, taus, estimator, window, hop, fit, confidence, max
     return static, dynamic, settings
 
 
-def _fit_record_and_windows(static, dynamic, unit_name, confidence, axis_names, notes, progress) -> tuple:
+def _fit_record_and_windows(static, dynamic, units, confidence, axis_names, notes, progress) -> tuple:
     """(whole-record fits, per-window series, their errors or None): the noise model of the whole record, then
-    of every window on the same τ range as its axis's whole-record fit; a failure becomes a note."""
+    of every window on the same τ range as its axis's whole-record fit; a failure becomes a note. ``units``: (the
+    gyro's unit or None, the accelerometer's or None) — the windows' coefficients carry either (an
+    accelerometer's: in its report units, as the whole record's table), the whole record's the gyro's alone."""
+    unit_name, window_unit = units[0], units[0] or units[1]
     fits = series = fit_error = series_error = None
     progress.step("noise-model fit")
     try:
@@ -351,13 +354,13 @@ def _fit_record_and_windows(static, dynamic, unit_name, confidence, axis_names, 
         if fits is not None:
             per_axis = [dynamic.avar] if dynamic.avar.ndim == 2 else list(dynamic.avar)
             series = [
-                _fit_windows(dataclasses.replace(dynamic, avar=row), unit_name, confidence, float(f.tau[0]))
+                _fit_windows(dataclasses.replace(dynamic, avar=row), window_unit, confidence, float(f.tau[0]))
                 for row, f in zip(per_axis, fits)
             ]
             if dynamic.avar.ndim == 2:
                 series = series[0]
         else:
-            series = fit_model(dynamic, unit=unit_name, confidence=confidence, tau_range="auto")
+            series = fit_model(dynamic, unit=window_unit, confidence=confidence, tau_range="auto")
     except AllaniteError as exc:
         series_error = str(exc)
         notes.append(

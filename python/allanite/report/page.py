@@ -244,7 +244,9 @@ def _series(fit: dict, rec: dict) -> dict:
     return {
         "status": "fitted",
         "confidence": f"{ser['confidence']:.1%}",
-        "units_note": ", in IEEE-952 units" if fit["unit"] else " (base form)",
+        "units_note": ", in the accelerometer's units"
+        if fit.get("sensor") == "accelerometer"
+        else (", in IEEE-952 units" if fit["unit"] else " (base form)"),
         "table": _table(["axis", "term", "unit", "median", "min", "max", "windows resolved (> 0)"], rows, left=3),
     }
 

@@ -478,7 +478,7 @@ def _dynamic_text(s: dict) -> list[str]:
     ser = fit.get("series")
     if ser and ser["axes"] is not None:
         lines.append(
-            f"  noise coefficients{' in IEEE-952 units' if fit['unit'] else ' (base form)'} over the windows "
+            f"  noise coefficients {_series_units(fit)} over the windows "
             "that resolve them (> 0): median [min, max] (windows resolving / all)"
         )
         for ax in ser["axes"]:
@@ -495,6 +495,13 @@ def _dynamic_text(s: dict) -> list[str]:
     elif ser and ser["error"]:
         lines.append(f"  noise coefficients over time: not fitted ({ser['error']})")
     return lines
+
+
+def _series_units(fit: dict) -> str:
+    """The units of the coefficients over the windows: IEEE-952's (a gyro's), an accelerometer's, or base form."""
+    if fit.get("sensor") == "accelerometer":
+        return "in the accelerometer's units"
+    return "in IEEE-952 units" if fit["unit"] else "(base form)"
 
 
 def _refinement_text(s: dict) -> list[str]:
