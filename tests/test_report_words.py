@@ -167,3 +167,26 @@ def test_the_cli_takes_an_accelerometers_unit_for_an_accelerometers_log(tmp_path
     assert "--unit g is an accelerometer's, and the names of columns gx [deg/s], gy [deg/s] give a gyro's" in (
         capsys.readouterr().err
     )
+
+
+# ------------------------------------------------------------------------------------------------
+# a slow sinusoid absorbed as R: "passes every calibrated check" beside a curve χ²/dof well above 1
+
+
+def test_passing_every_check_beside_a_large_misfit_says_both():
+    from allanite.model.refinement.words import MISFIT_CHI2_DOF
+
+    # 1.5 periods of a 133 s sinusoid in 200 s of an ADIS-like gyro: R takes it, every calibrated check passes
+    y = allanite.simulate(20_000, 100.0, Q=3.5e-4, N=2e-3, B=1e-3, K=6e-5, sinusoid=[(2e-2, 3 / 400.0, 0.7)], seed=3)
+    r = allanite.refine(y, 100.0, unit="deg/s", progress=False)
+    assert r.unexplained == [] and r.steps == []
+    chi2 = r.final_errors["chi2_dof"]
+    assert chi2 == pytest.approx(2.24, abs=0.01) and chi2 >= MISFIT_CHI2_DOF
+    passes, misfit, where, stand_in = r.missing_sentences()
+    assert passes.startswith("The final model passes every calibrated check")
+    assert misfit.startswith(f"Yet its curve χ²/dof is {chi2:.3g} (p = {r.final_errors['p_value']:.2g} under χ²(dof)")
+    assert "not for the size of the whole misfit" in misfit
+    assert max(abs(r.fit.z)) < 2 and where.startswith(f"No single τ is far off (|z| ≤ {max(abs(r.fit.z)):.2g}")
+    c = r.fit.coefficients["R"]
+    assert c.ci[0] > 0 and stand_in.startswith(f"R (rate ramp, {c.ieee:.3g} °/h²) is resolved")
+    assert "(22 s of a 200 s record): it may stand in for a slow periodic or a drift" in stand_in
