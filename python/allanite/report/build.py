@@ -158,6 +158,7 @@ def build_report(
     channels = check_channels(channels, candidates, np.shape(x)[0])
     if channels and candidates is None:  # channels imply refine=True: the regression is their only use
         candidates = refine_candidates(True)
+        notes.append("No refinement was asked for: the channels imply it (its regression is their only use).")
     channels = rate_aligned(channels, input)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
     accel_unit = accelerometer_unit(unit, input, notes)
