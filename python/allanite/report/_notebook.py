@@ -122,10 +122,15 @@ def _refinement_table(ref: dict) -> Table:
 
 
 def _missing_notes(ref: dict | None) -> list:
-    """What the refined model still misses, per axis (the console's and the page's sentences)."""
+    """What the refined model still misses and the channels it tried and did not keep, per axis (the console's and
+    the page's sentences)."""
     if ref is None:
         return []
-    return [f"{ax['name']}: {' '.join(ax['still_missing'])}" for ax in ref["axes"] if ax.get("still_missing")]
+    said = [
+        (ax["name"], ax.get("still_missing", []) + [d["text"] for d in ax.get("channels_not_kept", [])])
+        for ax in ref["axes"]
+    ]
+    return [f"{name}: {' '.join(words)}" for name, words in said if words]
 
 
 def _draw(rep, ax) -> None:
