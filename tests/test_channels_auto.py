@@ -188,9 +188,20 @@ def test_default_report_refines_on_the_recognised_temperature(coupled, tmp_path,
     assert (src["channels"], src["channels_recognised"], src["channels_used"]) == (["T [degC]"], True, ["T [degC]"])
     (note,) = [n for n in s["notes"] if "recognised as a temperature" in n]
     assert "Column 'T [degC]' was recognised as a temperature by its name: not analysed as an axis" in note
-    assert "--channels none" in note and "regresses on it" in note
+    assert (
+        "--channels none" in note
+        and "tries a regression on it (kept where its test and the held-out error ask for it)" in note
+    )
     assert note in printed and "°/s per unit of T [degC]" in printed
-    assert note.replace("'", "&#39;") in (tmp_path / "o" / "report.html").read_text()
+    page = (tmp_path / "o" / "report.html").read_text()
+    assert note.replace("'", "&#39;") in page
+    # g_y: the regression tried and not kept is said (the reader had only "nothing added" beside the note)
+    assert gx["channels_not_kept"] == []
+    (left,) = gy["channels_not_kept"]
+    assert left["channel"] == "T [degC]" and (left["why"] is not None or left["statistic"] < left["threshold"])
+    assert left["text"].startswith("A regression on T [degC] was tried and not kept: ") and left["text"] in printed
+    assert "T [degC] (the refinement tried a regression on it), recognised by name" in page
+    assert f"{gy['tau_from_s']:.4g}–{gy['tau_to_s']:.4g} s" in page  # the τ the refinement fitted and checked
 
 
 def test_default_report_without_refine_leaves_the_temperature_out(coupled, tmp_path):

@@ -89,6 +89,10 @@ def test_build_report_channels_imply_refine_and_match_the_cli(coupled_log):
     (r,) = rep.refinements
     (st,) = [st for st in r.steps if st.effect == "regression"]
     assert st.params["coefficient"] == pytest.approx(COEF, rel=0.2)
+    from test_report_words import _shown  # its notebook display names the regression step
+
+    assert f"g_x {', '.join(s.effect for s in r.steps)} " in _shown(rep)
+    assert "No refinement was asked for: the channels imply it (its regression is their only use)." in rep.notes
 
 
 def test_build_report_channel_errors_name_the_channel():

@@ -81,9 +81,9 @@ def test_the_channel_note_says_the_coefficient_is_per_the_channels_unit(monkeypa
     out = _sections.refinement_section(None, 10.0, "rate", "deg/s", None, ["gx"], asked, notes, settings, Progress())
     assert out == [None] and settings["channels"] == ["temp [degC]"]
     assert notes == [
-        "Channel temp [degC] passed to every axis's model refinement, for its regression on them (channels imply "
-        "refine); a coefficient is per unit of the channel's samples, as logged (its name's unit, where it gives "
-        "one, e.g. [degC]): allanite converts no channel's unit."
+        "Channel temp [degC] passed to every axis's model refinement, for its regression on it; a coefficient is "
+        "per unit of the channel's samples, as logged (its name's unit, where it gives one, e.g. [degC]): allanite "
+        "converts no channel's unit."
     ]
 
 

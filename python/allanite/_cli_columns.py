@@ -15,6 +15,11 @@ _GYRO_NAME = re.compile(r"gyr|omega|angular|ang_?vel|^[wg]_?[xyz]$", re.IGNORECA
 _ACCEL_NAME = re.compile(r"acc|specific_?force|^a_?[xyz]$", re.IGNORECASE)
 
 
+def is_accel_name(name: str) -> bool:
+    """Whether a column's name says it is an accelerometer's (``acc_x``, ``accel_y``, ``ax``, ``specific_force_z``)."""
+    return bool(_ACCEL_NAME.search(name))
+
+
 def gyro_columns(log):
     """Without --columns: a log with accelerometer columns beside others is analysed on the columns its
     header names as gyro ones (with a note); when it names none, the user is asked (a usage error that

@@ -121,8 +121,9 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
         "--unit",
         metavar="U",
         help="unit of the samples: deg/s, rad/s, deg/h, mrad/s, urad/s, ... (rate input) or deg, rad, "
-        "arcsec, ... (increment/angle input); without it the report says the unit is unknown "
-        "and gives the noise coefficients in base form",
+        "arcsec, ... (increment/angle input), or an accelerometer's m/s^2, g, mg, ... (rate input: the report is "
+        "an accelerometer's, its coefficients in m/s/√h, µg, m/s/h^1.5); without it the report says the unit is "
+        "unknown and gives the noise coefficients in base form",
     )
     inp.add_argument(
         "--input",
@@ -161,7 +162,8 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
         choices=ACCEL_UNITS,
         help="unit of the accelerometer columns (default: the one their names give, [g] or [m s^-2], else m/s^2; "
         "g = 9.80665 m/s^2); with --unit and without --columns, the columns named as an accelerometer's (acc_x, "
-        "...) are also reported in it, in DIR/accelerometer/",
+        "...) are also reported in it, in DIR/accelerometer/; without --unit, a log whose analysed columns are all "
+        "named as an accelerometer's (ax, acc_x, ...) is reported in it",
     )
 
 

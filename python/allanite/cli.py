@@ -18,7 +18,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-from ._cli_columns import ACCEL_FOLDER, sensor_columns
+from ._cli_columns import ACCEL_FOLDER, is_accel_name, sensor_columns
 from ._cli_columns import gyro_columns as gyro_columns  # allanite.cli.gyro_columns, as before the move
 from ._cli_options import (
     DESCRIPTION,
@@ -43,6 +43,7 @@ from .model import fit as fit_model
 from .report import build_report, from_log
 from .report._worker import close as close_figure_worker
 from .report._worker import start as start_figure_worker
+from .units import accel_unit_name
 
 EXIT_OK, EXIT_INTERNAL, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 
@@ -254,7 +255,7 @@ def _read_sensors(args, progress):
             fs=args.fs,
             columns=columns,
             time_column=_time_column(args),
-            unit=args.unit,
+            unit=None if accel_unit_name(args.unit) else args.unit,  # an accelerometer's: from_log's (below)
             input=args.input or "rate",
             gaps=args.gaps or "error",
             channels=_channel_specs(args, columns),
@@ -266,6 +267,24 @@ def _read_sensors(args, progress):
         log, accel, note = sensor_columns(log, args.accel_unit)
         notes += [note] if note else []
     return log, notes, log.channels or None, accel
+
+
+def _accelerometers_unit(args, log, accel) -> str | None:
+    """The accelerometer's unit the analysed columns are in where the log is an accelerometer's: --unit naming one
+    (``m/s^2``, ``g``), or --accel-unit without a gyro's unit (given or from the names) where no accelerometer
+    report of its own is split off and every analysed column is named as an accelerometer's (``ax``, ``acc_x``);
+    else None (a gyro's, or an unknown unit)."""
+    if accel_unit_name(args.unit) is not None:
+        if log.unit is not None:
+            raise UsageError(
+                f"--unit {args.unit} is an accelerometer's, and the names of columns "
+                f"{', '.join(map(str, log.columns))} give a gyro's ({log.unit.name}): give the accelerometer's "
+                "columns with --columns (or --accel-unit for the columns named as an accelerometer's beside the gyro's)"
+            )
+        return accel_unit_name(args.unit)
+    if args.accel_unit is None or args.unit is not None or log.unit is not None or accel is not None:
+        return None
+    return args.accel_unit if all(is_accel_name(str(c)) for c in log.columns) else None
 
 
 def _channel_specs(args, columns):
@@ -453,6 +472,9 @@ def _analysed_report(args, progress, common: dict):
     log, notes, _, accel = _read_sensors(args, progress)
     if args.kalibr and log.unit is None:
         raise UsageError(_KALIBR_NEEDS_UNIT)
+    own = _accelerometers_unit(args, log, accel)
+    if own is not None:  # the log is an accelerometer's: its report in that unit (build_report's accel_unit)
+        common = dict(common, unit=own)
     # an IMU log's two reports, every column taken (EuRoC), are what was asked: said in the report's notes alone
     both = accel is not None and "left out:" not in notes[-1]
     if not args.quiet:

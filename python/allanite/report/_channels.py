@@ -75,5 +75,8 @@ def log_channels(log, refine, notes: list) -> dict | None:
         if k not in used:
             notes.append(f"{kind} {k!r} (recognised as a temperature) is constant: not used as a channel.")
     if used:
-        notes.append(f"{found}; every axis's model refinement regresses on {'it' if one else 'them'}. {how}")
+        notes.append(
+            f"{found}; every axis's model refinement tries a regression on {'it' if one else 'them'} (kept where its "
+            f"test and the held-out error ask for it). {how}"
+        )
     return used or None

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.terms import TERM_NAMES
-from ..units import ACCEL_TERMS, accel_report_unit, coefficient_unit, ieee952
+from ..units import ACCEL_TERMS, accel_report_unit, accel_unit_name, coefficient_unit, ieee952, report_unit
 from .fmt import json_list, json_number
 from .settings import FIT_MODEL
 
@@ -42,7 +42,7 @@ def fit_dict(rep, inline: bool) -> dict:
             ser["window_samples"] = int(dy.window)
             ser["hop_samples"] = int(dy.hop)
             ser["axes"] = [
-                dict(axis=k, name=rep.axis_names[k], **_series_dict(s, rep.unit, inline))
+                dict(axis=k, name=rep.axis_names[k], **_series_dict(s, rep.unit or rep.accel_unit, inline))
                 for k, s in enumerate(rep.series)
             ]
         fit["series"] = ser
@@ -141,13 +141,15 @@ def _readoffs(f, unit, adev_unit, accel_unit=None) -> dict:
 
 
 def _series_dict(s, unit, inline: bool = True) -> dict:
-    """One axis's coefficient series; ``inline`` False: statistics only (the per-window lists are in the
-    side files, :mod:`allanite.report.sidefiles`)."""
+    """One axis's coefficient series (``unit``: a gyro's, an accelerometer's — its coefficients then in the
+    accelerometer's report units and names — or None); ``inline`` False: statistics only (the per-window lists are
+    in the side files, :mod:`allanite.report.sidefiles`)."""
     coeffs = {}
+    accel = accel_unit_name(unit) is not None
     for t in s.terms:
         v, lo, hi = s.values[t], s.ci_low[t], s.ci_high[t]
         d = {
-            "name": TERM_NAMES[t],
+            "name": ACCEL_TERMS[t][0] if accel else TERM_NAMES[t],
             "unit": coefficient_unit(t, unit) if unit is not None else None,
             "value": json_list(v) if inline else None,
             "ci_low": json_list(lo) if inline else None,
@@ -155,13 +157,13 @@ def _series_dict(s, unit, inline: bool = True) -> dict:
         }
         show, show_unit = v, d["unit"]
         if unit is not None:
-            ie = ieee952(t, v, unit)
+            ie = report_unit(t, v, unit)
             show, show_unit = np.asarray(ie.value), ie.unit
             d.update(
                 ieee_unit=ie.unit,
                 ieee=json_list(show) if inline else None,
-                ieee_ci_low=json_list(ieee952(t, lo, unit).value) if inline else None,
-                ieee_ci_high=json_list(ieee952(t, hi, unit).value) if inline else None,
+                ieee_ci_low=json_list(report_unit(t, lo, unit).value) if inline else None,
+                ieee_ci_high=json_list(report_unit(t, hi, unit).value) if inline else None,
             )
         d["stats"] = _resolved_stats(np.asarray(show, dtype=np.float64), v, s.t, show_unit)
         coeffs[t] = d

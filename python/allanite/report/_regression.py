@@ -143,3 +143,28 @@ def regression_row(axis: str, st: dict) -> list | None:
         _moves_words(tba) if tba else "—",
         "; ".join(notes) or "—",
     ]
+
+
+def channels_not_kept(r) -> list[dict]:
+    """The channels a refinement tried a regression on and kept none of (``Refinement.considered``), each the
+    proposal nearest its threshold: ``channel``, ``statistic`` (the likelihood ratio), ``threshold``, ``why`` (a
+    test passed but the proposal was refused: the held-out error, another effect taken …; else None) and ``text``
+    — a temperature the report handed on and no step used is said, not left to the reader to infer."""
+    kept = {st.params.get("channel") for st in r.steps if st.effect == "regression"}
+    best: dict = {}
+    for rec in r.considered.get("regression", ()):
+        ch = rec.get("channel")
+        lr, thr = rec.get("likelihood_ratio"), rec.get("threshold")
+        if ch is None or ch in kept or lr is None or not thr:
+            continue
+        if ch not in best or lr / thr > best[ch]["statistic"] / best[ch]["threshold"]:
+            best[ch] = {"channel": str(ch), "statistic": float(lr), "threshold": float(thr), "why": rec.get("rejected")}
+    out = []
+    for d in best.values():
+        because = (
+            f"its test passed ({g(d['statistic'], 3)} > {g(d['threshold'], 3)}) but {d['why']}"
+            if d["why"]
+            else f"likelihood ratio {g(d['statistic'], 3)} under its threshold {g(d['threshold'], 3)}"
+        )
+        out.append(dict(d, text=f"A regression on {d['channel']} was tried and not kept: {because}."))
+    return out

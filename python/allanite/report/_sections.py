@@ -35,9 +35,9 @@ def refinement_section(x, fs, input, unit_name, static, axis_names, asked, notes
             settings["channels"] = list(channels)
             notes.append(
                 f"Channel{'s' if len(channels) > 1 else ''} {', '.join(channels)} passed to every axis's model "
-                "refinement, for its regression on them (channels imply refine); a coefficient is per unit of the "
-                "channel's samples, as logged (its name's unit, where it gives one, e.g. [degC]): allanite converts "
-                "no channel's unit."
+                f"refinement, for its regression on {'them' if len(channels) > 1 else 'it'}; a coefficient is per "
+                "unit of the channel's samples, as logged (its name's unit, where it gives one, e.g. [degC]): "
+                "allanite converts no channel's unit."
             )
     return refinements
 

@@ -165,6 +165,7 @@ def build_report(
     channels = check_channels(channels, candidates, np.shape(x)[0])
     if channels and candidates is None:  # channels imply refine=True: the regression is their only use
         candidates = refine_candidates(True)
+        notes.append("No refinement was asked for: the channels imply it (its regression is their only use).")
     channels = rate_aligned(channels, input)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
     accel_unit = accelerometer_unit(unit, input, notes)
@@ -181,7 +182,7 @@ def build_report(
     fits = series = fit_error = series_error = None
     if fit:
         fits, series, fit_error, series_error = _fit_record_and_windows(
-            static, dynamic, unit_name, confidence, axis_names, notes, progress
+            static, dynamic, (unit_name, accel_unit), confidence, axis_names, notes, progress
         )
     else:
         progress.add(2)
@@ -354,9 +355,12 @@ def _bridged(x) -> np.ndarray:
     return out
 
 
-def _fit_record_and_windows(static, dynamic, unit_name, confidence, axis_names, notes, progress) -> tuple:
+def _fit_record_and_windows(static, dynamic, units, confidence, axis_names, notes, progress) -> tuple:
     """(whole-record fits, per-window series, their errors or None): the noise model of the whole record, then
-    of every window on the same τ range as its axis's whole-record fit; a failure becomes a note."""
+    of every window on the same τ range as its axis's whole-record fit; a failure becomes a note. ``units``: (the
+    gyro's unit or None, the accelerometer's or None) — the windows' coefficients carry either (an
+    accelerometer's: in its report units, as the whole record's table), the whole record's the gyro's alone."""
+    unit_name, window_unit = units[0], units[0] or units[1]
     fits = series = fit_error = series_error = None
     progress.step("noise-model fit")
     try:
@@ -376,13 +380,13 @@ def _fit_record_and_windows(static, dynamic, unit_name, confidence, axis_names, 
         if fits is not None:
             per_axis = [dynamic.avar] if dynamic.avar.ndim == 2 else list(dynamic.avar)
             series = [
-                _fit_windows(dataclasses.replace(dynamic, avar=row), unit_name, confidence, float(f.tau[0]))
+                _fit_windows(dataclasses.replace(dynamic, avar=row), window_unit, confidence, float(f.tau[0]))
                 for row, f in zip(per_axis, fits)
             ]
             if dynamic.avar.ndim == 2:
                 series = series[0]
         else:
-            series = fit_model(dynamic, unit=unit_name, confidence=confidence, tau_range="auto")
+            series = fit_model(dynamic, unit=window_unit, confidence=confidence, tau_range="auto")
     except AllaniteError as exc:
         series_error = str(exc)
         notes.append(
@@ -478,6 +482,34 @@ def log_has_nan(log) -> bool:
     return data.dtype.kind == "f" and bool(np.isnan(data).any())
 
 
+def _time_notes(log) -> list:
+    """The notes on the time column where the reader chose it or its unit: recognised by its name (no time column
+    named, no fs given — with the unit that was given, if one was), its unit from its name or from an epoch
+    magnitude. None where the time column and its unit were both given, or fs was (no time column read)."""
+    notes = []
+    if log.time_column_recognised:
+        given = (
+            f", read in {log.time_unit} as given (--time-unit / time_unit=)"
+            if log.time_unit_source == "time_unit="
+            else ""
+        )
+        notes.append(
+            f"No time column was named (--time-column / time_column=) nor fs given: column {log.time_column!r} was "
+            f"taken as the time column by its name{given}; fs = {log.fs:g} Hz from its steps."
+        )
+    if log.time_unit_from_name:
+        notes.append(
+            f"Time column {log.time_column!r} was read in {log.time_unit}, the unit its name gives (time_ns, "
+            "t [ms]; rostopic echo -p's %time: ns) (--time-unit / read_log(time_unit=…) overrides it)."
+        )
+    if log.time_unit_source == "epoch magnitude":
+        notes.append(
+            f"Time column {log.time_column!r} names no unit: read in {log.time_unit}, the unit in which its first "
+            "stamp is an epoch date (--time-unit / read_log(time_unit=…) overrides it)."
+        )
+    return notes
+
+
 def from_log(log, **kwargs) -> Report:
     """:func:`build_report` on a :class:`~allanite.Log` from :func:`allanite.read_log` (its unit — a gyro's, or
     the accelerometer's its columns' names all give, as ``Log.take`` keeps one of ``Log.groups`` —, its
@@ -485,17 +517,7 @@ def from_log(log, **kwargs) -> Report:
     those named in ``read_log(channels=[…])`` imply the refinement, as ``channels=`` does; those recognised as a
     temperature by their names are handed to the refinement only when ``refine=`` asks for one that tries the
     regression — a report without ``refine`` stays the same, and says in a note that the column is no axis."""
-    notes = list(kwargs.pop("notes", ()))
-    if log.time_column_recognised:
-        notes.append(
-            f"Neither fs nor a time column was given: column {log.time_column!r} was taken as the time "
-            f"column by its name; fs = {log.fs:g} Hz from its steps."
-        )
-    if log.time_unit_from_name:
-        notes.append(
-            f"Time column {log.time_column!r} was read in {log.time_unit}, the unit its name gives (time_ns, "
-            "t [ms]; rostopic echo -p's %time: ns) (--time-unit / read_log(time_unit=…) overrides it)."
-        )
+    notes = list(kwargs.pop("notes", ())) + _time_notes(log)
     if log.gaps and log_has_nan(log):
         lost = int(np.isnan(np.asarray(log.data)).reshape(len(log.data), -1).any(axis=1).sum())
         notes.append(
@@ -513,11 +535,6 @@ def from_log(log, **kwargs) -> Report:
                 if log.segment_spans is not None
                 else "."
             )
-        )
-    if log.time_unit_source == "epoch magnitude":
-        notes.append(
-            f"Time column {log.time_column!r} names no unit: read in {log.time_unit}, the unit in which its first "
-            "stamp is an epoch date (--time-unit / read_log(time_unit=…) overrides it)."
         )
     notes += _unit_notes(log) if "unit" not in kwargs else []
     unit = kwargs.pop("unit", None) or (log.unit.name if log.unit is not None else log_accel_unit(log))

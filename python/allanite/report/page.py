@@ -70,13 +70,22 @@ def _record(rec: dict) -> dict:
         if src.get(key) is not None:
             rows.append((label, src[key]))
     if src.get("time_column"):
-        how = (
-            " (recognised by its name: neither fs nor a time column was given)"
-            if src.get("time_column_recognised")
-            else ""
-        )
+        how = " (recognised by its name: none was named, nor fs given)" if src.get("time_column_recognised") else ""
         unit = f", in {src['time_unit']}" if src.get("time_unit") not in (None, "s") else ""
         rows.append(("time column", f"{src['time_column']}{unit}{how}"))
+    if src.get("channels"):  # the log's other channels (a temperature): none is an axis
+        used = set(src.get("channels_used") or ())
+        how = " by name" if src.get("channels_recognised") else ""
+        rows.append(
+            (
+                "channels (not axes)",
+                "; ".join(
+                    f"{c} ({'the refinement tried a regression on it' if c in used else 'not used'})"
+                    for c in src["channels"]
+                )
+                + (f", recognised{how}" if how else ""),
+            )
+        )
     if src.get("gaps"):
         shown = "; ".join(f"{gap['duration_s']:.6g} s after sample {gap['after_sample']}" for gap in src["gaps"][:10])
         rows.append(("gaps", shown + (" …" if len(src["gaps"]) > 10 else "")))
@@ -248,7 +257,9 @@ def _series(fit: dict, rec: dict) -> dict:
     return {
         "status": "fitted",
         "confidence": f"{ser['confidence']:.1%}",
-        "units_note": ", in IEEE-952 units" if fit["unit"] else " (base form)",
+        "units_note": ", in the accelerometer's units"
+        if fit.get("sensor") == "accelerometer"
+        else (", in IEEE-952 units" if fit["unit"] else " (base form)"),
         "table": _table(["axis", "term", "unit", "median", "min", "max", "windows resolved (> 0)"], rows, left=3),
     }
 
@@ -261,14 +272,22 @@ def _heldout(st: dict) -> str:
 
 
 def _axis_summary(ax: dict) -> list:
-    """The summary row of one refined axis: effects added, χ²/dof and RMS error start → final, τ fitted from."""
+    """The summary row of one refined axis: effects added, χ²/dof and RMS error start → final, the τ fitted."""
     return [
         ax["name"],
         ", ".join(st["effect"] for st in ax["steps"]) or NOTHING_ADDED,
         f"{g(ax['start']['chi2_dof'], 3)} → {g(ax['final']['chi2_dof'], 3)}",
         f"{g(ax['start']['rms_adev_pct'], 3)} → {g(ax['final']['rms_adev_pct'], 3)} %",
-        f"{g(ax['tau_from_s'])} s" if ax["tau_from_s"] is not None else "—",
+        _tau_fitted(ax),
     ]
+
+
+def _tau_fitted(ax: dict) -> str:
+    """The τ the refinement fitted and checked the curve on: a misfit beyond its end is not what it judged."""
+    lo, hi = ax["tau_from_s"], ax.get("tau_to_s")
+    if lo is None:
+        return "—"
+    return f"{g(lo)}–{g(hi)} s" if hi is not None else f"{g(lo)} s on"
 
 
 def _step_rows(name: str, st: dict, fs: float, duration_s: float) -> tuple[list, list | None]:
@@ -301,7 +320,8 @@ def _refinement_rows(axes: list, fs: float, duration_s: float) -> dict[str, list
         if ax.get("error"):
             rows["summary"].append([ax["name"], "failed (see the notes)", "—", "—", "—"])
             continue
-        rows["missing"].append({"name": ax["name"], "sentences": ax["still_missing"], "found": bool(ax["unexplained"])})
+        said = ax["still_missing"] + [d["text"] for d in ax.get("channels_not_kept", [])]
+        rows["missing"].append({"name": ax["name"], "sentences": said, "found": bool(ax["unexplained"])})
         rows["summary"].append(_axis_summary(ax))
         rows["move"] += [[ax["name"], m["text"]] for m in ax.get("term_moves", [])]
         for st in ax["steps"]:
@@ -319,7 +339,7 @@ def _refinement_tables(rows: dict[str, list]) -> list[dict[str, Any]]:
     """The refinement's tables for the template: the summary always, the others where they have rows."""
     tables = [
         _table(
-            ["axis", "effects added", "curve χ²/dof start → final", "RMS ADEV error start → final", "fitted from τ"],
+            ["axis", "effects added", "curve χ²/dof start → final", "RMS ADEV error start → final", "τ fitted"],
             rows["summary"],
             left=2,
         )

@@ -8,10 +8,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from .._display import render
 from .._progress import StepBar
 from ..results import AllanResult, DynamicAllanResult
 from ..units import ACCEL_LABELS, adev_unit_label
 from . import _worker
+from ._notebook import report_summary
 from .figures import figure_specs
 from .fmt import count
 from .page import html_page, page_context
@@ -35,7 +37,9 @@ def steps(progress, total: int, desc: str):
 
 @dataclass
 class Report:
-    """Everything the report shows. Build it with :func:`build_report` or :func:`from_log`.
+    """Everything the report shows. Build it with :func:`build_report` or :func:`from_log`. In a notebook it
+    shows as its main numbers, the units they are in, what the refinement left unexplained and where
+    :meth:`write` put the files (``_repr_html_``).
 
     Attributes
     ----------
@@ -57,6 +61,8 @@ class Report:
         Where the record came from (JSON-able): path, format, columns, gaps, …
     notes : list of str
         Things the reader must know (unit unknown, gaps, warnings while reading).
+    written_to : Path or None
+        The folder the last :meth:`write` wrote into (None before).
     """
 
     static: AllanResult
@@ -85,6 +91,7 @@ class Report:
     #: the paper-002 sections (``taper=`` / ``split=``; :mod:`allanite.report.paper002`), else None
     paper002: dict | None = None
     accel_unit: str | None = None
+    written_to: Path | None = field(default=None, init=False)
     _summary: dict | None = field(default=None, repr=False)
 
     # ---------------------------------------------------------------------------- properties
@@ -116,6 +123,10 @@ class Report:
         if self._summary is None:
             self._summary = summarize(self)
         return self._summary
+
+    def _repr_html_(self) -> str:
+        """The notebook display (:mod:`allanite.report._notebook`, in :mod:`allanite._display`'s template)."""
+        return render(report_summary(self))
 
     def text(self) -> str:
         """The terminal summary: ADEV table with intervals, fitted coefficients, DAVAR summary."""
@@ -178,6 +189,7 @@ class Report:
         written = write_side_files(self, out) if side else []
         (out / "summary.json").write_text(text, encoding="utf-8")
         (out / "report.html").write_text(html_page(self, images, page), encoding="utf-8")
+        self.written_to = out
         if own:
             progress.close()
         return [out / "report.html", out / "summary.json"] + pngs + written

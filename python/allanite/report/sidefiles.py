@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..units import ieee952
+from ..units import report_unit
 from .budget import SIDE_FILE_WINDOWS
 
 __all__ = ["NPZ", "PARQUET", "uses_side_files", "side_files_entry", "series_columns", "write_side_files"]
@@ -45,9 +45,9 @@ def series_columns(rep) -> dict:
         for t in s.terms:
             v, lo, hi = (np.asarray(a, dtype=np.float64) for a in (s.values[t], s.ci_low[t], s.ci_high[t]))
             cols.update({f"axis{k}_{t}_value": v, f"axis{k}_{t}_ci_low": lo, f"axis{k}_{t}_ci_high": hi})
-            if rep.unit is not None:
+            if s.unit is not None:  # a gyro's IEEE-952 units, or an accelerometer's report units
                 for name, a in (("ieee", v), ("ieee_ci_low", lo), ("ieee_ci_high", hi)):
-                    cols[f"axis{k}_{t}_{name}"] = np.asarray(ieee952(t, a, rep.unit).value, dtype=np.float64)
+                    cols[f"axis{k}_{t}_{name}"] = np.asarray(report_unit(t, a, s.unit).value, dtype=np.float64)
     return cols
 
 
@@ -64,7 +64,8 @@ def side_files_entry(rep) -> dict:
             "axes": {f"axis{k}": name for k, name in enumerate(rep.axis_names)},
             "terms": None if s0 is None else list(s0.terms),
             "units": "t_s in s; value/ci_* in the base form of each coefficient's unit (fit.series.axes[k]"
-            ".coefficients[term].unit), ieee* in IEEE-952 units (….ieee_unit); ci_high may be inf (no upper bound)",
+            ".coefficients[term].unit), ieee* in IEEE-952 units or an accelerometer's (….ieee_unit); ci_high may "
+            "be inf (no upper bound)",
         }
     }
 

@@ -13,7 +13,7 @@ from ..model.fitting import row_medians
 from ..model.refinement.result import term_move_text
 from ..model.refinement.words import describe_region
 from ._fitsummary import fit_dict
-from ._regression import regression_dict, regression_lines
+from ._regression import channels_not_kept, regression_dict, regression_lines
 from .fmt import CLOCK_TERMS, count, duration, g, json_list, json_number, json_value, pct, step_params
 from .forecasting import forecast_dict, forecast_text
 from .paper002 import text_lines as paper002_text
@@ -99,6 +99,7 @@ def _axis_dict(k: int, r, rep, rate: str) -> dict:
         "name": rep.axis_names[k],
         "terms": list(r.terms),
         "tau_from_s": json_number(r.start.tau[0]),
+        "tau_to_s": json_number(r.start.tau[-1]),
         "start": _fit_errors(r.start, r),
         "start_heldout_rms_adev_pct": json_number(r.start_heldout_rms_adev_pct),
         "heldout_note": r.heldout_note,
@@ -109,6 +110,7 @@ def _axis_dict(k: int, r, rep, rate: str) -> dict:
         "level": json_number(r.level),
         "unexplained": [_region_dict(reg) for reg in r.unexplained],
         "still_missing": r.missing_sentences(),
+        "channels_not_kept": [{k: json_value(v) for k, v in d.items()} for d in channels_not_kept(r)],
     }
 
 
@@ -478,7 +480,7 @@ def _dynamic_text(s: dict) -> list[str]:
     ser = fit.get("series")
     if ser and ser["axes"] is not None:
         lines.append(
-            f"  noise coefficients{' in IEEE-952 units' if fit['unit'] else ' (base form)'} over the windows "
+            f"  noise coefficients {_series_units(fit)} over the windows "
             "that resolve them (> 0): median [min, max] (windows resolving / all)"
         )
         for ax in ser["axes"]:
@@ -495,6 +497,13 @@ def _dynamic_text(s: dict) -> list[str]:
     elif ser and ser["error"]:
         lines.append(f"  noise coefficients over time: not fitted ({ser['error']})")
     return lines
+
+
+def _series_units(fit: dict) -> str:
+    """The units of the coefficients over the windows: IEEE-952's (a gyro's), an accelerometer's, or base form."""
+    if fit.get("sensor") == "accelerometer":
+        return "in the accelerometer's units"
+    return "in IEEE-952 units" if fit["unit"] else "(base form)"
 
 
 def _refinement_text(s: dict) -> list[str]:
@@ -526,6 +535,7 @@ def _refinement_text(s: dict) -> list[str]:
             lines += [f"      {t}" for t in regression_lines(st.get("regression"))]
         lines += [f"    {m['text']}" for m in ax.get("term_moves", [])]
         lines += [f"    {t}" for t in ax.get("still_missing", [])]
+        lines += [f"    {d['text']}" for d in ax.get("channels_not_kept", [])]
     return lines
 
 

@@ -18,7 +18,7 @@ from ..terms import TERM_NAMES
 from ._family_fold import folded
 from ._gapfill import filled_words
 from .levels import LEVEL
-from .words import missing_sentences
+from .words import MISFIT_CHI2_DOF, misfit_sentences, missing_sentences
 
 __all__ = ["Step", "Refinement", "term_moves", "term_move_text"]
 
@@ -279,7 +279,40 @@ class Refinement(RichDisplay):
         """What the final model still misses, one sentence per entry of ``unexplained`` — or the one sentence
         saying that it passes every calibrated check, at the level they spent (the same words as the report
         page and the console: :mod:`allanite.model.refinement.words`)."""
-        return missing_sentences(self.unexplained, self.level)
+        out = missing_sentences(self.unexplained, self.level)
+        return out if self.unexplained else out + self._misfit_sentences()
+
+    def _misfit_sentences(self) -> list[str]:
+        """Beside "passes every calibrated check", where the final curve χ²/dof is ``MISFIT_CHI2_DOF`` or more:
+        that number, what the checks test, where the largest residuals are, and a resolved K or R that sets the
+        model at its longest τ (it may stand in for a slow periodic or a drift) — :func:`words.misfit_sentences`."""
+        e = self.curve_errors(self.fit)
+        chi2 = e.get("chi2_dof")
+        if chi2 is None or not chi2 >= MISFIT_CHI2_DOF:
+            return []
+        f, record_s = self.fit, self.result.n_samples / self.result.fs
+        z2 = np.asarray(f.z, dtype=np.float64) ** 2
+        where = None
+        if z2.size and np.isfinite(z2).any():
+            big = np.flatnonzero(z2 >= 0.5 * np.nanmax(z2))
+            lo, hi = float(f.tau[big[0]]), float(f.tau[big[-1]])
+            where = {"tau": (lo, hi), "max_z": float(np.sqrt(np.nanmax(z2))), "clusters": record_s / hi}
+        errors = self.final_errors or {}
+        return misfit_sentences(chi2, errors.get("p_value"), where, self._stand_in(record_s))
+
+    def _stand_in(self, record_s: float) -> dict | None:
+        """The rate random walk or ramp of the final model where its interval excludes 0 and it is the largest
+        component at the longest τ fitted, else None."""
+        f = self.fit
+        shares = {k: float(np.asarray(v)[-1]) for k, v in (f.components or {}).items() if np.size(v) == f.tau.size}
+        if not shares:
+            return None
+        top = max(shares, key=shares.__getitem__)
+        c = f.coefficients.get(top)
+        if top not in ("K", "R") or c is None or not c.ci[0] > 0:
+            return None
+        value = f"{c.ieee:.3g} {c.ieee_unit}" if c.ieee is not None else f"{c.value:.3g} {c.unit or ''}".rstrip()
+        return {"term": top, "name": TERM_NAMES[top], "value": value, "tau_max": float(f.tau[-1]), "record_s": record_s}
 
     def _nothing_added(self) -> str:
         """What to say when no effect was added: that the start passes — only when nothing is missing."""

@@ -12,7 +12,24 @@ import math
 
 from .levels import UNEXPLAINED_SHARES
 
-__all__ = ["describe_region", "missing_sentences", "passes_sentence", "checks_alpha", "span_text", "heldout_clause"]
+__all__ = [
+    "MISFIT_CHI2_DOF",
+    "checks_alpha",
+    "describe_region",
+    "heldout_clause",
+    "misfit_sentences",
+    "missing_sentences",
+    "passes_sentence",
+    "span_text",
+]
+
+#: The final curve χ²/dof from which the words beside "passes every calibrated check" also say the misfit: the
+#: checks test for the signatures they know, at their share of the level — not the whole misfit's size.
+MISFIT_CHI2_DOF = 2.0
+#: A normalised residual |z| from which a τ is "far off" the model (about 2σ of its estimate).
+FAR_Z = 2.0
+#: Fewer non-overlapping clusters than this at a τ: "few clusters" (the estimate rests on few differences).
+FEW_CLUSTERS = 20
 
 
 def checks_alpha(level: float) -> float:
@@ -84,6 +101,51 @@ def missing_sentences(unexplained: list, level: float) -> list[str]:
     if not unexplained:
         return [passes_sentence(level)]
     return [f"The model still misses something at {describe_region(r)}." for r in unexplained]
+
+
+def misfit_sentences(chi2_dof: float, p_value: float | None, where: dict | None, stand_in: dict | None) -> list[str]:
+    """What is said beside :func:`passes_sentence` when the final model's curve χ²/dof is ``MISFIT_CHI2_DOF`` or
+    more: that number and what the checks test; ``where``: the τ of its largest normalised residuals (``"tau"``
+    (lo, hi) s, ``"max_z"``, ``"clusters"`` the fewest non-overlapping clusters there); ``stand_in``: a resolved
+    term that sets the model at its longest τ (``"term"``, ``"name"``, ``"value"`` in words, ``"tau_max"`` s,
+    ``"record_s"``) — it may stand in for a slow periodic or a drift.
+
+    Examples
+    --------
+    >>> said = misfit_sentences(3.54, 7.5e-12, {"tau": (0.16, 1.3), "max_z": 2.3, "clusters": 470.0}, None)
+    >>> said[0][:44]
+    'Yet its curve χ²/dof is 3.54 (p = 7.5e-12 un'
+    >>> said[1]
+    'Its largest normalised residuals are at τ 0.16–1.3 s (|z| up to 2.3).'
+    """
+    p = "" if p_value is None else f"p = {p_value:.2g} under χ²(dof), "
+    out = [
+        f"Yet its curve χ²/dof is {chi2_dof:.3g} ({p}a guide, not calibrated: the calibrated checks decide): they "
+        "test the record for the signatures of the effects they know — a line, a drift, a step, a change of level, "
+        "a bump in the Allan curve — each at its share of the level, not for the size of the whole misfit."
+    ]
+    if where is not None and where["max_z"] < FAR_Z:
+        out.append(
+            f"No single τ is far off (|z| ≤ {where['max_z']:.2g} on the dense curve): the misfit is in the curve's "
+            "shape across τ, which the estimates' correlation across τ makes count."
+        )
+    elif where is not None:
+        lo, hi = where["tau"]
+        few = (
+            f", where the record holds only {where['clusters']:.0f} non-overlapping clusters"
+            if where["clusters"] < FEW_CLUSTERS
+            else ""
+        )
+        z = f"|z| up to {where['max_z']:.2g}"
+        out.append(f"Its largest normalised residuals are at τ {_span(lo, hi)} s ({z}){few}.")
+    if stand_in is not None:
+        out.append(
+            f"{stand_in['term']} ({stand_in['name']}, {stand_in['value']}) is resolved and sets the model at its "
+            f"longest τ ({_num(stand_in['tau_max'])} s of a {_num(stand_in['record_s'])} s record): it may stand in "
+            "for a slow periodic or a drift whose period or time scale is near the record's length, which a record "
+            "this short cannot tell from it — a longer record can."
+        )
+    return out
 
 
 def span_text(lo: float, hi: float) -> str:
