@@ -317,7 +317,7 @@ def write(results, out: Path, load, notes: list, stem: str = "refine_blind2", wh
     flagged = sum(v.get("without_candidate_flags", False) for v in with_inj)
     judged_as = "refine_blind.py" if stem == "refine_blind2" else "refine_blind2.py"
     lines = [
-        f"# refine on a {which} blind suite of simulated sensors (issue 29)",
+        f"# refine on {'an' if which[0] in 'aeiou' else 'a'} {which} blind suite of simulated sensors (issue 29)",
         "",
         f"Default call, `python benches/{stem}.py`, {m['cpu_model']}, {m['cpus_usable']} CPUs, allanite at "
         f"{m['git_commit']}, {m['date_utc'][:10]}; other processes used {load:.0%} of the CPUs during the run "

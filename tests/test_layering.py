@@ -175,6 +175,7 @@ MODEL_RANKS = {
     "model.timeframes": 2,
     "model.warmup": 2,
     "model.refinement.levels": 2,
+    "model.refinement._slow_lines": 2,  # slow lines' least-squares component, for the drift's retest (on periodic)
     "model.refinement._irls": 2,
     "model.refinement._brent": 0,
     "model.refinement._line_constancy": 0,
