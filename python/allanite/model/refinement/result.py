@@ -50,8 +50,8 @@ class Step:
     comparison that accepted it, where that is not the chain's; a change point — whose before and after on the
     record's curve are the same numbers: a change of noise level leaves the curve's model as it is — has its
     statistic on the windows' levels in ``window_levels``, without → with it, every other change point in both,
-    and held out per segment in ``heldout_test``, without → with it, the earlier change points in both); ``truth_error``: relative parameter errors when
-    ``truth`` was given.
+    and held out per segment in ``heldout_test``, without → with it, the earlier change points in both);
+    ``truth_error``: relative parameter errors when ``truth`` was given.
     """
 
     effect: str
