@@ -74,3 +74,24 @@ def test_partition_is_the_exhaustive_optimum(seed):
     got = lv.partition(pen)
     assert total(got) == pytest.approx(total(best))
     assert got == best
+
+
+def test_level_between_change_points_is_judged_against_the_per_segment_heldout_error():
+    # the noise growing 3× smoothly, cut in three by change points: within each third it still grows 1.2–1.4×
+    # (9–16 % off its segment's level). The record's curve held out by alternate blocks (here 20 %) is the same
+    # with and without the change points; the held-out error per segment with them (here 3 %) is what the
+    # model misses given them
+    from types import SimpleNamespace
+
+    from allanite.model.refinement._time_checks import level_check
+
+    rng = np.random.default_rng(8)
+    n = 200_000
+    y = rng.standard_normal(n) * np.linspace(1.0, 3.0, n)
+    ctx = SimpleNamespace(y=y, fs=FS, change_times=[n / 3 / FS, 2 * n / 3 / FS], curve=SimpleNamespace(tau=[0.01]))
+    ctx.heldout_pct, ctx.segments_heldout_pct = 20.0, None
+    assert level_check(ctx, 0.01) == []
+    ctx.segments_heldout_pct = 3.0
+    said = level_check(ctx, 0.01)
+    assert len(said) == 3 and all(3.0 < e["departure_pct"] < 20.0 for e in said)
+    assert all("held-out error per segment 3 %" in e["what"] for e in said)
