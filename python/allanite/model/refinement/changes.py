@@ -9,10 +9,11 @@ binary segmentation before it took at most two and, on a stretch that switches o
 records for that search (τ count per octave × ln 16 + 4 ``MIN_GAIN``), kept: the criterion's false-alarm rate is
 measured again by simulation on 400 clean records (``benches/change_points_null.py``; the search alone, before
 refine's held-out check per segment). Each τ's weight is 1/var of a window's log σ̂², the larger of the EDF's
-2/ν and the robust scatter of consecutive windows; that scatter is read first from their lower quartile
-(|difference| of |N(0, s²)|: 0.3186 s — a record with many changes has up to half its differences across one,
-which the median took for scatter), then, once change points are found, from the median of the differences not
-across one, and the partition redone until it holds (≤ 5 rounds). Cost: the windows' Allan variances, O(N) per
+2/ν and the robust scatter of consecutive windows, read from their lower quartile (|difference| of |N(0, s²)|:
+0.3186 s — a record with many changes has up to half its differences across one, which the median took for
+scatter). Not re-read without the differences across the change points found: on the ADIS16405 accelerometers,
+whose level wanders, each round took the largest differences out and found more (run 6 acc_z: 5 change points
+where one round finds 3 and binary segmentation found none). Cost: the windows' Allan variances, O(N) per
 τ; the partition O(16² × τ). Each change point is located to the sample by a two-segment likelihood of the
 squared m-sample differences at the τ of its largest gain, within the windows between its neighbours; a window
 straddling a change is a segment of its own where the partition makes it one, so one change may come from two
@@ -58,23 +59,15 @@ class _Levels:
         self.c1, self.c2 = c.copy(), c
         self.c1[:, 1:] = np.cumsum(self.lav, axis=1)
         self.c2[:, 1:] = np.cumsum(self.lav**2, axis=1)
-        self.reweigh(())
+        self.reweigh()
 
-    def reweigh(self, bounds) -> None:
+    def reweigh(self) -> None:
         """1/var(log σ̂²) per τ: ν/2 for white rate, but long τ scatter more (fewer degrees of freedom for
-        flicker/random walk): the larger of 2/ν and the robust scatter of consecutive windows (median
-        |difference|), leaving out the differences across the change points ``bounds`` (window indices b: the
-        difference of windows b − 1 and b) — a record with many changes would otherwise read its changes as the
-        windows' own scatter."""
+        flicker/random walk): the larger of 2/ν and the robust scatter of consecutive windows, read from their
+        lower quartile (|difference| of |N(0, s²)|: 0.3186 s) — a record with many changes has up to half its
+        differences across one, which the median took for the windows' own scatter (blind7's pump: 7 of 15)."""
         diffs = np.abs(np.diff(self.lav, axis=1))
-        if not bounds:  # before any change point is known: the lower quartile, |N(0, s²)|'s 0.3186 s
-            sd = np.quantile(diffs, 0.25, axis=1) / 0.3186
-        else:
-            keep = np.ones(diffs.shape[1], dtype=bool)
-            keep[[b - 1 for b in bounds]] = False
-            if keep.sum() < 5:  # too few differences left to estimate a scatter: keep the one before
-                return
-            sd = 1.4826 * np.median(diffs[:, keep], axis=1)
+        sd = np.quantile(diffs, 0.25, axis=1) / 0.3186
         self.w = 1.0 / np.maximum(self.floor, sd**2 / 2.0)
 
     def cost_tau(self, a, b) -> np.ndarray:
@@ -130,18 +123,8 @@ def penalty(lv: _Levels) -> float:
 
 
 def _bounds(lv: _Levels) -> list:
-    """The change points' window indices: the optimal partition, the windows' scatter re-read without the
-    differences across the change points found and the partition redone, until it holds (≤ 5 rounds)."""
-    bounds: list = []
-    for _ in range(5):
-        new = lv.partition(penalty(lv))
-        if new == bounds:
-            break
-        bounds = new
-        if not bounds:
-            break
-        lv.reweigh(bounds)
-    return bounds
+    """The change points' window indices: the windows' optimal partition at the calibrated penalty."""
+    return lv.partition(penalty(lv))
 
 
 def _segment(lv: _Levels, y, fs, window, max_points) -> list:
