@@ -103,7 +103,9 @@ def run_power(per_cell: int) -> dict:
 NOTES = [
     "The run above: the optimal partition of the windows (`changes._bounds`) at b49e971 with it uncommitted "
     "(committed as c4dd92e; what changed after the run — two bounds of one change merged, the windows' levels "
-    "given the other change points — cannot turn no change point into one), beside two helpers' runs and CI "
+    "given the other change points — cannot turn no change point into one; the scatter's re-reading without the "
+    "differences across the change points found, dropped at 34a55b6, ran only after a first partition had found "
+    "one, which none of the 400 did), beside two helpers' runs and CI "
     "(load average 11–14 on 2 CPUs). The same 400 records (seeds 1000–1399) through main's binary segmentation "
     "(b49e971, `PYTHONPATH` to an export of it): also 0 of 400 at `MIN_GAIN` 6. So the partition, which takes "
     "as many change points as the evidence pays for, raised no false alarm where the search of at most two had "

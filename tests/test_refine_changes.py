@@ -1,5 +1,5 @@
-"""Several change points of the noise level (``changes.change_points``): the windows' optimal partition, its
-scatter read without the changes it found, each change located to the sample."""
+"""Several change points of the noise level (``changes.change_points``): the windows' optimal partition, their
+scatter read from the lower quartile of consecutive differences, each change located to the sample."""
 
 import itertools
 
