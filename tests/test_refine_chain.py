@@ -174,10 +174,11 @@ def test_change_points_chain_on_the_curve_and_each_has_its_own_numbers(line_and_
     assert [round(float(c.params["t"])) for c in cps] == [2000, 3000]
     for c in cps:  # on the record's curve a change of noise level changes nothing: before = after, said so
         assert c.before == c.after and "before = after" in c.evidence["on_the_curve"]
-    # what found them, a chain of its own: the first one's before is one level, each next before the previous
-    # after — the windows' levels and the held-out error per segment alike, each falling
+    # what found them: on the windows' levels each one without → with it, the other in both (the after is the
+    # whole partition's); held out per segment a chain of its own — the first one's before is one level, each
+    # next before the previous after; each falling
     w0, w1 = cps[0].evidence["window_levels"], cps[1].evidence["window_levels"]
-    assert w0["after"] == w1["before"] and w0["before"] != w1["before"]
+    assert w0["after"]["chi2_dof"] == w1["after"]["chi2_dof"] and w0["before"] != w1["before"]
     h0, h1 = cps[0].evidence["heldout_test"], cps[1].evidence["heldout_test"]
     assert h0["after"] == h1["before"] == w0["after"]["heldout_rms_adev_pct"]
     for w, h in ((w0, h0), (w1, h1)):

@@ -42,10 +42,10 @@ _STATISTICS = {
     "level leaves the curve's model as it is (before = after); a spectral line's amplitude and f0, measured "
     "in the samples, are held in every fit of the curve",
     "window_levels": "what found a change point (its step's window_levels): the log Allan variances of "
-    "16 windows along the record about piecewise-constant levels without → with this change point (the "
-    "earlier ones in both: the first one's before is one level, each next one's before the previous one's "
-    "after); heldout_rms_adev_pct in it: held out per segment (each segment's alternate blocks predicted "
-    "by its own held-in part's model), without → with it",
+    "16 windows along the record about piecewise-constant levels without → with this change point (every "
+    "other one in both); heldout_rms_adev_pct in it: held out per segment (each segment's alternate blocks "
+    "predicted by its own held-in part's model), without → with it, the earlier ones in both (the first "
+    "one's before is one level, each next one's before the previous one's after)",
 }
 
 #: What an axis's ``unexplained`` entries hold (summary.json's refinement.unexplained).

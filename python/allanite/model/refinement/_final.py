@@ -87,6 +87,9 @@ class FinalModel(RunState):
         )
         ctx.change_times = [st.params["t"] for st in cp_steps]
         ctx.heldout_pct = self.state[0].get("heldout_rms_adev_pct")
+        per_segment = [(st.evidence.get("heldout_test") or {}).get("after") for st in cp_steps]
+        if per_segment and per_segment[-1] is not None:  # with every change point: the chain's last after
+            ctx.segments_heldout_pct = per_segment[-1]
         ctx.samples = self.y0
         ctx.replaced = _replaced([rem for _st, rem, *_rest in self.removed], self.y0.size if self.y0 is not None else 0)
         ctx.families = [

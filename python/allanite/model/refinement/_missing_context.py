@@ -37,6 +37,10 @@ class MissingContext:
     change_times: list = field(default_factory=list)
     #: the final model's held-out RMS ADEV error (%), the yardstick of a level change's size (None: not known)
     heldout_pct: float | None = None
+    #: with change points accepted, the held-out RMS ADEV error per segment with all of them (each segment's
+    #: held-out part predicted by its own held-in part's model): what the model misses given the change points,
+    #: the yardstick of a level change between them (None: no change point, ``heldout_pct`` is)
+    segments_heldout_pct: float | None = None
     #: the ``"periodic"`` families removed in time, as (fundamentals, line frequencies, line amplitudes, the
     #: removed component's samples): the ``"line"`` check tests each one's strongest line (:mod:`._line_check`)
     families: list = field(default_factory=list)

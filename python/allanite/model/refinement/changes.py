@@ -1,13 +1,29 @@
 """Change points: steps of the noise level along the record (needs the samples).
 
-The Allan variances of 16 non-overlapping windows (octave τ), in logs, are split where the weighted
-within-segment scatter falls most (binary segmentation, at most two changes); a split is kept when its gain
-beats a penalty calibrated on clean records (``MIN_GAIN``), then located to the sample by a two-segment
-likelihood of the squared m-sample differences at the τ of the largest gain. Its statistic is on the
-windows' levels, not on the Allan curve: a change point's before/after says how the windows' piecewise-
-constant levels without and with it (the earlier change points in both) describe them. On the record's own
-Allan curve a change of noise level changes nothing: the curve of a record whose level steps is the
-length-weighted mean of its segments' curves, a model of the same terms with pooled coefficients, which
+The Allan variances of 16 non-overlapping windows (octave τ), in logs, are partitioned into segments of one
+level each by optimal partitioning (exact dynamic programming over the windows): the partition minimises the
+windows' weighted scatter about their segments' levels plus a penalty per change point, so it takes as many
+change points as the evidence pays for — a pump or a fan switching on and off, several stretches — where the
+binary segmentation before it took at most two and, on a stretch that switches on and off again, often none
+(one split of an on/off/on pattern gains little). The penalty per change point is the one calibrated on clean
+records for that search (τ count per octave × ln 16 + 4 ``MIN_GAIN``), kept: the criterion's false-alarm rate is
+measured again by simulation on 400 clean records (``benches/change_points_null.py``; the search alone, before
+refine's held-out check per segment). Each τ's weight is 1/var of a window's log σ̂², the larger of the EDF's
+2/ν and the robust scatter of consecutive windows, read from their lower quartile (|difference| of |N(0, s²)|:
+0.3186 s — a record with many changes has up to half its differences across one, which the median took for
+scatter). Not re-read without the differences across the change points found: on the ADIS16405 accelerometers,
+whose level wanders, each round took the largest differences out and found more (run 6 acc_z: 5 change points
+where one round finds 3 and binary segmentation found none). Cost: the windows' Allan variances, O(N) per
+τ; the partition O(16² × τ). Each change point is located to the sample by a two-segment likelihood of the
+squared m-sample differences at the τ of its largest gain, within the windows between its neighbours; a window
+straddling a change is a segment of its own where the partition makes it one, so one change may come from two
+bounds: located within an eighth of a window of each other (or with overlapping intervals) they are one. Two
+changes closer than that are one; a stretch shorter than a window shows as one window's level.
+
+Its statistic is on the windows' levels, not on the Allan curve: a change point's before/after says how the
+windows' piecewise-constant levels without and with it, every other one in both, describe them. On the
+record's own Allan curve a change of noise level changes nothing: the curve of a record whose level steps is
+the length-weighted mean of its segments' curves, a model of the same terms with pooled coefficients, which
 the fit of the whole curve already is.
 """
 
@@ -38,27 +54,48 @@ class _Levels:
         self.lav = np.log(np.maximum(d.avar, 1e-300))  # (tau, windows)
         # SD of log σ̂² per τ: from the EDF of the dominant noise (white rate is a fair middle)
         nu = fitting.edf_per_tau(np.zeros(d.m.size, dtype=int), d.m, window + 1, "oavar")
-        # 1/var(log σ̂²): ν/2 for white rate, but long τ scatter more (fewer degrees of freedom for
-        # flicker/random walk): take the larger of 2/ν and the robust scatter of consecutive windows
-        # (median |difference|, insensitive to a few steps).
-        mad = 1.4826 * np.median(np.abs(np.diff(self.lav, axis=1)), axis=1)
-        self.w = 1.0 / np.maximum(2.0 / nu, mad**2 / 2.0)
+        self.floor = 2.0 / nu
+        c = np.zeros((self.lav.shape[0], self.lav.shape[1] + 1))
+        self.c1, self.c2 = c.copy(), c
+        self.c1[:, 1:] = np.cumsum(self.lav, axis=1)
+        self.c2[:, 1:] = np.cumsum(self.lav**2, axis=1)
+        self.reweigh()
 
-    def _scatter(self, x, axis=None):
-        return np.sum(self.w[:, None] * (x - x.mean(axis=1, keepdims=True)) ** 2, axis=axis)
+    def reweigh(self) -> None:
+        """1/var(log σ̂²) per τ: ν/2 for white rate, but long τ scatter more (fewer degrees of freedom for
+        flicker/random walk): the larger of 2/ν and the robust scatter of consecutive windows, read from their
+        lower quartile (|difference| of |N(0, s²)|: 0.3186 s) — a record with many changes has up to half its
+        differences across one, which the median took for the windows' own scatter (blind7's pump: 7 of 15)."""
+        diffs = np.abs(np.diff(self.lav, axis=1))
+        sd = np.quantile(diffs, 0.25, axis=1) / 0.3186
+        self.w = 1.0 / np.maximum(self.floor, sd**2 / 2.0)
 
-    def best_split(self, a, b):
-        """(gain, window index of the split, τ index of the largest gain) of the best split of windows a..b."""
-        lav = self.lav
-        seg = lav[:, a:b]
-        best = (0.0, None, None)
-        for j in range(a + 1, b):
-            left, right = lav[:, a:j], lav[:, j:b]
-            gain = self._scatter(seg) - (self._scatter(left) + self._scatter(right))
-            if gain > best[0]:
-                gain_tau = self._scatter(seg, axis=1) - self._scatter(left, axis=1) - self._scatter(right, axis=1)
-                best = (gain, j, int(np.argmax(gain_tau)))
-        return best
+    def cost_tau(self, a, b) -> np.ndarray:
+        """Weighted scatter of windows a..b about their mean, per τ."""
+        s, q = self.c1[:, b] - self.c1[:, a], self.c2[:, b] - self.c2[:, a]
+        return self.w * np.maximum(q - s**2 / (b - a), 0.0)
+
+    def partition(self, penalty) -> list:
+        """Window indices of the change points minimising the windows' weighted scatter about one level per
+        segment + ``penalty`` per change point: optimal partitioning, exact (dynamic programming over the
+        windows, O(windows² × τ)); a segment may be one window long."""
+        nw = self.lav.shape[1]
+        cost = np.full((nw + 1, nw + 1), np.inf)
+        for a in range(nw):
+            for b in range(a + 1, nw + 1):
+                cost[a, b] = float(np.sum(self.cost_tau(a, b)))
+        best, back = np.zeros(nw + 1), np.zeros(nw + 1, dtype=int)
+        best[0] = -penalty
+        for b in range(1, nw + 1):
+            tot = best[:b] + cost[:b, b] + penalty
+            back[b] = int(np.argmin(tot))
+            best[b] = tot[back[b]]
+        bounds, b = [], nw
+        while b > 0:
+            b = int(back[b])
+            if b > 0:
+                bounds.append(b)
+        return sorted(bounds)
 
     def stats(self, segments, keep) -> dict:
         """χ²/dof, RMS z and RMS ADEV error (%) of the windows' levels about one level per segment."""
@@ -78,66 +115,88 @@ class _Levels:
         }
 
 
-def _segment(lv: _Levels, y, fs, window, max_points) -> list:
-    """Binary segmentation of the windows: [{t, interval, gain, tau, window_s, coarse_split_s}] by time."""
-    # windows are independent but the τ of one window are correlated: penalise per octave count
+def penalty(lv: _Levels) -> float:
+    """The penalty per change point: the windows are independent but the τ of one window are correlated, so
+    the τ count per octave (``MIN_GAIN`` calibrated with it on clean records)."""
     n_tau_eff = max(2.0, math.log2(lv.tau[-1] / lv.tau[0]) + 1.0)
-    penalty = n_tau_eff * math.log(N_WINDOWS) + 4.0 * MIN_GAIN
+    return n_tau_eff * math.log(N_WINDOWS) + 4.0 * MIN_GAIN
+
+
+def _bounds(lv: _Levels) -> list:
+    """The change points' window indices: the windows' optimal partition at the calibrated penalty."""
+    return lv.partition(penalty(lv))
+
+
+def _segment(lv: _Levels, y, fs, window, max_points) -> list:
+    """The change points of the windows' levels (:func:`_bounds`), each located to the sample within the
+    windows between its neighbours: [{t, interval, gain, tau, window_s, coarse_split_s}] by time."""
+    bounds = _bounds(lv)
+    edges = [0] + bounds + [N_WINDOWS]
+    found = []
+    for k, j in enumerate(bounds):
+        a, b = edges[k], edges[k + 2]
+        gain_tau = lv.cost_tau(a, b) - lv.cost_tau(a, j) - lv.cost_tau(j, b)
+        found.append((float(np.sum(gain_tau)), j, int(np.argmax(gain_tau)), a, b))
     out: list = []
-    stack = [(0, N_WINDOWS)]
-    while stack and len(out) < max_points:
-        a, b = stack.pop(0)
-        if b - a < 3:
-            continue
-        gain, j, k_tau = lv.best_split(a, b)
-        if j is None or gain < penalty:
-            continue
+    for gain, j, k_tau, a, b in sorted(found, key=lambda f: -f[0]):
+        if max_points is not None and len(out) >= max_points:
+            break
         # locate at sample resolution with the squared differences at the τ of the largest gain
         m = int(lv.m[k_tau])
         lo_s, hi_s = a * window, b * window
         t_hat, t_int = locate(y[lo_s:hi_s], m, fs)
         t_abs = t_hat + lo_s / fs
-        if any(abs(c["t"] - t_abs) < window / fs for c in out):
+        interval = (t_int[0] + lo_s / fs, t_int[1] + lo_s / fs)
+        same = [c for c in out if _same(c, t_abs, interval, window / fs)]
+        if same:  # one found already: a window straddling a change is a segment of its own, two bounds
+            same[0]["bounds"].append(j)
             continue
         out.append(
             {
                 "t": t_abs,
-                "interval": (t_int[0] + lo_s / fs, t_int[1] + lo_s / fs),
-                "gain": float(gain),
+                "interval": interval,
+                "gain": gain,
                 "tau": float(lv.tau[k_tau]),
                 "window_s": window / fs,
                 "coarse_split_s": j * window / fs,
+                "bounds": [j],
             }
         )
-        # search each side again, leaving out the window that straddles the change
-        jw = int(t_abs * fs // window)
-        stack += [(a, min(jw, j)), (max(jw + 1, j), b)]
     out.sort(key=lambda c: c["t"])
     return out
 
 
-def change_points(y, fs, terms, max_points=2):
+def _same(c: dict, t: float, interval: tuple, window_s: float) -> bool:
+    """Whether a change located at ``t`` (``interval``) is change point ``c`` found again: their intervals
+    overlap, or they lie within an eighth of a window (the windows' levels do not resolve two changes closer
+    than that, and two spans' locations of one change differ by a few samples)."""
+    overlap = interval[0] <= c["interval"][1] and c["interval"][0] <= interval[1]
+    return overlap or abs(c["t"] - t) < window_s / 8
+
+
+def change_points(y, fs, terms, max_points=None):
     """Level steps of the Allan variance along the record: [{t, interval, gain, tau, window_s, coarse_split_s,
-    before, after}] by time, ``before``/``after`` the windows' levels about piecewise-constant levels without
-    and with this change point, the earlier ones in both — a chain of its own: the first change point's before
-    is one constant level, each next one's before the previous one's after (windows that straddle any change
-    belong to no segment: left out of all)."""
+    before, after}] by time (at most ``max_points``, the largest gains), ``before``/``after`` the windows'
+    levels about piecewise-constant levels without and with this change point, every other one in both (the
+    partition's own question: dropping any one of its change points raises the scatter by more than the
+    penalty). The segments are the partition's (:func:`_bounds`): a window that straddles a change is a
+    segment of its own where the partition made it one (a change point's bounds, one or two)."""
     window = y.size // N_WINDOWS
     if window < 64:
         return []
     lv = _Levels(y, fs, window)
     out = _segment(lv, y, fs, window, max_points)
-    cut = [int(c["t"] * fs // window) for c in out]
     keep = np.ones(N_WINDOWS, dtype=bool)
-    keep[[j for j in cut if j < N_WINDOWS]] = False
 
-    def levels(n: int) -> dict:  # the windows about one level per segment between the first n changes
-        edges = [0] + sorted(cut[:n]) + [N_WINDOWS]
+    def levels(skip: int | None) -> dict:  # the windows about one level per segment, change point skip left out
+        edges = [0] + sorted({j for i, c in enumerate(out) if i != skip for j in c["bounds"]}) + [N_WINDOWS]
         return lv.stats([(a, b) for a, b in zip(edges[:-1], edges[1:])], keep)
 
-    chain = [levels(n) for n in range(len(out) + 1)]
+    after = levels(None)
     for n, c in enumerate(out):
-        c["before"], c["after"] = chain[n], chain[n + 1]
+        c["before"], c["after"] = levels(n), dict(after)
+    for c in out:
+        del c["bounds"]
     return out
 
 
@@ -179,11 +238,11 @@ def change_point_step(c: dict, heldout: list | None, truth: dict | None, duratio
     On the record's Allan curve a change of noise level changes nothing: the curve of the whole record is the
     length-weighted mean of its segments', a model of the same terms with pooled coefficients — the fit of the
     whole curve already —, so its before and after there are both the model so far, the same numbers by
-    construction (``evidence["on_the_curve"]``). What found it is in its evidence, a chain of its own:
-    ``window_levels`` (the windows' levels about piecewise levels without → with it, the earlier change points
-    in both) and ``heldout_test`` (``heldout`` = [without, with]: the final segments' held-out parts predicted
-    without → with it, :func:`.scoring.segments_heldout`). ``truth``: the true ``{"t": …}`` (s), for the error
-    as a fraction of the record (``duration_s``)."""
+    construction (``evidence["on_the_curve"]``). What found it is in its evidence:
+    ``window_levels`` (the windows' levels about piecewise levels without → with it, every other change point
+    in both) and, a chain of its own, ``heldout_test`` (``heldout`` = [without, with]: the final segments'
+    held-out parts predicted without → with it, :func:`.scoring.segments_heldout`). ``truth``: the true
+    ``{"t": …}`` (s), for the error as a fraction of the record (``duration_s``)."""
     terr = None
     if truth is not None:
         terr = {"t": float(np.min(np.abs(np.atleast_1d(truth["t"]) - c["t"])) / duration_s)}

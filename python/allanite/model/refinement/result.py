@@ -50,9 +50,9 @@ class Step:
     ``evidence``: where in τ, f or t the residual was and the test that accepted it (``heldout_test``: the held-out
     comparison that accepted it, where that is not the chain's; a change point — whose before and after on the
     record's curve are the same numbers: a change of noise level leaves the curve's model as it is — has its
-    statistic on the windows' levels in ``window_levels`` and held out per segment in ``heldout_test``, each
-    without → with it, the earlier change points in both); ``truth_error``: relative parameter errors when
-    ``truth`` was given.
+    statistic on the windows' levels in ``window_levels``, without → with it, every other change point in both,
+    and held out per segment in ``heldout_test``, without → with it, the earlier change points in both);
+    ``truth_error``: relative parameter errors when ``truth`` was given.
     """
 
     effect: str
@@ -242,7 +242,8 @@ class Refinement(RichDisplay):
             "AVAR(y) − AVAR(y − component), part of it. A change of noise level leaves the record's curve model as "
             "it is (the curve of a record whose level steps is the length-weighted mean of its segments' curves: a "
             "model of the same terms), so its before and after there are the same numbers; what found it is on the "
-            "windows' levels along the record (evidence['window_levels'], each change point without → with it) and "
+            "windows' levels along the record (evidence['window_levels'], each change point without → with it, every "
+            "other one in both) and "
             "held out per segment (evidence['heldout_test']).",
             "Parameters measured in the time domain keep their time-domain values in the final joint refit: a "
             "spectral line's amplitude (its power in the samples' spectrum; the part whose phase carries across "
