@@ -133,15 +133,18 @@ def test_real_adis_noise_with_an_injected_gauss_markov(shared_data):
     assert r.fit.chi2_dof <= 2
 
 
-@pytest.mark.parametrize("records", [8, pytest.param(20, marks=pytest.mark.slow)])
-def test_no_false_alarms_on_clean_records(records):
-    # a CI-sized subset of benches/refine_false_alarms.py (186 records over five mixtures: 2.2 %); the default run
-    # refines the first 8 of the 20 seeds
+@pytest.mark.parametrize("records, allowed", [(5, 0), pytest.param(20, 1, marks=pytest.mark.slow)])
+def test_no_false_alarms_on_clean_records(records, allowed):
+    # a CI-sized subset of benches/refine_false_alarms.py (613 records over eight mixtures: 0.2 %); the default run
+    # refines the first 5 of the 20 seeds and allows none of them to add anything — stricter per record than the
+    # 1 of 8 it allowed before (a rate of 10 % passes 5 of 0 with probability 0.59, 8 of ≤ 1 with 0.81), at 5/8
+    # of the cost; every one of the 20 adds nothing at the last count. A clean record's every surface (steps,
+    # unexplained, the report's words) is test_refine_unexplained_surfaces.py's
     found = 0
     for seed in range(records):
         y = allanite.simulate(100_000, FS, Q=3e-4, N=2e-3, B=1e-3, K=2e-5, seed=200 + seed)
         found += bool(allanite.refine(y, FS).found)
-    assert found <= 1  # ≥ 95 % of 20 seeds add nothing (0 of 40 did at the last count)
+    assert found <= allowed
 
 
 @pytest.mark.slow  # reruns equal: test_refine_cost.py; a curve: test_calibrated_test_and_heldout_are_reported
