@@ -399,16 +399,14 @@ def test_simulated_multi_position_without_the_coupling_adds_nothing():
     assert "regression" not in allanite.refine(noise, FS, channels={"acc_z": acc}).found
 
 
-def test_calibrated_test_and_heldout_are_reported(gm_small=None):
+def test_calibrated_test_and_heldout_are_reported():
+    # on samples, the calibrated test's score against its threshold and the held-out error before and after are
+    # test_refine.py::test_finds_an_undeclared_gauss_markov's (a refine of samples fewer here: 1.5 CPU s)
     y = allanite.simulate(200_000, FS, N=2e-3, K=2e-5, gauss_markov=[(6e-3, 5.0)], seed=12)
-    r = allanite.refine(y, FS)
-    assert r.found[:1] == ["gauss_markov"]
-    st = r.steps[0]
-    assert st.evidence["test"]["gls_score"] > st.evidence["test"]["threshold"] > 0
-    assert st.before["heldout_rms_adev_pct"] > st.after["heldout_rms_adev_pct"]
-    assert "held-out" in r.report().lower()
     # curve-only input: no held-out error, and the result says so
     c = allanite.refine(allanite.avar(y, FS, taus=allanite.tau_grid(y.size, FS, "exp", points=300)))
+    assert c.found[:1] == ["gauss_markov"]
+    assert c.steps[0].evidence["test"]["gls_score"] > c.steps[0].evidence["test"]["threshold"] > 0
     assert c.start_heldout_rms_adev_pct is None and "no held-out error" in c.heldout_note
     assert all(s.after["heldout_rms_adev_pct"] is None for s in c.steps)
 
