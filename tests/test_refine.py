@@ -53,11 +53,14 @@ def test_finds_an_undeclared_gauss_markov(gm_record):
     lo, hi = st.intervals["tc"]
     assert lo < st.params["tc"] < hi
     assert st.evidence["runs_beyond_2sigma"]  # where the residual was
+    # accepted by its calibrated test (score 196 against 12.0), and the held-out error falls (25.2 → 4.5 %)
+    assert st.evidence["test"]["gls_score"] > st.evidence["test"]["threshold"] > 0
+    assert st.before["heldout_rms_adev_pct"] > st.after["heldout_rms_adev_pct"]
     # a second domain: the residual's autocorrelation in time gives the same correlation time
     assert st.evidence["autocorrelation"]["tc"] == pytest.approx(truth["tc"], rel=0.1)
     assert "gauss_markov" in r.fit.coefficients and r.fit.chi2_dof <= 2
     text = r.report()
-    assert "Step 1: gauss_markov" in text and "tc =" in text
+    assert "Step 1: gauss_markov" in text and "tc =" in text and "held-out" in text.lower()
 
 
 def test_finds_an_undeclared_sinusoid():
@@ -93,6 +96,9 @@ def test_locates_a_variance_step_within_one_window():
     assert ho["after"] < 0.5 * ho["before"]
     # the record's own Allan curve it leaves as it is: on the chain its before is its after
     assert st.before == st.after
+    # and unexplained's level check, run within the segments, finds nothing left (without the change-point candidate
+    # it says the level changes: test_refine_unexplained_level.py)
+    assert not any(u["domain"] == "level" for u in r.unexplained)
 
 
 def test_two_effects_at_once():
@@ -133,15 +139,18 @@ def test_real_adis_noise_with_an_injected_gauss_markov(shared_data):
     assert r.fit.chi2_dof <= 2
 
 
-@pytest.mark.parametrize("records", [8, pytest.param(20, marks=pytest.mark.slow)])
-def test_no_false_alarms_on_clean_records(records):
-    # a CI-sized subset of benches/refine_false_alarms.py (186 records over five mixtures: 2.2 %); the default run
-    # refines the first 8 of the 20 seeds
+@pytest.mark.parametrize("records, allowed", [(5, 0), pytest.param(20, 1, marks=pytest.mark.slow)])
+def test_no_false_alarms_on_clean_records(records, allowed):
+    # a CI-sized subset of benches/refine_false_alarms.py (613 records over eight mixtures: 0.2 %); the default run
+    # refines the first 5 of the 20 seeds and allows none of them to add anything — stricter per record than the
+    # 1 of 8 it allowed before (a rate of 10 % passes 5 of 0 with probability 0.59, 8 of ≤ 1 with 0.81), at 5/8
+    # of the cost; every one of the 20 adds nothing at the last count. A clean record's every surface (steps,
+    # unexplained, the report's words) is test_refine_unexplained_surfaces.py's
     found = 0
     for seed in range(records):
         y = allanite.simulate(100_000, FS, Q=3e-4, N=2e-3, B=1e-3, K=2e-5, seed=200 + seed)
         found += bool(allanite.refine(y, FS).found)
-    assert found <= 1  # ≥ 95 % of 20 seeds add nothing (0 of 40 did at the last count)
+    assert found <= allowed
 
 
 @pytest.mark.slow  # reruns equal: test_refine_cost.py; a curve: test_calibrated_test_and_heldout_are_reported
@@ -161,9 +170,20 @@ def test_plot_draws():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    # the plot draws what every refinement has (the curve, the starting and the final model, their residuals): a
+    # curve input's refinement (0.6 s, the same Gauss–Markov found) draws it as the samples' (1.8 s) would
     y = allanite.simulate(100_000, FS, N=2e-3, gauss_markov=[(5e-3, 3.0)], seed=2)
-    fig = allanite.refine(y, FS).plot()
+    r = allanite.refine(allanite.avar(y, FS, taus=allanite.tau_grid(y.size, FS, "exp", points=300)))
+    assert r.found == ["gauss_markov"]
+    fig = r.plot()
     assert len(fig.axes) == 2
+    curve, start, final = fig.axes[0].get_lines()
+    np.testing.assert_allclose(curve.get_ydata(), np.sqrt(r.start.avar))
+    np.testing.assert_allclose(start.get_ydata(), np.sqrt(r.start.model))
+    np.testing.assert_allclose(final.get_ydata(), np.sqrt(r.fit.model))
+    before, after = fig.axes[1].get_lines()
+    np.testing.assert_allclose(after.get_ydata(), r.fit.z)
+    assert np.max(np.abs(after.get_ydata())) < np.max(np.abs(before.get_ydata()))  # the effect took the bump
     plt.close(fig)
 
 

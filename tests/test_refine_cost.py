@@ -11,7 +11,8 @@ bootstrap's one-product statistics against a QR per grid point (within
 after another (scipy's bounded search, one fit per call), the line spectra remembered within a refine and the EDF
 remembered per averaging factors against fresh ones, the line families' phase gridding, DTFT and waveforms against
 their plain forms, and a whole default ``refine`` with every memory and the lockstep against one that recomputes
-everything one search at a time. The fits here run the Python loop (``_irls.irls_python``; the Rust core's
+everything one search at a time (a record with a Gauss–Markov term and a temperature coupling: the curve's memories
+and the channel's transforms in one pair of refines). The fits here run the Python loop (``_irls.irls_python``; the Rust core's
 loop, which agrees with it to rounding, is checked in ``tests/test_refine_irls.py``), but for the whole default
 ``refine``, which runs the core's loop both ways. No timings here: ``benches/bench_refine_cost.py``.
 """
@@ -248,16 +249,30 @@ def _one_at_a_time(curve, terms, effects, specs):
 
 def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
     monkeypatch.setattr(_irls, "COMPILED", COMPILED)  # the default path: the core's loop where it is built
-    y = allanite.simulate(100_000, 50.0, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 4.0)], seed=8)
-    cached = allanite.refine(y, 50.0, progress=False)
+    # a Gauss–Markov term and a temperature coupling (2.5 cycles): the curve's searches and the channel's remembered
+    # transforms in one pair of refines (test_refine_cost_memos.py's refine with a channel alone: the slow set)
+    n, fs = 100_000, 50.0
+    t = np.arange(n) / fs
+    temp = 10.0 + 5.0 * np.sin(2 * np.pi * t / (n / fs / 2.5)) + 0.01 * np.random.default_rng(2).standard_normal(n)
+    y = allanite.simulate(n, fs, N=2e-3, K=2e-5, gauss_markov=[(5e-3, 4.0)], seed=8) + 2e-3 * temp
+    hits, recent_get = [], Recent.get
+
+    def counted(self, arr, key=()):
+        value = recent_get(self, arr, key)
+        hits.append(value is not None)
+        return value
+
+    monkeypatch.setattr(Recent, "get", counted)
+    cached = allanite.refine(y, fs, channels={"temp": temp}, progress=False)
+    assert sum(hits) > 10  # the channel's and the held-out curves' memories were used (28 times at the last count)
     monkeypatch.setattr(curvefit.Curve, "cached", lambda self, key: None)  # every column, EDF and subset afresh
     loop = importlib.import_module("allanite.model.refinement.loop")
     monkeypatch.setattr(loop, "prefetch", lambda rnd, c: None)
     monkeypatch.setattr(loop, "remembering_spectra", contextlib.nullcontext)  # every line spectrum afresh
     monkeypatch.setattr(curvefit, "searches", _one_at_a_time)  # each search alone, when proposed
     monkeypatch.setattr(Recent, "get", lambda self, arr, key=(): None)  # held-out curves, phasors, … afresh
-    plain = allanite.refine(y, 50.0, progress=False)
-    assert cached.found == plain.found
+    plain = allanite.refine(y, fs, channels={"temp": temp}, progress=False)
+    assert cached.found == plain.found == ["gauss_markov", "regression"]
     for a, b in zip(cached.steps, plain.steps):
         assert a.params == b.params and a.intervals == b.intervals
         assert a.before == b.before and a.after == b.after

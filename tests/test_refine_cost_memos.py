@@ -47,6 +47,10 @@ def test_remembered_transforms_equal_fresh_ones(monkeypatch):
     assert channels.band_limited is _rfft.band_limited  # the channel regression's own name for it
 
 
+# slow: the default run's twin is tests/test_refine_cost.py::test_refine_with_remembered_columns_equals_recomputing,
+# whose record carries a temperature coupling beside its Gauss–Markov term and whose plain refine gets nothing from
+# these memories either — one pair of refines instead of two
+@pytest.mark.slow
 def test_refine_with_a_channel_and_its_memories_equals_recomputing(monkeypatch):
     n, fs = 120_000, 10.0
     t = np.arange(n) / fs

@@ -4,7 +4,8 @@ the slow set only (``ALLANITE_SLOW=1``: outliers are tests/test_refine_lines.py'
 default; the issue's cycling temperature and a square wave's line family are tests/test_channels.py's and
 tests/test_refine_lines.py's). Each must be named with its parameters (20 %, frequencies 1 %), lower the errors in sample
 and held out, and leave nothing unexplained; refined without its effect's candidate, the model cannot be
-complete, and ``unexplained`` must say so. The whole suite (17 cases) is ``benches/refine_sensors.py``."""
+complete, and ``unexplained`` must say so (the slow set; by default a shorter swing's twin in
+tests/test_channel_swing_bootstrap.py). The whole suite (17 cases) is ``benches/refine_sensors.py``."""
 
 from __future__ import annotations
 
@@ -37,6 +38,10 @@ def test_the_default_call_names_the_effect_and_leaves_nothing_unexplained(case_r
     assert v["explained"], [u["what"] for u in r.unexplained]
 
 
+# a second refine of the 25-hour record: slow. The default run's cheaper twin of the same property (a temperature
+# swinging once, refined without the regression candidate: `unexplained` names the channel, its statistic above its
+# threshold) is tests/test_channel_swing_bootstrap.py::test_unexplained_says_the_channel_when_the_regression_is_left_out
+@pytest.mark.slow
 def test_without_its_candidate_the_model_says_what_it_misses(case_record):
     case, y, fs, kw = case_record
     r = allanite.refine(y, fs, unit=case.unit, candidates=sensors.candidates_without(case), progress=False, **kw)

@@ -80,6 +80,13 @@ def test_refine_says_where_the_noise_level_changes_unless_a_change_point_explain
         r"t (19\d|20\d)–400 s, τ 0\.010 s: the noise level changes along the record: (1\.9\d|2\.0\d)× ", text
     )
     assert any(s.startswith(f"The model still misses something at {text}") for s in r.missing_sentences())
+
+
+# a second refine of the record: slow. The default run's twin: test_refine.py::test_locates_a_variance_step_within_
+# one_window, whose change point leaves no level entry either
+@pytest.mark.slow
+def test_a_change_point_explains_the_same_level_change():
+    y = _doubling(40_000)
     with_cp = allanite.refine(y, FS, progress=False)
     assert "change_point" in with_cp.found
     assert not any(u["domain"] == "level" for u in with_cp.unexplained)  # tested within its segments
