@@ -16,7 +16,7 @@ edges against Whittle's; the law restored, its mean is 2 or below. Prints a Mark
 
 Usage::
 
-    python benches/channel_warmup_edge_null.py                # ≈ 5 s CPU
+    python benches/channel_warmup_edge_null.py                # ≈ 10 s CPU
     python benches/channel_warmup_edge_null.py --records 60
 """
 

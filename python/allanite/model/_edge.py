@@ -14,7 +14,8 @@ The exact variance under a noise PSD P is computed here in time: ``u = Σ_t v_t�
 differenced noise's Toeplitz covariance — ``(1/M)·Σ_j P(2πj/M)·|V_j|²`` over the 2·(n − 1)-point transform of v
 zero-padded (the padding keeps the record's ends apart: no wrap-around; only the noise's covariance beyond
 n − 1 lags aliases back). P is the fitted noise: the parametric shapes' amounts at half-bin spacing in the
-parametric bands, each own band's level above. Three FFTs per direction; O(N log N).
+parametric bands, each own band's level above. Per test: the record-length transform of each regressor, one
+per direction (a quadrature shares its direction's) and one of twice the length per two directions; O(N log N).
 """
 
 from __future__ import annotations
@@ -157,9 +158,11 @@ def edge_factor(bands: wh.Bands, fit: dict, design: wh.Design, directions: np.nd
     ratios = [float(v) for v in eigh(exact, whittle, eigvals_only=True)]
     weights = 1.0 / np.asarray(fit["s"], dtype=np.float64)
     u = d @ wh.score(bands, design, weights)
-    q_w = float(u @ np.linalg.solve(whittle, u))
-    q_e = float(u @ np.linalg.solve(exact, u))
-    factor = q_w / q_e if q_e > 0 else 1.0
+    try:
+        q_w, q_e = float(u @ np.linalg.solve(whittle, u)), float(u @ np.linalg.solve(exact, u))
+        factor = q_w / q_e if q_e > 0 else max(ratios)
+    except np.linalg.LinAlgError:  # an exact covariance without an inverse: the largest ratio, conservatively
+        factor = max(ratios)
     if d.shape[0] == 1:
         factor = float(exact[0, 0] / whittle[0, 0])
     return {"factor": max(1.0, factor), "ratios": ratios, "exact": exact, "whittle": whittle}
