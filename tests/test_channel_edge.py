@@ -10,12 +10,12 @@ import math
 
 import numpy as np
 import pytest
-from sensors import temperature_profile
 
 import allanite
 from allanite.model import _edge
 from allanite.model import _whittle as wh
 from allanite.model.channels import channel_bands, regress_channel
+from sensors import temperature_profile
 
 FS, N = 20.0, 2000
 
@@ -42,7 +42,11 @@ def test_the_scores_exact_variance_matches_simulated_records(kind):
     # the score Re Σ conj(Z)·D/S over 600 records of the same noise beside the same channel
     s_bin = null["s"][_edge._band_of(bands, np.arange(1, n_bins + 1, dtype=np.float64))]
     u = [
-        float(np.sum(np.conj(z) * wh._dft(allanite.simulate(y.size, FS, N=1e-3, seed=100 + r), w, n_bins) / norm / s_bin).real)
+        float(
+            np.sum(
+                np.conj(z) * wh._dft(allanite.simulate(y.size, FS, N=1e-3, seed=100 + r), w, n_bins) / norm / s_bin
+            ).real
+        )
         for r in range(600)
     ]
     simulated = float(np.var(u)) / whittle[0, 0]
