@@ -12,6 +12,7 @@ intervals; writes nothing.
 Usage::
 
     python benches/channel_turnover_null.py --records 600     # ~10 min CPU
+    python benches/channel_turnover_null.py --records 600 --kind swing   # its 200 warm-ups only
 """
 
 from __future__ import annotations
@@ -54,10 +55,13 @@ def _cp(k: int, n: int) -> tuple[float, float]:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--records", type=int, default=600)
+    ap.add_argument("--kind", choices=KINDS, default=None, help="only the records of this temperature kind")
     args = ap.parse_args(argv)
     counts = {k: [0, 0, 0] for k in KINDS}
     t0 = time.process_time()
     for seed in range(args.records):
+        if args.kind is not None and KINDS[seed % 3] != args.kind:
+            continue
         kind, y, temp, fs = _record(seed)
         by = regress_channel(y, temp, fs, name="temp").test.get("accepted_by")
         c = counts[kind]

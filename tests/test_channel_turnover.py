@@ -6,6 +6,7 @@ at scale: the null counts in docs/channels.md; the suite's case: benches/refine_
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import allanite
 from allanite.model.channels import regress_channel
@@ -28,7 +29,9 @@ def test_a_turnover_is_taken_by_the_quadratic_where_the_channel_alone_reads_noth
     assert r.test["statistic"] < r.test["threshold"]
     assert r.accepted and r.test["accepted_by"] == "quadratic"
     q = r.test["quadratic"]
-    assert q["statistic"] > q["threshold"] and q["alpha"] == 0.02 * 0.05  # the quadratic's share of the level
+    # its α: the quadratic's part of the coupling's own (FIRST_QUADRATIC), the pair the rest
+    assert q["statistic"] > q["threshold"] and q["alpha"] == pytest.approx(0.2 * 0.075 * 0.05)
+    assert r.test["alpha"] == pytest.approx(0.8 * 0.075 * 0.05)
     assert r.terms["quadratic"]["kept"] and "rate_coefficient" not in r.params and "lag_s" not in r.params
     assert abs(r.params["quadratic"] / Q - 1.0) < 0.1
     lo, hi = r.intervals["quadratic"]

@@ -14,6 +14,7 @@ from scipy.stats import chi2
 from scipy.stats import f as f_dist
 
 from . import _whittle as wh
+from ._edge import edge_factor
 from ._lag import lag_profile, lag_response, lag_test
 from ._regressors import regressor_design
 from ._shares import TERM_SHARE
@@ -57,13 +58,32 @@ def _new_direction(bands, design, s) -> np.ndarray:
     return v
 
 
-def _nested(bands, design, fit_small, alpha) -> tuple[dict, dict]:
+def _nested(bands, design, fit_small, alpha, edge: bool = True) -> tuple[dict, dict]:
     """Likelihood-ratio test of the last regressor of ``design`` (both models refitted, noise included; the larger
-    one never below the smaller: :func:`allanite.model._whittle.nested_fit`)."""
+    one never below the smaller: :func:`allanite.model._whittle.nested_fit`), its reference widened by the
+    record's edge factor along the new direction (:func:`allanite.model._edge.edge_factor`, at the smaller
+    model's noise; ``edge`` False: not here — the caller widens it)."""
     big = wh.nested_fit(bands, design, fit_small)
     v = _new_direction(bands, design, big["s"])
     dof = wh.noise_dof(bands, big, wh.band_info(bands, design, v))
-    return _f_test(2.0 * (big["loglik"] - fit_small["loglik"]), dof, alpha), big
+    test = _f_test(2.0 * (big["loglik"] - fit_small["loglik"]), dof, alpha)
+    if edge and bands.source is not None:
+        widen = _edge_if_passing(test["statistic"], test["threshold"], bands, fit_small, design, v)
+        k = widen["factor"]
+        test |= {"threshold": test["threshold"] * k, "edge": widen}
+        test["p_value"] = float(f_dist.sf(max(test["statistic"], 0.0) / k, 1, dof))
+    return test, big
+
+
+def _edge_if_passing(stat: float, threshold: float, bands, fit, design, directions) -> dict:
+    """The record's edge factor (:func:`allanite.model._edge.edge_factor`) where the statistic passes the reference
+    without it; else ``{"factor": 1.0, "computed": False}`` — a factor ≥ 1 can only turn an acceptance into a
+    rejection, so below the threshold it changes nothing and its transforms (≈ 2 FFTs of the record per
+    direction) are not spent: on a clean record the tests almost never pass."""
+    if stat <= threshold:
+        return {"factor": 1.0, "ratios": [], "computed": False}
+    e = edge_factor(bands, fit, design, directions)
+    return {"factor": e["factor"], "ratios": e["ratios"], "computed": True}
 
 
 def _pair_statistic(bands, null) -> tuple[float, dict]:
@@ -129,23 +149,34 @@ def coupling_test(bands, null, alpha) -> tuple[dict, dict, dict]:
 
     Returns (the test, the in-phase 1-dof test — what this test was before, kept for the record and for the
     coefficient's interval —, the in-phase fit, from which the optional terms are tested)."""
-    in_phase, fit = _nested(bands, regressor_design([], bands.m.size), null, alpha)
+    in_phase, fit = _nested(bands, regressor_design([], bands.m.size), null, alpha, edge=False)
     stat, big = _pair_statistic(bands, null)
     dof = in_phase["dof"]
     threshold = float(2.0 * f_dist.isf(alpha, 2, dof))
-    p_value = float(f_dist.sf(max(stat, 0.0) / 2.0, 2, dof))
     calibration: dict = {"reference": "2·F(2, ν), ν Satterthwaite"}
-    if threshold > BOOT_COST * chi2.isf(alpha, 2):
+    bootstrap = threshold > BOOT_COST * chi2.isf(alpha, 2)
+    scale = scale_1 = 1.0
+    if bootstrap:
         scale, scale_1 = bootstrap_scale(bands, null)
-        threshold, p_value = scale * float(chi2.isf(alpha, 2)), float(chi2.sf(max(stat, 0.0) / scale, 2))
+        threshold = scale * float(chi2.isf(alpha, 2))
         calibration = {"reference": f"χ²₂ × Bartlett's factor, parametric bootstrap ({BOOT_DRAWS} draws)"}
         calibration["bartlett"] = scale
         # the in-phase test alone (unexplained's channel check runs it beside the pair) the same way, χ²₁
-        in_phase = in_phase | {
-            "threshold": scale_1 * float(chi2.isf(alpha, 1)),
-            "p_value": float(chi2.sf(max(in_phase["statistic"], 0.0) / scale_1, 1)),
-            "bartlett": scale_1,
-        }
+        in_phase = in_phase | {"threshold": scale_1 * float(chi2.isf(alpha, 1)), "bartlett": scale_1}
+    edges = _pair_edges(bands, null, (stat, threshold), (in_phase["statistic"], in_phase["threshold"]))
+    f2 = f1 = 1.0
+    if edges is not None:
+        calibration["edge"], in_phase = edges[0], in_phase | {"edge": edges[1]}
+        f2, f1 = edges[0]["factor"], edges[1]["factor"]
+        threshold *= f2
+        in_phase["threshold"] *= f1
+    in_stat = max(in_phase["statistic"], 0.0)
+    if bootstrap:
+        p_value = float(chi2.sf(max(stat, 0.0) / scale / f2, 2))
+        in_phase["p_value"] = float(chi2.sf(in_stat / scale_1 / f1, 1))
+    else:
+        p_value = float(f_dist.sf(max(stat, 0.0) / f2 / 2.0, 2, dof))
+        in_phase["p_value"] = float(f_dist.sf(in_stat / f1, 1, dof))
     test = {
         "statistic": float(stat),
         "threshold": threshold,
@@ -153,18 +184,40 @@ def coupling_test(bands, null, alpha) -> tuple[dict, dict, dict]:
         "dof": float(dof),
         "p_value": p_value,
         "phase_deg": float(np.degrees(np.arctan2(big["c"][1], big["c"][0]))),
-        "in_phase": {k: in_phase[k] for k in ("statistic", "threshold", "dof", "p_value", "bartlett") if k in in_phase},
+        "in_phase": {
+            key: in_phase[key]
+            for key in ("statistic", "threshold", "dof", "p_value", "bartlett", "edge")
+            if key in in_phase
+        },
     } | calibration
     return test, in_phase, fit
 
 
-def quadratic_test(bands, fit, level) -> tuple[dict, dict]:
+def _pair_edges(bands, null, pair: tuple, one: tuple) -> tuple[dict, dict] | None:
+    """The edge factors of the pair's test and of the in-phase one, each (statistic, threshold) before it, from one
+    computation at the null fit (the in-phase direction is the pair's first): each where its statistic passes
+    without it (:func:`_edge_if_passing`), else 1. None where ``bands`` carries no source."""
+    if bands.source is None:
+        return None
+    skip = {"factor": 1.0, "ratios": [], "computed": False}
+    if pair[0] <= pair[1] and one[0] <= one[1]:
+        return skip, skip
+    ones = np.ones(bands.m.size)
+    e = edge_factor(bands, null, wh.Design([0, 0], [ones, -1j * ones]), np.eye(2))
+    e1 = {"factor": max(1.0, float(e["exact"][0, 0] / e["whittle"][0, 0])), "computed": True}
+    e2 = {"factor": e["factor"], "ratios": e["ratios"], "computed": True}
+    return (e2 if pair[0] > pair[1] else skip), (e1 if one[0] > one[1] else skip)
+
+
+def quadratic_test(bands, fit, alpha) -> tuple[dict, dict]:
     """The quadratic's nested test: (ch − mean)² beside the channel against the channel alone (``fit``, the
-    in-phase fit), 2Δℓ against F(1, ν) at its :data:`TERM_SHARE` of ``level``. Returns (the test with ``kept``,
-    the fit with both columns). Run whether or not the coupling's own test accepts (docs/channels.md, "A
-    turnover temperature"): a bias on (T − T₀)² with T₀ inside the swing has almost no linear part."""
+    in-phase fit), 2Δℓ against F(1, ν) at ``alpha`` (its :data:`TERM_SHARE` of the level once the coupling is
+    accepted; where the coupling's test fails, its :data:`FIRST_QUADRATIC` part of the coupling's α). Returns (the
+    test with ``kept``, the fit with both columns). Run whether or not the coupling's own test accepts
+    (docs/channels.md, "A turnover temperature"): a bias on (T − T₀)² with T₀ inside the swing has almost no
+    linear part."""
     nb = bands.m.size
-    t_q, big = _nested(bands, regressor_design(["quadratic"], nb), fit, TERM_SHARE["quadratic"] * level)
+    t_q, big = _nested(bands, regressor_design(["quadratic"], nb), fit, alpha)
     return t_q | {"kept": t_q["statistic"] > t_q["threshold"]}, big
 
 
@@ -175,7 +228,8 @@ def optional_terms(bands, fit, terms, level, grid, z2, quadratic=None):
     keys: list = []
     tests: dict = {}
     if "quadratic" in terms:
-        tests["quadratic"], big = quadratic if quadratic is not None else quadratic_test(bands, fit, level)
+        q_alpha = TERM_SHARE["quadratic"] * level
+        tests["quadratic"], big = quadratic if quadratic is not None else quadratic_test(bands, fit, q_alpha)
         if tests["quadratic"]["kept"]:
             keys, fit = ["quadratic"], big
     design = regressor_design(keys, nb)

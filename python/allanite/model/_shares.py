@@ -7,8 +7,13 @@ reading the budget (as the report's summary does) loads no scipy.
 
 from __future__ import annotations
 
-__all__ = ["TERM_SHARE"]
+__all__ = ["TERM_SHARE", "FIRST_QUADRATIC"]
 
 #: Share of the per-record level spent on each optional term's test of a channel regression (a test run only
 #: once the coupling itself is accepted).
 TERM_SHARE = {"quadratic": 0.02, "rate_coefficient": 0.02, "lag_s": 0.02}
+#: Fraction of the coupling's own α spent on the quadratic's test where the channel's test fails (a turnover
+#: temperature: :func:`allanite.model.channels.regress_channel`); the channel and its quadrature get the rest. The
+#: coupling is accepted by either, so the two together spend the coupling's α — not the coupling's and the
+#: quadratic's :data:`TERM_SHARE` beside it (docs/channels.md, "A turnover temperature").
+FIRST_QUADRATIC = 0.2

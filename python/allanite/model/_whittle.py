@@ -5,9 +5,11 @@ then has a bounded spectrum (a random walk of rate becomes white, flicker's 1/f 
 constant, which only the dropped bin 0 sees), so the periodogram has no leakage from f → 0 —, tapered at the
 ends (a Tukey taper over :data:`TAPER` of the record at each end: the differenced white noise's two end values
 would otherwise leak a flat floor, the same at every bin, into the lowest bins, where the random walk's level
-is read) and transformed (rfft; bin 0 and the Nyquist bin are left out). Bins are pooled into bands about
-1/:data:`BAND_DIV` of their frequency wide (single bins at the bottom); per band the sums of |D|², Z̄·D and
-Z̄·Zᵀ are the sufficient statistics of the Whittle likelihood when the noise PSD is constant across the band:
+is read; what the taper leaves of it is coherent across those bins, and the channel tests widen their references
+for it: :mod:`allanite.model._edge`) and transformed (rfft; bin 0 and the Nyquist bin are left out). Bins are
+pooled into bands about 1/:data:`BAND_DIV` of their frequency wide (single bins at the bottom); per band the sums
+of |D|², Z̄·D and Z̄·Zᵀ are the sufficient statistics of the Whittle likelihood when the noise PSD is constant
+across the band:
 
     ℓ(c, S) = −Σ_b [ m_b·ln S_b + R_b(c)/S_b ],   R_b(c) = Σ_{k∈b} |D_k − Z_k·c|²   (m_b bins in band b).
 
@@ -90,6 +92,7 @@ class Bands:
     names: tuple
     fs: float
     n_diff: int
+    source: object | None = None
 
     @property
     def own(self) -> np.ndarray:

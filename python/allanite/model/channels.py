@@ -13,7 +13,10 @@ channel and its quadrature (its Hilbert transform: every phase of each band) aga
 frequencies, where a random walk's level is known to ±20 %, is tested as such — and where ν is so small that
 2·F(2, ν) costs power (a temperature rising once within the record: ν ≈ 3, threshold ≈ 100), against χ²₂ times
 Bartlett's factor from a parametric bootstrap of the statistic (:func:`allanite.model._coupling.bootstrap_scale`,
-docs/channels.md). The quadrature is there for a
+docs/channels.md). Every reference is widened where Whittle's independent bins understate the statistic's null
+variance — a channel whose change sits at the record's edge, where the differenced noise's end term is coherent
+across the lowest bins — by the exact variance of its score under the fitted noise (:mod:`allanite.model._edge`;
+docs/channels.md, "The record's edges"). The quadrature is there for a
 channel that reaches the rate shifted in phase — through a lag, a lead, a d(ch)/dt term — which a test of the
 channel alone sees only as cos φ of its size (:func:`coupling_test`). O(N log N) (one FFT of the record and
 one per regressor).
@@ -56,6 +59,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from itertools import islice
 
 import numpy as np
 from scipy.stats import t as t_dist
@@ -64,10 +68,11 @@ from .._validate import check_fs, check_probability
 from ..errors import InputError, ParameterError
 from . import _whittle as wh
 from ._coupling import LAG_MARGIN, coupling_test, optional_terms, quadratic_test
+from ._edge import EdgeSource
 from ._lag import exact_lag, lag_grid, lagged, unresolved_lag
 from ._regressors import CHANNEL_SNR, channel_signal, form_signal, regressor_design, regressor_iter, regressors
 from ._rfft import band_limited
-from ._shares import TERM_SHARE
+from ._shares import FIRST_QUADRATIC, TERM_SHARE
 from ._staircase import ChannelForm, channel_form, reconstructed
 
 __all__ = [
@@ -291,7 +296,9 @@ def regress_channel(
     name : str
         The channel's name, for messages.
     alpha : float
-        Level of the coupling's test (default 0.375 %: refine's time-domain share of the 5 % per-record level).
+        Level of the coupling's decision (default 0.375 %: refine's time-domain share of the 5 % per-record
+        level): the channel and its quadrature at 1 − :data:`~allanite.model._shares.FIRST_QUADRATIC` of it, the
+        quadratic where that fails at the rest (all of it to the pair when ``quadratic`` is not among ``terms``).
     level : float
         Per-record level; each optional term is tested at its :data:`TERM_SHARE` of it.
     terms : sequence of {"quadratic", "rate_coefficient", "lag_s"}
@@ -321,8 +328,10 @@ def regress_channel(
     terms = _check_subterms(terms)
     y, form, floor, sig, xs, mean, quad_mean, bands = channel_bands(y, x, fs)
     null = wh.joint_fit(bands, wh.Design([], []))
-    test, in_phase, fit = coupling_test(bands, null, alpha)
-    accepted, quad = _first_test(bands, fit, test, level, terms)
+    # where the quadratic is tried beside it, the coupling's α is shared: the pair gets 1 − FIRST_QUADRATIC of it
+    a_quad = FIRST_QUADRATIC * alpha if "quadratic" in terms else 0.0
+    test, in_phase, fit = coupling_test(bands, null, alpha - a_quad)
+    accepted, quad = _first_test(bands, fit, test, a_quad, terms)
     keys, lag_s, tests, removal_lag = [], None, {}, None
     if accepted:
         z2 = float(t_dist.isf((1.0 - confidence) / 2.0, in_phase["dof"])) ** 2
@@ -359,26 +368,29 @@ def channel_bands(y: np.ndarray, x: np.ndarray, fs: float) -> tuple:
     mean = float(xs.mean())
     quad_mean = float(np.mean((xs - mean) ** 2))
     bands = wh.spectra(y, regressor_iter(xs, mean, quad_mean, fs, None), fs)
+    bands.source = EdgeSource(lambda i: next(islice(regressor_iter(xs, mean, quad_mean, fs, None), i, None)))
     return y, form, floor, sig, xs, mean, quad_mean, bands
 
 
-def _first_test(bands, fit, test: dict, level: float, terms) -> tuple[bool, tuple | None]:
+def _first_test(bands, fit, test: dict, a_quad: float, terms) -> tuple[bool, tuple | None]:
     """Whether the coupling is accepted: by its own test (the channel and its quadrature), or — where that
-    fails and ``quadratic`` is among ``terms`` — by the quadratic's nested test at its own share of ``level``
+    fails and ``quadratic`` is among ``terms`` — by the quadratic's nested test at ``a_quad`` (its part of the
+    coupling's α, :data:`allanite.model._shares.FIRST_QUADRATIC`)
     (:func:`allanite.model._coupling.quadratic_test`), written into ``test`` (``"quadratic"``, and
     ``"accepted_by"``: ``"channel"`` or ``"quadratic"``). Returns (accepted, the quadratic's (test, fit) when run
     here, for :func:`optional_terms` not to run it again).
 
     Why: a bias on (T − T₀)² with the turnover T₀ inside the swing has almost no linear part — the channel's test
     read 0.19 against 13.7 on a 4·10⁻⁵ °/s per °C² turnover at 25 °C of a 15–35 °C cycle, and the quadratic was
-    never tried. The share was already the quadratic's in the record's budget (levels.SHARES); before, it was
-    spent only once the coupling had passed, so on a clean record almost never (docs/channels.md)."""
+    never tried. Its α is part of the coupling's own: the coupling is accepted by either test, so the two together
+    spend the coupling's α (r10wnull; before, the quadratic's 0.1 % was spent beside it on every record with a
+    slow channel — docs/channels.md, "A turnover temperature")."""
     if test["statistic"] > test["threshold"]:
         test["accepted_by"] = "channel"
         return True, None
     if "quadratic" not in terms:
         return False, None
-    t_q, big = quadratic_test(bands, fit, level)
+    t_q, big = quadratic_test(bands, fit, a_quad)
     test["quadratic"] = {k: t_q[k] for k in ("statistic", "threshold", "alpha", "dof", "p_value")}
     if not t_q["kept"]:
         return False, None

@@ -86,9 +86,10 @@ TIME_SHARES = {"outliers": OUTLIER_SHARE, "drift": TIME_SHARE, "regression": TIM
 #: d(channel)/dt, lag; :data:`allanite.model.channels.TERM_SHARE`), each at this share of ``level``. On a clean
 #: record they never run unless the regression itself is a false alarm, so they take nothing from the
 #: per-record budget; on a record with a linear coupling each is the rate of naming a term that is not there
-#: (0 of 600 each, benches/results/channel_regression.md). Except the quadratic's: it is also run where the
-#: coupling's test fails (a turnover temperature has no linear part), so a record with a slow channel spends it
-#: beside the regression's own share (docs/channels.md, "A turnover temperature").
+#: (0 of 600 each, benches/results/channel_regression.md). The quadratic is also tried where the coupling's own
+#: test fails (a turnover temperature has no linear part); there it is part of the coupling's decision and spends
+#: part of the regression's :data:`TIME_SHARE` (:data:`allanite.model._shares.FIRST_QUADRATIC` of it, the channel
+#: and its quadrature the rest), not a share beside it (docs/channels.md, "A turnover temperature").
 CONDITIONAL_SHARES = {f"regression:{k}": v for k, v in TERM_SHARE.items()}
 
 

@@ -298,7 +298,9 @@ def _slow_regression(
     fast = r is not None
     if r is None:
         r = channels.regress_channel(ctx.y, ch, ctx.fs, name=name, alpha=a, level=ctx.level)
-    test = tested("likelihood_ratio", r.test["statistic"], r.test["threshold"], a) | {"dof": r.test["dof"]}
+    test = tested("likelihood_ratio", r.test["statistic"], r.test["threshold"], r.test["alpha"]) | {
+        "dof": r.test["dof"]
+    }
     if r.test.get("accepted_by") == "quadratic":  # a turnover: the channel's square, its own share (docs/channels.md)
         q = r.test["quadratic"]
         test = tested("likelihood_ratio", q["statistic"], q["threshold"], q["alpha"])
