@@ -290,6 +290,8 @@ def test_ros_bag_round_trip(tmp_path, rng, ros):
     assert recv.t0 == pytest.approx(1.7e9 + 1e-6, abs=1e-6)
     with pytest.raises(InputError, match=r"no sensor_msgs/Imu topic '/gyro'; Imu topics: /imu/data"):
         read_log(path, topic="/gyro")
+    with pytest.raises(ParameterError, match=r"time_unit='ns' is given for a ROS bag, whose stamps are seconds"):
+        read_log(path, time_unit="ns")  # was silently unused
 
 
 def test_ros_bag_gap(tmp_path, rng):

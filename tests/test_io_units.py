@@ -244,3 +244,23 @@ def test_a_long_log_with_a_utf8_header_is_read_from_its_head(tmp_path):
     log = read_log(p)
     assert log.unit.name == "deg/s" and log.unit_source == "from the column names: [°/s]" and log.fs == 100.0
     assert np.array_equal(log.data, np.loadtxt(lines[1:], delimiter=",")[:, 1:])
+
+
+def test_time_unit_with_fs_and_no_time_column_is_an_error(tmp_path, capsys):
+    # read_log(p, fs=100, time_unit="ms", columns=["gx"]) read no time column and dropped time_unit silently
+    from allanite import cli
+
+    p = _csv(tmp_path / "ms.csv", "t,gx", np.arange(500) * 10, np.zeros(500))
+    with pytest.raises(ParameterError, match=r"time_unit='ms' .* fs=100 without time_column= reads no time column"):
+        read_log(p, fs=100, time_unit="ms", columns=["gx"])
+    assert issubclass(ParameterError, ValueError)
+    # with the time column named, the unit is used: its stamps (10 ms apart) agree with fs, no gap
+    log = read_log(p, fs=100, time_column="t", time_unit="ms", columns=["gx"])
+    assert log.fs == 100.0 and log.time_unit == "ms" and log.time_unit_source == "time_unit="
+    assert read_log(p, fs=100, columns=["gx"]).time_unit is None  # neither given: no time column read, no error
+    out = tmp_path / "o"
+    args = ["report", str(p), "--fs", "100", "--time-unit", "ms", "--columns", "gx", "--no-fit", "--out", str(out)]
+    assert cli.main(args) == 2
+    err = capsys.readouterr().err
+    assert "--time-unit ms is the unit of a time column, but --fs 100 without --time-column reads no time" in err
+    assert not out.exists()

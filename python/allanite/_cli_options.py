@@ -115,7 +115,8 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
     inp.add_argument(
         "--time-unit",
         choices=("s", "ms", "us", "ns"),
-        help="unit of the time column (default: the unit its name ends in — time_ns, t [ms] — else s)",
+        help="unit of the time column (default: the unit its name ends in — time_ns, t [ms] — else s); with --fs "
+        "only beside --time-column (else an error: no time column is read)",
     )
     inp.add_argument(
         "--unit",

@@ -220,6 +220,8 @@ def cli_words(message: str) -> str:
     )
     message = message.replace("(fs=… in Hz)", "(--fs HZ)").replace("(time_column=…)", "(--time-column C)")
     message = re.sub(r"\btime_column='([^']*)'", r"--time-column \1", message).replace("columns=[…]", "--columns")
+    message = re.sub(r"\bfs=([0-9][0-9.e+-]*)", r"--fs \1", message)
+    message = re.sub(r"\btime_column=(?=[\s,:;]|$)", "--time-column", message)
     return " ".join(message.split())
 
 

@@ -101,12 +101,13 @@ def read_log(
         Text field separator; default: guessed from the first data line (``,``, tab, ``;`` or
         whitespace). Numbers take a decimal point: a decimal comma (``0,0125``) is an InputError that says so.
     time_unit : {"s", "ms", "us", "ns"}, optional
-        Unit of a text/array time column. Default: the unit its name ends in (``time_ns``, ``timestamp_us``,
-        ``t [ms]``, ``Time (nsec)``; ``rostopic echo -p``'s ``%time``: ns), else the unit in which its first stamp
-        is an epoch date (≈ 1.7·10⁹ s, 10¹² ms, 10¹⁵ µs, 10¹⁸ ns), else seconds — where seconds are implausible, an
-        InputError (a span over 10 years) or a warning (under 1 Hz over 10⁴ rows) says so, with what the steps
-        read as in ms, µs and ns (:mod:`allanite.io._timeunit`). ``Log.time_unit`` says which unit was used,
-        ``Log.time_unit_source`` why.
+        Unit of a text/array time column (a ParameterError where no time column is read — ``fs`` given without
+        ``time_column``, or a ROS bag, whose stamps are seconds — rather than a unit silently unused). Default: the
+        unit its name ends in (``time_ns``, ``timestamp_us``, ``t [ms]``, ``Time (nsec)``; ``rostopic echo -p``'s
+        ``%time``: ns), else the unit in which its first stamp is an epoch date (≈ 1.7·10⁹ s, 10¹² ms, 10¹⁵ µs,
+        10¹⁸ ns), else seconds — where seconds are implausible, an InputError (a span over 10 years) or a warning
+        (under 1 Hz over 10⁴ rows) says so, with what the steps read as in ms, µs and ns
+        (:mod:`allanite.io._timeunit`). ``Log.time_unit`` says which unit was used, ``Log.time_unit_source`` why.
     array : str, optional
         For ``.npz``: which array holds the samples (default: the only one).
     topic : str, optional
@@ -139,7 +140,8 @@ def read_log(
         The file cannot be read as asked: missing, empty, ragged rows, text in a numeric column,
         NaN/inf, missing column, time that does not increase, gaps with ``gaps="error"``.
     ParameterError
-        Bad arguments: neither ``fs`` nor ``time_column``, an unknown or mismatched unit, …
+        Bad arguments: neither ``fs`` nor ``time_column``, an unknown or mismatched unit, a ``time_unit`` no time
+        column is read in, …
     MissingDependencyError
         pyarrow (Parquet) or rosbags (ROS bags) is not installed.
 
@@ -165,6 +167,7 @@ def read_log(
     fs = None if fs is None else check_fs(fs)
     u = _check_arguments(path, columns, time_column, unit, input, gaps, time_unit, channels)
     fmt = sniff_format(path)
+    _check_time_unit_used(time_unit, fs, time_column, fmt)
     if fmt in ("ros1", "ros2"):
         rec = read_bag(path, fmt, columns, time_column, topic, channels)
     else:
@@ -203,6 +206,23 @@ def _check_arguments(path, columns, time_column, unit, input, gaps, time_unit, c
     if not path.exists():
         raise InputError(f"{path}: no such file")
     return u
+
+
+def _check_time_unit_used(time_unit, fs, time_column, fmt) -> None:
+    """A ParameterError where ``time_unit`` would be silently unused: with ``fs`` and no ``time_column`` no time
+    column is read, and a ROS bag's stamps are seconds (``header.stamp`` or the receive time)."""
+    if time_unit is None:
+        return
+    if fmt in ("ros1", "ros2"):
+        raise ParameterError(
+            f"time_unit={time_unit!r} is given for a ROS bag, whose stamps are seconds (header.stamp, or the "
+            "receive time): time_unit applies to a text or array log's time column; drop time_unit="
+        )
+    if fs is not None and time_column is None:
+        raise ParameterError(
+            f"time_unit={time_unit!r} is the unit of a time column, but fs={fs:g} without time_column= reads no time "
+            "column: give time_column= as well (its stamps then find gaps, in that unit) or drop time_unit="
+        )
 
 
 def _read_file(path, fmt, columns, time_column, delimiter, array, channels):
