@@ -1,7 +1,8 @@
 """The report page reads as written (issue 32 item 3): no template blanks, times along the record in
 seconds to the sample (h:mm:ss on long records), the same words on the console and the page, every
 figure written shown (the refinement's too), no empty header row, "1 axis", tables that scroll, and
-the coefficients over time summarised over the windows that resolve them.
+the coefficients over time summarised over the windows (median of all, an unresolved window at 0; min, max and
+count of the windows that resolve them).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import pytest  # noqa: E402
 import allanite  # noqa: E402
 from allanite.model.effects import EFFECTS, format_param  # noqa: E402
 from allanite.report import build_report  # noqa: E402
-from allanite.report.fmt import clock, num, step_params  # noqa: E402
+from allanite.report.fmt import clock, g, num, step_params  # noqa: E402
 from allanite.report.settings import NOTHING_ADDED  # noqa: E402
 
 FS = 100.0
@@ -201,12 +202,15 @@ def test_coefficients_over_time_summarise_the_resolved_windows(refined):
         ok = v > 0
         assert (st["windows_nonzero"], st["windows"]) == (int(ok.sum()), v.size)
         if not ok.any():
-            assert st["min"] is None and st["median"] is None
+            assert st["min"] is None and st["median_resolved"] is None and st["median"] == 0.0
             continue
         scale = np.asarray(s.ieee[t])[ok] / v[ok]
         assert st["min"] == pytest.approx(float(np.min(v[ok] * scale)), rel=1e-12)
         assert st["max"] == pytest.approx(float(np.max(v[ok] * scale)), rel=1e-12)
-        assert st["median"] == pytest.approx(float(np.median(v[ok] * scale)), rel=1e-12)
+        assert st["median_resolved"] == pytest.approx(float(np.median(v[ok] * scale)), rel=1e-12)
+        # the median is over every window, an unresolved one counted as 0 (not the resolving windows' swings)
+        everywhere = np.where(ok, np.asarray(s.ieee[t]), 0.0)
+        assert st["median"] == pytest.approx(float(np.median(everywhere)), rel=1e-12)
         assert st["min"] > 0 and s.t[v == np.min(v[ok])][0] == st["t_of_min_s"]
         checked += not ok.all()
     assert checked >= 1  # a term resolved in some windows only (Q and B in this record)
@@ -218,7 +222,9 @@ def test_coefficients_over_time_summarise_the_resolved_windows(refined):
     }
     for t in s.terms:
         st = ser[t]["stats"]
-        assert rows[t][-1] == f"{st['windows_nonzero']}/{st['windows']}"
+        their = f" (their median {g(st['median_resolved'])})" if 0 < st["windows_nonzero"] < st["windows"] else ""
+        assert rows[t][-1] == f"{st['windows_nonzero']}/{st['windows']}{their}"
+        assert rows[t][3] == g(st["median"])
         assert not rows[t][4].startswith("0 at")
 
 

@@ -1,6 +1,7 @@
 """The noise-model fit of a report as JSON (``summary.json``'s ``fit``): the record's fit per axis with its
 coefficients (base form and IEEE-952 units), χ² and read-offs, and the coefficient series over the DAVAR
-windows with the statistics of the windows that resolve each term."""
+windows with their statistics: each term's median over all windows (an unresolved window counted as 0) and the
+median, minimum and maximum of the windows that resolve it."""
 
 from __future__ import annotations
 
@@ -173,16 +174,22 @@ def _series_dict(s, unit, inline: bool = True) -> dict:
 
 
 def _resolved_stats(show: np.ndarray, value: np.ndarray, t: np.ndarray, unit) -> dict:
-    """Median, minimum and maximum of a coefficient over the windows that resolve it (value > 0): a
-    window whose fit leaves the term at 0 says "at most its upper bound", not 0. None when none does."""
-    resolved = np.flatnonzero(np.asarray(value) > 0)
+    """A coefficient over the windows. ``median``: over every window, one whose fit leaves the term at 0 (does not
+    resolve it) counted as 0, its fit's value — so a term resolved in fewer than half the windows has median 0, not
+    the median of its upward swings (the windows that resolve a term absent from the record are those whose noise
+    happened to swing up). ``median_resolved``, ``min`` and ``max`` (and where): over the windows that resolve it
+    (value > 0), None when none does; ``windows_nonzero`` of ``windows`` resolve it."""
+    value = np.asarray(value)
+    resolved = np.flatnonzero(value > 0)
     out = {"unit": unit, "windows_nonzero": int(resolved.size), "windows": int(np.size(value))}
+    everywhere = np.where(value > 0, show, 0.0)
+    out["median"] = json_number(np.median(everywhere)) if everywhere.size else None
     if resolved.size == 0:
-        return out | {"median": None, "min": None, "t_of_min_s": None, "max": None, "t_of_max_s": None}
+        return out | {"median_resolved": None, "min": None, "t_of_min_s": None, "max": None, "t_of_max_s": None}
     shown = show[resolved]
     j_min, j_max = resolved[int(np.argmin(shown))], resolved[int(np.argmax(shown))]
     return out | {
-        "median": json_number(np.median(shown)),
+        "median_resolved": json_number(np.median(shown)),
         "min": json_number(show[j_min]),
         "t_of_min_s": json_number(t[j_min]),
         "max": json_number(show[j_max]),

@@ -251,7 +251,7 @@ def _series(fit: dict, rec: dict) -> dict:
                     g(sc["median"]),
                     at(sc["min"], sc["t_of_min_s"]),
                     at(sc["max"], sc["t_of_max_s"]),
-                    f"{sc['windows_nonzero']}/{sc['windows']}",
+                    _resolved_count(sc),
                 ]
             )
     return {
@@ -260,8 +260,17 @@ def _series(fit: dict, rec: dict) -> dict:
         "units_note": ", in the accelerometer's units"
         if fit.get("sensor") == "accelerometer"
         else (", in IEEE-952 units" if fit["unit"] else " (base form)"),
-        "table": _table(["axis", "term", "unit", "median", "min", "max", "windows resolved (> 0)"], rows, left=3),
+        "table": _table(
+            ["axis", "term", "unit", "median (unresolved = 0)", "min", "max", "windows resolved (> 0)"], rows, left=3
+        ),
     }
+
+
+def _resolved_count(sc: dict) -> str:
+    """ "31/276 (their median 271)": how many windows resolve a term and, where some do not, those windows' median —
+    beside the median of all windows, not as the typical value."""
+    n, total = sc["windows_nonzero"], sc["windows"]
+    return f"{n}/{total}" + (f" (their median {g(sc['median_resolved'])})" if 0 < n < total else "")
 
 
 def _heldout(st: dict) -> str:

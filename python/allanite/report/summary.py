@@ -480,8 +480,8 @@ def _dynamic_text(s: dict) -> list[str]:
     ser = fit.get("series")
     if ser and ser["axes"] is not None:
         lines.append(
-            f"  noise coefficients {_series_units(fit)} over the windows "
-            "that resolve them (> 0): median [min, max] (windows resolving / all)"
+            f"  noise coefficients {_series_units(fit)} over the windows: median of all windows (one that does not "
+            "resolve the term counts as 0) [min, max of those resolving it (> 0)] (windows resolving / all: theirs)"
         )
         for ax in ser["axes"]:
             parts = []
@@ -491,7 +491,8 @@ def _dynamic_text(s: dict) -> list[str]:
                 st_ = c["stats"]
                 parts.append(
                     f"{t} {g(st_['median'], 3)} [{g(st_['min'], 3)}, {g(st_['max'], 3)}]"
-                    f"{' ' + st_['unit'] if st_['unit'] else ''} ({st_['windows_nonzero']}/{st_['windows']})"
+                    f"{' ' + st_['unit'] if st_['unit'] else ''} ({st_['windows_nonzero']}/{st_['windows']}"
+                    + (f": {g(st_['median_resolved'], 3)})" if st_["windows_nonzero"] < st_["windows"] else ")")
                 )
             lines.append(f"    {ax['name']}: " + ("; ".join(parts) or "all zero"))
     elif ser and ser["error"]:
