@@ -403,6 +403,36 @@ def test_batch_reports_each_file_and_survives_a_malformed_one(client, tmp_path):
     assert sorted(f["status"] for f in again.files) == ["error", "skipped", "skipped", "skipped"]
 
 
+def test_batch_reports_an_accelerometer_log_in_its_units(client, tmp_path):
+    # `allanite batch --unit g` on ax, ay, az was "unknown unit 'g'" for every file (read_log takes a gyro's unit):
+    # now read as allanite report reads it, the report an accelerometer's (m/s/√h, µg, m/s/h^1.5)
+    import csv
+
+    from allanite.report import from_log
+
+    n, fs = 6_000, 100.0
+    acc = np.column_stack([allanite.simulate(n, fs, N=1e-3, seed=1) + 1.0, np.arange(n) / fs])  # az, t (s)
+    (tmp_path / "logs").mkdir()
+    np.savetxt(tmp_path / "logs" / "acc.csv", acc, delimiter=",", header="az,t", comments="")
+    np.savetxt(tmp_path / "logs" / "gyro.csv", acc, delimiter=",", header="gz (deg/s),t", comments="")
+    res = adask.batch(str(tmp_path / "logs" / "*.csv"), out=tmp_path / "res", time_column="t", unit="g", client=client)
+    status = {Path(f["path"]).name: f for f in res.files}
+    assert status["acc.csv"]["status"] == "ok"
+    # a log whose names give a gyro's unit is an error row naming both, not a gyro read in g
+    assert status["gyro.csv"]["status"] == "error"
+    assert (
+        "--unit g is an accelerometer's, and the names of columns gz (deg/s) give a gyro's (deg/s)"
+        in status["gyro.csv"]["error"]
+    )
+    rows = [r for r in csv.DictReader((tmp_path / "res" / "fleet.csv").open(encoding="utf-8")) if r["status"] == "ok"]
+    assert [r["axis"] for r in rows] == ["az"]  # one axis: a report's figures are most of its cost
+    assert {(r["N_unit"], r["B_unit"], r["K_unit"]) for r in rows} == {("m/s/√h", "µg", "m/s/h^1.5")}
+    one = from_log(allanite.read_log(tmp_path / "logs" / "acc.csv", time_column="t"), unit="g")  # report --unit g
+    for r, ax in zip(rows, one.summary()["fit"]["axes"]):
+        assert float(r["N"]) == pytest.approx(ax["coefficients"]["N"]["ieee"], rel=1e-12)
+        assert float(r["N"]) == pytest.approx(1e-3 * 9.80665 * 60.0, rel=0.1)  # 1 mg·√s = 0.588 m/s/√h
+
+
 def test_robust_z_flags_the_outlier():
     from allanite.dask.fleet import robust_z
 

@@ -8,11 +8,28 @@ import re
 from dataclasses import replace
 
 from ._cli_options import UsageError
+from .units import accel_unit_name
 
 #: Column names that say "gyro" and "accelerometer" (case-insensitive): gyro_x, omega_y, angular_velocity.z,
 #: wx / gx; acc_x, accel_y, specific_force_z, ax.
 _GYRO_NAME = re.compile(r"gyr|omega|angular|ang_?vel|^[wg]_?[xyz]$", re.IGNORECASE)
 _ACCEL_NAME = re.compile(r"acc|specific_?force|^a_?[xyz]$", re.IGNORECASE)
+
+
+def given_accel_unit(unit, log, hint: str = "") -> str | None:
+    """The accelerometer's unit (canonical: ``m/s^2``, ``g``, ``mg``, …) that ``unit`` (--unit) names, for ``log``
+    read without it (``read_log`` takes a gyro's or an angle unit only), else None (a gyro's, or none given); a
+    UsageError where the log's column names give a gyro's unit (``hint``: what else the command offers).
+    ``allanite report`` and ``allanite batch`` both read an accelerometer's log so, its report in that unit
+    (``from_log(unit=…)``)."""
+    name = accel_unit_name(unit)
+    if name is not None and log.unit is not None:
+        raise UsageError(
+            f"--unit {unit} is an accelerometer's, and the names of columns "
+            f"{', '.join(map(str, log.columns))} give a gyro's ({log.unit.name}): give the accelerometer's "
+            f"columns with --columns{hint}"
+        )
+    return name
 
 
 def is_accel_name(name: str) -> bool:

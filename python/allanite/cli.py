@@ -18,7 +18,7 @@ import warnings
 from pathlib import Path
 from typing import Any
 
-from ._cli_columns import ACCEL_FOLDER, is_accel_name, sensor_columns
+from ._cli_columns import ACCEL_FOLDER, given_accel_unit, is_accel_name, sensor_columns
 from ._cli_columns import gyro_columns as gyro_columns  # allanite.cli.gyro_columns, as before the move
 from ._cli_options import (
     DESCRIPTION,
@@ -276,14 +276,9 @@ def _accelerometers_unit(args, log, accel) -> str | None:
     (``m/s^2``, ``g``), or --accel-unit without a gyro's unit (given or from the names) where no accelerometer
     report of its own is split off and every analysed column is named as an accelerometer's (``ax``, ``acc_x``);
     else None (a gyro's, or an unknown unit)."""
-    if accel_unit_name(args.unit) is not None:
-        if log.unit is not None:
-            raise UsageError(
-                f"--unit {args.unit} is an accelerometer's, and the names of columns "
-                f"{', '.join(map(str, log.columns))} give a gyro's ({log.unit.name}): give the accelerometer's "
-                "columns with --columns (or --accel-unit for the columns named as an accelerometer's beside the gyro's)"
-            )
-        return accel_unit_name(args.unit)
+    beside = " (or --accel-unit for the columns named as an accelerometer's beside the gyro's)"
+    if (named := given_accel_unit(args.unit, log, beside)) is not None:
+        return named
     if args.accel_unit is None or args.unit is not None or log.unit is not None or accel is not None:
         return None
     return args.accel_unit if all(is_accel_name(str(c)) for c in log.columns) else None

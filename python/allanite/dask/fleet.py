@@ -6,7 +6,8 @@ Dask task — a LocalCluster by default, any scheduler given by its address — 
 
 * ``out/<path relative to the glob's root, extensions stripped>/`` — the file's report;
 * ``out/fleet.csv`` (and ``fleet.parquet`` when pyarrow is installed) — one row per file and axis: the
-  fitted N, B, K with their intervals (IEEE-952 units; without a unit, the base form, ``N_unit`` "base form"),
+  fitted N, B, K with their intervals (IEEE-952 units; an accelerometer's — ``unit="g"``, or names such as
+  ``ax [g]`` — in m/s/√h, µg, m/s/h^1.5; without a unit, the base form, ``N_unit`` "base form"),
   the effects ``refine`` found and what the refined
   model still misses (``still_missing``), robust z-scores of N, B, K against the fleet's rows in the same unit
   and a flag when one is beyond :data:`Z_FLAG`, or the file's error;
@@ -42,6 +43,7 @@ from .._cli_options import UsageError
 from ..errors import AllaniteError, ParameterError
 from ..io import read_log
 from ..report import from_log
+from ..units import accel_unit_name
 
 __all__ = ["batch", "FleetResult", "main", "Z_FLAG", "TERMS"]
 
@@ -107,6 +109,10 @@ def run_one(path: str, folder: str, read_opts: dict, report_opts: dict) -> dict:
 
                 log, note = gyro_columns(log)
                 notes += [note] if note else []
+            if report_opts.get("unit") is not None:  # an accelerometer's (batch): the log's names give no gyro's
+                from .._cli_columns import given_accel_unit
+
+                given_accel_unit(report_opts["unit"], log)
             rep = from_log(log, notes=notes, **report_opts)
             dst.parent.mkdir(parents=True, exist_ok=True)
             tmp = dst.parent / f".{dst.name}.tmp-{uuid.uuid4().hex[:8]}"
@@ -310,7 +316,9 @@ def batch(
     out : path
         Output folder.
     fs, columns, time_column, unit, input, gaps, channels, time_unit
-        As for :func:`allanite.read_log` (the same for every file): by default a column named as a temperature
+        As for :func:`allanite.read_log` (the same for every file) — ``unit`` also an accelerometer's (``m/s^2``,
+        ``g``, ``mg``, …: the reports an accelerometer's, as ``allanite report --unit g``; a file whose column names
+        give a gyro's unit is then an error row): by default a column named as a temperature
         is no axis, and a channel of the refinement when ``refine`` (:func:`allanite.report.from_log`); channels
         named here imply the refinement (``allanite report --channels``).
     window, hop, taus, estimator, refine, fit
@@ -334,11 +342,14 @@ def batch(
     out = Path(out)
     paths, folders = _report_folders(pattern, out)
     out.mkdir(parents=True, exist_ok=True)
-    read_opts = {"fs": fs, "columns": columns, "time_column": time_column, "unit": unit, "input": input}
-    read_opts["time_unit"] = time_unit
+    # an accelerometer's unit (m/s^2, g, …) is the report's, as allanite report takes it: read_log takes a gyro's
+    accel = accel_unit_name(unit)
+    read_opts = {"fs": fs, "columns": columns, "time_column": time_column, "input": input, "time_unit": time_unit}
+    read_opts["unit"] = None if accel else unit
     read_opts = {k: v for k, v in read_opts.items() if v is not None}
     read_opts.update(gaps=gaps, channels=channels)
     report_opts = {"window": window, "hop": hop, "taus": taus, "estimator": estimator, "refine": refine, "fit": fit}
+    report_opts.update({"unit": accel} if accel else {})
     statuses: dict[str, dict] = {}
     todo = []
     for f, p in folders.items():
@@ -456,7 +467,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--unit",
         metavar="U",
-        help="unit of the samples, as allanite report's (without it the coefficients are in base form)",
+        help="unit of the samples, as allanite report's: a gyro's (deg/s, rad/s, ...) or an accelerometer's (m/s^2, "
+        "g, mg, ...: the reports an accelerometer's, in m/s/√h, µg, m/s/h^1.5); without it the unit the column names "
+        "give (ax [g]), else the coefficients are in base form",
     )
     p.add_argument(
         "--input", choices=("rate", "increment", "angle"), default="rate", help="what a sample is (default rate)"
