@@ -433,6 +433,19 @@ def test_batch_reports_an_accelerometer_log_in_its_units(client, tmp_path):
         assert float(r["N"]) == pytest.approx(1e-3 * 9.80665 * 60.0, rel=0.1)  # 1 mg·√s = 0.588 m/s/√h
 
 
+def test_batch_refuses_a_time_unit_no_time_column_is_read_in(tmp_path, capsys):
+    # --fs with --time-unit and no --time-column: once, before any file (it was silently unused)
+    from allanite.dask.fleet import main
+
+    np.savetxt(tmp_path / "a.csv", np.zeros((50, 1)), header="gx", comments="")
+    with pytest.raises(ParameterError, match=r"time_unit='ms' .* fs=100 without time_column= reads no time column"):
+        adask.batch(str(tmp_path / "*.csv"), out=tmp_path / "res", fs=100.0, time_unit="ms")
+    assert main([str(tmp_path / "*.csv"), "--fs", "100", "--time-unit", "ms", "--out", str(tmp_path / "res")]) == 2
+    err = capsys.readouterr().err
+    assert "--time-unit ms is the unit of a time column, but --fs 100 without --time-column reads no time" in err
+    assert not (tmp_path / "res").exists()
+
+
 def test_robust_z_flags_the_outlier():
     from allanite.dask.fleet import robust_z
 

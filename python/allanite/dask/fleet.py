@@ -42,6 +42,7 @@ import numpy as np
 from .._cli_options import UsageError
 from ..errors import AllaniteError, ParameterError
 from ..io import read_log
+from ..io.reader import check_time_unit_used
 from ..report import from_log
 from ..units import accel_unit_name
 
@@ -339,6 +340,7 @@ def batch(
     """
     import distributed  # noqa: F401  (missing: this fails at once, before any folder is made)
 
+    check_time_unit_used(time_unit, fs, time_column, None)  # once, not an error row per file
     out = Path(out)
     paths, folders = _report_folders(pattern, out)
     out.mkdir(parents=True, exist_ok=True)
@@ -550,7 +552,9 @@ def main(argv=None) -> int:
             quiet=args.quiet,
         )
     except AllaniteError as exc:
-        print(f"allanite: error: {exc}", file=sys.stderr)
+        from ..cli import cli_words  # in the command's words (--time-unit ms, not time_unit='ms')
+
+        print(f"allanite: error: {cli_words(str(exc))}", file=sys.stderr)
         return 2
     if not args.quiet:
         n_ok = sum(f["status"] == "ok" for f in res.files)

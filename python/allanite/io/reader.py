@@ -167,7 +167,7 @@ def read_log(
     fs = None if fs is None else check_fs(fs)
     u = _check_arguments(path, columns, time_column, unit, input, gaps, time_unit, channels)
     fmt = sniff_format(path)
-    _check_time_unit_used(time_unit, fs, time_column, fmt)
+    check_time_unit_used(time_unit, fs, time_column, fmt)
     if fmt in ("ros1", "ros2"):
         rec = read_bag(path, fmt, columns, time_column, topic, channels)
     else:
@@ -208,9 +208,10 @@ def _check_arguments(path, columns, time_column, unit, input, gaps, time_unit, c
     return u
 
 
-def _check_time_unit_used(time_unit, fs, time_column, fmt) -> None:
+def check_time_unit_used(time_unit, fs, time_column, fmt) -> None:
     """A ParameterError where ``time_unit`` would be silently unused: with ``fs`` and no ``time_column`` no time
-    column is read, and a ROS bag's stamps are seconds (``header.stamp`` or the receive time)."""
+    column is read, and a ROS bag's stamps are seconds (``header.stamp`` or the receive time). ``fmt`` None: no file
+    yet (``allanite batch`` checks its options once, before its files)."""
     if time_unit is None:
         return
     if fmt in ("ros1", "ros2"):
