@@ -65,6 +65,7 @@ import numpy as np
 from scipy.stats import t as t_dist
 
 from .. import channels, lines, tracing
+from ._channel_shape import channel_shape_check
 from ._curve_checks import MAX_REGIONS, allan_check, allan_family, fit_check
 from ._line_check import line_check
 from ._mean_step import mean_step_check
@@ -204,6 +205,7 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "level": level_check,
     "line": line_check,
     "channels": _channels,
+    "channel_shape": channel_shape_check,
     "outliers": outliers_check,
     "clipped": clipped_check,
     "held": held_check,
