@@ -27,10 +27,10 @@ import json
 import time
 
 import numpy as np
-from channel_turnover_null import KINDS, _cp, _record
 
 from allanite.model._shape import shape_test
 from allanite.model.refinement.levels import alpha
+from channel_turnover_null import KINDS, _cp, _record
 
 LEVELS = (0.05, 0.01, 0.001)
 
