@@ -157,8 +157,8 @@ def shape_test(y, x, fs: float, alpha: float, kept=(), bins: int = BINS, exact: 
     quad_mean = float(np.mean((xs - mean) ** 2))
     cuts = np.unique(np.quantile(xs, np.arange(1, bins) / bins))
     cuts = cuts[(cuts > xs.min()) & (cuts < xs.max())]
-    out: dict = {"statistic": 0.0, "threshold": math.inf, "alpha": float(alpha), "nu": math.inf, "edge": 1.0, "p_value": 1.0}
-    out |= {"fired": False, "cuts": [float(c) for c in cuts], "named": []}
+    out: dict = {"statistic": 0.0, "threshold": math.inf, "alpha": float(alpha), "nu": math.inf, "edge": 1.0}
+    out |= {"p_value": 1.0, "fired": False, "cuts": [float(c) for c in cuts], "named": [], "threshold_is_bound": False}
     if cuts.size < 2:
         return out
     bands = wh.spectra(y, _columns(xs, mean, quad_mean, fs, cuts), fs)
