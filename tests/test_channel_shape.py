@@ -101,3 +101,15 @@ def test_the_words_name_steps_and_curvature():
     assert w == "the rate depends on 'temp' beyond its kept terms: steps near 20.4 and 29.8 (largest ≈ 0.0015 °/s)"
     w = _where([("curvature", 1e-5), (14.0, -2e-4)], None, "T")
     assert "steps near 14 (largest ≈ 0.0002 rate unit); curvature its kept terms do not model" in w
+
+
+def test_the_null_draws_reach_beyond_a_small_alpha():
+    """At a small α (many channels, a small level) the draws are enough for 20 of them beyond it: the 1 − α
+    quantile is never the largest draw. With two independent candidates the statistic is χ²₂ exactly (both are
+    chosen): its quantile at α = 10⁻⁵ is −2·ln α = 23.0."""
+    from allanite.model._shape import _null_draws
+
+    draws = _null_draws(np.eye(2), float("inf"), 1e-5)
+    assert draws.size == 2_000_000
+    assert np.quantile(draws, 1 - 1e-5) == pytest.approx(-2 * np.log(1e-5), rel=0.1)
+    assert _null_draws(np.eye(2), float("inf"), 0.05).size == 100_000

@@ -45,8 +45,11 @@ __all__ = ["shape_test", "BINS", "DRAWS", "MAX_POINTS"]
 
 #: Bins of the channel's value (quantiles): steps are looked for at its BINS − 1 inner quantiles.
 BINS = 64
-#: Null draws of the greedy statistic (its threshold: the 1 − α quantile).
+#: Null draws of the greedy statistic (its threshold: the 1 − α quantile), at least; more where α is so small
+#: that fewer than :data:`TAIL` draws would lie beyond it (up to :data:`MAX_DRAWS`).
 DRAWS = 100_000
+TAIL = 20
+MAX_DRAWS = 2_000_000
 #: Draws per chunk.
 CHUNK = 10_000
 #: The record and channel are tested as block means of at most this many points (a step's edge in time needs
@@ -90,24 +93,25 @@ def _scores(bands: wh.Bands, design: wh.Design, n_null: int, s: np.ndarray) -> t
     return z, h
 
 
-def _draws(rng: np.random.Generator, h: np.ndarray, nu: float):
-    """:data:`DRAWS` null score vectors, N(0, h) over √(χ²_ν/ν), in chunks of :data:`CHUNK` (memory)."""
+def _draws(rng: np.random.Generator, h: np.ndarray, nu: float, n_draws: int):
+    """``n_draws`` null score vectors, N(0, h) over √(χ²_ν/ν), in chunks of :data:`CHUNK` (memory)."""
     w, v = np.linalg.eigh(h)
     root = v * np.sqrt(np.maximum(w, 0.0))
-    for start in range(0, DRAWS, CHUNK):
-        size = min(CHUNK, DRAWS - start)
+    for start in range(0, n_draws, CHUNK):
+        size = min(CHUNK, n_draws - start)
         z = rng.standard_normal((size, h.shape[0])) @ root.T
         if math.isfinite(nu):
             z /= np.sqrt(rng.chisquare(nu, size) / nu)[:, None]
         yield z
 
 
-def _null_draws(h: np.ndarray, nu: float, seed: int = 0) -> np.ndarray:
+def _null_draws(h: np.ndarray, nu: float, alpha: float, seed: int = 0) -> np.ndarray:
     """The greedy statistic under the null, sorted (its 1 − α quantile the threshold): scores N(0, h) over a
-    χ²_ν/ν noise level (the multivariate t, as an F reference takes the noise level's own error), :data:`DRAWS`
-    seeded draws."""
+    χ²_ν/ν noise level (the multivariate t, as an F reference takes the noise level's own error), seeded:
+    :data:`DRAWS`, or enough for :data:`TAIL` of them beyond ``alpha`` (at most :data:`MAX_DRAWS`)."""
     rng = np.random.default_rng(seed)
-    return np.sort(np.concatenate([_greedy(z, h)[0] for z in _draws(rng, h, nu)]))
+    n_draws = int(min(MAX_DRAWS, max(DRAWS, math.ceil(TAIL / max(alpha, 1e-300)))))
+    return np.sort(np.concatenate([_greedy(z, h)[0] for z in _draws(rng, h, nu, n_draws)]))
 
 
 def _direction(bands: wh.Bands, design: wh.Design, n_null: int, s: np.ndarray, j: int) -> np.ndarray:
@@ -181,7 +185,7 @@ def shape_test(y, x, fs: float, alpha: float, kept=(), bins: int = BINS, exact: 
     nu = min(wh.noise_dof(bands, small, wh.band_info(bands, design, v)) for v in rows)
     # the best pair of many is never below a fixed pair's 2·F(2, ν): below that bound the draws are not spent
     bound = float(2.0 * f_dist.isf(alpha, 2, nu))
-    null = _null_draws(h, nu) if (stat > bound or exact) else None
+    null = _null_draws(h, nu, alpha) if (stat > bound or exact) else None
     threshold = float(np.quantile(null, 1.0 - alpha)) if null is not None else bound
     if stat > threshold:  # the edge factor (≥ 1) can only turn a pass into a fail: computed only then
         out["edge"] = float(edge_factor(bands, small, design, np.array(rows))["factor"])
