@@ -7,8 +7,8 @@ Null records: ``benches/channel_turnover_null.py``'s (white noise with rate rand
 Gauss–Markov term; 1, 20 or 100 Hz; 8000–40 000 samples; a 15–35 °C temperature cycling, warming once or
 wandering, 0.01 °C of sensor noise), the check run on the record as it is (the kept terms: the channel alone).
 Counted per temperature kind at several levels (the p value below α), with 95 % Clopper–Pearson intervals: the
-check's own α (:data:`allanite.model.refinement.levels.CHANNEL_SHAPE` of the ``"channels"`` share at level 5 %) is
-too small to see in a few hundred records, so its calibration is shown at 5 %, 1 % and 0.1 %, where it can be.
+check's own α (``levels.UNEXPLAINED_SHARES["channel_shape"]`` of level 5 %, run with ``exact=True`` so that every
+record's p value is read) is too small to see in a few hundred records, so its calibration is shown at 5 %, 1 % and 0.1 %, where it can be.
 
 ``--power``: the same records with a staircase (+s at 20 °C and 30 °C, less its straight line in T: what a removed
 linear coupling leaves) or a quadratic left in them, s in multiples of the noise's per-sample σ; counted at the
@@ -16,8 +16,8 @@ check's own α.
 
 Usage::
 
-    python benches/channel_shape_null.py --records 300            # ~1 min CPU
-    python benches/channel_shape_null.py --records 90 --power
+    python benches/channel_shape_null.py --records 600            # ~7 min CPU
+    python benches/channel_shape_null.py --records 150 --power --size 0.3   # ~2 min CPU
 """
 
 from __future__ import annotations
