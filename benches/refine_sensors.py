@@ -140,6 +140,8 @@ NOTES = [
     "**Rerun whole at 6909b06** (r9line, r9blind7, r9chan, r9acc, r9pump, r9turn merged; beside CI and two helpers): **17 of 17**, without the candidate **17 of 17**; every row's effects, parameters and words as at 44eba23 but *sparse spikes*' outliers rate (+0.9 → +0.7 %, the outliers test's local scale).",
     "",
     "**Rerun whole at a9820b6** (r10gaps, r10ux, r10blind8, r10pump, r10wnull, r10ci, r10small merged; the table above is this run's, beside two helpers and a false-alarm run — its CPU seconds are not a cost measurement): **17 of 17**, without the candidate **17 of 17**; every verdict, found effect, parameter error and `unexplained` entry as at 6909b06. The only numbers that moved are the channel check's thresholds in the runs without the regression candidate (e.g. 20.12 → 20.36 against a statistic of 146.5), by r10wnull's edge factor.",
+    "",
+    "**The six temperature rows** are then r10stair's reruns with `--case` (the channel shape check in `unexplained` merged; beside two helpers): every verdict, effect and parameter error as above; without the regression candidate each still says the rate follows 'temp', thresholds moved by the channel share's split (the linear check at half its α).",
 ]
 
 

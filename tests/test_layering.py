@@ -172,6 +172,7 @@ MODEL_RANKS = {
     "model._regressors": 0.7,  # a channel regression's signal bands and regressors (on _whittle, _lag)
     "model._staircase": -0.5,  # a channel's form (quantum, hold) read from it, and the channel read back (numpy only)
     "model._coupling": 0.8,  # a channel regression's coupling test and optional terms
+    "model._shape": 0.8,  # a coupling's shape beyond its kept terms: steps at the channel's quantiles (unexplained)
     "model.channels": 1,
     "model.timeframes": 2,
     "model.warmup": 2,
@@ -206,6 +207,7 @@ MODEL_RANKS = {
     "model.refinement._missing_context": 3.5,
     "model.refinement._curve_checks": 6.5,
     "model.refinement._time_checks": 6.5,
+    "model.refinement._channel_shape": 6.5,  # the residual's dependence on a channel's value (on model._shape)
     "model.refinement.missing": 7,
     "model.refinement._rolloff": 5.5,
     "model.refinement._inputs": 4.5,

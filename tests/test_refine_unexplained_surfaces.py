@@ -155,6 +155,7 @@ def test_the_passing_sentence_names_every_check_of_unexplained():
         "steps": "steps of the mean",
         "level": "the noise level along the record",
         "channels": "the channels",
+        "channel_shape": "the channels",
         "outliers": "outliers",
         "clipped": "clipped or repeated samples",
         "held": "clipped or repeated samples",

@@ -43,7 +43,8 @@ OUTLIER_SHARE = 0.05
 
 #: Share of ``level`` spent on saying what the final model still misses (``Refinement.unexplained``), split
 #: between its checks: the Allan curve, lines in the PSD, a drift in time, a step of the mean, steps of the mean
-#: at several times, the noise level along the record, a coupling to a channel left in the samples, impulsive
+#: at several times, the noise level along the record, a coupling to a channel left in the samples, a dependence on
+#: a channel's value that no kept term models, impulsive
 #: noise left in them, clipped and held samples in the record as given
 #: (:data:`allanite.model.refinement.missing.CHECKS`).
 UNEXPLAINED_SHARES = {
@@ -60,7 +61,12 @@ UNEXPLAINED_SHARES = {
     "mean": 0.003125,
     "steps": 0.003125,
     "level": 0.0125,
-    "channels": 0.0125,
+    # "channel_shape" (the residual's dependence on a slow channel's value beyond its kept terms: steps at its
+    # quantiles, :mod:`allanite.model._shape`) takes half of what "channels" (a coupling left, linear) had: the
+    # two look at the same channel, and a record with a channel spends what the linear check alone did
+    # (docs/channels.md, "A coupling no term models"; benches/results/channel_shape_null.md)
+    "channels": 0.00625,
+    "channel_shape": 0.00625,
     "outliers": 0.0125,
     # clipped and held samples (:mod:`._quality`): exact-count tests on the samples as given, far from their
     # thresholds on clean records (0 of 889: the 613 of benches/refine_false_alarms.py, quantised and float32
@@ -71,7 +77,19 @@ UNEXPLAINED_SHARES = {
 }
 #: The checks that need the samples; on curve-only input their shares go to the ``"fit"`` check (the GLS χ²
 #: of the whole curve, two-sided), so that curve-only input spends the same share on ``unexplained``.
-SAMPLE_CHECKS = ("psd", "time", "mean", "steps", "level", "channels", "outliers", "line", "clipped", "held")
+SAMPLE_CHECKS = (
+    "psd",
+    "time",
+    "mean",
+    "steps",
+    "level",
+    "channels",
+    "channel_shape",
+    "outliers",
+    "line",
+    "clipped",
+    "held",
+)
 
 #: Tests with a share of their own, by name (the Allan-curve test, ``"curve"``, takes the rest).
 SHARES = {

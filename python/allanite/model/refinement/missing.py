@@ -48,6 +48,11 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
 - ``"channels"`` — a coupling to a channel of ``channels=`` left in the final samples (the regression's tests:
   the Whittle GLS for a slow channel — the pair of any phase and the in-phase test, each at half the share —,
   within blocks for a fast one).
+- ``"channel_shape"`` (domain ``"channels"``) — the final samples' dependence on a slow channel's *value* beyond
+  the terms kept for it (:mod:`._channel_shape`, :func:`allanite.model._shape.shape_test`: steps of the rate where
+  the channel crosses its quantiles, or its square where not kept, the best two by a greedy search calibrated on
+  draws of their scores): a staircase, a thermostat, a compensation table with steps that a straight line leaves
+  uncorrelated with the channel; ``"channel"``, ``"cuts"`` [(value, step)] where it departs.
 - ``"outliers"`` — impulsive noise left in the final samples (:func:`allanite.model.outliers.outlier_test`).
 - ``"clipped"`` — samples piled at the record's largest or smallest value, or held at one value longer than
   the record's quantisation gives, in the samples as given (:mod:`._quality`); ``"t"`` their first and last
@@ -65,6 +70,7 @@ import numpy as np
 from scipy.stats import t as t_dist
 
 from .. import channels, lines, tracing
+from ._channel_shape import channel_shape_check
 from ._curve_checks import MAX_REGIONS, allan_check, allan_family, fit_check
 from ._line_check import line_check
 from ._mean_step import mean_step_check
@@ -204,6 +210,7 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "level": level_check,
     "line": line_check,
     "channels": _channels,
+    "channel_shape": channel_shape_check,
     "outliers": outliers_check,
     "clipped": clipped_check,
     "held": held_check,
