@@ -10,6 +10,7 @@ import numpy as np
 from .._display import Summary, Table, thin
 from .fmt import count, duration, g
 from .settings import NOTHING_ADDED
+from .summary import coefficient_rows
 
 __all__ = ["report_summary"]
 
@@ -77,16 +78,7 @@ def _files(rep) -> str:
 def _fit_table(fit: dict, rec: dict) -> Table:
     """Term × axis: the coefficient with its interval (IEEE-952 or the accelerometer's units where known), χ²/dof
     and σmin at its τ."""
-    ieee = fit["unit_known"]
-    rows = []
-    for t in fit["terms"]:
-        c0 = fit["axes"][0]["coefficients"][t]
-        cells = []
-        for ax in fit["axes"]:
-            c = ax["coefficients"][t]
-            v, ci = (c["ieee"], c["ieee_ci"]) if ieee else (c["value"], c["ci"])
-            cells.append(f"{g(v, 3)} [{g(ci[0], 3)}, {g(ci[1], 3) if ci[1] is not None else '∞'}]")
-        rows.append([f"{t} {c0['name']}", (c0["ieee_unit"] if ieee else c0["unit"]) or "", *cells])
+    rows = [[label, unit, *cells] for label, unit, cells in coefficient_rows(fit)]
     rows.append(["χ²/dof of the fit", "", *(g(ax["chi2_dof"], 3) for ax in fit["axes"])])
     rows.append(
         [

@@ -403,6 +403,22 @@ def _adev_text(s: dict) -> list[str]:
     return lines
 
 
+def coefficient_rows(fit: dict) -> list:
+    """(term label, unit, one "value [lo, hi]" cell per axis) for each term of :func:`fit_dict`'s ``fit``: IEEE-952
+    (or the accelerometer's) units where the unit is known, the fit's own otherwise; an open upper bound as ∞."""
+    ieee = fit["unit_known"]
+    rows = []
+    for t in fit["terms"]:
+        c0 = fit["axes"][0]["coefficients"][t]
+        cells = []
+        for ax in fit["axes"]:
+            c = ax["coefficients"][t]
+            v, ci = (c["ieee"], c["ieee_ci"]) if ieee else (c["value"], c["ci"])
+            cells.append(f"{g(v, 3)} [{g(ci[0], 3)}, {g(ci[1] if ci[1] is not None else math.inf, 3)}]")
+        rows.append((f"{t} {c0['name']}", (c0["ieee_unit"] if ieee else c0["unit"]) or "", cells))
+    return rows
+
+
 def _fit_text(s: dict) -> list[str]:
     """The noise model: a table of terms × axes with intervals, χ²/dof and the read-offs (or why not fitted)."""
     rec, fit = s["record"], s["fit"]
@@ -416,15 +432,7 @@ def _fit_text(s: dict) -> list[str]:
         f"  {fit['model']}",
         *([] if ieee else [f"  ({CLOCK_TERMS})"]),
     ]
-    rows = []
-    for t in fit["terms"]:
-        c0 = fit["axes"][0]["coefficients"][t]
-        cells = []
-        for ax in fit["axes"]:
-            c = ax["coefficients"][t]
-            v, ci = (c["ieee"], c["ieee_ci"]) if ieee else (c["value"], c["ci"])
-            cells.append(f"{g(v, 3)} [{g(ci[0], 3)}, {g(ci[1] if ci[1] is not None else math.inf, 3)}]")
-        rows.append((f"{t} {c0['name']}", (c0["ieee_unit"] if ieee else c0["unit"]) or "", cells))
+    rows = coefficient_rows(fit)
     # each column as wide as its widest cell and two spaces: "2.37e-05 [2.37e-05, 2.37e-05]" ran into the next
     w2 = max([26] + [len(c) + 2 for _, _, cells in rows for c in cells])
     w1 = max([25] + [len(label) + 1 for label, _, _ in rows])  # "K acceleration random walk" (26)
