@@ -124,18 +124,15 @@ def _readoffs(f, unit, adev_unit, accel_unit=None) -> dict:
         "readoff_tau_max_s": json_number(r.get("readoff_tau_max")),
         "adev_unit": adev_unit,
     }
-    if unit is not None:
-        n_ro = ieee952("N", r["adev_at_1s"], unit) if r["adev_at_1s"] is not None else None
-        b_ro = ieee952("B", r["bias_instability_readoff"], unit)
+    if unit is not None or accel_unit is not None:  # the read-offs in IEEE-952 units, or the accelerometer's
+
+        def report(term, value):
+            return ieee952(term, value, unit) if unit is not None else accel_report_unit(term, value, accel_unit)
+
+        n_ro = report("N", r["adev_at_1s"]) if r["adev_at_1s"] is not None else None
+        b_ro = report("B", r["bias_instability_readoff"])
         out["arw_readoff_ieee"] = None if n_ro is None else json_number(n_ro.value)
-        out["arw_readoff_ieee_unit"] = ieee952("N", 1.0, unit).unit
-        out["bias_instability_readoff_ieee"] = json_number(b_ro.value)
-        out["bias_instability_readoff_ieee_unit"] = b_ro.unit
-    elif accel_unit is not None:
-        n_ro = accel_report_unit("N", r["adev_at_1s"], accel_unit) if r["adev_at_1s"] is not None else None
-        b_ro = accel_report_unit("B", r["bias_instability_readoff"], accel_unit)
-        out["arw_readoff_ieee"] = None if n_ro is None else json_number(n_ro.value)
-        out["arw_readoff_ieee_unit"] = accel_report_unit("N", 1.0, accel_unit).unit
+        out["arw_readoff_ieee_unit"] = report("N", 1.0).unit
         out["bias_instability_readoff_ieee"] = json_number(b_ro.value)
         out["bias_instability_readoff_ieee_unit"] = b_ro.unit
     return out
