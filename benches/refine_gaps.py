@@ -18,6 +18,7 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -28,20 +29,13 @@ import _common
 import allanite
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "tests"))
+from sensors import dropped  # noqa: E402  (the tests' simulation helpers, as refine_blind.py reads them)
+
 FS = 100.0
 SIZE = 2**15
 MIXES = {"white": {"N": 0.01}, "with_K": {"N": 0.01, "K": 2e-3}, "flicker": {"N": 0.01, "B": 3e-3, "K": 5e-4}}
 SINE = (0.02, 2.3)
-
-
-def dropped(y: np.ndarray, seed: int, n_gaps: int = 20, frac: float = 0.01) -> np.ndarray:
-    """``y`` with ``frac`` of its samples NaN in ``n_gaps`` equal gaps at seeded, non-overlapping places."""
-    z = y.copy()
-    width = max(1, int(frac * y.size / n_gaps))
-    slots = np.random.default_rng(seed).choice(y.size // width - 1, n_gaps, replace=False)
-    for s in slots:
-        z[s * width : (s + 1) * width] = np.nan
-    return z
 
 
 def alarm(r) -> list[str]:

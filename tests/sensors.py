@@ -65,6 +65,17 @@ class Case:
 # slow channels and injected components
 
 
+def dropped(y: np.ndarray, seed: int, n_gaps: int = 20, frac: float = 0.01) -> np.ndarray:
+    """``y`` with ``frac`` of its samples NaN in ``n_gaps`` equal gaps at seeded, non-overlapping places (a logger's
+    dropped samples, as ``read_log(..., gaps="nan")`` marks them)."""
+    z = y.copy()
+    width = max(1, int(frac * y.size / n_gaps))
+    slots = np.random.default_rng(seed).choice(y.size // width - 1, n_gaps, replace=False)
+    for s in slots:
+        z[s * width : (s + 1) * width] = np.nan
+    return z
+
+
 def temperature_profile(t: np.ndarray, kind: str, rng: np.random.Generator, lo=5.0, hi=20.0) -> np.ndarray:
     """A slow temperature (°C) over the record: ``"cycle"`` (a thermal chamber's cycles plus a little wander),
     ``"swing"`` (a housing warming up once, then steady) or ``"walk"`` (a room drifting: a random walk through

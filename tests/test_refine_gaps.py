@@ -10,17 +10,9 @@ import pytest
 import allanite
 from allanite.errors import DataGapError, InputError, ParameterError
 from allanite.model.refinement._gapfill import check_gaps, fill_gaps, gap_runs
+from sensors import dropped
 
 FS = 100.0
-
-
-def dropped(y, seed, n_gaps=20, frac=0.01):
-    z = y.copy()
-    width = max(1, int(frac * y.size / n_gaps))
-    slots = np.random.default_rng(seed).choice(y.size // width - 1, n_gaps, replace=False)
-    for s in slots:
-        z[s * width : (s + 1) * width] = np.nan
-    return z
 
 
 def test_gap_runs_and_the_fill_of_a_line_is_the_line():
