@@ -476,10 +476,12 @@ def _unit_notes(log) -> list:
     return []
 
 
-def log_has_nan(log) -> bool:
-    """Whether a log's samples hold NaN rows (``read_log(..., gaps="nan")`` marked its gaps)."""
+def _nan_rows(log) -> int:
+    """How many of a log's rows hold a NaN (``read_log(..., gaps="nan")`` marked its gaps so)."""
     data = np.asarray(log.data)
-    return data.dtype.kind == "f" and bool(np.isnan(data).any())
+    if data.dtype.kind != "f":
+        return 0
+    return int(np.isnan(data).reshape(len(data), -1).any(axis=1).sum())
 
 
 def _time_notes(log) -> list:
@@ -518,8 +520,8 @@ def from_log(log, **kwargs) -> Report:
     temperature by their names are handed to the refinement only when ``refine=`` asks for one that tries the
     regression — a report without ``refine`` stays the same, and says in a note that the column is no axis."""
     notes = list(kwargs.pop("notes", ())) + _time_notes(log)
-    if log.gaps and log_has_nan(log):
-        lost = int(np.isnan(np.asarray(log.data)).reshape(len(log.data), -1).any(axis=1).sum())
+    lost = _nan_rows(log) if log.gaps else 0
+    if lost:
         notes.append(
             f"The log has {len(log.gaps)} gap(s): {lost} missing rows marked NaN (--gaps nan) — the Allan curves skip "
             "the terms that touch one, the fit scales each τ's EDF by the terms kept, the refinement fills them for "
