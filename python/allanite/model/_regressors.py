@@ -11,10 +11,18 @@ import numpy as np
 
 from . import _whittle as wh
 from ._lag import lagged
-from ._rfft import rfft
-from ._staircase import ChannelForm, reading_index, reading_rate
+from ._rfft import band_limited, rfft
+from ._staircase import ChannelForm, channel_form, reading_index, reading_rate, reconstructed
 
-__all__ = ["CHANNEL_SNR", "channel_signal", "form_signal", "regressors", "regressor_iter", "regressor_design"]
+__all__ = [
+    "CHANNEL_SNR",
+    "channel_signal",
+    "form_signal",
+    "read_channel",
+    "regressors",
+    "regressor_iter",
+    "regressor_design",
+]
 
 
 #: A band of the channel takes part only where its power is this many times its measurement noise's.
@@ -61,6 +69,16 @@ def form_signal(xr: np.ndarray, fs: float, form: ChannelForm) -> tuple[float, li
     rate = reading_rate(fs, form)
     floor, sig = channel_signal(xr[reading_index(xr.size, form.hold, form.phase)], rate)
     return floor, sig if sig is not None else [(0.0, 0.5 * rate)]
+
+
+def read_channel(x: np.ndarray, fs: float) -> tuple[ChannelForm, float, list | None, np.ndarray]:
+    """A channel as the regressions read it: its form detected (:func:`allanite.model._staircase.channel_form`)
+    and read back, its floor and signal bands (:func:`form_signal`), and the channel band-limited to them. Returns
+    (form, floor, signal bands, band-limited channel)."""
+    form = channel_form(x)
+    xr = reconstructed(x, form)
+    floor, sig = form_signal(xr, fs, form)
+    return form, floor, sig, band_limited(xr, fs, sig)
 
 
 def regressors(xs: np.ndarray, mean: float, quad_mean: float, fs: float, lag_s: float | None) -> list:

@@ -37,9 +37,7 @@ from scipy.stats import f as f_dist
 
 from . import _whittle as wh
 from ._edge import EdgeSource, edge_factor
-from ._regressors import form_signal, regressor_design, regressor_iter
-from ._rfft import band_limited
-from ._staircase import channel_form, reconstructed
+from ._regressors import read_channel, regressor_design, regressor_iter
 
 __all__ = ["shape_test", "BINS", "DRAWS", "MAX_POINTS"]
 
@@ -136,13 +134,6 @@ def _decimated(y: np.ndarray, xs: np.ndarray, fs: float) -> tuple[np.ndarray, np
     return yb[:m], xb[:m], fs / f
 
 
-def _channel_values(x: np.ndarray, fs: float) -> np.ndarray:
-    """The channel as the regressors read it: its form read back, band-limited to its signal bands."""
-    form = channel_form(x)
-    xr = reconstructed(x, form)
-    return band_limited(xr, fs, form_signal(xr, fs, form)[1])
-
-
 def shape_test(y, x, fs: float, alpha: float, kept=(), bins: int = BINS, exact: bool = False) -> dict:
     """Steps of the rate at ``bins`` − 1 quantiles of the channel ``x``'s value, beside the kept terms (``kept``:
     names among ``"quadratic"``, ``"rate_coefficient"``; the channel itself always), against them alone (module
@@ -155,7 +146,7 @@ def shape_test(y, x, fs: float, alpha: float, kept=(), bins: int = BINS, exact: 
     fired)."""
     n_use = wh.usable_length(y.size)
     y, x = np.asarray(y, dtype=np.float64)[:n_use], np.asarray(x, dtype=np.float64)[:n_use]
-    xs = _channel_values(x, fs)
+    xs = read_channel(x, fs)[3]  # the channel as the regressions read it
     y, xs, fs = _decimated(y, xs, fs)
     mean = float(xs.mean())
     quad_mean = float(np.mean((xs - mean) ** 2))

@@ -70,10 +70,17 @@ from . import _whittle as wh
 from ._coupling import LAG_MARGIN, coupling_test, optional_terms, quadratic_test
 from ._edge import EdgeSource
 from ._lag import exact_lag, lag_grid, lagged, unresolved_lag
-from ._regressors import CHANNEL_SNR, channel_signal, form_signal, regressor_design, regressor_iter, regressors
+from ._regressors import (
+    CHANNEL_SNR,
+    channel_signal,
+    read_channel,
+    regressor_design,
+    regressor_iter,
+    regressors,
+)
 from ._rfft import band_limited
 from ._shares import FIRST_QUADRATIC, TERM_SHARE
-from ._staircase import ChannelForm, channel_form, reconstructed
+from ._staircase import ChannelForm, reconstructed
 
 __all__ = [
     "regress_channel",
@@ -361,10 +368,7 @@ def channel_bands(y: np.ndarray, x: np.ndarray, fs: float) -> tuple:
     quad_mean, bands)."""
     n_use = wh.usable_length(y.size)
     y, x = y[:n_use], x[:n_use]
-    form = channel_form(x)
-    x = reconstructed(x, form)
-    floor, sig = form_signal(x, fs, form)
-    xs = band_limited(x, fs, sig)
+    form, floor, sig, xs = read_channel(x, fs)
     mean = float(xs.mean())
     quad_mean = float(np.mean((xs - mean) ** 2))
     bands = wh.spectra(y, regressor_iter(xs, mean, quad_mean, fs, None), fs)
