@@ -142,6 +142,7 @@ MODEL_RANKS = {
     "model._robust_scale": -1,  # the differences' robust scale, on a lattice and local (numpy, scipy only)
     "model._rfft": -0.5,  # the channel regression's transforms, remembered by content
     "model._sinc": -0.5,  # the sinc^k (CIC) roll-off's autocorrelation and cutoff (numpy only)
+    "model._signatures": -0.25,  # the effects' Allan-variance signatures: filter kinds, sinusoid, resonance, drift
     "model._batched": 0,
     "model._chi2_draws": 0,
     "model._covariance": 0,
