@@ -22,10 +22,7 @@ is complete and newer than the file.
 from __future__ import annotations
 
 import argparse
-import base64
-import csv
 import glob
-import io
 import json
 import math
 import os
@@ -45,14 +42,9 @@ from ..io import read_log
 from ..io.reader import check_time_unit_used
 from ..report import from_log
 from ..units import accel_unit_name
+from ._fleet_pages import TERMS, Z_FLAG, write_html, write_table
 
 __all__ = ["batch", "FleetResult", "main", "Z_FLAG", "TERMS"]
-
-#: |robust z| above which a sensor is flagged as outside the fleet's spread.
-Z_FLAG = 3.5
-
-#: The coefficients summarised per sensor axis.
-TERMS = ("N", "B", "K")
 
 _EXTENSIONS = {".gz", ".bz2", ".xz", ".zst", ".csv", ".tsv", ".txt", ".dat", ".npy", ".npz", ".parquet", ".bag"}
 
@@ -198,91 +190,6 @@ def _flag(rows: list) -> None:
         r["flag"] = ",".join(out) if out else ""
 
 
-COLUMNS = (
-    ["file", "axis", "status", "error"]
-    + [f"{t}{s}" for t in TERMS for s in ("", "_low", "_high", "_unit")]
-    + ["effects", "still_missing"]
-    + [f"z_{t}" for t in TERMS]
-    + ["flag", "out"]
-)
-
-
-def _atomic_write(path: Path, data: bytes) -> None:
-    tmp = path.with_name(f".{path.name}.tmp-{uuid.uuid4().hex[:8]}")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
-
-
-def _write_table(rows: list, out: Path) -> dict:
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=COLUMNS, extrasaction="ignore", lineterminator="\n")
-    w.writeheader()
-    for r in rows:
-        w.writerow({k: ("" if r.get(k) is None else r.get(k)) for k in COLUMNS})
-    paths = {"csv": out / "fleet.csv"}
-    _atomic_write(paths["csv"], buf.getvalue().encode("utf-8"))
-    try:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-    except ImportError:
-        return paths
-    table = pa.table({k: [r.get(k) for r in rows] for k in COLUMNS})
-    sink = io.BytesIO()
-    pq.write_table(table, sink)
-    paths["parquet"] = out / "fleet.parquet"
-    _atomic_write(paths["parquet"], sink.getvalue())
-    return paths
-
-
-def _write_html(rows: list, files: list, out: Path) -> Path:
-    from html import escape
-
-    from matplotlib.figure import Figure
-
-    ok = [r for r in rows if r["status"] != "error"]
-    fig = Figure(figsize=(10, 3.2), dpi=100)
-    for i, t in enumerate(TERMS):
-        ax = fig.add_subplot(1, 3, i + 1)
-        v = np.array([r[t] for r in ok if r.get(t) is not None and r[t] > 0])
-        flagged = np.array([r[t] for r in ok if r.get(t) is not None and r[t] > 0 and t in r["flag"].split(",")])
-        if v.size:
-            bins = list(np.logspace(np.log10(v.min()) - 0.05, np.log10(v.max()) + 0.05, 20))
-            ax.hist(v, bins=bins, color="0.6", label="fleet")
-            if flagged.size:
-                ax.hist(flagged, bins=bins, color="C3", label="flagged")
-            ax.set_xscale("log")
-        unit = next((r[f"{t}_unit"] for r in ok if r.get(f"{t}_unit")), "")
-        ax.set_title(f"{t} ({unit})" if unit else t)
-        ax.set_ylabel("sensor axes" if i == 0 else "")
-    fig.tight_layout()
-    png = io.BytesIO()
-    fig.savefig(png, format="png")
-    img = base64.b64encode(png.getvalue()).decode("ascii")
-    flagged_rows = [r for r in rows if r.get("flag")]
-    failed = [f for f in files if f["status"] == "error"]
-
-    def table(rs, cols):
-        head = "".join(f"<th>{escape(c)}</th>" for c in cols)
-        body = "".join(
-            "<tr>" + "".join(f"<td>{escape('' if r.get(c) is None else str(r.get(c)))}</td>" for c in cols) + "</tr>"
-            for r in rs
-        )
-        return f"<table><tr>{head}</tr>{body}</table>"
-
-    page = (
-        "<!doctype html><meta charset='utf-8'><title>allanite fleet</title>"
-        "<style>body{font-family:sans-serif;margin:2em}td,th{padding:2px 8px;border-bottom:1px solid #ddd}</style>"
-        f"<h1>Fleet: {len(files)} files, {len(ok)} sensor axes</h1>"
-        f"<p>{len(failed)} failed; {len(flagged_rows)} axes flagged (|robust z| of log10 N, B or K > {Z_FLAG}).</p>"
-        f"<img alt='distributions of N, B, K' src='data:image/png;base64,{img}'>"
-        "<h2>Flagged</h2>" + table(flagged_rows, ["file", "axis", "N", "B", "K", "z_N", "z_B", "z_K", "flag"]) + ""
-        "<h2>Failed</h2>" + table(failed, ["path", "error"]) + "<h2>All</h2>" + table(rows, COLUMNS[:-1])
-    )
-    path = out / "fleet.html"
-    _atomic_write(path, page.encode("utf-8"))
-    return path
-
-
 def batch(
     pattern: str,
     *,
@@ -380,8 +287,8 @@ def batch(
         except (OSError, ValueError, KeyError) as exc:  # a resumed report that cannot be read
             rows.extend(_rows(dict(st, status="error", error=f"summary.json unreadable: {exc}")))
     _flag(rows)
-    written = _write_table(rows, out)
-    written["html"] = _write_html(rows, files, out)
+    written = write_table(rows, out)
+    written["html"] = write_html(rows, files, out)
     return FleetResult(rows=rows, files=files, paths=written)
 
 
