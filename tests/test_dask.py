@@ -433,6 +433,43 @@ def test_batch_reports_an_accelerometer_log_in_its_units(client, tmp_path):
         assert float(r["N"]) == pytest.approx(1e-3 * 9.80665 * 60.0, rel=0.1)  # 1 mg·√s = 0.588 m/s/√h
 
 
+def test_batch_reports_a_mixed_logs_accelerometer_in_its_own_units(client, tmp_path):
+    # allanite batch on a gyro + accelerometer log analysed the gyro's columns alone (allanite report writes the
+    # accelerometer's in accelerometer/): now each file's accelerometer columns have their report and fleet rows
+    import csv
+    import json
+
+    from allanite.report import from_log
+
+    n, fs = 4_000, 100.0
+    g = allanite.simulate(n, fs, N=2e-3, seed=1)  # °/s·√s: 0.12 °/√h
+    a = allanite.simulate(n, fs, N=1e-3, seed=2) + 1.0  # g·√s: 0.588 m/s/√h
+    (tmp_path / "logs").mkdir()
+    np.savetxt(tmp_path / "logs" / "imu.csv", np.c_[np.arange(n) / fs, g, a], delimiter=",", comments="",
+               header="t,gyro_z,acc_z")  # fmt: skip
+    res = adask.batch(str(tmp_path / "logs" / "*.csv"), out=tmp_path / "res", time_column="t", unit="deg/s",
+                      accel_unit="g", window=1000, hop=500, client=client)  # fmt: skip
+    assert [f["status"] for f in res.files] == ["ok"]
+    rows = list(csv.DictReader((tmp_path / "res" / "fleet.csv").open(encoding="utf-8")))
+    assert [(r["axis"], r["sensor"], r["N_unit"], r["B_unit"], r["K_unit"]) for r in rows] == [
+        ("gyro_z", "gyro", "°/√h", "°/h", "°/h^1.5"),
+        ("acc_z", "accelerometer", "m/s/√h", "µg", "m/s/h^1.5"),
+    ]
+    assert float(rows[0]["N"]) == pytest.approx(2e-3 * 60.0, rel=0.1)
+    assert float(rows[1]["N"]) == pytest.approx(1e-3 * 9.80665 * 60.0, rel=0.1)
+    # the accelerometer's report is allanite report's (--unit deg/s --accel-unit g): same numbers, linked pages
+    acc_dir = tmp_path / "res" / "imu" / "accelerometer"
+    assert rows[1]["out"] == str(acc_dir) and (acc_dir / "report.html").is_file()
+    log = allanite.read_log(tmp_path / "logs" / "imu.csv", time_column="t", columns=["acc_z"])
+    one = from_log(log, unit="g", window=1000, hop=500).summary()["fit"]["axes"][0]["coefficients"]
+    assert float(rows[1]["N"]) == pytest.approx(one["N"]["ieee"], rel=1e-12)
+    summary = json.loads((tmp_path / "res" / "imu" / "summary.json").read_text(encoding="utf-8"))
+    assert summary["record"]["source"]["accelerometer_report"] == "accelerometer/report.html"
+    assert summary["record"]["axis_names"] == ["gyro_z"]
+    with pytest.raises(ParameterError, match=r"accel_unit='deg/s' is no accelerometer's unit; allowed: m/s\^2"):
+        adask.batch(str(tmp_path / "logs" / "*.csv"), out=tmp_path / "r2", accel_unit="deg/s", client=client)
+
+
 def test_batch_refuses_a_time_unit_no_time_column_is_read_in(tmp_path, capsys):
     # --fs with --time-unit and no --time-column: once, before any file (it was silently unused)
     from allanite.dask.fleet import main
@@ -580,4 +617,4 @@ def test_cli_batch_help(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["batch", "--help"])
     assert exc.value.code == 0
-    assert "--dask-workers" in capsys.readouterr().out
+    assert "--dask-workers" in (out := capsys.readouterr().out) and "--accel-unit" in out

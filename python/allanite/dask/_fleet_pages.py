@@ -21,7 +21,7 @@ TERMS = ("N", "B", "K")
 
 #: The fleet table's columns, in order.
 COLUMNS = (
-    ["file", "axis", "status", "error"]
+    ["file", "axis", "sensor", "status", "error"]
     + [f"{t}{s}" for t in TERMS for s in ("", "_low", "_high", "_unit")]
     + ["effects", "still_missing"]
     + [f"z_{t}" for t in TERMS]
@@ -56,30 +56,40 @@ def write_table(rows: list, out: Path) -> dict:
     return paths
 
 
-def write_html(rows: list, files: list, out: Path) -> Path:
-    from html import escape
-
+def _histograms(ok: list) -> str:
+    """The base64 PNG of N, B, K's distributions over the rows ``ok``: one row of three histograms per unit the
+    rows are in (a gyro's °/√h and an accelerometer's m/s/√h never share an axis), the flagged rows in red."""
     from matplotlib.figure import Figure
 
-    ok = [r for r in rows if r["status"] != "error"]
-    fig = Figure(figsize=(10, 3.2), dpi=100)
-    for i, t in enumerate(TERMS):
-        ax = fig.add_subplot(1, 3, i + 1)
-        v = np.array([r[t] for r in ok if r.get(t) is not None and r[t] > 0])
-        flagged = np.array([r[t] for r in ok if r.get(t) is not None and r[t] > 0 and t in r["flag"].split(",")])
-        if v.size:
-            bins = list(np.logspace(np.log10(v.min()) - 0.05, np.log10(v.max()) + 0.05, 20))
-            ax.hist(v, bins=bins, color="0.6", label="fleet")
-            if flagged.size:
-                ax.hist(flagged, bins=bins, color="C3", label="flagged")
-            ax.set_xscale("log")
-        unit = next((r[f"{t}_unit"] for r in ok if r.get(f"{t}_unit")), "")
-        ax.set_title(f"{t} ({unit})" if unit else t)
-        ax.set_ylabel("sensor axes" if i == 0 else "")
+    units = sorted({r.get("N_unit") or "" for r in ok}) or [""]
+    fig = Figure(figsize=(10, 3.2 * len(units)), dpi=100)
+    for j, unit in enumerate(units):
+        same = [r for r in ok if (r.get("N_unit") or "") == unit]
+        for i, t in enumerate(TERMS):
+            ax = fig.add_subplot(len(units), 3, 3 * j + i + 1)
+            v = np.array([r[t] for r in same if r.get(t) is not None and r[t] > 0])
+            flagged = np.array([r[t] for r in same if r.get(t) is not None and r[t] > 0 and t in r["flag"].split(",")])
+            if v.size:
+                bins = list(np.logspace(np.log10(v.min()) - 0.05, np.log10(v.max()) + 0.05, 20))
+                ax.hist(v, bins=bins, color="0.6", label="fleet")
+                if flagged.size:
+                    ax.hist(flagged, bins=bins, color="C3", label="flagged")
+                ax.set_xscale("log")
+            t_unit = next((r[f"{t}_unit"] for r in same if r.get(f"{t}_unit")), "")
+            ax.set_title(f"{t} ({t_unit})" if t_unit else t)
+            ax.set_ylabel("sensor axes" if i == 0 else "")
     fig.tight_layout()
     png = io.BytesIO()
     fig.savefig(png, format="png")
-    img = base64.b64encode(png.getvalue()).decode("ascii")
+    return base64.b64encode(png.getvalue()).decode("ascii")
+
+
+def write_html(rows: list, files: list, out: Path) -> Path:
+    """``out/fleet.html``: the distributions of N, B, K (a row per unit), the flagged, the failed and all rows."""
+    from html import escape
+
+    ok = [r for r in rows if r["status"] != "error"]
+    img = _histograms(ok)
     flagged_rows = [r for r in rows if r.get("flag")]
     failed = [f for f in files if f["status"] == "error"]
 

@@ -4,14 +4,15 @@
 that matches, builds its report (:func:`allanite.report.from_log`, what ``allanite report`` writes) as a
 Dask task — a LocalCluster by default, any scheduler given by its address — and writes
 
-* ``out/<path relative to the glob's root, extensions stripped>/`` — the file's report;
-* ``out/fleet.csv`` (and ``fleet.parquet`` when pyarrow is installed) — one row per file and axis: the
-  fitted N, B, K with their intervals (IEEE-952 units; an accelerometer's — ``unit="g"``, or names such as
-  ``ax [g]`` — in m/s/√h, µg, m/s/h^1.5; without a unit, the base form, ``N_unit`` "base form"),
-  the effects ``refine`` found and what the refined
-  model still misses (``still_missing``), robust z-scores of N, B, K against the fleet's rows in the same unit
-  and a flag when one is beyond :data:`Z_FLAG`, or the file's error;
-* ``out/fleet.html`` — the fleet's distributions.
+* ``out/<path relative to the glob's root, extensions stripped>/`` — the file's report (and, for an IMU log's
+  accelerometer columns beside the gyro's, their report in its ``accelerometer/``, as ``allanite report`` writes);
+* ``out/fleet.csv`` (and ``fleet.parquet`` when pyarrow is installed) — one row per file and axis (``sensor``
+  gyro or accelerometer): the fitted N, B, K with their intervals (IEEE-952 units; an accelerometer's —
+  ``unit="g"``, or names such as ``ax [g]`` — in m/s/√h, µg, m/s/h^1.5; without a unit, the base form,
+  ``N_unit`` "base form"), the effects ``refine`` found and what the refined model still misses
+  (``still_missing``), robust z-scores of N, B, K against the fleet's rows in the same unit and a flag when one
+  is beyond :data:`Z_FLAG`, or the file's error;
+* ``out/fleet.html`` — the fleet's distributions, one row of histograms per unit (a gyro's, an accelerometer's).
 
 Reliability: a file that fails (malformed, gaps, …) becomes a row with its error and does not stop the
 others; a report is written into a temporary folder and renamed into place, so a worker killed
@@ -41,7 +42,7 @@ from ..errors import AllaniteError, ParameterError
 from ..io import read_log
 from ..io.reader import check_time_unit_used
 from ..report import from_log
-from ..units import accel_unit_name
+from ..units import ACCEL_UNITS, accel_unit_name
 from ._fleet_pages import TERMS, Z_FLAG, write_html, write_table
 
 __all__ = ["batch", "FleetResult", "main", "Z_FLAG", "TERMS"]
@@ -89,55 +90,93 @@ def _complete(folder: Path, source: Path) -> bool:
     return all(p.is_file() for p in need) and min(p.stat().st_mtime for p in need) >= source.stat().st_mtime
 
 
-def run_one(path: str, folder: str, read_opts: dict, report_opts: dict) -> dict:
-    """One file: read it, build its report, write it atomically; never raises for a bad file."""
+def run_one(path: str, folder: str, read_opts: dict, report_opts: dict, accel_unit=None) -> dict:
+    """One file: read it, build its report — and, as ``allanite report`` does, a report of its own for the
+    accelerometer's columns beside a gyro's (:func:`allanite._cli_columns.sensor_columns`: where their names give
+    its unit, or ``accel_unit`` names it and their names tell them from the gyro's), in ``folder/accelerometer/`` —
+    write them atomically; never raises for a bad file."""
     src, dst = Path(path), Path(folder)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            log = read_log(src, **read_opts)
-            notes = []
-            if "columns" not in read_opts:  # as allanite report: the gyro columns beside accelerometer ones
-                from ..cli import gyro_columns
-
-                log, note = gyro_columns(log)
-                notes += [note] if note else []
-            if report_opts.get("unit") is not None:  # an accelerometer's (batch): the log's names give no gyro's
-                from .._cli_columns import given_accel_unit
-
-                given_accel_unit(report_opts["unit"], log)
-            rep = from_log(log, notes=notes, **report_opts)
-            dst.parent.mkdir(parents=True, exist_ok=True)
-            tmp = dst.parent / f".{dst.name}.tmp-{uuid.uuid4().hex[:8]}"
-            try:
-                rep.write(tmp)
-                if dst.exists():
-                    old = dst.parent / f".{dst.name}.old-{uuid.uuid4().hex[:8]}"
-                    os.rename(dst, old)
-                    os.rename(tmp, dst)
-                    shutil.rmtree(old, ignore_errors=True)
-                else:
-                    os.rename(tmp, dst)
-            finally:
-                if tmp.exists():
-                    shutil.rmtree(tmp, ignore_errors=True)
+            reports = _reports(read_log(src, **read_opts), "columns" not in read_opts, report_opts, accel_unit)
+            _write_atomically(reports, dst)
         return {"path": path, "out": folder, "status": "ok", "error": None}
     except (AllaniteError, OSError, ValueError, UsageError) as exc:
         return {"path": path, "out": folder, "status": "error", "error": f"{type(exc).__name__}: {exc}"}
 
 
+def _reports(log, choose: bool, report_opts: dict, accel_unit) -> dict:
+    """The reports of one log by the folder they go in ("" the log's, ``ACCEL_FOLDER`` its accelerometer's): the
+    columns chosen as ``allanite report`` chooses them without --columns (``choose``)."""
+    from .._cli_columns import ACCEL_FOLDER, given_accel_unit, is_accel_name, sensor_columns
+
+    notes, accel = [], None
+    if choose:  # as allanite report: the gyro's columns, and the accelerometer's in a report of their own
+        log, accel, note = sensor_columns(log, accel_unit)
+        notes += [note] if note else []
+    if report_opts.get("unit") is not None:  # an accelerometer's (batch): the log's names give no gyro's
+        given_accel_unit(report_opts["unit"], log)
+    elif (
+        accel is None and accel_unit is not None and log.unit is None and all(map(is_accel_name, map(str, log.columns)))
+    ):
+        report_opts = dict(report_opts, unit=accel_unit)  # an accelerometer's log (ax, ay, az): in --accel-unit
+    rep = from_log(log, notes=notes, **report_opts)
+    if accel is None:
+        return {"": rep}
+    opts = {k: v for k, v in report_opts.items() if k != "unit"}  # its unit: accel_unit, else its names'
+    arep = from_log(accel, notes=[], **(opts if accel_unit is None else dict(opts, unit=accel_unit)))
+    rep.source["accelerometer_report"] = f"{ACCEL_FOLDER}/report.html"  # each page links the other
+    arep.source["gyro_report"] = "../report.html"
+    return {"": rep, ACCEL_FOLDER: arep}
+
+
+def _write_atomically(reports: dict, dst: Path) -> None:
+    """The reports (folder inside ``dst`` → report) written into a temporary folder renamed to ``dst``: a worker
+    killed mid-write leaves no half-written report."""
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    tmp = dst.parent / f".{dst.name}.tmp-{uuid.uuid4().hex[:8]}"
+    try:
+        for sub, rep in reports.items():
+            rep.write(tmp / sub if sub else tmp)
+        if dst.exists():
+            old = dst.parent / f".{dst.name}.old-{uuid.uuid4().hex[:8]}"
+            os.rename(dst, old)
+            os.rename(tmp, dst)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.rename(tmp, dst)
+    finally:
+        if tmp.exists():
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
 def _rows(status: dict) -> list:
-    """Fleet rows of one file, from its summary.json (the same for a fresh and a resumed report)."""
+    """Fleet rows of one file, from its summary.json (the same for a fresh and a resumed report) and, where it
+    names one, its accelerometer's report's (the rows' ``out`` that report's folder, ``sensor`` accelerometer)."""
     base = {"file": status["path"], "out": status["out"], "status": status["status"], "error": status["error"]}
     if status["status"] == "error":
         return [dict(base, axis=None)]
     summary = json.loads((Path(status["out"]) / "summary.json").read_text(encoding="utf-8"))
+    rows = _axis_rows(summary, base)
+    beside = (summary["record"].get("source") or {}).get("accelerometer_report")
+    if beside:
+        folder = Path(status["out"]) / Path(beside).parent
+        accel = json.loads((folder / "summary.json").read_text(encoding="utf-8"))
+        rows += _axis_rows(accel, dict(base, out=str(folder)))
+    return rows
+
+
+def _axis_rows(summary: dict, base: dict) -> list:
+    """One fleet row per axis of a report's summary.json: N, B, K with their intervals and units, the effects
+    refine kept and what it still misses."""
     fit = summary.get("fit") or {}
     ref = summary.get("refinement") or {}
     ref_axes = {a["axis"]: a for a in (ref.get("axes") or [])}
+    sensor = "accelerometer" if summary["record"].get("accel_unit") else "gyro"
     rows = []
     for ax in fit.get("axes") or [{"axis": k, "name": str(k)} for k in range(int(summary["record"]["axes"]))]:
-        row = dict(base, axis=ax.get("name"))
+        row = dict(base, axis=ax.get("name"), sensor=sensor)
         coefs = ax.get("coefficients") or {}
         for t in TERMS:
             c = coefs.get(t) or {}
@@ -198,6 +237,7 @@ def batch(
     columns=None,
     time_column=None,
     unit=None,
+    accel_unit=None,
     input: str = "rate",
     gaps: str = "error",
     channels="auto",
@@ -229,6 +269,13 @@ def batch(
         give a gyro's unit is then an error row): by default a column named as a temperature
         is no axis, and a channel of the refinement when ``refine`` (:func:`allanite.report.from_log`); channels
         named here imply the refinement (``allanite report --channels``).
+    accel_unit : str, optional
+        The accelerometer columns' unit (``m/s^2``, ``g``, ``mg``, …), as ``allanite report --accel-unit``: without
+        ``columns``, a log's accelerometer columns beside a gyro's — where their names give its unit (EuRoC's
+        ``a_RS_S_x [m s^-2]``), or where this names it and their names (``acc_x``) tell them from the gyro's —
+        are reported in their own report, ``<file's folder>/accelerometer/``, and their fleet rows are in the
+        accelerometer's units (``sensor`` accelerometer); a log whose columns are all named as an accelerometer's
+        (``ax``) and give no unit is reported in it.
     window, hop, taus, estimator, refine, fit
         As for ``allanite report``.
     scheduler : str, optional
@@ -259,6 +306,7 @@ def batch(
     read_opts.update(gaps=gaps, channels=channels)
     report_opts = {"window": window, "hop": hop, "taus": taus, "estimator": estimator, "refine": refine, "fit": fit}
     report_opts.update({"unit": accel} if accel else {})
+    accel_unit = None if accel_unit is None else _accel_unit_named(accel_unit)
     statuses: dict[str, dict] = {}
     todo = []
     for f, p in folders.items():
@@ -271,7 +319,8 @@ def batch(
     if client is None:
         client, own = _start_client(scheduler, dask_workers)
     try:
-        statuses.update(_run_reports(client, todo, read_opts, report_opts, retries, quiet))
+        opts = (read_opts, report_opts, accel_unit)
+        statuses.update(_run_reports(client, todo, opts, retries, quiet))
     finally:
         for o in own:
             o.close()
@@ -290,6 +339,14 @@ def batch(
     written = write_table(rows, out)
     written["html"] = write_html(rows, files, out)
     return FleetResult(rows=rows, files=files, paths=written)
+
+
+def _accel_unit_named(unit: str) -> str:
+    """The canonical name of an accelerometer's unit (``m/s^2``, ``g``, …); a ParameterError naming the allowed."""
+    name = accel_unit_name(unit)
+    if name is None:
+        raise ParameterError(f"accel_unit={unit!r} is no accelerometer's unit; allowed: {', '.join(ACCEL_UNITS)}")
+    return name
 
 
 def _report_folders(pattern: str, out: Path) -> tuple[list[Path], dict[Path, Path]]:
@@ -326,7 +383,7 @@ def _start_client(scheduler, dask_workers):
     return client, own
 
 
-def _run_reports(client, todo, read_opts, report_opts, retries, quiet) -> dict[str, dict]:
+def _run_reports(client, todo, opts: tuple, retries, quiet) -> dict[str, dict]:
     """Each (file, folder) of ``todo`` reported as a Dask task: file path → its status (a task that died is an
     error row, not a stop)."""
     from distributed import as_completed
@@ -336,8 +393,7 @@ def _run_reports(client, todo, read_opts, report_opts, retries, quiet) -> dict[s
     # disable=None: no bar when stderr is no terminal (a pipe, a log file)
     bar = tqdm(total=len(todo), disable=True if quiet else None, unit="file", file=sys.stderr, desc="allanite batch")
     futures = [
-        client.submit(run_one, p, f, read_opts, report_opts, key=f"allanite-report-{uuid.uuid4().hex}", retries=retries)
-        for p, f in todo
+        client.submit(run_one, p, f, *opts, key=f"allanite-report-{uuid.uuid4().hex}", retries=retries) for p, f in todo
     ]
     for fut in as_completed(futures):
         try:
@@ -379,6 +435,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="unit of the samples, as allanite report's: a gyro's (deg/s, rad/s, ...) or an accelerometer's (m/s^2, "
         "g, mg, ...: the reports an accelerometer's, in m/s/√h, µg, m/s/h^1.5); without it the unit the column names "
         "give (ax [g]), else the coefficients are in base form",
+    )
+    p.add_argument(
+        "--accel-unit",
+        choices=ACCEL_UNITS,
+        help="as allanite report's: unit of the accelerometer columns beside a gyro's (default: the one their names "
+        "give, [g] or [m s^-2]); each file's accelerometer columns are then reported in OUT/<file>/accelerometer/ "
+        "and their fleet rows are in m/s/√h, µg, m/s/h^1.5 (sensor accelerometer)",
     )
     p.add_argument(
         "--input", choices=("rate", "increment", "angle"), default="rate", help="what a sample is (default rate)"
@@ -443,6 +506,7 @@ def main(argv=None) -> int:
             columns=_spec(args.columns),
             time_column=None if tc is None else (int(tc) if tc.isdigit() else tc),
             unit=args.unit,
+            accel_unit=args.accel_unit,
             input=args.input,
             gaps=args.gaps,
             channels=_channels(args.channels),
