@@ -119,3 +119,25 @@ def test_report_of_a_log_with_gaps_marked_nan(tmp_path, capsys):
     assert "could not be fitted" not in notes and summary["fit"]["error"] is None
     n_coef = summary["fit"]["axes"][0]["coefficients"]["N"]
     assert n_coef["value"] == pytest.approx(0.01, rel=0.05) and n_coef["ci"][0] < 0.01 < n_coef["ci"][1]
+
+
+def test_the_report_identifies_the_noise_through_the_gaps_on_the_same_fill():
+    # the report joined a gap's two single neighbours to identify each τ's noise type behind the intervals: a spike
+    # beside each gap became a ramp across it, and white noise read as flicker and random-walk FM at the shortest τ
+    # (-1, -2, -2). It fills as refine does now (filled_columns): the types of the record before the drop
+    from allanite.model.refinement._gapfill import filled_columns
+    from allanite.report.build import build_report
+
+    y = allanite.simulate(20_000, FS, N=0.01, K=1e-3, seed=0)
+    z = dropped(y, 0)
+    nan = np.isnan(z)
+    z[np.flatnonzero(nan[1:] & ~nan[:-1])] += 3.0  # a 30σ spike before each gap (a logger's glitch as it drops)
+    st = build_report(z, FS, unit="deg/s", gaps="skip", fit=False).static
+    before = st.with_confidence(np.where(nan, y, z)[:, None])  # the same spikes, the gaps' samples present
+    np.testing.assert_array_equal(st.alpha, before.alpha)
+    assert list(st.alpha[0, :3]) == [0, 0, 0]  # white FM at τ0..4τ0
+    np.testing.assert_allclose(st.ci_high, before.ci_high, rtol=1e-12)
+    # the filler: each column's runs as fill_gaps fills them, an all-NaN column left NaN
+    two = filled_columns(np.column_stack([z, np.full(z.size, np.nan)]))
+    np.testing.assert_array_equal(two[:, 0], fill_gaps(z, gap_runs(nan)))
+    assert np.isnan(two[:, 1]).all() and not np.isnan(two[:, 0]).any()

@@ -330,9 +330,14 @@ def _analyse(
         )  # fmt: skip
         on_dynamic(static, dynamic)  # before the intervals: the DAVAR figures need nothing more
         progress.step("confidence intervals")
-        # the noise type behind each interval is identified on the samples (gaps: joined by straight lines for
-        # that alone; the EDF counts the complete terms, ``static.n``)
-        static = static.with_confidence(_bridged(x) if gaps == "skip" else x, confidence=confidence)
+        # the noise type behind each interval is identified on the samples (gaps: filled for that alone by the
+        # line between their neighbourhoods' medians, as refine fills them — a spike beside a gap is no ramp across
+        # it; the EDF counts the complete terms, ``static.n``)
+        if gaps == "skip":
+            from ..model.refinement._gapfill import filled_columns  # here: refine's package loads with refine
+
+            x = filled_columns(x)
+        static = static.with_confidence(x, confidence=confidence)
     settings.update(
         taus=taus if isinstance(taus, str) else "explicit",
         estimator=estimator,
@@ -342,17 +347,6 @@ def _analyse(
         by_axis=by_axis,
     )
     return static, dynamic, settings
-
-
-def _bridged(x) -> np.ndarray:
-    """A copy of the samples with each NaN replaced by the straight line between the finite samples around it."""
-    out = np.array(x, dtype=np.float64)
-    idx = np.arange(out.shape[0])
-    for col in out.reshape(out.shape[0], -1).T:
-        bad = np.isnan(col)
-        if bad.any() and not bad.all():
-            col[bad] = np.interp(idx[bad], idx[~bad], col[~bad])
-    return out
 
 
 def _fit_record_and_windows(static, dynamic, units, confidence, axis_names, notes, progress) -> tuple:
