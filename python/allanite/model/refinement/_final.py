@@ -91,6 +91,7 @@ class FinalModel(RunState):
         if per_segment and per_segment[-1] is not None:  # with every change point: the chain's last after
             ctx.segments_heldout_pct = per_segment[-1]
         ctx.samples = self.y0
+        ctx.considered, ctx.offered_lines = self.considered, self.offered_lines
         ctx.replaced = _replaced([rem for _st, rem, *_rest in self.removed], self.y0.size if self.y0 is not None else 0)
         ctx.families = [
             (st.params["fundamentals"], st.evidence["frequencies_hz"], st.evidence["amplitudes"], rem.component)

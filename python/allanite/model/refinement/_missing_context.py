@@ -50,6 +50,11 @@ class MissingContext:
     #: True at the samples an accepted removal replaced (the ``"outliers"`` step's; None: none): the clipped
     #: and held checks leave them out
     replaced: np.ndarray | None = None
+    #: every proposal refine tried, by effect (``Refinement.considered``), and the lines (Hz) the ``"sinusoid"``
+    #: candidate's search found (None: the candidate was left out or had no samples): the ``"psd"`` check says why
+    #: a line it names was not kept
+    considered: dict = field(default_factory=dict)
+    offered_lines: list | None = None
 
 
 def chi2_dof(ctx: MissingContext, lo: float, hi: float) -> float:

@@ -71,6 +71,7 @@ class RunState:
         self.considered: dict[str, list] = {}
         self.line_search: dict | None = None  # the periodic removal's line search, for the sinusoid candidate
         self.declined_families: list = []  # line families the removal in time turned down: their lines stay
+        self.offered_lines: list | None = None  # the sinusoid candidate's lines (Hz); None: the candidate not run
 
     def build(self, res, samples):
         """The curve (and, with samples, the held-out split) of ``res``'s estimates in the τ range."""

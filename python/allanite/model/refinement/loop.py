@@ -187,6 +187,7 @@ class _Run(TimeRemovals, FinalModel):
                 # every line there offered (conditional on a family found: no share of level under the null)
                 search, fams = periodic.periodic_search(y, self.fs, alpha("lines", self.level)), True
             lines = periodic.sinusoid_lines(search, families=fams)
+            self.offered_lines = [float(ln["f0"]) for ln in lines]
         fork = self.fork()
         self.curve_loop(candidates, thin, exact, lines)
         if sinc_named(self.effects):  # the kinds without the sinc^k carried too: the whole chain decides

@@ -28,7 +28,11 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   the periodic effect, afresh) that no sinusoid of the model accounts for; neighbouring lines (gaps ≤ f/16 or
   8 bins) are one entry, with its band, ``lines`` (how many), ``rms`` and the largest ``amplitude`` — where
   their Allan variance would move an estimate of the final curve by :data:`.scoring.MATERIAL_Z` of its
-  standard errors (as impulsive noise below; a line visible only in a filter's noise null moves none).
+  standard errors (as impulsive noise below; a line visible only in a filter's noise null moves none). Each entry
+  says why the ``"sinusoid"`` candidate did not keep it (``"not_kept"``, also in ``"what"``: :func:`why_not_kept`)
+  — the reason it turned down a line it tested there (the held-out error, …), its search found it but no step
+  reached it, its search did not find it, or the candidate was not run — so a line named here is never one refine
+  seems not to have looked at.
 - ``"time"`` — a warm-up drift left in the final samples (:func:`allanite.model.tracing.drift_fit` against its
   bootstrap threshold under the final model's slow terms).
 - ``"mean"`` — one step of the mean along the final samples (:mod:`._mean_step`: the best split of its block
@@ -82,7 +86,7 @@ from .curvefit import base_name, chi2_dof_between
 from .levels import alpha
 from .scoring import MATERIAL_Z, curve_change_z
 
-__all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS", "allan_family"]
+__all__ = ["MissingContext", "CHECKS", "unexplained", "MAX_REGIONS", "allan_family", "why_not_kept"]
 
 #: Leftover lines closer than 1/LINE_GAP of their frequency, or LINE_GAP_BINS bins, are reported as one band.
 LINE_GAP = 16
@@ -133,13 +137,16 @@ def _lines(ctx: MissingContext, a: float) -> list[dict]:
             what = f"a spectral line at {f_lo:.4g} Hz (amplitude {amps[0]:.3g})"
         else:
             what = f"{len(grp)} spectral lines at {f_lo:.4g}–{f_hi:.4g} Hz (rms {rms:.3g}, largest {amps.max():.3g})"
+        band = (f_lo - 2 * grp[0]["bin_hz"], f_hi + 2 * grp[-1]["bin_hz"])  # as a sinusoid accounts for a line
+        why = why_not_kept(ctx, band, len(grp))
         out.append(
             {
                 "domain": "psd",
                 "tau": (lo, hi),
                 "band_hz": (f_lo - grp[0]["bin_hz"], f_hi + grp[-1]["bin_hz"]),
                 "chi2_dof": _chi2_dof(ctx, lo, hi) if hi >= lo else None,
-                "what": what,
+                "what": f"{what} — {why}",
+                "not_kept": why,
                 "lines": len(grp),
                 "rms": rms,
                 "amplitude": float(amps.max()),
@@ -149,6 +156,27 @@ def _lines(ctx: MissingContext, a: float) -> list[dict]:
             }
         )
     return out
+
+
+def why_not_kept(ctx: MissingContext, band: tuple, n_lines: int = 1) -> str:
+    """Why the ``"sinusoid"`` candidate did not keep the line(s) in ``band`` (Hz), in words: the reason it gave
+    for turning down a line it tested there (``ctx.considered``: the held-out error, a parameter at its range's
+    edge, another effect taken at that step), or that its search found the line but no step offered it (a step
+    offers the strongest line not yet held that moves the Allan curve by MATERIAL_Z standard errors, and the
+    steps end when one is turned down), or that its search did not find it, or that the candidate was left out."""
+    it = "it" if n_lines == 1 else "them"
+    tried = [e for e in ctx.considered.get("sinusoid", []) if band[0] <= e["param"] <= band[1]]
+    if tried:
+        e = max(tried, key=lambda e: e["statistic"] / max(e["threshold"], 1e-300))
+        return f"tested as a sinusoid ({e['param']:.4g} Hz) and not kept: {e.get('rejected', 'not taken')}"
+    if ctx.offered_lines is None:
+        return "the sinusoid candidate was not among the candidates refine ran, so no line was tested"
+    if any(band[0] <= f <= band[1] for f in ctx.offered_lines):
+        return (
+            f"the sinusoid search found {it} but no step tested {it}: a step offers the strongest line not yet held "
+            f"that moves the Allan curve by {MATERIAL_Z:g} standard errors, and the steps ended before {it}"
+        )
+    return f"the sinusoid search (at the lines' share of level) did not find {it} before the final model's removals"
 
 
 def _lines_move_curve(ctx: MissingContext, freqs: np.ndarray, amps: np.ndarray) -> bool:
