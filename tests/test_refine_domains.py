@@ -520,7 +520,7 @@ def test_unexplained_says_why_refine_did_not_keep_a_line_it_names():
     assert tried["rejected"].startswith("held-out error") and not any(s.effect == "sinusoid" for s in r.steps)
     (said,) = [u for u in r.unexplained if u["domain"] == "psd"]
     assert said["band_hz"][0] < 2.9 < said["band_hz"][1]
-    assert said["not_kept"] == f"tested as a sinusoid (2.9 Hz) and not kept: {tried['rejected']}"
+    assert said["not_kept"] == f"tested as a sinusoid (2.9 Hz) and not kept: {tried['rejected']} (a step must lower it)"
     assert said["not_kept"] in r.missing_sentences()[0]
     # the other reasons, on the context alone: left out, found but never offered, not found
     ctx = SimpleNamespace(considered={}, offered_lines=None)

@@ -168,7 +168,9 @@ def why_not_kept(ctx: MissingContext, band: tuple, n_lines: int = 1) -> str:
     tried = [e for e in ctx.considered.get("sinusoid", []) if band[0] <= e["param"] <= band[1]]
     if tried:
         e = max(tried, key=lambda e: e["statistic"] / max(e["threshold"], 1e-300))
-        return f"tested as a sinusoid ({e['param']:.4g} Hz) and not kept: {e.get('rejected', 'not taken')}"
+        why = e.get("rejected", "not taken")
+        must = " (a step must lower it)" if why.startswith("held-out error") else ""
+        return f"tested as a sinusoid ({e['param']:.4g} Hz) and not kept: {why}{must}"
     if ctx.offered_lines is None:
         return "the sinusoid candidate was not among the candidates refine ran, so no line was tested"
     if any(band[0] <= f <= band[1] for f in ctx.offered_lines):
