@@ -156,7 +156,9 @@ def build_report(
         ``"skip"``: NaN marks missing samples (``read_log(..., gaps="nan")``; :func:`from_log` sets it for such a
         log) — the Allan deviation and DAVAR skip the terms that touch one (``avar(gaps="skip")``), the fit scales
         each τ's EDF by the terms kept (``fit(gaps="skip")``), the refinement fills the gaps for its searches along
-        time (``refine(gaps="skip")``, at most 5 % missing). Overlapping Allan only (``estimator="oavar"``).
+        time (``refine(gaps="skip")``, at most 5 % missing), and the noise type behind each interval is identified
+        on the samples with the gaps filled the same way (the line between their neighbourhoods' medians:
+        :func:`allanite.model.refinement._gapfill.filled_columns`). Overlapping Allan only (``estimator="oavar"``).
     """
     notes = list(notes)
     check_choice(gaps, "gaps", ("error", "skip"))
