@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +20,9 @@ from ._family_fold import folded
 from ._gapfill import filled_words
 from .levels import LEVEL
 from .words import MISFIT_CHI2_DOF, misfit_sentences, missing_sentences
+
+if TYPE_CHECKING:  # the counter's module loads SciPy: not for a summary
+    from .._counter import Counter
 
 __all__ = ["Step", "Refinement", "term_moves", "term_move_text"]
 
@@ -177,6 +181,9 @@ class Refinement(RichDisplay):
     #: the largest change (%) the fill made to the Allan curve against the curve that skips the gaps
     #: (``"curve_change_pct"``); None for a gapless record.
     filled: dict | None = None
+    #: The record read as a delta-angle counter's (:func:`allanite.model._counter.detect_counter`): its angle step,
+    #: noise per sample and phase — every Q column was then the counter's exact Allan variance; None otherwise.
+    counter: Counter | None = None
 
     def curve_errors(self, fit) -> dict:
         """χ²/dof, RMS z and RMS ADEV error (%) of ``start`` or ``fit`` on the record's curve: the chain's
@@ -252,7 +259,8 @@ class Refinement(RichDisplay):
             "accepted; the joint refit moves the amplitudes only the curve measures (σ of a Gauss–Markov term "
             "or a resonance, the noise terms).",
         ]
-        return out + [term_move_text(m, self.fit.unit) for m in self.term_moves]
+        counter = [] if self.counter is None else [self.counter.describe(self._rate_unit()).capitalize() + "."]
+        return out + counter + [term_move_text(m, self.fit.unit) for m in self.term_moves]
 
     def report(self) -> str:
         """Markdown: the starting residual, each step with its parameters, evidence and errors, the final model."""
@@ -270,6 +278,8 @@ class Refinement(RichDisplay):
         ]
         if self.filled:
             lines += [f"Gaps: {filled_words(self.filled)}.", ""]
+        if self.counter is not None:
+            lines += [f"Quantisation: {self.counter.describe(self._rate_unit())}.", ""]
         if not self.steps:
             lines.append(self._nothing_added().capitalize() + ".")
         for i, st in enumerate(self.steps, 1):

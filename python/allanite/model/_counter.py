@@ -1,0 +1,223 @@
+"""A delta-angle counter's quantisation, exactly: the Q term's column where the angle, not the rate, is quantised.
+
+A counter (a ring-laser or fibre-optic gyro's pulse count, a MEMS part that outputs delta angles or delta
+velocities) outputs y'_k = (Θ_k − Θ_{k−1})/τ₀ with Θ_k = θ_k + e_k the true angle θ_k quantised at step q. The
+Q term's 3Q²/τ² (Q = q/√12) holds for a white angle error e; a counter's e is the fractional part of a random
+walk, correlated from sample to sample wherever the angle's increment per sample, σ_θ (white rate noise N:
+σ_θ² = N²τ₀), is not large beside q. With θ's fractional part (mod q) uniform, e is independent of the
+increments (E[y_j e_k] = 0) and, from the sawtooth's Fourier series,
+
+    R_e(m) = E[e_k e_{k+m}] = Σ_{n≥1} (q²/(2π²n²)) · cos(2πn·b·m·τ₀/q) · exp(−2π²n²·m·σ_θ²/q²),  R_e(0) = q²/12,
+
+b the mean rate. The output's Allan variance is the rate noise's plus the exact Allan variance of the
+differenced sequence (e_k − e_{k−1})/τ₀; its mean over m samples telescopes to (e_{k+m} − e_k)/τ, so
+
+    σ²_e(τ) = (3R_e(0) − 4R_e(m) + R_e(2m))/τ²,   τ = mτ₀,
+
+which is 3Q²/τ² times :func:`counter_factor`, 1 where R_e(m) = 0 (σ_θ ≫ q: the plain Q term). No free parameter
+beyond q (the samples' lattice), σ_θ and b (both read off the samples, :func:`detect_counter`).
+
+Where it lives: in refine's Q term. The right answer for a counter's record is the Q term with its exact form —
+nothing added — so where the samples are a counter's (:func:`detect_counter`: on a lattice whose counts' Allan
+variance at τ₀ and lag-1 autocovariance both agree with a quantised angle's), refine runs inside
+:func:`counter_quantisation` and every Q column it builds is 3/τ² × :func:`counter_factor` (Q's coefficient
+still fitted: ≈ q/√12 on a counter). A rate quantised at the output (the ADIS16405's 14-bit samples) has a
+white error: its counts' lag-1 autocovariance is near 0, not the counter's −(R_e(0) − 2R_e(1) + R_e(2)), and
+it is left as it is; so is any record whose factor differs from 1 by less than :data:`MIN_EFFECT` (σ_θ ≳ 0.7q).
+The rate noise's increments are taken as white over the few samples R_e lasts (B, K and a filter change them
+only over many more).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+__all__ = [
+    "Counter",
+    "angle_error_autocorrelation",
+    "counter_factor",
+    "counter_avar",
+    "detect_counter",
+    "counter_quantisation",
+    "active_counter",
+    "MIN_EFFECT",
+    "LAG1_AGREE",
+]
+
+#: The counter's column is used only where it differs from 3Q²/τ² by at least this share at some τ (else the
+#: plain term is exact to that share and the record is left as it is).
+MIN_EFFECT = 1e-4
+#: The counts' lag-1 autocovariance must agree with the counter's prediction within this share (plus five of
+#: its standard errors): an extra white angle noise, or a rate quantised at the output, does not.
+LAG1_AGREE = 0.1
+#: Fourier terms of R_e at most (the tail beyond is ≤ 3/(π²·n) of R_e(0), 7·10⁻⁵ here: only for σ_θ ≪ q).
+N_TERMS = 4096
+#: Lattice: a sample is on it within this share of a step (plus float32's relative spacing of its magnitude).
+LATTICE_TOL = 1e-3
+#: Shortest record read as a counter's (its lag-1 autocovariance needs samples).
+MIN_SAMPLES = 1000
+
+
+def angle_error_autocorrelation(m, ratio: float, phase: float) -> np.ndarray:
+    """R_e(m)/q² for lags ``m`` (samples, ≥ 0): the quantisation error's autocovariance over q², with ``ratio``
+    σ_θ/q and ``phase`` b·τ₀/q (the mean counts per sample; only its fractional part matters). R_e(0)/q² = 1/12.
+
+    Examples
+    --------
+    >>> r = angle_error_autocorrelation(np.array([0, 1, 2]), 1 / 3, 0.0)
+    >>> [round(float(v) * 12, 4) for v in r]
+    [1.0, 0.0678, 0.0076]
+    """
+    m = np.atleast_1d(np.asarray(m, dtype=np.float64))
+    out = np.zeros(m.shape)
+    s2 = 2.0 * math.pi**2 * ratio**2
+    for i, mi in enumerate(m.ravel()):
+        if mi == 0:
+            out.flat[i] = 1.0 / 12.0
+            continue
+        # terms while exp(−s2·n²·m) ≥ e^{−40}
+        n_max = N_TERMS if s2 * mi <= 0 else min(N_TERMS, int(math.sqrt(40.0 / (s2 * mi))) + 1)
+        if n_max < 1:
+            continue
+        n = np.arange(1, n_max + 1, dtype=np.float64)
+        terms = np.cos(2.0 * math.pi * n * phase * mi) * np.exp(-s2 * n * n * mi) / (2.0 * math.pi**2 * n * n)
+        out.flat[i] = float(terms.sum())
+    return out
+
+
+def counter_factor(m, ratio: float, phase: float) -> np.ndarray:
+    """The counter's Allan variance over the plain Q term's at τ = mτ₀: (3R_e(0) − 4R_e(m) + R_e(2m))/(3R_e(0)).
+
+    Examples
+    --------
+    >>> [round(float(g), 4) for g in counter_factor(np.array([1, 2, 8]), 1 / 3, 0.0)]
+    [0.9121, 0.9899, 1.0]
+    """
+    m = np.atleast_1d(np.asarray(m, dtype=np.float64))
+    r1, r2 = angle_error_autocorrelation(m, ratio, phase), angle_error_autocorrelation(2.0 * m, ratio, phase)
+    return 1.0 - 4.0 * (4.0 * r1 - r2)
+
+
+def counter_avar(tau, fs: float, step: float, ratio: float, phase: float) -> np.ndarray:
+    """The Allan variance the counter's quantisation adds at ``tau`` (s, multiples of 1/``fs``): ``step`` q in
+    the angle unit, ``ratio`` σ_θ/q, ``phase`` b/(q·fs); (3R_e(0) − 4R_e(m) + R_e(2m))/τ²."""
+    tau = np.asarray(tau, dtype=np.float64)
+    return step**2 / (4.0 * tau**2) * counter_factor(np.rint(tau * fs), ratio, phase)
+
+
+@dataclass(frozen=True)
+class Counter:
+    """A record read as a delta-angle counter's: its angle ``step`` q (rate unit·s: the angle unit), the rate
+    lattice's ``rate_step`` (q·f_s), ``ratio`` σ_θ/q and ``phase`` b/(q·f_s) read off the counts, ``fs``, and the
+    counts' lag-1 autocovariance measured and predicted (``lag1``, in steps²)."""
+
+    step: float
+    rate_step: float
+    ratio: float
+    phase: float
+    fs: float
+    lag1: tuple[float, float]
+
+    def factor(self, m) -> np.ndarray:
+        """:func:`counter_factor` at averaging factors ``m``."""
+        return counter_factor(m, self.ratio, self.phase)
+
+    @property
+    def key(self) -> tuple:
+        """What a remembered column depends on."""
+        return (self.ratio, self.phase, self.fs)
+
+    def describe(self, unit: str | None = None) -> str:
+        """The counter in words, for a refinement's notes."""
+        u = f" {unit[:-2]}" if unit and unit.endswith("/s") else f" ({unit})·s" if unit else " (rate unit·s)"
+        return (
+            f"the samples are a delta-angle counter's (on a lattice of {self.rate_step:.4g}, anti-correlated as a "
+            f"quantised angle's differences: lag-1 autocovariance {self.lag1[0]:.3g} steps², {self.lag1[1]:.3g} "
+            f"predicted): the angle is quantised at step q = {self.step:.4g}{u}, its noise per sample "
+            f"{self.ratio:.3g} q; the Q term's column is the counter's exact Allan variance (its angle error "
+            f"correlated from sample to sample), not 3Q²/τ² — Q = q/√12 on a counter"
+        )
+
+
+def _lattice(y: np.ndarray) -> tuple[float, np.ndarray] | None:
+    """(step, counts from the first sample) where every sample is on a lattice through the first, else None."""
+    d = np.abs(np.diff(y))
+    step = float(np.min(d, where=d > 0, initial=np.inf))
+    if not np.isfinite(step) or step <= 0:
+        return None
+    k = (y - y[0]) / step
+    counts = np.rint(k)
+    tol = LATTICE_TOL + 2.4e-7 * (np.abs(y) + abs(float(y[0]))) / step  # float32's spacing of the magnitude
+    if not np.all(np.abs(k - counts) <= tol):
+        return None
+    return step, counts
+
+
+def _allan_tau0(ratio: float, phase: float) -> float:
+    """The counts' Allan variance at τ₀ (steps²) a counter of ``ratio`` and ``phase`` gives: σ_θ²/q² plus
+    3R_e(0) − 4R_e(1) + R_e(2) over q²."""
+    r = angle_error_autocorrelation(np.array([0.0, 1.0, 2.0]), ratio, phase)
+    return ratio**2 + 3.0 * r[0] - 4.0 * r[1] + r[2]
+
+
+def detect_counter(y, fs: float) -> Counter | None:
+    """The record read as a delta-angle counter's, or None.
+
+    Read so where (1) every sample lies on a lattice (step Δ, the smallest non-zero difference: q = Δ/f_s);
+    (2) the counts' Allan variance at τ₀ gives a ratio σ_θ/q (solved for exactly, :func:`_allan_tau0`) at which
+    the counter's column differs from 3Q²/τ² by at least :data:`MIN_EFFECT`; and (3) the counts' lag-1
+    autocovariance agrees with the counter's, 2R_e(1) − R_e(0) − R_e(2), within :data:`LAG1_AGREE` plus five
+    standard errors (a rate quantised at the output has white counts: near 0)."""
+    y = np.asarray(y, dtype=np.float64)
+    if y.ndim != 1 or y.size < MIN_SAMPLES or not np.all(np.isfinite(y[:MIN_SAMPLES])):
+        return None
+    if _lattice(y[:MIN_SAMPLES]) is None:  # a continuous record: out at once
+        return None
+    got = _lattice(y)
+    if got is None:
+        return None
+    step, counts = got
+    a1 = 0.5 * float(np.mean(np.diff(counts) ** 2))
+    phase = float(np.mean(y) / step) % 1.0
+    hi = math.sqrt(a1) + 1.0
+    f = lambda r: _allan_tau0(r, phase) - a1  # noqa: E731
+    if not f(0.0) < 0.0 < f(hi):
+        return None
+    ratio = float(brentq(f, 0.0, hi, xtol=1e-6))
+    effect = float(np.max(np.abs(1.0 - counter_factor(np.arange(1, 9), ratio, phase))))
+    if effect < MIN_EFFECT:
+        return None
+    c = counts - counts.mean()
+    var = float(np.mean(c * c))
+    measured = float(np.mean(c[1:] * c[:-1]))
+    r = angle_error_autocorrelation(np.array([0.0, 1.0, 2.0]), ratio, phase)
+    predicted = float(2.0 * r[1] - r[0] - r[2])
+    if abs(measured - predicted) > LAG1_AGREE * abs(predicted) + 5.0 * var / math.sqrt(y.size):
+        return None
+    return Counter(step / fs, step, ratio, phase, float(fs), (measured, predicted))
+
+
+#: The counter refine's Q columns take (None: 3Q²/τ²), set by :func:`counter_quantisation`.
+_ACTIVE: contextvars.ContextVar[Counter | None] = contextvars.ContextVar("allanite_counter", default=None)
+
+
+@contextlib.contextmanager
+def counter_quantisation(counter: Counter | None) -> Iterator[None]:
+    """Within it every Q column refine builds is ``counter``'s exact one (nothing changes for None)."""
+    token = _ACTIVE.set(counter)
+    try:
+        yield
+    finally:
+        _ACTIVE.reset(token)
+
+
+def active_counter() -> Counter | None:
+    """The counter set by :func:`counter_quantisation`, or None."""
+    return _ACTIVE.get()
