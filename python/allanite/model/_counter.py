@@ -17,15 +17,21 @@ differenced sequence (e_k − e_{k−1})/τ₀; its mean over m samples telescop
 which is 3Q²/τ² times :func:`counter_factor`, 1 where R_e(m) = 0 (σ_θ ≫ q: the plain Q term). No free parameter
 beyond q (the samples' lattice), σ_θ and b (both read off the samples, :func:`detect_counter`).
 
-Where it lives: in refine's Q term. The right answer for a counter's record is the Q term with its exact form —
-nothing added — so where the samples are a counter's (:func:`detect_counter`: on a lattice whose counts' Allan
-variance at τ₀ and lag-1 autocovariance both agree with a quantised angle's), refine runs inside
-:func:`counter_quantisation` and every Q column it builds is 3/τ² × :func:`counter_factor` (Q's coefficient
-still fitted: ≈ q/√12 on a counter). A rate quantised at the output (the ADIS16405's 14-bit samples) has a
-white error: its counts' lag-1 autocovariance is near 0, not the counter's −(R_e(0) − 2R_e(1) + R_e(2)), and
-it is left as it is; so is any record whose factor differs from 1 by less than :data:`MIN_EFFECT` (σ_θ ≳ 0.7q).
-The rate noise's increments are taken as white over the few samples R_e lasts (B, K and a filter change them
-only over many more).
+Where it lives: in refine's Q term, not as an effect. The right answer for a counter's record is the Q term with
+its exact form — nothing added (the record is clean) — so where the samples are a counter's (:func:`detect_counter`),
+refine runs inside :func:`counter_quantisation` and every Q column it builds (the start, every step's fits, the
+tests' columns, the held-out parts) is 3/τ² × :func:`counter_factor`; Q's coefficient is still fitted (≈ q/√12 on
+a counter) and ``Refinement.counter`` says the step, in the angle unit, and in words. Read as a counter's: every
+sample on a lattice (q = the lattice's step / f_s), the counts' Allan variance at τ₀ solved for σ_θ/q, and the
+counts' autocovariance at lag 1 less lag 2 agreeing with the counter's, (3R_e(1) − R_e(0) − 3R_e(2) + R_e(3))/q²
+(≈ −1/12; white rate noise and slow components add alike at both lags). A rate quantised at the output (the
+ADIS16405's 14-bit samples, a dead band) has a white error — the contrast near 0 — and is left as it is; so is any
+record whose factor differs from 1 by less than :data:`MIN_EFFECT` at every τ (σ_θ ≳ 0.7q: there 3Q²/τ² is exact).
+
+Assumed: the rate noise's increments are white over the few samples R_e lasts (B, K and a filter change them
+only over many more); b is each block's mean rate (:func:`block_phases`: a bias drifting along the record is a
+mix of phases), so a rate that changes by a good part of a step per sample within a block (a turning platform) is
+not modelled — there the contrast usually disagrees and the plain Q term stays.
 """
 
 from __future__ import annotations
@@ -47,27 +53,44 @@ __all__ = [
     "detect_counter",
     "counter_quantisation",
     "active_counter",
+    "block_phases",
+    "Phase",
     "MIN_EFFECT",
-    "LAG1_AGREE",
+    "CONTRAST_AGREE",
 ]
 
 #: The counter's column is used only where it differs from 3Q²/τ² by at least this share at some τ (else the
 #: plain term is exact to that share and the record is left as it is).
 MIN_EFFECT = 1e-4
-#: The counts' lag-1 autocovariance must agree with the counter's prediction within this share (plus five of
-#: its standard errors): an extra white angle noise, or a rate quantised at the output, does not.
-LAG1_AGREE = 0.1
+#: The counts' autocovariance at lag 1 less lag 2 must agree with the counter's prediction within this share
+#: (plus five of its standard errors): an extra white angle noise, or a rate quantised at the output, does not.
+CONTRAST_AGREE = 0.1
 #: Fourier terms of R_e at most (the tail beyond is ≤ 3/(π²·n) of R_e(0), 7·10⁻⁵ here: only for σ_θ ≪ q).
 N_TERMS = 4096
 #: Lattice: a sample is on it within this share of a step (plus float32's relative spacing of its magnitude).
 LATTICE_TOL = 1e-3
-#: Shortest record read as a counter's (its lag-1 autocovariance needs samples).
+#: Samples per block whose mean rate gives one phase of the mix (:func:`block_phases`).
+PHASE_BLOCK = 1024
+#: Bins the blocks' phases are gathered in.
+PHASE_BINS = 256
+#: Shortest record read as a counter's (its autocovariances need samples).
 MIN_SAMPLES = 1000
 
 
-def angle_error_autocorrelation(m, ratio: float, phase: float) -> np.ndarray:
+#: A mean rate: b·τ₀/q (the mean counts per sample; only its fractional part matters), or a mix of them —
+#: (phases, weights): a rate that drifts along the record, each block's mean weighted by its share.
+Phase = float | tuple[np.ndarray, np.ndarray]
+
+
+def _mix(phase: Phase) -> tuple[np.ndarray, np.ndarray]:
+    if isinstance(phase, tuple):
+        return np.asarray(phase[0], dtype=np.float64), np.asarray(phase[1], dtype=np.float64)
+    return np.array([float(phase)]), np.array([1.0])
+
+
+def angle_error_autocorrelation(m, ratio: float, phase: Phase) -> np.ndarray:
     """R_e(m)/q² for lags ``m`` (samples, ≥ 0): the quantisation error's autocovariance over q², with ``ratio``
-    σ_θ/q and ``phase`` b·τ₀/q (the mean counts per sample; only its fractional part matters). R_e(0)/q² = 1/12.
+    σ_θ/q and ``phase`` b·τ₀/q (:data:`Phase`; a mix averages the cosines). R_e(0)/q² = 1/12.
 
     Examples
     --------
@@ -78,6 +101,7 @@ def angle_error_autocorrelation(m, ratio: float, phase: float) -> np.ndarray:
     m = np.atleast_1d(np.asarray(m, dtype=np.float64))
     out = np.zeros(m.shape)
     s2 = 2.0 * math.pi**2 * ratio**2
+    phases, weights = _mix(phase)
     for i, mi in enumerate(m.ravel()):
         if mi == 0:
             out.flat[i] = 1.0 / 12.0
@@ -87,12 +111,13 @@ def angle_error_autocorrelation(m, ratio: float, phase: float) -> np.ndarray:
         if n_max < 1:
             continue
         n = np.arange(1, n_max + 1, dtype=np.float64)
-        terms = np.cos(2.0 * math.pi * n * phase * mi) * np.exp(-s2 * n * n * mi) / (2.0 * math.pi**2 * n * n)
+        cosines = weights @ np.cos(2.0 * math.pi * mi * np.outer(phases, n))
+        terms = cosines * np.exp(-s2 * n * n * mi) / (2.0 * math.pi**2 * n * n)
         out.flat[i] = float(terms.sum())
     return out
 
 
-def counter_factor(m, ratio: float, phase: float) -> np.ndarray:
+def counter_factor(m, ratio: float, phase: Phase) -> np.ndarray:
     """The counter's Allan variance over the plain Q term's at τ = mτ₀: (3R_e(0) − 4R_e(m) + R_e(2m))/(3R_e(0)).
 
     Examples
@@ -105,7 +130,7 @@ def counter_factor(m, ratio: float, phase: float) -> np.ndarray:
     return 1.0 - 4.0 * (4.0 * r1 - r2)
 
 
-def counter_avar(tau, fs: float, step: float, ratio: float, phase: float) -> np.ndarray:
+def counter_avar(tau, fs: float, step: float, ratio: float, phase: Phase) -> np.ndarray:
     """The Allan variance the counter's quantisation adds at ``tau`` (s, multiples of 1/``fs``): ``step`` q in
     the angle unit, ``ratio`` σ_θ/q, ``phase`` b/(q·fs); (3R_e(0) − 4R_e(m) + R_e(2m))/τ²."""
     tau = np.asarray(tau, dtype=np.float64)
@@ -115,34 +140,41 @@ def counter_avar(tau, fs: float, step: float, ratio: float, phase: float) -> np.
 @dataclass(frozen=True)
 class Counter:
     """A record read as a delta-angle counter's: its angle ``step`` q (rate unit·s: the angle unit), the rate
-    lattice's ``rate_step`` (q·f_s), ``ratio`` σ_θ/q and ``phase`` b/(q·f_s) read off the counts, ``fs``, and the
-    counts' lag-1 autocovariance measured and predicted (``lag1``, in steps²)."""
+    lattice's ``rate_step`` (q·f_s), ``ratio`` σ_θ/q and the mean rate's ``phases`` b/(q·f_s) with their ``weights``
+    (per block of :data:`PHASE_BLOCK` samples, :func:`block_phases`) read off the counts, ``fs``, and the
+    counts' autocovariance at lag 1 less lag 2, measured and predicted (``contrast``, in steps²)."""
 
     step: float
     rate_step: float
     ratio: float
-    phase: float
+    phases: tuple[float, ...]
+    weights: tuple[float, ...]
     fs: float
-    lag1: tuple[float, float]
+    contrast: tuple[float, float]
 
     def factor(self, m) -> np.ndarray:
         """:func:`counter_factor` at averaging factors ``m``."""
         return counter_factor(m, self.ratio, self.phase)
 
     @property
+    def phase(self) -> Phase:
+        """The mean rate's :data:`Phase` mix."""
+        return (np.asarray(self.phases), np.asarray(self.weights))
+
+    @property
     def key(self) -> tuple:
         """What a remembered column depends on."""
-        return (self.ratio, self.phase, self.fs)
+        return (self.ratio, self.phases, self.weights, self.fs)
 
     def describe(self, unit: str | None = None) -> str:
         """The counter in words, for a refinement's notes."""
         u = f" {unit[:-2]}" if unit and unit.endswith("/s") else f" ({unit})·s" if unit else " (rate unit·s)"
         return (
             f"the samples are a delta-angle counter's (on a lattice of {self.rate_step:.4g}, anti-correlated as a "
-            f"quantised angle's differences: lag-1 autocovariance {self.lag1[0]:.3g} steps², {self.lag1[1]:.3g} "
-            f"predicted): the angle is quantised at step q = {self.step:.4g}{u}, its noise per sample "
-            f"{self.ratio:.3g} q; the Q term's column is the counter's exact Allan variance (its angle error "
-            f"correlated from sample to sample), not 3Q²/τ² — Q = q/√12 on a counter"
+            f"quantised angle's differences: autocovariance at lag 1 less lag 2 {self.contrast[0]:.3g} steps², "
+            f"{self.contrast[1]:.3g} predicted): the angle is quantised at step q = {self.step:.4g}{u}, its noise "
+            f"per sample {self.ratio:.3g} q; the Q term's column is the counter's exact Allan variance (its angle "
+            f"error correlated from sample to sample), not 3Q²/τ² — Q = q/√12 on a counter"
         )
 
 
@@ -160,21 +192,61 @@ def _lattice(y: np.ndarray) -> tuple[float, np.ndarray] | None:
     return step, counts
 
 
-def _allan_tau0(ratio: float, phase: float) -> float:
+def _allan_tau0(ratio: float, phase: Phase) -> float:
     """The counts' Allan variance at τ₀ (steps²) a counter of ``ratio`` and ``phase`` gives: σ_θ²/q² plus
     3R_e(0) − 4R_e(1) + R_e(2) over q²."""
     r = angle_error_autocorrelation(np.array([0.0, 1.0, 2.0]), ratio, phase)
     return ratio**2 + 3.0 * r[0] - 4.0 * r[1] + r[2]
 
 
+def block_phases(counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The mean rate's phases (fractional counts per sample) along the record: each block of :data:`PHASE_BLOCK`
+    samples' mean, gathered in :data:`PHASE_BINS` bins of [0, 1) (each bin's mean phase, weighted by its share of
+    the blocks). A static record's is one phase; a bias drifting with temperature spreads it. The block mean's
+    own noise (σ_θ/q/√32 at most) is left in: it blurs the cosine of R_e(1) by < 1 % where R_e matters."""
+    nb = counts.size // PHASE_BLOCK
+    if nb < 1:
+        return np.array([float(np.mean(counts)) % 1.0]), np.array([1.0])
+    beta = counts[: nb * PHASE_BLOCK].reshape(nb, PHASE_BLOCK).mean(axis=1) % 1.0
+    idx = np.minimum((beta * PHASE_BINS).astype(np.int64), PHASE_BINS - 1)
+    n = np.bincount(idx, minlength=PHASE_BINS)
+    keep = n > 0
+    means = np.bincount(idx, weights=beta, minlength=PHASE_BINS)[keep] / n[keep]
+    return means, n[keep] / nb
+
+
+def _ratios(a1: float, phase: Phase) -> list[float]:
+    """Every ratio σ_θ/q at which a counter of ``phase`` gives the counts' Allan variance ``a1`` at τ₀ (one where
+    the mean rate is a whole number of steps per sample; with a fractional one, a nearly noiseless counter's
+    pattern can give the same: the contrast picks)."""
+    grid = np.concatenate(([0.0], np.geomspace(1e-3, math.sqrt(a1) + 1.0, 160)))
+    f = np.array([_allan_tau0(float(r), phase) - a1 for r in grid])
+    out = []
+    for i in np.flatnonzero(np.sign(f[:-1]) * np.sign(f[1:]) <= 0):
+        lo, hi = float(grid[i]), float(grid[i + 1])
+        out.append(lo if f[i] == 0 else float(brentq(lambda r: _allan_tau0(r, phase) - a1, lo, hi, xtol=1e-7)))
+    return out
+
+
+def _contrast(ratio: float, phase: Phase) -> float:
+    """The counts' autocovariance at lag 1 less lag 2 a counter gives (steps²): (3R_e(1) − R_e(0) − 3R_e(2) +
+    R_e(3))/q² (white rate noise and slow components add alike at both lags)."""
+    r = angle_error_autocorrelation(np.arange(4.0), ratio, phase)
+    return float(3.0 * r[1] - r[0] - 3.0 * r[2] + r[3])
+
+
 def detect_counter(y, fs: float) -> Counter | None:
     """The record read as a delta-angle counter's, or None.
 
     Read so where (1) every sample lies on a lattice (step Δ, the smallest non-zero difference: q = Δ/f_s);
-    (2) the counts' Allan variance at τ₀ gives a ratio σ_θ/q (solved for exactly, :func:`_allan_tau0`) at which
-    the counter's column differs from 3Q²/τ² by at least :data:`MIN_EFFECT`; and (3) the counts' lag-1
-    autocovariance agrees with the counter's, 2R_e(1) − R_e(0) − R_e(2), within :data:`LAG1_AGREE` plus five
-    standard errors (a rate quantised at the output has white counts: near 0)."""
+    (2) the counts' Allan variance at τ₀ gives a ratio σ_θ/q (solved for exactly: every root of :func:`_ratios`,
+    the one whose contrast (3) agrees best; with a fractional mean rate a nearly noiseless counter's pattern can
+    give the same Allan variance) at which the counter's column differs from 3Q²/τ² by at least
+    :data:`MIN_EFFECT`; and (3) the counts' autocovariance at
+    lag 1 less lag 2 agrees with the counter's, (3R_e(1) − R_e(0) − 3R_e(2) + R_e(3))/q², within
+    :data:`CONTRAST_AGREE` plus five standard errors (a rate quantised at the output has white counts: near 0;
+    white rate noise and slow components add alike at both lags). A strong line near the Nyquist frequency
+    changes the contrast too: the record is then left with the plain Q term."""
     y = np.asarray(y, dtype=np.float64)
     if y.ndim != 1 or y.size < MIN_SAMPLES or not np.all(np.isfinite(y[:MIN_SAMPLES])):
         return None
@@ -185,23 +257,20 @@ def detect_counter(y, fs: float) -> Counter | None:
         return None
     step, counts = got
     a1 = 0.5 * float(np.mean(np.diff(counts) ** 2))
-    phase = float(np.mean(y) / step) % 1.0
-    hi = math.sqrt(a1) + 1.0
-    f = lambda r: _allan_tau0(r, phase) - a1  # noqa: E731
-    if not f(0.0) < 0.0 < f(hi):
-        return None
-    ratio = float(brentq(f, 0.0, hi, xtol=1e-6))
-    effect = float(np.max(np.abs(1.0 - counter_factor(np.arange(1, 9), ratio, phase))))
-    if effect < MIN_EFFECT:
-        return None
+    phase = block_phases(y / step)
     c = counts - counts.mean()
-    var = float(np.mean(c * c))
-    measured = float(np.mean(c[1:] * c[:-1]))
-    r = angle_error_autocorrelation(np.array([0.0, 1.0, 2.0]), ratio, phase)
-    predicted = float(2.0 * r[1] - r[0] - r[2])
-    if abs(measured - predicted) > LAG1_AGREE * abs(predicted) + 5.0 * var / math.sqrt(y.size):
+    measured = float(np.mean(c[1:] * c[:-1]) - np.mean(c[2:] * c[:-2]))
+    fits = [(abs(measured - _contrast(r, phase)), r) for r in _ratios(a1, phase)]
+    if not fits:
         return None
-    return Counter(step / fs, step, ratio, phase, float(fs), (measured, predicted))
+    miss, ratio = min(fits)
+    if np.max(np.abs(1.0 - counter_factor(np.arange(1, 9), ratio, phase))) < MIN_EFFECT:
+        return None
+    predicted = _contrast(ratio, phase)
+    if miss > CONTRAST_AGREE * abs(predicted) + 5.0 * a1 * math.sqrt(2.0 / y.size):
+        return None
+    phases, weights = (tuple(float(v) for v in a) for a in phase)
+    return Counter(step / fs, step, float(ratio), phases, weights, float(fs), (measured, predicted))
 
 
 #: The counter refine's Q columns take (None: 3Q²/τ²), set by :func:`counter_quantisation`.
