@@ -16,11 +16,11 @@ import pytest
 import allanite
 from allanite.model._counter import (
     MIN_EFFECT,
+    active_counter,
     angle_error_autocorrelation,
     counter_avar,
     counter_factor,
     counter_quantisation,
-    active_counter,
     detect_counter,
 )
 
