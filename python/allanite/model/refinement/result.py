@@ -156,7 +156,9 @@ class Refinement(RichDisplay):
     step's ``before`` and the last one's ``after``: χ²/dof on the tests' covariance,
     :func:`allanite.model.refinement.scoring.settle_chi2`) — what :meth:`report`, the summary and the report
     page say; ``fit.chi2_dof`` stays the weighted fit's own
-    (EDF variances, the one its intervals are inflated by)."""
+    (EDF variances, the one its intervals are inflated by). ``counter``: the record read as a delta-angle counter's
+    (:class:`allanite.model._counter.Counter`: its angle step, noise per sample, mean rate's phases), every Q column
+    then its exact Allan variance; None otherwise."""
 
     steps: list
     fit: fitting.NoiseFit
