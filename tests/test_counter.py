@@ -134,3 +134,14 @@ def test_refine_reads_a_counter_as_clean():
     assert r.fit.coefficients["Q"].value == pytest.approx(q / math.sqrt(12.0), rel=0.01)
     assert "delta-angle counter" in r.report()
     assert any("delta-angle counter" in n for n in r.notes())
+
+
+def test_detects_a_counter_given_as_its_angle():
+    """A counter's angle given in floating point (``input="angle"``) differenced back to a rate: its differences
+    carry rounding of ~10⁻¹⁵ beside the steps, and the lattice is still the counter's."""
+    y, q = _counter(200_000, 3.0, 0.13, seed=5)
+    rate = np.diff(np.cumsum(y) / FS, prepend=0.0) * FS
+    assert np.count_nonzero((np.abs(np.diff(rate)) > 0) & (np.abs(np.diff(rate)) < 1e-9)) > 0
+    c = detect_counter(rate, FS)
+    assert c is not None and c.step == pytest.approx(q, rel=1e-9)
+    assert c.ratio == pytest.approx(1 / 3, rel=0.02)

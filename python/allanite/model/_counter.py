@@ -45,6 +45,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from ..errors import ParameterError
+from ..units import parse_unit
+
 __all__ = [
     "Counter",
     "angle_error_autocorrelation",
@@ -53,6 +56,7 @@ __all__ = [
     "detect_counter",
     "counter_quantisation",
     "active_counter",
+    "angle_unit",
     "block_phases",
     "Phase",
     "MIN_EFFECT",
@@ -168,7 +172,7 @@ class Counter:
 
     def describe(self, unit: str | None = None) -> str:
         """The counter in words, for a refinement's notes."""
-        u = f" {unit[:-2]}" if unit and unit.endswith("/s") else f" ({unit})·s" if unit else " (rate unit·s)"
+        u = f" {angle_unit(unit)}"
         return (
             f"the samples are a delta-angle counter's (on a lattice of {self.rate_step:.4g}, anti-correlated as a "
             f"quantised angle's differences: autocovariance at lag 1 less lag 2 {self.contrast[0]:.3g} steps², "
@@ -178,10 +182,36 @@ class Counter:
         )
 
 
+def angle_unit(unit: str | None) -> str:
+    """The unit a counter's step is in, from the samples' ``unit``: "deg" for "deg/s", an angle unit as given
+    (``input="angle"``: the rate is its differences per second), else "(unit)·s".
+
+    Examples
+    --------
+    >>> angle_unit("deg/s"), angle_unit("rad"), angle_unit("m/s^2"), angle_unit(None)
+    ('deg', 'rad', '(m/s^2)·s', '(rate unit)·s')
+    """
+    if not unit:
+        return "(rate unit)·s"
+    if unit.endswith("/s"):
+        return unit[:-2]
+    try:
+        parse_unit(unit, "angle")
+    except ParameterError:
+        return f"({unit})·s"
+    return unit
+
+
 def _lattice(y: np.ndarray) -> tuple[float, np.ndarray] | None:
-    """(step, counts from the first sample) where every sample is on a lattice through the first, else None."""
+    """(step, counts from the first sample) where every sample is on a lattice through the first, else None. The
+    step is the smallest difference above 10⁻⁶ of the median non-zero one: a rate made by differencing a quantised
+    angle given in floating point (``input="angle"``) has rounding differences of ~10⁻¹⁵ beside its steps."""
     d = np.abs(np.diff(y))
-    step = float(np.min(d, where=d > 0, initial=np.inf))
+    nonzero = d[d > 0]
+    if nonzero.size == 0:
+        return None
+    floor = 1e-6 * float(np.median(nonzero))
+    step = float(np.min(nonzero, where=nonzero > floor, initial=np.inf))
     if not np.isfinite(step) or step <= 0:
         return None
     k = (y - y[0]) / step

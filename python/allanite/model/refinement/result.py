@@ -261,7 +261,8 @@ class Refinement(RichDisplay):
             "accepted; the joint refit moves the amplitudes only the curve measures (σ of a Gauss–Markov term "
             "or a resonance, the noise terms).",
         ]
-        counter = [] if self.counter is None else [self.counter.describe(self._rate_unit()).capitalize() + "."]
+        said = "" if self.counter is None else self.counter.describe(self._rate_unit())
+        counter = [said[:1].upper() + said[1:] + "."] if said else []
         return out + counter + [term_move_text(m, self.fit.unit) for m in self.term_moves]
 
     def report(self) -> str:
