@@ -109,6 +109,9 @@ def refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes) -> li
             )
             if refinements[-1].filled:  # the one note the page needs: which samples the searches saw filled
                 notes.append(f"Model refinement of {axis_names[k]}: {filled_words(refinements[-1].filled)}.")
+            counter = refinements[-1].counter  # its Q term is the counter's exact one: said where it is read
+            if counter is not None:
+                notes.append(f"Model refinement of {axis_names[k]}: {counter.describe(refinements[-1].fit.unit)}.")
         except AllaniteError as exc:
             refinements.append(None)
             notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")

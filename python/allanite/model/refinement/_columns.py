@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from .. import fitting
+from .._counter import active_counter
 from ..effects import EFFECTS, butterworth_order, filtered_white_avar, resonance_avar
 from ..terms import TERM_ALPHA, design_matrix
 
@@ -27,6 +28,7 @@ __all__ = [
     "design",
     "edf_columns",
     "edf_of",
+    "term_columns",
 ]
 
 
@@ -160,7 +162,7 @@ def design(curve, terms, effects):
     """Columns of the terms and the effects [(key, nonlinear parameter)] on ``curve``, and each column's
     noise type per τ (for the EDF)."""
     tau = curve.tau
-    a0 = _term_columns(curve, terms)
+    a0 = term_columns(curve, terms)
     zeroed = [EFFECTS[base_name(key)].replaces for key, _p in effects if not has_floor(key)]
     if any(rep in terms for rep in zeroed):
         a0 = a0.copy()
@@ -186,12 +188,19 @@ def has_floor(key: str) -> bool:
     return key.endswith(FLOOR_TAG) or butterworth_order(bw_kind(key)) > 0
 
 
-def _term_columns(curve, terms):
-    """The terms' columns on ``curve`` (read-only, remembered by the curve)."""
-    got = curve.cached(("terms", tuple(terms)))
+def term_columns(curve, terms):
+    """The terms' columns on ``curve`` (read-only, remembered by the curve); inside
+    :func:`allanite.model._counter.counter_quantisation` the Q column is the delta-angle counter's exact one
+    (3/τ² × :func:`~allanite.model._counter.counter_factor`)."""
+    counter = active_counter()
+    key = ("terms", tuple(terms), None if counter is None else counter.key)
+    got = curve.cached(key)
     if got is None:
         tau = curve.tau
-        got = curve.remember(("terms", tuple(terms)), design_matrix(tau, tau * curve.fs, curve.fs, terms))
+        got = design_matrix(tau, tau * curve.fs, curve.fs, terms)
+        if counter is not None and "Q" in terms:
+            got[:, list(terms).index("Q")] *= counter.factor(np.rint(tau * curve.fs))
+        got = curve.remember(key, got)
     return got
 
 

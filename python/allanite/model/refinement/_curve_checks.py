@@ -13,11 +13,10 @@ from scipy import signal
 from scipy.linalg import solve_triangular
 
 from .. import tracing
-from ..terms import design_matrix
 from ._missing_context import MissingContext, chi2_dof
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
-from .curvefit import Curve
+from .curvefit import Curve, term_columns
 
 __all__ = ["MAX_REGIONS", "allan_family", "allan_check", "fit_check"]
 
@@ -56,7 +55,7 @@ def allan_family(sub: Curve, start: tuple, has_samples: bool) -> np.ndarray:
     record whose fit took a little flicker gets a correlation above its own, and the nulls alone gave p ≤ 0.05
     on 15 of 200 clean records (benches/results/refine_calibration.md)."""
     fam = families(sub, tuple(CURVE_CANDIDATES), has_samples)
-    terms = design_matrix(sub.tau, sub.m, sub.fs, start)
+    terms = term_columns(sub, start)
     return np.column_stack([fam, terms]) if fam.size else terms
 
 

@@ -17,8 +17,7 @@ import numpy as np
 from scipy.optimize import nnls
 
 from .. import tracing
-from ..terms import design_matrix
-from .curvefit import Curve, Solution, base_name, design, held_coherent, held_theta, theta_terms
+from .curvefit import Curve, Solution, base_name, design, held_coherent, held_theta, term_columns, theta_terms
 
 __all__ = ["N_BOOT", "curve_test", "line_cross_vectors", "noise_psd", "nearest_terms", "residual_evidence", "tested"]
 
@@ -44,7 +43,7 @@ def curve_test(curve: Curve, thin: np.ndarray, sol: Solution, start, effects, ex
     (``benches/line_covariance.py``: the whitened estimates' χ²/n 5.75 scaled, 0.99 so). A line whose phase
     or amplitude wanders keeps the noise's covariance for its incoherent share."""
     sub = curve.subset(thin)
-    a_terms = design_matrix(sub.tau, sub.m, curve.fs, start)
+    a_terms = term_columns(sub, start)
     theta_t = theta_terms(sol, start, effects)
     a_thin, _ = design(sub, start, effects)
     model = sol.model[thin]

@@ -36,6 +36,7 @@ from ._columns import (
     held_coherent,
     held_key,
     held_theta,
+    term_columns,
 )
 from ._irls import chi2_at, irls
 from ._noisefit import effect_column_name, noise_fit, theta_terms, upper_theta
@@ -64,6 +65,7 @@ __all__ = [
     "theta_terms",
     "noise_fit",
     "effect_column_name",
+    "term_columns",
 ]
 
 

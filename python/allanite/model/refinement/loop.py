@@ -18,6 +18,7 @@ from ..._blas import one_thread
 from ..._progress import StepBar
 from ...errors import ParameterError
 from .. import periodic, tracing
+from .._counter import counter_quantisation, detect_counter
 from .._recent import remembering
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
@@ -138,12 +139,16 @@ def refine(
         start = check_terms(start)
         candidates = _check_candidates(candidates, level)
         y, result, chans, filled = inputs(x_or_result, fs, input, points, axis, channels, gaps)
-        run = _Run(y, result, start, tau_range, level, truth, unit)
-        run.remove_in_time(candidates, chans)
-        run.add_curve_effects(candidates)
-        cp_steps = run.change_point_steps(candidates)
-        out = run.refinement(cp_steps, unit, confidence, run.unexplained(chans, cp_steps))
+        # a delta-angle counter's samples: every Q column is its exact one (allanite.model._counter)
+        counter = detect_counter(y, result.fs) if y is not None and "Q" in start else None
+        with counter_quantisation(counter):
+            run = _Run(y, result, start, tau_range, level, truth, unit)
+            run.remove_in_time(candidates, chans)
+            run.add_curve_effects(candidates)
+            cp_steps = run.change_point_steps(candidates)
+            out = run.refinement(cp_steps, unit, confidence, run.unexplained(chans, cp_steps))
         out.filled = filled
+        out.counter = counter
         return out
 
 

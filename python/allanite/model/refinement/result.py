@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,6 +20,9 @@ from ._family_fold import folded
 from ._gapfill import filled_words
 from .levels import LEVEL
 from .words import MISFIT_CHI2_DOF, misfit_sentences, missing_sentences
+
+if TYPE_CHECKING:  # the counter's module loads SciPy: not for a summary
+    from .._counter import Counter
 
 __all__ = ["Step", "Refinement", "term_moves", "term_move_text"]
 
@@ -152,7 +156,9 @@ class Refinement(RichDisplay):
     step's ``before`` and the last one's ``after``: χ²/dof on the tests' covariance,
     :func:`allanite.model.refinement.scoring.settle_chi2`) — what :meth:`report`, the summary and the report
     page say; ``fit.chi2_dof`` stays the weighted fit's own
-    (EDF variances, the one its intervals are inflated by)."""
+    (EDF variances, the one its intervals are inflated by). ``counter``: the record read as a delta-angle counter's
+    (:class:`allanite.model._counter.Counter`: its angle step, noise per sample, mean rate's phases), every Q column
+    then its exact Allan variance; None otherwise."""
 
     steps: list
     fit: fitting.NoiseFit
@@ -177,6 +183,9 @@ class Refinement(RichDisplay):
     #: the largest change (%) the fill made to the Allan curve against the curve that skips the gaps
     #: (``"curve_change_pct"``); None for a gapless record.
     filled: dict | None = None
+    #: The record read as a delta-angle counter's (:func:`allanite.model._counter.detect_counter`): its angle step,
+    #: noise per sample and phase — every Q column was then the counter's exact Allan variance; None otherwise.
+    counter: Counter | None = None
 
     def curve_errors(self, fit) -> dict:
         """χ²/dof, RMS z and RMS ADEV error (%) of ``start`` or ``fit`` on the record's curve: the chain's
@@ -252,7 +261,9 @@ class Refinement(RichDisplay):
             "accepted; the joint refit moves the amplitudes only the curve measures (σ of a Gauss–Markov term "
             "or a resonance, the noise terms).",
         ]
-        return out + [term_move_text(m, self.fit.unit) for m in self.term_moves]
+        said = "" if self.counter is None else self.counter.describe(self._rate_unit())
+        counter = [said[:1].upper() + said[1:] + "."] if said else []
+        return out + counter + [term_move_text(m, self.fit.unit) for m in self.term_moves]
 
     def report(self) -> str:
         """Markdown: the starting residual, each step with its parameters, evidence and errors, the final model."""
@@ -270,6 +281,8 @@ class Refinement(RichDisplay):
         ]
         if self.filled:
             lines += [f"Gaps: {filled_words(self.filled)}.", ""]
+        if self.counter is not None:
+            lines += [f"Quantisation: {self.counter.describe(self._rate_unit())}.", ""]
         if not self.steps:
             lines.append(self._nothing_added().capitalize() + ".")
         for i, st in enumerate(self.steps, 1):
