@@ -24,10 +24,15 @@ def chunks(n: int, size: int = CHUNK):
         yield slice(a, min(n, a + size))
 
 
+#: Nonzero |x| at or below this share of the largest are rounding residues, not a lattice (:func:`lattice_step`).
+TINY = 1e-6
+
+
 def lattice_step(x: np.ndarray) -> float:
     """The quantisation step of ``x`` (:func:`allanite.model.outliers.lattice_step`'s rule): the smallest nonzero
     |x| that recurs (its value over max|x|, rounded to 12 digits, three times or more), if at least 99 % of the
-    nonzero |x| are whole multiples of it (to 1e-6), else 0. One sorted copy of the rounded quotients (the record's
+    nonzero |x| are whole multiples of it (to 1e-6), else 0 (|x| ≤ :data:`TINY`·max|x|, float rounding, count as
+    zero). One sorted copy of the rounded quotients (the record's
     size) is the only record-length array; everything else is chunked (a record of one chunk has its nonzero |x|
     taken once for the four passes). The same result as the whole-array form
     (the same quotients, the same first value with three equal in the sorted order that ``np.unique`` counts)."""
@@ -48,9 +53,16 @@ def lattice_step(x: np.ndarray) -> float:
             scale = max(scale, float(nz.max()))
     if n_nz == 0:
         return 0.0
+    # below 1e-6 of the largest |x| a value is the float rounding of samples with a large offset (a rate
+    # differenced from an angle of 10⁴ °: residues of 10⁻⁹ on a lattice of 10⁻²), not a step: counted as zero
+    floor = TINY * scale
+    n_nz = 0
+    for nz in passes():
+        n_nz += int(np.count_nonzero(nz > floor))
     r = np.empty(n_nz)
     pos = 0
     for nz in passes():
+        nz = nz[nz > floor]
         r[pos : pos + nz.size] = np.round(nz / scale, 12)
         pos += nz.size
     r.sort()
@@ -65,7 +77,7 @@ def lattice_step(x: np.ndarray) -> float:
             step = min(step, float(near.min()))
     on = 0
     for nz in passes():
-        q = nz / step
+        q = nz[nz > floor] / step
         on += int(np.count_nonzero(np.abs(q - np.round(q)) <= 1e-6 * np.maximum(1.0, q)))
     return step if on / n_nz >= 0.99 else 0.0
 
