@@ -213,3 +213,39 @@ def test_memories_keep_one_copy_of_the_same_samples():
     first.put(strided, (), 5)
     assert first.get(np.arange(0.0, 40.0, 2.0)) == 5 and first._items[-1][1].flags.c_contiguous
     assert second._items[0][1] is kept[0]  # still kept by the second memory after the first let it go
+
+
+def test_remembered_noise_fits_and_bartlett_factors_equal_fresh_ones(monkeypatch):
+    """The Whittle noise fit and the coupling bootstrap's Bartlett factors, found again by their inputs' bytes within
+    a refine (a cold-started joint fit refits the record's own power; unexplained's channel check bootstraps the
+    candidate step's null again): equal to the bit to a fresh computation, read-only."""
+    import allanite
+    from allanite.model import _coupling
+    from allanite.model import _whittle as wh
+    from allanite.model._recent import Small
+
+    monkeypatch.setattr(_coupling, "BOOT_DRAWS", 20)  # a small bootstrap: the memory, not the calibration, is tested
+    rng = np.random.default_rng(5)
+    n = 6000
+    temp = np.cumsum(rng.standard_normal(n)) * 0.01
+    y = allanite.simulate(n, 10.0, N=1e-3, B=2e-4, K=1e-5, seed=rng)
+    bands = wh.spectra(y, [temp - temp.mean()], 10.0)
+    power, m = bands.q[bands.par] / bands.m[bands.par], bands.m[bands.par]
+    first = wh.fit_noise(power, m, bands.basis)
+    again = wh.fit_noise(power.copy(), m.copy(), bands.basis.copy())  # equal inputs in other arrays
+    assert again is first and not first[0].flags.writeable and not first[1].flags.writeable
+    fresh = wh._fit_noise(power, m, bands.basis, None)
+    assert [a.tobytes() for a in first] == [a.tobytes() for a in fresh]
+    warm = wh.fit_noise(power, m, bands.basis, first[0])  # another start: another fit
+    assert warm is not first
+    null = wh.joint_fit(bands, wh.Design([], []))
+    inside = _coupling.bootstrap_scale(bands, null)
+    assert _coupling.bootstrap_scale(bands, null) is inside
+    assert _coupling._bootstrap_scale(bands, null, 0) == inside
+    assert _coupling.bootstrap_scale(bands, null, seed=1) != inside  # another seed: other draws
+    small = Small(2)
+    for k in range(3):
+        small.put(Small.key(np.arange(3.0) + k, k), k)
+    assert small.get(Small.key(np.arange(3.0), 0)) is None  # the oldest out
+    assert small.get(Small.key(np.arange(3.0) + 2, 2)) == 2
+    assert small.get(Small.key(np.arange(3, dtype=np.int64) + 2, 2)) is None  # another dtype: another key
