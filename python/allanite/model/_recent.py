@@ -167,8 +167,7 @@ class Small:
     def key(*parts) -> tuple:
         """A key of ``parts``: each array as (shape, dtype, bytes), anything else as itself (hashable)."""
         return tuple(
-            (p.shape, p.dtype.str, np.ascontiguousarray(p).tobytes()) if isinstance(p, np.ndarray) else p
-            for p in parts
+            (p.shape, p.dtype.str, np.ascontiguousarray(p).tobytes()) if isinstance(p, np.ndarray) else p for p in parts
         )
 
     def get(self, key: tuple):
