@@ -110,12 +110,12 @@ def _null_bands(bands, s, rng):
 
 def bootstrap_scale(bands, null, seed: int = 0) -> tuple[float, float]:
     """Bartlett's factors of the coupling's statistic (the pair, 2 dof) and of the in-phase one (1 dof) under the
-        null: their means over :data:`BOOT_DRAWS` records of the null fit's noise beside the same channel
-        (:func:`_null_bands`; the noise refitted in every draw from a cold start, as on the record: the noise fit's
-        optimum depends on where it starts — started at the null fit's amounts, a 3600-sample record's factor read 0.9
-        where 2.5 cold) over χ²'s means 2 and 1 — each at least 1. Seeded: the same record gets the same thresholds
-    (within a refine, found again rather than drawn again: what the draws read is the bands' counts, the channel's
-    power, the noise model's shapes and the null's noise level)."""
+    null: their means over :data:`BOOT_DRAWS` records of the null fit's noise beside the same channel
+    (:func:`_null_bands`; the noise refitted in every draw from a cold start, as on the record: the noise fit's
+    optimum depends on where it starts — started at the null fit's amounts, a 3600-sample record's factor read 0.9
+    where 2.5 cold) over χ²'s means 2 and 1 — each at least 1. Seeded: the same record gets the same thresholds
+    (within a refine found again, not drawn again: the draws read the bands' counts, the channel's power, the
+    noise model's shapes and the null's noise level)."""
     key = Small.key(bands.m, bands.G[:, :1, :1], bands.par, bands.basis, null["s"], seed, BOOT_DRAWS)
     hit = _SCALES.get(key)
     if hit is None:
