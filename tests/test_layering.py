@@ -146,7 +146,7 @@ MODEL_RANKS = {
     "model._batched": 0,
     "model._chi2_draws": 0,
     "model._covariance": 0,
-    "model._nnls": 0,
+    "model._nnls": -0.5,  # SciPy's Lawson–Hanson routine without its wrapper (numpy, scipy only)
     "model.terms": 0,
     "model.effects": 0,
     "model.linefit": 0,

@@ -130,6 +130,19 @@ def test_nnls_equals_scipy_and_keeps_its_errors():
         _nnls.nnls(a, b)
 
 
+def test_whittle_noise_fit_nnls_equals_scipy_and_keeps_its_errors():
+    from allanite.model import _whittle as wh
+
+    rng = np.random.default_rng(6)
+    for _ in range(20):  # a noise fit's weighted problems: band powers on a few non-negative shapes
+        a = np.abs(rng.standard_normal((80, 12))) * rng.uniform(0.1, 10.0, 80)[:, None]
+        b = a @ np.abs(rng.standard_normal(12)) * rng.exponential(1.0, 80) - rng.uniform(0, 1, 80)
+        np.testing.assert_array_equal(wh._lawson_hanson(a, b, 600), scipy_nnls(a, b, maxiter=600)[0])
+    a[5, 3] = np.inf
+    with pytest.raises(ValueError, match="infs or NaNs"):
+        wh._lawson_hanson(a, b, 600)
+
+
 def _plain_cross(d, mi, mj, tau0):
     """The lag kernels of one pair of averaging factors, as before the pairs were evaluated together."""
     lam = (1.0, -2.0, 1.0)
