@@ -105,7 +105,7 @@ def _null_bands(bands, s, rng):
     rest_dof = bands.m - has
     rest = np.where(rest_dof > 0, rng.gamma(np.maximum(rest_dof, 1e-9), 1.0), 0.0)
     g = (np.sqrt(s * g00) * w)[:, None]
-    return dataclasses.replace(bands, q=s * (np.abs(w) ** 2 + rest), g=g, G=bands.G[:, :1, :1])
+    return dataclasses.replace(bands, q=s * (np.abs(w) ** 2 + rest), g=g, G=bands.G[:, :1, :1], compiled=True)
 
 
 def bootstrap_scale(bands, null, seed: int = 0) -> tuple[float, float]:
