@@ -249,3 +249,53 @@ def test_remembered_noise_fits_and_bartlett_factors_equal_fresh_ones(monkeypatch
     assert small.get(Small.key(np.arange(3.0), 0)) is None  # the oldest out
     assert small.get(Small.key(np.arange(3.0) + 2, 2)) == 2
     assert small.get(Small.key(np.arange(3, dtype=np.int64) + 2, 2)) is None  # another dtype: another key
+
+
+@pytest.mark.parametrize(
+    "terms", [(1.0, 0.3, 0.02, 0.0), (0.0, 0.5, 0.0, 1e-4), (2.0, 0.0, 0.1, 0.0), (0.7, 0.2, 0.05, 3e-5)]
+)
+def test_null_records_equal_simulate_and_share_their_flicker(terms):
+    """The checks' null records (``model/_null_records.py``): allanite.simulate's numbers to the bit, for an int
+    seed and a generator, the flicker found again for the same length and generator state (the generator left where
+    the draws leave it), kept from one call to the next only within ``sharing``."""
+    import allanite
+    from allanite.model import _null_records as nr
+    from allanite.model import _recent
+
+    n, fs = 4096, 0.37
+    kw = dict(zip("NBKR", terms))
+    for seed in (7919, [7919, 3]):
+        ref = allanite.simulate(n, fs, **kw, seed=np.random.default_rng(seed))
+        for _ in range(2):  # drawn, then found again
+            rng = np.random.default_rng(seed)
+            got = nr.block_rate_record(n, fs, **kw, seed=rng)
+            assert got.tobytes() == ref.tobytes()
+            after = np.random.default_rng(seed)
+            allanite.simulate(n, fs, **kw, seed=after)
+            assert rng.bit_generator.state == after.bit_generator.state  # the next draws are simulate's
+    assert len(nr._FLICKER._items) == (2 if terms[1] else 0)
+    depth = len(_recent._OPEN)
+    for _ in range(depth):  # leave the fixture's call: a plain call's memory is emptied when it returns
+        _recent._OPEN.pop()
+    nr._FLICKER._items.clear()  # (what this test drew within the fixture's call)
+    try:
+        with nr.sharing():
+            with _recent.remembering():
+                nr.block_rate_record(n, fs, **kw, seed=1)
+            kept = len(nr._FLICKER._items)
+            assert kept == (1 if terms[1] else 0)  # between two calls of a report
+            with _recent.remembering():
+                assert (
+                    nr.block_rate_record(n, fs, **kw, seed=1).tobytes()
+                    == allanite.simulate(n, fs, **kw, seed=1).tobytes()
+                )
+            assert len(nr._FLICKER._items) == kept
+        assert nr._FLICKER._items == {}  # the report's scope left: forgotten
+        with _recent.remembering():
+            nr.block_rate_record(n, fs, **kw, seed=2)
+        assert nr._FLICKER._items == {}  # a call outside any sharing: forgotten when it returns
+    finally:
+        for _ in range(depth):
+            _recent._OPEN.append(True)
+    with pytest.raises(ValueError, match="finite"):
+        nr.block_rate_record(n, fs, N=float("nan"), B=0.0, K=0.0, R=0.0, seed=0)

@@ -26,7 +26,7 @@ import weakref
 
 import numpy as np
 
-__all__ = ["Recent", "Suffixes", "Small", "remembering"]
+__all__ = ["Recent", "Suffixes", "Small", "holding", "remembering"]
 
 #: One entry per :func:`remembering` open (refine calls in threads each open one); every memory made.
 _OPEN: list = []
@@ -78,6 +78,23 @@ def remembering():
             memos = [] if _OPEN else list(_ALL)
         for memo in memos:
             with memo._lock:
+                if not getattr(memo, "_held", 0):  # a memory :func:`holding` keeps for the next call
+                    memo._items.clear()
+
+
+@contextlib.contextmanager
+def holding(memo):
+    """Within it, ``memo`` (a :class:`Small`) keeps what it remembered from one call (a :func:`remembering`) to the
+    next — a report's refinements of a log's axes, each a call, share what depends on none of them — and forgets
+    it when the last holding is left. It remembers still only within calls."""
+    with memo._lock:
+        memo._held += 1
+    try:
+        yield
+    finally:
+        with memo._lock:
+            memo._held -= 1
+            if not memo._held and not _OPEN:
                 memo._items.clear()
 
 
@@ -159,6 +176,7 @@ class Small:
     def __init__(self, keep: int):
         self.keep = keep
         self._items: dict = {}
+        self._held = 0  # open :func:`holding` scopes
         self._lock = threading.Lock()
         with _LOCK:
             _ALL.add(self)
