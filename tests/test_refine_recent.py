@@ -267,13 +267,16 @@ def test_null_records_equal_simulate_and_share_their_flicker(terms):
     for seed in (7919, [7919, 3]):
         ref = allanite.simulate(n, fs, **kw, seed=np.random.default_rng(seed))
         for _ in range(2):  # drawn, then found again
-            rng = np.random.default_rng(seed)
-            got = nr.block_rate_record(n, fs, **kw, seed=rng)
+            with nr.sharing():
+                rng = np.random.default_rng(seed)
+                got = nr.block_rate_record(n, fs, **kw, seed=rng)
+                assert len(nr._FLICKER._items) == (1 if terms[1] else 0)
             assert got.tobytes() == ref.tobytes()
             after = np.random.default_rng(seed)
             allanite.simulate(n, fs, **kw, seed=after)
             assert rng.bit_generator.state == after.bit_generator.state  # the next draws are simulate's
-    assert len(nr._FLICKER._items) == (2 if terms[1] else 0)
+    nr.block_rate_record(n, fs, **kw, seed=5)
+    assert nr._FLICKER._items == {}  # one call draws no record twice: outside ``sharing`` nothing is kept
     depth = len(_recent._OPEN)
     for _ in range(depth):  # leave the fixture's call: a plain call's memory is emptied when it returns
         _recent._OPEN.pop()

@@ -8,10 +8,10 @@ draws do not). Three quarters of such a record's cost is its flicker — Kasdin 
 twice its length — which is a function of the generator's state and the length alone. :func:`block_rate_record`
 is :func:`allanite.simulate`'s arithmetic for constant white-rate, flicker, random-walk and ramp coefficients,
 term for term in the same order, with the flicker taken from a memory (by the length and the generator's state
-before it, with the state after it) within a refine call; within :func:`sharing` from one call to the next: a
-report's refinements of a log's axes share them, so its second and later axes draw no flicker (≈ 50 MB kept
-meanwhile, 2 MB a record; no other memory is kept between the calls). Bit for bit :func:`allanite.simulate`'s
-record (``tests/test_refine_recent.py``).
+before it, with the state after it) within :func:`sharing`, from one refine call to the next: a report's
+refinements of a log's axes share them, so its second and later axes draw no flicker (≈ 50 MB kept meanwhile,
+2 MB a record; no other memory is kept between the calls, and a call outside it keeps none). Bit for bit
+:func:`allanite.simulate`'s record (``tests/test_refine_recent.py``).
 """
 
 from __future__ import annotations
@@ -41,7 +41,10 @@ def _state_key(rng: np.random.Generator) -> tuple:
 
 def _flicker(n: int, rng: np.random.Generator) -> np.ndarray:
     """``kasdin_walter(n, 1.0, rng)``, found again for the same length and generator state (the generator then
-    set to the state the draws leave it in)."""
+    set to the state the draws leave it in) within :func:`sharing` — one refine call draws no record twice, so
+    outside it nothing is kept (≈ 50 MB a call would hold for nothing)."""
+    if not _FLICKER._held:
+        return kasdin_walter(n, 1.0, rng)
     key = (n, _state_key(rng))
     hit = _FLICKER.get(key)
     if hit is not None:

@@ -86,7 +86,7 @@ def remembering():
 def holding(memo):
     """Within it, ``memo`` (a :class:`Small`) keeps what it remembered from one call (a :func:`remembering`) to the
     next — a report's refinements of a log's axes, each a call, share what depends on none of them — and forgets
-    it when the last holding is left. It remembers still only within calls."""
+    it when the last holding is left. It remembers still only within calls (:func:`remembering`)."""
     with memo._lock:
         memo._held += 1
     try:
@@ -94,7 +94,7 @@ def holding(memo):
     finally:
         with memo._lock:
             memo._held -= 1
-            if not memo._held and not _OPEN:
+            if not memo._held:
                 memo._items.clear()
 
 
