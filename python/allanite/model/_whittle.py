@@ -217,7 +217,7 @@ def _lawson_hanson(a: np.ndarray, b: np.ndarray, maxiter: int) -> np.ndarray:
     return raw_solver()(a, b, maxiter)
 
 
-def _fit_noise(power: np.ndarray, m: np.ndarray, basis: np.ndarray, start: np.ndarray | None, compiled=False):
+def _fit_noise(power: np.ndarray, m: np.ndarray, basis: np.ndarray, start: np.ndarray | None, compiled: bool = False):
     scale = np.maximum(basis.max(axis=0), 1e-300)
     a_s = basis / scale
     if start is None:
