@@ -2,8 +2,10 @@
 """The cost of one default ``allanite.refine`` (issue 29: ≤ 5 s per 10⁶ samples), before and after, as ratios.
 
 Records: seven ADIS16405 channels (10⁶ samples at 100 Hz, from the shared data: the slowest of
-``benches/results/refine.json`` — the accelerometers of runs 3 and 6 — and gyros) and three simulated sensors of ``tests/sensors.py`` (10⁶ samples at 100 Hz with a temperature channel, line families at
-100 Hz × 10⁶, a sawtooth at 1 kHz × 10⁷). Each record is refined with the default call in a fresh process
+``benches/results/refine.json`` — the accelerometers of runs 3 and 6 — and gyros), three simulated sensors of
+``tests/sensors.py`` (10⁶ samples at 100 Hz with a temperature channel, line families at 100 Hz × 10⁶, a sawtooth
+at 1 kHz × 10⁷) and a short 3-axis log with a temperature (1.2·10⁵ samples per axis at 100 Hz, every axis refined
+as ``allanite report --refine`` does; the row is the three calls). Each record is refined with the default call in a fresh process
 (imports paid by a small refine first, untimed), once with this checkout and once with the baseline — a
 ``python/`` folder of an earlier checkout (``--baseline``; by default a worktree of main at
 :data:`BASELINE` made under the temporary folder, with this checkout's compiled core copied in) — the two
@@ -23,6 +25,8 @@ Usage::
                                                         # checkout runs first
     python benches/bench_refine_cost.py --records sensor:temperature "sensor:line families" --out /tmp/x
                                                         # simulated sensors, by a part of their name
+    python benches/bench_refine_cost.py --records log --rounds 2 --out /tmp/x
+                                                        # the short 3-axis log with a temperature
 """
 
 from __future__ import annotations
@@ -57,6 +61,31 @@ SENSORS = [
     ("sensor", "consumer IMU line families"),
     ("sensor", "sawtooth 0.05 Hz, 1 kHz"),
 ]
+#: A short multi-axis log with a channel (a notebook user's 20 minutes): every axis refined as ``allanite report
+#: --refine`` refines them (one call per axis, the checks' null records shared between the calls where the checkout
+#: can: ``model/_null_records.sharing``); the row is the sum over the axes.
+LOGS = [("log", "3-axis gyro log with a temperature, 100 Hz × 1.2·10⁵ per axis")]
+LOG_AXES = (("gyro_x", 2e-3, 3e-3), ("gyro_y", 0.0, 2.5e-3), ("gyro_z", -1e-3, 3.5e-3))
+
+
+def _short_log():
+    """(axes (n, 3), fs, {"temp": channel}) of :data:`LOGS`: white rate, flicker and a random walk per axis, two of
+    the three following a room's temperature (a random walk through the housing's lag) by their coefficient."""
+    import numpy as np
+
+    import allanite
+
+    sys.path.insert(0, str(REPO / "tests"))
+    import sensors
+
+    n, fs = 120_000, 100.0
+    rng = np.random.default_rng(42)
+    temp = sensors.temperature_profile(np.arange(n) / fs, "walk", rng)
+    cols = []
+    for _name, c, white in LOG_AXES:
+        y = allanite.simulate(n, fs, N=white, K=2e-5, seed=rng) + 1.5e-3 * sensors.kasdin_walter(8 * n, 1.0, rng)[-n:]
+        cols.append(y + c * (temp - temp.mean()))
+    return np.column_stack(cols), fs, {"temp": temp + 0.01 * rng.standard_normal(n)}
 
 
 def _record(spec):
@@ -81,7 +110,10 @@ def _record(spec):
 
 
 def _spec(text: str) -> tuple:
-    """A record of ``--records``: ``RUN:AXIS`` (ADIS16405) or ``sensor:NAME`` (a part of a sensor's name)."""
+    """A record of ``--records``: ``RUN:AXIS`` (ADIS16405), ``sensor:NAME`` (a part of a sensor's name) or ``log`` (the
+    short 3-axis log with a temperature, :data:`LOGS`)."""
+    if text == "log":
+        return LOGS[0]
     kind, rest = text.split(":", 1)
     return ("sensor", rest) if kind == "sensor" else ("adis", int(kind), rest)
 
@@ -93,15 +125,45 @@ def worker(spec, out: Path) -> None:
     import allanite
     from refine_measured import _jsonable, summarize
 
-    x, fs, kw, name = _record(spec)
+    if spec[0] == "log":
+        x, fs, channels = _short_log()
+        kw, name = {"unit": "deg/s", "channels": channels}, spec[1]
+    else:
+        x, fs, kw, name = _record(spec)
     allanite.refine(np.random.default_rng(0).standard_normal(20_000), 10.0, progress=False)  # imports, untimed
     load = os.getloadavg()[0]
+
+    def summary(r, label):
+        return _jsonable(summarize(label, r)) | {
+            "fit_chi2": float(r.fit.chi2),
+            "unexplained_all": _jsonable(r.unexplained),
+        }
+
     t0, c0 = time.perf_counter(), time.process_time()
-    r = allanite.refine(x, fs, progress=False, **kw)
+    if spec[0] == "log":
+        with _sharing():
+            rs = [allanite.refine(x[:, k], fs, progress=False, **kw) for k in range(x.shape[1])]
+    else:
+        r = allanite.refine(x, fs, progress=False, **kw)
     seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
-    row = _jsonable(summarize(name, r)) | {"fit_chi2": float(r.fit.chi2), "unexplained_all": _jsonable(r.unexplained)}
+    if spec[0] == "log":
+        row = {"record": name, "axes": [summary(r, ax[0]) for r, ax in zip(rs, LOG_AXES)]}
+    else:
+        row = summary(r, name)
     info = {"row": row, "seconds": seconds, "cpu": cpu, "samples": int(x.size), "load": load}
     out.write_text(json.dumps(info, default=float))
+
+
+def _sharing():
+    """The report's scope over a log's axes (the null records' flicker kept between the calls), where the checkout
+    being timed has it; else nothing (a checkout before it refines each axis afresh, as its report did)."""
+    import contextlib
+
+    try:
+        from allanite.model._null_records import sharing
+    except ImportError:
+        return contextlib.nullcontext()
+    return sharing()
 
 
 def _baseline_python(ref: str) -> Path:
@@ -139,7 +201,10 @@ def main(argv=None) -> int:
     ap.add_argument("--baseline", type=Path, help="python/ folder of the baseline checkout (with its core)")
     ap.add_argument("--after", type=Path, default=REPO / "python", help="python/ folder to time (default: this one)")
     ap.add_argument(
-        "--records", nargs="+", metavar="RUN:AXIS", help="ADIS16405 records or sensor:NAME (default: the list above)"
+        "--records",
+        nargs="+",
+        metavar="RUN:AXIS",
+        help="ADIS16405 records, sensor:NAME or log (default: the lists above)",
     )
     ap.add_argument("--rounds", type=int, default=1, help="times each record is refined by each checkout")
     ap.add_argument("--worker", nargs=2, help=argparse.SUPPRESS)
@@ -152,7 +217,7 @@ def main(argv=None) -> int:
 
     out = a.out or (Path(tempfile.mkdtemp()) if a.quick else HERE / "results")
     base = a.baseline or _baseline_python(BASELINE)
-    specs = ADIS[:1] if a.quick else ADIS + SENSORS
+    specs = ADIS[:1] if a.quick else ADIS + SENSORS + LOGS
     if a.records:
         specs = [_spec(r) for r in a.records]
     rows, load0 = [], os.getloadavg()

@@ -136,6 +136,7 @@ def test_imports_run_one_way(module):
 #: refine's inputs checked, the proposals per domain (curve candidates, removals in time, change points), the loop, the package.
 MODEL_RANKS = {
     "model._recent": -1,
+    "model._null_records": -0.5,  # the checks' null records, their flicker remembered (simulation, _recent)
     "model._chunked": -1,  # record-length passes a chunk at a time (numpy, scipy only)
     "model._medians": -1,  # medians along an axis by one sort (numpy only)
     "model._welch_spread": -1,  # Welch segments' spread per band: the line search's dof (numpy only)
@@ -147,7 +148,7 @@ MODEL_RANKS = {
     "model._batched": 0,
     "model._chi2_draws": 0,
     "model._covariance": 0,
-    "model._nnls": 0,
+    "model._nnls": -0.5,  # SciPy's Lawson–Hanson routine without its wrapper (numpy, scipy only)
     "model.terms": 0,
     "model.effects": 0,
     "model.linefit": 0,

@@ -30,7 +30,7 @@ from scipy.optimize import nnls as scipy_nnls
 
 import allanite
 from allanite.model import _covariance, _nnls, linefit, lines, tracing
-from allanite.model._recent import Recent
+from allanite.model._recent import Recent, Small
 from allanite.model.refinement import _brent, _irls, curvefit
 from allanite.model.refinement import candidates as cands
 from allanite.model.refinement.candidates import bandwidth_grids
@@ -271,6 +271,7 @@ def test_refine_with_remembered_columns_equals_recomputing(monkeypatch):
     monkeypatch.setattr(loop, "remembering_spectra", contextlib.nullcontext)  # every line spectrum afresh
     monkeypatch.setattr(curvefit, "searches", _one_at_a_time)  # each search alone, when proposed
     monkeypatch.setattr(Recent, "get", lambda self, arr, key=(): None)  # held-out curves, phasors, … afresh
+    monkeypatch.setattr(Small, "get", lambda self, key: None)  # noise fits, Bartlett factors afresh
     plain = allanite.refine(y, fs, channels={"temp": temp}, progress=False)
     assert cached.found == plain.found == ["gauss_markov", "regression"]
     for a, b in zip(cached.steps, plain.steps):

@@ -213,3 +213,92 @@ def test_memories_keep_one_copy_of_the_same_samples():
     first.put(strided, (), 5)
     assert first.get(np.arange(0.0, 40.0, 2.0)) == 5 and first._items[-1][1].flags.c_contiguous
     assert second._items[0][1] is kept[0]  # still kept by the second memory after the first let it go
+
+
+def test_remembered_noise_fits_and_bartlett_factors_equal_fresh_ones(monkeypatch):
+    """The Whittle noise fit and the coupling bootstrap's Bartlett factors, found again by their inputs' bytes within
+    a refine (a cold-started joint fit refits the record's own power; unexplained's channel check bootstraps the
+    candidate step's null again): equal to the bit to a fresh computation, read-only."""
+    import allanite
+    from allanite.model import _coupling
+    from allanite.model import _whittle as wh
+    from allanite.model._recent import Small
+
+    monkeypatch.setattr(_coupling, "BOOT_DRAWS", 20)  # a small bootstrap: the memory, not the calibration, is tested
+    rng = np.random.default_rng(5)
+    n = 6000
+    temp = np.cumsum(rng.standard_normal(n)) * 0.01
+    y = allanite.simulate(n, 10.0, N=1e-3, B=2e-4, K=1e-5, seed=rng)
+    bands = wh.spectra(y, [temp - temp.mean()], 10.0)
+    power, m = bands.q[bands.par] / bands.m[bands.par], bands.m[bands.par]
+    first = wh.fit_noise(power, m, bands.basis)
+    again = wh.fit_noise(power.copy(), m.copy(), bands.basis.copy())  # equal inputs in other arrays
+    assert again is first and not first[0].flags.writeable and not first[1].flags.writeable
+    fresh = wh._fit_noise(power, m, bands.basis, None)
+    assert [a.tobytes() for a in first] == [a.tobytes() for a in fresh]
+    warm = wh.fit_noise(power, m, bands.basis, first[0])  # another start: another fit
+    assert warm is not first
+    null = wh.joint_fit(bands, wh.Design([], []))
+    inside = _coupling.bootstrap_scale(bands, null)
+    assert _coupling.bootstrap_scale(bands, null) is inside
+    assert _coupling._bootstrap_scale(bands, null, 0) == inside
+    assert _coupling.bootstrap_scale(bands, null, seed=1) != inside  # another seed: other draws
+    small = Small(2)
+    for k in range(3):
+        small.put(Small.key(np.arange(3.0) + k, k), k)
+    assert small.get(Small.key(np.arange(3.0), 0)) is None  # the oldest out
+    assert small.get(Small.key(np.arange(3.0) + 2, 2)) == 2
+    assert small.get(Small.key(np.arange(3, dtype=np.int64) + 2, 2)) is None  # another dtype: another key
+
+
+@pytest.mark.parametrize(
+    "terms", [(1.0, 0.3, 0.02, 0.0), (0.0, 0.5, 0.0, 1e-4), (2.0, 0.0, 0.1, 0.0), (0.7, 0.2, 0.05, 3e-5)]
+)
+def test_null_records_equal_simulate_and_share_their_flicker(terms):
+    """The checks' null records (``model/_null_records.py``): allanite.simulate's numbers to the bit, for an int
+    seed and a generator, the flicker found again for the same length and generator state (the generator left where
+    the draws leave it), kept from one call to the next only within ``sharing``."""
+    import allanite
+    from allanite.model import _null_records as nr
+    from allanite.model import _recent
+
+    n, fs = 4096, 0.37
+    kw = dict(zip("NBKR", terms))
+    for seed in (7919, [7919, 3]):
+        ref = allanite.simulate(n, fs, **kw, seed=np.random.default_rng(seed))
+        for _ in range(2):  # drawn, then found again
+            with nr.sharing():
+                rng = np.random.default_rng(seed)
+                got = nr.block_rate_record(n, fs, **kw, seed=rng)
+                assert len(nr._FLICKER._items) == (1 if terms[1] else 0)
+            assert got.tobytes() == ref.tobytes()
+            after = np.random.default_rng(seed)
+            allanite.simulate(n, fs, **kw, seed=after)
+            assert rng.bit_generator.state == after.bit_generator.state  # the next draws are simulate's
+    nr.block_rate_record(n, fs, **kw, seed=5)
+    assert nr._FLICKER._items == {}  # one call draws no record twice: outside ``sharing`` nothing is kept
+    depth = len(_recent._OPEN)
+    for _ in range(depth):  # leave the fixture's call: a plain call's memory is emptied when it returns
+        _recent._OPEN.pop()
+    nr._FLICKER._items.clear()  # (what this test drew within the fixture's call)
+    try:
+        with nr.sharing():
+            with _recent.remembering():
+                nr.block_rate_record(n, fs, **kw, seed=1)
+            kept = len(nr._FLICKER._items)
+            assert kept == (1 if terms[1] else 0)  # between two calls of a report
+            with _recent.remembering():
+                assert (
+                    nr.block_rate_record(n, fs, **kw, seed=1).tobytes()
+                    == allanite.simulate(n, fs, **kw, seed=1).tobytes()
+                )
+            assert len(nr._FLICKER._items) == kept
+        assert nr._FLICKER._items == {}  # the report's scope left: forgotten
+        with _recent.remembering():
+            nr.block_rate_record(n, fs, **kw, seed=2)
+        assert nr._FLICKER._items == {}  # a call outside any sharing: forgotten when it returns
+    finally:
+        for _ in range(depth):
+            _recent._OPEN.append(True)
+    with pytest.raises(ValueError, match="finite"):
+        nr.block_rate_record(n, fs, N=float("nan"), B=0.0, K=0.0, R=0.0, seed=0)

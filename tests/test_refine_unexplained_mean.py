@@ -113,14 +113,14 @@ def test_a_small_level_does_not_simulate_a_record_beyond_the_cap(monkeypatch):
     be 7.7·10⁸ block-rate samples (gigabytes). The draws stop at :data:`MAX_BOOT`; below what they resolve the
     threshold is their largest statistic (the rank rule's last index)."""
     asked = []
-    real = tracing.simulate
+    real = tracing.block_rate_record  # the nulls' records (allanite.simulate's numbers, model/_null_records.py)
 
     def counted(n, *args, **kw):
         asked.append(n)
         assert n <= tracing.SIM_CHUNK, f"{n} block-rate samples asked for at once"
         return real(n, *args, **kw)
 
-    monkeypatch.setattr(tracing, "simulate", counted)
+    monkeypatch.setattr(tracing, "block_rate_record", counted)
     theta = [0.0, 4e-6, 9e-8, 4e-12, 0.0]
     thr = ms.mean_step_threshold(200_000, FS, START, theta, alpha("unexplained:mean", 1e-4))
     # MAX_BOOT records, a chunk of records at a time (each chunk a whole long record: the last one's spare pieces

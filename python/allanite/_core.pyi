@@ -63,6 +63,18 @@ def irls_curves(
     nu_cols, ν from nu0; fixed[k] a held coefficient or NaN: (θ (designs, k), ν (designs, n)). ValueError
     for a non-finite weighted problem, RuntimeError when the NNLS does not settle (as scipy's nnls)."""
 
+def whittle_noise(
+    shapes: npt.NDArray[np.float64],
+    power: npt.NDArray[np.float64],
+    root_m: npt.NDArray[np.float64],
+    s_start: npt.NDArray[np.float64],
+    max_iter: int,
+    rtol: float,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """The Whittle noise fit's reweighted NNLS: non-negative amounts of shapes (bands, k) fitted to the band
+    powers, weights root_m/S from the level s_start on, until S moves by less than rtol: (amounts (k), S
+    (bands)). ValueError for a non-finite weighted problem, RuntimeError when the NNLS does not settle."""
+
 def davar_part(
     columns: Sequence[npt.NDArray[np.float64]],
     window: int,

@@ -16,6 +16,7 @@ from scipy.stats import f as f_dist
 from . import _whittle as wh
 from ._edge import edge_factor
 from ._lag import lag_profile, lag_response, lag_test
+from ._recent import Small
 from ._regressors import regressor_design
 from ._shares import TERM_SHARE
 
@@ -104,7 +105,7 @@ def _null_bands(bands, s, rng):
     rest_dof = bands.m - has
     rest = np.where(rest_dof > 0, rng.gamma(np.maximum(rest_dof, 1e-9), 1.0), 0.0)
     g = (np.sqrt(s * g00) * w)[:, None]
-    return dataclasses.replace(bands, q=s * (np.abs(w) ** 2 + rest), g=g, G=bands.G[:, :1, :1])
+    return dataclasses.replace(bands, q=s * (np.abs(w) ** 2 + rest), g=g, G=bands.G[:, :1, :1], compiled=True)
 
 
 def bootstrap_scale(bands, null, seed: int = 0) -> tuple[float, float]:
@@ -112,7 +113,22 @@ def bootstrap_scale(bands, null, seed: int = 0) -> tuple[float, float]:
     null: their means over :data:`BOOT_DRAWS` records of the null fit's noise beside the same channel
     (:func:`_null_bands`; the noise refitted in every draw from a cold start, as on the record: the noise fit's
     optimum depends on where it starts — started at the null fit's amounts, a 3600-sample record's factor read 0.9
-    where 2.5 cold) over χ²'s means 2 and 1 — each at least 1. Seeded: the same record gets the same thresholds."""
+    where 2.5 cold) over χ²'s means 2 and 1 — each at least 1. Seeded: the same record gets the same thresholds
+    (within a refine found again, not drawn again: the draws read the bands' counts, the channel's power, the
+    noise model's shapes and the null's noise level)."""
+    key = Small.key(bands.m, bands.G[:, :1, :1], bands.par, bands.basis, null["s"], seed, BOOT_DRAWS)
+    hit = _SCALES.get(key)
+    if hit is None:
+        hit = _SCALES.put(key, _bootstrap_scale(bands, null, seed))
+    return hit
+
+
+#: Bartlett's factors by the bootstrap's inputs, within a refine: where the coupling is not kept, unexplained's
+#: channel check tests the same record beside the same channel at the same null fit (the same draws, refitted).
+_SCALES = Small(8)
+
+
+def _bootstrap_scale(bands, null, seed: int) -> tuple[float, float]:
     rng = np.random.default_rng(seed)
     one = regressor_design([], bands.m.size)
     total = np.zeros(2)

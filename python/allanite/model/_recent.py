@@ -11,6 +11,8 @@ of each content between them (:func:`_shared_copy`): the outlier test's local sc
 for each frequency, the held-out curves and the line refits are asked for on the same samples, and each memory's
 own copy was 213 MB of copies for 122 MB of distinct samples in one refine of a 10⁶-sample ADIS channel.
 
+:class:`Small` remembers the last results of a small computation repeated many times on equal small inputs (a
+noise fit of a few hundred numbers asked for again by every nested fit's cold start), by the inputs' bytes.
 :class:`Suffixes` remembers the last few results computed per τ (covariance blocks, EDF columns) for a fit that
 cuts its shortest τ one at a time. Both are used from threads (Dask workers, a user's threads, the report's):
 each memory's look-ups and inserts hold its lock, the computations run outside it.
@@ -24,7 +26,7 @@ import weakref
 
 import numpy as np
 
-__all__ = ["Recent", "Suffixes", "remembering"]
+__all__ = ["Recent", "Suffixes", "Small", "holding", "remembering"]
 
 #: One entry per :func:`remembering` open (refine calls in threads each open one); every memory made.
 _OPEN: list = []
@@ -76,6 +78,23 @@ def remembering():
             memos = [] if _OPEN else list(_ALL)
         for memo in memos:
             with memo._lock:
+                if not getattr(memo, "_held", 0):  # a memory :func:`holding` keeps for the next call
+                    memo._items.clear()
+
+
+@contextlib.contextmanager
+def holding(memo):
+    """Within it, ``memo`` (a :class:`Small`) keeps what it remembered from one call (a :func:`remembering`) to the
+    next — a report's refinements of a log's axes, each a call, share what depends on none of them — and forgets
+    it when the last holding is left. It remembers still only within calls (:func:`remembering`)."""
+    with memo._lock:
+        memo._held += 1
+    try:
+        yield
+    finally:
+        with memo._lock:
+            memo._held -= 1
+            if not memo._held:
                 memo._items.clear()
 
 
@@ -145,4 +164,44 @@ class Suffixes:
             self._items[(m, rest)] = value
             while len(self._items) > self.keep:
                 self._items.pop(next(iter(self._items)))
+        return value
+
+
+class Small:
+    """The last ``keep`` values computed from a few small arrays (and hashable scalars), found again by the arrays'
+    bytes, shapes and dtypes: a dictionary look-up, for computations of microseconds to milliseconds repeated
+    thousands of times in a refine on equal inputs. Remembers only within :func:`remembering`, as :class:`Recent`
+    does; the values are handed out as they were put (the caller keeps them read-only)."""
+
+    def __init__(self, keep: int):
+        self.keep = keep
+        self._items: dict = {}
+        self._held = 0  # open :func:`holding` scopes
+        self._lock = threading.Lock()
+        with _LOCK:
+            _ALL.add(self)
+
+    @staticmethod
+    def key(*parts) -> tuple:
+        """A key of ``parts``: each array as (shape, dtype, bytes), anything else as itself (hashable)."""
+        return tuple(
+            (p.shape, p.dtype.str, np.ascontiguousarray(p).tobytes()) if isinstance(p, np.ndarray) else p for p in parts
+        )
+
+    def get(self, key: tuple):
+        """The value remembered for ``key``, or None (always outside :func:`remembering`)."""
+        if not _OPEN:
+            return None
+        with self._lock:
+            return self._items.get(key)
+
+    def put(self, key: tuple, value):
+        """Remember ``value`` for ``key`` (within :func:`remembering`; the oldest beyond ``keep`` out); returns it."""
+        if _OPEN:
+            with self._lock:
+                if _OPEN:
+                    self._items.pop(key, None)
+                    self._items[key] = value
+                    while len(self._items) > self.keep:
+                        self._items.pop(next(iter(self._items)))
         return value

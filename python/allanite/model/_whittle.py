@@ -34,7 +34,10 @@ from scipy import fft as sfft
 from scipy.optimize import nnls as scipy_nnls
 from scipy.signal.windows import tukey
 
+from .. import _core
 from . import _rfft
+from ._nnls import raw_solver
+from ._recent import Small
 
 __all__ = [
     "Bands",
@@ -93,6 +96,9 @@ class Bands:
     fs: float
     n_diff: int
     source: object | None = None
+    #: a null draw's bands (:func:`allanite.model._coupling._null_bands`): their noise fits in the Rust core
+    #: (:data:`COMPILED`, the same loop, the numbers to rounding); the record's own fits stay SciPy's, bit for bit
+    compiled: bool = False
 
     @property
     def own(self) -> np.ndarray:
@@ -174,9 +180,44 @@ def spectra(y: np.ndarray, regressors: Iterable[np.ndarray], fs: float, parity: 
     return Bands(m, f, q, g, big, par, basis, names, float(fs), n_diff)
 
 
-def fit_noise(power: np.ndarray, m: np.ndarray, basis: np.ndarray, start: np.ndarray | None = None):
+#: The noise fit's loop in the Rust core (``allanite._core.whittle_noise``), or None where the core lacks it.
+COMPILED = getattr(_core, "whittle_noise", None)
+#: Relative change of the noise level in every band below which the noise fit's reweighting stops.
+NOISE_RTOL = 1e-6
+
+#: Noise fits by their inputs, within a refine: every cold-started :func:`joint_fit` (its coefficients 0) refits,
+#: at its first step, the noise of the record's own power — the null model's, bit for bit —, and the coupling's
+#: bootstrap does so three times in each of its draws: 60 % of a short record's noise fits were repeats.
+_FITS = Small(512)
+
+
+def fit_noise(
+    power: np.ndarray, m: np.ndarray, basis: np.ndarray, start: np.ndarray | None = None, compiled: bool = False
+):
     """Whittle fit of non-negative amounts of ``basis`` to band-mean powers ``power`` (m bins each): iteratively
-    reweighted NNLS (weights m/S², the score equations of Σ m(ln S + P/S)). Returns (amounts, S)."""
+    reweighted NNLS (weights m/S², the score equations of Σ m(ln S + P/S)). Returns (amounts, S), read-only
+    (within a refine the same inputs' fit is found again, not repeated). ``compiled``: the loop in the Rust core
+    where it has it (:data:`COMPILED`; its own Lawson–Hanson NNLS: the numbers to rounding, not SciPy's bits)."""
+    key = Small.key(power, m, basis, start, compiled)
+    hit = _FITS.get(key)
+    if hit is not None:
+        return hit
+    coef, s_cur = _fit_noise(power, m, basis, start, compiled)
+    coef.setflags(write=False)
+    s_cur.setflags(write=False)
+    return _FITS.put(key, (coef, s_cur))
+
+
+def _lawson_hanson(a: np.ndarray, b: np.ndarray, maxiter: int) -> np.ndarray:
+    """``scipy.optimize.nnls(a, b, maxiter=maxiter)[0]``: the same routine and numbers, without the wrapper's checks
+    (:func:`allanite.model._nnls.raw_solver`: a quarter of a noise fit's time, and a short record's refine makes
+    ≈ 2·10⁴ of these calls); the public function, with its error, where ``a`` or ``b`` is not finite."""
+    if not math.isfinite(float(a.sum()) + float(b.sum())):
+        return scipy_nnls(a, b, maxiter=maxiter)[0]
+    return raw_solver()(a, b, maxiter)
+
+
+def _fit_noise(power: np.ndarray, m: np.ndarray, basis: np.ndarray, start: np.ndarray | None, compiled: bool = False):
     scale = np.maximum(basis.max(axis=0), 1e-300)
     a_s = basis / scale
     if start is None:
@@ -187,12 +228,16 @@ def fit_noise(power: np.ndarray, m: np.ndarray, basis: np.ndarray, start: np.nda
     else:
         s_cur = np.maximum(a_s @ (start * scale), 1e-300)
     coef = np.zeros(basis.shape[1])
+    root_m, maxiter = np.sqrt(m), 50 * basis.shape[1]
+    if compiled and COMPILED is not None:
+        coef, s_cur = COMPILED(np.ascontiguousarray(a_s), power, root_m, s_cur, MAX_ITER, NOISE_RTOL)
+        return coef / scale, s_cur
     for _ in range(MAX_ITER):
-        sw = np.sqrt(m) / s_cur
-        coef_new, _ = scipy_nnls(a_s * sw[:, None], power * sw, maxiter=50 * basis.shape[1])
+        sw = root_m / s_cur
+        coef_new = _lawson_hanson(a_s * sw[:, None], power * sw, maxiter)
         s_new = a_s @ coef_new
         s_new = np.maximum(s_new, 1e-12 * max(float(s_new.max()), 1e-300))
-        done = np.max(np.abs(s_new / s_cur - 1.0)) < 1e-6
+        done = np.max(np.abs(s_new / s_cur - 1.0)) < NOISE_RTOL
         coef, s_cur = coef_new, s_new
         if done:
             break
@@ -266,7 +311,7 @@ def noise_psd(bands: Bands, resid: np.ndarray, start=None):
     amounts = None
     if bands.par.any():
         par_power = resid[bands.par] / bands.m[bands.par]
-        amounts, s_par = fit_noise(par_power, bands.m[bands.par], bands.basis, start)
+        amounts, s_par = fit_noise(par_power, bands.m[bands.par], bands.basis, start, bands.compiled)
         s = s.copy()
         s[bands.par] = s_par
     return s, amounts

@@ -25,9 +25,9 @@ from scipy import signal
 from scipy.linalg import solve_triangular
 from scipy.optimize import minimize_scalar
 
-from ..simulation import simulate
 from . import _chi2_draws, _covariance
 from ._chunked import welch_mean
+from ._null_records import block_rate_record
 from ._recent import Recent
 
 __all__ = [
@@ -163,13 +163,14 @@ def simulated_block_mean_chunks(nb: int, per: int, fs: float, terms, theta, n_bo
     i). A null's memory no longer grows with its records (2²² samples at once were ≈ 240 MB with the flicker's
     transforms); each record is, as before, a piece of a record ≥ 2¹⁸ block-rate samples long."""
     coef = {t: math.sqrt(max(float(v), 0.0)) for t, v in zip(terms, theta)}
-    terms5 = {t: coef.get(t, 0.0) for t in ("N", "B", "K", "R")}
+    terms4 = {t: coef.get(t, 0.0) for t in ("N", "B", "K", "R")}
     if nb * n_boot <= SIM_CHUNK:
-        yield np.asarray(simulate(nb * n_boot, fs / per, **terms5, seed=seed), dtype=np.float64).reshape(n_boot, nb).T
+        long = block_rate_record(nb * n_boot, fs / per, **terms4, seed=seed)
+        yield np.asarray(long, dtype=np.float64).reshape(n_boot, nb).T
         return
     each = max(1, SIM_CHUNK // nb)
     for i, first in enumerate(range(0, n_boot, each)):
-        long = simulate(nb * each, fs / per, **terms5, seed=np.random.default_rng([seed, i]))
+        long = block_rate_record(nb * each, fs / per, **terms4, seed=np.random.default_rng([seed, i]))
         k = min(each, n_boot - first)
         yield np.asarray(long[: nb * k], dtype=np.float64).reshape(k, nb).T
 
@@ -181,15 +182,8 @@ def simulated_block_means(nb: int, per: int, fs: float, terms, theta, n_boot: in
     as the consecutive pieces of one long record — the drift check's null (5·10⁵ samples; the mean and steps
     checks' larger nulls are drawn a chunk at a time, :func:`simulated_block_mean_chunks`)."""
     coef = {t: math.sqrt(max(float(v), 0.0)) for t, v in zip(terms, theta)}
-    long = simulate(
-        nb * n_boot,
-        fs / per,
-        N=coef.get("N", 0.0),
-        B=coef.get("B", 0.0),
-        K=coef.get("K", 0.0),
-        R=coef.get("R", 0.0),
-        seed=seed,
-    )
+    terms4 = {t: coef.get(t, 0.0) for t in ("N", "B", "K", "R")}
+    long = block_rate_record(nb * n_boot, fs / per, **terms4, seed=seed)
     return np.asarray(long, dtype=np.float64).ravel().reshape(n_boot, nb).T
 
 

@@ -81,11 +81,24 @@ def refine_candidates(refine) -> tuple | None:
     return names
 
 
+def _axis_notes(ref, name: str) -> list[str]:
+    """The notes the page needs from one axis's refinement: which samples the searches saw filled, and a counter's
+    exact quantisation term (its Q is the counter's: said where it is read)."""
+    from ..model.refinement._gapfill import filled_words
+
+    out = []
+    if ref.filled:
+        out.append(f"Model refinement of {name}: {filled_words(ref.filled)}.")
+    if ref.counter is not None:
+        out.append(f"Model refinement of {name}: {ref.counter.describe(ref.fit.unit)}.")
+    return out
+
+
 def refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes) -> list:
     """:func:`allanite.refine` on every axis (None for an axis it fails on, with a note why); ``asked``: the
     candidate effects and the other channels (None: none)."""
     from ..model import refine as refine_axis  # the refinement package (scipy.signal) only when asked
-    from ..model.refinement._gapfill import filled_words
+    from ..model._null_records import sharing
 
     candidates, channels = asked
 
@@ -93,26 +106,24 @@ def refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes) -> li
     # the same τ range the whole-record fit used (none unless given): start at 0.1 s when the
     # shortest τ are below it, as real gyros' anti-alias filters colour them
     t0 = 0.1 if static.tau[0] < 0.1 else None
-    for k in range(x.shape[1]):
-        try:
-            refinements.append(
-                refine_axis(
-                    axis_column(x, k),
-                    fs,
-                    input=input,
-                    unit=unit_name,
-                    tau_range=None if t0 is None else (t0, None),
-                    candidates=candidates,
-                    channels=channels,
-                    gaps="skip" if np.any(np.asarray(static.missing) > 0) else "error",
+    # the checks' null records are every axis's: their flicker kept from one axis's call to the next
+    with sharing():
+        for k in range(x.shape[1]):
+            try:
+                refinements.append(
+                    refine_axis(
+                        axis_column(x, k),
+                        fs,
+                        input=input,
+                        unit=unit_name,
+                        tau_range=None if t0 is None else (t0, None),
+                        candidates=candidates,
+                        channels=channels,
+                        gaps="skip" if np.any(np.asarray(static.missing) > 0) else "error",
+                    )
                 )
-            )
-            if refinements[-1].filled:  # the one note the page needs: which samples the searches saw filled
-                notes.append(f"Model refinement of {axis_names[k]}: {filled_words(refinements[-1].filled)}.")
-            counter = refinements[-1].counter  # its Q term is the counter's exact one: said where it is read
-            if counter is not None:
-                notes.append(f"Model refinement of {axis_names[k]}: {counter.describe(refinements[-1].fit.unit)}.")
-        except AllaniteError as exc:
-            refinements.append(None)
-            notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")
+                notes.extend(_axis_notes(refinements[-1], axis_names[k]))
+            except AllaniteError as exc:
+                refinements.append(None)
+                notes.append(f"Model refinement of {axis_names[k]} failed: {exc}")
     return refinements

@@ -3,7 +3,7 @@
 
 use crate::{c_slice, parameter_error, run_interruptible, to_2d};
 use numpy::{
-    PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods,
+    PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods,
 };
 use pyo3::prelude::*;
 
@@ -127,4 +127,47 @@ pub(crate) fn irls_curves<'py>(
         }
     })?;
     Ok((to_2d(py, g_n, k, theta)?, to_2d(py, g_n, n, nu)?))
+}
+
+/// The Whittle noise fit's reweighted NNLS (allanite-core `fit::whittle`): `shapes` (bands, k) scaled
+/// as Python scales them, `power`, `root_m` and the first pass's level `s_start` per band. Returns
+/// (amounts, level per band). Errors as `scipy.optimize.nnls`'s: ValueError for a non-finite weighted
+/// problem, RuntimeError when the NNLS does not settle. A fit is some tens of microseconds: the GIL
+/// is kept, and Ctrl-C is seen between fits.
+#[pyfunction]
+#[pyo3(signature = (shapes, power, root_m, s_start, max_iter, rtol))]
+#[allow(clippy::type_complexity)]
+pub(crate) fn whittle_noise<'py>(
+    py: Python<'py>,
+    shapes: PyReadonlyArray2<'py, f64>,
+    power: PyReadonlyArray1<'py, f64>,
+    root_m: PyReadonlyArray1<'py, f64>,
+    s_start: PyReadonlyArray1<'py, f64>,
+    max_iter: usize,
+    rtol: f64,
+) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    use allanite_core::fit::curves::CurveFitError;
+    let (nb, k) = (shapes.shape()[0], shapes.shape()[1]);
+    let a = c_slice(py, &shapes, "shapes")?;
+    let (p, r, s) = (
+        c_slice(py, &power, "power")?,
+        c_slice(py, &root_m, "root_m")?,
+        c_slice(py, &s_start, "s_start")?,
+    );
+    if p.len() != nb || r.len() != nb || s.len() != nb {
+        return Err(parameter_error(
+            py,
+            format!("whittle_noise: power, root_m and s_start must have one value per band ({nb})"),
+        ));
+    }
+    let (coef, level) = allanite_core::fit::whittle::whittle_noise(a, k, p, r, s, max_iter, rtol)
+        .map_err(|e| match e {
+        CurveFitError::NonFinite => {
+            pyo3::exceptions::PyValueError::new_err("array must not contain infs or NaNs")
+        }
+        CurveFitError::MaxIter => {
+            pyo3::exceptions::PyRuntimeError::new_err("Maximum number of iterations reached.")
+        }
+    })?;
+    Ok((PyArray1::from_vec(py, coef), PyArray1::from_vec(py, level)))
 }

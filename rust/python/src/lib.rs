@@ -37,7 +37,7 @@ use deviations::{
     deviation_gaps, deviation_gaps_dynamic, deviation_static, mtie_phase, ohvar_dynamic, tie_gaps,
     tierms_phase, ttotvar_static,
 };
-use fits::{fit_windows, irls_curves};
+use fits::{fit_windows, irls_curves, whittle_noise};
 use phase_terms::{allan_covariance_phase, oavar_phase_gaps, pvar_phase};
 use pyo3::prelude::*;
 use streaming::StreamingVariance;
@@ -52,6 +52,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(davar_hann, m)?)?;
     m.add_function(wrap_pyfunction!(fit_windows, m)?)?;
     m.add_function(wrap_pyfunction!(irls_curves, m)?)?;
+    m.add_function(wrap_pyfunction!(whittle_noise, m)?)?;
     m.add_function(wrap_pyfunction!(phase_grid::phase_bins, m)?)?;
     m.add_function(wrap_pyfunction!(phase_grid::add_waveform, m)?)?;
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;

@@ -10,6 +10,7 @@
 pub mod curves;
 mod dense;
 mod shared;
+pub mod whittle;
 mod window;
 
 use crate::cancel::Cancel;
