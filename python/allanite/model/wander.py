@@ -13,7 +13,9 @@ wanders: the lines smear over k·Δf and a fixed-frequency fit leaves most of th
    0.225–0.45·f0 away), times 2, at least :data:`MIN_CYCLES`/T;
 3. complex demodulation at k·f0: the band ±B of the zero-padded spectrum (cosine tapered to 1.5·B) shifted to 0
    and transformed back (the record's own end stays an edge, not a wrap), its phase unwrapped and divided by k —
-   the fundamental's phase θ(t) beside 2π·f0·t; interpolated linearly at every sample;
+   the fundamental's phase θ(t) beside 2π·f0·t; then once more against that track (:func:`_retracked`: near the
+   ends the low pass sees one side only, which biases a phase running away from a fixed carrier); interpolated
+   linearly at every sample;
 4. each order k removed as a_k·cos(k·θ) + b_k·sin(k·θ): amplitudes constant per harmonic (least squares on every
    sample), the tracked phase shared — held out, the amplitudes are refitted on the held-in blocks with θ fixed
    (as a steady family's are with its frequencies fixed).
@@ -185,6 +187,69 @@ def _demodulate(pad_spec: np.ndarray, n: int, fs: float, fc: float, band: float,
     return z, knots[inside], snr
 
 
+def _phase_band(knots: np.ndarray, dev: np.ndarray, fs: float, band: float, n: int) -> float:
+    """The fundamental's phase bandwidth: the highest frequency where the first track's periodogram (less its line,
+    Hann-windowed) stands 10× above its own floor (the median of its upper half-band over ln 2: the track's noise,
+    white within ±band), × 1.5; within [MIN_CYCLES/T, band]. The carrier's band must hold the line's whole spread
+    (k·Δf); the phase itself moves far slower (a wheel's over 13 000 s), and its noise goes as the band it is read
+    in."""
+    t = knots / fs
+    d = dev - np.polyval(np.polyfit(t, dev, 1), t)
+    p = np.abs(np.fft.rfft(d * np.hanning(d.size))) ** 2  # Hann: a phase swinging radians leaks no far floor
+    f = np.fft.rfftfreq(d.size, t[1] - t[0])
+    low = MIN_CYCLES * fs / n
+    upper = (f > band / 2) & (f <= band)
+    if upper.sum() < 8:
+        return band
+    floor = float(np.median(p[upper]) / math.log(2.0))
+    above = f[(f <= band) & (p > 10.0 * floor)]
+    return float(min(max(1.5 * above.max() if above.size else low, low), band))
+
+
+def _smoothed(knots: np.ndarray, dev: np.ndarray, fs: float, band: float) -> np.ndarray:
+    """The track low-passed to ±band (cosine taper to 1.5·band), less its straight line, extended by half its length
+    at each end by point reflection about the end value (slope carries on: no jump, no kink at the ends)."""
+    t = knots / fs
+    line = np.polyval(np.polyfit(t, dev, 1), t)
+    d = dev - line
+    h = d.size // 2
+    ext = np.concatenate([2 * d[0] - d[h:0:-1], d, 2 * d[-1] - d[-2 : -h - 2 : -1]])
+    spec = np.fft.rfft(ext)
+    f = np.fft.rfftfreq(ext.size, t[1] - t[0])
+    taper = np.where(f <= band, 1.0, 0.5 * (1 + np.cos(np.pi * np.minimum(f - band, 0.5 * band) / (0.5 * band))))
+    return np.fft.irfft(spec * taper, ext.size)[h : h + d.size] + line
+
+
+def _retracked(y: np.ndarray, fs: float, f0: float, k0: int, knots: np.ndarray, dev: np.ndarray, band: float):
+    """The phase tracked once more against the first track: the record times e^{−i2π·k0·phase}, low-passed to ±band
+    (zero-padded, tapered as in :func:`_demodulate`), its phase added to the first's. Near the record's ends the low
+    pass averages over one side only, which biases a phase that runs away from the carrier (a wheel's 1.2 Hz
+    wandering 0.003 Hz, at B = 0.006 Hz: ≈ 1.6 rad at the ends); against the first track what is left is small."""
+    n = y.size
+    w = np.empty(n, dtype=np.complex128)
+    mean = float(y.mean())
+    for s in range(0, n, CHUNK):
+        x = np.arange(s, min(s + CHUNK, n), dtype=np.float64)
+        c = np.mod(k0 * (f0 * x / fs + np.interp(x, knots, dev)), 1.0)
+        w[s : s + CHUNK] = (y[s : s + CHUNK] - mean) * np.exp(-2j * np.pi * c)
+    spec = np.fft.fft(w, 2 * n)
+    del w
+    df = fs / (2 * n)
+    q = int(math.ceil(1.5 * band / df))
+    j = np.arange(-q, q + 1)
+    off = np.abs(j * df)
+    taper = np.where(off <= band, 1.0, 0.5 * (1 + np.cos(np.pi * (off - band) / (0.5 * band))))
+    taper[off > 1.5 * band] = 0.0
+    m = 1 << max(14, int(math.ceil(math.log2(4 * j.size))))
+    base = np.zeros(m, dtype=np.complex128)
+    base[j % m] = spec[j % (2 * n)] * taper
+    z = np.fft.ifft(base)
+    k2 = np.arange(m) * (2 * n / m)
+    inside = k2 <= n - 1
+    k2 = k2[inside]
+    return k2, np.interp(k2, knots, dev) + np.unwrap(np.angle(z[inside])) / (2.0 * np.pi * k0)
+
+
 def wander_test(resid: np.ndarray, fs: float, fc: float, band: float, f0: float, alpha: float) -> dict:
     """What a steady fit left (``resid``) within ±band of fc against the ring 0.225–0.45·f0 around it: the ratio of
     their periodogram means, F(2·in, 2·ring) at ``alpha``."""
@@ -258,9 +323,11 @@ def track_family(y: np.ndarray, fs: float, gens, coefs, steady: np.ndarray, alph
     test["snr"] = snr
     if not snr > MIN_SNR:
         return None, test | {"accepted": False, "why": "the reference line is too weak to track"}
-    phase = np.unwrap(np.angle(z))
-    dev = phase / (2.0 * np.pi * k0)
-    mean, rms, half_span = _stats(knots, f0 * knots / fs + dev, fs, band, n)
+    dev = np.unwrap(np.angle(z)) / (2.0 * np.pi * k0)
+    slow = _phase_band(knots, dev, fs, band, n)
+    knots, dev = _retracked(y, fs, f0, k0, knots, _smoothed(knots, dev, fs, slow), slow)
+    test["phase_bandwidth_hz"] = slow
+    mean, rms, half_span = _stats(knots, f0 * knots / fs + dev, fs, slow, n)
     fam = WanderingFamily(
         fs, n, orders.astype(np.float64), knots, dev, np.zeros(orders.size), np.zeros(orders.size),
         mean, rms, half_span, band, k0, f0,
