@@ -26,7 +26,10 @@ each), at its own share of ``level`` (:data:`allanite.model._shares.WANDER_SHARE
 is accepted — nothing from the per-record budget under the null), and the tracked form's held-out variance ratio
 must be below the steady one's. A family of more than :data:`MAX_ORDERS` lines (a square wave's, a sawtooth's) or
 whose reference line is too weak to track (its band's power under :data:`MIN_SNR` times the noise there) is not
-tracked.
+tracked; nor is a line whose envelope, read in its phase band, changes as a narrowband noise's does (its SD beyond
+the noise's over its mean above :data:`MAX_ENVELOPE_CHANGE`; a Rayleigh envelope's is 0.52): the model's amplitudes are
+constant per harmonic, and a building's sway — amplitude and phase both wandering — is power on the curve, not a line
+to follow.
 
 Reported: the fundamental's mean (the tracked phase's mean slope) and its wander — the instantaneous frequency's
 rms about the mean and half its 1–99 % span, Hz and relative — away from the record's ends (1/B each).
@@ -40,7 +43,16 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import f as f_dist
 
-__all__ = ["WanderingFamily", "track_family", "wander_test", "MAX_ORDERS", "MIN_CYCLES", "MIN_SNR", "SPREAD_SHARE"]
+__all__ = [
+    "WanderingFamily",
+    "track_family",
+    "wander_test",
+    "MAX_ENVELOPE_CHANGE",
+    "MAX_ORDERS",
+    "MIN_CYCLES",
+    "MIN_SNR",
+    "SPREAD_SHARE",
+]
 
 #: Most lines of a family the tracker takes (a waveform with a jump has hundreds: those are folded, not tracked).
 MAX_ORDERS = 16
@@ -50,6 +62,11 @@ MIN_CYCLES = 16.0
 SPREAD_SHARE = 0.95
 #: Least power of the reference line in its band over the noise there (phase noise ≲ 1/√MIN_SNR rad per sample).
 MIN_SNR = 10.0
+#: Largest change of the reference line's envelope (its SD beyond the noise's, over its mean): a wandering
+#: fundamental keeps its amplitude (≈ 0); a narrowband noise's Rayleigh envelope changes by 0.52 (a building's sway
+#: on the ADIS16405 accelerometers, its amplitude 5× apart between eighths of the record: left to the sinusoid term,
+#: which describes its power on the Allan curve).
+MAX_ENVELOPE_CHANGE = 0.25
 #: Samples per chunk of the least-squares passes (the design is never held whole).
 CHUNK = 1 << 18
 
@@ -224,7 +241,9 @@ def _retracked(y: np.ndarray, fs: float, f0: float, k0: int, knots: np.ndarray, 
     """The phase tracked once more against the first track: the record times e^{−i2π·k0·phase}, low-passed to ±band
     (zero-padded, tapered as in :func:`_demodulate`), its phase added to the first's. Near the record's ends the low
     pass averages over one side only, which biases a phase that runs away from the carrier (a wheel's 1.2 Hz
-    wandering 0.003 Hz, at B = 0.006 Hz: ≈ 1.6 rad at the ends); against the first track what is left is small."""
+    wandering 0.003 Hz, at B = 0.006 Hz: ≈ 1.6 rad at the ends); against the first track what is left is small.
+    Returns the knots, the phase (cycles beyond f0·n/f_s), the envelope and the noise's variance in it (the same
+    band read 0.3·f0 either side, between the harmonics: the noise there, through the same filter)."""
     n = y.size
     w = np.empty(n, dtype=np.complex128)
     mean = float(y.mean())
@@ -247,7 +266,13 @@ def _retracked(y: np.ndarray, fs: float, f0: float, k0: int, knots: np.ndarray, 
     k2 = np.arange(m) * (2 * n / m)
     inside = k2 <= n - 1
     k2 = k2[inside]
-    return k2, np.interp(k2, knots, dev) + np.unwrap(np.angle(z[inside])) / (2.0 * np.pi * k0)
+    z = z[inside]
+    noise = 0.0
+    for side in (-1, 1):
+        base[:] = 0.0
+        base[j % m] = spec[(j + side * int(round(0.3 * f0 / df))) % (2 * n)] * taper
+        noise += 0.5 * float(np.mean(np.abs(np.fft.ifft(base)[inside]) ** 2))
+    return k2, np.interp(k2, knots, dev) + np.unwrap(np.angle(z)) / (2.0 * np.pi * k0), np.abs(z), noise
 
 
 def wander_test(resid: np.ndarray, fs: float, fc: float, band: float, f0: float, alpha: float) -> dict:
@@ -281,6 +306,16 @@ def _harmonic_orders(gens: np.ndarray, coefs: np.ndarray, fs: float) -> tuple[fl
     if f0 <= 0 or orders.size == 0 or orders.size > MAX_ORDERS or orders.max() * f0 >= fs / 2.0:
         return None
     return f0, orders
+
+
+def _envelope_change(knots: np.ndarray, env: np.ndarray, noise: float, fs: float, band: float, n: int) -> float:
+    """The reference line's envelope in its phase band, away from the ends: its SD beyond the noise's (half the
+    noise's variance goes into the envelope of a line well above it) over its mean."""
+    t = knots / fs
+    keep = (t >= 1.0 / band) & (t <= n / fs - 1.0 / band)
+    e = env[keep] if keep.sum() >= 8 else env
+    mean = float(e.mean())
+    return float(math.sqrt(max(float(e.var()) - noise / 2.0, 0.0)) / mean) if mean > 0 else math.inf
 
 
 def _stats(knots: np.ndarray, cycles: np.ndarray, fs: float, band: float, n: int) -> tuple[float, float, float]:
@@ -325,8 +360,12 @@ def track_family(y: np.ndarray, fs: float, gens, coefs, steady: np.ndarray, alph
         return None, test | {"accepted": False, "why": "the reference line is too weak to track"}
     dev = np.unwrap(np.angle(z)) / (2.0 * np.pi * k0)
     slow = _phase_band(knots, dev, fs, band, n)
-    knots, dev = _retracked(y, fs, f0, k0, knots, _smoothed(knots, dev, fs, slow), slow)
+    knots, dev, env, noise = _retracked(y, fs, f0, k0, knots, _smoothed(knots, dev, fs, slow), slow)
     test["phase_bandwidth_hz"] = slow
+    test["envelope_change"] = change = _envelope_change(knots, env, noise, fs, slow, n)
+    if not change < MAX_ENVELOPE_CHANGE:
+        why = "its amplitude changes along the record as much as its phase: narrowband noise, not a wandering line"
+        return None, test | {"accepted": False, "why": why}
     mean, rms, half_span = _stats(knots, f0 * knots / fs + dev, fs, slow, n)
     fam = WanderingFamily(
         fs, n, orders.astype(np.float64), knots, dev, np.zeros(orders.size), np.zeros(orders.size),
