@@ -28,8 +28,8 @@ must be below the steady one's. A family of more than :data:`MAX_ORDERS` lines (
 whose reference line is too weak to track (its band's power under :data:`MIN_SNR` times the noise there) is not
 tracked; nor is a line whose envelope, read in its phase band, changes as a narrowband noise's does (its SD beyond
 the noise's over its mean above :data:`MAX_ENVELOPE_CHANGE`; a Rayleigh envelope's is 0.52): the model's amplitudes are
-constant per harmonic, and a building's sway — amplitude and phase both wandering — is power on the curve, not a line
-to follow.
+constant per harmonic, and a narrowband noise — amplitude and phase both wandering — is power on the curve, not a
+line to follow.
 
 Reported: the fundamental's mean (the tracked phase's mean slope) and its wander — the instantaneous frequency's
 rms about the mean and half its 1–99 % span, Hz and relative — away from the record's ends (1/B each).
@@ -63,9 +63,10 @@ SPREAD_SHARE = 0.95
 #: Least power of the reference line in its band over the noise there (phase noise ≲ 1/√MIN_SNR rad per sample).
 MIN_SNR = 10.0
 #: Largest change of the reference line's envelope (its SD beyond the noise's, over its mean): a wandering
-#: fundamental keeps its amplitude (≈ 0); a narrowband noise's Rayleigh envelope changes by 0.52 (a building's sway
-#: on the ADIS16405 accelerometers, its amplitude 5× apart between eighths of the record: left to the sinusoid term,
-#: which describes its power on the Allan curve).
+#: fundamental keeps its amplitude (≈ 0.02 simulated); a narrowband noise's Rayleigh envelope changes by 0.52
+#: (simulated 0.41–0.57): left to the sinusoid term, which describes its power on the Allan curve. The ADIS16405
+#: accelerometers' 0.47–0.56 Hz site family reads 0.08–0.12 and is tracked on six channels
+#: (benches/results/wander_measured.md).
 MAX_ENVELOPE_CHANGE = 0.25
 #: Samples per chunk of the least-squares passes (the design is never held whole).
 CHUNK = 1 << 18
