@@ -157,6 +157,7 @@ MODEL_RANKS = {
     "model.noise_level": 0,
     "model.periodic": 1,
     "model.template": 0,
+    "model.wander": 0,  # a line family's wandering fundamental tracked (numpy, scipy only)
     # fit's parts, between the registries and fit itself: the one-curve solver (and it in the core), the result
     # objects, the windows
     "model._fitcore": 0.5,

@@ -36,9 +36,14 @@ def _wandering_mains(seed: int):
     return y + sum(amp * np.sin(k * phase + 0.3 * k) for k, amp in zip((1, 3, 5), AMPS, strict=True)), fs
 
 
-def test_wandering_family_takes_its_own_lines_and_their_power():
+def test_wandering_family_takes_its_own_lines_and_their_power(monkeypatch):
     # main: the family's rms 0.065 (the coherent 41 % of the power, −36 %) beside three sinusoids holding the rest,
-    # all four in the final model; folded: 0.1019 for 0.1022
+    # all four in the final model; folded: 0.1019 for 0.1022. This family's fundamental is now tracked
+    # (allanite.model.wander, tests/test_wander.py); the fold is for a family whose lines are not followed (a
+    # narrowband line's, the tracker's test turned down), so the tracker is turned off here.
+    from allanite.model.refinement import removals
+
+    monkeypatch.setattr(removals.wander, "track_family", lambda *a, **k: (None, None))
     y, fs = _wandering_mains(5)
     r = allanite.refine(y, fs, unit="deg/s", candidates=("periodic", "sinusoid"), progress=False)
     fams = [st for st in r.steps if st.effect == "periodic"]

@@ -7,7 +7,7 @@ reading the budget (as the report's summary does) loads no scipy.
 
 from __future__ import annotations
 
-__all__ = ["TERM_SHARE", "FIRST_QUADRATIC"]
+__all__ = ["TERM_SHARE", "FIRST_QUADRATIC", "WANDER_SHARE"]
 
 #: Share of the per-record level spent on each optional term's test of a channel regression (a test run only
 #: once the coupling itself is accepted).
@@ -17,3 +17,6 @@ TERM_SHARE = {"quadratic": 0.02, "rate_coefficient": 0.02, "lag_s": 0.02}
 #: coupling is accepted by either, so the two together spend the coupling's α — not the coupling's and the
 #: quadratic's :data:`TERM_SHARE` beside it (docs/channels.md, "A turnover temperature").
 FIRST_QUADRATIC = 0.2
+#: Share of the per-record level spent on whether an accepted line family's fundamental wanders (its phase tracked
+#: instead of fixed: :func:`allanite.model.wander.track_family`) — a test run only once the family is accepted.
+WANDER_SHARE = 0.02

@@ -247,13 +247,23 @@ EFFECTS: dict[str, Effect] = {
                     "sinusoids found again at its own lines hold (a wandering phase; the removed part alone in "
                     "evidence['coherent_rms'])",
                 ),
+                (
+                    "wander_hz",
+                    "Hz",
+                    "rms of the fundamental's instantaneous frequency about its mean, when its phase is tracked (a "
+                    "wandering fundamental: allanite.model.wander; then fundamentals is [its mean])",
+                ),
+                ("wander_pct", "%", "wander_hz over the mean fundamental, when tracked"),
+                ("wander_half_span_hz", "Hz", "half the 1–99 % span of the instantaneous frequency, when tracked"),
             ),
             "every significant line of the Welch PSD (Blackman–Harris, the neighbours' median, Bonferroni over the "
             "bins, at the line share of level) grouped into families on a lattice — harmonics k·f0, sidebands "
             "k·f1 ± s·f2, aliases folded — each family's lattice points tested where it predicts them, the "
             "frequencies refined on the samples (Gauss–Newton on the lines' offsets) and the family removed in time "
             "by least squares at them (allanite.model.periodic); held out, amplitudes and phases are refitted on "
-            "the held-in blocks with the frequencies fixed. A line no family takes stays a sinusoid",
+            "the held-in blocks with the frequencies fixed. A family of harmonics whose fundamental wanders (a nested "
+            "test at its share of level) is removed with the fundamental's phase tracked, each harmonic at its order "
+            "times that phase. A line no family takes stays a sinusoid",
             domain="psd",
         ),
         Effect(

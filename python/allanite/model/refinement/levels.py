@@ -8,7 +8,7 @@ calibrated with the rest on clean records (``benches/refine_false_alarms.py``).
 
 from __future__ import annotations
 
-from .._shares import TERM_SHARE
+from .._shares import TERM_SHARE, WANDER_SHARE
 
 __all__ = [
     "LEVEL",
@@ -109,6 +109,8 @@ TIME_SHARES = {"outliers": OUTLIER_SHARE, "drift": TIME_SHARE, "regression": TIM
 #: part of the regression's :data:`TIME_SHARE` (:data:`allanite.model._shares.FIRST_QUADRATIC` of it, the channel
 #: and its quadrature the rest), not a share beside it (docs/channels.md, "A turnover temperature").
 CONDITIONAL_SHARES = {f"regression:{k}": v for k, v in TERM_SHARE.items()}
+#: An accepted line family's fundamental tracked (:mod:`allanite.model.wander`): conditional on the family, as above.
+CONDITIONAL_SHARES["periodic:wander"] = WANDER_SHARE
 
 
 def share(test: str) -> float:

@@ -50,7 +50,7 @@ import numpy as np
 from scipy.stats import t as t_dist
 
 from ...analysis import avar
-from .. import channels, linefit, outliers, periodic, template, tracing, warmup
+from .. import channels, linefit, outliers, periodic, template, tracing, wander, warmup
 from .calibrated import tested
 from .curvefit import Curve, Solution, theta_terms, upper_theta
 from .levels import alpha
@@ -452,7 +452,10 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
             "bins_searched": search["bins"],
         }
         component, refit, ratio = fam.component(), fam.refit, heldout_variance_ratio(ctx.y, fam.refit)
-        wave = _waveform(ctx, fam, ratio)
+        tracked = _tracked(ctx, fam, component, ratio, (params, intervals, evidence))
+        wave = None if tracked is not None else _waveform(ctx, fam, ratio)
+        if tracked is not None:
+            component, refit, ratio = tracked
         if wave is not None:
             tpl, ratio_t = wave
             component, refit = tpl.component(), tpl.refit
@@ -489,6 +492,42 @@ def _refit_family(fam: periodic.LineFamily, y: np.ndarray) -> periodic.LineFamil
     sinusoid then held, ``tests/sensors.py``)."""
     a, b = linefit.solve(y, np.arange(y.size), fam.gens / fam.fs, fam.coefs)
     return dataclasses.replace(fam, a=a, b=b)
+
+
+def _tracked(ctx: RemovalContext, fam: periodic.LineFamily, steady: np.ndarray, ratio_steady: float, out: tuple):
+    """The family with its fundamental's phase tracked (:func:`allanite.model.wander.track_family`) where its nested
+    test says the fundamental wanders and the tracked form predicts held-out samples better than the steady one:
+    (component, refit, held-out ratio), the step's ``params``, ``intervals`` and ``evidence`` in ``out`` updated
+    (the fundamental's mean and wander); else None (the test's numbers, where it ran, in ``evidence["wander"]``)."""
+    params, intervals, evidence = out
+    tf, test = wander.track_family(ctx.y, ctx.fs, fam.gens, fam.coefs, steady, alpha("periodic:wander", ctx.level))
+    if test is None:
+        return None
+    ratio = heldout_variance_ratio(ctx.y, tf.refit) if tf is not None else math.nan
+    evidence["wander"] = {"test": test, "heldout_variance_ratio": {"steady": ratio_steady, "tracked": ratio}}
+    if tf is None or not ratio < ratio_steady:
+        return None
+    mean, rms, half = tf.mean_hz, tf.wander_rms_hz, tf.wander_half_span_hz
+    # the mean of a track of ≈ 2·B·T independent values: its SD the wander's rms over √(2BT)
+    sd = rms / math.sqrt(max(2.0 * tf.bandwidth_hz * ctx.y.size / ctx.fs, 1.0))
+    rel = fam.rms_sd / fam.rms if fam.rms > 0 else 0.0
+    params |= {"fundamentals": [mean], "lines": int(tf.orders.size), "rms": tf.rms}
+    params |= {"wander_hz": rms, "wander_pct": 100.0 * rms / mean, "wander_half_span_hz": half}
+    intervals["fundamentals"] = [(mean - sd, mean + sd)]
+    intervals["rms"] = (max(0.0, tf.rms * (1.0 - rel)), tf.rms * (1.0 + rel))
+    evidence["frequencies_hz"] = [float(k * mean) for k in tf.orders]
+    evidence["coefficients"] = [[int(k)] for k in tf.orders]
+    evidence["amplitudes"] = [float(v) for v in np.hypot(tf.a, tf.b)]
+    evidence["wander"] |= {
+        "bandwidth_hz": tf.bandwidth_hz,
+        "reference_order": tf.reference,
+        "note": (
+            f"the fundamental wanders: mean {mean:.6g} Hz, rms {rms:.3g} Hz ({100 * rms / mean:.3g} %), "
+            f"±{half:.3g} Hz over 1–99 % of the record; removed with its phase tracked (the {tf.reference}. "
+            f"harmonic demodulated in ±{tf.bandwidth_hz:.3g} Hz), each harmonic at its order times that phase"
+        ),
+    }
+    return tf.component(), tf.refit, ratio
 
 
 def _waveform(ctx: RemovalContext, fam: periodic.LineFamily, ratio_lines: float):

@@ -38,7 +38,8 @@ class Step:
     effect's parameters and units: Gauss–Markov ``sigma`` rate unit, ``tc`` s; sinusoid ``amplitude`` rate unit,
     ``f0`` Hz; bandwidth ``cutoff`` Hz, ``taps``, ``filter``, where a floor is modelled (beside a Butterworth;
     another kind where the spectrum shows one) ``floor`` rate unit·√s; resonance ``sigma`` rate unit, ``f0`` Hz,
-    ``q``; periodic ``fundamentals`` (a list, Hz), ``lines``, ``rms`` rate unit; outliers ``rate`` (share of the
+    ``q``; periodic ``fundamentals`` (a list, Hz), ``lines``, ``rms`` rate unit and, where its fundamental wanders
+    and is tracked, ``wander_hz``, ``wander_pct``, ``wander_half_span_hz``; outliers ``rate`` (share of the
     samples), ``threshold`` rate unit; drift ``amplitude`` rate unit, ``T`` s; regression ``channel``,
     ``coefficient`` rate unit per channel unit and, where their tests keep them, ``quadratic``,
     ``rate_coefficient``, ``lag_s``; change point ``t`` s);
