@@ -220,7 +220,7 @@ CASES = [
     Blind7(
         "400 Hz MEMS × 10⁶ behind a 2nd-order Butterworth at 60 Hz and a notch at 30 Hz (Q 3): only the roll-off to name",
         _notch,
-        [Injected("bandwidth", {"cutoff": NOTCH_BUTTER})],
+        [Injected("bandwidth", {"cutoff": NOTCH_BUTTER, "notch_f": NOTCH_F}, ("notch_f",))],
         filter="butterworth2",
         forbidden=("resonance",),
         seed=702,

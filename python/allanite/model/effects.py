@@ -19,6 +19,7 @@ from ._signatures import (
     BUTTERWORTH_ORDERS,
     CASCADE_SPANS,
     FILTERS,
+    NOTCH_Q,
     RESONANCE_Q,
     SINC_ORDERS,
     butterworth_order,
@@ -28,9 +29,12 @@ from ._signatures import (
     filter_cutoff,
     filtered_white_avar,
     gm_avar,
+    notch_kind,
+    notch_zpk,
     resonance_avar,
     sinc_order,
     sinusoid_avar,
+    split_notch,
 )
 
 __all__ = [
@@ -56,6 +60,10 @@ __all__ = [
     "CASCADE_SPANS",
     "RESONANCE_Q",
     "resonance_avar",
+    "NOTCH_Q",
+    "notch_kind",
+    "split_notch",
+    "notch_zpk",
 ]
 
 

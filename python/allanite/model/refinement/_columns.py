@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from .. import fitting
-from ..effects import EFFECTS, butterworth_order, filtered_white_avar, resonance_avar
+from ..effects import EFFECTS, butterworth_order, filtered_white_avar, resonance_avar, split_notch
 from ..terms import TERM_ALPHA, design_matrix
 
 __all__ = [
@@ -183,7 +183,7 @@ def has_floor(key: str) -> bool:
     gyro_z's single pole beside a second resonance at 24.5 Hz)."""
     if base_name(key) != "bandwidth":
         return False
-    return key.endswith(FLOOR_TAG) or butterworth_order(bw_kind(key)) > 0
+    return key.endswith(FLOOR_TAG) or butterworth_order(split_notch(bw_kind(key))[0]) > 0  # a notch after it too
 
 
 def _term_columns(curve, terms):

@@ -109,6 +109,10 @@ TIME_SHARES = {"outliers": OUTLIER_SHARE, "drift": TIME_SHARE, "regression": TIM
 #: part of the regression's :data:`TIME_SHARE` (:data:`allanite.model._shares.FIRST_QUADRATIC` of it, the channel
 #: and its quadrature the rest), not a share beside it (docs/channels.md, "A turnover temperature").
 CONDITIONAL_SHARES = {f"regression:{k}": v for k, v in TERM_SHARE.items()}
+#: A notch after an accepted roll-off (:mod:`.refinement._notch`): tried only once the bandwidth step has its
+#: kind, so on a record without a roll-off it spends nothing; on a filtered record without a notch it is the rate
+#: of naming one (benches/results/notch_null.md).
+CONDITIONAL_SHARES["bandwidth:notch"] = 0.02
 
 
 def share(test: str) -> float:

@@ -1,0 +1,264 @@
+"""A digital notch after the sensor's roll-off: the bandwidth's kind changed to the roll-off followed by
+``scipy.signal.iirnotch(f_n, Q, fs)`` (:func:`allanite.model.effects.notch_kind`), where the Allan curve and the
+samples' spectrum both show one.
+
+A notch removes power, so it cannot be a column added with a non-negative amplitude beside the roll-off's: it is a
+change of the filter's shape, the kind the bandwidth step names. It is tried once the step has its kind
+(:func:`notch_choice`, with samples only): beside each of the few best kinds the step searched (the lowest χ²
+first — a notch below the cutoff bends the curve the way a lower cutoff does, so the kind without it may be the
+wrong one: a 2nd-order Butterworth at 60 Hz behind a 30 Hz notch reads as a single pole and boxcar at 40 Hz), a
+2-D grid of f_n × Q (:data:`NOTCH_Q`; f_n geometric at :data:`PER_OCTAVE` points an octave in the roll-off's
+passband, each notch's −3 dB width f_n/Q at least :data:`MIN_BINS` bins of the Welch spectrum, f_n at least as far
+from 0 and at most :data:`TOP` of the cutoff) screened at the kind's parameter; at the best pair the kind's
+parameter is searched again on its grid, f_n refined (Brent, between its grid neighbours), the parameter searched
+once more.
+
+It is accepted only by its own nested test, at its own share of ``level`` (``"bandwidth:notch"`` in
+:data:`.levels.CONDITIONAL_SHARES`: run only once a roll-off is accepted, so a record without one spends nothing on
+it, and on a filtered record it is the rate of naming a notch that is not there): the drop in χ² from the kind
+without a notch, counted in the curve's effective independent points (as :func:`.curvefit.profile_interval` counts
+them), above χ²₃'s quantile at that α shared over the grid's pairs (Bonferroni) — and only where the Welch spectrum
+in the notch's −3 dB band shows it (:func:`notch_in_spectrum`: the band's power within :data:`SPECTRUM_FACTOR` of
+the cascade's prediction and nearer to it than to the kind's alone, each levelled on the flanks beside the band).
+A kind that is named only where the spectrum shows its roll-off (a Butterworth) is checked so with the notch in.
+Its parameter is then not searched again once the loop is done (:func:`._rolloff.research_rolloff`: no grid for a
+kind with a notch): the accepted value stays.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import tracing
+from ..effects import NOTCH_Q, filter_autocorrelation, filter_cutoff, notch_kind, notch_zpk, split_notch
+from . import _brent
+from ._rolloff import needs_spectrum, spectrum_agrees
+from .curvefit import FLOOR_TAG, PROFILE_RHO, Curve, bw_kind, chi2s_of, search
+from .levels import alpha
+
+__all__ = ["notch_choice", "notch_grid", "notch_in_spectrum", "notch_threshold", "PER_OCTAVE", "MIN_BINS", "TOP"]
+
+#: Points an octave of the notch's frequency grid (a notch of Q 8 is 0.18 octave wide at −3 dB; f_n and Q are then
+#: fitted on the spectrum, :func:`_spectrum_notch`).
+PER_OCTAVE = 3
+#: The most a pair's −3 dB band may hold, in the Welch spectrum, of the power the step's kind predicts there
+#: (each levelled on the flanks) for the pair to be screened on the curve: a notch's band holds ≈ 0.21 of it, white
+#: noise's its own scatter about 1 — a cheap gate (:func:`_dips`), the acceptance is :func:`notch_in_spectrum`.
+DIP = 0.6
+#: The fewest Welch bins a notch's −3 dB width f_n/Q, and its distance from 0, may span.
+MIN_BINS = 4
+#: The highest notch frequency searched, as a fraction of the roll-off's −3 dB cutoff (inside its passband).
+TOP = 0.8
+#: How many of the step's kinds (lowest χ² first) a notch is tried after.
+KINDS = 3
+#: How far (a factor either way) the spectrum's power in the notch's −3 dB band may lie from the cascade's
+#: prediction (levelled on the flanks beside the band); a notch's band holds 1 − π/4 ≈ 0.21 of the power the
+#: kind alone predicts there, a factor 4.7: the two are told apart at its square root.
+SPECTRUM_FACTOR = 1.5
+
+
+def _nper(n: int) -> int:
+    """The Welch segment length the roll-off's spectrum checks use (:func:`.tracing.rolloff_psd`)."""
+    return int(min(4096, 2 ** int(math.log2(max(n // 8, 256)))))
+
+
+def notch_grid(fc: float, fs: float, tmax: float, n: int) -> list[tuple[float, float]]:
+    """The (f_n, Q) pairs a notch is screened at after a roll-off of −3 dB cutoff ``fc`` (Hz) on a curve reaching
+    τ ``tmax`` of ``n`` samples at ``fs``: f_n geometric at :data:`PER_OCTAVE` an octave from the larger of
+    :data:`MIN_BINS` Welch bins and 4/τ_max up to :data:`TOP`·f_c (below f_s/2 and :data:`MIN_BINS` bins from the
+    cutoff), each Q of :data:`NOTCH_Q` where the width f_n/Q spans :data:`MIN_BINS` bins. Empty where none fits."""
+    bin_hz = fs / _nper(n)
+    f_lo = max(MIN_BINS * bin_hz, 4.0 / tmax)
+    f_hi = min(TOP * fc, fc - MIN_BINS * bin_hz, 0.45 * fs)
+    if not f_hi > f_lo:
+        return []
+    fs_grid = np.geomspace(f_lo, f_hi, max(2, int(math.ceil(PER_OCTAVE * math.log2(f_hi / f_lo))) + 1))
+    return [(float(f), q) for q in NOTCH_Q for f in fs_grid if f / q >= MIN_BINS * bin_hz]
+
+
+def notch_threshold(level: float, n_pairs: int) -> float:
+    """The nested test's threshold on the effective χ² drop: χ²₃'s upper α/n_pairs quantile, α the notch's share
+    of ``level`` (f_n, Q and the roll-off's parameter moved; Bonferroni over the grid's pairs)."""
+    from scipy.stats import chi2
+
+    return float(chi2.isf(alpha("bandwidth:notch", level) / max(1, n_pairs), 3))
+
+
+def _h2(kind: str, p: float, fs: float, f: np.ndarray) -> np.ndarray:
+    """|H(f)|² of the filter ``kind`` (with its notch, if any) at the frequencies ``f``."""
+    from scipy import signal
+
+    base, f_n, q = split_notch(kind)
+    r = filter_autocorrelation(base, p, fs)
+    h2 = r[0] + 2.0 * np.cos(2.0 * np.pi * np.outer(f / fs, np.arange(1, r.size))) @ r[1:]
+    if f_n is not None and q is not None:
+        _w, h = signal.freqz_zpk(*notch_zpk(f_n, q, fs), worN=f, fs=fs)
+        h2 = h2 * np.abs(h) ** 2
+    return np.maximum(h2, 0.0)
+
+
+def notch_in_spectrum(y: np.ndarray, fs: float, kind: str, p: float) -> bool:
+    """Whether the Welch PSD of ``y`` shows the notch of ``kind`` (:func:`notch_kind`) at ``p``: its power in the
+    notch's −3 dB band (f_n ± f_n/2Q) within :data:`SPECTRUM_FACTOR` of the cascade's prediction, and nearer to it
+    than to the kind's without the notch — each prediction levelled on the flanks (up to a band's width either
+    side, below the cutoff)."""
+    base, f_n, q = split_notch(kind)
+    if f_n is None or q is None:
+        return False
+    f, meas = tracing._rolloff_welch(np.asarray(y, dtype=np.float64), float(fs), _nper(y.size))
+    half = f_n / (2.0 * q)
+    dist = np.abs(f - f_n)
+    band = dist <= half
+    flank = (dist > half) & (dist <= 3.0 * half) & (f > 0) & (f <= filter_cutoff(base, p, fs))
+    if band.sum() < 2 or flank.sum() < 2:
+        return False
+    both, alone = _h2(kind, p, fs, f[band | flank]), _h2(base, p, fs, f[band | flank])
+    sel_b, sel_f = band[band | flank], flank[band | flank]
+    m_band, m_flank = float(meas[band].sum()), float(meas[flank].sum())
+    if not (m_band > 0 and m_flank > 0 and both[sel_f].sum() > 0 and alone[sel_f].sum() > 0):
+        return False
+    pred_notch = m_flank * both[sel_b].sum() / both[sel_f].sum()
+    pred_alone = m_flank * alone[sel_b].sum() / alone[sel_f].sum()
+    off = abs(math.log(m_band / pred_notch)) if pred_notch > 0 else math.inf
+    return off <= math.log(SPECTRUM_FACTOR) and off < abs(math.log(m_band / pred_alone))
+
+
+def _with_notch(key: str, f_n: float, q: float) -> str:
+    """The bandwidth key ``key`` with a notch at ``f_n``, ``q`` after its filter (its floor tag kept)."""
+    tag = FLOOR_TAG if key.endswith(FLOOR_TAG) else ""
+    return f"bandwidth:{notch_kind(bw_kind(key), f_n, q)}{tag}"
+
+
+def _spectrum_notch(y: np.ndarray, fs: float, base: str, p: float, notch: tuple) -> tuple:
+    """The notch (f_n, Q) near ``notch`` that fits the Welch PSD of ``y`` best beside the filter ``base`` at ``p``:
+    least squares of log(measured / (level·|H_base|²·|H_notch|²)) over the bins within two −3 dB widths of f_n
+    (below 0.45·f_s), the level free (Nelder–Mead on log f_n, log Q) — the spectrum resolves a notch the Allan
+    curve blurs, where f_n, Q and the roll-off's parameter trade."""
+    from scipy import optimize, signal
+
+    f, meas = tracing._rolloff_welch(np.asarray(y, dtype=np.float64), float(fs), _nper(y.size))
+    f0, q0 = notch
+    sel = (np.abs(f - f0) <= 2.0 * f0 / q0) & (f > 0) & (f < 0.45 * fs) & (meas > 0)
+    if sel.sum() < 8:
+        return notch
+    fr, logm = f[sel], np.log(meas[sel]) - np.log(np.maximum(_h2(base, p, fs, f[sel]), 1e-300))
+
+    def cost(x):
+        fn, q = math.exp(x[0]), math.exp(x[1])
+        if not (0.0 < fn < 0.5 * fs and 0.1 < q < 100.0):
+            return math.inf
+        _w, h = signal.freqz_zpk(*notch_zpk(fn, q, fs), worN=fr, fs=fs)
+        d = logm - np.log(np.maximum(np.abs(h) ** 2, 1e-30))
+        return float(np.sum((d - d.mean()) ** 2))
+
+    res = optimize.minimize(
+        cost, [math.log(f0), math.log(q0)], method="Nelder-Mead", options={"xatol": 1e-5, "fatol": 1e-9}
+    )
+    return (math.exp(res.x[0]), math.exp(res.x[1])) if math.isfinite(res.fun) else notch
+
+
+def _dips(y: np.ndarray, fs: float, kind: str, p: float, pairs: list) -> list:
+    """The (f_n, Q) of ``pairs`` whose −3 dB band holds at most :data:`DIP` of the power the filter ``kind`` at
+    ``p`` predicts there in the Welch PSD of ``y``, both levelled on the flanks (up to a band's width either
+    side) — band and flank sums by cumulative sums over the bins."""
+    if not pairs:
+        return []
+    f, meas = tracing._rolloff_welch(np.asarray(y, dtype=np.float64), float(fs), _nper(y.size))
+    top = min(f.size, int(np.searchsorted(f, 1.5 * max(fn for fn, _q in pairs))) + 1)
+    pred = _h2(kind, p, fs, f[:top])
+    cm, cp = np.concatenate([[0.0], np.cumsum(meas[:top])]), np.concatenate([[0.0], np.cumsum(pred)])
+    out = []
+    for fn, q in pairs:
+        half = fn / (2.0 * q)
+        i0, i1, i2, i3 = np.searchsorted(f[:top], [max(fn - 3 * half, 1e-12), fn - half, fn + half, fn + 3 * half])
+        m_b, p_b = cm[i2] - cm[i1], cp[i2] - cp[i1]
+        m_f, p_f = cm[i1] - cm[i0] + cm[i3] - cm[i2], cp[i1] - cp[i0] + cp[i3] - cp[i2]
+        if min(m_f, p_b, p_f) > 0 and (m_b / m_f) / (p_b / p_f) <= DIP:
+            out.append((fn, q))
+    return out
+
+
+def _screen(rnd, bases: list, best: tuple) -> list:
+    """(base, pairs, χ² per pair) of each base (key, p, sol, edge): the (f_n, Q) pairs of its grid where the
+    spectrum dips beside the step's kind ``best`` (:func:`_dips`), fitted at the base's own parameter, all in one
+    batch of fits (a few reweighting passes: the ranking settles early)."""
+    fs, n = rnd.curve.fs, rnd.y.size
+    kind, p = bw_kind(best[0]), best[1]
+    grids = [notch_grid(filter_cutoff(bw_kind(b[0]), b[1], fs), fs, rnd.tmax, n) for b in bases]
+    pairs = [_dips(rnd.y, fs, kind, p, g) for g in grids]
+    models = [rnd.effects + [(_with_notch(b[0], f, q), b[1])] for b, pp in zip(bases, pairs) for f, q in pp]
+    chi2 = chi2s_of(rnd.curve, rnd.start, models, 6) if models else np.zeros(0)
+    parts = np.split(chi2, np.cumsum([len(pp) for pp in pairs])[:-1]) if models else [np.zeros(0)] * len(bases)
+    return [(b, pp, c, g) for b, pp, c, g in zip(bases, pairs, parts, grids) if pp]
+
+
+def _notch_after(rnd, base: tuple, screened: tuple, grid: np.ndarray, cont: bool) -> tuple | None:
+    """(key, p, sol, edge) of the best notch after the kind of ``base`` = (key, p, sol, edge), from its screened
+    (pairs, their χ², the whole grid of pairs), its parameter searched on ``grid``; None where the best f_n sits at
+    the edge of the whole grid (not identified)."""
+    curve, start, effects, key = rnd.curve, rnd.start, rnd.effects, base[0]
+    pairs, chi2, whole = screened
+    f_n, q = pairs[int(np.argmin(chi2))]
+    if f_n in (min(f for f, _q in whole), max(f for f, _q in whole)):
+        return None  # at the edge of its range: not identified
+    # the notch from the spectrum beside the kind at its parameter, the parameter searched on the curve beside the
+    # notch, in turn until the parameter settles (three rounds at most)
+    notch, p = (f_n, q), base[1]
+    for _round in range(3):
+        notch = _spectrum_notch(rnd.y, curve.fs, bw_kind(key), p, notch)
+        p_new, sol, edge = search(curve, start, effects, _with_notch(key, *notch), grid, continuous=cont)
+        settled = abs(math.log(p_new / p)) < 1e-3
+        p = p_new
+        if settled:
+            break
+    # Q once more on the curve (the Welch estimate's window widens a notch a little), and the parameter beside it
+    notch = (notch[0], _curve_q(curve, start, effects, key, p, notch))
+    p, sol, edge = search(curve, start, effects, _with_notch(key, *notch), grid, continuous=cont)
+    return _with_notch(key, *notch), p, sol, edge
+
+
+def _curve_q(curve: Curve, start: tuple, effects: list, key: str, p: float, notch: tuple) -> float:
+    """The notch's Q within a factor 1.25 of ``notch``'s of least χ² on the curve, f_n and the kind's parameter
+    ``p`` held (Brent on log Q)."""
+    gen = _brent.bounded(math.log(notch[1] / 1.25), math.log(notch[1] * 1.25), xatol=1e-4)
+    x = next(gen)
+    try:
+        while True:
+            x = gen.send(
+                float(chi2s_of(curve, start, [effects + [(_with_notch(key, notch[0], math.exp(x)), p)]], 40)[0])
+            )
+    except StopIteration as stop:
+        return math.exp(stop.value)
+
+
+def notch_choice(rnd, found: list, best: tuple, grids: dict, level: float) -> tuple:
+    """``best`` = (key, p, sol, edge), the kind the bandwidth step chose, or a kind of ``found`` followed by a
+    notch where its nested test passes and the spectrum shows it (module docstring); ``grids`` each searched
+    key's (grid, continuous). Only with samples (``rnd.y``)."""
+    if rnd.y is None or best[3]:
+        return best
+    bases = [f for f in found if not f[3] and f[0].removesuffix(FLOOR_TAG) in grids]
+    if best[0] not in [f[0] for f in bases]:
+        bases.append(best)
+    screened = _screen(rnd, bases, best)
+    fs = rnd.curve.fs
+    n_pairs = sum(len(notch_grid(filter_cutoff(bw_kind(b[0]), b[1], fs), fs, rnd.tmax, rnd.y.size)) for b in bases)
+    tried = []
+    for base, *got_screen in sorted(screened, key=lambda s: float(np.min(s[2])))[:KINDS]:
+        got = _notch_after(rnd, base, tuple(got_screen), *grids[base[0].removesuffix(FLOOR_TAG)])
+        if got is None or got[3]:
+            continue
+        kind = bw_kind(got[0])
+        if needs_spectrum(split_notch(kind)[0]) and not spectrum_agrees(rnd.y, rnd.curve.fs, kind, got[1]):
+            continue
+        if notch_in_spectrum(rnd.y, rnd.curve.fs, kind, got[1]):
+            tried.append(got)
+    if not tried:
+        return best
+    pick = min(tried, key=lambda g: g[2].chi2)
+    scale = rnd.curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / rnd.curve.tau.size
+    if (best[2].chi2 - pick[2].chi2) * scale <= notch_threshold(level, n_pairs):
+        return best
+    return pick
