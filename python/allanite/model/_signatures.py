@@ -88,8 +88,11 @@ def notch_zpk(f_n: float, q: float, fs: float) -> tuple[np.ndarray, np.ndarray, 
     """Zeros, poles and gain of ``scipy.signal.iirnotch(f_n, q, fs=fs)`` (remembered; read-only arrays)."""
     from scipy import signal
 
-    if not (0.0 < f_n < fs / 2.0 and q > 0.0):
-        raise ParameterError(f"notch at {f_n!r} Hz, Q {q!r}: f_n must lie in (0, fs/2 = {fs / 2.0!r}), Q above 0")
+    if not (0.0 < f_n < fs / 2.0 and q > 0.0 and f_n / q < fs / 2.0):
+        raise ParameterError(
+            f"notch at {f_n!r} Hz, Q {q!r}: f_n must lie in (0, fs/2 = {fs / 2.0!r}), Q above 0 and the width f_n/Q "
+            "below fs/2 (a wider notch's poles leave the unit circle)"
+        )
     zeros, poles, k = signal.tf2zpk(*signal.iirnotch(f_n, q, fs=fs))
     zeros.flags.writeable = poles.flags.writeable = False
     return zeros, poles, float(k)

@@ -51,6 +51,9 @@ DIP = 0.6
 MIN_BINS = 4
 #: The highest notch frequency searched, as a fraction of the roll-off's −3 dB cutoff (inside its passband).
 TOP = 0.8
+#: The quality factors a notch's fit may reach (a factor 2 beyond :data:`NOTCH_Q`'s ends), its width f_n/Q below
+#: 0.45·f_s.
+Q_RANGE = (NOTCH_Q[0] / 2.0, NOTCH_Q[-1] * 2.0)
 #: How many of the step's kinds (lowest χ² first) a notch is tried after.
 KINDS = 3
 #: How far (a factor either way) the spectrum's power in the notch's −3 dB band may lie from the cascade's
@@ -147,7 +150,7 @@ def _spectrum_notch(y: np.ndarray, fs: float, base: str, p: float, notch: tuple)
 
     def cost(x):
         fn, q = math.exp(x[0]), math.exp(x[1])
-        if not (0.0 < fn < 0.5 * fs and 0.1 < q < 100.0):
+        if not (0.0 < fn < 0.45 * fs and Q_RANGE[0] <= q <= Q_RANGE[1] and fn / q < 0.45 * fs):
             return math.inf
         _w, h = signal.freqz_zpk(*notch_zpk(fn, q, fs), worN=fr, fs=fs)
         d = logm - np.log(np.maximum(np.abs(h) ** 2, 1e-30))
@@ -222,7 +225,9 @@ def _notch_after(rnd, base: tuple, screened: tuple, grid: np.ndarray, cont: bool
 def _curve_q(curve: Curve, start: tuple, effects: list, key: str, p: float, notch: tuple) -> float:
     """The notch's Q within a factor 1.25 of ``notch``'s of least χ² on the curve, f_n and the kind's parameter
     ``p`` held (Brent on log Q)."""
-    gen = _brent.bounded(math.log(notch[1] / 1.25), math.log(notch[1] * 1.25), xatol=1e-4)
+    lo = max(notch[1] / 1.25, Q_RANGE[0], notch[0] / (0.45 * curve.fs))
+    hi = max(min(notch[1] * 1.25, Q_RANGE[1]), lo)
+    gen = _brent.bounded(math.log(lo), math.log(hi), xatol=1e-4)
     x = next(gen)
     try:
         while True:
