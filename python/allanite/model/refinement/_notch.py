@@ -137,7 +137,8 @@ def _with_notch(key: str, f_n: float, q: float) -> str:
 def _spectrum_notch(y: np.ndarray, fs: float, base: str, p: float, notch: tuple) -> tuple:
     """The notch (f_n, Q) near ``notch`` that fits the Welch PSD of ``y`` best beside the filter ``base`` at ``p``:
     least squares of log(measured / (level·|H_base|²·|H_notch|²)) over the bins within two −3 dB widths of f_n
-    (below 0.45·f_s), the level free (Nelder–Mead on log f_n, log Q) — the spectrum resolves a notch the Allan
+    (below 0.45·f_s), the level free (Nelder–Mead on log f_n, log Q; f_n within a factor 1.5 of ``notch``'s, Q in
+    :data:`Q_RANGE`) — the spectrum resolves a notch the Allan
     curve blurs, where f_n, Q and the roll-off's parameter trade."""
     from scipy import optimize, signal
 
@@ -150,7 +151,8 @@ def _spectrum_notch(y: np.ndarray, fs: float, base: str, p: float, notch: tuple)
 
     def cost(x):
         fn, q = math.exp(x[0]), math.exp(x[1])
-        if not (0.0 < fn < 0.45 * fs and Q_RANGE[0] <= q <= Q_RANGE[1] and fn / q < 0.45 * fs):
+        near = abs(math.log(fn / f0)) <= math.log(1.5)  # within the bins fitted: no wandering off to another dip
+        if not (near and fn < 0.45 * fs and Q_RANGE[0] <= q <= Q_RANGE[1] and fn / q < 0.45 * fs):
             return math.inf
         _w, h = signal.freqz_zpk(*notch_zpk(fn, q, fs), worN=fr, fs=fs)
         d = logm - np.log(np.maximum(np.abs(h) ** 2, 1e-30))
