@@ -47,7 +47,9 @@ __all__ = [
 #: prewarped, −3 dB at f_c exactly — the 2nd- to 6th-order anti-alias low-passes of MEMS, tactical and
 #: navigation gyros; one parameter, f_c; the order is in the kind's name, as every other kind's shape is), and
 #: sinc^k of order 2 to 5 ("sinc2" … "sinc5": a CIC decimator read at its output rate, k boxcars of span D,
-#: the samples' autocorrelation the B-spline M_2k(l/D); :mod:`allanite.model._sinc`).
+#: the samples' autocorrelation the B-spline M_2k(l/D); :mod:`allanite.model._sinc`). Any of them may be followed
+#: by a digital notch (:func:`notch_kind`: ``"<kind>+notch:<f_n>:<Q>"``, not listed here — its f_n and Q are in the
+#: kind's name, searched by :mod:`allanite.model.refinement._notch`).
 FILTERS: tuple[str, ...] = (
     ("single_pole", "moving_average", "bartlett", "boxcar")
     + tuple(f"sinc{k}" for k in SINC_ORDERS)
@@ -237,7 +239,9 @@ def _geometric_avar(rho: np.ndarray, m: np.ndarray) -> np.ndarray:
 def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
     """Normalised autocorrelation r(l), l = 0, 1, …, of unit-DC-gain filtered white noise: Σ_l r(|l|) = 1.
 
-    ``kind`` one of :data:`FILTERS`; ``p`` the cutoff (Hz) for ``"single_pole"`` and the Butterworths, the
+    ``kind`` one of :data:`FILTERS`, or one followed by a notch (:func:`notch_kind`: a Butterworth's and the
+    notch's poles together in closed form, :func:`rational_terms`; any other kind's autocorrelation convolved with
+    the notch's); ``p`` the cutoff (Hz) for ``"single_pole"`` and the Butterworths, the
     length L (taps of one moving average) for the FIRs, the span D·f_s (samples, ≥ 1, any real) for
     ``"boxcar"``, each boxcar's span in output samples (≥ 1/k, any real) for a sinc^k (``"sinc2"`` …)."""
     terms = _notch_terms(kind, p, fs)
@@ -318,7 +322,9 @@ def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float)
     tends to N²/τ for τ well above 1/f_c (the filter only reshapes the shortest τ). For a Butterworth
     R(l) = Σ_j C_j·p_j^|l| beyond lag 0 (:func:`butterworth_terms`), so the sum is closed: (r(0) − Σ C_j)/m plus
     Σ_j C_j times the geometric sums of :func:`resonance_avar` at ρ = p_j; at f_c ≥ f_s/2 its limit (the poles
-    meet the n-fold zero at z = −1: no filter), N²/τ."""
+    meet the n-fold zero at z = −1: no filter), N²/τ. A Butterworth followed by a notch (:func:`notch_kind`) is one
+    rational filter: the same closed sums over its and the notch's poles; another kind with a notch sums its
+    (long) autocorrelation by prefix sums (:func:`_prefix_avar`)."""
     tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
     m = np.maximum(1.0, np.round(tau * fs))
     order = butterworth_order(kind)

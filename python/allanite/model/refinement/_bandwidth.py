@@ -1,7 +1,8 @@
 """The ``"bandwidth"`` curve candidate: the sensor's low-pass on its white rate noise (single pole, moving average,
 Bartlett, boxcar, a CIC's sinc^k, pole + boxcar, Butterworth), replacing the N column — its search grids per
 filter kind, bootstrap family, searches, proposal (the kind with the lowest χ², :mod:`._rolloff` deciding the
-Butterworths, the sinc^k order and the white floor), parameters and evidence in the spectrum
+Butterworths, the sinc^k order and the white floor, :mod:`._notch` a notch after the kind), parameters and evidence
+in the spectrum
 (:data:`.candidates.CURVE_CANDIDATES`)."""
 
 from __future__ import annotations
