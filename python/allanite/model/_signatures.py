@@ -133,7 +133,7 @@ def _notch_terms(kind: str, p: float, fs: float) -> tuple | None:
     """The closed-form terms of a Butterworth followed by a notch (:func:`notch_kind`); None for another kind."""
     base, f_n, q = split_notch(kind)
     order = butterworth_order(base)
-    if f_n is None or not order:
+    if f_n is None or q is None or not order:
         return None
     return _cascade_terms(order, float(p), float(f_n), float(q), float(fs))
 
