@@ -57,8 +57,8 @@ Q_RANGE = (NOTCH_Q[0] / 2.0, NOTCH_Q[-1] * 2.0)
 #: How many of the step's kinds (lowest χ² first) a notch is tried after.
 KINDS = 3
 #: How far (a factor either way) the spectrum's power in the notch's −3 dB band may lie from the cascade's
-#: prediction (levelled on the flanks beside the band); a notch's band holds 1 − π/4 ≈ 0.21 of the power the
-#: kind alone predicts there, a factor 4.7: the two are told apart at its square root.
+#: prediction (relative to the flanks beside the band, :func:`_band_ratio`); a notch's band holds 1 − π/4 ≈ 0.21 of
+#: the power the kind alone predicts there, a factor 4.7: the two are told apart at its square root.
 SPECTRUM_FACTOR = 1.5
 
 
@@ -102,30 +102,41 @@ def _h2(kind: str, p: float, fs: float, f: np.ndarray) -> np.ndarray:
     return np.maximum(h2, 0.0)
 
 
+def _band_ratio(f: np.ndarray, meas: np.ndarray, pred: np.ndarray, f_n: float, q: float) -> float:
+    """The power ``meas`` holds in the −3 dB band f_n ± f_n/2Q over what ``pred`` predicts there, relative to the
+    same ratio on the flanks — each flank (up to a band's width beside it, the lower one from f_n/4) levelled on its
+    own and the two joined log-linearly in log f at f_n, so that a slope the prediction lacks (rate random walk,
+    bias instability or a Gauss–Markov term below a white passband) is not read as a dip. NaN where a part holds
+    no bin or no power."""
+    half = f_n / (2.0 * q)
+    i0, i1, i2, i3 = np.searchsorted(f, [max(f_n - 3.0 * half, f_n / 4.0), f_n - half, f_n + half, f_n + 3.0 * half])
+    cm, cp = np.concatenate([[0.0], np.cumsum(meas)]), np.concatenate([[0.0], np.cumsum(pred)])
+    parts = [(i0, i1), (i1, i2), (i2, i3)]
+    if any(j <= i or cp[j] - cp[i] <= 0 or cm[j] - cm[i] <= 0 for i, j in parts):
+        return math.nan
+    lo, band, hi = ((cm[j] - cm[i]) / (cp[j] - cp[i]) for i, j in parts)
+    f_lo, f_hi = math.sqrt(f[i0] * f[i1 - 1]), math.sqrt(f[i2] * f[i3 - 1])
+    w = (math.log(f_n) - math.log(f_lo)) / (math.log(f_hi) - math.log(f_lo)) if f_hi > f_lo else 0.5
+    return band / math.exp((1.0 - w) * math.log(lo) + w * math.log(hi))
+
+
 def notch_in_spectrum(y: np.ndarray, fs: float, kind: str, p: float) -> bool:
-    """Whether the Welch PSD of ``y`` shows the notch of ``kind`` (:func:`notch_kind`) at ``p``: its power in the
-    notch's −3 dB band (f_n ± f_n/2Q) within :data:`SPECTRUM_FACTOR` of the cascade's prediction, and nearer to it
-    than to the kind's without the notch — each prediction levelled on the flanks (up to a band's width either
-    side, below the cutoff)."""
+    """Whether the Welch PSD of ``y`` shows the notch of ``kind`` (:func:`notch_kind`) at ``p``: the power in the
+    notch's −3 dB band over the kind's prediction without it, relative to the flanks (:func:`_band_ratio`), within
+    :data:`SPECTRUM_FACTOR` of what the notch predicts there, and nearer to it than to 1 (no notch)."""
     base, f_n, q = split_notch(kind)
     if f_n is None or q is None:
         return False
     f, meas = tracing._rolloff_welch(np.asarray(y, dtype=np.float64), float(fs), _nper(y.size))
-    half = f_n / (2.0 * q)
-    dist = np.abs(f - f_n)
-    band = dist <= half
-    flank = (dist > half) & (dist <= 3.0 * half) & (f > 0) & (f <= filter_cutoff(base, p, fs))
-    if band.sum() < 2 or flank.sum() < 2:
+    sel = (f > 0) & (f <= min(f_n * (1.0 + 1.5 / q) * 1.01, 0.5 * fs))
+    f, meas = f[sel], meas[sel]
+    alone = _h2(base, p, fs, f)
+    measured = _band_ratio(f, meas, alone, f_n, q)
+    predicted = _band_ratio(f, _h2(kind, p, fs, f), alone, f_n, q)
+    if not (measured > 0 and predicted > 0):
         return False
-    both, alone = _h2(kind, p, fs, f[band | flank]), _h2(base, p, fs, f[band | flank])
-    sel_b, sel_f = band[band | flank], flank[band | flank]
-    m_band, m_flank = float(meas[band].sum()), float(meas[flank].sum())
-    if not (m_band > 0 and m_flank > 0 and both[sel_f].sum() > 0 and alone[sel_f].sum() > 0):
-        return False
-    pred_notch = m_flank * both[sel_b].sum() / both[sel_f].sum()
-    pred_alone = m_flank * alone[sel_b].sum() / alone[sel_f].sum()
-    off = abs(math.log(m_band / pred_notch)) if pred_notch > 0 else math.inf
-    return off <= math.log(SPECTRUM_FACTOR) and off < abs(math.log(m_band / pred_alone))
+    off = abs(math.log(measured / predicted))
+    return off <= math.log(SPECTRUM_FACTOR) and off < abs(math.log(measured))
 
 
 def _with_notch(key: str, f_n: float, q: float) -> str:
@@ -166,23 +177,14 @@ def _spectrum_notch(y: np.ndarray, fs: float, base: str, p: float, notch: tuple)
 
 def _dips(y: np.ndarray, fs: float, kind: str, p: float, pairs: list) -> list:
     """The (f_n, Q) of ``pairs`` whose −3 dB band holds at most :data:`DIP` of the power the filter ``kind`` at
-    ``p`` predicts there in the Welch PSD of ``y``, both levelled on the flanks (up to a band's width either
-    side) — band and flank sums by cumulative sums over the bins."""
+    ``p`` predicts there in the Welch PSD of ``y``, relative to the flanks (:func:`_band_ratio`)."""
     if not pairs:
         return []
     f, meas = tracing._rolloff_welch(np.asarray(y, dtype=np.float64), float(fs), _nper(y.size))
-    top = min(f.size, int(np.searchsorted(f, 1.5 * max(fn for fn, _q in pairs))) + 1)
-    pred = _h2(kind, p, fs, f[:top])
-    cm, cp = np.concatenate([[0.0], np.cumsum(meas[:top])]), np.concatenate([[0.0], np.cumsum(pred)])
-    out = []
-    for fn, q in pairs:
-        half = fn / (2.0 * q)
-        i0, i1, i2, i3 = np.searchsorted(f[:top], [max(fn - 3 * half, 1e-12), fn - half, fn + half, fn + 3 * half])
-        m_b, p_b = cm[i2] - cm[i1], cp[i2] - cp[i1]
-        m_f, p_f = cm[i1] - cm[i0] + cm[i3] - cm[i2], cp[i1] - cp[i0] + cp[i3] - cp[i2]
-        if min(m_f, p_b, p_f) > 0 and (m_b / m_f) / (p_b / p_f) <= DIP:
-            out.append((fn, q))
-    return out
+    top = min(f.size, int(np.searchsorted(f, 2.5 * max(fn for fn, _q in pairs))) + 1)
+    f, meas = f[:top], meas[:top]
+    pred = _h2(kind, p, fs, f)
+    return [(fn, q) for fn, q in pairs if _band_ratio(f, meas, pred, fn, q) <= DIP]
 
 
 def _screen(rnd, bases: list, best: tuple) -> list:
