@@ -4,14 +4,18 @@ samples' spectrum both show one.
 
 A notch removes power, so it cannot be a column added with a non-negative amplitude beside the roll-off's: it is a
 change of the filter's shape, the kind the bandwidth step names. It is tried once the step has its kind
-(:func:`notch_choice`, with samples only): beside each of the few best kinds the step searched (the lowest χ²
-first — a notch below the cutoff bends the curve the way a lower cutoff does, so the kind without it may be the
-wrong one: a 2nd-order Butterworth at 60 Hz behind a 30 Hz notch reads as a single pole and boxcar at 40 Hz), a
-2-D grid of f_n × Q (:data:`NOTCH_Q`; f_n geometric at :data:`PER_OCTAVE` points an octave in the roll-off's
-passband, each notch's −3 dB width f_n/Q at least :data:`MIN_BINS` bins of the Welch spectrum, f_n at least as far
-from 0 and at most :data:`TOP` of the cutoff) screened at the kind's parameter; at the best pair the kind's
-parameter is searched again on its grid, f_n refined (Brent, between its grid neighbours), the parameter searched
-once more.
+(:func:`notch_choice`, with samples only). A 2-D grid of f_n × Q (:func:`notch_grid`: Q of :data:`NOTCH_Q`; f_n
+geometric at :data:`PER_OCTAVE` points an octave in each kind's passband, up to :data:`TOP` of its cutoff, each
+notch's −3 dB width f_n/Q and f_n itself at least :data:`MIN_BINS` bins of the Welch spectrum) is first gated on the
+spectrum: only the pairs whose band holds at most :data:`DIP` of what the step's kind predicts there, relative to
+the flanks (:func:`_dips`, :func:`_band_ratio`), go on — on a record without a notch, none. Those are screened on
+the curve beside every kind the step searched, in one batch of fits at each kind's parameter: a notch below the
+cutoff bends the curve the way a lower cutoff does, so the kind named without it may be the wrong one (a
+2nd-order Butterworth at 60 Hz behind a 30 Hz notch reads as a single pole after a 2-sample boxcar at 40 Hz).
+After each of the :data:`KINDS` kinds that fit best, f_n and Q are fitted on the spectrum beside the kind
+(:func:`_spectrum_notch`: the spectrum resolves the notch the curve blurs, where f_n, Q and the cutoff trade) in
+turn with the kind's parameter searched on the curve beside the notch, then Q once more on the curve
+(:func:`_curve_q`) and the parameter again.
 
 It is accepted only by its own nested test, at its own share of ``level`` (``"bandwidth:notch"`` in
 :data:`.levels.CONDITIONAL_SHARES`: run only once a roll-off is accepted, so a record without one spends nothing on
