@@ -411,7 +411,7 @@ def filter_params(kind: str, p: float, fs: float, profile) -> tuple[dict, dict]:
     cascade's ``pole_cutoff``) of the kind ``kind`` at its searched parameter ``p``; ``profile()`` gives the
     parameter's profile interval (called only where the kind's intervals come from it); a kind with a notch after
     it (:func:`allanite.model.effects.notch_kind`) its low-pass's, and ``notch_f`` (Hz) and ``notch_q`` beside them
-    (no intervals: searched on a grid, f_n refined)."""
+    (no intervals: fitted on the spectrum, :mod:`._notch`)."""
     base, f_n, q = split_notch(kind)
     if f_n is not None:
         params, intervals = filter_params(base, p, fs, profile)
