@@ -36,7 +36,7 @@ import math
 import numpy as np
 
 from .. import tracing
-from ..effects import NOTCH_Q, filter_autocorrelation, filter_cutoff, notch_kind, notch_zpk, split_notch
+from ..effects import NOTCH_Q, filter_autocorrelation, filter_cutoff, notch_kind, split_notch
 from . import _brent
 from ._rolloff import needs_spectrum, spectrum_agrees
 from .curvefit import FLOOR_TAG, PROFILE_RHO, Curve, bw_kind, chi2s_of, search
@@ -93,25 +93,34 @@ def notch_threshold(level: float, n_pairs: int) -> float:
     return float(chi2.isf(alpha("bandwidth:notch", level) / max(1, n_pairs), 3))
 
 
+def _notch_h2(f_n: float, q: float, fs: float, e1: np.ndarray) -> np.ndarray:
+    """|H|² of ``scipy.signal.iirnotch(f_n, q, fs=fs)`` at z⁻¹ = ``e1`` — its coefficients in closed form
+    (g = 1/(1 + tan(π·f_n/(q·f_s))), b = g·(1, −2cos ω₀, 1), a = (1, −2g·cos ω₀, 2g − 1)), without the design call."""
+    w0 = 2.0 * math.pi * f_n / fs
+    g = 1.0 / (1.0 + math.tan(math.pi * f_n / (q * fs)))
+    c = math.cos(w0)
+    num = g * (1.0 - 2.0 * c * e1 + e1 * e1)
+    den = 1.0 - 2.0 * g * c * e1 + (2.0 * g - 1.0) * e1 * e1
+    return np.abs(num) ** 2 / np.abs(den) ** 2
+
+
 def _h2(kind: str, p: float, fs: float, f: np.ndarray) -> np.ndarray:
     """|H(f)|² of the filter ``kind`` (with its notch, if any) at the frequencies ``f``."""
-    from scipy import signal
-
     base, f_n, q = split_notch(kind)
     r = filter_autocorrelation(base, p, fs)
     h2 = r[0] + 2.0 * np.cos(2.0 * np.pi * np.outer(f / fs, np.arange(1, r.size))) @ r[1:]
     if f_n is not None and q is not None:
-        _w, h = signal.freqz_zpk(*notch_zpk(f_n, q, fs), worN=f, fs=fs)
-        h2 = h2 * np.abs(h) ** 2
+        h2 = h2 * _notch_h2(f_n, q, fs, np.exp(-2j * np.pi * f / fs))
     return np.maximum(h2, 0.0)
 
 
-def _band_ratio(f: np.ndarray, meas: np.ndarray, pred: np.ndarray, f_n: float, q: float) -> float:
+def _band_ratio(f: np.ndarray, meas: np.ndarray, pred: np.ndarray, f_n: float, q: float, dip: bool = False) -> float:
     """The power ``meas`` holds in the −3 dB band f_n ± f_n/2Q over what ``pred`` predicts there, relative to the
     same ratio on the flanks — each flank (up to a band's width beside it, the lower one from f_n/4) levelled on its
     own and the two joined log-linearly in log f at f_n, so that a slope the prediction lacks (rate random walk,
-    bias instability or a Gauss–Markov term below a white passband) is not read as a dip. NaN where a part holds
-    no bin or no power."""
+    bias instability or a Gauss–Markov term below a white passband) is not read as a dip; with ``dip``, over the
+    lower of the two flanks instead — a dip must lie below both sides (a slope, or a hump beside the band, such as
+    the ADIS16405 gyros' 20 Hz resonances, lies above one side only). NaN where a part holds no bin or no power."""
     half = f_n / (2.0 * q)
     i0, i1, i2, i3 = np.searchsorted(f, [max(f_n - 3.0 * half, f_n / 4.0), f_n - half, f_n + half, f_n + 3.0 * half])
     cm, cp = np.concatenate([[0.0], np.cumsum(meas)]), np.concatenate([[0.0], np.cumsum(pred)])
@@ -119,6 +128,8 @@ def _band_ratio(f: np.ndarray, meas: np.ndarray, pred: np.ndarray, f_n: float, q
     if any(j <= i or cp[j] - cp[i] <= 0 or cm[j] - cm[i] <= 0 for i, j in parts):
         return math.nan
     lo, band, hi = ((cm[j] - cm[i]) / (cp[j] - cp[i]) for i, j in parts)
+    if dip:
+        return band / min(lo, hi)
     f_lo, f_hi = math.sqrt(f[i0] * f[i1 - 1]), math.sqrt(f[i2] * f[i3 - 1])
     w = (math.log(f_n) - math.log(f_lo)) / (math.log(f_hi) - math.log(f_lo)) if f_hi > f_lo else 0.5
     return band / math.exp((1.0 - w) * math.log(lo) + w * math.log(hi))
@@ -155,7 +166,7 @@ def _spectrum_notch(y: np.ndarray, fs: float, base: str, p: float, notch: tuple)
     (below 0.45·f_s), the level free (Nelder–Mead on log f_n, log Q; f_n within a factor 1.5 of ``notch``'s, Q in
     :data:`Q_RANGE`) — the spectrum resolves a notch the Allan
     curve blurs, where f_n, Q and the roll-off's parameter trade."""
-    from scipy import optimize, signal
+    from scipy import optimize
 
     f, meas = tracing._rolloff_welch(np.asarray(y, dtype=np.float64), float(fs), _nper(y.size))
     f0, q0 = notch
@@ -164,13 +175,14 @@ def _spectrum_notch(y: np.ndarray, fs: float, base: str, p: float, notch: tuple)
         return notch
     fr, logm = f[sel], np.log(meas[sel]) - np.log(np.maximum(_h2(base, p, fs, f[sel]), 1e-300))
 
+    e1 = np.exp(-2j * np.pi * fr / fs)
+
     def cost(x):
         fn, q = math.exp(x[0]), math.exp(x[1])
         near = abs(math.log(fn / f0)) <= math.log(1.5)  # within the bins fitted: no wandering off to another dip
         if not (near and fn < 0.45 * fs and Q_RANGE[0] <= q <= Q_RANGE[1] and fn / q < 0.45 * fs):
             return math.inf
-        _w, h = signal.freqz_zpk(*notch_zpk(fn, q, fs), worN=fr, fs=fs)
-        d = logm - np.log(np.maximum(np.abs(h) ** 2, 1e-30))
+        d = logm - np.log(np.maximum(_notch_h2(fn, q, fs, e1), 1e-30))
         return float(np.sum((d - d.mean()) ** 2))
 
     res = optimize.minimize(
@@ -181,14 +193,14 @@ def _spectrum_notch(y: np.ndarray, fs: float, base: str, p: float, notch: tuple)
 
 def _dips(y: np.ndarray, fs: float, kind: str, p: float, pairs: list) -> list:
     """The (f_n, Q) of ``pairs`` whose −3 dB band holds at most :data:`DIP` of the power the filter ``kind`` at
-    ``p`` predicts there in the Welch PSD of ``y``, relative to the flanks (:func:`_band_ratio`)."""
+    ``p`` predicts there in the Welch PSD of ``y``, relative to each flank (:func:`_band_ratio` with ``dip``)."""
     if not pairs:
         return []
     f, meas = tracing._rolloff_welch(np.asarray(y, dtype=np.float64), float(fs), _nper(y.size))
     top = min(f.size, int(np.searchsorted(f, 2.5 * max(fn for fn, _q in pairs))) + 1)
     f, meas = f[:top], meas[:top]
     pred = _h2(kind, p, fs, f)
-    return [(fn, q) for fn, q in pairs if _band_ratio(f, meas, pred, fn, q) <= DIP]
+    return [(fn, q) for fn, q in pairs if _band_ratio(f, meas, pred, fn, q, dip=True) <= DIP]
 
 
 def _screen(rnd, bases: list, best: tuple) -> list:
@@ -198,7 +210,8 @@ def _screen(rnd, bases: list, best: tuple) -> list:
     fs, n = rnd.curve.fs, rnd.y.size
     kind, p = bw_kind(best[0]), best[1]
     grids = [notch_grid(filter_cutoff(bw_kind(b[0]), b[1], fs), fs, rnd.tmax, n) for b in bases]
-    pairs = [_dips(rnd.y, fs, kind, p, g) for g in grids]
+    dipping = set(_dips(rnd.y, fs, kind, p, sorted({pair for g in grids for pair in g})))  # one pass, one prediction
+    pairs = [[pair for pair in g if pair in dipping] for g in grids]
     models = [rnd.effects + [(_with_notch(b[0], f, q), b[1])] for b, pp in zip(bases, pairs) for f, q in pp]
     chi2 = chi2s_of(rnd.curve, rnd.start, models, 6) if models else np.zeros(0)
     parts = np.split(chi2, np.cumsum([len(pp) for pp in pairs])[:-1]) if models else [np.zeros(0)] * len(bases)
@@ -214,9 +227,14 @@ def _notch_after(rnd, base: tuple, screened: tuple, grid: np.ndarray, cont: bool
     f_n, q = pairs[int(np.argmin(chi2))]
     if f_n in (min(f for f, _q in whole), max(f for f, _q in whole)):
         return None  # at the edge of its range: not identified
-    # the notch from the spectrum beside the kind at its parameter, the parameter searched on the curve beside the
-    # notch, in turn until the parameter settles (three rounds at most)
+    # the notch from the spectrum beside the kind at its parameter — none where the spectrum does not show it there
+    # (the check an accepted notch passes, :func:`notch_in_spectrum`, made before the curve's searches) —, the
+    # parameter searched on the curve beside the notch, in turn until the parameter settles (three rounds at most)
     notch, p = (f_n, q), base[1]
+    if not notch_in_spectrum(
+        rnd.y, curve.fs, notch_kind(bw_kind(key), *_spectrum_notch(rnd.y, curve.fs, bw_kind(key), p, notch)), p
+    ):
+        return None
     for _round in range(3):
         notch = _spectrum_notch(rnd.y, curve.fs, bw_kind(key), p, notch)
         p_new, sol, edge = search(curve, start, effects, _with_notch(key, *notch), grid, continuous=cont)
