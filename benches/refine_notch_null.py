@@ -11,7 +11,7 @@ Gauss–Markov term, through one of five low-passes — a 2nd- or 4th-order Butt
 
 Usage::
 
-    python benches/refine_notch_null.py --records 120 --json /tmp/after.json    # ~6 min CPU
+    python benches/refine_notch_null.py --records 120 --json /tmp/after.json    # ~2.5 min CPU
     python benches/refine_notch_null.py --compare /tmp/before.json /tmp/after.json
 """
 
