@@ -238,12 +238,17 @@ def _judge_change_points(r, v: dict) -> None:
 
 
 def _judge_kind(r, case: Blind, v: dict) -> None:
-    """The bandwidth's kind named where the case says which (after the final refit), no stand-in added."""
+    """The bandwidth's kind named where the case says which (after the final refit), no stand-in added; a notch
+    after the low-pass (kind ``"<low-pass>+notch"``) only where the case's bandwidth truth has one (``notch_f``,
+    judged as a frequency by ``sensors.judge``), the low-pass's kind judged without it."""
     if case.filter is None and not case.forbidden:
         return
     kinds = [(s.final_params or s.params).get("filter") for s in r.steps if s.effect == "bandwidth"]
     v["filter"], v["forbidden_found"] = kinds, [f for f in case.forbidden if f in r.found]
-    if (case.filter is not None and case.filter not in kinds) or v["forbidden_found"]:
+    notch = any("notch_f" in inj.truth for inj in case.injected if inj.effect == "bandwidth")
+    lowpass = [str(k).removesuffix("+notch") for k in kinds if k is not None]
+    wrong_notch = any(str(k).endswith("+notch") for k in kinds if k is not None) != notch
+    if (case.filter is not None and case.filter not in lowpass) or v["forbidden_found"] or wrong_notch:
         v["named"] = v["passed"] = False
 
 

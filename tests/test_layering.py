@@ -214,6 +214,7 @@ MODEL_RANKS = {
     "model.refinement._channel_shape": 6.5,  # the residual's dependence on a channel's value (on model._shape)
     "model.refinement.missing": 7,
     "model.refinement._rolloff": 5.5,
+    "model.refinement._notch": 5.6,  # a notch after the roll-off (on _rolloff; the bandwidth candidate's)
     "model.refinement._inputs": 4.5,
     # refine's parts, below loop (its curve steps): the refinement under way and its chain; the removals in time
     # on it; the chain scored, the change points and the result on it (with what is missing: above missing)

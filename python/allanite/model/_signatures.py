@@ -31,6 +31,11 @@ __all__ = [
     "CASCADE_SPANS",
     "RESONANCE_Q",
     "resonance_avar",
+    "rational_terms",
+    "NOTCH_Q",
+    "notch_kind",
+    "split_notch",
+    "notch_zpk",
 ]
 
 #: Low-pass filters a "bandwidth" effect can be: a single pole (first-order IIR, impulse-invariant:
@@ -42,7 +47,9 @@ __all__ = [
 #: prewarped, −3 dB at f_c exactly — the 2nd- to 6th-order anti-alias low-passes of MEMS, tactical and
 #: navigation gyros; one parameter, f_c; the order is in the kind's name, as every other kind's shape is), and
 #: sinc^k of order 2 to 5 ("sinc2" … "sinc5": a CIC decimator read at its output rate, k boxcars of span D,
-#: the samples' autocorrelation the B-spline M_2k(l/D); :mod:`allanite.model._sinc`).
+#: the samples' autocorrelation the B-spline M_2k(l/D); :mod:`allanite.model._sinc`). Any of them may be followed
+#: by a digital notch (:func:`notch_kind`: ``"<kind>+notch:<f_n>:<Q>"``, not listed here — its f_n and Q are in the
+#: kind's name, searched by :mod:`allanite.model.refinement._notch`).
 FILTERS: tuple[str, ...] = (
     ("single_pole", "moving_average", "bartlett", "boxcar")
     + tuple(f"sinc{k}" for k in SINC_ORDERS)
@@ -54,6 +61,81 @@ BUTTERWORTH_ORDERS = (2, 3, 4, 5, 6)
 #: Spans (samples) of the boxcar a single pole may follow ("single_pole+boxcar:<span>": a filter added after
 #: a part's own averaging, e.g. an anti-alias stage or a user's low-pass on the logged rate).
 CASCADE_SPANS = (1.2, 1.5, 2.0)
+#: Quality factors a notch after the roll-off is searched at (:func:`notch_kind`; Q = f_n / its −3 dB width).
+NOTCH_Q = (1.0, 2.0, 4.0, 8.0)
+#: The tail of a filter kind that cascades a notch after the kind before it (:func:`notch_kind`).
+_NOTCH = "+notch:"
+
+
+def notch_kind(base: str, f_n: float, q: float) -> str:
+    """The kind of :data:`FILTERS` ``base`` followed by a digital notch at ``f_n`` (Hz) of quality factor ``q``:
+    ``scipy.signal.iirnotch(f_n, q, fs=f_s)`` — H(z) = g·(1 − 2cos ω₀·z⁻¹ + z⁻²)/(1 − 2g·cos ω₀·z⁻¹ + (2g − 1)·z⁻²),
+    zeros on the unit circle at ±ω₀ = ±2πf_n/f_s, unit gain at DC (so the curve still tends to N²/τ), −3 dB width
+    f_n/q: the user or vibration notch of a MEMS part's digital chain (InvenSense/TDK, Bosch), after its
+    anti-alias low-pass. Its parameter ``p`` stays the base kind's (:func:`filter_autocorrelation`)."""
+    return f"{base}{_NOTCH}{float(f_n)!r}:{float(q)!r}"
+
+
+def split_notch(kind: str) -> tuple[str, float | None, float | None]:
+    """(base kind, f_n, q) of a kind of :func:`notch_kind`; (``kind``, None, None) for a kind without a notch."""
+    base, sep, tail = kind.rpartition(_NOTCH)
+    if not sep:
+        return kind, None, None
+    f_n, q = tail.split(":")
+    return base, float(f_n), float(q)
+
+
+@functools.lru_cache(maxsize=4096)
+def notch_zpk(f_n: float, q: float, fs: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """Zeros, poles and gain of ``scipy.signal.iirnotch(f_n, q, fs=fs)`` (remembered; read-only arrays)."""
+    from scipy import signal
+
+    if not (0.0 < f_n < fs / 2.0 and q > 0.0 and f_n / q < fs / 2.0):
+        raise ParameterError(
+            f"notch at {f_n!r} Hz, Q {q!r}: f_n must lie in (0, fs/2 = {fs / 2.0!r}), Q above 0 and the width f_n/Q "
+            "below fs/2 (a wider notch's poles leave the unit circle)"
+        )
+    zeros, poles, k = signal.tf2zpk(*signal.iirnotch(f_n, q, fs=fs))
+    zeros.flags.writeable = poles.flags.writeable = False
+    return zeros, poles, float(k)
+
+
+@functools.lru_cache(maxsize=4096)
+def _cascade_terms(order: int, fc: float, f_n: float, q: float, fs: float) -> tuple:
+    """:func:`rational_terms` of a Butterworth (order, f_c; none at f_c ≥ f_s/2) followed by a notch."""
+    zn, pn, kn = notch_zpk(f_n, q, fs)
+    if fc >= fs / 2.0:
+        return rational_terms(zn, pn, kn)
+    zb, pb, kb = _butterworth_zpk(order, fc, fs)
+    return rational_terms(np.concatenate([zb, zn]), np.concatenate([pb, pn]), kb * kn)
+
+
+@functools.lru_cache(maxsize=1024)
+def _notch_autocorrelation(f_n: float, q: float, fs: float) -> np.ndarray:
+    """r(l) of a notch alone (:func:`notch_zpk`), remembered (read-only)."""
+    r = _terms_autocorrelation(rational_terms(*notch_zpk(f_n, q, fs)))
+    r.flags.writeable = False
+    return r
+
+
+def _terms_autocorrelation(terms: tuple) -> np.ndarray:
+    """r(l), l = 0, 1, …, of (r(0), C, p, d) (:func:`rational_terms`), to where the poles' terms fall below 1e-17."""
+    r0, c, poles, lag1 = terms
+    decay = max(float(np.max(np.abs(poles))), 1e-300) if poles.size else 1e-300
+    n = int(min(200_000, math.ceil(math.log(1e-17) / math.log(decay)) if decay < 1.0 else 200_000)) + 2
+    lags = np.arange(1, n, dtype=np.float64)
+    tail = (c[None, :] * np.exp(lags[:, None] * np.log(poles.astype(np.complex128))[None, :])).sum(axis=1).real
+    tail[0] += lag1
+    return np.concatenate([[r0], tail])
+
+
+def _notch_terms(kind: str, p: float, fs: float) -> tuple | None:
+    """The closed-form terms of a Butterworth followed by a notch (:func:`notch_kind`); None for another kind."""
+    base, f_n, q = split_notch(kind)
+    order = butterworth_order(base)
+    if f_n is None or q is None or not order:
+        return None
+    return _cascade_terms(order, float(p), float(f_n), float(q), float(fs))
 
 
 def gm_avar(tau: np.ndarray | float, tc: float) -> np.ndarray:
@@ -109,10 +191,24 @@ def butterworth_terms(order: int, fc: float, fs: float) -> tuple[float, np.ndarr
 def _butterworth_terms(order: int, fc: float, fs: float) -> tuple[float, np.ndarray, np.ndarray, float]:
     """:func:`butterworth_terms`, remembered (a bandwidth search asks for the same cutoffs on every curve it fits:
     the record's, the held-out parts', a removal's; SciPy's filter design costs ~2 ms a call). Read-only arrays."""
+    return rational_terms(*_butterworth_zpk(order, fc, fs))
+
+
+@functools.lru_cache(maxsize=1024)
+def _butterworth_zpk(order: int, fc: float, fs: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """``scipy.signal.butter(order, fc, fs=fs, output="zpk")``, remembered."""
     from scipy import signal  # here, not at import: `import allanite` stays free of scipy.signal
 
     zeros, poles, k = signal.butter(order, fc, fs=fs, output="zpk")
-    b, a = signal.zpk2tf(zeros, poles, k)
+    return zeros, poles, float(k)
+
+
+def rational_terms(zeros: np.ndarray, poles: np.ndarray, k: float) -> tuple[float, np.ndarray, np.ndarray, float]:
+    """The autocorrelation of filtered unit white noise, normalised to unit DC gain, of any stable rational filter
+    H(z) = k·Π(z − z_i)/Π(z − p_i) with as many zeros as poles and the poles distinct: (r(0), C, p, d) as
+    :func:`butterworth_terms` gives them (the residues of H(z)·H(1/z)·z^{l−1} inside the unit circle)."""
+    zeros, poles = np.asarray(zeros, dtype=np.complex128), np.asarray(poles, dtype=np.complex128)
+    b, a = np.poly(zeros).real * k, np.poly(poles).real
     dc2 = float((b.sum() / a.sum()) ** 2)
     # H at z = 1/p_j: b and a as polynomials in z⁻¹, evaluated at z⁻¹ = p_j
     h_inv = np.polyval(b[::-1], poles) / np.polyval(a[::-1], poles)
@@ -143,9 +239,18 @@ def _geometric_avar(rho: np.ndarray, m: np.ndarray) -> np.ndarray:
 def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
     """Normalised autocorrelation r(l), l = 0, 1, …, of unit-DC-gain filtered white noise: Σ_l r(|l|) = 1.
 
-    ``kind`` one of :data:`FILTERS`; ``p`` the cutoff (Hz) for ``"single_pole"`` and the Butterworths, the
+    ``kind`` one of :data:`FILTERS`, or one followed by a notch (:func:`notch_kind`: a Butterworth's and the
+    notch's poles together in closed form, :func:`rational_terms`; any other kind's autocorrelation convolved with
+    the notch's); ``p`` the cutoff (Hz) for ``"single_pole"`` and the Butterworths, the
     length L (taps of one moving average) for the FIRs, the span D·f_s (samples, ≥ 1, any real) for
     ``"boxcar"``, each boxcar's span in output samples (≥ 1/k, any real) for a sinc^k (``"sinc2"`` …)."""
+    terms = _notch_terms(kind, p, fs)
+    if terms is not None:  # a Butterworth and a notch: one rational filter, its closed form
+        return _terms_autocorrelation(terms)
+    base, f_n, q = split_notch(kind)
+    if f_n is not None:  # any other kind and a notch: the two (two-sided, unit-sum) autocorrelations convolved
+        assert q is not None
+        return _convolved(filter_autocorrelation(base, p, fs), _notch_autocorrelation(f_n, q, fs))
     if kind == "single_pole":
         a = math.exp(-2.0 * math.pi * p / fs)
         n = int(min(200_000, math.ceil(40.0 / max(1.0 - a, 1e-9)))) + 1
@@ -154,13 +259,7 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
     if order and p >= fs / 2.0:  # its limit there: H → 1, no filter
         return np.ones(1)
     if order:  # to where the poles' terms fall below 1e-17 of r(0)
-        r0, c, poles, lag1 = butterworth_terms(order, p, fs)
-        decay = max(float(np.max(np.abs(poles))), 1e-300)
-        n = int(min(200_000, math.ceil(math.log(1e-17) / math.log(decay)) if decay < 1.0 else 200_000)) + 2
-        lags = np.arange(1, n, dtype=np.float64)
-        tail = (c[None, :] * np.exp(lags[:, None] * np.log(poles.astype(np.complex128))[None, :])).sum(axis=1).real
-        tail[0] += lag1
-        return np.concatenate([[r0], tail])
+        return _terms_autocorrelation(butterworth_terms(order, p, fs))
     if sinc_order(kind):
         return sinc_autocorrelation(sinc_order(kind), p)
     if kind == "boxcar":
@@ -170,9 +269,7 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
     if kind.startswith("single_pole+boxcar:"):
         # the cascade's autocorrelation: the two (two-sided, unit-sum) autocorrelations convolved
         r_pole = filter_autocorrelation("single_pole", p, fs)
-        r_box = filter_autocorrelation("boxcar", float(kind.split(":", 1)[1]), fs)
-        both = np.convolve(np.concatenate([r_pole[:0:-1], r_pole]), np.concatenate([r_box[:0:-1], r_box]))
-        return both[both.size // 2 :]
+        return _convolved(r_pole, filter_autocorrelation("boxcar", float(kind.split(":", 1)[1]), fs))
     taps = max(1, int(round(p)))
     h = np.full(taps, 1.0 / taps)
     if kind == "bartlett":
@@ -181,9 +278,19 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
     return r
 
 
+def _convolved(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
+    """The autocorrelation (lags ≥ 0) of two filters in cascade from each one's (lags ≥ 0, unit two-sided sum)."""
+    from scipy.signal import fftconvolve
+
+    both = fftconvolve(np.concatenate([r1[:0:-1], r1]), np.concatenate([r2[:0:-1], r2]))
+    return both[both.size // 2 :]
+
+
 def filter_cutoff(kind: str, p: float, fs: float) -> float:
     """−3 dB frequency (Hz) of a filter of :data:`FILTERS` (``p`` as in :func:`filter_autocorrelation`); for a
-    boxcar the continuous filter's, 0.4430/D (sinc² = ½), and a sinc^k's, before the output sampling aliases it."""
+    boxcar the continuous filter's, 0.4430/D (sinc² = ½), and a sinc^k's, before the output sampling aliases it;
+    for a kind with a notch (:func:`notch_kind`) its low-pass's (the notch's own −3 dB points are f_n ∓ f_n/2q)."""
+    kind = split_notch(kind)[0]
     if sinc_order(kind):
         return sinc_cutoff(sinc_order(kind), p, fs)
     if kind == "single_pole" or butterworth_order(kind):  # a Butterworth's prewarped cutoff: −3 dB at f_c exactly
@@ -215,17 +322,22 @@ def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float)
     tends to N²/τ for τ well above 1/f_c (the filter only reshapes the shortest τ). For a Butterworth
     R(l) = Σ_j C_j·p_j^|l| beyond lag 0 (:func:`butterworth_terms`), so the sum is closed: (r(0) − Σ C_j)/m plus
     Σ_j C_j times the geometric sums of :func:`resonance_avar` at ρ = p_j; at f_c ≥ f_s/2 its limit (the poles
-    meet the n-fold zero at z = −1: no filter), N²/τ."""
+    meet the n-fold zero at z = −1: no filter), N²/τ. A Butterworth followed by a notch (:func:`notch_kind`) is one
+    rational filter: the same closed sums over its and the notch's poles; another kind with a notch sums its
+    (long) autocorrelation by prefix sums (:func:`_prefix_avar`)."""
     tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
     m = np.maximum(1.0, np.round(tau * fs))
     order = butterworth_order(kind)
     if order and p >= fs / 2.0:  # its limit there: H → 1, white noise
         return fs / m
-    if order:  # geometric autocorrelation: closed sums, white part r(0) − Σ C_j at lag 0
-        r0, c, poles, lag1 = butterworth_terms(order, p, fs)
+    terms = butterworth_terms(order, p, fs) if order else _notch_terms(kind, p, fs)
+    if terms is not None:  # geometric autocorrelation: closed sums, white part r(0) − Σ C_j at lag 0
+        r0, c, poles, lag1 = terms
         s2 = (r0 - c.sum().real) / m + (c[:, None] * _geometric_avar(poles, m)).sum(axis=0).real
         return (s2 + (2.0 * m - 3.0) * lag1 / (m * m)) * fs  # a lag-1 term d: A_m(±1) = 2m − 3
     r = filter_autocorrelation(kind, p, fs)
+    if split_notch(kind)[1] is not None:  # a notch's long autocorrelation: the sums by prefix sums, O(lags + τ)
+        return _prefix_avar(r, m) * fs
     lag = np.arange(r.size, dtype=np.float64)
     # A_m(l) at the lags l ≥ 0 (tri_m(l + m) = 0 there): 2m − 3l wherever m reaches the last lag, the triangles
     # only on the rows of shorter m — the same whole numbers, so the same sum
@@ -238,6 +350,23 @@ def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float)
     w[0] = 1.0
     s = a @ (w * r)
     return s / (2.0 * m * m) * fs  # σ_w² = N²·f_s
+
+
+def _prefix_avar(r: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """(1/2m²)·Σ_l A_m(l)·w_l·r(l) (w = 1 at lag 0, else 2) by prefix sums: A_m(l) = 2m − 3l for l ≤ m and
+    −(2m − l) for m < l < 2m (0 beyond), so the sum is 2m·S0(m+1) − 3·S1(m+1) − 2m·(S0(2m) − S0(m+1)) +
+    (S1(2m) − S1(m+1)) with S0(L) = Σ_{l<L} w_l·r(l), S1(L) = Σ_{l<L} l·w_l·r(l) — the same sum as the matrix
+    product of :func:`filtered_white_avar`, in time linear in the lags and the τ."""
+    wr = 2.0 * r
+    wr[0] = r[0]
+    s0 = np.concatenate([[0.0], np.cumsum(wr)])
+    s1 = np.concatenate([[0.0], np.cumsum(np.arange(r.size) * wr)])
+    top = r.size
+    mid = np.minimum(m.astype(np.int64) + 1, top)
+    end = np.minimum(2 * m.astype(np.int64), top)
+    end = np.maximum(end, mid)
+    s = 2.0 * m * s0[mid] - 3.0 * s1[mid] - 2.0 * m * (s0[end] - s0[mid]) + (s1[end] - s1[mid])
+    return s / (2.0 * m * m)
 
 
 #: Quality factors a "resonance" is searched at (Q = f_r / full width at half maximum of its PSD): a hump,

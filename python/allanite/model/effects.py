@@ -19,6 +19,7 @@ from ._signatures import (
     BUTTERWORTH_ORDERS,
     CASCADE_SPANS,
     FILTERS,
+    NOTCH_Q,
     RESONANCE_Q,
     SINC_ORDERS,
     butterworth_order,
@@ -28,9 +29,12 @@ from ._signatures import (
     filter_cutoff,
     filtered_white_avar,
     gm_avar,
+    notch_kind,
+    notch_zpk,
     resonance_avar,
     sinc_order,
     sinusoid_avar,
+    split_notch,
 )
 
 __all__ = [
@@ -56,6 +60,10 @@ __all__ = [
     "CASCADE_SPANS",
     "RESONANCE_Q",
     "resonance_avar",
+    "NOTCH_Q",
+    "notch_kind",
+    "split_notch",
+    "notch_zpk",
 ]
 
 
@@ -164,6 +172,8 @@ EFFECTS: dict[str, Effect] = {
                     "the N column beside the filtered one, 0 where there is none; beside a Butterworth always, beside "
                     "another kind only where the spectrum above f_s/4 shows one and the fit agrees with it",
                 ),
+                ("notch_f", "Hz", "centre of a digital notch after the low-pass (``filter`` ``<kind>+notch``)"),
+                ("notch_q", "", "the notch's quality factor, f_n over its −3 dB width"),
             ),
             "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
             "decimating MEMS part, a boxcar of any span read at the output rate, a CIC decimator's sinc^k of "
@@ -174,7 +184,9 @@ EFFECTS: dict[str, Effect] = {
             "(and beside another kind where the spectrum above f_s/4 shows a floor the fit agrees with) "
             "the N²/τ column stays, non-negative, as white noise added after the filter (``floor``: a digital "
             "part's quantised output adds a step Δ's Δ²/12 per sample, floor = Δ·√(τ0/12); a readout's noise): a "
-            "steep filter's stop band is then flat, not a resonance. Accepted first, its parameter is searched "
+            "steep filter's stop band is then flat, not a resonance. With samples, a digital notch "
+            "(``scipy.signal.iirnotch``) may follow the low-pass — a kind of its own, ``<kind>+notch``, named where "
+            "its nested test passes and the Welch spectrum shows it. Accepted first, its parameter is searched "
             "again beside the terms later steps add",
             signature=None,
             alpha=lambda tau, p: np.zeros(np.asarray(tau).size, dtype=int),

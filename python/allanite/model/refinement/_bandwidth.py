@@ -1,7 +1,8 @@
 """The ``"bandwidth"`` curve candidate: the sensor's low-pass on its white rate noise (single pole, moving average,
 Bartlett, boxcar, a CIC's sinc^k, pole + boxcar, Butterworth), replacing the N column — its search grids per
 filter kind, bootstrap family, searches, proposal (the kind with the lowest χ², :mod:`._rolloff` deciding the
-Butterworths, the sinc^k order and the white floor), parameters and evidence in the spectrum
+Butterworths, the sinc^k order and the white floor, :mod:`._notch` a notch after the kind), parameters and evidence
+in the spectrum
 (:data:`.candidates.CURVE_CANDIDATES`)."""
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import numpy as np
 
 from .. import tracing
 from ..effects import CASCADE_SPANS, filter_autocorrelation
+from ._notch import notch_choice
 from ._proposal import Proposal, Round, column_amplitude, with_stat
 from ._rolloff import (
     STEEPER,
@@ -82,13 +84,14 @@ def bw_propose(rnd: Round) -> list:
     found, grids = [], {}
     for key, grid, cont in bw_searches(rnd):
         found.append((key, *search(rnd.curve, rnd.start, rnd.effects, key, grid, continuous=cont)))
-        grids[key] = grid
+        grids[key] = (grid, cont)
     two = "bandwidth:butterworth2"
     if two in grids and rnd.y is not None:  # steeper Butterworths, named only with a spectrum as the 2nd order
         steeper, superseded = higher_butterworths(
-            rnd.curve, rnd.start, rnd.effects, grids[two], found[list(grids).index(two)], tie, rnd.y
+            rnd.curve, rnd.start, rnd.effects, grids[two][0], found[list(grids).index(two)], tie, rnd.y
         )
         found = [f for f in found if f[0] not in superseded] + steeper
+        grids.update({f[0]: grids[two] for f in steeper})
     found = sinc_choice(found, tie)  # one sinc^k order at most, where it beats the boxcar and the orders below
     for key, p, s_new, edge in found:
         kind = bw_kind(key)  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)
@@ -98,7 +101,8 @@ def bw_propose(rnd: Round) -> list:
             best = (key, p, s_new, edge)
     if best is None:
         return []
-    key, p, s_new, edge = floor_choice(rnd.curve, rnd.start, rnd.effects, best, bw_searches(rnd), rnd.y, tie)
+    best = floor_choice(rnd.curve, rnd.start, rnd.effects, best, bw_searches(rnd), rnd.y, tie)
+    key, p, s_new, edge = notch_choice(rnd, found, best, grids, rnd.level)  # a notch after it (:mod:`._notch`)
     assert rnd.sub is not None
     return [with_stat(rnd, key, p, s_new, edge, bump=1.0 / rnd.sub.tau)]
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from .. import fitting
 from .._counter import active_counter
-from ..effects import EFFECTS, butterworth_order, filtered_white_avar, resonance_avar
+from ..effects import EFFECTS, butterworth_order, filtered_white_avar, resonance_avar, split_notch
 from ..terms import TERM_ALPHA, design_matrix
 
 __all__ = [
@@ -185,7 +185,7 @@ def has_floor(key: str) -> bool:
     gyro_z's single pole beside a second resonance at 24.5 Hz)."""
     if base_name(key) != "bandwidth":
         return False
-    return key.endswith(FLOOR_TAG) or butterworth_order(bw_kind(key)) > 0
+    return key.endswith(FLOOR_TAG) or butterworth_order(split_notch(bw_kind(key))[0]) > 0  # a notch after it too
 
 
 def term_columns(curve, terms):

@@ -16,6 +16,7 @@ import numpy as np
 from .. import tracing
 from ..effects import EFFECTS
 from .curvefit import Curve, Solution, base_name, column, profile_interval
+from .levels import LEVEL
 from .scoring import Split
 
 __all__ = [
@@ -33,8 +34,9 @@ __all__ = [
 class Round:
     """What one step of the loop offers every curve candidate: the curve, the current model (terms ``start``
     plus ``effects``, solution ``sol``), the thinned curve with the curve test and its threshold, the held-out
-    split, the samples (None for curve-only input) and the spectral lines found in them. (A round that only
-    reads an effect's parameters off a solution needs the first four.)"""
+    split, the samples (None for curve-only input), the spectral lines found in them and the record's false-alarm
+    ``level`` (for a candidate's own nested test). (A round that only reads an effect's parameters off a solution
+    needs the first four.)"""
 
     curve: Curve
     start: tuple
@@ -46,6 +48,7 @@ class Round:
     split: Split | None = None
     y: np.ndarray | None = None
     lines: list = field(default_factory=list)
+    level: float = LEVEL
 
     @property
     def tmin(self) -> float:

@@ -46,7 +46,7 @@ from scipy.optimize import nnls
 
 from .. import tracing
 from .._sinc import SINC_ORDERS, sinc_order
-from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation, filter_cutoff
+from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation, filter_cutoff, split_notch
 from .curvefit import FLOOR_TAG, PROFILE_RHO, Curve, Solution, base_name, bw_kind, search, searches, solve
 
 __all__ = [
@@ -409,7 +409,13 @@ def _butterworth_beside(curve: Curve, start: tuple, others: list, grids: dict, y
 def filter_params(kind: str, p: float, fs: float, profile) -> tuple[dict, dict]:
     """A bandwidth's reported parameters and intervals: ``cutoff`` (−3 dB, Hz), ``taps``, ``filter`` (and a
     cascade's ``pole_cutoff``) of the kind ``kind`` at its searched parameter ``p``; ``profile()`` gives the
-    parameter's profile interval (called only where the kind's intervals come from it)."""
+    parameter's profile interval (called only where the kind's intervals come from it); a kind with a notch after
+    it (:func:`allanite.model.effects.notch_kind`) its low-pass's, and ``notch_f`` (Hz) and ``notch_q`` beside them
+    (no intervals: fitted on the spectrum, :mod:`._notch`)."""
+    base, f_n, q = split_notch(kind)
+    if f_n is not None:
+        params, intervals = filter_params(base, p, fs, profile)
+        return params | {"filter": f"{params['filter']}+notch", "notch_f": f_n, "notch_q": q}, intervals
     cut = filter_cutoff(kind, p, fs)
     if kind == "single_pole" or needs_spectrum(kind):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
         c_int = profile() if kind == "single_pole" else tuple(min(c, fs / 2.0) for c in profile())

@@ -111,6 +111,10 @@ TIME_SHARES = {"outliers": OUTLIER_SHARE, "drift": TIME_SHARE, "regression": TIM
 CONDITIONAL_SHARES = {f"regression:{k}": v for k, v in TERM_SHARE.items()}
 #: An accepted line family's fundamental tracked (:mod:`allanite.model.wander`): conditional on the family, as above.
 CONDITIONAL_SHARES["periodic:wander"] = WANDER_SHARE
+#: A notch after an accepted roll-off (:mod:`.refinement._notch`): tried only once the bandwidth step has its
+#: kind, so on a record without a roll-off it spends nothing; on a filtered record without a notch it is the rate
+#: of naming one (benches/results/notch_null.md).
+CONDITIONAL_SHARES["bandwidth:notch"] = 0.02
 
 
 def share(test: str) -> float:

@@ -241,7 +241,9 @@ class _Run(TimeRemovals, FinalModel):
         test = curve_test(self.curve, thin, self.sol, self.start, self.effects, exact)
         fam = families(sub, candidates, self.y is not None)
         thr = test.threshold(fam, alpha("curve", self.level), N_BOOT, seed=n_step)
-        rnd = Round(self.curve, self.start, self.effects, self.sol, sub, test, thr, self.heldout, self.y, lines)
+        rnd = Round(
+            self.curve, self.start, self.effects, self.sol, sub, test, thr, self.heldout, self.y, lines, self.level
+        )
         prefetch(rnd, candidates)  # every candidate's bounded searches, run together
         props = [pr for name, c in CURVE_CANDIDATES.items() if name in candidates for pr in c.propose(rnd)]
         for pr in props:
