@@ -106,9 +106,8 @@ class TimeRemovals(RunState):
         y_less = lines_less(self.y, self.fs, freqs)
         c_less, _h = self.build(avar(y_less, self.fs, taus=self.result.tau), None)
         s_less = solve(c_less, self.start, self.effects)
-        less = RemovalContext(
-            y_less, self.fs, c_less, s_less, self.start, ctx.channels, self.level, self.consider, effects=ctx.effects
-        )
+        said = lambda effect, entry: self.consider(effect, entry | {"beside_lines_hz": freqs})  # noqa: E731
+        less = RemovalContext(y_less, self.fs, c_less, s_less, self.start, ctx.channels, self.level, said, ctx.effects)
         for rem in REMOVALS["outliers"](less):
             rem.evidence["beside_lines_hz"] = freqs
             self.remove(rem, basis=(c_less, s_less, y_less))
