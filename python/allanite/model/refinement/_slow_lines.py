@@ -1,5 +1,6 @@
-"""Lines slow enough to move the drift test's block means, and their least-squares component in time
-(:meth:`._in_time.TimeRemovals.drift_beside_slow_lines`: the drift test once more with them taken out)."""
+"""Lone lines the time-domain tests are retried without: lines slow enough to move the drift test's block means
+(:meth:`._in_time.TimeRemovals.drift_beside_slow_lines`), lines strong in the first differences the outlier test reads
+(:meth:`._in_time.TimeRemovals.outliers_beside_lines`); their least-squares component in time."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import numpy as np
 from .. import periodic
 from ..tracing import DRIFT_BLOCKS
 
-__all__ = ["slow_lines", "lines_component"]
+__all__ = ["slow_lines", "lines_component", "lines_in_differences", "lines_less"]
 
 
 def slow_lines(search: dict | None, length_s: float, declined: list) -> list[float]:
@@ -32,3 +33,53 @@ def lines_component(y: np.ndarray, fs: float, freqs: list[float]) -> np.ndarray:
     x = np.column_stack(cols)
     coef, *_ = np.linalg.lstsq(x, np.asarray(y, dtype=np.float64), rcond=None)
     return x[:, 2:] @ coef[2:]
+
+
+#: The lone lines the outlier test is retried without, at most (the strongest first).
+FAST_LINES_MAX = 4
+#: A line is strong in the first differences when its swing there, 2A·|sin(πf/fs)|, is at least this share of the
+#: differences' robust σ (their median absolute value over 0.6745, the line in it).
+FAST_LINE_SHARE = 0.25
+
+
+def lines_in_differences(search: dict | None, y: np.ndarray, fs: float, declined: list) -> list[float]:
+    """The frequencies (Hz) of the search's lone lines (and of the families a removal turned down) strong in the
+    record's first differences — where the outlier test measures the noise's scale and the spikes' distance —
+    strongest first, at most :data:`FAST_LINES_MAX`."""
+    if search is None:
+        return []
+    d = np.diff(np.asarray(y, dtype=np.float64))
+    sigma_d = float(np.median(np.abs(d - np.median(d)))) / 0.6745
+    out = []
+    for line in periodic.sinusoid_lines(search, families=declined):
+        swing = 2.0 * line["amplitude"] * abs(np.sin(np.pi * line["f0"] / fs))
+        if swing >= FAST_LINE_SHARE * sigma_d:
+            out.append(float(line["f0"]))
+    return out[:FAST_LINES_MAX]
+
+
+def lines_less(y: np.ndarray, fs: float, freqs: list[float], chunk: int = 1 << 20) -> np.ndarray:
+    """``y`` less the sinusoids at ``freqs`` fitted by least squares together with a constant and a ramp (as
+    :func:`lines_component`), the normal equations summed over chunks of ``chunk`` samples: memory of the record
+    and a chunk's columns, not the record's size times the columns."""
+    y = np.asarray(y, dtype=np.float64)
+    n, k = y.size, 2 + 2 * len(freqs)
+    t_mean, t_ptp = (n - 1) / (2.0 * fs), max((n - 1) / fs, 1e-300)
+
+    def cols(a: int, b: int) -> np.ndarray:
+        t = np.arange(a, b) / fs
+        out = [np.ones(b - a), (t - t_mean) / t_ptp]
+        for f in freqs:
+            out += [np.sin(2 * np.pi * f * t), np.cos(2 * np.pi * f * t)]
+        return np.column_stack(out)
+
+    gram, rhs = np.zeros((k, k)), np.zeros(k)
+    for a in range(0, n, chunk):
+        x = cols(a, min(n, a + chunk))
+        gram += x.T @ x
+        rhs += x.T @ y[a : a + chunk]
+    coef = np.linalg.lstsq(gram, rhs, rcond=None)[0]
+    out = y.copy()
+    for a in range(0, n, chunk):
+        out[a : a + chunk] -= cols(a, min(n, a + chunk))[:, 2:] @ coef[2:]
+    return out
