@@ -280,3 +280,15 @@ def test_the_final_fits_bandwidth_amplitude_is_n_in_ns_unit():
     assert bw.unit == n.unit == "deg/√s" and bw.value == pytest.approx(n.value, rel=1e-12)
     assert bw.value == pytest.approx(2e-3, rel=0.02)
     assert "bandwidth = " in repr(r.fit) and "deg/s [" not in repr(bw)
+
+
+def test_rms_adev_pct_of_a_prediction_of_nothing_is_bounded():
+    # a held-out prediction a removal's correction drove below zero read 3·10¹⁴⁷ % (blind9's spikes on a line)
+    from allanite.model.refinement.scoring import MODEL_FLOOR, rms_adev_pct
+
+    obs = np.array([1.0, 2.0, 4.0])
+    assert rms_adev_pct(obs, obs) == 0.0
+    assert rms_adev_pct(obs, obs / 4.0) == pytest.approx(100.0)  # ADEV half the truth's reciprocal: +100 %
+    worst = rms_adev_pct(obs, np.array([1.0, -3.0, 0.0]))
+    assert worst == pytest.approx(100 * np.sqrt(2 / 3) * (MODEL_FLOOR**-0.5 - 1))
+    assert np.isfinite(worst) and worst <= 1e6

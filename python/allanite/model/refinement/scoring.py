@@ -43,8 +43,17 @@ HELDOUT_MIN_EDF = 50.0
 HELDOUT_AGREE = 0.2
 
 
+#: A model Allan variance below this share of the observed one counts as this share (:func:`rms_adev_pct`): a
+#: held-out prediction that a removal's correction drives to zero or below otherwise read 3·10¹⁴⁷ % (floored at
+#: 10⁻³⁰⁰; ``benches/refine_blind9.py``'s spikes on a line) — now at most 10⁶ % per τ, still the worst of any.
+MODEL_FLOOR = 1e-8
+
+
 def rms_adev_pct(obs, model) -> float:
-    """RMS relative error (%) of the Allan deviation ``sqrt(model)`` against ``sqrt(obs)``."""
+    """RMS relative error (%) of the Allan deviation ``sqrt(model)`` against ``sqrt(obs)``; a model at or below
+    :data:`MODEL_FLOOR` of ``obs`` is taken at that floor (a prediction of nothing: 10⁶ % at that τ)."""
+    obs = np.asarray(obs, dtype=np.float64)
+    model = np.maximum(model, MODEL_FLOOR * obs)
     return float(100 * np.sqrt(np.mean((np.sqrt(obs / model) - 1) ** 2)))
 
 
