@@ -166,8 +166,9 @@ def write(res: dict, out: Path) -> None:
         "",
         *_power_lines(res["power"]),
         "",
-        "The optional terms are tested as before (the lag against the d(ch)/dt term, `LAG_MARGIN`); the coefficient "
-        "is the in-phase one where a d(ch)/dt term stands in for the lag.",
+        "The optional terms: a lag and a d(ch)/dt term weighed by their likelihoods where the d(ch)/dt term passes, "
+        'the phase\'s sign deciding within `LAG_MARGIN` (docs/channels.md, "A lag or a d(ch)/dt term"); the '
+        "coefficient is the in-phase one where a d(ch)/dt term is kept.",
         "",
         f"## Null ({nl['records']} records, no coupling: cycling / random-walk channels; white + flicker, white + "
         "random walk, all three)",

@@ -80,10 +80,15 @@ def _optional_words(terms: dict) -> str:
     for name in [t for t in OPTIONAL_TERMS if t in terms] + [t for t in terms if t not in OPTIONAL_TERMS]:
         t = terms[name]
         kept = bool(t.get("kept"))
+        stat, thr = t.get("statistic"), t.get("threshold")
+        # the sign is the test's own: a lag and a d(ch)/dt term are chosen between, so a term may be kept below its
+        # threshold (standing in for the other, which passed) or not kept above it (docs/channels.md)
         sign = "≥" if kept else "<"
+        if isinstance(stat, (int, float)) and isinstance(thr, (int, float)):
+            sign = "≥" if stat >= thr else "<"
+        why = f"; {t['why']}" if isinstance(t.get("why"), str) and name in ("lag_s", "rate_coefficient") else ""
         parts.append(
-            f"{name} {'kept' if kept else 'not kept'} (statistic {g(t.get('statistic'), 3)} {sign} "
-            f"threshold {g(t.get('threshold'), 3)})"
+            f"{name} {'kept' if kept else 'not kept'} (statistic {g(stat, 3)} {sign} threshold {g(thr, 3)}{why})"
         )
     return "; ".join(parts)
 
