@@ -354,6 +354,7 @@ NOTES: list = [
     "2.0 % at 1 %, 5.7 % at 5 %.",
     "**Rerun at 44eba23** (every branch of the 2026-11-27 afternoon merged: the sinc^k kind chain, the family fold, the mean check's per-term nulls, the coupling test's bootstrap where its dof is small, the cost round, the module splits): the table above, **12 of 12**, without the candidate **9 of 9** — every row's effects, parameters and words as at bfcb29f (only the CPU column moved).",
     '**The 1/16 °C row rerun with the channel read back** (r9chan, `--case "quantised to 1/16"`; its row above replaced, the other rows as at 44eba23): the channel is read as quantised at 0.0625 (a slow staircase) and held for 1 s (`evidence["channel_form"]`, docs/channels.md "Quantised and held channels") — coefficient 6.027 → 6.031·10⁻⁴ (+0.5 %), RMS ADEV 1.68 → 1.36 → now 1.35 %, held out 5.29 → 2.27 % as before, nothing unexplained; ✓ as before.',
+    "**Rerun whole at ba83de7** (every branch of the 2026-11-27 evening merged but r11lagrate, whose rule runs only where a d(ch)/dt term passes; this suite's channel rows keep none): the table above, **12 of 12** — every row's verdict and effects as before; the clock's final χ²/dof 9.06 → 1.6 (its sinusoid as before), the clipped record's change point at 1198 s (1184 before).",
 ]
 
 

@@ -383,6 +383,7 @@ NOTES: list = [
     " that split's eighths the warm-up is still refitted on a part that holds it alone; the final 3.85 % "
     "where the first run ended at 3.53 %.",
     "**Rerun at 44eba23** (every branch of the 2026-11-27 afternoon merged: the sinc^k kind chain, the family fold, the mean check's per-term nulls, the coupling test's bootstrap where its dof is small, the cost round, the module splits): the table above, **10 of 11**, without the candidate **9 of 9** — every row's effects, parameters and words as at bfcb29f but the 24 h log's: refined without the regression candidate it now leaves 2 regions unexplained (1 before; the coupling test's bootstrap). The cold start still fails on its coefficient (+30.3 %, its interval holding the truth).",
+    "**Rerun whole at ba83de7** (every branch of the 2026-11-27 evening merged but r11lagrate, whose rule runs only where a d(ch)/dt term passes; none of this suite's rows keeps one): the table above, **10 of 11** — every row's verdict as before; the 24 h log no longer adds a Gauss–Markov beside its 900 s cycle (the sinusoid and the regression as before; χ²/dof 1.19 → 1.94 at the end, held out 0.70 → 0.72 %). The cold start still fails on its coefficient (+30.3 %).",
 ]
 
 
