@@ -62,20 +62,8 @@ class TimeRemovals(RunState):
             return
         _st, rem, *_rest = self.removed[-1]
         y_back = self.y + rem.component
-        y_less = lines_less(y_back, self.fs, freqs)
-        c_less, _h = self.build(avar(y_less, self.fs, taus=self.result.tau), None)
         found: list = []
-        less = RemovalContext(
-            y_less,
-            self.fs,
-            c_less,
-            solve(c_less, self.start, self.effects),
-            self.start,
-            ctx.channels,
-            self.level,
-            lambda _e, entry: found.append(entry),
-            effects=ctx.effects,
-        )
+        less = self._less(lines_less(y_back, self.fs, freqs), ctx, lambda _e, entry: found.append(entry))
         if (
             any(True for _r in REMOVALS["drift"](less))
             or not found
@@ -103,14 +91,11 @@ class TimeRemovals(RunState):
         freqs = lines_in_differences(ctx.lines, self.y, self.fs, self.declined_families)
         if not freqs:
             return
-        y_less = lines_less(self.y, self.fs, freqs)
-        c_less, _h = self.build(avar(y_less, self.fs, taus=self.result.tau), None)
-        s_less = solve(c_less, self.start, self.effects)
         said = lambda effect, entry: self.consider(effect, entry | {"beside_lines_hz": freqs})  # noqa: E731
-        less = RemovalContext(y_less, self.fs, c_less, s_less, self.start, ctx.channels, self.level, said, ctx.effects)
+        less = self._less(lines_less(self.y, self.fs, freqs), ctx, said)
         for rem in REMOVALS["outliers"](less):
             rem.evidence["beside_lines_hz"] = freqs
-            self.remove(rem, basis=(c_less, s_less, y_less))
+            self.remove(rem, basis=(less.curve, less.sol, less.y))
 
     def drift_beside_slow_lines(self, ctx: RemovalContext) -> None:
         """The drift test once more where the line search found lone lines slow enough to move the drift test's
@@ -124,23 +109,19 @@ class TimeRemovals(RunState):
         slow = slow_lines(ctx.lines, self.y.size / self.fs, self.declined_families)
         if not slow:
             return
-        y_less = self.y - lines_component(self.y, self.fs, slow)
-        res_less = avar(y_less, self.fs, taus=self.result.tau)
-        c_less, _h = self.build(res_less, None)
-        less = RemovalContext(
-            y_less,
-            self.fs,
-            c_less,
-            solve(c_less, self.start, self.effects),
-            self.start,
-            ctx.channels,
-            self.level,
-            self.consider,
-            effects=ctx.effects,
-        )
+        less = self._less(self.y - lines_component(self.y, self.fs, slow), ctx, self.consider)
         for rem in REMOVALS["drift"](less):
             rem.evidence["beside_lines_hz"] = [float(f) for f in slow]
             self.remove(rem)
+
+    def _less(self, y_less, ctx: RemovalContext, consider) -> RemovalContext:
+        """The removals' context on ``y_less`` (the samples less some lines): its curve, the five-term fit on it,
+        ``consider`` where what is turned down there is said — the retests beside lines are each run on one."""
+        c_less, _h = self.build(avar(y_less, self.fs, taus=self.result.tau), None)
+        s_less = solve(c_less, self.start, self.effects)
+        return RemovalContext(
+            y_less, self.fs, c_less, s_less, self.start, ctx.channels, self.level, consider, effects=ctx.effects
+        )
 
     def remove(self, rem: Removal, basis: tuple | None = None) -> bool:
         """Remove ``rem.component`` if the held-out error falls (or its held-out test in time passes); else
