@@ -68,6 +68,20 @@ pub(crate) fn fit_windows<'py>(
     to_2d(py, n_windows, width, values)
 }
 
+/// The reweighted NNLS's failures as `scipy.optimize.nnls` raises them: ValueError for a non-finite
+/// weighted problem, RuntimeError when the NNLS does not settle (`irls_curves` and `whittle_noise`).
+fn fit_error(e: allanite_core::fit::curves::CurveFitError) -> PyErr {
+    use allanite_core::fit::curves::CurveFitError;
+    match e {
+        CurveFitError::NonFinite => {
+            pyo3::exceptions::PyValueError::new_err("array must not contain infs or NaNs")
+        }
+        CurveFitError::MaxIter => {
+            pyo3::exceptions::PyRuntimeError::new_err("Maximum number of iterations reached.")
+        }
+    }
+}
+
 /// `refine`'s reweighted NNLS of one curve on many designs (allanite-core `fit::curves`): `design` and
 /// `nu_cols` (designs, n_tau, n_cols), `y` and `nu0` (n_tau), `fixed` (n_cols: a held column's
 /// coefficient, NaN for a fitted one). Returns θ (designs, n_cols) and ν (designs, n_tau). Errors as
@@ -87,7 +101,7 @@ pub(crate) fn irls_curves<'py>(
     floor: f64,
     rtol: f64,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-    use allanite_core::fit::curves::{irls_curves as run, CurveDesigns, CurveFitError};
+    use allanite_core::fit::curves::{irls_curves as run, CurveDesigns};
     let shape = design.shape().to_vec();
     let (g_n, n, k) = (shape[0], shape[1], shape[2]);
     let (a, nc) = (
@@ -118,14 +132,7 @@ pub(crate) fn irls_curves<'py>(
         floor,
         rtol,
     };
-    let (theta, nu) = py.detach(|| run(&p)).map_err(|e| match e {
-        CurveFitError::NonFinite => {
-            pyo3::exceptions::PyValueError::new_err("array must not contain infs or NaNs")
-        }
-        CurveFitError::MaxIter => {
-            pyo3::exceptions::PyRuntimeError::new_err("Maximum number of iterations reached.")
-        }
-    })?;
+    let (theta, nu) = py.detach(|| run(&p)).map_err(fit_error)?;
     Ok((to_2d(py, g_n, k, theta)?, to_2d(py, g_n, n, nu)?))
 }
 
@@ -146,7 +153,6 @@ pub(crate) fn whittle_noise<'py>(
     max_iter: usize,
     rtol: f64,
 ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
-    use allanite_core::fit::curves::CurveFitError;
     let (nb, k) = (shapes.shape()[0], shapes.shape()[1]);
     let a = c_slice(py, &shapes, "shapes")?;
     let (p, r, s) = (
@@ -161,13 +167,6 @@ pub(crate) fn whittle_noise<'py>(
         ));
     }
     let (coef, level) = allanite_core::fit::whittle::whittle_noise(a, k, p, r, s, max_iter, rtol)
-        .map_err(|e| match e {
-        CurveFitError::NonFinite => {
-            pyo3::exceptions::PyValueError::new_err("array must not contain infs or NaNs")
-        }
-        CurveFitError::MaxIter => {
-            pyo3::exceptions::PyRuntimeError::new_err("Maximum number of iterations reached.")
-        }
-    })?;
+        .map_err(fit_error)?;
     Ok((PyArray1::from_vec(py, coef), PyArray1::from_vec(py, level)))
 }
