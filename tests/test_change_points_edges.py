@@ -85,3 +85,16 @@ def test_a_tracked_familys_level_step_is_located_beside_its_bound_not_at_a_burst
     window_s = N / 16 / FS
     assert [round(c["t"] / window_s, 1) for c in found] == [pytest.approx(2.5, abs=0.1)]
     assert all(window_s < c["t"] < N / FS - window_s for c in found)
+
+
+def test_locate_keeps_the_split_a_guard_from_the_spans_ends():
+    # a 0.6 s burst at the span's start wins the two-segment likelihood against a 15 % step at 50 s; with the
+    # guard (an eighth of a window in ``_segment``: a change nearer the span's end would be the next bound) the
+    # split and its support stay at least that far in
+    fs, n, guard = 100.0, 8192, 512
+    y = _stepped(2, n, 5000, 1.15, slice(0, 60), 4.0)
+    t_free, _ = changes.locate(y, 1, fs)
+    assert t_free < 1.0
+    t, (lo, hi) = changes.locate(y, 1, fs, guard=guard)
+    assert guard / fs <= t <= (n - guard) / fs
+    assert lo >= (guard - 1) / fs and hi <= (n - guard + 1) / fs

@@ -16,10 +16,12 @@ whose level wanders, each round took the largest differences out and found more 
 where one round finds 3 and binary segmentation found none). Cost: the windows' Allan variances, O(N) per
 τ; the partition O(16² × τ). Each change point is located to the sample by a two-segment likelihood of the
 squared m-sample differences at the τ of its largest gain, within the window either side of its bound (the
-partition put the change in one of those two: a change deeper in a segment would have moved the bound), not across
-every window between its neighbours — there a short burst far from the bound won the two-segment likelihood
-(ADIS16405 run 1 acc_z: a 6 s burst 2–8 s from the start, 4× the level at τ 0.16 s, located a bound at 1875 s at
-7.8 s; ``benches/results/wander_measured.md``); a window straddling a change is a segment of its own where the
+partition put the change in one of those two: a change deeper in a segment would have moved the bound) and at
+least an eighth of a window from that span's ends (a change there would have been the next bound, and the
+likelihood favours a short segment at an end where the level wanders), not across every window between its
+neighbours — there a short burst far from the bound won the two-segment likelihood (ADIS16405 run 1 acc_z: a 6 s
+burst 2–8 s from the start, 4× the level at τ 0.16 s, located a bound at 1875 s at 7.8 s;
+``benches/results/wander_measured.md``); a window straddling a change is a segment of its own where the
 partition makes it one, so one change may come from two bounds: located within an eighth of a window of each other
 (or with overlapping intervals) they are one. Two changes closer than that are one; a stretch shorter than a
 window shows as one window's level.
@@ -150,7 +152,7 @@ def _segment(lv: _Levels, y, fs, window, max_points) -> list:
         # eighth of the span (two windows): the two-segment likelihood needs a few terms either side
         lo_s, hi_s = (j - 1) * window, (j + 1) * window  # its neighbours' bounds are no nearer
         m = min(int(lv.m[k_tau]), (hi_s - lo_s) // 8)
-        t_hat, t_int = locate(y[lo_s:hi_s], m, fs)
+        t_hat, t_int = locate(y[lo_s:hi_s], m, fs, guard=window // 8)
         t_abs = t_hat + lo_s / fs
         interval = (t_int[0] + lo_s / fs, t_int[1] + lo_s / fs)
         same = [c for c in out if _same(c, t_abs, interval, window / fs)]
@@ -206,8 +208,9 @@ def change_points(y, fs, terms, max_points=None):
     return out
 
 
-def locate(y, m, fs):
-    """Change in the mean of the squared m-sample second differences: MLE split and 2-unit support.
+def locate(y, m, fs, guard=0):
+    """Change in the mean of the squared m-sample second differences: MLE split and 2-unit support, the split
+    at least ``guard`` samples from either end of the span (where the span is longer than twice that).
 
     Each segment's mean square is floored at q²/6, the variance of the difference of two samples' rounding
     errors (Sheppard), when the terms are quantized (some exactly zero; q² their smallest non-zero value): a
@@ -221,7 +224,9 @@ def locate(y, m, fs):
     n = d.size
     c = np.cumsum(d)
     tail = np.cumsum(d[::-1])[::-1]  # tail[i] = sum of d[i:]
-    j = np.arange(2, n - 1)
+    lo = max(2, int(math.ceil(guard / m)))
+    lo = lo if 2 * lo <= n else 2
+    j = np.arange(lo, n - lo + 1)
     mu1 = c[j - 1] / j
     mu2 = tail[j] / (n - j)
     nonzero = d0[d0 > 0]
