@@ -15,10 +15,16 @@ scatter). Not re-read without the differences across the change points found: on
 whose level wanders, each round took the largest differences out and found more (run 6 acc_z: 5 change points
 where one round finds 3 and binary segmentation found none). Cost: the windows' Allan variances, O(N) per
 τ; the partition O(16² × τ). Each change point is located to the sample by a two-segment likelihood of the
-squared m-sample differences at the τ of its largest gain, within the windows between its neighbours; a window
-straddling a change is a segment of its own where the partition makes it one, so one change may come from two
-bounds: located within an eighth of a window of each other (or with overlapping intervals) they are one. Two
-changes closer than that are one; a stretch shorter than a window shows as one window's level.
+squared m-sample differences at the τ of its largest gain, within the window either side of its bound (the
+partition put the change in one of those two: a change deeper in a segment would have moved the bound) and at
+least an eighth of a window from that span's ends (a change there would have been the next bound, and the
+likelihood favours a short segment at an end where the level wanders), not across every window between its
+neighbours — there a short burst far from the bound won the two-segment likelihood (ADIS16405 run 1 acc_z: a 6 s
+burst 2–8 s from the start, 4× the level at τ 0.16 s, located a bound at 1875 s at 7.8 s;
+``benches/results/wander_measured.md``); a window straddling a change is a segment of its own where the
+partition makes it one, so one change may come from two bounds: located within an eighth of a window of each other
+(or with overlapping intervals) they are one. Two changes closer than that are one; a stretch shorter than a
+window shows as one window's level.
 
 Its statistic is on the windows' levels, not on the Allan curve: a change point's before/after says how the
 windows' piecewise-constant levels without and with it, every other one in both, describe them. On the
@@ -128,23 +134,25 @@ def _bounds(lv: _Levels) -> list:
 
 
 def _segment(lv: _Levels, y, fs, window, max_points) -> list:
-    """The change points of the windows' levels (:func:`_bounds`), each located to the sample within the
-    windows between its neighbours: [{t, interval, gain, tau, window_s, coarse_split_s}] by time."""
+    """The change points of the windows' levels (:func:`_bounds`), each located to the sample within the window
+    either side of its bound (its neighbours' bounds no nearer): [{t, interval, gain, tau, window_s,
+    coarse_split_s}] by time."""
     bounds = _bounds(lv)
     edges = [0] + bounds + [N_WINDOWS]
     found = []
     for k, j in enumerate(bounds):
         a, b = edges[k], edges[k + 2]
         gain_tau = lv.cost_tau(a, b) - lv.cost_tau(a, j) - lv.cost_tau(j, b)
-        found.append((float(np.sum(gain_tau)), j, int(np.argmax(gain_tau)), a, b))
+        found.append((float(np.sum(gain_tau)), j, int(np.argmax(gain_tau))))
     out: list = []
-    for gain, j, k_tau, a, b in sorted(found, key=lambda f: -f[0]):
+    for gain, j, k_tau in sorted(found, key=lambda f: -f[0]):
         if max_points is not None and len(out) >= max_points:
             break
-        # locate at sample resolution with the squared differences at the τ of the largest gain
-        m = int(lv.m[k_tau])
-        lo_s, hi_s = a * window, b * window
-        t_hat, t_int = locate(y[lo_s:hi_s], m, fs)
+        # locate at sample resolution with the squared differences at the τ of the largest gain, at most an
+        # eighth of the span (two windows): the two-segment likelihood needs a few terms either side
+        lo_s, hi_s = (j - 1) * window, (j + 1) * window  # its neighbours' bounds are no nearer
+        m = min(int(lv.m[k_tau]), (hi_s - lo_s) // 8)
+        t_hat, t_int = locate(y[lo_s:hi_s], m, fs, guard=window // 8)
         t_abs = t_hat + lo_s / fs
         interval = (t_int[0] + lo_s / fs, t_int[1] + lo_s / fs)
         same = [c for c in out if _same(c, t_abs, interval, window / fs)]
@@ -200,8 +208,9 @@ def change_points(y, fs, terms, max_points=None):
     return out
 
 
-def locate(y, m, fs):
-    """Change in the mean of the squared m-sample second differences: MLE split and 2-unit support.
+def locate(y, m, fs, guard=0):
+    """Change in the mean of the squared m-sample second differences: MLE split and 2-unit support, the split
+    at least ``guard`` samples from either end of the span (where the span is longer than twice that).
 
     Each segment's mean square is floored at q²/6, the variance of the difference of two samples' rounding
     errors (Sheppard), when the terms are quantized (some exactly zero; q² their smallest non-zero value): a
@@ -215,7 +224,9 @@ def locate(y, m, fs):
     n = d.size
     c = np.cumsum(d)
     tail = np.cumsum(d[::-1])[::-1]  # tail[i] = sum of d[i:]
-    j = np.arange(2, n - 1)
+    lo = max(2, int(math.ceil(guard / m)))
+    lo = lo if 2 * lo <= n else 2
+    j = np.arange(lo, n - lo + 1)
     mu1 = c[j - 1] / j
     mu2 = tail[j] / (n - j)
     nonzero = d0[d0 > 0]
