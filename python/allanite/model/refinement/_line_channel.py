@@ -29,8 +29,8 @@ __all__ = ["follows_channel"]
 
 def _block_means(x: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """The channel's mean over each block, Hann-weighted as the block's phasor weighs the line (a uniform mean
-    smooths a channel that moves within the blocks more than the phasors are smoothed: g read 0.024 for 0.02
-    on a channel cycling twice over 16 blocks)."""
+    smooths a channel that moves within the blocks more than the phasors are smoothed: on a noise-free line,
+    g 0.0203 for 0.02 on a channel cycling twice over 16 blocks, 0.0213 four times; Hann-weighted 0.0200)."""
     out = np.empty(edges.size - 1)
     for i, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
         w = np.sin(np.pi * (np.arange(b - a) + 0.5) / (b - a)) ** 2
