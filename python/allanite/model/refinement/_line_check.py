@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from ._line_channel import follows_channel
 from ._line_constancy import MAX_BLOCKS, MIN_PERIODS, block_phasors, line_constancy
 from .curvefit import base_name
 from .words import heldout_clause, span_text
@@ -118,6 +119,7 @@ def line_check(ctx: Any, a: float) -> list[dict]:
             reg = _amplitude_entry(ctx, r, k, sides, w)
         if reg is None:
             continue
+        reg = _tied(ctx, r, reg, a / len(tested), None if fam is None else ctx.families[fam][3])
         half = 1.0 / float(lengths.mean())
         out.append(
             reg
@@ -127,6 +129,25 @@ def line_check(ctx: Any, a: float) -> list[dict]:
         )
         del out[-1]["tau_peak"]
     return out
+
+
+def _tied(ctx: Any, r: dict, reg: dict, a: float, removed) -> dict:
+    """The entry with the channel its line's amplitude follows, where one does (:mod:`._line_channel`, at ``a``):
+    the line's block phasors as it is in the record — the final samples' plus, for a family's line, the removed
+    component's own (``removed``)."""
+    chans = getattr(ctx, "channels", None)
+    if not chans:
+        return reg
+    ph = np.asarray(r["phasors"])
+    if removed is not None:
+        ph = ph + block_phasors(np.asarray(removed, dtype=float), ctx.fs, float(r["f0"]), int(r["blocks"]))
+    tie = follows_channel(ph, r["phasor_unit"], r["noise_level"], r["noise_dof"], r["edges_s"], ctx.fs, chans, a)
+    if tie is None:
+        return reg
+    what = reg["what"][:-1] if reg["what"].endswith(")") else reg["what"]
+    name = repr(tie["channel"])
+    words = f"; it follows {name}: {100 * tie['g']:+.2g} % of its amplitude per unit of {name} about {tie['mean']:.4g})"
+    return reg | {"what": what + words, "follows": tie}
 
 
 def _tail(ctx: Any, dep: float, tau: float) -> str:

@@ -116,7 +116,8 @@ def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float, phasors: b
     degrees of freedom, ≈ 9.4 per block where all 2·OFF_BINS are inside (0, fs/2)), ``rejected``, ``blocks``,
     ``edges_s`` (block edges, s), ``amplitude`` (|A| per block) and ``amplitude_mean`` (|mean phasor|); with
     ``phasors`` also ``"phasors"``, the complex amplitude per block, and ``"phasor_var"``, each one's noise
-    variance E|c − A|².
+    variance E|c − A|² — the pooled level ``"noise_level"`` (``"noise_dof"`` its degrees of freedom) times the
+    block's variance under unit white noise, ``"phasor_unit"``.
 
     Examples
     --------
@@ -155,4 +156,5 @@ def line_constancy(y: np.ndarray, fs: float, f0: float, alpha: float, phasors: b
     }
     if phasors:
         out["phasors"], out["phasor_var"] = ph.tolist(), var.tolist()
+        out["phasor_unit"], out["noise_level"], out["noise_dof"] = unit.tolist(), s2, d2
     return out
