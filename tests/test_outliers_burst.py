@@ -87,3 +87,20 @@ def test_burst_scales_on_a_lattice():
     mid = np.array([(b.start + b.stop) // 2 for b in fine_blocks])
     inside = (mid > 20_000) & (mid < 23_000)
     assert inside.any() and np.all(np.abs(fine[inside] / 6.0 - 1.0) < 0.15)
+
+
+def test_no_fine_block_is_loud_on_a_low_pass_or_a_wandering_lattice():
+    """Shares of a low-passed record's differences (they move together) and of a quantised random walk (its
+    offsets not uniform over 512 samples) scatter beyond the binomial's: the threshold follows their own spread.
+    Against the binomial standard error alone, the fine blocks in the comments were split (seeds 21–23)."""
+    from scipy import signal
+
+    rng = np.random.default_rng(21)
+    b, a = signal.butter(2, 0.02)
+    d = np.diff(signal.lfilter(b, a, rng.standard_normal(200_000)))
+    assert _robust_scale.burst_scales(d, 0.0)[0] == _robust_scale.local_scales(d, 0.0)[0]  # binomial: 120–165
+    walk = np.cumsum(0.02 * rng.standard_normal(200_000)) + 0.3 * rng.standard_normal(200_000)
+    q = np.diff(np.round(walk))
+    assert _robust_scale.burst_scales(q, 1.0)[0] == _robust_scale.local_scales(q, 1.0)[0]  # 210–300 fine blocks
+    d[100_000:103_000] *= 3.0  # and a burst on the low-pass is still found
+    assert len(_robust_scale.burst_scales(d, 0.0)[0]) > len(_robust_scale.local_scales(d, 0.0)[0])

@@ -193,7 +193,8 @@ def _louder(x: np.ndarray, step: float, blocks: list, local: np.ndarray, fine: l
     """Per fine block: whether its share of samples beyond the median |x| of its block's local scale σ_b is above
     the share expected there by :data:`FINE_Z` binomial standard errors — |x − median| > 0.6745·σ_b, ½, when
     continuous; on a lattice of step L, |x| > (j + ½)L with j = round(0.6745·σ_b/L) and the lattice's own
-    probability of it (:func:`_inner`). One pass over the record; no robust σ per fine block."""
+    probability of it (:func:`_inner`) — or by FINE_Z times the z's robust spread over the record (each about its
+    block's median) where that is above 1. One pass over the record; no robust σ per fine block."""
     beyond = np.empty(x.size, dtype=bool)
     p0 = np.empty(len(blocks))
     for k, (b, s) in enumerate(zip(blocks, local)):
@@ -209,4 +210,11 @@ def _louder(x: np.ndarray, step: float, blocks: list, local: np.ndarray, fine: l
     size = np.array([f.stop - f.start for f in fine], dtype=np.float64)
     count = np.add.reduceat(beyond.astype(np.int64), starts)
     p = p0[coarse_of]
-    return count - size * p > FINE_Z * np.sqrt(size * p * (1.0 - p))
+    z = (count - size * p) / np.sqrt(size * p * (1.0 - p))
+    # samples that are not independent (a low-pass: the differences move together) or a lattice whose offsets are
+    # not uniform over a fine block (a quantised record wandering less than a step in 512 samples) scatter the
+    # shares beyond the binomial's: the z's own robust spread over the record, where larger (a burst is a few),
+    # each about its block's median (a block judged at its louder neighbour's scale has all its z's below 0)
+    centre = np.array([np.median(z[coarse_of == k]) for k in range(len(blocks))])
+    spread = 1.4826 * float(np.median(np.abs(z - centre[coarse_of])))
+    return z > FINE_Z * max(1.0, spread)
