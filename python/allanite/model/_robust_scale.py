@@ -48,7 +48,8 @@ SCALE_Z = 4.0
 FINE_BLOCK = 512
 #: z of the sign test by which a fine block is louder than its block's local scale (:func:`burst_scales`): the share
 #: of its samples beyond that scale's median |x| above the share expected, by FINE_Z binomial standard errors
-#: (2.9·10⁻⁷ per fine block on noise of one level: one fine block in ~7 records of 10⁷ samples).
+#: (2.9·10⁻⁷ per fine block on independent samples of one level: one fine block in ~7 records of 10⁷ samples), or
+#: FINE_Z times the z's own robust spread where the samples are not independent (:func:`_louder`).
 FINE_Z = 5.0
 
 _SQRT2, _SQRT_2PI = math.sqrt(2.0), math.sqrt(2.0 * math.pi)
