@@ -301,7 +301,7 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
             flags[b] = np.abs(r[b]) > cut
             lam += (b.stop - b.start) * p
             cuts.append(cut)
-        return flags, lam, float(np.median(cuts))
+        return flags, lam, _median_cut(cuts, s_blocks)
     cut_d = np.zeros(d.size)
     lam = 0.0
     for b, s_b in zip(blocks, sig):
@@ -313,7 +313,18 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
     # no Gaussian sample among the flags)
     flags, lengths = _off_neighbours(d, cut_d, summed)
     lam *= 1 + sum(lengths - {1})
-    return flags, lam, float(np.median([_tail(c, s_b, step)[0] for s_b in sig]))
+    return flags, lam, _median_cut([_tail(c, s_b, step)[0] for s_b in sig], blocks)
+
+
+def _median_cut(cuts: list, blocks: list) -> float:
+    """The reported cut: the median over blocks of equal length; over the samples where a block was cut into fine
+    blocks (:func:`._robust_scale.burst_scales`) — sixteen fine blocks of a burst are not sixteen blocks' say."""
+    size = np.array([b.stop - b.start for b in blocks], dtype=np.float64)
+    if size.max() - size.min() <= 1:
+        return float(np.median(cuts))
+    order = np.argsort(cuts)
+    at = np.cumsum(size[order])
+    return float(np.asarray(cuts)[order][int(np.searchsorted(at, 0.5 * at[-1]))])
 
 
 def _off_neighbours(d: np.ndarray, cut_d: np.ndarray, summed: np.ndarray | None = None) -> tuple[np.ndarray, set]:
