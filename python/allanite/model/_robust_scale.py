@@ -210,12 +210,13 @@ def _louder(x: np.ndarray, step: float, blocks: list, local: np.ndarray, fine: l
     starts = np.array([f.start for f in fine], dtype=np.int64)
     size = np.array([f.stop - f.start for f in fine], dtype=np.float64)
     count = np.add.reduceat(beyond.astype(np.int64), starts)
-    p = p0[coarse_of]
+    p = np.clip(p0[coarse_of], 1e-9, 1.0 - 1e-9)  # a lattice's share at its cut is never quite 0 or 1
     z = (count - size * p) / np.sqrt(size * p * (1.0 - p))
     # samples that are not independent (a low-pass: the differences move together) or a lattice whose offsets are
     # not uniform over a fine block (a quantised record wandering less than a step in 512 samples) scatter the
     # shares beyond the binomial's: the z's own robust spread over the record, where larger (a burst is a few),
     # each about its block's median (a block judged at its louder neighbour's scale has all its z's below 0)
-    centre = np.array([np.median(z[coarse_of == k]) for k in range(len(blocks))])
+    per_block = np.split(z, np.cumsum(np.bincount(coarse_of, minlength=len(blocks)))[:-1])  # fine blocks in order
+    centre = np.array([np.median(v) for v in per_block])
     spread = 1.4826 * float(np.median(np.abs(z - centre[coarse_of])))
     return z > FINE_Z * max(1.0, spread)
