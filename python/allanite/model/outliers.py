@@ -4,8 +4,9 @@
 differences d_t = y_t − y_{t−1} of any Gaussian record are Gaussian, whatever its spectrum (white, flicker,
 random walk, a ramp, a low-pass: a linear filter of Gaussian noise stays Gaussian; slow terms barely reach
 the differences, so they hide nothing). Their scale is estimated robustly and locally — per block of 8192
-differences, the block's own or its louder neighbour's (:func:`._robust_scale.local_scales`), so a noise level
-that changes along the record (a pump on for stretches) does not read as a heavy tail: the median absolute
+differences, the block's own or its louder neighbour's (:func:`._robust_scale.local_scales`), and per fine block
+of 512 where one is louder than its block (:func:`._robust_scale.burst_scales`), so a noise level that changes along
+the record (a pump on for stretches, a truck passing) does not read as a heavy tail: the median absolute
 difference, or — for quantised samples (every difference a multiple of a step L) — the σ of the Gaussian whose
 differences, quantised, put the observed share of |d| ≤ jL (j where that share is nearest ½). With y quantised as y + u
 (u uniform on a step, independent of d), P(|d_q| ≤ jL) = P(|d + U| < (j + ½)L), U uniform on (−L/2, L/2):
@@ -63,8 +64,8 @@ from scipy.stats import poisson
 
 from . import _chunked
 from ._recent import Recent
+from ._robust_scale import burst_scales, robust_sigma
 from ._robust_scale import lattice_sigma as _lattice_sigma  # noqa: F401 (its cache, asked by the tests)
-from ._robust_scale import local_scales, robust_sigma
 from ._robust_scale import tail_cut as _tail
 
 __all__ = [
@@ -85,7 +86,7 @@ CUTS = (4.0, 5.0, 6.0, 7.0)
 #: ADIS16405 gyros' differences hold 1.1–1.5× the Gaussian count at 3–4 σ, none beyond 5.2 σ: no spikes).
 TAIL_FACTOR = 2.0
 #: Samples per block of the replacement's scales and of the coarse-lattice check (at most MAX_BLOCKS blocks, at
-#: least one); the test's and the flagging's scale is local (:func:`._robust_scale.local_scales`).
+#: least one); the test's and the flagging's scale is local (:func:`._robust_scale.burst_scales`).
 BLOCK = 8192
 MAX_BLOCKS = 64
 #: Least spread of the samples (standard deviation per block, in quantisation steps) for the lattice model to
@@ -165,7 +166,7 @@ def outlier_test(y: np.ndarray, fs: float, alpha: float) -> dict:
     d = np.diff(y)
     step = lattice_step(d)
     out["step"] = step
-    blocks, sig = local_scales(d, step)  # each sample judged at its local scale (:mod:`._robust_scale`)
+    blocks, sig = burst_scales(d, step)  # each sample judged at its local scale (:mod:`._robust_scale`)
     out["sigma_d"] = float(np.nanmedian(sig)) if np.isfinite(sig).any() else float("nan")
     if not np.isfinite(sig).all():
         out["note"] = "a block of the differenced record has no spread (constant samples)"
@@ -217,7 +218,7 @@ def flag_at(y: np.ndarray, c: float) -> tuple[np.ndarray, float]:
     y = np.asarray(y, dtype=np.float64)
     d = np.diff(y)
     step = lattice_step(d)
-    blocks, sig = local_scales(d, step)
+    blocks, sig = burst_scales(d, step)
     if not np.isfinite(sig).all():
         return np.zeros(y.size, dtype=bool), 0.0
     flags, lam, _cut = _flags_of(y, d, blocks, sig, step, c, _level_residual(y, step))
@@ -241,7 +242,7 @@ def _level_residual(y: np.ndarray, step: float) -> tuple[np.ndarray, list, np.nd
     if span < LEVEL_SPAN:
         return None
     r = y - _slow_level(y, np.zeros(y.size, dtype=bool), span)
-    blocks, sig = local_scales(r, step)
+    blocks, sig = burst_scales(r, step)
     return (r, blocks, sig) if np.isfinite(sig).all() and np.all(sig > 0) else None
 
 
@@ -300,7 +301,7 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
             flags[b] = np.abs(r[b]) > cut
             lam += (b.stop - b.start) * p
             cuts.append(cut)
-        return flags, lam, float(np.median(cuts))
+        return flags, lam, _median_cut(cuts, s_blocks)
     cut_d = np.zeros(d.size)
     lam = 0.0
     for b, s_b in zip(blocks, sig):
@@ -312,7 +313,18 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
     # no Gaussian sample among the flags)
     flags, lengths = _off_neighbours(d, cut_d, summed)
     lam *= 1 + sum(lengths - {1})
-    return flags, lam, float(np.median([_tail(c, s_b, step)[0] for s_b in sig]))
+    return flags, lam, _median_cut([_tail(c, s_b, step)[0] for s_b in sig], blocks)
+
+
+def _median_cut(cuts: list, blocks: list) -> float:
+    """The reported cut: the median over blocks of equal length; over the samples where a block was cut into fine
+    blocks (:func:`._robust_scale.burst_scales`) — sixteen fine blocks of a burst are not sixteen blocks' say."""
+    size = np.array([b.stop - b.start for b in blocks], dtype=np.float64)
+    if size.max() - size.min() <= 1:
+        return float(np.median(cuts))
+    order = np.argsort(cuts)
+    at = np.cumsum(size[order])
+    return float(np.asarray(cuts)[order][int(np.searchsorted(at, 0.5 * at[-1]))])
 
 
 def _off_neighbours(d: np.ndarray, cut_d: np.ndarray, summed: np.ndarray | None = None) -> tuple[np.ndarray, set]:
