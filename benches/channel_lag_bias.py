@@ -221,6 +221,54 @@ def table(summ: dict) -> str:
     return "\n".join(lines)
 
 
+#: What the recorded page shows (kept true to it).
+NOTES = [
+    "**Replicas.** On the failing rows' own records (`--own-seed`: the blind builder at its seed, regressed whole "
+    "and block-averaged to the replica's rate) the estimates agree: blind5's FOG lag 475.2 s whole (2 kHz × 10⁷, "
+    "27 s CPU) and 476.6 s averaged to 10 Hz (0.6 s), coefficient 1.783 and 1.798·10⁻⁴; blind8's rate coefficient "
+    "2.652 whole and 2.653 at 0.5 Hz, coefficient 1.170 and 1.170·10⁻⁴.",
+    "**Bias or scatter: scatter.** blind5's lag: median −1.1 % (95 % CI −7.4 … +8.4 %), sd 13.3 % — the row's "
+    "−20.8 % is a 1.6σ draw; its coefficient median −0.2 % (sd 17 %). blind8's rate coefficient: +3.1 % "
+    "(−5.8 … +12.7 %) on these 40 seeds, sd 15.9 %; on 80 more (seeds 41–120) +6.4 % (+2.6 … +10.4 %), sd 13.1 %, "
+    "kept on 54 of 80, coverage 38 of 54 (70 %) — a few per cent high where it is kept (its test passes on the "
+    "larger estimates), the row's +32.6 % a 2σ draw. One record carries the lag to ±13 % and the dT/dt coefficient "
+    "to ±15 %: the judge's 20 % is 1.5σ and 1.3σ of that. The rows that pass stay unbiased (fog900 +1.3 %, the 300 s "
+    "lag −0.5 %, the lead +1.1 / +1.3 %).",
+    "**The intervals (the change, r12lag).** Before (the code at e849a13, same 200 records): blind5's coefficient "
+    "12 of 40 covered (median half-width 4.7 % for a scatter of 17 %: the lag's error left out), its lag 33 of 33 "
+    "(±54 %: the grid's profile at the lag-0 fit's noise); the 300 s lag's coefficient 22/40, its lags 12/12 and "
+    "26/27 (±29 %, ±32 %); fog900's profiled lag 27/35 (±50 %). After: the coefficient with the lag free "
+    "(`allanite.model._lag_time.cov_beside_lag`) 21/40 (±10.2 %; among the 33 with a kept lag 18, their errors "
+    "1.12× their half-widths in rms), the lag from its profile in time at the refitted noise 19/33 (±11.6 %); the "
+    "300 s lag's 23/40, 7/12, 19/27 (±14 %, ±18 %); fog900's profiled lag 26/35 (±47 %). Every estimate and "
+    "decision identical on all 200 records (which terms kept, the lag, the coefficients, the removal's lag), so "
+    "the channel tests' false alarms cannot move. Left: blind5's coefficient still below 68 % (21/40, CP 36–68 %): "
+    "on 7 records the lag is only profiled or the d(ch)/dt term takes its place (the one such record 5.2 half-widths "
+    "off), and the errors have heavier tails than the Fisher interval's.",
+    "**The blind rows** (`--case`, at the change): blind5's FOG exactly as recorded (lag 475.2 s, −20.8 %; "
+    "coefficient −10.9 %; χ²/dof 1.9 → 1.02, held out 5.06 → 1.24 %; ✗, 101 s CPU). Its intervals (`--own-seed`, "
+    "the whole record): the lag 416–532 s (was 338–711 s), the coefficient 1.60–1.97·10⁻⁴ (was 1.69–1.88·10⁻⁴) — "
+    "neither holds the truth: at ±12 % the row's lag is a 1.8σ draw, and 14 of the 33 replicas' kept lags are outside theirs "
+    "too. The regression on 10⁷ samples 27 → 36 s CPU (the profile in time, ≈ 10 transforms). blind8's 48 h "
+    "row as recorded (no lag used: nothing changes there; rate coefficient +32.6 %, ✗).",
+]
+
+
+def page(summ: dict) -> str:
+    return (
+        "\n\n".join(
+            [
+                "# A channel coupling's lag and d(ch)/dt coefficient: bias, scatter and coverage",
+                "`python benches/channel_lag_bias.py` (40 seeds per case; `allanite.model.channels.regress_channel` on "
+                "each record; ≈ 0.5 s CPU per record). The 68 % intervals are the regression's own.",
+                table(summ),
+                *NOTES,
+            ]
+        )
+        + "\n"
+    )
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--case", action="append", choices=sorted(CASES), help="run only these cases (repeatable)")
@@ -245,6 +293,7 @@ def main(argv=None) -> int:
     stem = "channel_lag_bias" + args.tag
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / f"{stem}.json").write_text(json.dumps({"rows": rows, "summary": summ}, indent=1))
+    (args.out / f"{stem}.md").write_text(page(summ))
     print(table(summ))
     return 0
 
