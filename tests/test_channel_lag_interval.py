@@ -73,3 +73,18 @@ def test_a_lags_interval_is_its_profile_in_time_at_the_noise_beside_the_lagged_c
     assert 0.7 * z * t["se_log"] < half < 1.5 * z * t["se_log"]
     g_lo, g_hi = t["grid_interval"]
     assert math.log(g_hi / g_lo) / 2.0 > 2.5 * half
+
+
+def test_a_lag_direction_not_separable_from_the_coefficient_keeps_the_fixed_lag_covariance():
+    # the lag's column a copy of the channel's: the information is singular — the coefficient's covariance is
+    # then the one at the lag held fixed, and the lag's variance infinite (its interval: the profile's, stepped)
+    from allanite.model._lag_time import cov_beside_lag
+
+    rng = np.random.default_rng(3)
+    x = np.sin(2 * np.pi * np.arange(4096) / 1024.0)
+    y = 0.3 * x + 0.1 * rng.standard_normal(x.size)
+    bands = wh.spectra(y, [x, x**2, np.gradient(x), x], 1.0)
+    s = wh.joint_fit(bands, wh.Design([0], [np.ones(bands.m.size)]))["s"]
+    full = cov_beside_lag(bands, [], s)
+    fixed = np.linalg.inv(2.0 * wh.Design([0], [np.ones(bands.m.size)]).gram(bands, 1.0 / s)[0])
+    assert math.isinf(full[1, 1]) and math.isclose(full[0, 0], fixed[0, 0], rel_tol=1e-12)

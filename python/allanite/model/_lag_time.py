@@ -76,9 +76,18 @@ def cov_beside_lag(exact, keys, s) -> np.ndarray:
     """The inverse Fisher information at the noise ``s`` of the kept coefficients and the lag's direction
     (:func:`lag_slope`, the band sums' column after the three regressors; its coefficient is c·δlog T): the
     coefficients' block is their covariance with the lag free (module docstring), the last diagonal element
-    c²·var(log T)."""
+    c²·var(log T). Where the lag's direction is not separable from the coefficients' (a singular information),
+    the coefficients' covariance at the lag held fixed and an infinite variance for the lag."""
     d = regressor_design(keys, exact.m.size).plus(3, np.ones(exact.m.size))
-    return np.linalg.inv(2.0 * d.gram(exact, 1.0 / s)[0])
+    info = 2.0 * d.gram(exact, 1.0 / s)[0]
+    try:
+        return np.linalg.inv(info)
+    except np.linalg.LinAlgError:
+        k = info.shape[0] - 1
+        full = np.zeros_like(info)
+        full[:k, :k] = np.linalg.inv(info[:k, :k])
+        full[k, k] = math.inf
+        return full
 
 
 def profile_interval(objective, best: float, se: float, z2: float, bounds: tuple, xtol: float = 0.02) -> tuple:
