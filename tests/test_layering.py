@@ -176,6 +176,7 @@ MODEL_RANKS = {
     "model._regressors": 0.7,  # a channel regression's signal bands and regressors (on _whittle, _lag)
     "model._staircase": -0.5,  # a channel's form (quantum, hold) read from it, and the channel read back (numpy only)
     "model._coupling": 0.8,  # a channel regression's coupling test and optional terms
+    "model._lag_time": 0.8,  # the lag a channel regression uses, in time: T, the fit beside it, both intervals
     "model._shape": 0.8,  # a coupling's shape beyond its kept terms: steps at the channel's quantiles (unexplained)
     "model.channels": 1,
     "model.timeframes": 2,

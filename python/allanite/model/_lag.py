@@ -11,8 +11,9 @@ The profile over the grid multiplies the channel's band sums by the lag's respon
 the removal runs the channel through the lag in time, from equilibrium with its first sample. Over a record a
 few lags long the two differ — the start's transient, the end wrapping onto the start — and the grid's T reads
 short: 473 s (median of 8) for a true 600 s on 5000 s at 10 Hz, 545 s with the record started in steady state.
-:func:`exact_lag` therefore refines T on the band sums of the channel lagged in time (590 and 602 s there), and
-moves the grid's interval with it.
+:func:`exact_lag` therefore refines T on the band sums of the channel lagged in time (590 and 602 s there); the
+interval that is reported is then the profile's in time at the noise refitted beside the lagged channel
+(:mod:`allanite.model._lag_time`).
 
 A lag the test does not resolve may still be the best description of the coupling: a coefficient fitted at
 lag 0 on a channel that reaches the rate through a 900 s lag leaves c·(L_T[ch] − ch) in the residual — the

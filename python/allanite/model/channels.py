@@ -53,8 +53,9 @@ Optional terms, each kept only by its own nested test at its own share of the le
   itself is reported as not resolved, under ``terms["lag_s"]["profiled"]``, not as a param) — at lag 0 the
   coupling's phase error stays in the residual (:mod:`allanite.model._lag`).
 
-Intervals: the coefficients ±t_ν quantile × the inverse Fisher information's standard error; the lag from the
-profile likelihood.
+Intervals: the coefficients ±t_ν quantile × the inverse Fisher information's standard error — where a lag is used,
+with the lag free (the lag is estimated from the same record; :mod:`allanite.model._lag_time`); the lag from its
+profile likelihood in time, at the noise refitted beside the lagged channel.
 """
 
 from __future__ import annotations
@@ -71,7 +72,8 @@ from ..errors import InputError, ParameterError
 from . import _whittle as wh
 from ._coupling import LAG_MARGIN, coupling_test, optional_terms, quadratic_test
 from ._edge import EdgeSource
-from ._lag import exact_lag, lag_grid, lagged, unresolved_lag
+from ._lag import lag_grid, lagged, unresolved_lag
+from ._lag_time import lag_in_time
 from ._regressors import (
     CHANNEL_SNR,
     channel_signal,
@@ -347,9 +349,7 @@ def regress_channel(
         keys, fit, lag_s, tests = optional_terms(bands, fit, terms, level, lag_grid(y.size, fs), z2, quad)
         removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, lag_grid(y.size, fs), z2)
         if removal_lag is not None:
-            removal_lag = _lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"])
-            exact = wh.spectra(y, regressor_iter(xs, mean, quad_mean, fs, removal_lag), fs)
-            fit = wh.joint_fit(exact, regressor_design(keys, exact.m.size))
+            removal_lag, fit = lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"], z2)
     lag = (removal_lag, tests["lag_s"]["interval"]) if lag_s is not None else None
     dofs = {"coefficient": in_phase["dof"]} | {k: tests[k]["dof"] for k in keys}
     params, intervals = _params(fit, keys, dofs, confidence, lag)
@@ -448,25 +448,6 @@ def _removal_lag(bands, fit, keys, tests, grid, z2) -> float | None:
     prof = unresolved_lag(bands, regressor_design(keys, bands.m.size), fit["s"], grid, z2)
     tests["lag_s"]["profiled"] = prof
     return float(prof["lag_s"]) if prof["used"] else None
-
-
-def _lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict) -> float:
-    """The lag the removal takes (kept, or profiled: ``t_lag["profiled"]``) refined on the band sums of the channel
-    lagged in time, its interval moved with it (:func:`allanite.model._lag.exact_lag`; the grid's profile lags
-    circularly and reads T short over a record a few lags long), written back into ``t_lag`` (the grid's T under
-    ``"grid_lag_s"``). Returns the refined T."""
-    rec = t_lag if t_lag.get("kept") else t_lag["profiled"]
-    n_cols = 2 if "quadratic" in keys else 1  # a lag is never beside the d(ch)/dt term
-
-    def objective(lag_s: float) -> float:
-        b = wh.spectra(y, regressors(xs, means[0], means[1], fs, lag_s)[:n_cols], fs)
-        info, sc = regressor_design(keys, b.m.size).gram(b, 1.0 / s)
-        return float(sc @ np.linalg.solve(info, sc))
-
-    grid = lag_grid(y.size, fs)
-    best, interval = exact_lag(objective, float(rec["lag_s"]), rec["interval"], (grid[0], grid[-1]))
-    rec |= {"grid_lag_s": float(rec["lag_s"]), "lag_s": best, "interval": interval}
-    return best
 
 
 def _informative(info: np.ndarray) -> np.ndarray:
