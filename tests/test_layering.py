@@ -185,6 +185,7 @@ MODEL_RANKS = {
     "model.refinement._slow_lines": 2,  # slow lines' least-squares component, for the drift's retest (on periodic)
     "model.refinement._irls": 2,
     "model.refinement._brent": 0,
+    "model.refinement._channel_order": 0,  # the order a record's channels are regressed in: the strongest first
     "model.refinement._line_constancy": 0,
     "model.refinement._line_channel": 3.8,  # does a line whose amplitude changes follow a channel (its words)
     "model.refinement._line_check": 4,

@@ -51,6 +51,7 @@ from scipy.stats import t as t_dist
 
 from ...analysis import avar
 from .. import channels, linefit, outliers, periodic, template, tracing, wander, warmup
+from ._channel_order import strongest_first
 from .calibrated import tested
 from .curvefit import Curve, Solution, theta_terms, upper_theta
 from .levels import alpha
@@ -218,55 +219,59 @@ def _channel_explaining(ctx: RemovalContext, thr_d: float) -> dict | None:
 
 
 def _regression(ctx: RemovalContext) -> Iterator[Removal]:
-    """Each channel in turn, on the samples with the channels before it removed: a component a channel
-    explains (a multi-position profile's steps, a temperature's swing) bends the curve as a Gauss–Markov term
-    or a random walk would, and fitted first those would take it; its test is in time (within blocks),
-    independent of the curve."""
+    """Each channel on the samples with the channels taken before it removed, the strongest first
+    (:mod:`._channel_order`): a component a channel explains (a multi-position profile's steps, a temperature's
+    swing) bends the curve as a Gauss–Markov term or a random walk would, and fitted first those would take it;
+    its test is in time (within blocks), independent of the curve."""
+    yield from strongest_first(ctx, _one_channel)
+
+
+def _one_channel(ctx: RemovalContext, name: str, ch: np.ndarray) -> Iterator[Removal]:
+    """One channel's regression on the current samples, at its share of the regression's α (at most one)."""
     fs, a = ctx.fs, alpha("regression", ctx.level)
-    for name, ch in ctx.channels.items():
-        rg = None if channels.is_slow(ch) else tracing.regression_fit(ctx.y, ch, REGRESSION_BLOCKS)
-        if rg is None or rg["dof"] < COLLAPSED_DOF:
-            yield from _slow_regression(ctx, name, ch, a / len(ctx.channels))
-            continue
-        # t with the blocks' effective number − 1 degrees of freedom (≤ REGRESSION_BLOCKS − 1)
-        t_thr = t_dist.isf(a / (2 * len(ctx.channels)), rg["dof"])
-        t_stat = abs(rg["coefficient"]) / rg["se"] if rg["se"] > 0 else 0.0
-        ev = {"domain": "channels", "test": tested("t", t_stat, float(t_thr), a)}
-        if not t_stat > t_thr:
-            ctx.consider("regression", {"channel": name, "t": t_stat, "threshold": t_thr})
-            continue
-        # the optional terms (d(ch)/dt, a lag, a square) by their own nested tests, as on a slow channel: a
-        # thermal chamber cycling 7 times is fast by its share, and a within-block coefficient cannot carry them
-        r = _with_terms(ctx, name, ch, a / len(ctx.channels), rg, t_thr)
-        if r is not None:
-            yield from _slow_regression(ctx, name, ch, a / len(ctx.channels), r)
-            continue
-        # band by band where the coupling differs across frequency (the whole-record coefficient elsewhere)
-        br = tracing.band_regression(ctx.y, ch, fs, a)
-        own = [b for b in br["bands"] if b["own"]]
-        if own:
-            ev["bands"] = own
+    rg = None if channels.is_slow(ch) else tracing.regression_fit(ctx.y, ch, REGRESSION_BLOCKS)
+    if rg is None or rg["dof"] < COLLAPSED_DOF:
+        yield from _slow_regression(ctx, name, ch, a / len(ctx.channels))
+        return
+    # t with the blocks' effective number − 1 degrees of freedom (≤ REGRESSION_BLOCKS − 1)
+    t_thr = t_dist.isf(a / (2 * len(ctx.channels)), rg["dof"])
+    t_stat = abs(rg["coefficient"]) / rg["se"] if rg["se"] > 0 else 0.0
+    ev = {"domain": "channels", "test": tested("t", t_stat, float(t_thr), a)}
+    if not t_stat > t_thr:
+        ctx.consider("regression", {"channel": name, "t": t_stat, "threshold": t_thr})
+        return
+    # the optional terms (d(ch)/dt, a lag, a square) by their own nested tests, as on a slow channel: a
+    # thermal chamber cycling 7 times is fast by its share, and a within-block coefficient cannot carry them
+    r = _with_terms(ctx, name, ch, a / len(ctx.channels), rg, t_thr)
+    if r is not None:
+        yield from _slow_regression(ctx, name, ch, a / len(ctx.channels), r)
+        return
+    # band by band where the coupling differs across frequency (the whole-record coefficient elsewhere)
+    br = tracing.band_regression(ctx.y, ch, fs, a)
+    own = [b for b in br["bands"] if b["own"]]
+    if own:
+        ev["bands"] = own
 
-        def refit(z, idx, ch=ch, banded=bool(own)):
-            if banded:
-                used = tracing.band_regression(z, ch[idx], fs, a)["used"]
-                return lambda i: tracing.band_component(ch[i] - ch.mean(), used)
-            cf = tracing.regression_fit(z, ch[idx], 2)["coefficient"]
-            return lambda i: cf * (ch[i] - ch.mean())
+    def refit(z, idx, ch=ch, banded=bool(own)):
+        if banded:
+            used = tracing.band_regression(z, ch[idx], fs, a)["used"]
+            return lambda i: tracing.band_component(ch[i] - ch.mean(), used)
+        cf = tracing.regression_fit(z, ch[idx], 2)["coefficient"]
+        return lambda i: cf * (ch[i] - ch.mean())
 
-        # the held-out test in time: the residual variance of each half with the other half's coefficient
-        held = tracing.regression_heldout(ctx.y, ch, fs, a) if own else tracing.regression_heldout(ctx.y, ch)
-        yield Removal(
-            "regression",
-            tracing.band_component(ch - ch.mean(), br["used"]),
-            refit,
-            {"channel": name, "coefficient": rg["coefficient"]},
-            {"coefficient": (rg["coefficient"] - rg["se"], rg["coefficient"] + rg["se"])},
-            ev,
-            1 + len(own),
-            on_raw=True,
-            heldout_in_time=held,
-        )
+    # the held-out test in time: the residual variance of each half with the other half's coefficient
+    held = tracing.regression_heldout(ctx.y, ch, fs, a) if own else tracing.regression_heldout(ctx.y, ch)
+    yield Removal(
+        "regression",
+        tracing.band_component(ch - ch.mean(), br["used"]),
+        refit,
+        {"channel": name, "coefficient": rg["coefficient"]},
+        {"coefficient": (rg["coefficient"] - rg["se"], rg["coefficient"] + rg["se"])},
+        ev,
+        1 + len(own),
+        on_raw=True,
+        heldout_in_time=held,
+    )
 
 
 def _with_terms(ctx: RemovalContext, name: str, ch: np.ndarray, a: float, rg: dict, t_thr: float):
