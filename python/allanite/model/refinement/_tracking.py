@@ -15,16 +15,20 @@ from .scoring import HELDOUT_BLOCKS
 __all__ = ["heldout_variance_ratio", "tracked"]
 
 
-def tracked(ctx, fam: periodic.LineFamily, steady: np.ndarray, ratio_steady: float, out: tuple):
+def tracked(ctx, fam: periodic.LineFamily, steady: np.ndarray, ratio_steady, out: tuple):
     """The family with its fundamental's phase tracked (:func:`allanite.model.wander.track_family`) where its nested
     test says the fundamental wanders and the tracked form predicts held-out samples better than the steady one:
     (component, refit, held-out ratio), the step's ``params``, ``intervals`` and ``evidence`` in ``out`` updated
-    (the fundamental's mean and wander); else None (the test's numbers, where it ran, in ``evidence["wander"]``)."""
+    (the fundamental's mean and wander); else None (the test's numbers, where it ran, in ``evidence["wander"]``).
+    ``ratio_steady`` is the steady form's held-out ratio, or a function giving it (computed only once the tracker
+    takes the family: a lone line's steady ratio is needed nowhere else)."""
     params, intervals, evidence = out
     tf, test = wander.track_family(ctx.y, ctx.fs, fam.gens, fam.coefs, steady, alpha("periodic:wander", ctx.level))
     if test is None:
         return None
     ratio = heldout_variance_ratio(ctx.y, tf.refit) if tf is not None else math.nan
+    if callable(ratio_steady):
+        ratio_steady = ratio_steady() if tf is not None else math.nan
     evidence["wander"] = {"test": test, "heldout_variance_ratio": {"steady": ratio_steady, "tracked": ratio}}
     if tf is None or not ratio < ratio_steady:
         return None

@@ -427,7 +427,8 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
     frequencies (refitted on the held-in blocks with the frequencies fixed for the held-out error) — or, for a
     family of harmonics, by its waveform folded on the period (:func:`allanite.model.template.fit_template`:
     every harmonic at once, the folded ones too) where that predicts held-out samples better; the lone lines
-    are left to the ``"sinusoid"`` curve candidate, and so are a turned-down family's (``family``)."""
+    are left to the ``"sinusoid"`` curve candidate, and so are a turned-down family's (``family``) — but a lone line
+    whose frequency wanders, removed along its tracked phase (:func:`_lone_tracked`)."""
     a = alpha("lines", ctx.level)
     search = periodic.periodic_search(ctx.y, ctx.fs, a)
     ctx.lines = search
@@ -435,23 +436,7 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
     for fam in search["families"]:
         if ctx.y is not searched:  # a family removed before: this one's amplitudes on what it left
             fam = _refit_family(fam, ctx.y)
-        ratios = fam.evidence["psd_ratio"]
-        i = int(np.argmax(ratios))
-        sd = fam.gens_sd
-        params = {"fundamentals": [float(g) for g in fam.gens], "lines": int(fam.coefs.shape[0]), "rms": fam.rms}
-        intervals = {
-            "fundamentals": [(float(g - s), float(g + s)) for g, s in zip(fam.gens, sd)],
-            "rms": (max(0.0, fam.rms - fam.rms_sd), fam.rms + fam.rms_sd),
-        }
-        evidence = {
-            "domain": "psd",
-            "test": tested("psd_ratio", float(ratios[i]), fam.evidence["threshold"], a),
-            "frequencies_hz": [float(f) for f in fam.frequencies],
-            "coefficients": fam.coefs.tolist(),
-            "amplitudes": [float(v) for v in fam.amplitudes],
-            "targeted": fam.evidence["targeted"],
-            "bins_searched": search["bins"],
-        }
+        params, intervals, evidence = _family_out(fam, a, search)
         component, refit, ratio = fam.component(), fam.refit, heldout_variance_ratio(ctx.y, fam.refit)
         tracked = _tracked(ctx, fam, component, ratio, (params, intervals, evidence))
         wave = None if tracked is not None else _waveform(ctx, fam, ratio)
@@ -483,6 +468,50 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
             heldout_in_time=ratio,
             family=fam,
         )
+    for sin in search["sinusoids"]:
+        rem = _lone_tracked(ctx, sin if ctx.y is searched else _refit_family(sin, ctx.y), a, search)
+        if rem is not None:
+            yield rem
+
+
+def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, search: dict) -> Removal | None:
+    """A lone line (a family of one order) removed in time along its tracked phase where the tracker's nested test
+    says its frequency wanders and the tracked form predicts held-out samples better than the fixed sinusoid
+    (:func:`._tracking.tracked`, as a family's fundamental): a ``"periodic"`` step of one line with its mean
+    frequency and wander. Else None: the line stays the ``"sinusoid"`` curve candidate's, held on the curve at its
+    power in the spectrum (a motor's, a fan's or a pump's single tone whose speed wanders would otherwise leave its
+    incoherent power there and nothing of it removed from the samples)."""
+    out = _family_out(sin, a, search)
+    got = _tracked(ctx, sin, sin.component(), lambda: heldout_variance_ratio(ctx.y, sin.refit), out)
+    if got is None:
+        if out[2].get("wander", {}).get("test", {}).get("accepted"):  # its test passed, the held-out ratio did not
+            ctx.consider("periodic", out[0] | {"rejected": "a lone line not tracked", "wander": out[2]["wander"]})
+        return None
+    component, refit, ratio = got
+    out[2]["lone_line"] = True
+    return Removal("periodic", component, refit, out[0], out[1], out[2], 1, heldout_in_time=ratio)
+
+
+def _family_out(fam: periodic.LineFamily, a: float, search: dict) -> tuple[dict, dict, dict]:
+    """A periodic step's ``params``, ``intervals`` and ``evidence`` for the family ``fam`` as found (steady)."""
+    ratios = fam.evidence["psd_ratio"]
+    i = int(np.argmax(ratios))
+    sd = fam.gens_sd
+    params = {"fundamentals": [float(g) for g in fam.gens], "lines": int(fam.coefs.shape[0]), "rms": fam.rms}
+    intervals = {
+        "fundamentals": [(float(g - s), float(g + s)) for g, s in zip(fam.gens, sd)],
+        "rms": (max(0.0, fam.rms - fam.rms_sd), fam.rms + fam.rms_sd),
+    }
+    evidence = {
+        "domain": "psd",
+        "test": tested("psd_ratio", float(ratios[i]), fam.evidence["threshold"], a),
+        "frequencies_hz": [float(f) for f in fam.frequencies],
+        "coefficients": fam.coefs.tolist(),
+        "amplitudes": [float(v) for v in fam.amplitudes],
+        "targeted": fam.evidence["targeted"],
+        "bins_searched": search["bins"],
+    }
+    return params, intervals, evidence
 
 
 def _refit_family(fam: periodic.LineFamily, y: np.ndarray) -> periodic.LineFamily:
