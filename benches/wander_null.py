@@ -111,6 +111,7 @@ def decide(args: tuple) -> dict:
     search = periodic.periodic_search(y, fs, alpha("lines", LEVEL))
     found = len(search["families"]) + len(search["sinusoids"])
     out = {"families": found, "tested": 0, "accepted_test": 0, "wandering": 0, "wander": []}
+    lone = {id(s) for s in search["sinusoids"]}
     for fam in search["families"] + search["sinusoids"]:
         steady = fam.component()
         tf, test = wander.track_family(y, fs, fam.gens, fam.coefs, steady, WANDER_SHARE * LEVEL)
@@ -118,6 +119,9 @@ def decide(args: tuple) -> dict:
             continue
         out["tested"] += 1
         out["accepted_test"] += int(bool(test["accepted"]))
+        if tf is not None and id(fam) in lone:  # a lone line: its tracked phase must take the excess left
+            if not wander.explained_share(y, tf.component(), fs, test, tf.f0) >= wander.MIN_EXPLAINED:
+                continue
         if tf is not None and heldout_variance_ratio(y, tf.refit) < heldout_variance_ratio(y, fam.refit):
             out["wandering"] += 1
             out["wander"].append({"mean_hz": tf.mean_hz, "rms_hz": tf.wander_rms_hz, "f0": f0})

@@ -49,7 +49,7 @@ import numpy as np
 from scipy.stats import t as t_dist
 
 from ...analysis import avar
-from .. import channels, linefit, outliers, periodic, template, tracing, warmup
+from .. import channels, linefit, outliers, periodic, template, tracing, wander, warmup
 from ._tracking import heldout_variance_ratio
 from ._tracking import tracked as _tracked
 from .calibrated import tested
@@ -477,10 +477,12 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
 def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, search: dict) -> Removal | None:
     """A lone line (a family of one order) removed in time along its tracked phase where the tracker's nested test
     says its frequency wanders and the tracked form predicts held-out samples better than the fixed sinusoid
-    (:func:`._tracking.tracked`, as a family's fundamental): a ``"periodic"`` step of one line with its mean
-    frequency and wander. Else None: the line stays the ``"sinusoid"`` curve candidate's, held on the curve at its
-    power in the spectrum (a motor's, a fan's or a pump's single tone whose speed wanders would otherwise leave its
-    incoherent power there and nothing of it removed from the samples)."""
+    (:func:`._tracking.tracked`, as a family's fundamental), and the tracked form takes at least
+    :data:`allanite.model.wander.MIN_EXPLAINED` of the excess the fixed sinusoid left around it (a line whose
+    amplitude changes at a steady frequency leaves that excess in its envelope): a ``"periodic"`` step of one line
+    with its mean frequency and wander. Else None: the line stays the ``"sinusoid"`` curve candidate's, held on the
+    curve at its power in the spectrum (a motor's, a fan's or a pump's single tone whose speed wanders would
+    otherwise leave its incoherent power there and nothing of it removed from the samples)."""
     out = _family_out(sin, a, search)
     got = _tracked(ctx, sin, sin.component(), lambda: heldout_variance_ratio(ctx.y, sin.refit), out)
     if got is None:
@@ -488,6 +490,12 @@ def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, searc
             ctx.consider("periodic", out[0] | {"rejected": "a lone line not tracked", "wander": out[2]["wander"]})
         return None
     component, refit, ratio = got
+    wv = out[2]["wander"]
+    wv["explained_share"] = share = wander.explained_share(ctx.y, component, ctx.fs, wv["test"], float(sin.gens[0]))
+    if not share >= wander.MIN_EXPLAINED:  # what the steady fit left is its amplitude changing, not its phase
+        why = "its tracked phase takes little of what the fixed sinusoid left: its amplitude changes, not its frequency"
+        ctx.consider("periodic", out[0] | {"rejected": why, "wander": wv})
+        return None
     out[2]["lone_line"] = True
     return Removal("periodic", component, refit, out[0], out[1], out[2], 1, heldout_in_time=ratio)
 
