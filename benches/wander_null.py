@@ -39,6 +39,7 @@ import _common
 import allanite
 from allanite.model import periodic, wander
 from allanite.model._shares import WANDER_SHARE
+from allanite.model.refinement import removals
 from allanite.model.refinement.levels import alpha
 from allanite.model.refinement.removals import heldout_variance_ratio
 
@@ -104,6 +105,15 @@ def record(mix: str, seed: int, wander_frac: float = 0.0):
     return y + comp, fs, f0
 
 
+def _lone_kept(y: np.ndarray, fs: float, tf, test: dict) -> bool:
+    """A lone line's two further conditions in the removal (``removals._lone_tracked``): the tracked phase takes at
+    least MIN_EXPLAINED of the excess, and a fixed sinusoid at the tracked mean still fails the nested test."""
+    if not wander.explained_share(y, tf.component(), fs, test, tf.f0) >= wander.MIN_EXPLAINED:
+        return False
+    steady = removals._sinusoid_at(y, fs, tf.mean_hz)
+    return wander.wander_test(y - steady, fs, tf.mean_hz, test["bandwidth_hz"], tf.mean_hz, test["alpha"])["accepted"]
+
+
 def decide(args: tuple) -> dict:
     """The periodic removal's decisions on one record: per family — or lone line, a family of one order (r12wline) —
     the test's numbers and whether it is tracked."""
@@ -119,9 +129,8 @@ def decide(args: tuple) -> dict:
             continue
         out["tested"] += 1
         out["accepted_test"] += int(bool(test["accepted"]))
-        if tf is not None and id(fam) in lone:  # a lone line: its tracked phase must take the excess left
-            if not wander.explained_share(y, tf.component(), fs, test, tf.f0) >= wander.MIN_EXPLAINED:
-                continue
+        if tf is not None and id(fam) in lone and not _lone_kept(y, fs, tf, test):
+            continue
         if tf is not None and heldout_variance_ratio(y, tf.refit) < heldout_variance_ratio(y, fam.refit):
             out["wandering"] += 1
             out["wander"].append({"mean_hz": tf.mean_hz, "rms_hz": tf.wander_rms_hz, "f0": f0})

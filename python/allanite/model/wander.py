@@ -31,6 +31,11 @@ the noise's over its mean above :data:`MAX_ENVELOPE_CHANGE`; a Rayleigh envelope
 constant per harmonic, and a narrowband noise — amplitude and phase both wandering — is power on the curve, not a
 line to follow.
 
+A lone line is tracked as a family of one order (its fundamental the line, k = 1); the removal then also asks that
+the tracked form take at least :data:`MIN_EXPLAINED` of the excess the steady fit left around it
+(:func:`explained_share`): a line whose amplitude changes at a steady frequency leaves power within ±B too, in its
+envelope, which a tracked phase of constant amplitude cannot take.
+
 Reported: the fundamental's mean (the tracked phase's mean slope) and its wander — the instantaneous frequency's
 rms about the mean and half its 1–99 % span, Hz and relative — away from the record's ends (1/B each).
 """

@@ -32,7 +32,8 @@ terms included.
   held-out samples better (:mod:`allanite.model.template`); last, on the samples the others left: a channel that
   cycles (a temperature) is its regression, not a line. The search's lone lines go to the ``"sinusoid"`` curve
   candidate (:attr:`RemovalContext.lines`): one search, one share of ``level``; so do the lines of a family whose
-  removal is turned down (its phase does not carry across the record: narrowband power, not a line).
+  removal is turned down (its phase does not carry across the record: narrowband power, not a line). A lone line
+  whose frequency wanders is removed here instead, a family of one order with its phase tracked.
 
 Removals run before the curve effects (a component left in the samples bends the curve every curve effect is
 fitted against), in the order of :data:`REMOVALS`. A new one is one entry here and one share in
@@ -479,7 +480,10 @@ def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, searc
     says its frequency wanders and the tracked form predicts held-out samples better than the fixed sinusoid
     (:func:`._tracking.tracked`, as a family's fundamental), and the tracked form takes at least
     :data:`allanite.model.wander.MIN_EXPLAINED` of the excess the fixed sinusoid left around it (a line whose
-    amplitude changes at a steady frequency leaves that excess in its envelope): a ``"periodic"`` step of one line
+    amplitude changes at a steady frequency leaves that excess in its envelope), and a fixed sinusoid at the tracked
+    mean frequency still fails the nested test (a strong steady line whose searched frequency is off by a hair leaves
+    an excess the tracker takes as a "wander" of 3·10⁻⁵ %: ``refine_blind9.py``'s 4 Hz line 8× the noise's σ, F 3.9
+    against 1.64): a ``"periodic"`` step of one line
     with its mean frequency and wander. Else None: the line stays the ``"sinusoid"`` curve candidate's, held on the
     curve at its power in the spectrum (a motor's, a fan's or a pump's single tone whose speed wanders would
     otherwise leave its incoherent power there and nothing of it removed from the samples)."""
@@ -492,12 +496,27 @@ def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, searc
     component, refit, ratio = got
     wv = out[2]["wander"]
     wv["explained_share"] = share = wander.explained_share(ctx.y, component, ctx.fs, wv["test"], float(sin.gens[0]))
+    mean = float(out[0]["fundamentals"][0])
+    wv["at_mean"] = again = wander.wander_test(
+        ctx.y - _sinusoid_at(ctx.y, ctx.fs, mean), ctx.fs, mean, wv["test"]["bandwidth_hz"], mean, wv["test"]["alpha"]
+    )
+    why = None
     if not share >= wander.MIN_EXPLAINED:  # what the steady fit left is its amplitude changing, not its phase
         why = "its tracked phase takes little of what the fixed sinusoid left: its amplitude changes, not its frequency"
+    elif not again["accepted"]:  # the steady fit's frequency was off: a better one leaves nothing to track
+        why = "a fixed sinusoid at the tracked mean frequency leaves nothing beyond the noise around it"
+    if why is not None:
         ctx.consider("periodic", out[0] | {"rejected": why, "wander": wv})
         return None
     out[2]["lone_line"] = True
     return Removal("periodic", component, refit, out[0], out[1], out[2], 1, heldout_in_time=ratio)
+
+
+def _sinusoid_at(y: np.ndarray, fs: float, f_hz: float) -> np.ndarray:
+    """The least-squares sinusoid at ``f_hz`` in ``y``."""
+    idx, nu, one = np.arange(y.size), np.array([f_hz / fs]), np.array([[1]])
+    a, b = linefit.solve(y, idx, nu, one)
+    return linefit.evaluate(idx, nu, one, a, b)
 
 
 def _family_out(fam: periodic.LineFamily, a: float, search: dict) -> tuple[dict, dict, dict]:
