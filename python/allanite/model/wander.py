@@ -34,7 +34,8 @@ line to follow.
 A lone line is tracked as a family of one order (its fundamental the line, k = 1); the removal then also asks that
 the tracked form take at least :data:`MIN_EXPLAINED` of the excess the steady fit left around it
 (:func:`explained_share`): a line whose amplitude changes at a steady frequency leaves power within ±B too, in its
-envelope, which a tracked phase of constant amplitude cannot take.
+envelope, which a tracked phase of constant amplitude cannot take; and that a fixed sinusoid at the tracked mean
+frequency still fail :func:`wander_test` (a strong steady line searched a hair off leaves an excess too).
 
 Reported: the fundamental's mean (the tracked phase's mean slope) and its wander — the instantaneous frequency's
 rms about the mean and half its 1–99 % span, Hz and relative — away from the record's ends (1/B each).
