@@ -483,10 +483,10 @@ def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, searc
     amplitude changes at a steady frequency leaves that excess in its envelope), and a fixed sinusoid at the tracked
     mean frequency still fails the nested test (a strong steady line whose searched frequency is off by a hair leaves
     an excess the tracker takes as a "wander" of 3·10⁻⁵ %: ``refine_blind9.py``'s 4 Hz line 8× the noise's σ, F 3.9
-    against 1.64): a ``"periodic"`` step of one line
-    with its mean frequency and wander. Else None: the line stays the ``"sinusoid"`` curve candidate's, held on the
-    curve at its power in the spectrum (a motor's, a fan's or a pump's single tone whose speed wanders would
-    otherwise leave its incoherent power there and nothing of it removed from the samples)."""
+    against 1.64): a ``"periodic"`` step of one line with its mean frequency and wander. Else None: the line stays
+    the ``"sinusoid"`` curve candidate's, held on the curve at its power in the spectrum (a motor's, a fan's or a
+    pump's single tone whose speed wanders would otherwise leave its incoherent power there and nothing of it
+    removed from the samples)."""
     out = _family_out(sin, a, search)
     got = _tracked(ctx, sin, sin.component(), lambda: heldout_variance_ratio(ctx.y, sin.refit), out)
     if got is None:
