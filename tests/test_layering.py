@@ -207,6 +207,7 @@ MODEL_RANKS = {
     "model.refinement._sinusoid": 5.7,
     "model.refinement._choose": 5.7,
     "model.refinement.candidates": 6,
+    "model.refinement._tracking": 5,  # a family's or a lone line's phase tracked, the held-out test in time
     "model.refinement.removals": 6,
     "model.refinement.changes": 6,
     # unexplained's parts, below missing (its spectral-line and channel checks, CHECKS): what a check is given;

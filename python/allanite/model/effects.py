@@ -275,7 +275,9 @@ EFFECTS: dict[str, Effect] = {
             "by least squares at them (allanite.model.periodic); held out, amplitudes and phases are refitted on "
             "the held-in blocks with the frequencies fixed. A family of harmonics whose fundamental wanders (a nested "
             "test at its share of level) is removed with the fundamental's phase tracked, each harmonic at its order "
-            "times that phase. A line no family takes stays a sinusoid",
+            "times that phase; so is a lone line whose frequency wanders (a family of one order: lines 1, its tracked "
+            "phase taking at least half of what the fixed sinusoid left around it). A line no family takes stays a "
+            "sinusoid",
             domain="psd",
         ),
         Effect(

@@ -31,6 +31,12 @@ the noise's over its mean above :data:`MAX_ENVELOPE_CHANGE`; a Rayleigh envelope
 constant per harmonic, and a narrowband noise — amplitude and phase both wandering — is power on the curve, not a
 line to follow.
 
+A lone line is tracked as a family of one order (its fundamental the line, k = 1); the removal then also asks that
+the tracked form take at least :data:`MIN_EXPLAINED` of the excess the steady fit left around it
+(:func:`explained_share`): a line whose amplitude changes at a steady frequency leaves power within ±B too, in its
+envelope, which a tracked phase of constant amplitude cannot take; and that a fixed sinusoid at the tracked mean
+frequency still fail :func:`wander_test` (a strong steady line searched a hair off leaves an excess too).
+
 Reported: the fundamental's mean (the tracked phase's mean slope) and its wander — the instantaneous frequency's
 rms about the mean and half its 1–99 % span, Hz and relative — away from the record's ends (1/B each).
 """
@@ -47,7 +53,9 @@ __all__ = [
     "WanderingFamily",
     "track_family",
     "wander_test",
+    "explained_share",
     "MAX_ENVELOPE_CHANGE",
+    "MIN_EXPLAINED",
     "MAX_ORDERS",
     "MIN_CYCLES",
     "MIN_SNR",
@@ -68,6 +76,13 @@ MIN_SNR = 10.0
 #: accelerometers' 0.47–0.56 Hz site family reads 0.08–0.12 and is tracked on six channels
 #: (benches/results/wander_measured.md).
 MAX_ENVELOPE_CHANGE = 0.25
+#: Least share of the excess a steady fit left within ±B of the reference line that the tracked form must take, for a
+#: lone line (:func:`explained_share`): a line whose frequency wanders leaves that excess in its phase (the tracked
+#: form takes 1.00 of it on a seeded line wandering ±0.3 %); a line whose *amplitude* changes at a steady frequency
+#: leaves it in its envelope, which a tracked phase with constant amplitude cannot take (``refine_blind6.py``'s
+#: vibrating-structure gyro, a 2 Hz line following the temperature ±20 %: F 247 against 1.64, envelope change 0.12,
+#: share 0.002 — "wandering" 0.0004 %, removed as such, left its sinusoid at −87 % of the amplitude).
+MIN_EXPLAINED = 0.5
 #: Samples per chunk of the least-squares passes (the design is never held whole).
 CHUNK = 1 << 18
 
@@ -291,6 +306,16 @@ def wander_test(resid: np.ndarray, fs: float, fc: float, band: float, f0: float,
     ratio = float(power[inner].mean() / power[ring].mean())
     thr = float(f_dist.isf(alpha, 2 * n_in, 2 * n_ring))
     return {"ratio": ratio, "threshold": thr, "alpha": alpha, "bins": n_in, "accepted": bool(ratio > thr)}
+
+
+def explained_share(y: np.ndarray, tracked: np.ndarray, fs: float, test: dict, f0: float) -> float:
+    """The share of the excess over the floor that the steady fit left within ±B of the reference line
+    (``test``: :func:`track_family`'s evidence) which the tracked component ``tracked`` takes: 1 − (ratio after
+    the tracked removal − 1)/(the steady ratio − 1), the ratios :func:`wander_test`'s."""
+    k, band = test["order"], test["bandwidth_hz"]
+    after = wander_test(np.asarray(y, dtype=np.float64) - tracked, fs, k * f0, band, f0, test["alpha"])["ratio"]
+    excess = test["ratio"] - 1.0
+    return float(1.0 - (after - 1.0) / excess) if excess > 0 else 0.0
 
 
 def _harmonic_orders(gens: np.ndarray, coefs: np.ndarray, fs: float) -> tuple[float, np.ndarray] | None:

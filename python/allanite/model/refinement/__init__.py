@@ -12,7 +12,7 @@ of the registry :data:`allanite.model.effects.EFFECTS`:
   and, for curve-only input, ``"sinusoid"`` (nulls at τ = k/f0, f0 ≥ 2/τ_max);
 - in the **PSD** (Welch) for spectral lines: a lone line is a ``"sinusoid"`` (f0 refined on the samples, its
   amplitude the line's power, held in every fit of the curve); a family of lines (harmonics, sidebands) is
-  ``"periodic"``, removed in time;
+  ``"periodic"``, removed in time, and so is a lone line whose frequency wanders (one line, its phase tracked);
 - in **time**: ``"outliers"`` (impulsive samples, replaced), ``"drift"`` (warm-up a·e^{−t/T} on block means)
   and ``"change_point"`` (steps of the noise level along the record);
 - in **other channels** of the log (``channels=``): ``"regression"`` — the rate regressed on each, band by

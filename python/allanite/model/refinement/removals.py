@@ -32,7 +32,8 @@ terms included.
   held-out samples better (:mod:`allanite.model.template`); last, on the samples the others left: a channel that
   cycles (a temperature) is its regression, not a line. The search's lone lines go to the ``"sinusoid"`` curve
   candidate (:attr:`RemovalContext.lines`): one search, one share of ``level``; so do the lines of a family whose
-  removal is turned down (its phase does not carry across the record: narrowband power, not a line).
+  removal is turned down (its phase does not carry across the record: narrowband power, not a line). A lone line
+  whose frequency wanders is removed here instead, a family of one order with its phase tracked.
 
 Removals run before the curve effects (a component left in the samples bends the curve every curve effect is
 fitted against), in the order of :data:`REMOVALS`. A new one is one entry here and one share in
@@ -42,7 +43,6 @@ fitted against), in the order of :data:`REMOVALS`. A new one is one entry here a
 from __future__ import annotations
 
 import dataclasses
-import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
@@ -52,6 +52,8 @@ from scipy.stats import t as t_dist
 from ...analysis import avar
 from .. import channels, linefit, outliers, periodic, template, tracing, wander, warmup
 from ._channel_order import strongest_first
+from ._tracking import heldout_variance_ratio
+from ._tracking import tracked as _tracked
 from .calibrated import tested
 from .curvefit import Curve, Solution, theta_terms, upper_theta
 from .levels import alpha
@@ -431,7 +433,8 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
     frequencies (refitted on the held-in blocks with the frequencies fixed for the held-out error) — or, for a
     family of harmonics, by its waveform folded on the period (:func:`allanite.model.template.fit_template`:
     every harmonic at once, the folded ones too) where that predicts held-out samples better; the lone lines
-    are left to the ``"sinusoid"`` curve candidate, and so are a turned-down family's (``family``)."""
+    are left to the ``"sinusoid"`` curve candidate, and so are a turned-down family's (``family``) — but a lone line
+    whose frequency wanders, removed along its tracked phase (:func:`_lone_tracked`)."""
     a = alpha("lines", ctx.level)
     search = periodic.periodic_search(ctx.y, ctx.fs, a)
     ctx.lines = search
@@ -439,23 +442,7 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
     for fam in search["families"]:
         if ctx.y is not searched:  # a family removed before: this one's amplitudes on what it left
             fam = _refit_family(fam, ctx.y)
-        ratios = fam.evidence["psd_ratio"]
-        i = int(np.argmax(ratios))
-        sd = fam.gens_sd
-        params = {"fundamentals": [float(g) for g in fam.gens], "lines": int(fam.coefs.shape[0]), "rms": fam.rms}
-        intervals = {
-            "fundamentals": [(float(g - s), float(g + s)) for g, s in zip(fam.gens, sd)],
-            "rms": (max(0.0, fam.rms - fam.rms_sd), fam.rms + fam.rms_sd),
-        }
-        evidence = {
-            "domain": "psd",
-            "test": tested("psd_ratio", float(ratios[i]), fam.evidence["threshold"], a),
-            "frequencies_hz": [float(f) for f in fam.frequencies],
-            "coefficients": fam.coefs.tolist(),
-            "amplitudes": [float(v) for v in fam.amplitudes],
-            "targeted": fam.evidence["targeted"],
-            "bins_searched": search["bins"],
-        }
+        params, intervals, evidence = _family_out(fam, a, search)
         component, refit, ratio = fam.component(), fam.refit, heldout_variance_ratio(ctx.y, fam.refit)
         tracked = _tracked(ctx, fam, component, ratio, (params, intervals, evidence))
         wave = None if tracked is not None else _waveform(ctx, fam, ratio)
@@ -487,6 +474,76 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
             heldout_in_time=ratio,
             family=fam,
         )
+    for sin in search["sinusoids"]:
+        rem = _lone_tracked(ctx, sin if ctx.y is searched else _refit_family(sin, ctx.y), a, search)
+        if rem is not None:
+            yield rem
+
+
+def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, search: dict) -> Removal | None:
+    """A lone line (a family of one order) removed in time along its tracked phase where the tracker's nested test
+    says its frequency wanders and the tracked form predicts held-out samples better than the fixed sinusoid
+    (:func:`._tracking.tracked`, as a family's fundamental), and the tracked form takes at least
+    :data:`allanite.model.wander.MIN_EXPLAINED` of the excess the fixed sinusoid left around it (a line whose
+    amplitude changes at a steady frequency leaves that excess in its envelope), and a fixed sinusoid at the tracked
+    mean frequency still fails the nested test (a strong steady line whose searched frequency is off by a hair leaves
+    an excess the tracker takes as a "wander" of 3·10⁻⁵ %: ``refine_blind9.py``'s 4 Hz line 8× the noise's σ, F 3.9
+    against 1.64): a ``"periodic"`` step of one line with its mean frequency and wander. Else None: the line stays
+    the ``"sinusoid"`` curve candidate's, held on the curve at its power in the spectrum (a motor's, a fan's or a
+    pump's single tone whose speed wanders would otherwise leave its incoherent power there and nothing of it
+    removed from the samples)."""
+    out = _family_out(sin, a, search)
+    got = _tracked(ctx, sin, sin.component(), lambda: heldout_variance_ratio(ctx.y, sin.refit), out)
+    if got is None:
+        if out[2].get("wander", {}).get("test", {}).get("accepted"):  # its test passed, the held-out ratio did not
+            ctx.consider("periodic", out[0] | {"rejected": "a lone line not tracked", "wander": out[2]["wander"]})
+        return None
+    component, refit, ratio = got
+    wv = out[2]["wander"]
+    wv["explained_share"] = share = wander.explained_share(ctx.y, component, ctx.fs, wv["test"], float(sin.gens[0]))
+    mean = float(out[0]["fundamentals"][0])
+    wv["at_mean"] = again = wander.wander_test(
+        ctx.y - _sinusoid_at(ctx.y, ctx.fs, mean), ctx.fs, mean, wv["test"]["bandwidth_hz"], mean, wv["test"]["alpha"]
+    )
+    why = None
+    if not share >= wander.MIN_EXPLAINED:  # what the steady fit left is its amplitude changing, not its phase
+        why = "its tracked phase takes little of what the fixed sinusoid left: its amplitude changes, not its frequency"
+    elif not again["accepted"]:  # the steady fit's frequency was off: a better one leaves nothing to track
+        why = "a fixed sinusoid at the tracked mean frequency leaves nothing beyond the noise around it"
+    if why is not None:
+        ctx.consider("periodic", out[0] | {"rejected": why, "wander": wv})
+        return None
+    out[2]["lone_line"] = True
+    return Removal("periodic", component, refit, out[0], out[1], out[2], 1, heldout_in_time=ratio)
+
+
+def _sinusoid_at(y: np.ndarray, fs: float, f_hz: float) -> np.ndarray:
+    """The least-squares sinusoid at ``f_hz`` in ``y``."""
+    idx, nu, one = np.arange(y.size), np.array([f_hz / fs]), np.array([[1]])
+    a, b = linefit.solve(y, idx, nu, one)
+    return linefit.evaluate(idx, nu, one, a, b)
+
+
+def _family_out(fam: periodic.LineFamily, a: float, search: dict) -> tuple[dict, dict, dict]:
+    """A periodic step's ``params``, ``intervals`` and ``evidence`` for the family ``fam`` as found (steady)."""
+    ratios = fam.evidence["psd_ratio"]
+    i = int(np.argmax(ratios))
+    sd = fam.gens_sd
+    params = {"fundamentals": [float(g) for g in fam.gens], "lines": int(fam.coefs.shape[0]), "rms": fam.rms}
+    intervals = {
+        "fundamentals": [(float(g - s), float(g + s)) for g, s in zip(fam.gens, sd)],
+        "rms": (max(0.0, fam.rms - fam.rms_sd), fam.rms + fam.rms_sd),
+    }
+    evidence = {
+        "domain": "psd",
+        "test": tested("psd_ratio", float(ratios[i]), fam.evidence["threshold"], a),
+        "frequencies_hz": [float(f) for f in fam.frequencies],
+        "coefficients": fam.coefs.tolist(),
+        "amplitudes": [float(v) for v in fam.amplitudes],
+        "targeted": fam.evidence["targeted"],
+        "bins_searched": search["bins"],
+    }
+    return params, intervals, evidence
 
 
 def _refit_family(fam: periodic.LineFamily, y: np.ndarray) -> periodic.LineFamily:
@@ -499,42 +556,6 @@ def _refit_family(fam: periodic.LineFamily, y: np.ndarray) -> periodic.LineFamil
     return dataclasses.replace(fam, a=a, b=b)
 
 
-def _tracked(ctx: RemovalContext, fam: periodic.LineFamily, steady: np.ndarray, ratio_steady: float, out: tuple):
-    """The family with its fundamental's phase tracked (:func:`allanite.model.wander.track_family`) where its nested
-    test says the fundamental wanders and the tracked form predicts held-out samples better than the steady one:
-    (component, refit, held-out ratio), the step's ``params``, ``intervals`` and ``evidence`` in ``out`` updated
-    (the fundamental's mean and wander); else None (the test's numbers, where it ran, in ``evidence["wander"]``)."""
-    params, intervals, evidence = out
-    tf, test = wander.track_family(ctx.y, ctx.fs, fam.gens, fam.coefs, steady, alpha("periodic:wander", ctx.level))
-    if test is None:
-        return None
-    ratio = heldout_variance_ratio(ctx.y, tf.refit) if tf is not None else math.nan
-    evidence["wander"] = {"test": test, "heldout_variance_ratio": {"steady": ratio_steady, "tracked": ratio}}
-    if tf is None or not ratio < ratio_steady:
-        return None
-    mean, rms, half = tf.mean_hz, tf.wander_rms_hz, tf.wander_half_span_hz
-    # the mean of a track of ≈ 2·B·T independent values: its SD the wander's rms over √(2BT)
-    sd = rms / math.sqrt(max(2.0 * tf.bandwidth_hz * ctx.y.size / ctx.fs, 1.0))
-    rel = fam.rms_sd / fam.rms if fam.rms > 0 else 0.0
-    params |= {"fundamentals": [mean], "lines": int(tf.orders.size), "rms": tf.rms}
-    params |= {"wander_hz": rms, "wander_pct": 100.0 * rms / mean, "wander_half_span_hz": half}
-    intervals["fundamentals"] = [(mean - sd, mean + sd)]
-    intervals["rms"] = (max(0.0, tf.rms * (1.0 - rel)), tf.rms * (1.0 + rel))
-    evidence["frequencies_hz"] = [float(k * mean) for k in tf.orders]
-    evidence["coefficients"] = [[int(k)] for k in tf.orders]
-    evidence["amplitudes"] = [float(v) for v in np.hypot(tf.a, tf.b)]
-    evidence["wander"] |= {
-        "bandwidth_hz": tf.bandwidth_hz,
-        "reference_order": tf.reference,
-        "note": (
-            f"the fundamental wanders: mean {mean:.6g} Hz, rms {rms:.3g} Hz ({100 * rms / mean:.3g} %), "
-            f"±{half:.3g} Hz over 1–99 % of the record; removed with its phase tracked (the {tf.reference}. "
-            f"harmonic demodulated in ±{tf.bandwidth_hz:.3g} Hz), each harmonic at its order times that phase"
-        ),
-    }
-    return tf.component(), tf.refit, ratio
-
-
 def _waveform(ctx: RemovalContext, fam: periodic.LineFamily, ratio_lines: float):
     """A family of harmonics as its waveform folded on the period, with its held-out variance ratio, when that
     is below the lines' (``ratio_lines``); None otherwise, or for a family of sidebands (two generators)."""
@@ -543,26 +564,6 @@ def _waveform(ctx: RemovalContext, fam: periodic.LineFamily, ratio_lines: float)
     tpl = template.fit_template(ctx.y, ctx.fs, float(fam.gens[0]))
     ratio = heldout_variance_ratio(ctx.y, tpl.refit)
     return (tpl, ratio) if ratio < ratio_lines else None
-
-
-def heldout_variance_ratio(y: np.ndarray, refit) -> float:
-    """The held-out test in time of a component that predicts samples: each part of alternate blocks (even,
-    odd) with the component refitted on the other part (``refit(samples, idx)`` → a function of indices)
-    removed, its residual power over its power without it, both parts pooled — below 1 when the component
-    predicts samples it was not fitted to. (The held-out Allan-curve error, the other removals' test, is
-    dominated by what the curve effects found after the removals have not modelled yet — a low-pass — and
-    turned down a 229×-the-floor sideband family on a consumer IMU's record.)"""
-    per = y.size // HELDOUT_BLOCKS
-    blocks = [np.arange(j * per, (j + 1) * per) for j in range(HELDOUT_BLOCKS)]
-    num = den = 0.0
-    for parity in (0, 1):
-        held_in = np.concatenate([b for j, b in enumerate(blocks) if j % 2 == parity])
-        held_out = np.concatenate([b for j, b in enumerate(blocks) if j % 2 != parity])
-        comp = np.asarray(refit(y[held_in], held_in)(held_out), dtype=np.float64)
-        z = y[held_out] - y[held_out].mean()
-        r = z - (comp - comp.mean())
-        num, den = num + float(r @ r), den + float(z @ z)
-    return num / den if den > 0 else math.inf
 
 
 #: The time-domain removals, in the order they run (each before the curve effects).
