@@ -105,6 +105,19 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(20240611)
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _null_records_shared():
+    """Refine's checks along time draw their null records from fixed seeds at lengths that do not depend on the
+    record (``allanite.model._null_records``): within :func:`~allanite.model._null_records.sharing` — what a report
+    opens around its axes' refinements — each record's flicker is drawn once and found again, bit for bit the same
+    numbers (``test_refine_recent.py`` holds that), so every refine of the session shares them as a report's axes do:
+    ≈ 13 % of a refine test's CPU (issue 29's CI share; ≤ 32 records of ≤ 4 MB kept per test process)."""
+    from allanite.model._null_records import sharing
+
+    with sharing():
+        yield
+
+
 @pytest.fixture(autouse=True)
 def _clean_allanite_env(monkeypatch):
     """The library reads ALLANITE_NUM_THREADS / ALLANITE_MAX_MEMORY; a value left in the caller's
