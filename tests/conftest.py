@@ -119,6 +119,23 @@ def _null_records_shared():
 
 
 @pytest.fixture(autouse=True)
+def _blas_one_thread(request):
+    """Every test runs OpenBLAS on one thread (:func:`allanite._blas.one_thread`, as refine does itself): the suite
+    runs on as many processes as cores (``-n 2``), and the tests that call the linear algebra outside refine (the
+    warm-up's GLS fits, the bound, the covariances) multiply matrices of 10²–10³ rows, where a second BLAS thread's
+    spin-wait costs more than the product — on the shared 2-core machine test_warmup's ramp choice took 8–13 CPU s
+    against 3.2–3.4 on one thread (issue 29's CI share). Tests of the thread count itself (``blas_threads``) keep
+    the library's own count."""
+    if request.node.get_closest_marker("blas_threads") is not None:
+        yield
+        return
+    from allanite._blas import one_thread
+
+    with one_thread():
+        yield
+
+
+@pytest.fixture(autouse=True)
 def _clean_allanite_env(monkeypatch):
     """The library reads ALLANITE_NUM_THREADS / ALLANITE_MAX_MEMORY; a value left in the caller's
     environment must not change what the tests see."""
