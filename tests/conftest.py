@@ -105,6 +105,36 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(20240611)
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _null_records_shared():
+    """Refine's checks along time draw their null records from fixed seeds at lengths that do not depend on the
+    record (``allanite.model._null_records``): within :func:`~allanite.model._null_records.sharing` — what a report
+    opens around its axes' refinements — each record's flicker is drawn once and found again, bit for bit the same
+    numbers (``test_refine_recent.py`` holds that), so every refine of the session shares them as a report's axes do:
+    ≈ 13 % of a refine test's CPU (issue 29's CI share; ≤ 32 records of ≤ 4 MB kept per test process)."""
+    from allanite.model._null_records import sharing
+
+    with sharing():
+        yield
+
+
+@pytest.fixture(autouse=True)
+def _blas_one_thread(request):
+    """Every test runs OpenBLAS on one thread (:func:`allanite._blas.one_thread`, as refine does itself): the suite
+    runs on as many processes as cores (``-n 2``), and the tests that call the linear algebra outside refine (the
+    warm-up's GLS fits, the bound, the covariances) multiply matrices of 10²–10³ rows, where a second BLAS thread's
+    spin-wait costs more than the product — on the shared 2-core machine test_warmup's ramp choice took 8–13 CPU s
+    against 3.2–3.4 on one thread (issue 29's CI share). Tests of the thread count itself (``blas_threads``) keep
+    the library's own count."""
+    if request.node.get_closest_marker("blas_threads") is not None:
+        yield
+        return
+    from allanite._blas import one_thread
+
+    with one_thread():
+        yield
+
+
 @pytest.fixture(autouse=True)
 def _clean_allanite_env(monkeypatch):
     """The library reads ALLANITE_NUM_THREADS / ALLANITE_MAX_MEMORY; a value left in the caller's

@@ -10,6 +10,8 @@ import allanite
 from allanite import _blas
 from allanite.model.refinement import loop
 
+pytestmark = pytest.mark.blas_threads  # the library's own thread count, not the suite's one thread (conftest)
+
 
 def _counts_or_skip() -> list[int]:
     import scipy.linalg  # noqa: F401  (loads SciPy's OpenBLAS)

@@ -254,7 +254,7 @@ def test_remembered_noise_fits_and_bartlett_factors_equal_fresh_ones(monkeypatch
 @pytest.mark.parametrize(
     "terms", [(1.0, 0.3, 0.02, 0.0), (0.0, 0.5, 0.0, 1e-4), (2.0, 0.0, 0.1, 0.0), (0.7, 0.2, 0.05, 3e-5)]
 )
-def test_null_records_equal_simulate_and_share_their_flicker(terms):
+def test_null_records_equal_simulate_and_share_their_flicker(terms, _flicker_unshared):
     """The checks' null records (``model/_null_records.py``): allanite.simulate's numbers to the bit, for an int
     seed and a generator, the flicker found again for the same length and generator state (the generator left where
     the draws leave it), kept from one call to the next only within ``sharing``."""
@@ -302,3 +302,21 @@ def test_null_records_equal_simulate_and_share_their_flicker(terms):
             _recent._OPEN.append(True)
     with pytest.raises(ValueError, match="finite"):
         nr.block_rate_record(n, fs, N=float("nan"), B=0.0, K=0.0, R=0.0, seed=0)
+
+
+@pytest.fixture
+def _flicker_unshared():
+    """The null records' flicker memory as a plain refine call finds it — held by no sharing and empty — for the
+    test of what it keeps: the suite's session-long sharing (conftest's ``_null_records_shared``) set aside and
+    given back after."""
+    from allanite.model import _null_records as nr
+
+    held, items = nr._FLICKER._held, dict(nr._FLICKER._items)
+    nr._FLICKER._held = 0
+    nr._FLICKER._items.clear()
+    try:
+        yield
+    finally:
+        nr._FLICKER._items.clear()
+        nr._FLICKER._items.update(items)
+        nr._FLICKER._held = held
