@@ -36,7 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import allanite
 import sensors
-from allanite.model.refinement._line_channel import _block_means, _one
+from allanite.model.refinement._line_channel import _one, block_means
 from allanite.model.refinement._line_constancy import line_constancy
 from allanite.model.refinement.levels import alpha
 from channel_turnover_null import _cp
@@ -98,7 +98,7 @@ def _calibration(records: int) -> dict:
     for seed in range(records):
         _kind, _c, y, fs, temp, f0 = _record(seed)
         r = line_constancy(y, fs, f0, 0.01, phasors=True)
-        xk = _block_means(temp, np.round(np.asarray(r["edges_s"]) * fs).astype(int))
+        xk = block_means(temp, np.round(np.asarray(r["edges_s"]) * fs).astype(int))
         one = _one(np.asarray(r["phasors"]), np.asarray(r["phasor_unit"]), r["noise_level"], r["noise_dof"], xk, 0.01)
         p = float(stats.f.sf(one["statistic"], 1, r["noise_dof"])) if one else 1.0
         hits = [h + (p < lv) for h, lv in zip(hits, LEVELS)]

@@ -29,7 +29,7 @@ import math
 import numpy as np
 from scipy import stats
 
-from ._line_channel import _block_means
+from ._line_channel import block_means
 from ._line_constancy import line_constancy
 
 __all__ = ["line_gain", "gain_component", "gain_params"]
@@ -70,7 +70,7 @@ def _one(r: dict, x: np.ndarray, fs: float, alpha: float) -> dict | None:
     edges = np.round(edges_s * fs).astype(int)
     if x.ndim != 1 or x.size < edges[-1] or not (s2 > 0.0 and d2 > 0.0):
         return None
-    xk = _block_means(x, edges)
+    xk = block_means(x, edges)
     w = 1.0 / u
     a, beta, sxx, xbar = _fit(ph, w, xk)
     if not sxx > 0.0 or a == 0:
