@@ -8,9 +8,13 @@ samples (1000 s); a 15–35 °C temperature cycling three times, warming once or
 (``tests/sensors.temperature_profile``) with 0.01 °C of sensor noise, the rate coupled to it linearly, with a
 quadratic, or through a first-order lag of 60 s; a line of constant amplitude (1–4 Hz, 0.6–1.2 × the white
 noise's σ per sample). Counted: records whose ``unexplained`` holds a ``"line"`` entry, one with the new words
-(``"follows"``), a ``"channels"`` entry (the coupling or its shape), and any entry at all; 95 % Clopper–Pearson
-intervals. The words are tested only where the line check fires, at its α (``levels.alpha("unexplained:line")``
+(``"follows"``), a ``"channels"`` entry (the coupling or its shape), and any entry at all, and records whose accepted
+sinusoid took a gain on the channel (``"gain"``: :mod:`allanite.model.refinement._line_gain`, at its conditional
+share ``levels.alpha("sinusoid:gain")`` over the lines offered); 95 % Clopper–Pearson intervals. The words are tested only where the line check fires, at its α (``levels.alpha("unexplained:line")``
 per line, split over the channels): their share is at most the line check's.
+
+``--gain``: the line's gain option alone (its F test at ``levels.alpha("sinusoid:gain")`` and its held-out blocks)
+on ``--records`` records, no refine.
 
 ``--calibration``: the statistic itself on ``--records`` records (white + flicker + random walk, a constant line,
 the same temperatures), counted at 5 %, 1 % and 0.1 % against its F(1, d₂) reference (no refine).
@@ -19,6 +23,7 @@ Usage::
 
     python benches/line_channel_null.py --records 120                 # whole refines, ~5 min CPU
     python benches/line_channel_null.py --records 1000 --calibration  # the statistic alone, ~2 min CPU
+    python benches/line_channel_null.py --records 1000 --gain         # the line's gain option alone
 """
 
 from __future__ import annotations
@@ -36,8 +41,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import allanite
 import sensors
-from allanite.model.refinement._line_channel import _block_means, _one
+from allanite.model.refinement._line_channel import _one, block_means
 from allanite.model.refinement._line_constancy import line_constancy
+from allanite.model.refinement._line_gain import line_gain
 from allanite.model.refinement.levels import alpha
 from channel_turnover_null import _cp
 
@@ -67,7 +73,7 @@ def _record(seed: int):
 
 
 def _refines(records: int, start: int = 0) -> dict:
-    keys = ("line", "follows", "channels", "any", "sinusoid")
+    keys = ("line", "follows", "channels", "any", "sinusoid", "gain")
     counts = {c: {k: 0 for k in ("records",) + keys} for c in COUPLINGS}
     said = []
     for seed in range(start, start + records):
@@ -81,10 +87,13 @@ def _refines(records: int, start: int = 0) -> dict:
         c["channels"] += any(u["domain"] == "channels" for u in un)
         c["any"] += bool(un)
         c["sinusoid"] += "sinusoid" in r.found
+        gains = [st.params["gain"] for st in r.steps if st.effect == "sinusoid" and "gain" in st.params]
+        c["gain"] += bool(gains)
         said += [(seed, u["domain"], u.get("what", "")) for u in un]
         print(
             json.dumps(
-                {"seed": seed, "coupling": coupling, "found": list(r.found), "said": said[-len(un) :] if un else []},
+                {"seed": seed, "coupling": coupling, "found": list(r.found), "gains": gains}
+                | {"said": said[-len(un) :] if un else []},
                 ensure_ascii=False,
             ),
             file=sys.stderr,
@@ -93,12 +102,25 @@ def _refines(records: int, start: int = 0) -> dict:
     return {"counts": counts, "said": said}
 
 
+def _gain(records: int) -> dict:
+    """The line's gain option alone (:func:`._line_gain.line_gain` at its conditional α, one line offered) on
+    null records: the rate at which a constant line takes a gain on the channel."""
+    a = alpha("sinusoid:gain", 0.05)
+    hits = 0
+    for seed in range(records):
+        _kind, _c, y, fs, temp, f0 = _record(seed)
+        g = line_gain(y, fs, f0, {"temp": temp}, a)
+        hits += g is not None
+        print(json.dumps({"seed": seed, "gain": None if g is None else g["gain"]}), file=sys.stderr, flush=True)
+    return {"alpha": a, "gains": [hits, records, _cp(hits, records)]}
+
+
 def _calibration(records: int) -> dict:
     hits = [0] * len(LEVELS)
     for seed in range(records):
         _kind, _c, y, fs, temp, f0 = _record(seed)
         r = line_constancy(y, fs, f0, 0.01, phasors=True)
-        xk = _block_means(temp, np.round(np.asarray(r["edges_s"]) * fs).astype(int))
+        xk = block_means(temp, np.round(np.asarray(r["edges_s"]) * fs).astype(int))
         one = _one(np.asarray(r["phasors"]), np.asarray(r["phasor_unit"]), r["noise_level"], r["noise_dof"], xk, 0.01)
         p = float(stats.f.sf(one["statistic"], 1, r["noise_dof"])) if one else 1.0
         hits = [h + (p < lv) for h, lv in zip(hits, LEVELS)]
@@ -110,12 +132,15 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--records", type=int, default=120)
     ap.add_argument("--calibration", action="store_true", help="the statistic alone against its F reference")
+    ap.add_argument("--gain", action="store_true", help="the line's gain option alone at its conditional share")
     ap.add_argument("--start", type=int, default=0, help="the first record's seed (a run split over processes)")
     args = ap.parse_args(argv)
     t0 = time.process_time()
     out: dict = {"alpha_line": alpha("unexplained:line", 0.05)}
     if args.calibration:
         out["calibration"] = _calibration(args.records)
+    elif args.gain:
+        out["gain"] = _gain(args.records)
     else:
         out |= _refines(args.records, args.start)
         total = {k: sum(c[k] for c in out["counts"].values()) for k in out["counts"]["linear"]}

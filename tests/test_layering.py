@@ -188,6 +188,7 @@ MODEL_RANKS = {
     "model.refinement._channel_order": 0,  # the order a record's channels are regressed in: the strongest first
     "model.refinement._line_constancy": 0,
     "model.refinement._line_channel": 3.8,  # does a line whose amplitude changes follow a channel (its words)
+    "model.refinement._line_gain": 3.9,  # an accepted line's amplitude following a channel, modelled (its option)
     "model.refinement._line_check": 4,
     "model.refinement._mean_step": 4,
     "model.refinement._mean_steps": 4,

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from allanite.analysis import avar
-from allanite.model.refinement._line_channel import _block_means, _one, follows_channel
+from allanite.model.refinement._line_channel import _one, block_means, follows_channel
 from allanite.model.refinement._line_check import line_check
 from allanite.model.refinement._line_constancy import line_constancy
 from allanite.model.refinement.levels import alpha
@@ -57,7 +57,7 @@ def test_a_constant_line_and_a_step_in_time_are_not_tied_to_the_channel():
     y, temp = _record(7, 0.0, step=True)
     r, tie = _tie(y, temp)
     assert r["rejected"] and tie is None
-    xk = _block_means(temp, np.round(np.asarray(r["edges_s"]) * FS).astype(int))
+    xk = block_means(temp, np.round(np.asarray(r["edges_s"]) * FS).astype(int))
     one = _one(np.asarray(r["phasors"]), np.asarray(r["phasor_unit"]), r["noise_level"], r["noise_dof"], xk, ALPHA)
     assert one["statistic"] > one["threshold"] and one["left"] > one["left_threshold"]
 

@@ -75,7 +75,7 @@ def test_every_kind_of_parameter_formats():
     assert format_param("fundamentals", [0.19], None, "Hz") == "fundamentals = 0.19 Hz"
     assert format_param("fundamentals", [], None, "Hz") == "fundamentals = none Hz"
     assert format_param("t", math.inf, (1.0, math.nan), "s") == "t = ∞ [1, NaN] s"
-    assert param_units("sinusoid", "°/s") == {"amplitude": "°/s", "f0": "Hz"}
+    assert param_units("sinusoid", "°/s") == {"amplitude": "°/s", "f0": "Hz", "channel": "", "gain": "per channel unit"}
     assert param_units("regression", "°/s")["coefficient"] == "°/s per channel unit"
     assert param_units("not_an_effect", "°/s") == {}
     assert format_params("bandwidth", {"cutoff": 25.0, "taps": 2, "filter": "moving_average"}, {}, "°/s") == (

@@ -7,7 +7,7 @@ reading the budget (as the report's summary does) loads no scipy.
 
 from __future__ import annotations
 
-__all__ = ["TERM_SHARE", "FIRST_QUADRATIC", "WANDER_SHARE"]
+__all__ = ["TERM_SHARE", "FIRST_QUADRATIC", "WANDER_SHARE", "LINE_GAIN_SHARE"]
 
 #: Share of the per-record level spent on each optional term's test of a channel regression (a test run only
 #: once the coupling itself is accepted).
@@ -20,3 +20,9 @@ FIRST_QUADRATIC = 0.2
 #: Share of the per-record level spent on whether an accepted line family's fundamental wanders (its phase tracked
 #: instead of fixed: :func:`allanite.model.wander.track_family`) — a test run only once the family is accepted.
 WANDER_SHARE = 0.02
+#: Share of the per-record level spent on whether an accepted spectral line's amplitude follows a given channel (its
+#: term then a·(1 + g·(channel − mean))·cos(2πf0t + φ): :mod:`allanite.model.refinement._line_gain`) — a test run
+#: only once the line is accepted and only where channels are given, so on a clean record it spends nothing; the
+#: same 0.02 as the other conditional options (a channel's optional terms, a family's wander), its false-alarm rate
+#: on lines that do not follow a channel measured in benches/results/line_channel_null.md.
+LINE_GAIN_SHARE = 0.02

@@ -141,12 +141,18 @@ EFFECTS: dict[str, Effect] = {
             "sinusoid",
             "sinusoid",
             "curve",
-            (("amplitude", "rate unit", "amplitude A of the rate sinusoid"), ("f0", "Hz", "frequency f0")),
+            (
+                ("amplitude", "rate unit", "amplitude A of the rate sinusoid"),
+                ("f0", "Hz", "frequency f0"),
+                ("channel", "", "the channel its amplitude follows, with samples and channels, when kept"),
+                ("gain", "per channel unit", "relative change g of A per unit of that channel, when kept"),
+            ),
             "rate sinusoid A·sin(2πf0t): A²·sin⁴(πf0τ)/(πf0τ)², nulls at τ = k/f0. With samples it is found as a "
             "line of the Welch PSD (a bin above its neighbours' median beyond the F quantile of the Welch "
             "average against that median, Bonferroni over the bins), f0 refined on the periodogram, A from the "
             "line's power over its width (held in every fit of the curve; the least-squares A at f0 in "
-            "evidence['coherent_amplitude']); "
+            "evidence['coherent_amplitude']); where channels are given, A·(1 + g·(channel − mean)) when its own "
+            "nested test and held-out blocks keep it (refinement._line_gain); "
             "on a curve only, f0 ≥ 2/τ_max so that two nulls fall inside it",
             signature=lambda tau, f0, fs: sinusoid_avar(tau, f0, fs),
             alpha=lambda tau, f0: np.zeros(np.asarray(tau).size, dtype=int),

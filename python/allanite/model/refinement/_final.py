@@ -92,6 +92,7 @@ class FinalModel(RunState):
             ctx.segments_heldout_pct = per_segment[-1]
         ctx.samples = self.y0
         ctx.considered, ctx.offered_lines = self.considered, self.offered_lines
+        ctx.line_gains = {float(ln["f0"]): ln["gain"] for ln in self.lines if ln is not None and ln.get("gain")}
         ctx.replaced = _replaced([rem for _st, rem, *_rest in self.removed], self.y0.size if self.y0 is not None else 0)
         ctx.families = [
             (st.params["fundamentals"], st.evidence["frequencies_hz"], st.evidence["amplitudes"], rem.component)

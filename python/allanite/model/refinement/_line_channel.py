@@ -24,10 +24,10 @@ import math
 import numpy as np
 from scipy import stats
 
-__all__ = ["follows_channel"]
+__all__ = ["follows_channel", "block_means"]
 
 
-def _block_means(x: np.ndarray, edges: np.ndarray) -> np.ndarray:
+def block_means(x: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """The channel's mean over each block, Hann-weighted as the block's phasor weighs the line (a uniform mean
     smooths a channel that moves within the blocks more than the phasors are smoothed: on a noise-free line,
     g 0.0203 for 0.02 on a channel cycling twice over 16 blocks, 0.0213 four times; Hann-weighted 0.0200)."""
@@ -82,7 +82,7 @@ def follows_channel(
         x = np.asarray(x, dtype=float)
         if x.ndim != 1 or x.size < edges[-1]:
             continue
-        r = _one(ph, u, s2, d2, _block_means(x, edges), alpha / len(channels))
+        r = _one(ph, u, s2, d2, block_means(x, edges), alpha / len(channels))
         if r is None or r["statistic"] <= r["threshold"] or r["left"] > r["left_threshold"]:
             continue
         if best is None or r["statistic"] > best["statistic"]:

@@ -63,6 +63,7 @@ class RunState:
         self.effects: list = []  # curve effects [(key, nonlinear parameter)], steps[j] ↔ effects[j]
         self.steps: list = []
         self.lines: list = []  # per curve step: the spectral line it came from, or None
+        self.channels: dict = {}  # the channels as given (for a line's gain: ._line_gain)
         # per time effect removed before the curve effects: (step, removal, its own change of the curve, the
         # curve after it, the held-out parts with the removals so far refitted on them)
         self.removed: list = []

@@ -5,6 +5,7 @@ family, searches, proposal, parameters and evidence (:data:`.candidates.CURVE_CA
 
 from __future__ import annotations
 
+from ._line_gain import gain_params
 from ._proposal import Proposal, Round, amplitude_and_profile, search_grid, with_stat
 from .curvefit import Curve, base_name, column, held_key, held_theta, search, solve
 from .scoring import MATERIAL_Z, curve_change_z
@@ -73,14 +74,16 @@ def sin_params(pr: Proposal, rnd: Round) -> tuple:
     if pr.line is None:
         return amplitude_and_profile(pr, rnd)
     ln = pr.line  # found in the PSD: amplitude (its power) and f0 from the samples, with their intervals
-    return {"amplitude": ln["power_amplitude"], "f0": pr.p}, {
-        "amplitude": ln["power_amplitude_interval"],
-        "f0": ln["f0_interval"],
-    }
+    params = {"amplitude": ln["power_amplitude"], "f0": pr.p}
+    return gain_params(ln, params, {"amplitude": ln["power_amplitude_interval"], "f0": ln["f0_interval"]})
 
 
 def sin_evidence(pr: Proposal, rnd: Round) -> dict:
     if pr.line is None:
         return {}
     ln = pr.line  # the part of the line whose phase carries across the whole record (least squares at f0)
-    return {"coherent_amplitude": ln["amplitude"], "coherent_amplitude_interval": ln["amplitude_interval"]}
+    out = {"coherent_amplitude": ln["amplitude"], "coherent_amplitude_interval": ln["amplitude_interval"]}
+    g = ln.get("gain")
+    if g:  # its nested option kept: the amplitude follows a channel (._line_gain)
+        out["gain_test"] = {k: g[k] for k in ("statistic", "threshold", "alpha", "heldout_ratio", "mean")}
+    return out

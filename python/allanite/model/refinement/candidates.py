@@ -31,6 +31,7 @@ import numpy as np
 from ._bandwidth import bandwidth_grids, bw_evidence, bw_family, bw_params, bw_propose, bw_searches
 from ._bumps import gm_evidence, gm_family, gm_propose, gm_searches, res_family, res_params, res_propose, res_searches
 from ._choose import PAIR_FACTOR, choose
+from ._line_gain import gain_params
 from ._proposal import CurveCandidate, Proposal, Round, amplitude_and_profile, column_amplitude
 from ._sinusoid import line_key, sin_evidence, sin_family, sin_params, sin_propose, sin_searches
 from .curvefit import Curve, base_name, searches
@@ -105,6 +106,6 @@ def final_params(key: str, p: float, line: dict | None, intervals: dict, j: int,
     column_j = len(rnd.start) + j
     if line is not None:  # held at its time-domain amplitude in every fit: as accepted
         amp, _sd, _int = column_amplitude(rnd.sol, column_j)
-        return {"amplitude": amp, "f0": p}, {"amplitude": intervals["amplitude"], "f0": intervals["f0"]}
+        return gain_params(line, {"amplitude": amp, "f0": p}, {k: intervals[k] for k in ("amplitude", "f0")})
     pr = Proposal(key, p, rnd.sol, False, math.nan, math.nan, None, column=column_j)
     return CURVE_CANDIDATES[base_name(key)].params(pr, Round(rnd.curve, rnd.start, others, rnd.sol))

@@ -8,7 +8,7 @@ calibrated with the rest on clean records (``benches/refine_false_alarms.py``).
 
 from __future__ import annotations
 
-from .._shares import TERM_SHARE, WANDER_SHARE
+from .._shares import LINE_GAIN_SHARE, TERM_SHARE, WANDER_SHARE
 
 __all__ = [
     "LEVEL",
@@ -115,6 +115,8 @@ CONDITIONAL_SHARES["periodic:wander"] = WANDER_SHARE
 #: kind, so on a record without a roll-off it spends nothing; on a filtered record without a notch it is the rate
 #: of naming one (benches/results/notch_null.md).
 CONDITIONAL_SHARES["bandwidth:notch"] = 0.02
+#: An accepted line's amplitude following a given channel (:mod:`.refinement._line_gain`): conditional on the line.
+CONDITIONAL_SHARES["sinusoid:gain"] = LINE_GAIN_SHARE
 
 
 def share(test: str) -> float:

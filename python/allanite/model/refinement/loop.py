@@ -26,6 +26,7 @@ from ..terms import check_terms
 from ._final import FinalModel
 from ._in_time import TimeRemovals
 from ._inputs import REFINE_SCALE, check_scale, check_truth, check_unit, inputs
+from ._line_gain import line_gain
 from ._rolloff import research_rolloff, sinc_chain_kept, sinc_named, without_sincs
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, bandwidth_grids, choose, families, prefetch
@@ -144,6 +145,7 @@ def refine(
         with counter_quantisation(counter):
             run = _Run(y, result, start, tau_range, level, truth, unit)
             run.remove_in_time(candidates, chans)
+            run.channels = chans or {}
             run.add_curve_effects(candidates)
             cp_steps = run.change_point_steps(candidates)
             out = run.refinement(cp_steps, unit, confidence, run.unexplained(chans, cp_steps))
@@ -265,6 +267,10 @@ class _Run(TimeRemovals, FinalModel):
     def curve_effect_step(self, pr: Proposal, rnd: Round, ho_b, ho_a) -> Step:
         """The step of an accepted curve proposal (scored along the chain once the loop is done)."""
         cand = CURVE_CANDIDATES[pr.effect]
+        if pr.line is not None and self.channels and self.y is not None and "gain" not in pr.line:
+            # its nested option: the amplitude following a channel, at its conditional share over the lines offered
+            a = alpha("sinusoid:gain", self.level) / max(1, len(self.offered_lines or []))
+            pr.line["gain"] = line_gain(self.y, self.fs, float(pr.line["f0"]), self.channels, a)
         params, intervals = cand.params(pr, rnd)
         evidence = residual_evidence(self.curve, self.sol)
         evidence["domain"] = EFFECTS[pr.effect].domain

@@ -1,0 +1,131 @@
+"""A line whose amplitude follows a channel, modelled: an accepted sinusoid's nested option
+a·(1 + g·(x̃(t) − x̄))·cos(2πf0t + φ) (docs/lines-and-outliers.md, "A line whose amplitude follows a channel").
+
+A vibrating-structure gyro's drive or quadrature line follows the temperature; :mod:`._line_channel` says so of a
+line the ``"line"`` check finds changing. Here the line's term carries it. The fit is the least squares of the
+line on cos, sin, (x − x̄)·cos, (x − x̄)·sin at the fixed f0, taken on the line's Hann-weighted complex amplitude
+c_k in the blocks of :mod:`._line_constancy` (≥ 20 periods each, at most 16): c_k = A + b·(x̄_k − x̄) + e_k, x̄_k
+the channel's mean over block k weighted as the phasor weighs the line — the channel smoothed to the blocks, so
+that its own sensor noise does not enter the product (a 0.01 °C noise on a temperature is gone from a block
+mean of 10⁴ samples) — and e_k the block's noise, E|e_k|² = s²·u_k (the off-line level at f0 and the block's
+phasor variance under unit white noise). The amplitude's relative change per channel unit is g = β/|A|, β the
+part of b in phase with A; F = 2·Sxx·β²/s² is F(1, d₂) where the amplitude does not follow the channel
+(:func:`._line_channel._one`, its null measured in benches/results/line_channel_null.md).
+
+Kept only where (1) F passes its 1 − α quantile, α = the ``"sinusoid:gain"`` conditional share of ``level``
+(:data:`allanite.model._shares.LINE_GAIN_SHARE`, spent only once a line is accepted) over the lines offered and
+the channels given, and (2) held out it predicts better: the blocks split in two alternate halves, the constant
+line and the line with its gain each fitted on one half and scored on the other (the squared phasor errors
+weighted by 1/u_k), their summed ratio below 1 — held out as the line's amplitudes are, refitted on held-in
+blocks. The component the gain adds, g·(x̃(t) − x̄)·Re(A·e^{2πif0t}) (x̃ the block means interpolated linearly
+between the blocks' centres), is what the ``"line"`` check leaves out of the final samples before it asks
+whether the line is the same along the record (:mod:`._line_check`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import stats
+
+from ._line_channel import block_means
+from ._line_constancy import line_constancy
+
+__all__ = ["line_gain", "gain_component", "gain_params"]
+
+
+def _fit(ph: np.ndarray, w: np.ndarray, xk: np.ndarray) -> tuple[complex, float, float, float]:
+    """Intercept A (at the weighted mean x̄), in-phase slope β, Sxx and x̄ of c_k on x̄_k (weights ``w``)."""
+    xbar = float(np.sum(w * xk) / np.sum(w))
+    xc = xk - xbar
+    sxx = float(np.sum(w * xc**2))
+    a = complex(np.sum(w * ph) / np.sum(w))
+    if not (sxx > 0.0 and math.isfinite(sxx)) or a == 0:
+        return a, 0.0, sxx, xbar
+    b = complex(np.sum(w * xc * ph) / sxx)
+    return a, (b * a.conjugate()).real / abs(a), sxx, xbar
+
+
+def _heldout_ratio(ph: np.ndarray, w: np.ndarray, xk: np.ndarray) -> float:
+    """Held-out squared error of the line with its gain over the constant line's: alternate blocks as the two
+    halves, each fitted on one and scored on the other (weights ``w`` = 1/u_k), summed over both ways."""
+    idx = np.arange(ph.size)
+    err_g = err_c = 0.0
+    for k in (0, 1):
+        inn, out = idx % 2 == k, idx % 2 != k
+        a, beta, sxx, xbar = _fit(ph[inn], w[inn], xk[inn])
+        a_c = complex(np.sum(w[inn] * ph[inn]) / np.sum(w[inn]))
+        g = beta / abs(a) if sxx > 0.0 and a != 0 else 0.0
+        pred = a * (1.0 + g * (xk[out] - xbar))
+        err_g += float(np.sum(w[out] * np.abs(ph[out] - pred) ** 2))
+        err_c += float(np.sum(w[out] * np.abs(ph[out] - a_c) ** 2))
+    return err_g / err_c if err_c > 0.0 else math.inf
+
+
+def _one(r: dict, x: np.ndarray, fs: float, alpha: float) -> dict | None:
+    ph, u = np.asarray(r["phasors"], dtype=complex), np.asarray(r["phasor_unit"], dtype=float)
+    s2, d2 = float(r["noise_level"]), float(r["noise_dof"])
+    edges_s = np.asarray(r["edges_s"], dtype=float)
+    edges = np.round(edges_s * fs).astype(int)
+    if x.ndim != 1 or x.size < edges[-1] or not (s2 > 0.0 and d2 > 0.0):
+        return None
+    xk = block_means(x, edges)
+    w = 1.0 / u
+    a, beta, sxx, xbar = _fit(ph, w, xk)
+    if not sxx > 0.0 or a == 0:
+        return None
+    f1, thr = 2.0 * sxx * beta**2 / s2, float(stats.f.isf(alpha, 1, d2))
+    sd = math.sqrt(s2 / (2.0 * sxx)) / abs(a)  # β's SD over |A|: g's ±1 SD
+    g = beta / abs(a)
+    return {
+        "gain": g,
+        "gain_interval": (g - sd, g + sd),
+        "mean": xbar,
+        "phasor": (a.real, a.imag),
+        "statistic": float(f1),
+        "threshold": thr,
+        "alpha": alpha,
+        "heldout_ratio": _heldout_ratio(ph, w, xk),
+        "centres_s": ((edges_s[:-1] + edges_s[1:]) / 2).tolist(),
+        "block_means": xk.tolist(),
+    }
+
+
+def line_gain(y: np.ndarray, fs: float, f0: float, channels: dict, alpha: float) -> dict | None:
+    """The channel the line at ``f0`` Hz of ``y`` follows in amplitude, kept by its nested F test at ``alpha``
+    (split over the channels) and a held-out ratio below 1 (module docstring), or None. Returns ``{"channel",
+    "gain" (relative change per channel unit), "gain_interval" (±1 SD), "mean" (x̄), "phasor" (A as (re, im)),
+    "statistic", "threshold", "alpha", "heldout_ratio", "centres_s", "block_means"}`` for the passing channel of
+    largest F."""
+    if not channels:
+        return None
+    r = line_constancy(np.asarray(y, dtype=float), fs, f0, alpha, phasors=True)
+    if r is None or int(r["blocks"]) < 4:
+        return None
+    best = None
+    for name, x in channels.items():
+        one = _one(r, np.asarray(x, dtype=float), fs, alpha / len(channels))
+        if one is None or not one["statistic"] > one["threshold"] or not one["heldout_ratio"] < 1.0:
+            continue
+        if best is None or one["statistic"] > best["statistic"]:
+            best = one | {"channel": name}
+    return best
+
+
+def gain_component(n: int, fs: float, f0: float, gain: dict) -> np.ndarray:
+    """The samples the gain adds to the constant line (module docstring): g·(x̃(t) − x̄)·Re(A·e^{2πif0t}) over
+    ``n`` samples at ``fs``, x̃ the block means interpolated linearly between the blocks' centres."""
+    t = np.arange(n) / fs
+    xt = np.interp(t, np.asarray(gain["centres_s"]), np.asarray(gain["block_means"]))
+    line = np.real(complex(*gain["phasor"]) * np.exp(2j * np.pi * f0 * t))
+    return gain["gain"] * (xt - gain["mean"]) * line
+
+
+def gain_params(line: dict, params: dict, intervals: dict) -> tuple[dict, dict]:
+    """A line's step parameters with its gain where it has one: ``channel`` and ``gain`` (relative change of the
+    amplitude per unit of the channel, ±1 SD interval)."""
+    g = line.get("gain")
+    if not g:
+        return params, intervals
+    return params | {"channel": g["channel"], "gain": g["gain"]}, intervals | {"gain": tuple(g["gain_interval"])}
