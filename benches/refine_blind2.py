@@ -406,6 +406,7 @@ NOTES: list = [
     "t 2500–5000 s. The model is not right, but it no longer reads as complete.",
     "**Rerun at 44eba23** (every branch of the 2026-11-27 afternoon merged: the sinc^k kind chain, the family fold, the mean check's per-term nulls, the coupling test's bootstrap where its dof is small, the cost round, the module splits): the table above, **11 of 11**, without the candidate **7 of 7** — every row's effects, parameters and words as at bfcb29f (only the CPU column moved).",
     "**Rerun whole at ba83de7** (every branch of the 2026-11-27 evening merged but r11lagrate, whose rule runs only where a d(ch)/dt term passes — none of this suite's rows but the chamber ramp, rerun on it unchanged): the table above, **11 of 11** — every row's verdict as before; the chirp (outside the family) is now read as a line whose frequency wanders (r11wander: a periodic at 2.30 Hz wandering 7.7 % rms, χ²/dof 2.08·10⁴ → 70.5, held out 40.5 → 5.6 %) and still said (the curve departs at τ 0.03–1.1 s), where three sinusoids and two change points stood in for it; the bursts' outlier threshold 0.2851 → 0.2858.",
+    "**Rerun whole at a593464** (every branch of the 2026-11-27 night merged: r12adis, r12chanres, r12burst, r12lag, r12blind10, r12wline, r12ci, r12lineamp; CI, other suites and the ADIS16405 run shared the 2 cores, so the CPU column is not a cost measurement): **11 of 11**, every row's verdict, effects, parameters and words as recorded.",
 ]
 
 
