@@ -384,6 +384,7 @@ NOTES: list = [
     "where the first run ended at 3.53 %.",
     "**Rerun at 44eba23** (every branch of the 2026-11-27 afternoon merged: the sinc^k kind chain, the family fold, the mean check's per-term nulls, the coupling test's bootstrap where its dof is small, the cost round, the module splits): the table above, **10 of 11**, without the candidate **9 of 9** — every row's effects, parameters and words as at bfcb29f but the 24 h log's: refined without the regression candidate it now leaves 2 regions unexplained (1 before; the coupling test's bootstrap). The cold start still fails on its coefficient (+30.3 %, its interval holding the truth).",
     "**Rerun whole at ba83de7** (every branch of the 2026-11-27 evening merged but r11lagrate, whose rule runs only where a d(ch)/dt term passes; none of this suite's rows keeps one): the table above, **10 of 11** — every row's verdict as before; the 24 h log no longer adds a Gauss–Markov beside its 900 s cycle (the sinusoid and the regression as before; χ²/dof 1.19 → 1.94 at the end, held out 0.70 → 0.72 %). The cold start still fails on its coefficient (+30.3 %).",
+    "**Rerun whole at a593464** (every branch of the 2026-11-27 night merged: r12adis, r12chanres, r12burst, r12lag, r12blind10, r12wline, r12ci, r12lineamp; CI, other suites and the ADIS16405 run shared the 2 cores, so the CPU column is not a cost measurement): **10 of 11**, every row's verdict, effects, parameters and words as recorded.",
 ]
 
 
