@@ -142,6 +142,7 @@ NOTES = [
     "**Rerun whole at a9820b6** (r10gaps, r10ux, r10blind8, r10pump, r10wnull, r10ci, r10small merged; the table above is this run's, beside two helpers and a false-alarm run — its CPU seconds are not a cost measurement): **17 of 17**, without the candidate **17 of 17**; every verdict, found effect, parameter error and `unexplained` entry as at 6909b06. The only numbers that moved are the channel check's thresholds in the runs without the regression candidate (e.g. 20.12 → 20.36 against a statistic of 146.5), by r10wnull's edge factor.",
     "",
     "**The six temperature rows** are then r10stair's reruns with `--case` (the channel shape check in `unexplained` merged; beside two helpers): every verdict, effect and parameter error as above; without the regression candidate each still says the rate follows 'temp', thresholds moved by the channel share's split (the linear check at half its α).",
+    "**Rerun whole at a593464** (every branch of the 2026-11-27 night merged: r12adis, r12chanres, r12burst, r12lag, r12blind10, r12wline, r12ci, r12lineamp; beside CI and other suites, so the CPU column is not a cost measurement): **17 of 17**, without the candidate **17 of 17**; every row's effects, parameters, errors and words as at ba83de7 (compared field by field).",
 ]
 
 
