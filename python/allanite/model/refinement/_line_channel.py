@@ -24,7 +24,7 @@ import math
 import numpy as np
 from scipy import stats
 
-__all__ = ["follows_channel", "block_means"]
+__all__ = ["follows_channel", "block_means", "inphase_fit"]
 
 
 def block_means(x: np.ndarray, edges: np.ndarray) -> np.ndarray:
@@ -38,21 +38,29 @@ def block_means(x: np.ndarray, edges: np.ndarray) -> np.ndarray:
     return out
 
 
+def inphase_fit(ph: np.ndarray, w: np.ndarray, xk: np.ndarray) -> tuple[complex, complex, float, float, float]:
+    """The weighted least squares of the phasors ``ph`` on the channel's block means ``xk`` (weights ``w`` = 1/u_k;
+    module docstring): intercept A at the weighted mean x̄, complex slope b, in-phase slope β = Re(b·Ā)/|A|, Sxx
+    and x̄ — b and β zero where the channel does not move across the blocks (Sxx not positive and finite) or A is 0."""
+    xbar = float(np.sum(w * xk) / np.sum(w))
+    xc = xk - xbar
+    sxx = float(np.sum(w * xc**2))
+    a = complex(np.sum(w * ph) / np.sum(w))
+    if not (sxx > 0.0 and math.isfinite(sxx)) or a == 0:
+        return a, 0j, 0.0, sxx, xbar
+    b = complex(np.sum(w * xc * ph) / sxx)
+    return a, b, (b * a.conjugate()).real / abs(a), sxx, xbar
+
+
 def _one(ph: np.ndarray, unit: np.ndarray, s2: float, d2: float, xk: np.ndarray, alpha: float) -> dict | None:
     """The in-phase slope's F and the leftover's for one channel's block means ``xk`` (module docstring); None
     where the channel does not move across the blocks."""
     w = 1.0 / unit
-    xc = xk - float(np.sum(w * xk) / np.sum(w))
-    sxx = float(np.sum(w * xc**2))
-    if not sxx > 0.0 or not math.isfinite(sxx):
+    a, b, beta, sxx, xbar = inphase_fit(ph, w, xk)
+    if not sxx > 0.0 or not math.isfinite(sxx) or abs(a) == 0.0:
         return None
-    a = complex(np.sum(w * ph) / np.sum(w))
-    b = complex(np.sum(w * xc * ph) / sxx)
-    if abs(a) == 0.0:
-        return None
-    beta = (b * a.conjugate()).real / abs(a)
     f1 = 2.0 * sxx * beta**2 / s2
-    left = ph - a - b * xc
+    left = ph - a - b * (xk - xbar)
     dof_left = 2 * (ph.size - 2)
     f_left = float(np.sum(np.abs(left) ** 2 * w) / s2) / (ph.size - 2)
     return {
@@ -61,7 +69,7 @@ def _one(ph: np.ndarray, unit: np.ndarray, s2: float, d2: float, xk: np.ndarray,
         "left": f_left,
         "left_threshold": float(stats.f.isf(alpha, dof_left, d2)),
         "g": float(beta / abs(a)),
-        "mean": float(np.sum(w * xk) / np.sum(w)),
+        "mean": xbar,
     }
 
 

@@ -29,22 +29,17 @@ import math
 import numpy as np
 from scipy import stats
 
-from ._line_channel import block_means
+from ._line_channel import block_means, inphase_fit
 from ._line_constancy import line_constancy
 
 __all__ = ["line_gain", "gain_component", "gain_params"]
 
 
 def _fit(ph: np.ndarray, w: np.ndarray, xk: np.ndarray) -> tuple[complex, float, float, float]:
-    """Intercept A (at the weighted mean x̄), in-phase slope β, Sxx and x̄ of c_k on x̄_k (weights ``w``)."""
-    xbar = float(np.sum(w * xk) / np.sum(w))
-    xc = xk - xbar
-    sxx = float(np.sum(w * xc**2))
-    a = complex(np.sum(w * ph) / np.sum(w))
-    if not (sxx > 0.0 and math.isfinite(sxx)) or a == 0:
-        return a, 0.0, sxx, xbar
-    b = complex(np.sum(w * xc * ph) / sxx)
-    return a, (b * a.conjugate()).real / abs(a), sxx, xbar
+    """Intercept A (at the weighted mean x̄), in-phase slope β, Sxx and x̄ of c_k on x̄_k (weights ``w``): the words'
+    own fit (:func:`._line_channel.inphase_fit`), so the gain and the words read the same slope."""
+    a, _, beta, sxx, xbar = inphase_fit(ph, w, xk)
+    return a, beta, sxx, xbar
 
 
 def _heldout_ratio(ph: np.ndarray, w: np.ndarray, xk: np.ndarray) -> float:
@@ -55,11 +50,10 @@ def _heldout_ratio(ph: np.ndarray, w: np.ndarray, xk: np.ndarray) -> float:
     for k in (0, 1):
         inn, out = idx % 2 == k, idx % 2 != k
         a, beta, sxx, xbar = _fit(ph[inn], w[inn], xk[inn])
-        a_c = complex(np.sum(w[inn] * ph[inn]) / np.sum(w[inn]))
         g = beta / abs(a) if sxx > 0.0 and a != 0 else 0.0
         pred = a * (1.0 + g * (xk[out] - xbar))
         err_g += float(np.sum(w[out] * np.abs(ph[out] - pred) ** 2))
-        err_c += float(np.sum(w[out] * np.abs(ph[out] - a_c) ** 2))
+        err_c += float(np.sum(w[out] * np.abs(ph[out] - a) ** 2))  # A is the constant line's fit too
     return err_g / err_c if err_c > 0.0 else math.inf
 
 
