@@ -18,8 +18,10 @@ the channels given, and (2) held out it predicts better: the blocks split in two
 line and the line with its gain each fitted on one half and scored on the other (the squared phasor errors
 weighted by 1/u_k), their summed ratio below 1 — held out as the line's amplitudes are, refitted on held-in
 blocks. The component the gain adds, g·(x̃(t) − x̄)·Re(A·e^{2πif0t}) (x̃ the block means interpolated linearly
-between the blocks' centres), is what the ``"line"`` check leaves out of the final samples before it asks
-whether the line is the same along the record (:mod:`._line_check`).
+between the blocks' centres), is taken out of the samples every step after the curve effects sees
+(:meth:`._final.FinalModel.after_curve`): the change points and the checks of ``unexplained`` — among them the
+``"line"`` check, which asks whether the line is the same along the record (:mod:`._line_check`). The line itself
+stays, as every line the ``"sinusoid"`` candidate holds on the curve does.
 """
 
 from __future__ import annotations
