@@ -39,7 +39,7 @@ def test_gain_found_and_its_component_leaves_a_constant_line():
     assert lo < g["gain"] < hi and hi - lo < 0.2 * g["gain"]
     assert g["heldout_ratio"] < 0.5 and g["statistic"] > g["threshold"]
     assert line_constancy(y, FS, F0, 0.001)["rejected"]  # the line changes along the record ...
-    rest = y - lg.gain_component(y.size, FS, F0, g)
+    rest = y - lg.gain_component(y.size, FS, F0, g, ch["temp"])
     assert not line_constancy(rest, FS, F0, 0.001)["rejected"]  # ... and less its gain's part it does not
 
 

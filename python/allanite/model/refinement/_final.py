@@ -94,7 +94,8 @@ class FinalModel(RunState):
             return None
         for ln in self.lines:
             if ln is not None and ln.get("gain"):
-                y = y - gain_component(y.size, self.fs, float(ln["f0"]), ln["gain"])
+                g = ln["gain"]
+                y = y - gain_component(y.size, self.fs, float(ln["f0"]), g, self.channels[g["channel"]])
         return y
 
     def unexplained(self, chans, cp_steps=()) -> list:
