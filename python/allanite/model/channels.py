@@ -372,8 +372,8 @@ def regress_channel(
 def channel_bands(y: np.ndarray, x: np.ndarray, fs: float) -> tuple:
     """The record and channel as :func:`regress_channel` tests them: both cut to the usable length, the channel's
     form detected and read back, its signal bands, the band-limited channel ``xs`` with its centring (the whole
-    record's mean in ``xs``'s frame, :func:`centring`) and mean square about it, and the Whittle band sums of ``y`` with the three regressors. Returns (y, form, floor, sig, xs, mean,
-    quad_mean, bands)."""
+    record's mean in ``xs``'s frame, :func:`centring`) and mean square about it, and the Whittle band sums of
+    ``y`` with the three regressors. Returns (y, form, floor, sig, xs, mean, quad_mean, bands)."""
     n_use = wh.usable_length(y.size)
     form, floor, sig, xs = read_channel(x[:n_use], fs)
     mean = centring(x, xs, form)[1]
@@ -391,7 +391,7 @@ def centring(x: np.ndarray, xs: np.ndarray, form: ChannelForm) -> tuple[float, f
     regressors are centred on. Returns (t_ref, the centring in ``xs``'s frame).
 
     Why not ``xs``'s own mean (before r13swing): that is the mean over the usable prefix only
-    (:func:`allanite.model._whittle.usable_length` drops up to ≈ 0.5 % at the end: 4671 of 10⁶ samples), and
+    (:func:`allanite.model._whittle.usable_length` drops up to 2.3 % at the end above 10⁶ samples: 4671 of 10⁶), and
     b₁·(x − m) + b₂·(x − m)² has the slope b₁ at x = m, so the reported coefficient was the slope at a value the
     user never asked for, 2·b₂·δm away: on a temperature going once 10 → 40 → 10 °C over 4·10⁶ samples (blind10's
     float32 gyro) the dropped end near 10 °C put m 0.07 °C above the record's mean, +4 % of the linear coefficient
