@@ -35,7 +35,9 @@ docs/channels.md "Quantised and held channels").
 
 Optional terms, each kept only by its own nested test at its own share of the level:
 
-- ``quadratic`` — on (ch − mean)² (per channel unit²): likelihood ratio, F(1, ν); run also where the coupling's
+- ``quadratic`` — on (ch − mean)² (per channel unit²), the mean the channel's over the whole record
+  (``terms["quadratic"]["t_ref"]``; the linear coefficient is then the slope there, :func:`centring`):
+  likelihood ratio, F(1, ν); run also where the coupling's
   test fails, and where it passes then the coupling is accepted by it (a turnover temperature: a bias on
   (T − T₀)² with T₀ inside the swing has no linear part; T₀ = mean − b₁/(2·b₂) with its interval in
   ``terms["quadratic"]["turnover"]``; docs/channels.md "A turnover temperature");
@@ -101,6 +103,7 @@ __all__ = [
     "LAG_MARGIN",
     "CHANNEL_SNR",
     "channel_signal",
+    "centring",
 ]
 
 #: Optional terms of a channel regression, in the order they are tried.
@@ -205,7 +208,8 @@ class ChannelRegression:
     the test before the quadrature was added), ``accepted_by`` (``"channel"``, or ``"quadratic"``: the
     quadratic's own test, under ``quadratic``, where the channel's failed — a turnover); ``terms``: each optional
     term's test (``statistic``, ``threshold``, ``alpha``, ``dof``, ``kept``, and why not; the quadratic's
-    ``turnover``: T₀, whether inside the channel's range, its interval there); ``accepted``: the coupling passed
+    ``turnover``: T₀, whether inside the channel's range, its interval there; where kept, ``t_ref``: the channel's
+    mean over the record, the value at which ``coefficient`` is the slope); ``accepted``: the coupling passed
     its test or the quadratic's (optional terms are tried only then).
     ``removal_lag_s``: the lag the component runs the channel through — the kept ``lag_s``, or a lag its test
     did not resolve but the profile prefers to none (``terms["lag_s"]["profiled"]``, not a param), or None.
@@ -353,8 +357,10 @@ def regress_channel(
     lag = (removal_lag, tests["lag_s"]["interval"]) if lag_s is not None else None
     dofs = {"coefficient": in_phase["dof"]} | {k: tests[k]["dof"] for k in keys}
     params, intervals = _params(fit, keys, dofs, confidence, lag)
-    if "quadratic" in keys:
-        tests["quadratic"]["turnover"] = _turnover(fit, mean, (float(xs.min()), float(xs.max())), dofs, confidence)
+    if "quadratic" in keys:  # the turnover and the slope's reference in the channel's own frame (centring())
+        t_ref = centring(x, xs, form)[0]
+        span = (float(xs.min()) + t_ref - mean, float(xs.max()) + t_ref - mean)
+        tests["quadratic"] |= {"t_ref": t_ref, "turnover": _turnover(fit, t_ref, span, dofs, confidence)}
     # the noise amounts are not read as IEEE-952 terms: over the parametric bands' few octaves K, B and the GM shapes
     # trade against each other (their sum is what is used); the terms before/after come from the Allan fits
     noise = {"channel_noise": math.sqrt(floor), "whittle_loglik_gain": float(fit["loglik"] - null["loglik"])}
@@ -365,17 +371,36 @@ def regress_channel(
 
 def channel_bands(y: np.ndarray, x: np.ndarray, fs: float) -> tuple:
     """The record and channel as :func:`regress_channel` tests them: both cut to the usable length, the channel's
-    form detected and read back, its signal bands, the band-limited channel ``xs`` with its mean and mean square
-    about it, and the Whittle band sums of ``y`` with the three regressors. Returns (y, form, floor, sig, xs, mean,
-    quad_mean, bands)."""
+    form detected and read back, its signal bands, the band-limited channel ``xs`` with its centring (the whole
+    record's mean in ``xs``'s frame, :func:`centring`) and mean square about it, and the Whittle band sums of
+    ``y`` with the three regressors. Returns (y, form, floor, sig, xs, mean, quad_mean, bands)."""
     n_use = wh.usable_length(y.size)
-    y, x = y[:n_use], x[:n_use]
-    form, floor, sig, xs = read_channel(x, fs)
-    mean = float(xs.mean())
+    form, floor, sig, xs = read_channel(x[:n_use], fs)
+    mean = centring(x, xs, form)[1]
+    y = y[:n_use]
     quad_mean = float(np.mean((xs - mean) ** 2))
     bands = wh.spectra(y, regressor_iter(xs, mean, quad_mean, fs, None), fs)
     bands.source = EdgeSource(lambda i: next(islice(regressor_iter(xs, mean, quad_mean, fs, None), i, None)))
     return y, form, floor, sig, xs, mean, quad_mean, bands
+
+
+def centring(x: np.ndarray, xs: np.ndarray, form: ChannelForm) -> tuple[float, float]:
+    """Where the linear coefficient is the slope when a quadratic is kept: ``t_ref``, the channel's mean over the
+    whole record as read back (``x`` all of it; :func:`allanite.model._staircase.reconstructed`), and that value
+    in the frame of ``xs`` (the band-limited channel over the usable prefix, :func:`channel_bands`), which the
+    regressors are centred on. Returns (t_ref, the centring in ``xs``'s frame).
+
+    Why not ``xs``'s own mean (before r13swing): that is the mean over the usable prefix only
+    (:func:`allanite.model._whittle.usable_length` drops up to 2.3 % at the end above 10⁶ samples: 4671 of 10⁶), and
+    b₁·(x − m) + b₂·(x − m)² has the slope b₁ at x = m, so the reported coefficient was the slope at a value the
+    user never asked for, 2·b₂·δm away: on a temperature going once 10 → 40 → 10 °C over 4·10⁶ samples (blind10's
+    float32 gyro) the dropped end near 10 °C put m 0.07 °C above the record's mean, +4 % of the linear coefficient
+    (docs/channels.md, "The linear coefficient beside a quadratic"). ``xs`` is offset from the channel by what its
+    band limit took (0.14 °C on blind4's cold start), hence the frame. Without a lag, the columns' span — and so
+    every test and the removed component — does not depend on m (d(x − m)² = dx² − 2m·dx)."""
+    xr = reconstructed(x, form)
+    t_ref = float(np.mean(xr))
+    return t_ref, t_ref + float(np.mean(xs)) - float(np.mean(xr[: xs.size]))
 
 
 def _first_test(bands, fit, test: dict, a_quad: float, terms) -> tuple[bool, tuple | None]:
