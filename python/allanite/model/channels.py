@@ -55,6 +55,10 @@ Optional terms, each kept only by its own nested test at its own share of the le
   itself is reported as not resolved, under ``terms["lag_s"]["profiled"]``, not as a param) — at lag 0 the
   coupling's phase error stays in the residual (:mod:`allanite.model._lag`).
 
+- the level term itself (``coefficient``), where a d(ch)/dt term alone is kept: the channel beside it against it
+  alone, at its own :data:`TERM_SHARE` (:func:`allanite.model._coupling.level_test`) — a coupling through d(ch)/dt
+  only (a fibre-optic gyro's Shupe effect) is reported with that term only (docs/channels.md, "The level term").
+
 Intervals: the coefficients ±t_ν quantile × the inverse Fisher information's standard error — where a lag is used,
 with the lag free (the lag is estimated from the same record; :mod:`allanite.model._lag_time`); the lag from its
 profile likelihood in time, at the noise refitted beside the lagged channel.
@@ -238,7 +242,7 @@ class ChannelRegression:
         x = reconstructed(np.asarray(ch, dtype=np.float64), self.form)
         xs = band_limited(x, self.fs, self.signal_bands)
         cols = regressors(xs, self.mean, self.quad_mean, self.fs, self.removal_lag_s)
-        keep = [0] + [i for i, k in ((1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
+        keep = [i for i, k in ((0, "coefficient"), (1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
         return np.array([cols[i] for i in keep])
 
     def lag_note(self) -> str | None:
@@ -277,8 +281,10 @@ class ChannelRegression:
         return lambda i: comp[np.asarray(i)]
 
 
-def _params(fit, keys, dofs, confidence, lag):
-    names = ["coefficient"] + [k for k in ("quadratic", "rate_coefficient") if k in keys]
+def _params(fit, keys, dofs, confidence, lag, level: bool = True):
+    """The kept terms' values and intervals (t quantile at each term's ν): the level term ``coefficient`` where
+    ``level`` (its nested test kept it, or none was run), then the optional terms of ``keys``, then the lag."""
+    names = ["coefficient"] * level + [k for k in ("quadratic", "rate_coefficient") if k in keys]
     params, intervals = {}, {}
     for i, k in enumerate(names):
         c, se = float(fit["c"][i]), math.sqrt(max(float(fit["cov"][i, i]), 0.0))
@@ -350,13 +356,15 @@ def regress_channel(
     keys, lag_s, tests, removal_lag = [], None, {}, None
     if accepted:
         z2 = float(t_dist.isf((1.0 - confidence) / 2.0, in_phase["dof"])) ** 2
-        keys, fit, lag_s, tests = optional_terms(bands, fit, terms, level, lag_grid(y.size, fs), z2, quad)
-        removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, lag_grid(y.size, fs), z2)
+        boot = test["in_phase"].get("bartlett") if "bartlett" in test else None  # the coupling's bootstrap factor
+        grid = lag_grid(y.size, fs)
+        keys, fit, lag_s, tests = optional_terms(bands, fit, terms, level, grid, z2, quad, boot)
+        removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, grid, z2)
         if removal_lag is not None:
             removal_lag, fit = lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"], z2)
     lag = (removal_lag, tests["lag_s"]["interval"]) if lag_s is not None else None
     dofs = {"coefficient": in_phase["dof"]} | {k: tests[k]["dof"] for k in keys}
-    params, intervals = _params(fit, keys, dofs, confidence, lag)
+    params, intervals = _params(fit, keys, dofs, confidence, lag, tests.get("coefficient", {}).get("kept", True))
     if "quadratic" in keys:  # the turnover and the slope's reference in the channel's own frame (centring())
         t_ref = centring(x, xs, form)[0]
         span = (float(xs.min()) + t_ref - mean, float(xs.max()) + t_ref - mean)
@@ -517,12 +525,13 @@ def heldout_ratio(y, ch, fs: float, reg: ChannelRegression) -> float:
 def _two_ways(sides: list, keys: list) -> tuple[float, float]:
     """(mean of the two ways' held-out ratios, the poorer side's share of the channel's information) of a split
     into two sides' band sums (:func:`heldout_ratio`)."""
-    coefs = [wh.joint_fit(b, regressor_design(keys, b.m.size))["c"] for b in sides]
+    level = "coefficient" in keys  # the level term, where its nested test dropped it, is not refitted either
+    coefs = [wh.joint_fit(b, regressor_design(keys, b.m.size, level))["c"] for b in sides]
     noise = [wh.joint_fit(b, wh.Design([], []))["s"] for b in sides]
     info = [float(np.sum(b.G[:, 0, 0].real / s)) for b, s in zip(sides, noise, strict=True)]
     ratios = []
     for held, s, c_other in ((sides[0], noise[0], coefs[1]), (sides[1], noise[1], coefs[0])):
-        d = regressor_design(keys, held.m.size)
+        d = regressor_design(keys, held.m.size, level)
         use = _informative(held.G[:, 0, 0].real / s)
         ratios.append(float(np.sum(wh.residual_power(held, d, c_other)[use] / s[use]) / np.sum(held.q[use] / s[use])))
     total = sum(info)

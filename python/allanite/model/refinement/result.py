@@ -42,7 +42,8 @@ class Step:
     and is tracked, ``wander_hz``, ``wander_pct``, ``wander_half_span_hz``; outliers ``rate`` (share of the
     samples), ``threshold`` rate unit; drift ``amplitude`` rate unit, ``T`` s; regression ``channel``,
     ``coefficient`` rate unit per channel unit and, where their tests keep them, ``quadratic``,
-    ``rate_coefficient``, ``lag_s``; change point ``t`` s);
+    ``rate_coefficient``, ``lag_s`` — beside a ``rate_coefficient`` alone ``coefficient`` only where its test
+    keeps it; change point ``t`` s);
     ``intervals`` the numeric keys → (low, high); ``final_params``/``final_intervals`` the same after the final
     joint refit (a curve effect's amplitude refitted beside every other effect — a bandwidth's cutoff searched
     again beside them —, its nonlinear parameter's interval profiled again; what was measured in the time
