@@ -50,8 +50,11 @@ def lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict, z2: float) -> tup
     def cols():
         return chain(regressor_iter(xs, means[0], means[1], fs, best), [lag_slope(xs - means[0], best, fs)])
 
+    def column(i: int) -> np.ndarray:  # one regressor again, for the score's exact variance (the lag's: 2 filters)
+        return lag_slope(xs - means[0], best, fs) if i == 3 else next(islice(cols(), i, None))
+
     exact = wh.spectra(y, cols(), fs)
-    exact.source = EdgeSource(lambda i: next(islice(cols(), i, None)))
+    exact.source = EdgeSource(column)
     fit = wh.joint_fit(exact, regressor_design(keys, exact.m.size))
     full, noise = interval_cov_beside_lag(exact, keys, fit)
     c = float(fit["c"][0])
