@@ -59,9 +59,12 @@ Optional terms, each kept only by its own nested test at its own share of the le
   alone, at its own :data:`TERM_SHARE` (:func:`allanite.model._coupling.level_test`) — a coupling through d(ch)/dt
   only (a fibre-optic gyro's Shupe effect) is reported with that term only (docs/channels.md, "The level term").
 
-Intervals: the coefficients ±t_ν quantile × the inverse Fisher information's standard error — where a lag is used,
-with the lag free (the lag is estimated from the same record; :mod:`allanite.model._lag_time`); the lag from its
-profile likelihood in time, at the noise refitted beside the lagged channel.
+Intervals: the coefficients ±t_ν quantile × their standard error — the GLS estimator's sandwich under the noise
+refitted with the power the coefficients took from their bands given back (a restricted estimate), the score's
+variance exact at the record's edges (:mod:`allanite.model._gls_cov`: the inverse Fisher information at the
+fitted noise covered 52–57 % at 68 %); where a lag is used, with the lag free (the lag is estimated from the same
+record; :mod:`allanite.model._lag_time`); the lag from its profile likelihood in time, at that restricted noise
+beside the lagged channel (docs/channels.md, "Intervals that cover").
 """
 
 from __future__ import annotations
@@ -78,6 +81,7 @@ from ..errors import InputError, ParameterError
 from . import _whittle as wh
 from ._coupling import LAG_MARGIN, coupling_test, optional_terms, quadratic_test
 from ._edge import EdgeSource
+from ._gls_cov import interval_cov
 from ._lag import lag_grid, lagged, unresolved_lag
 from ._lag_time import lag_in_time
 from ._regressors import (
@@ -362,9 +366,12 @@ def regress_channel(
         removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, grid, z2)
         if removal_lag is not None:
             removal_lag, fit = lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"], z2)
+    level_kept = tests.get("coefficient", {}).get("kept", True)  # False where the level term's own test dropped it
+    if removal_lag is None:
+        fit = fit | {"cov": interval_cov(bands, regressor_design(keys, bands.m.size, level_kept), fit)[0]}
     lag = (removal_lag, tests["lag_s"]["interval"]) if lag_s is not None else None
     dofs = {"coefficient": in_phase["dof"]} | {k: tests[k]["dof"] for k in keys}
-    params, intervals = _params(fit, keys, dofs, confidence, lag, tests.get("coefficient", {}).get("kept", True))
+    params, intervals = _params(fit, keys, dofs, confidence, lag, level_kept)
     if "quadratic" in keys:  # the turnover and the slope's reference in the channel's own frame (centring())
         t_ref = centring(x, xs, form)[0]
         span = (float(xs.min()) + t_ref - mean, float(xs.max()) + t_ref - mean)
