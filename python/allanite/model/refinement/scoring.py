@@ -277,8 +277,10 @@ class Split:
         return float(np.mean(errs))
 
 
-#: The held-out parts' curves last made (:meth:`Split.curve`), of parts up to 4·10⁶ samples.
-_CURVES = Recent(4, 4_000_000)
+#: The held-out parts' curves last made (:meth:`Split.curve`), of parts up to 4·10⁶ samples: six, so that a removal's
+#: four corrected parts (its held-out error, both ways) are still there when its step's parts are made again after
+#: the new split's two (``_in_time.TimeRemovals.remove``; with four, all four were made twice).
+_CURVES = Recent(6, 4_000_000)
 
 
 def heldout_split(y, fs, m_all, lo, hi, terms):
