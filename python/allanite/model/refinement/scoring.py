@@ -149,8 +149,9 @@ class _PartIndex:
         return range(parity, self.n_blocks, 2)
 
     def __getitem__(self, parity: int) -> np.ndarray:
-        per = self.per
-        return np.concatenate([np.arange(j * per, (j + 1) * per) for j in self.blocks(parity)])[: self.size]
+        # each block's first index plus 0 … per − 1: the blocks' ranges joined, in one broadcast sum
+        first = np.arange(parity, self.n_blocks, 2, dtype=np.int64) * self.per
+        return (first[:, None] + np.arange(self.per, dtype=np.int64)).ravel()[: self.size]
 
 
 class Split:
