@@ -132,8 +132,9 @@ def _frac(x: np.ndarray) -> np.ndarray:
 _PHASORS = Recent(4, 4_000_000)
 #: Unit phases remembered by :func:`_unit_phase` (8 bytes per sample each): a family's fit, its evaluation and its
 #: refits on the held-out parts take the same indices' phases at the same fundamental (33 calls, 16 distinct, in one
-#: refine of the line-family sensor of ``tests/sensors.py``).
-_PHASES = Recent(4, 4_000_000)
+#: refine of the line-family sensor of ``tests/sensors.py``; the last two kept find the 16 repeats as four did, at
+#: half the memory).
+_PHASES = Recent(2, 4_000_000)
 
 
 def _grid(kmax: int) -> int:
