@@ -62,7 +62,6 @@ def block_rate_record(n: int, fs: float, N: float, B: float, K: float, R: float,
         return simulate(n, fs, N=N, B=B, K=K, R=R, seed=seed)  # its error, naming the coefficient
     tau0 = 1.0 / float(fs)
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-    t = np.arange(n) * tau0
     y = np.zeros(n)
     if N != 0:
         y += rng.normal(size=n) * (N / np.sqrt(tau0))
@@ -71,7 +70,7 @@ def block_rate_record(n: int, fs: float, N: float, B: float, K: float, R: float,
     if K != 0:
         y += np.cumsum(rng.normal(size=n) * (K * np.sqrt(tau0)))
     if R != 0:
-        y += R * t
+        y += R * (np.arange(n) * tau0)  # the sample times only where a ramp needs them
     return y
 
 

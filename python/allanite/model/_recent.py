@@ -111,14 +111,21 @@ class Recent:
 
     def get(self, arr: np.ndarray, key: tuple = ()):
         """The value remembered for an array equal to ``arr`` (same shape, dtype and elements) and ``key``, or
-        None (always outside :func:`remembering`)."""
+        None (always outside :func:`remembering`). Equal arrays whose sampled elements (:func:`_fingerprint`)
+        differ in a zero's sign are kept apart, as :func:`_shared_copy` keeps them: the value is then computed
+        again, on ``arr`` itself."""
         if not _OPEN:
             return None
         with self._lock:
             items = list(self._items)
-        for k, a, value in items:
-            if k == key and a.shape == arr.shape and a.dtype == arr.dtype and np.array_equal(a, arr):
-                return value
+        fp = None
+        for k, a, value, fp_a in items:
+            if k == key and a.shape == arr.shape and a.dtype == arr.dtype:
+                # a few samples first (an unequal array of the same size — the record before and after a removal,
+                # another part — differs there almost always), the whole array only where they agree
+                fp = _fingerprint(arr) if fp is None else fp
+                if fp_a == fp and np.array_equal(a, arr):
+                    return value
         return None
 
     def put(self, arr: np.ndarray, key: tuple, value):
@@ -126,7 +133,7 @@ class Recent:
         :func:`remembering`); returns ``value``. The copy is shared with every memory keeping the same content
         (:func:`_shared_copy`)."""
         if _OPEN and arr.size <= self.max_size:
-            item = (key, _shared_copy(arr), value)
+            item = (key, _shared_copy(arr), value, _fingerprint(arr))
             with self._lock:
                 # checked again under the lock the last leaving refine clears under: a copy made as it left is
                 # dropped, not kept until some later call returns

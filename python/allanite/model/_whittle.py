@@ -105,8 +105,51 @@ class Bands:
         return ~self.par
 
 
+#: The tapers and the bands' layouts of :func:`spectra` by the differenced length (and the split), within a refine:
+#: the same lengths come back — the record's, its halves', the held-out refits', the final check's — and each call
+#: made a Tukey window and searched every bin's band again (≈ 20 ms at 10⁶ samples, a regression's transforms
+#: being remembered: :mod:`._rfft`).
+_TAPERS = Small(4)
+_LAYOUTS = Small(8)
+
+
 def _taper(n: int) -> np.ndarray:
-    return tukey(n, min(1.0, 2.0 * TAPER)) if n > 8 else np.ones(n)
+    """The Tukey taper of ``n`` differences (read-only; remembered by ``n`` within a refine)."""
+    got = _TAPERS.get((int(n),))
+    if got is None:
+        got = tukey(n, min(1.0, 2.0 * TAPER)) if n > 8 else np.ones(n)
+        got.flags.writeable = False
+        got = _TAPERS.put((int(n),), got)
+    return got
+
+
+def _layout(n_diff: int, parity: int | None, fs: float) -> tuple:
+    """:func:`spectra`'s bins and bands for ``n_diff`` differences (read-only; remembered within a refine): the bins
+    kept (``sel``: all, or the even or odd ones), each band's first kept bin ``idx``, its count of kept bins ``m``,
+    its mean frequency ``f`` (Hz), whether it is parametric (``par``) and the parametric bands' bins ``k_par``."""
+    key = (int(n_diff), parity, float(fs))
+    got = _LAYOUTS.get(key)
+    if got is not None:
+        return got
+    n_bins = (n_diff - 1) // 2  # strictly between 0 and the Nyquist frequency
+    starts = band_starts(n_bins)
+    k_all = np.arange(1, n_bins + 1, dtype=np.int64)
+    band_of = np.searchsorted(starts, k_all, side="right") - 1
+    sel = slice(None) if parity is None else (k_all % 2 == parity)
+    k_all, band_of = k_all[sel], band_of[sel]
+    idx = np.flatnonzero(np.diff(band_of, prepend=-1))
+    m = np.diff(np.append(idx, k_all.size))
+    f = np.add.reduceat(k_all.astype(np.float64), idx) / m * fs / n_diff
+    # the band's width in bins of the whole spectrum decides its noise model (a split keeps the full record's)
+    par = np.diff(np.append(starts, n_bins + 1))[band_of[idx]] < OWN_BINS
+    # the parametric bands are the lowest ones: a last band cut short by the Nyquist bin is narrow too, yet above
+    # bands that carry their own level (n = 3999: it indexed past the parametric bins' shapes)
+    par = np.logical_and.accumulate(par)
+    k_par = k_all[: int(m[par].sum())].astype(np.float64)
+    for a in (idx, m, f, par, k_par) + (() if isinstance(sel, slice) else (sel,)):
+        a.flags.writeable = False
+    # the bins' numbers and bands (half the record's length each) not kept: only the split's mask is
+    return _LAYOUTS.put(key, (sel, idx, m, f, par, k_par))
 
 
 def _dft(x: np.ndarray, w: np.ndarray, n_bins: int) -> np.ndarray:
@@ -148,22 +191,8 @@ def spectra(y: np.ndarray, regressors: Iterable[np.ndarray], fs: float, parity: 
     n_bins = (n_diff - 1) // 2  # strictly between 0 and the Nyquist frequency
     w = _taper(n_diff)
     norm = math.sqrt(float(w @ w))
-    starts = band_starts(n_bins)
-    k_all = np.arange(1, n_bins + 1, dtype=np.int64)
-    band_of = np.searchsorted(starts, k_all, side="right") - 1
-    sel = slice(None) if parity is None else (k_all % 2 == parity)
-    k_all, band_of = k_all[sel], band_of[sel]
-    idx = np.flatnonzero(np.diff(band_of, prepend=-1))
-    m = np.diff(np.append(idx, k_all.size))
-    f = np.add.reduceat(k_all.astype(np.float64), idx) / m * fs / n_diff
-    # the band's width in bins of the whole spectrum decides its noise model (a split keeps the full record's)
-    par = np.diff(np.append(starts, n_bins + 1))[band_of[idx]] < OWN_BINS
-    # the parametric bands are the lowest ones: a last band cut short by the Nyquist bin is narrow too, yet above
-    # bands that carry their own level (n = 3999: it indexed past the parametric bins' shapes)
-    par = np.logical_and.accumulate(par)
-    n_par_bins = int(m[par].sum())
-    k_par = k_all[:n_par_bins].astype(np.float64)
-    del k_all, band_of  # the bins' numbers and bands (half the record's length each): not held beside the transforms
+    sel, idx, m, f, par, k_par = _layout(n_diff, parity, fs)
+    n_par_bins = k_par.size
     d = _dft(y, w, n_bins)[sel] / norm
     zs = [_dft(np.asarray(r, dtype=np.float64), w, n_bins)[sel] / norm for r in regressors]
     p = len(zs)
@@ -178,7 +207,7 @@ def spectra(y: np.ndarray, regressors: Iterable[np.ndarray], fs: float, parity: 
             big[:, j, i] = np.conj(big[:, i, j])
     shapes, names = _basis(k_par, n_diff, fs)
     basis = np.add.reduceat(shapes, idx[par], axis=0) / m[par][:, None] if n_par_bins else np.zeros((0, 4))
-    return Bands(m, f, q, g, big, par, basis, names, float(fs), n_diff)
+    return Bands(m.copy(), f.copy(), q, g, big, par.copy(), basis, names, float(fs), n_diff)  # the layout's own
 
 
 #: The noise fit's loop in the Rust core (``allanite._core.whittle_noise``), or None where the core lacks it.

@@ -149,8 +149,9 @@ class _PartIndex:
         return range(parity, self.n_blocks, 2)
 
     def __getitem__(self, parity: int) -> np.ndarray:
-        per = self.per
-        return np.concatenate([np.arange(j * per, (j + 1) * per) for j in self.blocks(parity)])[: self.size]
+        # each block's first index plus 0 … per − 1: the blocks' ranges joined, in one broadcast sum
+        first = np.arange(parity, self.n_blocks, 2, dtype=np.int64) * self.per
+        return (first[:, None] + np.arange(self.per, dtype=np.int64)).ravel()[: self.size]
 
 
 class Split:
@@ -267,8 +268,10 @@ class Split:
         return self.predict(parts, terms, effects)
 
 
-#: The held-out parts' curves last made (:meth:`Split.curve`), of parts up to 4·10⁶ samples.
-_CURVES = Recent(4, 4_000_000)
+#: The held-out parts' curves last made (:meth:`Split.curve`), of parts up to 4·10⁶ samples: six, so that a removal's
+#: four corrected parts (its held-out error, both ways) are still there when its step's parts are made again after
+#: the new split's two (``_in_time.TimeRemovals.remove``; with four, all four were made twice).
+_CURVES = Recent(6, 4_000_000)
 
 
 def heldout_split(y, fs, m_all, lo, hi, terms):
