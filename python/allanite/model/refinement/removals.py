@@ -52,6 +52,7 @@ from scipy.stats import t as t_dist
 from ...analysis import avar
 from .. import channels, linefit, outliers, periodic, template, tracing, wander, warmup
 from ._channel_order import strongest_first
+from ._slow_lines import slow_line_removal
 from ._tracking import heldout_variance_ratio
 from ._tracking import tracked as _tracked
 from .calibrated import tested
@@ -436,7 +437,7 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
     are left to the ``"sinusoid"`` curve candidate, and so are a turned-down family's (``family``) — but a lone line
     whose frequency wanders, removed along its tracked phase (:func:`_lone_tracked`)."""
     a = alpha("lines", ctx.level)
-    search = periodic.periodic_search(ctx.y, ctx.fs, a)
+    search = periodic.periodic_search(ctx.y, ctx.fs, a, alpha("slow_lines", ctx.level))
     ctx.lines = search
     searched = ctx.y
     for fam in search["families"]:
@@ -478,6 +479,12 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
         rem = _lone_tracked(ctx, sin if ctx.y is searched else _refit_family(sin, ctx.y), a, search)
         if rem is not None:
             yield rem
+    for ln in search["slow"]:  # a line of few cycles, below the spectrum's reach: its test was in time
+        component, refit, params, intervals, evidence = slow_line_removal(ctx.y, ctx.fs, ln)
+        ratio = heldout_variance_ratio(ctx.y, refit)
+        yield Removal(
+            "sinusoid", component, refit, params, intervals, evidence, 3, heldout_in_time=ratio, on_curve=True
+        )
 
 
 def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, search: dict) -> Removal | None:
