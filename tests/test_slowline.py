@@ -35,9 +35,14 @@ def test_red_noise_alone_and_a_settling_drift_are_no_line():
     fs, n = 1.0, 50_000
     t = np.arange(n) / fs
     y = _red(n, fs, 4) + 0.5 * np.exp(-t / 4000.0)  # a drift 100× the noise's σ, no line
-    r = slow_line_test(y, fs, 1e-3)
+    r = slow_line_test(y, fs, 1e-3, calibrate=True)
     assert r is not None and not r["accepted"]
     assert r["p_value"] > 1e-3
+    assert r["threshold"] > -2.0 * math.log(1e-3)  # the scan's maximum is above one frequency's quantile
+    quick = slow_line_test(y, fs, 1e-3)  # below that bound: no draws, the bound said as the threshold
+    assert quick is not None and not quick["accepted"] and quick["statistic"] == r["statistic"]
+    if quick["statistic"] <= -2.0 * math.log(1e-3):
+        assert quick["p_value"] is None and quick["threshold"] == pytest.approx(-2.0 * math.log(1e-3))
 
 
 def test_too_short_a_record_is_not_tested_and_bad_alpha_is_named():
