@@ -22,23 +22,18 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).parent))
-
-import refine_blind as rb  # noqa: E402
-from _common import clopper_pearson, machine_info, machine_line  # noqa: E402
-
-import allanite  # noqa: E402
-from allanite._blas import one_thread  # noqa: E402
-from allanite.model.refinement.levels import LEVEL, alpha  # noqa: E402
-from allanite.model.slowline import slow_line_test  # noqa: E402
+import allanite
+import refine_blind as rb
+from _common import clopper_pearson, machine_info, machine_line
+from allanite._blas import one_thread
+from allanite.model.refinement.levels import LEVEL, alpha
+from allanite.model.slowline import slow_line_test
 
 ALPHA = alpha("slow_lines", LEVEL)
 
