@@ -6,18 +6,19 @@ tiltmeter's, a clock's, a thermal day/night cycle) has no neighbourhood to stand
 the noise is red (flicker, random walk), so a periodogram of white-noise law mistakes the noise for lines.
 
 :func:`slow_line_test` tests it in time: the record's :data:`BLOCKS` block means (each block's mean, every
-frequency tested is far below their Nyquist) are fitted as a constant and a ramp under a noise of three parts —
-white, random walk and flicker (a fractionally integrated noise, d = :data:`FLICKER_D`) — by restricted maximum
-likelihood; under that covariance every frequency from :data:`MIN_CYCLES`/T to the search's floor is tested by the
-generalised least-squares χ² of a sinusoid beside the constant and the ramp (2 degrees of freedom), and the record's
-statistic is the largest over a grid of quarter-cycle steps. Its null law is drawn, not assumed: the whitened block
-means are independent unit normals under the null, so :data:`DRAWS` draws of them through the same projections give
-the maximum's law with the scan's look-elsewhere in it; the line is found where the statistic passes that law's
-(1 − ``alpha``) quantile.
+frequency tested is far below their Nyquist) are fitted as a constant, a ramp and settling drifts
+(:data:`SETTLING`) under a noise of three parts — white, random walk and flicker (a fractionally integrated
+noise, d = :data:`FLICKER_D`) — by restricted maximum likelihood; under that covariance every frequency from
+:data:`SCAN_CYCLES`/T to the search's floor is tested by the generalised least-squares χ² of a sinusoid beside
+those terms (2 degrees of freedom), and the record's statistic is the largest over a grid of quarter-cycle steps.
+Its null law is drawn, not assumed: the whitened block means are independent unit normals under the null, so
+:data:`DRAWS` draws of them through the same projections give the maximum's law with the scan's look-elsewhere in
+it; the line is found where the statistic passes that law's (1 − ``alpha``) quantile and its frequency is at least
+:data:`MIN_CYCLES`/T (a maximum below is a power rising toward 0 Hz, not a line: ``below_band``).
 
-A line of few cycles and a slow drift are nearly collinear: the result says how much of the line's signal a
-quadratic drift could not take (``separable``, the share of its whitened columns outside the constant, ramp and
-t²), and its amplitude's interval is the generalised least squares' beside the constant and the ramp.
+A line of few cycles and a slow drift are nearly collinear: the result says how much of the line's whitened signal
+the constant, the ramp and the settling drifts cannot take (``separable``), and its amplitude's interval is the
+generalised least squares' beside them.
 """
 
 from __future__ import annotations
@@ -32,8 +33,12 @@ from ..errors import ParameterError
 
 __all__ = ["slow_line_test", "MIN_CYCLES", "BLOCKS", "DRAWS"]
 
-#: The fewest cycles in the record a line is tested at.
+#: The fewest cycles in the record a line is found at.
 MIN_CYCLES = 3.0
+#: The scan starts lower, at this many cycles: a maximum below :data:`MIN_CYCLES` is a power that rises toward the
+#: lowest frequencies — a slow wander or a deterministic excursion the null's drifts do not take (a temperature's
+#: coupling over 25 h read as 3.0 cycles), not a line standing out of its neighbours — and finds nothing.
+SCAN_CYCLES = 2.0
 #: Block means the record is read as (their Nyquist, BLOCKS/2 cycles, far above the 18 the test reaches).
 BLOCKS = 128
 #: Draws of the whitened null the scan's maximum is calibrated with.
@@ -169,12 +174,13 @@ def slow_line_test(
     f_min = MIN_CYCLES / length
     if n < 8 * BLOCKS or not f_max > f_min:
         return None
+    f_scan = SCAN_CYCLES / length
     z, t, tb = _block_means(y, fs, BLOCKS)
     x0 = _nuisance(t, length)
     cov, r = _noise_fit(z, x0)
     lw = np.linalg.cholesky(cov)
     x0w_q, _ = np.linalg.qr(solve_triangular(lw, x0, lower=True))
-    freqs = np.arange(f_min, f_max + 1e-12 / length, STEP_CYCLES / length)
+    freqs = np.arange(f_scan, f_max + 1e-12 / length, STEP_CYCLES / length)
     basis = _whitened_basis(lw, t, x0w_q, freqs)
     zw = solve_triangular(lw, z, lower=True)
     zw -= x0w_q @ (x0w_q.T @ zw)
@@ -187,8 +193,10 @@ def slow_line_test(
     proj = zw @ basis
     best = float(freqs[int(np.argmax(proj[0::2] ** 2 + proj[1::2] ** 2))])
     fit = _line_fit(z, t, x0, lw, best, length, tb)
+    below = best < f_min - 1e-9 / length  # the maximum below MIN_CYCLES: power rising toward 0 Hz, no line
     return fit | {
-        "accepted": bool(stats > thr),
+        "accepted": bool(stats > thr) and not below,
+        "below_band": bool(below),
         "statistic": float(stats),
         "threshold": thr,
         "alpha": float(alpha),
@@ -196,6 +204,7 @@ def slow_line_test(
         "cycles": fit["f0"] * length,
         "noise": {"random_walk": float(r[0]), "flicker": float(r[1])},
         "band_hz": (float(f_min), float(f_max)),
+        "scanned_hz": (float(f_scan), float(f_max)),
     }
 
 
