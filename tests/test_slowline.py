@@ -51,3 +51,27 @@ def test_too_short_a_record_is_not_tested_and_bad_alpha_is_named():
         slow_line_test(np.zeros(10_000), 1.0, 1.5)
     with pytest.raises(ParameterError, match="fs"):
         slow_line_test(np.zeros(10_000), -1.0, 0.01)
+
+
+def test_a_line_a_channel_explains_is_the_channels():
+    from types import SimpleNamespace
+
+    from allanite.model.refinement._slow_lines import explained_by_channel
+
+    fs, n = 1.0, 50_000
+    t = np.arange(n) / fs
+    cycle = 0.05 * np.sin(2 * np.pi * 4.2 * t / n)  # a chamber's cycles through the channel's coupling
+    y = _red(n, fs, 5) + cycle
+    found = slow_line_test(y, fs, 1e-3)
+    assert found is not None and found["accepted"]
+    line = {"slow": {"alpha": 1e-3, "band_hz": found["band_hz"]}}
+    other = SimpleNamespace(
+        component=0.01 * np.sign(np.sin(2 * np.pi * 40 * t / n)), evidence={}, params={"channel": "v"}
+    )
+    coupled = SimpleNamespace(component=cycle, evidence={}, params={"channel": "temp"})
+    lagged = SimpleNamespace(component=cycle, evidence={"lag": 1.0}, params={"channel": "temp"})
+    assert explained_by_channel(y, fs, line, [other]) is None
+    assert explained_by_channel(y, fs, line, [lagged]) is None  # through a lag its test did not resolve: no
+    why = explained_by_channel(y, fs, line, [other, coupled])
+    assert why is not None and why["explained_by"] == "temp"
+    assert why["statistic_without_channel"] < found["statistic"]

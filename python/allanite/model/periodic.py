@@ -409,7 +409,7 @@ def _slow_line(test: dict, length: float) -> dict:
         "psd_ratio": test["statistic"],
         "threshold": test["threshold"],
         "bin_hz": 1.0 / length,
-        "slow": {k: test[k] for k in ("statistic", "threshold", "alpha", "p_value", "cycles", "separable")},
+        "slow": {k: test[k] for k in ("statistic", "threshold", "alpha", "p_value", "cycles", "separable", "band_hz")},
     }
 
 

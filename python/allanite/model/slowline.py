@@ -29,6 +29,7 @@ import numpy as np
 from scipy.linalg import cho_factor, cho_solve, solve_triangular
 from scipy.optimize import minimize
 
+from .._blas import one_thread
 from ..errors import ParameterError
 
 __all__ = ["slow_line_test", "MIN_CYCLES", "BLOCKS", "DRAWS"]
@@ -167,7 +168,12 @@ def slow_line_test(
         raise ParameterError(f"alpha must be a probability in (0, 1), got {alpha!r}")
     if not (isinstance(fs, (int, float)) and math.isfinite(fs) and fs > 0.0):
         raise ParameterError(f"fs must be a positive finite sampling rate (Hz), got {fs!r}")
-    y = np.asarray(y, dtype=np.float64)
+    with one_thread():  # small matrices, many products: OpenBLAS's threads cost more than they give (_blas)
+        return _tested(np.asarray(y, dtype=np.float64), float(fs), float(alpha), f_max, seed, calibrate)
+
+
+def _tested(y: np.ndarray, fs: float, alpha: float, f_max: float | None, seed: int, calibrate: bool) -> dict | None:
+    """:func:`slow_line_test` on checked arguments."""
     n = y.size
     length = n / fs
     f_max = 18.0 / length if f_max is None else float(f_max)

@@ -8,10 +8,17 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .. import periodic
+from .. import periodic, slowline
 from ..tracing import DRIFT_BLOCKS
 
-__all__ = ["slow_lines", "lines_component", "lines_in_differences", "lines_less", "slow_line_removal"]
+__all__ = [
+    "slow_lines",
+    "lines_component",
+    "lines_in_differences",
+    "lines_less",
+    "slow_line_removal",
+    "explained_by_channel",
+]
 
 
 def slow_lines(search: dict | None, length_s: float, declined: list) -> list[float]:
@@ -123,3 +130,21 @@ def slow_line_removal(y: np.ndarray, fs: float, line: dict) -> tuple[np.ndarray,
         ),
     }
     return component, refit, params, intervals, evidence
+
+
+def explained_by_channel(y: np.ndarray, fs: float, line: dict, regressions) -> dict | None:
+    """The channel that explains a line of few cycles, or None: a regression on it (of ``regressions``, each
+    accepted by its own test on the samples as they are) after whose removal the line's test no longer finds it —
+    a thermal chamber's cycles of a gyro's temperature are its coupling, not a line (``tests/sensors.py``'s
+    temperature over 25 h, three cycles: without the regression a sinusoid took them and nothing was left to say
+    of the channel). Only through the terms the regression claims: a lag its test did not resolve does not
+    count (as for a drift a channel explains, ``removals._channel_explaining``)."""
+    slow = line["slow"]
+    for rem in regressions:
+        if "lag" in rem.evidence:
+            continue
+        again = slowline.slow_line_test(y - rem.component, fs, slow["alpha"], f_max=slow["band_hz"][1])
+        if again is None or not again["accepted"]:
+            left = None if again is None else float(again["statistic"])
+            return {"explained_by": rem.params["channel"], "statistic_without_channel": left}
+    return None
