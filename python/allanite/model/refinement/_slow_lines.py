@@ -137,12 +137,11 @@ def explained_by_channel(y: np.ndarray, fs: float, line: dict, regressions) -> d
     accepted by its own test on the samples as they are) after whose removal the line's test no longer finds it —
     a thermal chamber's cycles of a gyro's temperature are its coupling, not a line (``tests/sensors.py``'s
     temperature over 25 h, three cycles: without the regression a sinusoid took them and nothing was left to say
-    of the channel). Only through the terms the regression claims: a lag its test did not resolve does not
-    count (as for a drift a channel explains, ``removals._channel_explaining``)."""
+    of the channel). Through whatever terms the regression removes, a lag its test did not resolve too: unlike a
+    warm-up (``removals._channel_explaining``), a line is no shape a lag makes of a channel that does not carry it —
+    the lag only turns its phase."""
     slow = line["slow"]
     for rem in regressions:
-        if "lag" in rem.evidence:
-            continue
         again = slowline.slow_line_test(y - rem.component, fs, slow["alpha"], f_max=slow["band_hz"][1])
         if again is None or not again["accepted"]:
             left = None if again is None else float(again["statistic"])
