@@ -16,6 +16,7 @@ Usage::
 
     python benches/r13slowline.py                 # -> benches/results/r13slowline.{json,md}
     python benches/r13slowline.py --records 10 --seeds 5 --refine 1 --out /tmp/x
+    python benches/r13slowline.py --fa            # the test on refine_false_alarms.py's 613 records -> r13slowline_fa.*
 """
 
 from __future__ import annotations
@@ -181,13 +182,60 @@ def _md(res: dict) -> list[str]:
     return lines
 
 
+def false_alarm_records(out: Path) -> None:
+    """The test on every record of ``benches/refine_false_alarms.py`` (613, its seeds), calibrated (its p-value
+    from its own draws): refine's decisions on those records move only where it accepts (nothing else changed;
+    the Allan-curve test's critical draw at level 0.05 stays the 988th of 1001) -> r13slowline_fa.{json,md}."""
+    import refine_false_alarms as fa
+
+    rows = {}
+    with one_thread():
+        for mix in fa.MIXES:
+            ps = []
+            for k in range(80 if mix != "issue16" else 53):
+                y, fs, _ch = fa.record(mix, 10_000 + 1_000_003 * fa.MIXES.index(mix) + 97 * k)
+                r = slow_line_test(y, fs, ALPHA, calibrate=True)
+                ps.append(None if r is None else [r["p_value"], r["statistic"], r["threshold"], r["accepted"]])
+            rows[mix] = ps
+    (out / "r13slowline_fa.json").write_text(json.dumps(rows))
+    (out / "r13slowline_fa.md").write_text("\n".join(fa_md(rows, os.getloadavg())) + "\n")
+
+
+def fa_md(rows: dict, load) -> list[str]:
+    """The false-alarm records' table: per mixture, accepted (at α) and p-values ≤ 0.01, ≤ 0.05, with CP 95 %."""
+    lines = [
+        "# The slow-line test on refine_false_alarms.py's 613 null records",
+        "",
+        f"α = {ALPHA:g} (level {LEVEL} × 0.008); load average at the end {[round(v, 1) for v in load]} (2 cores).",
+        "",
+        "| mixture | records | accepted | p ≤ 0.01 | p ≤ 0.05 |",
+        "|---|---|---|---|---|",
+    ]
+    tot = [0, 0, 0, 0]
+    for mix, ps in rows.items():
+        got = [p for p in ps if p is not None]
+        c = [sum(1 for p in got if p[3]), sum(1 for p in got if p[0] <= 0.01), sum(1 for p in got if p[0] <= 0.05)]
+        tot = [tot[0] + len(ps), tot[1] + c[0], tot[2] + c[1], tot[3] + c[2]]
+        lines.append(f"| {mix} | {len(ps)} | {c[0]} | {c[1]} | {c[2]} |")
+    cells = []
+    for k in tot[1:]:
+        lo, hi = clopper_pearson(k, tot[0])
+        cells.append(f"**{k}** ({100 * lo:.2f}–{100 * hi:.2f} %)")
+    lines.append(f"| all | {tot[0]} | " + " | ".join(cells) + " |")
+    return lines
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--records", type=int, default=40, help="null records per kind")
     ap.add_argument("--seeds", type=int, default=30, help="seeds per power case and amplitude")
     ap.add_argument("--refine", type=int, default=2, help="seeds per power case through refine")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results"))
+    ap.add_argument("--fa", action="store_true", help="only the test on refine_false_alarms.py's 613 records")
     args = ap.parse_args(argv)
+    if args.fa:
+        false_alarm_records(Path(args.out))
+        return
     res: dict = {"machine": machine_info(), "load_start": [round(v, 1) for v in os.getloadavg()], "alpha": ALPHA}
     with one_thread():
         res["nulls"] = {name: _null(name, args.records) for name in NULLS}
