@@ -139,19 +139,6 @@ def _null_quantile(basis: np.ndarray, alpha: float, seed: int) -> tuple[float, n
     return float(np.quantile(draws, 1.0 - alpha)), draws
 
 
-def _scan(z: np.ndarray, t: np.ndarray, x0: np.ndarray, cov: np.ndarray, freqs: np.ndarray) -> tuple:
-    """The scan under ``cov``: its Cholesky factor, the whitened fixed effects' orthonormal basis, the frequencies'
-    whitened pairs, the whitened block means less the fixed effects, the largest χ² and its frequency."""
-    lw = np.linalg.cholesky(cov)
-    x0w_q, _ = np.linalg.qr(solve_triangular(lw, x0, lower=True))
-    basis = _whitened_basis(lw, t, x0w_q, freqs)
-    zw = solve_triangular(lw, z, lower=True)
-    zw -= x0w_q @ (x0w_q.T @ zw)
-    proj = zw @ basis
-    chi2 = proj[0::2] ** 2 + proj[1::2] ** 2
-    return lw, x0w_q, basis, zw, float(np.max(chi2)), float(freqs[int(np.argmax(chi2))])
-
-
 def _block_means(y: np.ndarray, fs: float, blocks: int) -> tuple[np.ndarray, np.ndarray, float]:
     """``blocks`` block means of ``y`` (the remainder samples at the end left out), their mid-times (s), and the
     block's length (s)."""
@@ -196,19 +183,21 @@ def _tested(y: np.ndarray, fs: float, alpha: float, f_max: float | None, seed: i
     f_scan = SCAN_CYCLES / length
     z, t, tb = _block_means(y, fs, BLOCKS)
     x0 = _nuisance(t, length)
-    freqs = np.arange(f_scan, f_max + 1e-12 / length, STEP_CYCLES / length)
     cov, r = _noise_fit(z, x0)
-    lw, x0w_q, basis, zw, stats, best = _scan(z, t, x0, cov, freqs)
-    # the noise fitted again beside the scan's best sinusoid: under the null fit alone, a line's power at low
-    # frequency is read as random walk and the line's own χ² falls (a daily line of 0.04 under flicker FM: its
-    # amplitude's SD 3× the one beside it) — the scan then runs once more under that covariance
-    cov, r = _noise_fit(z, np.column_stack([x0, _sincos(t, best)]))
-    lw, x0w_q, basis, zw, stats, best = _scan(z, t, x0, cov, freqs)
+    lw = np.linalg.cholesky(cov)
+    x0w_q, _ = np.linalg.qr(solve_triangular(lw, x0, lower=True))
+    freqs = np.arange(f_scan, f_max + 1e-12 / length, STEP_CYCLES / length)
+    basis = _whitened_basis(lw, t, x0w_q, freqs)
+    zw = solve_triangular(lw, z, lower=True)
+    zw -= x0w_q @ (x0w_q.T @ zw)
+    stats = _scan_max(zw[None, :], basis)[0]
     if calibrate or stats > -2.0 * math.log(alpha):
         thr, draws = _null_quantile(basis, alpha, seed)
         p_value: float | None = float((1 + np.count_nonzero(draws >= stats)) / (1 + draws.size))
     else:  # below one frequency's (1 − α) quantile: below the maximum's, no draws needed
         thr, p_value = -2.0 * math.log(alpha), None
+    proj = zw @ basis
+    best = float(freqs[int(np.argmax(proj[0::2] ** 2 + proj[1::2] ** 2))])
     fit = _line_fit(z, t, x0, lw, best, length, tb)
     below = best < f_min - 1e-9 / length  # the maximum below MIN_CYCLES: power rising toward 0 Hz, no line
     return fit | {
