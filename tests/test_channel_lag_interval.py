@@ -1,6 +1,6 @@
 """A coefficient fitted through a lag estimated from the same record carries the lag's error: its interval is the
-inverse Fisher information of (the coefficients, log T) marginalised over the lag
-(``allanite.model._lag_time.cov_beside_lag``). At a cycling channel's one frequency ω the variance at a fixed lag is (1 + (ωT)²)× too small;
+covariance of (the coefficients, log T) marginalised over the lag (``allanite.model._lag_time.cov_beside_lag``; for
+the intervals ``interval_cov_beside_lag``: the same at the restricted noise, tests/test_channel_interval_cov.py). At a cycling channel's one frequency ω the variance at a fixed lag is (1 + (ωT)²)× too small;
 blind5's 600 s lag on a 1667 s cycle (ωT ≈ 2.3) covered the truth on 12 of 40 records with it
 (benches/results/channel_lag_bias.md)."""
 
@@ -54,10 +54,12 @@ def test_a_coefficient_through_a_600_s_lag_has_the_lags_error_in_its_interval():
     assert lo < 2e-4 < hi
 
 
-def test_a_coefficient_without_a_lag_keeps_its_interval():
+def test_a_coefficient_without_a_lag_has_no_lags_error_in_its_interval():
     reported, fixed, r = _half_widths(*_record(2, None))
     assert r.removal_lag_s is None
-    assert math.isclose(reported, fixed, rel_tol=1e-9)
+    # no lag's direction: only the restricted noise and the score's exact variance widen it (1.038× here;
+    # tests/test_channel_interval_cov.py), not the lag's (1 + (ωT)²)^½
+    assert 1.0 < reported / fixed < 1.1
 
 
 def test_a_lags_interval_is_its_profile_in_time_at_the_noise_beside_the_lagged_channel():

@@ -68,3 +68,21 @@ def test_a_bent_linear_coupling_reports_its_turnover_outside_the_range_without_a
     assert r.accepted and r.test["accepted_by"] == "channel" and r.terms["quadratic"]["kept"]
     turn = r.terms["quadratic"]["turnover"]
     assert not turn["inside"] and turn["interval"] is None and abs(turn["value"] + 25.0) < 5.0
+
+
+def test_beside_a_quadratic_the_coefficient_is_the_slope_at_the_whole_records_mean():
+    # the Whittle fit uses the usable prefix (19 683 of 20 000 samples here: 5-smooth differences); the channel
+    # rising 0 → 30 °C once (half a cosine), its mean over that prefix is 0.24 °C below the record's. The slope
+    # b₁ + 2·b₂·(x − m) moves by 2·b₂·δm = 48 % of b₁ there (−49.6 % before r13swing, its interval 0.48–0.53·10⁻³
+    # missing the truth), so the reference must be the record's mean (channels.centring)
+    n, fs, c, q = 20_000, 2.0, 1e-3, 1e-3
+    rng = np.random.default_rng(11)
+    t = np.arange(n) / fs
+    temp = 15.0 * (1.0 - np.cos(np.pi * t / t[-1])) + 0.01 * rng.standard_normal(n)
+    d = temp - temp.mean()
+    y = allanite.simulate(n, fs, N=1e-5, K=1e-8, seed=rng) + c * d + q * (d * d)
+    r = regress_channel(y, temp, fs, name="temp")
+    assert r.accepted and r.terms["quadratic"]["kept"]
+    assert r.terms["quadratic"]["t_ref"] == pytest.approx(temp.mean(), abs=1e-9)
+    assert abs(r.params["quadratic"] / q - 1.0) < 0.01
+    assert abs(r.params["coefficient"] / c - 1.0) < 0.05

@@ -172,6 +172,7 @@ MODEL_RANKS = {
     "model.tracing": 1,
     "model._whittle": 0,
     "model._edge": 0.3,  # the channel tests' exact null variance at the record's edges (on _whittle)
+    "model._gls_cov": 0.6,  # a channel regression's interval covariance: restricted noise, exact score variance
     "model._lag": 0.5,  # a channel's first-order lag: its test and profile (on _whittle)
     "model._shares": 0,
     "model._regressors": 0.7,  # a channel regression's signal bands and regressors (on _whittle, _lag)

@@ -50,11 +50,10 @@ def test_parts_and_indices_are_the_old_ones(n, seed):
                 else:
                     g = rem(yf, old[f])
                     cf = split.curve(yf - g(old[f]))
-                    ch, extra = (
-                        (split.curves[h], split.curves[f].avar - cf.avar)
-                        if on_raw
-                        else (split.curve(yh - g(old[h])), 0.0)
-                    )
+                    # the held-out part's raw curve is the target either way (r13heldout): plus the held-in part's
+                    # change (on_raw) or the held-out part's own change under the held-in fit
+                    ch = split.curves[h]
+                    extra = split.curves[f].avar - cf.avar if on_raw else ch.avar - split.curve(yh - g(old[h])).avar
                 sol = scoring.solve(cf, terms, [])
                 a_h, _ = scoring.design(ch, terms, [])
                 pred = np.maximum(a_h @ sol.theta + extra, 1e-300)

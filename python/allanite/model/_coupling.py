@@ -27,6 +27,7 @@ __all__ = [
     "coupling_test",
     "quadratic_test",
     "optional_terms",
+    "level_test",
     "bootstrap_scale",
 ]
 
@@ -60,20 +61,26 @@ def _new_direction(bands, design, s) -> np.ndarray:
     return v
 
 
-def _nested(bands, design, fit_small, alpha, edge: bool = True) -> tuple[dict, dict]:
+def _nested(bands, design, fit_small, alpha, edge: bool = True, bartlett: float | None = None) -> tuple[dict, dict]:
     """Likelihood-ratio test of the last regressor of ``design`` (both models refitted, noise included; the larger
     one never below the smaller: :func:`allanite.model._whittle.nested_fit`), its reference widened by the
     record's edge factor along the new direction (:func:`allanite.model._edge.edge_factor`, at the smaller
-    model's noise; ``edge`` False: not here — the caller widens it)."""
+    model's noise; ``edge`` False: not here — the caller widens it). The reference is F(1, ν), or with
+    ``bartlett`` χ²₁ times that factor (:func:`level_test`)."""
     big = wh.nested_fit(bands, design, fit_small)
     v = _new_direction(bands, design, big["s"])
     dof = wh.noise_dof(bands, big, wh.band_info(bands, design, v))
     test = _f_test(2.0 * (big["loglik"] - fit_small["loglik"]), dof, alpha)
+    ref = (lambda x: f_dist.sf(x, 1, dof)) if bartlett is None else (lambda x: chi2.sf(x / bartlett, 1))
+    if bartlett is not None:
+        test |= {"threshold": bartlett * float(chi2.isf(alpha, 1)), "bartlett": bartlett}
+        test |= {"reference": "χ²₁ × Bartlett's factor (the coupling's in-phase bootstrap)"}
+        test["p_value"] = float(ref(max(test["statistic"], 0.0)))
     if edge and bands.source is not None:
         widen = _edge_if_passing(test["statistic"], test["threshold"], bands, fit_small, design, v)
         k = widen["factor"]
         test |= {"threshold": test["threshold"] * k, "edge": widen}
-        test["p_value"] = float(f_dist.sf(max(test["statistic"], 0.0) / k, 1, dof))
+        test["p_value"] = float(ref(max(test["statistic"], 0.0) / k))
     return test, big
 
 
@@ -238,9 +245,11 @@ def quadratic_test(bands, fit, alpha) -> tuple[dict, dict]:
     return t_q | {"kept": t_q["statistic"] > t_q["threshold"]}, big
 
 
-def optional_terms(bands, fit, terms, level, grid, z2, quadratic=None):
+def optional_terms(bands, fit, terms, level, grid, z2, quadratic=None, bartlett=None):
     """Quadratic first (``quadratic``: its :func:`quadratic_test` already run), then d(ch)/dt or a lag (never
-    both). Returns (kept keys, fit, lag_s, tests)."""
+    both), then — where a d(ch)/dt term alone was kept — the level term itself (:func:`level_test`).
+    ``bartlett``: the coupling's in-phase Bartlett factor where its reference was the bootstrap, for the level
+    test's. Returns (kept keys, fit, lag_s, tests)."""
     nb = bands.m.size
     keys: list = []
     tests: dict = {}
@@ -269,7 +278,43 @@ def optional_terms(bands, fit, terms, level, grid, z2, quadratic=None):
                 rate_ok, lag_s = False, best
     if rate_ok:
         keys, fit = keys + ["rate_coefficient"], fit_r
+    # only beside a d(ch)/dt term alone: a kept lag is the channel's own coupling (c·L_T[ch]), and beside a kept
+    # quadratic the level term stays (level_test's docstring)
+    if keys == ["rate_coefficient"] and lag_s is None:
+        tests["coefficient"], fit = level_test(bands, keys, fit, TERM_SHARE["coefficient"] * level, bartlett)
     return keys, fit, lag_s, tests
+
+
+def level_test(bands, keys, fit, alpha, bartlett: float | None = None) -> tuple[dict, dict]:
+    """The level term's nested test where a d(ch)/dt term (``keys``) carries part of the coupling: the channel
+    itself beside it against it alone, 2Δℓ against F(1, ν) at ``alpha`` (its :data:`TERM_SHARE` of the level) —
+    or, where the coupling's own reference was the parametric bootstrap (``bartlett``: its in-phase factor,
+    :func:`coupling_test`), against χ²₁ times that factor, as the coupling's in-phase test is —, the reference
+    widened by the record's edge factor where it passes, as every nested test's. Returns (the test with ``kept``,
+    the fit kept: ``fit`` — with the level term — where the test passes, else the model without it, its
+    coefficients in the order of ``keys``).
+
+    Why: the coupling's own test (the channel and its quadrature, any phase) accepts a coupling that reaches the
+    rate only through d(T)/dt — a fibre-optic gyro's Shupe effect, in quadrature with T on every cycle — and the
+    level term was then carried whatever the record said of it, so a d(T)/dt-only coupling was reported with a
+    level coefficient that is not there (blind9's FOG: 1.47·10⁻⁵ °/s per °C beside the 0.0237 rate coefficient,
+    truth 0; 20 of 20 replicas). A term is claimed only by its own test, the level term too once another carries
+    the coupling (docs/channels.md, "The level term").
+
+    Not beside a kept quadratic: (ch − mean)² alone is a parabola about the record's mean, an origin the sensor
+    does not know — the linear part is what places the turnover — and over a channel that swings once the two are
+    collinear: on blind4's cold start (2.5·10⁻⁴ °/s per °C, 5·10⁻⁵ per °C²) the level term failed beside the
+    quadratic, was dropped, and the quadratic alone held out at 1.8·10⁵ %.
+
+    Why the bootstrap's reference where the coupling had it: where ν is small (two daily cycles under flicker and
+    rate random walk, ν ≈ 10) F(1, ν) at 0.1 % is 21 where χ²₁'s is 10.8, while the coupling's bootstrap found the
+    null statistic at χ²'s size (factor 1.0–1.1)."""
+    nb = bands.m.size
+    small = wh.joint_fit(bands, regressor_design(keys, nb, level=False))
+    design = regressor_design(keys, nb, level=False).plus(0, np.ones(nb))
+    test, _big = _nested(bands, design, small, alpha, bartlett=bartlett)
+    kept = test["statistic"] > test["threshold"]
+    return test | {"kept": bool(kept)}, (fit if kept else small)
 
 
 def _lag_or_rate(bands, design, fit_r, tests) -> str:

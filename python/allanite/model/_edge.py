@@ -30,7 +30,7 @@ from scipy.linalg import eigh
 
 from . import _whittle as wh
 
-__all__ = ["EdgeSource", "covariances", "edge_factor"]
+__all__ = ["EdgeSource", "covariances", "score_covariances", "edge_factor"]
 
 
 @dataclass(frozen=True)
@@ -96,16 +96,22 @@ def _padded_spectra(vs: list[np.ndarray], big_m: int) -> list[np.ndarray]:
     return out
 
 
-def covariances(bands: wh.Bands, fit: dict, combos: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+def covariances(
+    bands: wh.Bands, fit: dict, combos: Sequence[np.ndarray], noise: dict | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """(exact, Whittle's) null covariance matrices of the scores u_i = Re Σ_k conj(combos[i]_k)·D_k / S_k, for
     per-bin regressor combinations (each a complex DFT over bins 1 … n_bins, normalised as in
-    :func:`allanite.model._whittle.spectra`) at the noise of ``fit``; equal where the bins are independent."""
+    :func:`allanite.model._whittle.spectra`), S the noise of ``fit``, the record's noise that of ``noise`` (a fit
+    with ``s`` and ``amounts``; default ``fit``'s); equal where the bins are independent and the two agree."""
     n_diff = bands.n_diff
     n_bins = (n_diff - 1) // 2
     w = wh._taper(n_diff)
     norm = math.sqrt(float(w @ w))
-    s_bin = np.asarray(fit["s"], dtype=np.float64)[_band_of(bands, np.arange(1, n_bins + 1, dtype=np.float64))]
-    p = psd_grid(bands, fit)
+    band = _band_of(bands, np.arange(1, n_bins + 1, dtype=np.float64))
+    s_bin = np.asarray(fit["s"], dtype=np.float64)[band]
+    p = psd_grid(bands, fit if noise is None else noise)
+    # Whittle's law per bin: Var u = ½·Σ |z|²/S (½·Σ |z|²·P/S² where the record's noise P is another fit's)
+    s_eff = s_bin if noise is None else s_bin**2 / np.asarray(noise["s"], dtype=np.float64)[band]
     big_m = 2 * n_diff
     weight = np.full(p.size, 2.0)
     weight[0] = weight[-1] = 1.0
@@ -116,8 +122,16 @@ def covariances(bands: wh.Bands, fit: dict, combos: Sequence[np.ndarray]) -> tup
     for i in range(k):
         for j in range(i, k):
             exact[i, j] = exact[j, i] = float(np.sum(weight * (spectra_v[i] * np.conj(spectra_v[j])).real))
-            whittle[i, j] = whittle[j, i] = 0.5 * float(np.sum((np.conj(combos[i]) * combos[j]).real / s_bin))
+            whittle[i, j] = whittle[j, i] = 0.5 * float(np.sum((np.conj(combos[i]) * combos[j]).real / s_eff))
     return exact, whittle
+
+
+def score_covariances(
+    bands: wh.Bands, fit: dict, design: wh.Design, directions: np.ndarray, noise: dict | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`covariances` of the scores along ``directions`` (rows over ``design``'s regressors; ``bands`` must
+    carry an :class:`EdgeSource`)."""
+    return covariances(bands, fit, _combos(bands, design, directions), noise)
 
 
 def _combos(bands: wh.Bands, design: wh.Design, directions: np.ndarray) -> list[np.ndarray]:

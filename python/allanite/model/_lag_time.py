@@ -1,7 +1,10 @@
 """The lag a channel regression uses (:mod:`allanite.model.channels`: kept, or profiled for the removal), worked in
 time: T refined on the band sums of the channel lagged in time (:func:`allanite.model._lag.exact_lag`), the fit at
 that T with its coefficients' covariance marginalised over the lag, and the lag's interval from the profile in time
-at the noise refitted beside the lagged channel (docs/channels.md, "The lag's and the coefficient's intervals").
+at the noise refitted beside the lagged channel (docs/channels.md, "The lag's and the coefficient's intervals") —
+for both intervals that noise restricted, the power the coefficients and the lag's direction took from their bands
+given back, and the coefficients' covariance the sandwich with the score's exact variance
+(:func:`interval_cov_beside_lag`, :mod:`allanite.model._gls_cov`; docs/channels.md, "Intervals that cover").
 
 Why the coefficients' covariance with the lag free: the lag is estimated from the same record, and the coefficient
 is not independent of it. At a cycling channel's one frequency ω the record fixes the coupling's amplitude c·|H|
@@ -19,35 +22,44 @@ last point on most; at the noise refitted beside the lagged channel the profile'
 from __future__ import annotations
 
 import math
-from itertools import chain
+from itertools import chain, islice
 
 import numpy as np
 from scipy.optimize import brentq
 
 from . import _whittle as wh
+from ._edge import EdgeSource
+from ._gls_cov import interval_cov
 from ._lag import exact_lag, lag_grid, lagged
 from ._regressors import regressor_design, regressor_iter, regressors
 
-__all__ = ["lag_in_time", "lag_slope", "cov_beside_lag", "profile_interval"]
+__all__ = ["lag_in_time", "lag_slope", "cov_beside_lag", "interval_cov_beside_lag", "profile_interval"]
 
 
 def lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict, z2: float) -> tuple[float, dict]:
     """The lag the removal takes (kept, or profiled: ``t_lag["profiled"]``) refined in time at the noise ``s`` of
     the fit without it, then the fit at that lag (noise refitted), its coefficients' covariance with the lag free
-    (:func:`cov_beside_lag`) and the lag's interval where the profile in time at that fit's noise is within
-    ``z2`` of its top (:func:`profile_interval`), written back into ``t_lag`` (the grid's T and interval under
-    ``"grid_lag_s"`` and ``"grid_interval"``). Returns (T, the fit)."""
+    (:func:`interval_cov_beside_lag`) and the lag's interval where the profile in time at that covariance's
+    restricted noise is within ``z2`` of its top (:func:`profile_interval`), written back into ``t_lag`` (the grid's
+    T and interval under ``"grid_lag_s"`` and ``"grid_interval"``). Returns (T, the fit)."""
     rec = t_lag if t_lag.get("kept") else t_lag["profiled"]
     grid = lag_grid(y.size, fs)
     bounds = (float(grid[0]), float(grid[-1]))
     best, _ = exact_lag(_objective(y, xs, means, fs, keys, s), float(rec["lag_s"]), rec["interval"], bounds)
-    cols = chain(regressor_iter(xs, means[0], means[1], fs, best), [lag_slope(xs - means[0], best, fs)])
-    exact = wh.spectra(y, cols, fs)
+
+    def cols():
+        return chain(regressor_iter(xs, means[0], means[1], fs, best), [lag_slope(xs - means[0], best, fs)])
+
+    def column(i: int) -> np.ndarray:  # one regressor again, for the score's exact variance (the lag's: 2 filters)
+        return lag_slope(xs - means[0], best, fs) if i == 3 else next(islice(cols(), i, None))
+
+    exact = wh.spectra(y, cols(), fs)
+    exact.source = EdgeSource(column)
     fit = wh.joint_fit(exact, regressor_design(keys, exact.m.size))
-    full = cov_beside_lag(exact, keys, fit["s"])
+    full, noise = interval_cov_beside_lag(exact, keys, fit)
     c = float(fit["c"][0])
     se = math.sqrt(max(float(full[-1, -1]), 0.0)) / abs(c) if c != 0.0 else math.inf
-    interval = profile_interval(_objective(y, xs, means, fs, keys, fit["s"]), best, se, z2, bounds)
+    interval = profile_interval(_objective(y, xs, means, fs, keys, noise["s"]), best, se, z2, bounds)
     rec |= {"grid_lag_s": float(rec["lag_s"]), "grid_interval": tuple(rec["interval"])}
     rec |= {"lag_s": best, "interval": interval, "se_log": se}
     return best, fit | {"cov": full[:-1, :-1]}
@@ -88,6 +100,23 @@ def cov_beside_lag(exact, keys, s) -> np.ndarray:
         full[:k, :k] = np.linalg.inv(info[:k, :k])
         full[k, k] = math.inf
         return full
+
+
+def interval_cov_beside_lag(exact, keys, fit: dict) -> tuple[np.ndarray, dict]:
+    """As :func:`cov_beside_lag`, for the intervals: the sandwich at the restricted noise
+    (:func:`allanite.model._gls_cov.interval_cov` — the lag's direction one more coefficient, its leverage given
+    back to the noise too), and that noise. Where the lag's direction is not separable: the kept coefficients'
+    at the lag held fixed, the lag's variance infinite."""
+    nb = exact.m.size
+    try:
+        return interval_cov(exact, regressor_design(keys, nb).plus(3, np.ones(nb)), fit)
+    except np.linalg.LinAlgError:
+        cov, noise = interval_cov(exact, regressor_design(keys, nb), fit)
+        k = cov.shape[0]
+        full = np.zeros((k + 1, k + 1))
+        full[:k, :k] = cov
+        full[k, k] = math.inf
+        return full, noise
 
 
 def profile_interval(objective, best: float, se: float, z2: float, bounds: tuple, xtol: float = 0.02) -> tuple:

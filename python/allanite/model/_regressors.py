@@ -101,9 +101,11 @@ def regressor_iter(xs: np.ndarray, mean: float, quad_mean: float, fs: float, lag
     yield np.gradient(xs) * fs
 
 
-def regressor_design(keys, nb: int) -> wh.Design:
+def regressor_design(keys, nb: int, level: bool = True) -> wh.Design:
+    """The design of the channel (where ``level``; the level term dropped by its nested test otherwise,
+    :func:`allanite.model._coupling.optional_terms`) and the optional terms among ``keys``, in that order."""
     one = np.ones(nb)
-    d = wh.Design([0], [one])
+    d = wh.Design([0], [one]) if level else wh.Design([], [])
     if "quadratic" in keys:
         d = d.plus(1, one)
     if "rate_coefficient" in keys:

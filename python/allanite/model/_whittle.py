@@ -131,8 +131,9 @@ def _basis(k: np.ndarray, n_diff: int, fs: float) -> tuple[np.ndarray, tuple]:
 
 
 def usable_length(n: int) -> int:
-    """The longest prefix (samples) whose differences have a fast FFT length (5-smooth; ≥ 99.9 % of ``n`` above
-    a few thousand samples): pocketfft on 999 999 points takes 4× as long as on 1 000 000."""
+    """The longest prefix (samples) whose differences have a fast FFT length (5-smooth): pocketfft on 999 999
+    points takes 4× as long as on 1 000 000. What is dropped at the end is up to 2.3 % of ``n`` above 10⁶ samples
+    (3 456 000, 40 Hz × 24 h, keeps 3 375 001), 2.8 % above 10⁵, 6.3 % above 10³ (995 329 of 10⁶ kept)."""
     m = n - 1
     while m > 1 and sfft.next_fast_len(m, real=True) != m:
         m -= 1

@@ -35,7 +35,9 @@ docs/channels.md "Quantised and held channels").
 
 Optional terms, each kept only by its own nested test at its own share of the level:
 
-- ``quadratic`` — on (ch − mean)² (per channel unit²): likelihood ratio, F(1, ν); run also where the coupling's
+- ``quadratic`` — on (ch − mean)² (per channel unit²), the mean the channel's over the whole record
+  (``terms["quadratic"]["t_ref"]``; the linear coefficient is then the slope there, :func:`centring`):
+  likelihood ratio, F(1, ν); run also where the coupling's
   test fails, and where it passes then the coupling is accepted by it (a turnover temperature: a bias on
   (T − T₀)² with T₀ inside the swing has no linear part; T₀ = mean − b₁/(2·b₂) with its interval in
   ``terms["quadratic"]["turnover"]``; docs/channels.md "A turnover temperature");
@@ -53,9 +55,16 @@ Optional terms, each kept only by its own nested test at its own share of the le
   itself is reported as not resolved, under ``terms["lag_s"]["profiled"]``, not as a param) — at lag 0 the
   coupling's phase error stays in the residual (:mod:`allanite.model._lag`).
 
-Intervals: the coefficients ±t_ν quantile × the inverse Fisher information's standard error — where a lag is used,
-with the lag free (the lag is estimated from the same record; :mod:`allanite.model._lag_time`); the lag from its
-profile likelihood in time, at the noise refitted beside the lagged channel.
+- the level term itself (``coefficient``), where a d(ch)/dt term alone is kept: the channel beside it against it
+  alone, at its own :data:`TERM_SHARE` (:func:`allanite.model._coupling.level_test`) — a coupling through d(ch)/dt
+  only (a fibre-optic gyro's Shupe effect) is reported with that term only (docs/channels.md, "The level term").
+
+Intervals: the coefficients ±t_ν quantile × their standard error — the GLS estimator's sandwich under the noise
+refitted with the power the coefficients took from their bands given back (a restricted estimate), the score's
+variance exact at the record's edges (:mod:`allanite.model._gls_cov`: the inverse Fisher information at the
+fitted noise covered 52–57 % at 68 %); where a lag is used, with the lag free (the lag is estimated from the same
+record; :mod:`allanite.model._lag_time`); the lag from its profile likelihood in time, at that restricted noise
+beside the lagged channel (docs/channels.md, "Intervals that cover").
 """
 
 from __future__ import annotations
@@ -72,6 +81,7 @@ from ..errors import InputError, ParameterError
 from . import _whittle as wh
 from ._coupling import LAG_MARGIN, coupling_test, optional_terms, quadratic_test
 from ._edge import EdgeSource
+from ._gls_cov import interval_cov
 from ._lag import lag_grid, lagged, unresolved_lag
 from ._lag_time import lag_in_time
 from ._regressors import (
@@ -101,6 +111,7 @@ __all__ = [
     "LAG_MARGIN",
     "CHANNEL_SNR",
     "channel_signal",
+    "centring",
 ]
 
 #: Optional terms of a channel regression, in the order they are tried.
@@ -205,7 +216,8 @@ class ChannelRegression:
     the test before the quadrature was added), ``accepted_by`` (``"channel"``, or ``"quadratic"``: the
     quadratic's own test, under ``quadratic``, where the channel's failed — a turnover); ``terms``: each optional
     term's test (``statistic``, ``threshold``, ``alpha``, ``dof``, ``kept``, and why not; the quadratic's
-    ``turnover``: T₀, whether inside the channel's range, its interval there); ``accepted``: the coupling passed
+    ``turnover``: T₀, whether inside the channel's range, its interval there; where kept, ``t_ref``: the channel's
+    mean over the record, the value at which ``coefficient`` is the slope); ``accepted``: the coupling passed
     its test or the quadratic's (optional terms are tried only then).
     ``removal_lag_s``: the lag the component runs the channel through — the kept ``lag_s``, or a lag its test
     did not resolve but the profile prefers to none (``terms["lag_s"]["profiled"]``, not a param), or None.
@@ -234,7 +246,7 @@ class ChannelRegression:
         x = reconstructed(np.asarray(ch, dtype=np.float64), self.form)
         xs = band_limited(x, self.fs, self.signal_bands)
         cols = regressors(xs, self.mean, self.quad_mean, self.fs, self.removal_lag_s)
-        keep = [0] + [i for i, k in ((1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
+        keep = [i for i, k in ((0, "coefficient"), (1, "quadratic"), (2, "rate_coefficient")) if k in self.params]
         return np.array([cols[i] for i in keep])
 
     def lag_note(self) -> str | None:
@@ -273,8 +285,10 @@ class ChannelRegression:
         return lambda i: comp[np.asarray(i)]
 
 
-def _params(fit, keys, dofs, confidence, lag):
-    names = ["coefficient"] + [k for k in ("quadratic", "rate_coefficient") if k in keys]
+def _params(fit, keys, dofs, confidence, lag, level: bool = True):
+    """The kept terms' values and intervals (t quantile at each term's ν): the level term ``coefficient`` where
+    ``level`` (its nested test kept it, or none was run), then the optional terms of ``keys``, then the lag."""
+    names = ["coefficient"] * level + [k for k in ("quadratic", "rate_coefficient") if k in keys]
     params, intervals = {}, {}
     for i, k in enumerate(names):
         c, se = float(fit["c"][i]), math.sqrt(max(float(fit["cov"][i, i]), 0.0))
@@ -346,15 +360,22 @@ def regress_channel(
     keys, lag_s, tests, removal_lag = [], None, {}, None
     if accepted:
         z2 = float(t_dist.isf((1.0 - confidence) / 2.0, in_phase["dof"])) ** 2
-        keys, fit, lag_s, tests = optional_terms(bands, fit, terms, level, lag_grid(y.size, fs), z2, quad)
-        removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, lag_grid(y.size, fs), z2)
+        boot = test["in_phase"].get("bartlett") if "bartlett" in test else None  # the coupling's bootstrap factor
+        grid = lag_grid(y.size, fs)
+        keys, fit, lag_s, tests = optional_terms(bands, fit, terms, level, grid, z2, quad, boot)
+        removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, grid, z2)
         if removal_lag is not None:
             removal_lag, fit = lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"], z2)
+    level_kept = tests.get("coefficient", {}).get("kept", True)  # False where the level term's own test dropped it
+    if removal_lag is None:
+        fit = fit | {"cov": interval_cov(bands, regressor_design(keys, bands.m.size, level_kept), fit)[0]}
     lag = (removal_lag, tests["lag_s"]["interval"]) if lag_s is not None else None
     dofs = {"coefficient": in_phase["dof"]} | {k: tests[k]["dof"] for k in keys}
-    params, intervals = _params(fit, keys, dofs, confidence, lag)
-    if "quadratic" in keys:
-        tests["quadratic"]["turnover"] = _turnover(fit, mean, (float(xs.min()), float(xs.max())), dofs, confidence)
+    params, intervals = _params(fit, keys, dofs, confidence, lag, level_kept)
+    if "quadratic" in keys:  # the turnover and the slope's reference in the channel's own frame (centring())
+        t_ref = centring(x, xs, form)[0]
+        span = (float(xs.min()) + t_ref - mean, float(xs.max()) + t_ref - mean)
+        tests["quadratic"] |= {"t_ref": t_ref, "turnover": _turnover(fit, t_ref, span, dofs, confidence)}
     # the noise amounts are not read as IEEE-952 terms: over the parametric bands' few octaves K, B and the GM shapes
     # trade against each other (their sum is what is used); the terms before/after come from the Allan fits
     noise = {"channel_noise": math.sqrt(floor), "whittle_loglik_gain": float(fit["loglik"] - null["loglik"])}
@@ -365,17 +386,36 @@ def regress_channel(
 
 def channel_bands(y: np.ndarray, x: np.ndarray, fs: float) -> tuple:
     """The record and channel as :func:`regress_channel` tests them: both cut to the usable length, the channel's
-    form detected and read back, its signal bands, the band-limited channel ``xs`` with its mean and mean square
-    about it, and the Whittle band sums of ``y`` with the three regressors. Returns (y, form, floor, sig, xs, mean,
-    quad_mean, bands)."""
+    form detected and read back, its signal bands, the band-limited channel ``xs`` with its centring (the whole
+    record's mean in ``xs``'s frame, :func:`centring`) and mean square about it, and the Whittle band sums of
+    ``y`` with the three regressors. Returns (y, form, floor, sig, xs, mean, quad_mean, bands)."""
     n_use = wh.usable_length(y.size)
-    y, x = y[:n_use], x[:n_use]
-    form, floor, sig, xs = read_channel(x, fs)
-    mean = float(xs.mean())
+    form, floor, sig, xs = read_channel(x[:n_use], fs)
+    mean = centring(x, xs, form)[1]
+    y = y[:n_use]
     quad_mean = float(np.mean((xs - mean) ** 2))
     bands = wh.spectra(y, regressor_iter(xs, mean, quad_mean, fs, None), fs)
     bands.source = EdgeSource(lambda i: next(islice(regressor_iter(xs, mean, quad_mean, fs, None), i, None)))
     return y, form, floor, sig, xs, mean, quad_mean, bands
+
+
+def centring(x: np.ndarray, xs: np.ndarray, form: ChannelForm) -> tuple[float, float]:
+    """Where the linear coefficient is the slope when a quadratic is kept: ``t_ref``, the channel's mean over the
+    whole record as read back (``x`` all of it; :func:`allanite.model._staircase.reconstructed`), and that value
+    in the frame of ``xs`` (the band-limited channel over the usable prefix, :func:`channel_bands`), which the
+    regressors are centred on. Returns (t_ref, the centring in ``xs``'s frame).
+
+    Why not ``xs``'s own mean (before r13swing): that is the mean over the usable prefix only
+    (:func:`allanite.model._whittle.usable_length` drops up to 2.3 % at the end above 10⁶ samples: 4671 of 10⁶), and
+    b₁·(x − m) + b₂·(x − m)² has the slope b₁ at x = m, so the reported coefficient was the slope at a value the
+    user never asked for, 2·b₂·δm away: on a temperature going once 10 → 40 → 10 °C over 4·10⁶ samples (blind10's
+    float32 gyro) the dropped end near 10 °C put m 0.07 °C above the record's mean, +4 % of the linear coefficient
+    (docs/channels.md, "The linear coefficient beside a quadratic"). ``xs`` is offset from the channel by what its
+    band limit took (0.14 °C on blind4's cold start), hence the frame. Without a lag, the columns' span — and so
+    every test and the removed component — does not depend on m (d(x − m)² = dx² − 2m·dx)."""
+    xr = reconstructed(x, form)
+    t_ref = float(np.mean(xr))
+    return t_ref, t_ref + float(np.mean(xs)) - float(np.mean(xr[: xs.size]))
 
 
 def _first_test(bands, fit, test: dict, a_quad: float, terms) -> tuple[bool, tuple | None]:
@@ -492,12 +532,13 @@ def heldout_ratio(y, ch, fs: float, reg: ChannelRegression) -> float:
 def _two_ways(sides: list, keys: list) -> tuple[float, float]:
     """(mean of the two ways' held-out ratios, the poorer side's share of the channel's information) of a split
     into two sides' band sums (:func:`heldout_ratio`)."""
-    coefs = [wh.joint_fit(b, regressor_design(keys, b.m.size))["c"] for b in sides]
+    level = "coefficient" in keys  # the level term, where its nested test dropped it, is not refitted either
+    coefs = [wh.joint_fit(b, regressor_design(keys, b.m.size, level))["c"] for b in sides]
     noise = [wh.joint_fit(b, wh.Design([], []))["s"] for b in sides]
     info = [float(np.sum(b.G[:, 0, 0].real / s)) for b, s in zip(sides, noise, strict=True)]
     ratios = []
     for held, s, c_other in ((sides[0], noise[0], coefs[1]), (sides[1], noise[1], coefs[0])):
-        d = regressor_design(keys, held.m.size)
+        d = regressor_design(keys, held.m.size, level)
         use = _informative(held.G[:, 0, 0].real / s)
         ratios.append(float(np.sum(wh.residual_power(held, d, c_other)[use] / s[use]) / np.sum(held.q[use] / s[use])))
     total = sum(info)

@@ -233,7 +233,13 @@ EFFECTS: dict[str, Effect] = {
             "time",
             (
                 ("channel", "", "name of the other channel (as passed in channels=)"),
-                ("coefficient", "rate unit per channel unit", "sensitivity: g-sensitivity, temperature, coupling"),
+                (
+                    "coefficient",
+                    "rate unit per channel unit",
+                    "sensitivity: g-sensitivity, temperature, coupling; beside a quadratic, the slope at the channel's "
+                    "mean over the record (evidence['terms']['quadratic']['t_ref']); on a slow channel absent where a "
+                    "d(channel)/dt term carries the coupling and the level term's own test drops it",
+                ),
                 ("quadratic", "rate unit per channel unit²", "on (channel − mean)², slow channels, when kept"),
                 ("rate_coefficient", "rate unit per (channel unit/s)", "on d(channel)/dt, slow channels, when kept"),
                 ("lag_s", "s", "the rate follows the channel through a first-order lag, slow channels, when kept"),

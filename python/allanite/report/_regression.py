@@ -87,6 +87,8 @@ def _optional_words(terms: dict) -> str:
         if isinstance(stat, (int, float)) and isinstance(thr, (int, float)):
             sign = "≥" if stat >= thr else "<"
         why = f"; {t['why']}" if isinstance(t.get("why"), str) and name in ("lag_s", "rate_coefficient") else ""
+        if kept and name == "quadratic" and isinstance(t.get("t_ref"), (int, float)):  # channels.centring
+            why = f"; the coefficient is the slope at the channel's mean {g(t['t_ref'], 4)}"
         parts.append(
             f"{name} {'kept' if kept else 'not kept'} (statistic {g(stat, 3)} {sign} threshold {g(thr, 3)}{why})"
         )

@@ -10,6 +10,7 @@ import numpy as np
 
 from .. import tracing
 from ._family_fold import fold_wandering
+from ._line_gain import gain_component
 from ._run import RunState
 from .candidates import Round, final_params
 from .changes import change_point_step, change_points
@@ -17,7 +18,7 @@ from .curvefit import base_name, noise_fit, solve
 from .missing import MissingContext, unexplained
 from .removals import Removal
 from .result import Refinement, Step, term_moves
-from .scoring import segments_heldout
+from .scoring import heldout_split, segments_heldout
 
 __all__ = ["FinalModel"]
 
@@ -54,7 +55,7 @@ class FinalModel(RunState):
         """Steps of the change points the held-out error per segment confirms (:func:`.changes.change_point_step`:
         on the record's curve its before and after are the model so far, the same numbers by construction; what
         found it, a chain of its own, in its evidence)."""
-        y = self.y
+        y = self.after_curve()
         if y is None or "change_point" not in candidates:
             return []
         cps = change_points(y, self.fs, self.start)
@@ -62,7 +63,9 @@ class FinalModel(RunState):
         if cps and self.heldout is not None:
             m_all = np.asarray(self.result.m, dtype=np.int64)
             times = [c["t"] for c in cps]
-            chain = segments_heldout(self.heldout, y, self.fs, m_all, self.lo, self.hi, self.start, self.effects, times)
+            whole = self.heldout if y is self.y else heldout_split(y, self.fs, m_all, self.lo, self.hi, self.start)
+            if whole is not None:
+                chain = segments_heldout(whole, y, self.fs, m_all, self.lo, self.hi, self.start, self.effects, times)
         if chain is not None and not chain[-1] < chain[0]:
             for c in cps:
                 why = f"held-out error {chain[0]:.3g} → {chain[-1]:.3g} %"
@@ -77,13 +80,32 @@ class FinalModel(RunState):
             steps.append(st)
         return steps
 
+    def after_curve(self) -> np.ndarray | None:
+        """The samples the steps after the curve effects see (the change points, the checks of ``unexplained``):
+        the samples the removals left, less the part of each accepted line's term that its gain on a channel
+        models, g·(x̃(t) − x̄)·Re(A·e^{2πif0t}) (:func:`._line_gain.gain_component`). The line itself stays in
+        the samples, as every line the ``"sinusoid"`` curve candidate holds does (held on the curve at its power
+        in the spectrum, which holds the sidebands the gain puts within the line's width); its modulation would
+        otherwise read as the noise level changing along the record (``tests/test_line_gain.py``'s 2 Hz line
+        ±20 % with a temperature cycling 1.5 times: two change points at 215 and 436 s of 600). The record's
+        own samples as they were when no accepted line has a gain."""
+        y = self.y
+        if y is None:
+            return None
+        for ln in self.lines:
+            if ln is not None and ln.get("gain"):
+                g = ln["gain"]
+                y = y - gain_component(y.size, self.fs, float(ln["f0"]), g, self.channels[g["channel"]])
+        return y
+
     def unexplained(self, chans, cp_steps=()) -> list:
         """What the final model still misses, every domain's check at its own share of ``level`` (the noise
         level's between the change points ``cp_steps``)."""
         exact = self.y is not None or (isinstance(self.est, str) and self.est == "oavar")
         thin = tracing.thin_indices(self.curve.tau)
+        y = self.after_curve()
         ctx = MissingContext(
-            self.curve, thin, self.sol, self.start, self.effects, self.y, self.fs, self.level, exact, chans, self.unit
+            self.curve, thin, self.sol, self.start, self.effects, y, self.fs, self.level, exact, chans, self.unit
         )
         ctx.change_times = [st.params["t"] for st in cp_steps]
         ctx.heldout_pct = self.state[0].get("heldout_rms_adev_pct")
@@ -92,7 +114,6 @@ class FinalModel(RunState):
             ctx.segments_heldout_pct = per_segment[-1]
         ctx.samples = self.y0
         ctx.considered, ctx.offered_lines = self.considered, self.offered_lines
-        ctx.line_gains = {float(ln["f0"]): ln["gain"] for ln in self.lines if ln is not None and ln.get("gain")}
         ctx.replaced = _replaced([rem for _st, rem, *_rest in self.removed], self.y0.size if self.y0 is not None else 0)
         ctx.families = [
             (st.params["fundamentals"], st.evidence["frequencies_hz"], st.evidence["amplitudes"], rem.component)

@@ -31,7 +31,6 @@ import numpy as np
 
 from ._line_channel import follows_channel
 from ._line_constancy import MAX_BLOCKS, MIN_PERIODS, block_phasors, line_constancy
-from ._line_gain import gain_component
 from .curvefit import base_name
 from .words import heldout_clause, span_text
 
@@ -107,10 +106,8 @@ def line_check(ctx: Any, a: float) -> list[dict]:
     tested = tested_lines(ctx)
     out: list[dict] = []
     for f0, fam, held in tested:
-        y, gain = ctx.y, getattr(ctx, "line_gains", {}).get(f0) if fam is None else None
-        if gain:  # the line's term follows a channel: what is tested is the line less the part its gain models
-            y = y - gain_component(y.size, ctx.fs, f0, gain)
-        r = line_constancy(y, ctx.fs, f0, a / len(tested), phasors=True)
+        # a line whose term follows a channel is tested less the part its gain models: ``ctx.y`` is without it
+        r = line_constancy(ctx.y, ctx.fs, f0, a / len(tested), phasors=True)
         if r is None or not r["rejected"]:
             continue
         edges = np.asarray(r["edges_s"])

@@ -55,9 +55,6 @@ class MissingContext:
     #: a line it names was not kept
     considered: dict = field(default_factory=dict)
     offered_lines: list | None = None
-    #: the accepted lines whose amplitude follows a channel, by f0 (Hz): their gain (:mod:`._line_gain`), whose
-    #: component the ``"line"`` check leaves out of the final samples
-    line_gains: dict = field(default_factory=dict)
 
 
 def chi2_dof(ctx: MissingContext, lo: float, hi: float) -> float:

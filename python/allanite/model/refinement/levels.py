@@ -108,10 +108,13 @@ SHARES = {
 #: ``"periodic"`` removal spends the ``"lines"`` share).
 TIME_SHARES = {"outliers": OUTLIER_SHARE, "drift": TIME_SHARE, "regression": TIME_SHARE}
 #: Tests run only once another has accepted its effect — a slow channel's optional terms (quadratic,
-#: d(channel)/dt, lag; :data:`allanite.model.channels.TERM_SHARE`), each at this share of ``level``. On a clean
-#: record they never run unless the regression itself is a false alarm, so they take nothing from the
+#: d(channel)/dt, lag; :data:`allanite.model.channels.TERM_SHARE`), each at this share of ``level``. On a
+#: clean record they never run unless the regression itself is a false alarm, so they take nothing from the
 #: per-record budget; on a record with a linear coupling each is the rate of naming a term that is not there
-#: (0 of 600 each, benches/results/channel_regression.md). The quadratic is also tried where the coupling's own
+#: (0 of 600 each, benches/results/channel_regression.md). The level term itself (``"regression:coefficient"``)
+#: is tested where a d(channel)/dt term alone is kept beside it, at the whole level: its share is the rate of
+#: keeping a level term that is not there (benches/results/r13rate.md; docs/channels.md, "The level term").
+#: The quadratic is also tried where the coupling's own
 #: test fails (a turnover temperature has no linear part); there it is part of the coupling's decision and spends
 #: part of the regression's :data:`TIME_SHARE` (:data:`allanite.model._shares.FIRST_QUADRATIC` of it, the channel
 #: and its quadrature the rest), not a share beside it (docs/channels.md, "A turnover temperature").

@@ -86,8 +86,10 @@ class Removal:
     n_fitted : int
         Numbers fitted (for the degrees of freedom of χ²/dof after the removal).
     on_raw : bool
-        Held out: predict the other part's *raw* curve (a component the two parts share, e.g. a multi-position
-        profile's steps, would otherwise change the scale the relative error is taken on).
+        Held out, the other part's *raw* curve is predicted either way; ``on_raw`` adds back the change the
+        held-in part's correction made to its own curve (a component the two parts share, e.g. a multi-position
+        profile's steps), else the change the held-in fit makes to the held-out part's curve (a slow channel, a
+        warm-up: :meth:`.scoring.Split.corrected`).
     heldout_in_time : float, optional
         A held-out test in time that decides instead of the held-out Allan curve (accepted when < 1): for a
         white-like component, which changes the curve's level, not how well one part predicts the other's.

@@ -42,7 +42,8 @@ class Step:
     and is tracked, ``wander_hz``, ``wander_pct``, ``wander_half_span_hz``; outliers ``rate`` (share of the
     samples), ``threshold`` rate unit; drift ``amplitude`` rate unit, ``T`` s; regression ``channel``,
     ``coefficient`` rate unit per channel unit and, where their tests keep them, ``quadratic``,
-    ``rate_coefficient``, ``lag_s``; change point ``t`` s);
+    ``rate_coefficient``, ``lag_s`` — beside a ``rate_coefficient`` alone ``coefficient`` only where its test
+    keeps it; change point ``t`` s);
     ``intervals`` the numeric keys → (low, high); ``final_params``/``final_intervals`` the same after the final
     joint refit (a curve effect's amplitude refitted beside every other effect — a bandwidth's cutoff searched
     again beside them —, its nonlinear parameter's interval profiled again; what was measured in the time
@@ -53,7 +54,9 @@ class Step:
     original record's Allan curve — each step's ``before`` is the previous step's ``after`` (the steps in the
     chain's order: curve effects, then the removals in time, which were searched first, then change points);
     ``evidence``: where in τ, f or t the residual was and the test that accepted it (``heldout_test``: the held-out
-    comparison that accepted it, where that is not the chain's; a change point — whose before and after on the
+    comparison on the samples as they were, where that is not the chain's — for a removal in time, the five terms
+    alone without → with it, the other part's raw curve predicted both times (the removal is decided by its own
+    test in time, ``heldout_variance_ratio``); a change point — whose before and after on the
     record's curve are the same numbers: a change of noise level leaves the curve's model as it is — has its
     statistic on the windows' levels in ``window_levels``, without → with it, every other change point in both,
     and held out per segment in ``heldout_test``, without → with it, the earlier change points in both);
