@@ -155,6 +155,7 @@ MODEL_RANKS = {
     "model.lines": 0,
     "model.outliers": 0,
     "model.noise_level": 0,
+    "model.slowline": 0.5,  # a line of few cycles tested in time under red noise (numpy, scipy only)
     "model.periodic": 1,
     "model.template": 0,
     "model.wander": 0,  # a line family's wandering fundamental tracked (numpy, scipy only)

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import f as f_dist
 
-from . import linefit, lines
+from . import linefit, lines, slowline
 from ._recent import Recent
 
 __all__ = ["LineFamily", "periodic_search", "sinusoid_lines"]
@@ -341,12 +341,15 @@ def _fit_family(y, fs, fam, found_lines, passes, alpha, taken_f) -> LineFamily:
     )
 
 
-def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
-    """Lines of ``y`` at false-alarm probability ``alpha`` per record, as families and isolated sinusoids.
+def periodic_search(y: np.ndarray, fs: float, alpha: float, slow_alpha: float | None = None) -> dict:
+    """Lines of ``y`` at false-alarm probability ``alpha`` per record, as families and isolated sinusoids; with
+    ``slow_alpha``, a line of few cycles below the search's lowest bin too, tested in time at that false-alarm
+    probability (:func:`allanite.model.slowline.slow_line_test`).
 
     Returns ``families`` (:class:`LineFamily`, two or more lines each, strongest (RMS) first), ``sinusoids`` (one-line
     :class:`LineFamily` each, strongest first), ``lines``, ``bins`` and ``p_value`` of the search
-    (:func:`allanite.model.lines.find_lines`)."""
+    (:func:`allanite.model.lines.find_lines`), ``slow`` (the line of few cycles found, as :func:`sinusoid_lines`
+    gives a line, or none) and ``slow_test`` (that test's result; None where it did not run)."""
     y = np.asarray(y, dtype=np.float64)
     found = lines.find_lines(y, fs, alpha)
     found_lines, passes = found["lines"], found["passes"]
@@ -363,12 +366,50 @@ def periodic_search(y: np.ndarray, fs: float, alpha: float) -> dict:
         fit = _fit_family(y, fs, one, [d], passes, alpha, taken_f)
         (fams if fit.coefs.shape[0] > 1 else sins).append(fit)
     fams.sort(key=lambda fm: -fm.rms)
+    slow_test = _slow_search(y, fs, slow_alpha, passes, taken_f) if slow_alpha is not None else None
     return {
         "families": fams,
         "sinusoids": sins,
         "lines": found_lines,
         "bins": found["bins"],
         "p_value": found["p_value"],
+        "slow": [_slow_line(slow_test, y.size / fs)] if slow_test is not None and slow_test["accepted"] else [],
+        "slow_test": slow_test,
+    }
+
+
+def _slow_search(y: np.ndarray, fs: float, alpha: float, passes: list[dict], taken_f: np.ndarray) -> dict | None:
+    """The line of few cycles below the line search's lowest searched bin (:func:`allanite.model.slowline.
+    slow_line_test`); not accepted where a line the search found lies within two cycles of it (the same line)."""
+    searched = [ps["f"][np.flatnonzero(np.isfinite(ps["noise"]))[0]] for ps in passes if np.isfinite(ps["noise"]).any()]
+    f_max = float(min(searched)) if searched else None
+    test = slowline.slow_line_test(y, fs, alpha, f_max=f_max)
+    if test is not None and test["accepted"] and taken_f.size:
+        if np.min(np.abs(taken_f - test["f0"])) <= 2.0 * fs / y.size:
+            test["accepted"] = False
+            test["rejected"] = "a line the spectrum's search found"
+    return test
+
+
+def _slow_line(test: dict, length: float) -> dict:
+    """A line of few cycles as :func:`sinusoid_lines` gives a line: its amplitude (least squares in time, all
+    its power: a line of few cycles has no width to wander in) with ±1σ intervals, its test's statistic and
+    threshold in place of the spectrum's ratio, and the test itself (``slow``)."""
+    amp, sd, f0, f_sd = test["amplitude"], test["amplitude_sd"], test["f0"], test["f0_sd"]
+    interval = (max(0.0, amp - sd), amp + sd)
+    return {
+        "f0": f0,
+        "amplitude": amp,
+        "phase": test["phase"],
+        "f0_interval": (f0 - f_sd, f0 + f_sd),
+        "amplitude_interval": interval,
+        "power_amplitude": amp,
+        "width_hz": (max(0.0, f0 - 1.0 / length), f0 + 1.0 / length),
+        "power_amplitude_interval": interval,
+        "psd_ratio": test["statistic"],
+        "threshold": test["threshold"],
+        "bin_hz": 1.0 / length,
+        "slow": {k: test[k] for k in ("statistic", "threshold", "alpha", "p_value", "cycles", "separable", "band_hz")},
     }
 
 
@@ -414,5 +455,6 @@ def sinusoid_lines(search: dict, families=False) -> list[dict]:
                     "bin_hz": float(near["bin_hz"]),
                 }
             )
+    out += [dict(d) for d in search.get("slow", ())]  # a line of few cycles, tested in time (:func:`_slow_search`)
     out.sort(key=lambda d: -d["psd_ratio"])
     return out

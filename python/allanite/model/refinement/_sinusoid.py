@@ -83,6 +83,8 @@ def sin_evidence(pr: Proposal, rnd: Round) -> dict:
         return {}
     ln = pr.line  # the part of the line whose phase carries across the whole record (least squares at f0)
     out = {"coherent_amplitude": ln["amplitude"], "coherent_amplitude_interval": ln["amplitude_interval"]}
+    if ln.get("slow"):  # a line of few cycles, found by its test in time (:mod:`allanite.model.slowline`)
+        out["slow_line"] = ln["slow"]
     g = ln.get("gain")
     if g:  # its nested option kept: the amplitude follows a channel (._line_gain)
         out["gain_test"] = {k: g[k] for k in ("statistic", "threshold", "alpha", "heldout_ratio", "mean")}

@@ -4,12 +4,21 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
-from .. import periodic
+from .. import periodic, slowline
 from ..tracing import DRIFT_BLOCKS
 
-__all__ = ["slow_lines", "lines_component", "lines_in_differences", "lines_less"]
+__all__ = [
+    "slow_lines",
+    "lines_component",
+    "lines_in_differences",
+    "lines_less",
+    "slow_line_removal",
+    "explained_by_channel",
+]
 
 
 def slow_lines(search: dict | None, length_s: float, declined: list) -> list[float]:
@@ -83,3 +92,58 @@ def lines_less(y: np.ndarray, fs: float, freqs: list[float], chunk: int = 1 << 2
     for a in range(0, n, chunk):
         out[a : a + chunk] -= cols(a, min(n, a + chunk))[:, 2:] @ coef[2:]
     return out
+
+
+def slow_line_removal(y: np.ndarray, fs: float, line: dict) -> tuple[np.ndarray, Callable, dict, dict, dict]:
+    """A line of few cycles (a :func:`allanite.model.periodic.sinusoid_lines` entry with ``"slow"``: found by its
+    test in time, :func:`allanite.model.slowline.slow_line_test`) as a removal in time: its component (the test's
+    generalised least-squares sinusoid, beside a constant, a ramp and settling drifts), its refit on held-in samples
+    (least squares at f0 with a constant and a ramp), and the step's params, intervals and evidence. Such a line is
+    removed from the samples rather than held on the Allan curve: its signature peaks near τ = 0.37/f0, beyond
+    the τ the curve's held-out halves reach (a daily line in 4.6 days: the held-out error 3.33 → 3.46 % held,
+    ``benches/refine_blind10.py``'s tiltmeter), while its phase, a few cycles, predicts the held-out blocks."""
+    f0, amp, phase = float(line["f0"]), float(line["amplitude"]), float(line["phase"])
+    component = amp * np.sin(2 * np.pi * f0 * np.arange(y.size) / fs + phase)
+    length = y.size / fs
+
+    def refit(samples: np.ndarray, idx: np.ndarray) -> Callable:
+        t = np.asarray(idx, dtype=np.float64) / fs
+        x = np.column_stack([np.ones_like(t), t / length, np.sin(2 * np.pi * f0 * t), np.cos(2 * np.pi * f0 * t)])
+        coef = np.linalg.lstsq(x, np.asarray(samples, dtype=np.float64), rcond=None)[0]
+
+        def at(i: np.ndarray) -> np.ndarray:
+            ti = np.asarray(i, dtype=np.float64) / fs
+            return coef[2] * np.sin(2 * np.pi * f0 * ti) + coef[3] * np.cos(2 * np.pi * f0 * ti)
+
+        return at
+
+    slow = line["slow"]
+    params = {"amplitude": amp, "f0": f0, "phase": phase}
+    intervals = {"amplitude": tuple(line["amplitude_interval"]), "f0": tuple(line["f0_interval"])}
+    evidence = {
+        "domain": "time",
+        "test": {"chi2": slow["statistic"], "threshold": slow["threshold"], "alpha": slow["alpha"]},
+        "slow_line": slow,
+        "note": (
+            f"{slow['cycles']:.1f} cycles in the record; {100 * slow['separable']:.0f} % of the line's whitened signal "
+            "lies outside what a constant, a ramp and settling drifts can take — the rest of it could be a drift"
+        ),
+    }
+    return component, refit, params, intervals, evidence
+
+
+def explained_by_channel(y: np.ndarray, fs: float, line: dict, regressions) -> dict | None:
+    """The channel that explains a line of few cycles, or None: a regression on it (of ``regressions``, each
+    accepted by its own test on the samples as they are) after whose removal the line's test no longer finds it —
+    a thermal chamber's cycles of a gyro's temperature are its coupling, not a line (``tests/sensors.py``'s
+    temperature over 25 h, three cycles: without the regression a sinusoid took them and nothing was left to say
+    of the channel). Through whatever terms the regression removes, a lag its test did not resolve too: unlike a
+    warm-up (``removals._channel_explaining``), a line is no shape a lag makes of a channel that does not carry it —
+    the lag only turns its phase."""
+    slow = line["slow"]
+    for rem in regressions:
+        again = slowline.slow_line_test(y - rem.component, fs, slow["alpha"], f_max=slow["band_hz"][1])
+        if again is None or not again["accepted"]:
+            left = None if again is None else float(again["statistic"])
+            return {"explained_by": rem.params["channel"], "statistic_without_channel": left}
+    return None

@@ -13,6 +13,7 @@ from .._shares import LINE_GAIN_SHARE, TERM_SHARE, WANDER_SHARE
 __all__ = [
     "LEVEL",
     "LINE_SHARE",
+    "SLOW_LINE_SHARE",
     "CHANGE_POINT_SHARE",
     "TIME_SHARE",
     "OUTLIER_SHARE",
@@ -32,6 +33,11 @@ LEVEL = 0.05
 #: only after a line was found, so under the null they spend nothing more). Measured over 640 null records:
 #: benches/results/periodic_outliers_null.md.
 LINE_SHARE = 0.2
+#: Share of ``level`` spent on a line of few cycles (3 to 18 in the record), below the spectral search's lowest bin:
+#: its test in time under the block means' fitted white, random-walk and flicker noise
+#: (:func:`allanite.model.slowline.slow_line_test`). 0.008 is what the Allan-curve test's rest can give without moving
+#: its bootstrap critical value (the 988th of 1001 draws at level 0.05); its null: benches/results/r13slowline.md.
+SLOW_LINE_SHARE = 0.008
 #: Share of ``level`` spent on change points of the noise level along the record.
 CHANGE_POINT_SHARE = 0.2
 #: Share of ``level`` for each time-domain test (regression on channels, drift).
@@ -94,6 +100,7 @@ SAMPLE_CHECKS = (
 #: Tests with a share of their own, by name (the Allan-curve test, ``"curve"``, takes the rest).
 SHARES = {
     "lines": LINE_SHARE,
+    "slow_lines": SLOW_LINE_SHARE,
     "change_point": CHANGE_POINT_SHARE,
     **{f"unexplained:{k}": v for k, v in UNEXPLAINED_SHARES.items()},
 }

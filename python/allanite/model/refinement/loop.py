@@ -183,7 +183,9 @@ class _Run(TimeRemovals, FinalModel):
             # one line search for both line effects (one share of level): the periodic removal's, or now
             search = self.line_search
             if search is None:
-                search = periodic.periodic_search(y, self.fs, alpha("lines", self.level))
+                search = periodic.periodic_search(
+                    y, self.fs, alpha("lines", self.level), alpha("slow_lines", self.level)
+                )
             # every line a family removal did not take: all of them without the periodic candidate, else the
             # lines of the families it turned down (their phase does not carry across the record's parts, their
             # power is still on the curve)
@@ -192,8 +194,12 @@ class _Run(TimeRemovals, FinalModel):
                 # a family removed in time takes the part of its lines whose phase carries across the record;
                 # what power they keep (a wandering phase) is searched again on the samples the removals left,
                 # every line there offered (conditional on a family found: no share of level under the null)
-                search, fams = periodic.periodic_search(y, self.fs, alpha("lines", self.level)), True
+                # (a line of few cycles, tested once in time, is carried over: the family took none of it)
+                again = periodic.periodic_search(y, self.fs, alpha("lines", self.level))
+                search, fams = again | {"slow": search.get("slow", []), "slow_test": search.get("slow_test")}, True
             lines = periodic.sinusoid_lines(search, families=fams)
+            if any(rem.effect == "sinusoid" for _st, rem, *_rest in self.removed):  # a line of few cycles, removed
+                lines = [ln for ln in lines if not ln.get("slow")]
             self.offered_lines = [float(ln["f0"]) for ln in lines]
         fork = self.fork()
         self.curve_loop(candidates, thin, exact, lines)

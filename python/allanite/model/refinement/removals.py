@@ -52,6 +52,7 @@ from scipy.stats import t as t_dist
 from ...analysis import avar
 from .. import channels, linefit, outliers, periodic, template, tracing, wander, warmup
 from ._channel_order import strongest_first
+from ._slow_lines import explained_by_channel, slow_line_removal
 from ._tracking import heldout_variance_ratio
 from ._tracking import tracked as _tracked
 from .calibrated import tested
@@ -438,7 +439,7 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
     are left to the ``"sinusoid"`` curve candidate, and so are a turned-down family's (``family``) — but a lone line
     whose frequency wanders, removed along its tracked phase (:func:`_lone_tracked`)."""
     a = alpha("lines", ctx.level)
-    search = periodic.periodic_search(ctx.y, ctx.fs, a)
+    search = periodic.periodic_search(ctx.y, ctx.fs, a, alpha("slow_lines", ctx.level))
     ctx.lines = search
     searched = ctx.y
     for fam in search["families"]:
@@ -480,6 +481,18 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
         rem = _lone_tracked(ctx, sin if ctx.y is searched else _refit_family(sin, ctx.y), a, search)
         if rem is not None:
             yield rem
+    for ln in list(search["slow"]):  # a line of few cycles, below the spectrum's reach: its test was in time
+        quiet = dataclasses.replace(ctx, consider=lambda _effect, _entry: None)
+        why = explained_by_channel(ctx.y, ctx.fs, ln, _regression(quiet)) if ctx.channels else None
+        if why is not None:  # a channel's, as a drift a channel explains: no line (``unexplained`` says the channel)
+            search["slow"].remove(ln)
+            ctx.consider("sinusoid", {"f0": ln["f0"], "amplitude": ln["amplitude"], "rejected": "a channel's"} | why)
+            continue
+        component, refit, params, intervals, evidence = slow_line_removal(ctx.y, ctx.fs, ln)
+        ratio = heldout_variance_ratio(ctx.y, refit)
+        yield Removal(
+            "sinusoid", component, refit, params, intervals, evidence, 3, heldout_in_time=ratio, on_curve=True
+        )
 
 
 def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, search: dict) -> Removal | None:

@@ -1,0 +1,77 @@
+"""A line of few cycles tested in time under red noise (:mod:`allanite.model.slowline`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import allanite
+from allanite.errors import ParameterError
+from allanite.model.slowline import slow_line_test
+
+
+def _red(n: int, fs: float, seed: int) -> np.ndarray:
+    """White noise and a rate random walk (no line)."""
+    return allanite.simulate(n, fs, N=0.02, K=2e-4, seed=seed)
+
+
+def test_a_line_of_five_cycles_is_found_with_its_frequency_and_amplitude():
+    fs, n = 1.0, 50_000
+    t = np.arange(n) / fs
+    f0, amp = 5.3 * fs / n, 0.05
+    y = _red(n, fs, 3) + amp * np.sin(2 * np.pi * f0 * t + 1.1) + 0.2 * np.exp(-t / 3000.0)
+    r = slow_line_test(y, fs, 1e-3)
+    assert r is not None and r["accepted"]
+    assert r["statistic"] > r["threshold"]
+    assert abs(r["f0"] - f0) < 3 * r["f0_sd"]
+    assert abs(r["amplitude"] - amp) < 3 * r["amplitude_sd"]
+    assert 0.0 < r["separable"] <= 1.0
+    assert math.isclose(r["cycles"], r["f0"] * n / fs)
+
+
+def test_red_noise_alone_and_a_settling_drift_are_no_line():
+    fs, n = 1.0, 50_000
+    t = np.arange(n) / fs
+    y = _red(n, fs, 4) + 0.5 * np.exp(-t / 4000.0)  # a drift 100× the noise's σ, no line
+    r = slow_line_test(y, fs, 1e-3, calibrate=True)
+    assert r is not None and not r["accepted"]
+    assert r["p_value"] > 1e-3
+    assert r["threshold"] > -2.0 * math.log(1e-3)  # the scan's maximum is above one frequency's quantile
+    quick = slow_line_test(y, fs, 1e-3)  # below that bound: no draws, the bound said as the threshold
+    assert quick is not None and not quick["accepted"] and quick["statistic"] == r["statistic"]
+    if quick["statistic"] <= -2.0 * math.log(1e-3):
+        assert quick["p_value"] is None and quick["threshold"] == pytest.approx(-2.0 * math.log(1e-3))
+
+
+def test_too_short_a_record_is_not_tested_and_bad_alpha_is_named():
+    assert slow_line_test(np.zeros(1000), 1.0, 0.01) is None
+    with pytest.raises(ParameterError, match="alpha"):
+        slow_line_test(np.zeros(10_000), 1.0, 1.5)
+    with pytest.raises(ParameterError, match="fs"):
+        slow_line_test(np.zeros(10_000), -1.0, 0.01)
+
+
+def test_a_line_a_channel_explains_is_the_channels():
+    from types import SimpleNamespace
+
+    from allanite.model.refinement._slow_lines import explained_by_channel
+
+    fs, n = 1.0, 50_000
+    t = np.arange(n) / fs
+    cycle = 0.05 * np.sin(2 * np.pi * 4.2 * t / n)  # a chamber's cycles through the channel's coupling
+    y = _red(n, fs, 5) + cycle
+    found = slow_line_test(y, fs, 1e-3)
+    assert found is not None and found["accepted"]
+    line = {"slow": {"alpha": 1e-3, "band_hz": found["band_hz"]}}
+    other = SimpleNamespace(
+        component=0.01 * np.sign(np.sin(2 * np.pi * 40 * t / n)), evidence={}, params={"channel": "v"}
+    )
+    coupled = SimpleNamespace(component=cycle, evidence={}, params={"channel": "temp"})
+    lagged = SimpleNamespace(component=cycle, evidence={"lag": 1.0}, params={"channel": "temp"})
+    assert explained_by_channel(y, fs, line, [other]) is None
+    assert explained_by_channel(y, fs, line, [lagged])["explained_by"] == "temp"  # a lag only turns its phase
+    why = explained_by_channel(y, fs, line, [other, coupled])
+    assert why is not None and why["explained_by"] == "temp"
+    assert why["statistic_without_channel"] < found["statistic"]
