@@ -368,7 +368,8 @@ def regress_channel(
             removal_lag, fit = lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"], z2)
     level_kept = tests.get("coefficient", {}).get("kept", True)  # False where the level term's own test dropped it
     if removal_lag is None:
-        fit = fit | {"cov": interval_cov(bands, regressor_design(keys, bands.m.size, level_kept), fit)[0]}
+        design = regressor_design(keys, bands.m.size, level_kept)
+        fit = fit | {"cov": interval_cov(bands, design, fit, exact=accepted)[0]}
     lag = (removal_lag, tests["lag_s"]["interval"]) if lag_s is not None else None
     dofs = {"coefficient": in_phase["dof"]} | {k: tests[k]["dof"] for k in keys}
     params, intervals = _params(fit, keys, dofs, confidence, lag, level_kept)
