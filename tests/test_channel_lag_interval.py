@@ -1,6 +1,6 @@
 """A coefficient fitted through a lag estimated from the same record carries the lag's error: its interval is the
-covariance of (the coefficients, log T) marginalised over the lag (``allanite.model._lag_time.cov_beside_lag``; for
-the intervals ``interval_cov_beside_lag``: the same at the restricted noise, tests/test_channel_interval_cov.py). At a cycling channel's one frequency ω the variance at a fixed lag is (1 + (ωT)²)× too small;
+covariance of (the coefficients, log T) marginalised over the lag (``allanite.model._lag_time.interval_cov_beside_lag``:
+the sandwich at the restricted noise, tests/test_channel_interval_cov.py). At a cycling channel's one frequency ω the variance at a fixed lag is (1 + (ωT)²)× too small;
 blind5's 600 s lag on a 1667 s cycle (ωT ≈ 2.3) covered the truth on 12 of 40 records with it
 (benches/results/channel_lag_bias.md)."""
 
@@ -80,13 +80,15 @@ def test_a_lags_interval_is_its_profile_in_time_at_the_noise_beside_the_lagged_c
 def test_a_lag_direction_not_separable_from_the_coefficient_keeps_the_fixed_lag_covariance():
     # the lag's column a copy of the channel's: the information is singular — the coefficient's covariance is
     # then the one at the lag held fixed, and the lag's variance infinite (its interval: the profile's, stepped)
-    from allanite.model._lag_time import cov_beside_lag
+    from allanite.model._gls_cov import interval_cov
+    from allanite.model._lag_time import interval_cov_beside_lag
 
     rng = np.random.default_rng(3)
     x = np.sin(2 * np.pi * np.arange(4096) / 1024.0)
     y = 0.3 * x + 0.1 * rng.standard_normal(x.size)
     bands = wh.spectra(y, [x, x**2, np.gradient(x), x], 1.0)
-    s = wh.joint_fit(bands, wh.Design([0], [np.ones(bands.m.size)]))["s"]
-    full = cov_beside_lag(bands, [], s)
-    fixed = np.linalg.inv(2.0 * wh.Design([0], [np.ones(bands.m.size)]).gram(bands, 1.0 / s)[0])
+    level = wh.Design([0], [np.ones(bands.m.size)])
+    fit = wh.joint_fit(bands, level)
+    full, _noise = interval_cov_beside_lag(bands, [], fit)
+    fixed = interval_cov(bands, level, fit)[0]
     assert math.isinf(full[1, 1]) and math.isclose(full[0, 0], fixed[0, 0], rel_tol=1e-12)

@@ -33,7 +33,7 @@ from ._gls_cov import interval_cov
 from ._lag import exact_lag, lag_grid, lagged
 from ._regressors import regressor_design, regressor_iter, regressors
 
-__all__ = ["lag_in_time", "lag_slope", "cov_beside_lag", "interval_cov_beside_lag", "profile_interval"]
+__all__ = ["lag_in_time", "lag_slope", "interval_cov_beside_lag", "profile_interval"]
 
 
 def lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict, z2: float) -> tuple[float, dict]:
@@ -84,29 +84,14 @@ def lag_slope(xm: np.ndarray, lag_s: float, fs: float, h: float = 0.01) -> np.nd
     return (lagged(xm, lag_s * math.exp(h), fs) - lagged(xm, lag_s * math.exp(-h), fs)) / (2.0 * h)
 
 
-def cov_beside_lag(exact, keys, s) -> np.ndarray:
-    """The inverse Fisher information at the noise ``s`` of the kept coefficients and the lag's direction
-    (:func:`lag_slope`, the band sums' column after the three regressors; its coefficient is c·δlog T): the
-    coefficients' block is their covariance with the lag free (module docstring), the last diagonal element
-    c²·var(log T). Where the lag's direction is not separable from the coefficients' (a singular information),
-    the coefficients' covariance at the lag held fixed and an infinite variance for the lag."""
-    d = regressor_design(keys, exact.m.size).plus(3, np.ones(exact.m.size))
-    info = 2.0 * d.gram(exact, 1.0 / s)[0]
-    try:
-        return np.linalg.inv(info)
-    except np.linalg.LinAlgError:
-        k = info.shape[0] - 1
-        full = np.zeros_like(info)
-        full[:k, :k] = np.linalg.inv(info[:k, :k])
-        full[k, k] = math.inf
-        return full
-
-
 def interval_cov_beside_lag(exact, keys, fit: dict) -> tuple[np.ndarray, dict]:
-    """As :func:`cov_beside_lag`, for the intervals: the sandwich at the restricted noise
-    (:func:`allanite.model._gls_cov.interval_cov` — the lag's direction one more coefficient, its leverage given
-    back to the noise too), and that noise. Where the lag's direction is not separable: the kept coefficients'
-    at the lag held fixed, the lag's variance infinite."""
+    """The covariance of the kept coefficients and the lag's direction (:func:`lag_slope`, the band sums' column
+    after the three regressors; its coefficient is c·δlog T) — the sandwich at the restricted noise
+    (:func:`allanite.model._gls_cov.interval_cov`, the lag's direction one more coefficient, its leverage given
+    back to the noise too) — and that noise: the coefficients' block is their covariance with the lag free (module
+    docstring), the last diagonal element c²·var(log T). Where the lag's direction is not separable from the
+    coefficients' (a singular information): the coefficients' covariance at the lag held fixed, the lag's variance
+    infinite."""
     nb = exact.m.size
     try:
         return interval_cov(exact, regressor_design(keys, nb).plus(3, np.ones(nb)), fit)
