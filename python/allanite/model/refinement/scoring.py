@@ -150,7 +150,7 @@ class _PartIndex:
 
     def __getitem__(self, parity: int) -> np.ndarray:
         # each block's first index plus 0 … per − 1: the blocks' ranges joined, in one broadcast sum
-        first = np.arange(parity, self.n_blocks, 2, dtype=np.int64) * self.per
+        first = np.asarray(self.blocks(parity), dtype=np.int64) * self.per
         return (first[:, None] + np.arange(self.per, dtype=np.int64)).ravel()[: self.size]
 
 
