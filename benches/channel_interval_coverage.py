@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import t as t_dist
 
+import _coverage_summary
 import channel_lag_bias as clb
 import channel_swing_interval as csi
 import refine_blind as rb
@@ -131,28 +132,9 @@ def _params(case: str) -> list:
 
 
 def summary(rows: list) -> dict:
-    out: dict = {}
-    for case in dict.fromkeys(r["case"] for r in rows):
-        rs = [r for r in rows if r["case"] == case]
-        s: dict = {"records": len(rs), "accepted": sum(r["accepted"] for r in rs)}
-        for k in _params(case):
-            have = [r[k] for r in rs if k in r]
-            if not have:
-                continue
-            err = np.array([h["error"] for h in have])
-            c68 = sum(h["covered"] for h in have)
-            s[k] = {
-                "n": len(have),
-                "sd_error": float(err.std(ddof=1)) if err.size > 1 else float("nan"),
-                "coverage": (c68, len(have), *clb._cp(c68, len(have))),
-                "median_half_width": float(np.median([h["width"] for h in have])),
-            }
-            if "covered95" in have[0]:
-                c95 = sum(h["covered95"] for h in have)
-                s[k]["coverage95"] = (c95, len(have), *clb._cp(c95, len(have)))
-        s["cpu_s"] = float(np.median([r["cpu_s"] for r in rs]))
-        out[case] = s
-    return out
+    """Per case: records, acceptances, and per parameter the error's s.d., the 68 % interval's median half-width
+    and the 68 % and 95 % intervals' coverage (:func:`_coverage_summary.summary`)."""
+    return _coverage_summary.summary(rows, _params)
 
 
 def _cov(c) -> str:

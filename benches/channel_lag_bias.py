@@ -24,14 +24,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import beta
 
+import _coverage_summary
 import refine_blind as rb
 from allanite.model.channels import regress_channel
 
@@ -161,43 +160,10 @@ def _blocks(a: np.ndarray, k: int) -> np.ndarray:
     return a[: m * k].reshape(m, k).mean(axis=1)
 
 
-def _median_ci(x: np.ndarray) -> tuple[float, float, float]:
-    """Median and its 95 % order-statistic interval (binomial ranks)."""
-    x = np.sort(x)
-    n = x.size
-    k = int(max(0, math.floor(n / 2 - 0.98 * math.sqrt(n))))
-    return float(np.median(x)), float(x[k]), float(x[min(n - 1, n - 1 - k)])
-
-
-def _cp(k: int, n: int) -> tuple[float, float]:
-    lo = 0.0 if k == 0 else float(beta.ppf(0.025, k, n - k + 1))
-    hi = 1.0 if k == n else float(beta.ppf(0.975, k + 1, n - k))
-    return lo, hi
-
-
 def summary(rows: list) -> dict:
-    out = {}
-    for case in dict.fromkeys(r["case"] for r in rows):
-        rs = [r for r in rows if r["case"] == case]
-        s: dict = {"records": len(rs), "accepted": sum(r["accepted"] for r in rs)}
-        s["kept"] = {k: sum(k in r["kept"] for r in rs) for k in ("quadratic", "rate_coefficient", "lag_s")}
-        for k in _params(case):
-            have = [r[k] for r in rs if k in r]
-            if not have:
-                continue
-            err = np.array([h["error"] for h in have])
-            cov = sum(h["covered"] for h in have)
-            s[k] = {
-                "n": len(have),
-                "median_error": _median_ci(err),
-                "mean_error": float(err.mean()),
-                "sd_error": float(err.std(ddof=1)) if err.size > 1 else float("nan"),
-                "coverage": (cov, len(have), *_cp(cov, len(have))),
-                "median_half_width": float(np.median([h["width"] for h in have])),
-            }
-        s["cpu_s"] = float(np.median([r["cpu_s"] for r in rs]))
-        out[case] = s
-    return out
+    """Per case: records, acceptances, the optional terms kept, and per parameter the error's median (95 % CI),
+    mean and s.d., the 68 % interval's coverage and median half-width (:func:`_coverage_summary.summary`)."""
+    return _coverage_summary.summary(rows, _params, kept=("quadratic", "rate_coefficient", "lag_s"), centre=True)
 
 
 def table(summ: dict) -> str:

@@ -29,7 +29,7 @@ def _channel(kind: str, seed: int) -> np.ndarray:
 def test_the_scores_exact_variance_matches_simulated_records(kind):
     x = _channel(kind, 1)
     y = allanite.simulate(N, FS, N=1e-3, seed=2)
-    y, _, _, _, xs, mean, _, bands = channel_bands(y, x, FS)
+    y, _, _, _, xs, _, mean, _, bands = channel_bands(y, x, FS)
     null = wh.joint_fit(bands, wh.Design([], []))
     n_bins = (bands.n_diff - 1) // 2
     w = wh._taper(bands.n_diff)

@@ -29,7 +29,7 @@ def _bands(seed: int, kind: str = "cycle", k: float = 1e-5):
     rng = np.random.default_rng(seed)
     temp = temperature_profile(np.arange(N) / FS, kind, rng, lo=10.0, hi=30.0)
     noise = allanite.simulate(N, FS, N=1e-3, K=k, seed=seed + 1000)
-    y, _, _, _, _, _, _, bands = channel_bands(noise + 1e-4 * temp, temp, FS)
+    y, *_, bands = channel_bands(noise + 1e-4 * temp, temp, FS)
     return bands, noise[: y.size], regressor_design([], bands.m.size)
 
 

@@ -96,6 +96,14 @@ def _padded_spectra(vs: list[np.ndarray], big_m: int) -> list[np.ndarray]:
     return out
 
 
+def _bin_grid(bands: wh.Bands) -> tuple[int, np.ndarray, float, np.ndarray]:
+    """The DFT grid the scores are read on, as :func:`allanite.model._whittle.spectra` made it: (bins 1 … n_bins of
+    the differenced record, its taper w, ‖w‖, each bin's band)."""
+    n_bins = (bands.n_diff - 1) // 2
+    w = wh._taper(bands.n_diff)
+    return n_bins, w, math.sqrt(float(w @ w)), _band_of(bands, np.arange(1, n_bins + 1, dtype=np.float64))
+
+
 def covariances(
     bands: wh.Bands, fit: dict, combos: Sequence[np.ndarray], noise: dict | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -104,10 +112,7 @@ def covariances(
     :func:`allanite.model._whittle.spectra`), S the noise of ``fit``, the record's noise that of ``noise`` (a fit
     with ``s`` and ``amounts``; default ``fit``'s); equal where the bins are independent and the two agree."""
     n_diff = bands.n_diff
-    n_bins = (n_diff - 1) // 2
-    w = wh._taper(n_diff)
-    norm = math.sqrt(float(w @ w))
-    band = _band_of(bands, np.arange(1, n_bins + 1, dtype=np.float64))
+    _, w, norm, band = _bin_grid(bands)
     s_bin = np.asarray(fit["s"], dtype=np.float64)[band]
     p = psd_grid(bands, fit if noise is None else noise)
     # Whittle's law per bin: Var u = ½·Σ |z|²/S (½·Σ |z|²·P/S² where the record's noise P is another fit's)
@@ -138,11 +143,7 @@ def _combos(bands: wh.Bands, design: wh.Design, directions: np.ndarray) -> list[
     """Per-bin DFTs of the combinations ``directions`` (rows: coefficients over ``design``'s regressors)."""
     source = bands.source
     assert isinstance(source, EdgeSource)
-    n_diff = bands.n_diff
-    n_bins = (n_diff - 1) // 2
-    w = wh._taper(n_diff)
-    norm = math.sqrt(float(w @ w))
-    band = _band_of(bands, np.arange(1, n_bins + 1, dtype=np.float64))
+    n_bins, w, norm, band = _bin_grid(bands)
     z = {i: wh._dft(np.asarray(source.column(i), dtype=np.float64), w, n_bins) / norm for i in set(design.src)}
     out = []
     for v in np.atleast_2d(directions):

@@ -351,7 +351,7 @@ def regress_channel(
     alpha, level = check_probability(alpha, "alpha"), check_probability(level, "level")
     confidence = check_probability(confidence)
     terms = _check_subterms(terms)
-    y, form, floor, sig, xs, mean, quad_mean, bands = channel_bands(y, x, fs)
+    y, form, floor, sig, xs, t_ref, mean, quad_mean, bands = channel_bands(y, x, fs)
     null = wh.joint_fit(bands, wh.Design([], []))
     # where the quadratic is tried beside it, the coupling's α is shared: the pair gets 1 − FIRST_QUADRATIC of it
     a_quad = FIRST_QUADRATIC * alpha if "quadratic" in terms else 0.0
@@ -374,7 +374,6 @@ def regress_channel(
     dofs = {"coefficient": in_phase["dof"]} | {k: tests[k]["dof"] for k in keys}
     params, intervals = _params(fit, keys, dofs, confidence, lag, level_kept)
     if "quadratic" in keys:  # the turnover and the slope's reference in the channel's own frame (centring())
-        t_ref = centring(x, xs, form)[0]
         span = (float(xs.min()) + t_ref - mean, float(xs.max()) + t_ref - mean)
         tests["quadratic"] |= {"t_ref": t_ref, "turnover": _turnover(fit, t_ref, span, dofs, confidence)}
     # the noise amounts are not read as IEEE-952 terms: over the parametric bands' few octaves K, B and the GM shapes
@@ -387,17 +386,18 @@ def regress_channel(
 
 def channel_bands(y: np.ndarray, x: np.ndarray, fs: float) -> tuple:
     """The record and channel as :func:`regress_channel` tests them: both cut to the usable length, the channel's
-    form detected and read back, its signal bands, the band-limited channel ``xs`` with its centring (the whole
-    record's mean in ``xs``'s frame, :func:`centring`) and mean square about it, and the Whittle band sums of
-    ``y`` with the three regressors. Returns (y, form, floor, sig, xs, mean, quad_mean, bands)."""
+    form detected and read back, its signal bands, the band-limited channel ``xs`` with the channel's mean over
+    the whole record ``t_ref`` and its centring (that mean in ``xs``'s frame, :func:`centring`: the channel read
+    back whole once, here, for both) and mean square about it, and the Whittle band sums of ``y`` with the three
+    regressors. Returns (y, form, floor, sig, xs, t_ref, mean, quad_mean, bands)."""
     n_use = wh.usable_length(y.size)
     form, floor, sig, xs = read_channel(x[:n_use], fs)
-    mean = centring(x, xs, form)[1]
+    t_ref, mean = centring(x, xs, form)
     y = y[:n_use]
     quad_mean = float(np.mean((xs - mean) ** 2))
     bands = wh.spectra(y, regressor_iter(xs, mean, quad_mean, fs, None), fs)
     bands.source = EdgeSource(lambda i: next(islice(regressor_iter(xs, mean, quad_mean, fs, None), i, None)))
-    return y, form, floor, sig, xs, mean, quad_mean, bands
+    return y, form, floor, sig, xs, t_ref, mean, quad_mean, bands
 
 
 def centring(x: np.ndarray, xs: np.ndarray, form: ChannelForm) -> tuple[float, float]:

@@ -163,12 +163,7 @@ def build_report(
     notes = list(notes)
     check_choice(gaps, "gaps", ("error", "skip"))
     x, plan = _record_and_plan(x, fs, frames, forecast)
-    candidates = refine_candidates(refine)
-    channels = check_channels(channels, candidates, np.shape(x)[0])
-    if channels and candidates is None:  # channels imply refine=True: the regression is their only use
-        candidates = refine_candidates(True)
-        notes.append("No refinement was asked for: the channels imply it (its regression is their only use).")
-    channels = rate_aligned(channels, input)
+    candidates, channels = _refine_asked(refine, channels, np.shape(x)[0], input, notes)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")
     accel_unit = accelerometer_unit(unit, input, notes)
     # an accelerometer's unit is no gyro's: none for the gyro's conversions, and its own note (not "unknown")
@@ -190,23 +185,13 @@ def build_report(
         progress.add(2)
     if candidates is not None or plan is not None or taper or split:  # and the rest while more is computed
         _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete=True)
-    refinements = refinement_section(
-        x, fs, input, unit_name, static, axis_names, (candidates, channels), notes, settings, progress
-    )
-    frame_fits, forecasts, forecast_settings, forecast_error = forecast_section(
-        x, fs, plan, unit_name, input, confidence, notes, progress
-    )
-    paper002 = paper002_section(x, fs, input, dynamic, unit_name, axis_names, taper, split, notes, progress)
+    asked = (candidates, channels, plan, confidence, taper, split)
+    sections = _later_sections((x, fs, input), static, dynamic, unit_name, axis_names, asked, notes, settings, progress)
     created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
     if own_bar:
         progress.close()
     return Report(
-        frames=frame_fits,
-        forecasts=forecasts,
-        forecast_settings=forecast_settings,
-        forecast_error=forecast_error,
-        paper002=paper002,
-        refinements=refinements,
+        **sections,
         static=static,
         dynamic=dynamic,
         fits=fits,
@@ -224,6 +209,42 @@ def build_report(
         series_error=series_error,
         created=created,
     )
+
+
+def _refine_asked(refine, channels, n_samples: int, input: str, notes: list) -> tuple:
+    """(candidate effects or None, channels) of the refinement: the channels checked against the candidates and
+    the record's length and aligned with its rates (:func:`._channels.rate_aligned`); channels without a
+    refinement asked imply ``refine=True``, said in ``notes``."""
+    candidates = refine_candidates(refine)
+    channels = check_channels(channels, candidates, n_samples)
+    if channels and candidates is None:  # channels imply refine=True: the regression is their only use
+        candidates = refine_candidates(True)
+        notes.append("No refinement was asked for: the channels imply it (its regression is their only use).")
+    return candidates, rate_aligned(channels, input)
+
+
+def _later_sections(record, static, dynamic, unit_name, axis_names, asked, notes, settings, progress) -> dict:
+    """The report's optional sections, as :class:`.result.Report`'s fields, in the order they are computed
+    (each None where not asked for): every axis's refinement, the time-frame forecast, paper 002's.
+    ``record``: (samples, fs, input); ``asked``: (candidates, channels, forecast plan, confidence, taper,
+    split)."""
+    x, fs, input = record
+    candidates, channels, plan, confidence, taper, split = asked
+    refinements = refinement_section(
+        x, fs, input, unit_name, static, axis_names, (candidates, channels), notes, settings, progress
+    )
+    frames, forecasts, forecast_settings, forecast_error = forecast_section(
+        x, fs, plan, unit_name, input, confidence, notes, progress
+    )
+    paper002 = paper002_section(x, fs, input, dynamic, unit_name, axis_names, taper, split, notes, progress)
+    return {
+        "refinements": refinements,
+        "frames": frames,
+        "forecasts": forecasts,
+        "forecast_settings": forecast_settings,
+        "forecast_error": forecast_error,
+        "paper002": paper002,
+    }
 
 
 def _record_and_plan(x, fs, frames, forecast):

@@ -51,11 +51,10 @@ class FinalModel(RunState):
         fams = [st for st, rem, *_rest in self.removed if rem.effect == "periodic"]
         fold_wandering(self.steps, self.lines, fams, self.truth_error)  # a family's own lines found again: one effect
 
-    def change_point_steps(self, candidates) -> list:
+    def change_point_steps(self, candidates, y: np.ndarray | None) -> list:
         """Steps of the change points the held-out error per segment confirms (:func:`.changes.change_point_step`:
         on the record's curve its before and after are the model so far, the same numbers by construction; what
-        found it, a chain of its own, in its evidence)."""
-        y = self.after_curve()
+        found it, a chain of its own, in its evidence), searched on ``y``, :meth:`after_curve`."""
         if y is None or "change_point" not in candidates:
             return []
         cps = change_points(y, self.fs, self.start)
@@ -88,7 +87,8 @@ class FinalModel(RunState):
         in the spectrum, which holds the sidebands the gain puts within the line's width); its modulation would
         otherwise read as the noise level changing along the record (``tests/test_line_gain.py``'s 2 Hz line
         ±20 % with a temperature cycling 1.5 times: two change points at 215 and 436 s of 600). The record's
-        own samples as they were when no accepted line has a gain."""
+        own samples as they were when no accepted line has a gain. An O(n) pass per line with a gain: the caller
+        computes it once for both (:func:`.loop.refine`)."""
         y = self.y
         if y is None:
             return None
@@ -98,12 +98,11 @@ class FinalModel(RunState):
                 y = y - gain_component(y.size, self.fs, float(ln["f0"]), g, self.channels[g["channel"]])
         return y
 
-    def unexplained(self, chans, cp_steps=()) -> list:
-        """What the final model still misses, every domain's check at its own share of ``level`` (the noise
-        level's between the change points ``cp_steps``)."""
+    def unexplained(self, chans, y: np.ndarray | None, cp_steps=()) -> list:
+        """What the final model still misses on ``y`` (:meth:`after_curve`), every domain's check at its own share
+        of ``level`` (the noise level's between the change points ``cp_steps``)."""
         exact = self.y is not None or (isinstance(self.est, str) and self.est == "oavar")
         thin = tracing.thin_indices(self.curve.tau)
-        y = self.after_curve()
         ctx = MissingContext(
             self.curve, thin, self.sol, self.start, self.effects, y, self.fs, self.level, exact, chans, self.unit
         )

@@ -147,8 +147,9 @@ def refine(
             run.remove_in_time(candidates, chans)
             run.channels = chans or {}
             run.add_curve_effects(candidates)
-            cp_steps = run.change_point_steps(candidates)
-            out = run.refinement(cp_steps, unit, confidence, run.unexplained(chans, cp_steps))
+            after = run.after_curve()  # the samples both see: a line's gain taken out once
+            cp_steps = run.change_point_steps(candidates, after)
+            out = run.refinement(cp_steps, unit, confidence, run.unexplained(chans, after, cp_steps))
         out.filled = filled
         out.counter = counter
         return out
