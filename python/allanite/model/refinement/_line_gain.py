@@ -138,8 +138,9 @@ def modulated_held(n: int, fs: float, f0: float, gain: dict, x: np.ndarray, tau:
     variance and its coherent share: the exact overlapping Allan variance of the component reconstructed from
     the fit, Re(A·e^{2πif0t})·(1 + g·(x̃(t) − x̄)) (:func:`gain_component`'s x̃), projected on that column by
     least squares — the modelled line's own Allan variance, in place of its power in the spectrum, which with a
-    gain also took noise beside the line (``temp200`` of ``benches/r13gain.py``, seed 1: the power 1.0 % above
-    the simulated line's Allan variance, the reconstructed component's 0.2 % below it). The modulation is slow
+    gain also took noise beside the line (``temp200`` of ``benches/r13gain.py``, seed 1: the power 1.7 % above
+    the simulated line's Allan variance plus its cross term with the noise, the rebuilt component 0.2 % below
+    that sum — 0.8 % below the line alone, the cross term coming with A). The modulation is slow
     against 1/f0, so the component's curve is the column's shape to within 10⁻⁴ there. Variance to first order:
     ``amp_sd`` (|A|'s SD) and the gain's ±1 SD, θ ≈ |A|²·(1 + g²·v). Coherent share |A|²/θ: the modulation's
     sidebands are held like a line's incoherent part (:func:`.calibrated.curve_test`)."""
