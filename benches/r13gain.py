@@ -187,6 +187,62 @@ NOTES = [
 ]
 
 
+#: r14modline's section (a line with its gain held on the curve at its modelled component's exact Allan
+#: variance, ``refinement._line_gain.modulated_held``): its measurements, ``r13gain_modline.json``.
+MODLINE = [
+    "## r14modline: the modulated line's term its exact Allan variance",
+    "",
+    "before: /work/main/python (d858d37); after: /work/wt-r14modline/python (2d33951); the same 10 seeds per "
+    "case as above, `--worker` runs of this script (`temp200`, `supply10`), 2 cores, load average 0.2–8 before, "
+    "4–8 after (the per-record rows in `r13gain_modline.json`).",
+    "",
+    "| case | tree | records | gain on the right channel | within 20 % | records with change points "
+    "(points) | records with spurious steps (steps) | records with unexplained |",
+    "|---|---|---|---|---|---|---|---|",
+    "| temp200 | before | 10 | 10 | 10 | 0 (0) | 3 (3) | 6 |",
+    "| temp200 | after | 10 | 10 | 10 | 0 (0) | 0 (0) | 1 |",
+    "| supply10 | before | 10 | 10 | 10 | 0 (0) | 0 (0) | 0 |",
+    "| supply10 | after | 10 | 10 | 10 | 0 (0) | 0 (0) | 0 |",
+    "",
+    "**What changed**: a line whose gain is kept is held on the curve at the exact overlapping Allan variance of "
+    "the component rebuilt from its fit, Re(A·e^{2πif0t})·(1 + g·(x̃ − x̄)), projected on the sinusoid's column "
+    '(`_sinusoid.gain_key`), not at its power in the spectrum. The `"allan"` entry on `temp200` was not the '
+    "term's shape: the simulated modulated line's Allan variance is 1.0167 × the constant line's at every τ "
+    "of seed 1's curve (to 10⁻⁴), so a constant line's column was right in shape. It was the coefficient: "
+    "the line's power held A² 1.1 % above the line alone and 1.7 % above the line plus its realised cross term "
+    "with the noise (the same line at constant amplitude: within 0.4 % of that sum), and the Butterworth's cutoff "
+    "fitted 56.1 Hz (truth 60) to make up; the curve then departed at the line's τ (0.015–0.035 s, χ²/dof 4.3). "
+    "Rebuilt, 0.8 % below the line alone (the cross term, −0.6 %, comes with A), the cutoff 59.8 Hz, nothing "
+    "unexplained. The resonance steps beside the low-pass (seeds 0, 4, 7) went with it.",
+    "",
+    '**Left**: `temp200` seed 3 still says `"allan"` (τ 0.015–0.06 s, χ²/dof 3.35; before 0.015–0.23 s, '
+    "1.78). Its line term is now right (rebuilt 8.718·10⁻⁴, the line plus its cross term 8.725·10⁻⁴), but the "
+    "bandwidth step takes a 3rd-order Butterworth at 57.4 Hz for the true 2nd order at 60 Hz (its own evidence: "
+    "the spectrum's white-floor misfit 1.53; before, a 2nd order at 57.5 Hz): the noise model is wrong there, "
+    "and the entry says so — the same record with the line at constant amplitude takes the 2nd order at "
+    "60.2 Hz. Why the order differs with the modulated line is the bandwidth choice's (not examined).",
+    "",
+    "**A constant-amplitude line** (the same generators, gain 0, 10 seeds each, before and after): every field "
+    'of every record identical (no gain kept on any; 1 of 20 with an entry, `temp200` seed 6 `"allan"`, in '
+    "both). **A wrong gain is still told** (`temp200`, the kept gain scaled before it is used): ×2 on seeds "
+    '0–4, `"allan"` at the line\'s τ (χ²/dof 2.3–9.0), `"line"` and `"level"` on 5 of 5; ×0 (the '
+    'modulation left unmodelled) `"line"` and `"level"` on 5 of 5, `"allan"` on 1 of 5 (seed 3); '
+    '`tests/test_line_gain.py` (slow): ×4, `"allan"` χ²/dof 128 and `"line"`.',
+    "",
+    "`refine_blind6.py --case` vibrating, odd rate, clock (two rows), mains, heater (every row with a line or a "
+    "family) against `refine_blind6.json`: every field but the CPU seconds identical except the vibrating gyro's "
+    "(its line has the gain): χ²/dof 1.50 → 1.38, final 0.72 → 0.63, RMS ADEV error 1.543 → 1.546 %, held out "
+    "1.934 → 1.926 %, the amplitude's error +0.3 → −0.0 % (the final amplitude √θ); effects, words, ✓ as "
+    "recorded.",
+    "",
+    "The null (`benches/line_channel_null.py --records 120`, two processes of 60, at 2d33951, load 18–23): a gain "
+    'kept on 0 of 120 records (95 % CP 0–3.0 %), no `"line"` entry (0, CP 0–3.0 %), one entry in all (1, CP '
+    '0.02–4.6 %: seed 43\'s `"channels"`, as `line_channel_null.md` records it). Where no gain is kept the '
+    "term is the line's power as before, the same key and every fit the same: the change cannot move a record "
+    "without a gain, and none of these has one.",
+]
+
+
 def _md(res: dict) -> list:
     lines = [
         "# r13gain: a line's gain taken out of what later steps see",
@@ -214,7 +270,7 @@ def _md(res: dict) -> list:
             f"- {a['case']} seed {a['seed']}: {b['spurious'] or '[]'} → {a['spurious'] or '[]'}; "
             f"{b['unexplained'] or '[]'} → {a['unexplained'] or '[]'}; gain {ge(b)} → {ge(a)}"
         )
-    return lines
+    return lines + ["", *MODLINE]
 
 
 #: the ADIS16405 channels with a tracked family (benches/results/wander_measured.md)

@@ -152,7 +152,8 @@ EFFECTS: dict[str, Effect] = {
             "average against that median, Bonferroni over the bins), f0 refined on the periodogram, A from the "
             "line's power over its width (held in every fit of the curve; the least-squares A at f0 in "
             "evidence['coherent_amplitude']); where channels are given, A·(1 + g·(channel − mean)) when its own "
-            "nested test and held-out blocks keep it (refinement._line_gain); "
+            "nested test and held-out blocks keep it (refinement._line_gain), the term then held at that modelled "
+            "component's exact Allan variance; "
             "on a curve only, f0 ≥ 2/τ_max so that two nulls fall inside it",
             signature=lambda tau, f0, fs: sinusoid_avar(tau, f0, fs),
             alpha=lambda tau, f0: np.zeros(np.asarray(tau).size, dtype=int),

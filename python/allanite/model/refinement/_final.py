@@ -83,8 +83,9 @@ class FinalModel(RunState):
         """The samples the steps after the curve effects see (the change points, the checks of ``unexplained``):
         the samples the removals left, less the part of each accepted line's term that its gain on a channel
         models, g·(x̃(t) − x̄)·Re(A·e^{2πif0t}) (:func:`._line_gain.gain_component`). The line itself stays in
-        the samples, as every line the ``"sinusoid"`` curve candidate holds does (held on the curve at its power
-        in the spectrum, which holds the sidebands the gain puts within the line's width); its modulation would
+        the samples, as every line the ``"sinusoid"`` curve candidate holds does (held on the curve at the exact
+        Allan variance of the modelled component, the gain's part with it: :func:`._sinusoid.gain_key`); its
+        modulation would
         otherwise read as the noise level changing along the record (``tests/test_line_gain.py``'s 2 Hz line
         ±20 % with a temperature cycling 1.5 times: two change points at 215 and 436 s of 600). The record's
         own samples as they were when no accepted line has a gain. An O(n) pass per line with a gain: the caller

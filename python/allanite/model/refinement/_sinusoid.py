@@ -5,12 +5,21 @@ family, searches, proposal, parameters and evidence (:data:`.candidates.CURVE_CA
 
 from __future__ import annotations
 
-from ._line_gain import gain_params
+from ._line_gain import gain_params, modulated_held
 from ._proposal import Proposal, Round, amplitude_and_profile, search_grid, with_stat
 from .curvefit import Curve, base_name, column, held_key, held_theta, search, solve
 from .scoring import MATERIAL_Z, curve_change_z
 
-__all__ = ["sin_family", "sin_searches", "sin_propose", "line_key", "coherent_share", "sin_params", "sin_evidence"]
+__all__ = [
+    "sin_family",
+    "sin_searches",
+    "sin_propose",
+    "line_key",
+    "gain_key",
+    "coherent_share",
+    "sin_params",
+    "sin_evidence",
+]
 
 
 def sin_family(sub: Curve, has_samples: bool) -> list:
@@ -58,6 +67,18 @@ def line_key(ln: dict) -> str:
     amp = ln["power_amplitude"]
     sd = ln["power_amplitude_interval"][1] - amp
     return held_key("sinusoid", amp**2, (2.0 * amp * sd) ** 2, coherent_share(ln))
+
+
+def gain_key(ln: dict, curve: Curve, n: int, channels: dict) -> str:
+    """The column key of a line whose gain on a channel was kept (``ln["gain"]``, :mod:`._line_gain`): held at
+    the exact Allan variance of the modelled component, the constant line and its gain's part together
+    (:func:`._line_gain.modulated_held`), not at the line's power in the spectrum — the curve the model is
+    fitted on holds the modulated line, and so does this term."""
+    g = ln["gain"]
+    sd = ln["amplitude_interval"][1] - ln["amplitude"]  # the coherent amplitude's +1 SD (its lower end is cut at 0)
+    x = channels[g["channel"]]
+    theta, var, share = modulated_held(n, curve.fs, float(ln["f0"]), g, x, curve.tau, sd)
+    return held_key("sinusoid", theta, var, share)
 
 
 def coherent_share(ln: dict) -> float:

@@ -28,6 +28,7 @@ from ._in_time import TimeRemovals
 from ._inputs import REFINE_SCALE, check_scale, check_truth, check_unit, inputs
 from ._line_gain import line_gain
 from ._rolloff import research_rolloff, sinc_chain_kept, sinc_named, without_sincs
+from ._sinusoid import gain_key
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, bandwidth_grids, choose, families, prefetch
 from .curvefit import base_name, held_theta, solve
@@ -278,6 +279,9 @@ class _Run(TimeRemovals, FinalModel):
             # its nested option: the amplitude following a channel, at its conditional share over the lines offered
             a = alpha("sinusoid:gain", self.level) / max(1, len(self.offered_lines or []))
             pr.line["gain"] = line_gain(self.y, self.fs, float(pr.line["f0"]), self.channels, a)
+            if pr.line["gain"]:  # its term the modulated line's exact Allan variance (._sinusoid.gain_key)
+                pr.key = gain_key(pr.line, rnd.curve, self.y.size, self.channels)
+                pr.sol = solve(rnd.curve, rnd.start, rnd.effects + [(pr.key, pr.p)])
         params, intervals = cand.params(pr, rnd)
         evidence = residual_evidence(self.curve, self.sol)
         evidence["domain"] = EFFECTS[pr.effect].domain
