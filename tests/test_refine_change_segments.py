@@ -81,3 +81,14 @@ def test_no_change_point_takes_nothing():
     ctx = _context(y, [])
     regions = [{"domain": "allan", "tau": (0.02, 0.05), "what": "the Allan curve departs from the model"}]
     assert explained_regions(ctx, regions, 0.05) == (regions, [])
+
+
+def test_a_base_shorter_than_half_the_record_takes_nothing():
+    rng = np.random.default_rng(14)
+    y = allanite.simulate(N, FS, N=NW, seed=rng)
+    y[80_000:] += _band(rng, N - 80_000, 20.0)  # loud from 800 s on: the quiet base is 40 % of the record
+    ctx = _context(y, [800.0])
+    seg = ctx.memo["segments"]
+    assert seg.base.tolist() == [True, False] and abs(seg.base_share() - 0.4) < 1e-9
+    regions = [{"domain": "allan", "tau": (0.025, 0.05), "what": "the Allan curve departs from the model"}]
+    assert explained_regions(ctx, regions, 0.05) == (regions, [])

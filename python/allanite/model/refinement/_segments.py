@@ -15,7 +15,8 @@ come from it, and without change points nothing changes.
 Each segment's Allan variance is its own overlapping estimate at octave averaging factors up to 1/16 of the
 shortest segment (the white-rate EDF for the SE of log σ̂², as the change-point search's floor). The base
 segments: the quietest one (lowest mean log AVAR over those τ) and every segment within 3 SE of it at each τ up
-to 1/64 of the shortest segment.
+to 1/64 of the shortest segment; they must hold at least half the record (``BASE_SHARE``), or nothing is taken —
+a short base has too few terms to say that a departure the whole record shows is not its own.
 """
 
 from __future__ import annotations
@@ -35,6 +36,10 @@ __all__ = ["Segments", "explained_regions"]
 
 #: the shortest segment whose Allan variance is read (samples)
 MIN_SEGMENT = 64
+#: the share of the record the base segments must hold for their check to take a region: at least half, so that
+#: it has at least half the record's terms (ADIS16405 run 5 acc_z: a base of 916 s in 10⁴ s did not show a
+#: departure at τ 30–60 ms that the whole record did, its louder segment 1.05× the base at 20 ms)
+BASE_SHARE = 0.5
 #: |z| of a difference of two log-AVAR estimates that counts as a level difference
 Z_DIFFER = 3.0
 
@@ -124,6 +129,11 @@ class Segments:
             "segments": self.times(~self.base),
         }
 
+    def base_share(self) -> float:
+        """The share of the record the base segments hold."""
+        n = sum(b - a for a, b in self.bounds)
+        return sum(b - a for (a, b), w in zip(self.bounds, self.base) if w) / n
+
     def base_samples(self, y: np.ndarray) -> np.ndarray:
         """The base segments' samples, joined in time order."""
         return np.concatenate([y[a:b] for (a, b), w in zip(self.bounds, self.base) if w])
@@ -134,10 +144,12 @@ def explained_regions(ctx: MissingContext, regions: list[dict], a: float) -> tup
     where the same check at ``a`` on the base segments' own curve (the model refitted there) finds no region
     overlapping it and the louder segments' Allan variance differs from the base's near its τ
     (:meth:`Segments.louder_at`). Each region the change points take carries ``louder`` (that difference) and
-    ``base_segments``. Nothing is taken without change points, samples, louder segments or enough base samples
-    for 8 of the curve's τ."""
+    ``base_segments``. Nothing is taken without change points, samples, louder segments, a base of at least
+    ``BASE_SHARE`` of the record or enough base samples for 8 of the curve's τ."""
     seg = ctx.memo.get("segments")
     if not regions or ctx.y is None or not isinstance(seg, Segments) or seg.base.all():
+        return regions, []
+    if seg.base_share() < BASE_SHARE:  # a short base cannot resolve what the whole record shows
         return regions, []
     base = _base_check(ctx, seg, a)
     if base is None:
