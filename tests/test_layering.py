@@ -218,6 +218,7 @@ MODEL_RANKS = {
     "model.refinement._missing_context": 3.5,
     "model.refinement._curve_checks": 6.5,
     "model.refinement._time_checks": 6.5,
+    "model.refinement._segments": 6.6,  # the change points' segments: their levels, the departures they carry
     "model.refinement._channel_shape": 6.5,  # the residual's dependence on a channel's value (on model._shape)
     "model.refinement.missing": 7,
     "model.refinement._rolloff": 5.5,

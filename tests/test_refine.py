@@ -96,6 +96,9 @@ def test_locates_a_variance_step_within_one_window():
     assert ho["after"] < 0.5 * ho["before"]
     # the record's own Allan curve it leaves as it is: on the chain its before is its after
     assert st.before == st.after
+    # what it changed: the Allan deviation 3× at τ₀ (white noise 2 → 6·10⁻³), its 95 % interval covering 3
+    lo3, hi3 = st.evidence["adev_ratio"]["interval95"][0]
+    assert lo3 <= 3.0 <= hi3 and hi3 < 1.05 * lo3
     # and unexplained's level check, run within the segments, finds nothing left (without the change-point candidate
     # it says the level changes: test_refine_unexplained_level.py)
     assert not any(u["domain"] == "level" for u in r.unexplained)

@@ -12,6 +12,7 @@ from .. import tracing
 from ._family_fold import fold_wandering
 from ._line_gain import gain_component
 from ._run import RunState
+from ._segments import Segments
 from .candidates import Round, final_params
 from .changes import change_point_step, change_points
 from .curvefit import base_name, noise_fit, solve
@@ -71,10 +72,13 @@ class FinalModel(RunState):
                 self.consider("change_point", {"t": c["t"], "gain_chi2": c["gain"], "rejected": why})
             cps = []
         self.change_points = cps
+        self.segments = Segments.of(y, self.fs, [c["t"] for c in cps])
         steps = []
         for n, c in enumerate(cps):
             truth = self.truth.get("change_point") if self.truth else None
             st = change_point_step(c, None if chain is None else chain[n : n + 2], truth, y.size / self.fs)
+            if self.segments is not None and n + 1 < len(self.segments.bounds):
+                st.evidence["adev_ratio"] = self.segments.ratio_across(n)
             self.advance(st, self.state)
             steps.append(st)
         return steps
@@ -120,7 +124,12 @@ class FinalModel(RunState):
             for st, rem, *_rest in self.removed
             if rem.effect == "periodic"
         ]
-        return unexplained(ctx)
+        if cp_steps and self.segments is not None:
+            ctx.memo["segments"] = self.segments
+        missing = unexplained(ctx)
+        for st in cp_steps:  # the departures of the record's curve only the louder segments carry
+            st.evidence["explains"] = list(ctx.memo.get("change_point_regions") or [])
+        return missing
 
     def refinement(self, cp_steps, unit, confidence, missing) -> Refinement:
         """The result: the start and the final model on the original record's curve, the steps in order."""

@@ -69,6 +69,7 @@ class RunState:
         self.removed: list = []
         self.states: list = [self.state]  # the chain: the model before the first step and after each
         self.change_points: list = []
+        self.segments = None  # the change points' segments (._segments.Segments), once they are accepted
         self.considered: dict[str, list] = {}
         self.line_search: dict | None = None  # the periodic removal's line search, for the sinusoid candidate
         self.declined_families: list = []  # line families the removal in time turned down: their lines stay

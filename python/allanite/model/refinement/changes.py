@@ -30,7 +30,9 @@ Its statistic is on the windows' levels, not on the Allan curve: a change point'
 windows' piecewise-constant levels without and with it, every other one in both, describe them. On the
 record's own Allan curve a change of noise level changes nothing: the curve of a record whose level steps is
 the length-weighted mean of its segments' curves, a model of the same terms with pooled coefficients, which
-the fit of the whole curve already is.
+the fit of the whole curve already is. Where the louder segments carry a noise outside the five terms (band noise
+switched on and off), the record's curve departs from that model only because of them: which of the ``"allan"``
+check's departures those are, and the factor each change point made per τ, is :mod:`._segments`'s.
 """
 
 from __future__ import annotations

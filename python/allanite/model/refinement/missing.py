@@ -81,6 +81,7 @@ from ._mean_step import mean_step_check
 from ._mean_steps import steps_check
 from ._missing_context import MissingContext
 from ._quality import clipped_check, held_check
+from ._segments import explained_regions
 from ._time_checks import drift_check, level_check, outliers_check
 from .curvefit import base_name, chi2_dof_between
 from .levels import alpha
@@ -250,6 +251,10 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
 def unexplained(ctx: MissingContext) -> list[dict]:
     """Every check's regions, the largest misfit (statistic over threshold) first."""
     found = {name: check(ctx, alpha(f"unexplained:{name}", ctx.level)) for name, check in CHECKS.items()}
+    # with change points: the departures only the louder segments carry are theirs (said on their steps)
+    found["allan"], ctx.memo["change_point_regions"] = explained_regions(
+        ctx, found["allan"], alpha("unexplained:allan", ctx.level)
+    )
     if found["allan"]:  # the score test's regions and misfit runs already say where the curve departs
         found["fit"] = [r for r in found["fit"] if not any(_overlap(r, q) for q in found["allan"])]
     if found["mean"]:  # one step already said: the steps check repeats it unless it found others

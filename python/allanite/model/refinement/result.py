@@ -59,7 +59,10 @@ class Step:
     test in time, ``heldout_variance_ratio``); a change point — whose before and after on the
     record's curve are the same numbers: a change of noise level leaves the curve's model as it is — has its
     statistic on the windows' levels in ``window_levels``, without → with it, every other change point in both,
-    and held out per segment in ``heldout_test``, without → with it, the earlier change points in both);
+    and held out per segment in ``heldout_test``, without → with it, the earlier change points in both; what it
+    changed in ``adev_ratio``, the Allan deviation after / before it per τ with 95 % intervals, and in
+    ``explains`` the Allan-curve departures only the louder segments carry, said there and not in ``unexplained``
+    — :mod:`._segments`);
     ``truth_error``: relative parameter errors when ``truth`` was given.
     """
 
