@@ -264,6 +264,35 @@ def add_waveform(
 ) -> None:
     """out += Re[wave interpolated at the phases u (× the phasors ph)]; complex arrays as interleaved float64."""
 
+def lattice_bins(
+    y: npt.NDArray[np.float64],
+    u: npt.NDArray[np.float64],
+    m_bins: int,
+    seg: npt.NDArray[np.int64] | None,
+    n_seg: int,
+    idx: npt.NDArray[np.int64],
+    blocks: npt.NDArray[np.float64],
+    offsets: npt.NDArray[np.float64],
+    k0: int,
+    power: int,
+    conj: bool,
+) -> list[npt.NDArray[np.float64]]:
+    """The bins of y·Re ph and y·(−Im ph), the phasors ph = (blocks[idx // B − k0]·offsets[idx % B])^power (conjugated
+    with conj; B = len(offsets) a power of two; complex tables as interleaved float64) made per sample."""
+
+def add_lattice_waveform(
+    out: npt.NDArray[np.float64],
+    u: npt.NDArray[np.float64],
+    wave: npt.NDArray[np.float64],
+    idx: npt.NDArray[np.int64],
+    blocks: npt.NDArray[np.float64],
+    offsets: npt.NDArray[np.float64],
+    k0: int,
+    power: int,
+    conj: bool,
+) -> None:
+    """:func:`add_waveform` with the phasors of :func:`lattice_bins` made per sample."""
+
 class StreamingVariance:
     """Streaming "oavar", "ohvar" or "tvar" of a growing phase record (values for τ0 = 1)."""
 

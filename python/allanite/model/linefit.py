@@ -23,13 +23,16 @@ lines:
 The two passes over the samples — the folding's gridding and the waveform's interpolation — run in the Rust
 core where it has them (``allanite._core.phase_bins``, ``add_waveform``: one pass each instead of NumPy's
 eight, the same operations in the same order, so the same numbers; ``tests/test_refine_irls.py`` holds the
-two paths equal); NumPy's path stays the reference.
+two paths equal); NumPy's path stays the reference. A two-generator family's phasors e^{i2π|s|ν2 n} are then
+made sample by sample in those passes from two short tables (``lattice_bins``, ``add_lattice_waveform``:
+:class:`_Lattice`) instead of being formed as 16 bytes a sample per family and part.
 """
 
 from __future__ import annotations
 
 import math
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
@@ -44,6 +47,10 @@ _BLOCK = 1024
 #: The Rust core's gridding and waveform passes, or None where the core lacks them (then NumPy's, below).
 _BINS = getattr(_core, "phase_bins", None)
 _WAVE = getattr(_core, "add_waveform", None)
+#: The core's passes with the second generator's phasors made per sample (:class:`_Lattice`), or None where it lacks
+#: them (then :func:`_phasor`'s arrays, to ``_BINS`` and ``_WAVE`` or NumPy's).
+_LBINS = getattr(_core, "lattice_bins", None)
+_LWAVE = getattr(_core, "add_lattice_waveform", None)
 
 
 def runs(idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -90,25 +97,58 @@ def _wrap(x: np.ndarray) -> np.ndarray:
 
 def _phasor(nu: float, idx: np.ndarray) -> np.ndarray:
     """e^{i2πν n} at the indices (read-only): per sample, the product of its block's phasor and its offset's within
-    the block, each from ``np.exp`` — one complex product per sample. The last few are remembered
+    the block (:func:`_tables`) — one complex product per sample. The last few are remembered
     (:data:`_PHASORS`): a family's sidebands are fitted on one half of a record and evaluated on the other,
-    family after family, at the same spacing ν."""
+    family after family, at the same spacing ν. (Where the Rust core has the lattice passes, :func:`_groups` hands
+    them the tables instead: no phasor is formed.)"""
     got = _PHASORS.get(idx, (nu,))
     if got is not None:
         return got
     if idx.size == 0:
         out = np.ones(0, dtype=np.complex128)
     else:
+        blocks, offsets, k0 = _tables(nu, idx)
         lo, hi = int(idx.min()), int(idx.max())
-        k0 = lo // _BLOCK
-        blocks = np.exp(2j * np.pi * _frac(np.arange(k0, hi // _BLOCK + 1, dtype=np.int64) * _BLOCK * nu))
-        offsets = np.exp(2j * np.pi * _frac(np.arange(_BLOCK) * nu))
         if hi - lo + 1 == idx.size and idx[0] == lo:  # one run: the outer product, sliced
             out = np.multiply.outer(blocks, offsets).ravel()[lo - k0 * _BLOCK : hi - k0 * _BLOCK + 1]
         else:
             out = blocks[idx // _BLOCK - k0] * offsets[idx % _BLOCK]
     out.flags.writeable = False
     return _PHASORS.put(idx, (nu,), out)
+
+
+def _tables(nu: float, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+    """(e^{i2πν·B·k} for the blocks k = k0 … ⌊max idx/B⌋, e^{i2πν·j} for j = 0 … B − 1, k0 = ⌊min idx/B⌋),
+    B = :data:`_BLOCK`, each from ``np.exp``: e^{i2πνn} is the product of n's block's and its offset's (idx not
+    empty)."""
+    lo, hi = int(idx.min()), int(idx.max())
+    k0 = lo // _BLOCK
+    blocks = np.exp(2j * np.pi * _frac(np.arange(k0, hi // _BLOCK + 1, dtype=np.int64) * _BLOCK * nu))
+    offsets = np.exp(2j * np.pi * _frac(np.arange(_BLOCK) * nu))
+    return blocks, offsets, k0
+
+
+class _Lattice(NamedTuple):
+    """The phasors e^{i2πaνn} at ``idx`` as the Rust core's lattice passes take them (``allanite._core.lattice_bins``,
+    ``add_lattice_waveform``): :func:`_tables`' two tables (complex as interleaved float64), k0 and the power a,
+    conjugated when ``conj`` — made there sample by sample, each product as NumPy's on x86-64 (a fused multiply-add:
+    the numbers of :func:`_phasor` and :func:`_groups`' powers bit for bit there, ``tests/test_refine_irls.py``), with
+    no array of n phasors formed (16 bytes a sample, and its fresh memory, per family and part)."""
+
+    idx: np.ndarray
+    blocks: np.ndarray
+    offsets: np.ndarray
+    k0: int
+    power: int
+    conj: bool = False
+
+    def args(self) -> tuple:
+        return self.idx, self.blocks, self.offsets, self.k0, self.power, self.conj
+
+
+def _conj(ph):
+    """The conjugate phasors: of an array, or a :class:`_Lattice` flagged to conjugate."""
+    return ph._replace(conj=not ph.conj) if isinstance(ph, _Lattice) else np.conj(ph)
 
 
 def _unit_phase(idx: np.ndarray, nu: float) -> np.ndarray:
@@ -151,15 +191,24 @@ def _oriented(gens: np.ndarray, coefs: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return gens, coefs
 
 
-def _groups(coefs: np.ndarray, nu2: float, idx: np.ndarray):
+def _groups(coefs: np.ndarray, nu2: float, idx: np.ndarray, lattice: bool = False):
     """(s, rows, e^{i2π|s|ν2 n} or None for s = 0) for each distinct second coefficient s (0 for one-generator
     lattices; a negative s's phasor is the conjugate, taken by the caller where it needs it); the phasors as
-    powers of one :func:`_phasor`, by increasing |s| (one complex product each)."""
+    powers of one :func:`_phasor`, by increasing |s| (one complex product each) — or, with ``lattice`` (the core's
+    lattice passes at hand, idx not empty), as a :class:`_Lattice` of power |s| each: the same numbers, made there."""
     s_all = coefs[:, 1] if coefs.shape[1] > 1 else np.zeros(coefs.shape[0], dtype=np.int64)
     present = set(np.unique(s_all).tolist())
     if 0 in present:
         yield 0, np.flatnonzero(s_all == 0), None
     top = max((abs(v) for v in present), default=0)
+    if top and lattice and idx.size:
+        blocks, offsets, k0 = _tables(nu2, idx)
+        tables = (np.ascontiguousarray(idx, dtype=np.int64), blocks.view(np.float64), offsets.view(np.float64), k0)
+        for a in range(1, top + 1):
+            for s in (a, -a):
+                if s in present:
+                    yield s, np.flatnonzero(s_all == s), _Lattice(*tables, a)
+        return
     base = _phasor(nu2, idx) if top else np.ones(0)
     cur = base
     for a in range(1, top + 1):
@@ -178,11 +227,15 @@ def _fold(z: np.ndarray, u: np.ndarray, m_bins: int, seg: np.ndarray | None, n_s
 def _bins_of(parts: list, u: np.ndarray, m_bins: int, seg: np.ndarray | None, n_seg: int, grids: dict, ph=None) -> list:
     """Each real part spread onto the phase bins of ``u`` (:func:`_binned` on :func:`_gridding`; in the Rust
     core where it has it, else the grid remembered in ``grids`` per grid size). With the phasors ``ph``, the
-    parts are y·Re ph and y·(−Im ph) of the one series ``parts[0]`` (the core forms them sample by sample)."""
+    parts are y·Re ph and y·(−Im ph) of the one series ``parts[0]`` (the core forms them sample by sample; a
+    :class:`_Lattice` only where the core has its lattice passes)."""
     if _BINS is not None:
         f64 = np.float64
         parts = [np.ascontiguousarray(part, dtype=f64) for part in parts]
         seg_c = None if seg is None else np.ascontiguousarray(seg, dtype=np.int64)
+        if isinstance(ph, _Lattice):
+            assert _LBINS is not None  # a lattice is made only where the core has its passes
+            return _LBINS(parts[0], np.ascontiguousarray(u, dtype=f64), m_bins, seg_c, n_seg, *ph.args())
         ph_f = None if ph is None else np.ascontiguousarray(ph, dtype=np.complex128).view(f64)
         return _BINS(parts, np.ascontiguousarray(u, dtype=f64), m_bins, seg_c, n_seg, ph_f)
     if ph is not None:
@@ -243,7 +296,7 @@ def dtft(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray, n_seg: int = 1
     nu2 = float(gens[1]) if gens.size > 1 else 0.0
     grids: dict = {}  # the phase bins per grid size, for every second coefficient
     bins: dict = {}  # (|s|, grid size): the bins of y·cos θ and y·sin θ, shared by s and −s
-    for s, rows, ph in _groups(coefs, nu2, idx):
+    for s, rows, ph in _groups(coefs, nu2, idx, lattice=_BINS is not None and _LBINS is not None):
         k = coefs[rows, 0]
         m_bins = _grid(int(np.max(np.abs(k))))
         if s == 0:
@@ -253,7 +306,7 @@ def dtft(y: np.ndarray, idx: np.ndarray, gens, coefs: np.ndarray, n_seg: int = 1
             # numbers); −s's phasor is s's conjugate: its imaginary part's bins are s's negated, exactly
             key = (abs(s), m_bins)
             if key not in bins:  # s's phasor (conjugated for a negative s: only where s itself is absent)
-                bins[key] = (*_bins_of([y], u, m_bins, seg, n_seg, grids, ph if s > 0 else np.conj(ph)), s)
+                bins[key] = (*_bins_of([y], u, m_bins, seg, n_seg, grids, ph if s > 0 else _conj(ph)), s)
             re, im, s_done = bins[key]
             g = _binned_fft([re, im if s == s_done else -im], m_bins, n_seg)
         out[:, rows] = g[:, np.mod(k, m_bins)]
@@ -308,8 +361,8 @@ def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndar
     u = _unit_phase(idx, float(gens[0]))
     nu2 = float(gens[1]) if gens.size > 1 else 0.0
     grids: dict = {}
-    for s, rows, ph in _groups(coefs, nu2, idx):
-        ph = np.conj(ph) if s < 0 else ph
+    for s, rows, ph in _groups(coefs, nu2, idx, lattice=_WAVE is not None and _LWAVE is not None):
+        ph = _conj(ph) if s < 0 else ph
         k = coefs[rows, 0]
         m_bins = _grid(int(np.max(np.abs(k))))
         spec = np.zeros(m_bins, dtype=np.complex128)
@@ -317,6 +370,10 @@ def evaluate(idx: np.ndarray, gens, coefs: np.ndarray, a: np.ndarray, b: np.ndar
         np.add.at(spec, np.mod(k, m_bins), (a[rows] - 1j * b[rows]) / np.sinc(k / m_bins) ** 2)
         wave = np.fft.ifft(spec) * m_bins
         wave = np.append(wave, wave[0])
+        if isinstance(ph, _Lattice):  # the same sums and phasors in the Rust core, one pass
+            assert _LWAVE is not None  # a lattice is made only where the core has its passes
+            _LWAVE(out, np.ascontiguousarray(u, dtype=np.float64), wave.view(np.float64), *ph.args())
+            continue
         if _WAVE is not None:  # the same sums in the Rust core, one pass
             _WAVE(out, u, wave.view(np.float64), None if ph is None else np.ascontiguousarray(ph).view(np.float64))
             continue

@@ -60,10 +60,171 @@ pub fn phase_bins_heterodyned(
     if y.len() != n || ph.len() != 2 * n || !valid(u, m, seg, n_seg.max(1), n) {
         return None;
     }
-    Some([
-        binned(|i| y[i] * ph[2 * i], u, m, seg, n_seg),
-        binned(|i| y[i] * -ph[2 * i + 1], u, m, seg, n_seg),
-    ])
+    Some(binned_pair(
+        |i| (y[i] * ph[2 * i], y[i] * -ph[2 * i + 1]),
+        u,
+        m,
+        seg,
+        n_seg,
+    ))
+}
+
+/// [`phase_bins_heterodyned`] with the phasors made sample by sample from a [`Lattice`] instead of read
+/// from an array of n complex values (the same numbers: see [`Lattice`]).
+pub fn phase_bins_lattice(
+    y: &[f64],
+    ph: &Lattice,
+    u: &[f64],
+    m: usize,
+    seg: Option<&[usize]>,
+    n_seg: usize,
+) -> Option<[Vec<f64>; 2]> {
+    let n = u.len();
+    if y.len() != n || !ph.valid(n) || !valid(u, m, seg, n_seg.max(1), n) {
+        return None;
+    }
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU has the feature the function is compiled for (checked just above).
+        return Some(unsafe { lattice_pair_fma(y, ph, u, m, seg, n_seg) });
+    }
+    Some(lattice_pair(y, ph, u, m, seg, n_seg))
+}
+
+/// [`lattice_pair`] compiled with the fused multiply-add instruction (`mul_add` is correctly rounded
+/// either way — an instruction instead of a call to libm's `fma`: the same numbers).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+unsafe fn lattice_pair_fma(
+    y: &[f64],
+    ph: &Lattice,
+    u: &[f64],
+    m: usize,
+    seg: Option<&[usize]>,
+    n_seg: usize,
+) -> [Vec<f64>; 2] {
+    lattice_pair(y, ph, u, m, seg, n_seg)
+}
+
+#[inline(always)]
+fn lattice_pair(
+    y: &[f64],
+    ph: &Lattice,
+    u: &[f64],
+    m: usize,
+    seg: Option<&[usize]>,
+    n_seg: usize,
+) -> [Vec<f64>; 2] {
+    binned_pair(
+        #[inline(always)]
+        |i| {
+            let (re, im) = ph.at(i);
+            (y[i] * re, y[i] * -im)
+        },
+        u,
+        m,
+        seg,
+        n_seg,
+    )
+}
+
+/// The phasors e^{i2πaνn} at the sample indices `idx` that `allanite.model.linefit` makes for a line
+/// family's second generator ν (`_phasor`, raised to the power a = |s| by `_groups`), made per sample
+/// instead of kept as n complex values: index n's block phasor `blocks[⌊n/B⌋ − k0]` times its offset's
+/// `offsets[n mod B]` (B = the offsets' count, a power of two; both tables complex, re/im interleaved),
+/// that product multiplied in a − 1 more times, conjugated when `conj`. Each complex product is NumPy's
+/// on x86-64 (its SIMD loop fuses a multiply-add): x·y = (fma(x.re, y.re, −x.im·y.im),
+/// fma(x.re, y.im, x.im·y.re)), the left operand the block's (then the running power's), so the
+/// phasors are NumPy's bit for bit there.
+pub struct Lattice<'a> {
+    pub idx: &'a [i64],
+    pub blocks: &'a [f64],
+    pub offsets: &'a [f64],
+    pub k0: i64,
+    pub power: usize,
+    pub conj: bool,
+}
+
+impl Lattice<'_> {
+    /// log2 of the block length B (the offsets' count), or None where it is not a power of two.
+    fn shift(&self) -> Option<u32> {
+        let b = self.offsets.len() / 2;
+        (b.is_power_of_two() && self.offsets.len().is_multiple_of(2)).then(|| b.trailing_zeros())
+    }
+
+    /// Whether the tables are whole complex numbers, B a power of two, the power ≥ 1 and every index's
+    /// block in the table.
+    fn valid(&self, n: usize) -> bool {
+        let nb = (self.blocks.len() / 2) as i64;
+        let Some(sh) = self.shift() else {
+            return false;
+        };
+        self.idx.len() == n
+            && self.power >= 1
+            && self.blocks.len().is_multiple_of(2)
+            && self
+                .idx
+                .iter()
+                .all(|&k| (0..nb).contains(&((k >> sh) - self.k0)))
+    }
+
+    /// The phasor of the i-th index (arguments checked by [`Lattice::valid`]): ⌊n/B⌋ and n mod B as an
+    /// arithmetic shift and a mask (B a power of two; the floor and the remainder ≥ 0 of NumPy's `//`, `%`).
+    #[inline(always)]
+    fn at(&self, i: usize) -> (f64, f64) {
+        let b = self.offsets.len() / 2;
+        let sh = b.trailing_zeros();
+        let k = self.idx[i];
+        let j = ((k >> sh) - self.k0) as usize;
+        let o = (k & (b as i64 - 1)) as usize;
+        let base = cmul(
+            (self.blocks[2 * j], self.blocks[2 * j + 1]),
+            (self.offsets[2 * o], self.offsets[2 * o + 1]),
+        );
+        let mut cur = base;
+        for _ in 1..self.power {
+            cur = cmul(cur, base);
+        }
+        if self.conj {
+            (cur.0, -cur.1)
+        } else {
+            cur
+        }
+    }
+}
+
+/// NumPy's complex product on x86-64 (see [`Lattice`]).
+#[inline(always)]
+fn cmul(x: (f64, f64), y: (f64, f64)) -> (f64, f64) {
+    (x.0.mul_add(y.0, -(x.1 * y.1)), x.0.mul_add(y.1, x.1 * y.0))
+}
+
+/// Two parts `p(i)` gridded in one pass: each part's bins summed in sample order, as [`binned`] sums
+/// them one part at a time (so the same numbers).
+#[inline(always)]
+fn binned_pair(
+    p: impl Fn(usize) -> (f64, f64),
+    u: &[f64],
+    m: usize,
+    seg: Option<&[usize]>,
+    n_seg: usize,
+) -> [Vec<f64>; 2] {
+    let size = m * n_seg.max(1);
+    let (mut lo0, mut hi0) = (vec![0.0; size], vec![0.0; size]);
+    let (mut lo1, mut hi1) = (vec![0.0; size], vec![0.0; size]);
+    for (i, &ui) in u.iter().enumerate() {
+        let off = seg.map_or(0, |s| s[i] * m);
+        let (j, j1, w) = bins(ui, m, off);
+        let (p0, p1) = p(i);
+        let (h0, h1) = (p0 * w, p1 * w);
+        lo0[j] += p0 - h0;
+        hi0[j1] += h0;
+        lo1[j] += p1 - h1;
+        hi1[j1] += h1;
+    }
+    lo0.iter_mut().zip(&hi0).for_each(|(a, b)| *a += b);
+    lo1.iter_mut().zip(&hi1).for_each(|(a, b)| *a += b);
+    [lo0, lo1]
 }
 
 /// The two bincounts of `linefit._binned` of the part `p(i)`, then their sum (arguments checked).
@@ -94,11 +255,53 @@ fn binned(
 /// Returns false (out untouched) when the lengths disagree or a phase is out of range.
 pub fn add_waveform(out: &mut [f64], u: &[f64], wave: &[f64], ph: Option<&[f64]>) -> bool {
     let n = out.len();
-    let m = (wave.len() / 2).saturating_sub(1);
-    if !wave.len().is_multiple_of(2) || m == 0 || ph.is_some_and(|p| p.len() != 2 * n) {
+    if ph.is_some_and(|p| p.len() != 2 * n) {
         return false;
     }
-    if !valid(u, m, None, 1, n) {
+    match ph {
+        None => add_wave(out, u, wave, None::<fn(usize) -> (f64, f64)>),
+        Some(p) => add_wave(out, u, wave, Some(|i: usize| (p[2 * i], p[2 * i + 1]))),
+    }
+}
+
+/// [`add_waveform`] with the phasors made sample by sample from a [`Lattice`].
+pub fn add_waveform_lattice(out: &mut [f64], u: &[f64], wave: &[f64], ph: &Lattice) -> bool {
+    if !ph.valid(out.len()) {
+        return false;
+    }
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU has the feature the function is compiled for (checked just above).
+        return unsafe { lattice_wave_fma(out, u, wave, ph) };
+    }
+    add_wave(out, u, wave, Some(|i| ph.at(i)))
+}
+
+/// [`add_waveform_lattice`]'s pass compiled with the fused multiply-add instruction (the same numbers).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+unsafe fn lattice_wave_fma(out: &mut [f64], u: &[f64], wave: &[f64], ph: &Lattice) -> bool {
+    add_wave(
+        out,
+        u,
+        wave,
+        Some(
+            #[inline(always)]
+            |i| ph.at(i),
+        ),
+    )
+}
+
+#[inline(always)]
+fn add_wave(
+    out: &mut [f64],
+    u: &[f64],
+    wave: &[f64],
+    ph: Option<impl Fn(usize) -> (f64, f64)>,
+) -> bool {
+    let n = out.len();
+    let m = (wave.len() / 2).saturating_sub(1);
+    if !wave.len().is_multiple_of(2) || m == 0 || !valid(u, m, None, 1, n) {
         return false;
     }
     for (i, (o, &ui)) in out.iter_mut().zip(u).enumerate() {
@@ -107,11 +310,12 @@ pub fn add_waveform(out: &mut [f64], u: &[f64], wave: &[f64], ph: Option<&[f64]>
         let f = x - j as f64;
         let g = 1.0 - f;
         let re = wave[2 * j] * g + wave[2 * j + 2] * f;
-        match ph {
+        match &ph {
             None => *o += re,
             Some(p) => {
                 let im = wave[2 * j + 1] * g + wave[2 * j + 3] * f;
-                *o += re * p[2 * i] - im * p[2 * i + 1];
+                let (pr, pi) = p(i);
+                *o += re * pr - im * pi;
             }
         }
     }
@@ -152,6 +356,86 @@ mod tests {
         let got = phase_bins_heterodyned(&y, &ph, &u, 32, None, 1).unwrap();
         assert_eq!(got.to_vec(), want);
         assert!(phase_bins_heterodyned(&y, &ph[1..], &u, 32, None, 1).is_none());
+    }
+
+    #[test]
+    fn lattice_phasors_are_the_products_of_the_tables_and_their_powers() {
+        // indices with a gap, from block 3 on (k0 = 3), B = 4: blocks 3 … 6
+        let idx: Vec<i64> = (12..20).chain(22..27).collect();
+        let tab = |k: f64, nu: f64| ((k * nu).cos(), (k * nu).sin());
+        let blocks: Vec<f64> = (3..7)
+            .flat_map(|k| [tab(4.0 * k as f64, 0.3).0, tab(4.0 * k as f64, 0.3).1])
+            .collect();
+        let offsets: Vec<f64> = (0..4)
+            .flat_map(|j| [tab(j as f64, 0.3).0, tab(j as f64, 0.3).1])
+            .collect();
+        let n = idx.len();
+        let u = phases(n, 0.0713);
+        let y: Vec<f64> = (0..n).map(|k| ((k * 7) % 5) as f64 - 2.0).collect();
+        for (power, conj) in [(1, false), (2, false), (3, true)] {
+            let mut ph = Vec::with_capacity(2 * n);
+            for &k in &idx {
+                let (j, o) = ((k / 4 - 3) as usize, (k % 4) as usize);
+                let base = cmul(
+                    (blocks[2 * j], blocks[2 * j + 1]),
+                    (offsets[2 * o], offsets[2 * o + 1]),
+                );
+                let mut cur = base;
+                for _ in 1..power {
+                    cur = cmul(cur, base);
+                }
+                ph.extend([cur.0, if conj { -cur.1 } else { cur.1 }]);
+            }
+            let lat = Lattice {
+                idx: &idx,
+                blocks: &blocks,
+                offsets: &offsets,
+                k0: 3,
+                power,
+                conj,
+            };
+            let want = phase_bins_heterodyned(&y, &ph, &u, 16, None, 1).unwrap();
+            assert_eq!(phase_bins_lattice(&y, &lat, &u, 16, None, 1).unwrap(), want);
+            let wave: Vec<f64> = (0..34).map(|k| ((k * 3) % 7) as f64 - 3.0).collect();
+            let (mut a, mut b) = (vec![1.0; n], vec![1.0; n]);
+            assert!(add_waveform(&mut a, &u, &wave, Some(&ph)));
+            assert!(add_waveform_lattice(&mut b, &u, &wave, &lat));
+            assert_eq!(a, b);
+            assert!(a.iter().any(|&v| (v - 1.0).abs() > 0.5)); // the waveform was added
+        }
+        // refused: an index before the first block, three offsets (not a power of two), power 0
+        let early = Lattice {
+            idx: &[11],
+            blocks: &blocks,
+            offsets: &offsets,
+            k0: 3,
+            power: 1,
+            conj: false,
+        };
+        assert!(phase_bins_lattice(&[1.0], &early, &[0.5], 4, None, 1).is_none());
+        let three = Lattice {
+            idx: &[12],
+            blocks: &blocks,
+            offsets: &offsets[..6],
+            k0: 3,
+            power: 1,
+            conj: false,
+        };
+        assert!(!add_waveform_lattice(
+            &mut [0.0],
+            &[0.5],
+            &[1.0, 0.0, 1.0, 0.0],
+            &three
+        ));
+        let zero = Lattice {
+            idx: &[12],
+            blocks: &blocks,
+            offsets: &offsets,
+            k0: 3,
+            power: 0,
+            conj: false,
+        };
+        assert!(phase_bins_lattice(&[1.0], &zero, &[0.5], 4, None, 1).is_none());
     }
 
     #[test]

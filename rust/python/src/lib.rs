@@ -55,6 +55,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(whittle_noise, m)?)?;
     m.add_function(wrap_pyfunction!(phase_grid::phase_bins, m)?)?;
     m.add_function(wrap_pyfunction!(phase_grid::add_waveform, m)?)?;
+    m.add_function(wrap_pyfunction!(phase_grid::lattice_bins, m)?)?;
+    m.add_function(wrap_pyfunction!(phase_grid::add_lattice_waveform, m)?)?;
     m.add_function(wrap_pyfunction!(davar_part, m)?)?;
     m.add_function(wrap_pyfunction!(part_grid, m)?)?;
     m.add_function(wrap_pyfunction!(compensated_sums, m)?)?;
