@@ -71,6 +71,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import partial
 from itertools import islice
 
 import numpy as np
@@ -83,7 +84,7 @@ from ._coupling import LAG_MARGIN, coupling_test, optional_terms, quadratic_test
 from ._edge import EdgeSource
 from ._gls_cov import interval_cov
 from ._lag import lag_grid, lagged, unresolved_lag
-from ._lag_time import lag_in_time
+from ._lag_time import lag_bands, lag_in_time
 from ._regressors import (
     CHANNEL_SNR,
     channel_signal,
@@ -362,7 +363,8 @@ def regress_channel(
         z2 = float(t_dist.isf((1.0 - confidence) / 2.0, in_phase["dof"])) ** 2
         boot = test["in_phase"].get("bartlett") if "bartlett" in test else None  # the coupling's bootstrap factor
         grid = lag_grid(y.size, fs)
-        keys, fit, lag_s, tests = optional_terms(bands, fit, terms, level, grid, z2, quad, boot)
+        timed = partial(lag_bands, y, xs, (mean, quad_mean), fs, state=True)  # (keys, T): lagged in time
+        keys, fit, lag_s, tests = optional_terms(bands, fit, terms, level, grid, z2, quad, boot, timed=timed)
         removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, grid, z2)
         if removal_lag is not None:
             removal_lag, fit = lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"], z2)
