@@ -334,7 +334,7 @@ def main(argv=None) -> int:
         return 0
     rows = []
     if args.part == "null":
-        for kind in ("slow_1hz", "channels_100hz", "level"):
+        for kind in ("level", "channels_100hz", "slow_1hz"):
             for k in range(args.null_records):
                 rows.append(null_one(kind, k))
                 print(json.dumps(rows[-1]), flush=True)

@@ -47,9 +47,11 @@ Optional terms, each kept only by its own nested test at its own share of the le
   statistic against the t-process upcrossing bound (Davies 1987; Worsley 1994: P(F(1, ν) > u) +
   (V/π)·(1 + u/ν)^{−(ν−1)/2}, V the arc length of the whitened family over the grid). A lag and a d(ch)/dt
   term are nearly collinear — never both: where the rate term passes its test, the pure lag model c·L_T[ch]
-  is weighed against it (two numbers each) and the larger likelihood kept, within :data:`LAG_MARGIN` in 2Δℓ
-  the phase's sign deciding (r/c < 0, a delay: the lag; r/c > 0, a lead: the rate term); where only the lag's
-  test passes, the lag (docs/channels.md, "A lag or a d(ch)/dt term"). A lag not kept
+  is weighed against it (two numbers each, the lag's state at the first sample one more, priced
+  :data:`~allanite.model._coupling.LAG_STATE_PRICE`; the channel lagged in time) and the larger likelihood
+  kept, within :data:`LAG_MARGIN` in 2Δℓ the phase's sign deciding (r/c < 0, a delay: the lag; r/c > 0, a
+  lead: the rate term); where only the lag's test passes, the lag (docs/channels.md, "A lag or a d(ch)/dt
+  term"). A lag not kept
   (and no d(ch)/dt term in its place) is still profiled: where the profile prefers a lag to none at the
   intervals' level, the removal takes the channel through it (:attr:`ChannelRegression.removal_lag_s`; the lag
   itself is reported as not resolved, under ``terms["lag_s"]["profiled"]``, not as a param) — at lag 0 the
