@@ -178,15 +178,19 @@ def one(name: str, seed: int) -> dict:
     return row
 
 
+#: The ``level`` null's coupling (per °C): on ``channels_100hz``'s 5–20 °C cycle, accepted on every record.
+LEVEL_COEF = 1e-3
+
+
 def null_one(kind: str, k: int) -> dict:
     """A ``refine_false_alarms`` record (``slow_1hz``, ``channels_100hz``) or ``level``: ``channels_100hz`` with
-    the rate on its cycling temperature's level alone."""
+    the rate on its cycling temperature's level alone (:data:`LEVEL_COEF`)."""
     mix = "slow_1hz" if kind == "slow_1hz" else "channels_100hz"
     seed = 77_000 + 1_000_003 * ("slow_1hz", "channels_100hz", "level").index(kind) + 97 * k
     y, fs, channels = rfa.record(mix, seed)
     temp = channels["temp"]
     if kind == "level":
-        y = y + 2e-4 * (temp - temp.mean())
+        y = y + LEVEL_COEF * (temp - temp.mean())
     r = _regress(y, temp, fs)
     sub = sorted(p for p in r.params if p != "coefficient")
     t_l = r.terms.get("lag_s", {})
@@ -239,6 +243,10 @@ def _pct(x) -> str:
     return "—" if x is None else f"{100 * x:+.1f} %"
 
 
+def _abs(x) -> str:
+    return "—" if x is None else f"{100 * x:.1f} %"
+
+
 def table(before: dict, after: dict) -> str:
     lines = [
         "| case | truth | records | weighed (b → a) | lag kept: before → after | d(ch)/dt kept: before → after "
@@ -260,7 +268,7 @@ def table(before: dict, after: dict) -> str:
             f"| {name} | {a['kind']} | {a['records']} | {m(b, 'weighed')} → {a['weighed']} | {m(b, 'lag')} → {a['lag']} "
             f"| {m(b, 'rate')} → {a['rate']} | {m(b, 'neither')} → {a['neither']} "
             f"| {_pct(m(b, 'median_error_coefficient'))} → {_pct(a.get('median_error_coefficient'))} "
-            f"| {_pct(m(b, 'median_abs_error_coefficient'))} → {_pct(a.get('median_abs_error_coefficient'))} "
+            f"| {_abs(m(b, 'median_abs_error_coefficient'))} → {_abs(a.get('median_abs_error_coefficient'))} "
             f"| {_pct(m(b, 'median_error_' + key))} → {_pct(a.get('median_error_' + key))} | {margin} |"
         )
     return "\n".join(lines)
@@ -271,7 +279,7 @@ def null_table(before: dict, after: dict) -> str:
         "slow_1hz": "refine_false_alarms' slow_1hz (1 Hz × 10⁵, a random-walk temperature, no coupling): coupling accepted",
         "channels_100hz": "refine_false_alarms' channels_100hz (100 Hz × 4·10⁵, a cycling temperature, no coupling): "
         "coupling accepted",
-        "level": "channels_100hz with 2·10⁻⁴ per °C on the level alone: any optional term kept",
+        "level": "channels_100hz with 10⁻³ per °C on the level alone: any optional term kept",
     }
     lines = ["| null | records | false alarms: before | after | lag kept (b → a) |", "|---|---|---|---|---|"]
     for kind, a in after.items():
@@ -313,6 +321,7 @@ def main(argv=None) -> int:
     p.add_argument("--case", action="append", help="only cases whose name contains this text (repeatable)")
     p.add_argument("--seeds", type=int, default=None, help="seeds per case (default the case's own count)")
     p.add_argument("--null-records", type=int, default=100, help="records per null kind")
+    p.add_argument("--null-kind", action="append", help="only these null kinds (repeatable; default all three)")
     p.add_argument("--out", type=Path, default=HERE / "results")
     p.add_argument("--tag", default="after", help="the JSON's suffix: before or after")
     p.add_argument("--page", action="store_true", help="only write the page from the JSONs")
@@ -321,10 +330,13 @@ def main(argv=None) -> int:
     stem = args.out / "r14lagrate"
     if args.page:
         runs = {}
-        for tag in ("before", "after", "null_before", "null_after"):
-            path = Path(f"{stem}_{tag}.json")
-            if path.exists():
-                runs[tag] = json.loads(path.read_text())
+        for tag in ("before", "after"):
+            runs[tag] = json.loads(Path(f"{stem}_{tag}.json").read_text())
+            parts = [json.loads(p.read_text())["rows"] for p in sorted(args.out.glob(f"r14lagrate_null_{tag}*.json"))]
+            if parts:  # a kind rerun on its own (``--null-kind``) replaces that kind's rows
+                own = {r["kind"] for r in parts[-1]} if len(parts) > 1 else set()
+                rows = [r for part in parts[:-1] for r in part if r["kind"] not in own] + parts[-1]
+                runs[f"null_{tag}"] = {"rows": rows}
         meta = runs["after"].get("meta", {}) | json.loads(args.meta)
         text = page(runs, meta)
         Path(f"{stem}.md").write_text(text)
@@ -334,11 +346,11 @@ def main(argv=None) -> int:
         return 0
     rows = []
     if args.part == "null":
-        for kind in ("level", "channels_100hz", "slow_1hz"):
+        for kind in args.null_kind or ("level", "channels_100hz", "slow_1hz"):
             for k in range(args.null_records):
                 rows.append(null_one(kind, k))
                 print(json.dumps(rows[-1]), flush=True)
-        tag = f"null_{args.tag}"
+        tag = f"null_{args.tag}" + "".join(f"_{k}" for k in args.null_kind or ())
     else:
         names = [n for n in CASES if not args.case or any(c in n for c in args.case)]
         for name in names:

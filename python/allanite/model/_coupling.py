@@ -348,11 +348,13 @@ def _lag_or_rate(keys, fit, fit_r, tests, timed, bounds: tuple) -> str:
     the channel's bins times the lag's response at each bin's own frequency did not (a cycle's leakage is
     lagged at the cycle's frequency, not its neighbours'), and that misfit, a few units of 2Δℓ in each bin
     beside a strong cycle, decided the choice: a 150 s lag on a 1000 s cycle (ωT = 0.94, mems50) lost to the
-    rate term by 15–160 on 18 of 40 records, the coefficient then −46 %; in time the lag won by 21–46 on each of
-    five of them. And with its state free: a lag that ran before the record began (a log started while the
-    temperature cycles) leaves e^{−t/T} times the difference between its output and the channel at the first
-    sample, which a lag started in equilibrium cannot fit and a memoryless d(ch)/dt term does not need — a 4775 s
-    lag on a 10⁴ s cycle (ωT = 3, 1 Hz × 10⁵) lost by 48 and 162 started in equilibrium, won by 17 and 18 free."""
+    rate term on 18 of 40 records, the coefficient then −46 %; in time the lag is kept on all 18 (by more than
+    :data:`LAG_MARGIN` on 15), the coefficient's median error +0.2 % (benches/results/r14lagrate.md). And with its
+    state free: a lag that ran before the record began (a log started while the temperature cycles) leaves
+    e^{−t/T} times the difference between its output and the channel at the first sample, which a lag started in
+    equilibrium cannot fit and a memoryless d(ch)/dt term does not need — a 4775 s lag on a 10⁴ s cycle (ωT = 3,
+    1 Hz × 10⁵) lost to the rate term by 48 and 162 started in equilibrium, won by 15 and 16 free (its price
+    paid)."""
     t_l, t_r = tests["lag_s"], tests["rate_coefficient"]
     lag_s, fit_l = _lag_fit_in_time(keys, fit, t_l, timed, bounds)
     margin = 2.0 * (float(fit_l["loglik"]) - float(fit_r["loglik"])) - LAG_STATE_PRICE
