@@ -318,7 +318,11 @@ NOTES: list[str] = [
     "**The suites' own records** (`regress_channel` on the rows' generators and seeds, /tmp driver): blind8's 48 h "
     "(seed 803) the rate term by 37.7 → 38.1, blind9's dT/dt only (902) 46.0 → 47.2, refine_sensors' dT/dt (4) "
     "192 → 194, every param identical; refine_sensors' 300 s lag row weighs nothing (no d(ch)/dt term passes) and "
-    "is identical.",
+    "is identical. The rows rerun through refine on this branch (`refine_sensors.py --case dT/dt`, "
+    "`refine_blind9.py --case 'dT/dt only'`, to a temporary folder): each row as recorded (✓ 0.844 / 1.74 %; ✗ on "
+    "the in-sample chain as since r13rate, the rate coefficient 0.02392, −4.3 %). `refine` with default arguments "
+    "on `mems50` seed 4: main keeps the d(ch)/dt term (coefficient 5.47·10⁻⁴, −45 %), this branch the lag (150.7 s, "
+    "1.004·10⁻³), nothing unexplained on either.",
     "**Nulls.** The choice is made only where the d(ch)/dt term passed its own test, so a record keeps a lag or a "
     "d(ch)/dt term exactly where it did before (only which one can change) and the coupling's test is untouched: "
     "the rows above read the same before and after on every record. The level-only rows (100 records, accepted on "
