@@ -14,7 +14,7 @@ from allanite.model._coupling import LAG_MARGIN
 from allanite.model.channels import regress_channel
 from allanite.model.refinement.levels import LEVEL, alpha
 from allanite.report._regression import _optional_words
-from sensors import temperature_profile
+from sensors import first_order_lag, temperature_profile
 from test_channel_lag_first_test import FS, UNIT, N, _record
 
 
@@ -62,3 +62,39 @@ def test_a_leading_rate_term_is_kept_not_a_lag():
     assert r.params["coefficient"] == pytest.approx(2e-4, rel=0.1)
     assert t_l["rate_over_coefficient"] > 0.0 and t_l["against_rate"] < -LAG_MARGIN and not t_l["tie"]
     assert t_r["why"].startswith("kept over the lag: it fits better")
+
+
+def _chamber(seed: int, lag_s: float, before: float):
+    """10 Hz × 4·10⁴ (4000 s), MEMS-like noise; a chamber cycling 0–50 °C every 1000 s (random phase, ±1 °C of
+    wander) reaching the rate through ``lag_s`` at 10⁻³ per °C, the lag run from ``before`` seconds before the
+    record (0: started with it, in equilibrium)."""
+    fs, n = 10.0, 40_000
+    rng = np.random.default_rng(seed)
+    pre = int(before * fs)
+    t = (np.arange(pre + n) - pre) / fs
+    walk = first_order_lag(np.cumsum(rng.standard_normal(t.size)), fs, 200.0)
+    temp = 25.0 + 25.0 * np.sin(2 * np.pi * t / 1000.0 + rng.uniform(0, 2 * np.pi)) + 2.0 * walk / np.ptp(walk)
+    drive = first_order_lag(temp, fs, lag_s)[pre:]
+    y = allanite.simulate(n, fs, N=4e-3, B=4e-4, K=3e-5, seed=seed + 100) + 1e-3 * (drive - drive.mean())
+    return y, temp[pre:] + 0.02 * rng.standard_normal(n), fs
+
+
+@pytest.mark.parametrize(("seed", "lag_s", "before"), [(4, 150.0, 0.0), (6, 477.0, 4000.0)])
+def test_a_lag_near_one_radian_is_weighed_in_time_and_kept(seed, lag_s, before):
+    # ωT 0.94 started with the record, and ωT 3 run long before it: the rate term passes its test on both. Weighed
+    # as each bin times the lag's response at its own frequency (a cycle's leakage is lagged at the cycle's) and
+    # in equilibrium at the first sample, the lag lost by 159 and 99 and the coefficient read −46 % and −90 %
+    y, temp, fs = _chamber(seed, lag_s, before)
+    r = _regress_at(y, temp, fs)
+    t_l, t_r = r.terms["lag_s"], r.terms["rate_coefficient"]
+    assert t_r["statistic"] > t_r["threshold"] and not t_r["kept"] and "rate_coefficient" not in r.params
+    assert t_l["kept"] and r.params["lag_s"] == pytest.approx(lag_s, rel=0.2)
+    assert r.params["coefficient"] == pytest.approx(1e-3, rel=0.2)
+    if before == 0.0:  # in equilibrium at the start, the wander tells them apart
+        assert t_l["against_rate"] > LAG_MARGIN and t_l["why"].startswith("kept over the d(ch)/dt term: it fits")
+    else:  # its state free, the lag fits as well as the rate term: the delay decides
+        assert t_l["against_rate"] > -LAG_MARGIN and t_l["rate_over_coefficient"] < 0.0
+
+
+def _regress_at(y, temp, fs):
+    return regress_channel(y, temp, fs, name="temp", alpha=alpha("regression", LEVEL), level=LEVEL)

@@ -15,13 +15,14 @@ from scipy.stats import f as f_dist
 
 from . import _whittle as wh
 from ._edge import edge_factor
-from ._lag import lag_profile, lag_response, lag_test
+from ._lag import exact_lag, lag_profile, lag_test
 from ._recent import Small
 from ._regressors import regressor_design
 from ._shares import TERM_SHARE
 
 __all__ = [
     "LAG_MARGIN",
+    "LAG_STATE_PRICE",
     "BOOT_COST",
     "BOOT_DRAWS",
     "coupling_test",
@@ -34,6 +35,9 @@ __all__ = [
 #: A lag and a d(ch)/dt term that both describe the channel's phase fit "within noise" of each other when their
 #: 2Δℓ differ by at most this (≈ χ²₁'s 95 % quantile, 3.84): the sign of r/c then chooses (:func:`_lag_or_rate`).
 LAG_MARGIN = 4.0
+#: The lag model weighed against the d(ch)/dt term carries one number more, the lag's state at the record's first
+#: sample (:func:`_lag_fit_in_time`): its 2Δℓ is taken less this (Akaike's price of a number, 2).
+LAG_STATE_PRICE = 2.0
 #: The coupling's F(2, ν) reference is calibrated by a parametric bootstrap when its threshold exceeds the one of
 #: a known noise level (χ²₂) by more than this factor: a Satterthwaite ν under ≈ 20 at refine's α.
 BOOT_COST = 4.0 / 3.0
@@ -245,11 +249,14 @@ def quadratic_test(bands, fit, alpha) -> tuple[dict, dict]:
     return t_q | {"kept": t_q["statistic"] > t_q["threshold"]}, big
 
 
-def optional_terms(bands, fit, terms, level, grid, z2, quadratic=None, bartlett=None):
+def optional_terms(bands, fit, terms, level, grid, z2, quadratic=None, bartlett=None, *, timed):
     """Quadratic first (``quadratic``: its :func:`quadratic_test` already run), then d(ch)/dt or a lag (never
     both), then — where a d(ch)/dt term alone was kept — the level term itself (:func:`level_test`).
     ``bartlett``: the coupling's in-phase Bartlett factor where its reference was the bootstrap, for the level
-    test's. Returns (kept keys, fit, lag_s, tests)."""
+    test's. ``timed(keys, lag_s)``: the record's band sums beside the channel lagged in time and the lag's decay
+    after it (:func:`allanite.model._lag_time.lag_bands` with ``state``), for weighing a lag against a d(ch)/dt
+    term (:func:`_lag_or_rate`).
+    Returns (kept keys, fit, lag_s, tests)."""
     nb = bands.m.size
     keys: list = []
     tests: dict = {}
@@ -273,7 +280,7 @@ def optional_terms(bands, fit, terms, level, grid, z2, quadratic=None, bartlett=
         if t_l["statistic"] > t_l["threshold"] or rate_ok:
             best, interval = lag_profile(bands, design, fit["s"], grid, z2)
             tests["lag_s"] |= {"lag_s": best, "interval": interval}
-            if not rate_ok or _lag_or_rate(bands, design, fit_r, tests) == "lag":
+            if not rate_ok or _lag_or_rate(keys, fit, fit_r, tests, timed, (grid[0], grid[-1])) == "lag":
                 tests["lag_s"]["kept"] = True
                 rate_ok, lag_s = False, best
     if rate_ok:
@@ -317,31 +324,45 @@ def level_test(bands, keys, fit, alpha, bartlett: float | None = None) -> tuple[
     return test | {"kept": bool(kept)}, (fit if kept else small)
 
 
-def _lag_or_rate(bands, design, fit_r, tests) -> str:
+def _lag_or_rate(keys, fit, fit_r, tests, timed, bounds: tuple) -> str:
     """Where the d(ch)/dt term passed its test (a phase term beside the channel is established), which of the two
-    descriptions of it is kept: ``"lag"`` (the pure lag model c·L_T[ch], T from the profile already in
-    ``tests["lag_s"]``) or ``"rate"`` (c·ch + r·d(ch)/dt, ``fit_r``) — never both; the choice written into
-    ``tests`` (``against_rate``: the lag model's 2Δℓ over the rate model; ``rate_over_coefficient``: r/c, s;
-    ``tie``; ``why``). Both models have two numbers (c, T against c, r), so the larger likelihood is kept;
-    within :data:`LAG_MARGIN` of each other the record cannot tell them apart at the one frequency a cycling
-    channel has (both are a phase shift there), and the sign of the phase decides: r/c < 0 is a delay — what a
-    first-order lag is (r ≈ −c·T) — so the lag; r/c > 0 a lead, which no lag makes, so the rate term.
+    descriptions of it is kept: ``"lag"`` (the pure lag model c·L_T[ch], the channel lagged in time:
+    :func:`_lag_fit_in_time`) or ``"rate"`` (c·ch + r·d(ch)/dt, ``fit_r``) — never both; the choice written into
+    ``tests`` (``against_rate``: the lag model's 2Δℓ over the rate model; ``lag_in_time_s``: the T it was weighed
+    at; ``rate_over_coefficient``: r/c, s; ``tie``; ``why``). Both models have two numbers (c, T against c, r),
+    so the larger likelihood is kept; within :data:`LAG_MARGIN` of each other the record cannot tell them apart at
+    the one frequency a cycling channel has (both are a phase shift there), and the sign of the phase decides:
+    r/c < 0 is a delay — what a first-order lag is (r ≈ −c·T) — so the lag; r/c > 0 a lead, which no lag makes,
+    so the rate term. ``fit``: the model without either (its noise the start of both). The lag model's 2Δℓ is
+    taken less :data:`LAG_STATE_PRICE` for its one more number, the lag's state at the first sample.
 
     Why not the lag's own test first: over a grid of T it pays for the search (the arc length's upcrossings), and
     on a 600 s lag (100 Hz × 10⁶, a 3333 s cycle) it read 13.8 against 20.3 where the rate term read 22.0 against
     14.8 — the lag never stood a chance, the rate term was kept with the coefficient at −52 % (blind9). The lag
     needs no test of its own here: it stands in for a term whose test passed, at the same count of numbers, so on
     a record without coupling it can be kept no more often than the rate term was (docs/channels.md, "A lag or a
-    d(ch)/dt term")."""
+    d(ch)/dt term").
+
+    Why in time (r14lagrate): the rate model's d(ch)/dt column is the channel differentiated in time, so it
+    describes a cycle's leakage into the neighbouring bins of the tapered transform exactly; the lag weighed as
+    the channel's bins times the lag's response at each bin's own frequency did not (a cycle's leakage is
+    lagged at the cycle's frequency, not its neighbours'), and that misfit, a few units of 2Δℓ in each bin
+    beside a strong cycle, decided the choice: a 150 s lag on a 1000 s cycle (ωT = 0.94, mems50) lost to the
+    rate term on 18 of 40 records, the coefficient then −46 %; in time the lag is kept on all 18 (by more than
+    :data:`LAG_MARGIN` on 15), the coefficient's median error +0.2 % (benches/results/r14lagrate.md). And with its
+    state free: a lag that ran before the record began (a log started while the temperature cycles) leaves
+    e^{−t/T} times the difference between its output and the channel at the first sample, which a lag started in
+    equilibrium cannot fit and a memoryless d(ch)/dt term does not need — a 4775 s lag on a 10⁴ s cycle (ωT = 3,
+    1 Hz × 10⁵) lost to the rate term by 48 and 162 started in equilibrium, won by 15 and 16 free (its price
+    paid)."""
     t_l, t_r = tests["lag_s"], tests["rate_coefficient"]
-    lag_design = wh.Design(design.src, [lag_response(bands.f, t_l["lag_s"], bands.fs)] + design.mult[1:])
-    fit_l = wh.joint_fit(bands, lag_design)
-    margin = 2.0 * (float(fit_l["loglik"]) - float(fit_r["loglik"]))
+    lag_s, fit_l = _lag_fit_in_time(keys, fit, t_l, timed, bounds)
+    margin = 2.0 * (float(fit_l["loglik"]) - float(fit_r["loglik"])) - LAG_STATE_PRICE
     c, r = float(fit_r["c"][0]), float(fit_r["c"][-1])
     ratio = r / c if c != 0.0 else math.copysign(math.inf, r)
     tie = abs(margin) <= LAG_MARGIN
     lag = margin > LAG_MARGIN or (tie and ratio < 0.0)
-    t_l |= {"against_rate": margin, "rate_over_coefficient": ratio, "tie": tie}
+    t_l |= {"against_rate": margin, "lag_in_time_s": lag_s, "rate_over_coefficient": ratio, "tie": tie}
     sides = f"2Δℓ {margin:+.3g} of the lag over the d(ch)/dt term, r/c {ratio:.3g} s"
     if tie:
         why = f"the two fit within {LAG_MARGIN:g} of each other ({sides}): " + (
@@ -354,3 +375,26 @@ def _lag_or_rate(bands, design, fit_r, tests) -> str:
     if lag:
         t_r["kept"] = False
     return "lag" if lag else "rate"
+
+
+def _lag_fit_in_time(keys, fit, t_l, timed, bounds: tuple) -> tuple[float, dict]:
+    """The pure lag model on the band sums of the channel lagged in time, its state at the first sample free
+    (``timed(keys, T)``: the lag's decay e^{−t/T} the column after the model's): T refined from the profile's
+    (``t_l["lag_s"]``) at ``fit``'s noise (:func:`allanite.model._lag.exact_lag`, as the removal's), then
+    coefficients and noise fitted jointly at that T — the better of a cold start and one from ``fit``'s noise (the
+    noise fit's optimum depends on where it starts: on one mems50 record the cold start ended 130 below).
+    Returns (T, the fit)."""
+    nb = fit["s"].size
+    design = regressor_design(keys, nb)
+    design = design.plus(len(design), np.ones(nb))
+
+    def objective(lag_s: float) -> float:
+        info, sc = design.gram(timed(keys, lag_s), 1.0 / fit["s"])
+        return float(sc @ np.linalg.solve(info, sc))
+
+    lag_s = exact_lag(objective, float(t_l["lag_s"]), tuple(t_l["interval"]), bounds)[0]
+    b = timed(keys, lag_s)
+    cold = wh.joint_fit(b, design)
+    start = wh.joint_fit(b, design, fixed_s=fit["s"]) | {"amounts": fit["amounts"]}
+    warm = wh.joint_fit(b, design, start=start)
+    return lag_s, (warm if warm["loglik"] > cold["loglik"] else cold)

@@ -33,7 +33,7 @@ from ._gls_cov import interval_cov
 from ._lag import exact_lag, lag_grid, lagged
 from ._regressors import regressor_design, regressor_iter, regressors
 
-__all__ = ["lag_in_time", "lag_slope", "interval_cov_beside_lag", "profile_interval"]
+__all__ = ["lag_in_time", "lag_bands", "lag_slope", "interval_cov_beside_lag", "profile_interval"]
 
 
 def lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict, z2: float) -> tuple[float, dict]:
@@ -65,13 +65,25 @@ def lag_in_time(y, xs, means, fs: float, keys, s, t_lag: dict, z2: float) -> tup
     return best, fit | {"cov": full[:-1, :-1]}
 
 
+def lag_bands(y, xs, means, fs: float, keys, lag_s: float, state: bool = False) -> wh.Bands:
+    """The band sums of ``y`` beside the channel lagged in time by ``lag_s`` (:func:`allanite.model._lag.lagged`,
+    from equilibrium with its first sample), the quadratic beside it where among ``keys`` — the pure lag model's
+    columns as the removal takes them —, and with ``state`` the lag's own decay e^{−t/T} after them: the lag's
+    output at the record's first sample is not the channel's there unless the lag started with the record (a log
+    begun while the temperature moves), and what it differs by decays so."""
+    n_cols = 2 if "quadratic" in keys else 1  # a lag is never beside the d(ch)/dt term
+    cols = regressors(xs, means[0], means[1], fs, lag_s)[:n_cols]
+    if state:
+        cols.append(np.exp(-np.arange(xs.size) / (fs * lag_s)))
+    return wh.spectra(y, cols, fs)
+
+
 def _objective(y, xs, means, fs: float, keys, s):
     """Δℓ of the pure lag model (the channel through T, the quadratic beside it where kept) at the noise ``s``, on
-    the band sums of the channel lagged in time — a function of T."""
-    n_cols = 2 if "quadratic" in keys else 1  # a lag is never beside the d(ch)/dt term
+    the band sums of the channel lagged in time (:func:`lag_bands`) — a function of T."""
 
     def objective(lag_s: float) -> float:
-        b = wh.spectra(y, regressors(xs, means[0], means[1], fs, lag_s)[:n_cols], fs)
+        b = lag_bands(y, xs, means, fs, keys, lag_s)
         info, sc = regressor_design(keys, b.m.size).gram(b, 1.0 / s)
         return float(sc @ np.linalg.solve(info, sc))
 

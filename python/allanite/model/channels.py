@@ -47,9 +47,11 @@ Optional terms, each kept only by its own nested test at its own share of the le
   statistic against the t-process upcrossing bound (Davies 1987; Worsley 1994: P(F(1, ν) > u) +
   (V/π)·(1 + u/ν)^{−(ν−1)/2}, V the arc length of the whitened family over the grid). A lag and a d(ch)/dt
   term are nearly collinear — never both: where the rate term passes its test, the pure lag model c·L_T[ch]
-  is weighed against it (two numbers each) and the larger likelihood kept, within :data:`LAG_MARGIN` in 2Δℓ
-  the phase's sign deciding (r/c < 0, a delay: the lag; r/c > 0, a lead: the rate term); where only the lag's
-  test passes, the lag (docs/channels.md, "A lag or a d(ch)/dt term"). A lag not kept
+  is weighed against it (two numbers each, the lag's state at the first sample one more, priced
+  :data:`~allanite.model._coupling.LAG_STATE_PRICE`; the channel lagged in time) and the larger likelihood
+  kept, within :data:`LAG_MARGIN` in 2Δℓ the phase's sign deciding (r/c < 0, a delay: the lag; r/c > 0, a
+  lead: the rate term); where only the lag's test passes, the lag (docs/channels.md, "A lag or a d(ch)/dt
+  term"). A lag not kept
   (and no d(ch)/dt term in its place) is still profiled: where the profile prefers a lag to none at the
   intervals' level, the removal takes the channel through it (:attr:`ChannelRegression.removal_lag_s`; the lag
   itself is reported as not resolved, under ``terms["lag_s"]["profiled"]``, not as a param) — at lag 0 the
@@ -71,6 +73,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import partial
 from itertools import islice
 
 import numpy as np
@@ -83,7 +86,7 @@ from ._coupling import LAG_MARGIN, coupling_test, optional_terms, quadratic_test
 from ._edge import EdgeSource
 from ._gls_cov import interval_cov
 from ._lag import lag_grid, lagged, unresolved_lag
-from ._lag_time import lag_in_time
+from ._lag_time import lag_bands, lag_in_time
 from ._regressors import (
     CHANNEL_SNR,
     channel_signal,
@@ -362,7 +365,8 @@ def regress_channel(
         z2 = float(t_dist.isf((1.0 - confidence) / 2.0, in_phase["dof"])) ** 2
         boot = test["in_phase"].get("bartlett") if "bartlett" in test else None  # the coupling's bootstrap factor
         grid = lag_grid(y.size, fs)
-        keys, fit, lag_s, tests = optional_terms(bands, fit, terms, level, grid, z2, quad, boot)
+        timed = partial(lag_bands, y, xs, (mean, quad_mean), fs, state=True)  # (keys, T): lagged in time
+        keys, fit, lag_s, tests = optional_terms(bands, fit, terms, level, grid, z2, quad, boot, timed=timed)
         removal_lag = lag_s if lag_s is not None else _removal_lag(bands, fit, keys, tests, grid, z2)
         if removal_lag is not None:
             removal_lag, fit = lag_in_time(y, xs, (mean, quad_mean), fs, keys, fit["s"], tests["lag_s"], z2)
