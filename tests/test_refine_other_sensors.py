@@ -122,11 +122,9 @@ def test_other_sensors_curves_get_one_region_per_misfit(shared_data, load_avar_c
     assert spans and all(b0 <= a1 * (1 + 1e-9) for (_a0, b0), (a1, _b1) in zip(spans, spans[1:])), spans
     r = allanite.refine(load_avar_curve(root / "ln200_av.csv")["Accel. Y"], progress=False)
     # the misfit around τ = 10 s is named — as "the model lies above the curve" when nothing is added; since the
-    # curve-only lines are taken (five at 0.7–40 Hz), as a region where the curve departs from the model; since the
-    # resonance kind is the digital resonator (r14reson: three resonances and three lines taken), χ²/dof 17 there
-    # (74 before) — still a misfit far beyond the score's calibration, named
+    # curve-only lines are taken (five at 0.7–40 Hz), as a region where the curve departs from the model
     named = [u for u in r.unexplained if u["tau"][0] <= 10.24 <= u["tau"][1]]
-    assert named and named[0]["chi2_dof"] > 10, r.unexplained
+    assert named and named[0]["chi2_dof"] > 50, r.unexplained
 
 
 def test_a_candidate_whose_test_passed_but_was_not_taken_says_why():
