@@ -389,32 +389,16 @@ def resonance_avar(tau: np.ndarray | float, f_r: float, q: float, fs: float) -> 
     σ²(m) = (Var S_m − Cov(S_m, next S_m))/(m²R(0)), both closed geometric sums in p_k (:func:`_two_pole_avar`)."""
     tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
     m = np.maximum(1.0, np.round(tau * fs))
-    w0, half = _resonator_angles(f_r, q, fs)
-    g = 1.0 / (1.0 + math.tan(half))
+    w0 = 2.0 * math.pi * f_r / fs
+    g = 1.0 / (1.0 + math.tan(w0 / (2.0 * q)))
     poles = np.roots([1.0, -2.0 * g * math.cos(w0), 2.0 * g - 1.0]).astype(np.complex128)
-    # a pole at 0 (g = 1/2; both at 0 when ω₀ is π/2 too): moved off it, apart, c_k·p_k^l keeps its limit
-    poles = np.where(np.abs(poles) < 1e-7, np.array([1e-7, -1e-7]), poles)
     if poles[0] == poles[1]:  # a double pole (f_r/q at its one value for f_r): nudged, the sums stay finite
         poles = poles * np.array([1.0 + 1e-9, 1.0 - 1e-9])
-    big = np.abs(poles) > 1.0 - 1e-12  # on the unit circle (half width at π/2 with ω₀ at π): just inside it
-    poles[big] *= (1.0 - 1e-12) / np.abs(poles[big])
     # the all-pole part's autocorrelation R_x(l) = Σ_k d_k p_k^l for l ≥ −1 (residues of its PSD); the zeros
     # (1 − z⁻²) make R(l) = 2R_x(l) − R_x(l − 2) − R_x(l + 2): c_k = −d_k(p_k − 1/p_k)² for l ≥ 1
     d = poles / ((poles - poles[::-1]) * (1.0 - poles * poles[0]) * (1.0 - poles * poles[1]))
     r0 = float(np.sum(2.0 * d * (1.0 - poles * poles)).real)
     return _two_pole_avar(m, r0, -d * (poles - 1.0 / poles) ** 2, poles)
-
-
-def _resonator_angles(f_r: float, q: float, fs: float) -> tuple[float, float]:
-    """The resonator's centre ω₀ (rad/sample) and half its −3 dB width (rad), kept where the design is defined:
-    a centre beyond f_s/2 (an interval's profile scans to 4.5× the best f_r) folds as a sampled resonance
-    aliases, kept just inside (0, π) where the zeros at DC and Nyquist would meet the peak; the half width
-    π·(f_r/q)/f_s (the physical width, whatever the fold) stays below π/2, where tan and the poles stay finite."""
-    f = math.fmod(abs(f_r), fs)
-    f = fs - f if f > fs / 2.0 else f
-    w0 = min(max(2.0 * math.pi * f / fs, 1e-6), math.pi * (1.0 - 1e-6))
-    half = min(math.pi * abs(f_r) / (q * fs), 0.5 * math.pi * (1.0 - 1e-6))
-    return w0, half
 
 
 def _two_pole_avar(m: np.ndarray, r0: float, c: np.ndarray, poles: np.ndarray) -> np.ndarray:
