@@ -425,39 +425,32 @@ def test_tau_range_auto_and_bad_arguments():
         allanite.refine(allanite.avar(y, FS), channels={"T": y})
 
 
+def _narrowband(n, f_r, q, sigma, seed):
+    """Narrowband noise with autocorrelation σ²·e^{−πf_r·l/(q·f_s)}·cos(2πf_r·l/f_s): a complex AR(1)'s real part."""
+    rho = np.exp(-np.pi * f_r / (q * FS) + 2j * np.pi * f_r / FS)
+    rng = np.random.default_rng(seed)
+    e = (rng.normal(size=n) + 1j * rng.normal(size=n)) * np.sqrt(1 - abs(rho) ** 2)
+    return sigma * signal.lfilter([1], [1, -rho], e).real
+
+
 def test_resonance_avar_matches_a_simulation():
-    # the kind is the digital resonator iirpeak designs (zeros at DC and Nyquist): white noise through it, at
-    # f_r/f_s 0.2 (Q 8) and 0.05 (Q 2), against the Rust core's overlapping AVAR
-    rng = np.random.default_rng(0)
-    for f_r, q in ((20.0, 8.0), (5.0, 2.0)):
-        b, a = signal.iirpeak(f_r, q, fs=FS)
-        y = signal.lfilter(b, a, rng.normal(size=1_000_000))[1000:]
-        tau = np.array([0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 1.0])
-        np.testing.assert_allclose(
-            allanite.avar(y, FS, taus=tau).avar / y.var(), resonance_avar(tau, f_r, q, FS), rtol=0.04
-        )
-    # the closed geometric sums equal the lag sum Σ_l A_m(l)·R(l)/2m² over the filter's own autocorrelation
-    b, a = signal.iirpeak(20.0, 2.0, fs=FS)
-    h = signal.lfilter(b, a, np.r_[1.0, np.zeros(4000)])
-    r_half = np.correlate(h, h, "full")[h.size - 1 :][:400]
-    r = np.r_[r_half[:0:-1], r_half] / r_half[0]
-    lag = np.arange(-399, 400)
-    for m in (1, 7, 60):
-        tri = lambda x, m=m: np.maximum(0, m - np.abs(x))  # noqa: E731
-        direct = np.sum((2 * tri(lag) - tri(lag - m) - tri(lag + m)) * r) / (2 * m * m)
-        assert resonance_avar(m / FS, 20.0, 2.0, FS)[0] == pytest.approx(direct, rel=1e-9)
-    # its PSD is zero at DC: the Allan variance falls as 1/τ², no white noise in the column (N's)
-    far = resonance_avar(np.array([10.0, 100.0]), 20.0, 8.0, FS)
-    assert far[1] / far[0] == pytest.approx(1e-2, rel=1e-3)
+    y = _narrowband(2_000_000, 20.0, 2.0, 1.0, 0)
+    tau = np.array([0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 1.0])
+    np.testing.assert_allclose(
+        allanite.avar(y, FS, taus=tau).avar / y.var(), resonance_avar(tau, 20.0, 2.0, FS), rtol=0.02
+    )
+    # the closed geometric sums equal the lag sum Σ_l A_m(l)·R(l)/2m² term by term
+    m = 7
+    lag = np.arange(-400, 401)
+    r = np.exp(-np.pi * 20.0 * np.abs(lag) / (2.0 * FS)) * np.cos(2 * np.pi * 20.0 * lag / FS)
+    tri = lambda x: np.maximum(0, m - np.abs(x))  # noqa: E731
+    direct = np.sum((2 * tri(lag) - tri(lag - m) - tri(lag + m)) * r) / (2 * m * m)
+    assert resonance_avar(m / FS, 20.0, 2.0, FS)[0] == pytest.approx(direct, rel=1e-12)
 
 
 def test_finds_a_simulated_resonance():
     n = 400_000
-    # a digital resonator (iirpeak), what the kind is; a Lorentzian pair (R(l) = Re ρ^|l|) holds white noise at DC
-    # beside its hump and now takes a second resonance
-    b, a = signal.iirpeak(12.0, 4.0, fs=FS)
-    hump = signal.lfilter(b, a, np.random.default_rng(7).normal(size=n + 2000))[2000:]
-    y = allanite.simulate(n, FS, N=2e-3, K=2e-5, seed=4) + 1e-2 * hump / hump.std()
+    y = allanite.simulate(n, FS, N=2e-3, K=2e-5, seed=4) + _narrowband(n, 12.0, 4.0, 1e-2, 7)
     r = allanite.refine(y, FS, truth={"resonance": {"sigma": 1e-2, "f0": 12.0}})
     assert r.found == ["resonance"]
     st = r.steps[0]

@@ -376,42 +376,24 @@ RESONANCE_Q = (2.0, 4.0, 8.0, 16.0)
 
 def resonance_avar(tau: np.ndarray | float, f_r: float, q: float, fs: float) -> np.ndarray:
     """Allan variance of unit-variance narrowband rate noise at ``f_r`` (Hz) with quality factor ``q`` —
-    exact in discrete time for samples at ``fs``: white noise through the digital 2nd-order resonator
-    H(z) = g(1 − z⁻²)/(1 − 2g·cos ω₀·z⁻¹ + (2g − 1)z⁻²), ω₀ = 2πf_r/f_s, g = 1/(1 + tan(ω₀/2q))
-    (``scipy.signal.iirpeak``: PSD peak 1 at f_r, half power at f_r ± f_r/2q, zeros at DC and Nyquist).
+    exact in discrete time for samples at ``fs``.
 
-    Its PSD is zero at DC, so its Allan variance falls as 1/τ² at τ ≫ 1/f_r, as a resonance's does: no white
-    noise in its column to trade with N (a Lorentzian pair, R(l) = Re ρ^|l|, which this kind was before, holds
-    a white level at DC and took all of N beside a 310 Hz, Q 8 hump at 2 kHz: ``benches/refine_blind11.py``).
-    A continuous resonator read as velocity and sampled is this kind plus white noise (N's) to ≤ 2 % rms at
-    f_r/f_s ≤ 0.3, Q 2–30; one read as displacement adds a flat band below f_r, a roll-off (the bandwidth kinds).
-    With R(l) = Σ_k c_k p_k^l (l ≥ 1) over the poles p_k and S_m the sum of m samples,
-    σ²(m) = (Var S_m − Cov(S_m, next S_m))/(m²R(0)), both closed geometric sums in p_k (:func:`_two_pole_avar`)."""
+    The noise's autocorrelation is R(l) = Re ρ^|l|, ρ = e^{−πf_r/(q·f_s)}·e^{i2πf_r/f_s} (a Lorentzian pair of
+    PSD peaks at ±f_r, full width f_r/q: a resonance driven by broadband noise, or a hump of vibration).
+    With S_m the sum of m samples, σ²(m) = (Var S_m − Cov(S_m, next S_m))/m², both linear in R, so closed
+    geometric sums in ρ: Var = m(1 + ρ)/(1 − ρ) − 2ρ(1 − ρ^m)/(1 − ρ)², Cov = ρ(1 − ρ^m)²/(1 − ρ)², real
+    part taken."""
     tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
     m = np.maximum(1.0, np.round(tau * fs))
-    w0 = 2.0 * math.pi * f_r / fs
-    g = 1.0 / (1.0 + math.tan(w0 / (2.0 * q)))
-    poles = np.roots([1.0, -2.0 * g * math.cos(w0), 2.0 * g - 1.0]).astype(np.complex128)
-    if poles[0] == poles[1]:  # a double pole (f_r/q at its one value for f_r): nudged, the sums stay finite
-        poles = poles * np.array([1.0 + 1e-9, 1.0 - 1e-9])
-    # the all-pole part's autocorrelation R_x(l) = Σ_k d_k p_k^l for l ≥ −1 (residues of its PSD); the zeros
-    # (1 − z⁻²) make R(l) = 2R_x(l) − R_x(l − 2) − R_x(l + 2): c_k = −d_k(p_k − 1/p_k)² for l ≥ 1
-    d = poles / ((poles - poles[::-1]) * (1.0 - poles * poles[0]) * (1.0 - poles * poles[1]))
-    r0 = float(np.sum(2.0 * d * (1.0 - poles * poles)).real)
-    return _two_pole_avar(m, r0, -d * (poles - 1.0 / poles) ** 2, poles)
-
-
-def _two_pole_avar(m: np.ndarray, r0: float, c: np.ndarray, poles: np.ndarray) -> np.ndarray:
-    """σ²(m) of a process with R(0) = ``r0`` and R(l) = Σ_k c_k p_k^l for l ≥ 1, per unit variance: Var S_m =
-    m·R(0) + 2Σ_{l<m}(m − l)R(l), Cov(S_m, next S_m) = Σ_{|l|<m}(m − |l|)R(m + l), each a geometric sum."""
-    s = m * r0
-    for ck, pk in zip(c, poles):
-        pm = np.exp(m * np.log(pk))
-        one = 1.0 - pk
-        g1 = m * pk / one - pk * (1.0 - pm) / one**2
-        g2 = pk * (1.0 - pm) ** 2 / one**2
-        s = s + ck * (2.0 * g1 - g2)
-    return np.maximum(s.real / (m * m * r0), 0.0)
+    rho = complex(
+        math.exp(-math.pi * f_r / (q * fs)) * math.cos(2 * math.pi * f_r / fs),
+        math.exp(-math.pi * f_r / (q * fs)) * math.sin(2 * math.pi * f_r / fs),
+    )
+    rm = np.exp(m * np.log(rho))
+    one = 1.0 - rho
+    var = m * (1.0 + rho) / one - 2.0 * rho * (1.0 - rm) / one**2
+    cov = rho * (1.0 - rm) ** 2 / one**2
+    return np.maximum(((var - cov) / (m * m)).real, 0.0)
 
 
 def drift_avar(tau: np.ndarray | float, t_const: float, fs: float, n: int) -> np.ndarray:
