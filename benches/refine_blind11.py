@@ -407,6 +407,7 @@ NOTES: list = [
     "",
     "Without the candidate (8 of 8 flagged): the RLG's 27 Hz line said by the PSD check; the FIR's curve departing at τ 1–222 ms; the 0.1 Hz thermometer's \"the rate still follows channel 'temp' (≈ 3.92·10⁻⁴)\"; the axis's \"depends on 'temp' beyond its kept terms\"; the clock's steps of the mean and \"a warm-up-like drift along the record (T ≈ 1.56·10⁴ s)\"; the bursts' curve above the model at τ 0.02–0.16 s; the accelerometer's level check; the resonance's curve at τ 1.5–4.5 ms.",
     "**Rerun whole at 3a5188d** (the first notes committed, no library change; other processes 88 % of the CPUs): every row's fields as at the first run — verdicts, effects, parameters, errors, words, without the candidate — only the CPU column moved: **8 of 12**, without the candidate 8 of 8 (the table above).",
+    "Rerun whole at 9eaf694 (the 2026-11-28 morning's branches merged: r14house, r14blind11, r14modline, r14pump, r14cost, r14lagrate, r14fir; r14reson merged and reverted; another suite chain, the ADIS16405 run and CI shared the 2 cores, so the CPU column is not a cost measurement): every row as at the first run — 8 of 12. The FIR row's misfit is its 1.3 dB passband ripple, not its steepness (r14fir); a digital-resonator kind passed the resonance row but moved the ADIS16405 rows and was reverted (r14reson).",
 ]
 
 

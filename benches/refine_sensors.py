@@ -144,6 +144,7 @@ NOTES = [
     "**The six temperature rows** are then r10stair's reruns with `--case` (the channel shape check in `unexplained` merged; beside two helpers): every verdict, effect and parameter error as above; without the regression candidate each still says the rate follows 'temp', thresholds moved by the channel share's split (the linear check at half its α).",
     "**Rerun whole at a593464** (every branch of the 2026-11-27 night merged: r12adis, r12chanres, r12burst, r12lag, r12blind10, r12wline, r12ci, r12lineamp; beside CI and other suites, so the CPU column is not a cost measurement): **17 of 17**, without the candidate **17 of 17**; every row's effects, parameters, errors and words as at ba83de7 (compared field by field).",
     "**Rerun whole at 55d58e5** (every branch of the 2026-11-28 night merged: r13heldout, r13gain, r13swing, r13rate, r13cover, r13cost, r13slowline; the other suites, the ADIS16405 run and CI shared the 2 cores, so the CPU column is not a cost measurement): every row's verdict, effects, parameters and words as recorded.",
+    "Rerun whole at 9eaf694 (the 2026-11-28 morning's branches merged: r14house, r14blind11, r14modline, r14pump, r14cost, r14lagrate, r14fir; r14reson merged and reverted; another suite chain, the ADIS16405 run and CI shared the 2 cores, so the CPU column is not a cost measurement): every row's verdict, effects and parameters as recorded — 17 of 17.",
 ]
 
 
