@@ -28,15 +28,7 @@ pub(crate) fn phase_bins<'py>(
         .map(|p| c_slice(py, p, "parts"))
         .collect::<PyResult<Vec<_>>>()?;
     let pv = ph.as_ref().map(|p| c_slice(py, p, "ph")).transpose()?;
-    let segs: Option<Vec<usize>> = match &seg {
-        None => None,
-        Some(s) => Some(
-            c_slice(py, s, "seg")?
-                .iter()
-                .map(|&k| usize::try_from(k).unwrap_or(usize::MAX))
-                .collect(),
-        ),
-    };
+    let segs = segment_indices(py, seg.as_ref())?;
     let sg = segs.as_deref();
     let out = py
         .detach(|| match (pv, ps.as_slice()) {
@@ -134,15 +126,7 @@ pub(crate) fn lattice_bins<'py>(
         c_slice(py, &blocks, "blocks")?,
         c_slice(py, &offsets, "offsets")?,
     );
-    let segs: Option<Vec<usize>> = match &seg {
-        None => None,
-        Some(s) => Some(
-            c_slice(py, s, "seg")?
-                .iter()
-                .map(|&k| usize::try_from(k).unwrap_or(usize::MAX))
-                .collect(),
-        ),
-    };
+    let segs = segment_indices(py, seg.as_ref())?;
     let sg = segs.as_deref();
     let ph = lattice(iv, bv, ov, k0, power, conj);
     let out = py
@@ -196,4 +180,19 @@ pub(crate) fn add_lattice_waveform<'py>(
         ));
     }
     Ok(())
+}
+
+/// The optional per-sample segment numbers as indices (a negative one maps past every segment: the core
+/// refuses it as out of range).
+fn segment_indices(
+    py: Python<'_>,
+    seg: Option<&PyReadonlyArray1<'_, i64>>,
+) -> PyResult<Option<Vec<usize>>> {
+    seg.map(|s| {
+        Ok(c_slice(py, s, "seg")?
+            .iter()
+            .map(|&k| usize::try_from(k).unwrap_or(usize::MAX))
+            .collect())
+    })
+    .transpose()
 }
