@@ -49,17 +49,13 @@ import refine_blind as rb
 import refine_blind2 as rb2
 import refine_blind8 as rb8
 import refine_blind9 as rb9
+import refine_blind10 as rb10
 
 sensors = rb.sensors
 Injected = sensors.Injected
 Blind11 = rb2.Blind2
 _periodic = rb2._periodic
-
-
-def _weather(n: int, fs: float, rng, lag_s: float) -> np.ndarray:
-    """A random walk through a first-order lag of ``lag_s``, scaled to a peak-to-peak of 1."""
-    w = sensors.first_order_lag(np.cumsum(rng.standard_normal(n)), fs, lag_s)
-    return (w - w.mean()) / max(np.ptp(w), 1e-300)
+_weather = rb10._weather  # a random walk through a first-order lag, peak-to-peak 1
 
 
 # ---------------------------------------------------------------------------------------------------------------
