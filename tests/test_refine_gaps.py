@@ -141,3 +141,19 @@ def test_the_report_identifies_the_noise_through_the_gaps_on_the_same_fill():
     two = filled_columns(np.column_stack([z, np.full(z.size, np.nan)]))
     np.testing.assert_array_equal(two[:, 0], fill_gaps(z, gap_runs(nan)))
     assert np.isnan(two[:, 1]).all() and not np.isnan(two[:, 0]).any()
+
+
+def test_angle_channel_read_at_the_angle_instants_is_averaged_per_interval():
+    """A clock's temperature logged with each of its M + 1 phase readings: refine's input check takes the mean of
+    each interval's two ends (it refused the channel, M + 1 samples against M rates); M samples stay as given."""
+    from allanite.model.refinement._inputs import inputs
+
+    rng = np.random.default_rng(3)
+    phase = np.cumsum(rng.standard_normal(4001)) * 1e-9
+    temp = 20.0 + np.cumsum(rng.standard_normal(4001)) * 0.01
+    y, _res, chans, _f = inputs(phase, 1.0, "angle", 50, None, {"temp": temp, "v": temp[1:]})
+    assert y.size == 4000
+    np.testing.assert_array_equal(chans["temp"], 0.5 * (temp[1:] + temp[:-1]))
+    np.testing.assert_array_equal(chans["v"], temp[1:])
+    with pytest.raises(ValueError, match="has 4001 samples; the rate has 4000"):
+        inputs(np.diff(phase), 1.0, "rate", 50, None, {"temp": temp})

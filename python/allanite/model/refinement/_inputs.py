@@ -117,12 +117,25 @@ def inputs(x_or_result, fs, input, points, axis, channels, gaps="error"):
         result = avar(y, fs, taus=grid)
         if filled is not None:
             filled["curve_change_pct"] = _fill_change(cols[axis], result)
+    if input == "angle" and y is not None and isinstance(channels, Mapping):
+        channels = {k: interval_means(c, y.size) for k, c in channels.items()}
     if filled is not None and channels is not None and isinstance(channels, Mapping):
         channels = {k: fill_channel(str(k), c, fs) for k, c in channels.items()}
     chans = check_channels(channels, y)
     if result.avar.ndim == 2:
         result = result.static_row(result.avar[_one_axis(axis, result.avar.shape[0])])
     return y, result, chans, filled
+
+
+def interval_means(c, n: int):
+    """A channel read at an angle record's M + 1 instants (``n`` = M rate samples): the mean of each interval's two
+    ends, the channel over the interval the rate sample stands for — a clock's temperature logged with each phase
+    reading, or an IMU's with each integrated angle. Any other channel as given (its own check names its size)."""
+    arr = np.asarray(c)
+    if arr.ndim == 1 and arr.size == n + 1 and arr.dtype.kind in "iuf":
+        arr = arr.astype(np.float64)
+        return 0.5 * (arr[1:] + arr[:-1])
+    return c
 
 
 def _rate_columns(x, fs, input, gaps):
