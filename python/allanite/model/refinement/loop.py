@@ -93,8 +93,9 @@ def refine(
     channels : dict of str → array_like, optional
         Other channels of the same log (same length as the samples: temperature, other axes,
         accelerometers; with ``input="angle"`` also read at the angle's M + 1 instants, each interval
-        then taking the mean of its two ends): the rate is regressed on each ("regression" effect; band by band where the
-        coupling differs across frequency, the bands in the step's ``evidence["bands"]``).
+        then taking the mean of its two ends): the rate is regressed on each ("regression" effect; band
+        by band where the coupling differs across frequency, the bands in the step's
+        ``evidence["bands"]``).
     level : float
         False-alarm probability per record on a clean record (default 0.05), split between every
         calibrated test (:mod:`allanite.model.refinement.levels`): spectral lines, change points, the
