@@ -75,3 +75,17 @@ def test_a_line_a_channel_explains_is_the_channels():
     why = explained_by_channel(y, fs, line, [other, coupled])
     assert why is not None and why["explained_by"] == "temp"
     assert why["statistic_without_channel"] < found["statistic"]
+
+
+def test_a_slow_line_is_no_step_where_the_sinusoid_candidate_is_left_out():
+    """The line search's few-cycle lines are removed in time as ``"sinusoid"`` steps by the ``"periodic"`` removal;
+    with ``"sinusoid"`` left out of ``candidates`` none is taken (it was: blind12's GNSS clock refined without the
+    candidate still named its diurnal line)."""
+    from allanite.model.refinement import CANDIDATES
+
+    fs, n = 1.0, 20_000
+    t = np.arange(n) / fs
+    y = _red(n, fs, 3) + 0.05 * np.sin(2 * np.pi * 5.3 / n * t + 1.1)
+    assert [s.effect for s in allanite.refine(y, fs, progress=False).steps] == ["sinusoid"]
+    without = allanite.refine(y, fs, progress=False, candidates=tuple(c for c in CANDIDATES if c != "sinusoid"))
+    assert "sinusoid" not in [s.effect for s in without.steps]

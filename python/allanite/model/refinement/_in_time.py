@@ -24,7 +24,8 @@ class TimeRemovals(RunState):
 
     def remove_in_time(self, candidates, chans) -> None:
         """Every removal of :data:`REMOVALS` among ``candidates``, in order, each on the samples the ones
-        before it left."""
+        before it left — and only of an effect among them (the line search's lone and few-cycle lines are
+        ``"sinusoid"`` removals: without that candidate they are not taken, as the curve's sinusoids are not)."""
         if self.y is None:
             return
         # the channels even where their regression may not be taken: a drift a channel explains is no drift (with
@@ -34,6 +35,8 @@ class TimeRemovals(RunState):
             if name not in candidates:
                 continue
             for rem in remover(ctx):
+                if rem.effect not in candidates:  # a line the line search tests in time is a "sinusoid"
+                    continue
                 if self.remove(rem):
                     ctx.y, ctx.curve, ctx.sol = self.y, self.curve, self.sol
                 elif rem.family is not None:
