@@ -289,6 +289,15 @@ def test_unknown_input(y, value):
         allanite.davar(y, 1.0, window=10, input=value)
 
 
+@pytest.mark.parametrize("value, ours", [("phase", "angle"), ("freq", "rate"), ("frequency", "rate")])
+def test_another_tools_input_word_names_ours(y, value, ours):
+    """allantools' data_type words are refused with allanite's word for them (a clock's phase: input='angle')."""
+    msg = rf"unknown input '{value}'; allowed: 'rate', 'increment', 'angle' — '{value}' .* is input='{ours}' here"
+    for call in (allanite.avar, allanite.refine):
+        with pytest.raises(ParameterError, match=msg):
+            call(y, 1.0, input=value)
+
+
 @pytest.mark.parametrize("workers, shown", [(0, "0"), (-1, "-1"), (1.5, "1.5"), ("2", "'2'"), (True, "True")])
 def test_bad_workers(y, workers, shown):
     with pytest.raises(ParameterError, match=rf"workers must be an integer ≥ 1, got {shown}"):

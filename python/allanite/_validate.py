@@ -30,6 +30,22 @@ def check_choice(value: object, name: str, allowed: Iterable[str]) -> str:
     return value
 
 
+#: the other tools' words for an ``input`` (allantools' ``data_type``, Stable32's data) and allanite's for each
+INPUT_WORDS = {"phase": "angle", "freq": "rate", "frequency": "rate"}
+
+
+def check_input(value: object) -> str:
+    """``value`` if it is one of :data:`INPUTS`, else a ParameterError listing them — naming allanite's word
+    where the value is another tool's (a clock's phase is ``input="angle"``: the integral of the rate)."""
+    if isinstance(value, str) and value in INPUT_WORDS:
+        raise ParameterError(
+            f"unknown input {value!r}; allowed: {', '.join(map(repr, INPUTS))} — {value!r} (allantools' data_type) "
+            f"is input={INPUT_WORDS[value]!r} here"
+            + (" (a clock's phase or time error: the integral of the rate, M + 1 points)" if value == "phase" else "")
+        )
+    return check_choice(value, "input", INPUTS)
+
+
 def check_fs(fs: object) -> float:
     """A sampling rate: a positive finite number whose inverse is finite."""
     if isinstance(fs, bool) or not isinstance(fs, (numbers.Real, np.floating, np.integer)):
@@ -109,7 +125,7 @@ def as_rate_columns(
     give it for rate input, so a caller that scales the columns need not read the record again).
     """
     fs = check_fs(fs)
-    check_choice(input, "input", INPUTS)
+    check_input(input)
     try:
         arr = np.asarray(x)
     except Exception as exc:  # ragged lists and the like

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from .._mapped import column, read_rows
-from .._validate import INPUTS, check_choice, check_fs
+from .._validate import check_choice, check_fs, check_input
 from ..errors import InputError, ParameterError
 from ..units import parse_unit
 from ._columns import AUTO_CHANNELS, check_column_spec
@@ -192,7 +192,7 @@ def read_log(
 def _check_arguments(path, columns, time_column, unit, input, gaps, time_unit, channels):
     """``read_log``'s arguments checked (a ParameterError naming a bad one; an InputError for a missing file);
     the samples' parsed unit, or None."""
-    check_choice(input, "input", INPUTS)
+    check_input(input)
     check_choice(gaps, "gaps", GAP_MODES)
     if time_unit is not None:
         check_choice(time_unit, "time_unit", tuple(TIME_UNITS))
