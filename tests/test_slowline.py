@@ -80,7 +80,7 @@ def test_a_line_a_channel_explains_is_the_channels():
 def test_a_slow_line_is_no_step_where_the_sinusoid_candidate_is_left_out():
     """The line search's few-cycle lines are removed in time as ``"sinusoid"`` steps by the ``"periodic"`` removal;
     with ``"sinusoid"`` left out of ``candidates`` none is taken (it was: blind12's GNSS clock refined without the
-    candidate still named its diurnal line)."""
+    candidate still named its diurnal line) and ``unexplained`` names the line its test found."""
     from allanite.model.refinement import CANDIDATES
 
     fs, n = 1.0, 20_000
@@ -89,3 +89,6 @@ def test_a_slow_line_is_no_step_where_the_sinusoid_candidate_is_left_out():
     assert [s.effect for s in allanite.refine(y, fs, progress=False).steps] == ["sinusoid"]
     without = allanite.refine(y, fs, progress=False, candidates=tuple(c for c in CANDIDATES if c != "sinusoid"))
     assert "sinusoid" not in [s.effect for s in without.steps]
+    said = [u for u in without.unexplained if u["what"].startswith("a line of few cycles")]
+    assert len(said) == 1 and said[0]["band_hz"][0] <= 5.3 / n <= said[0]["band_hz"][1]
+    assert said[0]["statistic"] > said[0]["threshold"] and "not among the candidates" in said[0]["what"]

@@ -118,6 +118,8 @@ class FinalModel(RunState):
             ctx.segments_heldout_pct = per_segment[-1]
         ctx.samples = self.y0
         ctx.considered, ctx.offered_lines = self.considered, self.offered_lines
+        if self.offered_lines is None and self.line_search is not None:  # no sinusoid candidate to take them
+            ctx.slow_lines = list(self.line_search.get("slow", []))
         ctx.replaced = _replaced([rem for _st, rem, *_rest in self.removed], self.y0.size if self.y0 is not None else 0)
         ctx.families = [
             (st.params["fundamentals"], st.evidence["frequencies_hz"], st.evidence["amplitudes"], rem.component)

@@ -55,6 +55,9 @@ class MissingContext:
     #: a line it names was not kept
     considered: dict = field(default_factory=dict)
     offered_lines: list | None = None
+    #: the line search's lines of few cycles (each found by its test in time, :mod:`allanite.model.slowline`) left
+    #: in the samples because the ``"sinusoid"`` candidate was left out: the ``"psd"`` check names them
+    slow_lines: list = field(default_factory=list)
 
 
 def chi2_dof(ctx: MissingContext, lo: float, hi: float) -> float:

@@ -156,7 +156,33 @@ def _lines(ctx: MissingContext, a: float) -> list[dict]:
                 "alpha": a,
             }
         )
-    return out
+    return out + [_slow_line(ctx, ln) for ln in ctx.slow_lines]
+
+
+def _slow_line(ctx: MissingContext, ln: dict) -> dict:
+    """A line of few cycles the line search found by its test in time (at that test's own share of ``level``) and
+    no step could take (the ``"sinusoid"`` candidate left out): below the spectrum's reach, so the PSD's lines
+    never name it — its band, the τ of its signature (0.2/f0 … 1/f0, as a line's) and its test's numbers."""
+    f0, slow = float(ln["f0"]), ln["slow"]
+    lo, hi = max(0.2 / f0, float(ctx.curve.tau[0])), min(1.0 / f0, float(ctx.curve.tau[-1]))
+    what = (
+        f"a line of few cycles at {f0:.4g} Hz ({slow['cycles']:.1f} cycles in the record, amplitude "
+        f"{float(ln['amplitude']):.3g}), found by its test in time (χ² {slow['statistic']:.3g} against "
+        f"{slow['threshold']:.3g}) — the sinusoid candidate was not among the candidates refine ran"
+    )
+    return {
+        "domain": "psd",
+        "tau": (lo, hi),
+        "band_hz": tuple(float(v) for v in ln["f0_interval"]),
+        "chi2_dof": _chi2_dof(ctx, lo, hi) if hi >= lo else None,
+        "what": what,
+        "not_kept": "the sinusoid candidate was not among the candidates refine ran",
+        "lines": 1,
+        "amplitude": float(ln["amplitude"]),
+        "statistic": float(slow["statistic"]),
+        "threshold": float(slow["threshold"]),
+        "alpha": float(slow["alpha"]),
+    }
 
 
 def why_not_kept(ctx: MissingContext, band: tuple, n_lines: int = 1) -> str:
