@@ -77,8 +77,10 @@ def refine(
     start : tuple of str
         The starting model's terms (``"Q"``, ``"N"``, ``"B"``, ``"K"``, ``"R"``).
     candidates : tuple of str
-        Effects to try (:data:`CANDIDATES`, the registry :data:`allanite.model.effects.EFFECTS`), with the
-        parameters each step reports and their units ("rate unit": the samples' rate unit):
+        Effects to try (:data:`CANDIDATES`, the registry :data:`allanite.model.effects.EFFECTS`); no step
+        takes an effect left out (a line removed in time is a ``"sinusoid"``; one of few cycles found but
+        left is said in ``unexplained``). The parameters each step reports and their units ("rate unit":
+        the samples' rate unit):
 
         {effects}
     unit : str, optional
