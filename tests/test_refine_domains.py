@@ -487,7 +487,7 @@ def test_leftover_lines_are_reported_as_bands_not_one_entry_per_line():
     m = np.maximum(np.round(tau * fs), 1.0)
     # the final model: the unit white noise (AVAR 1/m, EDF ≈ n/m); the lines move its curve by far more than 2 SE
     sol = SimpleNamespace(z=np.ones(40), model=1.0 / m, nu=n / m)
-    ctx = SimpleNamespace(y=y, fs=fs, effects=[], curve=SimpleNamespace(tau=tau), sol=sol)
+    ctx = SimpleNamespace(y=y, fs=fs, effects=[], curve=SimpleNamespace(tau=tau), sol=sol, slow_lines=[])
     ctx.considered, ctx.offered_lines = {"sinusoid": [{"param": 31.0, "statistic": 9.0, "threshold": 3.0}]}, comb
     out = missing._lines(ctx, 1e-3)
     assert len(out) == 2
