@@ -47,7 +47,6 @@ from scipy import signal
 
 import refine_blind as rb
 import refine_blind2 as rb2
-import refine_blind8 as rb8
 import refine_blind9 as rb9
 
 sensors = rb.sensors
@@ -319,14 +318,7 @@ CASES = [
 ]
 
 
-def run_case(case) -> dict:
-    y, fs, channels, kw, comp = case.build(np.random.default_rng(case.seed))
-    size = rb9._size(y, comp, fs, kw)
-    try:
-        v = rb.refined(case, y, fs, channels, kw, rb9.rb4._judged)
-    except Exception as err:  # noqa: BLE001 — recorded as the case's failure, the suite goes on
-        return rb8._raised(case, err, size)
-    return v | {"size": size, "outside": case.outside}
+run_case = rb9.run_case
 
 
 #: What the table shows and why (kept true to the recorded run).

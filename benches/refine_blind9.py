@@ -283,9 +283,11 @@ CASES = [
 ]
 
 
-def run_case(case) -> dict:
+def run_case(case, size_of=_size) -> dict:
+    """Refine one case with the default call and judge it (``refine_blind4._judged``); ``size_of(y, comp, fs, kw)``
+    its effect's size (blind suites 10–12 run their cases through this one)."""
     y, fs, channels, kw, comp = case.build(np.random.default_rng(case.seed))
-    size = _size(y, comp, fs, kw)
+    size = size_of(y, comp, fs, kw)
     try:
         v = rb.refined(case, y, fs, channels, kw, rb4._judged)
     except Exception as err:  # noqa: BLE001 — recorded as the case's failure, the suite goes on

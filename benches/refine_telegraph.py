@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 from scipy.signal import lfilter
 
+import allanite
 import refine_blind as rb
 import refine_blind11 as b11
 
@@ -49,8 +50,6 @@ def record(kind: str, seed: int) -> np.ndarray:
 
 
 def one(kind: str, seed: int) -> dict:
-    import allanite
-
     t0 = time.process_time()
     r = allanite.refine(record(kind, seed), FS, unit="deg/s", progress=False)
     effects = [st.effect for st in r.steps]
