@@ -159,6 +159,10 @@ def _lines(ctx: MissingContext, a: float) -> list[dict]:
     return out + [_slow_line(ctx, ln) for ln in ctx.slow_lines]
 
 
+#: why a line is left where no step could take it: the words of :func:`why_not_kept` and :func:`_slow_line`
+NO_SINUSOID = "the sinusoid candidate was not among the candidates refine ran"
+
+
 def _slow_line(ctx: MissingContext, ln: dict) -> dict:
     """A line of few cycles the line search found by its test in time (at that test's own share of ``level``) and
     no step could take (the ``"sinusoid"`` candidate left out): below the spectrum's reach, so the PSD's lines
@@ -168,7 +172,7 @@ def _slow_line(ctx: MissingContext, ln: dict) -> dict:
     what = (
         f"a line of few cycles at {f0:.4g} Hz ({slow['cycles']:.1f} cycles in the record, amplitude "
         f"{float(ln['amplitude']):.3g}), found by its test in time (χ² {slow['statistic']:.3g} against "
-        f"{slow['threshold']:.3g}) — the sinusoid candidate was not among the candidates refine ran"
+        f"{slow['threshold']:.3g}) — {NO_SINUSOID}"
     )
     return {
         "domain": "psd",
@@ -176,7 +180,7 @@ def _slow_line(ctx: MissingContext, ln: dict) -> dict:
         "band_hz": tuple(float(v) for v in ln["f0_interval"]),
         "chi2_dof": _chi2_dof(ctx, lo, hi) if hi >= lo else None,
         "what": what,
-        "not_kept": "the sinusoid candidate was not among the candidates refine ran",
+        "not_kept": NO_SINUSOID,
         "lines": 1,
         "amplitude": float(ln["amplitude"]),
         "statistic": float(slow["statistic"]),
@@ -199,7 +203,7 @@ def why_not_kept(ctx: MissingContext, band: tuple, n_lines: int = 1) -> str:
         must = " (a step must lower it)" if why.startswith("held-out error") else ""
         return f"tested as a sinusoid ({e['param']:.4g} Hz) and not kept: {why}{must}"
     if ctx.offered_lines is None:
-        return "the sinusoid candidate was not among the candidates refine ran, so no line was tested"
+        return f"{NO_SINUSOID}, so no line was tested"
     if any(band[0] <= f <= band[1] for f in ctx.offered_lines):
         return (
             f"the sinusoid search found {it} but no step tested {it}: a step offers the strongest line not yet held "
