@@ -337,6 +337,8 @@ def test_reader_warnings_are_one_line_and_in_the_report(tmp_path, rng, capfd):
         (["report", "{log}", "--fs", "1", "--unit", "furlongs"], "unknown unit 'furlongs'; allowed rate units: deg/s"),
         (["report", "{log}", "--fs", "1", "--unit", "deg"], "(--input rate needs a rate unit)"),
         (["report", "{log}", "--fs", "1", "--input", "increment", "--unit", "deg/s"], "an angle unit is needed"),
+        (["report", "{log}", "--fs", "1", "--input", "phase", "--unit", "deg/s"], "an angle unit is needed"),
+        (["report", "{log}", "--fs", "1", "--input", "phases"], "argument --input: invalid choice: 'phases'"),
         (["report", "{bad}", "--fs", "1"], "column 'col0': non-finite value nan"),
         (["report", "{log}", "--fs", "1", "--window", "5000"], "window (5000 samples) is longer than the record (100"),
         (["report", "{log}", "--fs", "1", "--window", "x"], "argument --window: invalid int value: 'x'"),

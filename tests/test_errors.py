@@ -280,9 +280,12 @@ def test_unknown_method(y, value):
         allanite.davar(y, 1.0, window=10, method=value)
 
 
-@pytest.mark.parametrize("value", ["phase", "frequency", "Rate", None])
+@pytest.mark.parametrize("value", ["phases", "Frequency", "Rate", None])
 def test_unknown_input(y, value):
-    msg = rf"unknown input {re.escape(repr(value))}; allowed: 'rate', 'increment', 'angle'"
+    msg = (
+        rf"unknown input {re.escape(repr(value))}; allowed: 'rate', 'increment', 'angle', or 'phase' \(= 'angle'\), "
+        r"'freq' \(= 'rate'\), 'frequency' \(= 'rate'\)"
+    )
     with pytest.raises(ParameterError, match=msg):
         allanite.avar(y, 1.0, input=value)
     with pytest.raises(ParameterError, match=msg):
@@ -290,12 +293,16 @@ def test_unknown_input(y, value):
 
 
 @pytest.mark.parametrize("value, ours", [("phase", "angle"), ("freq", "rate"), ("frequency", "rate")])
-def test_another_tools_input_word_names_ours(y, value, ours):
-    """allantools' data_type words are refused with allanite's word for them (a clock's phase: input='angle')."""
-    msg = rf"unknown input '{value}'; allowed: 'rate', 'increment', 'angle' — '{value}' .* is input='{ours}' here"
-    for call in (allanite.avar, allanite.refine):
-        with pytest.raises(ParameterError, match=msg):
-            call(y, 1.0, input=value)
+def test_another_tools_input_word_is_ours(y, value, ours):
+    """allantools' and Stable32's words for the samples are allanite's: the same numbers, and the result says
+    allanite's word (a clock's phase is input='angle', M + 1 points)."""
+    x = np.concatenate([[0.0], np.cumsum(y)]) if ours == "angle" else y
+    theirs, mine = allanite.avar(x, 1.0, input=value), allanite.avar(x, 1.0, input=ours)
+    assert theirs.input == ours
+    np.testing.assert_array_equal(theirs.avar, mine.avar)
+    dyn = allanite.davar(x, 1.0, window=40, input=value)
+    assert dyn.input == ours
+    np.testing.assert_array_equal(dyn.avar, allanite.davar(x, 1.0, window=40, input=ours).avar)
 
 
 @pytest.mark.parametrize("workers, shown", [(0, "0"), (-1, "-1"), (1.5, "1.5"), ("2", "'2'"), (True, "True")])
@@ -514,7 +521,7 @@ def _calls(draw):
         )
     kw = dict(
         fs=fs,
-        input=_mostly(draw, st.sampled_from(["rate", "increment", "angle"]), st.just("phase")),
+        input=_mostly(draw, st.sampled_from(["rate", "increment", "angle"]), st.just("phases")),
         taus=_mostly(draw, good_taus, _bad_taus),
         estimator=_mostly(draw, st.sampled_from(["oavar", "avar"]), st.just("x")),
         workers=_mostly(draw, st.sampled_from([None, 1, 2]), st.sampled_from([0, -1, 1.5])),

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 
+from ._validate import input_word
 from .model.effects import EFFECTS
 from .units import ACCEL_UNITS
 
@@ -128,8 +129,10 @@ def add_input_options(rep: argparse.ArgumentParser) -> None:
     )
     inp.add_argument(
         "--input",
+        type=input_word,
         choices=("rate", "increment", "angle"),
-        help="what the samples are: rate (default), angle increments per sample, cumulative angle",
+        help="what the samples are: rate (default), angle increments per sample, cumulative angle (allantools' and "
+        "Stable32's phase is angle, their freq/frequency rate)",
     )
     inp.add_argument(
         "--gaps",

@@ -34,16 +34,24 @@ def check_choice(value: object, name: str, allowed: Iterable[str]) -> str:
 INPUT_WORDS = {"phase": "angle", "freq": "rate", "frequency": "rate"}
 
 
+def input_word(value: str) -> str:
+    """allanite's word for another tool's ``input`` word, any other string as it is (a command line's ``type``:
+    its ``choices`` then judge it)."""
+    return INPUT_WORDS.get(value, value)
+
+
 def check_input(value: object) -> str:
-    """``value`` if it is one of :data:`INPUTS`, else a ParameterError listing them — naming allanite's word
-    where the value is another tool's (a clock's phase is ``input="angle"``: the integral of the rate)."""
+    """allanite's word for the kind of samples ``value`` names: one of :data:`INPUTS`, or another tool's word for
+    one of them (:data:`INPUT_WORDS`: allantools' and Stable32's ``"phase"`` is ``"angle"`` — a clock's phase or
+    time error is the integral of its fractional frequency, M + 1 points — and ``"freq"``/``"frequency"`` is
+    ``"rate"``); else a ParameterError listing both. Every public call that takes ``input`` keeps the returned word,
+    so its result says ``input="angle"`` where ``"phase"`` was given."""
     if isinstance(value, str) and value in INPUT_WORDS:
-        raise ParameterError(
-            f"unknown input {value!r}; allowed: {', '.join(map(repr, INPUTS))} — {value!r} (allantools' data_type) "
-            f"is input={INPUT_WORDS[value]!r} here"
-            + (" (a clock's phase or time error: the integral of the rate, M + 1 points)" if value == "phase" else "")
-        )
-    return check_choice(value, "input", INPUTS)
+        return INPUT_WORDS[value]
+    if isinstance(value, str) and value in INPUTS:
+        return value
+    aliases = ", ".join(f"{k!r} (= {v!r})" for k, v in INPUT_WORDS.items())
+    raise ParameterError(f"unknown input {value!r}; allowed: {', '.join(map(repr, INPUTS))}, or {aliases}")
 
 
 def check_fs(fs: object) -> float:
@@ -125,7 +133,7 @@ def as_rate_columns(
     give it for rate input, so a caller that scales the columns need not read the record again).
     """
     fs = check_fs(fs)
-    check_input(input)
+    input = check_input(input)
     try:
         arr = np.asarray(x)
     except Exception as exc:  # ragged lists and the like

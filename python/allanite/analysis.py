@@ -18,7 +18,7 @@ import numpy as np
 
 from . import estimators
 from ._progress import StepBar, show_progress
-from ._validate import as_rate_columns, check_choice, check_count, resolve_max_memory
+from ._validate import as_rate_columns, check_choice, check_count, check_input, resolve_max_memory
 from .errors import InputError, MemoryBudgetError, ParameterError
 from .estimators.deviations import GAP_DYNAMIC_ESTIMATORS, GAP_ESTIMATORS, gap_dynamic, gap_static
 from .results import AllanResult, DynamicAllanResult
@@ -134,7 +134,9 @@ def avar(
         Sampling rate, Hz (τ0 = 1/fs).
     input : {"rate", "increment", "angle"}
         What the samples are. Equivalent inputs give the same numbers: rate y, increments y/fs and
-        angle ``[0, cumsum(y/fs)]`` (M + 1 points). Results are always in rate units.
+        angle ``[0, cumsum(y/fs)]`` (M + 1 points). Results are always in rate units. allantools' and
+        Stable32's words are taken too: ``"phase"`` (a clock's time error) is ``"angle"``, ``"freq"`` and
+        ``"frequency"`` are ``"rate"``; ``result.input`` holds allanite's word.
     taus : str or array_like
         A grid name (``"octave"``, default; ``"decade"``, ``"all"``, ``"exp"`` — see
         :func:`allanite.tau_grid`) or τ in seconds, each rounded to m = round(τ·fs) and required to be
@@ -204,6 +206,7 @@ def avar(
     array([1., 1., 1.])
     """
     check_choice(gaps, "gaps", GAPS)
+    input = check_input(input)
     if gaps == "skip":
         if taper != "rect":
             raise ParameterError(f"gaps='skip' works with taper='rect' only, got taper={taper!r}")
@@ -383,6 +386,7 @@ def davar(
     tapered = estimators.get_taper(taper, estimator)
     check_choice(method, "method", METHODS)
     check_choice(gaps, "gaps", GAPS)
+    input = check_input(input)
     options = entry.check_options({"kf_rule": kf_rule})
     peaks: list[float] | None
     if gaps == "skip":

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from .. import _core, analysis, estimators
-from .._validate import check_choice, resolve_workers
+from .._validate import check_choice, check_input, resolve_workers
 from ..errors import InputError, ParameterError
 from ..estimators.allan import compensated_sums, n_terms, part_values
 from ..results import DynamicAllanResult
@@ -203,6 +203,7 @@ def davar(
     windows over 2^21 samples on such records, at hops ≥ 64, one chunk's phase: 16 B per sample of ≤ 2 · max(2^22,
     window) + hop).
     """
+    input = check_input(input)  # another tool's word for it (allanite._validate.INPUT_WORDS) as allanite's
     fs = check_inputs(estimator, input, fs)
     arr = as_dask(x)
     n = int(arr.shape[0])

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from .._cli_options import UsageError
+from .._validate import input_word
 from ..errors import AllaniteError, ParameterError
 from ..io import read_log
 from ..io.reader import check_time_unit_used
@@ -444,7 +445,11 @@ def build_parser() -> argparse.ArgumentParser:
         "and their fleet rows are in m/s/√h, µg, m/s/h^1.5 (sensor accelerometer)",
     )
     p.add_argument(
-        "--input", choices=("rate", "increment", "angle"), default="rate", help="what a sample is (default rate)"
+        "--input",
+        type=input_word,
+        choices=("rate", "increment", "angle"),
+        default="rate",
+        help="what a sample is (default rate; phase is angle, freq rate)",
     )
     p.add_argument(
         "--gaps",

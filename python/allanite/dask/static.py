@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from .._validate import resolve_workers
+from .._validate import check_input, resolve_workers
 from ..errors import InputError
 from ..estimators.allan import angle_term_sums, n_terms
 from ..estimators.grid import resolve_taus
@@ -115,6 +115,7 @@ def avar(
     m < chunk one task per chunk reads that chunk and the next two; for larger m each (chunk, m)
     reads at most six chunks. No task holds more than six chunks.
     """
+    input = check_input(input)  # another tool's word for it (allanite._validate.INPUT_WORDS) as allanite's
     fs = check_inputs(estimator, input, fs)
     arr = as_dask(x)
     n = int(arr.shape[0])

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .._validate import check_choice
+from .._validate import check_choice, check_input
 from ..errors import ParameterError
 from ._long_id import LONG_SAMPLES, LongRate
 
@@ -215,7 +215,7 @@ def identify_alpha(x, m, *, input="angle", estimator="oavar", method="auto", b1_
     >>> identify_alpha(np.cumsum(rng.normal(size=10_000)), [1, 10, 100], input="rate")  # rate random walk
     array([-2, -2, -2])
     """
-    check_choice(input, "input", INPUTS)
+    input = check_input(input)
     check_choice(estimator, "estimator", ESTIMATORS)
     check_choice(method, "method", ("auto", "acf", "b1"))
     check_choice(b1_n, "b1_n", ("averages", "terms"))

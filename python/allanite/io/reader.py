@@ -165,6 +165,7 @@ def read_log(
     """
     path = Path(os.fspath(path))
     fs = None if fs is None else check_fs(fs)
+    input = check_input(input)
     u = _check_arguments(path, columns, time_column, unit, input, gaps, time_unit, channels)
     fmt = sniff_format(path)
     check_time_unit_used(time_unit, fs, time_column, fmt)

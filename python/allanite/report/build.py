@@ -33,7 +33,7 @@ import datetime as _dt
 
 import numpy as np
 
-from .._validate import check_choice, check_positive
+from .._validate import check_choice, check_input, check_positive
 from ..analysis import avar, davar
 from ..errors import AllaniteError, ParameterError
 from ..estimators import get as get_estimator
@@ -162,6 +162,7 @@ def build_report(
     """
     notes = list(notes)
     check_choice(gaps, "gaps", ("error", "skip"))
+    input = check_input(input)
     x, plan = _record_and_plan(x, fs, frames, forecast)
     candidates, channels = _refine_asked(refine, channels, np.shape(x)[0], input, notes)
     progress, own_bar = steps(progress, 5 + (candidates is not None) + (plan is not None), "report")

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from ..._blas import one_thread
 from ..._progress import StepBar
+from ..._validate import check_input
 from ...errors import ParameterError
 from .. import periodic, tracing
 from .._counter import counter_quantisation, detect_counter
@@ -89,6 +90,9 @@ def refine(
         ``"g"``, ``"mg"``, … with ``input="rate"``) gives the terms in its report units (velocity random walk
         in m/s/√h, bias instability in µg, acceleration random walk in m/s/h^1.5). For a magnetometer or
         another sensor give none: the terms are then in the samples' own unit and seconds.
+    input : {"rate", "increment", "angle"}
+        What the samples are, as for :func:`allanite.avar` (allantools' ``"phase"`` is ``"angle"``: a clock's
+        time error, M + 1 points; ``"freq"`` is ``"rate"``).
     tau_range : (float, float) or "auto", optional
         τ (s) to use, as in :func:`allanite.fit`. Default: every τ — the shortest τ carry the sensor's
         bandwidth, which is a candidate effect; ``"auto"`` cuts them as ``fit`` does.
@@ -136,6 +140,7 @@ def refine(
     (['gauss_markov'], 10.0)
     """
     check_scale(x_or_result)
+    input = check_input(input)
     check_unit(unit, input, x_or_result)  # before any work: it was read only by the final fit
     check_truth(truth, tuple(EFFECTS))
     # each line spectrum once; curves, phasors and outlier scales of the same samples once; OpenBLAS on one
