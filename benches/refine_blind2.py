@@ -33,7 +33,9 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -413,14 +415,25 @@ NOTES: list = [
 
 
 def suite_main(argv, doc: str, cases, run, size, notes: list, stem: str, which: str) -> None:
-    """The command line of a blind suite (this one's and blind suite 3's): ``--case``, ``--out``, ``--sizes``
-    (``size(y, comp, fs, kw)`` printed per case, no refine)."""
+    """The command line of a blind suite (this one's and blind suites 3–12's): ``--case``, ``--out``, ``--sizes``
+    (``size(y, comp, fs, kw)`` printed per case, no refine), ``--seed-offset`` (every case on other noise)."""
     ap = argparse.ArgumentParser(description=doc.split("\n")[0])
     ap.add_argument("--case", default=None, help="only cases whose name contains this text")
     ap.add_argument("--out", default=None, help="results folder (default benches/results)")
     ap.add_argument("--sizes", action="store_true", help="print each case's effect size only (no refine)")
+    ap.add_argument(
+        "--seed-offset",
+        type=int,
+        default=0,
+        help="add this to every case's seed: the same sensors on other noise (written to --out, else a temporary "
+        "folder, never over the recorded table)",
+    )
     args = ap.parse_args(argv)
     chosen = [c for c in cases if args.case is None or args.case in c.name]
+    if args.seed_offset:
+        chosen = [dataclasses.replace(c, seed=c.seed + args.seed_offset) for c in chosen]
+        notes = [f"Seeds offset by {args.seed_offset:+d} from the recorded cases' (`--seed-offset`).", "", *notes]
+        args.out = args.out or tempfile.mkdtemp()
     if args.sizes:
         for case in chosen:
             y, fs, _ch, kw, comp = case.build(np.random.default_rng(case.seed))
