@@ -49,7 +49,9 @@ class Step:
     again beside them —, its nonlinear parameter's interval profiled again; what was measured in the time
     domain as accepted: a spectral line's amplitude and f0 — held in every fit of the curve —, a removal in
     time, a change point). ``before``/``after``:
-    ``chi2_dof``, ``rms_z``, ``rms_adev_pct`` (on ``Refinement.scored_tau``), ``p_value`` and
+    ``chi2_dof``, ``rms_z``, ``rms_adev_pct`` (on ``Refinement.scored_tau``), ``p_value``, ``deviance`` and ``aic``
+    (χ² + ln det Σ under the χ²'s covariance — −2 ln L less n ln 2π — and that + 2 per fitted number: only their
+    differences along one chain mean anything, :func:`allanite.model.refinement.scoring.settle_chi2`) and
     ``heldout_rms_adev_pct`` (None for curve-only input) of the model before and after the step, all on the
     original record's Allan curve — each step's ``before`` is the previous step's ``after`` (the steps in the
     chain's order: curve effects, then the removals in time, which were searched first, then change points);
