@@ -470,6 +470,20 @@ def _seeds(nu: np.ndarray, tol: np.ndarray, strength: np.ndarray) -> list[tuple[
     return out
 
 
+def _directions(coefs: np.ndarray) -> int:
+    """How many lines through the origin of the integer lattice the rows ``coefs`` lie on (each row's primitive
+    direction, sign-free) — independent of the basis the generators are written in. Rows on one or two directions
+    are the harmonics of one or two fundamentals (a 13.7 Hz hum's (1, 0), (2, 0) beside a 1.7 Hz square wave's
+    (0, 1), (0, 3), …): only a third direction — a mixed row i·f1 + j·f2 beyond both generators' harmonics — is an
+    intermodulation or sideband family."""
+    c = np.asarray(coefs, dtype=np.int64)
+    g = np.gcd(c[:, 0], c[:, 1])
+    u = c // np.maximum(g, 1)[:, None]
+    flip = (u[:, 0] < 0) | ((u[:, 0] == 0) & (u[:, 1] < 0))
+    u = np.where(flip[:, None], -u, u)
+    return int(np.unique(u, axis=0).shape[0])
+
+
 def _commensurate(gens: np.ndarray, tol: float, q_max: int = 4) -> bool:
     """Whether g2 = (p/q)·g1 within ``tol`` for some q ≤ q_max: then the lattice is one generator's, g1/q."""
     for q in range(1, q_max + 1):
@@ -557,6 +571,8 @@ def group_lines(lines: list[dict], fs: float) -> list[dict]:
             score = m.size - chance
             if score < gens.size + 0.5:
                 continue
+            if gens.size == 2 and _directions(coefs) < 3:
+                continue  # two harmonic families side by side, not sidebands: the one-generator families say them
             if gens.size == 1:
                 ones.append((score, gens, coefs, m, gen_sd, chance))
             if best[gens.size] is None or score > best[gens.size][0]:
