@@ -256,12 +256,24 @@ class _Run(TimeRemovals, FinalModel):
         fam = families(sub, candidates, self.y is not None)
         thr = test.threshold(fam, alpha("curve", self.level), N_BOOT, seed=n_step)
         rnd = Round(
-            self.curve, self.start, self.effects, self.sol, sub, test, thr, self.heldout, self.y, lines, self.level
+            self.curve,
+            self.start,
+            self.effects,
+            self.sol,
+            sub,
+            test,
+            thr,
+            self.heldout,
+            self.y,
+            lines,
+            self.level,
+            thin,
+            exact,
         )
         prefetch(rnd, candidates)  # every candidate's bounded searches, run together
         props = [pr for name, c in CURVE_CANDIDATES.items() if name in candidates for pr in c.propose(rnd)]
         for pr in props:
-            pr.record = {"param": float(pr.p), "statistic": float(pr.stat), "threshold": float(pr.thr)}
+            pr.record = {"param": float(pr.p), "statistic": float(pr.stat), "threshold": float(pr.thr)} | pr.notes
             self.consider(pr.effect, pr.record)
         chosen = choose(props, rnd, candidates)
         for other in props:  # a test that passed says why it was not taken (choose says it where it can)
