@@ -11,6 +11,8 @@ from scipy import signal
 import allanite
 from allanite.errors import ParameterError
 from allanite.model.effects import resonance_avar
+from allanite.model.refinement._bumps import bandpass_chain_kept, bandpass_named
+from allanite.model.refinement.curvefit import res_kind
 
 FS = 400.0
 
@@ -64,6 +66,17 @@ def test_an_unknown_shape_is_refused_by_name():
         resonance_avar(0.01, 60.0, 8.0, FS, "gaussian")
 
 
+def test_keys_name_the_shape_and_the_whole_chain_decides():
+    assert res_kind("resonance:8") == (8.0, "lorentzian") and res_kind("resonance:bp:16") == (16.0, "bandpass")
+    assert bandpass_named([("bandwidth:single_pole", 20.0), ("resonance:bp:4", 12.0)])
+    assert not bandpass_named([("resonance:4", 12.0), ("gauss_markov", 3.0)])
+    chi2 = lambda c: type("Sol", (), {"chi2": c})  # noqa: E731
+    # the band-pass chain only where its final χ² is more than one effective point (tie) below the Lorentzian's
+    assert bandpass_chain_kept(chi2(90.0), chi2(100.0), 5.0)
+    assert not bandpass_chain_kept(chi2(96.0), chi2(100.0), 5.0)
+    assert not bandpass_chain_kept(chi2(120.0), chi2(100.0), 5.0)
+
+
 def _lorentzian(n: int, f_r: float, q: float, sigma: float, seed: int) -> np.ndarray:
     rho = np.exp(-np.pi * f_r / (q * FS) + 2j * np.pi * f_r / FS)
     rng = np.random.default_rng(seed)
@@ -93,4 +106,7 @@ def test_refine_chooses_the_shape_of_a_simulated_resonance(shape):
     assert st.params["shape"] == shape and st.params["q"] == 8.0, (st.params, st.evidence["shape_test"])
     assert abs(st.params["f0"] / 60.0 - 1) < 0.01 and abs(st.params["sigma"] / sigma - 1) < 0.05
     assert st.evidence["shape_test"]["tested"] is True
+    if shape == "bandpass":  # the chain with the Lorentzian shape alone was run too, and ended worse
+        ch = st.evidence["shape_chains"]
+        assert ch["with_bandpass"]["chi2_dof"] < ch["lorentzian_only"]["chi2_dof"], ch
     assert abs(r.fit.coefficients["N"].value / 2e-3 - 1) < 0.03

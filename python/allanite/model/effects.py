@@ -219,7 +219,8 @@ EFFECTS: dict[str, Effect] = {
             "DC and Nyquist: a sense mode read through a demodulator; a 1/τ² tail, no white level to trade with "
             "N). The Lorentzian is taken unless a band-pass column beside it passes the curve test asked again "
             "with the Lorentzian in the model, and the band-pass resonance alone fits the curve better and "
-            "predicts the held-out half no worse. Allan variance exact in discrete time (Σ_l A_m(l)·R(l)/2m²); "
+            "lowers the held-out error; a chain that took one is kept only where its final χ² beats "
+            "the chain with the Lorentzian shape alone. Allan variance exact in discrete time (Σ_l A_m(l)·R(l)/2m²); "
             "a bump near τ ≈ 0.37/f_r with a dip beyond. A spectral line is the limit "
             "Q → ∞ (found in the PSD instead). f_r is searched at the short-τ end, from 0.05/τ_min to 0.49/τ_min "
             "(5–49 Hz at 100 Hz): a hump near the bandwidth; slower bumps are Gauss–Markov terms",
