@@ -455,6 +455,8 @@ def test_finds_a_simulated_resonance():
     assert r.found == ["resonance"]
     st = r.steps[0]
     assert abs(st.truth_error["f0"]) < 0.02 and abs(st.truth_error["sigma"]) < 0.2 and st.params["q"] == 4.0
+    # the band-pass shape was offered (its nested test asked) and the simulated Lorentzian kept
+    assert st.params["shape"] == "lorentzian" and st.evidence["shape_test"]["tested"] is True
     lo, hi = st.intervals["f0"]
     assert lo <= 12.0 <= hi or abs(st.truth_error["f0"]) < 0.005
     _falls(st)

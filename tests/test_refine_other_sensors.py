@@ -122,9 +122,11 @@ def test_other_sensors_curves_get_one_region_per_misfit(shared_data, load_avar_c
     assert spans and all(b0 <= a1 * (1 + 1e-9) for (_a0, b0), (a1, _b1) in zip(spans, spans[1:])), spans
     r = allanite.refine(load_avar_curve(root / "ln200_av.csv")["Accel. Y"], progress=False)
     # the misfit around τ = 10 s is named — as "the model lies above the curve" when nothing is added; since the
-    # curve-only lines are taken (five at 0.7–40 Hz), as a region where the curve departs from the model
+    # curve-only lines are taken (five at 0.7–40 Hz), as a region where the curve departs from the model; since a
+    # resonance may take the band-pass shape (r16reson: three band-pass resonances and three lines, final χ²/dof
+    # 78 → 20), χ²/dof 17 there (74 before) — still a misfit far beyond the score's calibration, named
     named = [u for u in r.unexplained if u["tau"][0] <= 10.24 <= u["tau"][1]]
-    assert named and named[0]["chi2_dof"] > 50, r.unexplained
+    assert named and named[0]["chi2_dof"] > 10, r.unexplained
 
 
 def test_a_candidate_whose_test_passed_but_was_not_taken_says_why():

@@ -30,6 +30,7 @@ __all__ = [
     "sinc_order",
     "CASCADE_SPANS",
     "RESONANCE_Q",
+    "RESONANCE_SHAPES",
     "resonance_avar",
     "rational_terms",
     "NOTCH_Q",
@@ -374,17 +375,33 @@ def _prefix_avar(r: np.ndarray, m: np.ndarray) -> np.ndarray:
 RESONANCE_Q = (2.0, 4.0, 8.0, 16.0)
 
 
-def resonance_avar(tau: np.ndarray | float, f_r: float, q: float, fs: float) -> np.ndarray:
-    """Allan variance of unit-variance narrowband rate noise at ``f_r`` (Hz) with quality factor ``q`` —
-    exact in discrete time for samples at ``fs``.
+#: The shapes a "resonance" takes (:func:`resonance_avar`): the Lorentzian pair, the default, and the band-pass
+#: digital resonator, offered only where the fit prefers it by the candidate's own test (``refinement._bumps``).
+RESONANCE_SHAPES = ("lorentzian", "bandpass")
 
-    The noise's autocorrelation is R(l) = Re ρ^|l|, ρ = e^{−πf_r/(q·f_s)}·e^{i2πf_r/f_s} (a Lorentzian pair of
-    PSD peaks at ±f_r, full width f_r/q: a resonance driven by broadband noise, or a hump of vibration).
-    With S_m the sum of m samples, σ²(m) = (Var S_m − Cov(S_m, next S_m))/m², both linear in R, so closed
-    geometric sums in ρ: Var = m(1 + ρ)/(1 − ρ) − 2ρ(1 − ρ^m)/(1 − ρ)², Cov = ρ(1 − ρ^m)²/(1 − ρ)², real
-    part taken."""
+
+def resonance_avar(tau: np.ndarray | float, f_r: float, q: float, fs: float, shape: str = "lorentzian") -> np.ndarray:
+    """Allan variance of unit-variance narrowband rate noise at ``f_r`` (Hz) with quality factor ``q`` —
+    exact in discrete time for samples at ``fs``, in one of two shapes (:data:`RESONANCE_SHAPES`).
+
+    ``"lorentzian"``: the autocorrelation is R(l) = Re ρ^|l|, ρ = e^{−πf_r/(q·f_s)}·e^{i2πf_r/f_s} (a Lorentzian
+    pair of PSD peaks at ±f_r, full width f_r/q: a mechanical mode seen as a narrowband rate bump, vibration).
+    Its PSD is not zero at DC, so its Allan variance keeps a white-like 1/τ tail. With S_m the sum of m samples,
+    σ²(m) = (Var S_m − Cov(S_m, next S_m))/m², both linear in R, so closed geometric sums in ρ:
+    Var = m(1 + ρ)/(1 − ρ) − 2ρ(1 − ρ^m)/(1 − ρ)², Cov = ρ(1 − ρ^m)²/(1 − ρ)², real part taken.
+
+    ``"bandpass"``: white noise through the digital 2nd-order resonator
+    H(z) = g(1 − z⁻²)/(1 − 2g·cos ω₀·z⁻¹ + (2g − 1)z⁻²), ω₀ = 2πf_r/f_s, g = 1/(1 + tan(ω₀/2q))
+    (``scipy.signal.iirpeak``: PSD peak at f_r, half power at f_r ± f_r/2q, zeros at DC and Nyquist: a sense
+    mode read through a demodulator). Its PSD is zero at DC, so its Allan variance falls as 1/τ² at τ ≫ 1/f_r
+    and its column holds no white noise to trade with N. With R(l) = Σ_k c_k p_k^l (l ≥ 1) over the poles p_k,
+    the same two sums are closed geometric sums in p_k (:func:`_two_pole_avar`)."""
     tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
     m = np.maximum(1.0, np.round(tau * fs))
+    if shape == "bandpass":
+        return _bandpass_avar(m, f_r, q, fs)
+    if shape != "lorentzian":
+        raise ParameterError(f"resonance shape {shape!r}: must be one of {RESONANCE_SHAPES}")
     rho = complex(
         math.exp(-math.pi * f_r / (q * fs)) * math.cos(2 * math.pi * f_r / fs),
         math.exp(-math.pi * f_r / (q * fs)) * math.sin(2 * math.pi * f_r / fs),
@@ -394,6 +411,49 @@ def resonance_avar(tau: np.ndarray | float, f_r: float, q: float, fs: float) -> 
     var = m * (1.0 + rho) / one - 2.0 * rho * (1.0 - rm) / one**2
     cov = rho * (1.0 - rm) ** 2 / one**2
     return np.maximum(((var - cov) / (m * m)).real, 0.0)
+
+
+def _bandpass_avar(m: np.ndarray, f_r: float, q: float, fs: float) -> np.ndarray:
+    """σ²(m) per unit variance of the ``iirpeak`` resonator's output (:func:`resonance_avar`'s band-pass shape)."""
+    w0, half = _resonator_angles(f_r, q, fs)
+    g = 1.0 / (1.0 + math.tan(half))
+    poles = np.roots([1.0, -2.0 * g * math.cos(w0), 2.0 * g - 1.0]).astype(np.complex128)
+    # a pole at 0 (g = 1/2; both at 0 when ω₀ is π/2 too): moved off it, apart, c_k·p_k^l keeps its limit
+    poles = np.where(np.abs(poles) < 1e-7, np.array([1e-7, -1e-7]), poles)
+    if poles[0] == poles[1]:  # a double pole (f_r/q at its one value for f_r): nudged, the sums stay finite
+        poles = poles * np.array([1.0 + 1e-9, 1.0 - 1e-9])
+    big = np.abs(poles) > 1.0 - 1e-12  # on the unit circle (half width at π/2 with ω₀ at π): just inside it
+    poles[big] *= (1.0 - 1e-12) / np.abs(poles[big])
+    # the all-pole part's autocorrelation R_x(l) = Σ_k d_k p_k^l for l ≥ −1 (residues of its PSD); the zeros
+    # (1 − z⁻²) make R(l) = 2R_x(l) − R_x(l − 2) − R_x(l + 2): c_k = −d_k(p_k − 1/p_k)² for l ≥ 1
+    d = poles / ((poles - poles[::-1]) * (1.0 - poles * poles[0]) * (1.0 - poles * poles[1]))
+    r0 = float(np.sum(2.0 * d * (1.0 - poles * poles)).real)
+    return _two_pole_avar(m, r0, -d * (poles - 1.0 / poles) ** 2, poles)
+
+
+def _resonator_angles(f_r: float, q: float, fs: float) -> tuple[float, float]:
+    """The resonator's centre ω₀ (rad/sample) and half its −3 dB width (rad), kept where the design is defined:
+    a centre beyond f_s/2 (an interval's profile scans past the best f_r) folds as a sampled resonance
+    aliases, kept just inside (0, π) where the zeros at DC and Nyquist would meet the peak; the half width
+    π·(f_r/q)/f_s (the physical width, whatever the fold) stays below π/2, where tan and the poles stay finite."""
+    f = math.fmod(abs(f_r), fs)
+    f = fs - f if f > fs / 2.0 else f
+    w0 = min(max(2.0 * math.pi * f / fs, 1e-6), math.pi * (1.0 - 1e-6))
+    half = min(math.pi * abs(f_r) / (q * fs), 0.5 * math.pi * (1.0 - 1e-6))
+    return w0, half
+
+
+def _two_pole_avar(m: np.ndarray, r0: float, c: np.ndarray, poles: np.ndarray) -> np.ndarray:
+    """σ²(m) of a process with R(0) = ``r0`` and R(l) = Σ_k c_k p_k^l for l ≥ 1, per unit variance: Var S_m =
+    m·R(0) + 2Σ_{l<m}(m − l)R(l), Cov(S_m, next S_m) = Σ_{|l|<m}(m − |l|)R(m + l), each a geometric sum."""
+    s = m * r0
+    for ck, pk in zip(c, poles):
+        pm = np.exp(m * np.log(pk))
+        one = 1.0 - pk
+        g1 = m * pk / one - pk * (1.0 - pm) / one**2
+        g2 = pk * (1.0 - pm) ** 2 / one**2
+        s = s + ck * (2.0 * g1 - g2)
+    return np.maximum(s.real / (m * m * r0), 0.0)
 
 
 def drift_avar(tau: np.ndarray | float, t_const: float, fs: float, n: int) -> np.ndarray:

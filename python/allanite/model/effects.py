@@ -21,6 +21,7 @@ from ._signatures import (
     FILTERS,
     NOTCH_Q,
     RESONANCE_Q,
+    RESONANCE_SHAPES,
     SINC_ORDERS,
     butterworth_order,
     butterworth_terms,
@@ -59,6 +60,7 @@ __all__ = [
     "sinc_order",
     "CASCADE_SPANS",
     "RESONANCE_Q",
+    "RESONANCE_SHAPES",
     "resonance_avar",
     "NOTCH_Q",
     "notch_kind",
@@ -208,10 +210,18 @@ EFFECTS: dict[str, Effect] = {
                 ("sigma", "rate unit", "standard deviation of the narrowband rate noise"),
                 ("f0", "Hz", "centre frequency f_r of its PSD hump"),
                 ("q", "", "quality factor f_r / full width at half maximum (searched at 2, 4, 8, 16)"),
+                ("shape", "", "``lorentzian`` (the default) or ``bandpass``, the one the fit chose"),
             ),
-            "narrowband rate noise — a resonance driven by broadband noise, or a hump of vibration: "
-            "autocorrelation σ²·e^{−πf_r·l/(Q·f_s)}·cos(2πf_r·l/f_s), Allan variance exact in discrete time "
-            "(Σ_l A_m(l)·R(l)/2m²); a bump near τ ≈ 0.37/f_r with a dip beyond. A spectral line is the limit "
+            "narrowband rate noise — a resonance driven by broadband noise, or a hump of vibration, in one of two "
+            "shapes: ``lorentzian``, autocorrelation σ²·e^{−πf_r·l/(Q·f_s)}·cos(2πf_r·l/f_s) (a Lorentzian "
+            "pair: a mechanical mode seen as a rate bump, its PSD not zero at DC, a white-like 1/τ tail), or "
+            "``bandpass``, white noise through the digital resonator ``scipy.signal.iirpeak`` designs (zeros at "
+            "DC and Nyquist: a sense mode read through a demodulator; a 1/τ² tail, no white level to trade with "
+            "N). The Lorentzian is taken unless a band-pass column beside it passes the curve test asked again "
+            "with the Lorentzian in the model, and the band-pass resonance alone fits the curve better and "
+            "lowers the held-out error; a chain that took one is kept only where its final χ² beats "
+            "the chain with the Lorentzian shape alone. Allan variance exact in discrete time (Σ_l A_m(l)·R(l)/2m²); "
+            "a bump near τ ≈ 0.37/f_r with a dip beyond. A spectral line is the limit "
             "Q → ∞ (found in the PSD instead). f_r is searched at the short-τ end, from 0.05/τ_min to 0.49/τ_min "
             "(5–49 Hz at 100 Hz): a hump near the bandwidth; slower bumps are Gauss–Markov terms",
             signature=None,

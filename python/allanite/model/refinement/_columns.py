@@ -19,6 +19,7 @@ __all__ = [
     "base_name",
     "has_floor",
     "bw_kind",
+    "res_kind",
     "FLOOR_TAG",
     "held_key",
     "held_theta",
@@ -40,6 +41,17 @@ def base_name(key: str) -> str:
 #: The tail of a bandwidth key whose N column stays beside a kind other than a Butterworth: a white floor after
 #: the filter that the samples' spectrum shows and the Allan curve's fit agrees with (:func:`._rolloff.floor_choice`).
 FLOOR_TAG = "|floor"
+
+
+#: The tag of a resonance key's band-pass shape ("resonance:bp:8"; the Lorentzian pair's key is "resonance:8").
+BANDPASS_TAG = "bp"
+
+
+def res_kind(key: str) -> tuple[float, str]:
+    """A resonance key's quality factor and shape ("resonance:8" → (8.0, "lorentzian"), "resonance:bp:8" →
+    (8.0, "bandpass"): :data:`allanite.model.effects.RESONANCE_SHAPES`)."""
+    shape, _sep, q = key.split(":", 1)[1].rpartition(":")
+    return float(q), "bandpass" if shape == BANDPASS_TAG else "lorentzian"
 
 
 def bw_kind(key: str) -> str:
@@ -87,7 +99,8 @@ def _column(key, p, curve):
     if base == "bandwidth":
         return filtered_white_avar(tau, bw_kind(key), p, curve.fs)
     if base == "resonance":
-        return resonance_avar(tau, p, float(key.split(":", 1)[1]), curve.fs)
+        q, shape = res_kind(key)
+        return resonance_avar(tau, p, q, curve.fs, shape)
     sig = EFFECTS[base].signature
     assert sig is not None
     return sig(tau, p, curve.fs)

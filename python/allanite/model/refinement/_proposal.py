@@ -34,9 +34,9 @@ __all__ = [
 class Round:
     """What one step of the loop offers every curve candidate: the curve, the current model (terms ``start``
     plus ``effects``, solution ``sol``), the thinned curve with the curve test and its threshold, the held-out
-    split, the samples (None for curve-only input), the spectral lines found in them and the record's false-alarm
-    ``level`` (for a candidate's own nested test). (A round that only reads an effect's parameters off a solution
-    needs the first four.)"""
+    split, the samples (None for curve-only input), the spectral lines found in them, the record's false-alarm
+    ``level`` and the curve test's thinning and covariance (for a candidate's own nested test). (A round that
+    only reads an effect's parameters off a solution needs the first four.)"""
 
     curve: Curve
     start: tuple
@@ -49,6 +49,9 @@ class Round:
     y: np.ndarray | None = None
     lines: list = field(default_factory=list)
     level: float = LEVEL
+    #: the thinned τ's indices and whether the test's covariance is exact (a candidate's own nested test)
+    thin: np.ndarray | None = None
+    exact: bool = False
 
     @property
     def tmin(self) -> float:
@@ -78,6 +81,8 @@ class Proposal:
     line: dict | None = None
     pair_note: str | None = None
     record: dict = field(default_factory=dict)
+    #: what the candidate's own comparisons said at this step, for its step's evidence (a resonance's shape)
+    notes: dict = field(default_factory=dict)
     #: its column in ``sol`` (the last while it is proposed; its place in the final model afterwards)
     column: int = -1
 

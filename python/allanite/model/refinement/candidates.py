@@ -29,7 +29,17 @@ import math
 import numpy as np
 
 from ._bandwidth import bandwidth_grids, bw_evidence, bw_family, bw_params, bw_propose, bw_searches
-from ._bumps import gm_evidence, gm_family, gm_propose, gm_searches, res_family, res_params, res_propose, res_searches
+from ._bumps import (
+    gm_evidence,
+    gm_family,
+    gm_propose,
+    gm_searches,
+    res_evidence,
+    res_family,
+    res_params,
+    res_propose,
+    res_searches,
+)
 from ._choose import PAIR_FACTOR, choose
 from ._line_gain import gain_params
 from ._proposal import CurveCandidate, Proposal, Round, amplitude_and_profile, column_amplitude
@@ -75,7 +85,13 @@ CURVE_CANDIDATES: dict[str, CurveCandidate] = {
         ),
         CurveCandidate("bandwidth", bw_family, bw_propose, bw_params, evidence=bw_evidence, searches=bw_searches),
         CurveCandidate(
-            "resonance", res_family, res_propose, res_params, amplitude=lambda pr: "sigma", searches=res_searches
+            "resonance",
+            res_family,
+            res_propose,
+            res_params,
+            evidence=res_evidence,
+            amplitude=lambda pr: "sigma",
+            searches=res_searches,
         ),
         CurveCandidate(
             "sinusoid",

@@ -36,6 +36,7 @@ from ._columns import (
     held_coherent,
     held_key,
     held_theta,
+    res_kind,
     term_columns,
 )
 from ._irls import chi2_at, irls
@@ -45,6 +46,7 @@ __all__ = [
     "base_name",
     "has_floor",
     "bw_kind",
+    "res_kind",
     "FLOOR_TAG",
     "held_key",
     "held_theta",

@@ -24,6 +24,7 @@ from .._recent import remembering
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
 from ..terms import check_terms
+from ._bumps import bandpass_chain_kept, bandpass_named, without_bandpass
 from ._final import FinalModel
 from ._in_time import TimeRemovals
 from ._inputs import REFINE_SCALE, check_scale, check_truth, check_unit, inputs
@@ -185,7 +186,8 @@ class _Run(TimeRemovals, FinalModel):
         """Curve effects one per step (at most :data:`MAX_STEPS`) while one is accepted; then an effect whose
         amplitude a later one took over entirely is dropped, and the steps are scored along the chain. Where the
         bandwidth named a sinc^k the steps run again without the sinc^k kinds, and the chain
-        :func:`._rolloff.sinc_chain_kept` prefers is kept."""
+        :func:`._rolloff.sinc_chain_kept` prefers is kept; where a resonance took the band-pass shape, again with
+        the Lorentzian shape alone, and the chain :func:`._bumps.bandpass_chain_kept` prefers is kept."""
         y = self.y
         exact = y is not None or (isinstance(self.est, str) and self.est == "oavar")
         thin = tracing.thin_indices(self.curve.tau)
@@ -213,6 +215,18 @@ class _Run(TimeRemovals, FinalModel):
                 lines = [ln for ln in lines if not ln.get("slow")]
             self.offered_lines = [float(ln["f0"]) for ln in lines]
         fork = self.fork()
+        self.curve_chain(fork, candidates, thin, exact, lines)
+        if bandpass_named(self.effects):  # the Lorentzian shape alone carried too: the whole chain decides
+            with_bp = self.fork()
+            self.effects, self.steps, self.lines, self.sol, self.considered = fork
+            with without_bandpass():
+                self.curve_chain(fork, candidates, thin, exact, lines)
+            self.keep_shape_chain(with_bp)
+        self.score()
+
+    def curve_chain(self, fork, candidates, thin, exact, lines) -> None:
+        """The curve steps from the state ``fork``; where the bandwidth named a sinc^k, again without the sinc^k
+        kinds, and the chain :func:`._rolloff.sinc_chain_kept` prefers kept."""
         self.curve_loop(candidates, thin, exact, lines)
         if sinc_named(self.effects):  # the kinds without the sinc^k carried too: the whole chain decides
             with_sinc = self.fork()
@@ -220,7 +234,21 @@ class _Run(TimeRemovals, FinalModel):
             with without_sincs():
                 self.curve_loop(candidates, thin, exact, lines)
             self.keep_chain(with_sinc)
-        self.score()
+
+    def keep_shape_chain(self, with_bp: tuple) -> None:
+        """The chain that took a band-pass resonance (``with_bp``, :meth:`fork`) or the one just run with the
+        Lorentzian shape alone, whichever :func:`._bumps.bandpass_chain_kept` prefers; both chains' final χ²/dof
+        and effects in every kept resonance step's ``evidence["shape_chains"]``."""
+        tie = self.curve.tau.size / self.curve.n_eff
+        chains = {
+            name: {"chi2_dof": float(fk[3].chi2_dof), "effects": [base_name(k) for k, _p in fk[0]]}
+            for name, fk in (("with_bandpass", with_bp), ("lorentzian_only", self.fork()))
+        }
+        if bandpass_chain_kept(with_bp[3], self.sol, tie):
+            self.effects, self.steps, self.lines, self.sol, self.considered = with_bp
+        for st in self.steps:
+            if st.effect == "resonance":
+                st.evidence["shape_chains"] = chains
 
     def curve_loop(self, candidates, thin, exact, lines) -> None:
         """The curve steps while one is accepted, the absorbed dropped, the roll-off searched again."""
@@ -261,12 +289,24 @@ class _Run(TimeRemovals, FinalModel):
         fam = families(sub, candidates, self.y is not None)
         thr = test.threshold(fam, alpha("curve", self.level), N_BOOT, seed=n_step)
         rnd = Round(
-            self.curve, self.start, self.effects, self.sol, sub, test, thr, self.heldout, self.y, lines, self.level
+            self.curve,
+            self.start,
+            self.effects,
+            self.sol,
+            sub,
+            test,
+            thr,
+            self.heldout,
+            self.y,
+            lines,
+            self.level,
+            thin,
+            exact,
         )
         prefetch(rnd, candidates)  # every candidate's bounded searches, run together
         props = [pr for name, c in CURVE_CANDIDATES.items() if name in candidates for pr in c.propose(rnd)]
         for pr in props:
-            pr.record = {"param": float(pr.p), "statistic": float(pr.stat), "threshold": float(pr.thr)}
+            pr.record = {"param": float(pr.p), "statistic": float(pr.stat), "threshold": float(pr.thr)} | pr.notes
             self.consider(pr.effect, pr.record)
         chosen = choose(props, rnd, candidates)
         for other in props:  # a test that passed says why it was not taken (choose says it where it can)
