@@ -17,7 +17,7 @@ it standard normal; one-sided (a telegraph's tail is heavy), Bonferroni over the
 differences are fewer than :data:`MIN_DIFFS` or finer than 4 steps of a quantised record's lattice are not
 tested.
 
-:func:`telegraph_fit` — the two levels and the state of each block of L = m*/2 samples (m* the octave whose
+:func:`telegraph_fit` — the two levels and the state of each block of L = m* samples (m* the octave whose
 kurtosis stands highest): block means less a slow baseline (their running median over a stretch of the
 record, then the running mean of what the levels leave), a two-Gaussian mixture for the levels, and the
 Viterbi path of a two-state hidden Markov chain with the dwells of the decoded runs (twice); each switch
@@ -49,7 +49,7 @@ __all__ = [
 #: Fewest Allan differences an octave's kurtosis is read from (the Anscombe–Glynn form needs n_eff ≫ 20).
 MIN_DIFFS = 4096
 #: The levels must stand this many block-noise σ apart for the states to be read from the samples.
-SEPARATION = 5.0
+SEPARATION = 4.0
 
 
 def telegraph_gm(amplitude: float, dwell_low: float, dwell_high: float) -> dict:
@@ -252,12 +252,12 @@ def _dwell(lengths: np.ndarray, fs: float, confidence: float) -> tuple[float, tu
 
 
 def telegraph_fit(y: np.ndarray, fs: float, m: int, confidence: float = 0.683) -> dict | None:
-    """The two-level switching of ``y`` read at blocks of L = max(1, m/2) samples (:func:`_decode`), switches placed
+    """The two-level switching of ``y`` read at blocks of L = max(1, m) samples (:func:`_decode`), switches placed
     to the sample: ``{"amplitude", "dwell_low", "dwell_high", "intervals", "visits", "separation", "block",
     "states", "baseline", "component"}`` (amplitude the upper level less the lower, rate unit; dwells in s, from the
     complete runs; ``separation`` |A| over the blocks' noise σ), or None where no second level shows."""
     n = y.size
-    block = max(1, m // 2, n // 200_000)
+    block = max(1, m, n // 200_000)
     nb = n // block
     b = y[: nb * block].reshape(nb, block).mean(axis=1)
     wb = max(33, int(max(64 * m, n / 32) / block)) | 1
