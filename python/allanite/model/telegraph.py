@@ -47,7 +47,7 @@ __all__ = [
 ]
 
 #: Fewest Allan differences an octave's kurtosis is read from (the Anscombe–Glynn form needs n_eff ≫ 20).
-MIN_DIFFS = 4096
+MIN_DIFFS = 2000
 #: The levels must stand this many block-noise σ apart for the states to be read from the samples.
 SEPARATION = 4.0
 
@@ -252,12 +252,29 @@ def _dwell(lengths: np.ndarray, fs: float, confidence: float) -> tuple[float, tu
 
 
 def telegraph_fit(y: np.ndarray, fs: float, m: int, confidence: float = 0.683) -> dict | None:
-    """The two-level switching of ``y`` read at blocks of L = max(1, m) samples (:func:`_decode`), switches placed
-    to the sample: ``{"amplitude", "dwell_low", "dwell_high", "intervals", "visits", "separation", "block",
-    "states", "baseline", "component"}`` (amplitude the upper level less the lower, rate unit; dwells in s, from the
-    complete runs; ``separation`` |A| over the blocks' noise σ), or None where no second level shows."""
+    """The two-level switching of ``y`` (:func:`_fit_at`) read at blocks of L = m samples, then at the finest L = m/2^k
+    at which the levels would still stand 2·:data:`SEPARATION` σ apart (the blocks' noise σ taken to fall as 1/√L,
+    white): a visit shorter than a block is not seen, so the finer the blocks the fewer missed; the coarse reading
+    kept where the fine one's levels stand less than :data:`SEPARATION` apart. ``{"amplitude", "dwell_low",
+    "dwell_high", "intervals", "visits", "separation", "block", "states", "baseline", "component"}`` (amplitude the
+    upper level less the lower, rate unit; dwells in s, from the complete runs; ``separation`` |A| over the blocks'
+    noise σ), or None where no second level shows."""
     n = y.size
-    block = max(1, m, n // 200_000)
+    coarse = _fit_at(y, fs, max(1, m, n // 200_000), m, confidence)
+    if coarse is None:
+        return None
+    k = int(math.floor(2.0 * math.log2(max(coarse["separation"] / (2.0 * SEPARATION), 1.0))))
+    block = max(1, coarse["block"] >> k, n // 200_000)
+    if block == coarse["block"]:
+        return coarse
+    fine = _fit_at(y, fs, block, m, confidence)
+    return fine if fine is not None and fine["separation"] >= SEPARATION else coarse
+
+
+def _fit_at(y: np.ndarray, fs: float, block: int, m: int, confidence: float) -> dict | None:
+    """The two-level switching of ``y`` read at blocks of ``block`` samples (:func:`_decode`, its baseline over
+    max(64·m, n/32) samples), switches placed to the sample."""
+    n = y.size
     nb = n // block
     b = y[: nb * block].reshape(nb, block).mean(axis=1)
     wb = max(33, int(max(64 * m, n / 32) / block)) | 1
