@@ -48,7 +48,7 @@ def _declined(f: dict | None, y: np.ndarray, fs: float, r: dict) -> tuple[str | 
         return f"complete visits {f['visits']} (< {MIN_VISITS} to each level)", {}
     m = int(r["m"])
     less = y - f["component"]
-    z, _ne = tg.kurtosis_z(np.diff(less[: (less.size // m) * m].reshape(-1, m).mean(axis=1)))
+    z, _ne, _g2 = tg.kurtosis_z(np.diff(less[: (less.size // m) * m].reshape(-1, m).mean(axis=1)))
     left = {"z": z, "threshold": r["threshold"], "tau": r["tau"]}
     if z > r["threshold"]:
         return "the samples less the two levels still fail the kurtosis test at its τ", left
