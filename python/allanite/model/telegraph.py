@@ -13,8 +13,9 @@ keeps them Gaussian.
 standard units under a Gaussian process of the differences' own autocorrelation ρ: a stationary Gaussian
 series of n terms has var(g₂) ≈ (24/n)·Σ_k ρ_k⁴, so its kurtosis is that of n_eff = n / Σ_k ρ_k⁴ independent
 terms, and the Anscombe–Glynn transformation of the kurtosis of n_eff Gaussian terms (D'Agostino's test) makes
-it standard normal; one-sided (a telegraph's tail is heavy), Bonferroni over the octaves, at an octave whose excess
-kurtosis is at least :data:`MIN_EXCESS` (real sensors' slight non-Gaussianity is no telegraph). Octaves whose
+it standard normal; one-sided (a telegraph's tail is heavy), Bonferroni over the octaves; the octave of the largest
+z must also show an excess kurtosis of at least :data:`MIN_EXCESS` (real sensors' slight non-Gaussianity is no
+telegraph). Octaves whose
 differences are fewer than :data:`MIN_DIFFS` or finer than 4 steps of a quantised record's lattice are not
 tested.
 
@@ -138,8 +139,7 @@ def telegraph_test(y: np.ndarray, fs: float, alpha: float) -> dict:
             octaves.append({"m": m, "tau": m / fs, "z": z, "n_eff": ne, "excess": g2})
         m *= 2
     thr = float(norm.isf(alpha / max(1, len(octaves))))
-    big = [o for o in octaves if o["excess"] >= MIN_EXCESS] or octaves
-    best = max(big, key=lambda o: o["z"]) if big else {"m": 0, "tau": 0.0, "z": -math.inf, "excess": 0.0}
+    best = max(octaves, key=lambda o: o["z"]) if octaves else {"m": 0, "tau": 0.0, "z": -math.inf, "excess": 0.0}
     out = {"z": best["z"], "threshold": thr, "m": best["m"], "tau": best["tau"], "excess": best["excess"]}
     accepted = best["z"] > thr and best["excess"] >= MIN_EXCESS
     return out | {"octaves": octaves, "accepted": bool(accepted), "alpha": alpha}
