@@ -154,6 +154,7 @@ MODEL_RANKS = {
     "model.linefit": 0,
     "model.lines": 0,
     "model.outliers": 0,
+    "model.telegraph": 0,  # random telegraph noise: its Allan variance, kurtosis test and two-level fit
     "model.noise_level": 0,
     "model.slowline": 0.5,  # a line of few cycles tested in time under red noise (numpy, scipy only)
     "model.periodic": 1,
@@ -211,6 +212,7 @@ MODEL_RANKS = {
     "model.refinement._choose": 5.7,
     "model.refinement.candidates": 6,
     "model.refinement._tracking": 5,  # a family's or a lone line's phase tracked, the held-out test in time
+    "model.refinement._telegraph": 5.8,  # the telegraph removal's test, fit and evidence (removals' entry)
     "model.refinement.removals": 6,
     "model.refinement.changes": 6,
     # unexplained's parts, below missing (its spectral-line and channel checks, CHECKS): what a check is given;

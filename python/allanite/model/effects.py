@@ -326,6 +326,25 @@ EFFECTS: dict[str, Effect] = {
             domain="time",
         ),
         Effect(
+            "telegraph",
+            "random telegraph (burst, popcorn) noise",
+            "time",
+            (
+                ("amplitude", "rate unit", "the upper level less the lower"),
+                ("dwell_low", "s", "mean time at the lower level"),
+                ("dwell_high", "s", "mean time at the upper level"),
+            ),
+            "a rate switching between two levels after exponential dwells: Allan variance the Gauss–Markov one "
+            "with σ² = A²·p(1 − p), p = dwell_high/(dwell_low + dwell_high), T_c = 1/(1/dwell_low + 1/dwell_high) "
+            "(its spectrum a Lorentzian). Found in time by the excess kurtosis of the Allan differences at octave τ "
+            "against a Gaussian process of their own autocorrelation (Anscombe–Glynn at n/Σρ⁴ terms, Bonferroni over "
+            "the octaves), its levels and switches decoded (a two-state hidden Markov chain on block means over a "
+            "slow baseline) and removed — taken only where the levels stand clear of the noise, each is visited at "
+            "least 3 times and the samples less it pass the test (allanite.model.telegraph); else a Gauss–Markov "
+            "term on the curve stands for it",
+            domain="time",
+        ),
+        Effect(
             "change_point",
             "changes of noise level",
             "time",

@@ -17,6 +17,7 @@ __all__ = [
     "CHANGE_POINT_SHARE",
     "TIME_SHARE",
     "OUTLIER_SHARE",
+    "TELEGRAPH_SHARE",
     "UNEXPLAINED_SHARES",
     "SAMPLE_CHECKS",
     "SHARES",
@@ -46,6 +47,11 @@ TIME_SHARE = 0.075
 #: expectation, Bonferroni over its cuts): proposed 0.05 (α = 0.25 % at level 0.05); its power on spikes and
 #: heavy tails is far above what the share costs (benches/results/periodic_outliers_power.md).
 OUTLIER_SHARE = 0.05
+#: Share of ``level`` for the telegraph test (the Allan differences' kurtosis, Bonferroni over the octaves):
+#: 0.002 is what the Allan-curve test's rest can give without moving its bootstrap critical value (the 988th of
+#: 1001 draws at level 0.05); its null on Gaussian records of Gauss–Markov and flicker spectra:
+#: benches/results/telegraph_null.md.
+TELEGRAPH_SHARE = 0.002
 
 #: Share of ``level`` spent on saying what the final model still misses (``Refinement.unexplained``), split
 #: between its checks: the Allan curve, lines in the PSD, a drift in time, a step of the mean, steps of the mean
@@ -106,7 +112,12 @@ SHARES = {
 }
 #: The share of each time-domain removal, by effect name (one entry per removal of ``removals.REMOVALS``; the
 #: ``"periodic"`` removal spends the ``"lines"`` share).
-TIME_SHARES = {"outliers": OUTLIER_SHARE, "drift": TIME_SHARE, "regression": TIME_SHARE}
+TIME_SHARES = {
+    "outliers": OUTLIER_SHARE,
+    "drift": TIME_SHARE,
+    "regression": TIME_SHARE,
+    "telegraph": TELEGRAPH_SHARE,
+}
 #: Tests run only once another has accepted its effect — a slow channel's optional terms (quadratic,
 #: d(channel)/dt, lag; :data:`allanite.model.channels.TERM_SHARE`), each at this share of ``level``. On a
 #: clean record they never run unless the regression itself is a false alarm, so they take nothing from the

@@ -34,6 +34,7 @@ terms included.
   candidate (:attr:`RemovalContext.lines`): one search, one share of ``level``; so do the lines of a family whose
   removal is turned down (its phase does not carry across the record: narrowband power, not a line). A lone line
   whose frequency wanders is removed here instead, a family of one order with its phase tracked.
+- ``"telegraph"`` — a rate switching between two levels, its switches decoded and removed (:mod:`._telegraph`).
 
 Removals run before the curve effects (a component left in the samples bends the curve every curve effect is
 fitted against), in the order of :data:`REMOVALS`. A new one is one entry here and one share in
@@ -53,6 +54,7 @@ from ...analysis import avar
 from .. import channels, linefit, outliers, periodic, template, tracing, wander, warmup
 from ._channel_order import strongest_first
 from ._slow_lines import explained_by_channel, slow_line_removal
+from ._telegraph import telegraph_removal
 from ._tracking import heldout_variance_ratio
 from ._tracking import tracked as _tracked
 from .calibrated import tested
@@ -608,10 +610,17 @@ def _others(y: np.ndarray, rest) -> np.ndarray | None:
     return out
 
 
+def _switching(ctx: RemovalContext) -> Iterator[Removal]:
+    """Random telegraph noise, last: a channel, a line family or spikes explain jumps first (:mod:`._telegraph`)."""
+    for fields in telegraph_removal(ctx):
+        yield Removal(**fields)
+
+
 #: The time-domain removals, in the order they run (each before the curve effects).
 REMOVALS: dict[str, Callable[[RemovalContext], Iterator[Removal]]] = {
     "outliers": _outliers,
     "drift": _drift,
     "regression": _regression,
     "periodic": _periodic,
+    "telegraph": _switching,
 }
