@@ -213,6 +213,7 @@ MODEL_RANKS = {
     "model.refinement.candidates": 6,
     "model.refinement._tracking": 5,  # a family's or a lone line's phase tracked, the held-out test in time
     "model.refinement._telegraph": 5.8,  # the telegraph removal's test, fit and evidence (removals' entry)
+    "model.refinement._family_parts": 5.5,  # a periodic removal's params, folded waveform and lone-line sinusoid (removals' entry)
     "model.refinement.removals": 6,
     "model.refinement.changes": 6,
     # unexplained's parts, below missing (its spectral-line and channel checks, CHECKS): what a check is given;

@@ -76,3 +76,16 @@ def test_changing_noise_level_is_no_telegraph():
     assert tg.telegraph_test(y, FS, ALPHA)["accepted"]
     got, said = _removal(y)
     assert got == [] and "rejected" in said[0]
+
+
+def test_pulse_train_is_no_telegraph():
+    """A pulse train (0.02 high for 2 s of every 20 s) switches between two levels as a telegraph does, but its dwells
+    are all alike: declined as periodic (its lines are the periodic candidate's), where the same levels with
+    exponential dwells are taken (test above)."""
+    t = np.arange(N) / FS
+    rng = np.random.default_rng(6)
+    y = rng.standard_normal(N) * A + A * ((t % 20.0) < 2.0)
+    cv = tg.dwell_cv(((t % 20.0) < 2.0).astype(int))
+    assert max(cv) < 1e-12
+    got, said = _removal(y)
+    assert got == [] and "regular" in said[0].get("rejected", ""), said

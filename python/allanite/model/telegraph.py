@@ -47,6 +47,7 @@ __all__ = [
     "kurtosis_z",
     "telegraph_test",
     "telegraph_fit",
+    "dwell_cv",
 ]
 
 #: Fewest Allan differences an octave's kurtosis is read from (the Anscombe–Glynn form needs n_eff ≫ 20).
@@ -200,6 +201,19 @@ def _runs(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     starts = np.concatenate([[0], edge])
     lengths = np.diff(np.concatenate([starts, [s.size]]))
     return starts, lengths, s[starts]
+
+
+def dwell_cv(states: np.ndarray) -> tuple[float, float]:
+    """The coefficient of variation (sample s.d. over mean) of the complete runs in each state of the 0/1 sequence
+    ``states`` — (state 0's, state 1's); NaN where a state has fewer than two complete runs. A telegraph's dwells are
+    exponential (CV ≈ 1); a pulse train's are all alike (CV ≈ 0)."""
+    _starts, lengths, st = _runs(np.asarray(states))
+    ln, st = lengths[1:-1].astype(np.float64), st[1:-1]  # the first and last runs are cut by the record's ends
+    out = []
+    for q in (0, 1):
+        d = ln[st == q]
+        out.append(float(np.std(d, ddof=1) / np.mean(d)) if d.size >= 2 else math.nan)
+    return out[0], out[1]
 
 
 def _decode(b: np.ndarray, wb: int) -> tuple | None:

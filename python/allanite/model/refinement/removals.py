@@ -51,8 +51,9 @@ import numpy as np
 from scipy.stats import t as t_dist
 
 from ...analysis import avar
-from .. import channels, linefit, outliers, periodic, template, tracing, wander, warmup
+from .. import channels, linefit, outliers, periodic, tracing, wander, warmup
 from ._channel_order import strongest_first
+from ._family_parts import family_out, folded_waveform, sinusoid_at
 from ._slow_lines import explained_by_channel, slow_line_removal
 from ._telegraph import telegraph_removal
 from ._tracking import heldout_variance_ratio
@@ -448,10 +449,10 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
     for i, fam in enumerate(families):
         if ctx.y is not searched:  # a family removed before: this one's amplitudes on what it left
             fam = _refit_family(fam, ctx.y)
-        params, intervals, evidence = _family_out(fam, a, search)
+        params, intervals, evidence = family_out(fam, a, search)
         component, refit, ratio = fam.component(), fam.refit, heldout_variance_ratio(ctx.y, fam.refit)
         tracked = _tracked(ctx, fam, component, ratio, (params, intervals, evidence))
-        wave = None if tracked is not None else _waveform(ctx, fam, ratio, families[i + 1 :])
+        wave = None if tracked is not None else folded_waveform(ctx, fam, ratio, families[i + 1 :])
         if tracked is not None:
             component, refit, ratio = tracked
         if wave is not None:
@@ -510,7 +511,7 @@ def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, searc
     the ``"sinusoid"`` curve candidate's, held on the curve at its power in the spectrum (a motor's, a fan's or a
     pump's single tone whose speed wanders would otherwise leave its incoherent power there and nothing of it
     removed from the samples)."""
-    out = _family_out(sin, a, search)
+    out = family_out(sin, a, search)
     got = _tracked(ctx, sin, sin.component(), lambda: heldout_variance_ratio(ctx.y, sin.refit), out)
     if got is None:
         if out[2].get("wander", {}).get("test", {}).get("accepted"):  # its test passed, the held-out ratio did not
@@ -521,7 +522,7 @@ def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, searc
     wv["explained_share"] = share = wander.explained_share(ctx.y, component, ctx.fs, wv["test"], float(sin.gens[0]))
     mean = float(out[0]["fundamentals"][0])
     wv["at_mean"] = again = wander.wander_test(
-        ctx.y - _sinusoid_at(ctx.y, ctx.fs, mean), ctx.fs, mean, wv["test"]["bandwidth_hz"], mean, wv["test"]["alpha"]
+        ctx.y - sinusoid_at(ctx.y, ctx.fs, mean), ctx.fs, mean, wv["test"]["bandwidth_hz"], mean, wv["test"]["alpha"]
     )
     why = None
     if not share >= wander.MIN_EXPLAINED:  # what the steady fit left is its amplitude changing, not its phase
@@ -535,35 +536,6 @@ def _lone_tracked(ctx: RemovalContext, sin: periodic.LineFamily, a: float, searc
     return Removal("periodic", component, refit, out[0], out[1], out[2], 1, heldout_in_time=ratio)
 
 
-def _sinusoid_at(y: np.ndarray, fs: float, f_hz: float) -> np.ndarray:
-    """The least-squares sinusoid at ``f_hz`` in ``y``."""
-    idx, nu, one = np.arange(y.size), np.array([f_hz / fs]), np.array([[1]])
-    a, b = linefit.solve(y, idx, nu, one)
-    return linefit.evaluate(idx, nu, one, a, b)
-
-
-def _family_out(fam: periodic.LineFamily, a: float, search: dict) -> tuple[dict, dict, dict]:
-    """A periodic step's ``params``, ``intervals`` and ``evidence`` for the family ``fam`` as found (steady)."""
-    ratios = fam.evidence["psd_ratio"]
-    i = int(np.argmax(ratios))
-    sd = fam.gens_sd
-    params = {"fundamentals": [float(g) for g in fam.gens], "lines": int(fam.coefs.shape[0]), "rms": fam.rms}
-    intervals = {
-        "fundamentals": [(float(g - s), float(g + s)) for g, s in zip(fam.gens, sd)],
-        "rms": (max(0.0, fam.rms - fam.rms_sd), fam.rms + fam.rms_sd),
-    }
-    evidence = {
-        "domain": "psd",
-        "test": tested("psd_ratio", float(ratios[i]), fam.evidence["threshold"], a),
-        "frequencies_hz": [float(f) for f in fam.frequencies],
-        "coefficients": fam.coefs.tolist(),
-        "amplitudes": [float(v) for v in fam.amplitudes],
-        "targeted": fam.evidence["targeted"],
-        "bins_searched": search["bins"],
-    }
-    return params, intervals, evidence
-
-
 def _refit_family(fam: periodic.LineFamily, y: np.ndarray) -> periodic.LineFamily:
     """``fam`` with its amplitudes and phases refitted on ``y`` (the samples an earlier family's removal left), its
     frequencies as found. Every family is found on the same samples; a line two families share was removed twice
@@ -572,42 +544,6 @@ def _refit_family(fam: periodic.LineFamily, y: np.ndarray) -> periodic.LineFamil
     sinusoid then held, ``tests/sensors.py``)."""
     a, b = linefit.solve(y, np.arange(y.size), fam.gens / fam.fs, fam.coefs)
     return dataclasses.replace(fam, a=a, b=b)
-
-
-def _waveform(ctx: RemovalContext, fam: periodic.LineFamily, ratio_lines: float, rest=()):
-    """A family of harmonics as its waveform folded on the period, with its held-out variance ratio, when that
-    is below the lines' (``ratio_lines``); None otherwise, or for a family of sidebands (two generators).
-
-    The fold is taken on the samples less the lines of the families still to come (``rest``, least squares on
-    the same samples): a fold holds whatever repeats on its period, and where two fundamentals share the sampled
-    lattice (1.7 and 13.7 Hz at 200 Hz both repeat every 2000 samples) the first family's fine template held the
-    other's square wave too, which then lost its lines to it (``benches/refine_blind10.py``'s two families); the
-    held-in samples of its held-out test are folded the same way."""
-    if fam.gens.size != 1 or not fam.gens[0] > 0:
-        return None
-    others = _others(ctx.y, rest)
-    tpl = template.fit_template(ctx.y if others is None else ctx.y - others, ctx.fs, float(fam.gens[0]))
-    refit = tpl.refit
-    if others is not None:
-
-        def refit(samples: np.ndarray, idx: np.ndarray):
-            return tpl.refit(samples - others[idx], idx)
-
-    ratio = heldout_variance_ratio(ctx.y, refit)
-    return (tpl, ratio, refit) if ratio < ratio_lines else None
-
-
-def _others(y: np.ndarray, rest) -> np.ndarray | None:
-    """The least-squares lines of the families ``rest`` in ``y`` (their frequencies as found), summed; None if none."""
-    if not rest:
-        return None
-    idx = np.arange(y.size)
-    out = np.zeros(y.size)
-    for fam in rest:
-        g = fam.gens / fam.fs
-        a, b = linefit.solve(y, idx, g, fam.coefs)
-        out += linefit.evaluate(idx, g, fam.coefs, a, b)
-    return out
 
 
 def _switching(ctx: RemovalContext) -> Iterator[Removal]:
