@@ -563,7 +563,9 @@ def test_other_errors(rng):
     with pytest.raises(ParameterError, match="too large"):
         identify_alpha(y, 600, input="rate")
     with pytest.raises(ParameterError, match="input"):
-        identify_alpha(y, 1, input="phase")
+        identify_alpha(y, 1, input="phases")
+    # allantools' word for a clock's time error is allanite's angle: the same identification
+    np.testing.assert_array_equal(identify_alpha(y, [1, 4], input="phase"), identify_alpha(y, [1, 4], input="angle"))
     with pytest.raises(ParameterError, match="AllanResult"):
         confidence_intervals(r.avar, alpha=0)
 

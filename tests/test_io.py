@@ -565,8 +565,8 @@ def test_parameter_errors(tmp_path, record):
         read_log(p, time_column="t", unit="deg/fortnight")
     with pytest.raises(ParameterError, match=r"unknown gaps 'ignore'; allowed: 'error', 'longest', 'split'"):
         read_log(p, time_column="t", gaps="ignore")
-    with pytest.raises(ParameterError, match=r"unknown input 'phase'"):
-        read_log(p, time_column="t", input="phase")
+    with pytest.raises(ParameterError, match=r"unknown input 'phases'"):
+        read_log(p, time_column="t", input="phases")
     with pytest.raises(ParameterError, match=r"fs must be a positive finite number"):
         read_log(p, fs=-1)
     with pytest.raises(ParameterError, match=r"columns must be a column name or index, or a non-empty list"):
