@@ -146,6 +146,7 @@ NOTES = [
     "**Rerun whole at 55d58e5** (every branch of the 2026-11-28 night merged: r13heldout, r13gain, r13swing, r13rate, r13cover, r13cost, r13slowline; the other suites, the ADIS16405 run and CI shared the 2 cores, so the CPU column is not a cost measurement): every row's verdict, effects, parameters and words as recorded.",
     "Rerun whole at 9eaf694 (the 2026-11-28 morning's branches merged: r14house, r14blind11, r14modline, r14pump, r14cost, r14lagrate, r14fir; r14reson merged and reverted; another suite chain, the ADIS16405 run and CI shared the 2 cores, so the CPU column is not a cost measurement): every row's verdict, effects and parameters as recorded — 17 of 17.",
     "**r16family** (`--case \"consumer IMU\"` rerun at eb50192, the row and its JSON replaced): a family's folded waveform is now taken on the samples less the other families' lines, so the 0.19 Hz family's fold no longer holds the sideband family's 6.65 Hz line (its 35th harmonic) and the family is removed by its three lines: rms error −0.15 → −0.07 %, χ²/dof 0.903 → 0.849, RMS ADEV 1.97 %, held out 3.484 → 3.486 %; passed as before.",
+    "**Rerun whole at 44c3f2f** (the 2026-11-28 late-morning branches merged: r16heldout — the chain's deviance and AIC, keys only —, r16family, r16reson, r16burst; other suites and the false-alarm bench shared the 2 cores, so the CPU column is not a cost measurement): every row's verdict, effects, parameters and words as recorded — 17 of 17.",
 ]
 
 
