@@ -340,8 +340,8 @@ EFFECTS: dict[str, Effect] = {
             "against a Gaussian process of their own autocorrelation (Anscombe–Glynn at n/Σρ⁴ terms, Bonferroni over "
             "the octaves), its levels and switches decoded (a two-state hidden Markov chain on block means over a "
             "slow baseline) and removed — taken only where the levels stand clear of the noise, each is visited at "
-            "least 3 times and the samples less it pass the test (allanite.model.telegraph); else a Gauss–Markov "
-            "term on the curve stands for it",
+            "least 3 times, its dwells are not all alike (a pulse train is periodic) and the samples less it pass "
+            "the test (allanite.model.telegraph); else a Gauss–Markov term on the curve stands for it",
             domain="time",
         ),
         Effect(
