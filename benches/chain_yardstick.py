@@ -187,7 +187,6 @@ def _pct(v) -> str:
 
 
 def _row_lines(label: str, rows: list, s: dict, named: int) -> list:
-    n = s["records"]
     lines = [f"### {label}", ""]
     for i, su in enumerate(rows[:named]):
         lines += [
@@ -200,17 +199,25 @@ def _row_lines(label: str, rows: list, s: dict, named: int) -> list:
             f"{_pct(su['truth']['rms_elsewhere'])} %.",
             "",
         ]
-    lines += [
-        f"| yardstick | truth < start (of {n}) | 95 % CP | median truth − start | spurious < null start (of {n}) | 95 % CP |",
-        "|---|---|---|---|---|---|",
+    return lines + _table(s, median=True, digits=0)
+
+
+def _table(s: dict, median: bool, digits: int) -> list:
+    """The yardsticks' table of summary ``s``: truth below the start and a false removal below its null start,
+    each with its Clopper–Pearson interval (``digits`` decimals), and the median truth − start where ``median``."""
+    n = s["records"]
+    mid = " median truth − start |" if median else ""
+    lines = [
+        f"| yardstick | truth < start (of {n}) | 95 % CP |{mid} spurious < null start (of {n}) | 95 % CP |",
+        "|---|---|---|---|---|---|" if median else "|---|---|---|---|---|",
     ]
     for k in KEYS:
         b = s["by_key"][k]
-        lo, hi = b["truth_lower_cp95"]
-        lo_s, hi_s = b["spurious_lower_cp95"]
+        (lo, hi), (lo_s, hi_s) = b["truth_lower_cp95"], b["spurious_lower_cp95"]
+        med = f" {b['truth_minus_start_median']:+.3g} |" if median else ""
         lines.append(
-            f"| {k} | {b['truth_lower']} | {100 * lo:.0f}–{100 * hi:.0f} % | {b['truth_minus_start_median']:+.3g} | "
-            f"{b['spurious_lower']} | {100 * lo_s:.0f}–{100 * hi_s:.0f} % |"
+            f"| {k} | {b['truth_lower']} | {100 * lo:.{digits}f}–{100 * hi:.{digits}f} % |{med} {b['spurious_lower']} | "
+            f"{100 * lo_s:.{digits}f}–{100 * hi_s:.{digits}f} % |"
         )
     return lines + [""]
 
@@ -252,23 +259,7 @@ NOTES = [
 def _pooled_lines(results: dict) -> list:
     """Every case's records together."""
     rows = [r for v in results.values() for r in v["rows"]]
-    s = summary(rows)
-    n = s["records"]
-    lines = [
-        "### All records",
-        "",
-        f"| yardstick | truth < start (of {n}) | 95 % CP | spurious < null start (of {n}) | 95 % CP |",
-        "|---|---|---|---|---|",
-    ]
-    for k in KEYS:
-        b = s["by_key"][k]
-        lo, hi = b["truth_lower_cp95"]
-        lo_s, hi_s = b["spurious_lower_cp95"]
-        lines.append(
-            f"| {k} | {b['truth_lower']} | {100 * lo:.1f}–{100 * hi:.1f} % | {b['spurious_lower']} | "
-            f"{100 * lo_s:.1f}–{100 * hi_s:.1f} % |"
-        )
-    return lines + [""]
+    return ["### All records", "", *_table(summary(rows), median=False, digits=1)]
 
 
 def main(argv=None) -> None:
