@@ -202,17 +202,24 @@ def _runs(s: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return starts, lengths, s[starts]
 
 
+def _cv(lengths: np.ndarray) -> float:
+    """The coefficient of variation (sample s.d. over mean) of run ``lengths``; NaN for fewer than two."""
+    d = np.asarray(lengths, dtype=np.float64)
+    return float(np.std(d, ddof=1) / np.mean(d)) if d.size >= 2 else math.nan
+
+
 def dwell_cv(states: np.ndarray) -> tuple[float, float]:
-    """The coefficient of variation (sample s.d. over mean) of the complete runs in each state of the 0/1 sequence
-    ``states`` — (state 0's, state 1's); NaN where a state has fewer than two complete runs. A telegraph's dwells are
-    exponential (CV ≈ 1); a pulse train's are all alike (CV ≈ 0)."""
+    """The coefficient of variation of the complete runs in each state of the 0/1 sequence ``states`` — (state 0's,
+    state 1's); NaN where a state has fewer than two complete runs. A telegraph's dwells are exponential (CV ≈ 1); a
+    pulse train's are all alike (CV ≈ 0). :func:`telegraph_fit` gives its own as ``"dwell_cv"`` (low, high)."""
     _starts, lengths, st = _runs(np.asarray(states))
-    ln, st = lengths[1:-1].astype(np.float64), st[1:-1]  # the first and last runs are cut by the record's ends
-    out = []
-    for q in (0, 1):
-        d = ln[st == q]
-        out.append(float(np.std(d, ddof=1) / np.mean(d)) if d.size >= 2 else math.nan)
-    return out[0], out[1]
+    ln, st = lengths[1:-1], st[1:-1]  # the first and last runs are cut by the record's ends
+    return _cv(ln[st == 0]), _cv(ln[st == 1])
+
+
+def _diff_sigma(x: np.ndarray) -> float:
+    """σ of white noise behind ``x`` from its first differences: 1.4826·median|Δx|/√2."""
+    return 1.4826 * float(np.median(np.abs(np.diff(x)))) / math.sqrt(2.0)
 
 
 def _decode(b: np.ndarray, wb: int) -> tuple | None:
@@ -221,7 +228,7 @@ def _decode(b: np.ndarray, wb: int) -> tuple | None:
     mean of what the levels leave, the levels the decoded states' means. None where no second level shows."""
     base = median_filter(b, size=wb, mode="nearest")
     r = b - base
-    sigma0 = 1.4826 * float(np.median(np.abs(np.diff(r)))) / math.sqrt(2.0)
+    sigma0 = _diff_sigma(r)
     mix = _mixture(r, max(sigma0, 1e-300))
     if mix is None:
         return None
@@ -240,7 +247,7 @@ def _decode(b: np.ndarray, wb: int) -> tuple | None:
         mu0, mu1 = float(np.mean(r[path == 0])), float(np.mean(r[path == 1]))
         s = max(float(np.std(r - np.where(path == 1, mu1, mu0))), 1e-300)
     left = r - np.where(path == 1, mu1, mu0)
-    sigma_b = 1.4826 * float(np.median(np.abs(np.diff(left)))) / math.sqrt(2.0)
+    sigma_b = _diff_sigma(left)
     return path, base, (mu0, mu1), max(sigma_b, 1e-300)
 
 
@@ -279,9 +286,9 @@ def telegraph_fit(y: np.ndarray, fs: float, m: int, confidence: float = 0.683) -
     at which the levels would still stand 2·:data:`SEPARATION` σ apart (the blocks' noise σ taken to fall as 1/√L,
     white): a visit shorter than a block is not seen, so the finer the blocks the fewer missed; the coarse reading
     kept where the fine one's levels stand less than :data:`SEPARATION` apart. ``{"amplitude", "dwell_low",
-    "dwell_high", "intervals", "visits", "separation", "block", "states", "baseline", "component"}`` (amplitude the
-    upper level less the lower, rate unit; dwells in s, from the complete runs; ``separation`` |A| over the blocks'
-    noise σ), or None where no second level shows."""
+    "dwell_high", "intervals", "visits", "dwell_cv", "separation", "block", "states", "baseline", "component"}``
+    (amplitude the upper level less the lower, rate unit; dwells in s and their coefficients of variation (low, high),
+    from the complete runs; ``separation`` |A| over the blocks' noise σ), or None where no second level shows."""
     n = y.size
     coarse = _fit_at(y, fs, max(1, m, n // 200_000), m, confidence)
     if coarse is None:
@@ -327,6 +334,7 @@ def _fit_at(y: np.ndarray, fs: float, block: int, m: int, confidence: float) -> 
         "dwell_high": d_hi,
         "intervals": {"amplitude": (abs(amp) - zc * se, abs(amp) + zc * se), "dwell_low": iv_lo, "dwell_high": iv_hi},
         "visits": {"low": k_lo, "high": k_hi},
+        "dwell_cv": (_cv(ln[st != up]), _cv(ln[st == up])),
         "separation": abs(amp) / sigma_b,
         "block": block,
         "states": s,

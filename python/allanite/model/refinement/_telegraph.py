@@ -52,10 +52,10 @@ def _declined(f: dict | None, y: np.ndarray, fs: float, r: dict) -> tuple[str | 
         return f"the levels stand {f['separation']:.3g} σ of the blocks' noise apart (< {tg.SEPARATION:g})", {}
     if min(f["visits"].values()) < MIN_VISITS:
         return f"complete visits {f['visits']} (< {MIN_VISITS} to each level)", {}
-    cv = tg.dwell_cv(f["states"])
-    if max(cv) < REGULAR_CV:  # NaN compares False: a state of one complete run is not judged regular
+    cv = f["dwell_cv"]
+    if all(c < REGULAR_CV for c in cv):  # NaN compares False: a state of one complete run is not judged regular
         return (
-            f"the dwells are regular (coefficient of variation {cv[0]:.2g} and {cv[1]:.2g}; a telegraph's are "
+            f"the dwells are regular (coefficient of variation {cv[0]:.2g} low and {cv[1]:.2g} high; a telegraph's are "
             "exponential, ≈ 1): a pulse train, periodic"
         ), {}
     m = int(r["m"])
