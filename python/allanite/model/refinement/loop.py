@@ -9,10 +9,15 @@ the false-alarm budget (:mod:`.levels`), the curve candidates and which one a st
 result with its report (:mod:`.result`), and the inputs checked (:mod:`._inputs`). The refinement under way
 and the chain it is scored along are :mod:`._run`'s, its removals' sequencing :mod:`._in_time`'s, the chain
 scored after the final joint refit, the change points' steps and the result's assembly :mod:`._final`'s;
-here are :func:`refine` and the curve steps (with the second chain where the bandwidth named a sinc^k).
+here are :func:`refine` and the curve steps (with a second chain where the first took an option the whole chain
+decides: :data:`ALTERNATIVES`).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from contextlib import AbstractContextManager
+from dataclasses import dataclass
 
 from ..._blas import one_thread
 from ..._progress import StepBar
@@ -33,7 +38,7 @@ from ._rolloff import research_rolloff, sinc_chain_kept, sinc_named, without_sin
 from ._sinusoid import gain_key
 from .calibrated import N_BOOT, curve_test, residual_evidence, tested
 from .candidates import CURVE_CANDIDATES, Proposal, Round, bandwidth_grids, choose, families, prefetch
-from .curvefit import base_name, held_theta, solve
+from .curvefit import Solution, base_name, held_theta, solve
 from .levels import LEVEL, alpha
 from .result import Refinement, Step
 
@@ -45,6 +50,45 @@ CANDIDATES = tuple(EFFECTS)
 #: held in the curve's fits — and change points come on top): two injected curve effects, the bandwidth and a
 #: resonance beside it (ADIS16405 run 1 z takes four) with room for one more.
 MAX_STEPS = 6
+
+
+@dataclass(frozen=True)
+class Alternative:
+    """An option a curve step may take whose choice the whole chain decides (:meth:`_Run.curve_chains`): ``named``
+    says whether the curve effects [(key, p)] hold it, ``withdrawn`` is a context in which no step takes it,
+    ``kept`` (the final solutions of the chain that took it and of the one without, one effective point) whether
+    the chain that took it stays; both chains' final χ²/dof and effects go into ``evidence[key]`` of the kept steps of
+    ``effect``, under ``labels`` (the chain that took it, the other)."""
+
+    named: Callable[[list], bool]
+    withdrawn: Callable[[], AbstractContextManager]
+    kept: Callable[[Solution, Solution, float], bool]
+    key: str
+    effect: str
+    labels: tuple[str, str]
+
+
+#: The options decided on whole chains, innermost first: a sinc^k bandwidth kind (the kinds without it,
+#: :func:`._rolloff.sinc_chain_kept`) within each resonance shape's chain (the Lorentzian alone,
+#: :func:`._bumps.bandpass_chain_kept`). The rules are looked up when asked (tests replace them).
+ALTERNATIVES = (
+    Alternative(
+        sinc_named,
+        without_sincs,
+        lambda taken, other, tie: sinc_chain_kept(taken, other, tie),
+        "kind_chains",
+        "bandwidth",
+        ("with_sinc", "without_sinc"),
+    ),
+    Alternative(
+        bandpass_named,
+        without_bandpass,
+        lambda taken, other, tie: bandpass_chain_kept(taken, other, tie),
+        "shape_chains",
+        "resonance",
+        ("with_bandpass", "lorentzian_only"),
+    ),
+)
 
 
 def refine(
@@ -185,9 +229,8 @@ class _Run(TimeRemovals, FinalModel):
     def add_curve_effects(self, candidates) -> None:
         """Curve effects one per step (at most :data:`MAX_STEPS`) while one is accepted; then an effect whose
         amplitude a later one took over entirely is dropped, and the steps are scored along the chain. Where the
-        bandwidth named a sinc^k the steps run again without the sinc^k kinds, and the chain
-        :func:`._rolloff.sinc_chain_kept` prefers is kept; where a resonance took the band-pass shape, again with
-        the Lorentzian shape alone, and the chain :func:`._bumps.bandpass_chain_kept` prefers is kept."""
+        chain took an option of :data:`ALTERNATIVES` (a sinc^k bandwidth kind, a band-pass resonance) the steps
+        run again without it and the chain its rule prefers is kept (:meth:`curve_chains`)."""
         y = self.y
         exact = y is not None or (isinstance(self.est, str) and self.est == "oavar")
         thin = tracing.thin_indices(self.curve.tau)
@@ -214,41 +257,40 @@ class _Run(TimeRemovals, FinalModel):
             if any(rem.effect == "sinusoid" for _st, rem, *_rest in self.removed):  # a line of few cycles, removed
                 lines = [ln for ln in lines if not ln.get("slow")]
             self.offered_lines = [float(ln["f0"]) for ln in lines]
-        fork = self.fork()
-        self.curve_chain(fork, candidates, thin, exact, lines)
-        if bandpass_named(self.effects):  # the Lorentzian shape alone carried too: the whole chain decides
-            with_bp = self.fork()
-            self.effects, self.steps, self.lines, self.sol, self.considered = fork
-            with without_bandpass():
-                self.curve_chain(fork, candidates, thin, exact, lines)
-            self.keep_shape_chain(with_bp)
+        self.curve_chains(self.fork(), ALTERNATIVES, (candidates, thin, exact, lines))
         self.score()
 
-    def curve_chain(self, fork, candidates, thin, exact, lines) -> None:
-        """The curve steps from the state ``fork``; where the bandwidth named a sinc^k, again without the sinc^k
-        kinds, and the chain :func:`._rolloff.sinc_chain_kept` prefers kept."""
-        self.curve_loop(candidates, thin, exact, lines)
-        if sinc_named(self.effects):  # the kinds without the sinc^k carried too: the whole chain decides
-            with_sinc = self.fork()
-            self.effects, self.steps, self.lines, self.sol, self.considered = fork
-            with without_sincs():
-                self.curve_loop(candidates, thin, exact, lines)
-            self.keep_chain(with_sinc)
+    def curve_chains(self, fork: tuple, alts: tuple, args: tuple) -> None:
+        """The curve steps (:meth:`curve_loop` of ``args``) from the state ``fork`` (:meth:`fork`), every option of
+        ``alts`` (innermost first) decided on whole chains: where the chain took the outermost one, the steps (with
+        the options inside it decided as here) run again from ``fork`` with it withdrawn, and :meth:`keep_chain`
+        keeps one of the two."""
+        if not alts:
+            self.curve_loop(*args)
+            return
+        *inner, alt = alts
+        self.curve_chains(fork, tuple(inner), args)
+        if alt.named(self.effects):  # the chain without it carried too: the whole chain decides
+            taken = self.fork()
+            self.restore(fork)
+            with alt.withdrawn():
+                self.curve_chains(fork, tuple(inner), args)
+            self.keep_chain(alt, taken)
 
-    def keep_shape_chain(self, with_bp: tuple) -> None:
-        """The chain that took a band-pass resonance (``with_bp``, :meth:`fork`) or the one just run with the
-        Lorentzian shape alone, whichever :func:`._bumps.bandpass_chain_kept` prefers; both chains' final χ²/dof
-        and effects in every kept resonance step's ``evidence["shape_chains"]``."""
+    def keep_chain(self, alt: Alternative, taken: tuple) -> None:
+        """The chain that took the option ``alt`` (``taken``, :meth:`fork`) or the one just run without it, whichever
+        its rule prefers; both chains' final χ²/dof and effects in every kept step of its effect's evidence."""
         tie = self.curve.tau.size / self.curve.n_eff
+        other = self.fork()
         chains = {
             name: {"chi2_dof": float(fk[3].chi2_dof), "effects": [base_name(k) for k, _p in fk[0]]}
-            for name, fk in (("with_bandpass", with_bp), ("lorentzian_only", self.fork()))
+            for name, fk in zip(alt.labels, (taken, other))
         }
-        if bandpass_chain_kept(with_bp[3], self.sol, tie):
-            self.effects, self.steps, self.lines, self.sol, self.considered = with_bp
+        if alt.kept(taken[3], other[3], tie):
+            self.restore(taken)
         for st in self.steps:
-            if st.effect == "resonance":
-                st.evidence["shape_chains"] = chains
+            if st.effect == alt.effect:
+                st.evidence[alt.key] = chains
 
     def curve_loop(self, candidates, thin, exact, lines) -> None:
         """The curve steps while one is accepted, the absorbed dropped, the roll-off searched again."""
@@ -266,21 +308,12 @@ class _Run(TimeRemovals, FinalModel):
         considered = {k: list(v) for k, v in self.considered.items()}
         return list(self.effects), list(self.steps), list(self.lines), self.sol, considered
 
-    def keep_chain(self, with_sinc: tuple) -> None:
-        """The chain that named a sinc^k (``with_sinc``, :meth:`fork`) or the one just run without the sinc^k
-        kinds, whichever :func:`._rolloff.sinc_chain_kept` prefers; the other's final χ²/dof and effects in the
-        kept bandwidth step's ``evidence["kind_chains"]``."""
-        tie = self.curve.tau.size / self.curve.n_eff
-        without = self.fork()
-        chains = {
-            name: {"chi2_dof": float(fk[3].chi2_dof), "effects": [base_name(k) for k, _p in fk[0]]}
-            for name, fk in (("with_sinc", with_sinc), ("without_sinc", without))
-        }
-        if sinc_chain_kept(with_sinc[3], without[3], tie):
-            self.effects, self.steps, self.lines, self.sol, self.considered = with_sinc
-        for st in self.steps:
-            if st.effect == "bandwidth":
-                st.evidence["kind_chains"] = chains
+    def restore(self, state: tuple) -> None:
+        """Set the curve steps' state to a copy of ``state`` (:meth:`fork`): a chain run from it leaves it as it was,
+        for the next chain run from it."""
+        effects, steps, lines, self.sol, considered = state
+        self.effects, self.steps, self.lines = list(effects), list(steps), list(lines)
+        self.considered = {k: list(v) for k, v in considered.items()}
 
     def curve_step(self, n_step, candidates, thin, exact, lines) -> bool:
         """One step: every candidate's proposal, the one :func:`choose` accepts added; False if none."""
