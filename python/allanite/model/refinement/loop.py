@@ -19,6 +19,8 @@ from collections.abc import Callable
 from contextlib import AbstractContextManager
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..._blas import one_thread
 from ..._progress import StepBar
 from ..._validate import check_input
@@ -318,9 +320,7 @@ class _Run(TimeRemovals, FinalModel):
     def curve_step(self, n_step, candidates, thin, exact, lines) -> bool:
         """One step: every candidate's proposal, the one :func:`choose` accepts added; False if none."""
         sub = self.curve.subset(thin)
-        test = curve_test(self.curve, thin, self.sol, self.start, self.effects, exact)
-        fam = families(sub, candidates, self.y is not None)
-        thr = test.threshold(fam, alpha("curve", self.level), N_BOOT, seed=n_step)
+        test, thr = self.step_test(n_step, candidates, thin, exact)
         rnd = Round(
             self.curve,
             self.start,
@@ -353,6 +353,27 @@ class _Run(TimeRemovals, FinalModel):
         self.lines.append(pr.line)
         self.effects, self.sol = self.effects + [(pr.key, pr.p)], pr.sol
         return True
+
+    def step_test(self, n_step, candidates, thin, exact) -> tuple:
+        """The step's curve test under the model so far and its bootstrap threshold over every candidate's family
+        (:func:`.candidates.families`, once per refinement: its columns depend on the thinned curve and the
+        candidates alone), remembered by the curve under the model (its effects and solution), the candidates, the
+        share of level and the step's seed — everything they are computed from: a chain run again without an
+        option (:meth:`curve_chains`) passes through the first chain's states until it parts from it, and its
+        steps there get the same test and threshold without their bootstrap."""
+        sol, a = self.sol, alpha("curve", self.level)
+        model = (tuple(self.start), tuple((k, float(p)) for k, p in self.effects))
+        fit = (sol.theta.tobytes(), sol.nu.tobytes(), sol.model.tobytes())
+        cands = (np.asarray(thin).tobytes(), bool(exact), tuple(candidates), self.y is not None)
+        key = ("step_test", model, fit, cands, a, n_step)
+        got = self.curve.cached(key)
+        if got is None:
+            fam = self.curve.cached(("families", cands))
+            if fam is None:
+                fam = self.curve.remember(("families", cands), families(self.curve.subset(thin), *cands[2:]))
+            test = curve_test(self.curve, thin, sol, self.start, self.effects, exact)
+            got = self.curve.remember(key, (test, test.threshold(fam, a, N_BOOT, seed=n_step)))
+        return got
 
     def curve_effect_step(self, pr: Proposal, rnd: Round, ho_b, ho_a) -> Step:
         """The step of an accepted curve proposal (scored along the chain once the loop is done)."""
