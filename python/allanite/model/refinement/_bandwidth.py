@@ -8,6 +8,7 @@ in the spectrum
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -101,10 +102,42 @@ def bw_propose(rnd: Round) -> list:
             best = (key, p, s_new, edge)
     if best is None:
         return []
-    best = floor_choice(rnd.curve, rnd.start, rnd.effects, best, bw_searches(rnd), rnd.y, tie)
-    key, p, s_new, edge = notch_choice(rnd, found, best, grids, rnd.level)  # a notch after it (:mod:`._notch`)
+    f_best = best
+    best = _remembered(rnd, "floor_choice", (_found(f_best), tie), lambda: _floor(rnd, f_best, tie))
+    parts = (tuple(_found(f) for f in found), _found(best), _grids(grids), rnd.level)
+    key, p, s_new, edge = _remembered(  # a notch after it (:mod:`._notch`)
+        rnd, "notch_choice", parts, lambda: notch_choice(rnd, found, best, grids, rnd.level)
+    )
     assert rnd.sub is not None
     return [with_stat(rnd, key, p, s_new, edge, bump=1.0 / rnd.sub.tau)]
+
+
+def _remembered(rnd: Round, name: str, parts: tuple, compute) -> tuple:
+    """``compute()``, a choice of :func:`bw_propose` — (key, p, solution, edge) made from the curve, the model (terms
+    and effects), the samples and ``parts`` alone — remembered by the curve under them: a chain run again without
+    an option (:meth:`.loop._Run.curve_chains`) asks again from the first chain's states. Each caller its own
+    :class:`.curvefit.Solution`, as :func:`.curvefit.searches` hands them out."""
+    y = rnd.y
+    samples = None if y is None else (id(y), y.size, y[:: max(1, y.size // 64)].tobytes())
+    key = ("bandwidth:" + name, tuple(rnd.start), tuple((k, float(p)) for k, p in rnd.effects), samples, parts)
+    got = rnd.curve.cached(key)
+    if got is None:
+        got = rnd.curve.remember(key, compute())
+    k, p, sol, edge = got
+    return k, p, replace(sol), edge
+
+
+def _floor(rnd: Round, best: tuple, tie: float) -> tuple:
+    return floor_choice(rnd.curve, rnd.start, rnd.effects, best, bw_searches(rnd), rnd.y, tie)
+
+
+def _found(f: tuple) -> tuple:
+    """A searched kind (key, p, solution, edge) as a key: its parameter, edge and fit's coefficients and χ²."""
+    return f[0], float(f[1]), bool(f[3]), f[2].theta.tobytes(), float(f[2].chi2)
+
+
+def _grids(grids: dict) -> tuple:
+    return tuple((k, np.asarray(g, dtype=np.float64).tobytes(), bool(c)) for k, (g, c) in grids.items())
 
 
 def bw_params(pr: Proposal, rnd: Round) -> tuple:
