@@ -4,6 +4,7 @@ for its 10 Hz resonance and left its 0.46 Hz line, ending at χ²/dof 2.22 where
 
 from __future__ import annotations
 
+import contextlib
 import math
 
 import numpy as np
@@ -13,6 +14,7 @@ from scipy import signal
 import allanite
 from allanite.model.refinement import loop
 from allanite.model.refinement._rolloff import sinc_chain_kept, sinc_choice, sinc_named, without_sincs
+from allanite.model.refinement.result import Step
 
 FS = 200.0
 
@@ -75,3 +77,79 @@ def test_refine_carries_both_chains_where_a_sinc_is_named(monkeypatch, kept):
     assert [base for base in mine["effects"]] == [st.effect for st in r.steps if st.effect != "change_point"]
     if kept:  # a sinc³ CIC: its chain ends better than the kinds without it
         assert chains["with_sinc"]["chi2_dof"] < chains["without_sinc"]["chi2_dof"]
+
+
+class _Fit:
+    def __init__(self, chi2_dof):
+        self.chi2_dof = chi2_dof
+
+
+class _Curve:
+    tau = np.ones(20)
+    n_eff = 4.0
+
+
+def _nested_run(monkeypatch, kept_inner: bool, kept_outer: bool):
+    """A curve loop stubbed as one step per call, named by which options are withdrawn, under two options that
+    every first chain takes (:data:`loop.ALTERNATIVES`' mechanism: sinc^k inside the resonance shape)."""
+    inner_on, outer_on = [True], [True]
+
+    def withdraw(flag):
+        @contextlib.contextmanager
+        def off():
+            flag.append(False)
+            try:
+                yield
+            finally:
+                flag.pop()
+
+        return off
+
+    def loop_stub(self, *args):
+        key = f"bandwidth:{'sinc3' if inner_on[-1] else 'boxcar'}" if outer_on[-1] else "resonance:4"
+        self.steps.append(Step(effect=key.split(":")[0], params={}, intervals={}, evidence={}, before={}, after={}))
+        self.lines.append(None)
+        self.consider(key, {"param": 1.0})
+        self.effects = self.effects + [(key, 1.0)]
+        self.sol = _Fit(1.0 + len(self.considered) + 0.5 * inner_on[-1])
+
+    alts = (
+        loop.Alternative(
+            lambda eff: any(k == "bandwidth:sinc3" for k, _p in eff),
+            withdraw(inner_on),
+            lambda a, b, tie: kept_inner,
+            "kind_chains",
+            "bandwidth",
+            ("with_sinc", "without_sinc"),
+        ),
+        loop.Alternative(
+            lambda eff: any(k.startswith("bandwidth") for k, _p in eff),
+            withdraw(outer_on),
+            lambda a, b, tie: kept_outer,
+            "shape_chains",
+            "bandwidth",
+            ("with_bandpass", "lorentzian_only"),
+        ),
+    )
+    monkeypatch.setattr(loop._Run, "curve_loop", loop_stub)
+    run = object.__new__(loop._Run)
+    run.curve, run.effects, run.steps, run.lines, run.sol, run.considered = _Curve(), [], [], [], _Fit(9.0), {}
+    run.curve_chains(run.fork(), alts, ())
+    return run
+
+
+@pytest.mark.parametrize("kept_inner", [True, False])
+@pytest.mark.parametrize("kept_outer", [True, False])
+def test_every_chain_runs_from_the_fork_as_it_was(monkeypatch, kept_inner, kept_outer):
+    # both options taken in the first chain: the inner one is decided (two chains), then the outer one runs again
+    # from the same fork — it must start empty, not with the steps the inner rerun appended to the fork
+    run = _nested_run(monkeypatch, kept_inner, kept_outer)
+    want = ("bandwidth:sinc3" if kept_inner else "bandwidth:boxcar") if kept_outer else "resonance:4"
+    assert [k for k, _p in run.effects] == [want]
+    assert len(run.steps) == len(run.lines) == 1
+    assert list(run.considered) == [want]
+    if kept_outer:  # the kept bandwidth step carries both decisions, each between its own two chains
+        ev = run.steps[0].evidence
+        assert list(ev["kind_chains"]) == ["with_sinc", "without_sinc"]
+        assert ev["kind_chains"]["with_sinc"]["effects"] == ["bandwidth"]
+        assert ev["shape_chains"]["lorentzian_only"]["effects"] == ["resonance"]
