@@ -320,3 +320,43 @@ def _flicker_unshared():
         nr._FLICKER._items.clear()
         nr._FLICKER._items.update(items)
         nr._FLICKER._held = held
+
+
+def _curve_run():
+    """A refinement under way on a short simulated record (its curve and held-out split built, no step taken)."""
+    import allanite
+    from allanite.model.refinement import loop
+    from allanite.model.refinement._inputs import inputs
+
+    x = allanite.simulate(40_000, 100.0, N=2e-3, K=2e-5, gauss_markov=[(4e-3, 2.0)], seed=5)
+    y, result, _ch, _f = inputs(x, 100.0, "rate", 300, None, None, "error")
+    run = loop._Run(y, result, ("Q", "N", "B", "K", "R"), None, 0.05, None, None)
+    return run, tracing.thin_indices(run.curve.tau)
+
+
+def test_remembered_step_test_equals_a_fresh_one():
+    # loop._Run.step_test: the curve test and its bootstrap threshold, remembered under the model, the candidates
+    # and the seed (a chain run again without an option asks from the same states)
+    from allanite.model.refinement.calibrated import N_BOOT, curve_test
+    from allanite.model.refinement.candidates import families
+    from allanite.model.refinement.curvefit import solve
+    from allanite.model.refinement.levels import alpha
+
+    run, thin = _curve_run()
+    cands = ("gauss_markov", "bandwidth", "resonance", "sinusoid")
+
+    def fresh(n_step):
+        test = curve_test(run.curve, thin, run.sol, run.start, run.effects, True)
+        fam = families(run.curve.subset(thin), cands, True)
+        return test, test.threshold(fam, alpha("curve", run.level), N_BOOT, seed=n_step)
+
+    test, thr = run.step_test(0, cands, thin, True)
+    assert run.step_test(0, cands, thin, True) == (test, thr)  # found again: the same objects
+    f_test, f_thr = fresh(0)
+    assert thr == f_thr and np.isfinite(thr)
+    np.testing.assert_array_equal(test.model, f_test.model)
+    assert run.step_test(1, cands, thin, True)[1] == fresh(1)[1]  # another seed: another draw
+    run.effects = [("gauss_markov", 2.0)]  # another model: computed for it, not the one before
+    run.sol = solve(run.curve, run.start, run.effects)
+    got = run.step_test(0, cands, thin, True)
+    assert got[0] is not test and got[1] == fresh(0)[1] != thr
