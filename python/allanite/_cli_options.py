@@ -209,6 +209,20 @@ def add_analysis_options(rep: argparse.ArgumentParser) -> None:
         + "; regression as well where a channel is given; e.g. without outliers on quantised accelerometers); "
         "'none': only say what the five-term model still misses",
     )
+    ana.add_argument(
+        "--refine-filter",
+        metavar="FILE",
+        help="the sensor's own digital filter, for the refinement (implies --refine): a text file of one row of FIR "
+        "taps, or two rows (IIR b, then a), numbers split by commas or spaces; the bandwidth effect's kind is then "
+        "this filter, exact, its shape fixed, and the page says so",
+    )
+    ana.add_argument(
+        "--refine-filter-rate",
+        type=float,
+        metavar="HZ",
+        help="the rate --refine-filter runs at, when faster than the output rate (a decimating filter: a whole "
+        "multiple of it); default the output rate",
+    )
     ana.add_argument("--no-fit", action="store_true", help="skip the noise-model fit (whole record and per window)")
     ana.add_argument(
         "--max-memory",

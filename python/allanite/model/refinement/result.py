@@ -452,6 +452,8 @@ class Refinement(RichDisplay):
                 f"{self.result.n_samples} samples at {self.result.fs:g} Hz, τ {s0.tau[0]:.4g}–{s0.tau[-1]:.4g} s",
             ),
         ]
+        if self.declared_filter is not None:
+            facts.append(("declared filter", declared_sentence(self.declared_filter, "bandwidth" in self.found)))
         facts.append(("still missing", " ".join(self.missing_sentences())))
         if self.change_points:
             facts.append(("change points", ", ".join(f"t = {float(c['t']):.4g} s" for c in self.change_points)))
