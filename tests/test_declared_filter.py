@@ -121,3 +121,45 @@ def test_refine_takes_the_declared_filter_as_the_bandwidth():
     assert "Declared filter: an IIR of order 4 at 200 Hz" in r.report()
     assert "declared filter" in r._repr_html_()
     assert r.unexplained == []
+
+
+def test_cli_reads_the_filter_file(tmp_path):
+    from allanite import cli
+
+    path = tmp_path / "iir.txt"
+    path.write_text("# b, then a\n0.2, 0.4, 0.2\n1.0 -0.3 0.1\n")
+    args = cli.build_parser().parse_args(["report", "x.npy", "--fs", "100", "--refine-filter", str(path)])
+    assert cli._refine_filter(args) == {"b": [0.2, 0.4, 0.2], "a": [1.0, -0.3, 0.1]}
+    assert cli._refine_option(args) is True  # the declared filter implies the refinement
+    path.write_text("1 2\n3 4\n5 6\n")
+    with pytest.raises(ParameterError, match="3 rows"):
+        cli._refine_filter(args)
+    args = cli.build_parser().parse_args(["report", "x.npy", "--fs", "100", "--refine-filter-rate", "400"])
+    with pytest.raises(ParameterError, match="give the filter too"):
+        cli._refine_filter(args)
+
+
+def test_the_page_says_the_declared_filter():
+    from types import SimpleNamespace
+
+    from allanite.report import _sections
+
+    said = {"type": "FIR", "words": "a 95-tap FIR at 8000 Hz, decimated by 8 (−3 dB at 321.6 Hz)"}
+    ref = SimpleNamespace(filled=None, counter=None, declared_filter=said, found=["bandwidth"])
+    assert _sections._axis_notes(ref, "gyro_z") == [
+        "Model refinement of gyro_z: Declared filter: a 95-tap FIR at 8000 Hz, decimated by 8 (−3 dB at 321.6 Hz); "
+        "the curve needed it: the bandwidth step's kind is the declared filter, its shape fixed (not searched)."
+    ]
+
+
+@pytest.mark.slow  # ≈ 9 s under load; the default tests above cover the sentence and refine's step
+def test_the_report_page_and_summary_carry_the_declared_filter():
+    from allanite.report import build_report
+
+    fs = 200.0
+    b, a = signal.ellip(4, 1.0, 40.0, 30.0, fs=fs)
+    y = signal.lfilter(b, a, 0.02 * np.random.default_rng(5).standard_normal(40_000))
+    rep = build_report(y, fs, unit="deg/s", refine=("bandwidth",), refine_filter=(b, a), progress=False)
+    assert "Declared filter: an IIR of order 4 at 200 Hz" in rep.html({})
+    (axis,) = rep.summary()["refinement"]["axes"]
+    assert axis["declared_filter"]["type"] == "IIR" and axis["declared_filter"]["order"] == 4
