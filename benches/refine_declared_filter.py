@@ -44,7 +44,6 @@ import _common  # noqa: E402
 import refine_blind as rb  # noqa: E402
 import refine_blind9 as rb9  # noqa: E402
 import refine_blind11 as rb11  # noqa: E402
-
 from allanite.model._declared import declared_filter  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
@@ -153,15 +152,14 @@ def main(argv=None) -> None:
 
 
 def _steps(v: dict) -> str:
-    return "; ".join(
-        f"{s['effect']} ({', '.join(f'{k} {_num(x)}' for k, x in s['params'].items())})" for s in v["steps"]
-    ) or "nothing"
+    return (
+        "; ".join(f"{s['effect']} ({', '.join(f'{k} {_num(x)}' for k, x in s['params'].items())})" for s in v["steps"])
+        or "nothing"
+    )
 
 
 def _num(x) -> str:
     return f"{x:.4g}" if isinstance(x, float) else str(x)
-
-
 
 
 def write_md(res: dict, out_dir: Path) -> None:
@@ -170,7 +168,7 @@ def write_md(res: dict, out_dir: Path) -> None:
         "",
         f"`python benches/refine_declared_filter.py` (other processes {100 * res['load_fraction']:.0f} % of the CPUs; "
         f"{res['seconds']:.0f} s). Judge: the blind suites' (named, parameters within 20 %, the chain's errors "
-        "falling, held out, nothing unexplained); \"without\": `unexplained` non-empty when the bandwidth candidate is "
+        'falling, held out, nothing unexplained); "without": `unexplained` non-empty when the bandwidth candidate is '
         "left out.",
         "",
         "| case | call | steps | errors | χ²/dof | RMS ADEV % | held out % | unexplained | without flags | passed |",

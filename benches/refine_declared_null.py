@@ -28,9 +28,8 @@ from scipy import signal
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import _common  # noqa: E402
-import refine_blind as rb  # noqa: E402
-
 import allanite  # noqa: E402
+import refine_blind as rb  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "results"
 N_OUT = 200_000
@@ -43,7 +42,13 @@ def _bartlett():
 
 #: (name, (b, a) maker, rate the filter runs at Hz, decimation, output quantum over the per-sample σ or 0)
 SENSORS = [
-    ("remez FIR 2 kHz → 500 Hz", lambda: (signal.remez(63, [0, 150, 230, 1000], [1, 0], fs=2000.0), np.ones(1)), 2000.0, 4, 0.0),
+    (
+        "remez FIR 2 kHz → 500 Hz",
+        lambda: (signal.remez(63, [0, 150, 230, 1000], [1, 0], fs=2000.0), np.ones(1)),
+        2000.0,
+        4,
+        0.0,
+    ),
     ("elliptic IIR at 200 Hz", lambda: signal.ellip(4, 1.0, 40.0, 30.0, fs=200.0), 200.0, 1, 0.0),
     ("Chebyshev I 1 kHz → 250 Hz", lambda: signal.cheby1(3, 0.5, 90.0, fs=1000.0), 1000.0, 4, 0.0),
     ("Bartlett 7 taps at 100 Hz, quantised", _bartlett, 100.0, 1, 0.5),
@@ -56,7 +61,14 @@ def record(i: int):
     rng = np.random.default_rng(17_000 + i)
     b, a = make()
     n_white = 10 ** rng.uniform(-3.5, -2.5)
-    x = rb.noise(N_OUT * dec + 2000, rate, rng, N=n_white, B=n_white * 10 ** rng.uniform(-1.5, -0.5), K=n_white * 10 ** rng.uniform(-3.0, -2.0))
+    x = rb.noise(
+        N_OUT * dec + 2000,
+        rate,
+        rng,
+        N=n_white,
+        B=n_white * 10 ** rng.uniform(-1.5, -0.5),
+        K=n_white * 10 ** rng.uniform(-3.0, -2.0),
+    )
     y = signal.lfilter(b, a, x)[2000::dec][:N_OUT]
     if quantum:
         step = quantum * n_white * np.sqrt(rate)
@@ -80,7 +92,11 @@ def main(argv=None) -> None:
             row = {"record": i, "sensor": name}
             for label, kw in (("declared", {"filter": spec}), ("default", {})):
                 r = allanite.refine(y, fs, progress=False, **kw)
-                row[label] = {"found": list(r.found), "unexplained": [u.get("what", "") for u in r.unexplained], "alarm": alarm(r)}
+                row[label] = {
+                    "found": list(r.found),
+                    "unexplained": [u.get("what", "") for u in r.unexplained],
+                    "alarm": alarm(r),
+                }
             rows.append(row)
             print(i, name, row["declared"], row["default"]["alarm"], row["default"]["found"], flush=True)
     res = {"records": rows, "load_fraction": load.fraction or 0.0, "seconds": time.time() - t0}

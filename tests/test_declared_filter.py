@@ -30,14 +30,21 @@ def _simulated_ratio(b, a, rate: float, dec: int, n_out: int, seed: int, m: np.n
     r = full[full.size // 2 :][::dec]
     dc = r[0] + 2 * r[1:].sum()
     span = max(1, decl.r.size)
-    sd = np.sqrt(4.0 * (res.m + span) / (3.0 * n_out))  # the overlapping estimate's spread, widened by the filter's span
+    sd = np.sqrt(
+        4.0 * (res.m + span) / (3.0 * n_out)
+    )  # the overlapping estimate's spread, widened by the filter's span
     return res.avar / (exact * dc), sd
 
 
 @pytest.mark.parametrize(
     "design",
     [
-        ("remez FIR, 2 kHz → 500 Hz", lambda: (signal.remez(63, [0, 150, 230, 1000], [1, 0], fs=2000.0), [1.0]), 2000.0, 4),
+        (
+            "remez FIR, 2 kHz → 500 Hz",
+            lambda: (signal.remez(63, [0, 150, 230, 1000], [1, 0], fs=2000.0), [1.0]),
+            2000.0,
+            4,
+        ),
         ("elliptic IIR at 100 Hz", lambda: signal.ellip(4, 1.0, 40.0, 20.0, fs=100.0), 100.0, 1),
         ("Chebyshev IIR, 1 kHz → 250 Hz", lambda: signal.cheby1(3, 0.5, 90.0, fs=1000.0), 1000.0, 4),
     ],

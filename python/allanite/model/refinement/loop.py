@@ -20,7 +20,7 @@ from ..._validate import check_input
 from ...errors import ParameterError
 from .. import periodic, tracing
 from .._counter import counter_quantisation, detect_counter
-from .._declared import declared_filter, declaring
+from .._declared import DeclaredFilter, declared_filter, declaring
 from .._recent import remembering
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
@@ -158,10 +158,7 @@ def refine(
     input = check_input(input)
     check_unit(unit, input, x_or_result)  # before any work: it was read only by the final fit
     check_truth(truth, tuple(EFFECTS))
-    out_fs = fs if fs is not None else getattr(x_or_result, "fs", None)
-    if filter is not None and out_fs is None:
-        raise ParameterError("filter= needs the output rate: pass fs (Hz) with samples")
-    decl = declared_filter(filter, float(out_fs)) if filter is not None else None  # before any work
+    decl = _declared(filter, fs, x_or_result)  # before any work
     # each line spectrum once; curves, phasors and outlier scales of the same samples once; OpenBLAS on one
     # thread (its products here are small or thin: its threads cost more than they save, :mod:`allanite._blas`)
     with StepBar(progress, 1, "refine") as bar, remembering_spectra(), remembering(), one_thread():
@@ -183,6 +180,16 @@ def refine(
         out.counter = counter
         out.declared_filter = None if decl is None else decl.describe() | {"words": decl.words()}
         return out
+
+
+def _declared(spec, fs, x_or_result) -> DeclaredFilter | None:
+    """The filter ``refine(..., filter=spec)`` declares, checked against the output rate (None without one)."""
+    if spec is None:
+        return None
+    out_fs = fs if fs is not None else getattr(x_or_result, "fs", None)
+    if out_fs is None:
+        raise ParameterError("filter= needs the output rate: pass fs (Hz) with samples")
+    return declared_filter(spec, float(out_fs))
 
 
 def _check_candidates(candidates, level) -> tuple:
