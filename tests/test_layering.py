@@ -143,6 +143,7 @@ MODEL_RANKS = {
     "model._robust_scale": -1,  # the differences' robust scale, on a lattice and local (numpy, scipy only)
     "model._rfft": -0.5,  # the channel regression's transforms, remembered by content
     "model._sinc": -0.5,  # the sinc^k (CIC) roll-off's autocorrelation and cutoff (numpy only)
+    "model._declared": -0.5,  # a user-declared filter (FIR taps, IIR b, a) as an exact bandwidth kind (numpy, scipy)
     "model._signatures": -0.25,  # the effects' Allan-variance signatures: filter kinds, sinusoid, resonance, drift
     "model._counter": -0.5,  # a delta-angle counter's exact Q column and the record read as one (numpy, scipy only)
     "model._batched": 0,

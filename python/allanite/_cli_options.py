@@ -193,22 +193,7 @@ def add_analysis_options(rep: argparse.ArgumentParser) -> None:
         "paper 001's dynamic TheoH (DHVAR) over time, reaching 75%% of the record or window "
         "(default window then at most 2001 samples)",
     )
-    ana.add_argument(
-        "--refine",
-        action="store_true",
-        help="also look for what the noise model lacks ("
-        + ", ".join(e.label for e in EFFECTS.values() if e.domain != "channels")
-        + ") and add a model-refinement section, with what the final model still misses (or that it passes "
-        "every calibrated check); a few seconds per axis and million samples",
-    )
-    ana.add_argument(
-        "--refine-candidates",
-        metavar="NAMES",
-        help="refine (as --refine) trying only these effects, comma-separated ("
-        + ", ".join(e.name for e in EFFECTS.values() if e.domain != "channels")
-        + "; regression as well where a channel is given; e.g. without outliers on quantised accelerometers); "
-        "'none': only say what the five-term model still misses",
-    )
+    _add_refine_options(ana)
     ana.add_argument("--no-fit", action="store_true", help="skip the noise-model fit (whole record and per window)")
     ana.add_argument(
         "--max-memory",
@@ -240,6 +225,40 @@ def add_analysis_options(rep: argparse.ArgumentParser) -> None:
         metavar="WAVELET",
         help="add a section: wavelet split (e.g. db5, 5 levels) and the window-function combination "
         "(low band rect, high band Hann), coefficients per window (paper 002)",
+    )
+
+
+def _add_refine_options(ana) -> None:
+    """The refinement's options in the analysis group: --refine, its candidates and the sensor's own filter."""
+    ana.add_argument(
+        "--refine",
+        action="store_true",
+        help="also look for what the noise model lacks ("
+        + ", ".join(e.label for e in EFFECTS.values() if e.domain != "channels")
+        + ") and add a model-refinement section, with what the final model still misses (or that it passes "
+        "every calibrated check); a few seconds per axis and million samples",
+    )
+    ana.add_argument(
+        "--refine-candidates",
+        metavar="NAMES",
+        help="refine (as --refine) trying only these effects, comma-separated ("
+        + ", ".join(e.name for e in EFFECTS.values() if e.domain != "channels")
+        + "; regression as well where a channel is given; e.g. without outliers on quantised accelerometers); "
+        "'none': only say what the five-term model still misses",
+    )
+    ana.add_argument(
+        "--refine-filter",
+        metavar="FILE",
+        help="the sensor's own digital filter, for the refinement (implies --refine): a text file of one row of FIR "
+        "taps, or two rows (IIR b, then a), numbers split by commas or spaces; the bandwidth effect's kind is then "
+        "this filter, exact, its shape fixed, and the page says so",
+    )
+    ana.add_argument(
+        "--refine-filter-rate",
+        type=float,
+        metavar="HZ",
+        help="the rate --refine-filter runs at, when faster than the output rate (a decimating filter: a whole "
+        "multiple of it); default the output rate",
     )
 
 

@@ -363,9 +363,40 @@ def _refine_option(args) -> bool | tuple:
     --refine-candidates."""
     if args.refine_candidates is None:
         # --channels C1,… implies --refine: a channel has no other use than the refinement's regression on it
-        return bool(args.refine or _named_channels(args))
+        # (so does --refine-filter: the declared filter is the refinement's bandwidth kind)
+        return bool(args.refine or _named_channels(args) or args.refine_filter)
     names = [n.strip() for n in args.refine_candidates.split(",") if n.strip()]
     return () if names == ["none"] else tuple(names)
+
+
+def _refine_filter(args) -> dict | None:
+    """``build_report``'s ``refine_filter=`` from --refine-filter FILE (one row of FIR taps, or two rows: b, then a;
+    numbers split by commas or white space, lines from '#' on ignored) and --refine-filter-rate; None without it."""
+    if not args.refine_filter:
+        if args.refine_filter_rate is not None:
+            raise ParameterError("--refine-filter-rate: give the filter too (--refine-filter FILE)")
+        return None
+    path = Path(args.refine_filter)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ParameterError(f"--refine-filter {path}: cannot be read ({exc.strerror})") from None
+    rows = []
+    for line in text.splitlines():
+        cells = [c for c in re.split(r"[,\s]+", line.split("#", 1)[0]) if c]
+        if cells:
+            try:
+                rows.append([float(c) for c in cells])
+            except ValueError:
+                raise ParameterError(f"--refine-filter {path}: not a number in {line.strip()!r}") from None
+    if len(rows) not in (1, 2):
+        raise ParameterError(
+            f"--refine-filter {path}: {len(rows)} rows of numbers; give one (FIR taps) or two (IIR b, then a)"
+        )
+    spec: dict = {"taps": rows[0]} if len(rows) == 1 else {"b": rows[0], "a": rows[1]}
+    if args.refine_filter_rate is not None:
+        spec["rate"] = args.refine_filter_rate
+    return spec
 
 
 def _named_channels(args) -> bool:
@@ -400,6 +431,7 @@ def _report(args) -> int:
                 progress=progress,
                 estimator=args.estimator,
                 refine=_refine_option(args),
+                refine_filter=_refine_filter(args),
                 frames=args.frames,
                 forecast=args.forecast,
                 taper=args.taper,

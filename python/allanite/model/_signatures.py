@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from ..errors import ParameterError
+from ._declared import declared_of
 from ._sinc import SINC_ORDERS, sinc_autocorrelation, sinc_cutoff, sinc_order
 
 __all__ = [
@@ -244,7 +245,12 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
     notch's poles together in closed form, :func:`rational_terms`; any other kind's autocorrelation convolved with
     the notch's); ``p`` the cutoff (Hz) for ``"single_pole"`` and the Butterworths, the
     length L (taps of one moving average) for the FIRs, the span D·f_s (samples, ≥ 1, any real) for
-    ``"boxcar"``, each boxcar's span in output samples (≥ 1/k, any real) for a sinc^k (``"sinc2"`` …)."""
+    ``"boxcar"``, each boxcar's span in output samples (≥ 1/k, any real) for a sinc^k (``"sinc2"`` …); a declared
+    filter's kind (``"declared:<token>"``, :mod:`allanite.model._declared`) its own exact autocorrelation, ``p``
+    not read (its shape is known)."""
+    decl = declared_of(kind)
+    if decl is not None:
+        return decl.r
     terms = _notch_terms(kind, p, fs)
     if terms is not None:  # a Butterworth and a notch: one rational filter, its closed form
         return _terms_autocorrelation(terms)
@@ -290,7 +296,11 @@ def _convolved(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
 def filter_cutoff(kind: str, p: float, fs: float) -> float:
     """−3 dB frequency (Hz) of a filter of :data:`FILTERS` (``p`` as in :func:`filter_autocorrelation`); for a
     boxcar the continuous filter's, 0.4430/D (sinc² = ½), and a sinc^k's, before the output sampling aliases it;
-    for a kind with a notch (:func:`notch_kind`) its low-pass's (the notch's own −3 dB points are f_n ∓ f_n/2q)."""
+    for a kind with a notch (:func:`notch_kind`) its low-pass's (the notch's own −3 dB points are f_n ∓ f_n/2q);
+    for a declared filter its own (:class:`allanite.model._declared.DeclaredFilter`: at the rate it runs at)."""
+    decl = declared_of(kind)
+    if decl is not None:
+        return decl.cutoff
     kind = split_notch(kind)[0]
     if sinc_order(kind):
         return sinc_cutoff(sinc_order(kind), p, fs)
@@ -324,8 +334,9 @@ def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float)
     R(l) = Σ_j C_j·p_j^|l| beyond lag 0 (:func:`butterworth_terms`), so the sum is closed: (r(0) − Σ C_j)/m plus
     Σ_j C_j times the geometric sums of :func:`resonance_avar` at ρ = p_j; at f_c ≥ f_s/2 its limit (the poles
     meet the n-fold zero at z = −1: no filter), N²/τ. A Butterworth followed by a notch (:func:`notch_kind`) is one
-    rational filter: the same closed sums over its and the notch's poles; another kind with a notch sums its
-    (long) autocorrelation by prefix sums (:func:`_prefix_avar`)."""
+    rational filter: the same closed sums over its and the notch's poles; another kind with a notch, and a declared
+    filter (``"declared:<token>"``, :mod:`allanite.model._declared`: the output's autocorrelation r_h(l·D), aliasing
+    included), sum their (long) autocorrelation by prefix sums (:func:`_prefix_avar`)."""
     tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
     m = np.maximum(1.0, np.round(tau * fs))
     order = butterworth_order(kind)
@@ -337,7 +348,8 @@ def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float)
         s2 = (r0 - c.sum().real) / m + (c[:, None] * _geometric_avar(poles, m)).sum(axis=0).real
         return (s2 + (2.0 * m - 3.0) * lag1 / (m * m)) * fs  # a lag-1 term d: A_m(±1) = 2m − 3
     r = filter_autocorrelation(kind, p, fs)
-    if split_notch(kind)[1] is not None:  # a notch's long autocorrelation: the sums by prefix sums, O(lags + τ)
+    if split_notch(kind)[1] is not None or declared_of(kind) is not None:
+        # a notch's, or a declared IIR's, long autocorrelation: the sums by prefix sums, O(lags + τ)
         return _prefix_avar(r, m) * fs
     lag = np.arange(r.size, dtype=np.float64)
     # A_m(l) at the lags l ≥ 0 (tri_m(l + m) = 0 there): 2m − 3l wherever m reaches the last lag, the triangles

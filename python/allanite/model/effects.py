@@ -172,7 +172,8 @@ EFFECTS: dict[str, Effect] = {
                     "taps",
                     "samples",
                     "FIR length (moving average L, Bartlett 2L − 1; a boxcar's span D·f_s, any real; a sinc^k's "
-                    "span per boxcar, 1 for a CIC read at its output rate); 0 for a single pole or a Butterworth",
+                    "span per boxcar, 1 for a CIC read at its output rate; a declared FIR's length); 0 for a single "
+                    "pole, a Butterworth or a declared IIR",
                 ),
                 (
                     "floor",
@@ -196,7 +197,9 @@ EFFECTS: dict[str, Effect] = {
             "steep filter's stop band is then flat, not a resonance. With samples, a digital notch "
             "(``scipy.signal.iirnotch``) may follow the low-pass — a kind of its own, ``<kind>+notch``, named where "
             "its nested test passes and the Welch spectrum shows it. Accepted first, its parameter is searched "
-            "again beside the terms later steps add",
+            "again beside the terms later steps add. With ``refine(..., filter=...)`` the user's own filter (FIR "
+            "taps or IIR (b, a), its rate and decimation) is the one kind, exact (aliasing included), its shape "
+            "fixed: ``filter`` ``declared``, ``cutoff`` its −3 dB frequency without an interval",
             signature=None,
             alpha=lambda tau, p: np.zeros(np.asarray(tau).size, dtype=int),
             search=None,

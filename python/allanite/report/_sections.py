@@ -23,9 +23,9 @@ __all__ = ["forecast_section", "paper002_section", "refine_axes", "refine_candid
 
 def refinement_section(x, fs, input, unit_name, static, axis_names, asked, notes, settings, progress):
     """Every axis's refinement (None where it failed), or None when not asked for; ``asked``: the candidate
-    effects and the other channels. The effects tried and the channels' names go
+    effects, the other channels and the declared filter (None: none). The effects tried and the channels' names go
     into ``settings``."""
-    candidates, channels = asked
+    candidates, channels = asked[:2]
     refinements: list[Refinement | None] | None = None
     if candidates is not None:
         progress.step("model refinement")
@@ -82,15 +82,18 @@ def refine_candidates(refine) -> tuple | None:
 
 
 def _axis_notes(ref, name: str) -> list[str]:
-    """The notes the page needs from one axis's refinement: which samples the searches saw filled, and a counter's
-    exact quantisation term (its Q is the counter's: said where it is read)."""
+    """The notes the page needs from one axis's refinement: which samples the searches saw filled, a counter's
+    exact quantisation term (its Q is the counter's: said where it is read), and the filter the user declared."""
     from ..model.refinement._gapfill import filled_words
+    from ..model.refinement.words import declared_sentence
 
     out = []
     if ref.filled:
         out.append(f"Model refinement of {name}: {filled_words(ref.filled)}.")
     if ref.counter is not None:
         out.append(f"Model refinement of {name}: {ref.counter.describe(ref.fit.unit)}.")
+    if getattr(ref, "declared_filter", None) is not None:
+        out.append(f"Model refinement of {name}: {declared_sentence(ref.declared_filter, 'bandwidth' in ref.found)}")
     return out
 
 
@@ -100,7 +103,8 @@ def refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes) -> li
     from ..model import refine as refine_axis  # the refinement package (scipy.signal) only when asked
     from ..model._null_records import sharing
 
-    candidates, channels = asked
+    candidates, channels = asked[:2]
+    declared = asked[2] if len(asked) > 2 else None
 
     refinements: list = []
     # the same τ range the whole-record fit used (none unless given): start at 0.1 s when the
@@ -119,6 +123,7 @@ def refine_axes(x, fs, input, unit_name, static, axis_names, asked, notes) -> li
                         tau_range=None if t0 is None else (t0, None),
                         candidates=candidates,
                         channels=channels,
+                        filter=declared,
                         gaps="skip" if np.any(np.asarray(static.missing) > 0) else "error",
                     )
                 )

@@ -83,6 +83,7 @@ def build_report(
     split: str | None = None,
     max_memory=None,
     gaps: str = "error",
+    refine_filter=None,
 ) -> Report:
     """Compute everything the report shows.
 
@@ -124,6 +125,10 @@ def build_report(
         is a :class:`~allanite.errors.ParameterError` (the channels would never be used). Their unit is not
         known to the report: a coefficient is in the rate unit per unit of the channel (e.g. "deg/s per unit of
         temp").
+    refine_filter : array_like, (b, a) or dict, optional
+        The sensor's own digital filter, passed to :func:`allanite.refine` on every axis as ``filter=`` (FIR taps,
+        an IIR's (b, a), or a dict with ``"rate"``/``"decimation"``): the bandwidth effect's one kind, exact; the
+        page says what was declared. Used only where the report refines.
     estimator : {"oavar", "theoh"}
         ``"oavar"`` (default): overlapping Allan deviation and DAVAR. ``"theoh"``: TheoH for the
         whole record and paper 001's DHVAR over time (overlapping Allan up to 10 % of the record or
@@ -186,7 +191,7 @@ def build_report(
         progress.add(2)
     if candidates is not None or plan is not None or taper or split:  # and the rest while more is computed
         _offer(static, dynamic, fits, series, unit_name, input, axis_names, complete=True)
-    asked = (candidates, channels, plan, confidence, taper, split)
+    asked = (candidates, channels, plan, confidence, taper, split, refine_filter)
     sections = _later_sections((x, fs, input), static, dynamic, unit_name, axis_names, asked, notes, settings, progress)
     created = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
     if own_bar:
@@ -228,11 +233,11 @@ def _later_sections(record, static, dynamic, unit_name, axis_names, asked, notes
     """The report's optional sections, as :class:`.result.Report`'s fields, in the order they are computed
     (each None where not asked for): every axis's refinement, the time-frame forecast, paper 002's.
     ``record``: (samples, fs, input); ``asked``: (candidates, channels, forecast plan, confidence, taper,
-    split)."""
+    split, the declared filter)."""
     x, fs, input = record
-    candidates, channels, plan, confidence, taper, split = asked
+    candidates, channels, plan, confidence, taper, split, declared = asked
     refinements = refinement_section(
-        x, fs, input, unit_name, static, axis_names, (candidates, channels), notes, settings, progress
+        x, fs, input, unit_name, static, axis_names, (candidates, channels, declared), notes, settings, progress
     )
     frames, forecasts, forecast_settings, forecast_error = forecast_section(
         x, fs, plan, unit_name, input, confidence, notes, progress

@@ -111,6 +111,10 @@ def _axis_dict(k: int, r, rep, rate: str) -> dict:
         "unexplained": [_region_dict(reg) for reg in r.unexplained],
         "still_missing": r.missing_sentences(),
         "channels_not_kept": [{k: json_value(v) for k, v in d.items()} for d in channels_not_kept(r)],
+        # refine(filter=...): what was declared (type, rate_hz, decimation, taps or order, cutoff_hz, words), or null
+        "declared_filter": None
+        if getattr(r, "declared_filter", None) is None
+        else {k: json_value(v) for k, v in r.declared_filter.items()},
     }
 
 

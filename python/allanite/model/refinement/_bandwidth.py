@@ -3,7 +3,9 @@ Bartlett, boxcar, a CIC's sinc^k, pole + boxcar, Butterworth), replacing the N c
 filter kind, bootstrap family, searches, proposal (the kind with the lowest χ², :mod:`._rolloff` deciding the
 Butterworths, the sinc^k order and the white floor, :mod:`._notch` a notch after the kind), parameters and evidence
 in the spectrum
-(:data:`.candidates.CURVE_CANDIDATES`)."""
+(:data:`.candidates.CURVE_CANDIDATES`). Where the user declared the filter (``refine(..., filter=...)``,
+:mod:`allanite.model._declared`) it is the one kind: its exact column, its shape fixed, no search — the test asks
+only whether the curve needs it; its floor after it kept as beside a Butterworth."""
 
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from .. import tracing
+from .._declared import DeclaredFilter, active_declared
 from ..effects import CASCADE_SPANS, filter_autocorrelation
 from ._notch import notch_choice
 from ._proposal import Proposal, Round, column_amplitude, with_stat
@@ -29,7 +32,7 @@ from ._rolloff import (
     sinc_grids,
     spectrum_agrees,
 )
-from .curvefit import Curve, base_name, bw_kind, column, has_floor, profile_interval, search
+from .curvefit import Curve, base_name, bw_kind, column, has_floor, profile_interval, search, solve
 
 __all__ = ["bandwidth_grids", "bw_family", "bw_searches", "bw_propose", "bw_params", "bw_evidence"]
 
@@ -61,6 +64,9 @@ def bandwidth_grids(curve: Curve) -> dict:
 
 
 def bw_family(sub: Curve, has_samples: bool) -> list:
+    decl = active_declared()
+    if decl is not None:  # the declared filter alone: the test's family is its one column
+        return [column(f"bandwidth:{decl.kind}", decl.cutoff, sub) - 1.0 / sub.tau]
     return [
         column(f"bandwidth:{kind}", p, sub) - 1.0 / sub.tau
         for kind, grid in bandwidth_grids(sub).items()
@@ -70,6 +76,8 @@ def bw_family(sub: Curve, has_samples: bool) -> list:
 
 
 def bw_searches(rnd: Round) -> list:
+    if active_declared() is not None:  # nothing to search: the declared filter's shape is known
+        return []
     if any(base_name(k) == "bandwidth" for k, _p in rnd.effects) or "N" not in rnd.start:
         return []
     return [  # the Butterworths above the 2nd order only where it was searched (:func:`bw_propose`)
@@ -80,6 +88,9 @@ def bw_searches(rnd: Round) -> list:
 
 
 def bw_propose(rnd: Round) -> list:
+    decl = active_declared()
+    if decl is not None:
+        return _declared_propose(rnd, decl)
     best = None
     tie = rnd.curve.tau.size / rnd.curve.n_eff
     found, grids = [], {}
@@ -140,13 +151,34 @@ def _grids(grids: dict) -> tuple:
     return tuple((k, np.asarray(g, dtype=np.float64).tobytes(), bool(c)) for k, (g, c) in grids.items())
 
 
+def _declared_propose(rnd: Round, decl: DeclaredFilter) -> list:
+    """The declared filter's proposal: its column in place of N's (the floor kept, :func:`.curvefit.has_floor`),
+    fitted at its fixed shape (its parameter the −3 dB frequency, reported, not searched); none where the model
+    has a bandwidth already or no N term to filter."""
+    if any(base_name(k) == "bandwidth" for k, _p in rnd.effects) or "N" not in rnd.start:
+        return []
+    key, p = f"bandwidth:{decl.kind}", decl.cutoff
+    sol = solve(rnd.curve, rnd.start, rnd.effects + [(key, p)])
+    assert rnd.sub is not None
+    return [with_stat(rnd, key, p, sol, False, bump=1.0 / rnd.sub.tau)]
+
+
 def bw_params(pr: Proposal, rnd: Round) -> tuple:
+    decl = active_declared()
+    if decl is not None and bw_kind(pr.key) == decl.kind:  # known, not fitted: no interval
+        params: dict = {"cutoff": decl.cutoff, "taps": int(decl.b.size) if decl.is_fir else 0, "filter": "declared"}
+        return _with_floor(params, {}, pr, rnd)
     params, intervals = filter_params(
         bw_kind(pr.key),
         pr.p,
         rnd.curve.fs,
         lambda: profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol),
     )
+    return _with_floor(params, intervals, pr, rnd)
+
+
+def _with_floor(params: dict, intervals: dict, pr: Proposal, rnd: Round) -> tuple:
+    """``params`` and ``intervals`` with the white floor after the filter where its N column is kept."""
     if "N" in rnd.start and has_floor(pr.key):  # the N column kept (has_floor): white noise after the filter
         floor, sd, floor_int = column_amplitude(pr.sol, list(rnd.start).index("N"))
         params["floor"] = floor
@@ -157,6 +189,9 @@ def bw_params(pr: Proposal, rnd: Round) -> tuple:
 
 def bw_evidence(pr: Proposal, rnd: Round) -> dict:
     ev: dict = {"N": math.sqrt(max(pr.sol.theta[-1], 0.0))}
+    decl = active_declared()
+    if decl is not None and bw_kind(pr.key) == decl.kind:
+        ev["declared_filter"] = decl.describe() | {"words": "the declared filter, " + decl.words()}
     if rnd.y is not None:  # a second domain: the roll-off the filter predicts in the spectrum, and the data's
         r = filter_autocorrelation(bw_kind(pr.key), pr.p, rnd.curve.fs)
         ev["psd"] = tracing.rolloff_psd(rnd.y, rnd.curve.fs, r)

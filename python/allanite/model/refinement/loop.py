@@ -27,6 +27,7 @@ from ..._validate import check_input
 from ...errors import ParameterError
 from .. import periodic, tracing
 from .._counter import counter_quantisation, detect_counter
+from .._declared import DeclaredFilter, declared_filter, declaring
 from .._recent import remembering
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
@@ -110,6 +111,7 @@ def refine(
     level: float = LEVEL,
     progress=None,
     gaps: str = "error",
+    filter=None,
 ) -> Refinement:
     """Fit the starting model, find what it lacks, add it, repeat; report the error before and after.
 
@@ -173,6 +175,18 @@ def refine(
     axis : int, optional
         Which axis of multi-axis input to refine; without it the first (a warning says so when there are
         others).
+    filter : array_like, (array_like, array_like) or dict, optional
+        The sensor's own digital filter, as its data sheet or driver gives it: FIR taps (1-D), an IIR's
+        ``(b, a)``, or a dict ``{"taps": …}`` / ``{"b": …, "a": …}`` with ``"rate"`` (Hz it runs at) and/or
+        ``"decimation"`` (it runs at ``decimation``·fs and every ``decimation``-th output is kept; default 1,
+        the output rate). The bandwidth effect's kind is then this filter alone, its exact Allan variance for
+        white noise (aliasing included; :mod:`allanite.model._declared`), its shape fixed — the bandwidth's test
+        asks only whether the curve needs it; ``cutoff`` (its −3 dB frequency) is reported without an interval,
+        ``filter`` is ``"declared"`` and the white floor after it (a quantised output) is kept as beside a
+        Butterworth. ``Refinement.declared_filter`` says what was declared. Checked before any work (a
+        :class:`~allanite.errors.ParameterError` for an empty, non-finite or wrongly shaped filter, an unstable
+        IIR, a rate that is not decimation × fs, a filter that passes no power at DC). Default: none — the
+        bandwidth's kinds are searched.
 
     Returns
     -------
@@ -190,6 +204,7 @@ def refine(
     input = check_input(input)
     check_unit(unit, input, x_or_result)  # before any work: it was read only by the final fit
     check_truth(truth, tuple(EFFECTS))
+    decl = _declared(filter, fs, x_or_result)  # before any work
     # each line spectrum once; curves, phasors and outlier scales of the same samples once; OpenBLAS on one
     # thread (its products here are small or thin: its threads cost more than they save, :mod:`allanite._blas`)
     with StepBar(progress, 1, "refine") as bar, remembering_spectra(), remembering(), one_thread():
@@ -199,7 +214,7 @@ def refine(
         y, result, chans, filled = inputs(x_or_result, fs, input, points, axis, channels, gaps)
         # a delta-angle counter's samples: every Q column is its exact one (allanite.model._counter)
         counter = detect_counter(y, result.fs) if y is not None and "Q" in start else None
-        with counter_quantisation(counter):
+        with counter_quantisation(counter), declaring(decl):
             run = _Run(y, result, start, tau_range, level, truth, unit)
             run.remove_in_time(candidates, chans)
             run.channels = chans or {}
@@ -209,7 +224,18 @@ def refine(
             out = run.refinement(cp_steps, unit, confidence, run.unexplained(chans, after, cp_steps))
         out.filled = filled
         out.counter = counter
+        out.declared_filter = None if decl is None else decl.describe() | {"words": decl.words()}
         return out
+
+
+def _declared(spec, fs, x_or_result) -> DeclaredFilter | None:
+    """The filter ``refine(..., filter=spec)`` declares, checked against the output rate (None without one)."""
+    if spec is None:
+        return None
+    out_fs = fs if fs is not None else getattr(x_or_result, "fs", None)
+    if out_fs is None:
+        raise ParameterError("filter= needs the output rate: pass fs (Hz) with samples")
+    return declared_filter(spec, float(out_fs))
 
 
 def _check_candidates(candidates, level) -> tuple:

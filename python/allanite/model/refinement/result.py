@@ -19,7 +19,7 @@ from ..terms import TERM_NAMES
 from ._family_fold import folded
 from ._gapfill import filled_words
 from .levels import LEVEL
-from .words import MISFIT_CHI2_DOF, misfit_sentences, missing_sentences
+from .words import MISFIT_CHI2_DOF, declared_sentence, misfit_sentences, missing_sentences
 
 if TYPE_CHECKING:  # the counter's module loads SciPy: not for a summary
     from .._counter import Counter
@@ -195,6 +195,9 @@ class Refinement(RichDisplay):
     #: The record read as a delta-angle counter's (:func:`allanite.model._counter.detect_counter`): its angle step,
     #: noise per sample and phase — every Q column was then the counter's exact Allan variance; None otherwise.
     counter: Counter | None = None
+    #: ``refine(..., filter=...)``: the filter declared (``"type"`` FIR/IIR, ``"rate_hz"``, ``"decimation"``,
+    #: ``"taps"`` or ``"order"``, ``"cutoff_hz"``, ``"words"``) — the bandwidth effect's one kind; None otherwise.
+    declared_filter: dict | None = None
 
     def curve_errors(self, fit) -> dict:
         """χ²/dof, RMS z and RMS ADEV error (%) of ``start`` or ``fit`` on the record's curve: the chain's
@@ -292,6 +295,8 @@ class Refinement(RichDisplay):
             lines += [f"Gaps: {filled_words(self.filled)}.", ""]
         if self.counter is not None:
             lines += [f"Quantisation: {self.counter.describe(self._rate_unit())}.", ""]
+        if self.declared_filter is not None:
+            lines += [declared_sentence(self.declared_filter, "bandwidth" in self.found), ""]
         if not self.steps:
             lines.append(self._nothing_added().capitalize() + ".")
         for i, st in enumerate(self.steps, 1):
@@ -447,6 +452,8 @@ class Refinement(RichDisplay):
                 f"{self.result.n_samples} samples at {self.result.fs:g} Hz, τ {s0.tau[0]:.4g}–{s0.tau[-1]:.4g} s",
             ),
         ]
+        if self.declared_filter is not None:
+            facts.append(("declared filter", declared_sentence(self.declared_filter, "bandwidth" in self.found)))
         facts.append(("still missing", " ".join(self.missing_sentences())))
         if self.change_points:
             facts.append(("change points", ", ".join(f"t = {float(c['t']):.4g} s" for c in self.change_points)))

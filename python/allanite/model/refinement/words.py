@@ -15,6 +15,7 @@ from .levels import UNEXPLAINED_SHARES
 __all__ = [
     "MISFIT_CHI2_DOF",
     "checks_alpha",
+    "declared_sentence",
     "describe_region",
     "heldout_clause",
     "misfit_sentences",
@@ -46,6 +47,17 @@ def heldout_clause(pct: float | None) -> str:
     ('; held-out error 4.6 %', '')
     """
     return "" if pct is None else f"; held-out error {pct:.2g} %"
+
+
+def declared_sentence(declared: dict, taken: bool) -> str:
+    """The filter the user declared (``Refinement.declared_filter``) and what the bandwidth step made of it — the
+    report, the notebook display, the HTML page and the console say it alike."""
+    did = (
+        "the curve needed it: the bandwidth step's kind is the declared filter, its shape fixed (not searched)"
+        if taken
+        else "the curve did not need it: no bandwidth step was taken"
+    )
+    return f"Declared filter: {declared.get('words', declared.get('type', 'a filter'))}; {did}."
 
 
 def describe_region(reg: dict) -> str:
