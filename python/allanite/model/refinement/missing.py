@@ -57,6 +57,11 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   the channel crosses its quantiles, or its square where not kept, the best two by a greedy search calibrated on
   draws of their scores): a staircase, a thermostat, a compensation table with steps that a straight line leaves
   uncorrelated with the channel; ``"channel"``, ``"cuts"`` [(value, step)] where it departs.
+- ``"follows"`` (domain ``"channels"``) — an accepted line (a ``"periodic"`` family removed in time, its strongest
+  line; a ``"sinusoid"``) that a channel no regression step uses carries coherently (:mod:`._channel_follows`: the
+  coherence over segments against its Beta null and the channel's own line at f0, both at the share split over the
+  pairs): one effect read twice, a regression on the channel may be the better reading; ``"channel"``,
+  ``"effect"``, ``"f0"``, ``"coherence"``. Its share is conditional on the line (:data:`.levels.CONDITIONAL_SHARES`).
 - ``"outliers"`` — impulsive noise left in the final samples (:func:`allanite.model.outliers.outlier_test`).
 - ``"clipped"`` — samples piled at the record's largest or smallest value, or held at one value longer than
   the record's quantisation gives, in the samples as given (:mod:`._quality`); ``"t"`` their first and last
@@ -74,6 +79,7 @@ import numpy as np
 from scipy.stats import t as t_dist
 
 from .. import channels, lines, tracing
+from ._channel_follows import follows_check
 from ._channel_shape import channel_shape_check
 from ._curve_checks import MAX_REGIONS, allan_check, allan_family, fit_check
 from ._line_check import line_check
@@ -260,7 +266,8 @@ def _channels(ctx: MissingContext, a: float) -> list[dict]:
     return out
 
 
-#: The checks, by the name of their share in :data:`.levels.SHARES` (``"unexplained:<name>"``).
+#: The checks, by the name of their share in :data:`.levels.SHARES` (``"unexplained:<name>"``; ``"follows"``'s is
+#: conditional on an accepted line, :data:`.levels.CONDITIONAL_SHARES`).
 CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "allan": allan_check,
     "fit": fit_check,
@@ -272,6 +279,7 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "line": line_check,
     "channels": _channels,
     "channel_shape": channel_shape_check,
+    "follows": follows_check,
     "outliers": outliers_check,
     "clipped": clipped_check,
     "held": held_check,
