@@ -79,6 +79,7 @@ import numpy as np
 from scipy.stats import t as t_dist
 
 from .. import channels, lines, tracing
+from .._shares import FIRST_QUADRATIC
 from ._channel_follows import follows_check
 from ._channel_shape import channel_shape_check
 from ._curve_checks import MAX_REGIONS, allan_check, allan_family, fit_check
@@ -233,24 +234,40 @@ def _lines_move_curve(ctx: MissingContext, freqs: np.ndarray, amps: np.ndarray) 
     return curve_change_z(ctx.curve, ctx.sol, change)[0] >= MATERIAL_Z
 
 
+#: A slow channel's three tests share a_ch/SLOW_SPLIT each way: the pair and the in-phase test each at
+#: (1 − FIRST_QUADRATIC) of it, the quadratic at FIRST_QUADRATIC of it — (2 − FIRST_QUADRATIC)·a_ch/SLOW_SPLIT ≤ a_ch.
+SLOW_SPLIT = 2.0 - FIRST_QUADRATIC
+
+
 def _channels(ctx: MissingContext, a: float) -> list[dict]:
     """A coupling to a channel of ``channels=`` left in the final samples (the regression candidate turned
-    down or left out): a slow channel by the Whittle GLS of :func:`allanite.model.channels.regress_channel`, a
-    fast one by the within-block t test — each at ``a`` split over the channels."""
+    down or left out): a slow channel by the Whittle GLS of :func:`allanite.model.channels.regress_channel` — the
+    pair, the in-phase test and, where the pair fails, the quadratic's (:data:`SLOW_SPLIT`) —, a fast one by the
+    within-block t test — each at ``a`` split over the channels."""
     if ctx.y is None or not ctx.channels:
         return []
     a_ch, out = a / len(ctx.channels), []
     t_lo, t_hi = float(ctx.curve.tau[0]), float(ctx.curve.tau[-1])
     for name, ch in ctx.channels.items():
+        coef_words = None
         if channels.is_slow(ch):
-            # the coupling's test (channel and quadrature, 2 dof: any phase) and the in-phase test alone (1 dof: more
-            # power on a coupling without lag), each at half the share — one of them may take a left coupling
-            r = channels.regress_channel(ctx.y, ch, ctx.fs, name=name, alpha=a_ch / 2, level=ctx.level, terms=())
+            # the coupling's test (channel and quadrature, 2 dof: any phase), the in-phase test alone (1 dof: more
+            # power on a coupling without lag), each at 1 − FIRST_QUADRATIC of a_ch/SLOW_SPLIT, and where the pair
+            # fails the quadratic's (a coupling mostly on (ch − mean)², whose linear part neither sees) at
+            # FIRST_QUADRATIC of it, as the regression candidate decides: together at most a_ch
+            r = channels.regress_channel(
+                ctx.y, ch, ctx.fs, name=name, alpha=a_ch / SLOW_SPLIT, level=ctx.level, terms=("quadratic",)
+            )
             hit, stat, thr = r.accepted, float(r.test["statistic"]), float(r.test["threshold"])
-            one = r.test["in_phase"]
+            one, quad = r.test["in_phase"], r.test.get("quadratic")
+            if r.test.get("accepted_by") == "quadratic" and quad is not None:
+                stat, thr = float(quad["statistic"]), float(quad["threshold"])
             if not hit and one["statistic"] > one["threshold"]:
                 hit, stat, thr = True, float(one["statistic"]), float(one["threshold"])
             coef = float(r.params.get("coefficient", float("nan")))
+            if r.test.get("accepted_by") == "quadratic" and "quadratic" in r.params:
+                q = float(r.params["quadratic"])
+                coef_words = f"through its square (≈ {q:.3g} {ctx.unit or 'rate unit'} per channel unit²)"
             lo = max(t_lo, min(t_hi, 0.1 * ctx.y.size / ctx.fs))  # a slow channel moves the longest τ
         else:
             rg = tracing.regression_fit(ctx.y, ch, 8)
@@ -258,7 +275,8 @@ def _channels(ctx: MissingContext, a: float) -> list[dict]:
             thr = float(t_dist.isf(a_ch / 2, rg["dof"]))
             hit, coef, lo = stat > thr, float(rg["coefficient"]), t_lo
         if hit:
-            what = f"the rate still follows channel {name!r} (≈ {coef:.3g} {ctx.unit or 'rate unit'} per channel unit)"
+            how = coef_words or f"(≈ {coef:.3g} {ctx.unit or 'rate unit'} per channel unit)"
+            what = f"the rate still follows channel {name!r} {how}"
             out.append(
                 {"domain": "channels", "tau": (lo, t_hi), "band_hz": None, "chi2_dof": _chi2_dof(ctx, lo, t_hi)}
                 | {"what": what, "statistic": stat, "threshold": thr, "alpha": a_ch}
