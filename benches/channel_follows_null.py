@@ -134,7 +134,9 @@ def main(argv=None) -> None:
         "| records | tested | α | coherence | channel's line | pair | pair 95 % CP |",
         "|---|---|---|---|---|---|---|",
     ]
-    for label, r in [("all null", res["null"])] + [(k, v) for k, v in res["by_kind"].items()] + [("power", res["power"])]:
+    for label, r in (
+        [("all null", res["null"])] + [(k, v) for k, v in res["by_kind"].items()] + [("power", res["power"])]
+    ):
         for a in LEVELS:
             c = r[str(a)]
             lo, hi = c["pair_ci95"]

@@ -133,7 +133,8 @@ def level_test(y: np.ndarray, fs: float, alpha: float, t0: float = 0.0) -> dict 
         at = j if i == 0 else i
         ratio = float(np.exp((x[0, at:].mean() - x[0, :at].mean()) / 2.0))
         split = t0 + at * block_s
-        return out | {"split_s": split, "left_s": (t0, split), "right_s": (split, end), "ratio": ratio, "stretch_s": None}
+        sides = {"left_s": (t0, split), "right_s": (split, end)}
+        return out | {"split_s": split, "ratio": ratio, "stretch_s": None} | sides
     inside = np.zeros(k, dtype=bool)
     inside[i:j] = True
     ratio = float(np.exp((x[0, inside].mean() - x[0, ~inside].mean()) / 2.0))

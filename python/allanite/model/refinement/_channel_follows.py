@@ -126,7 +126,8 @@ def follows_check(ctx: MissingContext, a: float) -> list[dict]:
             thr = 1.0 - a_pair ** (1.0 / (r["segments"] - 1))  # the coherence's critical value at a_pair
             out.append(
                 {"domain": "channels", "tau": (lo, hi), "band_hz": (f0, f0), "chi2_dof": chi2_dof(ctx, lo, hi)}
-                | {"what": what, "channel": name, "effect": effect, "f0": f0} | r
+                | {"what": what, "channel": name, "effect": effect, "f0": f0}
+                | r
                 | {"statistic": r["coherence"], "threshold": thr, "alpha": a_pair}
             )
     return out

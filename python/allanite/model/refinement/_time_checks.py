@@ -72,11 +72,16 @@ def level_check(ctx: MissingContext, a: float) -> list[dict]:
             continue
         tau = float(ctx.curve.tau[0])
         what = (
-            f"the noise level changes along the record: {ratio:.2f}× the Allan deviation at τ₀ of t "
-            f"{span_text(*lo_side)} s"
-            if r.get("stretch_s") is None
-            else f"the noise level changes along the record: the Allan deviation at τ₀ {where}"
-        ) + f" ({departure:.2g} % off the record's level" + clause + ")"
+            (
+                f"the noise level changes along the record: {ratio:.2f}× the Allan deviation at τ₀ of t "
+                f"{span_text(*lo_side)} s"
+                if r.get("stretch_s") is None
+                else f"the noise level changes along the record: the Allan deviation at τ₀ {where}"
+            )
+            + f" ({departure:.2g} % off the record's level"
+            + clause
+            + ")"
+        )
         out.append(
             {"domain": "level", "tau": (tau, tau), "t": hi_side, "band_hz": None, "chi2_dof": None}
             | {"what": what, "ratio": ratio, "departure_pct": departure, "heldout_pct": held}
