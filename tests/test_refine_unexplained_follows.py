@@ -15,6 +15,7 @@ from scipy import signal
 from allanite.model.refinement import _channel_follows as cf
 from allanite.model.refinement.levels import CONDITIONAL_SHARES, alpha
 from allanite.model.refinement.missing import CHECKS
+from allanite.model.refinement.words import describe_region
 
 FS, N, PERIOD = 10.0, 60_000, 60.0  # 6000 s: 100 periods of the line
 
@@ -56,6 +57,8 @@ def test_a_removed_family_the_channel_carries_is_said_with_its_channel_and_frequ
     assert out[0]["coherence"] > 0.8 and out[0]["p_coherence"] < a and out[0]["p_line"] < a
     assert out[0]["segments"] == 16 and out[0]["statistic"] > out[0]["threshold"]  # 100 periods / 6 per segment
     assert "follows channel 'temp'" in out[0]["what"] and "regression on 'temp'" in out[0]["what"]
+    assert out[0]["chi2_dof"] is None  # the evidence is the channel's, not the curve's
+    assert describe_region(out[0]).startswith("τ 12–60 s, ≈ 0.017 Hz: the periodic line the model took at 0.01667 Hz")
 
 
 def test_silent_where_a_regression_uses_the_channel_or_the_channel_does_not_carry_the_line():

@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import f as f_dist
 
-from ._missing_context import MissingContext, chi2_dof
+from ._missing_context import MissingContext
 from .curvefit import base_name
 
 __all__ = ["follows_check", "coherence_test", "MIN_SEGMENTS", "MAX_SEGMENTS", "PERIODS", "SIDE_BINS"]
@@ -125,7 +125,7 @@ def follows_check(ctx: MissingContext, a: float) -> list[dict]:
             )
             thr = 1.0 - a_pair ** (1.0 / (r["segments"] - 1))  # the coherence's critical value at a_pair
             out.append(
-                {"domain": "channels", "tau": (lo, hi), "band_hz": (f0, f0), "chi2_dof": chi2_dof(ctx, lo, hi)}
+                {"domain": "channels", "tau": (lo, hi), "band_hz": (f0, f0), "chi2_dof": None}  # not the curve's
                 | {"what": what, "channel": name, "effect": effect, "f0": f0}
                 | r
                 | {"statistic": r["coherence"], "threshold": thr, "alpha": a_pair}
