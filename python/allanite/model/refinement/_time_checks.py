@@ -23,10 +23,12 @@ __all__ = ["level_check", "drift_check", "outliers_check"]
 
 def level_check(ctx: MissingContext, a: float) -> list[dict]:
     """The noise level along the final samples (:func:`allanite.model.noise_level.level_test`: the Allan
-    variance at τ₀ in blocks, a studentised CUSUM against its simulated null), between the change points refine
-    accepted (``a`` split over the segments). Where it rejects: one entry with ``"t"`` the side of the largest
-    change where the level is higher (s; the split located to the sample by
-    :func:`.changes.locate` within its two blocks), the ratio of the Allan deviations at τ₀ and
+    variance at τ₀ in blocks, the largest studentised sum over a run of blocks against its simulated null: a split
+    of the record or a stretch louder or quieter than the rest), between the change points refine accepted (``a``
+    split over the segments). Where it rejects: one entry with ``"t"`` the side of the largest change where the
+    level is higher (s; the split located to the sample by :func:`.changes.locate` within its two blocks), or the
+    stretch (each end located so; louder or quieter, its ratio read on the located stretch's squared
+    differences), the ratio of the Allan deviations at τ₀ and
     ``"departure_pct"``, how far the side further from the record's level (the length-weighted mean) departs
     from it in Allan deviation at τ₀.
 
