@@ -44,14 +44,15 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   together move the Allan deviation beyond the held-out error; ``"steps"`` [(t, size)]. Not repeated where the
   ``"mean"`` check already said the one step it found.
 - ``"level"`` — the noise level along the final samples (:func:`allanite.model.noise_level.level_test`, between
-  the change points refine accepted): an entry with the time region ``"t"`` (lo, hi) s where the level is
-  higher, where the change exceeds the final model's held-out error.
+  the change points refine accepted; a split of the record or a stretch louder or quieter than the rest): an entry
+  with the time region ``"t"`` (lo, hi) s where the level is higher (or the stretch), where the change exceeds the
+  final model's held-out error.
 - ``"line"`` — an accepted line whose complex amplitude changes along the final samples (:mod:`._line_check`:
   each sinusoid, and the strongest line of each family removed in time), said where the change moves the
   Allan deviation beyond the final model's held-out error; ``"t"`` the side after the change.
 - ``"channels"`` — a coupling to a channel of ``channels=`` left in the final samples (the regression's tests:
-  the Whittle GLS for a slow channel — the pair of any phase and the in-phase test, each at half the share —,
-  within blocks for a fast one).
+  the Whittle GLS for a slow channel — the pair of any phase and the in-phase test, each at 0.8/1.8 of the share,
+  and where the pair fails the quadratic's at 0.2/1.8, :data:`SLOW_SPLIT` —, within blocks for a fast one).
 - ``"channel_shape"`` (domain ``"channels"``) — the final samples' dependence on a slow channel's *value* beyond
   the terms kept for it (:mod:`._channel_shape`, :func:`allanite.model._shape.shape_test`: steps of the rate where
   the channel crosses its quantiles, or its square where not kept, the best two by a greedy search calibrated on
