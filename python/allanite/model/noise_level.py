@@ -39,25 +39,26 @@ NULL_DRAWS = 40_000
 _NULL: dict[tuple[int, int], np.ndarray] = {}
 
 
-def _runs(k: int) -> tuple[np.ndarray, np.ndarray]:
-    """Every run of blocks (i, j], 0 ≤ i < j ≤ k, but the whole record: its ends as indices of the cumulative sum."""
-    i, j = np.triu_indices(k + 1, 1)
-    keep = (j - i) < k
-    return i[keep], j[keep]
-
-
 def _run_max(x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For rows of block levels ``x`` (draws, K) with pooled variances ``v`` (draws,): the largest standardised
     sum over a run of blocks of each row (module docstring) and the run (i, j] where it is reached (blocks i+1 … j,
-    counted from 1)."""
-    k = x.shape[1]
-    s = np.zeros((x.shape[0], k + 1))
+    counted from 1). One pass per run length L (slices of the cumulative sums, no gather)."""
+    rows, k = x.shape
+    s = np.zeros((rows, k + 1))
     s[:, 1:] = np.cumsum(x - x.mean(axis=1, keepdims=True), axis=1)
-    i, j = _runs(k)
-    length = j - i
-    z = np.abs(s[:, j] - s[:, i]) / np.sqrt(np.maximum(v, 1e-300)[:, None] * length * (k - length) / k)
-    at = np.argmax(z, axis=1)
-    return z[np.arange(x.shape[0]), at], i[at], j[at]
+    sd = np.sqrt(np.maximum(v, 1e-300))
+    best = np.full(rows, -1.0)
+    best_i = np.zeros(rows, dtype=np.int64)
+    best_len = np.ones(rows, dtype=np.int64)
+    for length in range(1, k):
+        z = np.abs(s[:, length:] - s[:, :-length])  # runs (i, i + length], i = 0 … k − length
+        at = np.argmax(z, axis=1)
+        top = z[np.arange(rows), at] / (sd * np.sqrt(length * (k - length) / k))
+        better = top > best
+        best = np.where(better, top, best)
+        best_i = np.where(better, at, best_i)
+        best_len = np.where(better, length, best_len)
+    return best, best_i, best_i + best_len
 
 
 def _levels(sub: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
