@@ -14,9 +14,12 @@ largest standardised sum of the xₖ − x̄ over a run of blocks i < k ≤ j, m
 start are the standardised CUSUM (one change of level), the others a stretch louder or quieter than the rest (a
 truck passing for 120 s of a 10⁴ s record: one block of 32, which a single split's CUSUM dilutes over the whole
 record). Its null distribution — which depends only on (K, SUB) — is simulated once, studentised the same way
-(Gaussian sub-block values), and the threshold is its (1 − α) quantile. The run of the maximum is where the level
-differs most: a split where it reaches an end of the record, else a stretch; exp((x̄_in − x̄_out)/2) the ratio of
-the Allan deviations at τ₀ inside and outside it (right over left for a split).
+(Gaussian sub-block values), and the threshold is its (1 − α) quantile. Where it rejects, the change is said as
+the split of the largest CUSUM where that alone exceeds the threshold and the stretch's gain over it in the squared
+statistic, z²_stretch − z²_split, does not exceed the threshold's square (one change is the simpler reading; the
+second must pay for itself at the test's own threshold; the decision is the maximum's either way, so the
+calibration does not move), else as the run of the maximum, a stretch; exp((x̄_in − x̄_out)/2) the ratio of the Allan deviations at τ₀ inside and outside it (right over left
+for a split).
 """
 
 from __future__ import annotations
@@ -39,10 +42,11 @@ NULL_DRAWS = 40_000
 _NULL: dict[tuple[int, int], np.ndarray] = {}
 
 
-def _run_max(x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _run_max(x: np.ndarray, v: np.ndarray, splits_only: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For rows of block levels ``x`` (draws, K) with pooled variances ``v`` (draws,): the largest standardised
     sum over a run of blocks of each row (module docstring) and the run (i, j] where it is reached (blocks i+1 … j,
-    counted from 1). One pass per run length L (slices of the cumulative sums, no gather)."""
+    counted from 1); ``splits_only``: over the runs from the record's start (the CUSUM of one split). One pass per
+    run length L (slices of the cumulative sums, no gather)."""
     rows, k = x.shape
     s = np.zeros((rows, k + 1))
     s[:, 1:] = np.cumsum(x - x.mean(axis=1, keepdims=True), axis=1)
@@ -52,6 +56,8 @@ def _run_max(x: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.n
     best_len = np.ones(rows, dtype=np.int64)
     for length in range(1, k):
         z = np.abs(s[:, length:] - s[:, :-length])  # runs (i, i + length], i = 0 … k − length
+        if splits_only:  # the runs from the record's start only: the CUSUM
+            z = z[:, :1]
         at = np.argmax(z, axis=1)
         top = z[np.arange(rows), at] / (sd * np.sqrt(length * (k - length) / k))
         better = top > best
@@ -122,6 +128,10 @@ def level_test(y: np.ndarray, fs: float, alpha: float, t0: float = 0.0) -> dict 
     thr_at = int(np.ceil((null.size + 1) * (1.0 - alpha) - 1e-9))
     thr = float(null[min(thr_at, null.size) - 1])
     i, j = int(i_run[0]), int(j_run[0])
+    if 0 < i and j < k:  # a stretch: a split where that alone rejects and the stretch's second change does not pay
+        split_z, _i, at = _run_max(x, v, splits_only=True)
+        if split_z[0] > thr and stat[0] ** 2 - split_z[0] ** 2 <= thr**2:
+            i, j = 0, int(at[0])
     block_s, end = SUB * per / fs, t0 + (y.size - 1) / fs
     out = {
         "statistic": float(stat[0]),
