@@ -224,6 +224,7 @@ MODEL_RANKS = {
     "model.refinement._time_checks": 6.5,
     "model.refinement._segments": 6.6,  # the change points' segments: their levels, the departures they carry
     "model.refinement._channel_shape": 6.5,  # the residual's dependence on a channel's value (on model._shape)
+    "model.refinement._channel_follows": 6.5,  # an accepted line a channel carries (on _missing_context, curvefit)
     "model.refinement.missing": 7,
     "model.refinement._rolloff": 5.5,
     "model.refinement._notch": 5.6,  # a notch after the roll-off (on _rolloff; the bandwidth candidate's)

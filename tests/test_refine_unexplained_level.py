@@ -47,6 +47,29 @@ def test_the_level_test_finds_a_doubling_where_it_is():
     assert r["ratio"] == pytest.approx(2.0, rel=0.05) and r["p_value"] < 1e-4
 
 
+def test_a_short_louder_stretch_is_found_as_a_stretch_and_said_with_both_ends():
+    """blind9's truck: white noise 3× for 120 s of 10⁴ s — 1.2 % of the record, within one block of 32. The CUSUM of
+    one split dilutes it over the whole record (nothing said without the change-point candidate); the runs of blocks
+    find it, and the check locates both ends and reads the ratio on the located stretch."""
+    from allanite.model.refinement._time_checks import level_check
+
+    rng = np.random.default_rng(11)
+    n, fs = 200_000, 20.0  # 10⁴ s
+    white = rng.standard_normal(n) * 2e-3 * np.sqrt(fs)
+    white[120_000:122_400] *= 3.0  # t 6000–6120 s
+    y = allanite.simulate(n, fs, K=1e-5, seed=rng) + white
+    a = alpha("unexplained:level", 0.05)
+    r = noise_level.level_test(y, fs, a)
+    assert r["rejected"] and r["stretch_s"][0] <= 6000.0 and r["stretch_s"][1] >= 6120.0
+    assert r["stretch_s"][1] - r["stretch_s"][0] <= 2 * 10_000.0 / 32 + 1e-9  # one or two blocks
+    ctx = dataclasses.make_dataclass("Ctx", ["y", "fs", "change_times", "heldout_pct", "segments_heldout_pct", "curve"])
+    tau = dataclasses.make_dataclass("Curve", ["tau"])(np.array([0.05, 100.0]))
+    out = level_check(ctx(y, fs, [], 5.0, None, tau), a)
+    assert len(out) == 1 and out[0]["t"][0] == pytest.approx(6000.0, abs=2.0)
+    assert out[0]["t"][1] == pytest.approx(6120.0, abs=2.0) and out[0]["ratio"] == pytest.approx(3.0, rel=0.08)
+    assert re.search(r"within t 6000–6120 s: 3\.0\d× the rest of the record's", out[0]["what"])
+
+
 def test_the_level_test_holds_its_alpha_on_clean_records_with_correlated_differences():
     # white + random walk through a 2nd-order low-pass at fs/40: the squared differences are correlated over
     # tens of samples — the batch means carry it; a test taking them as independent rejects most of these

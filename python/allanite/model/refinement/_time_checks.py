@@ -23,10 +23,12 @@ __all__ = ["level_check", "drift_check", "outliers_check"]
 
 def level_check(ctx: MissingContext, a: float) -> list[dict]:
     """The noise level along the final samples (:func:`allanite.model.noise_level.level_test`: the Allan
-    variance at τ₀ in blocks, a studentised CUSUM against its simulated null), between the change points refine
-    accepted (``a`` split over the segments). Where it rejects: one entry with ``"t"`` the side of the largest
-    change where the level is higher (s; the split located to the sample by
-    :func:`.changes.locate` within its two blocks), the ratio of the Allan deviations at τ₀ and
+    variance at τ₀ in blocks, the largest studentised sum over a run of blocks against its simulated null: a split
+    of the record or a stretch louder or quieter than the rest), between the change points refine accepted (``a``
+    split over the segments). Where it rejects: one entry with ``"t"`` the side of the largest change where the
+    level is higher (s; the split located to the sample by :func:`.changes.locate` within its two blocks), or the
+    stretch (each end located so; louder or quieter, its ratio read on the located stretch's squared
+    differences), the ratio of the Allan deviations at τ₀ and
     ``"departure_pct"``, how far the side further from the record's level (the length-weighted mean) departs
     from it in Allan deviation at τ₀.
 
@@ -49,20 +51,38 @@ def level_check(ctx: MissingContext, a: float) -> list[dict]:
         r = noise_level.level_test(y[i0:i1], fs, a_seg, t0=i0 / fs)
         if r is None or not r["rejected"]:
             continue
-        block = (r["right_s"][1] - r["left_s"][0]) / r["blocks"]
-        lo_i = max(i0, int((r["split_s"] - block) * fs))
-        split = lo_i / fs + locate(y[lo_i : min(i1, int((r["split_s"] + block) * fs))], 1, fs)[0]
-        left, right = (r["left_s"][0], split), (split, r["right_s"][1])
-        hi_side, lo_side, ratio = (right, left, r["ratio"]) if r["ratio"] >= 1 else (left, right, 1 / r["ratio"])
-        share_hi = (hi_side[1] - hi_side[0]) / max(r["right_s"][1] - r["left_s"][0], 1e-300)
+        span = (r["left_s"][0], r["right_s"][1])
+        block = (span[1] - span[0]) / r["blocks"]
+        if r.get("stretch_s") is None:
+            split = _located(y, fs, r["split_s"], block, i0, i1)
+            left, right = (span[0], split), (split, span[1])
+            hi_side, lo_side, ratio = (right, left, r["ratio"]) if r["ratio"] >= 1 else (left, right, 1 / r["ratio"])
+            share_hi = (hi_side[1] - hi_side[0]) / max(span[1] - span[0], 1e-300)
+        else:  # a stretch louder or quieter than the rest: each of its ends located within its two blocks
+            run = (_located(y, fs, r["stretch_s"][0], block, i0, i1), _located(y, fs, r["stretch_s"][1], block, i0, i1))
+            d2 = np.diff(y[i0:i1]) ** 2
+            inside = np.zeros(d2.size, dtype=bool)
+            inside[int(run[0] * fs) - i0 : int(run[1] * fs) - i0] = True
+            in_out = math.sqrt(d2[inside].mean() / d2[~inside].mean()) if 0 < inside.sum() < d2.size else r["ratio"]
+            hi_side, lo_side, ratio = run, span, max(in_out, 1 / in_out)  # on the located stretch, not its blocks'
+            share_hi = (run[1] - run[0]) / max(span[1] - span[0], 1e-300)
+            share_hi = share_hi if in_out >= 1 else 1 - share_hi
+            where = f"within t {span_text(*run)} s: {in_out:.2f}× the rest of the record's"
         mean = share_hi * ratio**2 + (1 - share_hi)  # the record's AVAR at τ₀ in units of the lower side's
         departure = 100 * max(ratio / math.sqrt(mean) - 1, 1 - 1 / math.sqrt(mean))
         if held is not None and not departure > held:
             continue
         tau = float(ctx.curve.tau[0])
         what = (
-            f"the noise level changes along the record: {ratio:.2f}× the Allan deviation at τ₀ of "
-            f"t {span_text(*lo_side)} s ({departure:.2g} % off the record's level" + clause + ")"
+            (
+                f"the noise level changes along the record: {ratio:.2f}× the Allan deviation at τ₀ of t "
+                f"{span_text(*lo_side)} s"
+                if r.get("stretch_s") is None
+                else f"the noise level changes along the record: the Allan deviation at τ₀ {where}"
+            )
+            + f" ({departure:.2g} % off the record's level"
+            + clause
+            + ")"
         )
         out.append(
             {"domain": "level", "tau": (tau, tau), "t": hi_side, "band_hz": None, "chi2_dof": None}
@@ -70,6 +90,13 @@ def level_check(ctx: MissingContext, a: float) -> list[dict]:
             | {"statistic": r["statistic"], "threshold": r["threshold"], "alpha": a_seg}
         )
     return out
+
+
+def _located(y: np.ndarray, fs: float, t: float, block: float, i0: int, i1: int) -> float:
+    """A change of the noise level found at the block boundary ``t`` (s), located to the sample within the block
+    on either side of it (:func:`.changes.locate`), within the samples ``i0:i1``."""
+    lo_i = max(i0, int((t - block) * fs))
+    return lo_i / fs + locate(y[lo_i : min(i1, int((t + block) * fs))], 1, fs)[0]
 
 
 def drift_check(ctx: MissingContext, a: float) -> list[dict]:

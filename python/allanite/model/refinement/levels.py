@@ -138,6 +138,11 @@ CONDITIONAL_SHARES["periodic:wander"] = WANDER_SHARE
 CONDITIONAL_SHARES["bandwidth:notch"] = 0.02
 #: An accepted line's amplitude following a given channel (:mod:`.refinement._line_gain`): conditional on the line.
 CONDITIONAL_SHARES["sinusoid:gain"] = LINE_GAIN_SHARE
+#: ``unexplained``'s check that an accepted line follows a channel no regression uses
+#: (:mod:`.refinement._channel_follows`): run only once a line is accepted and channels are given — conditional on the
+#: line, as the gain's test; its rate on lines beside channels that do not carry them:
+#: benches/results/channel_follows_null.md.
+CONDITIONAL_SHARES["unexplained:follows"] = LINE_GAIN_SHARE
 
 
 def share(test: str) -> float:

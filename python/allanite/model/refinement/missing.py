@@ -44,19 +44,25 @@ is not on the curve), ``"what"`` in words, and the test's ``"statistic"``, ``"th
   together move the Allan deviation beyond the held-out error; ``"steps"`` [(t, size)]. Not repeated where the
   ``"mean"`` check already said the one step it found.
 - ``"level"`` — the noise level along the final samples (:func:`allanite.model.noise_level.level_test`, between
-  the change points refine accepted): an entry with the time region ``"t"`` (lo, hi) s where the level is
-  higher, where the change exceeds the final model's held-out error.
+  the change points refine accepted; a split of the record or a stretch louder or quieter than the rest): an entry
+  with the time region ``"t"`` (lo, hi) s where the level is higher (or the stretch), where the change exceeds the
+  final model's held-out error.
 - ``"line"`` — an accepted line whose complex amplitude changes along the final samples (:mod:`._line_check`:
   each sinusoid, and the strongest line of each family removed in time), said where the change moves the
   Allan deviation beyond the final model's held-out error; ``"t"`` the side after the change.
 - ``"channels"`` — a coupling to a channel of ``channels=`` left in the final samples (the regression's tests:
-  the Whittle GLS for a slow channel — the pair of any phase and the in-phase test, each at half the share —,
-  within blocks for a fast one).
+  the Whittle GLS for a slow channel — the pair of any phase and the in-phase test, each at 0.8/1.8 of the share,
+  and where the pair fails the quadratic's at 0.2/1.8, :data:`SLOW_SPLIT` —, within blocks for a fast one).
 - ``"channel_shape"`` (domain ``"channels"``) — the final samples' dependence on a slow channel's *value* beyond
   the terms kept for it (:mod:`._channel_shape`, :func:`allanite.model._shape.shape_test`: steps of the rate where
   the channel crosses its quantiles, or its square where not kept, the best two by a greedy search calibrated on
   draws of their scores): a staircase, a thermostat, a compensation table with steps that a straight line leaves
   uncorrelated with the channel; ``"channel"``, ``"cuts"`` [(value, step)] where it departs.
+- ``"follows"`` (domain ``"channels"``) — an accepted line (a ``"periodic"`` family removed in time, its strongest
+  line; a ``"sinusoid"``) that a channel no regression step uses carries coherently (:mod:`._channel_follows`: the
+  coherence over segments against its Beta null and the channel's own line at f0, both at the share split over the
+  pairs): one effect read twice, a regression on the channel may be the better reading; ``"channel"``,
+  ``"effect"``, ``"f0"``, ``"coherence"``. Its share is conditional on the line (:data:`.levels.CONDITIONAL_SHARES`).
 - ``"outliers"`` — impulsive noise left in the final samples (:func:`allanite.model.outliers.outlier_test`).
 - ``"clipped"`` — samples piled at the record's largest or smallest value, or held at one value longer than
   the record's quantisation gives, in the samples as given (:mod:`._quality`); ``"t"`` their first and last
@@ -74,6 +80,8 @@ import numpy as np
 from scipy.stats import t as t_dist
 
 from .. import channels, lines, tracing
+from .._shares import FIRST_QUADRATIC
+from ._channel_follows import follows_check
 from ._channel_shape import channel_shape_check
 from ._curve_checks import MAX_REGIONS, allan_check, allan_family, fit_check
 from ._line_check import line_check
@@ -227,24 +235,40 @@ def _lines_move_curve(ctx: MissingContext, freqs: np.ndarray, amps: np.ndarray) 
     return curve_change_z(ctx.curve, ctx.sol, change)[0] >= MATERIAL_Z
 
 
+#: A slow channel's three tests share a_ch/SLOW_SPLIT each way: the pair and the in-phase test each at
+#: (1 − FIRST_QUADRATIC) of it, the quadratic at FIRST_QUADRATIC of it — (2 − FIRST_QUADRATIC)·a_ch/SLOW_SPLIT ≤ a_ch.
+SLOW_SPLIT = 2.0 - FIRST_QUADRATIC
+
+
 def _channels(ctx: MissingContext, a: float) -> list[dict]:
     """A coupling to a channel of ``channels=`` left in the final samples (the regression candidate turned
-    down or left out): a slow channel by the Whittle GLS of :func:`allanite.model.channels.regress_channel`, a
-    fast one by the within-block t test — each at ``a`` split over the channels."""
+    down or left out): a slow channel by the Whittle GLS of :func:`allanite.model.channels.regress_channel` — the
+    pair, the in-phase test and, where the pair fails, the quadratic's (:data:`SLOW_SPLIT`) —, a fast one by the
+    within-block t test — each at ``a`` split over the channels."""
     if ctx.y is None or not ctx.channels:
         return []
     a_ch, out = a / len(ctx.channels), []
     t_lo, t_hi = float(ctx.curve.tau[0]), float(ctx.curve.tau[-1])
     for name, ch in ctx.channels.items():
+        coef_words = None
         if channels.is_slow(ch):
-            # the coupling's test (channel and quadrature, 2 dof: any phase) and the in-phase test alone (1 dof: more
-            # power on a coupling without lag), each at half the share — one of them may take a left coupling
-            r = channels.regress_channel(ctx.y, ch, ctx.fs, name=name, alpha=a_ch / 2, level=ctx.level, terms=())
+            # the coupling's test (channel and quadrature, 2 dof: any phase), the in-phase test alone (1 dof: more
+            # power on a coupling without lag), each at 1 − FIRST_QUADRATIC of a_ch/SLOW_SPLIT, and where the pair
+            # fails the quadratic's (a coupling mostly on (ch − mean)², whose linear part neither sees) at
+            # FIRST_QUADRATIC of it, as the regression candidate decides: together at most a_ch
+            r = channels.regress_channel(
+                ctx.y, ch, ctx.fs, name=name, alpha=a_ch / SLOW_SPLIT, level=ctx.level, terms=("quadratic",)
+            )
             hit, stat, thr = r.accepted, float(r.test["statistic"]), float(r.test["threshold"])
-            one = r.test["in_phase"]
+            one, quad = r.test["in_phase"], r.test.get("quadratic")
+            if r.test.get("accepted_by") == "quadratic" and quad is not None:
+                stat, thr = float(quad["statistic"]), float(quad["threshold"])
             if not hit and one["statistic"] > one["threshold"]:
                 hit, stat, thr = True, float(one["statistic"]), float(one["threshold"])
             coef = float(r.params.get("coefficient", float("nan")))
+            if r.test.get("accepted_by") == "quadratic" and "quadratic" in r.params:
+                q = float(r.params["quadratic"])
+                coef_words = f"through its square (≈ {q:.3g} {ctx.unit or 'rate unit'} per channel unit²)"
             lo = max(t_lo, min(t_hi, 0.1 * ctx.y.size / ctx.fs))  # a slow channel moves the longest τ
         else:
             rg = tracing.regression_fit(ctx.y, ch, 8)
@@ -252,7 +276,8 @@ def _channels(ctx: MissingContext, a: float) -> list[dict]:
             thr = float(t_dist.isf(a_ch / 2, rg["dof"]))
             hit, coef, lo = stat > thr, float(rg["coefficient"]), t_lo
         if hit:
-            what = f"the rate still follows channel {name!r} (≈ {coef:.3g} {ctx.unit or 'rate unit'} per channel unit)"
+            how = coef_words or f"(≈ {coef:.3g} {ctx.unit or 'rate unit'} per channel unit)"
+            what = f"the rate still follows channel {name!r} {how}"
             out.append(
                 {"domain": "channels", "tau": (lo, t_hi), "band_hz": None, "chi2_dof": _chi2_dof(ctx, lo, t_hi)}
                 | {"what": what, "statistic": stat, "threshold": thr, "alpha": a_ch}
@@ -260,7 +285,8 @@ def _channels(ctx: MissingContext, a: float) -> list[dict]:
     return out
 
 
-#: The checks, by the name of their share in :data:`.levels.SHARES` (``"unexplained:<name>"``).
+#: The checks, by the name of their share in :data:`.levels.SHARES` (``"unexplained:<name>"``; ``"follows"``'s is
+#: conditional on an accepted line, :data:`.levels.CONDITIONAL_SHARES`).
 CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "allan": allan_check,
     "fit": fit_check,
@@ -272,6 +298,7 @@ CHECKS: dict[str, Callable[[MissingContext, float], list[dict]]] = {
     "line": line_check,
     "channels": _channels,
     "channel_shape": channel_shape_check,
+    "follows": follows_check,
     "outliers": outliers_check,
     "clipped": clipped_check,
     "held": held_check,
