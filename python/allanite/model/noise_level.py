@@ -18,8 +18,8 @@ record). Its null distribution — which depends only on (K, SUB) — is simulat
 the split of the largest CUSUM where that alone exceeds the threshold and the stretch's gain over it in the squared
 statistic, z²_stretch − z²_split, does not exceed the threshold's square (one change is the simpler reading; the
 second must pay for itself at the test's own threshold; the decision is the maximum's either way, so the
-calibration does not move), else as the run of the maximum, a stretch; exp((x̄_in − x̄_out)/2) the ratio of the Allan deviations at τ₀ inside and outside it (right over left
-for a split).
+calibration does not move), else as the run of the maximum, a stretch; exp((x̄_in − x̄_out)/2) the ratio of the
+Allan deviations at τ₀ inside and outside it (right over left for a split).
 """
 
 from __future__ import annotations
@@ -141,9 +141,9 @@ def level_test(y: np.ndarray, fs: float, alpha: float, t0: float = 0.0) -> dict 
         "blocks": k,
     }
     if i == 0 or j == k:  # a split: the run reaches an end of the record
-        at = j if i == 0 else i
-        ratio = float(np.exp((x[0, at:].mean() - x[0, :at].mean()) / 2.0))
-        split = t0 + at * block_s
+        cut = j if i == 0 else i
+        ratio = float(np.exp((x[0, cut:].mean() - x[0, :cut].mean()) / 2.0))
+        split = t0 + cut * block_s
         sides = {"left_s": (t0, split), "right_s": (split, end)}
         return out | {"split_s": split, "ratio": ratio, "stretch_s": None} | sides
     inside = np.zeros(k, dtype=bool)
