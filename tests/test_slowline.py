@@ -9,6 +9,7 @@ import pytest
 
 import allanite
 from allanite.errors import ParameterError
+from allanite.model import slowline
 from allanite.model.slowline import slow_line_test
 
 
@@ -41,8 +42,13 @@ def test_red_noise_alone_and_a_settling_drift_are_no_line():
     assert r["threshold"] > -2.0 * math.log(1e-3)  # the scan's maximum is above one frequency's quantile
     quick = slow_line_test(y, fs, 1e-3)  # below that bound: no draws, the bound said as the threshold
     assert quick is not None and not quick["accepted"] and quick["statistic"] == r["statistic"]
-    if quick["statistic"] <= -2.0 * math.log(1e-3):
-        assert quick["p_value"] is None and quick["threshold"] == pytest.approx(-2.0 * math.log(1e-3))
+    if max(quick["statistic"], quick["readings"]["refit"]["statistic"]) <= -2.0 * math.log(1e-3 / 2):
+        # each of the two readings at α/2: both below one frequency's quantile, no draws and no bootstrap
+        assert quick["p_value"] is None and quick["threshold"] == pytest.approx(-2.0 * math.log(1e-3 / 2))
+    # the Bonferroni p-value of the two readings, the second's from its bootstrap-mapped draws
+    ps = [v["p_value"] for v in r["readings"].values()]
+    assert r["p_value"] == pytest.approx(min(1.0, 2.0 * min(ps)))
+    assert r["readings"]["refit"]["bootstrap"]["draws"] == slowline.BOOT_DRAWS
 
 
 def test_too_short_a_record_is_not_tested_and_bad_alpha_is_named():
