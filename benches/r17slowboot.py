@@ -7,6 +7,8 @@ calibrated by a parametric bootstrap, :mod:`allanite.model.slowline`) before →
   two the test said nothing on; (c) a 0.5 Hz tiltmeter × 2·10⁵ (blind10's noise and settling drift, its daily line
   at a quarter of blind10's 0.6 µrad as 1×), where the test already found it (the α/2 split must not lose it).
   Seeds and cases as round r14slowred's (``benches/results/r14slowred.md`` on that branch): the rows compare.
+- **False alarms** (``--part fa``) — ``refine_false_alarms.py``'s clean records (its mixtures and seeds), the test
+  alone as refine runs it: accepted at α, how often the bootstrap ran, CPU.
 - **Nulls** — red-noise records (``r13slowline.NULLS``'s flicker- and random-walk-dominated kinds): rejected at α,
   the p-value (``calibrate=True``: every reading's draws, the bootstrap too) at 0.01 and 0.05 with Clopper–Pearson
   95 % intervals (uniformity of p), and the CPU seconds of the test as refine runs it (``calibrate=False``).
@@ -107,6 +109,26 @@ def _null_row(name: str, records: int, start: int) -> dict:
     return {"records": records, "start": start, "accepted": acc, "p_values": p, "cpu": cpu}
 
 
+def _fa_row(mix: str, per_mix: int) -> dict:
+    """The test alone (as refine runs it, ``calibrate=False``) on ``refine_false_alarms.py``'s clean records of
+    ``mix`` (its seeds, its first ``per_mix`` records): accepted at α, the second reading's bootstrap run, CPU."""
+    import refine_false_alarms as rfa
+
+    acc, boot, cpu, p = 0, 0, [], []
+    n = per_mix if mix != "issue16" else max(2, per_mix * 2 // 3)
+    for k in range(n):
+        y, fs, _channels = rfa.record(mix, 10_000 + 1_000_003 * rfa.MIXES.index(mix) + 97 * k)
+        r, c = _timed(np.asarray(y, dtype=np.float64), fs)
+        cpu.append(c)
+        if r is None:
+            continue
+        acc += int(r["accepted"])
+        boot += int(bool((r.get("readings") or {}).get("refit", {}).get("bootstrap")))
+        p.append(r["p_value"])
+    print(mix, "accepted", acc, "bootstrapped", boot, f"cpu median {np.median(cpu):.2f}", flush=True)
+    return {"records": n, "accepted": acc, "bootstrapped": boot, "cpu": cpu, "p_values": p}
+
+
 def _merge(label: str, part: str, rows: dict, meta: dict) -> dict:
     """``rows`` merged into the results file under ``label`` → ``part`` (locked: runs split over processes)."""
     path = OUT / "r17slowboot.json"
@@ -163,13 +185,27 @@ def _md(res: dict) -> list[str]:
                 lines.append(f"| {name} | {cells} | {np.median(r['cpu']):.2f} ({max(r['cpu']):.2f}) |")
             cells = " | ".join(f"**{_cp(k, tot[0])}**" for k in tot[1:])
             lines += [f"| all | {cells} | {np.median(cpu_all):.2f} ({max(cpu_all):.2f}) |", ""]
+        if run.get("fa"):
+            lines += [
+                "refine_false_alarms.py's clean records, the test alone as refine runs it (p only where computed):",
+                "",
+                f"| mixture | accepted at α {ALPHA:g} | bootstrap run | CPU s median (max) |",
+                "|---|---|---|---|",
+            ]
+            acc = tot = 0
+            for mix, r in run["fa"].items():
+                acc, tot = acc + r["accepted"], tot + r["records"]
+                cpu = f"{np.median(r['cpu']):.2f} ({max(r['cpu']):.2f})"
+                lines.append(f"| {mix} | {_cp(r['accepted'], r['records'])} | {r.get('bootstrapped', '—')} | {cpu} |")
+            lines += [f"| all | **{_cp(acc, tot)}** | | |", ""]
     return lines
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--label", required=True)
-    ap.add_argument("--part", choices=("power", "nulls", "table"), required=True)
+    ap.add_argument("--part", choices=("power", "nulls", "fa", "table"), required=True)
+    ap.add_argument("--per-mix", type=int, default=40, help="refine_false_alarms records per mixture (part fa)")
     ap.add_argument("--seeds", type=int, default=20)
     ap.add_argument("--mults", default="1,2,4")
     ap.add_argument("--cases", default="", help="substrings of the power cases to run (default all)")
@@ -189,6 +225,10 @@ def main(argv=None) -> None:
         elif args.part == "nulls":
             kinds = [k for k in RED_NULLS if not args.kinds or any(c in k for c in args.kinds.split(","))]
             rows = {k: _null_row(k, args.records, args.start) for k in kinds}
+        elif args.part == "fa":
+            import refine_false_alarms as rfa
+
+            rows = {m: _fa_row(m, args.per_mix) for m in rfa.MIXES}
     meta["load_end"] = [round(v, 1) for v in os.getloadavg()]
     res = _merge(args.label, args.part, rows, meta) if rows else json.loads((OUT / "r17slowboot.json").read_text())
     (OUT / "r17slowboot.md").write_text("\n".join(_md(res)) + "\n")

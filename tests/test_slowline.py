@@ -26,6 +26,8 @@ def test_a_line_of_five_cycles_is_found_with_its_frequency_and_amplitude():
     r = slow_line_test(y, fs, 1e-3)
     assert r is not None and r["accepted"]
     assert r["statistic"] > r["threshold"]
+    # found by the first reading: the second is not read (no bootstrap where it could not change the decision)
+    assert r["reading"] == "whole" and r["readings"]["refit"]["bootstrap"] is None
     assert abs(r["f0"] - f0) < 3 * r["f0_sd"]
     assert abs(r["amplitude"] - amp) < 3 * r["amplitude_sd"]
     assert 0.0 < r["separable"] <= 1.0
@@ -49,6 +51,26 @@ def test_red_noise_alone_and_a_settling_drift_are_no_line():
     ps = [v["p_value"] for v in r["readings"].values()]
     assert r["p_value"] == pytest.approx(min(1.0, 2.0 * min(ps)))
     assert r["readings"]["refit"]["bootstrap"]["draws"] == slowline.BOOT_DRAWS
+
+
+@pytest.mark.slow  # 5·10⁵ samples and the bootstrap's 120 records; the cheap default path (no bootstrap on a line the
+# first reading finds, none where both statistics stay low) is test_a_line_of_five_cycles_is_found_... and
+# test_red_noise_alone_and_a_settling_drift_are_no_line
+def test_a_daily_line_under_flicker_fm_is_found_by_the_refit_reading():
+    """A clock's daily line over 5 days under flicker FM: the noise fitted without the line takes its power (the
+    first reading misses it), the likelihood ratio with the noise refitted beside it, calibrated by the bootstrap,
+    finds it — frequency and amplitude within 3 SD of the truth."""
+    fs, n, f0, amp = 1.0, 432_000, 1.0 / 86_400.0, 0.04
+    t = np.arange(n) / fs
+    y = allanite.simulate(n, fs, N=1.0, B=0.01, seed=1) + amp * np.sin(2 * np.pi * f0 * t + 0.7)
+    r = slow_line_test(y, fs, 4e-4)
+    assert r is not None and r["accepted"] and r["reading"] == "refit"
+    first, second = r["readings"]["whole"], r["readings"]["refit"]
+    assert first["statistic"] < first["threshold"] < second["threshold"] < second["statistic"]
+    assert second["bootstrap"]["draws"] == slowline.BOOT_DRAWS and second["bootstrap"]["slope"] > 0.0
+    assert r["p_value"] == pytest.approx(min(1.0, 2.0 * min(first["p_value"], second["p_value"])))
+    assert abs(r["f0"] - f0) < 3 * r["f0_sd"]
+    assert abs(r["amplitude"] - amp) < 3 * r["amplitude_sd"]
 
 
 def test_too_short_a_record_is_not_tested_and_bad_alpha_is_named():
@@ -98,3 +120,23 @@ def test_a_slow_line_is_no_step_where_the_sinusoid_candidate_is_left_out():
     said = [u for u in without.unexplained if u["what"].startswith("a line of few cycles")]
     assert len(said) == 1 and said[0]["band_hz"][0] <= 5.3 / n <= said[0]["band_hz"][1]
     assert said[0]["statistic"] > said[0]["threshold"] and "not among the candidates" in said[0]["what"]
+
+
+def test_a_slow_line_no_step_kept_is_said_with_its_p_value(monkeypatch):
+    """A line of few cycles the test found but no step kept (here: the step's record of it hidden, as where a drift
+    or the noise's slow terms took the line) is said in ``unexplained`` in words — "a slow periodic component may
+    be present", its test's p-value and why the sinusoid candidate did not keep it — at τ around its half period."""
+    from allanite.model.refinement._final import FinalModel
+
+    fs, n = 1.0, 20_000
+    t = np.arange(n) / fs
+    y = _red(n, fs, 3) + 0.05 * np.sin(2 * np.pi * 5.3 / n * t + 1.1)
+    monkeypatch.setattr(FinalModel, "slow_line_kept", lambda self, ln: False)
+    r = allanite.refine(y, fs, progress=False)
+    said = [u for u in r.unexplained if u["what"].startswith("a slow periodic component may be present")]
+    assert len(said) == 1
+    u = said[0]
+    assert u["p_value"] is not None and 0.0 < u["p_value"] <= u["alpha"]
+    assert f"p = {u['p_value']:.2g}" in u["what"] and u["not_kept"] in u["what"]
+    assert u["not_kept"] != "the sinusoid candidate was not among the candidates refine ran"
+    assert u["tau"][0] <= n / 5.3 / 2 <= u["tau"][1]
