@@ -94,18 +94,17 @@ def _power_row(name: str, mult: float, seeds: int) -> dict:
     }
 
 
-def _null_row(name: str, records: int, start: int) -> dict:
+def _null_row(name: str, records: int, start: int, calibrate: bool) -> dict:
     fs, n, kw = r13.NULLS[name]
     p, acc, cpu = [], 0, []
     for i in range(start, start + records):
         rng = np.random.default_rng(7_000 + 101 * i + len(name))  # r13slowline's seeds
         y = rb.noise(n, fs, rng, **kw)
-        quick, c = _timed(y, fs)
-        r = sl.slow_line_test(y, fs, ALPHA, calibrate=True)
-        acc += int(quick["accepted"])
+        r, c = _timed(y, fs, calibrate)
+        acc += int(r["accepted"])
         cpu.append(c)
         p.append(r["p_value"])
-    print(name, start, "accepted", acc, "smallest p", np.sort(p)[:3], f"cpu median {np.median(cpu):.2f}", flush=True)
+    print(name, start, "accepted", acc, "smallest p", sorted(v for v in p if v is not None)[:3], flush=True)
     return {"records": records, "start": start, "accepted": acc, "p_values": p, "cpu": cpu}
 
 
@@ -139,7 +138,9 @@ def _merge(label: str, part: str, rows: dict, meta: dict) -> dict:
         run.setdefault("runs", []).append(meta)
         for k, v in rows.items():
             old = run.setdefault(part, {}).get(k)
-            if part == "nulls" and old is not None and old["start"] != v["start"]:  # a further slice of records
+            if (
+                part.startswith("nulls") and old is not None and old["start"] != v["start"]
+            ):  # a further slice of records
                 v = {key: old[key] + v[key] for key in ("records", "accepted", "p_values", "cpu")} | {"start": -1}
             run[part][k] = v
         path.write_text(json.dumps(res, indent=1))
@@ -149,6 +150,25 @@ def _merge(label: str, part: str, rows: dict, meta: dict) -> dict:
 def _cp(k: int, n: int) -> str:
     lo, hi = clopper_pearson(k, n)
     return f"{k}/{n} ({100 * lo:.1f}–{100 * hi:.1f} %)"
+
+
+def _null_table(rows: dict, title: str) -> list[str]:
+    lines = [
+        f"Red-noise nulls, the test {title}:",
+        "",
+        f"| null | accepted at α {ALPHA:g} | p ≤ 0.01 | p ≤ 0.05 | CPU s median (max) |",
+        "|---|---|---|---|---|",
+    ]
+    tot, cpu_all = [0, 0, 0, 0], []
+    for name, r in rows.items():
+        p = np.array([1.0 if v is None else v for v in r["p_values"]])
+        c = [r["accepted"], int(np.count_nonzero(p <= 0.01)), int(np.count_nonzero(p <= 0.05))]
+        tot = [tot[0] + r["records"]] + [a + b for a, b in zip(tot[1:], c, strict=True)]
+        cpu_all += r["cpu"]
+        cells = " | ".join(_cp(k, r["records"]) for k in c)
+        lines.append(f"| {name} | {cells} | {np.median(r['cpu']):.2f} ({max(r['cpu']):.2f}) |")
+    cells = " | ".join(f"**{_cp(k, tot[0])}**" for k in tot[1:])
+    return lines + [f"| all | {cells} | {np.median(cpu_all):.2f} ({max(cpu_all):.2f}) |", ""]
 
 
 def _md(res: dict) -> list[str]:
@@ -170,21 +190,9 @@ def _md(res: dict) -> list[str]:
                     f"{_cp(r['found'], r['seeds'])} | {cpu} |"
                 )
             lines.append("")
-        if run.get("nulls"):
-            lines += [
-                f"| null | accepted at α {ALPHA:g} | p ≤ 0.01 | p ≤ 0.05 | CPU s median (max) |",
-                "|---|---|---|---|---|",
-            ]
-            tot, cpu_all = [0, 0, 0, 0], []
-            for name, r in run["nulls"].items():
-                p = np.array([1.0 if v is None else v for v in r["p_values"]])
-                c = [r["accepted"], int(np.count_nonzero(p <= 0.01)), int(np.count_nonzero(p <= 0.05))]
-                tot = [tot[0] + r["records"]] + [a + b for a, b in zip(tot[1:], c, strict=True)]
-                cpu_all += r["cpu"]
-                cells = " | ".join(_cp(k, r["records"]) for k in c)
-                lines.append(f"| {name} | {cells} | {np.median(r['cpu']):.2f} ({max(r['cpu']):.2f}) |")
-            cells = " | ".join(f"**{_cp(k, tot[0])}**" for k in tot[1:])
-            lines += [f"| all | {cells} | {np.median(cpu_all):.2f} ({max(cpu_all):.2f}) |", ""]
+        for part, title in (("nulls", "as refine runs it (p where computed)"), ("nulls_p", "every p computed")):
+            if run.get(part):
+                lines += _null_table(run[part], title)
         if run.get("fa"):
             lines += [
                 "refine_false_alarms.py's clean records, the test alone as refine runs it (p only where computed):",
@@ -212,6 +220,7 @@ def main(argv=None) -> None:
     ap.add_argument("--kinds", default="", help="substrings of the null kinds to run (default all red kinds)")
     ap.add_argument("--records", type=int, default=40, help="null records per kind")
     ap.add_argument("--start", type=int, default=0, help="the first null record's index (to split a kind)")
+    ap.add_argument("--calibrate", action="store_true", help="nulls: every p-value computed (part nulls_p)")
     args = ap.parse_args(argv)
     commit = subprocess.run(["git", "describe", "--always", "--dirty"], capture_output=True, text=True).stdout.strip()
     meta = {"part": args.part, "commit": commit, "load_start": [round(v, 1) for v in os.getloadavg()]}
@@ -224,13 +233,15 @@ def main(argv=None) -> None:
                     rows[f"{k} @ {m:g}"] = _power_row(k, m, args.seeds)
         elif args.part == "nulls":
             kinds = [k for k in RED_NULLS if not args.kinds or any(c in k for c in args.kinds.split(","))]
-            rows = {k: _null_row(k, args.records, args.start) for k in kinds}
+            rows = {k: _null_row(k, args.records, args.start, args.calibrate) for k in kinds}
         elif args.part == "fa":
             import refine_false_alarms as rfa
 
             rows = {m: _fa_row(m, args.per_mix) for m in rfa.MIXES}
     meta["load_end"] = [round(v, 1) for v in os.getloadavg()]
-    res = _merge(args.label, args.part, rows, meta) if rows else json.loads((OUT / "r17slowboot.json").read_text())
+    part = "nulls_p" if args.part == "nulls" and args.calibrate else args.part
+    meta["part"] = part
+    res = _merge(args.label, part, rows, meta) if rows else json.loads((OUT / "r17slowboot.json").read_text())
     (OUT / "r17slowboot.md").write_text("\n".join(_md(res)) + "\n")
     print("\n".join(_md({args.label: res[args.label]})))
 

@@ -122,6 +122,34 @@ def test_a_slow_line_is_no_step_where_the_sinusoid_candidate_is_left_out():
     assert said[0]["statistic"] > said[0]["threshold"] and "not among the candidates" in said[0]["what"]
 
 
+def test_the_words_for_a_slow_line_the_sinusoid_candidate_turned_down():
+    """``unexplained``'s entry for a line of few cycles the candidate tested and did not keep: "a slow periodic
+    component may be present", the test's p-value, the candidate's reason, τ over its half period; without the
+    candidate, the words as before (``NO_SINUSOID``)."""
+    from types import SimpleNamespace
+
+    from allanite.model.refinement import missing
+
+    f0, tau = 1.0 / 86_400.0, np.logspace(0, 5, 40)
+    slow = {"statistic": 68.2, "threshold": 33.9, "alpha": 4e-4, "p_value": 1e-4, "cycles": 5.0}
+    ln = {"f0": f0, "amplitude": 0.042, "f0_interval": (0.99 * f0, 1.01 * f0), "slow": slow}
+    turned = {"param": f0, "statistic": 1.0, "threshold": 2.0, "rejected": "held-out error rose 3.1 → 3.2 %"}
+    ctx = SimpleNamespace(
+        curve=SimpleNamespace(tau=tau),
+        sol=SimpleNamespace(z=np.ones(tau.size)),
+        offered_lines=[f0],
+        considered={"sinusoid": [turned]},
+    )
+    u = missing._slow_line(ctx, ln)
+    assert u["what"].startswith("a slow periodic component may be present: a line of few cycles at 1.157e-05 Hz")
+    assert "p = 0.0001" in u["what"] and "held-out error rose 3.1 → 3.2 %" in u["not_kept"] and u["p_value"] == 1e-4
+    assert u["tau"][0] <= 0.5 / f0 <= u["tau"][1] and u["band_hz"] == ln["f0_interval"]
+    ctx.offered_lines, ctx.considered = None, {}
+    u = missing._slow_line(ctx, ln)
+    assert u["what"].startswith("a line of few cycles") and u["not_kept"] == missing.NO_SINUSOID
+
+
+@pytest.mark.slow  # a refine call (≈ 3.6 s CPU); the words: test_the_words_for_a_slow_line_the_sinusoid_candidate_...
 def test_a_slow_line_no_step_kept_is_said_with_its_p_value(monkeypatch):
     """A line of few cycles the test found but no step kept (here: the step's record of it hidden, as where a drift
     or the noise's slow terms took the line) is said in ``unexplained`` in words — "a slow periodic component may

@@ -13,7 +13,7 @@ noise, d = :data:`FLICKER_D`) — by restricted maximum likelihood; under that c
 those terms (2 degrees of freedom), and the record's statistic is the largest over a grid of quarter-cycle steps.
 Its null law is drawn, not assumed: the whitened block means are independent unit normals under the null, so
 :data:`DRAWS` draws of them through the same projections give the maximum's law with the scan's look-elsewhere in
-it; the line is found where the statistic passes that law's (1 − ``alpha``) quantile and its frequency is at least
+it; the line is found where the statistic passes that law's (1 − ``alpha``/2) quantile and its frequency is at least
 :data:`MIN_CYCLES`/T (a maximum below is a power rising toward 0 Hz, not a line: ``below_band``).
 
 The noise is read twice (:data:`READINGS`), each reading tested at ``alpha``/2 (Bonferroni: the test's false-alarm
@@ -174,14 +174,21 @@ def slow_line_test(
     means (see the module's docstring). None where the record holds fewer than :data:`BLOCKS` × 8 samples or the
     band is empty.
 
-    The null's draws are skipped (unless ``calibrate``) where the statistic does not reach −2·ln α, one
-    frequency's χ²₂ quantile, below the maximum's: then ``threshold`` is that bound and ``p_value`` None.
+    Each of the two readings (:data:`READINGS`) is tested at α/2. The null's draws are skipped (unless
+    ``calibrate``) where neither statistic reaches −2·ln(α/2), one frequency's χ²₂ quantile, below the maximum's:
+    then ``threshold`` is that bound and ``p_value`` None; the second reading's bootstrap is skipped where its ratio
+    does not pass the first reading's maximum law's (1 − α/2) quantile (its ``p_value`` None, the quantile its
+    ``threshold``), and where the first reading has found the line (its ``threshold`` None).
 
-    Returns ``accepted``, ``statistic`` (the scan's largest χ², 2 dof), ``threshold``, ``alpha``, ``p_value`` (of
-    the draws), ``f0`` (Hz, the scan's maximum refined) and ``f0_sd``, ``cycles``, ``amplitude`` and
+    Returns ``accepted``, ``statistic`` and ``threshold`` (of the reading that decided, ``reading``: the first's
+    unless only the second found the line), ``alpha``, ``p_value`` (Bonferroni, twice the smaller of the readings'
+    p-values computed; None where none was), ``readings`` (per reading its ``statistic``, ``threshold``,
+    ``p_value``, ``accepted``; the second's ``bootstrap``: its draws and the affine map's ``offset`` and
+    ``slope``), ``f0`` (Hz, the scan's maximum refined) and ``f0_sd``, ``cycles``, ``amplitude`` and
     ``amplitude_sd`` (generalised least squares beside a constant, a ramp and settling drifts, the block means'
-    averaging undone), ``phase`` (rad, of A·sin(2πf0·t + φ), t from the first sample), ``separable``, ``noise``
-    (the null fit's relative random-walk and flicker variances) and ``band_hz``."""
+    averaging undone, under the deciding reading's noise), ``phase`` (rad, of A·sin(2πf0·t + φ), t from the first
+    sample), ``separable``, ``noise`` (the deciding reading's relative random-walk and flicker variances) and
+    ``band_hz``."""
     if not (isinstance(alpha, (int, float)) and 0.0 < alpha < 1.0):
         raise ParameterError(f"alpha must be a probability in (0, 1), got {alpha!r}")
     if not (isinstance(fs, (int, float)) and math.isfinite(fs) and fs > 0.0):
