@@ -34,7 +34,8 @@ def test_a_line_of_five_cycles_is_found_with_its_frequency_and_amplitude():
     assert math.isclose(r["cycles"], r["f0"] * n / fs)
 
 
-def test_red_noise_alone_and_a_settling_drift_are_no_line():
+def test_red_noise_alone_and_a_settling_drift_are_no_line(monkeypatch):
+    monkeypatch.setattr(slowline, "BOOT_DRAWS", 20)  # calibrate runs the bootstrap: 20 records, not 120, in CI
     fs, n = 1.0, 50_000
     t = np.arange(n) / fs
     y = _red(n, fs, 4) + 0.5 * np.exp(-t / 4000.0)  # a drift 100× the noise's σ, no line
