@@ -152,6 +152,22 @@ def _cp(k: int, n: int) -> str:
     return f"{k}/{n} ({100 * lo:.1f}–{100 * hi:.1f} %)"
 
 
+#: What the tables do and do not say.
+NOTES = [
+    "## Notes",
+    "",
+    "- `before` is main's test (the first reading alone, at α) on the same seeds, run from this script with "
+    "`PYTHONPATH=/work/main/python`; the commit in its line is this worktree's, not the library's.",
+    '- "as refine runs it": `calibrate=False`, so a p-value is computed only where a statistic passes one '
+    "frequency's bound (and the bootstrap only where the ratio passes the maximum law's quantile): its p ≤ 0.05 "
+    'column undercounts. Uniformity of p is read from the "every p computed" table (`--calibrate`, the bootstrap '
+    "on every record; 7 s CPU a record, so fewer records).",
+    "- Other helpers' benches and tests shared the 2 cores (load 5–14): CPU seconds are the test's own process time "
+    "on one BLAS thread, comparable within a table, not idle timings.",
+    "",
+]
+
+
 def _null_table(rows: dict, title: str) -> list[str]:
     lines = [
         f"Red-noise nulls, the test {title}:",
@@ -206,7 +222,7 @@ def _md(res: dict) -> list[str]:
                 cpu = f"{np.median(r['cpu']):.2f} ({max(r['cpu']):.2f})"
                 lines.append(f"| {mix} | {_cp(r['accepted'], r['records'])} | {r.get('bootstrapped', '—')} | {cpu} |")
             lines += [f"| all | **{_cp(acc, tot)}** | | |", ""]
-    return lines
+    return lines + NOTES
 
 
 def main(argv=None) -> None:
