@@ -103,6 +103,16 @@ class FinalModel(RunState):
                 y = y - gain_component(y.size, self.fs, float(ln["f0"]), g, self.channels[g["channel"]])
         return y
 
+    def slow_line_kept(self, ln: dict) -> bool:
+        """Whether a step took the line of few cycles ``ln`` (a ``"sinusoid"`` step at its frequency whose evidence
+        holds its test in time)."""
+        steps = list(self.steps) + [st for st, *_rest in self.removed]
+        f0 = float(ln["f0"])
+        return any(
+            st.effect == "sinusoid" and "slow_line" in st.evidence and abs(st.params["f0"] - f0) <= 1e-9 * f0
+            for st in steps
+        )
+
     def unexplained(self, chans, y: np.ndarray | None, cp_steps=()) -> list:
         """What the final model still misses on ``y`` (:meth:`after_curve`), every domain's check at its own share
         of ``level`` (the noise level's between the change points ``cp_steps``)."""
@@ -118,8 +128,8 @@ class FinalModel(RunState):
             ctx.segments_heldout_pct = per_segment[-1]
         ctx.samples = self.y0
         ctx.considered, ctx.offered_lines = self.considered, self.offered_lines
-        if self.offered_lines is None and self.line_search is not None:  # no sinusoid candidate to take them
-            ctx.slow_lines = list(self.line_search.get("slow", []))
+        if self.line_search is not None:  # the lines of few cycles no step took (all, without the sinusoid candidate)
+            ctx.slow_lines = [ln for ln in self.line_search.get("slow", []) if not self.slow_line_kept(ln)]
         ctx.replaced = _replaced([rem for _st, rem, *_rest in self.removed], self.y0.size if self.y0 is not None else 0)
         ctx.families = [
             (st.params["fundamentals"], st.evidence["frequencies_hz"], st.evidence["amplitudes"], rem.component)

@@ -56,7 +56,8 @@ class MissingContext:
     considered: dict = field(default_factory=dict)
     offered_lines: list | None = None
     #: the line search's lines of few cycles (each found by its test in time, :mod:`allanite.model.slowline`) left
-    #: in the samples because the ``"sinusoid"`` candidate was left out: the ``"psd"`` check names them
+    #: in the samples because no step took them (the ``"sinusoid"`` candidate left out or turning them down): the
+    #: ``"psd"`` check names them
     slow_lines: list = field(default_factory=list)
 
 

@@ -173,22 +173,28 @@ NO_SINUSOID = "the sinusoid candidate was not among the candidates refine ran"
 
 def _slow_line(ctx: MissingContext, ln: dict) -> dict:
     """A line of few cycles the line search found by its test in time (at that test's own share of ``level``) and
-    no step could take (the ``"sinusoid"`` candidate left out): below the spectrum's reach, so the PSD's lines
-    never name it — its band, the τ of its signature (0.2/f0 … 1/f0, as a line's) and its test's numbers."""
+    no step took (the ``"sinusoid"`` candidate left out, or it turned the line down: a line of few cycles and a
+    drift or the noise's slow terms are nearly collinear): below the spectrum's reach, so the PSD's lines never name
+    it — its band, the τ of its signature (0.2/f0 … 1/f0, as a line's, period/2 within), its test's numbers and
+    p-value, and why no step kept it."""
     f0, slow = float(ln["f0"]), ln["slow"]
     lo, hi = max(0.2 / f0, float(ctx.curve.tau[0])), min(1.0 / f0, float(ctx.curve.tau[-1]))
-    what = (
+    why = NO_SINUSOID if ctx.offered_lines is None else why_not_kept(ctx, tuple(ln["f0_interval"]))
+    p = slow.get("p_value")
+    line = (
         f"a line of few cycles at {f0:.4g} Hz ({slow['cycles']:.1f} cycles in the record, amplitude "
         f"{float(ln['amplitude']):.3g}), found by its test in time (χ² {slow['statistic']:.3g} against "
-        f"{slow['threshold']:.3g}) — {NO_SINUSOID}"
+        f"{slow['threshold']:.3g}" + ("" if p is None else f", p = {p:.2g}") + f") — {why}"
     )
+    what = line if ctx.offered_lines is None else f"a slow periodic component may be present: {line}"
     return {
         "domain": "psd",
         "tau": (lo, hi),
         "band_hz": tuple(float(v) for v in ln["f0_interval"]),
         "chi2_dof": _chi2_dof(ctx, lo, hi) if hi >= lo else None,
         "what": what,
-        "not_kept": NO_SINUSOID,
+        "not_kept": why,
+        "p_value": p,
         "lines": 1,
         "amplitude": float(ln["amplitude"]),
         "statistic": float(slow["statistic"]),
