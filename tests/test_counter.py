@@ -145,3 +145,24 @@ def test_detects_a_counter_given_as_its_angle():
     c = detect_counter(rate, FS)
     assert c is not None and c.step == pytest.approx(q, rel=1e-9)
     assert c.ratio == pytest.approx(1 / 3, rel=0.02)
+
+
+def test_remembered_mixed_cosines_equal_fresh_ones():
+    """The root search's cosines (``_counter._mixed_cosines``) are computed once per phase mix and lag and sliced
+    for the shorter sums of larger ratios: R_e(m) then equals a fresh computation's to rounding, at every ratio of a
+    grid from the longest sum (ratio 0) up; the memory keeps at most 8 entries."""
+    from allanite.model import _counter
+
+    rng = np.random.default_rng(5)
+    phase = (rng.random(40), np.full(40, 1 / 40))
+    ratios = [0.0, 0.01, 0.1, 0.3, 1.0]
+    _counter._COSINES.clear()
+    kept = [_counter.angle_error_autocorrelation(np.arange(4.0), r, phase) for r in ratios]
+    assert 0 < len(_counter._COSINES) <= 8
+    for r, got in zip(ratios, kept):
+        _counter._COSINES.clear()
+        fresh = _counter.angle_error_autocorrelation(np.arange(4.0), r, phase)
+        np.testing.assert_allclose(got, fresh, rtol=1e-12, atol=1e-15)
+    for lag in range(1, 20):  # more lags than it keeps
+        _counter.angle_error_autocorrelation(np.array([float(lag)]), 0.05, phase)
+    assert len(_counter._COSINES) == 8

@@ -4,7 +4,10 @@ steps, not in ``unexplained``) — a band noise switched on and off, against one
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
+import pytest
 
 import allanite
 from allanite.model import tracing
@@ -92,3 +95,21 @@ def test_a_base_shorter_than_half_the_record_takes_nothing():
     assert seg.base.tolist() == [True, False] and abs(seg.base_share() - 0.4) < 1e-9
     regions = [{"domain": "allan", "tau": (0.025, 0.05), "what": "the Allan curve departs from the model"}]
     assert explained_regions(ctx, regions, 0.05) == (regions, [])
+
+
+@pytest.mark.parametrize("n, nper", [(200_000, 2**13), (9_000, 512), (300, 512)])
+def test_band_spectrum_is_scipys_linear_detrended_welch(n, nper):
+    """The ``"allan"`` check's band spectrum (``_curve_checks._welch_linear``: the segments' lines off in closed
+    form) is ``scipy.signal.welch(detrend="linear")``'s to rounding — on a random walk, whose segments' lines are
+    most of their power; a record shorter than a segment is SciPy's own."""
+    from scipy import signal
+
+    from allanite.model.refinement._curve_checks import _welch_linear
+
+    y = 5.0 + 1e-3 * np.cumsum(np.random.default_rng(n).standard_normal(n))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # SciPy's note that a segment longer than the record is cut to it
+        f, p = _welch_linear(y, 3.0, nper)
+        f_ref, p_ref = signal.welch(y - y.mean(), fs=3.0, nperseg=nper, detrend="linear")
+    np.testing.assert_array_equal(f, f_ref)
+    np.testing.assert_allclose(p, p_ref, rtol=1e-11)

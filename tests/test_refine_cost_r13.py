@@ -74,6 +74,10 @@ def test_remembered_unit_phases_and_phase_bins_equal_fresh_ones():
         # another fundamental, another grid: not the remembered ones
         np.testing.assert_array_equal(linefit._unit_phase(idx, 0.25), np.mod(idx * 0.25, 1.0))
         assert not np.array_equal(template._phase_bins(idx, nu, 256), want_k)
+    # np.modf's fractional part (ν > 0) and x − ⌊x⌋ (ν = 0) are np.mod's numbers to the bit, up to 10⁸·ν
+    far = np.concatenate([idx, np.arange(10**8 - 7, 10**8, dtype=np.int64)])
+    for f in (0.0313, 1.0 / 3.0, 7.77, 0.0):
+        assert linefit._unit_phase(far, f).tobytes() == np.mod(far * f, 1.0).tobytes()
 
 
 def test_part_indices_equal_the_blocks_ranges_joined():

@@ -39,6 +39,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import math
+import threading
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -115,10 +116,34 @@ def angle_error_autocorrelation(m, ratio: float, phase: Phase) -> np.ndarray:
         if n_max < 1:
             continue
         n = np.arange(1, n_max + 1, dtype=np.float64)
-        cosines = weights @ np.cos(2.0 * math.pi * mi * np.outer(phases, n))
+        cosines = _mixed_cosines(phases, weights, float(mi), n_max)
         terms = cosines * np.exp(-s2 * n * n * mi) / (2.0 * math.pi**2 * n * n)
         out.flat[i] = float(terms.sum())
     return out
+
+
+def _mixed_cosines(phases: np.ndarray, weights: np.ndarray, mi: float, n_max: int) -> np.ndarray:
+    """Σ_p w_p·cos(2π·m·β_p·n) for n = 1 … ``n_max``: independent of the ratio σ_θ/q, so the root search over the
+    ratio (:func:`_ratios`: 161 grid points and Brent's steps, each at lags 1 and 2, with up to 256 phases ×
+    :data:`N_TERMS` cosines) computes them once per lag; the last few kept (:data:`_COSINES`), longer ones sliced —
+    the same cosines, their weighted sum per n to rounding."""
+    key = (phases.tobytes(), weights.tobytes(), mi)
+    with _COSINES_LOCK:
+        got = _COSINES.get(key)
+    if got is None or got.size < n_max:
+        n = np.arange(1, n_max + 1, dtype=np.float64)
+        got = weights @ np.cos(2.0 * math.pi * mi * np.outer(phases, n))
+        got.flags.writeable = False
+        with _COSINES_LOCK:  # refine calls run in threads (Dask workers, the report's)
+            while len(_COSINES) >= 8:
+                _COSINES.pop(next(iter(_COSINES)))
+            _COSINES[key] = got
+    return got[:n_max]
+
+
+#: :func:`_mixed_cosines`' last few, by the phases, weights and lag (≤ 8 × N_TERMS numbers), and their lock.
+_COSINES: dict = {}
+_COSINES_LOCK = threading.Lock()
 
 
 def counter_factor(m, ratio: float, phase: Phase) -> np.ndarray:

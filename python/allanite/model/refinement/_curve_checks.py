@@ -13,6 +13,7 @@ from scipy import signal
 from scipy.linalg import solve_triangular
 
 from .. import tracing
+from .._chunked import welch_detrended
 from ._missing_context import MissingContext, chi2_dof
 from .calibrated import N_BOOT, curve_test
 from .candidates import CURVE_CANDIDATES, families
@@ -168,7 +169,7 @@ def _band(ctx: MissingContext, tau_lo: float, tau_hi: float) -> tuple[float, flo
     f_lo, f_hi = 0.5 / tau_hi, min(0.5 / tau_lo, 0.5 * fs)
     nper = int(min(2**14, 2 ** int(math.log2(max(y.size // 16, 256)))))
     if "welch" not in ctx.memo:  # one spectrum for every region
-        ctx.memo["welch"] = signal.welch(y - y.mean(), fs=fs, nperseg=nper, detrend="linear")
+        ctx.memo["welch"] = _welch_linear(y, fs, nper)
     f, p = ctx.memo["welch"]
     nseg = max(1, (y.size - nper) // (nper // 2) + 1)
     sel = (f >= f_lo / 2) & (f <= min(2 * f_hi, 0.5 * fs)) & (f > 0)
@@ -182,6 +183,20 @@ def _band(ctx: MissingContext, tau_lo: float, tau_hi: float) -> tuple[float, flo
         return (f_lo, f_hi)
     fsel = f[sel]
     return (float(fsel[up[0]]), float(fsel[up[-1]]))
+
+
+def _welch_linear(y: np.ndarray, fs: float, nper: int) -> tuple[np.ndarray, np.ndarray]:
+    """``scipy.signal.welch(y − mean, fs, nperseg=nper, detrend="linear")`` (Hann, one-sided density): the segments'
+    least-squares lines taken off in closed form (:func:`allanite.model._chunked.welch_detrended`, as the line
+    search's spectra) — the same numbers to rounding, without SciPy's least-squares solve over every segment (≈ 40 %
+    of this spectrum's time on 10⁶ samples)."""
+    if y.size < nper:
+        return signal.welch(y - y.mean(), fs=fs, nperseg=nper, detrend="linear")
+    win = signal.get_window("hann", nper)
+    p = welch_detrended(y, win, nper, float(y.mean()))
+    p *= 1.0 / (fs * float(win @ win)) / ((y.size - nper) // (nper // 2) + 1)
+    p[1:-1] *= 2.0  # one-sided (the Nyquist bin of an even nper once)
+    return np.arange(p.size) * fs / nper, p
 
 
 def fit_check(ctx: MissingContext, a: float) -> list[dict]:
