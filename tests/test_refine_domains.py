@@ -533,3 +533,20 @@ def test_unexplained_says_why_refine_did_not_keep_a_line_it_names():
     ctx.offered_lines = [2.9]
     assert "the sinusoid search found it but no step tested it" in why_not_kept(ctx, (2.8, 3.0))
     assert "did not find it" in why_not_kept(ctx, (3.1, 3.2))
+
+
+def test_why_not_kept_reads_a_line_left_to_a_channel():
+    # the removal in time records a line of few cycles that a channel explains as {"f0", "amplitude", "rejected",
+    # "explained_by", ...} — no "param", no statistic: blind2's thermal chamber (1 Hz, T and dT/dt) raised KeyError
+    # 'param' in unexplained once the slow-line test's second reading found the chamber's cycle
+    from types import SimpleNamespace
+
+    from allanite.model.refinement.missing import why_not_kept
+
+    left = {"f0": 1.2e-3, "amplitude": 0.4, "rejected": "a channel's", "explained_by": "temp"}
+    tested = {"param": 2.9, "statistic": 5.0, "threshold": 3.0, "rejected": "not taken: drift was taken at this step"}
+    ctx = SimpleNamespace(considered={"sinusoid": [left, tested]}, offered_lines=[2.9])
+    assert why_not_kept(ctx, (1e-3, 1.5e-3)) == (
+        "a line of few cycles there (0.0012 Hz) was left to channel 'temp', which explains it in time"
+    )
+    assert why_not_kept(ctx, (2.8, 3.0)).startswith("tested as a sinusoid (2.9 Hz) and not kept: not taken")

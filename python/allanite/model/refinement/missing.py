@@ -210,7 +210,13 @@ def why_not_kept(ctx: MissingContext, band: tuple, n_lines: int = 1) -> str:
     offers the strongest line not yet held that moves the Allan curve by MATERIAL_Z standard errors, and the
     steps end when one is turned down), or that its search did not find it, or that the candidate was left out."""
     it = "it" if n_lines == 1 else "them"
-    tried = [e for e in ctx.considered.get("sinusoid", []) if band[0] <= e["param"] <= band[1]]
+    considered = ctx.considered.get("sinusoid", [])
+    by_channel = [e for e in considered if "explained_by" in e and band[0] <= e["f0"] <= band[1]]
+    if by_channel:  # a line of few cycles the removal in time left to a channel (:mod:`._slow_lines`)
+        e = by_channel[0]
+        f0, ch = e["f0"], e["explained_by"]
+        return f"a line of few cycles there ({f0:.4g} Hz) was left to channel {ch!r}, which explains it in time"
+    tried = [e for e in considered if "param" in e and band[0] <= e["param"] <= band[1]]
     if tried:
         e = max(tried, key=lambda e: e["statistic"] / max(e["threshold"], 1e-300))
         why = e.get("rejected", "not taken")
