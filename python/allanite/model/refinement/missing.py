@@ -208,7 +208,9 @@ def why_not_kept(ctx: MissingContext, band: tuple, n_lines: int = 1) -> str:
     for turning down a line it tested there (``ctx.considered``: the held-out error, a parameter at its range's
     edge, another effect taken at that step), or that its search found the line but no step offered it (a step
     offers the strongest line not yet held that moves the Allan curve by MATERIAL_Z standard errors, and the
-    steps end when one is turned down), or that its search did not find it, or that the candidate was left out."""
+    steps end when one is turned down), or that its search did not find it, or that the candidate was left out —
+    and first, that a line of few cycles there was left to the channel that explains it in time
+    (:mod:`._slow_lines`)."""
     it = "it" if n_lines == 1 else "them"
     considered = ctx.considered.get("sinusoid", [])
     by_channel = [e for e in considered if "explained_by" in e and band[0] <= e["f0"] <= band[1]]
