@@ -5,7 +5,8 @@ a tangle. The layers, bottom up (a module may import only from its own layer or 
 
     0  errors, _core                       the exceptions; the Rust extension
     1  units, _validate, _progress,        shared checks and units; progress bars of long calls; reading a
-       _mapped, _blas                      memory-mapped record through its file; OpenBLAS on one thread
+       _mapped, _blas, _scoped             memory-mapped record through its file; OpenBLAS on one thread;
+                                           a context variable set within a block
     2  estimators.*, io.*                  the registry and its entries, EDF; the readers
     3  plot, results, _display             figures; result objects (EDF sits below them); notebook HTML
     4  analysis, simulation, datasets, _reference
@@ -36,6 +37,7 @@ LAYERS = {
     "_mapped": 1,
     "_dist": 1,
     "_blas": 1,
+    "_scoped": 1,
     "estimators": 2,
     "io": 2,
     "plot": 3,

@@ -36,16 +36,16 @@ not modelled — there the contrast usually disagrees and the plain Q term stays
 
 from __future__ import annotations
 
-import contextlib
 import contextvars
 import math
 import threading
-from collections.abc import Iterator
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq
 
+from .._scoped import scoped
 from ..errors import ParameterError
 from ..units import parse_unit
 
@@ -332,14 +332,9 @@ def detect_counter(y, fs: float) -> Counter | None:
 _ACTIVE: contextvars.ContextVar[Counter | None] = contextvars.ContextVar("allanite_counter", default=None)
 
 
-@contextlib.contextmanager
-def counter_quantisation(counter: Counter | None) -> Iterator[None]:
+def counter_quantisation(counter: Counter | None) -> AbstractContextManager[None]:
     """Within it every Q column refine builds is ``counter``'s exact one (nothing changes for None)."""
-    token = _ACTIVE.set(counter)
-    try:
-        yield
-    finally:
-        _ACTIVE.reset(token)
+    return scoped(_ACTIVE, counter)
 
 
 def active_counter() -> Counter | None:

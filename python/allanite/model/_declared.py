@@ -24,15 +24,15 @@ a :class:`~allanite.errors.ParameterError` naming it and what is allowed.
 
 from __future__ import annotations
 
-import contextlib
 import contextvars
 import hashlib
 import math
-from collections.abc import Iterator
+from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._scoped import scoped
 from ..errors import ParameterError
 
 __all__ = [
@@ -111,14 +111,9 @@ def declared_of(kind: str) -> DeclaredFilter | None:
     return got
 
 
-@contextlib.contextmanager
-def declaring(decl: DeclaredFilter | None) -> Iterator[None]:
+def declaring(decl: DeclaredFilter | None) -> AbstractContextManager[None]:
     """Within it :func:`active_declared` is ``decl`` (None: no filter declared, every kind searched)."""
-    tok = _ACTIVE.set(decl)
-    try:
-        yield
-    finally:
-        _ACTIVE.reset(tok)
+    return scoped(_ACTIVE, decl)
 
 
 def active_declared() -> DeclaredFilter | None:

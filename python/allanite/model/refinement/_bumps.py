@@ -6,11 +6,12 @@ proposal, parameters and evidence (:data:`.candidates.CURVE_CANDIDATES`)."""
 
 from __future__ import annotations
 
-import contextlib
 import contextvars
+from contextlib import AbstractContextManager
 
 import numpy as np
 
+from ..._scoped import scoped
 from .. import tracing
 from ..effects import RESONANCE_Q
 from ._proposal import Proposal, Round, column_amplitude, search_grid, with_stat
@@ -146,15 +147,10 @@ def res_evidence(pr: Proposal, rnd: Round) -> dict:
 _BANDPASS: contextvars.ContextVar[bool] = contextvars.ContextVar("allanite_bandpass", default=True)
 
 
-@contextlib.contextmanager
-def without_bandpass():
+def without_bandpass() -> AbstractContextManager[None]:
     """Within it a resonance keeps the Lorentzian shape (:func:`_shape_test` offers no band-pass): the chain the
     default shape alone would have taken, which :func:`bandpass_chain_kept` weighs against the one with it."""
-    token = _BANDPASS.set(False)
-    try:
-        yield
-    finally:
-        _BANDPASS.reset(token)
+    return scoped(_BANDPASS, False)
 
 
 def bandpass_named(effects: list) -> bool:

@@ -37,13 +37,14 @@ where the same sensor's other runs agree at acceptance); there the accepted valu
 
 from __future__ import annotations
 
-import contextlib
 import contextvars
 import math
+from contextlib import AbstractContextManager
 
 import numpy as np
 from scipy.optimize import nnls
 
+from ..._scoped import scoped
 from .. import tracing
 from .._sinc import SINC_ORDERS, sinc_order
 from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation, filter_cutoff, split_notch
@@ -129,15 +130,10 @@ def sinc_choice(found: list, tie: float) -> list:
 _SINCS: contextvars.ContextVar[bool] = contextvars.ContextVar("allanite_sincs", default=True)
 
 
-@contextlib.contextmanager
-def without_sincs():
+def without_sincs() -> AbstractContextManager[None]:
     """Within it the bandwidth step names no sinc^k kind (:func:`sinc_choice` drops them): the chain the kinds
     without them would have taken, which :func:`sinc_chain_kept` weighs against the one with them."""
-    token = _SINCS.set(False)
-    try:
-        yield
-    finally:
-        _SINCS.reset(token)
+    return scoped(_SINCS, False)
 
 
 def sinc_named(effects: list) -> bool:
