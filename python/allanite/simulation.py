@@ -59,13 +59,18 @@ def power_law_filter(w: np.ndarray, alpha: float) -> np.ndarray:
 _CACHED_MAX_N = 2**20
 
 
-def _response(n: int, alpha: float) -> np.ndarray:
-    """The transform (length-2n rfft) of the first n Kasdin & Walter filter coefficients."""
+def power_law_coefficients(n: int, alpha: float) -> np.ndarray:
+    """The first n Kasdin & Walter (1992) filter coefficients: h_0 = 1, h_k = h_{k−1}·(k − 1 + alpha/2)/k."""
     h = np.empty(n)
     h[0] = 1.0
     k = np.arange(1, n)
     h[1:] = np.cumprod((k - 1 + alpha / 2.0) / k)
-    out = np.fft.rfft(h, 2 * n)
+    return h
+
+
+def _response(n: int, alpha: float) -> np.ndarray:
+    """The transform (length-2n rfft) of the first n Kasdin & Walter filter coefficients."""
+    out = np.fft.rfft(power_law_coefficients(n, alpha), 2 * n)
     out.flags.writeable = False
     return out
 

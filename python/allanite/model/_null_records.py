@@ -25,7 +25,7 @@ import math
 import numpy as np
 import scipy.fft
 
-from ..simulation import simulate
+from ..simulation import power_law_coefficients, simulate
 from ._recent import Small, holding
 
 __all__ = ["block_rate_record", "sharing"]
@@ -71,13 +71,10 @@ def _unit_flicker(n: int, rng: np.random.Generator) -> np.ndarray:
 
 @functools.lru_cache(maxsize=4)
 def _flicker_response(n: int, size: int) -> np.ndarray:
-    """The length-``size`` transform of Kasdin & Walter's first n flicker (α = 1) coefficients h_0 = 1,
-    h_k = h_{k−1}·(k − 1/2)/k (read-only; the null records' few lengths are kept for the process: ≤ 4 × 8 MB)."""
-    h = np.empty(n)
-    h[0] = 1.0
-    k = np.arange(1, n)
-    h[1:] = np.cumprod((k - 0.5) / k)
-    out = scipy.fft.rfft(h, size)
+    """The length-``size`` transform of Kasdin & Walter's first n flicker (α = 1) coefficients
+    (:func:`allanite.simulation.power_law_coefficients`; read-only; the null records' few lengths are kept for the
+    process: ≤ 4 × 8 MB)."""
+    out = scipy.fft.rfft(power_law_coefficients(n, 1.0), size)
     out.flags.writeable = False
     return out
 
