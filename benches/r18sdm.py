@@ -272,19 +272,47 @@ def _merge(label: str, part: str, rows: list, load: float) -> dict:
 
 def _null_table(res: dict) -> list:
     lines = [
-        "| label | group | records | with an alarm | shaped_quantisation found | 95 % Clopper–Pearson (alarms) |",
-        "|---|---|---|---|---|---|",
+        "| label | group | records | anything found or unexplained | besides a bandwidth | shaped_quantisation "
+        "found | 95 % Clopper–Pearson (shaped) |",
+        "|---|---|---|---|---|---|---|",
     ]
     for label, parts in res.items():
         rows = parts.get("nulls", {}).get("rows", [])
-        groups = sorted({r["group"] for r in rows})
-        for g in groups + ["all"]:
+        for g in sorted({r["group"] for r in rows}) + ["all"]:
             sel = [r for r in rows if g == "all" or r["group"] == g]
             alarms = sum(bool(r["found"] or r["unexplained"]) for r in sel)
+            other = sum(bool([e for e in r["found"] if e != "bandwidth"] or r["unexplained"]) for r in sel)
             shaped = sum("shaped_quantisation" in r["found"] for r in sel)
-            lo, hi = _common.clopper_pearson(alarms, len(sel))
-            lines.append(f"| {label} | {g} | {len(sel)} | {alarms} | {shaped} | {100 * lo:.1f}–{100 * hi:.1f} % |")
+            lo, hi = _common.clopper_pearson(shaped, len(sel))
+            lines.append(
+                f"| {label} | {g} | {len(sel)} | {alarms} | {other} | {shaped} | {100 * lo:.1f}–{100 * hi:.1f} % |"
+            )
     return lines
+
+
+def _num(v, fmt=".3g") -> str:
+    return "—" if v is None else format(v, fmt)
+
+
+def _pair(v) -> str:
+    return "—" if not v or v[0] is None else f"{_num(v[0])} → {_num(v[1])}"
+
+
+def _row_line(label: str, row: dict) -> str:
+    sq = row.get("shaped")
+    steps = row.get("steps")
+    if sq is None and steps:
+        st = next((s for s in steps if s.get("effect") == "shaped_quantisation"), None)
+        sq = None if st is None else st["params"]
+    what = "—" if sq is None else f"order {sq['order']}, q {_num(sq['q'])}"
+    if row.get("q_error_pct") is not None:
+        what += f" ({row['q_error_pct']:+.2f} %, ±1 SD covers: {'yes' if row.get('covers') else 'no'})"
+    verdict = row.get("passed", row.get("suite_verdict"))
+    return (
+        f"| {label} | {row['name']} | {', '.join(row.get('found') or []) or '—'} | {what} | "
+        f"{'; '.join(row.get('unexplained') or []) or '—'} | {_pair(row.get('chi2_dof'))} | "
+        f"{_pair(row.get('heldout_rms_adev_pct'))} | {'✓' if verdict else '✗'} |"
+    )
 
 
 def write_md(res: dict, notes: list) -> None:
@@ -296,32 +324,67 @@ def write_md(res: dict, notes: list) -> None:
         "## Rows",
         "",
     ]
+    lines += [
+        "| label | row | found | shaped step | unexplained | χ²/dof | held-out RMS ADEV % | verdict |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for label, parts in res.items():
-        for row in parts.get("rows", {}).get("rows", []):
-            lines.append(
-                f"- **{label}** — {row['name']}: found {row.get('found')}; "
-                + ", ".join(
-                    f"{k} {row[k]}"
-                    for k in (
-                        "passed",
-                        "suite_verdict",
-                        "shaped",
-                        "q_error_pct",
-                        "covers",
-                        "steps",
-                        "unexplained",
-                        "chi2_dof",
-                        "heldout_rms_adev_pct",
-                    )
-                    if k in row
-                )
-            )
+        lines += [_row_line(label, row) for row in parts.get("rows", {}).get("rows", [])]
+    lines += [
+        "",
+        "Verdict: the blind12 rows as `refine_blind12.py` judges them (a clean case: nothing added); the other rows "
+        "named with the right order and q within 20 %, nothing else, nothing unexplained (a CIC or a rounded average: "
+        "a bandwidth, no shaped step; white angle noise: nothing).",
+    ]
     lines += ["", "## Nulls", ""] + _null_table(res) + ["", "## Notes", ""] + notes
     (OUT / "r18sdm.md").write_text("\n".join(lines) + "\n")
 
 
 #: What the tables show and why (kept true to the recorded runs).
-NOTES: list = []
+NOTES: list = [
+    "**Runs** (2026-11-28, 15:20–16:00 UTC): `before` is main at db0a328 (a copy of its `python/` with the compiled "
+    "core), `after` this branch at its first commit's code (decisions unchanged since: later edits are words and "
+    "tests). Load 15–28 on the 2 cores (four other helpers' runs beside): the CPU column of the JSON is this "
+    "process's, not a cost measurement. The null rows were run through a `/tmp` copy of `null_row` and its record "
+    "list (the same functions and seeds) and merged with `--from-jsonl`.",
+    "",
+    "**The blind12 row, judged as the suite judges** (`refine_blind12.run_case`, the judge unchanged): ✗ on all "
+    "three seeds before and after. Before: a boxcar of 2.78 / 2.83 taps as a stand-in on 1204 / 1404, nothing and "
+    "the curve said to depart on 1304. After: `shaped_quantisation`, order 2, q = 5.018·10⁻⁵, 5.000·10⁻⁵, "
+    "4.996·10⁻⁵ (truth 5·10⁻⁵ °/s·s: the modulator's error 0.05 °/s × τ0; +0.36, +0.01, −0.08 %), nothing "
+    "unexplained, χ²/dof 94 → 1.31, 96 → 1.16, 99 → 0.86. The judge fails it because the row is written as clean "
+    "(`allowed=()`): the shaped noise was outside the family when the suite was written; with the kind in the "
+    "family the row would be an injected `shaped_quantisation`. Judged so it would pass on 1204 and 1404 and fail "
+    "on 1304, whose in-sample RMS ADEV error rises 3.25 → 3.90 % and held-out error 2.79 → 3.24 % (both RMS over "
+    "every τ: beyond 1 s both models miss the parts' flicker alike and the refit's N decides the sum; at τ0 the "
+    "held-out error falls 3.1 → 0.03 %).",
+    "",
+    "**New sigma-delta rows**: order 3 at 400 Hz and order 2 at 10 Hz named alone (q +0.39 %, +1.14 %; the 10 Hz "
+    "row's ±1 SD interval [4.005, 4.086]·10⁻⁴ just misses 4·10⁻⁴); before, both read as a bandwidth plus a "
+    "resonance and a curve that still departs. Order 2 at 100 Hz × 2·10⁵ is named (q +0.12 %) but a resonance "
+    "follows (42 Hz, Q 8, GLS score 13.8 against 12.4 — the curve test's threshold by 11 %); on four more seeds "
+    "of the same row (1811–1814) the shaped step alone is taken (q −0.28, +0.21, +0.003, −0.10 %), so it reads as "
+    "that test's false alarm rather than a shape the kind lacks — not examined further. A second-order modulator "
+    "behind its sinc³ CIC decimator (8×) is a `bandwidth`, before and after: the decimation filter removes the "
+    "shaped noise above its cutoff, the output's spectrum falls toward f_s/2 and the guard never offers the kind.",
+    "",
+    "**Nulls** (119 records, none with shaped noise): every record's decision the same before and after but one — "
+    "17 → 18 records with anything but a bandwidth found or unexplained (95 % Clopper–Pearson 8.5–21.9 % → "
+    "9.2–22.8 %; the declared-filter records' 16 are main's sharp-filter stand-ins, unchanged), "
+    "`shaped_quantisation` on 1 of 119 (0.0–4.6 %): record 117, white noise through a 3-tap moving average beside "
+    "white angle noise with Q·√f_s/N = 0.83. That process is the kind's own: the 3-tap average's spectrum is "
+    "2N²(1 − 8s/3 + 16s²/9) (s = sin²(πf/f_s)), and beside white angle noise 8Q²f_s·s with Q²f_s ≥ (2/3)N² every "
+    "coefficient of 1, s, s² is non-negative — white rate noise, white angle noise and second-order shaped noise "
+    "with the same spectrum, so the same Gaussian process; no test on the samples' second moments can tell them "
+    "apart (the blind12 sigma-delta is the same identity read the other way: a 2.78-tap boxcar beside Q). Of the "
+    "three 3-tap records, the one outside that region (0.65) and one inside it (0.94) stayed a bandwidth. On the "
+    "other 110 (white angle noise dominating τ0 at 100/400/1000 Hz, delta-angle counters, the false-alarm "
+    "suite's Q + N + B, quantised, white, flicker and with_K records, the declared-filter records' default call) "
+    "`shaped_quantisation` was never found (0 of 110, 0.0–3.3 %).",
+    "",
+    "**ADIS16405** (`refine_measured.py --only` run 1 gyro_z, run 3 acc_x, run 5 gyro_y, run 6 acc_x, before and "
+    "after): every field of the four rows the same (487, 712, 63 and 653 fields; the seconds and load aside).",
+]
 
 
 def main(argv=None) -> None:

@@ -129,3 +129,19 @@ def test_default_refine_names_a_third_order_sigma_delta_at_1khz():
     assert st.params["order"] == 3 and st.params["q"] == pytest.approx(0.02 / FS, rel=0.05)
     assert st.intervals["q"][0] < 0.02 / FS < st.intervals["q"][1]
     assert r.fit.coefficients["Q"].value == pytest.approx(math.sqrt(6.0) * st.params["q"], rel=1e-6)
+
+
+def test_shaped_goes_before_a_bandwidth_only_within_the_tie():
+    from types import SimpleNamespace
+
+    from allanite.model.refinement._choose import _shaped_before_filter
+
+    def prop(effect, chi2):
+        return SimpleNamespace(effect=effect, sol=SimpleNamespace(chi2=chi2))
+
+    bw, sq, line = prop("bandwidth", 154.7), prop("shaped_quantisation", 155.6), prop("sinusoid", 100.0)
+    assert _shaped_before_filter([line, bw, sq], 17.0) == [line, sq, bw]  # a near-tie: the kind with a number fewer
+    assert _shaped_before_filter([line, bw, sq], 0.5) == [line, bw, sq]  # the bandwidth fits better beyond the tie
+    far = prop("shaped_quantisation", 200.0)
+    assert _shaped_before_filter([bw, far], 17.0) == [bw, far]
+    assert _shaped_before_filter([sq, bw], 17.0) == [sq, bw] and _shaped_before_filter([bw], 17.0) == [bw]

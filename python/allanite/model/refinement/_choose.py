@@ -1,8 +1,9 @@
 """Which curve proposal a step accepts (:func:`choose`): its test passes, its parameter is not at the edge of its
 range, its amplitude is positive, χ²/dof falls, and the held-out error falls — the sensor's roll-off, a
-sigma-delta's shaped quantisation and spectral lines first, then by statistic over threshold; a resonance waits for a bandwidth that passes; an unmistakable
-bandwidth may enter with a Gauss–Markov term or a resonance when alone it would raise the held-out error
-(:data:`PAIR_FACTOR`). Re-exported by :mod:`.candidates`."""
+sigma-delta's shaped quantisation and spectral lines first, then by statistic over threshold; a resonance waits
+for a bandwidth that passes; an unmistakable bandwidth may enter with a Gauss–Markov term or a resonance when alone
+it would raise the held-out error (:data:`PAIR_FACTOR`); shaped quantisation's held-out error is judged where its
+column differs from the Q line it replaces. Re-exported by :mod:`.candidates`."""
 
 from __future__ import annotations
 
