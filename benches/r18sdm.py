@@ -382,6 +382,12 @@ NOTES: list = [
     "suite's Q + N + B, quantised, white, flicker and with_K records, the declared-filter records' default call) "
     "`shaped_quantisation` was never found (0 of 110, 0.0–3.3 %).",
     "",
+    "**The spectrum's guard on rounded moving averages** (1 kHz × 2·10⁵, `/tmp` driver, this branch): a 3-tap "
+    "average reads a shaped share of 1.0 on two seeds (its spectrum rises from its zero at f_s/3 to f_s/2, and the "
+    "non-negative mix gives that rise to s²): the guard passes, the Allan-curve test scores the shaped column 0 "
+    "(one-sided: the average lowers τ0, the shaping would raise it) and a boxcar of 3.01 / 2.98 taps is named; a "
+    "5-tap average reads 0.0 and is a boxcar of 4.92. The guard is a guard, not a test; the docs say so.",
+    "",
     "**ADIS16405** (`refine_measured.py --only` run 1 gyro_z, run 3 acc_x, run 5 gyro_y, run 6 acc_x, before and "
     "after): every field of the four rows the same (487, 712, 63 and 653 fields; the seconds and load aside).",
 ]

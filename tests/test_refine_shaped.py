@@ -73,7 +73,7 @@ def test_order_must_be_whole():
 
 
 def test_spectrum_guard_takes_shaping_and_nothing_the_five_terms_or_a_low_pass_make():
-    n = 200_000
+    n = 50_000
     sd2 = _sigma_delta(n, FS, 2, 0.05, 5e-3, 1)
     sd3 = _sigma_delta(n, FS, 3, 0.02, 5e-3, 2)
     assert spectrum_shaped_share(sd2, FS)["share"] > 0.4 and spectrum_rises(sd3, FS)

@@ -102,7 +102,8 @@ class Effect:
         along time), "channels" (other channels of the log).
     replaces : str, optional
         The term whose noise the effect's column carries ("N" for a bandwidth: the filtered white noise *is* the
-        white rate noise, reported as N); the term's own column is zeroed — beside a Butterworth it stays, as
+        white rate noise, reported as N; "Q" for shaped quantisation, reported as the Q line it shows from m = k
+        on); the term's own column is zeroed — beside a Butterworth it stays, as
         white noise added after the filter (its ``floor``; :func:`allanite.model.refinement.curvefit.has_floor`),
         and beside another kind where the samples' spectrum shows a floor (:func:`.refinement._rolloff.floor_choice`).
     """
@@ -255,10 +256,12 @@ EFFECTS: dict[str, Effect] = {
             "variance exact for sampled data (allanite.model._shaped) in place of the Q column — white angle "
             "noise of Q² = C(2k − 2, k − 1)·q² from m = k on, above that line at the first k − 1 averaging factors "
             "(k = 2: 5/3 of it at τ0), its PSD rising toward f_s/2 as sin^{2k}(πf/f_s). Proposed with samples only, "
-            "where the periodogram's upper band rises above its middle band faster than white angle noise's sin² "
-            "allows (a low-pass falls there), the order with the lower χ²; tested by the Allan-curve test with the "
-            "other curve effects and, like the sensor's roll-off, taken before the rest where it fits the curve "
-            "better than the bandwidth. A modulator followed by a decimation filter (a CIC's sinc^k) reads as "
+            "where the Welch PSD rises toward f_s/2 faster than white angle noise's sin² allows (the sin⁴ and sin⁶ "
+            "parts of its best non-negative mix carry ≥ 25 % of 0.42–0.49·f_s; a low-pass falling to f_s/2 gives "
+            "none), the order with the lower χ²; tested by the Allan-curve test with the other curve effects and, "
+            "like the sensor's roll-off, taken before the rest, and before a bandwidth that fits the curve better "
+            "by less than one effective point per octave; its held-out error judged where its column differs from "
+            "the Q line. A modulator followed by a decimation filter (a CIC's sinc^k) reads as "
             "that filter's bandwidth: the filter removes the shaped noise above its cutoff",
             signature=lambda tau, k, fs: shaped_avar(tau, k, fs),
             alpha=lambda tau, k: np.full(np.asarray(tau).size, 2, dtype=int),

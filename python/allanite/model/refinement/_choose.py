@@ -56,9 +56,9 @@ def _shaped_before_filter(first: list, tie: float) -> list:
     and so is white noise through a boxcar of 2 to 3 samples beside white angle noise: both fit the curve, the
     boxcar with a number more (its span) and a white angle noise tuned to make the spectrum rise (the blind12
     sigma-delta: χ² 154.7 against 155.6, tie 17). The shaped kind is proposed only where the samples' spectrum
-    rises toward f_s/2 faster than white angle noise allows (:func:`._shaped.spectrum_rises`), which a low-pass on
-    white noise never does, and beside white angle noise only where the two are one process (white noise through
-    3 taps beside a Q that outgrows its fall); there the curve's near-tie goes to the kind with a number fewer."""
+    rises toward f_s/2 faster than white angle noise allows (:func:`._shaped.spectrum_rises`), which a low-pass
+    falling to f_s/2 never does; where the two are one process (white noise through 3 taps beside a Q that
+    outgrows its fall) the curve's near-tie goes to the kind with a number fewer."""
     sq = next((pr for pr in first if pr.effect == "shaped_quantisation"), None)
     bw = next((pr for pr in first if pr.effect == "bandwidth"), None)
     if sq is None or bw is None or first.index(sq) < first.index(bw) or sq.sol.chi2 > bw.sol.chi2 + tie:

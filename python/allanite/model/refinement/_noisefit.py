@@ -127,7 +127,7 @@ def _coefficients(sol, terms, effects, unit, zq, inflate) -> tuple[dict, np.ndar
         i = k + j
         name = effect_column_name(key, j, effects)
         # a column's amplitude is in the rate unit (σ, A), but a bandwidth's is the white noise N before the
-        # filter: N's unit (rate unit·√s), not the rate unit
+        # filter: N's unit (rate unit·√s), not the rate unit; shaped quantisation's q is in Q's unit
         rep = EFFECTS[base_name(key)].replaces
         coeffs[name] = fitting.Coefficient(
             name=name,

@@ -10,11 +10,15 @@ of every curve effect (its columns, less the Q they replace, among the bootstrap
 effect over all of them is in the threshold, so it spends no share of ``level`` of its own).
 
 It is proposed only with samples, and only where their spectrum rises toward f_s/2 faster than white angle noise
-does (:func:`spectrum_rises`): the Welch PSD over sin²(πf/f_s) — flat for white angle noise, falling for white
-rate noise, flicker, a random walk and any low-pass — is higher in 0.42–0.49·f_s than in 0.20–0.30·f_s by
-:data:`RISE_FACTOR`. A low-pass's roll-off cannot pass that, so a filtered sensor is never offered the shaped kind;
-a sigma-delta's shaped noise (sin^{2k}: 2.1× for k = 2 where it dominates) is. Where it fits the curve better than
-the bandwidth it is taken first, as the roll-off is (:func:`._choose.choose`).
+does (:func:`spectrum_rises`): the Welch PSD over 0.15–0.49·f_s as the best non-negative mix of 1, s, s², s³
+(s = sin²(πf/f_s): white rate noise, white angle noise, shaped noise of order 2 and 3) gives the s² and s³ parts
+at least :data:`SHAPED_SHARE` of the power in 0.42–0.49·f_s. The five terms take none (flicker and a random walk
+fall, white noise is flat, white angle noise is s), nor does a low-pass whose spectrum falls to f_s/2 (a
+Butterworth, a single pole, a CIC: a modulator behind its decimation filter reads as the filter's bandwidth). A
+guard, not a test: a moving average's sidelobe rising from its zero (3 taps: from f_s/3) passes it — a rounded
+3-tap average reads share 1.0 — and there the Allan-curve test decides (one-sided: the shaping raises τ0 above the
+Q line, an average lowers it; its score 0 on those records). Where it fits the curve better than the bandwidth, or
+within one effective point per octave of it, it is taken first (:func:`._choose.choose`).
 """
 
 from __future__ import annotations
@@ -43,7 +47,8 @@ KEY = "shaped_quantisation"
 #: The share of the Welch PSD in :data:`TOP_BAND` that the shaped parts (∝ sin⁴ and sin⁶ of πf/f_s) must carry in
 #: the spectrum's best non-negative mix of white rate noise (flat), white angle noise (∝ sin²) and those parts over
 #: :data:`FIT_BAND` (:func:`spectrum_shaped_share`) for the shaped kind to be proposed: 0 for every noise the five
-#: terms hold and for a low-pass (a falling spectrum takes no rising part), up to 1 where shaped noise is all there is.
+#: terms hold and a low-pass whose spectrum falls to f_s/2, up to 1 where shaped noise is all there is (and on a
+#: moving average's rising sidelobe: the curve test decides there).
 SHAPED_SHARE = 0.25
 #: The band the spectrum's mix is fitted over and the band its shaped share is read in, as fractions of f_s.
 FIT_BAND, TOP_BAND = (0.15, 0.49), (0.42, 0.49)
