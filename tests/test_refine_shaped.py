@@ -145,3 +145,17 @@ def test_shaped_goes_before_a_bandwidth_only_within_the_tie():
     far = prop("shaped_quantisation", 200.0)
     assert _shaped_before_filter([bw, far], 17.0) == [bw, far]
     assert _shaped_before_filter([sq, bw], 17.0) == [sq, bw] and _shaped_before_filter([bw], 17.0) == [bw]
+
+
+@pytest.mark.slow  # test_spectrum_guard_... covers the guard; here the curve test on a record the guard lets through
+def test_a_rounded_three_tap_average_stays_a_bandwidth():
+    # its spectrum rises from its zero at f_s/3 to f_s/2: the guard passes, the one-sided curve test does not
+    rng = np.random.default_rng(41)
+    n = 200_000
+    y = np.convolve(allanite.simulate(n + 2, FS, N=2e-3, K=1e-5, seed=rng), np.ones(3) / 3, "valid")
+    lsb = 0.5 * 2e-3 * math.sqrt(FS / 3)
+    y = np.round(y / lsb) * lsb
+    assert spectrum_rises(y, FS)
+    r = allanite.refine(y, FS, unit="deg/s", progress=False)
+    assert r.found == ["bandwidth"] and r.steps[0].params["taps"] == pytest.approx(3.0, abs=0.1)
+    assert all(c["statistic"] < c["threshold"] for c in r.considered["shaped_quantisation"])
