@@ -382,6 +382,11 @@ NOTES: list = [
     "suite's Q + N + B, quantised, white, flicker and with_K records, the declared-filter records' default call) "
     "`shaped_quantisation` was never found (0 of 110, 0.0–3.3 %).",
     "",
+    "**With channels** (`refine_false_alarms.record`'s slow_1hz × 5, channels_100hz × 4 and issue16 × 4, their "
+    "seeds, the default call with their channels; `/tmp` driver, both libraries): nothing found or unexplained on "
+    "any of the 13, before and after (0 of 13, 0.0–24.7 %). Over all 132 null records `shaped_quantisation` was "
+    "found once (0.02–4.1 %), on none of the 123 outside the moving-average-beside-Q group (0.0–3.0 %).",
+    "",
     "**The spectrum's guard on rounded moving averages** (1 kHz × 2·10⁵, `/tmp` driver, this branch): a 3-tap "
     "average reads a shaped share of 1.0 on two seeds (its spectrum rises from its zero at f_s/3 to f_s/2, and the "
     "non-negative mix gives that rise to s²): the guard passes, the Allan-curve test scores the shaped column 0 "
