@@ -144,6 +144,7 @@ MODEL_RANKS = {
     "model._welch_spread": -1,  # Welch segments' spread per band: the line search's dof (numpy only)
     "model._robust_scale": -1,  # the differences' robust scale, on a lattice and local (numpy, scipy only)
     "model._rfft": -0.5,  # the channel regression's transforms, remembered by content
+    "model._shaped": -0.5,  # noise-shaped (sigma-delta) quantisation's exact Allan variance (numpy only)
     "model._sinc": -0.5,  # the sinc^k (CIC) roll-off's autocorrelation and cutoff (numpy only)
     "model._declared": -0.5,  # a user-declared filter (FIR taps, IIR b, a) as an exact bandwidth kind (numpy, scipy)
     "model._signatures": -0.25,  # the effects' Allan-variance signatures: filter kinds, sinusoid, resonance, drift
@@ -212,6 +213,7 @@ MODEL_RANKS = {
     "model.refinement._bumps": 5.7,  # the curve candidates per domain (Gauss–Markov and resonance; bandwidth;
     "model.refinement._bandwidth": 5.7,  # sinusoid) and which proposal a step accepts: none imports another
     "model.refinement._sinusoid": 5.7,
+    "model.refinement._shaped": 5.7,  # shaped quantisation (sigma-delta) beside them
     "model.refinement._choose": 5.7,
     "model.refinement.candidates": 6,
     "model.refinement._tracking": 5,  # a family's or a lone line's phase tracked, the held-out test in time

@@ -12,7 +12,7 @@ import numpy as np
 from scipy.stats import chi2 as chi2_dist
 
 from .. import fitting
-from ..effects import EFFECTS
+from ..effects import EFFECTS, shaped_q_factor
 from ._columns import base_name, design, held_theta
 
 __all__ = ["upper_theta", "upper_models", "theta_terms", "effect_column_name", "noise_fit"]
@@ -94,10 +94,18 @@ def _terms_of(coef, terms, effects):
     """:func:`theta_terms` of the solution's coefficient vector ``coef`` (terms, then one per effect)."""
     k = len(terms)
     theta = np.array(coef[:k], dtype=np.float64)
-    for j, (key, _p) in enumerate(effects):
-        if EFFECTS[base_name(key)].replaces == "N" and "N" in terms:
-            theta[list(terms).index("N")] = coef[k + j]
+    for j, (key, p) in enumerate(effects):
+        rep = EFFECTS[base_name(key)].replaces
+        if rep in ("N", "Q") and rep in terms:
+            theta[list(terms).index(rep)] = coef[k + j] * _replaced_scale(key, p)
     return theta
+
+
+def _replaced_scale(key, p) -> float:
+    """The replaced term's squared coefficient per unit of the effect's: 1 for a bandwidth (its N is the white
+    noise before the filter), C(2k − 2, k − 1) for shaped quantisation of order k (the white angle noise its
+    curve shows from m = k on: :func:`allanite.model.effects.shaped_q_factor`)."""
+    return shaped_q_factor(p) if base_name(key) == "shaped_quantisation" else 1.0
 
 
 def _coefficients(sol, terms, effects, unit, zq, inflate) -> tuple[dict, np.ndarray, np.ndarray]:
@@ -105,25 +113,27 @@ def _coefficients(sol, terms, effects, unit, zq, inflate) -> tuple[dict, np.ndar
     k = len(terms)
     theta = sol.theta[:k].copy()
     cov = sol.cov[:k, :k].copy()
-    # a bandwidth carries the white rate noise N (before the filter): report it as N
-    for j, (key, _p) in enumerate(effects):
-        if EFFECTS[base_name(key)].replaces == "N" and "N" in terms:
-            i_n = list(terms).index("N")
-            theta[i_n] = sol.theta[k + j]
+    # a bandwidth carries the white rate noise N (before the filter): report it as N; shaped quantisation the white
+    # angle noise its curve shows from m = k on: report that as Q
+    for j, (key, p) in enumerate(effects):
+        rep = EFFECTS[base_name(key)].replaces
+        if rep in ("N", "Q") and rep in terms:
+            i_n, scale = list(terms).index(rep), _replaced_scale(key, p)
+            theta[i_n] = sol.theta[k + j] * scale
             cov[i_n, :] = cov[:, i_n] = np.nan
-            cov[i_n, i_n] = sol.cov[k + j, k + j]
+            cov[i_n, i_n] = sol.cov[k + j, k + j] * scale**2
     coeffs = fitting.coefficients(terms, theta, cov, zq, inflate, unit)
     for j, (key, _param) in enumerate(effects):
         i = k + j
         name = effect_column_name(key, j, effects)
         # a column's amplitude is in the rate unit (σ, A), but a bandwidth's is the white noise N before the
-        # filter: N's unit (rate unit·√s), not the rate unit
-        n_unit = EFFECTS[base_name(key)].replaces == "N" and "N" in coeffs
+        # filter: N's unit (rate unit·√s), not the rate unit; shaped quantisation's q is in Q's unit
+        rep = EFFECTS[base_name(key)].replaces
         coeffs[name] = fitting.Coefficient(
             name=name,
             value=float(math.sqrt(max(sol.theta[i], 0.0))),
             ci=fitting.interval(sol.theta[i], sol.cov[i, i], zq, inflate),
-            unit=coeffs["N"].unit if n_unit else unit,
+            unit=coeffs[rep].unit if rep in ("N", "Q") and rep in coeffs else unit,
         )
     return coeffs, theta, cov
 

@@ -7,6 +7,8 @@ parameters and intervals a step reports, and what a second domain says about it.
   a CIC's sinc^k, pole + boxcar, Butterworth), replacing the N column; the kind with the lowest χ² (ties: the one
   needing fewer other terms; a Butterworth only where the samples' spectrum shows its roll-off);
 - ``"resonance"`` — narrowband noise near the shortest τ, at quality factors :data:`RESONANCE_Q`;
+- ``"shaped_quantisation"`` — a sigma-delta's quantisation noise shaped by (1 − z⁻¹)^k, k = 2 or 3, replacing the
+  Q column; proposed where the samples' spectrum rises toward f_s/2 faster than white angle noise (:mod:`._shaped`);
 - ``"sinusoid"`` — with samples, the strongest spectral line of the Welch PSD not yet in the model (its own χ²
   test), its amplitude held at the line's power in the spectrum in every fit of the curve (:func:`line_key`);
   for curve-only input by its nulls at τ = k/f0, its amplitude fitted on the curve.
@@ -18,7 +20,8 @@ bandwidth may enter with a Gauss–Markov term or a resonance when alone it woul
 
 Here the registry itself (:data:`CURVE_CANDIDATES`), the bootstrap's columns (:func:`families`), the searches run
 together (:func:`prefetch`) and the final model's parameters (:func:`final_params`); each entry's functions in its
-domain's module (:mod:`._bumps`: Gauss–Markov and resonance; :mod:`._bandwidth`; :mod:`._sinusoid`), what they are
+domain's module (:mod:`._bumps`: Gauss–Markov and resonance; :mod:`._bandwidth`; :mod:`._sinusoid`;
+:mod:`._shaped`), what they are
 given and give in :mod:`._proposal`, :func:`choose` in :mod:`._choose` — their names re-exported here.
 """
 
@@ -43,6 +46,7 @@ from ._bumps import (
 from ._choose import PAIR_FACTOR, choose
 from ._line_gain import gain_params
 from ._proposal import CurveCandidate, Proposal, Round, amplitude_and_profile, column_amplitude
+from ._shaped import sq_evidence, sq_family, sq_params, sq_propose
 from ._sinusoid import line_key, sin_evidence, sin_family, sin_params, sin_propose, sin_searches
 from .curvefit import Curve, base_name, searches
 
@@ -101,6 +105,14 @@ CURVE_CANDIDATES: dict[str, CurveCandidate] = {
             evidence=sin_evidence,
             amplitude=lambda pr: "amplitude" if pr.line is None else None,
             searches=sin_searches,
+        ),
+        CurveCandidate(
+            "shaped_quantisation",
+            sq_family,
+            sq_propose,
+            sq_params,
+            evidence=sq_evidence,
+            amplitude=lambda pr: "q",
         ),
     )
 }

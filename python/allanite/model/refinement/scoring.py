@@ -258,18 +258,29 @@ class Split:
             out.append({"zf": zf, "cf": cf, "zh": zh, "ch": ch, "extra": p["extra"] + change})
         return out
 
-    def predict(self, parts: list, terms, effects) -> float:
+    def predict(self, parts: list, terms, effects, scored=None) -> float:
         """RMS ADEV error (%) of the model fitted on each corrected held-in part (plus what the removals changed
         in the curve) predicting the other part's raw curve, both ways: the held-out error on the original
-        record, removals refitted on the held-in samples."""
+        record, removals refitted on the held-in samples; over the τ ``scored`` (a mask; the split's own by
+        default)."""
+        scored = self.scored if scored is None else scored
         errs = []
         for h, p in zip((1, 0), parts):
             ch = self.curves[h]
             sol = solve(p["cf"], terms, effects)
             a_h, _ = design(ch, terms, effects)
             pred = np.maximum(a_h @ sol.theta + p["extra"], 1e-300)
-            errs.append(rms_adev_pct(ch.avar[self.scored], pred[self.scored]))
+            errs.append(rms_adev_pct(ch.avar[scored], pred[scored]))
         return float(np.mean(errs))
+
+    def error_below(self, terms, effects, tau_max: float) -> float:
+        """:meth:`error` (nothing removed) over the split's τ ≤ ``tau_max`` alone, NaN where there are none: the
+        held-out error where an effect's column differs from the term it replaces (shaped quantisation's first
+        averaging factors, :func:`._choose.choose`)."""
+        scored = self.curves[0].tau <= tau_max * (1 + 1e-9)
+        if not scored.any():
+            return float("nan")
+        return self.predict(self.raw_parts(), terms, effects, scored)
 
     def error(self, terms, effects, remove=None, on_raw=False) -> float:
         """RMS ADEV error (%) of one part's model predicting the other's *raw* curve, both ways; ``remove(samples,
