@@ -252,6 +252,9 @@ CASES = [
     Blind12(
         "sigma-delta MEMS at 1 kHz × 10⁶, its quantisation noise shaped (1 − z⁻¹)² to rise toward f_s/2 (clean)",
         _sigma_delta,
+        # its own noise named is no stand-in (as a clean filtered row allows its bandwidth); the kind did not
+        # exist when the suite was written (r18sdm added it), so this allowance came after the first run
+        allowed=("shaped_quantisation",),
         seed=1204,
     ),
     Blind12(
