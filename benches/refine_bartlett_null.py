@@ -16,6 +16,7 @@ Usage::
 
     python benches/refine_bartlett_null.py [--records 40] [--only 3,7] [--tag before]
     # -> benches/results/refine_bartlett_null.md/.json (with --tag: refine_bartlett_null_<tag>.json only)
+    python benches/refine_bartlett_null.py --table   # the .md again, with a run tagged "before" beside it
 """
 
 from __future__ import annotations
@@ -95,7 +96,19 @@ def main(argv=None) -> None:
     ap.add_argument("--records", type=int, default=40)
     ap.add_argument("--only", default="", help="comma-separated record numbers")
     ap.add_argument("--tag", default="", help="write results/refine_bartlett_null_<tag>.json only")
+    ap.add_argument(
+        "--table",
+        action="store_true",
+        help="only write the .md from results/refine_bartlett_null.json (and _before.json beside it, if there)",
+    )
     args = ap.parse_args(argv)
+    if args.table:
+        before = OUT / "refine_bartlett_null_before.json"
+        write_md(
+            json.loads((OUT / "refine_bartlett_null.json").read_text()),
+            json.loads(before.read_text()) if before.exists() else None,
+        )
+        return
     which = [int(s) for s in args.only.split(",") if s] or list(range(args.records))
     rows = []
     t0 = time.time()
@@ -123,7 +136,13 @@ def write_md(res: dict, before: dict | None = None) -> None:
         "# The default call on clean quantised moving-average / Bartlett sensors",
         "",
         f"`python benches/refine_bartlett_null.py --records {len(res['records'])}` (other processes "
-        f"{100 * res['load_fraction']:.0f} % of the CPUs; {res['seconds']:.0f} s). An alarm: any effect other than "
+        f"{100 * res['load_fraction']:.0f} % of the CPUs; {res['seconds']:.0f} s)"
+        + (
+            f"; before: the same records at main's library (other processes {100 * before['load_fraction']:.0f} %)"
+            if before
+            else ""
+        )
+        + ". An alarm: any effect other than "
         "the bandwidth, or `unexplained` non-empty; kind right: the filter's own or the sinc^k of the same process; "
         "cutoff within 20 %. 95 % Clopper–Pearson bounds.",
         "",

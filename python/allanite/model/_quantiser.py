@@ -157,7 +157,8 @@ def detect_output_quantiser(y, fs: float) -> OutputQuantiser | None:
     """The record read as a rate quantised at the output, or None: every sample on a lattice of step Δ
     (:func:`allanite.model._counter.sample_lattice`), the error's autocorrelation from the samples' structure
     function (:func:`_rho`, up to the lag where it falls below :data:`RHO_TAIL` or :data:`MAX_LAG`), and the
-    floor's factor differing from 1 by at least :data:`MIN_EFFECT` at some τ."""
+    floor's factor differing from 1 by at least :data:`MIN_EFFECT` at some τ. Out at once where the samples move
+    by more than a step from one to the next (D_y(1) > Δ²; a filter's D_x rises with the lag)."""
     y = np.asarray(y, dtype=np.float64)
     if y.ndim != 1 or y.size < MIN_SAMPLES or not np.all(np.isfinite(y[:MIN_SAMPLES])):
         return None
@@ -167,6 +168,8 @@ def detect_output_quantiser(y, fs: float) -> OutputQuantiser | None:
     if got is None:
         return None
     step = got[0]
+    if 0.5 * float(np.mean(np.diff(y) ** 2)) / step**2 > 1.0:  # D_y(1) ≥ Δ²: R_e(1) < e⁻³⁰ (the ADIS16405's)
+        return None
     lags = int(min(MAX_LAG, y.size // 8))
     rho = _rho(_structure(y, lags) / step**2)
     small = np.flatnonzero(np.abs(rho[1:]) < RHO_TAIL)
