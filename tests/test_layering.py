@@ -149,6 +149,7 @@ MODEL_RANKS = {
     "model._declared": -0.5,  # a user-declared filter (FIR taps, IIR b, a) as an exact bandwidth kind (numpy, scipy)
     "model._signatures": -0.25,  # the effects' Allan-variance signatures: filter kinds, sinusoid, resonance, drift
     "model._counter": -0.5,  # a delta-angle counter's exact Q column and the record read as one (numpy, scipy only)
+    "model._quantiser": -0.4,  # a rate quantised at the output: its error's exact floor column (on _counter's lattice)
     "model._batched": 0,
     "model._chi2_draws": 0,
     "model._covariance": 0,

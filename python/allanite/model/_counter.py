@@ -62,6 +62,7 @@ __all__ = [
     "Phase",
     "MIN_EFFECT",
     "CONTRAST_AGREE",
+    "sample_lattice",
 ]
 
 #: The counter's column is used only where it differs from 3Q²/τ² by at least this share at some τ (else the
@@ -245,6 +246,12 @@ def _lattice(y: np.ndarray) -> tuple[float, np.ndarray] | None:
     if not np.all(np.abs(k - counts) <= tol):
         return None
     return step, counts
+
+
+def sample_lattice(y: np.ndarray) -> tuple[float, np.ndarray] | None:
+    """(step, counts from the first sample) where every sample of ``y`` lies on a lattice, else None (the lattice
+    :func:`detect_counter` reads; :mod:`allanite.model._quantiser` reads a rate quantised at the output on it)."""
+    return _lattice(y)
 
 
 def _allan_tau0(ratio: float, phase: Phase) -> float:

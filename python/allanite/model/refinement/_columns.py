@@ -13,6 +13,7 @@ import numpy as np
 from .. import fitting
 from .._counter import active_counter
 from .._declared import declared_of
+from .._quantiser import active_quantiser
 from ..effects import EFFECTS, butterworth_order, filtered_white_avar, resonance_avar, split_notch
 from ..terms import TERM_ALPHA, design_matrix
 
@@ -183,6 +184,12 @@ def design(curve, terms, effects):
         for rep in zeroed:
             if rep in terms:
                 a0[:, list(terms).index(rep)] = 0.0
+    quant = active_quantiser()
+    if quant is not None and "N" in terms and any(has_floor(key) for key, _p in effects):
+        # the floor after the filter is the output quantiser's error: its exact Allan variance (its lag
+        # correlation where the quantum is coarse beside the filtered rate's change per sample)
+        a0 = a0.copy()
+        a0[:, list(terms).index("N")] *= quant.factor(np.rint(tau * curve.fs))
     cols = [a0] + [column(key, p, curve)[:, None] for key, p in effects]
     alphas = [np.full(tau.size, TERM_ALPHA[t]) for t in terms] + [_alpha_of(k, p, tau) for k, p in effects]
     return np.hstack(cols), alphas

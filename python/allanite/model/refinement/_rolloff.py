@@ -46,9 +46,10 @@ from scipy.optimize import nnls
 
 from ..._scoped import scoped
 from .. import tracing
+from .._counter import sample_lattice
 from .._sinc import SINC_ORDERS, sinc_order
 from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation, filter_cutoff, split_notch
-from .curvefit import FLOOR_TAG, PROFILE_RHO, Curve, Solution, base_name, bw_kind, search, searches, solve
+from .curvefit import FLOOR_TAG, PROFILE_RHO, Curve, Solution, base_name, bw_kind, column, search, searches, solve
 
 __all__ = [
     "better_kind",
@@ -276,9 +277,10 @@ def _spectrum_prefers(y, fs: float, new: tuple, prev: tuple, tie: float) -> bool
     return mis[0] < PSD_MISFIT_FACTOR * mis[1]
 
 
-#: The least white floor, as a fraction of N, that the spectrum above f_s/4 must show beside a kind other than a
-#: Butterworth (:func:`psd_white` at the kind found without one) for a floor to be tried there: a quantisation
-#: step of ≈ 0.17 σ of the white noise, whose Δ²/12 is 1/400 of its power — below that the floor moves nothing.
+#: The least white floor, as a fraction of N times the root of the share of white noise's Allan variance the filter
+#: passes at the curve's shortest τ (:func:`_passed`), that the spectrum above f_s/4 must show beside a kind other
+#: than a Butterworth (:func:`psd_white` at the kind found without one) for a floor to be tried there: a floor
+#: whose Allan variance is 1/400 of the filtered noise's at the shortest τ — below that the floor moves nothing.
 FLOOR_MIN = 0.05
 #: How far (a factor either way) the floor the Allan curve's fit gives may lie from the spectrum's at that fit
 #: (:func:`psd_white`) for the floor to be kept beside a kind other than a Butterworth.
@@ -286,32 +288,87 @@ FLOOR_AGREE = 1.5
 
 
 def floor_choice(curve: Curve, start: tuple, effects: list, best: tuple, specs: list, y, tie: float) -> tuple:
-    """The bandwidth (key, p, sol, edge) with a white floor after the filter where the samples show one beside a
-    kind other than a Butterworth (a Butterworth keeps its floor always: :func:`.curvefit.has_floor`), else
-    ``best`` as found without one. Tried where the spectrum above f_s/4 beside ``best`` flattens at a floor of
-    at least :data:`FLOOR_MIN` of N (:func:`psd_white`): every kind of ``specs`` ((key, grid, continuous), the
-    Butterworths left out) searched again with the floor (:data:`.curvefit.FLOOR_TAG`), the kind chosen as
-    without it (:func:`sinc_choice`, :func:`better_kind`), and kept only where the floor its fit gives agrees
-    with the spectrum's at that fit within :data:`FLOOR_AGREE` — on the Allan curve a floor trades with the
-    cutoff and white angle noise, so a floor the fit leaves at 0, or puts where the spectrum has none, is not
-    one (ADIS16405 run 4 gyro_x: the spectrum's 0.07·N beside a boxcar of 1.25 samples, the fit's 0 and a span
-    of 1.58 with white angle noise; run 1 gyro_z's single pole beside its 20 Hz resonances)."""
+    """The bandwidth (key, p, sol, edge) with a white floor after the filter where the samples show one, else
+    ``best`` as found without one. Two readings of the floor the spectrum above f_s/4 shows beside ``best``
+    (:func:`psd_white`):
+
+    - the output's quantisation, where the samples lie on a lattice whose Δ/√(12·f_s) is that floor within
+      :data:`FLOOR_AGREE` (:func:`_lattice_floor`): tried where it is at least :data:`FLOOR_MIN` of N times the root
+      of what the filter passes at the shortest τ (:func:`_passed`), every kind of ``specs`` ((key, grid,
+      continuous), the Butterworths left out) searched again with the floor (:data:`.curvefit.FLOOR_TAG`), and the
+      kinds whose fitted floor agrees with the spectrum's (:func:`_floor_agrees`) compete as without it
+      (:func:`sinc_choice`, :func:`better_kind`); beside a Butterworth (which keeps its floor always:
+      :func:`.curvefit.has_floor`) the pick only where it beats it (a 16-tap average quantised at 1.2 times its
+      output's SD was read as the one kind that had its floor). r18bartlett: before, the best kind with a floor was
+      taken or refused alone, and a quantised Bartlett read as a sinc⁵ of 2.4 samples whose fit put its floor into
+      white angle noise;
+    - any other floor, beside a kind other than a Butterworth: tried where it is at least :data:`FLOOR_MIN` of N,
+      the best kind with it kept only where its floor agrees — on the Allan curve a floor trades with the cutoff
+      and white angle noise, so a floor the fit leaves at 0, or puts where the spectrum has none, is not one
+      (ADIS16405 run 4 gyro_x: the spectrum's 0.07·N beside a boxcar of 1.25 samples, the fit's 0 and a span of
+      1.58 with white angle noise; run 1 gyro_z's single pole beside its 20 Hz resonances)."""
     key, p, sol, _edge = best
     kind = bw_kind(key)
-    if y is None or "N" not in start or butterworth_order(kind) or key.endswith(FLOOR_TAG):
+    if y is None or "N" not in start or key.endswith(FLOOR_TAG):
         return best
     n2 = float(sol.theta[-1])
-    if not n2 > 0 or psd_white(y, curve.fs, kind, p, n2)["floor"] < FLOOR_MIN * math.sqrt(n2):
+    if not n2 > 0:
         return best
-    tagged = [(k + FLOOR_TAG, g, c) for k, g, c in specs if not butterworth_order(bw_kind(k))]
-    found = [(spec[0], *res) for spec, res in zip(tagged, searches(curve, start, effects, tagged))]
+    spec = psd_white(y, curve.fs, kind, p, n2)["floor"]
+    if not _lattice_floor(y, curve.fs, spec):
+        # a floor the samples' lattice does not explain: tried beside a kind other than a Butterworth where it is at
+        # least FLOOR_MIN of N, the best kind with it kept only where its floor agrees
+        if butterworth_order(kind) or spec < FLOOR_MIN * math.sqrt(n2):
+            return best
+        found = _with_floor(curve, start, effects, specs)
+        pick = None
+        for f in sinc_choice(found, tie):
+            if better_kind(f, pick, tie):
+                pick = f
+        if pick is None or pick[3] or not _floor_agrees(y, curve.fs, list(start).index("N"), pick):
+            return best
+        return pick
+    # the output's quantisation: weighed against what the filter passes at the shortest τ, and the kinds whose
+    # fitted floor agrees with the spectrum's compete (a Bartlett of 7 taps, quantised, read as a sinc⁵ of 2.4
+    # samples whose fit put its floor into white angle noise, where the Bartlett's floor agrees)
+    if spec < FLOOR_MIN * math.sqrt(n2 * _passed(curve, key, p)):
+        return best
+    n_col = list(start).index("N")
+    found = _with_floor(curve, start, effects, specs)
+    agreed = [f for f in found if not f[3] and _floor_agrees(y, curve.fs, n_col, f)]
     pick = None
-    for f in sinc_choice(found, tie):
+    for f in sinc_choice(agreed, tie):
         if better_kind(f, pick, tie):
             pick = f
-    if pick is None or pick[3] or not _floor_agrees(y, curve.fs, list(start).index("N"), pick):
-        return best
-    return pick
+    if butterworth_order(kind):  # a Butterworth has its floor already: another kind with one must beat it
+        return pick if pick is not None and better_kind(pick, best, tie) else best
+    return best if pick is None else pick
+
+
+def _with_floor(curve: Curve, start: tuple, effects: list, specs: list) -> list:
+    """Every kind of ``specs`` but the Butterworths searched with the floor (:data:`.curvefit.FLOOR_TAG`)."""
+    tagged = [(k + FLOOR_TAG, g, c) for k, g, c in specs if not butterworth_order(bw_kind(k))]
+    return [(spec[0], *res) for spec, res in zip(tagged, searches(curve, start, effects, tagged))]
+
+
+def _lattice_floor(y: np.ndarray, fs: float, spec: float) -> bool:
+    """Whether every sample of ``y`` lies on a lattice (step Δ) whose quantisation floor, Δ/√(12·f_s) (rate
+    unit·√s, as N), lies within :data:`FLOOR_AGREE` of the spectrum's floor ``spec``: the floor is the output's
+    quantisation (ADIS16405 run 4 gyro_x's spectrum shows 19× its 0.05 °/s step's: not it)."""
+    if not spec > 0 or y.size < 1000 or sample_lattice(y[:1000]) is None:
+        return False
+    got = sample_lattice(y)
+    if got is None:
+        return False
+    return abs(math.log(spec / (got[0] / math.sqrt(12.0 * fs)))) <= math.log(FLOOR_AGREE)
+
+
+def _passed(curve: Curve, key: str, p: float) -> float:
+    """The share of white noise's Allan variance the filter of ``key`` at ``p`` passes at the curve's shortest τ
+    (at most 1): a floor after the filter is weighed against what the filter leaves there, not against N — a
+    moving average of 14 taps passes 1/196 of it at one sample, where a step of half the output's SD adds a
+    third to the curve with a floor of 0.04·N."""
+    return float(min(1.0, column(key, p, curve)[0] * curve.tau[0]))
 
 
 def _floor_agrees(y: np.ndarray, fs: float, n_col: int, found: tuple) -> bool:

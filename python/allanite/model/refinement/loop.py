@@ -28,6 +28,7 @@ from ...errors import ParameterError
 from .. import periodic, tracing
 from .._counter import counter_quantisation, detect_counter
 from .._declared import DeclaredFilter, declared_filter, declaring
+from .._quantiser import detect_output_quantiser, output_quantisation
 from .._recent import remembering
 from ..effects import EFFECTS, describe
 from ..lines import remembering_spectra
@@ -214,7 +215,10 @@ def refine(
         y, result, chans, filled = inputs(x_or_result, fs, input, points, axis, channels, gaps)
         # a delta-angle counter's samples: every Q column is its exact one (allanite.model._counter)
         counter = detect_counter(y, result.fs) if y is not None and "Q" in start else None
-        with counter_quantisation(counter), declaring(decl):
+        # a rate quantised at the output, coarse beside its filtered change per sample: the floor after a filter
+        # is its error's exact Allan variance (allanite.model._quantiser)
+        quant = detect_output_quantiser(y, result.fs) if y is not None and counter is None else None
+        with counter_quantisation(counter), output_quantisation(quant), declaring(decl):
             run = _Run(y, result, start, tau_range, level, truth, unit)
             run.remove_in_time(candidates, chans)
             run.channels = chans or {}
