@@ -92,15 +92,10 @@ def _edof(win: np.ndarray, n: int, nper: int) -> tuple[float, float, int]:
     return dof, 1.0 + 2.0 * float(np.sum(corr)), k
 
 
-#: Longest segment whose window :func:`_window_edof` keeps for the process (8 MB; a longer pass's is made each time).
-KEPT_WINDOW = 2**20
-
-
 @lru_cache(maxsize=16)
 def _window_edof(nper: int, n: int) -> tuple:
-    """The segments' window (read-only) and :func:`_edof` for ``nper`` of ``n`` samples: a function of the two lengths
-    alone, kept for the process (refine searches the record, what its removals left and the final samples, each of
-    the same length: each pass's window and sums over it were made three times)."""
+    """The window (read-only) and :func:`_edof` of ``nper`` of ``n`` samples, kept for the process up to 2²⁰-sample
+    segments (refine searches three records of one length: each pass's window and sums were made three times)."""
     win = signal.get_window(WINDOW, nper)
     win.flags.writeable = False
     return win, _edof(win, n, nper)
@@ -122,7 +117,7 @@ def _welch(x: np.ndarray, fs: float, win: np.ndarray, nper: int, mean: float = 0
 def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int, mean: float = 0.0) -> dict:
     """Welch PSD of one segment length up to the bins its search reaches, the bins k_lo ≤ k < k_hi it searches
     (grouped by their neighbourhood w) and, unmasked, the noise level under each (:func:`_noise`)."""
-    win, (dof, kappa, k_seg) = (_window_edof if nper <= KEPT_WINDOW else _window_edof.__wrapped__)(nper, x.size)
+    win, (dof, kappa, k_seg) = (_window_edof if nper <= 2**20 else _window_edof.__wrapped__)(nper, x.size)
     f, p, spread = _welch(x, fs, win, nper, mean)
     ks_all = np.arange(p.size)
     width = np.clip(ks_all // 2, *NEIGHBOURS)
