@@ -14,7 +14,6 @@ import numpy as np
 
 from ..errors import ParameterError
 from ._declared import declared_of
-from ._recent import Small
 from ._sinc import SINC_ORDERS, sinc_autocorrelation, sinc_cutoff, sinc_order
 
 __all__ = [
@@ -326,23 +325,6 @@ def filter_cutoff(kind: str, p: float, fs: float) -> float:
 
 
 def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float) -> np.ndarray:
-    """:func:`_filtered_white_avar`, remembered within a refine call by τ, kind, parameter and rate (a fresh array each
-    time): a bandwidth kind's keys with and without a floor, and the curves of one τ, ask for the same numbers."""
-    tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
-    if declared_of(kind) is not None:
-        return _filtered_white_avar(tau, kind, p, fs)
-    key = (tau.tobytes(), kind, float(p), float(fs))
-    got = _FILTERED.get(key)
-    if got is None:
-        got = _FILTERED.put(key, _filtered_white_avar(tau, kind, p, fs))
-    return got.copy()
-
-
-#: :func:`filtered_white_avar`'s curves within a refine call (a few thousand of a few hundred numbers).
-_FILTERED = Small(4096)
-
-
-def _filtered_white_avar(tau: np.ndarray, kind: str, p: float, fs: float) -> np.ndarray:
     """Allan variance of low-pass filtered white rate noise per unit N² — exact in discrete time.
 
     σ²(m) = (1/2m²)·Σ_l A_m(l)·R(l) with A_m(l) = 2·tri_m(l) − tri_m(l − m) − tri_m(l + m) (tri_m(l) =
