@@ -13,7 +13,6 @@ import numpy as np
 from .. import fitting
 from .._counter import active_counter
 from .._declared import declared_of
-from .._recent import Small
 from ..effects import EFFECTS, butterworth_order, filtered_white_avar, resonance_avar, split_notch
 from ..terms import TERM_ALPHA, design_matrix
 
@@ -88,22 +87,11 @@ def held_coherent(key: str) -> float:
 
 def column(key, p, curve):
     """Allan variance per unit amplitude² of effect ``key`` with nonlinear parameter ``p`` on ``curve`` (read-only:
-    remembered by the curve, which every step's searches ask for the same grids — and, within a refine call, by its
-    τ and rate: a column is a function of the key, the parameter, τ and f_s alone, and the curves a removal leaves
-    and the held-out parts' curves are on the same τ as the record's)."""
+    remembered by the curve, which every step's searches ask for the same grids)."""
     got = curve.cached(("column", key, float(p)))
     if got is None:
-        on_tau = (key, float(p), curve.tau.tobytes(), float(curve.fs))
-        got = _ON_TAU.get(on_tau)
-        if got is None:
-            got = _ON_TAU.put(on_tau, curve.remember(("column", key, float(p)), _column(key, p, curve)))
-        else:
-            got = curve.remember(("column", key, float(p)), got)
+        got = curve.remember(("column", key, float(p)), _column(key, p, curve))
     return got
-
-
-#: Columns by (key, parameter, τ, f_s) within a refine call (:func:`column`; a few thousand of a few hundred numbers).
-_ON_TAU = Small(8192)
 
 
 def _column(key, p, curve):
