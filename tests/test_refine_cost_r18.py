@@ -1,9 +1,8 @@
 """refine's speed-ups of round r18cost give the numbers of the computations they stand for, bit for bit.
 
 The χ² copula's Hermite table read in place (:func:`allanite.model._chi2_draws.scaled_quantiles`) against the
-whole-array form it replaced; the line-constancy basis made part by part against the complex form; a curve
-effect's column remembered across curves of one τ within a refine call, and a line family's refit evaluated once for
-equal indices, against fresh ones. No timings here: ``benches/bench_refine_cost.py``.
+whole-array form it replaced; the line-constancy basis made part by part against the complex form; a line family's
+refit evaluated once for equal indices against fresh ones. No timings here: ``benches/bench_refine_cost.py``.
 """
 
 from __future__ import annotations
@@ -13,7 +12,7 @@ import pytest
 
 from allanite.model import _chi2_draws, linefit, periodic
 from allanite.model._recent import remembering
-from allanite.model.refinement import _columns, _line_constancy
+from allanite.model.refinement import _line_constancy
 
 
 def _hermite_whole_array(z, nu):
@@ -70,25 +69,6 @@ def test_line_constancy_basis_equals_the_complex_form():
         first = _line_constancy._basis_of(size, fs, freqs)
         assert _line_constancy._basis_of(size, fs, freqs.copy()) is first and not first[0].flags.writeable
     assert np.array_equal(first[2], cov)
-
-
-def _curve(avar, fs=100.0):
-    tau = np.array([0.01, 0.02, 0.04, 0.08, 0.16, 0.32, 0.64, 1.28])
-    return _columns.Curve(tau, tau * fs, avar, fs, 100_001, "oavar")
-
-
-def test_a_column_is_shared_by_curves_of_one_tau_within_a_call():
-    key, p = "bandwidth:single_pole", 11.0
-    a, b = _curve(np.linspace(1.0, 2.0, 8)), _curve(np.linspace(3.0, 4.0, 8))
-    other_rate = _curve(np.linspace(1.0, 2.0, 8), fs=200.0)
-    fresh = _columns._column(key, p, a)
-    with remembering():
-        col_a = _columns.column(key, p, a)
-        col_b = _columns.column(key, p, b)  # another curve on the same τ and rate: the same column
-        col_c = _columns.column(key, p, other_rate)
-    assert col_b is col_a and np.array_equal(col_a, fresh) and not col_a.flags.writeable
-    assert np.array_equal(col_c, _columns._column(key, p, other_rate)) and not np.array_equal(col_c, fresh)
-    assert fresh[0] < 1.0 / a.tau[0]  # the pole at 11 Hz takes white noise's power at the shortest τ
 
 
 def test_a_refit_evaluated_twice_at_equal_indices_equals_fresh_ones():
