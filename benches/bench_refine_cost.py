@@ -44,9 +44,9 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-#: main before this round of refine's speed-ups (issue 29, refine's cost, round r17cost2; earlier rounds' baselines:
-#: 9165947, 313a76b, f836703, a0e3816, 3637a85, 904c152, 80c1a7b, f68a6c9, f24f72e, b12d419).
-BASELINE = "4ce759c"
+#: main before this round of refine's speed-ups (issue 29, refine's cost, round r18cost; earlier rounds' baselines:
+#: 9165947, 313a76b, f836703, a0e3816, 3637a85, 904c152, 80c1a7b, f68a6c9, f24f72e, b12d419, 4ce759c).
+BASELINE = "db0a328"
 ADIS = [
     ("adis", 1, "gyro_z"),
     ("adis", 4, "gyro_x"),

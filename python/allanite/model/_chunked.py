@@ -56,13 +56,16 @@ def lattice_step(x: np.ndarray) -> float:
     # below 1e-6 of the largest |x| a value is the float rounding of samples with a large offset (a rate
     # differenced from an angle of 10⁴ °: residues of 10⁻⁹ on a lattice of 10⁻²), not a step: counted as zero
     floor = TINY * scale
-    n_nz = 0
-    for nz in passes():
-        n_nz += int(np.count_nonzero(nz > floor))
+    # one chunk: its |x| above the floor taken once for the three passes that read them (the same values)
+    kept = None if one is None else [nz[nz > floor] for nz in one]
+
+    def above():
+        return kept if kept is not None else (nz[nz > floor] for nz in _nonzero_abs(x))
+
+    n_nz = sum(v.size for v in kept) if kept is not None else sum(int(np.count_nonzero(nz > floor)) for nz in passes())
     r = np.empty(n_nz)
     pos = 0
-    for nz in passes():
-        nz = nz[nz > floor]
+    for nz in above():
         r[pos : pos + nz.size] = np.round(nz / scale, 12)
         pos += nz.size
     r.sort()
@@ -76,9 +79,9 @@ def lattice_step(x: np.ndarray) -> float:
         if near.size:
             step = min(step, float(near.min()))
     on = 0
-    for nz in passes():
-        q = nz[nz > floor] / step
-        on += int(np.count_nonzero(np.abs(q - np.round(q)) <= 1e-6 * np.maximum(1.0, q)))
+    for nz in above():
+        q = nz / step
+        on += int(np.count_nonzero(np.abs(q - np.rint(q)) <= 1e-6 * np.maximum(1.0, q)))  # rint: round's numbers
     return step if on / n_nz >= 0.99 else 0.0
 
 

@@ -67,14 +67,13 @@ def _cross(d: np.ndarray, mi, mj, tau0: float) -> np.ndarray:
     mj = np.broadcast_to(np.asarray(mj, dtype=np.int64), d.shape)
     lam = (1.0, -2.0, 1.0)
     weights = [lam[a] * lam[b] for a in range(3) for b in range(3)]
-    offsets = [(b * mj - a * mi).astype(np.float64) for a in range(3) for b in range(3)]
     acc = np.zeros((4, d.size))
     far = np.abs(d) >= 4.0 * (2 * mi + 2 * mj)
     near = ~far
-    dn = d[near]
+    dn, mi_n, mj_n = d[near], mi[near], mj[near]  # the offsets on the near lags alone (the same integers)
     acc_near = np.zeros((4, dn.size))
-    for w, o in zip(weights, offsets):
-        acc_near += w * _kernels(dn + o[near], tau0)
+    for w, (a, b) in zip(weights, [(a, b) for a in range(3) for b in range(3)]):
+        acc_near += w * _kernels(dn + (b * mj_n - a * mi_n).astype(np.float64), tau0)
     acc[:, near] = acc_near
     outside = (d > 2 * mi) | (d < -2 * mj)
     acc[0, outside] = acc[1, outside] = acc[3, outside] = 0.0
@@ -94,16 +93,22 @@ def _cross(d: np.ndarray, mi, mj, tau0: float) -> np.ndarray:
         of = [(b * mj_f[first] - a * mi_f[first]).astype(np.float64) for a in range(3) for b in range(3)]
         total = np.zeros(df.size)
         # 1/|d|^(k−2) and sgn^k by products from one k to the next (pow over every lag, twice per k, was most of
-        # this loop's time); a term whose S_k is 0 adds 0, as 1/|d| is finite here (|d| ≥ 4·(2m_i + 2m_j) > 0)
+        # this loop's time); a term whose S_k is 0 adds 0, as 1/|d| is finite here (|d| ≥ 4·(2m_i + 2m_j) > 0).
+        # In place, into two buffers: c_k·sgn·|d|^−(k−2) is c_k·(sgn·|d|^−(k−2)) to the bit (sgn is ±1)
         inv = 1.0 / ad
         inv_pow = inv * inv
+        term = np.empty(df.size)
         for k in range(4, 17):
             s_k = weights[0] * of[0] ** k
             for w, o in zip(weights[1:], of[1:]):
                 s_k = s_k + w * o**k
             c_k = s_k * (2.0 * (-1.0) ** (k - 1) * math.factorial(k - 3) / math.factorial(k))
-            total += c_k[back] * (inv_pow if k % 2 == 0 else inv_pow * sgn)
-            inv_pow = inv_pow * inv
+            np.take(c_k, back, out=term)
+            if k % 2:
+                term *= sgn
+            term *= inv_pow
+            total += term
+            inv_pow *= inv
         acc[2, far] = total * (tau0 * tau0 / (2.0 * math.pi))
     return acc / ((mi * mj) * tau0 * tau0)
 

@@ -92,6 +92,15 @@ def _edof(win: np.ndarray, n: int, nper: int) -> tuple[float, float, int]:
     return dof, 1.0 + 2.0 * float(np.sum(corr)), k
 
 
+@lru_cache(maxsize=16)
+def _window_edof(nper: int, n: int) -> tuple:
+    """The window (read-only) and :func:`_edof` of ``nper`` of ``n`` samples, kept for the process up to 2²⁰-sample
+    segments (refine searches three records of one length: each pass's window and sums were made three times)."""
+    win = signal.get_window(WINDOW, nper)
+    win.flags.writeable = False
+    return win, _edof(win, n, nper)
+
+
 def _welch(x: np.ndarray, fs: float, win: np.ndarray, nper: int, mean: float = 0.0):
     """One-sided Welch PSD (unit²/Hz) of 50 %-overlapping segments, each with its least-squares line removed
     (as ``scipy.signal.welch(detrend="linear")``, without a least-squares solve per segment) of ``x − mean``; a few
@@ -108,9 +117,8 @@ def _welch(x: np.ndarray, fs: float, win: np.ndarray, nper: int, mean: float = 0
 def _one_pass(x: np.ndarray, fs: float, nper: int, k_lo: int, k_hi: int, mean: float = 0.0) -> dict:
     """Welch PSD of one segment length up to the bins its search reaches, the bins k_lo ≤ k < k_hi it searches
     (grouped by their neighbourhood w) and, unmasked, the noise level under each (:func:`_noise`)."""
-    win = signal.get_window(WINDOW, nper)
+    win, (dof, kappa, k_seg) = (_window_edof if nper <= 2**20 else _window_edof.__wrapped__)(nper, x.size)
     f, p, spread = _welch(x, fs, win, nper, mean)
-    dof, kappa, k_seg = _edof(win, x.size, nper)
     ks_all = np.arange(p.size)
     width = np.clip(ks_all // 2, *NEIGHBOURS)
     k_hi = min(k_hi, p.size - 1 - LOBE - NEIGHBOURS[0])

@@ -113,13 +113,28 @@ class LineFamily:
         idx = np.asarray(idx, dtype=np.int64)
         g = self.gens / self.fs
         a, b = _refitted(np.asarray(samples, dtype=np.float64), idx, g, self.coefs)
-        return lambda i: linefit.evaluate(np.asarray(i, dtype=np.int64), g, self.coefs, a, b)
+        return lambda i: _evaluated(np.asarray(i, dtype=np.int64), g, self.coefs, a, b)
 
 
 #: Amplitudes refitted by :meth:`LineFamily.refit`, by the held-in samples' content, the lattice and the indices
 #: (records up to 4·10⁶ samples): the removal's held-out test in time and its held-out Allan-curve errors refit the
 #: same family on the same alternate blocks.
 _REFITS = Recent(4, 4_000_000)
+
+
+#: Refitted components evaluated (:func:`_evaluated`), by the indices' content and the lines (records up to 4·10⁶
+#: samples): the removal's held-out test in time and its held-out Allan-curve error evaluate the same refit at the same
+#: held-out indices.
+_EVALUATED = Recent(2, 4_000_000)
+
+
+def _evaluated(idx: np.ndarray, g: np.ndarray, coefs: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``linefit.evaluate(idx, g, coefs, a, b)``, found again for equal indices and lines (a fresh array each time)."""
+    key = (g.tobytes(), np.shape(coefs), np.asarray(coefs, dtype=np.int64).tobytes(), a.tobytes(), b.tobytes())
+    got = _EVALUATED.get(idx, key)
+    if got is None:
+        got = _EVALUATED.put(idx, key, linefit.evaluate(idx, g, coefs, a, b))
+    return got.copy()
 
 
 def _refitted(samples: np.ndarray, idx: np.ndarray, g: np.ndarray, coefs: np.ndarray) -> tuple:

@@ -133,7 +133,9 @@ class TimeRemovals(RunState):
         y, start, effects, heldout = self.y, self.start, self.effects, self.heldout
         assert y is not None
         ho_b = heldout.error(start, effects) if heldout is not None else None
-        ho_a = heldout.error(start, effects, remove=rem.refit, on_raw=rem.on_raw) if heldout is not None else None
+        ho_a, parts_a = (None, None)
+        if heldout is not None:
+            ho_a, parts_a = heldout.error_parts(start, effects, remove=rem.refit, on_raw=rem.on_raw)
         if rem.heldout_in_time is not None:
             rem.evidence["heldout_variance_ratio"] = rem.heldout_in_time
             rejected = not rem.heldout_in_time < 1.0
@@ -172,7 +174,11 @@ class TimeRemovals(RunState):
             final_intervals=dict(rem.intervals),
         )
         parts = None
-        if self.split0 is not None:
+        if self.split0 is not None and heldout is self.split0 and not self.removed:
+            # the record's own split, nothing removed before: the held-out test's parts are these (its raw parts,
+            # this refit), made once — the refit evaluated on both parts and their four curves were made twice
+            parts = parts_a
+        elif self.split0 is not None:
             parts = self.split0.corrected(self.removed[-1][4] if self.removed else self.raw, rem.refit, rem.on_raw)
         self.removed.append((st, rem, self.curve.avar - c_new.avar, c_new, parts))
         self.y, self.result, self.curve, self.heldout = y_new, res_new, c_new, h_new

@@ -23,6 +23,8 @@ import math
 import numpy as np
 from scipy import stats
 
+from .._recent import Small
+
 __all__ = ["line_constancy", "block_phasors", "MAX_BLOCKS", "MIN_PERIODS", "OFF_BINS"]
 
 #: Blocks along the record at most.
@@ -56,10 +58,35 @@ def _basis(t: np.ndarray, freqs: np.ndarray) -> tuple:
     c -= np.outer(c @ rn, rn)  # the weighted constant projected out: columns orthogonal to it
     s -= np.outer(s @ rn, rn)
     cc, ss, cs = np.sum(c * c, 1), np.sum(s * s, 1), np.sum(c * s, 1)
-    det = (cc * ss - cs**2)[:, None]
-    g = ((ss[:, None] * c - cs[:, None] * s) - 1j * (cc[:, None] * s - cs[:, None] * c)) / det
-    gr = g * r
+    scale = 1.0 / (cc * ss - cs**2)[:, None]
+    # ((ss·c − cs·s) − i(cc·s − cs·c))/det part by part: NumPy divides a complex by a real det as by det + 0i, its
+    # real and imaginary parts each times 1/det — the same numbers, without the complex temporaries
+    g = np.empty(c.shape, dtype=np.complex128)
+    g.real = (ss[:, None] * c - cs[:, None] * s) * scale
+    g.imag = -((cc[:, None] * s - cs[:, None] * c) * scale)
+    gr = np.empty_like(g)
+    gr.real, gr.imag = g.real * r, g.imag * r
     return g, r, gr @ gr.conj().T
+
+
+#: The bases last made (:func:`_basis_of`), by block length, rate and frequencies: the final line check and the
+#: phasors of the components removed at a line ask for the same blocks' basis at the same frequencies.
+_BASES = Small(2)
+#: Largest basis kept (bytes of its phasor map; a longer block's is made each time).
+KEPT_BASIS = 2**25
+
+
+def _basis_of(size: int, fs: float, freqs: np.ndarray) -> tuple:
+    """:func:`_basis` at block-local times of ``size`` samples at ``fs``, the last few remembered (read-only)."""
+    key = Small.key(np.asarray(freqs, dtype=np.float64), int(size), float(fs))
+    got = _BASES.get(key)
+    if got is None:
+        got = _basis(np.arange(size) / fs, freqs)
+        for a in got:
+            a.flags.writeable = False
+        if got[0].nbytes <= KEPT_BASIS:
+            _BASES.put(key, got)
+    return got
 
 
 def _local_phasors(y: np.ndarray, basis: tuple) -> np.ndarray:
@@ -91,7 +118,7 @@ def _block_terms(y: np.ndarray, fs: float, f0: float, edges: np.ndarray) -> tupl
             off = np.concatenate([f0 - k * df, f0 + k * df])
             off = off[(off > 0) & (off < fs / 2)]
             freqs = np.concatenate([[f0], off])
-            basis = _basis(np.arange(yb.size) / fs, freqs)
+            basis = _basis_of(yb.size, fs, freqs)
             bases[yb.size] = (freqs, basis, *_noise_terms(basis[2]))
         freqs, basis, d, nu = bases[yb.size]
         z = _local_phasors(yb, basis) * np.exp(-2j * np.pi * freqs * (edges[b] / fs))

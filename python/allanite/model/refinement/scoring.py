@@ -294,10 +294,15 @@ class Split:
         the relative error of a slow regression's "after" was taken on a curve the removal had lowered where the
         component dominates: ``benches/refine_blind10.py``'s humidity read 1.91 → 5.31 % here while the chain
         read 1.91 → 2.65 % (``benches/results/r13heldout.md``)."""
+        return self.error_parts(terms, effects, remove, on_raw)[0]
+
+    def error_parts(self, terms, effects, remove=None, on_raw=False) -> tuple:
+        """:meth:`error` and the parts it was scored with (:meth:`corrected`'s, or :meth:`raw_parts`'): a removal
+        kept on the record's own split goes on from those same parts (``_in_time.TimeRemovals.remove``)."""
         parts = self.raw_parts()
         if remove is not None:
             parts = self.corrected(parts, remove, on_raw)
-        return self.predict(parts, terms, effects)
+        return self.predict(parts, terms, effects), parts
 
 
 #: The held-out parts' curves last made (:meth:`Split.curve`), of parts up to 4·10⁶ samples: six, so that a removal's
