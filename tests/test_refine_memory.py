@@ -62,6 +62,12 @@ def test_null_chunks_are_the_whole_up_to_one_chunk_and_seeded_per_chunk_beyond()
     again = list(tracing.simulated_block_mean_chunks(*args, n_boot, 11))
     assert all(np.array_equal(p, q) for p, q in zip(parts, again))  # reproducible from the seed
     assert not np.allclose(parts[0][:, :17], parts[3])  # each chunk its own stream
+    # drawn one ahead on a second thread: each chunk is its own generator's record, as drawn alone
+    from allanite.model._null_records import block_rate_record
+
+    sd = dict(zip(("N", "B", "K", "R"), (1e-3, 1e-4, 1e-6, 0.0)))
+    alone = block_rate_record(48 * (tracing.SIM_CHUNK // 48), 0.1, **sd, seed=np.random.default_rng([11, 2]))
+    assert np.array_equal(parts[2], alone.reshape(-1, 48).T)
 
 
 def test_the_chunked_nulls_statistic_per_record_is_the_whole_arrays():

@@ -18,7 +18,9 @@ Used by :func:`allanite.refine`:
 
 from __future__ import annotations
 
+import contextvars
 import math
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from scipy import signal
@@ -169,10 +171,31 @@ def simulated_block_mean_chunks(nb: int, per: int, fs: float, terms, theta, n_bo
         yield np.asarray(long, dtype=np.float64).reshape(n_boot, nb).T
         return
     each = max(1, SIM_CHUNK // nb)
-    for i, first in enumerate(range(0, n_boot, each)):
+
+    def chunk(i: int, first: int) -> np.ndarray:
         long = block_rate_record(nb * each, fs / per, **terms4, seed=np.random.default_rng([seed, i]))
         k = min(each, n_boot - first)
-        yield np.asarray(long[: nb * k], dtype=np.float64).reshape(k, nb).T
+        return np.asarray(long[: nb * k], dtype=np.float64).reshape(k, nb).T
+
+    yield from _prefetched(chunk, list(enumerate(range(0, n_boot, each))))
+
+
+def _prefetched(make, args: list):
+    """``make(*a)`` for each ``a`` of ``args`` in order, the next one drawn on a second thread while the caller
+    reads this one: each chunk has its own generator (:func:`simulated_block_mean_chunks`), so the numbers are
+    the same in any order, and NumPy's draws and FFTs release the GIL — on two cores the null's simulation
+    overlaps its statistics. One chunk ahead at most (its memory, ≈ 20 MB); the context (the flicker's memory,
+    :func:`allanite.model._null_records.sharing`) is the caller's."""
+    if len(args) < 2:
+        yield from (make(*a) for a in args)
+        return
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        ahead = pool.submit(contextvars.copy_context().run, make, *args[0])
+        for a in args[1:]:
+            done = ahead.result()
+            ahead = pool.submit(contextvars.copy_context().run, make, *a)
+            yield done
+        yield ahead.result()
 
 
 def simulated_block_means(nb: int, per: int, fs: float, terms, theta, n_boot: int, seed: int) -> np.ndarray:
