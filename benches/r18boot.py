@@ -245,8 +245,11 @@ NOTES = [
     "falls into different local minima of the fit beside the sinusoid under a mathematically null change of the "
     "record — the rescale table: main's ratio on one clock record 16.6 at ε = 0 and −10⁻⁹, 36.1 at +10⁻⁹ and 10⁻⁶; "
     "the analytic-gradient fits give 36.1 at all four. That record (power, a real daily line of 0.02, seed 15) is "
-    "the one whose decision differs: accepted after, not before, where main accepts it too at ε = 10⁻⁹ (see the "
-    "report of round r18boot).",
+    "the one whose decision differs: accepted after, not before — and main accepts it too at ε = 10⁻⁹ (its ratio "
+    "36.05 against its bootstrap-mapped threshold 35.22, p = 0.0004).",
+    "- The issue's low-pass record (refine at 100 Hz × 4·10⁵, seed 3; the test inside refine): bootstrap offset "
+    "−4.72698 → −4.72718, slope 1.95110 → 1.95114, the ratio 27.31833 → 27.31835, p 0.0231 → 0.0231; refine's CPU "
+    "9.8 → 5.6 s; steps equal. refine's CPU A/B: bench_slowline_boot.md.",
     "",
 ]
 
