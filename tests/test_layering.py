@@ -161,6 +161,7 @@ MODEL_RANKS = {
     "model.outliers": 0,
     "model.telegraph": 0,  # random telegraph noise: its Allan variance, kurtosis test and two-level fit
     "model.noise_level": 0,
+    "model._slowfit": 0.25,  # the slow-line test's noise fits: REML and ML deviances with their gradients (numpy, scipy)
     "model.slowline": 0.5,  # a line of few cycles tested in time under red noise (numpy, scipy only)
     "model.periodic": 1,
     "model.template": 0,

@@ -54,6 +54,35 @@ def test_red_noise_alone_and_a_settling_drift_are_no_line(monkeypatch):
     assert r["readings"]["refit"]["bootstrap"]["draws"] == slowline.BOOT_DRAWS
 
 
+@pytest.mark.parametrize("restricted", [True, False])
+def test_the_noise_fits_gradients_are_the_deviances_slopes(restricted):
+    """The REML and ML deviances' analytic gradients in ln r (_slowfit) against central differences, at a white-,
+    a random-walk- and a flicker-dominated point and one on the bounds' edge; and the batched start grid picks, per
+    record, the grid point whose deviance is least."""
+    from allanite.model import _slowfit
+
+    m = 64
+    rng = np.random.default_rng(11)
+    parts = _slowfit.noise_parts(m)
+    t = np.arange(m) + 0.5
+    x = np.column_stack([np.ones(m), t / m, np.exp(-t / (0.1 * m))])
+    z = np.cumsum(rng.standard_normal(m)) * 0.3 + rng.standard_normal(m)
+    h = 1e-5
+    for logr in ([-6.0, -3.0], [2.0, -4.0], [-5.0, 3.0], [-19.5, 11.5]):
+        g = np.array(logr)
+        f, grad = _slowfit.deviance(z, x, parts, g, restricted)
+        assert np.isfinite(f) and grad.shape == (2,)
+        for k in range(2):
+            e = h * np.eye(2)[k]
+            up, down = (_slowfit.deviance(z, x, parts, g + s * e, restricted)[0] for s in (1.0, -1.0))
+            assert grad[k] == pytest.approx((up - down) / (2 * h), rel=1e-5, abs=1e-6)
+    zs = np.column_stack([z, rng.standard_normal(m), 5.0 * np.cumsum(rng.standard_normal(m))])
+    starts = _slowfit.reml_starts(zs, x, parts)
+    for j in range(zs.shape[1]):
+        devs = [_slowfit.deviance(zs[:, j], x, parts, np.array(g), True)[0] for g in _slowfit.START_GRID]
+        assert tuple(starts[j]) == _slowfit.START_GRID[int(np.argmin(devs))]
+
+
 @pytest.mark.slow  # 5·10⁵ samples and the bootstrap's 120 records; the cheap default path (no bootstrap on a line the
 # first reading finds, none where both statistics stay low) is test_a_line_of_five_cycles_is_found_... and
 # test_red_noise_alone_and_a_settling_drift_are_no_line

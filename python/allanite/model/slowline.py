@@ -30,7 +30,8 @@ maximum law (its :data:`DRAWS` known-covariance draws), whose tail then gives th
 bootstrap alone cannot reach α/2 = 2·10⁻⁴; the ratio's law is that maximum's, stretched: on a clock null its
 quantiles 0.5–0.99 lie on one line against the maximum's, slope 1.45). The bootstrap runs only where the ratio
 passes the maximum's own (1 − α/2) quantile (the map never lowers a threshold below it), so a clean record pays one
-more pair of fits, not the draws.
+more pair of fits, not the draws. The fits (:mod:`allanite.model._slowfit`) take the deviances' gradients in ln r
+analytically, and the draws' restricted fits start from one grid evaluated for all draws at once.
 
 A line of few cycles and a slow drift are nearly collinear: the result says how much of the line's whitened signal
 the constant, the ramp and the settling drifts cannot take (``separable``), and its amplitude's interval is the
@@ -43,12 +44,12 @@ import math
 
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve, solve_triangular
-from scipy.optimize import minimize
 
 from .._blas import one_thread
 from ..errors import ParameterError
+from ._slowfit import FLICKER_D, LOG_R_BOUNDS, ml_fit, noise_parts, reml_fit, reml_starts
 
-__all__ = ["slow_line_test", "MIN_CYCLES", "BLOCKS", "DRAWS"]
+__all__ = ["slow_line_test", "MIN_CYCLES", "BLOCKS", "DRAWS", "FLICKER_D", "LOG_R_BOUNDS"]
 
 #: The fewest cycles in the record a line is found at.
 MIN_CYCLES = 3.0
@@ -68,10 +69,6 @@ READINGS = ("whole", "refit")
 BOOT_DRAWS = 120
 #: The quantiles of the bootstrap's ratios matched (least squares, affine) to the first reading's maximum's.
 BOOT_QUANTILES = tuple(np.linspace(0.5, 0.95, 10))
-#: The noise's relative parts' bounds, ln r.
-LOG_R_BOUNDS = (-20.0, 12.0)
-#: The flicker part's fractional difference (d → ½ is 1/f; below it the noise is stationary).
-FLICKER_D = 0.45
 #: The scan's step, cycles in the record.
 STEP_CYCLES = 0.25
 #: The settling drifts beside the constant and the ramp in the null: e^{−t/τ} at these τ/T (a warm-up's, a
@@ -87,46 +84,10 @@ def _nuisance(t: np.ndarray, length: float) -> np.ndarray:
     return np.column_stack(cols)
 
 
-def _flicker_cov(m: int) -> np.ndarray:
-    """Autocorrelation of fractionally integrated noise (d = FLICKER_D) at lags 0 … m−1, as a Toeplitz matrix."""
-    k = np.arange(1, m)
-    rho = np.concatenate([[1.0], np.cumprod((k - 1 + FLICKER_D) / (k - FLICKER_D))])
-    idx = np.abs(np.arange(m)[:, None] - np.arange(m)[None, :])
-    return rho[idx]
-
-
-def _parts(m: int) -> tuple[np.ndarray, np.ndarray]:
-    """The random walk's (its variance 1 at the record's end) and the flicker's covariance of m block means."""
-    i = np.arange(m)
-    rw = (np.minimum(i[:, None], i[None, :]) + 1.0) / m
-    return rw, _flicker_cov(m)
-
-
-def _reml(z: np.ndarray, x: np.ndarray, parts: tuple, logr: np.ndarray) -> float:
-    """−2 × the restricted log-likelihood of ``z`` (fixed effects ``x``) under σ²(I + r₁·RW + r₂·flicker), σ²
-    profiled out."""
-    r = np.exp(np.clip(logr, -30.0, 30.0))
-    cov = np.eye(z.size) + r[0] * parts[0] + r[1] * parts[1]
-    try:
-        c = cho_factor(cov, lower=True)
-    except np.linalg.LinAlgError:
-        return float("inf")
-    ci_x, ci_z = cho_solve(c, x), cho_solve(c, z)
-    xtx = x.T @ ci_x
-    beta = np.linalg.solve(xtx, x.T @ ci_z)
-    rss = float(z @ ci_z - (x.T @ ci_z) @ beta)
-    dof = z.size - x.shape[1]
-    logdet = 2.0 * float(np.sum(np.log(np.diag(c[0]))))
-    return dof * math.log(max(rss / dof, 1e-300)) + logdet + float(np.linalg.slogdet(xtx)[1])
-
-
-def _noise_fit(z: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The null's covariance of the block means (REML, σ² included) and its (r₁, r₂)."""
-    parts = _parts(z.size)
-    grid = [np.array([a, b]) for a in (-8.0, -2.0, 4.0) for b in (-8.0, -2.0, 4.0)]
-    start = min(grid, key=lambda g: _reml(z, x, parts, g))
-    res = minimize(lambda g: _reml(z, x, parts, g), start, method="L-BFGS-B", bounds=[LOG_R_BOUNDS] * 2)
-    r = np.exp(res.x)
+def _noise_fit(z: np.ndarray, x: np.ndarray, parts: tuple, start: np.ndarray | None = None) -> tuple:
+    """The null's covariance of the block means (REML from ``start``, by default the best of a grid; σ²
+    included) and its (r₁, r₂)."""
+    r = np.exp(reml_fit(z, x, parts, start))
     cov = np.eye(z.size) + r[0] * parts[0] + r[1] * parts[1]
     c = cho_factor(cov, lower=True)
     beta = np.linalg.lstsq(x.T @ cho_solve(c, x), x.T @ cho_solve(c, z), rcond=None)[0]
@@ -141,13 +102,17 @@ def _sincos(t: np.ndarray, f: float) -> np.ndarray:
 
 def _whitened_basis(lw: np.ndarray, t: np.ndarray, x0w_q: np.ndarray, freqs: np.ndarray) -> np.ndarray:
     """Per frequency an orthonormal pair: the whitened sinusoid's columns less their part in the whitened
-    constant and ramp (the null's fixed effects), shape (m, 2·len(freqs))."""
+    constant and ramp (the null's fixed effects), shape (m, 2·len(freqs)) — the pairs all at once, each
+    orthonormalised by Gram–Schmidt twice (the pair's plane is what the scan reads, not its axes)."""
+    phase = 2 * np.pi * np.outer(t, freqs)
+    cw = solve_triangular(lw, np.concatenate([np.sin(phase), np.cos(phase)], axis=1), lower=True)
+    cw -= x0w_q @ (x0w_q.T @ cw)
+    a, b = cw[:, : freqs.size], cw[:, freqs.size :]
+    a = a / np.linalg.norm(a, axis=0)
+    for _ in range(2):
+        b = b - a * np.sum(a * b, axis=0)
     out = np.empty((t.size, 2 * freqs.size))
-    for i, f in enumerate(freqs):
-        cw = solve_triangular(lw, _sincos(t, f), lower=True)
-        cw -= x0w_q @ (x0w_q.T @ cw)
-        q, _r = np.linalg.qr(cw)
-        out[:, 2 * i : 2 * i + 2] = q
+    out[:, 0::2], out[:, 1::2] = a, b / np.linalg.norm(b, axis=0)
     return out
 
 
@@ -246,18 +211,20 @@ def _tested(y: np.ndarray, fs: float, alpha: float, f_max: float | None, seed: i
     }
 
 
-def _whole(z: np.ndarray, t: np.ndarray, x0: np.ndarray, freqs: np.ndarray) -> dict:
-    """The first reading: the noise's REML fit beside the null's fixed effects ``x0``, and the scan under it —
-    ``chi`` (the χ² at each of ``freqs``), ``basis`` (the whitened sinusoids), ``lw`` (the covariance's Cholesky
-    factor) and ``r`` (the relative random-walk and flicker variances)."""
-    cov, r = _noise_fit(z, x0)
+def _whole(z: np.ndarray, t: np.ndarray, x0: np.ndarray, freqs: np.ndarray, start: np.ndarray | None = None) -> dict:
+    """The first reading: the noise's REML fit beside the null's fixed effects ``x0`` (from ``start``, by default
+    the best of a grid), and the scan under it — ``chi`` (the χ² at each of ``freqs``), ``basis`` (the whitened
+    sinusoids), ``lw`` (the covariance's Cholesky factor), ``r`` (the relative random-walk and flicker variances)
+    and ``parts`` (those two parts' covariances)."""
+    parts = noise_parts(z.size)
+    cov, r = _noise_fit(z, x0, parts, start)
     lw = np.linalg.cholesky(cov)
     x0w_q, _ = np.linalg.qr(solve_triangular(lw, x0, lower=True))
     basis = _whitened_basis(lw, t, x0w_q, freqs)
     zw = solve_triangular(lw, z, lower=True)
     zw -= x0w_q @ (x0w_q.T @ zw)
     proj = zw @ basis
-    return {"chi": proj[0::2] ** 2 + proj[1::2] ** 2, "basis": basis, "lw": lw, "r": r}
+    return {"chi": proj[0::2] ** 2 + proj[1::2] ** 2, "basis": basis, "lw": lw, "r": r, "parts": parts}
 
 
 def _null_draws(basis: np.ndarray, seed: int) -> np.ndarray:
@@ -276,37 +243,17 @@ def _judged(stat: float, draws: np.ndarray | None, alpha: float, bound: float) -
     return {"statistic": stat, "threshold": float(np.quantile(draws, 1.0 - alpha)), "p_value": p}
 
 
-def _ml_deviance(z: np.ndarray, x: np.ndarray, parts: tuple, logr: np.ndarray) -> float:
-    """−2 × the log-likelihood (maximum likelihood, σ² profiled out) of ``z`` beside fixed effects ``x`` under
-    σ²(I + r₁·RW + r₂·flicker), up to a constant; comparable between nested ``x`` (restricted likelihoods are
-    not)."""
-    r = np.exp(np.clip(logr, -30.0, 30.0))
-    try:
-        c = cho_factor(np.eye(z.size) + r[0] * parts[0] + r[1] * parts[1], lower=True)
-    except np.linalg.LinAlgError:
-        return float("inf")
-    ci_x, ci_z = cho_solve(c, x), cho_solve(c, z)
-    beta = np.linalg.lstsq(x.T @ ci_x, x.T @ ci_z, rcond=None)[0]
-    rss = float(z @ ci_z - (x.T @ ci_z) @ beta)
-    return z.size * math.log(max(rss / z.size, 1e-300)) + 2.0 * float(np.sum(np.log(np.diag(c[0]))))
-
-
-def _ml_fit(z: np.ndarray, x: np.ndarray, parts: tuple, start: np.ndarray) -> tuple[float, np.ndarray]:
-    """The smallest :func:`_ml_deviance` over ln r (from ``start``) and where."""
-    start = np.clip(start, *LOG_R_BOUNDS)
-    res = minimize(lambda g: _ml_deviance(z, x, parts, g), start, method="L-BFGS-B", bounds=[LOG_R_BOUNDS] * 2)
-    return float(res.fun), res.x
-
-
-def _ratio(z: np.ndarray, t: np.ndarray, x0: np.ndarray, freqs: np.ndarray, whole: dict) -> dict:
+def _ratio(z: np.ndarray, t: np.ndarray, x0: np.ndarray, freqs: np.ndarray, whole: dict, bootstrap=False) -> dict:
     """The second reading's statistic: the likelihood ratio of the null's fixed effects ``x0`` with and without a
     sinusoid at the first reading's best frequency, the noise refitted in each (maximum likelihood, started at
     the first reading's fit) — ``lr``, ``f`` (Hz), ``cov`` (the noise beside the sinusoid) and its ``r``."""
-    parts = _parts(z.size)
+    parts = whole["parts"]
     f = float(freqs[int(np.argmax(whole["chi"]))])
-    d0, th0 = _ml_fit(z, x0, parts, np.log(np.maximum(whole["r"], 1e-300)))
+    d0, th0 = ml_fit(z, x0, parts, np.log(np.maximum(whole["r"], 1e-300)))
     x1 = np.column_stack([x0, _sincos(t, f)])
-    d1, th1 = _ml_fit(z, x1, parts, th0)
+    d1, th1 = ml_fit(z, x1, parts, th0)
+    if bootstrap:  # a draw's ratio is all its reading gives
+        return {"lr": max(d0 - d1, 0.0), "f": f}
     r = np.exp(th1)
     cov = np.eye(z.size) + r[0] * parts[0] + r[1] * parts[1]
     c = cho_factor(cov, lower=True)
@@ -336,12 +283,15 @@ def _boot_map(z, t, x0, freqs, whole, draws, seed) -> tuple[float, float]:
     """The affine map (offset, slope ≥ 0) from the first reading's maximum law (``draws``) to the second
     reading's ratio under the null, matched on :data:`BOOT_QUANTILES` by least squares: the ratios of
     :data:`BOOT_DRAWS` block-mean records drawn from the first reading's fitted noise (no line), each read as the
-    record is — the noise's fit, the scan, its best frequency, the two maximum-likelihood fits."""
+    record is — the noise's fit (its start the best of the grid, evaluated for all draws at once), the scan, its
+    best frequency, the two maximum-likelihood fits."""
     rng = np.random.default_rng(seed + 1)
+    zs = whole["lw"] @ rng.standard_normal((BOOT_DRAWS, z.size)).T  # a draw a column
+    starts = reml_starts(zs, x0, whole["parts"])  # the noise fits' grid, one factorisation a point for all draws
     boot = np.empty(BOOT_DRAWS)
     for k in range(BOOT_DRAWS):
-        zs = whole["lw"] @ rng.standard_normal(z.size)
-        boot[k] = _ratio(zs, t, x0, freqs, _whole(zs, t, x0, freqs))["lr"]
+        zk = np.ascontiguousarray(zs[:, k])
+        boot[k] = _ratio(zk, t, x0, freqs, _whole(zk, t, x0, freqs, starts[k]), bootstrap=True)["lr"]
     q = np.array(BOOT_QUANTILES)
     slope, offset = np.polyfit(np.quantile(draws, q), np.quantile(boot, q), 1)
     return float(offset), float(max(slope, 0.0))
