@@ -1,11 +1,10 @@
 """The ``"bandwidth"`` curve candidate: the sensor's low-pass on its white rate noise (single pole, moving average,
-Bartlett, boxcar, a CIC's sinc^k, pole + boxcar, Butterworth), replacing the N column — its search grids per
-filter kind, bootstrap family, searches, proposal (the kind with the lowest χ², :mod:`._rolloff` deciding the
-Butterworths, the sinc^k order and the white floor, :mod:`._notch` a notch after the kind), parameters and evidence
-in the spectrum
-(:data:`.candidates.CURVE_CANDIDATES`). Where the user declared the filter (``refine(..., filter=...)``,
-:mod:`allanite.model._declared`) it is the one kind: its exact column, its shape fixed, no search — the test asks
-only whether the curve needs it; its floor after it kept as beside a Butterworth."""
+Bartlett, boxcar, a CIC's sinc^k, pole + boxcar, Butterworth, a sharp rippled elliptic: :mod:`._sharp`), replacing the N
+column — its search grids per filter kind, bootstrap family, searches, proposal (the kind with the lowest χ²,
+:mod:`._rolloff` deciding the Butterworths, the sinc^k order and the white floor, :mod:`._notch` a notch after the
+kind), parameters and evidence in the spectrum (:data:`.candidates.CURVE_CANDIDATES`). Where the user declared the
+filter (``refine(..., filter=...)``, :mod:`allanite.model._declared`) it is the one kind: its exact column, its shape
+fixed, no search — the test asks only whether the curve needs it; its floor after it kept as beside a Butterworth."""
 
 from __future__ import annotations
 
@@ -32,6 +31,7 @@ from ._rolloff import (
     sinc_grids,
     spectrum_agrees,
 )
+from ._sharp import sharp_kinds, sharp_searched
 from .curvefit import Curve, base_name, bw_kind, column, has_floor, profile_interval, search, solve
 
 __all__ = ["bandwidth_grids", "bw_family", "bw_searches", "bw_propose", "bw_params", "bw_evidence"]
@@ -104,6 +104,10 @@ def bw_propose(rnd: Round) -> list:
         )
         found = [f for f in found if f[0] not in superseded] + steeper
         grids.update({f[0]: grids[two] for f in steeper})
+        if sharp_searched({f[0] for f in steeper} | superseded):  # the chain climbed past the 3rd order
+            sharp, near = sharp_kinds(rnd.curve, rnd.start, rnd.effects, grids[two][0], steeper)
+            found += sharp
+            grids.update({f[0]: (near, True) for f in sharp})
     found = sinc_choice(found, tie)  # one sinc^k order at most, where it beats the boxcar and the orders below
     for key, p, s_new, edge in found:
         kind = bw_kind(key)  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)

@@ -1,0 +1,116 @@
+"""The sharp rippled kinds of the bandwidth step (:mod:`allanite.model._sharp`): an elliptic of fixed order and
+stop band whose cutoff is searched as a Butterworth's and whose signed passband ripple is searched on
+:data:`allanite.model._sharp.SHARP_RIPPLES`, then between the best ripple's neighbours (Brent's bounded search on
+log |r|, each point a cutoff search), per design.
+
+Searched only where the Butterworths' chain climbed past the 3rd order (:func:`sharp_searched`: the curve asked
+for a roll-off steeper than a 3rd order's) — a record whose roll-off a 2nd or 3rd order holds, or that has none,
+costs nothing more. A sharp kind then competes with the others on χ² (:func:`._rolloff.better_kind`, which counts
+its ripple as a parameter more: within one effective point a Butterworth keeps the name), is named only where
+the samples' spectrum shows its roll-off (:func:`._rolloff.spectrum_agrees`, as a Butterworth) and keeps the white
+floor after it (:func:`.curvefit.has_floor`). Its cutoff is not searched again beside later terms
+(:func:`._rolloff.research_rolloff` leaves a kind without a grid as accepted). Not in the step's bootstrap family
+(:func:`._bandwidth.bw_family`): it is searched only after the family's steepest columns were taken, as the
+shape those columns' roll-off has.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._sharp import RIPPLE_RANGE, SHARP_DESIGNS, SHARP_RIPPLES, sharp_kind
+from ._brent import bounded
+from .curvefit import Curve, searches
+
+__all__ = ["sharp_searched", "sharp_kinds", "near_grid", "RIPPLE_XTOL", "NEAR", "NEAR_NYQUIST"]
+
+#: Brent's tolerance on log |ripple| (a ripple named within ~3 %; the curve's χ² is flat at that scale).
+RIPPLE_XTOL = 0.03
+
+
+def sharp_searched(searched: set[str]) -> bool:
+    """Whether the sharp kinds are searched: the Butterworths' chain searched the 4th order (the 3rd beat the
+    2nd: the curve asks for a roll-off steeper than a 2nd order's and a 3rd order's own) — ``searched`` the keys
+    of every order it searched."""
+    return "bandwidth:butterworth4" in searched
+
+
+def sharp_kinds(curve: Curve, start: tuple, effects: list, grid: np.ndarray, butterworths: list) -> tuple:
+    """(the best sharp kind of each design as (key, f_c, solution, edge), the cutoff grid they were searched on):
+    every design at every ripple of :data:`SHARP_RIPPLES` searched on the points of the Butterworths' cutoff
+    ``grid`` near the best Butterworth's cutoff (:func:`near_grid`; ``butterworths`` the chain's (key, f_c, solution,
+    edge)), in one batch, then its best ripple refined between its neighbours of the same sign (Brent on log |r|,
+    the designs in lockstep). The decimated designs only where that cutoff lies above :data:`NEAR_NYQUIST`·f_s:
+    below it their folded stop band is 40 dB down and they are the undecimated designs' shapes."""
+    fb = min((f for f in butterworths if not f[3]), key=lambda f: f[2].chi2, default=butterworths[0])[1]
+    near = near_grid(grid, fb)
+    designs = [d for d in SHARP_DESIGNS if SHARP_DESIGNS[d][2] == 1 or fb > NEAR_NYQUIST * curve.fs]
+    specs = [(f"bandwidth:{sharp_kind(d, r)}", near, True) for d in designs for r in SHARP_RIPPLES]
+    found = [(spec[0], *res) for spec, res in zip(specs, searches(curve, start, effects, specs))]
+    per = len(SHARP_RIPPLES)
+    gens, best = [], []
+    for j, design in enumerate(designs):
+        rows = found[j * per : (j + 1) * per]
+        i = min(range(per), key=lambda k: (rows[k][3], rows[k][2].chi2))  # an edge cutoff last
+        best.append(rows[i])
+        gens.append((design, _ripple_brent(i)))
+    _advance(curve, start, effects, near, gens, best)
+    return best, near
+
+
+#: Where a sharp kind's passband edge is searched, as a factor on the best Butterworth's cutoff: at the same −3 dB
+#: point a sharp filter's edge lies below it (an elliptic of 1 dB: 0.96; a Chebyshev of 0.1 dB: 0.88) and
+#: the Butterworth's cutoff trades with the ripple's lift (0.6–1.3 holds every design of ``benches/refine_sharp.py``).
+NEAR = (0.6, 1.3)
+#: The cutoff (a share of f_s) above which the decimated designs are searched too.
+NEAR_NYQUIST = 0.25
+
+
+def near_grid(grid: np.ndarray, fb: float) -> np.ndarray:
+    """The points of ``grid`` within :data:`NEAR` of ``fb``; the three nearest (in log) where fewer lie there."""
+    grid = np.asarray(grid, dtype=np.float64)
+    keep = grid[(grid >= NEAR[0] * fb) & (grid <= NEAR[1] * fb)]
+    if keep.size >= 3:
+        return keep
+    return np.sort(grid[np.argsort(np.abs(np.log(grid / fb)))[:3]])
+
+
+def _ripple_brent(i: int):
+    """Brent's bounded search on log |r| between the neighbours of ripple ``i`` of :data:`SHARP_RIPPLES` on its side
+    of 0 (to the ends of :data:`allanite.model._sharp.RIPPLE_RANGE`), its sign kept; yields signed ripples."""
+    r = SHARP_RIPPLES[i]
+    side = sorted(abs(x) for x in SHARP_RIPPLES if x * r > 0)
+    k = side.index(abs(r))
+    lo = side[k - 1] if k > 0 else RIPPLE_RANGE[0]
+    hi = side[k + 1] if k + 1 < len(side) else RIPPLE_RANGE[1]
+    sign = math.copysign(1.0, r)
+    gen = bounded(math.log(lo), math.log(hi), xatol=RIPPLE_XTOL, maxfun=12)
+    try:
+        x = next(gen)
+        while True:
+            value = yield sign * math.exp(x)
+            x = gen.send(value)
+    except StopIteration:
+        return
+
+
+def _advance(curve: Curve, start: tuple, effects: list, grid: np.ndarray, gens: list, best: list) -> None:
+    """Runs the ripple searches ``gens`` [(design, generator)] in lockstep, each round's cutoff searches in one
+    batch, keeping in ``best`` (per design) the lowest χ² seen off the grid's edge."""
+    live = []
+    for j, (design, gen) in enumerate(gens):
+        live.append((j, design, gen, next(gen)))
+    while live:
+        specs = [(f"bandwidth:{sharp_kind(d, r)}", grid, True) for _j, d, _g, r in live]
+        got = searches(curve, start, effects, specs)
+        nxt = []
+        for (j, design, gen, _r), spec, (p, sol, edge) in zip(live, specs, got):
+            if not edge and (best[j][3] or sol.chi2 < best[j][2].chi2):
+                best[j] = (spec[0], p, sol, edge)
+            try:
+                nxt.append((j, design, gen, gen.send(sol.chi2)))
+            except StopIteration:
+                continue
+        live = nxt
