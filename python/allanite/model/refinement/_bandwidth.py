@@ -104,7 +104,8 @@ def bw_propose(rnd: Round) -> list:
         )
         found = [f for f in found if f[0] not in superseded] + steeper
         grids.update({f[0]: grids[two] for f in steeper})
-        if sharp_searched({f[0] for f in steeper} | superseded):  # the chain climbed past the 3rd order
+        butterworths = [f for f in found if needs_spectrum(bw_kind(f[0]))]
+        if sharp_searched(butterworths, {f[0] for f in steeper} | superseded, rnd.y, rnd.curve.fs):
             sharp, near = sharp_kinds(rnd.curve, rnd.start, rnd.effects, grids[two][0], steeper)
             found += sharp
             grids.update({f[0]: (near, True) for f in sharp})

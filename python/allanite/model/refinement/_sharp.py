@@ -3,15 +3,15 @@ stop band whose cutoff is searched as a Butterworth's and whose signed passband 
 :data:`allanite.model._sharp.SHARP_RIPPLES`, then between the best ripple's neighbours (Brent's bounded search on
 log |r|, each point a cutoff search), per design.
 
-Searched only where the Butterworths' chain climbed past the 3rd order (:func:`sharp_searched`: the curve asked
-for a roll-off steeper than a 3rd order's) — a record whose roll-off a 2nd or 3rd order holds, or that has none,
-costs nothing more. A sharp kind then competes with the others on χ² (:func:`._rolloff.better_kind`, which counts
-its ripple as a parameter more: within one effective point a Butterworth keeps the name), is named only where
-the samples' spectrum shows its roll-off (:func:`._rolloff.spectrum_agrees`, as a Butterworth) and keeps the white
-floor after it (:func:`.curvefit.has_floor`). Its cutoff is not searched again beside later terms
-(:func:`._rolloff.research_rolloff` leaves a kind without a grid as accepted). Not in the step's bootstrap family
-(:func:`._bandwidth.bw_family`): it is searched only after the family's steepest columns were taken, as the
-shape those columns' roll-off has.
+Searched only where the Butterworths' chain climbed past the 3rd order, or where the samples' spectrum shows the
+roll-off of one of its orders (:func:`sharp_searched`) — a record whose spectrum shows no steep roll-off (a boxcar, a
+single pole: the ADIS16405's), or that has none, costs nothing more. A sharp kind then competes with the others on χ²
+(:func:`._rolloff.better_kind`, which counts its ripple as a parameter more: within one effective point a Butterworth
+keeps the name), is named only where the samples' spectrum shows its roll-off (:func:`._rolloff.spectrum_agrees`, as a
+Butterworth) and keeps the white floor after it (:func:`.curvefit.has_floor`). Its cutoff is not searched again beside
+later terms (:func:`._rolloff.research_rolloff` leaves a kind without a grid as accepted). Not in the step's bootstrap
+family (:func:`._bandwidth.bw_family`): it is searched only after the family's steepest columns were taken, as the shape
+those columns' roll-off has.
 """
 
 from __future__ import annotations
@@ -22,7 +22,8 @@ import numpy as np
 
 from .._sharp import RIPPLE_RANGE, SHARP_DESIGNS, SHARP_RIPPLES, sharp_kind
 from ._brent import bounded
-from .curvefit import Curve, searches
+from ._rolloff import spectrum_agrees
+from .curvefit import Curve, bw_kind, searches
 
 __all__ = ["sharp_searched", "sharp_kinds", "near_grid", "RIPPLE_XTOL", "NEAR", "NEAR_NYQUIST"]
 
@@ -30,11 +31,16 @@ __all__ = ["sharp_searched", "sharp_kinds", "near_grid", "RIPPLE_XTOL", "NEAR", 
 RIPPLE_XTOL = 0.03
 
 
-def sharp_searched(searched: set[str]) -> bool:
+def sharp_searched(butterworths: list, searched: set[str], y: np.ndarray | None, fs: float) -> bool:
     """Whether the sharp kinds are searched: the Butterworths' chain searched the 4th order (the 3rd beat the
-    2nd: the curve asks for a roll-off steeper than a 2nd order's and a 3rd order's own) — ``searched`` the keys
-    of every order it searched."""
-    return "bandwidth:butterworth4" in searched
+    2nd: the curve asks for a roll-off steeper than a 2nd order's) — ``searched`` the keys of every order it
+    searched —, or the samples' spectrum ``y`` shows the roll-off of one of the orders found, ``butterworths``
+    (key, f_c, solution, edge) — a rippled filter's curve need not climb the chain (an elliptic of order 7 and
+    0.9 dB read as a 3rd order). Not where no order's roll-off is in the spectrum: a boxcar of 1.2 samples (the
+    ADIS16405's) leaves half the passband's power at 0.40–0.48·f_s, which no sharp kind may stand in for either."""
+    if "bandwidth:butterworth4" in searched:
+        return True
+    return any(not f[3] and spectrum_agrees(y, fs, bw_kind(f[0]), f[1]) for f in butterworths)
 
 
 def sharp_kinds(curve: Curve, start: tuple, effects: list, grid: np.ndarray, butterworths: list) -> tuple:
