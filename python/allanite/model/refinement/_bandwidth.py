@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import tracing
 from .._declared import DeclaredFilter, active_declared
-from ..effects import CASCADE_SPANS, filter_autocorrelation
+from ..effects import CASCADE_SPANS, filter_autocorrelation, split_notch
 from ._notch import notch_choice
 from ._proposal import Proposal, Round, column_amplitude, with_stat
 from ._rolloff import (
@@ -31,7 +31,7 @@ from ._rolloff import (
     sinc_grids,
     spectrum_agrees,
 )
-from ._sharp import sharp_kinds, sharp_searched
+from ._sharp import ripple_interval, sharp_kinds, sharp_searched
 from .curvefit import Curve, base_name, bw_kind, column, has_floor, profile_interval, search, solve
 
 __all__ = ["bandwidth_grids", "bw_family", "bw_searches", "bw_propose", "bw_params", "bw_evidence"]
@@ -173,12 +173,13 @@ def bw_params(pr: Proposal, rnd: Round) -> tuple:
     if decl is not None and bw_kind(pr.key) == decl.kind:  # known, not fitted: no interval
         params: dict = {"cutoff": decl.cutoff, "taps": int(decl.b.size) if decl.is_fir else 0, "filter": "declared"}
         return _with_floor(params, {}, pr, rnd)
+    kind = bw_kind(pr.key)
     params, intervals = filter_params(
-        bw_kind(pr.key),
-        pr.p,
-        rnd.curve.fs,
-        lambda: profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol),
+        kind, pr.p, rnd.curve.fs, lambda: profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol)
     )
+    if "ripple" in params:  # a sharp kind: its ripple's own profile, the edge searched again at each ripple
+        grid = bandwidth_grids(rnd.curve).get("butterworth2", np.asarray([pr.p]))
+        intervals["ripple"] = ripple_interval(rnd.curve, rnd.start, rnd.effects, split_notch(kind)[0], pr.p, grid)
     return _with_floor(params, intervals, pr, rnd)
 
 

@@ -23,9 +23,9 @@ import numpy as np
 from .._sharp import RIPPLE_RANGE, SHARP_DESIGNS, SHARP_RIPPLES, sharp_kind
 from ._brent import bounded
 from ._rolloff import spectrum_agrees
-from .curvefit import Curve, bw_kind, searches
+from .curvefit import PROFILE_RHO, Curve, bw_kind, searches
 
-__all__ = ["sharp_searched", "sharp_kinds", "near_grid", "RIPPLE_XTOL", "NEAR", "NEAR_NYQUIST"]
+__all__ = ["sharp_searched", "sharp_kinds", "near_grid", "ripple_interval", "RIPPLE_XTOL", "NEAR", "NEAR_NYQUIST"]
 
 #: Brent's tolerance on log |ripple| (a ripple named within ~3 %; the curve's χ² is flat at that scale).
 RIPPLE_XTOL = 0.03
@@ -66,9 +66,11 @@ def sharp_kinds(curve: Curve, start: tuple, effects: list, grid: np.ndarray, but
     return best, near
 
 
-#: Where a sharp kind's passband edge is searched, as a factor on the best Butterworth's cutoff: at the same −3 dB
-#: point a sharp filter's edge lies below it (an elliptic of 1 dB: 0.96; a Chebyshev of 0.1 dB: 0.88) and
-#: the Butterworth's cutoff trades with the ripple's lift (0.6–1.3 holds every design of ``benches/refine_sharp.py``).
+#: Where a sharp kind's passband edge is searched, as a factor on the best Butterworth's cutoff: a sharp filter's
+#: edge lies below its −3 dB point (an elliptic of order 4 and 1 dB at 30 Hz of 200: edge 30.2 Hz where the best
+#: Butterworth-6 reads 31.9, 0.95), and the Butterworth's cutoff trades with the ripple's lift. Not every design
+#: falls inside: a Chebyshev I of order 3 decimated by 4, its edge near the output's Nyquist, fits an edge of
+#: 93 Hz where its Butterworth-2 reads 68.8 (1.35) — there the search ends at the grid's last point.
 NEAR = (0.6, 1.3)
 #: The cutoff (a share of f_s) above which the decimated designs are searched too.
 NEAR_NYQUIST = 0.25
@@ -120,3 +122,35 @@ def _advance(curve: Curve, start: tuple, effects: list, grid: np.ndarray, gens: 
             except StopIteration:
                 continue
         live = nxt
+
+
+def ripple_interval(curve: Curve, start: tuple, effects: list, kind: str, p: float, grid: np.ndarray) -> tuple:
+    """The signed ripple's profile interval (dB) of the sharp ``kind`` at passband edge ``p`` beside ``effects``:
+    where the effective χ² (scaled as :func:`.curvefit.profile_interval` scales it), the edge searched again at each
+    ripple on the points of ``grid`` near ``p`` (:func:`near_grid`), rises by at most 1 over its minimum; 15 ripples
+    within a factor 2 either way of the named one (its sign kept, inside :data:`allanite.model._sharp.RIPPLE_RANGE`),
+    searched in one batch, the crossings interpolated in log |r|."""
+    design, _sep, tail = kind.partition(":")
+    r0 = float(tail)
+    lo_r, hi_r = RIPPLE_RANGE
+    local = np.unique(np.clip(abs(r0) * np.exp(np.linspace(-0.7, 0.7, 15)), lo_r, hi_r))
+    near = near_grid(grid, p)
+    specs = [(f"bandwidth:{sharp_kind(design, math.copysign(r, r0))}", near, True) for r in local]
+    chi2 = np.array([res[1].chi2 for res in searches(curve, start, effects, specs)])
+    scale = curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / curve.tau.size
+    d = (chi2 - chi2.min()) * scale - 1.0
+    i0 = int(np.argmin(d))
+    lo_i, hi_i = i0, i0
+    while lo_i > 0 and d[lo_i - 1] <= 0:
+        lo_i -= 1
+    while hi_i < local.size - 1 and d[hi_i + 1] <= 0:
+        hi_i += 1
+    ll = np.log(local)
+
+    def cross(i: int, j: int) -> float:
+        return math.exp(ll[i] + (ll[j] - ll[i]) * (-d[i]) / (d[j] - d[i]))
+
+    lo = cross(lo_i, lo_i - 1) if lo_i > 0 else float(local[0])
+    hi = cross(hi_i, hi_i + 1) if hi_i < local.size - 1 else float(local[-1])
+    lo, hi = min(lo, abs(r0)), max(hi, abs(r0))
+    return (lo, hi) if r0 > 0 else (-hi, -lo)
