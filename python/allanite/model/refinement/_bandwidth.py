@@ -15,6 +15,7 @@ import numpy as np
 
 from .. import tracing
 from .._declared import DeclaredFilter, active_declared
+from .._sharp import sharp_of
 from ..effects import CASCADE_SPANS, filter_autocorrelation, split_notch
 from ._notch import notch_choice
 from ._proposal import Proposal, Round, column_amplitude, with_stat
@@ -120,6 +121,8 @@ def bw_propose(rnd: Round) -> list:
         return []
     f_best = best
     best = _remembered(rnd, "floor_choice", (_found(f_best), tie), lambda: _floor(rnd, f_best, tie))
+    # a sharp kind is a notch's base only where it was chosen: as every base, it would widen the notch's family
+    found = [f for f in found if sharp_of(bw_kind(f[0])) is None or f[0] == best[0]]
     parts = (tuple(_found(f) for f in found), _found(best), _grids(grids), rnd.level)
     key, p, s_new, edge = _remembered(  # a notch after it (:mod:`._notch`)
         rnd, "notch_choice", parts, lambda: notch_choice(rnd, found, best, grids, rnd.level)

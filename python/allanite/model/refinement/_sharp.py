@@ -4,14 +4,14 @@ stop band whose cutoff is searched as a Butterworth's and whose signed passband 
 log |r|, each point a cutoff search), per design.
 
 Searched only where the Butterworths' chain climbed past the 3rd order, or where the samples' spectrum shows the
-roll-off of one of its orders (:func:`sharp_searched`) — a record whose spectrum shows no steep roll-off (a boxcar, a
-single pole: the ADIS16405's), or that has none, costs nothing more. A sharp kind then competes with the others on χ²
-(:func:`._rolloff.better_kind`, which counts its ripple as a parameter more: within one effective point a Butterworth
-keeps the name), is named only where the samples' spectrum shows its roll-off (:func:`._rolloff.spectrum_agrees`, as a
-Butterworth) and keeps the white floor after it (:func:`.curvefit.has_floor`). Its cutoff is not searched again beside
-later terms (:func:`._rolloff.research_rolloff` leaves a kind without a grid as accepted). Not in the step's bootstrap
-family (:func:`._bandwidth.bw_family`): it is searched only after the family's steepest columns were taken, as the shape
-those columns' roll-off has.
+roll-off of one of its orders (:func:`sharp_searched`) — a record whose spectrum shows no Butterworth's roll-off, or
+that has none, costs nothing more. A sharp kind then competes with the others on χ² (:func:`._rolloff.better_kind`,
+which counts its ripple as a parameter more: within one effective point a Butterworth keeps the name), is named only
+where the samples' spectrum shows its roll-off (:func:`._rolloff.spectrum_agrees`, as a Butterworth) and keeps the white
+floor after it (:func:`.curvefit.has_floor`). Its cutoff is not searched again beside later terms
+(:func:`._rolloff.research_rolloff` leaves a kind without a grid as accepted). Not in the step's bootstrap family
+(:func:`._bandwidth.bw_family`): it is searched only after the family's steepest columns were taken, as the shape those
+columns' roll-off has.
 """
 
 from __future__ import annotations
@@ -36,8 +36,10 @@ def sharp_searched(butterworths: list, searched: set[str], y: np.ndarray | None,
     2nd: the curve asks for a roll-off steeper than a 2nd order's) — ``searched`` the keys of every order it
     searched —, or the samples' spectrum ``y`` shows the roll-off of one of the orders found, ``butterworths``
     (key, f_c, solution, edge) — a rippled filter's curve need not climb the chain (an elliptic of order 7 and
-    0.9 dB read as a 3rd order). Not where no order's roll-off is in the spectrum: a boxcar of 1.2 samples (the
-    ADIS16405's) leaves half the passband's power at 0.40–0.48·f_s, which no sharp kind may stand in for either."""
+    0.9 dB read as a 3rd order). Not where no order's roll-off is in the spectrum: a boxcar of 1.2 samples leaves
+    half the passband's power at 0.40–0.48·f_s (ADIS16405 run 3 acc_x: closed on both chains). On 5 ADIS16405
+    channels it opened on 8 of 15 calls (a Butterworth order at some cutoff agreeing with their spectrum), every
+    field of their results unchanged (``benches/results/r18sharp.md``)."""
     if "bandwidth:butterworth4" in searched:
         return True
     return any(not f[3] and spectrum_agrees(y, fs, bw_kind(f[0]), f[1]) for f in butterworths)
@@ -63,7 +65,19 @@ def sharp_kinds(curve: Curve, start: tuple, effects: list, grid: np.ndarray, but
         best.append(rows[i])
         gens.append((design, _ripple_brent(i)))
     _advance(curve, start, effects, near, gens, best)
-    return best, near
+    return [_at_range_edge(f) for f in best], near
+
+
+def _at_range_edge(found: tuple) -> tuple:
+    """``found`` (key, f_c, solution, edge) marked at the edge where its ripple ends within two of Brent's steps of
+    an end of :data:`allanite.model._sharp.RIPPLE_RANGE`: a ripple the search runs into the end of is not identified
+    (:func:`._rolloff.better_kind` ranks it last, as a cutoff at its grid's end) — near 3 dB a dip in the passband
+    is what a notch after a Butterworth makes (a 2nd order at 40 Hz of 200 with a 12 Hz notch of Q 2: `elliptic6`
+    at −2.94 dB beat the Butterworth by χ² 18118 → 3349 before the notch was tried), near 0.05 dB a Butterworth."""
+    ripple = abs(float(found[0].rpartition(":")[2]))
+    lo, hi = RIPPLE_RANGE
+    slack = math.exp(2.0 * RIPPLE_XTOL)
+    return found if lo * slack < ripple < hi / slack else (*found[:3], True)
 
 
 #: Where a sharp kind's passband edge is searched, as a factor on the best Butterworth's cutoff: a sharp filter's
