@@ -158,7 +158,10 @@ NOTES: list = [
     "band and an order-8 Chebyshev I, shapes the fixed designs hold only roughly). The Butterworth-like filters "
     "(Chebyshev II, Kaiser FIRs: 2, 7, 9, 12, 17, 19) keep their kind and verdict. Not reached (the gate stays "
     "closed: no Butterworth order agrees with their spectrum): records 6, 14, 20, 21 (boxcar or sinc² named, the "
-    "curve departs) and the stand-ins of 4, 8, 18, 20, 22 — as before.",
+    "curve departs) and the stand-ins of 4, 8, 18, 20, 22 — as before. Commits after f0a5218 (the ripple's "
+    "interval; a ripple within two Brent steps of 0.05 or 3 dB marked at the edge; a sharp kind a notch's base "
+    "only where chosen) leave every kind named here as it is (no named ripple lies near either end, no notch was "
+    "named); the table was not rerun after them.",
 ]
 
 
