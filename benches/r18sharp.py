@@ -211,8 +211,8 @@ NOTES: list = [
     "324.1 Hz (−1.0 %; was butterworth3 at 309 Hz, −5.6 %), final χ²/dof 129 → 53.6, still ✗ on `unexplained` "
     "(the curve departs at τ 1–55 ms, χ²/dof 11 there: a 95-tap FIR's ripple is not an elliptic's).",
     "- *False alarms* (`refine_false_alarms.py`'s records, 13 per mixture and 8 of issue16: 99 records, the same "
-    "seeds; main db0a328 against this branch's 6adfc6c, load 12–28): 1 of 99 on both (95 % CP 0.0–5.5 %), the same "
-    "white record's resonance; the sharp kinds' gate opened on 0 of the branch's 126 bandwidth steps, so no sharp "
+    "seeds; main db0a328 against this branch's 6adfc6c, load 12–28): 1 of 99 on both (95 % CP 0.0–5.5 %), a "
+    "resonance on one white record on both; the sharp kinds' gate opened on 0 of the branch's 100 bandwidth steps, so no sharp "
     "fit ran on a null record.",
 ]
 
