@@ -139,7 +139,16 @@ def write_md(res: dict) -> None:
 
 #: What the recorded run shows (kept true to benches/results/refine_declared_null.json).
 NOTES: list = [
-    "Reading (the recorded run, at 78fec30's library — refine's behaviour unchanged since (later commits moved a check into a helper, docs); other processes used ~88 % of the CPUs): with the filter declared no record took anything beside the bandwidth and none said anything unexplained — 0 of 40 (95 % CP 0–8.8 %). The default call on the same records alarms on 28 of 40: it names a bandwidth kind of its family, which lacks the rippled filters' shape, and then says the curve departs from the model (and on 10 of them adds resonances or a Gauss–Markov term as stand-ins); 3 of the 10 Bartlett records alarm too, whose shape is in the family but whose quantised output's floor beside it is not always taken. What this null measures: the declared kind leaves nothing for the other tests to find when the declaration is right. The no-filter path is unchanged (six suite rows field by field identical to main), so the suites' false-alarm rates are not moved and `refine_false_alarms.py` was not rerun.",
+    "Reading (the recorded run, at r18sharp f0a5218 — the sharp rippled bandwidth kinds in the default call; "
+    "other helpers' runs used ~96 % of the CPUs): with the filter declared no record took anything beside the "
+    "bandwidth and none said anything unexplained — 0 of 40 (95 % CP 0–8.8 %), as before. The default call alarms "
+    "on 13 of 40 (18.6–49.1 %) where it alarmed on 28 of 40 (53.5–83.4 %) before the sharp kinds (78fec30–db0a328): "
+    "the elliptic IIR 10 → 0 of 10, the remez FIR 5 → 1, the Chebyshev I decimated by 4 to 250 Hz 10 → 9 (its edge "
+    "near the output's Nyquist: no Butterworth order agrees with its spectrum, so the sharp kinds are not searched "
+    "— the gate of allanite.model.refinement._sharp), the quantised Bartlett 3 → 3 (the same records 7, 15, 39, "
+    "whose kind is in the family). Stand-ins (a resonance or Gauss–Markov term added): 10 records → 2 (Chebyshev "
+    "records 6 and 26). Later commits on the branch (a ripple near its range's ends marked at the edge; a sharp "
+    "kind a notch's base only where chosen) were not rerun here.",
 ]
 
 

@@ -147,6 +147,7 @@ MODEL_RANKS = {
     "model._shaped": -0.5,  # noise-shaped (sigma-delta) quantisation's exact Allan variance (numpy only)
     "model._sinc": -0.5,  # the sinc^k (CIC) roll-off's autocorrelation and cutoff (numpy only)
     "model._declared": -0.5,  # a user-declared filter (FIR taps, IIR b, a) as an exact bandwidth kind (numpy, scipy)
+    "model._sharp": -0.5,  # the sharp rippled bandwidth kinds' designs (elliptic, fixed order and stop band; scipy)
     "model._signatures": -0.25,  # the effects' Allan-variance signatures: filter kinds, sinusoid, resonance, drift
     "model._counter": -0.5,  # a delta-angle counter's exact Q column and the record read as one (numpy, scipy only)
     "model._quantiser": -0.4,  # a rate quantised at the output: its error's exact floor column (on _counter's lattice)
@@ -234,6 +235,7 @@ MODEL_RANKS = {
     "model.refinement.missing": 7,
     "model.refinement._rolloff": 5.5,
     "model.refinement._notch": 5.6,  # a notch after the roll-off (on _rolloff; the bandwidth candidate's)
+    "model.refinement._sharp": 5.6,  # the sharp rippled kinds' search (on _rolloff; the bandwidth candidate's)
     "model.refinement._inputs": 4.5,
     # refine's parts, below loop (its curve steps): the refinement under way and its chain; the removals in time
     # on it; the chain scored, the change points and the result on it (with what is missing: above missing)

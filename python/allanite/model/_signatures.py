@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ._declared import declared_of
+from ._sharp import SHARP_DESIGNS, sharp_cutoff, sharp_of, sharp_zpk
 from ._sinc import SINC_ORDERS, sinc_autocorrelation, sinc_cutoff, sinc_order
 
 __all__ = [
@@ -29,6 +30,8 @@ __all__ = [
     "BUTTERWORTH_ORDERS",
     "SINC_ORDERS",
     "sinc_order",
+    "SHARP_DESIGNS",
+    "sharp_of",
     "CASCADE_SPANS",
     "RESONANCE_Q",
     "RESONANCE_SHAPES",
@@ -51,7 +54,10 @@ __all__ = [
 #: sinc^k of order 2 to 5 ("sinc2" … "sinc5": a CIC decimator read at its output rate, k boxcars of span D,
 #: the samples' autocorrelation the B-spline M_2k(l/D); :mod:`allanite.model._sinc`). Any of them may be followed
 #: by a digital notch (:func:`notch_kind`: ``"<kind>+notch:<f_n>:<Q>"``, not listed here — its f_n and Q are in the
-#: kind's name, searched by :mod:`allanite.model.refinement._notch`).
+#: kind's name, searched by :mod:`allanite.model.refinement._notch`), and the sharp rippled kinds
+#: (``"elliptic4:<r>"``, ``"elliptic6:<r>"``: an elliptic of fixed order and stop band whose signed passband ripple
+#: r dB is in the kind's name, :mod:`allanite.model._sharp`; not listed here either — searched by
+#: :mod:`allanite.model.refinement._sharp`).
 FILTERS: tuple[str, ...] = (
     ("single_pole", "moving_average", "bartlett", "boxcar")
     + tuple(f"sinc{k}" for k in SINC_ORDERS)
@@ -112,6 +118,23 @@ def _cascade_terms(order: int, fc: float, f_n: float, q: float, fs: float) -> tu
     return rational_terms(np.concatenate([zb, zn]), np.concatenate([pb, pn]), kb * kn)
 
 
+@functools.lru_cache(maxsize=4096)
+def _sharp_terms(kind: str, fc: float, fs: float) -> tuple:
+    """:func:`rational_terms` of a sharp kind (:func:`allanite.model._sharp.sharp_zpk`), remembered; of a decimated
+    one (every D-th output of the filter at D·f_s), the output's: r_out(l) = r_h(l·D) = Σ_j C_j·(p_j^D)^l for l ≥ 1
+    (a pole at z = 0 adds only at the filter's own lag 1, no output lag), renormalised to a unit two-sided sum —
+    the same closed form with poles p_j^D, the stop band's aliasing included."""
+    r0, c, poles, _lag1 = rational_terms(*sharp_zpk(kind, fc, fs))
+    dec = SHARP_DESIGNS[kind.partition(":")[0]][2]
+    if dec == 1:
+        return r0, c, poles, _lag1
+    folded = poles**dec
+    total = r0 + 2.0 * float((c * folded / (1.0 - folded)).sum().real)
+    c, folded = c / total, folded.copy()
+    c.flags.writeable = folded.flags.writeable = False
+    return r0 / total, c, folded, 0.0
+
+
 @functools.lru_cache(maxsize=1024)
 def _notch_autocorrelation(f_n: float, q: float, fs: float) -> np.ndarray:
     """r(l) of a notch alone (:func:`notch_zpk`), remembered (read-only)."""
@@ -132,7 +155,10 @@ def _terms_autocorrelation(terms: tuple) -> np.ndarray:
 
 
 def _notch_terms(kind: str, p: float, fs: float) -> tuple | None:
-    """The closed-form terms of a Butterworth followed by a notch (:func:`notch_kind`); None for another kind."""
+    """The closed-form terms of a Butterworth followed by a notch (:func:`notch_kind`), or of a sharp kind
+    (:mod:`allanite.model._sharp`, at f_c below f_s/2); None for another kind."""
+    if sharp_of(kind) is not None and p < fs / 2.0:
+        return _sharp_terms(kind, float(p), float(fs))
     base, f_n, q = split_notch(kind)
     order = butterworth_order(base)
     if f_n is None or q is None or not order:
@@ -247,12 +273,13 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
     length L (taps of one moving average) for the FIRs, the span D·f_s (samples, ≥ 1, any real) for
     ``"boxcar"``, each boxcar's span in output samples (≥ 1/k, any real) for a sinc^k (``"sinc2"`` …); a declared
     filter's kind (``"declared:<token>"``, :mod:`allanite.model._declared`) its own exact autocorrelation, ``p``
-    not read (its shape is known)."""
+    not read (its shape is known); a sharp kind (``"elliptic6:<ripple dB>"``, :mod:`allanite.model._sharp`) ``p``
+    its passband edge (Hz), its poles' closed form."""
     decl = declared_of(kind)
     if decl is not None:
         return decl.r
     terms = _notch_terms(kind, p, fs)
-    if terms is not None:  # a Butterworth and a notch: one rational filter, its closed form
+    if terms is not None:  # a Butterworth and a notch, or a sharp kind: one rational filter, its closed form
         return _terms_autocorrelation(terms)
     base, f_n, q = split_notch(kind)
     if f_n is not None:  # any other kind and a notch: the two (two-sided, unit-sum) autocorrelations convolved
@@ -263,7 +290,7 @@ def filter_autocorrelation(kind: str, p: float, fs: float) -> np.ndarray:
         n = int(min(200_000, math.ceil(40.0 / max(1.0 - a, 1e-9)))) + 1
         return (1.0 - a) / (1.0 + a) * a ** np.arange(n, dtype=np.float64)
     order = butterworth_order(kind)
-    if order and p >= fs / 2.0:  # its limit there: H → 1, no filter
+    if (order or sharp_of(kind) is not None) and p >= fs / 2.0:  # its limit there: H → 1, no filter
         return np.ones(1)
     if order:  # to where the poles' terms fall below 1e-17 of r(0)
         return _terms_autocorrelation(butterworth_terms(order, p, fs))
@@ -302,6 +329,8 @@ def filter_cutoff(kind: str, p: float, fs: float) -> float:
     if decl is not None:
         return decl.cutoff
     kind = split_notch(kind)[0]
+    if sharp_of(kind) is not None:
+        return sharp_cutoff(kind, float(p), float(fs))
     if sinc_order(kind):
         return sinc_cutoff(sinc_order(kind), p, fs)
     if kind == "single_pole" or butterworth_order(kind):  # a Butterworth's prewarped cutoff: −3 dB at f_c exactly
@@ -334,13 +363,15 @@ def filtered_white_avar(tau: np.ndarray | float, kind: str, p: float, fs: float)
     R(l) = Σ_j C_j·p_j^|l| beyond lag 0 (:func:`butterworth_terms`), so the sum is closed: (r(0) − Σ C_j)/m plus
     Σ_j C_j times the geometric sums of :func:`resonance_avar` at ρ = p_j; at f_c ≥ f_s/2 its limit (the poles
     meet the n-fold zero at z = −1: no filter), N²/τ. A Butterworth followed by a notch (:func:`notch_kind`) is one
-    rational filter: the same closed sums over its and the notch's poles; another kind with a notch, and a declared
+    rational filter: the same closed sums over its and the notch's poles, as a sharp kind's over its own
+    (:mod:`allanite.model._sharp`: an elliptic of fixed order and stop band, its ripple in its name); another kind
+    with a notch, and a declared
     filter (``"declared:<token>"``, :mod:`allanite.model._declared`: the output's autocorrelation r_h(l·D), aliasing
     included), sum their (long) autocorrelation by prefix sums (:func:`_prefix_avar`)."""
     tau = np.atleast_1d(np.asarray(tau, dtype=np.float64))
     m = np.maximum(1.0, np.round(tau * fs))
     order = butterworth_order(kind)
-    if order and p >= fs / 2.0:  # its limit there: H → 1, white noise
+    if (order or sharp_of(kind) is not None) and p >= fs / 2.0:  # its limit there: H → 1, white noise
         return fs / m
     terms = butterworth_terms(order, p, fs) if order else _notch_terms(kind, p, fs)
     if terms is not None:  # geometric autocorrelation: closed sums, white part r(0) − Σ C_j at lag 0

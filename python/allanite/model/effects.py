@@ -189,11 +189,20 @@ EFFECTS: dict[str, Effect] = {
                 ),
                 ("notch_f", "Hz", "centre of a digital notch after the low-pass (``filter`` ``<kind>+notch``)"),
                 ("notch_q", "", "the notch's quality factor, f_n over its −3 dB width"),
+                (
+                    "ripple",
+                    "dB",
+                    "a sharp kind's signed passband ripple (``filter`` ``elliptic4``, ``elliptic6``, decimated "
+                    "``…_dec4``): positive where the gain rises above DC (an even order), negative where it dips",
+                ),
+                ("passband_edge", "Hz", "a sharp kind's passband edge f_c, where the gain leaves the ripple band"),
             ),
             "the sensor's low-pass on its white rate noise (single pole, the moving-average/Bartlett FIR of a "
             "decimating MEMS part, a boxcar of any span read at the output rate, a CIC decimator's sinc^k of "
             "order 2 to 5, ``sinc2`` … ``sinc5``, or the Butterworth anti-alias "
-            "stage of a MEMS or tactical gyro, orders 2 to 6, ``butterworth2`` … ``butterworth6``): "
+            "stage of a MEMS or tactical gyro, orders 2 to 6, ``butterworth2`` … ``butterworth6``, or a sharp rippled "
+            "elliptic of fixed order and stop band whose signed ripple is searched, ``elliptic4``, ``elliptic6``, "
+            "``elliptic4_dec4``, ``elliptic6_dec4``): "
             "N²·(1/2m²)·Σ_l A_m(l)·r(l)/τ0, exact in discrete time, in place of N²/τ — a "
             "roll-off of the shortest τ; the N it reports is the white noise before the filter. Beside a Butterworth "
             "(and beside another kind where the spectrum above f_s/4 shows a floor the fit agrees with) "

@@ -1,11 +1,10 @@
 """The ``"bandwidth"`` curve candidate: the sensor's low-pass on its white rate noise (single pole, moving average,
-Bartlett, boxcar, a CIC's sinc^k, pole + boxcar, Butterworth), replacing the N column — its search grids per
-filter kind, bootstrap family, searches, proposal (the kind with the lowest χ², :mod:`._rolloff` deciding the
-Butterworths, the sinc^k order and the white floor, :mod:`._notch` a notch after the kind), parameters and evidence
-in the spectrum
-(:data:`.candidates.CURVE_CANDIDATES`). Where the user declared the filter (``refine(..., filter=...)``,
-:mod:`allanite.model._declared`) it is the one kind: its exact column, its shape fixed, no search — the test asks
-only whether the curve needs it; its floor after it kept as beside a Butterworth."""
+Bartlett, boxcar, a CIC's sinc^k, pole + boxcar, Butterworth, a sharp rippled elliptic: :mod:`._sharp`), replacing the N
+column — its search grids per filter kind, bootstrap family, searches, proposal (the kind with the lowest χ²,
+:mod:`._rolloff` deciding the Butterworths, the sinc^k order and the white floor, :mod:`._notch` a notch after the
+kind), parameters and evidence in the spectrum (:data:`.candidates.CURVE_CANDIDATES`). Where the user declared the
+filter (``refine(..., filter=...)``, :mod:`allanite.model._declared`) it is the one kind: its exact column, its shape
+fixed, no search — the test asks only whether the curve needs it; its floor after it kept as beside a Butterworth."""
 
 from __future__ import annotations
 
@@ -16,7 +15,8 @@ import numpy as np
 
 from .. import tracing
 from .._declared import DeclaredFilter, active_declared
-from ..effects import CASCADE_SPANS, filter_autocorrelation
+from .._sharp import sharp_of
+from ..effects import CASCADE_SPANS, filter_autocorrelation, split_notch
 from ._notch import notch_choice
 from ._proposal import Proposal, Round, column_amplitude, with_stat
 from ._rolloff import (
@@ -32,6 +32,7 @@ from ._rolloff import (
     sinc_grids,
     spectrum_agrees,
 )
+from ._sharp import ripple_interval, sharp_kinds, sharp_searched
 from .curvefit import Curve, base_name, bw_kind, column, has_floor, profile_interval, search, solve
 
 __all__ = ["bandwidth_grids", "bw_family", "bw_searches", "bw_propose", "bw_params", "bw_evidence"]
@@ -104,6 +105,11 @@ def bw_propose(rnd: Round) -> list:
         )
         found = [f for f in found if f[0] not in superseded] + steeper
         grids.update({f[0]: grids[two] for f in steeper})
+        butterworths = [f for f in found if needs_spectrum(bw_kind(f[0]))]
+        if sharp_searched(butterworths, {f[0] for f in steeper} | superseded, rnd.y, rnd.curve.fs):
+            sharp, near = sharp_kinds(rnd.curve, rnd.start, rnd.effects, grids[two][0], steeper)
+            found += sharp
+            grids.update({f[0]: (near, True) for f in sharp})
     found = sinc_choice(found, tie)  # one sinc^k order at most, where it beats the boxcar and the orders below
     for key, p, s_new, edge in found:
         kind = bw_kind(key)  # a Butterworth only where the spectrum shows its roll-off (:mod:`._rolloff`)
@@ -115,6 +121,8 @@ def bw_propose(rnd: Round) -> list:
         return []
     f_best = best
     best = _remembered(rnd, "floor_choice", (_found(f_best), tie), lambda: _floor(rnd, f_best, tie))
+    # a sharp kind is a notch's base only where it was chosen: as every base, it would widen the notch's family
+    found = [f for f in found if sharp_of(bw_kind(f[0])) is None or f[0] == best[0]]
     parts = (tuple(_found(f) for f in found), _found(best), _grids(grids), rnd.level)
     key, p, s_new, edge = _remembered(  # a notch after it (:mod:`._notch`)
         rnd, "notch_choice", parts, lambda: notch_choice(rnd, found, best, grids, rnd.level)
@@ -168,12 +176,13 @@ def bw_params(pr: Proposal, rnd: Round) -> tuple:
     if decl is not None and bw_kind(pr.key) == decl.kind:  # known, not fitted: no interval
         params: dict = {"cutoff": decl.cutoff, "taps": int(decl.b.size) if decl.is_fir else 0, "filter": "declared"}
         return _with_floor(params, {}, pr, rnd)
+    kind = bw_kind(pr.key)
     params, intervals = filter_params(
-        bw_kind(pr.key),
-        pr.p,
-        rnd.curve.fs,
-        lambda: profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol),
+        kind, pr.p, rnd.curve.fs, lambda: profile_interval(rnd.curve, rnd.start, rnd.effects, pr.key, pr.p, pr.sol)
     )
+    if "ripple" in params:  # a sharp kind: its ripple's own profile, the edge searched again at each ripple
+        grid = bandwidth_grids(rnd.curve).get("butterworth2", np.asarray([pr.p]))
+        intervals["ripple"] = ripple_interval(rnd.curve, rnd.start, rnd.effects, split_notch(kind)[0], pr.p, grid)
     return _with_floor(params, intervals, pr, rnd)
 
 

@@ -14,6 +14,7 @@ from .. import fitting
 from .._counter import active_counter
 from .._declared import declared_of
 from .._quantiser import active_quantiser
+from .._sharp import sharp_of
 from ..effects import EFFECTS, butterworth_order, filtered_white_avar, resonance_avar, split_notch
 from ..terms import TERM_ALPHA, design_matrix
 
@@ -196,20 +197,21 @@ def design(curve, terms, effects):
 
 
 def has_floor(key: str) -> bool:
-    """Whether the term a bandwidth ``key`` carries keeps its own column beside it — white noise added after the
-    filter (a quantised output's floor; the bandwidth's ``floor``): beside a Butterworth, whose stop band the
-    samples' spectrum shows and a floor is flat in, and beside any other kind whose key carries
-    :data:`FLOOR_TAG` — only where the spectrum above the roll-off shows a floor and the fit's floor agrees with
-    it (:func:`._rolloff.floor_choice`), and beside a declared filter (``refine(..., filter=...)``: its shape is
-    fixed, so the floor trades with nothing but white angle noise). Untagged, beside a single pole or a boxcar the
-    term is replaced: there a floor trades with the pole's cutoff, the boxcar's span and white angle noise on the
-    Allan curve (ADIS16405 run 5 gyro_y's boxcar read 1.41 → 1.61 samples with a floor of 0 and white angle noise
-    in its place, run 1 gyro_z's single pole beside a second resonance at 24.5 Hz)."""
+    """Whether the term a bandwidth ``key`` carries keeps its own column beside it — white noise added after the filter
+    (a quantised output's floor; the bandwidth's ``floor``): beside a Butterworth, whose stop band the samples' spectrum
+    shows and a floor is flat in (and a sharp kind, :mod:`allanite.model._sharp`), and beside any other kind whose key
+    carries :data:`FLOOR_TAG` — only where the spectrum above the roll-off shows a floor and the fit's floor agrees with
+    it (:func:`._rolloff.floor_choice`), and beside a declared filter (``refine(..., filter=...)``: its shape is fixed,
+    so the floor trades with nothing but white angle noise). Untagged, beside a single pole or a boxcar the term is
+    replaced: there a floor trades with the pole's cutoff, the boxcar's span and white angle noise on the Allan curve
+    (ADIS16405 run 5 gyro_y's boxcar read 1.41 → 1.61 samples with a floor of 0 and white angle noise in its place, run
+    1 gyro_z's single pole beside a second resonance at 24.5 Hz)."""
     if base_name(key) != "bandwidth":
         return False
     if declared_of(bw_kind(key)) is not None:  # a declared filter: its output's quantisation kept as a floor
         return True
-    return key.endswith(FLOOR_TAG) or butterworth_order(split_notch(bw_kind(key))[0]) > 0  # a notch after it too
+    base = split_notch(bw_kind(key))[0]  # a notch after it too
+    return key.endswith(FLOOR_TAG) or butterworth_order(base) > 0 or sharp_of(base) is not None
 
 
 def term_columns(curve, terms):

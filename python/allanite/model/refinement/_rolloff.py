@@ -47,6 +47,7 @@ from scipy.optimize import nnls
 from ..._scoped import scoped
 from .. import tracing
 from .._counter import sample_lattice
+from .._sharp import sharp_of
 from .._sinc import SINC_ORDERS, sinc_order
 from ..effects import BUTTERWORTH_ORDERS, butterworth_order, filter_autocorrelation, filter_cutoff, split_notch
 from .curvefit import FLOOR_TAG, PROFILE_RHO, Curve, Solution, base_name, bw_kind, column, search, searches, solve
@@ -167,7 +168,7 @@ SPECTRUM_FLOOR = 1.0 / 6.0
 
 def needs_spectrum(kind: str) -> bool:
     """Whether a bandwidth kind is named only where the samples' spectrum shows its roll-off."""
-    return butterworth_order(kind) > 0  # every Butterworth order
+    return butterworth_order(kind) > 0 or sharp_of(kind) is not None  # every Butterworth order, a sharp kind
 
 
 def needs_samples(kind: str) -> bool:
@@ -309,7 +310,8 @@ def floor_choice(curve: Curve, start: tuple, effects: list, best: tuple, specs: 
       1.58 with white angle noise; run 1 gyro_z's single pole beside its 20 Hz resonances)."""
     key, p, sol, _edge = best
     kind = bw_kind(key)
-    if y is None or "N" not in start or key.endswith(FLOOR_TAG):
+    # a sharp kind keeps its floor always, as a Butterworth does; a Butterworth goes on to the lattice reading
+    if y is None or "N" not in start or sharp_of(kind) is not None or key.endswith(FLOOR_TAG):
         return best
     n2 = float(sol.theta[-1])
     if not n2 > 0:
@@ -394,8 +396,8 @@ def better_kind(new, best, tie) -> bool:
     if best[3] != new[3]:
         return False
 
-    def n_par(key, sol):
-        return np.count_nonzero(sol.theta > 0) + ("+" in key)
+    def n_par(key, sol):  # a cascade's boxcar span, a sharp kind's ripple: one parameter more
+        return np.count_nonzero(sol.theta > 0) + ("+" in key) + (sharp_of(bw_kind(key)) is not None)
 
     s_new, s_best = new[2], best[2]
     return s_new.chi2 < s_best.chi2 - tie or (
@@ -470,6 +472,14 @@ def filter_params(kind: str, p: float, fs: float, profile) -> tuple[dict, dict]:
         params, intervals = filter_params(base, p, fs, profile)
         return params | {"filter": f"{params['filter']}+notch", "notch_f": f_n, "notch_q": q}, intervals
     cut = filter_cutoff(kind, p, fs)
+    if sharp_of(kind) is not None:  # searched on its passband edge; its −3 dB cutoff and interval reported beside it
+        e_lo, e_hi = (min(c, fs / 2.0) for c in profile())
+        design, ripple = kind.split(":")
+        params = {"cutoff": cut, "taps": 0, "filter": design, "ripple": float(ripple), "passband_edge": float(p)}
+        return params, {
+            "cutoff": (filter_cutoff(kind, e_lo, fs), filter_cutoff(kind, e_hi, fs)),
+            "passband_edge": (e_lo, e_hi),
+        }
     if kind == "single_pole" or needs_spectrum(kind):  # a Butterworth's f_c ends at f_s/2 (no filter beyond)
         c_int = profile() if kind == "single_pole" else tuple(min(c, fs / 2.0) for c in profile())
         return {"cutoff": cut, "taps": 0, "filter": kind}, {"cutoff": c_int}
