@@ -18,6 +18,10 @@
 4. amplitudes and phases by least squares at the lattice frequencies (:func:`allanite.model.linefit.solve`)
    — on the whole record, or, for a held-out test, on the held-in samples with the frequencies fixed
    (:meth:`LineFamily.refit`).
+
+:func:`hunting_family` gathers, for the removal, the lines of a family whose fundamental hunts (an engine's, a pump's
+idle speed): each harmonic smeared over k·Δf and found as several peaks, which step 2 splits among lattices of close
+"fundamentals"; the tracker (:mod:`allanite.model.wander`) then follows its phase.
 """
 
 from __future__ import annotations
@@ -31,7 +35,7 @@ from scipy.stats import f as f_dist
 from . import linefit, lines, slowline
 from ._recent import Recent
 
-__all__ = ["LineFamily", "periodic_search", "sinusoid_lines"]
+__all__ = ["LineFamily", "hunting_family", "periodic_search", "sinusoid_lines"]
 
 
 @dataclass
@@ -114,6 +118,101 @@ class LineFamily:
         g = self.gens / self.fs
         a, b = _refitted(np.asarray(samples, dtype=np.float64), idx, g, self.coefs)
         return lambda i: _evaluated(np.asarray(i, dtype=np.int64), g, self.coefs, a, b)
+
+
+#: Most orders of a hunting family's lattice (:func:`hunting_family`), as :data:`allanite.model.wander.MAX_ORDERS`.
+HUNT_ORDERS = 16
+
+
+def _clusters(found_lines: list[dict]) -> list[dict]:
+    """The search's lines grouped where their widths overlap (a line whose frequency wanders is found as several
+    peaks across its smear): each cluster's power-weighted centre, half span (its union of widths), power and count."""
+    order = sorted(range(len(found_lines)), key=lambda i: found_lines[i]["f"])
+    out: list[dict] = []
+    for i in order:
+        d = found_lines[i]
+        lo, hi = d["width_hz"]
+        if out and lo <= out[-1]["hi"]:
+            c = out[-1]
+            c["hi"], c["members"] = max(c["hi"], hi), c["members"] + [i]
+        else:
+            out.append({"lo": lo, "hi": hi, "members": [i]})
+    for c in out:
+        amp = np.array([found_lines[i]["amplitude"] for i in c["members"]])
+        f = np.array([found_lines[i]["f"] for i in c["members"]])
+        c["power"] = float(np.max(amp) ** 2)  # the peaks of one smeared line read its power each: not summed
+        c["centre"] = float(np.mean(f)) if f.size > 1 else float(f[0])
+        c["half"] = 0.5 * (c["hi"] - c["lo"])
+    return out
+
+
+def hunting_family(y: np.ndarray, fs: float, search: dict) -> tuple[LineFamily, list] | None:
+    """A harmonic family whose fundamental hunts, as the search left it split: the search's lines clustered where
+    their widths overlap (:func:`_clusters`), a fundamental f0 = centre/k (k ≤ 4) of one cluster taking the most
+    clusters at orders m·f0 within each cluster's half span (the largest f0 among equals: no subharmonic), refined by
+    least squares on the clusters' centres. Offered where it takes two or more clusters and one of them is smeared
+    (two or more peaks): a steady family's lines are single peaks, grouped on their lattice as found. Returns the
+    family (its orders fitted by least squares at fixed frequencies, for the tracker to start from) and the search's
+    families and sinusoids (:class:`LineFamily`) all of whose lines its clusters hold; None otherwise."""
+    found_lines = search["lines"]
+    cl = _clusters(found_lines)
+    if len(cl) < 2 or not any(len(c["members"]) > 1 for c in cl):
+        return None
+    centre = np.array([c["centre"] for c in cl])
+    half = np.array([max(c["half"], 2.0 * fs / y.size) for c in cl])
+    best: tuple | None = None
+    for c in cl:
+        for k in range(1, 5):
+            f0 = c["centre"] / k
+            m = np.round(centre / f0)
+            hit = (m >= 1) & (m <= HUNT_ORDERS) & (np.abs(centre - m * f0) <= half)
+            key = (int(hit.sum()), f0)
+            if best is None or key > best[0]:
+                best = (key, hit, m)
+    assert best is not None
+    (count, f0), hit, m = best
+    if count < 2 or not any(len(cl[i]["members"]) > 1 for i in np.flatnonzero(hit)) or m[hit].max() * f0 >= fs / 2:
+        return None
+    w = np.array([c["power"] for c in cl])[hit]
+    f0 = float(np.sum(w * m[hit] * centre[hit]) / np.sum(w * m[hit] ** 2))
+    orders = m[hit].astype(np.int64)
+    inside = [i for j in np.flatnonzero(hit) for i in cl[j]["members"]]
+    held = set(inside)
+    covered = [u for u in search["families"] + search["sinusoids"] if _held_by(u, found_lines, held)]
+    if len(covered) == 1 and covered[0].gens.size == 1 and covered[0].coefs.shape[0] > 1:
+        return None  # the search's own harmonic family: tracked as found where it wanders
+    coefs = orders[:, None]
+    noise = np.array([min(found_lines[i]["noise"] for i in cl[j]["members"]) for j in np.flatnonzero(hit)])
+    amp = np.array([math.sqrt(cl[j]["power"]) for j in np.flatnonzero(hit)])
+    g, _cov = linefit.refine_generators(y, np.array([f0 / fs]), coefs, _line_var(amp, noise, fs, y.size))
+    # the steady lattice the tracked form must beat at its best fundamental (a crude one leaves an excess that reads
+    # as wander); the cluster centres' where the refinement leaves the smear
+    if not (np.all(np.isfinite(g)) and abs(g[0] * fs - f0) <= float(np.min(half[hit] / m[hit]))):
+        g = np.array([f0 / fs])
+    f0 = float(g[0] * fs)
+    a, b = linefit.solve(y, np.arange(y.size), g, coefs)
+    fam = LineFamily(
+        fs, np.array([f0]), np.full((1, 1), np.nan), coefs, a, b, noise, np.ones(orders.size, dtype=bool), y.size,
+        {
+            "psd_ratio": [float(found_lines[i]["psd_ratio"]) for i in inside],
+            "threshold": float(min(found_lines[i]["threshold"] for i in inside)),
+            "targeted": {"tried": 0, "added": 0},
+            "hunting": [[float(found_lines[i]["f"]) for i in cl[j]["members"]] for j in np.flatnonzero(hit)],
+        },
+    )  # fmt: skip
+    return fam, covered
+
+
+def _held_by(unit: LineFamily, found_lines: list[dict], held: set) -> bool:
+    """Whether every line of ``unit`` that the search flagged is one of the search's lines in ``held``."""
+    found = np.array([d["f"] for d in found_lines])
+    for f, flagged in zip(unit.frequencies, unit.found):
+        if not flagged:
+            continue
+        j = int(np.argmin(np.abs(found - f)))
+        if abs(found[j] - f) > 2 * found_lines[j]["bin_hz"] or j not in held:
+            return False
+    return True
 
 
 #: Amplitudes refitted by :meth:`LineFamily.refit`, by the held-in samples' content, the lattice and the indices

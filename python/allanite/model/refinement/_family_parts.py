@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 
 from .. import linefit, periodic, template
-from ._tracking import heldout_variance_ratio
+from ._tracking import heldout_variance_ratio, tracked
 from .calibrated import tested
 
-__all__ = ["family_out", "folded_waveform", "other_lines", "sinusoid_at"]
+__all__ = ["family_out", "folded_waveform", "hunting", "other_lines", "sinusoid_at"]
 
 
 def sinusoid_at(y: np.ndarray, fs: float, f_hz: float) -> np.ndarray:
@@ -76,3 +76,25 @@ def other_lines(y: np.ndarray, rest) -> np.ndarray | None:
         a, b = linefit.solve(y, idx, g, fam.coefs)
         out += linefit.evaluate(idx, g, fam.coefs, a, b)
     return out
+
+
+def hunting(ctx, search: dict, a: float):
+    """A harmonic family whose fundamental hunts, which the search split among families and sinusoids
+    (:func:`allanite.model.periodic.hunting_family`), removed with its fundamental's phase tracked where the tracker's
+    nested test says it wanders (at its share of ``level``, as any family's) and the tracked form predicts held-out
+    samples better than the same lattice at fixed frequencies: (component, refit, held-out ratio, params, intervals,
+    evidence, family, the search's families and sinusoids it takes); else None (nothing considered: the parts are
+    offered as before)."""
+    got = periodic.hunting_family(ctx.y, ctx.fs, search)
+    if got is None:
+        return None
+    fam, covered = got
+    out = family_out(fam, a, search)
+    done = tracked(ctx, fam, fam.component(), lambda: heldout_variance_ratio(ctx.y, fam.refit), out)
+    if done is None:
+        return None
+    out[2]["hunting"] = {
+        "clusters_hz": fam.evidence["hunting"],
+        "note": "the search's peaks around each harmonic (one line smeared by the hunting) gathered on one lattice",
+    }
+    return (*done, *out, fam, covered)

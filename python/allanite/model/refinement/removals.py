@@ -33,7 +33,9 @@ terms included.
   cycles (a temperature) is its regression, not a line. The search's lone lines go to the ``"sinusoid"`` curve
   candidate (:attr:`RemovalContext.lines`): one search, one share of ``level``; so do the lines of a family whose
   removal is turned down (its phase does not carry across the record: narrowband power, not a line). A lone line
-  whose frequency wanders is removed here instead, a family of one order with its phase tracked.
+  whose frequency wanders is removed here instead, a family of one order with its phase tracked; and first, a family
+  whose fundamental hunts — each harmonic found as several peaks across its smear, which the lattices split — is
+  gathered on one lattice of its fundamental and removed with its phase tracked (:func:`._family_parts.hunting`).
 - ``"telegraph"`` — a rate switching between two levels, its switches decoded and removed (:mod:`._telegraph`).
 
 Removals run before the curve effects (a component left in the samples bends the curve every curve effect is
@@ -53,7 +55,7 @@ from scipy.stats import t as t_dist
 from ...analysis import avar
 from .. import channels, linefit, outliers, periodic, tracing, wander, warmup
 from ._channel_order import strongest_first
-from ._family_parts import family_out, folded_waveform, sinusoid_at
+from ._family_parts import family_out, folded_waveform, hunting, sinusoid_at
 from ._slow_lines import explained_by_channel, slow_line_removal
 from ._telegraph import telegraph_removal
 from ._tracking import heldout_variance_ratio
@@ -446,6 +448,13 @@ def _periodic(ctx: RemovalContext) -> Iterator[Removal]:
     ctx.lines = search
     searched = ctx.y
     families = search["families"]
+    hunt = hunting(ctx, search, a)  # a family whose fundamental hunts, split by the search: one family, tracked
+    if hunt is not None:
+        comp, refit, ratio, params, intervals, evidence, _fam, covered = hunt  # declined: its parts are offered
+        yield Removal("periodic", comp, refit, params, intervals, evidence, 1, heldout_in_time=ratio)
+        if ctx.y is not searched:  # taken: its parts are not offered again
+            families = [f for f in families if not any(f is c for c in covered)]
+            search["sinusoids"] = [f for f in search["sinusoids"] if not any(f is c for c in covered)]
     for i, fam in enumerate(families):
         if ctx.y is not searched:  # a family removed before: this one's amplitudes on what it left
             fam = _refit_family(fam, ctx.y)
