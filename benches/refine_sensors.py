@@ -148,6 +148,8 @@ NOTES = [
     "**r16family** (`--case \"consumer IMU\"` rerun at eb50192, the row and its JSON replaced): a family's folded waveform is now taken on the samples less the other families' lines, so the 0.19 Hz family's fold no longer holds the sideband family's 6.65 Hz line (its 35th harmonic) and the family is removed by its three lines: rms error −0.15 → −0.07 %, χ²/dof 0.903 → 0.849, RMS ADEV 1.97 %, held out 3.484 → 3.486 %; passed as before.",
     "**Rerun whole at 44c3f2f** (the 2026-11-28 late-morning branches merged: r16heldout — the chain's deviance and AIC, keys only —, r16family, r16reson, r16burst; other suites and the false-alarm bench shared the 2 cores, so the CPU column is not a cost measurement): every row's verdict, effects, parameters and words as recorded — 17 of 17.",
     "Rerun whole on 2026-11-28 at 45caf74 (the r17 merges: the alternative chains unified and memoised, the declared filter, the follows check, the channel check's first quadratic, the level test's runs of blocks, the slow-line test's second reading; r17cost2's cheaper arithmetic, equal to 1e-9, was merged after) with 044680b's why_not_kept fix: every row's verdict, effects and unexplained domains as recorded, and every without-candidate flag.",
+    "",
+    "Rerun whole on 2026-11-28 at da6740f (the r18 merges: r18cost's and r18boot's cheaper arithmetic, the sigma-delta's shaped quantisation (r18sdm), a quantised output's floor (r18bartlett), sharp rippled filter kinds (r18sharp), line families whose fundamental hunts (r18hunt); other suites, CI and the false-alarm bench shared the 2 cores, so the CPU column is not a cost measurement): every row's verdict, effects and words as recorded — 17 of 17, without the candidate 17 of 17.",
 ]
 
 
