@@ -390,6 +390,8 @@ NOTES: list = [
     "**Rerun whole at 44c3f2f** (the 2026-11-28 late-morning branches merged: r16heldout — the chain's deviance and AIC, keys only —, r16family, r16reson, r16burst; other suites and the false-alarm bench shared the 2 cores, so the CPU column is not a cost measurement): every row's verdict, effects, parameters and words as recorded — 10 of 11.",
     "**r17nocand: the heater on for a stretch without its candidate** (2026-11-28, `/tmp` driver at c2f778e; load 8–13 on the 2 cores, other helpers' runs beside): still flagged, now as the stretch it is — \"the noise level changes along the record: the Allan deviation at τ₀ within t 6000–11000 s: 1.80× the rest of the record's (44 % off the record's level; held-out error 4.5 %)\" (the level test's runs of blocks, 51.2 against 4.75; recorded: \"1.30× … of t 1…\", a split of the CUSUM's).",
     "Rerun whole on 2026-11-28 at 45caf74 (the r17 merges: the alternative chains unified and memoised, the declared filter, the follows check, the channel check's first quadratic, the level test's runs of blocks, the slow-line test's second reading; r17cost2's cheaper arithmetic, equal to 1e-9, was merged after) with 044680b's why_not_kept fix: every row's verdict, effects and unexplained domains as recorded, and every without-candidate flag.",
+    "",
+    "Rerun whole on 2026-11-28 at da6740f (the r18 merges: r18cost's and r18boot's cheaper arithmetic, the sigma-delta's shaped quantisation (r18sdm), a quantised output's floor (r18bartlett), sharp rippled filter kinds (r18sharp), line families whose fundamental hunts (r18hunt); other suites, CI and the false-alarm bench shared the 2 cores, so the CPU column is not a cost measurement): every row's verdict and effects as recorded — 10 of 11.",
 ]
 
 
