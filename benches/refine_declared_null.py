@@ -149,6 +149,7 @@ NOTES: list = [
     "whose kind is in the family). Stand-ins (a resonance or Gauss–Markov term added): 10 records → 2 (Chebyshev "
     "records 6 and 26). Later commits on the branch (a ripple near its range's ends marked at the edge; a sharp "
     "kind a notch's base only where chosen) were not rerun here.",
+    "Rerun whole at da6740f (2026-11-28, every r18 branch merged: r18sharp's sharp kinds and r18bartlett's quantised output floor together; other processes 94 % of the CPUs): declared 0 of 40 as before; the default call alarms on **10 of 40** (12.7–41.2 %) — the elliptic 0 of 10 and the quantised Bartlett 0 of 10 (r18bartlett: its floor the quantiser's exact one; 3 of 10 at r18sharp's run, which had not that fix), the remez FIR 1 of 10, and the Chebyshev decimated by 4 still 9 of 10: its edge sits near the output's Nyquist, where no Butterworth order agrees with the spectrum, so the sharp kinds' gate stays closed and the curve is said to depart (honest; the taps declared pass). Before the r18 branches: 28 of 40.",
 ]
 
 
