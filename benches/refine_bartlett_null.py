@@ -183,6 +183,7 @@ NOTES: list = [
     "sinc⁵ at a fine step, 0.28 σ: the floor gate is not entered; not traced) and 22 (a resonance beside a 7-tap "
     "average at 0.38 σ, 9·10⁵ samples: not traced). Kinds still not the filter's own: sinc⁵ for three Bartletts "
     "(cutoff within 3 %), Butterworth 2 for two at steps of 2.4–2.5 σ.",
+    "Rerun at da6740f (2026-11-28, every r18 branch merged — r18sharp's sharp kinds beside this floor; other processes 87 % of the CPUs, 702 s): every record's alarm, found effects, kind and cutoff verdict as above (3 of 40 alarms, 35 of 40 kinds right); the recorded JSON is the branch's run.",
 ]
 
 
