@@ -23,7 +23,7 @@ import numpy as np
 from .._sharp import RIPPLE_RANGE, SHARP_DESIGNS, SHARP_RIPPLES, sharp_kind
 from ._brent import bounded
 from ._rolloff import spectrum_agrees
-from .curvefit import PROFILE_RHO, Curve, bw_kind, searches
+from .curvefit import PROFILE_RHO, Curve, bw_kind, profile_crossings, searches
 
 __all__ = ["sharp_searched", "sharp_kinds", "near_grid", "ripple_interval", "RIPPLE_XTOL", "NEAR", "NEAR_NYQUIST"]
 
@@ -152,19 +152,6 @@ def ripple_interval(curve: Curve, start: tuple, effects: list, kind: str, p: flo
     specs = [(f"bandwidth:{sharp_kind(design, math.copysign(r, r0))}", near, True) for r in local]
     chi2 = np.array([res[1].chi2 for res in searches(curve, start, effects, specs)])
     scale = curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / curve.tau.size
-    d = (chi2 - chi2.min()) * scale - 1.0
-    i0 = int(np.argmin(d))
-    lo_i, hi_i = i0, i0
-    while lo_i > 0 and d[lo_i - 1] <= 0:
-        lo_i -= 1
-    while hi_i < local.size - 1 and d[hi_i + 1] <= 0:
-        hi_i += 1
-    ll = np.log(local)
-
-    def cross(i: int, j: int) -> float:
-        return math.exp(ll[i] + (ll[j] - ll[i]) * (-d[i]) / (d[j] - d[i]))
-
-    lo = cross(lo_i, lo_i - 1) if lo_i > 0 else float(local[0])
-    hi = cross(hi_i, hi_i + 1) if hi_i < local.size - 1 else float(local[-1])
+    lo, hi = profile_crossings(local, (chi2 - chi2.min()) * scale - 1.0)
     lo, hi = min(lo, abs(r0)), max(hi, abs(r0))
     return (lo, hi) if r0 > 0 else (-hi, -lo)

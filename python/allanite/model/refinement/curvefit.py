@@ -62,6 +62,7 @@ __all__ = [
     "searches",
     "chi2s_of",
     "profile_interval",
+    "profile_crossings",
     "PROFILE_RHO",
     "upper_theta",
     "theta_terms",
@@ -286,7 +287,13 @@ def profile_interval(curve, terms, effects, key, p, sol):
     scale = curve.n_eff * (1 - PROFILE_RHO) / (1 + PROFILE_RHO) / curve.tau.size
     local = p * np.exp(np.linspace(-1.5, 1.5, 41))
     lc = chi2s(curve, terms, effects, key, local)
-    d = (lc - min(sol.chi2, lc.min())) * scale - 1.0
+    lo, hi = profile_crossings(local, (lc - min(sol.chi2, lc.min())) * scale - 1.0)
+    return (min(lo, p), max(hi, p))
+
+
+def profile_crossings(local: np.ndarray, d: np.ndarray) -> tuple[float, float]:
+    """Where the scaled profile ``d`` (≤ 0 inside the interval) crosses 0 on either side of its least value,
+    interpolated in log-parameter over the ascending grid ``local``; the grid's end where it never does."""
     i0 = int(np.argmin(d))
     lo_i, hi_i = i0, i0
     while lo_i > 0 and d[lo_i - 1] <= 0:
@@ -300,4 +307,4 @@ def profile_interval(curve, terms, effects, key, p, sol):
 
     lo = cross(lo_i, lo_i - 1) if lo_i > 0 else float(local[0])
     hi = cross(hi_i, hi_i + 1) if hi_i < local.size - 1 else float(local[-1])
-    return (min(lo, p), max(hi, p))
+    return lo, hi
